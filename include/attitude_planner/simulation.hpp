@@ -1,0 +1,35 @@
+// Simulation entry point: integrate the discrete rigid body under a given torque sequence.
+// The tracker node, the CLI `simulate` tool and the benchmarks all call this.
+#pragma once
+
+#include <vector>
+
+#include "attitude_planner/discrete_scheme.hpp"
+#include "attitude_planner/maneuver.hpp"
+
+namespace attitude_planner {
+
+/// Initial data and torques of a simulation.
+struct SimulationInput {
+  Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
+  Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s]
+  std::vector<Vector3> torque;  ///< τ_k [N·m], k = 0..N; τ_0 and τ_N must be zero (seed eq. 18)
+};
+
+/// Figures of merit of a simulation.
+struct SimulationReport {
+  int max_step_iterations = 0;       ///< worst Newton count of the implicit step
+  double max_step_residual = 0.0;    ///< worst |μ(F_k) − p_k| [N·m·s]
+};
+
+/// Integrates R_{k+1} = R_k F_k, μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h τ_k for k = 1..N−1.
+/// N = torque.size() − 1 ≥ 1. Attitudes are re-orthonormalized each step (one Newton–Schulz
+/// iteration) so they stay on SO(3) to round-off over millions of steps.
+/// Throws StepTooLarge (naming the step) if an implicit step fails, InvalidInput on bad input.
+Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
+                  SimulationReport* report = nullptr);
+
+/// One Newton–Schulz step towards the nearest rotation: R (3I − RᵀR)/2.
+Matrix3 reorthonormalize(const Matrix3& R);
+
+}  // namespace attitude_planner

@@ -1,0 +1,66 @@
+# Shared set-up for scripts/demo, scripts/test and friends (sourced, not run).
+# Installs the Debian packages the package needs (only those missing), keeps the catkin
+# workspace in <repo>/.ws (gitignored) and keeps ROS_HOME and logs inside it.
+set -euo pipefail
+
+REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+WS_DIR="$REPO_DIR/.ws"
+BUILD_TYPE="${BUILD_TYPE:-Release}"
+
+# Debian bookworm ships ROS 1 (ros_comm 1.15); rosdep cannot reach its index, so list apt packages.
+DEBIAN_PACKAGES=(
+  build-essential cmake catkin python3-catkin-pkg python3-rospkg
+  libroscpp-dev ros-message-generation ros-message-runtime
+  libstd-msgs-dev libgeometry-msgs-dev libvisualization-msgs-dev libactionlib-msgs-dev
+  libtf2-ros-dev libtf2-geometry-msgs-dev tf2-tools libactionlib-dev python3-actionlib
+  librosbag-dev python3-rosbag librostest-dev python3-rostest rosbash rosout python3-roslaunch
+  libeigen3-dev libnlopt-cxx-dev libyaml-cpp-dev libboost-math-dev libgtest-dev
+  python3-numpy python3-matplotlib python3-yaml
+)
+
+log() { printf '[attitude_planner] %s\n' "$*" >&2; }
+
+install_debian_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -eq 0 ]; then return 0; fi
+  log "installing Debian packages: ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# The pyenv python3 on PATH has no ROS modules: pin the system interpreter for catkin and rostest.
+setup_ros_env() {
+  export PYENV_VERSION=system
+  export PATH="/usr/bin:$PATH"
+  export ROS_HOME="$WS_DIR/ros_home"
+  export ROS_LOG_DIR="$ROS_HOME/log"
+  mkdir -p "$ROS_LOG_DIR"
+}
+
+build_workspace() {
+  setup_ros_env
+  mkdir -p "$WS_DIR/src"
+  # The repository root is the package; the workspace sees it through a symlink.
+  [ -L "$WS_DIR/src/attitude_planner" ] || ln -sfn "$REPO_DIR" "$WS_DIR/src/attitude_planner"
+  log "building ($BUILD_TYPE) in $WS_DIR"
+  (cd "$WS_DIR" && catkin_make -DCMAKE_BUILD_TYPE="$BUILD_TYPE" \
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" "$@" >"$WS_DIR/build.log" 2>&1) \
+    || { tail -n 60 "$WS_DIR/build.log"; log "build failed (full log: $WS_DIR/build.log)"; return 1; }
+  source_workspace
+}
+
+source_workspace() {
+  setup_ros_env
+  set +u
+  # shellcheck disable=SC1091
+  source "$WS_DIR/devel/setup.bash"
+  set -u
+  export ROS_HOME="$WS_DIR/ros_home"
+  export ROS_LOG_DIR="$ROS_HOME/log"
+}

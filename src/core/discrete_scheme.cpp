@@ -1,0 +1,101 @@
+#include "attitude_planner/discrete_scheme.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <sstream>
+
+namespace attitude_planner {
+
+std::string schemeName(SchemeKind kind) {
+  return kind == SchemeKind::Paper ? "paper" : "variational";
+}
+
+SchemeKind parseSchemeName(const std::string& name) {
+  if (name == "paper") return SchemeKind::Paper;
+  if (name == "variational") return SchemeKind::Variational;
+  throw InvalidInput("scheme: unknown value '" + name + "' (expected paper or variational)");
+}
+
+DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step)
+    : kind_(kind), J_(inertia), J_inverse_(inertia.inverse()), h_(time_step) {
+  Jd_ = 0.5 * J_.trace() * Matrix3::Identity() - J_;
+}
+
+Vector3 DiscreteScheme::velocity(const Matrix3& F) const {
+  if (kind_ == SchemeKind::Paper) return so3::log(F) / h_;
+  return J_inverse_ * momentum<double>(F);
+}
+
+Matrix3 DiscreteScheme::stepFromVelocity(const Vector3& omega) const {
+  if (kind_ == SchemeKind::Paper) {
+    if (h_ * omega.norm() >= M_PI) {
+      std::ostringstream msg;
+      msg << "step too large, increase steps: h*|Omega| = " << h_ * omega.norm()
+          << " rad >= pi (one step may not rotate by more than pi)";
+      throw StepTooLarge(msg.str());
+    }
+    return so3::exp(Vector3(h_ * omega));
+  }
+  StepSolveReport report;
+  const Vector3 p = J_ * omega;
+  const Matrix3 F = solveStep(p, so3::exp(Vector3(h_ * omega)), &report);
+  if (!report.converged) {
+    std::ostringstream msg;
+    msg << "step too large, increase steps: no step with velocity |Omega| = " << omega.norm()
+        << " rad/s at h = " << h_ << " s (residual " << report.residual << ")";
+    throw StepTooLarge(msg.str());
+  }
+  return F;
+}
+
+Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
+                                  StepSolveReport* report) const {
+  constexpr int kMaxIterations = 60;
+  Matrix3 F = guess;
+  Vector3 r = momentum<double>(F) - p;
+  double r_norm = r.norm();
+  auto tolerance = [&](const Matrix3& G) {
+    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-300;
+  };
+  report->converged = false;
+  int stalled = 0;
+  int it = 0;
+  for (; it < kMaxIterations; ++it) {
+    if (r_norm <= tolerance(F)) {
+      report->converged = true;
+      break;
+    }
+    const Matrix3 D = momentumJacobian<double>(F);
+    Eigen::FullPivLU<Matrix3> lu(D);
+    if (!lu.isInvertible()) break;
+    Vector3 delta = -lu.solve(r);
+    if (!delta.allFinite()) break;
+    // Backtracking on |μ(F) − p| keeps the iteration inside the region where a solution exists.
+    double step = 1.0;
+    bool improved = false;
+    for (int back = 0; back < 30; ++back) {
+      const Matrix3 trial = F * so3::exp(Vector3(step * delta));
+      const Vector3 r_trial = momentum<double>(trial) - p;
+      if (r_trial.allFinite() && r_trial.norm() < r_norm) {
+        F = trial;
+        r = r_trial;
+        r_norm = r_trial.norm();
+        improved = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!improved) {
+      // Round-off floor: accept if already within 100× the tolerance.
+      if (r_norm <= 100.0 * tolerance(F)) report->converged = true;
+      break;
+    }
+    if (step < 1.0 && ++stalled > 40) break;
+  }
+  report->iterations = it;
+  report->residual = (momentum<double>(F) - p).norm();
+  if (!report->converged && report->residual <= tolerance(F)) report->converged = true;
+  return F;
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,58 @@
+#include "attitude_planner/simulation.hpp"
+
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+Matrix3 reorthonormalize(const Matrix3& R) {
+  return 0.5 * R * (3.0 * Matrix3::Identity() - R.transpose() * R);
+}
+
+Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
+                  SimulationReport* report) {
+  const int N = static_cast<int>(input.torque.size()) - 1;
+  if (N < 1) throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
+                                std::to_string(input.torque.size()));
+  if (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0)) {
+    throw InvalidInput("torque: tau_0 and tau_N must be zero (they do not enter eq. (18))");
+  }
+  const double h = scheme.timeStep();
+  Maneuver m;
+  m.time_step = h;
+  m.time.resize(N + 1);
+  m.attitude.resize(N + 1);
+  m.angular_velocity.resize(N + 1);
+  m.torque = input.torque;
+  for (int k = 0; k <= N; ++k) m.time[k] = k * h;
+
+  SimulationReport local;
+  Matrix3 F = scheme.stepFromVelocity(input.initial_velocity);  // F_0
+  m.attitude[0] = input.initial_attitude;
+  m.attitude[1] = reorthonormalize(input.initial_attitude * F);
+  m.angular_velocity[0] = input.initial_velocity;
+  Vector3 carried = F.transpose() * scheme.momentum<double>(F);  // F_{k−1}ᵀ μ(F_{k−1})
+  for (int k = 1; k < N; ++k) {
+    const Vector3 p = carried + h * input.torque[k];
+    StepSolveReport step;
+    F = scheme.solveStep(p, F, &step);
+    if (!step.converged) {
+      std::ostringstream msg;
+      msg << "step too large, increase steps: implicit step k = " << k
+          << " did not converge (|p| = " << p.norm() << " N m s, h = " << h
+          << " s, residual " << step.residual << ")";
+      throw StepTooLarge(msg.str());
+    }
+    local.max_step_iterations = std::max(local.max_step_iterations, step.iterations);
+    local.max_step_residual = std::max(local.max_step_residual, step.residual);
+    m.attitude[k + 1] = reorthonormalize(m.attitude[k] * F);
+    m.angular_velocity[k] = scheme.velocity(F);
+    carried = F.transpose() * scheme.momentum<double>(F);
+  }
+  m.angular_velocity[N] = m.angular_velocity[N - 1];
+  if (report) *report = local;
+  return m;
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,74 @@
+// The one entry point for planning a fully actuated maneuver: the CLI `plan_maneuver`, the planner
+// node and the benchmarks all call planManeuver().
+//
+// Problem (seed 000, Problem 3.2): minimize Σ_{k=1}^{N−1} ½|τ_k|² subject to the discrete dynamics
+// of the chosen scheme (discrete_scheme.hpp) and the boundary data R_0, Ω_0, R_N, Ω_{N−1}.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/discrete_scheme.hpp"
+#include "attitude_planner/maneuver.hpp"
+
+namespace attitude_planner {
+
+/// A rest-to-rest / slew problem for the fully actuated rigid body.
+struct PlanningProblem {
+  Matrix3 inertia = Matrix3::Identity();           ///< J [kg·m²], body frame, SPD
+  double duration = 1.0;                           ///< T [s]
+  int steps = 64;                                  ///< N (h = T/N)
+  Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
+  Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s], body
+  Matrix3 final_attitude = Matrix3::Identity();    ///< R_N
+  Vector3 final_velocity = Vector3::Zero();        ///< Ω_{N−1} [rad/s], body
+  SchemeKind scheme = SchemeKind::Paper;
+};
+
+/// Progress of one iteration, for feedback (action) and logging.
+struct IterationInfo {
+  int iteration = 0;
+  double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
+  double gradient_norm = 0.0;  ///< max-norm of the first-order optimality residual
+  double step_length = 0.0;    ///< line-search step accepted
+};
+
+/// Solver settings. Defaults solve to round-off on the seed's examples.
+struct SolverOptions {
+  std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
+  double tolerance = 1e-10;       ///< on the scaled optimality residual (see PlanResult)
+  int max_iterations = 200;
+  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  /// Called after every iteration; return false to cancel (the result says "cancelled").
+  std::function<bool(const IterationInfo&)> on_iteration;
+  /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
+  const Maneuver* warm_start = nullptr;
+};
+
+/// What a solve returns. `converged` is false with a reason in `message` otherwise.
+struct PlanResult {
+  bool converged = false;
+  std::string message;       ///< human-readable outcome ("converged", or why not)
+  std::string solver;        ///< "newton" or "nlopt"
+  SchemeKind scheme = SchemeKind::Paper;
+  Maneuver maneuver;         ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;         ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  int iterations = 0;
+  double max_residual = 0.0;             ///< max-norm of the optimality residual at the end
+  double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
+  double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
+  double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
+  double solve_time_s = 0.0;             ///< wall time [s]
+  std::vector<IterationInfo> history;    ///< one entry per iteration
+};
+
+/// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws
+/// InvalidInput naming the field and the value.
+void validateProblem(const PlanningProblem& problem);
+
+/// Plans the maneuver. Throws InvalidInput for a bad problem; never throws for a solve that
+/// does not converge (PlanResult::converged = false says so, with the reason).
+PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options = {});
+
+}  // namespace attitude_planner

@@ -72,3 +72,14 @@ void validateProblem(const PlanningProblem& problem);
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options = {});
 
 }  // namespace attitude_planner
+
+namespace attitude_planner {
+
+/// Replays τ_1..τ_{N−1} (torque[k], k = 0..N, τ_0 = τ_N = 0) through the problem's scheme from
+/// R_0, Ω_0 and fills result->maneuver, cost, dynamics_residual and the terminal errors.
+/// Both solvers finish through here, so every reported figure is measured on the same replay.
+/// Throws StepTooLarge if the replay's implicit step fails.
+void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
+                  PlanResult* result);
+
+}  // namespace attitude_planner

@@ -1,0 +1,17 @@
+// The solvers behind planManeuver(). Call planManeuver() rather than these directly: it
+// validates the problem, times the solve and fills the common figures.
+#pragma once
+
+#include "attitude_planner/planner.hpp"
+
+namespace attitude_planner {
+
+/// Newton's method on the first-order optimality conditions, O(N) per iteration
+/// (newton_solver.cpp). Fills everything but solve_time_s.
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options);
+
+/// Independent cross-check: NLopt on the direct method (τ_1..τ_{N−1} as variables, equality
+/// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
+PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);
+
+}  // namespace attitude_planner

@@ -1,0 +1,62 @@
+#include <Eigen/Eigenvalues>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+std::string str(const Eigen::MatrixXd& m) {
+  std::ostringstream s;
+  s << m.format(Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "",
+                                "[", "]"));
+  return s.str();
+}
+
+void requireFinite(const Eigen::MatrixXd& m, const std::string& field) {
+  if (!m.allFinite()) throw InvalidInput(field + ": not finite: " + str(m));
+}
+
+void requireRotation(const Matrix3& R, const std::string& field) {
+  requireFinite(R, field);
+  if (so3::orthogonalityError(R) > 1e-9) {
+    throw InvalidInput(field + ": not a rotation matrix (|R^T R - I| + |det R - 1| = " +
+                       std::to_string(so3::orthogonalityError(R)) + ")");
+  }
+}
+
+}  // namespace
+
+void validateProblem(const PlanningProblem& p) {
+  requireFinite(p.inertia, "inertia");
+  if ((p.inertia - p.inertia.transpose()).cwiseAbs().maxCoeff() >
+      1e-12 * p.inertia.cwiseAbs().maxCoeff()) {
+    throw InvalidInput("inertia: not symmetric: " + str(p.inertia));
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(p.inertia);
+  const Vector3 moments = eig.eigenvalues();  // ascending
+  if (!(moments(0) > 0.0)) {
+    throw InvalidInput("inertia: not positive definite (principal moments " +
+                       str(moments.transpose()) + ")");
+  }
+  if (moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
+    throw InvalidInput("inertia: principal moments " + str(moments.transpose()) +
+                       " violate the triangle inequality J1 + J2 >= J3 (no rigid body has them)");
+  }
+  if (moments(2) / moments(0) > 1e12) {
+    throw InvalidInput("inertia: condition number " + std::to_string(moments(2) / moments(0)) +
+                       " > 1e12");
+  }
+  if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
+    throw InvalidInput("duration: must be a finite number > 0 s, got " + std::to_string(p.duration));
+  }
+  if (p.steps < 4) throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
+  requireRotation(p.initial_attitude, "initial.attitude");
+  requireRotation(p.final_attitude, "final.attitude");
+  requireFinite(p.initial_velocity, "initial.angular_velocity");
+  requireFinite(p.final_velocity, "final.angular_velocity");
+}
+
+}  // namespace attitude_planner

@@ -39,7 +39,7 @@ struct SolverOptions {
   std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
   double tolerance = 1e-10;       ///< on the scaled optimality residual (see PlanResult)
   int max_iterations = 200;
-  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
   /// Called after every iteration; return false to cancel (the result says "cancelled").
   std::function<bool(const IterationInfo&)> on_iteration;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
@@ -49,11 +49,11 @@ struct SolverOptions {
 /// What a solve returns. `converged` is false with a reason in `message` otherwise.
 struct PlanResult {
   bool converged = false;
-  std::string message;       ///< human-readable outcome ("converged", or why not)
-  std::string solver;        ///< "newton" or "nlopt"
+  std::string message;  ///< human-readable outcome ("converged", or why not)
+  std::string solver;   ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;         ///< R_k, Ω_k, τ_k, k = 0..N
-  double cost = 0.0;         ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  Maneuver maneuver;  ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;  ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
   int iterations = 0;
   double max_residual = 0.0;             ///< max-norm of the optimality residual at the end
   double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]

@@ -10,8 +10,8 @@ namespace {
 
 std::string str(const Eigen::MatrixXd& m) {
   std::ostringstream s;
-  s << m.format(Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "",
-                                "[", "]"));
+  s << m.format(
+      Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "", "[", "]"));
   return s.str();
 }
 
@@ -50,7 +50,8 @@ void validateProblem(const PlanningProblem& p) {
                        " > 1e12");
   }
   if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
-    throw InvalidInput("duration: must be a finite number > 0 s, got " + std::to_string(p.duration));
+    throw InvalidInput("duration: must be a finite number > 0 s, got " +
+                       std::to_string(p.duration));
   }
   if (p.steps < 4) throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
   requireRotation(p.initial_attitude, "initial.attitude");

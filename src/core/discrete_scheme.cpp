@@ -57,7 +57,8 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
   Vector3 r = momentum<double>(F) - p;
   double r_norm = r.norm();
   auto tolerance = [&](const Matrix3& G) {
-    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-300;
+    // relative part, plus the absolute round-off floor of evaluating μ (≈ eps·‖J‖/h at any F)
+    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-15 * J_.norm() / h_;
   };
   report->converged = false;
   int polish_steps = 0;

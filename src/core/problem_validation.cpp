@@ -41,9 +41,11 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("inertia: not positive definite (principal moments " +
                        str(moments.transpose()) + ")");
   }
-  if (moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
-    throw InvalidInput("inertia: principal moments " + str(moments.transpose()) +
-                       " violate the triangle inequality J1 + J2 >= J3 (no rigid body has them)");
+  if (!p.allow_nonphysical_inertia && moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
+    throw InvalidInput(
+        "inertia: principal moments " + str(moments.transpose()) +
+        " violate the triangle inequality J1 + J2 >= J3 (no rigid body has them; set "
+        "allow_nonphysical_inertia to plan anyway)");
   }
   if (moments(2) / moments(0) > 1e12) {
     throw InvalidInput("inertia: condition number " + std::to_string(moments(2) / moments(0)) +

@@ -136,6 +136,18 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
     result.message = std::string("replay of the planned torques failed: ") + e.what();
     return result;
   }
+  // The replay is the final judge: stationarity of the reduced problem means nothing if the
+  // torques, integrated forward, do not land on the target (e.g. an implicit step that jumped to
+  // another branch of μ(F) = p when h|Ω| is large).
+  const double miss = std::max(result.terminal_attitude_error, result.terminal_velocity_error);
+  const double allowed_miss = 1e-9 * std::max(1.0, N * 1e-4);
+  if (converged && !(miss <= allowed_miss)) {
+    converged = false;
+    std::ostringstream why;
+    why << "stationary point found, but replaying its torques misses the target by " << miss
+        << " (step too large for this h? increase steps)";
+    reason = why.str();
+  }
   result.converged = converged;
   std::ostringstream msg;
   msg << reason << " after " << iteration << " iterations (relative gradient " << relative_gradient

@@ -55,9 +55,9 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("inertia: not positive definite: " + str(p.inertia) +
                        " (principal moments " + str(moments.transpose()) + ")");
   }
-  // The triangle inequality J1 + J2 >= J3 is NOT required here: the discrete dynamics are
-  // well posed for every SPD J, and the seed's own example inertia (moments 3.15, 12.54, 32.19)
-  // violates it. Scenes check it (requirePhysicalInertia) unless they opt out explicitly.
+  // The discrete dynamics are well posed for every SPD J, and the seed's own example inertia
+  // (moments 3.15, 12.54, 32.19) violates J1 + J2 >= J3: the check is skipped only on request.
+  if (!p.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
   if (moments(2) / moments(0) > 1e12) {
     throw InvalidInput("inertia: condition number " + num(moments(2) / moments(0)) + " of " +
                        str(p.inertia) + " > 1e12");

@@ -114,6 +114,7 @@ class SceneParser {
       scene.allow_nonphysical_inertia =
           boolean(root["allow_nonphysical_inertia"], "allow_nonphysical_inertia");
     }
+    p.allow_nonphysical_inertia = scene.allow_nonphysical_inertia;
 
     // Physical checks (SPD inertia, T > 0, N range, ...) live in validateProblem, shared with the
     // planner node; here they gain the file name and the line of the key they name.

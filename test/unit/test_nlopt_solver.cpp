@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <random>
 
 #include "attitude_planner/direct_method.hpp"
@@ -158,6 +159,7 @@ INSTANTIATE_TEST_SUITE_P(
                       SeedCase{"rest_to_rest.yaml", 32, ap::SchemeKind::Paper},
                       SeedCase{"slew_up.yaml", 16, ap::SchemeKind::Paper},
                       SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Paper},
+                      SeedCase{"rest_to_rest.yaml", 16, ap::SchemeKind::Variational},
                       SeedCase{"slew_up.yaml", 16, ap::SchemeKind::Variational},
                       SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Variational}),
     [](const auto& info) {
@@ -166,19 +168,6 @@ INSTANTIATE_TEST_SUITE_P(
              ap::schemeName(info.param.scheme);
       return name;
     });
-
-// Disabled until DiscreteScheme::solveStep's tolerance has an absolute floor: as p_{N−1} → 0 (end
-// at rest) its tolerance 1e-14·|p| falls below the round-off of μ(F) (~ε‖J‖/h) and the replay
-// throws StepTooLarge at k = N−1 although the residual is ~1e-15. Passes with that fix.
-TEST(NloptSolver, DISABLED_VariationalRestToRestReachesAFeasiblePoint) {
-  const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 16, ap::SchemeKind::Variational);
-  ap::SolverOptions options;
-  options.solver = "nlopt";
-  options.max_iterations = 2000;
-  const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_TRUE(r.converged) << r.message;
-  EXPECT_LE(r.terminal_attitude_error, 1e-10) << r.message;
-}
 
 TEST(NloptSolver, CancellationStopsAndIsReported) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 16, ap::SchemeKind::Paper);
@@ -202,3 +191,52 @@ TEST(NloptSolver, IterationLimitIsHonoredAndNotConverged) {
   EXPECT_LE(r.iterations, 3);
   EXPECT_NE(r.message.find("NLOPT_MAXEVAL_REACHED"), std::string::npos) << r.message;
 }
+
+namespace {
+
+class CrossCheck : public ::testing::TestWithParam<SeedCase> {};
+
+}  // namespace
+
+// The two solvers share only the dynamics and the replay: Newton on the optimality conditions
+// (newton_solver.cpp) and SLSQP on the direct method must find the same optimum.
+TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
+  const SeedCase sc = GetParam();
+  const ap::PlanningProblem p = seedProblem(sc.scene, sc.steps, sc.scheme);
+  ap::SolverOptions newton_options;
+  newton_options.solver = "newton";
+  const ap::PlanResult newton = ap::planManeuver(p, newton_options);
+  ap::SolverOptions nlopt_options;
+  nlopt_options.solver = "nlopt";
+  nlopt_options.max_iterations = 2000;
+  const ap::PlanResult nlopt = ap::planManeuver(p, nlopt_options);
+  ASSERT_TRUE(newton.converged) << newton.message;
+  ASSERT_TRUE(nlopt.converged) << nlopt.message;
+  EXPECT_NEAR(nlopt.cost, newton.cost, 1e-8 * newton.cost);
+  double torque_scale = 0.0, torque_difference = 0.0;
+  for (int k = 0; k <= p.steps; ++k) {
+    torque_scale = std::max(torque_scale, newton.maneuver.torque[k].cwiseAbs().maxCoeff());
+    torque_difference =
+        std::max(torque_difference,
+                 (newton.maneuver.torque[k] - nlopt.maneuver.torque[k]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(torque_difference, 1e-6 * torque_scale)
+      << "newton cost " << newton.cost << ", nlopt cost " << nlopt.cost;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Seed, CrossCheck,
+    ::testing::Values(SeedCase{"rest_to_rest.yaml", 16, ap::SchemeKind::Paper},
+                      SeedCase{"rest_to_rest.yaml", 32, ap::SchemeKind::Paper},
+                      SeedCase{"rest_to_rest.yaml", 64, ap::SchemeKind::Paper},
+                      SeedCase{"slew_up.yaml", 16, ap::SchemeKind::Paper},
+                      SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Paper},
+                      SeedCase{"slew_up.yaml", 64, ap::SchemeKind::Paper},
+                      SeedCase{"rest_to_rest.yaml", 32, ap::SchemeKind::Variational},
+                      SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Variational}),
+    [](const auto& info) {
+      std::string name = info.param.scene;
+      name = name.substr(0, name.find('.')) + "_N" + std::to_string(info.param.steps) + "_" +
+             ap::schemeName(info.param.scheme);
+      return name;
+    });

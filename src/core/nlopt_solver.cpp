@@ -21,6 +21,10 @@ constexpr double kConstraintTolerance = 1e-10;
 /// that a "success" return leaves margin.
 constexpr double kNloptConstraintTolerance = 1e-13;
 
+/// Largest N the cross-check accepts: SLSQP is dense (O(n²) memory, O(n³) time per iteration in
+/// n = 3(N − 1) unknowns), ~3.4 s at N = 128 here; N = 1024 already needs ~100 MB and hours.
+constexpr int kMaxNloptSteps = 1024;
+
 /// Constraint value [rad], [rad/s] reported for a trial point whose simulation fails: far larger
 /// than any real miss (≤ π rad), finite so that SLSQP's merit function stays meaningful.
 constexpr double kFailedSimulationMiss = 1e3;
@@ -118,6 +122,17 @@ void constraints(unsigned m, double* result, unsigned n, const double* x_raw, do
 
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options) {
   const int N = problem.steps;
+  if (N > kMaxNloptSteps) {
+    PlanResult refused;
+    refused.solver = "nlopt";
+    refused.scheme = problem.scheme;
+    refused.message =
+        "not converged; nlopt cross-check is dense (O(N^2) memory, O(N^3) time): "
+        "steps " +
+        std::to_string(N) + " > " + std::to_string(kMaxNloptSteps) +
+        " refused; use the newton solver";
+    return refused;
+  }
   const unsigned n = 3u * static_cast<unsigned>(N - 1);
 
   // Initial guess: zero torques (SLSQP's first QP is then the linearized minimum-norm transfer),

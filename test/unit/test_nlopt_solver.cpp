@@ -240,3 +240,12 @@ INSTANTIATE_TEST_SUITE_P(
              ap::schemeName(info.param.scheme);
       return name;
     });
+
+TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
+  const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 5000, ap::SchemeKind::Paper);
+  ap::SolverOptions options;
+  options.solver = "nlopt";
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  EXPECT_FALSE(r.converged);
+  EXPECT_NE(r.message.find("steps 5000 > 1024"), std::string::npos) << r.message;
+}

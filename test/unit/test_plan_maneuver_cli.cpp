@@ -112,6 +112,20 @@ TEST_F(CliTest, NloptPlanWritesCsvAndSummaryAndExitsZero) {
   EXPECT_CONTAINS(miss.output, "exceeds --max-miss");
 }
 
+TEST_F(CliTest, DefaultSolverPlansBothShippedScenesAtTheirOwnSteps) {
+  for (const std::string scene : {"rest_to_rest", "slew_up"}) {
+    const std::string json = dir_ + "/" + scene + ".json";
+    const ToolRun r = run("plan_maneuver", kScenes + scene + ".yaml --summary " + json);
+    EXPECT_EQ(r.status, 0) << r.output;
+    const std::string summary = readFile(json);
+    EXPECT_CONTAINS(summary, "\"converged\": true");
+    EXPECT_CONTAINS(summary, "\"solver\": \"newton\"");
+    EXPECT_CONTAINS(summary, "\"steps\": 128");
+    const std::size_t at = summary.find("\"terminal_attitude_error\": ") + 27;
+    EXPECT_LT(std::stod(summary.substr(at)), 1e-10) << summary;
+  }
+}
+
 TEST_F(CliTest, ExitStatusAgreesWithConvergedForEverySolver) {
   for (const std::string solver : {"newton", "nlopt"}) {
     const std::string json = dir_ + "/" + solver + ".json";

@@ -249,3 +249,14 @@ TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   EXPECT_FALSE(r.converged);
   EXPECT_NE(r.message.find("steps 5000 > 1024"), std::string::npos) << r.message;
 }
+
+TEST(NloptSolver, ExhaustedTimeBudgetIsNotConvergence) {
+  // A budget no solve can meet (1 ns): the result must say so rather than claim convergence.
+  const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 32, ap::SchemeKind::Paper);
+  ap::SolverOptions options;
+  options.solver = "nlopt";
+  options.time_budget_s = 1e-9;
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  EXPECT_FALSE(r.converged);
+  EXPECT_NE(r.message.find("NLOPT_MAXTIME_REACHED"), std::string::npos) << r.message;
+}

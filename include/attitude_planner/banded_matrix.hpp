@@ -34,3 +34,27 @@ class BandedSymmetricMatrix {
 };
 
 }  // namespace attitude_planner
+
+namespace attitude_planner {
+
+/// General square banded matrix (lower and upper bandwidth p) with an LU solve with partial
+/// pivoting, O(n·p²). For symmetric indefinite systems, such as the augmented Newton system
+/// whose condition number is the square root of the normal equations'.
+class BandedLinearSystem {
+ public:
+  BandedLinearSystem(int n, int bandwidth);
+  int size() const { return n_; }
+  void setZero() { rows_.setZero(); }
+  /// Adds v to A(i, j); |i − j| ≤ bandwidth.
+  void add(int i, int j, double v) { rows_(i, j - i + p_) += v; }
+  /// A(i, j) (0 outside the band), for tests.
+  double operator()(int i, int j) const;
+  /// Solves A x = b in place (A is overwritten by its factors). Returns false if singular.
+  bool solve(Eigen::VectorXd* b);
+
+ private:
+  int n_, p_;
+  Eigen::MatrixXd rows_;  ///< rows_(i, j − i + p) = A(i, j), j ∈ [i − p, i + 2p] (room for fill-in)
+};
+
+}  // namespace attitude_planner

@@ -52,6 +52,12 @@ class DiscreteScheme {
   template <typename S>
   so3::Vec3<S> momentum(const so3::Mat3<S>& F) const;
 
+  /// μ(exp(ω^)) from the step's rotation vector ω: the same value as momentum(exp(ω^)), but with
+  /// full relative precision for small steps (exp(ω^) − I is formed by series, never as a
+  /// difference). Torques are second differences of the attitude, so this is what keeps them
+  /// accurate over long horizons.
+  Vector3 momentumOfStep(const Vector3& omega) const;
+
   /// dμ(F exp(ε^))/dε at ε = 0 (3×3).
   template <typename S>
   so3::Mat3<S> momentumJacobian(const so3::Mat3<S>& F) const;

@@ -26,3 +26,13 @@ void writeManeuverCsv(const Maneuver& maneuver, const std::string& path);
 Maneuver readManeuverCsv(const std::string& path);
 
 }  // namespace attitude_planner
+
+namespace attitude_planner {
+
+/// The attitudes of `maneuver` (uniform grid on [0, T]) resampled on a uniform grid of `steps`
+/// steps over the same interval: on each original step R_i exp(φ(s)), φ a cubic Hermite curve
+/// in the Lie algebra with φ(1) = log(R_iᵀ R_{i+1}) and end slopes from central differences,
+/// so the result is C¹ and exact at the original nodes that fall on the new grid.
+std::vector<Matrix3> resampleAttitudes(const Maneuver& maneuver, int steps);
+
+}  // namespace attitude_planner

@@ -7,8 +7,13 @@
 // problem is min C = Σ_{k=1}^{N−1} ½|τ_k|² over R_2..R_{N−2} (3(N−3) unknowns: the seed's
 // 3(2N−3) unknowns τ, Ω with its 3(N−1) dynamics equations eliminated exactly). ∇C = 0 are the
 // discrete necessary conditions (docs/necessary_conditions.md relates them to the seed's eq. 28).
+//
+// The iterate is stored as the steps' rotation vectors ω_k = log F_k, not as attitudes: torques
+// are second differences of the attitude, and absolute attitudes would lose them to round-off
+// (relative error eps·N² instead of eps·N).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "attitude_planner/banded_matrix.hpp"
@@ -20,7 +25,20 @@ namespace attitude_planner {
 
 class ReducedProblem {
  public:
-  /// Fixes R_0, R_1, R_{N−1}, R_N; throws StepTooLarge if a boundary velocity has no step.
+  /// Rotation vectors ω_k of the steps F_k = exp(ω_k^), k = 0..N−1 (ω_0, ω_{N−1} fixed).
+  using Steps = std::vector<Vector3>;
+
+  /// What one torque contributes to the Newton system.
+  struct Stencil {
+    int k = 0;                             ///< torque index, 1..N−1
+    Vector3 tau;                           ///< τ_k [N m]
+    Eigen::Matrix<double, 3, 9> jacobian;  ///< ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1})
+    /// sym(Σ_i τ_{k,i} ∂jacobian_i/∂δ): with jacobianᵀ·jacobian, the exact Hessian block.
+    Eigen::Matrix<double, 9, 9> second;
+  };
+
+  /// Fixes the boundary steps and starts on the geodesic from R_1 to R_{N−1}; throws
+  /// StepTooLarge if a boundary velocity has no step.
   explicit ReducedProblem(const PlanningProblem& problem);
 
   int steps() const { return N_; }
@@ -28,26 +46,31 @@ class ReducedProblem {
   int unknowns() const { return 3 * (N_ - 3); }
   const DiscreteScheme& scheme() const { return scheme_; }
 
-  /// The current attitudes R_0..R_N.
-  const std::vector<Matrix3>& attitudes() const { return R_; }
-  /// Replaces the interior attitudes (the fixed four are kept).
-  void setInterior(const std::vector<Matrix3>& attitudes);
-  /// Interior on the geodesic from R_1 to R_{N−1} (uniform in angle).
-  void initializeOnGeodesic();
+  const Steps& current() const { return steps_; }
+  void setCurrent(const Steps& steps) { steps_ = steps; }
+  /// Interior from the attitudes of a maneuver with the same N (a warm start).
+  void setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes);
 
-  /// τ_k, k = 0..N (τ_0 = τ_N = 0), of the attitudes R.
-  std::vector<Vector3> torques(const std::vector<Matrix3>& R) const;
-  /// C = Σ ½|τ_k|² of the attitudes R.
-  double cost(const std::vector<Matrix3>& R) const;
+  /// R_0..R_N of the steps (products from R_0).
+  std::vector<Matrix3> attitudes(const Steps& steps) const;
+  /// τ_k, k = 0..N (τ_0 = τ_N = 0).
+  std::vector<Vector3> torques(const Steps& steps) const;
+  /// C = Σ ½|τ_k|².
+  double cost(const Steps& steps) const;
 
-  /// Cost, gradient and exact Hessian of δ ↦ C(R_j exp(δ_j^)) at δ = 0 for the current
-  /// attitudes. `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient).
-  /// With hessian == nullptr only the gradient is formed.
+  /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
+  /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).
+  Steps retract(const Eigen::VectorXd& delta, double alpha) const;
+
+  /// Calls visit(stencil) for k = 1..N−1 at the current iterate; `second` is formed only if
+  /// with_second_order. Returns the cost.
+  double forEachStencil(bool with_second_order,
+                        const std::function<void(const Stencil&)>& visit) const;
+
+  /// Cost, gradient and exact Hessian (normal equations) of δ ↦ C(R_j exp(δ_j^)) at δ = 0.
+  /// `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient); hessian may be null.
   double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
                   double* gradient_scale) const;
-
-  /// R_j exp(α δ_j^) for the free attitudes; the fixed ones unchanged.
-  std::vector<Matrix3> retract(const Eigen::VectorXd& delta, double alpha) const;
 
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
   int variableIndex(int j) const { return (j >= 2 && j <= N_ - 2) ? 3 * (j - 2) : -1; }
@@ -55,7 +78,8 @@ class ReducedProblem {
  private:
   int N_;
   DiscreteScheme scheme_;
-  std::vector<Matrix3> R_;
+  Matrix3 initial_attitude_;
+  Steps steps_;
 };
 
 }  // namespace attitude_planner

@@ -40,25 +40,73 @@ Vec3<S> vee(const Mat3<S>& m) {
   return Vec3<S>(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1)) * S(0.5);
 }
 
-/// Exponential map (Rodrigues), exact at 0 through its Taylor series.
+/// Rodrigues coefficients of exp(w^) = I + a w^ + b w^², a = sin θ/θ, b = (1 − cos θ)/θ², from
+/// θ² = |w|²: Taylor series below kSmallAngle, half-angle forms (no cancellation) above.
 template <typename S>
-Mat3<S> exp(const Vec3<S>& w) {
-  using std::cos;
+void rodriguesCoefficients(const S& theta2, S* a, S* b) {
   using std::sin;
   using std::sqrt;
-  const S theta2 = w.squaredNorm();
-  S a, b;  // R = I + a w^ + b w^²
   if (theta2 < S(kSmallAngle * kSmallAngle)) {
-    a = S(1) - theta2 / S(6) + theta2 * theta2 / S(120);
-    b = S(0.5) - theta2 / S(24) + theta2 * theta2 / S(720);
+    *a = S(1) - theta2 / S(6) + theta2 * theta2 / S(120);
+    *b = S(0.5) - theta2 / S(24) + theta2 * theta2 / S(720);
   } else {
     const S theta = sqrt(theta2);
     const S half_sin = sin(theta / S(2));
-    a = sin(theta) / theta;
-    b = S(2) * half_sin * half_sin / theta2;  // (1 − cos θ)/θ² without cancellation
+    *a = sin(theta) / theta;
+    *b = S(2) * half_sin * half_sin / theta2;
   }
+}
+
+/// Exponential map (Rodrigues), exact at 0 through its Taylor series.
+template <typename S>
+Mat3<S> exp(const Vec3<S>& w) {
+  S a, b;
+  rodriguesCoefficients<S>(w.squaredNorm(), &a, &b);
   const Mat3<S> W = hat(w);
   return Mat3<S>::Identity() + a * W + b * (W * W);
+}
+
+/// exp(w^) − I = a w^ + b w^², formed without subtracting I: full relative precision for small w,
+/// where exp(w^) itself is I plus only a few significant digits of w.
+template <typename S>
+Mat3<S> expMinusIdentity(const Vec3<S>& w) {
+  S a, b;
+  rodriguesCoefficients<S>(w.squaredNorm(), &a, &b);
+  const Mat3<S> W = hat(w);
+  return a * W + b * (W * W);
+}
+
+/// Unit quaternion (w, x, y, z) of exp(v^): (cos θ/2, sin(θ/2)/θ · v), full relative precision in
+/// the vector part for small v (series below kSmallAngle).
+template <typename S>
+Eigen::Matrix<S, 4, 1> quaternionOfRotationVector(const Vec3<S>& v) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const S theta2 = v.squaredNorm();
+  S c, k;  // cos(θ/2), sin(θ/2)/θ
+  if (theta2 < S(kSmallAngle * kSmallAngle)) {
+    c = S(1) - theta2 / S(8) + theta2 * theta2 / S(384);
+    k = S(0.5) - theta2 / S(48) + theta2 * theta2 / S(3840);
+  } else {
+    const S theta = sqrt(theta2);
+    c = cos(theta / S(2));
+    k = sin(theta / S(2)) / theta;
+  }
+  Eigen::Matrix<S, 4, 1> q;
+  q << c, k * v.x(), k * v.y(), k * v.z();
+  return q;
+}
+
+/// Hamilton product of quaternions (w, x, y, z).
+template <typename S>
+Eigen::Matrix<S, 4, 1> quaternionProduct(const Eigen::Matrix<S, 4, 1>& p,
+                                         const Eigen::Matrix<S, 4, 1>& q) {
+  const Vec3<S> pv = p.template tail<3>(), qv = q.template tail<3>();
+  Eigen::Matrix<S, 4, 1> r;
+  r(0) = p(0) * q(0) - pv.dot(qv);
+  r.template tail<3>() = p(0) * qv + q(0) * pv + pv.cross(qv);
+  return r;
 }
 
 /// Unit quaternion (w, x, y, z) of a rotation matrix by Shepperd's method: the largest of the four

@@ -50,3 +50,47 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
 }
 
 }  // namespace attitude_planner
+
+namespace attitude_planner {
+
+BandedLinearSystem::BandedLinearSystem(int n, int bandwidth)
+    : n_(n), p_(bandwidth), rows_(Eigen::MatrixXd::Zero(n, 3 * bandwidth + 1)) {}
+
+double BandedLinearSystem::operator()(int i, int j) const {
+  const int offset = j - i + p_;
+  return offset >= 0 && offset <= 3 * p_ ? rows_(i, offset) : 0.0;
+}
+
+bool BandedLinearSystem::solve(Eigen::VectorXd* b_in) {
+  Eigen::VectorXd& b = *b_in;
+  auto at = [&](int i, int j) -> double& { return rows_(i, j - i + p_); };
+  for (int k = 0; k < n_; ++k) {
+    const int last_row = std::min(n_ - 1, k + p_);
+    const int last_col = std::min(n_ - 1, k + 2 * p_);
+    int pivot = k;
+    for (int i = k + 1; i <= last_row; ++i) {
+      if (std::abs(at(i, k)) > std::abs(at(pivot, k))) pivot = i;
+    }
+    if (!(std::abs(at(pivot, k)) > 0.0) || !std::isfinite(at(pivot, k))) return false;
+    if (pivot != k) {
+      for (int j = k; j <= last_col; ++j) std::swap(at(k, j), at(pivot, j));
+      std::swap(b(k), b(pivot));
+    }
+    const double inverse_pivot = 1.0 / at(k, k);
+    for (int i = k + 1; i <= last_row; ++i) {
+      const double l = at(i, k) * inverse_pivot;
+      if (l == 0.0) continue;
+      at(i, k) = 0.0;
+      for (int j = k + 1; j <= last_col; ++j) at(i, j) -= l * at(k, j);
+      b(i) -= l * b(k);
+    }
+  }
+  for (int i = n_ - 1; i >= 0; --i) {
+    double s = b(i);
+    for (int j = i + 1; j <= std::min(n_ - 1, i + 2 * p_); ++j) s -= at(i, j) * b(j);
+    b(i) = s / at(i, i);
+  }
+  return b.allFinite();
+}
+
+}  // namespace attitude_planner

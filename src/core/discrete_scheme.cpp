@@ -21,6 +21,16 @@ DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double t
   Jd_ = 0.5 * J_.trace() * Matrix3::Identity() - J_;
 }
 
+Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega) const {
+  const Matrix3 E = so3::expMinusIdentity(omega);  // F − I
+  if (kind_ == SchemeKind::Paper) {
+    const Vector3 Jw = J_ * omega;
+    return (Jw + E * Jw) / h_;  // F J ω / h
+  }
+  const Matrix3 A = E * Jd_;  // F J_d − J_d Fᵀ = (F − I) J_d − J_d (F − I)ᵀ
+  return Vector3(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / h_;
+}
+
 Vector3 DiscreteScheme::velocity(const Matrix3& F) const {
   if (kind_ == SchemeKind::Paper) return so3::log(F) / h_;
   return J_inverse_ * momentum<double>(F);

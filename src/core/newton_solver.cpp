@@ -13,6 +13,9 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
 #include <optional>
 
 #include "attitude_planner/errors.hpp"
@@ -21,7 +24,81 @@
 
 namespace attitude_planner {
 
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+namespace {
+
+/// Above this N the normal equations (condition ~N⁴; measured λ_max/λ_min = 7e10 at N = 256 on a
+/// seed-inertia slew) risk losing the Cholesky factorization to round-off; the augmented system
+/// below has condition ~N².
+constexpr int kNormalEquationsMaxSteps = 256;
+
+/// A solve stalled at round-off counts as converged if its relative torque accuracy (Newton
+/// decrement / |τ|₂) is at least this good; the message then states the accuracy reached.
+constexpr double kRoundOffAcceptance = 1e-6;
+
+/// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
+///   [ −α I   J        ] [ z ]   [ −τ ]
+///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
+/// ordered y_1, y_2, δ_2, y_3, δ_3, …, y_{N−1} so it is banded (half bandwidth 14), and solved
+/// by LU with partial pivoting. `delta` holds −g on entry and δ on return.
+bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta) {
+  const int N = np.steps();
+  const auto y_block = [&](int k) { return k == 1 ? 0 : 2 * k - 3; };
+  const auto d_block = [&](int j) { return 2 * j - 2; };  // j = 2..N−2
+  const int n = 3 * (2 * N - 4);
+  BandedLinearSystem K(n, 14);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  // α ≈ σ_min(J) keeps cond(K) ≈ cond(J) (Björck; α ≈ σ_max would give cond(J)², no better
+  // than the normal equations). The smoothest attitude mode δ(t) = sin(πt/T) v has
+  // |δτ| ≈ J_min (π/T)² |δ|, which estimates σ_min.
+  const double T = np.scheme().timeStep() * N;
+  const double smallest_moment =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(np.scheme().inertia()).eigenvalues()(0);
+  const double alpha = smallest_moment * (M_PI / T) * (M_PI / T);
+  const double shift =
+      relative_shift * std::pow(2.0 * np.scheme().inertia().norm() /
+                                    (np.scheme().timeStep() * np.scheme().timeStep()),
+                                2);
+  np.forEachStencil(true, [&](const ReducedProblem::Stencil& st) {
+    const int ry = 3 * y_block(st.k);
+    for (int i = 0; i < 3; ++i) {
+      K.add(ry + i, ry + i, -alpha);
+      rhs(ry + i) = -st.tau(i);
+    }
+    for (int s = 0; s < 3; ++s) {
+      const int j = st.k - 1 + s;
+      if (np.variableIndex(j) < 0) continue;
+      const int rd = 3 * d_block(j);
+      for (int i = 0; i < 3; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          K.add(ry + i, rd + c, st.jacobian(i, 3 * s + c));
+          K.add(rd + c, ry + i, st.jacobian(i, 3 * s + c));
+        }
+      }
+      for (int t = 0; t < 3; ++t) {
+        const int jt = st.k - 1 + t;
+        if (np.variableIndex(jt) < 0) continue;
+        const int rt = 3 * d_block(jt);
+        for (int i = 0; i < 3; ++i) {
+          for (int c = 0; c < 3; ++c)
+            K.add(rd + i, rt + c, st.second(3 * s + i, 3 * t + c) / alpha);
+        }
+      }
+    }
+  });
+  if (shift > 0) {
+    for (int j = 2; j <= N - 2; ++j) {
+      for (int i = 0; i < 3; ++i) K.add(3 * d_block(j) + i, 3 * d_block(j) + i, shift / alpha);
+    }
+  }
+  if (!K.solve(&rhs)) return false;
+  for (int j = 2; j <= N - 2; ++j)
+    delta->segment<3>(np.variableIndex(j)) = rhs.segment<3>(3 * d_block(j));
+  return delta->allFinite();
+}
+
+}  // namespace
+
+PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -35,7 +112,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
     return result;
   }
   ReducedProblem& np = *reduced;
-  if (options.warm_start) np.setInterior(options.warm_start->attitude);
+  if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
   const int N = np.steps();
   const int n = 3 * (N - 3);
   BandedSymmetricMatrix hessian(n, 8);
@@ -44,10 +121,13 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   double relative_gradient = 0.0;
   double relative_decrement = 0.0;
   bool converged = false;
+  double best_decrement = std::numeric_limits<double>::infinity();
+  int stalled_iterations = 0;
   std::string reason = "iteration limit reached";
   int iteration = 0;
   for (;; ++iteration) {
-    const double cost = np.evaluate(&gradient, &hessian, &gradient_scale);
+    const bool augmented = N > kNormalEquationsMaxSteps;
+    const double cost = np.evaluate(&gradient, augmented ? nullptr : &hessian, &gradient_scale);
     relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
     if (!std::isfinite(cost) || !std::isfinite(relative_gradient)) {
       reason = "non-finite cost or gradient (step too large for this h? increase steps)";
@@ -64,18 +144,23 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
       reason = "time budget exceeded";
       break;
     }
-    // Newton direction; Levenberg shift until the Hessian is positive definite.
-    double shift = 0.0;
+    // Newton direction; Levenberg shift until the Hessian is positive definite (normal
+    // equations: Cholesky succeeds; augmented system: the step is a descent direction).
+    double shift = 0.0;  // relative to the Hessian's scale
     bool factored = false;
     for (int attempt = 0; attempt < 40; ++attempt) {
-      BandedSymmetricMatrix trial = hessian;
-      if (shift > 0) trial.addToDiagonal(shift);
       delta = -gradient;
-      if (trial.solvePositiveDefinite(&delta)) {
-        factored = true;
-        break;
+      if (augmented) {
+        factored = solveAugmented(np, shift, &delta) && gradient.dot(delta) < 0;
+      } else {
+        BandedSymmetricMatrix trial = hessian;
+        if (shift > 0) trial.addToDiagonal(shift * hessian.maxAbsDiagonal());
+        factored = trial.solvePositiveDefinite(&delta);
       }
-      shift = shift == 0.0 ? 1e-10 * hessian.maxAbsDiagonal() : 10.0 * shift;
+      if (factored) break;
+      // Start far below the smallest curvature (λ_max/λ_min reaches 1e13 at N = 1000): a shift
+      // of 1e-10 λ_max already swamps the smooth modes and makes convergence linear.
+      shift = shift == 0.0 ? 1e-14 : 100.0 * shift;
     }
     if (!factored) {
       reason = "Hessian could not be made positive definite";
@@ -91,7 +176,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
     // the cost's round-off the test is meaningless and the full Newton step is taken.
     double alpha = 1.0;
     bool accepted = final_step || -slope <= 1e-13 * cost;
-    std::vector<Matrix3> trial_R = np.retract(delta, alpha);
+    ReducedProblem::Steps trial_R = np.retract(delta, alpha);
     for (int back = 0; !accepted && back < 50; ++back) {
       const double trial_cost = np.cost(trial_R);
       if (std::isfinite(trial_cost) && trial_cost <= cost + 1e-4 * alpha * slope) {
@@ -105,8 +190,28 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
       reason = "line search failed";
       break;
     }
-    np.setInterior(trial_R);
+    np.setCurrent(trial_R);
+    // Round-off floor: full Newton steps that no longer halve the decrement for three iterations
+    // mean the gradient is noise (the Hessian's condition grows like N⁴). Stop there; the
+    // achieved relative accuracy is the decrement, accepted if ≤ kRoundOffAcceptance.
+    if (alpha == 1.0 && relative_decrement > 0.5 * best_decrement) {
+      ++stalled_iterations;
+    } else {
+      stalled_iterations = 0;
+    }
+    best_decrement = std::min(best_decrement, relative_decrement);
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
+    if (stalled_iterations >= 3) {
+      result.history.push_back(info);
+      ++iteration;
+      converged = relative_decrement <= kRoundOffAcceptance;
+      std::ostringstream why;
+      why << (converged ? "converged to the round-off floor" : "stalled above the tolerance")
+          << " (relative torque accuracy about " << relative_decrement << ", tolerance "
+          << options.tolerance << ")";
+      reason = why.str();
+      break;
+    }
     result.history.push_back(info);
     if (final_step) {
       // This last step took the iterate from the tolerance to ~round-off (quadratic convergence).
@@ -130,7 +235,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   result.max_residual = relative_gradient;
   result.newton_decrement = relative_decrement;
   try {
-    evaluatePlan(problem, np.torques(np.attitudes()), &result);
+    evaluatePlan(problem, np.torques(np.current()), &result);
   } catch (const StepTooLarge& e) {
     result.converged = false;
     result.message = std::string("replay of the planned torques failed: ") + e.what();
@@ -153,6 +258,37 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   msg << reason << " after " << iteration << " iterations (relative gradient " << relative_gradient
       << ", relative Newton decrement " << relative_decrement << ")";
   result.message = msg.str();
+  return result;
+}
+
+/// Grid continuation: above this N the problem is first solved on a 4× coarser grid (recursively)
+/// and the resampled solution starts the fine solve. From the geodesic guess, long horizons
+/// wander through regions where the Hessian is indefinite; from the coarse solution every level
+/// starts in the convex basin and takes a few Newton steps.
+constexpr int kCoarsestGrid = 256;
+
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+  if (problem.steps <= kCoarsestGrid || options.warm_start) return solveOnGrid(problem, options);
+  PlanningProblem coarse = problem;
+  coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
+  SolverOptions coarse_options = options;
+  coarse_options.on_iteration = nullptr;
+  coarse_options.tolerance = std::max(options.tolerance, 1e-8);
+  const PlanResult coarse_result = solveWithNewton(coarse, coarse_options);
+  SolverOptions fine_options = options;
+  Maneuver guess;
+  std::string level;
+  if (coarse_result.converged) {
+    guess.attitude = resampleAttitudes(coarse_result.maneuver, problem.steps);
+    fine_options.warm_start = &guess;
+    level = "; started from the N = " + std::to_string(coarse.steps) + " solution (" +
+            std::to_string(coarse_result.iterations) + " iterations there)";
+  } else {
+    level = "; the N = " + std::to_string(coarse.steps) + " level did not converge (" +
+            coarse_result.message + "), started from the geodesic";
+  }
+  PlanResult result = solveOnGrid(problem, fine_options);
+  result.message += level;
   return result;
 }
 

@@ -59,115 +59,153 @@ Matrix3 contract(const so3::Mat3<Dual3>& X, const Vector3& tau) {
 
 ReducedProblem::ReducedProblem(const PlanningProblem& problem)
     : N_(problem.steps),
-      scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps) {
-  R_.assign(N_ + 1, Matrix3::Identity());
-  R_[0] = problem.initial_attitude;
-  R_[1] = problem.initial_attitude * scheme_.stepFromVelocity(problem.initial_velocity);
-  R_[N_] = problem.final_attitude;
-  R_[N_ - 1] =
-      problem.final_attitude * scheme_.stepFromVelocity(problem.final_velocity).transpose();
-  initializeOnGeodesic();
+      scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps),
+      initial_attitude_(problem.initial_attitude) {
+  const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
+  const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
+  steps_.assign(N_, Vector3::Zero());
+  // paper: ω = hΩ exactly; variational: the implicit step's rotation vector
+  steps_[0] = problem.scheme == SchemeKind::Paper
+                  ? Vector3(scheme_.timeStep() * problem.initial_velocity)
+                  : so3::log(F_first);
+  steps_[N_ - 1] = problem.scheme == SchemeKind::Paper
+                       ? Vector3(scheme_.timeStep() * problem.final_velocity)
+                       : so3::log(F_last);
+  // Geodesic from R_1 to R_{N−1} in N − 2 equal steps.
+  const Matrix3 R1 = problem.initial_attitude * F_first;
+  const Matrix3 R_last = problem.final_attitude * F_last.transpose();
+  const Vector3 span = so3::log(Matrix3(R1.transpose() * R_last));
+  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = span / double(N_ - 2);
 }
 
-void ReducedProblem::setInterior(const std::vector<Matrix3>& attitudes) {
+void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes) {
   if (static_cast<int>(attitudes.size()) != N_ + 1) {
     throw InvalidInput("warm start: has " + std::to_string(attitudes.size() - 1) +
                        " steps, the problem " + std::to_string(N_));
   }
-  for (int j = 2; j <= N_ - 2; ++j) R_[j] = attitudes[j];
+  // The warm start's R_1 and R_{N−1} must be this problem's: keep ours at the ends.
+  const std::vector<Matrix3> own = this->attitudes(steps_);
+  std::vector<Matrix3> R = attitudes;
+  R[0] = own[0];
+  R[1] = own[1];
+  R[N_ - 1] = own[N_ - 1];
+  R[N_] = own[N_];
+  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
 }
 
-void ReducedProblem::initializeOnGeodesic() {
-  const Vector3 span = so3::log(Matrix3(R_[1].transpose() * R_[N_ - 1]));
-  for (int j = 2; j <= N_ - 2; ++j) {
-    R_[j] = R_[1] * so3::exp(Vector3(span * double(j - 1) / double(N_ - 2)));
-  }
+std::vector<Matrix3> ReducedProblem::attitudes(const Steps& steps) const {
+  std::vector<Matrix3> R(N_ + 1);
+  R[0] = initial_attitude_;
+  for (int k = 0; k < N_; ++k) R[k + 1] = R[k] * so3::exp(steps[k]);
+  return R;
 }
 
-std::vector<Vector3> ReducedProblem::torques(const std::vector<Matrix3>& R) const {
+std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
   std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
   const double h = scheme_.timeStep();
-  Matrix3 F = R[0].transpose() * R[1];
-  Vector3 carried = F.transpose() * scheme_.momentum<double>(F);  // G_{k−1}
+  Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
   for (int k = 1; k < N_; ++k) {
-    F = R[k].transpose() * R[k + 1];
-    const Vector3 mu = scheme_.momentum<double>(F);
-    tau[k] = (mu - carried) / h;
-    carried = F.transpose() * mu;
+    const Vector3 mu = scheme_.momentumOfStep(steps[k]);
+    // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
+    // cancel in a difference of accurately formed momenta.
+    tau[k] = ((mu - mu_prev) - so3::expMinusIdentity(steps[k - 1]).transpose() * mu_prev) / h;
+    mu_prev = mu;
   }
   return tau;
 }
 
-double ReducedProblem::cost(const std::vector<Matrix3>& R) const {
+double ReducedProblem::cost(const Steps& steps) const {
   double c = 0;
-  for (const Vector3& t : torques(R)) c += 0.5 * t.squaredNorm();
+  for (const Vector3& t : torques(steps)) c += 0.5 * t.squaredNorm();
   return c;
 }
 
-std::vector<Matrix3> ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
-  std::vector<Matrix3> R = R_;
-  for (int j = 2; j <= N_ - 2; ++j) {
-    R[j] = R_[j] * so3::exp(Vector3(alpha * delta.segment<3>(variableIndex(j))));
+ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
+  Steps out = steps_;
+  const auto perturbation = [&](int j) {
+    const int v = variableIndex(j);
+    return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));
+  };
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Eigen::Vector4d q = so3::quaternionProduct<double>(
+        so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),
+                                       so3::quaternionOfRotationVector<double>(steps_[j])),
+        so3::quaternionOfRotationVector<double>(perturbation(j + 1)));
+    out[j] = so3::logOfQuaternion<double>(q);
   }
-  return R;
+  return out;
+}
+
+double ReducedProblem::forEachStencil(bool with_second_order,
+                                      const std::function<void(const Stencil&)>& visit) const {
+  const double h = scheme_.timeStep();
+  const std::vector<Vector3> tau = torques(steps_);
+  double cost = 0.0;
+  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
+  const auto F_of = [&](int j) { return so3::exp(steps_[j]); };
+  std::optional<StepTerms<Dual3>> prev_d;  // derivatives only for the second-order term
+  if (with_second_order) prev_d.emplace(scheme_, perturbed(F_of(0)));
+  Matrix3 F_prev = F_of(0);
+  StepTerms<double> prev(scheme_, F_prev);
+  Stencil st;
+  st.second.setZero();
+  for (int k = 1; k < N_; ++k) {
+    const Matrix3 F = F_of(k);
+    StepTerms<double> next(scheme_, F);
+    st.k = k;
+    st.tau = tau[k];
+    st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
+    st.jacobian.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
+    st.jacobian.block<3, 3>(0, 6) = next.D / h;
+    cost += 0.5 * st.tau.squaredNorm();
+    if (with_second_order) {
+      StepTerms<Dual3> next_d(scheme_, perturbed(F));
+      // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
+      Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
+      const Matrix3 T_dGFt_prev = contract(prev_d->dGFt, st.tau) / h;  // block a, via ε_{k−1}
+      const Matrix3 T_dG_prev = -contract(prev_d->dG, st.tau) / h;     // block b, via ε_{k−1}
+      const Matrix3 T_DFt = -contract(next_d.DFt, st.tau) / h;         // block b, via ε_k
+      const Matrix3 T_D = contract(next_d.D, st.tau) / h;              // block c, via ε_k
+      second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
+      second.block<3, 3>(0, 3) = T_dGFt_prev;
+      second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
+      second.block<3, 3>(3, 3) = T_dG_prev - T_DFt * F.transpose();
+      second.block<3, 3>(3, 6) = T_DFt;
+      second.block<3, 3>(6, 3) = -T_D * F.transpose();
+      second.block<3, 3>(6, 6) = T_D;
+      // The antisymmetric part is cancelled exactly by the retraction's derivative
+      // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
+      st.second = 0.5 * (second + second.transpose());
+      prev_d.emplace(next_d);
+    }
+    visit(st);
+    prev = next;
+    F_prev = F;
+  }
+  return cost;
 }
 
 double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
                                 double* gradient_scale) const {
-  const double h = scheme_.timeStep();
   gradient->setZero(unknowns());
   if (hessian) hessian->setZero();
-  double cost = 0.0, jacobian_scale = 0.0, torque_scale = 0.0;
-  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  const auto step = [&](int j) { return Matrix3(R_[j].transpose() * R_[j + 1]); };
-  const auto terms_of = [&](int j) { return StepTerms<Dual3>(scheme_, perturbed(step(j))); };
-  std::optional<StepTerms<Dual3>> prev_d;  // derivatives are formed only for the Hessian
-  if (hessian) prev_d.emplace(terms_of(0));
-  StepTerms<double> prev(scheme_, step(0));
-  for (int k = 1; k < N_; ++k) {
-    const Matrix3 F_prev = R_[k - 1].transpose() * R_[k];
-    const Matrix3 F = R_[k].transpose() * R_[k + 1];
-    StepTerms<double> next(scheme_, F);
-    const Vector3 tau = (next.mu - prev.G) / h;
-    Eigen::Matrix<double, 3, 9> jac;
-    jac.block<3, 3>(0, 0) = prev.dGFt / h;
-    jac.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
-    jac.block<3, 3>(0, 6) = next.D / h;
-    const Eigen::Matrix<double, 9, 1> g = jac.transpose() * tau;
-    cost += 0.5 * tau.squaredNorm();
-    jacobian_scale = std::max(jacobian_scale, jac.cwiseAbs().maxCoeff());
-    torque_scale = std::max(torque_scale, tau.cwiseAbs().maxCoeff());
+  double jacobian_scale = 0.0, torque_scale = 0.0;
+  const double cost = forEachStencil(hessian != nullptr, [&](const Stencil& st) {
+    jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
+    torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
+    const Eigen::Matrix<double, 9, 1> g = st.jacobian.transpose() * st.tau;
     for (int s = 0; s < 3; ++s) {
-      const int v = variableIndex(k - 1 + s);
+      const int v = variableIndex(st.k - 1 + s);
       if (v >= 0) gradient->segment<3>(v) += g.segment<3>(3 * s);
     }
-    if (!hessian) {
-      prev = next;
-      continue;
-    }
-    StepTerms<Dual3> next_d = terms_of(k);
-    // second(m, l) = Σ_i τ_i ∂jac(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
-    Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
-    const Matrix3 T_dGFt_prev = contract(prev_d->dGFt, tau) / h;  // block a, via ε_{k−1}
-    const Matrix3 T_dG_prev = -contract(prev_d->dG, tau) / h;     // block b, via ε_{k−1}
-    const Matrix3 T_DFt = -contract(next_d.DFt, tau) / h;         // block b, via ε_k
-    const Matrix3 T_D = contract(next_d.D, tau) / h;              // block c, via ε_k
-    second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
-    second.block<3, 3>(0, 3) = T_dGFt_prev;
-    second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
-    second.block<3, 3>(3, 3) = T_dG_prev - T_DFt * F.transpose();
-    second.block<3, 3>(3, 6) = T_DFt;
-    second.block<3, 3>(6, 3) = -T_D * F.transpose();
-    second.block<3, 3>(6, 6) = T_D;
-    // The antisymmetric part of `second` is cancelled exactly by the retraction's derivative
-    // (dJr(δ)/dδ = −½(·)^ contracted with the gradient), so the exact Hessian is:
+    if (!hessian) return;
     const Eigen::Matrix<double, 9, 9> block =
-        jac.transpose().lazyProduct(jac) + 0.5 * (second + second.transpose());
+        st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
     for (int s = 0; s < 3; ++s) {
-      const int vs = variableIndex(k - 1 + s);
+      const int vs = variableIndex(st.k - 1 + s);
       if (vs < 0) continue;
       for (int t = 0; t <= s; ++t) {
-        const int vt = variableIndex(k - 1 + t);
+        const int vt = variableIndex(st.k - 1 + t);
         if (vt < 0) continue;
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < (s == t ? i + 1 : 3); ++j) {
@@ -176,9 +214,7 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
         }
       }
     }
-    prev_d.emplace(next_d);
-    prev = next;
-  }
+  });
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;
 }

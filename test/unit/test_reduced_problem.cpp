@@ -3,6 +3,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <random>
 
 #include "attitude_planner/reduced_problem.hpp"
@@ -31,7 +32,7 @@ ReducedProblem perturbedProblem(SchemeKind scheme, int N, unsigned seed) {
   std::normal_distribution<double> n(0.0, 0.05);
   Eigen::VectorXd delta(rp.unknowns());
   for (int i = 0; i < delta.size(); ++i) delta(i) = n(rng);
-  rp.setInterior(rp.retract(delta, 1.0));
+  rp.setCurrent(rp.retract(delta, 1.0));
   return rp;
 }
 
@@ -43,7 +44,7 @@ TEST(ReducedProblem, GradientMatchesFiniteDifferencesOfTheCost) {
     Eigen::VectorXd g;
     double scale;
     const double c = rp.evaluate(&g, nullptr, &scale);
-    EXPECT_NEAR(c, rp.cost(rp.attitudes()), 1e-12 * c);
+    EXPECT_NEAR(c, rp.cost(rp.current()), 1e-12 * c);
     const double eps = 1e-6;
     for (int i = 0; i < rp.unknowns(); ++i) {
       Eigen::VectorXd e = Eigen::VectorXd::Zero(rp.unknowns());
@@ -104,4 +105,29 @@ TEST(ReducedProblem, BandedCholeskyMatchesDenseSolve) {
   indefinite.add(2, 2, 1.0);
   Eigen::VectorXd b = Eigen::VectorXd::Ones(3);
   EXPECT_FALSE(indefinite.solvePositiveDefinite(&b));
+}
+
+TEST(BandedLinearSystem, PivotedLuMatchesDenseSolveOnAnIndefiniteMatrix) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const int size = 40, p = 5;
+  BandedLinearSystem A(size, p);
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(size, size);
+  for (int i = 0; i < size; ++i) {
+    for (int j = std::max(0, i - p); j <= std::min(size - 1, i + p); ++j) {
+      // zero diagonal in places: pivoting is required
+      const double v = (i == j && i % 3 == 0) ? 0.0 : n(rng);
+      A.add(i, j, v);
+      dense(i, j) = v;
+    }
+  }
+  Eigen::VectorXd b(size);
+  for (int i = 0; i < size; ++i) b(i) = n(rng);
+  Eigen::VectorXd x = b;
+  ASSERT_TRUE(A.solve(&x));
+  const Eigen::VectorXd reference = dense.fullPivLu().solve(b);
+  EXPECT_LE((x - reference).norm(), 1e-10 * reference.norm());
+  BandedLinearSystem singular(3, 1);
+  Eigen::VectorXd c = Eigen::VectorXd::Ones(3);
+  EXPECT_FALSE(singular.solve(&c));
 }

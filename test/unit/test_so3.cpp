@@ -184,3 +184,27 @@ TEST(So3, AxisAngleBeyondPiWrapsToTheShortRotation) {
   EXPECT_LE((so3::log(R) - Vector3(0, 0, -0.1)).norm(), 1e-15);
   EXPECT_NEAR(so3::angleBetween(Matrix3::Identity(), R), 0.1, 1e-15);
 }
+
+TEST(So3, ExpMinusIdentityKeepsRelativePrecisionForSmallRotations) {
+  for (double theta : {1e-12, 1e-8, 1e-5, 1e-3, 0.5, 3.0}) {
+    const Vector3 w = theta * Vector3(1, -2, 3).normalized();
+    const Matrix3 E = so3::expMinusIdentity(w);
+    // reference: the series w^ + w^²/2 + w^³/6 + ... summed far enough
+    Matrix3 reference = Matrix3::Zero(), term = Matrix3::Identity();
+    for (int n = 1; n < 40; ++n) {
+      term = term * so3::hat(w) / n;
+      reference += term;
+    }
+    EXPECT_LE((E - reference).norm(), 4e-16 * reference.norm()) << "theta = " << theta;
+  }
+}
+
+TEST(So3, QuaternionCompositionOfSmallStepsKeepsRelativePrecision) {
+  // log(exp(a) exp(b)) for tiny a, b: the quaternion route keeps ~1e-16 relative precision,
+  // where the matrix route keeps only ~eps/|a| (here 1e-8).
+  const Vector3 a(1e-8, -2e-8, 0.5e-8), b(3e-8, 1e-8, -1e-8);
+  const Vector3 via_quaternions = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(
+      so3::quaternionOfRotationVector<double>(a), so3::quaternionOfRotationVector<double>(b)));
+  const Vector3 bch = a + b + 0.5 * a.cross(b);  // exact to O(|a|³) = 1e-24
+  EXPECT_LE((via_quaternions - bch).norm(), 1e-15 * bch.norm());
+}

@@ -12,25 +12,41 @@
 
 namespace attitude_planner {
 
-void driftTwoInputShootingResidual(const Matrix3& g0, const Matrix3& g1, double T, int n_steps,
-                                   int order, const DriftTwoInputWeights& w, const Vector3& p0,
-                                   Vector3* residual, Matrix3* jacobian) {
-  using D = Dual<3>;
-  so3::Mat3<D> g = g0.cast<D>();
-  so3::Vec3<D> p(D(p0.x(), 0), D(p0.y(), 1), D(p0.z(), 2));  // seed the three directions
+namespace {
+
+// g(T) and p(T) from (g0, p0) by n_steps steps of the given order, in scalar type S.
+template <typename S>
+so3::Mat3<S> shootEndpoint(const Matrix3& g0, so3::Vec3<S> p, double T, int n_steps, int order,
+                           const DriftTwoInputWeights& w) {
+  so3::Mat3<S> g = g0.cast<S>();
   const double h = T / n_steps;
   for (int k = 0; k < n_steps; ++k) {
-    if (!drift_two_input::stepOfOrder<D>(g, p, h, w, order)) {
+    if (!drift_two_input::stepOfOrder<S>(g, p, h, w, order)) {
       std::ostringstream os;
-      os << "implicit step " << k << " (h = " << h << " s, |p| = " << p.norm().v
-         << ") did not converge during shooting";
+      os << "implicit step " << k << " (h = " << h << " s) did not converge during shooting";
       throw StepTooLarge(os.str());
     }
   }
+  return g;
+}
+
+}  // namespace
+
+void driftTwoInputShootingResidual(const Matrix3& g0, const Matrix3& g1, double T, int n_steps,
+                                   int order, const DriftTwoInputWeights& w, const Vector3& p0,
+                                   Vector3* residual, Matrix3* jacobian) {
+  if (!jacobian) {  // value only: plain doubles, several times cheaper than Dual<3>
+    const Matrix3 g = shootEndpoint<double>(g0, p0, T, n_steps, order, w);
+    *residual = so3::log(Matrix3(g1.transpose() * g));
+    return;
+  }
+  using D = Dual<3>;
+  const so3::Vec3<D> p(D(p0.x(), 0), D(p0.y(), 1), D(p0.z(), 2));  // seed the three directions
+  const so3::Mat3<D> g = shootEndpoint<D>(g0, p, T, n_steps, order, w);
   const so3::Vec3<D> r = so3::log<D>(so3::Mat3<D>(g1.cast<D>().transpose() * g));
   for (int i = 0; i < 3; ++i) {
     (*residual)(i) = r(i).v;
-    if (jacobian) jacobian->row(i) = r(i).d.transpose();
+    jacobian->row(i) = r(i).d.transpose();
   }
 }
 
@@ -88,24 +104,27 @@ bool newtonSolve(const DriftTwoInputRequest& rq, const Matrix3& target, int n_st
     for (int ls = 0; ls < 30; ++ls, step *= 0.5) {
       const Vector3 trial = p + step * dp;
       Vector3 rt;
-      Matrix3 Jt;
       try {
         driftTwoInputShootingResidual(rq.g0, target, rq.duration, n_steps, kOrder, rq.weights,
-                                      trial, &rt, &Jt);
+                                      trial, &rt, nullptr);
       } catch (const StepTooLarge&) {
         continue;  // too large a costate for the step: shorten
       }
       // Armijo on |r|; at round-off level accept any non-increase (the last digits are noise)
       if (rt.norm() <= (1.0 - 1e-4 * step) * error || (rt.norm() <= 1e-13 && rt.norm() <= error)) {
         p = trial;
-        r = rt;
-        J = Jt;
         error = rt.norm();
         accepted = true;
         break;
       }
     }
-    if (!accepted) break;
+    if (!accepted || error <= tol) break;
+    try {  // Jacobian at the accepted point (the residual's value is recomputed, identical)
+      driftTwoInputShootingResidual(rq.g0, target, rq.duration, n_steps, kOrder, rq.weights, p, &r,
+                                    &J);
+    } catch (const StepTooLarge&) {
+      break;
+    }
   }
   return error <= tol;
 }
@@ -168,7 +187,8 @@ Attempt solveFrom(const DriftTwoInputRequest& rq, int n_steps, const Vector3& st
     a.ok = true;
     a.p = p;
   }
-  a.how = "continuation on the target over " + std::to_string(stages) + " stages";
+  a.how =
+      "direct solve failed; continuation on the target over " + std::to_string(stages) + " targets";
   return a;
 }
 

@@ -163,6 +163,45 @@ TEST(DriftTwoInputPlanner, GuessSelectsWhichOfCoexistingExtremalsIsFound) {
   EXPECT_NE(b.message.find("cost"), std::string::npos);
 }
 
+TEST(DriftTwoInputPlanner, ShootingJacobianFromDualNumbersMatchesFiniteDifferences) {
+  const Matrix3 g0 = so3::exp(Vector3(0.3, -0.2, 0.5)), g1 = so3::exp(Vector3(-0.4, 0.9, 0.1));
+  const DriftTwoInputWeights w{0.8, 1.6};
+  const Vector3 p0(0.7, -0.4, 0.9);
+  Vector3 r;
+  Matrix3 J;
+  driftTwoInputShootingResidual(g0, g1, 2.5, 250, 4, w, p0, &r, &J);
+  Matrix3 fd;
+  for (int j = 0; j < 3; ++j) {
+    const double e = 1e-6;
+    Vector3 rp, rm;
+    driftTwoInputShootingResidual(g0, g1, 2.5, 250, 4, w, p0 + e * Vector3::Unit(j), &rp, nullptr);
+    driftTwoInputShootingResidual(g0, g1, 2.5, 250, 4, w, p0 - e * Vector3::Unit(j), &rm, nullptr);
+    fd.col(j) = (rp - rm) / (2 * e);
+  }
+  EXPECT_LE((J - fd).norm(), 1e-8 * J.norm()) << J << "\n" << fd;
+  EXPECT_GT(J.norm(), 0.1);
+}
+
+TEST(DriftTwoInputPlanner, LeftInvarianceGivesTheSameCostateForRotatedBoundaryAttitudes) {
+  // (3.8)–(3.10) are left-invariant: (g0, g1) → (R g0, R g1) leaves p(t) and the cost unchanged
+  DriftTwoInputRequest rq = exampleRequest();
+  rq.weights = {2.5, 0.7};  // the other ordering, c2 < c1
+  rq.initial_costate = Vector3(-1.0, -1.0, -1.0);
+  const DriftTwoInputPlan a = planDriftTwoInput(rq);
+  const Matrix3 R = so3::exp(Vector3(1.1, -0.3, 2.0));
+  rq.g0 = R * rq.g0;
+  rq.g1 = R * rq.g1;
+  const DriftTwoInputPlan b = planDriftTwoInput(rq);
+  ASSERT_TRUE(a.converged) << a.message;
+  ASSERT_TRUE(b.converged) << b.message;
+  EXPECT_LE((a.initial_costate - b.initial_costate).norm(), 1e-8);
+  EXPECT_NEAR(a.cost, b.cost, 1e-9 * a.cost);
+  EXPECT_LE(b.terminal_error, 1e-10);
+  for (size_t k = 0; k < a.trajectory.g.size(); ++k) {
+    EXPECT_LE((R * a.trajectory.g[k] - b.trajectory.g[k]).norm(), 1e-8);
+  }
+}
+
 TEST(DriftTwoInputPlanner, InvalidRequestsNameTheField) {
   DriftTwoInputRequest rq = exampleRequest();
   rq.duration = 0.0;

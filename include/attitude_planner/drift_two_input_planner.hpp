@@ -2,7 +2,8 @@
 // extremal steers g0 to g1 in the fixed time T. Single shooting on the terminal error
 // log(g1ᵀ g(T)) with exact sensitivities (forward-mode dual numbers through the same
 // structure-preserving scheme), Newton with a backtracking line search, and continuation on the
-// target attitude along the geodesic from the guess's endpoint to g1 when a direct solve fails.
+// target attitude along the geodesic from the guess's endpoint to g1 when a direct solve fails;
+// optionally multiple shooting (shooting_intervals > 1) for long horizons.
 //
 // Extremals are not unique (e.g. ones that wind once more about the drift axis): the plan says
 // which one was found through p(0) and its cost; a request's guess selects among them.
@@ -27,6 +28,7 @@ struct DriftTwoInputRequest {
   double tolerance = 1e-11;                ///< required terminal error |log(g1ᵀ g(T))| [rad]
   int max_iterations = 200;                ///< Newton iterations over all continuation stages
   int max_continuation_stages = 64;        ///< bound on the number of intermediate targets
+  int shooting_intervals = 1;  ///< 1: single shooting; M > 1: multiple shooting on M intervals
 };
 
 /// Result of planDriftTwoInput: the extremal found (or the best attempt) and how it went.

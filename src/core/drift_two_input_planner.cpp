@@ -64,6 +64,9 @@ void validate(const DriftTwoInputRequest& rq) {
   if (!std::isfinite(rq.max_step) || rq.max_step <= 0) fail("max_step", rq.max_step, "must be > 0");
   if (!(rq.tolerance > 0)) fail("tolerance", rq.tolerance, "must be > 0");
   if (rq.max_iterations < 1) fail("max_iterations", rq.max_iterations, "must be >= 1");
+  if (rq.shooting_intervals < 1 || rq.shooting_intervals > rq.steps) {
+    fail("shooting_intervals", rq.shooting_intervals, "must be in [1, steps]");
+  }
   if (rq.max_continuation_stages < 1) {
     fail("max_continuation_stages", rq.max_continuation_stages, "must be >= 1");
   }
@@ -80,10 +83,144 @@ void validate(const DriftTwoInputRequest& rq) {
 
 constexpr int kOrder = 4;  // triple-jump composition of the midpoint scheme
 
+// Multiple shooting (for long horizons, where the sensitivity of g(T) to p(0) grows): the
+// n_steps steps are split into M intervals [k_j, k_{j+1}); unknowns are p(0) and, at the inner
+// nodes, (g_j, p_j) with g_j updated on the group (ĝ_j exp(δ_j)). Equations: continuity of g and
+// p at each inner node and log(targetᵀ g_end) = 0 at T, 6(M−1) + 3 in all, Newton with exact
+// block Jacobians (Dual<9> over δ_j, p_j, δ_{j+1}) and backtracking on the residual norm.
+// Returns true when the residual norm ≤ tol; p holds p(0).
+bool multipleShootingSolve(const DriftTwoInputRequest& rq, const Matrix3& target, int n_steps,
+                           int M, double tol, int max_iterations, Vector3& p, int& iterations,
+                           double& error) {
+  const double h = rq.duration / n_steps;
+  std::vector<int> k(M + 1);
+  for (int j = 0; j <= M; ++j) k[j] = static_cast<int>(std::llround(double(j) * n_steps / M));
+  const int n = 6 * (M - 1) + 3;
+  std::vector<Matrix3> G(M);
+  std::vector<Vector3> P(M);
+  // initial nodes on the single-shooting trajectory from p
+  {
+    Matrix3 g = rq.g0;
+    Vector3 q = p;
+    for (int j = 0; j < M; ++j) {
+      G[j] = g;
+      P[j] = q;
+      for (int i = k[j]; i < k[j + 1]; ++i) {
+        if (!drift_two_input::stepOfOrder<double>(g, q, h, rq.weights, kOrder)) {
+          error = INFINITY;
+          return false;
+        }
+      }
+    }
+  }
+  G[0] = rq.g0;
+  using D = Dual<9>;
+  // residual (and, if J, Jacobian) of the whole system at nodes (G, P)
+  auto evaluate = [&](const std::vector<Matrix3>& Gs, const std::vector<Vector3>& Ps,
+                      Eigen::VectorXd& F, Eigen::MatrixXd* J) -> bool {
+    F.setZero(n);
+    if (J) J->setZero(n, n);
+    for (int j = 0; j < M; ++j) {
+      const bool last = j == M - 1;
+      const int row = 6 * j;
+      const int col_p = j == 0 ? 0 : 3 + 6 * (j - 1) + 3, col_d = 3 + 6 * (j - 1);
+      const int col_dn = 3 + 6 * j;  // δ_{j+1}
+      if (!J) {
+        Matrix3 g = Gs[j];
+        Vector3 q = Ps[j];
+        for (int i = k[j]; i < k[j + 1]; ++i) {
+          if (!drift_two_input::stepOfOrder<double>(g, q, h, rq.weights, kOrder)) return false;
+        }
+        const Matrix3& next = last ? target : Gs[j + 1];
+        F.segment<3>(row) = so3::log(Matrix3(next.transpose() * g));
+        if (!last) F.segment<3>(row + 3) = q - Ps[j + 1];
+        continue;
+      }
+      so3::Vec3<D> d0, q, dn;
+      for (int i = 0; i < 3; ++i) {
+        d0(i) = D(0.0, i);
+        q(i) = D(Ps[j](i), 3 + i);
+        dn(i) = D(0.0, 6 + i);
+      }
+      so3::Mat3<D> g = Gs[j].cast<D>() * so3::exp<D>(d0);
+      for (int i = k[j]; i < k[j + 1]; ++i) {
+        if (!drift_two_input::stepOfOrder<D>(g, q, h, rq.weights, kOrder)) return false;
+      }
+      const so3::Mat3<D> next = last ? so3::Mat3<D>(target.cast<D>())
+                                     : so3::Mat3<D>(Gs[j + 1].cast<D>() * so3::exp<D>(dn));
+      const so3::Vec3<D> rg = so3::log<D>(so3::Mat3<D>(next.transpose() * g));
+      for (int i = 0; i < 3; ++i) {
+        F(row + i) = rg(i).v;
+        if (j > 0) J->block<1, 3>(row + i, col_d) = rg(i).d.segment<3>(0).transpose();
+        J->block<1, 3>(row + i, col_p) = rg(i).d.segment<3>(3).transpose();
+        if (!last) J->block<1, 3>(row + i, col_dn) = rg(i).d.segment<3>(6).transpose();
+        if (last) continue;
+        F(row + 3 + i) = q(i).v - Ps[j + 1](i);
+        if (j > 0) J->block<1, 3>(row + 3 + i, col_d) = q(i).d.segment<3>(0).transpose();
+        J->block<1, 3>(row + 3 + i, col_p) = q(i).d.segment<3>(3).transpose();
+        (*J)(row + 3 + i, col_dn + 3 + i) = -1.0;  // ∂(q_end − p_{j+1})/∂p_{j+1}
+      }
+    }
+    return true;
+  };
+  auto retract = [&](const Eigen::VectorXd& dx, double a, std::vector<Matrix3>& Gs,
+                     std::vector<Vector3>& Ps) {
+    Gs = G;
+    Ps = P;
+    Ps[0] += a * dx.segment<3>(0);
+    for (int j = 1; j < M; ++j) {
+      Gs[j] = G[j] * so3::exp(Vector3(a * dx.segment<3>(3 + 6 * (j - 1))));
+      Ps[j] += a * dx.segment<3>(3 + 6 * (j - 1) + 3);
+    }
+  };
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  if (!evaluate(G, P, F, &J)) {
+    error = INFINITY;
+    return false;
+  }
+  error = F.norm();
+  while (error > tol && max_iterations-- > 0) {
+    ++iterations;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+    if (!lu.isInvertible()) break;
+    const Eigen::VectorXd dx = -lu.solve(F);
+    double a = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls < 30; ++ls, a *= 0.5) {
+      std::vector<Matrix3> Gs;
+      std::vector<Vector3> Ps;
+      retract(dx, a, Gs, Ps);
+      Eigen::VectorXd Ft;
+      if (!evaluate(Gs, Ps, Ft, nullptr)) continue;
+      if (Ft.norm() <= (1.0 - 1e-4 * a) * error || (Ft.norm() <= 1e-13 && Ft.norm() <= error)) {
+        G = Gs;
+        P = Ps;
+        error = Ft.norm();
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted || error <= tol) break;
+    if (!evaluate(G, P, F, &J)) break;
+  }
+  p = P[0];
+  return error <= tol;
+}
+
 // Newton with backtracking on ½|r|² for one target; updates p and counts iterations.
 // Returns true when |r| ≤ tol.
 bool newtonSolve(const DriftTwoInputRequest& rq, const Matrix3& target, int n_steps, double tol,
                  int max_iterations, Vector3& p, int& iterations, double& error) {
+  if (rq.shooting_intervals > 1) {
+    // Multiple shooting finds p(0); a few single-shooting Newton steps then polish it against
+    // the one-piece integration that produces the output (the node residuals are amplified by
+    // the sensitivity of g(T) to p(0) when the pieces are joined).
+    const bool ms_ok = multipleShootingSolve(rq, target, n_steps, rq.shooting_intervals, tol,
+                                             max_iterations, p, iterations, error);
+    if (!ms_ok && !(error <= 1e-6)) return false;
+    max_iterations = 5;
+  }
   Vector3 r;
   Matrix3 J;
   try {
@@ -264,6 +401,9 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
   const bool ok = best.ok;
   plan.continuation_stages = best.stages;
   std::string how = best.how;
+  if (rq.shooting_intervals > 1) {
+    how = "multiple shooting on " + std::to_string(rq.shooting_intervals) + " intervals, " + how;
+  }
   if (starts.size() > 1) {
     how += "; best of " + std::to_string(starts.size()) + " default starts, " +
            std::to_string(converged_starts) + " converged";

@@ -202,6 +202,26 @@ TEST(DriftTwoInputPlanner, LeftInvarianceGivesTheSameCostateForRotatedBoundaryAt
   }
 }
 
+TEST(DriftTwoInputPlanner, MultipleShootingSolvesALongHorizonAndSingleShootingConfirmsIt) {
+  DriftTwoInputRequest rq = exampleRequest();
+  rq.duration = 20.0;
+  rq.steps = 100;
+  rq.shooting_intervals = 8;
+  rq.initial_costate = Vector3(0.5, 0.5, 0.0);
+  const DriftTwoInputPlan ms = planDriftTwoInput(rq);
+  std::printf("multiple shooting, T = 20 s: %s\n", ms.message.c_str());
+  ASSERT_TRUE(ms.converged) << ms.message;
+  EXPECT_LE(ms.terminal_error, 1e-10);
+  // the same extremal is a fixed point of single shooting: started there it stays there
+  rq.shooting_intervals = 1;
+  rq.initial_costate = ms.initial_costate;
+  const DriftTwoInputPlan ss = planDriftTwoInput(rq);
+  ASSERT_TRUE(ss.converged) << ss.message;
+  EXPECT_LE(ss.iterations, 2);
+  EXPECT_LE((ss.initial_costate - ms.initial_costate).norm(), 1e-9);
+  EXPECT_NEAR(ss.cost, ms.cost, 1e-9 * ms.cost);
+}
+
 TEST(DriftTwoInputPlanner, InvalidRequestsNameTheField) {
   DriftTwoInputRequest rq = exampleRequest();
   rq.duration = 0.0;
@@ -219,6 +239,9 @@ TEST(DriftTwoInputPlanner, InvalidRequestsNameTheField) {
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("g1"), std::string::npos) << e.what();
   }
+  rq = exampleRequest();
+  rq.shooting_intervals = 0;
+  EXPECT_THROW(planDriftTwoInput(rq), InvalidInput);
   rq = exampleRequest();
   rq.weights.c2 = -1.0;
   EXPECT_THROW(planDriftTwoInput(rq), InvalidInput);

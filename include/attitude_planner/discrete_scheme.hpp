@@ -65,7 +65,8 @@ class DiscreteScheme {
   Matrix3 stepFromVelocity(const Vector3& omega) const;
 
   /// Solves μ(F) = p for F by a safeguarded Newton iteration on F ← F exp(δ^), starting from
-  /// `guess`. Converged when |μ(F) − p| ≤ 1e-14·(|p| + ‖J‖|log F|/h). Never returns NaN:
+  /// `guess`. Converged when |μ(F) − p| ≤ 1e-14·(|p| + ‖J‖|log F|/h) + 1e-15‖J‖/h (the
+  /// round-off floor of μ), then polished by up to two more Newton steps. Never returns NaN:
   /// `report.converged` is false if it fails (step too large for this h).
   Matrix3 solveStep(const Vector3& p, const Matrix3& guess, StepSolveReport* report) const;
 

@@ -10,11 +10,11 @@ namespace attitude_planner {
 
 /// Rows k = 0..N at t_k = k h (DESIGN.md, "Trajectory CSV").
 struct Maneuver {
-  double time_step = 0.0;               ///< h [s]
-  std::vector<double> time;             ///< t_k [s], k = 0..N
-  std::vector<Matrix3> attitude;        ///< R_k, body → world, k = 0..N
+  double time_step = 0.0;                 ///< h [s]
+  std::vector<double> time;               ///< t_k [s], k = 0..N
+  std::vector<Matrix3> attitude;          ///< R_k, body → world, k = 0..N
   std::vector<Vector3> angular_velocity;  ///< Ω_k [rad/s] body; row N repeats Ω_{N−1}
-  std::vector<Vector3> torque;          ///< τ_k [N·m] body; τ_0 = τ_N = 0
+  std::vector<Vector3> torque;            ///< τ_k [N·m] body; τ_0 = τ_N = 0
 
   int steps() const { return static_cast<int>(attitude.size()) - 1; }
 };

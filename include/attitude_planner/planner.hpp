@@ -24,22 +24,26 @@ struct PlanningProblem {
   Matrix3 final_attitude = Matrix3::Identity();    ///< R_N
   Vector3 final_velocity = Vector3::Zero();        ///< Ω_{N−1} [rad/s], body
   SchemeKind scheme = SchemeKind::Paper;
+  /// Accept an inertia whose principal moments violate J1 + J2 ≥ J3 (no rigid body has one).
+  /// The seed's example inertia is such a matrix (moments 3.146, 12.538, 32.186), so its scenes
+  /// opt in explicitly; the mathematics only needs J symmetric positive definite.
+  bool allow_nonphysical_inertia = false;
 };
 
 /// Progress of one iteration, for feedback (action) and logging.
 struct IterationInfo {
   int iteration = 0;
   double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
-  double gradient_norm = 0.0;  ///< max-norm of the first-order optimality residual
+  double gradient_norm = 0.0;  ///< optimality residual (Newton: relative Newton decrement)
   double step_length = 0.0;    ///< line-search step accepted
 };
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.
 struct SolverOptions {
   std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
-  double tolerance = 1e-10;       ///< on the scaled optimality residual (see PlanResult)
+  double tolerance = 1e-10;       ///< relative torque accuracy (Newton decrement / |τ|₂)
   int max_iterations = 200;
-  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
   /// Called after every iteration; return false to cancel (the result says "cancelled").
   std::function<bool(const IterationInfo&)> on_iteration;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
@@ -49,13 +53,17 @@ struct SolverOptions {
 /// What a solve returns. `converged` is false with a reason in `message` otherwise.
 struct PlanResult {
   bool converged = false;
-  std::string message;       ///< human-readable outcome ("converged", or why not)
-  std::string solver;        ///< "newton" or "nlopt"
+  std::string message;  ///< human-readable outcome ("converged", or why not)
+  std::string solver;   ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;         ///< R_k, Ω_k, τ_k, k = 0..N
-  double cost = 0.0;         ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  Maneuver maneuver;  ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;  ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
   int iterations = 0;
-  double max_residual = 0.0;             ///< max-norm of the optimality residual at the end
+  /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
+  double max_residual = 0.0;
+  /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the
+  /// final step (the convergence test); NLopt: 0.
+  double newton_decrement = 0.0;
   double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
   double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
   double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay

@@ -1,21 +1,85 @@
 // Scene files (YAML, DESIGN.md "Scene file"): what to plan and which effects are present.
+//
+// Keys (units SI, REP 103):
+//   inertia          3×3 nested list, or 3 principal moments [a, b, c]        [kg·m²]
+//   duration         T > 0                                                     [s]
+//   steps            N, 4 ≤ N ≤ 10,000,000 (validateProblem)
+//   initial, final   {attitude: A, angular_velocity: [x, y, z]}                [rad/s] body
+//                    A = {axis: [x, y, z], angle: a [rad]} or {quaternion: [w, x, y, z]}
+//   effects          list of single-key maps (see EffectSpec)
+//   scheme           optional: paper (default) | variational
+//   system           optional: rigid_body (default) | drift_two_input (seed 001)
+//   control_weights  [c1, c2] > 0, only with system: drift_two_input
+//   allow_nonphysical_inertia  optional bool (default false): accept an SPD inertia whose
+//                    principal moments violate J1 + J2 ≥ J3 (the seed's example inertia does)
 #pragma once
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <string>
+#include <variant>
+#include <vector>
 
 #include "attitude_planner/planner.hpp"
 
 namespace attitude_planner {
 
+/// Gravity-gradient torque of a circular orbit: 3 μ/r³ (ĉ × J ĉ), ĉ the nadir in the body frame.
+struct GravityGradientSpec {
+  double mu = 0.0;            ///< gravitational parameter μ [m³/s²], > 0
+  double orbit_radius = 0.0;  ///< orbit radius r [m], > 0
+};
+
+/// A constant disturbance torque [N·m].
+struct DisturbanceTorqueSpec {
+  std::string frame = "body";       ///< "body" or "world": the frame `value` is expressed in
+  Vector3 value = Vector3::Zero();  ///< torque [N·m]
+};
+
+/// Per-axis saturation of the control torque (body frame).
+struct ActuatorLimitsSpec {
+  Vector3 max_torque = Vector3::Zero();  ///< |τ_i| ≤ max_torque_i [N·m], each > 0
+};
+
+/// Zero-mean Gaussian noise added to the applied torque (body frame).
+struct TorqueNoiseSpec {
+  Vector3 std = Vector3::Zero();  ///< standard deviation per axis [N·m], each ≥ 0
+  std::uint64_t seed = 0;         ///< PRNG seed (reproducible runs)
+};
+
+/// One entry of the scene's `effects:` list.
+using EffectSpec =
+    std::variant<GravityGradientSpec, DisturbanceTorqueSpec, ActuatorLimitsSpec, TorqueNoiseSpec>;
+
+/// The YAML key of an effect ("gravity_gradient", "disturbance_torque", ...).
+std::string effectName(const EffectSpec& effect);
+
 /// A parsed scene. Unknown keys and bad values throw InvalidInput naming the key and the value.
 struct Scene {
   PlanningProblem problem;
-  std::string source;  ///< file name (for messages)
+  std::string source;                 ///< file name (for messages)
+  std::string system = "rigid_body";  ///< "rigid_body" or "drift_two_input" (seed 001)
+  Eigen::Vector2d control_weights = Eigen::Vector2d::Ones();  ///< c1, c2 (drift_two_input) [-]
+  std::vector<EffectSpec> effects;                            ///< in file order
+  /// true: the inertia need not satisfy the triangle inequality (only SPD is required).
+  bool allow_nonphysical_inertia = false;
 };
 
 /// Parses YAML text; `source` names it in error messages.
 Scene parseScene(const std::string& yaml_text, const std::string& source = "<scene>");
 /// Reads and parses a scene file.
 Scene loadScene(const std::string& path);
+
+/// Writes a scene as YAML that parseScene reads back to the same problem (attitudes as
+/// quaternions, numbers with %.17g).
+std::string formatScene(const Scene& scene);
+
+/// Throws InvalidInput naming the inertia and its principal moments unless J1 + J2 ≥ J3 (a mass
+/// distribution exists). Not part of validateProblem: the dynamics only need SPD.
+void requirePhysicalInertia(const Matrix3& inertia);
+
+/// Throws InvalidInput if planManeuver cannot plan this scene faithfully (effects present, or a
+/// system other than rigid_body): a scene's content is never silently ignored.
+void requirePlannable(const Scene& scene);
 
 }  // namespace attitude_planner

@@ -18,8 +18,8 @@ struct SimulationInput {
 
 /// Figures of merit of a simulation.
 struct SimulationReport {
-  int max_step_iterations = 0;       ///< worst Newton count of the implicit step
-  double max_step_residual = 0.0;    ///< worst |μ(F_k) − p_k| [N·m·s]
+  int max_step_iterations = 0;     ///< worst Newton count of the implicit step
+  double max_step_residual = 0.0;  ///< worst |μ(F_k) − p_k| [N·m·s]
 };
 
 /// Integrates R_{k+1} = R_k F_k, μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h τ_k for k = 1..N−1.

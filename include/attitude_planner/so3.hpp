@@ -187,13 +187,27 @@ Mat3<S> matrixFromQuaternion(const Eigen::Matrix<S, 4, 1>& q_in) {
 
 // ---- double-precision conveniences -------------------------------------------------------------
 
-inline Matrix3 hat(const Vector3& v) { return hat<double>(v); }
-inline Vector3 vee(const Matrix3& m) { return vee<double>(m); }
-inline Matrix3 exp(const Vector3& w) { return exp<double>(w); }
-inline Vector3 log(const Matrix3& R) { return log<double>(R); }
-inline Matrix3 rightJacobian(const Vector3& w) { return rightJacobian<double>(w); }
-inline Matrix3 rightJacobianInverse(const Vector3& w) { return rightJacobianInverse<double>(w); }
-inline Matrix3 leftJacobian(const Vector3& w) { return leftJacobian<double>(w); }
+inline Matrix3 hat(const Vector3& v) {
+  return hat<double>(v);
+}
+inline Vector3 vee(const Matrix3& m) {
+  return vee<double>(m);
+}
+inline Matrix3 exp(const Vector3& w) {
+  return exp<double>(w);
+}
+inline Vector3 log(const Matrix3& R) {
+  return log<double>(R);
+}
+inline Matrix3 rightJacobian(const Vector3& w) {
+  return rightJacobian<double>(w);
+}
+inline Matrix3 rightJacobianInverse(const Vector3& w) {
+  return rightJacobianInverse<double>(w);
+}
+inline Matrix3 leftJacobian(const Vector3& w) {
+  return leftJacobian<double>(w);
+}
 
 /// Hamilton quaternion of R, with w ≥ 0.
 Eigen::Quaterniond toQuaternion(const Matrix3& R);

@@ -51,24 +51,30 @@ Matrix3 DiscreteScheme::stepFromVelocity(const Vector3& omega) const {
 Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
                                   StepSolveReport* report) const {
   constexpr int kMaxIterations = 60;
-  Matrix3 F = guess;
+  // Warm starts chain F from step to step: restore orthogonality so round-off in F cannot
+  // accumulate over millions of steps (μ of a non-orthogonal F breaks momentum conservation).
+  Matrix3 F = 0.5 * guess * (3.0 * Matrix3::Identity() - guess.transpose() * guess);
   Vector3 r = momentum<double>(F) - p;
   double r_norm = r.norm();
   auto tolerance = [&](const Matrix3& G) {
-    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-300;
+    // relative part, plus the absolute round-off floor of evaluating μ (≈ eps·‖J‖/h at any F)
+    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-15 * J_.norm() / h_;
   };
   report->converged = false;
-  int stalled = 0;
+  int polish_steps = 0;
   int it = 0;
   for (; it < kMaxIterations; ++it) {
     if (r_norm <= tolerance(F)) {
       report->converged = true;
-      break;
+      // Newton converges quadratically: up to two more steps take the residual from the
+      // tolerance to round-off, so conserved quantities do not drift by tolerance × steps.
+      if (r_norm == 0.0 || polish_steps >= 2) break;
+      ++polish_steps;
     }
     const Matrix3 D = momentumJacobian<double>(F);
     Eigen::FullPivLU<Matrix3> lu(D);
     if (!lu.isInvertible()) break;
-    Vector3 delta = -lu.solve(r);
+    const Vector3 delta = -lu.solve(r);
     if (!delta.allFinite()) break;
     // Backtracking on |μ(F) − p| keeps the iteration inside the region where a solution exists.
     double step = 1.0;
@@ -83,14 +89,14 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
         improved = true;
         break;
       }
+      if (report->converged) break;  // polishing: full steps only
       step *= 0.5;
     }
     if (!improved) {
-      // Round-off floor: accept if already within 100× the tolerance.
+      // Round-off floor reached: accept if within 100× the tolerance.
       if (r_norm <= 100.0 * tolerance(F)) report->converged = true;
       break;
     }
-    if (step < 1.0 && ++stalled > 40) break;
   }
   report->iterations = it;
   report->residual = (momentum<double>(F) - p).norm();

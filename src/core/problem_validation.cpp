@@ -1,17 +1,31 @@
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/scene.hpp"
 
 namespace attitude_planner {
 
 namespace {
 
+/// Largest N accepted: the solvers hold O(N) state of a few hundred bytes per step, so this keeps
+/// a mistyped N from exhausting memory.
+constexpr int kMaxSteps = 10000000;
+
+/// %.17g: the value exactly as the user gave it.
+std::string num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
 std::string str(const Eigen::MatrixXd& m) {
   std::ostringstream s;
-  s << m.format(Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "",
-                                "[", "]"));
+  s << m.format(
+      Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "", "[", "]"));
   return s.str();
 }
 
@@ -23,7 +37,7 @@ void requireRotation(const Matrix3& R, const std::string& field) {
   requireFinite(R, field);
   if (so3::orthogonalityError(R) > 1e-9) {
     throw InvalidInput(field + ": not a rotation matrix (|R^T R - I| + |det R - 1| = " +
-                       std::to_string(so3::orthogonalityError(R)) + ")");
+                       num(so3::orthogonalityError(R)) + ")");
   }
 }
 
@@ -38,25 +52,39 @@ void validateProblem(const PlanningProblem& p) {
   const Eigen::SelfAdjointEigenSolver<Matrix3> eig(p.inertia);
   const Vector3 moments = eig.eigenvalues();  // ascending
   if (!(moments(0) > 0.0)) {
-    throw InvalidInput("inertia: not positive definite (principal moments " +
-                       str(moments.transpose()) + ")");
+    throw InvalidInput("inertia: not positive definite: " + str(p.inertia) +
+                       " (principal moments " + str(moments.transpose()) + ")");
   }
-  if (moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
-    throw InvalidInput("inertia: principal moments " + str(moments.transpose()) +
-                       " violate the triangle inequality J1 + J2 >= J3 (no rigid body has them)");
-  }
+  // The discrete dynamics are well posed for every SPD J, and the seed's own example inertia
+  // (moments 3.15, 12.54, 32.19) violates J1 + J2 >= J3: the check is skipped only on request.
+  if (!p.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
   if (moments(2) / moments(0) > 1e12) {
-    throw InvalidInput("inertia: condition number " + std::to_string(moments(2) / moments(0)) +
-                       " > 1e12");
+    throw InvalidInput("inertia: condition number " + num(moments(2) / moments(0)) + " of " +
+                       str(p.inertia) + " > 1e12");
   }
   if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
-    throw InvalidInput("duration: must be a finite number > 0 s, got " + std::to_string(p.duration));
+    throw InvalidInput("duration: must be a finite number > 0 s, got " + num(p.duration));
   }
   if (p.steps < 4) throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
+  if (p.steps > kMaxSteps) {
+    throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
+                       std::to_string(p.steps));
+  }
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
   requireFinite(p.final_velocity, "final.angular_velocity");
+}
+
+void requirePhysicalInertia(const Matrix3& inertia) {
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(inertia);
+  const Vector3 moments = eig.eigenvalues();  // ascending
+  if (moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
+    throw InvalidInput("inertia: " + str(inertia) + " has principal moments " +
+                       str(moments.transpose()) +
+                       " that violate the triangle inequality J1 + J2 >= J3 (no rigid body has "
+                       "them; set allow_nonphysical_inertia: true to plan anyway)");
+  }
 }
 
 }  // namespace attitude_planner

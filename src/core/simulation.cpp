@@ -13,8 +13,9 @@ Matrix3 reorthonormalize(const Matrix3& R) {
 Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
                   SimulationReport* report) {
   const int N = static_cast<int>(input.torque.size()) - 1;
-  if (N < 1) throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
-                                std::to_string(input.torque.size()));
+  if (N < 1)
+    throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
+                       std::to_string(input.torque.size()));
   if (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0)) {
     throw InvalidInput("torque: tau_0 and tau_N must be zero (they do not enter eq. (18))");
   }
@@ -32,23 +33,26 @@ Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
   m.attitude[0] = input.initial_attitude;
   m.attitude[1] = reorthonormalize(input.initial_attitude * F);
   m.angular_velocity[0] = input.initial_velocity;
-  Vector3 carried = F.transpose() * scheme.momentum<double>(F);  // F_{k−1}ᵀ μ(F_{k−1})
+  // The momentum is carried in the world frame, π_k = R_k μ(F_k): identical to the body-frame
+  // recursion μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h τ_k in exact arithmetic, but torque-free it is
+  // then conserved bit for bit instead of accumulating a rounding bias every step.
+  Vector3 spatial_momentum = input.initial_attitude * scheme.momentum<double>(F);
   for (int k = 1; k < N; ++k) {
-    const Vector3 p = carried + h * input.torque[k];
+    const Vector3 p = m.attitude[k].transpose() * spatial_momentum + h * input.torque[k];
     StepSolveReport step;
     F = scheme.solveStep(p, F, &step);
     if (!step.converged) {
       std::ostringstream msg;
       msg << "step too large, increase steps: implicit step k = " << k
-          << " did not converge (|p| = " << p.norm() << " N m s, h = " << h
-          << " s, residual " << step.residual << ")";
+          << " did not converge (|p| = " << p.norm() << " N m s, h = " << h << " s, residual "
+          << step.residual << ")";
       throw StepTooLarge(msg.str());
     }
     local.max_step_iterations = std::max(local.max_step_iterations, step.iterations);
     local.max_step_residual = std::max(local.max_step_residual, step.residual);
     m.attitude[k + 1] = reorthonormalize(m.attitude[k] * F);
     m.angular_velocity[k] = scheme.velocity(F);
-    carried = F.transpose() * scheme.momentum<double>(F);
+    if (!input.torque[k].isZero(0.0)) spatial_momentum = m.attitude[k] * p;
   }
   m.angular_velocity[N] = m.angular_velocity[N - 1];
   if (report) *report = local;

@@ -23,7 +23,7 @@ Matrix3 referenceRotation(const Vector3& axis, double theta) {
   return so3::fromQuaternion(q);
 }
 
-const double kAngles[] = {0.0,        1e-24,         1e-12,          1e-8, 1.0,
+const double kAngles[] = {0.0,         1e-24,       1e-12,        1e-8, 1.0,
                           M_PI - 1e-3, M_PI - 1e-8, M_PI - 1e-12, M_PI};
 
 }  // namespace
@@ -116,9 +116,10 @@ TEST(So3, RightJacobianMatchesFiniteDifferences) {
     for (int i = 0; i < 3; ++i) {
       const Vector3 e = Vector3::Unit(i) * eps;
       // exp(w + δ) = exp(w) exp(Jr δ)
-      const Vector3 fd_jr = (so3::log(Matrix3(so3::exp(w).transpose() * so3::exp(Vector3(w + e)))) -
-                             so3::log(Matrix3(so3::exp(w).transpose() * so3::exp(Vector3(w - e))))) /
-                            (2 * eps);
+      const Vector3 fd_jr =
+          (so3::log(Matrix3(so3::exp(w).transpose() * so3::exp(Vector3(w + e)))) -
+           so3::log(Matrix3(so3::exp(w).transpose() * so3::exp(Vector3(w - e))))) /
+          (2 * eps);
       EXPECT_LE((fd_jr - Jr.col(i)).norm(), 1e-8) << "theta = " << theta;
       // log(exp(w) exp(δ)) = w + Jr⁻¹ δ
       const Vector3 fd_inv = (so3::log(Matrix3(so3::exp(w) * so3::exp(e))) -

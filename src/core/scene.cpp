@@ -1,0 +1,490 @@
+// Scene parser: YAML → Scene, strict. Every error names the source, the line, the key path
+// (`final.attitude.quaternion`, `effects[1].torque_noise.std[2]`) and the offending value,
+// because a scene is typed by hand and a silently ignored key is a wrong maneuver.
+#include "attitude_planner/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// How far from 1 a quaternion's norm may be before it is an error rather than round-off in a
+/// hand-typed value (0.7071 has norm 0.99998).
+constexpr double kQuaternionNormTolerance = 1e-3;
+
+/// %.17g: every double round-trips.
+std::string fmt(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+/// A node's text for a message, one line.
+std::string show(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "null";
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  YAML::Emitter out;
+  out.SetMapFormat(YAML::Flow);
+  out.SetSeqFormat(YAML::Flow);
+  out << node;
+  return out.c_str();
+}
+
+class SceneParser {
+ public:
+  explicit SceneParser(std::string source) : source_(std::move(source)) {}
+
+  Scene parse(const std::string& text) {
+    YAML::Node loaded;
+    try {
+      loaded = YAML::Load(text);
+    } catch (const YAML::ParserException& e) {
+      throw InvalidInput(source_ + ":" + std::to_string(e.mark.line + 1) + ":" +
+                         std::to_string(e.mark.column + 1) + ": malformed YAML: " + e.msg);
+    }
+    // const: operator[] on a non-const node would insert the keys it looks up
+    const YAML::Node root = loaded;
+    if (!root.IsDefined() || root.IsNull()) throw InvalidInput(source_ + ": empty scene");
+    requireMap(root, "scene");
+    Scene scene;
+    scene.source = source_;
+
+    // The system decides which keys are required: the kinematic drift system of seed 001 has no
+    // inertia and no boundary velocities.
+    std::string system = "rigid_body";
+    if (root["system"]) {
+      system = scalarString(root["system"], "system");
+      if (system != "rigid_body" && system != "drift_two_input") {
+        fail(root["system"], "system",
+             "unknown value " + show(root["system"]) + " (expected rigid_body or drift_two_input)");
+      }
+    }
+    scene.system = system;
+    const bool rigid = system == "rigid_body";
+    if (rigid) {
+      checkKeys(root, "",
+                {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
+                 "allow_nonphysical_inertia"},
+                {"inertia", "duration", "steps", "initial", "final", "effects"});
+    } else {
+      checkKeys(root, "",
+                {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
+                 "control_weights", "allow_nonphysical_inertia"},
+                {"duration", "steps", "initial", "final", "effects", "control_weights"});
+    }
+
+    PlanningProblem& p = scene.problem;
+    if (root["inertia"]) p.inertia = inertia(root["inertia"], "inertia");
+    p.duration = number(root["duration"], "duration");
+    p.steps = integer(root["steps"], "steps");
+    readState(root["initial"], "initial", rigid, &p.initial_attitude, &p.initial_velocity);
+    readState(root["final"], "final", rigid, &p.final_attitude, &p.final_velocity);
+    if (root["scheme"]) {
+      const std::string name = scalarString(root["scheme"], "scheme");
+      try {
+        p.scheme = parseSchemeName(name);
+      } catch (const InvalidInput&) {
+        fail(root["scheme"], "scheme",
+             "unknown value " + show(root["scheme"]) + " (expected paper or variational)");
+      }
+    }
+    if (root["control_weights"]) {
+      const YAML::Node w = root["control_weights"];
+      requireSequence(w, "control_weights", 2);
+      for (int i = 0; i < 2; ++i) {
+        const std::string path = "control_weights[" + std::to_string(i) + "]";
+        scene.control_weights(i) = number(w[i], path);
+        if (!(scene.control_weights(i) > 0.0)) fail(w[i], path, "must be > 0, got " + show(w[i]));
+      }
+    }
+    scene.effects = effects(root["effects"], "effects");
+    if (root["allow_nonphysical_inertia"]) {
+      scene.allow_nonphysical_inertia =
+          boolean(root["allow_nonphysical_inertia"], "allow_nonphysical_inertia");
+    }
+    p.allow_nonphysical_inertia = scene.allow_nonphysical_inertia;
+
+    // Physical checks (SPD inertia, T > 0, N range, ...) live in validateProblem, shared with the
+    // planner node; here they gain the file name and the line of the key they name.
+    try {
+      validateProblem(p);
+      if (root["inertia"] && !scene.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
+    } catch (const InvalidInput& e) {
+      const std::string what = e.what();
+      const std::string key = what.substr(0, what.find_first_of(".:"));
+      const YAML::Node node = root[key];
+      if (node) throw InvalidInput(where(node) + what);
+      throw InvalidInput(source_ + ": " + what);
+    }
+    return scene;
+  }
+
+ private:
+  std::string where(const YAML::Node& node) const {
+    return source_ + ":" + std::to_string(node.Mark().line + 1) + ": ";
+  }
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
+                         const std::string& what) const {
+    throw InvalidInput(where(node) + path + ": " + what);
+  }
+
+  void requireMap(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsMap()) fail(node, path, "expected a mapping, got " + show(node));
+  }
+
+  void requireSequence(const YAML::Node& node, const std::string& path, int size) const {
+    if (!node.IsSequence()) {
+      fail(node, path,
+           "expected a list of " + std::to_string(size) + " numbers, got " + show(node));
+    }
+    if (static_cast<int>(node.size()) != size) {
+      fail(node, path,
+           "expected " + std::to_string(size) + " entries, got " + std::to_string(node.size()) +
+               ": " + show(node));
+    }
+  }
+
+  /// Unknown, duplicate and missing keys are all errors; `prefix` is the path of `node`.
+  void checkKeys(const YAML::Node& node, const std::string& prefix,
+                 const std::vector<std::string>& allowed,
+                 const std::vector<std::string>& required) const {
+    std::set<std::string> seen;
+    for (const auto& entry : node) {
+      const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : show(entry.first);
+      const std::string path = prefix.empty() ? key : prefix + "." + key;
+      bool known = false;
+      for (const auto& a : allowed) known = known || a == key;
+      if (!known) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(entry.first, path, "unknown key (expected one of: " + list + ")");
+      }
+      if (!seen.insert(key).second) fail(entry.first, path, "duplicate key");
+    }
+    for (const auto& r : required) {
+      if (!seen.count(r)) {
+        fail(node, prefix.empty() ? r : prefix + "." + r, "missing (required)");
+      }
+    }
+  }
+
+  std::string scalarString(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsScalar()) fail(node, path, "expected a name, got " + show(node));
+    return node.Scalar();
+  }
+
+  /// A finite number. Quoted strings are not numbers: "12.8" is a typo more often than intent.
+  double number(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsScalar() || node.Tag() == "!") {
+      fail(node, path, "expected a number, got " + show(node));
+    }
+    const std::string& s = node.Scalar();
+    double value = 0.0;
+    if (s == ".nan" || s == ".NaN" || s == ".NAN") {
+      value = std::numeric_limits<double>::quiet_NaN();
+    } else if (s == ".inf" || s == ".Inf" || s == ".INF" || s == "+.inf" || s == "+.Inf" ||
+               s == "+.INF") {
+      value = std::numeric_limits<double>::infinity();
+    } else if (s == "-.inf" || s == "-.Inf" || s == "-.INF") {
+      value = -std::numeric_limits<double>::infinity();
+    } else {
+      char* end = nullptr;
+      errno = 0;
+      value = std::strtod(s.c_str(), &end);
+      if (s.empty() || end != s.c_str() + s.size()) {
+        fail(node, path, "expected a number, got " + show(node));
+      }
+      if (errno == ERANGE && std::abs(value) > 1.0) {
+        fail(node, path, "out of the range of a double: " + show(node));
+      }
+    }
+    if (!std::isfinite(value)) fail(node, path, "not finite: " + show(node));
+    return value;
+  }
+
+  bool boolean(const YAML::Node& node, const std::string& path) const {
+    if (node.IsScalar() && node.Tag() != "!") {
+      const std::string& s = node.Scalar();
+      if (s == "true" || s == "True" || s == "TRUE") return true;
+      if (s == "false" || s == "False" || s == "FALSE") return false;
+    }
+    fail(node, path, "expected true or false, got " + show(node));
+  }
+
+  int integer(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsScalar() || node.Tag() == "!") {
+      fail(node, path, "expected an integer, got " + show(node));
+    }
+    const std::string& s = node.Scalar();
+    char* end = nullptr;
+    errno = 0;
+    const long long value = std::strtoll(s.c_str(), &end, 10);
+    if (s.empty() || end != s.c_str() + s.size()) {
+      fail(node, path, "expected an integer, got " + show(node));
+    }
+    if (errno == ERANGE || value > std::numeric_limits<int>::max() ||
+        value < std::numeric_limits<int>::min()) {
+      fail(node, path, "out of range: " + show(node));
+    }
+    return static_cast<int>(value);
+  }
+
+  Vector3 vector3(const YAML::Node& node, const std::string& path) const {
+    requireSequence(node, path, 3);
+    Vector3 v;
+    for (int i = 0; i < 3; ++i) v(i) = number(node[i], path + "[" + std::to_string(i) + "]");
+    return v;
+  }
+
+  /// 3×3 nested list, or the three principal moments [a, b, c] (diagonal inertia).
+  Matrix3 inertia(const YAML::Node& node, const std::string& path) const {
+    requireSequence(node, path, 3);
+    if (node[0].IsScalar()) return vector3(node, path).asDiagonal();
+    Matrix3 J;
+    for (int i = 0; i < 3; ++i) {
+      const std::string row = path + "[" + std::to_string(i) + "]";
+      if (!node[i].IsSequence()) {
+        fail(node[i], row,
+             "expected a row of 3 numbers (inertia is [[...], [...], [...]] or "
+             "[a, b, c]), got " +
+                 show(node[i]));
+      }
+      J.row(i) = vector3(node[i], row).transpose();
+    }
+    return J;
+  }
+
+  Matrix3 attitude(const YAML::Node& node, const std::string& path) const {
+    requireMap(node, path);
+    if (node["quaternion"]) {
+      checkKeys(node, path, {"quaternion"}, {"quaternion"});
+      const std::string qpath = path + ".quaternion";
+      const YAML::Node qn = node["quaternion"];
+      requireSequence(qn, qpath, 4);
+      Eigen::Vector4d q;
+      for (int i = 0; i < 4; ++i) q(i) = number(qn[i], qpath + "[" + std::to_string(i) + "]");
+      const double norm = q.norm();
+      if (norm == 0.0) fail(qn, qpath, "zero quaternion " + show(qn) + " is not a rotation");
+      if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
+        fail(qn, qpath,
+             "not a unit quaternion: " + show(qn) + " has norm " + fmt(norm) + " (must be within " +
+                 fmt(kQuaternionNormTolerance) + " of 1; [w, x, y, z])");
+      }
+      return so3::fromQuaternion(Eigen::Quaterniond(q(0), q(1), q(2), q(3)));
+    }
+    checkKeys(node, path, {"axis", "angle", "quaternion"}, {"axis", "angle"});
+    const Vector3 axis = vector3(node["axis"], path + ".axis");
+    if (axis.norm() == 0.0) {
+      fail(node["axis"], path + ".axis", "zero vector " + show(node["axis"]) + " has no direction");
+    }
+    const double angle = number(node["angle"], path + ".angle");
+    return so3::fromAxisAngle(axis, angle);
+  }
+
+  void readState(const YAML::Node& node, const std::string& path, bool velocity_required,
+                 Matrix3* attitude_out, Vector3* velocity_out) const {
+    requireMap(node, path);
+    std::vector<std::string> required = {"attitude"};
+    if (velocity_required) required.push_back("angular_velocity");
+    checkKeys(node, path, {"attitude", "angular_velocity"}, required);
+    *attitude_out = attitude(node["attitude"], path + ".attitude");
+    if (node["angular_velocity"]) {
+      *velocity_out = vector3(node["angular_velocity"], path + ".angular_velocity");
+    }
+  }
+
+  std::vector<EffectSpec> effects(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsSequence()) {
+      fail(node, path, "expected a list (use [] for none), got " + show(node));
+    }
+    std::vector<EffectSpec> out;
+    std::set<std::string> seen;
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const YAML::Node entry = node[i];
+      const std::string epath = path + "[" + std::to_string(i) + "]";
+      if (!entry.IsMap() || entry.size() != 1) {
+        fail(entry, epath,
+             "expected one effect as {name: {...}}, got " + show(entry) +
+                 " (names: gravity_gradient, disturbance_torque, actuator_limits, torque_noise)");
+      }
+      const auto kv = *entry.begin();
+      const std::string name = kv.first.Scalar();
+      const YAML::Node body = kv.second;
+      const std::string bpath = epath + "." + name;
+      // Several constant disturbances add up; the other effects are one-of-a-kind.
+      if (name != "disturbance_torque" && !seen.insert(name).second) {
+        fail(kv.first, bpath, "duplicate effect (at most one " + name + ")");
+      }
+      if (name == "gravity_gradient") {
+        requireMap(body, bpath);
+        checkKeys(body, bpath, {"mu", "orbit_radius"}, {"mu", "orbit_radius"});
+        GravityGradientSpec g;
+        g.mu = positive(body["mu"], bpath + ".mu");
+        g.orbit_radius = positive(body["orbit_radius"], bpath + ".orbit_radius");
+        out.emplace_back(g);
+      } else if (name == "disturbance_torque") {
+        requireMap(body, bpath);
+        checkKeys(body, bpath, {"frame", "value"}, {"frame", "value"});
+        DisturbanceTorqueSpec d;
+        d.frame = scalarString(body["frame"], bpath + ".frame");
+        if (d.frame != "body" && d.frame != "world") {
+          fail(body["frame"], bpath + ".frame",
+               "unknown value " + show(body["frame"]) + " (expected body or world)");
+        }
+        d.value = vector3(body["value"], bpath + ".value");
+        out.emplace_back(d);
+      } else if (name == "actuator_limits") {
+        requireMap(body, bpath);
+        checkKeys(body, bpath, {"max_torque"}, {"max_torque"});
+        ActuatorLimitsSpec a;
+        a.max_torque = vector3(body["max_torque"], bpath + ".max_torque");
+        for (int k = 0; k < 3; ++k) {
+          if (!(a.max_torque(k) > 0.0)) {
+            fail(body["max_torque"][k], bpath + ".max_torque[" + std::to_string(k) + "]",
+                 "must be > 0 N m, got " + show(body["max_torque"][k]));
+          }
+        }
+        out.emplace_back(a);
+      } else if (name == "torque_noise") {
+        requireMap(body, bpath);
+        checkKeys(body, bpath, {"std", "seed"}, {"std", "seed"});
+        TorqueNoiseSpec t;
+        t.std = vector3(body["std"], bpath + ".std");
+        for (int k = 0; k < 3; ++k) {
+          if (t.std(k) < 0.0) {
+            fail(body["std"][k], bpath + ".std[" + std::to_string(k) + "]",
+                 "must be >= 0 N m, got " + show(body["std"][k]));
+          }
+        }
+        const YAML::Node seed = body["seed"];
+        const std::string& s = seed.IsScalar() ? seed.Scalar() : std::string();
+        char* end = nullptr;
+        errno = 0;
+        const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+        if (s.empty() || s[0] == '-' || end != s.c_str() + s.size() || errno == ERANGE ||
+            seed.Tag() == "!") {
+          fail(seed, bpath + ".seed", "expected a non-negative integer, got " + show(seed));
+        }
+        t.seed = v;
+        out.emplace_back(t);
+      } else {
+        fail(kv.first, bpath,
+             "unknown effect (expected gravity_gradient, disturbance_torque, actuator_limits or "
+             "torque_noise)");
+      }
+    }
+    return out;
+  }
+
+  double positive(const YAML::Node& node, const std::string& path) const {
+    const double v = number(node, path);
+    if (!(v > 0.0)) fail(node, path, "must be > 0, got " + show(node));
+    return v;
+  }
+
+  std::string source_;
+};
+
+std::string vec(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v(i));
+  return s + "]";
+}
+
+std::string quaternionOf(const Matrix3& R) {
+  const Eigen::Quaterniond q = so3::toQuaternion(R);
+  return "{quaternion: " + vec(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z())) + "}";
+}
+
+}  // namespace
+
+std::string effectName(const EffectSpec& effect) {
+  switch (effect.index()) {
+    case 0:
+      return "gravity_gradient";
+    case 1:
+      return "disturbance_torque";
+    case 2:
+      return "actuator_limits";
+    default:
+      return "torque_noise";
+  }
+}
+
+Scene parseScene(const std::string& yaml_text, const std::string& source) {
+  return SceneParser(source).parse(yaml_text);
+}
+
+Scene loadScene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InvalidInput("scene: cannot read '" + path + "'");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseScene(text.str(), path);
+}
+
+std::string formatScene(const Scene& scene) {
+  const PlanningProblem& p = scene.problem;
+  std::ostringstream out;
+  out << "# written by formatScene; units: SI (kg m^2, s, rad, rad/s, N m)\n";
+  if (scene.system != "rigid_body") {
+    out << "system: " << scene.system << "\n";
+    out << "control_weights: " << vec(scene.control_weights) << "\n";
+  }
+  out << "inertia: [" << vec(p.inertia.row(0).transpose()) << ", "
+      << vec(p.inertia.row(1).transpose()) << ", " << vec(p.inertia.row(2).transpose()) << "]\n";
+  if (scene.allow_nonphysical_inertia) out << "allow_nonphysical_inertia: true\n";
+  out << "duration: " << fmt(p.duration) << "\n";
+  out << "steps: " << p.steps << "\n";
+  out << "scheme: " << schemeName(p.scheme) << "\n";
+  out << "initial: {attitude: " << quaternionOf(p.initial_attitude)
+      << ", angular_velocity: " << vec(p.initial_velocity) << "}\n";
+  out << "final: {attitude: " << quaternionOf(p.final_attitude)
+      << ", angular_velocity: " << vec(p.final_velocity) << "}\n";
+  out << "effects:";
+  if (scene.effects.empty()) out << " []";
+  out << "\n";
+  for (const EffectSpec& e : scene.effects) {
+    out << "  - " << effectName(e) << ": ";
+    if (const auto* g = std::get_if<GravityGradientSpec>(&e)) {
+      out << "{mu: " << fmt(g->mu) << ", orbit_radius: " << fmt(g->orbit_radius) << "}\n";
+    } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&e)) {
+      out << "{frame: " << d->frame << ", value: " << vec(d->value) << "}\n";
+    } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&e)) {
+      out << "{max_torque: " << vec(a->max_torque) << "}\n";
+    } else if (const auto* t = std::get_if<TorqueNoiseSpec>(&e)) {
+      out << "{std: " << vec(t->std) << ", seed: " << t->seed << "}\n";
+    }
+  }
+  return out.str();
+}
+
+void requirePlannable(const Scene& scene) {
+  if (scene.system != "rigid_body") {
+    throw InvalidInput(scene.source + ": system: '" + scene.system +
+                       "' is not supported by the planner yet (only rigid_body)");
+  }
+  if (!scene.effects.empty()) {
+    std::string names;
+    for (const EffectSpec& e : scene.effects) {
+      const std::string n = effectName(e);
+      if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
+    }
+    throw InvalidInput(scene.source + ": effects are not supported by the planner yet: " + names);
+  }
+}
+
+}  // namespace attitude_planner

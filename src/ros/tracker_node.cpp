@@ -66,7 +66,7 @@ PrincipalBox principalBox(const Matrix3& inertia, double size) {
   Vector3 edges = squared.cwiseSqrt();
   const double largest = edges.maxCoeff();
   edges = largest > 0.0 ? Vector3(edges * (size / largest)) : Vector3::Constant(size);
-  box.dimensions = edges.cwiseMax(0.02 * size);
+  box.dimensions = edges.cwiseMax(0.1 * size);
   return box;
 }
 
@@ -114,6 +114,7 @@ bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
   if (client && client->isValid()) {
     PlanAttitudeManeuver srv;
     srv.request.inertia = rc::inertiaToMsg(problem.inertia);
+    srv.request.allow_nonphysical_inertia = problem.allow_nonphysical_inertia;
     srv.request.initial_attitude = rc::attitudeToMsg(problem.initial_attitude);
     srv.request.initial_angular_velocity = rc::vectorToMsg(problem.initial_velocity);
     srv.request.final_attitude = rc::attitudeToMsg(problem.final_attitude);
@@ -179,6 +180,13 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   std::string error;
   try {
     const Scene parsed = loadScene(scene);
+    if (parsed.system != "rigid_body") {
+      throw InvalidInput("system: '" + parsed.system + "' is not replayed by this node (rigid_body only)");
+    }
+    if (!parsed.effects.empty()) {
+      ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only", scene.c_str(),
+               parsed.effects.size());
+    }
     ros::ServiceClient client;
     if (!plan_in_process) {
       client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
@@ -265,6 +273,7 @@ void TrackerNode::runReplay(Replay replay) {
     // The core validates the body (symmetric positive definite J) with the problem checks.
     PlanningProblem problem;
     problem.inertia = inertia;
+    problem.allow_nonphysical_inertia = true;  // replaying only needs J SPD
     problem.duration = N * plan.time_step;
     problem.steps = N;
     problem.initial_attitude = plan.attitude.front();

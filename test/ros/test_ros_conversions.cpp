@@ -19,6 +19,7 @@ PlanAttitudeManeuver::Request seedRequest() {
   PlanAttitudeManeuver::Request r;
   const double J[9] = {13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37};
   for (int i = 0; i < 9; ++i) r.inertia[i] = J[i];
+  r.allow_nonphysical_inertia = true;  // the seed J violates J1 + J2 >= J3
   r.initial_attitude.w = 1.0;
   r.final_attitude = rc::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3));
   r.duration = 12.8;

@@ -68,6 +68,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
                                    SolverOptions* options) {
   PlanningProblem p;
   p.inertia = inertiaFromMsg(req.inertia);
+  p.allow_nonphysical_inertia = req.allow_nonphysical_inertia;
   p.duration = req.duration;
   if (req.steps > defaults.max_steps) {
     throw InvalidInput("steps: " + std::to_string(req.steps) + " exceeds the node's ~max_steps = " +

@@ -50,7 +50,7 @@ struct PrincipalBox {
 
 /// Box edges a, b, c of a uniform box with principal moments J1..J3 (J1 = m (b² + c²)/12, ...),
 /// scaled so that the largest edge is `size` [m] (the mass only scales the box, so it is not
-/// needed). Degenerate (flat) bodies get a minimum edge of 2 % of `size`.
+/// needed). Flat or non-physical inertias (J1 + J2 < J3) get a minimum edge of 10 % of `size`.
 PrincipalBox principalBox(const Matrix3& inertia, double size);
 
 /// Markers of the body: id 0 the box, ids 1..3 arrows along the principal axes (red, green, blue

@@ -6,3 +6,15 @@ find_package(rostest REQUIRED)
 catkin_add_gtest(test_ros_conversions test/ros/test_ros_conversions.cpp)
 target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
 list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
+
+# rostest gtests: each launches the node(s) under test and a gtest client.
+foreach(name planner_service planner_action tracker)
+  add_rostest_gtest(test_${name} test/ros/${name}.test test/ros/test_${name}.cpp)
+  target_link_libraries(test_${name} ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+  add_dependencies(test_${name} attitude_planner_node attitude_tracker_node)
+  list(APPEND AP_EXPECTED_TESTS test_${name})
+endforeach()
+
+# rostest with the stock checkers (advertisetest, publishtest) on the whole demo pipeline.
+add_rostest(test/ros/demo_pipeline.test)
+list(APPEND AP_EXPECTED_TESTS demo_pipeline)

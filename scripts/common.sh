@@ -17,7 +17,7 @@ DEBIAN_PACKAGES=(
   libeigen3-dev libnlopt-cxx-dev libyaml-cpp-dev libboost-math-dev libgtest-dev
   python3-numpy python3-matplotlib python3-yaml
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
-  python3-visualization-msgs python3-rostopic
+  python3-visualization-msgs python3-rostopic python3-rosservice
 )
 
 log() { printf '[attitude_planner] %s\n' "$*" >&2; }

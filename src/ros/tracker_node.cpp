@@ -84,7 +84,7 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   m.scale.x = box.dimensions.x();
   m.scale.y = box.dimensions.y();
   m.scale.z = box.dimensions.z();
-  m.color = color(0.75f, 0.75f, 0.8f, 0.7f);
+  m.color = color(0.55f, 0.7f, 0.95f, 0.85f);
   array.markers.push_back(m);
   const std_msgs::ColorRGBA colors[3] = {color(0.9f, 0.1f, 0.1f, 1.0f),
                                          color(0.1f, 0.8f, 0.1f, 1.0f),

@@ -15,6 +15,13 @@ foreach(name planner_service planner_action tracker)
   list(APPEND AP_EXPECTED_TESTS test_${name})
 endforeach()
 
+# The tracker planning a scene at start-up: through the service, and in-process (same checks).
+add_rostest_gtest(test_tracker_scene test/ros/tracker_scene_service.test test/ros/test_tracker_scene.cpp)
+target_link_libraries(test_tracker_scene ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_scene attitude_planner_node attitude_tracker_node)
+add_rostest(test/ros/tracker_scene_in_process.test DEPENDENCIES test_tracker_scene)
+list(APPEND AP_EXPECTED_TESTS test_tracker_scene tracker_scene_in_process)
+
 # rostest with the stock checkers (advertisetest, publishtest) on the whole demo pipeline.
 add_rostest(test/ros/demo_pipeline.test)
 list(APPEND AP_EXPECTED_TESTS demo_pipeline)

@@ -45,7 +45,9 @@ geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R) {
   return m;
 }
 
-Vector3 vectorFromMsg(const geometry_msgs::Vector3& v) { return Vector3(v.x, v.y, v.z); }
+Vector3 vectorFromMsg(const geometry_msgs::Vector3& v) {
+  return Vector3(v.x, v.y, v.z);
+}
 
 geometry_msgs::Vector3 vectorToMsg(const Vector3& v) {
   geometry_msgs::Vector3 m;
@@ -93,8 +95,7 @@ Maneuver maneuverFromMsg(const AttitudeManeuver& msg) {
   if (rows < 2) {
     throw InvalidInput("maneuver.attitude: needs N + 1 >= 2 rows, got " + std::to_string(rows));
   }
-  if (msg.time.size() != rows || msg.angular_velocity.size() != rows ||
-      msg.torque.size() != rows) {
+  if (msg.time.size() != rows || msg.angular_velocity.size() != rows || msg.torque.size() != rows) {
     throw InvalidInput("maneuver: arrays disagree in length (time " +
                        std::to_string(msg.time.size()) + ", attitude " + std::to_string(rows) +
                        ", angular_velocity " + std::to_string(msg.angular_velocity.size()) +

@@ -11,8 +11,8 @@ T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Val
   T value;
   nh.param(name, value, fallback);
   if (!valid(value)) {
-    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement
-                         << "); using " << fallback);
+    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
+                         << fallback);
     return fallback;
   }
   return value;
@@ -45,20 +45,23 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   d.time_budget = readParam<double>(
       pnh, "time_budget", d.time_budget, [](double v) { return std::isfinite(v) && v >= 0.0; },
       ">= 0 s, 0 = none");
-  d.max_steps = readParam<int>(pnh, "max_steps", d.max_steps, [](int v) { return v >= 4; }, ">= 4");
+  d.max_steps = readParam<int>(
+      pnh, "max_steps", d.max_steps, [](int v) { return v >= 4; }, ">= 4");
   defaults_ = d;
   world_frame_ = readParam<std::string>(
       pnh, "world_frame", "world", [](const std::string& s) { return !s.empty(); }, "non-empty");
   body_frame_ = readParam<std::string>(
       pnh, "body_frame", "body", [](const std::string& s) { return !s.empty(); }, "non-empty");
-  threads_ = readParam<int>(pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
+  threads_ = readParam<int>(
+      pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
 
   service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);
   action_server_ = std::make_unique<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>>(
       nh_, "plan_attitude_maneuver_action",
       [this](const PlanAttitudeManeuverGoalConstPtr& goal) { onPlanGoal(goal); }, false);
   action_server_->start();
-  ROS_INFO_STREAM("attitude_planner_node ready: service " << service_.getService() << ", action "
+  ROS_INFO_STREAM("attitude_planner_node ready: service "
+                  << service_.getService() << ", action "
                   << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme " << d.scheme
                   << ", solver " << d.solver << ", tolerance " << d.tolerance << ", max_iterations "
                   << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "

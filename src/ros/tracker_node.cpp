@@ -27,8 +27,8 @@ T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Val
   T value;
   nh.param(name, value, fallback);
   if (!valid(value)) {
-    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement
-                         << "); using " << fallback);
+    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
+                         << fallback);
     return fallback;
   }
   return value;
@@ -86,9 +86,8 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   m.scale.z = box.dimensions.z();
   m.color = color(0.55f, 0.7f, 0.95f, 0.85f);
   array.markers.push_back(m);
-  const std_msgs::ColorRGBA colors[3] = {color(0.9f, 0.1f, 0.1f, 1.0f),
-                                         color(0.1f, 0.8f, 0.1f, 1.0f),
-                                         color(0.1f, 0.3f, 1.0f, 1.0f)};
+  const std_msgs::ColorRGBA colors[3] = {
+      color(0.9f, 0.1f, 0.1f, 1.0f), color(0.1f, 0.8f, 0.1f, 1.0f), color(0.1f, 0.3f, 1.0f, 1.0f)};
   for (int i = 0; i < 3; ++i) {
     visualization_msgs::Marker a;
     a.header = m.header;
@@ -109,8 +108,8 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
 }
 
 bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
-               const std::string& world_frame, const std::string& body_frame,
-               AttitudeManeuver* msg, double* solve_time, double* cost, std::string* error) {
+               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
+               double* solve_time, double* cost, std::string* error) {
   if (client && client->isValid()) {
     PlanAttitudeManeuver srv;
     srv.request.inertia = rc::inertiaToMsg(problem.inertia);
@@ -181,11 +180,12 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   try {
     const Scene parsed = loadScene(scene);
     if (parsed.system != "rigid_body") {
-      throw InvalidInput("system: '" + parsed.system + "' is not replayed by this node (rigid_body only)");
+      throw InvalidInput("system: '" + parsed.system +
+                         "' is not replayed by this node (rigid_body only)");
     }
     if (!parsed.effects.empty()) {
-      ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only", scene.c_str(),
-               parsed.effects.size());
+      ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only",
+               scene.c_str(), parsed.effects.size());
     }
     ros::ServiceClient client;
     if (!plan_in_process) {
@@ -216,7 +216,9 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   publishDone(failed);
 }
 
-TrackerNode::~TrackerNode() { stopReplay(); }
+TrackerNode::~TrackerNode() {
+  stopReplay();
+}
 
 void TrackerNode::onManeuver(const AttitudeManeuver::ConstPtr& msg) {
   Replay replay;

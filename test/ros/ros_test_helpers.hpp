@@ -20,8 +20,7 @@ void fillSeedRequest(Request* r, int steps = 32, double angle = M_PI / 3) {
   r->inertia = seedInertia();
   r->allow_nonphysical_inertia = true;  // the seed's J violates J1 + J2 >= J3
   r->initial_attitude.w = 1.0;
-  r->final_attitude =
-      ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), angle));
+  r->final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), angle));
   r->duration = 12.8;
   r->steps = steps;
 }

@@ -54,16 +54,16 @@ TEST_F(PlannerService, SeedSlewMeetsTheBoundaryData) {
   ASSERT_EQ(m.time.size(), size_t(N + 1));
   ASSERT_EQ(m.angular_velocity.size(), size_t(N + 1));
   ASSERT_EQ(m.torque.size(), size_t(N + 1));
-  EXPECT_DOUBLE_EQ(m.time_step, 12.8 / N);  // h [s]
-  EXPECT_NEAR(m.time.back(), 12.8, 1e-12);  // t_N = T [s]
+  EXPECT_DOUBLE_EQ(m.time_step, 12.8 / N);                          // h [s]
+  EXPECT_NEAR(m.time.back(), 12.8, 1e-12);                          // t_N = T [s]
   EXPECT_EQ(rc::vectorFromMsg(m.torque.front()), Vector3::Zero());  // τ_0 = 0
   EXPECT_EQ(rc::vectorFromMsg(m.torque.back()), Vector3::Zero());   // τ_N = 0
   const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
   EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.back(), "R_N"), target), 1e-8);
-  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.front(), "R_0"),
-                              Matrix3::Identity()), 1e-15);
-  EXPECT_LT(res.terminal_attitude_error, 1e-8);   // [rad]
-  EXPECT_LT(res.terminal_velocity_error, 1e-8);   // [rad/s]
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.front(), "R_0"), Matrix3::Identity()),
+            1e-15);
+  EXPECT_LT(res.terminal_attitude_error, 1e-8);                          // [rad]
+  EXPECT_LT(res.terminal_velocity_error, 1e-8);                          // [rad/s]
   EXPECT_LT(rc::vectorFromMsg(m.angular_velocity[N - 1]).norm(), 1e-8);  // rest at the end
   EXPECT_GT(res.cost, 0.0);
   EXPECT_GT(res.iterations, 0);

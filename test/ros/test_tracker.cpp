@@ -4,12 +4,12 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include <boost/filesystem.hpp>
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_listener.h>
+#include <boost/filesystem.hpp>
 
 #include <atomic>
 #include <mutex>
@@ -115,7 +115,7 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
   }
   ASSERT_TRUE(done.success) << done.message;
   EXPECT_EQ(done.steps, kSteps);
-  EXPECT_NEAR(done.duration, 3.2, 1e-12);  // N h [s]
+  EXPECT_NEAR(done.duration, 3.2, 1e-12);          // N h [s]
   EXPECT_LT(done.terminal_attitude_error, 1e-12);  // same torques, same integrator [rad]
   EXPECT_LT(done.max_attitude_deviation, 1e-12);
   EXPECT_EQ(done.plan_solve_time, -1.0);  // not planned by the tracker
@@ -123,8 +123,8 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
   EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(done.final_attitude, "final"), R_N), 1e-12);
 
   // The last tf world → body is R_N (stamped with the last step's time).
-  ASSERT_TRUE(waitFor([&] { return tf_buffer.canTransform("world", "body", done.header.stamp); },
-                      10.0));
+  ASSERT_TRUE(
+      waitFor([&] { return tf_buffer.canTransform("world", "body", done.header.stamp); }, 10.0));
   const geometry_msgs::TransformStamped tf =
       tf_buffer.lookupTransform("world", "body", done.header.stamp);
   EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(tf.transform.rotation, "tf"), R_N), 1e-9);
@@ -157,11 +157,11 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
   }
   rosbag::View tf_view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf"}));
   std::vector<tf2_msgs::TFMessage> tfs;
-  for (const rosbag::MessageInstance& m : tf_view) tfs.push_back(*m.instantiate<tf2_msgs::TFMessage>());
+  for (const rosbag::MessageInstance& m : tf_view)
+    tfs.push_back(*m.instantiate<tf2_msgs::TFMessage>());
   ASSERT_EQ(tfs.size(), size_t(kSteps + 1));
-  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(tfs.back().transforms.at(0).transform.rotation,
-                                                  "bag tf"),
-                              R_N),
+  EXPECT_LT(so3::angleBetween(
+                rc::attitudeFromMsg(tfs.back().transforms.at(0).transform.rotation, "bag tf"), R_N),
             1e-9);
   bag.close();
 }
@@ -175,7 +175,8 @@ TEST_F(Tracker, InconsistentManeuverIsRejectedWithAReason) {
   ASSERT_TRUE(waitFor([&] { return doneCount() > before; }, 30.0)) << "no done message";
   std::lock_guard<std::mutex> lock(mutex_);
   EXPECT_FALSE(done_.back().success);
-  EXPECT_NE(done_.back().message.find("arrays disagree"), std::string::npos) << done_.back().message;
+  EXPECT_NE(done_.back().message.find("arrays disagree"), std::string::npos)
+      << done_.back().message;
 }
 
 int main(int argc, char** argv) {

@@ -6,10 +6,10 @@
 
 #include <string>
 
-#include <boost/array.hpp>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
 #include <ros/time.h>
+#include <boost/array.hpp>
 
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/errors.hpp"
@@ -47,7 +47,7 @@ Maneuver maneuverFromMsg(const AttitudeManeuver& msg);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
-  std::string scheme = "paper";  ///< "paper" | "variational"
+  std::string scheme = "paper";   ///< "paper" | "variational"
   std::string solver = "newton";  ///< "newton" | "nlopt"
   double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
   int max_iterations = 200;       ///< iteration limit
@@ -71,8 +71,8 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   p.allow_nonphysical_inertia = req.allow_nonphysical_inertia;
   p.duration = req.duration;
   if (req.steps > defaults.max_steps) {
-    throw InvalidInput("steps: " + std::to_string(req.steps) + " exceeds the node's ~max_steps = " +
-                       std::to_string(defaults.max_steps));
+    throw InvalidInput("steps: " + std::to_string(req.steps) +
+                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
   }
   p.steps = req.steps;
   p.initial_attitude = attitudeFromMsg(req.initial_attitude, "initial_attitude");

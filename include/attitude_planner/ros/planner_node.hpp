@@ -13,7 +13,8 @@
 //   ~max_steps       int     100000     largest accepted N (>= 4)
 //   ~world_frame     string  "world"    frame_id of the returned maneuver
 //   ~body_frame      string  "body"     child_frame_id of the returned maneuver
-//   ~threads         int     4          service threads (>= 2: concurrent requests are solved in parallel)
+//   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
+//   parallel)
 //
 // Each solve owns all its state, so concurrent requests never share mutable data.
 #pragma once
@@ -109,8 +110,10 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
     out.solver_ran = true;
     out.error_code = classifyResult(out.result, cancelled, timed_out, budget);
     out.message = out.result.message;
-    if (out.error_code == PlanErrorCode::TIMED_OUT && out.message.find("time") == std::string::npos) {
-      out.message = "time budget of " + std::to_string(budget) + " s exhausted (" + out.message + ")";
+    if (out.error_code == PlanErrorCode::TIMED_OUT &&
+        out.message.find("time") == std::string::npos) {
+      out.message =
+          "time budget of " + std::to_string(budget) + " s exhausted (" + out.message + ")";
     } else if (out.error_code == PlanErrorCode::CANCELLED &&
                out.message.find("cancel") == std::string::npos) {
       out.message = "cancelled (" + out.message + ")";

@@ -2,13 +2,15 @@
 // of the plan are integrated again through simulate() (the core's DiscreteScheme), so what rviz
 // shows is the rigid body's response to the planned torques, not the plan's own attitudes.
 //
-// Subscribes  maneuver          (attitude_planner/AttitudeManeuver)   a new one replaces the current replay
-// Publishes   /tf               world → body at every step, stamped start + t_k / rate_factor
+// Subscribes  maneuver          (attitude_planner/AttitudeManeuver)   a new one replaces the
+// current replay Publishes   /tf               world → body at every step, stamped start + t_k /
+// rate_factor
 //             torque            (geometry_msgs/WrenchStamped, frame body)      τ_k [N·m]
 //             angular_velocity  (geometry_msgs/Vector3Stamped, frame body)     Ω_k [rad/s]
 //             body_marker       (visualization_msgs/MarkerArray, frame body)  box + principal axes
-//             attitude_path     (visualization_msgs/Marker LINE_STRIP, world)  tip of the body x axis
-//             done              (attitude_planner/ReplayResult, latched)      when a replay ends
+//             attitude_path     (visualization_msgs/Marker LINE_STRIP, world)  tip of the body x
+//             axis done              (attitude_planner/ReplayResult, latched)      when a replay
+//             ends
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
 //
 // Private parameters:
@@ -61,8 +63,8 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
 /// Plans a scene: via the service (if `client` is valid) or in-process. Fills `msg` and the
 /// planner's solve time [s] and cost; returns false with `error` set if planning failed.
 bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
-               const std::string& world_frame, const std::string& body_frame,
-               AttitudeManeuver* msg, double* solve_time, double* cost, std::string* error);
+               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
+               double* solve_time, double* cost, std::string* error);
 
 /// The node.
 class TrackerNode {
@@ -94,13 +96,13 @@ class TrackerNode {
   ros::Subscriber maneuver_sub_;
   ros::Publisher torque_pub_, velocity_pub_, marker_pub_, path_pub_, done_pub_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
-  double rate_factor_ = 1.0;   ///< maneuver seconds per ROS second
-  double start_delay_ = 0.5;   ///< [s] ROS time before step 0
-  std::string world_frame_;    ///< fixed frame
-  std::string body_frame_;     ///< body frame
-  double body_size_ = 1.0;     ///< [m]
-  double axis_length_ = 0.9;   ///< [m]
-  double path_radius_ = 1.2;   ///< [m]
+  double rate_factor_ = 1.0;  ///< maneuver seconds per ROS second
+  double start_delay_ = 0.5;  ///< [s] ROS time before step 0
+  std::string world_frame_;   ///< fixed frame
+  std::string body_frame_;    ///< body frame
+  double body_size_ = 1.0;    ///< [m]
+  double axis_length_ = 0.9;  ///< [m]
+  double path_radius_ = 1.2;  ///< [m]
   bool exit_when_done_ = false;
 
   std::mutex replay_mutex_;  ///< guards replay_thread_ (start/stop from callbacks)

@@ -12,33 +12,60 @@ namespace attitude_planner {
 
 template <int N>
 struct Dual {
-  double v = 0.0;                                                       ///< value
-  Eigen::Matrix<double, N, 1> d = Eigen::Matrix<double, N, 1>::Zero();  ///< ∂value/∂direction_i
+  /// ∂value/∂direction_i. A plain array: the small fixed loops below inline and vectorize, which
+  /// an Eigen vector member did not (it dominated the Newton solver's profile).
+  struct Derivatives {
+    double x[N] = {};
+    double& operator()(int i) { return x[i]; }
+    double operator()(int i) const { return x[i]; }
+    /// As an Eigen row, for assembling Jacobians.
+    Eigen::Matrix<double, 1, N> transpose() const {
+      return Eigen::Map<const Eigen::Matrix<double, 1, N>>(x);
+    }
+  };
+
+  double v = 0.0;  ///< value
+  Derivatives d;   ///< derivatives
 
   Dual() = default;
   Dual(double value) : v(value) {}  // NOLINT: implicit from constants, as Eigen expects
-  Dual(double value, int direction) : v(value) { d(direction) = 1.0; }
+  Dual(double value, int direction) : v(value) { d.x[direction] = 1.0; }
 
   Dual& operator+=(const Dual& o) {
     v += o.v;
-    d += o.d;
+    for (int i = 0; i < N; ++i) d.x[i] += o.d.x[i];
     return *this;
   }
   Dual& operator-=(const Dual& o) {
     v -= o.v;
-    d -= o.d;
+    for (int i = 0; i < N; ++i) d.x[i] -= o.d.x[i];
     return *this;
   }
   Dual& operator*=(const Dual& o) {
-    d = d * o.v + o.d * v;
+    for (int i = 0; i < N; ++i) d.x[i] = d.x[i] * o.v + o.d.x[i] * v;
     v *= o.v;
     return *this;
   }
   Dual& operator/=(const Dual& o) {
-    d = (d * o.v - o.d * v) / (o.v * o.v);
-    v /= o.v;
+    const double inv = 1.0 / o.v;
+    const double q = v * inv;
+    for (int i = 0; i < N; ++i) d.x[i] = (d.x[i] - o.d.x[i] * q) * inv;
+    v = q;
     return *this;
   }
+  /// Multiplies value and derivatives by s.
+  Dual& scale(double s) {
+    v *= s;
+    for (int i = 0; i < N; ++i) d.x[i] *= s;
+    return *this;
+  }
+  Dual operator-() const {
+    Dual r;
+    r.v = -v;
+    for (int i = 0; i < N; ++i) r.d.x[i] = -d.x[i];
+    return r;
+  }
+  Dual operator+() const { return *this; }
 };
 
 template <int N>
@@ -74,43 +101,25 @@ Dual<N> operator-(Dual<N> a, double b) {
 }
 template <int N>
 Dual<N> operator-(double b, const Dual<N>& a) {
-  Dual<N> r;
-  r.v = b - a.v;
-  r.d = -a.d;
+  Dual<N> r = -a;
+  r.v += b;
   return r;
 }
 template <int N>
 Dual<N> operator*(Dual<N> a, double b) {
-  a.v *= b;
-  a.d *= b;
-  return a;
+  return a.scale(b);
 }
 template <int N>
 Dual<N> operator*(double b, Dual<N> a) {
-  a.v *= b;
-  a.d *= b;
-  return a;
+  return a.scale(b);
 }
 template <int N>
 Dual<N> operator/(Dual<N> a, double b) {
-  a.v /= b;
-  a.d /= b;
-  return a;
+  return a.scale(1.0 / b);
 }
 template <int N>
 Dual<N> operator/(double b, const Dual<N>& a) {
   return Dual<N>(b) / a;
-}
-template <int N>
-Dual<N> operator-(const Dual<N>& a) {
-  Dual<N> r;
-  r.v = -a.v;
-  r.d = -a.d;
-  return r;
-}
-template <int N>
-Dual<N> operator+(const Dual<N>& a) {
-  return a;
 }
 
 template <int N>
@@ -138,26 +147,26 @@ bool operator!=(const Dual<N>& a, const Dual<N>& b) {
   return a.v != b.v;
 }
 
+/// f(a) given f(a.v) = value and f'(a.v) = slope.
+template <int N>
+Dual<N> chain(const Dual<N>& a, double value, double slope) {
+  Dual<N> r;
+  r.v = value;
+  for (int i = 0; i < N; ++i) r.d.x[i] = slope * a.d.x[i];
+  return r;
+}
 template <int N>
 Dual<N> sqrt(const Dual<N>& a) {
-  Dual<N> r;
-  r.v = std::sqrt(a.v);
-  r.d = a.d / (2.0 * r.v);
-  return r;
+  const double s = std::sqrt(a.v);
+  return chain(a, s, 0.5 / s);
 }
 template <int N>
 Dual<N> sin(const Dual<N>& a) {
-  Dual<N> r;
-  r.v = std::sin(a.v);
-  r.d = a.d * std::cos(a.v);
-  return r;
+  return chain(a, std::sin(a.v), std::cos(a.v));
 }
 template <int N>
 Dual<N> cos(const Dual<N>& a) {
-  Dual<N> r;
-  r.v = std::cos(a.v);
-  r.d = -a.d * std::sin(a.v);
-  return r;
+  return chain(a, std::cos(a.v), -std::sin(a.v));
 }
 template <int N>
 Dual<N> abs(const Dual<N>& a) {
@@ -167,7 +176,8 @@ template <int N>
 Dual<N> atan2(const Dual<N>& y, const Dual<N>& x) {
   Dual<N> r;
   r.v = std::atan2(y.v, x.v);
-  r.d = (y.d * x.v - x.d * y.v) / (x.v * x.v + y.v * y.v);
+  const double n = x.v * x.v + y.v * y.v;
+  for (int i = 0; i < N; ++i) r.d.x[i] = (y.d.x[i] * x.v - x.d.x[i] * y.v) / n;
   return r;
 }
 

@@ -56,7 +56,7 @@ std::string effectName(const EffectSpec& effect);
 
 /// A parsed scene. Unknown keys and bad values throw InvalidInput naming the key and the value.
 struct Scene {
-  PlanningProblem problem;
+  PlanningProblem problem;            ///< what to plan (SI units, see planner.hpp)
   std::string source;                 ///< file name (for messages)
   std::string system = "rigid_body";  ///< "rigid_body" or "drift_two_input" (seed 001)
   Eigen::Vector2d control_weights = Eigen::Vector2d::Ones();  ///< c1, c2 (drift_two_input) [-]

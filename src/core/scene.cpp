@@ -120,7 +120,6 @@ class SceneParser {
     // planner node; here they gain the file name and the line of the key they name.
     try {
       validateProblem(p);
-      if (root["inertia"] && !scene.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
     } catch (const InvalidInput& e) {
       const std::string what = e.what();
       const std::string key = what.substr(0, what.find_first_of(".:"));

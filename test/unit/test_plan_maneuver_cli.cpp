@@ -1,0 +1,226 @@
+// End-to-end tests of the command-line tools plan_maneuver and simulate_torques: run the built
+// binaries on the shipped scenes and on bad inputs; check exit status, messages and outputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "attitude_planner/maneuver.hpp"
+#include "attitude_planner/scene.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+const std::string kBin = AP_BINARY_DIR "/../../devel/lib/attitude_planner/";
+const std::string kScenes = AP_SOURCE_DIR "/scenes/";
+
+struct ToolRun {
+  int status = -1;     ///< exit status
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs `tool args` through the shell, capturing both streams.
+ToolRun run(const std::string& tool, const std::string& args) {
+  const std::string command = "'" + kBin + tool + "' " + args + " 2>&1";
+  ToolRun r;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return r;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.output.append(buffer, n);
+  const int raw = pclose(pipe);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/ap_cli_test_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+    ASSERT_EQ(access((kBin + "plan_maneuver").c_str(), X_OK), 0)
+        << "plan_maneuver not built at " << kBin;
+  }
+  void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
+
+  /// Writes a scene file into the test directory and returns its path.
+  std::string writeScene(const std::string& name, const std::string& text) {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  std::string dir_;
+};
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "output:\n" << (haystack)
+
+}  // namespace
+
+TEST_F(CliTest, NloptPlanWritesCsvAndSummaryAndExitsZero) {
+  const std::string csv = dir_ + "/plan.csv", json = dir_ + "/plan.json";
+  const ToolRun r =
+      run("plan_maneuver", kScenes + "rest_to_rest.yaml --solver nlopt --steps 16 --csv " + csv +
+                               " --summary=" + json);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "converged                yes");
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"converged\": true");
+  EXPECT_CONTAINS(summary, "\"solver\": \"nlopt\"");
+  EXPECT_CONTAINS(summary, "\"scheme\": \"paper\"");
+  EXPECT_CONTAINS(summary, "\"steps\": 16");
+  for (const char* key :
+       {"iterations", "cost", "terminal_attitude_error", "terminal_velocity_error", "max_residual",
+        "solve_time_s", "duration", "dynamics_residual", "message"}) {
+    EXPECT_CONTAINS(summary, std::string("\"") + key + "\": ");
+  }
+  const ap::Maneuver m = ap::readManeuverCsv(csv);
+  ASSERT_EQ(m.steps(), 16);
+  EXPECT_NEAR(m.time.back(), 12.8, 1e-12);
+  EXPECT_TRUE(m.torque.back().isZero(0.0));
+  EXPECT_GT(m.torque[1].norm(), 0.0);
+  // Full precision: the cost in the summary is the cost of the CSV's torques to round-off.
+  double cost = 0.0;
+  for (const auto& t : m.torque) cost += 0.5 * t.squaredNorm();
+  const std::size_t at = summary.find("\"cost\": ") + 8;
+  EXPECT_NEAR(std::stod(summary.substr(at)), cost, 1e-14 * cost);
+
+  // The simulation entry point replays the CSV onto the scene's final state.
+  const ToolRun replay =
+      run("simulate_torques", kScenes + "rest_to_rest.yaml " + csv + " --max-miss 1e-9");
+  EXPECT_EQ(replay.status, 0) << replay.output;
+  EXPECT_CONTAINS(replay.output, "terminal attitude error");
+  // Against another scene the same torques miss, and --max-miss says so.
+  const ToolRun miss =
+      run("simulate_torques", kScenes + "slew_up.yaml " + csv + " --max-miss 1e-9");
+  EXPECT_EQ(miss.status, 1) << miss.output;
+  EXPECT_CONTAINS(miss.output, "exceeds --max-miss");
+}
+
+TEST_F(CliTest, DefaultSolverPlansBothShippedScenesAtTheirOwnSteps) {
+  for (const std::string scene : {"rest_to_rest", "slew_up"}) {
+    const std::string json = dir_ + "/" + scene + ".json";
+    const ToolRun r = run("plan_maneuver", kScenes + scene + ".yaml --summary " + json);
+    EXPECT_EQ(r.status, 0) << r.output;
+    const std::string summary = readFile(json);
+    EXPECT_CONTAINS(summary, "\"converged\": true");
+    EXPECT_CONTAINS(summary, "\"solver\": \"newton\"");
+    EXPECT_CONTAINS(summary, "\"steps\": 128");
+    const std::size_t at = summary.find("\"terminal_attitude_error\": ") + 27;
+    EXPECT_LT(std::stod(summary.substr(at)), 1e-10) << summary;
+  }
+}
+
+TEST_F(CliTest, ExitStatusAgreesWithConvergedForEverySolver) {
+  for (const std::string solver : {"newton", "nlopt"}) {
+    const std::string json = dir_ + "/" + solver + ".json";
+    const ToolRun r = run("plan_maneuver", kScenes + "slew_up.yaml --steps 16 --solver " + solver +
+                                               " --summary " + json);
+    const bool converged = readFile(json).find("\"converged\": true") != std::string::npos;
+    EXPECT_EQ(r.status == 0, converged) << solver << "\n" << r.output;
+    if (!converged) EXPECT_CONTAINS(r.output, "not converged");
+  }
+}
+
+TEST_F(CliTest, IterationLimitGivesNonConvergedExitOne) {
+  const ToolRun r = run("plan_maneuver", kScenes +
+                                             "slew_up.yaml --solver nlopt --steps 16 "
+                                             "--max-iterations 2 --scheme variational");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_CONTAINS(r.output, "plan_maneuver: not converged: ");
+  EXPECT_CONTAINS(r.output, "NLOPT_MAXEVAL_REACHED");
+  EXPECT_CONTAINS(r.output, "nlopt / variational");
+}
+
+TEST_F(CliTest, InvalidSceneExitsOneNamingTheKey) {
+  std::string text = readFile(kScenes + "rest_to_rest.yaml");
+  text.replace(text.find("duration: 12.8"), 14, "duration: -3");
+  const ToolRun r = run("plan_maneuver", writeScene("bad.yaml", text));
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_CONTAINS(r.output, "invalid input");
+  EXPECT_CONTAINS(r.output, "duration: must be a finite number > 0 s, got -3");
+
+  const ToolRun missing = run("plan_maneuver", dir_ + "/nope.yaml");
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_CONTAINS(missing.output, "nope.yaml");
+
+  const ToolRun steps = run("plan_maneuver", kScenes + "rest_to_rest.yaml --steps 2");
+  EXPECT_EQ(steps.status, 1);
+  EXPECT_CONTAINS(steps.output, "steps: must be >= 4, got 2");
+}
+
+TEST_F(CliTest, EffectsAndOtherSystemsAreRefusedNotIgnored) {
+  std::string text = readFile(kScenes + "rest_to_rest.yaml");
+  text.replace(text.find("effects: []"), 11,
+               "effects: [{gravity_gradient: {mu: 3.986004418e14, orbit_radius: 7.0e6}}]");
+  const std::string scene = writeScene("gg.yaml", text);
+  const ToolRun r = run("plan_maneuver", scene + " --solver nlopt --steps 16");
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_CONTAINS(r.output, "effects are not supported by the planner yet: gravity_gradient");
+
+  const ToolRun drift =
+      run("plan_maneuver", writeScene("drift.yaml",
+                                      "system: drift_two_input\n"
+                                      "control_weights: [1, 2]\n"
+                                      "duration: 2\nsteps: 32\n"
+                                      "initial: {attitude: {quaternion: [1, 0, 0, 0]}}\n"
+                                      "final: {attitude: {quaternion: [1, 0, 0, 0]}}\n"
+                                      "effects: []\n"));
+  EXPECT_EQ(drift.status, 1) << drift.output;
+  EXPECT_CONTAINS(drift.output, "drift_two_input");
+}
+
+TEST_F(CliTest, UsageErrorsNameTheFlag) {
+  const ToolRun unknown = run("plan_maneuver", kScenes + "rest_to_rest.yaml --stepz 4");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_CONTAINS(unknown.output, "unknown option '--stepz'");
+  EXPECT_CONTAINS(unknown.output, "usage: plan_maneuver");
+
+  const ToolRun missing = run("plan_maneuver", kScenes + "rest_to_rest.yaml --steps");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_CONTAINS(missing.output, "--steps: missing value");
+
+  const ToolRun not_number = run("plan_maneuver", kScenes + "rest_to_rest.yaml --tolerance abc");
+  EXPECT_EQ(not_number.status, 2);
+  EXPECT_CONTAINS(not_number.output, "--tolerance: expected a finite number, got 'abc'");
+
+  const ToolRun scheme = run("plan_maneuver", kScenes + "rest_to_rest.yaml --scheme rk4");
+  EXPECT_EQ(scheme.status, 2);
+  EXPECT_CONTAINS(scheme.output, "--scheme: unknown value 'rk4'");
+
+  const ToolRun no_scene = run("plan_maneuver", "");
+  EXPECT_EQ(no_scene.status, 2);
+  EXPECT_CONTAINS(no_scene.output, "missing SCENE.yaml");
+
+  const ToolRun help = run("plan_maneuver", "--help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_CONTAINS(help.output, "--max-iterations");
+
+  const ToolRun sim = run("simulate_torques", kScenes + "rest_to_rest.yaml");
+  EXPECT_EQ(sim.status, 2);
+  EXPECT_CONTAINS(sim.output, "expected SCENE.yaml and MANEUVER.csv");
+}
+
+TEST_F(CliTest, SimulateTorquesRejectsABadCsvNamingTheLine) {
+  const std::string csv = dir_ + "/bad.csv";
+  std::ofstream(csv) << "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz\n0,0,1,0,0,0,0,0,0,0,0,0\n"
+                        "1,0.1,1,0,0,0,0,0,0,x,0,0\n";
+  const ToolRun r = run("simulate_torques", kScenes + "rest_to_rest.yaml " + csv);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_CONTAINS(r.output, "line 3");
+}

@@ -16,7 +16,9 @@
 //   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
 //   parallel)
 //
-// Each solve owns all its state, so concurrent requests never share mutable data.
+// Each solve owns all its state, so concurrent requests never share mutable data: service calls
+// are solved in parallel (~threads); the action serves one goal at a time (a new goal preempts
+// the running one, which ends PREEMPTED with error CANCELLED).
 #pragma once
 
 #include <functional>

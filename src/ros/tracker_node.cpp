@@ -71,7 +71,8 @@ PrincipalBox principalBox(const Matrix3& inertia, double size) {
 }
 
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
-                                            const std::string& body_frame, const ros::Time& stamp) {
+                                            double path_radius, const std::string& body_frame,
+                                            const ros::Time& stamp) {
   visualization_msgs::MarkerArray array;
   visualization_msgs::Marker m;
   m.header.frame_id = body_frame;
@@ -104,6 +105,21 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
     a.color = colors[i];
     array.markers.push_back(a);
   }
+  // The body x axis up to the traced tip, linking the body to `attitude_path` (same colour).
+  visualization_msgs::Marker x_axis;
+  x_axis.header = m.header;
+  x_axis.ns = "body_x_axis";
+  x_axis.id = 4;
+  x_axis.type = visualization_msgs::Marker::ARROW;
+  x_axis.action = visualization_msgs::Marker::ADD;
+  x_axis.pose.orientation.w = 1.0;
+  x_axis.points.push_back(point(Vector3::Zero()));
+  x_axis.points.push_back(point(Vector3(path_radius, 0.0, 0.0)));
+  x_axis.scale.x = 0.015 * path_radius;  // shaft diameter [m]
+  x_axis.scale.y = 0.04 * path_radius;   // head diameter [m]
+  x_axis.scale.z = 0.06 * path_radius;   // head length [m]
+  x_axis.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  array.markers.push_back(x_axis);
   return array;
 }
 
@@ -351,7 +367,7 @@ void TrackerNode::runReplay(Replay replay) {
     velocity.vector = rc::vectorToMsg(replayed.angular_velocity[k]);
     velocity_pub_.publish(velocity);
 
-    marker_pub_.publish(bodyMarkers(box, axis_length_, body_frame_, stamp));
+    marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
     path.header.stamp = stamp;
     path.points.push_back(point(path_radius_ * R.col(0)));
     if (path.points.size() >= 2) path_pub_.publish(path);

@@ -156,3 +156,23 @@ TEST(PrincipalBox, UniformBoxMomentsAreRecovered) {
   EXPECT_NEAR(box.axes.determinant(), 1.0, 1e-12);
   EXPECT_NEAR(std::abs(box.axes.col(0).dot(R.col(2))), 1.0, 1e-12);
 }
+
+TEST(PrincipalBox, MarkersAreTheBoxThreeAxesAndTheTracedAxisInTheBodyFrame) {
+  const PrincipalBox box = principalBox(Vector3(5, 10, 13).asDiagonal().toDenseMatrix(), 1.0);
+  const visualization_msgs::MarkerArray a = bodyMarkers(box, 0.9, 1.2, "body", ros::Time(3.0));
+  ASSERT_EQ(a.markers.size(), 5u);
+  EXPECT_EQ(a.markers[0].type, visualization_msgs::Marker::CUBE);
+  for (const visualization_msgs::Marker& m : a.markers) {
+    EXPECT_EQ(m.header.frame_id, "body");
+    EXPECT_EQ(m.header.stamp, ros::Time(3.0));
+  }
+  for (int i = 1; i <= 4; ++i) EXPECT_EQ(a.markers[i].type, visualization_msgs::Marker::ARROW);
+  EXPECT_DOUBLE_EQ(a.markers[4].points[1].x, 1.2);  // tip of body x at path_radius [m]
+}
+
+TEST(PrincipalBox, NonPhysicalInertiaStillGetsAVisibleBox) {
+  // The seed's J violates J1 + J2 >= J3: the third edge would be imaginary; it is clamped.
+  const PrincipalBox box = principalBox(rc::inertiaFromMsg(seedRequest().inertia), 1.0);
+  EXPECT_NEAR(box.dimensions.maxCoeff(), 1.0, 1e-12);
+  EXPECT_NEAR(box.dimensions.minCoeff(), 0.1, 1e-12);
+}

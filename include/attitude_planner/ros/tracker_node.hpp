@@ -56,9 +56,11 @@ struct PrincipalBox {
 PrincipalBox principalBox(const Matrix3& inertia, double size);
 
 /// Markers of the body: id 0 the box, ids 1..3 arrows along the principal axes (red, green, blue
-/// for the smallest, middle, largest moment), all in `body_frame`.
+/// for the smallest, middle, largest moment), id 4 the body x axis up to the traced tip at
+/// `path_radius` [m] (orange, as `attitude_path`); all in `body_frame`.
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
-                                            const std::string& body_frame, const ros::Time& stamp);
+                                            double path_radius, const std::string& body_frame,
+                                            const ros::Time& stamp);
 
 /// Plans a scene: via the service (if `client` is valid) or in-process. Fills `msg` and the
 /// planner's solve time [s] and cost; returns false with `error` set if planning failed.

@@ -119,6 +119,23 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   EXPECT_LT(good.terminal_attitude_error, 1e-8);
 }
 
+TEST_F(PlannerService, SchemeAndSolverFieldsAreHonoured) {
+  PlanAttitudeManeuver::Request req = seed();
+  req.scheme = "variational";
+  const PlanAttitudeManeuver::Response variational = call(req);
+  ASSERT_TRUE(variational.success) << variational.message;
+  EXPECT_EQ(variational.maneuver.scheme, "variational");
+  EXPECT_LT(variational.terminal_attitude_error, 1e-8);
+
+  const PlanAttitudeManeuver::Response newton = call(seed());
+  req = seed();
+  req.solver = "nlopt";  // the independent cross-check reaches the same optimum
+  const PlanAttitudeManeuver::Response nlopt = call(req);
+  ASSERT_TRUE(newton.success) << newton.message;
+  ASSERT_TRUE(nlopt.success) << nlopt.message;
+  EXPECT_NEAR(nlopt.cost, newton.cost, 1e-6 * newton.cost);
+}
+
 TEST_F(PlannerService, IterationLimitIsNotConverged) {
   PlanAttitudeManeuver::Request req = seed();
   req.max_iterations = 1;

@@ -8,7 +8,7 @@ target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
 list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
 
 # rostest gtests: each launches the node(s) under test and a gtest client.
-foreach(name planner_service planner_action tracker)
+foreach(name planner_service planner_action tracker tracker_sim_time)
   add_rostest_gtest(test_${name} test/ros/${name}.test test/ros/test_${name}.cpp)
   target_link_libraries(test_${name} ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
   add_dependencies(test_${name} attitude_planner_node attitude_tracker_node)

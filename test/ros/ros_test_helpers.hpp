@@ -3,7 +3,9 @@
 
 #include <cmath>
 
+#include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/simulation.hpp"
 
 namespace attitude_planner {
 namespace ros_testing {
@@ -23,6 +25,22 @@ void fillSeedRequest(Request* r, int steps = 32, double angle = M_PI / 3) {
   r->final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), angle));
   r->duration = 12.8;
   r->steps = steps;
+}
+
+/// A test maneuver needing no planner: the seed body driven by smooth known torques τ_k [N·m],
+/// h = 0.1 s, `steps` steps (the paper scheme); `plan` receives the simulated maneuver.
+inline AttitudeManeuver testManeuver(int steps, Maneuver* plan) {
+  PlanningProblem p;
+  p.inertia = ros_conversions::inertiaFromMsg(seedInertia());
+  const DiscreteScheme scheme(SchemeKind::Paper, p.inertia, 0.1);
+  SimulationInput input;
+  input.torque.assign(steps + 1, Vector3::Zero());
+  for (int k = 1; k < steps; ++k) {
+    const double s = std::sin(M_PI * k / steps);
+    input.torque[k] = Vector3(2.0 * s, -1.0 * s * s, 0.5 * std::sin(2 * M_PI * k / steps));
+  }
+  *plan = simulate(scheme, input);
+  return ros_conversions::maneuverToMsg(*plan, p, "world", "body", ros::Time::now());
 }
 
 }  // namespace ros_testing

@@ -48,21 +48,6 @@ bool isSubscribed(const std::string& topic, const std::string& node) {
   return false;
 }
 
-/// The test maneuver: the seed body driven by smooth known torques τ_k [N·m], h = 0.1 s.
-AttitudeManeuver testManeuver(Maneuver* plan) {
-  PlanningProblem p;
-  p.inertia = rc::inertiaFromMsg(ros_testing::seedInertia());
-  const DiscreteScheme scheme(SchemeKind::Paper, p.inertia, 0.1);
-  SimulationInput input;
-  input.torque.assign(kSteps + 1, Vector3::Zero());
-  for (int k = 1; k < kSteps; ++k) {
-    const double s = std::sin(M_PI * k / kSteps);
-    input.torque[k] = Vector3(2.0 * s, -1.0 * s * s, 0.5 * std::sin(2 * M_PI * k / kSteps));
-  }
-  *plan = simulate(scheme, input);
-  return rc::maneuverToMsg(*plan, p, "world", "body", ros::Time::now());
-}
-
 }  // namespace
 
 class Tracker : public ::testing::Test {
@@ -106,7 +91,7 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
   tf2_ros::TransformListener listener(tf_buffer);
 
   Maneuver plan;
-  maneuver_pub_.publish(testManeuver(&plan));
+  maneuver_pub_.publish(ros_testing::testManeuver(kSteps, &plan));
   ASSERT_TRUE(waitFor([&] { return doneCount() > 0; }, 60.0)) << "no done message";
   ReplayResult done;
   {
@@ -168,7 +153,7 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
 
 TEST_F(Tracker, InconsistentManeuverIsRejectedWithAReason) {
   Maneuver plan;
-  AttitudeManeuver bad = testManeuver(&plan);
+  AttitudeManeuver bad = ros_testing::testManeuver(kSteps, &plan);
   bad.torque.pop_back();
   const size_t before = doneCount();
   maneuver_pub_.publish(bad);

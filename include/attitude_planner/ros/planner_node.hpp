@@ -74,12 +74,13 @@ class PlannerNode {
   /// Action execute callback: feedback per iteration; preemption cancels the solve.
   void onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal);
 
-  ros::NodeHandle nh_;
+  ros::NodeHandle nh_;  ///< public handle: the service and action resolve here
   ros_conversions::PlannerDefaults defaults_;  ///< read once in the constructor, then const
   std::string world_frame_;                    ///< frame_id of returned maneuvers
   std::string body_frame_;                     ///< child_frame_id of returned maneuvers
   int threads_ = 4;                            ///< spinner threads
-  ros::ServiceServer service_;
+  ros::ServiceServer service_;                 ///< plan_attitude_maneuver
+  /// plan_attitude_maneuver_action (one goal at a time)
   std::unique_ptr<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>> action_server_;
 };
 

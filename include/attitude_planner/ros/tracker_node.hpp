@@ -84,32 +84,39 @@ class TrackerNode {
     double plan_cost = -1.0;        ///< [N²·m²], −1 if unknown
   };
 
+  /// `maneuver` callback: replaces the running replay.
   void onManeuver(const AttitudeManeuver::ConstPtr& msg);
   /// Stops the current replay (if any) and starts a new one in its own thread.
   void startReplay(const Replay& replay);
+  /// Stops the running replay and joins its thread (within ~10 ms).
   void stopReplay();
   /// The replay thread's body; returns early when stop_ is set.
   void runReplay(Replay replay);
   /// Sleeps until ROS time `t` (sim-time friendly); false if stopped meanwhile.
   bool sleepUntil(const ros::Time& t);
+  /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
 
-  ros::NodeHandle nh_;
-  ros::Subscriber maneuver_sub_;
-  ros::Publisher torque_pub_, velocity_pub_, marker_pub_, path_pub_, done_pub_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
-  double rate_factor_ = 1.0;  ///< maneuver seconds per ROS second
-  double start_delay_ = 0.5;  ///< [s] ROS time before step 0
-  std::string world_frame_;   ///< fixed frame
-  std::string body_frame_;    ///< body frame
-  double body_size_ = 1.0;    ///< [m]
-  double axis_length_ = 0.9;  ///< [m]
-  double path_radius_ = 1.2;  ///< [m]
-  bool exit_when_done_ = false;
+  ros::NodeHandle nh_;            ///< public handle: topics and the service resolve here
+  ros::Subscriber maneuver_sub_;  ///< `maneuver`
+  ros::Publisher torque_pub_;     ///< `torque` τ_k [N·m], frame body
+  ros::Publisher velocity_pub_;   ///< `angular_velocity` Ω_k [rad/s], frame body
+  ros::Publisher marker_pub_;     ///< `body_marker`
+  ros::Publisher path_pub_;       ///< `attitude_path`
+  ros::Publisher done_pub_;       ///< `done` (latched)
+  tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
+  double rate_factor_ = 1.0;                      ///< maneuver seconds per ROS second
+  double start_delay_ = 0.5;                      ///< [s] ROS time before step 0
+  std::string world_frame_;                       ///< fixed frame
+  std::string body_frame_;                        ///< body frame
+  double body_size_ = 1.0;                        ///< largest box edge [m]
+  double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
+  double path_radius_ = 1.2;                      ///< distance of the traced body-x tip [m]
+  bool exit_when_done_ = false;                   ///< shut down after `done`
 
-  std::mutex replay_mutex_;  ///< guards replay_thread_ (start/stop from callbacks)
-  std::thread replay_thread_;
-  std::atomic<bool> stop_{false};
+  std::mutex replay_mutex_;        ///< guards replay_thread_ (start/stop from callbacks)
+  std::thread replay_thread_;      ///< runs runReplay()
+  std::atomic<bool> stop_{false};  ///< asks the replay thread to return
 };
 
 }  // namespace attitude_planner

@@ -1,0 +1,27 @@
+# Tests of the ROS layer: a plain gtest on the adapters (no master) and rostests that drive the
+# nodes through their service, action and topics. Every test name is appended to
+# AP_EXPECTED_TESTS (scripts/test checks one result file per name).
+find_package(rostest REQUIRED)
+
+catkin_add_gtest(test_ros_conversions test/ros/test_ros_conversions.cpp)
+target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
+list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
+
+# rostest gtests: each launches the node(s) under test and a gtest client.
+foreach(name planner_service planner_action tracker tracker_sim_time)
+  add_rostest_gtest(test_${name} test/ros/${name}.test test/ros/test_${name}.cpp)
+  target_link_libraries(test_${name} ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+  add_dependencies(test_${name} attitude_planner_node attitude_tracker_node)
+  list(APPEND AP_EXPECTED_TESTS test_${name})
+endforeach()
+
+# The tracker planning a scene at start-up: through the service, and in-process (same checks).
+add_rostest_gtest(test_tracker_scene test/ros/tracker_scene_service.test test/ros/test_tracker_scene.cpp)
+target_link_libraries(test_tracker_scene ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_scene attitude_planner_node attitude_tracker_node)
+add_rostest(test/ros/tracker_scene_in_process.test DEPENDENCIES test_tracker_scene)
+list(APPEND AP_EXPECTED_TESTS test_tracker_scene tracker_scene_in_process)
+
+# rostest with the stock checkers (advertisetest, publishtest) on the whole demo pipeline.
+add_rostest(test/ros/demo_pipeline.test)
+list(APPEND AP_EXPECTED_TESTS demo_pipeline)

@@ -1,0 +1,112 @@
+// Conversions between the ROS interfaces (msg/srv/action) and the ROS-free core types.
+// Every check that is about the *encoding* (a quaternion that is not unit, a NaN in a message)
+// lives here and throws InvalidInput naming the field; every check about the *problem* lives in
+// the core (validateProblem).
+#pragma once
+
+#include <string>
+
+#include <geometry_msgs/Quaternion.h>
+#include <geometry_msgs/Vector3.h>
+#include <ros/time.h>
+#include <boost/array.hpp>
+
+#include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/maneuver.hpp"
+#include "attitude_planner/planner.hpp"
+
+namespace attitude_planner {
+namespace ros_conversions {
+
+/// Largest accepted | |q| − 1 | of a request quaternion (it is normalized after the check).
+constexpr double kQuaternionNormTolerance = 1e-3;
+
+/// Rotation matrix (body → world) of a message quaternion; throws InvalidInput naming `field` if
+/// the quaternion has a non-finite entry, is zero or is not unit within kQuaternionNormTolerance.
+Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field);
+/// Unit Hamilton quaternion (w ≥ 0) of a rotation matrix.
+geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R);
+/// Eigen vector of a message vector (no check: the core checks finiteness with the field name).
+Vector3 vectorFromMsg(const geometry_msgs::Vector3& v);
+/// Message vector of an Eigen vector.
+geometry_msgs::Vector3 vectorToMsg(const Vector3& v);
+/// J [kg·m²] from a row-major float64[9] (symmetry and definiteness are checked by the core).
+Matrix3 inertiaFromMsg(const boost::array<double, 9>& j);
+/// Row-major float64[9] of J [kg·m²].
+boost::array<double, 9> inertiaToMsg(const Matrix3& J);
+
+/// Message of a maneuver planned for `problem`; header.frame_id = world_frame, child_frame_id =
+/// body_frame, header.stamp = stamp (the time t_0 refers to).
+AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& problem,
+                               const std::string& world_frame, const std::string& body_frame,
+                               const ros::Time& stamp);
+/// Core maneuver of a message; throws InvalidInput if the arrays disagree in length, N < 1, or an
+/// entry is not finite / not a unit quaternion.
+Maneuver maneuverFromMsg(const AttitudeManeuver& msg);
+
+/// Planner defaults that fill the empty/zero fields of a request (the node's private params).
+struct PlannerDefaults {
+  std::string scheme = "paper";   ///< "paper" | "variational"
+  std::string solver = "newton";  ///< "newton" | "nlopt"
+  double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
+  int max_iterations = 200;       ///< iteration limit
+  double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none
+  int max_steps = 100000;         ///< largest accepted N
+};
+
+/// Builds the problem and solver options of a service request or action goal (both have the same
+/// fields). Throws InvalidInput naming the field and the value.
+template <class Request>
+PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& defaults,
+                                   SolverOptions* options);
+
+// ---- templates ----------------------------------------------------------------------------------
+
+template <class Request>
+PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& defaults,
+                                   SolverOptions* options) {
+  PlanningProblem p;
+  p.inertia = inertiaFromMsg(req.inertia);
+  p.allow_nonphysical_inertia = req.allow_nonphysical_inertia;
+  p.duration = req.duration;
+  if (req.steps > defaults.max_steps) {
+    throw InvalidInput("steps: " + std::to_string(req.steps) +
+                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
+  }
+  p.steps = req.steps;
+  p.initial_attitude = attitudeFromMsg(req.initial_attitude, "initial_attitude");
+  p.initial_velocity = vectorFromMsg(req.initial_angular_velocity);
+  p.final_attitude = attitudeFromMsg(req.final_attitude, "final_attitude");
+  p.final_velocity = vectorFromMsg(req.final_angular_velocity);
+  const std::string scheme = req.scheme.empty() ? defaults.scheme : req.scheme;
+  try {
+    p.scheme = parseSchemeName(scheme);
+  } catch (const InvalidInput&) {
+    throw InvalidInput("scheme: unknown value '" + scheme + "' (expected paper or variational)");
+  }
+  options->solver = req.solver.empty() ? defaults.solver : req.solver;
+  if (options->solver != "newton" && options->solver != "nlopt") {
+    throw InvalidInput("solver: unknown value '" + options->solver +
+                       "' (expected newton or nlopt)");
+  }
+  if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
+    throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +
+                       std::to_string(req.tolerance));
+  }
+  options->tolerance = req.tolerance > 0.0 ? req.tolerance : defaults.tolerance;
+  if (req.max_iterations < 0) {
+    throw InvalidInput("max_iterations: must be >= 0 (0 = default), got " +
+                       std::to_string(req.max_iterations));
+  }
+  options->max_iterations = req.max_iterations > 0 ? req.max_iterations : defaults.max_iterations;
+  if (!std::isfinite(req.time_budget) || req.time_budget < 0.0) {
+    throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = default), got " +
+                       std::to_string(req.time_budget));
+  }
+  options->time_budget_s = req.time_budget > 0.0 ? req.time_budget : defaults.time_budget;
+  return p;
+}
+
+}  // namespace ros_conversions
+}  // namespace attitude_planner

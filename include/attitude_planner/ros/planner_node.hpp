@@ -1,0 +1,160 @@
+// attitude_planner_node: the planner behind a service and an action. A thin adapter: it converts
+// the request, calls planManeuver() (the same entry point as the CLI) and fills the response.
+//
+//   service  plan_attitude_maneuver         (attitude_planner/PlanAttitudeManeuver)
+//   action   plan_attitude_maneuver_action  (attitude_planner/PlanAttitudeManeuverAction)
+//
+// Private parameters (defaults for the request fields left empty / zero):
+//   ~default_scheme  string  "paper"    discretization ("paper" | "variational")
+//   ~solver          string  "newton"   "newton" | "nlopt"
+//   ~tolerance       double  1e-10      optimality tolerance (> 0)
+//   ~max_iterations  int     200        iteration limit (> 0)
+//   ~time_budget     double  30.0       wall-time limit per solve [s] (0 = none)
+//   ~max_steps       int     100000     largest accepted N (>= 4)
+//   ~world_frame     string  "world"    frame_id of the returned maneuver
+//   ~body_frame      string  "body"     child_frame_id of the returned maneuver
+//   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
+//   parallel)
+//
+// Each solve owns all its state, so concurrent requests never share mutable data: service calls
+// are solved in parallel (~threads); the action serves one goal at a time (a new goal preempts
+// the running one, which ends PREEMPTED with error CANCELLED).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <actionlib/server/simple_action_server.h>
+#include <ros/ros.h>
+
+#include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/PlanAttitudeManeuverAction.h"
+#include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/ros/conversions.hpp"
+
+namespace attitude_planner {
+
+/// What one planning request produced, whatever happened.
+struct PlanOutcome {
+  int error_code = PlanErrorCode::INTERNAL_ERROR;  ///< a PlanErrorCode constant
+  std::string message;                             ///< outcome in words
+  bool solver_ran = false;                         ///< `result` is meaningful
+  PlanResult result;                               ///< the core's result
+  PlanningProblem problem;                         ///< the parsed problem (if parsing succeeded)
+};
+
+/// Decides the error code of a finished solve: converged → SUCCESS; cancelled by the caller →
+/// CANCELLED; time budget exhausted → TIMED_OUT; otherwise NOT_CONVERGED.
+int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s);
+
+/// Runs one request through the core. `keep_going(info, elapsed_s)` is called after every
+/// iteration; returning false cancels. Never throws.
+template <class Request>
+PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
+                        const std::function<bool(const IterationInfo&, double)>& keep_going);
+
+/// Copies an outcome into a service response or action result (same fields).
+template <class Response>
+void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
+                  const std::string& body_frame, Response* res);
+
+/// The node: service + action around planRequest().
+class PlannerNode {
+ public:
+  /// Reads the private parameters (range-checked, logged fall-back) and advertises the interfaces.
+  PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
+
+  /// Service threads requested by ~threads.
+  int threads() const { return threads_; }
+
+ private:
+  /// Service callback: always returns true (the outcome is in the response).
+  bool onPlanService(PlanAttitudeManeuver::Request& req, PlanAttitudeManeuver::Response& res);
+  /// Action execute callback: feedback per iteration; preemption cancels the solve.
+  void onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal);
+
+  ros::NodeHandle nh_;  ///< public handle: the service and action resolve here
+  ros_conversions::PlannerDefaults defaults_;  ///< read once in the constructor, then const
+  std::string world_frame_;                    ///< frame_id of returned maneuvers
+  std::string body_frame_;                     ///< child_frame_id of returned maneuvers
+  int threads_ = 4;                            ///< spinner threads
+  ros::ServiceServer service_;                 ///< plan_attitude_maneuver
+  /// plan_attitude_maneuver_action (one goal at a time)
+  std::unique_ptr<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>> action_server_;
+};
+
+// ---- templates ----------------------------------------------------------------------------------
+
+template <class Request>
+PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
+                        const std::function<bool(const IterationInfo&, double)>& keep_going) {
+  PlanOutcome out;
+  try {
+    SolverOptions options;
+    out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
+    bool cancelled = false;
+    bool timed_out = false;
+    const ros::WallTime start = ros::WallTime::now();
+    const double budget = options.time_budget_s;
+    options.on_iteration = [&](const IterationInfo& info) {
+      const double elapsed = (ros::WallTime::now() - start).toSec();
+      if (budget > 0.0 && elapsed >= budget) {
+        timed_out = true;
+        return false;
+      }
+      if (!ros::ok() || (keep_going && !keep_going(info, elapsed))) {
+        cancelled = true;
+        return false;
+      }
+      return true;
+    };
+    out.result = planManeuver(out.problem, options);
+    out.solver_ran = true;
+    out.error_code = classifyResult(out.result, cancelled, timed_out, budget);
+    out.message = out.result.message;
+    if (out.error_code == PlanErrorCode::TIMED_OUT &&
+        out.message.find("time") == std::string::npos) {
+      out.message =
+          "time budget of " + std::to_string(budget) + " s exhausted (" + out.message + ")";
+    } else if (out.error_code == PlanErrorCode::CANCELLED &&
+               out.message.find("cancel") == std::string::npos) {
+      out.message = "cancelled (" + out.message + ")";
+    }
+  } catch (const InvalidInput& e) {
+    out.error_code = PlanErrorCode::INVALID_INPUT;
+    out.message = e.what();
+  } catch (const StepTooLarge& e) {
+    out.error_code = PlanErrorCode::STEP_TOO_LARGE;
+    out.message = e.what();
+  } catch (const std::exception& e) {
+    out.error_code = PlanErrorCode::INTERNAL_ERROR;
+    out.message = std::string("internal error: ") + e.what();
+  } catch (...) {
+    out.error_code = PlanErrorCode::INTERNAL_ERROR;
+    out.message = "internal error: unknown exception";
+  }
+  return out;
+}
+
+template <class Response>
+void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
+                  const std::string& body_frame, Response* res) {
+  res->success = outcome.error_code == PlanErrorCode::SUCCESS;
+  res->error_code.val = outcome.error_code;
+  res->message = outcome.message;
+  if (!outcome.solver_ran) return;
+  const PlanResult& r = outcome.result;
+  if (!r.maneuver.attitude.empty()) {
+    res->maneuver = ros_conversions::maneuverToMsg(r.maneuver, outcome.problem, world_frame,
+                                                   body_frame, ros::Time::now());
+  }
+  res->cost = r.cost;
+  res->iterations = r.iterations;
+  res->max_residual = r.max_residual;
+  res->terminal_attitude_error = r.terminal_attitude_error;
+  res->terminal_velocity_error = r.terminal_velocity_error;
+  res->solve_time = r.solve_time_s;
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,122 @@
+// attitude_tracker_node: replays a planned maneuver in (ROS) real time for rviz. The torques τ_k
+// of the plan are integrated again through simulate() (the core's DiscreteScheme), so what rviz
+// shows is the rigid body's response to the planned torques, not the plan's own attitudes.
+//
+// Subscribes  maneuver          (attitude_planner/AttitudeManeuver)   a new one replaces the
+// current replay Publishes   /tf               world → body at every step, stamped start + t_k /
+// rate_factor
+//             torque            (geometry_msgs/WrenchStamped, frame body)      τ_k [N·m]
+//             angular_velocity  (geometry_msgs/Vector3Stamped, frame body)     Ω_k [rad/s]
+//             body_marker       (visualization_msgs/MarkerArray, frame body)  box + principal axes
+//             attitude_path     (visualization_msgs/Marker LINE_STRIP, world)  tip of the body x
+//             axis done              (attitude_planner/ReplayResult, latched)      when a replay
+//             ends
+// Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
+//
+// Private parameters:
+//   ~scene            string  ""       scene YAML planned at start-up (empty: wait for `maneuver`)
+//   ~plan_in_process  bool    false    plan the scene with planManeuver() instead of the service
+//   ~planner_timeout  double  30.0     wait for the planner service [s, wall]
+//   ~rate_factor      double  1.0      maneuver seconds per ROS second (> 0; 2 = twice as fast)
+//   ~start_delay      double  0.5      ROS seconds between receiving a maneuver and step 0 (>= 0)
+//   ~world_frame      string  "world"  fixed frame of tf, path and the maneuver
+//   ~body_frame       string  "body"   body frame of tf, torque, velocity and markers
+//   ~body_size        double  1.0      largest edge of the drawn box [m] (> 0)
+//   ~axis_length      double  0.9      length of the principal-axis arrows [m] (> 0)
+//   ~path_radius      double  1.2      distance of the traced body-x tip from the origin [m] (> 0)
+//   ~exit_when_done   bool    false    shut the node down after publishing `done` (demo/CI)
+#pragma once
+
+#include <atomic>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/maneuver.hpp"
+#include "attitude_planner/planner.hpp"
+
+namespace attitude_planner {
+
+/// A uniform box with the principal moments of J: edges along the principal axes.
+struct PrincipalBox {
+  Matrix3 axes;        ///< principal axes as columns (body frame), right-handed
+  Vector3 moments;     ///< principal moments [kg·m²], ascending
+  Vector3 dimensions;  ///< box edges [m] along the axes, largest = `size`
+};
+
+/// Box edges a, b, c of a uniform box with principal moments J1..J3 (J1 = m (b² + c²)/12, ...),
+/// scaled so that the largest edge is `size` [m] (the mass only scales the box, so it is not
+/// needed). Flat or non-physical inertias (J1 + J2 < J3) get a minimum edge of 10 % of `size`.
+PrincipalBox principalBox(const Matrix3& inertia, double size);
+
+/// Markers of the body: id 0 the box, ids 1..3 arrows along the principal axes (red, green, blue
+/// for the smallest, middle, largest moment), id 4 the body x axis up to the traced tip at
+/// `path_radius` [m] (orange, as `attitude_path`); all in `body_frame`.
+visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
+                                            double path_radius, const std::string& body_frame,
+                                            const ros::Time& stamp);
+
+/// Plans a scene: via the service (if `client` is valid) or in-process. Fills `msg` and the
+/// planner's solve time [s] and cost; returns false with `error` set if planning failed.
+bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
+               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
+               double* solve_time, double* cost, std::string* error);
+
+/// The node.
+class TrackerNode {
+ public:
+  /// Reads parameters, subscribes, and plans ~scene if it is set.
+  TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
+  /// Stops a running replay.
+  ~TrackerNode();
+
+ private:
+  /// One replay job, owned by the replay thread.
+  struct Replay {
+    AttitudeManeuver msg;           ///< the maneuver as received
+    double plan_solve_time = -1.0;  ///< [s], −1 if unknown
+    double plan_cost = -1.0;        ///< [N²·m²], −1 if unknown
+  };
+
+  /// `maneuver` callback: replaces the running replay.
+  void onManeuver(const AttitudeManeuver::ConstPtr& msg);
+  /// Stops the current replay (if any) and starts a new one in its own thread.
+  void startReplay(const Replay& replay);
+  /// Stops the running replay and joins its thread (within ~10 ms).
+  void stopReplay();
+  /// The replay thread's body; returns early when stop_ is set.
+  void runReplay(Replay replay);
+  /// Sleeps until ROS time `t` (sim-time friendly); false if stopped meanwhile.
+  bool sleepUntil(const ros::Time& t);
+  /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
+  void publishDone(ReplayResult result);
+
+  ros::NodeHandle nh_;            ///< public handle: topics and the service resolve here
+  ros::Subscriber maneuver_sub_;  ///< `maneuver`
+  ros::Publisher torque_pub_;     ///< `torque` τ_k [N·m], frame body
+  ros::Publisher velocity_pub_;   ///< `angular_velocity` Ω_k [rad/s], frame body
+  ros::Publisher marker_pub_;     ///< `body_marker`
+  ros::Publisher path_pub_;       ///< `attitude_path`
+  ros::Publisher done_pub_;       ///< `done` (latched)
+  tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
+  double rate_factor_ = 1.0;                      ///< maneuver seconds per ROS second
+  double start_delay_ = 0.5;                      ///< [s] ROS time before step 0
+  std::string world_frame_;                       ///< fixed frame
+  std::string body_frame_;                        ///< body frame
+  double body_size_ = 1.0;                        ///< largest box edge [m]
+  double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
+  double path_radius_ = 1.2;                      ///< distance of the traced body-x tip [m]
+  bool exit_when_done_ = false;                   ///< shut down after `done`
+
+  std::mutex replay_mutex_;        ///< guards replay_thread_ (start/stop from callbacks)
+  std::thread replay_thread_;      ///< runs runReplay()
+  std::atomic<bool> stop_{false};  ///< asks the replay thread to return
+};
+
+}  // namespace attitude_planner

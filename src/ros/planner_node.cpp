@@ -1,0 +1,126 @@
+#include "attitude_planner/ros/planner_node.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// Reads a private parameter; falls back (with an error in the log) if `valid` rejects it.
+template <class T, class Valid>
+T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Valid valid,
+            const std::string& requirement) {
+  T value;
+  nh.param(name, value, fallback);
+  if (!valid(value)) {
+    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
+                         << fallback);
+    return fallback;
+  }
+  return value;
+}
+
+}  // namespace
+
+int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s) {
+  if (result.converged) return PlanErrorCode::SUCCESS;
+  if (cancelled) return PlanErrorCode::CANCELLED;
+  if (timed_out || (time_budget_s > 0.0 && result.solve_time_s >= time_budget_s)) {
+    return PlanErrorCode::TIMED_OUT;
+  }
+  return PlanErrorCode::NOT_CONVERGED;
+}
+
+PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  ros_conversions::PlannerDefaults d;
+  d.scheme = readParam<std::string>(
+      pnh, "default_scheme", d.scheme,
+      [](const std::string& s) { return s == "paper" || s == "variational"; },
+      "paper or variational");
+  d.solver = readParam<std::string>(
+      pnh, "solver", d.solver, [](const std::string& s) { return s == "newton" || s == "nlopt"; },
+      "newton or nlopt");
+  d.tolerance = readParam<double>(
+      pnh, "tolerance", d.tolerance, [](double v) { return std::isfinite(v) && v > 0.0; }, "> 0");
+  d.max_iterations = readParam<int>(
+      pnh, "max_iterations", d.max_iterations, [](int v) { return v > 0; }, "> 0");
+  d.time_budget = readParam<double>(
+      pnh, "time_budget", d.time_budget, [](double v) { return std::isfinite(v) && v >= 0.0; },
+      ">= 0 s, 0 = none");
+  d.max_steps = readParam<int>(
+      pnh, "max_steps", d.max_steps, [](int v) { return v >= 4; }, ">= 4");
+  defaults_ = d;
+  world_frame_ = readParam<std::string>(
+      pnh, "world_frame", "world", [](const std::string& s) { return !s.empty(); }, "non-empty");
+  body_frame_ = readParam<std::string>(
+      pnh, "body_frame", "body", [](const std::string& s) { return !s.empty(); }, "non-empty");
+  threads_ = readParam<int>(
+      pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
+
+  service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);
+  action_server_ = std::make_unique<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>>(
+      nh_, "plan_attitude_maneuver_action",
+      [this](const PlanAttitudeManeuverGoalConstPtr& goal) { onPlanGoal(goal); }, false);
+  action_server_->start();
+  ROS_INFO_STREAM("attitude_planner_node ready: service "
+                  << service_.getService() << ", action "
+                  << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme " << d.scheme
+                  << ", solver " << d.solver << ", tolerance " << d.tolerance << ", max_iterations "
+                  << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "
+                  << d.max_steps << ")");
+}
+
+bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
+                                PlanAttitudeManeuver::Response& res) {
+  try {
+    const PlanOutcome outcome = planRequest(req, defaults_, nullptr);
+    fillResponse(outcome, world_frame_, body_frame_, &res);
+    if (res.success) {
+      ROS_INFO("plan: N = %d converged in %d iterations, %.3f s, cost %.6g", req.steps,
+               res.iterations, res.solve_time, res.cost);
+    } else {
+      ROS_WARN("plan failed (error %d): %s", res.error_code.val, res.message.c_str());
+    }
+  } catch (const std::exception& e) {  // e.g. bad_alloc while filling the response
+    res = PlanAttitudeManeuver::Response();
+    res.success = false;
+    res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
+    res.message = std::string("internal error: ") + e.what();
+  }
+  return true;
+}
+
+void PlannerNode::onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal) {
+  PlanAttitudeManeuverResult result;
+  try {
+    PlanAttitudeManeuverFeedback feedback;
+    const PlanOutcome outcome =
+        planRequest(*goal, defaults_, [&](const IterationInfo& info, double elapsed) {
+          feedback.iteration = info.iteration;
+          feedback.cost = info.cost;
+          feedback.residual = info.gradient_norm;
+          feedback.step_length = info.step_length;
+          feedback.elapsed = elapsed;
+          action_server_->publishFeedback(feedback);
+          return !action_server_->isPreemptRequested();
+        });
+    fillResponse(outcome, world_frame_, body_frame_, &result);
+  } catch (const std::exception& e) {
+    result = PlanAttitudeManeuverResult();
+    result.error_code.val = PlanErrorCode::INTERNAL_ERROR;
+    result.message = std::string("internal error: ") + e.what();
+  }
+  if (result.success) {
+    action_server_->setSucceeded(result, result.message);
+  } else if (result.error_code.val == PlanErrorCode::CANCELLED ||
+             action_server_->isPreemptRequested()) {
+    // A preempted goal ends PREEMPTED whatever the solver had reached.
+    if (result.error_code.val != PlanErrorCode::CANCELLED) {
+      result.error_code.val = PlanErrorCode::CANCELLED;
+      result.message = "cancelled (" + result.message + ")";
+    }
+    action_server_->setPreempted(result, result.message);
+  } else {
+    action_server_->setAborted(result, result.message);
+  }
+}
+
+}  // namespace attitude_planner

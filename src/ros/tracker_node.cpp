@@ -1,0 +1,383 @@
+#include "attitude_planner/ros/tracker_node.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/Vector3Stamped.h>
+#include <geometry_msgs/WrenchStamped.h>
+
+#include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/scene.hpp"
+#include "attitude_planner/simulation.hpp"
+
+namespace attitude_planner {
+
+namespace rc = ros_conversions;
+
+namespace {
+
+/// Reads a private parameter; falls back (with an error in the log) if `valid` rejects it.
+template <class T, class Valid>
+T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Valid valid,
+            const std::string& requirement) {
+  T value;
+  nh.param(name, value, fallback);
+  if (!valid(value)) {
+    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
+                         << fallback);
+    return fallback;
+  }
+  return value;
+}
+
+std_msgs::ColorRGBA color(float r, float g, float b, float a) {
+  std_msgs::ColorRGBA c;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.a = a;
+  return c;
+}
+
+geometry_msgs::Point point(const Vector3& v) {
+  geometry_msgs::Point p;
+  p.x = v.x();
+  p.y = v.y();
+  p.z = v.z();
+  return p;
+}
+
+}  // namespace
+
+PrincipalBox principalBox(const Matrix3& inertia, double size) {
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(0.5 * (inertia + inertia.transpose()));
+  PrincipalBox box;
+  box.moments = eig.eigenvalues();
+  box.axes = eig.eigenvectors();
+  if (box.axes.determinant() < 0.0) box.axes.col(2) *= -1.0;  // right-handed
+  const Vector3& J = box.moments;
+  // Uniform box, edges a, b, c along the axes: J1 = m (b² + c²)/12 etc. ⇒ a² ∝ J2 + J3 − J1.
+  Vector3 squared(J(1) + J(2) - J(0), J(0) + J(2) - J(1), J(0) + J(1) - J(2));
+  squared = squared.cwiseMax(0.0);
+  Vector3 edges = squared.cwiseSqrt();
+  const double largest = edges.maxCoeff();
+  edges = largest > 0.0 ? Vector3(edges * (size / largest)) : Vector3::Constant(size);
+  box.dimensions = edges.cwiseMax(0.1 * size);
+  return box;
+}
+
+visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
+                                            double path_radius, const std::string& body_frame,
+                                            const ros::Time& stamp) {
+  visualization_msgs::MarkerArray array;
+  visualization_msgs::Marker m;
+  m.header.frame_id = body_frame;
+  m.header.stamp = stamp;
+  m.ns = "body";
+  m.action = visualization_msgs::Marker::ADD;
+  m.id = 0;
+  m.type = visualization_msgs::Marker::CUBE;
+  m.pose.orientation = rc::attitudeToMsg(box.axes);
+  m.scale.x = box.dimensions.x();
+  m.scale.y = box.dimensions.y();
+  m.scale.z = box.dimensions.z();
+  m.color = color(0.55f, 0.7f, 0.95f, 0.85f);
+  array.markers.push_back(m);
+  const std_msgs::ColorRGBA colors[3] = {
+      color(0.9f, 0.1f, 0.1f, 1.0f), color(0.1f, 0.8f, 0.1f, 1.0f), color(0.1f, 0.3f, 1.0f, 1.0f)};
+  for (int i = 0; i < 3; ++i) {
+    visualization_msgs::Marker a;
+    a.header = m.header;
+    a.ns = "principal_axes";
+    a.id = i + 1;
+    a.type = visualization_msgs::Marker::ARROW;
+    a.action = visualization_msgs::Marker::ADD;
+    a.pose.orientation.w = 1.0;
+    a.points.push_back(point(Vector3::Zero()));
+    a.points.push_back(point(axis_length * box.axes.col(i)));
+    a.scale.x = 0.04 * axis_length;  // shaft diameter [m]
+    a.scale.y = 0.08 * axis_length;  // head diameter [m]
+    a.scale.z = 0.15 * axis_length;  // head length [m]
+    a.color = colors[i];
+    array.markers.push_back(a);
+  }
+  // The body x axis up to the traced tip, linking the body to `attitude_path` (same colour).
+  visualization_msgs::Marker x_axis;
+  x_axis.header = m.header;
+  x_axis.ns = "body_x_axis";
+  x_axis.id = 4;
+  x_axis.type = visualization_msgs::Marker::ARROW;
+  x_axis.action = visualization_msgs::Marker::ADD;
+  x_axis.pose.orientation.w = 1.0;
+  x_axis.points.push_back(point(Vector3::Zero()));
+  x_axis.points.push_back(point(Vector3(path_radius, 0.0, 0.0)));
+  x_axis.scale.x = 0.015 * path_radius;  // shaft diameter [m]
+  x_axis.scale.y = 0.04 * path_radius;   // head diameter [m]
+  x_axis.scale.z = 0.06 * path_radius;   // head length [m]
+  x_axis.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  array.markers.push_back(x_axis);
+  return array;
+}
+
+bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
+               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
+               double* solve_time, double* cost, std::string* error) {
+  if (client && client->isValid()) {
+    PlanAttitudeManeuver srv;
+    srv.request.inertia = rc::inertiaToMsg(problem.inertia);
+    srv.request.allow_nonphysical_inertia = problem.allow_nonphysical_inertia;
+    srv.request.initial_attitude = rc::attitudeToMsg(problem.initial_attitude);
+    srv.request.initial_angular_velocity = rc::vectorToMsg(problem.initial_velocity);
+    srv.request.final_attitude = rc::attitudeToMsg(problem.final_attitude);
+    srv.request.final_angular_velocity = rc::vectorToMsg(problem.final_velocity);
+    srv.request.duration = problem.duration;
+    srv.request.steps = problem.steps;
+    srv.request.scheme = schemeName(problem.scheme);
+    if (!client->call(srv)) {
+      *error = "service " + client->getService() + " call failed";
+      return false;
+    }
+    if (!srv.response.success) {
+      *error = "planner: " + srv.response.message;
+      return false;
+    }
+    *msg = srv.response.maneuver;
+    *solve_time = srv.response.solve_time;
+    *cost = srv.response.cost;
+    return true;
+  }
+  const PlanResult result = planManeuver(problem);
+  if (!result.converged) {
+    *error = "planner: " + result.message;
+    return false;
+  }
+  *msg = rc::maneuverToMsg(result.maneuver, problem, world_frame, body_frame, ros::Time::now());
+  *solve_time = result.solve_time_s;
+  *cost = result.cost;
+  return true;
+}
+
+TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  auto non_empty = [](const std::string& s) { return !s.empty(); };
+  rate_factor_ = readParam<double>(pnh, "rate_factor", 1.0, positive, "> 0");
+  start_delay_ = readParam<double>(
+      pnh, "start_delay", 0.5, [](double v) { return std::isfinite(v) && v >= 0.0; }, ">= 0 s");
+  world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
+  body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
+  body_size_ = readParam<double>(pnh, "body_size", 1.0, positive, "> 0 m");
+  axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
+  path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
+  pnh.param("exit_when_done", exit_when_done_, false);
+  std::string scene;
+  pnh.param<std::string>("scene", scene, "");
+  bool plan_in_process = false;
+  pnh.param("plan_in_process", plan_in_process, false);
+  const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
+
+  torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
+  velocity_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity", 10);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 1, true);
+  path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
+  done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
+  maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
+
+  if (scene.empty()) {
+    ROS_INFO("attitude_tracker_node: waiting for a maneuver on %s",
+             maneuver_sub_.getTopic().c_str());
+    return;
+  }
+  Replay replay;
+  std::string error;
+  try {
+    const Scene parsed = loadScene(scene);
+    if (parsed.system != "rigid_body") {
+      throw InvalidInput("system: '" + parsed.system +
+                         "' is not replayed by this node (rigid_body only)");
+    }
+    if (!parsed.effects.empty()) {
+      ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only",
+               scene.c_str(), parsed.effects.size());
+    }
+    ros::ServiceClient client;
+    if (!plan_in_process) {
+      client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
+      ROS_INFO("planning %s with %s", scene.c_str(), client.getService().c_str());
+      if (!client.waitForExistence(ros::Duration(planner_timeout))) {
+        error = "planner service " + client.getService() + " not available after " +
+                std::to_string(planner_timeout) + " s";
+      }
+    } else {
+      ROS_INFO("planning %s in-process", scene.c_str());
+    }
+    if (error.empty() &&
+        planScene(parsed.problem, plan_in_process ? nullptr : &client, world_frame_, body_frame_,
+                  &replay.msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
+      ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
+               replay.plan_solve_time);
+      startReplay(replay);
+      return;
+    }
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  ROS_ERROR("scene %s: %s", scene.c_str(), error.c_str());
+  ReplayResult failed;
+  failed.success = false;
+  failed.message = "scene " + scene + ": " + error;
+  publishDone(failed);
+}
+
+TrackerNode::~TrackerNode() {
+  stopReplay();
+}
+
+void TrackerNode::onManeuver(const AttitudeManeuver::ConstPtr& msg) {
+  Replay replay;
+  replay.msg = *msg;
+  startReplay(replay);
+}
+
+void TrackerNode::stopReplay() {
+  std::lock_guard<std::mutex> lock(replay_mutex_);
+  stop_ = true;
+  if (replay_thread_.joinable()) replay_thread_.join();
+  stop_ = false;
+}
+
+void TrackerNode::startReplay(const Replay& replay) {
+  stopReplay();
+  std::lock_guard<std::mutex> lock(replay_mutex_);
+  replay_thread_ = std::thread([this, replay]() { runReplay(replay); });
+}
+
+bool TrackerNode::sleepUntil(const ros::Time& t) {
+  // Short wall sleeps so that a stop request or a paused /clock never blocks shutdown.
+  while (!stop_ && ros::ok()) {
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero() && now >= t) return true;
+    const double remaining = now.isZero() ? 0.01 : (t - now).toSec() / 1.0;
+    ros::WallDuration(std::min(0.01, std::max(1e-4, remaining))).sleep();
+  }
+  return false;
+}
+
+void TrackerNode::publishDone(ReplayResult result) {
+  result.header.frame_id = world_frame_;
+  if (result.header.stamp.isZero()) result.header.stamp = ros::Time::now();
+  done_pub_.publish(result);
+  if (exit_when_done_) {
+    // Give latched subscribers (rosbag record, scripts) a moment to receive `done`.
+    ros::WallDuration(1.0).sleep();
+    ROS_INFO("exit_when_done: shutting down");
+    ros::requestShutdown();
+  }
+}
+
+void TrackerNode::runReplay(Replay replay) {
+  ReplayResult result;
+  result.plan_solve_time = replay.plan_solve_time;
+  result.plan_cost = replay.plan_cost;
+  Maneuver plan, replayed;
+  Matrix3 inertia;
+  try {
+    plan = rc::maneuverFromMsg(replay.msg);
+    inertia = rc::inertiaFromMsg(replay.msg.inertia);
+    const int N = plan.steps();
+    // The core validates the body (symmetric positive definite J) with the problem checks.
+    PlanningProblem problem;
+    problem.inertia = inertia;
+    problem.allow_nonphysical_inertia = true;  // replaying only needs J SPD
+    problem.duration = N * plan.time_step;
+    problem.steps = N;
+    problem.initial_attitude = plan.attitude.front();
+    problem.initial_velocity = plan.angular_velocity.front();
+    problem.final_attitude = plan.attitude.back();
+    problem.final_velocity = plan.angular_velocity[N - 1];
+    problem.scheme = parseSchemeName(replay.msg.scheme.empty() ? "paper" : replay.msg.scheme);
+    validateProblem(problem);
+    const DiscreteScheme scheme(problem.scheme, inertia, plan.time_step);
+    SimulationInput input;
+    input.initial_attitude = problem.initial_attitude;
+    input.initial_velocity = problem.initial_velocity;
+    input.torque = plan.torque;
+    replayed = simulate(scheme, input);
+    result.steps = N;
+    result.duration = problem.duration;
+    for (int k = 1; k < N; ++k) result.cost += 0.5 * plan.torque[k].squaredNorm();
+    result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], replayed.attitude[N]);
+    result.terminal_velocity_error =
+        (replayed.angular_velocity[N - 1] - plan.angular_velocity[N - 1]).norm();
+    for (int k = 0; k <= N; ++k) {
+      result.max_attitude_deviation = std::max(
+          result.max_attitude_deviation, so3::angleBetween(plan.attitude[k], replayed.attitude[k]));
+    }
+    result.final_attitude = rc::attitudeToMsg(replayed.attitude[N]);
+  } catch (const std::exception& e) {
+    ROS_ERROR("maneuver rejected: %s", e.what());
+    result.success = false;
+    result.message = std::string("maneuver rejected: ") + e.what();
+    publishDone(result);
+    return;
+  }
+
+  const PrincipalBox box = principalBox(inertia, body_size_);
+  // Wait for a valid clock (use_sim_time before the first /clock message).
+  while (ros::Time::now().isZero()) {
+    if (stop_ || !ros::ok()) return;
+    ros::WallDuration(0.01).sleep();
+  }
+  const ros::Time start = ros::Time::now() + ros::Duration(start_delay_);
+  visualization_msgs::Marker path;
+  path.header.frame_id = world_frame_;
+  path.ns = "attitude_path";
+  path.id = 0;
+  path.type = visualization_msgs::Marker::LINE_STRIP;
+  path.action = visualization_msgs::Marker::ADD;
+  path.pose.orientation.w = 1.0;
+  path.scale.x = 0.02 * path_radius_;  // line width [m]
+  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+
+  const int N = replayed.steps();
+  ROS_INFO("replaying %d steps over %.3f s (rate factor %g)", N, N * replayed.time_step,
+           rate_factor_);
+  for (int k = 0; k <= N; ++k) {
+    const ros::Time stamp = start + ros::Duration(replayed.time[k] / rate_factor_);
+    if (!sleepUntil(stamp)) return;
+    const Matrix3& R = replayed.attitude[k];
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = stamp;
+    tf.header.frame_id = world_frame_;
+    tf.child_frame_id = body_frame_;
+    tf.transform.rotation = rc::attitudeToMsg(R);
+    tf_broadcaster_.sendTransform(tf);
+
+    geometry_msgs::WrenchStamped wrench;
+    wrench.header.stamp = stamp;
+    wrench.header.frame_id = body_frame_;
+    wrench.wrench.torque = rc::vectorToMsg(replayed.torque[k]);
+    torque_pub_.publish(wrench);
+
+    geometry_msgs::Vector3Stamped velocity;
+    velocity.header = wrench.header;
+    velocity.vector = rc::vectorToMsg(replayed.angular_velocity[k]);
+    velocity_pub_.publish(velocity);
+
+    marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
+    path.header.stamp = stamp;
+    path.points.push_back(point(path_radius_ * R.col(0)));
+    if (path.points.size() >= 2) path_pub_.publish(path);
+  }
+  result.success = true;
+  result.message = "replayed " + std::to_string(N) + " steps";
+  result.header.stamp = start + ros::Duration(replayed.time[N] / rate_factor_);
+  ROS_INFO("replay done: terminal attitude error %.3g rad vs the plan's R_N",
+           result.terminal_attitude_error);
+  publishDone(result);
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,117 @@
+// rostest: drives attitude_planner_node through its action plan_attitude_maneuver_action.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <actionlib/client/simple_action_client.h>
+
+#include <atomic>
+
+#include "attitude_planner/PlanAttitudeManeuverAction.h"
+#include "attitude_planner/PlanErrorCode.h"
+#include "ros_test_helpers.hpp"
+
+using namespace attitude_planner;
+using Client = actionlib::SimpleActionClient<PlanAttitudeManeuverAction>;
+using State = actionlib::SimpleClientGoalState;
+
+namespace {
+
+PlanAttitudeManeuverGoal seed(int steps = 32) {
+  PlanAttitudeManeuverGoal g;
+  ros_testing::fillSeedRequest(&g, steps);
+  return g;
+}
+
+/// Waits (wall time, generous) until `pred` holds; returns it.
+template <class Pred>
+bool waitFor(Pred pred, double seconds) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (!pred() && ros::WallTime::now() < deadline) ros::WallDuration(0.01).sleep();
+  return pred();
+}
+
+}  // namespace
+
+class PlannerAction : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    client_ = std::make_unique<Client>("plan_attitude_maneuver_action", true);
+    ASSERT_TRUE(client_->waitForServer(ros::Duration(30.0)));
+  }
+  std::unique_ptr<Client> client_;
+};
+
+TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
+  std::atomic<int> feedbacks{0};
+  std::atomic<int> last_iteration{0};
+  client_->sendGoal(seed(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [&](const PlanAttitudeManeuverFeedbackConstPtr& f) {
+                      EXPECT_GT(f->iteration, last_iteration.load());  // increasing
+                      EXPECT_TRUE(std::isfinite(f->cost));
+                      EXPECT_GE(f->residual, 0.0);
+                      last_iteration = f->iteration;
+                      ++feedbacks;
+                    });
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED);
+  const auto result = client_->getResult();
+  EXPECT_TRUE(result->success) << result->message;
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::SUCCESS);
+  EXPECT_EQ(result->maneuver.attitude.size(), 33u);
+  EXPECT_LT(result->terminal_attitude_error, 1e-8);
+  // Feedback and result travel on different topics: allow the last feedback to land.
+  EXPECT_TRUE(waitFor([&] { return feedbacks > 0; }, 10.0)) << "no feedback received";
+  EXPECT_LE(last_iteration.load(), result->iterations);
+}
+
+TEST_F(PlannerAction, CancelEndsPreemptedWithCancelled) {
+  // A long solve: large N and an unreachable tolerance keep the solver iterating until cancelled.
+  PlanAttitudeManeuverGoal goal = seed(4000);
+  goal.tolerance = 1e-300;
+  goal.max_iterations = 1000000;
+  goal.time_budget = 600.0;
+  std::atomic<int> feedbacks{0};
+  client_->sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [&](const PlanAttitudeManeuverFeedbackConstPtr&) { ++feedbacks; });
+  ASSERT_TRUE(waitFor([&] { return feedbacks > 0; }, 60.0)) << "no feedback before cancelling";
+  client_->cancelGoal();
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::PREEMPTED);
+  const auto result = client_->getResult();
+  EXPECT_FALSE(result->success);
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::CANCELLED) << result->message;
+}
+
+TEST_F(PlannerAction, TimeBudgetEndsAbortedWithTimedOut) {
+  PlanAttitudeManeuverGoal goal = seed(4000);
+  goal.tolerance = 1e-300;
+  goal.max_iterations = 1000000;
+  goal.time_budget = 1e-6;  // [s]: exhausted after the first iteration
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  const auto result = client_->getResult();
+  EXPECT_FALSE(result->success);
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::TIMED_OUT) << result->message;
+}
+
+TEST_F(PlannerAction, InvalidGoalIsAbortedWithTheField) {
+  PlanAttitudeManeuverGoal goal = seed();
+  goal.initial_attitude = geometry_msgs::Quaternion();
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  const auto result = client_->getResult();
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(result->message.find("initial_attitude: zero quaternion"), std::string::npos)
+      << result->message;
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_planner_action");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,179 @@
+// rostest: drives attitude_planner_node through its service plan_attitude_maneuver.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <atomic>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/PlanErrorCode.h"
+#include "ros_test_helpers.hpp"
+
+using namespace attitude_planner;
+namespace rc = attitude_planner::ros_conversions;
+
+namespace {
+
+/// Calls the service (fresh persistent-free client: safe from any thread).
+PlanAttitudeManeuver::Response call(const PlanAttitudeManeuver::Request& req) {
+  PlanAttitudeManeuver srv;
+  srv.request = req;
+  EXPECT_TRUE(ros::service::call("plan_attitude_maneuver", srv));
+  return srv.response;
+}
+
+PlanAttitudeManeuver::Request seed(int steps = 32, double angle = M_PI / 3) {
+  PlanAttitudeManeuver::Request r;
+  ros_testing::fillSeedRequest(&r, steps, angle);
+  return r;
+}
+
+}  // namespace
+
+class PlannerService : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    ASSERT_TRUE(ros::service::waitForService("plan_attitude_maneuver", ros::Duration(30.0)));
+  }
+};
+
+TEST_F(PlannerService, SeedSlewMeetsTheBoundaryData) {
+  const int N = 32;
+  const ros::WallTime start = ros::WallTime::now();
+  const PlanAttitudeManeuver::Response res = call(seed(N));
+  const double latency = (ros::WallTime::now() - start).toSec();
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::SUCCESS);
+  const AttitudeManeuver& m = res.maneuver;
+  EXPECT_EQ(m.header.frame_id, "world");
+  EXPECT_EQ(m.child_frame_id, "body");
+  EXPECT_EQ(m.scheme, "paper");
+  ASSERT_EQ(m.attitude.size(), size_t(N + 1));
+  ASSERT_EQ(m.time.size(), size_t(N + 1));
+  ASSERT_EQ(m.angular_velocity.size(), size_t(N + 1));
+  ASSERT_EQ(m.torque.size(), size_t(N + 1));
+  EXPECT_DOUBLE_EQ(m.time_step, 12.8 / N);                          // h [s]
+  EXPECT_NEAR(m.time.back(), 12.8, 1e-12);                          // t_N = T [s]
+  EXPECT_EQ(rc::vectorFromMsg(m.torque.front()), Vector3::Zero());  // τ_0 = 0
+  EXPECT_EQ(rc::vectorFromMsg(m.torque.back()), Vector3::Zero());   // τ_N = 0
+  const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.back(), "R_N"), target), 1e-8);
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.front(), "R_0"), Matrix3::Identity()),
+            1e-15);
+  EXPECT_LT(res.terminal_attitude_error, 1e-8);                          // [rad]
+  EXPECT_LT(res.terminal_velocity_error, 1e-8);                          // [rad/s]
+  EXPECT_LT(rc::vectorFromMsg(m.angular_velocity[N - 1]).norm(), 1e-8);  // rest at the end
+  EXPECT_GT(res.cost, 0.0);
+  EXPECT_GT(res.iterations, 0);
+  EXPECT_GT(res.solve_time, 0.0);
+  RecordProperty("latency_s", std::to_string(latency));
+  std::printf("seed N = %d: service latency %.4f s (solve %.4f s, %d iterations, cost %.6g)\n", N,
+              latency, res.solve_time, res.iterations, res.cost);
+}
+
+TEST_F(PlannerService, SeedExampleAtFullResolutionForLatency) {
+  const ros::WallTime start = ros::WallTime::now();
+  const PlanAttitudeManeuver::Response res = call(seed(128));  // the seed example, N = 128
+  const double latency = (ros::WallTime::now() - start).toSec();
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_LT(res.terminal_attitude_error, 1e-8);
+  RecordProperty("latency_s", std::to_string(latency));
+  std::printf("seed N = 128: service latency %.4f s (solve %.4f s, %d iterations, cost %.8g)\n",
+              latency, res.solve_time, res.iterations, res.cost);
+}
+
+TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
+  struct Case {
+    const char* what;
+    PlanAttitudeManeuver::Request req;
+    const char* expected;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"zero quaternion", seed(), "final_attitude: zero quaternion"});
+  cases.back().req.final_attitude = geometry_msgs::Quaternion();
+  cases.push_back({"NaN inertia", seed(), "inertia"});
+  cases.back().req.inertia[4] = std::numeric_limits<double>::quiet_NaN();
+  cases.push_back({"steps = 2", seed(), "steps: must be >= 4, got 2"});
+  cases.back().req.steps = 2;
+  cases.push_back({"non-unit quaternion", seed(), "initial_attitude: quaternion norm 2"});
+  cases.back().req.initial_attitude.w = 2.0;
+  cases.push_back({"unknown scheme", seed(), "scheme: unknown value 'rk4'"});
+  cases.back().req.scheme = "rk4";
+  cases.push_back({"negative duration", seed(), "duration"});
+  cases.back().req.duration = -1.0;
+  cases.push_back({"indefinite inertia", seed(), "inertia"});
+  cases.back().req.inertia[0] = -1.0;
+  for (const Case& c : cases) {
+    const PlanAttitudeManeuver::Response res = call(c.req);
+    EXPECT_FALSE(res.success) << c.what;
+    EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << c.what << ": " << res.message;
+    EXPECT_NE(res.message.find(c.expected), std::string::npos)
+        << c.what << ": message '" << res.message << "' lacks '" << c.expected << "'";
+    EXPECT_TRUE(res.maneuver.attitude.empty()) << c.what;
+  }
+  // The node survived all of them and still plans.
+  const PlanAttitudeManeuver::Response good = call(seed());
+  EXPECT_TRUE(good.success) << good.message;
+  EXPECT_LT(good.terminal_attitude_error, 1e-8);
+}
+
+TEST_F(PlannerService, SchemeAndSolverFieldsAreHonoured) {
+  PlanAttitudeManeuver::Request req = seed();
+  req.scheme = "variational";
+  const PlanAttitudeManeuver::Response variational = call(req);
+  ASSERT_TRUE(variational.success) << variational.message;
+  EXPECT_EQ(variational.maneuver.scheme, "variational");
+  EXPECT_LT(variational.terminal_attitude_error, 1e-8);
+
+  const PlanAttitudeManeuver::Response newton = call(seed());
+  req = seed();
+  req.solver = "nlopt";  // the independent cross-check reaches the same optimum
+  const PlanAttitudeManeuver::Response nlopt = call(req);
+  ASSERT_TRUE(newton.success) << newton.message;
+  ASSERT_TRUE(nlopt.success) << nlopt.message;
+  EXPECT_NEAR(nlopt.cost, newton.cost, 1e-6 * newton.cost);
+}
+
+TEST_F(PlannerService, IterationLimitIsNotConverged) {
+  PlanAttitudeManeuver::Request req = seed();
+  req.max_iterations = 1;
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_FALSE(res.success);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::NOT_CONVERGED) << res.message;
+  EXPECT_EQ(res.maneuver.attitude.size(), 33u);  // the last iterate is still returned
+}
+
+TEST_F(PlannerService, ConcurrentRequestsEachGetTheirOwnAnswer) {
+  // Several threads, each slewing by its own angle: no answer may be another request's.
+  const int kThreads = 6;
+  std::vector<std::thread> threads;
+  std::vector<PlanAttitudeManeuver::Response> responses(kThreads);
+  for (int i = 0; i < kThreads; ++i) {
+    threads.emplace_back([&responses, i]() {
+      PlanAttitudeManeuver srv;
+      srv.request = seed(32 + 8 * i, 0.2 + 0.25 * i);
+      if (ros::service::call("plan_attitude_maneuver", srv)) responses[i] = srv.response;
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int i = 0; i < kThreads; ++i) {
+    const PlanAttitudeManeuver::Response& res = responses[i];
+    ASSERT_TRUE(res.success) << "request " << i << ": " << res.message;
+    ASSERT_EQ(res.maneuver.attitude.size(), size_t(32 + 8 * i + 1)) << "request " << i;
+    const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), 0.2 + 0.25 * i);
+    EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(res.maneuver.attitude.back(), "R_N"), target),
+              1e-8)
+        << "request " << i;
+  }
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_planner_service");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,178 @@
+// Unit tests of the ROS adapters that need no ROS master: conversions, request parsing, the box.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/ros/planner_node.hpp"
+#include "attitude_planner/ros/tracker_node.hpp"
+#include "attitude_planner/simulation.hpp"
+
+using namespace attitude_planner;
+namespace rc = attitude_planner::ros_conversions;
+
+namespace {
+
+PlanAttitudeManeuver::Request seedRequest() {
+  PlanAttitudeManeuver::Request r;
+  const double J[9] = {13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37};
+  for (int i = 0; i < 9; ++i) r.inertia[i] = J[i];
+  r.allow_nonphysical_inertia = true;  // the seed J violates J1 + J2 >= J3
+  r.initial_attitude.w = 1.0;
+  r.final_attitude = rc::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3));
+  r.duration = 12.8;
+  r.steps = 32;
+  return r;
+}
+
+std::string invalidMessage(const PlanAttitudeManeuver::Request& r) {
+  const PlanOutcome out = planRequest(r, rc::PlannerDefaults(), nullptr);
+  EXPECT_EQ(out.error_code, PlanErrorCode::INVALID_INPUT) << out.message;
+  EXPECT_FALSE(out.solver_ran);
+  return out.message;
+}
+
+}  // namespace
+
+TEST(RosConversions, QuaternionRoundTripIsExact) {
+  const Matrix3 R = so3::fromAxisAngle(Vector3(1, -2, 0.5), 2.3);
+  const Matrix3 back = rc::attitudeFromMsg(rc::attitudeToMsg(R), "q");
+  EXPECT_LT(so3::angleBetween(R, back), 1e-15);
+}
+
+TEST(RosConversions, InertiaIsRowMajor) {
+  boost::array<double, 9> j = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  const Matrix3 J = rc::inertiaFromMsg(j);
+  EXPECT_EQ(J(0, 1), 2.0);
+  EXPECT_EQ(J(1, 0), 4.0);
+  EXPECT_EQ(rc::inertiaToMsg(J), j);
+}
+
+TEST(RosConversions, ZeroQuaternionNamesTheField) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.final_attitude = geometry_msgs::Quaternion();  // (0, 0, 0, 0): a forgotten field
+  const std::string m = invalidMessage(r);
+  EXPECT_NE(m.find("final_attitude"), std::string::npos) << m;
+  EXPECT_NE(m.find("zero quaternion"), std::string::npos) << m;
+}
+
+TEST(RosConversions, NonUnitAndNanQuaternionsAreRejected) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.initial_attitude.w = 1.1;
+  EXPECT_NE(invalidMessage(r).find("initial_attitude: quaternion norm 1.1"), std::string::npos);
+  r.initial_attitude.w = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(invalidMessage(r).find("initial_attitude: quaternion not finite"), std::string::npos);
+}
+
+TEST(RosConversions, BadFieldsAreNamedWithTheirValue) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.inertia[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(invalidMessage(r).find("inertia"), std::string::npos);
+  r = seedRequest();
+  r.steps = 2;
+  EXPECT_NE(invalidMessage(r).find("steps: must be >= 4, got 2"), std::string::npos);
+  r = seedRequest();
+  r.steps = 1000000;
+  EXPECT_NE(invalidMessage(r).find("steps: 1000000 exceeds"), std::string::npos);
+  r = seedRequest();
+  r.scheme = "euler";
+  EXPECT_NE(invalidMessage(r).find("scheme: unknown value 'euler'"), std::string::npos);
+  r = seedRequest();
+  r.solver = "magic";
+  EXPECT_NE(invalidMessage(r).find("solver: unknown value 'magic'"), std::string::npos);
+  r = seedRequest();
+  r.duration = -1.0;
+  EXPECT_NE(invalidMessage(r).find("duration"), std::string::npos);
+  r = seedRequest();
+  r.time_budget = -3.0;
+  EXPECT_NE(invalidMessage(r).find("time_budget"), std::string::npos);
+}
+
+TEST(RosConversions, DefaultsFillEmptyFields) {
+  rc::PlannerDefaults d;
+  d.scheme = "variational";
+  d.tolerance = 1e-7;
+  d.max_iterations = 17;
+  d.time_budget = 3.0;
+  SolverOptions options;
+  const PlanningProblem p = rc::problemFromRequest(seedRequest(), d, &options);
+  EXPECT_EQ(p.scheme, SchemeKind::Variational);
+  EXPECT_EQ(options.solver, "newton");
+  EXPECT_EQ(options.tolerance, 1e-7);
+  EXPECT_EQ(options.max_iterations, 17);
+  EXPECT_EQ(options.time_budget_s, 3.0);
+  EXPECT_EQ(p.steps, 32);
+  EXPECT_LT(so3::angleBetween(p.final_attitude, so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3)),
+            1e-15);
+}
+
+TEST(RosConversions, ManeuverMessageRoundTrip) {
+  const Matrix3 J = rc::inertiaFromMsg(seedRequest().inertia);
+  const DiscreteScheme scheme(SchemeKind::Paper, J, 0.1);
+  SimulationInput input;
+  input.torque.assign(9, Vector3::Zero());
+  for (int k = 1; k < 8; ++k) input.torque[k] = Vector3(0.1 * k, -0.2, 0.05);
+  const Maneuver m = simulate(scheme, input);
+  PlanningProblem p;
+  p.inertia = J;
+  const AttitudeManeuver msg = rc::maneuverToMsg(m, p, "world", "body", ros::Time(0));
+  EXPECT_EQ(msg.attitude.size(), 9u);
+  EXPECT_EQ(msg.header.frame_id, "world");
+  EXPECT_EQ(msg.child_frame_id, "body");
+  EXPECT_EQ(msg.scheme, "paper");
+  const Maneuver back = rc::maneuverFromMsg(msg);
+  for (int k = 0; k <= 8; ++k) {
+    EXPECT_LT(so3::angleBetween(back.attitude[k], m.attitude[k]), 1e-15);
+    EXPECT_EQ(back.torque[k], m.torque[k]);
+  }
+  AttitudeManeuver bad = msg;
+  bad.torque.pop_back();
+  EXPECT_THROW(rc::maneuverFromMsg(bad), InvalidInput);
+}
+
+TEST(RosConversions, ErrorCodesFollowTheOutcome) {
+  PlanResult r;
+  r.converged = true;
+  EXPECT_EQ(classifyResult(r, true, true, 1.0), PlanErrorCode::SUCCESS);
+  r.converged = false;
+  EXPECT_EQ(classifyResult(r, true, false, 0.0), PlanErrorCode::CANCELLED);
+  EXPECT_EQ(classifyResult(r, false, true, 1.0), PlanErrorCode::TIMED_OUT);
+  r.solve_time_s = 2.0;
+  EXPECT_EQ(classifyResult(r, false, false, 1.0), PlanErrorCode::TIMED_OUT);
+  EXPECT_EQ(classifyResult(r, false, false, 0.0), PlanErrorCode::NOT_CONVERGED);
+}
+
+TEST(PrincipalBox, UniformBoxMomentsAreRecovered) {
+  // A uniform box 1 × 2 × 3 m (mass 12 kg): J = diag(b²+c², a²+c², a²+b²) = diag(13, 10, 5).
+  const Matrix3 R = so3::fromAxisAngle(Vector3(0.3, 1, -0.2), 0.9);
+  const Matrix3 J = R * Vector3(13, 10, 5).asDiagonal() * R.transpose();
+  const PrincipalBox box = principalBox(J, 3.0);
+  EXPECT_NEAR(box.moments(0), 5.0, 1e-12);
+  EXPECT_NEAR(box.dimensions(0), 3.0, 1e-12);  // smallest moment ↔ longest edge
+  EXPECT_NEAR(box.dimensions(1), 2.0, 1e-12);
+  EXPECT_NEAR(box.dimensions(2), 1.0, 1e-12);
+  EXPECT_NEAR(box.axes.determinant(), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(box.axes.col(0).dot(R.col(2))), 1.0, 1e-12);
+}
+
+TEST(PrincipalBox, MarkersAreTheBoxThreeAxesAndTheTracedAxisInTheBodyFrame) {
+  const PrincipalBox box = principalBox(Vector3(5, 10, 13).asDiagonal().toDenseMatrix(), 1.0);
+  const visualization_msgs::MarkerArray a = bodyMarkers(box, 0.9, 1.2, "body", ros::Time(3.0));
+  ASSERT_EQ(a.markers.size(), 5u);
+  EXPECT_EQ(a.markers[0].type, visualization_msgs::Marker::CUBE);
+  for (const visualization_msgs::Marker& m : a.markers) {
+    EXPECT_EQ(m.header.frame_id, "body");
+    EXPECT_EQ(m.header.stamp, ros::Time(3.0));
+  }
+  for (int i = 1; i <= 4; ++i) EXPECT_EQ(a.markers[i].type, visualization_msgs::Marker::ARROW);
+  EXPECT_DOUBLE_EQ(a.markers[4].points[1].x, 1.2);  // tip of body x at path_radius [m]
+}
+
+TEST(PrincipalBox, NonPhysicalInertiaStillGetsAVisibleBox) {
+  // The seed's J violates J1 + J2 >= J3: the third edge would be imaginary; it is clamped.
+  const PrincipalBox box = principalBox(rc::inertiaFromMsg(seedRequest().inertia), 1.0);
+  EXPECT_NEAR(box.dimensions.maxCoeff(), 1.0, 1e-12);
+  EXPECT_NEAR(box.dimensions.minCoeff(), 0.1, 1e-12);
+}

@@ -1,0 +1,59 @@
+// rostest: attitude_tracker_node plans the seed scene at start-up (~scene; through the planner
+// service or in-process, per launch file) and replays it; the final tf must be the scene's R_N.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <tf2_ros/transform_listener.h>
+
+#include <mutex>
+
+#include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/ros/conversions.hpp"
+
+using namespace attitude_planner;
+namespace rc = attitude_planner::ros_conversions;
+
+TEST(TrackerScene, FinalTransformIsTheScenesTargetAttitude) {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer tf_buffer(ros::Duration(60.0));
+  tf2_ros::TransformListener listener(tf_buffer);
+  std::mutex mutex;
+  ReplayResult::ConstPtr done;
+  ros::Subscriber sub = nh.subscribe<ReplayResult>("done", 1, [&](const ReplayResult::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    done = m;
+  });
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(90.0);
+  while (ros::WallTime::now() < deadline) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (done) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(done) << "no done message";
+  ASSERT_TRUE(done->success) << done->message;
+  EXPECT_EQ(done->steps, 128);
+  EXPECT_GT(done->plan_solve_time, 0.0);  // the tracker asked for the plan [s]
+  EXPECT_GT(done->plan_cost, 0.0);
+  EXPECT_NEAR(done->cost, done->plan_cost, 1e-9 * done->plan_cost);
+  EXPECT_LT(done->terminal_attitude_error, 1e-12);  // replay vs plan [rad]
+  // scenes/rest_to_rest.yaml: R_N = exp(π/3 e1^).
+  const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
+  const ros::WallTime tf_deadline = ros::WallTime::now() + ros::WallDuration(10.0);
+  while (!tf_buffer.canTransform("world", "body", done->header.stamp) &&
+         ros::WallTime::now() < tf_deadline) {
+    ros::WallDuration(0.05).sleep();
+  }
+  const geometry_msgs::TransformStamped tf =
+      tf_buffer.lookupTransform("world", "body", done->header.stamp);
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(tf.transform.rotation, "tf"), target), 1e-8);
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_scene");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -18,9 +18,15 @@ struct Dual {
     double x[N] = {};
     double& operator()(int i) { return x[i]; }
     double operator()(int i) const { return x[i]; }
-    /// As an Eigen row, for assembling Jacobians.
-    Eigen::Matrix<double, 1, N> transpose() const {
-      return Eigen::Map<const Eigen::Matrix<double, 1, N>>(x);
+    /// As an Eigen column, for assembling Jacobians.
+    Eigen::Map<const Eigen::Matrix<double, N, 1>> vector() const {
+      return Eigen::Map<const Eigen::Matrix<double, N, 1>>(x);
+    }
+    Eigen::Matrix<double, 1, N> transpose() const { return vector().transpose(); }
+    /// Derivatives start..start+K−1.
+    template <int K>
+    Eigen::Matrix<double, K, 1> segment(int start) const {
+      return vector().template segment<K>(start);
     }
   };
 

@@ -14,6 +14,13 @@
 
 namespace attitude_planner {
 
+/// Which way the maneuver turns from R_1 to R_{N−1} (the planner's initial guess; Newton then
+/// finds the extremal next to it).
+enum class RotationDirection {
+  Shortest,  ///< the geodesic (angle ≤ π); near π both ways are solved and the cheaper is kept
+  LongWay,   ///< the other way round the same axis (angle 2π − θ)
+};
+
 /// A rest-to-rest / slew problem for the fully actuated rigid body.
 struct PlanningProblem {
   Matrix3 inertia = Matrix3::Identity();           ///< J [kg·m²], body frame, SPD
@@ -28,6 +35,9 @@ struct PlanningProblem {
   /// The seed's example inertia is such a matrix (moments 3.146, 12.538, 32.186), so its scenes
   /// opt in explicitly; the mathematics only needs J symmetric positive definite.
   bool allow_nonphysical_inertia = false;
+  RotationDirection direction = RotationDirection::Shortest;
+  /// Extra full turns (2π each) about the same axis in the same sense, ≥ 0.
+  int extra_revolutions = 0;
 };
 
 /// Progress of one iteration, for feedback (action) and logging.
@@ -69,6 +79,9 @@ struct PlanResult {
   double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
   double solve_time_s = 0.0;             ///< wall time [s]
   std::vector<IterationInfo> history;    ///< one entry per iteration
+  /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
+  /// cost of the other way when both were solved.
+  std::string extremal;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws

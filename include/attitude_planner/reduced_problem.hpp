@@ -48,6 +48,15 @@ class ReducedProblem {
 
   const Steps& current() const { return steps_; }
   void setCurrent(const Steps& steps) { steps_ = steps; }
+  /// log(R_1ᵀ R_{N−1}): the principal rotation vector between the two fixed inner attitudes.
+  Vector3 principalSpan() const { return principal_span_; }
+  /// Interior on the constant-rate rotation by `span` from R_1 (span ≡ principalSpan() modulo
+  /// whole turns about its axis, so that R_{N−1} is still reached).
+  void initializeAlong(const Vector3& span);
+  /// Interior on R_1 exp(φ(s)), s ∈ [0, 1] from R_1 to R_{N−1}: φ the cubic Hermite curve with
+  /// φ(0) = 0, φ(1) = span, φ'(0) = start_slope, φ'(1) = end_slope (body rotation per unit s,
+  /// frame of R_1). Matches boundary velocities, so spinning ends start the solve spinning.
+  void initializeHermite(const Vector3& span, const Vector3& start_slope, const Vector3& end_slope);
   /// Interior from the attitudes of a maneuver with the same N (a warm start).
   void setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes);
 
@@ -79,6 +88,7 @@ class ReducedProblem {
   int N_;
   DiscreteScheme scheme_;
   Matrix3 initial_attitude_;
+  Vector3 principal_span_;
   Steps steps_;
 };
 

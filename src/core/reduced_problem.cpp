@@ -74,8 +74,31 @@ ReducedProblem::ReducedProblem(const PlanningProblem& problem)
   // Geodesic from R_1 to R_{N−1} in N − 2 equal steps.
   const Matrix3 R1 = problem.initial_attitude * F_first;
   const Matrix3 R_last = problem.final_attitude * F_last.transpose();
-  const Vector3 span = so3::log(Matrix3(R1.transpose() * R_last));
+  principal_span_ = so3::log(Matrix3(R1.transpose() * R_last));
+  initializeAlong(principal_span_);
+}
+
+void ReducedProblem::initializeAlong(const Vector3& span) {
   for (int j = 1; j <= N_ - 2; ++j) steps_[j] = span / double(N_ - 2);
+}
+
+void ReducedProblem::initializeHermite(const Vector3& span, const Vector3& start_slope,
+                                       const Vector3& end_slope) {
+  const auto phi = [&](double s) {
+    const double h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
+                 h11 = s * s * s - s * s;
+    return Vector3(h10 * start_slope + h01 * span + h11 * end_slope);
+  };
+  // Steps between consecutive samples R_1 exp(φ(s_{j−1})), R_1 exp(φ(s_j)), composed in
+  // quaternions; the last sample is exactly R_1 exp(span) = R_{N−1}.
+  Eigen::Vector4d q_prev = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Eigen::Vector4d q = so3::quaternionOfRotationVector<double>(phi(double(j) / (N_ - 2)));
+    Eigen::Vector4d q_prev_inverse = q_prev;
+    q_prev_inverse.tail<3>() *= -1.0;
+    steps_[j] = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(q_prev_inverse, q));
+    q_prev = q;
+  }
 }
 
 void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes) {

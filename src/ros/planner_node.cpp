@@ -1,24 +1,8 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
+#include "attitude_planner/ros/parameters.hpp"
+
 namespace attitude_planner {
-
-namespace {
-
-/// Reads a private parameter; falls back (with an error in the log) if `valid` rejects it.
-template <class T, class Valid>
-T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Valid valid,
-            const std::string& requirement) {
-  T value;
-  nh.param(name, value, fallback);
-  if (!valid(value)) {
-    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
-                         << fallback);
-    return fallback;
-  }
-  return value;
-}
-
-}  // namespace
 
 int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s) {
   if (result.converged) return PlanErrorCode::SUCCESS;

@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/tracker_node.hpp"
 
+#include "attitude_planner/ros/parameters.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -19,20 +21,6 @@ namespace attitude_planner {
 namespace rc = ros_conversions;
 
 namespace {
-
-/// Reads a private parameter; falls back (with an error in the log) if `valid` rejects it.
-template <class T, class Valid>
-T readParam(ros::NodeHandle& nh, const std::string& name, const T& fallback, Valid valid,
-            const std::string& requirement) {
-  T value;
-  nh.param(name, value, fallback);
-  if (!valid(value)) {
-    ROS_ERROR_STREAM("~" << name << " = " << value << " is invalid (" << requirement << "); using "
-                         << fallback);
-    return fallback;
-  }
-  return value;
-}
 
 std_msgs::ColorRGBA color(float r, float g, float b, float a) {
   std_msgs::ColorRGBA c;

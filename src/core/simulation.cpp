@@ -10,15 +10,14 @@ Matrix3 reorthonormalize(const Matrix3& R) {
   return 0.5 * R * (3.0 * Matrix3::Identity() - R.transpose() * R);
 }
 
-Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
-                  SimulationReport* report) {
+namespace {
+
+/// The integrator loop, specialized at compile time on whether anything acts besides the control
+/// (so an absent effect costs nothing per step: no branch, no zero evaluation).
+template <bool kWithEffects>
+Maneuver integrate(const DiscreteScheme& scheme, const SimulationInput& input,
+                   SimulationReport* report) {
   const int N = static_cast<int>(input.torque.size()) - 1;
-  if (N < 1)
-    throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
-                       std::to_string(input.torque.size()));
-  if (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0)) {
-    throw InvalidInput("torque: tau_0 and tau_N must be zero (they do not enter eq. (18))");
-  }
   const double h = scheme.timeStep();
   Maneuver m;
   m.time_step = h;
@@ -38,7 +37,13 @@ Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
   // then conserved bit for bit instead of accumulating a rounding bias every step.
   Vector3 spatial_momentum = input.initial_attitude * scheme.momentum<double>(F);
   for (int k = 1; k < N; ++k) {
-    const Vector3 p = m.attitude[k].transpose() * spatial_momentum + h * input.torque[k];
+    Vector3 applied = input.torque[k];
+    if constexpr (kWithEffects) {
+      if (input.actuation) applied = input.actuation->apply(applied);
+      m.torque[k] = applied;
+      if (input.effects) applied += input.effects->torque(m.attitude[k], m.time[k]);
+    }
+    const Vector3 p = m.attitude[k].transpose() * spatial_momentum + h * applied;
     StepSolveReport step;
     F = scheme.solveStep(p, F, &step);
     if (!step.converged) {
@@ -52,11 +57,29 @@ Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
     local.max_step_residual = std::max(local.max_step_residual, step.residual);
     m.attitude[k + 1] = reorthonormalize(m.attitude[k] * F);
     m.angular_velocity[k] = scheme.velocity(F);
-    if (!input.torque[k].isZero(0.0)) spatial_momentum = m.attitude[k] * p;
+    if (!applied.isZero(0.0)) spatial_momentum = m.attitude[k] * p;
   }
   m.angular_velocity[N] = m.angular_velocity[N - 1];
   if (report) *report = local;
   return m;
+}
+
+}  // namespace
+
+Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
+                  SimulationReport* report) {
+  const int N = static_cast<int>(input.torque.size()) - 1;
+  if (N < 1) {
+    throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
+                       std::to_string(input.torque.size()));
+  }
+  if (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0)) {
+    throw InvalidInput("torque: tau_0 and tau_N must be zero (they do not enter eq. (18))");
+  }
+  const bool with_effects =
+      (input.effects && !input.effects->empty()) || (input.actuation && !input.actuation->empty());
+  return with_effects ? integrate<true>(scheme, input, report)
+                      : integrate<false>(scheme, input, report);
 }
 
 }  // namespace attitude_planner

@@ -1,0 +1,154 @@
+// Effect models (issue 8): torques, Jacobians and second derivatives against definitions and
+// finite differences; only the listed effects change a simulation.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cstring>
+#include <random>
+
+#include "attitude_planner/effects.hpp"
+#include "attitude_planner/simulation.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+const Matrix3 kInertia =
+    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+constexpr double kMu = 3.986004418e14, kRadius = 6.778e6;  // Earth, 400 km orbit
+
+std::vector<std::unique_ptr<TorqueEffect>> sampleEffects() {
+  std::vector<std::unique_ptr<TorqueEffect>> out;
+  out.push_back(std::make_unique<GravityGradient>(kMu, kRadius, kInertia));
+  out.push_back(std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), true));
+  out.push_back(std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), false));
+  return out;
+}
+
+Maneuver run(const std::vector<Vector3>& torque, const EffectModel* effects, Actuation* actuation,
+             SchemeKind kind = SchemeKind::Variational) {
+  SimulationInput input;
+  input.initial_attitude = so3::exp(Vector3(0.3, -0.2, 0.9));
+  input.initial_velocity = Vector3(0.01, 0.02, -0.005);
+  input.torque = torque;
+  input.effects = effects;
+  input.actuation = actuation;
+  return simulate(DiscreteScheme(kind, kInertia, 1.0), input);
+}
+
+std::vector<Vector3> someTorques(int N) {
+  std::vector<Vector3> t(N + 1, Vector3::Zero());
+  for (int k = 1; k < N; ++k) t[k] = 1e-3 * Vector3(std::sin(0.1 * k), std::cos(0.07 * k), 0.3);
+  return t;
+}
+
+}  // namespace
+
+TEST(Effects, GravityGradientMatchesItsDefinition) {
+  const GravityGradient gg(kMu, kRadius, kInertia);
+  const double n = std::sqrt(kMu / (kRadius * kRadius * kRadius));
+  EXPECT_NEAR(gg.meanMotion(), n, 1e-18);
+  const Matrix3 R = so3::exp(Vector3(0.4, 1.1, -0.3));
+  const double t = 1234.5;
+  const Vector3 r_hat(std::cos(n * t), std::sin(n * t), 0.0);
+  const Vector3 b = R.transpose() * r_hat;
+  EXPECT_LE((gg.torque(R, t) - 3 * n * n * b.cross(kInertia * b)).norm(), 1e-20);
+  // no torque when a principal axis points at the Earth
+  Eigen::SelfAdjointEigenSolver<Matrix3> eig(kInertia);
+  Matrix3 principal = eig.eigenvectors();
+  if (principal.determinant() < 0) principal.col(2) *= -1;
+  const Matrix3 aligned = so3::exp(Vector3(0, 0, n * t)) * principal.transpose();
+  EXPECT_LE(gg.torque(aligned, t).norm(), 1e-12 * 3 * n * n * kInertia.norm());
+}
+
+TEST(Effects, JacobiansMatchFiniteDifferences) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (const auto& effect : sampleEffects()) {
+    for (int trial = 0; trial < 5; ++trial) {
+      const Matrix3 R = so3::exp(Vector3(g(rng), g(rng), g(rng)));
+      const double t = 500.0 * trial;
+      const Matrix3 J = effect->jacobian(R, t);
+      const double eps = 1e-6, scale = std::max(J.norm(), effect->torque(R, t).norm());
+      for (int i = 0; i < 3; ++i) {
+        const Vector3 e = eps * Vector3::Unit(i);
+        const Vector3 fd = (effect->torque(Matrix3(R * so3::exp(e)), t) -
+                            effect->torque(Matrix3(R * so3::exp(Vector3(-e))), t)) /
+                           (2 * eps);
+        EXPECT_LE((fd - J.col(i)).norm(), 1e-7 * scale + 1e-30) << effect->name();
+      }
+    }
+  }
+}
+
+TEST(Effects, WeightedSecondDerivativesMatchSecondDifferences) {
+  // w·τ(R exp δ): its Hessian at δ = 0 is the symmetric weighted second derivative.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (const auto& effect : sampleEffects()) {
+    const Matrix3 R = so3::exp(Vector3(g(rng), g(rng), g(rng)));
+    const Vector3 w(g(rng), g(rng), g(rng));
+    const double t = 777.0;
+    const Matrix3 H = effect->weightedSecondDerivative(R, t, w);
+    const auto f = [&](const Vector3& d) {
+      return w.dot(effect->torque(Matrix3(R * so3::exp(d)), t));
+    };
+    const double eps = 1e-4;
+    Matrix3 fd;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const Vector3 ei = eps * Vector3::Unit(i), ej = eps * Vector3::Unit(j);
+        fd(i, j) = (f(ei + ej) - f(ei - ej) - f(ej - ei) + f(-ei - ej)) / (4 * eps * eps);
+      }
+    }
+    const double scale = std::max(1e-30, std::max(fd.norm(), H.norm()));
+    EXPECT_LE((fd - H).norm(), 1e-6 * scale) << effect->name();
+  }
+}
+
+TEST(Effects, AnEmptyEffectListIsBitIdenticalToTheBareIntegrator) {
+  const auto torque = someTorques(200);
+  EffectModel none;
+  Actuation nothing;
+  const Maneuver bare = run(torque, nullptr, nullptr);
+  const Maneuver listed = run(torque, &none, &nothing);
+  for (int k = 0; k <= 200; ++k) {
+    EXPECT_EQ(std::memcmp(bare.attitude[k].data(), listed.attitude[k].data(), sizeof(Matrix3)), 0);
+    EXPECT_EQ(std::memcmp(bare.angular_velocity[k].data(), listed.angular_velocity[k].data(),
+                          sizeof(Vector3)),
+              0);
+  }
+}
+
+TEST(Effects, ABodyDisturbanceActsLikeAnExtraControlTorque) {
+  const Vector3 d(2e-3, -1e-3, 4e-4);
+  auto torque = someTorques(150);
+  EffectModel disturbed;
+  disturbed.add(std::make_unique<DisturbanceTorque>(d, false));
+  const Maneuver a = run(torque, &disturbed, nullptr);
+  for (int k = 1; k < 150; ++k) torque[k] += d;
+  const Maneuver b = run(torque, nullptr, nullptr);
+  for (int k = 0; k <= 150; ++k) EXPECT_LE((a.attitude[k] - b.attitude[k]).norm(), 1e-13);
+  EXPECT_GT((a.attitude[150] - run(someTorques(150), nullptr, nullptr).attitude[150]).norm(), 1e-3);
+}
+
+TEST(Effects, ActuatorLimitsAreNeverExceededAndNoiseIsReproducible) {
+  Actuation a, b, c;
+  const Vector3 limit(1e-3, 2e-3, 3e-3);
+  a.setLimits(limit);
+  EXPECT_LE((a.apply(Vector3(5, -5, 1e-4)) - Vector3(1e-3, -2e-3, 1e-4)).norm(), 0.0);
+  b.setNoise(Vector3(1e-4, 1e-4, 1e-4), 42);
+  c.setNoise(Vector3(1e-4, 1e-4, 1e-4), 42);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(b.apply(Vector3::Zero()), c.apply(Vector3::Zero()));
+  Actuation limited;
+  limited.setLimits(limit);
+  const auto torque = someTorques(120);
+  std::vector<Vector3> big = torque;
+  for (auto& t : big) t *= 10.0;
+  big.front().setZero();
+  big.back().setZero();
+  const Maneuver m = run(big, nullptr, &limited);
+  for (int k = 0; k <= 120; ++k) {
+    EXPECT_LE((m.torque[k].cwiseAbs() - limit).maxCoeff(), 1e-18);
+  }
+}

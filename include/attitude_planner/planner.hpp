@@ -6,10 +6,12 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "attitude_planner/discrete_scheme.hpp"
+#include "attitude_planner/effects.hpp"
 #include "attitude_planner/maneuver.hpp"
 
 namespace attitude_planner {
@@ -38,6 +40,9 @@ struct PlanningProblem {
   RotationDirection direction = RotationDirection::Shortest;
   /// Extra full turns (2π each) about the same axis in the same sense, ≥ 0.
   int extra_revolutions = 0;
+  /// Known external torques the plan must account for (gravity gradient, disturbances); null or
+  /// empty: none. Shared, immutable: several solves may use one model.
+  std::shared_ptr<const EffectModel> effects;
 };
 
 /// Progress of one iteration, for feedback (action) and logging.
@@ -82,6 +87,8 @@ struct PlanResult {
   /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
   /// cost of the other way when both were solved.
   std::string extremal;
+  /// The effects in the planning model (scene keys), in order.
+  std::vector<std::string> effects;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws

@@ -88,6 +88,7 @@ class ReducedProblem {
   int N_;
   DiscreteScheme scheme_;
   Matrix3 initial_attitude_;
+  std::shared_ptr<const EffectModel> effects_;  ///< null when the plan has no external torques
   Vector3 principal_span_;
   Steps steps_;
 };

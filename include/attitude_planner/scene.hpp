@@ -78,6 +78,13 @@ std::string formatScene(const Scene& scene);
 /// distribution exists). Not part of validateProblem: the dynamics only need SPD.
 void requirePhysicalInertia(const Matrix3& inertia);
 
+/// The plannable effects of `specs` (gravity gradient, disturbance torques) as one model for
+/// J = inertia; null if there are none. parseScene stores it in Scene::problem.effects.
+std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec>& specs,
+                                                    const Matrix3& inertia);
+/// The tracker-side effects of `specs` (actuator_limits, torque_noise).
+Actuation actuationOf(const std::vector<EffectSpec>& specs);
+
 /// Throws InvalidInput if planManeuver cannot plan this scene faithfully (effects present, or a
 /// system other than rigid_body): a scene's content is never silently ignored.
 void requirePlannable(const Scene& scene);

@@ -121,6 +121,13 @@ void constraints(unsigned m, double* result, unsigned n, const double* x_raw, do
 }  // namespace
 
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options) {
+  if (problem.effects && !problem.effects->empty()) {
+    PlanResult refused;
+    refused.message =
+        "solver nlopt: planning with effects is implemented in the newton solver only (its "
+        "constraint Jacobians do not include effect torques); use --solver newton";
+    return refused;
+  }
   const int N = problem.steps;
   if (N > kMaxNloptSteps) {
     PlanResult refused;

@@ -15,9 +15,11 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   input.initial_attitude = problem.initial_attitude;
   input.initial_velocity = problem.initial_velocity;
   input.torque = torque;
+  input.effects = problem.effects.get();
   SimulationReport report;
   result->maneuver = simulate(scheme, input, &report);
   result->scheme = problem.scheme;
+  result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
   result->dynamics_residual = report.max_step_residual;
   double cost = 0.0;
   for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();

@@ -60,7 +60,8 @@ Matrix3 contract(const so3::Mat3<Dual3>& X, const Vector3& tau) {
 ReducedProblem::ReducedProblem(const PlanningProblem& problem)
     : N_(problem.steps),
       scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps),
-      initial_attitude_(problem.initial_attitude) {
+      initial_attitude_(problem.initial_attitude),
+      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr) {
   const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
   const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
   steps_.assign(N_, Vector3::Zero());
@@ -127,11 +128,16 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
   std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
   const double h = scheme_.timeStep();
   Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
+  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
     const Vector3 mu = scheme_.momentumOfStep(steps[k]);
     // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
     // cancel in a difference of accurately formed momenta.
     tau[k] = ((mu - mu_prev) - so3::expMinusIdentity(steps[k - 1]).transpose() * mu_prev) / h;
+    if (effects_) {
+      R = R * so3::exp(steps[k - 1]);
+      tau[k] -= effects_->torque(R, k * h);  // the control supplies what the effects do not
+    }
     mu_prev = mu;
   }
   return tau;
@@ -172,14 +178,18 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   StepTerms<double> prev(scheme_, F_prev);
   Stencil st;
   st.second.setZero();
+  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
     const Matrix3 F = F_of(k);
+    if (effects_) R = R * F_prev;
     StepTerms<double> next(scheme_, F);
     st.k = k;
     st.tau = tau[k];
     st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
     st.jacobian.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
     st.jacobian.block<3, 3>(0, 6) = next.D / h;
+    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects.
+    if (effects_) st.jacobian.block<3, 3>(0, 3) -= effects_->jacobian(R, k * h);
     cost += 0.5 * st.tau.squaredNorm();
     if (with_second_order) {
       StepTerms<Dual3> next_d(scheme_, perturbed(F));
@@ -199,6 +209,8 @@ double ReducedProblem::forEachStencil(bool with_second_order,
       // The antisymmetric part is cancelled exactly by the retraction's derivative
       // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
       st.second = 0.5 * (second + second.transpose());
+      if (effects_)
+        st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, st.tau);
       prev_d.emplace(next_d);
     }
     visit(st);

@@ -57,7 +57,11 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"terminal_velocity_error\": " << jsonNumber(r.terminal_velocity_error) << ",\n"
       << "  \"max_residual\": " << jsonNumber(r.max_residual) << ",\n"
       << "  \"dynamics_residual\": " << jsonNumber(r.dynamics_residual) << ",\n"
-      << "  \"solve_time_s\": " << jsonNumber(r.solve_time_s) << "\n"
+      << "  \"solve_time_s\": " << jsonNumber(r.solve_time_s) << ",\n"
+      << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
+      << "  \"effects\": [";
+  for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
+  out << "]\n"
       << "}\n";
   return out.str();
 }

@@ -127,6 +127,7 @@ class SceneParser {
       if (node) throw InvalidInput(where(node) + what);
       throw InvalidInput(source_ + ": " + what);
     }
+    p.effects = plannableEffects(scene.effects, p.inertia);
     return scene;
   }
 
@@ -471,18 +472,45 @@ std::string formatScene(const Scene& scene) {
   return out.str();
 }
 
+std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec>& specs,
+                                                    const Matrix3& inertia) {
+  auto model = std::make_shared<EffectModel>();
+  for (const EffectSpec& spec : specs) {
+    if (const auto* gg = std::get_if<GravityGradientSpec>(&spec)) {
+      model->add(std::make_unique<GravityGradient>(gg->mu, gg->orbit_radius, inertia));
+    } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&spec)) {
+      model->add(std::make_unique<DisturbanceTorque>(d->value, d->frame == "world"));
+    }
+    // actuator_limits and torque_noise act on the commanded torque: see actuationOf().
+  }
+  return model->empty() ? nullptr : model;
+}
+
+Actuation actuationOf(const std::vector<EffectSpec>& specs) {
+  Actuation actuation;
+  for (const EffectSpec& spec : specs) {
+    if (const auto* limits = std::get_if<ActuatorLimitsSpec>(&spec)) {
+      actuation.setLimits(limits->max_torque);
+    } else if (const auto* noise = std::get_if<TorqueNoiseSpec>(&spec)) {
+      actuation.setNoise(noise->std, noise->seed);
+    }
+  }
+  return actuation;
+}
+
 void requirePlannable(const Scene& scene) {
   if (scene.system != "rigid_body") {
     throw InvalidInput(scene.source + ": system: '" + scene.system +
                        "' is not supported by the planner yet (only rigid_body)");
   }
-  if (!scene.effects.empty()) {
-    std::string names;
-    for (const EffectSpec& e : scene.effects) {
-      const std::string n = effectName(e);
-      if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
+  // Gravity gradient and disturbances are in the planning model; torque noise is tracker-only by
+  // nature (the plan cannot know it). Torque bounds need a constrained solver: not yet.
+  for (const EffectSpec& e : scene.effects) {
+    if (std::holds_alternative<ActuatorLimitsSpec>(e)) {
+      throw InvalidInput(scene.source +
+                         ": effects: actuator_limits is not supported by the planner yet (the "
+                         "Newton solver has no torque bounds); the tracker can saturate a replay");
     }
-    throw InvalidInput(scene.source + ": effects are not supported by the planner yet: " + names);
   }
 }
 

@@ -152,3 +152,51 @@ TEST(Effects, ActuatorLimitsAreNeverExceededAndNoiseIsReproducible) {
     EXPECT_LE((m.torque[k].cwiseAbs() - limit).maxCoeff(), 1e-18);
   }
 }
+
+#include "attitude_planner/planner.hpp"
+
+namespace {
+// A low-Earth-orbit slew: 90° about z in 10 min, with the orbit's gravity gradient and a small
+// world-frame disturbance (both comparable to the control torque).
+PlanningProblem leoSlew(bool with_effects) {
+  PlanningProblem p;
+  p.inertia = Vector3(800, 1200, 1500).asDiagonal();  // kg m², a small satellite
+  p.duration = 600.0;
+  p.steps = 300;
+  p.final_attitude = so3::fromAxisAngle(Vector3::UnitZ(), M_PI / 2);
+  p.scheme = SchemeKind::Variational;
+  if (with_effects) {
+    auto model = std::make_shared<EffectModel>();
+    model->add(std::make_unique<GravityGradient>(kMu, kRadius, p.inertia));
+    model->add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), true));
+    p.effects = model;
+  }
+  return p;
+}
+}  // namespace
+
+TEST(Effects, PlanningWithEffectsLandsWhenReplayedUnderTheSameEffects) {
+  const PlanResult r = planManeuver(leoSlew(true));
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_LE(r.terminal_attitude_error, 1e-9);  // evaluatePlan replays with the same effects
+  EXPECT_LE(r.terminal_velocity_error, 1e-9);
+  ASSERT_EQ(r.effects.size(), 2u);
+  EXPECT_EQ(r.effects[0], "gravity_gradient");
+  // The same torques replayed without the effects miss: the effects are in the plan.
+  SimulationInput bare;
+  bare.torque = r.maneuver.torque;
+  const PlanningProblem p = leoSlew(true);
+  const Maneuver m = simulate(DiscreteScheme(p.scheme, p.inertia, p.duration / p.steps), bare);
+  EXPECT_GT(so3::angleBetween(p.final_attitude, m.attitude[p.steps]), 1e-4);
+  // And a plan that ignores them lands only without them.
+  const PlanResult ignorant = planManeuver(leoSlew(false));
+  ASSERT_TRUE(ignorant.converged);
+  EffectModel actual;
+  actual.add(std::make_unique<GravityGradient>(kMu, kRadius, p.inertia));
+  SimulationInput replay;
+  replay.torque = ignorant.maneuver.torque;
+  replay.effects = &actual;
+  const Maneuver missed =
+      simulate(DiscreteScheme(p.scheme, p.inertia, p.duration / p.steps), replay);
+  EXPECT_GT(so3::angleBetween(p.final_attitude, missed.attitude[p.steps]), 1e-4);
+}

@@ -164,14 +164,22 @@ TEST_F(CliTest, InvalidSceneExitsOneNamingTheKey) {
   EXPECT_CONTAINS(steps.output, "steps: must be >= 4, got 2");
 }
 
-TEST_F(CliTest, EffectsAndOtherSystemsAreRefusedNotIgnored) {
+TEST_F(CliTest, EffectsArePlannedByNewtonAndRefusedWhereUnsupported) {
   std::string text = readFile(kScenes + "rest_to_rest.yaml");
   text.replace(text.find("effects: []"), 11,
                "effects: [{gravity_gradient: {mu: 3.986004418e14, orbit_radius: 7.0e6}}]");
   const std::string scene = writeScene("gg.yaml", text);
+  const ToolRun planned = run("plan_maneuver", scene + " --steps 32");
+  EXPECT_EQ(planned.status, 0) << planned.output;
   const ToolRun r = run("plan_maneuver", scene + " --solver nlopt --steps 16");
   EXPECT_EQ(r.status, 1) << r.output;
-  EXPECT_CONTAINS(r.output, "effects are not supported by the planner yet: gravity_gradient");
+  EXPECT_CONTAINS(r.output, "effects is implemented in the newton solver only");
+  std::string limited = readFile(kScenes + "rest_to_rest.yaml");
+  limited.replace(limited.find("effects: []"), 11,
+                  "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}]");
+  const ToolRun bounds = run("plan_maneuver", writeScene("limits.yaml", limited) + " --steps 16");
+  EXPECT_EQ(bounds.status, 1) << bounds.output;
+  EXPECT_CONTAINS(bounds.output, "actuator_limits is not supported by the planner yet");
 
   const ToolRun drift =
       run("plan_maneuver", writeScene("drift.yaml",

@@ -119,7 +119,7 @@ TEST(SceneOptionalKeys, NearUnitQuaternionIsNormalized) {
       1e-14);
 }
 
-TEST(SceneOptionalKeys, EffectsAreParsedAndRefusedByThePlanner) {
+TEST(SceneOptionalKeys, EffectsAreParsedIntoThePlanningModelAndActuation) {
   const std::string text =
       withLine("effects",
                "effects:\n"
@@ -141,14 +141,24 @@ TEST(SceneOptionalKeys, EffectsAreParsedAndRefusedByThePlanner) {
   const auto& n = std::get<ap::TorqueNoiseSpec>(s.effects[4]);
   EXPECT_EQ(n.std, ap::Vector3(1e-3, 1e-3, 0));
   EXPECT_EQ(n.seed, 42u);
+  // gravity gradient and disturbances are planned; limits and noise act on the commanded torque
+  ASSERT_TRUE(s.problem.effects);
+  EXPECT_EQ(
+      s.problem.effects->names(),
+      (std::vector<std::string>{"gravity_gradient", "disturbance_torque", "disturbance_torque"}));
+  EXPECT_FALSE(ap::actuationOf(s.effects).empty());
+  // torque bounds are not plannable yet: refused, never silently ignored
   try {
     ap::requirePlannable(s);
-    ADD_FAILURE() << "a scene with effects must be refused";
+    ADD_FAILURE() << "a scene with actuator_limits must be refused by the planner";
   } catch (const ap::InvalidInput& e) {
-    EXPECT_CONTAINS(e.what(),
-                    "effects are not supported by the planner yet: gravity_gradient, "
-                    "disturbance_torque, actuator_limits, torque_noise");
+    EXPECT_CONTAINS(e.what(), "actuator_limits is not supported by the planner yet");
   }
+  ap::Scene without_limits = s;
+  without_limits.effects.erase(without_limits.effects.begin() + 3);
+  EXPECT_NO_THROW(ap::requirePlannable(without_limits));
+  // no effects: no model at all (the bare integrator)
+  EXPECT_FALSE(ap::parseScene(withLine("effects", "effects: []"), "none.yaml").problem.effects);
 }
 
 TEST(SceneOptionalKeys, DriftTwoInputSystemIsStoredAndRefusedByThePlanner) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,6 +44,11 @@ struct PlanningProblem {
   /// Known external torques the plan must account for (gravity gradient, disturbances); null or
   /// empty: none. Shared, immutable: several solves may use one model.
   std::shared_ptr<const EffectModel> effects;
+  /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
+  /// A bounded problem whose unbounded optimum violates the bounds is solved by NLopt (SLSQP with
+  /// box bounds, N ≤ 1024) from the clipped Newton torques.
+  Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  bool hasTorqueBounds() const { return max_torque.allFinite(); }
 };
 
 /// Progress of one iteration, for feedback (action) and logging.

@@ -159,6 +159,16 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   opt.set_min_objective(objective, nullptr);
   opt.add_equality_mconstraint(
       constraints, &cb, std::vector<double>(kTerminalConstraints, kNloptConstraintTolerance));
+  if (problem.hasTorqueBounds()) {
+    std::vector<double> lower(n), upper(n);
+    for (unsigned i = 0; i < n; ++i) {
+      upper[i] = problem.max_torque(i % 3);
+      lower[i] = -upper[i];
+      x[i] = std::min(std::max(x[i], lower[i]), upper[i]);
+    }
+    opt.set_lower_bounds(lower);
+    opt.set_upper_bounds(upper);
+  }
   opt.set_xtol_rel(1e-14);
   opt.set_ftol_rel(1e-15);
   opt.set_maxeval(std::max(options.max_iterations, 1));
@@ -197,8 +207,23 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   // the cost gradient outside the span of the constraint gradients (relative to |∇f| = |τ|).
   const TerminalConstraints c = evaluateTerminalConstraints(problem, xv, true);
   const double violation = c.value.cwiseAbs().maxCoeff();
-  const double stationarity = stationarityResidual(xv, c.jacobian).cwiseAbs().maxCoeff() /
-                              std::max(xv.cwiseAbs().maxCoeff(), 1e-300);
+  // With bounds, stationarity holds on the free variables only (bound multipliers take the rest).
+  std::vector<int> free;
+  for (int i = 0; i < static_cast<int>(n); ++i) {
+    if (!problem.hasTorqueBounds() || std::abs(xv(i)) < problem.max_torque(i % 3) * (1.0 - 1e-9)) {
+      free.push_back(i);
+    }
+  }
+  Eigen::VectorXd x_free(free.size());
+  Eigen::MatrixXd jacobian_free(c.jacobian.rows(), free.size());
+  for (size_t j = 0; j < free.size(); ++j) {
+    x_free(j) = xv(free[j]);
+    jacobian_free.col(j) = c.jacobian.col(free[j]);
+  }
+  const double stationarity =
+      free.empty() ? 0.0
+                   : stationarityResidual(x_free, jacobian_free).cwiseAbs().maxCoeff() /
+                         std::max(xv.cwiseAbs().maxCoeff(), 1e-300);
   result.max_residual = std::max(violation, stationarity);
 
   const bool nlopt_success =

@@ -35,14 +35,39 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
   validateProblem(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
-  if (options.solver == "newton") {
+  if (options.solver == "newton" && problem.hasTorqueBounds()) {
+    result = solveWithNewton(problem, options);
+    const auto within_bounds = [&](const PlanResult& r) {
+      for (const Vector3& t : r.maneuver.torque) {
+        if (((t.cwiseAbs() - problem.max_torque).array() > 0.0).any()) return false;
+      }
+      return true;
+    };
+    if (!result.converged || !within_bounds(result)) {
+      // The unbounded optimum violates the bounds: the constrained solver, started from it.
+      Maneuver clipped = result.maneuver;
+      for (Vector3& t : clipped.torque)
+        t = t.cwiseMax(-problem.max_torque).cwiseMin(problem.max_torque);
+      SolverOptions bounded = options;
+      bounded.warm_start = result.converged ? &clipped : nullptr;
+      const std::string unbounded_note = result.converged ? "; the unbounded optimum (cost " +
+                                                                std::to_string(result.cost) +
+                                                                ") exceeds the bounds"
+                                                          : "";
+      result = solveWithNlopt(problem, bounded);
+      result.message += unbounded_note;
+      result.solver = "nlopt";
+    } else {
+      result.message += "; bounds inactive at the unbounded optimum";
+    }
+  } else if (options.solver == "newton") {
     result = solveWithNewton(problem, options);
   } else if (options.solver == "nlopt") {
     result = solveWithNlopt(problem, options);
   } else {
     throw InvalidInput("solver: unknown value '" + options.solver + "' (expected newton or nlopt)");
   }
-  result.solver = options.solver;
+  if (result.solver.empty()) result.solver = options.solver;
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -70,6 +70,21 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
                        std::to_string(p.steps));
   }
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(p.max_torque(i)) || !(p.max_torque(i) > 0.0)) {
+      throw InvalidInput("actuator_limits.max_torque: each bound must be > 0 N m, got " +
+                         str(p.max_torque.transpose()));
+    }
+  }
+  if (p.max_torque.array().isFinite().any() && !p.max_torque.allFinite()) {
+    throw InvalidInput("actuator_limits.max_torque: give all three bounds, got " +
+                       str(p.max_torque.transpose()));
+  }
+  if (p.hasTorqueBounds() && p.effects && !p.effects->empty()) {
+    throw InvalidInput(
+        "effects: actuator_limits together with gravity_gradient/disturbance_torque is not "
+        "supported yet (bounded plans use NLopt, which does not model effect torques)");
+  }
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");

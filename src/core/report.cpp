@@ -84,7 +84,14 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
                 schemeName(problem.scheme).c_str(), problem.steps, problem.duration,
                 problem.duration / problem.steps, r.iterations, r.cost, r.terminal_attitude_error,
                 r.terminal_velocity_error, r.max_residual, r.dynamics_residual, r.solve_time_s);
-  return buffer;
+  std::string text = buffer;
+  std::string effects;
+  for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
+  if (problem.hasTorqueBounds())
+    effects += std::string(effects.empty() ? "" : ", ") + "actuator_limits";
+  text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
+  if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
+  return text;
 }
 
 }  // namespace attitude_planner

@@ -128,6 +128,10 @@ class SceneParser {
       throw InvalidInput(source_ + ": " + what);
     }
     p.effects = plannableEffects(scene.effects, p.inertia);
+    for (const EffectSpec& e : scene.effects) {
+      if (const auto* limits = std::get_if<ActuatorLimitsSpec>(&e))
+        p.max_torque = limits->max_torque;
+    }
     return scene;
   }
 
@@ -503,15 +507,8 @@ void requirePlannable(const Scene& scene) {
     throw InvalidInput(scene.source + ": system: '" + scene.system +
                        "' is not supported by the planner yet (only rigid_body)");
   }
-  // Gravity gradient and disturbances are in the planning model; torque noise is tracker-only by
-  // nature (the plan cannot know it). Torque bounds need a constrained solver: not yet.
-  for (const EffectSpec& e : scene.effects) {
-    if (std::holds_alternative<ActuatorLimitsSpec>(e)) {
-      throw InvalidInput(scene.source +
-                         ": effects: actuator_limits is not supported by the planner yet (the "
-                         "Newton solver has no torque bounds); the tracker can saturate a replay");
-    }
-  }
+  // Gravity gradient and disturbances are in the planning model, actuator limits bound the plan's
+  // torques (PlanningProblem::max_torque); torque noise is tracker-only by nature.
 }
 
 }  // namespace attitude_planner

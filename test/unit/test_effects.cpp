@@ -200,3 +200,36 @@ TEST(Effects, PlanningWithEffectsLandsWhenReplayedUnderTheSameEffects) {
       simulate(DiscreteScheme(p.scheme, p.inertia, p.duration / p.steps), replay);
   EXPECT_GT(so3::angleBetween(p.final_attitude, missed.attitude[p.steps]), 1e-4);
 }
+
+TEST(Effects, TorqueLimitedPlansRespectTheBoundsAndCostAtLeastTheUnlimitedOne) {
+  PlanningProblem p;
+  p.inertia << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
+  p.allow_nonphysical_inertia = true;
+  p.duration = 12.8;
+  p.steps = 32;
+  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
+  const PlanResult free = planManeuver(p);
+  ASSERT_TRUE(free.converged);
+  double largest = 0;
+  for (const Vector3& t : free.maneuver.torque)
+    largest = std::max(largest, t.cwiseAbs().maxCoeff());
+  // inactive bounds: the Newton optimum is kept
+  p.max_torque = Vector3::Constant(2 * largest);
+  const PlanResult loose = planManeuver(p);
+  EXPECT_TRUE(loose.converged);
+  EXPECT_EQ(loose.solver, "newton");
+  EXPECT_EQ(loose.cost, free.cost);
+  // active bounds at 70 % of the unbounded peak
+  p.max_torque = Vector3::Constant(0.7 * largest);
+  const PlanResult tight = planManeuver(p);
+  ASSERT_TRUE(tight.converged) << tight.message;
+  EXPECT_EQ(tight.solver, "nlopt");
+  EXPECT_LE(tight.terminal_attitude_error, 1e-10);
+  int at_bound = 0;
+  for (const Vector3& t : tight.maneuver.torque) {
+    EXPECT_LE((t.cwiseAbs() - p.max_torque).maxCoeff(), 1e-12);
+    if ((t.cwiseAbs() - p.max_torque).maxCoeff() > -1e-9) ++at_bound;
+  }
+  EXPECT_GT(at_bound, 0);  // the limit is active
+  EXPECT_GE(tight.cost, free.cost * (1 - 1e-12));
+}

@@ -176,10 +176,11 @@ TEST_F(CliTest, EffectsArePlannedByNewtonAndRefusedWhereUnsupported) {
   EXPECT_CONTAINS(r.output, "effects is implemented in the newton solver only");
   std::string limited = readFile(kScenes + "rest_to_rest.yaml");
   limited.replace(limited.find("effects: []"), 11,
-                  "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}]");
+                  "effects: [{actuator_limits: {max_torque: [1, 1, 1]}},\n"
+                  "          {gravity_gradient: {mu: 3.986004418e14, orbit_radius: 7.0e6}}]");
   const ToolRun bounds = run("plan_maneuver", writeScene("limits.yaml", limited) + " --steps 16");
   EXPECT_EQ(bounds.status, 1) << bounds.output;
-  EXPECT_CONTAINS(bounds.output, "actuator_limits is not supported by the planner yet");
+  EXPECT_CONTAINS(bounds.output, "actuator_limits together with gravity_gradient");
 
   const ToolRun drift =
       run("plan_maneuver", writeScene("drift.yaml",

@@ -324,12 +324,21 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 /// starts in the convex basin and takes a few Newton steps.
 constexpr int kCoarsestGrid = 256;
 
+/// What is left of the options' time budget after `start` [s] (0 budget: unlimited, returned as 0).
+double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
+  if (options.time_budget_s <= 0) return 0.0;
+  const double used =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::max(options.time_budget_s - used, 1e-300);
+}
+
 PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   if (problem.steps <= kCoarsestGrid || options.warm_start) return solveOnGrid(problem, options);
   PlanningProblem coarse = problem;
   coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
   SolverOptions coarse_options = options;
-  coarse_options.on_iteration = nullptr;
+  // The callback is forwarded (feedback from every level, and cancel works during all of them).
   coarse_options.tolerance = std::max(options.tolerance, 1e-8);
   const PlanResult coarse_result = solveWithContinuation(coarse, coarse_options);
   SolverOptions fine_options = options;
@@ -344,6 +353,13 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
     level = "; the N = " + std::to_string(coarse.steps) + " level did not converge (" +
             coarse_result.message + "), started from the geodesic";
   }
+  fine_options.time_budget_s = remainingBudget(options, start);
+  if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
+    PlanResult out = coarse_result;
+    out.converged = false;
+    out.message = "time budget exceeded on the coarse levels" + level;
+    return out;
+  }
   PlanResult result = solveOnGrid(problem, fine_options);
   result.message += level;
   return result;
@@ -357,6 +373,7 @@ constexpr double kBothWaysBelowPi = 0.25;
 }  // namespace
 
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   PlanResult first = solveWithContinuation(problem, options);
   std::vector<InitialGuess> guesses;
   try {
@@ -376,7 +393,10 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   }
   PlanningProblem other = problem;
   other.direction = RotationDirection::LongWay;
-  PlanResult second = solveWithContinuation(other, options);
+  SolverOptions remaining = options;
+  remaining.time_budget_s = remainingBudget(options, start);
+  if (options.time_budget_s > 0 && remaining.time_budget_s <= 1e-299) return first;
+  PlanResult second = solveWithContinuation(other, remaining);
   // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice
   // at exactly π is deterministic.
   const bool take_second =

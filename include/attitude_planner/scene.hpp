@@ -69,7 +69,7 @@ struct Scene {
   Eigen::Vector2d control_weights = Eigen::Vector2d::Ones();  ///< c1, c2 (drift_two_input) [-]
   /// Guess for p(0) [c·rad/s] (drift_two_input only); empty: the planner's default starts.
   std::optional<Vector3> initial_costate;
-  std::vector<EffectSpec> effects;                            ///< in file order
+  std::vector<EffectSpec> effects;  ///< in file order
   /// true: the inertia need not satisfy the triangle inequality (only SPD is required).
   bool allow_nonphysical_inertia = false;
 };

@@ -81,8 +81,8 @@ std::vector<Matrix3> replayDriftTwoInputControls(const Matrix3& g0, const std::v
       throw InvalidInput("replay: sample " + std::to_string(k) + " is not finite");
     }
     if (k > 0 && !(t[k] > t[k - 1])) {
-      throw InvalidInput("replay: sample times must increase (t[" + std::to_string(k) +
-                         "] <= t[" + std::to_string(k - 1) + "])");
+      throw InvalidInput("replay: sample times must increase (t[" + std::to_string(k) + "] <= t[" +
+                         std::to_string(k - 1) + "])");
     }
   }
   const int points = std::min(4, n);  // cubic through the 4 nearest samples

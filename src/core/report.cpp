@@ -94,8 +94,8 @@ void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& tr, const std::string&
     const Eigen::Quaterniond q = so3::toQuaternion(tr.g[k]);
     const Eigen::Vector2d& u = tr.u[k];
     const Vector3& p = tr.p[k];
-    std::fprintf(file.get(), "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                 k, tr.t[k], q.w(), q.x(), q.y(), q.z(), u.x(), u.y(), p.x(), p.y(), p.z());
+    std::fprintf(file.get(), "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
+                 tr.t[k], q.w(), q.x(), q.y(), q.z(), u.x(), u.y(), p.x(), p.y(), p.z());
   }
   if (std::fflush(file.get()) != 0) throw InvalidInput("--csv: cannot write '" + path + "'");
 }
@@ -151,8 +151,8 @@ std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
                 "solve time               %.3f s\n",
                 plan.converged ? "yes" : "NO", plan.message.c_str(), request.weights.c1,
                 request.weights.c2, request.steps, request.duration,
-                request.duration / request.steps, plan.iterations, plan.continuation_stages,
-                p.x(), p.y(), p.z(), plan.cost, plan.terminal_error, solve_time_s);
+                request.duration / request.steps, plan.iterations, plan.continuation_stages, p.x(),
+                p.y(), p.z(), plan.cost, plan.terminal_error, solve_time_s);
   return buffer;
 }
 

@@ -298,8 +298,8 @@ class SceneParser {
 
   /// `rigid`: the rigid body's state (attitude and angular velocity, both required); otherwise
   /// the kinematic drift system's, whose only boundary value is the attitude.
-  void readState(const YAML::Node& node, const std::string& path, bool rigid,
-                 Matrix3* attitude_out, Vector3* velocity_out) const {
+  void readState(const YAML::Node& node, const std::string& path, bool rigid, Matrix3* attitude_out,
+                 Vector3* velocity_out) const {
     requireMap(node, path);
     if (!rigid && node["angular_velocity"]) {
       // Not ignored: the body rate of ġ = g(E3 + u1 E1 + u2 E2) is (u1, u2, 1), set by the

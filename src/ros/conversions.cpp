@@ -163,7 +163,8 @@ DriftTwoInputTrajectory driftManeuverFromMsg(const DriftTwoInputManeuver& msg,
   DriftTwoInputTrajectory tr;
   for (size_t k = 0; k < rows; ++k) {
     const std::string row = "[" + std::to_string(k) + "]";
-    if (!std::isfinite(msg.time[k])) throw InvalidInput("drift_maneuver.time" + row + ": not finite");
+    if (!std::isfinite(msg.time[k]))
+      throw InvalidInput("drift_maneuver.time" + row + ": not finite");
     const Vector3 u = vectorFromMsg(msg.control[k]);
     const Vector3 p = vectorFromMsg(msg.costate[k]);
     if (!u.allFinite()) throw InvalidInput("drift_maneuver.control" + row + ": not finite");

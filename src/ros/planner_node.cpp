@@ -64,8 +64,8 @@ void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world
   if (!outcome.solver_ran) return;
   const DriftTwoInputPlan& p = outcome.plan;
   if (!p.trajectory.g.empty()) {
-    res->maneuver = ros_conversions::driftManeuverToMsg(
-        p.trajectory, outcome.request.weights, world_frame, body_frame, ros::Time::now());
+    res->maneuver = ros_conversions::driftManeuverToMsg(p.trajectory, outcome.request.weights,
+                                                        world_frame, body_frame, ros::Time::now());
   }
   res->initial_costate = ros_conversions::vectorToMsg(p.initial_costate);
   res->cost = p.cost;

@@ -38,7 +38,8 @@ const char* const kUsage =
     "  --max-iterations K        iteration limit (nlopt: function evaluations; default 200)\n"
     "  --time-budget S           wall-time limit [s] (default: none; rigid_body only)\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
-    "  --csv OUT.csv             write the trajectory: rigid_body k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
+    "  --csv OUT.csv             write the trajectory: rigid_body "
+    "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
     "                            drift_two_input k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3\n"
     "  --summary OUT.json        write the result figures as JSON\n"
     "  --help                    show this help\n"
@@ -91,10 +92,10 @@ struct Arguments {
   int steps = 0;  ///< 0: the scene's
   std::string scheme;
   std::string solver = "newton";
-  bool solver_given = false;  ///< --solver was on the command line
+  bool solver_given = false;    ///< --solver was on the command line
   std::string initial_costate;  ///< --initial-costate text, "" if absent
-  double tolerance = -1.0;  ///< < 0: the default
-  int max_iterations = -1;  ///< < 0: the default
+  double tolerance = -1.0;      ///< < 0: the default
+  int max_iterations = -1;      ///< < 0: the default
   double time_budget = 0.0;
   std::string csv;
   std::string summary;

@@ -10,18 +10,15 @@
 // drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the cost
 // ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
 //
-// Subscribes  maneuver          (attitude_planner/AttitudeManeuver)   a new one replaces the
-//             drift_maneuver    (attitude_planner/DriftTwoInputManeuver)  current replay
-// Publishes   /tf               world → body at every step, stamped start + t_k /
-// rate_factor
-//             torque            (geometry_msgs/WrenchStamped, frame body)      τ_k [N·m]
-//             angular_velocity  (geometry_msgs/Vector3Stamped, frame body)     Ω_k [rad/s]
-//             body_marker       (visualization_msgs/MarkerArray, frame body)  box + principal axes
-//             attitude_path     (visualization_msgs/Marker LINE_STRIP, world)  tip of the body x
-//             axis done              (attitude_planner/ReplayResult, latched)      when a replay
-//             ends
-//             control           (geometry_msgs/Vector3Stamped, frame body)     (u1, u2, 0) [rad/s]
-//                               (drift maneuvers only)
+// Subscribes  maneuver          AttitudeManeuver (rigid body)    a new maneuver replaces the
+//             drift_maneuver    DriftTwoInputManeuver (seed 001) current replay
+// Publishes   /tf               world → body at every step, stamped start + t_k / rate_factor
+//             torque            geometry_msgs/WrenchStamped, body      τ_k [N·m] (rigid body)
+//             angular_velocity  geometry_msgs/Vector3Stamped, body     Ω_k [rad/s]
+//             control           geometry_msgs/Vector3Stamped, body     (u1, u2, 0) [rad/s] (drift)
+//             body_marker       visualization_msgs/MarkerArray, body   box + principal axes
+//             attitude_path     visualization_msgs/Marker, world       tip of the body x axis
+//             done              attitude_planner/ReplayResult, latched when a replay ends
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //

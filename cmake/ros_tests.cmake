@@ -22,6 +22,15 @@ add_dependencies(test_tracker_scene attitude_planner_node attitude_tracker_node)
 add_rostest(test/ros/tracker_scene_in_process.test DEPENDENCIES test_tracker_scene)
 list(APPEND AP_EXPECTED_TESTS test_tracker_scene tracker_scene_in_process)
 
+# Seed 001's drift + two-input system: the second service, and the tracker replaying a drift
+# scene planned through it.
+foreach(name planner_drift_service tracker_drift_scene)
+  add_rostest_gtest(test_${name} test/ros/${name}.test test/ros/test_${name}.cpp)
+  target_link_libraries(test_${name} ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+  add_dependencies(test_${name} attitude_planner_node attitude_tracker_node)
+  list(APPEND AP_EXPECTED_TESTS test_${name})
+endforeach()
+
 # rostest with the stock checkers (advertisetest, publishtest) on the whole demo pipeline.
 add_rostest(test/ros/demo_pipeline.test)
 list(APPEND AP_EXPECTED_TESTS demo_pipeline)

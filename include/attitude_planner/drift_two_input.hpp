@@ -182,4 +182,15 @@ DriftTwoInputTrajectory integrateDriftTwoInputExtremal(const Matrix3& g0, const 
                                                        const DriftTwoInputWeights& w,
                                                        const DriftTwoInputIntegration& opts = {});
 
+/// Replays sampled controls open loop: integrates ġ = g(E3 + u1 E1 + u2 E2) from g0 through the
+/// samples (t_k, u_k), k = 0..N (uniform or not, increasing), and returns g at every t_k
+/// (g[0] = g0). The control between samples is the cubic through the 4 nearest samples (fewer if
+/// N < 3); each interval takes `substeps` steps of the fourth-order Magnus method
+/// g⁺ = g exp(s/2 (ξ_a + ξ_b) + √3/12 s² ξ_a × ξ_b), ξ at the two Gauss points, so g stays on
+/// SO(3). Error O(Δt⁴) in the sample spacing (interpolation) plus O((Δt/substeps)⁴).
+/// Throws InvalidInput on mismatched sizes, non-finite or non-increasing samples, substeps < 1.
+std::vector<Matrix3> replayDriftTwoInputControls(const Matrix3& g0, const std::vector<double>& t,
+                                                 const std::vector<Eigen::Vector2d>& u,
+                                                 int substeps = 4);
+
 }  // namespace attitude_planner

@@ -5,21 +5,28 @@
 //   duration         T > 0                                                     [s]
 //   steps            N, 4 ≤ N ≤ 10,000,000 (validateProblem)
 //   initial, final   {attitude: A, angular_velocity: [x, y, z]}                [rad/s] body
+//                    (drift_two_input: {attitude: A} only; angular_velocity is an error there,
+//                    the kinematic system's body rate E3 + u1 E1 + u2 E2 is not a boundary value)
 //                    A = {axis: [x, y, z], angle: a [rad]} or {quaternion: [w, x, y, z]}
 //   effects          list of single-key maps (see EffectSpec)
 //   scheme           optional: paper (default) | variational
 //   system           optional: rigid_body (default) | drift_two_input (seed 001)
 //   control_weights  [c1, c2] > 0, only with system: drift_two_input
+//   initial_costate  optional [p1, p2, p3] (finite), only with system: drift_two_input: guess for
+//                    the extremal's p(0) [c·rad/s] (default: the planner's own starts)
+//   effects          required for rigid_body, optional for drift_two_input (must then be [])
 //   allow_nonphysical_inertia  optional bool (default false): accept an SPD inertia whose
 //                    principal moments violate J1 + J2 ≥ J3 (the seed's example inertia does)
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "attitude_planner/drift_two_input_planner.hpp"
 #include "attitude_planner/planner.hpp"
 
 namespace attitude_planner {
@@ -60,7 +67,9 @@ struct Scene {
   std::string source;                 ///< file name (for messages)
   std::string system = "rigid_body";  ///< "rigid_body" or "drift_two_input" (seed 001)
   Eigen::Vector2d control_weights = Eigen::Vector2d::Ones();  ///< c1, c2 (drift_two_input) [-]
-  std::vector<EffectSpec> effects;                            ///< in file order
+  /// Guess for p(0) [c·rad/s] (drift_two_input only); empty: the planner's default starts.
+  std::optional<Vector3> initial_costate;
+  std::vector<EffectSpec> effects;  ///< in file order
   /// true: the inertia need not satisfy the triangle inequality (only SPD is required).
   bool allow_nonphysical_inertia = false;
 };
@@ -86,7 +95,13 @@ std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec
 Actuation actuationOf(const std::vector<EffectSpec>& specs);
 
 /// Throws InvalidInput if planManeuver cannot plan this scene faithfully (effects present, or a
-/// system other than rigid_body): a scene's content is never silently ignored.
+/// system other than rigid_body): a scene's content is never silently ignored. A drift_two_input
+/// scene is planned by planDriftTwoInput instead (driftTwoInputRequest).
 void requirePlannable(const Scene& scene);
+
+/// The planDriftTwoInput request of a `system: drift_two_input` scene: g0, g1, T, N, (c1, c2) and
+/// the initial_costate guess (solver settings at their defaults). Throws InvalidInput naming the
+/// scene if it is not a drift_two_input scene or lists effects (not modelled for this system).
+DriftTwoInputRequest driftTwoInputRequest(const Scene& scene);
 
 }  // namespace attitude_planner

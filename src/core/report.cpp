@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
+
+#include "attitude_planner/errors.hpp"
 
 namespace attitude_planner {
 
@@ -92,6 +95,76 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
   if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
   return text;
+}
+
+void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& tr, const std::string& path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
+  if (!file) throw InvalidInput("--csv: cannot write '" + path + "'");
+  std::fprintf(file.get(), "%s\n", kDriftTwoInputCsvHeader);
+  for (std::size_t k = 0; k < tr.g.size(); ++k) {
+    const Eigen::Quaterniond q = so3::toQuaternion(tr.g[k]);
+    const Eigen::Vector2d& u = tr.u[k];
+    const Vector3& p = tr.p[k];
+    std::fprintf(file.get(), "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
+                 tr.t[k], q.w(), q.x(), q.y(), q.z(), u.x(), u.y(), p.x(), p.y(), p.z());
+  }
+  if (std::fflush(file.get()) != 0) throw InvalidInput("--csv: cannot write '" + path + "'");
+}
+
+namespace {
+
+std::string jsonVector(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + jsonNumber(v(i));
+  return s + "]";
+}
+
+}  // namespace
+
+std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
+                                  const DriftTwoInputPlan& plan, double solve_time_s) {
+  std::ostringstream out;
+  out << "{\n"
+      << "  \"converged\": " << (plan.converged ? "true" : "false") << ",\n"
+      << "  \"message\": " << jsonString(plan.message) << ",\n"
+      << "  \"system\": \"drift_two_input\",\n"
+      << "  \"steps\": " << request.steps << ",\n"
+      << "  \"duration\": " << jsonNumber(request.duration) << ",\n"
+      << "  \"control_weights\": "
+      << jsonVector(Eigen::Vector2d(request.weights.c1, request.weights.c2)) << ",\n"
+      << "  \"iterations\": " << plan.iterations << ",\n"
+      << "  \"continuation_stages\": " << plan.continuation_stages << ",\n"
+      << "  \"cost\": " << jsonNumber(plan.cost) << ",\n"
+      << "  \"terminal_attitude_error\": " << jsonNumber(plan.terminal_error) << ",\n"
+      << "  \"initial_costate\": " << jsonVector(plan.initial_costate) << ",\n"
+      << "  \"initial_costate_guess\": "
+      << (request.initial_costate ? jsonVector(*request.initial_costate) : std::string("null"))
+      << ",\n"
+      << "  \"solve_time_s\": " << jsonNumber(solve_time_s) << "\n"
+      << "}\n";
+  return out.str();
+}
+
+std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
+                                  const DriftTwoInputPlan& plan, double solve_time_s) {
+  char buffer[2048];
+  const Vector3& p = plan.initial_costate;
+  std::snprintf(buffer, sizeof buffer,
+                "system                   drift_two_input (seed 001)\n"
+                "converged                %s\n"
+                "message                  %s\n"
+                "control weights c1, c2   %.6g, %.6g\n"
+                "steps N, duration T      %d, %.6g s (h = %.6g s)\n"
+                "iterations               %d (%d continuation stages)\n"
+                "initial costate p(0)     (%.12g, %.12g, %.12g)\n"
+                "cost 1/2 int c.u^2 dt    %.12g\n"
+                "terminal attitude error  %.3g rad\n"
+                "solve time               %.3f s\n",
+                plan.converged ? "yes" : "NO", plan.message.c_str(), request.weights.c1,
+                request.weights.c2, request.steps, request.duration,
+                request.duration / request.steps, plan.iterations, plan.continuation_stages, p.x(),
+                p.y(), p.z(), plan.cost, plan.terminal_error, solve_time_s);
+  return buffer;
 }
 
 }  // namespace attitude_planner

@@ -81,8 +81,8 @@ class SceneParser {
     } else {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
-                 "control_weights", "allow_nonphysical_inertia"},
-                {"duration", "steps", "initial", "final", "effects", "control_weights"});
+                 "control_weights", "initial_costate", "allow_nonphysical_inertia"},
+                {"duration", "steps", "initial", "final", "control_weights"});
     }
 
     PlanningProblem& p = scene.problem;
@@ -109,7 +109,10 @@ class SceneParser {
         if (!(scene.control_weights(i) > 0.0)) fail(w[i], path, "must be > 0, got " + show(w[i]));
       }
     }
-    scene.effects = effects(root["effects"], "effects");
+    if (root["initial_costate"]) {
+      scene.initial_costate = vector3(root["initial_costate"], "initial_costate");
+    }
+    if (root["effects"]) scene.effects = effects(root["effects"], "effects");
     if (root["allow_nonphysical_inertia"]) {
       scene.allow_nonphysical_inertia =
           boolean(root["allow_nonphysical_inertia"], "allow_nonphysical_inertia");
@@ -298,11 +301,20 @@ class SceneParser {
     return so3::fromAxisAngle(axis, angle);
   }
 
-  void readState(const YAML::Node& node, const std::string& path, bool velocity_required,
-                 Matrix3* attitude_out, Vector3* velocity_out) const {
+  /// `rigid`: the rigid body's state (attitude and angular velocity, both required); otherwise
+  /// the kinematic drift system's, whose only boundary value is the attitude.
+  void readState(const YAML::Node& node, const std::string& path, bool rigid, Matrix3* attitude_out,
+                 Vector3* velocity_out) const {
     requireMap(node, path);
+    if (!rigid && node["angular_velocity"]) {
+      // Not ignored: the body rate of ġ = g(E3 + u1 E1 + u2 E2) is (u1, u2, 1), set by the
+      // controls; a boundary velocity would be a second, conflicting condition.
+      fail(node["angular_velocity"], path + ".angular_velocity",
+           "not allowed with system: drift_two_input (a kinematic system: the body rate "
+           "(u1, u2, 1) is set by the controls, only the attitude is a boundary condition)");
+    }
     std::vector<std::string> required = {"attitude"};
-    if (velocity_required) required.push_back("angular_velocity");
+    if (rigid) required.push_back("angular_velocity");
     checkKeys(node, path, {"attitude", "angular_velocity"}, required);
     *attitude_out = attitude(node["attitude"], path + ".attitude");
     if (node["angular_velocity"]) {
@@ -447,6 +459,7 @@ std::string formatScene(const Scene& scene) {
   if (scene.system != "rigid_body") {
     out << "system: " << scene.system << "\n";
     out << "control_weights: " << vec(scene.control_weights) << "\n";
+    if (scene.initial_costate) out << "initial_costate: " << vec(*scene.initial_costate) << "\n";
   }
   out << "inertia: [" << vec(p.inertia.row(0).transpose()) << ", "
       << vec(p.inertia.row(1).transpose()) << ", " << vec(p.inertia.row(2).transpose()) << "]\n";
@@ -454,10 +467,13 @@ std::string formatScene(const Scene& scene) {
   out << "duration: " << fmt(p.duration) << "\n";
   out << "steps: " << p.steps << "\n";
   out << "scheme: " << schemeName(p.scheme) << "\n";
-  out << "initial: {attitude: " << quaternionOf(p.initial_attitude)
-      << ", angular_velocity: " << vec(p.initial_velocity) << "}\n";
-  out << "final: {attitude: " << quaternionOf(p.final_attitude)
-      << ", angular_velocity: " << vec(p.final_velocity) << "}\n";
+  const bool rigid = scene.system == "rigid_body";
+  out << "initial: {attitude: " << quaternionOf(p.initial_attitude);
+  if (rigid) out << ", angular_velocity: " << vec(p.initial_velocity);
+  out << "}\n";
+  out << "final: {attitude: " << quaternionOf(p.final_attitude);
+  if (rigid) out << ", angular_velocity: " << vec(p.final_velocity);
+  out << "}\n";
   out << "effects:";
   if (scene.effects.empty()) out << " []";
   out << "\n";
@@ -505,10 +521,39 @@ Actuation actuationOf(const std::vector<EffectSpec>& specs) {
 void requirePlannable(const Scene& scene) {
   if (scene.system != "rigid_body") {
     throw InvalidInput(scene.source + ": system: '" + scene.system +
-                       "' is not supported by the planner yet (only rigid_body)");
+                       "' is not planned by planManeuver (rigid_body only; drift_two_input "
+                       "scenes go to planDriftTwoInput, as plan_maneuver does)");
   }
   // Gravity gradient and disturbances are in the planning model, actuator limits bound the plan's
   // torques (PlanningProblem::max_torque); torque noise is tracker-only by nature.
+}
+
+DriftTwoInputRequest driftTwoInputRequest(const Scene& scene) {
+  if (scene.system != "drift_two_input") {
+    throw InvalidInput(scene.source + ": system: '" + scene.system +
+                       "' is not drift_two_input (planManeuver plans rigid_body scenes)");
+  }
+  if (!scene.effects.empty()) {
+    std::string names;
+    for (const EffectSpec& e : scene.effects) {
+      const std::string n = effectName(e);
+      if (names.find(n) == std::string::npos) names += (names.empty() ? "" : ", ") + n;
+    }
+    throw InvalidInput(scene.source +
+                       ": effects: not modelled for system: drift_two_input (a kinematic system "
+                       "has no torques), got: " +
+                       names);
+  }
+  DriftTwoInputRequest r;
+  const PlanningProblem& p = scene.problem;
+  r.g0 = p.initial_attitude;
+  r.g1 = p.final_attitude;
+  r.duration = p.duration;
+  r.steps = p.steps;
+  r.weights.c1 = scene.control_weights(0);
+  r.weights.c2 = scene.control_weights(1);
+  r.initial_costate = scene.initial_costate;
+  return r;
 }
 
 }  // namespace attitude_planner

@@ -1,5 +1,6 @@
 #include "attitude_planner/ros/conversions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -120,6 +121,113 @@ Maneuver maneuverFromMsg(const AttitudeManeuver& msg) {
     m.torque.push_back(t);
   }
   return m;
+}
+
+DriftTwoInputManeuver driftManeuverToMsg(const DriftTwoInputTrajectory& tr,
+                                         const DriftTwoInputWeights& weights,
+                                         const std::string& world_frame,
+                                         const std::string& body_frame, const ros::Time& stamp) {
+  DriftTwoInputManeuver m;
+  m.header.stamp = stamp;
+  m.header.frame_id = world_frame;
+  m.child_frame_id = body_frame;
+  m.control_weights = {weights.c1, weights.c2};
+  m.time_step = tr.t.size() >= 2 ? tr.t[1] - tr.t[0] : 0.0;
+  m.time = tr.t;
+  for (const Matrix3& g : tr.g) m.attitude.push_back(attitudeToMsg(g));
+  for (const Eigen::Vector2d& u : tr.u) m.control.push_back(vectorToMsg(Vector3(u.x(), u.y(), 0)));
+  for (const Vector3& p : tr.p) m.costate.push_back(vectorToMsg(p));
+  return m;
+}
+
+DriftTwoInputTrajectory driftManeuverFromMsg(const DriftTwoInputManeuver& msg,
+                                             DriftTwoInputWeights* weights) {
+  const size_t rows = msg.attitude.size();
+  if (rows < 2) {
+    throw InvalidInput("drift_maneuver.attitude: needs N + 1 >= 2 rows, got " +
+                       std::to_string(rows));
+  }
+  if (msg.time.size() != rows || msg.control.size() != rows || msg.costate.size() != rows) {
+    throw InvalidInput("drift_maneuver: arrays disagree in length (time " +
+                       std::to_string(msg.time.size()) + ", attitude " + std::to_string(rows) +
+                       ", control " + std::to_string(msg.control.size()) + ", costate " +
+                       std::to_string(msg.costate.size()) + ")");
+  }
+  weights->c1 = msg.control_weights[0];
+  weights->c2 = msg.control_weights[1];
+  try {
+    validateDriftTwoInputWeights(*weights);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(std::string("drift_maneuver.control_weights: ") + e.what());
+  }
+  DriftTwoInputTrajectory tr;
+  for (size_t k = 0; k < rows; ++k) {
+    const std::string row = "[" + std::to_string(k) + "]";
+    if (!std::isfinite(msg.time[k]))
+      throw InvalidInput("drift_maneuver.time" + row + ": not finite");
+    const Vector3 u = vectorFromMsg(msg.control[k]);
+    const Vector3 p = vectorFromMsg(msg.costate[k]);
+    if (!u.allFinite()) throw InvalidInput("drift_maneuver.control" + row + ": not finite");
+    if (u.z() != 0.0) {
+      throw InvalidInput("drift_maneuver.control" + row +
+                         ".z: must be 0 (the drift about body z is fixed), got " +
+                         std::to_string(u.z()));
+    }
+    if (!p.allFinite()) throw InvalidInput("drift_maneuver.costate" + row + ": not finite");
+    tr.t.push_back(msg.time[k]);
+    tr.g.push_back(attitudeFromMsg(msg.attitude[k], "drift_maneuver.attitude" + row));
+    tr.u.emplace_back(u.x(), u.y());
+    tr.p.push_back(p);
+  }
+  return tr;
+}
+
+DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
+                                         const PlannerDefaults& defaults) {
+  DriftTwoInputRequest r;
+  r.g0 = attitudeFromMsg(req.initial_attitude, "initial_attitude");
+  r.g1 = attitudeFromMsg(req.final_attitude, "final_attitude");
+  if (!std::isfinite(req.duration) || !(req.duration > 0.0)) {
+    throw InvalidInput("duration: must be a finite number > 0 s, got " +
+                       std::to_string(req.duration));
+  }
+  r.duration = req.duration;
+  if (req.steps < 1) throw InvalidInput("steps: must be >= 1, got " + std::to_string(req.steps));
+  if (req.steps > defaults.max_steps) {
+    throw InvalidInput("steps: " + std::to_string(req.steps) +
+                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
+  }
+  r.steps = req.steps;
+  for (int i = 0; i < 2; ++i) {
+    const double c = req.control_weights[i];
+    if (!std::isfinite(c) || !(c > 0.0)) {
+      throw InvalidInput("control_weights[" + std::to_string(i) +
+                         "]: must be a finite number > 0, got " + std::to_string(c));
+    }
+  }
+  r.weights.c1 = req.control_weights[0];
+  r.weights.c2 = req.control_weights[1];
+  if (req.use_initial_costate) {
+    const Vector3 p0 = vectorFromMsg(req.initial_costate);
+    if (!p0.allFinite()) throw InvalidInput("initial_costate: not finite");
+    r.initial_costate = p0;
+  }
+  if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
+    throw InvalidInput("tolerance: must be a finite number >= 0 rad (0 = default), got " +
+                       std::to_string(req.tolerance));
+  }
+  if (req.tolerance > 0.0) r.tolerance = req.tolerance;
+  if (req.max_iterations < 0) {
+    throw InvalidInput("max_iterations: must be >= 0 (0 = default), got " +
+                       std::to_string(req.max_iterations));
+  }
+  if (req.max_iterations > 0) r.max_iterations = req.max_iterations;
+  if (req.shooting_intervals < 0) {
+    throw InvalidInput("shooting_intervals: must be >= 0 (0 = 1, single shooting), got " +
+                       std::to_string(req.shooting_intervals));
+  }
+  r.shooting_intervals = std::max(1, static_cast<int>(req.shooting_intervals));
+  return r;
 }
 
 }  // namespace ros_conversions

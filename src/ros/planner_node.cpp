@@ -13,6 +13,52 @@ int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, dou
   return PlanErrorCode::NOT_CONVERGED;
 }
 
+DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
+                                  const ros_conversions::PlannerDefaults& defaults) {
+  DriftPlanOutcome out;
+  try {
+    out.request = ros_conversions::driftRequestFromMsg(req, defaults);
+    const ros::WallTime start = ros::WallTime::now();
+    out.plan = planDriftTwoInput(out.request);
+    out.solve_time_s = (ros::WallTime::now() - start).toSec();
+    out.solver_ran = true;
+    out.error_code = out.plan.converged ? PlanErrorCode::SUCCESS : PlanErrorCode::NOT_CONVERGED;
+    out.message = out.plan.message;
+  } catch (const InvalidInput& e) {
+    out.error_code = PlanErrorCode::INVALID_INPUT;
+    out.message = e.what();
+  } catch (const StepTooLarge& e) {
+    out.error_code = PlanErrorCode::STEP_TOO_LARGE;
+    out.message = e.what();
+  } catch (const std::exception& e) {
+    out.error_code = PlanErrorCode::INTERNAL_ERROR;
+    out.message = std::string("internal error: ") + e.what();
+  } catch (...) {
+    out.error_code = PlanErrorCode::INTERNAL_ERROR;
+    out.message = "internal error: unknown exception";
+  }
+  return out;
+}
+
+void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world_frame,
+                       const std::string& body_frame, PlanDriftTwoInput::Response* res) {
+  res->success = outcome.error_code == PlanErrorCode::SUCCESS;
+  res->error_code.val = outcome.error_code;
+  res->message = outcome.message;
+  if (!outcome.solver_ran) return;
+  const DriftTwoInputPlan& p = outcome.plan;
+  if (!p.trajectory.g.empty()) {
+    res->maneuver = ros_conversions::driftManeuverToMsg(p.trajectory, outcome.request.weights,
+                                                        world_frame, body_frame, ros::Time::now());
+  }
+  res->initial_costate = ros_conversions::vectorToMsg(p.initial_costate);
+  res->cost = p.cost;
+  res->iterations = p.iterations;
+  res->continuation_stages = p.continuation_stages;
+  res->terminal_attitude_error = p.terminal_error;
+  res->solve_time = outcome.solve_time_s;
+}
+
 PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   ros_conversions::PlannerDefaults d;
   d.scheme = readParam<std::string>(
@@ -40,12 +86,14 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
 
   service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);
+  drift_service_ =
+      nh_.advertiseService("plan_drift_two_input", &PlannerNode::onPlanDriftService, this);
   action_server_ = std::make_unique<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>>(
       nh_, "plan_attitude_maneuver_action",
       [this](const PlanAttitudeManeuverGoalConstPtr& goal) { onPlanGoal(goal); }, false);
   action_server_->start();
-  ROS_INFO_STREAM("attitude_planner_node ready: service "
-                  << service_.getService() << ", action "
+  ROS_INFO_STREAM("attitude_planner_node ready: services "
+                  << service_.getService() << ", " << drift_service_.getService() << ", action "
                   << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme " << d.scheme
                   << ", solver " << d.solver << ", tolerance " << d.tolerance << ", max_iterations "
                   << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "
@@ -65,6 +113,25 @@ bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
     }
   } catch (const std::exception& e) {  // e.g. bad_alloc while filling the response
     res = PlanAttitudeManeuver::Response();
+    res.success = false;
+    res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
+    res.message = std::string("internal error: ") + e.what();
+  }
+  return true;
+}
+
+bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
+                                     PlanDriftTwoInput::Response& res) {
+  try {
+    fillDriftResponse(planDriftRequest(req, defaults_), world_frame_, body_frame_, &res);
+    if (res.success) {
+      ROS_INFO("drift plan: N = %d converged in %d iterations, %.3f s, cost %.6g", req.steps,
+               res.iterations, res.solve_time, res.cost);
+    } else {
+      ROS_WARN("drift plan failed (error %d): %s", res.error_code.val, res.message.c_str());
+    }
+  } catch (const std::exception& e) {  // e.g. bad_alloc while filling the response
+    res = PlanDriftTwoInput::Response();
     res.success = false;
     res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     res.message = std::string("internal error: ") + e.what();

@@ -11,6 +11,7 @@
 #include <geometry_msgs/WrenchStamped.h>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/scene.hpp"
@@ -149,6 +150,47 @@ bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
   return true;
 }
 
+bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* client,
+                    const std::string& world_frame, const std::string& body_frame,
+                    DriftTwoInputManeuver* msg, double* solve_time, double* cost,
+                    std::string* error) {
+  if (client && client->isValid()) {
+    PlanDriftTwoInput srv;
+    srv.request.initial_attitude = rc::attitudeToMsg(request.g0);
+    srv.request.final_attitude = rc::attitudeToMsg(request.g1);
+    srv.request.duration = request.duration;
+    srv.request.steps = request.steps;
+    srv.request.control_weights = {request.weights.c1, request.weights.c2};
+    srv.request.use_initial_costate = request.initial_costate.has_value();
+    if (request.initial_costate) {
+      srv.request.initial_costate = rc::vectorToMsg(*request.initial_costate);
+    }
+    if (!client->call(srv)) {
+      *error = "service " + client->getService() + " call failed";
+      return false;
+    }
+    if (!srv.response.success) {
+      *error = "planner: " + srv.response.message;
+      return false;
+    }
+    *msg = srv.response.maneuver;
+    *solve_time = srv.response.solve_time;
+    *cost = srv.response.cost;
+    return true;
+  }
+  const ros::WallTime start = ros::WallTime::now();
+  const DriftTwoInputPlan plan = planDriftTwoInput(request);
+  if (!plan.converged) {
+    *error = "planner: " + plan.message;
+    return false;
+  }
+  *msg = rc::driftManeuverToMsg(plan.trajectory, request.weights, world_frame, body_frame,
+                                ros::Time::now());
+  *solve_time = (ros::WallTime::now() - start).toSec();
+  *cost = plan.cost;
+  return true;
+}
+
 TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto non_empty = [](const std::string& s) { return !s.empty(); };
@@ -172,20 +214,42 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 1, true);
   path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
   done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
+  control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
   maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
+  drift_sub_ = nh_.subscribe("drift_maneuver", 1, &TrackerNode::onDriftManeuver, this);
 
   if (scene.empty()) {
-    ROS_INFO("attitude_tracker_node: waiting for a maneuver on %s",
-             maneuver_sub_.getTopic().c_str());
+    ROS_INFO("attitude_tracker_node: waiting for a maneuver on %s or %s",
+             maneuver_sub_.getTopic().c_str(), drift_sub_.getTopic().c_str());
     return;
   }
   Replay replay;
   std::string error;
   try {
     const Scene parsed = loadScene(scene);
-    if (parsed.system != "rigid_body") {
-      throw InvalidInput("system: '" + parsed.system +
-                         "' is not replayed by this node (rigid_body only)");
+    if (parsed.system == "drift_two_input") {
+      const DriftTwoInputRequest request = driftTwoInputRequest(parsed);  // refuses effects
+      ros::ServiceClient client;
+      if (!plan_in_process) {
+        client = nh_.serviceClient<PlanDriftTwoInput>("plan_drift_two_input");
+        ROS_INFO("planning %s with %s", scene.c_str(), client.getService().c_str());
+        if (!client.waitForExistence(ros::Duration(planner_timeout))) {
+          error = "planner service " + client.getService() + " not available after " +
+                  std::to_string(planner_timeout) + " s";
+        }
+      } else {
+        ROS_INFO("planning %s in-process", scene.c_str());
+      }
+      replay.drift = true;
+      if (error.empty() &&
+          planDriftScene(request, plan_in_process ? nullptr : &client, world_frame_, body_frame_,
+                         &replay.drift_msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
+        ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
+                 replay.plan_solve_time);
+        startReplay(replay);
+        return;
+      }
+      throw InvalidInput(error);
     }
     if (!parsed.effects.empty()) {
       ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only",
@@ -230,6 +294,13 @@ void TrackerNode::onManeuver(const AttitudeManeuver::ConstPtr& msg) {
   startReplay(replay);
 }
 
+void TrackerNode::onDriftManeuver(const DriftTwoInputManeuver::ConstPtr& msg) {
+  Replay replay;
+  replay.drift = true;
+  replay.drift_msg = *msg;
+  startReplay(replay);
+}
+
 void TrackerNode::stopReplay() {
   std::lock_guard<std::mutex> lock(replay_mutex_);
   stop_ = true;
@@ -267,6 +338,10 @@ void TrackerNode::publishDone(ReplayResult result) {
 }
 
 void TrackerNode::runReplay(Replay replay) {
+  if (replay.drift) {
+    runDriftReplay(replay);
+    return;
+  }
   ReplayResult result;
   result.plan_solve_time = replay.plan_solve_time;
   result.plan_cost = replay.plan_cost;
@@ -364,6 +439,97 @@ void TrackerNode::runReplay(Replay replay) {
   result.message = "replayed " + std::to_string(N) + " steps";
   result.header.stamp = start + ros::Duration(replayed.time[N] / rate_factor_);
   ROS_INFO("replay done: terminal attitude error %.3g rad vs the plan's R_N",
+           result.terminal_attitude_error);
+  publishDone(result);
+}
+
+void TrackerNode::runDriftReplay(const Replay& replay) {
+  ReplayResult result;
+  result.plan_solve_time = replay.plan_solve_time;
+  result.plan_cost = replay.plan_cost;
+  DriftTwoInputTrajectory plan;
+  std::vector<Matrix3> replayed;
+  try {
+    DriftTwoInputWeights weights;
+    plan = rc::driftManeuverFromMsg(replay.drift_msg, &weights);
+    // Open loop: only g(0) and the controls are used; the plan's later attitudes are the check.
+    replayed = replayDriftTwoInputControls(plan.g.front(), plan.t, plan.u);
+    const int N = static_cast<int>(plan.t.size()) - 1;
+    result.steps = N;
+    result.duration = plan.t.back() - plan.t.front();
+    for (int k = 0; k < N; ++k) {  // ½∫(c1 u1² + c2 u2²) dt, trapezoid on the samples
+      auto running = [&](int i) {
+        return 0.5 * (weights.c1 * plan.u[i].x() * plan.u[i].x() +
+                      weights.c2 * plan.u[i].y() * plan.u[i].y());
+      };
+      result.cost += 0.5 * (plan.t[k + 1] - plan.t[k]) * (running(k) + running(k + 1));
+    }
+    result.terminal_attitude_error = so3::angleBetween(plan.g[N], replayed[N]);
+    result.terminal_velocity_error = 0.0;  // no velocity boundary condition (kinematic system)
+    for (int k = 0; k <= N; ++k) {
+      result.max_attitude_deviation =
+          std::max(result.max_attitude_deviation, so3::angleBetween(plan.g[k], replayed[k]));
+    }
+    result.final_attitude = rc::attitudeToMsg(replayed[N]);
+  } catch (const std::exception& e) {
+    ROS_ERROR("drift maneuver rejected: %s", e.what());
+    result.success = false;
+    result.message = std::string("drift maneuver rejected: ") + e.what();
+    publishDone(result);
+    return;
+  }
+
+  const PrincipalBox box = principalBox(Matrix3::Identity(), body_size_);  // a cube
+  while (ros::Time::now().isZero()) {
+    if (stop_ || !ros::ok()) return;
+    ros::WallDuration(0.01).sleep();
+  }
+  const ros::Time start = ros::Time::now() + ros::Duration(start_delay_);
+  visualization_msgs::Marker path;
+  path.header.frame_id = world_frame_;
+  path.ns = "attitude_path";
+  path.id = 0;
+  path.type = visualization_msgs::Marker::LINE_STRIP;
+  path.action = visualization_msgs::Marker::ADD;
+  path.pose.orientation.w = 1.0;
+  path.scale.x = 0.02 * path_radius_;  // line width [m]
+  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+
+  const int N = static_cast<int>(replayed.size()) - 1;
+  const double t0 = plan.t.front();
+  ROS_INFO("replaying drift maneuver: %d steps over %.3f s (rate factor %g)", N, result.duration,
+           rate_factor_);
+  for (int k = 0; k <= N; ++k) {
+    const ros::Time stamp = start + ros::Duration((plan.t[k] - t0) / rate_factor_);
+    if (!sleepUntil(stamp)) return;
+    const Matrix3& g = replayed[k];
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = stamp;
+    tf.header.frame_id = world_frame_;
+    tf.child_frame_id = body_frame_;
+    tf.transform.rotation = rc::attitudeToMsg(g);
+    tf_broadcaster_.sendTransform(tf);
+
+    geometry_msgs::Vector3Stamped control;
+    control.header.stamp = stamp;
+    control.header.frame_id = body_frame_;
+    control.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 0.0));
+    control_pub_.publish(control);
+
+    geometry_msgs::Vector3Stamped velocity;  // body rate ξ = (u1, u2, 1) [rad/s]
+    velocity.header = control.header;
+    velocity.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 1.0));
+    velocity_pub_.publish(velocity);
+
+    marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
+    path.header.stamp = stamp;
+    path.points.push_back(point(path_radius_ * g.col(0)));
+    if (path.points.size() >= 2) path_pub_.publish(path);
+  }
+  result.success = true;
+  result.message = "replayed drift maneuver, " + std::to_string(N) + " steps";
+  result.header.stamp = start + ros::Duration((plan.t[N] - t0) / rate_factor_);
+  ROS_INFO("drift replay done: terminal attitude error %.3g rad vs the plan's g(T)",
            result.terminal_attitude_error);
   publishDone(result);
 }

@@ -1,8 +1,10 @@
-// plan_maneuver: plan the minimum-effort maneuver of a scene file (command-line entry point).
-// Reads the scene, applies flag overrides, calls planManeuver(), prints a summary and writes the
+// plan_maneuver: plan the optimal maneuver of a scene file (command-line entry point).
+// Reads the scene, applies flag overrides, calls planManeuver() (system: rigid_body, seed 000) or
+// planDriftTwoInput() (system: drift_two_input, seed 001), prints a summary and writes the
 // trajectory CSV / JSON summary. Exit status: 0 converged, 1 not converged or invalid input,
 // 2 usage error.
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,16 +24,23 @@ namespace {
 const char* const kUsage =
     "usage: plan_maneuver SCENE.yaml [options]\n"
     "\n"
-    "Plans the minimum-effort attitude maneuver of a scene (seed 000, Problem 3.2).\n"
+    "Plans the optimal attitude maneuver of a scene: the minimum-effort rigid-body transfer\n"
+    "(seed 000, Problem 3.2; system: rigid_body, the default) or the drift + two-input\n"
+    "extremal g' = g(E3 + u1 E1 + u2 E2), min 1/2 int c1 u1^2 + c2 u2^2 dt (seed 001;\n"
+    "system: drift_two_input).\n"
     "\n"
     "options (override the scene):\n"
     "  --steps N                 number of time steps (h = T/N)\n"
-    "  --scheme paper|variational  discretization\n"
-    "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check\n"
-    "  --tolerance TOL           optimality tolerance (default 1e-10)\n"
+    "  --scheme paper|variational  discretization (rigid_body only)\n"
+    "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check (rigid_body)\n"
+    "  --tolerance TOL           rigid_body: optimality tolerance (default 1e-10);\n"
+    "                            drift_two_input: terminal attitude error [rad] (default 1e-11)\n"
     "  --max-iterations K        iteration limit (nlopt: function evaluations; default 200)\n"
-    "  --time-budget S           wall-time limit [s] (default: none)\n"
-    "  --csv OUT.csv             write the trajectory (k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz)\n"
+    "  --time-budget S           wall-time limit [s] (default: none; rigid_body only)\n"
+    "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
+    "  --csv OUT.csv             write the trajectory: rigid_body "
+    "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
+    "                            drift_two_input k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3\n"
     "  --summary OUT.json        write the result figures as JSON\n"
     "  --help                    show this help\n"
     "\n"
@@ -63,13 +72,30 @@ double parseDouble(const std::string& flag, const std::string& text) {
   return v;
 }
 
+/// "p1,p2,p3" → the three finite numbers.
+ap::Vector3 parseCostate(const std::string& text) {
+  ap::Vector3 p;
+  std::size_t start = 0;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t comma = text.find(',', start);
+    if ((i < 2) != (comma != std::string::npos)) {
+      throw UsageError{"--initial-costate: expected P1,P2,P3 (three numbers), got '" + text + "'"};
+    }
+    p(i) = parseDouble("--initial-costate", text.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return p;
+}
+
 struct Arguments {
   std::string scene;
   int steps = 0;  ///< 0: the scene's
   std::string scheme;
   std::string solver = "newton";
-  double tolerance = -1.0;  ///< < 0: the default
-  int max_iterations = -1;  ///< < 0: the default
+  bool solver_given = false;    ///< --solver was on the command line
+  std::string initial_costate;  ///< --initial-costate text, "" if absent
+  double tolerance = -1.0;      ///< < 0: the default
+  int max_iterations = -1;      ///< < 0: the default
   double time_budget = 0.0;
   std::string csv;
   std::string summary;
@@ -114,6 +140,7 @@ Arguments parseArguments(int argc, char** argv) {
       }
     } else if (arg == "--solver") {
       a.solver = next();
+      a.solver_given = true;
       if (a.solver != "newton" && a.solver != "nlopt") {
         throw UsageError{"--solver: unknown value '" + a.solver + "' (newton or nlopt)"};
       }
@@ -126,6 +153,9 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (arg == "--time-budget") {
       a.time_budget = parseDouble(arg, next());
       if (!(a.time_budget > 0.0)) throw UsageError{"--time-budget: must be > 0 s"};
+    } else if (arg == "--initial-costate") {
+      a.initial_costate = next();
+      parseCostate(a.initial_costate);  // checked here: a usage error, exit status 2
     } else if (arg == "--csv") {
       a.csv = next();
     } else if (arg == "--summary") {
@@ -136,6 +166,41 @@ Arguments parseArguments(int argc, char** argv) {
   }
   if (!a.help && a.scene.empty()) throw UsageError{"missing SCENE.yaml"};
   return a;
+}
+
+/// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
+int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
+  if (!args.scheme.empty() || args.solver_given || args.time_budget > 0.0) {
+    std::cerr << "plan_maneuver: --scheme, --solver and --time-budget apply to system: rigid_body "
+                 "only (this scene is drift_two_input)\n\n"
+              << kUsage;
+    return 2;
+  }
+  ap::DriftTwoInputRequest request = ap::driftTwoInputRequest(scene);
+  if (args.steps > 0) request.steps = args.steps;
+  if (args.tolerance > 0.0) request.tolerance = args.tolerance;
+  if (args.max_iterations > 0) request.max_iterations = args.max_iterations;
+  if (!args.initial_costate.empty()) request.initial_costate = parseCostate(args.initial_costate);
+
+  const auto start = std::chrono::steady_clock::now();
+  const ap::DriftTwoInputPlan plan = ap::planDriftTwoInput(request);
+  const double solve_time =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "scene                    " << args.scene << "\n"
+            << ap::driftTwoInputPlanText(request, plan, solve_time);
+  if (!args.csv.empty() && !plan.trajectory.g.empty()) {
+    ap::writeDriftTwoInputCsv(plan.trajectory, args.csv);
+  }
+  if (!args.summary.empty()) {
+    std::ofstream out(args.summary);
+    out << ap::driftTwoInputPlanJson(request, plan, solve_time);
+    if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
+  }
+  if (!plan.converged) {
+    std::cerr << "plan_maneuver: not converged: " << plan.message << "\n";
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -155,6 +220,12 @@ int main(int argc, char** argv) {
 
   try {
     ap::Scene scene = ap::loadScene(args.scene);
+    if (scene.system == "drift_two_input") return runDriftTwoInput(args, scene);
+    if (!args.initial_costate.empty()) {
+      std::cerr << "plan_maneuver: --initial-costate applies to system: drift_two_input only\n\n"
+                << kUsage;
+      return 2;
+    }
     ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
     ap::PlanningProblem& problem = scene.problem;
     if (args.steps > 0) problem.steps = args.steps;

@@ -132,6 +132,78 @@ TEST(RosConversions, ManeuverMessageRoundTrip) {
   EXPECT_THROW(rc::maneuverFromMsg(bad), InvalidInput);
 }
 
+TEST(RosConversions, DriftManeuverMessageRoundTrip) {
+  const DriftTwoInputWeights w{1.0, 2.0};
+  const DriftTwoInputTrajectory tr = integrateDriftTwoInputExtremal(
+      so3::fromAxisAngle(Vector3(0, 1, 1), 0.3), Vector3(-1.5, 0.5, 1.0), 2.0, 20, w);
+  const DriftTwoInputManeuver m = rc::driftManeuverToMsg(tr, w, "world", "body", ros::Time(12.0));
+  EXPECT_EQ(m.header.frame_id, "world");
+  EXPECT_EQ(m.child_frame_id, "body");
+  EXPECT_DOUBLE_EQ(m.time_step, 0.1);
+  ASSERT_EQ(m.control.size(), 21u);
+  DriftTwoInputWeights back_w;
+  const DriftTwoInputTrajectory back = rc::driftManeuverFromMsg(m, &back_w);
+  EXPECT_EQ(back_w.c1, 1.0);
+  EXPECT_EQ(back_w.c2, 2.0);
+  ASSERT_EQ(back.g.size(), 21u);
+  for (int k = 0; k <= 20; ++k) {
+    EXPECT_EQ(back.t[k], tr.t[k]);
+    EXPECT_EQ(back.u[k], tr.u[k]);
+    EXPECT_EQ(back.p[k], tr.p[k]);
+    EXPECT_LT(so3::angleBetween(back.g[k], tr.g[k]), 1e-15);
+    EXPECT_EQ(m.control[k].z, 0.0);
+  }
+  DriftTwoInputManeuver bad = m;
+  bad.control[3].z = 1.0;
+  EXPECT_THROW(rc::driftManeuverFromMsg(bad, &back_w), InvalidInput);
+  bad = m;
+  bad.costate.pop_back();
+  EXPECT_THROW(rc::driftManeuverFromMsg(bad, &back_w), InvalidInput);
+  bad = m;
+  bad.control_weights[0] = -1.0;
+  EXPECT_THROW(rc::driftManeuverFromMsg(bad, &back_w), InvalidInput);
+}
+
+TEST(RosConversions, DriftRequestFieldsAreNamed) {
+  PlanDriftTwoInput::Request r;
+  r.initial_attitude.w = 1.0;
+  r.final_attitude.w = 1.0;
+  r.duration = 3.0;
+  r.steps = 60;
+  r.control_weights = {1.0, 2.0};
+  const rc::PlannerDefaults d;
+  DriftTwoInputRequest req = rc::driftRequestFromMsg(r, d);
+  EXPECT_FALSE(req.initial_costate.has_value());
+  EXPECT_EQ(req.tolerance, 1e-11);  // 0 = the core's default
+  EXPECT_EQ(req.max_iterations, 200);
+  EXPECT_EQ(req.shooting_intervals, 1);
+  r.use_initial_costate = true;
+  r.initial_costate.x = 0.5;
+  req = rc::driftRequestFromMsg(r, d);
+  ASSERT_TRUE(req.initial_costate.has_value());
+  EXPECT_EQ(*req.initial_costate, Vector3(0.5, 0, 0));
+  auto message = [&](PlanDriftTwoInput::Request bad) {
+    try {
+      rc::driftRequestFromMsg(bad, d);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  PlanDriftTwoInput::Request bad = r;
+  bad.duration = 0.0;
+  EXPECT_EQ(message(bad).rfind("duration:", 0), 0u) << message(bad);
+  bad = r;
+  bad.steps = d.max_steps + 1;
+  EXPECT_EQ(message(bad).rfind("steps:", 0), 0u) << message(bad);
+  bad = r;
+  bad.control_weights[0] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(message(bad).rfind("control_weights[0]:", 0), 0u) << message(bad);
+  bad = r;
+  bad.shooting_intervals = -1;
+  EXPECT_EQ(message(bad).rfind("shooting_intervals:", 0), 0u) << message(bad);
+}
+
 TEST(RosConversions, ErrorCodesFollowTheOutcome) {
   PlanResult r;
   r.converged = true;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/scene.hpp"
@@ -66,6 +67,12 @@ class CliTest : public ::testing::Test {
 
   std::string dir_;
 };
+
+/// `text` with its first occurrence of `from` replaced by `to`.
+std::string withReplaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
 
 #define EXPECT_CONTAINS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "output:\n" << (haystack)
@@ -181,17 +188,111 @@ TEST_F(CliTest, EffectsArePlannedByNewtonAndRefusedWhereUnsupported) {
   const ToolRun bounds = run("plan_maneuver", writeScene("limits.yaml", limited) + " --steps 16");
   EXPECT_EQ(bounds.status, 1) << bounds.output;
   EXPECT_CONTAINS(bounds.output, "actuator_limits together with gravity_gradient");
+}
 
-  const ToolRun drift =
-      run("plan_maneuver", writeScene("drift.yaml",
-                                      "system: drift_two_input\n"
-                                      "control_weights: [1, 2]\n"
-                                      "duration: 2\nsteps: 32\n"
-                                      "initial: {attitude: {quaternion: [1, 0, 0, 0]}}\n"
-                                      "final: {attitude: {quaternion: [1, 0, 0, 0]}}\n"
-                                      "effects: []\n"));
-  EXPECT_EQ(drift.status, 1) << drift.output;
-  EXPECT_CONTAINS(drift.output, "drift_two_input");
+TEST_F(CliTest, DriftTwoInputSceneWritesCsvAndSummaryAndReachesTheTarget) {
+  // scenes/drift_two_input.yaml: the worked example of docs/drift_two_input.md (no guess).
+  const std::string csv = dir_ + "/drift.csv", json = dir_ + "/drift.json";
+  const ToolRun r =
+      run("plan_maneuver", kScenes + "drift_two_input.yaml --csv " + csv + " --summary " + json);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "drift_two_input");
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"converged\": true");
+  EXPECT_CONTAINS(summary, "\"system\": \"drift_two_input\"");
+  EXPECT_CONTAINS(summary, "\"steps\": 60");
+  EXPECT_CONTAINS(summary, "\"control_weights\": [1, 2]");
+  EXPECT_CONTAINS(summary, "\"initial_costate_guess\": null");
+  EXPECT_CONTAINS(summary, "extremal with p(0) = ");  // the message names the extremal found
+  for (const char* key : {"iterations", "cost", "solve_time_s", "initial_costate", "message"}) {
+    EXPECT_CONTAINS(summary, std::string("\"") + key + "\": ");
+  }
+  const std::size_t at = summary.find("\"terminal_attitude_error\": ") + 27;
+  EXPECT_LE(std::stod(summary.substr(at)), 1e-10) << summary;
+
+  std::istringstream lines(readFile(csv));
+  std::string line;
+  ASSERT_TRUE(std::getline(lines, line));
+  EXPECT_EQ(line, "k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3");
+  int rows = 0;
+  std::string last;
+  while (std::getline(lines, line)) {
+    EXPECT_EQ(line.rfind(std::to_string(rows) + ",", 0), 0u) << line;
+    last = line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 61);  // k = 0..N
+  // Last row: t = T, g(T) = g1 = exp(1.2 (1, 1, 0)/√2) to the solver tolerance; u_i = p_i / c_i.
+  std::vector<double> v;
+  std::istringstream fields(last);
+  for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+  ASSERT_EQ(v.size(), 11u);
+  EXPECT_NEAR(v[1], 3.0, 1e-12);
+  const ap::Matrix3 g = ap::so3::fromQuaternion(Eigen::Quaterniond(v[2], v[3], v[4], v[5]));
+  const ap::Matrix3 g1 = ap::so3::fromAxisAngle(ap::Vector3(1, 1, 0), 1.2);
+  EXPECT_LT(ap::so3::angleBetween(g, g1), 1e-10);
+  EXPECT_DOUBLE_EQ(v[6], v[8] / 1.0);
+  EXPECT_DOUBLE_EQ(v[7], v[9] / 2.0);
+
+  // A guess from the command line is reported and selects the same extremal here.
+  const ToolRun guessed =
+      run("plan_maneuver", kScenes +
+                               "drift_two_input.yaml --initial-costate=-1.6,-0.9,-1.3 "
+                               "--summary " +
+                               json);
+  EXPECT_EQ(guessed.status, 0) << guessed.output;
+  EXPECT_CONTAINS(readFile(json),
+                  "\"initial_costate_guess\": [-1.6000000000000001, -0.90000000000000002, -1.3]");
+}
+
+TEST_F(CliTest, BadDriftTwoInputScenesExitOneNamingTheKey) {
+  const std::string base = readFile(kScenes + "drift_two_input.yaml");
+  std::string velocity = base;
+  velocity.replace(
+      velocity.find("final:   {attitude: {axis: [1, 1, 0], angle: 1.2}}"), 51,
+      "final:   {attitude: {axis: [1, 1, 0], angle: 1.2}, angular_velocity: [0, 0, 1]}");
+  const ToolRun v = run("plan_maneuver", writeScene("velocity.yaml", velocity));
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_CONTAINS(v.output, "final.angular_velocity: not allowed with system: drift_two_input");
+
+  const ToolRun weights = run(
+      "plan_maneuver", writeScene("weights.yaml", withReplaced(base, "control_weights: [1.0, 2.0]",
+                                                               "control_weights: [1.0, 0]")));
+  EXPECT_EQ(weights.status, 1) << weights.output;
+  EXPECT_CONTAINS(weights.output, "control_weights[1]: must be > 0, got '0'");
+
+  const ToolRun costate =
+      run("plan_maneuver", writeScene("costate.yaml", base + "initial_costate: [1, .nan, 0]\n"));
+  EXPECT_EQ(costate.status, 1) << costate.output;
+  EXPECT_CONTAINS(costate.output, "initial_costate[1]: not finite");
+
+  const ToolRun effects =
+      run("plan_maneuver",
+          writeScene("effects.yaml",
+                     base + "effects: [{disturbance_torque: {frame: body, value: [0, 0, 1]}}]\n"));
+  EXPECT_EQ(effects.status, 1) << effects.output;
+  EXPECT_CONTAINS(effects.output, "effects: not modelled for system: drift_two_input");
+
+  // Too few iterations: not converged, exit 1, and the summary says so.
+  const std::string json = dir_ + "/short.json";
+  const ToolRun short_run =
+      run("plan_maneuver", kScenes + "drift_two_input.yaml --max-iterations 1 --summary " + json);
+  EXPECT_EQ(short_run.status, 1) << short_run.output;
+  EXPECT_CONTAINS(short_run.output, "not converged");
+  EXPECT_CONTAINS(readFile(json), "\"converged\": false");
+
+  // Rigid-body-only flags are usage errors for this system, and vice versa.
+  const ToolRun scheme =
+      run("plan_maneuver", kScenes + "drift_two_input.yaml --scheme variational");
+  EXPECT_EQ(scheme.status, 2) << scheme.output;
+  EXPECT_CONTAINS(scheme.output, "apply to system: rigid_body only");
+  const ToolRun rigid_guess =
+      run("plan_maneuver", kScenes + "rest_to_rest.yaml --initial-costate 0,0,0");
+  EXPECT_EQ(rigid_guess.status, 2) << rigid_guess.output;
+  const ToolRun bad_guess =
+      run("plan_maneuver", kScenes + "drift_two_input.yaml --initial-costate 1,2");
+  EXPECT_EQ(bad_guess.status, 2) << bad_guess.output;
+  EXPECT_CONTAINS(bad_guess.output, "--initial-costate: expected P1,P2,P3");
 }
 
 TEST_F(CliTest, UsageErrorsNameTheFlag) {

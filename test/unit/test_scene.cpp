@@ -186,6 +186,60 @@ TEST(SceneOptionalKeys, DriftTwoInputSystemIsStoredAndRefusedByThePlanner) {
                   "system: unknown value 'unicycle'");
 }
 
+TEST(SceneOptionalKeys, DriftTwoInputSceneGivesThePlannerRequest) {
+  const std::string text =
+      "system: drift_two_input\ncontrol_weights: [1.5, 2.5]\nduration: 3.0\nsteps: 64\n"
+      "initial: {attitude: {axis: [0, 0, 1], angle: 0.5}}\n"
+      "final: {attitude: {axis: [1, 1, 0], angle: 1.2}}\n"
+      "initial_costate: [-1.5, -0.5, 2]\n";  // effects: optional for this system
+  const ap::Scene s = ap::parseScene(text);
+  ASSERT_TRUE(s.initial_costate.has_value());
+  EXPECT_EQ(*s.initial_costate, ap::Vector3(-1.5, -0.5, 2));
+  const ap::DriftTwoInputRequest r = ap::driftTwoInputRequest(s);
+  EXPECT_EQ(r.weights.c1, 1.5);
+  EXPECT_EQ(r.weights.c2, 2.5);
+  EXPECT_EQ(r.duration, 3.0);
+  EXPECT_EQ(r.steps, 64);
+  EXPECT_EQ(r.initial_costate, s.initial_costate);
+  EXPECT_LT(ap::so3::angleBetween(r.g0, ap::so3::fromAxisAngle(ap::Vector3::UnitZ(), 0.5)), 1e-15);
+  EXPECT_LT(ap::so3::angleBetween(r.g1, ap::so3::fromAxisAngle(ap::Vector3(1, 1, 0), 1.2)), 1e-15);
+  // formatScene keeps the guess and writes no angular velocities for this system.
+  const std::string formatted = ap::formatScene(s);
+  EXPECT_EQ(formatted.find("angular_velocity"), std::string::npos) << formatted;
+  EXPECT_EQ(ap::parseScene(formatted).initial_costate, s.initial_costate);
+  // A rigid-body scene is not a drift request.
+  EXPECT_THROW(ap::driftTwoInputRequest(ap::parseScene(kValid)), ap::InvalidInput);
+
+  const ap::Scene with_effects = ap::parseScene(
+      text + "effects: [{disturbance_torque: {frame: body, value: [1, 0, 0]}}]\n", "fx.yaml");
+  try {
+    ap::driftTwoInputRequest(with_effects);
+    ADD_FAILURE() << "effects must be refused for drift_two_input";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_CONTAINS(e.what(), "fx.yaml: effects: not modelled for system: drift_two_input");
+  }
+}
+
+TEST(SceneErrors, DriftTwoInputRefusesBoundaryVelocitiesAndBadGuesses) {
+  const std::string head =
+      "system: drift_two_input\ncontrol_weights: [1, 2]\nduration: 3.0\nsteps: 64\n"
+      "final: {attitude: {axis: [1, 1, 0], angle: 1.2}}\n";
+  EXPECT_CONTAINS(
+      errorOf(head +
+              "initial: {attitude: {axis: [0, 0, 1], angle: 0}, angular_velocity: [0, 0, 1]}\n"),
+      "bad.yaml:6: initial.angular_velocity: not allowed with system: drift_two_input");
+  const std::string initial = "initial: {attitude: {axis: [0, 0, 1], angle: 0}}\n";
+  EXPECT_CONTAINS(errorOf(head + initial + "initial_costate: [1, 2]\n"),
+                  "initial_costate: expected 3 entries, got 2: [1, 2]");
+  EXPECT_CONTAINS(errorOf(head + initial + "initial_costate: [1, x, 0]\n"),
+                  "initial_costate[1]: expected a number, got 'x'");
+  EXPECT_CONTAINS(errorOf(head + initial + "initial_costate: [1, .inf, 0]\n"),
+                  "initial_costate[1]: not finite");
+  // Only the drift system has a costate.
+  EXPECT_CONTAINS(errorOf(withLine("effects", "effects: []\ninitial_costate: [0, 0, 0]")),
+                  "initial_costate: unknown key");
+}
+
 TEST(SceneErrors, MalformedYamlNamesTheLine) {
   const std::string e = errorOf(withLine("steps", "steps: [1, 2"));
   EXPECT_CONTAINS(e, "bad.yaml:");

@@ -12,6 +12,9 @@
 #include <boost/array.hpp>
 
 #include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/DriftTwoInputManeuver.h"
+#include "attitude_planner/PlanDriftTwoInput.h"
+#include "attitude_planner/drift_two_input_planner.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/planner.hpp"
@@ -45,6 +48,19 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
 /// entry is not finite / not a unit quaternion.
 Maneuver maneuverFromMsg(const AttitudeManeuver& msg);
 
+/// Message of a drift + two-input trajectory (seed 001): time, attitude g(t_k), control
+/// (u1, u2, 0) [rad/s], costate p [c·rad/s]; time_step = t_1 − t_0 [s]; frames and stamp as
+/// maneuverToMsg.
+DriftTwoInputManeuver driftManeuverToMsg(const DriftTwoInputTrajectory& trajectory,
+                                         const DriftTwoInputWeights& weights,
+                                         const std::string& world_frame,
+                                         const std::string& body_frame, const ros::Time& stamp);
+/// Core trajectory (t, g, u, p; cost left 0: not transported) and weights of a message; throws
+/// InvalidInput if the arrays disagree in length, N < 1, a weight is not > 0, an entry is not
+/// finite or not a unit quaternion, or a control's z component is not 0.
+DriftTwoInputTrajectory driftManeuverFromMsg(const DriftTwoInputManeuver& msg,
+                                             DriftTwoInputWeights* weights);
+
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
   std::string scheme = "paper";   ///< "paper" | "variational"
@@ -54,6 +70,11 @@ struct PlannerDefaults {
   double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none
   int max_steps = 100000;         ///< largest accepted N
 };
+
+/// Builds the core request of a plan_drift_two_input call (zero fields take the documented
+/// defaults). Throws InvalidInput naming the field and the value; the core checks the rest.
+DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
+                                         const PlannerDefaults& defaults);
 
 /// Builds the problem and solver options of a service request or action goal (both have the same
 /// fields). Throws InvalidInput naming the field and the value.

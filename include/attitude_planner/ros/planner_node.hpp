@@ -1,8 +1,14 @@
-// attitude_planner_node: the planner behind a service and an action. A thin adapter: it converts
-// the request, calls planManeuver() (the same entry point as the CLI) and fills the response.
+// attitude_planner_node: the planner behind services and an action. A thin adapter: it converts
+// the request, calls planManeuver() / planDriftTwoInput() (the same entry points as the CLI) and
+// fills the response.
 //
-//   service  plan_attitude_maneuver         (attitude_planner/PlanAttitudeManeuver)
+//   service  plan_attitude_maneuver         (attitude_planner/PlanAttitudeManeuver)   rigid body
 //   action   plan_attitude_maneuver_action  (attitude_planner/PlanAttitudeManeuverAction)
+//   service  plan_drift_two_input           (attitude_planner/PlanDriftTwoInput)  seed 001's
+//            drift + two-input system; a service of its own rather than a `system` field in
+//            PlanAttitudeManeuver: the two problems share no request field but the attitudes and
+//            T, N, and adding fields would change the MD5 sum of a published interface (existing
+//            clients would be refused by the node).
 //
 // Private parameters (defaults for the request fields left empty / zero):
 //   ~default_scheme  string  "paper"    discretization ("paper" | "variational")
@@ -10,7 +16,7 @@
 //   ~tolerance       double  1e-10      optimality tolerance (> 0)
 //   ~max_iterations  int     200        iteration limit (> 0)
 //   ~time_budget     double  30.0       wall-time limit per solve [s] (0 = none)
-//   ~max_steps       int     100000     largest accepted N (>= 4)
+//   ~max_steps       int     100000     largest accepted N (>= 4; both services)
 //   ~world_frame     string  "world"    frame_id of the returned maneuver
 //   ~body_frame      string  "body"     child_frame_id of the returned maneuver
 //   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
@@ -30,6 +36,7 @@
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanAttitudeManeuverAction.h"
+#include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
 #include "attitude_planner/ros/conversions.hpp"
 
@@ -54,6 +61,25 @@ template <class Request>
 PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
                         const std::function<bool(const IterationInfo&, double)>& keep_going);
 
+/// What one plan_drift_two_input request produced, whatever happened.
+struct DriftPlanOutcome {
+  int error_code = PlanErrorCode::INTERNAL_ERROR;  ///< a PlanErrorCode constant
+  std::string message;                             ///< outcome in words
+  bool solver_ran = false;                         ///< `plan` is meaningful
+  DriftTwoInputPlan plan;                          ///< the core's result
+  DriftTwoInputRequest request;                    ///< the parsed request (if parsing succeeded)
+  double solve_time_s = 0.0;                       ///< wall time of planDriftTwoInput [s]
+};
+
+/// Runs one plan_drift_two_input request through planDriftTwoInput(): converged → SUCCESS,
+/// otherwise NOT_CONVERGED; bad fields → INVALID_INPUT. Never throws.
+DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
+                                  const ros_conversions::PlannerDefaults& defaults);
+
+/// Copies a drift outcome into the plan_drift_two_input response.
+void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world_frame,
+                       const std::string& body_frame, PlanDriftTwoInput::Response* res);
+
 /// Copies an outcome into a service response or action result (same fields).
 template <class Response>
 void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
@@ -71,6 +97,8 @@ class PlannerNode {
  private:
   /// Service callback: always returns true (the outcome is in the response).
   bool onPlanService(PlanAttitudeManeuver::Request& req, PlanAttitudeManeuver::Response& res);
+  /// plan_drift_two_input callback: always returns true (the outcome is in the response).
+  bool onPlanDriftService(PlanDriftTwoInput::Request& req, PlanDriftTwoInput::Response& res);
   /// Action execute callback: feedback per iteration; preemption cancels the solve.
   void onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal);
 
@@ -80,6 +108,7 @@ class PlannerNode {
   std::string body_frame_;                     ///< child_frame_id of returned maneuvers
   int threads_ = 4;                            ///< spinner threads
   ros::ServiceServer service_;                 ///< plan_attitude_maneuver
+  ros::ServiceServer drift_service_;           ///< plan_drift_two_input
   /// plan_attitude_maneuver_action (one goal at a time)
   std::unique_ptr<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>> action_server_;
 };

@@ -2,16 +2,25 @@
 // of the plan are integrated again through simulate() (the core's DiscreteScheme), so what rviz
 // shows is the rigid body's response to the planned torques, not the plan's own attitudes.
 //
-// Subscribes  maneuver          (attitude_planner/AttitudeManeuver)   a new one replaces the
-// current replay Publishes   /tf               world → body at every step, stamped start + t_k /
-// rate_factor
-//             torque            (geometry_msgs/WrenchStamped, frame body)      τ_k [N·m]
-//             angular_velocity  (geometry_msgs/Vector3Stamped, frame body)     Ω_k [rad/s]
-//             body_marker       (visualization_msgs/MarkerArray, frame body)  box + principal axes
-//             attitude_path     (visualization_msgs/Marker LINE_STRIP, world)  tip of the body x
-//             axis done              (attitude_planner/ReplayResult, latched)      when a replay
-//             ends
+// A drift + two-input maneuver (seed 001, attitude_planner/DriftTwoInputManeuver on
+// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls:
+// ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
+// fourth order) from g(0); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity` the body
+// rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the body is
+// drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the cost
+// ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
+//
+// Subscribes  maneuver          AttitudeManeuver (rigid body)    a new maneuver replaces the
+//             drift_maneuver    DriftTwoInputManeuver (seed 001) current replay
+// Publishes   /tf               world → body at every step, stamped start + t_k / rate_factor
+//             torque            geometry_msgs/WrenchStamped, body      τ_k [N·m] (rigid body)
+//             angular_velocity  geometry_msgs/Vector3Stamped, body     Ω_k [rad/s]
+//             control           geometry_msgs/Vector3Stamped, body     (u1, u2, 0) [rad/s] (drift)
+//             body_marker       visualization_msgs/MarkerArray, body   box + principal axes
+//             attitude_path     visualization_msgs/Marker, world       tip of the body x axis
+//             done              attitude_planner/ReplayResult, latched when a replay ends
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
+//             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //
 // Private parameters:
 //   ~scene            string  ""       scene YAML planned at start-up (empty: wait for `maneuver`)
@@ -37,7 +46,9 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/drift_two_input_planner.hpp"
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/planner.hpp"
 
@@ -68,6 +79,14 @@ bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
                const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
                double* solve_time, double* cost, std::string* error);
 
+/// Plans a drift + two-input request: via plan_drift_two_input (if `client` is valid) or
+/// in-process. Fills `msg`, the planner's solve time [s] and cost; false with `error` set if
+/// planning failed.
+bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* client,
+                    const std::string& world_frame, const std::string& body_frame,
+                    DriftTwoInputManeuver* msg, double* solve_time, double* cost,
+                    std::string* error);
+
 /// The node.
 class TrackerNode {
  public:
@@ -79,19 +98,25 @@ class TrackerNode {
  private:
   /// One replay job, owned by the replay thread.
   struct Replay {
-    AttitudeManeuver msg;           ///< the maneuver as received
-    double plan_solve_time = -1.0;  ///< [s], −1 if unknown
-    double plan_cost = -1.0;        ///< [N²·m²], −1 if unknown
+    AttitudeManeuver msg;             ///< the maneuver as received (rigid body)
+    bool drift = false;               ///< true: replay `drift_msg` instead of `msg`
+    DriftTwoInputManeuver drift_msg;  ///< the drift + two-input maneuver as received
+    double plan_solve_time = -1.0;    ///< [s], −1 if unknown
+    double plan_cost = -1.0;          ///< [N²·m²], −1 if unknown
   };
 
   /// `maneuver` callback: replaces the running replay.
   void onManeuver(const AttitudeManeuver::ConstPtr& msg);
+  /// `drift_maneuver` callback: replaces the running replay.
+  void onDriftManeuver(const DriftTwoInputManeuver::ConstPtr& msg);
   /// Stops the current replay (if any) and starts a new one in its own thread.
   void startReplay(const Replay& replay);
   /// Stops the running replay and joins its thread (within ~10 ms).
   void stopReplay();
   /// The replay thread's body; returns early when stop_ is set.
   void runReplay(Replay replay);
+  /// runReplay for a drift + two-input maneuver.
+  void runDriftReplay(const Replay& replay);
   /// Sleeps until ROS time `t` (sim-time friendly); false if stopped meanwhile.
   bool sleepUntil(const ros::Time& t);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
@@ -99,6 +124,8 @@ class TrackerNode {
 
   ros::NodeHandle nh_;            ///< public handle: topics and the service resolve here
   ros::Subscriber maneuver_sub_;  ///< `maneuver`
+  ros::Subscriber drift_sub_;     ///< `drift_maneuver`
+  ros::Publisher control_pub_;    ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
   ros::Publisher torque_pub_;     ///< `torque` τ_k [N·m], frame body
   ros::Publisher velocity_pub_;   ///< `angular_velocity` Ω_k [rad/s], frame body
   ros::Publisher marker_pub_;     ///< `body_marker`

@@ -34,3 +34,14 @@ endforeach()
 # rostest with the stock checkers (advertisetest, publishtest) on the whole demo pipeline.
 add_rostest(test/ros/demo_pipeline.test)
 list(APPEND AP_EXPECTED_TESTS demo_pipeline)
+
+# Scenes with effects: planned through the service, replayed under the scene's own effects (lands)
+# and under ~replay_scene's (torque noise: misses); actuator limits planned and saturated.
+add_rostest_gtest(test_tracker_effects test/ros/tracker_effects_planned.test
+                  test/ros/test_tracker_effects.cpp)
+target_link_libraries(test_tracker_effects ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_effects attitude_planner_node attitude_tracker_node)
+add_rostest(test/ros/tracker_effects_unplanned.test DEPENDENCIES test_tracker_effects)
+add_rostest(test/ros/tracker_effects_limited.test DEPENDENCIES test_tracker_effects)
+list(APPEND AP_EXPECTED_TESTS test_tracker_effects tracker_effects_unplanned
+     tracker_effects_limited)

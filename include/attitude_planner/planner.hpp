@@ -93,7 +93,8 @@ struct PlanResult {
   /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
   /// cost of the other way when both were solved.
   std::string extremal;
-  /// The effects in the planning model (scene keys), in order.
+  /// The effects in the planning model (scene keys), in order; "actuator_limits" last when the
+  /// control torques are bounded.
   std::vector<std::string> effects;
 };
 

@@ -61,6 +61,12 @@ using EffectSpec =
 /// The YAML key of an effect ("gravity_gradient", "disturbance_torque", ...).
 std::string effectName(const EffectSpec& effect);
 
+/// Checks the values of a list of effects, however they arrived (scene file, service request):
+/// μ, r > 0; frame body|world; finite torques; max_torque > 0; std ≥ 0; at most one of each effect
+/// except disturbance_torque (several add up). Throws InvalidInput naming
+/// `field`[i].<effect>.<key> and the value.
+void validateEffects(const std::vector<EffectSpec>& effects, const std::string& field);
+
 /// A parsed scene. Unknown keys and bad values throw InvalidInput naming the key and the value.
 struct Scene {
   PlanningProblem problem;            ///< what to plan (SI units, see planner.hpp)
@@ -91,6 +97,10 @@ void requirePhysicalInertia(const Matrix3& inertia);
 /// J = inertia; null if there are none. parseScene stores it in Scene::problem.effects.
 std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec>& specs,
                                                     const Matrix3& inertia);
+/// Puts `specs` into the planning model of `problem` (whose inertia must be set): the plannable
+/// effects into problem->effects, actuator_limits into problem->max_torque. torque_noise is not
+/// plannable and is left to the replay (actuationOf).
+void applyEffects(const std::vector<EffectSpec>& specs, PlanningProblem* problem);
 /// The tracker-side effects of `specs` (actuator_limits, torque_noise).
 Actuation actuationOf(const std::vector<EffectSpec>& specs);
 

@@ -20,6 +20,7 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   result->maneuver = simulate(scheme, input, &report);
   result->scheme = problem.scheme;
   result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
+  if (problem.hasTorqueBounds()) result->effects.push_back("actuator_limits");
   result->dynamics_residual = report.max_step_residual;
   double cost = 0.0;
   for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();

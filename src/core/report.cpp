@@ -90,8 +90,6 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   std::string text = buffer;
   std::string effects;
   for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
-  if (problem.hasTorqueBounds())
-    effects += std::string(effects.empty() ? "" : ", ") + "actuator_limits";
   text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
   if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
   return text;

@@ -42,6 +42,39 @@ std::string show(const YAML::Node& node) {
   return out.c_str();
 }
 
+/// The value checks of one effect (shared by scene files and service requests).
+void validateEffect(const EffectSpec& effect, const std::string& path) {
+  auto require = [&](bool ok, const std::string& key, double value, const char* rule) {
+    if (!ok) throw InvalidInput(path + "." + key + ": " + rule + ", got " + fmt(value));
+  };
+  auto requireVector = [&](const Vector3& v, const std::string& key, bool positive) {
+    for (int k = 0; k < 3; ++k) {
+      const std::string element = key + "[" + std::to_string(k) + "]";
+      require(std::isfinite(v(k)), element, v(k), "must be finite");
+      if (positive) require(v(k) > 0.0, element, v(k), "must be > 0 N m");
+      if (!positive) require(v(k) >= 0.0, element, v(k), "must be >= 0 N m");
+    }
+  };
+  if (const auto* g = std::get_if<GravityGradientSpec>(&effect)) {
+    require(std::isfinite(g->mu) && g->mu > 0.0, "mu", g->mu, "must be finite and > 0 m^3/s^2");
+    require(std::isfinite(g->orbit_radius) && g->orbit_radius > 0.0, "orbit_radius",
+            g->orbit_radius, "must be finite and > 0 m");
+  } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&effect)) {
+    if (d->frame != "body" && d->frame != "world") {
+      throw InvalidInput(path + ".frame: unknown value '" + d->frame +
+                         "' (expected body or world)");
+    }
+    for (int k = 0; k < 3; ++k) {
+      require(std::isfinite(d->value(k)), "value[" + std::to_string(k) + "]", d->value(k),
+              "must be finite");
+    }
+  } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&effect)) {
+    requireVector(a->max_torque, "max_torque", true);
+  } else if (const auto* n = std::get_if<TorqueNoiseSpec>(&effect)) {
+    requireVector(n->std, "std", false);
+  }
+}
+
 class SceneParser {
  public:
   explicit SceneParser(std::string source) : source_(std::move(source)) {}
@@ -130,11 +163,7 @@ class SceneParser {
       if (node) throw InvalidInput(where(node) + what);
       throw InvalidInput(source_ + ": " + what);
     }
-    p.effects = plannableEffects(scene.effects, p.inertia);
-    for (const EffectSpec& e : scene.effects) {
-      if (const auto* limits = std::get_if<ActuatorLimitsSpec>(&e))
-        p.max_torque = limits->max_torque;
-    }
+    applyEffects(scene.effects, &p);
     return scene;
   }
 
@@ -327,7 +356,6 @@ class SceneParser {
       fail(node, path, "expected a list (use [] for none), got " + show(node));
     }
     std::vector<EffectSpec> out;
-    std::set<std::string> seen;
     for (std::size_t i = 0; i < node.size(); ++i) {
       const YAML::Node entry = node[i];
       const std::string epath = path + "[" + std::to_string(i) + "]";
@@ -340,26 +368,18 @@ class SceneParser {
       const std::string name = kv.first.Scalar();
       const YAML::Node body = kv.second;
       const std::string bpath = epath + "." + name;
-      // Several constant disturbances add up; the other effects are one-of-a-kind.
-      if (name != "disturbance_torque" && !seen.insert(name).second) {
-        fail(kv.first, bpath, "duplicate effect (at most one " + name + ")");
-      }
       if (name == "gravity_gradient") {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"mu", "orbit_radius"}, {"mu", "orbit_radius"});
         GravityGradientSpec g;
-        g.mu = positive(body["mu"], bpath + ".mu");
-        g.orbit_radius = positive(body["orbit_radius"], bpath + ".orbit_radius");
+        g.mu = number(body["mu"], bpath + ".mu");
+        g.orbit_radius = number(body["orbit_radius"], bpath + ".orbit_radius");
         out.emplace_back(g);
       } else if (name == "disturbance_torque") {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"frame", "value"}, {"frame", "value"});
         DisturbanceTorqueSpec d;
         d.frame = scalarString(body["frame"], bpath + ".frame");
-        if (d.frame != "body" && d.frame != "world") {
-          fail(body["frame"], bpath + ".frame",
-               "unknown value " + show(body["frame"]) + " (expected body or world)");
-        }
         d.value = vector3(body["value"], bpath + ".value");
         out.emplace_back(d);
       } else if (name == "actuator_limits") {
@@ -367,24 +387,12 @@ class SceneParser {
         checkKeys(body, bpath, {"max_torque"}, {"max_torque"});
         ActuatorLimitsSpec a;
         a.max_torque = vector3(body["max_torque"], bpath + ".max_torque");
-        for (int k = 0; k < 3; ++k) {
-          if (!(a.max_torque(k) > 0.0)) {
-            fail(body["max_torque"][k], bpath + ".max_torque[" + std::to_string(k) + "]",
-                 "must be > 0 N m, got " + show(body["max_torque"][k]));
-          }
-        }
         out.emplace_back(a);
       } else if (name == "torque_noise") {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"std", "seed"}, {"std", "seed"});
         TorqueNoiseSpec t;
         t.std = vector3(body["std"], bpath + ".std");
-        for (int k = 0; k < 3; ++k) {
-          if (t.std(k) < 0.0) {
-            fail(body["std"][k], bpath + ".std[" + std::to_string(k) + "]",
-                 "must be >= 0 N m, got " + show(body["std"][k]));
-          }
-        }
         const YAML::Node seed = body["seed"];
         const std::string& s = seed.IsScalar() ? seed.Scalar() : std::string();
         char* end = nullptr;
@@ -401,14 +409,18 @@ class SceneParser {
              "unknown effect (expected gravity_gradient, disturbance_torque, actuator_limits or "
              "torque_noise)");
       }
+      try {
+        validateEffect(out.back(), bpath);
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(where(body) + e.what());
+      }
+    }
+    try {
+      validateEffects(out, path);  // what spans entries (duplicates)
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(where(node) + e.what());
     }
     return out;
-  }
-
-  double positive(const YAML::Node& node, const std::string& path) const {
-    const double v = number(node, path);
-    if (!(v > 0.0)) fail(node, path, "must be > 0, got " + show(node));
-    return v;
   }
 
   std::string source_;
@@ -437,6 +449,19 @@ std::string effectName(const EffectSpec& effect) {
       return "actuator_limits";
     default:
       return "torque_noise";
+  }
+}
+
+void validateEffects(const std::vector<EffectSpec>& effects, const std::string& field) {
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::string name = effectName(effects[i]);
+    const std::string path = field + "[" + std::to_string(i) + "]." + name;
+    validateEffect(effects[i], path);
+    // Several constant disturbances add up; the other effects are one-of-a-kind.
+    if (name != "disturbance_torque" && !seen.insert(name).second) {
+      throw InvalidInput(path + ": duplicate effect (at most one " + name + ")");
+    }
   }
 }
 
@@ -504,6 +529,14 @@ std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec
     // actuator_limits and torque_noise act on the commanded torque: see actuationOf().
   }
   return model->empty() ? nullptr : model;
+}
+
+void applyEffects(const std::vector<EffectSpec>& specs, PlanningProblem* problem) {
+  problem->effects = plannableEffects(specs, problem->inertia);
+  for (const EffectSpec& e : specs) {
+    if (const auto* limits = std::get_if<ActuatorLimitsSpec>(&e))
+      problem->max_torque = limits->max_torque;
+  }
 }
 
 Actuation actuationOf(const std::vector<EffectSpec>& specs) {

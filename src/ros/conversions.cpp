@@ -16,7 +16,81 @@ std::string quaternionText(const geometry_msgs::Quaternion& q) {
   return s.str();
 }
 
+std::string numberText(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
 }  // namespace
+
+EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
+  // A field the type does not read must stay at zero: a value there is a mistake, not a default.
+  auto unused = [&](bool is_zero, const std::string& key, const std::string& value) {
+    if (!is_zero) {
+      throw InvalidInput(field + "." + key + ": not used by type '" + msg.type +
+                         "' (leave it at zero/empty), got " + value);
+    }
+  };
+  const Vector3 value = vectorFromMsg(msg.value);
+  const bool uses_orbit = msg.type == Effect::GRAVITY_GRADIENT;
+  const bool uses_frame = msg.type == Effect::DISTURBANCE_TORQUE;
+  const bool uses_value = msg.type != Effect::GRAVITY_GRADIENT;
+  const bool uses_seed = msg.type == Effect::TORQUE_NOISE;
+  if (msg.type != Effect::GRAVITY_GRADIENT && msg.type != Effect::DISTURBANCE_TORQUE &&
+      msg.type != Effect::ACTUATOR_LIMITS && msg.type != Effect::TORQUE_NOISE) {
+    throw InvalidInput(field + ".type: unknown value '" + msg.type +
+                       "' (expected gravity_gradient, disturbance_torque, actuator_limits or "
+                       "torque_noise)");
+  }
+  if (!uses_orbit) unused(msg.mu == 0.0, "mu", numberText(msg.mu));
+  if (!uses_orbit) unused(msg.orbit_radius == 0.0, "orbit_radius", numberText(msg.orbit_radius));
+  if (!uses_frame) unused(msg.frame.empty(), "frame", "'" + msg.frame + "'");
+  if (!uses_value) {
+    unused(value.isZero(0.0), "value",
+           "[" + numberText(value.x()) + ", " + numberText(value.y()) + ", " +
+               numberText(value.z()) + "]");
+  }
+  if (!uses_seed) unused(msg.seed == 0, "seed", std::to_string(msg.seed));
+  if (uses_orbit) return GravityGradientSpec{msg.mu, msg.orbit_radius};
+  if (uses_frame) return DisturbanceTorqueSpec{msg.frame, value};
+  if (msg.type == Effect::ACTUATOR_LIMITS) return ActuatorLimitsSpec{value};
+  return TorqueNoiseSpec{value, msg.seed};
+}
+
+Effect effectToMsg(const EffectSpec& spec) {
+  Effect msg;
+  msg.type = effectName(spec);
+  if (const auto* g = std::get_if<GravityGradientSpec>(&spec)) {
+    msg.mu = g->mu;
+    msg.orbit_radius = g->orbit_radius;
+  } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&spec)) {
+    msg.frame = d->frame;
+    msg.value = vectorToMsg(d->value);
+  } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&spec)) {
+    msg.value = vectorToMsg(a->max_torque);
+  } else if (const auto* n = std::get_if<TorqueNoiseSpec>(&spec)) {
+    msg.value = vectorToMsg(n->std);
+    msg.seed = n->seed;
+  }
+  return msg;
+}
+
+void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
+  std::vector<EffectSpec> specs;
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::string field = "effects[" + std::to_string(i) + "]";
+    specs.push_back(effectFromMsg(effects[i], field));
+    if (std::holds_alternative<TorqueNoiseSpec>(specs.back())) {
+      throw InvalidInput(field +
+                         ".type: 'torque_noise' is not plannable (random; it acts in the "
+                         "tracker's replay only): leave it out of planning requests");
+    }
+  }
+  validateEffects(specs, "effects");
+  applyEffects(specs, problem);
+}
 
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {
   if (!std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {

@@ -112,9 +112,10 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   return array;
 }
 
-bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
-               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
-               double* solve_time, double* cost, std::string* error) {
+bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
+               ros::ServiceClient* client, const std::string& world_frame,
+               const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
+               double* cost, std::string* error) {
   if (client && client->isValid()) {
     PlanAttitudeManeuver srv;
     srv.request.inertia = rc::inertiaToMsg(problem.inertia);
@@ -126,6 +127,11 @@ bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
     srv.request.duration = problem.duration;
     srv.request.steps = problem.steps;
     srv.request.scheme = schemeName(problem.scheme);
+    for (const EffectSpec& e : effects) {
+      // Noise is random: the replay adds it, the plan cannot know it.
+      if (!std::holds_alternative<TorqueNoiseSpec>(e))
+        srv.request.effects.push_back(rc::effectToMsg(e));
+    }
     if (!client->call(srv)) {
       *error = "service " + client->getService() + " call failed";
       return false;
@@ -203,8 +209,9 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
   pnh.param("exit_when_done", exit_when_done_, false);
-  std::string scene;
+  std::string scene, replay_scene;
   pnh.param<std::string>("scene", scene, "");
+  pnh.param<std::string>("replay_scene", replay_scene, "");
   bool plan_in_process = false;
   pnh.param("plan_in_process", plan_in_process, false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
@@ -218,6 +225,21 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
   drift_sub_ = nh_.subscribe("drift_maneuver", 1, &TrackerNode::onDriftManeuver, this);
 
+  if (!replay_scene.empty()) {
+    try {
+      replay_scene_effects_ = loadScene(replay_scene).effects;
+      ROS_INFO("replays act under the %zu effects of %s", replay_scene_effects_->size(),
+               replay_scene.c_str());
+    } catch (const std::exception& e) {
+      // A replay under effects other than the requested ones would be silently wrong: refuse.
+      ROS_ERROR("~replay_scene %s: %s", replay_scene.c_str(), e.what());
+      ReplayResult failed;
+      failed.success = false;
+      failed.message = "~replay_scene " + replay_scene + ": " + e.what();
+      publishDone(failed);
+      return;
+    }
+  }
   if (scene.empty()) {
     ROS_INFO("attitude_tracker_node: waiting for a maneuver on %s or %s",
              maneuver_sub_.getTopic().c_str(), drift_sub_.getTopic().c_str());
@@ -251,10 +273,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       }
       throw InvalidInput(error);
     }
-    if (!parsed.effects.empty()) {
-      ROS_WARN("scene %s lists %zu effects: the replay applies the planned torques only",
-               scene.c_str(), parsed.effects.size());
-    }
+    replay.effects = parsed.effects;
     ros::ServiceClient client;
     if (!plan_in_process) {
       client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
@@ -267,8 +286,8 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       ROS_INFO("planning %s in-process", scene.c_str());
     }
     if (error.empty() &&
-        planScene(parsed.problem, plan_in_process ? nullptr : &client, world_frame_, body_frame_,
-                  &replay.msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
+        planScene(parsed.problem, parsed.effects, plan_in_process ? nullptr : &client, world_frame_,
+                  body_frame_, &replay.msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
       ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
                replay.plan_solve_time);
       startReplay(replay);
@@ -308,7 +327,8 @@ void TrackerNode::stopReplay() {
   stop_ = false;
 }
 
-void TrackerNode::startReplay(const Replay& replay) {
+void TrackerNode::startReplay(Replay replay) {
+  if (replay_scene_effects_) replay.effects = *replay_scene_effects_;
   stopReplay();
   std::lock_guard<std::mutex> lock(replay_mutex_);
   replay_thread_ = std::thread([this, replay]() { runReplay(replay); });
@@ -364,14 +384,20 @@ void TrackerNode::runReplay(Replay replay) {
     problem.scheme = parseSchemeName(replay.msg.scheme.empty() ? "paper" : replay.msg.scheme);
     validateProblem(problem);
     const DiscreteScheme scheme(problem.scheme, inertia, plan.time_step);
+    // Exactly the effects of the replay's scene: forcing on the body, then what the actuators do.
+    const std::shared_ptr<const EffectModel> effects = plannableEffects(replay.effects, inertia);
+    Actuation actuation = actuationOf(replay.effects);
     SimulationInput input;
     input.initial_attitude = problem.initial_attitude;
     input.initial_velocity = problem.initial_velocity;
     input.torque = plan.torque;
+    input.effects = effects.get();
+    input.actuation = &actuation;
     replayed = simulate(scheme, input);
+    for (const EffectSpec& e : replay.effects) result.replay_effects.push_back(effectName(e));
     result.steps = N;
     result.duration = problem.duration;
-    for (int k = 1; k < N; ++k) result.cost += 0.5 * plan.torque[k].squaredNorm();
+    for (int k = 1; k < N; ++k) result.cost += 0.5 * replayed.torque[k].squaredNorm();
     result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], replayed.attitude[N]);
     result.terminal_velocity_error =
         (replayed.angular_velocity[N - 1] - plan.angular_velocity[N - 1]).norm();
@@ -450,6 +476,12 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
   DriftTwoInputTrajectory plan;
   std::vector<Matrix3> replayed;
   try {
+    if (!replay.effects.empty()) {
+      throw InvalidInput(
+          "~replay_scene: effects are not modelled for a drift + two-input "
+          "maneuver (a kinematic system has no torques), got " +
+          std::to_string(replay.effects.size()) + " effect(s)");
+    }
     DriftTwoInputWeights weights;
     plan = rc::driftManeuverFromMsg(replay.drift_msg, &weights);
     // Open loop: only g(0) and the controls are used; the plan's later attitudes are the check.

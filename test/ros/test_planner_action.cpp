@@ -5,6 +5,7 @@
 #include <actionlib/client/simple_action_client.h>
 
 #include <atomic>
+#include <memory>
 
 #include "attitude_planner/PlanAttitudeManeuverAction.h"
 #include "attitude_planner/PlanErrorCode.h"
@@ -42,15 +43,19 @@ class PlannerAction : public ::testing::Test {
 };
 
 TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
-  std::atomic<int> feedbacks{0};
-  std::atomic<int> last_iteration{0};
+  // Shared, not on the stack: a late feedback may run its callback after this body has returned.
+  struct Seen {
+    std::atomic<int> feedbacks{0};
+    std::atomic<int> last_iteration{0};
+  };
+  auto seen = std::make_shared<Seen>();
   client_->sendGoal(seed(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                    [&](const PlanAttitudeManeuverFeedbackConstPtr& f) {
-                      EXPECT_GT(f->iteration, last_iteration.load());  // increasing
+                    [seen](const PlanAttitudeManeuverFeedbackConstPtr& f) {
+                      EXPECT_GT(f->iteration, seen->last_iteration.load());  // increasing
                       EXPECT_TRUE(std::isfinite(f->cost));
                       EXPECT_GE(f->residual, 0.0);
-                      last_iteration = f->iteration;
-                      ++feedbacks;
+                      seen->last_iteration = f->iteration;
+                      ++seen->feedbacks;
                     });
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::SUCCEEDED);
@@ -60,8 +65,9 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_EQ(result->maneuver.attitude.size(), 33u);
   EXPECT_LT(result->terminal_attitude_error, 1e-8);
   // Feedback and result travel on different topics: allow the last feedback to land.
-  EXPECT_TRUE(waitFor([&] { return feedbacks > 0; }, 10.0)) << "no feedback received";
-  EXPECT_LE(last_iteration.load(), result->iterations);
+  waitFor([&] { return seen->last_iteration >= result->iterations; }, 5.0);
+  EXPECT_GT(seen->feedbacks.load(), 0) << "no feedback received";
+  EXPECT_LE(seen->last_iteration.load(), result->iterations);
 }
 
 TEST_F(PlannerAction, CancelEndsPreemptedWithCancelled) {
@@ -70,10 +76,10 @@ TEST_F(PlannerAction, CancelEndsPreemptedWithCancelled) {
   goal.tolerance = 1e-300;
   goal.max_iterations = 1000000;
   goal.time_budget = 600.0;
-  std::atomic<int> feedbacks{0};
+  auto feedbacks = std::make_shared<std::atomic<int>>(0);  // outlives late callbacks
   client_->sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                    [&](const PlanAttitudeManeuverFeedbackConstPtr&) { ++feedbacks; });
-  ASSERT_TRUE(waitFor([&] { return feedbacks > 0; }, 60.0)) << "no feedback before cancelling";
+                    [feedbacks](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*feedbacks; });
+  ASSERT_TRUE(waitFor([&] { return *feedbacks > 0; }, 60.0)) << "no feedback before cancelling";
   client_->cancelGoal();
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::PREEMPTED);

@@ -9,6 +9,8 @@
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/scene.hpp"
+#include "attitude_planner/simulation.hpp"
 #include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
@@ -117,6 +119,45 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   const PlanAttitudeManeuver::Response good = call(seed());
   EXPECT_TRUE(good.success) << good.message;
   EXPECT_LT(good.terminal_attitude_error, 1e-8);
+}
+
+TEST_F(PlannerService, EffectsArePlannedListedAndLandWhenReplayedUnderThem) {
+  // scenes/leo_slew.yaml as a request: gravity gradient + world disturbance in the planning model.
+  PlanAttitudeManeuver::Request r;
+  r.inertia = {800, 0, 0, 0, 1200, 0, 0, 0, 1500};
+  r.initial_attitude.w = 1.0;
+  r.final_attitude = rc::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitZ(), M_PI / 2));
+  r.duration = 600.0;
+  r.steps = 300;
+  r.scheme = "variational";
+  const std::vector<EffectSpec> effects = {
+      GravityGradientSpec{3.986004418e14, 6.778e6},
+      DisturbanceTorqueSpec{"world", Vector3(2e-4, 0.0, -1e-4)}};
+  for (const EffectSpec& e : effects) r.effects.push_back(rc::effectToMsg(e));
+  const PlanAttitudeManeuver::Response res = call(r);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.effects, (std::vector<std::string>{"gravity_gradient", "disturbance_torque"}));
+  // Replayed under the same effects, the plan lands; without them it misses (they matter).
+  const Maneuver plan = rc::maneuverFromMsg(res.maneuver);
+  const Matrix3 J = rc::inertiaFromMsg(r.inertia);
+  const DiscreteScheme scheme(SchemeKind::Variational, J, plan.time_step);
+  SimulationInput input;
+  input.torque = plan.torque;
+  const auto model = plannableEffects(effects, J);
+  input.effects = model.get();
+  const Matrix3 target = rc::attitudeFromMsg(r.final_attitude, "final_attitude");
+  EXPECT_LT(so3::angleBetween(simulate(scheme, input).attitude.back(), target), 1e-8);
+  input.effects = nullptr;
+  EXPECT_GT(so3::angleBetween(simulate(scheme, input).attitude.back(), target), 1e-3);
+
+  PlanAttitudeManeuver::Request noisy = r;
+  noisy.effects.push_back(rc::effectToMsg(TorqueNoiseSpec{Vector3(1e-4, 1e-4, 1e-4), 7}));
+  const PlanAttitudeManeuver::Response refused = call(noisy);
+  EXPECT_FALSE(refused.success);
+  EXPECT_EQ(refused.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(refused.message.find("effects[2].type: 'torque_noise' is not plannable"),
+            std::string::npos)
+      << refused.message;
 }
 
 TEST_F(PlannerService, SchemeAndSolverFieldsAreHonoured) {

@@ -8,6 +8,7 @@
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
 #include "attitude_planner/ros/tracker_node.hpp"
+#include "attitude_planner/scene.hpp"
 #include "attitude_planner/simulation.hpp"
 
 using namespace attitude_planner;
@@ -88,6 +89,74 @@ TEST(RosConversions, BadFieldsAreNamedWithTheirValue) {
   r = seedRequest();
   r.time_budget = -3.0;
   EXPECT_NE(invalidMessage(r).find("time_budget"), std::string::npos);
+}
+
+TEST(RosConversions, EffectMessagesRoundTrip) {
+  const std::vector<EffectSpec> specs = {
+      GravityGradientSpec{3.986004418e14, 6.778e6},
+      DisturbanceTorqueSpec{"world", Vector3(2e-4, 0.0, -1e-4)},
+      ActuatorLimitsSpec{Vector3(0.3, 0.4, 0.5)},
+      TorqueNoiseSpec{Vector3(1e-4, 2e-4, 0.0), 7},
+  };
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    const Effect msg = rc::effectToMsg(specs[i]);
+    EXPECT_EQ(msg.type, effectName(specs[i]));
+    const EffectSpec back = rc::effectFromMsg(msg, "effects[0]");
+    ASSERT_EQ(back.index(), specs[i].index());
+    EXPECT_EQ(rc::effectToMsg(back), msg) << msg.type;
+  }
+}
+
+TEST(RosConversions, BadEffectsNameTheFieldAndTheValue) {
+  auto message = [](const std::vector<Effect>& effects) {
+    PlanAttitudeManeuver::Request r = seedRequest();
+    r.effects = effects;
+    return invalidMessage(r);
+  };
+  Effect unknown;
+  unknown.type = "solar_pressure";
+  EXPECT_NE(message({unknown}).find("effects[0].type: unknown value 'solar_pressure'"),
+            std::string::npos);
+  Effect gravity = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
+  gravity.mu = -1.0;
+  EXPECT_NE(message({gravity}).find("effects[0].gravity_gradient.mu: must be finite and > 0"),
+            std::string::npos);
+  Effect stray = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
+  stray.value.x = 1.0;  // not read by gravity_gradient: a mistake, not a default
+  EXPECT_NE(message({stray}).find("effects[0].value: not used by type 'gravity_gradient'"),
+            std::string::npos);
+  Effect frame = rc::effectToMsg(DisturbanceTorqueSpec{"body", Vector3(1e-3, 0, 0)});
+  frame.frame = "orbit";
+  EXPECT_NE(message({frame}).find("effects[0].disturbance_torque.frame: unknown value 'orbit'"),
+            std::string::npos);
+  Effect limits = rc::effectToMsg(ActuatorLimitsSpec{Vector3(1.0, 1.0, 1.0)});
+  limits.value.y = 0.0;
+  EXPECT_NE(
+      message({limits}).find("effects[0].actuator_limits.max_torque[1]: must be > 0 N m, got 0"),
+      std::string::npos);
+  const Effect good = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
+  EXPECT_NE(message({good, good}).find("effects[1].gravity_gradient: duplicate effect"),
+            std::string::npos);
+  const Effect noise = rc::effectToMsg(TorqueNoiseSpec{Vector3(1e-4, 1e-4, 1e-4), 3});
+  EXPECT_NE(message({noise}).find("effects[0].type: 'torque_noise' is not plannable"),
+            std::string::npos);
+}
+
+TEST(RosConversions, RequestEffectsEnterThePlanningModel) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.effects.push_back(rc::effectToMsg(DisturbanceTorqueSpec{"body", Vector3(1e-3, 0.0, 0.0)}));
+  SolverOptions options;
+  PlanningProblem p = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  ASSERT_TRUE(p.effects);
+  EXPECT_EQ(p.effects->names(), std::vector<std::string>{"disturbance_torque"});
+  EXPECT_EQ(p.effects->torque(Matrix3::Identity(), 0.0), Vector3(1e-3, 0.0, 0.0));
+  EXPECT_FALSE(p.hasTorqueBounds());
+
+  r = seedRequest();
+  r.effects.push_back(rc::effectToMsg(ActuatorLimitsSpec{Vector3(0.3, 0.4, 0.5)}));
+  p = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  EXPECT_FALSE(p.effects);
+  EXPECT_EQ(p.max_torque, Vector3(0.3, 0.4, 0.5));
 }
 
 TEST(RosConversions, DefaultsFillEmptyFields) {

@@ -190,6 +190,29 @@ TEST_F(CliTest, EffectsArePlannedByNewtonAndRefusedWhereUnsupported) {
   EXPECT_CONTAINS(bounds.output, "actuator_limits together with gravity_gradient");
 }
 
+TEST_F(CliTest, ReplayAppliesExactlyTheScenesEffects) {
+  // leo_slew is planned with its gravity gradient and disturbance: replayed under the same scene
+  // it lands; under rest_to_rest-like "no effects" and under disturbed_replay (+ torque noise) it
+  // misses, and simulate_torques says which effects acted.
+  const std::string csv = dir_ + "/leo.csv";
+  const ToolRun plan = run("plan_maneuver", kScenes + "leo_slew.yaml --csv " + csv);
+  ASSERT_EQ(plan.status, 0) << plan.output;
+  const ToolRun same =
+      run("simulate_torques", kScenes + "leo_slew.yaml " + csv + " --max-miss 1e-8");
+  EXPECT_EQ(same.status, 0) << same.output;
+  EXPECT_CONTAINS(same.output, "replay effects           gravity_gradient, disturbance_torque\n");
+  std::string bare = readFile(kScenes + "leo_slew.yaml");
+  bare = bare.substr(0, bare.find("effects:")) + "effects: []\n";
+  const ToolRun none =
+      run("simulate_torques", writeScene("bare.yaml", bare) + " " + csv + " --max-miss 1e-3");
+  EXPECT_EQ(none.status, 1) << none.output;  // the effects moved the body by more than 1e-3 rad
+  EXPECT_CONTAINS(none.output, "replay effects           none\n");
+  const ToolRun noisy =
+      run("simulate_torques", kScenes + "disturbed_replay.yaml " + csv + " --max-miss 1e-4");
+  EXPECT_EQ(noisy.status, 1) << noisy.output;
+  EXPECT_CONTAINS(noisy.output, "gravity_gradient, disturbance_torque, torque_noise");
+}
+
 TEST_F(CliTest, DriftTwoInputSceneWritesCsvAndSummaryAndReachesTheTarget) {
   // scenes/drift_two_input.yaml: the worked example of docs/drift_two_input.md (no guess).
   const std::string csv = dir_ + "/drift.csv", json = dir_ + "/drift.json";

@@ -13,11 +13,13 @@
 
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
+#include "attitude_planner/Effect.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/drift_two_input_planner.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/scene.hpp"
 
 namespace attitude_planner {
 namespace ros_conversions {
@@ -60,6 +62,16 @@ DriftTwoInputManeuver driftManeuverToMsg(const DriftTwoInputTrajectory& trajecto
 /// finite or not a unit quaternion, or a control's z component is not 0.
 DriftTwoInputTrajectory driftManeuverFromMsg(const DriftTwoInputManeuver& msg,
                                              DriftTwoInputWeights* weights);
+
+/// Core spec of an Effect message (`field` names it in errors, e.g. "effects[2]"). Throws
+/// InvalidInput naming the field and the value for an unknown type or a field the type does not
+/// use that is not left at zero; the values themselves are checked by validateEffects.
+EffectSpec effectFromMsg(const Effect& msg, const std::string& field);
+/// Effect message of a core spec.
+Effect effectToMsg(const EffectSpec& spec);
+/// The effects of a planning request: converted, validated (validateEffects) and put into the
+/// planning model of `problem` (applyEffects). torque_noise is refused: it is not plannable.
+void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
@@ -126,6 +138,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
                        std::to_string(req.time_budget));
   }
   options->time_budget_s = req.time_budget > 0.0 ? req.time_budget : defaults.time_budget;
+  applyRequestEffects(req.effects, &p);
   return p;
 }
 

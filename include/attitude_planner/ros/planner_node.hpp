@@ -184,6 +184,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->terminal_attitude_error = r.terminal_attitude_error;
   res->terminal_velocity_error = r.terminal_velocity_error;
   res->solve_time = r.solve_time_s;
+  res->effects = r.effects;
 }
 
 }  // namespace attitude_planner

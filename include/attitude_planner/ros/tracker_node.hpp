@@ -1,6 +1,8 @@
 // attitude_tracker_node: replays a planned maneuver in (ROS) real time for rviz. The torques τ_k
 // of the plan are integrated again through simulate() (the core's DiscreteScheme), so what rviz
-// shows is the rigid body's response to the planned torques, not the plan's own attitudes.
+// shows is the rigid body's response to the planned torques, not the plan's own attitudes. The
+// replay includes exactly the effects of the scene (~scene, or ~replay_scene when set; none for a
+// maneuver from the topic without ~replay_scene); `done` lists them and reports the miss.
 //
 // A drift + two-input maneuver (seed 001, attitude_planner/DriftTwoInputManeuver on
 // `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls:
@@ -23,7 +25,14 @@
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //
 // Private parameters:
-//   ~scene            string  ""       scene YAML planned at start-up (empty: wait for `maneuver`)
+//   ~scene            string  ""       scene YAML planned at start-up (empty: wait for `maneuver`);
+//                                      its effects act during the replay (gravity gradient and
+//                                      disturbances as forcing, actuator_limits saturate,
+//                                      torque_noise perturbs the applied torque)
+//   ~replay_scene     string  ""       scene YAML whose effects act during every replay instead
+//                                      (only its `effects` are used: body and plan come from the
+//                                      maneuver) — replaying a plan under effects it was not made
+//                                      for shows the miss in `done`
 //   ~plan_in_process  bool    false    plan the scene with planManeuver() instead of the service
 //   ~planner_timeout  double  30.0     wait for the planner service [s, wall]
 //   ~rate_factor      double  1.0      maneuver seconds per ROS second (> 0; 2 = twice as fast)
@@ -38,8 +47,10 @@
 
 #include <atomic>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -51,6 +62,7 @@
 #include "attitude_planner/drift_two_input_planner.hpp"
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/scene.hpp"
 
 namespace attitude_planner {
 
@@ -73,11 +85,14 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
                                             double path_radius, const std::string& body_frame,
                                             const ros::Time& stamp);
 
-/// Plans a scene: via the service (if `client` is valid) or in-process. Fills `msg` and the
-/// planner's solve time [s] and cost; returns false with `error` set if planning failed.
-bool planScene(const PlanningProblem& problem, ros::ServiceClient* client,
-               const std::string& world_frame, const std::string& body_frame, AttitudeManeuver* msg,
-               double* solve_time, double* cost, std::string* error);
+/// Plans a scene: via the service (if `client` is valid; the request carries the scene's
+/// plannable `effects` and actuator limits) or in-process (`problem` already holds them). Fills
+/// `msg` and the planner's solve time [s] and cost; returns false with `error` set if planning
+/// failed.
+bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
+               ros::ServiceClient* client, const std::string& world_frame,
+               const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
+               double* cost, std::string* error);
 
 /// Plans a drift + two-input request: via plan_drift_two_input (if `client` is valid) or
 /// in-process. Fills `msg`, the planner's solve time [s] and cost; false with `error` set if
@@ -103,14 +118,16 @@ class TrackerNode {
     DriftTwoInputManeuver drift_msg;  ///< the drift + two-input maneuver as received
     double plan_solve_time = -1.0;    ///< [s], −1 if unknown
     double plan_cost = -1.0;          ///< [N²·m²], −1 if unknown
+    std::vector<EffectSpec> effects;  ///< effects acting during the replay (rigid body only)
   };
 
   /// `maneuver` callback: replaces the running replay.
   void onManeuver(const AttitudeManeuver::ConstPtr& msg);
   /// `drift_maneuver` callback: replaces the running replay.
   void onDriftManeuver(const DriftTwoInputManeuver::ConstPtr& msg);
-  /// Stops the current replay (if any) and starts a new one in its own thread.
-  void startReplay(const Replay& replay);
+  /// Stops the current replay (if any) and starts a new one in its own thread (under
+  /// ~replay_scene's effects if that is set).
+  void startReplay(Replay replay);
   /// Stops the running replay and joins its thread (within ~10 ms).
   void stopReplay();
   /// The replay thread's body; returns early when stop_ is set.
@@ -140,6 +157,8 @@ class TrackerNode {
   double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
   double path_radius_ = 1.2;                      ///< distance of the traced body-x tip [m]
   bool exit_when_done_ = false;                   ///< shut down after `done`
+  /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
+  std::optional<std::vector<EffectSpec>> replay_scene_effects_;
 
   std::mutex replay_mutex_;        ///< guards replay_thread_ (start/stop from callbacks)
   std::thread replay_thread_;      ///< runs runReplay()

@@ -13,6 +13,24 @@ int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, dou
   return PlanErrorCode::NOT_CONVERGED;
 }
 
+void describeCurrentException(int* error_code, std::string* message) {
+  try {
+    throw;
+  } catch (const InvalidInput& e) {
+    *error_code = PlanErrorCode::INVALID_INPUT;
+    *message = e.what();
+  } catch (const StepTooLarge& e) {
+    *error_code = PlanErrorCode::STEP_TOO_LARGE;
+    *message = e.what();
+  } catch (const std::exception& e) {
+    *error_code = PlanErrorCode::INTERNAL_ERROR;
+    *message = std::string("internal error: ") + e.what();
+  } catch (...) {
+    *error_code = PlanErrorCode::INTERNAL_ERROR;
+    *message = "internal error: unknown exception";
+  }
+}
+
 DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
                                   const ros_conversions::PlannerDefaults& defaults) {
   DriftPlanOutcome out;
@@ -24,18 +42,8 @@ DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
     out.solver_ran = true;
     out.error_code = out.plan.converged ? PlanErrorCode::SUCCESS : PlanErrorCode::NOT_CONVERGED;
     out.message = out.plan.message;
-  } catch (const InvalidInput& e) {
-    out.error_code = PlanErrorCode::INVALID_INPUT;
-    out.message = e.what();
-  } catch (const StepTooLarge& e) {
-    out.error_code = PlanErrorCode::STEP_TOO_LARGE;
-    out.message = e.what();
-  } catch (const std::exception& e) {
-    out.error_code = PlanErrorCode::INTERNAL_ERROR;
-    out.message = std::string("internal error: ") + e.what();
   } catch (...) {
-    out.error_code = PlanErrorCode::INTERNAL_ERROR;
-    out.message = "internal error: unknown exception";
+    describeCurrentException(&out.error_code, &out.message);
   }
   return out;
 }

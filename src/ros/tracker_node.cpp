@@ -345,6 +345,43 @@ bool TrackerNode::sleepUntil(const ros::Time& t) {
   return false;
 }
 
+bool TrackerNode::waitForClock(ros::Time* start) {
+  // use_sim_time: ROS time is zero until the first /clock message.
+  while (ros::Time::now().isZero()) {
+    if (stop_ || !ros::ok()) return false;
+    ros::WallDuration(0.01).sleep();
+  }
+  *start = ros::Time::now() + ros::Duration(start_delay_);
+  return true;
+}
+
+visualization_msgs::Marker TrackerNode::pathMarker() const {
+  visualization_msgs::Marker path;
+  path.header.frame_id = world_frame_;
+  path.ns = "attitude_path";
+  path.id = 0;
+  path.type = visualization_msgs::Marker::LINE_STRIP;
+  path.action = visualization_msgs::Marker::ADD;
+  path.pose.orientation.w = 1.0;
+  path.scale.x = 0.02 * path_radius_;  // line width [m]
+  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  return path;
+}
+
+void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
+                              visualization_msgs::Marker* path) {
+  geometry_msgs::TransformStamped tf;
+  tf.header.stamp = stamp;
+  tf.header.frame_id = world_frame_;
+  tf.child_frame_id = body_frame_;
+  tf.transform.rotation = rc::attitudeToMsg(R);
+  tf_broadcaster_.sendTransform(tf);
+  marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
+  path->header.stamp = stamp;
+  path->points.push_back(point(path_radius_ * R.col(0)));
+  if (path->points.size() >= 2) path_pub_.publish(*path);
+}
+
 void TrackerNode::publishDone(ReplayResult result) {
   result.header.frame_id = world_frame_;
   if (result.header.stamp.isZero()) result.header.stamp = ros::Time::now();
@@ -415,21 +452,9 @@ void TrackerNode::runReplay(Replay replay) {
   }
 
   const PrincipalBox box = principalBox(inertia, body_size_);
-  // Wait for a valid clock (use_sim_time before the first /clock message).
-  while (ros::Time::now().isZero()) {
-    if (stop_ || !ros::ok()) return;
-    ros::WallDuration(0.01).sleep();
-  }
-  const ros::Time start = ros::Time::now() + ros::Duration(start_delay_);
-  visualization_msgs::Marker path;
-  path.header.frame_id = world_frame_;
-  path.ns = "attitude_path";
-  path.id = 0;
-  path.type = visualization_msgs::Marker::LINE_STRIP;
-  path.action = visualization_msgs::Marker::ADD;
-  path.pose.orientation.w = 1.0;
-  path.scale.x = 0.02 * path_radius_;  // line width [m]
-  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  ros::Time start;
+  if (!waitForClock(&start)) return;
+  visualization_msgs::Marker path = pathMarker();
 
   const int N = replayed.steps();
   ROS_INFO("replaying %d steps over %.3f s (rate factor %g)", N, N * replayed.time_step,
@@ -437,13 +462,7 @@ void TrackerNode::runReplay(Replay replay) {
   for (int k = 0; k <= N; ++k) {
     const ros::Time stamp = start + ros::Duration(replayed.time[k] / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    const Matrix3& R = replayed.attitude[k];
-    geometry_msgs::TransformStamped tf;
-    tf.header.stamp = stamp;
-    tf.header.frame_id = world_frame_;
-    tf.child_frame_id = body_frame_;
-    tf.transform.rotation = rc::attitudeToMsg(R);
-    tf_broadcaster_.sendTransform(tf);
+    publishPose(replayed.attitude[k], stamp, box, &path);
 
     geometry_msgs::WrenchStamped wrench;
     wrench.header.stamp = stamp;
@@ -455,11 +474,6 @@ void TrackerNode::runReplay(Replay replay) {
     velocity.header = wrench.header;
     velocity.vector = rc::vectorToMsg(replayed.angular_velocity[k]);
     velocity_pub_.publish(velocity);
-
-    marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
-    path.header.stamp = stamp;
-    path.points.push_back(point(path_radius_ * R.col(0)));
-    if (path.points.size() >= 2) path_pub_.publish(path);
   }
   result.success = true;
   result.message = "replayed " + std::to_string(N) + " steps";
@@ -512,20 +526,9 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
   }
 
   const PrincipalBox box = principalBox(Matrix3::Identity(), body_size_);  // a cube
-  while (ros::Time::now().isZero()) {
-    if (stop_ || !ros::ok()) return;
-    ros::WallDuration(0.01).sleep();
-  }
-  const ros::Time start = ros::Time::now() + ros::Duration(start_delay_);
-  visualization_msgs::Marker path;
-  path.header.frame_id = world_frame_;
-  path.ns = "attitude_path";
-  path.id = 0;
-  path.type = visualization_msgs::Marker::LINE_STRIP;
-  path.action = visualization_msgs::Marker::ADD;
-  path.pose.orientation.w = 1.0;
-  path.scale.x = 0.02 * path_radius_;  // line width [m]
-  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  ros::Time start;
+  if (!waitForClock(&start)) return;
+  visualization_msgs::Marker path = pathMarker();
 
   const int N = static_cast<int>(replayed.size()) - 1;
   const double t0 = plan.t.front();
@@ -534,13 +537,7 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
   for (int k = 0; k <= N; ++k) {
     const ros::Time stamp = start + ros::Duration((plan.t[k] - t0) / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    const Matrix3& g = replayed[k];
-    geometry_msgs::TransformStamped tf;
-    tf.header.stamp = stamp;
-    tf.header.frame_id = world_frame_;
-    tf.child_frame_id = body_frame_;
-    tf.transform.rotation = rc::attitudeToMsg(g);
-    tf_broadcaster_.sendTransform(tf);
+    publishPose(replayed[k], stamp, box, &path);
 
     geometry_msgs::Vector3Stamped control;
     control.header.stamp = stamp;
@@ -552,11 +549,6 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
     velocity.header = control.header;
     velocity.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 1.0));
     velocity_pub_.publish(velocity);
-
-    marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
-    path.header.stamp = stamp;
-    path.points.push_back(point(path_radius_ * g.col(0)));
-    if (path.points.size() >= 2) path_pub_.publish(path);
   }
   result.success = true;
   result.message = "replayed drift maneuver, " + std::to_string(N) + " steps";

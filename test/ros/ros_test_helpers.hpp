@@ -2,13 +2,45 @@
 #pragma once
 
 #include <cmath>
+#include <mutex>
+
+#include <ros/ros.h>
 
 #include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/ReplayResult.h"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/simulation.hpp"
 
 namespace attitude_planner {
 namespace ros_testing {
+
+/// Holds the tracker's latched `done` message once it arrives (callbacks from a spinner thread).
+class DoneListener {
+ public:
+  explicit DoneListener(ros::NodeHandle& nh)
+      : sub_(nh.subscribe("done", 1, &DoneListener::onDone, this)) {}
+  /// Waits up to `seconds` of wall time for `done`; null if none arrived.
+  ReplayResult::ConstPtr wait(double seconds) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::WallTime::now() < deadline) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (done_) return done_;
+      }
+      ros::WallDuration(0.05).sleep();
+    }
+    return nullptr;
+  }
+
+ private:
+  void onDone(const ReplayResult::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = m;
+  }
+  std::mutex mutex_;
+  ReplayResult::ConstPtr done_;
+  ros::Subscriber sub_;  ///< last: unsubscribed before the rest is destroyed
+};
 
 /// Seed 000's inertia J [kg·m²], row-major.
 inline boost::array<double, 9> seedInertia() {

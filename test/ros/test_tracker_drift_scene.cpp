@@ -11,6 +11,7 @@
 
 #include "attitude_planner/ReplayResult.h"
 #include "attitude_planner/ros/conversions.hpp"
+#include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
 namespace rc = attitude_planner::ros_conversions;
@@ -20,13 +21,9 @@ TEST(TrackerDriftScene, FinalTransformIsTheScenesTargetAttitude) {
   tf2_ros::Buffer tf_buffer(ros::Duration(60.0));
   tf2_ros::TransformListener listener(tf_buffer);
   std::mutex mutex;
-  ReplayResult::ConstPtr done;
+  ros_testing::DoneListener listener_done(nh);
   int controls = 0;
   double max_abs_z = 0.0, max_abs_u = 0.0;
-  ros::Subscriber sub = nh.subscribe<ReplayResult>("done", 1, [&](const ReplayResult::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    done = m;
-  });
   ros::Subscriber control_sub = nh.subscribe<geometry_msgs::Vector3Stamped>(
       "control", 2000, [&](const geometry_msgs::Vector3Stamped::ConstPtr& m) {
         std::lock_guard<std::mutex> lock(mutex);
@@ -34,14 +31,7 @@ TEST(TrackerDriftScene, FinalTransformIsTheScenesTargetAttitude) {
         max_abs_z = std::max(max_abs_z, std::abs(m->vector.z));
         max_abs_u = std::max(max_abs_u, std::hypot(m->vector.x, m->vector.y));
       });
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(45.0);
-  while (ros::WallTime::now() < deadline) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (done) break;
-    }
-    ros::WallDuration(0.05).sleep();
-  }
+  const ReplayResult::ConstPtr done = listener_done.wait(45.0);
   ASSERT_TRUE(done) << "no done message";
   ASSERT_TRUE(done->success) << done->message;
   EXPECT_EQ(done->steps, 1000);

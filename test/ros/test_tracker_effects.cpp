@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include <mutex>
 #include <sstream>
 
 #include "attitude_planner/ReplayResult.h"
+#include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
 
@@ -21,20 +21,8 @@ TEST(TrackerEffects, ReplayAppliesTheScenesEffectsAndReportsTheMiss) {
   ASSERT_TRUE(pnh.getParam("expected_effects", expected_effects));
   pnh.getParam("max_miss", max_miss);
   pnh.getParam("min_miss", min_miss);
-  std::mutex mutex;
-  ReplayResult::ConstPtr done;
-  ros::Subscriber sub = nh.subscribe<ReplayResult>("done", 1, [&](const ReplayResult::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    done = m;
-  });
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(90.0);
-  while (ros::WallTime::now() < deadline) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (done) break;
-    }
-    ros::WallDuration(0.05).sleep();
-  }
+  ros_testing::DoneListener listener_done(nh);
+  const ReplayResult::ConstPtr done = listener_done.wait(90.0);
   ASSERT_TRUE(done) << "no done message";
   ASSERT_TRUE(done->success) << done->message;
   std::ostringstream applied;

@@ -5,10 +5,9 @@
 
 #include <tf2_ros/transform_listener.h>
 
-#include <mutex>
-
 #include "attitude_planner/ReplayResult.h"
 #include "attitude_planner/ros/conversions.hpp"
+#include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
 namespace rc = attitude_planner::ros_conversions;
@@ -17,20 +16,8 @@ TEST(TrackerScene, FinalTransformIsTheScenesTargetAttitude) {
   ros::NodeHandle nh;
   tf2_ros::Buffer tf_buffer(ros::Duration(60.0));
   tf2_ros::TransformListener listener(tf_buffer);
-  std::mutex mutex;
-  ReplayResult::ConstPtr done;
-  ros::Subscriber sub = nh.subscribe<ReplayResult>("done", 1, [&](const ReplayResult::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    done = m;
-  });
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(90.0);
-  while (ros::WallTime::now() < deadline) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (done) break;
-    }
-    ros::WallDuration(0.05).sleep();
-  }
+  ros_testing::DoneListener listener_done(nh);
+  const ReplayResult::ConstPtr done = listener_done.wait(90.0);
   ASSERT_TRUE(done) << "no done message";
   ASSERT_TRUE(done->success) << done->message;
   EXPECT_EQ(done->steps, 128);

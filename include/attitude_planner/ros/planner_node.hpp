@@ -61,6 +61,10 @@ template <class Request>
 PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
                         const std::function<bool(const IterationInfo&, double)>& keep_going);
 
+/// The error code and message of the exception being handled (call only inside a catch block):
+/// InvalidInput → INVALID_INPUT, StepTooLarge → STEP_TOO_LARGE, anything else → INTERNAL_ERROR.
+void describeCurrentException(int* error_code, std::string* message);
+
 /// What one plan_drift_two_input request produced, whatever happened.
 struct DriftPlanOutcome {
   int error_code = PlanErrorCode::INTERNAL_ERROR;  ///< a PlanErrorCode constant
@@ -150,18 +154,8 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
                out.message.find("cancel") == std::string::npos) {
       out.message = "cancelled (" + out.message + ")";
     }
-  } catch (const InvalidInput& e) {
-    out.error_code = PlanErrorCode::INVALID_INPUT;
-    out.message = e.what();
-  } catch (const StepTooLarge& e) {
-    out.error_code = PlanErrorCode::STEP_TOO_LARGE;
-    out.message = e.what();
-  } catch (const std::exception& e) {
-    out.error_code = PlanErrorCode::INTERNAL_ERROR;
-    out.message = std::string("internal error: ") + e.what();
   } catch (...) {
-    out.error_code = PlanErrorCode::INTERNAL_ERROR;
-    out.message = "internal error: unknown exception";
+    describeCurrentException(&out.error_code, &out.message);
   }
   return out;
 }

@@ -136,6 +136,14 @@ class TrackerNode {
   void runDriftReplay(const Replay& replay);
   /// Sleeps until ROS time `t` (sim-time friendly); false if stopped meanwhile.
   bool sleepUntil(const ros::Time& t);
+  /// Waits for a valid ROS clock (sim time); sets the replay's start = now + ~start_delay. False
+  /// if stopped meanwhile.
+  bool waitForClock(ros::Time* start);
+  /// The empty `attitude_path` LINE_STRIP.
+  visualization_msgs::Marker pathMarker() const;
+  /// tf world → body, the body markers and the path's next point at `stamp`.
+  void publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
+                   visualization_msgs::Marker* path);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
 

@@ -3,23 +3,36 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <vector>
 
 namespace attitude_planner {
 
-/// Symmetric matrix stored by its lower band (band(i, d) = A(i, i − d), d = 0..bandwidth).
+/// Symmetric matrix stored by its lower band, row by row: row i holds A(i, i − p..i) contiguously
+/// (the Cholesky inner products then run over consecutive memory).
 class BandedSymmetricMatrix {
  public:
   BandedSymmetricMatrix(int n, int bandwidth);
   int size() const { return n_; }
   int bandwidth() const { return p_; }
-  void setZero() { band_.setZero(); }
+  void setZero() { std::fill(data_.begin(), data_.end(), 0.0); }
   /// Adds v to A(i, j) (and so to A(j, i)); |i − j| ≤ bandwidth.
   void add(int i, int j, double v) {
     if (i < j) std::swap(i, j);
-    band_(i, i - j) += v;
+    at(i, j) += v;
   }
-  void addToDiagonal(double v) { band_.col(0).array() += v; }
-  double maxAbsDiagonal() const { return band_.col(0).cwiseAbs().maxCoeff(); }
+  /// Adds the symmetric K×K block M at rows/columns offset..offset+K−1, restricted to the
+  /// block's indices first..last−1 (the others are skipped: fixed variables). Uses M's lower
+  /// triangle; the block must lie within the band.
+  template <int K>
+  void addSymmetricBlock(int offset, const Eigen::Matrix<double, K, K>& M, int first, int last) {
+    for (int r = first; r < last; ++r) {
+      double* row = &at(offset + r, offset);
+      for (int c = first; c <= r; ++c) row[c] += M(r, c);
+    }
+  }
+  void addToDiagonal(double v);
+  double maxAbsDiagonal() const;
   /// A(i, j), for tests and diagnostics.
   double operator()(int i, int j) const;
   /// The full matrix, for tests and diagnostics.
@@ -29,8 +42,10 @@ class BandedSymmetricMatrix {
   bool solvePositiveDefinite(Eigen::VectorXd* b) const;
 
  private:
+  /// A(i, j) for i − p ≤ j ≤ i.
+  double& at(int i, int j) { return data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)]; }
   int n_, p_;
-  Eigen::MatrixXd band_;
+  std::vector<double> data_;
 };
 
 }  // namespace attitude_planner
@@ -44,17 +59,20 @@ class BandedLinearSystem {
  public:
   BandedLinearSystem(int n, int bandwidth);
   int size() const { return n_; }
-  void setZero() { rows_.setZero(); }
+  void setZero() { std::fill(data_.begin(), data_.end(), 0.0); }
   /// Adds v to A(i, j); |i − j| ≤ bandwidth.
-  void add(int i, int j, double v) { rows_(i, j - i + p_) += v; }
+  void add(int i, int j, double v) { at(i, j) += v; }
   /// A(i, j) (0 outside the band), for tests.
   double operator()(int i, int j) const;
   /// Solves A x = b in place (A is overwritten by its factors). Returns false if singular.
   bool solve(Eigen::VectorXd* b);
 
  private:
+  /// Row i holds A(i, i − p..i + 2p) contiguously (the upper 2p: room for pivoting fill-in), so
+  /// eliminations run over consecutive memory.
+  double& at(int i, int j) { return data_[static_cast<size_t>(i) * (3 * p_ + 1) + (j - i + p_)]; }
   int n_, p_;
-  Eigen::MatrixXd rows_;  ///< rows_(i, j − i + p) = A(i, j), j ∈ [i − p, i + 2p] (room for fill-in)
+  std::vector<double> data_;
 };
 
 }  // namespace attitude_planner

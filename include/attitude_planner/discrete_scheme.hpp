@@ -62,6 +62,16 @@ class DiscreteScheme {
   template <typename S>
   so3::Mat3<S> momentumJacobian(const so3::Mat3<S>& F) const;
 
+  /// momentumJacobian(F) of the step F = exp(ω^) given as both (no log map to recover ω).
+  Matrix3 momentumJacobianOfStep(const Matrix3& F, const Vector3& omega) const;
+
+  /// The τ-weighted derivative of the momentum Jacobian of the step F = exp(ω^), in closed form:
+  ///   C(m, e) = Σ_i τ_i ∂D(i, m)/∂ε_e,  D = momentumJacobian(F exp(ε^)) at ε = 0,
+  /// i.e. the mixed second derivative ∂²/∂ε_e∂η_m of τᵀμ(F exp(ε^) exp(η^)). The Newton solver's
+  /// exact Hessian is built from it (derivation in discrete_scheme.cpp).
+  Matrix3 momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
+                                      const Vector3& tau) const;
+
   /// Body angular velocity [rad/s] reported for a step: paper log(F)/h (constant over the step),
   /// variational J⁻¹ μ(F) (nodal velocity at the step's start).
   Vector3 velocity(const Matrix3& F) const;
@@ -77,6 +87,10 @@ class DiscreteScheme {
   Matrix3 solveStep(const Vector3& p, const Matrix3& guess, StepSolveReport* report) const;
 
  private:
+  /// The paper scheme's dμ/dε at F = exp(w^).
+  template <typename S>
+  so3::Mat3<S> paperMomentumJacobian(const so3::Mat3<S>& F, const so3::Vec3<S>& w) const;
+
   SchemeKind kind_;
   Matrix3 J_;
   Matrix3 J_inverse_;
@@ -99,14 +113,17 @@ so3::Vec3<S> DiscreteScheme::momentum(const so3::Mat3<S>& F) const {
 }
 
 template <typename S>
-so3::Mat3<S> DiscreteScheme::momentumJacobian(const so3::Mat3<S>& F) const {
+so3::Mat3<S> DiscreteScheme::paperMomentumJacobian(const so3::Mat3<S>& F,
+                                                   const so3::Vec3<S>& w) const {
+  // μ = F J ω/h, ω = log F:  δμ = F (J Jr⁻¹(ω) − (Jω)^) ε / h
   const so3::Mat3<S> J = J_.template cast<S>();
-  if (kind_ == SchemeKind::Paper) {
-    // μ = F J ω/h, ω = log F:  δμ = F (J Jr⁻¹(ω) − (Jω)^) ε / h
-    const so3::Vec3<S> w = so3::log<S>(F);
-    const so3::Vec3<S> Jw = J * w;
-    return F * (J * so3::rightJacobianInverse<S>(w) - so3::hat<S>(Jw)) / S(h_);
-  }
+  const so3::Vec3<S> Jw = J * w;
+  return F * (J * so3::rightJacobianInverse<S>(w) - so3::hat<S>(Jw)) / S(h_);
+}
+
+template <typename S>
+so3::Mat3<S> DiscreteScheme::momentumJacobian(const so3::Mat3<S>& F) const {
+  if (kind_ == SchemeKind::Paper) return paperMomentumJacobian<S>(F, so3::log<S>(F));
   // μ = (F J_d − J_d Fᵀ)^∨/h:  δμ = (F ε^ J_d + J_d ε^ Fᵀ)^∨/h, column by column
   const so3::Mat3<S> Jd = Jd_.template cast<S>();
   so3::Mat3<S> D;

@@ -63,9 +63,10 @@ struct IterationInfo {
 struct SolverOptions {
   std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
   double tolerance = 1e-10;       ///< relative torque accuracy (Newton decrement / |τ|₂)
-  int max_iterations = 200;
-  double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
-  /// Called after every iteration; return false to cancel (the result says "cancelled").
+  int max_iterations = 200;       ///< Newton: per grid level (coarse levels start the fine one)
+  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  /// Called after every iteration, numbered across grid levels (the first ones may run on
+  /// coarser grids); return false to cancel (the result says "cancelled").
   std::function<bool(const IterationInfo&)> on_iteration;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
   const Maneuver* warm_start = nullptr;
@@ -74,12 +75,13 @@ struct SolverOptions {
 /// What a solve returns. `converged` is false with a reason in `message` otherwise.
 struct PlanResult {
   bool converged = false;
-  std::string message;  ///< human-readable outcome ("converged", or why not)
-  std::string solver;   ///< "newton" or "nlopt"
+  bool cancelled = false;  ///< the on_iteration callback asked to stop
+  std::string message;     ///< human-readable outcome ("converged", or why not)
+  std::string solver;      ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;  ///< R_k, Ω_k, τ_k, k = 0..N
-  double cost = 0.0;  ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
-  int iterations = 0;
+  Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  int iterations = 0;  ///< Newton iterations, coarser continuation levels included
   /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
   double max_residual = 0.0;
   /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the

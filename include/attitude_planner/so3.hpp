@@ -197,22 +197,29 @@ Mat3<S> rightJacobian(const Vec3<S>& w) {
 }
 
 /// Inverse right Jacobian: log(exp(w) exp(δ)) = w + Jr⁻¹(w) δ + O(δ²). Singular at |w| = 2π.
+/// The coefficient c(θ²) of Jr⁻¹(w) = I + ½ w^ + c w^², θ² = |w|².
 template <typename S>
-Mat3<S> rightJacobianInverse(const Vec3<S>& w) {
+S rightJacobianInverseCoefficient(const S& theta2) {
   using std::cos;
   using std::sin;
   using std::sqrt;
-  const S theta2 = w.squaredNorm();
-  S c;  // Jr⁻¹ = I + ½ w^ + c w^²
   if (theta2 < S(kSmallAngle * kSmallAngle)) {
-    c = S(1.0 / 12.0) + theta2 / S(720) + theta2 * theta2 / S(30240);
-  } else {
-    const S half = sqrt(theta2) / S(2);
-    // (1 − θ sin θ / (2(1 − cos θ)))/θ² = (1 − (θ/2) cot(θ/2))/θ²: no 1 − cos θ to cancel
-    c = (S(1) - half * cos(half) / sin(half)) / theta2;
+    return S(1.0 / 12.0) + theta2 / S(720) + theta2 * theta2 / S(30240);
   }
+  const S half = sqrt(theta2) / S(2);
+  // (1 − θ sin θ / (2(1 − cos θ)))/θ² = (1 − (θ/2) cot(θ/2))/θ²: no 1 − cos θ to cancel
+  return (S(1) - half * cos(half) / sin(half)) / theta2;
+}
+
+/// dc/d(θ²) of rightJacobianInverseCoefficient (for exact second derivatives of the log map):
+/// series Σ_{n≥2} (n−1)|B_2n| θ^(2n−4)/(2n)! below θ = 0.1, where the closed form cancels.
+double rightJacobianInverseCoefficientDerivative(double theta2);
+
+template <typename S>
+Mat3<S> rightJacobianInverse(const Vec3<S>& w) {
   const Mat3<S> W = hat(w);
-  return Mat3<S>::Identity() + S(0.5) * W + c * (W * W);
+  return Mat3<S>::Identity() + S(0.5) * W +
+         rightJacobianInverseCoefficient<S>(w.squaredNorm()) * (W * W);
 }
 
 /// Left Jacobian: Jl(w) = Jr(−w) = exp(w) Jr(w).

@@ -6,11 +6,22 @@
 namespace attitude_planner {
 
 BandedSymmetricMatrix::BandedSymmetricMatrix(int n, int bandwidth)
-    : n_(n), p_(bandwidth), band_(Eigen::MatrixXd::Zero(n, bandwidth + 1)) {}
+    : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (bandwidth + 1), 0.0) {}
+
+void BandedSymmetricMatrix::addToDiagonal(double v) {
+  for (int i = 0; i < n_; ++i) at(i, i) += v;
+}
+
+double BandedSymmetricMatrix::maxAbsDiagonal() const {
+  double m = 0.0;
+  for (int i = 0; i < n_; ++i)
+    m = std::max(m, std::abs(data_[static_cast<size_t>(i) * (p_ + 1) + p_]));
+  return m;
+}
 
 double BandedSymmetricMatrix::operator()(int i, int j) const {
   if (i < j) std::swap(i, j);
-  return i - j <= p_ ? band_(i, i - j) : 0.0;
+  return i - j <= p_ ? data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)] : 0.0;
 }
 
 Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
@@ -22,29 +33,39 @@ Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
 }
 
 bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
-  Eigen::MatrixXd L = band_;  // L(i, d) = L_{i, i−d}
-  for (int j = 0; j < n_; ++j) {
-    double d = L(j, 0);
-    for (int k = std::max(0, j - p_); k < j; ++k) d -= L(j, j - k) * L(j, j - k);
-    if (!(d > 0.0) || !std::isfinite(d)) return false;
-    const double ljj = std::sqrt(d);
-    L(j, 0) = ljj;
-    for (int i = j + 1; i <= std::min(n_ - 1, j + p_); ++i) {
-      double s = L(i, i - j);
-      for (int k = std::max(0, i - p_); k < j; ++k) s -= L(i, i - k) * L(j, j - k);
-      L(i, i - j) = s / ljj;
+  // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
+  // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
+  const int w = p_ + 1;
+  std::vector<double> L = data_;
+  const auto row = [&](int i) {
+    return L.data() + static_cast<size_t>(i) * w + p_ - i;
+  };  // row(i)[j] = L(i, j)
+  for (int i = 0; i < n_; ++i) {
+    double* li = row(i);
+    const int first = std::max(0, i - p_);
+    for (int j = first; j <= i; ++j) {
+      const double* lj = row(j);
+      double s = li[j];
+      for (int k = std::max(first, j - p_); k < j; ++k) s -= li[k] * lj[k];
+      if (j < i) {
+        li[j] = s / lj[j];
+      } else {
+        if (!(s > 0.0) || !std::isfinite(s)) return false;
+        li[i] = std::sqrt(s);
+      }
     }
   }
   Eigen::VectorXd& y = *b;
   for (int i = 0; i < n_; ++i) {  // L y = b
+    const double* li = row(i);
     double s = y(i);
-    for (int k = std::max(0, i - p_); k < i; ++k) s -= L(i, i - k) * y(k);
-    y(i) = s / L(i, 0);
+    for (int k = std::max(0, i - p_); k < i; ++k) s -= li[k] * y(k);
+    y(i) = s / li[i];
   }
   for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
     double s = y(i);
-    for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= L(k, k - i) * y(k);
-    y(i) = s / L(i, 0);
+    for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y(k);
+    y(i) = s / row(i)[i];
   }
   return true;
 }
@@ -54,41 +75,48 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
 namespace attitude_planner {
 
 BandedLinearSystem::BandedLinearSystem(int n, int bandwidth)
-    : n_(n), p_(bandwidth), rows_(Eigen::MatrixXd::Zero(n, 3 * bandwidth + 1)) {}
+    : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (3 * bandwidth + 1), 0.0) {}
 
 double BandedLinearSystem::operator()(int i, int j) const {
   const int offset = j - i + p_;
-  return offset >= 0 && offset <= 3 * p_ ? rows_(i, offset) : 0.0;
+  return offset >= 0 && offset <= 3 * p_ ? data_[static_cast<size_t>(i) * (3 * p_ + 1) + offset]
+                                         : 0.0;
 }
 
 bool BandedLinearSystem::solve(Eigen::VectorXd* b_in) {
   Eigen::VectorXd& b = *b_in;
-  auto at = [&](int i, int j) -> double& { return rows_(i, j - i + p_); };
+  const size_t w = 3 * p_ + 1;
+  // row(i)[j] = A(i, j) for i − p ≤ j ≤ i + 2p.
+  const auto row = [&](int i) { return data_.data() + i * w + p_ - i; };
   for (int k = 0; k < n_; ++k) {
     const int last_row = std::min(n_ - 1, k + p_);
     const int last_col = std::min(n_ - 1, k + 2 * p_);
     int pivot = k;
     for (int i = k + 1; i <= last_row; ++i) {
-      if (std::abs(at(i, k)) > std::abs(at(pivot, k))) pivot = i;
+      if (std::abs(row(i)[k]) > std::abs(row(pivot)[k])) pivot = i;
     }
-    if (!(std::abs(at(pivot, k)) > 0.0) || !std::isfinite(at(pivot, k))) return false;
+    double* rk = row(k);
+    if (!(std::abs(row(pivot)[k]) > 0.0) || !std::isfinite(row(pivot)[k])) return false;
     if (pivot != k) {
-      for (int j = k; j <= last_col; ++j) std::swap(at(k, j), at(pivot, j));
+      double* rp = row(pivot);
+      for (int j = k; j <= last_col; ++j) std::swap(rk[j], rp[j]);
       std::swap(b(k), b(pivot));
     }
-    const double inverse_pivot = 1.0 / at(k, k);
+    const double inverse_pivot = 1.0 / rk[k];
     for (int i = k + 1; i <= last_row; ++i) {
-      const double l = at(i, k) * inverse_pivot;
+      double* ri = row(i);
+      const double l = ri[k] * inverse_pivot;
       if (l == 0.0) continue;
-      at(i, k) = 0.0;
-      for (int j = k + 1; j <= last_col; ++j) at(i, j) -= l * at(k, j);
+      ri[k] = 0.0;
+      for (int j = k + 1; j <= last_col; ++j) ri[j] -= l * rk[j];
       b(i) -= l * b(k);
     }
   }
   for (int i = n_ - 1; i >= 0; --i) {
+    const double* ri = row(i);
     double s = b(i);
-    for (int j = i + 1; j <= std::min(n_ - 1, i + 2 * p_); ++j) s -= at(i, j) * b(j);
-    b(i) = s / at(i, i);
+    for (int j = i + 1; j <= std::min(n_ - 1, i + 2 * p_); ++j) s -= ri[j] * b(j);
+    b(i) = s / ri[i];
   }
   return b.allFinite();
 }

@@ -31,6 +31,43 @@ Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega) const {
   return Vector3(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / h_;
 }
 
+Matrix3 DiscreteScheme::momentumJacobianOfStep(const Matrix3& F, const Vector3& omega) const {
+  return kind_ == SchemeKind::Paper ? paperMomentumJacobian<double>(F, omega)
+                                    : momentumJacobian<double>(F);
+}
+
+Matrix3 DiscreteScheme::momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
+                                                    const Vector3& tau) const {
+  using so3::hat;
+  if (kind_ == SchemeKind::Variational) {
+    // The bilinear part of h μ(F e^ε e^η) is (A − Aᵀ)^∨, A = F ε^ η^ J_d, and
+    // τ·(A − Aᵀ)^∨ = −tr(P ε^ η^) = εᵀ(tr(P) I − P)η with P = J_d τ^ F.
+    const Matrix3 P = Jd_ * hat<double>(tau) * F / h_;
+    const Matrix3 K = P.trace() * Matrix3::Identity() - P;
+    return K.transpose();
+  }
+  // h μ(F e^ε e^η) = F e^ε e^η J ω(ε, η), ω = log(F e^ε e^η) with ∂ω/∂η = Jr⁻¹(ω(ε)) and
+  // ∂ω/∂ε = Jr⁻¹(ω) at 0. Its mixed second derivative, weighted by τ (a = Fᵀτ):
+  //   aᵀ ε^ η^ Jω + aᵀ ε^ J Jr⁻¹ η + aᵀ η^ J Jr⁻¹ ε + (Ja)ᵀ dJr⁻¹(ω)[Jr⁻¹ε] η,
+  // and with Jr⁻¹(ω) = I + ½ω^ + c(|ω|²) ω^², for q = Ja and u = Jr⁻¹ε:
+  //   qᵀ dJr⁻¹[u] η = uᵀ(−½ q^ + 2c' ω (ω^² q)ᵀ − c q^ ω^ − c (q × ω)^) η.
+  const Vector3& w = omega;
+  const double theta2 = w.squaredNorm();
+  const double c = so3::rightJacobianInverseCoefficient<double>(theta2);
+  const double dc = so3::rightJacobianInverseCoefficientDerivative(theta2);
+  const Matrix3 W = hat<double>(w);
+  const Matrix3 Jr_inverse = Matrix3::Identity() + 0.5 * W + c * (W * W);
+  const Vector3 a = F.transpose() * tau;
+  const Vector3 q = J_ * a;
+  const Matrix3 A = hat<double>(a);
+  const Matrix3 M = J_ * Jr_inverse;
+  const Matrix3 B = -0.5 * hat<double>(q) + 2 * dc * w * (W * (W * q)).transpose() -
+                    c * hat<double>(q) * W - c * hat<double>(Vector3(q.cross(w)));
+  const Matrix3 K =
+      A * hat<double>(Vector3(J_ * w)) - A * M + M.transpose() * A + Jr_inverse.transpose() * B;
+  return K.transpose() / h_;
+}
+
 Vector3 DiscreteScheme::velocity(const Matrix3& F) const {
   if (kind_ == SchemeKind::Paper) return so3::log(F) / h_;
   return J_inverse_ * momentum<double>(F);
@@ -82,9 +119,11 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
       ++polish_steps;
     }
     const Matrix3 D = momentumJacobian<double>(F);
-    Eigen::FullPivLU<Matrix3> lu(D);
-    if (!lu.isInvertible()) break;
-    const Vector3 delta = -lu.solve(r);
+    // 3×3 cofactor inverse (a Newton step corrects its own round-off); singular relative to
+    // D's scale means no step can be found from here.
+    const double scale = D.cwiseAbs().maxCoeff();
+    if (!(std::abs(D.determinant()) > 1e-13 * scale * scale * scale)) break;
+    const Vector3 delta = -(D.inverse() * r);
     if (!delta.allFinite()) break;
     // Backtracking on |μ(F) − p| keeps the iteration inside the region where a solution exists.
     double step = 1.0;

@@ -16,6 +16,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 
 #include "attitude_planner/errors.hpp"
@@ -33,19 +34,29 @@ constexpr int kNormalEquationsMaxSteps = 256;
 
 /// A solve stalled at round-off counts as converged if its relative torque accuracy (Newton
 /// decrement / |τ|₂) is at least this good; the message then states the accuracy reached.
-constexpr double kRoundOffAcceptance = 1e-6;
+/// The floor itself grows like eps·N² (torques are second differences of the attitudes; measured
+/// decrements at the floor: 5e-9 at N = 10⁴, 4e-7 at 10⁵, 1e-5..1e-4 at 10⁶), so above
+/// N ≈ 700 the acceptance follows it instead of iterating on noise.
+double roundOffAcceptance(int steps) {
+  return std::max(1e-6, std::numeric_limits<double>::epsilon() * double(steps) * steps);
+}
 
 /// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
 ///   [ −α I   J        ] [ z ]   [ −τ ]
 ///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
 /// ordered y_1, y_2, δ_2, y_3, δ_3, …, y_{N−1} so it is banded (half bandwidth 14), and solved
-/// by LU with partial pivoting. `delta` holds −g on entry and δ on return.
-bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta) {
+/// by LU with partial pivoting. `delta` holds −g on entry and δ on return. `K` is the caller's
+/// workspace (allocated once per solve: at N = 10⁶ it is 2 GB, and fresh pages cost more
+/// system time than the factorization).
+bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta,
+                    std::unique_ptr<BandedLinearSystem>* workspace) {
   const int N = np.steps();
   const auto y_block = [&](int k) { return k == 1 ? 0 : 2 * k - 3; };
   const auto d_block = [&](int j) { return 2 * j - 2; };  // j = 2..N−2
   const int n = 3 * (2 * N - 4);
-  BandedLinearSystem K(n, 14);
+  if (!*workspace) workspace->reset(new BandedLinearSystem(n, 14));
+  BandedLinearSystem& K = **workspace;
+  K.setZero();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
   // α ≈ σ_min(J) keeps cond(K) ≈ cond(J) (Björck; α ≈ σ_max would give cond(J)², no better
   // than the normal equations). The smoothest attitude mode δ(t) = sin(πt/T) v has
@@ -162,7 +173,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
   const int N = np.steps();
   const int n = 3 * (N - 3);
+  const double round_off_acceptance = roundOffAcceptance(N);
   BandedSymmetricMatrix hessian(n, 8);
+  std::unique_ptr<BandedLinearSystem> augmented_workspace;
   Eigen::VectorXd gradient(n), delta(n);
   double gradient_scale = 0.0;
   double relative_gradient = 0.0;
@@ -199,7 +212,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     for (int attempt = 0; attempt < 40; ++attempt) {
       delta = -gradient;
       if (augmented) {
-        factored = solveAugmented(np, shift, &delta) && gradient.dot(delta) < 0;
+        factored =
+            solveAugmented(np, shift, &delta, &augmented_workspace) && gradient.dot(delta) < 0;
       } else {
         BandedSymmetricMatrix trial = hessian;
         if (shift > 0) trial.addToDiagonal(shift * hessian.maxAbsDiagonal());
@@ -221,9 +235,13 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
     const bool final_step = shift == 0.0 && relative_decrement <= options.tolerance;
     // Armijo backtracking on the cost along the retraction. Once the predicted decrease is below
-    // the cost's round-off the test is meaningless and the full Newton step is taken.
+    // the cost's round-off the test is meaningless and the full Newton step is taken: that is
+    // when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the round-off acceptance
+    // relative (predicted decrease ≤ 1e-12 C) — at large N the cost's own round-off (torques are
+    // second differences: relative error ~eps·N²) exceeds that, and Armijo would fail on noise.
     double alpha = 1.0;
-    bool accepted = final_step || -slope <= 1e-13 * cost;
+    bool accepted =
+        final_step || -slope <= 1e-13 * cost || relative_decrement <= round_off_acceptance;
     ReducedProblem::Steps trial_R = np.retract(delta, alpha);
     for (int back = 0; !accepted && back < 50; ++back) {
       const double trial_cost = np.cost(trial_R);
@@ -248,10 +266,10 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       damping = shift / 100.0 < 1e-14 ? 0.0 : shift / 100.0;
     }
     // Round-off floor: once the decrement is small, full Newton steps that no longer halve it for
-    // three iterations mean the gradient is noise (the Hessian's condition grows like N⁴). Stop
-    // there; the achieved relative accuracy is the decrement (≤ kRoundOffAcceptance). A large
+    // two iterations mean the gradient is noise (the Hessian's condition grows like N⁴). Stop
+    // there; the achieved relative accuracy is the decrement (≤ round_off_acceptance). A large
     // decrement that stagnates is not round-off: the iteration goes on.
-    if (alpha == 1.0 && relative_decrement <= kRoundOffAcceptance &&
+    if (alpha == 1.0 && relative_decrement <= round_off_acceptance &&
         relative_decrement > 0.5 * best_decrement) {
       ++stalled_iterations;
     } else {
@@ -259,7 +277,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     }
     best_decrement = std::min(best_decrement, relative_decrement);
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
-    if (stalled_iterations >= 3) {
+    if (stalled_iterations >= 2) {
       result.history.push_back(info);
       ++iteration;
       converged = true;
@@ -278,6 +296,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       break;
     }
     if (options.on_iteration && !options.on_iteration(info)) {
+      result.cancelled = true;
       reason = "cancelled";
       ++iteration;
       break;
@@ -322,7 +341,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 /// and the resampled solution starts the fine solve. From the geodesic guess, long horizons
 /// wander through regions where the Hessian is indefinite; from the coarse solution every level
 /// starts in the convex basin and takes a few Newton steps.
-constexpr int kCoarsestGrid = 256;
+constexpr int kCoarsestGrid = 16;
 
 /// What is left of the options' time budget after `start` [s] (0 budget: unlimited, returned as 0).
 double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
@@ -339,10 +358,26 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
   SolverOptions coarse_options = options;
   // The callback is forwarded (feedback from every level, and cancel works during all of them).
-  coarse_options.tolerance = std::max(options.tolerance, 1e-8);
+  // A coarse level only starts the next one, whose own O(h²) difference from it is far larger.
+  coarse_options.tolerance = std::max(options.tolerance, 1e-6);
   const PlanResult coarse_result = solveWithContinuation(coarse, coarse_options);
   SolverOptions fine_options = options;
   Maneuver guess;
+  // Stopped on a coarse level (cancel, time budget): answer on the requested grid anyway, with
+  // the coarse iterate resampled and replayed (no iteration on this grid).
+  const auto stopped = [&](const std::string& why) {
+    guess.attitude = resampleAttitudes(coarse_result.maneuver, problem.steps);
+    fine_options.warm_start = &guess;
+    fine_options.max_iterations = 0;
+    PlanResult out = solveOnGrid(problem, fine_options);
+    out.converged = false;
+    out.cancelled = coarse_result.cancelled;
+    out.iterations = coarse_result.iterations;
+    out.message = why + " on the N = " + std::to_string(coarse.steps) + " level (" +
+                  coarse_result.message + ")";
+    return out;
+  };
+  if (coarse_result.cancelled) return stopped("cancelled");
   std::string level;
   if (coarse_result.converged) {
     guess.attitude = resampleAttitudes(coarse_result.maneuver, problem.steps);
@@ -355,12 +390,19 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   }
   fine_options.time_budget_s = remainingBudget(options, start);
   if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
-    PlanResult out = coarse_result;
-    out.converged = false;
-    out.message = "time budget exceeded on the coarse levels" + level;
-    return out;
+    return stopped("time budget exceeded");
+  }
+  // Iterations are numbered across levels, so progress reports keep increasing.
+  const int before = coarse_result.iterations;
+  if (options.on_iteration) {
+    fine_options.on_iteration = [&options, before](const IterationInfo& info) {
+      IterationInfo global = info;
+      global.iteration += before;
+      return options.on_iteration(global);
+    };
   }
   PlanResult result = solveOnGrid(problem, fine_options);
+  result.iterations += before;
   result.message += level;
   return result;
 }

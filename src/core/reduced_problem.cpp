@@ -1,59 +1,50 @@
 #include "attitude_planner/reduced_problem.hpp"
 
-#include <optional>
-
-#include "attitude_planner/dual.hpp"
 #include "attitude_planner/errors.hpp"
 
 namespace attitude_planner {
 
 namespace {
 
-using Dual3 = Dual<3>;
-
 /// What one step F_j contributes to the torques next to it, and to their Jacobians
 /// (right perturbation F exp(ε^); D = dμ/dε, G = Fᵀμ, dG = dG/dε = (Fᵀμ)^ + FᵀD):
 ///   τ_k = (μ_k − G_{k−1})/h
 ///   ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1}) = [dG_{k−1}F_{k−1}ᵀ, −(D_k F_kᵀ + dG_{k−1}), D_k] / h,
 /// from F_{k−1} → F_{k−1} exp(δ_k − F_{k−1}ᵀ δ_{k−1}) and F_k → F_k exp(δ_{k+1} − F_kᵀ δ_k).
-template <typename S>
 struct StepTerms {
-  so3::Vec3<S> mu, G;
-  so3::Mat3<S> D, dG, DFt, dGFt;
+  Vector3 omega;  ///< ω = log F, as stored: no log map to recover it
+  Matrix3 F;
+  Vector3 mu, G;
+  Matrix3 D, dG, DFt, dGFt;
 
-  StepTerms(const DiscreteScheme& scheme, const so3::Mat3<S>& F) {
-    mu = scheme.momentum<S>(F);
+  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in)
+      : omega(omega_in), F(so3::exp(omega_in)) {
+    mu = scheme.momentumOfStep(omega);
     G = F.transpose() * mu;
-    D = scheme.momentumJacobian<S>(F);
-    dG = so3::hat<S>(G) + F.transpose() * D;
+    D = scheme.momentumJacobianOfStep(F, omega);
+    dG = so3::hat<double>(G) + F.transpose() * D;
     DFt = D * F.transpose();
     dGFt = dG * F.transpose();
   }
+
+  /// τ-weighted derivatives C_X(m, e) = Σ_i τ_i ∂X(i, m)/∂ε_e of this step's Jacobian blocks
+  /// X = D, D Fᵀ, dG, dG Fᵀ, all from the scheme's C_D by the product rule with
+  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^.
+  Matrix3 contractD(const DiscreteScheme& scheme, const Vector3& tau) const {
+    return scheme.momentumJacobianContraction(F, omega, tau);
+  }
+  Matrix3 contractDFt(const Matrix3& C_D, const Vector3& tau) const {
+    return F * (C_D - so3::hat<double>(Vector3(D.transpose() * tau)));
+  }
+  Matrix3 contractdG(const DiscreteScheme& scheme, const Vector3& tau) const {
+    const Matrix3 tau_hat = so3::hat<double>(tau);
+    return tau_hat * dG + scheme.momentumJacobianContraction(F, omega, Vector3(F * tau)) -
+           D.transpose() * F * tau_hat;
+  }
+  Matrix3 contractdGFt(const Matrix3& C_dG, const Vector3& tau) const {
+    return F * (C_dG - so3::hat<double>(Vector3(dG.transpose() * tau)));
+  }
 };
-
-/// F exp(ε^) to first order in a dual ε (value 0, unit derivatives): F + Σ_e ε_e F ê_e^.
-so3::Mat3<Dual3> perturbed(const Matrix3& F) {
-  so3::Mat3<Dual3> Fd;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) Fd(r, c) = Dual3(F(r, c));
-  }
-  for (int e = 0; e < 3; ++e) {
-    const Matrix3 dF = F * so3::hat(Vector3(Vector3::Unit(e)));
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) Fd(r, c).d(e) = dF(r, c);
-    }
-  }
-  return Fd;
-}
-
-/// T(m, e) = Σ_i τ_i ∂X(i, m)/∂ε_e: the τ-weighted derivative of a Jacobian block.
-Matrix3 contract(const so3::Mat3<Dual3>& X, const Vector3& tau) {
-  Matrix3 T = Matrix3::Zero();
-  for (int i = 0; i < 3; ++i) {
-    for (int m = 0; m < 3; ++m) T.row(m) += tau(i) * X(i, m).d.transpose();
-  }
-  return T;
-}
 
 }  // namespace
 
@@ -171,18 +162,15 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   const std::vector<Vector3> tau = torques(steps_);
   double cost = 0.0;
   // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  const auto F_of = [&](int j) { return so3::exp(steps_[j]); };
-  std::optional<StepTerms<Dual3>> prev_d;  // derivatives only for the second-order term
-  if (with_second_order) prev_d.emplace(scheme_, perturbed(F_of(0)));
-  Matrix3 F_prev = F_of(0);
-  StepTerms<double> prev(scheme_, F_prev);
+  StepTerms prev(scheme_, steps_[0]);
   Stencil st;
   st.second.setZero();
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
-    const Matrix3 F = F_of(k);
+    StepTerms next(scheme_, steps_[k]);
+    const Matrix3& F = next.F;
+    const Matrix3& F_prev = prev.F;
     if (effects_) R = R * F_prev;
-    StepTerms<double> next(scheme_, F);
     st.k = k;
     st.tau = tau[k];
     st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
@@ -192,13 +180,14 @@ double ReducedProblem::forEachStencil(bool with_second_order,
     if (effects_) st.jacobian.block<3, 3>(0, 3) -= effects_->jacobian(R, k * h);
     cost += 0.5 * st.tau.squaredNorm();
     if (with_second_order) {
-      StepTerms<Dual3> next_d(scheme_, perturbed(F));
       // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
       Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
-      const Matrix3 T_dGFt_prev = contract(prev_d->dGFt, st.tau) / h;  // block a, via ε_{k−1}
-      const Matrix3 T_dG_prev = -contract(prev_d->dG, st.tau) / h;     // block b, via ε_{k−1}
-      const Matrix3 T_DFt = -contract(next_d.DFt, st.tau) / h;         // block b, via ε_k
-      const Matrix3 T_D = contract(next_d.D, st.tau) / h;              // block c, via ε_k
+      const Matrix3 C_dG_prev = prev.contractdG(scheme_, st.tau);
+      const Matrix3 C_D = next.contractD(scheme_, st.tau);
+      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, st.tau) / h;  // block a, via ε_{k−1}
+      const Matrix3 T_dG_prev = -C_dG_prev / h;                  // block b, via ε_{k−1}
+      const Matrix3 T_DFt = -next.contractDFt(C_D, st.tau) / h;  // block b, via ε_k
+      const Matrix3 T_D = C_D / h;                               // block c, via ε_k
       second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
       second.block<3, 3>(0, 3) = T_dGFt_prev;
       second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
@@ -211,11 +200,9 @@ double ReducedProblem::forEachStencil(bool with_second_order,
       st.second = 0.5 * (second + second.transpose());
       if (effects_)
         st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, st.tau);
-      prev_d.emplace(next_d);
     }
     visit(st);
     prev = next;
-    F_prev = F;
   }
   return cost;
 }
@@ -236,19 +223,10 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
     if (!hessian) return;
     const Eigen::Matrix<double, 9, 9> block =
         st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
-    for (int s = 0; s < 3; ++s) {
-      const int vs = variableIndex(st.k - 1 + s);
-      if (vs < 0) continue;
-      for (int t = 0; t <= s; ++t) {
-        const int vt = variableIndex(st.k - 1 + t);
-        if (vt < 0) continue;
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < (s == t ? i + 1 : 3); ++j) {
-            hessian->add(vs + i, vt + j, block(3 * s + i, 3 * t + j));
-          }
-        }
-      }
-    }
+    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (first at 3(k − 3)); the
+    // fixed ones among them (R_1, R_{N−1}) are cut off the block.
+    const int first_free = std::max(0, 3 - st.k), last_free = std::min(2, N_ - 1 - st.k);
+    hessian->addSymmetricBlock<9>(3 * (st.k - 3), block, 3 * first_free, 3 * (last_free + 1));
   });
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;

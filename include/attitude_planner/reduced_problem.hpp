@@ -59,6 +59,13 @@ class ReducedProblem {
   void initializeHermite(const Vector3& span, const Vector3& start_slope, const Vector3& end_slope);
   /// Interior from the attitudes of a maneuver with the same N (a warm start).
   void setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes);
+  /// Interior from the steps of this problem's solution on a coarser grid (grid continuation):
+  /// the coarse rates ω^c_k/h_c, interpolated in time by a C¹ cubic, times h; then a smooth
+  /// R_j → R_j exp(φ_j^) closes the small gap left at R_{N−1}. Composed in quaternions, so small
+  /// steps keep their relative precision. Its torques differ from the fine solution's by about
+  /// the coarse solution's own discretization error (resampling attitudes instead left O(1)
+  /// torque jumps at the coarse nodes and the ends).
+  void initializeFromCoarser(const Steps& coarse);
 
   /// R_0..R_N of the steps (products from R_0).
   std::vector<Matrix3> attitudes(const Steps& steps) const;

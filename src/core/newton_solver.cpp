@@ -41,6 +41,14 @@ double roundOffAcceptance(int steps) {
   return std::max(1e-6, std::numeric_limits<double>::epsilon() * double(steps) * steps);
 }
 
+/// Below this relative decrement no iteration can improve the torques at N steps (the floor
+/// above is 0.1–0.5 eps·N²): the step is taken as a final one, as at the tolerance, instead of
+/// iterating until the stall is seen (two more iterations, each O(N), at N = 10⁶ seconds).
+/// Below N ≈ 700 it is under the default tolerance and changes nothing.
+double roundOffFloor(int steps) {
+  return 0.5 * std::numeric_limits<double>::epsilon() * double(steps) * steps;
+}
+
 /// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
 ///   [ −α I   J        ] [ z ]   [ −τ ]
 ///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
@@ -149,7 +157,12 @@ std::vector<InitialGuess> initialGuesses(const PlanningProblem& problem, const R
   return out;
 }
 
-PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options) {
+/// Newton on one grid. Starts from `coarse_steps` (a coarser grid's final iterate) if given, else
+/// from options.warm_start, else from the Hermite guess; leaves its final iterate in
+/// `final_steps` if given (the next finer grid starts from it).
+PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                       const ReducedProblem::Steps* coarse_steps = nullptr,
+                       ReducedProblem::Steps* final_steps = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -171,6 +184,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   np.initializeHermite(guess.lift, T_inner * problem.initial_velocity,
                        T_inner * (so3::exp(guess.lift) * problem.final_velocity));
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
+  if (coarse_steps) np.initializeFromCoarser(*coarse_steps);
   const int N = np.steps();
   const int n = 3 * (N - 3);
   const double round_off_acceptance = roundOffAcceptance(N);
@@ -233,7 +247,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // conditioning grows like N⁴.
     const double slope = gradient.dot(delta);
     relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
-    const bool final_step = shift == 0.0 && relative_decrement <= options.tolerance;
+    const bool final_step =
+        shift == 0.0 && relative_decrement <= std::max(options.tolerance, roundOffFloor(N));
     // Armijo backtracking on the cost along the retraction. Once the predicted decrease is below
     // the cost's round-off the test is meaningless and the full Newton step is taken: that is
     // when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the round-off acceptance
@@ -292,6 +307,13 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       // This last step took the iterate from the tolerance to ~round-off (quadratic convergence).
       converged = true;
       reason = "converged";
+      if (relative_decrement > options.tolerance) {
+        std::ostringstream why;
+        why << "converged to the round-off floor (relative torque accuracy about "
+            << relative_decrement << " before the last step, tolerance " << options.tolerance
+            << " is below the floor ~eps N^2 at this N)";
+        reason = why.str();
+      }
       ++iteration;
       break;
     }
@@ -307,6 +329,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     np.evaluate(&gradient, nullptr, &gradient_scale);
     relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
   }
+  if (final_steps) *final_steps = np.current();
   result.iterations = iteration;
   result.max_residual = relative_gradient;
   result.newton_decrement = relative_decrement;
@@ -338,9 +361,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 }
 
 /// Grid continuation: above this N the problem is first solved on a 4× coarser grid (recursively)
-/// and the resampled solution starts the fine solve. From the geodesic guess, long horizons
-/// wander through regions where the Hessian is indefinite; from the coarse solution every level
-/// starts in the convex basin and takes a few Newton steps.
+/// and its solution, carried over (ReducedProblem::initializeFromCoarser), starts the fine solve.
+/// From the geodesic guess, long horizons wander through regions where the Hessian is indefinite;
+/// from the coarse solution every level starts in the convex basin and takes a few Newton steps.
 constexpr int kCoarsestGrid = 16;
 
 /// What is left of the options' time budget after `start` [s] (0 budget: unlimited, returned as 0).
@@ -351,25 +374,26 @@ double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::
   return std::max(options.time_budget_s - used, 1e-300);
 }
 
-PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options) {
+PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options,
+                                 ReducedProblem::Steps* final_steps = nullptr) {
   const auto start = std::chrono::steady_clock::now();
-  if (problem.steps <= kCoarsestGrid || options.warm_start) return solveOnGrid(problem, options);
+  if (problem.steps <= kCoarsestGrid || options.warm_start) {
+    return solveOnGrid(problem, options, nullptr, final_steps);
+  }
   PlanningProblem coarse = problem;
   coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
   SolverOptions coarse_options = options;
   // The callback is forwarded (feedback from every level, and cancel works during all of them).
   // A coarse level only starts the next one, whose own O(h²) difference from it is far larger.
   coarse_options.tolerance = std::max(options.tolerance, 1e-6);
-  const PlanResult coarse_result = solveWithContinuation(coarse, coarse_options);
+  ReducedProblem::Steps coarse_steps;
+  const PlanResult coarse_result = solveWithContinuation(coarse, coarse_options, &coarse_steps);
   SolverOptions fine_options = options;
-  Maneuver guess;
   // Stopped on a coarse level (cancel, time budget): answer on the requested grid anyway, with
-  // the coarse iterate resampled and replayed (no iteration on this grid).
+  // the coarse iterate carried over and replayed (no iteration on this grid).
   const auto stopped = [&](const std::string& why) {
-    guess.attitude = resampleAttitudes(coarse_result.maneuver, problem.steps);
-    fine_options.warm_start = &guess;
     fine_options.max_iterations = 0;
-    PlanResult out = solveOnGrid(problem, fine_options);
+    PlanResult out = solveOnGrid(problem, fine_options, &coarse_steps, final_steps);
     out.converged = false;
     out.cancelled = coarse_result.cancelled;
     out.iterations = coarse_result.iterations;
@@ -380,8 +404,6 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   if (coarse_result.cancelled) return stopped("cancelled");
   std::string level;
   if (coarse_result.converged) {
-    guess.attitude = resampleAttitudes(coarse_result.maneuver, problem.steps);
-    fine_options.warm_start = &guess;
     level = "; started from the N = " + std::to_string(coarse.steps) + " solution (" +
             std::to_string(coarse_result.iterations) + " iterations there)";
   } else {
@@ -401,7 +423,8 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
       return options.on_iteration(global);
     };
   }
-  PlanResult result = solveOnGrid(problem, fine_options);
+  PlanResult result = solveOnGrid(problem, fine_options,
+                                  coarse_result.converged ? &coarse_steps : nullptr, final_steps);
   result.iterations += before;
   result.message += level;
   return result;

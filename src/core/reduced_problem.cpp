@@ -108,6 +108,56 @@ void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitu
   for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
 }
 
+void ReducedProblem::initializeFromCoarser(const Steps& coarse) {
+  const int Nc = static_cast<int>(coarse.size());
+  if (Nc < 4 || Nc >= N_) {
+    throw InvalidInput("grid continuation: a coarse grid of " + std::to_string(Nc) +
+                       " steps cannot start one of " + std::to_string(N_));
+  }
+  // Where a step belongs in time: the boundary data make the first step's rate Ω(0) and the
+  // last one's Ω(T), and the optimal discrete solutions are smooth in k between them (measured),
+  // so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h puts the fixed end steps
+  // a fraction of a coarse step off: O(1) torque jumps at the ends.) Rates ω^c_k/h_c are
+  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h.
+  const auto slope = [&](int k) {
+    if (k == 0) return Vector3(coarse[1] - coarse[0]);
+    if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
+    return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
+  };
+  const double ratio = double(Nc) / N_;  // h / h_c
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const double x = double(j) * (Nc - 1) / (N_ - 1);  // in coarse steps
+    const int i = std::min(static_cast<int>(x), Nc - 2);
+    const double s = x - i;
+    const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
+                 h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+    steps_[j] =
+        ratio * (h00 * coarse[i] + h10 * slope(i) + h01 * coarse[i + 1] + h11 * slope(i + 1));
+  }
+  // The gap ψ between where the interpolated steps end and R_{N−1} (body frame of R_{N−1}),
+  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ_1 = 0 and φ_{N−1} = ψ, zero end slopes:
+  // F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In quaternions throughout.
+  using Quaternion = Eigen::Vector4d;
+  Quaternion reached = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = 1; j <= N_ - 2; ++j) {
+    reached = so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(steps_[j]));
+  }
+  reached.tail<3>() *= -1.0;  // its inverse
+  const Vector3 gap = so3::logOfQuaternion<double>(
+      so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(principal_span_)));
+  const auto phi = [&](int j) {
+    const double u = double(j - 1) / (N_ - 2);
+    return Vector3((3 * u * u - 2 * u * u * u) * gap);
+  };
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Quaternion q = so3::quaternionProduct<double>(
+        so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-phi(j)),
+                                       so3::quaternionOfRotationVector<double>(steps_[j])),
+        so3::quaternionOfRotationVector<double>(phi(j + 1)));
+    steps_[j] = so3::logOfQuaternion<double>(q);
+  }
+}
+
 std::vector<Matrix3> ReducedProblem::attitudes(const Steps& steps) const {
   std::vector<Matrix3> R(N_ + 1);
   R[0] = initial_attitude_;

@@ -96,7 +96,7 @@ def sci(x):
 
 
 def ms(t):
-    return "%.3g ms" % (t * 1e3)
+    return "%.3g ms" % (t * 1e3) if t < 1 else "%.3g s" % t
 
 
 by = {(c["scene"], c["scheme"]): c for c in cases}
@@ -122,8 +122,8 @@ w("")
 paper_needed = rest_paper["sweep"][-1]["N"] * rest_paper["sweep"][-1]["attitude_miss"] / 1e-6
 w("- **For a 1e-6 rad terminal attitude miss on the seed's rest-to-rest example use the "
   "`variational` scheme: N = %d, %s** (planned to the target by `plan_maneuver "
-  "scenes/rest_to_rest.yaml --target-miss 1e-6 --scheme auto`, %s including the two coarse "
-  "resolutions it solves first; measured miss %s). The `paper` scheme would need N ≈ %s for the "
+  "scenes/rest_to_rest.yaml --target-miss 1e-6 --scheme variational` — `--scheme auto` picks the "
+  "same — %s including the coarse resolution it solves first; measured miss %s). The `paper` scheme would need N ≈ %s for the "
   "same miss (its miss converges at order 1): the planner refuses that up front."
   % (miss6["N"], ms(miss6["plain_solve_time_s"]), ms(miss6["solve_time_s"]), sci(miss6["actual"]),
      "{:,}".format(int(round(paper_needed, -3)))))
@@ -250,22 +250,37 @@ w("`planManeuver` with `PlanningProblem::accuracy` (CLI `--target-miss RAD` / "
   "*actual* is measured against the continuous reference. Time: the whole request (coarse "
   "resolutions included) and a plain solve at the chosen N.")
 w("")
-w("| case | scheme | measure | target | N chosen | predicted | estimated (returned) | actual | actual/estimated | time (request) | time (plain solve at N) | N tried |")
-w("|---|---|---|---|---|---|---|---|---|---|---|---|")
+w("For `terminal_miss` the returned estimate *is* a measurement of the plan (the same replay the "
+  "study uses), so actual/estimated = 1 by construction; the honest test there is the prediction "
+  "made from N = 64 alone (column actual/predicted). For `cost_error` both columns are genuine "
+  "estimates against the continuous reference.")
+w("")
+w("| case | scheme | measure | target | N chosen | predicted | estimated (returned) | actual | actual/predicted | actual/estimated | time (request) | time (plain solve at N) | N tried |")
+w("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for c in cases:
     for t in c["targets"]:
         if not t["converged"]:
-            w("| %s | %s | %s | %.0e | — | | | | | %s | | refused: %s |" % (
+            w("| %s | %s | %s | %.0e | — | | | | | | %s | | refused: %s |" % (
                 c["scene"], c["scheme"], t["measure"], t["target"], ms(t["solve_time_s"]),
                 "needs N > max_steps (order-1 miss)" if t["tried"].count(",") == 0 else t["tried"]))
             continue
-        w("| %s | %s | %s | %.0e | %d | %s | %s | %s | %.3f | %s | %s | %s |" % (
+        w("| %s | %s | %s | %.0e | %d | %s | %s | %s | %.3f | %.3f | %s | %s | %s |" % (
             c["scene"], c["scheme"], t["measure"], t["target"], t["N"], sci(t["predicted"]),
-            sci(t["estimated"]), sci(t["actual"]), t["actual"] / t["estimated"],
+            sci(t["estimated"]), sci(t["actual"]), t["actual"] / t["predicted"],
+            t["actual"] / t["estimated"],
             ms(t["solve_time_s"]), ms(t["plain_solve_time_s"]), t["tried"]))
 w("")
-w("Every plan that was returned meets its target in the actual error, and the cost estimate is "
-  "within a few per cent of the actual error (the order-1 term dominates cleanly). Requests the "
+ratios = [t["actual"] / t["estimated"] for c in cases for t in c["targets"]
+          if t["converged"] and t["measure"] == "cost_error"]
+pred = [t["actual"] / t["predicted"] for c in cases for t in c["targets"] if t["converged"]]
+w("Every plan that was returned meets its target in the actual error (%d of %d requests; the "
+  "others were refused). The cost estimates are within %.1f %% of the actual error, the "
+  "predictions from N = 64 within %.0f %% (actual/predicted %.2f … %.2f), so no refinement round "
+  "was needed." % (sum(1 for c in cases for t in c["targets"] if t["converged"]),
+                   sum(len(c["targets"]) for c in cases),
+                   100 * max(abs(r - 1) for r in ratios), 100 * max(abs(r - 1) for r in pred),
+                   min(pred), max(pred)) + " "
+  "The margin of 15 % in the predicted N is why the returned errors sit at 0.7–0.9 of the target. Requests the "
   "`paper` scheme cannot meet within `max_steps` (2^18 in the core, `~max_steps` in the node) are "
   "refused after the coarse resolution, with the N they would need in the message.")
 w("")

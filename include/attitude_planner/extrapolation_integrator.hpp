@@ -15,8 +15,8 @@
 
 namespace attitude_planner {
 
-/// Extrapolation stages K (order 2K = 16). Enough that a macro step of 1/200 of a smooth
-/// maneuver's duration is accurate to round-off.
+/// Extrapolation stages K (order 2K = 16). Enough that a macro step of 1/64 of a smooth
+/// maneuver's duration is accurate to round-off (test_accuracy.cpp).
 constexpr int kExtrapolationStages = 8;
 
 /// One GBS macro step of length H from x; `f(x)` returns ẋ (same type as x).

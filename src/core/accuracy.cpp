@@ -90,7 +90,7 @@ AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver&
 }
 
 double measuredOrder(SchemeKind scheme, AccuracyMeasure measure) {
-  // Least-squares slopes over N = 16..16384 on both seed examples (docs/accuracy.md, "Observed
+  // Least-squares slopes over N = 64..16384 on both seed examples (docs/accuracy.md, "Observed
   // orders"); test_accuracy.cpp checks them on a small sweep. The cost converges at order 1 in
   // both schemes (the boundary data Ω_0, Ω_{N−1} hold over a whole step: the maneuver is
   // effectively h shorter); the attitude miss at order 2 only for the variational scheme.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "attitude_planner/accuracy_target.hpp"
 #include "attitude_planner/discrete_scheme.hpp"
 #include "attitude_planner/effects.hpp"
 #include "attitude_planner/maneuver.hpp"
@@ -49,6 +50,9 @@ struct PlanningProblem {
   /// box bounds, N ≤ 1024) from the clipped Newton torques.
   Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   bool hasTorqueBounds() const { return max_torque.allFinite(); }
+  /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
+  /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
+  AccuracyTarget accuracy;
 };
 
 /// Progress of one iteration, for feedback (action) and logging.
@@ -98,6 +102,8 @@ struct PlanResult {
   /// The effects in the planning model (scene keys), in order; "actuator_limits" last when the
   /// control torques are bounded.
   std::vector<std::string> effects;
+  /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
+  AccuracyEstimate accuracy;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws
@@ -105,7 +111,8 @@ struct PlanResult {
 void validateProblem(const PlanningProblem& problem);
 
 /// Plans the maneuver. Throws InvalidInput for a bad problem; never throws for a solve that
-/// does not converge (PlanResult::converged = false says so, with the reason).
+/// does not converge (PlanResult::converged = false says so, with the reason). With an active
+/// problem.accuracy it chooses N itself (planToAccuracy, accuracy.hpp).
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options = {});
 
 }  // namespace attitude_planner

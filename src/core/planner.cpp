@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "attitude_planner/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/simulation.hpp"
 #include "attitude_planner/solvers.hpp"
@@ -34,6 +35,7 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
 
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
+  if (problem.accuracy.active()) return planToAccuracy(problem, options);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
   if (options.solver == "newton" && problem.hasTorqueBounds()) {

@@ -65,8 +65,11 @@ void validateProblem(const PlanningProblem& p) {
   if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
     throw InvalidInput("duration: must be a finite number > 0 s, got " + num(p.duration));
   }
-  if (p.steps < 4) throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
-  if (p.steps > kMaxSteps) {
+  // With an accuracy target the planner chooses N: `steps` is not used.
+  if (!p.accuracy.active() && p.steps < 4) {
+    throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
+  }
+  if (!p.accuracy.active() && p.steps > kMaxSteps) {
     throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
                        std::to_string(p.steps));
   }
@@ -84,6 +87,22 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput(
         "effects: actuator_limits together with gravity_gradient/disturbance_torque is not "
         "supported yet (bounded plans use NLopt, which does not model effect torques)");
+  }
+  if (p.accuracy.active()) {
+    if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
+      throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
+                         accuracyMeasureName(p.accuracy.measure) + "), got " +
+                         num(p.accuracy.value));
+    }
+    if (p.hasTorqueBounds() || (p.effects && !p.effects->empty())) {
+      throw InvalidInput(
+          "accuracy_target: not supported with effects or actuator_limits (the continuous "
+          "reference and the measured orders are for the bare rigid body)");
+    }
+    if (p.accuracy.max_steps < 16 || p.accuracy.max_steps > kMaxSteps) {
+      throw InvalidInput("accuracy.max_steps: must be in [16, " + std::to_string(kMaxSteps) +
+                         "], got " + std::to_string(p.accuracy.max_steps));
+    }
   }
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");

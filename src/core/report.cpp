@@ -45,14 +45,45 @@ std::string jsonNumber(double value) {
   return buffer;
 }
 
+namespace {
+
+/// N and scheme of the returned plan: chosen by the planner when an accuracy target was given.
+int planSteps(const PlanningProblem& problem, const PlanResult& r) {
+  return r.accuracy.requested && !r.maneuver.attitude.empty() ? r.maneuver.steps() : problem.steps;
+}
+SchemeKind planScheme(const PlanningProblem& problem, const PlanResult& r) {
+  return r.accuracy.requested ? r.scheme : problem.scheme;
+}
+
+std::string accuracyJson(const AccuracyEstimate& a) {
+  std::ostringstream out;
+  out << "{\"measure\": " << jsonString(accuracyMeasureName(a.measure))
+      << ", \"target\": " << jsonNumber(a.target)
+      << ", \"estimated_error\": " << jsonNumber(a.estimated_error)
+      << ", \"predicted_error\": " << jsonNumber(a.predicted_error)
+      << ", \"order\": " << jsonNumber(a.order) << ", \"method\": " << jsonString(a.method)
+      << ", \"steps_tried\": [";
+  for (size_t i = 0; i < a.steps_tried.size(); ++i) out << (i ? ", " : "") << a.steps_tried[i];
+  out << "], \"errors_tried\": [";
+  for (size_t i = 0; i < a.errors_tried.size(); ++i)
+    out << (i ? ", " : "") << jsonNumber(a.errors_tried[i]);
+  out << "], \"schemes_tried\": [";
+  for (size_t i = 0; i < a.schemes_tried.size(); ++i)
+    out << (i ? ", " : "") << jsonString(a.schemes_tried[i]);
+  out << "]}";
+  return out.str();
+}
+
+}  // namespace
+
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
   std::ostringstream out;
   out << "{\n"
       << "  \"converged\": " << (r.converged ? "true" : "false") << ",\n"
       << "  \"message\": " << jsonString(r.message) << ",\n"
       << "  \"solver\": " << jsonString(r.solver) << ",\n"
-      << "  \"scheme\": " << jsonString(schemeName(problem.scheme)) << ",\n"
-      << "  \"steps\": " << problem.steps << ",\n"
+      << "  \"scheme\": " << jsonString(schemeName(planScheme(problem, r))) << ",\n"
+      << "  \"steps\": " << planSteps(problem, r) << ",\n"
       << "  \"duration\": " << jsonNumber(problem.duration) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
@@ -64,8 +95,9 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
       << "  \"effects\": [";
   for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
-  out << "]\n"
-      << "}\n";
+  out << "]";
+  if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
+  out << "\n}\n";
   return out.str();
 }
 
@@ -84,14 +116,29 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
                 "dynamics residual        %.3g N m s\n"
                 "solve time               %.3f s\n",
                 r.converged ? "yes" : "NO", r.message.c_str(), r.solver.c_str(),
-                schemeName(problem.scheme).c_str(), problem.steps, problem.duration,
-                problem.duration / problem.steps, r.iterations, r.cost, r.terminal_attitude_error,
-                r.terminal_velocity_error, r.max_residual, r.dynamics_residual, r.solve_time_s);
+                schemeName(planScheme(problem, r)).c_str(), planSteps(problem, r), problem.duration,
+                problem.duration / planSteps(problem, r), r.iterations, r.cost,
+                r.terminal_attitude_error, r.terminal_velocity_error, r.max_residual,
+                r.dynamics_residual, r.solve_time_s);
   std::string text = buffer;
   std::string effects;
   for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
   text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
   if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
+  if (r.accuracy.requested) {
+    const AccuracyEstimate& a = r.accuracy;
+    std::string tried;
+    for (size_t i = 0; i < a.steps_tried.size(); ++i) {
+      tried += (i ? ", " : "") + a.schemes_tried[i] + " " + std::to_string(a.steps_tried[i]);
+    }
+    std::snprintf(buffer, sizeof buffer,
+                  "accuracy target          %s <= %.3g\n"
+                  "estimated error          %.3g (predicted %.3g, order %.3g; %s)\n"
+                  "resolutions solved       %s\n",
+                  accuracyMeasureName(a.measure).c_str(), a.target, a.estimated_error,
+                  a.predicted_error, a.order, a.method.c_str(), tried.c_str());
+    text += buffer;
+  }
   return text;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace attitude_planner {
@@ -302,6 +303,28 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
   }
   r.shooting_intervals = std::max(1, static_cast<int>(req.shooting_intervals));
   return r;
+}
+
+AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double target,
+                                         const PlannerDefaults& defaults) {
+  char value[32];
+  std::snprintf(value, sizeof value, "%.17g", target);
+  AccuracyTarget t;
+  if (measure.empty()) {
+    if (target != 0.0) {
+      throw InvalidInput(std::string("accuracy_target: ") + value +
+                         " given without accuracy_measure (terminal_miss or cost_error)");
+    }
+    return t;
+  }
+  t.measure = parseAccuracyMeasure(measure, "accuracy_measure");
+  if (!std::isfinite(target) || !(target > 0.0)) {
+    throw InvalidInput("accuracy_target: must be a finite number > 0 (" + measure + "), got " +
+                       value);
+  }
+  t.value = target;
+  t.max_steps = defaults.max_steps;
+  return t;
 }
 
 }  // namespace ros_conversions

@@ -31,7 +31,13 @@ const char* const kUsage =
     "\n"
     "options (override the scene):\n"
     "  --steps N                 number of time steps (h = T/N)\n"
-    "  --scheme paper|variational  discretization (rigid_body only)\n"
+    "  --scheme paper|variational|auto  discretization (rigid_body only; auto: the planner\n"
+    "                            chooses, with a --target-* flag only)\n"
+    "  --target-miss RAD         instead of --steps: choose N so that the terminal attitude miss\n"
+    "                            of the torques held over the steps on the continuous body is\n"
+    "                            <= RAD (rigid_body; docs/accuracy.md)\n"
+    "  --target-cost-error E     instead of --steps: choose N so that |h cost - continuous cost|\n"
+    "                            <= E [N^2 m^2 s] (Richardson estimate; rigid_body)\n"
     "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check (rigid_body)\n"
     "  --tolerance TOL           rigid_body: optimality tolerance (default 1e-10);\n"
     "                            drift_two_input: terminal attitude error [rad] (default 1e-11)\n"
@@ -97,6 +103,8 @@ struct Arguments {
   double tolerance = -1.0;      ///< < 0: the default
   int max_iterations = -1;      ///< < 0: the default
   double time_budget = 0.0;
+  std::string target_flag;    ///< "--target-miss" / "--target-cost-error", "" if absent
+  double target_value = 0.0;  ///< its value (> 0)
   std::string csv;
   std::string summary;
   bool help = false;
@@ -135,8 +143,8 @@ Arguments parseArguments(int argc, char** argv) {
       if (a.steps < 1) throw UsageError{"--steps: must be >= 4, got " + std::to_string(a.steps)};
     } else if (arg == "--scheme") {
       a.scheme = next();
-      if (a.scheme != "paper" && a.scheme != "variational") {
-        throw UsageError{"--scheme: unknown value '" + a.scheme + "' (paper or variational)"};
+      if (a.scheme != "paper" && a.scheme != "variational" && a.scheme != "auto") {
+        throw UsageError{"--scheme: unknown value '" + a.scheme + "' (paper, variational or auto)"};
       }
     } else if (arg == "--solver") {
       a.solver = next();
@@ -153,6 +161,14 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (arg == "--time-budget") {
       a.time_budget = parseDouble(arg, next());
       if (!(a.time_budget > 0.0)) throw UsageError{"--time-budget: must be > 0 s"};
+    } else if (arg == "--target-miss" || arg == "--target-cost-error") {
+      if (!a.target_flag.empty()) {
+        throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
+      }
+      a.target_flag = arg;
+      const std::string text = next();
+      a.target_value = parseDouble(arg, text);
+      if (!(a.target_value > 0.0)) throw UsageError{arg + ": must be > 0, got " + text};
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
       parseCostate(a.initial_costate);  // checked here: a usage error, exit status 2
@@ -165,13 +181,21 @@ Arguments parseArguments(int argc, char** argv) {
     }
   }
   if (!a.help && a.scene.empty()) throw UsageError{"missing SCENE.yaml"};
+  if (!a.target_flag.empty() && a.steps > 0) {
+    throw UsageError{a.target_flag + " chooses N: do not give --steps with it"};
+  }
+  if (a.scheme == "auto" && a.target_flag.empty()) {
+    throw UsageError{"--scheme auto needs --target-miss or --target-cost-error"};
+  }
   return a;
 }
 
 /// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
-  if (!args.scheme.empty() || args.solver_given || args.time_budget > 0.0) {
-    std::cerr << "plan_maneuver: --scheme, --solver and --time-budget apply to system: rigid_body "
+  if (!args.scheme.empty() || args.solver_given || args.time_budget > 0.0 ||
+      !args.target_flag.empty()) {
+    std::cerr << "plan_maneuver: --scheme, --solver, --time-budget and --target-* apply to system: "
+                 "rigid_body "
                  "only (this scene is drift_two_input)\n\n"
               << kUsage;
     return 2;
@@ -229,7 +253,16 @@ int main(int argc, char** argv) {
     ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
     ap::PlanningProblem& problem = scene.problem;
     if (args.steps > 0) problem.steps = args.steps;
-    if (!args.scheme.empty()) problem.scheme = ap::parseSchemeName(args.scheme);
+    if (!args.scheme.empty() && args.scheme != "auto") {
+      problem.scheme = ap::parseSchemeName(args.scheme);
+    }
+    if (!args.target_flag.empty()) {
+      problem.accuracy.measure = args.target_flag == "--target-miss"
+                                     ? ap::AccuracyMeasure::TerminalMiss
+                                     : ap::AccuracyMeasure::CostError;
+      problem.accuracy.value = args.target_value;
+      problem.accuracy.choose_scheme = args.scheme == "auto";
+    }
 
     ap::SolverOptions options;
     options.solver = args.solver;

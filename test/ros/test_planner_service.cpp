@@ -3,6 +3,7 @@
 #include <ros/ros.h>
 
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -119,6 +120,39 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   const PlanAttitudeManeuver::Response good = call(seed());
   EXPECT_TRUE(good.success) << good.message;
   EXPECT_LT(good.terminal_attitude_error, 1e-8);
+}
+
+TEST_F(PlannerService, AccuracyTargetChoosesStepsAndReturnsTheEstimate) {
+  PlanAttitudeManeuver::Request req = seed(0);  // steps 0: the planner chooses N
+  req.accuracy_measure = "terminal_miss";
+  req.accuracy_target = 1e-6;  // [rad]
+  req.scheme = "auto";
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.scheme, "variational");  // order-2 miss: far fewer steps than paper (order 1)
+  EXPECT_EQ(res.maneuver.scheme, "variational");
+  ASSERT_GE(res.steps, 16);
+  EXPECT_EQ(res.maneuver.attitude.size(), size_t(res.steps + 1));
+  EXPECT_GT(res.estimated_error, 0.0);
+  EXPECT_LE(res.estimated_error, 1e-6);
+  EXPECT_GT(res.predicted_error, 0.0);
+  // Bad targets name the field and the value; the node keeps serving.
+  for (double bad : {0.0, -1e-6, std::numeric_limits<double>::quiet_NaN()}) {
+    req.accuracy_target = bad;
+    const PlanAttitudeManeuver::Response r = call(req);
+    EXPECT_EQ(r.error_code.val, PlanErrorCode::INVALID_INPUT) << r.message;
+    EXPECT_NE(r.message.find("accuracy_target: must be a finite number > 0"), std::string::npos)
+        << r.message;
+    EXPECT_NE(r.message.find(std::isnan(bad) ? "nan" : (bad == 0.0 ? "got 0" : "got -9.99")),
+              std::string::npos)
+        << r.message;
+  }
+  req.accuracy_measure = "miss";
+  req.accuracy_target = 1e-6;
+  const PlanAttitudeManeuver::Response unknown = call(req);
+  EXPECT_EQ(unknown.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(unknown.message.find("accuracy_measure: unknown value 'miss'"), std::string::npos)
+      << unknown.message;
 }
 
 TEST_F(PlannerService, EffectsArePlannedListedAndLandWhenReplayedUnderThem) {

@@ -318,6 +318,37 @@ TEST_F(CliTest, BadDriftTwoInputScenesExitOneNamingTheKey) {
   EXPECT_CONTAINS(bad_guess.output, "--initial-costate: expected P1,P2,P3");
 }
 
+TEST_F(CliTest, TargetMissChoosesStepsAndReportsTheEstimate) {
+  const std::string csv = dir_ + "/target.csv", json = dir_ + "/target.json";
+  const ToolRun r =
+      run("plan_maneuver", kScenes + "rest_to_rest.yaml --target-miss 1e-6 --scheme auto --csv " +
+                               csv + " --summary " + json);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "accuracy target          terminal_miss <= 1e-06");
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"accuracy\": {\"measure\": \"terminal_miss\"");
+  // auto: the variational scheme (order-2 miss) needs far fewer steps than paper (order 1)
+  EXPECT_CONTAINS(summary, "\"scheme\": \"variational\"");
+  const std::size_t at = summary.find("\"estimated_error\": ");
+  ASSERT_NE(at, std::string::npos) << summary;
+  EXPECT_LE(std::stod(summary.substr(at + 19)), 1e-6) << summary;
+  // The CSV has the N the planner chose, the one the summary reports (not the scene's 128).
+  const ap::Maneuver m = ap::readManeuverCsv(csv);
+  EXPECT_CONTAINS(summary, "\"steps\": " + std::to_string(m.steps()) + ",");
+  EXPECT_NE(m.steps(), 128);
+
+  for (const char* bad : {"0", "-1e-6", "nan"}) {
+    const ToolRun b = run("plan_maneuver", kScenes + "rest_to_rest.yaml --target-miss " + bad);
+    EXPECT_EQ(b.status, 2) << b.output;
+    EXPECT_CONTAINS(b.output, std::string("--target-miss: "));
+    EXPECT_CONTAINS(b.output, bad);
+  }
+  const ToolRun both =
+      run("plan_maneuver", kScenes + "rest_to_rest.yaml --target-cost-error 1e-3 --steps 64");
+  EXPECT_EQ(both.status, 2) << both.output;
+  EXPECT_CONTAINS(both.output, "--target-cost-error chooses N");
+}
+
 TEST_F(CliTest, UsageErrorsNameTheFlag) {
   const ToolRun unknown = run("plan_maneuver", kScenes + "rest_to_rest.yaml --stepz 4");
   EXPECT_EQ(unknown.status, 2);

@@ -88,6 +88,12 @@ struct PlannerDefaults {
 DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
                                          const PlannerDefaults& defaults);
 
+/// The accuracy target of a request: inactive for an empty measure (then accuracy_target must be
+/// 0); otherwise the measure ("terminal_miss" | "cost_error"), the target (finite, > 0) and the
+/// node's ~max_steps as the largest N. Throws InvalidInput naming the field and the value.
+AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double target,
+                                         const PlannerDefaults& defaults);
+
 /// Builds the problem and solver options of a service request or action goal (both have the same
 /// fields). Throws InvalidInput naming the field and the value.
 template <class Request>
@@ -103,20 +109,31 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   p.inertia = inertiaFromMsg(req.inertia);
   p.allow_nonphysical_inertia = req.allow_nonphysical_inertia;
   p.duration = req.duration;
-  if (req.steps > defaults.max_steps) {
+  const bool to_accuracy = !req.accuracy_measure.empty();
+  if (!to_accuracy && req.steps > defaults.max_steps) {
     throw InvalidInput("steps: " + std::to_string(req.steps) +
                        " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
   }
   p.steps = req.steps;
+  p.accuracy = accuracyTargetFromRequest(req.accuracy_measure, req.accuracy_target, defaults);
   p.initial_attitude = attitudeFromMsg(req.initial_attitude, "initial_attitude");
   p.initial_velocity = vectorFromMsg(req.initial_angular_velocity);
   p.final_attitude = attitudeFromMsg(req.final_attitude, "final_attitude");
   p.final_velocity = vectorFromMsg(req.final_angular_velocity);
   const std::string scheme = req.scheme.empty() ? defaults.scheme : req.scheme;
-  try {
-    p.scheme = parseSchemeName(scheme);
-  } catch (const InvalidInput&) {
-    throw InvalidInput("scheme: unknown value '" + scheme + "' (expected paper or variational)");
+  if (scheme == "auto" && !to_accuracy) {
+    throw InvalidInput(
+        "scheme: 'auto' needs accuracy_measure (the planner chooses the scheme "
+        "only for a requested accuracy)");
+  }
+  p.accuracy.choose_scheme = scheme == "auto";
+  if (scheme != "auto") {
+    try {
+      p.scheme = parseSchemeName(scheme);
+    } catch (const InvalidInput&) {
+      throw InvalidInput("scheme: unknown value '" + scheme +
+                         "' (expected paper, variational or auto)");
+    }
   }
   options->solver = req.solver.empty() ? defaults.solver : req.solver;
   if (options->solver != "newton" && options->solver != "nlopt") {

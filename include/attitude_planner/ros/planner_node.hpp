@@ -168,10 +168,17 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->message = outcome.message;
   if (!outcome.solver_ran) return;
   const PlanResult& r = outcome.result;
+  PlanningProblem planned = outcome.problem;  // with an accuracy target the planner chose these
+  if (r.accuracy.requested) planned.scheme = r.scheme;
   if (!r.maneuver.attitude.empty()) {
-    res->maneuver = ros_conversions::maneuverToMsg(r.maneuver, outcome.problem, world_frame,
-                                                   body_frame, ros::Time::now());
+    planned.steps = r.maneuver.steps();
+    res->maneuver = ros_conversions::maneuverToMsg(r.maneuver, planned, world_frame, body_frame,
+                                                   ros::Time::now());
   }
+  res->steps = planned.steps;
+  res->scheme = schemeName(planned.scheme);
+  res->estimated_error = r.accuracy.estimated_error;
+  res->predicted_error = r.accuracy.predicted_error;
   res->cost = r.cost;
   res->iterations = r.iterations;
   res->max_residual = r.max_residual;

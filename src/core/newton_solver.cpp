@@ -197,6 +197,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   bool converged = false;
   double best_decrement = std::numeric_limits<double>::infinity();
   double damping = 0.0;  // Levenberg shift the next iteration starts from (relative)
+  // Decrement of the previous iteration if its step was a full, unshifted Newton step (the
+  // quadratic model below is only valid after one); 0 otherwise.
+  double previous_full_step_decrement = 0.0;
   int stalled_iterations = 0;
   std::string reason = "iteration limit reached";
   int iteration = 0;
@@ -247,8 +250,18 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // conditioning grows like N⁴.
     const double slope = gradient.dot(delta);
     relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
+    // Quadratic convergence observed on this very run: the last full step took the decrement
+    // from d₋ to d, so this one will leave about C d², C = d/d₋². Well inside the tolerance
+    // (10×), this step is the last (saves the iteration that would only confirm it).
+    const double d_prev = previous_full_step_decrement;
+    const double predicted_decrement =
+        d_prev > 0.0 && relative_decrement < d_prev
+            ? relative_decrement / (d_prev * d_prev) * relative_decrement * relative_decrement
+            : std::numeric_limits<double>::infinity();
+    const bool predicted_within_tolerance = predicted_decrement <= 0.1 * options.tolerance;
     const bool final_step =
-        shift == 0.0 && relative_decrement <= std::max(options.tolerance, roundOffFloor(N));
+        shift == 0.0 && (relative_decrement <= std::max(options.tolerance, roundOffFloor(N)) ||
+                         predicted_within_tolerance);
     // Armijo backtracking on the cost along the retraction. Once the predicted decrease is below
     // the cost's round-off the test is meaningless and the full Newton step is taken: that is
     // when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the round-off acceptance
@@ -291,6 +304,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       stalled_iterations = 0;
     }
     best_decrement = std::min(best_decrement, relative_decrement);
+    previous_full_step_decrement = alpha == 1.0 && shift == 0.0 ? relative_decrement : 0.0;
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
     if (stalled_iterations >= 2) {
       result.history.push_back(info);
@@ -307,7 +321,18 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       // This last step took the iterate from the tolerance to ~round-off (quadratic convergence).
       converged = true;
       reason = "converged";
-      if (relative_decrement > options.tolerance) {
+      if (relative_decrement > options.tolerance && predicted_within_tolerance) {
+        std::ostringstream why;
+        why << "converged (relative torque accuracy ";
+        if (predicted_decrement < 1e-16) {
+          why << "at round-off";
+        } else {
+          why << "about " << predicted_decrement;
+        }
+        why << " after the last step, predicted from the quadratic convergence of the steps"
+            << " before it; " << relative_decrement << " before it)";
+        reason = why.str();
+      } else if (relative_decrement > options.tolerance) {
         std::ostringstream why;
         why << "converged to the round-off floor (relative torque accuracy about "
             << relative_decrement << " before the last step, tolerance " << options.tolerance

@@ -14,13 +14,19 @@ import sys
 import time
 
 # Complexity exponent used to predict a peer's time at the next size (skip if > the limit).
-EXPONENT = {"newton": 1.0, "slsqp": 3.0, "complex_step": 3.0, "auglag": 2.0, "ipopt": 1.5}
+EXPONENT = {"newton": 1.0, "slsqp": 3.0, "complex_step": 3.0, "auglag": 2.0, "ipopt": 1.5,
+            "ipopt_lbfgs": 1.5}
 PEERS = ["slsqp", "auglag", "ipopt", "complex_step"]
+# Extra rows of the side-by-side table only (not the slew-up table or the plot), run at
+# N <= EXTRA_MAX_N: IPOPT with its L-BFGS Hessian, for comparison with the exact-Hessian "ipopt".
+EXTRA = ["ipopt_lbfgs"]
+EXTRA_MAX_N = 1024
 LABEL = {
     "newton": "ours (Newton, reduced problem)",
     "slsqp": "NLopt SLSQP (direct, exact gradients)",
     "auglag": "NLopt AUGLAG_EQ + LD_LBFGS (direct)",
-    "ipopt": "IPOPT 3.11 (simultaneous, exact Jacobian, L-BFGS Hessian)",
+    "ipopt": "IPOPT 3.11 (simultaneous, exact sparse Jacobian and Hessian)",
+    "ipopt_lbfgs": "IPOPT 3.11 (simultaneous, exact Jacobian, L-BFGS Hessian)",
     "complex_step": "seed's approach (dense complex-step Newton)",
 }
 
@@ -77,7 +83,7 @@ def main():
     rows = {}
     last = {}
     for n in sizes:
-        for solver in ["newton"] + PEERS:
+        for solver in ["newton"] + PEERS + (EXTRA if n <= EXTRA_MAX_N else []):
             prev = last.get(solver)
             if solver == "complex_step" and 8.0 * (3 * (2 * n - 3)) ** 2 > 4e9:
                 rows[(solver, n)] = {"skipped": "not run: its dense %d² Jacobian alone needs %.0f GB"
@@ -163,7 +169,7 @@ def write_doc(args, sizes, rows, slew_rows, scale_rows, repeats, load_before, lo
     L.append("|---|---|---|---|---|---|---|---|---|---|---|")
     for n in sizes:
         ours = rows.get(("newton", n))
-        for solver in ["newton"] + PEERS:
+        for solver in ["newton"] + PEERS + EXTRA:
             m = rows.get((solver, n))
             if m is None:
                 continue

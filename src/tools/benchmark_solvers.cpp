@@ -9,12 +9,14 @@
 //   auglag        NLopt AUGLAG_EQ with an LD_LBFGS subsolver on the same direct method
 //   ipopt         IPOPT on a simultaneous transcription (quaternions q_1..q_N, Ω_1..Ω_{N−2},
 //                 τ_1..τ_{N−1}; kinematics, dynamics and terminal constraints), exact sparse
-//                 first derivatives, limited-memory (L-BFGS) Hessian (only if built with IPOPT;
-//                 exact second derivatives are not implemented — see docs/performance.md)
+//                 Jacobian and exact sparse Hessian of the Lagrangian (only if built with IPOPT)
+//   ipopt_lbfgs   the same, with IPOPT's limited-memory (L-BFGS) Hessian instead (for comparison)
 //   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
 //                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
 //                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
 // Output: one JSON object per line on stdout.
+// --check-hessian compares IPOPT's exact Hessian (eval_h) with central differences of the
+// Lagrangian's gradient (eval_grad_f + eval_jac_gᵀλ) at a random point; exit 0 iff they agree.
 #include <sys/resource.h>
 
 #include <Eigen/Dense>
@@ -27,6 +29,7 @@
 #include <functional>
 #include <iostream>
 #include <nlopt.hpp>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -44,6 +47,200 @@
 #include <coin/IpTNLP.hpp>
 #endif
 
+#ifdef AP_HAVE_IPOPT
+// ---- second-order forward mode for IPOPT's exact Hessian -----------------------------------
+namespace benchmark_ad {
+
+/// Hyper-dual number for N variables: value, gradient and (full, symmetric) Hessian, propagated
+/// exactly through +, −, ×, ÷, sqrt, sin, cos. Usable as an Eigen scalar, so the templated
+/// ap::so3 formulas (quaternionOfRotationVector, exp) give exact second derivatives. Branches
+/// compare values only, as ap::Dual does. Benchmark code only (ap::Dual does not nest).
+template <int N>
+struct HyperDual {
+  double v = 0.0;
+  double g[N] = {};
+  double H[N][N] = {};
+
+  HyperDual() = default;
+  HyperDual(double value) : v(value) {}  // NOLINT: implicit from constants, as Eigen expects
+  HyperDual(double value, int direction) : v(value) { g[direction] = 1.0; }
+
+  HyperDual& operator+=(const HyperDual& o) {
+    v += o.v;
+    for (int i = 0; i < N; ++i) g[i] += o.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] += o.H[i][j];
+    return *this;
+  }
+  HyperDual& operator-=(const HyperDual& o) {
+    v -= o.v;
+    for (int i = 0; i < N; ++i) g[i] -= o.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] -= o.H[i][j];
+    return *this;
+  }
+  /// (ab)'' = a b'' + b a'' + a' b'ᵀ + b' a'ᵀ
+  HyperDual& operator*=(const HyperDual& o) {
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j)
+        H[i][j] = v * o.H[i][j] + o.v * H[i][j] + g[i] * o.g[j] + o.g[i] * g[j];
+    for (int i = 0; i < N; ++i) g[i] = g[i] * o.v + o.g[i] * v;
+    v *= o.v;
+    return *this;
+  }
+  HyperDual& operator/=(const HyperDual& o) { return *this *= reciprocal(o); }
+  HyperDual& scale(double s) {
+    v *= s;
+    for (int i = 0; i < N; ++i) g[i] *= s;
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] *= s;
+    return *this;
+  }
+  HyperDual operator-() const { return HyperDual(*this).scale(-1.0); }
+  HyperDual operator+() const { return *this; }
+
+  /// f(a) given f, f′, f″ at a.v: f(a)′ = f′ a′, f(a)″ = f′ a″ + f″ a′ a′ᵀ.
+  static HyperDual chain(const HyperDual& a, double f, double df, double d2f) {
+    HyperDual r;
+    r.v = f;
+    for (int i = 0; i < N; ++i) r.g[i] = df * a.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) r.H[i][j] = df * a.H[i][j] + d2f * a.g[i] * a.g[j];
+    return r;
+  }
+  static HyperDual reciprocal(const HyperDual& a) {
+    const double inv = 1.0 / a.v;
+    return chain(a, inv, -inv * inv, 2.0 * inv * inv * inv);
+  }
+};
+
+template <int N>
+HyperDual<N> operator+(HyperDual<N> a, const HyperDual<N>& b) {
+  return a += b;
+}
+template <int N>
+HyperDual<N> operator-(HyperDual<N> a, const HyperDual<N>& b) {
+  return a -= b;
+}
+template <int N>
+HyperDual<N> operator*(HyperDual<N> a, const HyperDual<N>& b) {
+  return a *= b;
+}
+template <int N>
+HyperDual<N> operator/(HyperDual<N> a, const HyperDual<N>& b) {
+  return a /= b;
+}
+template <int N>
+HyperDual<N> operator+(HyperDual<N> a, double b) {
+  a.v += b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator+(double b, HyperDual<N> a) {
+  a.v += b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator-(HyperDual<N> a, double b) {
+  a.v -= b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator-(double b, const HyperDual<N>& a) {
+  HyperDual<N> r = -a;
+  r.v += b;
+  return r;
+}
+template <int N>
+HyperDual<N> operator*(HyperDual<N> a, double b) {
+  return a.scale(b);
+}
+template <int N>
+HyperDual<N> operator*(double b, HyperDual<N> a) {
+  return a.scale(b);
+}
+template <int N>
+HyperDual<N> operator/(HyperDual<N> a, double b) {
+  return a.scale(1.0 / b);
+}
+template <int N>
+HyperDual<N> operator/(double b, const HyperDual<N>& a) {
+  return HyperDual<N>::reciprocal(a).scale(b);
+}
+template <int N>
+bool operator<(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v < b.v;
+}
+template <int N>
+bool operator>(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v > b.v;
+}
+template <int N>
+bool operator<=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v <= b.v;
+}
+template <int N>
+bool operator>=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v >= b.v;
+}
+template <int N>
+bool operator==(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v == b.v;
+}
+template <int N>
+bool operator!=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v != b.v;
+}
+template <int N>
+HyperDual<N> sqrt(const HyperDual<N>& a) {
+  const double s = std::sqrt(a.v);
+  return HyperDual<N>::chain(a, s, 0.5 / s, -0.25 / (s * a.v));
+}
+template <int N>
+HyperDual<N> sin(const HyperDual<N>& a) {
+  const double s = std::sin(a.v);
+  return HyperDual<N>::chain(a, s, std::cos(a.v), -s);
+}
+template <int N>
+HyperDual<N> cos(const HyperDual<N>& a) {
+  const double c = std::cos(a.v);
+  return HyperDual<N>::chain(a, c, -std::sin(a.v), -c);
+}
+template <int N>
+HyperDual<N> abs(const HyperDual<N>& a) {
+  return a.v < 0 ? -a : a;
+}
+
+}  // namespace benchmark_ad
+
+namespace Eigen {
+template <int N>
+struct NumTraits<benchmark_ad::HyperDual<N>> : NumTraits<double> {
+  using Real = benchmark_ad::HyperDual<N>;
+  using NonInteger = benchmark_ad::HyperDual<N>;
+  using Nested = benchmark_ad::HyperDual<N>;
+  using Literal = benchmark_ad::HyperDual<N>;
+  enum {
+    IsComplex = 0,
+    IsInteger = 0,
+    IsSigned = 1,
+    RequireInitialization = 1,
+    ReadCost = 1,
+    AddCost = 1 + N + N * N,
+    MulCost = 1 + 3 * N + 4 * N * N
+  };
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<benchmark_ad::HyperDual<N>, double, BinaryOp> {
+  using ReturnType = benchmark_ad::HyperDual<N>;
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<double, benchmark_ad::HyperDual<N>, BinaryOp> {
+  using ReturnType = benchmark_ad::HyperDual<N>;
+};
+}  // namespace Eigen
+#endif
+
 namespace ap = attitude_planner;
 using ap::Matrix3;
 using ap::Vector3;
@@ -51,10 +248,14 @@ using ap::Vector3;
 namespace {
 
 const char* const kUsage =
-    "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|complex_step\n"
+    "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
     "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
     "                         [--time-budget S]\n"
     "       benchmark_solvers --quick   every solver on the seed's rest-to-rest example, N = 16\n"
+    "       benchmark_solvers --check-hessian [--steps N]   IPOPT's exact Hessian against central\n"
+    "                         differences of its exact gradients (exit 0 iff relative error <= "
+    "1e-6;\n"
+    "                         exit 3 if this build has no IPOPT)\n"
     "Prints one JSON line: solver, scheme, steps, time_s, iterations, cost, converged,\n"
     "terminal_miss, peak_rss_kb, message. Without --scene: the seed's rest-to-rest example.\n";
 
@@ -197,10 +398,13 @@ Eigen::Matrix4d rightProduct(const Quaternion& q) {
 ///   dynamics    exp(hΩ_k^) J Ω_k − J Ω_{k−1} − h τ_k = 0,    k = 1..N−1 (3 each; eq. (18))
 ///   terminal    vec(q_N*⁻¹ ⊗ q_N) = 0                        (3)
 /// with q_0, Ω_0, Ω_{N−1} the boundary data. Every constraint is local: the KKT matrix is banded.
+/// Hessian of the Lagrangian σ f + Σ λ_i g_i (exact_hessian): per k = 1..N−2 the (q_k, Ω_k)
+/// block of the kinematics (q_k ⊗ e(hΩ_k) is bilinear in q_k and e, so no q_k q_k part) plus the
+/// Ω_k Ω_k block of the dynamics, and σ on the τ diagonal; the terminal constraint is linear.
 class TranscriptionNlp : public Ipopt::TNLP {
  public:
-  explicit TranscriptionNlp(const ap::PlanningProblem& p)
-      : p_(p), N_(p.steps), h_(p.duration / p.steps) {
+  TranscriptionNlp(const ap::PlanningProblem& p, bool exact_hessian)
+      : p_(p), N_(p.steps), h_(p.duration / p.steps), exact_hessian_(exact_hessian) {
     q0_ = ap::so3::quaternionCoefficients<double>(p.initial_attitude);
     qN_ = ap::so3::quaternionCoefficients<double>(p.final_attitude);
   }
@@ -218,7 +422,7 @@ class TranscriptionNlp : public Ipopt::TNLP {
     m = this->m();
     buildPattern();
     nnz_jac = static_cast<Ipopt::Index>(rows_.size());
-    nnz_h = 0;
+    nnz_h = exact_hessian_ ? static_cast<Ipopt::Index>(hrows_.size()) : 0;
     style = C_STYLE;
     return true;
   }
@@ -327,6 +531,50 @@ class TranscriptionNlp : public Ipopt::TNLP {
       for (int c = 0; c < 4; ++c) values[z++] = L(r, c);
     return true;
   }
+  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
+              const Ipopt::Number* lambda, bool, Ipopt::Index, Ipopt::Index* iRow,
+              Ipopt::Index* jCol, Ipopt::Number* values) override {
+    if (!exact_hessian_) return false;
+    if (!values) {
+      for (std::size_t i = 0; i < hrows_.size(); ++i) iRow[i] = hrows_[i], jCol[i] = hcols_[i];
+      return true;
+    }
+    using HD = benchmark_ad::HyperDual<3>;
+    const Matrix3& J = p_.inertia;
+    std::size_t z = 0;
+    for (int k = 1; k <= N_ - 2; ++k) {
+      const Vector3 w = omega(x, k);
+      const Quaternion qk(Eigen::Map<const Quaternion>(x + Q(k)));
+      const Quaternion mu(Eigen::Map<const Quaternion>(lambda + 4 * k));           // kinematics k
+      const Vector3 nu(Eigen::Map<const Vector3>(lambda + 4 * N_ + 3 * (k - 1)));  // dynamics k
+      ap::so3::Vec3<HD> wd;
+      for (int i = 0; i < 3; ++i) wd(i) = HD(w(i), i);
+      // Kinematics, −μᵀ(q_k ⊗ e(hΩ_k)): e and its first and second derivatives in Ω_k.
+      const Eigen::Matrix<HD, 4, 1> e =
+          ap::so3::quaternionOfRotationVector<HD>(ap::so3::Vec3<HD>(wd * h_));
+      // ∂²/∂Ω_j ∂q_k = −R(∂e/∂Ω_j)ᵀ μ   (q ⊗ p = right(p) q)
+      for (int j = 0; j < 3; ++j) {
+        const Quaternion de(e(0).g[j], e(1).g[j], e(2).g[j], e(3).g[j]);
+        const Quaternion col = -rightProduct(de).transpose() * mu;
+        for (int a = 0; a < 4; ++a) values[z++] = col(a);
+      }
+      // ∂²/∂Ω² of −μᵀ L(q_k) e = Σ_r c_r ∂²e_r, c = −L(q_k)ᵀ μ; plus νᵀ exp(hΩ^) J Ω.
+      const Quaternion c = -leftProduct(qk).transpose() * mu;
+      const ap::so3::Vec3<HD> f =
+          ap::so3::exp<HD>(ap::so3::Vec3<HD>(wd * h_)) * (J.cast<HD>() * wd);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j <= i; ++j) {
+          double v = 0.0;
+          for (int r = 0; r < 4; ++r) v += c(r) * e(r).H[i][j];
+          for (int r = 0; r < 3; ++r) v += nu(r) * f(r).H[i][j];
+          values[z++] = v;
+        }
+      }
+    }
+    for (int k = 1; k <= N_ - 1; ++k)
+      for (int i = 0; i < 3; ++i) values[z++] = obj_factor;
+    return true;
+  }
   bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
@@ -369,21 +617,38 @@ class TranscriptionNlp : public Ipopt::TNLP {
       block(r0, T(k), 3, 3, true);
     }
     block(4 * N_ + 3 * (N_ - 1), Q(N_), 3, 4, false);
+    // Hessian, lower triangle (row ≥ column; every W index exceeds every Q index), in eval_h's
+    // order: per k = 1..N−2 the Ω_k × q_k block (row-major), the Ω_k Ω_k lower triangle; then
+    // the τ diagonal.
+    hrows_.clear();
+    hcols_.clear();
+    for (int k = 1; k <= N_ - 2; ++k) {
+      for (int j = 0; j < 3; ++j)
+        for (int a = 0; a < 4; ++a) hrows_.push_back(W(k) + j), hcols_.push_back(Q(k) + a);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) hrows_.push_back(W(k) + i), hcols_.push_back(W(k) + j);
+    }
+    for (int k = 1; k <= N_ - 1; ++k)
+      for (int i = 0; i < 3; ++i) hrows_.push_back(T(k) + i), hcols_.push_back(T(k) + i);
   }
 
   ap::PlanningProblem p_;
   int N_;
   double h_;
+  bool exact_hessian_;
   Quaternion q0_, qN_;
   std::vector<int> rows_, cols_;
+  std::vector<int> hrows_, hcols_;
 };
 
-PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget) {
-  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem);
+/// exact_hessian: IPOPT's Newton steps use eval_h; otherwise its L-BFGS approximation.
+PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, bool exact_hessian) {
+  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, exact_hessian);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation",
+                                 exact_hessian ? "exact" : "limited-memory");
   app->Options()->SetNumericValue("tol", 1e-12);
   app->Options()->SetNumericValue("constr_viol_tol", 1e-12);
   app->Options()->SetIntegerValue("max_iter", 5000);
@@ -399,6 +664,102 @@ PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget) {
   out.iterations = nlp->iterations;
   out.torque = nlp->torque;
   return out;
+}
+
+/// --check-hessian: eval_h against central differences of ∇L = σ∇f + Jᵀλ (both from the exact
+/// first derivatives, eval_grad_f and eval_jac_g) at a random point with random multipliers.
+/// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
+/// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
+/// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
+int checkHessian(int steps) {
+  ap::PlanningProblem problem = seedRestToRest(steps);
+  problem.initial_velocity = Vector3(0.02, -0.01, 0.03);  // nonzero boundary data too
+  problem.final_velocity = Vector3(-0.01, 0.02, 0.01);
+  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, true);
+  Ipopt::Index n = 0, m = 0, nnz_jac = 0, nnz_h = 0;
+  Ipopt::TNLP::IndexStyleEnum style;
+  nlp->get_nlp_info(n, m, nnz_jac, nnz_h, style);
+  std::vector<double> x(n), lambda(m);
+  nlp->get_starting_point(n, true, x.data(), false, nullptr, nullptr, m, false, nullptr);
+  std::mt19937 rng(20240611);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int k = 1; k <= steps; ++k)
+    for (int i = 0; i < 4; ++i) x[nlp->Q(k) + i] += 0.1 * uniform(rng);
+  for (int k = 1; k <= steps - 2; ++k)
+    for (int i = 0; i < 3; ++i) x[nlp->W(k) + i] += 0.4 * uniform(rng);
+  if (steps >= 4) {
+    for (int i = 0; i < 3; ++i) x[nlp->W(2) + i] = 1e-7 * uniform(rng);  // series branch
+  }
+  for (int k = 1; k <= steps - 1; ++k)
+    for (int i = 0; i < 3; ++i) x[nlp->T(k) + i] += uniform(rng);
+  for (double& l : lambda) l = uniform(rng);
+  const double sigma = 0.7;
+
+  // The exact Hessian, dense and symmetric; the pattern must be the lower triangle, no repeats.
+  std::vector<Ipopt::Index> hr(nnz_h), hc(nnz_h);
+  std::vector<double> hv(nnz_h);
+  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, hr.data(), hc.data(),
+              nullptr);
+  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, nullptr, nullptr, hv.data());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXi seen = Eigen::MatrixXi::Zero(n, n);
+  int pattern_errors = 0;
+  for (int i = 0; i < nnz_h; ++i) {
+    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0 || seen(hr[i], hc[i])++) ++pattern_errors;
+    H(hr[i], hc[i]) = hv[i];
+    H(hc[i], hr[i]) = hv[i];
+  }
+
+  // ∇L from the exact first derivatives.
+  std::vector<Ipopt::Index> jr(nnz_jac), jc(nnz_jac);
+  std::vector<double> jv(nnz_jac), grad(n);
+  nlp->eval_jac_g(n, x.data(), true, m, nnz_jac, jr.data(), jc.data(), nullptr);
+  const auto gradient = [&](const std::vector<double>& y) {
+    Eigen::VectorXd gl(n);
+    nlp->eval_grad_f(n, y.data(), true, grad.data());
+    nlp->eval_jac_g(n, y.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
+    for (int i = 0; i < n; ++i) gl(i) = sigma * grad[i];
+    for (int i = 0; i < nnz_jac; ++i) gl(jc[i]) += lambda[jr[i]] * jv[i];
+    return gl;
+  };
+  constexpr double kStep = 1e-5;
+  Eigen::MatrixXd fd(n, n);
+  std::vector<double> y = x;
+  for (int j = 0; j < n; ++j) {
+    y[j] = x[j] + kStep;
+    const Eigen::VectorXd plus = gradient(y);
+    y[j] = x[j] - kStep;
+    const Eigen::VectorXd minus = gradient(y);
+    y[j] = x[j];
+    fd.col(j) = (plus - minus) / (2.0 * kStep);
+  }
+  // The FD matrix is symmetric only up to its own error: compare with its symmetric part and
+  // report the asymmetry (a bound on the FD error) separately.
+  const double asymmetry = (fd - fd.transpose()).cwiseAbs().maxCoeff();
+  const Eigen::MatrixXd fd_sym = 0.5 * (fd + fd.transpose());
+  const double scale = H.cwiseAbs().maxCoeff();
+  const double error = (H - fd_sym).cwiseAbs().maxCoeff();
+  double outside = 0.0;  // largest FD entry where the pattern has none
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (!seen(std::max(i, j), std::min(i, j)))
+        outside = std::max(outside, std::abs(fd_sym(i, j)));
+  // Entrywise, on the entries that are not negligible.
+  double entry_error = 0.0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (std::abs(H(i, j)) > 1e-3 * scale)
+        entry_error = std::max(entry_error, std::abs(H(i, j) - fd_sym(i, j)) / std::abs(H(i, j)));
+  const double relative = error / scale;
+  const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale;
+  std::printf(
+      "{\"check\": \"hessian\", \"steps\": %d, \"n\": %d, \"nnz_h\": %d, \"fd_step\": %g, "
+      "\"max_abs_entry\": %.6g, \"max_abs_error\": %.3g, \"relative_error\": %.3g, "
+      "\"max_entry_relative_error\": %.3g, \"fd_outside_pattern\": %.3g, \"fd_asymmetry\": "
+      "%.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
+      steps, static_cast<int>(n), static_cast<int>(nnz_h), kStep, scale, error, relative,
+      entry_error, outside, asymmetry, pattern_errors, pass ? "true" : "false");
+  return pass ? 0 : 1;
 }
 #endif
 
@@ -668,9 +1029,9 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
     is_ours = true;
   } else if (solver == "auglag") {
     peer = solveAuglag(problem, time_budget);
-  } else if (solver == "ipopt") {
+  } else if (solver == "ipopt" || solver == "ipopt_lbfgs") {
 #ifdef AP_HAVE_IPOPT
-    peer = solveIpopt(problem, time_budget);
+    peer = solveIpopt(problem, time_budget, solver == "ipopt");
 #else
     throw ap::InvalidInput("ipopt: this build has no IPOPT (install coinor-libipopt-dev)");
 #endif
@@ -705,6 +1066,7 @@ int quick() {
   std::vector<std::string> solvers = {"newton", "slsqp", "auglag", "complex_step"};
 #ifdef AP_HAVE_IPOPT
   solvers.push_back("ipopt");
+  solvers.push_back("ipopt_lbfgs");
 #endif
   double reference = 0.0;
   int failures = 0;
@@ -724,6 +1086,7 @@ int quick() {
 
 int main(int argc, char** argv) {
   std::string solver, scene, scheme;
+  bool check_hessian = false;
   int steps = 0;
   double time_budget = 120.0;
   for (int i = 1; i < argc; ++i) {
@@ -748,12 +1111,23 @@ int main(int argc, char** argv) {
       steps = std::atoi(value().c_str());
     } else if (a == "--scheme") {
       scheme = value();
+    } else if (a == "--check-hessian") {
+      check_hessian = true;
     } else if (a == "--time-budget") {
       time_budget = std::atof(value().c_str());
     } else {
       std::cerr << "unknown argument '" << a << "'\n" << kUsage;
       return 2;
     }
+  }
+  if (check_hessian) {
+#ifdef AP_HAVE_IPOPT
+    return checkHessian(steps > 0 ? steps : 16);
+#else
+    std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
+                 "(install coinor-libipopt-dev)\n";
+    return 3;
+#endif
   }
   if (solver.empty()) {
     std::cerr << kUsage;

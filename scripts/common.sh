@@ -15,6 +15,7 @@ DEBIAN_PACKAGES=(
   libtf2-ros-dev libtf2-geometry-msgs-dev tf2-tools libactionlib-dev python3-actionlib
   librosbag-dev python3-rosbag librostest-dev python3-rostest rosbash rosout python3-roslaunch
   libeigen3-dev libnlopt-cxx-dev libyaml-cpp-dev libboost-math-dev libgtest-dev
+  coinor-libipopt-dev
   python3-numpy python3-matplotlib python3-yaml
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
   python3-visualization-msgs python3-rostopic python3-rosservice

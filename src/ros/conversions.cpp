@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace attitude_planner {
@@ -13,13 +14,6 @@ std::string quaternionText(const geometry_msgs::Quaternion& q) {
   std::ostringstream s;
   s.precision(17);
   s << "(w, x, y, z) = (" << q.w << ", " << q.x << ", " << q.y << ", " << q.z << ")";
-  return s.str();
-}
-
-std::string numberText(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
   return s.str();
 }
 
@@ -90,6 +84,12 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
   }
   validateEffects(specs, "effects");
   applyEffects(specs, problem);
+}
+
+std::string numberText(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
 }
 
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {

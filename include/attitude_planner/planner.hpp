@@ -80,8 +80,11 @@ struct SolverOptions {
 struct PlanResult {
   bool converged = false;
   bool cancelled = false;  ///< the on_iteration callback asked to stop
-  std::string message;     ///< human-readable outcome ("converged", or why not)
-  std::string solver;      ///< "newton" or "nlopt"
+  /// Failed because an implicit step has no solution at this h (h·|Ω| too large): the message
+  /// says "increase steps". The node answers STEP_TOO_LARGE.
+  bool step_too_large = false;
+  std::string message;  ///< human-readable outcome ("converged", or why not)
+  std::string solver;   ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
   Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
   double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
@@ -110,9 +113,15 @@ struct PlanResult {
 /// InvalidInput naming the field and the value.
 void validateProblem(const PlanningProblem& problem);
 
-/// Plans the maneuver. Throws InvalidInput for a bad problem; never throws for a solve that
-/// does not converge (PlanResult::converged = false says so, with the reason). With an active
-/// problem.accuracy it chooses N itself (planToAccuracy, accuracy.hpp).
+/// Checks the solver settings (tolerance finite and > 0, max_iterations ≥ 0, time budget finite
+/// and ≥ 0): throws InvalidInput naming the option and the value.
+void validateOptions(const SolverOptions& options);
+
+/// Plans the maneuver. Throws InvalidInput for a bad problem or options, StepTooLarge if a
+/// boundary velocity has no step at h = T/N (the message names it and says "increase steps");
+/// never throws for a solve that does not converge (PlanResult::converged = false says so, with
+/// the reason). With an active problem.accuracy it chooses N itself (planToAccuracy,
+/// accuracy.hpp).
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options = {});
 
 }  // namespace attitude_planner

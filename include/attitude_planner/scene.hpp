@@ -3,7 +3,7 @@
 // Keys (units SI, REP 103):
 //   inertia          3×3 nested list, or 3 principal moments [a, b, c]        [kg·m²]
 //   duration         T > 0                                                     [s]
-//   steps            N, 4 ≤ N ≤ 10,000,000 (validateProblem)
+//   steps            N, 4 ≤ N ≤ 2,000,000 (validateProblem; ~2.3 kB/step)
 //   initial, final   {attitude: A, angular_velocity: [x, y, z]}                [rad/s] body
 //                    (drift_two_input: {attitude: A} only; angular_velocity is an error there,
 //                    the kinematic system's body rate E3 + u1 E1 + u2 E2 is not a boundary value)
@@ -15,6 +15,8 @@
 //   initial_costate  optional [p1, p2, p3] (finite), only with system: drift_two_input: guess for
 //                    the extremal's p(0) [c·rad/s] (default: the planner's own starts)
 //   effects          required for rigid_body, optional for drift_two_input (must then be [])
+//   direction        optional: shortest (default) | long_way (rigid_body; see RotationDirection)
+//   extra_revolutions optional integer ≥ 0: whole extra turns (rigid_body; validateProblem)
 //   allow_nonphysical_inertia  optional bool (default false): accept an SPD inertia whose
 //                    principal moments violate J1 + J2 ≥ J3 (the seed's example inertia does)
 #pragma once

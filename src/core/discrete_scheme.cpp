@@ -150,6 +150,9 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
   report->iterations = it;
   report->residual = (momentum<double>(F) - p).norm();
   if (!report->converged && report->residual <= tolerance(F)) report->converged = true;
+  // |p| beyond ~1e154 overflows the norms: the tolerance becomes +inf and every test above
+  // passes (found by fuzz_request: Ω_0 = −5e153 rad/s was "solved"). No such step exists.
+  if (!std::isfinite(report->residual) || !F.allFinite()) report->converged = false;
   return F;
 }
 

@@ -173,6 +173,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     reduced.emplace(problem);
   } catch (const StepTooLarge& e) {
     result.message = std::string("boundary velocity: ") + e.what();
+    result.step_too_large = true;
     return result;
   }
   ReducedProblem& np = *reduced;
@@ -209,6 +210,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
     if (!std::isfinite(cost) || !std::isfinite(relative_gradient)) {
       reason = "non-finite cost or gradient (step too large for this h? increase steps)";
+      result.step_too_large = true;
       break;
     }
     if (gradient.cwiseAbs().maxCoeff() == 0.0) {  // e.g. the zero maneuver
@@ -377,6 +379,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   } catch (const StepTooLarge& e) {
     result.converged = false;
     result.message = std::string("replay of the planned torques failed: ") + e.what();
+    result.step_too_large = true;
     return result;
   }
   // The replay is the final judge: stationarity of the reduced problem means nothing if the
@@ -388,7 +391,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     converged = false;
     std::ostringstream why;
     why << "stationary point found, but replaying its torques misses the target by " << miss
-        << " (step too large for this h? increase steps)";
+        << " (an implicit step on another branch when h|Omega| is large: increase steps; or an "
+           "unstable motion amplifying round-off over the horizon)";
     reason = why.str();
   }
   return finish();
@@ -408,6 +412,18 @@ double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::
   return std::max(options.time_budget_s - used, 1e-300);
 }
 
+/// A coarse level helps only while its boundary steps stay small: at h·|Ω| ≳ 1 rad the coarse
+/// problem is a different (and much harder) one — measured (issue 7): spinning ends Ω = 5 rad/s
+/// at N = 128 spent 200 failed iterations on the N = 32 level (2 rad per step) before the fine
+/// level started from the Hermite guess anyway.
+constexpr double kCoarseMaxStepAngle = 1.0;  // [rad]
+
+bool coarseLevelHelps(const PlanningProblem& coarse) {
+  const double h = coarse.duration / coarse.steps;
+  return h * std::max(coarse.initial_velocity.norm(), coarse.final_velocity.norm()) <=
+         kCoarseMaxStepAngle;
+}
+
 PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options,
                                  ReducedProblem::Steps* final_steps = nullptr) {
   const auto start = std::chrono::steady_clock::now();
@@ -416,6 +432,7 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   }
   PlanningProblem coarse = problem;
   coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
+  if (!coarseLevelHelps(coarse)) return solveOnGrid(problem, options, nullptr, final_steps);
   SolverOptions coarse_options = options;
   // The callback is forwarded (feedback from every level, and cancel works during all of them).
   // A coarse level only starts the next one, whose own O(h²) difference from it is far larger.

@@ -1,6 +1,7 @@
 #include "attitude_planner/planner.hpp"
 
 #include <chrono>
+#include <sstream>
 
 #include "attitude_planner/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
@@ -33,9 +34,35 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
       (result->maneuver.angular_velocity[N - 1] - problem.final_velocity).norm();
 }
 
+namespace {
+
+/// The boundary steps F_0 (from Ω_0) and F_{N−1} (from Ω_{N−1}) are fixed by the data: if either
+/// has no solution at h = T/N no solver can plan, so the request is refused up front, naming the
+/// velocity (StepTooLarge: "step too large, increase steps: ...").
+void requireBoundarySteps(const PlanningProblem& problem) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  const std::pair<const char*, const Vector3*> ends[] = {
+      {"initial.angular_velocity", &problem.initial_velocity},
+      {"final.angular_velocity", &problem.final_velocity}};
+  for (const auto& [field, velocity] : ends) {
+    try {
+      scheme.stepFromVelocity(*velocity);
+    } catch (const StepTooLarge& e) {
+      std::ostringstream what;
+      what << field << ": " << e.what() << " (N = " << problem.steps << ", T = " << problem.duration
+           << " s)";
+      throw StepTooLarge(what.str());
+    }
+  }
+}
+
+}  // namespace
+
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
+  validateOptions(options);
   if (problem.accuracy.active()) return planToAccuracy(problem, options);
+  requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
   if (options.solver == "newton" && problem.hasTorqueBounds()) {

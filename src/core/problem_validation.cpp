@@ -11,9 +11,10 @@ namespace attitude_planner {
 
 namespace {
 
-/// Largest N accepted: the solvers hold O(N) state of a few hundred bytes per step, so this keeps
-/// a mistyped N from exhausting memory.
-constexpr int kMaxSteps = 10000000;
+/// Largest N accepted: the Newton solver holds ~2.3 kB per step (measured at N = 1e6, 2.3 GB
+/// peak; docs/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7, would need
+/// ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
+constexpr int kMaxSteps = 2000000;
 
 /// %.17g: the value exactly as the user gave it.
 std::string num(double v) {
@@ -104,10 +105,29 @@ void validateProblem(const PlanningProblem& p) {
                          "], got " + std::to_string(p.accuracy.max_steps));
     }
   }
+  if (p.extra_revolutions < 0) {
+    throw InvalidInput(
+        "extra_revolutions: must be >= 0 (whole extra turns in the sense of the "
+        "chosen way; use direction LongWay to turn the other way), got " +
+        std::to_string(p.extra_revolutions));
+  }
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
   requireFinite(p.final_velocity, "final.angular_velocity");
+}
+
+void validateOptions(const SolverOptions& o) {
+  if (!std::isfinite(o.tolerance) || !(o.tolerance > 0.0)) {
+    throw InvalidInput("tolerance: must be a finite number > 0, got " + num(o.tolerance));
+  }
+  if (o.max_iterations < 0) {
+    throw InvalidInput("max_iterations: must be >= 0, got " + std::to_string(o.max_iterations));
+  }
+  if (!std::isfinite(o.time_budget_s) || o.time_budget_s < 0.0) {
+    throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = none), got " +
+                       num(o.time_budget_s));
+  }
 }
 
 void requirePhysicalInertia(const Matrix3& inertia) {

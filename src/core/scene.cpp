@@ -109,7 +109,7 @@ class SceneParser {
     if (rigid) {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
-                 "allow_nonphysical_inertia"},
+                 "allow_nonphysical_inertia", "direction", "extra_revolutions"},
                 {"inertia", "duration", "steps", "initial", "final", "effects"});
     } else {
       checkKeys(root, "",
@@ -132,6 +132,20 @@ class SceneParser {
         fail(root["scheme"], "scheme",
              "unknown value " + show(root["scheme"]) + " (expected paper or variational)");
       }
+    }
+    if (root["direction"]) {
+      const std::string name = scalarString(root["direction"], "direction");
+      if (name == "shortest") {
+        p.direction = RotationDirection::Shortest;
+      } else if (name == "long_way") {
+        p.direction = RotationDirection::LongWay;
+      } else {
+        fail(root["direction"], "direction",
+             "unknown value " + show(root["direction"]) + " (expected shortest or long_way)");
+      }
+    }
+    if (root["extra_revolutions"]) {
+      p.extra_revolutions = integer(root["extra_revolutions"], "extra_revolutions");
     }
     if (root["control_weights"]) {
       const YAML::Node w = root["control_weights"];
@@ -492,6 +506,8 @@ std::string formatScene(const Scene& scene) {
   out << "duration: " << fmt(p.duration) << "\n";
   out << "steps: " << p.steps << "\n";
   out << "scheme: " << schemeName(p.scheme) << "\n";
+  if (p.direction == RotationDirection::LongWay) out << "direction: long_way\n";
+  if (p.extra_revolutions != 0) out << "extra_revolutions: " << p.extra_revolutions << "\n";
   const bool rigid = scene.system == "rigid_body";
   out << "initial: {attitude: " << quaternionOf(p.initial_attitude);
   if (rigid) out << ", angular_velocity: " << vec(p.initial_velocity);

@@ -17,13 +17,6 @@ std::string quaternionText(const geometry_msgs::Quaternion& q) {
   return s.str();
 }
 
-std::string numberText(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
@@ -91,6 +84,12 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
   }
   validateEffects(specs, "effects");
   applyEffects(specs, problem);
+}
+
+std::string numberText(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
 }
 
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {

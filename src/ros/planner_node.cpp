@@ -7,6 +7,7 @@ namespace attitude_planner {
 int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s) {
   if (result.converged) return PlanErrorCode::SUCCESS;
   if (cancelled) return PlanErrorCode::CANCELLED;
+  if (result.step_too_large) return PlanErrorCode::STEP_TOO_LARGE;
   if (timed_out || (time_budget_s > 0.0 && result.solve_time_s >= time_budget_s)) {
     return PlanErrorCode::TIMED_OUT;
   }
@@ -85,6 +86,9 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       ">= 0 s, 0 = none");
   d.max_steps = readParam<int>(
       pnh, "max_steps", d.max_steps, [](int v) { return v >= 4; }, ">= 4");
+  d.max_solve_time = readParam<double>(
+      pnh, "max_solve_time", d.max_solve_time, [](double v) { return std::isfinite(v) && v > 0.0; },
+      "> 0 s");
   defaults_ = d;
   world_frame_ = readParam<std::string>(
       pnh, "world_frame", "world", [](const std::string& s) { return !s.empty(); }, "non-empty");
@@ -105,7 +109,7 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
                   << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme " << d.scheme
                   << ", solver " << d.solver << ", tolerance " << d.tolerance << ", max_iterations "
                   << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "
-                  << d.max_steps << ")");
+                  << d.max_steps << ", max_solve_time " << d.max_solve_time << " s)");
 }
 
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,

@@ -127,6 +127,9 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     srv.request.duration = problem.duration;
     srv.request.steps = problem.steps;
     srv.request.scheme = schemeName(problem.scheme);
+    srv.request.direction =
+        problem.direction == RotationDirection::LongWay ? "long_way" : "shortest";
+    srv.request.extra_revolutions = problem.extra_revolutions;
     for (const EffectSpec& e : effects) {
       // Noise is random: the replay adds it, the plan cannot know it.
       if (!std::holds_alternative<TorqueNoiseSpec>(e))

@@ -43,6 +43,8 @@ const char* const kUsage =
     "                            drift_two_input: terminal attitude error [rad] (default 1e-11)\n"
     "  --max-iterations K        iteration limit (nlopt: function evaluations; default 200)\n"
     "  --time-budget S           wall-time limit [s] (default: none; rigid_body only)\n"
+    "  --direction shortest|long_way  which way round (rigid_body; overrides the scene)\n"
+    "  --extra-revolutions K     K >= 0 extra full turns (rigid_body; overrides the scene)\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
     "  --csv OUT.csv             write the trajectory: rigid_body "
     "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
@@ -103,8 +105,10 @@ struct Arguments {
   double tolerance = -1.0;      ///< < 0: the default
   int max_iterations = -1;      ///< < 0: the default
   double time_budget = 0.0;
-  std::string target_flag;    ///< "--target-miss" / "--target-cost-error", "" if absent
-  double target_value = 0.0;  ///< its value (> 0)
+  std::string target_flag;     ///< "--target-miss" / "--target-cost-error", "" if absent
+  double target_value = 0.0;   ///< its value (> 0)
+  std::string direction;       ///< "" : the scene's
+  int extra_revolutions = -1;  ///< < 0: the scene's
   std::string csv;
   std::string summary;
   bool help = false;
@@ -133,6 +137,7 @@ Arguments parseArguments(int argc, char** argv) {
       arg = arg.substr(0, eq);
       has_value = true;
     }
+    std::string value_text;  // a flag's value as typed, for messages
     const auto next = [&]() -> std::string {
       if (has_value) return value;
       if (i + 1 >= argc) throw UsageError{arg + ": missing value"};
@@ -153,14 +158,19 @@ Arguments parseArguments(int argc, char** argv) {
         throw UsageError{"--solver: unknown value '" + a.solver + "' (newton or nlopt)"};
       }
     } else if (arg == "--tolerance") {
-      a.tolerance = parseDouble(arg, next());
-      if (!(a.tolerance > 0.0)) throw UsageError{"--tolerance: must be > 0"};
+      value_text = next();
+      a.tolerance = parseDouble(arg, value_text);
+      if (!(a.tolerance > 0.0)) throw UsageError{"--tolerance: must be > 0, got " + value_text};
     } else if (arg == "--max-iterations") {
       a.max_iterations = parseInt(arg, next());
-      if (a.max_iterations < 1) throw UsageError{"--max-iterations: must be >= 1"};
+      if (a.max_iterations < 1) {
+        throw UsageError{"--max-iterations: must be >= 1, got " + std::to_string(a.max_iterations)};
+      }
     } else if (arg == "--time-budget") {
-      a.time_budget = parseDouble(arg, next());
-      if (!(a.time_budget > 0.0)) throw UsageError{"--time-budget: must be > 0 s"};
+      value_text = next();
+      a.time_budget = parseDouble(arg, value_text);
+      if (!(a.time_budget > 0.0))
+        throw UsageError{"--time-budget: must be > 0 s, got " + value_text};
     } else if (arg == "--target-miss" || arg == "--target-cost-error") {
       if (!a.target_flag.empty()) {
         throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
@@ -169,6 +179,17 @@ Arguments parseArguments(int argc, char** argv) {
       const std::string text = next();
       a.target_value = parseDouble(arg, text);
       if (!(a.target_value > 0.0)) throw UsageError{arg + ": must be > 0, got " + text};
+    } else if (arg == "--direction") {
+      a.direction = next();
+      if (a.direction != "shortest" && a.direction != "long_way") {
+        throw UsageError{"--direction: unknown value '" + a.direction + "' (shortest or long_way)"};
+      }
+    } else if (arg == "--extra-revolutions") {
+      a.extra_revolutions = parseInt(arg, next());
+      if (a.extra_revolutions < 0) {
+        throw UsageError{"--extra-revolutions: must be >= 0, got " +
+                         std::to_string(a.extra_revolutions)};
+      }
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
       parseCostate(a.initial_costate);  // checked here: a usage error, exit status 2
@@ -193,10 +214,10 @@ Arguments parseArguments(int argc, char** argv) {
 /// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
   if (!args.scheme.empty() || args.solver_given || args.time_budget > 0.0 ||
-      !args.target_flag.empty()) {
-    std::cerr << "plan_maneuver: --scheme, --solver, --time-budget and --target-* apply to system: "
-                 "rigid_body "
-                 "only (this scene is drift_two_input)\n\n"
+      !args.target_flag.empty() || !args.direction.empty() || args.extra_revolutions >= 0) {
+    std::cerr << "plan_maneuver: --scheme, --solver, --time-budget, --direction, "
+                 "--extra-revolutions and --target-* apply to system: rigid_body only (this "
+                 "scene is drift_two_input)\n\n"
               << kUsage;
     return 2;
   }
@@ -263,6 +284,9 @@ int main(int argc, char** argv) {
       problem.accuracy.value = args.target_value;
       problem.accuracy.choose_scheme = args.scheme == "auto";
     }
+    if (args.direction == "shortest") problem.direction = ap::RotationDirection::Shortest;
+    if (args.direction == "long_way") problem.direction = ap::RotationDirection::LongWay;
+    if (args.extra_revolutions >= 0) problem.extra_revolutions = args.extra_revolutions;
 
     ap::SolverOptions options;
     options.solver = args.solver;

@@ -1,6 +1,8 @@
 // rostest: drives attitude_planner_node through its action plan_attitude_maneuver_action.
 #include <gtest/gtest.h>
+
 #include <ros/ros.h>
+#include <limits>
 
 #include <actionlib/client/simple_action_client.h>
 
@@ -111,6 +113,29 @@ TEST_F(PlannerAction, InvalidGoalIsAbortedWithTheField) {
   EXPECT_EQ(result->error_code.val, PlanErrorCode::INVALID_INPUT);
   EXPECT_NE(result->message.find("initial_attitude: zero quaternion"), std::string::npos)
       << result->message;
+}
+
+TEST_F(PlannerAction, StepTooLargeGoalIsAbortedWithItsCodeAndTheNextGoalSucceeds) {
+  PlanAttitudeManeuverGoal goal = seed(8);
+  goal.duration = 1.0;
+  goal.final_angular_velocity.x = 40.0;  // h|Ω_{N-1}| = 5 rad > π
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::STEP_TOO_LARGE)
+      << client_->getResult()->message;
+  PlanAttitudeManeuverGoal nan_goal = seed();
+  nan_goal.final_angular_velocity.y = std::numeric_limits<double>::quiet_NaN();
+  client_->sendGoal(nan_goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(client_->getResult()->message.find("final.angular_velocity: not finite"),
+            std::string::npos)
+      << client_->getResult()->message;
+  client_->sendGoal(seed());
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED) << client_->getResult()->message;
 }
 
 int main(int argc, char** argv) {

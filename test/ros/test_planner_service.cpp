@@ -155,6 +155,58 @@ TEST_F(PlannerService, AccuracyTargetChoosesStepsAndReturnsTheEstimate) {
       << unknown.message;
 }
 
+TEST_F(PlannerService, StepTooLargeIsItsOwnErrorAndTheNodeKeepsServing) {
+  PlanAttitudeManeuver::Request req = seed(8);
+  req.duration = 1.0;
+  req.initial_angular_velocity.z = 40.0;  // h|Ω_0| = 5 rad > π: no paper step exists
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_FALSE(res.success);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::STEP_TOO_LARGE) << res.message;
+  EXPECT_NE(res.message.find("initial.angular_velocity: step too large, increase steps"),
+            std::string::npos)
+      << res.message;
+  req.steps = 64;  // h|Ω_0| = 0.625
+  const PlanAttitudeManeuver::Response fine = call(req);
+  EXPECT_TRUE(fine.success) << fine.message;
+}
+
+TEST_F(PlannerService, RunawaySolveIsStoppedByMaxSolveTimeAndTheNextRequestIsServed) {
+  // planner_service.test sets ~max_solve_time 3 s; this request asks for 1e6 s with the NLopt
+  // cross-check at N = 512 (dense SLSQP, O(N³) per iteration: minutes unbounded). (Newton is no
+  // runaway: even at N = 1e5 with an unreachable tolerance it stops at the round-off floor.)
+  PlanAttitudeManeuver::Request req = seed(512);
+  req.solver = "nlopt";
+  req.max_iterations = 1000000;
+  req.time_budget = 1e6;
+  const ros::WallTime start = ros::WallTime::now();
+  const PlanAttitudeManeuver::Response res = call(req);
+  const double elapsed = (ros::WallTime::now() - start).toSec();
+  EXPECT_FALSE(res.success);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
+  EXPECT_LT(elapsed, 3.0 + 15.0) << res.message;  // the budget, one fine iteration and transport
+  std::printf("runaway request stopped after %.2f s: %s\n", elapsed, res.message.c_str());
+  const PlanAttitudeManeuver::Response next = call(seed());
+  EXPECT_TRUE(next.success) << next.message;
+}
+
+TEST_F(PlannerService, LongWayAndExtraTurnsAreHonoured) {
+  // 1 rad about x (seed J, N = 64): the other way round and one extra turn cost more than the
+  // short way and still land.
+  const PlanAttitudeManeuver::Response short_way = call(seed(64, 1.0));
+  PlanAttitudeManeuver::Request req = seed(64, 1.0);
+  req.direction = "long_way";
+  const PlanAttitudeManeuver::Response long_way = call(req);
+  req.direction = "";
+  req.extra_revolutions = 1;
+  const PlanAttitudeManeuver::Response extra = call(req);
+  for (const auto* r : {&short_way, &long_way, &extra}) {
+    ASSERT_TRUE(r->success) << r->message;
+    EXPECT_LT(r->terminal_attitude_error, 1e-9);
+  }
+  EXPECT_GT(long_way.cost, short_way.cost);
+  EXPECT_GT(extra.cost, short_way.cost);
+}
+
 TEST_F(PlannerService, EffectsArePlannedListedAndLandWhenReplayedUnderThem) {
   // scenes/leo_slew.yaml as a request: gravity gradient + world disturbance in the planning model.
   PlanAttitudeManeuver::Request r;

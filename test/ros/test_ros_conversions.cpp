@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
 #include <limits>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
@@ -89,6 +92,140 @@ TEST(RosConversions, BadFieldsAreNamedWithTheirValue) {
   r = seedRequest();
   r.time_budget = -3.0;
   EXPECT_NE(invalidMessage(r).find("time_budget"), std::string::npos);
+}
+
+TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
+  // Issue 7: every bad request is refused with a specific message and code, never a crash. With
+  // AP_BAD_INPUT_TABLE=<file> the rows are also written as markdown (docs/robustness.md).
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    std::string what;
+    std::function<void(PlanAttitudeManeuver::Request*)> edit;
+    int code;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"inertia[4] = NaN", [&](auto* r) { r->inertia[4] = nan; }, PlanErrorCode::INVALID_INPUT,
+       "inertia: not finite"},
+      {"duration = Inf", [&](auto* r) { r->duration = inf; }, PlanErrorCode::INVALID_INPUT,
+       "duration: must be a finite number > 0 s, got inf"},
+      {"initial_angular_velocity.y = NaN", [&](auto* r) { r->initial_angular_velocity.y = nan; },
+       PlanErrorCode::INVALID_INPUT, "initial.angular_velocity: not finite"},
+      {"final_angular_velocity.z = -Inf", [&](auto* r) { r->final_angular_velocity.z = -inf; },
+       PlanErrorCode::INVALID_INPUT, "final.angular_velocity: not finite"},
+      {"final_attitude.x = NaN", [&](auto* r) { r->final_attitude.x = nan; },
+       PlanErrorCode::INVALID_INPUT, "final_attitude: quaternion not finite"},
+      {"inertia not symmetric (J01 = 0)", [&](auto* r) { r->inertia[1] = 0.0; },
+       PlanErrorCode::INVALID_INPUT, "inertia: not symmetric"},
+      {"inertia not positive definite (J00 = -1)", [&](auto* r) { r->inertia[0] = -1.0; },
+       PlanErrorCode::INVALID_INPUT, "inertia: not positive definite"},
+      {"seed J without allow_nonphysical_inertia",
+       [&](auto* r) { r->allow_nonphysical_inertia = false; }, PlanErrorCode::INVALID_INPUT,
+       "violate the triangle inequality J1 + J2 >= J3"},
+      {"inertia diag(1, 1e13, 1e13) (condition 1e13)",
+       [&](auto* r) {
+         r->inertia = {1, 0, 0, 0, 1e13, 0, 0, 0, 1e13};
+         r->allow_nonphysical_inertia = false;
+       },
+       PlanErrorCode::INVALID_INPUT, "inertia: condition number 10000000000000"},
+      {"final_attitude = (0, 0, 0, 0)",
+       [&](auto* r) { r->final_attitude = geometry_msgs::Quaternion(); },
+       PlanErrorCode::INVALID_INPUT, "final_attitude: zero quaternion"},
+      {"initial_attitude = (2, 0, 0, 0)", [&](auto* r) { r->initial_attitude.w = 2.0; },
+       PlanErrorCode::INVALID_INPUT, "initial_attitude: quaternion norm 2 is not 1"},
+      {"duration = 0", [&](auto* r) { r->duration = 0.0; }, PlanErrorCode::INVALID_INPUT,
+       "duration: must be a finite number > 0 s, got 0"},
+      {"duration = -12.8", [&](auto* r) { r->duration = -12.8; }, PlanErrorCode::INVALID_INPUT,
+       "duration: must be a finite number > 0 s, got -12.8"},
+      {"steps = 3", [&](auto* r) { r->steps = 3; }, PlanErrorCode::INVALID_INPUT,
+       "steps: must be >= 4, got 3"},
+      {"steps = -2147483648", [&](auto* r) { r->steps = std::numeric_limits<int>::min(); },
+       PlanErrorCode::INVALID_INPUT, "steps: must be >= 4, got -2147483648"},
+      {"steps = 2147483647 (> ~max_steps)",
+       [&](auto* r) { r->steps = std::numeric_limits<int>::max(); }, PlanErrorCode::INVALID_INPUT,
+       "steps: 2147483647 exceeds the node's ~max_steps = 100000"},
+      {"tolerance = -1e-12", [&](auto* r) { r->tolerance = -1e-12; }, PlanErrorCode::INVALID_INPUT,
+       "tolerance: must be a finite number >= 0 (0 = default), got -9.9999999999999998e-13"},
+      {"tolerance = NaN", [&](auto* r) { r->tolerance = nan; }, PlanErrorCode::INVALID_INPUT,
+       "tolerance: must be a finite number >= 0 (0 = default), got nan"},
+      {"max_iterations = -1", [&](auto* r) { r->max_iterations = -1; },
+       PlanErrorCode::INVALID_INPUT, "max_iterations: must be >= 0 (0 = default), got -1"},
+      {"time_budget = -3", [&](auto* r) { r->time_budget = -3.0; }, PlanErrorCode::INVALID_INPUT,
+       "time_budget: must be a finite number >= 0 s (0 = default), got -3"},
+      {"scheme = \"rk4\"", [&](auto* r) { r->scheme = "rk4"; }, PlanErrorCode::INVALID_INPUT,
+       "scheme: unknown value 'rk4'"},
+      {"direction = \"sideways\"", [&](auto* r) { r->direction = "sideways"; },
+       PlanErrorCode::INVALID_INPUT, "direction: unknown value 'sideways'"},
+      {"extra_revolutions = -1", [&](auto* r) { r->extra_revolutions = -1; },
+       PlanErrorCode::INVALID_INPUT, "extra_revolutions: must be >= 0"},
+      {"effects[0].type = \"torque_noise\"",
+       [&](auto* r) {
+         r->effects = {rc::effectToMsg(TorqueNoiseSpec{Vector3(1e-4, 0, 0), 1})};
+       },
+       PlanErrorCode::INVALID_INPUT, "torque_noise"},
+      {"initial_angular_velocity.z = 40, duration 1, steps 8 (h|Ω| = 5)",
+       [&](auto* r) {
+         r->initial_angular_velocity.z = 40.0;
+         r->duration = 1.0;
+         r->steps = 8;
+       },
+       PlanErrorCode::STEP_TOO_LARGE, "initial.angular_velocity: step too large, increase steps"},
+  };
+  std::ofstream table;
+  if (const char* path = std::getenv("AP_BAD_INPUT_TABLE")) table.open(path);
+  for (const Case& c : cases) {
+    PlanAttitudeManeuver::Request r = seedRequest();
+    c.edit(&r);
+    const PlanOutcome out = planRequest(r, rc::PlannerDefaults(), nullptr);
+    EXPECT_EQ(out.error_code, c.code) << c.what << ": " << out.message;
+    EXPECT_NE(out.message.find(c.expected), std::string::npos)
+        << c.what << ": '" << out.message << "' lacks '" << c.expected << "'";
+    PlanAttitudeManeuver::Response res;
+    fillResponse(out, "world", "body", &res);
+    EXPECT_FALSE(res.success) << c.what;
+    EXPECT_TRUE(res.maneuver.attitude.empty()) << c.what;
+    if (table) {
+      std::string message = out.message;
+      for (char& ch : message) ch = ch == '|' ? '/' : ch;
+      table << "| " << c.what << " | " << out.error_code << " | `" << message << "` |\n";
+    }
+  }
+  // Accepted: a near-unit quaternion (normalized) and w < 0.
+  PlanAttitudeManeuver::Request near = seedRequest();
+  near.initial_attitude.w = -1.0005;
+  SolverOptions options;
+  const PlanningProblem p = rc::problemFromRequest(near, rc::PlannerDefaults(), &options);
+  EXPECT_LT(so3::angleBetween(p.initial_attitude, Matrix3::Identity()), 1e-15);
+}
+
+TEST(RosConversions, DirectionAndExtraRevolutionsReachTheProblem) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.direction = "long_way";
+  r.extra_revolutions = 2;
+  SolverOptions options;
+  const PlanningProblem p = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  EXPECT_EQ(p.direction, RotationDirection::LongWay);
+  EXPECT_EQ(p.extra_revolutions, 2);
+  r.direction = "";
+  EXPECT_EQ(rc::problemFromRequest(r, rc::PlannerDefaults(), &options).direction,
+            RotationDirection::Shortest);
+}
+
+TEST(RosConversions, MaxSolveTimeCapsEveryRequestsBudget) {
+  rc::PlannerDefaults d;
+  d.time_budget = 0.0;  // "none" by default ...
+  d.max_solve_time = 7.0;
+  SolverOptions options;
+  PlanAttitudeManeuver::Request r = seedRequest();
+  rc::problemFromRequest(r, d, &options);
+  EXPECT_EQ(options.time_budget_s, 7.0);  // ... is still bounded
+  r.time_budget = 1e9;
+  rc::problemFromRequest(r, d, &options);
+  EXPECT_EQ(options.time_budget_s, 7.0);
+  r.time_budget = 2.0;
+  rc::problemFromRequest(r, d, &options);
+  EXPECT_EQ(options.time_budget_s, 2.0);
 }
 
 TEST(RosConversions, EffectMessagesRoundTrip) {
@@ -283,6 +420,8 @@ TEST(RosConversions, ErrorCodesFollowTheOutcome) {
   r.solve_time_s = 2.0;
   EXPECT_EQ(classifyResult(r, false, false, 1.0), PlanErrorCode::TIMED_OUT);
   EXPECT_EQ(classifyResult(r, false, false, 0.0), PlanErrorCode::NOT_CONVERGED);
+  r.step_too_large = true;
+  EXPECT_EQ(classifyResult(r, false, false, 0.0), PlanErrorCode::STEP_TOO_LARGE);
 }
 
 TEST(PrincipalBox, UniformBoxMomentsAreRecovered) {

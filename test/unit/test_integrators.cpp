@@ -92,28 +92,8 @@ TEST(Integrators, MomentumJacobianMatchesFiniteDifferences) {
   }
 }
 
-TEST(Integrators, TorqueFreeMillionStepsStayOnGroupAndConserveSpatialMomentum) {
-  const Matrix3 J = Vector3(1, 2, 3).asDiagonal();
-  const int N = 1000000;
-  for (SchemeKind kind : {SchemeKind::Paper, SchemeKind::Variational}) {
-    const DiscreteScheme scheme(kind, J, 0.01);
-    const Maneuver m =
-        run(kind, J, 0.01, Vector3(0.6, 0.5, 0.4), std::vector<Vector3>(N + 1, Vector3::Zero()));
-    const auto spatial = [&](int k) {
-      return Vector3(m.attitude[k] * scheme.momentum<double>(
-                                         Matrix3(m.attitude[k].transpose() * m.attitude[k + 1])));
-    };
-    const Vector3 pi0 = spatial(0);
-    double worst_momentum = 0, worst_orthogonality = 0;
-    for (int k = 0; k < N; k += 997) {
-      worst_momentum = std::max(worst_momentum, (spatial(k) - pi0).norm() / pi0.norm());
-      worst_orthogonality = std::max(worst_orthogonality, so3::orthogonalityError(m.attitude[k]));
-    }
-    worst_orthogonality = std::max(worst_orthogonality, so3::orthogonalityError(m.attitude[N]));
-    EXPECT_LE(worst_orthogonality, 1e-14) << schemeName(kind);
-    EXPECT_LE(worst_momentum, 1e-13) << schemeName(kind);
-  }
-}
+// The 1e6-step torque-free drift test lives in the hard-case catalog of issue 7
+// (TorqueFreeMillionSteps in src/core/robustness_cases.cpp, asserted by test_hard_cases).
 
 TEST(Integrators, VariationalEnergyDoesNotDriftOver2000Seconds) {
   const Matrix3 J = Vector3(1, 2, 3).asDiagonal();

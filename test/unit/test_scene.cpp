@@ -364,8 +364,8 @@ TEST(SceneErrors, DurationAndStepsOutOfRange) {
   EXPECT_CONTAINS(errorOf(withLine("duration", "duration: 0")), "duration: must be");
   EXPECT_CONTAINS(errorOf(withLine("duration", "duration: -1.5")), "got -1.5");
   EXPECT_CONTAINS(errorOf(withLine("steps", "steps: 3")), "steps: must be >= 4, got 3");
-  EXPECT_CONTAINS(errorOf(withLine("steps", "steps: 10000001")),
-                  "steps: must be <= 10000000, got 10000001");
+  EXPECT_CONTAINS(errorOf(withLine("steps", "steps: 2000001")),
+                  "steps: must be <= 2000000, got 2000001");
 }
 
 TEST(SceneErrors, BadQuaternionIsNamed) {

@@ -73,14 +73,20 @@ Effect effectToMsg(const EffectSpec& spec);
 /// planning model of `problem` (applyEffects). torque_noise is refused: it is not plannable.
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem);
 
+/// %.17g of a number (every double round-trips; NaN and Inf spelled nan, inf).
+std::string numberText(double value);
+
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
   std::string scheme = "paper";   ///< "paper" | "variational"
   std::string solver = "newton";  ///< "newton" | "nlopt"
   double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
   int max_iterations = 200;       ///< iteration limit
-  double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none
+  double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none (then max_solve_time)
   int max_steps = 100000;         ///< largest accepted N
+  /// Cap on every request's time budget [s] (> 0): a request asking for more, or for none
+  /// (time_budget 0 with ~time_budget 0), is solved with this budget, so no solve runs away.
+  double max_solve_time = 300.0;
 };
 
 /// Builds the core request of a plan_drift_two_input call (zero fields take the documented
@@ -135,6 +141,15 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
                          "' (expected paper, variational or auto)");
     }
   }
+  if (req.direction.empty() || req.direction == "shortest") {
+    p.direction = RotationDirection::Shortest;
+  } else if (req.direction == "long_way") {
+    p.direction = RotationDirection::LongWay;
+  } else {
+    throw InvalidInput("direction: unknown value '" + req.direction +
+                       "' (expected shortest or long_way; empty = shortest)");
+  }
+  p.extra_revolutions = req.extra_revolutions;  // < 0 refused by validateProblem
   options->solver = req.solver.empty() ? defaults.solver : req.solver;
   if (options->solver != "newton" && options->solver != "nlopt") {
     throw InvalidInput("solver: unknown value '" + options->solver +
@@ -142,7 +157,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   }
   if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
     throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +
-                       std::to_string(req.tolerance));
+                       numberText(req.tolerance));
   }
   options->tolerance = req.tolerance > 0.0 ? req.tolerance : defaults.tolerance;
   if (req.max_iterations < 0) {
@@ -152,9 +167,13 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   options->max_iterations = req.max_iterations > 0 ? req.max_iterations : defaults.max_iterations;
   if (!std::isfinite(req.time_budget) || req.time_budget < 0.0) {
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = default), got " +
-                       std::to_string(req.time_budget));
+                       numberText(req.time_budget));
   }
   options->time_budget_s = req.time_budget > 0.0 ? req.time_budget : defaults.time_budget;
+  if (defaults.max_solve_time > 0.0 &&
+      (options->time_budget_s <= 0.0 || options->time_budget_s > defaults.max_solve_time)) {
+    options->time_budget_s = defaults.max_solve_time;  // the node's ~max_solve_time bounds all
+  }
   applyRequestEffects(req.effects, &p);
   return p;
 }

@@ -17,6 +17,8 @@
 //   ~max_iterations  int     200        iteration limit (> 0)
 //   ~time_budget     double  30.0       wall-time limit per solve [s] (0 = none)
 //   ~max_steps       int     100000     largest accepted N (>= 4; both services)
+//   ~max_solve_time  double  300.0      cap on every request's time budget [s] (> 0): a request
+//                                       asking for more (or for none) gets this budget
 //   ~world_frame     string  "world"    frame_id of the returned maneuver
 //   ~body_frame      string  "body"     child_frame_id of the returned maneuver
 //   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
@@ -52,7 +54,8 @@ struct PlanOutcome {
 };
 
 /// Decides the error code of a finished solve: converged → SUCCESS; cancelled by the caller →
-/// CANCELLED; time budget exhausted → TIMED_OUT; otherwise NOT_CONVERGED.
+/// CANCELLED; an implicit step without solution (PlanResult::step_too_large) → STEP_TOO_LARGE;
+/// time budget exhausted → TIMED_OUT; otherwise NOT_CONVERGED.
 int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s);
 
 /// Runs one request through the core. `keep_going(info, elapsed_s)` is called after every

@@ -172,9 +172,10 @@ TEST_F(PlannerService, StepTooLargeIsItsOwnErrorAndTheNodeKeepsServing) {
 
 TEST_F(PlannerService, RunawaySolveIsStoppedByMaxSolveTimeAndTheNextRequestIsServed) {
   // planner_service.test sets ~max_solve_time 3 s; this request asks for 1e6 s with the NLopt
-  // cross-check at N = 512 (dense SLSQP, O(N³) per iteration: minutes unbounded). (Newton is no
-  // runaway: even at N = 1e5 with an unreachable tolerance it stops at the round-off floor.)
-  PlanAttitudeManeuver::Request req = seed(512);
+  // cross-check at N = 256 (dense SLSQP, O(N³) per iteration: ~0.5 s each, about a minute
+  // unbounded). (Newton is no runaway: even at N = 1e5 with an unreachable tolerance it stops at
+  // the round-off floor in ~2 s.)
+  PlanAttitudeManeuver::Request req = seed(256);
   req.solver = "nlopt";
   req.max_iterations = 1000000;
   req.time_budget = 1e6;

@@ -444,7 +444,10 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   // the coarse iterate carried over and replayed (no iteration on this grid).
   const auto stopped = [&](const std::string& why) {
     fine_options.max_iterations = 0;
-    PlanResult out = solveOnGrid(problem, fine_options, &coarse_steps, final_steps);
+    // (A coarse level that failed before iterating left no steps: the Hermite guess then.)
+    const bool have_steps = static_cast<int>(coarse_steps.size()) == coarse.steps;
+    PlanResult out =
+        solveOnGrid(problem, fine_options, have_steps ? &coarse_steps : nullptr, final_steps);
     out.converged = false;
     out.cancelled = coarse_result.cancelled;
     out.iterations = coarse_result.iterations;

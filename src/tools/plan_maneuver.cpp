@@ -52,10 +52,17 @@ const char* const kUsage =
     "  --summary OUT.json        write the result figures as JSON\n"
     "  --help                    show this help\n"
     "\n"
-    "exit status: 0 converged, 1 not converged or invalid input, 2 usage error\n";
+    "exit status: 0 converged, 1 not converged or invalid input (a bad scene or a bad flag\n"
+    "value), 2 usage error (unknown option, missing value or scene file)\n";
 
-/// A command-line mistake: reported with the usage text, exit status 2.
+/// A malformed command line (unknown option, missing value or scene): the usage text, exit 2.
 struct UsageError {
+  std::string message;
+};
+
+/// A flag whose value is invalid (not a number, NaN, out of range, unknown name): bad input like
+/// a bad scene value, exit status 1, the message names the flag and the value.
+struct InvalidFlagValue {
   std::string message;
 };
 
@@ -65,7 +72,7 @@ int parseInt(const std::string& flag, const std::string& text) {
   const long v = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || v > 2147483647L ||
       v < -2147483647L) {
-    throw UsageError{flag + ": expected an integer, got '" + text + "'"};
+    throw InvalidFlagValue{flag + ": expected an integer, got '" + text + "'"};
   }
   return static_cast<int>(v);
 }
@@ -75,7 +82,7 @@ double parseDouble(const std::string& flag, const std::string& text) {
   errno = 0;
   const double v = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v)) {
-    throw UsageError{flag + ": expected a finite number, got '" + text + "'"};
+    throw InvalidFlagValue{flag + ": expected a finite number, got '" + text + "'"};
   }
   return v;
 }
@@ -87,7 +94,8 @@ ap::Vector3 parseCostate(const std::string& text) {
   for (int i = 0; i < 3; ++i) {
     const std::size_t comma = text.find(',', start);
     if ((i < 2) != (comma != std::string::npos)) {
-      throw UsageError{"--initial-costate: expected P1,P2,P3 (three numbers), got '" + text + "'"};
+      throw InvalidFlagValue{"--initial-costate: expected P1,P2,P3 (three numbers), got '" + text +
+                             "'"};
     }
     p(i) = parseDouble("--initial-costate", text.substr(start, comma - start));
     start = comma + 1;
@@ -145,32 +153,36 @@ Arguments parseArguments(int argc, char** argv) {
     };
     if (arg == "--steps") {
       a.steps = parseInt(arg, next());
-      if (a.steps < 1) throw UsageError{"--steps: must be >= 4, got " + std::to_string(a.steps)};
+      if (a.steps < 1)
+        throw InvalidFlagValue{"--steps: must be >= 4, got " + std::to_string(a.steps)};
     } else if (arg == "--scheme") {
       a.scheme = next();
       if (a.scheme != "paper" && a.scheme != "variational" && a.scheme != "auto") {
-        throw UsageError{"--scheme: unknown value '" + a.scheme + "' (paper, variational or auto)"};
+        throw InvalidFlagValue{"--scheme: unknown value '" + a.scheme +
+                               "' (paper, variational or auto)"};
       }
     } else if (arg == "--solver") {
       a.solver = next();
       a.solver_given = true;
       if (a.solver != "newton" && a.solver != "nlopt") {
-        throw UsageError{"--solver: unknown value '" + a.solver + "' (newton or nlopt)"};
+        throw InvalidFlagValue{"--solver: unknown value '" + a.solver + "' (newton or nlopt)"};
       }
     } else if (arg == "--tolerance") {
       value_text = next();
       a.tolerance = parseDouble(arg, value_text);
-      if (!(a.tolerance > 0.0)) throw UsageError{"--tolerance: must be > 0, got " + value_text};
+      if (!(a.tolerance > 0.0))
+        throw InvalidFlagValue{"--tolerance: must be > 0, got " + value_text};
     } else if (arg == "--max-iterations") {
       a.max_iterations = parseInt(arg, next());
       if (a.max_iterations < 1) {
-        throw UsageError{"--max-iterations: must be >= 1, got " + std::to_string(a.max_iterations)};
+        throw InvalidFlagValue{"--max-iterations: must be >= 1, got " +
+                               std::to_string(a.max_iterations)};
       }
     } else if (arg == "--time-budget") {
       value_text = next();
       a.time_budget = parseDouble(arg, value_text);
       if (!(a.time_budget > 0.0))
-        throw UsageError{"--time-budget: must be > 0 s, got " + value_text};
+        throw InvalidFlagValue{"--time-budget: must be > 0 s, got " + value_text};
     } else if (arg == "--target-miss" || arg == "--target-cost-error") {
       if (!a.target_flag.empty()) {
         throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
@@ -178,21 +190,22 @@ Arguments parseArguments(int argc, char** argv) {
       a.target_flag = arg;
       const std::string text = next();
       a.target_value = parseDouble(arg, text);
-      if (!(a.target_value > 0.0)) throw UsageError{arg + ": must be > 0, got " + text};
+      if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
     } else if (arg == "--direction") {
       a.direction = next();
       if (a.direction != "shortest" && a.direction != "long_way") {
-        throw UsageError{"--direction: unknown value '" + a.direction + "' (shortest or long_way)"};
+        throw InvalidFlagValue{"--direction: unknown value '" + a.direction +
+                               "' (shortest or long_way)"};
       }
     } else if (arg == "--extra-revolutions") {
       a.extra_revolutions = parseInt(arg, next());
       if (a.extra_revolutions < 0) {
-        throw UsageError{"--extra-revolutions: must be >= 0, got " +
-                         std::to_string(a.extra_revolutions)};
+        throw InvalidFlagValue{"--extra-revolutions: must be >= 0, got " +
+                               std::to_string(a.extra_revolutions)};
       }
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
-      parseCostate(a.initial_costate);  // checked here: a usage error, exit status 2
+      parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
     } else if (arg == "--csv") {
       a.csv = next();
     } else if (arg == "--summary") {
@@ -257,6 +270,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "plan_maneuver: " << e.message << "\n\n" << kUsage;
     return 2;
+  } catch (const InvalidFlagValue& e) {
+    std::cerr << "plan_maneuver: " << e.message << "\n";
+    return 1;
   }
   if (args.help) {
     std::cout << kUsage;

@@ -23,6 +23,7 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/robustness_cases.hpp"
 #include "attitude_planner/scene.hpp"
+#include "tool_runner.hpp"
 
 namespace ap = attitude_planner;
 namespace fs = std::filesystem;
@@ -30,7 +31,9 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string kHostile = AP_SOURCE_DIR "/test/hostile/scenes/";
-const std::string kBin = AP_BINARY_DIR "/../../devel/lib/attitude_planner/";
+using attitude_planner_test::runTool;
+using attitude_planner_test::ToolRun;
+const std::string& kBin = attitude_planner_test::kToolDir;
 
 struct HostileScene {
   std::string path;
@@ -53,22 +56,8 @@ std::vector<HostileScene> hostileScenes() {
   return out;
 }
 
-struct ToolRun {
-  int status = -1;
-  std::string output;
-};
-
 ToolRun run(const std::string& args) {
-  const std::string command = "timeout 60 '" + kBin + "plan_maneuver' " + args + " 2>&1";
-  ToolRun r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.output.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
+  return runTool("plan_maneuver", args, 60);
 }
 
 std::string errorOf(const std::function<void()>& f) {
@@ -167,26 +156,27 @@ TEST(HostileOptions, BadSolverOptionsNameTheOptionAndTheValue) {
 }
 
 TEST(HostileOptions, FlagValuesAreUsageErrorsNamingTheValue) {
-  // Command-line flags keep the documented usage-error status 2 (scene content: 1).
+  // A bad flag value is invalid input like a bad scene value: exit status 1, naming flag and value
+  // (2 stays for a malformed command line: unknown option, missing value).
   const std::string scene = "'" AP_SOURCE_DIR "/scenes/rest_to_rest.yaml'";
   const ToolRun tol = run(scene + " --tolerance -1e-3");
-  EXPECT_EQ(tol.status, 2) << tol.output;
+  EXPECT_EQ(tol.status, 1) << tol.output;
   EXPECT_NE(tol.output.find("--tolerance: must be > 0, got -1e-3"), std::string::npos)
       << tol.output;
   const ToolRun nan = run(scene + " --tolerance nan");
-  EXPECT_EQ(nan.status, 2) << nan.output;
+  EXPECT_EQ(nan.status, 1) << nan.output;
   EXPECT_NE(nan.output.find("--tolerance: expected a finite number, got 'nan'"), std::string::npos)
       << nan.output;
   const ToolRun budget = run(scene + " --time-budget -5");
-  EXPECT_EQ(budget.status, 2) << budget.output;
+  EXPECT_EQ(budget.status, 1) << budget.output;
   EXPECT_NE(budget.output.find("--time-budget: must be > 0 s, got -5"), std::string::npos)
       << budget.output;
   const ToolRun turns = run(scene + " --extra-revolutions -1");
-  EXPECT_EQ(turns.status, 2) << turns.output;
+  EXPECT_EQ(turns.status, 1) << turns.output;
   EXPECT_NE(turns.output.find("--extra-revolutions: must be >= 0, got -1"), std::string::npos)
       << turns.output;
   const ToolRun way = run(scene + " --direction sideways");
-  EXPECT_EQ(way.status, 2) << way.output;
+  EXPECT_EQ(way.status, 1) << way.output;
   EXPECT_NE(way.output.find("--direction: unknown value 'sideways'"), std::string::npos)
       << way.output;
 }

@@ -13,31 +13,19 @@
 
 #include "attitude_planner/maneuver.hpp"
 #include "attitude_planner/scene.hpp"
+#include "tool_runner.hpp"
 
 namespace ap = attitude_planner;
 
 namespace {
 
-const std::string kBin = AP_BINARY_DIR "/../../devel/lib/attitude_planner/";
+using attitude_planner_test::runTool;
+using attitude_planner_test::ToolRun;
+const std::string& kBin = attitude_planner_test::kToolDir;
 const std::string kScenes = AP_SOURCE_DIR "/scenes/";
 
-struct ToolRun {
-  int status = -1;     ///< exit status
-  std::string output;  ///< stdout and stderr together
-};
-
-/// Runs `tool args` through the shell, capturing both streams.
 ToolRun run(const std::string& tool, const std::string& args) {
-  const std::string command = "'" + kBin + tool + "' " + args + " 2>&1";
-  ToolRun r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.output.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
+  return runTool(tool, args);
 }
 
 std::string readFile(const std::string& path) {
@@ -314,7 +302,7 @@ TEST_F(CliTest, BadDriftTwoInputScenesExitOneNamingTheKey) {
   EXPECT_EQ(rigid_guess.status, 2) << rigid_guess.output;
   const ToolRun bad_guess =
       run("plan_maneuver", kScenes + "drift_two_input.yaml --initial-costate 1,2");
-  EXPECT_EQ(bad_guess.status, 2) << bad_guess.output;
+  EXPECT_EQ(bad_guess.status, 1) << bad_guess.output;  // a bad value: invalid input
   EXPECT_CONTAINS(bad_guess.output, "--initial-costate: expected P1,P2,P3");
 }
 
@@ -339,7 +327,7 @@ TEST_F(CliTest, TargetMissChoosesStepsAndReportsTheEstimate) {
 
   for (const char* bad : {"0", "-1e-6", "nan"}) {
     const ToolRun b = run("plan_maneuver", kScenes + "rest_to_rest.yaml --target-miss " + bad);
-    EXPECT_EQ(b.status, 2) << b.output;
+    EXPECT_EQ(b.status, 1) << b.output;  // a bad value: invalid input
     EXPECT_CONTAINS(b.output, std::string("--target-miss: "));
     EXPECT_CONTAINS(b.output, bad);
   }
@@ -360,11 +348,11 @@ TEST_F(CliTest, UsageErrorsNameTheFlag) {
   EXPECT_CONTAINS(missing.output, "--steps: missing value");
 
   const ToolRun not_number = run("plan_maneuver", kScenes + "rest_to_rest.yaml --tolerance abc");
-  EXPECT_EQ(not_number.status, 2);
+  EXPECT_EQ(not_number.status, 1);  // a bad value is invalid input (1), not a usage error
   EXPECT_CONTAINS(not_number.output, "--tolerance: expected a finite number, got 'abc'");
 
   const ToolRun scheme = run("plan_maneuver", kScenes + "rest_to_rest.yaml --scheme rk4");
-  EXPECT_EQ(scheme.status, 2);
+  EXPECT_EQ(scheme.status, 1);
   EXPECT_CONTAINS(scheme.output, "--scheme: unknown value 'rk4'");
 
   const ToolRun no_scene = run("plan_maneuver", "");

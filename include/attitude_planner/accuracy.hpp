@@ -61,8 +61,9 @@ double measuredOrder(SchemeKind scheme, AccuracyMeasure measure);
 
 /// Plans to problem.accuracy: solves N = 64 of each candidate scheme (and N = 32 for the cost's
 /// Richardson estimate), predicts N from the error there and the order, solves at N and checks
-/// the estimate (repeating with a larger N if it misses, at most 4 times). The result is the plan at the final N with
-/// PlanResult::accuracy filled; converged = false if the target was not reached.
+/// the estimate (repeating with a larger N if it misses, at most 4 times). The result is the plan
+/// at the final N with PlanResult::accuracy filled; converged = false if the target was not
+/// reached.
 PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& options);
 
 }  // namespace attitude_planner

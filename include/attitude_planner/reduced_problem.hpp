@@ -65,7 +65,8 @@ class ReducedProblem {
   /// steps keep their relative precision. Its torques differ from the fine solution's by about
   /// the coarse solution's own discretization error (resampling attitudes instead left O(1)
   /// torque jumps at the coarse nodes and the ends).
-  void initializeFromCoarser(const Steps& coarse);
+  /// With `coarser` (the solution on a still coarser grid) the two are extrapolated to this h.
+  void initializeFromCoarser(const Steps& coarse, const Steps* coarser = nullptr);
 
   /// R_0..R_N of the steps (products from R_0).
   std::vector<Matrix3> attitudes(const Steps& steps) const;

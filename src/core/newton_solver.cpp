@@ -162,7 +162,8 @@ std::vector<InitialGuess> initialGuesses(const PlanningProblem& problem, const R
 /// `final_steps` if given (the next finer grid starts from it).
 PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
                        const ReducedProblem::Steps* coarse_steps = nullptr,
-                       ReducedProblem::Steps* final_steps = nullptr) {
+                       ReducedProblem::Steps* final_steps = nullptr,
+                       const ReducedProblem::Steps* coarser_steps = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -185,7 +186,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   np.initializeHermite(guess.lift, T_inner * problem.initial_velocity,
                        T_inner * (so3::exp(guess.lift) * problem.final_velocity));
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
-  if (coarse_steps) np.initializeFromCoarser(*coarse_steps);
+  if (coarse_steps) np.initializeFromCoarser(*coarse_steps, coarser_steps);
   const int N = np.steps();
   const int n = 3 * (N - 3);
   const double round_off_acceptance = roundOffAcceptance(N);
@@ -425,7 +426,8 @@ bool coarseLevelHelps(const PlanningProblem& coarse) {
 }
 
 PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options,
-                                 ReducedProblem::Steps* final_steps = nullptr) {
+                                 ReducedProblem::Steps* final_steps = nullptr,
+                                 ReducedProblem::Steps* converged_level_below = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   if (problem.steps <= kCoarsestGrid || options.warm_start) {
     return solveOnGrid(problem, options, nullptr, final_steps);
@@ -437,8 +439,12 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   // The callback is forwarded (feedback from every level, and cancel works during all of them).
   // A coarse level only starts the next one, whose own O(h²) difference from it is far larger.
   coarse_options.tolerance = std::max(options.tolerance, 1e-6);
-  ReducedProblem::Steps coarse_steps;
-  const PlanResult coarse_result = solveWithContinuation(coarse, coarse_options, &coarse_steps);
+  ReducedProblem::Steps coarse_steps, coarser_steps;
+  const PlanResult coarse_result =
+      solveWithContinuation(coarse, coarse_options, &coarse_steps, &coarser_steps);
+  if (coarse_result.converged && converged_level_below) *converged_level_below = coarse_steps;
+  // Two converged levels below: the guess is extrapolated from both (first-order Richardson).
+  const ReducedProblem::Steps* extrapolate_from = coarser_steps.empty() ? nullptr : &coarser_steps;
   SolverOptions fine_options = options;
   // Stopped on a coarse level (cancel, time budget): answer on the requested grid anyway, with
   // the coarse iterate carried over and replayed (no iteration on this grid).
@@ -477,8 +483,9 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
       return options.on_iteration(global);
     };
   }
-  PlanResult result = solveOnGrid(problem, fine_options,
-                                  coarse_result.converged ? &coarse_steps : nullptr, final_steps);
+  PlanResult result =
+      solveOnGrid(problem, fine_options, coarse_result.converged ? &coarse_steps : nullptr,
+                  final_steps, extrapolate_from);
   result.iterations += before;
   result.message += level;
   return result;

@@ -108,9 +108,32 @@ void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitu
   for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
 }
 
-void ReducedProblem::initializeFromCoarser(const Steps& coarse) {
+namespace {
+
+/// The rate of `coarse` (steps of a grid of coarse.size() steps) at the position of step j of N,
+/// scaled to a step of that grid: step k of N belongs to T k/(N − 1) (see initializeFromCoarser).
+Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N) {
   const int Nc = static_cast<int>(coarse.size());
-  if (Nc < 4 || Nc >= N_) {
+  const auto slope = [&](int k) {
+    if (k == 0) return Vector3(coarse[1] - coarse[0]);
+    if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
+    return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
+  };
+  const double x = double(j) * (Nc - 1) / (N - 1);  // in coarse steps
+  const int i = std::min(static_cast<int>(x), Nc - 2);
+  const double s = x - i;
+  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
+               h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+  return double(Nc) / N *
+         (h00 * coarse[i] + h10 * slope(i) + h01 * coarse[i + 1] + h11 * slope(i + 1));
+}
+
+}  // namespace
+
+void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coarser) {
+  const int Nc = static_cast<int>(coarse.size());
+  if (Nc < 4 || Nc >= N_ ||
+      (coarser && (coarser->size() < 4 || coarser->size() >= coarse.size()))) {
     throw InvalidInput("grid continuation: a coarse grid of " + std::to_string(Nc) +
                        " steps cannot start one of " + std::to_string(N_));
   }
@@ -118,21 +141,16 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse) {
   // last one's Ω(T), and the optimal discrete solutions are smooth in k between them (measured),
   // so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h puts the fixed end steps
   // a fraction of a coarse step off: O(1) torque jumps at the ends.) Rates ω^c_k/h_c are
-  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h.
-  const auto slope = [&](int k) {
-    if (k == 0) return Vector3(coarse[1] - coarse[0]);
-    if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
-    return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
-  };
-  const double ratio = double(Nc) / N_;  // h / h_c
+  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a second,
+  // coarser solution the two are extrapolated to this grid's h (Richardson, first order: the
+  // discrete solutions converge like h, docs/accuracy.md), s(h) = s(h₁) − (s(h₂) − s(h₁))
+  // (h₁ − h)/(h₂ − h₁).
+  const double h1 = 1.0 / Nc, h = 1.0 / N_;
+  const double weight = coarser ? (h1 - h) / (1.0 / coarser->size() - h1) : 0.0;
   for (int j = 1; j <= N_ - 2; ++j) {
-    const double x = double(j) * (Nc - 1) / (N_ - 1);  // in coarse steps
-    const int i = std::min(static_cast<int>(x), Nc - 2);
-    const double s = x - i;
-    const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
-                 h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+    const Vector3 fine = interpolatedStep(coarse, j, N_);
     steps_[j] =
-        ratio * (h00 * coarse[i] + h10 * slope(i) + h01 * coarse[i + 1] + h11 * slope(i + 1));
+        coarser ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_) - fine)) : fine;
   }
   // The gap ψ between where the interpolated steps end and R_{N−1} (body frame of R_{N−1}),
   // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ_1 = 0 and φ_{N−1} = ψ, zero end slopes:

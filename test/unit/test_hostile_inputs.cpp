@@ -199,27 +199,28 @@ TEST(HostileOptions, StepTooLargeIsExitOneSayingIncreaseSteps) {
 }
 
 TEST(HostileOptions, TimeBudgetStopsALongSolveCleanly) {
-  // N = 1e5 takes ~15 s unbounded; a 0.5 s budget stops it at the next iteration boundary with a
-  // not-converged result on the requested grid (no exception, finite figures).
+  // N = 1e5 takes ~1 s unbounded (its coarse levels alone ~0.3 s); a 0.01 s budget stops it at
+  // the next iteration boundary, on any machine, with a not-converged result on the requested grid
+  // (no exception, finite figures).
   const ap::PlanningProblem p = seedRestToRest(100000);
   ap::SolverOptions options;
-  options.time_budget_s = 0.5;
+  options.time_budget_s = 0.01;
   const auto start = std::chrono::steady_clock::now();
   const ap::PlanResult r = ap::planManeuver(p, options);
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_FALSE(r.converged);
   EXPECT_NE(r.message.find("time budget"), std::string::npos) << r.message;
-  EXPECT_LT(elapsed, 0.5 + 5.0) << r.message;
+  EXPECT_LT(elapsed, 0.01 + 5.0) << r.message;
   EXPECT_EQ(r.maneuver.steps(), 100000);
   EXPECT_TRUE(std::isfinite(r.cost));
-  std::printf("budget 0.5 s: returned after %.2f s: %s\n", elapsed, r.message.c_str());
+  std::printf("budget 0.01 s: returned after %.2f s: %s\n", elapsed, r.message.c_str());
 }
 
 TEST(HostileOptions, PlanManeuverTimeBudgetFlagStopsTheCli) {
   const std::string scene = "'" AP_SOURCE_DIR "/scenes/rest_to_rest.yaml'";
   const auto start = std::chrono::steady_clock::now();
-  const ToolRun r = run(scene + " --steps 100000 --time-budget 0.5");
+  const ToolRun r = run(scene + " --steps 100000 --time-budget 0.01");
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(r.status, 1) << r.output;

@@ -16,13 +16,6 @@ namespace {
 /// ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
 constexpr int kMaxSteps = 2000000;
 
-/// %.17g: the value exactly as the user gave it.
-std::string num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
-}
-
 std::string str(const Eigen::MatrixXd& m) {
   std::ostringstream s;
   s << m.format(
@@ -38,7 +31,7 @@ void requireRotation(const Matrix3& R, const std::string& field) {
   requireFinite(R, field);
   if (so3::orthogonalityError(R) > 1e-9) {
     throw InvalidInput(field + ": not a rotation matrix (|R^T R - I| + |det R - 1| = " +
-                       num(so3::orthogonalityError(R)) + ")");
+                       exactNumber(so3::orthogonalityError(R)) + ")");
   }
 }
 
@@ -60,11 +53,11 @@ void validateProblem(const PlanningProblem& p) {
   // (moments 3.15, 12.54, 32.19) violates J1 + J2 >= J3: the check is skipped only on request.
   if (!p.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
   if (moments(2) / moments(0) > 1e12) {
-    throw InvalidInput("inertia: condition number " + num(moments(2) / moments(0)) + " of " +
-                       str(p.inertia) + " > 1e12");
+    throw InvalidInput("inertia: condition number " + exactNumber(moments(2) / moments(0)) +
+                       " of " + str(p.inertia) + " > 1e12");
   }
   if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
-    throw InvalidInput("duration: must be a finite number > 0 s, got " + num(p.duration));
+    throw InvalidInput("duration: must be a finite number > 0 s, got " + exactNumber(p.duration));
   }
   // With an accuracy target the planner chooses N: `steps` is not used.
   if (!p.accuracy.active() && p.steps < 4) {
@@ -93,7 +86,7 @@ void validateProblem(const PlanningProblem& p) {
     if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
       throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
                          accuracyMeasureName(p.accuracy.measure) + "), got " +
-                         num(p.accuracy.value));
+                         exactNumber(p.accuracy.value));
     }
     if (p.hasTorqueBounds() || (p.effects && !p.effects->empty())) {
       throw InvalidInput(
@@ -119,14 +112,14 @@ void validateProblem(const PlanningProblem& p) {
 
 void validateOptions(const SolverOptions& o) {
   if (!std::isfinite(o.tolerance) || !(o.tolerance > 0.0)) {
-    throw InvalidInput("tolerance: must be a finite number > 0, got " + num(o.tolerance));
+    throw InvalidInput("tolerance: must be a finite number > 0, got " + exactNumber(o.tolerance));
   }
   if (o.max_iterations < 0) {
     throw InvalidInput("max_iterations: must be >= 0, got " + std::to_string(o.max_iterations));
   }
   if (!std::isfinite(o.time_budget_s) || o.time_budget_s < 0.0) {
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = none), got " +
-                       num(o.time_budget_s));
+                       exactNumber(o.time_budget_s));
   }
 }
 

@@ -39,10 +39,7 @@ std::string jsonString(const std::string& text) {
 }
 
 std::string jsonNumber(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
+  return std::isfinite(value) ? exactNumber(value) : "null";
 }
 
 namespace {

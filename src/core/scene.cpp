@@ -24,13 +24,6 @@ namespace {
 /// hand-typed value (0.7071 has norm 0.99998).
 constexpr double kQuaternionNormTolerance = 1e-3;
 
-/// %.17g: every double round-trips.
-std::string fmt(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
-}
-
 /// A node's text for a message, one line.
 std::string show(const YAML::Node& node) {
   if (!node.IsDefined() || node.IsNull()) return "null";
@@ -45,7 +38,7 @@ std::string show(const YAML::Node& node) {
 /// The value checks of one effect (shared by scene files and service requests).
 void validateEffect(const EffectSpec& effect, const std::string& path) {
   auto require = [&](bool ok, const std::string& key, double value, const char* rule) {
-    if (!ok) throw InvalidInput(path + "." + key + ": " + rule + ", got " + fmt(value));
+    if (!ok) throw InvalidInput(path + "." + key + ": " + rule + ", got " + exactNumber(value));
   };
   auto requireVector = [&](const Vector3& v, const std::string& key, bool positive) {
     for (int k = 0; k < 3; ++k) {
@@ -330,8 +323,9 @@ class SceneParser {
       if (norm == 0.0) fail(qn, qpath, "zero quaternion " + show(qn) + " is not a rotation");
       if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
         fail(qn, qpath,
-             "not a unit quaternion: " + show(qn) + " has norm " + fmt(norm) + " (must be within " +
-                 fmt(kQuaternionNormTolerance) + " of 1; [w, x, y, z])");
+             "not a unit quaternion: " + show(qn) + " has norm " + exactNumber(norm) +
+                 " (must be within " + exactNumber(kQuaternionNormTolerance) +
+                 " of 1; [w, x, y, z])");
       }
       return so3::fromQuaternion(Eigen::Quaterniond(q(0), q(1), q(2), q(3)));
     }
@@ -442,7 +436,7 @@ class SceneParser {
 
 std::string vec(const Eigen::VectorXd& v) {
   std::string s = "[";
-  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v(i));
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + exactNumber(v(i));
   return s + "]";
 }
 
@@ -503,7 +497,7 @@ std::string formatScene(const Scene& scene) {
   out << "inertia: [" << vec(p.inertia.row(0).transpose()) << ", "
       << vec(p.inertia.row(1).transpose()) << ", " << vec(p.inertia.row(2).transpose()) << "]\n";
   if (scene.allow_nonphysical_inertia) out << "allow_nonphysical_inertia: true\n";
-  out << "duration: " << fmt(p.duration) << "\n";
+  out << "duration: " << exactNumber(p.duration) << "\n";
   out << "steps: " << p.steps << "\n";
   out << "scheme: " << schemeName(p.scheme) << "\n";
   if (p.direction == RotationDirection::LongWay) out << "direction: long_way\n";
@@ -521,7 +515,8 @@ std::string formatScene(const Scene& scene) {
   for (const EffectSpec& e : scene.effects) {
     out << "  - " << effectName(e) << ": ";
     if (const auto* g = std::get_if<GravityGradientSpec>(&e)) {
-      out << "{mu: " << fmt(g->mu) << ", orbit_radius: " << fmt(g->orbit_radius) << "}\n";
+      out << "{mu: " << exactNumber(g->mu) << ", orbit_radius: " << exactNumber(g->orbit_radius)
+          << "}\n";
     } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&e)) {
       out << "{frame: " << d->frame << ", value: " << vec(d->value) << "}\n";
     } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&e)) {

@@ -38,13 +38,13 @@ EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
                        "' (expected gravity_gradient, disturbance_torque, actuator_limits or "
                        "torque_noise)");
   }
-  if (!uses_orbit) unused(msg.mu == 0.0, "mu", numberText(msg.mu));
-  if (!uses_orbit) unused(msg.orbit_radius == 0.0, "orbit_radius", numberText(msg.orbit_radius));
+  if (!uses_orbit) unused(msg.mu == 0.0, "mu", exactNumber(msg.mu));
+  if (!uses_orbit) unused(msg.orbit_radius == 0.0, "orbit_radius", exactNumber(msg.orbit_radius));
   if (!uses_frame) unused(msg.frame.empty(), "frame", "'" + msg.frame + "'");
   if (!uses_value) {
     unused(value.isZero(0.0), "value",
-           "[" + numberText(value.x()) + ", " + numberText(value.y()) + ", " +
-               numberText(value.z()) + "]");
+           "[" + exactNumber(value.x()) + ", " + exactNumber(value.y()) + ", " +
+               exactNumber(value.z()) + "]");
   }
   if (!uses_seed) unused(msg.seed == 0, "seed", std::to_string(msg.seed));
   if (uses_orbit) return GravityGradientSpec{msg.mu, msg.orbit_radius};
@@ -84,12 +84,6 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
   }
   validateEffects(specs, "effects");
   applyEffects(specs, problem);
-}
-
-std::string numberText(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
 }
 
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {
@@ -306,8 +300,7 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
 
 AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double target,
                                          const PlannerDefaults& defaults) {
-  char value[32];
-  std::snprintf(value, sizeof value, "%.17g", target);
+  const std::string value = exactNumber(target);
   AccuracyTarget t;
   if (measure.empty()) {
     if (target != 0.0) {

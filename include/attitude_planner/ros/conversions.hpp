@@ -73,9 +73,6 @@ Effect effectToMsg(const EffectSpec& spec);
 /// planning model of `problem` (applyEffects). torque_noise is refused: it is not plannable.
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem);
 
-/// %.17g of a number (every double round-trips; NaN and Inf spelled nan, inf).
-std::string numberText(double value);
-
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
   std::string scheme = "paper";   ///< "paper" | "variational"
@@ -157,7 +154,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   }
   if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
     throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +
-                       numberText(req.tolerance));
+                       exactNumber(req.tolerance));
   }
   options->tolerance = req.tolerance > 0.0 ? req.tolerance : defaults.tolerance;
   if (req.max_iterations < 0) {
@@ -167,7 +164,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   options->max_iterations = req.max_iterations > 0 ? req.max_iterations : defaults.max_iterations;
   if (!std::isfinite(req.time_budget) || req.time_budget < 0.0) {
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = default), got " +
-                       numberText(req.time_budget));
+                       exactNumber(req.time_budget));
   }
   options->time_budget_s = req.time_budget > 0.0 ? req.time_budget : defaults.time_budget;
   if (defaults.max_solve_time > 0.0 &&

@@ -100,12 +100,7 @@ void validateProblem(const PlanningProblem& p) {
                          "], got " + std::to_string(p.accuracy.max_steps));
     }
   }
-  if (p.extra_revolutions < 0) {
-    throw InvalidInput(
-        "extra_revolutions: must be >= 0 (whole extra turns in the sense of the "
-        "chosen way; use direction LongWay to turn the other way), got " +
-        std::to_string(p.extra_revolutions));
-  }
+  requireExtraRevolutions(p.extra_revolutions, "extra_revolutions");
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
@@ -122,6 +117,14 @@ void applySchemeName(const std::string& text, const std::string& field, Planning
   std::vector<std::string> accepted = namesOf(kSchemeNames);
   accepted.push_back(kAutoSchemeName);
   throw InvalidInput(field + ": unknown value '" + text + "' (expected " + oneOf(accepted) + ")");
+}
+
+void requireExtraRevolutions(int extra_revolutions, const std::string& field) {
+  if (extra_revolutions < 0) {
+    throw InvalidInput(field + ": must be >= 0, got " + std::to_string(extra_revolutions) +
+                       " (whole extra turns in the sense of the chosen way; use direction "
+                       "long_way to turn the other way)");
+  }
 }
 
 void validateOptions(const SolverOptions& o) {

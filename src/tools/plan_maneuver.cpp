@@ -202,10 +202,7 @@ Arguments parseArguments(int argc, char** argv) {
       checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
     } else if (arg == "--extra-revolutions") {
       a.extra_revolutions = parseInt(arg, next());
-      if (a.extra_revolutions < 0) {
-        throw InvalidFlagValue{"--extra-revolutions: must be >= 0, got " +
-                               std::to_string(a.extra_revolutions)};
-      }
+      checkFlagValue([&] { ap::requireExtraRevolutions(a.extra_revolutions, arg); });
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
       parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1

@@ -130,6 +130,9 @@ struct SolverOptions {
 /// field and the value.
 void validateProblem(const PlanningProblem& problem);
 
+/// Throws InvalidInput naming `field` and the value unless extra_revolutions ≥ 0.
+void requireExtraRevolutions(int extra_revolutions, const std::string& field);
+
 /// Sets the scheme of `problem` from its name, or lets the planner choose it for "auto"
 /// (accuracy.choose_scheme; validateProblem requires an accuracy target then). Throws
 /// InvalidInput naming `field`, the value and the accepted names (the schemes and auto).

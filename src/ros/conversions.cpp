@@ -228,7 +228,8 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
   DriftTwoInputRequest r;
   r.g0 = attitudeFromMsg(req.initial_attitude, "initial_attitude");
   r.g1 = attitudeFromMsg(req.final_attitude, "final_attitude");
-  r.duration = req.duration;  // checked by planDriftTwoInput (requireDuration)
+  requireDuration(req.duration, "duration");  // the rule planDriftTwoInput applies too
+  r.duration = req.duration;
   r.steps = stepsFromRequest(req.steps, defaults);
   for (int i = 0; i < 2; ++i) {
     const double c = req.control_weights[i];

@@ -73,17 +73,17 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       }
       return true;
     };
-    if (!result.converged || !within_bounds(result)) {
+    if (!result.converged() || !within_bounds(result)) {
       // The unbounded optimum violates the bounds: the constrained solver, started from it.
       Maneuver clipped = result.maneuver;
       for (Vector3& t : clipped.torque)
         t = t.cwiseMax(-problem.max_torque).cwiseMin(problem.max_torque);
       SolverOptions bounded = options;
-      bounded.warm_start = result.converged ? &clipped : nullptr;
-      const std::string unbounded_note = result.converged ? "; the unbounded optimum (cost " +
-                                                                std::to_string(result.cost) +
-                                                                ") exceeds the bounds"
-                                                          : "";
+      bounded.warm_start = result.converged() ? &clipped : nullptr;
+      const std::string unbounded_note = result.converged() ? "; the unbounded optimum (cost " +
+                                                                  std::to_string(result.cost) +
+                                                                  ") exceeds the bounds"
+                                                            : "";
       result = solveWithNlopt(problem, bounded);
       result.message += unbounded_note;
       result.solver = solverName(SolverKind::Nlopt);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "attitude_planner/accuracy_target.hpp"
+#include "attitude_planner/constraints.hpp"
 #include "attitude_planner/discrete_scheme.hpp"
 #include "attitude_planner/effects.hpp"
 #include "attitude_planner/maneuver.hpp"
@@ -46,10 +47,14 @@ struct PlanningProblem {
   /// empty: none. Shared, immutable: several solves may use one model.
   std::shared_ptr<const EffectModel> effects;
   /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
-  /// A bounded problem whose unbounded optimum violates the bounds is solved by NLopt (SLSQP with
-  /// box bounds, N ≤ 1024) from the clipped Newton torques.
+  /// A problem whose unconstrained optimum violates a bound or a constraint is solved by the
+  /// interior-point solver (interior_point_solver.cpp), O(N) per iteration.
   Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   bool hasTorqueBounds() const { return max_torque.allFinite(); }
+  /// Constraints at every node (scene key `constraints:`, constraints.hpp); empty: none.
+  std::vector<PlanningConstraint> constraints;
+  /// Any per-axis bound or node constraint.
+  bool hasNodeConstraints() const { return hasTorqueBounds() || !constraints.empty(); }
   /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
   /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
   AccuracyTarget accuracy;
@@ -107,6 +112,16 @@ struct PlanResult {
   std::vector<std::string> effects;
   /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
   AccuracyEstimate accuracy;
+  /// The request cannot be met: a bound or constraint excludes every maneuver the solver could
+  /// reach (message names it, with the closest violation found).
+  bool infeasible = false;
+  /// The node constraints in force (scene keys, in order; "actuator_limits" first when bounded).
+  std::vector<std::string> constraints;
+  /// Worst violation over all nodes and constraints, each in its own unit (N m, rad/s, rad), ≥ 0,
+  /// measured on the returned maneuver (checkConstraints).
+  double max_constraint_violation = 0.0;
+  /// Node constraints at their bound (within kActiveConstraintTolerance relative) on the result.
+  int active_constraints = 0;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws
@@ -134,5 +149,20 @@ namespace attitude_planner {
 /// Throws StepTooLarge if the replay's implicit step fails.
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
                   PlanResult* result);
+
+/// A node constraint is counted active when its slack is within this fraction of its limit
+/// (torque, rate) or this many radians (cones).
+constexpr double kActiveConstraintTolerance = 1e-6;
+
+/// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
+/// on a maneuver's own rows, independently of any solver.
+struct ConstraintCheck {
+  std::vector<std::string> names;  ///< the keys in force ("actuator_limits" first if bounded)
+  double max_violation = 0.0;      ///< worst violation, each in its own unit, ≥ 0
+  int active = 0;                  ///< node constraints at their bound
+  std::string worst;  ///< the worst violated constraint, e.g. "|tau_x| <= 0.1 N m"; empty if none
+  std::string worst_where;  ///< its violation and node, e.g. "by 0.02 at k = 64 (t = 6.4 s)"
+};
+ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver);
 
 }  // namespace attitude_planner

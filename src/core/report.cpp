@@ -92,7 +92,12 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
       << "  \"effects\": [";
   for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
-  out << "]";
+  out << "],\n  \"constraints\": [";
+  for (size_t i = 0; i < r.constraints.size(); ++i)
+    out << (i ? ", " : "") << jsonString(r.constraints[i]);
+  out << "],\n  \"max_constraint_violation\": " << jsonNumber(r.max_constraint_violation)
+      << ",\n  \"active_constraints\": " << r.active_constraints
+      << ",\n  \"infeasible\": " << (r.infeasible ? "true" : "false");
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
   out << "\n}\n";
   return out.str();
@@ -122,6 +127,15 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
   text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
   if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
+  if (!r.constraints.empty()) {
+    std::string names;
+    for (const std::string& c : r.constraints) names += (names.empty() ? "" : ", ") + c;
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "constraints              %s (%d active, max violation %.3g)\n", names.c_str(),
+                  r.active_constraints, r.max_constraint_violation);
+    text += line;
+  }
   if (r.accuracy.requested) {
     const AccuracyEstimate& a = r.accuracy;
     std::string tried;

@@ -135,8 +135,9 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
     for (int k = 1; k < N; ++k) {
       for (int i = 0; i < 3; ++i) {
         const double a = problem.max_torque(i);
-        visit(a - std::abs(maneuver.torque[k](i)), a,
-              std::string("|tau_") + axis[i] + "| <= " + exactNumber(a) + " N m", k);
+        std::ostringstream what;
+        what << "|tau_" << axis[i] << "| <= " << a << " N m";
+        visit(a - std::abs(maneuver.torque[k](i)), a, what.str(), k);
       }
     }
   }

@@ -29,7 +29,7 @@
 // At μ_final a full step with decrement below the tolerance ends the solve; then the elastic
 // violations are v ≈ μ/ρ if the constraints can be met. If they cannot at ρ, ρ grows once by
 // kPenaltyGrowth; if they still cannot, the request is answered as infeasible, naming the
-// constraint the closest plan still violates.
+// constraint the last iterate still violates.
 //
 // Between nodes: the constraints hold at the nodes only. Within step k the continuous motion
 // R_k exp(s ω_k^), s ∈ [0, 1], turns at the constant rate ω_k/h (paper scheme), so a rate limit
@@ -74,6 +74,10 @@ constexpr double kWarmBarrier = 1e-3;
 constexpr int kCoarsestConstrainedGrid = 256;
 /// Relative decrement below which a stall at the final barrier counts as converged.
 constexpr double kStallAcceptance = 1e-7;
+/// Iterations without any reduction of a nonzero violation after which it counts as stalled.
+constexpr int kViolationStall = 8;
+/// Largest violation at which the penalty is raised before a request is called infeasible.
+constexpr double kPenaltyRaiseViolation = 1e-3;
 /// Elastic violation (constraint units: relative torque/rate, cosine) that counts as infeasible.
 constexpr double kFeasibilityTolerance = 1e-8;
 
@@ -257,7 +261,8 @@ class InteriorPoint {
         in.z = z_primal;
       } else {
         in.z = std::min(std::max(in.z, mu / (kDualSafeguard * in.s)), kDualSafeguard * z_primal);
-        const double u_min = mu / (kDualSafeguard * in.v);
+        // u = ρ − z stays positive (u → 0 would make D and q infinite).
+        const double u_min = std::max(mu / (kDualSafeguard * in.v), 1e-12 * rho);
         in.z = std::min(in.z, rho - u_min);
       }
       const double u = rho - in.z;
@@ -495,6 +500,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   double relative_decrement = 0.0;
   int penalty_raises = 0;
   int stalled_iterations = 0;
+  double best_violation = std::numeric_limits<double>::infinity();
+  int last_violation_progress = 0;
   double best_final_decrement = std::numeric_limits<double>::infinity();
   std::vector<double> dz;
   for (;; ++iteration) {
@@ -543,16 +550,29 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // At the final barrier the condensed system's condition grows like 1/μ̂ in the active
     // directions: decrements stall at ~1e-9 relative (measured). Two full steps that no longer
     // halve the decrement, below kStallAcceptance, end the solve as at the tolerance.
-    if (at_final_barrier && relative_decrement <= kStallAcceptance &&
+    // With the constraints still violated at the final barrier, the iterate minimizes the ℓ1
+    // violation: a stall there ends the solve too (then: penalty raise, or infeasible).
+    const bool violated = ip.maxViolation() > kFeasibilityTolerance;
+    if (at_final_barrier && (relative_decrement <= kStallAcceptance || violated) &&
         relative_decrement > 0.5 * best_final_decrement) {
       ++stalled_iterations;
     } else if (at_final_barrier) {
       stalled_iterations = 0;
     }
     if (at_final_barrier) best_final_decrement = std::min(best_final_decrement, relative_decrement);
+    // A violation that no iteration reduces any more (kViolationStall iterations) is a local
+    // minimum of the ℓ1 infeasibility at any barrier: end the solve (then: penalty raise, or
+    // infeasible) instead of iterating to the limit.
+    if (!violated || ip.maxViolation() < best_violation * (1.0 - 1e-6)) {
+      best_violation = violated ? ip.maxViolation() : std::numeric_limits<double>::infinity();
+      last_violation_progress = iteration;
+    }
+    const bool violation_stalled =
+        violated && iteration - last_violation_progress >= kViolationStall;
     const bool final_step =
-        at_final_barrier &&
-        ((shift == 0.0 && relative_decrement <= options.tolerance) || stalled_iterations >= 2);
+        violation_stalled ||
+        (at_final_barrier &&
+         ((shift == 0.0 && relative_decrement <= options.tolerance) || stalled_iterations >= 2));
 
     // Armijo on φ_μ along the retraction; a predicted decrease below φ's round-off is taken.
     double current_cost = 0.0;
@@ -596,11 +616,16 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         reason = "converged";
         break;
       }
-      if (penalty_raises == 0) {
+      // A small violation may be a penalty below a multiplier; a large one is not (and at a far
+      // larger ρ the cost no longer regularizes the ℓ1 infeasibility minimization: measured, the
+      // iterate then wanders to multi-turn motions).
+      if (penalty_raises == 0 && violation <= kPenaltyRaiseViolation) {
         // Perhaps ρ was below a multiplier: raise it once and re-solve from here.
         ++penalty_raises;
         rho *= kPenaltyGrowth;
         mu = mu_start;
+        best_violation = std::numeric_limits<double>::infinity();
+        last_violation_progress = iteration;
         best_final_decrement = std::numeric_limits<double>::infinity();
         stalled_iterations = 0;
         ip.initializeMultipliers(mu, rho, 10.0 * f_scale / m);
@@ -636,8 +661,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   std::ostringstream msg;
   if (result.infeasible) {
     msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
-        << " " << describeManeuverSpan(problem) << " (the closest plan found violates it "
-        << check.worst_where << ")";
+        << " " << describeManeuverSpan(problem)
+        << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
+        << ")";
     result.converged = false;
   } else {
     if (converged && !(miss <= allowed_miss)) {
@@ -684,13 +710,20 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
       iterations += unconstrained.iterations;
     }
     ReducedProblem::Steps next;
+    const PlanResult coarse = result;
     result = solveOnGrid(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
-    // An infeasible coarse level goes on: the answer (and its closest plan) is the fine grid's.
+    if (stopped && coarse.infeasible) {
+      // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
+      result.infeasible = true;
+      result.converged = false;
+      result.message = coarse.message + " (on the N = " + std::to_string(coarse.maneuver.steps()) +
+                       " level of the grid continuation)";
+    }
     stopped =
-        stopped || result.cancelled ||
+        stopped || result.cancelled || result.infeasible ||
         (options.time_budget_s > 0 && result.message.find("time budget") != std::string::npos);
-    steps = result.converged || result.infeasible || stopped ? next : ReducedProblem::Steps{};
+    steps = result.converged || stopped ? next : ReducedProblem::Steps{};
   }
   result.iterations = iterations;
   if (levels.size() > 1) {

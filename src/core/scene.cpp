@@ -576,6 +576,16 @@ std::string formatScene(const Scene& scene) {
       out << "{std: " << vec(t->std) << ", seed: " << t->seed << "}\n";
     }
   }
+  if (!p.constraints.empty()) out << "constraints:\n";
+  for (const PlanningConstraint& c : p.constraints) {
+    out << "  - " << constraintKindName(c.kind) << ": ";
+    if (c.isCone()) {
+      out << "{body_axis: " << vec(c.body_axis) << ", world_direction: " << vec(c.world_direction)
+          << ", half_angle: " << exactNumber(c.half_angle) << "}\n";
+    } else {
+      out << exactNumber(c.limit) << "\n";
+    }
+  }
   return out.str();
 }
 

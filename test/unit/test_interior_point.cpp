@@ -423,3 +423,14 @@ TEST(ConstraintScenes, BoundaryAlreadyViolatingIsNamed) {
                 .find("initial.angular_velocity already violates it"),
             std::string::npos);
 }
+
+TEST(ConstraintScenes, FormatSceneRoundTripsConstraints) {
+  const ap::Scene s = ap::loadScene(AP_SOURCE_DIR "/scenes/sun_keep_out.yaml");
+  ap::Scene with = s;
+  with.problem.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.3));
+  const ap::Scene back = ap::parseScene(ap::formatScene(with), "round.yaml");
+  ASSERT_EQ(back.problem.constraints.size(), 2u);
+  EXPECT_EQ(back.problem.constraints[0].world_direction, s.problem.constraints[0].world_direction);
+  EXPECT_EQ(back.problem.constraints[0].half_angle, s.problem.constraints[0].half_angle);
+  EXPECT_EQ(back.problem.constraints[1].limit, 0.3);
+}

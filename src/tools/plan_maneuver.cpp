@@ -13,9 +13,9 @@
 #include <string>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/report.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/report.hpp"
-#include "attitude_planner/scene.hpp"
 
 namespace ap = attitude_planner;
 

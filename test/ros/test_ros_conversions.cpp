@@ -8,11 +8,11 @@
 #include <limits>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
 #include "attitude_planner/ros/tracker_node.hpp"
-#include "attitude_planner/scene.hpp"
-#include "attitude_planner/simulation.hpp"
 
 using namespace attitude_planner;
 namespace rc = attitude_planner::ros_conversions;

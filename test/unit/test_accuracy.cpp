@@ -5,8 +5,9 @@
 #include <cmath>
 #include <string>
 
-#include "attitude_planner/accuracy.hpp"
+#include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
 
 using namespace attitude_planner;
 

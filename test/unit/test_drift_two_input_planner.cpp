@@ -6,7 +6,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
-#include "attitude_planner/drift_two_input_planner.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/errors.hpp"
 
 using namespace attitude_planner;

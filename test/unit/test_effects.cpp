@@ -6,8 +6,8 @@
 #include <cstring>
 #include <random>
 
-#include "attitude_planner/effects.hpp"
-#include "attitude_planner/simulation.hpp"
+#include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
 
 using namespace attitude_planner;
 

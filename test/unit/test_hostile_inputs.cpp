@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/robustness_cases.hpp"
-#include "attitude_planner/scene.hpp"
+#include "support/robustness_cases.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;

@@ -7,11 +7,11 @@
 #include <Eigen/QR>
 #include <random>
 
-#include "attitude_planner/direct_method.hpp"
-#include "attitude_planner/node_constraints.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/reduced_problem.hpp"
-#include "attitude_planner/scene.hpp"
+#include "planning/direct_method.hpp"
+#include "planning/node_constraints.hpp"
+#include "planning/reduced_problem.hpp"
 
 namespace ap = attitude_planner;
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <random>
 
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/simulation.hpp"
 
 using namespace attitude_planner;
 
@@ -201,7 +201,7 @@ TEST(NewtonSolver, IterationsConvergeQuadratically) {
   EXPECT_LT(e2, 1e-2 * e1);
 }
 
-// Moved to the hard-case catalog of issue 7 (src/core/robustness_cases.cpp, asserted by
+// Moved to the hard-case catalog of issue 7 (test/support/robustness_cases.cpp, asserted by
 // test_hard_cases): the zero maneuver (ZeroManeuverIsExactlyZero), the choice at exactly π
 // (CutLocusAboutX/CutLocusAboutDiagonal), the long way and extra revolutions
 // (BeyondPiShortWayLongWayExtraTurns) and the spinning ends (SpinningEnds).

@@ -6,9 +6,10 @@
 #include <algorithm>
 #include <random>
 
-#include "attitude_planner/direct_method.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/scene.hpp"
+#include "planning/direct_method.hpp"
+#include "planning/solvers.hpp"
 
 namespace ap = attitude_planner;
 

@@ -6,8 +6,9 @@
 #include <Eigen/LU>
 #include <random>
 
-#include "attitude_planner/dual.hpp"
-#include "attitude_planner/reduced_problem.hpp"
+#include "attitude_planner/planner.hpp"
+#include "lie/dual.hpp"
+#include "planning/reduced_problem.hpp"
 
 using namespace attitude_planner;
 

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
+#include "attitude_planner/analysis/seed_conditions.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/seed_conditions.hpp"
 
 using namespace attitude_planner;
 

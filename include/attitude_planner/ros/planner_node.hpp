@@ -40,6 +40,7 @@
 #include "attitude_planner/PlanAttitudeManeuverAction.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/planner.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 
 namespace attitude_planner {

@@ -1,0 +1,54 @@
+// What a solve returns (PlanResult) and how it ended (Termination).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "attitude_planner/planning/problem.hpp"
+
+namespace attitude_planner {
+
+/// What a solve returns. `converged` is false with a reason in `message` otherwise.
+struct PlanResult {
+  bool converged = false;
+  bool cancelled = false;  ///< the on_iteration callback asked to stop
+  /// Failed because an implicit step has no solution at this h (h·|Ω| too large): the message
+  /// says "increase steps". The node answers STEP_TOO_LARGE.
+  bool step_too_large = false;
+  std::string message;  ///< human-readable outcome ("converged", or why not)
+  std::string solver;   ///< "newton" or "nlopt"
+  SchemeKind scheme = SchemeKind::Paper;
+  Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  int iterations = 0;  ///< Newton iterations, coarser continuation levels included
+  /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
+  double max_residual = 0.0;
+  /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the
+  /// final step (the convergence test); NLopt: 0.
+  double newton_decrement = 0.0;
+  double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
+  double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
+  double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
+  double solve_time_s = 0.0;             ///< wall time [s]
+  std::vector<IterationInfo> history;    ///< one entry per iteration
+  /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
+  /// cost of the other way when both were solved.
+  std::string extremal;
+  /// The effects in the planning model (scene keys), in order; "actuator_limits" last when the
+  /// control torques are bounded.
+  std::vector<std::string> effects;
+  /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
+  AccuracyEstimate accuracy;
+  /// The request cannot be met: a bound or constraint excludes every maneuver the solver could
+  /// reach (message names it, with the violation of the last iterate).
+  bool infeasible = false;
+  /// The node constraints in force (scene keys, in order; "actuator_limits" first when bounded).
+  std::vector<std::string> constraints;
+  /// Worst violation over all nodes and constraints, each in its own unit (N m, rad/s, rad), ≥ 0,
+  /// measured on the returned maneuver (checkConstraints).
+  double max_constraint_violation = 0.0;
+  /// Node constraints at their bound (within kActiveConstraintTolerance relative) on the result.
+  int active_constraints = 0;
+};
+
+}  // namespace attitude_planner

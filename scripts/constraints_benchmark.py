@@ -34,6 +34,7 @@ def without_constraints(scene, tmpdir):
     text = open(scene).read()
     text = re.sub(r"\nconstraints:\n(  - .*\n?)+", "\n", text)
     text = re.sub(r"\n  - actuator_limits: .*", "", text)
+    text = re.sub(r"^effects:\s*$(?!\n  - )", "effects: []", text, flags=re.M)
     path = os.path.join(tmpdir, "free_" + os.path.basename(scene))
     open(path, "w").write(text)
     return path

@@ -235,6 +235,15 @@ class InteriorPoint {
     return phi;
   }
 
+  /// φ_μ = f + Σ ψ_μ(c_i) from the constraint values of the last assembly (f = its cost).
+  double assembledMerit(double cost, double mu, double rho) const {
+    double phi = cost;
+    for (const Group& g : groups_) {
+      for (const Instance& in : g.at) phi += elasticSlacks(in.c, mu, rho).psi;
+    }
+    return phi;
+  }
+
   /// Assembles the condensed Newton system at the current iterate: H, rhs, ∇φ_μ; returns f.
   /// `primal`: the multipliers are replaced by their primal values μ/s (then the step is Newton's
   /// on φ_μ, a descent direction whenever H is positive definite).
@@ -586,8 +595,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
          ((shift == 0.0 && relative_decrement <= options.tolerance) || stalled_iterations >= 2));
 
     // Armijo on φ_μ along the retraction; a predicted decrease below φ's round-off is taken.
-    double current_cost = 0.0;
-    const double phi = ip.merit(np.current(), mu, rho, &current_cost);
+    // φ_μ at the current iterate from the values the assembly just formed (no re-evaluation).
+    const double phi = ip.assembledMerit(cost, mu, rho);
     double alpha = 1.0;
     bool accepted = final_step || -slope <= 1e-14 * std::abs(phi);
     ReducedProblem::Steps trial = np.retract(delta, alpha);

@@ -93,6 +93,8 @@ def main():
                "--time-budget %.0f`, started from zero torques; the former fallback started from "
                "the clipped unconstrained optimum). Machine: shared, 2 cores; times vary by "
                "~2x between runs.\n" % (repeats, args.slsqp_cap, args.slsqp_cap))
+    out.append("What the figures mean and which targets of issue 16 they meet: "
+               "[constraints_notes.md](constraints_notes.md) (written by hand).\n")
     out.append("## scenes/torque_limited.yaml (per-axis limits bind), new vs old\n")
     out.append("| N | interior point | iterations (Newton + IP) | SLSQP | SLSQP status | cost IP | "
                "cost SLSQP | relative difference | max violation IP | active |")

@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
                      "\"cost_integral\": %.17g, \"cost_error\": %.6e, \"trajectory_error\": %.6e, "
                      "\"torque_error\": %.6e, \"attitude_miss\": %.6e, \"velocity_miss\": %.6e, "
                      "\"attitude_miss_step_start\": %.6e, \"velocity_miss_step_start\": %.6e}\n",
-                     N == 16 ? "" : ",", N, plan.converged ? "true" : "false", median(times),
+                     N == 16 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
                      plan.cost, m.cost_integral, m.cost_error, m.trajectory_error, m.torque_error,
                      m.miss.attitude_miss, m.miss.velocity_miss, m.miss_step_start.attitude_miss,
                      m.miss_step_start.velocity_miss);
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
         const int N = plan.maneuver.steps();
         double actual = 0.0;
         double plain_time = 0.0;
-        if (plan.converged) {
+        if (plan.converged()) {
           PlanningProblem at_N = problem;
           at_N.steps = N;
           const AccuracyMeasures m = measureAccuracy(at_N, plan.maneuver, ref);
@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
                      "\"estimated\": %.6e, \"predicted\": %.6e, \"actual\": %.6e, "
                      "\"solve_time_s\": %.6g, \"plain_solve_time_s\": %.6g, \"tried\": \"%s\"}\n",
                      first_target ? "" : ",", accuracyMeasureName(q.measure).c_str(), q.value,
-                     plan.converged ? "true" : "false", N, plan.accuracy.estimated_error,
+                     plan.converged() ? "true" : "false", N, plan.accuracy.estimated_error,
                      plan.accuracy.predicted_error, actual, median(times), plain_time,
                      tried.c_str());
         first_target = false;

@@ -1046,7 +1046,7 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
   m.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (is_ours) {
     m.iterations = ours.iterations;
-    m.converged = ours.converged;
+    m.converged = ours.converged();
     m.message = ours.message;
   } else {
     // The peer's torques replayed exactly as ours are (outside the timed region).

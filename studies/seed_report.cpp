@@ -10,6 +10,7 @@
 #include "attitude_planner/analysis/seed_conditions.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/io/csv.hpp"
 
 using namespace attitude_planner;
 
@@ -52,7 +53,7 @@ int main(int argc, char** argv) {
       const PlanResult r = planManeuver(p);
       const double h = p.duration / p.steps;
       std::fprintf(md, "| %s | %s | %s | %d | %.10g | %.10g | %.1e | %.1e | %.1e | %.2f |\n", name,
-                   schemeName(kind).c_str(), r.converged ? "yes" : "NO", r.iterations, r.cost,
+                   schemeName(kind).c_str(), r.converged() ? "yes" : "NO", r.iterations, r.cost,
                    h * r.cost, r.max_residual, r.terminal_attitude_error, r.terminal_velocity_error,
                    1e3 * medianSolveTime(p, 11));
       writeManeuverCsv(r.maneuver, out + "/seed_" + name + "_" + schemeName(kind) + ".csv");

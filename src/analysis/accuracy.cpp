@@ -120,14 +120,14 @@ Rung solveRung(PlanningProblem problem, int N, const SolverOptions& options, dou
   problem.steps = N;
   Rung rung;
   rung.plan = planAtResolution(problem, options);
-  if (!rung.plan.converged) return rung;
+  if (!rung.plan.converged()) return rung;
   if (measure == AccuracyMeasure::TerminalMiss) {
     rung.error = replayZeroOrderHold(problem, rung.plan.maneuver).attitude_miss;
   } else {
     problem.steps = N / 2;
     const PlanResult half = planAtResolution(problem, options);
-    if (!half.converged) {
-      rung.plan.converged = false;
+    if (!half.converged()) {
+      rung.plan.termination = half.termination;
       rung.plan.message =
           "N/2 = " + std::to_string(N / 2) + " for the Richardson estimate: " + half.message;
       return rung;
@@ -172,6 +172,17 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
+  // One time budget for all resolutions: each solve gets what is left of it (and ends TimedOut
+  // when nothing is).
+  const auto budgeted = [&] {
+    SolverOptions remaining = options;
+    if (options.time_budget_s > 0) {
+      const double used =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      remaining.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
+    }
+    return remaining;
+  };
 
   // Coarse resolution (N = 64; its estimate uses N = 32 too) of each candidate scheme.
   constexpr int kCoarse = 64;
@@ -184,11 +195,11 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
     PlanningProblem candidate = problem;
     candidate.scheme = scheme;
     const double p = measuredOrder(scheme, target.measure);
-    Rung coarse = solveRung(candidate, kCoarse, options, p);
+    Rung coarse = solveRung(candidate, kCoarse, budgeted(), p);
     estimate.steps_tried.push_back(kCoarse);
     estimate.errors_tried.push_back(coarse.error);
     estimate.schemes_tried.push_back(schemeName(scheme));
-    if (!coarse.plan.converged) {
+    if (!coarse.plan.converged()) {
       coarse.plan.message = "coarse resolution N = 64 (" + schemeName(scheme) +
                             ") did not converge: " + coarse.plan.message;
       return finish(coarse.plan);
@@ -212,17 +223,17 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
       // The finest plan solved so far, with its own estimate.
       estimate.estimated_error = last.error;
       PlanResult failed = last.plan;
-      failed.converged = false;
+      failed.termination = Termination::NotConverged;
       failed.message = "accuracy_target " + formatted("%.3g", target.value) + " (" +
                        accuracyMeasureName(target.measure) + ") needs N = " + std::to_string(N) +
                        " > max_steps = " + std::to_string(target.max_steps);
       return finish(failed);
     }
-    Rung rung = solveRung(chosen, N, options, estimate.order);
+    Rung rung = solveRung(chosen, N, budgeted(), estimate.order);
     estimate.steps_tried.push_back(N);
     estimate.errors_tried.push_back(rung.error);
     estimate.schemes_tried.push_back(schemeName(best_scheme));
-    if (!rung.plan.converged) return finish(rung.plan);
+    if (!rung.plan.converged()) return finish(rung.plan);
     estimate.estimated_error = rung.error;
     last = rung;
     if (rung.error <= target.value) {
@@ -234,7 +245,7 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
     const int next = predictSteps(N, rung.error, target.value, estimate.order);
     estimate.predicted_error = rung.error * std::pow(double(N) / next, estimate.order);
     if (round == 3) {
-      rung.plan.converged = false;
+      rung.plan.termination = Termination::NotConverged;
       rung.plan.message = "accuracy_target not reached: " + accuracyMeasureName(target.measure) +
                           " " + formatted("%.3g > target %.3g", rung.error, target.value) +
                           " at N = " + std::to_string(N) +

@@ -190,7 +190,7 @@ ContinuousReference solveContinuousReference(const PlanningProblem& problem_in,
     coarse.steps = 256;
     coarse.scheme = SchemeKind::Paper;
     const PlanResult plan = planAtResolution(coarse);
-    if (!plan.converged) {
+    if (!plan.converged()) {
       ref.message = "initial guess: the discrete plan did not converge: " + plan.message;
       return ref;
     }

@@ -1,7 +1,9 @@
 #include "attitude_planner/io/report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <memory>
 #include <sstream>
 
@@ -71,12 +73,23 @@ std::string accuracyJson(const AccuracyEstimate& a) {
   return out.str();
 }
 
+std::string levelJson(const LevelSummary& level) {
+  std::ostringstream out;
+  out << "{\"steps\": " << level.steps << ", \"iterations\": " << level.iterations
+      << ", \"termination\": " << jsonString(terminationName(level.termination))
+      << ", \"relative_gradient\": " << jsonNumber(level.relative_gradient)
+      << ", \"newton_decrement\": " << jsonNumber(level.newton_decrement)
+      << ", \"reason\": " << jsonString(level.reason) << "}";
+  return out.str();
+}
+
 }  // namespace
 
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
   std::ostringstream out;
   out << "{\n"
-      << "  \"converged\": " << (r.converged ? "true" : "false") << ",\n"
+      << "  \"converged\": " << (r.converged() ? "true" : "false") << ",\n"
+      << "  \"termination\": " << jsonString(terminationName(r.termination)) << ",\n"
       << "  \"message\": " << jsonString(r.message) << ",\n"
       << "  \"solver\": " << jsonString(r.solver) << ",\n"
       << "  \"scheme\": " << jsonString(schemeName(planScheme(problem, r))) << ",\n"
@@ -92,49 +105,73 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
       << "  \"effects\": [";
   for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
+  out << "],\n  \"levels\": [";
+  for (size_t i = 0; i < r.levels.size(); ++i) out << (i ? ", " : "") << levelJson(r.levels[i]);
   out << "],\n  \"constraints\": [";
   for (size_t i = 0; i < r.constraints.size(); ++i)
     out << (i ? ", " : "") << jsonString(r.constraints[i]);
   out << "],\n  \"max_constraint_violation\": " << jsonNumber(r.max_constraint_violation)
-      << ",\n  \"active_constraints\": " << r.active_constraints
-      << ",\n  \"infeasible\": " << (r.infeasible ? "true" : "false");
+      << ",\n  \"active_constraints\": " << r.active_constraints;
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
   out << "\n}\n";
   return out.str();
 }
 
+namespace {
+
+/// One aligned "label  value" line of the text summary.
+std::string line(const std::string& label, const std::string& value) {
+  std::string text = label;
+  text.resize(std::max<std::size_t>(label.size() + 1, 25), ' ');
+  return text + value + "\n";
+}
+
+/// A number in printf's %g style with `digits` significant digits (std::string, no buffer).
+std::string general(double value, int digits) {
+  std::ostringstream out;
+  out.precision(digits);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
 std::string planResultText(const PlanningProblem& problem, const PlanResult& r) {
-  char buffer[1024];
-  std::snprintf(buffer, sizeof buffer,
-                "converged                %s\n"
-                "message                  %s\n"
-                "solver / scheme          %s / %s\n"
-                "steps N, duration T      %d, %.6g s (h = %.6g s)\n"
-                "iterations               %d\n"
-                "cost sum 1/2|tau_k|^2    %.12g N^2 m^2\n"
-                "terminal attitude error  %.3g rad\n"
-                "terminal velocity error  %.3g rad/s\n"
-                "max residual             %.3g\n"
-                "dynamics residual        %.3g N m s\n"
-                "solve time               %.3f s\n",
-                r.converged ? "yes" : "NO", r.message.c_str(), r.solver.c_str(),
-                schemeName(planScheme(problem, r)).c_str(), planSteps(problem, r), problem.duration,
-                problem.duration / planSteps(problem, r), r.iterations, r.cost,
-                r.terminal_attitude_error, r.terminal_velocity_error, r.max_residual,
-                r.dynamics_residual, r.solve_time_s);
-  std::string text = buffer;
+  const int N = planSteps(problem, r);
+  std::string text;
+  text += line("converged", r.converged() ? "yes" : "NO (" + terminationName(r.termination) + ")");
+  text += line("message", r.message);
+  text += line("solver / scheme", r.solver + " / " + schemeName(planScheme(problem, r)));
+  text += line("steps N, duration T", std::to_string(N) + ", " + general(problem.duration, 6) +
+                                          " s (h = " + general(problem.duration / N, 6) + " s)");
+  text += line("iterations", std::to_string(r.iterations));
+  text += line("cost sum 1/2|tau_k|^2", general(r.cost, 12) + " N^2 m^2");
+  text += line("terminal attitude error", general(r.terminal_attitude_error, 3) + " rad");
+  text += line("terminal velocity error", general(r.terminal_velocity_error, 3) + " rad/s");
+  text += line("max residual", general(r.max_residual, 3));
+  text += line("dynamics residual", general(r.dynamics_residual, 3) + " N m s");
+  std::ostringstream time;
+  time << std::fixed << std::setprecision(3) << r.solve_time_s << " s";
+  text += line("solve time", time.str());
   std::string effects;
   for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
-  text += "planned effects          " + (effects.empty() ? std::string("none") : effects) + "\n";
-  if (!r.extremal.empty()) text += "extremal                 " + r.extremal + "\n";
+  text += line("planned effects", effects.empty() ? std::string("none") : effects);
+  if (!r.extremal.empty()) text += line("extremal", r.extremal);
+  if (r.levels.size() > 1) {
+    std::string levels;
+    for (const LevelSummary& level : r.levels) {
+      levels += (levels.empty() ? "" : ", ") + std::string("N = ") + std::to_string(level.steps) +
+                ": " + std::to_string(level.iterations) + " it " +
+                terminationName(level.termination);
+    }
+    text += line("grid levels", levels);
+  }
   if (!r.constraints.empty()) {
     std::string names;
     for (const std::string& c : r.constraints) names += (names.empty() ? "" : ", ") + c;
-    char line[256];
-    std::snprintf(line, sizeof line,
-                  "constraints              %s (%d active, max violation %.3g)\n", names.c_str(),
-                  r.active_constraints, r.max_constraint_violation);
-    text += line;
+    text += line("constraints", names + " (" + std::to_string(r.active_constraints) +
+                                    " active, max violation " +
+                                    general(r.max_constraint_violation, 3) + ")");
   }
   if (r.accuracy.requested) {
     const AccuracyEstimate& a = r.accuracy;
@@ -142,29 +179,13 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
     for (size_t i = 0; i < a.steps_tried.size(); ++i) {
       tried += (i ? ", " : "") + a.schemes_tried[i] + " " + std::to_string(a.steps_tried[i]);
     }
-    std::snprintf(buffer, sizeof buffer,
-                  "accuracy target          %s <= %.3g\n"
-                  "estimated error          %.3g (predicted %.3g, order %.3g; %s)\n"
-                  "resolutions solved       %s\n",
-                  accuracyMeasureName(a.measure).c_str(), a.target, a.estimated_error,
-                  a.predicted_error, a.order, a.method.c_str(), tried.c_str());
-    text += buffer;
+    text += line("accuracy target", accuracyMeasureName(a.measure) + " <= " + general(a.target, 3));
+    text += line("estimated error", general(a.estimated_error, 3) + " (predicted " +
+                                        general(a.predicted_error, 3) + ", order " +
+                                        general(a.order, 3) + "; " + a.method + ")");
+    text += line("resolutions solved", tried);
   }
   return text;
-}
-
-void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& tr, const std::string& path) {
-  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
-  if (!file) throw InvalidInput("--csv: cannot write '" + path + "'");
-  std::fprintf(file.get(), "%s\n", kDriftTwoInputCsvHeader);
-  for (std::size_t k = 0; k < tr.g.size(); ++k) {
-    const Eigen::Quaterniond q = so3::toQuaternion(tr.g[k]);
-    const Eigen::Vector2d& u = tr.u[k];
-    const Vector3& p = tr.p[k];
-    std::fprintf(file.get(), "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
-                 tr.t[k], q.w(), q.x(), q.y(), q.z(), u.x(), u.y(), p.x(), p.y(), p.z());
-  }
-  if (std::fflush(file.get()) != 0) throw InvalidInput("--csv: cannot write '" + path + "'");
 }
 
 namespace {
@@ -203,24 +224,27 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
 
 std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
                                   const DriftTwoInputPlan& plan, double solve_time_s) {
-  char buffer[2048];
   const Vector3& p = plan.initial_costate;
-  std::snprintf(buffer, sizeof buffer,
-                "system                   drift_two_input (seed 001)\n"
-                "converged                %s\n"
-                "message                  %s\n"
-                "control weights c1, c2   %.6g, %.6g\n"
-                "steps N, duration T      %d, %.6g s (h = %.6g s)\n"
-                "iterations               %d (%d continuation stages)\n"
-                "initial costate p(0)     (%.12g, %.12g, %.12g)\n"
-                "cost 1/2 int c.u^2 dt    %.12g\n"
-                "terminal attitude error  %.3g rad\n"
-                "solve time               %.3f s\n",
-                plan.converged ? "yes" : "NO", plan.message.c_str(), request.weights.c1,
-                request.weights.c2, request.steps, request.duration,
-                request.duration / request.steps, plan.iterations, plan.continuation_stages, p.x(),
-                p.y(), p.z(), plan.cost, plan.terminal_error, solve_time_s);
-  return buffer;
+  std::string text;
+  text += line("system", "drift_two_input (seed 001)");
+  text += line("converged", plan.converged ? "yes" : "NO");
+  text += line("message", plan.message);
+  text += line("control weights c1, c2",
+               general(request.weights.c1, 6) + ", " + general(request.weights.c2, 6));
+  text += line("steps N, duration T",
+               std::to_string(request.steps) + ", " + general(request.duration, 6) +
+                   " s (h = " + general(request.duration / request.steps, 6) + " s)");
+  text +=
+      line("iterations", std::to_string(plan.iterations) + " (" +
+                             std::to_string(plan.continuation_stages) + " continuation stages)");
+  text += line("initial costate p(0)", "(" + general(p.x(), 12) + ", " + general(p.y(), 12) + ", " +
+                                           general(p.z(), 12) + ")");
+  text += line("cost 1/2 int c.u^2 dt", general(plan.cost, 12));
+  text += line("terminal attitude error", general(plan.terminal_error, 3) + " rad");
+  std::ostringstream time;
+  time << std::fixed << std::setprecision(3) << solve_time_s << " s";
+  text += line("solve time", time.str());
+  return text;
 }
 
 }  // namespace attitude_planner

@@ -457,7 +457,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     reduced.emplace(problem);
   } catch (const StepTooLarge& e) {
     result.message = std::string("boundary velocity: ") + e.what();
-    result.step_too_large = true;
+    result.termination = Termination::StepTooLarge;
     return result;
   }
   ReducedProblem& np = *reduced;
@@ -480,7 +480,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
           why << "infeasible: " << describeConstraint(c) << " is violated by " << -margin
               << " rad at k = " << k
               << ", an attitude the boundary velocities fix (increase steps or move the boundary)";
-          result.infeasible = true;
+          result.termination = Termination::Infeasible;
           result.message = why.str();
           return result;
         }
@@ -515,7 +515,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   ip.initializeMultipliers(mu, rho, 10.0 * f_scale / m);
 
   std::string reason = "iteration limit reached";
-  bool converged = false;
+  Termination ending = Termination::NotConverged;
   int iteration = 0;
   double relative_decrement = 0.0;
   int penalty_raises = 0;
@@ -529,6 +529,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     if (iteration >= options.max_iterations) break;
     if (options.time_budget_s > 0 && elapsed() > options.time_budget_s) {
       reason = "time budget exceeded";
+      ending = Termination::TimedOut;
       break;
     }
     bool primal = false;
@@ -558,7 +559,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     }
     if (!std::isfinite(cost)) {
       reason = "non-finite cost (step too large for this h? increase steps)";
-      result.step_too_large = true;
+      ending = Termination::StepTooLarge;
       break;
     }
     if (!factored) {
@@ -617,7 +618,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         why << "converged to the round-off floor (relative Newton decrement " << relative_decrement
             << ", the line search can no longer decrease the merit)";
         reason = why.str();
-        converged = true;
+        ending = Termination::Converged;
         break;
       }
       reason = "line search failed";
@@ -631,7 +632,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
     result.history.push_back(info);
     if (options.on_iteration && !options.on_iteration(info)) {
-      result.cancelled = true;
+      ending = Termination::Cancelled;
       reason = "cancelled";
       ++iteration;
       break;
@@ -642,7 +643,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       ip.evaluateValues(np.current(), nullptr);
       const double violation = ip.maxViolation();
       if (violation <= kFeasibilityTolerance) {
-        converged = true;
+        ending = Termination::Converged;
         reason = "converged";
         break;
       }
@@ -661,7 +662,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         ip.initializeMultipliers(mu, rho, 10.0 * f_scale / m);
         continue;
       }
-      result.infeasible = true;
+      ending = Termination::Infeasible;
       reason = "infeasible";
       break;
     }
@@ -684,31 +685,29 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   try {
     evaluatePlan(problem, np.torques(np.current()), &result);
   } catch (const StepTooLarge& e) {
-    result.converged = false;
     result.message = std::string("replay of the planned torques failed: ") + e.what();
-    result.step_too_large = true;
+    result.termination = Termination::StepTooLarge;
     return result;
   }
   const ConstraintCheck check = checkConstraints(problem, result.maneuver);
   const double miss = std::max(result.terminal_attitude_error, result.terminal_velocity_error);
   const double allowed_miss = 1e-9 * std::max(1.0, N * 1e-4);
   std::ostringstream msg;
-  if (result.infeasible) {
+  if (ending == Termination::Infeasible) {
     msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
         << " " << describeManeuverSpan(problem)
         << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
         << ")";
-    result.converged = false;
   } else {
-    if (converged && !(miss <= allowed_miss)) {
-      converged = false;
+    if (ending == Termination::Converged && !(miss <= allowed_miss)) {
+      ending = Termination::NotConverged;
       std::ostringstream why;
       why << "stationary point found, but replaying its torques misses the target by " << miss;
       reason = why.str();
     }
-    result.converged = converged;
     msg << reason;
   }
+  result.termination = ending;
   msg << " after " << iteration << " interior-point iterations (relative Newton decrement "
       << relative_decrement << ", barrier " << mu / f_scale << " x cost, max elastic violation "
       << ip.maxViolation() << ")";
@@ -740,24 +739,23 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
     PlanResult unconstrained;
     if (steps.empty()) {
       unconstrained = solveWithNewton(at, level_options);
-      if (unconstrained.converged) level_options.warm_start = &unconstrained.maneuver;
+      if (unconstrained.converged()) level_options.warm_start = &unconstrained.maneuver;
       iterations += unconstrained.iterations;
     }
     ReducedProblem::Steps next;
     const PlanResult coarse = result;
     result = solveOnGrid(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
-    if (stopped && coarse.infeasible) {
+    if (stopped && coarse.termination == Termination::Infeasible) {
       // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
-      result.infeasible = true;
-      result.converged = false;
+      result.termination = Termination::Infeasible;
       result.message = coarse.message + " (on the N = " + std::to_string(coarse.maneuver.steps()) +
                        " level of the grid continuation)";
     }
-    stopped =
-        stopped || result.cancelled || result.infeasible ||
-        (options.time_budget_s > 0 && result.message.find("time budget") != std::string::npos);
-    steps = result.converged || stopped ? next : ReducedProblem::Steps{};
+    stopped = stopped || result.termination == Termination::Cancelled ||
+              result.termination == Termination::Infeasible ||
+              result.termination == Termination::TimedOut;
+    steps = result.converged() || stopped ? next : ReducedProblem::Steps{};
   }
   result.iterations = iterations;
   if (levels.size() > 1) {

@@ -173,8 +173,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   try {
     reduced.emplace(problem);
   } catch (const StepTooLarge& e) {
+    result.termination = Termination::StepTooLarge;
     result.message = std::string("boundary velocity: ") + e.what();
-    result.step_too_large = true;
+    result.levels.push_back({problem.steps, 0, result.termination, 0.0, 0.0, result.message});
     return result;
   }
   ReducedProblem& np = *reduced;
@@ -196,7 +197,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   double gradient_scale = 0.0;
   double relative_gradient = 0.0;
   double relative_decrement = 0.0;
-  bool converged = false;
+  Termination termination = Termination::NotConverged;
   double best_decrement = std::numeric_limits<double>::infinity();
   double damping = 0.0;  // Levenberg shift the next iteration starts from (relative)
   // Decrement of the previous iteration if its step was a full, unshifted Newton step (the
@@ -211,11 +212,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
     if (!std::isfinite(cost) || !std::isfinite(relative_gradient)) {
       reason = "non-finite cost or gradient (step too large for this h? increase steps)";
-      result.step_too_large = true;
+      termination = Termination::StepTooLarge;
       break;
     }
     if (gradient.cwiseAbs().maxCoeff() == 0.0) {  // e.g. the zero maneuver
-      converged = true;
+      termination = Termination::Converged;
       relative_decrement = 0.0;
       reason = "converged";
       break;
@@ -223,6 +224,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     if (iteration >= options.max_iterations) break;
     if (options.time_budget_s > 0 && elapsed() > options.time_budget_s) {
       reason = "time budget exceeded";
+      termination = Termination::TimedOut;
       break;
     }
     // Newton direction; Levenberg shift until the Hessian is positive definite (normal
@@ -312,7 +314,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     if (stalled_iterations >= 2) {
       result.history.push_back(info);
       ++iteration;
-      converged = true;
+      termination = Termination::Converged;
       std::ostringstream why;
       why << "converged to the round-off floor (relative torque accuracy about "
           << relative_decrement << ", tolerance " << options.tolerance << ")";
@@ -322,7 +324,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     result.history.push_back(info);
     if (final_step) {
       // This last step took the iterate from the tolerance to ~round-off (quadratic convergence).
-      converged = true;
+      termination = Termination::Converged;
       reason = "converged";
       if (relative_decrement > options.tolerance && predicted_within_tolerance) {
         std::ostringstream why;
@@ -346,18 +348,20 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       break;
     }
     if (options.on_iteration && !options.on_iteration(info)) {
-      result.cancelled = true;
+      termination = Termination::Cancelled;
       reason = "cancelled";
       ++iteration;
       break;
     }
   }
   const auto finish = [&] {
-    result.converged = converged;
+    result.termination = termination;
     std::ostringstream msg;
     msg << reason << " after " << iteration << " iterations (relative gradient "
         << relative_gradient << ", relative Newton decrement " << relative_decrement << ")";
     result.message = msg.str();
+    result.levels.push_back(
+        {N, iteration, termination, relative_gradient, relative_decrement, result.message});
     return result;
   };
   result.iterations = iteration;
@@ -370,7 +374,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     return finish();
   }
   // Report the first-order residual at the final iterate, not at the one before the last step.
-  if (converged && iteration > 0) {
+  if (termination == Termination::Converged && iteration > 0) {
     np.evaluate(&gradient, nullptr, &gradient_scale);
     relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
   }
@@ -378,18 +382,17 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   try {
     evaluatePlan(problem, np.torques(np.current()), &result);
   } catch (const StepTooLarge& e) {
-    result.converged = false;
-    result.message = std::string("replay of the planned torques failed: ") + e.what();
-    result.step_too_large = true;
-    return result;
+    termination = Termination::StepTooLarge;
+    reason = std::string("replay of the planned torques failed: ") + e.what();
+    return finish();
   }
   // The replay is the final judge: stationarity of the reduced problem means nothing if the
   // torques, integrated forward, do not land on the target (e.g. an implicit step that jumped to
   // another branch of μ(F) = p when h|Ω| is large).
   const double miss = std::max(result.terminal_attitude_error, result.terminal_velocity_error);
   const double allowed_miss = 1e-9 * std::max(1.0, N * 1e-4);
-  if (converged && !(miss <= allowed_miss)) {
-    converged = false;
+  if (termination == Termination::Converged && !(miss <= allowed_miss)) {
+    termination = Termination::NotConverged;
     std::ostringstream why;
     why << "stationary point found, but replaying its torques misses the target by " << miss
         << " (an implicit step on another branch when h|Omega| is large: increase steps; or an "
@@ -442,37 +445,40 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
   ReducedProblem::Steps coarse_steps, coarser_steps;
   const PlanResult coarse_result =
       solveWithContinuation(coarse, coarse_options, &coarse_steps, &coarser_steps);
-  if (coarse_result.converged && converged_level_below) *converged_level_below = coarse_steps;
+  if (coarse_result.converged() && converged_level_below) *converged_level_below = coarse_steps;
   // Two converged levels below: the guess is extrapolated from both (first-order Richardson).
   const ReducedProblem::Steps* extrapolate_from = coarser_steps.empty() ? nullptr : &coarser_steps;
   SolverOptions fine_options = options;
   // Stopped on a coarse level (cancel, time budget): answer on the requested grid anyway, with
   // the coarse iterate carried over and replayed (no iteration on this grid).
-  const auto stopped = [&](const std::string& why) {
+  const auto stopped = [&](Termination why) {
     fine_options.max_iterations = 0;
     // (A coarse level that failed before iterating left no steps: the Hermite guess then.)
     const bool have_steps = static_cast<int>(coarse_steps.size()) == coarse.steps;
     PlanResult out =
         solveOnGrid(problem, fine_options, have_steps ? &coarse_steps : nullptr, final_steps);
-    out.converged = false;
-    out.cancelled = coarse_result.cancelled;
+    out.termination = why;
     out.iterations = coarse_result.iterations;
-    out.message = why + " on the N = " + std::to_string(coarse.steps) + " level (" +
-                  coarse_result.message + ")";
+    out.message =
+        (why == Termination::Cancelled ? "cancelled" : "time budget exceeded") +
+        std::string(" on the N = ") + std::to_string(coarse.steps) +
+        " level; the plan is its iterate carried over to N = " + std::to_string(problem.steps);
+    out.levels.back().termination = why;
+    out.levels.insert(out.levels.begin(), coarse_result.levels.begin(), coarse_result.levels.end());
     return out;
   };
-  if (coarse_result.cancelled) return stopped("cancelled");
+  if (coarse_result.termination == Termination::Cancelled) return stopped(Termination::Cancelled);
   std::string level;
-  if (coarse_result.converged) {
+  if (coarse_result.converged()) {
     level = "; started from the N = " + std::to_string(coarse.steps) + " solution (" +
             std::to_string(coarse_result.iterations) + " iterations there)";
   } else {
-    level = "; the N = " + std::to_string(coarse.steps) + " level did not converge (" +
-            coarse_result.message + "), started from the geodesic";
+    level = "; the N = " + std::to_string(coarse.steps) + " level ended " +
+            terminationName(coarse_result.termination) + ", started from the geodesic";
   }
   fine_options.time_budget_s = remainingBudget(options, start);
   if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
-    return stopped("time budget exceeded");
+    return stopped(Termination::TimedOut);
   }
   // Iterations are numbered across levels, so progress reports keep increasing.
   const int before = coarse_result.iterations;
@@ -484,10 +490,12 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
     };
   }
   PlanResult result =
-      solveOnGrid(problem, fine_options, coarse_result.converged ? &coarse_steps : nullptr,
+      solveOnGrid(problem, fine_options, coarse_result.converged() ? &coarse_steps : nullptr,
                   final_steps, extrapolate_from);
   result.iterations += before;
   result.message += level;
+  result.levels.insert(result.levels.begin(), coarse_result.levels.begin(),
+                       coarse_result.levels.end());
   return result;
 }
 
@@ -526,13 +534,13 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice
   // at exactly π is deterministic.
   const bool take_second =
-      second.converged && (!first.converged || second.cost < first.cost * (1 - 1e-12));
+      second.converged() && (!first.converged() || second.cost < first.cost * (1 - 1e-12));
   PlanResult& kept = take_second ? second : first;
   const PlanResult& dropped = take_second ? first : second;
   std::ostringstream note;
   note << " (cheaper of both ways near π; the other, " << dropped.extremal << ", "
-       << (dropped.converged ? "costs " + std::to_string(dropped.cost)
-                             : std::string("did not converge"))
+       << (dropped.converged() ? "costs " + std::to_string(dropped.cost)
+                               : std::string("did not converge"))
        << ")";
   kept.extremal += note.str();
   kept.iterations += dropped.iterations;

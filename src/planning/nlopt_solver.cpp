@@ -311,7 +311,7 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   try {
     evaluatePlan(problem, torque, &result);
   } catch (const StepTooLarge& e) {
-    result.converged = false;
+    result.termination = Termination::StepTooLarge;
     result.message =
         "nlopt: " + resultName(code) + "; final torques cannot be replayed: " + e.what();
     return result;
@@ -347,7 +347,15 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
       code > 0 && code != nlopt::MAXEVAL_REACHED && code != nlopt::MAXTIME_REACHED;
   const bool feasible = result.terminal_attitude_error <= kConstraintTolerance &&
                         result.terminal_velocity_error <= kConstraintTolerance;
-  result.converged = nlopt_success && feasible;
+  if (cb.stop_reason == "cancelled") {
+    result.termination = Termination::Cancelled;
+  } else if (nlopt_success && feasible) {
+    result.termination = Termination::Converged;
+  } else if (code == nlopt::MAXTIME_REACHED) {
+    result.termination = Termination::TimedOut;
+  } else {
+    result.termination = Termination::NotConverged;
+  }
   std::string message = "nlopt SLSQP: " + resultName(code);
   if (!cb.stop_reason.empty()) message += " (" + cb.stop_reason + ")";
   if (!exception_text.empty()) message += " (" + exception_text + ")";
@@ -356,9 +364,10 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
                 "; constraint violation %.3g, relative stationarity residual %.3g", violation,
                 stationarity);
   message += figures;
-  if (!result.converged && nlopt_success && !feasible) message += "; terminal constraints not met";
+  if (!result.converged() && nlopt_success && !feasible)
+    message += "; terminal constraints not met";
   if (cb.stop_reason == "cancelled") message = "cancelled; " + message;
-  result.message = (result.converged ? "converged; " : "not converged; ") + message;
+  result.message = (result.converged() ? "converged; " : "not converged; ") + message;
   return result;
 }
 

@@ -70,7 +70,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
                                               ? checkConstraints(problem, result.maneuver)
                                               : ConstraintCheck{};
-    if (!result.converged || unconstrained.max_violation > 0.0) {
+    if (!result.converged() || unconstrained.max_violation > 0.0) {
       SolverOptions constrained = options;
       if (options.time_budget_s > 0) {
         const double used =
@@ -79,13 +79,13 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       }
       const int newton_iterations = result.iterations;
       std::ostringstream note;
-      if (result.converged) {
+      if (result.converged()) {
         note << "; the unconstrained optimum (cost " << result.cost << ") violates "
              << unconstrained.worst << " " << unconstrained.worst_where << " and started it ("
              << newton_iterations << " Newton iterations)";
       }
       const Maneuver unconstrained_plan = result.maneuver;
-      constrained.warm_start = result.converged ? &unconstrained_plan : options.warm_start;
+      constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
       result = solveWithInteriorPoint(problem, constrained);
       result.iterations += newton_iterations;
       result.message += note.str();

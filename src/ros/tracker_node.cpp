@@ -150,7 +150,7 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     return true;
   }
   const PlanResult result = planManeuver(problem);
-  if (!result.converged) {
+  if (!result.converged()) {
     *error = "planner: " + result.message;
     return false;
   }

@@ -14,6 +14,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/io/csv.hpp"
 
 namespace ap = attitude_planner;
 

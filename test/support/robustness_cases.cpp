@@ -323,9 +323,10 @@ void intermediateAxisSpin(Recorder& r) {
     const PlanResult res = planManeuver(p);
     r.record(label, p, res);
     iterations.push_back(res.iterations);
-    r.holds("T = 60: not claimed converged; the message gives the replay miss",
-            !res.converged && res.message.find("replaying its torques misses") != std::string::npos,
-            res.message.substr(0, 120));
+    r.holds(
+        "T = 60: not claimed converged; the message gives the replay miss",
+        !res.converged() && res.message.find("replaying its torques misses") != std::string::npos,
+        res.message.substr(0, 120));
     r.atMost("T = 60: relative first-order residual at the end (stationary point found)",
              res.max_residual, 1e-9);
     r.atMost("T = 60: replay miss [rad] ≤ 10·eps·e^{λT} (round-off amplification)",
@@ -356,13 +357,14 @@ std::string convergesOrClearError(Recorder& r, const std::string& label, const P
   try {
     const PlanResult res = planManeuver(p);
     r.record(label, p, res);
-    if (res.converged) {
+    if (res.converged()) {
       r.atMost(label + ": converged, terminal error [rad]",
                std::max(res.terminal_attitude_error, res.terminal_velocity_error), 1e-9);
       return "converged";
     }
     r.holds(label + ": not converged, and the result says step too large / increase steps",
-            res.step_too_large && res.message.find("increase steps") != std::string::npos,
+            res.termination == Termination::StepTooLarge &&
+                res.message.find("increase steps") != std::string::npos,
             res.message);
     return res.message;
   } catch (const StepTooLarge& e) {
@@ -478,7 +480,7 @@ void Recorder::record(const std::string& label, const PlanningProblem& problem,
                       const PlanResult& res) {
   RunFigures f;
   f.label = label;
-  f.converged = res.converged;
+  f.converged = res.converged();
   f.finite = allFinite(res.maneuver) && std::isfinite(res.cost);
   f.steps = problem.steps;
   f.iterations = res.iterations;
@@ -498,7 +500,7 @@ PlanResult Recorder::plan(const std::string& label, const PlanningProblem& probl
                           const SolverOptions& options, double terminal_bound) {
   PlanResult res = planManeuver(problem, options);
   record(label, problem, res);
-  holds(label + ": converged", res.converged, res.message);
+  holds(label + ": converged", res.converged(), res.message);
   holds(label + ": no NaN/Inf in R_k, Ω_k, τ_k, cost",
         allFinite(res.maneuver) && std::isfinite(res.cost));
   atMost(label + ": terminal attitude error [rad]", res.terminal_attitude_error, terminal_bound);

@@ -43,8 +43,8 @@ void expectAgreesWithNlopt(const ap::PlanningProblem& p, double tolerance = 1e-8
   for (ap::Vector3& t : start.torque) t *= 0.9;
   if (perturbed_start) o.warm_start = &start;
   const ap::PlanResult slsqp = ap::planManeuver(p, o);
-  ASSERT_TRUE(ip.converged) << ip.message;
-  ASSERT_TRUE(slsqp.converged) << slsqp.message;
+  ASSERT_TRUE(ip.converged()) << ip.message;
+  ASSERT_TRUE(slsqp.converged()) << slsqp.message;
   EXPECT_EQ(ip.solver, "interior_point") << ip.message;
   EXPECT_NEAR(ip.cost, slsqp.cost, tolerance * slsqp.cost) << ip.message;
   EXPECT_LE(ip.max_constraint_violation, 1e-9);
@@ -214,7 +214,7 @@ TEST(InteriorPoint, KeepInAgreesWithNlopt) {
       ap::PlanningConstraint::keepIn(out.body_axis, -out.world_direction, M_PI - out.half_angle)};
   const ap::PlanResult keep_in = plan(p, "newton");
   const ap::PlanResult keep_out = plan(sceneProblem("sun_keep_out.yaml", 24), "newton");
-  ASSERT_TRUE(keep_in.converged) << keep_in.message;
+  ASSERT_TRUE(keep_in.converged()) << keep_in.message;
   EXPECT_NEAR(keep_in.cost, keep_out.cost, 1e-8 * keep_out.cost);
   expectAgreesWithNlopt(p, 1e-8, true);
 }
@@ -238,7 +238,7 @@ TEST(InteriorPoint, RandomizedTorqueNormCasesAgreeWithNlopt) {
     p.steps = 16;
     p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)));
     const ap::PlanResult free = plan(p, "newton");
-    ASSERT_TRUE(free.converged);
+    ASSERT_TRUE(free.converged());
     double peak = 0.0;
     for (const ap::Vector3& t : free.maneuver.torque) peak = std::max(peak, t.norm());
     p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.8 * peak)};
@@ -253,7 +253,7 @@ TEST(InteriorPoint, KktConditionsHoldInTorqueSpace) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 32);
   p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5)};
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message;
   const Eigen::VectorXd x = ap::unknownsFromTorqueSequence(r.maneuver.torque);
   const ap::TerminalConstraints c = ap::evaluateTerminalConstraints(p, x, true);
   EXPECT_LT(c.value.cwiseAbs().maxCoeff(), 1e-10);  // feasibility: terminal state
@@ -292,7 +292,7 @@ TEST(InteriorPoint, InactiveConstraintsKeepTheNewtonPath) {
   p.constraints = {ap::PlanningConstraint::maxTorqueNorm(10.0),
                    ap::PlanningConstraint::maxAngularRate(5.0)};
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged);
+  ASSERT_TRUE(r.converged());
   EXPECT_EQ(r.solver, "newton");
   EXPECT_NE(r.message.find("inactive"), std::string::npos) << r.message;
   EXPECT_EQ(r.active_constraints, 0);
@@ -301,7 +301,7 @@ TEST(InteriorPoint, InactiveConstraintsKeepTheNewtonPath) {
 TEST(InteriorPoint, WorksWithGravityGradientAndLimits) {
   ap::PlanningProblem p = sceneProblem("leo_slew_limited.yaml", 60);
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_EQ(r.solver, "interior_point");
   EXPECT_GT(r.active_constraints, 0);
   EXPECT_LE(r.max_constraint_violation, 1e-9);
@@ -314,7 +314,7 @@ TEST(InteriorPoint, ShippedConstrainedScenesBindAndHold) {
     const ap::PlanningProblem p =
         ap::loadScene(AP_SOURCE_DIR "/scenes/" + std::string(scene)).problem;
     const ap::PlanResult r = plan(p, "newton");
-    ASSERT_TRUE(r.converged) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message;
     EXPECT_EQ(r.solver, "interior_point") << "the constraint must bind: " << r.message;
     EXPECT_GT(r.active_constraints, 0);
     EXPECT_LE(r.max_constraint_violation, 1e-9);
@@ -328,8 +328,8 @@ TEST(InteriorPoint, InfeasibleTorqueLimitIsNamed) {
   ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);
   p.max_torque = ap::Vector3::Constant(0.01);
   const ap::PlanResult r = plan(p, "newton");
-  EXPECT_FALSE(r.converged);
-  EXPECT_TRUE(r.infeasible) << r.message;
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
   EXPECT_NE(r.message.find("infeasible: |tau_"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("cannot turn this body by 1.047"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("in T = 12.8 s"), std::string::npos) << r.message;
@@ -341,8 +341,8 @@ TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {
   ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.05)};
   const ap::PlanResult r = plan(p, "newton");
-  EXPECT_FALSE(r.converged);
-  EXPECT_TRUE(r.infeasible) << r.message;
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
   EXPECT_NE(r.message.find("infeasible: max_angular_rate 0.05 rad/s"), std::string::npos)
       << r.message;
   EXPECT_LT(r.iterations, 200);

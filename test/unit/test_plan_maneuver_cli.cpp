@@ -13,6 +13,7 @@
 
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/io/csv.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;

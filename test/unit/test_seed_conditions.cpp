@@ -34,7 +34,7 @@ double worst(const std::vector<double>& v) {
 TEST(SeedConditions, CorrectedConditionsVanishAtTheOptimum) {
   for (int N : {32, 128}) {
     const PlanResult r = solveSlewUp(N);
-    ASSERT_TRUE(r.converged) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message;
     EXPECT_LE(worst(seedConditionRelativeResiduals(r.maneuver, kSeedInertia,
                                                    SeedConditionForm::Corrected)),
               1e-9)
@@ -44,7 +44,7 @@ TEST(SeedConditions, CorrectedConditionsVanishAtTheOptimum) {
 
 TEST(SeedConditions, PrintedConditionsDoNotVanish) {
   const PlanResult r = solveSlewUp(128);
-  ASSERT_TRUE(r.converged);
+  ASSERT_TRUE(r.converged());
   EXPECT_GT(
       worst(seedConditionRelativeResiduals(r.maneuver, kSeedInertia, SeedConditionForm::Printed)),
       1e-2);

@@ -8,7 +8,7 @@
 
 namespace attitude_planner {
 
-/// Rows k = 0..N at t_k = k h (DESIGN.md, "Trajectory CSV").
+/// Rows k = 0..N at t_k = k h (docs/DESIGN.md, "Trajectory CSV").
 struct Maneuver {
   double time_step = 0.0;                 ///< h [s]
   std::vector<double> time;               ///< t_k [s], k = 0..N
@@ -18,12 +18,6 @@ struct Maneuver {
 
   int steps() const { return static_cast<int>(attitude.size()) - 1; }
 };
-
-/// Writes the CSV `k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz` with %.17g; throws InvalidInput if the
-/// file cannot be written.
-void writeManeuverCsv(const Maneuver& maneuver, const std::string& path);
-/// Reads a CSV written by writeManeuverCsv (header checked); throws InvalidInput naming the line.
-Maneuver readManeuverCsv(const std::string& path);
 
 }  // namespace attitude_planner
 

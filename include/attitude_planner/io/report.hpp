@@ -16,14 +16,6 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& res
 /// A few aligned lines for a terminal (units included).
 std::string planResultText(const PlanningProblem& problem, const PlanResult& result);
 
-/// Header of the drift + two-input trajectory CSV (seed 001).
-constexpr const char* kDriftTwoInputCsvHeader = "k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3";
-
-/// Writes the CSV `k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3` (rows k = 0..N, %.17g): t_k [s], g(t_k) as a
-/// Hamilton quaternion (body → world, w ≥ 0), controls u [rad/s], costate p [c·rad/s]. Throws
-/// InvalidInput if the file cannot be written.
-void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& trajectory, const std::string& path);
-
 /// JSON object of a drift + two-input plan: converged, message, system, steps, duration [s],
 /// control_weights [c1, c2], iterations, continuation_stages, cost [cost units],
 /// terminal_attitude_error [rad], initial_costate [p1, p2, p3] (found), initial_costate_guess

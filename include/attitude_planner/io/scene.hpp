@@ -1,4 +1,4 @@
-// Scene files (YAML, DESIGN.md "Scene file"): what to plan and which effects are present.
+// Scene files (YAML, docs/DESIGN.md "Scene file"): what to plan and which effects are present.
 //
 // Keys (units SI, REP 103):
 //   inertia          3×3 nested list, or 3 principal moments [a, b, c]        [kg·m²]

@@ -1,6 +1,6 @@
 // SO(3) toolkit: hat/vee, exp, log, Jacobians, quaternions, projection.
 //
-// Conventions (DESIGN.md): R maps body vectors to the world; quaternions are Hamilton (w, x, y, z);
+// Conventions (docs/DESIGN.md): R maps body vectors to the world; quaternions are Hamilton (w, x, y, z);
 // perturbations are on the right, R exp(ε^), so Jacobians act on body-frame tangent vectors.
 // Every function is a template on the scalar type so that the solvers can evaluate the same code
 // with forward-mode dual numbers (exact derivatives); the double versions are the everyday API.

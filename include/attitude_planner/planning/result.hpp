@@ -8,15 +8,41 @@
 
 namespace attitude_planner {
 
-/// What a solve returns. `converged` is false with a reason in `message` otherwise.
+/// How a solve ended: the one status of a result. Messages explain it, they never carry it; the
+/// node maps it to PlanErrorCode in one switch (ros/planner_node.cpp, errorCodeOf).
+enum class Termination {
+  Converged,     ///< first-order optimal and consistent to the tolerance
+  NotConverged,  ///< iteration limit, stall, or a check failed (the message says which)
+  Infeasible,    ///< the constraints admit no maneuver (the message names the binding one)
+  StepTooLarge,  ///< an implicit step has no solution at this h (h·|Ω| too large): increase N
+  TimedOut,      ///< the time budget ran out (the plan so far is returned)
+  Cancelled,     ///< the on_iteration callback asked to stop (the plan so far is returned)
+  InvalidInput,  ///< the problem or options were refused (a node answers this; the core throws)
+};
+
+/// "converged", "not_converged", "infeasible", "step_too_large", "timed_out", "cancelled",
+/// "invalid_input" (JSON summary, logs).
+std::string terminationName(Termination termination);
+
+/// One grid level of a continuation solve (coarsest first; the last one is the requested N).
+struct LevelSummary {
+  int steps = 0;       ///< N of this level
+  int iterations = 0;  ///< Newton iterations on this level
+  Termination termination = Termination::NotConverged;
+  double relative_gradient = 0.0;  ///< max|∇C| / (|∂τ/∂R|·max|τ|) at the level's last iterate
+  double newton_decrement = 0.0;  ///< relative Newton decrement of its last iteration
+  std::string reason;             ///< why the level ended, one sentence
+};
+
+/// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
+/// and the figures that judge it.
 struct PlanResult {
-  bool converged = false;
-  bool cancelled = false;  ///< the on_iteration callback asked to stop
-  /// Failed because an implicit step has no solution at this h (h·|Ω| too large): the message
-  /// says "increase steps". The node answers STEP_TOO_LARGE.
-  bool step_too_large = false;
-  std::string message;  ///< human-readable outcome ("converged", or why not)
-  std::string solver;   ///< "newton" or "nlopt"
+  Termination termination = Termination::NotConverged;
+  bool converged() const { return termination == Termination::Converged; }
+  std::string message;  ///< human-readable explanation of `termination`, one level only
+  /// The grid levels solved, coarsest first (continuation); empty for solvers without levels.
+  std::vector<LevelSummary> levels;
+  std::string solver;  ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
   Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
   double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
@@ -39,9 +65,6 @@ struct PlanResult {
   std::vector<std::string> effects;
   /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
   AccuracyEstimate accuracy;
-  /// The request cannot be met: a bound or constraint excludes every maneuver the solver could
-  /// reach (message names it, with the violation of the last iterate).
-  bool infeasible = false;
   /// The node constraints in force (scene keys, in order; "actuator_limits" first when bounded).
   std::vector<std::string> constraints;
   /// Worst violation over all nodes and constraints, each in its own unit (N m, rad/s, rad), ≥ 0,

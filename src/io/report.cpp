@@ -107,7 +107,11 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
   for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
   out << "],\n  \"levels\": [";
   for (size_t i = 0; i < r.levels.size(); ++i) out << (i ? ", " : "") << levelJson(r.levels[i]);
-  out << "]";
+  out << "],\n  \"constraints\": [";
+  for (size_t i = 0; i < r.constraints.size(); ++i)
+    out << (i ? ", " : "") << jsonString(r.constraints[i]);
+  out << "],\n  \"max_constraint_violation\": " << jsonNumber(r.max_constraint_violation)
+      << ",\n  \"active_constraints\": " << r.active_constraints;
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
   out << "\n}\n";
   return out.str();
@@ -161,6 +165,13 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
                 terminationName(level.termination);
     }
     text += line("grid levels", levels);
+  }
+  if (!r.constraints.empty()) {
+    std::string names;
+    for (const std::string& c : r.constraints) names += (names.empty() ? "" : ", ") + c;
+    text += line("constraints", names + " (" + std::to_string(r.active_constraints) +
+                                    " active, max violation " +
+                                    general(r.max_constraint_violation, 3) + ")");
   }
   if (r.accuracy.requested) {
     const AccuracyEstimate& a = r.accuracy;

@@ -89,7 +89,7 @@ class SceneParser {
     if (rigid) {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
-                 "allow_nonphysical_inertia", "direction", "extra_revolutions"},
+                 "allow_nonphysical_inertia", "direction", "extra_revolutions", "constraints"},
                 {"inertia", "duration", "steps", "initial", "final"});
     } else {
       checkKeys(root, "",
@@ -124,6 +124,7 @@ class SceneParser {
       scene.initial_costate = vector3(root["initial_costate"], "initial_costate");
     }
     if (root["effects"]) scene.effects = effects(root["effects"], "effects");
+    if (root["constraints"]) p.constraints = constraints(root["constraints"], "constraints");
     if (root["allow_nonphysical_inertia"]) {
       scene.allow_nonphysical_inertia =
           boolean(root["allow_nonphysical_inertia"], "allow_nonphysical_inertia");
@@ -136,7 +137,7 @@ class SceneParser {
       validateProblem(p);
     } catch (const InvalidInput& e) {
       const std::string what = e.what();
-      const std::string key = what.substr(0, what.find_first_of(".:"));
+      const std::string key = what.substr(0, what.find_first_of(".:["));
       const YAML::Node node = root[key];
       if (node) throw InvalidInput(where(node) + what);
       throw InvalidInput(source_ + ": " + what);
@@ -338,6 +339,56 @@ class SceneParser {
     }
   }
 
+  /// The `constraints:` list: single-key maps, values checked by validateConstraints.
+  std::vector<PlanningConstraint> constraints(const YAML::Node& node,
+                                              const std::string& path) const {
+    if (!node.IsSequence()) {
+      fail(node, path, "expected a list (use [] for none), got " + show(node));
+    }
+    std::vector<PlanningConstraint> out;
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const YAML::Node entry = node[i];
+      const std::string epath = path + "[" + std::to_string(i) + "]";
+      if (!entry.IsMap() || entry.size() != 1) {
+        fail(entry, epath,
+             "expected one constraint as {name: value}, got " + show(entry) +
+                 " (names: max_torque_norm, max_angular_rate, keep_out, keep_in)");
+      }
+      const auto kv = *entry.begin();
+      const std::string name = kv.first.Scalar();
+      const YAML::Node body = kv.second;
+      const std::string bpath = epath + "." + name;
+      if (name == "max_torque_norm") {
+        out.push_back(PlanningConstraint::maxTorqueNorm(number(body, bpath)));
+      } else if (name == "max_angular_rate") {
+        out.push_back(PlanningConstraint::maxAngularRate(number(body, bpath)));
+      } else if (name == "keep_out" || name == "keep_in") {
+        requireMap(body, bpath);
+        checkKeys(body, bpath, {"body_axis", "world_direction", "half_angle"},
+                  {"body_axis", "world_direction", "half_angle"});
+        const Vector3 b = vector3(body["body_axis"], bpath + ".body_axis");
+        const Vector3 s = vector3(body["world_direction"], bpath + ".world_direction");
+        const double a = number(body["half_angle"], bpath + ".half_angle");
+        out.push_back(name == "keep_out" ? PlanningConstraint::keepOut(b, s, a)
+                                         : PlanningConstraint::keepIn(b, s, a));
+      } else {
+        fail(kv.first, bpath,
+             "unknown constraint (expected max_torque_norm, max_angular_rate, keep_out or "
+             "keep_in)");
+      }
+      try {
+        validateConstraints({out.back()}, epath.substr(0, epath.rfind('[')));
+      } catch (const InvalidInput& e) {
+        // Renumber: the single-entry check names index 0.
+        std::string what = e.what();
+        const std::string wrong = path + "[0]";
+        if (what.compare(0, wrong.size(), wrong) == 0) what = epath + what.substr(wrong.size());
+        throw InvalidInput(where(body) + what);
+      }
+    }
+    return out;
+  }
+
   std::vector<EffectSpec> effects(const YAML::Node& node, const std::string& path) const {
     if (!node.IsSequence()) {
       fail(node, path, "expected a list (use [] for none), got " + show(node));
@@ -525,6 +576,16 @@ std::string formatScene(const Scene& scene) {
       out << "{max_torque: " << vec(a->max_torque) << "}\n";
     } else if (const auto* t = std::get_if<TorqueNoiseSpec>(&e)) {
       out << "{std: " << vec(t->std) << ", seed: " << t->seed << "}\n";
+    }
+  }
+  if (!p.constraints.empty()) out << "constraints:\n";
+  for (const PlanningConstraint& c : p.constraints) {
+    out << "  - " << constraintKindName(c.kind) << ": ";
+    if (c.isCone()) {
+      out << "{body_axis: " << vec(c.body_axis) << ", world_direction: " << vec(c.world_direction)
+          << ", half_angle: " << exactNumber(c.half_angle) << "}\n";
+    } else {
+      out << exactNumber(c.limit) << "\n";
     }
   }
   return out.str();

@@ -65,30 +65,34 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
-  if (options.solver == SolverKind::Newton && problem.hasTorqueBounds()) {
+  if (options.solver == SolverKind::Newton && problem.hasNodeConstraints()) {
+    // The unconstrained optimum first (fast path): if it meets every node constraint it is the
+    // constrained optimum too; otherwise it starts the interior-point solver.
     result = solveWithNewton(problem, options);
-    const auto within_bounds = [&](const PlanResult& r) {
-      for (const Vector3& t : r.maneuver.torque) {
-        if (((t.cwiseAbs() - problem.max_torque).array() > 0.0).any()) return false;
+    const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
+                                              ? checkConstraints(problem, result.maneuver)
+                                              : ConstraintCheck{};
+    if (!result.converged() || unconstrained.max_violation > 0.0) {
+      SolverOptions constrained = options;
+      if (options.time_budget_s > 0) {
+        const double used =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        constrained.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
       }
-      return true;
-    };
-    if (!result.converged() || !within_bounds(result)) {
-      // The unbounded optimum violates the bounds: the constrained solver, started from it.
-      Maneuver clipped = result.maneuver;
-      for (Vector3& t : clipped.torque)
-        t = t.cwiseMax(-problem.max_torque).cwiseMin(problem.max_torque);
-      SolverOptions bounded = options;
-      bounded.warm_start = result.converged() ? &clipped : nullptr;
-      const std::string unbounded_note = result.converged() ? "; the unbounded optimum (cost " +
-                                                                  std::to_string(result.cost) +
-                                                                  ") exceeds the bounds"
-                                                            : "";
-      result = solveWithNlopt(problem, bounded);
-      result.message += unbounded_note;
-      result.solver = solverName(SolverKind::Nlopt);
+      const int newton_iterations = result.iterations;
+      std::ostringstream note;
+      if (result.converged()) {
+        note << "; the unconstrained optimum (cost " << result.cost << ") violates "
+             << unconstrained.worst << " " << unconstrained.worst_where << " and started it ("
+             << newton_iterations << " Newton iterations)";
+      }
+      const Maneuver unconstrained_plan = result.maneuver;
+      constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
+      result = solveWithInteriorPoint(problem, constrained);
+      result.iterations += newton_iterations;
+      result.message += note.str();
     } else {
-      result.message += "; bounds inactive at the unbounded optimum";
+      result.message += "; constraints inactive at the unconstrained optimum";
     }
   } else if (options.solver == SolverKind::Newton) {
     result = solveWithNewton(problem, options);
@@ -96,6 +100,12 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     result = solveWithNlopt(problem, options);
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);
+  if (problem.hasNodeConstraints() && result.maneuver.steps() == problem.steps) {
+    const ConstraintCheck check = checkConstraints(problem, result.maneuver);
+    result.constraints = check.names;
+    result.max_constraint_violation = check.max_violation;
+    result.active_constraints = check.active;
+  }
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -32,6 +32,40 @@ void requireRotation(const Matrix3& R, const std::string& field) {
   }
 }
 
+/// The boundary data must meet the node constraints themselves: R_0, R_N every cone, Ω_0 and
+/// Ω_{N−1} every rate limit (they are data, no plan can change them).
+void requireBoundaryWithinConstraints(const PlanningProblem& p) {
+  for (std::size_t i = 0; i < p.constraints.size(); ++i) {
+    const PlanningConstraint& c = p.constraints[i];
+    const std::string path = "constraints[" + std::to_string(i) + "]." + constraintKindName(c.kind);
+    if (c.isCone()) {
+      const std::pair<const char*, const Matrix3*> ends[] = {
+          {"initial.attitude", &p.initial_attitude}, {"final.attitude", &p.final_attitude}};
+      for (const auto& [field, R] : ends) {
+        const double margin = coneMargin(c, *R);
+        if (margin < 0.0) {
+          throw InvalidInput(
+              path + ": " + field + " already violates it: the angle between R b and s is " +
+              exactNumber(c.kind == ConstraintKind::KeepOut ? c.half_angle + margin
+                                                            : c.half_angle - margin) +
+              " rad, half_angle " + exactNumber(c.half_angle) + " rad");
+        }
+      }
+    } else if (c.kind == ConstraintKind::MaxAngularRate) {
+      const std::pair<const char*, const Vector3*> ends[] = {
+          {"initial.angular_velocity", &p.initial_velocity},
+          {"final.angular_velocity", &p.final_velocity}};
+      for (const auto& [field, Omega] : ends) {
+        if (Omega->norm() > c.limit) {
+          throw InvalidInput(path + ": " + field +
+                             " already violates it: |Omega| = " + exactNumber(Omega->norm()) +
+                             " rad/s > " + exactNumber(c.limit) + " rad/s");
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void validateProblem(const PlanningProblem& p) {
@@ -73,27 +107,23 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("actuator_limits.max_torque: give all three bounds, got " +
                        str(p.max_torque.transpose()));
   }
-  if (p.hasTorqueBounds() && p.effects && !p.effects->empty()) {
-    throw InvalidInput(
-        "effects: actuator_limits together with gravity_gradient/disturbance_torque is not "
-        "supported yet (bounded plans use NLopt, which does not model effect torques)");
-  }
   if (p.accuracy.choose_scheme && !p.accuracy.active()) {
     throw InvalidInput(std::string("scheme: '") + kAutoSchemeName +
                        "' needs an accuracy target (accuracy_measure, --target-miss or "
                        "--target-cost-error): the planner chooses the scheme only for a "
                        "requested accuracy");
   }
+  validateConstraints(p.constraints, "constraints");
   if (p.accuracy.active()) {
     if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
       throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
                          accuracyMeasureName(p.accuracy.measure) + "), got " +
                          exactNumber(p.accuracy.value));
     }
-    if (p.hasTorqueBounds() || (p.effects && !p.effects->empty())) {
+    if (p.hasNodeConstraints() || (p.effects && !p.effects->empty())) {
       throw InvalidInput(
-          "accuracy_target: not supported with effects or actuator_limits (the continuous "
-          "reference and the measured orders are for the bare rigid body)");
+          "accuracy_target: not supported with effects, actuator_limits or constraints (the "
+          "continuous reference and the measured orders are for the bare rigid body)");
     }
     if (p.accuracy.max_steps < 16 || p.accuracy.max_steps > kMaxSteps) {
       throw InvalidInput("accuracy.max_steps: must be in [16, " + std::to_string(kMaxSteps) +
@@ -105,6 +135,7 @@ void validateProblem(const PlanningProblem& p) {
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
   requireFinite(p.final_velocity, "final.angular_velocity");
+  requireBoundaryWithinConstraints(p);
 }
 
 void applySchemeName(const std::string& text, const std::string& field, PlanningProblem* problem) {

@@ -225,7 +225,8 @@ ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, doub
 }
 
 double ReducedProblem::forEachStencil(bool with_second_order,
-                                      const std::function<void(const Stencil&)>& visit) const {
+                                      const std::function<void(const Stencil&)>& visit,
+                                      const SecondOrderWeights& weights) const {
   const double h = scheme_.timeStep();
   const std::vector<Vector3> tau = torques(steps_);
   double cost = 0.0;
@@ -250,12 +251,13 @@ double ReducedProblem::forEachStencil(bool with_second_order,
     if (with_second_order) {
       // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
       Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
-      const Matrix3 C_dG_prev = prev.contractdG(scheme_, st.tau);
-      const Matrix3 C_D = next.contractD(scheme_, st.tau);
-      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, st.tau) / h;  // block a, via ε_{k−1}
-      const Matrix3 T_dG_prev = -C_dG_prev / h;                  // block b, via ε_{k−1}
-      const Matrix3 T_DFt = -next.contractDFt(C_D, st.tau) / h;  // block b, via ε_k
-      const Matrix3 T_D = C_D / h;                               // block c, via ε_k
+      const Vector3 w = weights ? weights(k, st.tau) : st.tau;
+      const Matrix3 C_dG_prev = prev.contractdG(scheme_, w);
+      const Matrix3 C_D = next.contractD(scheme_, w);
+      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, w) / h;  // block a, via ε_{k−1}
+      const Matrix3 T_dG_prev = -C_dG_prev / h;                         // block b, via ε_{k−1}
+      const Matrix3 T_DFt = -next.contractDFt(C_D, w) / h;              // block b, via ε_k
+      const Matrix3 T_D = C_D / h;                                      // block c, via ε_k
       second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
       second.block<3, 3>(0, 3) = T_dGFt_prev;
       second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
@@ -266,8 +268,7 @@ double ReducedProblem::forEachStencil(bool with_second_order,
       // The antisymmetric part is cancelled exactly by the retraction's derivative
       // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
       st.second = 0.5 * (second + second.transpose());
-      if (effects_)
-        st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, st.tau);
+      if (effects_) st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, w);
     }
     visit(st);
     prev = next;

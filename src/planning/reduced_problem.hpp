@@ -80,10 +80,15 @@ class ReducedProblem {
   /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).
   Steps retract(const Eigen::VectorXd& delta, double alpha) const;
 
+  /// Weights w_k(τ_k) for `second` in place of τ_k (see forEachStencil).
+  using SecondOrderWeights = std::function<Vector3(int k, const Vector3& tau)>;
+
   /// Calls visit(stencil) for k = 1..N−1 at the current iterate; `second` is formed only if
-  /// with_second_order. Returns the cost.
-  double forEachStencil(bool with_second_order,
-                        const std::function<void(const Stencil&)>& visit) const;
+  /// with_second_order. Returns the cost. With `weights`, `second` is sym(Σ_i w_i ∂jacobian_i/∂δ),
+  /// w = weights(k, τ_k): the Hessian of a Lagrangian whose constraints are functions of τ_k
+  /// (the formulas are linear in the weights; interior_point_solver.cpp).
+  double forEachStencil(bool with_second_order, const std::function<void(const Stencil&)>& visit,
+                        const SecondOrderWeights& weights = nullptr) const;
 
   /// Cost, gradient and exact Hessian (normal equations) of δ ↦ C(R_j exp(δ_j^)) at δ = 0.
   /// `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient); hessian may be null.

@@ -11,6 +11,12 @@ namespace attitude_planner {
 /// (newton_solver.cpp). Fills everything but solve_time_s.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options);
 
+/// Primal–dual interior point on the reduced problem with the node constraints (per-axis torque
+/// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
+/// from options.warm_start if given. Sets PlanResult::infeasible when the constraints cannot be
+/// met. Fills everything but solve_time_s and the constraint figures.
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
+
 /// Independent cross-check: NLopt on the direct method (τ_1..τ_{N−1} as variables, equality
 /// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);

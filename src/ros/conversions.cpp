@@ -58,6 +58,31 @@ Effect effectToMsg(const EffectSpec& spec) {
   return msg;
 }
 
+PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field) {
+  const auto vector = [](const geometry_msgs::Vector3& v) { return Vector3(v.x, v.y, v.z); };
+  const Vector3 b = vector(msg.body_axis), s = vector(msg.world_direction);
+  const bool cone = msg.type == Constraint::KEEP_OUT || msg.type == Constraint::KEEP_IN;
+  if (!cone && msg.type != Constraint::MAX_TORQUE_NORM &&
+      msg.type != Constraint::MAX_ANGULAR_RATE) {
+    throw InvalidInput(field + ".type: unknown value '" + msg.type +
+                       "' (expected max_torque_norm, max_angular_rate, keep_out or keep_in)");
+  }
+  const std::string path = field + "." + msg.type;
+  if (cone && msg.limit != 0.0) {
+    throw InvalidInput(path + ".limit: not used by " + msg.type + ", must be 0, got " +
+                       exactNumber(msg.limit));
+  }
+  if (!cone && (!b.isZero(0.0) || !s.isZero(0.0) || msg.half_angle != 0.0)) {
+    throw InvalidInput(path + ": body_axis, world_direction and half_angle are not used by " +
+                       msg.type + ", must be 0");
+  }
+  if (msg.type == Constraint::MAX_TORQUE_NORM) return PlanningConstraint::maxTorqueNorm(msg.limit);
+  if (msg.type == Constraint::MAX_ANGULAR_RATE)
+    return PlanningConstraint::maxAngularRate(msg.limit);
+  if (msg.type == Constraint::KEEP_OUT) return PlanningConstraint::keepOut(b, s, msg.half_angle);
+  return PlanningConstraint::keepIn(b, s, msg.half_angle);
+}
+
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
   std::vector<EffectSpec> specs;
   for (std::size_t i = 0; i < effects.size(); ++i) {

@@ -288,3 +288,36 @@ int main(int argc, char** argv) {
   spinner.start();
   return RUN_ALL_TESTS();
 }
+
+TEST_F(PlannerService, ConstraintsArePlannedReportedAndABadOneIsNamed) {
+  // The seed slew (N = 32) with |tau_k| <= 0.45 N m (the unconstrained peak is ~0.6 N m): the
+  // bound binds, the response lists it and its figures; then a keep-out cone with a non-unit
+  // axis is refused naming the field, and the node keeps serving.
+  PlanAttitudeManeuver::Request req = seed(32);
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = 0.45;
+  req.constraints.push_back(norm);
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  ASSERT_EQ(res.constraints.size(), 1u);
+  EXPECT_EQ(res.constraints[0], "max_torque_norm");
+  EXPECT_GT(res.active_constraints, 0);
+  EXPECT_LE(res.max_constraint_violation, 1e-9);
+  for (const geometry_msgs::Vector3& t : res.maneuver.torque) {
+    EXPECT_LE(std::sqrt(t.x * t.x + t.y * t.y + t.z * t.z), 0.45 * (1 + 1e-9));
+  }
+  Constraint cone;
+  cone.type = Constraint::KEEP_OUT;
+  cone.body_axis.z = 2.0;
+  cone.world_direction.y = 1.0;
+  cone.half_angle = 0.3;
+  req.constraints = {cone};
+  const PlanAttitudeManeuver::Response bad = call(req);
+  EXPECT_FALSE(bad.success);
+  EXPECT_EQ(bad.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(bad.message.find("constraints[0].keep_out.body_axis: not a unit vector"),
+            std::string::npos)
+      << bad.message;
+  EXPECT_TRUE(call(seed(16)).success);
+}

@@ -224,7 +224,7 @@ TEST(Effects, TorqueLimitedPlansRespectTheBoundsAndCostAtLeastTheUnlimitedOne) {
   p.max_torque = Vector3::Constant(0.7 * largest);
   const PlanResult tight = planManeuver(p);
   ASSERT_TRUE(tight.converged()) << tight.message;
-  EXPECT_EQ(tight.solver, "nlopt");
+  EXPECT_EQ(tight.solver, "interior_point");
   EXPECT_LE(tight.terminal_attitude_error, 1e-10);
   int at_bound = 0;
   for (const Vector3& t : tight.maneuver.torque) {

@@ -150,13 +150,8 @@ TEST(SceneOptionalKeys, EffectsAreParsedIntoThePlanningModelAndActuation) {
   EXPECT_FALSE(ap::actuationOf(s.effects).empty());
   // actuator limits bound the plan
   EXPECT_EQ(s.problem.max_torque, ap::Vector3(0.5, 0.5, 0.25));
-  // ... but a bounded plan with effect torques is not supported yet: refused, never ignored
-  try {
-    ap::validateProblem(s.problem);
-    ADD_FAILURE() << "actuator_limits with gravity_gradient must be refused";
-  } catch (const ap::InvalidInput& e) {
-    EXPECT_CONTAINS(e.what(), "actuator_limits together with gravity_gradient");
-  }
+  // ... together with the effect torques (the interior point plans both)
+  EXPECT_NO_THROW(ap::validateProblem(s.problem));
   // no effects: no model at all (the bare integrator)
   EXPECT_FALSE(ap::parseScene(withLine("effects", "effects: []"), "none.yaml").problem.effects);
 }

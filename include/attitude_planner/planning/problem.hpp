@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/dynamics/effects.hpp"
@@ -17,6 +18,7 @@
 #include "attitude_planner/input_rules.hpp"
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
+#include "attitude_planner/planning/constraints.hpp"
 
 namespace attitude_planner {
 
@@ -95,10 +97,14 @@ struct PlanningProblem {
   /// empty: none. Shared, immutable: several solves may use one model.
   std::shared_ptr<const EffectModel> effects;
   /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
-  /// A bounded problem whose unbounded optimum violates the bounds is solved by NLopt (SLSQP with
-  /// box bounds, N ≤ 1024) from the clipped Newton torques.
+  /// A problem whose unconstrained optimum violates a bound or a constraint is solved by the
+  /// interior-point solver (interior_point_solver.cpp), O(N) per iteration.
   Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   bool hasTorqueBounds() const { return max_torque.allFinite(); }
+  /// Constraints at every node (scene key `constraints:`, constraints.hpp); empty: none.
+  std::vector<PlanningConstraint> constraints;
+  /// Any per-axis bound or node constraint.
+  bool hasNodeConstraints() const { return hasTorqueBounds() || !constraints.empty(); }
   /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
   /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
   AccuracyTarget accuracy;
@@ -141,6 +147,21 @@ void applySchemeName(const std::string& text, const std::string& field, Planning
 /// Checks the solver settings (tolerance finite and > 0, max_iterations ≥ 0, time budget finite
 /// and ≥ 0): throws InvalidInput naming the option and the value.
 void validateOptions(const SolverOptions& options);
+
+/// A node constraint is counted active when its slack is within this fraction of its limit
+/// (torque, rate) or this many radians (cones).
+constexpr double kActiveConstraintTolerance = 1e-6;
+
+/// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
+/// on a maneuver's own rows, independently of any solver (constraints.cpp).
+struct ConstraintCheck {
+  std::vector<std::string> names;  ///< the keys in force ("actuator_limits" first if bounded)
+  double max_violation = 0.0;      ///< worst violation, each in its own unit, ≥ 0
+  int active = 0;                  ///< node constraints at their bound
+  std::string worst;  ///< the worst violated constraint, e.g. "|tau_x| <= 0.1 N m"; empty if none
+  std::string worst_where;  ///< its violation and node, e.g. "by 0.02 at k = 64 (t = 6.4 s)"
+};
+ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver);
 
 /// Throws InvalidInput naming the inertia and its principal moments unless J1 + J2 ≥ J3 (a mass
 /// distribution exists). validateProblem applies it unless

@@ -65,6 +65,13 @@ struct PlanResult {
   std::vector<std::string> effects;
   /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
   AccuracyEstimate accuracy;
+  /// The node constraints in force (scene keys, in order; "actuator_limits" first when bounded).
+  std::vector<std::string> constraints;
+  /// Worst violation over all nodes and constraints, each in its own unit (N m, rad/s, rad), ≥ 0,
+  /// measured on the returned maneuver (checkConstraints).
+  double max_constraint_violation = 0.0;
+  /// Node constraints at their bound (within kActiveConstraintTolerance relative) on the result.
+  int active_constraints = 0;
 };
 
 }  // namespace attitude_planner

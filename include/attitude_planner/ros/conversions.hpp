@@ -12,6 +12,7 @@
 #include <boost/array.hpp>
 
 #include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/Constraint.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/Effect.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
@@ -70,6 +71,11 @@ Effect effectToMsg(const EffectSpec& spec);
 /// The effects of a planning request: converted, validated (validateEffects) and put into the
 /// planning model of `problem` (applyEffects). torque_noise is refused: it is not plannable.
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem);
+
+/// Core constraint of a Constraint message (`field` names it in errors, e.g. "constraints[1]").
+/// Throws InvalidInput for an unknown type or a field of another type that is not left at zero;
+/// the values themselves are checked by validateConstraints (validateProblem).
+PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
@@ -149,6 +155,11 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
     options->time_budget_s = defaults.max_solve_time;  // the node's ~max_solve_time bounds all
   }
   applyRequestEffects(req.effects, &p);
+  for (std::size_t i = 0; i < req.constraints.size(); ++i) {
+    p.constraints.push_back(
+        constraintFromMsg(req.constraints[i], "constraints[" + std::to_string(i) + "]"));
+  }
+  validateConstraints(p.constraints, "constraints");
   return p;
 }
 

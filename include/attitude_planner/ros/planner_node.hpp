@@ -174,6 +174,9 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->terminal_velocity_error = r.terminal_velocity_error;
   res->solve_time = r.solve_time_s;
   res->effects = r.effects;
+  res->constraints = r.constraints;
+  res->max_constraint_violation = r.max_constraint_violation;
+  res->active_constraints = r.active_constraints;
 }
 
 }  // namespace attitude_planner

@@ -1,0 +1,58 @@
+// Planning constraints at every node (scene key `constraints:`, DESIGN.md "Scene file"), besides
+// the per-axis actuator limits |τ_i| ≤ a_i (effect `actuator_limits`, PlanningProblem::max_torque):
+//
+//   max_torque_norm  t   |τ_k|₂ ≤ t [N m],            k = 1..N−1 (control torque)
+//   max_angular_rate w   |Ω_k|₂ ≤ w [rad/s],          k = 0..N−1 (the scheme's reported Ω_k)
+//   keep_out {b, s, a}   angle(R_k b, s) ≥ a [rad],   k = 0..N
+//   keep_in  {b, s, a}   angle(R_k b, s) ≤ a [rad],   k = 0..N
+//
+// b is a unit body axis, s a unit world direction, a ∈ (0, π). The constraints hold at the nodes;
+// between two nodes the continuous motion may exceed them by O(h²) (see interior_point_solver.cpp).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "attitude_planner/lie/so3.hpp"
+
+namespace attitude_planner {
+
+enum class ConstraintKind { MaxTorqueNorm, MaxAngularRate, KeepOut, KeepIn };
+
+/// The scene key of a kind: "max_torque_norm", "max_angular_rate", "keep_out", "keep_in".
+std::string constraintKindName(ConstraintKind kind);
+
+/// One constraint imposed at every node.
+struct PlanningConstraint {
+  ConstraintKind kind = ConstraintKind::MaxTorqueNorm;
+  double limit = 0.0;                          ///< t [N m] or w [rad/s] (norm and rate kinds)
+  Vector3 body_axis = Vector3::UnitZ();        ///< b, unit, body frame (cone kinds)
+  Vector3 world_direction = Vector3::UnitX();  ///< s, unit, world frame (cone kinds)
+  double half_angle = 0.0;                     ///< a [rad] in (0, π) (cone kinds)
+
+  static PlanningConstraint maxTorqueNorm(double max_torque_norm);
+  static PlanningConstraint maxAngularRate(double max_angular_rate);
+  static PlanningConstraint keepOut(const Vector3& body_axis, const Vector3& world_direction,
+                                    double half_angle);
+  static PlanningConstraint keepIn(const Vector3& body_axis, const Vector3& world_direction,
+                                   double half_angle);
+  bool isCone() const { return kind == ConstraintKind::KeepOut || kind == ConstraintKind::KeepIn; }
+};
+
+/// Tolerance on |b|, |s| − 1 for a unit vector.
+constexpr double kUnitVectorTolerance = 1e-9;
+
+/// Checks the values (limits finite and > 0; b, s unit within kUnitVectorTolerance; half angle in
+/// (0, π)); throws InvalidInput naming `field`[i].<kind>.<key> and the value.
+void validateConstraints(const std::vector<PlanningConstraint>& constraints,
+                         const std::string& field);
+
+/// Signed margin of a cone constraint at attitude R [rad]: ≥ 0 where it holds
+/// (keep_out: angle − a, keep_in: a − angle).
+double coneMargin(const PlanningConstraint& cone, const Matrix3& R);
+
+/// A one-line description, e.g. "keep_out {body_axis [0, 0, 1], world_direction [1, 0, 0],
+/// half_angle 0.5 rad}" or "max_angular_rate 0.2 rad/s".
+std::string describeConstraint(const PlanningConstraint& constraint);
+
+}  // namespace attitude_planner

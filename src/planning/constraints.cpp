@@ -1,0 +1,165 @@
+#include "attitude_planner/planning/constraints.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/problem.hpp"
+
+namespace attitude_planner {
+
+std::string constraintKindName(ConstraintKind kind) {
+  switch (kind) {
+    case ConstraintKind::MaxTorqueNorm:
+      return "max_torque_norm";
+    case ConstraintKind::MaxAngularRate:
+      return "max_angular_rate";
+    case ConstraintKind::KeepOut:
+      return "keep_out";
+    case ConstraintKind::KeepIn:
+      return "keep_in";
+  }
+  return "unknown";
+}
+
+PlanningConstraint PlanningConstraint::maxTorqueNorm(double max_torque_norm) {
+  PlanningConstraint c;
+  c.kind = ConstraintKind::MaxTorqueNorm;
+  c.limit = max_torque_norm;
+  return c;
+}
+
+PlanningConstraint PlanningConstraint::maxAngularRate(double max_angular_rate) {
+  PlanningConstraint c;
+  c.kind = ConstraintKind::MaxAngularRate;
+  c.limit = max_angular_rate;
+  return c;
+}
+
+PlanningConstraint PlanningConstraint::keepOut(const Vector3& body_axis,
+                                               const Vector3& world_direction, double half_angle) {
+  PlanningConstraint c;
+  c.kind = ConstraintKind::KeepOut;
+  c.body_axis = body_axis;
+  c.world_direction = world_direction;
+  c.half_angle = half_angle;
+  return c;
+}
+
+PlanningConstraint PlanningConstraint::keepIn(const Vector3& body_axis,
+                                              const Vector3& world_direction, double half_angle) {
+  PlanningConstraint c = keepOut(body_axis, world_direction, half_angle);
+  c.kind = ConstraintKind::KeepIn;
+  return c;
+}
+
+namespace {
+
+std::string vectorText(const Vector3& v) {
+  return "[" + exactNumber(v(0)) + ", " + exactNumber(v(1)) + ", " + exactNumber(v(2)) + "]";
+}
+
+void requireUnit(const Vector3& v, const std::string& path) {
+  if (!v.allFinite()) throw InvalidInput(path + ": not finite: " + vectorText(v));
+  if (v.norm() == 0.0)
+    throw InvalidInput(path + ": zero vector " + vectorText(v) + " has no direction");
+  if (std::abs(v.norm() - 1.0) > kUnitVectorTolerance) {
+    throw InvalidInput(path + ": not a unit vector: " + vectorText(v) + " has norm " +
+                       exactNumber(v.norm()) + " (must be within " +
+                       exactNumber(kUnitVectorTolerance) + " of 1)");
+  }
+}
+
+}  // namespace
+
+void validateConstraints(const std::vector<PlanningConstraint>& constraints,
+                         const std::string& field) {
+  for (std::size_t i = 0; i < constraints.size(); ++i) {
+    const PlanningConstraint& c = constraints[i];
+    const std::string path = field + "[" + std::to_string(i) + "]." + constraintKindName(c.kind);
+    if (c.isCone()) {
+      requireUnit(c.body_axis, path + ".body_axis");
+      requireUnit(c.world_direction, path + ".world_direction");
+      if (!std::isfinite(c.half_angle) || !(c.half_angle > 0.0) || !(c.half_angle < M_PI)) {
+        throw InvalidInput(path + ".half_angle: must be in (0, pi) rad, got " +
+                           exactNumber(c.half_angle));
+      }
+    } else {
+      const char* unit = c.kind == ConstraintKind::MaxTorqueNorm ? " N m" : " rad/s";
+      if (!std::isfinite(c.limit) || !(c.limit > 0.0)) {
+        throw InvalidInput(path + ": must be a finite number > 0" + unit + ", got " +
+                           exactNumber(c.limit));
+      }
+    }
+  }
+}
+
+double coneMargin(const PlanningConstraint& cone, const Matrix3& R) {
+  const Vector3 pointing = R * cone.body_axis;
+  // atan2 of |a × b| and a·b: accurate at every angle (acos loses it near 0 and π).
+  const double angle =
+      std::atan2(pointing.cross(cone.world_direction).norm(), pointing.dot(cone.world_direction));
+  return cone.kind == ConstraintKind::KeepOut ? angle - cone.half_angle : cone.half_angle - angle;
+}
+
+std::string describeConstraint(const PlanningConstraint& c) {
+  std::ostringstream s;
+  s << constraintKindName(c.kind);
+  if (c.isCone()) {
+    s << " {body_axis " << vectorText(c.body_axis) << ", world_direction "
+      << vectorText(c.world_direction) << ", half_angle " << c.half_angle << " rad}";
+  } else {
+    s << " " << c.limit << (c.kind == ConstraintKind::MaxTorqueNorm ? " N m" : " rad/s");
+  }
+  return s.str();
+}
+
+ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver) {
+  ConstraintCheck out;
+  const int N = maneuver.steps();
+  const double h = maneuver.time_step;
+  // One node constraint with signed slack (≥ 0: holds) against `scale` (its limit, or 1 rad).
+  const auto visit = [&](double slack, double scale, const std::string& what, int k) {
+    if (slack <= kActiveConstraintTolerance * scale) ++out.active;
+    if (-slack > out.max_violation) {
+      out.max_violation = -slack;
+      std::ostringstream w;
+      w << "by " << -slack << " at k = " << k << " (t = " << k * h << " s)";
+      out.worst = what;
+      out.worst_where = w.str();
+    }
+  };
+  if (problem.hasTorqueBounds()) {
+    out.names.push_back("actuator_limits");
+    static const char* axis[] = {"x", "y", "z"};
+    for (int k = 1; k < N; ++k) {
+      for (int i = 0; i < 3; ++i) {
+        const double a = problem.max_torque(i);
+        std::ostringstream what;
+        what << "|tau_" << axis[i] << "| <= " << a << " N m";
+        visit(a - std::abs(maneuver.torque[k](i)), a, what.str(), k);
+      }
+    }
+  }
+  for (const PlanningConstraint& c : problem.constraints) {
+    out.names.push_back(constraintKindName(c.kind));
+    const std::string what = describeConstraint(c);
+    switch (c.kind) {
+      case ConstraintKind::MaxTorqueNorm:
+        for (int k = 1; k < N; ++k) visit(c.limit - maneuver.torque[k].norm(), c.limit, what, k);
+        break;
+      case ConstraintKind::MaxAngularRate:
+        for (int k = 0; k < N; ++k) {
+          visit(c.limit - maneuver.angular_velocity[k].norm(), c.limit, what, k);
+        }
+        break;
+      case ConstraintKind::KeepOut:
+      case ConstraintKind::KeepIn:
+        for (int k = 0; k <= N; ++k) visit(coneMargin(c, maneuver.attitude[k]), 1.0, what, k);
+        break;
+    }
+  }
+  return out;
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,436 @@
+// The interior-point solver for node constraints: exact constraint derivatives against finite
+// differences, KKT conditions of constrained optima checked in the torque space of the direct
+// method (independent of the solver's reduced coordinates), agreement with NLopt SLSQP given the
+// same constraints, infeasible requests answered with the named reason, and scene validation.
+#include <gtest/gtest.h>
+
+#include <Eigen/QR>
+#include <random>
+
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "planning/direct_method.hpp"
+#include "planning/node_constraints.hpp"
+#include "planning/reduced_problem.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+ap::PlanningProblem sceneProblem(const std::string& scene, int steps) {
+  ap::PlanningProblem p = ap::loadScene(AP_SOURCE_DIR "/scenes/" + scene).problem;
+  p.steps = steps;
+  return p;
+}
+
+ap::PlanResult plan(const ap::PlanningProblem& p, const std::string& solver) {
+  ap::SolverOptions o;
+  o.solver = solver;
+  if (solver == "nlopt") o.max_iterations = 5000;
+  return ap::planManeuver(p, o);
+}
+
+/// Relative cost agreement of the interior point (newton path) and NLopt SLSQP. `perturbed_start`:
+/// SLSQP starts from the interior point's torques scaled by 0.9 (not from zero), so that both
+/// look at the same local optimum (pointing cones have one on either side of the cone).
+void expectAgreesWithNlopt(const ap::PlanningProblem& p, double tolerance = 1e-8,
+                           bool perturbed_start = false) {
+  const ap::PlanResult ip = plan(p, "newton");
+  ap::SolverOptions o;
+  o.solver = "nlopt";
+  o.max_iterations = 5000;
+  ap::Maneuver start = ip.maneuver;
+  for (ap::Vector3& t : start.torque) t *= 0.9;
+  if (perturbed_start) o.warm_start = &start;
+  const ap::PlanResult slsqp = ap::planManeuver(p, o);
+  ASSERT_TRUE(ip.converged()) << ip.message;
+  ASSERT_TRUE(slsqp.converged()) << slsqp.message;
+  EXPECT_EQ(ip.solver, "interior_point") << ip.message;
+  EXPECT_NEAR(ip.cost, slsqp.cost, tolerance * slsqp.cost) << ip.message;
+  EXPECT_LE(ip.max_constraint_violation, 1e-9);
+  EXPECT_GT(ip.active_constraints, 0);
+}
+
+std::string invalidMessage(const std::string& text) {
+  try {
+    ap::parseScene(text, "bad.yaml");
+  } catch (const ap::InvalidInput& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InvalidInput for:\n" << text;
+  return "";
+}
+
+const char* kSceneHead = R"(inertia: [20, 25, 30]
+duration: 60.0
+steps: 32
+initial: {attitude: {axis: [0, 0, 1], angle: 0.0}, angular_velocity: [0, 0, 0]}
+final: {attitude: {axis: [0, 0, 1], angle: 1.5707963267948966}, angular_velocity: [0, 0, 0]}
+effects: []
+)";
+
+}  // namespace
+
+TEST(NodeConstraintDerivatives, PointingTermsMatchFiniteDifferences) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 5; ++trial) {
+    const ap::Matrix3 R = ap::so3::exp(ap::Vector3(normal(rng), normal(rng), normal(rng)));
+    const ap::Vector3 b = ap::Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+    const ap::Vector3 s = ap::Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+    const ap::PointingTerms t = ap::pointingTerms(R, b, s);
+    const auto p = [&](const ap::Vector3& d) { return s.dot(R * ap::so3::exp(d) * b); };
+    EXPECT_NEAR(t.cosine, p(ap::Vector3::Zero()), 1e-15);
+    const double e = 1e-4;
+    for (int i = 0; i < 3; ++i) {
+      const ap::Vector3 ei = e * ap::Vector3::Unit(i);
+      EXPECT_NEAR(t.gradient(i), (p(ei) - p(-ei)) / (2 * e), 1e-8);
+      for (int j = 0; j < 3; ++j) {
+        const ap::Vector3 ej = e * ap::Vector3::Unit(j);
+        const double fd = (p(ei + ej) - p(ei - ej) - p(-ei + ej) + p(-ei - ej)) / (4 * e * e);
+        EXPECT_NEAR(t.hessian(i, j), fd, 1e-6) << i << "," << j;
+      }
+    }
+  }
+}
+
+class BothSchemes : public ::testing::TestWithParam<ap::SchemeKind> {};
+
+TEST_P(BothSchemes, AngularRateTermsMatchFiniteDifferences) {
+  const ap::Matrix3 J = sceneProblem("rest_to_rest.yaml", 16).inertia;
+  const ap::DiscreteScheme scheme(GetParam(), J, 0.1);
+  const ap::Vector3 omega(0.05, -0.08, 0.11);
+  const ap::Matrix3 F = ap::so3::exp(omega);
+  const ap::AngularRateTerms t = ap::angularRateTerms(scheme, omega);
+  // φ(a, b) = ½|Ω(exp(−a^) F exp(b^))|², the retraction of R_k and R_{k+1}.
+  const auto phi = [&](const Eigen::Matrix<double, 6, 1>& x) {
+    const ap::Matrix3 Fp =
+        ap::so3::exp(ap::Vector3(-x.head<3>())) * F * ap::so3::exp(ap::Vector3(x.tail<3>()));
+    return 0.5 * scheme.velocity(Fp).squaredNorm();
+  };
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  EXPECT_NEAR(t.half_squared_rate, phi(Vec6::Zero()), 1e-14);
+  const double e = 1e-4;
+  const double scale = t.hessian.cwiseAbs().maxCoeff();
+  for (int i = 0; i < 6; ++i) {
+    const Vec6 ei = e * Vec6::Unit(i);
+    EXPECT_NEAR(t.gradient(i), (phi(ei) - phi(-ei)) / (2 * e), 1e-7 * scale);
+    for (int j = 0; j < 6; ++j) {
+      const Vec6 ej = e * Vec6::Unit(j);
+      const double fd = (phi(ei + ej) - phi(ei - ej) - phi(-ei + ej) + phi(-ei - ej)) / (4 * e * e);
+      EXPECT_NEAR(t.hessian(i, j), fd, 1e-5 * scale) << i << "," << j;
+    }
+  }
+}
+
+TEST_P(BothSchemes, WeightedTorqueHessianMatchesFiniteDifferences) {
+  // sym(Σ_i w_i ∂jacobian_i/∂δ) is the Hessian of Σ_k w_kᵀ τ_k(δ) for any fixed weights: what the
+  // interior point needs for −Σ z ∇²c of torque constraints.
+  ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 10);
+  p.scheme = GetParam();
+  p.initial_velocity = ap::Vector3(0.05, -0.02, 0.03);
+  ap::ReducedProblem np(p);
+  np.initializeAlong(np.principalSpan() * 1.0);
+  const int n = np.unknowns();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<ap::Vector3> w(p.steps);
+  for (auto& v : w) v = ap::Vector3(normal(rng), normal(rng), normal(rng));
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  np.forEachStencil(
+      true,
+      [&](const ap::ReducedProblem::Stencil& st) {
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) {
+            const int va = np.variableIndex(st.k - 1 + a), vb = np.variableIndex(st.k - 1 + b);
+            if (va >= 0 && vb >= 0) H.block<3, 3>(va, vb) += st.second.block<3, 3>(3 * a, 3 * b);
+          }
+        }
+      },
+      [&](int k, const ap::Vector3&) { return w[k]; });
+  const auto value = [&](const Eigen::VectorXd& d) {
+    const std::vector<ap::Vector3> tau = np.torques(np.retract(d, 1.0));
+    double sum = 0.0;
+    for (int k = 1; k < p.steps; ++k) sum += w[k].dot(tau[k]);
+    return sum;
+  };
+  const double e = 1e-4;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      Eigen::VectorXd ei = Eigen::VectorXd::Zero(n), ej = Eigen::VectorXd::Zero(n);
+      ei(i) = e;
+      ej(j) = e;
+      const double fd =
+          (value(ei + ej) - value(ei - ej) - value(-ei + ej) + value(-ei - ej)) / (4 * e * e);
+      EXPECT_NEAR(H(i, j), fd, 1e-5 * H.cwiseAbs().maxCoeff()) << i << "," << j;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, BothSchemes,
+                         ::testing::Values(ap::SchemeKind::Paper, ap::SchemeKind::Variational));
+
+TEST(ElasticSlacks, SolveTheirDefiningEquationsWithoutCancellation) {
+  const double rho = 1e4, mu = 1e-6;
+  for (double c : {-2.0, -1e-3, -1e-12, 0.0, 1e-12, 1e-3, 2.0}) {
+    const ap::ElasticSlacks e = ap::elasticSlacks(c, mu, rho);
+    EXPECT_GT(e.s, 0.0);
+    EXPECT_GT(e.v, 0.0);
+    EXPECT_NEAR(e.s - e.v, c, 1e-15 * std::max(1.0, std::abs(c)));
+    EXPECT_NEAR(mu / e.s + mu / e.v, rho, 1e-9 * rho) << c;
+  }
+}
+
+// ---- constrained optima
+// --------------------------------------------------------------------------
+
+TEST(InteriorPoint, PerAxisTorqueLimitsAgreeWithNlopt) {
+  expectAgreesWithNlopt(sceneProblem("torque_limited.yaml", 24));
+}
+
+TEST(InteriorPoint, TorqueNormAgreesWithNlopt) {
+  expectAgreesWithNlopt(sceneProblem("torque_norm_limited.yaml", 24));
+}
+
+TEST(InteriorPoint, AngularRateAgreesWithNlopt) {
+  expectAgreesWithNlopt(sceneProblem("rate_limited.yaml", 24));
+}
+
+TEST(InteriorPoint, AngularRateAgreesWithNloptVariationalScheme) {
+  ap::PlanningProblem p = sceneProblem("rate_limited.yaml", 24);
+  p.scheme = ap::SchemeKind::Variational;
+  expectAgreesWithNlopt(p);
+}
+
+TEST(InteriorPoint, KeepOutAgreesWithNlopt) {
+  expectAgreesWithNlopt(sceneProblem("sun_keep_out.yaml", 24), 1e-8, true);
+}
+
+TEST(InteriorPoint, KeepInAgreesWithNlopt) {
+  // A keep-in cone wider than π/2 about −s is the keep-out cone about s: same optimum.
+  ap::PlanningProblem p = sceneProblem("sun_keep_out.yaml", 24);
+  const ap::PlanningConstraint out = p.constraints[0];
+  p.constraints = {
+      ap::PlanningConstraint::keepIn(out.body_axis, -out.world_direction, M_PI - out.half_angle)};
+  const ap::PlanResult keep_in = plan(p, "newton");
+  const ap::PlanResult keep_out = plan(sceneProblem("sun_keep_out.yaml", 24), "newton");
+  ASSERT_TRUE(keep_in.converged()) << keep_in.message;
+  EXPECT_NEAR(keep_in.cost, keep_out.cost, 1e-8 * keep_out.cost);
+  expectAgreesWithNlopt(p, 1e-8, true);
+}
+
+TEST(InteriorPoint, CombinationAgreesWithNlopt) {
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 24);
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5),
+                   ap::PlanningConstraint::maxAngularRate(0.15)};
+  expectAgreesWithNlopt(p);
+}
+
+TEST(InteriorPoint, RandomizedTorqueNormCasesAgreeWithNlopt) {
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < 4; ++trial) {
+    ap::PlanningProblem p;
+    p.allow_nonphysical_inertia = true;
+    p.inertia = ap::Vector3(10 + 5 * uniform(rng), 14 + 5 * uniform(rng), 18 + 5 * uniform(rng))
+                    .asDiagonal();
+    p.duration = 10.0;
+    p.steps = 16;
+    p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)));
+    const ap::PlanResult free = plan(p, "newton");
+    ASSERT_TRUE(free.converged());
+    double peak = 0.0;
+    for (const ap::Vector3& t : free.maneuver.torque) peak = std::max(peak, t.norm());
+    p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.8 * peak)};
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    expectAgreesWithNlopt(p);
+  }
+}
+
+TEST(InteriorPoint, KktConditionsHoldInTorqueSpace) {
+  // Direct method: min ½|x|² s.t. terminal c(x) = 0, h_i(x) ≤ 0 (the active torque bounds and
+  // norms). At the solution x = −Cᵀλ − Σ ν_i ∇h_i must have a solution with ν ≥ 0.
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 32);
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5)};
+  const ap::PlanResult r = plan(p, "newton");
+  ASSERT_TRUE(r.converged()) << r.message;
+  const Eigen::VectorXd x = ap::unknownsFromTorqueSequence(r.maneuver.torque);
+  const ap::TerminalConstraints c = ap::evaluateTerminalConstraints(p, x, true);
+  EXPECT_LT(c.value.cwiseAbs().maxCoeff(), 1e-10);  // feasibility: terminal state
+  EXPECT_LE(r.max_constraint_violation, 1e-9);      // feasibility: node constraints
+  std::vector<Eigen::VectorXd> active;
+  const int n = static_cast<int>(x.size());
+  for (int k = 1; k < p.steps; ++k) {
+    const ap::Vector3 tau = r.maneuver.torque[k];
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(tau(i)) >= p.max_torque(i) * (1 - 1e-7)) {
+        Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+        g(3 * (k - 1) + i) = tau(i) > 0 ? 1.0 : -1.0;
+        active.push_back(g);
+      }
+    }
+    if (tau.norm() >= 0.5 * (1 - 1e-7)) {
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+      g.segment<3>(3 * (k - 1)) = 2 * tau;
+      active.push_back(g);
+    }
+  }
+  ASSERT_FALSE(active.empty());
+  Eigen::MatrixXd A(n, 6 + active.size());
+  A.leftCols<6>() = c.jacobian.transpose();
+  for (std::size_t i = 0; i < active.size(); ++i) A.col(6 + i) = active[i];
+  const Eigen::VectorXd multipliers = A.colPivHouseholderQr().solve(-x);
+  const double stationarity = (A * multipliers + x).cwiseAbs().maxCoeff();
+  EXPECT_LT(stationarity, 1e-6 * x.cwiseAbs().maxCoeff());
+  for (std::size_t i = 0; i < active.size(); ++i) {
+    EXPECT_GE(multipliers(6 + i), -1e-6 * x.cwiseAbs().maxCoeff()) << "active constraint " << i;
+  }
+}
+
+TEST(InteriorPoint, InactiveConstraintsKeepTheNewtonPath) {
+  ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 64);
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(10.0),
+                   ap::PlanningConstraint::maxAngularRate(5.0)};
+  const ap::PlanResult r = plan(p, "newton");
+  ASSERT_TRUE(r.converged());
+  EXPECT_EQ(r.solver, "newton");
+  EXPECT_NE(r.message.find("inactive"), std::string::npos) << r.message;
+  EXPECT_EQ(r.active_constraints, 0);
+}
+
+TEST(InteriorPoint, WorksWithGravityGradientAndLimits) {
+  ap::PlanningProblem p = sceneProblem("leo_slew_limited.yaml", 60);
+  const ap::PlanResult r = plan(p, "newton");
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.solver, "interior_point");
+  EXPECT_GT(r.active_constraints, 0);
+  EXPECT_LE(r.max_constraint_violation, 1e-9);
+}
+
+TEST(InteriorPoint, ShippedConstrainedScenesBindAndHold) {
+  for (const char* scene : {"torque_limited.yaml", "torque_norm_limited.yaml", "rate_limited.yaml",
+                            "sun_keep_out.yaml"}) {
+    SCOPED_TRACE(scene);
+    const ap::PlanningProblem p =
+        ap::loadScene(AP_SOURCE_DIR "/scenes/" + std::string(scene)).problem;
+    const ap::PlanResult r = plan(p, "newton");
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_EQ(r.solver, "interior_point") << "the constraint must bind: " << r.message;
+    EXPECT_GT(r.active_constraints, 0);
+    EXPECT_LE(r.max_constraint_violation, 1e-9);
+  }
+}
+
+// ---- infeasible requests
+// -------------------------------------------------------------------------
+
+TEST(InteriorPoint, InfeasibleTorqueLimitIsNamed) {
+  ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);
+  p.max_torque = ap::Vector3::Constant(0.01);
+  const ap::PlanResult r = plan(p, "newton");
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_NE(r.message.find("infeasible: |tau_"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("cannot turn this body by 1.047"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("in T = 12.8 s"), std::string::npos) << r.message;
+  EXPECT_LT(r.iterations, 200) << "detected, not iterated to the limit";
+}
+
+TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {
+  // 1.047 rad in 12.8 s needs a mean rate of 0.082 rad/s.
+  ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);
+  p.constraints = {ap::PlanningConstraint::maxAngularRate(0.05)};
+  const ap::PlanResult r = plan(p, "newton");
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_NE(r.message.find("infeasible: max_angular_rate 0.05 rad/s"), std::string::npos)
+      << r.message;
+  EXPECT_LT(r.iterations, 200);
+}
+
+// ---- scene validation
+// ----------------------------------------------------------------------------
+
+TEST(ConstraintScenes, ParseEveryKind) {
+  const ap::Scene s = ap::parseScene(std::string(kSceneHead) + R"(constraints:
+  - max_torque_norm: 0.5
+  - max_angular_rate: 0.2
+  - keep_out: {body_axis: [0, 0, 1], world_direction: [1, 0, 0], half_angle: 0.5}
+  - keep_in: {body_axis: [0, 0, 1], world_direction: [0, 0, 1], half_angle: 1.2}
+)");
+  ASSERT_EQ(s.problem.constraints.size(), 4u);
+  EXPECT_EQ(s.problem.constraints[0].kind, ap::ConstraintKind::MaxTorqueNorm);
+  EXPECT_DOUBLE_EQ(s.problem.constraints[1].limit, 0.2);
+  EXPECT_EQ(s.problem.constraints[2].kind, ap::ConstraintKind::KeepOut);
+  EXPECT_DOUBLE_EQ(s.problem.constraints[3].half_angle, 1.2);
+}
+
+TEST(ConstraintScenes, BadValuesAreNamed) {
+  const std::string head = kSceneHead;
+  EXPECT_NE(invalidMessage(head + "constraints:\n  - max_torque_norm: -1\n")
+                .find("constraints[0].max_torque_norm: must be a finite number > 0"),
+            std::string::npos);
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - max_angular_rate: 0.3\n  - max_angular_rate: 0\n")
+          .find("constraints[1].max_angular_rate"),
+      std::string::npos);
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - keep_out: {body_axis: [0, 0, 2], world_direction: "
+                            "[1, 0, 0], half_angle: 0.5}\n")
+          .find("constraints[0].keep_out.body_axis: not a unit vector"),
+      std::string::npos);
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - keep_in: {body_axis: [0, 0, 1], world_direction: "
+                            "[0, 0, 0], half_angle: 0.5}\n")
+          .find("constraints[0].keep_in.world_direction: zero vector"),
+      std::string::npos);
+  for (const char* angle : {"0", "3.2", "-0.1"}) {
+    EXPECT_NE(invalidMessage(head +
+                             "constraints:\n  - keep_out: {body_axis: [0, 0, 1], world_direction: "
+                             "[1, 0, 0], half_angle: " +
+                             angle + "}\n")
+                  .find("half_angle: must be in (0, pi) rad"),
+              std::string::npos)
+        << angle;
+  }
+  EXPECT_NE(invalidMessage(head + "constraints:\n  - max_torque: 1\n").find("unknown constraint"),
+            std::string::npos);
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - keep_out: {body_axis: [0, 0, 1], world_direction: "
+                            "[1, 0, 0], half_angle: 0.5, margin: 1}\n")
+          .find("unknown key"),
+      std::string::npos);
+}
+
+TEST(ConstraintScenes, BoundaryAlreadyViolatingIsNamed) {
+  const std::string head = kSceneHead;
+  // Body x starts along world x: inside a keep-out cone about world x.
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - keep_out: {body_axis: [1, 0, 0], world_direction: "
+                            "[1, 0, 0], half_angle: 0.5}\n")
+          .find("initial.attitude already violates it"),
+      std::string::npos);
+  // Body x ends along world y: outside a keep-in cone about world x of 1 rad.
+  EXPECT_NE(
+      invalidMessage(head + "constraints:\n  - keep_in: {body_axis: [1, 0, 0], world_direction: "
+                            "[1, 0, 0], half_angle: 1.0}\n")
+          .find("final.attitude already violates it"),
+      std::string::npos);
+  std::string spinning = head;
+  spinning.replace(spinning.find("angular_velocity: [0, 0, 0]"), 27,
+                   "angular_velocity: [0, 0, 0.5]");
+  EXPECT_NE(invalidMessage(spinning + "constraints:\n  - max_angular_rate: 0.2\n")
+                .find("initial.angular_velocity already violates it"),
+            std::string::npos);
+}
+
+TEST(ConstraintScenes, FormatSceneRoundTripsConstraints) {
+  const ap::Scene s = ap::loadScene(AP_SOURCE_DIR "/scenes/sun_keep_out.yaml");
+  ap::Scene with = s;
+  with.problem.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.3));
+  const ap::Scene back = ap::parseScene(ap::formatScene(with), "round.yaml");
+  ASSERT_EQ(back.problem.constraints.size(), 2u);
+  EXPECT_EQ(back.problem.constraints[0].world_direction, s.problem.constraints[0].world_direction);
+  EXPECT_EQ(back.problem.constraints[0].half_angle, s.problem.constraints[0].half_angle);
+  EXPECT_EQ(back.problem.constraints[1].limit, 0.3);
+}

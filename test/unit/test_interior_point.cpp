@@ -25,7 +25,7 @@ ap::PlanningProblem sceneProblem(const std::string& scene, int steps) {
 
 ap::PlanResult plan(const ap::PlanningProblem& p, const std::string& solver) {
   ap::SolverOptions o;
-  o.solver = solver;
+  o.solver = ap::parseSolver(solver, "solver");
   if (solver == "nlopt") o.max_iterations = 5000;
   return ap::planManeuver(p, o);
 }
@@ -37,7 +37,7 @@ void expectAgreesWithNlopt(const ap::PlanningProblem& p, double tolerance = 1e-8
                            bool perturbed_start = false) {
   const ap::PlanResult ip = plan(p, "newton");
   ap::SolverOptions o;
-  o.solver = "nlopt";
+  o.solver = ap::SolverKind::Nlopt;
   o.max_iterations = 5000;
   ap::Maneuver start = ip.maneuver;
   for (ap::Vector3& t : start.torque) t *= 0.9;

@@ -182,6 +182,16 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
       << "  \"initial_costate_guess\": "
       << (request.initial_costate ? jsonVector(*request.initial_costate) : std::string("null"))
       << ",\n"
+      << "  \"extremal\": " << jsonString(plan.extremal) << ",\n"
+      << "  \"other_extremal_costs\": [";
+  for (size_t i = 0; i < plan.other_costs.size(); ++i) {
+    out << (i ? ", " : "") << jsonNumber(plan.other_costs[i]);
+  }
+  out << "],\n"
+      << "  \"starts\": " << plan.starts << ",\n"
+      << "  \"converged_starts\": " << plan.converged_starts << ",\n"
+      << "  \"integration_steps\": " << plan.integration_steps << ",\n"
+      << "  \"timed_out\": " << (plan.timed_out ? "true" : "false") << ",\n"
       << "  \"solve_time_s\": " << jsonNumber(solve_time_s) << "\n"
       << "}\n";
   return out.str();
@@ -189,7 +199,7 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
 
 std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
                                   const DriftTwoInputPlan& plan, double solve_time_s) {
-  char buffer[2048];
+  char buffer[4096];
   const Vector3& p = plan.initial_costate;
   std::snprintf(buffer, sizeof buffer,
                 "system                   drift_two_input (seed 001)\n"
@@ -200,12 +210,13 @@ std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
                 "iterations               %d (%d continuation stages)\n"
                 "initial costate p(0)     (%.12g, %.12g, %.12g)\n"
                 "cost 1/2 int c.u^2 dt    %.12g\n"
+                "extremal                 %s\n"
                 "terminal attitude error  %.3g rad\n"
-                "solve time               %.3f s\n",
+                "solve time               %.4f s\n",
                 plan.converged ? "yes" : "NO", plan.message.c_str(), request.weights.c1,
                 request.weights.c2, request.steps, request.duration,
                 request.duration / request.steps, plan.iterations, plan.continuation_stages, p.x(),
-                p.y(), p.z(), plan.cost, plan.terminal_error, solve_time_s);
+                p.y(), p.z(), plan.cost, plan.extremal.c_str(), plan.terminal_error, solve_time_s);
   return buffer;
 }
 

@@ -157,7 +157,7 @@ for c in cases:
         fit_order(c["sweep"], "attitude_miss"), fit_order(c["sweep"], "velocity_miss"),
         fit_order(c["sweep"], "attitude_miss_step_start")))
 w("")
-w("The planner uses the documented orders (`measuredOrder()` in `src/core/accuracy.cpp`): cost "
+w("The planner uses the documented orders (`measuredOrder()` in `src/analysis/accuracy.cpp`): cost "
   "error 1 (both schemes), attitude miss 1 (`paper`) and 2 (`variational`). "
   "`MeasuredOrders.SmallSweepAgreesWithDocumentedOrders` re-measures them (and trajectory/torque "
   "= 1) on N = 128 … 1024 for both cases and schemes and fails if any differs by more than 0.2.")

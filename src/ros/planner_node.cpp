@@ -4,24 +4,34 @@
 
 namespace attitude_planner {
 
-int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s) {
-  if (result.converged) return PlanErrorCode::SUCCESS;
-  if (cancelled) return PlanErrorCode::CANCELLED;
-  if (result.step_too_large) return PlanErrorCode::STEP_TOO_LARGE;
-  if (timed_out || (time_budget_s > 0.0 && result.solve_time_s >= time_budget_s)) {
-    return PlanErrorCode::TIMED_OUT;
+int errorCodeOf(Termination termination) {
+  switch (termination) {
+    case Termination::Converged:
+      return PlanErrorCode::SUCCESS;
+    case Termination::NotConverged:
+      return PlanErrorCode::NOT_CONVERGED;
+    case Termination::Infeasible:
+      return PlanErrorCode::INFEASIBLE;
+    case Termination::StepTooLarge:
+      return PlanErrorCode::STEP_TOO_LARGE;
+    case Termination::TimedOut:
+      return PlanErrorCode::TIMED_OUT;
+    case Termination::Cancelled:
+      return PlanErrorCode::CANCELLED;
+    case Termination::InvalidInput:
+      return PlanErrorCode::INVALID_INPUT;
   }
-  return PlanErrorCode::NOT_CONVERGED;
+  return PlanErrorCode::INTERNAL_ERROR;
 }
 
 void describeCurrentException(int* error_code, std::string* message) {
   try {
     throw;
   } catch (const InvalidInput& e) {
-    *error_code = PlanErrorCode::INVALID_INPUT;
+    *error_code = errorCodeOf(Termination::InvalidInput);
     *message = e.what();
   } catch (const StepTooLarge& e) {
-    *error_code = PlanErrorCode::STEP_TOO_LARGE;
+    *error_code = errorCodeOf(Termination::StepTooLarge);
     *message = e.what();
   } catch (const std::exception& e) {
     *error_code = PlanErrorCode::INTERNAL_ERROR;

@@ -13,9 +13,10 @@
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
 #include "attitude_planner/ros/conversions.hpp"
-#include "attitude_planner/scene.hpp"
-#include "attitude_planner/simulation.hpp"
 
 namespace attitude_planner {
 
@@ -149,7 +150,7 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     return true;
   }
   const PlanResult result = planManeuver(problem);
-  if (!result.converged) {
+  if (!result.converged()) {
     *error = "planner: " + result.message;
     return false;
   }

@@ -13,9 +13,10 @@
 #include <string>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/report.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/report.hpp"
-#include "attitude_planner/scene.hpp"
+#include "attitude_planner/io/csv.hpp"
 
 namespace ap = attitude_planner;
 
@@ -322,8 +323,9 @@ int main(int argc, char** argv) {
       out << ap::planResultJson(problem, result);
       if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
     }
-    if (!result.converged) {
-      std::cerr << "plan_maneuver: not converged: " << result.message << "\n";
+    if (!result.converged()) {
+      std::cerr << "plan_maneuver: not converged: " << result.message << " (termination "
+                << ap::terminationName(result.termination) << ")\n";
       return 1;
     }
     return 0;

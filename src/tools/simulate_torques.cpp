@@ -11,9 +11,10 @@
 #include <iostream>
 #include <string>
 
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/scene.hpp"
-#include "attitude_planner/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/io/csv.hpp"
 
 namespace ap = attitude_planner;
 

@@ -30,7 +30,7 @@ inline void boundedPlan(attitude_planner::PlanningProblem problem) {
     const ap::PlanResult r = ap::planManeuver(problem, options);
     invariant(r.maneuver.steps() == problem.steps || r.maneuver.attitude.empty(),
               "result has the requested N");
-    if (r.converged) {
+    if (r.converged()) {
       invariant(std::isfinite(r.cost), "converged cost finite");
       invariant(r.terminal_attitude_error <= 1e-6, "converged plan lands (attitude)");
       invariant(r.terminal_velocity_error <= 1e-6, "converged plan lands (velocity)");

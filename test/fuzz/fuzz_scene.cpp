@@ -11,8 +11,8 @@
 #include <string>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/scene.hpp"
 #include "fuzz_common.hpp"
 
 namespace ap_fuzz {

@@ -8,8 +8,8 @@
 
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/ros/conversions.hpp"
-#include "attitude_planner/simulation.hpp"
 
 namespace attitude_planner {
 namespace ros_testing {

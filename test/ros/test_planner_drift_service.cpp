@@ -5,7 +5,7 @@
 
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
-#include "attitude_planner/drift_two_input.hpp"
+#include "attitude_planner/drift_two_input/system.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 
 using namespace attitude_planner;

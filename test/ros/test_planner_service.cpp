@@ -9,8 +9,8 @@
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanErrorCode.h"
-#include "attitude_planner/scene.hpp"
-#include "attitude_planner/simulation.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;

@@ -1,6 +1,8 @@
 // Unit tests of the ROS adapters that need no ROS master: conversions, request parsing, the box.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -8,11 +10,11 @@
 #include <limits>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
 #include "attitude_planner/ros/tracker_node.hpp"
-#include "attitude_planner/scene.hpp"
-#include "attitude_planner/simulation.hpp"
 
 using namespace attitude_planner;
 namespace rc = attitude_planner::ros_conversions;
@@ -410,18 +412,48 @@ TEST(RosConversions, DriftRequestFieldsAreNamed) {
   EXPECT_EQ(message(bad).rfind("shooting_intervals:", 0), 0u) << message(bad);
 }
 
-TEST(RosConversions, ErrorCodesFollowTheOutcome) {
-  PlanResult r;
-  r.converged = true;
-  EXPECT_EQ(classifyResult(r, true, true, 1.0), PlanErrorCode::SUCCESS);
-  r.converged = false;
-  EXPECT_EQ(classifyResult(r, true, false, 0.0), PlanErrorCode::CANCELLED);
-  EXPECT_EQ(classifyResult(r, false, true, 1.0), PlanErrorCode::TIMED_OUT);
-  r.solve_time_s = 2.0;
-  EXPECT_EQ(classifyResult(r, false, false, 1.0), PlanErrorCode::TIMED_OUT);
-  EXPECT_EQ(classifyResult(r, false, false, 0.0), PlanErrorCode::NOT_CONVERGED);
-  r.step_too_large = true;
-  EXPECT_EQ(classifyResult(r, false, false, 0.0), PlanErrorCode::STEP_TOO_LARGE);
+TEST(RosConversions, EveryTerminationHasItsOwnErrorCode) {
+  // One switch maps the core's status to the interface's: each termination gets a distinct code,
+  // SUCCESS only for Converged, and none falls through to INTERNAL_ERROR.
+  const std::pair<Termination, int> expected[] = {
+      {Termination::Converged, PlanErrorCode::SUCCESS},
+      {Termination::NotConverged, PlanErrorCode::NOT_CONVERGED},
+      {Termination::Infeasible, PlanErrorCode::INFEASIBLE},
+      {Termination::StepTooLarge, PlanErrorCode::STEP_TOO_LARGE},
+      {Termination::TimedOut, PlanErrorCode::TIMED_OUT},
+      {Termination::Cancelled, PlanErrorCode::CANCELLED},
+      {Termination::InvalidInput, PlanErrorCode::INVALID_INPUT}};
+  std::set<int> codes;
+  for (const auto& [termination, code] : expected) {
+    EXPECT_EQ(errorCodeOf(termination), code) << terminationName(termination);
+    codes.insert(errorCodeOf(termination));
+  }
+  EXPECT_EQ(codes.size(), std::size(expected));
+}
+
+TEST(RosConversions, ExceptionsMapThroughTheSameSwitch) {
+  int code = 0;
+  std::string message;
+  try {
+    throw InvalidInput("steps: must be >= 4, got 2");
+  } catch (...) {
+    describeCurrentException(&code, &message);
+  }
+  EXPECT_EQ(code, PlanErrorCode::INVALID_INPUT);
+  EXPECT_EQ(message, "steps: must be >= 4, got 2");
+  try {
+    throw StepTooLarge("increase steps");
+  } catch (...) {
+    describeCurrentException(&code, &message);
+  }
+  EXPECT_EQ(code, PlanErrorCode::STEP_TOO_LARGE);
+  try {
+    throw std::runtime_error("boom");
+  } catch (...) {
+    describeCurrentException(&code, &message);
+  }
+  EXPECT_EQ(code, PlanErrorCode::INTERNAL_ERROR);
+  EXPECT_EQ(message, "internal error: boom");
 }
 
 TEST(PrincipalBox, UniformBoxMomentsAreRecovered) {

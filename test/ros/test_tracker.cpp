@@ -15,7 +15,7 @@
 #include <mutex>
 
 #include "attitude_planner/ReplayResult.h"
-#include "attitude_planner/simulation.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;

@@ -5,8 +5,9 @@
 #include <cmath>
 #include <string>
 
-#include "attitude_planner/accuracy.hpp"
+#include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
 
 using namespace attitude_planner;
 
@@ -102,7 +103,7 @@ TEST(ContinuousReference, DiscretePlansConvergeToIt) {
   for (int N : {64, 256, 1024}) {
     p.steps = N;
     const PlanResult plan = planManeuver(p);
-    ASSERT_TRUE(plan.converged);
+    ASSERT_TRUE(plan.converged());
     const AccuracyMeasures m = measureAccuracy(p, plan.maneuver, ref);
     EXPECT_LT(m.cost_error, 0.5 * previous_cost) << "N = " << N;
     EXPECT_LT(m.trajectory_error, 0.5 * previous_trajectory) << "N = " << N;
@@ -166,7 +167,7 @@ TEST(MeasuredOrders, SmallSweepAgreesWithDocumentedOrders) {
       for (int N = 128; N <= 1024; N *= 2) {
         p.steps = N;
         const PlanResult plan = planManeuver(p);
-        ASSERT_TRUE(plan.converged);
+        ASSERT_TRUE(plan.converged());
         const AccuracyMeasures m = measureAccuracy(p, plan.maneuver, ref);
         Ns.push_back(N);
         cost.push_back(m.cost_error);
@@ -194,7 +195,7 @@ TEST(PlanToAccuracy, TerminalMissTargetIsMetAndReported) {
     p.accuracy.measure = AccuracyMeasure::TerminalMiss;
     p.accuracy.value = target;
     const PlanResult plan = planManeuver(p);
-    ASSERT_TRUE(plan.converged) << plan.message;
+    ASSERT_TRUE(plan.converged()) << plan.message;
     ASSERT_TRUE(plan.accuracy.requested);
     EXPECT_EQ(plan.scheme, scheme);
     EXPECT_LE(plan.accuracy.estimated_error, target);
@@ -215,7 +216,7 @@ TEST(PlanToAccuracy, UnreachableTargetFailsFastNamingTheSteps) {
   p.accuracy.measure = AccuracyMeasure::TerminalMiss;
   p.accuracy.value = 1e-8;
   const PlanResult plan = planManeuver(p);
-  EXPECT_FALSE(plan.converged);
+  EXPECT_FALSE(plan.converged());
   EXPECT_NE(plan.message.find("> max_steps"), std::string::npos) << plan.message;
   EXPECT_EQ(plan.accuracy.steps_tried.size(), 1u);  // only the coarse resolution was solved
 }
@@ -226,7 +227,7 @@ TEST(PlanToAccuracy, CostErrorEstimateIsHonest) {
   p.accuracy.value = 1e-2;
   p.accuracy.choose_scheme = true;
   const PlanResult plan = planManeuver(p);
-  ASSERT_TRUE(plan.converged) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message;
   EXPECT_LE(plan.accuracy.estimated_error, 1e-2);
   EXPECT_EQ(plan.accuracy.schemes_tried.size(), plan.accuracy.steps_tried.size());
   PlanningProblem at_N = seedProblem(true);

@@ -7,8 +7,8 @@
 #include <map>
 #include <random>
 
-#include "attitude_planner/drift_two_input_closed_forms.hpp"
-#include "attitude_planner/drift_two_input_planner.hpp"
+#include "attitude_planner/drift_two_input/closed_forms.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/errors.hpp"
 
 using namespace attitude_planner;

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include "attitude_planner/drift_two_input_planner.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/scene.hpp"
+#include "attitude_planner/io/scene.hpp"
 
 using namespace attitude_planner;
 namespace dti = attitude_planner::drift_two_input;

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "attitude_planner/drift_two_input.hpp"
+#include "attitude_planner/drift_two_input/system.hpp"
 #include "attitude_planner/errors.hpp"
 
 namespace ap = attitude_planner;

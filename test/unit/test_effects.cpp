@@ -6,8 +6,8 @@
 #include <cstring>
 #include <random>
 
-#include "attitude_planner/effects.hpp"
-#include "attitude_planner/simulation.hpp"
+#include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
 
 using namespace attitude_planner;
 
@@ -177,7 +177,7 @@ PlanningProblem leoSlew(bool with_effects) {
 
 TEST(Effects, PlanningWithEffectsLandsWhenReplayedUnderTheSameEffects) {
   const PlanResult r = planManeuver(leoSlew(true));
-  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_LE(r.terminal_attitude_error, 1e-9);  // evaluatePlan replays with the same effects
   EXPECT_LE(r.terminal_velocity_error, 1e-9);
   ASSERT_EQ(r.effects.size(), 2u);
@@ -190,7 +190,7 @@ TEST(Effects, PlanningWithEffectsLandsWhenReplayedUnderTheSameEffects) {
   EXPECT_GT(so3::angleBetween(p.final_attitude, m.attitude[p.steps]), 1e-4);
   // And a plan that ignores them lands only without them.
   const PlanResult ignorant = planManeuver(leoSlew(false));
-  ASSERT_TRUE(ignorant.converged);
+  ASSERT_TRUE(ignorant.converged());
   EffectModel actual;
   actual.add(std::make_unique<GravityGradient>(kMu, kRadius, p.inertia));
   SimulationInput replay;
@@ -209,20 +209,20 @@ TEST(Effects, TorqueLimitedPlansRespectTheBoundsAndCostAtLeastTheUnlimitedOne) {
   p.steps = 32;
   p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
   const PlanResult free = planManeuver(p);
-  ASSERT_TRUE(free.converged);
+  ASSERT_TRUE(free.converged());
   double largest = 0;
   for (const Vector3& t : free.maneuver.torque)
     largest = std::max(largest, t.cwiseAbs().maxCoeff());
   // inactive bounds: the Newton optimum is kept
   p.max_torque = Vector3::Constant(2 * largest);
   const PlanResult loose = planManeuver(p);
-  EXPECT_TRUE(loose.converged);
+  EXPECT_TRUE(loose.converged());
   EXPECT_EQ(loose.solver, "newton");
   EXPECT_EQ(loose.cost, free.cost);
   // active bounds at 70 % of the unbounded peak
   p.max_torque = Vector3::Constant(0.7 * largest);
   const PlanResult tight = planManeuver(p);
-  ASSERT_TRUE(tight.converged) << tight.message;
+  ASSERT_TRUE(tight.converged()) << tight.message;
   EXPECT_EQ(tight.solver, "nlopt");
   EXPECT_LE(tight.terminal_attitude_error, 1e-10);
   int at_bound = 0;

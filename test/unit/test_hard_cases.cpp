@@ -1,5 +1,5 @@
-// Issue 7: the named hard cases (include/attitude_planner/robustness_cases.hpp). One test per
-// case; each case's pass criterion is written next to its code in src/core/robustness_cases.cpp
+// Issue 7: the named hard cases (test/support/robustness_cases.hpp). One test per
+// case; each case's pass criterion is written next to its code in test/support/robustness_cases.cpp
 // and printed here on failure, with every check that failed. Cases tagged slow (N = 1e5, 1e6)
 // run only under ATTITUDE_PLANNER_SLOW_TESTS=1 (`scripts/test --all`); otherwise they are
 // reported as skipped, saying how to run them. docs/robustness.md lists the measured figures
@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "attitude_planner/robustness_cases.hpp"
+#include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
 using robustness::HardCase;

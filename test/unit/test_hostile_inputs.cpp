@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/robustness_cases.hpp"
-#include "attitude_planner/scene.hpp"
+#include "support/robustness_cases.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;
@@ -209,7 +209,7 @@ TEST(HostileOptions, TimeBudgetStopsALongSolveCleanly) {
   const ap::PlanResult r = ap::planManeuver(p, options);
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.converged());
   EXPECT_NE(r.message.find("time budget"), std::string::npos) << r.message;
   EXPECT_LT(elapsed, 0.01 + 5.0) << r.message;
   EXPECT_EQ(r.maneuver.steps(), 100000);

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/simulation.hpp"
 
 using namespace attitude_planner;
 
@@ -93,7 +93,7 @@ TEST(Integrators, MomentumJacobianMatchesFiniteDifferences) {
 }
 
 // The 1e6-step torque-free drift test lives in the hard-case catalog of issue 7
-// (TorqueFreeMillionSteps in src/core/robustness_cases.cpp, asserted by test_hard_cases).
+// (TorqueFreeMillionSteps in test/support/robustness_cases.cpp, asserted by test_hard_cases).
 
 TEST(Integrators, VariationalEnergyDoesNotDriftOver2000Seconds) {
   const Matrix3 J = Vector3(1, 2, 3).asDiagonal();

@@ -6,9 +6,10 @@
 #include <algorithm>
 #include <random>
 
-#include "attitude_planner/direct_method.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/scene.hpp"
+#include "planning/direct_method.hpp"
+#include "planning/solvers.hpp"
 
 namespace ap = attitude_planner;
 
@@ -120,7 +121,7 @@ TEST_P(SeedExamples, NloptReachesAFeasibleKktPoint) {
   options.solver = "nlopt";
   options.max_iterations = 2000;
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_TRUE(r.converged) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message;
   EXPECT_EQ(r.solver, "nlopt");
   EXPECT_LE(r.terminal_attitude_error, 1e-10) << r.message;
   EXPECT_LE(r.terminal_velocity_error, 1e-10) << r.message;
@@ -176,7 +177,7 @@ TEST(NloptSolver, CancellationStopsAndIsReported) {
   int calls = 0;
   options.on_iteration = [&](const ap::IterationInfo&) { return ++calls < 3; };
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.converged());
   EXPECT_EQ(calls, 3);
   EXPECT_NE(r.message.find("cancelled"), std::string::npos) << r.message;
 }
@@ -187,7 +188,7 @@ TEST(NloptSolver, IterationLimitIsHonoredAndNotConverged) {
   options.solver = "nlopt";
   options.max_iterations = 3;
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.converged());
   EXPECT_LE(r.iterations, 3);
   EXPECT_NE(r.message.find("NLOPT_MAXEVAL_REACHED"), std::string::npos) << r.message;
 }
@@ -210,8 +211,8 @@ TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
   nlopt_options.solver = "nlopt";
   nlopt_options.max_iterations = 2000;
   const ap::PlanResult nlopt = ap::planManeuver(p, nlopt_options);
-  ASSERT_TRUE(newton.converged) << newton.message;
-  ASSERT_TRUE(nlopt.converged) << nlopt.message;
+  ASSERT_TRUE(newton.converged()) << newton.message;
+  ASSERT_TRUE(nlopt.converged()) << nlopt.message;
   EXPECT_NEAR(nlopt.cost, newton.cost, 1e-8 * newton.cost);
   double torque_scale = 0.0, torque_difference = 0.0;
   for (int k = 0; k <= p.steps; ++k) {
@@ -246,7 +247,7 @@ TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   ap::SolverOptions options;
   options.solver = "nlopt";
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.converged());
   EXPECT_NE(r.message.find("steps 5000 > 1024"), std::string::npos) << r.message;
 }
 
@@ -257,6 +258,6 @@ TEST(NloptSolver, ExhaustedTimeBudgetIsNotConvergence) {
   options.solver = "nlopt";
   options.time_budget_s = 1e-9;
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_FALSE(r.converged);
+  EXPECT_FALSE(r.converged());
   EXPECT_NE(r.message.find("NLOPT_MAXTIME_REACHED"), std::string::npos) << r.message;
 }

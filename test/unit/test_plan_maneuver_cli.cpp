@@ -11,8 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "attitude_planner/maneuver.hpp"
-#include "attitude_planner/scene.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/io/csv.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;

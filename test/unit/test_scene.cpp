@@ -6,7 +6,7 @@
 #include <string>
 
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/scene.hpp"
+#include "attitude_planner/io/scene.hpp"
 
 namespace ap = attitude_planner;
 

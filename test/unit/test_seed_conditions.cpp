@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
+#include "attitude_planner/analysis/seed_conditions.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/seed_conditions.hpp"
 
 using namespace attitude_planner;
 
@@ -34,7 +34,7 @@ double worst(const std::vector<double>& v) {
 TEST(SeedConditions, CorrectedConditionsVanishAtTheOptimum) {
   for (int N : {32, 128}) {
     const PlanResult r = solveSlewUp(N);
-    ASSERT_TRUE(r.converged) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message;
     EXPECT_LE(worst(seedConditionRelativeResiduals(r.maneuver, kSeedInertia,
                                                    SeedConditionForm::Corrected)),
               1e-9)
@@ -44,7 +44,7 @@ TEST(SeedConditions, CorrectedConditionsVanishAtTheOptimum) {
 
 TEST(SeedConditions, PrintedConditionsDoNotVanish) {
   const PlanResult r = solveSlewUp(128);
-  ASSERT_TRUE(r.converged);
+  ASSERT_TRUE(r.converged());
   EXPECT_GT(
       worst(seedConditionRelativeResiduals(r.maneuver, kSeedInertia, SeedConditionForm::Printed)),
       1e-2);

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include "attitude_planner/dual.hpp"
-#include "attitude_planner/so3.hpp"
+#include "attitude_planner/lie/so3.hpp"
+#include "lie/dual.hpp"
 
 using namespace attitude_planner;
 

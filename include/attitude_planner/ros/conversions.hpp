@@ -15,11 +15,11 @@
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/Effect.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
-#include "attitude_planner/drift_two_input_planner.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/maneuver.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/scene.hpp"
 
 namespace attitude_planner {
 namespace ros_conversions {

@@ -40,6 +40,7 @@
 #include "attitude_planner/PlanAttitudeManeuverAction.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/planner.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 
 namespace attitude_planner {
@@ -53,10 +54,9 @@ struct PlanOutcome {
   PlanningProblem problem;                         ///< the parsed problem (if parsing succeeded)
 };
 
-/// Decides the error code of a finished solve: converged → SUCCESS; cancelled by the caller →
-/// CANCELLED; an implicit step without solution (PlanResult::step_too_large) → STEP_TOO_LARGE;
-/// time budget exhausted → TIMED_OUT; otherwise NOT_CONVERGED.
-int classifyResult(const PlanResult& result, bool cancelled, bool timed_out, double time_budget_s);
+/// The PlanErrorCode constant of a termination: the one mapping from the core's status to the
+/// interface's (INTERNAL_ERROR is not a termination: it is an exception the core did not expect).
+int errorCodeOf(Termination termination);
 
 /// Runs one request through the core. `keep_going(info, elapsed_s)` is called after every
 /// iteration; returning false cancels. Never throws.
@@ -65,7 +65,7 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
                         const std::function<bool(const IterationInfo&, double)>& keep_going);
 
 /// The error code and message of the exception being handled (call only inside a catch block):
-/// InvalidInput → INVALID_INPUT, StepTooLarge → STEP_TOO_LARGE, anything else → INTERNAL_ERROR.
+/// InvalidInput and StepTooLarge through errorCodeOf, anything else → INTERNAL_ERROR.
 void describeCurrentException(int* error_code, std::string* message);
 
 /// What one plan_drift_two_input request produced, whatever happened.
@@ -129,34 +129,17 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
   try {
     SolverOptions options;
     out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
-    bool cancelled = false;
-    bool timed_out = false;
+    // The time budget (options.time_budget_s) is enforced by the core, which then ends
+    // TimedOut; the callback only cancels (node shutting down, action preempted).
     const ros::WallTime start = ros::WallTime::now();
-    const double budget = options.time_budget_s;
     options.on_iteration = [&](const IterationInfo& info) {
       const double elapsed = (ros::WallTime::now() - start).toSec();
-      if (budget > 0.0 && elapsed >= budget) {
-        timed_out = true;
-        return false;
-      }
-      if (!ros::ok() || (keep_going && !keep_going(info, elapsed))) {
-        cancelled = true;
-        return false;
-      }
-      return true;
+      return ros::ok() && (!keep_going || keep_going(info, elapsed));
     };
     out.result = planManeuver(out.problem, options);
     out.solver_ran = true;
-    out.error_code = classifyResult(out.result, cancelled, timed_out, budget);
+    out.error_code = errorCodeOf(out.result.termination);
     out.message = out.result.message;
-    if (out.error_code == PlanErrorCode::TIMED_OUT &&
-        out.message.find("time") == std::string::npos) {
-      out.message =
-          "time budget of " + std::to_string(budget) + " s exhausted (" + out.message + ")";
-    } else if (out.error_code == PlanErrorCode::CANCELLED &&
-               out.message.find("cancel") == std::string::npos) {
-      out.message = "cancelled (" + out.message + ")";
-    }
   } catch (...) {
     describeCurrentException(&out.error_code, &out.message);
   }

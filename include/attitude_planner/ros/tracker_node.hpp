@@ -59,10 +59,10 @@
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/ReplayResult.h"
-#include "attitude_planner/drift_two_input_planner.hpp"
-#include "attitude_planner/maneuver.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/scene.hpp"
 
 namespace attitude_planner {
 

@@ -1,0 +1,69 @@
+// What accuracy a discrete plan has, and plans to a requested accuracy (docs/accuracy.md).
+//
+// Three measures of a plan of N steps (h = T/N) against the continuous optimum
+// (continuous_reference.hpp):
+//   (a) cost error  |h Σ_k ½|τ_k|² − ½∫₀ᵀ|τ|²dt|: the discrete cost sums N − 1 torques of a
+//       Riemann sum, so h times it approximates the integral;
+//   (b) trajectory error max_k ‖log(R(t_k)ᵀ R_k)‖ and torque error max_k |τ_k − τ(t_k)|: both
+//       schemes apply the torque as an impulse hτ_k at the node t_k (discrete_scheme.hpp: the
+//       momentum jumps by hτ_k between step k−1 and step k), so τ_k samples τ(t_k);
+//   (c) physical miss: the plan's torques drive the continuous rigid body (integrated to ~1e-13)
+//       as a zero-order hold; terminal ‖log(R_Tᵀ R(T))‖ and |Ω(T) − Ω_T|. The impulse hτ_k at t_k
+//       is held over [t_k − h/2, t_k + h/2] (node-centred, the default); holding it over the step
+//       [t_k, t_{k+1}) (what a naive controller does) adds a half-step delay.
+#pragma once
+
+#include "attitude_planner/analysis/continuous_reference.hpp"
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+
+namespace attitude_planner {
+
+/// Over which interval a zero-order hold applies τ_k.
+enum class TorqueHold {
+  NodeCentred,  ///< [t_k − h/2, t_k + h/2] ∩ [0, T]: the impulse hτ_k spread around its node
+  StepStart,    ///< [t_k, t_{k+1}), k = 0..N−1: τ_k held over the step that starts at t_k
+};
+
+/// Terminal state of the continuous body driven by a plan's torques (zero-order hold).
+struct ZeroOrderHoldReplay {
+  Matrix3 attitude = Matrix3::Identity();      ///< R(T)
+  Vector3 angular_velocity = Vector3::Zero();  ///< Ω(T) [rad/s]
+  double attitude_miss = 0.0;                  ///< ‖log(R_Tᵀ R(T))‖ [rad]
+  double velocity_miss = 0.0;                  ///< |Ω(T) − Ω_T| [rad/s]
+};
+
+/// Drives the continuous rigid body of `problem` from (R_0, Ω_0) with the plan's torques τ_k,
+/// k = 0..N, as a zero-order hold (GBS order 16, every hold interval split into steps of at most
+/// T/64 and 0.25 rad of rotation at the plan's fastest Ω_k: accurate to ~1e-13 on the seed's
+/// examples, test_accuracy.cpp).
+ZeroOrderHoldReplay replayZeroOrderHold(const PlanningProblem& problem, const Maneuver& plan,
+                                        TorqueHold hold = TorqueHold::NodeCentred);
+
+/// The three measures of a plan.
+struct AccuracyMeasures {
+  int steps = 0;                        ///< N
+  double cost_integral = 0.0;           ///< h Σ ½|τ_k|² [N²·m²·s]
+  double cost_error = 0.0;              ///< |h Σ ½|τ_k|² − ½∫|τ|²dt| [N²·m²·s]
+  double trajectory_error = 0.0;        ///< max_k ‖log(R(t_k)ᵀ R_k)‖ [rad], k = 0..N
+  double torque_error = 0.0;            ///< max_{k=1..N−1} |τ_k − τ(t_k)| [N·m]
+  ZeroOrderHoldReplay miss;             ///< (c) with the node-centred hold
+  ZeroOrderHoldReplay miss_step_start;  ///< (c) with the step-start hold (comparison)
+};
+
+/// Measures a plan of `problem` against its continuous reference.
+AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver& plan,
+                                 const ContinuousReference& reference);
+
+/// The convergence order p of a measure (error ≈ C N^−p) as measured by scripts/accuracy on the
+/// seed's examples (docs/accuracy.md): cost error 1 (both schemes), terminal attitude miss 1
+/// (paper) and 2 (variational). The planner predicts N from it.
+double measuredOrder(SchemeKind scheme, AccuracyMeasure measure);
+
+/// Plans to problem.accuracy: solves N = 64 of each candidate scheme (and N = 32 for the cost's
+/// Richardson estimate), predicts N from the error there and the order, solves at N and checks
+/// the estimate (repeating with a larger N if it misses, at most 4 times). The result is the plan
+/// at the final N with PlanResult::accuracy filled; converged = false if the target was not
+/// reached.
+PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& options);
+
+}  // namespace attitude_planner

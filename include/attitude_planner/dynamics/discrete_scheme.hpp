@@ -1,0 +1,139 @@
+// Discrete forced rigid-body dynamics in one form shared by every scheme.
+//
+// With F_k = R_kᵀ R_{k+1} (the relative rotation of step k) every scheme here reads
+//
+//     R_{k+1} = R_k F_k,          h τ_k = μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}),      k = 1..N−1,
+//
+// where μ(F) is the body angular momentum a step "carries" (expressed at its start node) and
+// F_{k−1}ᵀ μ(F_{k−1}) the same momentum seen from the end node. The schemes differ only in μ:
+//
+//   paper        μ(F) = F J Ω,  Ω = log(F)/h                   seed 000, eq. (18):
+//                J Ω_k = exp(hΩ_k)ᵀ (h τ_k + J Ω_{k−1})
+//   variational  μ(F) = (F J_d − J_d Fᵀ)^∨ / h,  J_d = ½ tr(J) I − J
+//                Lee–Leok–McClamroch LGVI; forced through the discrete Lagrange–d'Alembert
+//                principle with the torque at the node: Π_k = F_{k−1}ᵀ Π_{k−1} + h τ_k.
+//
+// Torque-free, the spatial momentum R_k μ(F_k) is conserved exactly by construction.
+// Derivatives are with respect to right perturbations F exp(ε^).
+#pragma once
+
+#include <string>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/lie/so3.hpp"
+
+namespace attitude_planner {
+
+/// Which discretization of the rigid body.
+enum class SchemeKind { Paper, Variational };
+
+/// "paper" or "variational".
+std::string schemeName(SchemeKind kind);
+/// Parses "paper" / "variational"; throws InvalidInput naming the value otherwise.
+SchemeKind parseSchemeName(const std::string& name);
+
+/// Outcome of one implicit step solve μ(F) = p.
+struct StepSolveReport {
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;  ///< |μ(F) − p| [N·m·s]
+};
+
+/// One discretization of the rigid body with inertia J [kg·m²] and time step h [s].
+class DiscreteScheme {
+ public:
+  DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step);
+
+  SchemeKind kind() const { return kind_; }
+  const Matrix3& inertia() const { return J_; }
+  double timeStep() const { return h_; }
+
+  /// μ(F): momentum carried by a step with relative rotation F [N·m·s], body frame at its start.
+  template <typename S>
+  so3::Vec3<S> momentum(const so3::Mat3<S>& F) const;
+
+  /// μ(exp(ω^)) from the step's rotation vector ω: the same value as momentum(exp(ω^)), but with
+  /// full relative precision for small steps (exp(ω^) − I is formed by series, never as a
+  /// difference). Torques are second differences of the attitude, so this is what keeps them
+  /// accurate over long horizons.
+  Vector3 momentumOfStep(const Vector3& omega) const;
+
+  /// dμ(F exp(ε^))/dε at ε = 0 (3×3).
+  template <typename S>
+  so3::Mat3<S> momentumJacobian(const so3::Mat3<S>& F) const;
+
+  /// momentumJacobian(F) of the step F = exp(ω^) given as both (no log map to recover ω).
+  Matrix3 momentumJacobianOfStep(const Matrix3& F, const Vector3& omega) const;
+
+  /// The τ-weighted derivative of the momentum Jacobian of the step F = exp(ω^), in closed form:
+  ///   C(m, e) = Σ_i τ_i ∂D(i, m)/∂ε_e,  D = momentumJacobian(F exp(ε^)) at ε = 0,
+  /// i.e. the mixed second derivative ∂²/∂ε_e∂η_m of τᵀμ(F exp(ε^) exp(η^)). The Newton solver's
+  /// exact Hessian is built from it (derivation in discrete_scheme.cpp).
+  Matrix3 momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
+                                      const Vector3& tau) const;
+
+  /// Body angular velocity [rad/s] reported for a step: paper log(F)/h (constant over the step),
+  /// variational J⁻¹ μ(F) (nodal velocity at the step's start).
+  Vector3 velocity(const Matrix3& F) const;
+
+  /// Relative rotation of a step whose reported velocity is Ω (inverse of velocity()).
+  /// Throws StepTooLarge if the implicit equation has no solution it can find.
+  Matrix3 stepFromVelocity(const Vector3& omega) const;
+
+  /// Solves μ(F) = p for F by a safeguarded Newton iteration on F ← F exp(δ^), starting from
+  /// `guess`. Converged when |μ(F) − p| ≤ 1e-14·(|p| + ‖J‖|log F|/h) + 1e-15‖J‖/h (the
+  /// round-off floor of μ), then polished by up to two more Newton steps. Never returns NaN:
+  /// `report.converged` is false if it fails (step too large for this h).
+  Matrix3 solveStep(const Vector3& p, const Matrix3& guess, StepSolveReport* report) const;
+
+ private:
+  /// The paper scheme's dμ/dε at F = exp(w^).
+  template <typename S>
+  so3::Mat3<S> paperMomentumJacobian(const so3::Mat3<S>& F, const so3::Vec3<S>& w) const;
+
+  SchemeKind kind_;
+  Matrix3 J_;
+  Matrix3 J_inverse_;
+  Matrix3 Jd_;  ///< nonstandard inertia ½ tr(J) I − J (variational)
+  double h_;
+};
+
+// ---- templates ----------------------------------------------------------------------------------
+
+template <typename S>
+so3::Vec3<S> DiscreteScheme::momentum(const so3::Mat3<S>& F) const {
+  const so3::Mat3<S> J = J_.template cast<S>();
+  if (kind_ == SchemeKind::Paper) {
+    const so3::Vec3<S> Omega = so3::log<S>(F) / S(h_);
+    return F * (J * Omega);
+  }
+  const so3::Mat3<S> Jd = Jd_.template cast<S>();
+  const so3::Mat3<S> A = F * Jd;
+  return so3::Vec3<S>(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / S(h_);
+}
+
+template <typename S>
+so3::Mat3<S> DiscreteScheme::paperMomentumJacobian(const so3::Mat3<S>& F,
+                                                   const so3::Vec3<S>& w) const {
+  // μ = F J ω/h, ω = log F:  δμ = F (J Jr⁻¹(ω) − (Jω)^) ε / h
+  const so3::Mat3<S> J = J_.template cast<S>();
+  const so3::Vec3<S> Jw = J * w;
+  return F * (J * so3::rightJacobianInverse<S>(w) - so3::hat<S>(Jw)) / S(h_);
+}
+
+template <typename S>
+so3::Mat3<S> DiscreteScheme::momentumJacobian(const so3::Mat3<S>& F) const {
+  if (kind_ == SchemeKind::Paper) return paperMomentumJacobian<S>(F, so3::log<S>(F));
+  // μ = (F J_d − J_d Fᵀ)^∨/h:  δμ = (F ε^ J_d + J_d ε^ Fᵀ)^∨/h, column by column
+  const so3::Mat3<S> Jd = Jd_.template cast<S>();
+  so3::Mat3<S> D;
+  for (int i = 0; i < 3; ++i) {
+    so3::Vec3<S> e = so3::Vec3<S>::Zero();
+    e(i) = S(1);
+    const so3::Mat3<S> A = F * so3::hat<S>(e) * Jd;
+    D.col(i) = so3::Vec3<S>(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1)) / S(h_);
+  }
+  return D;
+}
+
+}  // namespace attitude_planner

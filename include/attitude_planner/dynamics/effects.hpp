@@ -1,0 +1,110 @@
+// Physical effects a scene may call for (issue 8): only the effects a scene lists are simulated.
+//
+// Plannable effects are known external torques τ_e(R_k, t_k) [N m, body frame] that enter the
+// discrete dynamics as a forcing term alongside the control, at the node (DiscreteScheme):
+//     μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h (τ_k + τ_e(R_k, t_k)).
+// For the `variational` scheme this is the discrete Lagrange–d'Alembert forcing, not a potential
+// in the discrete Lagrangian (documented choice: one forcing rule for both schemes).
+// Tracker-only effects (actuator saturation, torque noise) act on the commanded torque.
+#pragma once
+
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/lie/so3.hpp"
+
+namespace attitude_planner {
+
+/// A known external torque on the body.
+class TorqueEffect {
+ public:
+  virtual ~TorqueEffect() = default;
+  /// The scene key ("gravity_gradient", ...).
+  virtual std::string name() const = 0;
+  /// τ_e(R, t) [N m], body frame.
+  virtual Vector3 torque(const Matrix3& R, double t) const = 0;
+  /// ∂τ_e(R exp(δ^), t)/∂δ at δ = 0 [N m / rad].
+  virtual Matrix3 jacobian(const Matrix3& R, double t) const = 0;
+  /// sym(Σ_i w_i ∂(jacobian row i)(R exp(δ^))/∂δ) at δ = 0: the w-weighted second derivative
+  /// the Newton solver's exact Hessian needs (the antisymmetric rest is the retraction's term).
+  virtual Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const = 0;
+};
+
+/// Gravity gradient of a circular orbit in the world x–y plane (issue 8):
+/// τ = 3 n² (b × J b), b = Rᵀ r̂(t), r̂(t) = (cos nt, sin nt, 0), n² = μ/r³.
+class GravityGradient : public TorqueEffect {
+ public:
+  /// μ [m³/s²], r [m], J [kg m²].
+  GravityGradient(double mu, double orbit_radius, const Matrix3& inertia);
+  std::string name() const override { return "gravity_gradient"; }
+  Vector3 torque(const Matrix3& R, double t) const override;
+  Matrix3 jacobian(const Matrix3& R, double t) const override;
+  Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
+  /// The orbit's mean motion n [rad/s].
+  double meanMotion() const { return n_; }
+  /// r̂(t), the unit vector from the Earth to the body, world frame.
+  Vector3 radial(double t) const;
+
+ private:
+  double n_;   ///< mean motion √(μ/r³) [rad/s]
+  Matrix3 J_;  ///< inertia [kg m²]
+};
+
+/// A known constant torque, given in the body or the world frame.
+class DisturbanceTorque : public TorqueEffect {
+ public:
+  /// value [N m] expressed in the body frame (in_world = false) or the world frame.
+  DisturbanceTorque(const Vector3& value, bool in_world);
+  std::string name() const override { return "disturbance_torque"; }
+  Vector3 torque(const Matrix3& R, double t) const override;
+  Matrix3 jacobian(const Matrix3& R, double t) const override;
+  Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
+
+ private:
+  Vector3 value_;
+  bool in_world_;
+};
+
+/// The plannable effects of a scene, composed once. Empty when the scene lists none.
+class EffectModel {
+ public:
+  EffectModel() = default;
+  void add(std::unique_ptr<TorqueEffect> effect) { effects_.push_back(std::move(effect)); }
+  bool empty() const { return effects_.empty(); }
+  std::vector<std::string> names() const;
+  /// Σ τ_e(R, t) [N m].
+  Vector3 torque(const Matrix3& R, double t) const;
+  /// Σ ∂τ_e/∂δ.
+  Matrix3 jacobian(const Matrix3& R, double t) const;
+  /// Σ weighted second derivatives (see TorqueEffect).
+  Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const;
+
+ private:
+  std::vector<std::shared_ptr<const TorqueEffect>> effects_;
+};
+
+/// What happens to a commanded torque on the way to the body (tracker-only effects): per-axis
+/// saturation, then additive Gaussian noise. Deterministic for a given seed.
+class Actuation {
+ public:
+  Actuation() = default;
+  /// |τ_i| ≤ max_torque_i [N m].
+  void setLimits(const Vector3& max_torque) {
+    limits_ = max_torque;
+    has_limits_ = true;
+  }
+  /// Per-axis standard deviation [N m] and PRNG seed.
+  void setNoise(const Vector3& std_dev, std::uint64_t seed);
+  bool empty() const { return !has_limits_ && !has_noise_; }
+  /// The torque the body receives for commanded τ (advances the noise stream).
+  Vector3 apply(const Vector3& commanded);
+
+ private:
+  bool has_limits_ = false, has_noise_ = false;
+  Vector3 limits_ = Vector3::Zero(), noise_std_ = Vector3::Zero();
+  std::mt19937_64 rng_;
+};
+
+}  // namespace attitude_planner

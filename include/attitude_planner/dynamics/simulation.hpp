@@ -1,0 +1,43 @@
+// Simulation entry point: integrate the discrete rigid body under a given torque sequence.
+// The tracker node, the CLI `simulate` tool and the benchmarks all call this.
+#pragma once
+
+#include <vector>
+
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
+#include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+
+namespace attitude_planner {
+
+/// Initial data and torques of a simulation.
+struct SimulationInput {
+  Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
+  Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s]
+  std::vector<Vector3> torque;  ///< τ_k [N·m], k = 0..N; τ_0 and τ_N must be zero (seed eq. 18)
+  /// Known external torques τ_e(R_k, t_k) added at each node (nullptr or empty: none).
+  const EffectModel* effects = nullptr;
+  /// Saturation/noise applied to each commanded τ_k (nullptr or empty: none); advanced in place.
+  Actuation* actuation = nullptr;
+};
+
+/// Figures of merit of a simulation.
+struct SimulationReport {
+  int max_step_iterations = 0;     ///< worst Newton count of the implicit step
+  double max_step_residual = 0.0;  ///< worst |μ(F_k) − p_k| [N·m·s]
+};
+
+/// Integrates R_{k+1} = R_k F_k, μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h (τ_k + τ_e(R_k, t_k)),
+/// k = 1..N−1. The returned maneuver's torque column holds the torques the body received (after
+/// actuation), not the effects. Without effects and actuation the inner loop is the bare
+/// integrator (chosen once, at compile time): bit-identical to a scene with `effects: []`.
+/// N = torque.size() − 1 ≥ 1. Attitudes are re-orthonormalized each step (one Newton–Schulz
+/// iteration) so they stay on SO(3) to round-off over millions of steps.
+/// Throws StepTooLarge (naming the step) if an implicit step fails, InvalidInput on bad input.
+Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
+                  SimulationReport* report = nullptr);
+
+/// One Newton–Schulz step towards the nearest rotation: R (3I − RᵀR)/2.
+Matrix3 reorthonormalize(const Matrix3& R);
+
+}  // namespace attitude_planner

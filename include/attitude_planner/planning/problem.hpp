@@ -1,0 +1,92 @@
+// What a caller asks the planner for: the problem (seed 000, Problem 3.2) and the solver settings,
+// with the one validation function for each. Every entry point (scene parser, CLI, nodes) builds
+// these and calls validateProblem / validateOptions, so each rule lives here once.
+//
+// Problem: minimize Σ_{k=1}^{N−1} ½|τ_k|² subject to the discrete dynamics of the chosen scheme
+// (dynamics/discrete_scheme.hpp) and the boundary data R_0, Ω_0, R_N, Ω_{N−1}.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
+#include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/planning/accuracy_target.hpp"
+
+namespace attitude_planner {
+
+/// Which way the maneuver turns from R_1 to R_{N−1} (the planner's initial guess; Newton then
+/// finds the extremal next to it).
+enum class RotationDirection {
+  Shortest,  ///< the geodesic (angle ≤ π); near π both ways are solved and the cheaper is kept
+  LongWay,   ///< the other way round the same axis (angle 2π − θ)
+};
+
+/// A rest-to-rest / slew problem for the fully actuated rigid body.
+struct PlanningProblem {
+  Matrix3 inertia = Matrix3::Identity();           ///< J [kg·m²], body frame, SPD
+  double duration = 1.0;                           ///< T [s]
+  int steps = 64;                                  ///< N (h = T/N)
+  Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
+  Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s], body
+  Matrix3 final_attitude = Matrix3::Identity();    ///< R_N
+  Vector3 final_velocity = Vector3::Zero();        ///< Ω_{N−1} [rad/s], body
+  SchemeKind scheme = SchemeKind::Paper;
+  /// Accept an inertia whose principal moments violate J1 + J2 ≥ J3 (no rigid body has one).
+  /// The seed's example inertia is such a matrix (moments 3.146, 12.538, 32.186), so its scenes
+  /// opt in explicitly; the mathematics only needs J symmetric positive definite.
+  bool allow_nonphysical_inertia = false;
+  RotationDirection direction = RotationDirection::Shortest;
+  /// Extra full turns (2π each) about the same axis in the same sense, ≥ 0.
+  int extra_revolutions = 0;
+  /// Known external torques the plan must account for (gravity gradient, disturbances); null or
+  /// empty: none. Shared, immutable: several solves may use one model.
+  std::shared_ptr<const EffectModel> effects;
+  /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
+  /// A bounded problem whose unbounded optimum violates the bounds is solved by NLopt (SLSQP with
+  /// box bounds, N ≤ 1024) from the clipped Newton torques.
+  Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  bool hasTorqueBounds() const { return max_torque.allFinite(); }
+  /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
+  /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
+  AccuracyTarget accuracy;
+};
+
+/// Progress of one iteration, for feedback (action) and logging.
+struct IterationInfo {
+  int iteration = 0;
+  double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
+  double gradient_norm = 0.0;  ///< optimality residual (Newton: relative Newton decrement)
+  double step_length = 0.0;    ///< line-search step accepted
+};
+
+/// Solver settings. Defaults solve to round-off on the seed's examples.
+struct SolverOptions {
+  std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
+  double tolerance = 1e-10;       ///< relative torque accuracy (Newton decrement / |τ|₂)
+  int max_iterations = 200;       ///< Newton: per grid level (coarse levels start the fine one)
+  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  /// Called after every iteration, numbered across grid levels (the first ones may run on
+  /// coarser grids); return false to cancel (the result says "cancelled").
+  std::function<bool(const IterationInfo&)> on_iteration;
+  /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
+  const Maneuver* warm_start = nullptr;
+};
+
+/// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws
+/// InvalidInput naming the field and the value.
+void validateProblem(const PlanningProblem& problem);
+
+/// Checks the solver settings (tolerance finite and > 0, max_iterations ≥ 0, time budget finite
+/// and ≥ 0): throws InvalidInput naming the option and the value.
+void validateOptions(const SolverOptions& options);
+
+/// Throws InvalidInput naming the inertia and its principal moments unless J1 + J2 ≥ J3 (a mass
+/// distribution exists). validateProblem applies it unless
+/// allow_nonphysical_inertia; the dynamics themselves only need SPD.
+void requirePhysicalInertia(const Matrix3& inertia);
+
+}  // namespace attitude_planner

@@ -1,0 +1,70 @@
+// What a solve returns (PlanResult) and how it ended (Termination).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "attitude_planner/planning/problem.hpp"
+
+namespace attitude_planner {
+
+/// How a solve ended: the one status of a result. Messages explain it, they never carry it; the
+/// node maps it to PlanErrorCode in one switch (ros/planner_node.cpp, errorCodeOf).
+enum class Termination {
+  Converged,     ///< first-order optimal and consistent to the tolerance
+  NotConverged,  ///< iteration limit, stall, or a check failed (the message says which)
+  Infeasible,    ///< the constraints admit no maneuver (the message names the binding one)
+  StepTooLarge,  ///< an implicit step has no solution at this h (h·|Ω| too large): increase N
+  TimedOut,      ///< the time budget ran out (the plan so far is returned)
+  Cancelled,     ///< the on_iteration callback asked to stop (the plan so far is returned)
+  InvalidInput,  ///< the problem or options were refused (a node answers this; the core throws)
+};
+
+/// "converged", "not_converged", "infeasible", "step_too_large", "timed_out", "cancelled",
+/// "invalid_input" (JSON summary, logs).
+std::string terminationName(Termination termination);
+
+/// One grid level of a continuation solve (coarsest first; the last one is the requested N).
+struct LevelSummary {
+  int steps = 0;       ///< N of this level
+  int iterations = 0;  ///< Newton iterations on this level
+  Termination termination = Termination::NotConverged;
+  double relative_gradient = 0.0;  ///< max|∇C| / (|∂τ/∂R|·max|τ|) at the level's last iterate
+  double newton_decrement = 0.0;  ///< relative Newton decrement of its last iteration
+  std::string reason;             ///< why the level ended, one sentence
+};
+
+/// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
+/// and the figures that judge it.
+struct PlanResult {
+  Termination termination = Termination::NotConverged;
+  bool converged() const { return termination == Termination::Converged; }
+  std::string message;  ///< human-readable explanation of `termination`, one level only
+  /// The grid levels solved, coarsest first (continuation); empty for solvers without levels.
+  std::vector<LevelSummary> levels;
+  std::string solver;  ///< "newton" or "nlopt"
+  SchemeKind scheme = SchemeKind::Paper;
+  Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
+  double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  int iterations = 0;  ///< Newton iterations, coarser continuation levels included
+  /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
+  double max_residual = 0.0;
+  /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the
+  /// final step (the convergence test); NLopt: 0.
+  double newton_decrement = 0.0;
+  double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
+  double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
+  double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
+  double solve_time_s = 0.0;             ///< wall time [s]
+  std::vector<IterationInfo> history;    ///< one entry per iteration
+  /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
+  /// cost of the other way when both were solved.
+  std::string extremal;
+  /// The effects in the planning model (scene keys), in order; "actuator_limits" last when the
+  /// control torques are bounded.
+  std::vector<std::string> effects;
+  /// The accuracy of the plan when PlanningProblem::accuracy was given (requested = true).
+  AccuracyEstimate accuracy;
+};
+
+}  // namespace attitude_planner

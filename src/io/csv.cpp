@@ -1,0 +1,94 @@
+#include "attitude_planner/io/csv.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+namespace {
+constexpr const char* kCsvHeader = "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz";
+}
+
+void writeManeuverCsv(const Maneuver& m, const std::string& path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
+  if (!file) throw InvalidInput("--csv: cannot write '" + path + "'");
+  std::fprintf(file.get(), "%s\n", kCsvHeader);
+  for (int k = 0; k <= m.steps(); ++k) {
+    const Eigen::Quaterniond q = so3::toQuaternion(m.attitude[k]);
+    const Vector3& w = m.angular_velocity[k];
+    const Vector3& t = m.torque[k];
+    std::fprintf(file.get(),
+                 "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
+                 m.time[k], q.w(), q.x(), q.y(), q.z(), w.x(), w.y(), w.z(), t.x(), t.y(), t.z());
+  }
+}
+
+Maneuver readManeuverCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InvalidInput("maneuver CSV: cannot read '" + path + "'");
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != kCsvHeader) {
+    throw InvalidInput("maneuver CSV '" + path + "': header is '" + line + "', expected '" +
+                       kCsvHeader + "'");
+  }
+  Maneuver m;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    std::stringstream ss(line);
+    std::string cell;
+    double v[12];
+    int n = 0;
+    while (n < 12 && std::getline(ss, cell, ',')) {
+      try {
+        size_t used = 0;
+        v[n] = std::stod(cell, &used);
+        if (used != cell.size() && cell.substr(used).find_first_not_of(" \r") != std::string::npos)
+          throw std::invalid_argument(cell);
+      } catch (const std::exception&) {
+        throw InvalidInput("maneuver CSV '" + path + "' line " + std::to_string(line_number) +
+                           ": column " + std::to_string(n + 1) + " is not a number: '" + cell +
+                           "'");
+      }
+      ++n;
+    }
+    if (n != 12) {
+      throw InvalidInput("maneuver CSV '" + path + "' line " + std::to_string(line_number) +
+                         ": expected 12 columns, got " + std::to_string(n));
+    }
+    if (static_cast<int>(v[0]) != static_cast<int>(m.time.size())) {
+      throw InvalidInput("maneuver CSV '" + path + "' line " + std::to_string(line_number) +
+                         ": k = " + std::to_string(static_cast<int>(v[0])) + " out of order");
+    }
+    m.time.push_back(v[1]);
+    m.attitude.push_back(so3::fromQuaternion(Eigen::Quaterniond(v[2], v[3], v[4], v[5])));
+    m.angular_velocity.emplace_back(v[6], v[7], v[8]);
+    m.torque.emplace_back(v[9], v[10], v[11]);
+  }
+  if (m.time.size() < 2) throw InvalidInput("maneuver CSV '" + path + "': fewer than 2 rows");
+  m.time_step = m.time[1] - m.time[0];
+  return m;
+}
+
+void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& tr, const std::string& path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
+  if (!file) throw InvalidInput("--csv: cannot write '" + path + "'");
+  std::fprintf(file.get(), "%s\n", kDriftTwoInputCsvHeader);
+  for (std::size_t k = 0; k < tr.g.size(); ++k) {
+    const Eigen::Quaterniond q = so3::toQuaternion(tr.g[k]);
+    const Eigen::Vector2d& u = tr.u[k];
+    const Vector3& p = tr.p[k];
+    std::fprintf(file.get(), "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
+                 tr.t[k], q.w(), q.x(), q.y(), q.z(), u.x(), u.y(), p.x(), p.y(), p.z());
+  }
+  if (std::fflush(file.get()) != 0) throw InvalidInput("--csv: cannot write '" + path + "'");
+}
+
+}  // namespace attitude_planner

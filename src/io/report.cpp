@@ -1,0 +1,250 @@
+#include "attitude_planner/io/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buffer[8];
+          std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+          out += buffer;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string jsonNumber(double value) {
+  return std::isfinite(value) ? exactNumber(value) : "null";
+}
+
+namespace {
+
+/// N and scheme of the returned plan: chosen by the planner when an accuracy target was given.
+int planSteps(const PlanningProblem& problem, const PlanResult& r) {
+  return r.accuracy.requested && !r.maneuver.attitude.empty() ? r.maneuver.steps() : problem.steps;
+}
+SchemeKind planScheme(const PlanningProblem& problem, const PlanResult& r) {
+  return r.accuracy.requested ? r.scheme : problem.scheme;
+}
+
+std::string accuracyJson(const AccuracyEstimate& a) {
+  std::ostringstream out;
+  out << "{\"measure\": " << jsonString(accuracyMeasureName(a.measure))
+      << ", \"target\": " << jsonNumber(a.target)
+      << ", \"estimated_error\": " << jsonNumber(a.estimated_error)
+      << ", \"predicted_error\": " << jsonNumber(a.predicted_error)
+      << ", \"order\": " << jsonNumber(a.order) << ", \"method\": " << jsonString(a.method)
+      << ", \"steps_tried\": [";
+  for (size_t i = 0; i < a.steps_tried.size(); ++i) out << (i ? ", " : "") << a.steps_tried[i];
+  out << "], \"errors_tried\": [";
+  for (size_t i = 0; i < a.errors_tried.size(); ++i)
+    out << (i ? ", " : "") << jsonNumber(a.errors_tried[i]);
+  out << "], \"schemes_tried\": [";
+  for (size_t i = 0; i < a.schemes_tried.size(); ++i)
+    out << (i ? ", " : "") << jsonString(a.schemes_tried[i]);
+  out << "]}";
+  return out.str();
+}
+
+std::string levelJson(const LevelSummary& level) {
+  std::ostringstream out;
+  out << "{\"steps\": " << level.steps << ", \"iterations\": " << level.iterations
+      << ", \"termination\": " << jsonString(terminationName(level.termination))
+      << ", \"relative_gradient\": " << jsonNumber(level.relative_gradient)
+      << ", \"newton_decrement\": " << jsonNumber(level.newton_decrement)
+      << ", \"reason\": " << jsonString(level.reason) << "}";
+  return out.str();
+}
+
+}  // namespace
+
+std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
+  std::ostringstream out;
+  out << "{\n"
+      << "  \"converged\": " << (r.converged() ? "true" : "false") << ",\n"
+      << "  \"termination\": " << jsonString(terminationName(r.termination)) << ",\n"
+      << "  \"message\": " << jsonString(r.message) << ",\n"
+      << "  \"solver\": " << jsonString(r.solver) << ",\n"
+      << "  \"scheme\": " << jsonString(schemeName(planScheme(problem, r))) << ",\n"
+      << "  \"steps\": " << planSteps(problem, r) << ",\n"
+      << "  \"duration\": " << jsonNumber(problem.duration) << ",\n"
+      << "  \"iterations\": " << r.iterations << ",\n"
+      << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
+      << "  \"terminal_attitude_error\": " << jsonNumber(r.terminal_attitude_error) << ",\n"
+      << "  \"terminal_velocity_error\": " << jsonNumber(r.terminal_velocity_error) << ",\n"
+      << "  \"max_residual\": " << jsonNumber(r.max_residual) << ",\n"
+      << "  \"dynamics_residual\": " << jsonNumber(r.dynamics_residual) << ",\n"
+      << "  \"solve_time_s\": " << jsonNumber(r.solve_time_s) << ",\n"
+      << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
+      << "  \"effects\": [";
+  for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
+  out << "],\n  \"levels\": [";
+  for (size_t i = 0; i < r.levels.size(); ++i) out << (i ? ", " : "") << levelJson(r.levels[i]);
+  out << "]";
+  if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
+  out << "\n}\n";
+  return out.str();
+}
+
+namespace {
+
+/// One aligned "label  value" line of the text summary.
+std::string line(const std::string& label, const std::string& value) {
+  std::string text = label;
+  text.resize(std::max<std::size_t>(label.size() + 1, 25), ' ');
+  return text + value + "\n";
+}
+
+/// A number in printf's %g style with `digits` significant digits (std::string, no buffer).
+std::string general(double value, int digits) {
+  std::ostringstream out;
+  out.precision(digits);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+std::string planResultText(const PlanningProblem& problem, const PlanResult& r) {
+  const int N = planSteps(problem, r);
+  std::string text;
+  text += line("converged", r.converged() ? "yes" : "NO (" + terminationName(r.termination) + ")");
+  text += line("message", r.message);
+  text += line("solver / scheme", r.solver + " / " + schemeName(planScheme(problem, r)));
+  text += line("steps N, duration T", std::to_string(N) + ", " + general(problem.duration, 6) +
+                                          " s (h = " + general(problem.duration / N, 6) + " s)");
+  text += line("iterations", std::to_string(r.iterations));
+  text += line("cost sum 1/2|tau_k|^2", general(r.cost, 12) + " N^2 m^2");
+  text += line("terminal attitude error", general(r.terminal_attitude_error, 3) + " rad");
+  text += line("terminal velocity error", general(r.terminal_velocity_error, 3) + " rad/s");
+  text += line("max residual", general(r.max_residual, 3));
+  text += line("dynamics residual", general(r.dynamics_residual, 3) + " N m s");
+  std::ostringstream time;
+  time << std::fixed << std::setprecision(3) << r.solve_time_s << " s";
+  text += line("solve time", time.str());
+  std::string effects;
+  for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
+  text += line("planned effects", effects.empty() ? std::string("none") : effects);
+  if (!r.extremal.empty()) text += line("extremal", r.extremal);
+  if (r.levels.size() > 1) {
+    std::string levels;
+    for (const LevelSummary& level : r.levels) {
+      levels += (levels.empty() ? "" : ", ") + std::string("N = ") + std::to_string(level.steps) +
+                ": " + std::to_string(level.iterations) + " it " +
+                terminationName(level.termination);
+    }
+    text += line("grid levels", levels);
+  }
+  if (r.accuracy.requested) {
+    const AccuracyEstimate& a = r.accuracy;
+    std::string tried;
+    for (size_t i = 0; i < a.steps_tried.size(); ++i) {
+      tried += (i ? ", " : "") + a.schemes_tried[i] + " " + std::to_string(a.steps_tried[i]);
+    }
+    text += line("accuracy target", accuracyMeasureName(a.measure) + " <= " + general(a.target, 3));
+    text += line("estimated error", general(a.estimated_error, 3) + " (predicted " +
+                                        general(a.predicted_error, 3) + ", order " +
+                                        general(a.order, 3) + "; " + a.method + ")");
+    text += line("resolutions solved", tried);
+  }
+  return text;
+}
+
+namespace {
+
+std::string jsonVector(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + jsonNumber(v(i));
+  return s + "]";
+}
+
+}  // namespace
+
+std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
+                                  const DriftTwoInputPlan& plan, double solve_time_s) {
+  std::ostringstream out;
+  out << "{\n"
+      << "  \"converged\": " << (plan.converged ? "true" : "false") << ",\n"
+      << "  \"message\": " << jsonString(plan.message) << ",\n"
+      << "  \"system\": \"drift_two_input\",\n"
+      << "  \"steps\": " << request.steps << ",\n"
+      << "  \"duration\": " << jsonNumber(request.duration) << ",\n"
+      << "  \"control_weights\": "
+      << jsonVector(Eigen::Vector2d(request.weights.c1, request.weights.c2)) << ",\n"
+      << "  \"iterations\": " << plan.iterations << ",\n"
+      << "  \"continuation_stages\": " << plan.continuation_stages << ",\n"
+      << "  \"cost\": " << jsonNumber(plan.cost) << ",\n"
+      << "  \"terminal_attitude_error\": " << jsonNumber(plan.terminal_error) << ",\n"
+      << "  \"initial_costate\": " << jsonVector(plan.initial_costate) << ",\n"
+      << "  \"initial_costate_guess\": "
+      << (request.initial_costate ? jsonVector(*request.initial_costate) : std::string("null"))
+      << ",\n"
+      << "  \"extremal\": " << jsonString(plan.extremal) << ",\n"
+      << "  \"other_extremal_costs\": [";
+  for (size_t i = 0; i < plan.other_costs.size(); ++i) {
+    out << (i ? ", " : "") << jsonNumber(plan.other_costs[i]);
+  }
+  out << "],\n"
+      << "  \"starts\": " << plan.starts << ",\n"
+      << "  \"converged_starts\": " << plan.converged_starts << ",\n"
+      << "  \"integration_steps\": " << plan.integration_steps << ",\n"
+      << "  \"timed_out\": " << (plan.timed_out ? "true" : "false") << ",\n"
+      << "  \"solve_time_s\": " << jsonNumber(solve_time_s) << "\n"
+      << "}\n";
+  return out.str();
+}
+
+std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
+                                  const DriftTwoInputPlan& plan, double solve_time_s) {
+  const Vector3& p = plan.initial_costate;
+  std::string text;
+  text += line("system", "drift_two_input (seed 001)");
+  text += line("converged", plan.converged ? "yes" : "NO");
+  text += line("message", plan.message);
+  text += line("control weights c1, c2",
+               general(request.weights.c1, 6) + ", " + general(request.weights.c2, 6));
+  text += line("steps N, duration T",
+               std::to_string(request.steps) + ", " + general(request.duration, 6) +
+                   " s (h = " + general(request.duration / request.steps, 6) + " s)");
+  text +=
+      line("iterations", std::to_string(plan.iterations) + " (" +
+                             std::to_string(plan.continuation_stages) + " continuation stages)");
+  text += line("initial costate p(0)", "(" + general(p.x(), 12) + ", " + general(p.y(), 12) + ", " +
+                                           general(p.z(), 12) + ")");
+  text += line("cost 1/2 int c.u^2 dt", general(plan.cost, 12));
+  text += line("extremal", plan.extremal);
+  text += line("terminal attitude error", general(plan.terminal_error, 3) + " rad");
+  std::ostringstream time;
+  time << std::fixed << std::setprecision(4) << solve_time_s << " s";
+  text += line("solve time", time.str());
+  return text;
+}
+
+}  // namespace attitude_planner

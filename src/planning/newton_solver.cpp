@@ -1,0 +1,550 @@
+// Newton's method on the first-order optimality conditions of the discrete problem (seed 000,
+// Problem 3.2), O(N) time and memory per iteration.
+//
+// The problem is reduced_problem.hpp's unconstrained minimization over the interior attitudes;
+// with right perturbations R_j exp(δ_j^) its gradient is Σ_k J_kᵀ τ_k and its exact Hessian is
+// JᵀJ + sym(Σ_k Σ_i τ_{k,i} ∂J_{k,i}/∂δ), block-pentadiagonal: a banded Cholesky costs O(N).
+//
+// Globalization: the cost itself is the merit function. If the Hessian is not positive definite a
+// multiple of the identity is added (Levenberg); an Armijo backtracking line search along the
+// retraction R_j exp(α δ_j^) follows. Convergence: the Newton decrement relative to |τ|₂ is below
+// the tolerance; the step it came with is then taken, leaving the torques exact to ~round-off.
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include "attitude_planner/errors.hpp"
+#include "planning/reduced_problem.hpp"
+#include "planning/solvers.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// Above this N the normal equations (condition ~N⁴; measured λ_max/λ_min = 7e10 at N = 256 on a
+/// seed-inertia slew) risk losing the Cholesky factorization to round-off; the augmented system
+/// below has condition ~N².
+constexpr int kNormalEquationsMaxSteps = 256;
+
+/// A solve stalled at round-off counts as converged if its relative torque accuracy (Newton
+/// decrement / |τ|₂) is at least this good; the message then states the accuracy reached.
+/// The floor itself grows like eps·N² (torques are second differences of the attitudes; measured
+/// decrements at the floor: 5e-9 at N = 10⁴, 4e-7 at 10⁵, 1e-5..1e-4 at 10⁶), so above
+/// N ≈ 700 the acceptance follows it instead of iterating on noise.
+double roundOffAcceptance(int steps) {
+  return std::max(1e-6, std::numeric_limits<double>::epsilon() * double(steps) * steps);
+}
+
+/// Below this relative decrement no iteration can improve the torques at N steps (the floor
+/// above is 0.1–0.5 eps·N²): the step is taken as a final one, as at the tolerance, instead of
+/// iterating until the stall is seen (two more iterations, each O(N), at N = 10⁶ seconds).
+/// Below N ≈ 700 it is under the default tolerance and changes nothing.
+double roundOffFloor(int steps) {
+  return 0.5 * std::numeric_limits<double>::epsilon() * double(steps) * steps;
+}
+
+/// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
+///   [ −α I   J        ] [ z ]   [ −τ ]
+///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
+/// ordered y_1, y_2, δ_2, y_3, δ_3, …, y_{N−1} so it is banded (half bandwidth 14), and solved
+/// by LU with partial pivoting. `delta` holds −g on entry and δ on return. `K` is the caller's
+/// workspace (allocated once per solve: at N = 10⁶ it is 2 GB, and fresh pages cost more
+/// system time than the factorization).
+bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta,
+                    std::unique_ptr<BandedLinearSystem>* workspace) {
+  const int N = np.steps();
+  const auto y_block = [&](int k) { return k == 1 ? 0 : 2 * k - 3; };
+  const auto d_block = [&](int j) { return 2 * j - 2; };  // j = 2..N−2
+  const int n = 3 * (2 * N - 4);
+  if (!*workspace) workspace->reset(new BandedLinearSystem(n, 14));
+  BandedLinearSystem& K = **workspace;
+  K.setZero();
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  // α ≈ σ_min(J) keeps cond(K) ≈ cond(J) (Björck; α ≈ σ_max would give cond(J)², no better
+  // than the normal equations). The smoothest attitude mode δ(t) = sin(πt/T) v has
+  // |δτ| ≈ J_min (π/T)² |δ|, which estimates σ_min.
+  const double T = np.scheme().timeStep() * N;
+  const double smallest_moment =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(np.scheme().inertia()).eigenvalues()(0);
+  const double alpha = smallest_moment * (M_PI / T) * (M_PI / T);
+  const double shift =
+      relative_shift * std::pow(2.0 * np.scheme().inertia().norm() /
+                                    (np.scheme().timeStep() * np.scheme().timeStep()),
+                                2);
+  np.forEachStencil(true, [&](const ReducedProblem::Stencil& st) {
+    const int ry = 3 * y_block(st.k);
+    for (int i = 0; i < 3; ++i) {
+      K.add(ry + i, ry + i, -alpha);
+      rhs(ry + i) = -st.tau(i);
+    }
+    for (int s = 0; s < 3; ++s) {
+      const int j = st.k - 1 + s;
+      if (np.variableIndex(j) < 0) continue;
+      const int rd = 3 * d_block(j);
+      for (int i = 0; i < 3; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          K.add(ry + i, rd + c, st.jacobian(i, 3 * s + c));
+          K.add(rd + c, ry + i, st.jacobian(i, 3 * s + c));
+        }
+      }
+      for (int t = 0; t < 3; ++t) {
+        const int jt = st.k - 1 + t;
+        if (np.variableIndex(jt) < 0) continue;
+        const int rt = 3 * d_block(jt);
+        for (int i = 0; i < 3; ++i) {
+          for (int c = 0; c < 3; ++c)
+            K.add(rd + i, rt + c, st.second(3 * s + i, 3 * t + c) / alpha);
+        }
+      }
+    }
+  });
+  if (shift > 0) {
+    for (int j = 2; j <= N - 2; ++j) {
+      for (int i = 0; i < 3; ++i) K.add(3 * d_block(j) + i, 3 * d_block(j) + i, shift / alpha);
+    }
+  }
+  if (!K.solve(&rhs)) return false;
+  for (int j = 2; j <= N - 2; ++j)
+    delta->segment<3>(np.variableIndex(j)) = rhs.segment<3>(3 * d_block(j));
+  return delta->allFinite();
+}
+
+/// The initial guess: R_1 exp(φ(s)) with φ a cubic Hermite curve ending at `lift`, one of the
+/// rotation vectors ψ = (θ + 2πk) u with exp(ψ^) = R_1ᵀ R_{N−1} (θ u the principal one).
+struct InitialGuess {
+  Vector3 lift;
+  std::string description;
+};
+
+/// The lifts of the principal rotation ordered by distance from the coasting displacement
+/// c = T (Ω_0 + R_1ᵀR_{N−1} Ω_{N−1})/2 (rest to rest: c = 0, so the principal one comes first and
+/// the other way round second). RotationDirection::LongWay takes the second, extra revolutions add
+/// whole turns in the lift's own sense.
+std::vector<InitialGuess> initialGuesses(const PlanningProblem& problem, const ReducedProblem& rp) {
+  const Vector3 principal = rp.principalSpan();
+  const double angle = principal.norm();
+  const Vector3 u = angle > 0 ? Vector3(principal / angle) : Vector3(Vector3::UnitX());
+  const Vector3 coasting =
+      0.5 * problem.duration *
+      (problem.initial_velocity + so3::exp(principal) * problem.final_velocity);
+  const int reach = 2 + static_cast<int>(coasting.norm() / (2 * M_PI));
+  std::vector<std::pair<double, Vector3>> lifts;
+  for (int k = -reach; k <= reach; ++k) {
+    const Vector3 lift = (angle + 2 * M_PI * k) * u;
+    lifts.emplace_back((lift - coasting).norm(), lift);
+  }
+  std::stable_sort(lifts.begin(), lifts.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<InitialGuess> out;
+  for (int i = 0; i < 2; ++i) {
+    Vector3 lift = lifts[i].second;
+    const double turned = lift.norm();
+    const Vector3 axis = turned > 0 ? Vector3(lift / turned) : u;
+    lift += 2 * M_PI * problem.extra_revolutions * axis;
+    std::ostringstream d;
+    d << (i == 0 ? "nearest lift" : "second-nearest lift (the other way round)");
+    if (problem.extra_revolutions > 0) d << " + " << problem.extra_revolutions << " extra turn(s)";
+    d << ": " << lift.norm() << " rad about [" << axis.x() << ", " << axis.y() << ", " << axis.z()
+      << "] from R_1 to R_{N-1}";
+    out.push_back({lift, d.str()});
+  }
+  return out;
+}
+
+/// Newton on one grid. Starts from `coarse_steps` (a coarser grid's final iterate) if given, else
+/// from options.warm_start, else from the Hermite guess; leaves its final iterate in
+/// `final_steps` if given (the next finer grid starts from it).
+PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                       const ReducedProblem::Steps* coarse_steps = nullptr,
+                       ReducedProblem::Steps* final_steps = nullptr,
+                       const ReducedProblem::Steps* coarser_steps = nullptr) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  PlanResult result;
+  std::optional<ReducedProblem> reduced;
+  try {
+    reduced.emplace(problem);
+  } catch (const StepTooLarge& e) {
+    result.termination = Termination::StepTooLarge;
+    result.message = std::string("boundary velocity: ") + e.what();
+    result.levels.push_back({problem.steps, 0, result.termination, 0.0, 0.0, result.message});
+    return result;
+  }
+  ReducedProblem& np = *reduced;
+  const std::vector<InitialGuess> guesses = initialGuesses(problem, np);
+  const InitialGuess& guess = guesses[problem.direction == RotationDirection::LongWay ? 1 : 0];
+  result.extremal = guess.description;
+  // Hermite slopes: body rotation per unit s, dR/ds = R Ω dt/ds with dt/ds = (N − 2) h.
+  const double T_inner = (problem.steps - 2) * problem.duration / problem.steps;
+  np.initializeHermite(guess.lift, T_inner * problem.initial_velocity,
+                       T_inner * (so3::exp(guess.lift) * problem.final_velocity));
+  if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
+  if (coarse_steps) np.initializeFromCoarser(*coarse_steps, coarser_steps);
+  const int N = np.steps();
+  const int n = 3 * (N - 3);
+  const double round_off_acceptance = roundOffAcceptance(N);
+  BandedSymmetricMatrix hessian(n, 8);
+  std::unique_ptr<BandedLinearSystem> augmented_workspace;
+  Eigen::VectorXd gradient(n), delta(n);
+  double gradient_scale = 0.0;
+  double relative_gradient = 0.0;
+  double relative_decrement = 0.0;
+  Termination termination = Termination::NotConverged;
+  double best_decrement = std::numeric_limits<double>::infinity();
+  double damping = 0.0;  // Levenberg shift the next iteration starts from (relative)
+  // Decrement of the previous iteration if its step was a full, unshifted Newton step (the
+  // quadratic model below is only valid after one); 0 otherwise.
+  double previous_full_step_decrement = 0.0;
+  int stalled_iterations = 0;
+  std::string reason = "iteration limit reached";
+  int iteration = 0;
+  for (;; ++iteration) {
+    const bool augmented = N > kNormalEquationsMaxSteps;
+    const double cost = np.evaluate(&gradient, augmented ? nullptr : &hessian, &gradient_scale);
+    relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
+    if (!std::isfinite(cost) || !std::isfinite(relative_gradient)) {
+      reason = "non-finite cost or gradient (step too large for this h? increase steps)";
+      termination = Termination::StepTooLarge;
+      break;
+    }
+    if (gradient.cwiseAbs().maxCoeff() == 0.0) {  // e.g. the zero maneuver
+      termination = Termination::Converged;
+      relative_decrement = 0.0;
+      reason = "converged";
+      break;
+    }
+    if (iteration >= options.max_iterations) break;
+    if (options.time_budget_s > 0 && elapsed() > options.time_budget_s) {
+      reason = "time budget exceeded";
+      termination = Termination::TimedOut;
+      break;
+    }
+    // Newton direction; Levenberg shift until the Hessian is positive definite (normal
+    // equations: Cholesky succeeds; augmented system: the step is a descent direction).
+    double shift = damping;  // relative to the Hessian's scale
+    bool factored = false;
+    for (int attempt = 0; attempt < 40; ++attempt) {
+      delta = -gradient;
+      if (augmented) {
+        factored =
+            solveAugmented(np, shift, &delta, &augmented_workspace) && gradient.dot(delta) < 0;
+      } else {
+        BandedSymmetricMatrix trial = hessian;
+        if (shift > 0) trial.addToDiagonal(shift * hessian.maxAbsDiagonal());
+        factored = trial.solvePositiveDefinite(&delta);
+      }
+      if (factored) break;
+      // Start far below the smallest curvature (λ_max/λ_min reaches 1e13 at N = 1000): a shift
+      // of 1e-10 λ_max already swamps the smooth modes and makes convergence linear.
+      shift = shift == 0.0 ? 1e-14 : 100.0 * shift;
+    }
+    if (!factored) {
+      reason = "Hessian could not be made positive definite";
+      break;
+    }
+    // Newton decrement λ = √(gᵀH⁻¹g): λ ≈ the ℓ2 error of the torques, so λ/|τ|₂ with
+    // |τ|₂ = √(2C) is the relative torque accuracy — scale-free, unlike the raw gradient, whose
+    // conditioning grows like N⁴.
+    const double slope = gradient.dot(delta);
+    relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
+    // Quadratic convergence observed on this very run: the last full step took the decrement
+    // from d₋ to d, so this one will leave about C d², C = d/d₋². Well inside the tolerance
+    // (10×), this step is the last (saves the iteration that would only confirm it).
+    const double d_prev = previous_full_step_decrement;
+    const double predicted_decrement =
+        d_prev > 0.0 && relative_decrement < d_prev
+            ? relative_decrement / (d_prev * d_prev) * relative_decrement * relative_decrement
+            : std::numeric_limits<double>::infinity();
+    const bool predicted_within_tolerance = predicted_decrement <= 0.1 * options.tolerance;
+    const bool final_step =
+        shift == 0.0 && (relative_decrement <= std::max(options.tolerance, roundOffFloor(N)) ||
+                         predicted_within_tolerance);
+    // Armijo backtracking on the cost along the retraction. Once the predicted decrease is below
+    // the cost's round-off the test is meaningless and the full Newton step is taken: that is
+    // when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the round-off acceptance
+    // relative (predicted decrease ≤ 1e-12 C) — at large N the cost's own round-off (torques are
+    // second differences: relative error ~eps·N²) exceeds that, and Armijo would fail on noise.
+    double alpha = 1.0;
+    bool accepted =
+        final_step || -slope <= 1e-13 * cost || relative_decrement <= round_off_acceptance;
+    ReducedProblem::Steps trial_R = np.retract(delta, alpha);
+    for (int back = 0; !accepted && back < 50; ++back) {
+      const double trial_cost = np.cost(trial_R);
+      if (std::isfinite(trial_cost) && trial_cost <= cost + 1e-4 * alpha * slope) {
+        accepted = true;
+        break;
+      }
+      alpha *= 0.5;
+      trial_R = np.retract(delta, alpha);
+    }
+    if (!accepted) {
+      reason = "line search failed";
+      break;
+    }
+    np.setCurrent(trial_R);
+    // Levenberg–Marquardt-style memory: a step that had to be cut means the model was trusted too
+    // far, so start the next iteration more damped; full steps relax the damping back to pure
+    // Newton (quadratic convergence needs shift 0 near the solution).
+    if (alpha < 1.0) {
+      damping = std::max(100.0 * shift, 1e-12);
+    } else {
+      damping = shift / 100.0 < 1e-14 ? 0.0 : shift / 100.0;
+    }
+    // Round-off floor: once the decrement is small, full Newton steps that no longer halve it for
+    // two iterations mean the gradient is noise (the Hessian's condition grows like N⁴). Stop
+    // there; the achieved relative accuracy is the decrement (≤ round_off_acceptance). A large
+    // decrement that stagnates is not round-off: the iteration goes on.
+    if (alpha == 1.0 && relative_decrement <= round_off_acceptance &&
+        relative_decrement > 0.5 * best_decrement) {
+      ++stalled_iterations;
+    } else {
+      stalled_iterations = 0;
+    }
+    best_decrement = std::min(best_decrement, relative_decrement);
+    previous_full_step_decrement = alpha == 1.0 && shift == 0.0 ? relative_decrement : 0.0;
+    IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
+    if (stalled_iterations >= 2) {
+      result.history.push_back(info);
+      ++iteration;
+      termination = Termination::Converged;
+      std::ostringstream why;
+      why << "converged to the round-off floor (relative torque accuracy about "
+          << relative_decrement << ", tolerance " << options.tolerance << ")";
+      reason = why.str();
+      break;
+    }
+    result.history.push_back(info);
+    if (final_step) {
+      // This last step took the iterate from the tolerance to ~round-off (quadratic convergence).
+      termination = Termination::Converged;
+      reason = "converged";
+      if (relative_decrement > options.tolerance && predicted_within_tolerance) {
+        std::ostringstream why;
+        why << "converged (relative torque accuracy ";
+        if (predicted_decrement < 1e-16) {
+          why << "at round-off";
+        } else {
+          why << "about " << predicted_decrement;
+        }
+        why << " after the last step, predicted from the quadratic convergence of the steps"
+            << " before it; " << relative_decrement << " before it)";
+        reason = why.str();
+      } else if (relative_decrement > options.tolerance) {
+        std::ostringstream why;
+        why << "converged to the round-off floor (relative torque accuracy about "
+            << relative_decrement << " before the last step, tolerance " << options.tolerance
+            << " is below the floor ~eps N^2 at this N)";
+        reason = why.str();
+      }
+      ++iteration;
+      break;
+    }
+    if (options.on_iteration && !options.on_iteration(info)) {
+      termination = Termination::Cancelled;
+      reason = "cancelled";
+      ++iteration;
+      break;
+    }
+  }
+  const auto finish = [&] {
+    result.termination = termination;
+    std::ostringstream msg;
+    msg << reason << " after " << iteration << " iterations (relative gradient "
+        << relative_gradient << ", relative Newton decrement " << relative_decrement << ")";
+    result.message = msg.str();
+    result.levels.push_back(
+        {N, iteration, termination, relative_gradient, relative_decrement, result.message});
+    return result;
+  };
+  result.iterations = iteration;
+  result.newton_decrement = relative_decrement;
+  if (final_steps) {
+    // A coarse level: its only product is the iterate the next grid starts from; the residual
+    // and the replay below are the finest level's (a tenth of the N = 128 solve otherwise).
+    *final_steps = np.current();
+    result.max_residual = relative_gradient;
+    return finish();
+  }
+  // Report the first-order residual at the final iterate, not at the one before the last step.
+  if (termination == Termination::Converged && iteration > 0) {
+    np.evaluate(&gradient, nullptr, &gradient_scale);
+    relative_gradient = gradient.size() ? gradient.cwiseAbs().maxCoeff() / gradient_scale : 0.0;
+  }
+  result.max_residual = relative_gradient;
+  try {
+    evaluatePlan(problem, np.torques(np.current()), &result);
+  } catch (const StepTooLarge& e) {
+    termination = Termination::StepTooLarge;
+    reason = std::string("replay of the planned torques failed: ") + e.what();
+    return finish();
+  }
+  // The replay is the final judge: stationarity of the reduced problem means nothing if the
+  // torques, integrated forward, do not land on the target (e.g. an implicit step that jumped to
+  // another branch of μ(F) = p when h|Ω| is large).
+  const double miss = std::max(result.terminal_attitude_error, result.terminal_velocity_error);
+  const double allowed_miss = 1e-9 * std::max(1.0, N * 1e-4);
+  if (termination == Termination::Converged && !(miss <= allowed_miss)) {
+    termination = Termination::NotConverged;
+    std::ostringstream why;
+    why << "stationary point found, but replaying its torques misses the target by " << miss
+        << " (an implicit step on another branch when h|Omega| is large: increase steps; or an "
+           "unstable motion amplifying round-off over the horizon)";
+    reason = why.str();
+  }
+  return finish();
+}
+
+/// Grid continuation: above this N the problem is first solved on a 4× coarser grid (recursively)
+/// and its solution, carried over (ReducedProblem::initializeFromCoarser), starts the fine solve.
+/// From the geodesic guess, long horizons wander through regions where the Hessian is indefinite;
+/// from the coarse solution every level starts in the convex basin and takes a few Newton steps.
+constexpr int kCoarsestGrid = 16;
+
+/// What is left of the options' time budget after `start` [s] (0 budget: unlimited, returned as 0).
+double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
+  if (options.time_budget_s <= 0) return 0.0;
+  const double used =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::max(options.time_budget_s - used, 1e-300);
+}
+
+/// A coarse level helps only while its boundary steps stay small: at h·|Ω| ≳ 1 rad the coarse
+/// problem is a different (and much harder) one — measured (issue 7): spinning ends Ω = 5 rad/s
+/// at N = 128 spent 200 failed iterations on the N = 32 level (2 rad per step) before the fine
+/// level started from the Hermite guess anyway.
+constexpr double kCoarseMaxStepAngle = 1.0;  // [rad]
+
+bool coarseLevelHelps(const PlanningProblem& coarse) {
+  const double h = coarse.duration / coarse.steps;
+  return h * std::max(coarse.initial_velocity.norm(), coarse.final_velocity.norm()) <=
+         kCoarseMaxStepAngle;
+}
+
+PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOptions& options,
+                                 ReducedProblem::Steps* final_steps = nullptr,
+                                 ReducedProblem::Steps* converged_level_below = nullptr) {
+  const auto start = std::chrono::steady_clock::now();
+  if (problem.steps <= kCoarsestGrid || options.warm_start) {
+    return solveOnGrid(problem, options, nullptr, final_steps);
+  }
+  PlanningProblem coarse = problem;
+  coarse.steps = std::max(kCoarsestGrid, problem.steps / 4);
+  if (!coarseLevelHelps(coarse)) return solveOnGrid(problem, options, nullptr, final_steps);
+  SolverOptions coarse_options = options;
+  // The callback is forwarded (feedback from every level, and cancel works during all of them).
+  // A coarse level only starts the next one, whose own O(h²) difference from it is far larger.
+  coarse_options.tolerance = std::max(options.tolerance, 1e-6);
+  ReducedProblem::Steps coarse_steps, coarser_steps;
+  const PlanResult coarse_result =
+      solveWithContinuation(coarse, coarse_options, &coarse_steps, &coarser_steps);
+  if (coarse_result.converged() && converged_level_below) *converged_level_below = coarse_steps;
+  // Two converged levels below: the guess is extrapolated from both (first-order Richardson).
+  const ReducedProblem::Steps* extrapolate_from = coarser_steps.empty() ? nullptr : &coarser_steps;
+  SolverOptions fine_options = options;
+  // Stopped on a coarse level (cancel, time budget): answer on the requested grid anyway, with
+  // the coarse iterate carried over and replayed (no iteration on this grid).
+  const auto stopped = [&](Termination why) {
+    fine_options.max_iterations = 0;
+    // (A coarse level that failed before iterating left no steps: the Hermite guess then.)
+    const bool have_steps = static_cast<int>(coarse_steps.size()) == coarse.steps;
+    PlanResult out =
+        solveOnGrid(problem, fine_options, have_steps ? &coarse_steps : nullptr, final_steps);
+    out.termination = why;
+    out.iterations = coarse_result.iterations;
+    out.message =
+        (why == Termination::Cancelled ? "cancelled" : "time budget exceeded") +
+        std::string(" on the N = ") + std::to_string(coarse.steps) +
+        " level; the plan is its iterate carried over to N = " + std::to_string(problem.steps);
+    out.levels.back().termination = why;
+    out.levels.insert(out.levels.begin(), coarse_result.levels.begin(), coarse_result.levels.end());
+    return out;
+  };
+  if (coarse_result.termination == Termination::Cancelled) return stopped(Termination::Cancelled);
+  std::string level;
+  if (coarse_result.converged()) {
+    level = "; started from the N = " + std::to_string(coarse.steps) + " solution (" +
+            std::to_string(coarse_result.iterations) + " iterations there)";
+  } else {
+    level = "; the N = " + std::to_string(coarse.steps) + " level ended " +
+            terminationName(coarse_result.termination) + ", started from the geodesic";
+  }
+  fine_options.time_budget_s = remainingBudget(options, start);
+  if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
+    return stopped(Termination::TimedOut);
+  }
+  // Iterations are numbered across levels, so progress reports keep increasing.
+  const int before = coarse_result.iterations;
+  if (options.on_iteration) {
+    fine_options.on_iteration = [&options, before](const IterationInfo& info) {
+      IterationInfo global = info;
+      global.iteration += before;
+      return options.on_iteration(global);
+    };
+  }
+  PlanResult result =
+      solveOnGrid(problem, fine_options, coarse_result.converged() ? &coarse_steps : nullptr,
+                  final_steps, extrapolate_from);
+  result.iterations += before;
+  result.message += level;
+  result.levels.insert(result.levels.begin(), coarse_result.levels.begin(),
+                       coarse_result.levels.end());
+  return result;
+}
+
+/// Within this angle of π the two ways round are close in cost (which is cheaper depends on the
+/// inertia), so both are solved and the cheaper kept (measured: 1 rad about x with the seed's J
+/// at exactly π costs 16.683 the short way and 16.639 the other way).
+constexpr double kBothWaysBelowPi = 0.25;
+
+}  // namespace
+
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult first = solveWithContinuation(problem, options);
+  std::vector<InitialGuess> guesses;
+  try {
+    const ReducedProblem rp(problem);
+    guesses = initialGuesses(problem, rp);
+  } catch (const StepTooLarge&) {
+    return first;  // already reported by the solve
+  }
+  // Rest to rest, the two ways round are about equally long when the angle is near π (their
+  // lengths θ and 2π − θ differ by less than 2·kBothWaysBelowPi): both are solved.
+  const bool at_rest = problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0);
+  const double gap = std::abs(guesses[1].lift.norm() - guesses[0].lift.norm());
+  const bool ambiguous = at_rest && gap < 2 * kBothWaysBelowPi;
+  if (problem.direction != RotationDirection::Shortest || problem.extra_revolutions != 0 ||
+      !ambiguous || options.warm_start) {
+    return first;
+  }
+  PlanningProblem other = problem;
+  other.direction = RotationDirection::LongWay;
+  SolverOptions remaining = options;
+  remaining.time_budget_s = remainingBudget(options, start);
+  if (options.time_budget_s > 0 && remaining.time_budget_s <= 1e-299) return first;
+  PlanResult second = solveWithContinuation(other, remaining);
+  // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice
+  // at exactly π is deterministic.
+  const bool take_second =
+      second.converged() && (!first.converged() || second.cost < first.cost * (1 - 1e-12));
+  PlanResult& kept = take_second ? second : first;
+  const PlanResult& dropped = take_second ? first : second;
+  std::ostringstream note;
+  note << " (cheaper of both ways near π; the other, " << dropped.extremal << ", "
+       << (dropped.converged() ? "costs " + std::to_string(dropped.cost)
+                               : std::string("did not converge"))
+       << ")";
+  kept.extremal += note.str();
+  kept.iterations += dropped.iterations;
+  return kept;
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,104 @@
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/errors.hpp"
+#include "planning/solvers.hpp"
+
+namespace attitude_planner {
+
+void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
+                  PlanResult* result) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  SimulationInput input;
+  input.initial_attitude = problem.initial_attitude;
+  input.initial_velocity = problem.initial_velocity;
+  input.torque = torque;
+  input.effects = problem.effects.get();
+  SimulationReport report;
+  result->maneuver = simulate(scheme, input, &report);
+  result->scheme = problem.scheme;
+  result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
+  if (problem.hasTorqueBounds()) result->effects.push_back("actuator_limits");
+  result->dynamics_residual = report.max_step_residual;
+  double cost = 0.0;
+  for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();
+  result->cost = cost;
+  const int N = problem.steps;
+  result->terminal_attitude_error =
+      so3::angleBetween(problem.final_attitude, result->maneuver.attitude[N]);
+  result->terminal_velocity_error =
+      (result->maneuver.angular_velocity[N - 1] - problem.final_velocity).norm();
+}
+
+namespace {
+
+/// The boundary steps F_0 (from Ω_0) and F_{N−1} (from Ω_{N−1}) are fixed by the data: if either
+/// has no solution at h = T/N no solver can plan, so the request is refused up front, naming the
+/// velocity (StepTooLarge: "step too large, increase steps: ...").
+void requireBoundarySteps(const PlanningProblem& problem) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  const std::pair<const char*, const Vector3*> ends[] = {
+      {"initial.angular_velocity", &problem.initial_velocity},
+      {"final.angular_velocity", &problem.final_velocity}};
+  for (const auto& [field, velocity] : ends) {
+    try {
+      scheme.stepFromVelocity(*velocity);
+    } catch (const StepTooLarge& e) {
+      std::ostringstream what;
+      what << field << ": " << e.what() << " (N = " << problem.steps << ", T = " << problem.duration
+           << " s)";
+      throw StepTooLarge(what.str());
+    }
+  }
+}
+
+}  // namespace
+
+PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
+  validateProblem(problem);
+  validateOptions(options);
+  requireBoundarySteps(problem);
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult result;
+  if (options.solver == "newton" && problem.hasTorqueBounds()) {
+    result = solveWithNewton(problem, options);
+    const auto within_bounds = [&](const PlanResult& r) {
+      for (const Vector3& t : r.maneuver.torque) {
+        if (((t.cwiseAbs() - problem.max_torque).array() > 0.0).any()) return false;
+      }
+      return true;
+    };
+    if (!result.converged() || !within_bounds(result)) {
+      // The unbounded optimum violates the bounds: the constrained solver, started from it.
+      Maneuver clipped = result.maneuver;
+      for (Vector3& t : clipped.torque)
+        t = t.cwiseMax(-problem.max_torque).cwiseMin(problem.max_torque);
+      SolverOptions bounded = options;
+      bounded.warm_start = result.converged() ? &clipped : nullptr;
+      const std::string unbounded_note = result.converged() ? "; the unbounded optimum (cost " +
+                                                                  std::to_string(result.cost) +
+                                                                  ") exceeds the bounds"
+                                                            : "";
+      result = solveWithNlopt(problem, bounded);
+      result.message += unbounded_note;
+      result.solver = "nlopt";
+    } else {
+      result.message += "; bounds inactive at the unbounded optimum";
+    }
+  } else if (options.solver == "newton") {
+    result = solveWithNewton(problem, options);
+  } else if (options.solver == "nlopt") {
+    result = solveWithNlopt(problem, options);
+  } else {
+    throw InvalidInput("solver: unknown value '" + options.solver + "' (expected newton or nlopt)");
+  }
+  if (result.solver.empty()) result.solver = options.solver;
+  result.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace attitude_planner

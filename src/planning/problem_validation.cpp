@@ -1,0 +1,137 @@
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// Largest N accepted: the Newton solver holds ~2.3 kB per step (measured at N = 1e6, 2.3 GB
+/// peak; docs/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7, would need
+/// ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
+constexpr int kMaxSteps = 2000000;
+
+std::string str(const Eigen::MatrixXd& m) {
+  std::ostringstream s;
+  s << m.format(
+      Eigen::IOFormat(Eigen::FullPrecision, Eigen::DontAlignCols, ", ", "; ", "", "", "[", "]"));
+  return s.str();
+}
+
+void requireFinite(const Eigen::MatrixXd& m, const std::string& field) {
+  if (!m.allFinite()) throw InvalidInput(field + ": not finite: " + str(m));
+}
+
+void requireRotation(const Matrix3& R, const std::string& field) {
+  requireFinite(R, field);
+  if (so3::orthogonalityError(R) > 1e-9) {
+    throw InvalidInput(field + ": not a rotation matrix (|R^T R - I| + |det R - 1| = " +
+                       exactNumber(so3::orthogonalityError(R)) + ")");
+  }
+}
+
+}  // namespace
+
+void validateProblem(const PlanningProblem& p) {
+  requireFinite(p.inertia, "inertia");
+  if ((p.inertia - p.inertia.transpose()).cwiseAbs().maxCoeff() >
+      1e-12 * p.inertia.cwiseAbs().maxCoeff()) {
+    throw InvalidInput("inertia: not symmetric: " + str(p.inertia));
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(p.inertia);
+  const Vector3 moments = eig.eigenvalues();  // ascending
+  if (!(moments(0) > 0.0)) {
+    throw InvalidInput("inertia: not positive definite: " + str(p.inertia) +
+                       " (principal moments " + str(moments.transpose()) + ")");
+  }
+  // The discrete dynamics are well posed for every SPD J, and the seed's own example inertia
+  // (moments 3.15, 12.54, 32.19) violates J1 + J2 >= J3: the check is skipped only on request.
+  if (!p.allow_nonphysical_inertia) requirePhysicalInertia(p.inertia);
+  if (moments(2) / moments(0) > 1e12) {
+    throw InvalidInput("inertia: condition number " + exactNumber(moments(2) / moments(0)) +
+                       " of " + str(p.inertia) + " > 1e12");
+  }
+  if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
+    throw InvalidInput("duration: must be a finite number > 0 s, got " + exactNumber(p.duration));
+  }
+  // With an accuracy target the planner chooses N: `steps` is not used.
+  if (!p.accuracy.active() && p.steps < 4) {
+    throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
+  }
+  if (!p.accuracy.active() && p.steps > kMaxSteps) {
+    throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
+                       std::to_string(p.steps));
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(p.max_torque(i)) || !(p.max_torque(i) > 0.0)) {
+      throw InvalidInput("actuator_limits.max_torque: each bound must be > 0 N m, got " +
+                         str(p.max_torque.transpose()));
+    }
+  }
+  if (p.max_torque.array().isFinite().any() && !p.max_torque.allFinite()) {
+    throw InvalidInput("actuator_limits.max_torque: give all three bounds, got " +
+                       str(p.max_torque.transpose()));
+  }
+  if (p.hasTorqueBounds() && p.effects && !p.effects->empty()) {
+    throw InvalidInput(
+        "effects: actuator_limits together with gravity_gradient/disturbance_torque is not "
+        "supported yet (bounded plans use NLopt, which does not model effect torques)");
+  }
+  if (p.accuracy.active()) {
+    if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
+      throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
+                         accuracyMeasureName(p.accuracy.measure) + "), got " +
+                         exactNumber(p.accuracy.value));
+    }
+    if (p.hasTorqueBounds() || (p.effects && !p.effects->empty())) {
+      throw InvalidInput(
+          "accuracy_target: not supported with effects or actuator_limits (the continuous "
+          "reference and the measured orders are for the bare rigid body)");
+    }
+    if (p.accuracy.max_steps < 16 || p.accuracy.max_steps > kMaxSteps) {
+      throw InvalidInput("accuracy.max_steps: must be in [16, " + std::to_string(kMaxSteps) +
+                         "], got " + std::to_string(p.accuracy.max_steps));
+    }
+  }
+  if (p.extra_revolutions < 0) {
+    throw InvalidInput(
+        "extra_revolutions: must be >= 0 (whole extra turns in the sense of the "
+        "chosen way; use direction LongWay to turn the other way), got " +
+        std::to_string(p.extra_revolutions));
+  }
+  requireRotation(p.initial_attitude, "initial.attitude");
+  requireRotation(p.final_attitude, "final.attitude");
+  requireFinite(p.initial_velocity, "initial.angular_velocity");
+  requireFinite(p.final_velocity, "final.angular_velocity");
+}
+
+void validateOptions(const SolverOptions& o) {
+  if (!std::isfinite(o.tolerance) || !(o.tolerance > 0.0)) {
+    throw InvalidInput("tolerance: must be a finite number > 0, got " + exactNumber(o.tolerance));
+  }
+  if (o.max_iterations < 0) {
+    throw InvalidInput("max_iterations: must be >= 0, got " + std::to_string(o.max_iterations));
+  }
+  if (!std::isfinite(o.time_budget_s) || o.time_budget_s < 0.0) {
+    throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = none), got " +
+                       exactNumber(o.time_budget_s));
+  }
+}
+
+void requirePhysicalInertia(const Matrix3& inertia) {
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(inertia);
+  const Vector3 moments = eig.eigenvalues();  // ascending
+  if (moments(0) + moments(1) < moments(2) * (1.0 - 1e-12)) {
+    throw InvalidInput("inertia: " + str(inertia) + " has principal moments " +
+                       str(moments.transpose()) +
+                       " that violate the triangle inequality J1 + J2 >= J3 (no rigid body has "
+                       "them; set allow_nonphysical_inertia: true to plan anyway)");
+  }
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,303 @@
+#include "planning/reduced_problem.hpp"
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// What one step F_j contributes to the torques next to it, and to their Jacobians
+/// (right perturbation F exp(ε^); D = dμ/dε, G = Fᵀμ, dG = dG/dε = (Fᵀμ)^ + FᵀD):
+///   τ_k = (μ_k − G_{k−1})/h
+///   ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1}) = [dG_{k−1}F_{k−1}ᵀ, −(D_k F_kᵀ + dG_{k−1}), D_k] / h,
+/// from F_{k−1} → F_{k−1} exp(δ_k − F_{k−1}ᵀ δ_{k−1}) and F_k → F_k exp(δ_{k+1} − F_kᵀ δ_k).
+struct StepTerms {
+  Vector3 omega;  ///< ω = log F, as stored: no log map to recover it
+  Matrix3 F;
+  Vector3 mu, G;
+  Matrix3 D, dG, DFt, dGFt;
+
+  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in)
+      : omega(omega_in), F(so3::exp(omega_in)) {
+    mu = scheme.momentumOfStep(omega);
+    G = F.transpose() * mu;
+    D = scheme.momentumJacobianOfStep(F, omega);
+    dG = so3::hat<double>(G) + F.transpose() * D;
+    DFt = D * F.transpose();
+    dGFt = dG * F.transpose();
+  }
+
+  /// τ-weighted derivatives C_X(m, e) = Σ_i τ_i ∂X(i, m)/∂ε_e of this step's Jacobian blocks
+  /// X = D, D Fᵀ, dG, dG Fᵀ, all from the scheme's C_D by the product rule with
+  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^.
+  Matrix3 contractD(const DiscreteScheme& scheme, const Vector3& tau) const {
+    return scheme.momentumJacobianContraction(F, omega, tau);
+  }
+  Matrix3 contractDFt(const Matrix3& C_D, const Vector3& tau) const {
+    return F * (C_D - so3::hat<double>(Vector3(D.transpose() * tau)));
+  }
+  Matrix3 contractdG(const DiscreteScheme& scheme, const Vector3& tau) const {
+    const Matrix3 tau_hat = so3::hat<double>(tau);
+    return tau_hat * dG + scheme.momentumJacobianContraction(F, omega, Vector3(F * tau)) -
+           D.transpose() * F * tau_hat;
+  }
+  Matrix3 contractdGFt(const Matrix3& C_dG, const Vector3& tau) const {
+    return F * (C_dG - so3::hat<double>(Vector3(dG.transpose() * tau)));
+  }
+};
+
+}  // namespace
+
+ReducedProblem::ReducedProblem(const PlanningProblem& problem)
+    : N_(problem.steps),
+      scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps),
+      initial_attitude_(problem.initial_attitude),
+      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr) {
+  const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
+  const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
+  steps_.assign(N_, Vector3::Zero());
+  // paper: ω = hΩ exactly; variational: the implicit step's rotation vector
+  steps_[0] = problem.scheme == SchemeKind::Paper
+                  ? Vector3(scheme_.timeStep() * problem.initial_velocity)
+                  : so3::log(F_first);
+  steps_[N_ - 1] = problem.scheme == SchemeKind::Paper
+                       ? Vector3(scheme_.timeStep() * problem.final_velocity)
+                       : so3::log(F_last);
+  // Geodesic from R_1 to R_{N−1} in N − 2 equal steps.
+  const Matrix3 R1 = problem.initial_attitude * F_first;
+  const Matrix3 R_last = problem.final_attitude * F_last.transpose();
+  principal_span_ = so3::log(Matrix3(R1.transpose() * R_last));
+  initializeAlong(principal_span_);
+}
+
+void ReducedProblem::initializeAlong(const Vector3& span) {
+  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = span / double(N_ - 2);
+}
+
+void ReducedProblem::initializeHermite(const Vector3& span, const Vector3& start_slope,
+                                       const Vector3& end_slope) {
+  const auto phi = [&](double s) {
+    const double h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
+                 h11 = s * s * s - s * s;
+    return Vector3(h10 * start_slope + h01 * span + h11 * end_slope);
+  };
+  // Steps between consecutive samples R_1 exp(φ(s_{j−1})), R_1 exp(φ(s_j)), composed in
+  // quaternions; the last sample is exactly R_1 exp(span) = R_{N−1}.
+  Eigen::Vector4d q_prev = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Eigen::Vector4d q = so3::quaternionOfRotationVector<double>(phi(double(j) / (N_ - 2)));
+    Eigen::Vector4d q_prev_inverse = q_prev;
+    q_prev_inverse.tail<3>() *= -1.0;
+    steps_[j] = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(q_prev_inverse, q));
+    q_prev = q;
+  }
+}
+
+void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes) {
+  if (static_cast<int>(attitudes.size()) != N_ + 1) {
+    throw InvalidInput("warm start: has " + std::to_string(attitudes.size() - 1) +
+                       " steps, the problem " + std::to_string(N_));
+  }
+  // The warm start's R_1 and R_{N−1} must be this problem's: keep ours at the ends.
+  const std::vector<Matrix3> own = this->attitudes(steps_);
+  std::vector<Matrix3> R = attitudes;
+  R[0] = own[0];
+  R[1] = own[1];
+  R[N_ - 1] = own[N_ - 1];
+  R[N_] = own[N_];
+  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
+}
+
+namespace {
+
+/// The rate of `coarse` (steps of a grid of coarse.size() steps) at the position of step j of N,
+/// scaled to a step of that grid: step k of N belongs to T k/(N − 1) (see initializeFromCoarser).
+Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N) {
+  const int Nc = static_cast<int>(coarse.size());
+  const auto slope = [&](int k) {
+    if (k == 0) return Vector3(coarse[1] - coarse[0]);
+    if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
+    return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
+  };
+  const double x = double(j) * (Nc - 1) / (N - 1);  // in coarse steps
+  const int i = std::min(static_cast<int>(x), Nc - 2);
+  const double s = x - i;
+  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
+               h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+  return double(Nc) / N *
+         (h00 * coarse[i] + h10 * slope(i) + h01 * coarse[i + 1] + h11 * slope(i + 1));
+}
+
+}  // namespace
+
+void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coarser) {
+  const int Nc = static_cast<int>(coarse.size());
+  if (Nc < 4 || Nc >= N_ ||
+      (coarser && (coarser->size() < 4 || coarser->size() >= coarse.size()))) {
+    throw InvalidInput("grid continuation: a coarse grid of " + std::to_string(Nc) +
+                       " steps cannot start one of " + std::to_string(N_));
+  }
+  // Where a step belongs in time: the boundary data make the first step's rate Ω(0) and the
+  // last one's Ω(T), and the optimal discrete solutions are smooth in k between them (measured),
+  // so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h puts the fixed end steps
+  // a fraction of a coarse step off: O(1) torque jumps at the ends.) Rates ω^c_k/h_c are
+  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a second,
+  // coarser solution the two are extrapolated to this grid's h (Richardson, first order: the
+  // discrete solutions converge like h, docs/accuracy.md), s(h) = s(h₁) − (s(h₂) − s(h₁))
+  // (h₁ − h)/(h₂ − h₁).
+  const double h1 = 1.0 / Nc, h = 1.0 / N_;
+  const double weight = coarser ? (h1 - h) / (1.0 / coarser->size() - h1) : 0.0;
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Vector3 fine = interpolatedStep(coarse, j, N_);
+    steps_[j] =
+        coarser ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_) - fine)) : fine;
+  }
+  // The gap ψ between where the interpolated steps end and R_{N−1} (body frame of R_{N−1}),
+  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ_1 = 0 and φ_{N−1} = ψ, zero end slopes:
+  // F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In quaternions throughout.
+  using Quaternion = Eigen::Vector4d;
+  Quaternion reached = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = 1; j <= N_ - 2; ++j) {
+    reached = so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(steps_[j]));
+  }
+  reached.tail<3>() *= -1.0;  // its inverse
+  const Vector3 gap = so3::logOfQuaternion<double>(
+      so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(principal_span_)));
+  const auto phi = [&](int j) {
+    const double u = double(j - 1) / (N_ - 2);
+    return Vector3((3 * u * u - 2 * u * u * u) * gap);
+  };
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Quaternion q = so3::quaternionProduct<double>(
+        so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-phi(j)),
+                                       so3::quaternionOfRotationVector<double>(steps_[j])),
+        so3::quaternionOfRotationVector<double>(phi(j + 1)));
+    steps_[j] = so3::logOfQuaternion<double>(q);
+  }
+}
+
+std::vector<Matrix3> ReducedProblem::attitudes(const Steps& steps) const {
+  std::vector<Matrix3> R(N_ + 1);
+  R[0] = initial_attitude_;
+  for (int k = 0; k < N_; ++k) R[k + 1] = R[k] * so3::exp(steps[k]);
+  return R;
+}
+
+std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
+  std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
+  const double h = scheme_.timeStep();
+  Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
+  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
+  for (int k = 1; k < N_; ++k) {
+    const Vector3 mu = scheme_.momentumOfStep(steps[k]);
+    // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
+    // cancel in a difference of accurately formed momenta.
+    tau[k] = ((mu - mu_prev) - so3::expMinusIdentity(steps[k - 1]).transpose() * mu_prev) / h;
+    if (effects_) {
+      R = R * so3::exp(steps[k - 1]);
+      tau[k] -= effects_->torque(R, k * h);  // the control supplies what the effects do not
+    }
+    mu_prev = mu;
+  }
+  return tau;
+}
+
+double ReducedProblem::cost(const Steps& steps) const {
+  double c = 0;
+  for (const Vector3& t : torques(steps)) c += 0.5 * t.squaredNorm();
+  return c;
+}
+
+ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
+  Steps out = steps_;
+  const auto perturbation = [&](int j) {
+    const int v = variableIndex(j);
+    return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));
+  };
+  for (int j = 1; j <= N_ - 2; ++j) {
+    const Eigen::Vector4d q = so3::quaternionProduct<double>(
+        so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),
+                                       so3::quaternionOfRotationVector<double>(steps_[j])),
+        so3::quaternionOfRotationVector<double>(perturbation(j + 1)));
+    out[j] = so3::logOfQuaternion<double>(q);
+  }
+  return out;
+}
+
+double ReducedProblem::forEachStencil(bool with_second_order,
+                                      const std::function<void(const Stencil&)>& visit) const {
+  const double h = scheme_.timeStep();
+  const std::vector<Vector3> tau = torques(steps_);
+  double cost = 0.0;
+  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
+  StepTerms prev(scheme_, steps_[0]);
+  Stencil st;
+  st.second.setZero();
+  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
+  for (int k = 1; k < N_; ++k) {
+    StepTerms next(scheme_, steps_[k]);
+    const Matrix3& F = next.F;
+    const Matrix3& F_prev = prev.F;
+    if (effects_) R = R * F_prev;
+    st.k = k;
+    st.tau = tau[k];
+    st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
+    st.jacobian.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
+    st.jacobian.block<3, 3>(0, 6) = next.D / h;
+    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects.
+    if (effects_) st.jacobian.block<3, 3>(0, 3) -= effects_->jacobian(R, k * h);
+    cost += 0.5 * st.tau.squaredNorm();
+    if (with_second_order) {
+      // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
+      Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
+      const Matrix3 C_dG_prev = prev.contractdG(scheme_, st.tau);
+      const Matrix3 C_D = next.contractD(scheme_, st.tau);
+      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, st.tau) / h;  // block a, via ε_{k−1}
+      const Matrix3 T_dG_prev = -C_dG_prev / h;                  // block b, via ε_{k−1}
+      const Matrix3 T_DFt = -next.contractDFt(C_D, st.tau) / h;  // block b, via ε_k
+      const Matrix3 T_D = C_D / h;                               // block c, via ε_k
+      second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
+      second.block<3, 3>(0, 3) = T_dGFt_prev;
+      second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
+      second.block<3, 3>(3, 3) = T_dG_prev - T_DFt * F.transpose();
+      second.block<3, 3>(3, 6) = T_DFt;
+      second.block<3, 3>(6, 3) = -T_D * F.transpose();
+      second.block<3, 3>(6, 6) = T_D;
+      // The antisymmetric part is cancelled exactly by the retraction's derivative
+      // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
+      st.second = 0.5 * (second + second.transpose());
+      if (effects_)
+        st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, st.tau);
+    }
+    visit(st);
+    prev = next;
+  }
+  return cost;
+}
+
+double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
+                                double* gradient_scale) const {
+  gradient->setZero(unknowns());
+  if (hessian) hessian->setZero();
+  double jacobian_scale = 0.0, torque_scale = 0.0;
+  const double cost = forEachStencil(hessian != nullptr, [&](const Stencil& st) {
+    jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
+    torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
+    const Eigen::Matrix<double, 9, 1> g = st.jacobian.transpose() * st.tau;
+    for (int s = 0; s < 3; ++s) {
+      const int v = variableIndex(st.k - 1 + s);
+      if (v >= 0) gradient->segment<3>(v) += g.segment<3>(3 * s);
+    }
+    if (!hessian) return;
+    const Eigen::Matrix<double, 9, 9> block =
+        st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
+    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (first at 3(k − 3)); the
+    // fixed ones among them (R_1, R_{N−1}) are cut off the block.
+    const int first_free = std::max(0, 3 - st.k), last_free = std::min(2, N_ - 1 - st.k);
+    hessian->addSymmetricBlock<9>(3 * (st.k - 3), block, 3 * first_free, 3 * (last_free + 1));
+  });
+  *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
+  return cost;
+}
+
+}  // namespace attitude_planner

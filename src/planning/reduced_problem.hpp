@@ -1,0 +1,105 @@
+// The discrete optimal control problem (seed 000, Problem 3.2) reduced to an unconstrained
+// minimization over the interior attitudes R_2..R_{N−2}.
+//
+// The boundary data fix R_0, R_1 = R_0 F_0 (F_0 from Ω_0), R_{N−1} = R_N F_{N−1}ᵀ (F_{N−1} from
+// Ω_{N−1}) and R_N. Each torque is then an explicit function of three consecutive attitudes
+// (discrete_scheme.hpp):  τ_k = (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h,  F_k = R_kᵀ R_{k+1}, and the
+// problem is min C = Σ_{k=1}^{N−1} ½|τ_k|² over R_2..R_{N−2} (3(N−3) unknowns: the seed's
+// 3(2N−3) unknowns τ, Ω with its 3(N−1) dynamics equations eliminated exactly). ∇C = 0 are the
+// discrete necessary conditions (docs/necessary_conditions.md relates them to the seed's eq. 28).
+//
+// The iterate is stored as the steps' rotation vectors ω_k = log F_k, not as attitudes: torques
+// are second differences of the attitude, and absolute attitudes would lose them to round-off
+// (relative error eps·N² instead of eps·N).
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/banded_matrix.hpp"
+
+namespace attitude_planner {
+
+class ReducedProblem {
+ public:
+  /// Rotation vectors ω_k of the steps F_k = exp(ω_k^), k = 0..N−1 (ω_0, ω_{N−1} fixed).
+  using Steps = std::vector<Vector3>;
+
+  /// What one torque contributes to the Newton system.
+  struct Stencil {
+    int k = 0;                             ///< torque index, 1..N−1
+    Vector3 tau;                           ///< τ_k [N m]
+    Eigen::Matrix<double, 3, 9> jacobian;  ///< ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1})
+    /// sym(Σ_i τ_{k,i} ∂jacobian_i/∂δ): with jacobianᵀ·jacobian, the exact Hessian block.
+    Eigen::Matrix<double, 9, 9> second;
+  };
+
+  /// Fixes the boundary steps and starts on the geodesic from R_1 to R_{N−1}; throws
+  /// StepTooLarge if a boundary velocity has no step.
+  explicit ReducedProblem(const PlanningProblem& problem);
+
+  int steps() const { return N_; }
+  /// Number of unknowns, 3(N − 3).
+  int unknowns() const { return 3 * (N_ - 3); }
+  const DiscreteScheme& scheme() const { return scheme_; }
+
+  const Steps& current() const { return steps_; }
+  void setCurrent(const Steps& steps) { steps_ = steps; }
+  /// log(R_1ᵀ R_{N−1}): the principal rotation vector between the two fixed inner attitudes.
+  Vector3 principalSpan() const { return principal_span_; }
+  /// Interior on the constant-rate rotation by `span` from R_1 (span ≡ principalSpan() modulo
+  /// whole turns about its axis, so that R_{N−1} is still reached).
+  void initializeAlong(const Vector3& span);
+  /// Interior on R_1 exp(φ(s)), s ∈ [0, 1] from R_1 to R_{N−1}: φ the cubic Hermite curve with
+  /// φ(0) = 0, φ(1) = span, φ'(0) = start_slope, φ'(1) = end_slope (body rotation per unit s,
+  /// frame of R_1). Matches boundary velocities, so spinning ends start the solve spinning.
+  void initializeHermite(const Vector3& span, const Vector3& start_slope, const Vector3& end_slope);
+  /// Interior from the attitudes of a maneuver with the same N (a warm start).
+  void setInteriorFromAttitudes(const std::vector<Matrix3>& attitudes);
+  /// Interior from the steps of this problem's solution on a coarser grid (grid continuation):
+  /// the coarse rates ω^c_k/h_c, interpolated in time by a C¹ cubic, times h; then a smooth
+  /// R_j → R_j exp(φ_j^) closes the small gap left at R_{N−1}. Composed in quaternions, so small
+  /// steps keep their relative precision. Its torques differ from the fine solution's by about
+  /// the coarse solution's own discretization error (resampling attitudes instead left O(1)
+  /// torque jumps at the coarse nodes and the ends).
+  /// With `coarser` (the solution on a still coarser grid) the two are extrapolated to this h.
+  void initializeFromCoarser(const Steps& coarse, const Steps* coarser = nullptr);
+
+  /// R_0..R_N of the steps (products from R_0).
+  std::vector<Matrix3> attitudes(const Steps& steps) const;
+  /// τ_k, k = 0..N (τ_0 = τ_N = 0).
+  std::vector<Vector3> torques(const Steps& steps) const;
+  /// C = Σ ½|τ_k|².
+  double cost(const Steps& steps) const;
+
+  /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
+  /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).
+  Steps retract(const Eigen::VectorXd& delta, double alpha) const;
+
+  /// Calls visit(stencil) for k = 1..N−1 at the current iterate; `second` is formed only if
+  /// with_second_order. Returns the cost.
+  double forEachStencil(bool with_second_order,
+                        const std::function<void(const Stencil&)>& visit) const;
+
+  /// Cost, gradient and exact Hessian (normal equations) of δ ↦ C(R_j exp(δ_j^)) at δ = 0.
+  /// `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient); hessian may be null.
+  double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
+                  double* gradient_scale) const;
+
+  /// Index of R_j's first unknown, or −1 if R_j is fixed.
+  int variableIndex(int j) const { return (j >= 2 && j <= N_ - 2) ? 3 * (j - 2) : -1; }
+
+ private:
+  int N_;
+  DiscreteScheme scheme_;
+  Matrix3 initial_attitude_;
+  std::shared_ptr<const EffectModel> effects_;  ///< null when the plan has no external torques
+  Vector3 principal_span_;
+  Steps steps_;
+};
+
+}  // namespace attitude_planner

@@ -1,0 +1,186 @@
+// accuracy_study: what accuracy costs in time (issue 6). For each scene and scheme, solves the
+// continuous reference, then plans at N = 16, 32, ..., max and records the three accuracy
+// measures (accuracy.hpp) and the median solve time; then plans to requested accuracies and
+// compares the planner's estimate with the actual error. Writes one JSON object (raw data for
+// scripts/plot_accuracy.py, which writes docs/accuracy.md and the plots).
+//
+// usage: accuracy_study OUT.json SCENE.yaml... [--max-steps N] [--repeats K]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/analysis/accuracy.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string loadAverage() {
+  double a[3] = {0, 0, 0};
+  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf %lf %lf", &a[0], &a[1], &a[2]) != 3) a[0] = a[1] = a[2] = -1;
+    std::fclose(f);
+  }
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.2f %.2f %.2f", a[0], a[1], a[2]);
+  return buffer;
+}
+
+std::string sceneName(const std::string& path) {
+  std::string base = path.substr(path.find_last_of('/') + 1);
+  return base.substr(0, base.find('.'));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr,
+                 "usage: accuracy_study OUT.json SCENE.yaml... [--max-steps N] [--repeats K]\n");
+    return 2;
+  }
+  const std::string out_path = argv[1];
+  std::vector<std::string> scenes;
+  int max_steps = 8192;
+  int repeats = 3;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--max-steps" && i + 1 < argc) {
+      max_steps = std::atoi(argv[++i]);
+    } else if (a == "--repeats" && i + 1 < argc) {
+      repeats = std::max(1, std::atoi(argv[++i]));
+    } else {
+      scenes.push_back(a);
+    }
+  }
+  FILE* out = std::fopen(out_path.c_str(), "w");
+  if (!out) {
+    std::fprintf(stderr, "accuracy_study: cannot write %s\n", out_path.c_str());
+    return 1;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::fprintf(out, "{\n\"load_average_start\": \"%s\",\n\"repeats\": %d,\n\"cases\": [\n",
+               loadAverage().c_str(), repeats);
+  bool first_case = true;
+  for (const std::string& path : scenes) {
+    Scene scene = loadScene(path);
+    PlanningProblem problem = scene.problem;
+    // The reference, and its self-check at twice the segments and macro steps.
+    auto t0 = std::chrono::steady_clock::now();
+    const ContinuousReference ref = solveContinuousReference(problem);
+    const double ref_time = seconds(t0);
+    ReferenceOptions fine_options;
+    fine_options.segments = 16;
+    fine_options.macro_steps_per_segment = 32;
+    const ContinuousReference fine = solveContinuousReference(problem, fine_options);
+    const ContinuousState mid = ref.stateAt(0.37 * problem.duration);
+    const ContinuousState mid_fine = fine.stateAt(0.37 * problem.duration);
+    std::fprintf(stderr, "%s: reference %s (%.2f s), cost %.15g\n", path.c_str(),
+                 ref.message.c_str(), ref_time, ref.cost);
+    for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+      problem.scheme = scheme;
+      std::fprintf(
+          out,
+          "%s{\"scene\": \"%s\", \"scheme\": \"%s\", \"duration\": %.17g,\n"
+          " \"reference\": {\"converged\": %s, \"cost\": %.17g, \"iterations\": %d, "
+          "\"max_defect\": %.3e, \"integration_error\": %.3e, \"hamiltonian_drift\": %.3e, "
+          "\"solve_time_s\": %.4g, \"cost_vs_finer\": %.3e, \"attitude_vs_finer\": %.3e, "
+          "\"torque_vs_finer\": %.3e},\n \"sweep\": [\n",
+          first_case ? "" : ",\n", sceneName(path).c_str(), schemeName(scheme).c_str(),
+          problem.duration, ref.converged ? "true" : "false", ref.cost, ref.iterations,
+          ref.max_defect, ref.integration_error, ref.hamiltonian_drift, ref_time,
+          std::abs(ref.cost - fine.cost), so3::angleBetween(mid.attitude, mid_fine.attitude),
+          (mid.torque() - mid_fine.torque()).norm());
+      first_case = false;
+      for (int N = 16; N <= max_steps; N *= 2) {
+        problem.steps = N;
+        std::vector<double> times;
+        PlanResult plan;
+        for (int r = 0; r < repeats; ++r) {
+          plan = planManeuver(problem);
+          times.push_back(plan.solve_time_s);
+        }
+        const AccuracyMeasures m = measureAccuracy(problem, plan.maneuver, ref);
+        std::fprintf(out,
+                     "  %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, \"cost\": %.17g, "
+                     "\"cost_integral\": %.17g, \"cost_error\": %.6e, \"trajectory_error\": %.6e, "
+                     "\"torque_error\": %.6e, \"attitude_miss\": %.6e, \"velocity_miss\": %.6e, "
+                     "\"attitude_miss_step_start\": %.6e, \"velocity_miss_step_start\": %.6e}\n",
+                     N == 16 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
+                     plan.cost, m.cost_integral, m.cost_error, m.trajectory_error, m.torque_error,
+                     m.miss.attitude_miss, m.miss.velocity_miss, m.miss_step_start.attitude_miss,
+                     m.miss_step_start.velocity_miss);
+        std::fprintf(stderr, "  %s N=%d %.3g s cost_err %.3e traj %.3e miss %.3e\n",
+                     schemeName(scheme).c_str(), N, median(times), m.cost_error, m.trajectory_error,
+                     m.miss.attitude_miss);
+      }
+      std::fprintf(out, " ],\n \"targets\": [\n");
+      // Plans to a requested accuracy: the planner's estimate against the actual error.
+      struct Request {
+        AccuracyMeasure measure;
+        double value;
+      };
+      const Request requests[] = {
+          {AccuracyMeasure::TerminalMiss, 1e-4}, {AccuracyMeasure::TerminalMiss, 1e-6},
+          {AccuracyMeasure::TerminalMiss, 1e-8}, {AccuracyMeasure::CostError, 1e-2},
+          {AccuracyMeasure::CostError, 1e-3},    {AccuracyMeasure::CostError, 1e-4}};
+      bool first_target = true;
+      for (const Request& q : requests) {
+        PlanningProblem wanted = problem;
+        wanted.accuracy.measure = q.measure;
+        wanted.accuracy.value = q.value;
+        std::vector<double> times;
+        PlanResult plan;
+        for (int r = 0; r < repeats; ++r) {
+          plan = planManeuver(wanted);
+          times.push_back(plan.solve_time_s);
+        }
+        const int N = plan.maneuver.steps();
+        double actual = 0.0;
+        double plain_time = 0.0;
+        if (plan.converged()) {
+          PlanningProblem at_N = problem;
+          at_N.steps = N;
+          const AccuracyMeasures m = measureAccuracy(at_N, plan.maneuver, ref);
+          actual = q.measure == AccuracyMeasure::TerminalMiss ? m.miss.attitude_miss : m.cost_error;
+          std::vector<double> plain;
+          for (int r = 0; r < repeats; ++r) plain.push_back(planManeuver(at_N).solve_time_s);
+          plain_time = median(plain);
+        }
+        std::string tried;
+        for (size_t i = 0; i < plan.accuracy.steps_tried.size(); ++i) {
+          tried += (i ? "," : "") + std::to_string(plan.accuracy.steps_tried[i]);
+        }
+        std::fprintf(out,
+                     "  %s{\"measure\": \"%s\", \"target\": %.3g, \"converged\": %s, \"N\": %d, "
+                     "\"estimated\": %.6e, \"predicted\": %.6e, \"actual\": %.6e, "
+                     "\"solve_time_s\": %.6g, \"plain_solve_time_s\": %.6g, \"tried\": \"%s\"}\n",
+                     first_target ? "" : ",", accuracyMeasureName(q.measure).c_str(), q.value,
+                     plan.converged() ? "true" : "false", N, plan.accuracy.estimated_error,
+                     plan.accuracy.predicted_error, actual, median(times), plain_time,
+                     tried.c_str());
+        first_target = false;
+      }
+      std::fprintf(out, " ]}");
+    }
+  }
+  std::fprintf(out, "\n],\n\"load_average_end\": \"%s\",\n\"wall_time_s\": %.1f\n}\n",
+               loadAverage().c_str(), seconds(start));
+  std::fclose(out);
+  return 0;
+}

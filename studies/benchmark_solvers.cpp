@@ -1,0 +1,1162 @@
+// benchmark_solvers: one solve of the seed's discrete problem (seed 000, Problem 3.2) by one
+// solver, timed, with its peak memory; scripts/benchmark runs it once per process and repetition
+// and writes docs/performance.md.
+//
+// Solvers (all on the same discrete problem; every result is replayed through evaluatePlan so the
+// reported cost and terminal miss are measured the same way for all of them):
+//   newton        ours: Newton on the reduced problem (planManeuver, either scheme)
+//   slsqp         NLopt LD_SLSQP on the direct method, exact gradients (solveWithNlopt)
+//   auglag        NLopt AUGLAG_EQ with an LD_LBFGS subsolver on the same direct method
+//   ipopt         IPOPT on a simultaneous transcription (quaternions q_1..q_N, Ω_1..Ω_{N−2},
+//                 τ_1..τ_{N−1}; kinematics, dynamics and terminal constraints), exact sparse
+//                 Jacobian and exact sparse Hessian of the Lagrangian (only if built with IPOPT)
+//   ipopt_lbfgs   the same, with IPOPT's limited-memory (L-BFGS) Hessian instead (for comparison)
+//   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
+//                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
+//                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
+// Output: one JSON object per line on stdout.
+// --check-hessian compares IPOPT's exact Hessian (eval_h) with central differences of the
+// Lagrangian's gradient (eval_grad_f + eval_jac_gᵀλ) at a random point; exit 0 iff they agree.
+#include <sys/resource.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <nlopt.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "lie/dual.hpp"
+#include "planning/direct_method.hpp"
+#include "planning/reduced_problem.hpp"
+#include "planning/solvers.hpp"
+
+#ifdef AP_HAVE_IPOPT
+#include <coin/IpIpoptApplication.hpp>
+#include <coin/IpTNLP.hpp>
+#endif
+
+#ifdef AP_HAVE_IPOPT
+// ---- second-order forward mode for IPOPT's exact Hessian -----------------------------------
+namespace benchmark_ad {
+
+/// Hyper-dual number for N variables: value, gradient and (full, symmetric) Hessian, propagated
+/// exactly through +, −, ×, ÷, sqrt, sin, cos. Usable as an Eigen scalar, so the templated
+/// ap::so3 formulas (quaternionOfRotationVector, exp) give exact second derivatives. Branches
+/// compare values only, as ap::Dual does. Benchmark code only (ap::Dual does not nest).
+template <int N>
+struct HyperDual {
+  double v = 0.0;
+  double g[N] = {};
+  double H[N][N] = {};
+
+  HyperDual() = default;
+  HyperDual(double value) : v(value) {}  // NOLINT: implicit from constants, as Eigen expects
+  HyperDual(double value, int direction) : v(value) { g[direction] = 1.0; }
+
+  HyperDual& operator+=(const HyperDual& o) {
+    v += o.v;
+    for (int i = 0; i < N; ++i) g[i] += o.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] += o.H[i][j];
+    return *this;
+  }
+  HyperDual& operator-=(const HyperDual& o) {
+    v -= o.v;
+    for (int i = 0; i < N; ++i) g[i] -= o.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] -= o.H[i][j];
+    return *this;
+  }
+  /// (ab)'' = a b'' + b a'' + a' b'ᵀ + b' a'ᵀ
+  HyperDual& operator*=(const HyperDual& o) {
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j)
+        H[i][j] = v * o.H[i][j] + o.v * H[i][j] + g[i] * o.g[j] + o.g[i] * g[j];
+    for (int i = 0; i < N; ++i) g[i] = g[i] * o.v + o.g[i] * v;
+    v *= o.v;
+    return *this;
+  }
+  HyperDual& operator/=(const HyperDual& o) { return *this *= reciprocal(o); }
+  HyperDual& scale(double s) {
+    v *= s;
+    for (int i = 0; i < N; ++i) g[i] *= s;
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) H[i][j] *= s;
+    return *this;
+  }
+  HyperDual operator-() const { return HyperDual(*this).scale(-1.0); }
+  HyperDual operator+() const { return *this; }
+
+  /// f(a) given f, f′, f″ at a.v: f(a)′ = f′ a′, f(a)″ = f′ a″ + f″ a′ a′ᵀ.
+  static HyperDual chain(const HyperDual& a, double f, double df, double d2f) {
+    HyperDual r;
+    r.v = f;
+    for (int i = 0; i < N; ++i) r.g[i] = df * a.g[i];
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) r.H[i][j] = df * a.H[i][j] + d2f * a.g[i] * a.g[j];
+    return r;
+  }
+  static HyperDual reciprocal(const HyperDual& a) {
+    const double inv = 1.0 / a.v;
+    return chain(a, inv, -inv * inv, 2.0 * inv * inv * inv);
+  }
+};
+
+template <int N>
+HyperDual<N> operator+(HyperDual<N> a, const HyperDual<N>& b) {
+  return a += b;
+}
+template <int N>
+HyperDual<N> operator-(HyperDual<N> a, const HyperDual<N>& b) {
+  return a -= b;
+}
+template <int N>
+HyperDual<N> operator*(HyperDual<N> a, const HyperDual<N>& b) {
+  return a *= b;
+}
+template <int N>
+HyperDual<N> operator/(HyperDual<N> a, const HyperDual<N>& b) {
+  return a /= b;
+}
+template <int N>
+HyperDual<N> operator+(HyperDual<N> a, double b) {
+  a.v += b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator+(double b, HyperDual<N> a) {
+  a.v += b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator-(HyperDual<N> a, double b) {
+  a.v -= b;
+  return a;
+}
+template <int N>
+HyperDual<N> operator-(double b, const HyperDual<N>& a) {
+  HyperDual<N> r = -a;
+  r.v += b;
+  return r;
+}
+template <int N>
+HyperDual<N> operator*(HyperDual<N> a, double b) {
+  return a.scale(b);
+}
+template <int N>
+HyperDual<N> operator*(double b, HyperDual<N> a) {
+  return a.scale(b);
+}
+template <int N>
+HyperDual<N> operator/(HyperDual<N> a, double b) {
+  return a.scale(1.0 / b);
+}
+template <int N>
+HyperDual<N> operator/(double b, const HyperDual<N>& a) {
+  return HyperDual<N>::reciprocal(a).scale(b);
+}
+template <int N>
+bool operator<(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v < b.v;
+}
+template <int N>
+bool operator>(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v > b.v;
+}
+template <int N>
+bool operator<=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v <= b.v;
+}
+template <int N>
+bool operator>=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v >= b.v;
+}
+template <int N>
+bool operator==(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v == b.v;
+}
+template <int N>
+bool operator!=(const HyperDual<N>& a, const HyperDual<N>& b) {
+  return a.v != b.v;
+}
+template <int N>
+HyperDual<N> sqrt(const HyperDual<N>& a) {
+  const double s = std::sqrt(a.v);
+  return HyperDual<N>::chain(a, s, 0.5 / s, -0.25 / (s * a.v));
+}
+template <int N>
+HyperDual<N> sin(const HyperDual<N>& a) {
+  const double s = std::sin(a.v);
+  return HyperDual<N>::chain(a, s, std::cos(a.v), -s);
+}
+template <int N>
+HyperDual<N> cos(const HyperDual<N>& a) {
+  const double c = std::cos(a.v);
+  return HyperDual<N>::chain(a, c, -std::sin(a.v), -c);
+}
+template <int N>
+HyperDual<N> abs(const HyperDual<N>& a) {
+  return a.v < 0 ? -a : a;
+}
+
+}  // namespace benchmark_ad
+
+namespace Eigen {
+template <int N>
+struct NumTraits<benchmark_ad::HyperDual<N>> : NumTraits<double> {
+  using Real = benchmark_ad::HyperDual<N>;
+  using NonInteger = benchmark_ad::HyperDual<N>;
+  using Nested = benchmark_ad::HyperDual<N>;
+  using Literal = benchmark_ad::HyperDual<N>;
+  enum {
+    IsComplex = 0,
+    IsInteger = 0,
+    IsSigned = 1,
+    RequireInitialization = 1,
+    ReadCost = 1,
+    AddCost = 1 + N + N * N,
+    MulCost = 1 + 3 * N + 4 * N * N
+  };
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<benchmark_ad::HyperDual<N>, double, BinaryOp> {
+  using ReturnType = benchmark_ad::HyperDual<N>;
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<double, benchmark_ad::HyperDual<N>, BinaryOp> {
+  using ReturnType = benchmark_ad::HyperDual<N>;
+};
+}  // namespace Eigen
+#endif
+
+namespace ap = attitude_planner;
+using ap::Matrix3;
+using ap::Vector3;
+
+namespace {
+
+const char* const kUsage =
+    "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
+    "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
+    "                         [--time-budget S] [--in-process K]\n"
+    "       benchmark_solvers --quick   every solver on the seed's rest-to-rest example, N = 16\n"
+    "       benchmark_solvers --check-hessian [--steps N]   IPOPT's exact Hessian against central\n"
+    "                         differences of its exact gradients (exit 0 iff relative error <= "
+    "1e-6;\n"
+    "                         exit 3 if this build has no IPOPT)\n"
+    "Prints one JSON line: solver, scheme, steps, time_s, iterations, cost, converged,\n"
+    "terminal_miss, peak_rss_kb, message. Without --scene: the seed's rest-to-rest example.\n";
+
+/// What a peer returns: the torques τ_0..τ_N and its own account.
+struct PeerOutcome {
+  std::vector<Vector3> torque;
+  int iterations = 0;
+  bool ok = false;
+  std::string message;
+};
+
+/// The seed's rest-to-rest example (scenes/rest_to_rest.yaml): π/3 about x in 12.8 s.
+ap::PlanningProblem seedRestToRest(int steps) {
+  ap::PlanningProblem p;
+  p.inertia << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
+  p.duration = 12.8;
+  p.steps = steps;
+  p.final_attitude = ap::so3::exp(Vector3(M_PI / 3.0, 0.0, 0.0));
+  p.allow_nonphysical_inertia = true;
+  return p;
+}
+
+/// Peak resident set size of this process [kB] (VmHWM).
+long peakRssKb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::atol(line.c_str() + 6);
+  }
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss;
+}
+
+/// The geodesic start every peer shares with ours: steps ω_k of ReducedProblem's initial guess.
+std::vector<Vector3> geodesicSteps(const ap::PlanningProblem& problem) {
+  return ap::ReducedProblem(problem).current();
+}
+
+std::vector<Vector3> geodesicTorques(const ap::PlanningProblem& problem) {
+  const ap::ReducedProblem reduced(problem);
+  return reduced.torques(reduced.current());
+}
+
+// ---- NLopt AUGLAG + LBFGS on the direct method ---------------------------------------------
+
+struct AuglagData {
+  const ap::PlanningProblem* problem = nullptr;
+  int evaluations = 0;
+};
+
+double auglagObjective(unsigned n, const double* x, double* grad, void* data) {
+  ++static_cast<AuglagData*>(data)->evaluations;
+  double f = 0.0;
+  for (unsigned i = 0; i < n; ++i) {
+    f += 0.5 * x[i] * x[i];
+    if (grad) grad[i] = x[i];
+  }
+  return f;
+}
+
+void auglagConstraints(unsigned m, double* result, unsigned n, const double* x_raw, double* grad,
+                       void* data) {
+  auto* d = static_cast<AuglagData*>(data);
+  const Eigen::Map<const Eigen::VectorXd> x(x_raw, n);
+  try {
+    const ap::TerminalConstraints c = ap::evaluateTerminalConstraints(*d->problem, x, grad);
+    for (unsigned i = 0; i < m; ++i) result[i] = c.value(i);
+    if (grad) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          grad, m, n) = c.jacobian;
+    }
+  } catch (const ap::StepTooLarge&) {
+    for (unsigned i = 0; i < m; ++i) result[i] = 1e3;
+    if (grad) std::fill(grad, grad + static_cast<std::size_t>(m) * n, 0.0);
+  }
+}
+
+PeerOutcome solveAuglag(const ap::PlanningProblem& problem, double time_budget) {
+  const int N = problem.steps;
+  const unsigned n = 3u * static_cast<unsigned>(N - 1);
+  const Eigen::VectorXd start = ap::unknownsFromTorqueSequence(geodesicTorques(problem));
+  std::vector<double> x(start.data(), start.data() + n);
+  AuglagData data{&problem, 0};
+  nlopt::opt opt(nlopt::AUGLAG_EQ, n);
+  nlopt::opt local(nlopt::LD_LBFGS, n);
+  // Inner tolerances tighter than round-off make LBFGS stop with a generic failure; these are the
+  // tightest that let the outer iteration proceed.
+  local.set_ftol_rel(1e-14);
+  local.set_xtol_rel(1e-12);
+  local.set_vector_storage(20);
+  opt.set_local_optimizer(local);
+  opt.set_min_objective(auglagObjective, &data);
+  opt.add_equality_mconstraint(auglagConstraints, &data,
+                               std::vector<double>(ap::kTerminalConstraints, 1e-12));
+  opt.set_xtol_rel(1e-13);
+  opt.set_ftol_rel(1e-15);
+  opt.set_maxtime(time_budget);
+  PeerOutcome out;
+  double f = 0.0;
+  nlopt::result code = nlopt::FAILURE;
+  try {
+    code = opt.optimize(x, f);
+  } catch (const nlopt::roundoff_limited& e) {
+    code = nlopt::ROUNDOFF_LIMITED;  // x holds the last iterate; judged by its cost and miss
+    out.message = e.what();
+  } catch (const std::exception& e) {
+    out.message = e.what();
+  }
+  out.ok = (code > 0 && code != nlopt::MAXTIME_REACHED) || code == nlopt::ROUNDOFF_LIMITED;
+  out.message += " nlopt code " + std::to_string(static_cast<int>(code));
+  out.iterations = data.evaluations;  // objective evaluations (LBFGS iterations + line search)
+  out.torque = ap::torqueSequenceFromUnknowns(Eigen::Map<const Eigen::VectorXd>(x.data(), n));
+  return out;
+}
+
+// ---- IPOPT on a simultaneous transcription -------------------------------------------------
+
+#ifdef AP_HAVE_IPOPT
+using Quaternion = Eigen::Vector4d;  // (w, x, y, z), Hamilton
+
+/// Q(q) with q ⊗ p = left(q) p.
+Eigen::Matrix4d leftProduct(const Quaternion& q) {
+  Eigen::Matrix4d L;
+  L << q(0), -q(1), -q(2), -q(3), q(1), q(0), -q(3), q(2), q(2), q(3), q(0), -q(1), q(3), -q(2),
+      q(1), q(0);
+  return L;
+}
+/// p ⊗ q = right(q) p.
+Eigen::Matrix4d rightProduct(const Quaternion& q) {
+  Eigen::Matrix4d R;
+  R << q(0), -q(1), -q(2), -q(3), q(1), q(0), q(3), -q(2), q(2), -q(3), q(0), q(1), q(3), q(2),
+      -q(1), q(0);
+  return R;
+}
+
+/// Simultaneous transcription of the paper scheme. Unknowns: q_1..q_N (4 each), Ω_1..Ω_{N−2}
+/// (3 each), τ_1..τ_{N−1} (3 each). Constraints:
+///   kinematics  q_{k+1} − q_k ⊗ e(hΩ_k) = 0,                 k = 0..N−1 (4 each)
+///   dynamics    exp(hΩ_k^) J Ω_k − J Ω_{k−1} − h τ_k = 0,    k = 1..N−1 (3 each; eq. (18))
+///   terminal    vec(q_N*⁻¹ ⊗ q_N) = 0                        (3)
+/// with q_0, Ω_0, Ω_{N−1} the boundary data. Every constraint is local: the KKT matrix is banded.
+/// Hessian of the Lagrangian σ f + Σ λ_i g_i (exact_hessian): per k = 1..N−2 the (q_k, Ω_k)
+/// block of the kinematics (q_k ⊗ e(hΩ_k) is bilinear in q_k and e, so no q_k q_k part) plus the
+/// Ω_k Ω_k block of the dynamics, and σ on the τ diagonal; the terminal constraint is linear.
+class TranscriptionNlp : public Ipopt::TNLP {
+ public:
+  TranscriptionNlp(const ap::PlanningProblem& p, bool exact_hessian)
+      : p_(p), N_(p.steps), h_(p.duration / p.steps), exact_hessian_(exact_hessian) {
+    q0_ = ap::so3::quaternionCoefficients<double>(p.initial_attitude);
+    qN_ = ap::so3::quaternionCoefficients<double>(p.final_attitude);
+  }
+  int Q(int k) const { return 4 * (k - 1); }                          // k = 1..N
+  int W(int k) const { return 4 * N_ + 3 * (k - 1); }                 // k = 1..N−2
+  int T(int k) const { return 4 * N_ + 3 * (N_ - 2) + 3 * (k - 1); }  // k = 1..N−1
+  int n() const { return 4 * N_ + 3 * (N_ - 2) + 3 * (N_ - 1); }
+  int m() const { return 4 * N_ + 3 * (N_ - 1) + 3; }
+  int iterations = 0;
+  std::vector<Vector3> torque;
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = this->n();
+    m = this->m();
+    buildPattern();
+    nnz_jac = static_cast<Ipopt::Index>(rows_.size());
+    nnz_h = exact_hessian_ ? static_cast<Ipopt::Index>(hrows_.size()) : 0;
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
+                       Ipopt::Number* gl, Ipopt::Number* gu) override {
+    for (int i = 0; i < n; ++i) xl[i] = -1e19, xu[i] = 1e19;
+    for (int i = 0; i < m; ++i) gl[i] = gu[i] = 0.0;
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index, bool, Ipopt::Number* x, bool, Ipopt::Number*,
+                          Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
+    // The geodesic start ours uses (feasible: the torques are its dynamics' torques).
+    const std::vector<Vector3> w = geodesicSteps(p_);
+    const ap::ReducedProblem reduced(p_);
+    const std::vector<Vector3> tau = reduced.torques(w);
+    Quaternion q = q0_;
+    for (int k = 0; k < N_; ++k) {
+      q = ap::so3::quaternionProduct<double>(
+          q, ap::so3::quaternionOfRotationVector<double>(Vector3(w[k])));
+      Eigen::Map<Quaternion>(x + Q(k + 1)) = q;
+    }
+    for (int k = 1; k <= N_ - 2; ++k) Eigen::Map<Vector3>(x + W(k)) = w[k] / h_;
+    for (int k = 1; k <= N_ - 1; ++k) Eigen::Map<Vector3>(x + T(k)) = tau[k];
+    return true;
+  }
+  bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    f = 0.0;
+    for (int i = T(1); i < n(); ++i) f += 0.5 * x[i] * x[i];
+    return true;
+  }
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    for (int i = 0; i < n; ++i) g[i] = i >= T(1) ? x[i] : 0.0;
+    return true;
+  }
+  bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Number* g) override {
+    for (int k = 0; k < N_; ++k) {
+      const Quaternion qk = k == 0 ? q0_ : Quaternion(Eigen::Map<const Quaternion>(x + Q(k)));
+      const Quaternion e = ap::so3::quaternionOfRotationVector<double>(Vector3(h_ * omega(x, k)));
+      Eigen::Map<Quaternion>(g + 4 * k) =
+          Eigen::Map<const Quaternion>(x + Q(k + 1)) - ap::so3::quaternionProduct<double>(qk, e);
+    }
+    const Matrix3& J = p_.inertia;
+    for (int k = 1; k <= N_ - 1; ++k) {
+      const Vector3 w = omega(x, k);
+      Eigen::Map<Vector3>(g + 4 * N_ + 3 * (k - 1)) = ap::so3::exp(Vector3(h_ * w)) * (J * w) -
+                                                      J * omega(x, k - 1) -
+                                                      h_ * Eigen::Map<const Vector3>(x + T(k));
+    }
+    const Quaternion qN(Eigen::Map<const Quaternion>(x + Q(N_)));
+    const Quaternion conj(qN_(0), -qN_(1), -qN_(2), -qN_(3));
+    Eigen::Map<Vector3>(g + 4 * N_ + 3 * (N_ - 1)) =
+        ap::so3::quaternionProduct<double>(conj, qN).tail<3>();
+    return true;
+  }
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index* iRow, Ipopt::Index* jCol, Ipopt::Number* values) override {
+    if (!values) {
+      for (std::size_t i = 0; i < rows_.size(); ++i) iRow[i] = rows_[i], jCol[i] = cols_[i];
+      return true;
+    }
+    using Dual3 = ap::Dual<3>;
+    std::size_t z = 0;
+    const Matrix3& J = p_.inertia;
+    for (int k = 0; k < N_; ++k) {
+      // q_{k+1}: identity
+      for (int i = 0; i < 4; ++i) values[z++] = 1.0;
+      const Vector3 w = omega(x, k);
+      const Quaternion e = ap::so3::quaternionOfRotationVector<double>(Vector3(h_ * w));
+      const Quaternion qk = k == 0 ? q0_ : Quaternion(Eigen::Map<const Quaternion>(x + Q(k)));
+      if (k >= 1) {
+        const Eigen::Matrix4d D = -rightProduct(e);
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) values[z++] = D(r, c);
+      }
+      if (k >= 1 && k <= N_ - 2) {
+        ap::so3::Vec3<Dual3> wd;
+        for (int i = 0; i < 3; ++i) wd(i) = Dual3(h_ * w(i), i);
+        const Eigen::Matrix<Dual3, 4, 1> ed = ap::so3::quaternionOfRotationVector<Dual3>(wd);
+        Eigen::Matrix<double, 4, 3> de;
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 3; ++c) de(r, c) = h_ * ed(r).d(c);
+        const Eigen::Matrix<double, 4, 3> D = -leftProduct(qk) * de;
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 3; ++c) values[z++] = D(r, c);
+      }
+    }
+    for (int k = 1; k <= N_ - 1; ++k) {
+      if (k <= N_ - 2) {  // ∂/∂Ω_k of exp(hΩ^) J Ω
+        const Vector3 w = omega(x, k);
+        ap::so3::Vec3<Dual3> wd;
+        for (int i = 0; i < 3; ++i) wd(i) = Dual3(w(i), i);
+        const ap::so3::Vec3<Dual3> f =
+            ap::so3::exp<Dual3>(ap::so3::Vec3<Dual3>(wd * h_)) * (J.cast<Dual3>() * wd);
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) values[z++] = f(r).d(c);
+      }
+      if (k - 1 >= 1) {
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) values[z++] = -J(r, c);
+      }
+      for (int i = 0; i < 3; ++i) values[z++] = -h_;
+    }
+    const Quaternion conj(qN_(0), -qN_(1), -qN_(2), -qN_(3));
+    const Eigen::Matrix4d L = leftProduct(conj);
+    for (int r = 1; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) values[z++] = L(r, c);
+    return true;
+  }
+  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
+              const Ipopt::Number* lambda, bool, Ipopt::Index, Ipopt::Index* iRow,
+              Ipopt::Index* jCol, Ipopt::Number* values) override {
+    if (!exact_hessian_) return false;
+    if (!values) {
+      for (std::size_t i = 0; i < hrows_.size(); ++i) iRow[i] = hrows_[i], jCol[i] = hcols_[i];
+      return true;
+    }
+    using HD = benchmark_ad::HyperDual<3>;
+    const Matrix3& J = p_.inertia;
+    std::size_t z = 0;
+    for (int k = 1; k <= N_ - 2; ++k) {
+      const Vector3 w = omega(x, k);
+      const Quaternion qk(Eigen::Map<const Quaternion>(x + Q(k)));
+      const Quaternion mu(Eigen::Map<const Quaternion>(lambda + 4 * k));           // kinematics k
+      const Vector3 nu(Eigen::Map<const Vector3>(lambda + 4 * N_ + 3 * (k - 1)));  // dynamics k
+      ap::so3::Vec3<HD> wd;
+      for (int i = 0; i < 3; ++i) wd(i) = HD(w(i), i);
+      // Kinematics, −μᵀ(q_k ⊗ e(hΩ_k)): e and its first and second derivatives in Ω_k.
+      const Eigen::Matrix<HD, 4, 1> e =
+          ap::so3::quaternionOfRotationVector<HD>(ap::so3::Vec3<HD>(wd * h_));
+      // ∂²/∂Ω_j ∂q_k = −R(∂e/∂Ω_j)ᵀ μ   (q ⊗ p = right(p) q)
+      for (int j = 0; j < 3; ++j) {
+        const Quaternion de(e(0).g[j], e(1).g[j], e(2).g[j], e(3).g[j]);
+        const Quaternion col = -rightProduct(de).transpose() * mu;
+        for (int a = 0; a < 4; ++a) values[z++] = col(a);
+      }
+      // ∂²/∂Ω² of −μᵀ L(q_k) e = Σ_r c_r ∂²e_r, c = −L(q_k)ᵀ μ; plus νᵀ exp(hΩ^) J Ω.
+      const Quaternion c = -leftProduct(qk).transpose() * mu;
+      const ap::so3::Vec3<HD> f =
+          ap::so3::exp<HD>(ap::so3::Vec3<HD>(wd * h_)) * (J.cast<HD>() * wd);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j <= i; ++j) {
+          double v = 0.0;
+          for (int r = 0; r < 4; ++r) v += c(r) * e(r).H[i][j];
+          for (int r = 0; r < 3; ++r) v += nu(r) * f(r).H[i][j];
+          values[z++] = v;
+        }
+      }
+    }
+    for (int k = 1; k <= N_ - 1; ++k)
+      for (int i = 0; i < 3; ++i) values[z++] = obj_factor;
+    return true;
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    torque.assign(N_ + 1, Vector3::Zero());
+    for (int k = 1; k <= N_ - 1; ++k) torque[k] = Eigen::Map<const Vector3>(x + T(k));
+  }
+
+ private:
+  /// Ω_k: unknown for k = 1..N−2, boundary data for k = 0 and N−1.
+  Vector3 omega(const double* x, int k) const {
+    if (k == 0) return p_.initial_velocity;
+    if (k == N_ - 1) return p_.final_velocity;
+    return Eigen::Map<const Vector3>(x + W(k));
+  }
+  void buildPattern() {
+    rows_.clear();
+    cols_.clear();
+    const auto block = [&](int r0, int c0, int nr, int nc, bool diagonal) {
+      for (int r = 0; r < nr; ++r)
+        for (int c = 0; c < nc; ++c)
+          if (!diagonal || r == c) rows_.push_back(r0 + r), cols_.push_back(c0 + c);
+    };
+    for (int k = 0; k < N_; ++k) {
+      block(4 * k, Q(k + 1), 4, 4, true);
+      if (k >= 1) block(4 * k, Q(k), 4, 4, false);
+      if (k >= 1 && k <= N_ - 2) block(4 * k, W(k), 4, 3, false);
+    }
+    for (int k = 1; k <= N_ - 1; ++k) {
+      const int r0 = 4 * N_ + 3 * (k - 1);
+      if (k <= N_ - 2) block(r0, W(k), 3, 3, false);
+      if (k - 1 >= 1) block(r0, W(k - 1), 3, 3, false);
+      block(r0, T(k), 3, 3, true);
+    }
+    block(4 * N_ + 3 * (N_ - 1), Q(N_), 3, 4, false);
+    // Hessian, lower triangle (row ≥ column; every W index exceeds every Q index), in eval_h's
+    // order: per k = 1..N−2 the Ω_k × q_k block (row-major), the Ω_k Ω_k lower triangle; then
+    // the τ diagonal.
+    hrows_.clear();
+    hcols_.clear();
+    for (int k = 1; k <= N_ - 2; ++k) {
+      for (int j = 0; j < 3; ++j)
+        for (int a = 0; a < 4; ++a) hrows_.push_back(W(k) + j), hcols_.push_back(Q(k) + a);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) hrows_.push_back(W(k) + i), hcols_.push_back(W(k) + j);
+    }
+    for (int k = 1; k <= N_ - 1; ++k)
+      for (int i = 0; i < 3; ++i) hrows_.push_back(T(k) + i), hcols_.push_back(T(k) + i);
+  }
+
+  ap::PlanningProblem p_;
+  int N_;
+  double h_;
+  bool exact_hessian_;
+  Quaternion q0_, qN_;
+  std::vector<int> rows_, cols_;
+  std::vector<int> hrows_, hcols_;
+};
+
+/// exact_hessian: IPOPT's Newton steps use eval_h; otherwise its L-BFGS approximation.
+PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, bool exact_hessian) {
+  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, exact_hessian);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->Options()->SetIntegerValue("print_level", 0);
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetStringValue("hessian_approximation",
+                                 exact_hessian ? "exact" : "limited-memory");
+  app->Options()->SetNumericValue("tol", 1e-12);
+  app->Options()->SetNumericValue("constr_viol_tol", 1e-12);
+  app->Options()->SetIntegerValue("max_iter", 5000);
+  app->Options()->SetNumericValue("max_cpu_time", time_budget);
+  PeerOutcome out;
+  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+    out.message = "IPOPT initialization failed";
+    return out;
+  }
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(nlp);
+  out.ok = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+  out.message = "ipopt status " + std::to_string(static_cast<int>(status));
+  out.iterations = nlp->iterations;
+  out.torque = nlp->torque;
+  return out;
+}
+
+/// --check-hessian: eval_h against central differences of ∇L = σ∇f + Jᵀλ (both from the exact
+/// first derivatives, eval_grad_f and eval_jac_g) at a random point with random multipliers.
+/// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
+/// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
+/// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
+int checkHessian(int steps) {
+  ap::PlanningProblem problem = seedRestToRest(steps);
+  problem.initial_velocity = Vector3(0.02, -0.01, 0.03);  // nonzero boundary data too
+  problem.final_velocity = Vector3(-0.01, 0.02, 0.01);
+  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, true);
+  Ipopt::Index n = 0, m = 0, nnz_jac = 0, nnz_h = 0;
+  Ipopt::TNLP::IndexStyleEnum style;
+  nlp->get_nlp_info(n, m, nnz_jac, nnz_h, style);
+  std::vector<double> x(n), lambda(m);
+  nlp->get_starting_point(n, true, x.data(), false, nullptr, nullptr, m, false, nullptr);
+  std::mt19937 rng(20240611);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int k = 1; k <= steps; ++k)
+    for (int i = 0; i < 4; ++i) x[nlp->Q(k) + i] += 0.1 * uniform(rng);
+  for (int k = 1; k <= steps - 2; ++k)
+    for (int i = 0; i < 3; ++i) x[nlp->W(k) + i] += 0.4 * uniform(rng);
+  if (steps >= 4) {
+    for (int i = 0; i < 3; ++i) x[nlp->W(2) + i] = 1e-7 * uniform(rng);  // series branch
+  }
+  for (int k = 1; k <= steps - 1; ++k)
+    for (int i = 0; i < 3; ++i) x[nlp->T(k) + i] += uniform(rng);
+  for (double& l : lambda) l = uniform(rng);
+  const double sigma = 0.7;
+
+  // The exact Hessian, dense and symmetric; the pattern must be the lower triangle, no repeats.
+  std::vector<Ipopt::Index> hr(nnz_h), hc(nnz_h);
+  std::vector<double> hv(nnz_h);
+  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, hr.data(), hc.data(),
+              nullptr);
+  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, nullptr, nullptr, hv.data());
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXi seen = Eigen::MatrixXi::Zero(n, n);
+  int pattern_errors = 0;
+  for (int i = 0; i < nnz_h; ++i) {
+    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0 || seen(hr[i], hc[i])++) ++pattern_errors;
+    H(hr[i], hc[i]) = hv[i];
+    H(hc[i], hr[i]) = hv[i];
+  }
+
+  // ∇L from the exact first derivatives.
+  std::vector<Ipopt::Index> jr(nnz_jac), jc(nnz_jac);
+  std::vector<double> jv(nnz_jac), grad(n);
+  nlp->eval_jac_g(n, x.data(), true, m, nnz_jac, jr.data(), jc.data(), nullptr);
+  const auto gradient = [&](const std::vector<double>& y) {
+    Eigen::VectorXd gl(n);
+    nlp->eval_grad_f(n, y.data(), true, grad.data());
+    nlp->eval_jac_g(n, y.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
+    for (int i = 0; i < n; ++i) gl(i) = sigma * grad[i];
+    for (int i = 0; i < nnz_jac; ++i) gl(jc[i]) += lambda[jr[i]] * jv[i];
+    return gl;
+  };
+  constexpr double kStep = 1e-5;
+  Eigen::MatrixXd fd(n, n);
+  std::vector<double> y = x;
+  for (int j = 0; j < n; ++j) {
+    y[j] = x[j] + kStep;
+    const Eigen::VectorXd plus = gradient(y);
+    y[j] = x[j] - kStep;
+    const Eigen::VectorXd minus = gradient(y);
+    y[j] = x[j];
+    fd.col(j) = (plus - minus) / (2.0 * kStep);
+  }
+  // The FD matrix is symmetric only up to its own error: compare with its symmetric part and
+  // report the asymmetry (a bound on the FD error) separately.
+  const double asymmetry = (fd - fd.transpose()).cwiseAbs().maxCoeff();
+  const Eigen::MatrixXd fd_sym = 0.5 * (fd + fd.transpose());
+  const double scale = H.cwiseAbs().maxCoeff();
+  const double error = (H - fd_sym).cwiseAbs().maxCoeff();
+  double outside = 0.0;  // largest FD entry where the pattern has none
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (!seen(std::max(i, j), std::min(i, j)))
+        outside = std::max(outside, std::abs(fd_sym(i, j)));
+  // Entrywise, on the entries that are not negligible.
+  double entry_error = 0.0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (std::abs(H(i, j)) > 1e-3 * scale)
+        entry_error = std::max(entry_error, std::abs(H(i, j) - fd_sym(i, j)) / std::abs(H(i, j)));
+  const double relative = error / scale;
+  const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale;
+  std::printf(
+      "{\"check\": \"hessian\", \"steps\": %d, \"n\": %d, \"nnz_h\": %d, \"fd_step\": %g, "
+      "\"max_abs_entry\": %.6g, \"max_abs_error\": %.3g, \"relative_error\": %.3g, "
+      "\"max_entry_relative_error\": %.3g, \"fd_outside_pattern\": %.3g, \"fd_asymmetry\": "
+      "%.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
+      steps, static_cast<int>(n), static_cast<int>(nnz_h), kStep, scale, error, relative,
+      entry_error, outside, asymmetry, pattern_errors, pass ? "true" : "false");
+  return pass ? 0 : 1;
+}
+#endif
+
+// ---- the seed's approach: Newton on the necessary conditions, dense complex-step Jacobian ----
+
+using Complex = std::complex<double>;
+double realPart(double x) {
+  return x;
+}
+double realPart(const Complex& x) {
+  return x.real();
+}
+
+template <typename S>
+using V3 = Eigen::Matrix<S, 3, 1>;
+template <typename S>
+using M3 = Eigen::Matrix<S, 3, 3>;
+
+/// Σ a_i b_i without conjugation (Eigen's dot conjugates complex scalars, which would break the
+/// complex step: every function below must stay analytic in its argument).
+template <typename S>
+S plainDot(const V3<S>& a, const V3<S>& b) {
+  return a(0) * b(0) + a(1) * b(1) + a(2) * b(2);
+}
+
+/// a × b without conjugation (Eigen's cross conjugates its result for complex scalars).
+template <typename S>
+V3<S> plainCross(const V3<S>& a, const V3<S>& b) {
+  return V3<S>(a(1) * b(2) - a(2) * b(1), a(2) * b(0) - a(0) * b(2), a(0) * b(1) - a(1) * b(0));
+}
+
+template <typename S>
+M3<S> hatOf(const V3<S>& v) {
+  M3<S> m;
+  m << S(0), -v(2), v(1), v(2), S(0), -v(0), -v(1), v(0), S(0);
+  return m;
+}
+
+/// exp(w^) (Rodrigues), analytic in w so the complex step differentiates it.
+template <typename S>
+M3<S> expOf(const V3<S>& w) {
+  const S t2 = plainDot<S>(w, w);
+  S a, b;
+  if (std::abs(realPart(t2)) < 1e-8) {
+    a = S(1) - t2 / 6.0 + t2 * t2 / 120.0;
+    b = S(0.5) - t2 / 24.0 + t2 * t2 / 720.0;
+  } else {
+    const S t = std::sqrt(t2);
+    a = std::sin(t) / t;
+    b = (S(1) - std::cos(t)) / t2;
+  }
+  const M3<S> W = hatOf<S>(w);
+  return M3<S>::Identity() + a * W + b * W * W;
+}
+
+/// Jr⁻¹(w) = I + ½ w^ + c w^², c = (1 − (θ/2) cot(θ/2))/θ².
+template <typename S>
+M3<S> rightJacobianInverseOf(const V3<S>& w) {
+  const S t2 = plainDot<S>(w, w);
+  S c;
+  if (std::abs(realPart(t2)) < 1e-8) {
+    c = S(1.0 / 12.0) + t2 / 720.0;
+  } else {
+    const S half = std::sqrt(t2) / 2.0;
+    c = (S(1) - half * std::cos(half) / std::sin(half)) / t2;
+  }
+  const M3<S> W = hatOf<S>(w);
+  return M3<S>::Identity() + S(0.5) * W + c * W * W;
+}
+
+template <typename S>
+Eigen::Matrix<S, 4, 1> quaternionOf(const V3<S>& w) {
+  const S t2 = plainDot<S>(w, w);
+  S c, k;
+  if (std::abs(realPart(t2)) < 1e-8) {
+    c = S(1) - t2 / 8.0;
+    k = S(0.5) - t2 / 48.0;
+  } else {
+    const S t = std::sqrt(t2);
+    c = std::cos(t / 2.0);
+    k = std::sin(t / 2.0) / t;
+  }
+  Eigen::Matrix<S, 4, 1> q;
+  q << c, k * w(0), k * w(1), k * w(2);
+  return q;
+}
+
+template <typename S>
+Eigen::Matrix<S, 4, 1> quaternionTimes(const Eigen::Matrix<S, 4, 1>& p,
+                                       const Eigen::Matrix<S, 4, 1>& q) {
+  const V3<S> pv = p.template tail<3>(), qv = q.template tail<3>();
+  Eigen::Matrix<S, 4, 1> r;
+  r(0) = p(0) * q(0) - plainDot<S>(pv, qv);
+  r.template tail<3>() = p(0) * qv + q(0) * pv + plainCross<S>(pv, qv);
+  return r;
+}
+
+/// The seed's system, 3(2N−3) equations in x = (τ_1..τ_{N−1}, Ω_1..Ω_{N−2}):
+///   h² × corrected eq. (28), k = 2..N−2 (docs/necessary_conditions.md)
+///   J Ω_k − exp(hΩ_k)ᵀ (h τ_k + J Ω_{k−1}), k = 1..N−1 (eq. (18))
+///   log(R_Nᵀ R_0 Π_k exp(hΩ_k)) (terminal attitude, through quaternions)
+template <typename S>
+void seedResidual(const ap::PlanningProblem& p, const Eigen::Matrix<S, Eigen::Dynamic, 1>& x,
+                  Eigen::Matrix<S, Eigen::Dynamic, 1>* r) {
+  const int N = p.steps;
+  const double h = p.duration / N;
+  const M3<S> J = p.inertia.cast<S>();
+  const auto tau = [&](int k) -> V3<S> {
+    return (k < 1 || k > N - 1) ? V3<S>::Zero() : V3<S>(x.template segment<3>(3 * (k - 1)));
+  };
+  const auto W = [&](int k) -> V3<S> {
+    if (k == 0) return p.initial_velocity.cast<S>();
+    if (k == N - 1) return p.final_velocity.cast<S>();
+    return x.template segment<3>(3 * (N - 1) + 3 * (k - 1));
+  };
+  r->resize(3 * (2 * N - 3));
+  std::vector<M3<S>> g(N), Jt(N);
+  for (int k = 0; k < N; ++k) {
+    const V3<S> w = W(k) * h;
+    g[k] = expOf<S>(w);
+    Jt[k] = rightJacobianInverseOf<S>(w).transpose() * J;
+  }
+  int row = 0;
+  for (int k = 2; k <= N - 2; ++k) {
+    const V3<S> t = -Jt[k - 1] * tau(k) + g[k] * Jt[k] * tau(k + 1) +
+                    Jt[k - 1] * g[k - 1].transpose() * tau(k - 1) -
+                    g[k] * Jt[k] * g[k].transpose() * tau(k) -
+                    h * g[k] * plainCross<S>(J * W(k), g[k].transpose() * tau(k)) +
+                    h * plainCross<S>(J * W(k - 1), g[k - 1].transpose() * tau(k - 1));
+    r->template segment<3>(row) = t;
+    row += 3;
+  }
+  for (int k = 1; k <= N - 1; ++k) {
+    r->template segment<3>(row) = J * W(k) - g[k].transpose() * (h * tau(k) + J * W(k - 1));
+    row += 3;
+  }
+  Eigen::Matrix<S, 4, 1> q = ap::so3::quaternionCoefficients<double>(
+                                 Matrix3(p.final_attitude.transpose() * p.initial_attitude))
+                                 .cast<S>();
+  for (int k = 0; k < N; ++k) q = quaternionTimes<S>(q, quaternionOf<S>(V3<S>(W(k) * h)));
+  // log of a quaternion near the identity: 2 atan(|v|/w) v/|v| (≈ 2v/w (1 − s²/3w²))
+  const V3<S> v = q.template tail<3>();
+  const S s2 = plainDot<S>(v, v);
+  V3<S> log_q;
+  if (std::abs(realPart(s2)) < 1e-16) {
+    log_q = v * (S(2) / q(0)) * (S(1) - s2 / (S(3) * q(0) * q(0)));
+  } else {
+    const S s = std::sqrt(s2);
+    log_q = v * (S(2) * std::atan(s / q(0)) / s);
+  }
+  r->template segment<3>(row) = log_q;
+}
+
+PeerOutcome solveComplexStep(const ap::PlanningProblem& p, double time_budget) {
+  const auto start = std::chrono::steady_clock::now();
+  const int N = p.steps;
+  const double h = p.duration / N;
+  const int n = 3 * (2 * N - 3);
+  // The geodesic start ours uses: its torques and velocities.
+  const std::vector<Vector3> w = geodesicSteps(p);
+  const std::vector<Vector3> tau = geodesicTorques(p);
+  Eigen::VectorXd x(n);
+  for (int k = 1; k <= N - 1; ++k) x.segment<3>(3 * (k - 1)) = tau[k];
+  for (int k = 1; k <= N - 2; ++k) x.segment<3>(3 * (N - 1) + 3 * (k - 1)) = w[k] / h;
+  const auto residual = [&](const Eigen::VectorXd& y) {
+    Eigen::VectorXd r;
+    seedResidual<double>(p, y, &r);
+    return r;
+  };
+  PeerOutcome out;
+  Eigen::VectorXd r = residual(x);
+  double r_norm = r.norm();
+  Eigen::MatrixXd jac(n, n);
+  Eigen::Matrix<Complex, Eigen::Dynamic, 1> xc(n), rc;
+  constexpr double kStep = 1e-30;
+  for (int it = 0; it < 50; ++it) {
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+        time_budget) {
+      out.message = "time budget exceeded";
+      break;
+    }
+    // Dense complex-step Jacobian: one residual evaluation per unknown.
+    xc = x.cast<Complex>();
+    for (int j = 0; j < n; ++j) {
+      xc(j) += Complex(0.0, kStep);
+      seedResidual<Complex>(p, xc, &rc);
+      for (int i = 0; i < n; ++i) jac(i, j) = rc(i).imag() / kStep;
+      xc(j) = x(j);
+    }
+    const Eigen::VectorXd dx = -jac.partialPivLu().solve(r);
+    ++out.iterations;
+    double step = 1.0;
+    bool improved = false;
+    for (int back = 0; back < 30; ++back) {
+      const Eigen::VectorXd trial = x + step * dx;
+      const Eigen::VectorXd r_trial = residual(trial);
+      if (r_trial.allFinite() && r_trial.norm() < r_norm) {
+        x = trial;
+        r = r_trial;
+        r_norm = r.norm();
+        improved = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    // Converged: the full Newton step is at round-off relative to x.
+    if (dx.norm() <= 1e-11 * x.norm() || !improved) {
+      out.ok = true;
+      out.message = improved ? "step below 1e-11 relative" : "residual at round-off";
+      break;
+    }
+  }
+  out.torque.assign(N + 1, Vector3::Zero());
+  for (int k = 1; k <= N - 1; ++k) out.torque[k] = x.segment<3>(3 * (k - 1));
+  return out;
+}
+
+// ---- driver --------------------------------------------------------------------------------
+
+struct Measurement {
+  std::string solver, scheme, message;
+  int steps = 0, iterations = 0;
+  double time_s = 0.0, cost = 0.0, terminal_miss = 0.0;
+  double warm_time_s = 0.0;  ///< median of the repeated in-process solves (0: not measured)
+  bool converged = false;
+  long peak_rss_kb = 0;
+};
+
+std::string escaped(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += (c == '\n') ? ' ' : c;
+  }
+  return out;
+}
+
+void printJson(const Measurement& m) {
+  std::printf(
+      "{\"solver\": \"%s\", \"scheme\": \"%s\", \"steps\": %d, \"time_s\": %.9g, "
+      "\"iterations\": %d, \"cost\": %.17g, \"converged\": %s, \"terminal_miss\": %.3g, "
+      "\"peak_rss_kb\": %ld, \"warm_time_s\": %.9g, \"message\": \"%s\"}\n",
+      m.solver.c_str(), m.scheme.c_str(), m.steps, m.time_s, m.iterations, m.cost,
+      m.converged ? "true" : "false", m.terminal_miss, m.peak_rss_kb, m.warm_time_s,
+      escaped(m.message).c_str());
+  std::fflush(stdout);
+}
+
+Measurement run(const std::string& solver, const ap::PlanningProblem& problem, double time_budget) {
+  Measurement m;
+  m.solver = solver;
+  m.scheme = ap::schemeName(problem.scheme);
+  m.steps = problem.steps;
+  const auto start = std::chrono::steady_clock::now();
+  PeerOutcome peer;
+  ap::PlanResult ours;
+  bool is_ours = false;
+  if (solver == "newton") {
+    ap::SolverOptions options;
+    options.time_budget_s = time_budget;
+    ours = ap::planManeuver(problem, options);
+    is_ours = true;
+  } else if (solver == "slsqp") {
+    ap::SolverOptions options;
+    options.solver = "nlopt";
+    options.max_iterations = 100000;
+    options.time_budget_s = time_budget;
+    ours = ap::planManeuver(problem, options);
+    is_ours = true;
+  } else if (solver == "auglag") {
+    peer = solveAuglag(problem, time_budget);
+  } else if (solver == "ipopt" || solver == "ipopt_lbfgs") {
+#ifdef AP_HAVE_IPOPT
+    peer = solveIpopt(problem, time_budget, solver == "ipopt");
+#else
+    throw ap::InvalidInput("ipopt: this build has no IPOPT (install coinor-libipopt-dev)");
+#endif
+  } else if (solver == "complex_step") {
+    peer = solveComplexStep(problem, time_budget);
+  } else {
+    throw ap::InvalidInput("unknown solver '" + solver + "'");
+  }
+  m.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (is_ours) {
+    m.iterations = ours.iterations;
+    m.converged = ours.converged();
+    m.message = ours.message;
+  } else {
+    // The peer's torques replayed exactly as ours are (outside the timed region).
+    ap::PlanResult replay;
+    ap::evaluatePlan(problem, peer.torque, &replay);
+    ours = replay;
+    m.iterations = peer.iterations;
+    m.converged =
+        peer.ok && std::max(replay.terminal_attitude_error, replay.terminal_velocity_error) <= 1e-8;
+    m.message = peer.message;
+  }
+  m.cost = ours.cost;
+  m.terminal_miss = std::max(ours.terminal_attitude_error, ours.terminal_velocity_error);
+  m.peak_rss_kb = peakRssKb();
+  return m;
+}
+
+int quick() {
+  const ap::PlanningProblem problem = seedRestToRest(16);
+  std::vector<std::string> solvers = {"newton", "slsqp", "auglag", "complex_step"};
+#ifdef AP_HAVE_IPOPT
+  solvers.push_back("ipopt");
+  solvers.push_back("ipopt_lbfgs");
+#endif
+  double reference = 0.0;
+  int failures = 0;
+  for (const std::string& s : solvers) {
+    const Measurement m = run(s, problem, 60.0);
+    printJson(m);
+    if (s == "newton") reference = m.cost;
+    // AUGLAG+LBFGS is reported, not required: it does not reach the optimum on this problem.
+    if (s == "auglag") continue;
+    if (!m.converged) ++failures;
+    if (std::abs(m.cost - reference) > 1e-8 * reference) ++failures;
+  }
+  return failures == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string solver, scene, scheme;
+  bool check_hessian = false;
+  int steps = 0;
+  int in_process = 1;  // solves in this process; > 1 adds the warm median (runs 2..K)
+  double time_budget = 120.0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << a << ": missing value\n" << kUsage;
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--quick") return quick();
+    if (a == "--help") {
+      std::cout << kUsage;
+      return 0;
+    }
+    if (a == "--solver") {
+      solver = value();
+    } else if (a == "--scene") {
+      scene = value();
+    } else if (a == "--steps") {
+      steps = std::atoi(value().c_str());
+    } else if (a == "--scheme") {
+      scheme = value();
+    } else if (a == "--check-hessian") {
+      check_hessian = true;
+    } else if (a == "--time-budget") {
+      time_budget = std::atof(value().c_str());
+    } else if (a == "--in-process") {
+      in_process = std::atoi(value().c_str());
+    } else {
+      std::cerr << "unknown argument '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (check_hessian) {
+#ifdef AP_HAVE_IPOPT
+    return checkHessian(steps > 0 ? steps : 16);
+#else
+    std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
+                 "(install coinor-libipopt-dev)\n";
+    return 3;
+#endif
+  }
+  if (solver.empty()) {
+    std::cerr << kUsage;
+    return 2;
+  }
+  try {
+    ap::PlanningProblem problem =
+        scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
+    if (steps > 0) problem.steps = steps;
+    if (!scheme.empty()) problem.scheme = ap::parseSchemeName(scheme);
+    Measurement m = run(solver, problem, time_budget);
+    if (in_process > 1) {
+      // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):
+      // reported apart from time_s, which stays the first, cold solve of a fresh process.
+      std::vector<double> warm;
+      for (int r = 1; r < in_process; ++r) warm.push_back(run(solver, problem, time_budget).time_s);
+      std::sort(warm.begin(), warm.end());
+      m.warm_time_s = warm[warm.size() / 2];
+    }
+    printJson(m);
+  } catch (const std::exception& e) {
+    std::cerr << "benchmark_solvers: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,150 @@
+// Issue 15: one Termination per result, per-level progress as data, reports of any length.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/report.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "tool_runner.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+PlanningProblem seedRestToRest(int N) {
+  PlanningProblem p = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/rest_to_rest.yaml").problem;
+  p.steps = N;
+  return p;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(Termination, EveryValueHasADistinctName) {
+  const Termination all[] = {Termination::Converged,   Termination::NotConverged,
+                             Termination::Infeasible,  Termination::StepTooLarge,
+                             Termination::TimedOut,    Termination::Cancelled,
+                             Termination::InvalidInput};
+  std::set<std::string> names;
+  for (Termination t : all) names.insert(terminationName(t));
+  EXPECT_EQ(names.size(), std::size(all));
+  EXPECT_EQ(terminationName(Termination::Converged), "converged");
+  EXPECT_EQ(terminationName(Termination::TimedOut), "timed_out");
+}
+
+TEST(Termination, ConvergedSolveListsItsGridLevelsCoarsestFirst) {
+  const PlanResult r = planManeuver(seedRestToRest(128));
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.termination, Termination::Converged);
+  ASSERT_GE(r.levels.size(), 2u);  // continuation: 16 -> 32 -> 128
+  EXPECT_EQ(r.levels.back().steps, 128);
+  int iterations = 0;
+  for (size_t i = 0; i < r.levels.size(); ++i) {
+    if (i > 0) EXPECT_LT(r.levels[i - 1].steps, r.levels[i].steps);
+    EXPECT_EQ(r.levels[i].termination, Termination::Converged) << r.levels[i].reason;
+    EXPECT_FALSE(r.levels[i].reason.empty());
+    iterations += r.levels[i].iterations;
+  }
+  EXPECT_EQ(iterations, r.iterations);
+  // The message explains the outcome in one level: no coarse-level message nested in it.
+  EXPECT_LT(r.message.size(), 400u) << r.message;
+}
+
+TEST(Termination, CancelledByTheCallback) {
+  SolverOptions options;
+  options.on_iteration = [](const IterationInfo&) { return false; };
+  for (int N : {12, 128}) {  // one grid; several levels (cancelled on the coarsest)
+    const PlanResult r = planManeuver(seedRestToRest(N), options);
+    EXPECT_EQ(r.termination, Termination::Cancelled) << N << ": " << r.message;
+    EXPECT_FALSE(r.converged());
+    EXPECT_EQ(r.maneuver.steps(), N);  // the plan so far, on the requested grid
+  }
+}
+
+TEST(Termination, TimedOutWhenTheBudgetRunsOut) {
+  SolverOptions options;
+  options.time_budget_s = 1e-9;
+  const PlanResult r = planManeuver(seedRestToRest(1024), options);
+  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message;
+  EXPECT_TRUE(contains(r.message, "time budget")) << r.message;
+  EXPECT_EQ(r.maneuver.steps(), 1024);
+}
+
+TEST(Termination, TimedOutAlsoWhenPlanningToAnAccuracy) {
+  PlanningProblem p = seedRestToRest(128);
+  p.accuracy.measure = AccuracyMeasure::TerminalMiss;
+  p.accuracy.value = 1e-9;
+  SolverOptions options;
+  options.time_budget_s = 1e-9;
+  const PlanResult r = planManeuver(p, options);
+  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message;
+}
+
+TEST(Termination, IterationLimitIsNotConverged) {
+  SolverOptions options;
+  options.max_iterations = 1;
+  const PlanResult r = planManeuver(seedRestToRest(64), options);
+  EXPECT_EQ(r.termination, Termination::NotConverged) << r.message;
+  EXPECT_TRUE(contains(r.message, "iteration limit")) << r.message;
+}
+
+TEST(Termination, StepTooLargeIsItsOwnStatusOrException) {
+  // A boundary velocity without a step at this h is refused up front (exception); the node and
+  // the CLI map it to the same status as a result ending StepTooLarge.
+  PlanningProblem p = seedRestToRest(8);
+  p.initial_velocity = Vector3(0, 0, 40.0);
+  EXPECT_THROW(planManeuver(p), StepTooLarge);
+}
+
+TEST(Report, TextSummaryKeepsEveryFieldWhateverTheMessageLength) {
+  // Defect 1 of issue 15: a 1,024-byte buffer cut the summary after `message`.
+  const PlanningProblem p = seedRestToRest(128);
+  PlanResult r;
+  r.message = std::string(5000, 'x');
+  r.extremal = "short way";
+  r.solver = "newton";
+  r.iterations = 7;
+  r.solve_time_s = 0.25;
+  const std::string text = planResultText(p, r);
+  for (const char* label :
+       {"converged", "message", "solver / scheme", "steps N, duration T", "iterations",
+        "cost sum 1/2|tau_k|^2", "terminal attitude error", "terminal velocity error",
+        "max residual", "dynamics residual", "solve time", "planned effects", "extremal"}) {
+    EXPECT_TRUE(contains(text, std::string("\n") + label) || text.rfind(label, 0) == 0) << label;
+  }
+  EXPECT_TRUE(contains(text, std::string(5000, 'x')));
+  EXPECT_TRUE(contains(text, "0.250 s"));
+  EXPECT_TRUE(contains(text, "NO (not_converged)"));
+}
+
+TEST(Report, JsonSummaryCarriesTheTerminationAndTheLevels) {
+  const PlanningProblem p = seedRestToRest(128);
+  const PlanResult r = planManeuver(p);
+  const std::string json = planResultJson(p, r);
+  EXPECT_TRUE(contains(json, "\"converged\": true"));
+  EXPECT_TRUE(contains(json, "\"termination\": \"converged\""));
+  EXPECT_TRUE(contains(json, "\"levels\": [{\"steps\": 16"));
+  EXPECT_TRUE(contains(json, "{\"steps\": 128, \"iterations\": "));
+}
+
+TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
+  // Defect 1 as the user met it: at N = 65536 with one iteration per level the message is long
+  // and the summary used to stop after it.
+  const attitude_planner_test::ToolRun r = attitude_planner_test::runTool(
+      "plan_maneuver",
+      std::string(AP_SOURCE_DIR) + "/scenes/rest_to_rest.yaml --steps 65536 --max-iterations 1",
+      120);
+  EXPECT_EQ(r.status, 1) << r.output;  // not converged after one iteration
+  for (const char* label :
+       {"solver / scheme", "steps N, duration T      65536", "iterations", "cost sum 1/2|tau_k|^2",
+        "terminal attitude error", "solve time", "grid levels"}) {
+    EXPECT_TRUE(contains(r.output, label)) << label << "\n" << r.output;
+  }
+}

@@ -680,7 +680,7 @@ std::vector<Vector3> linearizedStarts(Shooter& sh, const DriftTwoInputRequest& r
     Eigen::Vector2d q = B.completeOrthogonalDecomposition().solve(-r);
     // g1 reached from (0, 0, p3) up to a rotation about e3 (which (p1, p2) cannot change to
     // first order): start off the singular axis instead
-    if (!(q.norm() > 1e-3 * c)) q = Eigen::Vector2d(0.1, 0.1) * c;
+    if (!(q.norm() > 1e-3 * c) && r.norm() > rq.tolerance) q = Eigen::Vector2d(0.1, 0.1) * c;
     starts.emplace_back(q.x(), q.y(), p3);
   }
   return starts;
@@ -796,7 +796,7 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
     double best_cost = INFINITY;
     int skipped = 0;
     for (int i = 0; i < n && !deadline.expired(); ++i) {
-      if (sym[i].cost > best_cost * ratio) {
+      if (best_cost < INFINITY && sym[i].cost >= best_cost * ratio) {
         ++skipped;
         continue;
       }
@@ -817,7 +817,9 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
     os << attempts.size() << " start" << (attempts.size() == 1 ? "" : "s")
        << " (extremals of the symmetric problem c1 = c2 = " << c_bar << ": " << sym.size()
        << " listed, the " << n << " cheapest considered, " << skipped
-       << " of them not pursued by the cost bound)";
+       << " of them not pursued by the cost bound";
+    if (n < 2) os << "; starts from the linearized shooting equation";
+    os << ")";
     start_kind = os.str();
   }
   plan.timed_out = deadline.expired();

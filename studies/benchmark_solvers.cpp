@@ -1025,7 +1025,7 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
     is_ours = true;
   } else if (solver == "slsqp") {
     ap::SolverOptions options;
-    options.solver = "nlopt";
+    options.solver = ap::SolverKind::Nlopt;
     options.max_iterations = 100000;
     options.time_budget_s = time_budget;
     ours = ap::planManeuver(problem, options);
@@ -1143,7 +1143,7 @@ int main(int argc, char** argv) {
     ap::PlanningProblem problem =
         scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
     if (steps > 0) problem.steps = steps;
-    if (!scheme.empty()) problem.scheme = ap::parseSchemeName(scheme);
+    if (!scheme.empty()) problem.scheme = ap::parseScheme(scheme, "--scheme");
     Measurement m = run(solver, problem, time_budget);
     if (in_process > 1) {
       // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):

@@ -74,10 +74,10 @@ int main(int argc, char** argv) {
   EffectModel models[4];
   models[1].add(std::make_unique<GravityGradient>(3.986004418e14, 6.778e6, p.inertia));
   models[2].add(std::make_unique<GravityGradient>(3.986004418e14, 6.778e6, p.inertia));
-  models[2].add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), true));
+  models[2].add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), TorqueFrame::World));
   models[3].add(std::make_unique<GravityGradient>(3.986004418e14, 6.778e6, p.inertia));
-  models[3].add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), true));
-  models[3].add(std::make_unique<DisturbanceTorque>(Vector3(0, 1e-5, 0), false));
+  models[3].add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), TorqueFrame::World));
+  models[3].add(std::make_unique<DisturbanceTorque>(Vector3(0, 1e-5, 0), TorqueFrame::Body));
   const char* labels[4] = {"none (`effects: []`)", "gravity_gradient",
                            "gravity_gradient + disturbance (world)",
                            "gravity_gradient + disturbance (world) + disturbance (body)"};
@@ -93,7 +93,8 @@ int main(int argc, char** argv) {
   const PlanResult ignorant = planManeuver(bare_problem);
   EffectModel gravity_only, disturbance_only;
   gravity_only.add(std::make_unique<GravityGradient>(3.986004418e14, 6.778e6, p.inertia));
-  disturbance_only.add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), true));
+  disturbance_only.add(
+      std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), TorqueFrame::World));
   std::fprintf(md,
                "\n## The LEO slew (scenes/leo_slew.yaml): the miss each unplanned effect causes\n\n"
                "90° about z in 600 s, N = 300, J = diag(800, 1200, 1500) kg m², 400 km orbit. "

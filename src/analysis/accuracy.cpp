@@ -10,25 +10,6 @@
 
 namespace attitude_planner {
 
-std::string accuracyMeasureName(AccuracyMeasure measure) {
-  switch (measure) {
-    case AccuracyMeasure::TerminalMiss:
-      return "terminal_miss";
-    case AccuracyMeasure::CostError:
-      return "cost_error";
-    case AccuracyMeasure::None:
-      break;
-  }
-  return "";
-}
-
-AccuracyMeasure parseAccuracyMeasure(const std::string& name, const std::string& field) {
-  if (name == "terminal_miss") return AccuracyMeasure::TerminalMiss;
-  if (name == "cost_error") return AccuracyMeasure::CostError;
-  throw InvalidInput(field + ": unknown value '" + name +
-                     "' (expected terminal_miss or cost_error)");
-}
-
 ZeroOrderHoldReplay replayZeroOrderHold(const PlanningProblem& problem, const Maneuver& plan,
                                         TorqueHold hold) {
   const int N = plan.steps();

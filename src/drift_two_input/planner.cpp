@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/input_rules.hpp"
 #include "lie/dual.hpp"
 
 namespace attitude_planner {
@@ -251,7 +252,7 @@ void validate(const DriftTwoInputRequest& rq) {
     os << field << " " << why << ", got " << value;
     throw InvalidInput(os.str());
   };
-  if (!std::isfinite(rq.duration) || rq.duration <= 0) fail("duration", rq.duration, "must be > 0");
+  requireDuration(rq.duration, "duration");
   if (rq.steps < 1) fail("steps", rq.steps, "must be >= 1");
   if (!std::isfinite(rq.max_step) || rq.max_step < 0) {
     fail("max_step", rq.max_step, "must be >= 0 (0 = adaptive only)");

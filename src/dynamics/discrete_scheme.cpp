@@ -6,16 +6,6 @@
 
 namespace attitude_planner {
 
-std::string schemeName(SchemeKind kind) {
-  return kind == SchemeKind::Paper ? "paper" : "variational";
-}
-
-SchemeKind parseSchemeName(const std::string& name) {
-  if (name == "paper") return SchemeKind::Paper;
-  if (name == "variational") return SchemeKind::Variational;
-  throw InvalidInput("scheme: unknown value '" + name + "' (expected paper or variational)");
-}
-
 DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step)
     : kind_(kind), J_(inertia), J_inverse_(inertia.inverse()), h_(time_step) {
   Jd_ = 0.5 * J_.trace() * Matrix3::Identity() - J_;

@@ -2,8 +2,8 @@
 
 namespace attitude_planner {
 
-DisturbanceTorque::DisturbanceTorque(const Vector3& value, bool in_world)
-    : value_(value), in_world_(in_world) {}
+DisturbanceTorque::DisturbanceTorque(const Vector3& value, TorqueFrame frame)
+    : value_(value), in_world_(frame == TorqueFrame::World) {}
 
 Vector3 DisturbanceTorque::torque(const Matrix3& R, double) const {
   return in_world_ ? Vector3(R.transpose() * value_) : value_;

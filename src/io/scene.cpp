@@ -11,18 +11,16 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "attitude_planner/errors.hpp"
 
 namespace attitude_planner {
 
 namespace {
-
-/// How far from 1 a quaternion's norm may be before it is an error rather than round-off in a
-/// hand-typed value (0.7071 has norm 0.99998).
-constexpr double kQuaternionNormTolerance = 1e-3;
 
 /// A node's text for a message, one line.
 std::string show(const YAML::Node& node) {
@@ -53,10 +51,6 @@ void validateEffect(const EffectSpec& effect, const std::string& path) {
     require(std::isfinite(g->orbit_radius) && g->orbit_radius > 0.0, "orbit_radius",
             g->orbit_radius, "must be finite and > 0 m");
   } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&effect)) {
-    if (d->frame != "body" && d->frame != "world") {
-      throw InvalidInput(path + ".frame: unknown value '" + d->frame +
-                         "' (expected body or world)");
-    }
     for (int k = 0; k < 3; ++k) {
       require(std::isfinite(d->value(k)), "value[" + std::to_string(k) + "]", d->value(k),
               "must be finite");
@@ -89,21 +83,14 @@ class SceneParser {
 
     // The system decides which keys are required: the kinematic drift system of seed 001 has no
     // inertia and no boundary velocities.
-    std::string system = "rigid_body";
-    if (root["system"]) {
-      system = scalarString(root["system"], "system");
-      if (system != "rigid_body" && system != "drift_two_input") {
-        fail(root["system"], "system",
-             "unknown value " + show(root["system"]) + " (expected rigid_body or drift_two_input)");
-      }
-    }
-    scene.system = system;
-    const bool rigid = system == "rigid_body";
+    if (root["system"]) scene.system = named(root["system"], "system", kSystemNames);
+    const bool rigid = scene.system == SystemKind::RigidBody;
+    // `effects` is optional: a scene without the key simulates none, like `effects: []`.
     if (rigid) {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
                  "allow_nonphysical_inertia", "direction", "extra_revolutions"},
-                {"inertia", "duration", "steps", "initial", "final", "effects"});
+                {"inertia", "duration", "steps", "initial", "final"});
     } else {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
@@ -117,25 +104,9 @@ class SceneParser {
     p.steps = integer(root["steps"], "steps");
     readState(root["initial"], "initial", rigid, &p.initial_attitude, &p.initial_velocity);
     readState(root["final"], "final", rigid, &p.final_attitude, &p.final_velocity);
-    if (root["scheme"]) {
-      const std::string name = scalarString(root["scheme"], "scheme");
-      try {
-        p.scheme = parseSchemeName(name);
-      } catch (const InvalidInput&) {
-        fail(root["scheme"], "scheme",
-             "unknown value " + show(root["scheme"]) + " (expected paper or variational)");
-      }
-    }
+    if (root["scheme"]) p.scheme = named(root["scheme"], "scheme", kSchemeNames);
     if (root["direction"]) {
-      const std::string name = scalarString(root["direction"], "direction");
-      if (name == "shortest") {
-        p.direction = RotationDirection::Shortest;
-      } else if (name == "long_way") {
-        p.direction = RotationDirection::LongWay;
-      } else {
-        fail(root["direction"], "direction",
-             "unknown value " + show(root["direction"]) + " (expected shortest or long_way)");
-      }
+      p.direction = named(root["direction"], "direction", kRotationDirectionNames);
     }
     if (root["extra_revolutions"]) {
       p.extra_revolutions = integer(root["extra_revolutions"], "extra_revolutions");
@@ -182,6 +153,18 @@ class SceneParser {
   [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
                          const std::string& what) const {
     throw InvalidInput(where(node) + path + ": " + what);
+  }
+
+  /// The value a scalar names in `table`; an unknown name is an error listing the table's names.
+  template <class Enum, std::size_t N>
+  Enum named(const YAML::Node& node, const std::string& path,
+             const NamedValue<Enum> (&table)[N]) const {
+    const std::string text = scalarString(node, path);
+    try {
+      return parseIn(table, text, path);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(where(node) + e.what());
+    }
   }
 
   void requireMap(const YAML::Node& node, const std::string& path) const {
@@ -319,15 +302,11 @@ class SceneParser {
       requireSequence(qn, qpath, 4);
       Eigen::Vector4d q;
       for (int i = 0; i < 4; ++i) q(i) = number(qn[i], qpath + "[" + std::to_string(i) + "]");
-      const double norm = q.norm();
-      if (norm == 0.0) fail(qn, qpath, "zero quaternion " + show(qn) + " is not a rotation");
-      if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
-        fail(qn, qpath,
-             "not a unit quaternion: " + show(qn) + " has norm " + exactNumber(norm) +
-                 " (must be within " + exactNumber(kQuaternionNormTolerance) +
-                 " of 1; [w, x, y, z])");
+      try {
+        return attitudeFromQuaternion(q, qpath, show(qn));
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(where(qn) + e.what());
       }
-      return so3::fromQuaternion(Eigen::Quaterniond(q(0), q(1), q(2), q(3)));
     }
     checkKeys(node, path, {"axis", "angle", "quaternion"}, {"axis", "angle"});
     const Vector3 axis = vector3(node["axis"], path + ".axis");
@@ -376,27 +355,31 @@ class SceneParser {
       const std::string name = kv.first.Scalar();
       const YAML::Node body = kv.second;
       const std::string bpath = epath + "." + name;
-      if (name == "gravity_gradient") {
+      const std::optional<EffectKind> kind = findByName(kEffectKindNames, name);
+      if (!kind) {
+        fail(kv.first, bpath, "unknown effect (expected " + oneOf(namesOf(kEffectKindNames)) + ")");
+      }
+      if (*kind == EffectKind::GravityGradient) {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"mu", "orbit_radius"}, {"mu", "orbit_radius"});
         GravityGradientSpec g;
         g.mu = number(body["mu"], bpath + ".mu");
         g.orbit_radius = number(body["orbit_radius"], bpath + ".orbit_radius");
         out.emplace_back(g);
-      } else if (name == "disturbance_torque") {
+      } else if (*kind == EffectKind::DisturbanceTorque) {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"frame", "value"}, {"frame", "value"});
         DisturbanceTorqueSpec d;
-        d.frame = scalarString(body["frame"], bpath + ".frame");
+        d.frame = named(body["frame"], bpath + ".frame", kTorqueFrameNames);
         d.value = vector3(body["value"], bpath + ".value");
         out.emplace_back(d);
-      } else if (name == "actuator_limits") {
+      } else if (*kind == EffectKind::ActuatorLimits) {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"max_torque"}, {"max_torque"});
         ActuatorLimitsSpec a;
         a.max_torque = vector3(body["max_torque"], bpath + ".max_torque");
         out.emplace_back(a);
-      } else if (name == "torque_noise") {
+      } else {
         requireMap(body, bpath);
         checkKeys(body, bpath, {"std", "seed"}, {"std", "seed"});
         TorqueNoiseSpec t;
@@ -412,10 +395,6 @@ class SceneParser {
         }
         t.seed = v;
         out.emplace_back(t);
-      } else {
-        fail(kv.first, bpath,
-             "unknown effect (expected gravity_gradient, disturbance_torque, actuator_limits or "
-             "torque_noise)");
       }
       try {
         validateEffect(out.back(), bpath);
@@ -447,17 +426,38 @@ std::string quaternionOf(const Matrix3& R) {
 
 }  // namespace
 
+EffectKind effectKindOf(const EffectSpec& effect) {
+  static_assert(
+      std::is_same_v<std::variant_alternative_t<0, EffectSpec>, GravityGradientSpec> &&
+          std::is_same_v<std::variant_alternative_t<1, EffectSpec>, DisturbanceTorqueSpec> &&
+          std::is_same_v<std::variant_alternative_t<2, EffectSpec>, ActuatorLimitsSpec> &&
+          std::is_same_v<std::variant_alternative_t<3, EffectSpec>, TorqueNoiseSpec>,
+      "EffectSpec's alternatives follow EffectKind");
+  constexpr EffectKind kByIndex[] = {EffectKind::GravityGradient, EffectKind::DisturbanceTorque,
+                                     EffectKind::ActuatorLimits, EffectKind::TorqueNoise};
+  return kByIndex[effect.index()];
+}
+
 std::string effectName(const EffectSpec& effect) {
-  switch (effect.index()) {
-    case 0:
-      return "gravity_gradient";
-    case 1:
-      return "disturbance_torque";
-    case 2:
-      return "actuator_limits";
-    default:
-      return "torque_noise";
+  return effectKindName(effectKindOf(effect));
+}
+
+Matrix3 attitudeFromQuaternion(const Eigen::Vector4d& q, const std::string& field,
+                               const std::string& shown) {
+  const std::string text = shown.empty() ? vec(q) : shown;
+  if (!q.allFinite()) throw InvalidInput(field + ": quaternion not finite: " + text);
+  const double norm = q.norm();
+  if (norm == 0.0) {
+    throw InvalidInput(field + ": zero quaternion " + text +
+                       " is not a rotation (expected a unit quaternion [w, x, y, z]; identity is "
+                       "[1, 0, 0, 0])");
   }
+  if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
+    throw InvalidInput(field + ": not a unit quaternion: " + text + " has norm " +
+                       exactNumber(norm) + " (must be within " +
+                       exactNumber(kQuaternionNormTolerance) + " of 1; [w, x, y, z])");
+  }
+  return so3::fromQuaternion(Eigen::Quaterniond(q(0), q(1), q(2), q(3)));
 }
 
 void validateEffects(const std::vector<EffectSpec>& effects, const std::string& field) {
@@ -467,7 +467,7 @@ void validateEffects(const std::vector<EffectSpec>& effects, const std::string& 
     const std::string path = field + "[" + std::to_string(i) + "]." + name;
     validateEffect(effects[i], path);
     // Several constant disturbances add up; the other effects are one-of-a-kind.
-    if (name != "disturbance_torque" && !seen.insert(name).second) {
+    if (effectKindOf(effects[i]) != EffectKind::DisturbanceTorque && !seen.insert(name).second) {
       throw InvalidInput(path + ": duplicate effect (at most one " + name + ")");
     }
   }
@@ -489,8 +489,8 @@ std::string formatScene(const Scene& scene) {
   const PlanningProblem& p = scene.problem;
   std::ostringstream out;
   out << "# written by formatScene; units: SI (kg m^2, s, rad, rad/s, N m)\n";
-  if (scene.system != "rigid_body") {
-    out << "system: " << scene.system << "\n";
+  if (scene.system != SystemKind::RigidBody) {
+    out << "system: " << systemName(scene.system) << "\n";
     out << "control_weights: " << vec(scene.control_weights) << "\n";
     if (scene.initial_costate) out << "initial_costate: " << vec(*scene.initial_costate) << "\n";
   }
@@ -500,9 +500,11 @@ std::string formatScene(const Scene& scene) {
   out << "duration: " << exactNumber(p.duration) << "\n";
   out << "steps: " << p.steps << "\n";
   out << "scheme: " << schemeName(p.scheme) << "\n";
-  if (p.direction == RotationDirection::LongWay) out << "direction: long_way\n";
+  if (p.direction != RotationDirection::Shortest) {
+    out << "direction: " << directionName(p.direction) << "\n";
+  }
   if (p.extra_revolutions != 0) out << "extra_revolutions: " << p.extra_revolutions << "\n";
-  const bool rigid = scene.system == "rigid_body";
+  const bool rigid = scene.system == SystemKind::RigidBody;
   out << "initial: {attitude: " << quaternionOf(p.initial_attitude);
   if (rigid) out << ", angular_velocity: " << vec(p.initial_velocity);
   out << "}\n";
@@ -518,7 +520,7 @@ std::string formatScene(const Scene& scene) {
       out << "{mu: " << exactNumber(g->mu) << ", orbit_radius: " << exactNumber(g->orbit_radius)
           << "}\n";
     } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&e)) {
-      out << "{frame: " << d->frame << ", value: " << vec(d->value) << "}\n";
+      out << "{frame: " << torqueFrameName(d->frame) << ", value: " << vec(d->value) << "}\n";
     } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&e)) {
       out << "{max_torque: " << vec(a->max_torque) << "}\n";
     } else if (const auto* t = std::get_if<TorqueNoiseSpec>(&e)) {
@@ -535,7 +537,7 @@ std::shared_ptr<const EffectModel> plannableEffects(const std::vector<EffectSpec
     if (const auto* gg = std::get_if<GravityGradientSpec>(&spec)) {
       model->add(std::make_unique<GravityGradient>(gg->mu, gg->orbit_radius, inertia));
     } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&spec)) {
-      model->add(std::make_unique<DisturbanceTorque>(d->value, d->frame == "world"));
+      model->add(std::make_unique<DisturbanceTorque>(d->value, d->frame));
     }
     // actuator_limits and torque_noise act on the commanded torque: see actuationOf().
   }
@@ -563,8 +565,8 @@ Actuation actuationOf(const std::vector<EffectSpec>& specs) {
 }
 
 void requirePlannable(const Scene& scene) {
-  if (scene.system != "rigid_body") {
-    throw InvalidInput(scene.source + ": system: '" + scene.system +
+  if (scene.system != SystemKind::RigidBody) {
+    throw InvalidInput(scene.source + ": system: '" + systemName(scene.system) +
                        "' is not planned by planManeuver (rigid_body only; drift_two_input "
                        "scenes go to planDriftTwoInput, as plan_maneuver does)");
   }
@@ -573,8 +575,8 @@ void requirePlannable(const Scene& scene) {
 }
 
 DriftTwoInputRequest driftTwoInputRequest(const Scene& scene) {
-  if (scene.system != "drift_two_input") {
-    throw InvalidInput(scene.source + ": system: '" + scene.system +
+  if (scene.system != SystemKind::DriftTwoInput) {
+    throw InvalidInput(scene.source + ": system: '" + systemName(scene.system) +
                        "' is not drift_two_input (planManeuver plans rigid_body scenes)");
   }
   if (!scene.effects.empty()) {

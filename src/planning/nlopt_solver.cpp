@@ -131,7 +131,7 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   const int N = problem.steps;
   if (N > kMaxNloptSteps) {
     PlanResult refused;
-    refused.solver = "nlopt";
+    refused.solver = solverName(SolverKind::Nlopt);
     refused.scheme = problem.scheme;
     refused.message =
         "not converged; nlopt cross-check is dense (O(N^2) memory, O(N^3) time): "
@@ -189,7 +189,7 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   }
 
   PlanResult result;
-  result.solver = "nlopt";
+  result.solver = solverName(SolverKind::Nlopt);
   result.iterations = cb.evaluations;
   result.history = std::move(cb.history);
   const Eigen::Map<const Eigen::VectorXd> xv(x.data(), n);

@@ -21,7 +21,9 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   result->maneuver = simulate(scheme, input, &report);
   result->scheme = problem.scheme;
   result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
-  if (problem.hasTorqueBounds()) result->effects.push_back("actuator_limits");
+  if (problem.hasTorqueBounds()) {
+    result->effects.push_back(effectKindName(EffectKind::ActuatorLimits));
+  }
   result->dynamics_residual = report.max_step_residual;
   double cost = 0.0;
   for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();
@@ -63,7 +65,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
-  if (options.solver == "newton" && problem.hasTorqueBounds()) {
+  if (options.solver == SolverKind::Newton && problem.hasTorqueBounds()) {
     result = solveWithNewton(problem, options);
     const auto within_bounds = [&](const PlanResult& r) {
       for (const Vector3& t : r.maneuver.torque) {
@@ -84,18 +86,16 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
                                                             : "";
       result = solveWithNlopt(problem, bounded);
       result.message += unbounded_note;
-      result.solver = "nlopt";
+      result.solver = solverName(SolverKind::Nlopt);
     } else {
       result.message += "; bounds inactive at the unbounded optimum";
     }
-  } else if (options.solver == "newton") {
+  } else if (options.solver == SolverKind::Newton) {
     result = solveWithNewton(problem, options);
-  } else if (options.solver == "nlopt") {
-    result = solveWithNlopt(problem, options);
   } else {
-    throw InvalidInput("solver: unknown value '" + options.solver + "' (expected newton or nlopt)");
+    result = solveWithNlopt(problem, options);
   }
-  if (result.solver.empty()) result.solver = options.solver;
+  if (result.solver.empty()) result.solver = solverName(options.solver);
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -1,7 +1,9 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/problem.hpp"
@@ -10,11 +12,6 @@
 namespace attitude_planner {
 
 namespace {
-
-/// Largest N accepted: the Newton solver holds ~2.3 kB per step (measured at N = 1e6, 2.3 GB
-/// peak; docs/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7, would need
-/// ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
-constexpr int kMaxSteps = 2000000;
 
 std::string str(const Eigen::MatrixXd& m) {
   std::ostringstream s;
@@ -56,12 +53,11 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("inertia: condition number " + exactNumber(moments(2) / moments(0)) +
                        " of " + str(p.inertia) + " > 1e12");
   }
-  if (!std::isfinite(p.duration) || !(p.duration > 0.0)) {
-    throw InvalidInput("duration: must be a finite number > 0 s, got " + exactNumber(p.duration));
-  }
+  requireDuration(p.duration, "duration");
   // With an accuracy target the planner chooses N: `steps` is not used.
-  if (!p.accuracy.active() && p.steps < 4) {
-    throw InvalidInput("steps: must be >= 4, got " + std::to_string(p.steps));
+  if (!p.accuracy.active() && p.steps < kMinSteps) {
+    throw InvalidInput("steps: must be >= " + std::to_string(kMinSteps) + ", got " +
+                       std::to_string(p.steps));
   }
   if (!p.accuracy.active() && p.steps > kMaxSteps) {
     throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
@@ -82,6 +78,12 @@ void validateProblem(const PlanningProblem& p) {
         "effects: actuator_limits together with gravity_gradient/disturbance_torque is not "
         "supported yet (bounded plans use NLopt, which does not model effect torques)");
   }
+  if (p.accuracy.choose_scheme && !p.accuracy.active()) {
+    throw InvalidInput(std::string("scheme: '") + kAutoSchemeName +
+                       "' needs an accuracy target (accuracy_measure, --target-miss or "
+                       "--target-cost-error): the planner chooses the scheme only for a "
+                       "requested accuracy");
+  }
   if (p.accuracy.active()) {
     if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
       throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
@@ -98,16 +100,31 @@ void validateProblem(const PlanningProblem& p) {
                          "], got " + std::to_string(p.accuracy.max_steps));
     }
   }
-  if (p.extra_revolutions < 0) {
-    throw InvalidInput(
-        "extra_revolutions: must be >= 0 (whole extra turns in the sense of the "
-        "chosen way; use direction LongWay to turn the other way), got " +
-        std::to_string(p.extra_revolutions));
-  }
+  requireExtraRevolutions(p.extra_revolutions, "extra_revolutions");
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
   requireFinite(p.final_velocity, "final.angular_velocity");
+}
+
+void applySchemeName(const std::string& text, const std::string& field, PlanningProblem* problem) {
+  problem->accuracy.choose_scheme = text == kAutoSchemeName;
+  if (problem->accuracy.choose_scheme) return;
+  if (const std::optional<SchemeKind> scheme = findByName(kSchemeNames, text)) {
+    problem->scheme = *scheme;
+    return;
+  }
+  std::vector<std::string> accepted = namesOf(kSchemeNames);
+  accepted.push_back(kAutoSchemeName);
+  throw InvalidInput(field + ": unknown value '" + text + "' (expected " + oneOf(accepted) + ")");
+}
+
+void requireExtraRevolutions(int extra_revolutions, const std::string& field) {
+  if (extra_revolutions < 0) {
+    throw InvalidInput(field + ": must be >= 0, got " + std::to_string(extra_revolutions) +
+                       " (whole extra turns in the sense of the chosen way; use direction "
+                       "long_way to turn the other way)");
+  }
 }
 
 void validateOptions(const SolverOptions& o) {

@@ -8,17 +8,6 @@
 namespace attitude_planner {
 namespace ros_conversions {
 
-namespace {
-
-std::string quaternionText(const geometry_msgs::Quaternion& q) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "(w, x, y, z) = (" << q.w << ", " << q.x << ", " << q.y << ", " << q.z << ")";
-  return s.str();
-}
-
-}  // namespace
-
 EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
   // A field the type does not read must stay at zero: a value there is a mistake, not a default.
   auto unused = [&](bool is_zero, const std::string& key, const std::string& value) {
@@ -28,16 +17,11 @@ EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
     }
   };
   const Vector3 value = vectorFromMsg(msg.value);
-  const bool uses_orbit = msg.type == Effect::GRAVITY_GRADIENT;
-  const bool uses_frame = msg.type == Effect::DISTURBANCE_TORQUE;
-  const bool uses_value = msg.type != Effect::GRAVITY_GRADIENT;
-  const bool uses_seed = msg.type == Effect::TORQUE_NOISE;
-  if (msg.type != Effect::GRAVITY_GRADIENT && msg.type != Effect::DISTURBANCE_TORQUE &&
-      msg.type != Effect::ACTUATOR_LIMITS && msg.type != Effect::TORQUE_NOISE) {
-    throw InvalidInput(field + ".type: unknown value '" + msg.type +
-                       "' (expected gravity_gradient, disturbance_torque, actuator_limits or "
-                       "torque_noise)");
-  }
+  const EffectKind kind = parseEffectKind(msg.type, field + ".type");
+  const bool uses_orbit = kind == EffectKind::GravityGradient;
+  const bool uses_frame = kind == EffectKind::DisturbanceTorque;
+  const bool uses_value = kind != EffectKind::GravityGradient;
+  const bool uses_seed = kind == EffectKind::TorqueNoise;
   if (!uses_orbit) unused(msg.mu == 0.0, "mu", exactNumber(msg.mu));
   if (!uses_orbit) unused(msg.orbit_radius == 0.0, "orbit_radius", exactNumber(msg.orbit_radius));
   if (!uses_frame) unused(msg.frame.empty(), "frame", "'" + msg.frame + "'");
@@ -48,8 +32,11 @@ EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
   }
   if (!uses_seed) unused(msg.seed == 0, "seed", std::to_string(msg.seed));
   if (uses_orbit) return GravityGradientSpec{msg.mu, msg.orbit_radius};
-  if (uses_frame) return DisturbanceTorqueSpec{msg.frame, value};
-  if (msg.type == Effect::ACTUATOR_LIMITS) return ActuatorLimitsSpec{value};
+  if (uses_frame) {
+    const std::string frame_field = field + "." + effectKindName(kind) + ".frame";
+    return DisturbanceTorqueSpec{parseTorqueFrame(msg.frame, frame_field), value};
+  }
+  if (kind == EffectKind::ActuatorLimits) return ActuatorLimitsSpec{value};
   return TorqueNoiseSpec{value, msg.seed};
 }
 
@@ -60,7 +47,7 @@ Effect effectToMsg(const EffectSpec& spec) {
     msg.mu = g->mu;
     msg.orbit_radius = g->orbit_radius;
   } else if (const auto* d = std::get_if<DisturbanceTorqueSpec>(&spec)) {
-    msg.frame = d->frame;
+    msg.frame = torqueFrameName(d->frame);
     msg.value = vectorToMsg(d->value);
   } else if (const auto* a = std::get_if<ActuatorLimitsSpec>(&spec)) {
     msg.value = vectorToMsg(a->max_torque);
@@ -87,21 +74,7 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 }
 
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {
-  if (!std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
-    throw InvalidInput(field + ": quaternion not finite: " + quaternionText(q));
-  }
-  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (norm == 0.0) {
-    throw InvalidInput(field + ": zero quaternion " + quaternionText(q) +
-                       " (expected a unit quaternion; identity is w = 1)");
-  }
-  if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
-    std::ostringstream s;
-    s << field << ": quaternion norm " << norm << " is not 1 (tolerance "
-      << kQuaternionNormTolerance << "): " << quaternionText(q);
-    throw InvalidInput(s.str());
-  }
-  return so3::fromQuaternion(Eigen::Quaterniond(q.w, q.x, q.y, q.z));
+  return attitudeFromQuaternion(Eigen::Vector4d(q.w, q.x, q.y, q.z), field);
 }
 
 geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R) {
@@ -255,17 +228,9 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
   DriftTwoInputRequest r;
   r.g0 = attitudeFromMsg(req.initial_attitude, "initial_attitude");
   r.g1 = attitudeFromMsg(req.final_attitude, "final_attitude");
-  if (!std::isfinite(req.duration) || !(req.duration > 0.0)) {
-    throw InvalidInput("duration: must be a finite number > 0 s, got " +
-                       std::to_string(req.duration));
-  }
+  requireDuration(req.duration, "duration");  // the rule planDriftTwoInput applies too
   r.duration = req.duration;
-  if (req.steps < 1) throw InvalidInput("steps: must be >= 1, got " + std::to_string(req.steps));
-  if (req.steps > defaults.max_steps) {
-    throw InvalidInput("steps: " + std::to_string(req.steps) +
-                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
-  }
-  r.steps = req.steps;
+  r.steps = stepsFromRequest(req.steps, defaults);
   for (int i = 0; i < 2; ++i) {
     const double c = req.control_weights[i];
     if (!std::isfinite(c) || !(c > 0.0)) {
@@ -303,6 +268,15 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
     r.time_budget_s = defaults.max_solve_time;
   }
   return r;
+}
+
+int stepsFromRequest(int steps, const PlannerDefaults& defaults) {
+  if (steps == 0) return defaults.steps;
+  if (steps > defaults.max_steps) {
+    throw InvalidInput("steps: " + std::to_string(steps) +
+                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
+  }
+  return steps;
 }
 
 AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double target,

@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
+#include <algorithm>
+
 #include "attitude_planner/ros/parameters.hpp"
 
 namespace attitude_planner {
@@ -82,13 +84,8 @@ void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world
 
 PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   ros_conversions::PlannerDefaults d;
-  d.scheme = readParam<std::string>(
-      pnh, "default_scheme", d.scheme,
-      [](const std::string& s) { return s == "paper" || s == "variational"; },
-      "paper or variational");
-  d.solver = readParam<std::string>(
-      pnh, "solver", d.solver, [](const std::string& s) { return s == "newton" || s == "nlopt"; },
-      "newton or nlopt");
+  d.scheme = readNamedParam(pnh, "default_scheme", d.scheme, kSchemeNames);
+  d.solver = readNamedParam(pnh, "solver", d.solver, kSolverNames);
   d.tolerance = readParam<double>(
       pnh, "tolerance", d.tolerance, [](double v) { return std::isfinite(v) && v > 0.0; }, "> 0");
   d.max_iterations = readParam<int>(
@@ -97,7 +94,12 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       pnh, "time_budget", d.time_budget, [](double v) { return std::isfinite(v) && v >= 0.0; },
       ">= 0 s, 0 = none");
   d.max_steps = readParam<int>(
-      pnh, "max_steps", d.max_steps, [](int v) { return v >= 4; }, ">= 4");
+      pnh, "max_steps", d.max_steps, [](int v) { return v >= kMinSteps; },
+      ">= " + std::to_string(kMinSteps));
+  d.steps = readParam<int>(
+      pnh, "default_steps", std::min(d.steps, d.max_steps),
+      [&](int v) { return v >= kMinSteps && v <= d.max_steps; },
+      ">= " + std::to_string(kMinSteps) + " and <= ~max_steps");
   d.max_solve_time = readParam<double>(
       pnh, "max_solve_time", d.max_solve_time, [](double v) { return std::isfinite(v) && v > 0.0; },
       "> 0 s");
@@ -118,8 +120,9 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   action_server_->start();
   ROS_INFO_STREAM("attitude_planner_node ready: services "
                   << service_.getService() << ", " << drift_service_.getService() << ", action "
-                  << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme " << d.scheme
-                  << ", solver " << d.solver << ", tolerance " << d.tolerance << ", max_iterations "
+                  << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme "
+                  << schemeName(d.scheme) << ", solver " << solverName(d.solver) << ", steps "
+                  << d.steps << ", tolerance " << d.tolerance << ", max_iterations "
                   << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "
                   << d.max_steps << ", max_solve_time " << d.max_solve_time << " s)");
 }
@@ -130,7 +133,7 @@ bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
     const PlanOutcome outcome = planRequest(req, defaults_, nullptr);
     fillResponse(outcome, world_frame_, body_frame_, &res);
     if (res.success) {
-      ROS_INFO("plan: N = %d converged in %d iterations, %.3f s, cost %.6g", req.steps,
+      ROS_INFO("plan: N = %d converged in %d iterations, %.3f s, cost %.6g", res.steps,
                res.iterations, res.solve_time, res.cost);
     } else {
       ROS_WARN("plan failed (error %d): %s", res.error_code.val, res.message.c_str());

@@ -128,8 +128,7 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     srv.request.duration = problem.duration;
     srv.request.steps = problem.steps;
     srv.request.scheme = schemeName(problem.scheme);
-    srv.request.direction =
-        problem.direction == RotationDirection::LongWay ? "long_way" : "shortest";
+    srv.request.direction = directionName(problem.direction);
     srv.request.extra_revolutions = problem.extra_revolutions;
     for (const EffectSpec& e : effects) {
       // Noise is random: the replay adds it, the plan cannot know it.
@@ -253,7 +252,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   std::string error;
   try {
     const Scene parsed = loadScene(scene);
-    if (parsed.system == "drift_two_input") {
+    if (parsed.system == SystemKind::DriftTwoInput) {
       const DriftTwoInputRequest request = driftTwoInputRequest(parsed);  // refuses effects
       ros::ServiceClient client;
       if (!plan_in_process) {
@@ -422,7 +421,8 @@ void TrackerNode::runReplay(Replay replay) {
     problem.initial_velocity = plan.angular_velocity.front();
     problem.final_attitude = plan.attitude.back();
     problem.final_velocity = plan.angular_velocity[N - 1];
-    problem.scheme = parseSchemeName(replay.msg.scheme.empty() ? "paper" : replay.msg.scheme);
+    if (!replay.msg.scheme.empty())
+      problem.scheme = parseScheme(replay.msg.scheme, "maneuver.scheme");
     validateProblem(problem);
     const DiscreteScheme scheme(problem.scheme, inertia, plan.time_step);
     // Exactly the effects of the replay's scene: forcing on the body, then what the actuators do.

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "attitude_planner/errors.hpp"
@@ -67,6 +68,16 @@ struct InvalidFlagValue {
   std::string message;
 };
 
+/// Runs a core name check on a flag's value: a refused name is a bad flag value (exit 1).
+template <class Check>
+void checkFlagValue(const Check& check) {
+  try {
+    check();
+  } catch (const ap::InvalidInput& e) {
+    throw InvalidFlagValue{e.what()};
+  }
+}
+
 int parseInt(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   errno = 0;
@@ -106,7 +117,7 @@ ap::Vector3 parseCostate(const std::string& text) {
 
 struct Arguments {
   std::string scene;
-  int steps = 0;  ///< 0: the scene's
+  std::optional<int> steps;  ///< absent: the scene's
   std::string scheme;
   std::string solver = "newton";
   bool solver_given = false;    ///< --solver was on the command line
@@ -153,21 +164,16 @@ Arguments parseArguments(int argc, char** argv) {
       return argv[++i];
     };
     if (arg == "--steps") {
+      // Its range is the planner's rule (validateProblem / planDriftTwoInput), checked there.
       a.steps = parseInt(arg, next());
-      if (a.steps < 1)
-        throw InvalidFlagValue{"--steps: must be >= 4, got " + std::to_string(a.steps)};
     } else if (arg == "--scheme") {
       a.scheme = next();
-      if (a.scheme != "paper" && a.scheme != "variational" && a.scheme != "auto") {
-        throw InvalidFlagValue{"--scheme: unknown value '" + a.scheme +
-                               "' (paper, variational or auto)"};
-      }
+      ap::PlanningProblem checked;
+      checkFlagValue([&] { ap::applySchemeName(a.scheme, arg, &checked); });
     } else if (arg == "--solver") {
       a.solver = next();
       a.solver_given = true;
-      if (a.solver != "newton" && a.solver != "nlopt") {
-        throw InvalidFlagValue{"--solver: unknown value '" + a.solver + "' (newton or nlopt)"};
-      }
+      checkFlagValue([&] { ap::parseSolver(a.solver, arg); });
     } else if (arg == "--tolerance") {
       value_text = next();
       a.tolerance = parseDouble(arg, value_text);
@@ -194,16 +200,10 @@ Arguments parseArguments(int argc, char** argv) {
       if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
     } else if (arg == "--direction") {
       a.direction = next();
-      if (a.direction != "shortest" && a.direction != "long_way") {
-        throw InvalidFlagValue{"--direction: unknown value '" + a.direction +
-                               "' (shortest or long_way)"};
-      }
+      checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
     } else if (arg == "--extra-revolutions") {
       a.extra_revolutions = parseInt(arg, next());
-      if (a.extra_revolutions < 0) {
-        throw InvalidFlagValue{"--extra-revolutions: must be >= 0, got " +
-                               std::to_string(a.extra_revolutions)};
-      }
+      checkFlagValue([&] { ap::requireExtraRevolutions(a.extra_revolutions, arg); });
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
       parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
@@ -216,10 +216,10 @@ Arguments parseArguments(int argc, char** argv) {
     }
   }
   if (!a.help && a.scene.empty()) throw UsageError{"missing SCENE.yaml"};
-  if (!a.target_flag.empty() && a.steps > 0) {
+  if (!a.target_flag.empty() && a.steps) {
     throw UsageError{a.target_flag + " chooses N: do not give --steps with it"};
   }
-  if (a.scheme == "auto" && a.target_flag.empty()) {
+  if (a.scheme == ap::kAutoSchemeName && a.target_flag.empty()) {
     throw UsageError{"--scheme auto needs --target-miss or --target-cost-error"};
   }
   return a;
@@ -236,7 +236,7 @@ int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
     return 2;
   }
   ap::DriftTwoInputRequest request = ap::driftTwoInputRequest(scene);
-  if (args.steps > 0) request.steps = args.steps;
+  if (args.steps) request.steps = *args.steps;
   if (args.tolerance > 0.0) request.tolerance = args.tolerance;
   if (args.max_iterations > 0) request.max_iterations = args.max_iterations;
   request.time_budget_s = args.time_budget;
@@ -283,7 +283,7 @@ int main(int argc, char** argv) {
 
   try {
     ap::Scene scene = ap::loadScene(args.scene);
-    if (scene.system == "drift_two_input") return runDriftTwoInput(args, scene);
+    if (scene.system == ap::SystemKind::DriftTwoInput) return runDriftTwoInput(args, scene);
     if (!args.initial_costate.empty()) {
       std::cerr << "plan_maneuver: --initial-costate applies to system: drift_two_input only\n\n"
                 << kUsage;
@@ -291,23 +291,20 @@ int main(int argc, char** argv) {
     }
     ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
     ap::PlanningProblem& problem = scene.problem;
-    if (args.steps > 0) problem.steps = args.steps;
-    if (!args.scheme.empty() && args.scheme != "auto") {
-      problem.scheme = ap::parseSchemeName(args.scheme);
-    }
+    if (args.steps) problem.steps = *args.steps;
+    if (!args.scheme.empty()) ap::applySchemeName(args.scheme, "--scheme", &problem);
     if (!args.target_flag.empty()) {
       problem.accuracy.measure = args.target_flag == "--target-miss"
                                      ? ap::AccuracyMeasure::TerminalMiss
                                      : ap::AccuracyMeasure::CostError;
       problem.accuracy.value = args.target_value;
-      problem.accuracy.choose_scheme = args.scheme == "auto";
     }
-    if (args.direction == "shortest") problem.direction = ap::RotationDirection::Shortest;
-    if (args.direction == "long_way") problem.direction = ap::RotationDirection::LongWay;
+    if (!args.direction.empty())
+      problem.direction = ap::parseDirection(args.direction, "--direction");
     if (args.extra_revolutions >= 0) problem.extra_revolutions = args.extra_revolutions;
 
     ap::SolverOptions options;
-    options.solver = args.solver;
+    options.solver = ap::parseSolver(args.solver, "--solver");
     if (args.tolerance > 0.0) options.tolerance = args.tolerance;
     if (args.max_iterations > 0) options.max_iterations = args.max_iterations;
     options.time_budget_s = args.time_budget;

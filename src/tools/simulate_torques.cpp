@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
     const ap::Scene scene = ap::loadScene(scene_path);
     ap::requirePlannable(scene);  // rigid_body scenes only (drift_two_input has no torques)
     const ap::PlanningProblem& p = scene.problem;
-    const ap::SchemeKind kind = scheme.empty() ? p.scheme : ap::parseSchemeName(scheme);
+    const ap::SchemeKind kind = scheme.empty() ? p.scheme : ap::parseScheme(scheme, "--scheme");
     const ap::Maneuver planned = ap::readManeuverCsv(csv_path);
     const int N = planned.steps();
     const double h = planned.time.back() / N;  // the CSV's time base

@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "fuzz_common.hpp"
 
@@ -29,16 +30,12 @@ struct Reader {
   }
 };
 
-/// The node's quaternion check (ros_conversions::attitudeFromMsg), without ROS types.
+/// The node's quaternion check (ros_conversions::attitudeFromMsg: attitudeFromQuaternion), without
+/// ROS types.
 inline attitude_planner::Matrix3 attitudeOf(Reader& r) {
-  namespace ap = attitude_planner;
-  const double w = r.next<double>(), x = r.next<double>(), y = r.next<double>(),
-               z = r.next<double>();
-  if (!std::isfinite(w) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
-    throw ap::InvalidInput("quaternion not finite");
-  const double norm = std::sqrt(w * w + x * x + y * y + z * z);
-  if (norm == 0.0 || std::abs(norm - 1.0) > 1e-3) throw ap::InvalidInput("quaternion not unit");
-  return ap::so3::fromQuaternion(Eigen::Quaterniond(w, x, y, z));
+  Eigen::Vector4d wxyz;
+  for (int i = 0; i < 4; ++i) wxyz(i) = r.next<double>();
+  return attitude_planner::attitudeFromQuaternion(wxyz, "quaternion");
 }
 
 inline int fuzzRequest(const std::uint8_t* data, std::size_t size) {

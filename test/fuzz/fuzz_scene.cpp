@@ -27,7 +27,7 @@ inline int fuzzScene(const std::uint8_t* data, std::size_t size) {
   } catch (const ap::InvalidInput&) {
     return 0;  // the expected refusal
   }
-  if (scene.system == "drift_two_input") {
+  if (scene.system == ap::SystemKind::DriftTwoInput) {
     try {
       ap::driftTwoInputRequest(scene);
     } catch (const ap::InvalidInput&) {

@@ -99,7 +99,8 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   cases.back().req.inertia[4] = std::numeric_limits<double>::quiet_NaN();
   cases.push_back({"steps = 2", seed(), "steps: must be >= 4, got 2"});
   cases.back().req.steps = 2;
-  cases.push_back({"non-unit quaternion", seed(), "initial_attitude: quaternion norm 2"});
+  cases.push_back(
+      {"non-unit quaternion", seed(), "initial_attitude: not a unit quaternion: [2, 0, 0, 0]"});
   cases.back().req.initial_attitude.w = 2.0;
   cases.push_back({"unknown scheme", seed(), "scheme: unknown value 'rk4'"});
   cases.back().req.scheme = "rk4";
@@ -119,6 +120,15 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   const PlanAttitudeManeuver::Response good = call(seed());
   EXPECT_TRUE(good.success) << good.message;
   EXPECT_LT(good.terminal_attitude_error, 1e-8);
+}
+
+TEST_F(PlannerService, StepsLeftAtZeroTakeTheNodesDefaultSteps) {
+  // Issue 15, defect 3: empty/0 fields take the node's defaults (README), steps included; the
+  // node here runs with ~default_steps = 128 (launch/planner.launch).
+  const PlanAttitudeManeuver::Response res = call(seed(0));
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.steps, 128);
+  EXPECT_EQ(res.maneuver.attitude.size(), size_t(129));
 }
 
 TEST_F(PlannerService, StepTooLargeIsItsOwnErrorAndTheNodeKeepsServing) {
@@ -192,7 +202,7 @@ TEST_F(PlannerService, EffectsArePlannedListedAndLandWhenReplayedUnderThem) {
   r.scheme = "variational";
   const std::vector<EffectSpec> effects = {
       GravityGradientSpec{3.986004418e14, 6.778e6},
-      DisturbanceTorqueSpec{"world", Vector3(2e-4, 0.0, -1e-4)}};
+      DisturbanceTorqueSpec{TorqueFrame::World, Vector3(2e-4, 0.0, -1e-4)}};
   for (const EffectSpec& e : effects) r.effects.push_back(rc::effectToMsg(e));
   const PlanAttitudeManeuver::Response res = call(r);
   ASSERT_TRUE(res.success) << res.message;

@@ -67,7 +67,7 @@ TEST(RosConversions, ZeroQuaternionNamesTheField) {
 TEST(RosConversions, NonUnitAndNanQuaternionsAreRejected) {
   PlanAttitudeManeuver::Request r = seedRequest();
   r.initial_attitude.w = 1.1;
-  EXPECT_NE(invalidMessage(r).find("initial_attitude: quaternion norm 1.1"), std::string::npos);
+  EXPECT_NE(invalidMessage(r).find("initial_attitude: not a unit quaternion"), std::string::npos);
   r.initial_attitude.w = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(invalidMessage(r).find("initial_attitude: quaternion not finite"), std::string::npos);
 }
@@ -135,7 +135,9 @@ TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
        [&](auto* r) { r->final_attitude = geometry_msgs::Quaternion(); },
        PlanErrorCode::INVALID_INPUT, "final_attitude: zero quaternion"},
       {"initial_attitude = (2, 0, 0, 0)", [&](auto* r) { r->initial_attitude.w = 2.0; },
-       PlanErrorCode::INVALID_INPUT, "initial_attitude: quaternion norm 2 is not 1"},
+       PlanErrorCode::INVALID_INPUT,
+       "initial_attitude: not a unit quaternion: [2, 0, 0, 0] has norm 2 (must be within 0.001 of "
+       "1"},
       {"duration = 0", [&](auto* r) { r->duration = 0.0; }, PlanErrorCode::INVALID_INPUT,
        "duration: must be a finite number > 0 s, got 0"},
       {"duration = -12.8", [&](auto* r) { r->duration = -12.8; }, PlanErrorCode::INVALID_INPUT,
@@ -233,7 +235,7 @@ TEST(RosConversions, MaxSolveTimeCapsEveryRequestsBudget) {
 TEST(RosConversions, EffectMessagesRoundTrip) {
   const std::vector<EffectSpec> specs = {
       GravityGradientSpec{3.986004418e14, 6.778e6},
-      DisturbanceTorqueSpec{"world", Vector3(2e-4, 0.0, -1e-4)},
+      DisturbanceTorqueSpec{TorqueFrame::World, Vector3(2e-4, 0.0, -1e-4)},
       ActuatorLimitsSpec{Vector3(0.3, 0.4, 0.5)},
       TorqueNoiseSpec{Vector3(1e-4, 2e-4, 0.0), 7},
   };
@@ -264,7 +266,7 @@ TEST(RosConversions, BadEffectsNameTheFieldAndTheValue) {
   stray.value.x = 1.0;  // not read by gravity_gradient: a mistake, not a default
   EXPECT_NE(message({stray}).find("effects[0].value: not used by type 'gravity_gradient'"),
             std::string::npos);
-  Effect frame = rc::effectToMsg(DisturbanceTorqueSpec{"body", Vector3(1e-3, 0, 0)});
+  Effect frame = rc::effectToMsg(DisturbanceTorqueSpec{TorqueFrame::Body, Vector3(1e-3, 0, 0)});
   frame.frame = "orbit";
   EXPECT_NE(message({frame}).find("effects[0].disturbance_torque.frame: unknown value 'orbit'"),
             std::string::npos);
@@ -283,7 +285,8 @@ TEST(RosConversions, BadEffectsNameTheFieldAndTheValue) {
 
 TEST(RosConversions, RequestEffectsEnterThePlanningModel) {
   PlanAttitudeManeuver::Request r = seedRequest();
-  r.effects.push_back(rc::effectToMsg(DisturbanceTorqueSpec{"body", Vector3(1e-3, 0.0, 0.0)}));
+  r.effects.push_back(
+      rc::effectToMsg(DisturbanceTorqueSpec{TorqueFrame::Body, Vector3(1e-3, 0.0, 0.0)}));
   SolverOptions options;
   PlanningProblem p = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
   ASSERT_TRUE(p.effects);
@@ -300,20 +303,50 @@ TEST(RosConversions, RequestEffectsEnterThePlanningModel) {
 
 TEST(RosConversions, DefaultsFillEmptyFields) {
   rc::PlannerDefaults d;
-  d.scheme = "variational";
+  d.scheme = SchemeKind::Variational;
   d.tolerance = 1e-7;
   d.max_iterations = 17;
   d.time_budget = 3.0;
   SolverOptions options;
   const PlanningProblem p = rc::problemFromRequest(seedRequest(), d, &options);
   EXPECT_EQ(p.scheme, SchemeKind::Variational);
-  EXPECT_EQ(options.solver, "newton");
+  EXPECT_EQ(options.solver, SolverKind::Newton);
   EXPECT_EQ(options.tolerance, 1e-7);
   EXPECT_EQ(options.max_iterations, 17);
   EXPECT_EQ(options.time_budget_s, 3.0);
   EXPECT_EQ(p.steps, 32);
   EXPECT_LT(so3::angleBetween(p.final_attitude, so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3)),
             1e-15);
+}
+
+TEST(RosConversions, StepsLeftAtZeroTakeTheNodesDefaultSteps) {
+  // Issue 15, defect 3: a request that leaves steps at 0 was refused ("steps: must be >= 4, got
+  // 0") although empty/0 fields take the node's defaults.
+  rc::PlannerDefaults d;
+  EXPECT_EQ(d.steps, 128);
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.steps = 0;
+  SolverOptions options;
+  EXPECT_EQ(rc::problemFromRequest(r, d, &options).steps, 128);
+  d.steps = 64;
+  EXPECT_EQ(rc::problemFromRequest(r, d, &options).steps, 64);
+  PlanDriftTwoInput::Request drift;
+  drift.initial_attitude.w = 1.0;
+  drift.final_attitude.w = 1.0;
+  drift.duration = 1.0;
+  drift.control_weights = {1.0, 1.0};
+  EXPECT_EQ(rc::driftRequestFromMsg(drift, d).steps, 64);
+  // A negative N is still refused by the planner's own rule, naming the value.
+  r.steps = -1;
+  EXPECT_NE(invalidMessage(r).find("steps: must be >= 4, got -1"), std::string::npos);
+}
+
+TEST(RosConversions, EffectTypeConstantsAreTheEffectNames) {
+  // Effect.msg spells the types as constants; the core's name table must agree with them.
+  EXPECT_EQ(Effect::GRAVITY_GRADIENT, effectKindName(EffectKind::GravityGradient));
+  EXPECT_EQ(Effect::DISTURBANCE_TORQUE, effectKindName(EffectKind::DisturbanceTorque));
+  EXPECT_EQ(Effect::ACTUATOR_LIMITS, effectKindName(EffectKind::ActuatorLimits));
+  EXPECT_EQ(Effect::TORQUE_NOISE, effectKindName(EffectKind::TorqueNoise));
 }
 
 TEST(RosConversions, ManeuverMessageRoundTrip) {

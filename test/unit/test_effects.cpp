@@ -20,8 +20,9 @@ constexpr double kMu = 3.986004418e14, kRadius = 6.778e6;  // Earth, 400 km orbi
 std::vector<std::unique_ptr<TorqueEffect>> sampleEffects() {
   std::vector<std::unique_ptr<TorqueEffect>> out;
   out.push_back(std::make_unique<GravityGradient>(kMu, kRadius, kInertia));
-  out.push_back(std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), true));
-  out.push_back(std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), false));
+  out.push_back(
+      std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), TorqueFrame::World));
+  out.push_back(std::make_unique<DisturbanceTorque>(Vector3(1e-3, -2e-3, 5e-4), TorqueFrame::Body));
   return out;
 }
 
@@ -124,7 +125,7 @@ TEST(Effects, ABodyDisturbanceActsLikeAnExtraControlTorque) {
   const Vector3 d(2e-3, -1e-3, 4e-4);
   auto torque = someTorques(150);
   EffectModel disturbed;
-  disturbed.add(std::make_unique<DisturbanceTorque>(d, false));
+  disturbed.add(std::make_unique<DisturbanceTorque>(d, TorqueFrame::Body));
   const Maneuver a = run(torque, &disturbed, nullptr);
   for (int k = 1; k < 150; ++k) torque[k] += d;
   const Maneuver b = run(torque, nullptr, nullptr);
@@ -168,7 +169,7 @@ PlanningProblem leoSlew(bool with_effects) {
   if (with_effects) {
     auto model = std::make_shared<EffectModel>();
     model->add(std::make_unique<GravityGradient>(kMu, kRadius, p.inertia));
-    model->add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), true));
+    model->add(std::make_unique<DisturbanceTorque>(Vector3(2e-4, 0, -1e-4), TorqueFrame::World));
     p.effects = model;
   }
   return p;

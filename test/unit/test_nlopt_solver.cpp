@@ -118,7 +118,7 @@ TEST_P(SeedExamples, NloptReachesAFeasibleKktPoint) {
   const SeedCase sc = GetParam();
   const ap::PlanningProblem p = seedProblem(sc.scene, sc.steps, sc.scheme);
   ap::SolverOptions options;
-  options.solver = "nlopt";
+  options.solver = ap::SolverKind::Nlopt;
   options.max_iterations = 2000;
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_TRUE(r.converged()) << r.message;
@@ -173,7 +173,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(NloptSolver, CancellationStopsAndIsReported) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 16, ap::SchemeKind::Paper);
   ap::SolverOptions options;
-  options.solver = "nlopt";
+  options.solver = ap::SolverKind::Nlopt;
   int calls = 0;
   options.on_iteration = [&](const ap::IterationInfo&) { return ++calls < 3; };
   const ap::PlanResult r = ap::planManeuver(p, options);
@@ -185,7 +185,7 @@ TEST(NloptSolver, CancellationStopsAndIsReported) {
 TEST(NloptSolver, IterationLimitIsHonoredAndNotConverged) {
   const ap::PlanningProblem p = seedProblem("slew_up.yaml", 16, ap::SchemeKind::Paper);
   ap::SolverOptions options;
-  options.solver = "nlopt";
+  options.solver = ap::SolverKind::Nlopt;
   options.max_iterations = 3;
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());
@@ -205,10 +205,10 @@ TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
   const SeedCase sc = GetParam();
   const ap::PlanningProblem p = seedProblem(sc.scene, sc.steps, sc.scheme);
   ap::SolverOptions newton_options;
-  newton_options.solver = "newton";
+  newton_options.solver = ap::SolverKind::Newton;
   const ap::PlanResult newton = ap::planManeuver(p, newton_options);
   ap::SolverOptions nlopt_options;
-  nlopt_options.solver = "nlopt";
+  nlopt_options.solver = ap::SolverKind::Nlopt;
   nlopt_options.max_iterations = 2000;
   const ap::PlanResult nlopt = ap::planManeuver(p, nlopt_options);
   ASSERT_TRUE(newton.converged()) << newton.message;
@@ -245,7 +245,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 5000, ap::SchemeKind::Paper);
   ap::SolverOptions options;
-  options.solver = "nlopt";
+  options.solver = ap::SolverKind::Nlopt;
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());
   EXPECT_NE(r.message.find("steps 5000 > 1024"), std::string::npos) << r.message;
@@ -255,7 +255,7 @@ TEST(NloptSolver, ExhaustedTimeBudgetIsNotConvergence) {
   // A budget no solve can meet (1 ns): the result must say so rather than claim convergence.
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 32, ap::SchemeKind::Paper);
   ap::SolverOptions options;
-  options.solver = "nlopt";
+  options.solver = ap::SolverKind::Nlopt;
   options.time_budget_s = 1e-9;
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());

@@ -160,6 +160,21 @@ TEST_F(CliTest, InvalidSceneExitsOneNamingTheKey) {
   EXPECT_CONTAINS(steps.output, "steps: must be >= 4, got 2");
 }
 
+TEST_F(CliTest, StepsAreCheckedByThePlannersRuleOnly) {
+  // Issue 15, defect 2: the CLI had its own copy of the rule (`< 1`, worded ">= 4"): --steps 0
+  // was refused with the wrong bound for both systems. Now each planner's rule decides.
+  for (const char* bad : {"0", "-5", "3"}) {
+    const ToolRun r = run("plan_maneuver", kScenes + "rest_to_rest.yaml --steps " + bad);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_CONTAINS(r.output, std::string("invalid input: steps: must be >= 4, got ") + bad);
+    EXPECT_EQ(r.output.find("--steps: must be"), std::string::npos) << r.output;
+  }
+  // The drift + two-input system needs N >= 1 only: --steps 0 is refused with that bound.
+  const ToolRun drift = run("plan_maneuver", kScenes + "drift_two_input.yaml --steps 0");
+  EXPECT_EQ(drift.status, 1) << drift.output;
+  EXPECT_CONTAINS(drift.output, "steps must be >= 1, got 0");
+}
+
 TEST_F(CliTest, EffectsArePlannedByNewtonAndRefusedWhereUnsupported) {
   std::string text = readFile(kScenes + "rest_to_rest.yaml");
   text.replace(text.find("effects: []"), 11,

@@ -31,7 +31,7 @@ PlanningProblem randomProblem(SchemeKind scheme, int N) {
 PlanningProblem withEffects(PlanningProblem p) {
   auto model = std::make_shared<EffectModel>();
   model->add(std::make_unique<GravityGradient>(1.0, 1.0, p.inertia));  // n = 1 rad/s
-  model->add(std::make_unique<DisturbanceTorque>(Vector3(0.5, -0.2, 0.3), true));
+  model->add(std::make_unique<DisturbanceTorque>(Vector3(0.5, -0.2, 0.3), TorqueFrame::World));
   p.effects = model;
   return p;
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 #include <string>
 
 #include "attitude_planner/errors.hpp"
@@ -74,7 +75,7 @@ TEST(SceneFiles, RestToRestIsSeedExampleOne) {
   EXPECT_LT((ap::so3::log(p.final_attitude) - ap::Vector3(M_PI / 3, 0, 0)).norm(), 1e-15);
   EXPECT_EQ(p.final_velocity, ap::Vector3::Zero());
   EXPECT_TRUE(s.effects.empty());
-  EXPECT_EQ(s.system, "rigid_body");
+  EXPECT_EQ(s.system, ap::SystemKind::RigidBody);
   EXPECT_NO_THROW(ap::requirePlannable(s));
 }
 
@@ -134,9 +135,9 @@ TEST(SceneOptionalKeys, EffectsAreParsedIntoThePlanningModelAndActuation) {
   EXPECT_EQ(g.mu, 3.986004418e14);
   EXPECT_EQ(g.orbit_radius, 7.0e6);
   const auto& d = std::get<ap::DisturbanceTorqueSpec>(s.effects[1]);
-  EXPECT_EQ(d.frame, "world");
+  EXPECT_EQ(d.frame, ap::TorqueFrame::World);
   EXPECT_EQ(d.value, ap::Vector3(1e-4, 0, -2e-4));
-  EXPECT_EQ(std::get<ap::DisturbanceTorqueSpec>(s.effects[2]).frame, "body");
+  EXPECT_EQ(std::get<ap::DisturbanceTorqueSpec>(s.effects[2]).frame, ap::TorqueFrame::Body);
   EXPECT_EQ(std::get<ap::ActuatorLimitsSpec>(s.effects[3]).max_torque, ap::Vector3(0.5, 0.5, 0.25));
   const auto& n = std::get<ap::TorqueNoiseSpec>(s.effects[4]);
   EXPECT_EQ(n.std, ap::Vector3(1e-3, 1e-3, 0));
@@ -166,7 +167,7 @@ TEST(SceneOptionalKeys, DriftTwoInputSystemIsStoredAndRefusedByThePlanner) {
       "initial: {attitude: {axis: [0, 0, 1], angle: 0}}\n"
       "final: {attitude: {quaternion: [1, 0, 0, 0]}}\neffects: []\n";
   const ap::Scene s = ap::parseScene(text);
-  EXPECT_EQ(s.system, "drift_two_input");
+  EXPECT_EQ(s.system, ap::SystemKind::DriftTwoInput);
   EXPECT_EQ(s.control_weights, Eigen::Vector2d(1.0, 2.5));
   try {
     ap::requirePlannable(s);
@@ -415,7 +416,7 @@ TEST(SceneRoundTrip, EffectsAndDriftSystemSurviveFormatting) {
       "{disturbance_torque: {frame: world, value: [1, 2, 3]}}]\n";
   const ap::Scene s = ap::parseScene(text);
   const ap::Scene back = ap::parseScene(ap::formatScene(s));
-  EXPECT_EQ(back.system, "drift_two_input");
+  EXPECT_EQ(back.system, ap::SystemKind::DriftTwoInput);
   EXPECT_EQ(back.control_weights, s.control_weights);
   ASSERT_EQ(back.effects.size(), 2u);
   EXPECT_EQ(std::get<ap::TorqueNoiseSpec>(back.effects[0]).seed, 18446744073709551615ull);
@@ -431,4 +432,72 @@ TEST(SceneFiles, MissingFileIsNamed) {
   } catch (const ap::InvalidInput& e) {
     EXPECT_CONTAINS(e.what(), "/nonexistent/scene.yaml");
   }
+}
+
+TEST(SceneFiles, AbsentEffectsKeyMeansNone) {
+  // Issue 15, defect 4: a scene without `effects:` was refused ("effects: missing (required)").
+  const ap::Scene absent = ap::parseScene(withLine("effects", ""), "no_effects.yaml");
+  EXPECT_TRUE(absent.effects.empty());
+  EXPECT_FALSE(absent.problem.effects);
+  EXPECT_FALSE(absent.problem.hasTorqueBounds());
+  const ap::Scene empty = ap::parseScene(kValid, "empty_effects.yaml");  // `effects: []` stays
+  EXPECT_TRUE(empty.effects.empty());
+  EXPECT_EQ(ap::formatScene(absent), ap::formatScene(empty));
+}
+
+TEST(NameTables, EveryNameRoundTripsAndIsUnique) {
+  const auto check = [](const auto& table, auto name, auto parse) {
+    std::set<std::string> names;
+    for (const auto& row : table) {
+      EXPECT_EQ(name(row.value), row.name);
+      EXPECT_EQ(parse(row.name, "field"), row.value) << row.name;
+      EXPECT_TRUE(names.insert(row.name).second) << "duplicate name " << row.name;
+    }
+  };
+  check(ap::kSchemeNames, ap::schemeName, ap::parseScheme);
+  check(ap::kSolverNames, ap::solverName, ap::parseSolver);
+  check(ap::kRotationDirectionNames, ap::directionName, ap::parseDirection);
+  check(ap::kSystemNames, ap::systemName, ap::parseSystem);
+  check(ap::kTorqueFrameNames, ap::torqueFrameName, ap::parseTorqueFrame);
+  check(ap::kAccuracyMeasureNames, ap::accuracyMeasureName, ap::parseAccuracyMeasure);
+  check(ap::kEffectKindNames, ap::effectKindName, ap::parseEffectKind);
+}
+
+TEST(NameTables, UnknownNameIsRefusedNamingFieldValueAndEveryAcceptedName) {
+  try {
+    ap::parseSolver("magic", "--solver");
+    ADD_FAILURE() << "no InvalidInput";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "--solver: unknown value 'magic' (expected newton or nlopt)");
+  }
+  EXPECT_CONTAINS(errorOf(withLine("effects", "effects: []\ndirection: sideways")),
+                  "direction: unknown value 'sideways' (expected shortest or long_way)");
+  EXPECT_CONTAINS(errorOf(withLine("effects", "effects: [{solar_pressure: {}}]")),
+                  "unknown effect (expected gravity_gradient, disturbance_torque, "
+                  "actuator_limits or torque_noise)");
+  ap::PlanningProblem p;
+  try {
+    ap::applySchemeName("rk4", "scheme", &p);
+    ADD_FAILURE() << "no InvalidInput";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "scheme: unknown value 'rk4' (expected paper, variational or auto)");
+  }
+  ap::applySchemeName("auto", "scheme", &p);
+  EXPECT_TRUE(p.accuracy.choose_scheme);
+  EXPECT_THROW(ap::validateProblem(p), ap::InvalidInput);  // auto needs an accuracy target
+}
+
+TEST(QuaternionRule, SceneAndMessagesShareOneToleranceAndMessage) {
+  const Eigen::Vector4d near_unit(0.7071, 0.7071, 0, 0);  // norm 0.99998: typed, accepted
+  EXPECT_LT(ap::so3::angleBetween(ap::attitudeFromQuaternion(near_unit, "q"),
+                                  ap::so3::fromAxisAngle(ap::Vector3::UnitX(), M_PI / 2)),
+            1e-12);
+  try {
+    ap::attitudeFromQuaternion(Eigen::Vector4d(2, 0, 0, 0), "initial_attitude");
+    ADD_FAILURE() << "no InvalidInput";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_CONTAINS(e.what(), "initial_attitude: not a unit quaternion: [2, 0, 0, 0] has norm 2");
+  }
+  EXPECT_THROW(ap::attitudeFromQuaternion(Eigen::Vector4d::Zero(), "q"), ap::InvalidInput);
+  EXPECT_THROW(ap::attitudeFromQuaternion(Eigen::Vector4d(NAN, 0, 0, 1), "q"), ap::InvalidInput);
 }

@@ -21,16 +21,27 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/name_table.hpp"
 
 namespace attitude_planner {
 
 /// Which discretization of the rigid body.
 enum class SchemeKind { Paper, Variational };
 
+/// The names of the schemes (scene key `scheme`, --scheme, request field `scheme`, JSON).
+inline constexpr NamedValue<SchemeKind> kSchemeNames[] = {
+    {SchemeKind::Paper, "paper"},
+    {SchemeKind::Variational, "variational"},
+};
+
 /// "paper" or "variational".
-std::string schemeName(SchemeKind kind);
-/// Parses "paper" / "variational"; throws InvalidInput naming the value otherwise.
-SchemeKind parseSchemeName(const std::string& name);
+inline std::string schemeName(SchemeKind kind) {
+  return nameIn(kSchemeNames, kind);
+}
+/// The scheme named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline SchemeKind parseScheme(const std::string& text, const std::string& field) {
+  return parseIn(kSchemeNames, text, field);
+}
 
 /// Outcome of one implicit step solve μ(F) = p.
 struct StepSolveReport {

@@ -14,8 +14,47 @@
 #include <vector>
 
 #include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/name_table.hpp"
 
 namespace attitude_planner {
+
+/// The effects a scene or a request may list (plannable torques and tracker-side actuation).
+enum class EffectKind { GravityGradient, DisturbanceTorque, ActuatorLimits, TorqueNoise };
+
+/// The names of the effects (scene keys under `effects:`, Effect.msg `type`, JSON `effects`).
+inline constexpr NamedValue<EffectKind> kEffectKindNames[] = {
+    {EffectKind::GravityGradient, "gravity_gradient"},
+    {EffectKind::DisturbanceTorque, "disturbance_torque"},
+    {EffectKind::ActuatorLimits, "actuator_limits"},
+    {EffectKind::TorqueNoise, "torque_noise"},
+};
+
+/// "gravity_gradient", "disturbance_torque", "actuator_limits" or "torque_noise".
+inline std::string effectKindName(EffectKind kind) {
+  return nameIn(kEffectKindNames, kind);
+}
+/// The effect named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline EffectKind parseEffectKind(const std::string& text, const std::string& field) {
+  return parseIn(kEffectKindNames, text, field);
+}
+
+/// The frame a constant torque is given in.
+enum class TorqueFrame { Body, World };
+
+/// The names of the frames (disturbance_torque `frame`, scene and Effect.msg).
+inline constexpr NamedValue<TorqueFrame> kTorqueFrameNames[] = {
+    {TorqueFrame::Body, "body"},
+    {TorqueFrame::World, "world"},
+};
+
+/// "body" or "world".
+inline std::string torqueFrameName(TorqueFrame frame) {
+  return nameIn(kTorqueFrameNames, frame);
+}
+/// The frame named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline TorqueFrame parseTorqueFrame(const std::string& text, const std::string& field) {
+  return parseIn(kTorqueFrameNames, text, field);
+}
 
 /// A known external torque on the body.
 class TorqueEffect {
@@ -38,7 +77,7 @@ class GravityGradient : public TorqueEffect {
  public:
   /// μ [m³/s²], r [m], J [kg m²].
   GravityGradient(double mu, double orbit_radius, const Matrix3& inertia);
-  std::string name() const override { return "gravity_gradient"; }
+  std::string name() const override { return effectKindName(EffectKind::GravityGradient); }
   Vector3 torque(const Matrix3& R, double t) const override;
   Matrix3 jacobian(const Matrix3& R, double t) const override;
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
@@ -55,9 +94,9 @@ class GravityGradient : public TorqueEffect {
 /// A known constant torque, given in the body or the world frame.
 class DisturbanceTorque : public TorqueEffect {
  public:
-  /// value [N m] expressed in the body frame (in_world = false) or the world frame.
-  DisturbanceTorque(const Vector3& value, bool in_world);
-  std::string name() const override { return "disturbance_torque"; }
+  /// value [N m] expressed in `frame`.
+  DisturbanceTorque(const Vector3& value, TorqueFrame frame);
+  std::string name() const override { return effectKindName(EffectKind::DisturbanceTorque); }
   Vector3 torque(const Matrix3& R, double t) const override;
   Matrix3 jacobian(const Matrix3& R, double t) const override;
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;

@@ -3,18 +3,18 @@
 // Keys (units SI, REP 103):
 //   inertia          3×3 nested list, or 3 principal moments [a, b, c]        [kg·m²]
 //   duration         T > 0                                                     [s]
-//   steps            N, 4 ≤ N ≤ 2,000,000 (validateProblem; ~2.3 kB/step)
+//   steps            N, kMinSteps ≤ N ≤ kMaxSteps (planning/problem.hpp, validateProblem)
 //   initial, final   {attitude: A, angular_velocity: [x, y, z]}                [rad/s] body
 //                    (drift_two_input: {attitude: A} only; angular_velocity is an error there,
 //                    the kinematic system's body rate E3 + u1 E1 + u2 E2 is not a boundary value)
 //                    A = {axis: [x, y, z], angle: a [rad]} or {quaternion: [w, x, y, z]}
-//   effects          list of single-key maps (see EffectSpec)
+//   effects          optional list of single-key maps (see EffectSpec); absent or []: none
 //   scheme           optional: paper (default) | variational
 //   system           optional: rigid_body (default) | drift_two_input (seed 001)
 //   control_weights  [c1, c2] > 0, only with system: drift_two_input
 //   initial_costate  optional [p1, p2, p3] (finite), only with system: drift_two_input: guess for
 //                    the extremal's p(0) [c·rad/s] (default: the planner's own starts)
-//   effects          required for rigid_body, optional for drift_two_input (must then be [])
+//                    (drift_two_input: must be absent or [])
 //   direction        optional: shortest (default) | long_way (rigid_body; see RotationDirection)
 //   extra_revolutions optional integer ≥ 0: whole extra turns (rigid_body; validateProblem)
 //   allow_nonphysical_inertia  optional bool (default false): accept an SPD inertia whose
@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "attitude_planner/drift_two_input/planner.hpp"
+#include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planner.hpp"
 
 namespace attitude_planner {
@@ -41,8 +42,8 @@ struct GravityGradientSpec {
 
 /// A constant disturbance torque [N·m].
 struct DisturbanceTorqueSpec {
-  std::string frame = "body";       ///< "body" or "world": the frame `value` is expressed in
-  Vector3 value = Vector3::Zero();  ///< torque [N·m]
+  TorqueFrame frame = TorqueFrame::Body;  ///< the frame `value` is expressed in
+  Vector3 value = Vector3::Zero();        ///< torque [N·m]
 };
 
 /// Per-axis saturation of the control torque (body frame).
@@ -60,8 +61,42 @@ struct TorqueNoiseSpec {
 using EffectSpec =
     std::variant<GravityGradientSpec, DisturbanceTorqueSpec, ActuatorLimitsSpec, TorqueNoiseSpec>;
 
+/// Which effect a spec is (the alternatives of EffectSpec are in the order of EffectKind).
+EffectKind effectKindOf(const EffectSpec& effect);
 /// The YAML key of an effect ("gravity_gradient", "disturbance_torque", ...).
 std::string effectName(const EffectSpec& effect);
+
+/// Which system a scene describes.
+enum class SystemKind {
+  RigidBody,      ///< the fully actuated rigid body (seed 000), planned by planManeuver
+  DriftTwoInput,  ///< the drift + two-input kinematic system (seed 001), planDriftTwoInput
+};
+
+/// The names of the systems (scene key `system`, JSON `system`).
+inline constexpr NamedValue<SystemKind> kSystemNames[] = {
+    {SystemKind::RigidBody, "rigid_body"},
+    {SystemKind::DriftTwoInput, "drift_two_input"},
+};
+
+/// "rigid_body" or "drift_two_input".
+inline std::string systemName(SystemKind system) {
+  return nameIn(kSystemNames, system);
+}
+/// The system named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline SystemKind parseSystem(const std::string& text, const std::string& field) {
+  return parseIn(kSystemNames, text, field);
+}
+
+/// How far from 1 the norm of a given quaternion may be before it is an error rather than
+/// round-off in a hand-typed value (0.7071 has norm 0.99998); it is normalized after the check.
+constexpr double kQuaternionNormTolerance = 1e-3;
+
+/// The rotation (body → world) of a Hamilton quaternion [w, x, y, z] given by a user, in a scene
+/// or a message: it must be finite, nonzero and of norm within kQuaternionNormTolerance of 1.
+/// Throws InvalidInput naming `field` and the quaternion (`shown`: as the user wrote it; empty:
+/// its numbers).
+Matrix3 attitudeFromQuaternion(const Eigen::Vector4d& wxyz, const std::string& field,
+                               const std::string& shown = "");
 
 /// Checks the values of a list of effects, however they arrived (scene file, service request):
 /// μ, r > 0; frame body|world; finite torques; max_torque > 0; std ≥ 0; at most one of each effect
@@ -73,7 +108,7 @@ void validateEffects(const std::vector<EffectSpec>& effects, const std::string& 
 struct Scene {
   PlanningProblem problem;            ///< what to plan (SI units, see planner.hpp)
   std::string source;                 ///< file name (for messages)
-  std::string system = "rigid_body";  ///< "rigid_body" or "drift_two_input" (seed 001)
+  SystemKind system = SystemKind::RigidBody;
   Eigen::Vector2d control_weights = Eigen::Vector2d::Ones();  ///< c1, c2 (drift_two_input) [-]
   /// Guess for p(0) [c·rad/s] (drift_two_input only); empty: the planner's default starts.
   std::optional<Vector3> initial_costate;

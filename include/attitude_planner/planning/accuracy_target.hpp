@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "attitude_planner/name_table.hpp"
+
 namespace attitude_planner {
 
 /// Which error of a plan a target bounds (docs/accuracy.md, "The three measures").
@@ -15,10 +17,21 @@ enum class AccuracyMeasure {
   CostError,  ///< |h Σ½|τ_k|² − ½∫|τ|²dt| [N²·m²·s] against the continuous optimum
 };
 
+/// The names of the measures (request field `accuracy_measure`, JSON `accuracy.measure`); None
+/// has no name: it is spelled by leaving the measure out.
+inline constexpr NamedValue<AccuracyMeasure> kAccuracyMeasureNames[] = {
+    {AccuracyMeasure::TerminalMiss, "terminal_miss"},
+    {AccuracyMeasure::CostError, "cost_error"},
+};
+
 /// "terminal_miss" / "cost_error" ("" for None).
-std::string accuracyMeasureName(AccuracyMeasure measure);
-/// Parses "terminal_miss" / "cost_error"; throws InvalidInput naming `field` and the value.
-AccuracyMeasure parseAccuracyMeasure(const std::string& name, const std::string& field);
+inline std::string accuracyMeasureName(AccuracyMeasure measure) {
+  return measure == AccuracyMeasure::None ? "" : nameIn(kAccuracyMeasureNames, measure);
+}
+/// The measure named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline AccuracyMeasure parseAccuracyMeasure(const std::string& text, const std::string& field) {
+  return parseIn(kAccuracyMeasureNames, text, field);
+}
 
 /// A requested accuracy instead of a number of steps.
 struct AccuracyTarget {

@@ -14,6 +14,8 @@
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/input_rules.hpp"
+#include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
 
 namespace attitude_planner {
@@ -24,6 +26,53 @@ enum class RotationDirection {
   Shortest,  ///< the geodesic (angle ≤ π); near π both ways are solved and the cheaper is kept
   LongWay,   ///< the other way round the same axis (angle 2π − θ)
 };
+
+/// The names of the directions (scene key `direction`, --direction, request field `direction`).
+inline constexpr NamedValue<RotationDirection> kRotationDirectionNames[] = {
+    {RotationDirection::Shortest, "shortest"},
+    {RotationDirection::LongWay, "long_way"},
+};
+
+/// "shortest" or "long_way".
+inline std::string directionName(RotationDirection direction) {
+  return nameIn(kRotationDirectionNames, direction);
+}
+/// The direction named `text`; throws InvalidInput naming `field`, the value and the accepted
+/// names.
+inline RotationDirection parseDirection(const std::string& text, const std::string& field) {
+  return parseIn(kRotationDirectionNames, text, field);
+}
+
+/// Which solver plans the maneuver.
+enum class SolverKind {
+  Newton,  ///< ours: Newton on the optimality conditions, O(N) per iteration
+  Nlopt,   ///< NLopt SLSQP: the independent cross-check (and the bounded-torque solver)
+};
+
+/// The names of the solvers (--solver, request field `solver`, ~solver, JSON `solver`).
+inline constexpr NamedValue<SolverKind> kSolverNames[] = {
+    {SolverKind::Newton, "newton"},
+    {SolverKind::Nlopt, "nlopt"},
+};
+
+/// "newton" or "nlopt".
+inline std::string solverName(SolverKind solver) {
+  return nameIn(kSolverNames, solver);
+}
+/// The solver named `text`; throws InvalidInput naming `field`, the value and the accepted names.
+inline SolverKind parseSolver(const std::string& text, const std::string& field) {
+  return parseIn(kSolverNames, text, field);
+}
+
+/// The scheme value that lets the planner choose the scheme (with an accuracy target only).
+inline constexpr const char* kAutoSchemeName = "auto";
+
+/// Fewest steps N of a rigid-body plan (validateProblem).
+constexpr int kMinSteps = 4;
+/// Most steps N of a rigid-body plan: the Newton solver holds ~2.3 kB per step (measured at
+/// N = 1e6, 2.3 GB peak; docs/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7,
+/// would need ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
+constexpr int kMaxSteps = 2000000;
 
 /// A rest-to-rest / slew problem for the fully actuated rigid body.
 struct PlanningProblem {
@@ -65,7 +114,7 @@ struct IterationInfo {
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.
 struct SolverOptions {
-  std::string solver = "newton";  ///< "newton" (ours) or "nlopt" (independent cross-check)
+  SolverKind solver = SolverKind::Newton;
   double tolerance = 1e-10;       ///< relative torque accuracy (Newton decrement / |τ|₂)
   int max_iterations = 200;       ///< Newton: per grid level (coarse levels start the fine one)
   double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
@@ -76,9 +125,18 @@ struct SolverOptions {
   const Maneuver* warm_start = nullptr;
 };
 
-/// Checks the problem (finite numbers, SPD and physical inertia, T > 0, N ≥ 4, ...): throws
-/// InvalidInput naming the field and the value.
+/// Checks the problem (finite numbers, SPD and physical inertia, T > 0, kMinSteps ≤ N ≤
+/// kMaxSteps, `auto` scheme only with an accuracy target, ...): throws InvalidInput naming the
+/// field and the value.
 void validateProblem(const PlanningProblem& problem);
+
+/// Throws InvalidInput naming `field` and the value unless extra_revolutions ≥ 0.
+void requireExtraRevolutions(int extra_revolutions, const std::string& field);
+
+/// Sets the scheme of `problem` from its name, or lets the planner choose it for "auto"
+/// (accuracy.choose_scheme; validateProblem requires an accuracy target then). Throws
+/// InvalidInput naming `field`, the value and the accepted names (the schemes and auto).
+void applySchemeName(const std::string& text, const std::string& field, PlanningProblem* problem);
 
 /// Checks the solver settings (tolerance finite and > 0, max_iterations ≥ 0, time budget finite
 /// and ≥ 0): throws InvalidInput naming the option and the value.

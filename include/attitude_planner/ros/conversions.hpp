@@ -24,11 +24,9 @@
 namespace attitude_planner {
 namespace ros_conversions {
 
-/// Largest accepted | |q| − 1 | of a request quaternion (it is normalized after the check).
-constexpr double kQuaternionNormTolerance = 1e-3;
-
 /// Rotation matrix (body → world) of a message quaternion; throws InvalidInput naming `field` if
-/// the quaternion has a non-finite entry, is zero or is not unit within kQuaternionNormTolerance.
+/// the quaternion has a non-finite entry, is zero or is not unit within kQuaternionNormTolerance
+/// (the scene's rule: attitudeFromQuaternion, io/scene.hpp).
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field);
 /// Unit Hamilton quaternion (w ≥ 0) of a rotation matrix.
 geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R);
@@ -75,8 +73,10 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
-  std::string scheme = "paper";   ///< "paper" | "variational"
-  std::string solver = "newton";  ///< "newton" | "nlopt"
+  SchemeKind scheme = SchemeKind::Paper;
+  SolverKind solver = SolverKind::Newton;
+  /// N of a request that leaves `steps` at 0 (both services): the seed's example resolution.
+  int steps = 128;
   double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
   int max_iterations = 200;       ///< iteration limit
   double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none (then max_solve_time)
@@ -85,6 +85,11 @@ struct PlannerDefaults {
   /// (time_budget 0 with ~time_budget 0), is solved with this budget, so no solve runs away.
   double max_solve_time = 300.0;
 };
+
+/// The N of a request: `steps`, or defaults.steps for 0; throws InvalidInput naming `steps` if it
+/// exceeds the node's ~max_steps. The planners check the lower bounds (validateProblem, N >= 4;
+/// planDriftTwoInput, N >= 1).
+int stepsFromRequest(int steps, const PlannerDefaults& defaults);
 
 /// Builds the core request of a plan_drift_two_input call (zero fields take the documented
 /// defaults). Throws InvalidInput naming the field and the value; the core checks the rest.
@@ -112,46 +117,18 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   p.inertia = inertiaFromMsg(req.inertia);
   p.allow_nonphysical_inertia = req.allow_nonphysical_inertia;
   p.duration = req.duration;
-  const bool to_accuracy = !req.accuracy_measure.empty();
-  if (!to_accuracy && req.steps > defaults.max_steps) {
-    throw InvalidInput("steps: " + std::to_string(req.steps) +
-                       " exceeds the node's ~max_steps = " + std::to_string(defaults.max_steps));
-  }
-  p.steps = req.steps;
+  // With an accuracy target the planner chooses N (at most ~max_steps): `steps` is not used.
+  p.steps = req.accuracy_measure.empty() ? stepsFromRequest(req.steps, defaults) : req.steps;
   p.accuracy = accuracyTargetFromRequest(req.accuracy_measure, req.accuracy_target, defaults);
   p.initial_attitude = attitudeFromMsg(req.initial_attitude, "initial_attitude");
   p.initial_velocity = vectorFromMsg(req.initial_angular_velocity);
   p.final_attitude = attitudeFromMsg(req.final_attitude, "final_attitude");
   p.final_velocity = vectorFromMsg(req.final_angular_velocity);
-  const std::string scheme = req.scheme.empty() ? defaults.scheme : req.scheme;
-  if (scheme == "auto" && !to_accuracy) {
-    throw InvalidInput(
-        "scheme: 'auto' needs accuracy_measure (the planner chooses the scheme "
-        "only for a requested accuracy)");
-  }
-  p.accuracy.choose_scheme = scheme == "auto";
-  if (scheme != "auto") {
-    try {
-      p.scheme = parseSchemeName(scheme);
-    } catch (const InvalidInput&) {
-      throw InvalidInput("scheme: unknown value '" + scheme +
-                         "' (expected paper, variational or auto)");
-    }
-  }
-  if (req.direction.empty() || req.direction == "shortest") {
-    p.direction = RotationDirection::Shortest;
-  } else if (req.direction == "long_way") {
-    p.direction = RotationDirection::LongWay;
-  } else {
-    throw InvalidInput("direction: unknown value '" + req.direction +
-                       "' (expected shortest or long_way; empty = shortest)");
-  }
+  p.scheme = defaults.scheme;
+  if (!req.scheme.empty()) applySchemeName(req.scheme, "scheme", &p);
+  if (!req.direction.empty()) p.direction = parseDirection(req.direction, "direction");
   p.extra_revolutions = req.extra_revolutions;  // < 0 refused by validateProblem
-  options->solver = req.solver.empty() ? defaults.solver : req.solver;
-  if (options->solver != "newton" && options->solver != "nlopt") {
-    throw InvalidInput("solver: unknown value '" + options->solver +
-                       "' (expected newton or nlopt)");
-  }
+  options->solver = req.solver.empty() ? defaults.solver : parseSolver(req.solver, "solver");
   if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
     throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +
                        exactNumber(req.tolerance));

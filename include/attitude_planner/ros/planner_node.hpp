@@ -17,6 +17,8 @@
 //   ~max_iterations  int     200        iteration limit (> 0)
 //   ~time_budget     double  30.0       wall-time limit per solve [s] (0 = none)
 //   ~max_steps       int     100000     largest accepted N (>= 4; both services)
+//   ~default_steps   int     128        N of a request with steps 0 (>= 4, <= ~max_steps; both
+//                                       services)
 //   ~max_solve_time  double  300.0      cap on every request's time budget [s] (> 0): a request
 //                                       asking for more (or for none) gets this budget
 //   ~world_frame     string  "world"    frame_id of the returned maneuver

@@ -103,8 +103,8 @@ int main(int argc, char** argv) {
       "worked example: g0 = I, g1 = rotation of 1.2 rad about (1,1,0)/sqrt2, T = 3 s, "
       "N = 60, c1 = 1, c2 = 2, default starts\n%s\n",
       plan.message.c_str());
-  std::printf("converged %d, iterations %d, continuation stages %d, substeps %d\n", plan.converged,
-              plan.iterations, plan.continuation_stages, plan.substeps);
+  std::printf("converged %d, iterations %d, continuation stages %d, integration steps %d\n",
+              plan.converged, plan.iterations, plan.continuation_stages, plan.integration_steps);
   std::printf("p(0) = (%.12f, %.12f, %.12f), cost = %.12f, terminal error = %.3e rad\n",
               plan.initial_costate.x(), plan.initial_costate.y(), plan.initial_costate.z(),
               plan.cost, plan.terminal_error);

@@ -217,6 +217,16 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
       << "  \"initial_costate_guess\": "
       << (request.initial_costate ? jsonVector(*request.initial_costate) : std::string("null"))
       << ",\n"
+      << "  \"extremal\": " << jsonString(plan.extremal) << ",\n"
+      << "  \"other_extremal_costs\": [";
+  for (size_t i = 0; i < plan.other_costs.size(); ++i) {
+    out << (i ? ", " : "") << jsonNumber(plan.other_costs[i]);
+  }
+  out << "],\n"
+      << "  \"starts\": " << plan.starts << ",\n"
+      << "  \"converged_starts\": " << plan.converged_starts << ",\n"
+      << "  \"integration_steps\": " << plan.integration_steps << ",\n"
+      << "  \"timed_out\": " << (plan.timed_out ? "true" : "false") << ",\n"
       << "  \"solve_time_s\": " << jsonNumber(solve_time_s) << "\n"
       << "}\n";
   return out.str();
@@ -240,9 +250,10 @@ std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
   text += line("initial costate p(0)", "(" + general(p.x(), 12) + ", " + general(p.y(), 12) + ", " +
                                            general(p.z(), 12) + ")");
   text += line("cost 1/2 int c.u^2 dt", general(plan.cost, 12));
+  text += line("extremal", plan.extremal);
   text += line("terminal attitude error", general(plan.terminal_error, 3) + " rad");
   std::ostringstream time;
-  time << std::fixed << std::setprecision(3) << solve_time_s << " s";
+  time << std::fixed << std::setprecision(4) << solve_time_s << " s";
   text += line("solve time", time.str());
   return text;
 }

@@ -285,6 +285,13 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
                        std::to_string(req.shooting_intervals));
   }
   r.shooting_intervals = std::max(1, static_cast<int>(req.shooting_intervals));
+  // No time_budget field in the request (adding one would change the service's MD5): the node's
+  // ~time_budget applies, capped by ~max_solve_time, as for plan_attitude_maneuver.
+  r.time_budget_s = defaults.time_budget;
+  if (defaults.max_solve_time > 0.0 &&
+      (r.time_budget_s <= 0.0 || r.time_budget_s > defaults.max_solve_time)) {
+    r.time_budget_s = defaults.max_solve_time;
+  }
   return r;
 }
 

@@ -44,7 +44,7 @@ const char* const kUsage =
     "  --tolerance TOL           rigid_body: optimality tolerance (default 1e-10);\n"
     "                            drift_two_input: terminal attitude error [rad] (default 1e-11)\n"
     "  --max-iterations K        iteration limit (nlopt: function evaluations; default 200)\n"
-    "  --time-budget S           wall-time limit [s] (default: none; rigid_body only)\n"
+    "  --time-budget S           wall-time limit [s] (default: none)\n"
     "  --direction shortest|long_way  which way round (rigid_body; overrides the scene)\n"
     "  --extra-revolutions K     K >= 0 extra full turns (rigid_body; overrides the scene)\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
@@ -227,9 +227,9 @@ Arguments parseArguments(int argc, char** argv) {
 
 /// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
-  if (!args.scheme.empty() || args.solver_given || args.time_budget > 0.0 ||
-      !args.target_flag.empty() || !args.direction.empty() || args.extra_revolutions >= 0) {
-    std::cerr << "plan_maneuver: --scheme, --solver, --time-budget, --direction, "
+  if (!args.scheme.empty() || args.solver_given || !args.target_flag.empty() ||
+      !args.direction.empty() || args.extra_revolutions >= 0) {
+    std::cerr << "plan_maneuver: --scheme, --solver, --direction, "
                  "--extra-revolutions and --target-* apply to system: rigid_body only (this "
                  "scene is drift_two_input)\n\n"
               << kUsage;
@@ -239,6 +239,7 @@ int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
   if (args.steps) request.steps = *args.steps;
   if (args.tolerance > 0.0) request.tolerance = args.tolerance;
   if (args.max_iterations > 0) request.max_iterations = args.max_iterations;
+  request.time_budget_s = args.time_budget;
   if (!args.initial_costate.empty()) request.initial_costate = parseCostate(args.initial_costate);
 
   const auto start = std::chrono::steady_clock::now();

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "attitude_planner/drift_two_input/closed_forms.hpp"
+#include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/errors.hpp"
 
 using namespace attitude_planner;
@@ -138,4 +139,57 @@ TEST(DriftTwoInputClosedForms, PrintedProposition42HasTheWrongRotationSense) {
                         std::sqrt(k1) * std::sin((1 - k2 / w.c1) * t + k3), k2);
   EXPECT_GT((printed - cf.evaluate(t)).norm(), 0.1);
   EXPECT_LE(maxDeviation(cf, p0, w, 3.0), 1e-10);
+}
+
+TEST(DriftTwoInputClosedForms, PlannedExtremalsFollowTheClosedForms) {
+  // The planner's output against Prop. 4.2 / 4.3 at every sample, at two samplings N.
+  // c1 = c2 with default starts: the symmetric extremals the planner starts from are exact
+  // (g(T) = g0 exp(T p̂0/c) exp(−(p3/c − 1)T E3)), so the cheapest needs no Newton correction.
+  DriftTwoInputRequest rq;
+  rq.g1 = so3::exp(Vector3(0.7, -0.5, 0.9));
+  rq.duration = 4.0;
+  rq.weights = {1.5, 1.5};
+  for (int N : {50, 800}) {
+    rq.steps = N;
+    const DriftTwoInputPlan plan = planDriftTwoInput(rq);
+    ASSERT_TRUE(plan.converged) << plan.message;
+    EXPECT_LE(plan.iterations, 1) << plan.message;
+    const DriftTwoInputClosedForm cf(plan.initial_costate, rq.weights);
+    ASSERT_TRUE(cf.valid()) << cf.message();
+    double e = 0;
+    for (size_t k = 0; k < plan.trajectory.t.size(); ++k) {
+      e = std::max(e, (cf.evaluate(plan.trajectory.t[k]) - plan.trajectory.p[k]).norm());
+    }
+    std::printf("circular, N = %d: cost %.10g, max |p_cf - p_plan| = %.3g\n", N, plan.cost, e);
+    EXPECT_LE(e, 1e-11);
+  }
+  // c1 ≠ c2: an extremal in case (i) or (ii) (p0 from the random search of the test above),
+  // its endpoint as the target, a perturbed guess: the planner returns that extremal and its
+  // samples follow the elliptic form.
+  const DriftTwoInputWeights w{3.0, 1.0};
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  int checked = 0;
+  for (int i = 0; i < 5000 && checked < 4; ++i) {
+    const Vector3 p0(nd(rng), nd(rng), nd(rng));
+    const DriftTwoInputClosedForm cf(p0, w);
+    if (!cf.valid() || cf.stateCase() == DriftTwoInputCase::kCircular) continue;
+    DriftTwoInputRequest er;
+    er.weights = w;
+    er.duration = 2.0;
+    er.steps = 200;
+    er.g1 = sampleDriftTwoInputExtremal(er.g0, p0, er.duration, 1, w).g.back();
+    er.initial_costate = p0 + Vector3(0.02, -0.02, 0.01);
+    const DriftTwoInputPlan plan = planDriftTwoInput(er);
+    ASSERT_TRUE(plan.converged) << plan.message;
+    ASSERT_LE((plan.initial_costate - p0).norm(), 1e-9) << plan.message;
+    double e = 0;
+    for (size_t k = 0; k < plan.trajectory.t.size(); ++k) {
+      e = std::max(e, (cf.evaluate(plan.trajectory.t[k]) - plan.trajectory.p[k]).norm());
+    }
+    std::printf("%s: max |p_cf - p_plan| = %.3g\n", toString(cf.stateCase()).c_str(), e);
+    EXPECT_LE(e, 1e-10);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);
 }

@@ -290,7 +290,7 @@ TEST(DriftTwoInputPlanner, SameExtremalWhateverTheOutputSamplingForEveryDriftSce
   for (const auto& entry : std::filesystem::directory_iterator(AP_SOURCE_DIR "/scenes")) {
     if (entry.path().extension() != ".yaml") continue;
     const Scene scene = loadScene(entry.path().string());
-    if (scene.system != "drift_two_input") continue;
+    if (scene.system != SystemKind::DriftTwoInput) continue;
     ++scenes;
     DriftTwoInputRequest rq = driftTwoInputRequest(scene);
     std::optional<DriftTwoInputPlan> first;

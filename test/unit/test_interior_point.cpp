@@ -12,6 +12,7 @@
 #include "planning/direct_method.hpp"
 #include "planning/node_constraints.hpp"
 #include "planning/reduced_problem.hpp"
+#include "scene_errors.hpp"
 
 namespace ap = attitude_planner;
 
@@ -52,13 +53,7 @@ void expectAgreesWithNlopt(const ap::PlanningProblem& p, double tolerance = 1e-8
 }
 
 std::string invalidMessage(const std::string& text) {
-  try {
-    ap::parseScene(text, "bad.yaml");
-  } catch (const ap::InvalidInput& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InvalidInput for:\n" << text;
-  return "";
+  return attitude_planner_test::sceneErrorOf(text);
 }
 
 const char* kSceneHead = R"(inertia: [20, 25, 30]

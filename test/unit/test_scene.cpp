@@ -8,6 +8,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "scene_errors.hpp"
 
 namespace ap = attitude_planner;
 
@@ -41,15 +42,8 @@ std::string strict(std::string text) {
   return at == std::string::npos ? text : text.replace(at, line.size(), "");
 }
 
-/// The message of the InvalidInput parseScene throws; fails the test if none is thrown.
 std::string errorOf(const std::string& text) {
-  try {
-    ap::parseScene(text, "bad.yaml");
-  } catch (const ap::InvalidInput& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InvalidInput for:\n" << text;
-  return "";
+  return attitude_planner_test::sceneErrorOf(text);
 }
 
 #define EXPECT_CONTAINS(haystack, needle) \

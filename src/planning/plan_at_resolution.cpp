@@ -76,7 +76,10 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
-  if (options.solver == SolverKind::Newton && problem.hasNodeConstraints()) {
+  if (options.solver == SolverKind::Newton && problem.hasNodeConstraints() &&
+      options.constrained_from_warm_start && options.warm_start) {
+    result = solveWithInteriorPoint(problem, options);
+  } else if (options.solver == SolverKind::Newton && problem.hasNodeConstraints()) {
     // The unconstrained optimum first (fast path): if it meets every node constraint it is the
     // constrained optimum too; otherwise it starts the interior-point solver.
     result = solveWithNewton(problem, options);

@@ -156,6 +156,10 @@ struct SolverOptions {
   std::function<bool(const IterationInfo&)> on_iteration;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
   const Maneuver* warm_start = nullptr;
+  /// With node constraints and a warm start: start the interior point from the warm start itself
+  /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
+  /// is far closer to the next one than the unconstrained optimum is).
+  bool constrained_from_warm_start = false;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, kMinSteps ≤ N ≤

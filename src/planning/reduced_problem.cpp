@@ -202,6 +202,19 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
   return tau;
 }
 
+Maneuver ReducedProblem::maneuver(const Steps& steps) const {
+  Maneuver m;
+  m.time_step = scheme_.timeStep();
+  m.attitude = attitudes(steps);
+  m.torque = torques(steps);
+  m.time.resize(N_ + 1);
+  m.angular_velocity.resize(N_ + 1);
+  for (int k = 0; k <= N_; ++k) m.time[k] = k * m.time_step;
+  for (int k = 0; k < N_; ++k) m.angular_velocity[k] = scheme_.velocityOfStep(steps[k]);
+  m.angular_velocity[N_] = m.angular_velocity[N_ - 1];
+  return m;
+}
+
 double ReducedProblem::cost(const Steps& steps) const {
   double c = 0;
   for (const Vector3& t : torques(steps)) c += 0.5 * t.squaredNorm();

@@ -73,6 +73,9 @@ class ReducedProblem {
   std::vector<Matrix3> attitudes(const Steps& steps) const;
   /// τ_k, k = 0..N (τ_0 = τ_N = 0).
   std::vector<Vector3> torques(const Steps& steps) const;
+  /// The planned maneuver itself: R_k = R_0 F_0 ⋯ F_{k−1}, Ω_k the scheme's velocity of step k
+  /// (row N repeats Ω_{N−1}), τ_k as torques(); k = 0..N on t_k = k h.
+  Maneuver maneuver(const Steps& steps) const;
   /// C = Σ ½|τ_k|².
   double cost(const Steps& steps) const;
 

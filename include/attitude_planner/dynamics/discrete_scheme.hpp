@@ -87,6 +87,14 @@ class DiscreteScheme {
   /// variational J⁻¹ μ(F) (nodal velocity at the step's start).
   Vector3 velocity(const Matrix3& F) const;
 
+  /// velocity(exp(ω^)) from the step's rotation vector, with full relative precision for small
+  /// steps (paper ω/h, variational J⁻¹ momentumOfStep(ω)).
+  Vector3 velocityOfStep(const Vector3& omega) const;
+
+  /// μ of the step whose reported velocity is Ω, without solving for the step: paper
+  /// exp(hΩ^) J Ω, variational J Ω (its reported velocity is J⁻¹ μ).
+  Vector3 momentumOfVelocity(const Vector3& omega) const;
+
   /// Relative rotation of a step whose reported velocity is Ω (inverse of velocity()).
   /// Throws StepTooLarge if the implicit equation has no solution it can find.
   Matrix3 stepFromVelocity(const Vector3& omega) const;

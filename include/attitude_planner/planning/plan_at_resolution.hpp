@@ -12,4 +12,23 @@ namespace attitude_planner {
 /// (InvalidInput), refuses boundary velocities without a step (StepTooLarge), times the solve.
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options = {});
 
+/// How well a maneuver satisfies the discrete problem, step by step, relative to its own scales:
+/// rate W = max_k|Ω_k| + θ/T (θ the angle from R_0 to R_N*), momentum P = ‖J‖·W.
+///   kinematics  |μ(R_kᵀR_{k+1}) − μ(Ω_k)| / P               (the step carries its velocity)
+///   dynamics    |μ_k − F_{k−1}ᵀμ_{k−1} − h(τ_k + τ_e)| / P  (seed 000, eq. 18), k = 1..N−1
+///   boundary    ∠(R_0, R_0*), ∠(R_N, R_N*) [rad], |Ω_0 − Ω_0*| / W, |Ω_{N−1} − Ω*_{N−1}| / W
+/// Invariant under T → sT and J → jJ (time by T, inertia by its scale).
+struct StepResidual {
+  double relative = 0.0;   ///< the worst of the figures above
+  double tolerance = 0.0;  ///< what a consistent plan meets (stepResidualTolerance)
+};
+StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver& maneuver);
+
+/// kStepResidualTolerance above the round-off floor of the attitudes (absolute eps per entry,
+/// so a step of angle h·W carries its momentum to ~eps/(hW), and R_N is a product of N steps).
+double stepResidualTolerance(int steps, double step_angle);
+
+/// Relative step residual a converged plan must meet (above the round-off floor).
+constexpr double kStepResidualTolerance = 1e-8;
+
 }  // namespace attitude_planner

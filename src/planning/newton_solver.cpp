@@ -157,6 +157,18 @@ std::vector<InitialGuess> initialGuesses(const PlanningProblem& problem, const R
   return out;
 }
 
+/// Puts the guess for problem.direction on `np` (Hermite curve to its lift, matching both
+/// boundary velocities) and returns its description.
+std::string startFromGuess(const PlanningProblem& problem, ReducedProblem* np) {
+  const std::vector<InitialGuess> guesses = initialGuesses(problem, *np);
+  const InitialGuess& guess = guesses[problem.direction == RotationDirection::LongWay ? 1 : 0];
+  // Hermite slopes: body rotation per unit s, dR/ds = R Ω dt/ds with dt/ds = (N − 2) h.
+  const double T_inner = (problem.steps - 2) * problem.duration / problem.steps;
+  np->initializeHermite(guess.lift, T_inner * problem.initial_velocity,
+                        T_inner * (so3::exp(guess.lift) * problem.final_velocity));
+  return guess.description;
+}
+
 /// Newton on one grid. Starts from `coarse_steps` (a coarser grid's final iterate) if given, else
 /// from options.warm_start, else from the Hermite guess; leaves its final iterate in
 /// `final_steps` if given (the next finer grid starts from it).
@@ -179,13 +191,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     return result;
   }
   ReducedProblem& np = *reduced;
-  const std::vector<InitialGuess> guesses = initialGuesses(problem, np);
-  const InitialGuess& guess = guesses[problem.direction == RotationDirection::LongWay ? 1 : 0];
-  result.extremal = guess.description;
-  // Hermite slopes: body rotation per unit s, dR/ds = R Ω dt/ds with dt/ds = (N − 2) h.
-  const double T_inner = (problem.steps - 2) * problem.duration / problem.steps;
-  np.initializeHermite(guess.lift, T_inner * problem.initial_velocity,
-                       T_inner * (so3::exp(guess.lift) * problem.final_velocity));
+  result.extremal = startFromGuess(problem, &np);
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
   if (coarse_steps) np.initializeFromCoarser(*coarse_steps, coarser_steps);
   const int N = np.steps();
@@ -502,6 +508,12 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
 constexpr double kBothWaysBelowPi = 0.25;
 
 }  // namespace
+
+std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
+  ReducedProblem np(problem);
+  startFromGuess(problem, &np);
+  return np.current();
+}
 
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();

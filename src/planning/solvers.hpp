@@ -17,6 +17,12 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
 /// met. Fills everything but solve_time_s and the constraint figures.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
+/// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
+/// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before
+/// any continuation level: the start a peer solver gets in a like-for-like comparison
+/// (benchmark_solvers --random-suite). Throws StepTooLarge like ReducedProblem.
+std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem);
+
 /// Independent cross-check: NLopt on the direct method (τ_1..τ_{N−1} as variables, equality
 /// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);

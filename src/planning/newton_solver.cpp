@@ -507,6 +507,88 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
 /// at exactly π costs 16.683 the short way and 16.639 the other way).
 constexpr double kBothWaysBelowPi = 0.25;
 
+/// Continuation in the boundary rates: when the direct solve stalls (issue 19: fast boundary
+/// rates over long horizons end at the iteration limit from the Hermite guess), the problem is
+/// solved with Ω_0, Ω_{N−1} scaled by s = 0 (rest to rest, easy), then s rising to 1, each stage
+/// from the previous stage's plan; a stage that fails halves the increment. Returns the s = 1
+/// plan, or `failed` (with a note) if it is not reached.
+constexpr int kRateContinuationMaxStages = 24;
+constexpr double kRateContinuationMinIncrement = 1.0 / 64;
+
+PlanResult solveWithRateContinuation(const PlanningProblem& problem, const SolverOptions& options,
+                                     std::chrono::steady_clock::time_point start,
+                                     PlanResult failed) {
+  PlanningProblem stage = problem;
+  const auto at = [&](double s) {
+    stage.initial_velocity = s * problem.initial_velocity;
+    stage.final_velocity = s * problem.final_velocity;
+  };
+  int iterations = failed.iterations;
+  int stages = 0;
+  SolverOptions stage_options = options;
+  // Progress reports keep increasing across stages; cancel works in all of them.
+  if (options.on_iteration) {
+    stage_options.on_iteration = [&options, &iterations](const IterationInfo& info) {
+      IterationInfo global = info;
+      global.iteration += iterations;
+      return options.on_iteration(global);
+    };
+  }
+  const auto budget = [&] {
+    stage_options.time_budget_s = remainingBudget(options, start);
+    return options.time_budget_s <= 0 || stage_options.time_budget_s > 1e-299;
+  };
+  const auto stopped = [&](PlanResult r) {  // cancelled or out of time inside a stage
+    r.iterations += iterations;
+    r.message += "; during continuation in the boundary rates after the direct solve stalled";
+    return r;
+  };
+  at(0.0);
+  if (!budget()) return failed;
+  PlanResult last = solveWithContinuation(stage, stage_options);
+  if (last.termination == Termination::Cancelled || last.termination == Termination::TimedOut) {
+    return stopped(last);
+  }
+  iterations += last.iterations;
+  double s = 0.0, ds = 0.25;
+  while (last.converged() && s < 1.0 && stages < kRateContinuationMaxStages) {
+    if (!budget()) break;
+    const double next = std::min(1.0, s + ds);
+    at(next);
+    const Maneuver from = last.maneuver;
+    stage_options.warm_start = &from;
+    PlanResult r = solveWithContinuation(stage, stage_options);
+    stage_options.warm_start = nullptr;
+    ++stages;
+    if (r.termination == Termination::Cancelled || r.termination == Termination::TimedOut) {
+      return stopped(r);
+    }
+    iterations += r.iterations;
+    if (r.converged()) {
+      last = std::move(r);
+      s = next;
+      ds = std::min(2.0 * ds, 0.5);
+    } else {
+      ds *= 0.5;
+      if (ds < kRateContinuationMinIncrement) break;
+    }
+  }
+  std::ostringstream note;
+  if (last.converged() && s == 1.0) {
+    note << "; reached by continuation in the boundary rates (" << stages
+         << " stages from rest to rest) after the direct solve stalled: " << failed.message;
+    last.iterations = iterations;
+    last.message += note.str();
+    last.levels.insert(last.levels.begin(), failed.levels.begin(), failed.levels.end());
+    return last;
+  }
+  note << "; continuation in the boundary rates reached s = " << s << " of 1 (" << stages
+       << " stages, " << iterations - failed.iterations << " iterations) and stalled too";
+  failed.iterations = iterations;
+  failed.message += note.str();
+  return failed;
+}
+
 }  // namespace
 
 std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
@@ -518,6 +600,11 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   PlanResult first = solveWithContinuation(problem, options);
+  const bool spinning_ends =
+      !problem.initial_velocity.isZero(0.0) || !problem.final_velocity.isZero(0.0);
+  if (first.termination == Termination::NotConverged && spinning_ends && !options.warm_start) {
+    first = solveWithRateContinuation(problem, options, start, std::move(first));
+  }
   std::vector<InitialGuess> guesses;
   try {
     const ReducedProblem rp(problem);

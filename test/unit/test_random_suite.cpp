@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <vector>
 
 #include "attitude_planner/planner.hpp"
@@ -26,6 +27,13 @@ namespace {
 /// kCiCases cases, ~30 s at Release on one core of this machine.
 constexpr std::uint64_t kSuiteSeed = 19;
 constexpr int kCiCases = 40;
+
+/// Cases of the CI subset that do not converge today (issue 19's 100 % target is not met):
+/// seed-like inertia, variational, T ≈ 65–72 s with ~4 rad/s at both ends (~40 turns); the
+/// Newton iteration stalls from the Hermite guess and continuation in the boundary rates stalls
+/// near s = 0.8. A strict expected failure: if one converges the test fails until it is removed
+/// here, so the list cannot go stale. docs/robustness.md has the full-size figures.
+const std::set<int> kKnownStalls = {1, 25};
 
 }  // namespace
 
@@ -60,4 +68,37 @@ TEST(RandomSuite, GeneratorIsDeterministicAndMeetsItsBounds) {
   EXPECT_GT(spinning, 10);
   // A different seed draws different problems.
   EXPECT_NE(robustness::randomCase(kSuiteSeed + 1, 0).problem.inertia, a[0].problem.inertia);
+}
+TEST(RandomSuite, EveryCaseConverges) {
+  int converged = 0;
+  std::vector<int> iterations;
+  const auto start = std::chrono::steady_clock::now();
+  for (const RandomCase& c : robustness::randomSuite(kSuiteSeed, kCiCases)) {
+    const PlanResult r = planManeuver(c.problem);
+    if (kKnownStalls.count(c.index)) {
+      EXPECT_NE(r.termination, Termination::Converged)
+          << c.label << " converges now: remove it from kKnownStalls";
+      EXPECT_EQ(r.termination, Termination::NotConverged) << c.label << ": " << r.message;
+    } else {
+      EXPECT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
+    }
+    if (r.converged()) {
+      ++converged;
+      EXPECT_LE(r.step_residual, measureStepResidual(c.problem, r.maneuver).tolerance);
+    }
+    iterations.push_back(r.iterations);
+    std::printf("%-60s %-14s %4d it %8.3f s cost %.10g replay miss %.1e\n", c.label.c_str(),
+                terminationName(r.termination).c_str(), r.iterations, r.solve_time_s, r.cost,
+                r.replay_miss);
+  }
+  std::sort(iterations.begin(), iterations.end());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "random suite (seed %llu, %d cases): %d converged, median %d iterations, max %d, "
+      "%.1f s\n",
+      static_cast<unsigned long long>(kSuiteSeed), kCiCases, converged,
+      iterations[iterations.size() / 2], iterations.back(), seconds);
+  RecordProperty("converged", converged);
+  RecordProperty("cases", kCiCases);
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
@@ -130,10 +131,16 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
       out.worst_where = w.str();
     }
   };
+  // The torques τ_k and rates Ω_k of the plan: k = 1..N−1 and steps 0..N−1 for paper and
+  // variational (τ_0 = τ_N = 0; Ω_N repeats Ω_{N−1}); every node k = 0..N with end torques.
+  const bool end_torques =
+      DiscreteScheme(problem.scheme, problem.inertia, problem.duration / N).hasEndTorques();
+  const int first_torque = end_torques ? 0 : 1, last_torque = end_torques ? N : N - 1;
+  const int last_rate = end_torques ? N : N - 1;
   if (problem.hasTorqueBounds()) {
     out.names.push_back("actuator_limits");
     static const char* axis[] = {"x", "y", "z"};
-    for (int k = 1; k < N; ++k) {
+    for (int k = first_torque; k <= last_torque; ++k) {
       for (int i = 0; i < 3; ++i) {
         const double a = problem.max_torque(i);
         std::ostringstream what;
@@ -147,10 +154,12 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
     const std::string what = describeConstraint(c);
     switch (c.kind) {
       case ConstraintKind::MaxTorqueNorm:
-        for (int k = 1; k < N; ++k) visit(c.limit - maneuver.torque[k].norm(), c.limit, what, k);
+        for (int k = first_torque; k <= last_torque; ++k) {
+          visit(c.limit - maneuver.torque[k].norm(), c.limit, what, k);
+        }
         break;
       case ConstraintKind::MaxAngularRate:
-        for (int k = 0; k < N; ++k) {
+        for (int k = 0; k <= last_rate; ++k) {
           visit(c.limit - maneuver.angular_velocity[k].norm(), c.limit, what, k);
         }
         break;

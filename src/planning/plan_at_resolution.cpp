@@ -39,21 +39,40 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
   const auto relative = [](double value, double scale) {
     return scale > 0 ? value / scale : (value == 0 ? 0.0 : std::numeric_limits<double>::infinity());
   };
+  // The boundary velocities sit on row N − 1 (paper, variational: the last step's) or N (node
+  // velocities, second_order).
+  const bool nodes = scheme.hasEndTorques();
+  const int last_velocity = nodes ? N : N - 1;
   double worst = std::max(so3::angleBetween(problem.initial_attitude, m.attitude[0]),
                           so3::angleBetween(problem.final_attitude, m.attitude[N]));
   worst = std::max(worst, relative((m.angular_velocity[0] - problem.initial_velocity).norm(), W));
-  worst = std::max(worst, relative((m.angular_velocity[N - 1] - problem.final_velocity).norm(), W));
-  std::vector<Vector3> mu(N);
-  for (int k = 0; k < N; ++k) {
-    mu[k] = scheme.momentumOfVelocity(m.angular_velocity[k]);
-    const Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
-    worst = std::max(worst, relative((scheme.momentumOfStep(so3::log(F)) - mu[k]).norm(), P));
+  worst = std::max(
+      worst, relative((m.angular_velocity[last_velocity] - problem.final_velocity).norm(), W));
+  // a_k: what the body receives at node k (control and effects).
+  std::vector<Vector3> applied(N + 1);
+  for (int k = 0; k <= N; ++k) {
+    applied[k] = m.torque[k];
+    if (problem.effects) applied[k] += problem.effects->torque(m.attitude[k], k * h);
   }
+  // c_k: the momentum step k carries, from the reported velocities (full precision): paper
+  // exp(hΩ_k^) J Ω_k, variational J Ω_k; second_order Π_k + (h/2) a_k with Π_k = J Ω_k.
+  std::vector<Vector3> carried(N);
+  for (int k = 0; k < N; ++k) {
+    carried[k] = nodes ? Vector3(problem.inertia * m.angular_velocity[k] + 0.5 * h * applied[k])
+                       : scheme.momentumOfVelocity(m.angular_velocity[k]);
+    const Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
+    worst = std::max(worst, relative((scheme.momentumOfStep(so3::log(F)) - carried[k]).norm(), P));
+  }
+  // c_k = F_{k−1}ᵀ c_{k−1} + h a_k (seed 000, eq. 18; second_order: both half impulses).
   for (int k = 1; k < N; ++k) {
     const Matrix3 F_prev = m.attitude[k - 1].transpose() * m.attitude[k];
-    Vector3 applied = m.torque[k];
-    if (problem.effects) applied += problem.effects->torque(m.attitude[k], k * h);
-    const Vector3 r = mu[k] - F_prev.transpose() * mu[k - 1] - h * applied;
+    const Vector3 r = carried[k] - F_prev.transpose() * carried[k - 1] - h * applied[k];
+    worst = std::max(worst, relative(r.norm(), P));
+  }
+  if (nodes) {  // Π_N = F_{N−1}ᵀ c_{N−1} + (h/2) a_N
+    const Matrix3 F_last = m.attitude[N - 1].transpose() * m.attitude[N];
+    const Vector3 r = problem.inertia * m.angular_velocity[N] -
+                      F_last.transpose() * carried[N - 1] - 0.5 * h * applied[N];
     worst = std::max(worst, relative(r.norm(), P));
   }
   out.relative = std::isfinite(worst) ? worst : std::numeric_limits<double>::infinity();
@@ -98,13 +117,11 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
     result->effects.push_back(effectKindName(EffectKind::ActuatorLimits));
   }
   result->dynamics_residual = report.max_step_residual;
-  double cost = 0.0;
-  for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();
-  result->cost = cost;
   const int N = problem.steps;
+  result->cost = scheme.cost(torque);
+  result->effort = scheme.timeStep() * result->cost;
   result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replay.attitude[N]);
-  result->terminal_velocity_error =
-      (replay.angular_velocity[N - 1] - problem.final_velocity).norm();
+  result->terminal_velocity_error = (replay.angular_velocity[N] - problem.final_velocity).norm();
   result->replay_miss =
       std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
   result->maneuver = planned ? *planned : replay;
@@ -133,11 +150,22 @@ void requireBoundarySteps(const PlanningProblem& problem) {
   }
 }
 
+/// The NLopt cross-check (a direct method on τ_1..τ_{N−1}) knows only the schemes without end
+/// torques.
+void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions& options) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  if (scheme.hasEndTorques() && options.solver == SolverKind::Nlopt) {
+    throw InvalidInput("scheme: '" + schemeName(problem.scheme) +
+                       "' is not available with solver nlopt (use 'paper' or 'variational')");
+  }
+}
+
 }  // namespace
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateOptions(options);
+  requireSchemeSupported(problem, options);
   requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;

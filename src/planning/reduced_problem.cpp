@@ -1,5 +1,7 @@
 #include "planning/reduced_problem.hpp"
 
+#include <cmath>
+
 #include "attitude_planner/errors.hpp"
 
 namespace attitude_planner {
@@ -52,7 +54,11 @@ ReducedProblem::ReducedProblem(const PlanningProblem& problem)
     : N_(problem.steps),
       scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps),
       initial_attitude_(problem.initial_attitude),
-      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr) {
+      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr),
+      first_free_(scheme_.hasEndTorques() ? 1 : 2),
+      last_free_(scheme_.hasEndTorques() ? problem.steps - 1 : problem.steps - 2),
+      initial_momentum_(problem.inertia * problem.initial_velocity),
+      final_momentum_(problem.inertia * problem.final_velocity) {
   const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
   const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
   steps_.assign(N_, Vector3::Zero());
@@ -98,28 +104,37 @@ void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitu
     throw InvalidInput("warm start: has " + std::to_string(attitudes.size() - 1) +
                        " steps, the problem " + std::to_string(N_));
   }
-  // The warm start's R_1 and R_{N−1} must be this problem's: keep ours at the ends.
+  // The warm start's fixed attitudes must be this problem's: keep ours there.
   const std::vector<Matrix3> own = this->attitudes(steps_);
   std::vector<Matrix3> R = attitudes;
-  R[0] = own[0];
-  R[1] = own[1];
-  R[N_ - 1] = own[N_ - 1];
-  R[N_] = own[N_];
-  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
+  for (int j = 0; j <= N_; ++j) {
+    if (variableIndex(j) < 0) R[j] = own[j];
+  }
+  for (int j = 0; j < N_; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
 }
 
 namespace {
 
 /// The rate of `coarse` (steps of a grid of coarse.size() steps) at the position of step j of N,
-/// scaled to a step of that grid: step k of N belongs to T k/(N − 1) (see initializeFromCoarser).
-Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N) {
+/// scaled to a step of that grid. `midpoints`: step k of a grid of n steps belongs to
+/// T (k + ½)/n (schemes with end torques, whose every step is free); else to T k/(n − 1) (paper
+/// and variational: the fixed first and last steps carry Ω(0) and Ω(T); see
+/// initializeFromCoarser).
+Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N, bool midpoints) {
   const int Nc = static_cast<int>(coarse.size());
   const auto slope = [&](int k) {
     if (k == 0) return Vector3(coarse[1] - coarse[0]);
     if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
     return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
   };
-  const double x = double(j) * (Nc - 1) / (N - 1);  // in coarse steps
+  const double x = midpoints ? (j + 0.5) * Nc / N - 0.5 : double(j) * (Nc - 1) / (N - 1);
+  // Midpoints of the first and last fine steps lie outside the coarse ones: extrapolate
+  // linearly (near a rest end the rate grows linearly in t; holding the coarse end rate made
+  // the fine end torque τ_0 = 2Jω_0/h² too large by h_c/h).
+  if (x < 0.0) return double(Nc) / N * (coarse[0] + x * (coarse[1] - coarse[0]));
+  if (x > Nc - 1) {
+    return double(Nc) / N * (coarse[Nc - 1] + (x - (Nc - 1)) * (coarse[Nc - 1] - coarse[Nc - 2]));
+  }
   const int i = std::min(static_cast<int>(x), Nc - 2);
   const double s = x - i;
   const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
@@ -137,37 +152,50 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coa
     throw InvalidInput("grid continuation: a coarse grid of " + std::to_string(Nc) +
                        " steps cannot start one of " + std::to_string(N_));
   }
-  // Where a step belongs in time: the boundary data make the first step's rate Ω(0) and the
-  // last one's Ω(T), and the optimal discrete solutions are smooth in k between them (measured),
-  // so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h puts the fixed end steps
-  // a fraction of a coarse step off: O(1) torque jumps at the ends.) Rates ω^c_k/h_c are
-  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a second,
-  // coarser solution the two are extrapolated to this grid's h (Richardson, first order: the
-  // discrete solutions converge like h, docs/accuracy.md), s(h) = s(h₁) − (s(h₂) − s(h₁))
-  // (h₁ − h)/(h₂ − h₁).
+  // Where a step belongs in time: for paper and variational the boundary data make the first
+  // step's rate Ω(0) and the last one's Ω(T), and the optimal discrete solutions are smooth in k
+  // between them (measured), so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h
+  // puts the fixed end steps a fraction of a coarse step off: O(1) torque jumps at the ends.)
+  // With end torques every step is free and sits at its midpoint (k + ½)h. Rates ω^c_k/h_c are
+  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a
+  // second, coarser solution the two are extrapolated to this grid's h (Richardson at the
+  // scheme's order p: 1, or 2 with end torques, docs/accuracy.md),
+  // s(h) = s(h₁) − (s(h₂) − s(h₁)) (h₁ᵖ − hᵖ)/(h₂ᵖ − h₁ᵖ).
+  const bool midpoints = scheme_.hasEndTorques();
+  const double p = midpoints ? 2.0 : 1.0;
   const double h1 = 1.0 / Nc, h = 1.0 / N_;
-  const double weight = coarser ? (h1 - h) / (1.0 / coarser->size() - h1) : 0.0;
-  for (int j = 1; j <= N_ - 2; ++j) {
-    const Vector3 fine = interpolatedStep(coarse, j, N_);
-    steps_[j] =
-        coarser ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_) - fine)) : fine;
-  }
-  // The gap ψ between where the interpolated steps end and R_{N−1} (body frame of R_{N−1}),
-  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ_1 = 0 and φ_{N−1} = ψ, zero end slopes:
-  // F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In quaternions throughout.
+  const double weight = coarser ? (std::pow(h1, p) - std::pow(h, p)) /
+                                      (std::pow(1.0 / coarser->size(), p) - std::pow(h1, p))
+                                : 0.0;
+  // The free steps: those next to a free attitude (1..N−2, or 0..N−1 with end torques). What
+  // they compose to now is what they must compose to: R_firstᵀ R_last+1 of the fixed ends.
   using Quaternion = Eigen::Vector4d;
+  const int first = first_free_ - 1, last = last_free_;
+  Quaternion target = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = first; j <= last; ++j) {
+    target = so3::quaternionProduct<double>(target, so3::quaternionOfRotationVector(steps_[j]));
+  }
+  for (int j = first; j <= last; ++j) {
+    const Vector3 fine = interpolatedStep(coarse, j, N_, midpoints);
+    steps_[j] = coarser
+                    ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_, midpoints) - fine))
+                    : fine;
+  }
+  // The gap ψ between where the interpolated steps end and the fixed end (body frame there),
+  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ = 0 at the first fixed node and ψ at the
+  // last, zero end slopes: F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In
+  // quaternions throughout.
   Quaternion reached = so3::quaternionOfRotationVector<double>(Vector3::Zero());
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first; j <= last; ++j) {
     reached = so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(steps_[j]));
   }
   reached.tail<3>() *= -1.0;  // its inverse
-  const Vector3 gap = so3::logOfQuaternion<double>(
-      so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(principal_span_)));
+  const Vector3 gap = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(reached, target));
   const auto phi = [&](int j) {
-    const double u = double(j - 1) / (N_ - 2);
+    const double u = double(j - first) / (last + 1 - first);
     return Vector3((3 * u * u - 2 * u * u * u) * gap);
   };
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first; j <= last; ++j) {
     const Quaternion q = so3::quaternionProduct<double>(
         so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-phi(j)),
                                        so3::quaternionOfRotationVector<double>(steps_[j])),
@@ -199,6 +227,15 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
     }
     mu_prev = mu;
   }
+  if (scheme_.hasEndTorques()) {
+    // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N
+    tau[0] = 2.0 * (scheme_.momentumOfStep(steps[0]) - initial_momentum_) / h;
+    tau[N_] = 2.0 * (final_momentum_ - so3::exp(steps[N_ - 1]).transpose() * mu_prev) / h;
+    if (effects_) {
+      tau[0] -= effects_->torque(initial_attitude_, 0.0);
+      tau[N_] -= effects_->torque(Matrix3(R * so3::exp(steps[N_ - 1])), N_ * h);
+    }
+  }
   return tau;
 }
 
@@ -210,15 +247,28 @@ Maneuver ReducedProblem::maneuver(const Steps& steps) const {
   m.time.resize(N_ + 1);
   m.angular_velocity.resize(N_ + 1);
   for (int k = 0; k <= N_; ++k) m.time[k] = k * m.time_step;
+  if (scheme_.hasEndTorques()) {
+    // Node velocities J⁻¹Π_k: Π_0, Π_N are the boundary momenta (τ_0, τ_N make them so), and
+    // inside Π_k = μ_k − (h/2) a_k = ½(μ_k + F_{k−1}ᵀ μ_{k−1}) whatever the effects.
+    const Matrix3 J_inverse = scheme_.inertia().inverse();
+    m.angular_velocity[0] = J_inverse * initial_momentum_;
+    m.angular_velocity[N_] = J_inverse * final_momentum_;
+    Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
+    for (int k = 1; k < N_; ++k) {
+      const Vector3 mu = scheme_.momentumOfStep(steps[k]);
+      m.angular_velocity[k] =
+          J_inverse * (0.5 * (mu + so3::exp(steps[k - 1]).transpose() * mu_prev));
+      mu_prev = mu;
+    }
+    return m;
+  }
   for (int k = 0; k < N_; ++k) m.angular_velocity[k] = scheme_.velocityOfStep(steps[k]);
   m.angular_velocity[N_] = m.angular_velocity[N_ - 1];
   return m;
 }
 
 double ReducedProblem::cost(const Steps& steps) const {
-  double c = 0;
-  for (const Vector3& t : torques(steps)) c += 0.5 * t.squaredNorm();
-  return c;
+  return scheme_.cost(torques(steps));
 }
 
 ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
@@ -227,7 +277,7 @@ ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, doub
     const int v = variableIndex(j);
     return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));
   };
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first_free_ - 1; j <= last_free_; ++j) {  // the steps next to a free attitude
     const Eigen::Vector4d q = so3::quaternionProduct<double>(
         so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),
                                        so3::quaternionOfRotationVector<double>(steps_[j])),
@@ -237,56 +287,110 @@ ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, doub
   return out;
 }
 
+namespace {
+
+/// Jacobian (3×9 over δ_{k−1}, δ_k, δ_{k+1}) of a μ_k + b G_{k−1} (either step may be absent), and
+/// with `w` the symmetric part of Σ_i w_i ∂(jacobian_i)/∂δ, by the chain rule through ε_{k−1},
+/// ε_k (StepTerms). Torques are a = f/h, b = −f/h; the node momentum Π_k is a = b = ½.
+void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, const StepTerms* next,
+                         double a, double b, const Vector3* w,
+                         Eigen::Matrix<double, 3, 9>* jacobian,
+                         Eigen::Matrix<double, 9, 9>* second) {
+  jacobian->setZero();
+  if (prev) {
+    jacobian->block<3, 3>(0, 0) = -b * prev->dGFt;
+    jacobian->block<3, 3>(0, 3) = b * prev->dG;
+  }
+  if (next) {
+    jacobian->block<3, 3>(0, 3) -= a * next->DFt;
+    jacobian->block<3, 3>(0, 6) = a * next->D;
+  }
+  if (!w) return;
+  Eigen::Matrix<double, 9, 9> raw = Eigen::Matrix<double, 9, 9>::Zero();
+  if (prev) {
+    const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
+    const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}
+    const Matrix3 T_dG_prev = b * C_dG_prev;                             // block b, via ε_{k−1}
+    raw.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
+    raw.block<3, 3>(0, 3) = T_dGFt_prev;
+    raw.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
+    raw.block<3, 3>(3, 3) = T_dG_prev;
+  }
+  if (next) {
+    const Matrix3 C_D = next->contractD(scheme, *w);
+    const Matrix3 T_DFt = -a * next->contractDFt(C_D, *w);  // block b, via ε_k
+    const Matrix3 T_D = a * C_D;                            // block c, via ε_k
+    raw.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
+    raw.block<3, 3>(3, 6) = T_DFt;
+    raw.block<3, 3>(6, 3) = -T_D * next->F.transpose();
+    raw.block<3, 3>(6, 6) = T_D;
+  }
+  // The antisymmetric part is cancelled exactly by the retraction's derivative
+  // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
+  *second = 0.5 * (raw + raw.transpose());
+}
+
+}  // namespace
+
 double ReducedProblem::forEachStencil(bool with_second_order,
                                       const std::function<void(const Stencil&)>& visit,
                                       const SecondOrderWeights& weights) const {
   const double h = scheme_.timeStep();
   const std::vector<Vector3> tau = torques(steps_);
   double cost = 0.0;
-  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  StepTerms prev(scheme_, steps_[0]);
   Stencil st;
   st.second.setZero();
+  // τ_k = f (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h, where at an end node (end torques only) the missing
+  // step's momentum is the boundary one (J Ω(0), J Ω(T)), a constant, and f = 2. The stencil
+  // holds the residual r_k = √w_k τ_k of the cost Σ ½ w_k |τ_k|² = Σ ½ |r_k|².
+  const auto visit_torque = [&](int k, const StepTerms* prev, const StepTerms* next,
+                                const Matrix3& R_k) {
+    const double root = std::sqrt(scheme_.torqueWeight(k, N_));
+    const double factor = (prev && next ? 1.0 : 2.0) * root / h;
+    st.k = k;
+    st.tau = root * tau[k];
+    const Vector3 w = with_second_order && weights ? weights(k, st.tau) : st.tau;
+    momentumCombination(scheme_, prev, next, factor, -factor, with_second_order ? &w : nullptr,
+                        &st.jacobian, &st.second);
+    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects (fixed at the end nodes).
+    const bool interior = prev && next;
+    if (effects_ && interior)
+      st.jacobian.block<3, 3>(0, 3) -= root * effects_->jacobian(R_k, k * h);
+    if (effects_ && interior && with_second_order) {
+      st.second.block<3, 3>(3, 3) -= root * effects_->weightedSecondDerivative(R_k, k * h, w);
+    }
+    cost += 0.5 * st.tau.squaredNorm();
+    visit(st);
+  };
+  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
+  StepTerms prev(scheme_, steps_[0]);
+  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, &prev, initial_attitude_);
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
     StepTerms next(scheme_, steps_[k]);
-    const Matrix3& F = next.F;
-    const Matrix3& F_prev = prev.F;
-    if (effects_) R = R * F_prev;
-    st.k = k;
-    st.tau = tau[k];
-    st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
-    st.jacobian.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
-    st.jacobian.block<3, 3>(0, 6) = next.D / h;
-    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects.
-    if (effects_) st.jacobian.block<3, 3>(0, 3) -= effects_->jacobian(R, k * h);
-    cost += 0.5 * st.tau.squaredNorm();
-    if (with_second_order) {
-      // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
-      Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
-      const Vector3 w = weights ? weights(k, st.tau) : st.tau;
-      const Matrix3 C_dG_prev = prev.contractdG(scheme_, w);
-      const Matrix3 C_D = next.contractD(scheme_, w);
-      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, w) / h;  // block a, via ε_{k−1}
-      const Matrix3 T_dG_prev = -C_dG_prev / h;                         // block b, via ε_{k−1}
-      const Matrix3 T_DFt = -next.contractDFt(C_D, w) / h;              // block b, via ε_k
-      const Matrix3 T_D = C_D / h;                                      // block c, via ε_k
-      second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
-      second.block<3, 3>(0, 3) = T_dGFt_prev;
-      second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
-      second.block<3, 3>(3, 3) = T_dG_prev - T_DFt * F.transpose();
-      second.block<3, 3>(3, 6) = T_DFt;
-      second.block<3, 3>(6, 3) = -T_D * F.transpose();
-      second.block<3, 3>(6, 6) = T_D;
-      // The antisymmetric part is cancelled exactly by the retraction's derivative
-      // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
-      st.second = 0.5 * (second + second.transpose());
-      if (effects_) st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, w);
-    }
-    visit(st);
+    if (effects_) R = R * prev.F;
+    visit_torque(k, &prev, &next, R);
     prev = next;
   }
+  if (scheme_.hasEndTorques()) visit_torque(N_, &prev, nullptr, R);
   return cost;
+}
+
+void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMomentum&)>& visit,
+                                         const SecondOrderWeights& weights) const {
+  NodeMomentum node;
+  node.second.setZero();
+  StepTerms prev(scheme_, steps_[0]);
+  for (int k = 1; k < N_; ++k) {
+    StepTerms next(scheme_, steps_[k]);
+    node.k = k;
+    node.momentum = 0.5 * (next.mu + prev.G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
+    const Vector3 w = weights ? weights(k, node.momentum) : Vector3::Zero().eval();
+    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, &node.jacobian,
+                        &node.second);
+    visit(node);
+    prev = next;
+  }
 }
 
 double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
@@ -305,10 +409,12 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
     if (!hessian) return;
     const Eigen::Matrix<double, 9, 9> block =
         st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
-    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (first at 3(k − 3)); the
-    // fixed ones among them (R_1, R_{N−1}) are cut off the block.
-    const int first_free = std::max(0, 3 - st.k), last_free = std::min(2, N_ - 1 - st.k);
-    hessian->addSymmetricBlock<9>(3 * (st.k - 3), block, 3 * first_free, 3 * (last_free + 1));
+    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (R_{k−1}'s would be at
+    // 3(k − 1 − first free node)); the fixed ones among them are cut off the block.
+    const int first_slot = std::max(0, first_free_ - (st.k - 1));
+    const int last_slot = std::min(2, last_free_ - (st.k - 1));
+    hessian->addSymmetricBlock<9>(3 * (st.k - 1 - first_free_), block, 3 * first_slot,
+                                  3 * (last_slot + 1));
   });
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;

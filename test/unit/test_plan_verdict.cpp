@@ -60,7 +60,7 @@ TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {
 }
 
 TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
-  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     const PlanResult base = planManeuver(spinningShape(1.0, 1.0, scheme));
     ASSERT_TRUE(base.converged()) << base.message;
     struct Scaling {
@@ -114,7 +114,7 @@ TEST(PlanVerdict, UnstableOptimumConvergesAndReportsItsReplayMiss) {
 TEST(PlanVerdict, StepResidualDetectsAnInconsistentPlan) {
   // The check can fail: a converged plan with one torque (1e-3 of the largest), one velocity
   // (1e-4 rad/s) or the end attitude (1e-6 rad) disturbed no longer satisfies the equations.
-  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     const PlanningProblem p = spinningShape(1.0, 1.0, scheme);
     const PlanResult r = planManeuver(p);
     ASSERT_TRUE(r.converged()) << r.message;

@@ -47,7 +47,12 @@ struct PlanResult {
   /// R_k, Ω_k, τ_k, k = 0..N: the plan itself (Newton, interior point: the solver's attitudes,
   /// their velocities and torques; NLopt: its torques replayed).
   Maneuver maneuver;
-  double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
+  /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½).
+  double cost = 0.0;
+  /// h · cost [N²·m²·s]: the scheme's quadrature of ½∫₀ᵀ|τ|²dt, comparable across schemes and
+  /// with the continuous optimum.
+  double effort = 0.0;
   int iterations = 0;  ///< Newton iterations, coarser continuation levels included
   /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
   double max_residual = 0.0;
@@ -60,7 +65,8 @@ struct PlanResult {
   /// the convergence verdict.
   double step_residual = 0.0;
   double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
-  double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
+  /// |Ω_N − Ω(T)| [rad/s] of the replay (Ω_N = Ω_{N−1} for paper and variational)
+  double terminal_velocity_error = 0.0;
   /// max(terminal_attitude_error, T·terminal_velocity_error) [rad]: how far the planned torques,
   /// replayed open-loop from R_0, Ω_0 through the same integrator, end from the target. A
   /// sensitivity of the maneuver (round-off grows like e^{λT} on unstable motions), reported,

@@ -47,6 +47,9 @@ struct PlanResult {
   /// R_k, Ω_k, τ_k, k = 0..N: the plan itself (Newton, interior point: the solver's attitudes,
   /// their velocities and torques; NLopt: its torques replayed).
   Maneuver maneuver;
+  double duration = 0.0;  ///< T [s] of the returned plan (minimum_time: chosen by the planner)
+  /// T* [s]: the least duration found feasible (objective minimum_time; else 0).
+  double minimum_duration = 0.0;
   /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
   /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½).
   double cost = 0.0;

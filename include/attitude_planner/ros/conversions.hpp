@@ -83,10 +83,10 @@ struct PlannerDefaults {
   SolverKind solver = SolverKind::Newton;
   /// N of a request that leaves `steps` at 0 (both services): the seed's example resolution.
   int steps = 128;
-  double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
-  int max_iterations = 200;       ///< iteration limit
-  double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none (then max_solve_time)
-  int max_steps = 100000;         ///< largest accepted N
+  double tolerance = 1e-10;   ///< optimality tolerance (scaled residual)
+  int max_iterations = 200;   ///< iteration limit
+  double time_budget = 30.0;  ///< wall-time limit [s]; 0 = none (then max_solve_time)
+  int max_steps = 100000;     ///< largest accepted N
   /// Cap on every request's time budget [s] (> 0): a request asking for more, or for none
   /// (time_budget 0 with ~time_budget 0), is solved with this budget, so no solve runs away.
   double max_solve_time = 300.0;
@@ -134,6 +134,8 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   if (!req.scheme.empty()) applySchemeName(req.scheme, "scheme", &p);
   if (!req.direction.empty()) p.direction = parseDirection(req.direction, "direction");
   p.extra_revolutions = req.extra_revolutions;  // < 0 refused by validateProblem
+  if (!req.objective.empty()) p.objective = parseObjective(req.objective, "objective");
+  p.time_margin = req.time_margin;  // rules in validateProblem
   options->solver = req.solver.empty() ? defaults.solver : parseSolver(req.solver, "solver");
   if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
     throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +

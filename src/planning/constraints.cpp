@@ -122,6 +122,7 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   // One node constraint with signed slack (≥ 0: holds) against `scale` (its limit, or 1 rad).
   const auto visit = [&](double slack, double scale, const std::string& what, int k) {
     if (slack <= kActiveConstraintTolerance * scale) ++out.active;
+    out.max_relative_violation = std::max(out.max_relative_violation, -slack / scale);
     if (-slack > out.max_violation) {
       out.max_violation = -slack;
       std::ostringstream w;

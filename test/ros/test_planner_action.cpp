@@ -67,6 +67,10 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_EQ(result->error_code.val, PlanErrorCode::SUCCESS);
   EXPECT_EQ(result->maneuver.attitude.size(), 33u);
   EXPECT_LT(result->terminal_attitude_error, 1e-8);
+  // Issue 19: the verdict's step residual and the replay's sensitivity travel in the result.
+  EXPECT_LE(result->step_residual, 1e-8);
+  EXPECT_GE(result->replay_miss, result->terminal_attitude_error);
+  EXPECT_LT(result->replay_miss, 1e-8);
   // Feedback and result travel on different topics: allow the last feedback to land.
   waitFor([&] { return seen->last_iteration >= result->iterations; }, 5.0);
   EXPECT_GT(seen->feedbacks.load(), 0) << "no feedback received";

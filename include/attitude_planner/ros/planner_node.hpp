@@ -180,6 +180,8 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->constraints = r.constraints;
   res->max_constraint_violation = r.max_constraint_violation;
   res->active_constraints = r.active_constraints;
+  res->replay_miss = r.replay_miss;
+  res->step_residual = r.step_residual;
 }
 
 }  // namespace attitude_planner

@@ -165,15 +165,7 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
   };
   // One time budget for all resolutions: each solve gets what is left of it (and ends TimedOut
   // when nothing is).
-  const auto budgeted = [&] {
-    SolverOptions remaining = options;
-    if (options.time_budget_s > 0) {
-      const double used =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      remaining.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
-    }
-    return remaining;
-  };
+  const auto budgeted = [&] { return withRemainingBudget(options, start); };
 
   // Coarse resolution (N = 64; its estimate uses N = 32 too) of each candidate scheme.
   constexpr int kCoarse = 64;

@@ -55,15 +55,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   validateProblem(problem);
   validateMinimumTime(problem);
   const auto start = std::chrono::steady_clock::now();
-  const auto remaining = [&] {
-    SolverOptions o = options;
-    if (options.time_budget_s > 0) {
-      const double used =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      o.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
-    }
-    return o;
-  };
+  const auto remaining = [&] { return withRemainingBudget(options, start); };
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;

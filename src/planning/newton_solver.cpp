@@ -414,14 +414,6 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 /// from the coarse solution every level starts in the convex basin and takes a few Newton steps.
 constexpr int kCoarsestGrid = 16;
 
-/// What is left of the options' time budget after `start` [s] (0 budget: unlimited, returned as 0).
-double remainingBudget(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
-  if (options.time_budget_s <= 0) return 0.0;
-  const double used =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return std::max(options.time_budget_s - used, 1e-300);
-}
-
 /// A coarse level helps only while its boundary steps stay small: at h·|Ω| ≳ 1 rad the coarse
 /// problem is a different (and much harder) one — measured (issue 7): spinning ends Ω = 5 rad/s
 /// at N = 128 spent 200 failed iterations on the N = 32 level (2 rad per step) before the fine
@@ -482,7 +474,7 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
     level = "; the N = " + std::to_string(coarse.steps) + " level ended " +
             terminationName(coarse_result.termination) + ", started from the geodesic";
   }
-  fine_options.time_budget_s = remainingBudget(options, start);
+  fine_options.time_budget_s = withRemainingBudget(options, start).time_budget_s;
   if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
     return stopped(Termination::TimedOut);
   }
@@ -538,7 +530,7 @@ PlanResult solveWithRateContinuation(const PlanningProblem& problem, const Solve
     };
   }
   const auto budget = [&] {
-    stage_options.time_budget_s = remainingBudget(options, start);
+    stage_options.time_budget_s = withRemainingBudget(options, start).time_budget_s;
     return options.time_budget_s <= 0 || stage_options.time_budget_s > 1e-299;
   };
   const auto stopped = [&](PlanResult r) {  // cancelled or out of time inside a stage
@@ -627,7 +619,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   PlanningProblem other = problem;
   other.direction = RotationDirection::LongWay;
   SolverOptions remaining = options;
-  remaining.time_budget_s = remainingBudget(options, start);
+  remaining.time_budget_s = withRemainingBudget(options, start).time_budget_s;
   if (options.time_budget_s > 0 && remaining.time_budget_s <= 1e-299) return first;
   PlanResult second = solveWithContinuation(other, remaining);
   // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice

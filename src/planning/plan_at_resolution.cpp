@@ -181,12 +181,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
                                               ? checkConstraints(problem, result.maneuver)
                                               : ConstraintCheck{};
     if (!result.converged() || unconstrained.max_violation > 0.0) {
-      SolverOptions constrained = options;
-      if (options.time_budget_s > 0) {
-        const double used =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        constrained.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
-      }
+      SolverOptions constrained = withRemainingBudget(options, start);
       const int newton_iterations = result.iterations;
       std::ostringstream note;
       if (result.converged()) {

@@ -6,6 +6,8 @@
 // (dynamics/discrete_scheme.hpp) and the boundary data R_0, Ω_0, R_N, Ω_{N−1}.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -161,6 +163,20 @@ struct SolverOptions {
   /// is far closer to the next one than the unconstrained optimum is).
   bool constrained_from_warm_start = false;
 };
+
+/// `options` with what is left of its time budget after `start` (several solves sharing one
+/// budget: grid levels, accuracy resolutions, the minimum-time search). A budget of 0 (none) stays
+/// 0; a spent one becomes 1e-300 s, so the next solve ends TimedOut at once.
+inline SolverOptions withRemainingBudget(const SolverOptions& options,
+                                         std::chrono::steady_clock::time_point start) {
+  SolverOptions remaining = options;
+  if (options.time_budget_s > 0) {
+    const double used =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    remaining.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
+  }
+  return remaining;
+}
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, kMinSteps ≤ N ≤
 /// kMaxSteps, `auto` scheme only with an accuracy target, ...): throws InvalidInput naming the

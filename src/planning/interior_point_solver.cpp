@@ -33,8 +33,9 @@
 // Between nodes: the constraints hold at the nodes only. Within step k the continuous motion
 // R_k exp(s ω_k^), s ∈ [0, 1], turns at the constant rate ω_k/h (paper scheme), so a rate limit
 // holds between nodes too, and torques are held over a step, so their bounds hold throughout; a
-// cone's angle can dip below its bound within a step by O(|ω_k|²) (not yet bounded or offset by
-// a margin).
+// cone's angle can dip past its bound within a step by up to a − acos(cos a + |ω_k|²/8): the
+// cones are imposed at their node half angle, tightened by the user's margin
+// (constraints.hpp: requiredConeMargin).
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -208,12 +209,12 @@ class InteriorPoint {
             break;
           }
           case Family::KeepOut:
-            in.c = std::cos(g.spec->half_angle) -
+            in.c = std::cos(g.spec->nodeHalfAngle()) -
                    g.spec->world_direction.dot(R[k] * g.spec->body_axis);
             break;
           case Family::KeepIn:
             in.c = g.spec->world_direction.dot(R[k] * g.spec->body_axis) -
-                   std::cos(g.spec->half_angle);
+                   std::cos(g.spec->nodeHalfAngle());
             break;
         }
       }
@@ -342,7 +343,7 @@ class InteriorPoint {
         } else {
           const PointingTerms t = pointingTerms(R[k], g->spec->body_axis, g->spec->world_direction);
           const double sign = g->family == Family::KeepOut ? -1.0 : 1.0;  // c = ±p ∓ cos α
-          in.c = sign * (t.cosine - std::cos(g->spec->half_angle));
+          in.c = sign * (t.cosine - std::cos(g->spec->nodeHalfAngle()));
           prepare(in);
           in.g.head<3>() = sign * t.gradient;
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
@@ -474,10 +475,10 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     for (const PlanningConstraint& c : problem.constraints) {
       if (!c.isCone()) continue;
       for (int k : {1, N - 1}) {
-        const double margin = coneMargin(c, R[k]);
-        if (margin < 0.0) {
+        const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
+        if (slack < 0.0) {
           std::ostringstream why;
-          why << "infeasible: " << describeConstraint(c) << " is violated by " << -margin
+          why << "infeasible: " << describeConstraint(c) << " is violated by " << -slack
               << " rad at k = " << k
               << ", an attitude the boundary velocities fix (increase steps or move the boundary)";
           result.termination = Termination::Infeasible;

@@ -392,7 +392,7 @@ TEST(ConstraintScenes, BadValuesAreNamed) {
             std::string::npos);
   EXPECT_NE(
       invalidMessage(head + "constraints:\n  - keep_out: {body_axis: [0, 0, 1], world_direction: "
-                            "[1, 0, 0], half_angle: 0.5, margin: 1}\n")
+                            "[1, 0, 0], half_angle: 0.5, margins: 1}\n")
           .find("unknown key"),
       std::string::npos);
 }

@@ -121,9 +121,9 @@ struct IterationInfo {
 /// Solver settings. Defaults solve to round-off on the seed's examples.
 struct SolverOptions {
   SolverKind solver = SolverKind::Newton;
-  double tolerance = 1e-10;       ///< relative torque accuracy (Newton decrement / |τ|₂)
-  int max_iterations = 200;       ///< Newton: per grid level (coarse levels start the fine one)
-  double time_budget_s = 0.0;     ///< wall-time limit; 0 = none
+  double tolerance = 1e-10;    ///< relative torque accuracy (Newton decrement / |τ|₂)
+  int max_iterations = 200;    ///< Newton: per grid level (coarse levels start the fine one)
+  double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
   /// Called after every iteration, numbered across grid levels (the first ones may run on
   /// coarser grids); return false to cancel (the result says "cancelled").
   std::function<bool(const IterationInfo&)> on_iteration;
@@ -148,8 +148,9 @@ void applySchemeName(const std::string& text, const std::string& field, Planning
 /// and ≥ 0): throws InvalidInput naming the option and the value.
 void validateOptions(const SolverOptions& options);
 
-/// A node constraint is counted active when its slack is within this fraction of its limit
-/// (torque, rate) or this many radians (cones).
+/// A node constraint is counted active when its slack to the node bound (a cone's half angle
+/// tightened by its margin) is within this fraction of its limit (torque, rate) or this many
+/// radians (cones).
 constexpr double kActiveConstraintTolerance = 1e-6;
 
 /// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
@@ -160,6 +161,11 @@ struct ConstraintCheck {
   int active = 0;                  ///< node constraints at their bound
   std::string worst;  ///< the worst violated constraint, e.g. "|tau_x| <= 0.1 N m"; empty if none
   std::string worst_where;  ///< its violation and node, e.g. "by 0.02 at k = 64 (t = 6.4 s)"
+  /// Worst violation of the node bounds the planner imposes (cones tightened by their margin).
+  double max_node_bound_violation = 0.0;
+  /// Worst violation of the stated limits over the continuous motion between the nodes too
+  /// (R_k exp(s ω_k^), torques held; constraints.hpp), each in its own unit, ≥ max_violation.
+  double max_violation_between_nodes = 0.0;
 };
 ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver);
 

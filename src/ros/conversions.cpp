@@ -85,6 +85,20 @@ PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& f
   return PlanningConstraint::keepIn(b, s, msg.half_angle, msg.margin);
 }
 
+Constraint constraintToMsg(const PlanningConstraint& c) {
+  Constraint msg;
+  msg.type = constraintKindName(c.kind);
+  if (c.isCone()) {
+    msg.body_axis = vectorToMsg(c.body_axis);
+    msg.world_direction = vectorToMsg(c.world_direction);
+    msg.half_angle = c.half_angle;
+    msg.margin = c.margin;
+  } else {
+    msg.limit = c.limit;
+  }
+  return msg;
+}
+
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
   std::vector<EffectSpec> specs;
   for (std::size_t i = 0; i < effects.size(); ++i) {

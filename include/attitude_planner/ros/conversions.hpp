@@ -76,6 +76,8 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 /// Throws InvalidInput for an unknown type or a field of another type that is not left at zero;
 /// the values themselves are checked by validateConstraints (validateProblem).
 PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field);
+/// The Constraint message of a core constraint (the fields its kind does not use left at 0).
+Constraint constraintToMsg(const PlanningConstraint& constraint);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
@@ -83,10 +85,10 @@ struct PlannerDefaults {
   SolverKind solver = SolverKind::Newton;
   /// N of a request that leaves `steps` at 0 (both services): the seed's example resolution.
   int steps = 128;
-  double tolerance = 1e-10;       ///< optimality tolerance (scaled residual)
-  int max_iterations = 200;       ///< iteration limit
-  double time_budget = 30.0;      ///< wall-time limit [s]; 0 = none (then max_solve_time)
-  int max_steps = 100000;         ///< largest accepted N
+  double tolerance = 1e-10;   ///< optimality tolerance (scaled residual)
+  int max_iterations = 200;   ///< iteration limit
+  double time_budget = 30.0;  ///< wall-time limit [s]; 0 = none (then max_solve_time)
+  int max_steps = 100000;     ///< largest accepted N
   /// Cap on every request's time budget [s] (> 0): a request asking for more, or for none
   /// (time_budget 0 with ~time_budget 0), is solved with this budget, so no solve runs away.
   double max_solve_time = 300.0;

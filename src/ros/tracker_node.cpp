@@ -161,7 +161,7 @@ visualization_msgs::MarkerArray constraintMarkers(
     axis.pose.orientation.w = 1.0;
     axis.points.push_back(point(Vector3::Zero()));
     axis.points.push_back(point(length * c.body_axis));
-    axis.scale.x = 0.02 * length;  // shaft diameter [m]
+    axis.scale.x = 0.03 * length;  // shaft diameter [m] (twice the body x arrow: drawn around it)
     axis.scale.y = 0.05 * length;  // head diameter [m]
     axis.scale.z = 0.08 * length;  // head length [m]
     axis.color = tint;
@@ -339,9 +339,10 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       throw InvalidInput(error);
     }
     replay.effects = parsed.effects;
-    const visualization_msgs::MarkerArray cones = constraintMarkers(
-        parsed.problem.constraints, path_radius_, world_frame_, body_frame_, ros::Time());
-    if (!cones.markers.empty()) constraint_pub_.publish(cones);
+    replay.constraint_markers = constraintMarkers(parsed.problem.constraints, path_radius_,
+                                                  world_frame_, body_frame_, ros::Time());
+    if (!replay.constraint_markers.markers.empty())
+      constraint_pub_.publish(replay.constraint_markers);
     ros::ServiceClient client;
     if (!plan_in_process) {
       client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
@@ -437,7 +438,8 @@ visualization_msgs::Marker TrackerNode::pathMarker() const {
 }
 
 void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                              visualization_msgs::Marker* path) {
+                              visualization_msgs::Marker* path,
+                              visualization_msgs::MarkerArray* constraint_markers) {
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = stamp;
   tf.header.frame_id = world_frame_;
@@ -448,6 +450,10 @@ void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const Pr
   path->header.stamp = stamp;
   path->points.push_back(point(path_radius_ * R.col(0)));
   if (path->points.size() >= 2) path_pub_.publish(*path);
+  if (constraint_markers && !constraint_markers->markers.empty()) {
+    for (visualization_msgs::Marker& m : constraint_markers->markers) m.header.stamp = stamp;
+    constraint_pub_.publish(*constraint_markers);
+  }
 }
 
 void TrackerNode::publishDone(ReplayResult result) {
@@ -531,7 +537,7 @@ void TrackerNode::runReplay(Replay replay) {
   for (int k = 0; k <= N; ++k) {
     const ros::Time stamp = start + ros::Duration(replayed.time[k] / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    publishPose(replayed.attitude[k], stamp, box, &path);
+    publishPose(replayed.attitude[k], stamp, box, &path, &replay.constraint_markers);
 
     geometry_msgs::WrenchStamped wrench;
     wrench.header.stamp = stamp;

@@ -131,6 +131,9 @@ class TrackerNode {
     double plan_solve_time = -1.0;    ///< [s], −1 if unknown
     double plan_cost = -1.0;          ///< [N²·m²], −1 if unknown
     std::vector<EffectSpec> effects;  ///< effects acting during the replay (rigid body only)
+    /// ~scene's constraintMarkers (empty for a maneuver from the topic), re-published with every
+    /// pose so rviz finds the body frame at their stamp.
+    visualization_msgs::MarkerArray constraint_markers;
   };
 
   /// `maneuver` callback: replaces the running replay.
@@ -153,9 +156,11 @@ class TrackerNode {
   bool waitForClock(ros::Time* start);
   /// The empty `attitude_path` LINE_STRIP.
   visualization_msgs::Marker pathMarker() const;
-  /// tf world → body, the body markers and the path's next point at `stamp`.
+  /// tf world → body, the body markers, the path's next point and (if any) the constraint
+  /// markers at `stamp`.
   void publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                   visualization_msgs::Marker* path);
+                   visualization_msgs::Marker* path,
+                   visualization_msgs::MarkerArray* constraint_markers = nullptr);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
 

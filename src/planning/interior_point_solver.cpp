@@ -36,6 +36,7 @@
 // cone's angle can dip past its bound within a step by up to a − acos(cos a + |ω_k|²/8): the
 // cones are imposed at their node half angle, tightened by the user's margin
 // (constraints.hpp: requiredConeMargin).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -718,7 +719,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 
 }  // namespace
 
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
+namespace {
+
+/// The interior point on the requested grid, with grid continuation above
+/// kCoarsestConstrainedGrid.
+PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options) {
   if (problem.steps <= kCoarsestConstrainedGrid) {
     return solveOnGrid(problem, options, nullptr, nullptr);
   }
@@ -762,6 +767,55 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   if (levels.size() > 1) {
     result.message += "; grid continuation from N = " + std::to_string(levels.back());
   }
+  return result;
+}
+
+}  // namespace
+
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult result = solveContinued(problem, options);
+  // Pointing cones together with torque or rate limits, from a start inside a cone: the
+  // iterate can leave the cone with torques far beyond their bounds and never recover (measured:
+  // a Sun keep-out + |τ| ≤ 0.07 N m slew that IPOPT solves was called infeasible after 13
+  // iterations). Retry once in two stages: the cones alone (a path around them), then every
+  // constraint from that path.
+  const bool stuck = result.termination == Termination::Infeasible ||
+                     result.termination == Termination::NotConverged;
+  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  const bool others = problem.hasTorqueBounds() ||
+                      std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                  [](const PlanningConstraint& c) { return !c.isCone(); });
+  if (!stuck || !cones || !others) return result;
+  SolverOptions staged = options;
+  const auto remaining = [&] {
+    const double used =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return std::max(options.time_budget_s - used, 1e-300);
+  };
+  if (options.time_budget_s > 0) staged.time_budget_s = remaining();
+  PlanningProblem cones_only = problem;
+  cones_only.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  cones_only.constraints.clear();
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.isCone()) cones_only.constraints.push_back(c);
+  const PlanResult around = solveContinued(cones_only, staged);
+  int iterations = result.iterations + around.iterations;
+  if (!around.converged()) return result;
+  staged.warm_start = &around.maneuver;
+  if (options.time_budget_s > 0) staged.time_budget_s = remaining();
+  PlanResult second = solveContinued(problem, staged);
+  iterations += second.iterations;
+  const std::string first_message = result.message;
+  // The staged answer replaces the first unless it did no better (then the first is kept: its
+  // reason is the one measured from the requested start).
+  if (second.converged() || second.termination == Termination::Infeasible) result = second;
+  result.iterations = iterations;
+  result.message +=
+      "; retried in two stages (the cones alone, then every constraint from that "
+      "path) after: " +
+      first_message;
   return result;
 }
 

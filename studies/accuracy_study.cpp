@@ -41,6 +41,13 @@ std::string loadAverage() {
   return buffer;
 }
 
+/// max_k |τ_k| [N m]: the scale of the relative torque error.
+double maxTorque(const Maneuver& m) {
+  double largest = 0.0;
+  for (const Vector3& t : m.torque) largest = std::max(largest, t.norm());
+  return largest;
+}
+
 std::string sceneName(const std::string& path) {
   std::string base = path.substr(path.find_last_of('/') + 1);
   return base.substr(0, base.find('.'));
@@ -92,7 +99,8 @@ int main(int argc, char** argv) {
     const ContinuousState mid_fine = fine.stateAt(0.37 * problem.duration);
     std::fprintf(stderr, "%s: reference %s (%.2f s), cost %.15g\n", path.c_str(),
                  ref.message.c_str(), ref_time, ref.cost);
-    for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+    for (SchemeKind scheme :
+         {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
       problem.scheme = scheme;
       std::fprintf(
           out,
@@ -119,11 +127,12 @@ int main(int argc, char** argv) {
         std::fprintf(out,
                      "  %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, \"cost\": %.17g, "
                      "\"cost_integral\": %.17g, \"cost_error\": %.6e, \"trajectory_error\": %.6e, "
-                     "\"torque_error\": %.6e, \"attitude_miss\": %.6e, \"velocity_miss\": %.6e, "
+                     "\"torque_error\": %.6e, \"max_torque\": %.6e, \"attitude_miss\": %.6e, "
+                     "\"velocity_miss\": %.6e, "
                      "\"attitude_miss_step_start\": %.6e, \"velocity_miss_step_start\": %.6e}\n",
                      N == 16 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
                      plan.cost, m.cost_integral, m.cost_error, m.trajectory_error, m.torque_error,
-                     m.miss.attitude_miss, m.miss.velocity_miss, m.miss_step_start.attitude_miss,
+                     maxTorque(plan.maneuver), m.miss.attitude_miss, m.miss.velocity_miss, m.miss_step_start.attitude_miss,
                      m.miss_step_start.velocity_miss);
         std::fprintf(stderr, "  %s N=%d %.3g s cost_err %.3e traj %.3e miss %.3e\n",
                      schemeName(scheme).c_str(), N, median(times), m.cost_error, m.trajectory_error,

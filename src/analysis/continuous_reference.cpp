@@ -137,19 +137,29 @@ ContinuousState propagateExtremal(const Matrix3& inertia, const ContinuousState&
 
 void propagateRigidBody(const Matrix3& inertia, const Vector3& torque, double duration,
                         int macro_steps, Matrix3* attitude, Vector3* angular_velocity) {
-  using State = Eigen::Matrix<double, 7, 1>;  // (q, Ω)
+  propagateRigidBody(inertia, torque, torque, duration, macro_steps, attitude, angular_velocity);
+}
+
+void propagateRigidBody(const Matrix3& inertia, const Vector3& torque_start,
+                        const Vector3& torque_end, double duration, int macro_steps,
+                        Matrix3* attitude, Vector3* angular_velocity) {
+  using State = Eigen::Matrix<double, 8, 1>;  // (q, Ω, t): time makes the linear torque autonomous
   const Matrix3 J_inverse = inertia.inverse();
+  const Vector3 slope =
+      duration > 0 ? Vector3((torque_end - torque_start) / duration) : Vector3::Zero().eval();
   const auto f = [&](const State& x) {
     const Vector3 W = x.segment<3>(4);
     State dx;
     dx.head<4>() =
         0.5 * so3::quaternionProduct<double>(x.head<4>(), Quaternion4(0, W(0), W(1), W(2)));
-    dx.segment<3>(4) = J_inverse * ((inertia * W).cross(W) + torque);
+    dx.segment<3>(4) = J_inverse * ((inertia * W).cross(W) + torque_start + x(7) * slope);
+    dx(7) = 1.0;
     return dx;
   };
   State x;
   x.head<4>() = so3::quaternionCoefficients<double>(*attitude);
   x.segment<3>(4) = *angular_velocity;
+  x(7) = 0.0;
   const double H = duration / macro_steps;
   for (int i = 0; i < macro_steps; ++i) {
     x = extrapolationStep(f, x, H);

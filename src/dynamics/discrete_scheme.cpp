@@ -11,6 +11,13 @@ DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double t
   Jd_ = 0.5 * J_.trace() * Matrix3::Identity() - J_;
 }
 
+double DiscreteScheme::cost(const std::vector<Vector3>& torque) const {
+  const int N = static_cast<int>(torque.size()) - 1;
+  double c = 0.0;
+  for (int k = 0; k <= N; ++k) c += torqueWeight(k, N) * 0.5 * torque[k].squaredNorm();
+  return c;
+}
+
 Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega) const {
   const Matrix3 E = so3::expMinusIdentity(omega);  // F − I
   if (kind_ == SchemeKind::Paper) {
@@ -29,7 +36,7 @@ Matrix3 DiscreteScheme::momentumJacobianOfStep(const Matrix3& F, const Vector3& 
 Matrix3 DiscreteScheme::momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
                                                     const Vector3& tau) const {
   using so3::hat;
-  if (kind_ == SchemeKind::Variational) {
+  if (kind_ != SchemeKind::Paper) {  // the variational μ
     // The bilinear part of h μ(F e^ε e^η) is (A − Aᵀ)^∨, A = F ε^ η^ J_d, and
     // τ·(A − Aᵀ)^∨ = −tr(P ε^ η^) = εᵀ(tr(P) I − P)η with P = J_d τ^ F.
     const Matrix3 P = Jd_ * hat<double>(tau) * F / h_;

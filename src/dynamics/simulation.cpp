@@ -28,24 +28,20 @@ Maneuver integrate(const DiscreteScheme& scheme, const SimulationInput& input,
   for (int k = 0; k <= N; ++k) m.time[k] = k * h;
 
   SimulationReport local;
-  Matrix3 F = scheme.stepFromVelocity(input.initial_velocity);  // F_0
-  m.attitude[0] = input.initial_attitude;
-  m.attitude[1] = reorthonormalize(input.initial_attitude * F);
-  m.angular_velocity[0] = input.initial_velocity;
-  // The momentum is carried in the world frame, π_k = R_k μ(F_k): identical to the body-frame
-  // recursion μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h τ_k in exact arithmetic, but torque-free it is
-  // then conserved bit for bit instead of accumulating a rounding bias every step.
-  Vector3 spatial_momentum = input.initial_attitude * scheme.momentum<double>(F);
-  for (int k = 1; k < N; ++k) {
+  // What the body receives at node k: the commanded torque after actuation (recorded), plus the
+  // effects at (R_k, t_k). Called once per node in increasing k (actuation noise advances).
+  const auto applied_at = [&](int k) {
     Vector3 applied = input.torque[k];
     if constexpr (kWithEffects) {
       if (input.actuation) applied = input.actuation->apply(applied);
       m.torque[k] = applied;
       if (input.effects) applied += input.effects->torque(m.attitude[k], m.time[k]);
     }
-    const Vector3 p = m.attitude[k].transpose() * spatial_momentum + h * applied;
+    return applied;
+  };
+  const auto solve_step = [&](int k, const Vector3& p, const Matrix3& guess) {
     StepSolveReport step;
-    F = scheme.solveStep(p, F, &step);
+    const Matrix3 F_k = scheme.solveStep(p, guess, &step);
     if (!step.converged) {
       std::ostringstream msg;
       msg << "step too large, increase steps: implicit step k = " << k
@@ -55,11 +51,46 @@ Maneuver integrate(const DiscreteScheme& scheme, const SimulationInput& input,
     }
     local.max_step_iterations = std::max(local.max_step_iterations, step.iterations);
     local.max_step_residual = std::max(local.max_step_residual, step.residual);
+    return F_k;
+  };
+  // With end torques (second_order) the node velocity is J⁻¹ Π_k, the node momentum between the
+  // two half impulses: Π_k = F_{k−1}ᵀ μ(F_{k−1}) + (h/2) τ_k (discrete_scheme.hpp).
+  const bool end_torques = scheme.hasEndTorques();
+  const Matrix3 J_inverse = scheme.inertia().inverse();
+  m.attitude[0] = input.initial_attitude;
+  m.angular_velocity[0] = input.initial_velocity;
+  Matrix3 F;  // F_0
+  Vector3 spatial_momentum;
+  if (end_torques) {
+    // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0
+    const Vector3 p = scheme.inertia() * input.initial_velocity + 0.5 * h * applied_at(0);
+    F = solve_step(0, p, so3::exp(Vector3(h * input.initial_velocity)));
+    spatial_momentum = input.initial_attitude * p;
+  } else {
+    F = scheme.stepFromVelocity(input.initial_velocity);
+    spatial_momentum = input.initial_attitude * scheme.momentum<double>(F);
+  }
+  m.attitude[1] = reorthonormalize(input.initial_attitude * F);
+  // The momentum is carried in the world frame, π_k = R_k μ(F_k): identical to the body-frame
+  // recursion μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h τ_k in exact arithmetic, but torque-free it is
+  // then conserved bit for bit instead of accumulating a rounding bias every step.
+  for (int k = 1; k < N; ++k) {
+    const Vector3 applied = applied_at(k);
+    const Vector3 p = m.attitude[k].transpose() * spatial_momentum + h * applied;
+    F = solve_step(k, p, F);
     m.attitude[k + 1] = reorthonormalize(m.attitude[k] * F);
-    m.angular_velocity[k] = scheme.velocity(F);
+    m.angular_velocity[k] =
+        end_torques ? Vector3(J_inverse * (p - 0.5 * h * applied)) : scheme.velocity(F);
     if (!applied.isZero(0.0)) spatial_momentum = m.attitude[k] * p;
   }
-  m.angular_velocity[N] = m.angular_velocity[N - 1];
+  if (end_torques) {
+    // Π_N = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N = J Ω(T)
+    const Vector3 applied = applied_at(N);
+    m.angular_velocity[N] =
+        J_inverse * (m.attitude[N].transpose() * spatial_momentum + 0.5 * h * applied);
+  } else {
+    m.angular_velocity[N] = m.angular_velocity[N - 1];
+  }
   if (report) *report = local;
   return m;
 }
@@ -73,8 +104,10 @@ Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
     throw InvalidInput("torque: need at least 2 entries (k = 0..N), got " +
                        std::to_string(input.torque.size()));
   }
-  if (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0)) {
-    throw InvalidInput("torque: tau_0 and tau_N must be zero (they do not enter eq. (18))");
+  if (!scheme.hasEndTorques() &&
+      (!input.torque.front().isZero(0.0) || !input.torque.back().isZero(0.0))) {
+    throw InvalidInput("torque: tau_0 and tau_N must be zero with scheme " +
+                       schemeName(scheme.kind()) + " (they do not enter eq. (18))");
   }
   const bool with_effects =
       (input.effects && !input.effects->empty()) || (input.actuation && !input.actuation->empty());

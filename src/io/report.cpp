@@ -97,6 +97,7 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"duration\": " << jsonNumber(problem.duration) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
+      << "  \"effort\": " << jsonNumber(r.effort) << ",\n"
       << "  \"terminal_attitude_error\": " << jsonNumber(r.terminal_attitude_error) << ",\n"
       << "  \"terminal_velocity_error\": " << jsonNumber(r.terminal_velocity_error) << ",\n"
       << "  \"max_residual\": " << jsonNumber(r.max_residual) << ",\n"
@@ -147,6 +148,7 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
                                           " s (h = " + general(problem.duration / N, 6) + " s)");
   text += line("iterations", std::to_string(r.iterations));
   text += line("cost sum 1/2|tau_k|^2", general(r.cost, 12) + " N^2 m^2");
+  text += line("effort h*cost", general(r.effort, 12) + " N^2 m^2 s");
   text += line("terminal attitude error", general(r.terminal_attitude_error, 3) + " rad");
   text += line("terminal velocity error", general(r.terminal_velocity_error, 3) + " rad/s");
   text += line("max residual", general(r.max_residual, 3));

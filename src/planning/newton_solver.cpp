@@ -52,16 +52,19 @@ double roundOffFloor(int steps) {
 /// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
 ///   [ −α I   J        ] [ z ]   [ −τ ]
 ///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
-/// ordered y_1, y_2, δ_2, y_3, δ_3, …, y_{N−1} so it is banded (half bandwidth 14), and solved
+/// ordered by node, y_k before δ_k (y_1, y_2, δ_2, y_3, δ_3, …, y_{N−1}; with end torques
+/// y_0, y_1, δ_1, …, δ_{N−1}, y_N) so it is banded (half bandwidth 14), and solved
 /// by LU with partial pivoting. `delta` holds −g on entry and δ on return. `K` is the caller's
 /// workspace (allocated once per solve: at N = 10⁶ it is 2 GB, and fresh pages cost more
 /// system time than the factorization).
 bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
   const int N = np.steps();
-  const auto y_block = [&](int k) { return k == 1 ? 0 : 2 * k - 3; };
-  const auto d_block = [&](int j) { return 2 * j - 2; };  // j = 2..N−2
-  const int n = 3 * (2 * N - 4);
+  const int first = np.firstFreeNode(), last = np.lastFreeNode();
+  // Block positions: the torques k = first − 1 .. last + 1, each followed by δ_k if R_k is free.
+  const auto y_block = [&](int k) { return k < first ? 0 : 2 * (k - first) + 1; };
+  const auto d_block = [&](int j) { return 2 * (j - first) + 2; };
+  const int n = 3 * (y_block(last + 1) + 1);
   if (!*workspace) workspace->reset(new BandedLinearSystem(n, 14));
   BandedLinearSystem& K = **workspace;
   K.setZero();
@@ -105,12 +108,12 @@ bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::Vect
     }
   });
   if (shift > 0) {
-    for (int j = 2; j <= N - 2; ++j) {
+    for (int j = first; j <= last; ++j) {
       for (int i = 0; i < 3; ++i) K.add(3 * d_block(j) + i, 3 * d_block(j) + i, shift / alpha);
     }
   }
   if (!K.solve(&rhs)) return false;
-  for (int j = 2; j <= N - 2; ++j)
+  for (int j = first; j <= last; ++j)
     delta->segment<3>(np.variableIndex(j)) = rhs.segment<3>(3 * d_block(j));
   return delta->allFinite();
 }
@@ -189,7 +192,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
   if (coarse_steps) np.initializeFromCoarser(*coarse_steps, coarser_steps);
   const int N = np.steps();
-  const int n = 3 * (N - 3);
+  const int n = np.unknowns();
   const double round_off_acceptance = roundOffAcceptance(N);
   BandedSymmetricMatrix hessian(n, 8);
   std::unique_ptr<BandedLinearSystem> augmented_workspace;

@@ -25,14 +25,13 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
     result->effects.push_back(effectKindName(EffectKind::ActuatorLimits));
   }
   result->dynamics_residual = report.max_step_residual;
-  double cost = 0.0;
-  for (const Vector3& t : torque) cost += 0.5 * t.squaredNorm();
-  result->cost = cost;
   const int N = problem.steps;
+  result->cost = scheme.cost(torque);
+  result->effort = scheme.timeStep() * result->cost;
   result->terminal_attitude_error =
       so3::angleBetween(problem.final_attitude, result->maneuver.attitude[N]);
   result->terminal_velocity_error =
-      (result->maneuver.angular_velocity[N - 1] - problem.final_velocity).norm();
+      (result->maneuver.angular_velocity[N] - problem.final_velocity).norm();
 }
 
 namespace {
@@ -57,11 +56,25 @@ void requireBoundarySteps(const PlanningProblem& problem) {
   }
 }
 
+/// The interior-point and NLopt solvers know only the schemes without end torques (for now).
+void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions& options) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  if (!scheme.hasEndTorques()) return;
+  const char* with = options.solver == SolverKind::Nlopt ? "solver nlopt"
+                     : problem.hasNodeConstraints()      ? "constraints or actuator_limits"
+                                                         : nullptr;
+  if (with) {
+    throw InvalidInput("scheme: '" + schemeName(problem.scheme) + "' is not available with " +
+                       with + " yet (use 'paper' or 'variational')");
+  }
+}
+
 }  // namespace
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateOptions(options);
+  requireSchemeSupported(problem, options);
   requireBoundarySteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;

@@ -1,5 +1,7 @@
 #include "planning/reduced_problem.hpp"
 
+#include <cmath>
+
 #include "attitude_planner/errors.hpp"
 
 namespace attitude_planner {
@@ -52,7 +54,11 @@ ReducedProblem::ReducedProblem(const PlanningProblem& problem)
     : N_(problem.steps),
       scheme_(problem.scheme, problem.inertia, problem.duration / problem.steps),
       initial_attitude_(problem.initial_attitude),
-      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr) {
+      effects_(problem.effects && !problem.effects->empty() ? problem.effects : nullptr),
+      first_free_(scheme_.hasEndTorques() ? 1 : 2),
+      last_free_(scheme_.hasEndTorques() ? problem.steps - 1 : problem.steps - 2),
+      initial_momentum_(problem.inertia * problem.initial_velocity),
+      final_momentum_(problem.inertia * problem.final_velocity) {
   const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
   const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
   steps_.assign(N_, Vector3::Zero());
@@ -98,14 +104,13 @@ void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitu
     throw InvalidInput("warm start: has " + std::to_string(attitudes.size() - 1) +
                        " steps, the problem " + std::to_string(N_));
   }
-  // The warm start's R_1 and R_{N−1} must be this problem's: keep ours at the ends.
+  // The warm start's fixed attitudes must be this problem's: keep ours there.
   const std::vector<Matrix3> own = this->attitudes(steps_);
   std::vector<Matrix3> R = attitudes;
-  R[0] = own[0];
-  R[1] = own[1];
-  R[N_ - 1] = own[N_ - 1];
-  R[N_] = own[N_];
-  for (int j = 1; j <= N_ - 2; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
+  for (int j = 0; j <= N_; ++j) {
+    if (variableIndex(j) < 0) R[j] = own[j];
+  }
+  for (int j = 0; j < N_; ++j) steps_[j] = so3::log(Matrix3(R[j].transpose() * R[j + 1]));
 }
 
 namespace {
@@ -199,13 +204,20 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
     }
     mu_prev = mu;
   }
+  if (scheme_.hasEndTorques()) {
+    // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N
+    tau[0] = 2.0 * (scheme_.momentumOfStep(steps[0]) - initial_momentum_) / h;
+    tau[N_] = 2.0 * (final_momentum_ - so3::exp(steps[N_ - 1]).transpose() * mu_prev) / h;
+    if (effects_) {
+      tau[0] -= effects_->torque(initial_attitude_, 0.0);
+      tau[N_] -= effects_->torque(Matrix3(R * so3::exp(steps[N_ - 1])), N_ * h);
+    }
+  }
   return tau;
 }
 
 double ReducedProblem::cost(const Steps& steps) const {
-  double c = 0;
-  for (const Vector3& t : torques(steps)) c += 0.5 * t.squaredNorm();
-  return c;
+  return scheme_.cost(torques(steps));
 }
 
 ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
@@ -214,7 +226,7 @@ ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, doub
     const int v = variableIndex(j);
     return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));
   };
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first_free_ - 1; j <= last_free_; ++j) {  // the steps next to a free attitude
     const Eigen::Vector4d q = so3::quaternionProduct<double>(
         so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),
                                        so3::quaternionOfRotationVector<double>(steps_[j])),
@@ -230,49 +242,74 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   const double h = scheme_.timeStep();
   const std::vector<Vector3> tau = torques(steps_);
   double cost = 0.0;
-  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  StepTerms prev(scheme_, steps_[0]);
   Stencil st;
   st.second.setZero();
-  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
-  for (int k = 1; k < N_; ++k) {
-    StepTerms next(scheme_, steps_[k]);
-    const Matrix3& F = next.F;
-    const Matrix3& F_prev = prev.F;
-    if (effects_) R = R * F_prev;
+  // τ_k = f (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h, where at an end node (end torques only) the missing
+  // step's momentum is the boundary one (J Ω(0), J Ω(T)), a constant, and f = 2. The stencil
+  // holds the residual r_k = √w_k τ_k of the cost Σ ½ w_k |τ_k|² = Σ ½ |r_k|².
+  const auto visit_torque = [&](int k, const StepTerms* prev, const StepTerms* next,
+                                const Matrix3& R_k) {
+    const double weight = scheme_.torqueWeight(k, N_);
+    const double root = std::sqrt(weight);
+    const double factor = (prev && next ? 1.0 : 2.0) * root / h;
     st.k = k;
-    st.tau = tau[k];
-    st.jacobian.block<3, 3>(0, 0) = prev.dGFt / h;
-    st.jacobian.block<3, 3>(0, 3) = -(next.DFt + prev.dG) / h;
-    st.jacobian.block<3, 3>(0, 6) = next.D / h;
-    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects.
-    if (effects_) st.jacobian.block<3, 3>(0, 3) -= effects_->jacobian(R, k * h);
+    st.tau = root * tau[k];
+    st.jacobian.setZero();
+    if (prev) {
+      st.jacobian.block<3, 3>(0, 0) = factor * prev->dGFt;
+      st.jacobian.block<3, 3>(0, 3) = -factor * prev->dG;
+    }
+    if (next) {
+      st.jacobian.block<3, 3>(0, 3) -= factor * next->DFt;
+      st.jacobian.block<3, 3>(0, 6) = factor * next->D;
+    }
+    // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects (fixed at the end nodes).
+    const bool interior = prev && next;
+    if (effects_ && interior)
+      st.jacobian.block<3, 3>(0, 3) -= root * effects_->jacobian(R_k, k * h);
     cost += 0.5 * st.tau.squaredNorm();
     if (with_second_order) {
-      // second(m, l) = Σ_i τ_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
+      // second(m, l) = Σ_i w_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
       Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
       const Vector3 w = weights ? weights(k, st.tau) : st.tau;
-      const Matrix3 C_dG_prev = prev.contractdG(scheme_, w);
-      const Matrix3 C_D = next.contractD(scheme_, w);
-      const Matrix3 T_dGFt_prev = prev.contractdGFt(C_dG_prev, w) / h;  // block a, via ε_{k−1}
-      const Matrix3 T_dG_prev = -C_dG_prev / h;                         // block b, via ε_{k−1}
-      const Matrix3 T_DFt = -next.contractDFt(C_D, w) / h;              // block b, via ε_k
-      const Matrix3 T_D = C_D / h;                                      // block c, via ε_k
-      second.block<3, 3>(0, 0) = -T_dGFt_prev * F_prev.transpose();
-      second.block<3, 3>(0, 3) = T_dGFt_prev;
-      second.block<3, 3>(3, 0) = -T_dG_prev * F_prev.transpose();
-      second.block<3, 3>(3, 3) = T_dG_prev - T_DFt * F.transpose();
-      second.block<3, 3>(3, 6) = T_DFt;
-      second.block<3, 3>(6, 3) = -T_D * F.transpose();
-      second.block<3, 3>(6, 6) = T_D;
+      if (prev) {
+        const Matrix3 C_dG_prev = prev->contractdG(scheme_, w);
+        const Matrix3 T_dGFt_prev = factor * prev->contractdGFt(C_dG_prev, w);  // a, via ε_{k−1}
+        const Matrix3 T_dG_prev = -factor * C_dG_prev;                          // b, via ε_{k−1}
+        second.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
+        second.block<3, 3>(0, 3) = T_dGFt_prev;
+        second.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
+        second.block<3, 3>(3, 3) = T_dG_prev;
+      }
+      if (next) {
+        const Matrix3 C_D = next->contractD(scheme_, w);
+        const Matrix3 T_DFt = -factor * next->contractDFt(C_D, w);  // block b, via ε_k
+        const Matrix3 T_D = factor * C_D;                           // block c, via ε_k
+        second.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
+        second.block<3, 3>(3, 6) = T_DFt;
+        second.block<3, 3>(6, 3) = -T_D * next->F.transpose();
+        second.block<3, 3>(6, 6) = T_D;
+      }
       // The antisymmetric part is cancelled exactly by the retraction's derivative
       // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
       st.second = 0.5 * (second + second.transpose());
-      if (effects_) st.second.block<3, 3>(3, 3) -= effects_->weightedSecondDerivative(R, k * h, w);
+      if (effects_ && interior) {
+        st.second.block<3, 3>(3, 3) -= root * effects_->weightedSecondDerivative(R_k, k * h, w);
+      }
     }
     visit(st);
+  };
+  // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
+  StepTerms prev(scheme_, steps_[0]);
+  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, &prev, initial_attitude_);
+  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
+  for (int k = 1; k < N_; ++k) {
+    StepTerms next(scheme_, steps_[k]);
+    if (effects_) R = R * prev.F;
+    visit_torque(k, &prev, &next, R);
     prev = next;
   }
+  if (scheme_.hasEndTorques()) visit_torque(N_, &prev, nullptr, R);
   return cost;
 }
 
@@ -292,10 +329,12 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
     if (!hessian) return;
     const Eigen::Matrix<double, 9, 9> block =
         st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
-    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (first at 3(k − 3)); the
-    // fixed ones among them (R_1, R_{N−1}) are cut off the block.
-    const int first_free = std::max(0, 3 - st.k), last_free = std::min(2, N_ - 1 - st.k);
-    hessian->addSymmetricBlock<9>(3 * (st.k - 3), block, 3 * first_free, 3 * (last_free + 1));
+    // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (R_{k−1}'s would be at
+    // 3(k − 1 − first free node)); the fixed ones among them are cut off the block.
+    const int first_slot = std::max(0, first_free_ - (st.k - 1));
+    const int last_slot = std::min(2, last_free_ - (st.k - 1));
+    hessian->addSymmetricBlock<9>(3 * (st.k - 1 - first_free_), block, 3 * first_slot,
+                                  3 * (last_slot + 1));
   });
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;

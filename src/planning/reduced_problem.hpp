@@ -8,6 +8,10 @@
 // 3(2N−3) unknowns τ, Ω with its 3(N−1) dynamics equations eliminated exactly). ∇C = 0 are the
 // discrete necessary conditions (docs/necessary_conditions.md relates them to the seed's eq. 28).
 //
+// With end torques (second_order, discrete_scheme.hpp) R_1 and R_{N−1} are free too, τ_0 and
+// τ_N are functions of F_0 and F_{N−1} (the boundary velocities enter through the Legendre
+// transforms at the end nodes), and the cost is the trapezoidal Σ ½ w_k |τ_k|², k = 0..N.
+//
 // The iterate is stored as the steps' rotation vectors ω_k = log F_k, not as attitudes: torques
 // are second differences of the attitude, and absolute attitudes would lose them to round-off
 // (relative error eps·N² instead of eps·N).
@@ -29,10 +33,11 @@ class ReducedProblem {
   /// Rotation vectors ω_k of the steps F_k = exp(ω_k^), k = 0..N−1 (ω_0, ω_{N−1} fixed).
   using Steps = std::vector<Vector3>;
 
-  /// What one torque contributes to the Newton system.
+  /// What one torque contributes to the Newton system: the residual r_k = √w_k τ_k of the cost
+  /// Σ ½ |r_k|² (w_k = 1 but at the end nodes of a scheme with end torques).
   struct Stencil {
-    int k = 0;                             ///< torque index, 1..N−1
-    Vector3 tau;                           ///< τ_k [N m]
+    int k = 0;                             ///< torque index, 1..N−1 (0..N with end torques)
+    Vector3 tau;                           ///< r_k = √w_k τ_k [N m]
     Eigen::Matrix<double, 3, 9> jacobian;  ///< ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1})
     /// sym(Σ_i τ_{k,i} ∂jacobian_i/∂δ): with jacobianᵀ·jacobian, the exact Hessian block.
     Eigen::Matrix<double, 9, 9> second;
@@ -43,8 +48,12 @@ class ReducedProblem {
   explicit ReducedProblem(const PlanningProblem& problem);
 
   int steps() const { return N_; }
-  /// Number of unknowns, 3(N − 3).
-  int unknowns() const { return 3 * (N_ - 3); }
+  /// Number of unknowns, 3(N − 3) (3(N − 1) with end torques).
+  int unknowns() const { return 3 * (last_free_ - first_free_ + 1); }
+  /// The free attitudes are R_j, j = firstFreeNode()..lastFreeNode() (2..N−2; 1..N−1 with end
+  /// torques); the stencils run over k = firstFreeNode() − 1 .. lastFreeNode() + 1.
+  int firstFreeNode() const { return first_free_; }
+  int lastFreeNode() const { return last_free_; }
   const DiscreteScheme& scheme() const { return scheme_; }
 
   const Steps& current() const { return steps_; }
@@ -71,9 +80,9 @@ class ReducedProblem {
 
   /// R_0..R_N of the steps (products from R_0).
   std::vector<Matrix3> attitudes(const Steps& steps) const;
-  /// τ_k, k = 0..N (τ_0 = τ_N = 0).
+  /// τ_k, k = 0..N (τ_0 = τ_N = 0 unless the scheme has end torques).
   std::vector<Vector3> torques(const Steps& steps) const;
-  /// C = Σ ½|τ_k|².
+  /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
   double cost(const Steps& steps) const;
 
   /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
@@ -96,13 +105,17 @@ class ReducedProblem {
                   double* gradient_scale) const;
 
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
-  int variableIndex(int j) const { return (j >= 2 && j <= N_ - 2) ? 3 * (j - 2) : -1; }
+  int variableIndex(int j) const {
+    return (j >= first_free_ && j <= last_free_) ? 3 * (j - first_free_) : -1;
+  }
 
  private:
   int N_;
   DiscreteScheme scheme_;
   Matrix3 initial_attitude_;
   std::shared_ptr<const EffectModel> effects_;  ///< null when the plan has no external torques
+  int first_free_, last_free_;                  ///< the free attitudes R_j
+  Vector3 initial_momentum_, final_momentum_;   ///< J Ω(0), J Ω(T)
   Vector3 principal_span_;
   Steps steps_;
 };

@@ -491,7 +491,7 @@ void TrackerNode::runReplay(Replay replay) {
     problem.initial_attitude = plan.attitude.front();
     problem.initial_velocity = plan.angular_velocity.front();
     problem.final_attitude = plan.attitude.back();
-    problem.final_velocity = plan.angular_velocity[N - 1];
+    problem.final_velocity = plan.angular_velocity[N];
     if (!replay.msg.scheme.empty())
       problem.scheme = parseScheme(replay.msg.scheme, "maneuver.scheme");
     validateProblem(problem);
@@ -509,10 +509,10 @@ void TrackerNode::runReplay(Replay replay) {
     for (const EffectSpec& e : replay.effects) result.replay_effects.push_back(effectName(e));
     result.steps = N;
     result.duration = problem.duration;
-    for (int k = 1; k < N; ++k) result.cost += 0.5 * replayed.torque[k].squaredNorm();
+    result.cost = scheme.cost(replayed.torque);
     result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], replayed.attitude[N]);
     result.terminal_velocity_error =
-        (replayed.angular_velocity[N - 1] - plan.angular_velocity[N - 1]).norm();
+        (replayed.angular_velocity[N] - plan.angular_velocity[N]).norm();
     for (int k = 0; k <= N; ++k) {
       result.max_attitude_deviation = std::max(
           result.max_attitude_deviation, so3::angleBetween(plan.attitude[k], replayed.attitude[k]));

@@ -14,10 +14,10 @@
 #include <string>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/csv.hpp"
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/io/csv.hpp"
 
 namespace ap = attitude_planner;
 
@@ -33,8 +33,9 @@ const char* const kUsage =
     "\n"
     "options (override the scene):\n"
     "  --steps N                 number of time steps (h = T/N)\n"
-    "  --scheme paper|variational|auto  discretization (rigid_body only; auto: the planner\n"
-    "                            chooses, with a --target-* flag only)\n"
+    "  --scheme paper|variational|second_order|auto\n"
+    "                            discretization (rigid_body only; auto: the planner chooses,\n"
+    "                            with a --target-* flag only)\n"
     "  --target-miss RAD         instead of --steps: choose N so that the terminal attitude miss\n"
     "                            of the torques held over the steps on the continuous body is\n"
     "                            <= RAD (rigid_body; docs/accuracy.md)\n"

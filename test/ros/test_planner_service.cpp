@@ -245,6 +245,30 @@ TEST_F(PlannerService, SchemeAndSolverFieldsAreHonoured) {
   ASSERT_TRUE(newton.success) << newton.message;
   ASSERT_TRUE(nlopt.success) << nlopt.message;
   EXPECT_NEAR(nlopt.cost, newton.cost, 1e-6 * newton.cost);
+
+  // second_order: end torques in the plan, effort = h·cost, lower effort error than paper's
+  // (the seed's cost is ≈ 3h/T too high); with solver nlopt it is refused by name.
+  req = seed();
+  req.scheme = "second_order";
+  const PlanAttitudeManeuver::Response second = call(req);
+  ASSERT_TRUE(second.success) << second.message;
+  EXPECT_EQ(second.scheme, "second_order");
+  EXPECT_EQ(second.maneuver.scheme, "second_order");
+  EXPECT_LT(second.terminal_attitude_error, 1e-8);
+  EXPECT_LT(second.terminal_velocity_error, 1e-8);
+  const double h = req.duration / second.steps;
+  EXPECT_NEAR(second.effort, h * second.cost, 1e-12 * second.effort);
+  EXPECT_NEAR(newton.effort, h * newton.cost, 1e-12 * newton.effort);
+  EXPECT_GT(std::abs(second.maneuver.torque.front().x) +
+                std::abs(second.maneuver.torque.front().y) +
+                std::abs(second.maneuver.torque.front().z),
+            0.0);
+  req.solver = "nlopt";
+  const PlanAttitudeManeuver::Response refused = call(req);
+  EXPECT_FALSE(refused.success);
+  EXPECT_EQ(refused.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(refused.message.find("scheme: 'second_order'"), std::string::npos) << refused.message;
+  EXPECT_TRUE(call(seed()).success);  // and the node keeps serving
 }
 
 TEST_F(PlannerService, IterationLimitIsNotConverged) {

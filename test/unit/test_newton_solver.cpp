@@ -33,7 +33,7 @@ PlanningProblem slewUp(SchemeKind scheme, int N) {
   return p;
 }
 
-const SchemeKind kSchemes[] = {SchemeKind::Paper, SchemeKind::Variational};
+const SchemeKind kSchemes[] = {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder};
 
 }  // namespace
 
@@ -67,13 +67,25 @@ TEST(NewtonSolver, SolutionIsALocalMinimumUnderIndependentPerturbations) {
     const PlanResult r = planManeuver(p);
     ASSERT_TRUE(r.converged()) << r.message;
     const DiscreteScheme ds(scheme, p.inertia, p.duration / p.steps);
+    const bool ends = ds.hasEndTorques();
+    const int N = p.steps;
+    const double h = ds.timeStep();
+    // second_order (written out from discrete_scheme.hpp, not through the solver's code): end
+    // torques from Π_0 = JΩ(0) = μ(F_0) − (h/2)τ_0, Π_N = JΩ(T) = F_{N−1}ᵀμ(F_{N−1}) + (h/2)τ_N,
+    // weights ½ at the ends; R_1 and R_{N−1} free.
     auto cost_of = [&](const std::vector<Matrix3>& R) {
       double c = 0;
-      for (int k = 1; k < p.steps; ++k) {
+      for (int k = 1; k < N; ++k) {
         const Matrix3 Fp = R[k - 1].transpose() * R[k], F = R[k].transpose() * R[k + 1];
-        const Vector3 tau =
-            (ds.momentum<double>(F) - Fp.transpose() * ds.momentum<double>(Fp)) / ds.timeStep();
+        const Vector3 tau = (ds.momentum<double>(F) - Fp.transpose() * ds.momentum<double>(Fp)) / h;
         c += 0.5 * tau.squaredNorm();
+      }
+      if (ends) {
+        const Matrix3 F0 = R[0].transpose() * R[1], FN = R[N - 1].transpose() * R[N];
+        const Vector3 tau0 = 2 * (ds.momentum<double>(F0) - p.inertia * p.initial_velocity) / h;
+        const Vector3 tauN =
+            2 * (p.inertia * p.final_velocity - FN.transpose() * ds.momentum<double>(FN)) / h;
+        c += 0.25 * (tau0.squaredNorm() + tauN.squaredNorm());
       }
       return c;
     };
@@ -82,7 +94,7 @@ TEST(NewtonSolver, SolutionIsALocalMinimumUnderIndependentPerturbations) {
     for (int trial = 0; trial < 10; ++trial) {
       const double eps = 1e-4;
       std::vector<Matrix3> plus = r.maneuver.attitude, minus = plus;
-      for (int j = 2; j <= p.steps - 2; ++j) {
+      for (int j = ends ? 1 : 2; j <= (ends ? N - 1 : N - 2); ++j) {
         const Vector3 v(n(rng), n(rng), n(rng));
         plus[j] = plus[j] * so3::exp(Vector3(eps * v));
         minus[j] = minus[j] * so3::exp(Vector3(-eps * v));
@@ -118,7 +130,7 @@ TEST(NewtonSolver, IsotropicRestToRestTorquesAreParallelToTheAxisAndCostConverge
   const double j = 2.5, theta = 1.2, T = 10.0;
   const Vector3 a = Vector3(1, 2, 3).normalized();
   for (SchemeKind scheme : kSchemes) {
-    double previous_error = 0;
+    double previous_error = 0, previous_torque_error = 0;
     for (int N : {32, 64, 128, 256}) {
       PlanningProblem p;
       p.inertia = j * Matrix3::Identity();
@@ -130,17 +142,96 @@ TEST(NewtonSolver, IsotropicRestToRestTorquesAreParallelToTheAxisAndCostConverge
       ASSERT_TRUE(r.converged()) << r.message;
       double largest = 0;
       for (const Vector3& t : r.maneuver.torque) largest = std::max(largest, t.norm());
-      for (int k = 1; k < N; ++k) {
+      for (int k = 0; k <= N; ++k) {
         EXPECT_LE(r.maneuver.torque[k].cross(a).norm(), 1e-10 * largest) << "k = " << k;
       }
       const double h = T / N;
-      const double error = std::abs(h * r.cost - 6 * j * j * theta * theta / (T * T * T));
+      const double exact_effort = 6 * j * j * theta * theta / (T * T * T);
+      EXPECT_NEAR(r.effort, h * r.cost, 1e-14 * r.effort);
+      const double error = std::abs(r.effort - exact_effort);
+      // second_order: order 2, also in the torques at every node, ends included
+      // (τ(t) = j θ (6/T² − 12 t/T³) a).
+      const bool second = scheme == SchemeKind::SecondOrder;
+      double torque_error = 0;
+      for (int k = 0; k <= N; ++k) {
+        const Vector3 exact = j * theta * (6 / (T * T) - 12 * k * h / (T * T * T)) * a;
+        torque_error = std::max(torque_error, (r.maneuver.torque[k] - exact).norm());
+      }
       if (previous_error > 0) {
-        EXPECT_LT(error, 0.6 * previous_error) << schemeName(scheme) << " N " << N;
+        EXPECT_LT(error, (second ? 0.3 : 0.6) * previous_error) << schemeName(scheme) << " N " << N;
+        if (second) {
+          EXPECT_LT(torque_error, 0.3 * previous_torque_error) << "N " << N;
+        }
       }
       previous_error = error;
+      previous_torque_error = torque_error;
     }
-    EXPECT_LE(previous_error, 2e-2 * 6 * j * j * theta * theta / (T * T * T));
+    EXPECT_LE(previous_error, (scheme == SchemeKind::SecondOrder ? 1e-4 : 2e-2) * 6 * j * j *
+                                  theta * theta / (T * T * T))
+        << schemeName(scheme);
+  }
+}
+
+// second_order is time-symmetric (its discrete Lagrangian tr((I − F)J_d)/h is, and so are its
+// boundary conditions and trapezoidal weights): the problem run backwards, R'(t) = R(T − t),
+// Ω'(t) = −Ω(T − t), has the plan τ'_k = τ_{N−k}, R'_k = R_{N−k}, Ω'_k = −Ω_{N−k}.
+TEST(NewtonSolver, SecondOrderIsTimeReversible) {
+  const int N = 64;
+  // Slow boundary rates: one extremal, found from both ends (fast ones may leave the two solves
+  // on different local extremals, which says nothing about the scheme).
+  PlanningProblem forward = slewUp(SchemeKind::SecondOrder, N);
+  forward.initial_velocity = Vector3(-0.05, 0.02, 0.04);
+  forward.final_velocity = Vector3(0.03, -0.02, 0.05);
+  PlanningProblem backward = forward;
+  backward.initial_attitude = forward.final_attitude;
+  backward.final_attitude = forward.initial_attitude;
+  backward.initial_velocity = -forward.final_velocity;
+  backward.final_velocity = -forward.initial_velocity;
+  const PlanResult a = planManeuver(forward), b = planManeuver(backward);
+  ASSERT_TRUE(a.converged()) << a.message;
+  ASSERT_TRUE(b.converged()) << b.message;
+  EXPECT_NEAR(a.cost, b.cost, 1e-10 * a.cost) << a.extremal << " / " << b.extremal;
+  double torque = 0, attitude = 0, velocity = 0, largest = 0;
+  for (int k = 0; k <= N; ++k) {
+    largest = std::max(largest, a.maneuver.torque[k].norm());
+    torque = std::max(torque, (a.maneuver.torque[k] - b.maneuver.torque[N - k]).norm());
+    attitude =
+        std::max(attitude, so3::angleBetween(a.maneuver.attitude[k], b.maneuver.attitude[N - k]));
+    velocity = std::max(
+        velocity, (a.maneuver.angular_velocity[k] + b.maneuver.angular_velocity[N - k]).norm());
+  }
+  EXPECT_LE(torque, 1e-9 * largest);
+  EXPECT_LE(attitude, 1e-10);
+  EXPECT_LE(velocity, 1e-10);
+  // paper is not time-symmetric: the same test fails there (the check can fail).
+  forward.scheme = backward.scheme = SchemeKind::Paper;
+  const PlanResult c = planManeuver(forward), d = planManeuver(backward);
+  ASSERT_TRUE(c.converged() && d.converged());
+  double paper_torque = 0;
+  for (int k = 0; k <= N; ++k) {
+    paper_torque = std::max(paper_torque, (c.maneuver.torque[k] - d.maneuver.torque[N - k]).norm());
+  }
+  EXPECT_GT(paper_torque, 1e-4 * largest);
+}
+
+// The solvers that do not know end torques yet refuse second_order by name.
+TEST(NewtonSolver, SecondOrderWithNloptOrConstraintsIsRefusedByName) {
+  PlanningProblem p = restToRest(SchemeKind::SecondOrder, 32);
+  SolverOptions nlopt;
+  nlopt.solver = SolverKind::Nlopt;
+  try {
+    planManeuver(p, nlopt);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("scheme: 'second_order'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nlopt"), std::string::npos) << e.what();
+  }
+  p.max_torque = Vector3(1, 1, 1);
+  try {
+    planManeuver(p);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("second_order"), std::string::npos) << e.what();
   }
 }
 

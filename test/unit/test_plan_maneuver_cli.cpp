@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "attitude_planner/dynamics/maneuver.hpp"
-#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/io/csv.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;
@@ -120,6 +120,32 @@ TEST_F(CliTest, DefaultSolverPlansBothShippedScenesAtTheirOwnSteps) {
     const std::size_t at = summary.find("\"terminal_attitude_error\": ") + 27;
     EXPECT_LT(std::stod(summary.substr(at)), 1e-10) << summary;
   }
+}
+
+// --scheme second_order end to end: the summary names the scheme and reports effort = h·cost,
+// the CSV holds node torques at the ends too, and simulate_torques replays it to round-off.
+TEST_F(CliTest, SecondOrderPlanReportsEffortAndReplaysThroughSimulateTorques) {
+  const std::string csv = dir_ + "/second.csv", json = dir_ + "/second.json";
+  const ToolRun r = run("plan_maneuver", kScenes + "slew_up.yaml --scheme second_order --steps 64" +
+                                             " --csv " + csv + " --summary " + json);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"scheme\": \"second_order\"");
+  EXPECT_CONTAINS(summary, "\"converged\": true");
+  const double cost = std::stod(summary.substr(summary.find("\"cost\": ") + 8));
+  const double effort = std::stod(summary.substr(summary.find("\"effort\": ") + 10));
+  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  EXPECT_NEAR(effort, duration / 64 * cost, 1e-9 * effort) << summary;
+  const ap::Maneuver plan = ap::readManeuverCsv(csv);
+  EXPECT_GT(plan.torque.front().norm(), 0.0);  // end torques are part of the plan
+  EXPECT_GT(plan.torque.back().norm(), 0.0);
+  const ToolRun replay = run("simulate_torques", kScenes + "slew_up.yaml " + csv +
+                                                     " --scheme second_order --max-miss 1e-9");
+  EXPECT_EQ(replay.status, 0) << replay.output;
+  // The seed's paper scheme has no end torques: replaying this plan with it is refused by name.
+  const ToolRun wrong = run("simulate_torques", kScenes + "slew_up.yaml " + csv);
+  EXPECT_NE(wrong.status, 0) << wrong.output;
+  EXPECT_CONTAINS(wrong.output, "tau_0 and tau_N must be zero with scheme paper");
 }
 
 TEST_F(CliTest, ExitStatusAgreesWithConvergedForEverySolver) {

@@ -113,7 +113,7 @@ TEST(So3, RightJacobianInverseCoefficientDerivativeMatchesHighPrecisionReference
 }
 
 TEST(ReducedProblem, GradientMatchesFiniteDifferencesOfTheCost) {
-  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     for (bool effects : {false, true}) {
       const ReducedProblem rp = perturbedProblem(scheme, 9, 1, effects);
       Eigen::VectorXd g;
@@ -134,8 +134,9 @@ TEST(ReducedProblem, GradientMatchesFiniteDifferencesOfTheCost) {
 
 TEST(ReducedProblem, HessianMatchesSecondDifferencesOfTheCost) {
   // Second differences of δ ↦ C(R exp δ) along pairs of unit directions: the exact Hessian of
-  // the retracted cost, independent of how evaluate() assembles it.
-  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational}) {
+  // the retracted cost, independent of how evaluate() assembles it. second_order adds the end
+  // torques τ_0(R_1), τ_N(R_{N−1}) with weight ½.
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     for (bool effects : {false, true}) {
       const ReducedProblem rp = perturbedProblem(scheme, 8, 2, effects);
       const int n = rp.unknowns();

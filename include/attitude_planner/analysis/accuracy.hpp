@@ -2,15 +2,18 @@
 //
 // Three measures of a plan of N steps (h = T/N) against the continuous optimum
 // (continuous_reference.hpp):
-//   (a) cost error  |h Σ_k ½|τ_k|² − ½∫₀ᵀ|τ|²dt|: the discrete cost sums N − 1 torques of a
-//       Riemann sum, so h times it approximates the integral;
-//   (b) trajectory error max_k ‖log(R(t_k)ᵀ R_k)‖ and torque error max_k |τ_k − τ(t_k)|: both
-//       schemes apply the torque as an impulse hτ_k at the node t_k (discrete_scheme.hpp: the
-//       momentum jumps by hτ_k between step k−1 and step k), so τ_k samples τ(t_k);
+//   (a) cost error  |h Σ_k ½ w_k|τ_k|² − ½∫₀ᵀ|τ|²dt| (the effort's error): paper and
+//       variational sum the N − 1 interior torques (w_k = 1, a Riemann sum), second_order all
+//       N + 1 with the trapezoidal weights;
+//   (b) trajectory error max_k ‖log(R(t_k)ᵀ R_k)‖ and torque error max_k |τ_k − τ(t_k)| (the end
+//       nodes too for second_order): all schemes apply the torque as an impulse hτ_k at the node
+//       t_k (discrete_scheme.hpp: the momentum jumps by hτ_k between step k−1 and step k), so τ_k
+//       samples τ(t_k);
 //   (c) physical miss: the plan's torques drive the continuous rigid body (integrated to ~1e-13)
-//       as a zero-order hold; terminal ‖log(R_Tᵀ R(T))‖ and |Ω(T) − Ω_T|. The impulse hτ_k at t_k
-//       is held over [t_k − h/2, t_k + h/2] (node-centred, the default); holding it over the step
-//       [t_k, t_{k+1}) (what a naive controller does) adds a half-step delay.
+//       under the scheme's own hold; terminal ‖log(R_Tᵀ R(T))‖ and |Ω(T) − Ω_T|. paper and
+//       variational: the impulse hτ_k at t_k is held over [t_k − h/2, t_k + h/2] (node-centred);
+//       holding it over the step [t_k, t_{k+1}) (what a naive controller does) adds a half-step
+//       delay. second_order: τ linear between the node values (first-order hold).
 #pragma once
 
 #include "attitude_planner/analysis/continuous_reference.hpp"
@@ -22,7 +25,14 @@ namespace attitude_planner {
 enum class TorqueHold {
   NodeCentred,  ///< [t_k − h/2, t_k + h/2] ∩ [0, T]: the impulse hτ_k spread around its node
   StepStart,    ///< [t_k, t_{k+1}), k = 0..N−1: τ_k held over the step that starts at t_k
+  /// τ linear between the nodes (first-order hold): the interpolant of the node torques of a
+  /// scheme with end torques (second_order), which keeps its order 2.
+  PiecewiseLinear,
 };
+
+/// The hold that keeps a scheme's order: node-centred for paper and variational (the impulse
+/// hτ_k at t_k), piecewise linear for second_order (τ_k are samples of τ(t_k), ends included).
+TorqueHold naturalHold(SchemeKind scheme);
 
 /// Terminal state of the continuous body driven by a plan's torques (zero-order hold).
 struct ZeroOrderHoldReplay {
@@ -37,16 +47,21 @@ struct ZeroOrderHoldReplay {
 /// T/64 and 0.25 rad of rotation at the plan's fastest Ω_k: accurate to ~1e-13 on the seed's
 /// examples, test_accuracy.cpp).
 ZeroOrderHoldReplay replayZeroOrderHold(const PlanningProblem& problem, const Maneuver& plan,
-                                        TorqueHold hold = TorqueHold::NodeCentred);
+                                        TorqueHold hold);
+/// The same with the hold that keeps the order of problem.scheme (naturalHold).
+inline ZeroOrderHoldReplay replayZeroOrderHold(const PlanningProblem& problem,
+                                               const Maneuver& plan) {
+  return replayZeroOrderHold(problem, plan, naturalHold(problem.scheme));
+}
 
 /// The three measures of a plan.
 struct AccuracyMeasures {
-  int steps = 0;                        ///< N
-  double cost_integral = 0.0;           ///< h Σ ½|τ_k|² [N²·m²·s]
-  double cost_error = 0.0;              ///< |h Σ ½|τ_k|² − ½∫|τ|²dt| [N²·m²·s]
-  double trajectory_error = 0.0;        ///< max_k ‖log(R(t_k)ᵀ R_k)‖ [rad], k = 0..N
-  double torque_error = 0.0;            ///< max_{k=1..N−1} |τ_k − τ(t_k)| [N·m]
-  ZeroOrderHoldReplay miss;             ///< (c) with the node-centred hold
+  int steps = 0;                  ///< N
+  double cost_integral = 0.0;     ///< effort h Σ ½ w_k |τ_k|² [N²·m²·s]
+  double cost_error = 0.0;        ///< |h Σ ½ w_k |τ_k|² − ½∫|τ|²dt| [N²·m²·s]
+  double trajectory_error = 0.0;  ///< max_k ‖log(R(t_k)ᵀ R_k)‖ [rad], k = 0..N
+  double torque_error = 0.0;  ///< max_k |τ_k − τ(t_k)| [N·m], k = 1..N−1 (0..N with end torques)
+  ZeroOrderHoldReplay miss;             ///< (c) with the scheme's own hold (naturalHold)
   ZeroOrderHoldReplay miss_step_start;  ///< (c) with the step-start hold (comparison)
 };
 

@@ -91,4 +91,9 @@ ContinuousState propagateExtremal(const Matrix3& inertia, const ContinuousState&
 void propagateRigidBody(const Matrix3& inertia, const Vector3& torque, double duration,
                         int macro_steps, Matrix3* attitude, Vector3* angular_velocity);
 
+/// The same with τ linear in time from `torque_start` to `torque_end` (first-order hold).
+void propagateRigidBody(const Matrix3& inertia, const Vector3& torque_start,
+                        const Vector3& torque_end, double duration, int macro_steps,
+                        Matrix3* attitude, Vector3* angular_velocity);
+
 }  // namespace attitude_planner

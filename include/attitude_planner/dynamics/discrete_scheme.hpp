@@ -12,12 +12,21 @@
 //   variational  μ(F) = (F J_d − J_d Fᵀ)^∨ / h,  J_d = ½ tr(J) I − J
 //                Lee–Leok–McClamroch LGVI; forced through the discrete Lagrange–d'Alembert
 //                principle with the torque at the node: Π_k = F_{k−1}ᵀ Π_{k−1} + h τ_k.
+//   second_order the variational μ (the LGVI's discrete Lagrangian tr((I − F) J_d)/h is
+//                time-symmetric, hence of even order ≥ 2), but the ends are nodes like the others:
+//                each torque impulse is split h/2 + h/2 over the two steps it touches, so the
+//                node momenta are the forced discrete Legendre transforms
+//                    Π_k = μ(F_k) − (h/2) τ_k = F_{k−1}ᵀ μ(F_{k−1}) + (h/2) τ_k,
+//                and the boundary velocities are imposed at the instants 0 and T themselves:
+//                Π_0 = J Ω(0), Π_N = J Ω(T) (τ_0, τ_N are unknowns, not zero). The cost is the
+//                trapezoidal rule, weights ½ at the end nodes. Derivation: docs/second_order.md.
 //
 // Torque-free, the spatial momentum R_k μ(F_k) is conserved exactly by construction.
 // Derivatives are with respect to right perturbations F exp(ε^).
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
@@ -26,15 +35,16 @@
 namespace attitude_planner {
 
 /// Which discretization of the rigid body.
-enum class SchemeKind { Paper, Variational };
+enum class SchemeKind { Paper, Variational, SecondOrder };
 
 /// The names of the schemes (scene key `scheme`, --scheme, request field `scheme`, JSON).
 inline constexpr NamedValue<SchemeKind> kSchemeNames[] = {
     {SchemeKind::Paper, "paper"},
     {SchemeKind::Variational, "variational"},
+    {SchemeKind::SecondOrder, "second_order"},
 };
 
-/// "paper" or "variational".
+/// "paper", "variational" or "second_order".
 inline std::string schemeName(SchemeKind kind) {
   return nameIn(kSchemeNames, kind);
 }
@@ -56,6 +66,18 @@ class DiscreteScheme {
   DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step);
 
   SchemeKind kind() const { return kind_; }
+  /// True if the torques at the end nodes are impulses of the scheme (second_order: Π_0 = J Ω(0)
+  /// = μ(F_0) − (h/2) τ_0, Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N); false if τ_0 = τ_N = 0
+  /// and the boundary velocities fix the first and last steps (paper, variational).
+  bool hasEndTorques() const { return kind_ == SchemeKind::SecondOrder; }
+  /// Quadrature weight of ½|τ_k|² in the cost, k = 0..N: ½ at the ends with end torques
+  /// (trapezoidal rule), else 1.
+  double torqueWeight(int k, int steps) const {
+    return hasEndTorques() && (k == 0 || k == steps) ? 0.5 : 1.0;
+  }
+  /// The scheme's cost Σ_k ½ w_k |τ_k|² [N²·m²] of the node torques τ_0..τ_N (the effort is
+  /// h times it).
+  double cost(const std::vector<Vector3>& torque) const;
   const Matrix3& inertia() const { return J_; }
   double timeStep() const { return h_; }
 
@@ -84,7 +106,8 @@ class DiscreteScheme {
                                       const Vector3& tau) const;
 
   /// Body angular velocity [rad/s] reported for a step: paper log(F)/h (constant over the step),
-  /// variational J⁻¹ μ(F) (nodal velocity at the step's start).
+  /// variational and second_order J⁻¹ μ(F) (nodal velocity at the step's start; second_order
+  /// reports J⁻¹ Π_k at the nodes instead, simulation.hpp).
   Vector3 velocity(const Matrix3& F) const;
 
   /// Relative rotation of a step whose reported velocity is Ω (inverse of velocity()).
@@ -114,7 +137,7 @@ class DiscreteScheme {
 template <typename S>
 so3::Vec3<S> DiscreteScheme::momentum(const so3::Mat3<S>& F) const {
   const so3::Mat3<S> J = J_.template cast<S>();
-  if (kind_ == SchemeKind::Paper) {
+  if (kind_ == SchemeKind::Paper) {  // variational and second_order share μ
     const so3::Vec3<S> Omega = so3::log<S>(F) / S(h_);
     return F * (J * Omega);
   }

@@ -14,7 +14,9 @@ namespace attitude_planner {
 struct SimulationInput {
   Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
   Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s]
-  std::vector<Vector3> torque;  ///< τ_k [N·m], k = 0..N; τ_0 and τ_N must be zero (seed eq. 18)
+  /// τ_k [N·m], k = 0..N; τ_0 and τ_N must be zero (seed eq. 18) unless the scheme has end
+  /// torques (second_order).
+  std::vector<Vector3> torque;
   /// Known external torques τ_e(R_k, t_k) added at each node (nullptr or empty: none).
   const EffectModel* effects = nullptr;
   /// Saturation/noise applied to each commanded τ_k (nullptr or empty: none); advanced in place.
@@ -28,12 +30,14 @@ struct SimulationReport {
 };
 
 /// Integrates R_{k+1} = R_k F_k, μ(F_k) = F_{k−1}ᵀ μ(F_{k−1}) + h (τ_k + τ_e(R_k, t_k)),
-/// k = 1..N−1. The returned maneuver's torque column holds the torques the body received (after
-/// actuation), not the effects. Without effects and actuation the inner loop is the bare
-/// integrator (chosen once, at compile time): bit-identical to a scene with `effects: []`.
-/// N = torque.size() − 1 ≥ 1. Attitudes are re-orthonormalized each step (one Newton–Schulz
-/// iteration) so they stay on SO(3) to round-off over millions of steps.
-/// Throws StepTooLarge (naming the step) if an implicit step fails, InvalidInput on bad input.
+/// k = 1..N−1; with end torques (second_order) also μ(F_0) = J Ω_0 + (h/2) τ_0, and the node
+/// velocities are J⁻¹ Π_k (Π_N = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N). The returned maneuver's torque
+/// column holds the torques the body received (after actuation), not the effects. Without effects
+/// and actuation the inner loop is the bare integrator (chosen once, at compile time):
+/// bit-identical to a scene with `effects: []`. N = torque.size() − 1 ≥ 1. Attitudes are
+/// re-orthonormalized each step (one Newton–Schulz iteration) so they stay on SO(3) to round-off
+/// over millions of steps. Throws StepTooLarge (naming the step) if an implicit step fails,
+/// InvalidInput on bad input.
 Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
                   SimulationReport* report = nullptr);
 

@@ -44,8 +44,13 @@ struct PlanResult {
   std::vector<LevelSummary> levels;
   std::string solver;  ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;   ///< R_k, Ω_k, τ_k, k = 0..N
-  double cost = 0.0;   ///< Σ_{k=1}^{N−1} ½|τ_k|² [N²·m²]
+  Maneuver maneuver;  ///< R_k, Ω_k, τ_k, k = 0..N
+  /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
+  /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½).
+  double cost = 0.0;
+  /// h · cost [N²·m²·s]: the scheme's quadrature of ½∫₀ᵀ|τ|²dt, comparable across schemes and
+  /// with the continuous optimum.
+  double effort = 0.0;
   int iterations = 0;  ///< Newton iterations, coarser continuation levels included
   /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
   double max_residual = 0.0;
@@ -54,9 +59,10 @@ struct PlanResult {
   double newton_decrement = 0.0;
   double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
   double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
-  double terminal_velocity_error = 0.0;  ///< |Ω_{N−1} − Ω*_{N−1}| [rad/s] of the replay
-  double solve_time_s = 0.0;             ///< wall time [s]
-  std::vector<IterationInfo> history;    ///< one entry per iteration
+  double terminal_velocity_error =
+      0.0;  ///< |Ω_N − Ω(T)| [rad/s] of the replay (Ω_N = Ω_{N−1} for paper and variational)
+  double solve_time_s = 0.0;           ///< wall time [s]
+  std::vector<IterationInfo> history;  ///< one entry per iteration
   /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
   /// cost of the other way when both were solved.
   std::string extremal;

@@ -168,6 +168,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->estimated_error = r.accuracy.estimated_error;
   res->predicted_error = r.accuracy.predicted_error;
   res->cost = r.cost;
+  res->effort = r.effort;
   res->iterations = r.iterations;
   res->max_residual = r.max_residual;
   res->terminal_attitude_error = r.terminal_attitude_error;

@@ -12,6 +12,10 @@ void BandedSymmetricMatrix::addToDiagonal(double v) {
   for (int i = 0; i < n_; ++i) at(i, i) += v;
 }
 
+void BandedSymmetricMatrix::addRelativeToDiagonal(double factor, double floor) {
+  for (int i = 0; i < n_; ++i) at(i, i) += factor * (std::abs(at(i, i)) + floor);
+}
+
 double BandedSymmetricMatrix::maxAbsDiagonal() const {
   double m = 0.0;
   for (int i = 0; i < n_; ++i)

@@ -32,6 +32,10 @@ class BandedSymmetricMatrix {
     }
   }
   void addToDiagonal(double v);
+  /// A(i, i) += factor · (|A(i, i)| + floor): a shift relative to each row's own scale, so that a
+  /// matrix whose diagonal spans many orders (barrier terms) is regularized in every direction
+  /// alike; `floor` gives zero diagonals a scale.
+  void addRelativeToDiagonal(double factor, double floor);
   double maxAbsDiagonal() const;
   /// A(i, j), for tests and diagnostics.
   double operator()(int i, int j) const;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
@@ -179,14 +180,21 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
       out.worst_where = w.str();
     }
   };
-  // Between nodes (torques held: their bounds need nothing more).
+  // Between nodes: torques are held (or, with end torques, interpolated linearly: the bounds are
+  // convex), so only rates and cones need more.
   const auto between = [&](double slack) {
     out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
   };
+  // The torques τ_k and rates Ω_k of the plan: k = 1..N−1 and steps 0..N−1 for paper and
+  // variational (τ_0 = τ_N = 0; Ω_N repeats Ω_{N−1}); every node k = 0..N with end torques.
+  const bool end_torques =
+      DiscreteScheme(problem.scheme, problem.inertia, problem.duration / N).hasEndTorques();
+  const int first_torque = end_torques ? 0 : 1, last_torque = end_torques ? N : N - 1;
+  const int last_rate = end_torques ? N : N - 1;
   if (problem.hasTorqueBounds()) {
     out.names.push_back("actuator_limits");
     static const char* axis[] = {"x", "y", "z"};
-    for (int k = 1; k < N; ++k) {
+    for (int k = first_torque; k <= last_torque; ++k) {
       for (int i = 0; i < 3; ++i) {
         const double a = problem.max_torque(i);
         std::ostringstream what;
@@ -201,19 +209,21 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
     const std::string what = describeConstraint(c);
     switch (c.kind) {
       case ConstraintKind::MaxTorqueNorm:
-        for (int k = 1; k < N; ++k) {
+        for (int k = first_torque; k <= last_torque; ++k) {
           const double slack = c.limit - maneuver.torque[k].norm();
           visit(slack, slack, c.limit, what, k);
         }
         break;
       case ConstraintKind::MaxAngularRate:
-        for (int k = 0; k < N; ++k) {
+        for (int k = 0; k <= last_rate; ++k) {
           const double slack = c.limit - maneuver.angular_velocity[k].norm();
           visit(slack, slack, c.limit, what, k);
-          // The motion between nodes turns at log(F_k)/h (the variational scheme's Ω_k differs
+          // The motion between nodes turns at log(F_k)/h (a scheme's reported Ω_k may differ
           // from it by O(h²)).
-          const Matrix3 F = maneuver.attitude[k].transpose() * maneuver.attitude[k + 1];
-          between(c.limit - so3::log(F).norm() / h);
+          if (k < N) {
+            const Matrix3 F = maneuver.attitude[k].transpose() * maneuver.attitude[k + 1];
+            between(c.limit - so3::log(F).norm() / h);
+          }
         }
         break;
       case ConstraintKind::KeepOut:

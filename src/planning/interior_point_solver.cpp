@@ -1,6 +1,9 @@
 // Primal–dual interior-point Newton method for the discrete problem with node constraints
 // (per-axis torque bounds, torque norm, angular rate, keep-out / keep-in cones), O(N) per
-// iteration on the reduced problem's band (reduced_problem.hpp).
+// iteration on the reduced problem's band (reduced_problem.hpp), for every scheme. With end
+// torques (second_order) the torque constraints hold at k = 0..N too, the stencils carry the
+// residuals √w_k τ_k (constraints act on τ_k), and rates are node rates J⁻¹Π_k through the node
+// momentum's stencil (ReducedProblem::forEachNodeMomentum).
 //
 // Every constraint is stage-local in the reduced unknowns δ_j (R_j → R_j exp(δ_j^)): a torque
 // constraint depends on R_{k−1}, R_k, R_{k+1} (τ_k's stencil), a rate constraint on F_k =
@@ -72,6 +75,8 @@ constexpr int kCoarsestConstrainedGrid = 256;
 constexpr double kStallAcceptance = 1e-6;
 /// Iterations without any reduction of a nonzero violation after which it counts as stalled.
 constexpr int kViolationStall = 8;
+/// Largest relative diagonal shift tried after failed line searches (1e-8, 1e-6, ..., 1e-2).
+constexpr double kMaxShiftFloor = 1e-2;
 /// Largest violation at which the penalty is raised before a request is called infeasible.
 constexpr double kPenaltyRaiseViolation = 1e-3;
 /// Elastic violation (constraint units: relative torque/rate, cosine) that counts as infeasible.
@@ -109,11 +114,11 @@ bool isTorqueFamily(Family f) {
 /// to the banded Hessian, skipping fixed nodes.
 void addLocal(const ReducedProblem& np, BandedSymmetricMatrix* H, int first_node, int width,
               const Eigen::Matrix<double, 9, 9>& M) {
-  const int N = np.steps();
-  const int first_free = std::max(0, 2 - first_node);
-  const int last_free = std::min(width - 1, N - 2 - first_node);
+  const int first_free = std::max(0, np.firstFreeNode() - first_node);
+  const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
   if (first_free > last_free) return;
-  H->addSymmetricBlock<9>(3 * (first_node - 2), M, 3 * first_free, 3 * (last_free + 1));
+  H->addSymmetricBlock<9>(3 * (first_node - np.firstFreeNode()), M, 3 * first_free,
+                          3 * (last_free + 1));
 }
 
 /// gᵀ dδ over the local nodes (fixed nodes contribute nothing).
@@ -137,8 +142,16 @@ void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>&
 
 class InteriorPoint {
  public:
-  InteriorPoint(const PlanningProblem& problem, ReducedProblem* np) : problem_(problem), np_(*np) {
-    const int N = np_.steps();
+  InteriorPoint(const PlanningProblem& problem, ReducedProblem* np)
+      : problem_(problem),
+        np_(*np),
+        node_rates_(np->scheme().hasEndTorques()),
+        inverse_inertia_squared_(problem.inertia.inverse() * problem.inertia.inverse()) {
+    // The torques are k = first..last (1..N−1; 0..N with end torques), the free attitudes
+    // first + 1..last − 1. Rates: per step (the step's own velocity) for paper and variational,
+    // whose first and last steps are boundary data; per node (J⁻¹Π_k, k = 1..N−1) for schemes
+    // with end torques, whose node velocities are the plan's.
+    const int first = np_.firstFreeNode() - 1, last = np_.lastFreeNode() + 1;
     const auto add = [&](Family family, int first_k, int last_k, int node_offset, int width) {
       Group g;
       g.family = family;
@@ -153,7 +166,7 @@ class InteriorPoint {
     if (problem.hasTorqueBounds()) {
       for (int a = 0; a < 3; ++a) {
         for (Family f : {Family::TorqueUpper, Family::TorqueLower}) {
-          Group* g = add(f, 1, N - 1, -1, 3);
+          Group* g = add(f, first, last, -1, 3);
           g->axis = a;
           g->limit = problem.max_torque(a);
         }
@@ -163,16 +176,17 @@ class InteriorPoint {
       Group* g = nullptr;
       switch (c.kind) {
         case ConstraintKind::MaxTorqueNorm:
-          g = add(Family::TorqueNorm, 1, N - 1, -1, 3);
+          g = add(Family::TorqueNorm, first, last, -1, 3);
           break;
-        case ConstraintKind::MaxAngularRate:  // F_0, F_{N−1} are boundary data
-          g = add(Family::AngularRate, 1, N - 2, 0, 2);
+        case ConstraintKind::MaxAngularRate:
+          g = node_rates_ ? add(Family::AngularRate, first + 1, last - 1, -1, 3)
+                          : add(Family::AngularRate, first, last - 1, 0, 2);
           break;
-        case ConstraintKind::KeepOut:  // R_0, R_1, R_{N−1}, R_N are fixed
-          g = add(Family::KeepOut, 2, N - 2, 0, 1);
+        case ConstraintKind::KeepOut:  // the fixed attitudes are checked up front
+          g = add(Family::KeepOut, first + 1, last - 1, 0, 1);
           break;
         case ConstraintKind::KeepIn:
-          g = add(Family::KeepIn, 2, N - 2, 0, 1);
+          g = add(Family::KeepIn, first + 1, last - 1, 0, 1);
           break;
       }
       g->spec = &c;
@@ -205,7 +219,8 @@ class InteriorPoint {
             in.c = 1.0 - tau[k].squaredNorm() / (g.limit * g.limit);
             break;
           case Family::AngularRate: {
-            const Vector3 Omega = np_.scheme().velocity(so3::exp(steps[k]));
+            const Vector3 Omega =
+                node_rates_ ? nodeVelocity(steps, k) : np_.scheme().velocity(so3::exp(steps[k]));
             in.c = 1.0 - Omega.squaredNorm() / (g.limit * g.limit);
             break;
           }
@@ -227,8 +242,7 @@ class InteriorPoint {
   double merit(const ReducedProblem::Steps& steps, double mu, double rho, double* cost) {
     std::vector<Vector3> tau;
     evaluateValues(steps, &tau);
-    double f = 0.0;
-    for (const Vector3& t : tau) f += 0.5 * t.squaredNorm();
+    const double f = np_.scheme().cost(tau);
     double phi = f;
     for (Group& g : groups_) {
       for (Instance& in : g.at) phi += elasticSlacks(in.c, mu, rho).psi;
@@ -281,22 +295,28 @@ class InteriorPoint {
       (isTorqueFamily(g.family) ? torque_groups : other_groups).push_back(&g);
     std::vector<double> gauss_newton_factor;  // β_k = 1 + Σ_norm 2z/t², per stencil
     double jacobian_scale = 0.0, torque_scale = 0.0;
-    const auto weights = [&](int k, const Vector3& tau) {
-      Vector3 w = tau;
+    // The stencils hold the residuals r_k = √w_k τ_k (w_k the cost weight, 1 but at the end
+    // nodes of schemes with end torques): constraints are on τ_k = r_k/√w_k.
+    const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
+    const auto weights = [&](int k, const Vector3& residual) {
+      const double r = root(k);
+      const Vector3 tau = residual / r;
+      Vector3 w = residual;
       double beta = 1.0;
       for (Group* g : torque_groups) {
         Instance& in = g->instance(k);
         if (g->family == Family::TorqueNorm) {
           in.c = 1.0 - tau.squaredNorm() / (g->limit * g->limit);
           prepare(in);
-          const double factor = 2.0 * in.z / (g->limit * g->limit);  // −z∇²c = factor ∇²(½|τ|²)
+          // −z∇²c = (2z/t²) ∇²(½|τ|²) = factor ∇²(½|r|²)
+          const double factor = 2.0 * in.z / (g->limit * g->limit * r * r);
           beta += factor;
-          w += factor * tau;
+          w += factor * residual;
         } else {
           const double sign = g->family == Family::TorqueUpper ? 1.0 : -1.0;
           in.c = 1.0 - sign * tau(g->axis) / g->limit;
           prepare(in);
-          w(g->axis) += sign * in.z / g->limit;  // −z∇²c = ±(z/a) ∇²τ_a
+          w(g->axis) += sign * in.z / (g->limit * r);  // −z∇²c = ±(z/a) ∇²τ_a = ±z/(a√w) ∇²r_a
         }
       }
       current_beta_ = beta;
@@ -310,13 +330,14 @@ class InteriorPoint {
           const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
           Eigen::Matrix<double, 9, 9> block =
               current_beta_ * st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
+          const double r = root(st.k);
           for (Group* g : torque_groups) {
             Instance& in = g->instance(st.k);
             if (g->family == Family::TorqueNorm) {
-              in.g = -2.0 / (g->limit * g->limit) * grad_f;
+              in.g = -2.0 / (g->limit * g->limit * r * r) * grad_f;
             } else {
               const double sign = g->family == Family::TorqueUpper ? 1.0 : -1.0;
-              in.g = -sign / g->limit * st.jacobian.row(g->axis).transpose();
+              in.g = -sign / (g->limit * r) * st.jacobian.row(g->axis).transpose();
             }
             block += (in.g / in.D) * in.g.transpose();
           }
@@ -326,9 +347,47 @@ class InteriorPoint {
         },
         torque_groups.empty() ? ReducedProblem::SecondOrderWeights() : weights);
     *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
-    // Rate and cone constraints: their own derivatives (node_constraints.hpp).
+    // Node rates (schemes with end torques): c = 1 − |J⁻¹Π_k|²/w², through the node momentum's
+    // stencil: ∇c = −(2/w²) J_Πᵀ J⁻²Π, −z∇²c = (2z/w²)(J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i).
+    std::vector<Group*> node_rate_groups;
+    if (node_rates_) {
+      for (Group* g : other_groups)
+        if (g->family == Family::AngularRate) node_rate_groups.push_back(g);
+    }
+    if (!node_rate_groups.empty()) {
+      double gamma = 0.0;
+      const auto rate_weights = [&](int k, const Vector3& Pi) {
+        const Vector3 a = inverse_inertia_squared_ * Pi;  // J⁻²Π
+        const double rate_squared = Pi.dot(a);            // |J⁻¹Π|²
+        gamma = 0.0;
+        for (Group* g : node_rate_groups) {
+          Instance& in = g->instance(k);
+          in.c = 1.0 - rate_squared / (g->limit * g->limit);
+          prepare(in);
+          gamma += 2.0 * in.z / (g->limit * g->limit);
+        }
+        return Vector3(gamma * a);
+      };
+      np_.forEachNodeMomentum(
+          [&](const ReducedProblem::NodeMomentum& node) {
+            const Vector3 a = inverse_inertia_squared_ * node.momentum;
+            Eigen::Matrix<double, 9, 9> block =
+                gamma * node.jacobian.transpose() * inverse_inertia_squared_ * node.jacobian +
+                node.second;
+            const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;
+            for (Group* g : node_rate_groups) {
+              Instance& in = g->instance(node.k);
+              in.g = -2.0 / (g->limit * g->limit) * grad;
+              block += (in.g / in.D) * in.g.transpose();
+            }
+            addLocal(np_, H, node.k - 1, 3, block);
+          },
+          rate_weights);
+    }
+    // Step rates and cone constraints: their own derivatives (node_constraints.hpp).
     std::vector<Matrix3> R;
     for (Group* g : other_groups) {
+      if (node_rates_ && g->family == Family::AngularRate) continue;
       if (g->family != Family::AngularRate && R.empty()) R = np_.attitudes(steps);
       for (int k = g->first_k; k <= g->last_k; ++k) {
         Instance& in = g->instance(k);
@@ -428,8 +487,20 @@ class InteriorPoint {
   }
 
  private:
+  /// J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2: the node velocity of a scheme with end
+  /// torques.
+  Vector3 nodeVelocity(const ReducedProblem::Steps& steps, int k) const {
+    const DiscreteScheme& scheme = np_.scheme();
+    const Vector3 Pi =
+        0.5 * (scheme.momentumOfStep(steps[k]) +
+               so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
+    return problem_.inertia.inverse() * Pi;
+  }
+
   const PlanningProblem& problem_;
   ReducedProblem& np_;
+  bool node_rates_;
+  Matrix3 inverse_inertia_squared_;  ///< J⁻²
   std::vector<Group> groups_;
   int constraint_count_ = 0;
   double current_beta_ = 1.0;
@@ -476,6 +547,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     for (const PlanningConstraint& c : problem.constraints) {
       if (!c.isCone()) continue;
       for (int k : {1, N - 1}) {
+        if (np.variableIndex(k) >= 0) continue;               // free with end torques
         const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
         if (slack < 0.0) {
           std::ostringstream why;
@@ -522,6 +594,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   double relative_decrement = 0.0;
   int penalty_raises = 0;
   int stalled_iterations = 0;
+  double shift_floor = 0.0;  // raised after a failed line search, reset after a success
   const double stall_acceptance = kStallAcceptance * std::max(1.0, N / 1024.0);
   double best_violation = std::numeric_limits<double>::infinity();
   int last_violation_progress = 0;
@@ -540,11 +613,15 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     for (int attempt = 0; attempt < 2 && !factored; ++attempt) {
       cost = ip.assemble(mu, rho, primal, &hessian, &rhs, &merit_gradient, &gradient_scale);
       if (!std::isfinite(cost)) break;
-      shift = 0.0;
+      shift = shift_floor;
       for (int tries = 0; tries < 40; ++tries) {
         delta = rhs;
         BandedSymmetricMatrix trial = hessian;
-        if (shift > 0) trial.addToDiagonal(shift * hessian.maxAbsDiagonal());
+        // Inertia correction relative to each row's scale: at the final barrier the active
+        // constraints' rows are ~1/μ larger than the others, and a uniform shift sized by them
+        // (the largest diagonal) damped the free directions into linear convergence (measured:
+        // torque_limited, second_order, N = 512: 200 iterations at a decrement of 2e-6).
+        if (shift > 0) trial.addRelativeToDiagonal(shift, 1e-8 * hessian.maxAbsDiagonal());
         if (trial.solvePositiveDefinite(&delta) && delta.allFinite()) {
           factored = true;
           break;
@@ -623,6 +700,12 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         ending = Termination::Converged;
         break;
       }
+      // A direction the line search rejects: regularize more (Levenberg–Marquardt) and retry,
+      // a few times, before giving up.
+      if (shift_floor < kMaxShiftFloor) {
+        shift_floor = std::max(1e-8, 100.0 * shift_floor);
+        continue;
+      }
       reason = "line search failed";
       break;
     }
@@ -631,6 +714,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     const double alpha_dual = ip.dualStep(delta, rho, &dz);
     ip.applyDualStep(dz, std::min(alpha_dual, 1.0));
     np.setCurrent(trial);
+    shift_floor = shift_floor > 1e-8 ? shift_floor / 100.0 : 0.0;
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
     result.history.push_back(info);
     if (options.on_iteration && !options.on_iteration(info)) {
@@ -678,6 +762,10 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       const double xi = smallest / average;
       const double sigma = 0.1 * std::pow(std::min(0.05 * (1 - xi) / xi, 2.0), 3);
       mu = std::max(mu_final, std::min(mu, sigma * average));
+      // Within 10× of the final barrier the complementarity products sit at round-off and the
+      // rule above can leave μ just above μ_final for good (measured: N = 8192, μ = 1.07 μ_final,
+      // then no stall test applies): snap to it.
+      if (mu < 10.0 * mu_final) mu = mu_final;
     }
   }
 

@@ -56,16 +56,13 @@ void requireBoundarySteps(const PlanningProblem& problem) {
   }
 }
 
-/// The interior-point and NLopt solvers know only the schemes without end torques (for now).
+/// The NLopt cross-check (a direct method on τ_1..τ_{N−1}) knows only the schemes without end
+/// torques.
 void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions& options) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
-  if (!scheme.hasEndTorques()) return;
-  const char* with = options.solver == SolverKind::Nlopt ? "solver nlopt"
-                     : problem.hasNodeConstraints()      ? "constraints or actuator_limits"
-                                                         : nullptr;
-  if (with) {
-    throw InvalidInput("scheme: '" + schemeName(problem.scheme) + "' is not available with " +
-                       with + " yet (use 'paper' or 'variational')");
+  if (scheme.hasEndTorques() && options.solver == SolverKind::Nlopt) {
+    throw InvalidInput("scheme: '" + schemeName(problem.scheme) +
+                       "' is not available with solver nlopt (use 'paper' or 'variational')");
   }
 }
 

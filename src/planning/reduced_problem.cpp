@@ -116,15 +116,25 @@ void ReducedProblem::setInteriorFromAttitudes(const std::vector<Matrix3>& attitu
 namespace {
 
 /// The rate of `coarse` (steps of a grid of coarse.size() steps) at the position of step j of N,
-/// scaled to a step of that grid: step k of N belongs to T k/(N − 1) (see initializeFromCoarser).
-Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N) {
+/// scaled to a step of that grid. `midpoints`: step k of a grid of n steps belongs to
+/// T (k + ½)/n (schemes with end torques, whose every step is free); else to T k/(n − 1) (paper
+/// and variational: the fixed first and last steps carry Ω(0) and Ω(T); see
+/// initializeFromCoarser).
+Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N, bool midpoints) {
   const int Nc = static_cast<int>(coarse.size());
   const auto slope = [&](int k) {
     if (k == 0) return Vector3(coarse[1] - coarse[0]);
     if (k == Nc - 1) return Vector3(coarse[Nc - 1] - coarse[Nc - 2]);
     return Vector3(0.5 * (coarse[k + 1] - coarse[k - 1]));
   };
-  const double x = double(j) * (Nc - 1) / (N - 1);  // in coarse steps
+  const double x = midpoints ? (j + 0.5) * Nc / N - 0.5 : double(j) * (Nc - 1) / (N - 1);
+  // Midpoints of the first and last fine steps lie outside the coarse ones: extrapolate
+  // linearly (near a rest end the rate grows linearly in t; holding the coarse end rate made
+  // the fine end torque τ_0 = 2Jω_0/h² too large by h_c/h).
+  if (x < 0.0) return double(Nc) / N * (coarse[0] + x * (coarse[1] - coarse[0]));
+  if (x > Nc - 1) {
+    return double(Nc) / N * (coarse[Nc - 1] + (x - (Nc - 1)) * (coarse[Nc - 1] - coarse[Nc - 2]));
+  }
   const int i = std::min(static_cast<int>(x), Nc - 2);
   const double s = x - i;
   const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
@@ -142,37 +152,50 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coa
     throw InvalidInput("grid continuation: a coarse grid of " + std::to_string(Nc) +
                        " steps cannot start one of " + std::to_string(N_));
   }
-  // Where a step belongs in time: the boundary data make the first step's rate Ω(0) and the
-  // last one's Ω(T), and the optimal discrete solutions are smooth in k between them (measured),
-  // so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h puts the fixed end steps
-  // a fraction of a coarse step off: O(1) torque jumps at the ends.) Rates ω^c_k/h_c are
-  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a second,
-  // coarser solution the two are extrapolated to this grid's h (Richardson, first order: the
-  // discrete solutions converge like h, docs/accuracy.md), s(h) = s(h₁) − (s(h₂) − s(h₁))
-  // (h₁ − h)/(h₂ − h₁).
+  // Where a step belongs in time: for paper and variational the boundary data make the first
+  // step's rate Ω(0) and the last one's Ω(T), and the optimal discrete solutions are smooth in k
+  // between them (measured), so step k of N belongs to T k/(N − 1). (Centring steps at (k + ½)h
+  // puts the fixed end steps a fraction of a coarse step off: O(1) torque jumps at the ends.)
+  // With end torques every step is free and sits at its midpoint (k + ½)h. Rates ω^c_k/h_c are
+  // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a
+  // second, coarser solution the two are extrapolated to this grid's h (Richardson at the
+  // scheme's order p: 1, or 2 with end torques, docs/accuracy.md),
+  // s(h) = s(h₁) − (s(h₂) − s(h₁)) (h₁ᵖ − hᵖ)/(h₂ᵖ − h₁ᵖ).
+  const bool midpoints = scheme_.hasEndTorques();
+  const double p = midpoints ? 2.0 : 1.0;
   const double h1 = 1.0 / Nc, h = 1.0 / N_;
-  const double weight = coarser ? (h1 - h) / (1.0 / coarser->size() - h1) : 0.0;
-  for (int j = 1; j <= N_ - 2; ++j) {
-    const Vector3 fine = interpolatedStep(coarse, j, N_);
-    steps_[j] =
-        coarser ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_) - fine)) : fine;
-  }
-  // The gap ψ between where the interpolated steps end and R_{N−1} (body frame of R_{N−1}),
-  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ_1 = 0 and φ_{N−1} = ψ, zero end slopes:
-  // F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In quaternions throughout.
+  const double weight = coarser ? (std::pow(h1, p) - std::pow(h, p)) /
+                                      (std::pow(1.0 / coarser->size(), p) - std::pow(h1, p))
+                                : 0.0;
+  // The free steps: those next to a free attitude (1..N−2, or 0..N−1 with end torques). What
+  // they compose to now is what they must compose to: R_firstᵀ R_last+1 of the fixed ends.
   using Quaternion = Eigen::Vector4d;
+  const int first = first_free_ - 1, last = last_free_;
+  Quaternion target = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = first; j <= last; ++j) {
+    target = so3::quaternionProduct<double>(target, so3::quaternionOfRotationVector(steps_[j]));
+  }
+  for (int j = first; j <= last; ++j) {
+    const Vector3 fine = interpolatedStep(coarse, j, N_, midpoints);
+    steps_[j] = coarser
+                    ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_, midpoints) - fine))
+                    : fine;
+  }
+  // The gap ψ between where the interpolated steps end and the fixed end (body frame there),
+  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ = 0 at the first fixed node and ψ at the
+  // last, zero end slopes: F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In
+  // quaternions throughout.
   Quaternion reached = so3::quaternionOfRotationVector<double>(Vector3::Zero());
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first; j <= last; ++j) {
     reached = so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(steps_[j]));
   }
   reached.tail<3>() *= -1.0;  // its inverse
-  const Vector3 gap = so3::logOfQuaternion<double>(
-      so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(principal_span_)));
+  const Vector3 gap = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(reached, target));
   const auto phi = [&](int j) {
-    const double u = double(j - 1) / (N_ - 2);
+    const double u = double(j - first) / (last + 1 - first);
     return Vector3((3 * u * u - 2 * u * u * u) * gap);
   };
-  for (int j = 1; j <= N_ - 2; ++j) {
+  for (int j = first; j <= last; ++j) {
     const Quaternion q = so3::quaternionProduct<double>(
         so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-phi(j)),
                                        so3::quaternionOfRotationVector<double>(steps_[j])),
@@ -236,6 +259,51 @@ ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, doub
   return out;
 }
 
+namespace {
+
+/// Jacobian (3×9 over δ_{k−1}, δ_k, δ_{k+1}) of a μ_k + b G_{k−1} (either step may be absent), and
+/// with `w` the symmetric part of Σ_i w_i ∂(jacobian_i)/∂δ, by the chain rule through ε_{k−1},
+/// ε_k (StepTerms). Torques are a = f/h, b = −f/h; the node momentum Π_k is a = b = ½.
+void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, const StepTerms* next,
+                         double a, double b, const Vector3* w,
+                         Eigen::Matrix<double, 3, 9>* jacobian,
+                         Eigen::Matrix<double, 9, 9>* second) {
+  jacobian->setZero();
+  if (prev) {
+    jacobian->block<3, 3>(0, 0) = -b * prev->dGFt;
+    jacobian->block<3, 3>(0, 3) = b * prev->dG;
+  }
+  if (next) {
+    jacobian->block<3, 3>(0, 3) -= a * next->DFt;
+    jacobian->block<3, 3>(0, 6) = a * next->D;
+  }
+  if (!w) return;
+  Eigen::Matrix<double, 9, 9> raw = Eigen::Matrix<double, 9, 9>::Zero();
+  if (prev) {
+    const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
+    const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}
+    const Matrix3 T_dG_prev = b * C_dG_prev;                             // block b, via ε_{k−1}
+    raw.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
+    raw.block<3, 3>(0, 3) = T_dGFt_prev;
+    raw.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
+    raw.block<3, 3>(3, 3) = T_dG_prev;
+  }
+  if (next) {
+    const Matrix3 C_D = next->contractD(scheme, *w);
+    const Matrix3 T_DFt = -a * next->contractDFt(C_D, *w);  // block b, via ε_k
+    const Matrix3 T_D = a * C_D;                            // block c, via ε_k
+    raw.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
+    raw.block<3, 3>(3, 6) = T_DFt;
+    raw.block<3, 3>(6, 3) = -T_D * next->F.transpose();
+    raw.block<3, 3>(6, 6) = T_D;
+  }
+  // The antisymmetric part is cancelled exactly by the retraction's derivative
+  // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
+  *second = 0.5 * (raw + raw.transpose());
+}
+
+}  // namespace
+
 double ReducedProblem::forEachStencil(bool with_second_order,
                                       const std::function<void(const Stencil&)>& visit,
                                       const SecondOrderWeights& weights) const {
@@ -249,54 +317,21 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   // holds the residual r_k = √w_k τ_k of the cost Σ ½ w_k |τ_k|² = Σ ½ |r_k|².
   const auto visit_torque = [&](int k, const StepTerms* prev, const StepTerms* next,
                                 const Matrix3& R_k) {
-    const double weight = scheme_.torqueWeight(k, N_);
-    const double root = std::sqrt(weight);
+    const double root = std::sqrt(scheme_.torqueWeight(k, N_));
     const double factor = (prev && next ? 1.0 : 2.0) * root / h;
     st.k = k;
     st.tau = root * tau[k];
-    st.jacobian.setZero();
-    if (prev) {
-      st.jacobian.block<3, 3>(0, 0) = factor * prev->dGFt;
-      st.jacobian.block<3, 3>(0, 3) = -factor * prev->dG;
-    }
-    if (next) {
-      st.jacobian.block<3, 3>(0, 3) -= factor * next->DFt;
-      st.jacobian.block<3, 3>(0, 6) = factor * next->D;
-    }
+    const Vector3 w = with_second_order && weights ? weights(k, st.tau) : st.tau;
+    momentumCombination(scheme_, prev, next, factor, -factor, with_second_order ? &w : nullptr,
+                        &st.jacobian, &st.second);
     // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects (fixed at the end nodes).
     const bool interior = prev && next;
     if (effects_ && interior)
       st.jacobian.block<3, 3>(0, 3) -= root * effects_->jacobian(R_k, k * h);
-    cost += 0.5 * st.tau.squaredNorm();
-    if (with_second_order) {
-      // second(m, l) = Σ_i w_i ∂jacobian(i, m)/∂δ_l by the chain rule through ε_{k−1}, ε_k.
-      Eigen::Matrix<double, 9, 9> second = Eigen::Matrix<double, 9, 9>::Zero();
-      const Vector3 w = weights ? weights(k, st.tau) : st.tau;
-      if (prev) {
-        const Matrix3 C_dG_prev = prev->contractdG(scheme_, w);
-        const Matrix3 T_dGFt_prev = factor * prev->contractdGFt(C_dG_prev, w);  // a, via ε_{k−1}
-        const Matrix3 T_dG_prev = -factor * C_dG_prev;                          // b, via ε_{k−1}
-        second.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
-        second.block<3, 3>(0, 3) = T_dGFt_prev;
-        second.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
-        second.block<3, 3>(3, 3) = T_dG_prev;
-      }
-      if (next) {
-        const Matrix3 C_D = next->contractD(scheme_, w);
-        const Matrix3 T_DFt = -factor * next->contractDFt(C_D, w);  // block b, via ε_k
-        const Matrix3 T_D = factor * C_D;                           // block c, via ε_k
-        second.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
-        second.block<3, 3>(3, 6) = T_DFt;
-        second.block<3, 3>(6, 3) = -T_D * next->F.transpose();
-        second.block<3, 3>(6, 6) = T_D;
-      }
-      // The antisymmetric part is cancelled exactly by the retraction's derivative
-      // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
-      st.second = 0.5 * (second + second.transpose());
-      if (effects_ && interior) {
-        st.second.block<3, 3>(3, 3) -= root * effects_->weightedSecondDerivative(R_k, k * h, w);
-      }
+    if (effects_ && interior && with_second_order) {
+      st.second.block<3, 3>(3, 3) -= root * effects_->weightedSecondDerivative(R_k, k * h, w);
     }
+    cost += 0.5 * st.tau.squaredNorm();
     visit(st);
   };
   // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
@@ -311,6 +346,23 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   }
   if (scheme_.hasEndTorques()) visit_torque(N_, &prev, nullptr, R);
   return cost;
+}
+
+void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMomentum&)>& visit,
+                                         const SecondOrderWeights& weights) const {
+  NodeMomentum node;
+  node.second.setZero();
+  StepTerms prev(scheme_, steps_[0]);
+  for (int k = 1; k < N_; ++k) {
+    StepTerms next(scheme_, steps_[k]);
+    node.k = k;
+    node.momentum = 0.5 * (next.mu + prev.G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
+    const Vector3 w = weights ? weights(k, node.momentum) : Vector3::Zero().eval();
+    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, &node.jacobian,
+                        &node.second);
+    visit(node);
+    prev = next;
+  }
 }
 
 double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,

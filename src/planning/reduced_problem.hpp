@@ -99,6 +99,19 @@ class ReducedProblem {
   double forEachStencil(bool with_second_order, const std::function<void(const Stencil&)>& visit,
                         const SecondOrderWeights& weights = nullptr) const;
 
+  /// The node momentum Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2 [N m s] (= μ(F_k) − (h/2)τ_k, the
+  /// forced discrete Legendre transform of schemes with end torques; J⁻¹Π_k is the node velocity).
+  struct NodeMomentum {
+    int k = 0;                             ///< node, 1..N−1
+    Vector3 momentum;                      ///< Π_k [N m s] (the effects cancel in the mean)
+    Eigen::Matrix<double, 3, 9> jacobian;  ///< ∂Π_k/∂(δ_{k−1}, δ_k, δ_{k+1})
+    Eigen::Matrix<double, 9, 9> second;    ///< sym(Σ_i w_i ∂jacobian_i/∂δ), with weights only
+  };
+  /// Calls visit(node) for k = 1..N−1 at the current iterate; `second` is formed with weights
+  /// w = weights(k, Π_k) only.
+  void forEachNodeMomentum(const std::function<void(const NodeMomentum&)>& visit,
+                           const SecondOrderWeights& weights = nullptr) const;
+
   /// Cost, gradient and exact Hessian (normal equations) of δ ↦ C(R_j exp(δ_j^)) at δ = 0.
   /// `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient); hessian may be null.
   double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,

@@ -709,12 +709,7 @@ void driftTwoInputShootingResidual(const Matrix3& g0, const Matrix3& g1, double 
 DriftTwoInputTrajectory sampleDriftTwoInputExtremal(const Matrix3& g0, const Vector3& p0, double T,
                                                     int steps, const DriftTwoInputWeights& w,
                                                     double max_step, int* integration_steps) {
-  validateDriftTwoInputWeights(w);
-  if (!std::isfinite(T) || T <= 0.0) {
-    throw InvalidInput("duration T must be finite and > 0, got " + std::to_string(T));
-  }
-  if (steps < 1) throw InvalidInput("steps must be >= 1, got " + std::to_string(steps));
-  if (!p0.allFinite()) throw InvalidInput("initial costate p0 must be finite");
+  validateDriftTwoInputExtremalInputs(w, T, steps, p0);
   DriftTwoInputTrajectory out;
   out.t.resize(steps + 1);
   out.p.resize(steps + 1);

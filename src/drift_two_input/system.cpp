@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/input_rules.hpp"
 
 namespace attitude_planner {
 
@@ -19,22 +20,25 @@ void validateDriftTwoInputWeights(const DriftTwoInputWeights& w) {
   }
 }
 
+void validateDriftTwoInputExtremalInputs(const DriftTwoInputWeights& w, double T, int steps,
+                                         const Vector3& p0) {
+  validateDriftTwoInputWeights(w);
+  requireDuration(T, "duration");
+  if (steps < 1) throw InvalidInput("steps must be >= 1, got " + std::to_string(steps));
+  if (!p0.allFinite()) throw InvalidInput("initial costate p0 must be finite");
+}
+
 DriftTwoInputTrajectory integrateDriftTwoInputExtremal(const Matrix3& g0, const Vector3& p0,
                                                        double T, int steps,
                                                        const DriftTwoInputWeights& w,
                                                        const DriftTwoInputIntegration& opts) {
-  validateDriftTwoInputWeights(w);
-  if (!std::isfinite(T) || T <= 0.0) {
-    throw InvalidInput("duration T must be finite and > 0, got " + std::to_string(T));
-  }
-  if (steps < 1) throw InvalidInput("steps must be >= 1, got " + std::to_string(steps));
+  validateDriftTwoInputExtremalInputs(w, T, steps, p0);
   if (opts.substeps < 1) {
     throw InvalidInput("substeps must be >= 1, got " + std::to_string(opts.substeps));
   }
   if (opts.order != 2 && opts.order != 4) {
     throw InvalidInput("order must be 2 or 4, got " + std::to_string(opts.order));
   }
-  if (!p0.allFinite()) throw InvalidInput("initial costate p0 must be finite");
 
   DriftTwoInputTrajectory out;
   out.t.reserve(steps + 1);

@@ -94,7 +94,9 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"solver\": " << jsonString(r.solver) << ",\n"
       << "  \"scheme\": " << jsonString(schemeName(planScheme(problem, r))) << ",\n"
       << "  \"steps\": " << planSteps(problem, r) << ",\n"
-      << "  \"duration\": " << jsonNumber(problem.duration) << ",\n"
+      << "  \"duration\": " << jsonNumber(r.duration > 0 ? r.duration : problem.duration) << ",\n"
+      << "  \"objective\": " << jsonString(objectiveName(problem.objective)) << ",\n"
+      << "  \"minimum_duration\": " << jsonNumber(r.minimum_duration) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"
@@ -144,8 +146,12 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   text += line("converged", r.converged() ? "yes" : "NO (" + terminationName(r.termination) + ")");
   text += line("message", r.message);
   text += line("solver / scheme", r.solver + " / " + schemeName(planScheme(problem, r)));
-  text += line("steps N, duration T", std::to_string(N) + ", " + general(problem.duration, 6) +
-                                          " s (h = " + general(problem.duration / N, 6) + " s)");
+  const double T = r.duration > 0 ? r.duration : problem.duration;
+  text += line("steps N, duration T",
+               std::to_string(N) + ", " + general(T, 6) + " s (h = " + general(T / N, 6) + " s)");
+  if (problem.objective == Objective::MinimumTime) {
+    text += line("minimum duration T*", general(r.minimum_duration, 8) + " s");
+  }
   text += line("iterations", std::to_string(r.iterations));
   text += line("cost sum 1/2|tau_k|^2", general(r.cost, 12) + " N^2 m^2");
   text += line("effort h*cost", general(r.effort, 12) + " N^2 m^2 s");

@@ -87,10 +87,18 @@ class SceneParser {
     const bool rigid = scene.system == SystemKind::RigidBody;
     // `effects` is optional: a scene without the key simulates none, like `effects: []`.
     if (rigid) {
+      // With objective minimum_time the duration is optional (an upper bound and first guess).
+      if (root["objective"]) {
+        scene.problem.objective = named(root["objective"], "objective", kObjectiveNames);
+      }
+      const bool timed = scene.problem.objective == Objective::MinimumTime;
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
-                 "allow_nonphysical_inertia", "direction", "extra_revolutions", "constraints"},
-                {"inertia", "duration", "steps", "initial", "final"});
+                 "allow_nonphysical_inertia", "direction", "extra_revolutions", "constraints",
+                 "objective", "time_margin"},
+                timed
+                    ? std::vector<std::string>{"inertia", "steps", "initial", "final"}
+                    : std::vector<std::string>{"inertia", "duration", "steps", "initial", "final"});
     } else {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
@@ -100,7 +108,10 @@ class SceneParser {
 
     PlanningProblem& p = scene.problem;
     if (root["inertia"]) p.inertia = inertia(root["inertia"], "inertia");
-    p.duration = number(root["duration"], "duration");
+    p.duration = root["duration"] || p.objective != Objective::MinimumTime
+                     ? number(root["duration"], "duration")
+                     : 0.0;  // minimum_time without a duration: no upper bound given
+    if (root["time_margin"]) p.time_margin = number(root["time_margin"], "time_margin");
     p.steps = integer(root["steps"], "steps");
     readState(root["initial"], "initial", rigid, &p.initial_attitude, &p.initial_velocity);
     readState(root["final"], "final", rigid, &p.final_attitude, &p.final_velocity);
@@ -549,7 +560,13 @@ std::string formatScene(const Scene& scene) {
   out << "inertia: [" << vec(p.inertia.row(0).transpose()) << ", "
       << vec(p.inertia.row(1).transpose()) << ", " << vec(p.inertia.row(2).transpose()) << "]\n";
   if (scene.allow_nonphysical_inertia) out << "allow_nonphysical_inertia: true\n";
-  out << "duration: " << exactNumber(p.duration) << "\n";
+  if (p.objective != Objective::MinimumTime || p.duration != 0.0) {
+    out << "duration: " << exactNumber(p.duration) << "\n";
+  }
+  if (p.objective != Objective::MinimumEffort) {
+    out << "objective: " << objectiveName(p.objective) << "\n";
+  }
+  if (p.time_margin != 0.0) out << "time_margin: " << exactNumber(p.time_margin) << "\n";
   out << "steps: " << p.steps << "\n";
   out << "scheme: " << schemeName(p.scheme) << "\n";
   if (p.direction != RotationDirection::Shortest) {

@@ -26,6 +26,7 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   }
   result->dynamics_residual = report.max_step_residual;
   const int N = problem.steps;
+  result->duration = problem.duration;
   result->cost = scheme.cost(torque);
   result->effort = scheme.timeStep() * result->cost;
   result->terminal_attitude_error =

@@ -87,7 +87,18 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("inertia: condition number " + exactNumber(moments(2) / moments(0)) +
                        " of " + str(p.inertia) + " > 1e12");
   }
-  requireDuration(p.duration, "duration");
+  // minimum_time: the duration is optional (0 = not given; else an upper bound and first guess).
+  if (p.objective != Objective::MinimumTime || p.duration != 0.0) {
+    requireDuration(p.duration, "duration");
+  }
+  if (p.objective == Objective::MinimumEffort && p.time_margin != 0.0) {
+    throw InvalidInput("time_margin: only with objective minimum_time, got " +
+                       exactNumber(p.time_margin));
+  }
+  if (!std::isfinite(p.time_margin) || p.time_margin < 0.0) {
+    throw InvalidInput("time_margin: must be a finite number >= 0, got " +
+                       exactNumber(p.time_margin));
+  }
   // With an accuracy target the planner chooses N: `steps` is not used.
   if (!p.accuracy.active() && p.steps < kMinSteps) {
     throw InvalidInput("steps: must be >= " + std::to_string(kMinSteps) + ", got " +

@@ -189,6 +189,8 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     srv.request.scheme = schemeName(problem.scheme);
     srv.request.direction = directionName(problem.direction);
     srv.request.extra_revolutions = problem.extra_revolutions;
+    srv.request.objective = objectiveName(problem.objective);
+    srv.request.time_margin = problem.time_margin;
     for (const EffectSpec& e : effects) {
       // Noise is random: the replay adds it, the plan cannot know it.
       if (!std::holds_alternative<TorqueNoiseSpec>(e))

@@ -42,6 +42,12 @@ const char* const kUsage =
     "  --target-cost-error E     instead of --steps: choose N so that |h cost - continuous cost|\n"
     "                            <= E [N^2 m^2 s] (Richardson estimate; rigid_body)\n"
     "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check (rigid_body)\n"
+    "  --objective minimum_effort|minimum_time\n"
+    "                            minimum_time: the least duration T* under the torque bounds\n"
+    "                            and constraints in force (rigid_body; the scene's duration\n"
+    "                            becomes an upper bound and first guess)\n"
+    "  --time-margin M           with minimum_time: plan the minimum-effort maneuver at\n"
+    "                            (1 + M) T* instead of the bang-bang one at T* (M >= 0)\n"
     "  --tolerance TOL           rigid_body: optimality tolerance (default 1e-10);\n"
     "                            drift_two_input: terminal attitude error [rad] (default 1e-11)\n"
     "  --max-iterations K        iteration limit (nlopt: function evaluations; default 200)\n"
@@ -128,6 +134,8 @@ struct Arguments {
   double time_budget = 0.0;
   std::string target_flag;     ///< "--target-miss" / "--target-cost-error", "" if absent
   double target_value = 0.0;   ///< its value (> 0)
+  std::string objective;       ///< "" : the scene's
+  double time_margin = -1.0;   ///< < 0: the scene's
   std::string direction;       ///< "" : the scene's
   int extra_revolutions = -1;  ///< < 0: the scene's
   std::string csv;
@@ -199,6 +207,15 @@ Arguments parseArguments(int argc, char** argv) {
       const std::string text = next();
       a.target_value = parseDouble(arg, text);
       if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
+    } else if (arg == "--objective") {
+      a.objective = next();
+      checkFlagValue([&] { ap::parseObjective(a.objective, arg); });
+    } else if (arg == "--time-margin") {
+      value_text = next();
+      a.time_margin = parseDouble(arg, value_text);
+      if (!(a.time_margin >= 0.0) || !std::isfinite(a.time_margin)) {
+        throw InvalidFlagValue{"--time-margin: must be a finite number >= 0, got " + value_text};
+      }
     } else if (arg == "--direction") {
       a.direction = next();
       checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
@@ -300,6 +317,10 @@ int main(int argc, char** argv) {
                                      : ap::AccuracyMeasure::CostError;
       problem.accuracy.value = args.target_value;
     }
+    if (!args.objective.empty()) {
+      problem.objective = ap::parseObjective(args.objective, "--objective");
+    }
+    if (args.time_margin >= 0.0) problem.time_margin = args.time_margin;
     if (!args.direction.empty())
       problem.direction = ap::parseDirection(args.direction, "--direction");
     if (args.extra_revolutions >= 0) problem.extra_revolutions = args.extra_revolutions;

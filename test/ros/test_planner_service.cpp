@@ -397,6 +397,35 @@ TEST_F(PlannerService, BadConstraintValuesAreNamedAndTheNodeKeepsServing) {
   EXPECT_GE(ros_testing::constrainedRequestSlacks(good.maneuver).cone, -1e-9);
 }
 
+TEST_F(PlannerService, MinimumTimeReturnsTStarAndTheMarginPlan) {
+  // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m: T* = 2√10 s (eigenaxis bang–bang). No
+  // duration given; the plan at 1.1 T*. Then a minimum-time request without a bound is named.
+  PlanAttitudeManeuver::Request req = seed(32);
+  req.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
+  req.allow_nonphysical_inertia = false;
+  req.duration = 0.0;
+  req.scheme = "second_order";
+  req.objective = "minimum_time";
+  req.time_margin = 0.1;
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = 1.0;
+  req.constraints.push_back(norm);
+  req.final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), 1.0));
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_NEAR(res.minimum_duration, 2 * std::sqrt(10.0), 2e-3 * res.minimum_duration);
+  EXPECT_NEAR(res.duration, 1.1 * res.minimum_duration, 1e-9 * res.duration);
+  EXPECT_LE(res.max_constraint_violation, 1e-9);
+  req.constraints.clear();
+  const PlanAttitudeManeuver::Response bad = call(req);
+  EXPECT_FALSE(bad.success);
+  EXPECT_EQ(bad.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(bad.message.find("objective: 'minimum_time' needs a torque bound"), std::string::npos)
+      << bad.message;
+  EXPECT_TRUE(call(seed(16)).success);
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_planner_service");

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -146,6 +147,27 @@ TEST_F(CliTest, SecondOrderPlanReportsEffortAndReplaysThroughSimulateTorques) {
   const ToolRun wrong = run("simulate_torques", kScenes + "slew_up.yaml " + csv);
   EXPECT_NE(wrong.status, 0) << wrong.output;
   EXPECT_CONTAINS(wrong.output, "tau_0 and tau_N must be zero with scheme paper");
+}
+
+// --objective minimum_time on the closed-form scene: T* in the summary, the plan at (1 + M) T*
+// with --time-margin M; a minimum-time request without any torque bound is refused by name.
+TEST_F(CliTest, MinimumTimeReportsTStarAndHonoursTheMargin) {
+  const std::string json = dir_ + "/min.json";
+  const ToolRun r =
+      run("plan_maneuver",
+          kScenes + "min_time_sphere.yaml --steps 32 --time-margin " + "0.25 --summary " + json);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"objective\": \"minimum_time\"");
+  const double t_star = std::stod(summary.substr(summary.find("\"minimum_duration\": ") + 20));
+  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  EXPECT_NEAR(t_star, 2 * std::sqrt(10.0), 2e-3 * t_star);  // closed form, N = 32
+  EXPECT_NEAR(duration, 1.25 * t_star, 1e-9 * duration);
+  EXPECT_CONTAINS(r.output, "minimum duration T*");
+  const ToolRun unbounded =
+      run("plan_maneuver", kScenes + "rest_to_rest.yaml --objective minimum_time");
+  EXPECT_EQ(unbounded.status, 1) << unbounded.output;
+  EXPECT_CONTAINS(unbounded.output, "objective: 'minimum_time' needs a torque bound");
 }
 
 TEST_F(CliTest, ExitStatusAgreesWithConvergedForEverySolver) {

@@ -26,6 +26,11 @@ struct DriftTwoInputWeights {
 
 /// Throws InvalidInput unless c1, c2 are finite and > 0.
 void validateDriftTwoInputWeights(const DriftTwoInputWeights& w);
+/// The inputs every extremal integration and sampling shares: weights, duration T (the shared
+/// duration rule, input_rules.hpp), output steps ≥ 1 and a finite costate p0; InvalidInput names
+/// the one that is bad.
+void validateDriftTwoInputExtremalInputs(const DriftTwoInputWeights& w, double T, int steps,
+                                         const Vector3& p0);
 
 namespace drift_two_input {
 

@@ -66,6 +66,27 @@ inline SolverKind parseSolver(const std::string& text, const std::string& field)
   return parseIn(kSolverNames, text, field);
 }
 
+/// What the plan minimizes (scene key `objective`, --objective, request field `objective`).
+enum class Objective {
+  MinimumEffort,  ///< ½∫|τ|²dt at the given duration (the seed's problem; default)
+  MinimumTime,    ///< the duration T*, under the torque bounds and constraints in force
+};
+
+inline constexpr NamedValue<Objective> kObjectiveNames[] = {
+    {Objective::MinimumEffort, "minimum_effort"},
+    {Objective::MinimumTime, "minimum_time"},
+};
+
+/// "minimum_effort" or "minimum_time".
+inline std::string objectiveName(Objective objective) {
+  return nameIn(kObjectiveNames, objective);
+}
+/// The objective named `text`; throws InvalidInput naming `field`, the value and the accepted
+/// names.
+inline Objective parseObjective(const std::string& text, const std::string& field) {
+  return parseIn(kObjectiveNames, text, field);
+}
+
 /// The scheme value that lets the planner choose the scheme (with an accuracy target only).
 inline constexpr const char* kAutoSchemeName = "auto";
 
@@ -108,6 +129,12 @@ struct PlanningProblem {
   /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
   /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
   AccuracyTarget accuracy;
+  /// Minimum effort at `duration` (default), or minimum time (minimum_time.hpp): then `duration`
+  /// is an upper bound and the first guess (≤ 0: none), and a torque bound must be in force.
+  Objective objective = Objective::MinimumEffort;
+  /// With minimum_time: plan the minimum-effort maneuver at (1 + time_margin) T* instead of the
+  /// bang–bang one at T*; ≥ 0.
+  double time_margin = 0.0;
 };
 
 /// Progress of one iteration, for feedback (action) and logging.

@@ -44,7 +44,10 @@ struct PlanResult {
   std::vector<LevelSummary> levels;
   std::string solver;  ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;  ///< R_k, Ω_k, τ_k, k = 0..N
+  Maneuver maneuver;      ///< R_k, Ω_k, τ_k, k = 0..N
+  double duration = 0.0;  ///< T [s] of the returned plan (minimum_time: chosen by the planner)
+  /// T* [s]: the least duration found feasible (objective minimum_time; else 0).
+  double minimum_duration = 0.0;
   /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
   /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½).
   double cost = 0.0;

@@ -136,6 +136,8 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   if (!req.scheme.empty()) applySchemeName(req.scheme, "scheme", &p);
   if (!req.direction.empty()) p.direction = parseDirection(req.direction, "direction");
   p.extra_revolutions = req.extra_revolutions;  // < 0 refused by validateProblem
+  if (!req.objective.empty()) p.objective = parseObjective(req.objective, "objective");
+  p.time_margin = req.time_margin;  // rules in validateProblem
   options->solver = req.solver.empty() ? defaults.solver : parseSolver(req.solver, "solver");
   if (!std::isfinite(req.tolerance) || req.tolerance < 0.0) {
     throw InvalidInput("tolerance: must be a finite number >= 0 (0 = default), got " +

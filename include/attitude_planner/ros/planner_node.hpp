@@ -169,6 +169,8 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->predicted_error = r.accuracy.predicted_error;
   res->cost = r.cost;
   res->effort = r.effort;
+  res->duration = r.duration;
+  res->minimum_duration = r.minimum_duration;
   res->iterations = r.iterations;
   res->max_residual = r.max_residual;
   res->terminal_attitude_error = r.terminal_attitude_error;

@@ -1,0 +1,153 @@
+// Minimum-time slews (objective minimum_time, minimum_time.hpp): the closed form of a spherical
+// body under a torque-norm bound (the eigenaxis bang–bang, T* = 2√(θJ/t)), its convergence in N,
+// the bang–bang structure, the time margin, monotonicity in the bounds, and named errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "scene_errors.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+constexpr double kMoment = 10.0, kAngle = 1.0, kNormBound = 1.0;
+
+/// A sphere J = jI turned by θ about `axis`, rest to rest, |τ|₂ ≤ t: the time-optimal maneuver
+/// is the eigenaxis bang–bang (the problem is symmetric about every axis), T* = 2√(θ j / t).
+ap::PlanningProblem sphere(int steps, const ap::Vector3& axis = ap::Vector3::UnitX(),
+                           double bound = kNormBound) {
+  ap::PlanningProblem p;
+  p.inertia = kMoment * ap::Matrix3::Identity();
+  p.steps = steps;
+  p.duration = 0.0;  // not given: the search starts from the eigenaxis guess
+  p.final_attitude = ap::so3::fromAxisAngle(axis.normalized(), kAngle);
+  p.scheme = ap::SchemeKind::SecondOrder;
+  p.objective = ap::Objective::MinimumTime;
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(bound)};
+  return p;
+}
+
+double closedForm(double bound = kNormBound) {
+  return 2.0 * std::sqrt(kAngle * kMoment / bound);
+}
+
+}  // namespace
+
+TEST(MinimumTime, SphereUnderANormBoundConvergesToTheClosedForm) {
+  double previous = 0.0;
+  for (int N : {32, 64, 128}) {
+    const ap::PlanResult r = ap::planManeuver(sphere(N, ap::Vector3(1, 2, -1)));
+    ASSERT_TRUE(r.converged()) << r.message;
+    const double error = std::abs(r.minimum_duration - closedForm());
+    std::printf("N = %d: T* = %.8f s (closed form %.8f), %.3f s\n", N, r.minimum_duration,
+                closedForm(), r.solve_time_s);
+    EXPECT_LE(error, 5e-4 * closedForm()) << "N = " << N;
+    if (previous > 0) {
+      EXPECT_LT(error, 0.5 * previous) << "N = " << N;  // measured: order 2
+    }
+    previous = error;
+    EXPECT_NEAR(r.duration, r.minimum_duration, 1e-12 * r.duration);
+    EXPECT_LE(r.max_constraint_violation, 1e-9);
+  }
+}
+
+TEST(MinimumTime, PlanAtTStarIsBangBang) {
+  const ap::PlanResult r = ap::planManeuver(sphere(64));
+  ASSERT_TRUE(r.converged()) << r.message;
+  // At every node but those next to the switch (t = T/2) |τ| is at its bound.
+  int at_bound = 0;
+  for (const ap::Vector3& t : r.maneuver.torque) at_bound += t.norm() >= kNormBound * (1 - 1e-3);
+  EXPECT_GE(at_bound, static_cast<int>(r.maneuver.torque.size()) - 4) << at_bound;
+  // ...and about the eigenaxis: accelerating in the first half, braking in the second.
+  EXPECT_GT(r.maneuver.torque[5].x(), 0.99 * kNormBound);
+  EXPECT_LT(r.maneuver.torque[59].x(), -0.99 * kNormBound);
+}
+
+TEST(MinimumTime, MarginGivesAFeasibleCheaperPlan) {
+  ap::PlanningProblem p = sphere(64);
+  const ap::PlanResult tight = ap::planManeuver(p);
+  p.time_margin = 0.2;
+  const ap::PlanResult relaxed = ap::planManeuver(p);
+  ASSERT_TRUE(tight.converged() && relaxed.converged()) << relaxed.message;
+  EXPECT_NEAR(relaxed.minimum_duration, tight.minimum_duration, 1e-4 * tight.minimum_duration);
+  EXPECT_NEAR(relaxed.duration, 1.2 * relaxed.minimum_duration, 1e-12 * relaxed.duration);
+  EXPECT_NEAR(relaxed.maneuver.time.back(), relaxed.duration, 1e-9 * relaxed.duration);
+  EXPECT_LE(relaxed.max_constraint_violation, 1e-9);
+  EXPECT_LT(relaxed.effort, tight.effort);
+}
+
+TEST(MinimumTime, TStarFallsWithAStrongerBoundAndRisesWithARateLimit) {
+  const ap::PlanResult base = ap::planManeuver(sphere(64));
+  const ap::PlanResult stronger = ap::planManeuver(sphere(64, ap::Vector3::UnitX(), 2.0));
+  ASSERT_TRUE(base.converged() && stronger.converged());
+  EXPECT_LT(stronger.minimum_duration, base.minimum_duration);
+  EXPECT_NEAR(stronger.minimum_duration, closedForm(2.0), 5e-4 * closedForm(2.0));
+  // The bang–bang peaks at Ω = √(θ t / J) = 0.316 rad/s mid-way: a limit below it costs time.
+  ap::PlanningProblem limited = sphere(64);
+  limited.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.25));
+  const ap::PlanResult slower = ap::planManeuver(limited);
+  ASSERT_TRUE(slower.converged()) << slower.message;
+  EXPECT_GT(slower.minimum_duration, base.minimum_duration * 1.01);
+  EXPECT_LE(slower.max_constraint_violation, 1e-9);
+}
+
+TEST(MinimumTime, RequestsWithoutABoundOrWithABadMarginAreNamed) {
+  ap::PlanningProblem p = sphere(32);
+  p.constraints.clear();
+  try {
+    ap::planManeuver(p);
+    ADD_FAILURE() << "no error";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("objective: 'minimum_time' needs a torque bound"),
+              std::string::npos)
+        << e.what();
+  }
+  p = sphere(32);
+  p.time_margin = -0.5;
+  EXPECT_THROW(ap::planManeuver(p), ap::InvalidInput);
+  p = sphere(32);
+  p.objective = ap::Objective::MinimumEffort;
+  p.duration = 5.0;
+  p.time_margin = 0.1;
+  try {
+    ap::planManeuver(p);
+    ADD_FAILURE() << "no error";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("time_margin: only with objective minimum_time"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(MinimumTime, SceneKeysParseAndRoundTrip) {
+  const std::string text = R"(inertia: [10, 10, 10]
+steps: 32
+objective: minimum_time
+time_margin: 0.1
+initial: {attitude: {axis: [1, 0, 0], angle: 0.0}, angular_velocity: [0, 0, 0]}
+final: {attitude: {axis: [1, 0, 0], angle: 1.0}, angular_velocity: [0, 0, 0]}
+constraints: [{max_torque_norm: 1.0}]
+)";
+  const ap::Scene scene = ap::parseScene(text, "inline");
+  EXPECT_EQ(scene.problem.objective, ap::Objective::MinimumTime);
+  EXPECT_EQ(scene.problem.time_margin, 0.1);
+  EXPECT_EQ(scene.problem.duration, 0.0);  // optional with minimum_time
+  const ap::Scene again = ap::parseScene(ap::formatScene(scene), "formatted");
+  EXPECT_EQ(again.problem.objective, ap::Objective::MinimumTime);
+  EXPECT_EQ(again.problem.time_margin, 0.1);
+  // Without minimum_time the duration is required; a bad objective is named.
+  EXPECT_NE(attitude_planner_test::sceneErrorOf(
+                "inertia: [1, 1, 1]\nsteps: 8\ninitial: {attitude: {axis: [1, 0, 0], angle: 0}}\n"
+                "final: {attitude: {axis: [1, 0, 0], angle: 1}}\n")
+                .find("duration"),
+            std::string::npos);
+  EXPECT_NE(
+      attitude_planner_test::sceneErrorOf("inertia: [1, 1, 1]\nsteps: 8\nobjective: fastest\n"
+                                          "initial: {attitude: {axis: [1, 0, 0], angle: 0}}\n"
+                                          "final: {attitude: {axis: [1, 0, 0], angle: 1}}\n")
+          .find("objective: unknown value 'fastest' (expected minimum_effort or minimum_time)"),
+      std::string::npos);
+}

@@ -4,6 +4,7 @@
 // this with the request table written by test_ros_conversions and the last fuzz summary.
 //
 //   robustness_report [--all] [--case NAME]... [--hostile DIR] [--requests FILE] [--fuzz FILE]
+//                     [--random FILE] (the randomized suite's section, benchmark_solvers)
 //                     [--notes FILE] [--out FILE]
 #include <sys/utsname.h>
 
@@ -127,7 +128,7 @@ void writeCase(std::ostream& out, const rb::HardCase& c, const rb::CaseOutcome& 
 int main(int argc, char** argv) {
   bool all = false;
   std::vector<std::string> only;
-  std::string hostile, requests, fuzz, notes, out_path;
+  std::string hostile, requests, fuzz, random_suite, notes, out_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto next = [&]() -> std::string {
@@ -147,13 +148,15 @@ int main(int argc, char** argv) {
       requests = next();
     } else if (a == "--fuzz") {
       fuzz = next();
+    } else if (a == "--random") {
+      random_suite = next();
     } else if (a == "--notes") {
       notes = next();
     } else if (a == "--out") {
       out_path = next();
     } else {
       std::cerr << "usage: robustness_report [--all] [--case NAME]... [--hostile DIR] "
-                   "[--requests FILE] [--fuzz FILE] [--notes FILE] [--out FILE]\n";
+                   "[--requests FILE] [--fuzz FILE] [--random FILE] [--notes FILE] [--out FILE]\n";
       return 2;
     }
   }
@@ -251,6 +254,7 @@ int main(int argc, char** argv) {
         << readFile(requests) << "\n";
   }
   if (!fuzz.empty()) out << readFile(fuzz) << "\n";
+  if (!random_suite.empty()) out << readFile(random_suite) << "\n";
   if (!notes.empty()) out << readFile(notes) << "\n";
 
   if (out_path.empty()) {

@@ -70,6 +70,16 @@ Vector3 DiscreteScheme::velocity(const Matrix3& F) const {
   return J_inverse_ * momentum<double>(F);
 }
 
+Vector3 DiscreteScheme::velocityOfStep(const Vector3& omega) const {
+  if (kind_ == SchemeKind::Paper) return omega / h_;
+  return J_inverse_ * momentumOfStep(omega);
+}
+
+Vector3 DiscreteScheme::momentumOfVelocity(const Vector3& omega) const {
+  if (kind_ == SchemeKind::Paper) return momentumOfStep(h_ * omega);
+  return J_ * omega;
+}
+
 Matrix3 DiscreteScheme::stepFromVelocity(const Vector3& omega) const {
   if (kind_ == SchemeKind::Paper) {
     if (h_ * omega.norm() >= M_PI) {

@@ -104,6 +104,8 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"terminal_velocity_error\": " << jsonNumber(r.terminal_velocity_error) << ",\n"
       << "  \"max_residual\": " << jsonNumber(r.max_residual) << ",\n"
       << "  \"dynamics_residual\": " << jsonNumber(r.dynamics_residual) << ",\n"
+      << "  \"step_residual\": " << jsonNumber(r.step_residual) << ",\n"
+      << "  \"replay_miss\": " << jsonNumber(r.replay_miss) << ",\n"
       << "  \"solve_time_s\": " << jsonNumber(r.solve_time_s) << ",\n"
       << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
       << "  \"effects\": [";
@@ -159,6 +161,8 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   text += line("terminal velocity error", general(r.terminal_velocity_error, 3) + " rad/s");
   text += line("max residual", general(r.max_residual, 3));
   text += line("dynamics residual", general(r.dynamics_residual, 3) + " N m s");
+  text += line("step residual", general(r.step_residual, 3) + " (relative)");
+  text += line("replay miss", general(r.replay_miss, 3) + " rad (open-loop replay, sensitivity)");
   std::ostringstream time;
   time << std::fixed << std::setprecision(3) << r.solve_time_s << " s";
   text += line("solve time", time.str());

@@ -172,6 +172,8 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
     if (node_slack <= kActiveConstraintTolerance * scale) ++out.active;
     out.max_node_bound_violation = std::max(out.max_node_bound_violation, -node_slack);
     out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
+    // The solver's verdict (planInconsistency) is on the bound it was asked to meet.
+    out.max_relative_violation = std::max(out.max_relative_violation, -node_slack / scale);
     if (-slack > out.max_violation) {
       out.max_violation = -slack;
       std::ostringstream w;

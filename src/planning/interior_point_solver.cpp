@@ -80,7 +80,7 @@ constexpr double kMaxShiftFloor = 1e-2;
 /// Largest violation at which the penalty is raised before a request is called infeasible.
 constexpr double kPenaltyRaiseViolation = 1e-3;
 /// Elastic violation (constraint units: relative torque/rate, cosine) that counts as infeasible.
-constexpr double kFeasibilityTolerance = 1e-8;
+constexpr double kFeasibilityTolerance = kNodeConstraintTolerance;
 
 enum class Family { TorqueUpper, TorqueLower, TorqueNorm, AngularRate, KeepOut, KeepIn };
 
@@ -772,16 +772,15 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   result.iterations = iteration;
   result.newton_decrement = relative_decrement;
   if (final_steps) *final_steps = np.current();
+  const Maneuver planned = np.maneuver(np.current());
   try {
-    evaluatePlan(problem, np.torques(np.current()), &result);
+    evaluatePlan(problem, planned.torque, &result, &planned);
   } catch (const StepTooLarge& e) {
     result.message = std::string("replay of the planned torques failed: ") + e.what();
     result.termination = Termination::StepTooLarge;
     return result;
   }
   const ConstraintCheck check = checkConstraints(problem, result.maneuver);
-  const double miss = std::max(result.terminal_attitude_error, result.terminal_velocity_error);
-  const double allowed_miss = 1e-9 * std::max(1.0, N * 1e-4);
   std::ostringstream msg;
   if (ending == Termination::Infeasible) {
     msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
@@ -789,11 +788,12 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
         << ")";
   } else {
-    if (ending == Termination::Converged && !(miss <= allowed_miss)) {
-      ending = Termination::NotConverged;
-      std::ostringstream why;
-      why << "stationary point found, but replaying its torques misses the target by " << miss;
-      reason = why.str();
+    if (ending == Termination::Converged) {
+      const std::string inconsistent = planInconsistency(problem, result, true);
+      if (!inconsistent.empty()) {
+        ending = Termination::NotConverged;
+        reason = inconsistent;
+      }
     }
     msg << reason;
   }

@@ -75,7 +75,10 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   const auto feasible = [&](double T) {
     effort.duration = T;
     SolverOptions o = remaining();
-    if (best.converged()) o.warm_start = &best.maneuver;
+    if (best.converged()) {
+      o.warm_start = &best.maneuver;
+      o.constrained_from_warm_start = true;
+    }
     PlanResult r = planAtResolution(effort, o);
     ++solves;
     if (r.termination == Termination::TimedOut) timed_out = true;

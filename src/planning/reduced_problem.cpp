@@ -239,6 +239,34 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
   return tau;
 }
 
+Maneuver ReducedProblem::maneuver(const Steps& steps) const {
+  Maneuver m;
+  m.time_step = scheme_.timeStep();
+  m.attitude = attitudes(steps);
+  m.torque = torques(steps);
+  m.time.resize(N_ + 1);
+  m.angular_velocity.resize(N_ + 1);
+  for (int k = 0; k <= N_; ++k) m.time[k] = k * m.time_step;
+  if (scheme_.hasEndTorques()) {
+    // Node velocities J⁻¹Π_k: Π_0, Π_N are the boundary momenta (τ_0, τ_N make them so), and
+    // inside Π_k = μ_k − (h/2) a_k = ½(μ_k + F_{k−1}ᵀ μ_{k−1}) whatever the effects.
+    const Matrix3 J_inverse = scheme_.inertia().inverse();
+    m.angular_velocity[0] = J_inverse * initial_momentum_;
+    m.angular_velocity[N_] = J_inverse * final_momentum_;
+    Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
+    for (int k = 1; k < N_; ++k) {
+      const Vector3 mu = scheme_.momentumOfStep(steps[k]);
+      m.angular_velocity[k] =
+          J_inverse * (0.5 * (mu + so3::exp(steps[k - 1]).transpose() * mu_prev));
+      mu_prev = mu;
+    }
+    return m;
+  }
+  for (int k = 0; k < N_; ++k) m.angular_velocity[k] = scheme_.velocityOfStep(steps[k]);
+  m.angular_velocity[N_] = m.angular_velocity[N_ - 1];
+  return m;
+}
+
 double ReducedProblem::cost(const Steps& steps) const {
   return scheme_.cost(torques(steps));
 }

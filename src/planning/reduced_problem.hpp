@@ -82,6 +82,10 @@ class ReducedProblem {
   std::vector<Matrix3> attitudes(const Steps& steps) const;
   /// τ_k, k = 0..N (τ_0 = τ_N = 0 unless the scheme has end torques).
   std::vector<Vector3> torques(const Steps& steps) const;
+  /// The planned maneuver itself: R_k = R_0 F_0 ⋯ F_{k−1}, Ω_k the scheme's reported velocity
+  /// (paper, variational: of step k, row N repeating Ω_{N−1}; second_order: the node velocity
+  /// J⁻¹Π_k, k = 0..N), τ_k as torques(); k = 0..N on t_k = k h.
+  Maneuver maneuver(const Steps& steps) const;
   /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
   double cost(const Steps& steps) const;
 

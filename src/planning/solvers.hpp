@@ -17,15 +17,30 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
 /// met. Fills everything but solve_time_s and the constraint figures.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
+/// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
+/// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before
+/// any continuation level: the start a peer solver gets in a like-for-like comparison
+/// (benchmark_solvers --random-suite). Throws StepTooLarge like ReducedProblem.
+std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem);
+
 /// Independent cross-check: NLopt on the direct method (τ_1..τ_{N−1} as variables, equality
 /// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);
 
-/// Replays τ_1..τ_{N−1} (torque[k], k = 0..N, τ_0 = τ_N = 0) through the problem's scheme from
-/// R_0, Ω_0 and fills result->maneuver, cost, dynamics_residual and the terminal errors.
-/// Both solvers finish through here, so every reported figure is measured on the same replay.
+/// Fills result->maneuver with `planned` (the solver's own trajectory; null: the replay below),
+/// its cost and step_residual, and replays τ_1..τ_{N−1} (torque[k], k = 0..N, τ_0 = τ_N = 0)
+/// through the problem's scheme from R_0, Ω_0 for dynamics_residual, the terminal errors and
+/// replay_miss. Every solver finishes through here, so every figure is measured the same way.
 /// Throws StepTooLarge if the replay's implicit step fails.
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
-                  PlanResult* result);
+                  PlanResult* result, const Maneuver* planned = nullptr);
+
+/// The one convergence rule beside first-order optimality (which each solver tests on its own
+/// iterate): the plan satisfies the discrete equations of motion step by step
+/// (measureStepResidual within its tolerance) and, with `constraints`, its node constraints
+/// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
+/// it does. The open-loop replay (replay_miss) is not part of it.
+std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
+                              bool constraints);
 
 }  // namespace attitude_planner

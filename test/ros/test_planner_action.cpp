@@ -7,6 +7,7 @@
 #include <actionlib/client/simple_action_client.h>
 
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,10 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_EQ(result->error_code.val, PlanErrorCode::SUCCESS);
   EXPECT_EQ(result->maneuver.attitude.size(), 33u);
   EXPECT_LT(result->terminal_attitude_error, 1e-8);
+  // Issue 19: the verdict's step residual and the replay's sensitivity travel in the result.
+  EXPECT_LE(result->step_residual, 1e-8);
+  EXPECT_GE(result->replay_miss, result->terminal_attitude_error);
+  EXPECT_LT(result->replay_miss, 1e-8);
   // Feedback and result travel on different topics: allow the last feedback to land.
   waitFor([&] { return seen->last_iteration >= result->iterations; }, 5.0);
   EXPECT_GT(seen->feedbacks.load(), 0) << "no feedback received";
@@ -185,6 +190,31 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::SUCCEEDED) << client_->getResult()->message;
   EXPECT_GE(ros_testing::constrainedRequestSlacks(client_->getResult()->maneuver).cone, -1e-9);
+}
+
+TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
+  // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration: T* = 2√10 s (eigenaxis
+  // bang–bang), the plan at (1 + 0.2) T*.
+  PlanAttitudeManeuverGoal goal = seed(32);
+  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
+  goal.duration = 0.0;
+  goal.scheme = "second_order";
+  goal.objective = "minimum_time";
+  goal.time_margin = 0.2;
+  goal.final_attitude.w = std::cos(0.5);
+  goal.final_attitude.x = std::sin(0.5);
+  goal.final_attitude.y = goal.final_attitude.z = 0.0;
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = 1.0;
+  goal.constraints.push_back(norm);
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED);
+  const auto result = client_->getResult();
+  ASSERT_TRUE(result->success) << result->message;
+  EXPECT_NEAR(result->minimum_duration, 2 * std::sqrt(10.0), 2e-3 * result->minimum_duration);
+  EXPECT_NEAR(result->duration, 1.2 * result->minimum_duration, 1e-9 * result->duration);
 }
 
 int main(int argc, char** argv) {

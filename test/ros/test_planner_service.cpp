@@ -75,6 +75,23 @@ TEST_F(PlannerService, SeedSlewMeetsTheBoundaryData) {
               latency, res.solve_time, res.iterations, res.cost);
 }
 
+TEST_F(PlannerService, NanosecondHorizonIsJudgedByThePlanAndReportsItsReplayMiss) {
+  // Issue 19: T = 1e-9 s, π about x (rates ~3e9 rad/s) was refused NOT_CONVERGED for an absolute
+  // replay miss; relative thresholds judge it like the same shape at T = 12.8 s.
+  PlanAttitudeManeuver::Request req = seed(64, M_PI);
+  req.duration = 1e-9;
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::SUCCESS);
+  EXPECT_LE(res.step_residual, 1e-8);
+  EXPECT_GE(res.replay_miss, 0.0);
+  EXPECT_LE(res.replay_miss, 1e-6);  // [rad]; this motion is stable
+  req.duration = 12.8;
+  const PlanAttitudeManeuver::Response slow = call(req);
+  ASSERT_TRUE(slow.success) << slow.message;
+  EXPECT_EQ(res.iterations, slow.iterations);
+}
+
 TEST_F(PlannerService, SeedExampleAtFullResolutionForLatency) {
   const ros::WallTime start = ros::WallTime::now();
   const PlanAttitudeManeuver::Response res = call(seed(128));  // the seed example, N = 128

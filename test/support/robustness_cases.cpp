@@ -13,6 +13,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/plan_at_resolution.hpp"
 
 namespace attitude_planner {
 namespace robustness {
@@ -316,22 +317,25 @@ void intermediateAxisSpin(Recorder& r) {
       iterations.push_back(r.plan(label, p).iterations);
       continue;
     }
-    // T = 60 s: the Newton iteration converges as fast, but the replay that judges the result
-    // (forward integration of the torques from R_0, Ω_0) amplifies round-off by e^{λT} ≈ 1e15:
-    // the open-loop torques cannot be replayed to 1e-9 in double precision. The planner must
-    // say so (not converged, the miss in the message) instead of claiming success.
+    // T = 60 s: the Newton iteration converges as fast, and the plan satisfies the discrete
+    // equations step by step; only its open-loop replay (forward integration of the torques
+    // from R_0, Ω_0) amplifies round-off by e^{λT} ≈ 1e15. That is a property of the motion,
+    // reported as replay_miss, not a reason to refuse the optimum (issue 19, item 3).
     const PlanResult res = planManeuver(p);
     r.record(label, p, res);
     iterations.push_back(res.iterations);
-    r.holds(
-        "T = 60: not claimed converged; the message gives the replay miss",
-        !res.converged() && res.message.find("replaying its torques misses") != std::string::npos,
-        res.message.substr(0, 120));
+    r.holds("T = 60: converged (judged by the plan, not by its open-loop replay)", res.converged(),
+            res.message.substr(0, 160));
     r.atMost("T = 60: relative first-order residual at the end (stationary point found)",
              res.max_residual, 1e-9);
-    r.atMost("T = 60: replay miss [rad] ≤ 10·eps·e^{λT} (round-off amplification)",
-             std::max(res.terminal_attitude_error, res.terminal_velocity_error),
-             10 * 2.2e-16 * std::exp(std::sqrt(1.0 / 3.0) * 60.0));
+    r.atMost("T = 60: relative step residual of the plan", res.step_residual,
+             measureStepResidual(p, res.maneuver).tolerance);
+    r.atMost("T = 60: the plan's R_N from the target [rad]",
+             so3::angleBetween(res.maneuver.attitude[p.steps], p.final_attitude), 1e-9);
+    r.atLeast("T = 60: replay miss [rad] reported (round-off amplified by e^{λT})",
+              res.replay_miss, 1e-9);
+    r.atMost("T = 60: replay miss [rad] ≤ 10·T·eps·e^{λT} (round-off amplification)",
+             res.replay_miss, 10 * 60.0 * 2.2e-16 * std::exp(std::sqrt(1.0 / 3.0) * 60.0));
   }
   r.atMost("iterations(T = 60) − iterations(T = 10)", iterations[2] - iterations[0], 4);
   r.atMost("iterations(T = 30) − iterations(T = 10)", iterations[1] - iterations[0], 4);
@@ -586,9 +590,10 @@ const std::vector<HardCase>& hardCases() {
       {"IntermediateAxisSpin", "5. dynamics",
        "J = diag(1, 2, 3), Ω = (0, 1, 0) rad/s at both ends (intermediate axis), target 0.2 rad "
        "off the steady spin, T = 10, 30, 60 s at h = 0.1 s",
-       "T = 10, 30: converged, terminal ≤ 1e-9; T = 60: stationary point (residual ≤ 1e-9) but "
-       "the open-loop replay misses by ~eps·e^{λT} (e^{λT} ≈ 1e15), reported not converged with "
-       "the miss (a documented limit of double precision, not claimed as success); iterations at "
+       "T = 10, 30: converged, terminal ≤ 1e-9; T = 60: converged (residual ≤ 1e-9, step "
+       "residual within tolerance, plan's R_N on the target to 1e-9) while the open-loop replay "
+       "misses by ~eps·e^{λT} (e^{λT} ≈ 1e15), reported as replay_miss ≥ 1e-9 (a sensitivity "
+       "of the motion, not a failure of the plan); iterations at "
        "T = 30, 60 at most 4 more than at T = 10",
        false, intermediateAxisSpin},
       {"SlowManeuverN1e4", "5. dynamics",

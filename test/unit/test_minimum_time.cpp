@@ -50,7 +50,8 @@ TEST(MinimumTime, SphereUnderANormBoundConvergesToTheClosedForm) {
     }
     previous = error;
     EXPECT_NEAR(r.duration, r.minimum_duration, 1e-12 * r.duration);
-    EXPECT_LE(r.max_constraint_violation, 1e-9);
+    // At T* the plan sits on the bound: within the interior point's feasibility tolerance.
+    EXPECT_LE(r.max_constraint_violation, 1e-8 * kNormBound);
   }
 }
 

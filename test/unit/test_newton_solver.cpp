@@ -7,6 +7,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/random_problems.hpp"
 
 using namespace attitude_planner;
 
@@ -289,3 +290,29 @@ TEST(NewtonSolver, IterationsConvergeQuadratically) {
 // test_hard_cases): the zero maneuver (ZeroManeuverIsExactlyZero), the choice at exactly π
 // (CutLocusAboutX/CutLocusAboutDiagonal), the long way and extra revolutions
 // (BeyondPiShortWayLongWayExtraTurns) and the spinning ends (SpinningEnds).
+
+TEST(NewtonSolver, StalledFastRatesConvergeByContinuationInTheRates) {
+  // Issue 19: seed-like inertia, 4.7 rad/s at the end over 10.2 s (random suite case #22). From
+  // the Hermite guess Newton stops at the iteration limit; from rest to rest, with the boundary
+  // rates raised in stages, it converges.
+  const PlanningProblem p = robustness::randomCase(19, 22).problem;
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_NE(r.message.find("continuation in the boundary rates"), std::string::npos) << r.message;
+  EXPECT_LE(r.terminal_attitude_error, 1e-9);
+  EXPECT_LE(r.terminal_velocity_error, 1e-9);
+  EXPECT_GT(r.iterations, 200);  // the stalled direct solve's iterations are counted
+  // Cancel works inside the continuation, and progress keeps counting across its stages.
+  int last = 0;
+  bool increasing = true;
+  SolverOptions cancel;
+  cancel.on_iteration = [&](const IterationInfo& info) {
+    increasing = increasing && info.iteration > last;
+    last = info.iteration;
+    return info.iteration < 230;
+  };
+  const PlanResult c = planManeuver(p, cancel);
+  EXPECT_EQ(c.termination, Termination::Cancelled) << c.message;
+  EXPECT_TRUE(increasing);
+  EXPECT_EQ(last, 230);
+}

@@ -83,7 +83,8 @@ TEST_F(CliTest, NloptPlanWritesCsvAndSummaryAndExitsZero) {
   EXPECT_CONTAINS(summary, "\"steps\": 16");
   for (const char* key :
        {"iterations", "cost", "terminal_attitude_error", "terminal_velocity_error", "max_residual",
-        "solve_time_s", "duration", "dynamics_residual", "message"}) {
+        "solve_time_s", "duration", "dynamics_residual", "step_residual", "replay_miss",
+        "message"}) {
     EXPECT_CONTAINS(summary, std::string("\"") + key + "\": ");
   }
   const ap::Maneuver m = ap::readManeuverCsv(csv);

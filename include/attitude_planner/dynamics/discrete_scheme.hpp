@@ -110,6 +110,16 @@ class DiscreteScheme {
   /// reports J⁻¹ Π_k at the nodes instead, simulation.hpp).
   Vector3 velocity(const Matrix3& F) const;
 
+  /// velocity(exp(ω^)) from the step's rotation vector, with full relative precision for small
+  /// steps (paper ω/h, variational and second_order J⁻¹ momentumOfStep(ω); second_order reports
+  /// node velocities instead, ReducedProblem::maneuver).
+  Vector3 velocityOfStep(const Vector3& omega) const;
+
+  /// μ of the step whose reported velocity is Ω, without solving for the step: paper
+  /// exp(hΩ^) J Ω, variational J Ω (its reported velocity is J⁻¹ μ); not for second_order,
+  /// whose node velocities are J⁻¹Π_k (μ = Π_k + (h/2) a_k needs the node's torque).
+  Vector3 momentumOfVelocity(const Vector3& omega) const;
+
   /// Relative rotation of a step whose reported velocity is Ω (inverse of velocity()).
   /// Throws StepTooLarge if the implicit equation has no solution it can find.
   Matrix3 stepFromVelocity(const Vector3& omega) const;

@@ -10,7 +10,8 @@ namespace attitude_planner {
 
 /// JSON object with converged, message, solver, scheme, steps, duration [s], iterations,
 /// cost [N²·m²], terminal_attitude_error [rad], terminal_velocity_error [rad/s], max_residual,
-/// dynamics_residual [N·m·s], solve_time_s [s]; numbers with %.17g (full precision).
+/// dynamics_residual [N·m·s], step_residual (relative), replay_miss [rad], solve_time_s [s];
+/// numbers with %.17g (full precision).
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& result);
 
 /// A few aligned lines for a terminal (units included).

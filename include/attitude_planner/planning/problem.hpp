@@ -156,6 +156,10 @@ struct SolverOptions {
   std::function<bool(const IterationInfo&)> on_iteration;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
   const Maneuver* warm_start = nullptr;
+  /// With node constraints and a warm start: start the interior point from the warm start itself
+  /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
+  /// is far closer to the next one than the unconstrained optimum is).
+  bool constrained_from_warm_start = false;
 };
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, kMinSteps ≤ N ≤
@@ -180,12 +184,20 @@ void validateOptions(const SolverOptions& options);
 /// radians (cones).
 constexpr double kActiveConstraintTolerance = 1e-6;
 
+/// A plan meets its node constraints when no violation exceeds this fraction of the constraint's
+/// scale (ConstraintCheck::max_relative_violation); the interior-point solver stops on the same
+/// figure for its elastic violations.
+constexpr double kNodeConstraintTolerance = 1e-8;
+
 /// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
 /// on a maneuver's own rows, independently of any solver (constraints.cpp).
 struct ConstraintCheck {
   std::vector<std::string> names;  ///< the keys in force ("actuator_limits" first if bounded)
   double max_violation = 0.0;      ///< worst violation, each in its own unit, ≥ 0
-  int active = 0;                  ///< node constraints at their bound
+  /// Worst violation of the node bounds (cones tightened by their margin) relative to the
+  /// constraint's scale (limit, or 1 rad for cones), ≥ 0.
+  double max_relative_violation = 0.0;
+  int active = 0;     ///< node constraints at their bound
   std::string worst;  ///< the worst violated constraint, e.g. "|tau_x| <= 0.1 N m"; empty if none
   std::string worst_where;  ///< its violation and node, e.g. "by 0.02 at k = 64 (t = 6.4 s)"
   /// Worst violation of the node bounds the planner imposes (cones tightened by their margin).

@@ -44,7 +44,9 @@ struct PlanResult {
   std::vector<LevelSummary> levels;
   std::string solver;  ///< "newton" or "nlopt"
   SchemeKind scheme = SchemeKind::Paper;
-  Maneuver maneuver;      ///< R_k, Ω_k, τ_k, k = 0..N
+  /// R_k, Ω_k, τ_k, k = 0..N: the plan itself (Newton, interior point: the solver's attitudes,
+  /// their velocities and torques; NLopt: its torques replayed).
+  Maneuver maneuver;
   double duration = 0.0;  ///< T [s] of the returned plan (minimum_time: chosen by the planner)
   /// T* [s]: the least duration found feasible (objective minimum_time; else 0).
   double minimum_duration = 0.0;
@@ -60,10 +62,19 @@ struct PlanResult {
   /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the
   /// final step (the convergence test); NLopt: 0.
   double newton_decrement = 0.0;
-  double dynamics_residual = 0.0;        ///< worst implicit-step residual on replay [N·m·s]
+  double dynamics_residual = 0.0;  ///< worst implicit-step residual on replay [N·m·s]
+  /// Worst residual of the discrete equations of motion and boundary data on the returned
+  /// maneuver, step by step, relative to the problem's scales (measureStepResidual); part of
+  /// the convergence verdict.
+  double step_residual = 0.0;
   double terminal_attitude_error = 0.0;  ///< ‖log(R_N*ᵀ R_N)‖ [rad] of the replayed maneuver
-  double terminal_velocity_error =
-      0.0;  ///< |Ω_N − Ω(T)| [rad/s] of the replay (Ω_N = Ω_{N−1} for paper and variational)
+  /// |Ω_N − Ω(T)| [rad/s] of the replay (Ω_N = Ω_{N−1} for paper and variational)
+  double terminal_velocity_error = 0.0;
+  /// max(terminal_attitude_error, T·terminal_velocity_error) [rad]: how far the planned torques,
+  /// replayed open-loop from R_0, Ω_0 through the same integrator, end from the target. A
+  /// sensitivity of the maneuver (round-off grows like e^{λT} on unstable motions), reported,
+  /// never a reason to refuse an optimum.
+  double replay_miss = 0.0;
   double solve_time_s = 0.0;           ///< wall time [s]
   std::vector<IterationInfo> history;  ///< one entry per iteration
   /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the

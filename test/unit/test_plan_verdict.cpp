@@ -1,0 +1,144 @@
+// Issue 19, item 3: a plan is judged by what it is — first-order optimality and the discrete
+// equations of motion step by step, relative to the problem's own scales — and the open-loop
+// replay of its torques is a reported sensitivity (replay_miss), not a verdict.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+const Matrix3 kSeedInertia =
+    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+
+/// π about x, rest to rest, with the seed's J (the issue's T = 1e-9 s service request).
+PlanningProblem piAboutX(double T, int N) {
+  PlanningProblem p;
+  p.inertia = kSeedInertia;
+  p.allow_nonphysical_inertia = true;
+  p.duration = T;
+  p.steps = N;
+  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), M_PI);
+  return p;
+}
+
+/// A problem with spinning ends, 1.3 rad about (1, 2, 3)/√14: the shape kept while T and J scale.
+PlanningProblem spinningShape(double time_scale, double inertia_scale, SchemeKind scheme) {
+  PlanningProblem p;
+  p.inertia = inertia_scale * kSeedInertia;
+  p.allow_nonphysical_inertia = true;
+  p.scheme = scheme;
+  p.duration = 12.8 * time_scale;
+  p.steps = 128;
+  p.initial_velocity = Vector3(0.0, 0.2, 0.6) / time_scale;
+  p.final_velocity = Vector3(0.4, -0.1, 0.0) / time_scale;
+  p.final_attitude = so3::fromAxisAngle(Vector3(1, 2, 3).normalized(), 1.3);
+  return p;
+}
+
+}  // namespace
+
+TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {
+  // Rates of ~3e9 rad/s: the absolute 1e-9 replay threshold refused this optimum before.
+  const PlanningProblem p = piAboutX(1e-9, 64);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(r.step_residual, measureStepResidual(p, r.maneuver).tolerance);
+  EXPECT_LE(r.max_residual, 1e-9);
+  EXPECT_TRUE(std::isfinite(r.replay_miss));
+  // The same shape at T = 12.8 s costs (12.8/1e-9)⁴ less: τ ∝ 1/T².
+  const PlanResult slow = planManeuver(piAboutX(12.8, 64));
+  ASSERT_TRUE(slow.converged()) << slow.message;
+  EXPECT_NEAR(r.cost * std::pow(1e-9 / 12.8, 4), slow.cost, 1e-9 * slow.cost);
+  std::printf("T = 1e-9 s: %d iterations, step residual %.2e, replay miss %.2e rad\n", r.iterations,
+              r.step_residual, r.replay_miss);
+}
+
+TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    const PlanResult base = planManeuver(spinningShape(1.0, 1.0, scheme));
+    ASSERT_TRUE(base.converged()) << base.message;
+    struct Scaling {
+      double time, inertia;
+    };
+    for (const Scaling s : {Scaling{1e-6, 1.0}, Scaling{1e3, 1.0}, Scaling{1.0, 1e4},
+                            Scaling{1e-6, 1e4}, Scaling{1e3, 1e4}}) {
+      const PlanningProblem p = spinningShape(s.time, s.inertia, scheme);
+      const PlanResult r = planManeuver(p);
+      SCOPED_TRACE(schemeName(scheme) + ", T x " + std::to_string(s.time) + ", J x " +
+                   std::to_string(s.inertia));
+      EXPECT_EQ(r.termination, base.termination) << r.message;
+      EXPECT_EQ(r.iterations, base.iterations);
+      // τ ∝ J/T², so the cost ∝ J²/T⁴: equal to round-off once scaled back.
+      const double cost_scale = s.inertia * s.inertia / std::pow(s.time, 4);
+      EXPECT_NEAR(r.cost / cost_scale, base.cost, 1e-9 * base.cost);
+      // The relative figures are the same numbers, up to round-off.
+      EXPECT_NEAR(r.max_residual, base.max_residual, 1e-9);
+      EXPECT_NEAR(r.newton_decrement, base.newton_decrement, 1e-9);
+      EXPECT_NEAR(r.step_residual, base.step_residual, 1e-12);
+      EXPECT_LE(r.step_residual, measureStepResidual(p, r.maneuver).tolerance);
+      // The replay miss in radians: T·ΔΩ is scale-free too.
+      EXPECT_NEAR(r.replay_miss, base.replay_miss, 1e-9);
+    }
+  }
+}
+
+TEST(PlanVerdict, UnstableOptimumConvergesAndReportsItsReplayMiss) {
+  // Intermediate-axis spin over 60 s (J = diag(1, 2, 3), λ = 0.577 s⁻¹, e^{λT} ≈ 1e15): the
+  // optimum is a consistent plan, but its torques replayed open-loop miss by ~eps·e^{λT}.
+  PlanningProblem p;
+  p.inertia = Vector3(1, 2, 3).asDiagonal();
+  p.duration = 60.0;
+  p.steps = 600;
+  p.initial_velocity = Vector3(0, 1, 0);
+  p.final_velocity = Vector3(0, 1, 0);
+  p.final_attitude = so3::exp(Vector3(0, 60.0, 0)) * so3::exp(Vector3(0.2, 0, 0));
+  const PlanResult r = planManeuver(p);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  EXPECT_LE(r.max_residual, 1e-9);
+  EXPECT_LE(r.step_residual, measureStepResidual(p, r.maneuver).tolerance);
+  // The returned plan itself ends on the target; the replay does not.
+  EXPECT_LE(so3::angleBetween(r.maneuver.attitude[p.steps], p.final_attitude), 1e-9);
+  EXPECT_GT(r.replay_miss, 1e-6);
+  EXPECT_DOUBLE_EQ(r.replay_miss,
+                   std::max(r.terminal_attitude_error, p.duration * r.terminal_velocity_error));
+  std::printf("intermediate-axis spin, T = 60 s: replay miss %.2e rad, step residual %.2e\n",
+              r.replay_miss, r.step_residual);
+}
+
+TEST(PlanVerdict, StepResidualDetectsAnInconsistentPlan) {
+  // The check can fail: a converged plan with one torque (1e-3 of the largest), one velocity
+  // (1e-4 rad/s) or the end attitude (1e-6 rad) disturbed no longer satisfies the equations.
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    const PlanningProblem p = spinningShape(1.0, 1.0, scheme);
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    const StepResidual clean = measureStepResidual(p, r.maneuver);
+    EXPECT_LE(clean.relative, clean.tolerance);
+    double max_torque = 0.0;
+    for (const Vector3& t : r.maneuver.torque) max_torque = std::max(max_torque, t.norm());
+    Maneuver torque = r.maneuver;
+    torque.torque[40].x() += 1e-3 * max_torque;
+    EXPECT_GT(measureStepResidual(p, torque).relative, 100 * clean.tolerance);
+    Maneuver velocity = r.maneuver;
+    velocity.angular_velocity[70].y() += 1e-4;  // rad/s, rates ~0.6 rad/s
+    EXPECT_GT(measureStepResidual(p, velocity).relative, 100 * clean.tolerance);
+    Maneuver end = r.maneuver;
+    end.attitude[p.steps] = end.attitude[p.steps] * so3::exp(Vector3(1e-6, 0, 0));
+    EXPECT_GT(measureStepResidual(p, end).relative, 100 * clean.tolerance);
+  }
+}
+
+TEST(PlanVerdict, ZeroManeuverHasZeroResidual) {
+  PlanningProblem p = piAboutX(12.8, 32);
+  p.final_attitude = Matrix3::Identity();
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.step_residual, 0.0);
+  EXPECT_EQ(r.replay_miss, 0.0);
+}

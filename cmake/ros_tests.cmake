@@ -24,6 +24,13 @@ add_rostest(test/ros/tracker_scene_second_order.test DEPENDENCIES test_tracker_s
 list(APPEND AP_EXPECTED_TESTS test_tracker_scene tracker_scene_in_process
      tracker_scene_second_order)
 
+# The tracker drawing a scene's pointing constraints (and planning it with them via the service).
+add_rostest_gtest(test_tracker_constraints test/ros/tracker_constraints.test
+                  test/ros/test_tracker_constraints.cpp)
+target_link_libraries(test_tracker_constraints ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_constraints attitude_planner_node attitude_tracker_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_constraints)
+
 # Seed 001's drift + two-input system: the second service, and the tracker replaying a drift
 # scene planned through it.
 foreach(name planner_drift_service tracker_drift_scene)

@@ -9,14 +9,17 @@
 //   auglag        NLopt AUGLAG_EQ with an LD_LBFGS subsolver on the same direct method
 //   ipopt         IPOPT on a simultaneous transcription (quaternions q_1..q_N, Ω_1..Ω_{N−2},
 //                 τ_1..τ_{N−1}; kinematics, dynamics and terminal constraints), exact sparse
-//                 Jacobian and exact sparse Hessian of the Lagrangian (only if built with IPOPT)
+//                 Jacobian and exact sparse Hessian of the Lagrangian (only if built with IPOPT);
+//                 with the scene's node constraints too (per-axis torque limits as variable bounds,
+//                 max_torque_norm, max_angular_rate, keep_out, keep_in as exact constraint rows)
 //   ipopt_lbfgs   the same, with IPOPT's limited-memory (L-BFGS) Hessian instead (for comparison)
 //   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
 //                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
 //                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
 // Output: one JSON object per line on stdout.
 // --check-hessian compares IPOPT's exact Hessian (eval_h) with central differences of the
-// Lagrangian's gradient (eval_grad_f + eval_jac_gᵀλ) at a random point; exit 0 iff they agree.
+// Lagrangian's gradient (eval_grad_f + eval_jac_gᵀλ) at a random point; exit 0 iff they agree
+// (--constrained: with one constraint of every kind, so their rows and Hessian terms too).
 #include <sys/resource.h>
 
 #include <Eigen/Dense>
@@ -255,13 +258,17 @@ const char* const kUsage =
     "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
     "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
     "                         [--time-budget S] [--in-process K]\n"
+    "                         [--start geodesic|unconstrained]  the peers' start (ipopt): the\n"
+    "                         geodesic (default) or our unconstrained optimum, as ours starts a\n"
+    "                         constrained solve (computed before the peer's clock starts)\n"
     "       benchmark_solvers --quick   every solver on the seed's rest-to-rest example, N = 16\n"
     "       benchmark_solvers --random-suite COUNT [--seed S] [--out FILE.md] [--time-budget S]\n"
     "                         ours and IPOPT (exact Hessian, paper scheme, same start) on the\n"
     "                         seeded random problems of test/support/random_problems.hpp\n"
-    "       benchmark_solvers --check-hessian [--steps N]   IPOPT's exact Hessian against central\n"
-    "                         differences of its exact gradients (exit 0 iff relative error <= "
-    "1e-6;\n"
+    "       benchmark_solvers --check-hessian [--steps N] [--constrained]   IPOPT's exact Hessian\n"
+    "                         against central differences of its exact gradients, its Jacobian\n"
+    "                         against differences of its constraints (exit 0 iff relative errors\n"
+    "                         <= 1e-6; --constrained: with one node constraint of every kind;\n"
     "                         exit 3 if this build has no IPOPT)\n"
     "Prints one JSON line: solver, scheme, steps, time_s, iterations, cost, converged,\n"
     "terminal_miss, peak_rss_kb, message. Without --scene: the seed's rest-to-rest example.\n";
@@ -409,6 +416,13 @@ Eigen::Matrix4d rightProduct(const Quaternion& q) {
 /// Hessian of the Lagrangian σ f + Σ λ_i g_i (exact_hessian): per k = 1..N−2 the (q_k, Ω_k)
 /// block of the kinematics (q_k ⊗ e(hΩ_k) is bilinear in q_k and e, so no q_k q_k part) plus the
 /// Ω_k Ω_k block of the dynamics, and σ on the τ diagonal; the terminal constraint is linear.
+/// Node constraints (the problem's, as ours imposes them; rows after the equalities):
+///   per-axis limits  bounds −a ≤ τ_k ≤ a on the variables
+///   max_torque_norm  |τ_k|²/t² ≤ 1,  k = 1..N−1    (Hessian 2λ/t² on the τ_k diagonal)
+///   max_angular_rate |Ω_k|²/w² ≤ 1,  k = 1..N−2    (2λ/w² on the Ω_k diagonal; Ω_0, Ω_{N−1} data)
+///   keep_out/keep_in qᵀM q ≤ / ≥ cos a_node, k = 2..N−2 (q_1, q_{N−1} follow from the data)
+/// where sᵀR(q)b = qᵀMq for unit q, M = [[s·b, (b×s)ᵀ], [b×s, s bᵀ + b sᵀ − (s·b) I]]; its
+/// Hessian 2λM fills a q_k q_k block (added to the pattern only when a cone is present).
 class TranscriptionNlp : public Ipopt::TNLP {
  public:
   /// `start`: the steps ω_k to start from (empty: the geodesic start ReducedProblem begins on).
@@ -421,12 +435,30 @@ class TranscriptionNlp : public Ipopt::TNLP {
         start_(std::move(start)) {
     q0_ = ap::so3::quaternionCoefficients<double>(p.initial_attitude);
     qN_ = ap::so3::quaternionCoefficients<double>(p.final_attitude);
+    for (const ap::PlanningConstraint& c : p_.constraints) {
+      int first = 1, last = N_ - 1;
+      if (c.kind == ap::ConstraintKind::MaxAngularRate) last = N_ - 2;
+      if (c.isCone()) first = 2, last = N_ - 2, has_cone_ = true;
+      for (int k = first; k <= last; ++k) rows_of_constraints_.push_back({&c, k});
+    }
+  }
+  /// sᵀR(q)b = qᵀ M q for a unit quaternion q (w, x, y, z).
+  static Eigen::Matrix4d pointingForm(const ap::PlanningConstraint& c) {
+    const Vector3& s = c.world_direction;
+    const Vector3& b = c.body_axis;
+    Eigen::Matrix4d M;
+    M(0, 0) = s.dot(b);
+    M.block<3, 1>(1, 0) = b.cross(s);
+    M.block<1, 3>(0, 1) = b.cross(s).transpose();
+    M.block<3, 3>(1, 1) = s * b.transpose() + b * s.transpose() - s.dot(b) * Matrix3::Identity();
+    return M;
   }
   int Q(int k) const { return 4 * (k - 1); }                          // k = 1..N
   int W(int k) const { return 4 * N_ + 3 * (k - 1); }                 // k = 1..N−2
   int T(int k) const { return 4 * N_ + 3 * (N_ - 2) + 3 * (k - 1); }  // k = 1..N−1
   int n() const { return 4 * N_ + 3 * (N_ - 2) + 3 * (N_ - 1); }
-  int m() const { return 4 * N_ + 3 * (N_ - 1) + 3; }
+  int equalities() const { return 4 * N_ + 3 * (N_ - 1) + 3; }
+  int m() const { return equalities() + static_cast<int>(rows_of_constraints_.size()); }
   int iterations = 0;
   std::vector<Vector3> torque;
 
@@ -443,7 +475,23 @@ class TranscriptionNlp : public Ipopt::TNLP {
   bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
                        Ipopt::Number* gl, Ipopt::Number* gu) override {
     for (int i = 0; i < n; ++i) xl[i] = -1e19, xu[i] = 1e19;
+    if (p_.hasTorqueBounds()) {
+      for (int k = 1; k <= N_ - 1; ++k)
+        for (int i = 0; i < 3; ++i)
+          xl[T(k) + i] = -p_.max_torque(i), xu[T(k) + i] = p_.max_torque(i);
+    }
     for (int i = 0; i < m; ++i) gl[i] = gu[i] = 0.0;
+    for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
+      const ap::PlanningConstraint& c = *rows_of_constraints_[r].constraint;
+      const int row = equalities() + static_cast<int>(r);
+      if (!c.isCone()) {
+        gl[row] = -1e19, gu[row] = 1.0;
+      } else if (c.kind == ap::ConstraintKind::KeepOut) {
+        gl[row] = -1e19, gu[row] = std::cos(c.nodeHalfAngle());
+      } else {
+        gl[row] = std::cos(c.nodeHalfAngle()), gu[row] = 1e19;
+      }
+    }
     return true;
   }
   bool get_starting_point(Ipopt::Index, bool, Ipopt::Number* x, bool, Ipopt::Number*,
@@ -489,6 +537,18 @@ class TranscriptionNlp : public Ipopt::TNLP {
     const Quaternion conj(qN_(0), -qN_(1), -qN_(2), -qN_(3));
     Eigen::Map<Vector3>(g + 4 * N_ + 3 * (N_ - 1)) =
         ap::so3::quaternionProduct<double>(conj, qN).tail<3>();
+    for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
+      const auto& [c, k] = rows_of_constraints_[r];
+      double& value = g[equalities() + r];
+      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
+        value = Eigen::Map<const Vector3>(x + T(k)).squaredNorm() / (c->limit * c->limit);
+      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
+        value = omega(x, k).squaredNorm() / (c->limit * c->limit);
+      } else {
+        const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
+        value = q.dot(pointingForm(*c) * q);
+      }
+    }
     return true;
   }
   bool eval_jac_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Index,
@@ -543,6 +603,18 @@ class TranscriptionNlp : public Ipopt::TNLP {
     const Eigen::Matrix4d L = leftProduct(conj);
     for (int r = 1; r < 4; ++r)
       for (int c = 0; c < 4; ++c) values[z++] = L(r, c);
+    for (const auto& [c, k] : rows_of_constraints_) {
+      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
+        const Vector3 d = 2.0 / (c->limit * c->limit) * Eigen::Map<const Vector3>(x + T(k));
+        for (int i = 0; i < 3; ++i) values[z++] = d(i);
+      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
+        const Vector3 d = 2.0 / (c->limit * c->limit) * omega(x, k);
+        for (int i = 0; i < 3; ++i) values[z++] = d(i);
+      } else {
+        const Quaternion d = 2.0 * pointingForm(*c) * Eigen::Map<const Quaternion>(x + Q(k));
+        for (int i = 0; i < 4; ++i) values[z++] = d(i);
+      }
+    }
     return true;
   }
   bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
@@ -555,6 +627,20 @@ class TranscriptionNlp : public Ipopt::TNLP {
     }
     using HD = benchmark_ad::HyperDual<3>;
     const Matrix3& J = p_.inertia;
+    // The node constraints' terms: λ-weighted, per node (τ and Ω diagonals, q_k q_k blocks).
+    std::vector<double> tau_diagonal(N_ + 1, obj_factor), omega_diagonal(N_ + 1, 0.0);
+    std::vector<Eigen::Matrix4d> cone_block(has_cone_ ? N_ + 1 : 0, Eigen::Matrix4d::Zero());
+    for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
+      const auto& [c, k] = rows_of_constraints_[r];
+      const double l = lambda[equalities() + r];
+      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
+        tau_diagonal[k] += 2.0 * l / (c->limit * c->limit);
+      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
+        omega_diagonal[k] += 2.0 * l / (c->limit * c->limit);
+      } else {
+        cone_block[k] += 2.0 * l * pointingForm(*c);
+      }
+    }
     std::size_t z = 0;
     for (int k = 1; k <= N_ - 2; ++k) {
       const Vector3 w = omega(x, k);
@@ -581,12 +667,18 @@ class TranscriptionNlp : public Ipopt::TNLP {
           double v = 0.0;
           for (int r = 0; r < 4; ++r) v += c(r) * e(r).H[i][j];
           for (int r = 0; r < 3; ++r) v += nu(r) * f(r).H[i][j];
+          if (i == j) v += omega_diagonal[k];
           values[z++] = v;
         }
       }
     }
     for (int k = 1; k <= N_ - 1; ++k)
-      for (int i = 0; i < 3; ++i) values[z++] = obj_factor;
+      for (int i = 0; i < 3; ++i) values[z++] = tau_diagonal[k];
+    if (has_cone_) {
+      for (int k = 2; k <= N_ - 2; ++k)
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j <= i; ++j) values[z++] = cone_block[k](i, j);
+    }
     return true;
   }
   bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
@@ -631,6 +723,17 @@ class TranscriptionNlp : public Ipopt::TNLP {
       block(r0, T(k), 3, 3, true);
     }
     block(4 * N_ + 3 * (N_ - 1), Q(N_), 3, 4, false);
+    for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
+      const auto& [c, k] = rows_of_constraints_[r];
+      const int row = equalities() + static_cast<int>(r);
+      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
+        block(row, T(k), 1, 3, false);
+      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
+        block(row, W(k), 1, 3, false);
+      } else {
+        block(row, Q(k), 1, 4, false);
+      }
+    }
     // Hessian, lower triangle (row ≥ column; every W index exceeds every Q index), in eval_h's
     // order: per k = 1..N−2 the Ω_k × q_k block (row-major), the Ω_k Ω_k lower triangle; then
     // the τ diagonal.
@@ -644,6 +747,11 @@ class TranscriptionNlp : public Ipopt::TNLP {
     }
     for (int k = 1; k <= N_ - 1; ++k)
       for (int i = 0; i < 3; ++i) hrows_.push_back(T(k) + i), hcols_.push_back(T(k) + i);
+    if (has_cone_) {  // q_k q_k lower triangles, k = 2..N−2
+      for (int k = 2; k <= N_ - 2; ++k)
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j <= i; ++j) hrows_.push_back(Q(k) + i), hcols_.push_back(Q(k) + j);
+    }
   }
 
   ap::PlanningProblem p_;
@@ -654,11 +762,23 @@ class TranscriptionNlp : public Ipopt::TNLP {
   Quaternion q0_, qN_;
   std::vector<int> rows_, cols_;
   std::vector<int> hrows_, hcols_;
+  struct ConstraintRow {
+    const ap::PlanningConstraint* constraint;  ///< into p_.constraints
+    int k;                                     ///< node
+  };
+  std::vector<ConstraintRow> rows_of_constraints_;
+  bool has_cone_ = false;
 };
 
 /// exact_hessian: IPOPT's Newton steps use eval_h; otherwise its L-BFGS approximation.
+/// start: ω_0..ω_{N−1} of the starting plan (empty: the geodesic).
 PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, bool exact_hessian,
                        std::vector<Vector3> start = {}) {
+  if (problem.scheme != ap::SchemeKind::Paper || problem.effects) {
+    throw ap::InvalidInput("ipopt: the transcription is the paper scheme without effects (scheme " +
+                           ap::schemeName(problem.scheme) +
+                           (problem.effects ? ", with effects)" : ")"));
+  }
   Ipopt::SmartPtr<TranscriptionNlp> nlp =
       new TranscriptionNlp(problem, exact_hessian, std::move(start));
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
@@ -670,6 +790,8 @@ PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, b
   app->Options()->SetNumericValue("constr_viol_tol", 1e-12);
   app->Options()->SetIntegerValue("max_iter", 5000);
   app->Options()->SetNumericValue("max_cpu_time", time_budget);
+  // IPOPT relaxes every bound by 1e-8 relative by default; ours meets them exactly.
+  if (problem.hasNodeConstraints()) app->Options()->SetNumericValue("bound_relax_factor", 0.0);
   PeerOutcome out;
   if (app->Initialize() != Ipopt::Solve_Succeeded) {
     out.message = "IPOPT initialization failed";
@@ -689,10 +811,17 @@ PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, b
 /// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
 /// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
 /// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
-int checkHessian(int steps) {
+int checkHessian(int steps, bool constrained) {
   ap::PlanningProblem problem = seedRestToRest(steps);
   problem.initial_velocity = Vector3(0.02, -0.01, 0.03);  // nonzero boundary data too
   problem.final_velocity = Vector3(-0.01, 0.02, 0.01);
+  if (constrained) {  // one of every kind (two cones: both signs of their rows)
+    problem.max_torque = Vector3(0.5, 0.6, 0.7);
+    problem.constraints = {
+        ap::PlanningConstraint::maxTorqueNorm(0.8), ap::PlanningConstraint::maxAngularRate(0.3),
+        ap::PlanningConstraint::keepOut(Vector3(0, 0, 1), Vector3(0.6, 0.8, 0), 0.4, 0.01),
+        ap::PlanningConstraint::keepIn(Vector3(1, 0, 0), Vector3(0, 0.6, 0.8), 1.9)};
+  }
   Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, true);
   Ipopt::Index n = 0, m = 0, nnz_jac = 0, nnz_h = 0;
   Ipopt::TNLP::IndexStyleEnum style;
@@ -769,14 +898,37 @@ int checkHessian(int steps) {
       if (std::abs(H(i, j)) > 1e-3 * scale)
         entry_error = std::max(entry_error, std::abs(H(i, j) - fd_sym(i, j)) / std::abs(H(i, j)));
   const double relative = error / scale;
-  const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale;
+
+  // The constraint Jacobian (eval_jac_g) against central differences of eval_g, row-scaled.
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(m, n), jac_fd(m, n);
+  nlp->eval_jac_g(n, x.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
+  for (int i = 0; i < nnz_jac; ++i) jac(jr[i], jc[i]) += jv[i];
+  std::vector<double> g_plus(m), g_minus(m);
+  for (int j = 0; j < n; ++j) {
+    y[j] = x[j] + kStep;
+    nlp->eval_g(n, y.data(), true, m, g_plus.data());
+    y[j] = x[j] - kStep;
+    nlp->eval_g(n, y.data(), true, m, g_minus.data());
+    y[j] = x[j];
+    for (int i = 0; i < m; ++i) jac_fd(i, j) = (g_plus[i] - g_minus[i]) / (2.0 * kStep);
+  }
+  double jacobian_relative = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double row_scale = std::max(jac.row(i).cwiseAbs().maxCoeff(), 1e-300);
+    jacobian_relative =
+        std::max(jacobian_relative, (jac.row(i) - jac_fd.row(i)).cwiseAbs().maxCoeff() / row_scale);
+  }
+  const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale &&
+                    jacobian_relative <= 1e-6;
   std::printf(
-      "{\"check\": \"hessian\", \"steps\": %d, \"n\": %d, \"nnz_h\": %d, \"fd_step\": %g, "
+      "{\"check\": \"hessian\", \"constrained\": %s, \"steps\": %d, \"n\": %d, \"m\": %d, "
+      "\"nnz_h\": %d, \"fd_step\": %g, "
       "\"max_abs_entry\": %.6g, \"max_abs_error\": %.3g, \"relative_error\": %.3g, "
       "\"max_entry_relative_error\": %.3g, \"fd_outside_pattern\": %.3g, \"fd_asymmetry\": "
-      "%.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
-      steps, static_cast<int>(n), static_cast<int>(nnz_h), kStep, scale, error, relative,
-      entry_error, outside, asymmetry, pattern_errors, pass ? "true" : "false");
+      "%.3g, \"jacobian_relative_error\": %.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
+      constrained ? "true" : "false", steps, static_cast<int>(n), static_cast<int>(m),
+      static_cast<int>(nnz_h), kStep, scale, error, relative, entry_error, outside, asymmetry,
+      jacobian_relative, pattern_errors, pass ? "true" : "false");
   return pass ? 0 : 1;
 }
 #endif
@@ -1002,6 +1154,7 @@ struct Measurement {
   int steps = 0, iterations = 0;
   double time_s = 0.0, cost = 0.0, terminal_miss = 0.0;
   double warm_time_s = 0.0;  ///< median of the repeated in-process solves (0: not measured)
+  double max_constraint_violation = 0.0;  ///< checkConstraints on the replayed plan
   bool converged = false;
   long peak_rss_kb = 0;
 };
@@ -1019,18 +1172,39 @@ void printJson(const Measurement& m) {
   std::printf(
       "{\"solver\": \"%s\", \"scheme\": \"%s\", \"steps\": %d, \"time_s\": %.9g, "
       "\"iterations\": %d, \"cost\": %.17g, \"converged\": %s, \"terminal_miss\": %.3g, "
-      "\"peak_rss_kb\": %ld, \"warm_time_s\": %.9g, \"message\": \"%s\"}\n",
+      "\"peak_rss_kb\": %ld, \"warm_time_s\": %.9g, \"max_constraint_violation\": %.3g, "
+      "\"message\": \"%s\"}\n",
       m.solver.c_str(), m.scheme.c_str(), m.steps, m.time_s, m.iterations, m.cost,
       m.converged ? "true" : "false", m.terminal_miss, m.peak_rss_kb, m.warm_time_s,
-      escaped(m.message).c_str());
+      m.max_constraint_violation, escaped(m.message).c_str());
   std::fflush(stdout);
 }
 
-Measurement run(const std::string& solver, const ap::PlanningProblem& problem, double time_budget) {
+/// The steps ω_k of the problem's unconstrained optimum (ours), the start ours takes for a
+/// constrained solve: `--start unconstrained` gives it to the peer as well (computed before the
+/// peer's clock starts).
+std::vector<Vector3> unconstrainedSteps(const ap::PlanningProblem& problem) {
+  ap::PlanningProblem free = problem;
+  free.constraints.clear();
+  free.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  const ap::PlanResult r = ap::planManeuver(free, ap::SolverOptions());
+  if (!r.converged()) throw ap::InvalidInput("--start unconstrained: " + r.message);
+  std::vector<Vector3> w;
+  for (int k = 0; k < r.maneuver.steps(); ++k) {
+    w.push_back(
+        ap::so3::log(Matrix3(r.maneuver.attitude[k].transpose() * r.maneuver.attitude[k + 1])));
+  }
+  return w;
+}
+
+Measurement run(const std::string& solver, const ap::PlanningProblem& problem, double time_budget,
+                bool start_unconstrained = false) {
   Measurement m;
   m.solver = solver;
   m.scheme = ap::schemeName(problem.scheme);
   m.steps = problem.steps;
+  std::vector<Vector3> start_steps;
+  if (start_unconstrained) start_steps = unconstrainedSteps(problem);
   const auto start = std::chrono::steady_clock::now();
   PeerOutcome peer;
   ap::PlanResult ours;
@@ -1051,7 +1225,7 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
     peer = solveAuglag(problem, time_budget);
   } else if (solver == "ipopt" || solver == "ipopt_lbfgs") {
 #ifdef AP_HAVE_IPOPT
-    peer = solveIpopt(problem, time_budget, solver == "ipopt");
+    peer = solveIpopt(problem, time_budget, solver == "ipopt", start_steps);
 #else
     throw ap::InvalidInput("ipopt: this build has no IPOPT (install coinor-libipopt-dev)");
 #endif
@@ -1077,6 +1251,11 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
   }
   m.cost = ours.cost;
   m.terminal_miss = std::max(ours.terminal_attitude_error, ours.terminal_velocity_error);
+  if (problem.hasNodeConstraints() && ours.maneuver.steps() == problem.steps) {
+    m.max_constraint_violation = ap::checkConstraints(problem, ours.maneuver).max_violation;
+    // A peer "converges" only onto a plan that meets the constraints it was given.
+    if (!is_ours && m.max_constraint_violation > 1e-8) m.converged = false;
+  }
   m.peak_rss_kb = peakRssKb();
   return m;
 }
@@ -1337,6 +1516,8 @@ int randomSuite(int count, std::uint64_t seed, double time_budget, const std::st
 int main(int argc, char** argv) {
   std::string solver, scene, scheme;
   bool check_hessian = false;
+  bool constrained = false;
+  bool start_unconstrained = false;
   int steps = 0;
   int suite_count = 0;
   std::uint64_t suite_seed = 19;
@@ -1367,6 +1548,15 @@ int main(int argc, char** argv) {
       scheme = value();
     } else if (a == "--check-hessian") {
       check_hessian = true;
+    } else if (a == "--constrained") {
+      constrained = true;
+    } else if (a == "--start") {
+      const std::string v = value();
+      if (v != "geodesic" && v != "unconstrained") {
+        std::cerr << "--start: expected geodesic or unconstrained, got '" << v << "'\n";
+        return 2;
+      }
+      start_unconstrained = v == "unconstrained";
     } else if (a == "--time-budget") {
       time_budget = std::atof(value().c_str());
     } else if (a == "--random-suite") {
@@ -1388,7 +1578,7 @@ int main(int argc, char** argv) {
   }
   if (check_hessian) {
 #ifdef AP_HAVE_IPOPT
-    return checkHessian(steps > 0 ? steps : 16);
+    return checkHessian(steps > 0 ? steps : 16, constrained);
 #else
     std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
                  "(install coinor-libipopt-dev)\n";
@@ -1405,12 +1595,13 @@ int main(int argc, char** argv) {
         scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
     if (steps > 0) problem.steps = steps;
     if (!scheme.empty()) problem.scheme = ap::parseScheme(scheme, "--scheme");
-    Measurement m = run(solver, problem, time_budget);
+    Measurement m = run(solver, problem, time_budget, start_unconstrained);
     if (in_process > 1) {
       // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):
       // reported apart from time_s, which stays the first, cold solve of a fresh process.
       std::vector<double> warm;
-      for (int r = 1; r < in_process; ++r) warm.push_back(run(solver, problem, time_budget).time_s);
+      for (int r = 1; r < in_process; ++r)
+        warm.push_back(run(solver, problem, time_budget, start_unconstrained).time_s);
       std::sort(warm.begin(), warm.end());
       m.warm_time_s = warm[warm.size() / 2];
     }

@@ -116,7 +116,8 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
   for (size_t i = 0; i < r.constraints.size(); ++i)
     out << (i ? ", " : "") << jsonString(r.constraints[i]);
   out << "],\n  \"max_constraint_violation\": " << jsonNumber(r.max_constraint_violation)
-      << ",\n  \"active_constraints\": " << r.active_constraints;
+      << ",\n  \"active_constraints\": " << r.active_constraints
+      << ",\n  \"max_violation_between_nodes\": " << jsonNumber(r.max_violation_between_nodes);
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
   out << "\n}\n";
   return out.str();
@@ -183,7 +184,8 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
     for (const std::string& c : r.constraints) names += (names.empty() ? "" : ", ") + c;
     text += line("constraints", names + " (" + std::to_string(r.active_constraints) +
                                     " active, max violation " +
-                                    general(r.max_constraint_violation, 3) + ")");
+                                    general(r.max_constraint_violation, 3) + ", between nodes " +
+                                    general(r.max_violation_between_nodes, 3) + ")");
   }
   if (r.accuracy.requested) {
     const AccuracyEstimate& a = r.accuracy;

@@ -375,13 +375,14 @@ class SceneParser {
         out.push_back(PlanningConstraint::maxAngularRate(number(body, bpath)));
       } else if (name == "keep_out" || name == "keep_in") {
         requireMap(body, bpath);
-        checkKeys(body, bpath, {"body_axis", "world_direction", "half_angle"},
+        checkKeys(body, bpath, {"body_axis", "world_direction", "half_angle", "margin"},
                   {"body_axis", "world_direction", "half_angle"});
         const Vector3 b = vector3(body["body_axis"], bpath + ".body_axis");
         const Vector3 s = vector3(body["world_direction"], bpath + ".world_direction");
         const double a = number(body["half_angle"], bpath + ".half_angle");
-        out.push_back(name == "keep_out" ? PlanningConstraint::keepOut(b, s, a)
-                                         : PlanningConstraint::keepIn(b, s, a));
+        const double m = body["margin"] ? number(body["margin"], bpath + ".margin") : 0.0;
+        out.push_back(name == "keep_out" ? PlanningConstraint::keepOut(b, s, a, m)
+                                         : PlanningConstraint::keepIn(b, s, a, m));
       } else {
         fail(kv.first, bpath,
              "unknown constraint (expected max_torque_norm, max_angular_rate, keep_out or "
@@ -600,7 +601,9 @@ std::string formatScene(const Scene& scene) {
     out << "  - " << constraintKindName(c.kind) << ": ";
     if (c.isCone()) {
       out << "{body_axis: " << vec(c.body_axis) << ", world_direction: " << vec(c.world_direction)
-          << ", half_angle: " << exactNumber(c.half_angle) << "}\n";
+          << ", half_angle: " << exactNumber(c.half_angle);
+      if (c.margin != 0.0) out << ", margin: " << exactNumber(c.margin);
+      out << "}\n";
     } else {
       out << exactNumber(c.limit) << "\n";
     }

@@ -36,8 +36,10 @@
 // Between nodes: the constraints hold at the nodes only. Within step k the continuous motion
 // R_k exp(s ω_k^), s ∈ [0, 1], turns at the constant rate ω_k/h (paper scheme), so a rate limit
 // holds between nodes too, and torques are held over a step, so their bounds hold throughout; a
-// cone's angle can dip below its bound within a step by O(|ω_k|²) (not yet bounded or offset by
-// a margin).
+// cone's angle can dip past its bound within a step by up to a − acos(cos a + |ω_k|²/8): the
+// cones are imposed at their node half angle, tightened by the user's margin
+// (constraints.hpp: requiredConeMargin).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -223,12 +225,12 @@ class InteriorPoint {
             break;
           }
           case Family::KeepOut:
-            in.c = std::cos(g.spec->half_angle) -
+            in.c = std::cos(g.spec->nodeHalfAngle()) -
                    g.spec->world_direction.dot(R[k] * g.spec->body_axis);
             break;
           case Family::KeepIn:
             in.c = g.spec->world_direction.dot(R[k] * g.spec->body_axis) -
-                   std::cos(g.spec->half_angle);
+                   std::cos(g.spec->nodeHalfAngle());
             break;
         }
       }
@@ -401,7 +403,7 @@ class InteriorPoint {
         } else {
           const PointingTerms t = pointingTerms(R[k], g->spec->body_axis, g->spec->world_direction);
           const double sign = g->family == Family::KeepOut ? -1.0 : 1.0;  // c = ±p ∓ cos α
-          in.c = sign * (t.cosine - std::cos(g->spec->half_angle));
+          in.c = sign * (t.cosine - std::cos(g->spec->nodeHalfAngle()));
           prepare(in);
           in.g.head<3>() = sign * t.gradient;
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
@@ -545,11 +547,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     for (const PlanningConstraint& c : problem.constraints) {
       if (!c.isCone()) continue;
       for (int k : {1, N - 1}) {
-        if (np.variableIndex(k) >= 0) continue;  // free with end torques
-        const double margin = coneMargin(c, R[k]);
-        if (margin < 0.0) {
+        if (np.variableIndex(k) >= 0) continue;               // free with end torques
+        const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
+        if (slack < 0.0) {
           std::ostringstream why;
-          why << "infeasible: " << describeConstraint(c) << " is violated by " << -margin
+          why << "infeasible: " << describeConstraint(c) << " is violated by " << -slack
               << " rad at k = " << k
               << ", an attitude the boundary velocities fix (increase steps or move the boundary)";
           result.termination = Termination::Infeasible;
@@ -805,7 +807,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 
 }  // namespace
 
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
+namespace {
+
+/// The interior point on the requested grid, with grid continuation above
+/// kCoarsestConstrainedGrid.
+PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options) {
   if (problem.steps <= kCoarsestConstrainedGrid) {
     return solveOnGrid(problem, options, nullptr, nullptr);
   }
@@ -849,6 +855,49 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   if (levels.size() > 1) {
     result.message += "; grid continuation from N = " + std::to_string(levels.back());
   }
+  return result;
+}
+
+}  // namespace
+
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult result = solveContinued(problem, options);
+  // Pointing cones together with torque or rate limits, from a start inside a cone: the
+  // iterate can leave the cone with torques far beyond their bounds and never recover (measured:
+  // a Sun keep-out + |τ| ≤ 0.07 N m slew that IPOPT solves was called infeasible after 13
+  // iterations). Retry once in two stages: the cones alone (a path around them), then every
+  // constraint from that path.
+  const bool stuck = result.termination == Termination::Infeasible ||
+                     result.termination == Termination::NotConverged;
+  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  const bool others = problem.hasTorqueBounds() ||
+                      std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                  [](const PlanningConstraint& c) { return !c.isCone(); });
+  if (!stuck || !cones || !others) return result;
+  SolverOptions staged = withRemainingBudget(options, start);
+  PlanningProblem cones_only = problem;
+  cones_only.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  cones_only.constraints.clear();
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.isCone()) cones_only.constraints.push_back(c);
+  const PlanResult around = solveContinued(cones_only, staged);
+  int iterations = result.iterations + around.iterations;
+  if (!around.converged()) return result;
+  staged.warm_start = &around.maneuver;
+  staged.time_budget_s = withRemainingBudget(options, start).time_budget_s;
+  PlanResult second = solveContinued(problem, staged);
+  iterations += second.iterations;
+  const std::string first_message = result.message;
+  // The staged answer replaces the first unless it did no better (then the first is kept: its
+  // reason is the one measured from the requested start).
+  if (second.converged() || second.termination == Termination::Infeasible) result = second;
+  result.iterations = iterations;
+  result.message +=
+      "; retried in two stages (the cones alone, then every constraint from that "
+      "path) after: " +
+      first_message;
   return result;
 }
 

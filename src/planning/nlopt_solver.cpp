@@ -149,7 +149,7 @@ void nodeInequalities(unsigned m, double* result, unsigned n, const double* x_ra
       const double sign = c.kind == ConstraintKind::KeepOut ? 1.0 : -1.0;
       for (int k = 1; k <= N; ++k, ++i) {
         const Vector3 v = R[k].transpose() * c.world_direction;
-        result[i] = sign * (v.dot(c.body_axis) - std::cos(c.half_angle));
+        result[i] = sign * (v.dot(c.body_axis) - std::cos(c.nodeHalfAngle()));
         rows.push_back({k, false, false, sign * c.body_axis.cross(v).transpose()});
       }
     }

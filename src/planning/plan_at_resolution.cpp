@@ -180,14 +180,18 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
                                               ? checkConstraints(problem, result.maneuver)
                                               : ConstraintCheck{};
-    if (!result.converged() || unconstrained.max_violation > 0.0) {
+    if (!result.converged() || unconstrained.max_node_bound_violation > 0.0) {
       SolverOptions constrained = withRemainingBudget(options, start);
       const int newton_iterations = result.iterations;
       std::ostringstream note;
       if (result.converged()) {
-        note << "; the unconstrained optimum (cost " << result.cost << ") violates "
-             << unconstrained.worst << " " << unconstrained.worst_where << " and started it ("
-             << newton_iterations << " Newton iterations)";
+        note << "; the unconstrained optimum (cost " << result.cost << ") violates ";
+        if (unconstrained.worst.empty()) {
+          note << "a cone's margin";  // the stated limits hold, a tightened node bound does not
+        } else {
+          note << unconstrained.worst << " " << unconstrained.worst_where;
+        }
+        note << " and started it (" << newton_iterations << " Newton iterations)";
       }
       const Maneuver unconstrained_plan = result.maneuver;
       constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
@@ -207,6 +211,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     const ConstraintCheck check = checkConstraints(problem, result.maneuver);
     result.constraints = check.names;
     result.max_constraint_violation = check.max_violation;
+    result.max_violation_between_nodes = check.max_violation_between_nodes;
     result.active_constraints = check.active;
   }
   result.solve_time_s =

@@ -72,15 +72,31 @@ PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& f
     throw InvalidInput(path + ".limit: not used by " + msg.type + ", must be 0, got " +
                        exactNumber(msg.limit));
   }
-  if (!cone && (!b.isZero(0.0) || !s.isZero(0.0) || msg.half_angle != 0.0)) {
-    throw InvalidInput(path + ": body_axis, world_direction and half_angle are not used by " +
+  if (!cone && (!b.isZero(0.0) || !s.isZero(0.0) || msg.half_angle != 0.0 || msg.margin != 0.0)) {
+    throw InvalidInput(path +
+                       ": body_axis, world_direction, half_angle and margin are not used by " +
                        msg.type + ", must be 0");
   }
   if (msg.type == Constraint::MAX_TORQUE_NORM) return PlanningConstraint::maxTorqueNorm(msg.limit);
   if (msg.type == Constraint::MAX_ANGULAR_RATE)
     return PlanningConstraint::maxAngularRate(msg.limit);
-  if (msg.type == Constraint::KEEP_OUT) return PlanningConstraint::keepOut(b, s, msg.half_angle);
-  return PlanningConstraint::keepIn(b, s, msg.half_angle);
+  if (msg.type == Constraint::KEEP_OUT)
+    return PlanningConstraint::keepOut(b, s, msg.half_angle, msg.margin);
+  return PlanningConstraint::keepIn(b, s, msg.half_angle, msg.margin);
+}
+
+Constraint constraintToMsg(const PlanningConstraint& c) {
+  Constraint msg;
+  msg.type = constraintKindName(c.kind);
+  if (c.isCone()) {
+    msg.body_axis = vectorToMsg(c.body_axis);
+    msg.world_direction = vectorToMsg(c.world_direction);
+    msg.half_angle = c.half_angle;
+    msg.margin = c.margin;
+  } else {
+    msg.limit = c.limit;
+  }
+  return msg;
 }
 
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {

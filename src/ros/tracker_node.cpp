@@ -113,6 +113,65 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   return array;
 }
 
+visualization_msgs::MarkerArray constraintMarkers(
+    const std::vector<PlanningConstraint>& constraints, double length,
+    const std::string& world_frame, const std::string& body_frame, const ros::Time& stamp) {
+  visualization_msgs::MarkerArray array;
+  constexpr int kSegments = 48;  // triangles around the cone
+  int id = 0;
+  for (const PlanningConstraint& c : constraints) {
+    if (!c.isCone()) continue;
+    const bool out = c.kind == ConstraintKind::KeepOut;
+    const std_msgs::ColorRGBA tint =
+        out ? color(0.95f, 0.2f, 0.1f, 0.35f) : color(0.1f, 0.85f, 0.3f, 0.35f);
+    // The cone: a fan of triangles from the apex (the body origin) to the circle of points at
+    // slant distance `length` whose direction makes the half angle with s (any a in (0, π)).
+    visualization_msgs::Marker cone;
+    cone.header.frame_id = world_frame;
+    cone.header.stamp = stamp;
+    cone.ns = out ? "keep_out" : "keep_in";
+    cone.id = id;
+    cone.type = visualization_msgs::Marker::TRIANGLE_LIST;
+    cone.action = visualization_msgs::Marker::ADD;
+    cone.pose.orientation.w = 1.0;
+    cone.scale.x = cone.scale.y = cone.scale.z = 1.0;
+    cone.color = tint;
+    const Vector3& s = c.world_direction;
+    const Vector3 e1 = s.unitOrthogonal();
+    const Vector3 e2 = s.cross(e1);
+    const auto rim = [&](int i) {
+      const double phi = 2.0 * M_PI * i / kSegments;
+      return Vector3(length * (std::cos(c.half_angle) * s +
+                               std::sin(c.half_angle) * (std::cos(phi) * e1 + std::sin(phi) * e2)));
+    };
+    for (int i = 0; i < kSegments; ++i) {
+      cone.points.push_back(point(Vector3::Zero()));
+      cone.points.push_back(point(rim(i)));
+      cone.points.push_back(point(rim(i + 1)));
+    }
+    array.markers.push_back(cone);
+    // The constrained body axis b, in the body frame, as long as the cone's slant.
+    visualization_msgs::Marker axis;
+    axis.header.frame_id = body_frame;
+    axis.header.stamp = stamp;
+    axis.ns = out ? "keep_out_body_axis" : "keep_in_body_axis";
+    axis.id = id;
+    axis.type = visualization_msgs::Marker::ARROW;
+    axis.action = visualization_msgs::Marker::ADD;
+    axis.pose.orientation.w = 1.0;
+    axis.points.push_back(point(Vector3::Zero()));
+    axis.points.push_back(point(length * c.body_axis));
+    axis.scale.x = 0.03 * length;  // shaft diameter [m] (twice the body x arrow: drawn around it)
+    axis.scale.y = 0.05 * length;  // head diameter [m]
+    axis.scale.z = 0.08 * length;  // head length [m]
+    axis.color = tint;
+    axis.color.a = 1.0f;
+    array.markers.push_back(axis);
+    ++id;
+  }
+  return array;
+}
+
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
@@ -137,6 +196,8 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
       if (!std::holds_alternative<TorqueNoiseSpec>(e))
         srv.request.effects.push_back(rc::effectToMsg(e));
     }
+    for (const PlanningConstraint& c : problem.constraints)
+      srv.request.constraints.push_back(rc::constraintToMsg(c));
     if (!client->call(srv)) {
       *error = "service " + client->getService() + " call failed";
       return false;
@@ -226,6 +287,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 1, true);
   path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
   done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
+  constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
   control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
   maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
   drift_sub_ = nh_.subscribe("drift_maneuver", 1, &TrackerNode::onDriftManeuver, this);
@@ -279,6 +341,10 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       throw InvalidInput(error);
     }
     replay.effects = parsed.effects;
+    replay.constraint_markers = constraintMarkers(parsed.problem.constraints, path_radius_,
+                                                  world_frame_, body_frame_, ros::Time());
+    if (!replay.constraint_markers.markers.empty())
+      constraint_pub_.publish(replay.constraint_markers);
     ros::ServiceClient client;
     if (!plan_in_process) {
       client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
@@ -374,7 +440,8 @@ visualization_msgs::Marker TrackerNode::pathMarker() const {
 }
 
 void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                              visualization_msgs::Marker* path) {
+                              visualization_msgs::Marker* path,
+                              visualization_msgs::MarkerArray* constraint_markers) {
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = stamp;
   tf.header.frame_id = world_frame_;
@@ -385,6 +452,10 @@ void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const Pr
   path->header.stamp = stamp;
   path->points.push_back(point(path_radius_ * R.col(0)));
   if (path->points.size() >= 2) path_pub_.publish(*path);
+  if (constraint_markers && !constraint_markers->markers.empty()) {
+    for (visualization_msgs::Marker& m : constraint_markers->markers) m.header.stamp = stamp;
+    constraint_pub_.publish(*constraint_markers);
+  }
 }
 
 void TrackerNode::publishDone(ReplayResult result) {
@@ -468,7 +539,7 @@ void TrackerNode::runReplay(Replay replay) {
   for (int k = 0; k <= N; ++k) {
     const ros::Time stamp = start + ros::Duration(replayed.time[k] / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    publishPose(replayed.attitude[k], stamp, box, &path);
+    publishPose(replayed.attitude[k], stamp, box, &path, &replay.constraint_markers);
 
     geometry_msgs::WrenchStamped wrench;
     wrench.header.stamp = stamp;

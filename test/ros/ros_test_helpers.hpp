@@ -1,12 +1,15 @@
 // Shared pieces of the rostest gtests: the seed request (seed 000, example 1) at small N.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include <ros/ros.h>
 
 #include "attitude_planner/AttitudeManeuver.h"
+#include "attitude_planner/Constraint.h"
 #include "attitude_planner/ReplayResult.h"
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/ros/conversions.hpp"
@@ -57,6 +60,56 @@ void fillSeedRequest(Request* r, int steps = 32, double angle = M_PI / 3) {
   r->final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), angle));
   r->duration = 12.8;
   r->steps = steps;
+}
+
+/// scenes/sun_keep_out.yaml as a request at `steps` steps, plus |τ_k| ≤ 0.095 N m: a π/2 slew
+/// about world z in T = 60 s (J = diag(20, 25, 30) kg·m²) whose straight path crosses a keep-out
+/// cone of 0.5 rad around the Sun (body x); the plan around the cone alone peaks at ~0.10 N m
+/// (N = 16, 32), so both constraints bind.
+constexpr double kConstrainedTorqueNorm = 0.095;  // [N m]
+inline Vector3 constrainedRequestSun() {
+  return Vector3(0.7035741925769524, 0.7035741925769523, 0.09983341664682815);
+}
+constexpr double kConstrainedHalfAngle = 0.5;  // [rad]
+
+template <class Request>
+void fillConstrainedRequest(Request* r, int steps = 32) {
+  r->inertia = {20, 0, 0, 0, 25, 0, 0, 0, 30};
+  r->initial_attitude.w = 1.0;
+  r->final_attitude =
+      ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitZ(), M_PI / 2));
+  r->duration = 60.0;
+  r->steps = steps;
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = kConstrainedTorqueNorm;
+  Constraint sun;
+  sun.type = Constraint::KEEP_OUT;
+  sun.body_axis.x = 1.0;
+  sun.world_direction = ros_conversions::vectorToMsg(constrainedRequestSun());
+  sun.half_angle = kConstrainedHalfAngle;
+  r->constraints = {norm, sun};
+}
+
+/// The smallest slacks of fillConstrainedRequest's constraints over a returned maneuver's nodes,
+/// computed here from its rows: 0.095 N m − |τ_k| and angle(R_k x, Sun) − 0.5 rad (≥ 0: met).
+struct ConstrainedSlacks {
+  double torque = std::numeric_limits<double>::infinity();
+  double cone = std::numeric_limits<double>::infinity();
+};
+inline ConstrainedSlacks constrainedRequestSlacks(const AttitudeManeuver& m) {
+  const Vector3 sun = constrainedRequestSun();
+  ConstrainedSlacks out;
+  for (const geometry_msgs::Vector3& t : m.torque) {
+    out.torque =
+        std::min(out.torque, kConstrainedTorqueNorm - ros_conversions::vectorFromMsg(t).norm());
+  }
+  for (const geometry_msgs::Quaternion& q : m.attitude) {
+    const Vector3 x = ros_conversions::attitudeFromMsg(q, "attitude") * Vector3::UnitX();
+    out.cone =
+        std::min(out.cone, std::atan2(x.cross(sun).norm(), x.dot(sun)) - kConstrainedHalfAngle);
+  }
+  return out;
 }
 
 /// A test maneuver needing no planner: the seed body driven by smooth known torques τ_k [N·m],

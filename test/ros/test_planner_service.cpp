@@ -321,15 +321,6 @@ TEST_F(PlannerService, ConcurrentRequestsEachGetTheirOwnAnswer) {
   }
 }
 
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_planner_service");
-  ros::NodeHandle nh;
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  return RUN_ALL_TESTS();
-}
-
 TEST_F(PlannerService, ConstraintsArePlannedReportedAndABadOneIsNamed) {
   // The seed slew (N = 32) with |tau_k| <= 0.45 N m (the unconstrained peak is ~0.6 N m): the
   // bound binds, the response lists it and its figures; then a keep-out cone with a non-unit
@@ -363,6 +354,66 @@ TEST_F(PlannerService, ConstraintsArePlannedReportedAndABadOneIsNamed) {
   EXPECT_TRUE(call(seed(16)).success);
 }
 
+TEST_F(PlannerService, KeepOutAndTorqueNormBindAreEchoedAndMetAtEveryNode) {
+  PlanAttitudeManeuver::Request req;
+  ros_testing::fillConstrainedRequest(&req, 32);
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.constraints, (std::vector<std::string>{"max_torque_norm", "keep_out"}));
+  EXPECT_GT(res.active_constraints, 0);
+  EXPECT_LE(res.max_constraint_violation, 1e-9);
+  // Both met at every node and both at their bound (checked here from the returned rows).
+  const ros_testing::ConstrainedSlacks slack = ros_testing::constrainedRequestSlacks(res.maneuver);
+  EXPECT_GE(slack.torque, -1e-9);
+  EXPECT_GE(slack.cone, -1e-9);
+  EXPECT_LT(slack.torque, 1e-6);
+  EXPECT_LT(slack.cone, 1e-6);
+  EXPECT_LT(res.terminal_attitude_error, 1e-8);
+  // Both bind: the plan costs more than the same slew without them.
+  req.constraints.clear();
+  const PlanAttitudeManeuver::Response free = call(req);
+  ASSERT_TRUE(free.success) << free.message;
+  EXPECT_LT(ros_testing::constrainedRequestSlacks(free.maneuver).cone, -1e-3);
+  EXPECT_GT(res.cost, free.cost);
+}
+
+TEST_F(PlannerService, BadConstraintValuesAreNamedAndTheNodeKeepsServing) {
+  struct Case {
+    const char* what;
+    PlanAttitudeManeuver::Request req;
+    const char* expected;
+  };
+  std::vector<Case> cases;
+  PlanAttitudeManeuver::Request base;
+  ros_testing::fillConstrainedRequest(&base, 16);
+  cases.push_back({"zero body axis", base,
+                   "constraints[1].keep_out.body_axis: zero vector [0, 0, 0] has no direction"});
+  cases.back().req.constraints[1].body_axis = geometry_msgs::Vector3();
+  cases.push_back({"half angle above pi", base,
+                   "constraints[1].keep_out.half_angle: must be in (0, pi) rad, got 3.5"});
+  cases.back().req.constraints[1].half_angle = 3.5;
+  cases.push_back({"keep_in half angle 0", base,
+                   "constraints[1].keep_in.half_angle: must be in (0, pi) rad, got 0"});
+  cases.back().req.constraints[1].type = Constraint::KEEP_IN;
+  cases.back().req.constraints[1].half_angle = 0.0;
+  cases.push_back({"negative torque norm", base,
+                   "constraints[0].max_torque_norm: must be a finite number > 0 N m, got -0.095"});
+  cases.back().req.constraints[0].limit = -0.095;
+  cases.push_back({"unknown type", base, "constraints[0].type: unknown value 'max_torque'"});
+  cases.back().req.constraints[0].type = "max_torque";
+  for (const Case& c : cases) {
+    const PlanAttitudeManeuver::Response res = call(c.req);
+    EXPECT_FALSE(res.success) << c.what;
+    EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << c.what << ": " << res.message;
+    EXPECT_NE(res.message.find(c.expected), std::string::npos)
+        << c.what << ": message '" << res.message << "' lacks '" << c.expected << "'";
+    EXPECT_TRUE(res.maneuver.attitude.empty()) << c.what;
+  }
+  const PlanAttitudeManeuver::Response good = call(base);
+  EXPECT_TRUE(good.success) << good.message;
+  EXPECT_GE(ros_testing::constrainedRequestSlacks(good.maneuver).cone, -1e-9);
+}
+
 TEST_F(PlannerService, MinimumTimeReturnsTStarAndTheMarginPlan) {
   // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m: T* = 2√10 s (eigenaxis bang–bang). No
   // duration given; the plan at 1.1 T*. Then a minimum-time request without a bound is named.
@@ -390,4 +441,13 @@ TEST_F(PlannerService, MinimumTimeReturnsTStarAndTheMarginPlan) {
   EXPECT_NE(bad.message.find("objective: 'minimum_time' needs a torque bound"), std::string::npos)
       << bad.message;
   EXPECT_TRUE(call(seed(16)).success);
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_planner_service");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
 }

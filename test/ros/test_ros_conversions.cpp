@@ -248,6 +248,39 @@ TEST(RosConversions, EffectMessagesRoundTrip) {
   }
 }
 
+TEST(RosConversions, ConstraintMessagesRoundTrip) {
+  const std::vector<PlanningConstraint> constraints = {
+      PlanningConstraint::maxTorqueNorm(0.5), PlanningConstraint::maxAngularRate(0.2),
+      PlanningConstraint::keepOut(Vector3(0, 0, 1), Vector3(0.6, 0.8, 0), 0.5, 0.01),
+      PlanningConstraint::keepIn(Vector3(1, 0, 0), Vector3(0, 0, -1), 1.2)};
+  for (const PlanningConstraint& c : constraints) {
+    const Constraint msg = rc::constraintToMsg(c);
+    EXPECT_EQ(msg.type, constraintKindName(c.kind));
+    const PlanningConstraint back = rc::constraintFromMsg(msg, "constraints[0]");
+    EXPECT_EQ(back.kind, c.kind);
+    EXPECT_EQ(back.limit, c.isCone() ? 0.0 : c.limit);
+    if (c.isCone()) {
+      EXPECT_EQ(back.body_axis, c.body_axis);
+      EXPECT_EQ(back.world_direction, c.world_direction);
+      EXPECT_EQ(back.half_angle, c.half_angle);
+      EXPECT_EQ(back.margin, c.margin);
+    }
+    EXPECT_EQ(rc::constraintToMsg(back), msg) << msg.type;
+  }
+  // A margin on a kind that has none is named.
+  Constraint bad = rc::constraintToMsg(constraints[0]);
+  bad.margin = 0.1;
+  try {
+    rc::constraintFromMsg(bad, "constraints[3]");
+    ADD_FAILURE() << "margin on max_torque_norm accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("constraints[3].max_torque_norm: body_axis, "
+                                         "world_direction, half_angle and margin are not used"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RosConversions, BadEffectsNameTheFieldAndTheValue) {
   auto message = [](const std::vector<Effect>& effects) {
     PlanAttitudeManeuver::Request r = seedRequest();

@@ -1,8 +1,10 @@
 // The benchmark harness builds and runs: benchmark_solvers --quick solves the seed's rest-to-rest
 // example at N = 16 with every solver and agrees on the cost. No timing is checked here.
 // When CMake found IPOPT (AP_BENCHMARK_HAS_IPOPT), the IPOPT peers are required in that run and
-// IPOPT's exact Hessian is checked against central differences of its exact gradients
-// (benchmark_solvers --check-hessian); without IPOPT those checks are reported as SKIPPED.
+// IPOPT's exact Hessian is checked against central differences of its exact gradients, and its
+// Jacobian against differences of its constraints, without and with node constraints
+// (benchmark_solvers --check-hessian [--constrained]); without IPOPT those checks are reported as
+// SKIPPED.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -55,12 +57,20 @@ TEST(BenchmarkSolvers, IpoptExactHessianAgreesWithFiniteDifferencesOfGradients) 
                   "has no IPOPT peer, so its Hessian is not checked";
 #else
   // N = 5 (smallest with every block), 16 and 64; relative error ≤ 1e-6 against the largest
-  // entry, no pattern errors, nothing outside the pattern (the binary's exit status says so).
-  for (const char* steps : {"5", "16", "64"}) {
-    std::string output;
-    EXPECT_EQ(runTool(std::string("--check-hessian --steps ") + steps, &output), 0) << output;
-    EXPECT_NE(output.find("\"pass\": true"), std::string::npos) << output;
-    std::printf("%s", output.c_str());
+  // entry, no pattern errors, nothing outside the pattern, and the constraint Jacobian against
+  // differences of the constraints (the binary's exit status says so); without and with one node
+  // constraint of every kind (torque norm and rate rows, keep_out and keep_in q_k q_k blocks).
+  for (const char* constrained : {"", " --constrained"}) {
+    for (const char* steps : {"5", "16", "64"}) {
+      std::string output;
+      EXPECT_EQ(runTool(std::string("--check-hessian --steps ") + steps + constrained, &output), 0)
+          << output;
+      EXPECT_NE(output.find("\"pass\": true"), std::string::npos) << output;
+      EXPECT_NE(output.find(std::string("\"constrained\": ") + (*constrained ? "true" : "false")),
+                std::string::npos)
+          << output;
+      std::printf("%s", output.c_str());
+    }
   }
 #endif
 }

@@ -195,8 +195,9 @@ void applySchemeName(const std::string& text, const std::string& field, Planning
 /// and ≥ 0): throws InvalidInput naming the option and the value.
 void validateOptions(const SolverOptions& options);
 
-/// A node constraint is counted active when its slack is within this fraction of its limit
-/// (torque, rate) or this many radians (cones).
+/// A node constraint is counted active when its slack to the node bound (a cone's half angle
+/// tightened by its margin) is within this fraction of its limit (torque, rate) or this many
+/// radians (cones).
 constexpr double kActiveConstraintTolerance = 1e-6;
 
 /// A plan meets its node constraints when no violation exceeds this fraction of the constraint's
@@ -209,11 +210,17 @@ constexpr double kNodeConstraintTolerance = 1e-8;
 struct ConstraintCheck {
   std::vector<std::string> names;  ///< the keys in force ("actuator_limits" first if bounded)
   double max_violation = 0.0;      ///< worst violation, each in its own unit, ≥ 0
-  /// Worst violation relative to its constraint's scale (limit, or 1 rad for cones), ≥ 0.
+  /// Worst violation of the node bounds (cones tightened by their margin) relative to the
+  /// constraint's scale (limit, or 1 rad for cones), ≥ 0.
   double max_relative_violation = 0.0;
   int active = 0;     ///< node constraints at their bound
   std::string worst;  ///< the worst violated constraint, e.g. "|tau_x| <= 0.1 N m"; empty if none
   std::string worst_where;  ///< its violation and node, e.g. "by 0.02 at k = 64 (t = 6.4 s)"
+  /// Worst violation of the node bounds the planner imposes (cones tightened by their margin).
+  double max_node_bound_violation = 0.0;
+  /// Worst violation of the stated limits over the continuous motion between the nodes too
+  /// (R_k exp(s ω_k^), torques held; constraints.hpp), each in its own unit, ≥ max_violation.
+  double max_violation_between_nodes = 0.0;
 };
 ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver);
 

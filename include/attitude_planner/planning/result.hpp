@@ -90,6 +90,9 @@ struct PlanResult {
   /// Worst violation over all nodes and constraints, each in its own unit (N m, rad/s, rad), ≥ 0,
   /// measured on the returned maneuver (checkConstraints).
   double max_constraint_violation = 0.0;
+  /// The same over the continuous motion between the nodes too (R_k exp(s ω_k^), torques held):
+  /// what a cone's `margin` is for (checkConstraints), ≥ max_constraint_violation.
+  double max_violation_between_nodes = 0.0;
   /// Node constraints at their bound (within kActiveConstraintTolerance relative) on the result.
   int active_constraints = 0;
 };

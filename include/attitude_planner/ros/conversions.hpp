@@ -76,6 +76,8 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 /// Throws InvalidInput for an unknown type or a field of another type that is not left at zero;
 /// the values themselves are checked by validateConstraints (validateProblem).
 PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field);
+/// The Constraint message of a core constraint (the fields its kind does not use left at 0).
+Constraint constraintToMsg(const PlanningConstraint& constraint);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {

@@ -179,6 +179,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->effects = r.effects;
   res->constraints = r.constraints;
   res->max_constraint_violation = r.max_constraint_violation;
+  res->max_violation_between_nodes = r.max_violation_between_nodes;
   res->active_constraints = r.active_constraints;
   res->replay_miss = r.replay_miss;
   res->step_residual = r.step_residual;

@@ -20,6 +20,8 @@
 //             control           geometry_msgs/Vector3Stamped, body     (u1, u2, 0) [rad/s] (drift)
 //             body_marker       visualization_msgs/MarkerArray, body   box + principal axes
 //             attitude_path     visualization_msgs/Marker, world       tip of the body x axis
+//             constraint_markers visualization_msgs/MarkerArray, latched, when ~scene has keep_out
+//                               / keep_in constraints: each cone (world) and its body axis (body)
 //             done              attitude_planner/ReplayResult, latched when a replay ends
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
@@ -85,10 +87,20 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
                                             double path_radius, const std::string& body_frame,
                                             const ros::Time& stamp);
 
+/// Markers of the pointing constraints (keep_out, keep_in; others are skipped), cone i (in the
+/// order of `constraints`, counting cones only) as id i: a TRIANGLE_LIST cone in `world_frame`
+/// (ns "keep_out" red / "keep_in" green, translucent), apex at the origin, axis the world
+/// direction s, every rim point at slant distance `length` [m] and at the half angle from s; and
+/// an ARROW in `body_frame` (ns "keep_out_body_axis" / "keep_in_body_axis") from the origin to
+/// `length` · b. Stamp zero: rviz draws the body axis at the latest transform.
+visualization_msgs::MarkerArray constraintMarkers(
+    const std::vector<PlanningConstraint>& constraints, double length,
+    const std::string& world_frame, const std::string& body_frame, const ros::Time& stamp);
+
 /// Plans a scene: via the service (if `client` is valid; the request carries the scene's
-/// plannable `effects` and actuator limits) or in-process (`problem` already holds them). Fills
-/// `msg` and the planner's solve time [s] and cost; returns false with `error` set if planning
-/// failed.
+/// plannable `effects`, actuator limits and constraints) or in-process (`problem` already holds
+/// them). Fills `msg` and the planner's solve time [s] and cost; returns false with `error` set if
+/// planning failed.
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
@@ -119,6 +131,9 @@ class TrackerNode {
     double plan_solve_time = -1.0;    ///< [s], −1 if unknown
     double plan_cost = -1.0;          ///< [N²·m²], −1 if unknown
     std::vector<EffectSpec> effects;  ///< effects acting during the replay (rigid body only)
+    /// ~scene's constraintMarkers (empty for a maneuver from the topic), re-published with every
+    /// pose so rviz finds the body frame at their stamp.
+    visualization_msgs::MarkerArray constraint_markers;
   };
 
   /// `maneuver` callback: replaces the running replay.
@@ -141,21 +156,24 @@ class TrackerNode {
   bool waitForClock(ros::Time* start);
   /// The empty `attitude_path` LINE_STRIP.
   visualization_msgs::Marker pathMarker() const;
-  /// tf world → body, the body markers and the path's next point at `stamp`.
+  /// tf world → body, the body markers, the path's next point and (if any) the constraint
+  /// markers at `stamp`.
   void publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                   visualization_msgs::Marker* path);
+                   visualization_msgs::Marker* path,
+                   visualization_msgs::MarkerArray* constraint_markers = nullptr);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
 
-  ros::NodeHandle nh_;            ///< public handle: topics and the service resolve here
-  ros::Subscriber maneuver_sub_;  ///< `maneuver`
-  ros::Subscriber drift_sub_;     ///< `drift_maneuver`
-  ros::Publisher control_pub_;    ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
-  ros::Publisher torque_pub_;     ///< `torque` τ_k [N·m], frame body
-  ros::Publisher velocity_pub_;   ///< `angular_velocity` Ω_k [rad/s], frame body
-  ros::Publisher marker_pub_;     ///< `body_marker`
-  ros::Publisher path_pub_;       ///< `attitude_path`
-  ros::Publisher done_pub_;       ///< `done` (latched)
+  ros::NodeHandle nh_;             ///< public handle: topics and the service resolve here
+  ros::Subscriber maneuver_sub_;   ///< `maneuver`
+  ros::Subscriber drift_sub_;      ///< `drift_maneuver`
+  ros::Publisher control_pub_;     ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
+  ros::Publisher torque_pub_;      ///< `torque` τ_k [N·m], frame body
+  ros::Publisher velocity_pub_;    ///< `angular_velocity` Ω_k [rad/s], frame body
+  ros::Publisher marker_pub_;      ///< `body_marker`
+  ros::Publisher path_pub_;        ///< `attitude_path`
+  ros::Publisher done_pub_;        ///< `done` (latched)
+  ros::Publisher constraint_pub_;  ///< `constraint_markers` (latched)
   tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
   double rate_factor_ = 1.0;                      ///< maneuver seconds per ROS second
   double start_delay_ = 0.5;                      ///< [s] ROS time before step 0

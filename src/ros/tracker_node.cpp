@@ -60,17 +60,41 @@ PrincipalBox principalBox(const Matrix3& inertia, double size) {
   return box;
 }
 
+/// A marker of `type` in `frame`, added, at the frame's origin with the identity orientation.
+visualization_msgs::Marker newMarker(const std::string& frame, const ros::Time& stamp,
+                                     const std::string& ns, int id, int type) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame;
+  m.header.stamp = stamp;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  return m;
+}
+
+/// An arrow from the frame's origin to `tip`: shaft and head diameters and head length [m].
+visualization_msgs::Marker arrowMarker(const std::string& frame, const ros::Time& stamp,
+                                       const std::string& ns, int id, const Vector3& tip,
+                                       const Vector3& shaft_head_length,
+                                       const std_msgs::ColorRGBA& tint) {
+  visualization_msgs::Marker a = newMarker(frame, stamp, ns, id, visualization_msgs::Marker::ARROW);
+  a.points.push_back(point(Vector3::Zero()));
+  a.points.push_back(point(tip));
+  a.scale.x = shaft_head_length.x();
+  a.scale.y = shaft_head_length.y();
+  a.scale.z = shaft_head_length.z();
+  a.color = tint;
+  return a;
+}
+
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
                                             double path_radius, const std::string& body_frame,
                                             const ros::Time& stamp) {
   visualization_msgs::MarkerArray array;
-  visualization_msgs::Marker m;
-  m.header.frame_id = body_frame;
-  m.header.stamp = stamp;
-  m.ns = "body";
-  m.action = visualization_msgs::Marker::ADD;
-  m.id = 0;
-  m.type = visualization_msgs::Marker::CUBE;
+  visualization_msgs::Marker m =
+      newMarker(body_frame, stamp, "body", 0, visualization_msgs::Marker::CUBE);
   m.pose.orientation = rc::attitudeToMsg(box.axes);
   m.scale.x = box.dimensions.x();
   m.scale.y = box.dimensions.y();
@@ -80,36 +104,14 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   const std_msgs::ColorRGBA colors[3] = {
       color(0.9f, 0.1f, 0.1f, 1.0f), color(0.1f, 0.8f, 0.1f, 1.0f), color(0.1f, 0.3f, 1.0f, 1.0f)};
   for (int i = 0; i < 3; ++i) {
-    visualization_msgs::Marker a;
-    a.header = m.header;
-    a.ns = "principal_axes";
-    a.id = i + 1;
-    a.type = visualization_msgs::Marker::ARROW;
-    a.action = visualization_msgs::Marker::ADD;
-    a.pose.orientation.w = 1.0;
-    a.points.push_back(point(Vector3::Zero()));
-    a.points.push_back(point(axis_length * box.axes.col(i)));
-    a.scale.x = 0.04 * axis_length;  // shaft diameter [m]
-    a.scale.y = 0.08 * axis_length;  // head diameter [m]
-    a.scale.z = 0.15 * axis_length;  // head length [m]
-    a.color = colors[i];
-    array.markers.push_back(a);
+    array.markers.push_back(arrowMarker(body_frame, stamp, "principal_axes", i + 1,
+                                        axis_length * box.axes.col(i),
+                                        Vector3(0.04, 0.08, 0.15) * axis_length, colors[i]));
   }
   // The body x axis up to the traced tip, linking the body to `attitude_path` (same colour).
-  visualization_msgs::Marker x_axis;
-  x_axis.header = m.header;
-  x_axis.ns = "body_x_axis";
-  x_axis.id = 4;
-  x_axis.type = visualization_msgs::Marker::ARROW;
-  x_axis.action = visualization_msgs::Marker::ADD;
-  x_axis.pose.orientation.w = 1.0;
-  x_axis.points.push_back(point(Vector3::Zero()));
-  x_axis.points.push_back(point(Vector3(path_radius, 0.0, 0.0)));
-  x_axis.scale.x = 0.015 * path_radius;  // shaft diameter [m]
-  x_axis.scale.y = 0.04 * path_radius;   // head diameter [m]
-  x_axis.scale.z = 0.06 * path_radius;   // head length [m]
-  x_axis.color = color(1.0f, 0.6f, 0.0f, 1.0f);
-  array.markers.push_back(x_axis);
+  array.markers.push_back(
+      arrowMarker(body_frame, stamp, "body_x_axis", 4, Vector3(path_radius, 0.0, 0.0),
+                  Vector3(0.015, 0.04, 0.06) * path_radius, color(1.0f, 0.6f, 0.0f, 1.0f)));
   return array;
 }
 
@@ -126,14 +128,8 @@ visualization_msgs::MarkerArray constraintMarkers(
         out ? color(0.95f, 0.2f, 0.1f, 0.35f) : color(0.1f, 0.85f, 0.3f, 0.35f);
     // The cone: a fan of triangles from the apex (the body origin) to the circle of points at
     // slant distance `length` whose direction makes the half angle with s (any a in (0, π)).
-    visualization_msgs::Marker cone;
-    cone.header.frame_id = world_frame;
-    cone.header.stamp = stamp;
-    cone.ns = out ? "keep_out" : "keep_in";
-    cone.id = id;
-    cone.type = visualization_msgs::Marker::TRIANGLE_LIST;
-    cone.action = visualization_msgs::Marker::ADD;
-    cone.pose.orientation.w = 1.0;
+    visualization_msgs::Marker cone = newMarker(world_frame, stamp, out ? "keep_out" : "keep_in",
+                                                id, visualization_msgs::Marker::TRIANGLE_LIST);
     cone.scale.x = cone.scale.y = cone.scale.z = 1.0;
     cone.color = tint;
     const Vector3& s = c.world_direction;
@@ -151,22 +147,12 @@ visualization_msgs::MarkerArray constraintMarkers(
     }
     array.markers.push_back(cone);
     // The constrained body axis b, in the body frame, as long as the cone's slant.
-    visualization_msgs::Marker axis;
-    axis.header.frame_id = body_frame;
-    axis.header.stamp = stamp;
-    axis.ns = out ? "keep_out_body_axis" : "keep_in_body_axis";
-    axis.id = id;
-    axis.type = visualization_msgs::Marker::ARROW;
-    axis.action = visualization_msgs::Marker::ADD;
-    axis.pose.orientation.w = 1.0;
-    axis.points.push_back(point(Vector3::Zero()));
-    axis.points.push_back(point(length * c.body_axis));
-    axis.scale.x = 0.03 * length;  // shaft diameter [m] (twice the body x arrow: drawn around it)
-    axis.scale.y = 0.05 * length;  // head diameter [m]
-    axis.scale.z = 0.08 * length;  // head length [m]
-    axis.color = tint;
-    axis.color.a = 1.0f;
-    array.markers.push_back(axis);
+    // (shaft twice the body x arrow's: drawn around it)
+    std_msgs::ColorRGBA opaque = tint;
+    opaque.a = 1.0f;
+    array.markers.push_back(
+        arrowMarker(body_frame, stamp, out ? "keep_out_body_axis" : "keep_in_body_axis", id,
+                    length * c.body_axis, Vector3(0.03, 0.05, 0.08) * length, opaque));
     ++id;
   }
   return array;

@@ -8,13 +8,13 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
 #include "support/random_problems.hpp"
+#include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-const Matrix3 kSeedInertia =
-    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+const Matrix3 kSeedInertia = robustness::seedInertia();
 
 PlanningProblem restToRest(SchemeKind scheme, int N) {
   PlanningProblem p;

@@ -8,13 +8,13 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-const Matrix3 kSeedInertia =
-    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+const Matrix3 kSeedInertia = robustness::seedInertia();
 
 /// π about x, rest to rest, with the seed's J (the T = 1e-9 s service request).
 PlanningProblem piAboutX(double T, int N) {

@@ -5,13 +5,13 @@
 
 #include "attitude_planner/analysis/seed_conditions.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-const Matrix3 kSeedInertia =
-    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+const Matrix3 kSeedInertia = robustness::seedInertia();
 
 PlanResult solveSlewUp(int N) {
   PlanningProblem p;

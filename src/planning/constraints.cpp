@@ -189,8 +189,7 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   };
   // The torques τ_k and rates Ω_k of the plan: k = 1..N−1 and steps 0..N−1 for paper and
   // variational (τ_0 = τ_N = 0; Ω_N repeats Ω_{N−1}); every node k = 0..N with end torques.
-  const bool end_torques =
-      DiscreteScheme(problem.scheme, problem.inertia, problem.duration / N).hasEndTorques();
+  const bool end_torques = schemeHasEndTorques(problem.scheme);
   const int first_torque = end_torques ? 0 : 1, last_torque = end_torques ? N : N - 1;
   const int last_rate = end_torques ? N : N - 1;
   if (problem.hasTorqueBounds()) {

@@ -146,7 +146,8 @@ class InteriorPoint {
       : problem_(problem),
         np_(*np),
         node_rates_(np->scheme().hasEndTorques()),
-        inverse_inertia_squared_(problem.inertia.inverse() * problem.inertia.inverse()) {
+        inverse_inertia_(problem.inertia.inverse()),
+        inverse_inertia_squared_(inverse_inertia_ * inverse_inertia_) {
     // The torques are k = first..last (1..N−1; 0..N with end torques), the free attitudes
     // first + 1..last − 1. Rates: per step (the step's own velocity) for paper and variational,
     // whose first and last steps are boundary data; per node (J⁻¹Π_k, k = 1..N−1) for schemes
@@ -494,12 +495,13 @@ class InteriorPoint {
     const Vector3 Pi =
         0.5 * (scheme.momentumOfStep(steps[k]) +
                so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
-    return problem_.inertia.inverse() * Pi;
+    return inverse_inertia_ * Pi;
   }
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
   bool node_rates_;
+  Matrix3 inverse_inertia_;          ///< J⁻¹
   Matrix3 inverse_inertia_squared_;  ///< J⁻²
   std::vector<Group> groups_;
   int constraint_count_ = 0;

@@ -154,8 +154,7 @@ void requireBoundarySteps(const PlanningProblem& problem) {
 /// The NLopt cross-check (a direct method on τ_1..τ_{N−1}) knows only the schemes without end
 /// torques.
 void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions& options) {
-  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
-  if (scheme.hasEndTorques() && options.solver == SolverKind::Nlopt) {
+  if (schemeHasEndTorques(problem.scheme) && options.solver == SolverKind::Nlopt) {
     throw InvalidInput("scheme: '" + schemeName(problem.scheme) +
                        "' is not available with solver nlopt (use 'paper' or 'variational')");
   }

@@ -53,6 +53,12 @@ inline SchemeKind parseScheme(const std::string& text, const std::string& field)
   return parseIn(kSchemeNames, text, field);
 }
 
+/// True if the scheme's end-node torques are impulses of the plan (second_order; see
+/// DiscreteScheme::hasEndTorques).
+inline bool schemeHasEndTorques(SchemeKind kind) {
+  return kind == SchemeKind::SecondOrder;
+}
+
 /// Outcome of one implicit step solve μ(F) = p.
 struct StepSolveReport {
   bool converged = false;
@@ -69,7 +75,7 @@ class DiscreteScheme {
   /// True if the torques at the end nodes are impulses of the scheme (second_order: Π_0 = J Ω(0)
   /// = μ(F_0) − (h/2) τ_0, Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N); false if τ_0 = τ_N = 0
   /// and the boundary velocities fix the first and last steps (paper, variational).
-  bool hasEndTorques() const { return kind_ == SchemeKind::SecondOrder; }
+  bool hasEndTorques() const { return schemeHasEndTorques(kind_); }
   /// Quadrature weight of ½|τ_k|² in the cost, k = 0..N: ½ at the ends with end torques
   /// (trapezoidal rule), else 1.
   double torqueWeight(int k, int steps) const {

@@ -119,6 +119,10 @@ w("Machine: 2 cores shared with other builds. Load average (1/5/15 min) at the s
   "tolerance 1e-10) in one process." % (data["load_average_start"], data["load_average_end"],
                                        data["wall_time_s"], data["repeats"]))
 w("")
+w("Against a peer a user would pick instead (IPOPT on Hermite–Simpson collocation of the same "
+  "continuous problem), the accuracy-versus-solve-time frontier: [frontier.md](frontier.md) "
+  "(`scripts/frontier`).")
+w("")
 w("## The answer")
 w("")
 # The paper scheme's miss is order 1: the N it would need for 1e-6, from its finest point.

@@ -208,10 +208,15 @@ w("The continuous reference is the Pontryagin optimum of `analysis/continuous_re
   "(accurate to ~1e-13; docs/accuracy.md). With τ(t) its torque and τ_max = max_t |τ(t)| "
   "(4001 samples):")
 w("")
+peer_runs = [r for c in cases for m in c["methods"] if m["method"] == PEER for r in good_runs(m)]
+mid_ratio = [r["torque_error_midpoints"] / r["torque_error"] for r in peer_runs
+             if r["torque_error"] > 0]
+peer_iterations = [r["iterations"] for r in peer_runs]
 w("- **relative torque error** = max_k |τ_k − τ(t_k)| / τ_max over the mesh nodes t_k = kT/N at "
   "which the method has a torque: `paper`, `variational` k = 1..N−1 (their τ_0, τ_N are not "
   "unknowns), `second_order` and IPOPT-HS k = 0..N. IPOPT-HS's midpoint torques are not in it; "
-  "their error is in the raw data (`torque_error_midpoints`, half the node error on both examples).")
+  "their error is in the raw data (`torque_error_midpoints`: %.2f–%.2f times the node error)."
+  % (min(mid_ratio), max(mid_ratio)))
 w("- **relative effort error** = |E − E*| / E*, E the method's own quadrature of ½∫|τ|²dt "
   "(ours: `PlanResult::effort`; IPOPT-HS: its Simpson objective), E* the reference's.")
 w("- **solve time**: ours `PlanResult::solve_time_s` (the whole `planManeuver` solve: grid "
@@ -250,13 +255,13 @@ w("Exact derivatives, hand-derived (f is polynomial of degree 2): sparse Jacobia
   "the kinematics, the Ω–Ω block of the gyroscopic term, the τ diagonal); "
   "`test_hermite_simpson` checks both against central differences and checks that the "
   "continuous optimum satisfies the rows at orders 4 and 5. IPOPT options: exact Hessian, "
-  "MUMPS (default ordering; AMD, PORD and METIS were tried: no consistent gain), tol = "
+  "MUMPS with its default ordering, tol = "
   "constr_viol_tol = %g, max_iter 3000. The problem has equalities only, so IPOPT is a Newton "
-  "method on the KKT system here: 6–16 iterations at every N. Loosening tol to 1e-8 or 1e-6 "
-  "changes the time by < 10 %% (measured at N = 8 … 256 on slew_up), so the tolerance does not "
-  "decide the comparison. The start is the geodesic our solver also starts from: "
+  "method on the KKT system here: %d–%d iterations at every N. Tuning checks (one-off, "
+  "docs/frontier_notes.md): tol 1e-8 or 1e-6 instead and other MUMPS orderings change the time by "
+  "at most ~2×, which moves no level across the 10× line. The start is the geodesic our solver also starts from: "
   "q(t) = q_0 ⊗ e(tφ/T), φ = log(R_0ᵀR_T), Ω = φ/T between the ends, τ = −(JΩ)×Ω."
-  % data["ipopt_tol"])
+  % (data["ipopt_tol"], min(peer_iterations), max(peer_iterations)))
 w("")
 for scene, key, title, table in tables:
     w("## %s: %s" % (scene, title))

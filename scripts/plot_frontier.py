@@ -166,7 +166,8 @@ w("")
 w("Regenerate: `%s` (this file, `docs/frontier.png` and the raw data `docs/frontier_raw.json`; "
   "study `studies/frontier_study.cpp`, peer `test/support/hermite_simpson.hpp`, report and plot "
   "`scripts/plot_frontier.py`). Tests: `test/unit/test_hermite_simpson.cpp` (the peer's exact "
-  "Jacobian and Hessian against finite differences, its rows on the continuous optimum)."
+  "Jacobian and Hessian against finite differences, its rows on the continuous optimum, and a "
+  "smoke run of `frontier_study` at tiny sizes)."
   % command)
 w("")
 w("Machine: 2 cores shared with two other engineers' builds and tests. Load average (1/5/15 min) "

@@ -2,14 +2,23 @@
 // exact derivatives against central differences (the objective's gradient, the constraint
 // Jacobian, the Hessian of the Lagrangian against differences of the exact gradient of the
 // Lagrangian), its sparsity patterns, and its constraints on the continuous optimum (they must
-// vanish at the collocation method's order as h → 0). Runs in well under a second.
+// vanish at the collocation method's order as h → 0), and a smoke run of frontier_study at tiny
+// sizes (every scheme of the name table, and the IPOPT peer when CMake found IPOPT). Runs in about
+// a second.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Dense>
+#include <cstdio>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "attitude_planner/analysis/continuous_reference.hpp"
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "support/hermite_simpson.hpp"
 
@@ -197,6 +206,53 @@ TEST(HermiteSimpson, ContinuousOptimumSatisfiesTheRowsAtTheMethodsOrder) {
     previous_interpolation = interpolation;
     previous_collocation = collocation;
   }
+}
+
+/// frontier_study at tiny sizes: every scheme of kSchemeNames and (with IPOPT) ipopt_hs appear,
+/// converge, and their torque error falls with N.
+TEST(FrontierStudy, SmallRunMeasuresEverySchemeAndThePeer) {
+  const std::string tool = AP_BINARY_DIR "/../../devel/lib/attitude_planner/frontier_study";
+  ASSERT_EQ(access(tool.c_str(), X_OK), 0) << "frontier_study not built at " << tool;
+  const std::string out = AP_BINARY_DIR "/frontier_smoke.json";
+  const std::string command = "cd '" AP_BINARY_DIR "' && '" + tool + "' '" + out +
+                              "' '" AP_SOURCE_DIR
+                              "/scenes/slew_up.yaml' --repeats 1 "
+                              "--max-steps 16 --max-hs-steps 8 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string log;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) log.append(buffer, n);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << log;
+  std::ifstream in(out);
+  std::stringstream json;
+  json << in.rdbuf();
+  const std::string text = json.str();
+  std::vector<std::string> methods;
+  for (const auto& entry : kSchemeNames) methods.push_back(entry.name);
+#ifdef AP_FRONTIER_HAS_IPOPT
+  methods.push_back("ipopt_hs");
+#endif
+  for (const std::string& m : methods) {
+    EXPECT_NE(text.find("\"method\": \"" + m + "\""), std::string::npos) << m << " missing:\n"
+                                                                         << text;
+  }
+  EXPECT_EQ(text.find("\"converged\": false"), std::string::npos) << text;
+#ifdef AP_FRONTIER_HAS_IPOPT
+  // The peer at N = 4, 6, 8 (stderr lines "ipopt_hs N=… torque E …"): its torque error falls.
+  std::vector<double> errors;
+  for (std::size_t at = log.find("ipopt_hs N="); at != std::string::npos;
+       at = log.find("ipopt_hs N=", at + 1)) {
+    const std::size_t t = log.find("torque ", at);
+    ASSERT_NE(t, std::string::npos) << log;
+    errors.push_back(std::stod(log.substr(t + 7)));
+  }
+  ASSERT_EQ(errors.size(), 3u) << log;
+  EXPECT_LT(errors[1], errors[0]) << log;
+  EXPECT_LT(errors[2], errors[1]) << log;
+#endif
 }
 
 }  // namespace

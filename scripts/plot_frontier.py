@@ -259,8 +259,9 @@ w("Exact derivatives, hand-derived (f is polynomial of degree 2): sparse Jacobia
   "MUMPS with its default ordering, tol = "
   "constr_viol_tol = %g, max_iter 3000. The problem has equalities only, so IPOPT is a Newton "
   "method on the KKT system here: %d–%d iterations at every N. Tuning checks (one-off, "
-  "docs/frontier_notes.md): tol 1e-8 or 1e-6 instead and other MUMPS orderings change the time by "
-  "at most ~2×, which moves no level across the 10× line. The start is the geodesic our solver also starts from: "
+  "docs/frontier_notes.md): tol 1e-8 or 1e-6 instead changed the time by ≤ 25 %%, and no other "
+  "MUMPS ordering was consistently faster (AMD at most ~2× at N = 1024); neither would move a "
+  "torque-error level across the 10× line. The start is the geodesic our solver also starts from: "
   "q(t) = q_0 ⊗ e(tφ/T), φ = log(R_0ᵀR_T), Ω = φ/T between the ends, τ = −(JΩ)×Ω."
   % (data["ipopt_tol"], min(peer_iterations), max(peer_iterations)))
 w("")

@@ -1,9 +1,13 @@
 #include "attitude_planner/planning/minimum_time.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "attitude_planner/errors.hpp"
 
@@ -13,6 +17,16 @@ namespace {
 
 /// Each step of the downward continuation in T shortens it by 5 %.
 constexpr double kContinuationFactor = 0.95;
+/// The largest angles of the excursion starts off the eigenaxis [rad], and their first T
+/// relative to the eigenaxis slew's least T.
+constexpr double kExcursionAngles[] = {0.3, 0.8};
+constexpr double kExcursionStartFactors[] = {1.04, 0.96};
+/// The structured starts' first T, relative to the eigenaxis slew's least T.
+constexpr double kEigenaxisStartFactor = 1.02;
+/// Grids above this N search from the T* plan of the grid with half the steps.
+constexpr int kCoarsestSearchGrid = 64;
+/// That search's first T, relative to the coarse grid's T*.
+constexpr double kCoarseStartFactor = 1.01;
 
 /// The smallest torque every bound in force allows about any axis [N m].
 double smallestAuthority(const PlanningProblem& problem) {
@@ -51,6 +65,72 @@ double eigenaxisDurationGuess(const PlanningProblem& problem) {
   return 2.0 * std::sqrt(angle / acceleration) + spin;
 }
 
+namespace {
+
+/// A rest-to-rest slew R(t) = R_0 exp(θ(s) ê) exp(b(s) p̂), s = t/T: the eigenaxis bang–bang
+/// θ(s) = 2Θs² (s ≤ ½), Θ(1 − 2(1 − s)²) (s > ½) about ê = log(R_0ᵀR_T)/Θ, and an excursion
+/// b(s) = ε sin²(πs) about a unit p̂ ⟂ ê (ε = 0: the eigenaxis slew itself), which leaves both
+/// ends and their rest untouched. The attitudes at the N + 1 nodes: a start for the search.
+Maneuver excursionSlew(const PlanningProblem& problem, const Vector3& excursion_axis,
+                       double excursion) {
+  const Vector3 rotation = so3::log(problem.initial_attitude.transpose() * problem.final_attitude);
+  const double angle = rotation.norm();
+  const Vector3 axis = angle > 0 ? Vector3(rotation / angle) : Vector3::UnitX();
+  Maneuver m;
+  const int N = problem.steps;
+  m.time_step = problem.duration / N;
+  for (int k = 0; k <= N; ++k) {
+    const double s = static_cast<double>(k) / N;
+    const double theta = s <= 0.5 ? 2.0 * angle * s * s : angle * (1.0 - 2.0 * (1 - s) * (1 - s));
+    const double bump = excursion * std::pow(std::sin(M_PI * s), 2);
+    m.time.push_back(s * problem.duration);
+    m.attitude.push_back(problem.initial_attitude * so3::exp(theta * axis) *
+                         so3::exp(bump * excursion_axis));
+    m.angular_velocity.push_back(Vector3::Zero());
+    m.torque.push_back(Vector3::Zero());
+  }
+  return m;
+}
+
+/// The least T at which the eigenaxis bang–bang slew keeps the torque bounds (per axis and norm)
+/// and rate limits in force: its torques τ = J ê θ̈ + θ̇² ê × J ê scale like 1/T² and its peak
+/// rate 2Θ/T like 1/T, so T follows in closed form from the profile at T = 1.
+double eigenaxisBangBangDuration(const PlanningProblem& problem) {
+  const Vector3 rotation = so3::log(problem.initial_attitude.transpose() * problem.final_attitude);
+  const double angle = std::max(rotation.norm(), 1e-9);
+  const Vector3 e = rotation / angle;
+  const Matrix3& J = problem.inertia;
+  // At T = 1: θ̈ = ±4Θ, θ̇ ≤ 2Θ (peak at s = ½, where the gyroscopic term is largest).
+  const Vector3 gyroscopic = e.cross(J * e) * (4.0 * angle * angle);  // θ̇² ê × Jê at s = ½
+  const Vector3 inertial = J * e * (4.0 * angle);
+  double T_squared = 0.0;
+  for (const double sign : {1.0, -1.0}) {  // accelerating and braking at the peak rate
+    const Vector3 tau = sign * inertial + gyroscopic;
+    if (problem.hasTorqueBounds()) {
+      T_squared =
+          std::max(T_squared, (tau.cwiseAbs().array() / problem.max_torque.array()).maxCoeff());
+    }
+    for (const PlanningConstraint& c : problem.constraints)
+      if (c.kind == ConstraintKind::MaxTorqueNorm)
+        T_squared = std::max(T_squared, tau.norm() / c.limit);
+  }
+  double T = std::sqrt(T_squared);
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.kind == ConstraintKind::MaxAngularRate) T = std::max(T, 2.0 * angle / c.limit);
+  return T;
+}
+
+/// One search on T from one start.
+struct SearchOutcome {
+  std::string start;  ///< which start
+  PlanResult best;    ///< the plan at the least feasible T (not converged: none found)
+  double T_lo = 0.0;  ///< the bracket [T_lo infeasible, T_hi feasible]
+  double T_hi = 0.0;
+  int solves = 0;
+};
+
+}  // namespace
+
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateMinimumTime(problem);
@@ -59,71 +139,163 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
-  int solves = 0;
-  PlanResult best;  // the plan at the least feasible T so far
-  double T_hi = 0.0, T_lo = 0.0;
   bool timed_out = false;
-  // One minimum-effort solve at T, warm-started from the last feasible plan (same N).
-  const auto feasible = [&](double T) {
-    effort.duration = T;
-    SolverOptions o = remaining();
-    if (best.converged()) {
-      o.warm_start = &best.maneuver;
-      o.constrained_from_warm_start = true;
+  int solves = 0;
+
+  // One search from one start: `from` (attitudes, any T) starts the first solve at T_first;
+  // null: the minimum-effort problem's own start (its unconstrained optimum).
+  const auto search = [&](const std::string& name, const Maneuver* from, double T_first) {
+    SearchOutcome out;
+    out.start = name;
+    // One minimum-effort solve at T, warm-started from the last feasible plan (same N).
+    const auto feasible = [&](double T) {
+      effort.duration = T;
+      SolverOptions o = remaining();
+      const Maneuver* warm = out.best.converged() ? &out.best.maneuver : from;
+      if (warm) {
+        o.warm_start = warm;
+        o.constrained_from_warm_start = true;
+      }
+      PlanResult r = planAtResolution(effort, o);
+      ++out.solves;
+      if (r.termination == Termination::TimedOut) timed_out = true;
+      if (!r.converged()) return false;
+      out.best = std::move(r);
+      return true;
+    };
+    // Bracket: double until feasible (at most 2^12).
+    double T = T_first;
+    for (int doublings = 0; !feasible(T) && !timed_out; T *= 2.0) {
+      if (++doublings > 12) return out;
     }
-    PlanResult r = planAtResolution(effort, o);
-    ++solves;
-    if (r.termination == Termination::TimedOut) timed_out = true;
-    if (!r.converged()) return false;
-    best = std::move(r);
-    return true;
+    if (!out.best.converged()) return out;
+    // Down from the first feasible T in small steps, each warm-started from the last feasible
+    // plan: a large step leaves the interior point far outside the bounds (torques grow like
+    // 1/T²), where it can stop at a local minimum of the violation.
+    out.T_hi = T;
+    out.T_lo = T * kContinuationFactor;
+    while (!timed_out && feasible(out.T_lo)) {
+      out.T_hi = out.T_lo;
+      out.T_lo *= kContinuationFactor;
+    }
+    return out;
   };
+  // Bisection of a search's bracket [T_lo infeasible, T_hi feasible], from its plans.
+  const auto bisect = [&](SearchOutcome* out) {
+    while (!timed_out && out->T_hi - out->T_lo > kMinimumTimeTolerance * out->T_hi) {
+      const double mid = 0.5 * (out->T_lo + out->T_hi);
+      effort.duration = mid;
+      SolverOptions o = remaining();
+      o.warm_start = &out->best.maneuver;
+      o.constrained_from_warm_start = true;
+      PlanResult r = planAtResolution(effort, o);
+      ++out->solves;
+      if (r.termination == Termination::TimedOut) timed_out = true;
+      if (r.converged()) {
+        out->T_hi = mid;
+        out->best = std::move(r);
+      } else {
+        out->T_lo = mid;
+      }
+    }
+  };
+
+  // Starts (minimum-time problems have several local optima, and the search's "infeasible"
+  // verdicts are local): the minimum-effort continuation from the given duration or the
+  // eigenaxis guess, and, rest to rest, the eigenaxis bang–bang slew at the least T its bounds
+  // allow and excursions off it about the two axes perpendicular to the eigenaxis, both signs
+  // (the eigenaxis slew is a symmetric saddle the solver cannot leave on its own).
+  std::vector<SearchOutcome> outcomes;
   const double guess = problem.duration > 0 ? problem.duration : eigenaxisDurationGuess(problem);
-  // Bracket: double until feasible (at most 2^12), then halve until infeasible.
-  double T = guess;
-  int doublings = 0;
-  while (!feasible(T) && !timed_out) {
-    if (++doublings > 12) {
-      PlanResult none;
-      none.termination = Termination::Infeasible;
-      none.message = "infeasible: no duration up to " + exactNumber(T) +
-                     " s (2^12 times the first guess " + exactNumber(guess) +
-                     " s) admits a plan under the bounds and constraints in force";
-      return none;
+  // Above kCoarsestSearchGrid the starts are searched on a coarser grid (N/2, recursively) and
+  // its T* plan, resampled, starts the search here just above its T* (the discrete T* converges
+  // in N; measured, Betts's case: every start searched at N = 128 stopped above 34 s, while the
+  // N = 64 search reaches 28.6 s). The full set of starts runs here only if that finds nothing.
+  std::string coarse_note;
+  if (problem.steps > kCoarsestSearchGrid && problem.steps % 2 == 0) {
+    PlanningProblem coarse_problem = problem;
+    coarse_problem.steps = problem.steps / 2;
+    coarse_problem.time_margin = 0.0;
+    const PlanResult coarse = planMinimumTime(coarse_problem, remaining());
+    if (coarse.converged()) {
+      Maneuver resampled = coarse.maneuver;
+      resampled.attitude = resampleAttitudes(coarse.maneuver, problem.steps);
+      outcomes.push_back(search("coarse grid (N = " + std::to_string(coarse_problem.steps) + ")",
+                                &resampled, coarse.minimum_duration * kCoarseStartFactor));
+      coarse_note =
+          "; on the coarse grid: " + coarse.message.substr(coarse.message.rfind("minimum time T*"));
     }
-    T *= 2.0;
   }
-  // Down from the first feasible T in small steps, each warm-started from the last feasible plan:
-  // a large step left the interior point far outside the bounds (torques grow like 1/T²) and
-  // its ℓ1 phase could end at a local minimum of the violation, a false "infeasible" (measured on
-  // Betts's asymmetric body: halving from 68.6 s stopped at 36.6 s, stepping by 5 % reaches the
-  // published 28.6 s).
-  T_hi = T;
-  T_lo = T * kContinuationFactor;
-  while (!timed_out && feasible(T_lo)) {
-    T_hi = T_lo;
-    T_lo *= kContinuationFactor;
+  const bool searched_coarse = !outcomes.empty() && outcomes.back().best.converged();
+  if (!searched_coarse) outcomes.push_back(search("continuation", nullptr, guess));
+  const bool rest_to_rest = !searched_coarse && problem.initial_velocity.isZero(0.0) &&
+                            problem.final_velocity.isZero(0.0) &&
+                            so3::angleBetween(problem.initial_attitude, problem.final_attitude) > 0;
+  if (rest_to_rest && !timed_out) {
+    const double T_eigenaxis = eigenaxisBangBangDuration(problem);
+    const Vector3 e =
+        so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
+    const Vector3 p1 = e.unitOrthogonal(), p2 = e.cross(p1);
+    struct Start {
+      std::string name;
+      Vector3 axis;
+      double angle, duration_factor;
+    };
+    std::vector<Start> starts{{"eigenaxis", e, 0.0, kEigenaxisStartFactor}};
+    // Excursions of two sizes about ±p1, ±p2, first solved just above and just below the
+    // eigenaxis T (the nutating time-optimal slews lie below it; measured: which combination
+    // reaches the published T* differs between Betts's and Bilimoria–Wie's cases).
+    for (const double angle : kExcursionAngles) {
+      for (const double factor : kExcursionStartFactors) {
+        for (const auto& [name, axis] : {std::pair<std::string, Vector3>{"+p1", p1},
+                                         {"-p1", -p1},
+                                         {"+p2", p2},
+                                         {"-p2", -p2}}) {
+          std::ostringstream label;
+          label << "excursion " << angle << " rad " << name << " from " << factor << " T_eig";
+          starts.push_back({label.str(), axis, angle, factor});
+        }
+      }
+    }
+    for (const Start& st : starts) {
+      if (timed_out) break;
+      // Just above the eigenaxis slew's least T: at it the slew is on the bounds, and the
+      // interior point needs room inside them (measured: Betts's case, a first solve at T
+      // itself failed and the search restarted from 2T).
+      PlanningProblem shaped = effort;
+      shaped.duration = T_eigenaxis * st.duration_factor;
+      const Maneuver slew = excursionSlew(shaped, st.axis, st.angle);
+      outcomes.push_back(search(st.name, &slew, shaped.duration));
+    }
   }
-  // Bisection on the bracket [T_lo infeasible, T_hi feasible].
-  while (!timed_out && T_hi - T_lo > kMinimumTimeTolerance * T_hi) {
-    const double mid = 0.5 * (T_lo + T_hi);
-    if (feasible(mid)) {
-      T_hi = mid;
+  // Bisection of the bracket of the search with the least feasible T (the others' brackets are
+  // not refined: a 5 % bracket each, and bisecting them all cost 5× the solves, measured on the
+  // seed's torque_limited scene, for T* within 2e-4 of each other).
+  SearchOutcome* found = nullptr;
+  for (SearchOutcome& o : outcomes) {
+    if (o.best.converged() && (!found || o.T_hi < found->T_hi)) found = &o;
+  }
+  if (found) bisect(found);
+  for (const SearchOutcome& o : outcomes) solves += o.solves;
+  if (!found) {
+    PlanResult none;
+    if (timed_out) {
+      none.termination = Termination::TimedOut;
+      none.message = "time budget exceeded before any duration was found feasible";
     } else {
-      T_lo = mid;
+      none.termination = Termination::Infeasible;
+      none.message = "infeasible: no duration up to 2^12 times the first guess " +
+                     exactNumber(guess) +
+                     " s admits a plan under the bounds and constraints in force";
     }
+    return none;
   }
-  if (timed_out && !best.converged()) {
-    best.termination = Termination::TimedOut;
-    best.message = "time budget exceeded before any duration was found feasible";
-    return best;
-  }
-  const double T_star = T_hi;
-  PlanResult result = best;
+  const double T_star = found->T_hi;
+  PlanResult result = found->best;
   if (problem.time_margin > 0.0) {
     effort.duration = (1.0 + problem.time_margin) * T_star;
     SolverOptions o = remaining();
-    o.warm_start = &best.maneuver;
+    o.warm_start = &found->best.maneuver;
     result = planAtResolution(effort, o);
     ++solves;
   }
@@ -131,9 +303,20 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   std::ostringstream note;
   // T* is the least duration the interior point found feasible: an upper bound on the true
   // minimum (a false "infeasible" below it cannot be told from a true one; docs/minimum_time.md).
-  note << "; minimum time T* = " << T_star << " s, the least duration found feasible (bracket ["
-       << T_lo << ", " << T_hi << "] s, " << solves << " minimum-effort solves"
+  note << "; minimum time T* = " << T_star << " s, the least duration found feasible, from the "
+       << found->start << " start (bracket [" << found->T_lo << ", " << found->T_hi
+       << "] s; starts:";
+  for (const SearchOutcome& o : outcomes) {
+    note << " " << o.start << " ";
+    if (o.best.converged()) {
+      note << o.T_hi << " s;";
+    } else {
+      note << "none feasible;";
+    }
+  }
+  note << " " << solves << " minimum-effort solves"
        << (timed_out ? ", stopped by the time budget" : "") << ")";
+  note << coarse_note;
   if (problem.time_margin > 0.0) {
     note << "; planned at (1 + " << problem.time_margin << ") T* = " << result.duration << " s";
   }

@@ -3,7 +3,9 @@
 // the bang–bang structure, the time margin, monotonicity in the bounds, and named errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -92,7 +94,42 @@ TEST(MinimumTime, TStarFallsWithAStrongerBoundAndRisesWithARateLimit) {
   const ap::PlanResult slower = ap::planManeuver(limited);
   ASSERT_TRUE(slower.converged()) << slower.message;
   EXPECT_GT(slower.minimum_duration, base.minimum_duration * 1.01);
-  EXPECT_LE(slower.max_constraint_violation, 1e-9);
+  // At T* the plan sits on the limits: within the planner's node tolerance (relative).
+  EXPECT_LE(slower.max_constraint_violation, ap::kNodeConstraintTolerance * 0.25);
+}
+
+TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
+  // Betts (2010), asymmetric body, |τ_i| ≤ 50 N m, 150° about x: published T* = 28.6304 s. The
+  // eigenaxis slew needs 34.31 s; the search from the minimum-effort continuation alone stopped
+  // at 35–37 s, and only a start off the eigenaxis reaches the multi-axis optimum.
+  const ap::PlanningProblem p = ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_betts.yaml").problem;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  std::printf("Betts, N = %d: T* = %.6f s (published 28.6304), %.2f s\n", p.steps,
+              r.minimum_duration, r.solve_time_s);
+  EXPECT_NEAR(r.minimum_duration, 28.6304, 0.005 * 28.6304) << r.message;
+  EXPECT_NE(r.message.find("excursion"), std::string::npos) << r.message;
+  // Bang–bang: at most nodes some torque component is at its bound.
+  int saturated = 0;
+  for (const ap::Vector3& t : r.maneuver.torque)
+    saturated += t.cwiseAbs().maxCoeff() >= 50 * (1 - 1e-3);
+  EXPECT_GE(saturated, static_cast<int>(r.maneuver.torque.size()) - 4);
+}
+
+TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {
+  // J = I, |u_i| ≤ 1, 180° about z: the eigenaxis slew takes 2√π = 3.5449 s; the time-optimal
+  // one nutates (published 3.2430 s). The search must find a nutating plan below the eigenaxis
+  // time (docs/minimum_time.md: 3.318 s at N = 64, +2.3 % above the published optimum).
+  ap::PlanningProblem p =
+      ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_bilimoria_wie.yaml").problem;
+  p.steps = 32;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LT(r.minimum_duration, 0.97 * 2.0 * std::sqrt(M_PI)) << r.message;
+  double off_axis = 0.0;  // the largest torque about x or y: zero on the eigenaxis slew
+  for (const ap::Vector3& t : r.maneuver.torque)
+    off_axis = std::max(off_axis, t.head<2>().cwiseAbs().maxCoeff());
+  EXPECT_GT(off_axis, 0.5);
 }
 
 TEST(MinimumTime, RequestsWithoutABoundOrWithABadMarginAreNamed) {

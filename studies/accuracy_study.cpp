@@ -138,6 +138,30 @@ int main(int argc, char** argv) {
                      schemeName(scheme).c_str(), N, median(times), m.cost_error, m.trajectory_error,
                      m.miss.attitude_miss);
       }
+      // Coarse grids, every N = 4 … 32: which N (and time) reaches a given loose accuracy, e.g.
+      // the seed's default plan's (README, "Which scheme reaches the seed's default accuracy").
+      std::fprintf(out, " ],\n \"coarse\": [\n");
+      for (int N = 4; N <= 32; ++N) {
+        problem.steps = N;
+        std::vector<double> times;
+        PlanResult plan;
+        for (int r = 0; r < 5 * repeats; ++r) {
+          plan = planManeuver(problem);
+          times.push_back(plan.solve_time_s);
+        }
+        if (!plan.converged() || plan.maneuver.steps() != N) {  // e.g. a step too large
+          std::fprintf(out, "  %s{\"N\": %d, \"converged\": false}\n", N == 4 ? "" : ",", N);
+          continue;
+        }
+        const AccuracyMeasures m = measureAccuracy(problem, plan.maneuver, ref);
+        std::fprintf(out,
+                     "  %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, "
+                     "\"relative_torque_error\": %.6e, \"trajectory_error\": %.6e, "
+                     "\"attitude_miss\": %.6e}\n",
+                     N == 4 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
+                     m.torque_error / maxTorque(plan.maneuver), m.trajectory_error,
+                     m.miss.attitude_miss);
+      }
       std::fprintf(out, " ],\n \"targets\": [\n");
       // Plans to a requested accuracy: the planner's estimate against the actual error.
       struct Request {

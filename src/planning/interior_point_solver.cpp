@@ -565,6 +565,22 @@ class InteriorPoint {
     return worst;
   }
 
+  /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function) at the current
+  /// multipliers; empty without per-axis bounds.
+  std::vector<Vector3> switchingFunction(const std::vector<Vector3>& torque) const {
+    std::vector<Vector3> sigma;
+    for (const Group& g : groups_) {
+      if (g.family != Family::TorqueUpper && g.family != Family::TorqueLower) continue;
+      if (sigma.empty()) sigma = torque;
+      const double sign = g.family == Family::TorqueUpper ? 1.0 : -1.0;
+      for (int k = g.first_k; k <= g.last_k; ++k) {
+        const double weight = np_.scheme().torqueWeight(k, np_.steps());
+        sigma[k](g.axis) += sign * g.at[k - g.first_k].z / (g.limit * weight);
+      }
+    }
+    return sigma;
+  }
+
   /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
   /// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
   void initializeMultipliers(double mu, double rho, double cap) {
@@ -902,6 +918,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   result.newton_decrement = relative_decrement;
   if (final_steps) *final_steps = np.current();
   const Maneuver planned = np.maneuver(np.current());
+  result.switching_function = ip.switchingFunction(planned.torque);
   try {
     evaluatePlan(problem, planned.torque, &result, &planned);
   } catch (const StepTooLarge& e) {

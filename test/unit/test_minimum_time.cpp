@@ -114,6 +114,23 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
   for (const ap::Vector3& t : r.maneuver.torque)
     saturated += t.cwiseAbs().maxCoeff() >= 50 * (1 - 1e-3);
   EXPECT_GE(saturated, static_cast<int>(r.maneuver.torque.size()) - 4);
+  // The switching function σ_k (PMP, from the bounds' multipliers): τ_k = sat(σ_k) at every node
+  // (KKT: a multiplier only where its bound is active, and on its side), and σ is smooth where τ
+  // jumps (its second differences small against its range).
+  ASSERT_EQ(r.switching_function.size(), r.maneuver.torque.size());
+  double largest = 0.0;
+  for (const ap::Vector3& s : r.switching_function)
+    largest = std::max(largest, s.cwiseAbs().maxCoeff());
+  for (std::size_t k = 0; k < r.maneuver.torque.size(); ++k) {
+    const ap::Vector3 saturated_sigma = r.switching_function[k].cwiseMax(-50.0).cwiseMin(50.0);
+    EXPECT_LE((r.maneuver.torque[k] - saturated_sigma).cwiseAbs().maxCoeff(), 1e-5 * 50)
+        << k;  // barrier: z = μ/s
+    if (k > 0 && k + 1 < r.maneuver.torque.size()) {
+      const ap::Vector3 second =
+          r.switching_function[k + 1] - 2.0 * r.switching_function[k] + r.switching_function[k - 1];
+      EXPECT_LE(second.cwiseAbs().maxCoeff(), 0.05 * largest) << k;
+    }
+  }
 }
 
 TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {

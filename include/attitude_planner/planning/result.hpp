@@ -96,6 +96,12 @@ struct PlanResult {
   double max_violation_between_nodes = 0.0;
   /// Node constraints at their bound (within kActiveConstraintTolerance relative) on the result.
   int active_constraints = 0;
+  /// Interior-point plans under per-axis torque bounds: the discrete PMP switching function
+  /// σ_k = τ_k + (z⁺_k − z⁻_k)/(a w_k) per axis [N m], k = 0..N (z± the multipliers of the upper
+  /// and lower bound, a the bound, w_k the cost weight): the minimizer of the Lagrangian in τ_k
+  /// without the bound, so τ_k = sat(σ_k) at a KKT point, and a bang–bang plan switches where σ_k
+  /// changes sign. Empty otherwise.
+  std::vector<Vector3> switching_function;
 };
 
 }  // namespace attitude_planner

@@ -226,6 +226,15 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   }
   m.attitude.front() = problem.initial_attitude;  // the boundary data exactly
   m.attitude.back() = problem.final_attitude;
+  // The switching function (per-axis torque bounds) is a node quantity like τ_k: combined alike.
+  if (coarse.switching_function.size() == static_cast<size_t>(N + 1) &&
+      fine.switching_function.size() == static_cast<size_t>(2 * N + 1)) {
+    result.switching_function.resize(N + 1);
+    for (int k = 0; k <= N; ++k) {
+      const Vector3& s_fine = fine.switching_function[2 * k];
+      result.switching_function[k] = s_fine + (s_fine - coarse.switching_function[k]) / 3.0;
+    }
+  }
 
   result.cost = schemeCost(SchemeKind::FourthOrder, m.torque);
   result.effort = problem.duration / N * result.cost;

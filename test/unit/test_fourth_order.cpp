@@ -354,6 +354,9 @@ TEST(FourthOrder, ConstrainedScenesPlanThroughTheInteriorPoint) {
     EXPECT_EQ(four.scheme, SchemeKind::FourthOrder);
     EXPECT_FALSE(four.constraints.empty()) << c.scene;
     EXPECT_LE(four.max_constraint_violation, 1e-8) << c.scene;
+    if (p.hasTorqueBounds()) {  // the switching function, combined like the torques
+      EXPECT_EQ(four.switching_function.size(), 65u) << c.scene;
+    }
     p.scheme = SchemeKind::SecondOrder;
     const PlanResult second = planManeuver(p);
     ASSERT_TRUE(second.converged()) << c.scene << ": " << second.message;

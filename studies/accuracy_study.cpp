@@ -99,8 +99,8 @@ int main(int argc, char** argv) {
     const ContinuousState mid_fine = fine.stateAt(0.37 * problem.duration);
     std::fprintf(stderr, "%s: reference %s (%.2f s), cost %.15g\n", path.c_str(),
                  ref.message.c_str(), ref_time, ref.cost);
-    for (SchemeKind scheme :
-         {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder,
+                              SchemeKind::FourthOrder}) {
       problem.scheme = scheme;
       std::fprintf(
           out,
@@ -132,10 +132,34 @@ int main(int argc, char** argv) {
                      "\"attitude_miss_step_start\": %.6e, \"velocity_miss_step_start\": %.6e}\n",
                      N == 16 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
                      plan.cost, m.cost_integral, m.cost_error, m.trajectory_error, m.torque_error,
-                     maxTorque(plan.maneuver), m.miss.attitude_miss, m.miss.velocity_miss, m.miss_step_start.attitude_miss,
-                     m.miss_step_start.velocity_miss);
+                     maxTorque(plan.maneuver), m.miss.attitude_miss, m.miss.velocity_miss,
+                     m.miss_step_start.attitude_miss, m.miss_step_start.velocity_miss);
         std::fprintf(stderr, "  %s N=%d %.3g s cost_err %.3e traj %.3e miss %.3e\n",
                      schemeName(scheme).c_str(), N, median(times), m.cost_error, m.trajectory_error,
+                     m.miss.attitude_miss);
+      }
+      // Coarse grids, every N = 4 … 32: which N (and time) reaches a given loose accuracy, e.g.
+      // the seed's default plan's (README, "Which scheme reaches the seed's default accuracy").
+      std::fprintf(out, " ],\n \"coarse\": [\n");
+      for (int N = 4; N <= 32; ++N) {
+        problem.steps = N;
+        std::vector<double> times;
+        PlanResult plan;
+        for (int r = 0; r < 5 * repeats; ++r) {
+          plan = planManeuver(problem);
+          times.push_back(plan.solve_time_s);
+        }
+        if (!plan.converged() || plan.maneuver.steps() != N) {  // e.g. a step too large
+          std::fprintf(out, "  %s{\"N\": %d, \"converged\": false}\n", N == 4 ? "" : ",", N);
+          continue;
+        }
+        const AccuracyMeasures m = measureAccuracy(problem, plan.maneuver, ref);
+        std::fprintf(out,
+                     "  %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, "
+                     "\"relative_torque_error\": %.6e, \"trajectory_error\": %.6e, "
+                     "\"attitude_miss\": %.6e}\n",
+                     N == 4 ? "" : ",", N, plan.converged() ? "true" : "false", median(times),
+                     m.torque_error / maxTorque(plan.maneuver), m.trajectory_error,
                      m.miss.attitude_miss);
       }
       std::fprintf(out, " ],\n \"targets\": [\n");

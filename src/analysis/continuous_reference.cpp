@@ -143,16 +143,24 @@ void propagateRigidBody(const Matrix3& inertia, const Vector3& torque, double du
 void propagateRigidBody(const Matrix3& inertia, const Vector3& torque_start,
                         const Vector3& torque_end, double duration, int macro_steps,
                         Matrix3* attitude, Vector3* angular_velocity) {
-  using State = Eigen::Matrix<double, 8, 1>;  // (q, Ω, t): time makes the linear torque autonomous
-  const Matrix3 J_inverse = inertia.inverse();
   const Vector3 slope =
       duration > 0 ? Vector3((torque_end - torque_start) / duration) : Vector3::Zero().eval();
+  propagateRigidBody(inertia, {torque_start, slope, Vector3::Zero(), Vector3::Zero()}, duration,
+                     macro_steps, attitude, angular_velocity);
+}
+
+void propagateRigidBody(const Matrix3& inertia, const std::array<Vector3, 4>& c, double duration,
+                        int macro_steps, Matrix3* attitude, Vector3* angular_velocity) {
+  using State = Eigen::Matrix<double, 8, 1>;  // (q, Ω, s): time makes the torque autonomous
+  const Matrix3 J_inverse = inertia.inverse();
   const auto f = [&](const State& x) {
     const Vector3 W = x.segment<3>(4);
+    const double s = x(7);
     State dx;
     dx.head<4>() =
         0.5 * so3::quaternionProduct<double>(x.head<4>(), Quaternion4(0, W(0), W(1), W(2)));
-    dx.segment<3>(4) = J_inverse * ((inertia * W).cross(W) + torque_start + x(7) * slope);
+    const Vector3 tau = c[0] + s * (c[1] + s * (c[2] + s * c[3]));
+    dx.segment<3>(4) = J_inverse * ((inertia * W).cross(W) + tau);
     dx(7) = 1.0;
     return dx;
   };

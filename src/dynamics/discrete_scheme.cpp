@@ -8,14 +8,23 @@ namespace attitude_planner {
 
 DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step)
     : kind_(kind), J_(inertia), J_inverse_(inertia.inverse()), h_(time_step) {
+  if (!schemeIsDiscretization(kind)) {
+    throw InvalidInput("scheme '" + schemeName(kind) +
+                       "' has no discrete equations of motion (it extrapolates two second_order "
+                       "plans); use planAtResolution to plan and replayPlan to replay it");
+  }
   Jd_ = 0.5 * J_.trace() * Matrix3::Identity() - J_;
 }
 
-double DiscreteScheme::cost(const std::vector<Vector3>& torque) const {
+double schemeCost(SchemeKind kind, const std::vector<Vector3>& torque) {
   const int N = static_cast<int>(torque.size()) - 1;
   double c = 0.0;
-  for (int k = 0; k <= N; ++k) c += torqueWeight(k, N) * 0.5 * torque[k].squaredNorm();
+  for (int k = 0; k <= N; ++k) c += schemeTorqueWeight(kind, k, N) * 0.5 * torque[k].squaredNorm();
   return c;
+}
+
+double DiscreteScheme::cost(const std::vector<Vector3>& torque) const {
+  return schemeCost(kind_, torque);
 }
 
 Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega) const {

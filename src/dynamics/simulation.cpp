@@ -1,5 +1,8 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
@@ -113,6 +116,90 @@ Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
       (input.effects && !input.effects->empty()) || (input.actuation && !input.actuation->empty());
   return with_effects ? integrate<true>(scheme, input, report)
                       : integrate<false>(scheme, input, report);
+}
+
+std::array<Vector3, 4> cubicHoldCoefficients(const std::vector<Vector3>& torque, int k, double h) {
+  const int N = static_cast<int>(torque.size()) - 1;
+  if (N < 3 || k < 0 || k >= N) {
+    throw InvalidInput("cubic hold: needs N >= 3 and 0 <= k < N, got N = " + std::to_string(N) +
+                       ", k = " + std::to_string(k));
+  }
+  const int first = std::min(std::max(k - 1, 0), N - 3);  // nodes first..first+3
+  // τ(t_k + σh) = Σ_j a_j σ^j through σ_i = first + i − k; then c_j = a_j / h^j.
+  Eigen::Matrix4d V;
+  for (int i = 0; i < 4; ++i) {
+    const double sigma = first + i - k;
+    for (int j = 0; j < 4; ++j) V(i, j) = std::pow(sigma, j);
+  }
+  const Eigen::Matrix4d L = V.inverse();  // a = L · (τ_first..τ_first+3)
+  std::array<Vector3, 4> c;
+  double scale = 1.0;
+  for (int j = 0; j < 4; ++j) {
+    c[j] = Vector3::Zero();
+    for (int i = 0; i < 4; ++i) c[j] += L(j, i) * torque[first + i];
+    c[j] /= scale;
+    scale *= h;
+  }
+  return c;
+}
+
+namespace {
+
+/// fourth_order's replay: the continuous body under the cubic hold, RKMK4 (replayPlan).
+Maneuver integrateCubicHold(const Matrix3& inertia, double h, const SimulationInput& input) {
+  const int N = static_cast<int>(input.torque.size()) - 1;
+  Maneuver m;
+  m.time_step = h;
+  m.time.resize(N + 1);
+  m.attitude.resize(N + 1);
+  m.angular_velocity.resize(N + 1);
+  m.torque = input.torque;
+  for (int k = 0; k <= N; ++k) m.time[k] = k * h;
+  if (input.actuation && !input.actuation->empty()) {
+    for (int k = 0; k <= N; ++k) m.torque[k] = input.actuation->apply(input.torque[k]);
+  }
+  const bool with_effects = input.effects && !input.effects->empty();
+  const Matrix3 J_inverse = inertia.inverse();
+  m.attitude[0] = input.initial_attitude;
+  m.angular_velocity[0] = input.initial_velocity;
+  for (int k = 0; k < N; ++k) {
+    const std::array<Vector3, 4> c = cubicHoldCoefficients(m.torque, k, h);
+    const Matrix3& R = m.attitude[k];
+    const Vector3& W = m.angular_velocity[k];
+    // (u̇, Ω̇) at R_k exp(u^), Ω, time t_k + s.
+    const auto f = [&](const Vector3& u, const Vector3& w, double s, Vector3* du, Vector3* dw) {
+      Vector3 tau = c[0] + s * (c[1] + s * (c[2] + s * c[3]));
+      if (with_effects) tau += input.effects->torque(R * so3::exp(u), m.time[k] + s);
+      *du = so3::rightJacobianInverse(u) * w;
+      *dw = J_inverse * ((inertia * w).cross(w) + tau);
+    };
+    Vector3 u1, w1, u2, w2, u3, w3, u4, w4;
+    f(Vector3::Zero(), W, 0.0, &u1, &w1);
+    f(0.5 * h * u1, W + 0.5 * h * w1, 0.5 * h, &u2, &w2);
+    f(0.5 * h * u2, W + 0.5 * h * w2, 0.5 * h, &u3, &w3);
+    f(h * u3, W + h * w3, h, &u4, &w4);
+    const Vector3 u = h / 6.0 * (u1 + 2.0 * u2 + 2.0 * u3 + u4);
+    m.attitude[k + 1] = reorthonormalize(R * so3::exp(u));
+    m.angular_velocity[k + 1] = W + h / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);
+  }
+  return m;
+}
+
+}  // namespace
+
+Maneuver replayPlan(SchemeKind kind, const Matrix3& inertia, double time_step,
+                    const SimulationInput& input, SimulationReport* report) {
+  if (schemeIsDiscretization(kind)) {
+    return simulate(DiscreteScheme(kind, inertia, time_step), input, report);
+  }
+  const int N = static_cast<int>(input.torque.size()) - 1;
+  if (N < 3) {
+    throw InvalidInput("torque: the cubic hold of scheme " + schemeName(kind) +
+                       " needs at least 4 entries (k = 0..N, N >= 3), got " +
+                       std::to_string(input.torque.size()));
+  }
+  if (report) *report = SimulationReport{};
+  return integrateCubicHold(inertia, time_step, input);
 }
 
 }  // namespace attitude_planner

@@ -27,6 +27,13 @@
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
 // Inertia correction: a multiple of the identity until the Cholesky factorization succeeds.
 //
+// A grid level that ends infeasible or unconverged in this elastic form is solved once more in the
+// free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free variables,
+// the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
+// f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z, and a monotone barrier. Its
+// Hessian carries Newton's own multipliers instead of z → ρ for violated constraints, which is
+// where the elastic form stalls (solveOnGridWithRetry).
+//
 // Barrier update: LOQO's adaptive rule after every iteration (see the loop). At μ_final a full step
 // with decrement below the tolerance ends the solve; then the elastic violations are v ≈ μ/ρ if the
 // constraints can be met. If they cannot at ρ, ρ grows once by kPenaltyGrowth; if they still
@@ -73,8 +80,11 @@ constexpr int kCoarsestConstrainedGrid = 256;
 /// Relative decrement below which a stall at the final barrier counts as converged (at
 /// N ≤ 1024; above, it grows like N: measured floors 9e-7 at N = 2048, 2e-6 at N = 8192).
 constexpr double kStallAcceptance = 1e-6;
-/// Iterations without any reduction of a nonzero violation after which it counts as stalled.
+/// Iterations without any reduction of a nonzero violation after which it counts as stalled (the
+/// free-slack form's iterates may violate the constraints more for a while on their way: it
+/// gets longer).
 constexpr int kViolationStall = 8;
+constexpr int kFreeSlackViolationStall = 40;
 /// Largest relative diagonal shift tried after failed line searches (1e-8, 1e-6, ..., 1e-2).
 constexpr double kMaxShiftFloor = 1e-2;
 /// Largest violation at which the penalty is raised before a request is called infeasible.
@@ -799,7 +809,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       last_violation_progress = iteration;
     }
     const bool violation_stalled =
-        violated && iteration - last_violation_progress >= kViolationStall;
+        violated && iteration - last_violation_progress >=
+                        (free_slacks ? kFreeSlackViolationStall : kViolationStall);
     const bool final_step =
         violation_stalled ||
         (at_final_barrier &&
@@ -955,12 +966,44 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 
 namespace {
 
+/// solveOnGrid in the elastic form, retried once in the free-slack form from the same start when
+/// it ends infeasible or unconverged: the elastic form stalls where most nodes bind and the
+/// violated constraints' curvature (weighted by z → ρ) swamps the Hessian, while the free-slack
+/// form's Hessian carries Newton's own multipliers (measured: rate_limited with the variational
+/// scheme at N = 128, and torque plus rate limits at N = 128 that IPOPT solves, were answered
+/// "infeasible" by the elastic form alone).
+PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
+                                const ReducedProblem::Steps* coarse_steps,
+                                ReducedProblem::Steps* final_steps) {
+  const auto start = std::chrono::steady_clock::now();
+  ReducedProblem::Steps elastic_steps;
+  PlanResult first =
+      solveOnGrid(problem, options, Formulation::Elastic, coarse_steps, &elastic_steps);
+  const bool retry = first.termination == Termination::Infeasible ||
+                     first.termination == Termination::NotConverged;
+  if (retry) {
+    ReducedProblem::Steps free_steps;
+    PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start),
+                                    Formulation::FreeSlacks, coarse_steps, &free_steps);
+    if (second.converged()) {
+      second.iterations += first.iterations;
+      second.message +=
+          "; solved with free slacks after the elastic form stopped: " + first.message;
+      if (final_steps) *final_steps = free_steps;
+      return second;
+    }
+    first.iterations += second.iterations;
+    first.message += "; retried with free slacks: " + second.message;
+  }
+  if (final_steps) *final_steps = elastic_steps;
+  return first;
+}
+
 /// The interior point on the requested grid, with grid continuation above
 /// kCoarsestConstrainedGrid.
-PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options,
-                          Formulation formulation) {
+PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options) {
   if (problem.steps <= kCoarsestConstrainedGrid) {
-    return solveOnGrid(problem, options, formulation, nullptr, nullptr);
+    return solveOnGridWithRetry(problem, options, nullptr, nullptr);
   }
   // Coarse levels start from their own unconstrained optimum; the finest from the coarse level.
   std::vector<int> levels{problem.steps};
@@ -985,7 +1028,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     }
     ReducedProblem::Steps next;
     const PlanResult coarse = result;
-    result = solveOnGrid(at, level_options, formulation, steps.empty() ? nullptr : &steps, &next);
+    result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
     if (stopped && coarse.termination == Termination::Infeasible) {
       // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
@@ -1009,22 +1052,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
 
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  PlanResult result = solveContinued(problem, options, Formulation::Elastic);
-  // The elastic form stalls where most nodes bind and the violated constraints' curvature
-  // (weighted by z → ρ) swamps the Hessian; the free-slack form, whose Hessian carries Newton's
-  // own multipliers, often converges there (measured: Betts's minimum-time search reached
-  // 35.24 s instead of 36.50 s). Retry in it once from the same start.
-  if (result.termination == Termination::Infeasible ||
-      result.termination == Termination::NotConverged) {
-    PlanResult free =
-        solveContinued(problem, withRemainingBudget(options, start), Formulation::FreeSlacks);
-    const int iterations = result.iterations + free.iterations;
-    if (free.converged()) {
-      free.message += "; solved with free slacks after the elastic form stopped: " + result.message;
-      result = free;
-    }
-    result.iterations = iterations;
-  }
+  PlanResult result = solveContinued(problem, options);
   // Pointing cones together with torque or rate limits, from a start inside a cone: the
   // iterate can leave the cone with torques far beyond their bounds and never recover (measured:
   // a Sun keep-out + |τ| ≤ 0.07 N m slew that IPOPT solves was called infeasible after 13
@@ -1044,12 +1072,12 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   cones_only.constraints.clear();
   for (const PlanningConstraint& c : problem.constraints)
     if (c.isCone()) cones_only.constraints.push_back(c);
-  const PlanResult around = solveContinued(cones_only, staged, Formulation::Elastic);
+  const PlanResult around = solveContinued(cones_only, staged);
   int iterations = result.iterations + around.iterations;
   if (!around.converged()) return result;
   staged.warm_start = &around.maneuver;
   staged.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-  PlanResult second = solveContinued(problem, staged, Formulation::Elastic);
+  PlanResult second = solveContinued(problem, staged);
   iterations += second.iterations;
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its

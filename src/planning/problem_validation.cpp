@@ -108,6 +108,11 @@ void validateProblem(const PlanningProblem& p) {
     throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps) + ", got " +
                        std::to_string(p.steps));
   }
+  if (!p.accuracy.active() && p.scheme == SchemeKind::FourthOrder && p.steps > kMaxSteps / 2) {
+    throw InvalidInput("steps: must be <= " + std::to_string(kMaxSteps / 2) +
+                       " with scheme fourth_order (it solves second_order at 2N), got " +
+                       std::to_string(p.steps));
+  }
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(p.max_torque(i)) || !(p.max_torque(i) > 0.0)) {
       throw InvalidInput("actuator_limits.max_torque: each bound must be > 0 N m, got " +

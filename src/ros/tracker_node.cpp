@@ -483,7 +483,6 @@ void TrackerNode::runReplay(Replay replay) {
     if (!replay.msg.scheme.empty())
       problem.scheme = parseScheme(replay.msg.scheme, "maneuver.scheme");
     validateProblem(problem);
-    const DiscreteScheme scheme(problem.scheme, inertia, plan.time_step);
     // Exactly the effects of the replay's scene: forcing on the body, then what the actuators do.
     const std::shared_ptr<const EffectModel> effects = plannableEffects(replay.effects, inertia);
     Actuation actuation = actuationOf(replay.effects);
@@ -493,11 +492,11 @@ void TrackerNode::runReplay(Replay replay) {
     input.torque = plan.torque;
     input.effects = effects.get();
     input.actuation = &actuation;
-    replayed = simulate(scheme, input);
+    replayed = replayPlan(problem.scheme, inertia, plan.time_step, input);
     for (const EffectSpec& e : replay.effects) result.replay_effects.push_back(effectName(e));
     result.steps = N;
     result.duration = problem.duration;
-    result.cost = scheme.cost(replayed.torque);
+    result.cost = schemeCost(problem.scheme, replayed.torque);
     result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], replayed.attitude[N]);
     result.terminal_velocity_error =
         (replayed.angular_velocity[N] - plan.angular_velocity[N]).norm();

@@ -33,7 +33,7 @@ const char* const kUsage =
     "\n"
     "options (override the scene):\n"
     "  --steps N                 number of time steps (h = T/N)\n"
-    "  --scheme paper|variational|second_order|auto\n"
+    "  --scheme paper|variational|second_order|fourth_order|auto\n"
     "                            discretization (rigid_body only; auto: the planner chooses,\n"
     "                            with a --target-* flag only)\n"
     "  --target-miss RAD         instead of --steps: choose N so that the terminal attitude miss\n"

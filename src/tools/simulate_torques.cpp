@@ -24,13 +24,14 @@ const char* const kUsage =
     "usage: simulate_torques SCENE.yaml MANEUVER.csv [options]\n"
     "\n"
     "Replays the torques tau_k of MANEUVER.csv (as written by plan_maneuver --csv) through the\n"
-    "discrete rigid body of SCENE.yaml (inertia, scheme, initial state; N and h from the CSV)\n"
+    "discrete rigid body of SCENE.yaml (inertia, scheme, initial state; N and h from the CSV;\n"
+    "fourth_order: the continuous body under a cubic hold of the torques, RKMK4)\n"
     "under exactly the scene's effects: gravity gradient and disturbances act on the body,\n"
     "actuator_limits saturate and torque_noise perturbs the applied torques. Replaying a plan\n"
     "under a scene with more effects than it was planned for shows their terminal miss.\n"
     "\n"
     "options:\n"
-    "  --scheme paper|variational|second_order  override the scene's discretization\n"
+    "  --scheme paper|variational|second_order|fourth_order  override the scene's scheme\n"
     "  --csv OUT.csv             write the replayed trajectory\n"
     "  --max-miss TOL            exit 1 unless both terminal errors are <= TOL\n"
     "  --help                    show this help\n";
@@ -103,7 +104,6 @@ int main(int argc, char** argv) {
       std::cerr << "simulate_torques: note: CSV duration " << N * h
                 << " s differs from the scene's " << p.duration << " s; using the CSV's\n";
     }
-    const ap::DiscreteScheme dynamics(kind, p.inertia, h);
     ap::SimulationInput input;
     input.initial_attitude = p.initial_attitude;
     input.initial_velocity = p.initial_velocity;
@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
     input.effects = effects.get();
     input.actuation = &actuation;
     ap::SimulationReport report;
-    const ap::Maneuver replay = ap::simulate(dynamics, input, &report);
+    const ap::Maneuver replay = ap::replayPlan(kind, p.inertia, h, input, &report);
 
     std::string effect_names;
     for (const ap::EffectSpec& e : scene.effects) {

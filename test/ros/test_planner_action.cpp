@@ -217,6 +217,24 @@ TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
   EXPECT_NEAR(result->duration, 1.2 * result->minimum_duration, 1e-9 * result->duration);
 }
 
+// The action's scheme field reaches fourth_order (Richardson extrapolation of second_order at N
+// and 2N): node values with end torques, the scheme named in the result and its maneuver.
+TEST_F(PlannerAction, FourthOrderGoalSucceeds) {
+  PlanAttitudeManeuverGoal goal = seed(32);
+  goal.scheme = "fourth_order";
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED);
+  const auto result = client_->getResult();
+  ASSERT_TRUE(result->success) << result->message;
+  EXPECT_EQ(result->scheme, "fourth_order");
+  EXPECT_EQ(result->maneuver.scheme, "fourth_order");
+  EXPECT_EQ(result->maneuver.torque.size(), 33u);
+  EXPECT_NE(result->message.find("Richardson extrapolation of second_order"), std::string::npos)
+      << result->message;
+  EXPECT_NEAR(result->effort, goal.duration / 32 * result->cost, 1e-12 * result->effort);
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_planner_action");

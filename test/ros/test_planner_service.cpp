@@ -285,6 +285,27 @@ TEST_F(PlannerService, SchemeAndSolverFieldsAreHonoured) {
   EXPECT_FALSE(refused.success);
   EXPECT_EQ(refused.error_code.val, PlanErrorCode::INVALID_INPUT);
   EXPECT_NE(refused.message.find("scheme: 'second_order'"), std::string::npos) << refused.message;
+
+  // fourth_order: Richardson extrapolation of second_order at N and 2N; node values with end
+  // torques, effort = h·cost (Gregory weights), replayed with the cubic hold to O(h⁴).
+  req = seed();
+  req.scheme = "fourth_order";
+  const PlanAttitudeManeuver::Response fourth = call(req);
+  ASSERT_TRUE(fourth.success) << fourth.message;
+  EXPECT_EQ(fourth.scheme, "fourth_order");
+  EXPECT_EQ(fourth.maneuver.scheme, "fourth_order");
+  EXPECT_NE(fourth.message.find("Richardson extrapolation of second_order"), std::string::npos)
+      << fourth.message;
+  EXPECT_EQ(fourth.maneuver.torque.size(), second.maneuver.torque.size());
+  EXPECT_NEAR(fourth.effort, req.duration / fourth.steps * fourth.cost, 1e-12 * fourth.effort);
+  EXPECT_LT(fourth.terminal_attitude_error, 1e-3);
+  // closer to the continuous optimum's effort than second_order's at the same N
+  EXPECT_LT(std::abs(fourth.effort - second.effort), 0.1 * std::abs(second.effort - newton.effort));
+  req.solver = "nlopt";
+  const PlanAttitudeManeuver::Response refused4 = call(req);
+  EXPECT_FALSE(refused4.success);
+  EXPECT_EQ(refused4.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(refused4.message.find("scheme: 'fourth_order'"), std::string::npos) << refused4.message;
   EXPECT_TRUE(call(seed()).success);  // and the node keeps serving
 }
 

@@ -20,11 +20,16 @@ TEST(TrackerScene, FinalTransformIsTheScenesTargetAttitude) {
   const ReplayResult::ConstPtr done = listener_done.wait(90.0);
   ASSERT_TRUE(done) << "no done message";
   ASSERT_TRUE(done->success) << done->message;
+  // The replay integrates the plan's own discrete equations (to round-off), except fourth_order's
+  // cubic hold on the continuous body (RKMK4, O(h⁴)): its launch file widens both tolerances.
+  ros::NodeHandle private_nh("~");
+  const double replay_tolerance = private_nh.param("replay_tolerance", 1e-12);
+  const double target_tolerance = private_nh.param("target_tolerance", 1e-8);
   EXPECT_EQ(done->steps, 128);
   EXPECT_GT(done->plan_solve_time, 0.0);  // the tracker asked for the plan [s]
   EXPECT_GT(done->plan_cost, 0.0);
   EXPECT_NEAR(done->cost, done->plan_cost, 1e-9 * done->plan_cost);
-  EXPECT_LT(done->terminal_attitude_error, 1e-12);  // replay vs plan [rad]
+  EXPECT_LT(done->terminal_attitude_error, replay_tolerance);  // replay vs plan [rad]
   // scenes/rest_to_rest.yaml: R_N = exp(π/3 e1^).
   const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
   const ros::WallTime tf_deadline = ros::WallTime::now() + ros::WallDuration(10.0);
@@ -34,7 +39,8 @@ TEST(TrackerScene, FinalTransformIsTheScenesTargetAttitude) {
   }
   const geometry_msgs::TransformStamped tf =
       tf_buffer.lookupTransform("world", "body", done->header.stamp);
-  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(tf.transform.rotation, "tf"), target), 1e-8);
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(tf.transform.rotation, "tf"), target),
+            target_tolerance);
 }
 
 int main(int argc, char** argv) {

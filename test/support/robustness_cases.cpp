@@ -294,8 +294,9 @@ void spinningEnds(Recorder& r) {
   p.final_velocity = Vector3(3, 0, 0);
   const PlanResult res = r.plan("Ω (0,0,5) → (3,0,0) rad/s, 1 rad about x, N = 128", p);
   // Measured 168 from the Hermite guess (~10 turns away from the extremal's shape): within the
-  // default iteration limit, not fast (see docs/robustness.md).
-  r.atMost("iterations (default limit 200)", res.iterations, 200);
+  // default iteration limit, not fast (see docs/robustness.md). Both lifts are about equally near
+  // the coasting displacement, so the other one is solved too (152 more): each solve within it.
+  r.atMost("iterations (two solves, default limit 200 each)", res.iterations, 400);
 }
 
 void intermediateAxisSpin(Recorder& r) {
@@ -332,8 +333,8 @@ void intermediateAxisSpin(Recorder& r) {
              measureStepResidual(p, res.maneuver).tolerance);
     r.atMost("T = 60: the plan's R_N from the target [rad]",
              so3::angleBetween(res.maneuver.attitude[p.steps], p.final_attitude), 1e-9);
-    r.atLeast("T = 60: replay miss [rad] reported (round-off amplified by e^{λT})",
-              res.replay_miss, 1e-9);
+    r.atLeast("T = 60: replay miss [rad] reported (round-off amplified by e^{λT})", res.replay_miss,
+              1e-9);
     r.atMost("T = 60: replay miss [rad] ≤ 10·T·eps·e^{λT} (round-off amplification)",
              res.replay_miss, 10 * 60.0 * 2.2e-16 * std::exp(std::sqrt(1.0 / 3.0) * 60.0));
   }
@@ -586,7 +587,8 @@ const std::vector<HardCase>& hardCases() {
        "all converge; τ(sJ) = s·τ(J) to 1e-10 relative", false, scaledInertia},
       {"SpinningEnds", "5. dynamics",
        "seed J, Ω_0 = (0, 0, 5) → Ω_{N−1} = (3, 0, 0) rad/s, 1 rad about x, T = 12.8 s, N = 128",
-       "converged, terminal ≤ 1e-9, within the default 200 iterations", false, spinningEnds},
+       "converged, terminal ≤ 1e-9, both lifts solved within the default 200 iterations each",
+       false, spinningEnds},
       {"IntermediateAxisSpin", "5. dynamics",
        "J = diag(1, 2, 3), Ω = (0, 1, 0) rad/s at both ends (intermediate axis), target 0.2 rad "
        "off the steady spin, T = 10, 30, 60 s at h = 0.1 s",

@@ -81,10 +81,9 @@ TEST_F(CliTest, NloptPlanWritesCsvAndSummaryAndExitsZero) {
   EXPECT_CONTAINS(summary, "\"solver\": \"nlopt\"");
   EXPECT_CONTAINS(summary, "\"scheme\": \"paper\"");
   EXPECT_CONTAINS(summary, "\"steps\": 16");
-  for (const char* key :
-       {"iterations", "cost", "terminal_attitude_error", "terminal_velocity_error", "max_residual",
-        "solve_time_s", "duration", "dynamics_residual", "step_residual", "replay_miss",
-        "message"}) {
+  for (const char* key : {"iterations", "cost", "terminal_attitude_error",
+                          "terminal_velocity_error", "max_residual", "solve_time_s", "duration",
+                          "dynamics_residual", "step_residual", "replay_miss", "message"}) {
     EXPECT_CONTAINS(summary, std::string("\"") + key + "\": ");
   }
   const ap::Maneuver m = ap::readManeuverCsv(csv);
@@ -148,6 +147,35 @@ TEST_F(CliTest, SecondOrderPlanReportsEffortAndReplaysThroughSimulateTorques) {
   const ToolRun wrong = run("simulate_torques", kScenes + "slew_up.yaml " + csv);
   EXPECT_NE(wrong.status, 0) << wrong.output;
   EXPECT_CONTAINS(wrong.output, "tau_0 and tau_N must be zero with scheme paper");
+}
+
+// --scheme fourth_order end to end: the summary names the scheme, the message says it extrapolates
+// second_order at N and 2N, the CSV holds N + 1 node rows with end torques, and simulate_torques
+// replays it with the cubic hold (RKMK4) to the plan's own O(h⁴) accuracy.
+TEST_F(CliTest, FourthOrderPlanExtrapolatesAndReplaysThroughSimulateTorques) {
+  const std::string csv = dir_ + "/fourth.csv", json = dir_ + "/fourth.json";
+  const ToolRun r = run("plan_maneuver", kScenes + "slew_up.yaml --scheme fourth_order --steps 64" +
+                                             " --csv " + csv + " --summary " + json);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string summary = readFile(json);
+  EXPECT_CONTAINS(summary, "\"scheme\": \"fourth_order\"");
+  EXPECT_CONTAINS(summary, "\"converged\": true");
+  EXPECT_CONTAINS(summary, "Richardson extrapolation of second_order at N = 64 and 2N = 128");
+  const double cost = std::stod(summary.substr(summary.find("\"cost\": ") + 8));
+  const double effort = std::stod(summary.substr(summary.find("\"effort\": ") + 10));
+  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  EXPECT_NEAR(effort, duration / 64 * cost, 1e-9 * effort) << summary;
+  const ap::Maneuver plan = ap::readManeuverCsv(csv);
+  EXPECT_EQ(plan.steps(), 64);
+  EXPECT_GT(plan.torque.front().norm(), 0.0);
+  EXPECT_GT(plan.torque.back().norm(), 0.0);
+  const ToolRun replay = run("simulate_torques", kScenes + "slew_up.yaml " + csv +
+                                                     " --scheme fourth_order --max-miss 1e-5");
+  EXPECT_EQ(replay.status, 0) << replay.output;
+  const ToolRun nlopt =
+      run("plan_maneuver", kScenes + "slew_up.yaml --scheme fourth_order --solver nlopt");
+  EXPECT_EQ(nlopt.status, 1) << nlopt.output;
+  EXPECT_CONTAINS(nlopt.output, "scheme: 'fourth_order' is not available with solver nlopt");
 }
 
 // --objective minimum_time on the closed-form scene: T* in the summary, the plan at (1 + M) T*
@@ -381,8 +409,12 @@ TEST_F(CliTest, TargetMissChoosesStepsAndReportsTheEstimate) {
   EXPECT_CONTAINS(r.output, "accuracy target          terminal_miss <= 1e-06");
   const std::string summary = readFile(json);
   EXPECT_CONTAINS(summary, "\"accuracy\": {\"measure\": \"terminal_miss\"");
-  // auto: the variational scheme (order-2 miss) needs far fewer steps than paper (order 1)
-  EXPECT_CONTAINS(summary, "\"scheme\": \"variational\"");
+  // auto: fourth_order (order-4 miss) needs the least work (3N = 240 against N = 1634 for
+  // variational, the best order-2 miss; paper would need N ≈ 1.3 million)
+  EXPECT_CONTAINS(summary, "\"scheme\": \"fourth_order\"");
+  EXPECT_CONTAINS(
+      summary,
+      "\"schemes_tried\": [\"paper\", \"variational\", \"second_order\", \"fourth_order\"");
   const std::size_t at = summary.find("\"estimated_error\": ");
   ASSERT_NE(at, std::string::npos) << summary;
   EXPECT_LE(std::stod(summary.substr(at + 19)), 1e-6) << summary;

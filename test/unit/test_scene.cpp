@@ -469,8 +469,10 @@ TEST(NameTables, UnknownNameIsRefusedNamingFieldValueAndEveryAcceptedName) {
     ap::applySchemeName("rk4", "scheme", &p);
     ADD_FAILURE() << "no InvalidInput";
   } catch (const ap::InvalidInput& e) {
-    EXPECT_STREQ(e.what(),
-                 "scheme: unknown value 'rk4' (expected paper, variational, second_order or auto)");
+    EXPECT_STREQ(
+        e.what(),
+        "scheme: unknown value 'rk4' (expected paper, variational, second_order, fourth_order or "
+        "auto)");
   }
   ap::applySchemeName("auto", "scheme", &p);
   EXPECT_TRUE(p.accuracy.choose_scheme);

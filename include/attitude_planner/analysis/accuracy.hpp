@@ -4,16 +4,17 @@
 // (continuous_reference.hpp):
 //   (a) cost error  |h Σ_k ½ w_k|τ_k|² − ½∫₀ᵀ|τ|²dt| (the effort's error): paper and
 //       variational sum the N − 1 interior torques (w_k = 1, a Riemann sum), second_order all
-//       N + 1 with the trapezoidal weights;
+//       N + 1 with the trapezoidal weights, fourth_order with Gregory's end-corrected ones;
 //   (b) trajectory error max_k ‖log(R(t_k)ᵀ R_k)‖ and torque error max_k |τ_k − τ(t_k)| (the end
-//       nodes too for second_order): all schemes apply the torque as an impulse hτ_k at the node
+//       nodes too for second_order and fourth_order): all schemes apply the torque as an impulse hτ_k at the node
 //       t_k (discrete_scheme.hpp: the momentum jumps by hτ_k between step k−1 and step k), so τ_k
 //       samples τ(t_k);
 //   (c) physical miss: the plan's torques drive the continuous rigid body (integrated to ~1e-13)
 //       under the scheme's own hold; terminal ‖log(R_Tᵀ R(T))‖ and |Ω(T) − Ω_T|. paper and
 //       variational: the impulse hτ_k at t_k is held over [t_k − h/2, t_k + h/2] (node-centred);
 //       holding it over the step [t_k, t_{k+1}) (what a naive controller does) adds a half-step
-//       delay. second_order: τ linear between the node values (first-order hold).
+//       delay. second_order: τ linear between the node values (first-order hold); fourth_order:
+//       the cubic hold of the node torques (cubicHoldCoefficients, simulation.hpp).
 #pragma once
 
 #include "attitude_planner/analysis/continuous_reference.hpp"
@@ -28,10 +29,14 @@ enum class TorqueHold {
   /// τ linear between the nodes (first-order hold): the interpolant of the node torques of a
   /// scheme with end torques (second_order), which keeps its order 2.
   PiecewiseLinear,
+  /// τ the local cubic interpolant of the node torques (cubicHoldCoefficients): fourth_order,
+  /// order 4.
+  PiecewiseCubic,
 };
 
 /// The hold that keeps a scheme's order: node-centred for paper and variational (the impulse
-/// hτ_k at t_k), piecewise linear for second_order (τ_k are samples of τ(t_k), ends included).
+/// hτ_k at t_k), piecewise linear for second_order (τ_k are samples of τ(t_k), ends included),
+/// piecewise cubic for fourth_order (samples accurate to O(h⁴)).
 TorqueHold naturalHold(SchemeKind scheme);
 
 /// Terminal state of the continuous body driven by a plan's torques (zero-order hold).
@@ -70,8 +75,9 @@ AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver&
                                  const ContinuousReference& reference);
 
 /// The convergence order p of a measure (error ≈ C N^−p) as measured by scripts/accuracy on the
-/// seed's examples (docs/accuracy.md): cost error 1 (both schemes), terminal attitude miss 1
-/// (paper) and 2 (variational). The planner predicts N from it.
+/// seed's examples (docs/accuracy.md): cost error 1 (paper, variational), terminal attitude miss
+/// 1 (paper) and 2 (variational); second_order 2 and fourth_order 4 in both. The planner predicts
+/// N from it.
 double measuredOrder(SchemeKind scheme, AccuracyMeasure measure);
 
 /// Plans to problem.accuracy: solves N = 64 of each candidate scheme (and N = 32 for the cost's

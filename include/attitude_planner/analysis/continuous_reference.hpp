@@ -16,6 +16,8 @@
 // integrator). The Hamiltonian −½|ν|² + π·Ω + ν·((JΩ)×Ω) is conserved along the flow (a check).
 #pragma once
 
+#include <array>
+
 #include <vector>
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
@@ -95,5 +97,11 @@ void propagateRigidBody(const Matrix3& inertia, const Vector3& torque, double du
 void propagateRigidBody(const Matrix3& inertia, const Vector3& torque_start,
                         const Vector3& torque_end, double duration, int macro_steps,
                         Matrix3* attitude, Vector3* angular_velocity);
+
+/// The same with τ(s) = Σ_i c_i s^i a cubic in the time s since the start (fourth_order's cubic
+/// hold, cubicHoldCoefficients in simulation.hpp).
+void propagateRigidBody(const Matrix3& inertia, const std::array<Vector3, 4>& torque_polynomial,
+                        double duration, int macro_steps, Matrix3* attitude,
+                        Vector3* angular_velocity);
 
 }  // namespace attitude_planner

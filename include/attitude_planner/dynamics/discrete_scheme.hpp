@@ -20,6 +20,11 @@
 //                and the boundary velocities are imposed at the instants 0 and T themselves:
 //                Π_0 = J Ω(0), Π_N = J Ω(T) (τ_0, τ_N are unknowns, not zero). The cost is the
 //                trapezoidal rule, weights ½ at the end nodes. Derivation: docs/second_order.md.
+//   fourth_order not a discretization: one Richardson extrapolation step of second_order (plans
+//                at N and 2N combined node by node, planAtResolution; docs/fourth_order.md). No
+//                DiscreteScheme is built for it (the constructor refuses it); its node torques
+//                are replayed with a cubic hold (replayPlan, simulation.hpp) and its effort is the
+//                end-corrected trapezoidal rule (schemeTorqueWeight).
 //
 // Torque-free, the spatial momentum R_k μ(F_k) is conserved exactly by construction.
 // Derivatives are with respect to right perturbations F exp(ε^).
@@ -35,16 +40,17 @@
 namespace attitude_planner {
 
 /// Which discretization of the rigid body.
-enum class SchemeKind { Paper, Variational, SecondOrder };
+enum class SchemeKind { Paper, Variational, SecondOrder, FourthOrder };
 
 /// The names of the schemes (scene key `scheme`, --scheme, request field `scheme`, JSON).
 inline constexpr NamedValue<SchemeKind> kSchemeNames[] = {
     {SchemeKind::Paper, "paper"},
     {SchemeKind::Variational, "variational"},
     {SchemeKind::SecondOrder, "second_order"},
+    {SchemeKind::FourthOrder, "fourth_order"},
 };
 
-/// "paper", "variational" or "second_order".
+/// "paper", "variational", "second_order" or "fourth_order".
 inline std::string schemeName(SchemeKind kind) {
   return nameIn(kSchemeNames, kind);
 }
@@ -53,11 +59,39 @@ inline SchemeKind parseScheme(const std::string& text, const std::string& field)
   return parseIn(kSchemeNames, text, field);
 }
 
-/// True if the scheme's end-node torques are impulses of the plan (second_order; see
-/// DiscreteScheme::hasEndTorques).
+/// True if the scheme's end-node torques are part of the plan and its rows k = 0..N are node
+/// values (second_order, see DiscreteScheme::hasEndTorques; fourth_order, built from two
+/// second_order plans).
 inline bool schemeHasEndTorques(SchemeKind kind) {
-  return kind == SchemeKind::SecondOrder;
+  return kind == SchemeKind::SecondOrder || kind == SchemeKind::FourthOrder;
 }
+
+/// True if plans of the scheme are solutions of discrete equations of motion (a DiscreteScheme);
+/// false for fourth_order, the Richardson extrapolation of two second_order plans.
+inline bool schemeIsDiscretization(SchemeKind kind) {
+  return kind != SchemeKind::FourthOrder;
+}
+
+/// Quadrature weight w_k of ½|τ_k|² in the scheme's cost Σ_k w_k ½|τ_k|² (the effort is h times
+/// it), k = 0..N:
+///   paper, variational  1 (τ_0 = τ_N = 0: a Riemann sum of the interior torques)
+///   second_order        the trapezoidal rule: ½ at the end nodes, else 1
+///   fourth_order        the trapezoidal rule with Gregory's end corrections (exact for cubics,
+///                       order 4 for N ≥ 3): 3/8, 7/6, 23/24, 1, …, 1, 23/24, 7/6, 3/8; for small
+///                       N the two ends' corrections add.
+inline double schemeTorqueWeight(SchemeKind kind, int k, int steps) {
+  if (!schemeHasEndTorques(kind)) return 1.0;
+  double w = (k == 0 || k == steps) ? 0.5 : 1.0;
+  if (kind == SchemeKind::FourthOrder) {
+    constexpr double kCorrection[3] = {-1.0 / 8.0, 1.0 / 6.0, -1.0 / 24.0};
+    if (k < 3) w += kCorrection[k];
+    if (steps - k < 3) w += kCorrection[steps - k];
+  }
+  return w;
+}
+
+/// The scheme's cost Σ_k w_k ½|τ_k|² [N²·m²] of the node torques τ_0..τ_N (schemeTorqueWeight).
+double schemeCost(SchemeKind kind, const std::vector<Vector3>& torque);
 
 /// Outcome of one implicit step solve μ(F) = p.
 struct StepSolveReport {
@@ -69,6 +103,7 @@ struct StepSolveReport {
 /// One discretization of the rigid body with inertia J [kg·m²] and time step h [s].
 class DiscreteScheme {
  public:
+  /// Throws InvalidInput for fourth_order (not a discretization: schemeIsDiscretization).
   DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step);
 
   SchemeKind kind() const { return kind_; }
@@ -78,9 +113,7 @@ class DiscreteScheme {
   bool hasEndTorques() const { return schemeHasEndTorques(kind_); }
   /// Quadrature weight of ½|τ_k|² in the cost, k = 0..N: ½ at the ends with end torques
   /// (trapezoidal rule), else 1.
-  double torqueWeight(int k, int steps) const {
-    return hasEndTorques() && (k == 0 || k == steps) ? 0.5 : 1.0;
-  }
+  double torqueWeight(int k, int steps) const { return schemeTorqueWeight(kind_, k, steps); }
   /// The scheme's cost Σ_k ½ w_k |τ_k|² [N²·m²] of the node torques τ_0..τ_N (the effort is
   /// h times it).
   double cost(const std::vector<Vector3>& torque) const;

@@ -2,6 +2,7 @@
 // The tracker node, the CLI `simulate` tool and the benchmarks all call this.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
@@ -40,6 +41,29 @@ struct SimulationReport {
 /// InvalidInput on bad input.
 Maneuver simulate(const DiscreteScheme& scheme, const SimulationInput& input,
                   SimulationReport* report = nullptr);
+
+/// The cubic hold of fourth_order on step k, [t_k, t_{k+1}] (h = t_{k+1} − t_k): the Lagrange
+/// cubic through the four node torques nearest to the step (nodes k−1..k+2; 0..3 on the first
+/// step, N−3..N on the last), as coefficients c_0..c_3 of τ(t_k + s) = Σ_i c_i s^i. It
+/// interpolates the node torques and is O(h⁴) from a smooth τ(t) sampled at the nodes. N ≥ 3.
+std::array<Vector3, 4> cubicHoldCoefficients(const std::vector<Vector3>& torque, int k, double h);
+
+/// Replays the node torques of a plan of scheme `kind` (time step h) with the hold and integrator
+/// that keep the scheme's order — the one replay the tracker, simulate_torques and the planner's
+/// own replay_miss use:
+///   paper, variational, second_order  simulate(DiscreteScheme(kind, J, h), …): the scheme's own
+///                                     discrete integrator, i.e. exactly the motion it plans;
+///   fourth_order                      the continuous rigid body Ṙ = RΩ^, JΩ̇ = JΩ×Ω + τ(t) + τ_e,
+///                                     τ(t) the cubic hold of the node torques
+///                                     (cubicHoldCoefficients), integrated by RKMK4 (classical
+///                                     Runge–Kutta on R = R_k exp(u^), u̇ = J_r(u)⁻¹Ω with the exact
+///                                     inverse right Jacobian; one step per plan step): order 4 in
+///                                     h, N ≥ 3. Actuation is applied to the node torques (in k
+///                                     order) before they are interpolated; effects are evaluated
+///                                     at every stage. The report's step figures stay 0 (explicit).
+/// Rows k = 0..N are node values (t_k, R_k, Ω(t_k), received τ_k).
+Maneuver replayPlan(SchemeKind kind, const Matrix3& inertia, double time_step,
+                    const SimulationInput& input, SimulationReport* report = nullptr);
 
 /// One Newton–Schulz step towards the nearest rotation: R (3I − RᵀR)/2.
 Matrix3 reorthonormalize(const Matrix3& R);

@@ -9,7 +9,7 @@
 //                    the kinematic system's body rate E3 + u1 E1 + u2 E2 is not a boundary value)
 //                    A = {axis: [x, y, z], angle: a [rad]} or {quaternion: [w, x, y, z]}
 //   effects          optional list of single-key maps (see EffectSpec); absent or []: none
-//   scheme           optional: paper (default) | variational
+//   scheme           optional: paper (default) | variational | second_order | fourth_order
 //   system           optional: rigid_body (default) | drift_two_input (seed 001)
 //   control_weights  [c1, c2] > 0, only with system: drift_two_input
 //   initial_costate  optional [p1, p2, p3] (finite), only with system: drift_two_input: guess for

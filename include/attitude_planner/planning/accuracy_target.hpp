@@ -37,7 +37,7 @@ inline AccuracyMeasure parseAccuracyMeasure(const std::string& text, const std::
 struct AccuracyTarget {
   AccuracyMeasure measure = AccuracyMeasure::None;
   double value = 0.0;          ///< the bound on the measure (its units), finite and > 0
-  bool choose_scheme = false;  ///< also choose the scheme (paper or variational)
+  bool choose_scheme = false;  ///< also choose the scheme (any of the four, least work)
   int max_steps = 1 << 18;     ///< largest N the planner may choose
 
   bool active() const { return measure != AccuracyMeasure::None; }

@@ -51,7 +51,8 @@ struct PlanResult {
   /// T* [s]: the least duration found feasible (objective minimum_time; else 0).
   double minimum_duration = 0.0;
   /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
-  /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½).
+  /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½; fourth_order:
+  /// Gregory's end-corrected weights, schemeTorqueWeight).
   double cost = 0.0;
   /// h · cost [N²·m²·s]: the scheme's quadrature of ½∫₀ᵀ|τ|²dt, comparable across schemes and
   /// with the continuous optimum.

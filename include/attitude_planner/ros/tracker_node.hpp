@@ -1,5 +1,6 @@
 // attitude_tracker_node: replays a planned maneuver in (ROS) real time for rviz. The torques τ_k
-// of the plan are integrated again through simulate() (the core's DiscreteScheme), so what rviz
+// of the plan are integrated again through replayPlan() (the core's DiscreteScheme via simulate(),
+// or fourth_order's cubic hold on the continuous body, RKMK4), so what rviz
 // shows is the rigid body's response to the planned torques, not the plan's own attitudes. The
 // replay includes exactly the effects of the scene (~scene, or ~replay_scene when set; none for a
 // maneuver from the topic without ~replay_scene); `done` lists them and reports the miss.

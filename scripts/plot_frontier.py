@@ -127,14 +127,15 @@ for c in cases:
 
 # ---- plot --------------------------------------------------------------------------------------
 styles = {"paper": ("tab:blue", "o"), "variational": ("tab:green", "s"),
-          "second_order": ("tab:red", "^"), PEER: ("black", "D")}
+          "second_order": ("tab:red", "^"), "fourth_order": ("tab:purple", "v"),
+          PEER: ("black", "D")}
 fig, axes = plt.subplots(2, len(cases), figsize=(6.5 * len(cases), 9), squeeze=False)
 for j, c in enumerate(cases):
     for i, (key, title) in enumerate(MEASURES):
         ax = axes[i][j]
         for m in c["methods"]:
             runs = good_runs(m)
-            color, marker = styles.get(m["method"], ("tab:purple", "v"))
+            color, marker = styles.get(m["method"], ("tab:orange", "x"))
             label = "IPOPT on Hermite–Simpson" if m["method"] == PEER else "ours, " + m["method"]
             ax.loglog([r["solve_time_s"] for r in runs], [r[key] for r in runs],
                       "-" if m["family"] == "ours" else "--", color=color, marker=marker, ms=3,

@@ -8,43 +8,14 @@
 #include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/seed_examples.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-/// The seed's inertia (scenes/*.yaml), non-physical but SPD.
-Matrix3 seedInertia() {
-  Matrix3 J;
-  J << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
-  return J;
-}
-
-/// scenes/rest_to_rest.yaml (π/3 about x in 12.8 s) or slew_up.yaml (π/6, arriving at
-/// (0.3,0.2,0.3)).
-PlanningProblem seedProblem(bool slew_up) {
-  PlanningProblem p;
-  p.inertia = seedInertia();
-  p.allow_nonphysical_inertia = true;
-  p.duration = 12.8;
-  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), slew_up ? M_PI / 6 : M_PI / 3);
-  if (slew_up) p.final_velocity = Vector3(0.3, 0.2, 0.3);
-  return p;
-}
-
-/// Least-squares slope of −log(error) against log(N).
-double fittedOrder(const std::vector<int>& N, const std::vector<double>& error) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(N.size());
-  for (size_t i = 0; i < N.size(); ++i) {
-    const double x = std::log(double(N[i])), y = std::log(error[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return -(n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
+using test_support::fittedOrder;
+using test_support::seedProblem;
 
 }  // namespace
 

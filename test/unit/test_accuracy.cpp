@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "attitude_planner/analysis/accuracy.hpp"
@@ -219,6 +220,42 @@ TEST(PlanToAccuracy, CostErrorEstimateIsHonest) {
   const double actual = measureAccuracy(at_N, plan.maneuver, ref).cost_error;
   EXPECT_LE(actual, 1e-2);
   EXPECT_NEAR(actual / plan.accuracy.estimated_error, 1.0, 0.1);
+}
+
+TEST(PlanToAccuracy, WithTorqueLimitsTheTargetsHoldAndTheCostEstimateIsAnUpperBound) {
+  // scenes/torque_limited.yaml's limits on the seed's rest-to-rest example: the interior point
+  // plans every resolution. Terminal miss: measured by the replay, so it holds as measured. Cost
+  // error: with node constraints the Richardson estimate assumes order 1 (active sets start and
+  // end between nodes), an upper bound on the true error, here checked against N = 8192.
+  PlanningProblem p = seedProblem(false, SchemeKind::SecondOrder);
+  p.max_torque = Vector3(0.264, 0.331, 0.416);
+  p.accuracy.measure = AccuracyMeasure::TerminalMiss;
+  p.accuracy.value = 1e-5;
+  const PlanResult miss = planManeuver(p);
+  ASSERT_TRUE(miss.converged()) << miss.message;
+  EXPECT_LE(miss.accuracy.estimated_error, 1e-5);
+  EXPECT_LE(miss.max_constraint_violation, 1e-8);
+  EXPECT_GT(miss.active_constraints, 0);  // the limits bind
+  PlanningProblem at_N = p;
+  at_N.accuracy = AccuracyTarget{};
+  at_N.steps = miss.maneuver.steps();
+  EXPECT_LE(replayZeroOrderHold(at_N, miss.maneuver, naturalHold(at_N.scheme)).attitude_miss, 1e-5);
+
+  p.accuracy.measure = AccuracyMeasure::CostError;
+  p.accuracy.value = 1e-3;
+  const PlanResult cost = planManeuver(p);
+  ASSERT_TRUE(cost.converged()) << cost.message;
+  EXPECT_EQ(cost.accuracy.order, 1.0);
+  EXPECT_LE(cost.accuracy.estimated_error, 1e-3);
+  PlanningProblem fine = p;
+  fine.accuracy = AccuracyTarget{};
+  fine.steps = 8192;
+  const PlanResult reference = planManeuver(fine);
+  ASSERT_TRUE(reference.converged()) << reference.message;
+  const double actual = std::abs(cost.effort - reference.effort);
+  std::printf("torque limits, cost error target 1e-3: N = %d, estimate %.3g, actual %.3g\n",
+              cost.maneuver.steps(), cost.accuracy.estimated_error, actual);
+  EXPECT_LE(actual, cost.accuracy.estimated_error);
 }
 
 TEST(PlanToAccuracy, BadTargetsNameTheFieldAndValue) {

@@ -38,6 +38,28 @@ def run_peer(benchmark, scene, steps, solver, budget, extra=()):
     return json.loads(lines[-1]) if lines else None
 
 
+def run_with_memory(binary, scene, steps):
+    """One plan_maneuver process under /usr/bin/time: its summary and peak RSS [MB]."""
+    with tempfile.TemporaryDirectory() as tmp:
+        summary = os.path.join(tmp, "s.json")
+        rss = os.path.join(tmp, "rss")
+        subprocess.run(["/usr/bin/time", "-f", "%M", "-o", rss, binary, scene, "--summary",
+                        summary, "--steps", str(steps)],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        with open(summary) as f:
+            result = json.load(f)
+        result["peak_rss_mb"] = int(open(rss).read().split()[-1]) / 1024.0
+        return result
+
+
+def with_rate_limit(scene, rate, tmpdir):
+    """The scene with `max_angular_rate: rate` appended to its constraints."""
+    text = open(scene).read().rstrip("\n") + "\nconstraints:\n  - max_angular_rate: %g\n" % rate
+    path = os.path.join(tmpdir, "rate_%g_" % rate + os.path.basename(scene))
+    open(path, "w").write(text)
+    return path
+
+
 def without_constraints(scene, tmpdir):
     """The scene with its constraints: list and actuator_limits removed."""
     text = open(scene).read()
@@ -78,6 +100,15 @@ def main():
     large = [1024, 2048] if args.quick else [1024, 2048, 8192]
     large_rows = [(N, median_ip(scene, N)) for N in large]
 
+    # Torque and rate limits together up to N = 1e5 (issue 16: ≤ 10 s, memory linear in N). IPOPT
+    # (benchmark_solvers) at N = 128: feasible for w ≥ 0.11 rad/s, locally infeasible at 0.1.
+    huge_rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for rate in ([0.12] if args.quick else [0.12, 0.11]):
+            path = with_rate_limit(scene, rate, tmp)
+            for N in ([1024, 8192] if args.quick else [1024, 8192, 100000]):
+                huge_rows.append((rate, N, run_with_memory(args.binary, path, N)))
+
     scene_rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in ["torque_limited.yaml", "torque_norm_limited.yaml", "rate_limited.yaml",
@@ -111,7 +142,7 @@ def main():
     def status(r):
         if r["converged"]:
             return "converged"
-        return "infeasible" if r.get("infeasible") else "not converged"
+        return r.get("termination", "not converged").replace("_", " ")
 
     out = []
     out.append("# Constrained planning: interior point vs SLSQP\n")
@@ -141,6 +172,18 @@ def main():
         out.append("| %d | %s | %s | %d | %.12g | %.1e | %d |" % (
             N, ms(ip), status(ip), ip["iterations"], ip["cost"], ip["max_constraint_violation"],
             ip["active_constraints"]))
+    out.append("")
+    out.append("## Torque and rate limits together, up to N = 10⁵\n")
+    out.append("scenes/torque_limited.yaml with `constraints: [max_angular_rate: w]` added; one "
+               "plan_maneuver process each, peak RSS by `/usr/bin/time`. Target: N = 10⁵ in ≤ 10 s, "
+               "memory linear in N.\n")
+    out.append("| w [rad/s] | N | time | status | iterations | cost | max violation | peak RSS | "
+               "RSS / N |")
+    out.append("|---|---|---|---|---|---|---|---|---|")
+    for rate, N, r in huge_rows:
+        out.append("| %g | %d | %s | %s | %d | %.9g | %.1e | %.0f MB | %.2f kB |" % (
+            rate, N, ms(r), status(r), r["iterations"], r["cost"], r["max_constraint_violation"],
+            r["peak_rss_mb"], 1024.0 * r["peak_rss_mb"] / N))
     out.append("")
     out.append("## Each constrained scene vs the same scene without its constraints\n")
     out.append("| scene | N | constrained | status | iterations | without constraints | ratio | "

@@ -15,6 +15,19 @@ Matrix3 reorthonormalize(const Matrix3& R) {
 
 namespace {
 
+/// A maneuver on the uniform grid t_k = k h, k = 0..N, carrying `torque`, its attitudes and
+/// velocities to be filled.
+Maneuver nodeGrid(int N, double h, const std::vector<Vector3>& torque) {
+  Maneuver m;
+  m.time_step = h;
+  m.time.resize(N + 1);
+  m.attitude.resize(N + 1);
+  m.angular_velocity.resize(N + 1);
+  m.torque = torque;
+  for (int k = 0; k <= N; ++k) m.time[k] = k * h;
+  return m;
+}
+
 /// The integrator loop, specialized at compile time on whether anything acts besides the control
 /// (so an absent effect costs nothing per step: no branch, no zero evaluation).
 template <bool kWithEffects>
@@ -22,13 +35,7 @@ Maneuver integrate(const DiscreteScheme& scheme, const SimulationInput& input,
                    SimulationReport* report) {
   const int N = static_cast<int>(input.torque.size()) - 1;
   const double h = scheme.timeStep();
-  Maneuver m;
-  m.time_step = h;
-  m.time.resize(N + 1);
-  m.attitude.resize(N + 1);
-  m.angular_velocity.resize(N + 1);
-  m.torque = input.torque;
-  for (int k = 0; k <= N; ++k) m.time[k] = k * h;
+  Maneuver m = nodeGrid(N, h, input.torque);
 
   SimulationReport local;
   // What the body receives at node k: the commanded torque after actuation (recorded), plus the
@@ -148,13 +155,7 @@ namespace {
 /// fourth_order's replay: the continuous body under the cubic hold, RKMK4 (replayPlan).
 Maneuver integrateCubicHold(const Matrix3& inertia, double h, const SimulationInput& input) {
   const int N = static_cast<int>(input.torque.size()) - 1;
-  Maneuver m;
-  m.time_step = h;
-  m.time.resize(N + 1);
-  m.attitude.resize(N + 1);
-  m.angular_velocity.resize(N + 1);
-  m.torque = input.torque;
-  for (int k = 0; k <= N; ++k) m.time[k] = k * h;
+  Maneuver m = nodeGrid(N, h, input.torque);
   if (input.actuation && !input.actuation->empty()) {
     for (int k = 0; k <= N; ++k) m.torque[k] = input.actuation->apply(input.torque[k]);
   }

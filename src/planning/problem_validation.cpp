@@ -136,10 +136,10 @@ void validateProblem(const PlanningProblem& p) {
                          accuracyMeasureName(p.accuracy.measure) + "), got " +
                          exactNumber(p.accuracy.value));
     }
-    if (p.hasNodeConstraints() || (p.effects && !p.effects->empty())) {
+    if (p.effects && !p.effects->empty()) {
       throw InvalidInput(
-          "accuracy_target: not supported with effects, actuator_limits or constraints (the "
-          "continuous reference and the measured orders are for the bare rigid body)");
+          "accuracy_target: not supported with effects (the replay that measures the terminal "
+          "miss is of the bare rigid body); actuator_limits and constraints are supported");
     }
     if (p.accuracy.max_steps < 16 || p.accuracy.max_steps > kMaxSteps) {
       throw InvalidInput("accuracy.max_steps: must be in [16, " + std::to_string(kMaxSteps) +

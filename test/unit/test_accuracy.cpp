@@ -3,48 +3,20 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/seed_examples.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-/// The seed's inertia (scenes/*.yaml), non-physical but SPD.
-Matrix3 seedInertia() {
-  Matrix3 J;
-  J << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
-  return J;
-}
-
-/// scenes/rest_to_rest.yaml (π/3 about x in 12.8 s) or slew_up.yaml (π/6, arriving at
-/// (0.3,0.2,0.3)).
-PlanningProblem seedProblem(bool slew_up) {
-  PlanningProblem p;
-  p.inertia = seedInertia();
-  p.allow_nonphysical_inertia = true;
-  p.duration = 12.8;
-  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), slew_up ? M_PI / 6 : M_PI / 3);
-  if (slew_up) p.final_velocity = Vector3(0.3, 0.2, 0.3);
-  return p;
-}
-
-/// Least-squares slope of −log(error) against log(N).
-double fittedOrder(const std::vector<int>& N, const std::vector<double>& error) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(N.size());
-  for (size_t i = 0; i < N.size(); ++i) {
-    const double x = std::log(double(N[i])), y = std::log(error[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return -(n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
+using test_support::fittedOrder;
+using test_support::seedProblem;
 
 }  // namespace
 
@@ -248,6 +220,42 @@ TEST(PlanToAccuracy, CostErrorEstimateIsHonest) {
   const double actual = measureAccuracy(at_N, plan.maneuver, ref).cost_error;
   EXPECT_LE(actual, 1e-2);
   EXPECT_NEAR(actual / plan.accuracy.estimated_error, 1.0, 0.1);
+}
+
+TEST(PlanToAccuracy, WithTorqueLimitsTheTargetsHoldAndTheCostEstimateIsAnUpperBound) {
+  // scenes/torque_limited.yaml's limits on the seed's rest-to-rest example: the interior point
+  // plans every resolution. Terminal miss: measured by the replay, so it holds as measured. Cost
+  // error: with node constraints the Richardson estimate assumes order 1 (active sets start and
+  // end between nodes), an upper bound on the true error, here checked against N = 8192.
+  PlanningProblem p = seedProblem(false, SchemeKind::SecondOrder);
+  p.max_torque = Vector3(0.264, 0.331, 0.416);
+  p.accuracy.measure = AccuracyMeasure::TerminalMiss;
+  p.accuracy.value = 1e-5;
+  const PlanResult miss = planManeuver(p);
+  ASSERT_TRUE(miss.converged()) << miss.message;
+  EXPECT_LE(miss.accuracy.estimated_error, 1e-5);
+  EXPECT_LE(miss.max_constraint_violation, 1e-8);
+  EXPECT_GT(miss.active_constraints, 0);  // the limits bind
+  PlanningProblem at_N = p;
+  at_N.accuracy = AccuracyTarget{};
+  at_N.steps = miss.maneuver.steps();
+  EXPECT_LE(replayZeroOrderHold(at_N, miss.maneuver, naturalHold(at_N.scheme)).attitude_miss, 1e-5);
+
+  p.accuracy.measure = AccuracyMeasure::CostError;
+  p.accuracy.value = 1e-3;
+  const PlanResult cost = planManeuver(p);
+  ASSERT_TRUE(cost.converged()) << cost.message;
+  EXPECT_EQ(cost.accuracy.order, 1.0);
+  EXPECT_LE(cost.accuracy.estimated_error, 1e-3);
+  PlanningProblem fine = p;
+  fine.accuracy = AccuracyTarget{};
+  fine.steps = 8192;
+  const PlanResult reference = planManeuver(fine);
+  ASSERT_TRUE(reference.converged()) << reference.message;
+  const double actual = std::abs(cost.effort - reference.effort);
+  std::printf("torque limits, cost error target 1e-3: N = %d, estimate %.3g, actual %.3g\n",
+              cost.maneuver.steps(), cost.accuracy.estimated_error, actual);
+  EXPECT_LE(actual, cost.accuracy.estimated_error);
 }
 
 TEST(PlanToAccuracy, BadTargetsNameTheFieldAndValue) {

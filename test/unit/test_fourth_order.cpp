@@ -14,34 +14,16 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "support/robustness_cases.hpp"
+#include "support/seed_examples.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-PlanningProblem seedProblem(bool slew_up, SchemeKind scheme = SchemeKind::FourthOrder) {
-  PlanningProblem p;
-  p.inertia = robustness::seedInertia();
-  p.allow_nonphysical_inertia = true;
-  p.duration = 12.8;
-  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), slew_up ? M_PI / 6 : M_PI / 3);
-  if (slew_up) p.final_velocity = Vector3(0.3, 0.2, 0.3);
-  p.scheme = scheme;
-  return p;
-}
+using test_support::fittedOrder;
 
-/// Least-squares slope of −log(error) against log(N).
-double fittedOrder(const std::vector<int>& N, const std::vector<double>& error) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(N.size());
-  for (size_t i = 0; i < N.size(); ++i) {
-    const double x = std::log(double(N[i])), y = std::log(error[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return -(n * sxy - sx * sy) / (n * sxx - sx * sx);
+PlanningProblem seedProblem(bool slew_up, SchemeKind scheme = SchemeKind::FourthOrder) {
+  return test_support::seedProblem(slew_up, scheme);
 }
 
 double maxTorque(const Maneuver& m) {

@@ -53,8 +53,9 @@ struct AccuracyEstimate {
   double estimated_error = 0.0;
   /// What the coarse resolutions and the order predicted for the chosen N (before solving it).
   double predicted_error = 0.0;
-  double order = 0.0;                      ///< convergence order p used (documented, measured)
-  std::string method;                      ///< how estimated_error was obtained
+  double order = 0.0;  ///< convergence order p assumed (the measured one; cost error with node
+                       ///< constraints: at most 1)
+  std::string method;  ///< how estimated_error was obtained
   std::vector<int> steps_tried;            ///< every N solved, in order (coarse resolutions first)
   std::vector<double> errors_tried;        ///< the estimate at each of them
   std::vector<std::string> schemes_tried;  ///< the scheme of each of them

@@ -21,6 +21,7 @@
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "support/hermite_simpson.hpp"
+#include "support/robustness_cases.hpp"
 
 namespace attitude_planner {
 namespace {
@@ -31,7 +32,7 @@ using peers::HermiteSimpsonTranscription;
 /// ends, so every block of the transcription is exercised).
 PlanningProblem slewProblem(int steps) {
   PlanningProblem p;
-  p.inertia << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
+  p.inertia = robustness::seedInertia();
   p.allow_nonphysical_inertia = true;
   p.duration = 4.0;
   p.steps = steps;

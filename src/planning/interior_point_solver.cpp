@@ -1002,6 +1002,7 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
 /// The interior point on the requested grid, with grid continuation above
 /// kCoarsestConstrainedGrid.
 PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   if (problem.steps <= kCoarsestConstrainedGrid) {
     return solveOnGridWithRetry(problem, options, nullptr, nullptr);
   }
@@ -1030,6 +1031,31 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     const PlanResult coarse = result;
     result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
+    const bool ran_out =
+        result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
+    if (!result.converged() && !ran_out && !stopped && !steps.empty() && *level % 2 == 0) {
+      // A 4× refinement can start too far from the fine optimum where bounds bind near the ends
+      // (measured: torque + rate limits, N = 10⁵ from 25 000, stalled 1 % over a bound near T):
+      // once more through the level in between.
+      PlanningProblem half = at;
+      half.steps = *level / 2;
+      ReducedProblem::Steps between, retried;
+      SolverOptions from_coarse = withRemainingBudget(options, start);
+      from_coarse.warm_start = nullptr;  // both start from the coarse steps
+      const PlanResult middle = solveOnGridWithRetry(half, from_coarse, &steps, &between);
+      iterations += middle.iterations;
+      if (middle.converged()) {
+        from_coarse.time_budget_s = withRemainingBudget(options, start).time_budget_s;
+        PlanResult fine = solveOnGridWithRetry(at, from_coarse, &between, &retried);
+        iterations += fine.iterations;
+        if (fine.converged()) {
+          fine.message += "; reached through N = " + std::to_string(half.steps) +
+                          " after the direct refinement stopped: " + result.message;
+          result = fine;
+          next = retried;
+        }
+      }
+    }
     if (stopped && coarse.termination == Termination::Infeasible) {
       // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
       result.termination = Termination::Infeasible;

@@ -15,31 +15,15 @@
 #include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/study_tools.hpp"
 
 using namespace attitude_planner;
 
 namespace {
 
-double seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-std::string loadAverage() {
-  double a[3] = {0, 0, 0};
-  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf %lf %lf", &a[0], &a[1], &a[2]) != 3) a[0] = a[1] = a[2] = -1;
-    std::fclose(f);
-  }
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.2f %.2f %.2f", a[0], a[1], a[2]);
-  return buffer;
-}
+using attitude_planner::study::loadAverage;
+using attitude_planner::study::median;
+using attitude_planner::study::seconds;
 
 /// max_k |τ_k| [N m]: the scale of the relative torque error.
 double maxTorque(const Maneuver& m) {

@@ -48,6 +48,7 @@
 #include "planning/reduced_problem.hpp"
 #include "planning/solvers.hpp"
 #include "support/random_problems.hpp"
+#include "support/study_tools.hpp"
 
 #ifdef AP_HAVE_IPOPT
 #include <coin/IpIpoptApplication.hpp>
@@ -253,6 +254,8 @@ using ap::Matrix3;
 using ap::Vector3;
 
 namespace {
+
+using attitude_planner::study::median;
 
 const char* const kUsage =
     "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
@@ -1290,12 +1293,6 @@ struct SuiteRow {
   PeerOutcome ipopt;
   double ipopt_cost = 0.0, ipopt_time_s = 0.0, ipopt_replay_miss = 0.0;
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 std::string percent(int part, int whole) {
   char b[64];

@@ -35,6 +35,7 @@
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
 #include "support/hermite_simpson.hpp"
+#include "support/study_tools.hpp"
 
 #ifdef AP_HAVE_IPOPT
 #include <coin/IpoptConfig.h>
@@ -46,26 +47,9 @@ using namespace attitude_planner;
 
 namespace {
 
-double seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-std::string loadAverage() {
-  double a[3] = {0, 0, 0};
-  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf %lf %lf", &a[0], &a[1], &a[2]) != 3) a[0] = a[1] = a[2] = -1;
-    std::fclose(f);
-  }
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.2f %.2f %.2f", a[0], a[1], a[2]);
-  return buffer;
-}
+using attitude_planner::study::loadAverage;
+using attitude_planner::study::median;
+using attitude_planner::study::seconds;
 
 std::string sceneName(const std::string& path) {
   std::string base = path.substr(path.find_last_of('/') + 1);

@@ -23,12 +23,15 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "support/robustness_cases.hpp"
+#include "support/study_tools.hpp"
 
 namespace ap = attitude_planner;
 namespace rb = attitude_planner::robustness;
 namespace fs = std::filesystem;
 
 namespace {
+
+using attitude_planner::study::loadAverage;
 
 std::string g(double v, const char* format = "%.3g") {
   char buffer[64];
@@ -54,13 +57,6 @@ std::string readFile(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  double a = 0, b = 0, c = 0;
-  in >> a >> b >> c;
-  return g(a, "%.2f") + " " + g(b, "%.2f") + " " + g(c, "%.2f");
 }
 
 std::string relationText(const rb::Check& c) {

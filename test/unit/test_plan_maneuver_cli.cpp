@@ -37,6 +37,14 @@ std::string readFile(const std::string& path) {
   return s.str();
 }
 
+/// The number after `"key": ` in a JSON summary (the first occurrence).
+double jsonNumber(const std::string& summary, const std::string& key) {
+  const std::string field = "\"" + key + "\": ";
+  const std::size_t at = summary.find(field);
+  EXPECT_NE(at, std::string::npos) << key << " missing in " << summary;
+  return at == std::string::npos ? std::nan("") : std::stod(summary.substr(at + field.size()));
+}
+
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -133,9 +141,9 @@ TEST_F(CliTest, SecondOrderPlanReportsEffortAndReplaysThroughSimulateTorques) {
   const std::string summary = readFile(json);
   EXPECT_CONTAINS(summary, "\"scheme\": \"second_order\"");
   EXPECT_CONTAINS(summary, "\"converged\": true");
-  const double cost = std::stod(summary.substr(summary.find("\"cost\": ") + 8));
-  const double effort = std::stod(summary.substr(summary.find("\"effort\": ") + 10));
-  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  const double cost = jsonNumber(summary, "cost");
+  const double effort = jsonNumber(summary, "effort");
+  const double duration = jsonNumber(summary, "duration");
   EXPECT_NEAR(effort, duration / 64 * cost, 1e-9 * effort) << summary;
   const ap::Maneuver plan = ap::readManeuverCsv(csv);
   EXPECT_GT(plan.torque.front().norm(), 0.0);  // end torques are part of the plan
@@ -161,9 +169,9 @@ TEST_F(CliTest, FourthOrderPlanExtrapolatesAndReplaysThroughSimulateTorques) {
   EXPECT_CONTAINS(summary, "\"scheme\": \"fourth_order\"");
   EXPECT_CONTAINS(summary, "\"converged\": true");
   EXPECT_CONTAINS(summary, "Richardson extrapolation of second_order at N = 64 and 2N = 128");
-  const double cost = std::stod(summary.substr(summary.find("\"cost\": ") + 8));
-  const double effort = std::stod(summary.substr(summary.find("\"effort\": ") + 10));
-  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  const double cost = jsonNumber(summary, "cost");
+  const double effort = jsonNumber(summary, "effort");
+  const double duration = jsonNumber(summary, "duration");
   EXPECT_NEAR(effort, duration / 64 * cost, 1e-9 * effort) << summary;
   const ap::Maneuver plan = ap::readManeuverCsv(csv);
   EXPECT_EQ(plan.steps(), 64);
@@ -188,8 +196,8 @@ TEST_F(CliTest, MinimumTimeReportsTStarAndHonoursTheMargin) {
   ASSERT_EQ(r.status, 0) << r.output;
   const std::string summary = readFile(json);
   EXPECT_CONTAINS(summary, "\"objective\": \"minimum_time\"");
-  const double t_star = std::stod(summary.substr(summary.find("\"minimum_duration\": ") + 20));
-  const double duration = std::stod(summary.substr(summary.find("\"duration\": ") + 12));
+  const double t_star = jsonNumber(summary, "minimum_duration");
+  const double duration = jsonNumber(summary, "duration");
   EXPECT_NEAR(t_star, 2 * std::sqrt(10.0), 2e-3 * t_star);  // closed form, N = 32
   EXPECT_NEAR(duration, 1.25 * t_star, 1e-9 * duration);
   EXPECT_CONTAINS(r.output, "minimum duration T*");

@@ -5,9 +5,11 @@
 // with right perturbations R_j exp(δ_j^) its gradient is Σ_k J_kᵀ τ_k and its exact Hessian is
 // JᵀJ + sym(Σ_k Σ_i τ_{k,i} ∂J_{k,i}/∂δ), block-pentadiagonal: a banded Cholesky costs O(N).
 //
-// Globalization: the cost itself is the merit function. If the Hessian is not positive definite a
-// multiple of the identity is added (Levenberg); an Armijo backtracking line search along the
-// retraction R_j exp(α δ_j^) follows. Convergence: the Newton decrement relative to |τ|₂ is below
+// Globalization: the cost itself is the merit function; a trust region through the shift
+// (Levenberg–Marquardt): the step solves (H + λI)δ = −g along the retraction R_j exp(δ_j^), with
+// λ raised while H + λI is indefinite, and then by the ratio of the actual to the model's
+// decrease (Nielsen's update: a rejected step raises λ and is recomputed; a well-predicted one
+// lowers it, to 0 = pure Newton). Convergence: the Newton decrement relative to |τ|₂ is below
 // the tolerance; the step it came with is then taken, leaving the torques exact to ~round-off.
 #include <chrono>
 #include <cmath>

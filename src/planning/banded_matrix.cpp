@@ -23,6 +23,20 @@ double BandedSymmetricMatrix::maxAbsDiagonal() const {
   return m;
 }
 
+void BandedSymmetricMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd* y_out) const {
+  Eigen::VectorXd& y = *y_out;
+  y.setZero(n_);
+  for (int i = 0; i < n_; ++i) {
+    const double* row = &data_[static_cast<size_t>(i) * (p_ + 1) + p_ - i];  // row[j] = A(i, j)
+    double sum = row[i] * x(i);
+    for (int j = std::max(0, i - p_); j < i; ++j) {
+      sum += row[j] * x(j);
+      y(j) += row[j] * x(i);
+    }
+    y(i) += sum;
+  }
+}
+
 double BandedSymmetricMatrix::operator()(int i, int j) const {
   if (i < j) std::swap(i, j);
   return i - j <= p_ ? data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)] : 0.0;
@@ -37,12 +51,21 @@ Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
 }
 
 bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
+  BandedCholesky cholesky;
+  if (!cholesky.factor(*this)) return false;
+  cholesky.solve(b);
+  return true;
+}
+
+bool BandedCholesky::factor(const BandedSymmetricMatrix& A) {
   // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
   // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
+  n_ = A.n_;
+  p_ = A.p_;
   const int w = p_ + 1;
-  std::vector<double> L = data_;
+  L_ = A.data_;
   const auto row = [&](int i) {
-    return L.data() + static_cast<size_t>(i) * w + p_ - i;
+    return L_.data() + static_cast<size_t>(i) * w + p_ - i;
   };  // row(i)[j] = L(i, j)
   for (int i = 0; i < n_; ++i) {
     double* li = row(i);
@@ -59,6 +82,12 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
       }
     }
   }
+  return true;
+}
+
+void BandedCholesky::solve(Eigen::VectorXd* b) const {
+  const int w = p_ + 1;
+  const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
   Eigen::VectorXd& y = *b;
   for (int i = 0; i < n_; ++i) {  // L y = b
     const double* li = row(i);
@@ -71,7 +100,6 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
     for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y(k);
     y(i) = s / row(i)[i];
   }
-  return true;
 }
 
 }  // namespace attitude_planner

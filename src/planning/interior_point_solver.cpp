@@ -595,25 +595,6 @@ class InteriorPoint {
     }
   }
 
-  /// Elastic form: the largest primal step in (0, 1] that keeps every slack s(c) (elasticSlacks)
-  /// at least (1 − τ) of its value to first order, s(c + α gᵀd) ≈ s + α s'(c) gᵀd with
-  /// s' = s²/(s² + v²) (≈ 1 for a satisfied constraint, ≈ 0 for a violated one), at the values of
-  /// the last assembly.
-  double primalStep(const Eigen::VectorXd& d, double mu, double rho) const {
-    double alpha = 1.0;
-    for (const Group& g : groups_) {
-      for (int k = g.first_k; k <= g.last_k; ++k) {
-        const Instance& in = g.at[k - g.first_k];
-        const double slope = linearization(g, k, d);
-        if (slope >= 0.0) continue;
-        const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
-        const double ds = sl.s * sl.s / (sl.s * sl.s + sl.v * sl.v) * slope;
-        if (ds < 0.0) alpha = std::min(alpha, -kFractionToBoundary * sl.s / ds);
-      }
-    }
-    return alpha;
-  }
-
   /// FreeSlacks: the largest multiplier after the dual step dz (for the merit's ν).
   double largestMultiplier(const std::vector<double>& dz, double alpha) const {
     double largest = 0.0;
@@ -1004,15 +985,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // φ_μ at the current iterate from the values the assembly just formed (no re-evaluation).
     const double penalty = free_slacks ? nu : rho;
     const double phi = ip.assembledMerit(cost, mu, penalty);
-    // The first trial: the fraction to the boundary of the slacks (free: s itself; elastic, once
-    // the iterate is feasible: the slacks s(c) to first order). Without it a constraint about to
-    // bind, its z still small, was stepped past its bound, the ℓ1 penalty rejected the full step
-    // and halving followed at every iteration of the final barrier (measured: α = 1/2
-    // throughout, the decrement falling by 1/√2 per iteration; torque + rate limits, N = 8192:
-    // 29 iterations on the finest level, 18 with it). While constraints are violated it is not
-    // used: there the step that repairs them may pass others' slacks (measured: N = 10⁵ from
-    // N = 25 000 then crawled at α ~ 1e-2 and never became feasible).
-    double alpha = free_slacks ? alpha_slack : violated ? 1.0 : ip.primalStep(delta, mu, rho);
+    double alpha = free_slacks ? alpha_slack : 1.0;
     bool accepted = final_step || -slope <= 1e-14 * std::abs(phi);
     ReducedProblem::Steps trial = np.retract(delta, alpha);
     for (int back = 0; !accepted && back < 60; ++back) {

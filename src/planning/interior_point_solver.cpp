@@ -27,6 +27,14 @@
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
 // Inertia correction: a multiple of the identity until the Cholesky factorization succeeds.
 //
+// Large N: the condensed matrix H = Σ_k J_kᵀ W_k J_k + S (J_k = ∂τ_k/∂δ, W_k the stencil's
+// 3×3 weight: β I plus the torque constraints' g gᵀ/D; S the rest) has condition ~N⁴, and above
+// InteriorPointSettings::normal_equations_max_steps the step comes from the augmented system
+// [−α W⁻¹ J; Jᵀ S/α] (condition ~N², solveAugmented) while the Cholesky factor still decides the
+// shift. The torque constraints' gᵀdδ are then taken from its J_k dδ (dz = (q − gᵀdδ)/D amplifies
+// their error by 1/D). Measured: torque + rate limits at N = 10⁵ ended in a false "infeasible"
+// on the normal equations (their solves' relative residuals grow from 2e-4 at N = 8192).
+//
 // A grid level that ends infeasible or unconverged in this elastic form is solved once more in the
 // free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free variables,
 // the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit

@@ -266,6 +266,7 @@ const char* const kUsage =
     "                         constrained solve (computed before the peer's clock starts)\n"
     "       benchmark_solvers --quick   every solver on the seed's rest-to-rest example, N = 16\n"
     "       benchmark_solvers --random-suite COUNT [--seed S] [--out FILE.md] [--time-budget S]\n"
+    "                         [--cases I,J,...]  (only these case indices, e.g. to re-plan one)\n"
     "                         ours and IPOPT (exact Hessian, paper scheme, same start) on the\n"
     "                         seeded random problems of test/support/random_problems.hpp\n"
     "       benchmark_solvers --check-hessian [--steps N] [--constrained]   IPOPT's exact Hessian\n"
@@ -1303,10 +1304,15 @@ std::string percent(int part, int whole) {
 /// Runs `count` cases of the suite seeded `seed`: ours (planManeuver, default options but the
 /// time budget) and, on paper-scheme cases, IPOPT from the same start (newtonInitialSteps).
 /// Writes a markdown section to `out_path` (stdout if empty); one JSON line per case to stderr.
-int randomSuite(int count, std::uint64_t seed, double time_budget, const std::string& out_path) {
+int randomSuite(int count, std::uint64_t seed, double time_budget, const std::string& out_path,
+                const std::vector<int>& only_cases) {
   std::vector<SuiteRow> rows;
   const auto wall_start = std::chrono::steady_clock::now();
   for (const ap::robustness::RandomCase& c : ap::robustness::randomSuite(seed, count)) {
+    if (!only_cases.empty() &&
+        std::find(only_cases.begin(), only_cases.end(), c.index) == only_cases.end()) {
+      continue;
+    }
     SuiteRow row;
     row.c = c;
     ap::SolverOptions options;
@@ -1518,6 +1524,7 @@ int main(int argc, char** argv) {
   int steps = 0;
   int suite_count = 0;
   std::uint64_t suite_seed = 19;
+  std::vector<int> only_cases;
   std::string out_path;
   int in_process = 1;  // solves in this process; > 1 adds the warm median (runs 2..K)
   double time_budget = 120.0;
@@ -1562,6 +1569,10 @@ int main(int argc, char** argv) {
         std::cerr << "--random-suite: expected a positive count, got '" << argv[i] << "'\n";
         return 1;
       }
+    } else if (a == "--cases") {
+      std::stringstream list(value());
+      for (std::string item; std::getline(list, item, ',');)
+        only_cases.push_back(std::atoi(item.c_str()));
     } else if (a == "--seed") {
       suite_seed = std::strtoull(value().c_str(), nullptr, 10);
     } else if (a == "--out") {
@@ -1582,7 +1593,8 @@ int main(int argc, char** argv) {
     return 3;
 #endif
   }
-  if (suite_count > 0) return randomSuite(suite_count, suite_seed, time_budget, out_path);
+  if (suite_count > 0)
+    return randomSuite(suite_count, suite_seed, time_budget, out_path, only_cases);
   if (solver.empty()) {
     std::cerr << kUsage;
     return 2;

@@ -5,9 +5,11 @@
 // with right perturbations R_j exp(δ_j^) its gradient is Σ_k J_kᵀ τ_k and its exact Hessian is
 // JᵀJ + sym(Σ_k Σ_i τ_{k,i} ∂J_{k,i}/∂δ), block-pentadiagonal: a banded Cholesky costs O(N).
 //
-// Globalization: the cost itself is the merit function. If the Hessian is not positive definite a
-// multiple of the identity is added (Levenberg); an Armijo backtracking line search along the
-// retraction R_j exp(α δ_j^) follows. Convergence: the Newton decrement relative to |τ|₂ is below
+// Globalization: the cost itself is the merit function; a trust region through the shift
+// (Levenberg–Marquardt): the step solves (H + λI)δ = −g along the retraction R_j exp(δ_j^), with
+// λ raised while H + λI is indefinite, and then by the ratio of the actual to the model's
+// decrease (Nielsen's update: a rejected step raises λ and is recomputed; a well-predicted one
+// lowers it, to 0 = pure Newton). Convergence: the Newton decrement relative to |τ|₂ is below
 // the tolerance; the step it came with is then taken, leaving the torques exact to ~round-off.
 #include <chrono>
 #include <cmath>
@@ -49,6 +51,16 @@ double roundOffFloor(int steps) {
   return 0.5 * std::numeric_limits<double>::epsilon() * double(steps) * steps;
 }
 
+/// Levenberg–Marquardt control (relative shifts λ, × the Hessian's scale).
+constexpr int kMaxStepAttempts = 80;
+constexpr double kSmallestShift = 1e-14;  ///< below this λ counts as 0 (pure Newton)
+/// Below this λ a well-predicted step is followed by pure Newton (quadratic convergence).
+constexpr double kNegligibleShift = 1e-7;
+constexpr double kIndefiniteShiftGrowth = 4;   ///< λ growth while H + λI is indefinite
+constexpr double kFirstRejectionShift = 1e-8;  ///< λ after a rejected pure Newton step
+constexpr double kAcceptRatio = 1e-4;          ///< least actual/predicted decrease accepted
+constexpr double kShiftMinFactor = 1.0 / 10;   ///< most λ falls after one step
+
 /// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
 ///   [ −α I   J        ] [ z ]   [ −τ ]
 ///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
@@ -57,6 +69,13 @@ double roundOffFloor(int steps) {
 /// by LU with partial pivoting. `delta` holds −g on entry and δ on return. `K` is the caller's
 /// workspace (allocated once per solve: at N = 10⁶ it is 2 GB, and fresh pages cost more
 /// system time than the factorization).
+/// The scale the augmented system's relative shift multiplies: (2|J|/h²)², the largest
+/// curvature of |τ|² in one attitude.
+double augmentedShiftScale(const ReducedProblem& np) {
+  const double h = np.scheme().timeStep();
+  return std::pow(2.0 * np.scheme().inertia().norm() / (h * h), 2);
+}
+
 bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
   const int N = np.steps();
@@ -76,10 +95,7 @@ bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::Vect
   const double smallest_moment =
       Eigen::SelfAdjointEigenSolver<Matrix3>(np.scheme().inertia()).eigenvalues()(0);
   const double alpha = smallest_moment * (M_PI / T) * (M_PI / T);
-  const double shift =
-      relative_shift * std::pow(2.0 * np.scheme().inertia().norm() /
-                                    (np.scheme().timeStep() * np.scheme().timeStep()),
-                                2);
+  const double shift = relative_shift * augmentedShiftScale(np);
   np.forEachStencil(true, [&](const ReducedProblem::Stencil& st) {
     const int ry = 3 * y_block(st.k);
     for (int i = 0; i < 3; ++i) {
@@ -237,77 +253,89 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       termination = Termination::TimedOut;
       break;
     }
-    // Newton direction; Levenberg shift until the Hessian is positive definite (normal
-    // equations: Cholesky succeeds; augmented system: the step is a descent direction).
+    // Levenberg–Marquardt step, the shift λ (relative to the Hessian's scale) controlled by the
+    // ratio ρ of the actual to the predicted decrease (a trust region through λ; Nielsen's update):
+    // H + λI must be positive definite (normal equations: Cholesky succeeds; augmented system:
+    // the step is a descent direction); the full step is tried, accepted if ρ ≥ kAcceptRatio,
+    // else λ grows (×ν, ν doubling) and the step is recomputed within this iteration.
+    // (An Armijo line search along Levenberg steps of fixed λ stalled for hundreds of iterations
+    // with a shift 100× above the least one that keeps H + λI definite: issue 19.)
     double shift = damping;  // relative to the Hessian's scale
-    bool factored = false;
-    for (int attempt = 0; attempt < 40; ++attempt) {
+    const double shift_scale = augmented ? augmentedShiftScale(np) : hessian.maxAbsDiagonal();
+    double growth = 2.0;  // ν
+    bool accepted = false, factored = false, final_step = false;
+    bool predicted_within_tolerance = false;
+    double slope = 0.0, predicted_decrement = std::numeric_limits<double>::infinity();
+    const double alpha = 1.0;  // steps are taken in full; λ does the damping
+    ReducedProblem::Steps trial_R;
+    for (int attempt = 0; attempt < kMaxStepAttempts && !accepted; ++attempt) {
       delta = -gradient;
       if (augmented) {
         factored =
             solveAugmented(np, shift, &delta, &augmented_workspace) && gradient.dot(delta) < 0;
       } else {
         BandedSymmetricMatrix trial = hessian;
-        if (shift > 0) trial.addToDiagonal(shift * hessian.maxAbsDiagonal());
+        if (shift > 0) trial.addToDiagonal(shift * shift_scale);
         factored = trial.solvePositiveDefinite(&delta);
       }
-      if (factored) break;
-      // Start far below the smallest curvature (λ_max/λ_min reaches 1e13 at N = 1000): a shift
-      // of 1e-10 λ_max already swamps the smooth modes and makes convergence linear.
-      shift = shift == 0.0 ? 1e-14 : 100.0 * shift;
+      if (!factored) {
+        // Indefinite: grow the shift in steps fine enough to stay near the least definite one
+        // (λ_max/λ_min reaches 1e13 at N = 1000: a needlessly large shift swamps the smooth
+        // modes and makes convergence linear).
+        shift = shift == 0.0 ? kSmallestShift : kIndefiniteShiftGrowth * shift;
+        continue;
+      }
+      // Newton decrement λ = √(gᵀH⁻¹g): λ ≈ the ℓ2 error of the torques, so λ/|τ|₂ with
+      // |τ|₂ = √(2C) is the relative torque accuracy — scale-free, unlike the raw gradient,
+      // whose conditioning grows like N⁴.
+      slope = gradient.dot(delta);
+      relative_decrement =
+          std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
+      // Quadratic convergence observed on this very run: the last full step took the decrement
+      // from d₋ to d, so this one will leave about C d², C = d/d₋². Well inside the tolerance
+      // (10×), this step is the last (saves the iteration that would only confirm it).
+      const double d_prev = previous_full_step_decrement;
+      predicted_decrement =
+          d_prev > 0.0 && relative_decrement < d_prev
+              ? relative_decrement / (d_prev * d_prev) * relative_decrement * relative_decrement
+              : std::numeric_limits<double>::infinity();
+      predicted_within_tolerance = predicted_decrement <= 0.1 * options.tolerance;
+      final_step =
+          shift == 0.0 && (relative_decrement <= std::max(options.tolerance, roundOffFloor(N)) ||
+                           predicted_within_tolerance);
+      trial_R = np.retract(delta, alpha);
+      // Once the predicted decrease is below the cost's round-off the ratio is meaningless and
+      // the step is taken: when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the
+      // round-off acceptance relative — at large N the cost's own round-off (torques are second
+      // differences: relative error ~eps·N²) exceeds that, and the test would fail on noise.
+      if (final_step || -slope <= 1e-13 * cost || relative_decrement <= round_off_acceptance) {
+        accepted = true;
+        damping = 0.0;
+        break;
+      }
+      const double trial_cost = np.cost(trial_R);
+      // Model m(δ) = C + gᵀδ + ½δᵀHδ with (H + λI)δ = −g: C − m(δ) = ½(−gᵀδ + λ|δ|²).
+      const double predicted = 0.5 * (-slope + shift * shift_scale * delta.squaredNorm());
+      const double ratio = (cost - trial_cost) / predicted;
+      if (std::isfinite(trial_cost) && ratio >= kAcceptRatio) {
+        accepted = true;
+        const double t = 2.0 * ratio - 1.0;
+        const double next = shift * std::max(kShiftMinFactor, 1.0 - t * t * t);
+        damping = next < kNegligibleShift ? 0.0 : next;
+      } else {
+        shift = shift == 0.0 ? kFirstRejectionShift : growth * shift;
+        growth *= 2.0;
+      }
     }
     if (!factored) {
       reason = "Hessian could not be made positive definite";
       break;
     }
-    // Newton decrement λ = √(gᵀH⁻¹g): λ ≈ the ℓ2 error of the torques, so λ/|τ|₂ with
-    // |τ|₂ = √(2C) is the relative torque accuracy — scale-free, unlike the raw gradient, whose
-    // conditioning grows like N⁴.
-    const double slope = gradient.dot(delta);
-    relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(std::max(2.0 * cost, 1e-300));
-    // Quadratic convergence observed on this very run: the last full step took the decrement
-    // from d₋ to d, so this one will leave about C d², C = d/d₋². Well inside the tolerance
-    // (10×), this step is the last (saves the iteration that would only confirm it).
-    const double d_prev = previous_full_step_decrement;
-    const double predicted_decrement =
-        d_prev > 0.0 && relative_decrement < d_prev
-            ? relative_decrement / (d_prev * d_prev) * relative_decrement * relative_decrement
-            : std::numeric_limits<double>::infinity();
-    const bool predicted_within_tolerance = predicted_decrement <= 0.1 * options.tolerance;
-    const bool final_step =
-        shift == 0.0 && (relative_decrement <= std::max(options.tolerance, roundOffFloor(N)) ||
-                         predicted_within_tolerance);
-    // Armijo backtracking on the cost along the retraction. Once the predicted decrease is below
-    // the cost's round-off the test is meaningless and the full Newton step is taken: that is
-    // when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the round-off acceptance
-    // relative (predicted decrease ≤ 1e-12 C) — at large N the cost's own round-off (torques are
-    // second differences: relative error ~eps·N²) exceeds that, and Armijo would fail on noise.
-    double alpha = 1.0;
-    bool accepted =
-        final_step || -slope <= 1e-13 * cost || relative_decrement <= round_off_acceptance;
-    ReducedProblem::Steps trial_R = np.retract(delta, alpha);
-    for (int back = 0; !accepted && back < 50; ++back) {
-      const double trial_cost = np.cost(trial_R);
-      if (std::isfinite(trial_cost) && trial_cost <= cost + 1e-4 * alpha * slope) {
-        accepted = true;
-        break;
-      }
-      alpha *= 0.5;
-      trial_R = np.retract(delta, alpha);
-    }
     if (!accepted) {
-      reason = "line search failed";
+      reason = "no step decreased the cost (trust region collapsed)";
       break;
     }
     np.setCurrent(trial_R);
-    // Levenberg–Marquardt-style memory: a step that had to be cut means the model was trusted too
-    // far, so start the next iteration more damped; full steps relax the damping back to pure
-    // Newton (quadratic convergence needs shift 0 near the solution).
-    if (alpha < 1.0) {
-      damping = std::max(100.0 * shift, 1e-12);
-    } else {
-      damping = shift / 100.0 < 1e-14 ? 0.0 : shift / 100.0;
-    }
     // Round-off floor: once the decrement is small, full Newton steps that no longer halve it for
     // two iterations mean the gradient is noise (the Hessian's condition grows like N⁴). Stop
     // there; the achieved relative accuracy is the decrement (≤ round_off_acceptance). A large

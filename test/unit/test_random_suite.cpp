@@ -28,12 +28,12 @@ namespace {
 constexpr std::uint64_t kSuiteSeed = 19;
 constexpr int kCiCases = 40;
 
-/// Cases of the CI subset that do not converge today (issue 19's 100 % target is not met):
-/// seed-like inertia, variational, T ≈ 65–72 s with ~4 rad/s at both ends (~40 turns); the
-/// Newton iteration stalls from the Hermite guess and continuation in the boundary rates stalls
-/// near s = 0.8. A strict expected failure: if one converges the test fails until it is removed
-/// here, so the list cannot go stale. docs/robustness.md has the full-size figures.
-const std::set<int> kKnownStalls = {1, 25};
+/// Cases of the CI subset that do not converge today (a strict expected failure: if one
+/// converges the test fails until it is removed here, so the list cannot go stale). Empty since
+/// the Levenberg–Marquardt control of the Newton shift: #1 and #25 (seed-like, variational,
+/// T ≈ 65–72 s, ~4 rad/s at both ends) converge by continuation in the boundary rates.
+/// docs/robustness.md has the full-size figures.
+const std::set<int> kKnownStalls = {};
 
 }  // namespace
 

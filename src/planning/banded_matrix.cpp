@@ -23,20 +23,6 @@ double BandedSymmetricMatrix::maxAbsDiagonal() const {
   return m;
 }
 
-void BandedSymmetricMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd* y_out) const {
-  Eigen::VectorXd& y = *y_out;
-  y.setZero(n_);
-  for (int i = 0; i < n_; ++i) {
-    const double* row = &data_[static_cast<size_t>(i) * (p_ + 1) + p_ - i];  // row[j] = A(i, j)
-    double sum = row[i] * x(i);
-    for (int j = std::max(0, i - p_); j < i; ++j) {
-      sum += row[j] * x(j);
-      y(j) += row[j] * x(i);
-    }
-    y(i) += sum;
-  }
-}
-
 double BandedSymmetricMatrix::operator()(int i, int j) const {
   if (i < j) std::swap(i, j);
   return i - j <= p_ ? data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)] : 0.0;

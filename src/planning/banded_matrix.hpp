@@ -37,8 +37,6 @@ class BandedSymmetricMatrix {
   /// alike; `floor` gives zero diagonals a scale.
   void addRelativeToDiagonal(double factor, double floor);
   double maxAbsDiagonal() const;
-  /// y = A x.
-  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
   /// A(i, j), for tests and diagnostics.
   double operator()(int i, int j) const;
   /// The full matrix, for tests and diagnostics.
@@ -56,7 +54,7 @@ class BandedSymmetricMatrix {
 };
 
 /// The banded Cholesky factor L Lᵀ = A of a BandedSymmetricMatrix, kept so that several right-hand
-/// sides can be solved with one factorization (the interior point's second-order correction).
+/// sides can be solved with one factorization (e.g. a predictor–corrector's second solve).
 class BandedCholesky {
  public:
   /// Factors A (the factor replaces any previous one). Returns false if A is not numerically

@@ -27,14 +27,6 @@
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
 // Inertia correction: a multiple of the identity until the Cholesky factorization succeeds.
 //
-// Large N: the condensed matrix H = Σ_k J_kᵀ W_k J_k + S (J_k = ∂τ_k/∂δ, W_k the stencil's
-// 3×3 weight: β I plus the torque constraints' g gᵀ/D; S the rest) has condition ~N⁴, and above
-// InteriorPointSettings::normal_equations_max_steps the step comes from the augmented system
-// [−α W⁻¹ J; Jᵀ S/α] (condition ~N², solveAugmented) while the Cholesky factor still decides the
-// shift. The torque constraints' gᵀdδ are then taken from its J_k dδ (dz = (q − gᵀdδ)/D amplifies
-// their error by 1/D). Measured: torque + rate limits at N = 10⁵ ended in a false "infeasible"
-// on the normal equations (their solves' relative residuals grow from 2e-4 at N = 8192).
-//
 // A grid level that ends infeasible or unconverged in this elastic form is solved once more in the
 // free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free variables,
 // the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
@@ -58,11 +50,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <optional>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
@@ -126,7 +114,6 @@ struct Instance {
   double s = 0.0, v = 0.0;        ///< slacks (Elastic: elasticSlacks of c; FreeSlacks: s free)
   double D = 1.0, q = 0.0;        ///< condensation terms (see the header comment)
   double ds = 0.0;                ///< FreeSlacks: the slack's Newton step
-  Vector3 torque_gradient;        ///< torque families: ∂c/∂r_k (so g = J_kᵀ torque_gradient)
 };
 
 /// All node constraints of one kind (one axis and sign of the torque box, or one spec).
@@ -175,27 +162,6 @@ void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>&
     if (v >= 0) out->segment<3>(v) += weight * g.segment<3>(3 * n);
   }
 }
-
-/// The condensed Newton matrix split as H = Σ_k J_kᵀ W_k J_k + S for the augmented solve
-/// (solveAugmented): J_k = ∂τ_k/∂(δ_{k−1}, δ_k, δ_{k+1}) (residual r_k = √w_k τ_k), W_k the
-/// stencil's 3×3 weight (β I plus the torque constraints' g gᵀ/D, all of the form J_kᵀ(·)J_k),
-/// and S the rest (second-order terms, rate and cone blocks), banded as H.
-struct AugmentedParts {
-  std::vector<Eigen::Matrix<double, 3, 9>> jacobian;  ///< J_k, by torque index k
-  std::vector<Matrix3> weight;                        ///< W_k
-  BandedSymmetricMatrix rest;                         ///< S
-  /// J_k d = α W_k⁻¹ y_k of the last solve: the torque constraints' linearizations g_iᵀd are
-  /// taken from it, not from d (a binding constraint's dz = (q − gᵀd)/D amplifies the error of
-  /// gᵀd by 1/D, and J d recomputed from d loses what the augmented solve resolved).
-  std::vector<Vector3> torque_step;
-  std::vector<Vector3> residual;  ///< r_k (∇f = Σ J_kᵀ r_k)
-  explicit AugmentedParts(const ReducedProblem& np)
-      : jacobian(np.steps() + 1),
-        residual(np.steps() + 1, Vector3::Zero()),
-        weight(np.steps() + 1),
-        rest(np.unknowns(), 8),
-        torque_step(np.steps() + 1, Vector3::Zero()) {}
-};
 
 class InteriorPoint {
  public:
@@ -334,16 +300,9 @@ class InteriorPoint {
   /// `primal`: the multipliers are replaced by their primal values μ/s (then the step is Newton's
   /// on φ_μ, a descent direction whenever H is positive definite).
   double assemble(double mu, double rho, bool primal, BandedSymmetricMatrix* H,
-                  Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, double* gradient_scale,
-                  AugmentedParts* parts = nullptr) {
+                  Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, double* gradient_scale) {
     const int n = np_.unknowns();
     H->setZero();
-    if (parts) parts->rest.setZero();
-    // A block of S (everything not of the form J_kᵀ W J_k): into H and, if split, S.
-    const auto add_rest = [&](int first_node, int width, const Eigen::Matrix<double, 9, 9>& M) {
-      addLocal(np_, H, first_node, width, M);
-      if (parts) addLocal(np_, &parts->rest, first_node, width, M);
-    };
     rhs->setZero(n);
     merit_gradient->setZero(n);
     const ReducedProblem::Steps& steps = np_.current();
@@ -419,30 +378,17 @@ class InteriorPoint {
           Eigen::Matrix<double, 9, 9> block =
               current_beta_ * st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
           const double r = root(st.k);
-          Matrix3 W = current_beta_ * Matrix3::Identity();
           for (Group* g : torque_groups) {
             Instance& in = g->instance(st.k);
             if (g->family == Family::TorqueNorm) {
-              const double a = -2.0 / (g->limit * g->limit * r * r);
-              in.g = a * grad_f;
-              in.torque_gradient = a * st.tau;
-              W += (a * a / in.D) * st.tau * st.tau.transpose();
+              in.g = -2.0 / (g->limit * g->limit * r * r) * grad_f;
             } else {
               const double sign = g->family == Family::TorqueUpper ? 1.0 : -1.0;
-              const double a = -sign / (g->limit * r);
-              in.g = a * st.jacobian.row(g->axis).transpose();
-              in.torque_gradient = Vector3::Unit(g->axis) * a;
-              W(g->axis, g->axis) += a * a / in.D;
+              in.g = -sign / (g->limit * r) * st.jacobian.row(g->axis).transpose();
             }
             block += (in.g / in.D) * in.g.transpose();
           }
           addLocal(np_, H, st.k - 1, 3, block);
-          if (parts) {
-            parts->jacobian[st.k] = st.jacobian;
-            parts->residual[st.k] = st.tau;
-            parts->weight[st.k] = W;
-            addLocal(np_, &parts->rest, st.k - 1, 3, st.second);
-          }
           addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
           addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
         },
@@ -481,7 +427,7 @@ class InteriorPoint {
               in.g = -2.0 / (g->limit * g->limit) * grad;
               block += (in.g / in.D) * in.g.transpose();
             }
-            add_rest(node.k - 1, 3, block);
+            addLocal(np_, H, node.k - 1, 3, block);
           },
           rate_weights);
     }
@@ -510,7 +456,7 @@ class InteriorPoint {
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
         }
         block += (in.g / in.D) * in.g.transpose();
-        add_rest(k + g->node_offset, g->width, block);
+        addLocal(np_, H, k + g->node_offset, g->width, block);
       }
     }
     // ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is
@@ -526,32 +472,6 @@ class InteriorPoint {
     return cost;
   }
 
-  /// Uses (or, with null, stops using) the augmented solve's J_k d for the torque constraints.
-  void setTorqueSteps(const std::vector<Vector3>* torque_step) { torque_step_ = torque_step; }
-
-  /// ∇φ_μᵀd: from `merit_gradient` (assembled), or with the augmented solve's J_k d as
-  /// Σ r_kᵀ J_k d − Σ (μ/s_i) g_iᵀd (elastic; free slacks: the first sum only).
-  double meritSlope(const Eigen::VectorXd& d, const Eigen::VectorXd& merit_gradient, double mu,
-                    const std::vector<Vector3>& residual) const {
-    if (!torque_step_) return merit_gradient.dot(d);
-    double slope = 0.0;
-    for (int k = np_.firstFreeNode() - 1; k <= np_.lastFreeNode() + 1; ++k)
-      slope += residual[k].dot((*torque_step_)[k]);
-    if (free_slacks_) return slope;
-    for (const Group& g : groups_) {
-      for (int k = g.first_k; k <= g.last_k; ++k)
-        slope -= mu / g.at[k - g.first_k].s * linearization(g, k, d);
-    }
-    return slope;
-  }
-
-  /// g_iᵀd of instance k of group g.
-  double linearization(const Group& g, int k, const Eigen::VectorXd& d) const {
-    const Instance& in = g.at[k - g.first_k];
-    if (torque_step_ && isTorqueFamily(g.family)) return in.torque_gradient.dot((*torque_step_)[k]);
-    return localDot(np_, in.g, k + g.node_offset, g.width, d);
-  }
-
   /// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
   /// and the steps dz themselves (stored in `dz`, instance order).
   double dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
@@ -560,7 +480,7 @@ class InteriorPoint {
     for (Group& g : groups_) {
       for (int k = g.first_k; k <= g.last_k; ++k) {
         const Instance& in = g.instance(k);
-        const double step = (in.q - linearization(g, k, d)) / in.D;
+        const double step = (in.q - localDot(np_, in.g, k + g.node_offset, g.width, d)) / in.D;
         dz->push_back(step);
         if (step < 0) alpha = std::min(alpha, -kFractionToBoundary * in.z / step);
         if (free_slacks_) continue;  // z has no upper bound
@@ -586,7 +506,7 @@ class InteriorPoint {
     for (Group& g : groups_) {
       for (int k = g.first_k; k <= g.last_k; ++k) {
         Instance& in = g.instance(k);
-        in.ds = linearization(g, k, d) + in.c - in.s;
+        in.ds = localDot(np_, in.g, k + g.node_offset, g.width, d) + in.c - in.s;
         if (in.ds < 0) alpha = std::min(alpha, -kFractionToBoundary * in.s / in.ds);
         slope -= mu * in.ds / in.s;
         sum += std::abs(in.c - in.s);
@@ -708,75 +628,8 @@ class InteriorPoint {
   Matrix3 inverse_inertia_squared_;  ///< J⁻²
   std::vector<Group> groups_;
   int constraint_count_ = 0;
-  const std::vector<Vector3>* torque_step_ = nullptr;
   double current_beta_ = 1.0;
 };
-
-/// Solves (Σ_k J_kᵀ W_k J_k + S + shift·diag(|H_ii| + floor)) d = b through the augmented form
-///   [ −α W⁻¹   J  ] [ y ]   [  0  ]
-///   [  Jᵀ     S/α ] [ d ] = [ b/α ],   y_k = W_k J_k d / α,
-/// ordered by node (y_k before δ_k, as the Newton solver's) so that it is banded (half bandwidth
-/// 14), by LU with partial pivoting. Its condition grows like N² where the normal equations'
-/// grows like N⁴ (above ~10⁴ steps their Cholesky solve leaves relative residuals ~1e-3: the
-/// interior point then crawls on inexact directions). `delta` holds b on entry, d on return.
-bool solveAugmented(const ReducedProblem& np, AugmentedParts* parts_out,
-                    const BandedSymmetricMatrix& hessian, double shift, double floor,
-                    Eigen::VectorXd* delta, std::unique_ptr<BandedLinearSystem>* workspace) {
-  const AugmentedParts& parts = *parts_out;
-  const int first = np.firstFreeNode(), last = np.lastFreeNode();
-  const auto y_block = [&](int k) { return k < first ? 0 : 2 * (k - first) + 1; };
-  const auto d_block = [&](int j) { return 2 * (j - first) + 2; };
-  const int n = 3 * (y_block(last + 1) + 1);
-  if (!*workspace) workspace->reset(new BandedLinearSystem(n, 14));
-  BandedLinearSystem& K = **workspace;
-  K.setZero();
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
-  // α ≈ σ_min(J) (the smoothest attitude mode; see the Newton solver's solveAugmented).
-  const double T = np.scheme().timeStep() * np.steps();
-  const double smallest_moment =
-      Eigen::SelfAdjointEigenSolver<Matrix3>(np.scheme().inertia()).eigenvalues()(0);
-  const double alpha = smallest_moment * (M_PI / T) * (M_PI / T);
-  for (int k = first - 1; k <= last + 1; ++k) {
-    const int ry = 3 * y_block(k);
-    const Matrix3 block = -alpha * parts.weight[k].inverse();
-    for (int i = 0; i < 3; ++i) {
-      for (int c = 0; c < 3; ++c) K.add(ry + i, ry + c, block(i, c));
-    }
-    for (int s = 0; s < 3; ++s) {
-      const int j = k - 1 + s;
-      if (np.variableIndex(j) < 0) continue;
-      const int rd = 3 * d_block(j);
-      for (int i = 0; i < 3; ++i) {
-        for (int c = 0; c < 3; ++c) {
-          K.add(ry + i, rd + c, parts.jacobian[k](i, 3 * s + c));
-          K.add(rd + c, ry + i, parts.jacobian[k](i, 3 * s + c));
-        }
-      }
-    }
-  }
-  const int p = parts.rest.bandwidth();
-  const int unknowns = np.unknowns();
-  const auto position = [&](int v) { return 3 * d_block(first + v / 3) + v % 3; };
-  for (int v = 0; v < unknowns; ++v) {
-    const int rv = position(v);
-    for (int w = std::max(0, v - p); w <= v; ++w) {
-      const double value = parts.rest(v, w) / alpha;
-      if (value == 0.0) continue;
-      const int rw = position(w);
-      K.add(rv, rw, value);
-      if (w != v) K.add(rw, rv, value);
-    }
-    if (shift > 0) K.add(rv, rv, shift * (std::abs(hessian(v, v)) + floor) / alpha);
-    rhs(rv) = (*delta)(v) / alpha;
-  }
-  if (!K.solve(&rhs)) return false;
-  for (int v = 0; v < unknowns; ++v) (*delta)(v) = rhs(position(v));
-  for (int k = first - 1; k <= last + 1; ++k) {
-    parts_out->torque_step[k] =
-        alpha * parts.weight[k].ldlt().solve(Vector3(rhs.segment<3>(3 * y_block(k))));
-  }
-  return delta->allFinite();
-}
 
 std::string describeManeuverSpan(const PlanningProblem& problem) {
   std::ostringstream s;
@@ -789,8 +642,7 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
 /// The interior point on one grid: from `coarse_steps` (a coarser grid's solution, with a small
 /// initial barrier) if given, else from options.warm_start; leaves its iterate in `final_steps`.
 PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
-                       const InteriorPointSettings& settings, Formulation formulation,
-                       const ReducedProblem::Steps* coarse_steps,
+                       Formulation formulation, const ReducedProblem::Steps* coarse_steps,
                        ReducedProblem::Steps* final_steps) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
@@ -839,13 +691,6 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   const bool free_slacks = ip.freeSlacks();
   const int n = np.unknowns();
   BandedSymmetricMatrix hessian(n, 8);
-  BandedSymmetricMatrix factored_matrix(n, 8);
-  BandedCholesky cholesky;
-  const bool augmented = N > settings.normal_equations_max_steps;
-  std::optional<AugmentedParts> parts;
-  if (augmented) parts.emplace(np);
-  std::unique_ptr<BandedLinearSystem>
-      augmented_workspace;  // of the last factored system (reused by the second-order correction)
   Eigen::VectorXd rhs(n), merit_gradient(n), delta(n);
   double gradient_scale = 0.0;
 
@@ -894,42 +739,24 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     double slope = 0.0, cost = 0.0, shift = 0.0;
     bool factored = false;
     for (int attempt = 0; attempt < 2 && !factored; ++attempt) {
-      cost = ip.assemble(mu, rho, primal, &hessian, &rhs, &merit_gradient, &gradient_scale,
-                         augmented ? &*parts : nullptr);
+      cost = ip.assemble(mu, rho, primal, &hessian, &rhs, &merit_gradient, &gradient_scale);
       if (!std::isfinite(cost)) break;
       shift = shift_floor;
       for (int tries = 0; tries < 40; ++tries) {
         delta = rhs;
-        bool ok = false;
-        factored_matrix = hessian;
-        if (shift > 0) {
-          // Inertia correction relative to each row's scale: at the final barrier the active
-          // constraints' rows are ~1/μ larger than the others, and a uniform shift sized by them
-          // (the largest diagonal) damped the free directions into linear convergence
-          // (measured: torque_limited, second_order, N = 512: 200 iterations at a decrement
-          // of 2e-6).
-          factored_matrix.addRelativeToDiagonal(shift, 1e-8 * hessian.maxAbsDiagonal());
-        }
-        // The Cholesky factorization decides the inertia correction (it fails unless the
-        // shifted matrix is positive definite); above kNormalEquationsMaxSteps the step itself
-        // comes from the augmented system with the same shift.
-        ok = cholesky.factor(factored_matrix);
-        if (ok && augmented) {
-          ok = solveAugmented(np, &*parts, hessian, shift, 1e-8 * hessian.maxAbsDiagonal(), &delta,
-                              &augmented_workspace);
-        } else if (ok) {
-          cholesky.solve(&delta);
-        }
-        ip.setTorqueSteps(ok && augmented ? &parts->torque_step : nullptr);
-        if (ok && delta.allFinite()) {
+        BandedSymmetricMatrix trial = hessian;
+        // Inertia correction relative to each row's scale: at the final barrier the active
+        // constraints' rows are ~1/μ larger than the others, and a uniform shift sized by them
+        // (the largest diagonal) damped the free directions into linear convergence (measured:
+        // torque_limited, second_order, N = 512: 200 iterations at a decrement of 2e-6).
+        if (shift > 0) trial.addRelativeToDiagonal(shift, 1e-8 * hessian.maxAbsDiagonal());
+        if (trial.solvePositiveDefinite(&delta) && delta.allFinite()) {
           factored = true;
           break;
         }
         shift = shift == 0.0 ? 1e-14 : 100.0 * shift;
       }
-      slope = factored ? ip.meritSlope(delta, merit_gradient, mu,
-                                       augmented ? parts->residual : std::vector<Vector3>{})
-                       : 0.0;
+      slope = merit_gradient.dot(delta);
       if (factored && free_slacks) {
         // ℓ1 merit: ν at least the multipliers after the step, and large enough that the
         // step decreases the merit by a tenth of its predicted infeasibility reduction.
@@ -1146,18 +973,17 @@ namespace {
 /// scheme at N = 128, and torque plus rate limits at N = 128 that IPOPT solves, were answered
 /// "infeasible" by the elastic form alone).
 PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
-                                const InteriorPointSettings& settings,
                                 const ReducedProblem::Steps* coarse_steps,
                                 ReducedProblem::Steps* final_steps) {
   const auto start = std::chrono::steady_clock::now();
   ReducedProblem::Steps elastic_steps;
   PlanResult first =
-      solveOnGrid(problem, options, settings, Formulation::Elastic, coarse_steps, &elastic_steps);
+      solveOnGrid(problem, options, Formulation::Elastic, coarse_steps, &elastic_steps);
   const bool retry = first.termination == Termination::Infeasible ||
                      first.termination == Termination::NotConverged;
   if (retry) {
     ReducedProblem::Steps free_steps;
-    PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start), settings,
+    PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start),
                                     Formulation::FreeSlacks, coarse_steps, &free_steps);
     if (second.converged()) {
       second.iterations += first.iterations;
@@ -1175,11 +1001,10 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
 
 /// The interior point on the requested grid, with grid continuation above
 /// kCoarsestConstrainedGrid.
-PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options,
-                          const InteriorPointSettings& settings) {
+PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (problem.steps <= kCoarsestConstrainedGrid) {
-    return solveOnGridWithRetry(problem, options, settings, nullptr, nullptr);
+    return solveOnGridWithRetry(problem, options, nullptr, nullptr);
   }
   // Coarse levels start from their own unconstrained optimum; the finest from the coarse level.
   std::vector<int> levels{problem.steps};
@@ -1204,8 +1029,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     }
     ReducedProblem::Steps next;
     const PlanResult coarse = result;
-    result =
-        solveOnGridWithRetry(at, level_options, settings, steps.empty() ? nullptr : &steps, &next);
+    result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
     const bool ran_out =
         result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
@@ -1218,11 +1042,11 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       ReducedProblem::Steps between, retried;
       SolverOptions from_coarse = withRemainingBudget(options, start);
       from_coarse.warm_start = nullptr;  // both start from the coarse steps
-      const PlanResult middle = solveOnGridWithRetry(half, from_coarse, settings, &steps, &between);
+      const PlanResult middle = solveOnGridWithRetry(half, from_coarse, &steps, &between);
       iterations += middle.iterations;
       if (middle.converged()) {
         from_coarse.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-        PlanResult fine = solveOnGridWithRetry(at, from_coarse, settings, &between, &retried);
+        PlanResult fine = solveOnGridWithRetry(at, from_coarse, &between, &retried);
         iterations += fine.iterations;
         if (fine.converged()) {
           fine.message += "; reached through N = " + std::to_string(half.steps) +
@@ -1252,10 +1076,9 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
 
 }  // namespace
 
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
-                                  const InteriorPointSettings& settings) {
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  PlanResult result = solveContinued(problem, options, settings);
+  PlanResult result = solveContinued(problem, options);
   // Pointing cones together with torque or rate limits, from a start inside a cone: the
   // iterate can leave the cone with torques far beyond their bounds and never recover (measured:
   // a Sun keep-out + |τ| ≤ 0.07 N m slew that IPOPT solves was called infeasible after 13
@@ -1275,12 +1098,12 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   cones_only.constraints.clear();
   for (const PlanningConstraint& c : problem.constraints)
     if (c.isCone()) cones_only.constraints.push_back(c);
-  const PlanResult around = solveContinued(cones_only, staged, settings);
+  const PlanResult around = solveContinued(cones_only, staged);
   int iterations = result.iterations + around.iterations;
   if (!around.converged()) return result;
   staged.warm_start = &around.maneuver;
   staged.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-  PlanResult second = solveContinued(problem, staged, settings);
+  PlanResult second = solveContinued(problem, staged);
   iterations += second.iterations;
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its

@@ -11,21 +11,11 @@ namespace attitude_planner {
 /// (newton_solver.cpp). Fills everything but solve_time_s.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options);
 
-/// How the interior point solves its Newton systems (tests exercise both paths at small N).
-struct InteriorPointSettings {
-  /// Above this N through the augmented system (condition ~N²), at and below it through the
-  /// normal equations' banded Cholesky (condition ~N⁴: measured relative residuals 2e-4 at
-  /// N = 8192 and 1.5e-3 at N = 32 768 with torque + rate limits; at N = 10⁵ its directions no
-  /// longer reached feasibility, a false "infeasible").
-  int normal_equations_max_steps = 16384;
-};
-
 /// Primal–dual interior point on the reduced problem with the node constraints (per-axis torque
 /// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
 /// from options.warm_start if given. Sets PlanResult::infeasible when the constraints cannot be
 /// met. Fills everything but solve_time_s and the constraint figures.
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
-                                  const InteriorPointSettings& settings = {});
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
 /// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before

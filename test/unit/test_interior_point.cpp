@@ -13,7 +13,6 @@
 #include "planning/direct_method.hpp"
 #include "planning/node_constraints.hpp"
 #include "planning/reduced_problem.hpp"
-#include "planning/solvers.hpp"
 #include "scene_errors.hpp"
 
 namespace ap = attitude_planner;
@@ -304,38 +303,6 @@ TEST(InteriorPoint, RandomizedTorqueNormCasesAgreeWithNlopt) {
     p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.8 * peak)};
     SCOPED_TRACE("trial " + std::to_string(trial));
     expectAgreesWithNlopt(p);
-  }
-}
-
-TEST(InteriorPoint, AugmentedNewtonSystemsReachTheSameOptima) {
-  // Above InteriorPointSettings::normal_equations_max_steps the steps come from the augmented
-  // system and the torque constraints' linearizations from its J_k d (the path that N = 10⁵
-  // needs); forced here at small N, every constraint kind and a scheme with end torques must reach
-  // the optimum the normal equations reach (which the tests above check against SLSQP).
-  std::vector<std::pair<std::string, ap::PlanningProblem>> cases;
-  cases.emplace_back("torque box", sceneProblem("torque_limited.yaml", 24));
-  cases.emplace_back("torque norm", sceneProblem("torque_norm_limited.yaml", 24));
-  cases.emplace_back("rate", sceneProblem("rate_limited.yaml", 24));
-  cases.emplace_back("keep-out", sceneProblem("sun_keep_out.yaml", 24));
-  ap::PlanningProblem both = sceneProblem("torque_limited.yaml", 40);
-  both.constraints = {ap::PlanningConstraint::maxAngularRate(0.12)};
-  cases.emplace_back("torque box + rate", both);
-  ap::PlanningProblem second = sceneProblem("torque_limited.yaml", 24);
-  second.scheme = ap::SchemeKind::SecondOrder;
-  second.constraints = {ap::PlanningConstraint::maxAngularRate(0.15)};
-  cases.emplace_back("second_order, torque box + node rates", second);
-  for (const auto& [name, p] : cases) {
-    SCOPED_TRACE(name);
-    ap::SolverOptions o;
-    const ap::PlanResult normal = ap::solveWithInteriorPoint(p, o);
-    ap::InteriorPointSettings augmented;
-    augmented.normal_equations_max_steps = 0;
-    const ap::PlanResult r = ap::solveWithInteriorPoint(p, o, augmented);
-    ASSERT_TRUE(normal.converged()) << normal.message;
-    ASSERT_TRUE(r.converged()) << r.message;
-    EXPECT_NEAR(r.cost, normal.cost, 1e-9 * normal.cost) << r.message;
-    const ap::ConstraintCheck check = ap::checkConstraints(p, r.maneuver);
-    EXPECT_LE(check.max_relative_violation, 1e-9) << check.worst;
   }
 }
 

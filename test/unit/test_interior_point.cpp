@@ -507,6 +507,18 @@ TEST(InteriorPoint, TightTorqueNormAroundAKeepOutConeIsNotCalledInfeasible) {
   expectAgreesWithNlopt(p, 1e-8, true);
 }
 
+// The open defect of docs/constraints_notes.md as a reproducer that runs in seconds: torque plus
+// rate limits at N = 8192 (grid continuation from N = 128), which converged before main's
+// Levenberg–Marquardt Newton (09a6d91) gave the levels other starts and converges at N = 4096, now
+// answered "infeasible". Disabled until fixed (--gtest_also_run_disabled_tests runs it).
+TEST(InteriorPoint, DISABLED_TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 8192);
+  p.constraints = {ap::PlanningConstraint::maxAngularRate(0.11)};
+  const ap::PlanResult r = plan(p, "newton");
+  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(r.max_constraint_violation, 1e-9);
+}
+
 TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {
   // 1.047 rad in 12.8 s needs a mean rate of 0.082 rad/s.
   ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);

@@ -37,12 +37,21 @@ Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
 }
 
 bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
+  BandedCholesky cholesky;
+  if (!cholesky.factor(*this)) return false;
+  cholesky.solve(b);
+  return true;
+}
+
+bool BandedCholesky::factor(const BandedSymmetricMatrix& A) {
   // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
   // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
+  n_ = A.n_;
+  p_ = A.p_;
   const int w = p_ + 1;
-  std::vector<double> L = data_;
+  L_ = A.data_;
   const auto row = [&](int i) {
-    return L.data() + static_cast<size_t>(i) * w + p_ - i;
+    return L_.data() + static_cast<size_t>(i) * w + p_ - i;
   };  // row(i)[j] = L(i, j)
   for (int i = 0; i < n_; ++i) {
     double* li = row(i);
@@ -59,6 +68,12 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
       }
     }
   }
+  return true;
+}
+
+void BandedCholesky::solve(Eigen::VectorXd* b) const {
+  const int w = p_ + 1;
+  const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
   Eigen::VectorXd& y = *b;
   for (int i = 0; i < n_; ++i) {  // L y = b
     const double* li = row(i);
@@ -71,7 +86,6 @@ bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
     for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y(k);
     y(i) = s / row(i)[i];
   }
-  return true;
 }
 
 }  // namespace attitude_planner

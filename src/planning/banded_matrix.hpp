@@ -46,10 +46,26 @@ class BandedSymmetricMatrix {
   bool solvePositiveDefinite(Eigen::VectorXd* b) const;
 
  private:
+  friend class BandedCholesky;
   /// A(i, j) for i − p ≤ j ≤ i.
   double& at(int i, int j) { return data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)]; }
   int n_, p_;
   std::vector<double> data_;
+};
+
+/// The banded Cholesky factor L Lᵀ = A of a BandedSymmetricMatrix, kept so that several right-hand
+/// sides can be solved with one factorization (e.g. a predictor–corrector's second solve).
+class BandedCholesky {
+ public:
+  /// Factors A (the factor replaces any previous one). Returns false if A is not numerically
+  /// positive definite (then solve must not be called).
+  bool factor(const BandedSymmetricMatrix& A);
+  /// Solves A x = b in place with the last successful factor.
+  void solve(Eigen::VectorXd* b) const;
+
+ private:
+  int n_ = 0, p_ = 0;
+  std::vector<double> L_;  ///< row i holds L(i, i − p..i), as BandedSymmetricMatrix's layout
 };
 
 }  // namespace attitude_planner

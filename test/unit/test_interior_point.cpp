@@ -507,6 +507,22 @@ TEST(InteriorPoint, TightTorqueNormAroundAKeepOutConeIsNotCalledInfeasible) {
   expectAgreesWithNlopt(p, 1e-8, true);
 }
 
+// Torque plus rate limits at N = 8192 (grid continuation from N = 128), answered "infeasible"
+// once main's Levenberg–Marquardt Newton (09a6d91) gave the levels other starts: the N = 8192
+// level's free-slack retry was feasible but kept its barrier for 180 full steps, its decrement
+// stuck at the round-off floor (2.5e-5) above the barrier problem's test (10 μ), until the
+// iteration limit.
+TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 8192);
+  p.constraints = {ap::PlanningConstraint::maxAngularRate(0.11)};
+  const ap::PlanResult r = plan(p, "newton");
+  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(r.max_constraint_violation, 1e-9);
+  // Before 09a6d91 it converged at 787.54698 (this answer lies 1e-4 above; a point at the
+  // round-off floor or a neighbouring local optimum).
+  EXPECT_NEAR(r.cost, 787.547, 1e-3 * 787.547);
+}
+
 TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {
   // 1.047 rad in 12.8 s needs a mean rate of 0.082 rad/s.
   ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);

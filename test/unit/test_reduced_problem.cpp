@@ -186,6 +186,34 @@ TEST(ReducedProblem, BandedCholeskyMatchesDenseSolve) {
   EXPECT_FALSE(indefinite.solvePositiveDefinite(&b));
 }
 
+TEST(ReducedProblem, BandedCholeskyFactorSolvesSeveralRightHandSides) {
+  // One factorization, several solves (kept for a second solve with the same factor: a
+  // predictor–corrector).
+  const ReducedProblem rp = perturbedProblem(SchemeKind::Paper, 12, 3);
+  Eigen::VectorXd g;
+  double scale;
+  BandedSymmetricMatrix H(rp.unknowns(), 8);
+  rp.evaluate(&g, &H, &scale);
+  const double lowest =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H.toDense()).eigenvalues()(0);
+  H.addToDiagonal(std::max(0.0, -lowest) + 1e-3 * H.maxAbsDiagonal());
+  BandedCholesky cholesky;
+  ASSERT_TRUE(cholesky.factor(H));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd b(rp.unknowns());
+    for (int i = 0; i < b.size(); ++i) b(i) = n(rng);
+    Eigen::VectorXd x = b;
+    cholesky.solve(&x);
+    EXPECT_LE((x - H.toDense().ldlt().solve(b)).norm(), 1e-10 * x.norm());
+  }
+  BandedSymmetricMatrix indefinite(2, 1);
+  indefinite.add(0, 0, 1.0);
+  indefinite.add(1, 1, -1.0);
+  EXPECT_FALSE(cholesky.factor(indefinite));
+}
+
 TEST(BandedLinearSystem, PivotedLuMatchesDenseSolveOnAnIndefiniteMatrix) {
   std::mt19937 rng(5);
   std::normal_distribution<double> n(0.0, 1.0);

@@ -163,16 +163,26 @@ TEST(ReducedProblem, HessianMatchesSecondDifferencesOfTheCost) {
   }
 }
 
-TEST(ReducedProblem, BandedCholeskyMatchesDenseSolve) {
-  const ReducedProblem rp = perturbedProblem(SchemeKind::Paper, 12, 3);
-  Eigen::VectorXd g;
+namespace {
+
+/// The Hessian of `rp` at its iterate and its gradient, shifted by the most negative eigenvalue
+/// (away from optima the Hessian may be indefinite) so that it is positive definite.
+BandedSymmetricMatrix definiteHessian(const ReducedProblem& rp, Eigen::VectorXd* g) {
   double scale;
   BandedSymmetricMatrix H(rp.unknowns(), 8);
-  rp.evaluate(&g, &H, &scale);
-  // shift by the most negative eigenvalue (away from optima the Hessian may be indefinite)
+  rp.evaluate(g, &H, &scale);
   const double lowest =
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H.toDense()).eigenvalues()(0);
   H.addToDiagonal(std::max(0.0, -lowest) + 1e-3 * H.maxAbsDiagonal());
+  return H;
+}
+
+}  // namespace
+
+TEST(ReducedProblem, BandedCholeskyMatchesDenseSolve) {
+  const ReducedProblem rp = perturbedProblem(SchemeKind::Paper, 12, 3);
+  Eigen::VectorXd g;
+  const BandedSymmetricMatrix H = definiteHessian(rp, &g);
   Eigen::VectorXd x = g;
   ASSERT_TRUE(H.solvePositiveDefinite(&x));
   const Eigen::VectorXd dense = H.toDense().ldlt().solve(g);
@@ -191,12 +201,7 @@ TEST(ReducedProblem, BandedCholeskyFactorSolvesSeveralRightHandSides) {
   // predictor–corrector).
   const ReducedProblem rp = perturbedProblem(SchemeKind::Paper, 12, 3);
   Eigen::VectorXd g;
-  double scale;
-  BandedSymmetricMatrix H(rp.unknowns(), 8);
-  rp.evaluate(&g, &H, &scale);
-  const double lowest =
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H.toDense()).eigenvalues()(0);
-  H.addToDiagonal(std::max(0.0, -lowest) + 1e-3 * H.maxAbsDiagonal());
+  const BandedSymmetricMatrix H = definiteHessian(rp, &g);
   BandedCholesky cholesky;
   ASSERT_TRUE(cholesky.factor(H));
   std::mt19937 rng(3);

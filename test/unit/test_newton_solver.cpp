@@ -317,3 +317,27 @@ TEST(NewtonSolver, StalledFastRatesConvergeByContinuationInTheRates) {
   EXPECT_TRUE(increasing);
   EXPECT_EQ(last, 230);
 }
+
+TEST(NewtonSolver, EveryThresholdIsScaleFree) {
+  // Issue 19, item 1: thresholds mean the same at every scale. J → sJ, T → cT with the boundary
+  // rates Ω → Ω/c leaves the steps' rotations unchanged and scales every torque by s/c², so a
+  // solver whose tests are all relative takes the same iterations to the same plan, cost
+  // s²/c⁴ times (random suite cases with spinning ends, both schemes, and the seed's example).
+  for (int index : {0, 2, 3, 7, 13}) {
+    const PlanningProblem p = robustness::randomCase(19, index).problem;
+    const PlanResult base = planManeuver(p);
+    ASSERT_TRUE(base.converged()) << index << ": " << base.message;
+    for (const auto& [s, c] : {std::pair{1e3, 1.0}, {1.0, 10.0}, {1e-2, 0.1}}) {
+      PlanningProblem scaled = p;
+      scaled.inertia = s * p.inertia;
+      scaled.duration = c * p.duration;
+      scaled.initial_velocity = p.initial_velocity / c;
+      scaled.final_velocity = p.final_velocity / c;
+      const PlanResult r = planManeuver(scaled);
+      ASSERT_TRUE(r.converged()) << index << " s = " << s << " c = " << c << ": " << r.message;
+      EXPECT_EQ(r.iterations, base.iterations) << index << " s = " << s << " c = " << c;
+      EXPECT_NEAR(r.cost, base.cost * s * s / std::pow(c, 4), 1e-9 * r.cost)
+          << index << " s = " << s << " c = " << c;
+    }
+  }
+}

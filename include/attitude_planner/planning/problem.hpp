@@ -144,7 +144,7 @@ struct IterationInfo {
   int iteration = 0;
   double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
   double gradient_norm = 0.0;  ///< optimality residual (Newton: relative Newton decrement)
-  double step_length = 0.0;    ///< line-search step accepted
+  double step_length = 0.0;    ///< step accepted (Newton: 1, damped by its shift instead)
 };
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.

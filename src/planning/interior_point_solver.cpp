@@ -969,6 +969,10 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       << relative_decrement << ", barrier " << mu / f_scale << " x cost, max elastic violation "
       << ip.maxViolation() << ")";
   result.message = msg.str();
+  result.levels.push_back(
+      {N, iteration, ending, result.max_residual, relative_decrement,
+       std::string(free_slacks ? "interior point (free slacks): " : "interior point (elastic): ") +
+           result.message});
   return result;
 }
 
@@ -997,12 +1001,14 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
                                     Formulation::FreeSlacks, coarse_steps, &free_steps);
     if (second.converged()) {
       second.iterations += first.iterations;
+      second.levels.insert(second.levels.begin(), first.levels.begin(), first.levels.end());
       second.message +=
           "; solved with free slacks after the elastic form stopped: " + first.message;
       if (final_steps) *final_steps = free_steps;
       return second;
     }
     first.iterations += second.iterations;
+    first.levels.insert(first.levels.end(), second.levels.begin(), second.levels.end());
     first.message += "; retried with free slacks: " + second.message;
   }
   if (final_steps) *final_steps = elastic_steps;
@@ -1023,6 +1029,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
   }
   ReducedProblem::Steps steps;
   int iterations = 0;
+  std::vector<LevelSummary> solved_levels;  // every solve of every level, in order
   PlanResult result;
   bool stopped = false;  // cancelled or out of time: the remaining levels only carry the iterate
   for (auto level = levels.rbegin(); level != levels.rend(); ++level) {
@@ -1036,11 +1043,14 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       unconstrained = solveWithNewton(at, level_options);
       if (unconstrained.converged()) level_options.warm_start = &unconstrained.maneuver;
       iterations += unconstrained.iterations;
+      solved_levels.insert(solved_levels.end(), unconstrained.levels.begin(),
+                           unconstrained.levels.end());
     }
     ReducedProblem::Steps next;
     const PlanResult coarse = result;
     result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
+    solved_levels.insert(solved_levels.end(), result.levels.begin(), result.levels.end());
     const bool ran_out =
         result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
     if (!result.converged() && !ran_out && !stopped && !steps.empty() && *level % 2 == 0) {
@@ -1054,10 +1064,12 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       from_coarse.warm_start = nullptr;  // both start from the coarse steps
       const PlanResult middle = solveOnGridWithRetry(half, from_coarse, &steps, &between);
       iterations += middle.iterations;
+      solved_levels.insert(solved_levels.end(), middle.levels.begin(), middle.levels.end());
       if (middle.converged()) {
         from_coarse.time_budget_s = withRemainingBudget(options, start).time_budget_s;
         PlanResult fine = solveOnGridWithRetry(at, from_coarse, &between, &retried);
         iterations += fine.iterations;
+        solved_levels.insert(solved_levels.end(), fine.levels.begin(), fine.levels.end());
         if (fine.converged()) {
           fine.message += "; reached through N = " + std::to_string(half.steps) +
                           " after the direct refinement stopped: " + result.message;
@@ -1078,6 +1090,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     steps = result.converged() || stopped ? next : ReducedProblem::Steps{};
   }
   result.iterations = iterations;
+  result.levels = solved_levels;
   if (levels.size() > 1) {
     result.message += "; grid continuation from N = " + std::to_string(levels.back());
   }
@@ -1118,8 +1131,12 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
+  std::vector<LevelSummary> solved_levels = result.levels;
+  solved_levels.insert(solved_levels.end(), around.levels.begin(), around.levels.end());
+  solved_levels.insert(solved_levels.end(), second.levels.begin(), second.levels.end());
   if (second.converged() || second.termination == Termination::Infeasible) result = second;
   result.iterations = iterations;
+  result.levels = solved_levels;
   result.message +=
       "; retried in two stages (the cones alone, then every constraint from that "
       "path) after: " +

@@ -289,8 +289,10 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       }
       const Maneuver unconstrained_plan = result.maneuver;
       constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
+      const std::vector<LevelSummary> newton_levels = result.levels;
       result = solveWithInteriorPoint(problem, constrained);
       result.iterations += newton_iterations;
+      result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
       result.message += note.str();
     } else {
       result.message += "; constraints inactive at the unconstrained optimum";

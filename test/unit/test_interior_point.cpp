@@ -621,3 +621,19 @@ TEST(ConstraintScenes, FormatSceneRoundTripsConstraints) {
   EXPECT_EQ(back.problem.constraints[0].half_angle, s.problem.constraints[0].half_angle);
   EXPECT_EQ(back.problem.constraints[1].limit, 0.3);
 }
+
+TEST(InteriorPoint, LevelsAccountForEveryIteration) {
+  // Every solve of a constrained plan leaves a LevelSummary (the unconstrained Newton start on
+  // the requested grid, the coarse levels' own starts, every interior-point level and retry), so
+  // the per-level counts add up to the reported total and the last entry is the requested grid's
+  // interior point.
+  const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_FALSE(r.levels.empty());
+  int sum = 0;
+  for (const ap::LevelSummary& l : r.levels) sum += l.iterations;
+  EXPECT_EQ(sum, r.iterations);
+  EXPECT_EQ(r.levels.back().steps, 2048);
+  EXPECT_EQ(r.levels.back().termination, ap::Termination::Converged);
+  EXPECT_EQ(r.levels.back().reason.rfind("interior point", 0), 0u) << r.levels.back().reason;
+}

@@ -980,6 +980,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 
 namespace {
 
+/// Appends the levels `solved` reports to `levels` (every solve of a plan is listed, in order).
+void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
+  levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
+}
+
 /// solveOnGrid in the elastic form, retried once in the free-slack form from the same start when
 /// it ends infeasible or unconverged: the elastic form stalls where most nodes bind and the
 /// violated constraints' curvature (weighted by z → ρ) swamps the Hessian, while the free-slack
@@ -1008,7 +1013,7 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
       return second;
     }
     first.iterations += second.iterations;
-    first.levels.insert(first.levels.end(), second.levels.begin(), second.levels.end());
+    appendLevels(&first.levels, second);
     first.message += "; retried with free slacks: " + second.message;
   }
   if (final_steps) *final_steps = elastic_steps;
@@ -1043,14 +1048,13 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       unconstrained = solveWithNewton(at, level_options);
       if (unconstrained.converged()) level_options.warm_start = &unconstrained.maneuver;
       iterations += unconstrained.iterations;
-      solved_levels.insert(solved_levels.end(), unconstrained.levels.begin(),
-                           unconstrained.levels.end());
+      appendLevels(&solved_levels, unconstrained);
     }
     ReducedProblem::Steps next;
     const PlanResult coarse = result;
     result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
     iterations += result.iterations;
-    solved_levels.insert(solved_levels.end(), result.levels.begin(), result.levels.end());
+    appendLevels(&solved_levels, result);
     const bool ran_out =
         result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
     if (!result.converged() && !ran_out && !stopped && !steps.empty() && *level % 2 == 0) {
@@ -1064,12 +1068,12 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       from_coarse.warm_start = nullptr;  // both start from the coarse steps
       const PlanResult middle = solveOnGridWithRetry(half, from_coarse, &steps, &between);
       iterations += middle.iterations;
-      solved_levels.insert(solved_levels.end(), middle.levels.begin(), middle.levels.end());
+      appendLevels(&solved_levels, middle);
       if (middle.converged()) {
         from_coarse.time_budget_s = withRemainingBudget(options, start).time_budget_s;
         PlanResult fine = solveOnGridWithRetry(at, from_coarse, &between, &retried);
         iterations += fine.iterations;
-        solved_levels.insert(solved_levels.end(), fine.levels.begin(), fine.levels.end());
+        appendLevels(&solved_levels, fine);
         if (fine.converged()) {
           fine.message += "; reached through N = " + std::to_string(half.steps) +
                           " after the direct refinement stopped: " + result.message;
@@ -1132,8 +1136,8 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
   std::vector<LevelSummary> solved_levels = result.levels;
-  solved_levels.insert(solved_levels.end(), around.levels.begin(), around.levels.end());
-  solved_levels.insert(solved_levels.end(), second.levels.begin(), second.levels.end());
+  appendLevels(&solved_levels, around);
+  appendLevels(&solved_levels, second);
   if (second.converged() || second.termination == Termination::Infeasible) result = second;
   result.iterations = iterations;
   result.levels = solved_levels;

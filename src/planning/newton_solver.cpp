@@ -61,6 +61,13 @@ constexpr double kFirstRejectionShift = 1e-8;  ///< λ after a rejected pure New
 constexpr double kAcceptRatio = 1e-4;          ///< least actual/predicted decrease accepted
 constexpr double kShiftMinFactor = 1.0 / 10;   ///< most λ falls after one step
 
+/// The scale the augmented system's relative shift multiplies: (2|J|/h²)², the largest
+/// curvature of |τ|² in one attitude.
+double augmentedShiftScale(const ReducedProblem& np) {
+  const double h = np.scheme().timeStep();
+  return std::pow(2.0 * np.scheme().inertia().norm() / (h * h), 2);
+}
+
 /// Solves the Newton system (JᵀJ + S + shift I) δ = −Jᵀτ through its augmented form
 ///   [ −α I   J        ] [ z ]   [ −τ ]
 ///   [  Jᵀ   (S+shift)/α ] [ δ ] = [  0 ],   y = J δ + τ = α z,
@@ -69,13 +76,6 @@ constexpr double kShiftMinFactor = 1.0 / 10;   ///< most λ falls after one step
 /// by LU with partial pivoting. `delta` holds −g on entry and δ on return. `K` is the caller's
 /// workspace (allocated once per solve: at N = 10⁶ it is 2 GB, and fresh pages cost more
 /// system time than the factorization).
-/// The scale the augmented system's relative shift multiplies: (2|J|/h²)², the largest
-/// curvature of |τ|² in one attitude.
-double augmentedShiftScale(const ReducedProblem& np) {
-  const double h = np.scheme().timeStep();
-  return std::pow(2.0 * np.scheme().inertia().norm() / (h * h), 2);
-}
-
 bool solveAugmented(const ReducedProblem& np, double relative_shift, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
   const int N = np.steps();
@@ -266,7 +266,6 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     bool accepted = false, factored = false, final_step = false;
     bool predicted_within_tolerance = false;
     double slope = 0.0, predicted_decrement = std::numeric_limits<double>::infinity();
-    const double alpha = 1.0;  // steps are taken in full; λ does the damping
     ReducedProblem::Steps trial_R;
     for (int attempt = 0; attempt < kMaxStepAttempts && !accepted; ++attempt) {
       delta = -gradient;
@@ -303,7 +302,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       final_step =
           shift == 0.0 && (relative_decrement <= std::max(options.tolerance, roundOffFloor(N)) ||
                            predicted_within_tolerance);
-      trial_R = np.retract(delta, alpha);
+      trial_R = np.retract(delta, 1.0);  // steps are taken in full; λ does the damping
       // Once the predicted decrease is below the cost's round-off the ratio is meaningless and
       // the step is taken: when −slope ≤ 1e-13 C, or when the step changes the torques by ≤ the
       // round-off acceptance relative — at large N the cost's own round-off (torques are second
@@ -340,15 +339,14 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // two iterations mean the gradient is noise (the Hessian's condition grows like N⁴). Stop
     // there; the achieved relative accuracy is the decrement (≤ round_off_acceptance). A large
     // decrement that stagnates is not round-off: the iteration goes on.
-    if (alpha == 1.0 && relative_decrement <= round_off_acceptance &&
-        relative_decrement > 0.5 * best_decrement) {
+    if (relative_decrement <= round_off_acceptance && relative_decrement > 0.5 * best_decrement) {
       ++stalled_iterations;
     } else {
       stalled_iterations = 0;
     }
     best_decrement = std::min(best_decrement, relative_decrement);
-    previous_full_step_decrement = alpha == 1.0 && shift == 0.0 ? relative_decrement : 0.0;
-    IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
+    previous_full_step_decrement = shift == 0.0 ? relative_decrement : 0.0;
+    IterationInfo info{iteration + 1, cost, relative_decrement, 1.0};
     if (stalled_iterations >= 2) {
       result.history.push_back(info);
       ++iteration;

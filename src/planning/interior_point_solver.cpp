@@ -27,15 +27,20 @@
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
 // Inertia correction: a multiple of the identity until the Cholesky factorization succeeds.
 //
-// A grid level that ends infeasible or unconverged in this elastic form is solved once more in the
-// free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free variables,
-// the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
-// f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z, and a monotone barrier. Its
-// Hessian carries Newton's own multipliers instead of z → ρ for violated constraints, which is
-// where the elastic form stalls (solveOnGridWithRetry).
+// The free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free
+// variables, the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
+// f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z. Its Hessian carries Newton's own
+// multipliers instead of z → ρ for violated constraints, which is where the elastic form stalls.
+// Up to kPredictorCorrectorMaxSteps a grid level is solved in the free-slack form first, its
+// barrier chosen at every iteration by Mehrotra's predictor–corrector (the affine step μ = 0 from
+// the same Cholesky factor gives σ = (μ_aff/mean s z)³, the corrector adds ds_aff·dz_aff to the
+// complementarity target), and retried in the elastic form if it ends infeasible or unconverged;
+// above it the elastic form comes first and the free-slack retry keeps a monotone barrier
+// (solveOnGridWithRetry).
 //
-// Barrier update: LOQO's adaptive rule after every iteration (see the loop). At μ_final a full step
-// with decrement below the tolerance ends the solve; then the elastic violations are v ≈ μ/ρ if the
+// Elastic barrier update: LOQO's adaptive rule after every iteration (see the loop). At μ_final a
+// full step with decrement below the tolerance (or quadratic convergence seen well below the
+// stall acceptance) ends the solve; then the elastic violations are v ≈ μ/ρ if the
 // constraints can be met. If they cannot at ρ, ρ grows once by kPenaltyGrowth; if they still
 // cannot, the request is answered as infeasible, naming the constraint the last iterate still
 // violates.
@@ -89,6 +94,19 @@ constexpr int kFreeSlackViolationStall = 40;
 constexpr double kMaxShiftFloor = 1e-2;
 /// Largest violation at which the penalty is raised before a request is called infeasible.
 constexpr double kPenaltyRaiseViolation = 1e-3;
+/// Up to this N (every grid level up to it) a level is solved in the free-slack form first, with
+/// Mehrotra's predictor–corrector choosing the barrier at every iteration; above it the elastic
+/// form comes first and the free-slack retry keeps the monotone barrier. Measured (plan_maneuver,
+/// side by side, docs/constraints_notes.md): 42 % fewer iterations over the constrained scenes at
+/// N = 64 … 8192 and the same or lower optima; but at N = 32768 (torque + rate limits) the
+/// free-slack form's finest level ran 200 iterations without converging, where the elastic form
+/// converges in 29.
+constexpr int kPredictorCorrectorMaxSteps = 8192;
+/// The barrier never falls below this × (relative decrement)² × cost/m (see the predictor).
+constexpr double kBarrierProgressFloor = 0.01;
+/// A slack residual |c − s| below this (a hundredth of the feasibility tolerance) is round-off,
+/// not infeasibility: it does not count in the free-slack form's decrement.
+constexpr double kRoundOffSlackResidual = 1e-10;
 /// Elastic violation (constraint units: relative torque/rate, cosine) that counts as infeasible.
 constexpr double kFeasibilityTolerance = kNodeConstraintTolerance;
 
@@ -472,6 +490,75 @@ class InteriorPoint {
     return cost;
   }
 
+  /// FreeSlacks, Mehrotra's predictor: from the affine-scaling step dδ_aff (solved with μ = 0,
+  /// i.e. q = −c), the complementarity the step to the boundary would leave,
+  /// μ_aff = mean((s + α_p ds)(z + α_d dz)), and the mean complementarity now (*average). Keeps
+  /// each instance's ds_aff·dz_aff (in `products`) for the corrector.
+  double affineComplementarity(const Eigen::VectorXd& d, double* average,
+                               std::vector<double>* products) const {
+    products->clear();
+    double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
+    std::vector<double> ds, dz;
+    for (const Group& g : groups_) {
+      for (int k = g.first_k; k <= g.last_k; ++k) {
+        const Instance& in = g.at[k - g.first_k];
+        const double lin = localDot(np_, in.g, k + g.node_offset, g.width, d);
+        ds.push_back(lin + in.c - in.s);
+        dz.push_back((-in.c - lin) / in.D);
+        if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
+        if (dz.back() < 0) alpha_d = std::min(alpha_d, -in.z / dz.back());
+        sum += in.s * in.z;
+      }
+    }
+    double affine = 0.0;
+    std::size_t i = 0;
+    for (const Group& g : groups_) {
+      for (const Instance& in : g.at) {
+        affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
+        products->push_back(ds[i] * dz[i]);
+        ++i;
+      }
+    }
+    const double m = std::max<double>(1.0, static_cast<double>(i));
+    *average = sum / m;
+    return affine / m;
+  }
+
+  /// Adds Σ_i g_i w_i(instance) to `out` (w in instance order).
+  void addWeightedGradients(const std::vector<double>& w, Eigen::VectorXd* out) const {
+    std::size_t i = 0;
+    for (const Group& g : groups_) {
+      for (int k = g.first_k; k <= g.last_k; ++k)
+        addLocalVector(np_, g.at[k - g.first_k].g, w[i++], k + g.node_offset, g.width, out);
+    }
+  }
+
+  /// Per-instance weights 1/s_i (the barrier's part of the right-hand side is μ Σ g_i/s_i) and,
+  /// for the corrector, −products_i/s_i.
+  std::vector<double> slackWeights(const std::vector<double>* products) const {
+    std::vector<double> w;
+    std::size_t i = 0;
+    for (const Group& g : groups_) {
+      for (const Instance& in : g.at) {
+        w.push_back(products ? -(*products)[i] / in.s : 1.0 / in.s);
+        ++i;
+      }
+    }
+    return w;
+  }
+
+  /// The condensation's q for the complementarity target s z = μ − ds_aff dz_aff (FreeSlacks;
+  /// `products` may be null: the plain barrier μ).
+  void setComplementarityTarget(double mu, const std::vector<double>* products) {
+    std::size_t i = 0;
+    for (Group& g : groups_) {
+      for (Instance& in : g.at) {
+        in.q = (mu - (products ? (*products)[i] : 0.0)) / in.z - in.c;
+        ++i;
+      }
+    }
+  }
+
   /// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
   /// and the steps dz themselves (stored in `dz`, instance order).
   double dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
@@ -501,8 +588,9 @@ class InteriorPoint {
   /// FreeSlacks: the slack steps ds = gᵀdδ + c − s (stored in the instances), the largest step in
   /// (0, 1] keeping s ≥ (1 − τ)s, the slope of the barrier terms −μ Σ ds/s (in *barrier_slope)
   /// and ‖c − s‖₁ (in *residual).
-  double slackStep(const Eigen::VectorXd& d, double mu, double* barrier_slope, double* residual) {
-    double alpha = 1.0, slope = 0.0, sum = 0.0;
+  double slackStep(const Eigen::VectorXd& d, double mu, double* barrier_slope, double* residual,
+                   double* significant_residual) {
+    double alpha = 1.0, slope = 0.0, sum = 0.0, significant = 0.0;
     for (Group& g : groups_) {
       for (int k = g.first_k; k <= g.last_k; ++k) {
         Instance& in = g.instance(k);
@@ -510,10 +598,12 @@ class InteriorPoint {
         if (in.ds < 0) alpha = std::min(alpha, -kFractionToBoundary * in.s / in.ds);
         slope -= mu * in.ds / in.s;
         sum += std::abs(in.c - in.s);
+        if (std::abs(in.c - in.s) > kRoundOffSlackResidual) significant += std::abs(in.c - in.s);
       }
     }
     *barrier_slope = slope;
     *residual = sum;
+    *significant_residual = significant;
     return alpha;
   }
 
@@ -691,6 +781,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   const bool free_slacks = ip.freeSlacks();
   const int n = np.unknowns();
   BandedSymmetricMatrix hessian(n, 8);
+  BandedCholesky cholesky;
+  const bool predictor_corrector = free_slacks && N <= kPredictorCorrectorMaxSteps;
+  std::vector<double> products;  // ds_aff·dz_aff of the predictor
   Eigen::VectorXd rhs(n), merit_gradient(n), delta(n);
   double gradient_scale = 0.0;
 
@@ -730,6 +823,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   double alpha_dual = 1.0, alpha_slack = 1.0;
   int barrier_stall = 0;  // FreeSlacks: full steps in a row that did not halve the decrement
   double previous_decrement = std::numeric_limits<double>::infinity();
+  double previous_alpha = 0.0;  // the last accepted step length
+  bool previous_at_final_barrier = false;
   for (;; ++iteration) {
     if (iteration >= options.max_iterations) break;
     if (options.time_budget_s > 0 && elapsed() > options.time_budget_s) {
@@ -739,6 +834,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     }
     bool primal = false;
     double slope = 0.0, cost = 0.0, shift = 0.0;
+    double significant_residual = 0.0, decrement_slope = 0.0;
     bool factored = false;
     for (int attempt = 0; attempt < 2 && !factored; ++attempt) {
       cost = ip.assemble(mu, rho, primal, &hessian, &rhs, &merit_gradient, &gradient_scale);
@@ -752,18 +848,56 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         // (the largest diagonal) damped the free directions into linear convergence (measured:
         // torque_limited, second_order, N = 512: 200 iterations at a decrement of 2e-6).
         if (shift > 0) trial.addRelativeToDiagonal(shift, 1e-8 * hessian.maxAbsDiagonal());
-        if (trial.solvePositiveDefinite(&delta) && delta.allFinite()) {
-          factored = true;
-          break;
+        if (cholesky.factor(trial)) {
+          cholesky.solve(&delta);
+          if (delta.allFinite()) {
+            factored = true;
+            break;
+          }
         }
         shift = shift == 0.0 ? 1e-14 : 100.0 * shift;
+      }
+      if (factored && predictor_corrector && !primal && mu > mu_final) {
+        // Mehrotra's predictor–corrector: the affine-scaling step (μ = 0) says how far the
+        // complementarity can fall; the barrier of this step is σ·mean(s z), σ = (μ_aff/mean)³,
+        // and the corrector adds the affine step's second-order term ds_aff·dz_aff. One
+        // factorization, two more solves.
+        const Eigen::VectorXd barrier_part = [&] {
+          Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+          ip.addWeightedGradients(ip.slackWeights(nullptr), &v);
+          return v;
+        }();
+        const Eigen::VectorXd affine_rhs = rhs - mu * barrier_part;
+        Eigen::VectorXd affine = affine_rhs;
+        cholesky.solve(&affine);
+        double average = 0.0;
+        const double mu_affine = ip.affineComplementarity(affine, &average, &products);
+        const double sigma = std::pow(std::min(1.0, mu_affine / average), 3);
+        // Not below what the iterate's distance to the barrier problem's solution warrants (a
+        // relative decrement d is a cost error ~d²·f; the barrier's is ~m μ): a μ far below it
+        // leaves the rest of the way to Newton steps at a tiny μ, whose condensed system (its
+        // condition grows like N⁴ and 1/μ) no longer resolves them (measured: torque_limited,
+        // N = 2048, stalled 2.4e-7 above the optimum without this floor). The floor rises
+        // with N² above N = 1024 for the same reason.
+        const double floor_factor =
+            std::min(1.0, kBarrierProgressFloor * std::max(1.0, std::pow(N / 1024.0, 2)));
+        const double progress_floor =
+            std::isfinite(previous_decrement)
+                ? floor_factor * previous_decrement * previous_decrement * f_scale / m
+                : mu;
+        mu = std::max(mu_final, std::min(mu, std::max(sigma * average, progress_floor)));
+        if (mu < 10.0 * mu_final) mu = mu_final;
+        ip.setComplementarityTarget(mu, &products);
+        delta = affine_rhs + mu * barrier_part;
+        ip.addWeightedGradients(ip.slackWeights(&products), &delta);
+        cholesky.solve(&delta);
       }
       slope = merit_gradient.dot(delta);
       if (factored && free_slacks) {
         // ℓ1 merit: ν at least the multipliers after the step, and large enough that the
         // step decreases the merit by a tenth of its predicted infeasibility reduction.
         double barrier_slope = 0.0, residual = 0.0;
-        alpha_slack = ip.slackStep(delta, mu, &barrier_slope, &residual);
+        alpha_slack = ip.slackStep(delta, mu, &barrier_slope, &residual, &significant_residual);
         alpha_dual = ip.dualStep(delta, rho, &dz);
         nu = std::max(nu, 1.1 * ip.largestMultiplier(dz, 0.0));
         const double without_penalty = slope + barrier_slope;
@@ -771,6 +905,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
           nu = std::max(nu, 2.0 * without_penalty / (0.9 * residual));
         }
         slope = without_penalty - nu * residual;
+        // (Its magnitude: a step that mostly repairs round-off residuals may raise f and the
+        // barrier a little; that is not convergence.)
+        decrement_slope = -std::abs(without_penalty) - nu * significant_residual;
       }
       // The primal–dual step is Newton's on φ_μ only when z = μ/s; if it is not a descent
       // direction the primal multipliers are used (then it is, H being positive definite).
@@ -788,7 +925,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       reason = "Newton system could not be made positive definite";
       break;
     }
-    relative_decrement = std::sqrt(std::max(0.0, -slope)) / std::sqrt(2.0 * f_scale);
+    // Free slacks: the residuals c − s at round-off (~1e-12 each, a torque being a difference of
+    // momenta over h) add up over the m constraints in ν‖c − s‖₁ to a floor that grows with m;
+    // they do not count in the decrement.
+    relative_decrement = std::sqrt(std::max(0.0, -(free_slacks ? decrement_slope : slope))) /
+                         std::sqrt(2.0 * f_scale);
     const bool at_final_barrier = mu <= mu_final;
     // At the final barrier the condensed system's condition grows like 1/μ̂ in the active
     // directions: decrements stall at ~1e-9 relative (measured). Two full steps that no longer
@@ -813,10 +954,18 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     const bool violation_stalled =
         violated && iteration - last_violation_progress >=
                         (free_slacks ? kFreeSlackViolationStall : kViolationStall);
+    // Quadratic convergence seen at the final barrier: the last (full) step took the decrement
+    // from d₋ to d, so this one leaves about d·(d/d₋)²; well below the stall acceptance it is
+    // taken as the last (as the Newton solver does), instead of iterating on to the floor.
+    const bool quadratic_finish =
+        at_final_barrier && previous_at_final_barrier && !violated && shift == 0.0 &&
+        previous_alpha >= 0.9 && relative_decrement < previous_decrement &&
+        relative_decrement * std::pow(relative_decrement / previous_decrement, 2) <=
+            0.1 * stall_acceptance;
     const bool final_step =
         violation_stalled ||
-        (at_final_barrier &&
-         ((shift == 0.0 && relative_decrement <= options.tolerance) || stalled_iterations >= 2));
+        (at_final_barrier && ((shift == 0.0 && relative_decrement <= options.tolerance) ||
+                              stalled_iterations >= 2 || quadratic_finish));
 
     // Armijo on φ_μ along the retraction; a predicted decrease below φ's round-off is taken.
     // φ_μ at the current iterate from the values the assembly just formed (no re-evaluation).
@@ -905,7 +1054,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     // 2)³, ξ = smallest / mean product (how far from central), never increasing. Measured against
     // IPOPT's monotone rule on the five constrained scenes at N = 64, 128, 512: 20–25 % fewer
     // iterations, same optima.
-    if (!at_final_barrier && free_slacks) {
+    if (predictor_corrector) {
+      // μ is chosen by the predictor at the next iteration.
+    } else if (!at_final_barrier && free_slacks) {
       // Monotone (Fiacco–McCormick, as IPOPT's): μ falls only once the barrier problem is solved
       // to κ μ, feasibility included; the adaptive rule below would drive μ to μ_final while the
       // iterate is still far from feasible, and the slacks' fraction to the boundary then stalls.
@@ -933,6 +1084,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       if (mu < 10.0 * mu_final) mu = mu_final;
     }
     previous_decrement = relative_decrement;
+    previous_alpha = alpha;
+    previous_at_final_barrier = at_final_barrier;
   }
 
   result.iterations = iteration;
@@ -985,39 +1138,50 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
   levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
 }
 
-/// solveOnGrid in the elastic form, retried once in the free-slack form from the same start when
-/// it ends infeasible or unconverged: the elastic form stalls where most nodes bind and the
-/// violated constraints' curvature (weighted by z → ρ) swamps the Hessian, while the free-slack
-/// form's Hessian carries Newton's own multipliers (measured: rate_limited with the variational
-/// scheme at N = 128, and torque plus rate limits at N = 128 that IPOPT solves, were answered
-/// "infeasible" by the elastic form alone).
+/// solveOnGrid in one formulation, retried once in the other from the same start when it ends
+/// infeasible or unconverged (the order: kPredictorCorrectorMaxSteps). The elastic form stalls
+/// where most nodes bind and the violated constraints' curvature (weighted by z → ρ) swamps the
+/// Hessian, while the free-slack form's Hessian carries Newton's own multipliers (measured:
+/// rate_limited with the variational scheme at N = 128, and torque plus rate limits at N = 128
+/// that IPOPT solves, were answered "infeasible" by the elastic form alone); the elastic form
+/// certifies infeasibility where the free-slack form's line search fails (the infeasible
+/// torque and rate limits of test_interior_point).
 PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                 const ReducedProblem::Steps* coarse_steps,
                                 ReducedProblem::Steps* final_steps) {
   const auto start = std::chrono::steady_clock::now();
-  ReducedProblem::Steps elastic_steps;
-  PlanResult first =
-      solveOnGrid(problem, options, Formulation::Elastic, coarse_steps, &elastic_steps);
+  const bool free_first = problem.steps <= kPredictorCorrectorMaxSteps;
+  const Formulation forms[2] = {free_first ? Formulation::FreeSlacks : Formulation::Elastic,
+                                free_first ? Formulation::Elastic : Formulation::FreeSlacks};
+  const char* names[2] = {free_first ? "free slacks" : "the elastic form",
+                          free_first ? "the elastic form" : "free slacks"};
+  ReducedProblem::Steps first_steps;
+  PlanResult first = solveOnGrid(problem, options, forms[0], coarse_steps, &first_steps);
   const bool retry = first.termination == Termination::Infeasible ||
                      first.termination == Termination::NotConverged;
-  if (retry) {
-    ReducedProblem::Steps free_steps;
-    PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start),
-                                    Formulation::FreeSlacks, coarse_steps, &free_steps);
-    if (second.converged()) {
-      second.iterations += first.iterations;
-      second.levels.insert(second.levels.begin(), first.levels.begin(), first.levels.end());
-      second.message +=
-          "; solved with free slacks after the elastic form stopped: " + first.message;
-      if (final_steps) *final_steps = free_steps;
-      return second;
-    }
-    first.iterations += second.iterations;
-    appendLevels(&first.levels, second);
-    first.message += "; retried with free slacks: " + second.message;
+  if (!retry) {
+    if (final_steps) *final_steps = first_steps;
+    return first;
   }
-  if (final_steps) *final_steps = elastic_steps;
-  return first;
+  ReducedProblem::Steps second_steps;
+  PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start), forms[1],
+                                  coarse_steps, &second_steps);
+  // The answer: a converged solve, else an infeasibility certificate, else the first solve's
+  // reason; every solve's levels and iterations are kept.
+  const bool take_second = second.converged() || (first.termination != Termination::Infeasible &&
+                                                  second.termination == Termination::Infeasible);
+  PlanResult& answer = take_second ? second : first;
+  const PlanResult& other = take_second ? first : second;
+  std::vector<LevelSummary> levels = first.levels;
+  appendLevels(&levels, second);
+  answer.levels = levels;
+  answer.iterations = first.iterations + second.iterations;
+  answer.message +=
+      take_second ? std::string("; solved with ") + names[1] + " after " + names[0] + " stopped: "
+                  : std::string("; retried with ") + names[1] + ": ";
+  answer.message += other.message;
+  if (final_steps) *final_steps = take_second ? second_steps : first_steps;
+  return answer;
 }
 
 /// The interior point on the requested grid, with grid continuation above

@@ -54,6 +54,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -104,6 +105,9 @@ constexpr double kPenaltyRaiseViolation = 1e-3;
 constexpr int kPredictorCorrectorMaxSteps = 8192;
 /// The barrier never falls below this × (relative decrement)² × cost/m (see the predictor).
 constexpr double kBarrierProgressFloor = 0.01;
+/// A finer level started from a coarser level's duals pushes a binding constraint's slack at
+/// most this far inside (initializeMultipliers: 1e-2, which would undo the warm start).
+constexpr double kWarmSlackPush = 1e-6;
 /// A slack residual |c − s| below this (a hundredth of the feasibility tolerance) is round-off,
 /// not infeasibility: it does not count in the free-slack form's decrement.
 constexpr double kRoundOffSlackResidual = 1e-10;
@@ -145,6 +149,15 @@ struct Group {
   int width = 1;                ///< local nodes (3: torque stencil, 2: step, 1: node)
   std::vector<Instance> at;     ///< at[k − first_k]
   Instance& instance(int k) { return at[k - first_k]; }
+};
+
+/// A grid level's multipliers z and slacks s (free-slack form), per group and instance, to start
+/// the next finer level from (carried by the instances' times).
+struct LevelDuals {
+  int steps = 0;
+  std::vector<int> first_k;
+  std::vector<std::vector<double>> z, s;
+  bool empty() const { return steps == 0; }
 };
 
 bool isTorqueFamily(Family f) {
@@ -681,6 +694,49 @@ class InteriorPoint {
     return sigma;
   }
 
+  /// The multipliers and slacks of this iterate (FreeSlacks), to start a finer level from.
+  LevelDuals duals() const {
+    LevelDuals d;
+    d.steps = np_.steps();
+    for (const Group& g : groups_) {
+      d.first_k.push_back(g.first_k);
+      d.z.emplace_back();
+      d.s.emplace_back();
+      for (const Instance& in : g.at) {
+        d.z.back().push_back(in.z);
+        d.s.back().push_back(in.s);
+      }
+    }
+    return d;
+  }
+
+  /// FreeSlacks from a coarser level's duals: each instance takes the multiplier of the coarse
+  /// instance nearest in time (a node constraint's multiplier does not scale with h: the cost
+  /// Σ ½|τ_k|² weighs every node alike), and its slack c pushed inside by at most
+  /// kWarmSlackPush where the coarse constraint was binding (its coarse slack below the push),
+  /// else as initializeMultipliers pushes it. Returns mean(s z).
+  double warmStartDuals(const LevelDuals& coarse) {
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t gi = 0; gi < groups_.size() && gi < coarse.z.size(); ++gi) {
+      Group& g = groups_[gi];
+      const std::vector<double>& zc = coarse.z[gi];
+      if (zc.empty()) continue;
+      for (int k = g.first_k; k <= g.last_k; ++k) {
+        const int kc = static_cast<int>(std::lround(double(k) * coarse.steps / np_.steps()));
+        const int i = std::min<int>(zc.size() - 1, std::max(0, kc - coarse.first_k[gi]));
+        Instance& in = g.instance(k);
+        const bool binding = coarse.s[gi][i] < kWarmSlackPush;
+        in.z = zc[i];
+        in.s = std::max(in.c, binding ? kWarmSlackPush : 1e-2);
+        in.ds = 0.0;
+        sum += in.s * in.z;
+        ++count;
+      }
+    }
+    return sum / std::max(count, 1);
+  }
+
   /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
   /// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
   void initializeMultipliers(double mu, double rho, double cap) {
@@ -734,7 +790,8 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
 PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
                        Formulation formulation, bool predictor_corrector,
                        const ReducedProblem::Steps* coarse_steps,
-                       ReducedProblem::Steps* final_steps) {
+                       ReducedProblem::Steps* final_steps, const LevelDuals* coarse_duals = nullptr,
+                       LevelDuals* final_duals = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -807,6 +864,10 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   const double mu_final = std::min(mu, 0.1 * options.tolerance * f_scale / m);
   ip.evaluateValues(np.current(), nullptr);
   ip.initializeMultipliers(mu, rho, 10.0 * f_scale / m);
+  if (predictor_corrector && coarse_duals && !coarse_duals->empty() && coarse_steps) {
+    // The barrier of the warm start: its own complementarity (the predictor lowers it).
+    mu = std::max(mu_final, std::min(mu, ip.warmStartDuals(*coarse_duals)));
+  }
 
   std::string reason = "iteration limit reached";
   Termination ending = Termination::NotConverged;
@@ -1091,6 +1152,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   result.iterations = iteration;
   result.newton_decrement = relative_decrement;
   if (final_steps) *final_steps = np.current();
+  if (final_duals) *final_duals = free_slacks ? ip.duals() : LevelDuals{};
   const Maneuver planned = np.maneuver(np.current());
   result.switching_function = ip.switchingFunction(planned.torque);
   try {
@@ -1148,7 +1210,9 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
 /// torque and rate limits of test_interior_point).
 PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                 const ReducedProblem::Steps* coarse_steps,
-                                ReducedProblem::Steps* final_steps) {
+                                ReducedProblem::Steps* final_steps,
+                                const LevelDuals* coarse_duals = nullptr,
+                                LevelDuals* final_duals = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   // The minimum-time search's feasibility probes (started from its last feasible plan) keep the
   // elastic form first: with free slacks first its T* came out up to 0.3 % longer on Bilimoria
@@ -1160,14 +1224,15 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
   const char* names[2] = {free_first ? "free slacks" : "the elastic form",
                           free_first ? "the elastic form" : "free slacks"};
   ReducedProblem::Steps first_steps;
-  PlanResult first =
-      solveOnGrid(problem, options, forms[0], free_first, coarse_steps, &first_steps);
+  PlanResult first = solveOnGrid(problem, options, forms[0], free_first, coarse_steps, &first_steps,
+                                 coarse_duals, final_duals);
   const bool retry = first.termination == Termination::Infeasible ||
                      first.termination == Termination::NotConverged;
   if (!retry) {
     if (final_steps) *final_steps = first_steps;
     return first;
   }
+  if (final_duals) *final_duals = LevelDuals{};  // the retry's are not carried
   ReducedProblem::Steps second_steps;
   PlanResult second = solveOnGrid(problem, withRemainingBudget(options, start), forms[1], false,
                                   coarse_steps, &second_steps);
@@ -1202,6 +1267,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     levels.push_back(levels.back() / 4);
   }
   ReducedProblem::Steps steps;
+  LevelDuals duals;  // the last level's multipliers (free slacks), for the next one
   int iterations = 0;
   std::vector<LevelSummary> solved_levels;  // every solve of every level, in order
   PlanResult result;
@@ -1220,8 +1286,10 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
       appendLevels(&solved_levels, unconstrained);
     }
     ReducedProblem::Steps next;
+    LevelDuals next_duals;
     const PlanResult coarse = result;
-    result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next);
+    result = solveOnGridWithRetry(at, level_options, steps.empty() ? nullptr : &steps, &next,
+                                  &duals, &next_duals);
     iterations += result.iterations;
     appendLevels(&solved_levels, result);
     const bool ran_out =
@@ -1261,6 +1329,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
               result.termination == Termination::Infeasible ||
               result.termination == Termination::TimedOut;
     steps = result.converged() || stopped ? next : ReducedProblem::Steps{};
+    duals = result.converged() ? next_duals : LevelDuals{};
   }
   result.iterations = iterations;
   result.levels = solved_levels;

@@ -1277,7 +1277,8 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     levels.push_back(levels.back() / 4);
   }
   ReducedProblem::Steps steps;
-  LevelDuals duals;  // the last level's multipliers (free slacks), for the next one
+  LevelDuals duals;        // the last level's multipliers (free slacks), for the next one
+  int feasible_level = 0;  // the finest coarser level that met every constraint
   int iterations = 0;
   std::vector<LevelSummary> solved_levels;  // every solve of every level, in order
   PlanResult result;
@@ -1340,9 +1341,19 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
               result.termination == Termination::TimedOut;
     steps = result.converged() || stopped ? next : ReducedProblem::Steps{};
     duals = result.converged() ? next_duals : LevelDuals{};
+    if (result.converged() && !stopped) feasible_level = *level;
   }
   result.iterations = iterations;
   result.levels = solved_levels;
+  if (result.termination == Termination::Infeasible && feasible_level > 0) {
+    // A coarser grid met every constraint: the finer level's "infeasible" is its solver stopping
+    // (the ℓ1 violation stalled at a local minimum), not a certificate about the request
+    // (measured: torque + rate limits at N = 10⁵ stall there while N = 25 000 is feasible).
+    result.termination = Termination::NotConverged;
+    result.message = "not converged: the N = " + std::to_string(feasible_level) +
+                     " level met every constraint, but a finer level stopped (" + result.message +
+                     ")";
+  }
   if (levels.size() > 1) {
     result.message += "; grid continuation from N = " + std::to_string(levels.back());
   }

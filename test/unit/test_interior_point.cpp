@@ -3,6 +3,7 @@
 // method (independent of the solver's reduced coordinates), agreement with NLopt SLSQP given the
 // same constraints, infeasible requests answered with the named reason, and scene validation.
 #include <gtest/gtest.h>
+#include <cstdlib>
 
 #include <Eigen/QR>
 #include <functional>
@@ -519,6 +520,23 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
   // Before 09a6d91 it converged at 787.54698 (this answer lies 1e-4 above; a point at the
   // round-off floor or a neighbouring local optimum).
   EXPECT_NEAR(r.cost, 787.547, 1e-3 * 787.547);
+}
+
+// Slow (~60 s): N = 10⁵ with torque and rate limits (issue 16's target case). Its finest level
+// still stops (the normal equations' accuracy, docs/constraints_notes.md); what is asserted is
+// that the answer does not claim the request infeasible while the N = 25 000 level met every
+// constraint.
+TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5AreNotCalledInfeasible) {
+  if (!std::getenv("ATTITUDE_PLANNER_SLOW_TESTS")) {
+    GTEST_SKIP() << "slow: run scripts/test --all (ATTITUDE_PLANNER_SLOW_TESTS=1)";
+  }
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 100000);
+  p.constraints = {ap::PlanningConstraint::maxAngularRate(0.12)};
+  const ap::PlanResult r = plan(p, "newton");
+  EXPECT_NE(r.termination, ap::Termination::Infeasible) << r.message;
+  if (!r.converged()) {
+    EXPECT_NE(r.message.find("level met every constraint"), std::string::npos) << r.message;
+  }
 }
 
 TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {

@@ -104,8 +104,10 @@ constexpr double kPenaltyRaiseViolation = 1e-3;
 constexpr int kPredictorCorrectorMaxSteps = 8192;
 /// The barrier never falls below this × (relative decrement)² × cost/m (see the predictor).
 constexpr double kBarrierProgressFloor = 0.01;
+/// Free slacks start at c pushed inside s > 0 by this (IPOPT's κ₁ push).
+constexpr double kSlackPush = 1e-2;
 /// A finer level started from a coarser level's duals pushes a binding constraint's slack at
-/// most this far inside (initializeMultipliers: 1e-2, which would undo the warm start).
+/// most this far inside (kSlackPush would undo the warm start).
 constexpr double kWarmSlackPush = 1e-6;
 /// An inertia correction (relative shift) this small is round-off, not a change of the step.
 constexpr double kNegligibleShift = 1e-12;
@@ -538,27 +540,17 @@ class InteriorPoint {
     return affine / m;
   }
 
-  /// Adds Σ_i g_i w_i(instance) to `out` (w in instance order).
-  void addWeightedGradients(const std::vector<double>& w, Eigen::VectorXd* out) const {
+  /// Adds Σ_i g_i/s_i (the barrier's part of the right-hand side is μ times it) or, with
+  /// `products`, the corrector's Σ_i −g_i·products_i/s_i, to `out`.
+  void addSlackWeightedGradients(const std::vector<double>* products, Eigen::VectorXd* out) const {
     std::size_t i = 0;
     for (const Group& g : groups_) {
-      for (int k = g.first_k; k <= g.last_k; ++k)
-        addLocalVector(np_, g.at[k - g.first_k].g, w[i++], k + g.node_offset, g.width, out);
-    }
-  }
-
-  /// Per-instance weights 1/s_i (the barrier's part of the right-hand side is μ Σ g_i/s_i) and,
-  /// for the corrector, −products_i/s_i.
-  std::vector<double> slackWeights(const std::vector<double>* products) const {
-    std::vector<double> w;
-    std::size_t i = 0;
-    for (const Group& g : groups_) {
-      for (const Instance& in : g.at) {
-        w.push_back(products ? -(*products)[i] / in.s : 1.0 / in.s);
-        ++i;
+      for (int k = g.first_k; k <= g.last_k; ++k, ++i) {
+        const Instance& in = g.at[k - g.first_k];
+        const double weight = products ? -(*products)[i] / in.s : 1.0 / in.s;
+        addLocalVector(np_, in.g, weight, k + g.node_offset, g.width, out);
       }
     }
-    return w;
   }
 
   /// The condensation's q for the complementarity target s z = μ − ds_aff dz_aff (FreeSlacks;
@@ -729,7 +721,7 @@ class InteriorPoint {
         Instance& in = g.instance(k);
         const bool binding = coarse.s[gi][i] < kWarmSlackPush;
         in.z = zc[i];
-        in.s = std::max(in.c, binding ? kWarmSlackPush : 1e-2);
+        in.s = std::max(in.c, binding ? kWarmSlackPush : kSlackPush);
         in.ds = 0.0;
         sum += in.s * in.z;
         ++count;
@@ -744,8 +736,7 @@ class InteriorPoint {
     for (Group& g : groups_) {
       for (Instance& in : g.at) {
         if (free_slacks_) {
-          // The slacks start at c pushed inside s > 0 (as IPOPT's κ₁ = 1e-2 push).
-          in.s = std::max(in.c, 1e-2);
+          in.s = std::max(in.c, kSlackPush);
           in.ds = 0.0;
           in.z = std::min(mu / in.s, cap);
           continue;
@@ -926,7 +917,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         // factorization, two more solves.
         const Eigen::VectorXd barrier_part = [&] {
           Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
-          ip.addWeightedGradients(ip.slackWeights(nullptr), &v);
+          ip.addSlackWeightedGradients(nullptr, &v);
           return v;
         }();
         const Eigen::VectorXd affine_rhs = rhs - mu * barrier_part;
@@ -951,7 +942,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
         if (mu < 10.0 * mu_final) mu = mu_final;
         ip.setComplementarityTarget(mu, &products);
         delta = affine_rhs + mu * barrier_part;
-        ip.addWeightedGradients(ip.slackWeights(&products), &delta);
+        ip.addSlackWeightedGradients(&products, &delta);
         cholesky.solve(&delta);
       }
       slope = merit_gradient.dot(delta);

@@ -165,6 +165,7 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   ConstraintCheck out;
   const int N = maneuver.steps();
   const double h = maneuver.time_step;
+  int worst_k = -1;
   // One node constraint: `slack` to the stated limit (≥ 0: holds; violations are measured
   // against it), `node_slack` to the bound the planner imposes (activity), against `scale`.
   const auto visit = [&](double slack, double node_slack, double scale, const std::string& what,
@@ -176,10 +177,8 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
     out.max_relative_violation = std::max(out.max_relative_violation, -node_slack / scale);
     if (-slack > out.max_violation) {
       out.max_violation = -slack;
-      std::ostringstream w;
-      w << "by " << -slack << " at k = " << k << " (t = " << k * h << " s)";
       out.worst = what;
-      out.worst_where = w.str();
+      worst_k = k;  // worst_where is written once, at the end
     }
   };
   // Between nodes: torques are held (or, with end torques, interpolated linearly: the bounds are
@@ -195,13 +194,18 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   if (problem.hasTorqueBounds()) {
     out.names.push_back("actuator_limits");
     static const char* axis[] = {"x", "y", "z"};
+    std::string what[3];  // formed once: a stream per node and axis cost as much as the solve's
+                          // replay (measured, N = 128)
+    for (int i = 0; i < 3; ++i) {
+      std::ostringstream s;
+      s << "|tau_" << axis[i] << "| <= " << problem.max_torque(i) << " N m";
+      what[i] = s.str();
+    }
     for (int k = first_torque; k <= last_torque; ++k) {
       for (int i = 0; i < 3; ++i) {
         const double a = problem.max_torque(i);
-        std::ostringstream what;
-        what << "|tau_" << axis[i] << "| <= " << a << " N m";
         const double slack = a - std::abs(maneuver.torque[k](i));
-        visit(slack, slack, a, what.str(), k);
+        visit(slack, slack, a, what[i], k);
       }
     }
   }
@@ -236,6 +240,11 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
         }
         break;
     }
+  }
+  if (worst_k >= 0) {
+    std::ostringstream w;
+    w << "by " << out.max_violation << " at k = " << worst_k << " (t = " << worst_k * h << " s)";
+    out.worst_where = w.str();
   }
   return out;
 }

@@ -1261,7 +1261,7 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
   if (problem.steps <= kCoarsestConstrainedGrid) {
     return solveOnGridWithRetry(problem, options, nullptr, nullptr);
   }
-  // Coarse levels start from their own unconstrained optimum; the finest from the coarse level.
+  // The coarsest level starts from its own unconstrained optimum; the finer from the coarser.
   std::vector<int> levels{problem.steps};
   while (levels.back() / 4 >= 16 && levels.back() > kCoarsestConstrainedGrid) {
     levels.push_back(levels.back() / 4);
@@ -1280,9 +1280,19 @@ PlanResult solveContinued(const PlanningProblem& problem, const SolverOptions& o
     level_options.warm_start = nullptr;
     if (stopped) level_options.max_iterations = 0;
     PlanResult unconstrained;
+    Maneuver resampled;
     if (steps.empty()) {
+      // The coarsest level starts from its own unconstrained optimum; Newton reaches it from the
+      // warm start (the requested grid's unconstrained optimum) resampled, instead of repeating
+      // the grid continuation that found the warm start (measured on 20 constrained cases:
+      // 878 → 753 iterations; starting the interior point from the resampled plan itself
+      // saved more, 725, but ended further from IPOPT's optimum at N = 2048: 2.1e-9 vs 4.5e-10).
+      if (options.warm_start && options.warm_start->steps() == problem.steps) {
+        resampled.attitude = resampleAttitudes(*options.warm_start, at.steps);
+        level_options.warm_start = &resampled;
+      }
       unconstrained = solveWithNewton(at, level_options);
-      if (unconstrained.converged()) level_options.warm_start = &unconstrained.maneuver;
+      level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
       iterations += unconstrained.iterations;
       appendLevels(&solved_levels, unconstrained);
     }

@@ -261,9 +261,10 @@ const char* const kUsage =
     "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
     "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
     "                         [--time-budget S] [--in-process K]\n"
-    "                         [--start geodesic|unconstrained]  the peers' start (ipopt): the\n"
-    "                         geodesic (default) or our unconstrained optimum, as ours starts a\n"
-    "                         constrained solve (computed before the peer's clock starts)\n"
+    "                         [--start geodesic|unconstrained|ours]  the peers' start (ipopt):\n"
+    "                         the geodesic (default), our unconstrained optimum, as ours starts a\n"
+    "                         constrained solve, or our constrained optimum (does the peer stay\n"
+    "                         there?); computed before the peer's clock starts\n"
     "       benchmark_solvers --quick   every solver on the seed's rest-to-rest example, N = 16\n"
     "       benchmark_solvers --random-suite COUNT [--seed S] [--out FILE.md] [--time-budget S]\n"
     "                         [--cases I,J,...]  (only these case indices, e.g. to re-plan one)\n"
@@ -1184,15 +1185,21 @@ void printJson(const Measurement& m) {
   std::fflush(stdout);
 }
 
-/// The steps ω_k of the problem's unconstrained optimum (ours), the start ours takes for a
-/// constrained solve: `--start unconstrained` gives it to the peer as well (computed before the
-/// peer's clock starts).
-std::vector<Vector3> unconstrainedSteps(const ap::PlanningProblem& problem) {
-  ap::PlanningProblem free = problem;
-  free.constraints.clear();
-  free.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
-  const ap::PlanResult r = ap::planManeuver(free, ap::SolverOptions());
-  if (!r.converged()) throw ap::InvalidInput("--start unconstrained: " + r.message);
+/// Where the peer starts (`--start`): the geodesic; our unconstrained optimum, the start ours
+/// takes for a constrained solve; or our constrained optimum, so that a peer that stays there
+/// shows it is a local optimum of the same problem (a peer answer with another cost is then
+/// another local optimum, not a better solve of ours). Computed before the peer's clock starts.
+enum class PeerStart { Geodesic, Unconstrained, Ours };
+
+/// The steps ω_k of our optimum, without (Unconstrained) or with (Ours) the constraints.
+std::vector<Vector3> ourSteps(const ap::PlanningProblem& problem, PeerStart start) {
+  ap::PlanningProblem solved = problem;
+  if (start == PeerStart::Unconstrained) {
+    solved.constraints.clear();
+    solved.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  }
+  const ap::PlanResult r = ap::planManeuver(solved, ap::SolverOptions());
+  if (!r.converged()) throw ap::InvalidInput("--start: our plan did not converge: " + r.message);
   std::vector<Vector3> w;
   for (int k = 0; k < r.maneuver.steps(); ++k) {
     w.push_back(
@@ -1202,13 +1209,13 @@ std::vector<Vector3> unconstrainedSteps(const ap::PlanningProblem& problem) {
 }
 
 Measurement run(const std::string& solver, const ap::PlanningProblem& problem, double time_budget,
-                bool start_unconstrained = false) {
+                PeerStart peer_start = PeerStart::Geodesic) {
   Measurement m;
   m.solver = solver;
   m.scheme = ap::schemeName(problem.scheme);
   m.steps = problem.steps;
   std::vector<Vector3> start_steps;
-  if (start_unconstrained) start_steps = unconstrainedSteps(problem);
+  if (peer_start != PeerStart::Geodesic) start_steps = ourSteps(problem, peer_start);
   const auto start = std::chrono::steady_clock::now();
   PeerOutcome peer;
   ap::PlanResult ours;
@@ -1520,7 +1527,7 @@ int main(int argc, char** argv) {
   std::string solver, scene, scheme;
   bool check_hessian = false;
   bool constrained = false;
-  bool start_unconstrained = false;
+  PeerStart peer_start = PeerStart::Geodesic;
   int steps = 0;
   int suite_count = 0;
   std::uint64_t suite_seed = 19;
@@ -1556,11 +1563,13 @@ int main(int argc, char** argv) {
       constrained = true;
     } else if (a == "--start") {
       const std::string v = value();
-      if (v != "geodesic" && v != "unconstrained") {
-        std::cerr << "--start: expected geodesic or unconstrained, got '" << v << "'\n";
+      if (v != "geodesic" && v != "unconstrained" && v != "ours") {
+        std::cerr << "--start: expected geodesic, unconstrained or ours, got '" << v << "'\n";
         return 2;
       }
-      start_unconstrained = v == "unconstrained";
+      peer_start = v == "ours"            ? PeerStart::Ours
+                   : v == "unconstrained" ? PeerStart::Unconstrained
+                                          : PeerStart::Geodesic;
     } else if (a == "--time-budget") {
       time_budget = std::atof(value().c_str());
     } else if (a == "--random-suite") {
@@ -1604,13 +1613,13 @@ int main(int argc, char** argv) {
         scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
     if (steps > 0) problem.steps = steps;
     if (!scheme.empty()) problem.scheme = ap::parseScheme(scheme, "--scheme");
-    Measurement m = run(solver, problem, time_budget, start_unconstrained);
+    Measurement m = run(solver, problem, time_budget, peer_start);
     if (in_process > 1) {
       // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):
       // reported apart from time_s, which stays the first, cold solve of a fresh process.
       std::vector<double> warm;
       for (int r = 1; r < in_process; ++r)
-        warm.push_back(run(solver, problem, time_budget, start_unconstrained).time_s);
+        warm.push_back(run(solver, problem, time_budget, peer_start).time_s);
       std::sort(warm.begin(), warm.end());
       m.warm_time_s = warm[warm.size() / 2];
     }

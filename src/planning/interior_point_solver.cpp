@@ -1155,13 +1155,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   if (final_duals) *final_duals = free_slacks ? ip.duals() : LevelDuals{};
   const Maneuver planned = np.maneuver(np.current());
   result.switching_function = ip.switchingFunction(planned.torque);
-  try {
-    evaluatePlan(problem, planned.torque, &result, &planned);
-  } catch (const StepTooLarge& e) {
-    result.message = std::string("replay of the planned torques failed: ") + e.what();
-    result.termination = Termination::StepTooLarge;
-    return result;
-  }
+  evaluatePlan(problem, planned.torque, &result, &planned);
   const ConstraintCheck check = checkConstraints(problem, result.maneuver);
   std::ostringstream msg;
   if (ending == Termination::Infeasible) {

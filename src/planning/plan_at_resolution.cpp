@@ -106,31 +106,43 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
   return "";
 }
 
-void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
-                  PlanResult* result, const Maneuver* planned) {
+void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver* replay) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
   SimulationInput input;
   input.initial_attitude = problem.initial_attitude;
   input.initial_velocity = problem.initial_velocity;
-  input.torque = torque;
+  input.torque = result->maneuver.torque;
   input.effects = problem.effects.get();
   SimulationReport report;
-  const Maneuver replay = simulate(scheme, input, &report);
+  const Maneuver replayed = simulate(scheme, input, &report);
+  const int N = problem.steps;
+  result->dynamics_residual = report.max_step_residual;
+  result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replayed.attitude[N]);
+  result->terminal_velocity_error = (replayed.angular_velocity[N] - problem.final_velocity).norm();
+  result->replay_miss =
+      std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
+  if (replay) *replay = replayed;
+}
+
+void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
+                  PlanResult* result, const Maneuver* planned) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
   result->scheme = problem.scheme;
   result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
   if (problem.hasTorqueBounds()) {
     result->effects.push_back(effectKindName(EffectKind::ActuatorLimits));
   }
-  result->dynamics_residual = report.max_step_residual;
-  const int N = problem.steps;
   result->duration = problem.duration;
   result->cost = scheme.cost(torque);
   result->effort = scheme.timeStep() * result->cost;
-  result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replay.attitude[N]);
-  result->terminal_velocity_error = (replay.angular_velocity[N] - problem.final_velocity).norm();
-  result->replay_miss =
-      std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
-  result->maneuver = planned ? *planned : replay;
+  if (planned) {
+    result->maneuver = *planned;
+  } else {
+    result->maneuver.torque = torque;
+    Maneuver replay;
+    replayFigures(problem, result, &replay);
+    result->maneuver = replay;
+  }
   result->step_residual = measureStepResidual(problem, result->maneuver).relative;
 }
 
@@ -301,6 +313,18 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     result = solveWithNewton(problem, options);
   } else {
     result = solveWithNlopt(problem, options);
+  }
+  if (options.solver == SolverKind::Newton && schemeIsDiscretization(problem.scheme) &&
+      result.maneuver.steps() == problem.steps) {
+    // The Newton and interior-point plans are their own trajectories; their open-loop replay
+    // (replay_miss, the terminal errors) is measured once, here, for the plan returned.
+    try {
+      replayFigures(problem, &result);
+    } catch (const StepTooLarge& e) {
+      result.termination = Termination::StepTooLarge;
+      result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
+                       result.message + ")";
+    }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);
   if (problem.hasNodeConstraints() && result.maneuver.steps() == problem.steps) {

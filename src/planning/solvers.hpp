@@ -27,13 +27,21 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem);
 /// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);
 
-/// Fills result->maneuver with `planned` (the solver's own trajectory; null: the replay below),
-/// its cost and step_residual, and replays τ_1..τ_{N−1} (torque[k], k = 0..N, τ_0 = τ_N = 0)
-/// through the problem's scheme from R_0, Ω_0 for dynamics_residual, the terminal errors and
-/// replay_miss. Every solver finishes through here, so every figure is measured the same way.
-/// Throws StepTooLarge if the replay's implicit step fails.
+/// Fills result->maneuver with `planned` (the solver's own trajectory) and its cost and
+/// step_residual; without `planned`, with the replay of `torque` (replayFigures), which is then
+/// also the plan. Every solver finishes through here, so every figure is measured the same way.
+/// The replay of a planned trajectory is left to replayFigures, which planAtResolution calls once
+/// for the plan it returns (not for every grid level and start: at N = 512 with torque limits
+/// those replays were a fifth of the solve). Throws StepTooLarge if a replay's implicit step
+/// fails.
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
                   PlanResult* result, const Maneuver* planned = nullptr);
+
+/// Replays the plan's torques τ_k (k = 0..N, τ_0 = τ_N = 0 but with end torques) through the
+/// problem's scheme from R_0, Ω_0 and sets dynamics_residual, the terminal errors and replay_miss
+/// (`replay`: where to keep the replayed maneuver, or null). Throws StepTooLarge if the replay's
+/// implicit step fails.
+void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver* replay = nullptr);
 
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step

@@ -21,6 +21,7 @@
 #include <memory>
 #include <optional>
 
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "planning/reduced_problem.hpp"
 #include "planning/solvers.hpp"
@@ -607,6 +608,88 @@ PlanResult solveWithRateContinuation(const PlanningProblem& problem, const Solve
   return failed;
 }
 
+/// The coasting start's solve (a last resort) may take this many times the per-level iteration
+/// limit (5000 at the default 200).
+constexpr int kCoastingIterationFactor = 25;
+
+/// The coasting start: the torque-free motions from both ends, forward from (R_0, Ω_0) and
+/// backward from (R_N, Ω_{N−1}) (the forward motion from (R_N, −Ω_{N−1}), reversed), blended in
+/// their body steps, ξ_j = (1 − w_j) ξ^fwd_j + w_j ξ^bwd_j with w a smoothstep in time, the
+/// attitude gap left at R_{N−1} closed by a cubic (ReducedProblem::initializeFromSteps). Long
+/// spinning maneuvers coast most of the way; the Hermite curve matches only the end rates.
+/// Returns its attitudes, or nothing if a torque-free step has no solution at this h.
+std::optional<Maneuver> coastingStart(const PlanningProblem& problem) {
+  const int N = problem.steps;
+  try {
+    const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / N);
+    SimulationInput input;
+    input.torque.assign(N + 1, Vector3::Zero());
+    input.initial_attitude = problem.initial_attitude;
+    input.initial_velocity = problem.initial_velocity;
+    const Maneuver forward = simulate(scheme, input);
+    input.initial_attitude = problem.final_attitude;
+    input.initial_velocity = -problem.final_velocity;
+    const Maneuver backward = simulate(scheme, input);
+    ReducedProblem::Steps blend(N);
+    for (int j = 0; j < N; ++j) {
+      const double u = (j + 0.5) / N, w = u * u * (3 - 2 * u);
+      const Vector3 ahead =
+          so3::log(Matrix3(forward.attitude[j].transpose() * forward.attitude[j + 1]));
+      const Vector3 behind =
+          so3::log(Matrix3(backward.attitude[N - j].transpose() * backward.attitude[N - j - 1]));
+      blend[j] = (1 - w) * ahead + w * behind;
+    }
+    ReducedProblem np(problem);
+    np.initializeFromSteps(blend);
+    Maneuver start;
+    start.attitude = np.attitudes(np.current());
+    return start;
+  } catch (const StepTooLarge&) {
+    return std::nullopt;
+  }
+}
+
+/// A solve that stalled from the Hermite start (and in the continuation in the boundary rates)
+/// once more from the coasting start. Returns that plan if it converges, else `failed` with a
+/// note (measured on the random suite: cases of 40–90 s at 4–5 rad/s, seed-like inertias).
+PlanResult solveFromCoastingStart(const PlanningProblem& problem, const SolverOptions& options,
+                                  std::chrono::steady_clock::time_point start, PlanResult failed) {
+  const std::optional<Maneuver> coasting = coastingStart(problem);
+  SolverOptions from = options;
+  from.time_budget_s = withRemainingBudget(options, start).time_budget_s;
+  if (!coasting || (options.time_budget_s > 0 && from.time_budget_s <= 1e-299)) return failed;
+  from.warm_start = &*coasting;
+  // A last resort, once the other starts have stalled: it may take longer (measured on the random
+  // suite: #150 359 iterations, #117 1268, #127 2015, #41 4613, each creeping along a valley of
+  // negative curvature before Newton's quadratic convergence).
+  from.max_iterations =
+      options.max_iterations > std::numeric_limits<int>::max() / kCoastingIterationFactor
+          ? std::numeric_limits<int>::max()
+          : kCoastingIterationFactor * options.max_iterations;
+  if (options.on_iteration) {
+    const int before = failed.iterations;
+    from.on_iteration = [&options, before](const IterationInfo& info) {
+      IterationInfo global = info;
+      global.iteration += before;
+      return options.on_iteration(global);
+    };
+  }
+  PlanResult r = solveWithContinuation(problem, from);
+  if (r.converged()) {
+    r.message +=
+        "; from the coasting start (the torque-free motions from both ends, blended) "
+        "after the Hermite start stalled: " +
+        failed.message;
+    r.iterations += failed.iterations;
+    r.levels.insert(r.levels.begin(), failed.levels.begin(), failed.levels.end());
+    return r;
+  }
+  failed.iterations += r.iterations;
+  failed.message += "; from the coasting start too: " + r.message;
+  failed.levels.insert(failed.levels.end(), r.levels.begin(), r.levels.end());
+  return failed;
+}
+
 }  // namespace
 
 std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
@@ -622,6 +705,9 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
       !problem.initial_velocity.isZero(0.0) || !problem.final_velocity.isZero(0.0);
   if (first.termination == Termination::NotConverged && spinning_ends && !options.warm_start) {
     first = solveWithRateContinuation(problem, options, start, std::move(first));
+    if (first.termination == Termination::NotConverged) {
+      first = solveFromCoastingStart(problem, options, start, std::move(first));
+    }
   }
   std::vector<InitialGuess> guesses;
   try {

@@ -169,26 +169,43 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coa
                                 : 0.0;
   // The free steps: those next to a free attitude (1..N−2, or 0..N−1 with end torques). What
   // they compose to now is what they must compose to: R_firstᵀ R_last+1 of the fixed ends.
-  using Quaternion = Eigen::Vector4d;
   const int first = first_free_ - 1, last = last_free_;
-  Quaternion target = so3::quaternionOfRotationVector<double>(Vector3::Zero());
-  for (int j = first; j <= last; ++j) {
-    target = so3::quaternionProduct<double>(target, so3::quaternionOfRotationVector(steps_[j]));
-  }
+  const Eigen::Vector4d target = freeStepsComposition();
   for (int j = first; j <= last; ++j) {
     const Vector3 fine = interpolatedStep(coarse, j, N_, midpoints);
     steps_[j] = coarser
                     ? Vector3(fine - weight * (interpolatedStep(*coarser, j, N_, midpoints) - fine))
                     : fine;
   }
-  // The gap ψ between where the interpolated steps end and the fixed end (body frame there),
-  // closed by R_j → R_j exp(φ_j^), φ cubic in j with φ = 0 at the first fixed node and ψ at the
-  // last, zero end slopes: F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In
-  // quaternions throughout.
-  Quaternion reached = so3::quaternionOfRotationVector<double>(Vector3::Zero());
-  for (int j = first; j <= last; ++j) {
-    reached = so3::quaternionProduct<double>(reached, so3::quaternionOfRotationVector(steps_[j]));
+  closeGap(target);
+}
+
+void ReducedProblem::initializeFromSteps(const Steps& guess) {
+  if (static_cast<int>(guess.size()) != N_) {
+    throw InvalidInput("initial guess: has " + std::to_string(guess.size()) +
+                       " steps, the problem " + std::to_string(N_));
   }
+  const Eigen::Vector4d target = freeStepsComposition();
+  for (int j = first_free_ - 1; j <= last_free_; ++j) steps_[j] = guess[j];
+  closeGap(target);
+}
+
+Eigen::Vector4d ReducedProblem::freeStepsComposition() const {
+  Eigen::Vector4d q = so3::quaternionOfRotationVector<double>(Vector3::Zero());
+  for (int j = first_free_ - 1; j <= last_free_; ++j) {
+    q = so3::quaternionProduct<double>(q, so3::quaternionOfRotationVector(steps_[j]));
+  }
+  return q;
+}
+
+void ReducedProblem::closeGap(const Eigen::Vector4d& target) {
+  using Quaternion = Eigen::Vector4d;
+  const int first = first_free_ - 1, last = last_free_;
+  // The gap ψ between where the free steps end and the fixed end (body frame there), closed by
+  // R_j → R_j exp(φ_j^), φ cubic in j with φ = 0 at the first fixed node and ψ at the last,
+  // zero end slopes: F_j → exp(−φ_j^) F_j exp(φ_{j+1}^) telescopes to the target. In
+  // quaternions throughout.
+  Quaternion reached = freeStepsComposition();
   reached.tail<3>() *= -1.0;  // its inverse
   const Vector3 gap = so3::logOfQuaternion<double>(so3::quaternionProduct<double>(reached, target));
   const auto phi = [&](int j) {

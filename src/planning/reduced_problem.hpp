@@ -77,6 +77,10 @@ class ReducedProblem {
   /// torque jumps at the coarse nodes and the ends).
   /// With `coarser` (the solution on a still coarser grid) the two are extrapolated to this h.
   void initializeFromCoarser(const Steps& coarse, const Steps* coarser = nullptr);
+  /// Interior from a guess of every step (N of them; the fixed boundary steps are kept): the
+  /// free steps are taken from `guess` and the gap they leave at R_{N−1} is closed as in
+  /// initializeFromCoarser.
+  void initializeFromSteps(const Steps& guess);
 
   /// R_0..R_N of the steps (products from R_0).
   std::vector<Matrix3> attitudes(const Steps& steps) const;
@@ -127,6 +131,12 @@ class ReducedProblem {
   }
 
  private:
+  /// The free steps' composition R_firstᵀR_{last+1} (what they must compose to), in quaternions.
+  Eigen::Vector4d freeStepsComposition() const;
+  /// Closes the gap between the free steps' composition and `target` smoothly (see
+  /// initializeFromCoarser).
+  void closeGap(const Eigen::Vector4d& target);
+
   int N_;
   DiscreteScheme scheme_;
   Matrix3 initial_attitude_;

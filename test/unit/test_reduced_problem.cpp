@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 #include <random>
 
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
 #include "planning/reduced_problem.hpp"
@@ -298,5 +299,44 @@ TEST(ReducedProblem, CoarseSolutionCarriedToAFinerGridIsCloseAndKeepsTheEnds) {
         "%s: carried-over torque error %.3g (32 -> 128), %.3g (128 -> 512); resampled "
         "attitudes %.3g, %.3g\n",
         schemeName(scheme).c_str(), e128.steps, e512.steps, e128.resampled, e512.resampled);
+  }
+}
+
+// The coasting start's building block: a guess of every step is taken as the interior, and the gap
+// it leaves at the fixed end is closed. Guessing the very torque-free motion whose end the problem
+// asks for leaves no gap, so the interior is that motion: zero torques to round-off, for every
+// scheme's fixed ends (end torques too).
+TEST(ReducedProblem, StepsOfATorqueFreeMotionToItsOwnEndAreKeptExactly) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    PlanningProblem p = randomProblem(scheme, 64);
+    p.initial_velocity = Vector3(0.9, -0.4, 0.6);
+    const DiscreteScheme discrete(scheme, p.inertia, p.duration / p.steps);
+    SimulationInput input;
+    input.initial_attitude = p.initial_attitude;
+    input.initial_velocity = p.initial_velocity;
+    input.torque.assign(p.steps + 1, Vector3::Zero());
+    const Maneuver coast = simulate(discrete, input);
+    p.final_attitude = coast.attitude.back();
+    p.final_velocity = coast.angular_velocity.back();
+    ReducedProblem rp(p);
+    ReducedProblem::Steps guess(p.steps);
+    for (int j = 0; j < p.steps; ++j) {
+      guess[j] = so3::log(Matrix3(coast.attitude[j].transpose() * coast.attitude[j + 1]));
+    }
+    rp.initializeFromSteps(guess);
+    double worst_torque = 0.0, worst_step = 0.0;
+    for (const Vector3& tau : rp.torques(rp.current()))
+      worst_torque = std::max(worst_torque, tau.norm());
+    for (int j = 0; j < p.steps; ++j)
+      worst_step = std::max(worst_step, (rp.current()[j] - guess[j]).norm());
+    const double momentum = (p.inertia * p.initial_velocity).norm();
+    EXPECT_LE(worst_torque, 1e-9 * momentum / discrete.timeStep()) << schemeName(scheme);
+    EXPECT_LE(worst_step, 1e-12) << schemeName(scheme);
+    // A guess that ends elsewhere is closed onto the fixed end: R_N is the problem's.
+    for (Vector3& step : guess) step *= 0.5;
+    rp.initializeFromSteps(guess);
+    const std::vector<Matrix3> R = rp.attitudes(rp.current());
+    EXPECT_LE(so3::angleBetween(R.back(), p.final_attitude), 1e-12) << schemeName(scheme);
+    EXPECT_THROW(rp.initializeFromSteps(ReducedProblem::Steps(3)), InvalidInput);
   }
 }

@@ -150,8 +150,10 @@ struct IterationInfo {
 /// Solver settings. Defaults solve to round-off on the seed's examples.
 struct SolverOptions {
   SolverKind solver = SolverKind::Newton;
-  double tolerance = 1e-10;    ///< relative torque accuracy (Newton decrement / |τ|₂)
-  int max_iterations = 200;    ///< Newton: per grid level (coarse levels start the fine one)
+  double tolerance = 1e-10;  ///< relative torque accuracy (Newton decrement / |τ|₂)
+  /// Newton: per grid level (coarse levels start the fine one); a spinning solve that stalls from
+  /// every other start is retried from the coasting start with 25× this (newton_solver.cpp).
+  int max_iterations = 200;
   double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
   /// Called after every iteration, numbered across grid levels (the first ones may run on
   /// coarser grids); return false to cancel (the result says "cancelled").

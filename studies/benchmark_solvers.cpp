@@ -1160,6 +1160,7 @@ struct Measurement {
   double time_s = 0.0, cost = 0.0, terminal_miss = 0.0;
   double warm_time_s = 0.0;  ///< median of the repeated in-process solves (0: not measured)
   double max_constraint_violation = 0.0;  ///< checkConstraints on the replayed plan
+  int active_constraints = 0;             ///< node constraints at their bound (checkConstraints)
   bool converged = false;
   long peak_rss_kb = 0;
 };
@@ -1178,10 +1179,10 @@ void printJson(const Measurement& m) {
       "{\"solver\": \"%s\", \"scheme\": \"%s\", \"steps\": %d, \"time_s\": %.9g, "
       "\"iterations\": %d, \"cost\": %.17g, \"converged\": %s, \"terminal_miss\": %.3g, "
       "\"peak_rss_kb\": %ld, \"warm_time_s\": %.9g, \"max_constraint_violation\": %.3g, "
-      "\"message\": \"%s\"}\n",
+      "\"active_constraints\": %d, \"message\": \"%s\"}\n",
       m.solver.c_str(), m.scheme.c_str(), m.steps, m.time_s, m.iterations, m.cost,
       m.converged ? "true" : "false", m.terminal_miss, m.peak_rss_kb, m.warm_time_s,
-      m.max_constraint_violation, escaped(m.message).c_str());
+      m.max_constraint_violation, m.active_constraints, escaped(m.message).c_str());
   std::fflush(stdout);
 }
 
@@ -1263,7 +1264,9 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
   m.cost = ours.cost;
   m.terminal_miss = std::max(ours.terminal_attitude_error, ours.terminal_velocity_error);
   if (problem.hasNodeConstraints() && ours.maneuver.steps() == problem.steps) {
-    m.max_constraint_violation = ap::checkConstraints(problem, ours.maneuver).max_violation;
+    const ap::ConstraintCheck check = ap::checkConstraints(problem, ours.maneuver);
+    m.max_constraint_violation = check.max_violation;
+    m.active_constraints = check.active;
     // A peer "converges" only onto a plan that meets the constraints it was given.
     if (!is_ours && m.max_constraint_violation > 1e-8) m.converged = false;
   }

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -72,6 +73,36 @@ TEST(BenchmarkSolvers, IpoptExactHessianAgreesWithFiniteDifferencesOfGradients) 
       std::printf("%s", output.c_str());
     }
   }
+#endif
+}
+
+/// The number after `"key": ` in a benchmark_solvers JSON line (NaN if absent).
+double jsonNumber(const std::string& line, const std::string& key) {
+  const std::size_t at = line.find("\"" + key + "\": ");
+  return at == std::string::npos ? std::nan("") : std::stod(line.substr(at + key.size() + 4));
+}
+
+// `--start ours` gives the IPOPT peer our constrained optimum: on a scene where both reach the
+// same optimum (torque_limited, N = 64), IPOPT stays there (the same cost to 1e-8 and the same
+// active constraints) — the check the constraints benchmark's last column makes at large N.
+TEST(BenchmarkSolvers, IpoptStartedFromOurConstrainedOptimumStaysThere) {
+#ifndef AP_BENCHMARK_HAS_IPOPT
+  GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";
+#else
+  const std::string scene = std::string(AP_SOURCE_DIR) + "/scenes/torque_limited.yaml";
+  std::string ours, peer;
+  ASSERT_EQ(runTool("--solver newton --scene '" + scene + "' --steps 64", &ours), 0) << ours;
+  ASSERT_EQ(runTool("--solver ipopt --scene '" + scene + "' --steps 64 --start ours", &peer), 0)
+      << peer;
+  EXPECT_NE(peer.find("\"converged\": true"), std::string::npos) << peer;
+  const double cost = jsonNumber(ours, "cost");
+  EXPECT_NEAR(jsonNumber(peer, "cost"), cost, 1e-8 * cost) << ours << peer;
+  EXPECT_EQ(jsonNumber(peer, "active_constraints"), jsonNumber(ours, "active_constraints"))
+      << ours << peer;
+  EXPECT_GT(jsonNumber(ours, "active_constraints"), 0) << ours;
+  std::string bad;
+  EXPECT_EQ(runTool("--solver ipopt --start nowhere", &bad), 2) << bad;
+  EXPECT_NE(bad.find("geodesic, unconstrained or ours"), std::string::npos) << bad;
 #endif
 }
 

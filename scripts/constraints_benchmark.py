@@ -217,18 +217,19 @@ def main():
                    "1e-12; started (`--start unconstrained`) from our unconstrained optimum, "
                    "computed before its clock starts, as ours starts its interior point (ours pays "
                    "for that Newton solve, IPOPT does not). Both plans are replayed and checked "
-                   "the same way (cost, terminal miss, checkConstraints). Last column: IPOPT "
+                   "the same way (cost, terminal miss, checkConstraints; \"active\": node "
+                   "constraints at their bound in each plan). Last column: IPOPT "
                    "started from our constrained optimum instead (`--start ours`): its cost "
                    "relative to ours and its iterations; ≈ 0 says IPOPT accepts our plan as a "
                    "local optimum.\n" % (repeats, args.ipopt_cap))
         out.append("| scene | N | ours | IPOPT | IPOPT / ours | iterations ours / IPOPT | cost ours "
                    "| cost IPOPT | (ours − IPOPT) / IPOPT | max violation ours / IPOPT | "
-                   "peak RSS ours / IPOPT [MB] | IPOPT from ours: (cost − ours) / ours, its "
-                   "iterations |")
-        out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+                   "active ours / IPOPT | peak RSS ours / IPOPT [MB] | IPOPT from ours: "
+                   "(cost − ours) / ours, its iterations |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for name, N, ours, peer, stay in ipopt_rows:
             if peer is None:
-                out.append("| %s | %d | %s | failed | | | %.12g | | | | | |" % (
+                out.append("| %s | %d | %s | failed | | | %.12g | | | | | | |" % (
                     name, N, ms_peer(ours), ours["cost"]))
                 continue
             if stay is None:
@@ -239,12 +240,13 @@ def main():
                                              "" if stay["converged"] else " (not converged)")
             note = "" if peer["converged"] else " (not converged: %s)" % peer["message"]
             out.append("| %s | %d | %s | %s%s | %.1f | %d / %d | %.12g | %.12g | %.1e | "
-                       "%.1e / %.1e | %.0f / %.0f | %s |" % (
+                       "%.1e / %.1e | %d / %d | %.0f / %.0f | %s |" % (
                            name, N, ms_peer(ours), ms_peer(peer), note,
                            peer["time_s"] / max(ours["time_s"], 1e-9), ours["iterations"],
                            peer["iterations"], ours["cost"], peer["cost"],
                            (ours["cost"] - peer["cost"]) / peer["cost"],
                            ours["max_constraint_violation"], peer["max_constraint_violation"],
+                           ours.get("active_constraints", -1), peer.get("active_constraints", -1),
                            ours["peak_rss_kb"] / 1024.0, peer["peak_rss_kb"] / 1024.0, from_ours))
         out.append("")
     with open(os.path.join(args.docs, "constraints.md"), "w") as f:

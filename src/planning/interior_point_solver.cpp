@@ -332,16 +332,18 @@ class InteriorPoint {
 
   /// Assembles the condensed Newton system at the current iterate: H, rhs, ∇φ_μ; returns f.
   /// `primal`: the multipliers are replaced by their primal values μ/s (then the step is Newton's
-  /// on φ_μ, a descent direction whenever H is positive definite).
+  /// on φ_μ, a descent direction whenever H is positive definite). H = null: the constraint
+  /// values and gradients only (no second derivatives; multipliers and slacks untouched).
   double assemble(double mu, double rho, bool primal, BandedSymmetricMatrix* H,
                   Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, double* gradient_scale) {
     const int n = np_.unknowns();
-    H->setZero();
+    if (H) H->setZero();
     rhs->setZero(n);
     merit_gradient->setZero(n);
     const ReducedProblem::Steps& steps = np_.current();
     // Slacks and (safeguarded or primal) multipliers for constraint value c.
     const auto prepare = [&](Instance& in) {
+      if (!H) return;  // gradients only: the multipliers and slacks are left as they are
       if (free_slacks_) {
         // s is a variable: the multiplier stays near μ/s, and the condensation is that of
         // c − s = 0 (q = μ/z − c makes ds = gᵀdδ + c − s and dz = (q − gᵀdδ)/D).
@@ -404,13 +406,11 @@ class InteriorPoint {
       return w;
     };
     const double cost = np_.forEachStencil(
-        true,
+        H != nullptr,
         [&](const ReducedProblem::Stencil& st) {
           jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
           torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
           const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
-          Eigen::Matrix<double, 9, 9> block =
-              current_beta_ * st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
           const double r = root(st.k);
           for (Group* g : torque_groups) {
             Instance& in = g->instance(st.k);
@@ -420,9 +420,16 @@ class InteriorPoint {
               const double sign = g->family == Family::TorqueUpper ? 1.0 : -1.0;
               in.g = -sign / (g->limit * r) * st.jacobian.row(g->axis).transpose();
             }
-            block += (in.g / in.D) * in.g.transpose();
           }
-          addLocal(np_, H, st.k - 1, 3, block);
+          if (H) {
+            Eigen::Matrix<double, 9, 9> block =
+                current_beta_ * st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
+            for (Group* g : torque_groups) {
+              const Instance& in = g->instance(st.k);
+              block += (in.g / in.D) * in.g.transpose();
+            }
+            addLocal(np_, H, st.k - 1, 3, block);
+          }
           addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
           addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
         },
@@ -461,7 +468,7 @@ class InteriorPoint {
               in.g = -2.0 / (g->limit * g->limit) * grad;
               block += (in.g / in.D) * in.g.transpose();
             }
-            addLocal(np_, H, node.k - 1, 3, block);
+            if (H) addLocal(np_, H, node.k - 1, 3, block);
           },
           rate_weights);
     }
@@ -490,7 +497,7 @@ class InteriorPoint {
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
         }
         block += (in.g / in.D) * in.g.transpose();
-        addLocal(np_, H, k + g->node_offset, g->width, block);
+        if (H) addLocal(np_, H, k + g->node_offset, g->width, block);
       }
     }
     // ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is
@@ -685,6 +692,25 @@ class InteriorPoint {
       }
     }
     return sigma;
+  }
+
+  /// The first-order (KKT stationarity) residual at the current iterate with this solve's
+  /// multipliers: max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ|, as the Newton solver's
+  /// max_residual. Re-forms the gradients at the iterate (the last assembly's are the previous
+  /// iterate's), first order only, leaving the multipliers as they are.
+  double relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
+                              Eigen::VectorXd* merit_gradient) {
+    double scale = 0.0, unused = 0.0;
+    assemble(mu, rho, false, nullptr, rhs, merit_gradient, &scale);
+    Eigen::VectorXd residual;
+    np_.evaluate(&residual, nullptr, &unused);  // ∇f
+    for (const Group& g : groups_) {
+      for (int k = g.first_k; k <= g.last_k; ++k) {
+        const Instance& in = g.at[k - g.first_k];
+        addLocalVector(np_, in.g, -in.z, k + g.node_offset, g.width, &residual);
+      }
+    }
+    return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
   }
 
   /// The multipliers and slacks of this iterate (FreeSlacks), to start a finer level from.
@@ -1155,6 +1181,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   if (final_duals) *final_duals = free_slacks ? ip.duals() : LevelDuals{};
   const Maneuver planned = np.maneuver(np.current());
   result.switching_function = ip.switchingFunction(planned.torque);
+  result.max_residual = ip.relativeStationarity(mu, rho, &rhs, &merit_gradient);
   evaluatePlan(problem, planned.torque, &result, &planned);
   const ConstraintCheck check = checkConstraints(problem, result.maneuver);
   std::ostringstream msg;

@@ -474,6 +474,11 @@ TEST(InteriorPoint, ShippedConstrainedScenesBindAndHold) {
     EXPECT_EQ(r.solver, "interior_point") << "the constraint must bind: " << r.message;
     EXPECT_GT(r.active_constraints, 0);
     EXPECT_LE(r.max_constraint_violation, 1e-9);
+    // Its first-order (KKT stationarity) residual is measured and reported, as Newton's is: the
+    // plan's own figure and its finest level's.
+    EXPECT_GT(r.max_residual, 0.0);
+    EXPECT_LE(r.max_residual, 1e-9);
+    EXPECT_EQ(r.levels.back().relative_gradient, r.max_residual);
   }
 }
 

@@ -58,7 +58,8 @@ struct PlanResult {
   /// with the continuous optimum.
   double effort = 0.0;
   int iterations = 0;  ///< Newton iterations, coarser continuation levels included
-  /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|.
+  /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|
+  /// (the interior point: of the KKT stationarity residual ∇C − Σ zᵢ∇cᵢ with its multipliers).
   double max_residual = 0.0;
   /// Newton: √(gᵀH⁻¹g)/|τ|₂ of the last iteration, ≈ the relative ℓ2 torque error before the
   /// final step (the convergence test); NLopt: 0.

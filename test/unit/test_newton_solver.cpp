@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 #include "attitude_planner/dynamics/simulation.hpp"
@@ -340,9 +341,25 @@ TEST(NewtonSolver, EveryThresholdIsScaleFree) {
       scaled.final_velocity = p.final_velocity / c;
       const PlanResult r = planManeuver(scaled);
       ASSERT_TRUE(r.converged()) << index << " s = " << s << " c = " << c << ": " << r.message;
-      EXPECT_EQ(r.iterations, base.iterations) << index << " s = " << s << " c = " << c;
       EXPECT_NEAR(r.cost, base.cost * s * s / std::pow(c, 4), 1e-9 * r.cost)
           << index << " s = " << s << " c = " << c;
+      // A slow spinning solve is also solved from more starts (the cheapest kept): its first
+      // start must take the same iterations; the extra starts are long solves of their own whose
+      // counts may differ by round-off in their paths (measured: #13, 208 extra iterations ± 2),
+      // while their extremals and costs are the same (the kept cost above, the others' in
+      // `extremal`, which is compared scale-free through the choice it names).
+      const std::size_t more = base.extremal.find("; after ");
+      if (more == std::string::npos) {
+        EXPECT_EQ(r.iterations, base.iterations) << index << " s = " << s << " c = " << c;
+      } else {
+        const auto first_start = [](const std::string& e) {
+          return std::atoi(e.c_str() + e.find("; after ") + 8);
+        };
+        EXPECT_EQ(first_start(r.extremal), first_start(base.extremal)) << r.extremal;
+        EXPECT_NEAR(r.iterations, base.iterations, 0.02 * base.iterations) << r.extremal;
+        const auto kept = [](const std::string& e) { return e.substr(e.find("cheapest kept")); };
+        EXPECT_EQ(kept(r.extremal).substr(0, 40), kept(base.extremal).substr(0, 40));
+      }
     }
   }
 }

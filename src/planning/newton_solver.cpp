@@ -612,6 +612,15 @@ PlanResult solveWithRateContinuation(const PlanningProblem& problem, const Solve
 /// limit (5000 at the default 200).
 constexpr int kCoastingIterationFactor = 25;
 
+bool hasSpinningEnds(const PlanningProblem& problem) {
+  return !problem.initial_velocity.isZero(0.0) || !problem.final_velocity.isZero(0.0);
+}
+
+/// A time budget was given and nothing of it is left since `start`.
+bool outOfTime(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
+  return options.time_budget_s > 0 && withRemainingBudget(options, start).time_budget_s <= 1e-299;
+}
+
 /// The coasting start: the torque-free motions from both ends, forward from (R_0, Ω_0) and
 /// backward from (R_N, Ω_{N−1}) (the forward motion from (R_N, −Ω_{N−1}), reversed), blended in
 /// their body steps, ξ_j = (1 − w_j) ξ^fwd_j + w_j ξ^bwd_j with w a smoothstep in time, the
@@ -654,10 +663,10 @@ std::optional<Maneuver> coastingStart(const PlanningProblem& problem) {
 /// note (measured on the random suite: cases of 40–90 s at 4–5 rad/s, seed-like inertias).
 PlanResult solveFromCoastingStart(const PlanningProblem& problem, const SolverOptions& options,
                                   std::chrono::steady_clock::time_point start, PlanResult failed) {
+  if (outOfTime(options, start)) return failed;
   const std::optional<Maneuver> coasting = coastingStart(problem);
-  SolverOptions from = options;
-  from.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-  if (!coasting || (options.time_budget_s > 0 && from.time_budget_s <= 1e-299)) return failed;
+  if (!coasting) return failed;
+  SolverOptions from = withRemainingBudget(options, start);
   from.warm_start = &*coasting;
   // A last resort, once the other starts have stalled: it may take longer (measured on the random
   // suite: #150 359 iterations, #117 1268, #127 2015, #41 4613, each creeping along a valley of
@@ -700,15 +709,68 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 
 namespace {
 
+/// The solve from the Hermite start (with its fallbacks) and, where the two lifts are about
+/// equally near, from both (`other_way_solved` says so).
+PlanResult solveFromOneStart(const PlanningProblem& problem, const SolverOptions& options,
+                             bool* other_way_solved) {
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult first = solveWithContinuation(problem, options);
+  const bool spinning_ends = hasSpinningEnds(problem);
+  if (first.termination == Termination::NotConverged && spinning_ends && !options.warm_start) {
+    first = solveWithRateContinuation(problem, options, start, std::move(first));
+    if (first.termination == Termination::NotConverged) {
+      first = solveFromCoastingStart(problem, options, start, std::move(first));
+    }
+  }
+  std::vector<InitialGuess> guesses;
+  try {
+    const ReducedProblem rp(problem);
+    guesses = initialGuesses(problem, rp);
+  } catch (const StepTooLarge&) {
+    return first;  // already reported by the solve
+  }
+  // When the two nearest lifts are about equally near the coasting displacement (their
+  // distances differ by less than 2·kBothWaysBelowPi) both are solved and the cheaper kept: rest
+  // to rest that is an angle near π (the two ways round, lengths θ and 2π − θ); with spinning
+  // ends, a coasting displacement about as far from either (measured on the random suite: from
+  // the nearest alone, the extremal cost up to 3.7× IPOPT's in 15 of 97 cases).
+  const bool ambiguous = std::abs(guesses[1].distance - guesses[0].distance) < 2 * kBothWaysBelowPi;
+  const bool stopped =
+      first.termination == Termination::Cancelled || first.termination == Termination::TimedOut;
+  if (problem.direction != RotationDirection::Shortest || problem.extra_revolutions != 0 ||
+      !ambiguous || options.warm_start || stopped) {
+    return first;
+  }
+  PlanningProblem other = problem;
+  other.direction = RotationDirection::LongWay;
+  if (outOfTime(options, start)) return first;
+  PlanResult second = solveWithContinuation(other, withRemainingBudget(options, start));
+  *other_way_solved = true;
+  // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice
+  // at exactly π is deterministic.
+  const bool take_second =
+      second.converged() && (!first.converged() || second.cost < first.cost * (1 - 1e-12));
+  PlanResult& kept = take_second ? second : first;
+  const PlanResult& dropped = take_second ? first : second;
+  std::ostringstream note;
+  note << (spinning_ends ? " (cheaper of the two lifts about equally near the coasting "
+                           "displacement; the other, "
+                         : " (cheaper of both ways near π; the other, ")
+       << dropped.extremal << ", "
+       << (dropped.converged() ? "costs " + std::to_string(dropped.cost)
+                               : std::string("did not converge"))
+       << ": " << dropped.message << ")";
+  kept.extremal += note.str();
+  kept.iterations += dropped.iterations;
+  return kept;
+}
+
 /// A spinning solve that needed more than this many iterations wandered far from its start, and
 /// the extremal it reached may not be the cheapest: it is solved from more starts (below).
 /// Measured on the random suite (200 cases, seed 19): above 40, cost ≤ IPOPT's in 93 of 100
 /// cases instead of 90, cheaper in 31 instead of 23, the worst ratio 1.97 instead of 2.81, the
 /// median iterations unchanged (20): only solves above the median pay.
 constexpr int kMoreStartsAboveIterations = 40;
-
-PlanResult solveFromOneStart(const PlanningProblem& problem, const SolverOptions& options,
-                             bool* other_way_solved);
 
 /// The cheapest of `kept` and more structured starts: the other way round (unless already
 /// solved), one extra revolution, and the coasting start. The others' costs go to `extremal`.
@@ -720,29 +782,29 @@ PlanResult cheapestOfMoreStarts(const PlanningProblem& problem, const SolverOpti
     PlanResult result;
   };
   std::vector<Candidate> others;
-  const auto remaining = [&] {
-    SolverOptions o = options;
-    o.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-    return o;
+  // Each start gets what is left of the budget; a cancelled or timed-out one ends the search.
+  const auto go_on = [&] {
+    return !outOfTime(options, start) &&
+           (others.empty() || (others.back().result.termination != Termination::Cancelled &&
+                               others.back().result.termination != Termination::TimedOut));
   };
-  const auto out_of_time = [&] {
-    return options.time_budget_s > 0 && remaining().time_budget_s <= 1e-299;
-  };
-  if (!other_way_solved && !out_of_time()) {
+  if (!other_way_solved && go_on()) {
     PlanningProblem other = problem;
     other.direction = RotationDirection::LongWay;
-    others.push_back({"the other way round", solveWithContinuation(other, remaining())});
+    others.push_back(
+        {"the other way round", solveWithContinuation(other, withRemainingBudget(options, start))});
   }
-  if (!out_of_time()) {
+  if (go_on()) {
     PlanningProblem other = problem;
     other.extra_revolutions = 1;
-    others.push_back({"one extra revolution", solveWithContinuation(other, remaining())});
+    others.push_back({"one extra revolution",
+                      solveWithContinuation(other, withRemainingBudget(options, start))});
   }
-  const std::optional<Maneuver> coasting = coastingStart(problem);
-  if (coasting && !out_of_time()) {
-    SolverOptions o = remaining();
-    o.warm_start = &*coasting;
-    others.push_back({"the coasting start", solveWithContinuation(problem, o)});
+  const std::optional<Maneuver> coasting = go_on() ? coastingStart(problem) : std::nullopt;
+  if (coasting) {
+    SolverOptions from = withRemainingBudget(options, start);
+    from.warm_start = &*coasting;
+    others.push_back({"the coasting start", solveWithContinuation(problem, from)});
   }
   std::ostringstream note;
   note << "; after " << kept.iterations << " iterations also solved from";
@@ -774,77 +836,12 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   const auto start = std::chrono::steady_clock::now();
   bool other_way_solved = false;
   PlanResult result = solveFromOneStart(problem, options, &other_way_solved);
-  const bool spinning_ends =
-      !problem.initial_velocity.isZero(0.0) || !problem.final_velocity.isZero(0.0);
-  if (!result.converged() || !spinning_ends || options.warm_start ||
+  if (!result.converged() || !hasSpinningEnds(problem) || options.warm_start ||
       problem.direction != RotationDirection::Shortest || problem.extra_revolutions != 0 ||
       result.iterations <= kMoreStartsAboveIterations) {
     return result;
   }
   return cheapestOfMoreStarts(problem, options, start, std::move(result), other_way_solved);
 }
-
-namespace {
-
-/// The solve from the Hermite start (with its fallbacks) and, where the two lifts are about
-/// equally near, from both (`other_way_solved` says so).
-PlanResult solveFromOneStart(const PlanningProblem& problem, const SolverOptions& options,
-                             bool* other_way_solved) {
-  const auto start = std::chrono::steady_clock::now();
-  PlanResult first = solveWithContinuation(problem, options);
-  const bool spinning_ends =
-      !problem.initial_velocity.isZero(0.0) || !problem.final_velocity.isZero(0.0);
-  if (first.termination == Termination::NotConverged && spinning_ends && !options.warm_start) {
-    first = solveWithRateContinuation(problem, options, start, std::move(first));
-    if (first.termination == Termination::NotConverged) {
-      first = solveFromCoastingStart(problem, options, start, std::move(first));
-    }
-  }
-  std::vector<InitialGuess> guesses;
-  try {
-    const ReducedProblem rp(problem);
-    guesses = initialGuesses(problem, rp);
-  } catch (const StepTooLarge&) {
-    return first;  // already reported by the solve
-  }
-  // When the two nearest lifts are about equally near the coasting displacement (their
-  // distances differ by less than 2·kBothWaysBelowPi) both are solved and the cheaper kept: rest
-  // to rest that is an angle near π (the two ways round, lengths θ and 2π − θ); with spinning
-  // ends, a coasting displacement about as far from either (measured on the random suite: from
-  // the nearest alone, the extremal cost up to 3.7× IPOPT's in 15 of 97 cases).
-  const bool ambiguous = std::abs(guesses[1].distance - guesses[0].distance) < 2 * kBothWaysBelowPi;
-  const bool stopped =
-      first.termination == Termination::Cancelled || first.termination == Termination::TimedOut;
-  if (problem.direction != RotationDirection::Shortest || problem.extra_revolutions != 0 ||
-      !ambiguous || options.warm_start || stopped) {
-    return first;
-  }
-  PlanningProblem other = problem;
-  other.direction = RotationDirection::LongWay;
-  SolverOptions remaining = options;
-  remaining.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-  if (options.time_budget_s > 0 && remaining.time_budget_s <= 1e-299) return first;
-  PlanResult second = solveWithContinuation(other, remaining);
-  *other_way_solved = true;
-  // The cheaper converged one; ties (1e-12 relative) go to the principal branch, so the choice
-  // at exactly π is deterministic.
-  const bool take_second =
-      second.converged() && (!first.converged() || second.cost < first.cost * (1 - 1e-12));
-  PlanResult& kept = take_second ? second : first;
-  const PlanResult& dropped = take_second ? first : second;
-  std::ostringstream note;
-  note << (spinning_ends ? " (cheaper of the two lifts about equally near the coasting "
-                           "displacement; the other, "
-                         : " (cheaper of both ways near π; the other, ")
-       << dropped.extremal << ", "
-       << (dropped.converged() ? "costs " + std::to_string(dropped.cost)
-                               : std::string("did not converge"))
-       << ": " << dropped.message << ")";
-  kept.extremal += note.str();
-  kept.iterations += dropped.iterations;
-  return kept;
-}
-
-}  // namespace
 
 }  // namespace attitude_planner

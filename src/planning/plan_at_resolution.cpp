@@ -106,6 +106,20 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
   return "";
 }
 
+namespace {
+
+/// The terminal errors of an open-loop replay and replay_miss, the larger of the attitude miss
+/// and T × the velocity miss (one rule for every scheme's replay).
+void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result) {
+  const int N = problem.steps;
+  result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replayed.attitude[N]);
+  result->terminal_velocity_error = (replayed.angular_velocity[N] - problem.final_velocity).norm();
+  result->replay_miss =
+      std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
+}
+
+}  // namespace
+
 void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver* replay) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
   SimulationInput input;
@@ -115,12 +129,8 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
   input.effects = problem.effects.get();
   SimulationReport report;
   const Maneuver replayed = simulate(scheme, input, &report);
-  const int N = problem.steps;
   result->dynamics_residual = report.max_step_residual;
-  result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replayed.attitude[N]);
-  result->terminal_velocity_error = (replayed.angular_velocity[N] - problem.final_velocity).norm();
-  result->replay_miss =
-      std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
+  setReplayMiss(problem, replayed, result);
   if (replay) *replay = replayed;
 }
 
@@ -256,12 +266,9 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   input.initial_velocity = problem.initial_velocity;
   input.torque = m.torque;
   input.effects = problem.effects.get();
-  const Maneuver replay =
-      replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input);
-  result.terminal_attitude_error = so3::angleBetween(problem.final_attitude, replay.attitude[N]);
-  result.terminal_velocity_error = (replay.angular_velocity[N] - problem.final_velocity).norm();
-  result.replay_miss =
-      std::max(result.terminal_attitude_error, problem.duration * result.terminal_velocity_error);
+  setReplayMiss(problem,
+                replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input),
+                &result);
   return result;
 }
 

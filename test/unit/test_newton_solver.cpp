@@ -301,7 +301,8 @@ TEST(NewtonSolver, StalledFastRatesConvergeByContinuationInTheRates) {
   // Issue 19: seed-like inertia, 3.9 and 4 rad/s at the ends over 64.7 s, variational (random
   // suite case #1). From the Hermite guess Newton stops at the iteration limit; from rest to
   // rest, with the boundary rates raised in stages, it converges. (Case #22, this test's case
-  // before the Levenberg–Marquardt control of the shift, now converges directly.)
+  // before the Levenberg–Marquardt control of the shift, now converges directly.) A cheaper
+  // extremal from one of the more starts may be kept; `extremal` then names this path.
   const PlanningProblem p = robustness::randomCase(19, 1).problem;
   const PlanResult r = planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;

@@ -2,33 +2,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace attitude_planner {
 
-BandedSymmetricMatrix::BandedSymmetricMatrix(int n, int bandwidth)
-    : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (bandwidth + 1), 0.0) {}
+template <typename Scalar>
+BandedSymmetric<Scalar>::BandedSymmetric(int n, int bandwidth)
+    : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (bandwidth + 1), Scalar(0)) {}
 
-void BandedSymmetricMatrix::addToDiagonal(double v) {
+template <typename Scalar>
+void BandedSymmetric<Scalar>::addToDiagonal(double v) {
   for (int i = 0; i < n_; ++i) at(i, i) += v;
 }
 
-void BandedSymmetricMatrix::addRelativeToDiagonal(double factor, double floor) {
+template <typename Scalar>
+void BandedSymmetric<Scalar>::addRelativeToDiagonal(double factor, double floor) {
   for (int i = 0; i < n_; ++i) at(i, i) += factor * (std::abs(at(i, i)) + floor);
 }
 
-double BandedSymmetricMatrix::maxAbsDiagonal() const {
+template <typename Scalar>
+double BandedSymmetric<Scalar>::maxAbsDiagonal() const {
   double m = 0.0;
-  for (int i = 0; i < n_; ++i)
-    m = std::max(m, std::abs(data_[static_cast<size_t>(i) * (p_ + 1) + p_]));
+  for (int i = 0; i < n_; ++i) {
+    m = std::max(m, static_cast<double>(std::abs(data_[static_cast<size_t>(i) * (p_ + 1) + p_])));
+  }
   return m;
 }
 
-double BandedSymmetricMatrix::operator()(int i, int j) const {
+template <typename Scalar>
+double BandedSymmetric<Scalar>::operator()(int i, int j) const {
   if (i < j) std::swap(i, j);
-  return i - j <= p_ ? data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)] : 0.0;
+  return i - j <= p_ ? static_cast<double>(data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)])
+                     : 0.0;
 }
 
-Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
+template <typename Scalar>
+Eigen::MatrixXd BandedSymmetric<Scalar>::toDense() const {
   Eigen::MatrixXd A(n_, n_);
   for (int i = 0; i < n_; ++i) {
     for (int j = 0; j < n_; ++j) A(i, j) = (*this)(i, j);
@@ -36,14 +45,16 @@ Eigen::MatrixXd BandedSymmetricMatrix::toDense() const {
   return A;
 }
 
-bool BandedSymmetricMatrix::solvePositiveDefinite(Eigen::VectorXd* b) const {
-  BandedCholesky cholesky;
+template <typename Scalar>
+bool BandedSymmetric<Scalar>::solvePositiveDefinite(Eigen::VectorXd* b) const {
+  BandedCholeskyFactor<Scalar> cholesky;
   if (!cholesky.factor(*this)) return false;
   cholesky.solve(b);
   return true;
 }
 
-bool BandedCholesky::factor(const BandedSymmetricMatrix& A) {
+template <typename Scalar>
+bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
   // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
   // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
   n_ = A.n_;
@@ -54,16 +65,16 @@ bool BandedCholesky::factor(const BandedSymmetricMatrix& A) {
     return L_.data() + static_cast<size_t>(i) * w + p_ - i;
   };  // row(i)[j] = L(i, j)
   for (int i = 0; i < n_; ++i) {
-    double* li = row(i);
+    Scalar* li = row(i);
     const int first = std::max(0, i - p_);
     for (int j = first; j <= i; ++j) {
-      const double* lj = row(j);
-      double s = li[j];
+      const Scalar* lj = row(j);
+      Scalar s = li[j];
       for (int k = std::max(first, j - p_); k < j; ++k) s -= li[k] * lj[k];
       if (j < i) {
         li[j] = s / lj[j];
       } else {
-        if (!(s > 0.0) || !std::isfinite(s)) return false;
+        if (!(s > 0) || !std::isfinite(s)) return false;
         li[i] = std::sqrt(s);
       }
     }
@@ -71,22 +82,38 @@ bool BandedCholesky::factor(const BandedSymmetricMatrix& A) {
   return true;
 }
 
-void BandedCholesky::solve(Eigen::VectorXd* b) const {
-  const int w = p_ + 1;
-  const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
-  Eigen::VectorXd& y = *b;
-  for (int i = 0; i < n_; ++i) {  // L y = b
-    const double* li = row(i);
-    double s = y(i);
-    for (int k = std::max(0, i - p_); k < i; ++k) s -= li[k] * y(k);
-    y(i) = s / li[i];
-  }
-  for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
-    double s = y(i);
-    for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y(k);
-    y(i) = s / row(i)[i];
+template <typename Scalar>
+void BandedCholeskyFactor<Scalar>::solve(Eigen::VectorXd* b) const {
+  if constexpr (std::is_same_v<Scalar, double>) {
+    substitute(b->data());
+  } else {
+    std::vector<Scalar> y(b->data(), b->data() + n_);
+    substitute(y.data());
+    for (int i = 0; i < n_; ++i) (*b)(i) = static_cast<double>(y[i]);
   }
 }
+
+template <typename Scalar>
+void BandedCholeskyFactor<Scalar>::substitute(Scalar* y) const {
+  const int w = p_ + 1;
+  const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
+  for (int i = 0; i < n_; ++i) {  // L y = b
+    const Scalar* li = row(i);
+    Scalar s = y[i];
+    for (int k = std::max(0, i - p_); k < i; ++k) s -= li[k] * y[k];
+    y[i] = s / li[i];
+  }
+  for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
+    Scalar s = y[i];
+    for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y[k];
+    y[i] = s / row(i)[i];
+  }
+}
+
+template class BandedSymmetric<double>;
+template class BandedSymmetric<long double>;
+template class BandedCholeskyFactor<double>;
+template class BandedCholeskyFactor<long double>;
 
 }  // namespace attitude_planner
 

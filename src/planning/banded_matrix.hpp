@@ -9,13 +9,16 @@
 namespace attitude_planner {
 
 /// Symmetric matrix stored by its lower band, row by row: row i holds A(i, i − p..i) contiguously
-/// (the Cholesky inner products then run over consecutive memory).
-class BandedSymmetricMatrix {
+/// (the Cholesky inner products then run over consecutive memory). Scalar: double, or long double
+/// (ExtendedBandedMatrix) where a system's entries span more orders than double can add and factor
+/// without losing the small ones (the interior point's barrier terms; see interior_point_solver).
+template <typename Scalar>
+class BandedSymmetric {
  public:
-  BandedSymmetricMatrix(int n, int bandwidth);
+  BandedSymmetric(int n, int bandwidth);
   int size() const { return n_; }
   int bandwidth() const { return p_; }
-  void setZero() { std::fill(data_.begin(), data_.end(), 0.0); }
+  void setZero() { std::fill(data_.begin(), data_.end(), Scalar(0)); }
   /// Adds v to A(i, j) (and so to A(j, i)); |i − j| ≤ bandwidth.
   void add(int i, int j, double v) {
     if (i < j) std::swap(i, j);
@@ -27,8 +30,19 @@ class BandedSymmetricMatrix {
   template <int K>
   void addSymmetricBlock(int offset, const Eigen::Matrix<double, K, K>& M, int first, int last) {
     for (int r = first; r < last; ++r) {
-      double* row = &at(offset + r, offset);
+      Scalar* row = &at(offset + r, offset);
       for (int c = first; c <= r; ++c) row[c] += M(r, c);
+    }
+  }
+  /// Adds weight·g gᵀ at rows/columns offset..offset+K−1, restricted as addSymmetricBlock, each
+  /// product formed in Scalar (a rank-one term far larger than the rest keeps the rest).
+  template <int K>
+  void addRankOne(int offset, const Eigen::Matrix<double, K, 1>& g, double weight, int first,
+                  int last) {
+    for (int r = first; r < last; ++r) {
+      Scalar* row = &at(offset + r, offset);
+      const Scalar gr = Scalar(weight) * Scalar(g(r));
+      for (int c = first; c <= r; ++c) row[c] += gr * Scalar(g(c));
     }
   }
   void addToDiagonal(double v);
@@ -46,27 +60,38 @@ class BandedSymmetricMatrix {
   bool solvePositiveDefinite(Eigen::VectorXd* b) const;
 
  private:
-  friend class BandedCholesky;
+  template <typename>
+  friend class BandedCholeskyFactor;
   /// A(i, j) for i − p ≤ j ≤ i.
-  double& at(int i, int j) { return data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)]; }
+  Scalar& at(int i, int j) { return data_[static_cast<size_t>(i) * (p_ + 1) + (j - i + p_)]; }
   int n_, p_;
-  std::vector<double> data_;
+  std::vector<Scalar> data_;
 };
 
-/// The banded Cholesky factor L Lᵀ = A of a BandedSymmetricMatrix, kept so that several right-hand
+/// The banded Cholesky factor L Lᵀ = A of a BandedSymmetric, kept so that several right-hand
 /// sides can be solved with one factorization (e.g. a predictor–corrector's second solve).
-class BandedCholesky {
+/// Factors and solves in Scalar.
+template <typename Scalar>
+class BandedCholeskyFactor {
  public:
   /// Factors A (the factor replaces any previous one). Returns false if A is not numerically
   /// positive definite (then solve must not be called).
-  bool factor(const BandedSymmetricMatrix& A);
+  bool factor(const BandedSymmetric<Scalar>& A);
   /// Solves A x = b in place with the last successful factor.
   void solve(Eigen::VectorXd* b) const;
 
  private:
+  /// Forward and back substitution on y (in place).
+  void substitute(Scalar* y) const;
   int n_ = 0, p_ = 0;
-  std::vector<double> L_;  ///< row i holds L(i, i − p..i), as BandedSymmetricMatrix's layout
+  std::vector<Scalar> L_;  ///< row i holds L(i, i − p..i), as BandedSymmetric's layout
 };
+
+using BandedSymmetricMatrix = BandedSymmetric<double>;
+using BandedCholesky = BandedCholeskyFactor<double>;
+/// x86-64: 64-bit significand, ε ≈ 5e-20 (elsewhere long double may be double or quad).
+using ExtendedBandedMatrix = BandedSymmetric<long double>;
+using ExtendedBandedCholesky = BandedCholeskyFactor<long double>;
 
 }  // namespace attitude_planner
 

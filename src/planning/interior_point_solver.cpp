@@ -21,7 +21,8 @@
 //   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i),   q_i = μ/z_i − s_i − μ/u_i + v_i,
 //   W = ∇²f − Σ_i z_i ∇²c_i,  g_i = ∇c_i,  dz_i = (q_i − g_iᵀdδ)/D_i.
 // Each g_i g_iᵀ lies inside one stencil's 9×9 block, so the system keeps the unconstrained
-// Hessian's band (half bandwidth 8) and is factored by the same banded Cholesky. The slacks are
+// Hessian's band (half bandwidth 8) and is factored by the same banded Cholesky; above N = 1024
+// in long double, each g_i g_iᵀ formed in it (kExtendedPrecisionAboveSteps). The slacks are
 // eliminated exactly for the current c (node_constraints.hpp: elasticSlacks), so the merit
 // φ_μ(δ) = f + Σ ψ_μ(c_i) depends on δ alone; the line search is Armijo on φ_μ along the
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
@@ -167,15 +168,34 @@ bool isTorqueFamily(Family f) {
   return f == Family::TorqueUpper || f == Family::TorqueLower || f == Family::TorqueNorm;
 }
 
-/// Adds M (local 9×9, lower triangle used, rows/cols of nodes first_node..first_node+width−1)
-/// to the banded Hessian, skipping fixed nodes.
-void addLocal(const ReducedProblem& np, BandedSymmetricMatrix* H, int first_node, int width,
-              const Eigen::Matrix<double, 9, 9>& M) {
+/// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the unknowns:
+/// its offset and its free entries first..last−1 (fixed nodes skipped).
+struct LocalSlots {
+  int offset = 0, first = 0, last = 0;
+  bool empty() const { return first >= last; }
+};
+
+LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
   const int first_free = std::max(0, np.firstFreeNode() - first_node);
   const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
-  if (first_free > last_free) return;
-  H->addSymmetricBlock<9>(3 * (first_node - np.firstFreeNode()), M, 3 * first_free,
-                          3 * (last_free + 1));
+  return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
+}
+
+/// Adds M (local 9×9, lower triangle used) to the banded Hessian.
+template <typename Scalar>
+void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node, int width,
+              const Eigen::Matrix<double, 9, 9>& M) {
+  const LocalSlots l = localSlots(np, first_node, width);
+  if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
+}
+
+/// Adds weight·g gᵀ (local) to the banded Hessian, each product formed in its own precision (see
+/// kExtendedPrecisionAboveSteps). Rounding the weight only scales the term.
+template <typename Scalar>
+void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node,
+                     int width, const Eigen::Matrix<double, 9, 1>& g, double weight) {
+  const LocalSlots l = localSlots(np, first_node, width);
+  if (!l.empty()) H->template addRankOne<9>(l.offset, g, weight, l.first, l.last);
 }
 
 /// gᵀ dδ over the local nodes (fixed nodes contribute nothing).
@@ -334,7 +354,8 @@ class InteriorPoint {
   /// `primal`: the multipliers are replaced by their primal values μ/s (then the step is Newton's
   /// on φ_μ, a descent direction whenever H is positive definite). H = null: the constraint
   /// values and gradients only (no second derivatives; multipliers and slacks untouched).
-  double assemble(double mu, double rho, bool primal, BandedSymmetricMatrix* H,
+  template <typename Scalar>
+  double assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
                   Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, double* gradient_scale) {
     const int n = np_.unknowns();
     if (H) H->setZero();
@@ -422,13 +443,21 @@ class InteriorPoint {
             }
           }
           if (H) {
-            Eigen::Matrix<double, 9, 9> block =
-                current_beta_ * st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
+            // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and the box constraints' g gᵀ/D
+            // (g = ∓J_a/(a r)) per torque axis; the norm constraints' g gᵀ/D apart.
+            Vector3 weight = Vector3::Constant(current_beta_);
             for (Group* g : torque_groups) {
               const Instance& in = g->instance(st.k);
-              block += (in.g / in.D) * in.g.transpose();
+              if (g->family == Family::TorqueNorm) {
+                addLocalRankOne(np_, H, st.k - 1, 3, in.g, 1.0 / in.D);
+              } else {
+                weight(g->axis) += 1.0 / (in.D * (g->limit * r) * (g->limit * r));
+              }
             }
-            addLocal(np_, H, st.k - 1, 3, block);
+            for (int a = 0; a < 3; ++a) {
+              addLocalRankOne(np_, H, st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
+            }
+            addLocal(np_, H, st.k - 1, 3, st.second);
           }
           addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
           addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
@@ -466,9 +495,12 @@ class InteriorPoint {
             for (Group* g : node_rate_groups) {
               Instance& in = g->instance(node.k);
               in.g = -2.0 / (g->limit * g->limit) * grad;
-              block += (in.g / in.D) * in.g.transpose();
             }
             if (H) addLocal(np_, H, node.k - 1, 3, block);
+            for (Group* g : node_rate_groups) {
+              const Instance& in = g->instance(node.k);
+              if (H) addLocalRankOne(np_, H, node.k - 1, 3, in.g, 1.0 / in.D);
+            }
           },
           rate_weights);
     }
@@ -496,8 +528,8 @@ class InteriorPoint {
           in.g.head<3>() = sign * t.gradient;
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
         }
-        block += (in.g / in.D) * in.g.transpose();
         if (H) addLocal(np_, H, k + g->node_offset, g->width, block);
+        if (H) addLocalRankOne(np_, H, k + g->node_offset, g->width, in.g, 1.0 / in.D);
       }
     }
     // ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is
@@ -701,7 +733,7 @@ class InteriorPoint {
   double relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) {
     double scale = 0.0, unused = 0.0;
-    assemble(mu, rho, false, nullptr, rhs, merit_gradient, &scale);
+    assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient, &scale);
     Eigen::VectorXd residual;
     np_.evaluate(&residual, nullptr, &unused);  // ∇f
     for (const Group& g : groups_) {
@@ -805,11 +837,12 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
 
 /// The interior point on one grid: from `coarse_steps` (a coarser grid's solution, with a small
 /// initial barrier) if given, else from options.warm_start; leaves its iterate in `final_steps`.
-PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
-                       Formulation formulation, bool predictor_corrector,
-                       const ReducedProblem::Steps* coarse_steps,
-                       ReducedProblem::Steps* final_steps, const LevelDuals* coarse_duals = nullptr,
-                       LevelDuals* final_duals = nullptr) {
+template <typename Scalar>
+PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& options,
+                         Formulation formulation, bool predictor_corrector,
+                         const ReducedProblem::Steps* coarse_steps,
+                         ReducedProblem::Steps* final_steps, const LevelDuals* coarse_duals,
+                         LevelDuals* final_duals) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -856,8 +889,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
   InteriorPoint ip(problem, &np, formulation);
   const bool free_slacks = ip.freeSlacks();
   const int n = np.unknowns();
-  BandedSymmetricMatrix hessian(n, 8);
-  BandedCholesky cholesky;
+  BandedSymmetric<Scalar> hessian(n, 8);
+  BandedCholeskyFactor<Scalar> cholesky;
   std::vector<double> products;  // ds_aff·dz_aff of the predictor
   Eigen::VectorXd rhs(n), merit_gradient(n), delta(n);
   double gradient_scale = 0.0;
@@ -921,7 +954,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
       shift = shift_floor;
       for (int tries = 0; tries < 40; ++tries) {
         delta = rhs;
-        BandedSymmetricMatrix trial = hessian;
+        BandedSymmetric<Scalar> trial = hessian;
         // Inertia correction relative to each row's scale: at the final barrier the active
         // constraints' rows are ~1/μ larger than the others, and a uniform shift sized by them
         // (the largest diagonal) damped the free directions into linear convergence (measured:
@@ -1217,6 +1250,29 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
 namespace {
 
 /// Appends the levels `solved` reports to `levels` (every solve of a plan is listed, in order).
+/// Above this N the Newton system is assembled, factored and solved in long double. At a bound a
+/// constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12
+/// and the smooth modes' curvature falls like N⁻⁴ against the largest; the step along the active
+/// constraints' null space depends on that curvature alone, and double keeps only a few of its
+/// digits at large N. Measured against IPOPT (docs/constraints.md): in double the optima agreed
+/// to ≤ 7e-12 up to N = 1024, 1e-9 at 2048, 7e-8 at 4096 and 4e-6 at 8192 (torque and rate
+/// limits; 553 fewer active constraints than IPOPT's); in long double to ~1e-10 at 8192 with
+/// IPOPT's active set, at ~1.4× the time per iteration (x87 arithmetic), which below this N buys
+/// nothing measurable.
+constexpr int kExtendedPrecisionAboveSteps = 1024;
+
+PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                       Formulation formulation, bool predictor_corrector,
+                       const ReducedProblem::Steps* coarse_steps,
+                       ReducedProblem::Steps* final_steps, const LevelDuals* coarse_duals = nullptr,
+                       LevelDuals* final_duals = nullptr) {
+  return problem.steps > kExtendedPrecisionAboveSteps
+             ? solveOnGridIn<long double>(problem, options, formulation, predictor_corrector,
+                                          coarse_steps, final_steps, coarse_duals, final_duals)
+             : solveOnGridIn<double>(problem, options, formulation, predictor_corrector,
+                                     coarse_steps, final_steps, coarse_duals, final_duals);
+}
+
 void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
   levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
 }

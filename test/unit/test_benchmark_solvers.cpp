@@ -83,6 +83,24 @@ double jsonNumber(const std::string& line, const std::string& key) {
   return at == std::string::npos ? std::nan("") : std::stod(line.substr(at + key.size() + 4));
 }
 
+#ifdef AP_BENCHMARK_HAS_IPOPT
+/// Ours on `scene` at `steps`, then IPOPT started from our plan (`--start ours`): IPOPT must
+/// converge and stay there (the same cost to `tolerance` relative, the same active constraints).
+/// Returns our JSON line.
+std::string expectIpoptStaysAtOurOptimum(const std::string& scene, int steps, double tolerance) {
+  const std::string common = " --scene '" + scene + "' --steps " + std::to_string(steps);
+  std::string ours, peer;
+  EXPECT_EQ(runTool("--solver newton" + common, &ours), 0) << ours;
+  EXPECT_EQ(runTool("--solver ipopt" + common + " --start ours", &peer), 0) << peer;
+  EXPECT_NE(peer.find("\"converged\": true"), std::string::npos) << peer;
+  const double cost = jsonNumber(ours, "cost");
+  EXPECT_NEAR(jsonNumber(peer, "cost"), cost, tolerance * cost) << ours << peer;
+  EXPECT_EQ(jsonNumber(peer, "active_constraints"), jsonNumber(ours, "active_constraints"))
+      << ours << peer;
+  return ours;
+}
+#endif
+
 // `--start ours` gives the IPOPT peer our constrained optimum: on a scene where both reach the
 // same optimum (torque_limited, N = 64), IPOPT stays there (the same cost to 1e-8 and the same
 // active constraints) — the check the constraints benchmark's last column makes at large N.
@@ -90,16 +108,8 @@ TEST(BenchmarkSolvers, IpoptStartedFromOurConstrainedOptimumStaysThere) {
 #ifndef AP_BENCHMARK_HAS_IPOPT
   GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";
 #else
-  const std::string scene = std::string(AP_SOURCE_DIR) + "/scenes/torque_limited.yaml";
-  std::string ours, peer;
-  ASSERT_EQ(runTool("--solver newton --scene '" + scene + "' --steps 64", &ours), 0) << ours;
-  ASSERT_EQ(runTool("--solver ipopt --scene '" + scene + "' --steps 64 --start ours", &peer), 0)
-      << peer;
-  EXPECT_NE(peer.find("\"converged\": true"), std::string::npos) << peer;
-  const double cost = jsonNumber(ours, "cost");
-  EXPECT_NEAR(jsonNumber(peer, "cost"), cost, 1e-8 * cost) << ours << peer;
-  EXPECT_EQ(jsonNumber(peer, "active_constraints"), jsonNumber(ours, "active_constraints"))
-      << ours << peer;
+  const std::string ours = expectIpoptStaysAtOurOptimum(
+      std::string(AP_SOURCE_DIR) + "/scenes/torque_limited.yaml", 64, 1e-8);
   EXPECT_GT(jsonNumber(ours, "active_constraints"), 0) << ours;
   std::string bad;
   EXPECT_EQ(runTool("--solver ipopt --start nowhere", &bad), 2) << bad;
@@ -121,15 +131,7 @@ TEST(BenchmarkSolvers, IpoptAgreesWithOurTorqueAndRateLimitedOptimumAtN4096) {
     std::ofstream out(scene);
     out << in.rdbuf() << "constraints:\n  - max_angular_rate: 0.11\n";
   }
-  std::string ours, peer;
-  ASSERT_EQ(runTool("--solver newton --scene '" + scene + "' --steps 4096", &ours), 0) << ours;
-  ASSERT_EQ(runTool("--solver ipopt --scene '" + scene + "' --steps 4096 --start ours", &peer), 0)
-      << peer;
-  EXPECT_NE(peer.find("\"converged\": true"), std::string::npos) << peer;
-  const double cost = jsonNumber(ours, "cost");
-  EXPECT_NEAR(jsonNumber(peer, "cost"), cost, 1e-9 * cost) << ours << peer;
-  EXPECT_EQ(jsonNumber(peer, "active_constraints"), jsonNumber(ours, "active_constraints"))
-      << ours << peer;
+  expectIpoptStaysAtOurOptimum(scene, 4096, 1e-9);
 #endif
 }
 

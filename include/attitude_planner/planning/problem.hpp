@@ -151,8 +151,9 @@ struct IterationInfo {
 struct SolverOptions {
   SolverKind solver = SolverKind::Newton;
   double tolerance = 1e-10;  ///< relative torque accuracy (Newton decrement / |τ|₂)
-  /// Newton: per grid level (coarse levels start the fine one); a spinning solve that stalls from
-  /// every other start is retried from the coasting start with 25× this (newton_solver.cpp).
+  /// Newton: per grid level (coarse levels start the fine one) and start; the coasting start of a
+  /// spinning solve (after the others stalled, or as one of the more starts of a slow one) may
+  /// take 25× this (newton_solver.cpp).
   int max_iterations = 200;
   double time_budget_s = 0.0;  ///< wall-time limit; 0 = none
   /// Called after every iteration, numbered across grid levels (the first ones may run on

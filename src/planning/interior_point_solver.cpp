@@ -488,18 +488,19 @@ class InteriorPoint {
       np_.forEachNodeMomentum(
           [&](const ReducedProblem::NodeMomentum& node) {
             const Vector3 a = inverse_inertia_squared_ * node.momentum;
-            Eigen::Matrix<double, 9, 9> block =
-                gamma * node.jacobian.transpose() * inverse_inertia_squared_ * node.jacobian +
-                node.second;
             const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;
             for (Group* g : node_rate_groups) {
               Instance& in = g->instance(node.k);
               in.g = -2.0 / (g->limit * g->limit) * grad;
             }
-            if (H) addLocal(np_, H, node.k - 1, 3, block);
+            if (!H) return;
+            const Eigen::Matrix<double, 9, 9> block =
+                gamma * node.jacobian.transpose() * inverse_inertia_squared_ * node.jacobian +
+                node.second;
+            addLocal(np_, H, node.k - 1, 3, block);
             for (Group* g : node_rate_groups) {
               const Instance& in = g->instance(node.k);
-              if (H) addLocalRankOne(np_, H, node.k - 1, 3, in.g, 1.0 / in.D);
+              addLocalRankOne(np_, H, node.k - 1, 3, in.g, 1.0 / in.D);
             }
           },
           rate_weights);
@@ -528,8 +529,10 @@ class InteriorPoint {
           in.g.head<3>() = sign * t.gradient;
           block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
         }
-        if (H) addLocal(np_, H, k + g->node_offset, g->width, block);
-        if (H) addLocalRankOne(np_, H, k + g->node_offset, g->width, in.g, 1.0 / in.D);
+        if (H) {
+          addLocal(np_, H, k + g->node_offset, g->width, block);
+          addLocalRankOne(np_, H, k + g->node_offset, g->width, in.g, 1.0 / in.D);
+        }
       }
     }
     // ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is
@@ -1249,7 +1252,6 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
 
 namespace {
 
-/// Appends the levels `solved` reports to `levels` (every solve of a plan is listed, in order).
 /// Above this N the Newton system is assembled, factored and solved in long double. At a bound a
 /// constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12
 /// and the smooth modes' curvature falls like N⁻⁴ against the largest; the step along the active
@@ -1273,6 +1275,7 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
                                      coarse_steps, final_steps, coarse_duals, final_duals);
 }
 
+/// Appends the levels `solved` reports to `levels` (every solve of a plan is listed, in order).
 void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
   levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
 }

@@ -536,9 +536,7 @@ PlanResult solveWithContinuation(const PlanningProblem& problem, const SolverOpt
             terminationName(coarse_result.termination) + ", started from the geodesic";
   }
   fine_options.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-  if (options.time_budget_s > 0 && fine_options.time_budget_s <= 1e-299) {
-    return stopped(Termination::TimedOut);
-  }
+  if (budgetSpent(fine_options)) return stopped(Termination::TimedOut);
   // Iterations are numbered across levels, so progress reports keep increasing.
   const int before = coarse_result.iterations;
   if (options.on_iteration) {
@@ -594,7 +592,7 @@ PlanResult solveWithRateContinuation(const PlanningProblem& problem, const Solve
   }
   const auto budget = [&] {
     stage_options.time_budget_s = withRemainingBudget(options, start).time_budget_s;
-    return options.time_budget_s <= 0 || stage_options.time_budget_s > 1e-299;
+    return !budgetSpent(stage_options);
   };
   const auto stopped = [&](PlanResult r) {  // cancelled or out of time inside a stage
     r.iterations += iterations;
@@ -657,7 +655,7 @@ bool hasSpinningEnds(const PlanningProblem& problem) {
 
 /// A time budget was given and nothing of it is left since `start`.
 bool outOfTime(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
-  return options.time_budget_s > 0 && withRemainingBudget(options, start).time_budget_s <= 1e-299;
+  return budgetSpent(withRemainingBudget(options, start));
 }
 
 /// The coasting start: the torque-free motions from both ends, forward from (R_0, Ω_0) and

@@ -167,18 +167,26 @@ struct SolverOptions {
   bool constrained_from_warm_start = false;
 };
 
+/// The time budget withRemainingBudget leaves once the budget is spent.
+constexpr double kSpentBudget = 1e-300;
+
 /// `options` with what is left of its time budget after `start` (several solves sharing one
 /// budget: grid levels, accuracy resolutions, the minimum-time search). A budget of 0 (none) stays
-/// 0; a spent one becomes 1e-300 s, so the next solve ends TimedOut at once.
+/// 0; a spent one becomes kSpentBudget, so the next solve ends TimedOut at once.
 inline SolverOptions withRemainingBudget(const SolverOptions& options,
                                          std::chrono::steady_clock::time_point start) {
   SolverOptions remaining = options;
   if (options.time_budget_s > 0) {
     const double used =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    remaining.time_budget_s = std::max(options.time_budget_s - used, 1e-300);
+    remaining.time_budget_s = std::max(options.time_budget_s - used, kSpentBudget);
   }
   return remaining;
+}
+
+/// `remaining` (from withRemainingBudget) has a budget, and nothing of it is left.
+inline bool budgetSpent(const SolverOptions& remaining) {
+  return remaining.time_budget_s > 0 && remaining.time_budget_s <= kSpentBudget;
 }
 
 /// Checks the problem (finite numbers, SPD and physical inertia, T > 0, kMinSteps ≤ N ≤

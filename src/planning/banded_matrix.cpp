@@ -6,6 +6,37 @@
 
 namespace attitude_planner {
 
+namespace {
+// std:: for the built-in types, DoubleDouble's own by argument-dependent lookup.
+template <typename Scalar>
+Scalar scalarAbs(Scalar x) {
+  using std::abs;
+  return abs(x);
+}
+template <typename Scalar>
+bool scalarIsFinite(Scalar x) {
+  using std::isfinite;
+  return isfinite(x);
+}
+template <typename Scalar>
+Scalar scalarSqrt(Scalar x) {
+  using std::sqrt;
+  return sqrt(x);
+}
+/// s − Σ_{k = first}^{last − 1} a[k] b[k] (double-double: DoubleDoubleDifference).
+template <typename Scalar>
+Scalar minusDot(Scalar s, const Scalar* a, const Scalar* b, int first, int last) {
+  if constexpr (std::is_same_v<Scalar, DoubleDouble>) {
+    DoubleDoubleDifference d(s);
+    for (int k = first; k < last; ++k) d.subtractProduct(a[k], b[k]);
+    return d.value();
+  } else {
+    for (int k = first; k < last; ++k) s -= a[k] * b[k];
+    return s;
+  }
+}
+}  // namespace
+
 template <typename Scalar>
 BandedSymmetric<Scalar>::BandedSymmetric(int n, int bandwidth)
     : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (bandwidth + 1), Scalar(0)) {}
@@ -17,14 +48,14 @@ void BandedSymmetric<Scalar>::addToDiagonal(double v) {
 
 template <typename Scalar>
 void BandedSymmetric<Scalar>::addRelativeToDiagonal(double factor, double floor) {
-  for (int i = 0; i < n_; ++i) at(i, i) += factor * (std::abs(at(i, i)) + floor);
+  for (int i = 0; i < n_; ++i) at(i, i) += factor * (scalarAbs(at(i, i)) + floor);
 }
 
 template <typename Scalar>
 double BandedSymmetric<Scalar>::maxAbsDiagonal() const {
   double m = 0.0;
   for (int i = 0; i < n_; ++i) {
-    m = std::max(m, static_cast<double>(std::abs(data_[static_cast<size_t>(i) * (p_ + 1) + p_])));
+    m = std::max(m, static_cast<double>(scalarAbs(data_[static_cast<size_t>(i) * (p_ + 1) + p_])));
   }
   return m;
 }
@@ -64,18 +95,19 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
   const auto row = [&](int i) {
     return L_.data() + static_cast<size_t>(i) * w + p_ - i;
   };  // row(i)[j] = L(i, j)
+  if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_.resize(n_);
   for (int i = 0; i < n_; ++i) {
     Scalar* li = row(i);
     const int first = std::max(0, i - p_);
     for (int j = first; j <= i; ++j) {
       const Scalar* lj = row(j);
-      Scalar s = li[j];
-      for (int k = std::max(first, j - p_); k < j; ++k) s -= li[k] * lj[k];
+      const Scalar s = minusDot(li[j], li, lj, std::max(first, j - p_), j);
       if (j < i) {
-        li[j] = s / lj[j];
+        li[j] = divideByDiagonal(s, j);
       } else {
-        if (!(s > 0) || !std::isfinite(s)) return false;
-        li[i] = std::sqrt(s);
+        if (!(s > 0) || !scalarIsFinite(s)) return false;
+        li[i] = scalarSqrt(s);
+        if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_[i] = Scalar(1.0) / li[i];
       }
     }
   }
@@ -99,21 +131,28 @@ void BandedCholeskyFactor<Scalar>::substitute(Scalar* y) const {
   const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
   for (int i = 0; i < n_; ++i) {  // L y = b
     const Scalar* li = row(i);
-    Scalar s = y[i];
-    for (int k = std::max(0, i - p_); k < i; ++k) s -= li[k] * y[k];
-    y[i] = s / li[i];
+    y[i] = divideByDiagonal(minusDot(y[i], li, y, std::max(0, i - p_), i), i);
   }
   for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
-    Scalar s = y[i];
-    for (int k = i + 1; k <= std::min(n_ - 1, i + p_); ++k) s -= row(k)[i] * y[k];
-    y[i] = s / row(i)[i];
+    const int last = std::min(n_ - 1, i + p_);
+    if constexpr (std::is_same_v<Scalar, DoubleDouble>) {
+      DoubleDoubleDifference s(y[i]);
+      for (int k = i + 1; k <= last; ++k) s.subtractProduct(row(k)[i], y[k]);
+      y[i] = divideByDiagonal(s.value(), i);
+    } else {
+      Scalar s = y[i];
+      for (int k = i + 1; k <= last; ++k) s -= row(k)[i] * y[k];
+      y[i] = divideByDiagonal(s, i);
+    }
   }
 }
 
 template class BandedSymmetric<double>;
-template class BandedSymmetric<long double>;
 template class BandedCholeskyFactor<double>;
+template class BandedSymmetric<long double>;
+template class BandedSymmetric<DoubleDouble>;
 template class BandedCholeskyFactor<long double>;
+template class BandedCholeskyFactor<DoubleDouble>;
 
 }  // namespace attitude_planner
 

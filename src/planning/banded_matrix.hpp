@@ -4,14 +4,18 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <type_traits>
 #include <vector>
+
+#include "planning/double_double.hpp"
 
 namespace attitude_planner {
 
 /// Symmetric matrix stored by its lower band, row by row: row i holds A(i, i − p..i) contiguously
 /// (the Cholesky inner products then run over consecutive memory). Scalar: double, or long double
-/// (ExtendedBandedMatrix) where a system's entries span more orders than double can add and factor
-/// without losing the small ones (the interior point's barrier terms; see interior_point_solver).
+/// or DoubleDouble (ExtendedBandedMatrix, ~106 significant bits) where a system's entries span more
+/// orders than double can add and factor without losing the small ones (the interior point's
+/// barrier terms and its N⁴ condition; see interior_point_solver: kExtendedPrecisionAboveSteps).
 template <typename Scalar>
 class BandedSymmetric {
  public:
@@ -83,15 +87,27 @@ class BandedCholeskyFactor {
  private:
   /// Forward and back substitution on y (in place).
   void substitute(Scalar* y) const;
+  /// Double-double division costs several multiplications: its factor keeps 1/L(i, i) and
+  /// multiplies (the other scalars divide, as the hardware does it about as fast).
+  static constexpr bool kMultipliesByReciprocal = std::is_same_v<Scalar, DoubleDouble>;
+  /// s / L(i, i).
+  Scalar divideByDiagonal(const Scalar& s, int i) const {
+    if constexpr (kMultipliesByReciprocal) {
+      return s * reciprocal_diagonal_[i];
+    } else {
+      return s / L_[static_cast<size_t>(i) * (p_ + 1) + p_];
+    }
+  }
   int n_ = 0, p_ = 0;
   std::vector<Scalar> L_;  ///< row i holds L(i, i − p..i), as BandedSymmetric's layout
+  std::vector<Scalar> reciprocal_diagonal_;  ///< 1/L(i, i) (kMultipliesByReciprocal only)
 };
 
 using BandedSymmetricMatrix = BandedSymmetric<double>;
 using BandedCholesky = BandedCholeskyFactor<double>;
-/// x86-64: 64-bit significand, ε ≈ 5e-20 (elsewhere long double may be double or quad).
-using ExtendedBandedMatrix = BandedSymmetric<long double>;
-using ExtendedBandedCholesky = BandedCholeskyFactor<long double>;
+/// Double-double arithmetic (double_double.hpp): ε ≈ 1.2e-32, the same on every platform.
+using ExtendedBandedMatrix = BandedSymmetric<DoubleDouble>;
+using ExtendedBandedCholesky = BandedCholeskyFactor<DoubleDouble>;
 
 }  // namespace attitude_planner
 

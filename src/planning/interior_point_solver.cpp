@@ -22,7 +22,8 @@
 //   W = ∇²f − Σ_i z_i ∇²c_i,  g_i = ∇c_i,  dz_i = (q_i − g_iᵀdδ)/D_i.
 // Each g_i g_iᵀ lies inside one stencil's 9×9 block, so the system keeps the unconstrained
 // Hessian's band (half bandwidth 8) and is factored by the same banded Cholesky; above N = 1024
-// in long double, each g_i g_iᵀ formed in it (kExtendedPrecisionAboveSteps). The slacks are
+// in double-double arithmetic, each g_i g_iᵀ formed in it (kExtendedPrecisionAboveSteps). The
+// slacks are
 // eliminated exactly for the current c (node_constraints.hpp: elasticSlacks), so the merit
 // φ_μ(δ) = f + Σ ψ_μ(c_i) depends on δ alone; the line search is Armijo on φ_μ along the
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
@@ -32,12 +33,12 @@
 // variables, the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
 // f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z. Its Hessian carries Newton's own
 // multipliers instead of z → ρ for violated constraints, which is where the elastic form stalls.
-// Up to kPredictorCorrectorMaxSteps a grid level is solved in the free-slack form first, its
-// barrier chosen at every iteration by Mehrotra's predictor–corrector (the affine step μ = 0 from
-// the same Cholesky factor gives σ = (μ_aff/mean s z)³, the corrector adds ds_aff·dz_aff to the
-// complementarity target), and retried in the elastic form if it ends infeasible or unconverged;
-// above it the elastic form comes first and the free-slack retry keeps a monotone barrier
-// (solveOnGridWithRetry).
+// A grid level is solved in the free-slack form first, its barrier chosen at every iteration by
+// Mehrotra's predictor–corrector (the affine step μ = 0 from the same Cholesky factor gives
+// σ = (μ_aff/mean s z)³, the corrector adds ds_aff·dz_aff to the complementarity target), and
+// retried in the elastic form if it ends infeasible or unconverged; the minimum-time search's
+// feasibility probes take the elastic form first and the free-slack retry keeps a monotone
+// barrier (solveOnGridWithRetry).
 //
 // Elastic barrier update: LOQO's adaptive rule after every iteration (see the loop). At μ_final a
 // full step with decrement below the tolerance (or quadratic convergence seen well below the
@@ -95,14 +96,10 @@ constexpr int kFreeSlackViolationStall = 40;
 constexpr double kMaxShiftFloor = 1e-2;
 /// Largest violation at which the penalty is raised before a request is called infeasible.
 constexpr double kPenaltyRaiseViolation = 1e-3;
-/// Up to this N (every grid level up to it) a level is solved in the free-slack form first, with
-/// Mehrotra's predictor–corrector choosing the barrier at every iteration; above it the elastic
-/// form comes first and the free-slack retry keeps the monotone barrier. Measured (plan_maneuver,
-/// side by side, docs/constraints_notes.md): 42 % fewer iterations over the constrained scenes at
-/// N = 64 … 8192 and the same or lower optima; but at N = 32768 (torque + rate limits) the
-/// free-slack form's finest level ran 200 iterations without converging, where the elastic form
-/// converges in 29.
-constexpr int kPredictorCorrectorMaxSteps = 8192;
+/// Most halvings of the line search; at the round-off floor (final barrier, feasible, decrement
+/// ≤ 10× the stall acceptance) fewer.
+constexpr int kMaxHalvings = 60;
+constexpr int kFloorHalvings = 5;
 /// The barrier never falls below this × (relative decrement)² × cost/m (see the predictor).
 constexpr double kBarrierProgressFloor = 0.01;
 /// Free slacks start at c pushed inside s > 0 by this (IPOPT's κ₁ push).
@@ -1096,8 +1093,14 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
     const double phi = ip.assembledMerit(cost, mu, penalty);
     double alpha = free_slacks ? alpha_slack : 1.0;
     bool accepted = final_step || -slope <= 1e-14 * std::abs(phi);
+    // At the round-off floor (below) a step the line search must shorten 32× is no progress, and
+    // each halving costs a merit evaluation (measured: N = 10⁵, a final level's 60 halvings took
+    // 2.4 s of its 11 s, only to end at the floor anyway).
+    const bool at_floor =
+        at_final_barrier && !violated && relative_decrement <= 10.0 * stall_acceptance;
+    const int max_halvings = at_floor ? kFloorHalvings : kMaxHalvings;
     ReducedProblem::Steps trial = np.retract(delta, alpha);
-    for (int back = 0; !accepted && back < 60; ++back) {
+    for (int back = 0; !accepted && back < max_halvings; ++back) {
       const double trial_phi = ip.merit(trial, mu, penalty, nullptr, alpha);
       if (std::isfinite(trial_phi) && trial_phi <= phi + 1e-4 * alpha * slope) {
         accepted = true;
@@ -1109,7 +1112,7 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
     if (!accepted) {
       // At the final barrier below the round-off floor Armijo fails on noise: the iterate is
       // as good as the floor allows (a full step there was measured to make it worse).
-      if (at_final_barrier && !violated && relative_decrement <= 10.0 * stall_acceptance) {
+      if (at_floor) {
         std::ostringstream why;
         why << "converged to the round-off floor (relative Newton decrement " << relative_decrement
             << ", the line search can no longer decrease the merit)";
@@ -1252,26 +1255,41 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
 
 namespace {
 
-/// Above this N the Newton system is assembled, factored and solved in long double. At a bound a
-/// constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12
-/// and the smooth modes' curvature falls like N⁻⁴ against the largest; the step along the active
-/// constraints' null space depends on that curvature alone, and double keeps only a few of its
-/// digits at large N. Measured against IPOPT (docs/constraints.md): in double the optima agreed
-/// to ≤ 7e-12 up to N = 1024, 1e-9 at 2048, 7e-8 at 4096 and 4e-6 at 8192 (torque and rate
-/// limits; 553 fewer active constraints than IPOPT's); in long double to ~1e-10 at 8192 with
-/// IPOPT's active set, at ~1.4× the time per iteration (x87 arithmetic), which below this N buys
-/// nothing measurable.
+/// The interior point's Newton system is assembled, factored and solved in extended precision
+/// above kExtendedPrecisionAboveSteps: in long double where it is the x87 format (64-bit
+/// significand, hardware) up to kLongDoubleMaxSteps, and in double-double arithmetic
+/// (double_double.hpp, ~106 bits) above, and everywhere above 1024 where long double is not x87
+/// (aarch64: a software quad, slower than double-double; elsewhere plain double). At a bound a
+/// constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12,
+/// and the smooth modes' curvature falls like N⁻⁴ against the largest (torques are second
+/// differences of attitudes); the step along the active constraints' null space depends on that
+/// curvature alone. Measured against IPOPT (docs/constraints.md, torque and rate limits): in
+/// double the optima agreed to ≤ 7e-12 up to N = 1024, 1e-9 at 2048, 7e-8 at 4096 and 4e-6 at 8192
+/// (553 fewer active constraints than IPOPT's); in long double to ≤ 1e-10 up to 8192, but 2.4e-7
+/// above double-double's optimum at 16 384 and 5.5e-6 at 32 768 (9 800 fewer active), and
+/// N = 65 536 and 10⁵ did not converge (line search failed: the directions were wrong); in
+/// double-double IPOPT's optimum at 8192 to 1e-13 and N = 10⁵ converges in 13–14 iterations on its
+/// finest level, at ~1.3–1.4× long double's time per iteration (5–7 vs 1.8 ns per multiply–add;
+/// torque + rate limits at N = 2048: 9.8× faster than IPOPT instead of 13.2×).
 constexpr int kExtendedPrecisionAboveSteps = 1024;
+constexpr int kLongDoubleMaxSteps = 8192;
+constexpr bool kLongDoubleIsX87 = std::numeric_limits<long double>::digits == 64;
 
 PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
                        Formulation formulation, bool predictor_corrector,
                        const ReducedProblem::Steps* coarse_steps,
                        ReducedProblem::Steps* final_steps, const LevelDuals* coarse_duals = nullptr,
                        LevelDuals* final_duals = nullptr) {
-  return problem.steps > kExtendedPrecisionAboveSteps
-             ? solveOnGridIn<long double>(problem, options, formulation, predictor_corrector,
-                                          coarse_steps, final_steps, coarse_duals, final_duals)
-             : solveOnGridIn<double>(problem, options, formulation, predictor_corrector,
+  const int N = problem.steps;
+  if (N <= kExtendedPrecisionAboveSteps) {
+    return solveOnGridIn<double>(problem, options, formulation, predictor_corrector, coarse_steps,
+                                 final_steps, coarse_duals, final_duals);
+  }
+  if (kLongDoubleIsX87 && N <= kLongDoubleMaxSteps) {
+    return solveOnGridIn<long double>(problem, options, formulation, predictor_corrector,
+                                      coarse_steps, final_steps, coarse_duals, final_duals);
+  }
+  return solveOnGridIn<DoubleDouble>(problem, options, formulation, predictor_corrector,
                                      coarse_steps, final_steps, coarse_duals, final_duals);
 }
 
@@ -1281,7 +1299,12 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
 }
 
 /// solveOnGrid in one formulation, retried once in the other from the same start when it ends
-/// infeasible or unconverged (the order: kPredictorCorrectorMaxSteps). The elastic form stalls
+/// infeasible or unconverged: free slacks with Mehrotra's predictor–corrector first (measured,
+/// docs/constraints_notes.md: 42 % fewer iterations over the constrained scenes at N = 64 … 8192
+/// and the same or lower optima; with the double-double system also above, where the elastic
+/// form came first until session 28: torque + rate limits at N = 10⁵ in 14 finest-level
+/// iterations, where the elastic form stopped after 25 and its retry took 25 more), the elastic
+/// form first for the minimum-time probes. The elastic form stalls
 /// where most nodes bind and the violated constraints' curvature (weighted by z → ρ) swamps the
 /// Hessian, while the free-slack form's Hessian carries Newton's own multipliers (measured:
 /// rate_limited with the variational scheme at N = 128, and torque plus rate limits at N = 128
@@ -1297,8 +1320,7 @@ PlanResult solveOnGridWithRetry(const PlanningProblem& problem, const SolverOpti
   // The minimum-time search's feasibility probes (started from its last feasible plan) keep the
   // elastic form first: with free slacks first its T* came out up to 0.3 % longer on Bilimoria
   // and Wie's slew and its searches up to 2.7× slower (each infeasible probe paid both forms).
-  const bool free_first =
-      problem.steps <= kPredictorCorrectorMaxSteps && !options.constrained_from_warm_start;
+  const bool free_first = !options.constrained_from_warm_start;
   const Formulation forms[2] = {free_first ? Formulation::FreeSlacks : Formulation::Elastic,
                                 free_first ? Formulation::Elastic : Formulation::FreeSlacks};
   const char* names[2] = {free_first ? "free slacks" : "the elastic form",

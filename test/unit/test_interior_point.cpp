@@ -527,21 +527,24 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
   EXPECT_NEAR(r.cost, 787.547, 1e-3 * 787.547);
 }
 
-// Slow (~60 s): N = 10⁵ with torque and rate limits (issue 16's target case). Its finest level
-// still stops (the normal equations' accuracy, docs/constraints_notes.md); what is asserted is
-// that the answer does not claim the request infeasible while the N = 25 000 level met every
-// constraint.
-TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5AreNotCalledInfeasible) {
-  if (!std::getenv("ATTITUDE_PLANNER_SLOW_TESTS")) {
-    GTEST_SKIP() << "slow: run scripts/test --all (ATTITUDE_PLANNER_SLOW_TESTS=1)";
-  }
+// N = 10⁵ with torque and rate limits (issue 16's target case, ~8 s): converges since the Newton
+// system is formed and factored in double-double (before, in long double and double, its finest
+// level stopped: the line search failed on wrong directions, docs/constraints_notes.md). The
+// plan meets every node constraint, checked from its own attitudes and torques, and satisfies
+// the discrete equations step by step.
+TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5Converge) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 100000);
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.12)};
   const ap::PlanResult r = plan(p, "newton");
-  EXPECT_NE(r.termination, ap::Termination::Infeasible) << r.message;
-  if (!r.converged()) {
-    EXPECT_NE(r.message.find("level met every constraint"), std::string::npos) << r.message;
-  }
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(r.max_constraint_violation, 1e-9);
+  EXPECT_LE(r.dynamics_residual, 1e-12);
+  const ap::ConstraintCheck check = ap::checkConstraints(p, r.maneuver);
+  EXPECT_LE(check.max_violation, 1e-9);
+  EXPECT_GT(check.active, 100000);  // τ and rate bounds bind over most of the maneuver
+  // The effort h·Σ½|τ|² is the continuous one to O(h): within 1e-3 of N = 8192's (1.0546 there,
+  // docs/constraints.md), and not above it by more than that.
+  EXPECT_NEAR(r.cost * p.duration / p.steps, 1.0546, 2e-3);
 }
 
 TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {

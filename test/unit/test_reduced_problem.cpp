@@ -5,12 +5,14 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
+#include <cmath>
 #include <cstdio>
 #include <random>
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
+#include "planning/banded_matrix.hpp"
 #include "planning/reduced_problem.hpp"
 
 using namespace attitude_planner;
@@ -223,72 +225,136 @@ TEST(ReducedProblem, BandedCholeskyFactorSolvesSeveralRightHandSides) {
 }
 
 // The interior point's situation (kExtendedPrecisionAboveSteps): a banded SPD matrix S plus
-// rank-one terms w g gᵀ with w up to 1e12·|S| (constraints at their bounds). The step's part
-// along the rank-one terms' null space depends on S alone. Reference: Sherman–Morrison–Woodbury
-// through S's own (well-conditioned) dense factorization, in double. Formed and factored in long
-// double (ExtendedBandedMatrix) the solve keeps it; in double only a few digits are left
-// (measured here: 7e-5 relative in double, 4e-8 in long double).
+// rank-one terms w g gᵀ with w up to 1e12·|S| (constraints at their bounds) and beyond. The
+// step's part along the rank-one terms' null space depends on S alone. Reference:
+// Sherman–Morrison–Woodbury through S's own (well-conditioned) dense factorization, in double.
+// Formed and factored in double-double (ExtendedBandedMatrix) the solve keeps it to the
+// reference's own accuracy at w = 1e12 and at w = 1e20, where long double's 64-bit significand
+// (ε = 5e-20) would keep nothing; in double only a few digits are left at w = 1e12 (measured
+// here: 7e-5 relative; long double, session 27: 4e-8).
 TEST(BandedSymmetric, ExtendedPrecisionKeepsTheCurvatureUnderHugeRankOneTerms) {
-  const int n = 60, p = 8;
-  std::mt19937 rng(16);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, n);
-  for (int i = 0; i < n; ++i) {
-    S(i, i) = 4.0;
-    for (int j = std::max(0, i - 2); j < i; ++j) S(i, j) = S(j, i) = 0.5 * normal(rng) / 3.0;
+  for (const double weight : {1e12, 1e20}) {
+    const int n = 60, p = 8;
+    std::mt19937 rng(16);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+      S(i, i) = 4.0;
+      for (int j = std::max(0, i - 2); j < i; ++j) S(i, j) = S(j, i) = 0.5 * normal(rng) / 3.0;
+    }
+    // Rank-one terms, each local (within the band): g over 9 consecutive unknowns.
+    struct Term {
+      int offset;
+      Eigen::Matrix<double, 9, 1> g;
+    };
+    std::vector<Term> terms;
+    for (int offset = 0; offset + 9 <= n; offset += 5) {
+      Eigen::Matrix<double, 9, 1> g;
+      for (int i = 0; i < 9; ++i) g(i) = normal(rng);
+      terms.push_back({offset, g});
+    }
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) b(i) = normal(rng);
+    // Reference: x = S⁻¹b − S⁻¹G (W⁻¹ + GᵀS⁻¹G)⁻¹ GᵀS⁻¹b, with W⁻¹ = 1/weight tiny.
+    const int m = static_cast<int>(terms.size());
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, m);
+    for (int t = 0; t < m; ++t) G.block(terms[t].offset, t, 9, 1) = terms[t].g;
+    const Eigen::LLT<Eigen::MatrixXd> s_factor(S);
+    const Eigen::MatrixXd SG = s_factor.solve(G);
+    const Eigen::VectorXd Sb = s_factor.solve(b);
+    Eigen::MatrixXd capacitance = G.transpose() * SG;
+    capacitance.diagonal().array() += 1.0 / weight;
+    const Eigen::VectorXd reference = Sb - SG * capacitance.ldlt().solve(G.transpose() * Sb);
+    // The null-space part: the component of x orthogonal to range(G).
+    const Eigen::MatrixXd Q = G.householderQr().householderQ() * Eigen::MatrixXd::Identity(n, m);
+    const auto null_part = [&](const Eigen::VectorXd& x) {
+      return Eigen::VectorXd(x - Q * (Q.transpose() * x));
+    };
+    const auto solveIn = [&](auto matrix, bool* factored) {
+      for (int i = 0; i < n; ++i)
+        for (int j = std::max(0, i - p); j <= i; ++j)
+          if (S(i, j) != 0.0) matrix.add(i, j, S(i, j));
+      for (const Term& t : terms) matrix.template addRankOne<9>(t.offset, t.g, weight, 0, 9);
+      Eigen::VectorXd x = b;
+      *factored = matrix.solvePositiveDefinite(&x);
+      return x;
+    };
+    bool extended_factored = false, plain_factored = false;
+    const Eigen::VectorXd extended = solveIn(ExtendedBandedMatrix(n, p), &extended_factored);
+    const Eigen::VectorXd plain = solveIn(BandedSymmetricMatrix(n, p), &plain_factored);
+    ASSERT_TRUE(extended_factored);
+    const double scale = null_part(reference).norm();
+    const double extended_error = (null_part(extended) - null_part(reference)).norm() / scale;
+    // Expected: ~ε·w|g|²/λ_min(S) with ε = 1.2e-32 (~3e-12 at w = 1e20; long double: ~1).
+    EXPECT_LE(extended_error, 1e-10) << "w = " << weight;
+    if (plain_factored) {
+      const double plain_error = (null_part(plain) - null_part(reference)).norm() / scale;
+      EXPECT_GE(plain_error, 1e3 * extended_error) << "w = " << weight;
+      std::printf("w = %.0e, null-space part, relative error: double-double %.2e, double %.2e\n",
+                  weight, extended_error, plain_error);
+    } else {
+      std::printf(
+          "w = %.0e, null-space part, relative error: double-double %.2e, double: not "
+          "positive definite\n",
+          weight, extended_error);
+    }
   }
-  // Rank-one terms, each local (within the band): g over 9 consecutive unknowns.
-  struct Term {
-    int offset;
-    Eigen::Matrix<double, 9, 1> g;
-    double weight;
+}
+
+// Double-double arithmetic (double_double.hpp): the error-free transformations are exact, and
+// ÷, √ agree with long double (an independent 64-bit computation) to its own precision and leave
+// double-double residuals ≤ 1e-30.
+TEST(DoubleDouble, SumsAndProductsAreExact) {
+  const DoubleDouble sum = DoubleDouble::twoSum(1e16, 1.0);
+  EXPECT_EQ(sum.hi(), 1e16);
+  EXPECT_EQ(sum.lo(), 1.0);
+  const double a = 1.0 + std::ldexp(1.0, -30), b = 1.0 + std::ldexp(1.0, -31);
+  const DoubleDouble product = DoubleDouble::twoProduct(a, b);  // 1 + 2⁻³⁰ + 2⁻³¹ + 2⁻⁶¹
+  EXPECT_EQ(product.hi(), 1.0 + std::ldexp(1.0, -30) + std::ldexp(1.0, -31));
+  EXPECT_EQ(product.lo(), std::ldexp(1.0, -61));
+  // A small term survives a cancellation that double loses.
+  const DoubleDouble one(1.0);
+  EXPECT_EQ(static_cast<double>((one + 1e-25) - one), 1e-25);
+  EXPECT_EQ(static_cast<double>((one * 3.0 + 1e-20) - DoubleDouble(3.0)), 1e-20);
+}
+
+TEST(DoubleDouble, DivisionAndRootMatchLongDoubleAndLeaveTinyResiduals) {
+  std::mt19937 rng(28);
+  std::uniform_real_distribution<double> mantissa(1.0, 10.0);
+  std::uniform_int_distribution<int> exponent(-30, 30);
+  const auto value = [&] {
+    return DoubleDouble(std::ldexp(mantissa(rng), exponent(rng))) + std::ldexp(mantissa(rng), -80);
   };
-  std::vector<Term> terms;
-  for (int offset = 0; offset + 9 <= n; offset += 5) {
-    Eigen::Matrix<double, 9, 1> g;
-    for (int i = 0; i < 9; ++i) g(i) = normal(rng);
-    terms.push_back({offset, g, 1e12});
+  const auto asLong = [](DoubleDouble x) {
+    return static_cast<long double>(x.hi()) + static_cast<long double>(x.lo());
+  };
+  for (int trial = 0; trial < 1000; ++trial) {
+    const DoubleDouble x = value(), y = value();
+    const DoubleDouble q = x / y;
+    EXPECT_LE(std::abs(static_cast<double>((x - q * y) / x)), 1e-30);
+    EXPECT_LE(std::abs(static_cast<double>((asLong(q) - asLong(x) / asLong(y)) / asLong(q))),
+              2e-19);
+    const DoubleDouble r = sqrt(x);
+    EXPECT_LE(std::abs(static_cast<double>((r * r - x) / x)), 1e-30);
+    EXPECT_LE(std::abs(static_cast<double>((asLong(r) - std::sqrt(asLong(x))) / asLong(r))), 2e-19);
+    EXPECT_TRUE(q > DoubleDouble(0.0));
+    EXPECT_TRUE(x - y < x);
   }
-  Eigen::VectorXd b(n);
-  for (int i = 0; i < n; ++i) b(i) = normal(rng);
-  // Reference: x = S⁻¹b − S⁻¹G (W⁻¹ + GᵀS⁻¹G)⁻¹ GᵀS⁻¹b, with W⁻¹ = 1/weight tiny.
-  const int m = static_cast<int>(terms.size());
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, m);
-  Eigen::VectorXd inverse_weight(m);
-  for (int t = 0; t < m; ++t) {
-    G.block(terms[t].offset, t, 9, 1) = terms[t].g;
-    inverse_weight(t) = 1.0 / terms[t].weight;
+  // The Cholesky inner products' accumulation (DoubleDoubleDifference) against term-by-term
+  // double-double arithmetic: within 1e-30 of |s| + Σ|a_k b_k|.
+  for (int trial = 0; trial < 200; ++trial) {
+    DoubleDouble a[8], b[8], exact = value();
+    DoubleDouble magnitude = abs(exact);
+    DoubleDoubleDifference accumulated(exact);
+    for (int k = 0; k < 8; ++k) {
+      a[k] = value();
+      b[k] = value();
+      accumulated.subtractProduct(a[k], b[k]);
+      exact = exact - a[k] * b[k];
+      magnitude = magnitude + abs(a[k] * b[k]);
+    }
+    EXPECT_LE(std::abs(static_cast<double>((accumulated.value() - exact) / magnitude)), 1e-30);
   }
-  const Eigen::LLT<Eigen::MatrixXd> s_factor(S);
-  const Eigen::MatrixXd SG = s_factor.solve(G);
-  const Eigen::VectorXd Sb = s_factor.solve(b);
-  Eigen::MatrixXd capacitance = G.transpose() * SG;
-  capacitance.diagonal() += inverse_weight;
-  const Eigen::VectorXd reference = Sb - SG * capacitance.ldlt().solve(G.transpose() * Sb);
-  // The null-space part: the component of x orthogonal to range(G).
-  const Eigen::MatrixXd Q = G.householderQr().householderQ() * Eigen::MatrixXd::Identity(n, m);
-  const auto null_part = [&](const Eigen::VectorXd& x) {
-    return Eigen::VectorXd(x - Q * (Q.transpose() * x));
-  };
-  const auto solveIn = [&](auto matrix) {
-    for (int i = 0; i < n; ++i)
-      for (int j = std::max(0, i - p); j <= i; ++j)
-        if (S(i, j) != 0.0) matrix.add(i, j, S(i, j));
-    for (const Term& t : terms) matrix.template addRankOne<9>(t.offset, t.g, t.weight, 0, 9);
-    Eigen::VectorXd x = b;
-    EXPECT_TRUE(matrix.solvePositiveDefinite(&x));
-    return x;
-  };
-  const Eigen::VectorXd extended = solveIn(ExtendedBandedMatrix(n, p));
-  const Eigen::VectorXd plain = solveIn(BandedSymmetricMatrix(n, p));
-  const double scale = null_part(reference).norm();
-  const double extended_error = (null_part(extended) - null_part(reference)).norm() / scale;
-  const double plain_error = (null_part(plain) - null_part(reference)).norm() / scale;
-  // Expected: ~ε·w|g|²/λ_min(S), ε = 5e-20 (long double) or 1.1e-16 (double).
-  EXPECT_LE(extended_error, 1e-6);
-  EXPECT_LE(extended_error, 1e-2 * plain_error);
-  std::printf("null-space part, relative error: long double %.2e, double %.2e\n", extended_error,
-              plain_error);
 }
 
 TEST(BandedLinearSystem, PivotedLuMatchesDenseSolveOnAnIndefiniteMatrix) {

@@ -150,8 +150,8 @@ void BandedCholeskyFactor<Scalar>::substitute(Scalar* y) const {
 template class BandedSymmetric<double>;
 template class BandedCholeskyFactor<double>;
 template class BandedSymmetric<long double>;
-template class BandedSymmetric<DoubleDouble>;
 template class BandedCholeskyFactor<long double>;
+template class BandedSymmetric<DoubleDouble>;
 template class BandedCholeskyFactor<DoubleDouble>;
 
 }  // namespace attitude_planner

@@ -1,10 +1,10 @@
 // Double-double arithmetic: a number is the unevaluated sum hi + lo of two doubles with
 // |lo| ≤ ulp(hi)/2, about 106 significant bits (ε ≈ 1.2e-32), from IEEE double operations and a
 // correctly rounded fma alone (Dekker 1971; Knuth's two-sum; Hida, Li and Bailey's QD library
-// for the formulas). It is the interior point's scalar above N = 1024
-// (interior_point_solver.cpp: kExtendedPrecisionAboveSteps), where the Newton system's condition
-// (~N⁴ from torques that are second differences of attitudes, times the barrier's 1/D) exceeds
-// double's 53-bit significand and, at N ≳ 16 000, long double's 64 bits. Measured per
+// for the formulas). It is the interior point's scalar above N = 8192 (above 1024 where long
+// double is not the x87 format; interior_point_solver.cpp: kExtendedPrecisionAboveSteps), where
+// the Newton system's condition (~N⁴ from torques that are second differences of attitudes,
+// times the barrier's 1/D) exceeds long double's 64-bit significand. Measured per
 // multiply–add in a dependent chain (x86-64): double 0.44 ns, long double (x87) 1.8 ns,
 // double-double 5–7 ns, __float128 (software) 23 ns; long double is also a software quad on
 // aarch64 and plain double elsewhere, double-double the same everywhere.

@@ -22,9 +22,9 @@
 //   W = ∇²f − Σ_i z_i ∇²c_i,  g_i = ∇c_i,  dz_i = (q_i − g_iᵀdδ)/D_i.
 // Each g_i g_iᵀ lies inside one stencil's 9×9 block, so the system keeps the unconstrained
 // Hessian's band (half bandwidth 8) and is factored by the same banded Cholesky; above N = 1024
-// in double-double arithmetic, each g_i g_iᵀ formed in it (kExtendedPrecisionAboveSteps). The
-// slacks are
-// eliminated exactly for the current c (node_constraints.hpp: elasticSlacks), so the merit
+// in extended precision (long double, and double-double arithmetic above N = 8192), each
+// g_i g_iᵀ formed in it (kExtendedPrecisionAboveSteps). The slacks are eliminated exactly for
+// the current c (node_constraints.hpp: elasticSlacks), so the merit
 // φ_μ(δ) = f + Σ ψ_μ(c_i) depends on δ alone; the line search is Armijo on φ_μ along the
 // retraction, and the dual step keeps z and u positive (fraction to the boundary, τ = 0.99).
 // Inertia correction: a multiple of the identity until the Cholesky factorization succeeds.

@@ -860,7 +860,8 @@ PlanResult solveByInertiaHomotopy(const PlanningProblem& problem, const SolverOp
 /// cases instead of 90, cheaper in 31 instead of 23, the worst ratio 1.97 instead of 2.81, the
 /// median iterations unchanged (20): only solves above the median pay. With the requested grid
 /// directly and the coasting start's longer limit among them: 96 of 100, cheaper in 33, worst
-/// 1.23; with the line search too: 97, cheaper in 35.
+/// 1.23; with the line search too: 97, cheaper in 35; with the inertia homotopy too: 98, cheaper
+/// in 38 (the median iterations 19.5 throughout since the coarse levels' own tolerance).
 constexpr int kMoreStartsAboveIterations = 40;
 
 /// The cheapest of `kept` and more structured starts: the other way round (unless already
@@ -912,7 +913,7 @@ PlanResult cheapestOfMoreStarts(const PlanningProblem& problem, const SolverOpti
   // From the sphere of the same mean inertia, the inertia moved to J in stages: a path to the
   // extremals of the anisotropic body that the starts above, all made for J itself, miss
   // (measured on the random suite: #160 4002.9, below IPOPT's 4224.6 where every other start
-  // ended at 4420.9 or above; #80 836.8 and #104 3829.9, 17 % and 10 % below IPOPT's).
+  // ended at 4420.9 or above; #80 833.8 and #104 3829.9, 17 % and 10 % below IPOPT's).
   if (go_on()) {
     others.push_back(
         {"the inertia homotopy from the sphere", solveByInertiaHomotopy(problem, options, start)});

@@ -23,15 +23,16 @@ Scalar scalarSqrt(Scalar x) {
   using std::sqrt;
   return sqrt(x);
 }
-/// s − Σ_{k = first}^{last − 1} a[k] b[k] (double-double: DoubleDoubleDifference).
-template <typename Scalar>
-Scalar minusDot(Scalar s, const Scalar* a, const Scalar* b, int first, int last) {
+/// s − Σ_{k = first}^{last − 1} a(k) b(k) (double-double: DoubleDoubleDifference), for the
+/// factorization's and both substitutions' inner products.
+template <typename Scalar, typename A, typename B>
+Scalar minusDot(Scalar s, int first, int last, A a, B b) {
   if constexpr (std::is_same_v<Scalar, DoubleDouble>) {
     DoubleDoubleDifference d(s);
-    for (int k = first; k < last; ++k) d.subtractProduct(a[k], b[k]);
+    for (int k = first; k < last; ++k) d.subtractProduct(a(k), b(k));
     return d.value();
   } else {
-    for (int k = first; k < last; ++k) s -= a[k] * b[k];
+    for (int k = first; k < last; ++k) s -= a(k) * b(k);
     return s;
   }
 }
@@ -101,7 +102,9 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
     const int first = std::max(0, i - p_);
     for (int j = first; j <= i; ++j) {
       const Scalar* lj = row(j);
-      const Scalar s = minusDot(li[j], li, lj, std::max(first, j - p_), j);
+      const Scalar s = minusDot(
+          li[j], std::max(first, j - p_), j, [li](int k) { return li[k]; },
+          [lj](int k) { return lj[k]; });
       if (j < i) {
         li[j] = divideByDiagonal(s, j);
       } else {
@@ -131,19 +134,15 @@ void BandedCholeskyFactor<Scalar>::substitute(Scalar* y) const {
   const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
   for (int i = 0; i < n_; ++i) {  // L y = b
     const Scalar* li = row(i);
-    y[i] = divideByDiagonal(minusDot(y[i], li, y, std::max(0, i - p_), i), i);
+    const Scalar s = minusDot(
+        y[i], std::max(0, i - p_), i, [li](int k) { return li[k]; }, [y](int k) { return y[k]; });
+    y[i] = divideByDiagonal(s, i);
   }
   for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
-    const int last = std::min(n_ - 1, i + p_);
-    if constexpr (std::is_same_v<Scalar, DoubleDouble>) {
-      DoubleDoubleDifference s(y[i]);
-      for (int k = i + 1; k <= last; ++k) s.subtractProduct(row(k)[i], y[k]);
-      y[i] = divideByDiagonal(s.value(), i);
-    } else {
-      Scalar s = y[i];
-      for (int k = i + 1; k <= last; ++k) s -= row(k)[i] * y[k];
-      y[i] = divideByDiagonal(s, i);
-    }
+    const Scalar s = minusDot(
+        y[i], i + 1, std::min(n_ - 1, i + p_) + 1, [&row, i](int k) { return row(k)[i]; },
+        [y](int k) { return y[k]; });
+    y[i] = divideByDiagonal(s, i);
   }
 }
 

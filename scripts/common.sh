@@ -52,7 +52,13 @@ build_workspace() {
   # The repository root is the package; the workspace sees it through a symlink.
   [ -L "$WS_DIR/src/attitude_planner" ] || ln -sfn "$REPO_DIR" "$WS_DIR/src/attitude_planner"
   log "building ($BUILD_TYPE) in $WS_DIR"
-  (cd "$WS_DIR" && catkin_make -DCMAKE_BUILD_TYPE="$BUILD_TYPE" \
+  # ccache, where installed, serves unchanged files from its cache (other worktrees included).
+  local launcher=()
+  if command -v ccache >/dev/null; then
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$REPO_DIR")}"
+  fi
+  (cd "$WS_DIR" && catkin_make -DCMAKE_BUILD_TYPE="$BUILD_TYPE" "${launcher[@]}" \
       -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" "$@" >"$WS_DIR/build.log" 2>&1) \
     || { tail -n 60 "$WS_DIR/build.log"; log "build failed (full log: $WS_DIR/build.log)"; return 1; }
   source_workspace

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <limits>
@@ -159,6 +160,9 @@ struct SolverOptions {
   /// Called after every iteration, numbered across grid levels (the first ones may run on
   /// coarser grids); return false to cancel (the result says "cancelled").
   std::function<bool(const IterationInfo&)> on_iteration;
+  /// Optional cancel flag another thread may set (e.g. an action's cancel): polled inside long
+  /// iterations as well as between them, so a cancel ends the solve promptly ("cancelled").
+  const std::atomic<bool>* cancel_requested = nullptr;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
   const Maneuver* warm_start = nullptr;
   /// With node constraints and a warm start: start the interior point from the warm start itself

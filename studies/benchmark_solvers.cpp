@@ -44,9 +44,10 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
-#include "planning/direct_method.hpp"
-#include "planning/reduced_problem.hpp"
-#include "planning/solvers.hpp"
+#include "planning/transcription/direct_method.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "planning/newton/newton_solver.hpp"
+#include "planning/problem/verdict.hpp"
 #include "support/random_problems.hpp"
 #include "support/study_tools.hpp"
 

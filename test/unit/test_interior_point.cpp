@@ -11,9 +11,9 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "planning/direct_method.hpp"
-#include "planning/node_constraints.hpp"
-#include "planning/reduced_problem.hpp"
+#include "planning/transcription/direct_method.hpp"
+#include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 #include "scene_errors.hpp"
 
 namespace ap = attitude_planner;

@@ -118,3 +118,52 @@ TEST(Layering, PrivateHeadersAreNotIncludedByPublicOnes) {
     }
   }
 }
+
+namespace {
+
+/// Planning's sub-layers (src/planning/<sub>/, docs/ARCHITECTURE.md), in dependency order: a
+/// private file may include its own sub-layer and those before it. linalg and problem are
+/// independent foundations; the solvers sit on the transcription; strategies compose solves;
+/// drivers (plan at resolution, fourth order, minimum time) dispatch.
+const std::vector<std::string> kPlanningSubLayers = {
+    "linalg",         "problem",    "transcription", "newton",
+    "interior_point", "crosscheck", "strategies",    "drivers"};
+
+int subLayerRank(const std::string& sub) {
+  for (std::size_t i = 0; i < kPlanningSubLayers.size(); ++i) {
+    if (kPlanningSubLayers[i] == sub) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(Layering, PlanningSubLayersPointDownOnly) {
+  const fs::path planning = fs::path(AP_SOURCE_DIR) / "src/planning";
+  const std::regex private_include(R"re(^\s*#\s*include\s*"planning/([a-z_]+)/)re");
+  int checked = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(planning)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string relative = fs::relative(entry.path(), planning).generic_string();
+    const auto slash = relative.find('/');
+    ASSERT_NE(slash, std::string::npos) << entry.path() << " is not in a planning sub-layer";
+    const std::string own = relative.substr(0, slash);
+    ASSERT_GE(subLayerRank(own), 0) << entry.path() << ": unknown sub-layer " << own;
+    std::ifstream in(entry.path());
+    std::string line;
+    while (std::getline(in, line)) {
+      std::smatch m;
+      if (!std::regex_search(line, m, private_include)) continue;
+      ++checked;
+      const int target = subLayerRank(m[1]);
+      ASSERT_GE(target, 0) << entry.path() << " includes unknown sub-layer " << m[1];
+      if (own == "linalg" || own == "problem") {
+        // The two foundations do not include each other.
+        EXPECT_EQ(target, subLayerRank(own)) << entry.path() << " includes " << line;
+      } else {
+        EXPECT_LE(target, subLayerRank(own)) << entry.path() << " includes " << line;
+      }
+    }
+  }
+  EXPECT_GT(checked, 10);
+}

@@ -8,8 +8,8 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "planning/direct_method.hpp"
-#include "planning/solvers.hpp"
+#include "planning/transcription/direct_method.hpp"
+#include "planning/problem/verdict.hpp"
 
 namespace ap = attitude_planner;
 

@@ -12,8 +12,8 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
-#include "planning/banded_matrix.hpp"
-#include "planning/reduced_problem.hpp"
+#include "planning/linalg/banded_matrix.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 using namespace attitude_planner;
 

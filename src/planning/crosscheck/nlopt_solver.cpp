@@ -9,8 +9,9 @@
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "planning/direct_method.hpp"
-#include "planning/solvers.hpp"
+#include "planning/transcription/direct_method.hpp"
+#include "planning/crosscheck/nlopt_solver.hpp"
+#include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
 

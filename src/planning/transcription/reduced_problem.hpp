@@ -24,7 +24,7 @@
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
-#include "planning/banded_matrix.hpp"
+#include "planning/linalg/banded_matrix.hpp"
 
 namespace attitude_planner {
 

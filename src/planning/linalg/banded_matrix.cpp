@@ -1,4 +1,4 @@
-#include "planning/banded_matrix.hpp"
+#include "planning/linalg/banded_matrix.hpp"
 
 #include <algorithm>
 #include <cmath>

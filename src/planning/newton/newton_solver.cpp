@@ -24,8 +24,9 @@
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "planning/reduced_problem.hpp"
-#include "planning/solvers.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "planning/newton/newton_solver.hpp"
+#include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
 

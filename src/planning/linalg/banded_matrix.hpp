@@ -7,7 +7,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "planning/double_double.hpp"
+#include "planning/linalg/double_double.hpp"
 
 namespace attitude_planner {
 

@@ -1,4 +1,4 @@
-#include "planning/node_constraints.hpp"
+#include "planning/transcription/node_constraints.hpp"
 
 #include <cmath>
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
-#include "planning/solvers.hpp"
+#include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
 

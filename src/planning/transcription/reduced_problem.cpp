@@ -1,4 +1,4 @@
-#include "planning/reduced_problem.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 #include <cmath>
 

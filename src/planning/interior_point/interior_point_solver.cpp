@@ -61,9 +61,11 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
-#include "planning/node_constraints.hpp"
-#include "planning/reduced_problem.hpp"
-#include "planning/solvers.hpp"
+#include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "planning/interior_point/interior_point_solver.hpp"
+#include "planning/newton/newton_solver.hpp"
+#include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
 

@@ -1,4 +1,4 @@
-#include "planning/direct_method.hpp"
+#include "planning/transcription/direct_method.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>

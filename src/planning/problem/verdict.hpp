@@ -1,31 +1,11 @@
-// The solvers behind planManeuver(). Call planManeuver() rather than these directly: it
-// validates the problem, times the solve and fills the common figures.
+// How every solver's plan is judged: its figures measured the same way for every solver, and the
+// one convergence rule beside each solver's own first-order test.
 #pragma once
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 
 namespace attitude_planner {
-
-/// Newton's method on the first-order optimality conditions, O(N) per iteration
-/// (newton_solver.cpp). Fills everything but solve_time_s.
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options);
-
-/// Primal–dual interior point on the reduced problem with the node constraints (per-axis torque
-/// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
-/// from options.warm_start if given. Sets PlanResult::infeasible when the constraints cannot be
-/// met. Fills everything but solve_time_s and the constraint figures.
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
-
-/// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
-/// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before
-/// any continuation level: the start a peer solver gets in a like-for-like comparison
-/// (benchmark_solvers --random-suite). Throws StepTooLarge like ReducedProblem.
-std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem);
-
-/// Independent cross-check: NLopt on the direct method (τ_1..τ_{N−1} as variables, equality
-/// constraints on the terminal state, exact gradients) (nlopt_solver.cpp).
-PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options);
 
 /// Fills result->maneuver with `planned` (the solver's own trajectory) and its cost and
 /// step_residual; without `planned`, with the replay of `torque` (replayFigures), which is then
@@ -50,5 +30,9 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 /// it does. The open-loop replay (replay_miss) is not part of it.
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
                               bool constraints);
+
+/// Sets the terminal errors of an open-loop replay and replay_miss, the larger of the attitude
+/// miss and T × the velocity miss (one rule for every scheme's replay).
+void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result);
 
 }  // namespace attitude_planner

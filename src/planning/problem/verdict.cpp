@@ -1,0 +1,155 @@
+// The verdict on a plan: the figures every solver's result is judged by, measured the same way
+// for every solver (the step residual of the discrete equations, the node constraints, the
+// open-loop replay).
+#include "planning/problem/verdict.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/verdict.hpp"
+
+namespace attitude_planner {
+
+double stepResidualTolerance(int steps, double step_angle) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double floor = step_angle > 0 ? 16.0 * eps * (1.0 / step_angle + steps) : 0.0;
+  return kStepResidualTolerance + floor;
+}
+
+StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver& m) {
+  const int N = m.steps();
+  if (N < 1 || static_cast<int>(m.angular_velocity.size()) != N + 1 ||
+      static_cast<int>(m.torque.size()) != N + 1) {
+    throw InvalidInput("measureStepResidual: maneuver rows do not match its steps");
+  }
+  if (!schemeIsDiscretization(problem.scheme)) {
+    throw InvalidInput("measureStepResidual: scheme '" + schemeName(problem.scheme) +
+                       "' has no discrete equations (its step residual is the worst of its two "
+                       "second_order solves, PlanResult::step_residual)");
+  }
+  const double T = problem.duration;
+  const double h = m.time_step;
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, h);
+  double max_rate = 0.0;
+  for (int k = 0; k < N; ++k) max_rate = std::max(max_rate, m.angular_velocity[k].norm());
+  const double W =
+      max_rate + so3::angleBetween(problem.initial_attitude, problem.final_attitude) / T;
+  const double P = Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues()(2) * W;
+  StepResidual out;
+  out.tolerance = stepResidualTolerance(N, h * W);
+  // Relative to a zero scale (the zero maneuver) only an exact zero is consistent.
+  const auto relative = [](double value, double scale) {
+    return scale > 0 ? value / scale : (value == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+  };
+  // The boundary velocities sit on row N − 1 (paper, variational: the last step's) or N (node
+  // velocities, second_order).
+  const bool nodes = scheme.hasEndTorques();
+  const int last_velocity = nodes ? N : N - 1;
+  double worst = std::max(so3::angleBetween(problem.initial_attitude, m.attitude[0]),
+                          so3::angleBetween(problem.final_attitude, m.attitude[N]));
+  worst = std::max(worst, relative((m.angular_velocity[0] - problem.initial_velocity).norm(), W));
+  worst = std::max(
+      worst, relative((m.angular_velocity[last_velocity] - problem.final_velocity).norm(), W));
+  // a_k: what the body receives at node k (control and effects).
+  std::vector<Vector3> applied(N + 1);
+  for (int k = 0; k <= N; ++k) {
+    applied[k] = m.torque[k];
+    if (problem.effects) applied[k] += problem.effects->torque(m.attitude[k], k * h);
+  }
+  // c_k: the momentum step k carries, from the reported velocities (full precision): paper
+  // exp(hΩ_k^) J Ω_k, variational J Ω_k; second_order Π_k + (h/2) a_k with Π_k = J Ω_k.
+  std::vector<Vector3> carried(N);
+  for (int k = 0; k < N; ++k) {
+    carried[k] = nodes ? Vector3(problem.inertia * m.angular_velocity[k] + 0.5 * h * applied[k])
+                       : scheme.momentumOfVelocity(m.angular_velocity[k]);
+    const Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
+    worst = std::max(worst, relative((scheme.momentumOfStep(so3::log(F)) - carried[k]).norm(), P));
+  }
+  // c_k = F_{k−1}ᵀ c_{k−1} + h a_k (seed 000, eq. 18; second_order: both half impulses).
+  for (int k = 1; k < N; ++k) {
+    const Matrix3 F_prev = m.attitude[k - 1].transpose() * m.attitude[k];
+    const Vector3 r = carried[k] - F_prev.transpose() * carried[k - 1] - h * applied[k];
+    worst = std::max(worst, relative(r.norm(), P));
+  }
+  if (nodes) {  // Π_N = F_{N−1}ᵀ c_{N−1} + (h/2) a_N
+    const Matrix3 F_last = m.attitude[N - 1].transpose() * m.attitude[N];
+    const Vector3 r = problem.inertia * m.angular_velocity[N] -
+                      F_last.transpose() * carried[N - 1] - 0.5 * h * applied[N];
+    worst = std::max(worst, relative(r.norm(), P));
+  }
+  out.relative = std::isfinite(worst) ? worst : std::numeric_limits<double>::infinity();
+  return out;
+}
+
+std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
+                              bool constraints) {
+  std::ostringstream why;
+  const StepResidual residual = measureStepResidual(problem, result.maneuver);
+  if (!(residual.relative <= residual.tolerance)) {
+    why << "stationary point found, but its attitudes, velocities and torques miss the discrete "
+           "equations of motion by "
+        << residual.relative << " relative (tolerance " << residual.tolerance << ")";
+    return why.str();
+  }
+  if (constraints && problem.hasNodeConstraints()) {
+    const ConstraintCheck check = checkConstraints(problem, result.maneuver);
+    if (!(check.max_relative_violation <= kNodeConstraintTolerance)) {
+      why << "stationary point found, but it violates " << check.worst << " " << check.worst_where
+          << " (" << check.max_relative_violation << " relative, tolerance "
+          << kNodeConstraintTolerance << ")";
+      return why.str();
+    }
+  }
+  return "";
+}
+
+void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result) {
+  const int N = problem.steps;
+  result->terminal_attitude_error = so3::angleBetween(problem.final_attitude, replayed.attitude[N]);
+  result->terminal_velocity_error = (replayed.angular_velocity[N] - problem.final_velocity).norm();
+  result->replay_miss =
+      std::max(result->terminal_attitude_error, problem.duration * result->terminal_velocity_error);
+}
+
+void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver* replay) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  SimulationInput input;
+  input.initial_attitude = problem.initial_attitude;
+  input.initial_velocity = problem.initial_velocity;
+  input.torque = result->maneuver.torque;
+  input.effects = problem.effects.get();
+  SimulationReport report;
+  const Maneuver replayed = simulate(scheme, input, &report);
+  result->dynamics_residual = report.max_step_residual;
+  setReplayMiss(problem, replayed, result);
+  if (replay) *replay = replayed;
+}
+
+void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
+                  PlanResult* result, const Maneuver* planned) {
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
+  result->scheme = problem.scheme;
+  result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
+  if (problem.hasTorqueBounds()) {
+    result->effects.push_back(effectKindName(EffectKind::ActuatorLimits));
+  }
+  result->duration = problem.duration;
+  result->cost = scheme.cost(torque);
+  result->effort = scheme.timeStep() * result->cost;
+  if (planned) {
+    result->maneuver = *planned;
+  } else {
+    result->maneuver.torque = torque;
+    Maneuver replay;
+    replayFigures(problem, result, &replay);
+    result->maneuver = replay;
+  }
+  result->step_residual = measureStepResidual(problem, result->maneuver).relative;
+}
+
+}  // namespace attitude_planner

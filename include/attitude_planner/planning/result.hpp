@@ -1,9 +1,11 @@
 // What a solve returns (PlanResult) and how it ended (Termination).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
 namespace attitude_planner {
@@ -34,12 +36,102 @@ struct LevelSummary {
   std::string reason;             ///< why the level ended, one sentence
 };
 
+/// What an attempt was for: the role of one solve in the planner's order of attempts.
+enum class AttemptStage {
+  Solve,              ///< the request's own solve (the first start)
+  BothWays,           ///< near π: the other way round, the cheaper kept
+  RateContinuation,   ///< spinning ends: from rest to rest, boundary rates raised in stages
+  CoastingRetry,      ///< spinning ends: from the coasting start after the others stalled
+  MoreStarts,         ///< a slow spinning solve: further starts, the cheapest kept
+  Constrained,        ///< the interior point, after the unconstrained optimum violated a bound
+  ConstrainedRetry,   ///< the interior point once more (other formulation, or cones first)
+  FourthOrderCoarse,  ///< fourth_order: the N solve of its Richardson pair
+  FourthOrderFine,    ///< fourth_order: the 2N solve of its Richardson pair
+  MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
+  MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
+};
+inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
+    {AttemptStage::Solve, "solve"},
+    {AttemptStage::BothWays, "both_ways"},
+    {AttemptStage::RateContinuation, "rate_continuation"},
+    {AttemptStage::CoastingRetry, "coasting_retry"},
+    {AttemptStage::MoreStarts, "more_starts"},
+    {AttemptStage::Constrained, "constrained"},
+    {AttemptStage::ConstrainedRetry, "constrained_retry"},
+    {AttemptStage::FourthOrderCoarse, "fourth_order_coarse"},
+    {AttemptStage::FourthOrderFine, "fourth_order_fine"},
+    {AttemptStage::MinimumTimeProbe, "minimum_time_probe"},
+    {AttemptStage::MinimumTimeMargin, "minimum_time_margin"},
+};
+
+/// Where an attempt's iterate started.
+enum class AttemptStart {
+  Hermite,      ///< the rate-honouring Hermite curve to the chosen lift (newtonInitialSteps)
+  CoarseLevel,  ///< the coarser grid level's plan, refined (grid continuation)
+  WarmStart,    ///< the caller's guess (SolverOptions::warm_start)
+  Coasting,     ///< the torque-free motions from both ends blended
+  InertiaHomotopy,       ///< an extremal of the sphere J̄ = tr(J)/3·I carried to J in stages
+  UnconstrainedOptimum,  ///< the unconstrained optimum (the interior point's start)
+  PreviousAttempt,       ///< the plan of the attempt before it (staged continuations, retries)
+};
+inline constexpr NamedValue<AttemptStart> kAttemptStartNames[] = {
+    {AttemptStart::Hermite, "hermite"},
+    {AttemptStart::CoarseLevel, "coarse_level"},
+    {AttemptStart::WarmStart, "warm_start"},
+    {AttemptStart::Coasting, "coasting"},
+    {AttemptStart::InertiaHomotopy, "inertia_homotopy"},
+    {AttemptStart::UnconstrainedOptimum, "unconstrained_optimum"},
+    {AttemptStart::PreviousAttempt, "previous_attempt"},
+};
+
+/// How the problem was posed to the solver of an attempt.
+enum class Formulation {
+  Unconstrained,  ///< Newton on the reduced problem (no node constraints)
+  FreeSlacks,     ///< interior point, c(x) − s = 0 with s > 0
+  Elastic,        ///< interior point, ℓ1-elastic: elastic variables with a penalty
+};
+inline constexpr NamedValue<Formulation> kFormulationNames[] = {
+    {Formulation::Unconstrained, "unconstrained"},
+    {Formulation::FreeSlacks, "free_slacks"},
+    {Formulation::Elastic, "elastic"},
+};
+
+/// Which homotopy class a maneuver belongs to: the way round and the extra whole turns.
+struct HomotopyClass {
+  bool long_way = false;      ///< the other way round than the shortest rotation
+  int extra_revolutions = 0;  ///< extra full turns in the sense of the way
+};
+
+/// One solve the planner ran for a request (PlanResult::attempts, JSON `attempts`), in the order
+/// the attempts ended: the structured trail from which the message is rendered.
+struct Attempt {
+  AttemptStage stage = AttemptStage::Solve;
+  AttemptStart start = AttemptStart::Hermite;
+  Formulation formulation = Formulation::Unconstrained;
+  HomotopyClass homotopy;  ///< the class its start was in
+  int steps = 0;           ///< N of the grid it solved on (its finest level)
+  Termination termination = Termination::NotConverged;
+  int iterations = 0;  ///< iterations of this attempt, its coarser grid levels included
+  /// The scheme's Σ ½ w_k |τ_k|² of its plan [N²·m²]; NaN when it left no plan.
+  double cost = std::numeric_limits<double>::quiet_NaN();
+  bool kept = false;  ///< its plan is the one returned
+};
+
+/// "solve", "both_ways", ... (JSON, tests).
+std::string attemptStageName(AttemptStage stage);
+/// "hermite", "coarse_level", ... (JSON, tests).
+std::string attemptStartName(AttemptStart start);
+/// "unconstrained", "free_slacks", "elastic" (JSON, tests).
+std::string formulationName(Formulation formulation);
+
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
 /// and the figures that judge it.
 struct PlanResult {
   Termination termination = Termination::NotConverged;
   bool converged() const { return termination == Termination::Converged; }
-  std::string message;  ///< human-readable explanation of `termination`, one level only
+  std::string message;  ///< human-readable explanation of `termination`
+  /// Every solve run for this request, in order (the trail); the kept one has `kept`.
+  std::vector<Attempt> attempts;
   /// The grid levels solved, coarsest first (continuation); empty for solvers without levels.
   std::vector<LevelSummary> levels;
   std::string solver;  ///< "newton" or "nlopt"

@@ -22,4 +22,16 @@ std::string terminationName(Termination termination) {
   return "unknown";
 }
 
+std::string attemptStageName(AttemptStage stage) {
+  return nameIn(kAttemptStageNames, stage);
+}
+
+std::string attemptStartName(AttemptStart start) {
+  return nameIn(kAttemptStartNames, start);
+}
+
+std::string formulationName(Formulation formulation) {
+  return nameIn(kFormulationNames, formulation);
+}
+
 }  // namespace attitude_planner

@@ -1,0 +1,52 @@
+#include "planning/problem/solve_context.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace attitude_planner {
+
+SolveContext::SolveContext(const SolverOptions& options)
+    : options_(options), start_(Clock::now()) {}
+
+double SolveContext::elapsedSeconds() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
+double SolveContext::remainingSeconds() const {
+  if (options_.time_budget_s <= 0) return std::numeric_limits<double>::infinity();
+  return std::max(options_.time_budget_s - elapsedSeconds(), 0.0);
+}
+
+SolverOptions SolveContext::remainingOptions() const {
+  SolverOptions remaining = options_;
+  if (options_.time_budget_s > 0) {
+    remaining.time_budget_s = std::max(remainingSeconds(), kSpentBudget);
+  }
+  return remaining;
+}
+
+std::optional<Termination> SolveContext::stopReason() const {
+  if (refused_by_callback_) return Termination::Cancelled;
+  if (options_.cancel_requested && options_.cancel_requested->load(std::memory_order_relaxed)) {
+    return Termination::Cancelled;
+  }
+  if (options_.time_budget_s > 0 && elapsedSeconds() >= options_.time_budget_s) {
+    return Termination::TimedOut;
+  }
+  return std::nullopt;
+}
+
+void SolveContext::poll() const {
+  if (const auto reason = stopReason()) throw SolveInterrupted{*reason};
+}
+
+bool SolveContext::reportIteration(const IterationInfo& info) {
+  ++iterations_;
+  if (!options_.on_iteration) return true;
+  IterationInfo numbered = info;
+  numbered.iteration = iterations_;
+  if (!options_.on_iteration(numbered)) refused_by_callback_ = true;
+  return !refused_by_callback_;
+}
+
+}  // namespace attitude_planner

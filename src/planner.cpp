@@ -15,7 +15,7 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
     validateOptions(options);
     return planToAccuracy(problem, options);
   }
-  return planAtResolution(problem, options);
+  return planBoundedMinimumEffort(problem, options);
 }
 
 }  // namespace attitude_planner

@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
       "N = 60, c1 = 1, c2 = 2, default starts\n%s\n",
       plan.message.c_str());
   std::printf("converged %d, iterations %d, continuation stages %d, integration steps %d\n",
-              plan.converged, plan.iterations, plan.continuation_stages, plan.integration_steps);
+              plan.converged(), plan.iterations, plan.continuation_stages, plan.integration_steps);
   std::printf("p(0) = (%.12f, %.12f, %.12f), cost = %.12f, terminal error = %.3e rad\n",
               plan.initial_costate.x(), plan.initial_costate.y(), plan.initial_costate.z(),
               plan.cost, plan.terminal_error);

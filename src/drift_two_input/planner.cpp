@@ -818,7 +818,7 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
     os << ")";
     start_kind = os.str();
   }
-  plan.timed_out = deadline.expired();
+  const bool timed_out = deadline.expired();
 
   // The least-cost converged attempt; distinct extremals (p(0) apart) for the report.
   const Attempt* best = nullptr;
@@ -866,27 +866,30 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
     plan.cost = plan.trajectory.cost;
     plan.terminal_error = so3::angleBetween(rq.g1, plan.trajectory.g.back());
   } catch (const StepTooLarge& e) {
-    plan.converged = false;
+    plan.termination = Termination::StepTooLarge;
     plan.terminal_error = INFINITY;
     plan.message = std::string("extremal could not be integrated: ") + e.what();
     return plan;
   }
-  plan.converged = best && best->solve.ok && plan.terminal_error <= rq.tolerance;
+  const bool converged = best && best->solve.ok && plan.terminal_error <= rq.tolerance;
+  plan.termination = converged   ? Termination::Converged
+                     : timed_out ? Termination::TimedOut
+                                 : Termination::NotConverged;
   std::ostringstream os;
   os.precision(6);
   std::ostringstream budget;
   budget.precision(6);
-  if (plan.timed_out) {
+  if (timed_out) {
     budget << "; time budget of " << rq.time_budget_s << " s reached: search stopped after "
            << plan.starts << " start(s)";
   }
-  if (plan.converged) {
+  if (converged) {
     os << "converged (" << best->how << ", " << plan.iterations << " iterations, "
        << plan.converged_starts << " of " << plan.starts << " starts converged" << budget.str()
        << "): extremal with p(0) = " << vec(p) << ", cost " << plan.cost << ", terminal error "
        << plan.terminal_error << " rad; " << plan.extremal;
   } else {
-    os << (plan.timed_out ? "timed out" : "not converged") << " after " << plan.iterations
+    os << (timed_out ? "timed out" : "not converged") << " after " << plan.iterations
        << " iterations (" << (best ? best->how : std::string("no start")) << budget.str()
        << "): best p(0) = " << vec(p) << ", terminal error " << plan.terminal_error
        << " rad; try an initial_costate, multiple shooting or a shorter duration";

@@ -83,6 +83,21 @@ std::string levelJson(const LevelSummary& level) {
   return out.str();
 }
 
+/// One attempt of the trail (PlanResult::attempts) as a JSON object; a cost without a plan is
+/// null.
+std::string attemptJson(const Attempt& a) {
+  std::ostringstream out;
+  out << "{\"stage\": " << jsonString(attemptStageName(a.stage))
+      << ", \"start\": " << jsonString(attemptStartName(a.start))
+      << ", \"formulation\": " << jsonString(formulationName(a.formulation))
+      << ", \"long_way\": " << (a.homotopy.long_way ? "true" : "false")
+      << ", \"extra_revolutions\": " << a.homotopy.extra_revolutions << ", \"steps\": " << a.steps
+      << ", \"termination\": " << jsonString(terminationName(a.termination))
+      << ", \"iterations\": " << a.iterations << ", \"cost\": " << jsonNumber(a.cost)
+      << ", \"kept\": " << (a.kept ? "true" : "false") << "}";
+  return out.str();
+}
+
 }  // namespace
 
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
@@ -112,6 +127,10 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
   for (size_t i = 0; i < r.effects.size(); ++i) out << (i ? ", " : "") << jsonString(r.effects[i]);
   out << "],\n  \"levels\": [";
   for (size_t i = 0; i < r.levels.size(); ++i) out << (i ? ", " : "") << levelJson(r.levels[i]);
+  out << "],\n  \"attempts\": [";
+  for (size_t i = 0; i < r.attempts.size(); ++i) {
+    out << (i ? ",\n    " : "\n    ") << attemptJson(r.attempts[i]);
+  }
   out << "],\n  \"constraints\": [";
   for (size_t i = 0; i < r.constraints.size(); ++i)
     out << (i ? ", " : "") << jsonString(r.constraints[i]);
@@ -216,7 +235,8 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
                                   const DriftTwoInputPlan& plan, double solve_time_s) {
   std::ostringstream out;
   out << "{\n"
-      << "  \"converged\": " << (plan.converged ? "true" : "false") << ",\n"
+      << "  \"converged\": " << (plan.converged() ? "true" : "false") << ",\n"
+      << "  \"termination\": " << jsonString(terminationName(plan.termination)) << ",\n"
       << "  \"message\": " << jsonString(plan.message) << ",\n"
       << "  \"system\": \"drift_two_input\",\n"
       << "  \"steps\": " << request.steps << ",\n"
@@ -240,7 +260,8 @@ std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
       << "  \"starts\": " << plan.starts << ",\n"
       << "  \"converged_starts\": " << plan.converged_starts << ",\n"
       << "  \"integration_steps\": " << plan.integration_steps << ",\n"
-      << "  \"timed_out\": " << (plan.timed_out ? "true" : "false") << ",\n"
+      << "  \"timed_out\": " << (plan.termination == Termination::TimedOut ? "true" : "false")
+      << ",\n"
       << "  \"solve_time_s\": " << jsonNumber(solve_time_s) << "\n"
       << "}\n";
   return out.str();
@@ -251,7 +272,7 @@ std::string driftTwoInputPlanText(const DriftTwoInputRequest& request,
   const Vector3& p = plan.initial_costate;
   std::string text;
   text += line("system", "drift_two_input (seed 001)");
-  text += line("converged", plan.converged ? "yes" : "NO");
+  text += line("converged", plan.converged() ? "yes" : "NO");
   text += line("message", plan.message);
   text += line("control weights c1, c2",
                general(request.weights.c1, 6) + ", " + general(request.weights.c2, 6));

@@ -53,9 +53,7 @@ DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
     out.plan = planDriftTwoInput(out.request);
     out.solve_time_s = (ros::WallTime::now() - start).toSec();
     out.solver_ran = true;
-    out.error_code = out.plan.converged   ? PlanErrorCode::SUCCESS
-                     : out.plan.timed_out ? PlanErrorCode::TIMED_OUT
-                                          : PlanErrorCode::NOT_CONVERGED;
+    out.error_code = errorCodeOf(out.plan.termination);
     out.message = out.plan.message;
   } catch (...) {
     describeCurrentException(&out.error_code, &out.message);

@@ -238,7 +238,7 @@ bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* cli
   }
   const ros::WallTime start = ros::WallTime::now();
   const DriftTwoInputPlan plan = planDriftTwoInput(request);
-  if (!plan.converged) {
+  if (!plan.converged()) {
     *error = "planner: " + plan.message;
     return false;
   }

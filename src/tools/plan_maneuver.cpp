@@ -276,7 +276,7 @@ int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
     out << ap::driftTwoInputPlanJson(request, plan, solve_time);
     if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
   }
-  if (!plan.converged) {
+  if (!plan.converged()) {
     std::cerr << "plan_maneuver: not converged: " << plan.message << "\n";
     return 1;
   }

@@ -23,26 +23,26 @@ int main() {
     for (int N : {60, 100, 400, 1000, 4000}) {
       rq->steps = N;
       const auto p = planDriftTwoInput(*rq);
-      std::printf("N=%d converged=%d cost=%.10f\n", N, p.converged, p.cost);
+      std::printf("N=%d converged=%d cost=%.10f\n", N, p.converged(), p.cost);
     }
   a.time_budget_s = 1e-9;
   std::printf("budget: %s\n", planDriftTwoInput(a).message.c_str());
   a.time_budget_s = 0;
   a.initial_costate = Vector3(2, 1, 0);
   a.g1 = so3::exp(Vector3(0, 0, 3));
-  std::printf("guess: %d\n", planDriftTwoInput(a).converged);
+  std::printf("guess: %d\n", planDriftTwoInput(a).converged());
   a.initial_costate.reset();
-  std::printf("free drift: %d\n", planDriftTwoInput(a).converged);
+  std::printf("free drift: %d\n", planDriftTwoInput(a).converged());
   a.g1 = so3::fromAxisAngle(Vector3(1, 1, 0), 1.2);
   a.duration = 20;
   a.steps = 100;
   a.shooting_intervals = 8;
   a.initial_costate = Vector3(0.5, 0.5, 0);
-  std::printf("multiple shooting: %d\n", planDriftTwoInput(a).converged);
+  std::printf("multiple shooting: %d\n", planDriftTwoInput(a).converged());
   DriftTwoInputRequest c;
   c.duration = 8;
   c.weights = {0.5, 3.0};
   c.g1 = so3::exp(Vector3(0, 0, 3));
   c.steps = 50;
-  std::printf("z-axis target: %d\n", planDriftTwoInput(c).converged);
+  std::printf("z-axis target: %d\n", planDriftTwoInput(c).converged());
 }

@@ -152,7 +152,7 @@ TEST(DriftTwoInputClosedForms, PlannedExtremalsFollowTheClosedForms) {
   for (int N : {50, 800}) {
     rq.steps = N;
     const DriftTwoInputPlan plan = planDriftTwoInput(rq);
-    ASSERT_TRUE(plan.converged) << plan.message;
+    ASSERT_TRUE(plan.converged()) << plan.message;
     EXPECT_LE(plan.iterations, 1) << plan.message;
     const DriftTwoInputClosedForm cf(plan.initial_costate, rq.weights);
     ASSERT_TRUE(cf.valid()) << cf.message();
@@ -181,7 +181,7 @@ TEST(DriftTwoInputClosedForms, PlannedExtremalsFollowTheClosedForms) {
     er.g1 = sampleDriftTwoInputExtremal(er.g0, p0, er.duration, 1, w).g.back();
     er.initial_costate = p0 + Vector3(0.02, -0.02, 0.01);
     const DriftTwoInputPlan plan = planDriftTwoInput(er);
-    ASSERT_TRUE(plan.converged) << plan.message;
+    ASSERT_TRUE(plan.converged()) << plan.message;
     ASSERT_LE((plan.initial_costate - p0).norm(), 1e-9) << plan.message;
     double e = 0;
     for (size_t k = 0; k < plan.trajectory.t.size(); ++k) {

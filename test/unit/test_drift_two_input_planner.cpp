@@ -53,7 +53,7 @@ TEST(DriftTwoInputPlanner, PlannedManeuverReachesTheTargetAttitude) {
   rq.initial_costate.reset();  // default starts
   const DriftTwoInputPlan plan = planDriftTwoInput(rq);
   std::printf("%s\n", plan.message.c_str());
-  ASSERT_TRUE(plan.converged) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message;
   EXPECT_LE(plan.terminal_error, 1e-10);
   const auto& tr = plan.trajectory;
   ASSERT_EQ(tr.g.size(), static_cast<size_t>(rq.steps + 1));
@@ -85,7 +85,7 @@ TEST(DriftTwoInputPlanner, ExtremalCostIsBelowPerturbedAdmissibleControlsReachin
   rq.steps = 3000;  // fine samples: the controls of the independent model
   rq.max_step = 1e-3;
   const DriftTwoInputPlan plan = planDriftTwoInput(rq);
-  ASSERT_TRUE(plan.converged) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message;
   const auto& tr = plan.trajectory;
   const int N = rq.steps;
   const Discretized model{rq.g0, rq.duration / N, rq.weights};
@@ -156,8 +156,8 @@ TEST(DriftTwoInputPlanner, GuessSelectsWhichOfCoexistingExtremalsIsFound) {
   rq.initial_costate = Vector3(2.0, 1.0, 0.0);
   const DriftTwoInputPlan b = planDriftTwoInput(rq);
   std::printf("guess 0: %s\nguess (2, 1, 0): %s\n", a.message.c_str(), b.message.c_str());
-  ASSERT_TRUE(a.converged) << a.message;
-  ASSERT_TRUE(b.converged) << b.message;
+  ASSERT_TRUE(a.converged()) << a.message;
+  ASSERT_TRUE(b.converged()) << b.message;
   EXPECT_LE(a.terminal_error, 1e-10);
   EXPECT_LE(b.terminal_error, 1e-10);
   EXPECT_LE(a.cost, 1e-20);
@@ -195,8 +195,8 @@ TEST(DriftTwoInputPlanner, LeftInvarianceGivesTheSameCostateForRotatedBoundaryAt
   rq.g0 = R * rq.g0;
   rq.g1 = R * rq.g1;
   const DriftTwoInputPlan b = planDriftTwoInput(rq);
-  ASSERT_TRUE(a.converged) << a.message;
-  ASSERT_TRUE(b.converged) << b.message;
+  ASSERT_TRUE(a.converged()) << a.message;
+  ASSERT_TRUE(b.converged()) << b.message;
   EXPECT_LE((a.initial_costate - b.initial_costate).norm(), 1e-8);
   EXPECT_NEAR(a.cost, b.cost, 1e-9 * a.cost);
   EXPECT_LE(b.terminal_error, 1e-10);
@@ -213,13 +213,13 @@ TEST(DriftTwoInputPlanner, MultipleShootingSolvesALongHorizonAndSingleShootingCo
   rq.initial_costate = Vector3(0.5, 0.5, 0.0);
   const DriftTwoInputPlan ms = planDriftTwoInput(rq);
   std::printf("multiple shooting, T = 20 s: %s\n", ms.message.c_str());
-  ASSERT_TRUE(ms.converged) << ms.message;
+  ASSERT_TRUE(ms.converged()) << ms.message;
   EXPECT_LE(ms.terminal_error, 1e-10);
   // the same extremal is a fixed point of single shooting: started there it stays there
   rq.shooting_intervals = 1;
   rq.initial_costate = ms.initial_costate;
   const DriftTwoInputPlan ss = planDriftTwoInput(rq);
-  ASSERT_TRUE(ss.converged) << ss.message;
+  ASSERT_TRUE(ss.converged()) << ss.message;
   EXPECT_LE(ss.iterations, 2);
   EXPECT_LE((ss.initial_costate - ms.initial_costate).norm(), 1e-9);
   EXPECT_NEAR(ss.cost, ms.cost, 1e-9 * ms.cost);
@@ -300,7 +300,7 @@ TEST(DriftTwoInputPlanner, SameExtremalWhateverTheOutputSamplingForEveryDriftSce
       std::printf("%s N = %d: cost %.12g, p(0) = (%.9f, %.9f, %.9f); %s\n",
                   entry.path().filename().c_str(), N, plan.cost, plan.initial_costate.x(),
                   plan.initial_costate.y(), plan.initial_costate.z(), plan.extremal.c_str());
-      ASSERT_TRUE(plan.converged) << entry.path() << " N = " << N << ": " << plan.message;
+      ASSERT_TRUE(plan.converged()) << entry.path() << " N = " << N << ": " << plan.message;
       EXPECT_LE(plan.terminal_error, 1e-10);
       ASSERT_EQ(plan.trajectory.g.size(), static_cast<size_t>(N + 1));
       if (!first) {
@@ -331,18 +331,18 @@ TEST(DriftTwoInputPlanner, WorkedExampleReturnsTheCheapestExtremalFoundAndReport
   rq.initial_costate.reset();
   const DriftTwoInputPlan plan = planDriftTwoInput(rq);
   std::printf("%s\n", plan.message.c_str());
-  ASSERT_TRUE(plan.converged) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message;
   EXPECT_NEAR(plan.cost, 3.752939785, 1e-8);
   ASSERT_FALSE(plan.other_costs.empty()) << plan.extremal;
   EXPECT_NEAR(plan.other_costs.front(), 4.023833777, 1e-8) << plan.extremal;
   for (double c : plan.other_costs) EXPECT_GT(c, plan.cost);
   EXPECT_NE(plan.extremal.find("the others cost 4.02383"), std::string::npos) << plan.extremal;
   EXPECT_NE(plan.message.find(plan.extremal), std::string::npos);
-  EXPECT_FALSE(plan.timed_out);
+  EXPECT_NE(plan.termination, Termination::TimedOut);
   // the cheaper extremal is a local minimum too: started next to it, the solve stays there
   rq.initial_costate = plan.initial_costate + Vector3(0.01, -0.01, 0.01);
   const DriftTwoInputPlan again = planDriftTwoInput(rq);
-  ASSERT_TRUE(again.converged) << again.message;
+  ASSERT_TRUE(again.converged()) << again.message;
   EXPECT_NEAR(again.cost, plan.cost, 1e-10 * plan.cost);
 }
 
@@ -352,15 +352,15 @@ TEST(DriftTwoInputPlanner, TimeBudgetStopsTheSearchAndSaysSo) {
   rq.time_budget_s = 1e-9;  // expires before the first start is solved
   const DriftTwoInputPlan plan = planDriftTwoInput(rq);
   std::printf("%s\n", plan.message.c_str());
-  EXPECT_TRUE(plan.timed_out);
-  EXPECT_FALSE(plan.converged);
+  EXPECT_EQ(plan.termination, Termination::TimedOut);
+  EXPECT_FALSE(plan.converged());
   EXPECT_NE(plan.message.find("time budget"), std::string::npos) << plan.message;
   EXPECT_EQ(plan.trajectory.g.size(), static_cast<size_t>(rq.steps + 1));  // best attempt
   // a generous budget changes nothing
   rq.time_budget_s = 60.0;
   const DriftTwoInputPlan full = planDriftTwoInput(rq);
-  ASSERT_TRUE(full.converged) << full.message;
-  EXPECT_FALSE(full.timed_out);
+  ASSERT_TRUE(full.converged()) << full.message;
+  EXPECT_NE(full.termination, Termination::TimedOut);
   rq.time_budget_s = -1.0;
   EXPECT_THROW(planDriftTwoInput(rq), InvalidInput);
 }

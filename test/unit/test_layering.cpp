@@ -16,8 +16,8 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Which layers a layer may include (itself included). "top" is the entry point planner.hpp /
-/// src/planner.cpp; "base" is errors.hpp, name_table.hpp and
-/// input_rules.hpp, allowed everywhere.
+/// src/planner.cpp; "base" is errors.hpp, name_table.hpp, input_rules.hpp and termination.hpp,
+/// allowed everywhere.
 const std::map<std::string, std::set<std::string>> kAllowed = {
     {"lie", {"lie"}},
     {"dynamics", {"lie", "dynamics"}},
@@ -31,7 +31,8 @@ const std::map<std::string, std::set<std::string>> kAllowed = {
 /// The layer of a path below include/attitude_planner/ or src/ ("" if none of the core's).
 std::string layerOf(const std::string& relative) {
   if (relative == "planner.hpp" || relative == "planner.cpp") return "top";
-  if (relative == "errors.hpp" || relative == "name_table.hpp" || relative == "input_rules.hpp") {
+  if (relative == "errors.hpp" || relative == "name_table.hpp" || relative == "input_rules.hpp" ||
+      relative == "termination.hpp" || relative == "termination.cpp") {
     return "base";
   }
   const auto slash = relative.find('/');

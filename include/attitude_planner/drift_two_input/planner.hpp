@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "attitude_planner/drift_two_input/system.hpp"
+#include "attitude_planner/termination.hpp"
 
 namespace attitude_planner {
 
@@ -40,9 +41,11 @@ struct DriftTwoInputRequest {
 
 /// Result of planDriftTwoInput: the extremal found (or the best attempt) and how it went.
 struct DriftTwoInputPlan {
-  bool converged = false;  ///< terminal_error ≤ tolerance
-  bool timed_out = false;  ///< the time budget stopped the search (see message)
-  std::string message;     ///< what happened, including which extremal (p(0), cost) was found
+  /// Converged (terminal_error ≤ tolerance), NotConverged, TimedOut (the time budget stopped
+  /// the search) or StepTooLarge (the extremal could not be integrated); the message says why.
+  Termination termination = Termination::NotConverged;
+  bool converged() const { return termination == Termination::Converged; }
+  std::string message;  ///< what happened, including which extremal (p(0), cost) was found
   /// Which extremal was returned among those found, e.g. "least cost of 5 distinct extremals
   /// found from 8 starts; the others cost 12.4, 31.0, ...".
   std::string extremal;
@@ -76,7 +79,7 @@ DriftTwoInputTrajectory sampleDriftTwoInputExtremal(const Matrix3& g0, const Vec
                                                     int* integration_steps = nullptr);
 
 /// Solves the BVP (3.8)–(3.10); throws InvalidInput on a malformed request (names the field).
-/// Never throws for a non-converged solve: converged = false and message says why.
+/// Never throws for a non-converged solve: `termination` says how it ended and `message` why.
 DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& request);
 
 }  // namespace attitude_planner

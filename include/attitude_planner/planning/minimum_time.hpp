@@ -25,8 +25,16 @@ constexpr double kMinimumTimeTolerance = 1e-9;
 /// The minimum-time plan of `problem` (objective minimum_time). Throws InvalidInput naming the
 /// field if no torque bound is in force (actuator_limits or max_torque_norm), for a negative
 /// time_margin, or together with an accuracy target. The result's `minimum_duration` is T*,
-/// `duration` the T of the returned plan ((1 + time_margin)·T*).
+/// `duration` the T of the returned plan ((1 + time_margin)·T*, planned from the T* plan). A
+/// problem.duration > 0 is an upper bound: T* above it ends Infeasible, naming T*.
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
+
+/// A minimum-effort plan at problem.duration whose "infeasible" is backed: when the solve ends
+/// Infeasible under a torque bound, the minimum-time problem under the same bounds either shows
+/// the duration feasible (T* ≤ T: the plan is solved again from the T* plan, which meets every
+/// bound with room) or names the least duration found feasible ("needs T >= T* s"); the
+/// result's minimum_duration is that T* (0 when it was not needed or not found).
+PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options);
 
 /// A duration at which an eigenaxis bang–bang slew would need the smallest authority of the
 /// bounds in force (the search's first guess when the problem gives none) [s].

@@ -1,4 +1,4 @@
-// What a solve returns (PlanResult) and how it ended (Termination).
+// What a solve returns (PlanResult) and the trail of attempts behind it (Attempt).
 #pragma once
 
 #include <limits>
@@ -6,25 +6,10 @@
 #include <vector>
 
 #include "attitude_planner/name_table.hpp"
+#include "attitude_planner/termination.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
 namespace attitude_planner {
-
-/// How a solve ended: the one status of a result. Messages explain it, they never carry it; the
-/// node maps it to PlanErrorCode in one switch (ros/planner_node.cpp, errorCodeOf).
-enum class Termination {
-  Converged,     ///< first-order optimal and consistent to the tolerance
-  NotConverged,  ///< iteration limit, stall, or a check failed (the message says which)
-  Infeasible,    ///< the constraints admit no maneuver (the message names the binding one)
-  StepTooLarge,  ///< an implicit step has no solution at this h (h·|Ω| too large): increase N
-  TimedOut,      ///< the time budget ran out (the plan so far is returned)
-  Cancelled,     ///< the on_iteration callback asked to stop (the plan so far is returned)
-  InvalidInput,  ///< the problem or options were refused (a node answers this; the core throws)
-};
-
-/// "converged", "not_converged", "infeasible", "step_too_large", "timed_out", "cancelled",
-/// "invalid_input" (JSON summary, logs).
-std::string terminationName(Termination termination);
 
 /// One grid level of a continuation solve (coarsest first; the last one is the requested N).
 struct LevelSummary {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -24,6 +25,8 @@ constexpr double kExcursionAngles[] = {0.3, 0.8};
 constexpr double kExcursionStartFactors[] = {1.04, 0.96};
 /// The structured starts' first T, relative to the eigenaxis slew's least T.
 constexpr double kEigenaxisStartFactor = 1.02;
+/// A search doubles its first T at most this many times looking for a feasible one.
+constexpr int kMaxDoublings = 12;
 /// Grids above this N search from the T* plan of the grid with half the steps.
 constexpr int kCoarsestSearchGrid = 64;
 /// That search's first T, relative to the coarse grid's T*.
@@ -129,6 +132,7 @@ struct SearchOutcome {
   double T_lo = 0.0;      ///< the bracket [T_lo infeasible, T_hi feasible]
   double T_hi = 0.0;
   int solves = 0;
+  int iterations = 0;  ///< iterations of all its solves
 };
 
 /// A plan at T proves T feasible when it meets every node constraint and the discrete equations
@@ -145,49 +149,70 @@ bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
   return planInconsistency(problem, r, true).empty();
 }
 
-}  // namespace
+/// The search for T*: several starts, each a continuation downwards in T over minimum-effort
+/// solves warm-started from the last feasible plan, and a bisection of the best bracket.
+class MinimumTimeSearch {
+ public:
+  MinimumTimeSearch(const PlanningProblem& problem, const SolverOptions& options)
+      : problem_(problem), options_(options), start_(std::chrono::steady_clock::now()) {
+    effort_ = problem;
+    effort_.objective = Objective::MinimumEffort;
+    effort_.time_margin = 0.0;
+  }
 
-PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
-  validateProblem(problem);
-  validateMinimumTime(problem);
-  const auto start = std::chrono::steady_clock::now();
-  const auto remaining = [&] { return withRemainingBudget(options, start); };
-  PlanningProblem effort = problem;
-  effort.objective = Objective::MinimumEffort;
-  effort.time_margin = 0.0;
-  bool timed_out = false;
-  int solves = 0;
+  /// The plan at the least feasible T found (minimum_duration = T*), or why there is none.
+  PlanResult run() {
+    const double guess =
+        problem_.duration > 0 ? problem_.duration : eigenaxisDurationGuess(problem_);
+    searchFromCoarseGrid();
+    const bool searched_coarse = !outcomes_.empty() && outcomes_.back().feasible;
+    if (!searched_coarse) outcomes_.push_back(search("continuation", nullptr, guess));
+    if (!searched_coarse && isRestToRest()) searchStructuredStarts();
+    SearchOutcome* found = leastFeasible();
+    if (found) bisect(found);
+    for (const SearchOutcome& o : outcomes_) solves_ += o.solves;
+    if (!found) return noneFeasible(guess);
+    return atMinimumTime(*found);
+  }
 
-  // One minimum-effort solve at T from `warm`: true, with the plan kept in `out`, if it proves T
-  // feasible (provesFeasible).
-  const auto tryDuration = [&](double T, const Maneuver* warm, SearchOutcome* out) {
-    effort.duration = T;
+ private:
+  SolverOptions remaining() const { return withRemainingBudget(options_, start_); }
+
+  /// One minimum-effort solve at T from `warm`: true, with the plan kept in `out`, if it proves
+  /// T feasible (provesFeasible).
+  bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out) {
+    effort_.duration = T;
     SolverOptions o = remaining();
     if (warm) {
       o.warm_start = warm;
       o.constrained_from_warm_start = true;
     }
-    PlanResult r = planAtResolution(effort, o);
+    PlanResult r = planAtResolution(effort_, o);
     ++out->solves;
-    if (r.termination == Termination::TimedOut) timed_out = true;
-    if (!provesFeasible(effort, r)) return false;
+    out->iterations += r.iterations;
+    if (r.termination == Termination::TimedOut || r.termination == Termination::Cancelled) {
+      stopped_ = r.termination;
+    }
+    if (!provesFeasible(effort_, r)) return false;
     out->best = std::move(r);
     out->feasible = true;
     return true;
-  };
-  // One search from one start: `from` (attitudes, any T) starts the first solve at T_first;
-  // null: the minimum-effort problem's own start (its unconstrained optimum). Each later solve
-  // starts from the last feasible plan (same N).
-  const auto search = [&](const std::string& name, const Maneuver* from, double T_first) {
+  }
+
+  bool stopped() const { return stopped_.has_value(); }
+
+  /// One search from one start: `from` (attitudes, any T) starts the first solve at T_first;
+  /// null: the minimum-effort problem's own start (its unconstrained optimum). Each later solve
+  /// starts from the last feasible plan (same N).
+  SearchOutcome search(const std::string& name, const Maneuver* from, double T_first) {
     SearchOutcome out;
     out.start = name;
     const auto feasible = [&](double T) {
       return tryDuration(T, out.feasible ? &out.best.maneuver : from, &out);
     };
-    // Bracket: double until feasible (at most 2^12).
     double T = T_first;
-    for (int doublings = 0; !feasible(T) && !timed_out; T *= 2.0) {
-      if (++doublings > 12) return out;
+    for (int doublings = 0; !feasible(T) && !stopped(); T *= 2.0) {
+      if (++doublings > kMaxDoublings) return out;
     }
     if (!out.feasible) return out;
     // Down from the first feasible T in small steps, each warm-started from the last feasible
@@ -195,66 +220,58 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
     // 1/T²), where it can stop at a local minimum of the violation.
     out.T_hi = T;
     out.T_lo = T * kContinuationFactor;
-    while (!timed_out && feasible(out.T_lo)) {
+    while (!stopped() && feasible(out.T_lo)) {
       out.T_hi = out.T_lo;
       out.T_lo *= kContinuationFactor;
     }
     return out;
-  };
-  // Bisection of a search's bracket [T_lo infeasible, T_hi feasible], from its plans.
-  const auto bisect = [&](SearchOutcome* out) {
-    while (!timed_out && out->T_hi - out->T_lo > kMinimumTimeTolerance * out->T_hi) {
+  }
+
+  /// Bisection of a search's bracket [T_lo infeasible, T_hi feasible], from its plans.
+  void bisect(SearchOutcome* out) {
+    while (!stopped() && out->T_hi - out->T_lo > kMinimumTimeTolerance * out->T_hi) {
       const double mid = 0.5 * (out->T_lo + out->T_hi);
       const Maneuver from = out->best.maneuver;
       (tryDuration(mid, &from, out) ? out->T_hi : out->T_lo) = mid;
     }
-  };
-
-  // Starts (minimum-time problems have several local optima, and the search's "infeasible"
-  // verdicts are local): the minimum-effort continuation from the given duration or the
-  // eigenaxis guess, and, rest to rest, the eigenaxis bang–bang slew at the least T its bounds
-  // allow and excursions off it about the two axes perpendicular to the eigenaxis, both signs
-  // (the eigenaxis slew is a symmetric saddle the solver cannot leave on its own).
-  std::vector<SearchOutcome> outcomes;
-  const double guess = problem.duration > 0 ? problem.duration : eigenaxisDurationGuess(problem);
-  // Above kCoarsestSearchGrid the starts are searched on a coarser grid (N/2, recursively) and
-  // its T* plan, resampled, starts the search here just above its T* (the discrete T* converges
-  // in N; measured, Betts's case: every start searched at N = 128 stopped above 34 s, while the
-  // N = 64 search reaches 28.6 s). The full set of starts runs here only if that finds nothing.
-  std::string coarse_note;
-  if (problem.steps > kCoarsestSearchGrid && problem.steps % 2 == 0) {
-    PlanningProblem coarse_problem = problem;
-    coarse_problem.steps = problem.steps / 2;
-    coarse_problem.time_margin = 0.0;
-    const PlanResult coarse = planMinimumTime(coarse_problem, remaining());
-    if (coarse.converged()) {
-      Maneuver resampled = coarse.maneuver;
-      resampled.attitude = resampleAttitudes(coarse.maneuver, problem.steps);
-      outcomes.push_back(search("coarse grid (N = " + std::to_string(coarse_problem.steps) + ")",
-                                &resampled, coarse.minimum_duration * kCoarseStartFactor));
-      coarse_note =
-          "; on the coarse grid: " + coarse.message.substr(coarse.message.rfind("minimum time T*"));
-    }
   }
-  const bool searched_coarse = !outcomes.empty() && outcomes.back().feasible;
-  if (!searched_coarse) outcomes.push_back(search("continuation", nullptr, guess));
-  const bool rest_to_rest = !searched_coarse && problem.initial_velocity.isZero(0.0) &&
-                            problem.final_velocity.isZero(0.0) &&
-                            so3::angleBetween(problem.initial_attitude, problem.final_attitude) > 0;
-  if (rest_to_rest && !timed_out) {
-    const double T_eigenaxis = eigenaxisBangBangDuration(problem);
+
+  /// Above kCoarsestSearchGrid the starts are searched on a coarser grid (N/2, recursively) and
+  /// its T* plan, resampled, starts the search here just above its T* (the discrete T*
+  /// converges in N; measured, Betts's case: every start searched at N = 128 stopped above 34 s,
+  /// while the N = 64 search reaches 28.6 s). The full set of starts runs here only if that
+  /// finds nothing.
+  void searchFromCoarseGrid() {
+    if (problem_.steps <= kCoarsestSearchGrid || problem_.steps % 2 != 0) return;
+    PlanningProblem coarse_problem = problem_;
+    coarse_problem.steps = problem_.steps / 2;
+    coarse_problem.time_margin = 0.0;
+    const PlanResult coarse = MinimumTimeSearch(coarse_problem, remaining()).run();
+    if (!coarse.converged()) return;
+    Maneuver resampled = coarse.maneuver;
+    resampled.attitude = resampleAttitudes(coarse.maneuver, problem_.steps);
+    outcomes_.push_back(search("coarse grid (N = " + std::to_string(coarse_problem.steps) + ")",
+                               &resampled, coarse.minimum_duration * kCoarseStartFactor));
+    coarse_minimum_duration_ = coarse.minimum_duration;
+  }
+
+  bool isRestToRest() const {
+    return !stopped() && problem_.initial_velocity.isZero(0.0) &&
+           problem_.final_velocity.isZero(0.0) &&
+           so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
+  }
+
+  /// Rest to rest: the eigenaxis bang–bang slew at the least T its bounds allow and excursions
+  /// off it about the two axes perpendicular to the eigenaxis, both signs, two sizes, first
+  /// solved just above and just below the eigenaxis T (the eigenaxis slew is a symmetric saddle
+  /// the solver cannot leave on its own; the nutating time-optimal slews lie below it, and which
+  /// excursion reaches the published T* differs between Betts's and Bilimoria–Wie's cases).
+  void searchStructuredStarts() {
+    const double T_eigenaxis = eigenaxisBangBangDuration(problem_);
     const Vector3 e =
-        so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
+        so3::log(problem_.initial_attitude.transpose() * problem_.final_attitude).normalized();
     const Vector3 p1 = e.unitOrthogonal(), p2 = e.cross(p1);
-    struct Start {
-      std::string name;
-      Vector3 axis;
-      double angle, duration_factor;
-    };
-    std::vector<Start> starts{{"eigenaxis", e, 0.0, kEigenaxisStartFactor}};
-    // Excursions of two sizes about ±p1, ±p2, first solved just above and just below the
-    // eigenaxis T (the nutating time-optimal slews lie below it; measured: which combination
-    // reaches the published T* differs between Betts's and Bilimoria–Wie's cases).
+    std::vector<StructuredStart> starts{{"eigenaxis", e, 0.0, kEigenaxisStartFactor}};
     for (const double angle : kExcursionAngles) {
       for (const double factor : kExcursionStartFactors) {
         for (const auto& [name, axis] : {std::pair<std::string, Vector3>{"+p1", p1},
@@ -267,81 +284,238 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
         }
       }
     }
-    for (const Start& st : starts) {
-      if (timed_out) break;
-      // Just above the eigenaxis slew's least T: at it the slew is on the bounds, and the
-      // interior point needs room inside them (measured: Betts's case, a first solve at T
-      // itself failed and the search restarted from 2T).
-      PlanningProblem shaped = effort;
+    for (const StructuredStart& st : starts) {
+      if (stopped()) break;
+      PlanningProblem shaped = effort_;
       shaped.duration = T_eigenaxis * st.duration_factor;
       const Maneuver slew = excursionSlew(shaped, st.axis, st.angle);
-      outcomes.push_back(search(st.name, &slew, shaped.duration));
+      outcomes_.push_back(search(st.name, &slew, shaped.duration));
     }
   }
-  // Bisection of the bracket of the search with the least feasible T (the others' brackets are
-  // not refined: a 5 % bracket each, and bisecting them all cost 5× the solves, measured on the
-  // seed's torque_limited scene, for T* within 2e-4 of each other).
-  SearchOutcome* found = nullptr;
-  for (SearchOutcome& o : outcomes) {
-    if (o.feasible && (!found || o.T_hi < found->T_hi)) found = &o;
+
+  /// The search with the least feasible T (only its bracket is bisected: a 5 % bracket each, and
+  /// bisecting them all cost 5× the solves, measured on the seed's torque_limited scene, for T*
+  /// within 2e-4 of each other).
+  SearchOutcome* leastFeasible() {
+    SearchOutcome* found = nullptr;
+    for (SearchOutcome& o : outcomes_) {
+      if (o.feasible && (!found || o.T_hi < found->T_hi)) found = &o;
+    }
+    return found;
   }
-  if (found) bisect(found);
-  for (const SearchOutcome& o : outcomes) solves += o.solves;
-  if (!found) {
+
+  PlanResult noneFeasible(double guess) const {
     PlanResult none;
-    if (timed_out) {
-      none.termination = Termination::TimedOut;
-      none.message = "time budget exceeded before any duration was found feasible";
+    if (stopped_) {
+      none.termination = *stopped_;
+      none.message = terminationName(*stopped_) + " before any duration was found feasible";
     } else {
       none.termination = Termination::Infeasible;
-      none.message = "infeasible: no duration up to 2^12 times the first guess " +
-                     exactNumber(guess) +
-                     " s admits a plan under the bounds and constraints in force";
+      none.message = "infeasible: no duration up to 2^" + std::to_string(kMaxDoublings) +
+                     " times the first guess " + exactNumber(guess) +
+                     " s admits a plan under the bounds and constraints in force (a local "
+                     "search: every start's solves ended infeasible or unconverged)";
     }
+    none.attempts = trail();
     return none;
   }
-  const double T_star = found->T_hi;
-  PlanResult result = found->best;
-  if (!result.converged()) {
-    // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
-    // short of optimality while its plan meets every constraint, which is what T* rests on.
-    result.termination = Termination::Converged;
-    result.message =
-        "feasible at T* (its minimum-effort solve stopped short of optimality: " + result.message +
-        ")";
+
+  /// One attempt per start of the search (its solves summed), in the order the starts ran.
+  std::vector<Attempt> trail() const {
+    std::vector<Attempt> attempts;
+    for (const SearchOutcome& o : outcomes_) {
+      Attempt a;
+      a.stage = AttemptStage::MinimumTimeProbe;
+      a.start = o.start == "continuation" ? AttemptStart::Hermite : AttemptStart::WarmStart;
+      a.formulation = Formulation::FreeSlacks;
+      a.steps = problem_.steps;
+      a.termination = o.feasible ? Termination::Converged : Termination::Infeasible;
+      a.iterations = o.iterations;
+      if (o.feasible) a.cost = o.best.cost;
+      attempts.push_back(a);
+    }
+    return attempts;
+  }
+
+  PlanResult atMinimumTime(const SearchOutcome& found) const {
+    PlanResult result = found.best;
+    if (!result.converged()) {
+      // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
+      // short of optimality while its plan meets every constraint, which is what T* rests on.
+      result.termination = Termination::Converged;
+      result.message = "feasible at T* (its minimum-effort solve stopped short of optimality: " +
+                       result.message + ")";
+    }
+    result.minimum_duration = found.T_hi;
+    result.attempts = trail();
+    for (std::size_t i = 0; i < outcomes_.size(); ++i) {
+      result.attempts[i].kept = &outcomes_[i] == &found;
+    }
+    result.message += searchNote(found);
+    return result;
+  }
+
+  /// T* is the least duration the interior point found feasible: an upper bound on the true
+  /// minimum (a false "infeasible" below it cannot be told from a true one;
+  /// docs/minimum_time.md).
+  std::string searchNote(const SearchOutcome& found) const {
+    std::ostringstream note;
+    note << "; minimum time T* = " << found.T_hi << " s, the least duration found feasible, from "
+         << "the " << found.start << " start (bracket [" << found.T_lo << ", " << found.T_hi
+         << "] s; starts:";
+    for (const SearchOutcome& o : outcomes_) {
+      note << " " << o.start << " ";
+      if (o.feasible) {
+        note << o.T_hi << " s;";
+      } else {
+        note << "none feasible;";
+      }
+    }
+    note << " " << solves_ << " minimum-effort solves"
+         << (stopped_ ? ", stopped by " + terminationName(*stopped_) : std::string()) << ")";
+    if (coarse_minimum_duration_ > 0) {
+      note << "; on the coarse grid T* = " << coarse_minimum_duration_ << " s";
+    }
+    return note.str();
+  }
+
+  struct StructuredStart {
+    std::string name;
+    Vector3 axis;
+    double angle, duration_factor;
+  };
+
+  const PlanningProblem& problem_;
+  SolverOptions options_;
+  std::chrono::steady_clock::time_point start_;
+  PlanningProblem effort_;
+  std::vector<SearchOutcome> outcomes_;
+  std::optional<Termination> stopped_;
+  double coarse_minimum_duration_ = 0.0;
+  int solves_ = 0;
+};
+
+/// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
+/// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
+/// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
+/// strictly inside instead of from the unconstrained optimum.
+PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
+                                   const Maneuver& at_minimum_time, const SolverOptions& options) {
+  PlanningProblem effort = problem;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = T;
+  SolverOptions o = options;
+  o.warm_start = &at_minimum_time;
+  o.constrained_from_warm_start = true;
+  return planAtResolution(effort, o);
+}
+
+}  // namespace
+
+PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
+  validateProblem(problem);
+  validateMinimumTime(problem);
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult result = MinimumTimeSearch(problem, options).run();
+  if (!result.converged()) return result;
+  const double T_star = result.minimum_duration;
+  if (problem.duration > 0 && T_star > problem.duration * (1.0 + kMinimumTimeTolerance)) {
+    // `duration` is an upper bound: the request asked for T ≤ duration.
+    result.termination = Termination::Infeasible;
+    std::ostringstream why;
+    why << "infeasible: needs T >= " << T_star
+        << " s under these bounds (minimum time, the least duration found feasible), requested "
+           "duration <= "
+        << problem.duration << " s";
+    result.message = why.str() + result.message;
+    return result;
   }
   if (problem.time_margin > 0.0) {
-    effort.duration = (1.0 + problem.time_margin) * T_star;
-    SolverOptions o = remaining();
-    o.warm_start = &found->best.maneuver;
-    result = planAtResolution(effort, o);
-    ++solves;
+    const std::vector<Attempt> search_trail = result.attempts;
+    const Maneuver at_minimum_time = result.maneuver;
+    result = planFromMinimumTimePlan(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
+                                     withRemainingBudget(options, start));
+    std::vector<Attempt> attempts = search_trail;
+    for (Attempt& a : attempts) a.kept = false;
+    for (Attempt a : result.attempts) {
+      a.stage = AttemptStage::MinimumTimeMargin;
+      attempts.push_back(a);
+    }
+    result.attempts = attempts;
+    std::ostringstream note;
+    note << "; planned at (1 + " << problem.time_margin << ") T* = " << result.duration
+         << " s from the T* plan (minimum time T* = " << T_star << " s)";
+    result.message += note.str();
   }
   result.minimum_duration = T_star;
-  std::ostringstream note;
-  // T* is the least duration the interior point found feasible: an upper bound on the true
-  // minimum (a false "infeasible" below it cannot be told from a true one; docs/minimum_time.md).
-  note << "; minimum time T* = " << T_star << " s, the least duration found feasible, from the "
-       << found->start << " start (bracket [" << found->T_lo << ", " << found->T_hi
-       << "] s; starts:";
-  for (const SearchOutcome& o : outcomes) {
-    note << " " << o.start << " ";
-    if (o.feasible) {
-      note << o.T_hi << " s;";
-    } else {
-      note << "none feasible;";
-    }
-  }
-  note << " " << solves << " minimum-effort solves"
-       << (timed_out ? ", stopped by the time budget" : "") << ")";
-  note << coarse_note;
-  if (problem.time_margin > 0.0) {
-    note << "; planned at (1 + " << problem.time_margin << ") T* = " << result.duration << " s";
-  }
-  result.message += note.str();
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PlanResult result = planAtResolution(problem, options);
+  if (result.termination != Termination::Infeasible || !std::isfinite(smallestAuthority(problem)) ||
+      problem.accuracy.active()) {
+    return result;
+  }
+  // The interior point's "infeasible" is local (its elastic form stopped at a minimum of the
+  // violation): the minimum-time problem under the same bounds backs it or refutes it.
+  PlanningProblem fastest = problem;
+  fastest.objective = Objective::MinimumTime;
+  fastest.time_margin = 0.0;
+  fastest.duration = 0.0;
+  const PlanResult minimum_time =
+      MinimumTimeSearch(fastest, withRemainingBudget(options, start)).run();
+  const auto finish = [&](PlanResult r) {
+    r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
+    r.solve_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return r;
+  };
+  std::ostringstream why;
+  if (!minimum_time.converged()) {
+    why << "infeasible (a local verdict: the minimum-time problem under the same bounds found "
+           "no feasible duration either, "
+        << terminationName(minimum_time.termination) << "): " << result.message;
+    result.message = why.str();
+    return finish(result);
+  }
+  const double T_star = minimum_time.minimum_duration;
+  if (T_star > problem.duration) {
+    why << "infeasible: needs T >= " << T_star
+        << " s under these bounds (minimum time, the least duration found feasible), requested "
+        << problem.duration << " s";
+    result.message = why.str();
+    return finish(result);
+  }
+  PlanResult again = planFromMinimumTimePlan(problem, problem.duration, minimum_time.maneuver,
+                                             withRemainingBudget(options, start));
+  why << "; started from the minimum-time plan (T* = " << T_star
+      << " s) after the first solve ended infeasible";
+  if (again.termination == Termination::Infeasible) {
+    // Feasible at T* ≤ T, yet not reached from T*'s plan: not a proof of infeasibility.
+    again.termination = Termination::NotConverged;
+    again.message = "not converged (feasible: T* = " + exactNumber(T_star) +
+                    " s <= the requested duration, but the minimum-effort solve from the "
+                    "minimum-time plan ended at an infeasible point): " +
+                    again.message;
+  }
+  again.message += why.str();
+  std::vector<Attempt> attempts = result.attempts;
+  for (Attempt a : minimum_time.attempts) {
+    a.kept = false;
+    attempts.push_back(a);
+  }
+  for (Attempt a : again.attempts) {
+    a.stage = AttemptStage::ConstrainedRetry;
+    a.start = AttemptStart::WarmStart;
+    attempts.push_back(a);
+  }
+  again.attempts = attempts;
+  return finish(again);
 }
 
 }  // namespace attitude_planner

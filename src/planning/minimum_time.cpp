@@ -320,7 +320,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   result.minimum_duration = T_star;
   std::ostringstream note;
   // T* is the least duration the interior point found feasible: an upper bound on the true
-  // minimum (a false "infeasible" below it cannot be told from a true one; docs/minimum_time.md).
+  // minimum (a false "infeasible" below it cannot be told from a true one; docs/results/minimum_time.md).
   note << "; minimum time T* = " << T_star << " s, the least duration found feasible, from the "
        << found->start << " start (bracket [" << found->T_lo << ", " << found->T_hi
        << "] s; starts:";

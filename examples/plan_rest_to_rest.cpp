@@ -25,11 +25,15 @@ int main() {
   options.time_budget_s = 5;                               // wall-time limit [s]
   const PlanResult plan = planManeuver(problem, options);  // throws InvalidInput on bad input
 
-  std::printf("%s: %s\n", terminationName(plan.termination).c_str(), plan.message.c_str());
-  std::printf("cost %.8f N^2 m^2 in %d iterations, replay miss %.1e rad\n", plan.cost,
-              plan.iterations, plan.replay_miss);
+  std::printf("%s in %d iterations: cost %.8f N^2 m^2, replay miss %.1e rad\n",
+              terminationName(plan.termination).c_str(), plan.iterations, plan.cost,
+              plan.replay_miss);
+  if (!plan.converged()) {
+    std::fprintf(stderr, "%s\n", plan.message.c_str());  // why, in words
+    return 1;
+  }
   const Vector3& tau = plan.maneuver.torque[1];  // τ_k [N m], body, k = 0..N
   std::printf("tau_1 = [%.6f, %.6f, %.6f] N m\n", tau.x(), tau.y(), tau.z());
-  return plan.converged() ? 0 : 1;
+  return 0;
 }
 // END README EXAMPLE

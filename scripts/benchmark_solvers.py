@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Driver of scripts/benchmark: runs benchmark_solvers once per process and repetition, takes
-medians, writes docs/performance.md (tables, load, commands) and docs/performance_scaling.png.
+medians, writes docs/results/performance.md (tables, load, commands) and docs/results/performance_scaling.png.
 
 Hand-written measurements that need a running ROS graph (service round trip, replay jitter) and
-the profiles live in docs/performance_notes.md and are appended verbatim.
+the profiles live in docs/notes/performance_notes.md and are appended verbatim.
 """
 import argparse
 import json
@@ -67,7 +67,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--binary", required=True)
     ap.add_argument("--scenes", required=True)
-    ap.add_argument("--docs", required=True)
+    ap.add_argument("--docs", required=True, help="directory of the generated results")
+    ap.add_argument("--notes", help="hand-written notes appended verbatim after the tables")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--limit", type=float, default=60.0, help="time cap of a peer run [s]")
@@ -154,8 +155,8 @@ def cell(m):
 def write_doc(args, sizes, rows, slew_rows, scale_rows, repeats, load_before, load_after, wall):
     L = []
     L.append("# Performance: ours against every peer, and scaling to a million steps\n")
-    L.append("Regenerate: `scripts/benchmark` (this file and `docs/performance_scaling.png`; the "
-             "sections after the tables come from `docs/performance_notes.md`). Smoke test: "
+    L.append("Regenerate: `scripts/benchmark` (this file and `docs/results/performance_scaling.png`; the "
+             "sections after the tables come from `docs/notes/performance_notes.md`). Smoke test: "
              "`test/unit/test_benchmark_solvers.cpp` runs `benchmark_solvers --quick` (no timing).\n")
     L.append("Machine: %d cores, shared with other builds. Load average (1/5/15 min) at the start "
              "%s, at the end %s; the run took %.0f s. Every figure is the median of %d runs, one "
@@ -236,9 +237,8 @@ def write_doc(args, sizes, rows, slew_rows, scale_rows, repeats, load_before, lo
                   1024 * m["peak_rss_kb"] / m["steps"], "yes" if m["converged"] else "**no**"))
     L.append("\n![scaling](performance_scaling.png)\n")
     L.extend(targets(sizes, rows, scale_rows, args.limit))
-    notes = os.path.join(args.docs, "performance_notes.md")
-    if os.path.exists(notes):
-        L.append(open(notes).read())
+    if args.notes and os.path.exists(args.notes):
+        L.append(open(args.notes).read())
     with open(os.path.join(args.docs, "performance.md"), "w") as f:
         f.write("\n".join(L) + "\n")
     with open(os.path.join(args.docs, "performance_raw.json"), "w") as f:

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Constrained planning: the interior-point path of plan_maneuver against NLopt SLSQP (the former
 fallback for binding actuator limits), and each constrained scene against the same scene without
-its constraints. Writes docs/constraints.md. Run through scripts/constraints_benchmark.
+its constraints. Writes docs/results/constraints.md. Run through scripts/constraints_benchmark.
 
 Every figure is one plan_maneuver process (wall time inside it: solve_time_s of --summary); the
 interior point is run `repeats` times and the median kept; SLSQP once, capped by --time-budget.
@@ -166,7 +166,7 @@ def main():
                "the clipped unconstrained optimum). Machine: shared, 2 cores; times vary by "
                "~2x between runs.\n" % (repeats, args.slsqp_cap, args.slsqp_cap))
     out.append("What the figures mean and which targets of issue 16 they meet: "
-               "[constraints_notes.md](constraints_notes.md) (written by hand).\n")
+               "[constraints_notes.md](../notes/constraints_notes.md) (written by hand).\n")
     out.append("## scenes/torque_limited.yaml (per-axis limits bind), new vs old\n")
     out.append("| N | interior point | iterations (Newton + IP) | SLSQP | SLSQP status | cost IP | "
                "cost SLSQP | relative difference | max violation IP | active |")

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/accuracy.md and its plots from the raw data of accuracy_study (issue 6).
+"""Writes docs/results/accuracy.md and its plots from the raw data of accuracy_study (issue 6).
 
 usage: plot_accuracy.py RAW.json DOCS_DIR
 """
@@ -115,8 +115,8 @@ rest_paper = by[("rest_to_rest", "paper")]
 
 w("# What accuracy costs in time")
 w("")
-w("Regenerate: `scripts/accuracy` (this file, `docs/accuracy_vs_steps.png`, "
-  "`docs/accuracy_vs_time.png` and the raw data `docs/accuracy_raw.json`; tool "
+w("Regenerate: `scripts/accuracy` (this file, `docs/results/accuracy_vs_steps.png`, "
+  "`docs/results/accuracy_vs_time.png` and the raw data `docs/results/accuracy_raw.json`; tool "
   "`src/tools/accuracy_study.cpp`, plots `scripts/plot_accuracy.py`). Tests: "
   "`test/unit/test_accuracy.cpp`.")
 w("")
@@ -153,7 +153,7 @@ w("- **For a 1e-6 rad terminal attitude miss on the seed's rest-to-rest example 
 w("- **`second_order` converges at order 2 in every measure** (effort, trajectory, torque at every "
   "node, attitude and velocity miss): its boundary velocities act at the instants 0 and T through "
   "the node momenta, the end torques are unknowns and the cost is the trapezoidal rule "
-  "(docs/second_order.md). `paper` and `variational` stay as the seed has them: cost, trajectory and "
+  "(docs/design/second_order.md). `paper` and `variational` stay as the seed has them: cost, trajectory and "
   "torque errors of order 1, the physical miss of order 2 only with `variational`. The seed's "
   "\"effective order two\" (Sec. 3.4) does not hold for them as measured.")
 # The issue's torque target: relative torque error <= 1e-6 on the seed's rest-to-rest example.
@@ -161,7 +161,7 @@ fo_case = by[("rest_to_rest", "fourth_order")]
 fo = fo_case["sweep"]
 w("- **`fourth_order` converges at order 4** (effort, trajectory, torque, attitude and velocity "
   "miss; table below): it is one Richardson extrapolation step of `second_order` (plans at N and "
-  "2N combined node by node, docs/fourth_order.md), not a new discretization, and costs one "
+  "2N combined node by node, docs/design/fourth_order.md), not a new discretization, and costs one "
   "`second_order` solve at N plus one at 2N (≈ 3× a `second_order` solve at N). Its torque "
   "error reaches the round-off floor of the `second_order` torques (≈ eps·(2N)², second "
   "differences of attitudes) near N = 512, so its least-squares torque order over N = %d … %d is "
@@ -259,7 +259,7 @@ w("")
 w("`second_order` removes defects 1 and 3 (the boundary velocities act at t = 0 and T through the "
   "node momenta Π_0 = JΩ(0), Π_N = JΩ(T), with the end torques τ_0, τ_N as unknowns and the "
   "trapezoidal weights ½ at the ends) and uses the symmetric integrator of item 2: "
-  "docs/second_order.md derives it.")
+  "docs/design/second_order.md derives it.")
 w("")
 w("1. **The boundary velocities are held over a whole step.** The discrete problem fixes "
   "R_1 = R_0 exp(hΩ_0) and R_{N−1} = R_N exp(−hΩ_{N−1}): the prescribed velocity acts over the "
@@ -282,7 +282,7 @@ w("2. **The `paper` scheme is a first-order integrator of the rigid body.** Its 
 w("3. **The terminal velocity miss stays order 1 when Ω_T ≠ 0** (slew-up, both schemes): Ω_{N−1} "
   "is imposed on the last step (paper: its mean velocity; variational: the velocity at its start, "
   "t_{N−1}), h/2 or h before T.")
-w("4. The seed's printed necessary conditions drop a dexp factor (docs/necessary_conditions.md); "
+w("4. The seed's printed necessary conditions drop a dexp factor (docs/results/necessary_conditions.md); "
   "that does not enter here: the planner minimizes the discrete cost exactly (Newton on the exact "
   "gradient), so these orders belong to the discretization, not to a solver defect.")
 w("")

@@ -4,9 +4,9 @@ the intersection of the sphere C = |p|^2 = const (Casimir) with the paraboloid
 H = (p1^2/c1 + p2^2/c2)/2 + p3 = const (reduced Hamiltonian).
 
 Reads the CSV written by `drift_two_input_example` (columns orbit,c1,c2,t,p1,p2,p3,H,C; orbit 0 is
-the worked example's extremal) and writes docs/drift_two_input_sphere.png.
+the worked example's extremal) and writes docs/results/drift_two_input_sphere.png.
 Run with /usr/bin/python3 (numpy, matplotlib):
-  /usr/bin/python3 scripts/plot_drift_two_input.py [docs/drift_two_input_orbits.csv] [out.png]
+  /usr/bin/python3 scripts/plot_drift_two_input.py [docs/results/drift_two_input_orbits.csv] [out.png]
 """
 import csv
 import sys
@@ -19,8 +19,8 @@ import numpy as np  # noqa: E402
 
 
 def main():
-    src = sys.argv[1] if len(sys.argv) > 1 else "docs/drift_two_input_orbits.csv"
-    out = sys.argv[2] if len(sys.argv) > 2 else "docs/drift_two_input_sphere.png"
+    src = sys.argv[1] if len(sys.argv) > 1 else "docs/results/drift_two_input_orbits.csv"
+    out = sys.argv[2] if len(sys.argv) > 2 else "docs/results/drift_two_input_sphere.png"
     orbits = {}
     with open(src) as f:
         for row in csv.DictReader(f):

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/frontier.md and docs/frontier.png from the raw data of frontier_study (issue 18).
+"""Writes docs/results/frontier.md and docs/results/frontier.png from the raw data of frontier_study (issue 18).
 
 usage: plot_frontier.py RAW.json DOCS_DIR [COMMAND]
 
@@ -164,7 +164,7 @@ out = []
 w = out.append
 w("# Accuracy versus solve time: our schemes beside IPOPT on Hermite–Simpson collocation")
 w("")
-w("Regenerate: `%s` (this file, `docs/frontier.png` and the raw data `docs/frontier_raw.json`; "
+w("Regenerate: `%s` (this file, `docs/results/frontier.png` and the raw data `docs/results/frontier_raw.json`; "
   "study `studies/frontier_study.cpp`, peer `test/support/hermite_simpson.hpp`, report and plot "
   "`scripts/plot_frontier.py`). Tests: `test/unit/test_hermite_simpson.cpp` (the peer's exact "
   "Jacobian and Hessian against finite differences, its rows on the continuous optimum, and a "
@@ -207,7 +207,7 @@ w("")
 w("## What is measured")
 w("")
 w("The continuous reference is the Pontryagin optimum of `analysis/continuous_reference.hpp` "
-  "(accurate to ~1e-13; docs/accuracy.md). With τ(t) its torque and τ_max = max_t |τ(t)| "
+  "(accurate to ~1e-13; docs/results/accuracy.md). With τ(t) its torque and τ_max = max_t |τ(t)| "
   "(4001 samples):")
 w("")
 peer_runs = [r for c in cases for m in c["methods"] if m["method"] == PEER for r in good_runs(m)]
@@ -260,7 +260,7 @@ w("Exact derivatives, hand-derived (f is polynomial of degree 2): sparse Jacobia
   "MUMPS with its default ordering, tol = "
   "constr_viol_tol = %g, max_iter 3000. The problem has equalities only, so IPOPT is a Newton "
   "method on the KKT system here: %d–%d iterations at every N. Tuning checks (one-off, "
-  "docs/frontier_notes.md): tol 1e-8 or 1e-6 instead changed the time by ≤ 25 %%, and no other "
+  "docs/notes/frontier_notes.md): tol 1e-8 or 1e-6 instead changed the time by ≤ 25 %%, and no other "
   "MUMPS ordering was consistently faster (AMD at most ~2× at N = 1024); neither would move a "
   "torque-error level across the 10× line. The start is the geodesic our solver also starts from: "
   "q(t) = q_0 ⊗ e(tφ/T), φ = log(R_0ᵀR_T), Ω = φ/T between the ends, τ = −(JΩ)×Ω."
@@ -303,7 +303,7 @@ for c in cases:
             c["scene"], m["method"], order(m, "torque_error"), order(m, "effort_error"),
             order(m, "attitude_error"), best["torque_error"], best["N"]))
 w("")
-w("What this means, and what would close the gap: [frontier_notes.md](frontier_notes.md) "
+w("What this means, and what would close the gap: [frontier_notes.md](../notes/frontier_notes.md) "
   "(hand-written, from this run).")
 w("")
 w("## Raw sweeps")

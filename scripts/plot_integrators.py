@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots the long-run energy behaviour written by integrator_study (docs/energy_*.csv)."""
+"""Plots the long-run energy behaviour written by integrator_study (docs/results/energy_*.csv)."""
 import csv
 import sys
 
@@ -8,7 +8,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-out = sys.argv[1] if len(sys.argv) > 1 else "docs"
+out = sys.argv[1] if len(sys.argv) > 1 else "docs/results"
 fig, axes = plt.subplots(1, 2, figsize=(11, 4))
 for scheme, ax in zip(["paper", "variational"], axes):
     t, e, p = [], [], []

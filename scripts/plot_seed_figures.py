@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Figures like the seed's Figs. 2-7 from the CSVs written by seed_report (docs/seed_*.csv)."""
+"""Figures like the seed's Figs. 2-7 from the CSVs written by seed_report (docs/results/seed_*.csv)."""
 import sys
 
 import matplotlib
@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-out = sys.argv[1] if len(sys.argv) > 1 else "docs"
+out = sys.argv[1] if len(sys.argv) > 1 else "docs/results"
 TITLES = {"rest_to_rest": "rest-to-rest, pi/3 about x", "slew_up": "slew-up, pi/6 about x"}
 
 

@@ -2,7 +2,7 @@
 // continuous reference, then plans at N = 16, 32, ..., max and records the three accuracy
 // measures (accuracy.hpp) and the median solve time; then plans to requested accuracies and
 // compares the planner's estimate with the actual error. Writes one JSON object (raw data for
-// scripts/plot_accuracy.py, which writes docs/accuracy.md and the plots).
+// scripts/plot_accuracy.py, which writes docs/results/accuracy.md and the plots).
 //
 // usage: accuracy_study OUT.json SCENE.yaml... [--max-steps N] [--repeats K]
 #include <algorithm>

@@ -1,6 +1,6 @@
 // benchmark_solvers: one solve of the seed's discrete problem (seed 000, Problem 3.2) by one
 // solver, timed, with its peak memory; scripts/benchmark runs it once per process and repetition
-// and writes docs/performance.md.
+// and writes docs/results/performance.md.
 //
 // Solvers (all on the same discrete problem; every result is replayed through evaluatePlan so the
 // reported cost and terminal miss are measured the same way for all of them):
@@ -1034,7 +1034,7 @@ Eigen::Matrix<S, 4, 1> quaternionTimes(const Eigen::Matrix<S, 4, 1>& p,
 }
 
 /// The seed's system, 3(2N−3) equations in x = (τ_1..τ_{N−1}, Ω_1..Ω_{N−2}):
-///   h² × corrected eq. (28), k = 2..N−2 (docs/necessary_conditions.md)
+///   h² × corrected eq. (28), k = 2..N−2 (docs/results/necessary_conditions.md)
 ///   J Ω_k − exp(hΩ_k)ᵀ (h τ_k + J Ω_{k−1}), k = 1..N−1 (eq. (18))
 ///   log(R_Nᵀ R_0 Π_k exp(hΩ_k)) (terminal attitude, through quaternions)
 template <typename S>

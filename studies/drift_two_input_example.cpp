@@ -1,7 +1,7 @@
-// Worked example of the drift + two-input problem (seed 001) for docs/drift_two_input.md:
+// Worked example of the drift + two-input problem (seed 001) for docs/design/drift_two_input.md:
 // plans a maneuver, checks the closed forms of Prop. 4.2/4.3 against the flow, and writes the
 // CSVs that scripts/plot_drift_two_input.py plots.
-//   drift_two_input_example [output_dir]    (default: docs)
+//   drift_two_input_example [output_dir]    (default: docs/results)
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -91,7 +91,7 @@ void closedFormTable() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : "docs";
+  const std::string dir = argc > 1 ? argv[1] : "docs/results";
   DriftTwoInputRequest rq;
   rq.g0 = Matrix3::Identity();
   rq.g1 = so3::fromAxisAngle(Vector3(1, 1, 0), 1.2);

@@ -1,5 +1,5 @@
-// Measures what the effects cost and what they change (issue 8). Writes docs/effects.md.
-// Usage: effects_report [SCENE_DIR=scenes] [OUT_DIR=docs]
+// Measures what the effects cost and what they change (issue 8). Writes docs/results/effects.md.
+// Usage: effects_report [SCENE_DIR=scenes] [OUT_DIR=docs/results]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -45,7 +45,7 @@ double miss(const PlanningProblem& p, const std::vector<Vector3>& torque,
 
 int main(int argc, char** argv) {
   const std::string scenes = argc > 1 ? argv[1] : "scenes";
-  const std::string out = argc > 2 ? argv[2] : "docs";
+  const std::string out = argc > 2 ? argv[2] : "docs/results";
   FILE* md = std::fopen((out + "/effects.md").c_str(), "w");
   if (!md) return std::fprintf(stderr, "cannot write %s/effects.md\n", out.c_str()), 1;
   const Scene leo = loadScene(scenes + "/leo_slew.yaml");

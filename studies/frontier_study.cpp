@@ -7,8 +7,8 @@
 //             test/support/hermite_simpson.hpp) at N = 4, 6, 8, 12, ... mesh intervals,
 // all cold (from the geodesic), solve time the median of --repeats runs, and records the
 // relative torque error at the mesh nodes, the relative effort error and the solve time. Writes
-// one JSON object (raw data for scripts/plot_frontier.py, which writes docs/frontier.md and
-// docs/frontier.png).
+// one JSON object (raw data for scripts/plot_frontier.py, which writes docs/results/frontier.md and
+// docs/results/frontier.png).
 //
 // Accuracy (the same for every method): with τ(t) the continuous optimum and
 // τ_max = max_t |τ(t)| (sampled at 4001 points),

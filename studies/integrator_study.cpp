@@ -1,6 +1,6 @@
 // Measures the integrators (issue 2): long-run energy and momentum behaviour of both schemes on the
-// free rigid body, and the seed's SO(2) check (Fig. 1). Writes docs/integrators.md and CSVs for
-// the plot script. Usage: integrator_study [OUT_DIR=docs]
+// free rigid body, and the seed's SO(2) check (Fig. 1). Writes docs/results/integrators.md and CSVs for
+// the plot script. Usage: integrator_study [OUT_DIR=docs/results]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -97,7 +97,7 @@ So2Error so2Check(SchemeKind kind, int N) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string out = argc > 1 ? argv[1] : "docs";
+  const std::string out = argc > 1 ? argv[1] : "docs/results";
   FILE* md = std::fopen((out + "/integrators.md").c_str(), "w");
   if (!md) {
     std::fprintf(stderr, "cannot write %s/integrators.md\n", out.c_str());
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
   }
   std::fprintf(md,
                "# Integrators: measured behaviour\n\n"
-               "Regenerate: `scripts/integrator_study` (runs `integrator_study docs` and the plot "
+               "Regenerate: `scripts/integrator_study` (runs `integrator_study docs/results` and the plot "
                "script).\n\n"
                "## Free rigid body over T = 2000 s\n\n"
                "J = diag(1, 2, 3) kg m², Ω0 = (0.6, 0.5, 0.4) rad/s, h = 0.01 s, 200 000 steps, "

@@ -1,7 +1,7 @@
 // Reproduces the seed's two examples (seed 000, Sec. 4) with both schemes and checks the seed's
-// printed necessary conditions at the optimum. Writes docs/seed_examples.md,
-// docs/necessary_conditions.md and one CSV per example/scheme for scripts/plot_seed_figures.py.
-// Usage: seed_report [SCENE_DIR=scenes] [OUT_DIR=docs]
+// printed necessary conditions at the optimum. Writes docs/results/seed_examples.md,
+// docs/results/necessary_conditions.md and one CSV per example/scheme for scripts/plot_seed_figures.py.
+// Usage: seed_report [SCENE_DIR=scenes] [OUT_DIR=docs/results]
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -31,7 +31,7 @@ double medianSolveTime(const PlanningProblem& p, int repeats) {
 
 int main(int argc, char** argv) {
   const std::string scenes = argc > 1 ? argv[1] : "scenes";
-  const std::string out = argc > 2 ? argv[2] : "docs";
+  const std::string out = argc > 2 ? argv[2] : "docs/results";
   FILE* md = std::fopen((out + "/seed_examples.md").c_str(), "w");
   if (!md) return std::fprintf(stderr, "cannot write to %s\n", out.c_str()), 1;
   std::fprintf(

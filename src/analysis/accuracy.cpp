@@ -94,12 +94,12 @@ AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver&
 }
 
 double measuredOrder(SchemeKind scheme, AccuracyMeasure measure) {
-  // Least-squares slopes over N = 64..16384 on both seed examples (docs/accuracy.md, "Observed
+  // Least-squares slopes over N = 64..16384 on both seed examples (docs/results/accuracy.md, "Observed
   // orders"); test_accuracy.cpp checks them on a small sweep. The cost converges at order 1 in
   // both schemes (the boundary data Ω_0, Ω_{N−1} hold over a whole step: the maneuver is
   // effectively h shorter); the attitude miss at order 2 only for the variational scheme.
   // second_order: order 2 in every measure; fourth_order (its Richardson extrapolation): order 4
-  // in every measure (docs/accuracy.md, docs/fourth_order.md).
+  // in every measure (docs/results/accuracy.md, docs/design/fourth_order.md).
   if (scheme == SchemeKind::SecondOrder) return 2.0;
   if (scheme == SchemeKind::FourthOrder) return 4.0;
   switch (measure) {
@@ -117,7 +117,7 @@ namespace {
 
 /// The order planToAccuracy assumes: the measured one, but for the cost error of a problem with
 /// node constraints at most 1 (the bounds' active sets start and end between nodes, so the
-/// smooth-case order need not hold; docs/fourth_order.md measured none on torque_limited): the
+/// smooth-case order need not hold; docs/design/fourth_order.md measured none on torque_limited): the
 /// Richardson estimate |ΔC|/(2^p − 1) is then an upper bound rather than an underestimate. The
 /// terminal miss is measured by the replay whatever the order, which only steers the prediction.
 double assumedOrder(const PlanningProblem& problem, SchemeKind scheme, AccuracyMeasure measure) {

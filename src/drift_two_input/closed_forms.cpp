@@ -1,4 +1,4 @@
-// Closed forms of seed 001, Prop. 4.2 and Prop. 4.3, re-derived (docs/drift_two_input.md).
+// Closed forms of seed 001, Prop. 4.2 and Prop. 4.3, re-derived (docs/design/drift_two_input.md).
 //
 // Prop. 4.3 in brief (c2 < c1): with h0 = H(p0), c0 = C(p0), s = √(h0² − c0), α = h0 + s,
 // β = h0 − s, the Möbius substitution p3 = (α − βφ)/(1 − φ) turns (4.22) into

@@ -1,5 +1,5 @@
 // Shooting for the drift + two-input BVP (seed 001, (3.8)–(3.10)); see the header and
-// docs/drift_two_input.md ("Planner").
+// docs/design/drift_two_input.md ("Planner").
 #include "attitude_planner/drift_two_input/planner.hpp"
 
 #include <Eigen/Cholesky>

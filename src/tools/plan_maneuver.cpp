@@ -38,7 +38,7 @@ const char* const kUsage =
     "                            with a --target-* flag only)\n"
     "  --target-miss RAD         instead of --steps: choose N so that the terminal attitude miss\n"
     "                            of the torques held over the steps on the continuous body is\n"
-    "                            <= RAD (rigid_body; docs/accuracy.md)\n"
+    "                            <= RAD (rigid_body; docs/results/accuracy.md)\n"
     "  --target-cost-error E     instead of --steps: choose N so that |h cost - continuous cost|\n"
     "                            <= E [N^2 m^2 s] (Richardson estimate; rigid_body)\n"
     "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check (rigid_body)\n"

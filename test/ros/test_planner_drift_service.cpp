@@ -13,7 +13,7 @@ namespace rc = attitude_planner::ros_conversions;
 
 namespace {
 
-/// g1 of the worked example (docs/drift_two_input.md): 1.2 rad about (1, 1, 0)/√2.
+/// g1 of the worked example (docs/design/drift_two_input.md): 1.2 rad about (1, 1, 0)/√2.
 Matrix3 workedTarget() {
   return so3::fromAxisAngle(Vector3(1, 1, 0), 1.2);
 }
@@ -75,7 +75,7 @@ TEST_F(PlannerDriftService, WorkedExampleReachesTheTargetAttitude) {
     EXPECT_EQ(m.control[k].z, 0.0);
   }
   EXPECT_EQ(rc::vectorFromMsg(m.costate.front()), rc::vectorFromMsg(res.initial_costate));
-  // The worked example's least-cost extremal found (docs/drift_two_input.md, issue 19): cost
+  // The worked example's least-cost extremal found (docs/design/drift_two_input.md, issue 19): cost
   // 3.752939785 at every N; the extremal of cost 4.02383 returned before is reported among the
   // others.
   EXPECT_NEAR(res.cost, 3.752939785104, 1e-9);
@@ -83,7 +83,7 @@ TEST_F(PlannerDriftService, WorkedExampleReachesTheTargetAttitude) {
 }
 
 TEST_F(PlannerDriftService, GuessSelectsAnotherExtremal) {
-  // docs/drift_two_input.md, non-uniqueness: g1 = exp(3 E3) in T = 3 s is the uncontrolled drift
+  // docs/design/drift_two_input.md, non-uniqueness: g1 = exp(3 E3) in T = 3 s is the uncontrolled drift
   // (cost 0) from the default starts; the guess (2, 1, 0) selects an extremal that spends
   // control effort (cost 9.17592).
   PlanDriftTwoInput::Request r = workedExample();

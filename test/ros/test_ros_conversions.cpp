@@ -98,7 +98,7 @@ TEST(RosConversions, BadFieldsAreNamedWithTheirValue) {
 
 TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
   // Issue 7: every bad request is refused with a specific message and code, never a crash. With
-  // AP_BAD_INPUT_TABLE=<file> the rows are also written as markdown (docs/robustness.md).
+  // AP_BAD_INPUT_TABLE=<file> the rows are also written as markdown (docs/results/robustness.md).
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   struct Case {

@@ -1,4 +1,4 @@
-// Focused ASan + UBSan check of the drift + two-input planner alone (docs/sanitizers.md): both
+// Focused ASan + UBSan check of the drift + two-input planner alone (docs/notes/sanitizers.md): both
 // drift scenes at N = 60 … 4000, a time-budget stop, a guess, the free drift, multiple shooting and
 // a target about e3 (the linearized starts). Not part of the catkin build. From the repository
 // root, with F = -fsanitize=address,undefined -fno-sanitize-recover=undefined:

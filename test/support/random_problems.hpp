@@ -1,6 +1,6 @@
 // Issue 19, item 5: a seeded generator of random planning problems, shared by the CI-sized gtest
 // (test/unit/test_random_suite.cpp) and the full-size study (benchmark_solvers --random-suite,
-// run by scripts/robustness --random, which writes the table in docs/robustness.md).
+// run by scripts/robustness --random, which writes the table in docs/results/robustness.md).
 //
 // Each case draws, from its own seed (so any case can be re-planned alone):
 //   inertia     physical (J = tr(S) I − S for a random second moment S ≻ 0 — the triangle

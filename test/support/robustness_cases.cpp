@@ -294,7 +294,7 @@ void spinningEnds(Recorder& r) {
   p.final_velocity = Vector3(3, 0, 0);
   const PlanResult res = r.plan("Ω (0,0,5) → (3,0,0) rad/s, 1 rad about x, N = 128", p);
   // Measured 168 from the Hermite guess (~10 turns away from the extremal's shape): within the
-  // default iteration limit, not fast (see docs/robustness.md). Both lifts are about equally near
+  // default iteration limit, not fast (see docs/results/robustness.md). Both lifts are about equally near
   // the coasting displacement, so the other one is solved too (152 more), and a solve above 40
   // iterations from the more starts (session 28: 408 in all, with the inertia homotopy): what is
   // asserted is that no level of the kept solve needed more than the default limit.
@@ -354,7 +354,7 @@ void slowManeuver(Recorder& r, int steps, double terminal_bound) {
   const PlanResult ref = r.plan("N = 1000 (reference)", coarse);
   const PlanResult res = r.plan("N = " + std::to_string(steps), p, {}, terminal_bound);
   // h·C approximates ½∫|τ|²dt: the grids agree to O(h) (the paper scheme's Ω is first order,
-  // docs/integrators.md; measured 2.7e-3 between N = 1e3 and 1e4).
+  // docs/results/integrators.md; measured 2.7e-3 between N = 1e3 and 1e4).
   const double hc = res.cost * p.duration / steps, hc_ref = ref.cost * p.duration / 1000;
   r.atMost("|h·C(N) − h·C(1000)| / h·C(1000)", std::abs(hc - hc_ref) / hc_ref, 1e-2);
 }

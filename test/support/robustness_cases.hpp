@@ -2,7 +2,7 @@
 // integrates) one or more problems and checks its pass criterion, recording every figure it
 // measured. One catalog, two readers: test/unit/test_hard_cases.cpp asserts every check (the
 // slow cases only under ATTITUDE_PLANNER_SLOW_TESTS=1, i.e. `scripts/test --all`), and the tool
-// `robustness_report` writes the same figures into docs/robustness.md (`scripts/robustness`).
+// `robustness_report` writes the same figures into docs/results/robustness.md (`scripts/robustness`).
 #pragma once
 
 #include <functional>

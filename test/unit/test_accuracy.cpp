@@ -124,7 +124,7 @@ TEST(ZeroOrderHold, TorqueFreeAnisotropicBodyConservesEnergyAndMomentum) {
   EXPECT_GT((W - W0).norm(), 0.1);  // the body did tumble
 }
 
-// The orders the planner relies on (measuredOrder, docs/accuracy.md) hold on a small sweep of
+// The orders the planner relies on (measuredOrder, docs/results/accuracy.md) hold on a small sweep of
 // both seed examples and all schemes (property test: ±0.2). Trajectory and torque errors are
 // documented as order 1 for paper and variational, 2 for second_order (which also has order 2
 // in the velocity miss, ≥ 1.9 being the target).

@@ -1,5 +1,5 @@
 // Between nodes: how far a constraint met at the nodes can be violated by the motion between two
-// nodes, R_k exp(s ω_k^), s ∈ [0, 1] (docs/constraints_notes.md "Between nodes"), checked by
+// nodes, R_k exp(s ω_k^), s ∈ [0, 1] (docs/notes/constraints_notes.md "Between nodes"), checked by
 // sampling that motion; and the cone `margin`, which keeps the continuous motion within the
 // stated limit where the unmargined plan leaves it.
 #include <gtest/gtest.h>

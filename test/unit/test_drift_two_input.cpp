@@ -15,7 +15,7 @@ TEST(DriftTwoInputFlow, VectorFieldIsSeedEquations315To317) {
   const DriftTwoInputWeights w{2.0, 0.5};
   const Vector3 p(0.3, -1.1, 0.7);
   const Vector3 f = dti::costateRate<double>(p, w);
-  // printed (3.15)–(3.17), verified correct (see docs/drift_two_input.md)
+  // printed (3.15)–(3.17), verified correct (see docs/design/drift_two_input.md)
   EXPECT_NEAR(f.x(), -p.y() * p.z() / w.c2 + p.y(), 1e-15);
   EXPECT_NEAR(f.y(), p.x() * p.z() / w.c1 - p.x(), 1e-15);
   EXPECT_NEAR(f.z(), (1 / w.c2 - 1 / w.c1) * p.x() * p.y(), 1e-15);
@@ -49,7 +49,7 @@ TEST(DriftTwoInputFlow, CasimirAndHamiltonianConservedOverLongRuns) {
 
 TEST(DriftTwoInputFlow, SpatialCostateIsConservedWhichFixesTheSignOfTheLiePoissonEquations) {
   // First-order optimality of the fixed-endpoint problem requires μ = g p to be constant
-  // (docs/drift_two_input.md): with the opposite sign, ṗ = −p × ∇H, μ would rotate.
+  // (docs/design/drift_two_input.md): with the opposite sign, ṗ = −p × ∇H, μ would rotate.
   const DriftTwoInputWeights w{0.7, 1.9};
   const Vector3 p0(0.9, 0.4, -1.2);
   const Matrix3 g0 = so3::exp(Vector3(0.2, -0.4, 1.0));

@@ -11,7 +11,7 @@ namespace ap = attitude_planner;
 
 namespace {
 
-/// p(0) of the worked example's extremal (docs/drift_two_input.md): g0 = I, T = 3 s, c = (1, 2).
+/// p(0) of the worked example's extremal (docs/design/drift_two_input.md): g0 = I, T = 3 s, c = (1, 2).
 const ap::Vector3 kWorkedP0(-1.606814211891, -0.932477257024, -1.274829991641);
 const ap::DriftTwoInputWeights kWeights{1.0, 2.0};
 

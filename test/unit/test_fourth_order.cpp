@@ -1,5 +1,5 @@
 // fourth_order: one Richardson extrapolation step of the time-symmetric second_order scheme
-// (docs/fourth_order.md). Orders against the continuous reference on small sweeps, the isotropic
+// (docs/design/fourth_order.md). Orders against the continuous reference on small sweeps, the isotropic
 // closed form, equivariance, the cubic hold and its RKMK4 replay, and the refusals.
 #include <gtest/gtest.h>
 
@@ -35,7 +35,7 @@ double maxTorque(const Maneuver& m) {
 }  // namespace
 
 // The orders on N = 32 … 256 (below the torque's round-off floor eps·(2N)², which the
-// extrapolation reaches at N ≈ 512: docs/fourth_order.md). The documented order is 4.
+// extrapolation reaches at N ≈ 512: docs/design/fourth_order.md). The documented order is 4.
 TEST(FourthOrder, SmallSweepMeasuresOrderFourInEveryMeasure) {
   for (bool slew_up : {false, true}) {
     PlanningProblem p = seedProblem(slew_up);
@@ -319,11 +319,11 @@ TEST(FourthOrder, SceneKeyAndAutoChoice) {
 // With node constraints both second_order solves go through the interior point (exact Hessians,
 // the same band): the extrapolated plan meets the bounds, reports them, and its effort is closer
 // to the converged one than second_order's at the same N (no order is claimed with active
-// constraints: docs/fourth_order.md).
+// constraints: docs/design/fourth_order.md).
 TEST(FourthOrder, ConstrainedScenesPlanThroughTheInteriorPoint) {
   struct Case {
     const char* scene;
-    double converged_effort;  // second_order at N = 8192 (docs/second_order.md)
+    double converged_effort;  // second_order at N = 8192 (docs/design/second_order.md)
   };
   for (const Case& c : {Case{"sun_keep_out", 0.0959376}, Case{"torque_limited", 0.8299004},
                         Case{"rate_limited", 0.9637895}}) {

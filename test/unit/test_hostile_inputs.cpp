@@ -2,7 +2,7 @@
 // refused by the scene parser with InvalidInput naming the file, the field and the value, and by
 // plan_maneuver with exit status 1 and the same message, never a crash or a hang. Solver options
 // and the time budget are checked at the core. The same files seed the fuzz corpus (scripts/fuzz)
-// and the bad-input table of docs/robustness.md (scripts/robustness).
+// and the bad-input table of docs/results/robustness.md (scripts/robustness).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>

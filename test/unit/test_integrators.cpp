@@ -107,7 +107,7 @@ TEST(Integrators, VariationalEnergyDoesNotDriftOver2000Seconds) {
 }
 
 TEST(Integrators, PaperEnergyDecaysToMajorAxisSpin) {
-  // Finding (docs/integrators.md): the printed scheme conserves momentum but dissipates energy;
+  // Finding (docs/results/integrators.md): the printed scheme conserves momentum but dissipates energy;
   // the body ends in pure spin about the major axis, E = |π|²/(2 J_max).
   const Matrix3 J = Vector3(1, 2, 3).asDiagonal();
   const int N = 200000;
@@ -148,7 +148,7 @@ TEST(Integrators, So2CheckErrorDecreasesAtObservedOrder) {
       theta_error.push_back(et);
       omega_error.push_back(ew);
     }
-    // Measured (docs/integrators.md): θ converges at order 2, ω at order 1 (left-point torque).
+    // Measured (docs/results/integrators.md): θ converges at order 2, ω at order 1 (left-point torque).
     EXPECT_NEAR(std::log2(theta_error[0] / theta_error[1]), 2.0, 0.1) << schemeName(kind);
     EXPECT_NEAR(std::log2(omega_error[0] / omega_error[1]), 1.0, 0.1) << schemeName(kind);
   }

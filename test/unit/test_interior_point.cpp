@@ -537,7 +537,7 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
 
 // N = 10⁵ with torque and rate limits (issue 16's target case, ~8 s): converges since the Newton
 // system is formed and factored in double-double (before, in long double and double, its finest
-// level stopped: the line search failed on wrong directions, docs/constraints_notes.md). The
+// level stopped: the line search failed on wrong directions, docs/notes/constraints_notes.md). The
 // plan meets every node constraint, checked from its own attitudes and torques, satisfies the
 // discrete equations step by step and the first-order conditions.
 TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5Converge) {
@@ -554,7 +554,7 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5Converge) {
   EXPECT_LE(check.max_violation, 1e-9);
   EXPECT_GT(check.active, 100000);  // τ and rate bounds bind over most of the maneuver
   // The effort h·Σ½|τ|² is the continuous one to O(h): within 1e-3 of N = 8192's (1.0546 there,
-  // docs/constraints.md), and not above it by more than that.
+  // docs/results/constraints.md), and not above it by more than that.
   EXPECT_NEAR(r.cost * p.duration / p.steps, 1.0546, 2e-3);
 }
 
@@ -678,7 +678,7 @@ TEST(InteriorPoint, PredictorCorrectorReachesIpoptsOptimumAtN2048) {
   // corrector. Its barrier floor (μ ≥ 0.01 (N/1024)² d² f/m) keeps μ from outrunning the iterate:
   // without it torque_limited at N = 2048 stopped 2.4e-7 above the optimum (and the former
   // elastic-first solver 2.6e-9 above). IPOPT's optimum of the same discrete problem (exact
-  // Hessian, tol 1e-12; docs/constraints.md): 133.097692032.
+  // Hessian, tol 1e-12; docs/results/constraints.md): 133.097692032.
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_NEAR(r.cost, 133.097692032, 1e-9 * 133.1) << r.message;
@@ -695,7 +695,7 @@ TEST(InteriorPoint, PredictorCorrectorNeedsFewIterations) {
   ASSERT_TRUE(r.converged()) << r.message;
   ASSERT_FALSE(r.levels.empty());
   EXPECT_LE(r.levels.back().iterations, 18) << r.levels.back().reason;
-  EXPECT_NEAR(r.cost, 8.63484875423, 1e-10 * 8.63) << "SLSQP's optimum (docs/constraints.md)";
+  EXPECT_NEAR(r.cost, 8.63484875423, 1e-10 * 8.63) << "SLSQP's optimum (docs/results/constraints.md)";
 }
 
 TEST(InteriorPoint, FinerLevelsStartFromTheCoarserMultipliers) {

@@ -137,7 +137,7 @@ TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {
   // J = I, |u_i| ≤ 1, 180° about z: the eigenaxis slew takes 2√π = 3.5449 s; the time-optimal
   // one nutates (published 3.2430 s). At N = 32 the search must find a nutating plan below the
   // eigenaxis time; at N = 128 (searched from the N = 64 plan) it reaches the published T*
-  // (docs/minimum_time.md: 3.2427 s; at N = 64 the search stops at 3.286 s, +1.3 %).
+  // (docs/results/minimum_time.md: 3.2427 s; at N = 64 the search stops at 3.286 s, +1.3 %).
   ap::PlanningProblem p =
       ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_bilimoria_wie.yaml").problem;
   p.steps = 32;

@@ -304,7 +304,7 @@ TEST_F(CliTest, ReplayAppliesExactlyTheScenesEffects) {
 }
 
 TEST_F(CliTest, DriftTwoInputSceneWritesCsvAndSummaryAndReachesTheTarget) {
-  // scenes/drift_two_input.yaml: the worked example of docs/drift_two_input.md (no guess).
+  // scenes/drift_two_input.yaml: the worked example of docs/design/drift_two_input.md (no guess).
   const std::string csv = dir_ + "/drift.csv", json = dir_ + "/drift.json";
   const ToolRun r =
       run("plan_maneuver", kScenes + "drift_two_input.yaml --csv " + csv + " --summary " + json);

@@ -2,7 +2,7 @@
 // (test/support/random_problems.hpp: physical and seed-like inertias, random attitudes, boundary
 // rates up to 5 rad/s with h|Ω| ≤ 0.5, horizons up to 100 s, both schemes) must converge.
 // The full-size run with the IPOPT comparison is `scripts/robustness --random`
-// (docs/robustness.md).
+// (docs/results/robustness.md).
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -32,7 +32,7 @@ constexpr int kCiCases = 40;
 /// converges the test fails until it is removed here, so the list cannot go stale). Empty since
 /// the Levenberg–Marquardt control of the Newton shift: #1 and #25 (seed-like, variational,
 /// T ≈ 65–72 s, ~4 rad/s at both ends) converge by continuation in the boundary rates.
-/// docs/robustness.md has the full-size figures.
+/// docs/results/robustness.md has the full-size figures.
 const std::set<int> kKnownStalls = {};
 
 }  // namespace
@@ -107,7 +107,7 @@ TEST(RandomSuite, EveryCaseConverges) {
 // (#150: seed-like inertia, T = 92 s, 4.7–5 rad/s at both ends, ~70 revolutions): the direct
 // solve and the continuation in the boundary rates stall; the coasting start (the torque-free
 // motions from both ends, blended) converges. IPOPT's cost from the Hermite start is 547.642
-// (docs/robustness_random.md); ours from the coasting start is lower (measured 425.61).
+// (docs/results/robustness_random.md); ours from the coasting start is lower (measured 425.61).
 TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 150);
   const PlanResult r = planManeuver(c.problem);
@@ -124,7 +124,7 @@ TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
 // is solved from more structured starts (the other way round, one extra revolution, the coasting
 // start) and the cheapest kept, the others' costs reported in `extremal`. #192 (seed-like,
 // T = 17.6 s, 1.9 / 1.3 rad/s): the first start ends at 236.658 (64 iterations), the other way
-// round at IPOPT's 199.940 (docs/robustness_random.md).
+// round at IPOPT's 199.940 (docs/results/robustness_random.md).
 TEST(RandomSuite, SlowSpinningSolveKeepsTheCheapestOfMoreStarts) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 192);
   const PlanResult r = planManeuver(c.problem);
@@ -138,7 +138,7 @@ TEST(RandomSuite, SlowSpinningSolveKeepsTheCheapestOfMoreStarts) {
 }
 
 // Four of the more starts, each reaching an extremal at least as cheap as IPOPT's where the
-// first start did not (docs/robustness_random.md): #86 (seed-like, T = 2.64 s, rest to
+// first start did not (docs/results/robustness_random.md): #86 (seed-like, T = 2.64 s, rest to
 // 0.9 rad/s) on the requested grid directly reaches IPOPT's 53926.017, where every start through
 // the coarser grids with the trust region ends at 83088.8 (the line search's reaches 53590.9);
 // #176 (seed-like, T = 23.5 s, rest to 3.2 rad/s) from the coasting start, which needs more than

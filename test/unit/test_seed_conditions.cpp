@@ -54,7 +54,7 @@ TEST(SeedConditions, PrintedConditionsDoNotVanish) {
 }
 
 TEST(SeedConditions, DroppingDexpLeavesASmallDefectOfOrderThree) {
-  // Measured (docs/necessary_conditions.md): without the dexp factors the relative residual is
+  // Measured (docs/results/necessary_conditions.md): without the dexp factors the relative residual is
   // nonzero and falls like h³ (1.4e-4 at N = 128, 1.8e-5 at N = 256 on the slew-up).
   const double a = worst(seedConditionRelativeResiduals(solveSlewUp(128).maneuver, kSeedInertia,
                                                         SeedConditionForm::PrintedWithTyposFixed));

@@ -1,4 +1,4 @@
-// What accuracy a discrete plan has, and plans to a requested accuracy (docs/accuracy.md).
+// What accuracy a discrete plan has, and plans to a requested accuracy (docs/results/accuracy.md).
 //
 // Three measures of a plan of N steps (h = T/N) against the continuous optimum
 // (continuous_reference.hpp):
@@ -75,7 +75,7 @@ AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver&
                                  const ContinuousReference& reference);
 
 /// The convergence order p of a measure (error ≈ C N^−p) as measured by scripts/accuracy on the
-/// seed's examples (docs/accuracy.md): cost error 1 (paper, variational), terminal attitude miss
+/// seed's examples (docs/results/accuracy.md): cost error 1 (paper, variational), terminal attitude miss
 /// 1 (paper) and 2 (variational); second_order 2 and fourth_order 4 in both. The planner predicts
 /// N from it.
 double measuredOrder(SchemeKind scheme, AccuracyMeasure measure);

@@ -3,7 +3,7 @@
 //
 //   minimize ½∫₀ᵀ |τ|² dt   s.t.   Ṙ = R Ω^,   J Ω̇ = (JΩ) × Ω + τ,   R(0), Ω(0), R(T), Ω(T) given.
 //
-// Pontryagin form (derived in docs/accuracy.md, "The continuous reference"), with the costate of
+// Pontryagin form (derived in docs/results/accuracy.md, "The continuous reference"), with the costate of
 // R left-trivialized (π ∈ R³, body frame) and the costate of Ω written λ = J ν:
 //
 //   H = ½|τ|² + π·Ω + ν·((JΩ) × Ω + τ)     ⇒  τ = −ν   (∂H/∂τ = 0)

@@ -1,6 +1,6 @@
 // The seed's printed necessary conditions (seed 000, Theorem 3.1 / eq. (28)) and their corrected
 // form, evaluated at a maneuver of the `paper` scheme: a check of the printed equations against
-// the optimum our solver finds (docs/necessary_conditions.md).
+// the optimum our solver finds (docs/results/necessary_conditions.md).
 //
 // Vector forms used (seed Sec. 4): Ad_g ξ = g ξ, Ad*_g Π = gᵀ Π, [Π, ξ] = Π × ξ, 𝕁(ξ) = J ξ.
 #pragma once

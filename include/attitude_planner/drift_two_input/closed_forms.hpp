@@ -1,6 +1,6 @@
 // Closed-form extremals of the drift + two-input system (seed 001, Section 4): Prop. 4.2
 // (c1 = c2, circular functions) and Prop. 4.3 (c1 ≠ c2, Jacobi elliptic functions), with the
-// corrections listed in docs/drift_two_input.md. Only the cases the seed states are evaluated: an
+// corrections listed in docs/design/drift_two_input.md. Only the cases the seed states are evaluated: an
 // initial costate outside them is reported (status kOutsideStatedCases), never evaluated.
 #pragma once
 

@@ -9,7 +9,7 @@
 //
 // Extremals are not unique (they differ in how often the controls wind about the drift axis).
 // Without a guess the planner starts from every extremal of the symmetric problem c1 = c2 = c̄
-// (closed form, docs/drift_two_input.md) up to a cost bound, carries each to the requested
+// (closed form, docs/design/drift_two_input.md) up to a cost bound, carries each to the requested
 // weights (Levenberg–Marquardt, then continuation in the weights if needed), keeps the cheapest
 // and reports the others' costs in `extremal`. A guess selects among extremals instead.
 #pragma once

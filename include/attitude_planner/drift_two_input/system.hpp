@@ -1,7 +1,7 @@
 // Remsing's drift + two-input system on SO(3) (seed 001): ġ = g(E3 + u1 E1 + u2 E2),
 // cost ½∫(c1 u1² + c2 u2²) dt, and the flow of its normal extremals.
 //
-// Derivation (docs/drift_two_input.md): with the left-trivialized costate p ∈ so(3)* ≅ R³ the
+// Derivation (docs/design/drift_two_input.md): with the left-trivialized costate p ∈ so(3)* ≅ R³ the
 // maximum condition (seed 2.7, λ = −1) gives u_i = p_i/c_i and the reduced Hamiltonian
 // H(p) = ½(p1²/c1 + p2²/c2) + p3. The spatial costate μ = g p is constant along an extremal
 // (first-order optimality of the fixed-endpoint problem), so ṗ = d(gᵀμ)/dt = −ξ × p = p × ∇H(p)

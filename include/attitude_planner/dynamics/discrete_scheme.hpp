@@ -19,9 +19,9 @@
 //                    Π_k = μ(F_k) − (h/2) τ_k = F_{k−1}ᵀ μ(F_{k−1}) + (h/2) τ_k,
 //                and the boundary velocities are imposed at the instants 0 and T themselves:
 //                Π_0 = J Ω(0), Π_N = J Ω(T) (τ_0, τ_N are unknowns, not zero). The cost is the
-//                trapezoidal rule, weights ½ at the end nodes. Derivation: docs/second_order.md.
+//                trapezoidal rule, weights ½ at the end nodes. Derivation: docs/design/second_order.md.
 //   fourth_order not a discretization: one Richardson extrapolation step of second_order (plans
-//                at N and 2N combined node by node, planAtResolution; docs/fourth_order.md). No
+//                at N and 2N combined node by node, planAtResolution; docs/design/fourth_order.md). No
 //                DiscreteScheme is built for it (the constructor refuses it); its node torques
 //                are replayed with a cubic hold (replayPlan, simulation.hpp) and its effort is the
 //                end-corrected trapezoidal rule (schemeTorqueWeight).

@@ -1,6 +1,6 @@
 // Plans to a requested accuracy: what the caller asks for (AccuracyTarget, in PlanningProblem)
 // and what the planner reports back (AccuracyEstimate, in PlanResult). The measures and the
-// planner that chooses N are in accuracy.hpp; the measured orders are in docs/accuracy.md.
+// planner that chooses N are in accuracy.hpp; the measured orders are in docs/results/accuracy.md.
 #pragma once
 
 #include <string>
@@ -10,7 +10,7 @@
 
 namespace attitude_planner {
 
-/// Which error of a plan a target bounds (docs/accuracy.md, "The three measures").
+/// Which error of a plan a target bounds (docs/results/accuracy.md, "The three measures").
 enum class AccuracyMeasure {
   None,          ///< no target: plan at PlanningProblem::steps
   TerminalMiss,  ///< ‖log(R_Tᵀ R(T))‖ [rad] when the torques drive the continuous body (ZOH)

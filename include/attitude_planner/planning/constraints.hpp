@@ -10,7 +10,7 @@
 // Between two nodes the motion R_k exp(s ω_k^), s ∈ [0, 1], ω_k = log(R_kᵀR_{k+1}), keeps the
 // torque bounds (torques are held) and, for the paper scheme, the rate bound (constant rate
 // ω_k/h); a cone's angle can dip past its bound by up to a − acos(cos a + |ω_k|²/8) (keep_out,
-// docs/constraints_notes.md "Between nodes"). A cone's `margin` m tightens its node bound to
+// docs/notes/constraints_notes.md "Between nodes"). A cone's `margin` m tightens its node bound to
 // a + m (keep_out) or a − m (keep_in); requiredConeMargin gives the m that keeps the continuous
 // motion outside (inside) the cone for steps up to a given angle.
 #pragma once

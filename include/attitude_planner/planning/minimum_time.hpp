@@ -12,7 +12,7 @@
 // above and just below the eigenaxis T). Above N = 64 the starts are searched on the grid with
 // half the steps and its T* plan starts the search here. The message names the start that won
 // and every start's T. T* is the least duration found feasible: an upper bound on the true
-// minimum (docs/minimum_time.md: Betts's published T* reached to 0.05 %, Bilimoria–Wie's to 2 %).
+// minimum (docs/results/minimum_time.md: Betts's published T* reached to 0.05 %, Bilimoria–Wie's to 2 %).
 #pragma once
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"

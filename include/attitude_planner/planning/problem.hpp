@@ -96,7 +96,7 @@ inline constexpr const char* kAutoSchemeName = "auto";
 /// Fewest steps N of a rigid-body plan (validateProblem).
 constexpr int kMinSteps = 4;
 /// Most steps N of a rigid-body plan: the Newton solver holds ~2.3 kB per step (measured at
-/// N = 1e6, 2.3 GB peak; docs/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7,
+/// N = 1e6, 2.3 GB peak; docs/results/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7,
 /// would need ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
 constexpr int kMaxSteps = 2000000;
 

@@ -357,7 +357,7 @@ class MinimumTimeSearch {
 
   /// T* is the least duration the interior point found feasible: an upper bound on the true
   /// minimum (a false "infeasible" below it cannot be told from a true one;
-  /// docs/minimum_time.md).
+  /// docs/results/minimum_time.md).
   std::string searchNote(const SearchOutcome& found) const {
     std::ostringstream note;
     note << "; minimum time T* = " << found.T_hi << " s, the least duration found feasible, from "

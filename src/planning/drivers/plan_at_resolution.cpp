@@ -47,7 +47,7 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
   }
 }
 
-/// fourth_order: one Richardson extrapolation step of second_order (docs/fourth_order.md).
+/// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md).
 /// second_order is time-symmetric, so its node values have an error expansion in even powers of
 /// h; X = X_{2N} + (X_{2N} − X_N)/3 at the N + 1 common nodes cancels the h² term. On the group,
 /// R_k = R^{2N}_{2k} exp(⅓ log((R^N_k)ᵀ R^{2N}_{2k})). Both solves get the request's solver,

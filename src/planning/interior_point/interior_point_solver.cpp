@@ -1274,7 +1274,7 @@ namespace {
 /// constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12,
 /// and the smooth modes' curvature falls like N⁻⁴ against the largest (torques are second
 /// differences of attitudes); the step along the active constraints' null space depends on that
-/// curvature alone. Measured against IPOPT (docs/constraints.md, torque and rate limits): in
+/// curvature alone. Measured against IPOPT (docs/results/constraints.md, torque and rate limits): in
 /// double the optima agreed to ≤ 7e-12 up to N = 1024, 1e-9 at 2048, 7e-8 at 4096 and 4e-6 at 8192
 /// (553 fewer active constraints than IPOPT's); in long double to ≤ 1e-10 up to 8192, but 2.4e-7
 /// above double-double's optimum at 16 384 and 5.5e-6 at 32 768 (9 800 fewer active), and
@@ -1311,7 +1311,7 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
 
 /// solveOnGrid in one formulation, retried once in the other from the same start when it ends
 /// infeasible or unconverged: free slacks with Mehrotra's predictor–corrector first (measured,
-/// docs/constraints_notes.md: 42 % fewer iterations over the constrained scenes at N = 64 … 8192
+/// docs/notes/constraints_notes.md: 42 % fewer iterations over the constrained scenes at N = 64 … 8192
 /// and the same or lower optima; with the double-double system also above, where the elastic
 /// form came first until session 28: torque + rate limits at N = 10⁵ in 14 finest-level
 /// iterations, where the elastic form stopped after 25 and its retry took 25 more), the elastic

@@ -159,7 +159,7 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coa
   // With end torques every step is free and sits at its midpoint (k + ½)h. Rates ω^c_k/h_c are
   // interpolated by Catmull–Rom (C¹, slopes one-sided at the ends) and scaled by h. With a
   // second, coarser solution the two are extrapolated to this grid's h (Richardson at the
-  // scheme's order p: 1, or 2 with end torques, docs/accuracy.md),
+  // scheme's order p: 1, or 2 with end torques, docs/results/accuracy.md),
   // s(h) = s(h₁) − (s(h₂) − s(h₁)) (h₁ᵖ − hᵖ)/(h₂ᵖ − h₁ᵖ).
   const bool midpoints = scheme_.hasEndTorques();
   const double p = midpoints ? 2.0 : 1.0;

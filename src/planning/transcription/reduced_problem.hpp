@@ -6,7 +6,7 @@
 // (discrete_scheme.hpp):  τ_k = (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h,  F_k = R_kᵀ R_{k+1}, and the
 // problem is min C = Σ_{k=1}^{N−1} ½|τ_k|² over R_2..R_{N−2} (3(N−3) unknowns: the seed's
 // 3(2N−3) unknowns τ, Ω with its 3(N−1) dynamics equations eliminated exactly). ∇C = 0 are the
-// discrete necessary conditions (docs/necessary_conditions.md relates them to the seed's eq. 28).
+// discrete necessary conditions (docs/results/necessary_conditions.md relates them to the seed's eq. 28).
 //
 // With end torques (second_order, discrete_scheme.hpp) R_1 and R_{N−1} are free too, τ_0 and
 // τ_N are functions of F_0 and F_{N−1} (the boundary velocities enter through the Legendre

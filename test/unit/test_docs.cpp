@@ -1,0 +1,92 @@
+// The documentation cannot rot unnoticed: scripts/check_docs.py (relative links and anchors in
+// README.md, CHANGELOG.md and docs/, docs/ paths named anywhere in the package, README.md's copy
+// of examples/*.cpp) runs in the default suite, and README.md's C++ example is built and run.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tool_runner.hpp"
+
+namespace {
+
+using attitude_planner_test::runTool;
+using attitude_planner_test::ToolRun;
+
+const std::string kSourceDir = AP_SOURCE_DIR;
+
+/// Runs `command` through the shell, capturing stdout and stderr together.
+ToolRun runCommand(const std::string& command) {
+  ToolRun r;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.output.append(buffer, n);
+  const int raw = pclose(pipe);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+/// scripts/check_docs.py on the repository `repo` with the checks named in `checks`.
+ToolRun checkDocs(const std::string& repo, const std::string& checks) {
+  return runCommand("/usr/bin/python3 '" + kSourceDir + "/scripts/check_docs.py' --repo '" + repo +
+                    "' " + checks);
+}
+
+TEST(DocsCheck, RelativeLinksInReadmeAndDocsResolve) {
+  const ToolRun r = checkDocs(kSourceDir, "links");
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
+TEST(DocsCheck, DocsPathsNamedInThePackageExist) {
+  const ToolRun r = checkDocs(kSourceDir, "mentions");
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
+TEST(DocsCheck, ReadmeHoldsTheExampleProgramVerbatim) {
+  const ToolRun r = checkDocs(kSourceDir, "examples");
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
+/// The checker itself: a page with a broken link, a missing heading and a stale path fails.
+/// (The paths are spelled kDocs + "/..." so that this file names no docs/ path that is missing.)
+TEST(DocsCheck, ReportsBrokenLinksMissingHeadingsAndStalePaths) {
+  const std::string kDocs = "docs";
+  char pattern[] = "/tmp/ap_docs_check_XXXXXX";
+  const char* dir = mkdtemp(pattern);
+  ASSERT_NE(dir, nullptr);
+  const std::string repo = dir;
+  std::filesystem::create_directories(repo + "/" + kDocs + "/results");
+  std::ofstream(repo + "/" + kDocs + "/results/page.md") << "# Page\n\n## Some `code` heading\n";
+  std::ofstream(repo + "/README.md")
+      << "# Readme\n\n[ok](" << kDocs << "/results/page.md#some-code-heading) [gone](" << kDocs
+      << "/gone.md) [anchor](" << kDocs << "/results/page.md#no-such-heading)\n\n```\n"
+      << "[in code](ignored.md)\n```\n";
+  std::ofstream(repo + "/" + kDocs + "/results/stale.md") << "Written by " << kDocs << "/old.md.\n";
+  const ToolRun r = checkDocs(repo, "links mentions");
+  std::filesystem::remove_all(repo);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("README.md:3: broken link " + kDocs + "/gone.md"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("no heading #no-such-heading"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("names " + kDocs + "/old.md"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("some-code-heading"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("ignored.md"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("4 problem(s)"), std::string::npos) << r.output;
+}
+
+/// README.md's C++ example (examples/plan_rest_to_rest.cpp) plans the seed's slew and converges.
+TEST(ReadmeExample, PlansTheSeedsRestToRestSlew) {
+  const ToolRun r = runTool("plan_rest_to_rest", "", 120);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.rfind("converged in ", 0), 0u) << r.output;
+  EXPECT_NE(r.output.find("cost 7.910254"), std::string::npos) << r.output;  // the seed's optimum
+  EXPECT_NE(r.output.find("tau_1 = ["), std::string::npos) << r.output;
+}
+
+}  // namespace

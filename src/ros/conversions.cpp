@@ -170,6 +170,8 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
   for (const Matrix3& R : maneuver.attitude) m.attitude.push_back(attitudeToMsg(R));
   for (const Vector3& w : maneuver.angular_velocity) m.angular_velocity.push_back(vectorToMsg(w));
   for (const Vector3& t : maneuver.torque) m.torque.push_back(vectorToMsg(t));
+  for (const PlanningConstraint& c : problem.constraints)
+    m.constraints.push_back(constraintToMsg(c));
   return m;
 }
 

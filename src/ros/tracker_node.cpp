@@ -5,10 +5,13 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Vector3Stamped.h>
 #include <geometry_msgs/WrenchStamped.h>
+#include <std_msgs/Float64.h>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
@@ -40,6 +43,9 @@ geometry_msgs::Point point(const Vector3& v) {
   p.z = v.z();
   return p;
 }
+
+/// The traced axis, its planned path and its trail: orange (no principal axis is).
+const std_msgs::ColorRGBA kTraceColour = color(1.0f, 0.6f, 0.0f, 1.0f);
 
 }  // namespace
 
@@ -91,7 +97,7 @@ visualization_msgs::Marker arrowMarker(const std::string& frame, const ros::Time
 
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
                                             double path_radius, const std::string& body_frame,
-                                            const ros::Time& stamp) {
+                                            const ros::Time& stamp, const Vector3& trace_axis) {
   visualization_msgs::MarkerArray array;
   visualization_msgs::Marker m =
       newMarker(body_frame, stamp, "body", 0, visualization_msgs::Marker::CUBE);
@@ -108,10 +114,10 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
                                         axis_length * box.axes.col(i),
                                         Vector3(0.04, 0.08, 0.15) * axis_length, colors[i]));
   }
-  // The body x axis up to the traced tip, linking the body to `attitude_path` (same colour).
-  array.markers.push_back(
-      arrowMarker(body_frame, stamp, "body_x_axis", 4, Vector3(path_radius, 0.0, 0.0),
-                  Vector3(0.015, 0.04, 0.06) * path_radius, color(1.0f, 0.6f, 0.0f, 1.0f)));
+  // The traced body axis up to the traced tip, linking the body to `attitude_path` (same colour).
+  array.markers.push_back(arrowMarker(body_frame, stamp, "body_x_axis", 4,
+                                      path_radius * trace_axis.normalized(),
+                                      Vector3(0.015, 0.04, 0.06) * path_radius, kTraceColour));
   return array;
 }
 
@@ -124,8 +130,9 @@ visualization_msgs::MarkerArray constraintMarkers(
   for (const PlanningConstraint& c : constraints) {
     if (!c.isCone()) continue;
     const bool out = c.kind == ConstraintKind::KeepOut;
+    // Magenta and cyan: no principal axis (red, green, blue) or trace (orange) shares them.
     const std_msgs::ColorRGBA tint =
-        out ? color(0.95f, 0.2f, 0.1f, 0.35f) : color(0.1f, 0.85f, 0.3f, 0.35f);
+        out ? color(0.9f, 0.1f, 0.85f, 0.35f) : color(0.1f, 0.8f, 0.9f, 0.35f);
     // The cone: a fan of triangles from the apex (the body origin) to the circle of points at
     // slant distance `length` whose direction makes the half angle with s (any a in (0, π)).
     visualization_msgs::Marker cone = newMarker(world_frame, stamp, out ? "keep_out" : "keep_in",
@@ -150,12 +157,50 @@ visualization_msgs::MarkerArray constraintMarkers(
     // (shaft twice the body x arrow's: drawn around it)
     std_msgs::ColorRGBA opaque = tint;
     opaque.a = 1.0f;
-    array.markers.push_back(
+    visualization_msgs::Marker axis =
         arrowMarker(body_frame, stamp, out ? "keep_out_body_axis" : "keep_in_body_axis", id,
-                    length * c.body_axis, Vector3(0.03, 0.05, 0.08) * length, opaque));
+                    length * c.body_axis, Vector3(0.03, 0.05, 0.08) * length, opaque);
+    axis.frame_locked = true;  // published once: rviz moves it with the body frame
+    array.markers.push_back(axis);
     ++id;
   }
   return array;
+}
+
+Vector3 traceAxis(const std::string& name, const Matrix3& initial, const Matrix3& final) {
+  if (name == "x") return Vector3::UnitX();
+  if (name == "y") return Vector3::UnitY();
+  if (name == "z") return Vector3::UnitZ();
+  if (name != "auto") {
+    throw InvalidInput("~trace_axis: unknown value '" + name + "' (expected x, y, z or auto)");
+  }
+  const Vector3 rotation = so3::log(Matrix3(initial.transpose() * final));  // body frame
+  if (rotation.norm() == 0.0) return Vector3::UnitX();
+  Eigen::Index least = 0;
+  rotation.cwiseAbs().minCoeff(&least);  // the axis most perpendicular to the rotation axis
+  return Vector3::Unit(least);
+}
+
+std::vector<int> decimatedIndices(int n, int max_points) {
+  std::vector<int> indices;
+  const int points = std::max(2, std::min(n + 1, max_points));
+  for (int i = 0; i < points; ++i) {
+    // Evenly spread, rounded: 0 and n exactly, strictly increasing since points <= n + 1.
+    indices.push_back(static_cast<int>(std::lround(static_cast<double>(i) * n / (points - 1))));
+  }
+  return indices;
+}
+
+std::vector<double> sampleTimes(double duration, int steps, double rate, double rate_factor) {
+  std::vector<double> times;
+  if (rate == 0.0) {
+    for (int k = 0; k <= steps; ++k) times.push_back(duration * k / steps);
+    return times;
+  }
+  const double spacing = rate_factor / rate;  // maneuver seconds between samples
+  for (long j = 0; j * spacing < duration; ++j) times.push_back(j * spacing);
+  times.push_back(duration);
+  return times;
 }
 
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
@@ -193,6 +238,9 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
       return false;
     }
     *msg = srv.response.maneuver;
+    // A scene is planned for this tracker: its frames, whatever the planner's defaults are.
+    msg->header.frame_id = world_frame;
+    msg->child_frame_id = body_frame;
     *solve_time = srv.response.solve_time;
     *cost = srv.response.cost;
     return true;
@@ -251,37 +299,75 @@ bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* cli
 
 TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   auto non_empty = [](const std::string& s) { return !s.empty(); };
   rate_factor_ = readParam<double>(pnh, "rate_factor", 1.0, positive, "> 0");
-  start_delay_ = readParam<double>(
-      pnh, "start_delay", 0.5, [](double v) { return std::isfinite(v) && v >= 0.0; }, ">= 0 s");
+  start_delay_ = readParam<double>(pnh, "start_delay", 0.5, non_negative, ">= 0 s");
   world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
   body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
   body_size_ = readParam<double>(pnh, "body_size", 1.0, positive, "> 0 m");
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
+  rate_ = readParam<double>(pnh, "rate", 50.0, non_negative, ">= 0 Hz, 0 = at the plan nodes");
+  readParam<double>(pnh, "replan_period", 1.0, positive, "> 0 s");
+  tracking_.natural_frequency =
+      readParam<double>(pnh, "feedback_frequency", 0.0, non_negative, ">= 0 rad/s, 0 = 40 / T");
+  tracking_.damping = readParam<double>(pnh, "feedback_damping", 1.0, positive, "> 0");
   pnh.param("exit_when_done", exit_when_done_, false);
-  std::string scene, replay_scene;
+  std::string scene, replay_scene, mode;
   pnh.param<std::string>("scene", scene, "");
   pnh.param<std::string>("replay_scene", replay_scene, "");
+  pnh.param<std::string>("mode", mode, trackingModeName(TrackingMode::Replay));
+  pnh.param<std::string>("trace_axis", trace_axis_name_, "auto");
   bool plan_in_process = false;
   pnh.param("plan_in_process", plan_in_process, false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
 
   torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
   velocity_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity", 10);
-  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 1, true);
+  reference_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("reference_pose", 10);
+  error_pub_ = nh_.advertise<std_msgs::Float64>("attitude_error", 10);
+  rate_error_pub_ = nh_.advertise<std_msgs::Float64>("angular_velocity_error", 10);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 10, true);
+  trail_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_trail", 10);
+  text_pub_ = nh_.advertise<visualization_msgs::Marker>("status_text", 10);
   path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
+  ghost_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("ghost_markers", 1, true);
   done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
   constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
   control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
+
+  // A run in another mode than the one asked for would be silently wrong: refuse, and stop.
+  std::string refusal;
+  try {
+    mode_ = parseIn(kTrackingModeNames, mode, "~mode");
+    if (mode_ == TrackingMode::Replan) {
+      refusal =
+          "~mode = replan is not available: receding-horizon re-planning needs the planner "
+          "request's initial_guess (warm start), which this build's PlanAttitudeManeuver.srv does "
+          "not have; use replay or feedback";
+    }
+    traceAxis(trace_axis_name_, Matrix3::Identity(), Matrix3::Identity());  // checks the name
+  } catch (const std::exception& e) {
+    refusal = e.what();
+  }
+  if (!refusal.empty()) {
+    ROS_FATAL("attitude_tracker_node: %s", refusal.c_str());
+    ReplayResult failed;
+    failed.success = false;
+    failed.mode = mode;
+    failed.message = refusal;
+    done_pub_.publish(failed);
+    ros::requestShutdown();
+    return;
+  }
   maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
   drift_sub_ = nh_.subscribe("drift_maneuver", 1, &TrackerNode::onDriftManeuver, this);
 
   if (!replay_scene.empty()) {
     try {
       replay_scene_effects_ = loadScene(replay_scene).effects;
-      ROS_INFO("replays act under the %zu effects of %s", replay_scene_effects_->size(),
+      ROS_INFO("runs act under the %zu effects of %s", replay_scene_effects_->size(),
                replay_scene.c_str());
     } catch (const std::exception& e) {
       // A replay under effects other than the requested ones would be silently wrong: refuse.
@@ -294,70 +380,58 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     }
   }
   if (scene.empty()) {
-    ROS_INFO("attitude_tracker_node: waiting for a maneuver on %s or %s",
+    ROS_INFO("attitude_tracker_node (%s): waiting for a maneuver on %s or %s", mode.c_str(),
              maneuver_sub_.getTopic().c_str(), drift_sub_.getTopic().c_str());
     return;
   }
-  Replay replay;
   std::string error;
-  try {
-    const Scene parsed = loadScene(scene);
-    if (parsed.system == SystemKind::DriftTwoInput) {
-      const DriftTwoInputRequest request = driftTwoInputRequest(parsed);  // refuses effects
-      ros::ServiceClient client;
-      if (!plan_in_process) {
-        client = nh_.serviceClient<PlanDriftTwoInput>("plan_drift_two_input");
-        ROS_INFO("planning %s with %s", scene.c_str(), client.getService().c_str());
-        if (!client.waitForExistence(ros::Duration(planner_timeout))) {
-          error = "planner service " + client.getService() + " not available after " +
-                  std::to_string(planner_timeout) + " s";
-        }
-      } else {
-        ROS_INFO("planning %s in-process", scene.c_str());
-      }
-      replay.drift = true;
-      if (error.empty() &&
-          planDriftScene(request, plan_in_process ? nullptr : &client, world_frame_, body_frame_,
-                         &replay.drift_msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
-        ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
-                 replay.plan_solve_time);
-        startReplay(replay);
-        return;
-      }
-      throw InvalidInput(error);
-    }
-    replay.effects = parsed.effects;
-    replay.constraint_markers = constraintMarkers(parsed.problem.constraints, path_radius_,
-                                                  world_frame_, body_frame_, ros::Time());
-    if (!replay.constraint_markers.markers.empty())
-      constraint_pub_.publish(replay.constraint_markers);
-    ros::ServiceClient client;
-    if (!plan_in_process) {
-      client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
-      ROS_INFO("planning %s with %s", scene.c_str(), client.getService().c_str());
-      if (!client.waitForExistence(ros::Duration(planner_timeout))) {
-        error = "planner service " + client.getService() + " not available after " +
-                std::to_string(planner_timeout) + " s";
-      }
-    } else {
-      ROS_INFO("planning %s in-process", scene.c_str());
-    }
-    if (error.empty() &&
-        planScene(parsed.problem, parsed.effects, plan_in_process ? nullptr : &client, world_frame_,
-                  body_frame_, &replay.msg, &replay.plan_solve_time, &replay.plan_cost, &error)) {
-      ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
-               replay.plan_solve_time);
-      startReplay(replay);
-      return;
-    }
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
+  if (planAndStartScene(scene, plan_in_process, planner_timeout, &error)) return;
   ROS_ERROR("scene %s: %s", scene.c_str(), error.c_str());
   ReplayResult failed;
   failed.success = false;
   failed.message = "scene " + scene + ": " + error;
   publishDone(failed);
+}
+
+bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_process,
+                                    double planner_timeout, std::string* error) {
+  try {
+    const Scene parsed = loadScene(scene);
+    const bool drift = parsed.system == SystemKind::DriftTwoInput;
+    std::optional<DriftTwoInputRequest> drift_request;
+    if (drift) drift_request = driftTwoInputRequest(parsed);  // refuses effects
+    ros::ServiceClient client;
+    if (!plan_in_process) {
+      client = drift ? nh_.serviceClient<PlanDriftTwoInput>("plan_drift_two_input")
+                     : nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
+      ROS_INFO("planning %s with %s", scene.c_str(), client.getService().c_str());
+      if (!client.waitForExistence(ros::Duration(planner_timeout))) {
+        *error = "planner service " + client.getService() + " not available after " +
+                 std::to_string(planner_timeout) + " s";
+        return false;
+      }
+    } else {
+      ROS_INFO("planning %s in-process", scene.c_str());
+    }
+    ros::ServiceClient* via = plan_in_process ? nullptr : &client;
+    Replay replay;
+    replay.drift = drift;
+    const bool planned =
+        drift ? planDriftScene(*drift_request, via, world_frame_, body_frame_, &replay.drift_msg,
+                               &replay.plan_solve_time, &replay.plan_cost, error)
+              : planScene(parsed.problem, parsed.effects, via, world_frame_, body_frame_,
+                          &replay.msg, &replay.plan_solve_time, &replay.plan_cost, error);
+    if (!planned) return false;
+    ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
+             replay.plan_solve_time);
+    replay.effects = parsed.effects;
+    replay.scene_constraints = parsed.problem.constraints;
+    startReplay(replay);
+    return true;
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
 }
 
 TrackerNode::~TrackerNode() {
@@ -396,56 +470,66 @@ bool TrackerNode::sleepUntil(const ros::Time& t) {
   while (!stop_ && ros::ok()) {
     const ros::Time now = ros::Time::now();
     if (!now.isZero() && now >= t) return true;
-    const double remaining = now.isZero() ? 0.01 : (t - now).toSec() / 1.0;
+    const double remaining = now.isZero() ? 0.01 : (t - now).toSec();
     ros::WallDuration(std::min(0.01, std::max(1e-4, remaining))).sleep();
   }
   return false;
 }
 
-bool TrackerNode::waitForClock(ros::Time* start) {
+bool TrackerNode::waitForClock(const ros::Time& stamp, ros::Time* start) {
   // use_sim_time: ROS time is zero until the first /clock message.
+  bool warned = false;
   while (ros::Time::now().isZero()) {
     if (stop_ || !ros::ok()) return false;
+    if (!warned) {
+      ROS_WARN("waiting for /clock (/use_sim_time is true) before the run starts");
+      warned = true;
+    }
     ros::WallDuration(0.01).sleep();
   }
-  *start = ros::Time::now() + ros::Duration(start_delay_);
+  const ros::Time now = ros::Time::now();
+  // A maneuver stamped in the future starts then (t_0 = header.stamp); else after ~start_delay.
+  *start = stamp > now ? stamp : now + ros::Duration(start_delay_);
   return true;
 }
 
-visualization_msgs::Marker TrackerNode::pathMarker() const {
-  visualization_msgs::Marker path;
-  path.header.frame_id = world_frame_;
-  path.ns = "attitude_path";
-  path.id = 0;
-  path.type = visualization_msgs::Marker::LINE_STRIP;
-  path.action = visualization_msgs::Marker::ADD;
-  path.pose.orientation.w = 1.0;
+visualization_msgs::Marker TrackerNode::pathMarker(const std::string& frame, const std::string& ns,
+                                                   const std::vector<Vector3>& tips,
+                                                   float alpha) const {
+  visualization_msgs::Marker path =
+      newMarker(frame, ros::Time(), ns, 0, visualization_msgs::Marker::LINE_STRIP);
   path.scale.x = 0.02 * path_radius_;  // line width [m]
-  path.color = color(1.0f, 0.6f, 0.0f, 1.0f);
+  path.color = kTraceColour;
+  path.color.a = alpha;
+  for (const Vector3& tip : tips) path.points.push_back(point(tip));
   return path;
 }
 
-void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                              visualization_msgs::Marker* path,
-                              visualization_msgs::MarkerArray* constraint_markers) {
+void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp,
+                              const std::string& world_frame, const std::string& body_frame,
+                              const PrincipalBox& box, const Vector3& trace_axis,
+                              std::deque<Vector3>* trail) {
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = stamp;
-  tf.header.frame_id = world_frame_;
-  tf.child_frame_id = body_frame_;
+  tf.header.frame_id = world_frame;
+  tf.child_frame_id = body_frame;
   tf.transform.rotation = rc::attitudeToMsg(R);
   tf_broadcaster_.sendTransform(tf);
-  marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame_, stamp));
-  path->header.stamp = stamp;
-  path->points.push_back(point(path_radius_ * R.col(0)));
-  if (path->points.size() >= 2) path_pub_.publish(*path);
-  if (constraint_markers && !constraint_markers->markers.empty()) {
-    for (visualization_msgs::Marker& m : constraint_markers->markers) m.header.stamp = stamp;
-    constraint_pub_.publish(*constraint_markers);
+  marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame, stamp, trace_axis));
+  trail->push_back(path_radius_ * (R * trace_axis));
+  while (trail->size() > static_cast<std::size_t>(kTrailPoints)) trail->pop_front();
+  if (trail->size() >= 2) {
+    visualization_msgs::Marker m = pathMarker(
+        world_frame, "attitude_trail", std::vector<Vector3>(trail->begin(), trail->end()), 1.0f);
+    m.header.stamp = stamp;
+    m.color = color(1.0f, 0.9f, 0.2f, 1.0f);  // the trail: yellow over the orange plan
+    m.scale.x = 0.03 * path_radius_;
+    trail_pub_.publish(m);
   }
 }
 
 void TrackerNode::publishDone(ReplayResult result) {
-  result.header.frame_id = world_frame_;
+  if (result.header.frame_id.empty()) result.header.frame_id = world_frame_;
   if (result.header.stamp.isZero()) result.header.stamp = ros::Time::now();
   done_pub_.publish(result);
   if (exit_when_done_) {
@@ -456,97 +540,210 @@ void TrackerNode::publishDone(ReplayResult result) {
   }
 }
 
+void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matrix3& inertia,
+                          SchemeKind scheme, Playback* pb) const {
+  ReplayResult& result = pb->result;
+  const int N = plan.steps();
+  if (mode_ == TrackingMode::Feedback) {
+    Actuation actuation = actuationOf(replay.effects);
+    const TrackingRun run =
+        simulateTracking(*pb->reference, plan.attitude[0], plan.angular_velocity[0],
+                         pb->effects.get(), &actuation, tracking_);
+    result.effort = run.effort;
+    result.cost = run.effort / plan.time_step;  // the same units as the replay's Σ ½|τ_k|²
+    result.max_attitude_deviation = run.max_attitude_error;
+    result.message = "tracked " + std::to_string(N) + " steps with feedback (omega_n " +
+                     exactNumber(run.natural_frequency) + " rad/s, " +
+                     std::to_string(run.substeps) + " control samples per step)";
+    pb->actual = std::make_unique<ManeuverInterpolation>(run.actual, scheme, inertia, nullptr,
+                                                         TorqueHold::StepStart);
+  } else {
+    // Exactly the effects of the run's scene: forcing on the body, then what the actuators do.
+    Actuation actuation = actuationOf(replay.effects);
+    SimulationInput input;
+    input.initial_attitude = plan.attitude[0];
+    input.initial_velocity = plan.angular_velocity[0];
+    input.torque = plan.torque;
+    input.effects = pb->effects.get();
+    input.actuation = &actuation;
+    const Maneuver replayed = replayPlan(scheme, inertia, plan.time_step, input);
+    result.cost = schemeCost(scheme, replayed.torque);
+    result.effort = openLoopEffort(scheme, replayed);
+    for (int k = 0; k <= N; ++k) {
+      result.max_attitude_deviation = std::max(
+          result.max_attitude_deviation, so3::angleBetween(plan.attitude[k], replayed.attitude[k]));
+    }
+    result.message = "replayed " + std::to_string(N) + " steps";
+    pb->actual =
+        std::make_unique<ManeuverInterpolation>(replayed, scheme, inertia, pb->effects.get());
+  }
+  const ManeuverSample end = pb->actual->at(pb->actual->duration());
+  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], end.attitude);
+  result.terminal_velocity_error = (end.angular_velocity - plan.angular_velocity[N]).norm();
+  result.final_attitude = rc::attitudeToMsg(end.attitude);
+}
+
+TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
+  Playback pb;
+  const AttitudeManeuver& msg = replay.msg;
+  const Maneuver plan = rc::maneuverFromMsg(msg);
+  requireUniformTimeGrid(plan);
+  const Matrix3 inertia = rc::inertiaFromMsg(msg.inertia);
+  const int N = plan.steps();
+  // The core validates the body (symmetric positive definite J) with the problem checks.
+  PlanningProblem problem;
+  problem.inertia = inertia;
+  problem.allow_nonphysical_inertia = true;  // replaying only needs J SPD
+  problem.duration = N * plan.time_step;
+  problem.steps = N;
+  problem.initial_attitude = plan.attitude.front();
+  problem.initial_velocity = plan.angular_velocity.front();
+  problem.final_attitude = plan.attitude.back();
+  problem.final_velocity = plan.angular_velocity[N];
+  if (!msg.scheme.empty()) problem.scheme = parseScheme(msg.scheme, "maneuver.scheme");
+  for (std::size_t i = 0; i < msg.constraints.size(); ++i) {
+    pb.constraints.push_back(rc::constraintFromMsg(
+        msg.constraints[i], "maneuver.constraints[" + std::to_string(i) + "]"));
+  }
+  validateConstraints(pb.constraints, "maneuver.constraints");
+  validateProblem(problem);
+  if (pb.constraints.empty()) pb.constraints = replay.scene_constraints;
+
+  pb.world_frame = msg.header.frame_id.empty() ? world_frame_ : msg.header.frame_id;
+  pb.body_frame = msg.child_frame_id.empty() ? body_frame_ : msg.child_frame_id;
+  pb.box = principalBox(inertia, body_size_);
+  pb.trace_axis = traceAxis(trace_axis_name_, plan.attitude.front(), plan.attitude.back());
+  pb.effects = plannableEffects(replay.effects, inertia);
+  pb.reference =
+      std::make_unique<ManeuverInterpolation>(plan, problem.scheme, inertia, pb.effects.get());
+  runBody(replay, plan, inertia, problem.scheme, &pb);
+  pb.times = sampleTimes(problem.duration, N, rate_, rate_factor_);
+  ReplayResult& result = pb.result;
+  result.mode = trackingModeName(mode_);
+  for (const EffectSpec& e : replay.effects) result.replay_effects.push_back(effectName(e));
+  result.steps = N;
+  result.duration = problem.duration;
+  result.plan_solve_time = replay.plan_solve_time;
+  result.plan_cost = replay.plan_cost;
+  return pb;
+}
+
+void TrackerNode::publishManeuverMarkers(const Playback& pb) {
+  const ManeuverInterpolation& plan = *pb.reference;
+  const Maneuver& nodes = plan.nodes();
+  // The planned path of the traced tip, once: at most kMaxPathPoints nodes.
+  std::vector<Vector3> tips;
+  for (int k : decimatedIndices(plan.steps(), kMaxPathPoints))
+    tips.push_back(path_radius_ * (nodes.attitude[k] * pb.trace_axis));
+  path_pub_.publish(pathMarker(pb.world_frame, "attitude_path", tips, 0.6f));
+  // Start and target ghosts: the box at R_0 (grey) and R_N (white), translucent, in the world.
+  visualization_msgs::MarkerArray ghosts;
+  const std::pair<const char*, int> ends[2] = {{"start_ghost", 0}, {"target_ghost", plan.steps()}};
+  for (const auto& [ns, k] : ends) {
+    visualization_msgs::Marker box =
+        newMarker(pb.world_frame, ros::Time(), ns, 0, visualization_msgs::Marker::CUBE);
+    box.pose.orientation = rc::attitudeToMsg(Matrix3(nodes.attitude[k] * pb.box.axes));
+    box.scale.x = pb.box.dimensions.x();
+    box.scale.y = pb.box.dimensions.y();
+    box.scale.z = pb.box.dimensions.z();
+    box.color = k == 0 ? color(0.5f, 0.5f, 0.5f, 0.25f) : color(0.95f, 0.95f, 0.95f, 0.3f);
+    ghosts.markers.push_back(box);
+    ghosts.markers.push_back(arrowMarker(
+        pb.world_frame, ros::Time(), ns, 1, path_radius_ * (nodes.attitude[k] * pb.trace_axis),
+        Vector3(0.015, 0.04, 0.06) * path_radius_, color(1.0f, 0.6f, 0.0f, 0.4f)));
+  }
+  ghost_pub_.publish(ghosts);
+  const visualization_msgs::MarkerArray cones =
+      constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time());
+  if (!cones.markers.empty()) constraint_pub_.publish(cones);
+}
+
+void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& stamp,
+                                std::deque<Vector3>* trail) {
+  const ManeuverSample body = pb.actual->at(t);
+  const ManeuverSample plan = pb.reference->at(t);
+  publishPose(body.attitude, stamp, pb.world_frame, pb.body_frame, pb.box, pb.trace_axis, trail);
+
+  geometry_msgs::WrenchStamped wrench;
+  wrench.header.stamp = stamp;
+  wrench.header.frame_id = pb.body_frame;
+  wrench.wrench.torque = rc::vectorToMsg(body.torque);
+  torque_pub_.publish(wrench);
+  geometry_msgs::Vector3Stamped velocity;
+  velocity.header = wrench.header;
+  velocity.vector = rc::vectorToMsg(body.angular_velocity);
+  velocity_pub_.publish(velocity);
+
+  geometry_msgs::PoseStamped reference;
+  reference.header.stamp = stamp;
+  reference.header.frame_id = pb.world_frame;
+  reference.pose.orientation = rc::attitudeToMsg(plan.attitude);
+  reference_pub_.publish(reference);
+  AttitudeReference ref;
+  ref.attitude = plan.attitude;
+  ref.angular_velocity = plan.angular_velocity;
+  const TrackingErrors e = trackingErrors(body.attitude, body.angular_velocity, ref);
+  std_msgs::Float64 value;
+  value.data = e.angle;
+  error_pub_.publish(value);
+  value.data = e.rate.norm();
+  rate_error_pub_.publish(value);
+
+  const Matrix3& target = pb.reference->nodes().attitude.back();
+  char text[160];
+  std::snprintf(text, sizeof text, "%s  t %.1f / %.1f s\nto go %.3f rad  |tau| %.3g N m",
+                pb.result.mode.c_str(), t, pb.result.duration,
+                so3::angleBetween(body.attitude, target), body.torque.norm());
+  visualization_msgs::Marker label = newMarker(pb.world_frame, stamp, "status_text", 0,
+                                               visualization_msgs::Marker::TEXT_VIEW_FACING);
+  label.pose.position.z = 1.1 * body_size_ + 0.3 * path_radius_;
+  label.scale.z = 0.12 * path_radius_;  // text height [m]
+  label.color = color(1.0f, 1.0f, 1.0f, 1.0f);
+  label.text = text;
+  text_pub_.publish(label);
+}
+
 void TrackerNode::runReplay(Replay replay) {
   if (replay.drift) {
     runDriftReplay(replay);
     return;
   }
-  ReplayResult result;
-  result.plan_solve_time = replay.plan_solve_time;
-  result.plan_cost = replay.plan_cost;
-  Maneuver plan, replayed;
-  Matrix3 inertia;
+  Playback pb;
   try {
-    plan = rc::maneuverFromMsg(replay.msg);
-    inertia = rc::inertiaFromMsg(replay.msg.inertia);
-    const int N = plan.steps();
-    // The core validates the body (symmetric positive definite J) with the problem checks.
-    PlanningProblem problem;
-    problem.inertia = inertia;
-    problem.allow_nonphysical_inertia = true;  // replaying only needs J SPD
-    problem.duration = N * plan.time_step;
-    problem.steps = N;
-    problem.initial_attitude = plan.attitude.front();
-    problem.initial_velocity = plan.angular_velocity.front();
-    problem.final_attitude = plan.attitude.back();
-    problem.final_velocity = plan.angular_velocity[N];
-    if (!replay.msg.scheme.empty())
-      problem.scheme = parseScheme(replay.msg.scheme, "maneuver.scheme");
-    validateProblem(problem);
-    // Exactly the effects of the replay's scene: forcing on the body, then what the actuators do.
-    const std::shared_ptr<const EffectModel> effects = plannableEffects(replay.effects, inertia);
-    Actuation actuation = actuationOf(replay.effects);
-    SimulationInput input;
-    input.initial_attitude = problem.initial_attitude;
-    input.initial_velocity = problem.initial_velocity;
-    input.torque = plan.torque;
-    input.effects = effects.get();
-    input.actuation = &actuation;
-    replayed = replayPlan(problem.scheme, inertia, plan.time_step, input);
-    for (const EffectSpec& e : replay.effects) result.replay_effects.push_back(effectName(e));
-    result.steps = N;
-    result.duration = problem.duration;
-    result.cost = schemeCost(problem.scheme, replayed.torque);
-    result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], replayed.attitude[N]);
-    result.terminal_velocity_error =
-        (replayed.angular_velocity[N] - plan.angular_velocity[N]).norm();
-    for (int k = 0; k <= N; ++k) {
-      result.max_attitude_deviation = std::max(
-          result.max_attitude_deviation, so3::angleBetween(plan.attitude[k], replayed.attitude[k]));
-    }
-    result.final_attitude = rc::attitudeToMsg(replayed.attitude[N]);
+    pb = preparePlayback(replay);
   } catch (const std::exception& e) {
     ROS_ERROR("maneuver rejected: %s", e.what());
+    ReplayResult result;
     result.success = false;
+    result.mode = trackingModeName(mode_);
     result.message = std::string("maneuver rejected: ") + e.what();
     publishDone(result);
     return;
   }
-
-  const PrincipalBox box = principalBox(inertia, body_size_);
   ros::Time start;
-  if (!waitForClock(&start)) return;
-  visualization_msgs::Marker path = pathMarker();
-
-  const int N = replayed.steps();
-  ROS_INFO("replaying %d steps over %.3f s (rate factor %g)", N, N * replayed.time_step,
-           rate_factor_);
-  for (int k = 0; k <= N; ++k) {
-    const ros::Time stamp = start + ros::Duration(replayed.time[k] / rate_factor_);
+  if (!waitForClock(replay.msg.header.stamp, &start)) return;
+  publishManeuverMarkers(pb);
+  ROS_INFO("%s: %d steps over %.3f s, %zu samples (rate %g Hz, rate factor %g), frames %s -> %s",
+           pb.result.mode.c_str(), pb.result.steps, pb.result.duration, pb.times.size(), rate_,
+           rate_factor_, pb.world_frame.c_str(), pb.body_frame.c_str());
+  std::deque<Vector3> trail;
+  for (double t : pb.times) {
+    const ros::Time stamp = start + ros::Duration(t / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    publishPose(replayed.attitude[k], stamp, box, &path, &replay.constraint_markers);
-
-    geometry_msgs::WrenchStamped wrench;
-    wrench.header.stamp = stamp;
-    wrench.header.frame_id = body_frame_;
-    wrench.wrench.torque = rc::vectorToMsg(replayed.torque[k]);
-    torque_pub_.publish(wrench);
-
-    geometry_msgs::Vector3Stamped velocity;
-    velocity.header = wrench.header;
-    velocity.vector = rc::vectorToMsg(replayed.angular_velocity[k]);
-    velocity_pub_.publish(velocity);
+    publishSample(pb, t, stamp, &trail);
   }
+  ReplayResult result = pb.result;
   result.success = true;
-  result.message = "replayed " + std::to_string(N) + " steps";
-  result.header.stamp = start + ros::Duration(replayed.time[N] / rate_factor_);
-  ROS_INFO("replay done: terminal attitude error %.3g rad vs the plan's R_N",
-           result.terminal_attitude_error);
+  result.header.frame_id = pb.world_frame;
+  result.header.stamp = start + ros::Duration(pb.times.back() / rate_factor_);
+  ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
+           result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
 }
 
 void TrackerNode::runDriftReplay(const Replay& replay) {
   ReplayResult result;
+  result.mode = trackingModeName(TrackingMode::Replay);  // kinematic: nothing to feed back
   result.plan_solve_time = replay.plan_solve_time;
   result.plan_cost = replay.plan_cost;
   DriftTwoInputTrajectory plan;
@@ -572,6 +769,7 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
       };
       result.cost += 0.5 * (plan.t[k + 1] - plan.t[k]) * (running(k) + running(k + 1));
     }
+    result.effort = result.cost;
     result.terminal_attitude_error = so3::angleBetween(plan.g[N], replayed[N]);
     result.terminal_velocity_error = 0.0;  // no velocity boundary condition (kinematic system)
     for (int k = 0; k <= N; ++k) {
@@ -587,23 +785,32 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
     return;
   }
 
+  const std::string world =
+      replay.drift_msg.header.frame_id.empty() ? world_frame_ : replay.drift_msg.header.frame_id;
+  const std::string body =
+      replay.drift_msg.child_frame_id.empty() ? body_frame_ : replay.drift_msg.child_frame_id;
   const PrincipalBox box = principalBox(Matrix3::Identity(), body_size_);  // a cube
+  const Vector3 trace_axis = traceAxis(trace_axis_name_, plan.g.front(), plan.g.back());
   ros::Time start;
-  if (!waitForClock(&start)) return;
-  visualization_msgs::Marker path = pathMarker();
-
+  if (!waitForClock(replay.drift_msg.header.stamp, &start)) return;
   const int N = static_cast<int>(replayed.size()) - 1;
+  std::vector<Vector3> tips;
+  for (int k : decimatedIndices(N, kMaxPathPoints))
+    tips.push_back(path_radius_ * (plan.g[k] * trace_axis));
+  path_pub_.publish(pathMarker(world, "attitude_path", tips, 0.6f));
+
   const double t0 = plan.t.front();
   ROS_INFO("replaying drift maneuver: %d steps over %.3f s (rate factor %g)", N, result.duration,
            rate_factor_);
+  std::deque<Vector3> trail;
   for (int k = 0; k <= N; ++k) {
     const ros::Time stamp = start + ros::Duration((plan.t[k] - t0) / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    publishPose(replayed[k], stamp, box, &path);
+    publishPose(replayed[k], stamp, world, body, box, trace_axis, &trail);
 
     geometry_msgs::Vector3Stamped control;
     control.header.stamp = stamp;
-    control.header.frame_id = body_frame_;
+    control.header.frame_id = body;
     control.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 0.0));
     control_pub_.publish(control);
 
@@ -614,6 +821,7 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
   }
   result.success = true;
   result.message = "replayed drift maneuver, " + std::to_string(N) + " steps";
+  result.header.frame_id = world;
   result.header.stamp = start + ros::Duration((plan.t[N] - t0) / rate_factor_);
   ROS_INFO("drift replay done: terminal attitude error %.3g rad vs the plan's g(T)",
            result.terminal_attitude_error);

@@ -41,7 +41,7 @@ Matrix3 inertiaFromMsg(const boost::array<double, 9>& j);
 boost::array<double, 9> inertiaToMsg(const Matrix3& J);
 
 /// Message of a maneuver planned for `problem`; header.frame_id = world_frame, child_frame_id =
-/// body_frame, header.stamp = stamp (the time t_0 refers to).
+/// body_frame, header.stamp = stamp (the time t_0 refers to); `constraints` = problem.constraints.
 AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& problem,
                                const std::string& world_frame, const std::string& body_frame,
                                const ros::Time& stamp);

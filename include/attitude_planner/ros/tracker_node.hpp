@@ -1,54 +1,90 @@
-// attitude_tracker_node: replays a planned maneuver in (ROS) real time for rviz. The torques τ_k
-// of the plan are integrated again through replayPlan() (the core's DiscreteScheme via simulate(),
-// or fourth_order's cubic hold on the continuous body, RKMK4), so what rviz
-// shows is the rigid body's response to the planned torques, not the plan's own attitudes. The
-// replay includes exactly the effects of the scene (~scene, or ~replay_scene when set; none for a
-// maneuver from the topic without ~replay_scene); `done` lists them and reports the miss.
+// attitude_tracker_node: drives a simulated rigid body along a planned maneuver and shows it in
+// rviz (docs/ros_tracker.md). ~mode replay (default) integrates the plan's torques τ_k again
+// through replayPlan() (the core's DiscreteScheme via simulate(), or fourth_order's cubic hold on
+// the continuous body, RKMK4): open loop, what the planned torques alone do. ~mode feedback tracks
+// the plan with the geometric law on SO(3) (dynamics/tracking_controller.hpp; feed-forward τ(t)
+// plus PD on e_R, e_Ω, gyroscopic terms) closed around the continuous body
+// (analysis/tracking.hpp: simulateTracking). ~mode replan is refused at start-up (it needs the
+// planner request's initial_guess, not available yet). Either way the body acts under exactly the
+// effects of the scene (~scene, or ~replay_scene when set; none for a maneuver from the topic
+// without ~replay_scene): gravity gradient and disturbances as forcing, actuator_limits saturate,
+// torque_noise perturbs the delivered torque. The body (actual) and the plan (reference) are
+// streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
+// (ManeuverInterpolation); `done` reports the terminal attitude and rate errors against the plan.
+//
+// The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
+// (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
+// of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
+// with an error naming the row otherwise; the node keeps running); cones are drawn for the
+// maneuver's `constraints`.
 //
 // A drift + two-input maneuver (seed 001, attitude_planner/DriftTwoInputManeuver on
-// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls:
-// ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
+// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls at its
+// nodes: ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
 // fourth order) from g(0); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity` the body
 // rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the body is
 // drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the cost
 // ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
 //
-// Subscribes  maneuver          AttitudeManeuver (rigid body)    a new maneuver replaces the
-//             drift_maneuver    DriftTwoInputManeuver (seed 001) current replay
-// Publishes   /tf               world → body at every step, stamped start + t_k / rate_factor
-//             torque            geometry_msgs/WrenchStamped, body      τ_k [N·m] (rigid body)
-//             angular_velocity  geometry_msgs/Vector3Stamped, body     Ω_k [rad/s]
-//             control           geometry_msgs/Vector3Stamped, body     (u1, u2, 0) [rad/s] (drift)
-//             body_marker       visualization_msgs/MarkerArray, body   box + principal axes
-//             attitude_path     visualization_msgs/Marker, world       tip of the body x axis
-//             constraint_markers visualization_msgs/MarkerArray, latched, when ~scene has keep_out
-//                               / keep_in constraints: each cone (world) and its body axis (body)
-//             done              attitude_planner/ReplayResult, latched when a replay ends
+// Bandwidth is bounded: per sample a constant amount (tf, torque, rates, body markers, a trail of
+// at most kTrailPoints points, one text marker); per maneuver once (latched) the planned path
+// decimated to at most kMaxPathPoints points, the start/target ghosts and the cones. A recording
+// grows linearly with the number of samples, never with N² (test/ros/test_tracker_bandwidth.cpp).
+//
+// Subscribes  maneuver           AttitudeManeuver (rigid body)   a new maneuver replaces the
+//             drift_maneuver     DriftTwoInputManeuver (seed 001) current replay
+// Publishes   /tf                header.frame_id → child_frame_id, the body, at every sample
+//             torque             geometry_msgs/WrenchStamped, body   delivered τ(t) [N·m]
+//             angular_velocity   geometry_msgs/Vector3Stamped, body  Ω(t) [rad/s] (actual)
+//             control            geometry_msgs/Vector3Stamped, body  (u1, u2, 0) [rad/s] (drift)
+//             reference_pose     geometry_msgs/PoseStamped, world    R_d(t), the plan [rigid body]
+//             attitude_error     std_msgs/Float64   ‖log(R_d(t)ᵀ R(t))‖ [rad] (rqt_plot)
+//             angular_velocity_error std_msgs/Float64  |Ω − RᵀR_d Ω_d| [rad/s] (rqt_plot)
+//             body_marker        visualization_msgs/MarkerArray, body   box, principal axes, traced
+//             axis attitude_trail     visualization_msgs/Marker, world   the traced axis' last
+//             kTrailPoints tips status_text        visualization_msgs/Marker, world   "t / T, angle
+//             to go, |τ|, mode" attitude_path      visualization_msgs/Marker, world, latched   the
+//             PLANNED path of the
+//                                traced tip, once per maneuver (≤ kMaxPathPoints points)
+//             ghost_markers      visualization_msgs/MarkerArray, world, latched   start and target
+//             constraint_markers visualization_msgs/MarkerArray, latched, when the maneuver (or
+//                                ~scene) has keep_out / keep_in constraints: each cone (world) and
+//                                its body axis (body, frame-locked)
+//             done               attitude_planner/ReplayResult, latched when a run ends
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //
 // Private parameters:
+//   ~mode             string  "replay" replay | feedback | replan (replan: refused, see above); an
+//                                      unknown or unavailable mode stops the node with an error
+//   ~rate             double  50.0     samples per ROS second (>= 0); 0 = one sample per plan node
+//   ~replan_period    double  1.0      [s, maneuver time] (> 0; for replan)
+//   ~trace_axis       string  "auto"   body axis traced by the path: x | y | z | auto (the one
+//                                      most perpendicular to the maneuver's rotation axis)
+//   ~feedback_frequency double 0.0     ω_n of the law [rad/s] (>= 0; 0 = 40 / T)
+//   ~feedback_damping double  1.0      ζ of the law (> 0)
 //   ~scene            string  ""       scene YAML planned at start-up (empty: wait for `maneuver`);
-//                                      its effects act during the replay (gravity gradient and
-//                                      disturbances as forcing, actuator_limits saturate,
-//                                      torque_noise perturbs the applied torque)
-//   ~replay_scene     string  ""       scene YAML whose effects act during every replay instead
+//                                      its effects act during the run
+//   ~replay_scene     string  ""       scene YAML whose effects act during every run instead
 //                                      (only its `effects` are used: body and plan come from the
-//                                      maneuver) — replaying a plan under effects it was not made
-//                                      for shows the miss in `done`
+//                                      maneuver) — shows the miss of a plan under effects it was
+//                                      not made for, and in feedback mode how much of it the law
+//                                      removes
 //   ~plan_in_process  bool    false    plan the scene with planManeuver() instead of the service
 //   ~planner_timeout  double  30.0     wait for the planner service [s, wall]
 //   ~rate_factor      double  1.0      maneuver seconds per ROS second (> 0; 2 = twice as fast)
-//   ~start_delay      double  0.5      ROS seconds between receiving a maneuver and step 0 (>= 0)
-//   ~world_frame      string  "world"  fixed frame of tf, path and the maneuver
-//   ~body_frame       string  "body"   body frame of tf, torque, velocity and markers
+//   ~start_delay      double  0.5      ROS seconds between receiving a maneuver and t_0 (>= 0)
+//   ~world_frame      string  "world"  fixed frame when the maneuver's header.frame_id is empty
+//   ~body_frame       string  "body"   body frame when the maneuver's child_frame_id is empty
 //   ~body_size        double  1.0      largest edge of the drawn box [m] (> 0)
 //   ~axis_length      double  0.9      length of the principal-axis arrows [m] (> 0)
-//   ~path_radius      double  1.2      distance of the traced body-x tip from the origin [m] (> 0)
+//   ~path_radius      double  1.2      distance of the traced tip from the origin [m] (> 0)
 //   ~exit_when_done   bool    false    shut the node down after publishing `done` (demo/CI)
 #pragma once
 
 #include <atomic>
+#include <deque>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -62,12 +98,18 @@
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 
 namespace attitude_planner {
+
+/// Most points of the latched planned path (`attitude_path`): longer plans are decimated.
+inline constexpr int kMaxPathPoints = 400;
+/// Points of the live trail (`attitude_trail`), the newest samples' traced tips.
+inline constexpr int kTrailPoints = 60;
 
 /// A uniform box with the principal moments of J: edges along the principal axes.
 struct PrincipalBox {
@@ -82,26 +124,40 @@ struct PrincipalBox {
 PrincipalBox principalBox(const Matrix3& inertia, double size);
 
 /// Markers of the body: id 0 the box, ids 1..3 arrows along the principal axes (red, green, blue
-/// for the smallest, middle, largest moment), id 4 the body x axis up to the traced tip at
-/// `path_radius` [m] (orange, as `attitude_path`); all in `body_frame`.
+/// for the smallest, middle, largest moment), id 4 the traced body axis `trace_axis` (unit) up to
+/// the traced tip at `path_radius` [m] (orange, as `attitude_path`); all in `body_frame`.
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
                                             double path_radius, const std::string& body_frame,
-                                            const ros::Time& stamp);
+                                            const ros::Time& stamp,
+                                            const Vector3& trace_axis = Vector3::UnitX());
 
 /// Markers of the pointing constraints (keep_out, keep_in; others are skipped), cone i (in the
 /// order of `constraints`, counting cones only) as id i: a TRIANGLE_LIST cone in `world_frame`
-/// (ns "keep_out" red / "keep_in" green, translucent), apex at the origin, axis the world
-/// direction s, every rim point at slant distance `length` [m] and at the half angle from s; and
-/// an ARROW in `body_frame` (ns "keep_out_body_axis" / "keep_in_body_axis") from the origin to
-/// `length` · b. Stamp zero: rviz draws the body axis at the latest transform.
+/// (ns "keep_out" magenta / "keep_in" cyan, translucent: colours no principal axis has), apex at
+/// the origin, axis the world direction s, every rim point at slant distance `length` [m] and at
+/// the half angle from s; and a frame-locked ARROW in `body_frame` (ns "keep_out_body_axis" /
+/// "keep_in_body_axis") from the origin to `length` · b. Stamp zero: rviz draws the body axis at
+/// the latest transform, so the array is published once (latched).
 visualization_msgs::MarkerArray constraintMarkers(
     const std::vector<PlanningConstraint>& constraints, double length,
     const std::string& world_frame, const std::string& body_frame, const ros::Time& stamp);
 
+/// The body axis to trace: e_x, e_y, e_z for `name` "x", "y", "z"; for "auto" the principal
+/// direction e_i least aligned with the maneuver's rotation axis log(R_0ᵀ R_N) (body frame), so
+/// the turn shows (e_x if R_N = R_0). Throws InvalidInput naming ~trace_axis for another name.
+Vector3 traceAxis(const std::string& name, const Matrix3& initial, const Matrix3& final);
+
+/// Up to `max_points` indices of 0..n, evenly spread, 0 and n always included, increasing.
+std::vector<int> decimatedIndices(int n, int max_points);
+
+/// Maneuver times [s] of the published samples: t_j = j · rate_factor / rate while below T, then
+/// T itself; with rate = 0 the node times k h, k = 0..N.
+std::vector<double> sampleTimes(double duration, int steps, double rate, double rate_factor);
+
 /// Plans a scene: via the service (if `client` is valid; the request carries the scene's
 /// plannable `effects`, actuator limits and constraints) or in-process (`problem` already holds
-/// them). Fills `msg` and the planner's solve time [s] and cost; returns false with `error` set if
-/// planning failed.
+/// them). Fills `msg` (with the constraints it was planned under) and the planner's solve time
+/// [s] and cost; returns false with `error` set if planning failed.
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
@@ -118,7 +174,7 @@ bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* cli
 /// The node.
 class TrackerNode {
  public:
-  /// Reads parameters, subscribes, and plans ~scene if it is set.
+  /// Reads parameters, subscribes, and plans ~scene if it is set. A bad ~mode stops the node.
   TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
   /// Stops a running replay.
   ~TrackerNode();
@@ -132,15 +188,32 @@ class TrackerNode {
     double plan_solve_time = -1.0;    ///< [s], −1 if unknown
     double plan_cost = -1.0;          ///< [N²·m²], −1 if unknown
     std::vector<EffectSpec> effects;  ///< effects acting during the replay (rigid body only)
-    /// ~scene's constraintMarkers (empty for a maneuver from the topic), re-published with every
-    /// pose so rviz finds the body frame at their stamp.
-    visualization_msgs::MarkerArray constraint_markers;
+    /// Cones to draw when the message carries none (~scene's, for a drift scene's frames).
+    std::vector<PlanningConstraint> scene_constraints;
+  };
+
+  /// What a rigid-body run streams: the plan (reference) and the body (actual), both
+  /// interpolated, the frames, the sample times and the result so far.
+  struct Playback {
+    std::shared_ptr<const EffectModel> effects;        ///< known effects (kept alive)
+    std::unique_ptr<ManeuverInterpolation> reference;  ///< the plan
+    std::unique_ptr<ManeuverInterpolation> actual;     ///< the body
+    std::vector<double> times;                         ///< maneuver times of the samples [s]
+    std::string world_frame, body_frame;               ///< from the message
+    PrincipalBox box;                                  ///< the drawn body
+    Vector3 trace_axis = Vector3::UnitX();             ///< traced body axis (unit)
+    std::vector<PlanningConstraint> constraints;       ///< cones to draw
+    ReplayResult result;                               ///< filled before streaming
   };
 
   /// `maneuver` callback: replaces the running replay.
   void onManeuver(const AttitudeManeuver::ConstPtr& msg);
   /// `drift_maneuver` callback: replaces the running replay.
   void onDriftManeuver(const DriftTwoInputManeuver::ConstPtr& msg);
+  /// Plans ~scene (through the service or in-process) and starts its replay; false with
+  /// `error` set if it could not.
+  bool planAndStartScene(const std::string& scene, bool plan_in_process, double planner_timeout,
+                         std::string* error);
   /// Stops the current replay (if any) and starts a new one in its own thread (under
   /// ~replay_scene's effects if that is set).
   void startReplay(Replay replay);
@@ -148,20 +221,32 @@ class TrackerNode {
   void stopReplay();
   /// The replay thread's body; returns early when stop_ is set.
   void runReplay(Replay replay);
-  /// runReplay for a drift + two-input maneuver.
+  /// Builds the playback of a rigid-body maneuver in ~mode (replay or closed loop) and its
+  /// result (terminal errors, effort); throws InvalidInput / StepTooLarge naming what is wrong.
+  Playback preparePlayback(const Replay& replay) const;
+  /// The open-loop or closed-loop run of `playback`'s plan: fills playback->actual and the
+  /// result's errors and effort.
+  void runBody(const Replay& replay, const Maneuver& plan, const Matrix3& inertia,
+               SchemeKind scheme, Playback* playback) const;
+  /// Publishes one sample at maneuver time t, stamped `stamp`.
+  void publishSample(const Playback& playback, double t, const ros::Time& stamp,
+                     std::deque<Vector3>* trail);
+  /// Publishes (latched, once) the planned path, the start and target ghosts and the cones.
+  void publishManeuverMarkers(const Playback& playback);
+  /// runReplay for a drift + two-input maneuver (at its nodes).
   void runDriftReplay(const Replay& replay);
   /// Sleeps until ROS time `t` (sim-time friendly); false if stopped meanwhile.
   bool sleepUntil(const ros::Time& t);
-  /// Waits for a valid ROS clock (sim time); sets the replay's start = now + ~start_delay. False
-  /// if stopped meanwhile.
-  bool waitForClock(ros::Time* start);
-  /// The empty `attitude_path` LINE_STRIP.
-  visualization_msgs::Marker pathMarker() const;
-  /// tf world → body, the body markers, the path's next point and (if any) the constraint
-  /// markers at `stamp`.
-  void publishPose(const Matrix3& R, const ros::Time& stamp, const PrincipalBox& box,
-                   visualization_msgs::Marker* path,
-                   visualization_msgs::MarkerArray* constraint_markers = nullptr);
+  /// Waits for a valid ROS clock (sim time); sets the run's start: `stamp` if it is in the future,
+  /// else now + ~start_delay. False if stopped meanwhile.
+  bool waitForClock(const ros::Time& stamp, ros::Time* start);
+  /// The `attitude_path` LINE_STRIP through `tips` (world frame `frame`).
+  visualization_msgs::Marker pathMarker(const std::string& frame, const std::string& ns,
+                                        const std::vector<Vector3>& tips, float alpha) const;
+  /// tf frame → body, the body markers and the trail at `stamp`.
+  void publishPose(const Matrix3& R, const ros::Time& stamp, const std::string& world_frame,
+                   const std::string& body_frame, const PrincipalBox& box,
+                   const Vector3& trace_axis, std::deque<Vector3>* trail);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
 
@@ -169,20 +254,30 @@ class TrackerNode {
   ros::Subscriber maneuver_sub_;   ///< `maneuver`
   ros::Subscriber drift_sub_;      ///< `drift_maneuver`
   ros::Publisher control_pub_;     ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
-  ros::Publisher torque_pub_;      ///< `torque` τ_k [N·m], frame body
-  ros::Publisher velocity_pub_;    ///< `angular_velocity` Ω_k [rad/s], frame body
+  ros::Publisher torque_pub_;      ///< `torque` τ(t) [N·m], frame body
+  ros::Publisher velocity_pub_;    ///< `angular_velocity` Ω(t) [rad/s], frame body
+  ros::Publisher reference_pub_;   ///< `reference_pose` R_d(t)
+  ros::Publisher error_pub_;       ///< `attitude_error` [rad]
+  ros::Publisher rate_error_pub_;  ///< `angular_velocity_error` [rad/s]
   ros::Publisher marker_pub_;      ///< `body_marker`
-  ros::Publisher path_pub_;        ///< `attitude_path`
+  ros::Publisher trail_pub_;       ///< `attitude_trail`
+  ros::Publisher text_pub_;        ///< `status_text`
+  ros::Publisher path_pub_;        ///< `attitude_path` (latched)
+  ros::Publisher ghost_pub_;       ///< `ghost_markers` (latched)
   ros::Publisher done_pub_;        ///< `done` (latched)
   ros::Publisher constraint_pub_;  ///< `constraint_markers` (latched)
   tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
+  TrackingMode mode_ = TrackingMode::Replay;      ///< ~mode
+  double rate_ = 50.0;                            ///< ~rate [Hz]; 0 = at the nodes
+  std::string trace_axis_name_ = "auto";          ///< ~trace_axis
+  TrackingOptions tracking_;                      ///< ~feedback_frequency, ~feedback_damping
   double rate_factor_ = 1.0;                      ///< maneuver seconds per ROS second
   double start_delay_ = 0.5;                      ///< [s] ROS time before step 0
-  std::string world_frame_;                       ///< fixed frame
-  std::string body_frame_;                        ///< body frame
+  std::string world_frame_;                       ///< fixed frame (empty header.frame_id)
+  std::string body_frame_;                        ///< body frame (empty child_frame_id)
   double body_size_ = 1.0;                        ///< largest box edge [m]
   double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
-  double path_radius_ = 1.2;                      ///< distance of the traced body-x tip [m]
+  double path_radius_ = 1.2;                      ///< distance of the traced tip [m]
   bool exit_when_done_ = false;                   ///< shut down after `done`
   /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
   std::optional<std::vector<EffectSpec>> replay_scene_effects_;

@@ -1,0 +1,145 @@
+// A plan as a continuous reference, and the closed loop that tracks it (the tracker's `feedback`
+// mode, docs/ros_tracker.md). ROS-free: the tracker node converts and calls.
+//
+// Between the nodes a plan is interpolated the way its scheme moves (the "scheme's own
+// interpolation"): the torque with the scheme's hold (naturalHold: node-centred for paper and
+// variational, linear for second_order, cubic for fourth_order); the attitude along the step's
+// geodesic R_k exp(s log(R_kᵀ R_{k+1})), s ∈ [0, 1], which is exactly the paper scheme's motion
+// (constant body rate log(F_k)/h over the step); the body rate for paper linear between the step
+// rates placed at the step midpoints (so that its derivative is the node-centred torque's
+// acceleration), linear between the node rates otherwise (variational's rows J⁻¹μ(F_k) follow the
+// node's impulse h τ_k: the rate at t_k is taken halfway through it); fourth_order, not a
+// discretization, moves as the continuous body under its cubic hold (one RKMK4 step from the
+// node, as replayPlan does).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/analysis/accuracy.hpp"
+#include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/maneuver.hpp"
+#include "attitude_planner/dynamics/tracking_controller.hpp"
+#include "attitude_planner/name_table.hpp"
+
+namespace attitude_planner {
+
+/// How the tracker drives the body along a plan.
+enum class TrackingMode {
+  Replay,    ///< open loop: the plan's torques, as planned (the default)
+  Feedback,  ///< the geometric tracking law around the plan (simulateTracking)
+  Replan,    ///< receding-horizon re-planning from the current state (not available yet)
+};
+
+/// The names of the modes (the tracker's ~mode, ReplayResult.mode).
+inline constexpr NamedValue<TrackingMode> kTrackingModeNames[] = {
+    {TrackingMode::Replay, "replay"},
+    {TrackingMode::Feedback, "feedback"},
+    {TrackingMode::Replan, "replan"},
+};
+
+/// "replay", "feedback" or "replan".
+inline std::string trackingModeName(TrackingMode mode) {
+  return nameIn(kTrackingModeNames, mode);
+}
+
+/// Throws InvalidInput naming the first row if maneuver.time[k] is not k · time_step within
+/// kTimeGridTolerance · T (a message whose times and step disagree is ambiguous: refused).
+void requireUniformTimeGrid(const Maneuver& maneuver);
+
+/// Relative tolerance of requireUniformTimeGrid (times are k h in floating point, up to round-off).
+inline constexpr double kTimeGridTolerance = 1e-9;
+
+/// One sample of an interpolated maneuver.
+struct ManeuverSample {
+  double time = 0.0;                           ///< t [s] since t_0
+  Matrix3 attitude = Matrix3::Identity();      ///< R(t), body → world
+  Vector3 angular_velocity = Vector3::Zero();  ///< Ω(t) [rad/s], body
+  Vector3 torque = Vector3::Zero();            ///< τ(t) [N·m], body (the hold's value)
+};
+
+/// A maneuver on its uniform node grid, evaluated at any t ∈ [0, T].
+class ManeuverInterpolation {
+ public:
+  /// `maneuver` rows k = 0..N (N ≥ 1; fourth_order's cubic hold needs N ≥ 3), interpolated with
+  /// `scheme`'s rules (file comment), or with the zero-order hold of the step's start τ_k when
+  /// `hold` is TorqueHold::StepStart (a sampled controller's output); `effects` (may be null) act
+  /// on fourth_order's in-between motion and enter referenceAt's Ω̇.
+  ManeuverInterpolation(Maneuver maneuver, SchemeKind scheme, const Matrix3& inertia,
+                        const EffectModel* effects, TorqueHold hold);
+  /// The same with the scheme's own hold (naturalHold).
+  ManeuverInterpolation(Maneuver maneuver, SchemeKind scheme, const Matrix3& inertia,
+                        const EffectModel* effects);
+
+  double duration() const { return maneuver_.time_step * steps(); }  ///< T [s]
+  int steps() const { return maneuver_.steps(); }                    ///< N
+  const Maneuver& nodes() const { return maneuver_; }
+  const Matrix3& inertia() const { return inertia_; }  ///< J [kg·m²]
+  /// R(t), Ω(t), τ(t); t is clamped to [0, T].
+  ManeuverSample at(double t) const;
+  /// The tracking reference at t: R(t), Ω(t) and Ω̇(t) = J⁻¹(τ(t) + τ_e(R(t), t) − Ω × JΩ)
+  /// (the acceleration the plan's torque and the known effects give the body).
+  AttitudeReference referenceAt(double t) const;
+  /// τ(t) of the hold on node step k (t_k ≤ t ≤ t_{k+1}).
+  Vector3 torqueOnStep(int k, double t) const;
+
+ private:
+  /// paper's Ω(t): the step rates Ω_k at the midpoints t_k + h/2, linear in between.
+  Vector3 paperRateAt(double t) const;
+  /// Ω at node k: the row, except variational's, which is moved back by half the node's impulse.
+  Vector3 nodeRate(int k) const;
+
+  Maneuver maneuver_;
+  SchemeKind scheme_;
+  Matrix3 inertia_, inertia_inverse_;
+  const EffectModel* effects_;
+  TorqueHold hold_;
+};
+
+/// Settings of the closed loop.
+struct TrackingOptions {
+  double natural_frequency = 0.0;  ///< ω_n [rad/s] of the law; 0 = defaultTrackingFrequency(T)
+  double damping = 1.0;            ///< ζ > 0
+};
+
+/// ω_n = kTrackingCyclesPerManeuver / T [rad/s]: the error's time constant 1/ω_n is a small,
+/// fixed fraction of the maneuver (T/40), so disturbances are rejected well before the end
+/// while the gains stay proportional to the plan's own accelerations.
+double defaultTrackingFrequency(double duration);
+inline constexpr double kTrackingCyclesPerManeuver = 40.0;
+/// Largest ω_n · Δt of the sampled controller (Δt the control period): the control runs on the
+/// plan's node grid, subdivided until ω_n Δt ≤ 0.2 rad, so sampling barely changes the
+/// continuous law's damping.
+inline constexpr double kMaxControlPhasePerSample = 0.2;
+
+/// A closed-loop run.
+struct TrackingRun {
+  /// The body on the control grid t_j = j Δt, j = 0..M (Δt = h / substeps): R, Ω and, in the
+  /// torque column, the control the actuators delivered over [t_j, t_{j+1}) (after saturation
+  /// and noise; row M the command at T).
+  Maneuver actual;
+  int substeps = 1;                      ///< control samples per plan step
+  double natural_frequency = 0.0;        ///< ω_n used [rad/s]
+  double effort = 0.0;                   ///< ½∫|u|² dt of the delivered control [N²·m²·s]
+  double terminal_attitude_error = 0.0;  ///< ‖log(R_d(T)ᵀ R(T))‖ [rad]
+  double terminal_velocity_error = 0.0;  ///< |Ω(T) − Ω_d(T)| [rad/s]
+  double max_attitude_error = 0.0;       ///< max_j ‖log(R_d(t_j)ᵀ R(t_j))‖ [rad]
+};
+
+/// Tracks `reference` with the geometric law (tracking_controller.hpp) from (R_0, Ω_0): the
+/// control u_j = τ(R_j, Ω_j; reference at t_j) − τ_e(R_j, t_j) (the known effects compensated;
+/// at zero error u = the plan's τ(t)) is held over each control period, passed through
+/// `actuation` (saturation, then noise; may be null) and drives the continuous rigid body
+/// Ṙ = RΩ^, JΩ̇ = JΩ × Ω + u + τ_e(R, t) (RKMK4, one step per control period, effects at every
+/// stage). Throws InvalidInput for bad options (naming them).
+TrackingRun simulateTracking(const ManeuverInterpolation& reference,
+                             const Matrix3& initial_attitude, const Vector3& initial_velocity,
+                             const EffectModel* effects, Actuation* actuation,
+                             const TrackingOptions& options);
+
+/// The open-loop effort ½∫|τ|² dt [N²·m²·s] of node torques under their scheme's weights
+/// (h · schemeCost): the replay's counterpart of TrackingRun::effort.
+double openLoopEffort(SchemeKind scheme, const Maneuver& replayed);
+
+}  // namespace attitude_planner

@@ -1,0 +1,149 @@
+// Terminal error and torque effort of the tracker's modes (docs/ros_tracker.md): each scene is
+// planned once (planManeuver, as the tracker's ~plan_in_process does) and driven open loop
+// (replayPlan, mode replay) and with the tracking law (simulateTracking, mode feedback) under the
+// scene's effects; with torque noise over several noise seeds (median and worst). The same core
+// calls as attitude_tracker_node, without ROS.
+//
+//   tracking_study [--seeds K] [--noise STD] SCENE.yaml...
+//     --seeds K    noise seeds 1..K for scenes with torque noise (default 10)
+//     --noise STD  add torque_noise {std: [STD, STD, STD]} [N m] to every scene (default: none)
+//     --cycles C   the law's natural frequency ω_n = C / T (default kTrackingCyclesPerManeuver)
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+/// One mode's figures over the noise seeds.
+struct ModeFigures {
+  std::vector<double> attitude, rate, effort;  // terminal [rad], [rad/s], ½∫|τ|²dt [N²m²s]
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double worst(const std::vector<double>& v) {
+  return *std::max_element(v.begin(), v.end());
+}
+
+/// The effects with every torque_noise seed replaced by `seed`; whether any noise is present.
+std::vector<EffectSpec> withNoiseSeed(std::vector<EffectSpec> effects, std::uint64_t seed,
+                                      bool* noisy) {
+  *noisy = false;
+  for (EffectSpec& e : effects) {
+    if (auto* noise = std::get_if<TorqueNoiseSpec>(&e)) {
+      noise->seed = seed;
+      *noisy = true;
+    }
+  }
+  return effects;
+}
+
+void printRow(const std::string& scene, const std::string& mode, const ModeFigures& f) {
+  std::printf("| %s | %s | %.3g | %.3g | %.3g | %.3g | %.6g |\n", scene.c_str(), mode.c_str(),
+              median(f.attitude), worst(f.attitude), median(f.rate), worst(f.rate),
+              median(f.effort));
+}
+
+void study(const std::string& path, int seeds, double extra_noise, double cycles) {
+  Scene scene = loadScene(path);
+  if (extra_noise > 0.0) {
+    TorqueNoiseSpec noise;
+    noise.std = Vector3::Constant(extra_noise);
+    scene.effects.push_back(noise);
+  }
+  const PlanResult plan = planManeuver(scene.problem);
+  if (!plan.converged()) {
+    std::fprintf(stderr, "%s: not planned: %s\n", path.c_str(), plan.message.c_str());
+    std::exit(1);
+  }
+  const Matrix3& J = scene.problem.inertia;
+  const SchemeKind scheme = scene.problem.scheme;
+  const Maneuver& nodes = plan.maneuver;
+  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+  const ManeuverInterpolation reference(nodes, scheme, J, effects.get());
+  ModeFigures replay, feedback;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    bool noisy = false;
+    const std::vector<EffectSpec> specs = withNoiseSeed(scene.effects, seed, &noisy);
+    Actuation open_loop = actuationOf(specs);
+    SimulationInput input;
+    input.initial_attitude = nodes.attitude[0];
+    input.initial_velocity = nodes.angular_velocity[0];
+    input.torque = nodes.torque;
+    input.effects = effects.get();
+    input.actuation = &open_loop;
+    const Maneuver replayed = replayPlan(scheme, J, nodes.time_step, input);
+    replay.attitude.push_back(so3::angleBetween(replayed.attitude.back(), nodes.attitude.back()));
+    replay.rate.push_back(
+        (replayed.angular_velocity.back() - nodes.angular_velocity.back()).norm());
+    replay.effort.push_back(openLoopEffort(scheme, replayed));
+
+    Actuation closed_loop = actuationOf(specs);
+    TrackingOptions options;
+    options.natural_frequency = cycles / reference.duration();
+    const TrackingRun run =
+        simulateTracking(reference, nodes.attitude[0], nodes.angular_velocity[0], effects.get(),
+                         &closed_loop, options);
+    feedback.attitude.push_back(run.terminal_attitude_error);
+    feedback.rate.push_back(run.terminal_velocity_error);
+    feedback.effort.push_back(run.effort);
+    if (!noisy) break;  // deterministic: one run says it all
+  }
+  std::string name = path.substr(path.find_last_of('/') + 1);
+  if (extra_noise > 0.0) name += " + noise " + std::to_string(extra_noise).substr(0, 6) + " N m";
+  printRow(name, "replay", replay);
+  printRow(name, "feedback", feedback);
+  std::printf("| %s | replan | not available (needs the request's initial_guess) | | | | |\n",
+              name.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int seeds = 10;
+  double noise = 0.0;
+  double cycles = kTrackingCyclesPerManeuver;
+  std::vector<std::string> scenes;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--seeds" && i + 1 < argc) {
+      seeds = std::atoi(argv[++i]);
+    } else if (arg == "--cycles" && i + 1 < argc) {
+      cycles = std::atof(argv[++i]);
+    } else if (arg == "--noise" && i + 1 < argc) {
+      noise = std::atof(argv[++i]);
+    } else {
+      scenes.push_back(arg);
+    }
+  }
+  if (scenes.empty() || seeds < 1 || !(noise >= 0.0) || !(cycles > 0.0)) {
+    std::fprintf(stderr,
+                 "usage: tracking_study [--seeds K >= 1] [--noise STD >= 0] [--cycles C > 0] "
+                 "SCENE.yaml...\n");
+    return 2;
+  }
+  std::printf(
+      "| scene | mode | terminal attitude error, median [rad] | worst [rad] | terminal "
+      "rate error, median [rad/s] | worst [rad/s] | effort ½∫\\|τ\\|²dt, median "
+      "[N²·m²·s] |\n|---|---|---|---|---|---|---|\n");
+  try {
+    for (const std::string& s : scenes) study(s, seeds, noise, cycles);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tracking_study: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

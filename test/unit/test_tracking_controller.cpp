@@ -1,0 +1,237 @@
+// The geometric tracking law (dynamics/tracking_controller.hpp) and the closed loop around a plan
+// (analysis/tracking.hpp): the law's output at zero error, exponential convergence of the
+// continuous closed loop from a perturbed start, the interpolation's exactness at the nodes, and
+// feedback against open-loop replay under the disturbed scene.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/dynamics/tracking_controller.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+const Matrix3 kInertia =
+    (Matrix3() << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37).finished();
+
+/// A reference spinning at a constant rate about a non-principal axis: R_d(t) = R_d0 exp(t Ω_d^),
+/// Ω̇_d = 0, so the feed-forward is the gyroscopic Ω_d × JΩ_d ≠ 0.
+struct ConstantSpin {
+  Matrix3 start = so3::exp(Vector3(0.2, -0.4, 0.1));
+  Vector3 rate = Vector3(0.3, -0.2, 0.25);  // [rad/s]
+  AttitudeReference at(double t) const {
+    AttitudeReference r;
+    r.attitude = start * so3::exp(Vector3(t * rate));
+    r.angular_velocity = rate;
+    return r;
+  }
+};
+
+/// |e_R| + |e_Ω| / ω_n: the error in one number (both parts decay at the same rate).
+double errorSize(const Matrix3& R, const Vector3& W, const AttitudeReference& ref, double w_n) {
+  const TrackingErrors e = trackingErrors(R, W, ref);
+  return e.attitude.norm() + e.rate.norm() / w_n;
+}
+
+}  // namespace
+
+TEST(TrackingController, ZeroErrorGivesExactlyTheFeedForwardTorque) {
+  const TrackingGains gains = trackingGains(kInertia, 2.0, 0.8);
+  AttitudeReference ref;
+  ref.angular_velocity = Vector3(0.3, -1.2, 0.7);
+  ref.angular_acceleration = Vector3(-0.05, 0.4, 0.2);
+  // At R = R_d = I every error term is exactly zero: the output is the feed-forward, bit for bit.
+  const Vector3 ff = feedForwardTorque(kInertia, ref);
+  EXPECT_EQ(trackingTorque(kInertia, gains, ref.attitude, ref.angular_velocity, ref), ff);
+  // J Ω̇_d + Ω_d × JΩ_d: the torque Euler's equation needs for Ω̇_d.
+  EXPECT_LT((ff - (kInertia * ref.angular_acceleration +
+                   ref.angular_velocity.cross(kInertia * ref.angular_velocity)))
+                .norm(),
+            1e-15);
+  // Anywhere else on SO(3): the same to round-off (Rᵀ R is I only to round-off).
+  ref.attitude = so3::exp(Vector3(1.1, -2.0, 0.4));
+  const Vector3 tau = trackingTorque(kInertia, gains, ref.attitude, ref.angular_velocity, ref);
+  EXPECT_LT((tau - feedForwardTorque(kInertia, ref)).norm(), 1e-13 * ff.norm());
+  const TrackingErrors e = trackingErrors(ref.attitude, ref.angular_velocity, ref);
+  EXPECT_EQ(e.attitude.norm(), 0.0);
+  EXPECT_LT(e.rate.norm(), 1e-15);
+  EXPECT_LT(e.angle, 1e-7);  // ‖log(≈I)‖: the square root of round-off at worst
+}
+
+TEST(TrackingController, AttitudeErrorIsSineOfTheAngleAboutTheAxis) {
+  const Matrix3 R_d = so3::exp(Vector3(0.3, 0.1, -0.2));
+  const Vector3 axis = Vector3(1.0, -2.0, 0.5).normalized();
+  AttitudeReference ref;
+  ref.attitude = R_d;
+  for (double angle : {1e-6, 0.3, 1.5, 3.0}) {
+    const TrackingErrors e =
+        trackingErrors(R_d * so3::fromAxisAngle(axis, angle), Vector3::Zero(), ref);
+    EXPECT_LT((e.attitude - std::sin(angle) * axis).norm(), 1e-14) << angle;
+    EXPECT_NEAR(e.angle, angle, 1e-12) << angle;
+  }
+}
+
+TEST(TrackingController, GainsAreRefusedByName) {
+  EXPECT_THROW(trackingGains(kInertia, 0.0, 1.0), InvalidInput);
+  EXPECT_THROW(trackingGains(kInertia, 1.0, -1.0), InvalidInput);
+  try {
+    trackingGains(kInertia, std::nan(""), 1.0);
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("natural_frequency"), std::string::npos) << e.what();
+  }
+}
+
+// The continuous closed loop (the law evaluated at every Runge–Kutta stage) from 1 rad and a rate
+// error away converges exponentially: critically damped, the error envelope is (1 + ω_n t)
+// e^{−ω_n t}, so each 10/ω_n divides it by far more than 100.
+TEST(TrackingController, ConvergesExponentiallyFromAPerturbedStart) {
+  const double w_n = 1.5;
+  const TrackingGains gains = trackingGains(kInertia, w_n, 1.0);
+  const ConstantSpin spin;
+  Matrix3 R = spin.at(0.0).attitude * so3::fromAxisAngle(Vector3(0.2, 1.0, -0.4).normalized(), 1.0);
+  Vector3 W = spin.rate + Vector3(0.1, 0.2, -0.3);
+  const Matrix3 J_inverse = kInertia.inverse();
+  const auto derivative = [&](const Matrix3& R_s, const Vector3& w, double t) {
+    const Vector3 tau = trackingTorque(kInertia, gains, R_s, w, spin.at(t));
+    return Vector3(J_inverse * ((kInertia * w).cross(w) + tau));
+  };
+  const double dt = 0.002 / w_n;
+  std::vector<double> size_at;  // at t = 0, 10/ω_n, 20/ω_n
+  size_at.push_back(errorSize(R, W, spin.at(0.0), w_n));
+  const int per_block = static_cast<int>(std::lround(10.0 / w_n / dt));
+  for (int i = 1; i <= 2 * per_block; ++i) {
+    const double t = (i - 1) * dt;
+    // RKMK4 on R exp(u^), u̇ = J_r(u)⁻¹ Ω (the integrator of analysis/tracking.cpp).
+    const auto du = [&](const Vector3& u, const Vector3& w) {
+      return Vector3(so3::rightJacobianInverse(u) * w);
+    };
+    const Vector3 u1 = du(Vector3::Zero(), W), w1 = derivative(R, W, t);
+    const Vector3 a2 = 0.5 * dt * u1, W2 = W + 0.5 * dt * w1;
+    const Vector3 u2 = du(a2, W2), w2 = derivative(R * so3::exp(a2), W2, t + 0.5 * dt);
+    const Vector3 a3 = 0.5 * dt * u2, W3 = W + 0.5 * dt * w2;
+    const Vector3 u3 = du(a3, W3), w3 = derivative(R * so3::exp(a3), W3, t + 0.5 * dt);
+    const Vector3 a4 = dt * u3, W4 = W + dt * w3;
+    const Vector3 u4 = du(a4, W4), w4 = derivative(R * so3::exp(a4), W4, t + dt);
+    R = reorthonormalize(R * so3::exp(Vector3(dt / 6.0 * (u1 + 2.0 * u2 + 2.0 * u3 + u4))));
+    W += dt / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);
+    if (i % per_block == 0) size_at.push_back(errorSize(R, W, spin.at(i * dt), w_n));
+  }
+  ASSERT_EQ(size_at.size(), 3u);
+  EXPECT_GT(size_at[0], 0.5);
+  EXPECT_LT(size_at[1], 1e-2 * size_at[0]) << size_at[1];
+  EXPECT_LT(size_at[2], 1e-2 * size_at[1]) << size_at[2];  // the same factor again: exponential
+}
+
+TEST(ManeuverInterpolation, IsExactAtTheNodesAndOnThePaperSchemesGeodesic) {
+  const int N = 16;
+  const double h = 0.25;
+  SimulationInput input;
+  input.initial_velocity = Vector3(0.1, 0.0, -0.05);
+  input.torque.assign(N + 1, Vector3::Zero());
+  for (int k = 1; k < N; ++k) input.torque[k] = Vector3(std::sin(0.4 * k), 0.3, -0.2);
+  const Maneuver plan = simulate(DiscreteScheme(SchemeKind::Paper, kInertia, h), input);
+  const ManeuverInterpolation interp(plan, SchemeKind::Paper, kInertia, nullptr);
+  EXPECT_DOUBLE_EQ(interp.duration(), N * h);
+  for (int k = 0; k <= N; ++k) {
+    const ManeuverSample s = interp.at(k * h);
+    EXPECT_EQ(s.attitude, plan.attitude[k]) << k;
+    EXPECT_EQ(s.torque, plan.torque[k]) << k;
+    // paper's rates are the steps' (midpoint) rates: at an interior node their mean.
+    if (k > 0 && k < N) {
+      EXPECT_LT(
+          (s.angular_velocity - 0.5 * (plan.angular_velocity[k - 1] + plan.angular_velocity[k]))
+              .norm(),
+          1e-15)
+          << k;
+    }
+  }
+  EXPECT_EQ(interp.at(0.25 * h).angular_velocity, plan.angular_velocity[0]);
+  EXPECT_LT((interp.at((N - 0.5) * h).angular_velocity - plan.angular_velocity[N - 1]).norm(),
+            1e-15);
+  // paper: constant body rate Ω_k over step k, so R(t_k + s) = R_k exp(s Ω_k^).
+  const int k = 5;
+  const double s = 0.37 * h;
+  const ManeuverSample mid = interp.at(k * h + s);
+  EXPECT_LT(so3::angleBetween(mid.attitude,
+                              plan.attitude[k] * so3::exp(Vector3(s * plan.angular_velocity[k]))),
+            1e-12);
+  // The node-centred hold: τ_k on [t_k − h/2, t_k + h/2).
+  EXPECT_EQ(interp.at(k * h + 0.4 * h).torque, plan.torque[k]);
+  EXPECT_EQ(interp.at(k * h + 0.6 * h).torque, plan.torque[k + 1]);
+}
+
+TEST(ManeuverInterpolation, NonUniformTimesAreRefusedNamingTheRow) {
+  Maneuver m;
+  m.time_step = 0.5;
+  m.time = {0.0, 0.5, 1.2};
+  m.attitude.assign(3, Matrix3::Identity());
+  m.angular_velocity.assign(3, Vector3::Zero());
+  m.torque.assign(3, Vector3::Zero());
+  try {
+    requireUniformTimeGrid(m);
+    FAIL() << "accepted time[2] = 1.2 with time_step 0.5";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("maneuver.time[2]"), std::string::npos) << e.what();
+  }
+  m.time[2] = 1.0;
+  EXPECT_NO_THROW(requireUniformTimeGrid(m));
+}
+
+// Without effects, from the plan's own start, the loop reproduces the plan (the law only adds
+// the discretization's small corrections); from a perturbed start it lands anyway.
+TEST(SimulateTracking, TracksAPlanFromAPerturbedStart) {
+  const int N = 64;
+  const double h = 0.2;
+  SimulationInput input;
+  input.torque.assign(N + 1, Vector3::Zero());
+  for (int k = 1; k < N; ++k) input.torque[k] = 0.2 * Vector3(std::sin(0.1 * k), 0.5, -0.3);
+  const Maneuver plan = simulate(DiscreteScheme(SchemeKind::Variational, kInertia, h), input);
+  const ManeuverInterpolation reference(plan, SchemeKind::Variational, kInertia, nullptr);
+  const TrackingRun exact =
+      simulateTracking(reference, plan.attitude[0], plan.angular_velocity[0], nullptr, nullptr, {});
+  EXPECT_LT(exact.terminal_attitude_error, 1e-3);
+  const TrackingRun perturbed =
+      simulateTracking(reference, plan.attitude[0] * so3::exp(Vector3(0.3, -0.2, 0.1)),
+                       Vector3(0.05, 0.0, 0.02), nullptr, nullptr, {});
+  EXPECT_GT(perturbed.max_attitude_error, 0.3);
+  EXPECT_LT(perturbed.terminal_attitude_error, 1e-2 * perturbed.max_attitude_error);
+  EXPECT_EQ(perturbed.actual.steps(), N * perturbed.substeps);
+  EXPECT_GT(perturbed.effort, exact.effort);
+}
+
+// scenes/disturbed_replay.yaml: the plan knows the gravity gradient and the disturbance, not the
+// actuator noise. Open loop misses by the noise's random walk; closed loop by far less.
+TEST(SimulateTracking, FeedbackBeatsOpenLoopReplayUnderNoiseByAnOrderOfMagnitude) {
+  const Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
+  const PlanResult plan = planManeuver(scene.problem);
+  ASSERT_TRUE(plan.converged()) << plan.message;
+  const Matrix3& J = scene.problem.inertia;
+  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+  const Maneuver& nodes = plan.maneuver;
+
+  Actuation open_loop_actuation = actuationOf(scene.effects);
+  SimulationInput input;
+  input.initial_attitude = nodes.attitude[0];
+  input.initial_velocity = nodes.angular_velocity[0];
+  input.torque = nodes.torque;
+  input.effects = effects.get();
+  input.actuation = &open_loop_actuation;
+  const Maneuver replayed = replayPlan(scene.problem.scheme, J, nodes.time_step, input);
+  const double replay_miss = so3::angleBetween(replayed.attitude.back(), nodes.attitude.back());
+
+  Actuation closed_loop_actuation = actuationOf(scene.effects);
+  const ManeuverInterpolation reference(nodes, scene.problem.scheme, J, effects.get());
+  const TrackingRun run = simulateTracking(reference, nodes.attitude[0], nodes.angular_velocity[0],
+                                           effects.get(), &closed_loop_actuation, {});
+  EXPECT_GT(replay_miss, 1e-3);  // the noise matters open loop (~1.5e-3 rad, docs/ros_tracker.md)
+  EXPECT_LT(run.terminal_attitude_error, 0.1 * replay_miss)
+      << "feedback " << run.terminal_attitude_error << " rad, replay " << replay_miss << " rad";
+}

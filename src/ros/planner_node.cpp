@@ -265,6 +265,9 @@ void PlannerNode::workerLoop() {
 void PlannerNode::serveGoal(const ActiveGoal& goal) {
   GoalHandle handle = goal.handle;
   const std::string id = handle.getGoalID().id;
+  // A cancel that arrived before the goal was in active_ (so onCancel found no flag to set).
+  if (handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING)
+    goal.cancel->store(true);
   PlanAttitudeManeuverResult result;
   try {
     const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
@@ -300,9 +303,7 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
                          handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING;
   if (cancelled) {
     if (result.error_code.val != PlanErrorCode::CANCELLED) {
-      result.message = "cancelled by its client (the solve had ended " +
-                       std::string(result.success ? "converged" : "unconverged") + ": " +
-                       result.message + ")";
+      result.message = "cancelled (the cancel arrived as the solve ended: " + result.message + ")";
       result.success = false;
       result.error_code.val = PlanErrorCode::CANCELLED;
     }

@@ -36,7 +36,8 @@ std::string show(const YAML::Node& node) {
 /// The value checks of one effect (shared by scene files and service requests).
 void validateEffect(const EffectSpec& effect, const std::string& path) {
   auto require = [&](bool ok, const std::string& key, double value, const char* rule) {
-    if (!ok) throw InvalidInput(path + "." + key + ": " + rule + ", got " + exactNumber(value));
+    if (!ok)
+      throw InvalidInput(path + "." + key, std::string(rule) + ", got " + exactNumber(value));
   };
   auto requireVector = [&](const Vector3& v, const std::string& key, bool positive) {
     for (int k = 0; k < 3; ++k) {
@@ -531,7 +532,7 @@ void validateEffects(const std::vector<EffectSpec>& effects, const std::string& 
     validateEffect(effects[i], path);
     // Several constant disturbances add up; the other effects are one-of-a-kind.
     if (effectKindOf(effects[i]) != EffectKind::DisturbanceTorque && !seen.insert(name).second) {
-      throw InvalidInput(path + ": duplicate effect (at most one " + name + ")");
+      throw InvalidInput(path, "duplicate effect (at most one " + name + ")");
     }
   }
 }

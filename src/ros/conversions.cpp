@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 namespace attitude_planner {
@@ -33,8 +34,7 @@ EffectSpec effectFromMsg(const Effect& msg, const std::string& field) {
   if (!uses_seed) unused(msg.seed == 0, "seed", std::to_string(msg.seed));
   if (uses_orbit) return GravityGradientSpec{msg.mu, msg.orbit_radius};
   if (uses_frame) {
-    const std::string frame_field = field + "." + effectKindName(kind) + ".frame";
-    return DisturbanceTorqueSpec{parseTorqueFrame(msg.frame, frame_field), value};
+    return DisturbanceTorqueSpec{parseTorqueFrame(msg.frame, field + ".frame"), value};
   }
   if (kind == EffectKind::ActuatorLimits) return ActuatorLimitsSpec{value};
   return TorqueNoiseSpec{value, msg.seed};
@@ -67,13 +67,12 @@ PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& f
     throw InvalidInput(field + ".type: unknown value '" + msg.type +
                        "' (expected max_torque_norm, max_angular_rate, keep_out or keep_in)");
   }
-  const std::string path = field + "." + msg.type;
   if (cone && msg.limit != 0.0) {
-    throw InvalidInput(path + ".limit: not used by " + msg.type + ", must be 0, got " +
+    throw InvalidInput(field + ".limit: not used by " + msg.type + ", must be 0, got " +
                        exactNumber(msg.limit));
   }
   if (!cone && (!b.isZero(0.0) || !s.isZero(0.0) || msg.half_angle != 0.0 || msg.margin != 0.0)) {
-    throw InvalidInput(path +
+    throw InvalidInput(field +
                        ": body_axis, world_direction, half_angle and margin are not used by " +
                        msg.type + ", must be 0");
   }
@@ -130,6 +129,15 @@ geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R) {
 
 Vector3 vectorFromMsg(const geometry_msgs::Vector3& v) {
   return Vector3(v.x, v.y, v.z);
+}
+
+Vector3 finiteVectorFromMsg(const geometry_msgs::Vector3& v, const std::string& field) {
+  const Vector3 out = vectorFromMsg(v);
+  if (!out.allFinite()) {
+    throw InvalidInput(field + ": not finite: [" + exactNumber(out.x()) + ", " +
+                       exactNumber(out.y()) + ", " + exactNumber(out.z()) + "]");
+  }
+  return out;
 }
 
 geometry_msgs::Vector3 vectorToMsg(const Vector3& v) {
@@ -311,6 +319,103 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
     r.time_budget_s = defaults.max_solve_time;
   }
   return r;
+}
+
+namespace {
+
+/// Core (scene) field names spelt otherwise in the request.
+const std::map<std::string, std::string> kRenamedFields = {
+    {"initial.attitude", "initial_attitude"},
+    {"initial.angular_velocity", "initial_angular_velocity"},
+    {"final.attitude", "final_attitude"},
+    {"final.angular_velocity", "final_angular_velocity"},
+};
+
+bool startsWith(const std::string& s, const std::string& prefix) {
+  return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+/// `constraints[i].<kind>[.<key>]` → `constraints[i].limit` (torque and rate limits),
+/// `constraints[i].<key>` (cones), `constraints[i]` (a cone as a whole).
+std::string constraintRequestField(const std::string& item, const std::string& kind,
+                                   const std::string& key) {
+  const bool limit = kind == Constraint::MAX_TORQUE_NORM || kind == Constraint::MAX_ANGULAR_RATE;
+  if (!key.empty()) return item + "." + key;
+  return limit ? item + ".limit" : item;
+}
+
+/// `effects[i].<kind>.<key>[k]` → `effects[i].value.<x|y|z>` (max_torque, std and value are the
+/// message's `value`), `effects[i].<key>` (mu, orbit_radius, frame), `effects[i]` (the effect).
+std::string effectRequestField(const std::string& item, const std::string& key) {
+  if (key.empty()) return item;
+  const std::size_t bracket = key.find('[');
+  const std::string name = key.substr(0, bracket);
+  const bool vector = name == "max_torque" || name == "std" || name == "value";
+  std::string out = item + "." + (vector ? std::string("value") : name);
+  if (vector && bracket != std::string::npos && bracket + 1 < key.size()) {
+    const char axis = key[bracket + 1];
+    if (axis >= '0' && axis <= '2') out += std::string(".") + "xyz"[axis - '0'];
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string requestFieldName(const std::string& core_field) {
+  const auto renamed = kRenamedFields.find(core_field);
+  if (renamed != kRenamedFields.end()) return renamed->second;
+  // Paths of list items: `<list>[i].<kind>[.<key>]` (the scene nests a constraint's or effect's
+  // values under its kind; the message has flat fields and a `type`).
+  const std::size_t first = core_field.find('.');
+  if (first == std::string::npos) return core_field;
+  const std::string item = core_field.substr(0, first);
+  const std::size_t second = core_field.find('.', first + 1);
+  const std::string kind = core_field.substr(first + 1, second - first - 1);
+  const std::string key = second == std::string::npos ? "" : core_field.substr(second + 1);
+  if (startsWith(item, "constraints[")) return constraintRequestField(item, kind, key);
+  if (startsWith(item, "effects[")) return effectRequestField(item, key);
+  return core_field;
+}
+
+std::string requestErrorMessage(const FieldError& error) {
+  if (error.field().empty()) return error.what();
+  return requestFieldName(error.field()) + ": " + error.detail();
+}
+
+OutputSelection outputSelectionFromRequest(const std::string& return_maneuver, int output_steps) {
+  OutputSelection out;
+  if (!return_maneuver.empty()) {
+    out.output = parseIn(kManeuverOutputNames, return_maneuver, "return_maneuver");
+  }
+  if (output_steps < 0 || output_steps == 1) {
+    throw InvalidInput(
+        "output_steps: must be 0 (every node) or >= 2 (about that many nodes, "
+        "both ends included), got " +
+        std::to_string(output_steps));
+  }
+  if (out.output == ManeuverOutput::None && output_steps != 0) {
+    throw InvalidInput("output_steps: " + std::to_string(output_steps) +
+                       " given with return_maneuver 'none' (no maneuver is returned): leave it 0");
+  }
+  out.max_nodes = output_steps;
+  return out;
+}
+
+Maneuver decimatedManeuver(const Maneuver& m, int max_nodes) {
+  const int N = m.steps();
+  if (max_nodes <= 0 || max_nodes >= N + 1) return m;
+  const int stride = (N + max_nodes - 2) / (max_nodes - 1);  // ceil(N / (max_nodes − 1))
+  Maneuver out;
+  out.time_step = m.time_step;
+  const auto keep = [&](int k) {
+    out.time.push_back(m.time[k]);
+    out.attitude.push_back(m.attitude[k]);
+    out.angular_velocity.push_back(m.angular_velocity[k]);
+    out.torque.push_back(m.torque[k]);
+  };
+  for (int k = 0; k < N; k += stride) keep(k);
+  keep(N);
+  return out;
 }
 
 int stepsFromRequest(int steps, const PlannerDefaults& defaults) {

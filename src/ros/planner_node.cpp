@@ -1,6 +1,7 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include "attitude_planner/ros/parameters.hpp"
 
@@ -26,15 +27,48 @@ int errorCodeOf(Termination termination) {
   return PlanErrorCode::INTERNAL_ERROR;
 }
 
+std::string infeasibleSummary(const PlanningProblem& problem, const PlanResult& result) {
+  std::ostringstream s;
+  s << "infeasible: ";
+  const ConstraintCheck check = result.maneuver.attitude.empty()
+                                    ? ConstraintCheck()
+                                    : checkConstraints(problem, result.maneuver);
+  if (!check.worst.empty()) {
+    s << check.worst << " cannot be met (the returned plan violates it " << check.worst_where
+      << ")";
+  } else {
+    s << "no maneuver found that meets the constraints in force (";
+    for (std::size_t i = 0; i < result.constraints.size(); ++i) {
+      s << (i == 0 ? "" : ", ") << result.constraints[i];
+    }
+    s << ")";
+  }
+  s << "; details has the solver's account";
+  return s.str();
+}
+
+void enforceDeadline(PlanOutcome* outcome) {
+  if (outcome->error_code != PlanErrorCode::SUCCESS || !(outcome->time_budget_s > 0.0) ||
+      outcome->wall_time_s <= outcome->time_budget_s) {
+    return;
+  }
+  std::ostringstream s;
+  s << "timed out: the plan converged after " << outcome->wall_time_s
+    << " s, past the time budget of " << outcome->time_budget_s
+    << " s (the late plan is returned; details has the solver's account)";
+  outcome->error_code = PlanErrorCode::TIMED_OUT;
+  outcome->message = s.str();
+}
+
 void describeCurrentException(int* error_code, std::string* message) {
   try {
     throw;
   } catch (const InvalidInput& e) {
     *error_code = errorCodeOf(Termination::InvalidInput);
-    *message = e.what();
+    *message = ros_conversions::requestErrorMessage(e);
   } catch (const StepTooLarge& e) {
     *error_code = errorCodeOf(Termination::StepTooLarge);
-    *message = e.what();
+    *message = ros_conversions::requestErrorMessage(e);
   } catch (const std::exception& e) {
     *error_code = PlanErrorCode::INTERNAL_ERROR;
     *message = std::string("internal error: ") + e.what();
@@ -108,13 +142,16 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       pnh, "body_frame", "body", [](const std::string& s) { return !s.empty(); }, "non-empty");
   threads_ = readParam<int>(
       pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
+  action_workers_ = readParam<int>(
+      pnh, "action_workers", 2, [](int v) { return v >= 1; }, ">= 1");
+  for (int i = 0; i < action_workers_; ++i) workers_.emplace_back([this] { workerLoop(); });
 
   service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);
   drift_service_ =
       nh_.advertiseService("plan_drift_two_input", &PlannerNode::onPlanDriftService, this);
-  action_server_ = std::make_unique<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>>(
-      nh_, "plan_attitude_maneuver_action",
-      [this](const PlanAttitudeManeuverGoalConstPtr& goal) { onPlanGoal(goal); }, false);
+  action_server_ = std::make_unique<ActionServer>(
+      nh_, "plan_attitude_maneuver_action", [this](GoalHandle goal) { onGoal(goal); },
+      [this](GoalHandle goal) { onCancel(goal); }, false);
   action_server_->start();
   ROS_INFO_STREAM("attitude_planner_node ready: services "
                   << service_.getService() << ", " << drift_service_.getService() << ", action "
@@ -122,7 +159,18 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
                   << schemeName(d.scheme) << ", solver " << solverName(d.solver) << ", steps "
                   << d.steps << ", tolerance " << d.tolerance << ", max_iterations "
                   << d.max_iterations << ", time_budget " << d.time_budget << " s, max_steps "
-                  << d.max_steps << ", max_solve_time " << d.max_solve_time << " s)");
+                  << d.max_steps << ", max_solve_time " << d.max_solve_time << " s, "
+                  << action_workers_ << " action workers)");
+}
+
+PlannerNode::~PlannerNode() {
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    stopping_ = true;
+    for (auto& [id, goal] : active_) goal.cancel->store(true);
+  }
+  goal_ready_.notify_all();
+  for (std::thread& worker : workers_) worker.join();
 }
 
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
@@ -164,38 +212,104 @@ bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
   return true;
 }
 
-void PlannerNode::onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal) {
+void PlannerNode::onGoal(GoalHandle goal) {
+  const std::string id = goal.getGoalID().id;
+  ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false)};
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    const bool full = static_cast<int>(active_.size()) >= action_workers_;
+    if (!stopping_ && !full) active_[id] = active;  // the slot is reserved before accepting
+    if (stopping_ || full) active.cancel = nullptr;
+  }
+  if (!active.cancel) {
+    PlanAttitudeManeuverResult result;
+    result.error_code.val = PlanErrorCode::REJECTED;
+    result.message = "rejected: all " + std::to_string(action_workers_) +
+                     " action workers (~action_workers) are busy with other goals; send it again "
+                     "when one ends, or call the service plan_attitude_maneuver";
+    ROS_WARN("goal %s %s", id.c_str(), result.message.c_str());
+    goal.setRejected(result, result.message);
+    return;
+  }
+  goal.setAccepted();  // a cancel already received turns this into PREEMPTING: served as such
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    queued_.push_back(active);
+  }
+  goal_ready_.notify_one();
+}
+
+void PlannerNode::onCancel(GoalHandle goal) {
+  std::lock_guard<std::mutex> lock(goals_mutex_);
+  const auto it = active_.find(goal.getGoalID().id);
+  if (it != active_.end()) it->second.cancel->store(true);  // this goal only
+}
+
+void PlannerNode::workerLoop() {
+  for (;;) {
+    ActiveGoal goal;
+    {
+      std::unique_lock<std::mutex> lock(goals_mutex_);
+      goal_ready_.wait(lock, [this] { return stopping_ || !queued_.empty(); });
+      if (queued_.empty()) return;  // stopping, nothing left
+      goal = queued_.front();
+      queued_.pop_front();
+      if (stopping_) goal.cancel->store(true);
+    }
+    serveGoal(goal);
+  }
+}
+
+void PlannerNode::serveGoal(const ActiveGoal& goal) {
+  GoalHandle handle = goal.handle;
+  const std::string id = handle.getGoalID().id;
+  // A cancel that arrived before the goal was in active_ (so onCancel found no flag to set).
+  if (handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING)
+    goal.cancel->store(true);
   PlanAttitudeManeuverResult result;
   try {
+    const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
     PlanAttitudeManeuverFeedback feedback;
-    const PlanOutcome outcome =
-        planRequest(*goal, defaults_, [&](const IterationInfo& info, double elapsed) {
+    const PlanOutcome outcome = planRequest(
+        *request, defaults_,
+        [&](const IterationInfo& info, double elapsed) {
           feedback.iteration = info.iteration;
           feedback.cost = info.cost;
           feedback.residual = info.gradient_norm;
           feedback.step_length = info.step_length;
           feedback.elapsed = elapsed;
-          action_server_->publishFeedback(feedback);
-          return !action_server_->isPreemptRequested();
-        });
+          feedback.steps = info.steps;
+          feedback.effort = info.effort;
+          handle.publishFeedback(feedback);
+          return true;  // the cancel reaches the core through goal.cancel
+        },
+        goal.cancel.get());
     fillResponse(outcome, world_frame_, body_frame_, &result);
   } catch (const std::exception& e) {
     result = PlanAttitudeManeuverResult();
     result.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     result.message = std::string("internal error: ") + e.what();
   }
-  if (result.success) {
-    action_server_->setSucceeded(result, result.message);
-  } else if (result.error_code.val == PlanErrorCode::CANCELLED ||
-             action_server_->isPreemptRequested()) {
-    // A preempted goal ends PREEMPTED whatever the solver had reached.
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    active_.erase(id);  // the worker is free for the next goal
+  }
+  // Under the server's lock the goal's status cannot change: a cancel received at any time up to
+  // here (PREEMPTING, or our flag) ends the goal PREEMPTED, whatever the solver reached.
+  boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+  const bool cancelled = goal.cancel->load() ||
+                         handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING;
+  if (cancelled) {
     if (result.error_code.val != PlanErrorCode::CANCELLED) {
+      result.message = "cancelled (the cancel arrived as the solve ended: " + result.message + ")";
+      result.success = false;
       result.error_code.val = PlanErrorCode::CANCELLED;
-      result.message = "cancelled (" + result.message + ")";
     }
-    action_server_->setPreempted(result, result.message);
+    handle.setCanceled(result, result.message);
+  } else if (result.success) {
+    handle.setSucceeded(result, result.message);
   } else {
-    action_server_->setAborted(result, result.message);
+    handle.setAborted(result, result.message);
   }
 }
 

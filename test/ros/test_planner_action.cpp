@@ -32,7 +32,7 @@ PlanAttitudeManeuverGoal seed(int steps = 32) {
 template <class Pred>
 bool waitFor(Pred pred, double seconds) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (!pred() && ros::WallTime::now() < deadline) ros::WallDuration(0.01).sleep();
+  while (!pred() && ros::WallTime::now() < deadline) ros::WallDuration(0.001).sleep();
   return pred();
 }
 
@@ -59,6 +59,11 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
                       EXPECT_GT(f->iteration, seen->last_iteration.load());  // increasing
                       EXPECT_TRUE(std::isfinite(f->cost));
                       EXPECT_GE(f->residual, 0.0);
+                      // The grid level (continuation from N = 16 up to the requested 32) and
+                      // its effort h·cost with its own h = T / its N.
+                      EXPECT_GE(f->steps, 16);
+                      EXPECT_LE(f->steps, 32);
+                      EXPECT_NEAR(f->effort, f->cost * 12.8 / f->steps, 1e-12 * f->cost);
                       seen->last_iteration = f->iteration;
                       ++seen->feedbacks;
                     });
@@ -139,7 +144,7 @@ TEST_F(PlannerAction, StepTooLargeGoalIsAbortedWithItsCodeAndTheNextGoalSucceeds
   ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
   EXPECT_EQ(client_->getState(), State::ABORTED);
   EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::INVALID_INPUT);
-  EXPECT_NE(client_->getResult()->message.find("final.angular_velocity: not finite"),
+  EXPECT_NE(client_->getResult()->message.find("final_angular_velocity: not finite"),
             std::string::npos)
       << client_->getResult()->message;
   client_->sendGoal(seed());
@@ -173,7 +178,7 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
   EXPECT_EQ(client_->getState(), State::ABORTED);
   EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::INVALID_INPUT);
   EXPECT_NE(client_->getResult()->message.find(
-                "constraints[1].keep_out.body_axis: zero vector [0, 0, 0] has no direction"),
+                "constraints[1].body_axis: zero vector [0, 0, 0] has no direction"),
             std::string::npos)
       << client_->getResult()->message;
   bad = goal;
@@ -182,7 +187,7 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
   ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
   EXPECT_EQ(client_->getState(), State::ABORTED);
   EXPECT_NE(client_->getResult()->message.find(
-                "constraints[1].keep_out.half_angle: must be in (0, pi) rad, got -0.5"),
+                "constraints[1].half_angle: must be in (0, pi) rad, got -0.5"),
             std::string::npos)
       << client_->getResult()->message;
   // The server keeps serving: the good goal again.
@@ -233,6 +238,133 @@ TEST_F(PlannerAction, FourthOrderGoalSucceeds) {
   EXPECT_NE(result->message.find("Richardson extrapolation of second_order"), std::string::npos)
       << result->message;
   EXPECT_NEAR(result->effort, goal.duration / 32 * result->cost, 1e-12 * result->effort);
+}
+
+// ---- issue 31: an action that keeps its promises ---------------------------------------------
+
+/// A goal the solver never finishes: N = 1e5 with an unreachable tolerance and a long budget; it
+/// ends only when cancelled.
+PlanAttitudeManeuverGoal endlessGoal() {
+  PlanAttitudeManeuverGoal goal = seed(100000);
+  goal.tolerance = 1e-300;
+  goal.max_iterations = 1000000;
+  goal.time_budget = 600.0;
+  goal.return_maneuver = "none";
+  return goal;
+}
+
+TEST_F(PlannerAction, CancelInTheLastIterationEndsPreemptedNotSucceeded) {
+  // The solve at N = 1e5 is deterministic: a first run tells which feedback is its last (the
+  // final Newton step publishes none). The second run cancels on that feedback, so the cancel
+  // arrives while the last (long, N = 1e5) iteration runs: the goal must end PREEMPTED /
+  // CANCELLED, though the solver converges (before issue 31 it ended SUCCEEDED).
+  PlanAttitudeManeuverGoal goal = seed(100000);
+  goal.return_maneuver = "none";
+  auto last = std::make_shared<std::atomic<int>>(0);
+  client_->sendGoal(
+      goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+      [last](const PlanAttitudeManeuverFeedbackConstPtr& f) { *last = f->iteration; });
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(120.0)));
+  ASSERT_EQ(client_->getState(), State::SUCCEEDED) << client_->getResult()->message;
+  ros::WallDuration(1.0).sleep();  // feedback travels apart from the result: let it all land
+  const int last_feedback = *last;
+  ASSERT_GT(last_feedback, 0);
+
+  *last = 0;
+  client_->sendGoal(
+      goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+      [last](const PlanAttitudeManeuverFeedbackConstPtr& f) { *last = f->iteration; });
+  // Cancelled from this thread as soon as the last feedback is seen (polled every 1 ms).
+  const bool seen = waitFor([&] { return *last >= last_feedback; }, 120.0);
+  client_->cancelGoal();
+  ASSERT_TRUE(seen) << "the last feedback (iteration " << last_feedback << ") never arrived";
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(120.0)));
+  EXPECT_EQ(client_->getState(), State::PREEMPTED) << client_->getResult()->message;
+  EXPECT_FALSE(client_->getResult()->success);
+  EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::CANCELLED)
+      << client_->getResult()->message;
+  std::printf("cancel on the last feedback (iteration %d): %s\n", last_feedback,
+              client_->getResult()->message.c_str());
+}
+
+TEST_F(PlannerAction, TwoConcurrentGoalsBothSucceedWithTheirOwnAnswers) {
+  // Two clients, two slews sent back to back (each N = 20000: both run at once): each ends
+  // SUCCEEDED with its own target; neither preempts the other.
+  Client other("plan_attitude_maneuver_action", true);
+  ASSERT_TRUE(other.waitForServer(ros::Duration(30.0)));
+  PlanAttitudeManeuverGoal a = seed(20000), b = seed(20000);
+  b.final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), 0.5));
+  a.output_steps = b.output_steps = 2;  // the two ends
+  client_->sendGoal(a);
+  other.sendGoal(b);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(120.0)));
+  ASSERT_TRUE(other.waitForResult(ros::Duration(120.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED) << client_->getResult()->message;
+  EXPECT_EQ(other.getState(), State::SUCCEEDED) << other.getResult()->message;
+  const double angles[] = {M_PI / 3, 0.5};
+  const Client* clients[] = {client_.get(), &other};
+  for (int i = 0; i < 2; ++i) {
+    const auto result = clients[i]->getResult();
+    ASSERT_TRUE(result->success) << "goal " << i << ": " << result->message;
+    ASSERT_EQ(result->maneuver.attitude.size(), 2u) << "goal " << i;
+    const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), angles[i]);
+    EXPECT_LT(
+        so3::angleBetween(ros_conversions::attitudeFromMsg(result->maneuver.attitude.back(), "R_N"),
+                          target),
+        1e-8)
+        << "goal " << i;
+  }
+}
+
+TEST_F(PlannerAction, GoalBeyondTheWorkersIsRejectedAndTheRunningOnesAreUntouched) {
+  // The node runs ~action_workers = 2 (default): two endless goals occupy both; a third is
+  // refused explicitly (REJECTED, error REJECTED); the two keep running until their own clients
+  // cancel them, each ending PREEMPTED; then a new goal is served again.
+  Client second("plan_attitude_maneuver_action", true),
+      third("plan_attitude_maneuver_action", true);
+  ASSERT_TRUE(second.waitForServer(ros::Duration(30.0)));
+  ASSERT_TRUE(third.waitForServer(ros::Duration(30.0)));
+  auto fed1 = std::make_shared<std::atomic<int>>(0), fed2 = std::make_shared<std::atomic<int>>(0);
+  client_->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [fed1](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed1; });
+  second.sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                  [fed2](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed2; });
+  ASSERT_TRUE(waitFor([&] { return *fed1 > 0 && *fed2 > 0; }, 120.0)) << "both not running";
+  third.sendGoal(seed(16));
+  ASSERT_TRUE(third.waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(third.getState(), State::REJECTED);
+  EXPECT_EQ(third.getResult()->error_code.val, PlanErrorCode::REJECTED)
+      << third.getResult()->message;
+  EXPECT_NE(third.getResult()->message.find("action workers"), std::string::npos)
+      << third.getResult()->message;
+  // The running goals were not touched by the refusal.
+  EXPECT_EQ(client_->getState(), State::ACTIVE);
+  EXPECT_EQ(second.getState(), State::ACTIVE);
+  client_->cancelGoal();
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::PREEMPTED);
+  EXPECT_EQ(second.getState(), State::ACTIVE) << "one client's cancel ended another's goal";
+  second.cancelGoal();
+  ASSERT_TRUE(second.waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(second.getState(), State::PREEMPTED);
+  EXPECT_EQ(second.getResult()->error_code.val, PlanErrorCode::CANCELLED);
+  // A worker is free again (freed before the result was sent).
+  third.sendGoal(seed(16));
+  ASSERT_TRUE(third.waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(third.getState(), State::SUCCEEDED) << third.getResult()->message;
+}
+
+TEST_F(PlannerAction, BudgetFarBelowTheSolveEndsTimedOut) {
+  // A request that converges (normal tolerance) but needs seconds at N = 1e5, with a 10 ms
+  // deadline: ABORTED / TIMED_OUT, never SUCCEEDED. Times go to docs/ros_planner.md, not here.
+  PlanAttitudeManeuverGoal goal = seed(100000);
+  goal.time_budget = 0.01;
+  goal.return_maneuver = "none";
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(120.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::TIMED_OUT)
+      << client_->getResult()->message;
 }
 
 int main(int argc, char** argv) {

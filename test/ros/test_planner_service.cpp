@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <atomic>
 #include <limits>
 #include <thread>
@@ -155,7 +156,7 @@ TEST_F(PlannerService, StepTooLargeIsItsOwnErrorAndTheNodeKeepsServing) {
   const PlanAttitudeManeuver::Response res = call(req);
   EXPECT_FALSE(res.success);
   EXPECT_EQ(res.error_code.val, PlanErrorCode::STEP_TOO_LARGE) << res.message;
-  EXPECT_NE(res.message.find("initial.angular_velocity: step too large, increase steps"),
+  EXPECT_NE(res.message.find("initial_angular_velocity: step too large, increase steps"),
             std::string::npos)
       << res.message;
   req.steps = 64;  // h|Ω_0| = 0.625
@@ -369,8 +370,7 @@ TEST_F(PlannerService, ConstraintsArePlannedReportedAndABadOneIsNamed) {
   const PlanAttitudeManeuver::Response bad = call(req);
   EXPECT_FALSE(bad.success);
   EXPECT_EQ(bad.error_code.val, PlanErrorCode::INVALID_INPUT);
-  EXPECT_NE(bad.message.find("constraints[0].keep_out.body_axis: not a unit vector"),
-            std::string::npos)
+  EXPECT_NE(bad.message.find("constraints[0].body_axis: not a unit vector"), std::string::npos)
       << bad.message;
   EXPECT_TRUE(call(seed(16)).success);
 }
@@ -407,18 +407,18 @@ TEST_F(PlannerService, BadConstraintValuesAreNamedAndTheNodeKeepsServing) {
   std::vector<Case> cases;
   PlanAttitudeManeuver::Request base;
   ros_testing::fillConstrainedRequest(&base, 16);
-  cases.push_back({"zero body axis", base,
-                   "constraints[1].keep_out.body_axis: zero vector [0, 0, 0] has no direction"});
+  cases.push_back(
+      {"zero body axis", base, "constraints[1].body_axis: zero vector [0, 0, 0] has no direction"});
   cases.back().req.constraints[1].body_axis = geometry_msgs::Vector3();
-  cases.push_back({"half angle above pi", base,
-                   "constraints[1].keep_out.half_angle: must be in (0, pi) rad, got 3.5"});
+  cases.push_back(
+      {"half angle above pi", base, "constraints[1].half_angle: must be in (0, pi) rad, got 3.5"});
   cases.back().req.constraints[1].half_angle = 3.5;
-  cases.push_back({"keep_in half angle 0", base,
-                   "constraints[1].keep_in.half_angle: must be in (0, pi) rad, got 0"});
+  cases.push_back(
+      {"keep_in half angle 0", base, "constraints[1].half_angle: must be in (0, pi) rad, got 0"});
   cases.back().req.constraints[1].type = Constraint::KEEP_IN;
   cases.back().req.constraints[1].half_angle = 0.0;
   cases.push_back({"negative torque norm", base,
-                   "constraints[0].max_torque_norm: must be a finite number > 0 N m, got -0.095"});
+                   "constraints[0].limit: must be a finite number > 0 N m, got -0.095"});
   cases.back().req.constraints[0].limit = -0.095;
   cases.push_back({"unknown type", base, "constraints[0].type: unknown value 'max_torque'"});
   cases.back().req.constraints[0].type = "max_torque";
@@ -461,6 +461,177 @@ TEST_F(PlannerService, MinimumTimeReturnsTStarAndTheMarginPlan) {
   EXPECT_EQ(bad.error_code.val, PlanErrorCode::INVALID_INPUT);
   EXPECT_NE(bad.message.find("objective: 'minimum_time' needs a torque bound"), std::string::npos)
       << bad.message;
+  EXPECT_TRUE(call(seed(16)).success);
+}
+
+// ---- issue 31: a service for people and programs --------------------------------------------
+
+TEST_F(PlannerService, OutputStepsDecimatesToTheAskedSizeWithBothEnds) {
+  // N = 1000, at most 11 nodes: stride ceil(1000 / 10) = 100, k = 0, 100, ..., 1000.
+  PlanAttitudeManeuver::Request req = seed(1000);
+  req.output_steps = 11;
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_EQ(res.steps, 1000);  // the plan's N, not the rows returned
+  const AttitudeManeuver& m = res.maneuver;
+  ASSERT_EQ(m.attitude.size(), 11u);
+  ASSERT_EQ(m.time.size(), 11u);
+  ASSERT_EQ(m.angular_velocity.size(), 11u);
+  ASSERT_EQ(m.torque.size(), 11u);
+  EXPECT_DOUBLE_EQ(m.time_step, 12.8 / 1000);  // the plan's h
+  EXPECT_EQ(m.time.front(), 0.0);
+  EXPECT_NEAR(m.time[1], 100 * 12.8 / 1000, 1e-12);
+  EXPECT_NEAR(m.time.back(), 12.8, 1e-12);
+  const Matrix3 target = so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3);
+  EXPECT_LT(so3::angleBetween(rc::attitudeFromMsg(m.attitude.back(), "R_N"), target), 1e-8);
+  // The same rows as the full answer's.
+  const PlanAttitudeManeuver::Response full = call(seed(1000));
+  ASSERT_EQ(full.maneuver.attitude.size(), 1001u);
+  for (std::size_t i = 0; i < m.attitude.size(); ++i) {
+    const std::size_t k = std::min<std::size_t>(100 * i, 1000);
+    EXPECT_EQ(m.time[i], full.maneuver.time[k]) << "row " << i;
+    EXPECT_EQ(m.torque[i].x, full.maneuver.torque[k].x) << "row " << i;
+  }
+  // N = 32 at most 7 nodes: stride ceil(32 / 6) = 6, k = 0, 6, ..., 30 and 32 (7 rows).
+  req = seed(32);
+  req.output_steps = 7;
+  const PlanAttitudeManeuver::Response small = call(req);
+  ASSERT_TRUE(small.success) << small.message;
+  ASSERT_EQ(small.maneuver.time.size(), 7u);
+  EXPECT_NEAR(small.maneuver.time[5], 30 * 12.8 / 32, 1e-12);
+  EXPECT_NEAR(small.maneuver.time[6], 12.8, 1e-12);
+  // More nodes than the plan has: all of them.
+  req.output_steps = 1000;
+  EXPECT_EQ(call(req).maneuver.attitude.size(), 33u);
+}
+
+TEST_F(PlannerService, SummaryOnlyAnswerHasTheFiguresAndNoManeuver) {
+  PlanAttitudeManeuver::Request req = seed(128);
+  req.return_maneuver = "none";
+  const PlanAttitudeManeuver::Response res = call(req);
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_TRUE(res.maneuver.attitude.empty());
+  EXPECT_TRUE(res.maneuver.time.empty());
+  EXPECT_TRUE(res.maneuver.torque.empty());
+  EXPECT_EQ(res.steps, 128);
+  EXPECT_GT(res.cost, 0.0);
+  EXPECT_LT(res.terminal_attitude_error, 1e-8);
+  req.return_maneuver = "nodes";  // the default spelt out
+  EXPECT_EQ(call(req).maneuver.attitude.size(), 129u);
+}
+
+TEST_F(PlannerService, BadOutputFieldsAreNamed) {
+  struct Case {
+    const char* what;
+    PlanAttitudeManeuver::Request req;
+    const char* expected;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"output_steps 1", seed(), "output_steps: must be 0 (every node) or >= 2"});
+  cases.back().req.output_steps = 1;
+  cases.push_back({"output_steps -1", seed(), "output_steps: must be 0 (every node) or >= 2"});
+  cases.back().req.output_steps = -1;
+  cases.push_back({"unknown return_maneuver", seed(), "return_maneuver: unknown value 'all'"});
+  cases.back().req.return_maneuver = "all";
+  cases.push_back(
+      {"output_steps with none", seed(), "output_steps: 10 given with return_maneuver"});
+  cases.back().req.return_maneuver = "none";
+  cases.back().req.output_steps = 10;
+  for (const Case& c : cases) {
+    const PlanAttitudeManeuver::Response res = call(c.req);
+    EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << c.what << ": " << res.message;
+    EXPECT_EQ(res.message.rfind(c.expected, 0), 0u)
+        << c.what << ": message '" << res.message << "' does not start with '" << c.expected << "'";
+  }
+}
+
+TEST_F(PlannerService, ErrorsNameTheRequestsOwnFields) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    const char* what;
+    PlanAttitudeManeuver::Request req;
+    const char* expected;  // the message starts with it
+  };
+  std::vector<Case> cases;
+  cases.push_back({"NaN initial rate", seed(), "initial_angular_velocity: not finite"});
+  cases.back().req.initial_angular_velocity.y = nan;
+  cases.push_back({"NaN final rate", seed(), "final_angular_velocity: not finite"});
+  cases.back().req.final_angular_velocity.z = nan;
+  Constraint rate;
+  rate.type = Constraint::MAX_ANGULAR_RATE;
+  rate.limit = 0.2;
+  cases.push_back({"initial rate above a rate limit", seed(),
+                   "initial_angular_velocity: already violates constraints[0] (max_angular_rate)"});
+  cases.back().req.initial_angular_velocity.z = 0.5;
+  cases.back().req.constraints = {rate};
+  cases.push_back({"negative rate limit", seed(),
+                   "constraints[0].limit: must be a finite number > 0 rad/s, got -0.2"});
+  cases.back().req.constraints = {rate};
+  cases.back().req.constraints[0].limit = -0.2;
+  PlanAttitudeManeuver::Request constrained;
+  ros_testing::fillConstrainedRequest(&constrained, 16);
+  cases.push_back({"cone margin", constrained, "constraints[1].margin: must be >= 0 rad"});
+  cases.back().req.constraints[1].margin = -0.1;
+  cases.push_back({"limit on a cone", constrained, "constraints[1].limit: not used by keep_out"});
+  cases.back().req.constraints[1].limit = 1.0;
+  cases.push_back({"actuator limit", seed(), "effects[0].value.z: must be > 0 N m, got -1"});
+  cases.back().req.effects = {rc::effectToMsg(ActuatorLimitsSpec{Vector3(1.0, 1.0, 1.0)})};
+  cases.back().req.effects[0].value.z = -1.0;
+  for (const Case& c : cases) {
+    const PlanAttitudeManeuver::Response res = call(c.req);
+    EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << c.what << ": " << res.message;
+    EXPECT_EQ(res.message.rfind(c.expected, 0), 0u)
+        << c.what << ": message '" << res.message << "' does not start with '" << c.expected << "'";
+    // No scene key leaks into a request's error.
+    for (const char* scene_key : {"initial.", "final.", ".max_torque_norm",
+                                  ".max_angular_rate:", ".keep_out.", ".actuator_limits."}) {
+      EXPECT_EQ(res.message.find(scene_key), std::string::npos)
+          << c.what << ": '" << res.message << "' names the scene key '" << scene_key << "'";
+    }
+  }
+  EXPECT_TRUE(call(seed(16)).success);
+}
+
+TEST_F(PlannerService, NloptAboveItsLimitIsInvalidInputNamingSteps) {
+  PlanAttitudeManeuver::Request req = seed(2048);
+  req.solver = "nlopt";
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_FALSE(res.success);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << res.message;
+  EXPECT_EQ(res.message.rfind("steps: 2048 > 1024 is refused by solver nlopt", 0), 0u)
+      << res.message;
+  EXPECT_TRUE(res.maneuver.attitude.empty());
+}
+
+TEST_F(PlannerService, InfeasibleAnswerIsOneLineWithTheAccountInDetails) {
+  // 1.047 rad in 12.8 s needs a mean rate of 0.082 rad/s: |Omega| <= 0.05 rad/s cannot be met.
+  PlanAttitudeManeuver::Request req = seed(32);
+  Constraint rate;
+  rate.type = Constraint::MAX_ANGULAR_RATE;
+  rate.limit = 0.05;
+  req.constraints = {rate};
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_FALSE(res.success);
+  ASSERT_EQ(res.error_code.val, PlanErrorCode::INFEASIBLE) << res.message;
+  EXPECT_EQ(res.message.rfind("infeasible: ", 0), 0u) << res.message;
+  EXPECT_EQ(res.message.find('\n'), std::string::npos) << res.message;
+  EXPECT_NE(res.message.find("0.05 rad/s"), std::string::npos) << res.message;  // the binding one
+  EXPECT_LE(res.message.size(), 200u) << res.message;
+  EXPECT_GT(res.details.size(), res.message.size()) << res.details;
+  EXPECT_NE(res.details.find("interior-point iterations"), std::string::npos) << res.details;
+}
+
+TEST_F(PlannerService, BudgetFarBelowTheSolveIsTimedOut) {
+  // N = 1e5 needs seconds here; 10 ms is a deadline the answer cannot meet. The status is
+  // asserted, never the wall time (docs/ros_planner.md records the times).
+  PlanAttitudeManeuver::Request req = seed(100000);
+  req.time_budget = 0.01;
+  req.return_maneuver = "none";
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_FALSE(res.success);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
+  std::printf("N = 1e5, time_budget 0.01 s: solve_time %.3f s: %s\n", res.solve_time,
+              res.message.c_str());
   EXPECT_TRUE(call(seed(16)).success);
 }
 

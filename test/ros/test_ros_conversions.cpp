@@ -113,9 +113,9 @@ TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
       {"duration = Inf", [&](auto* r) { r->duration = inf; }, PlanErrorCode::INVALID_INPUT,
        "duration: must be a finite number > 0 s, got inf"},
       {"initial_angular_velocity.y = NaN", [&](auto* r) { r->initial_angular_velocity.y = nan; },
-       PlanErrorCode::INVALID_INPUT, "initial.angular_velocity: not finite"},
+       PlanErrorCode::INVALID_INPUT, "initial_angular_velocity: not finite"},
       {"final_angular_velocity.z = -Inf", [&](auto* r) { r->final_angular_velocity.z = -inf; },
-       PlanErrorCode::INVALID_INPUT, "final.angular_velocity: not finite"},
+       PlanErrorCode::INVALID_INPUT, "final_angular_velocity: not finite"},
       {"final_attitude.x = NaN", [&](auto* r) { r->final_attitude.x = nan; },
        PlanErrorCode::INVALID_INPUT, "final_attitude: quaternion not finite"},
       {"inertia not symmetric (J01 = 0)", [&](auto* r) { r->inertia[1] = 0.0; },
@@ -174,7 +174,7 @@ TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
          r->duration = 1.0;
          r->steps = 8;
        },
-       PlanErrorCode::STEP_TOO_LARGE, "initial.angular_velocity: step too large, increase steps"},
+       PlanErrorCode::STEP_TOO_LARGE, "initial_angular_velocity: step too large, increase steps"},
   };
   std::ofstream table;
   if (const char* path = std::getenv("AP_BAD_INPUT_TABLE")) table.open(path);
@@ -274,7 +274,7 @@ TEST(RosConversions, ConstraintMessagesRoundTrip) {
     rc::constraintFromMsg(bad, "constraints[3]");
     ADD_FAILURE() << "margin on max_torque_norm accepted";
   } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("constraints[3].max_torque_norm: body_axis, "
+    EXPECT_NE(std::string(e.what()).find("constraints[3]: body_axis, "
                                          "world_direction, half_angle and margin are not used"),
               std::string::npos)
         << e.what();
@@ -293,24 +293,20 @@ TEST(RosConversions, BadEffectsNameTheFieldAndTheValue) {
             std::string::npos);
   Effect gravity = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
   gravity.mu = -1.0;
-  EXPECT_NE(message({gravity}).find("effects[0].gravity_gradient.mu: must be finite and > 0"),
-            std::string::npos);
+  EXPECT_NE(message({gravity}).find("effects[0].mu: must be finite and > 0"), std::string::npos);
   Effect stray = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
   stray.value.x = 1.0;  // not read by gravity_gradient: a mistake, not a default
   EXPECT_NE(message({stray}).find("effects[0].value: not used by type 'gravity_gradient'"),
             std::string::npos);
   Effect frame = rc::effectToMsg(DisturbanceTorqueSpec{TorqueFrame::Body, Vector3(1e-3, 0, 0)});
   frame.frame = "orbit";
-  EXPECT_NE(message({frame}).find("effects[0].disturbance_torque.frame: unknown value 'orbit'"),
-            std::string::npos);
+  EXPECT_NE(message({frame}).find("effects[0].frame: unknown value 'orbit'"), std::string::npos);
   Effect limits = rc::effectToMsg(ActuatorLimitsSpec{Vector3(1.0, 1.0, 1.0)});
   limits.value.y = 0.0;
-  EXPECT_NE(
-      message({limits}).find("effects[0].actuator_limits.max_torque[1]: must be > 0 N m, got 0"),
-      std::string::npos);
-  const Effect good = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
-  EXPECT_NE(message({good, good}).find("effects[1].gravity_gradient: duplicate effect"),
+  EXPECT_NE(message({limits}).find("effects[0].value.y: must be > 0 N m, got 0"),
             std::string::npos);
+  const Effect good = rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6});
+  EXPECT_NE(message({good, good}).find("effects[1]: duplicate effect"), std::string::npos);
   const Effect noise = rc::effectToMsg(TorqueNoiseSpec{Vector3(1e-4, 1e-4, 1e-4), 3});
   EXPECT_NE(message({noise}).find("effects[0].type: 'torque_noise' is not plannable"),
             std::string::npos);
@@ -553,4 +549,106 @@ TEST(PrincipalBox, NonPhysicalInertiaStillGetsAVisibleBox) {
   const PrincipalBox box = principalBox(rc::inertiaFromMsg(seedRequest().inertia), 1.0);
   EXPECT_NEAR(box.dimensions.maxCoeff(), 1.0, 1e-12);
   EXPECT_NEAR(box.dimensions.minCoeff(), 0.1, 1e-12);
+}
+
+// ---- issue 31: errors in the request's fields, decimated answers, the deadline -----------------
+
+TEST(RequestFieldNames, SceneKeysMapToTheRequestsFields) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"initial.angular_velocity", "initial_angular_velocity"},
+      {"final.angular_velocity", "final_angular_velocity"},
+      {"initial.attitude", "initial_attitude"},
+      {"final.attitude", "final_attitude"},
+      {"constraints[0].max_torque_norm", "constraints[0].limit"},
+      {"constraints[12].max_angular_rate", "constraints[12].limit"},
+      {"constraints[1].keep_out.body_axis", "constraints[1].body_axis"},
+      {"constraints[2].keep_in.half_angle", "constraints[2].half_angle"},
+      {"constraints[2].keep_in", "constraints[2]"},
+      {"effects[0].actuator_limits.max_torque[2]", "effects[0].value.z"},
+      {"effects[1].disturbance_torque.value[0]", "effects[1].value.x"},
+      {"effects[0].gravity_gradient.mu", "effects[0].mu"},
+      {"effects[3].gravity_gradient", "effects[3]"},
+      {"steps", "steps"},
+      {"duration", "duration"},
+      {"accuracy_target", "accuracy_target"},
+  };
+  for (const auto& [core, request] : cases) EXPECT_EQ(rc::requestFieldName(core), request) << core;
+  // The structured field is mapped; the detail is kept as it is.
+  EXPECT_EQ(rc::requestErrorMessage(InvalidInput("constraints[0].max_torque_norm", "must be > 0")),
+            "constraints[0].limit: must be > 0");
+  EXPECT_EQ(rc::requestErrorMessage(InvalidInput("initial_attitude: zero quaternion")),
+            "initial_attitude: zero quaternion");  // no separate field: unchanged
+}
+
+TEST(DecimatedManeuver, KeepsBothEndsAndAtMostTheAskedNodes) {
+  for (const int N : {4, 31, 32, 100, 1000, 100000}) {
+    Maneuver plan;
+    plan.time_step = 0.5;
+    for (int k = 0; k <= N; ++k) {
+      plan.time.push_back(0.5 * k);
+      plan.attitude.push_back(Matrix3::Identity());
+      plan.angular_velocity.push_back(Vector3(k, 0, 0));
+      plan.torque.push_back(Vector3(0, k, 0));
+    }
+    for (const int M : {2, 3, 7, 11, 1000, 200000}) {
+      const Maneuver d = rc::decimatedManeuver(plan, M);
+      const std::size_t rows = d.attitude.size();
+      EXPECT_LE(rows, static_cast<std::size_t>(std::min(M, N + 1))) << N << ", " << M;
+      EXPECT_GE(rows, 2u);
+      if (M >= N + 1) EXPECT_EQ(rows, static_cast<std::size_t>(N + 1)) << N << ", " << M;
+      ASSERT_EQ(d.time.size(), rows);
+      ASSERT_EQ(d.torque.size(), rows);
+      ASSERT_EQ(d.angular_velocity.size(), rows);
+      EXPECT_EQ(d.time.front(), 0.0);
+      EXPECT_EQ(d.time.back(), 0.5 * N);        // both ends
+      EXPECT_EQ(d.time_step, 0.5);              // the plan's h
+      for (std::size_t i = 0; i < rows; ++i) {  // each row is the plan's own row
+        EXPECT_EQ(d.torque[i].y(), d.time[i] / 0.5);
+        EXPECT_EQ(d.angular_velocity[i].x(), d.time[i] / 0.5);
+      }
+    }
+  }
+  EXPECT_EQ(rc::decimatedManeuver(Maneuver(), 0).attitude.size(), 0u);
+}
+
+TEST(OutputSelection, AllZeroKeepsEveryNodeAndBadValuesAreNamed) {
+  const rc::OutputSelection none = rc::outputSelectionFromRequest("", 0);
+  EXPECT_EQ(none.output, rc::ManeuverOutput::Nodes);
+  EXPECT_EQ(none.max_nodes, 0);
+  EXPECT_EQ(rc::outputSelectionFromRequest("none", 0).output, rc::ManeuverOutput::None);
+  EXPECT_EQ(rc::outputSelectionFromRequest("nodes", 5).max_nodes, 5);
+  EXPECT_THROW(rc::outputSelectionFromRequest("", 1), InvalidInput);
+  EXPECT_THROW(rc::outputSelectionFromRequest("", -1), InvalidInput);
+  EXPECT_THROW(rc::outputSelectionFromRequest("none", 3), InvalidInput);
+  EXPECT_THROW(rc::outputSelectionFromRequest("summary", 0), InvalidInput);
+}
+
+TEST(Deadline, APlanThatConvergedAfterItsBudgetIsTimedOut) {
+  PlanOutcome late;
+  late.error_code = PlanErrorCode::SUCCESS;
+  late.time_budget_s = 0.3;
+  late.wall_time_s = 0.75;  // issue 31: a 0.3 s budget answered SUCCESS after 0.75 s
+  enforceDeadline(&late);
+  EXPECT_EQ(late.error_code, PlanErrorCode::TIMED_OUT);
+  EXPECT_EQ(late.message.rfind("timed out: the plan converged after 0.75 s", 0), 0u)
+      << late.message;
+  PlanOutcome in_time = late;
+  in_time.error_code = PlanErrorCode::SUCCESS;
+  in_time.message = "converged";
+  in_time.wall_time_s = 0.29;
+  enforceDeadline(&in_time);
+  EXPECT_EQ(in_time.error_code, PlanErrorCode::SUCCESS);
+  PlanOutcome unbounded = late;
+  unbounded.error_code = PlanErrorCode::SUCCESS;
+  unbounded.time_budget_s = 0.0;  // none
+  enforceDeadline(&unbounded);
+  EXPECT_EQ(unbounded.error_code, PlanErrorCode::SUCCESS);
+}
+
+TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.steps = 1025;
+  r.solver = "nlopt";
+  EXPECT_EQ(invalidMessage(r).rfind("steps: 1025 > 1024 is refused by solver nlopt", 0), 0u)
+      << invalidMessage(r);
 }

@@ -630,20 +630,21 @@ TEST(ConstraintScenes, BoundaryAlreadyViolatingIsNamed) {
   EXPECT_NE(
       invalidMessage(head + "constraints:\n  - keep_out: {body_axis: [1, 0, 0], world_direction: "
                             "[1, 0, 0], half_angle: 0.5}\n")
-          .find("initial.attitude already violates it"),
+          .find("initial.attitude: already violates constraints[0] (keep_out)"),
       std::string::npos);
   // Body x ends along world y: outside a keep-in cone about world x of 1 rad.
   EXPECT_NE(
       invalidMessage(head + "constraints:\n  - keep_in: {body_axis: [1, 0, 0], world_direction: "
                             "[1, 0, 0], half_angle: 1.0}\n")
-          .find("final.attitude already violates it"),
+          .find("final.attitude: already violates constraints[0] (keep_in)"),
       std::string::npos);
   std::string spinning = head;
   spinning.replace(spinning.find("angular_velocity: [0, 0, 0]"), 27,
                    "angular_velocity: [0, 0, 0.5]");
-  EXPECT_NE(invalidMessage(spinning + "constraints:\n  - max_angular_rate: 0.2\n")
-                .find("initial.angular_velocity already violates it"),
-            std::string::npos);
+  EXPECT_NE(
+      invalidMessage(spinning + "constraints:\n  - max_angular_rate: 0.2\n")
+          .find("initial.angular_velocity: already violates constraints[0] (max_angular_rate)"),
+      std::string::npos);
 }
 
 TEST(ConstraintScenes, FormatSceneRoundTripsConstraints) {

@@ -33,6 +33,9 @@ Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& f
 geometry_msgs::Quaternion attitudeToMsg(const Matrix3& R);
 /// Eigen vector of a message vector (no check: the core checks finiteness with the field name).
 Vector3 vectorFromMsg(const geometry_msgs::Vector3& v);
+/// Eigen vector of a message vector that must be finite (a NaN in a message is an encoding error:
+/// throws InvalidInput naming `field` and the value).
+Vector3 finiteVectorFromMsg(const geometry_msgs::Vector3& v, const std::string& field);
 /// Message vector of an Eigen vector.
 geometry_msgs::Vector3 vectorToMsg(const Vector3& v);
 /// J [kg·m²] from a row-major float64[9] (symmetry and definiteness are checked by the core).
@@ -78,6 +81,39 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field);
 /// The Constraint message of a core constraint (the fields its kind does not use left at 0).
 Constraint constraintToMsg(const PlanningConstraint& constraint);
+
+/// The request field a core error names, in the request's own spelling: the core (and the scene)
+/// say `initial.angular_velocity`, `constraints[0].max_torque_norm`,
+/// `constraints[1].keep_out.body_axis`, `effects[0].actuator_limits.max_torque[2]`; the request
+/// says `initial_angular_velocity`, `constraints[0].limit`, `constraints[1].body_axis`,
+/// `effects[0].value.z`. Fields spelt alike (`steps`, `duration`, ...) are returned unchanged.
+std::string requestFieldName(const std::string& core_field);
+/// The message of an error in the request's vocabulary: "<request field>: <detail>" when the
+/// error carries its field apart (FieldError::field), else its message unchanged.
+std::string requestErrorMessage(const FieldError& error);
+
+/// How much of the planned maneuver a response carries (request field `return_maneuver`).
+enum class ManeuverOutput {
+  Nodes,  ///< every node, or about `output_steps` of them (default; "" or "nodes")
+  None,   ///< none: the summary figures only ("none")
+};
+/// The names of `return_maneuver` ("" also means "nodes").
+inline constexpr NamedValue<ManeuverOutput> kManeuverOutputNames[] = {
+    {ManeuverOutput::Nodes, "nodes"},
+    {ManeuverOutput::None, "none"},
+};
+/// What a response carries of the maneuver: none, or at most `max_nodes` rows (0 = all).
+struct OutputSelection {
+  ManeuverOutput output = ManeuverOutput::Nodes;
+  int max_nodes = 0;  ///< 0: all N + 1 nodes; M >= 2: about M nodes, both ends included
+};
+/// The output selection of a request (`return_maneuver`, `output_steps`); throws InvalidInput
+/// naming the field and the value (an unknown name; output_steps < 0 or 1, or given with "none").
+OutputSelection outputSelectionFromRequest(const std::string& return_maneuver, int output_steps);
+/// The rows of `maneuver` kept by a decimation to at most `max_nodes` nodes (0 or >= N + 1: all):
+/// k = 0, s, 2s, ..., N with the stride s = ceil(N / (max_nodes - 1)), so both ends are kept and
+/// the last interval may be shorter. time[] keeps each row's t_k; time_step stays the plan's h.
+Maneuver decimatedManeuver(const Maneuver& maneuver, int max_nodes);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
@@ -129,9 +165,10 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   p.steps = req.accuracy_measure.empty() ? stepsFromRequest(req.steps, defaults) : req.steps;
   p.accuracy = accuracyTargetFromRequest(req.accuracy_measure, req.accuracy_target, defaults);
   p.initial_attitude = attitudeFromMsg(req.initial_attitude, "initial_attitude");
-  p.initial_velocity = vectorFromMsg(req.initial_angular_velocity);
+  p.initial_velocity =
+      finiteVectorFromMsg(req.initial_angular_velocity, "initial_angular_velocity");
   p.final_attitude = attitudeFromMsg(req.final_attitude, "final_attitude");
-  p.final_velocity = vectorFromMsg(req.final_angular_velocity);
+  p.final_velocity = finiteVectorFromMsg(req.final_angular_velocity, "final_angular_velocity");
   p.scheme = defaults.scheme;
   if (!req.scheme.empty()) applySchemeName(req.scheme, "scheme", &p);
   if (!req.direction.empty()) p.direction = parseDirection(req.direction, "direction");

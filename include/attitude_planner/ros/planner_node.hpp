@@ -24,18 +24,31 @@
 //   ~world_frame     string  "world"    frame_id of the returned maneuver
 //   ~body_frame      string  "body"     child_frame_id of the returned maneuver
 //   ~threads         int     4          service threads (>= 2: concurrent requests are solved in
-//   parallel)
+//                                       parallel)
+//   ~action_workers  int     2          action goals solved in parallel (>= 1); a goal arriving
+//                                       while all are busy is REJECTED (error REJECTED)
 //
 // Each solve owns all its state, so concurrent requests never share mutable data: service calls
-// are solved in parallel (~threads); the action serves one goal at a time (a new goal preempts
-// the running one, which ends PREEMPTED with error CANCELLED).
+// are solved in parallel (~threads), and so are action goals (~action_workers): goals never
+// preempt each other; a goal ends PREEMPTED (error CANCELLED) only when its own client cancels it,
+// and then whatever the solver had reached (the cancel is checked under the action server's lock
+// against the goal's own status, so a cancel that arrives in the last iteration still wins).
+// A request's time_budget is a deadline: a solve whose wall time exceeded it answers TIMED_OUT,
+// never SUCCESS.
 #pragma once
 
+#include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
-#include <actionlib/server/simple_action_server.h>
+#include <actionlib/server/action_server.h>
 #include <ros/ros.h>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
@@ -50,24 +63,40 @@ namespace attitude_planner {
 /// What one planning request produced, whatever happened.
 struct PlanOutcome {
   int error_code = PlanErrorCode::INTERNAL_ERROR;  ///< a PlanErrorCode constant
-  std::string message;                             ///< outcome in words
-  bool solver_ran = false;                         ///< `result` is meaningful
-  PlanResult result;                               ///< the core's result
-  PlanningProblem problem;                         ///< the parsed problem (if parsing succeeded)
+  std::string message;                             ///< outcome in words, one line
+  std::string details;      ///< the solver's full account (the core's message) when it ran
+  bool solver_ran = false;  ///< `result` is meaningful
+  PlanResult result;        ///< the core's result
+  PlanningProblem problem;  ///< the parsed problem (if parsing succeeded)
+  ros_conversions::OutputSelection output;  ///< how much of the maneuver to return
+  double time_budget_s = 0.0;               ///< the budget the solve ran under [s] (0 = none)
+  double wall_time_s = 0.0;                 ///< wall time of planManeuver [s]
 };
+
+/// The one-line message of an infeasible result, built from its figures (the worst violated
+/// constraint of the returned plan and where: checkConstraints), never from the core's message,
+/// which goes whole to `details`.
+std::string infeasibleSummary(const PlanningProblem& problem, const PlanResult& result);
+
+/// Applies the deadline: a result that converged after its time budget had run out (wall time
+/// > budget) becomes TIMED_OUT with a one-line message saying by how much.
+void enforceDeadline(PlanOutcome* outcome);
 
 /// The PlanErrorCode constant of a termination: the one mapping from the core's status to the
 /// interface's (INTERNAL_ERROR is not a termination: it is an exception the core did not expect).
 int errorCodeOf(Termination termination);
 
 /// Runs one request through the core. `keep_going(info, elapsed_s)` is called after every
-/// iteration; returning false cancels. Never throws.
+/// iteration; returning false cancels. `cancel` (optional) is handed to the core
+/// (SolverOptions::cancel_requested), which polls it inside long iterations too. Never throws.
 template <class Request>
 PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
-                        const std::function<bool(const IterationInfo&, double)>& keep_going);
+                        const std::function<bool(const IterationInfo&, double)>& keep_going,
+                        const std::atomic<bool>* cancel = nullptr);
 
 /// The error code and message of the exception being handled (call only inside a catch block):
-/// InvalidInput and StepTooLarge through errorCodeOf, anything else → INTERNAL_ERROR.
+/// InvalidInput and StepTooLarge through errorCodeOf, named in the request's fields
+/// (ros_conversions::requestErrorMessage); anything else → INTERNAL_ERROR.
 void describeCurrentException(int* error_code, std::string* message);
 
 /// What one plan_drift_two_input request produced, whatever happened.
@@ -97,51 +126,93 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
 /// The node: service + action around planRequest().
 class PlannerNode {
  public:
-  /// Reads the private parameters (range-checked, logged fall-back) and advertises the interfaces.
+  /// Reads the private parameters (range-checked, logged fall-back), starts the action workers
+  /// and advertises the interfaces.
   PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
+  /// Cancels the running goals and joins the workers.
+  ~PlannerNode();
 
   /// Service threads requested by ~threads.
   int threads() const { return threads_; }
 
  private:
+  /// ActionServer whose lock a worker can hold while it reads a goal's status and ends it, so a
+  /// cancel cannot slip in between (actionlib sets PREEMPTING under this lock).
+  class ActionServer : public actionlib::ActionServer<PlanAttitudeManeuverAction> {
+   public:
+    using actionlib::ActionServer<PlanAttitudeManeuverAction>::ActionServer;
+    boost::recursive_mutex& statusMutex() { return this->lock_; }
+  };
+  using GoalHandle = ActionServer::GoalHandle;
+  /// An accepted goal waiting for or running on a worker.
+  struct ActiveGoal {
+    GoalHandle handle;
+    std::shared_ptr<std::atomic<bool>> cancel;  ///< set by the goal's own cancel
+  };
+
   /// Service callback: always returns true (the outcome is in the response).
   bool onPlanService(PlanAttitudeManeuver::Request& req, PlanAttitudeManeuver::Response& res);
   /// plan_drift_two_input callback: always returns true (the outcome is in the response).
   bool onPlanDriftService(PlanDriftTwoInput::Request& req, PlanDriftTwoInput::Response& res);
-  /// Action execute callback: feedback per iteration; preemption cancels the solve.
-  void onPlanGoal(const PlanAttitudeManeuverGoalConstPtr& goal);
+  /// New goal: accepted and queued for a worker, or REJECTED when every worker is busy.
+  void onGoal(GoalHandle goal);
+  /// Cancel of one goal (only that goal's flag is set).
+  void onCancel(GoalHandle goal);
+  /// Worker thread: takes accepted goals until shutdown.
+  void workerLoop();
+  /// Solves one goal (feedback per iteration) and ends it: PREEMPTED if its cancel arrived at
+  /// any time before the end, else SUCCEEDED or ABORTED by its error code.
+  void serveGoal(const ActiveGoal& goal);
 
   ros::NodeHandle nh_;  ///< public handle: the service and action resolve here
   ros_conversions::PlannerDefaults defaults_;  ///< read once in the constructor, then const
   std::string world_frame_;                    ///< frame_id of returned maneuvers
   std::string body_frame_;                     ///< child_frame_id of returned maneuvers
   int threads_ = 4;                            ///< spinner threads
+  int action_workers_ = 2;                     ///< goals solved in parallel
   ros::ServiceServer service_;                 ///< plan_attitude_maneuver
   ros::ServiceServer drift_service_;           ///< plan_drift_two_input
-  /// plan_attitude_maneuver_action (one goal at a time)
-  std::unique_ptr<actionlib::SimpleActionServer<PlanAttitudeManeuverAction>> action_server_;
+
+  std::mutex goals_mutex_;  ///< guards the four members below
+  std::condition_variable goal_ready_;
+  std::deque<ActiveGoal> queued_;             ///< accepted, not yet on a worker
+  std::map<std::string, ActiveGoal> active_;  ///< accepted and not ended, by goal id
+  bool stopping_ = false;                     ///< the node is shutting down
+  std::vector<std::thread> workers_;          ///< ~action_workers threads
+  /// plan_attitude_maneuver_action (several goals at a time); last: destroyed first
+  std::unique_ptr<ActionServer> action_server_;
 };
 
 // ---- templates ----------------------------------------------------------------------------------
 
 template <class Request>
 PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
-                        const std::function<bool(const IterationInfo&, double)>& keep_going) {
+                        const std::function<bool(const IterationInfo&, double)>& keep_going,
+                        const std::atomic<bool>* cancel) {
   PlanOutcome out;
   try {
+    out.output = ros_conversions::outputSelectionFromRequest(req.return_maneuver, req.output_steps);
     SolverOptions options;
     out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
+    out.time_budget_s = options.time_budget_s;
     // The time budget (options.time_budget_s) is enforced by the core, which then ends
-    // TimedOut; the callback only cancels (node shutting down, action preempted).
+    // TimedOut; the callback and the flag only cancel (node shutting down, action cancelled).
+    options.cancel_requested = cancel;
     const ros::WallTime start = ros::WallTime::now();
     options.on_iteration = [&](const IterationInfo& info) {
       const double elapsed = (ros::WallTime::now() - start).toSec();
-      return ros::ok() && (!keep_going || keep_going(info, elapsed));
+      const bool cancelled = cancel && cancel->load();
+      return ros::ok() && !cancelled && (!keep_going || keep_going(info, elapsed));
     };
     out.result = planManeuver(out.problem, options);
+    out.wall_time_s = (ros::WallTime::now() - start).toSec();
     out.solver_ran = true;
     out.error_code = errorCodeOf(out.result.termination);
-    out.message = out.result.message;
+    out.message = out.result.termination == Termination::Infeasible
+                      ? infeasibleSummary(out.problem, out.result)
+                      : out.result.message;
+    out.details = out.result.message;
+    enforceDeadline(&out);
   } catch (...) {
     describeCurrentException(&out.error_code, &out.message);
   }
@@ -154,14 +225,18 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->success = outcome.error_code == PlanErrorCode::SUCCESS;
   res->error_code.val = outcome.error_code;
   res->message = outcome.message;
+  res->details = outcome.details;
   if (!outcome.solver_ran) return;
   const PlanResult& r = outcome.result;
   PlanningProblem planned = outcome.problem;  // with an accuracy target the planner chose these
   if (r.accuracy.requested) planned.scheme = r.scheme;
   if (!r.maneuver.attitude.empty()) {
     planned.steps = r.maneuver.steps();
-    res->maneuver = ros_conversions::maneuverToMsg(r.maneuver, planned, world_frame, body_frame,
-                                                   ros::Time::now());
+    if (outcome.output.output == ros_conversions::ManeuverOutput::Nodes) {
+      res->maneuver = ros_conversions::maneuverToMsg(
+          ros_conversions::decimatedManeuver(r.maneuver, outcome.output.max_nodes), planned,
+          world_frame, body_frame, ros::Time::now());
+    }
   }
   res->steps = planned.steps;
   res->scheme = schemeName(planned.scheme);

@@ -219,6 +219,8 @@ void constraints(unsigned m, double* result, unsigned n, const double* x_raw, do
   IterationInfo info;
   info.iteration = ++cb->evaluations;
   info.cost = 0.5 * x.squaredNorm();
+  info.steps = cb->problem->steps;
+  info.effort = info.cost * cb->problem->duration / cb->problem->steps;
   info.gradient_norm = std::max(c.value.cwiseAbs().maxCoeff(),
                                 stationarityResidual(x, c.jacobian).cwiseAbs().maxCoeff());
   cb->history.push_back(info);
@@ -239,16 +241,10 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
     return refused;
   }
   const int N = problem.steps;
-  if (N > kMaxNloptSteps) {
-    PlanResult refused;
-    refused.solver = solverName(SolverKind::Nlopt);
-    refused.scheme = problem.scheme;
-    refused.message =
-        "not converged; nlopt cross-check is dense (O(N^2) memory, O(N^3) time): "
-        "steps " +
-        std::to_string(N) + " > " + std::to_string(kMaxNloptSteps) +
-        " refused; use the newton solver";
-    return refused;
+  if (N > kMaxNloptSteps) {  // a refusal of the request, not a solve that failed to converge
+    throw InvalidInput("steps", std::to_string(N) + " > " + std::to_string(kMaxNloptSteps) +
+                                    " is refused by solver nlopt (the cross-check is dense: "
+                                    "O(N^2) memory, O(N^3) time); use the newton solver");
   }
   const unsigned n = 3u * static_cast<unsigned>(N - 1);
 

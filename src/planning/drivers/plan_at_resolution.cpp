@@ -31,9 +31,8 @@ void requireBoundarySteps(const PlanningProblem& problem) {
       scheme.stepFromVelocity(*velocity);
     } catch (const StepTooLarge& e) {
       std::ostringstream what;
-      what << field << ": " << e.what() << " (N = " << problem.steps << ", T = " << problem.duration
-           << " s)";
-      throw StepTooLarge(what.str());
+      what << e.what() << " (N = " << problem.steps << ", T = " << problem.duration << " s)";
+      throw StepTooLarge(field, what.str());
     }
   }
 }

@@ -1151,6 +1151,8 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
     np.setCurrent(trial);
     shift_floor = shift_floor > 1e-8 ? shift_floor / 100.0 : 0.0;
     IterationInfo info{iteration + 1, cost, relative_decrement, alpha};
+    info.steps = problem.steps;  // the grid level and its h·cost, for the action's feedback
+    info.effort = cost * problem.duration / problem.steps;
     result.history.push_back(info);
     if (options.on_iteration && !options.on_iteration(info)) {
       ending = Termination::Cancelled;

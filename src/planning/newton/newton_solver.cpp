@@ -379,6 +379,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, const SolverOptions& opti
     best_decrement = std::min(best_decrement, relative_decrement);
     previous_full_step_decrement = shift == 0.0 && step_length == 1.0 ? relative_decrement : 0.0;
     IterationInfo info{iteration + 1, cost, relative_decrement, step_length};
+    info.steps = problem.steps;  // the grid level and its h·cost, for the action's feedback
+    info.effort = cost * problem.duration / problem.steps;
     if (stalled_iterations >= 2) {
       result.history.push_back(info);
       ++iteration;

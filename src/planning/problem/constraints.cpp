@@ -66,13 +66,13 @@ std::string vectorText(const Vector3& v) {
 }
 
 void requireUnit(const Vector3& v, const std::string& path) {
-  if (!v.allFinite()) throw InvalidInput(path + ": not finite: " + vectorText(v));
+  if (!v.allFinite()) throw InvalidInput(path, "not finite: " + vectorText(v));
   if (v.norm() == 0.0)
-    throw InvalidInput(path + ": zero vector " + vectorText(v) + " has no direction");
+    throw InvalidInput(path, "zero vector " + vectorText(v) + " has no direction");
   if (std::abs(v.norm() - 1.0) > kUnitVectorTolerance) {
-    throw InvalidInput(path + ": not a unit vector: " + vectorText(v) + " has norm " +
-                       exactNumber(v.norm()) + " (must be within " +
-                       exactNumber(kUnitVectorTolerance) + " of 1)");
+    throw InvalidInput(path, "not a unit vector: " + vectorText(v) + " has norm " +
+                                 exactNumber(v.norm()) + " (must be within " +
+                                 exactNumber(kUnitVectorTolerance) + " of 1)");
   }
 }
 
@@ -87,21 +87,22 @@ void validateConstraints(const std::vector<PlanningConstraint>& constraints,
       requireUnit(c.body_axis, path + ".body_axis");
       requireUnit(c.world_direction, path + ".world_direction");
       if (!std::isfinite(c.half_angle) || !(c.half_angle > 0.0) || !(c.half_angle < M_PI)) {
-        throw InvalidInput(path + ".half_angle: must be in (0, pi) rad, got " +
-                           exactNumber(c.half_angle));
+        throw InvalidInput(path + ".half_angle",
+                           "must be in (0, pi) rad, got " + exactNumber(c.half_angle));
       }
       const double node = c.nodeHalfAngle();
       if (!std::isfinite(c.margin) || !(c.margin >= 0.0) || !(node > 0.0) || !(node < M_PI)) {
-        throw InvalidInput(path + ".margin: must be >= 0 rad and leave a cone (" +
-                           (c.kind == ConstraintKind::KeepOut ? "half_angle + margin < pi"
-                                                              : "half_angle - margin > 0") +
-                           "), got " + exactNumber(c.margin));
+        throw InvalidInput(path + ".margin",
+                           std::string("must be >= 0 rad and leave a cone (") +
+                               (c.kind == ConstraintKind::KeepOut ? "half_angle + margin < pi"
+                                                                  : "half_angle - margin > 0") +
+                               "), got " + exactNumber(c.margin));
       }
     } else {
       const char* unit = c.kind == ConstraintKind::MaxTorqueNorm ? " N m" : " rad/s";
       if (!std::isfinite(c.limit) || !(c.limit > 0.0)) {
-        throw InvalidInput(path + ": must be a finite number > 0" + unit + ", got " +
-                           exactNumber(c.limit));
+        throw InvalidInput(path, std::string("must be a finite number > 0") + unit + ", got " +
+                                     exactNumber(c.limit));
       }
     }
   }

@@ -21,23 +21,26 @@ std::string str(const Eigen::MatrixXd& m) {
 }
 
 void requireFinite(const Eigen::MatrixXd& m, const std::string& field) {
-  if (!m.allFinite()) throw InvalidInput(field + ": not finite: " + str(m));
+  if (!m.allFinite()) throw InvalidInput(field, "not finite: " + str(m));
 }
 
 void requireRotation(const Matrix3& R, const std::string& field) {
   requireFinite(R, field);
   if (so3::orthogonalityError(R) > 1e-9) {
-    throw InvalidInput(field + ": not a rotation matrix (|R^T R - I| + |det R - 1| = " +
-                       exactNumber(so3::orthogonalityError(R)) + ")");
+    throw InvalidInput(field, "not a rotation matrix (|R^T R - I| + |det R - 1| = " +
+                                  exactNumber(so3::orthogonalityError(R)) + ")");
   }
 }
 
 /// The boundary data must meet the node constraints themselves: R_0, R_N every cone, Ω_0 and
-/// Ω_{N−1} every rate limit (they are data, no plan can change them).
+/// Ω_{N−1} every rate limit (they are data, no plan can change them). The error's field is the
+/// boundary datum; the detail names the constraint by index and kind, a name both the scene and
+/// the request spell the same way.
 void requireBoundaryWithinConstraints(const PlanningProblem& p) {
   for (std::size_t i = 0; i < p.constraints.size(); ++i) {
     const PlanningConstraint& c = p.constraints[i];
-    const std::string path = "constraints[" + std::to_string(i) + "]." + constraintKindName(c.kind);
+    const std::string which =
+        "constraints[" + std::to_string(i) + "] (" + constraintKindName(c.kind) + ")";
     if (c.isCone()) {
       const std::pair<const char*, const Matrix3*> ends[] = {
           {"initial.attitude", &p.initial_attitude}, {"final.attitude", &p.final_attitude}};
@@ -45,10 +48,10 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
         const double margin = coneMargin(c, *R);
         if (margin < 0.0) {
           throw InvalidInput(
-              path + ": " + field + " already violates it: the angle between R b and s is " +
-              exactNumber(c.kind == ConstraintKind::KeepOut ? c.half_angle + margin
-                                                            : c.half_angle - margin) +
-              " rad, half_angle " + exactNumber(c.half_angle) + " rad");
+              field, "already violates " + which + ": the angle between R b and s is " +
+                         exactNumber(c.kind == ConstraintKind::KeepOut ? c.half_angle + margin
+                                                                       : c.half_angle - margin) +
+                         " rad, half_angle " + exactNumber(c.half_angle) + " rad");
         }
       }
     } else if (c.kind == ConstraintKind::MaxAngularRate) {
@@ -57,9 +60,9 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
           {"final.angular_velocity", &p.final_velocity}};
       for (const auto& [field, Omega] : ends) {
         if (Omega->norm() > c.limit) {
-          throw InvalidInput(path + ": " + field +
-                             " already violates it: |Omega| = " + exactNumber(Omega->norm()) +
-                             " rad/s > " + exactNumber(c.limit) + " rad/s");
+          throw InvalidInput(field, "already violates " + which +
+                                        ": |Omega| = " + exactNumber(Omega->norm()) + " rad/s > " +
+                                        exactNumber(c.limit) + " rad/s");
         }
       }
     }

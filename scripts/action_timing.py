@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""Cancel latency and deadline keeping of the planner node at N = 1e5 (docs/ros_timing.md).
+
+1. Cancel latency: an action goal that never converges (seed slew, N = 1e5, tolerance 1e-300) is
+   cancelled at a spread of moments after its first feedback; the latency is the wall time from
+   cancel_goal() to the result arriving in this client (transport both ways included).
+2. Deadline: service calls at N = 1e5 with a time_budget below, near and above what the solve
+   needs; the answer's status and its round trip against the budget.
+Needs a running master and planner.launch. Prints markdown tables.
+Usage: /usr/bin/python3 scripts/action_timing.py [--steps 100000] [--cancels 8]
+"""
+import argparse
+import math
+import statistics
+import threading
+import time
+
+import actionlib
+import rospy
+from actionlib_msgs.msg import GoalStatus
+from attitude_planner.msg import (PlanAttitudeManeuverAction, PlanAttitudeManeuverGoal,
+                                  PlanErrorCode)
+from attitude_planner.srv import PlanAttitudeManeuver, PlanAttitudeManeuverRequest
+
+STATES = {v: k for k, v in GoalStatus.__dict__.items() if k.isupper() and isinstance(v, int)}
+CODES = {v: k for k, v in PlanErrorCode.__dict__.items() if k.isupper() and isinstance(v, int)}
+
+
+def fill_seed(r, steps):
+    r.inertia = [13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37]
+    r.allow_nonphysical_inertia = True
+    r.initial_attitude.w = 1.0
+    r.final_attitude.w = math.cos(math.pi / 6)
+    r.final_attitude.x = math.sin(math.pi / 6)
+    r.duration = 12.8
+    r.steps = steps
+    r.return_maneuver = "none"
+    return r
+
+
+def cancel_latency(client, steps, delay):
+    """Sends an endless goal, cancels it `delay` s after its first feedback; returns
+    (latency [s], state, error code, iterations at the cancel)."""
+    goal = fill_seed(PlanAttitudeManeuverGoal(), steps)
+    goal.tolerance = 1e-300
+    goal.max_iterations = 1000000
+    goal.time_budget = 600.0
+    first = threading.Event()
+    seen = {"iteration": 0}
+
+    def on_feedback(f):
+        seen["iteration"] = f.iteration
+        first.set()
+
+    client.send_goal(goal, feedback_cb=on_feedback)
+    if not first.wait(120.0):
+        raise SystemExit("no feedback in 120 s")
+    time.sleep(delay)
+    at = seen["iteration"]
+    t0 = time.perf_counter()
+    client.cancel_goal()
+    client.wait_for_result(rospy.Duration(120.0))
+    latency = time.perf_counter() - t0
+    return latency, client.get_state(), client.get_result().error_code.val, at
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--steps", type=int, default=100000)
+    ap.add_argument("--cancels", type=int, default=8)
+    args = ap.parse_args()
+    rospy.init_node("action_timing", anonymous=True)
+    client = actionlib.SimpleActionClient("plan_attitude_maneuver_action",
+                                          PlanAttitudeManeuverAction)
+    if not client.wait_for_server(rospy.Duration(30.0)):
+        raise SystemExit("no action server")
+
+    print("### Cancel latency, N = %d\n" % args.steps)
+    print("| cancel sent after first feedback [s] | iteration at cancel | cancel -> result [ms] "
+          "| state | error |")
+    print("|---|---|---|---|---|")
+    latencies = []
+    for i in range(args.cancels):
+        delay = 0.05 + 0.137 * i  # spread over several iterations' phases
+        latency, state, code, at = cancel_latency(client, args.steps, delay)
+        latencies.append(latency)
+        print("| %.3f | %d | %.1f | %s | %s |" % (delay, at, 1e3 * latency,
+                                                 STATES.get(state, state), CODES.get(code, code)))
+    print("\nmedian %.1f ms, max %.1f ms over %d cancels\n" %
+          (1e3 * statistics.median(latencies), 1e3 * max(latencies), len(latencies)))
+
+    rospy.wait_for_service("plan_attitude_maneuver", timeout=30)
+    proxy = rospy.ServiceProxy("plan_attitude_maneuver", PlanAttitudeManeuver)
+    print("### Deadline, N = %d (service; the seed slew, default tolerance)\n" % args.steps)
+    print("| time_budget [s] | round trip [s] | solve_time [s] | over budget | status | "
+          "iterations |")
+    print("|---|---|---|---|---|---|")
+    for budget in (0.01, 0.1, 0.3, 1.0, 30.0):
+        req = fill_seed(PlanAttitudeManeuverRequest(), args.steps)
+        req.time_budget = budget
+        t0 = time.perf_counter()
+        res = proxy(req)
+        total = time.perf_counter() - t0
+        print("| %g | %.3f | %.3f | %+.0f %% | %s | %d |" %
+              (budget, total, res.solve_time, 100.0 * (total - budget) / budget,
+               CODES.get(res.error_code.val, res.error_code.val), res.iterations))
+
+
+if __name__ == "__main__":
+    main()

@@ -260,12 +260,10 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   body_size_ = readParam<double>(pnh, "body_size", 1.0, positive, "> 0 m");
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
-  pnh.param("exit_when_done", exit_when_done_, false);
-  std::string scene, replay_scene;
-  pnh.param<std::string>("scene", scene, "");
-  pnh.param<std::string>("replay_scene", replay_scene, "");
-  bool plan_in_process = false;
-  pnh.param("plan_in_process", plan_in_process, false);
+  exit_when_done_ = readParam<bool>(pnh, "exit_when_done", false);
+  const std::string scene = readFileParam(pnh, "scene");  // absolute, package:// or relative
+  const std::string replay_scene = readFileParam(pnh, "replay_scene");
+  const bool plan_in_process = readParam<bool>(pnh, "plan_in_process", false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
 
   torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
@@ -404,8 +402,12 @@ bool TrackerNode::sleepUntil(const ros::Time& t) {
 
 bool TrackerNode::waitForClock(ros::Time* start) {
   // use_sim_time: ROS time is zero until the first /clock message.
+  constexpr double kClockSilenceWarning = 2.0;  // [s] wall time before saying why nothing moves
+  const ros::WallTime waiting_since = ros::WallTime::now();
   while (ros::Time::now().isZero()) {
     if (stop_ || !ros::ok()) return false;
+    if ((ros::WallTime::now() - waiting_since).toSec() > kClockSilenceWarning)
+      ROS_WARN_ONCE("/use_sim_time is true and no /clock is published: waiting for /clock");
     ros::WallDuration(0.01).sleep();
   }
   *start = ros::Time::now() + ros::Duration(start_delay_);

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "attitude_planner/name_table.hpp"
 
@@ -70,9 +71,12 @@ T readParam(const ros::NodeHandle& nh, const std::string& name, const T& fallbac
   if (!nh.hasParam(name)) return fallback;
   T value;
   if (!nh.getParam(name, value)) {
+    std::string stored_as;  // roslaunch stores value="1e-10" (no type attribute) as a string
+    if (std::string text; nh.getParam(name, text) && !std::is_same<T, std::string>::value)
+      stored_as = "; it is stored as a string: in a launch file give the <param> a type";
     throw InvalidParameter("parameter " + nh.resolveName(name) + " = " +
                            parameter_detail::storedValue(nh, name) + " is not " +
-                           parameter_detail::typeName<T>() + " (" + requirement + ")");
+                           parameter_detail::typeName<T>() + " (" + requirement + ")" + stored_as);
   }
   if (!valid(value)) {
     std::ostringstream out;

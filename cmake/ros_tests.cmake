@@ -7,7 +7,9 @@ catkin_add_gtest(test_ros_conversions test/ros/test_ros_conversions.cpp)
 target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
 list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
 
-# rostest gtests: each launches the node(s) under test and a gtest client.
+# rostest gtests: each launches the node(s) under test and a gtest client, which roslaunch finds
+# by package and type in devel/share/attitude_planner/test_nodes (not offered by rosrun).
+set(CMAKE_RUNTIME_OUTPUT_DIRECTORY ${AP_ROSTEST_BIN_DIR})
 foreach(name planner_service planner_action tracker tracker_sim_time)
   add_rostest_gtest(test_${name} test/ros/${name}.test test/ros/test_${name}.cpp)
   target_link_libraries(test_${name} ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
@@ -65,3 +67,14 @@ foreach(name tracker_stream tracker_bandwidth tracker_feedback)
   add_dependencies(test_${name} attitude_tracker_node)
   list(APPEND AP_EXPECTED_TESTS test_${name})
 endforeach()
+
+# Start-up parameter checks: a bad private parameter stops each node with a named error (exit
+# 78); scene paths relative to the caller or package://; /use_sim_time through a remap (as
+# replay.launch gives it to rviz) and the tracker's one warning while /clock is silent.
+add_rostest_gtest(test_node_parameters test/ros/node_parameters.test
+                  test/ros/test_node_parameters.cpp)
+target_link_libraries(test_node_parameters gtest_main)  # no ROS client code: it runs the nodes
+target_compile_definitions(test_node_parameters PRIVATE AP_TOOL_DIR="${AP_TOOL_DIR}/"
+                           AP_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+add_dependencies(test_node_parameters attitude_planner_node attitude_tracker_node)
+list(APPEND AP_EXPECTED_TESTS test_node_parameters)

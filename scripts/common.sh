@@ -1,16 +1,24 @@
 # Shared set-up for scripts/demo, scripts/test and friends (sourced, not run).
 # Installs the Debian packages the package needs (only those missing), keeps the catkin
-# workspace in <repo>/.ws (gitignored) and keeps ROS_HOME and logs inside it.
+# workspace beside the repository in <repo>_ws (or $ATTITUDE_PLANNER_WS) and keeps ROS_HOME and
+# logs inside it.
 set -euo pipefail
 
 REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WS_DIR="$REPO_DIR/.ws"
+# The workspace lives outside the package: rosrun and roslaunch search the package directory
+# recursively (find -L), so a workspace inside it, linking back to it, is a file-system loop and
+# offers every build product as a rosrun executable.
+WS_DIR="${ATTITUDE_PLANNER_WS:-${REPO_DIR}_ws}"
+# Studies and test executables: in the build tree, not in devel/lib/attitude_planner (rosrun's
+# libexec), which holds only the nodes and the command-line tools (TOOL_DIR).
+study_bin_dir() { echo "$WS_DIR/build/attitude_planner/bin"; }
+tool_dir() { echo "$WS_DIR/devel/lib/attitude_planner"; }
 BUILD_TYPE="${BUILD_TYPE:-Release}"
 
 # Debian bookworm ships ROS 1 (ros_comm 1.15); rosdep cannot reach its index, so list apt packages.
 DEBIAN_PACKAGES=(
   build-essential cmake catkin python3-catkin-pkg python3-rospkg
-  libroscpp-dev ros-message-generation ros-message-runtime
+  libroscpp-dev libroslib-dev ros-message-generation ros-message-runtime
   libstd-msgs-dev libgeometry-msgs-dev libvisualization-msgs-dev libactionlib-msgs-dev
   libtf2-ros-dev libtf2-geometry-msgs-dev tf2-tools libactionlib-dev python3-actionlib
   librosbag-dev python3-rosbag librostest-dev python3-rostest rosbash rosout python3-roslaunch
@@ -46,10 +54,23 @@ setup_ros_env() {
   mkdir -p "$ROS_LOG_DIR"
 }
 
+# A workspace left inside the repository by an older version of these scripts links back to the
+# package (a find loop on every rosrun): its link is removed, the rest is left to delete by hand.
+remove_in_repo_workspace_links() {
+  local old
+  for old in "$REPO_DIR"/.ws "$REPO_DIR"/.ws-asan "$REPO_DIR"/.ws-tsan; do
+    if [ -L "$old/src/attitude_planner" ]; then
+      rm "$old/src/attitude_planner"
+      log "removed $old/src/attitude_planner (a link back to the package); $old is obsolete: rm -rf it"
+    fi
+  done
+}
+
 build_workspace() {
   setup_ros_env
+  remove_in_repo_workspace_links
   mkdir -p "$WS_DIR/src"
-  # The repository root is the package; the workspace sees it through a symlink.
+  # The repository root is the package; the workspace (outside it) sees it through a symlink.
   [ -L "$WS_DIR/src/attitude_planner" ] || ln -sfn "$REPO_DIR" "$WS_DIR/src/attitude_planner"
   log "building ($BUILD_TYPE) in $WS_DIR"
   # ccache, where installed, serves unchanged files from its cache (other worktrees included).

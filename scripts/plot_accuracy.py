@@ -48,51 +48,71 @@ def label(c):
     return "%s, %s" % (c["scene"], c["scheme"])
 
 
-styles = {"paper": "-", "variational": "--", "second_order": ":", "fourth_order": "-."}
-colors = {"rest_to_rest": "tab:blue", "slew_up": "tab:red"}
+# Series: the scheme by colour and marker, the scene by line style and marker fill, so that every
+# legend entry differs in two ways and stays distinguishable in grey print. The reference slopes
+# are labelled on the plot, not in the legend; one legend per figure, outside the axes.
+SCHEME_STYLE = {"paper": ("tab:blue", "o"), "variational": ("tab:orange", "s"),
+                "second_order": ("tab:green", "^"), "fourth_order": ("tab:purple", "D")}
+SCENE_STYLE = {"rest_to_rest": ("-", True), "slew_up": ("--", False)}
+
+
+def series(ax, x, y, c):
+    color, marker = SCHEME_STYLE[c["scheme"]]
+    linestyle, filled = SCENE_STYLE[c["scene"]]
+    return ax.loglog(x, y, linestyle=linestyle, color=color, marker=marker, ms=4, lw=1.2,
+                     markerfacecolor=color if filled else "white", markeredgecolor=color,
+                     label=label(c))[0]
+
+
+def reference_slopes(ax):
+    N0 = [16, 16384]
+    for scale, order, text in ((1e-1, 1, "N⁻¹"), (1e-2, 2, "N⁻²"), (1e-4, 4, "N⁻⁴")):
+        y = [scale * (16 / n) ** order for n in N0]
+        ax.loglog(N0, y, color="0.55", lw=0.8, zorder=0)
+        ax.annotate("∝ " + text, (N0[1], y[1]), xytext=(3, 0), textcoords="offset points",
+                    fontsize=7, color="0.4", va="center")
+
+
+def figure_legend(fig, handles, top):
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, top), ncol=4,
+               fontsize=8, frameon=False)
+
 
 # ---- plots -----------------------------------------------------------------------------------
-fig, axes = plt.subplots(2, 3, figsize=(15, 9))
+fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
 for ax, (key, title, unit) in zip(axes.flat, MEASURES):
-    for c in cases:
-        N = [r["N"] for r in c["sweep"]]
-        e = [r[key] for r in c["sweep"]]
-        ax.loglog(N, e, styles[c["scheme"]], color=colors[c["scene"]], marker="o", ms=3,
-                  label="%s (p = %.2f)" % (label(c), fit_order(c["sweep"], key)))
-    N0 = [16, 16384]
-    ax.loglog(N0, [1e-1 * (16 / n) for n in N0], ":", color="gray", label="∝ N⁻¹")
-    ax.loglog(N0, [1e-2 * (16 / n) ** 2 for n in N0], "-.", color="gray", label="∝ N⁻²")
-    ax.loglog(N0, [1e-4 * (16 / n) ** 4 for n in N0], "--", color="lightgray", label="∝ N⁻⁴")
+    handles = [series(ax, [r["N"] for r in c["sweep"]], [r[key] for r in c["sweep"]], c)
+               for c in cases]
+    reference_slopes(ax)
+    ax.set_xlim(right=16384 * 3.5)  # room for the slope labels
     ax.set_title(title, fontsize=10)
     ax.set_xlabel("steps N")
     ax.set_ylabel(unit)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
 ax = axes.flat[5]
 for c in cases:
-    N = [r["N"] for r in c["sweep"]]
-    ax.loglog(N, [r["solve_time_s"] * 1e3 for r in c["sweep"]], styles[c["scheme"]],
-              color=colors[c["scene"]], marker="o", ms=3, label=label(c))
+    series(ax, [r["N"] for r in c["sweep"]], [r["solve_time_s"] * 1e3 for r in c["sweep"]], c)
 ax.set_title("solve time (median of %d)" % data["repeats"], fontsize=10)
 ax.set_xlabel("steps N")
 ax.set_ylabel("ms")
 ax.grid(True, which="both", alpha=0.3)
-ax.legend(fontsize=7)
-fig.tight_layout()
+fig.tight_layout(rect=(0, 0, 1, 0.93))
+figure_legend(fig, handles, 0.995)
+fig.text(0.5, 0.935, "fitted orders p: the table in accuracy.md (Observed orders)",
+         ha="center", fontsize=8, color="0.3")
 fig.savefig(docs + "/accuracy_vs_steps.png", dpi=90)
 
-fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+fig, axes = plt.subplots(1, 3, figsize=(15, 5.6))
 for ax, key in zip(axes, ["attitude_miss", "cost_error", "trajectory_error"]):
     title, unit = [(t, u) for k, t, u in MEASURES if k == key][0]
-    for c in cases:
-        ax.loglog([r["solve_time_s"] * 1e3 for r in c["sweep"]], [r[key] for r in c["sweep"]],
-                  styles[c["scheme"]], color=colors[c["scene"]], marker="o", ms=3, label=label(c))
+    handles = [series(ax, [r["solve_time_s"] * 1e3 for r in c["sweep"]],
+                      [r[key] for r in c["sweep"]], c) for c in cases]
     ax.set_title(title + " vs solve time", fontsize=10)
     ax.set_xlabel("solve time [ms] (median)")
     ax.set_ylabel(unit)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-fig.tight_layout()
+fig.tight_layout(rect=(0, 0, 1, 0.88))
+figure_legend(fig, handles, 0.995)
 fig.savefig(docs + "/accuracy_vs_time.png", dpi=90)
 
 # ---- the document ----------------------------------------------------------------------------

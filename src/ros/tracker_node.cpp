@@ -313,14 +313,13 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   tracking_.natural_frequency =
       readParam<double>(pnh, "feedback_frequency", 0.0, non_negative, ">= 0 rad/s, 0 = 40 / T");
   tracking_.damping = readParam<double>(pnh, "feedback_damping", 1.0, positive, "> 0");
-  pnh.param("exit_when_done", exit_when_done_, false);
-  std::string scene, replay_scene, mode;
-  pnh.param<std::string>("scene", scene, "");
-  pnh.param<std::string>("replay_scene", replay_scene, "");
-  pnh.param<std::string>("mode", mode, trackingModeName(TrackingMode::Replay));
-  pnh.param<std::string>("trace_axis", trace_axis_name_, "auto");
-  bool plan_in_process = false;
-  pnh.param("plan_in_process", plan_in_process, false);
+  exit_when_done_ = readParam<bool>(pnh, "exit_when_done", false);
+  std::string scene = readFileParam(pnh, "scene");  // absolute, package:// or relative
+  std::string replay_scene = readFileParam(pnh, "replay_scene");
+  const std::string mode =
+      readParam<std::string>(pnh, "mode", trackingModeName(TrackingMode::Replay));
+  trace_axis_name_ = readParam<std::string>(pnh, "trace_axis", "auto");
+  const bool plan_in_process = readParam<bool>(pnh, "plan_in_process", false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
 
   torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
@@ -478,13 +477,12 @@ bool TrackerNode::sleepUntil(const ros::Time& t) {
 
 bool TrackerNode::waitForClock(const ros::Time& stamp, ros::Time* start) {
   // use_sim_time: ROS time is zero until the first /clock message.
-  bool warned = false;
+  constexpr double kClockSilenceWarning = 2.0;  // [s] wall time before saying why nothing moves
+  const ros::WallTime waiting_since = ros::WallTime::now();
   while (ros::Time::now().isZero()) {
     if (stop_ || !ros::ok()) return false;
-    if (!warned) {
-      ROS_WARN("waiting for /clock (/use_sim_time is true) before the run starts");
-      warned = true;
-    }
+    if ((ros::WallTime::now() - waiting_since).toSec() > kClockSilenceWarning)
+      ROS_WARN_ONCE("/use_sim_time is true and no /clock is published: waiting for /clock");
     ros::WallDuration(0.01).sleep();
   }
   const ros::Time now = ros::Time::now();

@@ -17,7 +17,7 @@
 
 namespace {
 
-const std::string kBin = AP_BINARY_DIR "/../../devel/lib/attitude_planner/";
+const std::string kBin = AP_STUDY_DIR;  // where CMakeLists.txt puts the studies
 
 /// Runs benchmark_solvers with `args`; returns its exit status (−1 if it did not exit).
 int runTool(const std::string& args, std::string* output) {

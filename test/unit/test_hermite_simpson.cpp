@@ -212,7 +212,7 @@ TEST(HermiteSimpson, ContinuousOptimumSatisfiesTheRowsAtTheMethodsOrder) {
 /// frontier_study at tiny sizes: every scheme of kSchemeNames and (with IPOPT) ipopt_hs appear,
 /// converge, and their torque error falls with N.
 TEST(FrontierStudy, SmallRunMeasuresEverySchemeAndThePeer) {
-  const std::string tool = AP_BINARY_DIR "/../../devel/lib/attitude_planner/frontier_study";
+  const std::string tool = AP_STUDY_DIR "frontier_study";
   ASSERT_EQ(access(tool.c_str(), X_OK), 0) << "frontier_study not built at " << tool;
   const std::string out = AP_BINARY_DIR "/frontier_smoke.json";
   const std::string command = "cd '" AP_BINARY_DIR "' && '" + tool + "' '" + out +

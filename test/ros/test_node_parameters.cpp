@@ -1,0 +1,127 @@
+// rostest: a private parameter the node cannot use stops it at start-up with exit status 78
+// (kExitInvalidParameter) and an error naming the parameter and the value, instead of a
+// fallback to the default. Scene paths: package://, relative to the caller's directory (a
+// missing one names that directory). /use_sim_time is read through the node's remappings
+// (replay.launch gives rviz alone simulated time that way) and the tracker says once that it
+// waits for /clock. Each case runs the node binary itself against the rostest master.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+namespace {
+
+const std::string kPlanner = AP_TOOL_DIR "attitude_planner_node";
+const std::string kTracker = AP_TOOL_DIR "attitude_tracker_node";
+constexpr int kExitInvalidParameter = 78;  // parameters.hpp: EX_CONFIG
+constexpr int kTimeoutExit = 124;          // timeout(1): the node was still running
+
+struct NodeRun {
+  int status = -1;  ///< exit status (-1: did not exit normally)
+  std::string output;
+};
+
+/// Runs `command` in `directory` (also its $PWD) with stderr merged; at most `seconds` long, then
+/// SIGINT (status kTimeoutExit).
+NodeRun runNode(const std::string& command, int seconds, const std::string& directory = "/tmp") {
+  const std::string line = "cd '" + directory + "' && PWD='" + directory + "' timeout -s INT " +
+                           std::to_string(seconds) + " " + command + " 2>&1";
+  NodeRun run;
+  FILE* pipe = popen(line.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  if (WIFEXITED(raw)) run.status = WEXITSTATUS(raw);
+  return run;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(NodeParameters, OutOfRangeValueStopsThePlannerNamingIt) {
+  const NodeRun run = runNode(kPlanner + " __name:=bad_tolerance _tolerance:=-1.0", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_tolerance/tolerance = -1 is invalid: must be > 0"))
+      << run.output;
+}
+
+TEST(NodeParameters, UnknownNameStopsThePlannerListingTheNames) {
+  const NodeRun run = runNode(kPlanner + " __name:=bad_solver _solver:=ipopt", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_solver/solver = ipopt is invalid")) << run.output;
+  EXPECT_TRUE(contains(run.output, "newton")) << run.output;
+}
+
+TEST(NodeParameters, WrongTypeStopsThePlannerNamingTheType) {
+  const NodeRun run = runNode(kPlanner + " __name:=bad_threads _threads:=many", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_threads/threads = many is not an integer")) << run.output;
+}
+
+TEST(NodeParameters, ValidValuesKeepThePlannerServing) {
+  const NodeRun run =
+      runNode(kPlanner + " __name:=good_planner _tolerance:=1e-9 _solver:=nlopt _threads:=2", 5);
+  EXPECT_EQ(run.status, kTimeoutExit) << "the planner should still run:\n" << run.output;
+}
+
+TEST(NodeParameters, OutOfRangeValueStopsTheTrackerNamingIt) {
+  const NodeRun run = runNode(kTracker + " __name:=bad_rate _rate_factor:=0", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_rate/rate_factor = 0 is invalid: must be > 0"))
+      << run.output;
+}
+
+TEST(NodeParameters, MissingRelativeSceneNamesTheCallersDirectory) {
+  const NodeRun run =
+      runNode(kTracker + " __name:=bad_scene _scene:=scenes/no_such_scene.yaml", 60, AP_SOURCE_DIR);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_scene/scene = scenes/no_such_scene.yaml")) << run.output;
+  EXPECT_TRUE(contains(run.output,
+                       "resolved against the directory roslaunch or rosrun was "
+                       "started in, " AP_SOURCE_DIR))
+      << run.output;
+}
+
+TEST(NodeParameters, MissingPackageSceneStopsTheTracker) {
+  const NodeRun run = runNode(
+      kTracker + " __name:=bad_package_scene _scene:=package://attitude_planner/scenes/none.yaml",
+      60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "no readable file")) << run.output;
+}
+
+TEST(NodeParameters, RelativeSceneIsPlannedFromTheCallersDirectory) {
+  // In-process planning, 10x real time, then exit_when_done: the tracker ends by itself (0).
+  const NodeRun run = runNode(kTracker +
+                                  " __name:=relative_scene _scene:=scenes/rest_to_rest.yaml"
+                                  " _plan_in_process:=true _rate_factor:=10.0 _start_delay:=0.0"
+                                  " _exit_when_done:=true",
+                              120, AP_SOURCE_DIR);
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "planning " AP_SOURCE_DIR "/scenes/rest_to_rest.yaml"))
+      << run.output;
+}
+
+TEST(NodeParameters, SimTimeThroughARemapAndOneWarningWhileClockIsSilent) {
+  // As replay.launch does for rviz: /use_sim_time remapped to a private parameter. Nothing
+  // publishes /clock here, so the replay waits and the tracker says so, once.
+  const NodeRun run = runNode(kTracker +
+                                  " __name:=silent_clock /use_sim_time:=silent_clock/use_sim_time"
+                                  " _use_sim_time:=true _plan_in_process:=true"
+                                  " _scene:=package://attitude_planner/scenes/rest_to_rest.yaml",
+                              15);
+  EXPECT_EQ(run.status, kTimeoutExit) << run.output;
+  const std::string warning = "no /clock is published: waiting for /clock";
+  const size_t first = run.output.find(warning);
+  EXPECT_NE(first, std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find(warning, first + 1), std::string::npos) << "warned twice:\n"
+                                                                    << run.output;
+}

@@ -73,7 +73,8 @@ template <typename Scalar>
 void BorderedBandedFactor<Scalar>::solve(Eigen::VectorXd* rhs) const {
   Eigen::VectorXd& v = *rhs;
   // u = A⁻¹b in Scalar.
-  std::vector<Scalar> u(v.data(), v.data() + n_);
+  std::vector<Scalar>& u = u_;
+  u.assign(v.data(), v.data() + n_);
   band_.solveInScalar(u.data());
   if (m_ == 0) {
     for (int i = 0; i < n_; ++i) v(i) = static_cast<double>(u[i]);

@@ -45,7 +45,8 @@ class BorderedBandedFactor {
   /// Factors K = [[A, B], [Bᵀ, D]] (B: A.size() × m, D: m × m symmetric, m ≥ 0).
   /// Returns inertia().solvable(); solve must not be called otherwise.
   bool factor(const BandedSymmetric<Scalar>& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& D);
-  /// Solves K (x, y) = (b, c) in place: `rhs` holds b (n entries) then c (m entries).
+  /// Solves K (x, y) = (b, c) in place: `rhs` holds b (n entries) then c (m entries). Uses a
+  /// work vector of the factor: not for concurrent calls on one factor.
   void solve(Eigen::VectorXd* rhs) const;
   const BorderedInertia& inertia() const { return inertia_; }
   /// S = D − BᵀA⁻¹B, for tests and diagnostics.
@@ -55,8 +56,9 @@ class BorderedBandedFactor {
   BandedCholeskyFactor<Scalar> band_;
   int n_ = 0, m_ = 0;
   Eigen::MatrixXd B_;
-  std::vector<Scalar> Z_;         ///< A⁻¹B, column-major (column j at j·n)
-  std::vector<Scalar> S_scalar_;  ///< S in Scalar, column-major
+  std::vector<Scalar> Z_;          ///< A⁻¹B, column-major (column j at j·n)
+  std::vector<Scalar> S_scalar_;   ///< S in Scalar, column-major
+  mutable std::vector<Scalar> u_;  ///< solve's A⁻¹b, kept to reuse its storage
   /// y = S⁻¹ r: the double eigen-decomposition's solve plus kSchurRefinements corrections with
   /// the residual in Scalar.
   std::vector<Scalar> solveSchur(const std::vector<Scalar>& r) const;

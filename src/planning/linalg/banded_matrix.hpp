@@ -83,6 +83,10 @@ class BandedCholeskyFactor {
   bool factor(const BandedSymmetric<Scalar>& A);
   /// Solves A x = b in place with the last successful factor.
   void solve(Eigen::VectorXd* b) const;
+  /// The same on y[0..n−1] held in Scalar (no rounding to double in between: the bordered solve
+  /// forms its Schur complement from these).
+  void solveInScalar(Scalar* y) const { substitute(y); }
+  int size() const { return n_; }
 
  private:
   /// Forward and back substitution on y (in place).

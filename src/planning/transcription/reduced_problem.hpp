@@ -25,6 +25,7 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/linalg/banded_matrix.hpp"
+#include "planning/transcription/objective.hpp"
 
 namespace attitude_planner {
 
@@ -125,6 +126,39 @@ class ReducedProblem {
   double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
                   double* gradient_scale) const;
 
+  // ---- the time step as a global unknown (objective.hpp, planning/linalg/bordered_band.hpp) ----
+  // The unknowns are (δ, h): the free attitudes R_j exp(δ_j^) and h, with the boundary data held
+  // (R_0, R_N, Ω(0), Ω(T)). Torque-free, μ(F) = μ̃(F)/h for every scheme, so at fixed steps the
+  // interior torques scale as 1/h² and the end torques of second_order as a/h² + b/h; paper and
+  // variational also move their fixed inner attitudes R_1, R_{N−1} with h (the first and last
+  // steps honour Ω(0), Ω(T) at the new h). Not with external effects (time-dependent: refused).
+
+  double timeStep() const { return scheme_.timeStep(); }
+  /// Sets h, keeping the free attitudes: the boundary steps are recomputed at the new h and the
+  /// steps next to them follow. Throws StepTooLarge as the constructor, InvalidInput for h ≤ 0
+  /// or with effects.
+  void setTimeStep(double h);
+
+  /// A stencil with its derivatives in h at fixed free attitudes: ∂r_k/∂h, and with the weights w
+  /// of `second` (forEachStencilWithTimeStep), ∂²(wᵀr_k)/∂δ∂h over (δ_{k−1}, δ_k, δ_{k+1}) and
+  /// ∂²(wᵀr_k)/∂h². Fixed nodes' columns are included, as in `jacobian`.
+  struct TimeStepStencil : Stencil {
+    Vector3 tau_h;                         ///< ∂r_k/∂h
+    Eigen::Matrix<double, 9, 1> second_h;  ///< ∂²(wᵀr_k)/∂δ∂h
+    double second_hh = 0.0;                ///< ∂²(wᵀr_k)/∂h²
+  };
+  /// As forEachStencil(true, …, weights) with the h-derivatives (throws InvalidInput with effects).
+  double forEachStencilWithTimeStep(const std::function<void(const TimeStepStencil&)>& visit,
+                                    const SecondOrderWeights& weights = nullptr) const;
+
+  /// Φ = ε C + φ(N h) of `objective` at δ = 0 and the current h: `gradient` (unknowns() + 1
+  /// entries, ∂Φ/∂h last), the Hessian's band (node unknowns; may be null, then border and
+  /// corner are not formed), its border column ∂²Φ/∂δ∂h and corner ∂²Φ/∂h². With the effort
+  /// objective the band and the node gradient are evaluate()'s, bit for bit.
+  double evaluateWithTimeStep(const TranscriptionObjective& objective, Eigen::VectorXd* gradient,
+                              BandedSymmetricMatrix* band, Eigen::VectorXd* border,
+                              double* corner) const;
+
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
   int variableIndex(int j) const {
     return (j >= first_free_ && j <= last_free_) ? 3 * (j - first_free_) : -1;
@@ -137,9 +171,19 @@ class ReducedProblem {
   /// initializeFromCoarser).
   void closeGap(const Eigen::Vector4d& target);
 
+  /// How a fixed inner attitude moves with h: R(h) = R exp(d(h)^), d = first Δh + ½ second Δh².
+  struct BoundaryPath {
+    Vector3 first = Vector3::Zero(), second = Vector3::Zero();
+  };
+  /// The path of R_1 (at_start) or R_{N−1}; zero for second_order (no fixed inner attitude).
+  BoundaryPath boundaryPath(bool at_start) const;
+  /// Throws InvalidInput if the time step cannot be an unknown here (effects).
+  void requireTimeStepUnknown(const char* what) const;
+
   int N_;
   DiscreteScheme scheme_;
-  Matrix3 initial_attitude_;
+  Matrix3 initial_attitude_, final_attitude_;
+  Vector3 initial_velocity_, final_velocity_;   ///< Ω(0), Ω(T): the boundary steps at any h
   std::shared_ptr<const EffectModel> effects_;  ///< null when the plan has no external torques
   int first_free_, last_free_;                  ///< the free attitudes R_j
   Vector3 initial_momentum_, final_momentum_;   ///< J Ω(0), J Ω(T)

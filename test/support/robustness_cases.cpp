@@ -133,8 +133,12 @@ void cutLocus(Recorder& r, const Vector3& axis) {
   r.atMost("max_k|τ(π+1e-6) − τ(π)| [N m] ≤ 2·slope·δ + 1e-9·max|τ|",
            torqueGap(above6.maneuver, at.maneuver), 2 * torque_slope * 1e-6 + torque_floor);
   r.holds("θ = π: bit-identical when repeated", bitIdentical(at, again));
-  r.holds("θ = π: PlanResult::extremal names the way taken and the other's cost",
-          at.extremal.find("cheaper of both ways") != std::string::npos, at.extremal);
+  r.holds("θ = π: both ways solved (attempts solve, both_ways), the other's cost in the extremal",
+          at.attempts.size() == 2 && at.attempts[1].stage == AttemptStage::BothWays &&
+              at.attempts[0].kept != at.attempts[1].kept &&
+              at.extremal_summary.others.size() == 1 &&
+              std::isfinite(at.extremal_summary.others[0].cost),
+          at.extremal);
 }
 
 // ---- 2. beyond π -------------------------------------------------------------------------------
@@ -155,8 +159,8 @@ void beyondPi(Recorder& r) {
   long_way.direction = RotationDirection::LongWay;
   const PlanResult lw = r.plan("θ = 2π − 0.1 about x, direction = LongWay", long_way);
   r.atLeast("long way: net turn about x [rad] ≥ π", turnedAbout(lw.maneuver, x), M_PI);
-  r.holds("long way: extremal says 'other way round'",
-          lw.extremal.find("other way") != std::string::npos, lw.extremal);
+  r.holds("long way: the extremal's class is the other way round",
+          lw.extremal_summary.homotopy.long_way, lw.extremal);
 
   PlanningProblem extra = restToRest(J, x, theta, 12.8, 64);
   extra.extra_revolutions = 1;

@@ -124,11 +124,12 @@ namespace {
 
 /// Planning's sub-layers (src/planning/<sub>/, docs/ARCHITECTURE.md), in dependency order: a
 /// private file may include its own sub-layer and those before it. linalg knows nothing of the
-/// problem; the solvers sit on the transcription; strategies compose solves; drivers (plan at
-/// resolution, fourth order, minimum time) dispatch.
-const std::vector<std::string> kPlanningSubLayers = {
-    "linalg",         "problem",    "transcription", "newton",
-    "interior_point", "crosscheck", "strategies",    "drivers"};
+/// problem; strategies (grid and staged continuation, starts) take a solver as a callable, so
+/// every solver below them can use them; the solvers sit on the transcription and the
+/// strategies; drivers (plan at resolution, fourth order, minimum time) dispatch.
+const std::vector<std::string> kPlanningSubLayers = {"linalg",     "problem", "transcription",
+                                                     "strategies", "newton",  "interior_point",
+                                                     "crosscheck", "drivers"};
 
 int subLayerRank(const std::string& sub) {
   for (std::size_t i = 0; i < kPlanningSubLayers.size(); ++i) {

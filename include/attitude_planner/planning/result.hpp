@@ -51,11 +51,11 @@ inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
 
 /// Where an attempt's iterate started.
 enum class AttemptStart {
-  Hermite,      ///< the rate-honouring Hermite curve to the chosen lift (newtonInitialSteps)
-  CoarseLevel,  ///< the coarser grid level's plan, refined (grid continuation)
-  WarmStart,    ///< the caller's guess (SolverOptions::warm_start)
-  Coasting,     ///< the torque-free motions from both ends blended
-  InertiaHomotopy,       ///< an extremal of the sphere J̄ = tr(J)/3·I carried to J in stages
+  Hermite,          ///< the rate-honouring Hermite curve to the chosen lift (newtonInitialSteps)
+  CoarseLevel,      ///< the coarser grid level's plan, refined (grid continuation)
+  WarmStart,        ///< the caller's guess (SolverOptions::warm_start)
+  Coasting,         ///< the torque-free motions from both ends blended
+  InertiaHomotopy,  ///< an extremal of the sphere J̄ = tr(J)/3·I carried to J in stages
   UnconstrainedOptimum,  ///< the unconstrained optimum (the interior point's start)
   PreviousAttempt,       ///< the plan of the attempt before it (staged continuations, retries)
 };
@@ -81,9 +81,21 @@ inline constexpr NamedValue<Formulation> kFormulationNames[] = {
     {Formulation::Elastic, "elastic"},
 };
 
+/// How an attempt's Newton steps were globalized (step control).
+enum class Globalization {
+  TrustRegion,  ///< Levenberg–Marquardt shift, Nielsen's update (Newton's default)
+  LineSearch,   ///< the least definite shift, then backtracking (Armijo)
+};
+inline constexpr NamedValue<Globalization> kGlobalizationNames[] = {
+    {Globalization::TrustRegion, "trust_region"},
+    {Globalization::LineSearch, "line_search"},
+};
+
 /// Which homotopy class a maneuver belongs to: the way round and the extra whole turns.
 struct HomotopyClass {
-  bool long_way = false;      ///< the other way round than the shortest rotation
+  /// The other way round: the second-nearest lift of the rotation between the ends
+  /// (RotationDirection::LongWay); rest to rest, the other way than the shortest rotation.
+  bool long_way = false;
   int extra_revolutions = 0;  ///< extra full turns in the sense of the way
 };
 
@@ -93,6 +105,8 @@ struct Attempt {
   AttemptStage stage = AttemptStage::Solve;
   AttemptStart start = AttemptStart::Hermite;
   Formulation formulation = Formulation::Unconstrained;
+  /// Newton's step control (interior-point attempts leave the default).
+  Globalization globalization = Globalization::TrustRegion;
   HomotopyClass homotopy;  ///< the class its start was in
   int steps = 0;           ///< N of the grid it solved on (its finest level)
   Termination termination = Termination::NotConverged;
@@ -102,12 +116,29 @@ struct Attempt {
   bool kept = false;  ///< its plan is the one returned
 };
 
+/// The extremal a solve returned, structured: its homotopy class, the rotation its start turned
+/// through (angle about axis, from R_1 to R_{N−1}), and the other attempts it was chosen among.
+/// PlanResult::extremal is rendered from it (describeExtremal).
+struct ExtremalSummary {
+  bool known = false;  ///< false: no extremal was described (e.g. NLopt, or no plan)
+  HomotopyClass homotopy;
+  double angle = 0.0;               ///< |lift| [rad], extra turns included
+  Vector3 axis = Vector3::UnitX();  ///< the lift's axis (frame of R_1)
+  /// The attempts it was chosen among (the cheapest converged is kept), with their costs.
+  std::vector<Attempt> others;
+};
+
 /// "solve", "both_ways", ... (JSON, tests).
 std::string attemptStageName(AttemptStage stage);
 /// "hermite", "coarse_level", ... (JSON, tests).
 std::string attemptStartName(AttemptStart start);
 /// "unconstrained", "free_slacks", "elastic" (JSON, tests).
 std::string formulationName(Formulation formulation);
+/// "trust_region", "line_search" (JSON, tests).
+std::string globalizationName(Globalization globalization);
+/// PlanResult::extremal, e.g. "nearest lift: 3.14159 rad about [1, 0, 0] from R_1 to R_{N-1}",
+/// then the others' costs: the one place the structure becomes prose.
+std::string describeExtremal(const ExtremalSummary& extremal);
 
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
 /// and the figures that judge it.
@@ -159,6 +190,8 @@ struct PlanResult {
   /// Which extremal was found, e.g. "short way: 3.14159 rad about [1, 0, 0]" (Newton), with the
   /// cost of the other way when both were solved.
   std::string extremal;
+  /// The same, structured (Newton; `known` false for the other solvers).
+  ExtremalSummary extremal_summary;
   /// The effects in the planning model (scene keys), in order; "actuator_limits" last when the
   /// control torques are bounded.
   std::vector<std::string> effects;

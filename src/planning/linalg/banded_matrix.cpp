@@ -78,15 +78,17 @@ Eigen::MatrixXd BandedSymmetric<Scalar>::toDense() const {
 }
 
 template <typename Scalar>
-bool BandedSymmetric<Scalar>::solvePositiveDefinite(Eigen::VectorXd* b) const {
+bool BandedSymmetric<Scalar>::solvePositiveDefinite(Eigen::VectorXd* b,
+                                                    const Interruption* interruption) const {
   BandedCholeskyFactor<Scalar> cholesky;
-  if (!cholesky.factor(*this)) return false;
+  if (!cholesky.factor(*this, interruption)) return false;
   cholesky.solve(b);
   return true;
 }
 
 template <typename Scalar>
-bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
+bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A,
+                                          const Interruption* interruption) {
   // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
   // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
   n_ = A.n_;
@@ -98,6 +100,7 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
   };  // row(i)[j] = L(i, j)
   if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_.resize(n_);
   for (int i = 0; i < n_; ++i) {
+    if (interruption && i % kColumnsBetweenPolls == 0) interruption->poll();
     Scalar* li = row(i);
     const int first = std::max(0, i - p_);
     for (int j = first; j <= i; ++j) {
@@ -166,12 +169,13 @@ double BandedLinearSystem::operator()(int i, int j) const {
                                          : 0.0;
 }
 
-bool BandedLinearSystem::solve(Eigen::VectorXd* b_in) {
+bool BandedLinearSystem::solve(Eigen::VectorXd* b_in, const Interruption* interruption) {
   Eigen::VectorXd& b = *b_in;
   const size_t w = 3 * p_ + 1;
   // row(i)[j] = A(i, j) for i − p ≤ j ≤ i + 2p.
   const auto row = [&](int i) { return data_.data() + i * w + p_ - i; };
   for (int k = 0; k < n_; ++k) {
+    if (interruption && k % kColumnsBetweenPolls == 0) interruption->poll();
     const int last_row = std::min(n_ - 1, k + p_);
     const int last_col = std::min(n_ - 1, k + 2 * p_);
     int pivot = k;

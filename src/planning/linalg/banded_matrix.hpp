@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "planning/linalg/double_double.hpp"
+#include "planning/linalg/interruption.hpp"
 
 namespace attitude_planner {
 
@@ -60,8 +61,9 @@ class BandedSymmetric {
   /// The full matrix, for tests and diagnostics.
   Eigen::MatrixXd toDense() const;
   /// Solves A x = b in place by a banded Cholesky factorization of a copy of A.
-  /// Returns false (x unspecified) if A is not numerically positive definite.
-  bool solvePositiveDefinite(Eigen::VectorXd* b) const;
+  /// Returns false (x unspecified) if A is not numerically positive definite. `interruption`
+  /// (optional) is polled every kColumnsBetweenPolls columns and may throw to stop the solve.
+  bool solvePositiveDefinite(Eigen::VectorXd* b, const Interruption* interruption = nullptr) const;
 
  private:
   template <typename>
@@ -79,8 +81,9 @@ template <typename Scalar>
 class BandedCholeskyFactor {
  public:
   /// Factors A (the factor replaces any previous one). Returns false if A is not numerically
-  /// positive definite (then solve must not be called).
-  bool factor(const BandedSymmetric<Scalar>& A);
+  /// positive definite (then solve must not be called). `interruption` (optional) is polled
+  /// every kColumnsBetweenPolls columns and may throw to stop the factorization.
+  bool factor(const BandedSymmetric<Scalar>& A, const Interruption* interruption = nullptr);
   /// Solves A x = b in place with the last successful factor.
   void solve(Eigen::VectorXd* b) const;
   /// The same on y[0..n−1] held in Scalar (no rounding to double in between: the bordered solve
@@ -130,7 +133,8 @@ class BandedLinearSystem {
   /// A(i, j) (0 outside the band), for tests.
   double operator()(int i, int j) const;
   /// Solves A x = b in place (A is overwritten by its factors). Returns false if singular.
-  bool solve(Eigen::VectorXd* b);
+  /// `interruption` (optional) is polled every kColumnsBetweenPolls columns and may throw.
+  bool solve(Eigen::VectorXd* b, const Interruption* interruption = nullptr);
 
  private:
   /// Row i holds A(i, i − p..i + 2p) contiguously (the upper 2p: room for pivoting fill-in), so

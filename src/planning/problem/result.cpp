@@ -1,5 +1,8 @@
 #include "attitude_planner/planning/result.hpp"
 
+#include <cmath>
+#include <sstream>
+
 namespace attitude_planner {
 
 std::string attemptStageName(AttemptStage stage) {
@@ -12,6 +15,58 @@ std::string attemptStartName(AttemptStart start) {
 
 std::string formulationName(Formulation formulation) {
   return nameIn(kFormulationNames, formulation);
+}
+
+std::string globalizationName(Globalization globalization) {
+  return nameIn(kGlobalizationNames, globalization);
+}
+
+namespace {
+
+/// What distinguishes an attempt among the starts an extremal was chosen from.
+std::string describeCandidate(const Attempt& a) {
+  if (a.stage == AttemptStage::Solve) return "the first start";
+  if (a.homotopy.long_way) return "the other way round";
+  if (a.homotopy.extra_revolutions > 0) return "one extra revolution";
+  if (a.globalization == Globalization::LineSearch) {
+    return "a line search instead of the trust region";
+  }
+  switch (a.start) {
+    case AttemptStart::InertiaHomotopy:
+      return "the inertia homotopy from the sphere";
+    case AttemptStart::Coasting:
+      return "the coasting start";
+    case AttemptStart::Hermite:
+      return "the requested grid directly";
+    default:
+      return attemptStageName(a.stage) + " from " + attemptStartName(a.start);
+  }
+}
+
+}  // namespace
+
+std::string describeExtremal(const ExtremalSummary& e) {
+  if (!e.known) return "";
+  std::ostringstream d;
+  d << (e.homotopy.long_way ? "second-nearest lift (the other way round)" : "nearest lift");
+  if (e.homotopy.extra_revolutions > 0) {
+    d << " + " << e.homotopy.extra_revolutions << " extra turn(s)";
+  }
+  d << ": " << e.angle << " rad about [" << e.axis.x() << ", " << e.axis.y() << ", " << e.axis.z()
+    << "] from R_1 to R_{N-1}";
+  for (std::size_t i = 0; i < e.others.size(); ++i) {
+    const Attempt& a = e.others[i];
+    d << (i == 0 ? "; also solved: " : ", ") << describeCandidate(a) << " (";
+    if (a.termination == Termination::Converged) {
+      d.precision(10);
+      d << "cost " << a.cost;
+      d.precision(6);
+    } else {
+      d << terminationName(a.termination);
+    }
+    d << ")";
+  }
+  return d.str();
 }
 
 }  // namespace attitude_planner

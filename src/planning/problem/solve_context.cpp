@@ -49,4 +49,8 @@ bool SolveContext::reportIteration(const IterationInfo& info) {
   return !refused_by_callback_;
 }
 
+void SolveContext::markKept(std::size_t index) {
+  for (std::size_t i = 0; i < attempts_.size(); ++i) attempts_[i].kept = i == index;
+}
+
 }  // namespace attitude_planner

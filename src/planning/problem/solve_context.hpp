@@ -51,6 +51,9 @@ class SolveContext : public Interruption {
 
   /// Appends an attempt to the trail (in the order attempts end).
   void record(const Attempt& attempt) { attempts_.push_back(attempt); }
+  /// Marks the attempt at `index` as the one whose plan is returned, clearing the others' mark
+  /// (a later solve of the same request, e.g. the interior point after Newton, marks its own).
+  void markKept(std::size_t index);
   const std::vector<Attempt>& attempts() const { return attempts_; }
 
  private:

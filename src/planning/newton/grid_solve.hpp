@@ -1,0 +1,39 @@
+// Newton on one grid: a short loop over named pieces — the Newton step (newtonStep: normal
+// equations or the augmented system), the step control (step_control.hpp: trust region or line
+// search), the stopping test (StoppingTest) — on the reduced problem (reduced_problem.hpp), whose
+// cost is the merit function. O(N) time and memory per iteration.
+#pragma once
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/newton/newton_parameters.hpp"
+#include "planning/newton/step_control.hpp"
+#include "planning/problem/solve_context.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// What one grid solve iterates to and with.
+struct GridSettings {
+  double tolerance = 1e-10;  ///< on the relative Newton decrement
+  int max_iterations = 200;
+  Globalization globalization = Globalization::TrustRegion;
+};
+
+/// Where one grid solve starts: the Hermite curve to the request's lift, replaced by the warm
+/// start's attitudes if given, then by the coarser level's steps if given (extrapolated with the
+/// one below it if given too).
+struct GridStart {
+  const Maneuver* warm_start = nullptr;
+  const ReducedProblem::Steps* coarse = nullptr;
+  const ReducedProblem::Steps* coarser = nullptr;
+};
+
+/// Newton on `problem`'s grid. Iterations are reported through `context` (numbered across the
+/// request); a cancel or the deadline ends it with its last accepted iterate. With `final_steps`
+/// (a coarse level) only the final iterate is produced, no plan figures.
+PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
+                       const GridSettings& settings, const GridStart& start,
+                       ReducedProblem::Steps* final_steps, const NewtonParameters& parameters);
+
+}  // namespace attitude_planner

@@ -1,0 +1,69 @@
+#include "planning/strategies/staged_continuation.hpp"
+
+#include <algorithm>
+
+namespace attitude_planner {
+
+namespace {
+
+bool stoppedEarly(const PlanResult& r) {
+  return r.termination == Termination::Cancelled || r.termination == Termination::TimedOut;
+}
+
+}  // namespace
+
+StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProblem& at,
+                                    const AdaptiveSchedule& schedule, const StageSolver& solve) {
+  StagedOutcome out;
+  out.reached = -1;
+  if (context.stopReason()) return out;
+  out.plan = solve(at(0.0), nullptr);
+  out.iterations += out.plan.iterations;
+  if (stoppedEarly(out.plan)) {
+    out.stopped = out.plan.termination;
+    return out;
+  }
+  if (!out.plan.converged()) return out;
+  out.reached = 0.0;
+  double ds = schedule.first_increment;
+  while (out.reached < 1.0 && out.stages < schedule.max_stages && !context.stopReason()) {
+    const double next = std::min(1.0, out.reached + ds);
+    const Maneuver from = out.plan.maneuver;
+    PlanResult r = solve(at(next), &from);
+    ++out.stages;
+    out.iterations += r.iterations;
+    if (stoppedEarly(r)) {
+      out.stopped = r.termination;
+      out.plan = std::move(r);
+      return out;
+    }
+    if (r.converged()) {
+      out.plan = std::move(r);
+      out.reached = next;
+      ds = std::min(2.0 * ds, schedule.max_increment);
+    } else {
+      ds *= 0.5;
+      if (ds < schedule.min_increment) break;
+    }
+  }
+  return out;
+}
+
+StagedOutcome solveByFixedStages(const StageProblem& at, int stages, const StageSolver& solve) {
+  StagedOutcome out;
+  out.reached = -1;
+  Maneuver previous;
+  for (int i = 0; i <= stages; ++i) {
+    const double s = static_cast<double>(i) / stages;
+    out.plan = solve(at(s), i > 0 ? &previous : nullptr);
+    out.iterations += out.plan.iterations;
+    if (stoppedEarly(out.plan)) out.stopped = out.plan.termination;
+    if (!out.plan.converged()) break;
+    out.reached = s;
+    out.stages = i;
+    previous = out.plan.maneuver;
+  }
+  return out;
+}
+
+}  // namespace attitude_planner

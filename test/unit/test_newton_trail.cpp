@@ -1,0 +1,179 @@
+// The Newton solver's structured trail (issue 29): every attempt recorded with its stage, start,
+// class, termination, iterations and cost; one kept; iterations numbered across attempts; the
+// extremal structured; a cancel from another thread ends a large solve promptly; and the grid
+// continuation, which takes any solver as a callable.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <future>
+#include <thread>
+
+#include "attitude_planner/planner.hpp"
+#include "planning/strategies/grid_continuation.hpp"
+#include "support/robustness_cases.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+PlanningProblem restToRest(double angle, int N) {
+  PlanningProblem p;
+  p.inertia = robustness::seedInertia();
+  p.duration = 12.8;
+  p.steps = N;
+  p.final_attitude = so3::fromAxisAngle(Vector3::UnitX(), angle);
+  p.allow_nonphysical_inertia = true;  // the seed's J violates J1 + J2 >= J3
+  return p;
+}
+
+int keptCount(const PlanResult& r) {
+  return static_cast<int>(
+      std::count_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; }));
+}
+
+}  // namespace
+
+TEST(NewtonTrail, OneAttemptForAPlainRequest) {
+  const PlanResult r = planManeuver(restToRest(M_PI / 3, 128));
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_EQ(r.attempts.size(), 1u);
+  const Attempt& a = r.attempts[0];
+  EXPECT_EQ(a.stage, AttemptStage::Solve);
+  EXPECT_EQ(a.start, AttemptStart::CoarseLevel);  // N = 128 goes through N = 32
+  EXPECT_EQ(a.formulation, Formulation::Unconstrained);
+  EXPECT_EQ(a.globalization, Globalization::TrustRegion);
+  EXPECT_FALSE(a.homotopy.long_way);
+  EXPECT_EQ(a.steps, 128);
+  EXPECT_EQ(a.termination, Termination::Converged);
+  EXPECT_EQ(a.iterations, r.iterations);
+  EXPECT_DOUBLE_EQ(a.cost, r.cost);
+  EXPECT_TRUE(a.kept);
+  // The structured extremal, and the string rendered from it as before.
+  EXPECT_TRUE(r.extremal_summary.known);
+  EXPECT_FALSE(r.extremal_summary.homotopy.long_way);
+  EXPECT_NEAR(r.extremal_summary.angle, M_PI / 3, 0.2);  // R_1 to R_{N-1}: less than the whole
+  EXPECT_NEAR(r.extremal_summary.axis.x(), 1.0, 1e-9);
+  EXPECT_TRUE(r.extremal_summary.others.empty());
+  EXPECT_EQ(r.extremal.rfind("nearest lift: ", 0), 0u) << r.extremal;
+  EXPECT_EQ(r.extremal, describeExtremal(r.extremal_summary));
+}
+
+TEST(NewtonTrail, NearPiRecordsBothWaysWithBothCostsAndOneKept) {
+  const PlanResult r = planManeuver(restToRest(M_PI - 0.05, 64));
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_EQ(r.attempts.size(), 2u) << r.message;
+  EXPECT_EQ(r.attempts[0].stage, AttemptStage::Solve);
+  EXPECT_FALSE(r.attempts[0].homotopy.long_way);
+  EXPECT_EQ(r.attempts[1].stage, AttemptStage::BothWays);
+  EXPECT_TRUE(r.attempts[1].homotopy.long_way);
+  for (const Attempt& a : r.attempts) {
+    EXPECT_EQ(a.termination, Termination::Converged);
+    EXPECT_TRUE(std::isfinite(a.cost) && a.cost > 0);
+  }
+  EXPECT_EQ(keptCount(r), 1);
+  const Attempt& kept = r.attempts[0].kept ? r.attempts[0] : r.attempts[1];
+  const Attempt& other = r.attempts[0].kept ? r.attempts[1] : r.attempts[0];
+  EXPECT_DOUBLE_EQ(kept.cost, r.cost);
+  EXPECT_LE(kept.cost, other.cost);
+  EXPECT_EQ(r.iterations, r.attempts[0].iterations + r.attempts[1].iterations);
+  EXPECT_EQ(r.extremal_summary.homotopy.long_way, kept.homotopy.long_way);
+  ASSERT_EQ(r.extremal_summary.others.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.extremal_summary.others[0].cost, other.cost);
+}
+
+TEST(NewtonTrail, AStalledSpinningRequestRecordsItsRateContinuationAndNumbersIterations) {
+  // Spinning at the end, two iterations per level: the direct solve stalls at its limit, so the
+  // continuation in the boundary rates and the coasting start follow, each recorded.
+  PlanningProblem p = restToRest(M_PI / 6, 64);
+  p.final_velocity = Vector3(0.3, 0.2, 0.3);
+  SolverOptions options;
+  options.max_iterations = 2;
+  std::vector<int> numbers;
+  options.on_iteration = [&](const IterationInfo& info) {
+    numbers.push_back(info.iteration);
+    return true;
+  };
+  const PlanResult r = planManeuver(p, options);
+  ASSERT_GE(r.attempts.size(), 3u) << r.message;
+  EXPECT_EQ(r.attempts[0].stage, AttemptStage::Solve);
+  EXPECT_EQ(r.attempts[0].termination, Termination::NotConverged);
+  EXPECT_EQ(r.attempts[1].stage, AttemptStage::RateContinuation);
+  EXPECT_EQ(r.attempts[1].start, AttemptStart::PreviousAttempt);
+  EXPECT_GT(r.attempts[1].iterations, 0);
+  EXPECT_EQ(r.attempts[2].stage, AttemptStage::CoastingRetry);
+  EXPECT_EQ(r.attempts[2].start, AttemptStart::Coasting);
+  EXPECT_EQ(keptCount(r), 1);
+  int total = 0;
+  for (const Attempt& a : r.attempts) total += a.iterations;
+  EXPECT_EQ(total, r.iterations);
+  // Every iteration of every attempt and level is reported, numbered 1..n without a gap.
+  ASSERT_EQ(static_cast<int>(numbers.size()), r.iterations);
+  for (std::size_t i = 0; i < numbers.size(); ++i) EXPECT_EQ(numbers[i], static_cast<int>(i) + 1);
+}
+
+TEST(NewtonTrail, ACancelFromAnotherThreadEndsALargeSolveCancelled) {
+  const int N = 100000;
+  std::atomic<bool> cancel{false};
+  std::promise<void> first_iteration, flag_set;
+  std::future<void> flag_set_seen = flag_set.get_future();
+  std::thread canceller([&, started = first_iteration.get_future()]() mutable {
+    started.wait();
+    cancel = true;
+    flag_set.set_value();
+  });
+  SolverOptions options;
+  options.cancel_requested = &cancel;
+  bool first = true;
+  options.on_iteration = [&](const IterationInfo&) {
+    if (first) {  // hand over to the other thread and wait until it has set the flag
+      first = false;
+      first_iteration.set_value();
+      flag_set_seen.wait();
+    }
+    return true;
+  };
+  const PlanResult r = planManeuver(restToRest(M_PI / 3, N), options);
+  canceller.join();
+  EXPECT_EQ(r.termination, Termination::Cancelled) << r.message;
+  EXPECT_EQ(r.maneuver.steps(), N);  // the last iterate, carried over to the requested grid
+  ASSERT_FALSE(r.attempts.empty());
+  EXPECT_EQ(r.attempts.back().termination, Termination::Cancelled);
+}
+
+// The continuation with a stand-in solver: levels coarsest first, each started from the one
+// below, a coarse level solved to the floor tolerance, and a stop carried up without iterating.
+TEST(GridContinuation, LevelsRunCoarsestFirstAndHandOnTheirIterates) {
+  PlanningProblem p = restToRest(1.0, 1024);
+  GridLevelRule rule;  // 16, ×4
+  SolverOptions options;
+  SolveContext context(options);
+  std::vector<int> seen;
+  const LevelSolver<std::vector<int>> solve = [&](const LevelRequest<std::vector<int>>& r,
+                                                  std::vector<int>* out) {
+    seen.push_back(r.problem.steps);
+    if (seen.size() > 1) {
+      EXPECT_NE(r.coarse, nullptr);
+      if (r.coarse) {
+        EXPECT_EQ(r.coarse->back(), seen[seen.size() - 2]);
+      }
+    }
+    EXPECT_EQ(r.tolerance, r.finest ? 1e-10 : 1e-6);
+    EXPECT_EQ(out == nullptr, r.finest);
+    if (out) *out = {r.problem.steps};
+    PlanResult result;
+    result.termination = Termination::Converged;
+    result.iterations = 3;
+    result.levels.push_back({r.problem.steps, 3, Termination::Converged, 0, 0, "converged"});
+    return result;
+  };
+  const PlanResult r = solveByGridContinuation(p, context, rule, 1e-10, solve);
+  EXPECT_EQ(seen, (std::vector<int>{16, 64, 256, 1024}));
+  EXPECT_EQ(r.iterations, 12);
+  EXPECT_EQ(r.levels.size(), 4u);
+  EXPECT_TRUE(r.converged());
+  // A level that helps not: no coarser level at all.
+  rule.level_helps = [](const PlanningProblem&) { return false; };
+  EXPECT_EQ(gridLevels(p, rule).size(), 1u);
+}

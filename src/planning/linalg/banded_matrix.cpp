@@ -86,7 +86,8 @@ bool BandedSymmetric<Scalar>::solvePositiveDefinite(Eigen::VectorXd* b) const {
 }
 
 template <typename Scalar>
-bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
+bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A,
+                                          const Interruption* interruption) {
   // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
   // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
   n_ = A.n_;
@@ -98,6 +99,7 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A) {
   };  // row(i)[j] = L(i, j)
   if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_.resize(n_);
   for (int i = 0; i < n_; ++i) {
+    if (interruption && i % kColumnsBetweenPolls == 0) interruption->poll();
     Scalar* li = row(i);
     const int first = std::max(0, i - p_);
     for (int j = first; j <= i; ++j) {

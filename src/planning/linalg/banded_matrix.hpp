@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "planning/linalg/double_double.hpp"
+#include "planning/linalg/interruption.hpp"
 
 namespace attitude_planner {
 
@@ -79,8 +80,9 @@ template <typename Scalar>
 class BandedCholeskyFactor {
  public:
   /// Factors A (the factor replaces any previous one). Returns false if A is not numerically
-  /// positive definite (then solve must not be called).
-  bool factor(const BandedSymmetric<Scalar>& A);
+  /// positive definite (then solve must not be called). `interruption` (optional) is polled every
+  /// kColumnsBetweenPolls columns; what it throws ends the factorization.
+  bool factor(const BandedSymmetric<Scalar>& A, const Interruption* interruption = nullptr);
   /// Solves A x = b in place with the last successful factor.
   void solve(Eigen::VectorXd* b) const;
 

@@ -408,13 +408,17 @@ class GridSolve {
     result.history = history_;
     out.steps = np_.current();
     if (free_slacks_) out.duals = system_.duals();
-    const Maneuver planned = np_.maneuver(np_.current());
-    result.switching_function = system_.switchingFunction(planned.torque);
-    // Stopped: answer at once (the stationarity residual costs a gradient at N; not measured).
-    result.max_residual = ranOut(ending_)
-                              ? std::numeric_limits<double>::quiet_NaN()
-                              : system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
-    evaluatePlan(problem_, planned.torque, &result, &planned);
+    // Stopped: answer at once (the stationarity residual costs a gradient at N: not measured;
+    // on a coarser level the plan is evaluated once carried to the requested grid).
+    result.max_residual = std::numeric_limits<double>::quiet_NaN();
+    if (!ranOut(ending_) || request_.evaluate_when_stopped) {
+      const Maneuver planned = np_.maneuver(np_.current());
+      result.switching_function = system_.switchingFunction(planned.torque);
+      if (!ranOut(ending_)) {
+        result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
+      }
+      evaluatePlan(problem_, planned.torque, &result, &planned);
+    }
     std::ostringstream msg;
     if (ending_ == Termination::Infeasible) {
       const ConstraintCheck check = checkConstraints(problem_, result.maneuver);

@@ -20,6 +20,9 @@ struct GridRequest {
   const ReducedProblem::Steps* coarse_steps = nullptr;
   /// The coarser grid's multipliers and slacks (free slacks with Mehrotra only); null: none.
   const LevelDuals* coarse_duals = nullptr;
+  /// A solve stopped (cancelled, out of time) on this grid still evaluates its plan; false on a
+  /// coarser level of a continuation, whose iterate is carried to the requested grid instead.
+  bool evaluate_when_stopped = true;
 };
 
 /// What one grid solve leaves: its result, its iterate and (free slacks) its duals.

@@ -100,6 +100,11 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
   levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
 }
 
+/// N of the grid a result was solved on (its last level).
+int levelSteps(const PlanResult& r) {
+  return r.levels.empty() ? r.maneuver.steps() : r.levels.back().steps;
+}
+
 bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
@@ -116,19 +121,19 @@ struct Solve {
 /// iterations are kept.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                const Solve& solve, const ReducedProblem::Steps* coarse_steps,
-                               const LevelDuals* coarse_duals) {
+                               const LevelDuals* coarse_duals, bool final_grid = true) {
   const FormulationRecipe& recipe =
       options.constrained_from_warm_start ? kProbeRecipe : kRequestRecipe;
-  GridOutcome first =
-      solveOnGrid(problem, options, solve.parameters, solve.context,
-                  {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals});
+  GridOutcome first = solveOnGrid(
+      problem, options, solve.parameters, solve.context,
+      {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals, final_grid});
   first.formulation = recipe.first.formulation;
   const Termination t = first.result.termination;
   if (t != Termination::Infeasible && t != Termination::NotConverged) return first;
   if (solve.context.stopReason()) return first;  // cancelled or out of time: no retry
-  GridOutcome second =
-      solveOnGrid(problem, options, solve.parameters, solve.context,
-                  {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr});
+  GridOutcome second = solveOnGrid(
+      problem, options, solve.parameters, solve.context,
+      {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr, final_grid});
   second.formulation = recipe.retry.formulation;
   const bool take_second =
       second.result.converged() ||
@@ -186,7 +191,8 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   half.steps = at.steps / 2;
   SolverOptions from_coarse = options;
   from_coarse.warm_start = nullptr;  // both start from the coarse steps
-  const GridOutcome middle = solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr);
+  const GridOutcome middle =
+      solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr, /*final_grid=*/false);
   *iterations += middle.result.iterations;
   appendLevels(solved_levels, middle.result);
   if (!middle.result.converged()) return;
@@ -224,10 +230,9 @@ GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& 
       if (*level != problem.steps) continue;
       const PlanResult coarse = outcome.result;
       const Formulation formulation = outcome.formulation;
-      outcome =
-          carryToGrid(at, steps, coarse.termination,
-                      coarse.message + " (on the N = " + std::to_string(coarse.maneuver.steps()) +
-                          " level of the grid continuation)");
+      outcome = carryToGrid(at, steps, coarse.termination,
+                            coarse.message + " (on the N = " + std::to_string(levelSteps(coarse)) +
+                                " level of the grid continuation)");
       outcome.formulation = formulation;
       appendLevels(&solved_levels, outcome.result);
       break;
@@ -244,8 +249,8 @@ GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& 
       appendLevels(&solved_levels, unconstrained);
     }
     const PlanResult coarse = outcome.result;
-    outcome =
-        solveGridWithRetry(at, level_options, solve, steps.empty() ? nullptr : &steps, &duals);
+    outcome = solveGridWithRetry(at, level_options, solve, steps.empty() ? nullptr : &steps, &duals,
+                                 *level == problem.steps);
     iterations += outcome.result.iterations;
     appendLevels(&solved_levels, outcome.result);
     const LevelDuals direct_duals = outcome.duals;
@@ -257,7 +262,7 @@ GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& 
       // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
       outcome.result.termination = coarse.termination;
       outcome.result.message = coarse.message +
-                               " (on the N = " + std::to_string(coarse.maneuver.steps()) +
+                               " (on the N = " + std::to_string(levelSteps(coarse)) +
                                " level of the grid continuation)";
     }
     const Termination t = outcome.result.termination;

@@ -42,6 +42,10 @@ const char* const kUsage =
     "  --target-cost-error E     instead of --steps: choose N so that |h cost - continuous cost|\n"
     "                            <= E [N^2 m^2 s] (Richardson estimate; rigid_body)\n"
     "  --solver newton|nlopt     newton (default) or the NLopt SLSQP cross-check (rigid_body)\n"
+    "  --precision auto|double|extended|double_double\n"
+    "                            arithmetic of the interior point's Newton system (rigid_body\n"
+    "                            with constraints; auto: double to N = 1024, extended to 8192,\n"
+    "                            double_double above)\n"
     "  --objective minimum_effort|minimum_time\n"
     "                            minimum_time: the least duration T* under the torque bounds\n"
     "                            and constraints in force (rigid_body; the scene's duration\n"
@@ -129,7 +133,8 @@ struct Arguments {
   std::optional<int> steps;  ///< absent: the scene's
   std::string scheme;
   std::string solver = "newton";
-  bool solver_given = false;    ///< --solver was on the command line
+  bool solver_given = false;  ///< --solver was on the command line
+  std::string precision = "auto";
   std::string initial_costate;  ///< --initial-costate text, "" if absent
   double tolerance = -1.0;      ///< < 0: the default
   int max_iterations = -1;      ///< < 0: the default
@@ -185,6 +190,9 @@ Arguments parseArguments(int argc, char** argv) {
       a.solver = next();
       a.solver_given = true;
       checkFlagValue([&] { ap::parseSolver(a.solver, arg); });
+    } else if (arg == "--precision") {
+      a.precision = next();
+      checkFlagValue([&] { ap::parsePrecision(a.precision, arg); });
     } else if (arg == "--tolerance") {
       value_text = next();
       a.tolerance = parseDouble(arg, value_text);
@@ -329,6 +337,7 @@ int main(int argc, char** argv) {
 
     ap::SolverOptions options;
     options.solver = ap::parseSolver(args.solver, "--solver");
+    options.precision = ap::parsePrecision(args.precision, "--precision");
     if (args.tolerance > 0.0) options.tolerance = args.tolerance;
     if (args.max_iterations > 0) options.max_iterations = args.max_iterations;
     options.time_budget_s = args.time_budget;

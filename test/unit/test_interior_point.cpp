@@ -3,7 +3,13 @@
 // method (independent of the solver's reduced coordinates), agreement with NLopt SLSQP given the
 // same constraints, infeasible requests answered with the named reason, and scene validation.
 #include <gtest/gtest.h>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
 #include <cstdlib>
+#include <mutex>
+#include <thread>
 
 #include <Eigen/QR>
 #include <functional>
@@ -12,6 +18,8 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/interior_point/grid_solve.hpp"
+#include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/direct_method.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -709,4 +717,128 @@ TEST(InteriorPoint, FinerLevelsStartFromTheCoarserMultipliers) {
   ASSERT_FALSE(r.levels.empty());
   EXPECT_EQ(r.levels.back().steps, 2048);
   EXPECT_LE(r.levels.back().iterations, 10) << r.levels.back().reason;
+}
+
+// The barrier rules as strategies: one grid solved from the unconstrained optimum with each
+// rule (Mehrotra's predictor–corrector and the monotone rule with free slacks, LOQO's with the
+// elastic form) reaches the same optimum, SLSQP's (docs/constraints.md), and each records its
+// iterations through the context.
+TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
+  const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 128);
+  ap::PlanningProblem free = p;
+  free.max_torque = ap::Vector3::Constant(std::numeric_limits<double>::infinity());
+  const ap::PlanResult unconstrained = ap::planManeuver(free, ap::SolverOptions{});
+  ASSERT_TRUE(unconstrained.converged()) << unconstrained.message;
+  ap::SolverOptions o;
+  o.warm_start = &unconstrained.maneuver;
+  const ap::InteriorPointParameters parameters;
+  const std::pair<ap::Formulation, ap::BarrierRule> forms[] = {
+      {ap::Formulation::FreeSlacks, ap::BarrierRule::Mehrotra},
+      {ap::Formulation::FreeSlacks, ap::BarrierRule::Monotone},
+      {ap::Formulation::Elastic, ap::BarrierRule::Loqo},
+  };
+  for (const auto& [formulation, rule] : forms) {
+    ap::SolveContext context(o);
+    ap::GridRequest request;
+    request.formulation = formulation;
+    request.barrier = rule;
+    const ap::GridOutcome out = ap::solveOnGrid(p, o, parameters, context, request);
+    SCOPED_TRACE(static_cast<int>(rule));
+    ASSERT_TRUE(out.result.converged()) << out.result.message;
+    EXPECT_NEAR(out.result.cost, 8.63484875423, 1e-9 * 8.63) << out.result.message;
+    EXPECT_EQ(context.iterations(), out.result.iterations);
+    EXPECT_EQ(out.duals.empty(), formulation == ap::Formulation::Elastic);
+  }
+}
+
+// The interior point records what it ran: one attempt for torque_limited (no cones), in the
+// free-slack form, started from the unconstrained optimum, kept, with the result's cost.
+TEST(InteriorPointStrategies, AttemptsRecordFormulationStartAndCost) {
+  const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 128), "newton");
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_EQ(r.attempts.size(), 1u);
+  const ap::Attempt& a = r.attempts.front();
+  EXPECT_EQ(a.stage, ap::AttemptStage::Constrained);
+  EXPECT_EQ(a.start, ap::AttemptStart::UnconstrainedOptimum);
+  EXPECT_EQ(a.formulation, ap::Formulation::FreeSlacks);
+  EXPECT_EQ(a.termination, ap::Termination::Converged);
+  EXPECT_EQ(a.steps, 128);
+  EXPECT_TRUE(a.kept);
+  EXPECT_DOUBLE_EQ(a.cost, r.cost);
+}
+
+// precision: auto is double to N = 1024, extended to 8192, double-double above; an explicit
+// precision is taken as asked (extended is double-double where long double is not x87).
+TEST(InteriorPointStrategies, PrecisionAutoFollowsTheStepThresholds) {
+  const bool x87 = std::numeric_limits<long double>::digits == 64;
+  const ap::SystemPrecision extended =
+      x87 ? ap::SystemPrecision::LongDouble : ap::SystemPrecision::DoubleDouble;
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Auto, 1024), ap::SystemPrecision::Double);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Auto, 1025), extended);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Auto, 8192), extended);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Auto, 8193), ap::SystemPrecision::DoubleDouble);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Double, 100000), ap::SystemPrecision::Double);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::Extended, 64), extended);
+  EXPECT_EQ(ap::resolvePrecision(ap::Precision::DoubleDouble, 64),
+            ap::SystemPrecision::DoubleDouble);
+  EXPECT_EQ(ap::parsePrecision("double_double", "precision"), ap::Precision::DoubleDouble);
+  EXPECT_THROW(ap::parsePrecision("quad", "precision"), ap::InvalidInput);
+}
+
+// The same optimum in every precision at N = 512 (where double suffices).
+TEST(InteriorPointStrategies, EveryPrecisionReachesTheSameOptimum) {
+  const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 512);
+  const ap::PlanResult reference = plan(p, "newton");
+  ASSERT_TRUE(reference.converged()) << reference.message;
+  for (ap::Precision precision :
+       {ap::Precision::Double, ap::Precision::Extended, ap::Precision::DoubleDouble}) {
+    ap::SolverOptions o;
+    o.precision = precision;
+    const ap::PlanResult r = ap::planManeuver(p, o);
+    ASSERT_TRUE(r.converged()) << ap::precisionName(precision) << ": " << r.message;
+    EXPECT_NEAR(r.cost, reference.cost, 1e-10 * reference.cost) << ap::precisionName(precision);
+  }
+}
+
+// A cancel flag set from another thread while the interior point runs at N = 10⁵ (torque and
+// rate limits, double-double system) ends the solve as Cancelled with the last accepted iterate
+// at the requested N; the flag is polled inside the assembly and the banded factorization, so the
+// answer comes promptly (the latency is logged, not asserted: timings are no test property). The
+// interior point is called directly: planManeuver's unconstrained Newton start is another
+// solver's loop.
+TEST(InteriorPointStrategies, CancelFromAnotherThreadEndsCancelledAtN1e5) {
+  ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 100000);
+  p.constraints = {ap::PlanningConstraint::maxAngularRate(0.12)};
+  std::atomic<bool> cancel{false};
+  ap::SolverOptions o;
+  o.cancel_requested = &cancel;
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point set_at;
+  std::mutex m;
+  std::condition_variable done;
+  bool finished = false;
+  std::thread canceller([&] {
+    std::unique_lock<std::mutex> lock(m);
+    // Well into the grid continuation (its levels up to N = 25 000 take ~1 s alone).
+    if (done.wait_for(lock, std::chrono::seconds(3), [&] { return finished; })) return;
+    set_at = Clock::now();
+    cancel = true;
+  });
+  ap::SolveContext context(o);
+  const ap::PlanResult r = ap::solveWithInteriorPoint(p, o, context);
+  const Clock::time_point returned = Clock::now();
+  {
+    std::lock_guard<std::mutex> lock(m);
+    finished = true;
+  }
+  done.notify_all();
+  canceller.join();
+  ASSERT_TRUE(cancel.load()) << "the solve ended before the cancel: " << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::Cancelled) << r.message;
+  EXPECT_EQ(r.maneuver.steps(), 100000);
+  ASSERT_FALSE(context.attempts().empty());
+  EXPECT_EQ(context.attempts().back().termination, ap::Termination::Cancelled);
+  const double latency_ms = std::chrono::duration<double, std::milli>(returned - set_at).count();
+  std::printf("cancel latency at N = 1e5: %.1f ms (flag set -> solve returned)\n", latency_ms);
+  RecordProperty("cancel_latency_ms", std::to_string(latency_ms));
 }

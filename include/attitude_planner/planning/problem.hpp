@@ -69,6 +69,40 @@ inline SolverKind parseSolver(const std::string& text, const std::string& field)
   return parseIn(kSolverNames, text, field);
 }
 
+/// The arithmetic of the interior point's condensed Newton system (SolverOptions::precision). At
+/// a bound the system's condition grows like N⁴/μ; the smooth modes need more than double above
+/// about N = 1024 (interior_point_solver.cpp).
+enum class Precision {
+  Auto,          ///< double to kAutoDoubleMaxSteps, extended to kAutoExtendedMaxSteps, then
+                 ///< double-double (extended only where long double is the x87 format)
+  Double,        ///< IEEE double throughout
+  Extended,      ///< long double where it is the x87 format (64-bit significand), else double-double
+  DoubleDouble,  ///< double-double arithmetic (~106-bit significand, software)
+};
+
+/// The names of the precisions (--precision, scene key `precision`).
+inline constexpr NamedValue<Precision> kPrecisionNames[] = {
+    {Precision::Auto, "auto"},
+    {Precision::Double, "double"},
+    {Precision::Extended, "extended"},
+    {Precision::DoubleDouble, "double_double"},
+};
+
+/// "auto", "double", "extended" or "double_double".
+inline std::string precisionName(Precision precision) {
+  return nameIn(kPrecisionNames, precision);
+}
+/// The precision named `text`; throws InvalidInput naming `field`, the value and the accepted
+/// names.
+inline Precision parsePrecision(const std::string& text, const std::string& field) {
+  return parseIn(kPrecisionNames, text, field);
+}
+
+/// Precision::Auto: double up to this N ...
+constexpr int kAutoDoubleMaxSteps = 1024;
+/// ... extended (x87 long double) up to this N, double-double above.
+constexpr int kAutoExtendedMaxSteps = 8192;
+
 /// What the plan minimizes (scene key `objective`, --objective, request field `objective`).
 enum class Objective {
   MinimumEffort,  ///< ½∫|τ|²dt at the given duration (the seed's problem; default)
@@ -167,6 +201,8 @@ struct SolverOptions {
   const std::atomic<bool>* cancel_requested = nullptr;
   /// Optional warm start: a maneuver with the same N (attitudes R_k are used).
   const Maneuver* warm_start = nullptr;
+  /// The arithmetic of the interior point's Newton system; `auto` chooses by N.
+  Precision precision = Precision::Auto;
   /// With node constraints and a warm start: start the interior point from the warm start itself
   /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
   /// is far closer to the next one than the unconstrained optimum is).

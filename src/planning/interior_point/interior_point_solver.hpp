@@ -4,13 +4,22 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/problem/solve_context.hpp"
 
 namespace attitude_planner {
 
 /// Primal–dual interior point on the reduced problem with the node constraints (per-axis torque
 /// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
-/// from options.warm_start if given. Sets PlanResult::infeasible when the constraints cannot be
-/// met. Fills everything but solve_time_s and the constraint figures.
+/// from options.warm_start if given. Ends Infeasible when the constraints cannot be met. Polls
+/// `context` (cancel flag, deadline) inside its long loops, reports its iterations and records
+/// its attempts there (the kept one marked). Fills everything but solve_time_s and the
+/// constraint figures.
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
+                                  SolveContext& context,
+                                  const InteriorPointParameters& parameters = {});
+
+/// The same with a context of its own (clock started now); its attempts in PlanResult::attempts.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
 }  // namespace attitude_planner

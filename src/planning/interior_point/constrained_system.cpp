@@ -1,0 +1,697 @@
+// The interior point's node constraints and its condensed Newton system (constrained_system.hpp).
+#include "planning/interior_point/constrained_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "planning/linalg/double_double.hpp"
+#include "planning/transcription/node_constraints.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+bool isTorqueFamily(ConstraintFamily f) {
+  return f == ConstraintFamily::TorqueUpper || f == ConstraintFamily::TorqueLower ||
+         f == ConstraintFamily::TorqueNorm;
+}
+
+/// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the unknowns:
+/// its offset and its free entries first..last−1 (fixed nodes skipped).
+struct LocalSlots {
+  int offset = 0, first = 0, last = 0;
+  bool empty() const { return first >= last; }
+};
+
+LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
+  const int first_free = std::max(0, np.firstFreeNode() - first_node);
+  const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
+  return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
+}
+
+/// Adds M (local 9×9, lower triangle used) to the banded Hessian.
+template <typename Scalar>
+void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node, int width,
+              const Eigen::Matrix<double, 9, 9>& M) {
+  const LocalSlots l = localSlots(np, first_node, width);
+  if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
+}
+
+/// Adds weight·g gᵀ (local) to the banded Hessian, each product formed in its own precision (see
+/// interior_point_solver.cpp: the precision rule). Rounding the weight only scales the term.
+template <typename Scalar>
+void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node,
+                     int width, const Eigen::Matrix<double, 9, 1>& g, double weight) {
+  const LocalSlots l = localSlots(np, first_node, width);
+  if (!l.empty()) H->template addRankOne<9>(l.offset, g, weight, l.first, l.last);
+}
+
+/// gᵀ dδ over the local nodes (fixed nodes contribute nothing).
+double localDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, int first_node,
+                int width, const Eigen::VectorXd& d) {
+  double sum = 0.0;
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
+  }
+  return sum;
+}
+
+void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, double weight,
+                    int first_node, int width, Eigen::VectorXd* out) {
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) out->segment<3>(v) += weight * g.segment<3>(3 * n);
+  }
+}
+
+}  // namespace
+
+ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np,
+                                     Formulation formulation,
+                                     const InteriorPointParameters& parameters)
+    : problem_(problem),
+      np_(*np),
+      parameters_(parameters),
+      free_slacks_(formulation == Formulation::FreeSlacks),
+      node_rates_(np->scheme().hasEndTorques()),
+      inverse_inertia_(problem.inertia.inverse()),
+      inverse_inertia_squared_(inverse_inertia_ * inverse_inertia_) {
+  // The torques are k = first..last (1..N−1; 0..N with end torques), the free attitudes
+  // first + 1..last − 1. Rates: per step (the step's own velocity) for paper and variational,
+  // whose first and last steps are boundary data; per node (J⁻¹Π_k, k = 1..N−1) for schemes
+  // with end torques, whose node velocities are the plan's.
+  const int first = np_.firstFreeNode() - 1, last = np_.lastFreeNode() + 1;
+  if (problem.hasTorqueBounds()) {
+    for (int a = 0; a < 3; ++a) {
+      for (ConstraintFamily f : {ConstraintFamily::TorqueUpper, ConstraintFamily::TorqueLower}) {
+        addGroup(f, first, last, -1, 3, problem.max_torque(a), nullptr, a);
+      }
+    }
+  }
+  for (const PlanningConstraint& c : problem.constraints) {
+    switch (c.kind) {
+      case ConstraintKind::MaxTorqueNorm:
+        addGroup(ConstraintFamily::TorqueNorm, first, last, -1, 3, c.limit, &c, 0);
+        break;
+      case ConstraintKind::MaxAngularRate:
+        if (node_rates_) {
+          addGroup(ConstraintFamily::AngularRate, first + 1, last - 1, -1, 3, c.limit, &c, 0);
+        } else {
+          addGroup(ConstraintFamily::AngularRate, first, last - 1, 0, 2, c.limit, &c, 0);
+        }
+        break;
+      case ConstraintKind::KeepOut:  // the fixed attitudes are checked up front
+        addGroup(ConstraintFamily::KeepOut, first + 1, last - 1, 0, 1, c.limit, &c, 0);
+        break;
+      case ConstraintKind::KeepIn:
+        addGroup(ConstraintFamily::KeepIn, first + 1, last - 1, 0, 1, c.limit, &c, 0);
+        break;
+    }
+  }
+  for (const ConstraintGroup& g : groups_) constraint_count_ += static_cast<int>(g.at.size());
+}
+
+void ConstrainedSystem::addGroup(ConstraintFamily family, int first_k, int last_k, int node_offset,
+                                 int width, double limit, const PlanningConstraint* spec,
+                                 int axis) {
+  ConstraintGroup& g = groups_.emplace_back();  // in place: `at` is ~100 bytes per node
+  g.family = family;
+  g.axis = axis;
+  g.limit = limit;
+  g.spec = spec;
+  g.first_k = first_k;
+  g.last_k = last_k;
+  g.node_offset = node_offset;
+  g.width = width;
+  g.at.resize(last_k - first_k + 1);
+}
+
+void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
+                                       std::vector<Vector3>* torques_out) {
+  const std::vector<Vector3> tau = np_.torques(steps);
+  std::vector<Matrix3> R;
+  for (ConstraintGroup& g : groups_) {
+    if ((g.family == ConstraintFamily::KeepOut || g.family == ConstraintFamily::KeepIn) &&
+        R.empty()) {
+      R = np_.attitudes(steps);
+    }
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      ConstraintInstance& in = g.instance(k);
+      switch (g.family) {
+        case ConstraintFamily::TorqueUpper:
+          in.c = 1.0 - tau[k](g.axis) / g.limit;
+          break;
+        case ConstraintFamily::TorqueLower:
+          in.c = 1.0 + tau[k](g.axis) / g.limit;
+          break;
+        case ConstraintFamily::TorqueNorm:
+          in.c = 1.0 - tau[k].squaredNorm() / (g.limit * g.limit);
+          break;
+        case ConstraintFamily::AngularRate: {
+          const Vector3 Omega =
+              node_rates_ ? nodeVelocity(steps, k) : np_.scheme().velocity(so3::exp(steps[k]));
+          in.c = 1.0 - Omega.squaredNorm() / (g.limit * g.limit);
+          break;
+        }
+        case ConstraintFamily::KeepOut:
+          in.c = std::cos(g.spec->nodeHalfAngle()) -
+                 g.spec->world_direction.dot(R[k] * g.spec->body_axis);
+          break;
+        case ConstraintFamily::KeepIn:
+          in.c = g.spec->world_direction.dot(R[k] * g.spec->body_axis) -
+                 std::cos(g.spec->nodeHalfAngle());
+          break;
+      }
+    }
+  }
+  if (torques_out) *torques_out = tau;
+}
+
+double ConstrainedSystem::merit(const ReducedProblem::Steps& steps, double mu, double rho,
+                                double* cost, double slack_alpha) {
+  std::vector<Vector3> tau;
+  evaluateValues(steps, &tau);
+  const double f = np_.scheme().cost(tau);
+  if (cost) *cost = f;
+  return f + constraintMerit(mu, rho, slack_alpha);
+}
+
+double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
+  double phi = 0.0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) {
+      if (free_slacks_) {
+        const double s = in.s + alpha * in.ds;
+        phi += -mu * std::log(s) + rho * std::abs(in.c - s);
+      } else {
+        phi += elasticSlacks(in.c, mu, rho).psi;
+      }
+    }
+  }
+  return phi;
+}
+
+void ConstrainedSystem::prepare(ConstraintInstance& in, double mu, double rho, bool primal) const {
+  const double kappa = parameters_.dual_safeguard;
+  if (free_slacks_) {
+    // s is a variable: the multiplier stays near μ/s, and the condensation is that of c − s = 0
+    // (q = μ/z − c makes ds = gᵀdδ + c − s and dz = (q − gᵀdδ)/D).
+    const double z_primal = mu / in.s;
+    in.z = primal ? z_primal : std::min(std::max(in.z, mu / (kappa * in.s)), kappa * z_primal);
+    in.D = in.s / in.z;
+    in.q = mu / in.z - in.c;
+    return;
+  }
+  const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
+  in.s = sl.s;
+  in.v = sl.v;
+  const double z_primal = mu / in.s;
+  if (primal) {
+    in.z = z_primal;
+  } else {
+    in.z = std::min(std::max(in.z, mu / (kappa * in.s)), kappa * z_primal);
+    // u = ρ − z stays positive (u → 0 would make D and q infinite).
+    const double u_min = std::max(mu / (kappa * in.v), parameters_.elastic_dual_floor * rho);
+    in.z = std::min(in.z, rho - u_min);
+  }
+  const double u = rho - in.z;
+  in.D = in.s / in.z + in.v / u;
+  in.q = mu / in.z - in.s - mu / u + in.v;
+}
+
+void ConstrainedSystem::pollEvery(int k) const {
+  if (interruption_ && k % kColumnsBetweenPolls == 0) interruption_->poll();
+}
+
+template <typename Scalar>
+Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
+                                     Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient) {
+  const int n = np_.unknowns();
+  if (H) H->setZero();
+  rhs->setZero(n);
+  merit_gradient->setZero(n);
+  Assembly out;
+  assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
+  if (node_rates_) assembleNodeRates(mu, rho, primal, H);
+  assembleNodeConstraints(mu, rho, primal, H);
+  addConstraintGradients(mu, rhs, merit_gradient);
+  return out;
+}
+
+/// The cost's stencils and the torque constraints on them: values and multipliers are needed for
+/// the stencil's second-order weights (∇²f − Σ z ∇²c, all through ∂²τ_k), so they are formed in
+/// the weights callback. The stencils hold the residuals r_k = √w_k τ_k (w_k the cost weight, 1
+/// but at the end nodes of schemes with end torques): constraints are on τ_k = r_k/√w_k.
+template <typename Scalar>
+void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
+                                        BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
+                                        Eigen::VectorXd* merit_gradient, Assembly* out) {
+  std::vector<ConstraintGroup*> torque_groups;
+  for (ConstraintGroup& g : groups_)
+    if (isTorqueFamily(g.family)) torque_groups.push_back(&g);
+  double beta_k = 1.0;  // β_k = 1 + Σ_norm 2z/t², of the stencil the weights were formed for
+  double jacobian_scale = 0.0, torque_scale = 0.0;
+  const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
+  const auto weights = [&](int k, const Vector3& residual) {
+    const double r = root(k);
+    const Vector3 tau = residual / r;
+    Vector3 w = residual;
+    double beta = 1.0;
+    for (ConstraintGroup* g : torque_groups) {
+      ConstraintInstance& in = g->instance(k);
+      if (g->family == ConstraintFamily::TorqueNorm) {
+        in.c = 1.0 - tau.squaredNorm() / (g->limit * g->limit);
+        if (H) prepare(in, mu, rho, primal);
+        // −z∇²c = (2z/t²) ∇²(½|τ|²) = factor ∇²(½|r|²)
+        const double factor = 2.0 * in.z / (g->limit * g->limit * r * r);
+        beta += factor;
+        w += factor * residual;
+      } else {
+        const double sign = g->family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
+        in.c = 1.0 - sign * tau(g->axis) / g->limit;
+        if (H) prepare(in, mu, rho, primal);
+        w(g->axis) += sign * in.z / (g->limit * r);  // −z∇²c = ±(z/a) ∇²τ_a = ±z/(a√w) ∇²r_a
+      }
+    }
+    beta_k = beta;
+    return w;
+  };
+  const auto visit = [&](const ReducedProblem::Stencil& st) {
+    pollEvery(st.k);
+    jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
+    torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
+    const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
+    const double r = root(st.k);
+    for (ConstraintGroup* g : torque_groups) {
+      ConstraintInstance& in = g->instance(st.k);
+      if (g->family == ConstraintFamily::TorqueNorm) {
+        in.g = -2.0 / (g->limit * g->limit * r * r) * grad_f;
+      } else {
+        const double sign = g->family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
+        in.g = -sign / (g->limit * r) * st.jacobian.row(g->axis).transpose();
+      }
+    }
+    if (H) {
+      // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and the box constraints' g gᵀ/D
+      // (g = ∓J_a/(a r)) per torque axis; the norm constraints' g gᵀ/D apart.
+      Vector3 weight = Vector3::Constant(beta_k);
+      for (ConstraintGroup* g : torque_groups) {
+        const ConstraintInstance& in = g->instance(st.k);
+        if (g->family == ConstraintFamily::TorqueNorm) {
+          addLocalRankOne(np_, H, st.k - 1, 3, in.g, 1.0 / in.D);
+        } else {
+          weight(g->axis) += 1.0 / (in.D * (g->limit * r) * (g->limit * r));
+        }
+      }
+      for (int a = 0; a < 3; ++a) {
+        addLocalRankOne(np_, H, st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
+      }
+      addLocal(np_, H, st.k - 1, 3, st.second);
+    }
+    addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
+    addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
+  };
+  out->cost =
+      np_.forEachStencil(H != nullptr, visit,
+                         torque_groups.empty() ? ReducedProblem::SecondOrderWeights()
+                                               : ReducedProblem::SecondOrderWeights(weights));
+  out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
+}
+
+/// Node rates (schemes with end torques): c = 1 − |J⁻¹Π_k|²/w², through the node momentum's
+/// stencil: ∇c = −(2/w²) J_Πᵀ J⁻²Π, −z∇²c = (2z/w²)(J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i).
+template <typename Scalar>
+void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
+                                          BandedSymmetric<Scalar>* H) {
+  std::vector<ConstraintGroup*> rate_groups;
+  for (ConstraintGroup& g : groups_)
+    if (g.family == ConstraintFamily::AngularRate) rate_groups.push_back(&g);
+  if (rate_groups.empty()) return;
+  double gamma = 0.0;
+  const auto rate_weights = [&](int k, const Vector3& Pi) {
+    const Vector3 a = inverse_inertia_squared_ * Pi;  // J⁻²Π
+    const double rate_squared = Pi.dot(a);            // |J⁻¹Π|²
+    gamma = 0.0;
+    for (ConstraintGroup* g : rate_groups) {
+      ConstraintInstance& in = g->instance(k);
+      in.c = 1.0 - rate_squared / (g->limit * g->limit);
+      if (H) prepare(in, mu, rho, primal);
+      gamma += 2.0 * in.z / (g->limit * g->limit);
+    }
+    return Vector3(gamma * a);
+  };
+  const auto visit = [&](const ReducedProblem::NodeMomentum& node) {
+    pollEvery(node.k);
+    const Vector3 a = inverse_inertia_squared_ * node.momentum;
+    const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;
+    for (ConstraintGroup* g : rate_groups) {
+      g->instance(node.k).g = -2.0 / (g->limit * g->limit) * grad;
+    }
+    if (!H) return;
+    const Eigen::Matrix<double, 9, 9> block =
+        gamma * node.jacobian.transpose() * inverse_inertia_squared_ * node.jacobian + node.second;
+    addLocal(np_, H, node.k - 1, 3, block);
+    for (ConstraintGroup* g : rate_groups) {
+      addLocalRankOne(np_, H, node.k - 1, 3, g->instance(node.k).g, 1.0 / g->instance(node.k).D);
+    }
+  };
+  np_.forEachNodeMomentum(visit, rate_weights);
+}
+
+/// Step rates and cone constraints: their own derivatives (node_constraints.hpp).
+template <typename Scalar>
+void ConstrainedSystem::assembleNodeConstraints(double mu, double rho, bool primal,
+                                                BandedSymmetric<Scalar>* H) {
+  const ReducedProblem::Steps& steps = np_.current();
+  std::vector<Matrix3> R;
+  for (ConstraintGroup& g : groups_) {
+    if (isTorqueFamily(g.family)) continue;
+    if (node_rates_ && g.family == ConstraintFamily::AngularRate) continue;
+    if (g.family != ConstraintFamily::AngularRate && R.empty()) R = np_.attitudes(steps);
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      pollEvery(k);
+      ConstraintInstance& in = g.instance(k);
+      Eigen::Matrix<double, 9, 9> block = Eigen::Matrix<double, 9, 9>::Zero();
+      in.g.setZero();
+      if (g.family == ConstraintFamily::AngularRate) {
+        const AngularRateTerms t = angularRateTerms(np_.scheme(), steps[k]);
+        const double scale = 2.0 / (g.limit * g.limit);  // c = 1 − scale φ
+        in.c = 1.0 - scale * t.half_squared_rate;
+        if (H) prepare(in, mu, rho, primal);
+        in.g.head<6>() = -scale * t.gradient;
+        block.topLeftCorner<6, 6>() = (in.z * scale) * t.hessian;  // −z∇²c
+      } else {
+        const PointingTerms t = pointingTerms(R[k], g.spec->body_axis, g.spec->world_direction);
+        const double sign = g.family == ConstraintFamily::KeepOut ? -1.0 : 1.0;  // c = ±p ∓ cos α
+        in.c = sign * (t.cosine - std::cos(g.spec->nodeHalfAngle()));
+        if (H) prepare(in, mu, rho, primal);
+        in.g.head<3>() = sign * t.gradient;
+        block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
+      }
+      if (H) {
+        addLocal(np_, H, k + g.node_offset, g.width, block);
+        addLocalRankOne(np_, H, k + g.node_offset, g.width, in.g, 1.0 / in.D);
+      }
+    }
+  }
+}
+
+/// ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is the slack step's
+/// slope); rhs = −∇f + Σ g (z + q/D).
+void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
+                                               Eigen::VectorXd* merit_gradient) const {
+  for (const ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const ConstraintInstance& in = g.instance(k);
+      const int first = k + g.node_offset;
+      if (!free_slacks_) addLocalVector(np_, in.g, -mu / in.s, first, g.width, merit_gradient);
+      addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.width, rhs);
+    }
+  }
+}
+
+/// J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2: the node velocity of a scheme with end
+/// torques.
+Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::Steps& steps, int k) const {
+  const DiscreteScheme& scheme = np_.scheme();
+  const Vector3 Pi =
+      0.5 * (scheme.momentumOfStep(steps[k]) +
+             so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
+  return inverse_inertia_ * Pi;
+}
+
+/// FreeSlacks, Mehrotra's predictor: from the affine-scaling step dδ_aff (solved with μ = 0,
+/// i.e. q = −c), the complementarity the step to the boundary would leave,
+/// μ_aff = mean((s + α_p ds)(z + α_d dz)), and the mean complementarity now (*average). Keeps
+/// each instance's ds_aff·dz_aff (in `products`) for the corrector.
+double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double* average,
+                                                std::vector<double>* products) const {
+  products->clear();
+  double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
+  std::vector<double> ds, dz;
+  for (const ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const ConstraintInstance& in = g.at[k - g.first_k];
+      const double lin = localDot(np_, in.g, k + g.node_offset, g.width, d);
+      ds.push_back(lin + in.c - in.s);
+      dz.push_back((-in.c - lin) / in.D);
+      if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
+      if (dz.back() < 0) alpha_d = std::min(alpha_d, -in.z / dz.back());
+      sum += in.s * in.z;
+    }
+  }
+  double affine = 0.0;
+  std::size_t i = 0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) {
+      affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
+      products->push_back(ds[i] * dz[i]);
+      ++i;
+    }
+  }
+  const double m = std::max<double>(1.0, static_cast<double>(i));
+  *average = sum / m;
+  return affine / m;
+}
+
+/// Adds Σ_i g_i/s_i (the barrier's part of the right-hand side is μ times it) or, with
+/// `products`, the corrector's Σ_i −g_i·products_i/s_i, to `out`.
+void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* products,
+                                                  Eigen::VectorXd* out) const {
+  std::size_t i = 0;
+  for (const ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k, ++i) {
+      const ConstraintInstance& in = g.at[k - g.first_k];
+      const double weight = products ? -(*products)[i] / in.s : 1.0 / in.s;
+      addLocalVector(np_, in.g, weight, k + g.node_offset, g.width, out);
+    }
+  }
+}
+
+/// The condensation's q for the complementarity target s z = μ − ds_aff dz_aff (FreeSlacks;
+/// `products` may be null: the plain barrier μ).
+void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<double>* products) {
+  std::size_t i = 0;
+  for (ConstraintGroup& g : groups_) {
+    for (ConstraintInstance& in : g.at) {
+      in.q = (mu - (products ? (*products)[i] : 0.0)) / in.z - in.c;
+      ++i;
+    }
+  }
+}
+
+/// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
+/// and the steps dz themselves (stored in `dz`, instance order).
+double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
+  dz->clear();
+  double alpha = 1.0;
+  for (ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const ConstraintInstance& in = g.instance(k);
+      const double step = (in.q - localDot(np_, in.g, k + g.node_offset, g.width, d)) / in.D;
+      dz->push_back(step);
+      if (step < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / step);
+      if (free_slacks_) continue;  // z has no upper bound
+      const double u = rho - in.z;
+      if (step > 0) alpha = std::min(alpha, parameters_.fraction_to_boundary * u / step);
+    }
+  }
+  return alpha;
+}
+
+void ConstrainedSystem::applyDualStep(const std::vector<double>& dz, double alpha) {
+  std::size_t i = 0;
+  for (ConstraintGroup& g : groups_) {
+    for (ConstraintInstance& in : g.at) in.z += alpha * dz[i++];
+  }
+}
+
+ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
+  SlackStep step;
+  for (ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      ConstraintInstance& in = g.instance(k);
+      in.ds = localDot(np_, in.g, k + g.node_offset, g.width, d) + in.c - in.s;
+      if (in.ds < 0) {
+        step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
+      }
+      step.barrier_slope -= mu * in.ds / in.s;
+      step.residual += std::abs(in.c - in.s);
+      if (std::abs(in.c - in.s) > parameters_.round_off_slack_residual) {
+        step.significant_residual += std::abs(in.c - in.s);
+      }
+    }
+  }
+  return step;
+}
+
+void ConstrainedSystem::applySlackStep(double alpha) {
+  for (ConstraintGroup& g : groups_) {
+    for (ConstraintInstance& in : g.at) in.s += alpha * in.ds;
+  }
+}
+
+/// FreeSlacks: the largest multiplier after the dual step dz (for the merit's ν).
+double ConstrainedSystem::largestMultiplier(const std::vector<double>& dz, double alpha) const {
+  double largest = 0.0;
+  std::size_t i = 0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) largest = std::max(largest, in.z + alpha * dz[i++]);
+  }
+  return largest;
+}
+
+/// FreeSlacks: max |c − s| at the last evaluated c.
+double ConstrainedSystem::maxSlackResidual() const {
+  double worst = 0.0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) worst = std::max(worst, std::abs(in.c - in.s));
+  }
+  return worst;
+}
+
+/// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z) at the last
+/// evaluated c.
+void ConstrainedSystem::complementarity(double mu, double rho, double* average,
+                                        double* smallest) const {
+  double sum = 0.0, low = std::numeric_limits<double>::infinity();
+  int count = 0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) {
+      if (free_slacks_) {
+        sum += in.s * in.z;
+        low = std::min(low, in.s * in.z);
+        ++count;
+        continue;
+      }
+      const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
+      const double a = sl.s * in.z, b = sl.v * (rho - in.z);
+      sum += a + b;
+      low = std::min(low, std::min(a, b));
+      count += 2;
+    }
+  }
+  *average = sum / std::max(count, 1);
+  *smallest = low;
+}
+
+/// Largest elastic violation max v_i (constraint units) at the last assembly or merit.
+double ConstrainedSystem::maxViolation() const {
+  double worst = 0.0;
+  for (const ConstraintGroup& g : groups_) {
+    for (const ConstraintInstance& in : g.at) worst = std::max(worst, -in.c);
+  }
+  return worst;
+}
+
+/// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function) at the current
+/// multipliers; empty without per-axis bounds.
+std::vector<Vector3> ConstrainedSystem::switchingFunction(
+    const std::vector<Vector3>& torque) const {
+  std::vector<Vector3> sigma;
+  for (const ConstraintGroup& g : groups_) {
+    if (g.family != ConstraintFamily::TorqueUpper && g.family != ConstraintFamily::TorqueLower)
+      continue;
+    if (sigma.empty()) sigma = torque;
+    const double sign = g.family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const double weight = np_.scheme().torqueWeight(k, np_.steps());
+      sigma[k](g.axis) += sign * g.at[k - g.first_k].z / (g.limit * weight);
+    }
+  }
+  return sigma;
+}
+
+/// The first-order (KKT stationarity) residual at the current iterate with this solve's
+/// multipliers: max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ|, as the Newton solver's
+/// max_residual. Re-forms the gradients at the iterate (the last assembly's are the previous
+/// iterate's), first order only, leaving the multipliers as they are.
+double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
+                                               Eigen::VectorXd* merit_gradient) {
+  double unused = 0.0;
+  const double scale =
+      assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient).gradient_scale;
+  Eigen::VectorXd residual;
+  np_.evaluate(&residual, nullptr, &unused);  // ∇f
+  for (const ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const ConstraintInstance& in = g.at[k - g.first_k];
+      addLocalVector(np_, in.g, -in.z, k + g.node_offset, g.width, &residual);
+    }
+  }
+  return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
+}
+
+/// The multipliers and slacks of this iterate (FreeSlacks), to start a finer level from.
+LevelDuals ConstrainedSystem::duals() const {
+  LevelDuals d;
+  d.steps = np_.steps();
+  for (const ConstraintGroup& g : groups_) {
+    d.first_k.push_back(g.first_k);
+    d.z.emplace_back();
+    d.s.emplace_back();
+    for (const ConstraintInstance& in : g.at) {
+      d.z.back().push_back(in.z);
+      d.s.back().push_back(in.s);
+    }
+  }
+  return d;
+}
+
+/// FreeSlacks from a coarser level's duals: each instance takes the multiplier of the coarse
+/// instance nearest in time (a node constraint's multiplier does not scale with h: the cost
+/// Σ ½|τ_k|² weighs every node alike), and its slack c pushed inside by at most
+/// parameters_.warm_slack_push where the coarse constraint was binding (its coarse slack below the
+/// push), else as initializeMultipliers pushes it. Returns mean(s z).
+double ConstrainedSystem::warmStartDuals(const LevelDuals& coarse) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t gi = 0; gi < groups_.size() && gi < coarse.z.size(); ++gi) {
+    ConstraintGroup& g = groups_[gi];
+    const std::vector<double>& zc = coarse.z[gi];
+    if (zc.empty()) continue;
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      const int kc = static_cast<int>(std::lround(double(k) * coarse.steps / np_.steps()));
+      const int i = std::min<int>(zc.size() - 1, std::max(0, kc - coarse.first_k[gi]));
+      ConstraintInstance& in = g.instance(k);
+      const bool binding = coarse.s[gi][i] < parameters_.warm_slack_push;
+      in.z = zc[i];
+      in.s = std::max(in.c, binding ? parameters_.warm_slack_push : parameters_.slack_push);
+      in.ds = 0.0;
+      sum += in.s * in.z;
+      ++count;
+    }
+  }
+  return sum / std::max(count, 1);
+}
+
+/// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
+/// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
+void ConstrainedSystem::initializeMultipliers(double mu, double rho, double cap) {
+  for (ConstraintGroup& g : groups_) {
+    for (ConstraintInstance& in : g.at) {
+      if (free_slacks_) {
+        in.s = std::max(in.c, parameters_.slack_push);
+        in.ds = 0.0;
+        in.z = std::min(mu / in.s, cap);
+        continue;
+      }
+      const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
+      in.z = std::min(mu / sl.s, std::min(cap, 0.5 * rho));
+    }
+  }
+}
+
+template Assembly ConstrainedSystem::assemble<double>(double, double, bool,
+                                                      BandedSymmetric<double>*, Eigen::VectorXd*,
+                                                      Eigen::VectorXd*);
+template Assembly ConstrainedSystem::assemble<long double>(double, double, bool,
+                                                           BandedSymmetric<long double>*,
+                                                           Eigen::VectorXd*, Eigen::VectorXd*);
+template Assembly ConstrainedSystem::assemble<DoubleDouble>(double, double, bool,
+                                                            BandedSymmetric<DoubleDouble>*,
+                                                            Eigen::VectorXd*, Eigen::VectorXd*);
+
+}  // namespace attitude_planner

@@ -1,0 +1,166 @@
+// The interior point's node constraints on the reduced problem's band: their primal–dual state
+// (values c_i, gradients g_i, multipliers z_i, slacks s_i, v_i) and the condensed Newton system
+//   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i)
+// assembled at the current iterate in O(N) (interior_point_solver.cpp's header comment derives
+// it). Each constraint is stage-local: g_i lives on at most three consecutive nodes, so g_i g_iᵀ
+// keeps the unconstrained Hessian's band (half bandwidth 8).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/linalg/banded_matrix.hpp"
+#include "planning/linalg/interruption.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// The kinds of node constraint, each written dimensionless as c(δ) ≥ 0.
+enum class ConstraintFamily { TorqueUpper, TorqueLower, TorqueNorm, AngularRate, KeepOut, KeepIn };
+
+/// One node constraint c(δ) ≥ 0 and its primal–dual state.
+struct ConstraintInstance {
+  double c = 0.0;                 ///< value (dimensionless)
+  Eigen::Matrix<double, 9, 1> g;  ///< ∂c/∂δ over the group's local nodes
+  double z = 0.0;                 ///< multiplier of c + v − s = 0 (0 < z < ρ)
+  double s = 0.0, v = 0.0;        ///< slacks (Elastic: elasticSlacks of c; FreeSlacks: s free)
+  double D = 1.0, q = 0.0;        ///< condensation terms
+  double ds = 0.0;                ///< FreeSlacks: the slack's Newton step
+};
+
+/// All node constraints of one kind (one axis and sign of the torque box, or one spec).
+struct ConstraintGroup {
+  ConstraintFamily family;
+  int axis = 0;        ///< torque box axis
+  double limit = 0.0;  ///< a_axis, t or w
+  const PlanningConstraint* spec = nullptr;
+  int first_k = 0, last_k = 0;         ///< instances k = first_k..last_k
+  int node_offset = 0;                 ///< first local node = k + node_offset
+  int width = 1;                       ///< local nodes (3: torque stencil, 2: step, 1: node)
+  std::vector<ConstraintInstance> at;  ///< at[k − first_k]
+  ConstraintInstance& instance(int k) { return at[k - first_k]; }
+  const ConstraintInstance& instance(int k) const { return at[k - first_k]; }
+};
+
+/// A grid level's multipliers z and slacks s (free-slack form), per group and instance, to start
+/// the next finer level from (carried by the instances' times).
+struct LevelDuals {
+  int steps = 0;
+  std::vector<int> first_k;
+  std::vector<std::vector<double>> z, s;
+  bool empty() const { return steps == 0; }
+};
+
+/// What an assembly returns besides the system.
+struct Assembly {
+  double cost = 0.0;            ///< f at the iterate
+  double gradient_scale = 0.0;  ///< max|∂τ/∂δ| · max|τ|
+};
+
+/// The node constraints of one problem in one formulation, and the condensed Newton system.
+class ConstrainedSystem {
+ public:
+  ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
+                    const InteriorPointParameters& parameters);
+
+  int constraintCount() const { return constraint_count_; }
+  bool freeSlacks() const { return free_slacks_; }
+  /// Polled every kColumnsBetweenPolls nodes during an assembly (null: never).
+  void setInterruption(const Interruption* interruption) { interruption_ = interruption; }
+
+  /// Constraint values at `steps` into each instance's c (gradients not formed).
+  void evaluateValues(const ReducedProblem::Steps& steps, std::vector<Vector3>* torques_out);
+  /// φ_μ = f + Σ ψ_μ(c_i) at `steps` (and f in *cost); FreeSlacks at s + slack_alpha ds.
+  double merit(const ReducedProblem::Steps& steps, double mu, double rho, double* cost,
+               double slack_alpha = 0.0);
+  /// The constraints' part of the merit at the current values c: Elastic Σ ψ_μ(c_i) (ρ the
+  /// penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν) at s = s + α ds.
+  double constraintMerit(double mu, double rho, double alpha) const;
+  /// φ_μ from the constraint values of the last assembly (f = its cost).
+  double assembledMerit(double cost, double mu, double rho) const {
+    return cost + constraintMerit(mu, rho, 0.0);
+  }
+
+  /// Assembles the condensed Newton system at the current iterate: H, rhs, ∇φ_μ. `primal`: the
+  /// multipliers are replaced by their primal values μ/s (then the step is Newton's on φ_μ).
+  /// H = null: the constraint values and gradients only (multipliers and slacks untouched).
+  template <typename Scalar>
+  Assembly assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
+                    Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient);
+
+  /// Mehrotra's predictor: from the affine-scaling step d (μ = 0), μ_aff = mean((s + α_p ds)(z +
+  /// α_d dz)), and the mean complementarity now (*average); ds_aff·dz_aff in `products`.
+  double affineComplementarity(const Eigen::VectorXd& d, double* average,
+                               std::vector<double>* products) const;
+  /// Adds Σ_i g_i/s_i or, with `products`, Σ_i −g_i·products_i/s_i, to `out`.
+  void addSlackWeightedGradients(const std::vector<double>* products, Eigen::VectorXd* out) const;
+  /// q for the complementarity target s z = μ − ds_aff dz_aff (`products` null: μ).
+  void setComplementarityTarget(double mu, const std::vector<double>* products);
+  /// The largest dual step in (0, 1] by the fraction to the boundary, and the steps dz.
+  double dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz);
+  void applyDualStep(const std::vector<double>& dz, double alpha);
+
+  /// What slackStep measures about the slack step.
+  struct SlackStep {
+    double alpha = 1.0;                 ///< largest step by the fraction to the boundary
+    double barrier_slope = 0.0;         ///< −μ Σ ds/s
+    double residual = 0.0;              ///< ‖c − s‖₁
+    double significant_residual = 0.0;  ///< the same without round-off residuals
+  };
+  /// FreeSlacks: the slack steps ds = gᵀdδ + c − s (stored in the instances).
+  SlackStep slackStep(const Eigen::VectorXd& d, double mu);
+  void applySlackStep(double alpha);
+  /// FreeSlacks: the largest multiplier after the dual step dz.
+  double largestMultiplier(const std::vector<double>& dz, double alpha) const;
+  /// FreeSlacks: max |c − s| at the last evaluated c.
+  double maxSlackResidual() const;
+  /// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z).
+  void complementarity(double mu, double rho, double* average, double* smallest) const;
+  /// Largest elastic violation max(−c_i) at the last assembly or merit.
+  double maxViolation() const;
+  /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function).
+  std::vector<Vector3> switchingFunction(const std::vector<Vector3>& torque) const;
+  /// max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ| at the current iterate.
+  double relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
+                              Eigen::VectorXd* merit_gradient);
+  /// The multipliers and slacks of this iterate (FreeSlacks), to start a finer level from.
+  LevelDuals duals() const;
+  /// FreeSlacks from a coarser level's duals (nearest in time); returns mean(s z).
+  double warmStartDuals(const LevelDuals& coarse);
+  /// Initial multipliers: the primal ones μ/s, capped at `cap`.
+  void initializeMultipliers(double mu, double rho, double cap);
+
+ private:
+  void addGroup(ConstraintFamily family, int first_k, int last_k, int node_offset, int width,
+                double limit, const PlanningConstraint* spec, int axis);
+  /// Slacks and (safeguarded or primal) multipliers for the instance's value c.
+  void prepare(ConstraintInstance& in, double mu, double rho, bool primal) const;
+  template <typename Scalar>
+  void assembleTorques(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
+                       Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, Assembly* out);
+  template <typename Scalar>
+  void assembleNodeRates(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
+  template <typename Scalar>
+  void assembleNodeConstraints(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
+  void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
+                              Eigen::VectorXd* merit_gradient) const;
+  void pollEvery(int k) const;
+  Vector3 nodeVelocity(const ReducedProblem::Steps& steps, int k) const;
+
+  const PlanningProblem& problem_;
+  ReducedProblem& np_;
+  const InteriorPointParameters& parameters_;
+  bool free_slacks_;
+  bool node_rates_;
+  Matrix3 inverse_inertia_;          ///< J⁻¹
+  Matrix3 inverse_inertia_squared_;  ///< J⁻²
+  std::vector<ConstraintGroup> groups_;
+  int constraint_count_ = 0;
+  const Interruption* interruption_ = nullptr;
+};
+
+}  // namespace attitude_planner

@@ -1,0 +1,583 @@
+// The interior point on one grid as a short loop over named pieces: the step (assembly, inertia
+// correction, the barrier rule's predictor), the stopping test, the line search with the
+// fraction to the boundary, the step's acceptance, the end of a barrier problem at μ_final
+// (converged, penalty raise or infeasible) and the barrier rule's update.
+#include "planning/interior_point/grid_solve.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "planning/linalg/banded_matrix.hpp"
+#include "planning/linalg/double_double.hpp"
+#include "planning/problem/verdict.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+std::string describeManeuverSpan(const PlanningProblem& problem) {
+  std::ostringstream s;
+  s << "cannot turn this body by "
+    << so3::angleBetween(problem.initial_attitude, problem.final_attitude)
+    << " rad in T = " << problem.duration << " s";
+  return s.str();
+}
+
+/// Nodes fixed by the boundary data (R_1, R_{N−1}, F_0, F_{N−1}) are not unknowns: a cone they
+/// violate cannot be repaired by any plan at this N. The message, or empty.
+std::string fixedNodeViolation(const PlanningProblem& problem, const ReducedProblem& np) {
+  const std::vector<Matrix3> R = np.attitudes(np.current());
+  const int N = np.steps();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (int k : {1, N - 1}) {
+      if (np.variableIndex(k) >= 0) continue;               // free with end torques
+      const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
+      if (slack < 0.0) {
+        std::ostringstream why;
+        why << "infeasible: " << describeConstraint(c) << " is violated by " << -slack
+            << " rad at k = " << k
+            << ", an attitude the boundary velocities fix (increase steps or move the boundary)";
+        return why.str();
+      }
+    }
+  }
+  return {};
+}
+
+/// The Newton direction of one iteration and what the line search and stopping test need of it.
+struct Direction {
+  bool factored = false;
+  double cost = 0.0;   ///< f at the iterate
+  double slope = 0.0;  ///< ∇φ·dδ (free slacks: with the slacks' and the penalty's part)
+  double shift = 0.0;  ///< the inertia correction used
+  double decrement_slope = 0.0;  ///< free slacks: the slope the decrement is measured on
+};
+
+/// The stopping test's verdict on one direction.
+struct StopTest {
+  double relative_decrement = 0.0;
+  bool at_final_barrier = false;
+  bool violated = false;
+  bool at_floor = false;    ///< at μ_final, feasible, at the round-off floor of the decrement
+  bool final_step = false;  ///< this step is the barrier problem's last
+};
+
+enum class Next { Continue, Stop };
+
+bool ranOut(Termination t) {
+  return t == Termination::Cancelled || t == Termination::TimedOut;
+}
+
+template <typename Scalar>
+class GridSolve {
+ public:
+  GridSolve(const PlanningProblem& problem, const SolverOptions& options,
+            const InteriorPointParameters& parameters, SolveContext& context,
+            const GridRequest& request, ReducedProblem* np)
+      : problem_(problem),
+        options_(options),
+        p_(parameters),
+        context_(context),
+        request_(request),
+        np_(*np),
+        system_(problem, np, request.formulation, parameters),
+        barrier_(makeBarrierUpdate(request.barrier, parameters)),
+        free_slacks_(system_.freeSlacks()),
+        hessian_(np->unknowns(), 8) {
+    system_.setInterruption(&context);
+  }
+
+  GridOutcome run() {
+    initialize();
+    for (;; ++iteration_) {
+      if (iteration_ >= options_.max_iterations) break;
+      if (const auto stop = context_.stopReason()) {
+        end(*stop, *stop == Termination::Cancelled ? "cancelled" : "time budget exceeded");
+        break;
+      }
+      try {
+        if (iterate() == Next::Stop) break;
+      } catch (const SolveInterrupted& interrupted) {
+        // Inside an assembly or factorization: the iterate is the last accepted one.
+        end(interrupted.termination, interrupted.termination == Termination::Cancelled
+                                         ? "cancelled"
+                                         : "time budget exceeded");
+        break;
+      }
+    }
+    system_.setInterruption(nullptr);
+    return finish();
+  }
+
+ private:
+  /// Scales, barriers, penalty and the first multipliers (from the coarse level's if given).
+  void initialize() {
+    // f_scale: the cost of the start (the unconstrained optimum), floored by the cost of a
+    // torque J·θ/T² at every node so a free coast still has a scale.
+    double start_cost = 0.0;
+    system_.merit(np_.current(), 1.0, 1.0, &start_cost);
+    const int N = np_.steps();
+    const double angle = std::max(
+        so3::angleBetween(problem_.initial_attitude, problem_.final_attitude), p_.angle_floor);
+    const double floor_torque =
+        problem_.inertia.norm() * angle / (problem_.duration * problem_.duration);
+    scales_.f_scale =
+        std::max(start_cost, p_.cost_scale_floor * 0.5 * N * floor_torque * floor_torque);
+    scales_.constraints = std::max(system_.constraintCount(), 1);
+    scales_.steps = N;
+    const double f = scales_.f_scale;
+    const int m = scales_.constraints;
+    rho_ = p_.initial_penalty * scales_.f_scale;
+    // From a coarse solution the active set is nearly right: a barrier that starts small keeps
+    // the iterate near it.
+    mu_start_ = (request_.coarse_steps ? p_.warm_barrier : p_.initial_barrier) * f / m;
+    mu_ = mu_start_;
+    // The final barrier grows with N above final_barrier_round_off_steps: a torque constraint's
+    // value 1 ∓ τ_a/a carries round-off ~ε|Π|/(h a), which grows like N, and final slacks below
+    // it would make the multipliers noise.
+    scales_.mu_final =
+        std::min(mu_, p_.final_barrier_fraction * options_.tolerance * f / m *
+                          std::max(1.0, static_cast<double>(N) / p_.final_barrier_round_off_steps));
+    stall_acceptance_ =
+        p_.stall_acceptance * std::max(1.0, N / static_cast<double>(p_.stall_acceptance_steps));
+    system_.evaluateValues(np_.current(), nullptr);
+    system_.initializeMultipliers(mu_, rho_, p_.initial_multiplier_cap * f / m);
+    if (request_.barrier == BarrierRule::Mehrotra && request_.coarse_duals &&
+        !request_.coarse_duals->empty() && request_.coarse_steps) {
+      // The barrier of the warm start: its own complementarity (the predictor lowers it).
+      mu_ =
+          std::max(scales_.mu_final, std::min(mu_, system_.warmStartDuals(*request_.coarse_duals)));
+    }
+  }
+
+  /// One iteration: direction, stopping test, line search, acceptance, barrier update.
+  Next iterate() {
+    const Direction direction = computeDirection();
+    if (!std::isfinite(direction.cost)) {
+      return end(Termination::StepTooLarge,
+                 "non-finite cost (step too large for this h? increase steps)");
+    }
+    if (!direction.factored) {
+      return end(Termination::NotConverged, "Newton system could not be made positive definite");
+    }
+    const StopTest test = stoppingTest(direction);
+    ReducedProblem::Steps trial;
+    double alpha = 0.0;
+    if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test);
+    accept(trial, alpha);
+    if (!report(direction.cost, test.relative_decrement, alpha)) {
+      ++iteration_;
+      return end(Termination::Cancelled, "cancelled");
+    }
+    if (test.final_step) return endBarrierProblem();
+    if (!test.at_final_barrier) {
+      barrier_->afterStep(system_, scales_,
+                          {test.relative_decrement, previous_decrement_, alpha, rho_}, &mu_);
+    }
+    previous_decrement_ = test.relative_decrement;
+    previous_alpha_ = alpha;
+    previous_at_final_barrier_ = test.at_final_barrier;
+    return Next::Continue;
+  }
+
+  /// Assembles and factors the condensed system, lets the barrier rule choose μ (Mehrotra),
+  /// and falls back to the primal multipliers μ/s when the primal–dual step is no descent
+  /// direction of φ_μ (it is one with them, H being positive definite).
+  Direction computeDirection() {
+    Direction d;
+    bool primal = false;
+    for (int attempt = 0; attempt < 2 && !d.factored; ++attempt) {
+      d.cost = system_.assemble(mu_, rho_, primal, &hessian_, &rhs_, &merit_gradient_).cost;
+      if (!std::isfinite(d.cost)) break;
+      d.factored = factorWithInertiaCorrection(&d.shift);
+      if (d.factored && !primal && mu_ > scales_.mu_final) {
+        barrier_->beforeStep(
+            system_, [this](Eigen::VectorXd* b) { cholesky_.solve(b); }, rhs_, scales_,
+            previous_decrement_, &mu_, &delta_);
+      }
+      d.slope = merit_gradient_.dot(delta_);
+      if (d.factored && free_slacks_) addSlackTerms(&d);
+      if (d.factored && d.slope >= 0.0 && !primal) {
+        d.factored = false;
+        primal = true;
+      }
+    }
+    return d;
+  }
+
+  /// Inertia correction: a shift relative to each row's scale, grown until the Cholesky
+  /// factorization succeeds (at the final barrier the active constraints' rows are ~1/μ larger
+  /// than the others, and a uniform shift sized by them damps the free directions into linear
+  /// convergence). Solves delta_ = H⁻¹ rhs_.
+  bool factorWithInertiaCorrection(double* shift) {
+    *shift = shift_floor_;
+    for (int tries = 0; tries < p_.max_inertia_corrections; ++tries) {
+      delta_ = rhs_;
+      BandedSymmetric<Scalar> trial = hessian_;
+      if (*shift > 0) {
+        trial.addRelativeToDiagonal(*shift, p_.shift_row_floor * hessian_.maxAbsDiagonal());
+      }
+      if (cholesky_.factor(trial, &context_)) {
+        cholesky_.solve(&delta_);
+        if (delta_.allFinite()) return true;
+      }
+      *shift = *shift == 0.0 ? p_.first_shift : p_.shift_growth * *shift;
+    }
+    return false;
+  }
+
+  /// Free slacks: the slack and dual steps, the ℓ1 merit's ν (at least the multipliers after the
+  /// step, and large enough that the step decreases the merit by a fraction of its predicted
+  /// infeasibility reduction), and the slopes with the slacks' and the penalty's part.
+  void addSlackTerms(Direction* d) {
+    const ConstrainedSystem::SlackStep slack = system_.slackStep(delta_, mu_);
+    alpha_slack_ = slack.alpha;
+    alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
+    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.largestMultiplier(dz_, 0.0));
+    const double without_penalty = d->slope + slack.barrier_slope;
+    const double fraction = p_.merit_infeasibility_fraction;
+    if (slack.residual > 0.0 && without_penalty > -fraction * nu_ * slack.residual) {
+      nu_ = std::max(nu_, 2.0 * without_penalty / ((1.0 - fraction) * slack.residual));
+    }
+    d->slope = without_penalty - nu_ * slack.residual;
+    // (Its magnitude: a step that mostly repairs round-off residuals may raise f and the barrier
+    // a little; that is not convergence.)
+    d->decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
+  }
+
+  /// The decrement, the stall counters and whether this step ends the barrier problem.
+  StopTest stoppingTest(const Direction& d) {
+    StopTest t;
+    t.relative_decrement = std::sqrt(std::max(0.0, -(free_slacks_ ? d.decrement_slope : d.slope))) /
+                           std::sqrt(2.0 * scales_.f_scale);
+    const double decrement = t.relative_decrement;
+    t.at_final_barrier = mu_ <= scales_.mu_final;
+    t.violated = system_.maxViolation() > p_.feasibility_tolerance;
+    countStalls(t);
+    const bool violation_stalled = violationStalled(t.violated);
+    const bool unshifted = d.shift <= p_.negligible_shift;
+    const bool mehrotra = request_.barrier == BarrierRule::Mehrotra;
+    // Quadratic convergence seen at the final barrier: this step leaves about d·(d/d₋)².
+    const bool quadratic_finish =
+        mehrotra && t.at_final_barrier && previous_at_final_barrier_ && !t.violated && unshifted &&
+        previous_alpha_ >= p_.quadratic_step && decrement < previous_decrement_ &&
+        decrement * std::pow(decrement / previous_decrement_, 2) <=
+            p_.quadratic_margin * stall_acceptance_;
+    const double reachable_tolerance =
+        mehrotra ? std::max(options_.tolerance, p_.reachable_fraction * stall_acceptance_)
+                 : options_.tolerance;
+    t.final_step =
+        violation_stalled ||
+        (t.at_final_barrier && ((unshifted && decrement <= reachable_tolerance) ||
+                                stalled_iterations_ >= p_.stalled_iterations || quadratic_finish));
+    t.at_floor =
+        t.at_final_barrier && !t.violated && decrement <= p_.floor_factor * stall_acceptance_;
+    return t;
+  }
+
+  /// At μ_final the condensed system's condition limits the decrement: full steps that no longer
+  /// halve it (below the stall acceptance, or with the constraints still violated) stall.
+  void countStalls(const StopTest& t) {
+    if (!t.at_final_barrier) return;
+    const double decrement = t.relative_decrement;
+    if ((decrement <= stall_acceptance_ || t.violated) &&
+        decrement > p_.stall_ratio * best_final_decrement_) {
+      ++stalled_iterations_;
+    } else {
+      stalled_iterations_ = 0;
+    }
+    best_final_decrement_ = std::min(best_final_decrement_, decrement);
+  }
+
+  /// A violation that no iteration reduces any more is a local minimum of the ℓ1 infeasibility.
+  bool violationStalled(bool violated) {
+    const double violation = system_.maxViolation();
+    if (!violated || violation < best_violation_ * (1.0 - p_.violation_progress)) {
+      best_violation_ = violated ? violation : kInfinity;
+      last_violation_progress_ = iteration_;
+    }
+    const int patience = free_slacks_ ? p_.free_slack_violation_stall : p_.violation_stall;
+    return violated && iteration_ - last_violation_progress_ >= patience;
+  }
+
+  /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step; a predicted
+  /// decrease below φ's round-off is taken. False if no step length was accepted.
+  bool lineSearch(const Direction& d, const StopTest& t, ReducedProblem::Steps* trial,
+                  double* alpha) {
+    const double penalty = free_slacks_ ? nu_ : rho_;
+    const double phi = system_.assembledMerit(d.cost, mu_, penalty);
+    *alpha = free_slacks_ ? alpha_slack_ : 1.0;
+    bool accepted = t.final_step || -d.slope <= p_.merit_round_off * std::abs(phi);
+    const int max_halvings = t.at_floor ? p_.floor_halvings : p_.max_halvings;
+    *trial = np_.retract(delta_, *alpha);
+    for (int back = 0; !accepted && back < max_halvings; ++back) {
+      const double trial_phi = system_.merit(*trial, mu_, penalty, nullptr, *alpha);
+      if (std::isfinite(trial_phi) && trial_phi <= phi + p_.armijo * *alpha * d.slope) {
+        accepted = true;
+        break;
+      }
+      *alpha *= 0.5;
+      *trial = np_.retract(delta_, *alpha);
+    }
+    return accepted;
+  }
+
+  /// A direction the line search rejects: at the round-off floor the iterate is as good as it
+  /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times.
+  Next rejected(const StopTest& t) {
+    if (t.at_floor) {
+      std::ostringstream why;
+      why << "converged to the round-off floor (relative Newton decrement " << t.relative_decrement
+          << ", the line search can no longer decrease the merit)";
+      return end(Termination::Converged, why.str(), t.relative_decrement);
+    }
+    relative_decrement_ = t.relative_decrement;
+    if (shift_floor_ < p_.max_shift_floor) {
+      shift_floor_ = std::max(p_.line_search_shift, p_.shift_growth * shift_floor_);
+      return Next::Continue;
+    }
+    return end(Termination::NotConverged, "line search failed");
+  }
+
+  /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
+  /// dual step), the iterate; relaxes the shift floor.
+  void accept(const ReducedProblem::Steps& trial, double alpha) {
+    if (free_slacks_) {
+      system_.applySlackStep(alpha);
+    } else {
+      alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
+    }
+    system_.applyDualStep(dz_, std::min(alpha_dual_, 1.0));
+    np_.setCurrent(trial);
+    shift_floor_ = shift_floor_ > p_.line_search_shift ? shift_floor_ / p_.shift_growth : 0.0;
+  }
+
+  /// Records the iteration and reports it; false if the caller asked to stop.
+  bool report(double cost, double decrement, double alpha) {
+    relative_decrement_ = decrement;
+    IterationInfo info{iteration_ + 1, cost, decrement, alpha};
+    info.steps = np_.steps();  // the grid level and its h·cost, for the action's feedback
+    info.effort = cost * np_.scheme().timeStep();
+    history_.push_back(info);
+    return context_.reportIteration(info);
+  }
+
+  /// The last step of a barrier problem at μ_final: converged if feasible; a small violation may
+  /// be a penalty below a multiplier (elastic: raise ρ once and re-solve from here); else
+  /// infeasible.
+  Next endBarrierProblem() {
+    ++iteration_;
+    system_.evaluateValues(np_.current(), nullptr);
+    const double violation = system_.maxViolation();
+    if (violation <= p_.feasibility_tolerance) return end(Termination::Converged, "converged");
+    if (!free_slacks_ && penalty_raises_ == 0 && violation <= p_.penalty_raise_violation) {
+      ++penalty_raises_;
+      rho_ *= p_.penalty_growth;
+      mu_ = mu_start_;
+      best_violation_ = kInfinity;
+      last_violation_progress_ = iteration_;
+      best_final_decrement_ = kInfinity;
+      stalled_iterations_ = 0;
+      system_.initializeMultipliers(
+          mu_, rho_, p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
+      return Next::Continue;
+    }
+    return end(Termination::Infeasible, "infeasible");
+  }
+
+  Next end(Termination termination, std::string reason,
+           std::optional<double> decrement = std::nullopt) {
+    ending_ = termination;
+    reason_ = std::move(reason);
+    if (decrement) relative_decrement_ = *decrement;
+    return Next::Stop;
+  }
+
+  /// The result: the plan at the last accepted iterate, its figures and the message.
+  GridOutcome finish() {
+    GridOutcome out;
+    PlanResult& result = out.result;
+    result.solver = "interior_point";
+    result.iterations = iteration_;
+    result.newton_decrement = relative_decrement_;
+    result.history = history_;
+    out.steps = np_.current();
+    if (free_slacks_) out.duals = system_.duals();
+    // Stopped: answer at once (the stationarity residual costs a gradient at N: not measured;
+    // on a coarser level the plan is evaluated once carried to the requested grid).
+    result.max_residual = std::numeric_limits<double>::quiet_NaN();
+    if (!ranOut(ending_) || request_.evaluate_when_stopped) {
+      const Maneuver planned = np_.maneuver(np_.current());
+      result.switching_function = system_.switchingFunction(planned.torque);
+      if (!ranOut(ending_)) {
+        result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
+      }
+      evaluatePlan(problem_, planned.torque, &result, &planned);
+    }
+    std::ostringstream msg;
+    if (ending_ == Termination::Infeasible) {
+      const ConstraintCheck check = checkConstraints(problem_, result.maneuver);
+      msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
+          << " " << describeManeuverSpan(problem_)
+          << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
+          << ")";
+    } else {
+      if (ending_ == Termination::Converged) {
+        const std::string inconsistent = planInconsistency(problem_, result, true);
+        if (!inconsistent.empty()) {
+          ending_ = Termination::NotConverged;
+          reason_ = inconsistent;
+        }
+      }
+      msg << reason_;
+    }
+    result.termination = ending_;
+    msg << " after " << iteration_ << " interior-point iterations (relative Newton decrement "
+        << relative_decrement_ << ", barrier " << mu_ / scales_.f_scale
+        << " x cost, max elastic violation " << system_.maxViolation() << ")";
+    result.message = msg.str();
+    result.levels.push_back({np_.steps(), iteration_, ending_, result.max_residual,
+                             relative_decrement_,
+                             std::string(free_slacks_ ? "interior point (free slacks): "
+                                                      : "interior point (elastic): ") +
+                                 result.message});
+    return out;
+  }
+
+  const PlanningProblem& problem_;
+  const SolverOptions& options_;
+  const InteriorPointParameters& p_;
+  SolveContext& context_;
+  const GridRequest request_;
+  ReducedProblem& np_;
+  ConstrainedSystem system_;
+  std::unique_ptr<BarrierUpdate> barrier_;
+  const bool free_slacks_;
+  BandedSymmetric<Scalar> hessian_;
+  BandedCholeskyFactor<Scalar> cholesky_;
+  Eigen::VectorXd rhs_, merit_gradient_, delta_;
+  BarrierScales scales_;
+  double stall_acceptance_ = 0.0;
+  double mu_ = 0.0, mu_start_ = 0.0;
+  double rho_ = 0.0;  ///< elastic penalty ρ
+  double nu_ = 0.0;   ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
+  std::vector<double> dz_;
+  double alpha_dual_ = 1.0, alpha_slack_ = 1.0;
+  double shift_floor_ = 0.0;  ///< raised after a failed line search, relaxed after a success
+  // The stopping test's memory.
+  int iteration_ = 0;
+  double relative_decrement_ = 0.0;
+  int penalty_raises_ = 0;
+  int stalled_iterations_ = 0;
+  double best_violation_ = kInfinity;
+  int last_violation_progress_ = 0;
+  double best_final_decrement_ = kInfinity;
+  double previous_decrement_ = kInfinity;
+  double previous_alpha_ = 0.0;  ///< the last accepted step length
+  bool previous_at_final_barrier_ = false;
+  std::vector<IterationInfo> history_;
+  Termination ending_ = Termination::NotConverged;
+  std::string reason_ = "iteration limit reached";
+};
+
+template <typename Scalar>
+GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options,
+                    const InteriorPointParameters& parameters, SolveContext& context,
+                    const GridRequest& request) {
+  std::optional<ReducedProblem> reduced;
+  GridOutcome out;
+  out.result.solver = "interior_point";
+  try {
+    reduced.emplace(problem);
+  } catch (const StepTooLarge& e) {
+    out.result.message = std::string("boundary velocity: ") + e.what();
+    out.result.termination = Termination::StepTooLarge;
+    return out;
+  }
+  ReducedProblem& np = *reduced;
+  // The initial guess: the warm start (the unconstrained optimum), a coarser grid's solution,
+  // else the geodesic.
+  if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
+  if (request.coarse_steps) np.initializeFromCoarser(*request.coarse_steps);
+  const std::string fixed = fixedNodeViolation(problem, np);
+  if (!fixed.empty()) {
+    out.result.termination = Termination::Infeasible;
+    out.result.message = fixed;
+    return out;
+  }
+  return GridSolve<Scalar>(problem, options, parameters, context, request, &np).run();
+}
+
+}  // namespace
+
+GridOutcome carryToGrid(const PlanningProblem& problem, const ReducedProblem::Steps& coarse_steps,
+                        Termination termination, const std::string& message) {
+  GridOutcome out;
+  PlanResult& result = out.result;
+  result.solver = "interior_point";
+  result.termination = termination;
+  result.message = message;
+  std::optional<ReducedProblem> reduced;
+  try {
+    reduced.emplace(problem);
+  } catch (const StepTooLarge& e) {
+    result.termination = Termination::StepTooLarge;
+    result.message = std::string("boundary velocity: ") + e.what();
+    return out;
+  }
+  ReducedProblem& np = *reduced;
+  np.initializeFromCoarser(coarse_steps);
+  out.steps = np.current();
+  const Maneuver planned = np.maneuver(np.current());
+  result.max_residual = std::numeric_limits<double>::quiet_NaN();  // not measured
+  evaluatePlan(problem, planned.torque, &result, &planned);
+  result.levels.push_back({np.steps(), 0, termination, result.max_residual, 0.0,
+                           "interior point: carried from a coarser level (" + message + ")"});
+  return out;
+}
+
+namespace {
+
+/// long double is the x87 extended format here (64-bit significand, in hardware).
+constexpr bool kLongDoubleIsX87 = std::numeric_limits<long double>::digits == 64;
+
+}  // namespace
+
+SystemPrecision resolvePrecision(Precision precision, int steps) {
+  switch (precision) {
+    case Precision::Double:
+      return SystemPrecision::Double;
+    case Precision::Extended:
+      return kLongDoubleIsX87 ? SystemPrecision::LongDouble : SystemPrecision::DoubleDouble;
+    case Precision::DoubleDouble:
+      return SystemPrecision::DoubleDouble;
+    case Precision::Auto:
+      break;
+  }
+  if (steps <= kAutoDoubleMaxSteps) return SystemPrecision::Double;
+  if (kLongDoubleIsX87 && steps <= kAutoExtendedMaxSteps) return SystemPrecision::LongDouble;
+  return SystemPrecision::DoubleDouble;
+}
+
+GridOutcome solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                        const InteriorPointParameters& parameters, SolveContext& context,
+                        const GridRequest& request) {
+  switch (resolvePrecision(options.precision, problem.steps)) {
+    case SystemPrecision::Double:
+      return solveIn<double>(problem, options, parameters, context, request);
+    case SystemPrecision::LongDouble:
+      return solveIn<long double>(problem, options, parameters, context, request);
+    case SystemPrecision::DoubleDouble:
+      break;
+  }
+  return solveIn<DoubleDouble>(problem, options, parameters, context, request);
+}
+
+}  // namespace attitude_planner

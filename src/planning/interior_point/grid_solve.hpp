@@ -1,0 +1,57 @@
+// The interior point on one grid: one formulation, one barrier rule, one start (grid_solve.cpp).
+#pragma once
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/barrier_update.hpp"
+#include "planning/interior_point/constrained_system.hpp"
+#include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/problem/solve_context.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// How one grid solve is posed.
+struct GridRequest {
+  Formulation formulation = Formulation::FreeSlacks;
+  BarrierRule barrier = BarrierRule::Mehrotra;
+  /// A coarser grid's solution to start from (with a small initial barrier); null: from
+  /// options.warm_start (the unconstrained optimum), else the geodesic.
+  const ReducedProblem::Steps* coarse_steps = nullptr;
+  /// The coarser grid's multipliers and slacks (free slacks with Mehrotra only); null: none.
+  const LevelDuals* coarse_duals = nullptr;
+  /// A solve stopped (cancelled, out of time) on this grid still evaluates its plan; false on a
+  /// coarser level of a continuation, whose iterate is carried to the requested grid instead.
+  bool evaluate_when_stopped = true;
+};
+
+/// What one grid solve leaves: its result, its iterate and (free slacks) its duals.
+struct GridOutcome {
+  PlanResult result;
+  ReducedProblem::Steps steps;
+  LevelDuals duals;
+  Formulation formulation = Formulation::FreeSlacks;  ///< of the solve whose result this is
+};
+
+/// The arithmetic of the condensed system (SolverOptions::precision resolved).
+enum class SystemPrecision { Double, LongDouble, DoubleDouble };
+
+/// `precision` resolved for N steps: `auto` is double up to N = 1024, long double up to 8192
+/// where it is the x87 format, double-double above (interior_point_solver.cpp derives why).
+SystemPrecision resolvePrecision(Precision precision, int steps);
+
+/// The interior point on one grid in the resolved precision (`options`: this solve's tolerance,
+/// iteration limit, warm start). Polls `context` (cancel, deadline) between iterations and inside
+/// the assembly and the factorization; an interrupted solve returns its last accepted iterate
+/// with Cancelled or TimedOut. Reports its iterations through the context.
+GridOutcome solveOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                        const InteriorPointParameters& parameters, SolveContext& context,
+                        const GridRequest& request);
+
+/// A coarser level's iterate carried to the requested grid without iterating (a solve stopped
+/// on a coarse level: cancelled or out of time), evaluated as a plan, with `termination` and
+/// `message` (StepTooLarge if the boundary data admit no step at this N).
+GridOutcome carryToGrid(const PlanningProblem& problem, const ReducedProblem::Steps& coarse_steps,
+                        Termination termination, const std::string& message);
+
+}  // namespace attitude_planner

@@ -1,0 +1,143 @@
+// The interior point's tuning constants, each with its symbol in the paper it follows (IPOPT:
+// Wächter & Biegler, Math. Program. 106 (2006); LOQO: Vanderbei & Shanno, Comput. Optim. Appl. 13
+// (1999); Mehrotra, SIAM J. Optim. 2 (1992)), its default and why. How the defaults were chosen
+// (the measurements behind them) is in docs/notes/interior_point_tuning.md.
+#pragma once
+
+#include "attitude_planner/planning/constraints.hpp"
+
+namespace attitude_planner {
+
+/// Every constant of the interior point (interior_point_solver.cpp). Scales: μ and ρ relative to
+/// f_scale/m (the start's cost over the number of constraints), decrements relative to √(2
+/// f_scale).
+struct InteriorPointParameters {
+  // --- barrier μ -------------------------------------------------------------------------------
+  /// μ₀ × f_scale/m: the barrier terms start as large as the cost.
+  double initial_barrier = 1.0;
+  /// μ₀ × f_scale/m on a grid started from a coarser grid's solution: its active set is nearly
+  /// right and a small barrier keeps the iterate near it.
+  double warm_barrier = 1e-3;
+  /// μ_final = this × tolerance × f_scale/m: the barrier's cost gap stays below the tolerance.
+  double final_barrier_fraction = 0.1;
+  /// Above this N μ_final grows like N: a torque constraint's value carries round-off ~ N.
+  int final_barrier_round_off_steps = 2048;
+  /// μ within this factor of μ_final is snapped to it (complementarity there is round-off).
+  double barrier_snap_factor = 10.0;
+  /// Mehrotra: σ = (μ_aff / mean s z)^this (Mehrotra's cube).
+  double mehrotra_exponent = 3.0;
+  /// Mehrotra: μ ≥ this × d² × f_scale/m (d the last relative decrement) at N ≤ 1024; a μ far
+  /// below the iterate's distance to the barrier problem leaves Newton an ill-conditioned system.
+  double barrier_progress_floor = 0.01;
+  /// The progress floor grows like (N / this)² above this N.
+  int barrier_progress_floor_steps = 1024;
+  /// Monotone (IPOPT κ_ε): the barrier problem counts as solved once its decrement and slack
+  /// residual are ≤ κ_ε μ (scaled).
+  double monotone_kappa_epsilon = 10.0;
+  /// Monotone (IPOPT κ_μ): linear decrease μ ← κ_μ μ.
+  double monotone_kappa_mu = 0.2;
+  /// Monotone (IPOPT θ_μ): superlinear decrease μ ← μ^θ_μ (scaled); the smaller of the two.
+  double monotone_theta_mu = 1.5;
+  /// Monotone: full steps in a row that no longer halve the decrement after which a barrier
+  /// problem counts as solved as far as round-off allows.
+  int monotone_stalled_steps = 2;
+  /// LOQO: σ = loqo_scale · min(loqo_centrality (1 − ξ)/ξ, loqo_cap)³ (Vanderbei–Shanno's 0.1,
+  /// 0.05, 2).
+  double loqo_scale = 0.1;
+  double loqo_centrality = 0.05;
+  double loqo_cap = 2.0;
+
+  // --- primal–dual safeguards ------------------------------------------------------------------
+  /// Fraction to the boundary (IPOPT τ_min): s and z keep at least 1 − τ of their values.
+  double fraction_to_boundary = 0.99;
+  /// Dual safeguard (IPOPT κ_Σ): z stays within [μ/(κ_Σ s), κ_Σ μ/s].
+  double dual_safeguard = 1e10;
+  /// Elastic form: u = ρ − z ≥ this × ρ (u → 0 would make D and q infinite).
+  double elastic_dual_floor = 1e-12;
+  /// Free slacks start at c pushed inside s > 0 by this (IPOPT κ₁).
+  double slack_push = 1e-2;
+  /// From a coarser level's duals a binding constraint's slack is pushed at most this far inside.
+  double warm_slack_push = 1e-6;
+  /// Initial multipliers are capped at this × f_scale/m (a violated constraint's primal
+  /// multiplier ≈ ρ would swamp the Hessian).
+  double initial_multiplier_cap = 10.0;
+
+  // --- penalty (elastic ρ, free-slack merit ν) -------------------------------------------------
+  /// ρ₀ × f_scale: far above the multipliers met in practice (a binding z is ~ f/N).
+  double initial_penalty = 1e4;
+  /// ρ ← this × ρ once before a request is called infeasible.
+  double penalty_growth = 1e4;
+  /// A violation above this is not a penalty below a multiplier: no raise, infeasible.
+  double penalty_raise_violation = 1e-3;
+  /// ν ≥ this × the largest multiplier after the step (the ℓ1 merit is exact above it).
+  double merit_multiplier_margin = 1.1;
+  /// ν large enough that the step decreases the merit by this fraction of its predicted
+  /// infeasibility reduction (IPOPT's ρ in the penalty update).
+  double merit_infeasibility_fraction = 0.1;
+
+  // --- inertia correction ----------------------------------------------------------------------
+  /// Factorizations tried with growing shifts before the system counts as not positive definite.
+  int max_inertia_corrections = 40;
+  /// First relative shift δ_w (IPOPT δ_w⁰, relative here): a round-off nudge.
+  double first_shift = 1e-14;
+  /// δ_w ← this × δ_w after a failed factorization (IPOPT κ_w⁺).
+  double shift_growth = 100.0;
+  /// The shift's floor per row: this × the largest diagonal (rows of zero scale still move).
+  double shift_row_floor = 1e-8;
+  /// After a failed line search the shift floor rises to max(this, 100 × floor) ...
+  double line_search_shift = 1e-8;
+  /// ... up to this; a direction still rejected ends the solve.
+  double max_shift_floor = 1e-2;
+  /// A shift this small is round-off, not a change of the step.
+  double negligible_shift = 1e-12;
+
+  // --- line search -----------------------------------------------------------------------------
+  /// Armijo's sufficient-decrease constant (IPOPT η_φ).
+  double armijo = 1e-4;
+  /// A predicted merit decrease below this × |φ| is round-off: the step is taken.
+  double merit_round_off = 1e-14;
+  /// Most halvings of the line search ...
+  int max_halvings = 60;
+  /// ... and at the round-off floor (where a 32× shortened step is no progress).
+  int floor_halvings = 5;
+
+  // --- stopping test ---------------------------------------------------------------------------
+  /// Relative decrement below which a stall at μ_final counts as converged (at N ≤ 1024) ...
+  double stall_acceptance = 1e-6;
+  /// ... growing like N above this N (measured round-off floors).
+  int stall_acceptance_steps = 1024;
+  /// A full step that leaves the decrement above this × the previous one does not progress.
+  double stall_ratio = 0.5;
+  /// Stalled iterations at μ_final that end the solve.
+  int stalled_iterations = 2;
+  /// Quadratic finish: the last step was at least this long ...
+  double quadratic_step = 0.9;
+  /// ... and the predicted next decrement is ≤ this × the stall acceptance.
+  double quadratic_margin = 0.1;
+  /// Mehrotra: decrements ≤ this × stall acceptance are the round-off floor (the last step).
+  double reachable_fraction = 0.01;
+  /// At μ_final, feasible, decrement ≤ this × stall acceptance: the round-off floor.
+  double floor_factor = 10.0;
+  /// Iterations without reducing a nonzero violation after which it counts as stalled (elastic,
+  /// free slacks: whose iterates may violate more for a while on their way).
+  int violation_stall = 8;
+  int free_slack_violation_stall = 40;
+  /// A violation counts as reduced when it falls by more than this fraction.
+  double violation_progress = 1e-6;
+  /// Violation (constraint units) that counts as infeasible.
+  double feasibility_tolerance = kNodeConstraintTolerance;
+  /// A slack residual |c − s| below this is round-off: not in the free-slack decrement.
+  double round_off_slack_residual = 1e-10;
+
+  // --- scales ----------------------------------------------------------------------------------
+  /// f_scale ≥ this × ½ N |J θ/T²|² so that a free coast still has a scale ...
+  double cost_scale_floor = 1e-6;
+  /// ... with θ at least this [rad].
+  double angle_floor = 1e-3;
+
+  // --- grids -----------------------------------------------------------------------------------
+  /// Above this N the constrained problem is first solved on 4× coarser grids (down to 16).
+  int coarsest_grid = 256;
+};
+
+}  // namespace attitude_planner

@@ -61,6 +61,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/multiplier_estimate.hpp"
 #include "planning/node_constraints.hpp"
 #include "planning/reduced_problem.hpp"
 #include "planning/solvers.hpp"
@@ -790,6 +791,39 @@ class InteriorPoint {
     return sum / std::max(count, 1);
   }
 
+  // ---- warm start from a plan without multipliers (issue 30; multiplier_estimate.hpp) ----
+  /// The duals of a start from the current iterate (a plan given as the initial guess) in the
+  /// form a finer grid level takes them (warmStartDuals): re-derived from stationarity there.
+  LevelDuals estimatedDuals() {
+    Eigen::VectorXd rhs, merit_gradient, cost_gradient;
+    double scale = 0.0;
+    assemble<double>(0.0, 1.0, false, nullptr, &rhs, &merit_gradient, &scale);  // gradients
+    evaluateValues(np_.current(), nullptr);  // values (the torques' are set with H only)
+    const double cost = np_.evaluate(&cost_gradient, nullptr, &scale);
+    std::vector<StationarityColumn> columns;
+    for (const Group& g : groups_) {
+      for (int k = g.first_k; k <= g.last_k; ++k) {
+        StationarityColumn column{g.at[k - g.first_k].c, g.at[k - g.first_k].g};
+        for (int n = 0; n < g.width; ++n)
+          column.index[n] = np_.variableIndex(k + g.node_offset + n);
+        columns.push_back(column);
+      }
+    }
+    const MultiplierEstimate e =
+        estimateMultipliers(cost_gradient, columns, cost / std::max(constraint_count_, 1));
+    LevelDuals d;
+    d.steps = np_.steps();
+    std::size_t i = 0;
+    for (const Group& g : groups_) {
+      d.first_k.push_back(g.first_k);
+      d.z.emplace_back(e.z.begin() + i, e.z.begin() + i + g.at.size());
+      d.s.emplace_back(e.s.begin() + i, e.s.begin() + i + g.at.size());
+      i += g.at.size();
+    }
+    return d;
+  }
+  // ---- end warm start ----
+
   /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
   /// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
   void initializeMultipliers(double mu, double rho, double cap) {
@@ -864,7 +898,11 @@ PlanResult solveOnGridIn(const PlanningProblem& problem, const SolverOptions& op
   // The initial guess: the warm start (the unconstrained optimum, from planManeuver), else the
   // geodesic.
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
-  if (coarse_steps) np.initializeFromCoarser(*coarse_steps);
+  if (coarse_steps && static_cast<int>(coarse_steps->size()) == problem.steps) {
+    np.setCurrent(*coarse_steps);  // a warm start's own steps (solveWithInteriorPointFromGuess)
+  } else if (coarse_steps) {
+    np.initializeFromCoarser(*coarse_steps);
+  }
 
   // Nodes fixed by the boundary data (R_1, R_{N−1}, F_0, F_{N−1}) are not unknowns: a constraint
   // they violate cannot be repaired by any plan at this N.
@@ -1517,5 +1555,27 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
       first_message;
   return result;
 }
+
+// ---- warm start from a plan without multipliers (issue 30) ----
+PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
+                                           const SolverOptions& options) {
+  LevelDuals duals;
+  ReducedProblem::Steps steps;
+  try {
+    ReducedProblem np(problem);
+    np.setInteriorFromAttitudes(options.warm_start->attitude);
+    InteriorPoint ip(problem, &np, Formulation::FreeSlacks);
+    duals = ip.estimatedDuals();
+    steps = np.current();
+  } catch (const StepTooLarge&) {
+    return solveWithInteriorPoint(problem, options);  // reports it
+  }
+  SolverOptions from = options;
+  from.warm_start = nullptr;  // the guess's steps start the level, as a coarser level's would
+  PlanResult result = solveOnGridWithRetry(problem, from, &steps, nullptr, &duals);
+  result.message += "; from the initial guess, its multipliers re-derived";
+  return result;
+}
+// ---- end warm start ----
 
 }  // namespace attitude_planner

@@ -17,6 +17,13 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
 /// met. Fills everything but solve_time_s and the constraint figures.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
+/// The interior point on the requested grid directly, from options.warm_start (a plan given as
+/// the initial guess, with the problem's N: initialGuessOnGrid) with its multipliers re-derived
+/// from stationarity at the guess (multiplier_estimate.hpp) and the small barrier of a warm
+/// level; free slacks with the predictor–corrector first, the elastic form as the retry.
+PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
+                                           const SolverOptions& options);
+
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
 /// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before
 /// any continuation level: the start a peer solver gets in a like-for-like comparison

@@ -131,6 +131,10 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
   try {
     SolverOptions options;
     out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
+    Maneuver guess;  // the request's warm start, if any (lives through the solve)
+    if (ros_conversions::initialGuessFromMsg(req.initial_guess, "initial_guess", &guess)) {
+      options.warm_start = &guess;
+    }
     // The time budget (options.time_budget_s) is enforced by the core, which then ends
     // TimedOut; the callback only cancels (node shutting down, action preempted).
     const ros::WallTime start = ros::WallTime::now();

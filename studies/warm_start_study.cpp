@@ -39,15 +39,18 @@ std::string g(double v, const char* format = "%.3g") {
 
 struct Timed {
   ap::PlanResult result;
-  double seconds = 0.0;
+  double seconds = 0.0;      ///< wall time [s]
+  double cpu_seconds = 0.0;  ///< this process's CPU time [s] (the solvers are single-threaded)
 };
 
 Timed timedPlan(const ap::PlanningProblem& p, const ap::Maneuver* guess) {
   ap::SolverOptions o;
   o.warm_start = guess;
   const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   Timed t;
   t.result = ap::planManeuver(p, o);
+  t.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   t.seconds = st::seconds(start);
   return t;
 }
@@ -117,10 +120,13 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
          "multipliers re-derived by least squares on stationarity, multiplier_estimate.hpp). "
          "Times: medians of "
       << repeats
-      << " interleaved cold / warm solves (planManeuver, wall time).\n\n"
-         "| scene | N | cold iterations | warm iterations | cold [ms] | warm [ms] | cold ÷ warm | "
-         "warm − cold cost (relative) | active constraints |\n"
-         "|---|---|---|---|---|---|---|---|---|\n";
+      << " interleaved cold / warm solves (planManeuver), in CPU time of this process (the "
+         "solvers are single-threaded; on a shared machine wall time mostly measures the other "
+         "processes), wall time beside.\n\n"
+         "| scene | N | cold iterations | warm iterations | cold CPU [ms] | warm CPU [ms] | "
+         "cold ÷ warm (CPU) | cold ÷ warm (wall) | warm − cold cost (relative) | active "
+         "constraints |\n"
+         "|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<double> ratios;
   for (const char* scene : {"torque_limited.yaml", "torque_norm_limited.yaml", "rate_limited.yaml",
                             "sun_keep_out.yaml"}) {
@@ -136,20 +142,24 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
       const int k = N / 4;
       const ap::PlanningProblem rest = ap::remainderProblem(p, plan.maneuver, k);
       const ap::Maneuver guess = ap::remainderOfPlan(plan.maneuver, k);
-      std::vector<double> cold_s, warm_s;
+      std::vector<double> cold_s, warm_s, cold_cpu, warm_cpu;
       Timed cold, warm;
       for (int r = 0; r < repeats; ++r) {
         cold = timedPlan(rest, nullptr);
         warm = timedPlan(rest, &guess);
         cold_s.push_back(cold.seconds);
         warm_s.push_back(warm.seconds);
+        cold_cpu.push_back(cold.cpu_seconds);
+        warm_cpu.push_back(warm.cpu_seconds);
       }
-      const double c = st::median(cold_s), w = st::median(warm_s);
+      const double c = st::median(cold_cpu), w = st::median(warm_cpu);
+      const double wall = st::median(cold_s) / st::median(warm_s);
       const bool both = cold.result.converged() && warm.result.converged();
       if (both) ratios.push_back(c / w);
       out << "| " << scene << " | " << N << " | " << cold.result.iterations << " | "
           << warm.result.iterations << " | " << g(1e3 * c) << " | " << g(1e3 * w) << " | "
           << (both ? g(c / w, "%.1f") : std::string("–")) << " | "
+          << (both ? g(wall, "%.1f") : std::string("–")) << " | "
           << (both ? g((warm.result.cost - cold.result.cost) / cold.result.cost, "%.1e")
                    : "cold " + ap::terminationName(cold.result.termination) + ", warm " +
                          ap::terminationName(warm.result.termination))
@@ -157,7 +167,7 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
     }
   }
   if (!ratios.empty()) {
-    out << "\ncold ÷ warm over the " << ratios.size() << " converged rows: median "
+    out << "\ncold ÷ warm (CPU) over the " << ratios.size() << " converged rows: median "
         << g(st::median(ratios), "%.1f") << ", least "
         << g(*std::min_element(ratios.begin(), ratios.end()), "%.1f") << ".\n\n";
   }
@@ -167,7 +177,10 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
 void resampled(const std::string& scenes, std::ostream& out) {
   out << "## 3. Resampled guesses\n\n"
          "The plan at N given as the initial guess of the same problem at 2N (initialGuessOnGrid: "
-         "the C¹ curve through its nodes along its own steps, resampleAttitudes).\n\n"
+         "the C¹ curve through its nodes along its own steps, resampleAttitudes). With "
+         "constraints a resampled guess starts the unconstrained optimum, which starts the "
+         "interior point (the start from the guess itself is for guesses of the problem's own "
+         "N).\n\n"
          "| scene | N → 2N | cold iterations | warm iterations | warm − cold cost (relative) "
          "|\n|---|---|---|---|---|\n";
   for (const char* scene : {"rest_to_rest.yaml", "torque_limited.yaml", "rate_limited.yaml"}) {
@@ -214,7 +227,8 @@ int main(int argc, char** argv) {
   const std::string load_before = st::loadAverage();
   const auto start = std::chrono::steady_clock::now();
   doc << "# Warm starts: re-planning from a state on the plan\n\n"
-         "Generated by `scripts/warm_start` (studies/warm_start_study.cpp); every figure below "
+         "Generated by `scripts/warm_start` (studies/warm_start_study.cpp; `warm_start_study "
+         "--scenes scenes --repeats R --out docs/warm_start.md`); every figure below "
          "comes from one run. Issue 30's target: the remainder's cost to 1e-8 in ≤ 2 iterations; "
          "constrained warm re-plans ≥ 2× faster than cold. A warm start is given as "
          "SolverOptions::warm_start, the request field `initial_guess` or `plan_maneuver "

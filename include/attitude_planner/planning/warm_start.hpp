@@ -20,7 +20,8 @@ constexpr double kGuessOrthogonalityTolerance = 1e-9;
 /// Throws InvalidInput naming `field` (e.g. "initial_guess", "--warm-start") and the offending
 /// row and value unless `guess` is a usable start: at least 2 rows (N ≥ 1); every attitude
 /// finite and a rotation within kGuessOrthogonalityTolerance; the other columns (time,
-/// angular_velocity, torque), where present, as long as the attitudes and finite. A guess that
+/// angular_velocity, torque), which may be empty or of another length (only the attitudes start
+/// the solve; NLopt takes the torques too when they have a row per node), finite. A guess that
 /// does not match the problem's boundary data is not refused: it is only a start.
 void validateInitialGuess(const Maneuver& guess, const std::string& field);
 

@@ -20,12 +20,7 @@ import sys
 # Pages the docs index links that other branches of the same work (issues 29-31) add; until they
 # are merged they may be missing here, and each missing one is printed as a note, not an error.
 # Delete an entry once its page is on main.
-PAGES_FROM_OPEN_BRANCHES = {
-    "docs/ros_planner.md",
-    "docs/ros_tracker.md",
-    "docs/ros_package.md",
-    "docs/warm_start.md",
-}
+PAGES_FROM_OPEN_BRANCHES = set()
 
 # Where `mentions` looks: the package's own text files (not the build workspaces).
 MENTION_ROOTS = ["README.md", "CHANGELOG.md", "CMakeLists.txt", "package.xml", "action", "cmake",

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 
 namespace attitude_planner {
 
@@ -68,7 +69,10 @@ Maneuver readManeuverCsv(const std::string& path) {
                          ": k = " + std::to_string(static_cast<int>(v[0])) + " out of order");
     }
     m.time.push_back(v[1]);
-    m.attitude.push_back(so3::fromQuaternion(Eigen::Quaterniond(v[2], v[3], v[4], v[5])));
+    // The scene's and the messages' quaternion rule (finite, unit within 1e-3), then normalized.
+    m.attitude.push_back(attitudeFromQuaternion(
+        Eigen::Vector4d(v[2], v[3], v[4], v[5]),
+        "maneuver CSV '" + path + "' line " + std::to_string(line_number) + " (qw,qx,qy,qz)"));
     m.angular_velocity.emplace_back(v[6], v[7], v[8]);
     m.torque.emplace_back(v[9], v[10], v[11]);
   }

@@ -6,6 +6,8 @@
 #include <map>
 #include <sstream>
 
+#include "attitude_planner/planning/warm_start.hpp"
+
 namespace attitude_planner {
 namespace ros_conversions {
 
@@ -213,6 +215,24 @@ Maneuver maneuverFromMsg(const AttitudeManeuver& msg) {
     m.torque.push_back(t);
   }
   return m;
+}
+
+bool initialGuessFromMsg(const AttitudeManeuver& msg, const std::string& field, Maneuver* guess) {
+  if (msg.attitude.empty()) return false;
+  Maneuver m;
+  m.time_step = msg.time_step;
+  m.time = msg.time;
+  for (size_t k = 0; k < msg.attitude.size(); ++k) {
+    m.attitude.push_back(
+        attitudeFromMsg(msg.attitude[k], field + ".attitude[" + std::to_string(k) + "]"));
+  }
+  for (const geometry_msgs::Vector3& w : msg.angular_velocity) {
+    m.angular_velocity.push_back(vectorFromMsg(w));
+  }
+  for (const geometry_msgs::Vector3& t : msg.torque) m.torque.push_back(vectorFromMsg(t));
+  validateInitialGuess(m, field);
+  *guess = std::move(m);
+  return true;
 }
 
 DriftTwoInputManeuver driftManeuverToMsg(const DriftTwoInputTrajectory& tr,

@@ -18,6 +18,7 @@
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/warm_start.hpp"
 
 namespace ap = attitude_planner;
 
@@ -61,6 +62,11 @@ const char* const kUsage =
     "  --direction shortest|long_way  which way round (rigid_body; overrides the scene)\n"
     "  --extra-revolutions K     K >= 0 extra full turns (rigid_body; overrides the scene)\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
+    "  --warm-start PLAN.csv     start from a previous plan (a CSV this tool wrote with --csv,\n"
+    "                            e.g. the remainder of the plan being flown): resampled to N\n"
+    "                            if its N differs; need not match the boundary data. The\n"
+    "                            solve stays in its homotopy class (no other starts); with\n"
+    "                            constraints the interior point starts from it (rigid_body)\n"
     "  --csv OUT.csv             write the trajectory: rigid_body "
     "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
     "                            drift_two_input k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3\n"
@@ -145,6 +151,7 @@ struct Arguments {
   double time_margin = -1.0;   ///< < 0: the scene's
   std::string direction;       ///< "" : the scene's
   int extra_revolutions = -1;  ///< < 0: the scene's
+  std::string warm_start;      ///< --warm-start PLAN.csv, "" if absent
   std::string csv;
   std::string summary;
   bool help = false;
@@ -235,6 +242,8 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (arg == "--initial-costate") {
       a.initial_costate = next();
       parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
+    } else if (arg == "--warm-start") {
+      a.warm_start = next();
     } else if (arg == "--csv") {
       a.csv = next();
     } else if (arg == "--summary") {
@@ -256,9 +265,10 @@ Arguments parseArguments(int argc, char** argv) {
 /// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
   if (!args.scheme.empty() || args.solver_given || !args.target_flag.empty() ||
-      !args.direction.empty() || args.extra_revolutions >= 0) {
+      !args.direction.empty() || args.extra_revolutions >= 0 || !args.warm_start.empty()) {
     std::cerr << "plan_maneuver: --scheme, --solver, --direction, "
-                 "--extra-revolutions and --target-* apply to system: rigid_body only (this "
+                 "--extra-revolutions, --warm-start and --target-* apply to system: rigid_body "
+                 "only (this "
                  "scene is drift_two_input)\n\n"
               << kUsage;
     return 2;
@@ -341,6 +351,16 @@ int main(int argc, char** argv) {
     if (args.tolerance > 0.0) options.tolerance = args.tolerance;
     if (args.max_iterations > 0) options.max_iterations = args.max_iterations;
     options.time_budget_s = args.time_budget;
+    ap::Maneuver guess;
+    if (!args.warm_start.empty()) {
+      try {
+        guess = ap::readManeuverCsv(args.warm_start);
+      } catch (const ap::InvalidInput& e) {
+        throw ap::InvalidInput(std::string("--warm-start: ") + e.what());
+      }
+      ap::validateInitialGuess(guess, "--warm-start");
+      options.warm_start = &guess;
+    }
 
     const ap::PlanResult result = ap::planManeuver(problem, options);
     std::cout << "scene                    " << args.scene << "\n"

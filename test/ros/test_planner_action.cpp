@@ -365,6 +365,46 @@ TEST_F(PlannerAction, BudgetFarBelowTheSolveEndsTimedOut) {
   EXPECT_EQ(client_->getState(), State::ABORTED);
   EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::TIMED_OUT)
       << client_->getResult()->message;
+// Issue 30: a constrained goal (keep-out cone and torque-norm bound, both binding), then the
+// re-plan from its node k with the plan's remainder as initial_guess: the interior point starts
+// from the guess and ends at the cold re-plan's optimum; a malformed guess is aborted by name.
+TEST_F(PlannerAction, InitialGuessStartsTheConstrainedReplan) {
+  const int N = 32, k = 8;
+  PlanAttitudeManeuverGoal goal;
+  ros_testing::fillConstrainedRequest(&goal, N);
+  const auto result_of = [&](const PlanAttitudeManeuverGoal& g) {
+    client_->sendGoal(g);
+    EXPECT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+    return client_->getResult();
+  };
+  const auto full = result_of(goal);
+  ASSERT_TRUE(full->success) << full->message;
+  const AttitudeManeuver& m = full->maneuver;
+  PlanAttitudeManeuverGoal rest = goal;
+  rest.steps = N - k;
+  rest.duration = goal.duration * (N - k) / N;
+  rest.initial_attitude = m.attitude[k];
+  rest.initial_angular_velocity = m.angular_velocity[k];
+  const auto cold = result_of(rest);
+  ASSERT_TRUE(cold->success) << cold->message;
+  rest.initial_guess = m;
+  rest.initial_guess.time.clear();
+  rest.initial_guess.attitude.assign(m.attitude.begin() + k, m.attitude.end());
+  rest.initial_guess.angular_velocity.clear();
+  rest.initial_guess.torque.clear();
+  const auto warm = result_of(rest);
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED);
+  ASSERT_TRUE(warm->success) << warm->message;
+  EXPECT_NE(warm->message.find("from the initial guess"), std::string::npos) << warm->message;
+  EXPECT_NEAR(warm->cost, cold->cost, 1e-7 * cold->cost);
+  EXPECT_LE(warm->max_constraint_violation, 1e-9);
+  rest.initial_guess.attitude[2].w = std::numeric_limits<double>::quiet_NaN();
+  const auto bad = result_of(rest);
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  EXPECT_EQ(bad->error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(bad->message.find("initial_guess.attitude[2]: quaternion not finite"),
+            std::string::npos)
+      << bad->message;
 }
 
 int main(int argc, char** argv) {

@@ -632,6 +632,52 @@ TEST_F(PlannerService, BudgetFarBelowTheSolveIsTimedOut) {
   EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
   std::printf("N = 1e5, time_budget 0.01 s: solve_time %.3f s: %s\n", res.solve_time,
               res.message.c_str());
+TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
+  // Issue 30: the seed's slew, then the re-plan from its node k (spinning) to the same end with
+  // the plan's remainder as initial_guess: the remainder comes back, cost to 1e-8, in <= 2
+  // iterations. A guess of another N is resampled; malformed guesses are named by row.
+  const int N = 32, k = 8;
+  const PlanAttitudeManeuver::Response full = call(seed(N));
+  ASSERT_TRUE(full.success) << full.message;
+  const AttitudeManeuver& m = full.maneuver;
+  PlanAttitudeManeuver::Request req = seed(N - k);
+  req.duration = 12.8 * (N - k) / N;
+  req.initial_attitude = m.attitude[k];
+  req.initial_angular_velocity = m.angular_velocity[k];
+  AttitudeManeuver& guess = req.initial_guess;
+  guess = m;
+  guess.time.clear();
+  guess.attitude.assign(m.attitude.begin() + k, m.attitude.end());
+  guess.angular_velocity.assign(m.angular_velocity.begin() + k, m.angular_velocity.end());
+  guess.torque.assign(m.torque.begin() + k, m.torque.end());
+  double remainder = 0.0;
+  for (int j = k + 1; j < N; ++j) remainder += 0.5 * rc::vectorFromMsg(m.torque[j]).squaredNorm();
+  const PlanAttitudeManeuver::Response warm = call(req);
+  ASSERT_TRUE(warm.success) << warm.message;
+  EXPECT_NEAR(warm.cost, remainder, 1e-8 * remainder);
+  EXPECT_LE(warm.iterations, 2);
+
+  PlanAttitudeManeuver::Request finer = seed(2 * N);
+  finer.initial_guess = m;  // N = 32 for a request at 64: resampled
+  const PlanAttitudeManeuver::Response resampled = call(finer);
+  EXPECT_TRUE(resampled.success) << resampled.message;
+  EXPECT_NEAR(resampled.cost, call(seed(2 * N)).cost, 1e-8 * resampled.cost);
+
+  PlanAttitudeManeuver::Request bad = req;
+  bad.initial_guess.attitude[3] = geometry_msgs::Quaternion();
+  const PlanAttitudeManeuver::Response zero = call(bad);
+  EXPECT_EQ(zero.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(zero.message.find("initial_guess.attitude[3]: zero quaternion"), std::string::npos)
+      << zero.message;
+  bad = req;
+  bad.initial_guess.attitude.resize(1);
+  bad.initial_guess.angular_velocity.clear();
+  bad.initial_guess.torque.clear();
+  const PlanAttitudeManeuver::Response one_row = call(bad);
+  EXPECT_EQ(one_row.error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(one_row.message.find("initial_guess: needs at least 2 rows (N >= 1), got 1"),
+            std::string::npos)
+      << one_row.message;
   EXPECT_TRUE(call(seed(16)).success);
 }
 

@@ -15,6 +15,7 @@
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/csv.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planning/warm_start.hpp"
 #include "tool_runner.hpp"
 
 namespace ap = attitude_planner;
@@ -481,4 +482,69 @@ TEST_F(CliTest, SimulateTorquesRejectsABadCsvNamingTheLine) {
   const ToolRun r = run("simulate_torques", kScenes + "rest_to_rest.yaml " + csv);
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_CONTAINS(r.output, "line 3");
+}
+
+// --warm-start PLAN.csv (issue 30): the re-plan from node k of a plan (a scene written from its
+// row k) warm-started with the plan's remainder CSV returns the remainder (cost to 1e-8, ≤ 2
+// iterations); a plan of another N is resampled; a broken CSV is named with the flag; the
+// drift + two-input system refuses the flag.
+TEST_F(CliTest, WarmStartFromAPlanCsvRecoversTheRemainder) {
+  const std::string csv = dir_ + "/plan.csv", rest_csv = dir_ + "/rest.csv";
+  ASSERT_EQ(run("plan_maneuver", kScenes + "rest_to_rest.yaml --steps 64 --csv " + csv).status, 0);
+  const ap::Maneuver plan = ap::readManeuverCsv(csv);
+  const int k = 16;
+  ap::writeManeuverCsv(ap::remainderOfPlan(plan, k), rest_csv);
+  const Eigen::Quaterniond q = ap::so3::toQuaternion(plan.attitude[k]);
+  const ap::Vector3& w = plan.angular_velocity[k];
+  const std::string n = ", ";
+  const std::string scene =
+      writeScene("rest.yaml",
+                 "inertia: [[13.25, -7.80, -11.40], [-7.80, 16.25, 4.71], [-11.40, 4.71, 18.37]]\n"
+                 "allow_nonphysical_inertia: true\nduration: " +
+                     ap::exactNumber(12.8 * 48 / 64) + "\nsteps: 48\nscheme: paper\n" +
+                     "initial: {attitude: {quaternion: [" + ap::exactNumber(q.w()) + n +
+                     ap::exactNumber(q.x()) + n + ap::exactNumber(q.y()) + n +
+                     ap::exactNumber(q.z()) + "]}, angular_velocity: [" + ap::exactNumber(w.x()) +
+                     n + ap::exactNumber(w.y()) + n + ap::exactNumber(w.z()) + "]}\n" +
+                     "final: {attitude: {axis: [1, 0, 0], angle: 1.0471975511965976}, "
+                     "angular_velocity: [0, 0, 0]}\n");
+  double remainder = 0.0;
+  for (int j = k + 1; j < 64; ++j) remainder += 0.5 * plan.torque[j].squaredNorm();
+  const std::string json = dir_ + "/warm.json";
+  const ToolRun warm =
+      run("plan_maneuver", scene + " --warm-start " + rest_csv + " --summary " + json);
+  ASSERT_EQ(warm.status, 0) << warm.output;
+  const std::string summary = readFile(json);
+  EXPECT_NEAR(jsonNumber(summary, "cost"), remainder, 1e-8 * remainder) << summary;
+  EXPECT_LE(jsonNumber(summary, "iterations"), 2) << summary;
+
+  // The full plan (N = 64) as the guess at N = 128: resampled, the cold solve's cost.
+  const std::string cold_json = dir_ + "/cold.json", fine_json = dir_ + "/fine.json";
+  ASSERT_EQ(run("plan_maneuver", kScenes + "rest_to_rest.yaml --summary " + cold_json).status, 0);
+  const ToolRun fine = run("plan_maneuver", kScenes + "rest_to_rest.yaml --warm-start=" + csv +
+                                                " --summary " + fine_json);
+  ASSERT_EQ(fine.status, 0) << fine.output;
+  EXPECT_NEAR(jsonNumber(readFile(fine_json), "cost"), jsonNumber(readFile(cold_json), "cost"),
+              1e-8 * jsonNumber(readFile(cold_json), "cost"));
+
+  // A row whose quaternion is not unit, and a missing file: exit 1, the flag and the value named.
+  std::string text = readFile(rest_csv);
+  const std::size_t row3 = text.find("\n3,");
+  ASSERT_NE(row3, std::string::npos);
+  const std::size_t qw = text.find(',', text.find(',', row3 + 1) + 1) + 1;
+  text.replace(qw, text.find(',', qw) - qw, "2");
+  const std::string broken = dir_ + "/broken.csv";
+  std::ofstream(broken) << text;
+  const ToolRun bad = run("plan_maneuver", scene + " --warm-start " + broken);
+  EXPECT_EQ(bad.status, 1) << bad.output;
+  EXPECT_CONTAINS(bad.output, "--warm-start: maneuver CSV '" + broken + "' line 5 (qw,qx,qy,qz)");
+  EXPECT_CONTAINS(bad.output, "not a unit quaternion");
+  const ToolRun missing = run("plan_maneuver", scene + " --warm-start " + dir_ + "/none.csv");
+  EXPECT_EQ(missing.status, 1) << missing.output;
+  EXPECT_CONTAINS(missing.output, "--warm-start: maneuver CSV: cannot read");
+  const ToolRun drift =
+      run("plan_maneuver", kScenes + "drift_two_input.yaml --warm-start " + rest_csv);
+  EXPECT_EQ(drift.status, 2) << drift.output;
+  EXPECT_CONTAINS(drift.output, "--warm-start");
+  EXPECT_CONTAINS(run("plan_maneuver", "--help").output, "--warm-start PLAN.csv");
 }

@@ -52,6 +52,12 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
 /// entry is not finite / not a unit quaternion.
 Maneuver maneuverFromMsg(const AttitudeManeuver& msg);
 
+/// The warm start of a request's `initial_guess` (`field` names it in errors): false, leaving
+/// `guess` alone, when it has no attitude rows (none); else its rows (the columns other than
+/// the attitudes may be left empty), checked by validateInitialGuess. Throws InvalidInput naming
+/// the field, the row and the value (e.g. "initial_guess.attitude[3]: not a unit quaternion").
+bool initialGuessFromMsg(const AttitudeManeuver& msg, const std::string& field, Maneuver* guess);
+
 /// Message of a drift + two-input trajectory (seed 001): time, attitude g(t_k), control
 /// (u1, u2, 0) [rad/s], costate p [c·rad/s]; time_step = t_1 − t_0 [s]; frames and stamp as
 /// maneuverToMsg.

@@ -195,6 +195,10 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
     SolverOptions options;
     out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
     out.time_budget_s = options.time_budget_s;
+    Maneuver guess;  // the request's warm start, if any (lives through the solve)
+    if (ros_conversions::initialGuessFromMsg(req.initial_guess, "initial_guess", &guess)) {
+      options.warm_start = &guess;
+    }
     // The time budget (options.time_budget_s) is enforced by the core, which then ends
     // TimedOut; the callback and the flag only cancel (node shutting down, action cancelled).
     options.cancel_requested = cancel;

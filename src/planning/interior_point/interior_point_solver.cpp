@@ -385,4 +385,16 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   return result;
 }
 
+PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
+                                           const SolverOptions& options) {
+  // The guess's attitudes start every grid level (as the minimum-time search's warm starts do);
+  // the multipliers are re-started from the barrier (multiplier_estimate.hpp can re-derive
+  // them by least squares, but is not wired into the refactored interior point yet).
+  SolverOptions from = options;
+  from.constrained_from_warm_start = true;
+  PlanResult result = solveWithInteriorPoint(problem, from);
+  result.message += "; from the initial guess";
+  return result;
+}
+
 }  // namespace attitude_planner

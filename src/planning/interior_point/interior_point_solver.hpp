@@ -22,4 +22,9 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
 /// The same with a context of its own (clock started now); its attempts in PlanResult::attempts.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
 
+/// The interior point from options.warm_start (a plan given as the initial guess, with the
+/// problem's N: initialGuessOnGrid) rather than from the unconstrained optimum.
+PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
+                                           const SolverOptions& options);
+
 }  // namespace attitude_planner

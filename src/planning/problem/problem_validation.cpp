@@ -8,6 +8,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "attitude_planner/planning/warm_start.hpp"
 
 namespace attitude_planner {
 
@@ -188,6 +189,7 @@ void validateOptions(const SolverOptions& o) {
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = none), got " +
                        exactNumber(o.time_budget_s));
   }
+  if (o.warm_start) validateInitialGuess(*o.warm_start, "warm_start");
 }
 
 void requirePhysicalInertia(const Matrix3& inertia) {

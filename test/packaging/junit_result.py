@@ -1,4 +1,5 @@
 """Writes one JUnit XML result file (what catkin_test_results and scripts/test count)."""
+import os
 import xml.etree.ElementTree as ET
 
 
@@ -24,5 +25,6 @@ class Suite:
             element = ET.SubElement(suite, "testcase", classname=self.name, name=case)
             if message is not None:
                 ET.SubElement(element, "failure", message=message[:2000]).text = message
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         ET.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
         return failures == 0

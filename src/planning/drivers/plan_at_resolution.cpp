@@ -92,6 +92,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   result.history = coarse.history;
   result.history.insert(result.history.end(), fine.history.begin(), fine.history.end());
   result.extremal = fine.extremal;
+  result.extremal_summary = fine.extremal_summary;
   result.duration = problem.duration;
   result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
 
@@ -132,6 +133,18 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   return result;
 }
 
+/// The trail of a solve that `earlier` attempts led to: those (none kept any more), then the
+/// later solve's own, whose first-stage attempts are marked `stage`.
+std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<Attempt>& later,
+                                AttemptStage stage) {
+  for (Attempt& a : earlier) a.kept = false;
+  for (Attempt a : later) {
+    if (a.stage == AttemptStage::Solve) a.stage = stage;
+    earlier.push_back(a);
+  }
+  return earlier;
+}
+
 }  // namespace
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested) {
@@ -164,6 +177,8 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
       result = solveWithInteriorPoint(problem, withRemainingBudget(options, start));
+      result.attempts =
+          followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
       result.iterations += first.iterations;
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
       result.message += "; after the start from the initial guess stopped: " + first.message;
@@ -194,7 +209,9 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       const Maneuver unconstrained_plan = result.maneuver;
       constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
       const std::vector<LevelSummary> newton_levels = result.levels;
+      const std::vector<Attempt> newton_attempts = result.attempts;
       result = solveWithInteriorPoint(problem, constrained);
+      result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
       result.iterations += newton_iterations;
       result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
       result.message += note.str();

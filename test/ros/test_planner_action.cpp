@@ -365,6 +365,8 @@ TEST_F(PlannerAction, BudgetFarBelowTheSolveEndsTimedOut) {
   EXPECT_EQ(client_->getState(), State::ABORTED);
   EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::TIMED_OUT)
       << client_->getResult()->message;
+}
+
 // Issue 30: a constrained goal (keep-out cone and torque-norm bound, both binding), then the
 // re-plan from its node k with the plan's remainder as initial_guess: the interior point starts
 // from the guess and ends at the cold re-plan's optimum; a malformed guess is aborted by name.

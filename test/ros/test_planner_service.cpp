@@ -632,6 +632,8 @@ TEST_F(PlannerService, BudgetFarBelowTheSolveIsTimedOut) {
   EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
   std::printf("N = 1e5, time_budget 0.01 s: solve_time %.3f s: %s\n", res.solve_time,
               res.message.c_str());
+}
+
 TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
   // Issue 30: the seed's slew, then the re-plan from its node k (spinning) to the same end with
   // the plan's remainder as initial_guess: the remainder comes back, cost to 1e-8, in <= 2

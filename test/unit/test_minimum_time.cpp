@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -213,4 +216,71 @@ constraints: [{max_torque_norm: 1.0}]
                                           "final: {attitude: {axis: [1, 0, 0], angle: 1}}\n")
           .find("objective: unknown value 'fastest' (expected minimum_effort or minimum_time)"),
       std::string::npos);
+}
+
+namespace {
+
+/// The scenes' minimum-time problems, at a grid the default suite can afford.
+std::vector<ap::PlanningProblem> minimumTimeCases() {
+  std::vector<ap::PlanningProblem> cases;
+  for (const char* scene :
+       {"min_time_betts.yaml", "min_time_bilimoria_wie.yaml", "min_time_sphere.yaml"}) {
+    ap::PlanningProblem p = ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + scene).problem;
+    p.steps = 32;
+    cases.push_back(p);
+  }
+  return cases;
+}
+
+}  // namespace
+
+TEST(MinimumTime, NoDurationAboveTStarIsAnsweredInfeasible) {
+  // Issue 30's target: minimum effort at (1 + m) T* converges for m in {0.005, 0.02, 0.1}
+  // (answered "infeasible" in ~15 ms before the feasibility phase backed such verdicts).
+  for (const ap::PlanningProblem& p : minimumTimeCases()) {
+    const ap::PlanResult fastest = ap::planManeuver(p);
+    ASSERT_TRUE(fastest.converged()) << fastest.message;
+    const double T_star = fastest.minimum_duration;
+    for (const double m : {0.005, 0.02, 0.1}) {
+      ap::PlanningProblem effort = p;
+      effort.objective = ap::Objective::MinimumEffort;
+      effort.duration = (1.0 + m) * T_star;
+      const ap::PlanResult r = ap::planManeuver(effort);
+      EXPECT_TRUE(r.converged()) << "T* = " << T_star << ", m = " << m << ": " << r.message;
+      EXPECT_LE(r.max_constraint_violation, 1e-8) << "m = " << m;
+    }
+  }
+}
+
+TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndNamesTStar) {
+  // `duration` with minimum_time is an upper bound; below T* the answer names T*, and so does a
+  // minimum-effort request at that duration.
+  ap::PlanningProblem p = minimumTimeCases()[1];  // Bilimoria–Wie
+  const ap::PlanResult free = ap::planManeuver(p);
+  ASSERT_TRUE(free.converged()) << free.message;
+  p.duration = 0.95 * free.minimum_duration;
+  const ap::PlanResult bounded = ap::planManeuver(p);
+  EXPECT_EQ(bounded.termination, ap::Termination::Infeasible) << bounded.message;
+  EXPECT_NEAR(bounded.minimum_duration, free.minimum_duration, 1e-9 * free.minimum_duration);
+  std::ostringstream named;
+  named << "needs T >= " << bounded.minimum_duration << " s";
+  EXPECT_NE(bounded.message.find(named.str()), std::string::npos) << bounded.message;
+  p.objective = ap::Objective::MinimumEffort;
+  const ap::PlanResult effort = ap::planManeuver(p);
+  EXPECT_EQ(effort.termination, ap::Termination::Infeasible) << effort.message;
+  EXPECT_GT(effort.minimum_duration, p.duration) << effort.message;
+}
+
+TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {
+  // time_margin on Betts failed for 0.01 ... 0.2 when the margin solve started from the
+  // unconstrained optimum; from the T* plan every one converges inside the bounds.
+  ap::PlanningProblem p = minimumTimeCases()[0];
+  for (const double m : {0.01, 0.2}) {
+    p.time_margin = m;
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "m = " << m << ": " << r.message;
+    EXPECT_NEAR(r.duration, (1.0 + m) * r.minimum_duration, 1e-9 * r.duration);
+    EXPECT_LE(r.max_constraint_violation, 1e-8);
+    EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);
+  }
 }

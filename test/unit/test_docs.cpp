@@ -82,7 +82,7 @@ TEST(DocsCheck, ReportsBrokenLinksMissingHeadingsAndStalePaths) {
 
 /// README.md's C++ example (examples/plan_rest_to_rest.cpp) plans the seed's slew and converges.
 TEST(ReadmeExample, PlansTheSeedsRestToRestSlew) {
-  const ToolRun r = runTool("plan_rest_to_rest", "", 120);
+  const ToolRun r = runProgram(AP_STUDY_DIR, "plan_rest_to_rest", "", 120);
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.rfind("converged in ", 0), 0u) << r.output;
   EXPECT_NE(r.output.find("cost 7.910254"), std::string::npos) << r.output;  // the seed's optimum

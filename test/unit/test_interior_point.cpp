@@ -704,7 +704,8 @@ TEST(InteriorPoint, PredictorCorrectorNeedsFewIterations) {
   ASSERT_TRUE(r.converged()) << r.message;
   ASSERT_FALSE(r.levels.empty());
   EXPECT_LE(r.levels.back().iterations, 18) << r.levels.back().reason;
-  EXPECT_NEAR(r.cost, 8.63484875423, 1e-10 * 8.63) << "SLSQP's optimum (docs/results/constraints.md)";
+  EXPECT_NEAR(r.cost, 8.63484875423, 1e-10 * 8.63)
+      << "SLSQP's optimum (docs/results/constraints.md)";
 }
 
 TEST(InteriorPoint, FinerLevelsStartFromTheCoarserMultipliers) {
@@ -721,8 +722,8 @@ TEST(InteriorPoint, FinerLevelsStartFromTheCoarserMultipliers) {
 
 // The barrier rules as strategies: one grid solved from the unconstrained optimum with each
 // rule (Mehrotra's predictor–corrector and the monotone rule with free slacks, LOQO's with the
-// elastic form) reaches the same optimum, SLSQP's (docs/constraints.md), and each records its
-// iterations through the context.
+// elastic form) reaches the same optimum, SLSQP's (docs/results/constraints.md), and each records
+// its iterations through the context.
 TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
   const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 128);
   ap::PlanningProblem free = p;
@@ -751,13 +752,16 @@ TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
   }
 }
 
-// The interior point records what it ran: one attempt for torque_limited (no cones), in the
-// free-slack form, started from the unconstrained optimum, kept, with the result's cost.
+// The trail of torque_limited (no cones): the unconstrained solve (not kept: it violates the
+// bound), then one interior-point attempt in the free-slack form, started from the unconstrained
+// optimum, kept, with the result's cost.
 TEST(InteriorPointStrategies, AttemptsRecordFormulationStartAndCost) {
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 128), "newton");
   ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_EQ(r.attempts.size(), 1u);
-  const ap::Attempt& a = r.attempts.front();
+  ASSERT_EQ(r.attempts.size(), 2u);
+  EXPECT_EQ(r.attempts.front().formulation, ap::Formulation::Unconstrained);
+  EXPECT_FALSE(r.attempts.front().kept);
+  const ap::Attempt& a = r.attempts.back();
   EXPECT_EQ(a.stage, ap::AttemptStage::Constrained);
   EXPECT_EQ(a.start, ap::AttemptStart::UnconstrainedOptimum);
   EXPECT_EQ(a.formulation, ap::Formulation::FreeSlacks);

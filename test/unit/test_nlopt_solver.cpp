@@ -8,8 +8,8 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
-#include "planning/transcription/direct_method.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/transcription/direct_method.hpp"
 
 namespace ap = attitude_planner;
 
@@ -246,9 +246,14 @@ TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 5000, ap::SchemeKind::Paper);
   ap::SolverOptions options;
   options.solver = ap::SolverKind::Nlopt;
-  const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_FALSE(r.converged());
-  EXPECT_NE(r.message.find("steps 5000 > 1024"), std::string::npos) << r.message;
+  // Refused before solving, as invalid input naming `steps` (a node answers INVALID_INPUT).
+  try {
+    ap::planManeuver(p, options);
+    ADD_FAILURE() << "N = 5000 with nlopt was not refused";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_EQ(e.field(), "steps") << e.what();
+    EXPECT_NE(std::string(e.what()).find("5000 > 1024"), std::string::npos) << e.what();
+  }
 }
 
 TEST(NloptSolver, ExhaustedTimeBudgetIsNotConvergence) {

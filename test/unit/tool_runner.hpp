@@ -17,11 +17,12 @@ struct ToolRun {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `tool args` through the shell (tool: a name in kToolDir), capturing both streams;
+/// Runs `directory/program args` through the shell, capturing both streams;
 /// `timeout_s` > 0 wraps it in coreutils' timeout, so a hang fails the test instead of CI.
-inline ToolRun runTool(const std::string& tool, const std::string& args, int timeout_s = 0) {
+inline ToolRun runProgram(const std::string& directory, const std::string& program,
+                          const std::string& args, int timeout_s = 0) {
   const std::string prefix = timeout_s > 0 ? "timeout " + std::to_string(timeout_s) + " " : "";
-  const std::string command = prefix + "'" + kToolDir + tool + "' " + args + " 2>&1";
+  const std::string command = prefix + "'" + directory + program + "' " + args + " 2>&1";
   ToolRun r;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return r;
@@ -31,6 +32,11 @@ inline ToolRun runTool(const std::string& tool, const std::string& args, int tim
   const int raw = pclose(pipe);
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return r;
+}
+
+/// runProgram for one of the installed tools (kToolDir).
+inline ToolRun runTool(const std::string& tool, const std::string& args, int timeout_s = 0) {
+  return runProgram(kToolDir, tool, args, timeout_s);
 }
 
 }  // namespace attitude_planner_test

@@ -14,6 +14,7 @@
 
 namespace {
 
+using attitude_planner_test::runProgram;
 using attitude_planner_test::runTool;
 using attitude_planner_test::ToolRun;
 

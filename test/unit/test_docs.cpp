@@ -14,24 +14,11 @@
 
 namespace {
 
+using attitude_planner_test::runCommand;
 using attitude_planner_test::runProgram;
-using attitude_planner_test::runTool;
 using attitude_planner_test::ToolRun;
 
 const std::string kSourceDir = AP_SOURCE_DIR;
-
-/// Runs `command` through the shell, capturing stdout and stderr together.
-ToolRun runCommand(const std::string& command) {
-  ToolRun r;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.output.append(buffer, n);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
 
 /// scripts/check_docs.py on the repository `repo` with the checks named in `checks`.
 ToolRun checkDocs(const std::string& repo, const std::string& checks) {

@@ -17,14 +17,10 @@ struct ToolRun {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `directory/program args` through the shell, capturing both streams;
-/// `timeout_s` > 0 wraps it in coreutils' timeout, so a hang fails the test instead of CI.
-inline ToolRun runProgram(const std::string& directory, const std::string& program,
-                          const std::string& args, int timeout_s = 0) {
-  const std::string prefix = timeout_s > 0 ? "timeout " + std::to_string(timeout_s) + " " : "";
-  const std::string command = prefix + "'" + directory + program + "' " + args + " 2>&1";
+/// Runs `command` through the shell, capturing stdout and stderr together.
+inline ToolRun runCommand(const std::string& command) {
   ToolRun r;
-  FILE* pipe = popen(command.c_str(), "r");
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return r;
   char buffer[4096];
   std::size_t n;
@@ -32,6 +28,14 @@ inline ToolRun runProgram(const std::string& directory, const std::string& progr
   const int raw = pclose(pipe);
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return r;
+}
+
+/// Runs `directory/program args` (both streams captured); `timeout_s` > 0 wraps it in
+/// coreutils' timeout, so a hang fails the test instead of CI.
+inline ToolRun runProgram(const std::string& directory, const std::string& program,
+                          const std::string& args, int timeout_s = 0) {
+  const std::string prefix = timeout_s > 0 ? "timeout " + std::to_string(timeout_s) + " " : "";
+  return runCommand(prefix + "'" + directory + program + "' " + args);
 }
 
 /// runProgram for one of the installed tools (kToolDir).

@@ -1,4 +1,4 @@
-// Physical effects a scene may call for (issue 8): only the effects a scene lists are simulated.
+// Physical effects a scene may call for: only the effects a scene lists are simulated.
 //
 // Plannable effects are known external torques τ_e(R_k, t_k) [N m, body frame] that enter the
 // discrete dynamics as a forcing term alongside the control, at the node (DiscreteScheme):
@@ -71,7 +71,7 @@ class TorqueEffect {
   virtual Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const = 0;
 };
 
-/// Gravity gradient of a circular orbit in the world x–y plane (issue 8):
+/// Gravity gradient of a circular orbit in the world x–y plane:
 /// τ = 3 n² (b × J b), b = Rᵀ r̂(t), r̂(t) = (cos nt, sin nt, 0), n² = μ/r³.
 class GravityGradient : public TorqueEffect {
  public:

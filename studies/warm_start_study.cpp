@@ -117,8 +117,9 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
          "The same re-plan for the constrained scenes (node k = N/4), cold (the unconstrained "
          "optimum, then the interior point from it with grid continuation above N = 256) and "
          "warm (the interior point from the remainder on the requested grid directly, its "
-         "multipliers re-derived by least squares on stationarity, multiplier_estimate.hpp). "
-         "Times: medians of "
+         "multipliers re-derived by least squares on stationarity and centered on one "
+         "complementarity, multiplier_estimate.hpp; a small first barrier, as a finer grid "
+         "level starts). Times: medians of "
       << repeats
       << " interleaved cold / warm solves (planManeuver), in CPU time of this process (the "
          "solvers are single-threaded; on a shared machine wall time mostly measures the other "
@@ -169,7 +170,13 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
   if (!ratios.empty()) {
     out << "\ncold ÷ warm (CPU) over the " << ratios.size() << " converged rows: median "
         << g(st::median(ratios), "%.1f") << ", least "
-        << g(*std::min_element(ratios.begin(), ratios.end()), "%.1f") << ".\n\n";
+        << g(*std::min_element(ratios.begin(), ratios.end()), "%.1f")
+        << ". Where the warm start gains least: the fixed cost of a solve (the estimate, the "
+           "plan's replay and verdict) at small N, and at large N the cold continuation's "
+           "cheap coarse levels (above N = 1024 the fine grid's system is solved in extended "
+           "precision, so a fine iteration costs several coarse ones: torque_limited at N = "
+           "4096 through `plan_maneuver --warm-start`, 8 warm iterations against 46 cold, took "
+           "about the same time).\n\n";
   }
 }
 

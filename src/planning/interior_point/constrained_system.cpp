@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "planning/interior_point/multiplier_estimate.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/transcription/node_constraints.hpp"
 
@@ -659,12 +660,46 @@ double ConstrainedSystem::warmStartDuals(const LevelDuals& coarse) {
       const bool binding = coarse.s[gi][i] < parameters_.warm_slack_push;
       in.z = zc[i];
       in.s = std::max(in.c, binding ? parameters_.warm_slack_push : parameters_.slack_push);
+      // Duals of this very grid (an estimate at an initial guess) come with their own slacks.
+      if (coarse.steps == np_.steps()) in.s = std::max(in.c, coarse.s[gi][i]);
       in.ds = 0.0;
       sum += in.s * in.z;
       ++count;
     }
   }
   return sum / std::max(count, 1);
+}
+
+LevelDuals ConstrainedSystem::estimatedDuals() {
+  Eigen::VectorXd rhs, merit_gradient, cost_gradient;
+  // Gradients of every constraint (H = null leaves multipliers and slacks untouched), then the
+  // values (the torque constraints' are formed with the Hessian only).
+  assemble<double>(0.0, 1.0, false, nullptr, &rhs, &merit_gradient);
+  evaluateValues(np_.current(), nullptr);
+  double gradient_scale = 0.0;
+  const double cost = np_.evaluate(&cost_gradient, nullptr, &gradient_scale);
+  std::vector<StationarityColumn> columns;
+  for (const ConstraintGroup& g : groups_) {
+    for (int k = g.first_k; k <= g.last_k; ++k) {
+      StationarityColumn column{g.instance(k).c, g.instance(k).g};
+      for (int n = 0; n < g.width; ++n) column.index[n] = np_.variableIndex(k + g.node_offset + n);
+      columns.push_back(column);
+    }
+  }
+  // Without an active constraint the multipliers take μ/c with μ a share of the cost per
+  // constraint: the scale the cold start's barrier has too.
+  const MultiplierEstimate e =
+      estimateMultipliers(cost_gradient, columns, cost / std::max(constraint_count_, 1));
+  LevelDuals d;
+  d.steps = np_.steps();
+  std::size_t i = 0;
+  for (const ConstraintGroup& g : groups_) {
+    d.first_k.push_back(g.first_k);
+    d.z.emplace_back(e.z.begin() + i, e.z.begin() + i + g.at.size());
+    d.s.emplace_back(e.s.begin() + i, e.s.begin() + i + g.at.size());
+    i += g.at.size();
+  }
+  return d;
 }
 
 /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal

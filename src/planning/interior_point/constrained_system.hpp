@@ -131,6 +131,10 @@ class ConstrainedSystem {
   LevelDuals duals() const;
   /// FreeSlacks from a coarser level's duals (nearest in time); returns mean(s z).
   double warmStartDuals(const LevelDuals& coarse);
+  /// The duals of a start from a plan that carries none (an initial guess of this N), in the form
+  /// warmStartDuals takes them: re-derived from stationarity at the current iterate
+  /// (multiplier_estimate.hpp). Evaluates the constraints' values and gradients.
+  LevelDuals estimatedDuals();
   /// Initial multipliers: the primal ones μ/s, capped at `cap`.
   void initializeMultipliers(double mu, double rho, double cap);
 

@@ -505,7 +505,11 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
   // The initial guess: the warm start (the unconstrained optimum), a coarser grid's solution,
   // else the geodesic.
   if (options.warm_start) np.setInteriorFromAttitudes(options.warm_start->attitude);
-  if (request.coarse_steps) np.initializeFromCoarser(*request.coarse_steps);
+  if (request.coarse_steps && static_cast<int>(request.coarse_steps->size()) == problem.steps) {
+    np.setCurrent(*request.coarse_steps);  // an initial guess's own steps (same N)
+  } else if (request.coarse_steps) {
+    np.initializeFromCoarser(*request.coarse_steps);
+  }
   const std::string fixed = fixedNodeViolation(problem, np);
   if (!fixed.empty()) {
     out.result.termination = Termination::Infeasible;

@@ -387,13 +387,40 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
 
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
                                            const SolverOptions& options) {
-  // The guess's attitudes start every grid level (as the minimum-time search's warm starts do);
-  // the multipliers are re-started from the barrier (multiplier_estimate.hpp can re-derive
-  // them by least squares, but is not wired into the refactored interior point yet).
+  // The guess (a plan of this N, e.g. the remainder of the plan being flown) starts the
+  // requested grid directly, as a converged coarser level starts a finer one: its steps, its
+  // multipliers re-derived from stationarity (the guess carries none) and a small barrier.
+  LevelDuals duals;
+  ReducedProblem::Steps steps;
+  try {
+    ReducedProblem np(problem);
+    np.setInteriorFromAttitudes(options.warm_start->attitude);
+    const InteriorPointParameters parameters;
+    duals = ConstrainedSystem(problem, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
+    steps = np.current();
+  } catch (const StepTooLarge&) {
+    return solveWithInteriorPoint(problem, options);  // reports it
+  }
+  SolveContext context(options);
+  const InteriorPointParameters parameters;
+  const Solve solve{parameters, context};
   SolverOptions from = options;
-  from.constrained_from_warm_start = true;
-  PlanResult result = solveWithInteriorPoint(problem, from);
-  result.message += "; from the initial guess";
+  from.warm_start = nullptr;  // the guess's steps start the grid
+  from.constrained_from_warm_start = false;
+  GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
+  Attempt a;
+  a.stage = AttemptStage::Constrained;
+  a.start = AttemptStart::WarmStart;
+  a.formulation = outcome.formulation;
+  a.homotopy = {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
+  a.steps = problem.steps;
+  a.termination = outcome.result.termination;
+  a.iterations = outcome.result.iterations;
+  if (!outcome.result.maneuver.torque.empty()) a.cost = outcome.result.cost;
+  recordTrail(context, {a}, 0);
+  PlanResult result = std::move(outcome.result);
+  result.attempts = context.attempts();
+  result.message += "; from the initial guess, its multipliers re-derived";
   return result;
 }
 

@@ -63,6 +63,20 @@ Eigen::VectorXd leastSquares(const Eigen::VectorXd& cost_gradient,
   return z.allFinite() ? z : Eigen::VectorXd::Zero(m);
 }
 
+/// One column's slack and multiplier on the central path s z = μ: an active column keeps its
+/// multiplier (slack μ/z, at most kNearActiveValue: a weakly active one, z ≈ 0, starts off the
+/// degenerate corner s = z = 0, from which Newton's steps on s z = μ only halve the gap), an
+/// inactive one its value as slack; never a slack below the value.
+void centerPair(double value, bool active, double mu, double* s, double* z) {
+  if (active) {
+    *s = std::min(mu / std::max(*z, mu / kNearActiveValue), kNearActiveValue);
+  } else {
+    *s = value > kNearActiveValue ? value : kNearActiveValue;
+  }
+  *s = std::max(*s, value);
+  *z = mu / *s;
+}
+
 }  // namespace
 
 MultiplierEstimate estimateMultipliers(const Eigen::VectorXd& cost_gradient,
@@ -105,13 +119,10 @@ MultiplierEstimate estimateMultipliers(const Eigen::VectorXd& cost_gradient,
     sum += out.z[i];
   }
   out.active = static_cast<int>(set.size());
-  const double mu = kEstimateComplementarity *
-                    (set.empty() ? fallback_scale : sum / static_cast<double>(set.size()));
-  for (int i = 0; i < count; ++i) {
-    if (active[i]) continue;  // binding: slack 0
-    out.z[i] = mu / std::max(columns[i].value, kNearActiveValue);
-    out.s[i] = std::max(columns[i].value, 0.0);
-  }
+  out.complementarity = kEstimateComplementarity *
+                        (set.empty() ? fallback_scale : sum / static_cast<double>(set.size()));
+  for (int i = 0; i < count; ++i)
+    centerPair(columns[i].value, active[i], out.complementarity, &out.s[i], &out.z[i]);
   return out;
 }
 

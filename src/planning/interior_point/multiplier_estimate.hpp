@@ -30,15 +30,18 @@ constexpr double kNearActiveValue = 1e-3;
 /// this start.
 constexpr double kEstimateComplementarity = 1e-6;
 
-/// The multipliers z ≥ 0 (one per column) and slacks of a start: the near-active columns
-/// (value ≤ kNearActiveValue) take the nonnegative least-squares solution of the stationarity
-/// condition ∇f = Σ z_i ∇c_i (active-set passes dropping negative ones; a 1e-10 relative ridge
-/// keeps dependent columns determined) and slack 0 (binding: the interior point starts them a
-/// hair inside, as it does a finer level's); the others z = μ/c, μ = kEstimateComplementarity ×
-/// the mean active multiplier (× `fallback_scale` when none is active), and slack c. O(columns).
+/// The multipliers z ≥ 0 (one per column) and slacks of a start, centered on one
+/// complementarity s_i z_i = μ: the near-active columns (value ≤ kNearActiveValue) take the
+/// nonnegative least-squares solution of the stationarity condition ∇f = Σ z_i ∇c_i (active-set
+/// passes dropping negative ones; a 1e-10 relative ridge keeps dependent columns determined) and
+/// slack μ/z_i (capped at kNearActiveValue); the others slack max(c, kNearActiveValue) and z = μ/s;
+/// μ = kEstimateComplementarity × the mean active multiplier (× `fallback_scale` when none is
+/// active): a strongly active column starts at the slack a finer grid level's binding one does.
+/// O(columns).
 struct MultiplierEstimate {
   std::vector<double> z, s;
-  int active = 0;  ///< columns taken as active
+  int active = 0;                ///< columns taken as active
+  double complementarity = 0.0;  ///< μ = s_i z_i of every column
 };
 MultiplierEstimate estimateMultipliers(const Eigen::VectorXd& cost_gradient,
                                        const std::vector<StationarityColumn>& columns,

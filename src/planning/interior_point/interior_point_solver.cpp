@@ -293,11 +293,9 @@ AttemptStart startOf(const SolverOptions& options) {
                                              : AttemptStart::UnconstrainedOptimum;
 }
 
-/// Runs one continuation and appends it to `trail` as an attempt (not kept).
-GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options,
-                    const Solve& solve, AttemptStage stage, AttemptStart start,
-                    std::vector<Attempt>* trail) {
-  GridOutcome outcome = solveContinued(problem, options, solve);
+/// The trail's entry for one solve of `problem` (not kept).
+Attempt attemptOf(const PlanningProblem& problem, const GridOutcome& outcome, AttemptStage stage,
+                  AttemptStart start) {
   Attempt a;
   a.stage = stage;
   a.start = start;
@@ -307,7 +305,15 @@ GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options
   a.termination = outcome.result.termination;
   a.iterations = outcome.result.iterations;
   if (!outcome.result.maneuver.torque.empty()) a.cost = outcome.result.cost;
-  trail->push_back(a);
+  return a;
+}
+
+/// Runs one continuation and appends it to `trail` as an attempt (not kept).
+GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options,
+                    const Solve& solve, AttemptStage stage, AttemptStart start,
+                    std::vector<Attempt>* trail) {
+  GridOutcome outcome = solveContinued(problem, options, solve);
+  trail->push_back(attemptOf(problem, outcome, stage, start));
   return outcome;
 }
 
@@ -408,16 +414,8 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   from.warm_start = nullptr;  // the guess's steps start the grid
   from.constrained_from_warm_start = false;
   GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
-  Attempt a;
-  a.stage = AttemptStage::Constrained;
-  a.start = AttemptStart::WarmStart;
-  a.formulation = outcome.formulation;
-  a.homotopy = {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
-  a.steps = problem.steps;
-  a.termination = outcome.result.termination;
-  a.iterations = outcome.result.iterations;
-  if (!outcome.result.maneuver.torque.empty()) a.cost = outcome.result.cost;
-  recordTrail(context, {a}, 0);
+  recordTrail(context,
+              {attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart)}, 0);
   PlanResult result = std::move(outcome.result);
   result.attempts = context.attempts();
   result.message += "; from the initial guess, its multipliers re-derived";

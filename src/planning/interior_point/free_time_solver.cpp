@@ -458,6 +458,9 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
 }  // namespace
 
 std::string freeTimeUnsupported(const PlanningProblem& problem) {
+  if (problem.scheme == SchemeKind::FourthOrder) {
+    return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
+  }
   if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
   for (const PlanningConstraint& c : problem.constraints) {
     if (c.kind == ConstraintKind::MaxAngularRate) return "constraints: max_angular_rate";

@@ -34,7 +34,8 @@ struct FreeTimeOutcome {
 };
 
 /// Why `problem` cannot be solved free-time here (empty: it can): rate limits, pointing cones
-/// and effects are not written in h yet (minimum_time.cpp falls back to the search).
+/// and effects are not written in h yet, fourth_order has no single transcription
+/// (minimum_time.cpp falls back to the search).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and

@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -63,7 +64,9 @@ constexpr int kMaxHalvings = 40;
 constexpr double kFirstShift = 1e-10;
 constexpr double kShiftGrowth = 100.0;
 constexpr double kMaxShift = 1e10;
-constexpr int kHalfBandwidth = 8;  ///< the reduced problem's Hessian band
+constexpr int kHalfBandwidth = 8;
+/// Above this N the stationarity tolerance grows like N² (round-off of second differences).
+constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 /// Most constraints on one torque: 6 box sides and one norm bound.
 constexpr int kMaxPerTorque = 7;
 
@@ -103,7 +106,7 @@ class FreeTimeSolver {
     return false;
   }
 
-  FreeTimeOutcome run(double tolerance, int max_iterations);
+  FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options);
 
  private:
   int constraintCount() const { return per_torque_ * (last_k_ - first_k_ + 1); }
@@ -380,12 +383,18 @@ double FreeTimeSolver::barrierResidual(double mu) const {
   return worst;
 }
 
-FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations) {
+FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
+                                    const SolverOptions* options) {
+  const auto started = std::chrono::steady_clock::now();
   const int m = constraintCount();
   const double mu0 = kInitialBarrier / m;
   const double mu_final = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
   const double C0 = np_.cost(np_.current());
   const double epsilon0 = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
+  // Torques are second differences of the attitudes: their round-off, and so the stationarity's
+  // floor, grows like N² (measured: 2e-10 at N = 512, above 1e-9 at 1024).
+  const double stationarity_tolerance =
+      tolerance * std::max(1.0, std::pow(static_cast<double>(N_) / kRoundOffSteps, 2));
   double mu = mu0;
   initializeDuals(mu);
   int iterations = 0;
@@ -396,12 +405,18 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations) {
     for (const auto& row : at_)
       for (int i = 0; i < per_torque_; ++i) gap += row[i].z * row[i].c;
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-    if (mu <= mu_final && stationarity <= tolerance && gap <= tolerance) {
+    if (mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
       return outcome(Termination::Converged, "converged", iterations, epsilon);
     }
     if (mu > mu_final && barrierResidual(mu) <= kBarrierSolved * mu) {
       mu = std::max(mu_final, std::min(kBarrierLinear * mu, std::pow(mu, kBarrierSuperlinear)));
       continue;  // the same iterate for the next barrier problem (not an iteration)
+    }
+    if (options && options->cancel_requested && options->cancel_requested->load()) {
+      return outcome(Termination::Cancelled, "cancelled", iterations, epsilon);
+    }
+    if (options && budgetSpent(withRemainingBudget(*options, started))) {
+      return outcome(Termination::TimedOut, "out of time", iterations, epsilon);
     }
     if (iterations >= max_iterations) {
       return outcome(Termination::NotConverged, "iteration limit", iterations, epsilon);
@@ -409,7 +424,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations) {
     Eigen::VectorXd d;
     double alpha = 0.0;
     if (!solveStep(&d) || !lineSearch(d, mu, epsilon, &alpha)) {
-      if (stationarity <= 100 * tolerance && gap <= 100 * tolerance) {
+      if (stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
         return outcome(Termination::Converged, "converged to the round-off floor", iterations,
                        epsilon);
       }
@@ -470,7 +485,8 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
 }
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations) {
+                              double start_duration, double tolerance, int max_iterations,
+                              const SolverOptions* options) {
   PlanningProblem at = problem;
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -485,7 +501,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
                        " times the start's duration";
       return failed;
     }
-    return solver.run(tolerance, max_iterations);
+    return solver.run(tolerance, max_iterations, options);
   } catch (const StepTooLarge& e) {
     failed.message = std::string("the boundary rates admit no step: ") + e.what();
     return failed;

@@ -41,9 +41,12 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
 /// R_N the problem's) at T = start_duration, raised until every constraint holds strictly (the
 /// iterates stay strictly feasible). Boundary rates are held at every h. Ends Converged at a KKT
-/// point of the discrete minimum-time problem (residuals within `tolerance`), NotConverged at
-/// the iteration limit or a failed line search (its last iterate still feasible).
+/// point of the discrete minimum-time problem (complementarity within `tolerance`, stationarity
+/// within it × max(1, (N/256)²): round-off), NotConverged at the iteration limit or a failed line
+/// search (its last iterate still feasible), Cancelled or TimedOut when `options` (may be null)
+/// asks: its cancel flag and time budget are polled every iteration.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations);
+                              double start_duration, double tolerance, int max_iterations,
+                              const SolverOptions* options = nullptr);
 
 }  // namespace attitude_planner

@@ -13,6 +13,11 @@
 //                 with the scene's node constraints too (per-axis torque limits as variable bounds,
 //                 max_torque_norm, max_angular_rate, keep_out, keep_in as exact constraint rows)
 //   ipopt_lbfgs   the same, with IPOPT's limited-memory (L-BFGS) Hessian instead (for comparison)
+//   free_time     minimum time, ours: ONE free-time interior-point solve (free_time_solver.hpp)
+//                 from ipopt_free_time's start, the scheme paper (its own JSON line too)
+//   ipopt_free_time  minimum time: the same transcription with h an unknown, objective N h, from
+//                 the eigenaxis slew with an excursion (L-BFGS Hessian; one JSON line of its own:
+//                 time_s, minimum_duration, status; docs/results/minimum_time.md's peer row)
 //   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
 //                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
 //                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
@@ -44,10 +49,11 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
-#include "planning/transcription/direct_method.hpp"
-#include "planning/transcription/reduced_problem.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/transcription/direct_method.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 #include "support/random_problems.hpp"
 #include "support/study_tools.hpp"
 
@@ -259,7 +265,8 @@ namespace {
 using attitude_planner::study::median;
 
 const char* const kUsage =
-    "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step\n"
+    "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step|\n"
+    "                                  free_time|ipopt_free_time (minimum time, own JSON line)\n"
     "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
     "                         [--time-budget S] [--in-process K]\n"
     "                         [--start geodesic|unconstrained|ours]  the peers' start (ipopt):\n"
@@ -702,7 +709,7 @@ class TranscriptionNlp : public Ipopt::TNLP {
     for (int k = 1; k <= N_ - 1; ++k) torque[k] = Eigen::Map<const Vector3>(x + T(k));
   }
 
- private:
+ protected:
   /// Ω_k: unknown for k = 1..N−2, boundary data for k = 0 and N−1.
   Vector3 omega(const double* x, int k) const {
     if (k == 0) return p_.initial_velocity;
@@ -760,9 +767,10 @@ class TranscriptionNlp : public Ipopt::TNLP {
     }
   }
 
+ protected:
   ap::PlanningProblem p_;
   int N_;
-  double h_;
+  double h_;  ///< fixed here; FreeTimeNlp's last unknown
   bool exact_hessian_;
   std::vector<Vector3> start_;
   Quaternion q0_, qN_;
@@ -810,6 +818,192 @@ PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, b
   out.iterations = nlp->iterations;
   out.torque = nlp->torque;
   return out;
+}
+
+/// The same transcription with the time step h as one more unknown (the last) and the objective
+/// T = N h: the free-T discrete problem of minimum time (paper scheme, node constraints as
+/// above), for the minimum-time peer row (docs/results/minimum_time.md). Its Jacobian adds the
+/// h column, ∂/∂h of the kinematics (−q_k ⊗ ∂e(hΩ_k)/∂h) and of the dynamics
+/// (∂(exp(hΩ_k^) J Ω_k)/∂h − τ_k), by forward-mode duals; the Hessian is IPOPT's L-BFGS
+/// approximation (the exact one would need the h rows and columns of every block).
+class FreeTimeNlp : public TranscriptionNlp {
+ public:
+  FreeTimeNlp(const ap::PlanningProblem& p, std::vector<Vector3> start)
+      : TranscriptionNlp(p, false, std::move(start)) {}
+  int H() const { return n(); }  ///< the index of h
+  double time_step = 0.0;        ///< h at the end
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    TranscriptionNlp::get_nlp_info(n, m, nnz_jac, nnz_h, style);
+    base_nnz_ = nnz_jac;
+    n += 1;
+    nnz_jac += 4 * N_ + 3 * (N_ - 1);  // the h column: kinematics and dynamics rows
+    nnz_h = 0;
+    return true;
+  }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
+                       Ipopt::Number* gl, Ipopt::Number* gu) override {
+    TranscriptionNlp::get_bounds_info(n, xl, xu, m, gl, gu);
+    xl[H()] = 1e-3 * h_, xu[H()] = 1e3 * h_;
+    return true;
+  }
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
+                          Ipopt::Number* zl, Ipopt::Number* zu, Ipopt::Index m, bool init_l,
+                          Ipopt::Number* l) override {
+    TranscriptionNlp::get_starting_point(n, init_x, x, init_z, zl, zu, m, init_l, l);
+    x[H()] = h_;
+    return true;
+  }
+  bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    f = N_ * x[H()];
+    return true;
+  }
+  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number*, bool, Ipopt::Number* g) override {
+    for (int i = 0; i < n; ++i) g[i] = 0.0;
+    g[H()] = N_;
+    return true;
+  }
+  bool eval_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Index m,
+              Ipopt::Number* g) override {
+    h_ = x[H()];
+    return TranscriptionNlp::eval_g(n, x, new_x, m, g);
+  }
+  bool eval_jac_g(Ipopt::Index n, const Ipopt::Number* x, bool new_x, Ipopt::Index m,
+                  Ipopt::Index nele, Ipopt::Index* iRow, Ipopt::Index* jCol,
+                  Ipopt::Number* values) override {
+    if (!values) {
+      TranscriptionNlp::eval_jac_g(n, x, new_x, m, base_nnz_, iRow, jCol, values);
+      for (int r = 0; r < 4 * N_ + 3 * (N_ - 1); ++r) {
+        iRow[base_nnz_ + r] = r;
+        jCol[base_nnz_ + r] = H();
+      }
+      return true;
+    }
+    h_ = x[H()];
+    TranscriptionNlp::eval_jac_g(n, x, new_x, m, base_nnz_, iRow, jCol, values);
+    using Dual1 = ap::Dual<1>;
+    const Dual1 h(h_, 0);
+    double* column = values + base_nnz_;
+    for (int k = 0; k < N_; ++k) {
+      const Vector3 w = omega(x, k);
+      ap::so3::Vec3<Dual1> v;
+      for (int i = 0; i < 3; ++i) v(i) = h * w(i);
+      const Eigen::Matrix<Dual1, 4, 1> e = ap::so3::quaternionOfRotationVector<Dual1>(v);
+      Quaternion de;
+      for (int r = 0; r < 4; ++r) de(r) = e(r).d(0);
+      const Quaternion qk = k == 0 ? q0_ : Quaternion(Eigen::Map<const Quaternion>(x + Q(k)));
+      const Quaternion d = -ap::so3::quaternionProduct<double>(qk, de);
+      for (int r = 0; r < 4; ++r) column[4 * k + r] = d(r);
+    }
+    const Matrix3& J = p_.inertia;
+    for (int k = 1; k <= N_ - 1; ++k) {
+      const Vector3 w = omega(x, k);
+      ap::so3::Vec3<Dual1> v;
+      for (int i = 0; i < 3; ++i) v(i) = h * w(i);
+      const ap::so3::Vec3<Dual1> f = ap::so3::exp<Dual1>(v) * (J * w).cast<Dual1>();
+      const Vector3 tau(Eigen::Map<const Vector3>(x + T(k)));
+      for (int r = 0; r < 3; ++r) column[4 * N_ + 3 * (k - 1) + r] = f(r).d(0) - tau(r);
+    }
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number* zl, const Ipopt::Number* zu, Ipopt::Index m,
+                         const Ipopt::Number* g, const Ipopt::Number* l, Ipopt::Number f,
+                         const Ipopt::IpoptData* data,
+                         Ipopt::IpoptCalculatedQuantities* q) override {
+    TranscriptionNlp::finalize_solution(status, n, x, zl, zu, m, g, l, f, data, q);
+    time_step = x[H()];
+  }
+
+ private:
+  Ipopt::Index base_nnz_ = 0;
+};
+
+/// The eigenaxis bang–bang slew at the least T its per-axis bounds allow (rest to rest, about a
+/// principal axis: no gyroscopic torque), with a 0.3 rad sin² excursion about the diagonal of
+/// the two body axes most perpendicular to the eigenaxis — the start that reaches the published
+/// optima in ours (minimum_time.cpp's structured starts). Sets problem->duration to that T.
+std::vector<Vector3> excursionStart(ap::PlanningProblem* problem) {
+  const Vector3 rotation =
+      ap::so3::log(Matrix3(problem->initial_attitude.transpose() * problem->final_attitude));
+  const double angle = rotation.norm();
+  const Vector3 e = rotation / angle;
+  const Vector3 Je = (problem->inertia * e).cwiseAbs();
+  const double T = std::sqrt(4 * angle * (Je.array() / problem->max_torque.array()).maxCoeff());
+  problem->duration = T;
+  std::vector<Vector3> projected;
+  for (int a = 0; a < 3; ++a) {
+    const Vector3 p = Vector3::Unit(a) - e * e(a);
+    if (p.norm() > 0.3) projected.push_back(p.normalized());
+  }
+  const Vector3 off = projected.size() >= 2 ? Vector3((projected[0] + projected[1]).normalized())
+                                            : e.unitOrthogonal();
+  std::vector<Matrix3> R;
+  const int N = problem->steps;
+  for (int k = 0; k <= N; ++k) {
+    const double s = static_cast<double>(k) / N;
+    const double theta = s <= 0.5 ? 2 * angle * s * s : angle * (1 - 2 * (1 - s) * (1 - s));
+    R.push_back(problem->initial_attitude * ap::so3::exp(Vector3(theta * e)) *
+                ap::so3::exp(Vector3(0.3 * std::pow(std::sin(M_PI * s), 2) * off)));
+  }
+  std::vector<Vector3> w;
+  for (int k = 0; k < N; ++k) w.push_back(ap::so3::log(Matrix3(R[k].transpose() * R[k + 1])));
+  return w;
+}
+
+/// --solver free_time: ours, ONE free-time interior-point solve from excursionStart (the same
+/// start and scheme as ipopt_free_time; planMinimumTime runs several starts and a polish).
+int solveOursFreeTime(ap::PlanningProblem problem) {
+  problem.objective = ap::Objective::MinimumEffort;
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Vector3> steps = excursionStart(&problem);
+  std::vector<Matrix3> R{problem.initial_attitude};
+  for (const Vector3& w : steps) R.push_back(R.back() * ap::so3::exp(w));
+  const ap::FreeTimeOutcome o = ap::solveFreeTime(problem, R, problem.duration, 1e-9, 500);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "{\"solver\": \"free_time\", \"scheme\": \"%s\", \"steps\": %d, \"time_s\": %.6g, "
+      "\"minimum_duration\": %.10g, \"status\": \"%s\", \"iterations\": %d}\n",
+      ap::schemeName(problem.scheme).c_str(), problem.steps, seconds, o.duration,
+      ap::terminationName(o.termination).c_str(), o.iterations);
+  return o.termination == ap::Termination::Converged ? 0 : 1;
+}
+
+/// --solver ipopt_free_time: IPOPT on the free-T problem from excursionStart, the scheme paper.
+/// Prints one JSON line: time_s, minimum_duration (N h at the end), status, iterations.
+int solveIpoptFreeTime(ap::PlanningProblem problem, double time_budget) {
+  problem.scheme = ap::SchemeKind::Paper;
+  problem.objective = ap::Objective::MinimumEffort;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Vector3> steps = excursionStart(&problem);
+  Ipopt::SmartPtr<FreeTimeNlp> nlp = new FreeTimeNlp(problem, std::move(steps));
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->Options()->SetIntegerValue("print_level", 0);
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetNumericValue("tol", 1e-9);
+  app->Options()->SetIntegerValue("max_iter", 5000);
+  app->Options()->SetNumericValue("max_cpu_time", time_budget);
+  app->Options()->SetNumericValue("bound_relax_factor", 0.0);
+  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+    std::cerr << "IPOPT initialization failed\n";
+    return 1;
+  }
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(nlp);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "{\"solver\": \"ipopt_free_time\", \"scheme\": \"paper\", \"steps\": %d, \"time_s\": %.6g, "
+      "\"minimum_duration\": %.10g, \"status\": \"%s\", \"iterations\": %d}\n",
+      problem.steps, seconds, problem.steps * nlp->time_step,
+      status == Ipopt::Solve_Succeeded ? "optimal"
+      : status == Ipopt::Solved_To_Acceptable_Level
+          ? "acceptable"
+          : ("status " + std::to_string(static_cast<int>(status))).c_str(),
+      nlp->iterations);
+  return status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level ? 0 : 1;
 }
 
 /// --check-hessian: eval_h against central differences of ∇L = σ∇f + Jᵀλ (both from the exact
@@ -1617,6 +1811,16 @@ int main(int argc, char** argv) {
         scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
     if (steps > 0) problem.steps = steps;
     if (!scheme.empty()) problem.scheme = ap::parseScheme(scheme, "--scheme");
+    if (solver == "free_time" || solver == "ipopt_free_time") {
+#ifdef AP_HAVE_IPOPT  // the two share the peer's start (excursionStart)
+      if (solver == "ipopt_free_time") return solveIpoptFreeTime(problem, time_budget);
+      problem.scheme = ap::SchemeKind::Paper;
+      return solveOursFreeTime(problem);
+#else
+      std::cerr << "benchmark_solvers: " << solver << ": this build has no IPOPT\n";
+      return 3;
+#endif
+    }
     Measurement m = run(solver, problem, time_budget, peer_start);
     if (in_process > 1) {
       // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):

@@ -112,6 +112,11 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"duration\": " << jsonNumber(r.duration > 0 ? r.duration : problem.duration) << ",\n"
       << "  \"objective\": " << jsonString(objectiveName(problem.objective)) << ",\n"
       << "  \"minimum_duration\": " << jsonNumber(r.minimum_duration) << ",\n"
+      << "  \"minimum_time\": {\"kkt_point\": " << (r.minimum_time.kkt_point ? "true" : "false")
+      << ", \"stationarity\": " << jsonNumber(r.minimum_time.stationarity)
+      << ", \"time_stationarity\": " << jsonNumber(r.minimum_time.time_stationarity)
+      << ", \"complementarity\": " << jsonNumber(r.minimum_time.complementarity)
+      << ", \"solves\": " << r.minimum_time.solves << "},\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"

@@ -1,25 +1,26 @@
 // Minimum-time slews (objective minimum_time): the least duration T* at which the torque bounds
 // and constraints in force admit a plan, and the plan at T* (bang–bang) or at (1 + m)·T*.
 //
-// Method: searches on T over minimum-effort problems with the same N and constraints, each solve
-// by the interior-point solver (plan_at_resolution.hpp) warm-started from the last feasible plan
-// of its search: from a first T down in steps of 5 % while feasible; the search with the least
-// feasible T then bisects its last step to a relative width of kMinimumTimeTolerance. A solve that
-// does not converge counts as infeasible at that T. Minimum-time problems have several local
-// optima, so there are several starts: the minimum-effort continuation from the problem's
-// duration (or an eigenaxis guess, doubled until feasible) and, rest to rest, the eigenaxis
-// bang–bang slew and excursions off it (two sizes, ±two perpendicular axes, first solved just
-// above and just below the eigenaxis T). Above N = 64 the starts are searched on the grid with
-// half the steps and its T* plan starts the search here. The message names the start that won
-// and every start's T. T* is the least duration found feasible: an upper bound on the true
-// minimum (docs/results/minimum_time.md: Betts's published T* reached to 0.05 %, Bilimoria–Wie's to 2 %).
+// Method (src/planning/drivers/minimum_time.cpp): minimum time as ONE interior-point problem per
+// start, the time step h (T = N h) an unknown next to the node unknowns, objective T, the torque
+// bounds as constraints (src/planning/interior_point/free_time_solver.hpp). Starts, rest to rest:
+// the eigenaxis bang–bang slew at its closed-form T and excursions off it about the body axes'
+// parts perpendicular to the eigenaxis and their diagonals (body-fixed: the same in every world
+// frame); otherwise the geodesic. Above N = 64 the starts run on N = 64 and the best is refined
+// once on N. The least T is kept and polished (the minimum-effort plan at T* from it, for the
+// switching functions). T* is a KKT point of the discrete minimum-time problem, its residuals in
+// PlanResult::minimum_time. Rate limits, cones, fourth_order and effects are not written in h
+// yet: for them (or if no free-time solve converges) the former search answers — several starts,
+// each a continuation down in T over minimum-effort solves warm-started from the last feasible
+// plan and a bisection to kMinimumTimeTolerance; its T* is the least duration found feasible, an
+// upper bound (minimum_time.kkt_point false). docs/results/minimum_time.md has the figures.
 #pragma once
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 
 namespace attitude_planner {
 
-/// Relative width of the final bracket on T*.
+/// Relative width of the search's final bracket on T* (the fallback).
 constexpr double kMinimumTimeTolerance = 1e-9;
 
 /// The minimum-time plan of `problem` (objective minimum_time). Throws InvalidInput naming the
@@ -37,7 +38,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options);
 
 /// A duration at which an eigenaxis bang–bang slew would need the smallest authority of the
-/// bounds in force (the search's first guess when the problem gives none) [s].
+/// bounds in force (the first guess when the problem gives none) [s].
 double eigenaxisDurationGuess(const PlanningProblem& problem);
 
 }  // namespace attitude_planner

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "attitude_planner/name_table.hpp"
-#include "attitude_planner/termination.hpp"
 #include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/termination.hpp"
 
 namespace attitude_planner {
 
@@ -34,6 +34,8 @@ enum class AttemptStage {
   FourthOrderFine,    ///< fourth_order: the 2N solve of its Richardson pair
   MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
   MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
+  MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
+  MinimumTimePolish,  ///< minimum_time: the minimum-effort plan at T* from the free-time plan
 };
 inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::Solve, "solve"},
@@ -47,6 +49,8 @@ inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::FourthOrderFine, "fourth_order_fine"},
     {AttemptStage::MinimumTimeProbe, "minimum_time_probe"},
     {AttemptStage::MinimumTimeMargin, "minimum_time_margin"},
+    {AttemptStage::MinimumTimeSolve, "minimum_time_solve"},
+    {AttemptStage::MinimumTimePolish, "minimum_time_polish"},
 };
 
 /// Where an attempt's iterate started.
@@ -58,6 +62,8 @@ enum class AttemptStart {
   InertiaHomotopy,  ///< an extremal of the sphere J̄ = tr(J)/3·I carried to J in stages
   UnconstrainedOptimum,  ///< the unconstrained optimum (the interior point's start)
   PreviousAttempt,       ///< the plan of the attempt before it (staged continuations, retries)
+  EigenaxisSlew,         ///< minimum_time: the eigenaxis bang–bang slew at its closed-form T
+  Excursion,             ///< minimum_time: the eigenaxis slew with an excursion off its axis
 };
 inline constexpr NamedValue<AttemptStart> kAttemptStartNames[] = {
     {AttemptStart::Hermite, "hermite"},
@@ -67,6 +73,8 @@ inline constexpr NamedValue<AttemptStart> kAttemptStartNames[] = {
     {AttemptStart::InertiaHomotopy, "inertia_homotopy"},
     {AttemptStart::UnconstrainedOptimum, "unconstrained_optimum"},
     {AttemptStart::PreviousAttempt, "previous_attempt"},
+    {AttemptStart::EigenaxisSlew, "eigenaxis_slew"},
+    {AttemptStart::Excursion, "excursion"},
 };
 
 /// How the problem was posed to the solver of an attempt.
@@ -140,6 +148,18 @@ std::string globalizationName(Globalization globalization);
 /// then the others' costs: the one place the structure becomes prose.
 std::string describeExtremal(const ExtremalSummary& extremal);
 
+/// minimum_time: how T* was found. A KKT point: one free-time interior-point solve (T = N h an
+/// unknown, src/planning/interior_point/free_time_solver.hpp) ended with these residuals of the
+/// discrete minimum-time problem (unknowns δ and η = h/h₀, objective T/T₀); else T* is the least
+/// duration a search over minimum-effort solves found feasible (an upper bound).
+struct MinimumTimeCertificate {
+  bool kkt_point = false;
+  double stationarity = 0.0;       ///< max-norm of ∇(T/T₀) − Σ zᵢ∇cᵢ over (δ, η)
+  double time_stationarity = 0.0;  ///< its η row alone
+  double complementarity = 0.0;    ///< Σ zᵢcᵢ (the duality gap, relative to T₀)
+  int solves = 0;                  ///< free-time solves run (one per start)
+};
+
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
 /// and the figures that judge it.
 struct PlanResult {
@@ -158,6 +178,8 @@ struct PlanResult {
   double duration = 0.0;  ///< T [s] of the returned plan (minimum_time: chosen by the planner)
   /// T* [s]: the least duration found feasible (objective minimum_time; else 0).
   double minimum_duration = 0.0;
+  /// minimum_time: what backs T* (the free-time interior point's KKT residuals, or the search).
+  MinimumTimeCertificate minimum_time;
   /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
   /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½; fourth_order:
   /// Gregory's end-corrected weights, schemeTorqueWeight).

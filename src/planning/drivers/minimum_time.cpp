@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
@@ -395,6 +396,277 @@ class MinimumTimeSearch {
   int solves_ = 0;
 };
 
+/// The free-time solves' tolerance on the KKT residuals (objective T/T₀, constraints
+/// dimensionless): the duality gap Σ zc bounds T − T* relative to T₀ by this much.
+constexpr double kFreeTimeTolerance = 1e-9;
+constexpr int kFreeTimeMaxIterations = 500;
+/// The excursion starts: their size [rad] and first T relative to the eigenaxis slew's.
+constexpr double kFreeTimeExcursion = 0.3;
+constexpr double kFreeTimeStartFactor = 0.96;
+/// A body axis whose part perpendicular to the eigenaxis is shorter than this gives no start.
+constexpr double kSmallestProjection = 0.3;
+/// Two excursion axes closer than this (cosine) are one start.
+constexpr double kSameAxis = 0.99;
+/// The starts run on the coarsest of N, N/2, ... at or above this N; the best is refined up.
+constexpr int kFreeTimeStartGrid = 64;
+
+/// One start of the free-time solve.
+struct FreeTimeStart {
+  std::string name;
+  AttemptStart kind;
+  std::vector<Matrix3> attitudes;  ///< empty: the reduced problem's own start (the geodesic)
+  double duration;
+};
+
+/// The axes ⟂ ê the excursions turn about: the body axes' parts perpendicular to the eigenaxis
+/// and their normalized sums and differences (the box bounds act on body axes, so the nutating
+/// optima turn about them and their diagonals: measured, Bilimoria–Wie reaches its published T*
+/// only from a diagonal, Betts's from the diagonals of y and z). Body-fixed: the same in every
+/// world frame.
+std::vector<Vector3> excursionAxes(const Vector3& e) {
+  std::vector<Vector3> projected;
+  for (int a = 0; a < 3; ++a) {
+    const Vector3 p = Vector3::Unit(a) - e * e(a);
+    if (p.norm() > kSmallestProjection) projected.push_back(p.normalized());
+  }
+  std::vector<Vector3> axes = projected;
+  for (std::size_t i = 0; i < projected.size(); ++i) {
+    for (std::size_t j = i + 1; j < projected.size(); ++j) {
+      for (const double sign : {1.0, -1.0}) {
+        const Vector3 d = projected[i] + sign * projected[j];
+        if (d.norm() > kSmallestProjection) axes.push_back(d.normalized());
+      }
+    }
+  }
+  std::vector<Vector3> distinct;
+  for (const Vector3& a : axes) {
+    const bool seen = std::any_of(distinct.begin(), distinct.end(),
+                                  [&](const Vector3& b) { return a.dot(b) > kSameAxis; });
+    if (!seen) distinct.push_back(a);
+  }
+  return distinct;
+}
+
+std::string axisName(const Vector3& v) {
+  std::ostringstream out;
+  out << "[" << std::round(v.x() * 1000) / 1000 << ", " << std::round(v.y() * 1000) / 1000 << ", "
+      << std::round(v.z() * 1000) / 1000 << "]";
+  return out.str();
+}
+
+/// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
+/// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
+/// guess.
+std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest) {
+  if (!rest_to_rest) {
+    return {{"geodesic", AttemptStart::Hermite, {}, eigenaxisDurationGuess(problem)}};
+  }
+  const double T_eigenaxis = eigenaxisBangBangDuration(problem);
+  PlanningProblem at = problem;
+  at.duration = T_eigenaxis;
+  const Vector3 e =
+      so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
+  std::vector<FreeTimeStart> starts{
+      {"eigenaxis", AttemptStart::EigenaxisSlew, excursionSlew(at, e, 0.0).attitude, T_eigenaxis}};
+  for (const Vector3& axis : excursionAxes(e)) {
+    std::ostringstream name;
+    name << "excursion " << kFreeTimeExcursion << " rad about " << axisName(axis);
+    starts.push_back({name.str(), AttemptStart::Excursion,
+                      excursionSlew(at, axis, kFreeTimeExcursion).attitude,
+                      kFreeTimeStartFactor * T_eigenaxis});
+  }
+  return starts;
+}
+
+/// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
+/// free-time solve, the least T kept; the starts run on the coarsest of N, N/2, ... at or above
+/// kFreeTimeStartGrid and the best, resampled, is solved once on each finer grid. The answer is
+/// then polished: the minimum-effort plan at T* from the free-time plan (its multipliers give the
+/// switching functions). Empty if no solve converged (the caller falls back to the search).
+class FreeTimeMinimumTime {
+ public:
+  FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
+      : problem_(problem), options_(options), start_(std::chrono::steady_clock::now()) {}
+
+  std::optional<PlanResult> run() {
+    const bool rest_to_rest =
+        problem_.initial_velocity.isZero(0.0) && problem_.final_velocity.isZero(0.0) &&
+        so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
+    // The grids: N, N/2, ... down to the coarsest at or above kFreeTimeStartGrid (a refinement by
+    // 2 at a time: measured, a resampled N = 64 plan started N = 512 so far from its optimum that
+    // the solve slid to the eigenaxis slew's T).
+    std::vector<int> levels{problem_.steps};
+    while (levels.back() / 2 >= kFreeTimeStartGrid) levels.push_back(levels.back() / 2);
+    PlanningProblem grid = problem_;
+    grid.steps = levels.back();
+    const int best = solveStarts(grid, freeTimeStarts(grid, rest_to_rest));
+    if (best < 0) return std::nullopt;
+    FreeTimeOutcome answer = outcomes_[best];
+    std::string from = names_[best];
+    for (auto level = levels.rbegin() + 1; level != levels.rend(); ++level) {
+      grid.steps = *level;
+      const std::vector<Matrix3> resampled = resampleAttitudes(answer.maneuver, grid.steps);
+      answer = solve(grid, resampled, answer.duration, AttemptStart::CoarseLevel);
+      if (answer.termination != Termination::Converged) return std::nullopt;
+    }
+    if (levels.size() > 1) {
+      best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
+      from = "coarse grid (N = " + std::to_string(levels.back()) + ", " + names_[best] +
+             "), refined by 2 at a time";
+    }
+    return polished(answer, from);
+  }
+
+ private:
+  FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& attitudes,
+                        double duration, AttemptStart kind) {
+    const SolverOptions remaining = withRemainingBudget(options_, start_);
+    FreeTimeOutcome o = solveFreeTime(p, attitudes, duration, kFreeTimeTolerance,
+                                      kFreeTimeMaxIterations, &remaining);
+    Attempt a;
+    a.stage = AttemptStage::MinimumTimeSolve;
+    a.start = kind;
+    a.formulation = Formulation::FreeSlacks;
+    a.steps = p.steps;
+    a.termination = o.termination;
+    a.iterations = o.iterations;
+    a.cost = o.duration;  // the free-time objective: T [s]
+    trail_.push_back(a);
+    ++solves_;
+    return o;
+  }
+
+  /// Runs every start on `grid`; returns the index of the converged one with the least T (−1:
+  /// none converged).
+  int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
+    int best = -1;
+    for (const FreeTimeStart& st : starts) {
+      if (budgetSpent(withRemainingBudget(options_, start_))) break;
+      outcomes_.push_back(solve(grid, st.attitudes, st.duration, st.kind));
+      names_.push_back(st.name);
+      const FreeTimeOutcome& o = outcomes_.back();
+      if (o.termination == Termination::Converged &&
+          (best < 0 || o.duration < outcomes_[best].duration)) {
+        best = static_cast<int>(outcomes_.size()) - 1;
+        best_attempt_ = trail_.size() - 1;
+      }
+    }
+    return best;
+  }
+
+  /// The plan at T*: the minimum-effort plan at T* from the free-time plan if that proves T*
+  /// feasible (provesFeasible), else the free-time plan itself evaluated at T* by the same solve.
+  PlanResult polished(const FreeTimeOutcome& answer, const std::string& from) {
+    PlanningProblem effort = problem_;
+    effort.objective = Objective::MinimumEffort;
+    effort.time_margin = 0.0;
+    effort.duration = answer.duration;
+    SolverOptions o = withRemainingBudget(options_, start_);
+    o.warm_start = &answer.maneuver;
+    o.constrained_from_warm_start = true;
+    PlanResult result = planAtResolution(effort, o);
+    const std::vector<Attempt> polish_attempts = result.attempts;
+    const bool feasible = provesFeasible(effort, result);
+    // A polish that stops short of optimality with a plan meeting every constraint still gives
+    // the plan at T* (provesFeasible).
+    if (feasible) result.termination = Termination::Converged;
+    std::string polish_note;
+    if (!feasible) {
+      // At T* the feasible set is (nearly) the one bang–bang plan: the polish can stop short
+      // (measured at N ≥ 512); the free-time plan itself is the answer then.
+      polish_note = "; its minimum-effort polish at T* did not converge (" + result.message +
+                    "): the plan is the free-time solve's";
+      result = freeTimePlan(effort, answer);
+    }
+    for (Attempt a : polish_attempts) {
+      a.stage = AttemptStage::MinimumTimePolish;
+      a.kept = false;
+      trail_.push_back(a);
+    }
+    if (!trail_.empty()) trail_[best_attempt_].kept = true;
+    std::ostringstream note;
+    note << "minimum time T* = " << answer.duration
+         << " s: a KKT point of the discrete minimum-time problem (one free-time interior-point "
+            "solve from the "
+         << from << " start, " << answer.iterations << " iterations; stationarity "
+         << answer.stationarity << ", h row " << answer.time_row << ", complementarity "
+         << answer.complementarity << "; starts:";
+    for (std::size_t i = 0; i < outcomes_.size(); ++i) {
+      note << " " << names_[i] << " ";
+      if (outcomes_[i].termination == Termination::Converged) {
+        note << outcomes_[i].duration << " s;";
+      } else {
+        note << terminationName(outcomes_[i].termination) << ";";
+      }
+    }
+    note << " " << solves_ << " free-time solves)";
+    note << polish_note;
+    result.message = note.str();
+    result.minimum_duration = answer.duration;
+    result.minimum_time.kkt_point = true;
+    result.minimum_time.stationarity = answer.stationarity;
+    result.minimum_time.time_stationarity = answer.time_row;
+    result.minimum_time.complementarity = answer.complementarity;
+    result.minimum_time.solves = solves_;
+    result.attempts = trail_;
+    return result;
+  }
+
+  /// The free-time plan as the answer (at T*, measured as every plan is: evaluatePlan, the
+  /// replay, the constraint figures).
+  static PlanResult freeTimePlan(const PlanningProblem& effort, const FreeTimeOutcome& answer) {
+    PlanResult r;
+    r.solver = "interior_point";
+    r.termination = Termination::Converged;
+    r.iterations = answer.iterations;
+    evaluatePlan(effort, answer.maneuver.torque, &r, &answer.maneuver);
+    try {
+      replayFigures(effort, &r);
+    } catch (const StepTooLarge& e) {
+      r.termination = Termination::StepTooLarge;
+      r.message = std::string("replay of the planned torques failed: ") + e.what();
+    }
+    const ConstraintCheck check = checkConstraints(effort, r.maneuver);
+    r.constraints = check.names;
+    r.max_constraint_violation = check.max_violation;
+    r.max_violation_between_nodes = check.max_violation_between_nodes;
+    r.active_constraints = check.active;
+    return r;
+  }
+
+  const PlanningProblem& problem_;
+  SolverOptions options_;
+  std::chrono::steady_clock::time_point start_;
+  std::vector<FreeTimeOutcome> outcomes_;
+  std::vector<std::string> names_;
+  std::vector<Attempt> trail_;
+  std::size_t best_attempt_ = 0;
+  int solves_ = 0;
+};
+
+/// What T* is, for messages.
+std::string tStarKind(const PlanResult& r) {
+  return r.minimum_time.kkt_point ? "minimum time, a KKT point of the discrete minimum-time problem"
+                                  : "minimum time, the least duration found feasible";
+}
+
+/// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
+/// or if none of its solves converged, the search (MinimumTimeSearch, an upper bound).
+PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options) {
+  const std::string unsupported = freeTimeUnsupported(problem);
+  std::string why;
+  if (unsupported.empty()) {
+    std::optional<PlanResult> free_time = FreeTimeMinimumTime(problem, options).run();
+    if (free_time && free_time->converged()) return *free_time;
+    why = free_time ? "the free-time plan's replay failed" : "no free-time solve converged";
+  } else {
+    why = "the free-time interior point does not take " + unsupported + " yet";
+  }
+  PlanResult result = MinimumTimeSearch(problem, options).run();
+  result.message += "; searched on T (" + why + ")";
+  return result;
+}
+
 /// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
 /// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
 /// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
@@ -417,17 +689,15 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   validateProblem(problem);
   validateMinimumTime(problem);
   const auto start = std::chrono::steady_clock::now();
-  PlanResult result = MinimumTimeSearch(problem, options).run();
+  PlanResult result = minimumTimePlan(problem, options);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
   if (problem.duration > 0 && T_star > problem.duration * (1.0 + kMinimumTimeTolerance)) {
     // `duration` is an upper bound: the request asked for T ≤ duration.
     result.termination = Termination::Infeasible;
     std::ostringstream why;
-    why << "infeasible: needs T >= " << T_star
-        << " s under these bounds (minimum time, the least duration found feasible), requested "
-           "duration <= "
-        << problem.duration << " s";
+    why << "infeasible: needs T >= " << T_star << " s under these bounds (" << tStarKind(result)
+        << "), requested duration <= " << problem.duration << " s";
     result.message = why.str() + result.message;
     return result;
   }
@@ -467,8 +737,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   fastest.objective = Objective::MinimumTime;
   fastest.time_margin = 0.0;
   fastest.duration = 0.0;
-  const PlanResult minimum_time =
-      MinimumTimeSearch(fastest, withRemainingBudget(options, start)).run();
+  const PlanResult minimum_time = minimumTimePlan(fastest, withRemainingBudget(options, start));
   const auto finish = [&](PlanResult r) {
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     r.solve_time_s =
@@ -485,9 +754,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   }
   const double T_star = minimum_time.minimum_duration;
   if (T_star > problem.duration) {
-    why << "infeasible: needs T >= " << T_star
-        << " s under these bounds (minimum time, the least duration found feasible), requested "
-        << problem.duration << " s";
+    why << "infeasible: needs T >= " << T_star << " s under these bounds ("
+        << tStarKind(minimum_time) << "), requested " << problem.duration << " s";
     result.message = why.str();
     return finish(result);
   }

@@ -1,0 +1,52 @@
+// Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
+// node unknowns δ of the reduced problem, objective T, the torque constraints in force
+// (free_time_solver.cpp derives the method).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// What one free-time solve leaves: the plan's steps at its h, and the KKT residuals of the
+/// discrete minimum-time problem at the end.
+struct FreeTimeOutcome {
+  Termination termination = Termination::NotConverged;
+  std::string message;
+  ReducedProblem::Steps steps;   ///< the iterate's steps (every iterate meets the constraints)
+  double time_step = 0.0;        ///< h at the end
+  double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)
+  double duration = 0.0;         ///< T = N h
+  int iterations = 0;
+  /// max-norm of ∇T − Σ zᵢ∇cᵢ over (δ, h/h₀) relative to ∂T/∂(h/h₀) = T₀ (h₀ the start's h):
+  /// the stationarity of the minimum-time Lagrangian, its h row included.
+  double stationarity = 0.0;
+  double time_row = 0.0;                    ///< the h row of that residual alone, same scale
+  double complementarity = 0.0;             ///< Σ zᵢcᵢ: the duality gap, relative to T₀
+  double smallest_value = 0.0;              ///< min cᵢ (> 0: strictly feasible)
+  double effort_weight = 0.0;               ///< ε of T + ε C at the end (→ 0 with the barrier)
+  Maneuver maneuver;                        ///< the plan at the end (N + 1 nodes on t = k h)
+  std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
+};
+
+/// Why `problem` cannot be solved free-time here (empty: it can): rate limits, pointing cones
+/// and effects are not written in h yet, fourth_order has no single transcription
+/// (minimum_time.cpp falls back to the search).
+std::string freeTimeUnsupported(const PlanningProblem& problem);
+
+/// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
+/// R_N the problem's) at T = start_duration, raised until every constraint holds strictly (the
+/// iterates stay strictly feasible). Boundary rates are held at every h. Ends Converged at a KKT
+/// point of the discrete minimum-time problem (complementarity within `tolerance`, stationarity
+/// within it × max(1, (N/256)²): round-off), NotConverged at the iteration limit or a failed line
+/// search (its last iterate still feasible), Cancelled or TimedOut when `options` (may be null)
+/// asks: its cancel flag and time budget are polled every iteration.
+FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
+                              double start_duration, double tolerance, int max_iterations,
+                              const SolverOptions* options = nullptr);
+
+}  // namespace attitude_planner

@@ -127,7 +127,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
 /// 10 %): the core stops at B, but turning a stopped N = 1e5 solve into a result (evaluating and
 /// replaying its plan) can take longer than the rest; a solve still running then is told to stop
 /// and its result is dropped: the answer is TIMED_OUT without a plan.
-inline constexpr double kDeadlineSlack = 0.05;
+inline constexpr double kDeadlineSlack = 0.02;
 
 /// A solve run on its own thread so that its caller can answer at the deadline without it.
 struct SolveSlot {

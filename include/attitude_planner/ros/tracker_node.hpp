@@ -24,12 +24,13 @@
 // maneuver's `constraints`.
 //
 // A drift + two-input maneuver (seed 001, attitude_planner/DriftTwoInputManeuver on
-// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls at its
-// nodes: ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
-// fourth order) from g(0); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity` the body
-// rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the body is
-// drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the cost
-// ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
+// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls:
+// ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
+// fourth order) from g(0), streamed at ~rate like a rigid-body plan (between nodes the replay's own
+// motion, replayedDriftTwoInputAt); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity`
+// the body rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the
+// body is drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the
+// cost ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
 //
 // Bandwidth is bounded: per sample a constant amount (tf, torque, rates, body markers, a trail of
 // at most kTrailPoints points, one text marker); per maneuver once (latched) the planned path

@@ -68,6 +68,13 @@ foreach(name tracker_stream tracker_bandwidth tracker_feedback)
   list(APPEND AP_EXPECTED_TESTS test_${name})
 endforeach()
 
+# ~mode replan: re-plans through the planner node's service without stalling the stream, lands as
+# the law alone does; a failed re-plan keeps the plan in force.
+add_rostest_gtest(test_tracker_replan test/ros/tracker_replan.test test/ros/test_tracker_replan.cpp)
+target_link_libraries(test_tracker_replan ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_replan attitude_planner_node attitude_tracker_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_replan)
+
 # Start-up parameter checks: a bad private parameter stops each node with a named error (exit
 # 78); scene paths relative to the caller or package://; /use_sim_time through a remap (as
 # replay.launch gives it to rviz) and the tracker's one warning while /clock is silent.

@@ -71,6 +71,54 @@ DriftTwoInputTrajectory integrateDriftTwoInputExtremal(const Matrix3& g0, const 
   return out;
 }
 
+namespace {
+
+/// The replay's control between samples: Lagrange interpolation of u through the `points`
+/// samples first..first+points−1 at time s.
+Eigen::Vector2d cubicControl(const std::vector<double>& t, const std::vector<Eigen::Vector2d>& u,
+                             int first, int points, double s) {
+  Eigen::Vector2d v = Eigen::Vector2d::Zero();
+  for (int i = first; i < first + points; ++i) {
+    double l = 1.0;
+    for (int j = first; j < first + points; ++j) {
+      if (j != i) l *= (s - t[j]) / (t[i] - t[j]);
+    }
+    v += l * u[i];
+  }
+  return v;
+}
+
+/// The first of the (up to) 4 samples whose cubic drives interval k, and how many there are.
+std::pair<int, int> cubicWindow(int k, int n) {
+  const int points = std::min(4, n);  // cubic through the 4 nearest samples
+  return {std::max(0, std::min(k - 1, n - points)), points};
+}
+
+/// `substeps` fourth-order Magnus steps of ġ = g(E3 + u1 E1 + u2 E2) over [from, to] of interval
+/// k's cubic, starting at g.
+Matrix3 magnusSteps(Matrix3 g, const std::vector<double>& t, const std::vector<Eigen::Vector2d>& u,
+                    int k, double from, double to, int substeps) {
+  const auto [first, points] = cubicWindow(k, static_cast<int>(t.size()));
+  auto xi = [&](double s) {
+    const Eigen::Vector2d c = cubicControl(t, u, first, points, s);
+    return Vector3(c.x(), c.y(), 1.0);  // body rate E3 + u1 E1 + u2 E2 [rad/s]
+  };
+  constexpr double kGaussOffset = 0.28867513459481287;  // √3/6
+  constexpr double kCommutator = 0.14433756729740643;   // √3/12
+  const double hs = (to - from) / substeps;
+  for (int j = 0; j < substeps; ++j) {
+    const double s0 = from + j * hs;
+    const Vector3 a = xi(s0 + (0.5 - kGaussOffset) * hs);
+    const Vector3 b = xi(s0 + (0.5 + kGaussOffset) * hs);
+    // Fourth-order Magnus for the right-invariant form ġ = g ξ^: Ω = s/2 (a + b) + √3/12 s² a × b
+    const Vector3 omega = 0.5 * hs * (a + b) + kCommutator * hs * hs * a.cross(b);
+    g = g * so3::exp(omega);
+  }
+  return g;
+}
+
+}  // namespace
+
 std::vector<Matrix3> replayDriftTwoInputControls(const Matrix3& g0, const std::vector<double>& t,
                                                  const std::vector<Eigen::Vector2d>& u,
                                                  int substeps) {
@@ -89,43 +137,35 @@ std::vector<Matrix3> replayDriftTwoInputControls(const Matrix3& g0, const std::v
                          std::to_string(k - 1) + "])");
     }
   }
-  const int points = std::min(4, n);  // cubic through the 4 nearest samples
-  // Lagrange interpolation of u through samples first..first+points−1 at time s.
-  auto control = [&](int first, double s) {
-    Eigen::Vector2d v = Eigen::Vector2d::Zero();
-    for (int i = first; i < first + points; ++i) {
-      double l = 1.0;
-      for (int j = first; j < first + points; ++j) {
-        if (j != i) l *= (s - t[j]) / (t[i] - t[j]);
-      }
-      v += l * u[i];
-    }
-    return v;
-  };
-  auto xi = [&](int first, double s) {
-    const Eigen::Vector2d c = control(first, s);
-    return Vector3(c.x(), c.y(), 1.0);  // body rate E3 + u1 E1 + u2 E2 [rad/s]
-  };
-  constexpr double kGaussOffset = 0.28867513459481287;  // √3/6
-  constexpr double kCommutator = 0.14433756729740643;   // √3/12
   std::vector<Matrix3> g(n);
   g[0] = g0;
-  Matrix3 current = g0;
   for (int k = 0; k + 1 < n; ++k) {
-    const int first = std::max(0, std::min(k - 1, n - points));
-    const double hs = (t[k + 1] - t[k]) / substeps;
-    for (int j = 0; j < substeps; ++j) {
-      const double s0 = t[k] + j * hs;
-      const Vector3 a = xi(first, s0 + (0.5 - kGaussOffset) * hs);
-      const Vector3 b = xi(first, s0 + (0.5 + kGaussOffset) * hs);
-      // Fourth-order Magnus for the right-invariant form ġ = g ξ^: Ω = s/2 (a + b) + √3/12 s² a × b
-      const Vector3 omega = 0.5 * hs * (a + b) + kCommutator * hs * hs * a.cross(b);
-      current = current * so3::exp(omega);
-    }
-    g[k + 1] = so3::projectToSO3(current);
-    current = g[k + 1];
+    g[k + 1] = so3::projectToSO3(magnusSteps(g[k], t, u, k, t[k], t[k + 1], substeps));
   }
   return g;
+}
+
+DriftTwoInputReplaySample replayedDriftTwoInputAt(const std::vector<Matrix3>& g,
+                                                  const std::vector<double>& t,
+                                                  const std::vector<Eigen::Vector2d>& u, double s,
+                                                  int substeps) {
+  const int n = static_cast<int>(t.size());
+  if (n < 1 || u.size() != t.size() || g.size() != t.size()) {
+    throw InvalidInput("replayedDriftTwoInputAt: need as many attitudes and controls as times");
+  }
+  s = std::clamp(s, t.front(), t.back());
+  int k = static_cast<int>(std::upper_bound(t.begin(), t.end(), s) - t.begin()) - 1;
+  k = std::clamp(k, 0, n - 1);
+  DriftTwoInputReplaySample out;
+  if (s == t[k] || k == n - 1) {  // a sample itself: the replay's own row
+    out.g = g[k];
+    out.u = u[k];
+    return out;
+  }
+  out.g = so3::projectToSO3(magnusSteps(g[k], t, u, k, t[k], s, substeps));
+  const auto [first, points] = cubicWindow(k, n);
+  out.u = cubicControl(t, u, first, points, s);
+  return out;
 }
 
 }  // namespace attitude_planner

@@ -2,6 +2,37 @@
 
 namespace attitude_planner {
 
+namespace {
+
+/// An effect read on a clock moved on by a fixed offset (EffectModel::timeShifted).
+class TimeShiftedEffect : public TorqueEffect {
+ public:
+  TimeShiftedEffect(std::shared_ptr<const TorqueEffect> effect, double offset)
+      : effect_(std::move(effect)), offset_(offset) {}
+  std::string name() const override { return effect_->name(); }
+  Vector3 torque(const Matrix3& R, double t) const override {
+    return effect_->torque(R, t + offset_);
+  }
+  Matrix3 jacobian(const Matrix3& R, double t) const override {
+    return effect_->jacobian(R, t + offset_);
+  }
+  Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override {
+    return effect_->weightedSecondDerivative(R, t + offset_, w);
+  }
+
+ private:
+  std::shared_ptr<const TorqueEffect> effect_;
+  double offset_;
+};
+
+}  // namespace
+
+EffectModel EffectModel::timeShifted(double offset) const {
+  EffectModel shifted;
+  for (const auto& e : effects_) shifted.add(std::make_unique<TimeShiftedEffect>(e, offset));
+  return shifted;
+}
+
 std::vector<std::string> EffectModel::names() const {
   std::vector<std::string> out;
   for (const auto& e : effects_) out.push_back(e->name());

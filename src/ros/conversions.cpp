@@ -468,5 +468,14 @@ AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double targ
   return t;
 }
 
+double effectiveTimeBudget(double requested, const PlannerDefaults& defaults) {
+  if (!std::isfinite(requested) || requested < 0.0) return 0.0;
+  double budget = requested > 0.0 ? requested : defaults.time_budget;
+  if (defaults.max_solve_time > 0.0 && (budget <= 0.0 || budget > defaults.max_solve_time)) {
+    budget = defaults.max_solve_time;  // the node's ~max_solve_time bounds all
+  }
+  return budget;
+}
+
 }  // namespace ros_conversions
 }  // namespace attitude_planner

@@ -1,6 +1,9 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
 #include <sstream>
 
 #include "attitude_planner/ros/parameters.hpp"
@@ -58,6 +61,17 @@ void enforceDeadline(PlanOutcome* outcome) {
     << " s (the late plan is returned; details has the solver's account)";
   outcome->error_code = PlanErrorCode::TIMED_OUT;
   outcome->message = s.str();
+}
+
+PlanOutcome deadlineOutcome(double budget) {
+  PlanOutcome out;
+  out.error_code = PlanErrorCode::TIMED_OUT;
+  out.time_budget_s = budget;
+  std::ostringstream s;
+  s << "timed out: no plan within the time budget of " << budget
+    << " s (the solve was told to stop; its late result is dropped)";
+  out.message = s.str();
+  return out;
 }
 
 void describeCurrentException(int* error_code, std::string* message) {
@@ -164,6 +178,7 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
 }
 
 PlannerNode::~PlannerNode() {
+  reapLateSolves(true);
   {
     std::lock_guard<std::mutex> lock(goals_mutex_);
     stopping_ = true;
@@ -173,10 +188,55 @@ PlannerNode::~PlannerNode() {
   for (std::thread& worker : workers_) worker.join();
 }
 
+PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request& req) {
+  reapLateSolves(false);
+  const double budget = ros_conversions::effectiveTimeBudget(req.time_budget, defaults_);
+  if (!(budget > 0.0)) return planRequest(req, defaults_, nullptr);
+  auto slot = std::make_shared<SolveSlot>();
+  auto request = std::make_shared<const PlanAttitudeManeuver::Request>(req);
+  std::thread solve([slot, request, defaults = defaults_] {
+    PlanOutcome outcome = planRequest(*request, defaults, nullptr, &slot->cancel);
+    std::lock_guard<std::mutex> lock(slot->mutex);
+    slot->outcome = std::move(outcome);
+    slot->done = true;
+    slot->finished.notify_all();
+  });
+  std::unique_lock<std::mutex> lock(slot->mutex);
+  const auto deadline = std::chrono::duration<double>(budget * (1.0 + kDeadlineSlack));
+  if (slot->finished.wait_for(lock, deadline, [&] { return slot->done; })) {
+    lock.unlock();
+    solve.join();
+    return std::move(slot->outcome);
+  }
+  lock.unlock();
+  slot->cancel.store(true);
+  std::lock_guard<std::mutex> late(late_mutex_);
+  late_solves_.emplace_back(std::move(solve), slot);
+  return deadlineOutcome(budget);
+}
+
+void PlannerNode::reapLateSolves(bool all) {
+  std::lock_guard<std::mutex> late(late_mutex_);
+  for (auto it = late_solves_.begin(); it != late_solves_.end();) {
+    bool done = false;
+    {
+      std::lock_guard<std::mutex> lock(it->second->mutex);
+      done = it->second->done;
+    }
+    if (!done && !all) {
+      ++it;
+      continue;
+    }
+    it->second->cancel.store(true);
+    it->first.join();
+    it = late_solves_.erase(it);
+  }
+}
+
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
                                 PlanAttitudeManeuver::Response& res) {
   try {
-    const PlanOutcome outcome = planRequest(req, defaults_, nullptr);
+    const PlanOutcome outcome = planServiceRequest(req);
     fillResponse(outcome, world_frame_, body_frame_, &res);
     if (res.success) {
       ROS_INFO("plan: N = %d converged in %d iterations, %.3f s, cost %.6g", res.steps,
@@ -214,7 +274,8 @@ bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
 
 void PlannerNode::onGoal(GoalHandle goal) {
   const std::string id = goal.getGoalID().id;
-  ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false)};
+  ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false),
+                    std::make_shared<std::atomic<double>>(0.0)};
   {
     std::lock_guard<std::mutex> lock(goals_mutex_);
     const bool full = static_cast<int>(active_.size()) >= action_workers_;
@@ -240,10 +301,69 @@ void PlannerNode::onGoal(GoalHandle goal) {
 }
 
 void PlannerNode::onCancel(GoalHandle goal) {
-  std::lock_guard<std::mutex> lock(goals_mutex_);
+  std::lock_guard<std::mutex> goals(goals_mutex_);
   const auto it = active_.find(goal.getGoalID().id);
-  if (it != active_.end()) it->second.cancel->store(true);  // this goal only
+  if (it != active_.end()) it->second.cancel->store(true);  // this goal only: the solver stops
+  // The goal ends now, not when the solver has stopped and its N = 1e5 plan has been evaluated:
+  // the worker's late result is discarded (serveGoal). Under the server's lock, so that the
+  // worker cannot end it in between. A goal not yet accepted (RECALLING) is ended by its worker.
+  boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+  if (goal.getGoalStatus().status != actionlib_msgs::GoalStatus::PREEMPTING) return;
+  PlanAttitudeManeuverResult result;
+  result.success = false;
+  result.error_code.val = PlanErrorCode::CANCELLED;
+  result.message = "cancelled by its client (the solve was stopped; no plan is returned)";
+  if (it != active_.end()) {
+    // Its slot is free before the result goes out: a goal sent on receiving it is accepted
+    // (queued for the worker, which is stopping this solve).
+    it->second.ended_at->store(ros::WallTime::now().toSec());
+    active_.erase(it);
+  }
+  goal.setCanceled(result, result.message);
 }
+
+namespace {
+
+/// The goal has ended (PREEMPTED by onCancel, RECALLED, ...): nothing more may be sent for it.
+bool goalEnded(unsigned status) {
+  using actionlib_msgs::GoalStatus;
+  return status != GoalStatus::PENDING && status != GoalStatus::ACTIVE &&
+         status != GoalStatus::PREEMPTING && status != GoalStatus::RECALLING;
+}
+
+/// Calls `on_deadline` once `seconds` [s] of wall time have passed, unless destroyed before (the
+/// action's deadline: the worker holds one while it solves).
+class DeadlineWatch {
+ public:
+  DeadlineWatch(double seconds, std::function<void()> on_deadline) {
+    if (!(seconds > 0.0)) return;
+    thread_ = std::thread([this, seconds, on_deadline = std::move(on_deadline)] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (ended_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return over_; }))
+        return;
+      lock.unlock();
+      on_deadline();
+    });
+  }
+  ~DeadlineWatch() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      over_ = true;
+    }
+    ended_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  DeadlineWatch(const DeadlineWatch&) = delete;
+  DeadlineWatch& operator=(const DeadlineWatch&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ended_;
+  bool over_ = false;
+  std::thread thread_;
+};
+
+}  // namespace
 
 void PlannerNode::workerLoop() {
   for (;;) {
@@ -264,11 +384,23 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   GoalHandle handle = goal.handle;
   const std::string id = handle.getGoalID().id;
   // A cancel that arrived before the goal was in active_ (so onCancel found no flag to set).
-  if (handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING)
-    goal.cancel->store(true);
+  const unsigned status = handle.getGoalStatus().status;
+  if (goalEnded(status)) return;  // cancelled while it waited: onCancel ended it and freed its slot
+  if (status == actionlib_msgs::GoalStatus::PREEMPTING) goal.cancel->store(true);
   PlanAttitudeManeuverResult result;
   try {
     const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
+    // The deadline: an answer by budget (1 + kDeadlineSlack) even when the stopped solve takes
+    // longer to return; the solve is told to stop and its late result is discarded below.
+    const double budget = ros_conversions::effectiveTimeBudget(request->time_budget, defaults_);
+    const DeadlineWatch deadline(budget * (1.0 + kDeadlineSlack), [&] {
+      goal.cancel->store(true);
+      boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+      if (handle.getGoalStatus().status != actionlib_msgs::GoalStatus::ACTIVE) return;
+      PlanAttitudeManeuverResult late;
+      fillResponse(deadlineOutcome(budget), world_frame_, body_frame_, &late);
+      handle.setAborted(late, late.message);
+    });
     PlanAttitudeManeuverFeedback feedback;
     const PlanOutcome outcome = planRequest(
         *request, defaults_,
@@ -297,6 +429,14 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   // Under the server's lock the goal's status cannot change: a cancel received at any time up to
   // here (PREEMPTING, or our flag) ends the goal PREEMPTED, whatever the solver reached.
   boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+  if (goalEnded(handle.getGoalStatus().status)) {  // cancelled: its result was sent then
+    const double ended = goal.ended_at->load();
+    if (ended > 0.0) {
+      ROS_INFO("goal %s: the worker stopped %.3f s after the cancel ended the goal", id.c_str(),
+               ros::WallTime::now().toSec() - ended);
+    }
+    return;
+  }
   const bool cancelled = goal.cancel->load() ||
                          handle.getGoalStatus().status == actionlib_msgs::GoalStatus::PREEMPTING;
   if (cancelled) {

@@ -4,8 +4,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -203,32 +205,75 @@ std::vector<double> sampleTimes(double duration, int steps, double rate, double 
   return times;
 }
 
+PlanAttitudeManeuver::Request planRequestOf(const PlanningProblem& problem,
+                                            const std::vector<EffectSpec>& effects) {
+  PlanAttitudeManeuver::Request request;
+  request.inertia = rc::inertiaToMsg(problem.inertia);
+  request.allow_nonphysical_inertia = problem.allow_nonphysical_inertia;
+  request.initial_attitude = rc::attitudeToMsg(problem.initial_attitude);
+  request.initial_angular_velocity = rc::vectorToMsg(problem.initial_velocity);
+  request.final_attitude = rc::attitudeToMsg(problem.final_attitude);
+  request.final_angular_velocity = rc::vectorToMsg(problem.final_velocity);
+  request.duration = problem.duration;
+  request.steps = problem.steps;
+  request.scheme = schemeName(problem.scheme);
+  request.direction = directionName(problem.direction);
+  request.extra_revolutions = problem.extra_revolutions;
+  request.objective = objectiveName(problem.objective);
+  request.time_margin = problem.time_margin;
+  for (const EffectSpec& e : effects) {
+    // Noise is random: the replay adds it, the plan cannot know it.
+    if (!std::holds_alternative<TorqueNoiseSpec>(e)) request.effects.push_back(rc::effectToMsg(e));
+  }
+  for (const PlanningConstraint& c : problem.constraints)
+    request.constraints.push_back(rc::constraintToMsg(c));
+  return request;
+}
+
+ReplanAnswer planRemainder(const PlanningProblem& rest, const std::vector<EffectSpec>& effects,
+                           double start_time, const Maneuver& guess, ros::ServiceClient client) {
+  ReplanAnswer answer;
+  try {
+    if (client.isValid()) {
+      PlanAttitudeManeuver srv;
+      srv.request = planRequestOf(rest, effects);
+      srv.request.start_time = start_time;  // the service shifts the effects' clock itself
+      srv.request.initial_guess = rc::maneuverToMsg(guess, rest, "", "", ros::Time());
+      if (!client.call(srv)) {
+        answer.error = "service " + client.getService() + " call failed";
+      } else if (!srv.response.success) {
+        answer.error = "planner: " + srv.response.message;
+      } else {
+        answer.plan = rc::maneuverFromMsg(srv.response.maneuver);
+        answer.solve_time = srv.response.solve_time;
+        answer.ok = true;
+      }
+      return answer;
+    }
+    SolverOptions options;
+    options.warm_start = &guess;
+    const PlanResult result = planManeuver(rest, options);  // rest's effects: already shifted
+    answer.solve_time = result.solve_time_s;
+    if (!result.converged()) {
+      answer.error = "planner: " + result.message;
+      return answer;
+    }
+    answer.plan = result.maneuver;
+    answer.ok = true;
+  } catch (const std::exception& e) {
+    answer.ok = false;
+    answer.error = e.what();
+  }
+  return answer;
+}
+
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
                double* cost, std::string* error) {
   if (client && client->isValid()) {
     PlanAttitudeManeuver srv;
-    srv.request.inertia = rc::inertiaToMsg(problem.inertia);
-    srv.request.allow_nonphysical_inertia = problem.allow_nonphysical_inertia;
-    srv.request.initial_attitude = rc::attitudeToMsg(problem.initial_attitude);
-    srv.request.initial_angular_velocity = rc::vectorToMsg(problem.initial_velocity);
-    srv.request.final_attitude = rc::attitudeToMsg(problem.final_attitude);
-    srv.request.final_angular_velocity = rc::vectorToMsg(problem.final_velocity);
-    srv.request.duration = problem.duration;
-    srv.request.steps = problem.steps;
-    srv.request.scheme = schemeName(problem.scheme);
-    srv.request.direction = directionName(problem.direction);
-    srv.request.extra_revolutions = problem.extra_revolutions;
-    srv.request.objective = objectiveName(problem.objective);
-    srv.request.time_margin = problem.time_margin;
-    for (const EffectSpec& e : effects) {
-      // Noise is random: the replay adds it, the plan cannot know it.
-      if (!std::holds_alternative<TorqueNoiseSpec>(e))
-        srv.request.effects.push_back(rc::effectToMsg(e));
-    }
-    for (const PlanningConstraint& c : problem.constraints)
-      srv.request.constraints.push_back(rc::constraintToMsg(c));
+    srv.request = planRequestOf(problem, effects);
     if (!client->call(srv)) {
       *error = "service " + client->getService() + " call failed";
       return false;
@@ -309,7 +354,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
   rate_ = readParam<double>(pnh, "rate", 50.0, non_negative, ">= 0 Hz, 0 = at the plan nodes");
-  readParam<double>(pnh, "replan_period", 1.0, positive, "> 0 s");
+  replan_period_ = readParam<double>(pnh, "replan_period", 1.0, positive, "> 0 s");
   tracking_.natural_frequency =
       readParam<double>(pnh, "feedback_frequency", 0.0, non_negative, ">= 0 rad/s, 0 = 40 / T");
   tracking_.damping = readParam<double>(pnh, "feedback_damping", 1.0, positive, "> 0");
@@ -319,7 +364,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string mode =
       readParam<std::string>(pnh, "mode", trackingModeName(TrackingMode::Replay));
   trace_axis_name_ = readParam<std::string>(pnh, "trace_axis", "auto");
-  const bool plan_in_process = readParam<bool>(pnh, "plan_in_process", false);
+  plan_in_process_ = readParam<bool>(pnh, "plan_in_process", false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
 
   torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
@@ -340,12 +385,6 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   std::string refusal;
   try {
     mode_ = parseIn(kTrackingModeNames, mode, "~mode");
-    if (mode_ == TrackingMode::Replan) {
-      refusal =
-          "~mode = replan is not available: receding-horizon re-planning needs the planner "
-          "request's initial_guess (warm start), which this build's PlanAttitudeManeuver.srv does "
-          "not have; use replay or feedback";
-    }
     traceAxis(trace_axis_name_, Matrix3::Identity(), Matrix3::Identity());  // checks the name
   } catch (const std::exception& e) {
     refusal = e.what();
@@ -384,7 +423,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
     return;
   }
   std::string error;
-  if (planAndStartScene(scene, plan_in_process, planner_timeout, &error)) return;
+  if (planAndStartScene(scene, plan_in_process_, planner_timeout, &error)) return;
   ROS_ERROR("scene %s: %s", scene.c_str(), error.c_str());
   ReplayResult failed;
   failed.success = false;
@@ -425,6 +464,7 @@ bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_proce
              replay.plan_solve_time);
     replay.effects = parsed.effects;
     replay.scene_constraints = parsed.problem.constraints;
+    replay.problem = parsed.problem;
     startReplay(replay);
     return true;
   } catch (const std::exception& e) {
@@ -542,6 +582,13 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
                           SchemeKind scheme, Playback* pb) const {
   ReplayResult& result = pb->result;
   const int N = plan.steps();
+  if (mode_ == TrackingMode::Replan) {
+    // The closed loop on the first plan until a re-plan is adopted (serviceReplans).
+    pb->horizon = std::make_shared<RecedingHorizonRun>(plan, scheme, inertia, pb->effects,
+                                                       actuationOf(replay.effects), tracking_);
+    finishReplanResult(pb);
+    return;
+  }
   if (mode_ == TrackingMode::Feedback) {
     Actuation actuation = actuationOf(replay.effects);
     const TrackingRun run =
@@ -606,6 +653,16 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   validateConstraints(pb.constraints, "maneuver.constraints");
   validateProblem(problem);
   if (pb.constraints.empty()) pb.constraints = replay.scene_constraints;
+  // What a re-plan solves: the scene's problem, or the message's own; either way under the
+  // effects of the run (the body's environment), so a re-plan also corrects a model mismatch.
+  pb.problem = replay.problem ? *replay.problem : problem;
+  if (!replay.problem) pb.problem.constraints = pb.constraints;
+  pb.problem.steps = N;  // the plan's grid (an accuracy target may have chosen it)
+  pb.problem.duration = problem.duration;
+  pb.problem.scheme = problem.scheme;
+  pb.problem.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  applyEffects(replay.effects, &pb.problem);
+  pb.effects_specs = replay.effects;
 
   pb.world_frame = msg.header.frame_id.empty() ? world_frame_ : msg.header.frame_id;
   pb.body_frame = msg.child_frame_id.empty() ? body_frame_ : msg.child_frame_id;
@@ -658,8 +715,9 @@ void TrackerNode::publishManeuverMarkers(const Playback& pb) {
 
 void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& stamp,
                                 std::deque<Vector3>* trail) {
-  const ManeuverSample body = pb.actual->at(t);
-  const ManeuverSample plan = pb.reference->at(t);
+  // replan: the body under the plans adopted so far, the reference the plan in force.
+  const ManeuverSample body = pb.horizon ? pb.horizon->bodyAt(t) : pb.actual->at(t);
+  const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
   publishPose(body.attitude, stamp, pb.world_frame, pb.body_frame, pb.box, pb.trace_axis, trail);
 
   geometry_msgs::WrenchStamped wrench;
@@ -698,6 +756,7 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   label.scale.z = 0.12 * path_radius_;  // text height [m]
   label.color = color(1.0f, 1.0f, 1.0f, 1.0f);
   label.text = text;
+  if (!pb.replan_status.empty()) label.text += "\n" + pb.replan_status;
   text_pub_.publish(label);
 }
 
@@ -725,11 +784,17 @@ void TrackerNode::runReplay(Replay replay) {
            pb.result.mode.c_str(), pb.result.steps, pb.result.duration, pb.times.size(), rate_,
            rate_factor_, pb.world_frame.c_str(), pb.body_frame.c_str());
   std::deque<Vector3> trail;
+  ReplanState replans;
+  replans.period_steps =
+      std::max(1, static_cast<int>(std::lround(replan_period_ / pb.reference->nodes().time_step)));
+  replans.next_node = replans.period_steps;
   for (double t : pb.times) {
     const ros::Time stamp = start + ros::Duration(t / rate_factor_);
     if (!sleepUntil(stamp)) return;
+    if (pb.horizon) serviceReplans(t, &pb, &replans);
     publishSample(pb, t, stamp, &trail);
   }
+  if (pb.horizon) finishReplanResult(&pb);  // a re-plan still in flight is not adopted
   ReplayResult result = pb.result;
   result.success = true;
   result.header.frame_id = pb.world_frame;
@@ -737,6 +802,87 @@ void TrackerNode::runReplay(Replay replay) {
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
            result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
+}
+
+void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
+  RecedingHorizonRun& run = *pb->horizon;
+  const int N = run.steps();
+  const double h = run.timeStep();
+  ReplayResult& result = pb->result;
+  constexpr double kNodeSlack = 1e-9;  // a sample time k h in floating point is node k
+  if (state->pending) {
+    if (state->answer.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      ++result.samples_during_replans;  // this sample goes out while the planner works
+      return;
+    }
+    state->pending = false;
+    ReplanAnswer answer = state->answer.get();
+    const int from = state->pending_from;
+    const int at = std::max(from, static_cast<int>(std::ceil(t / h - kNodeSlack)));
+    char line[200];
+    if (answer.ok && at < N) {
+      try {
+        run.adopt(answer.plan, from, at);
+      } catch (const std::exception& e) {  // e.g. a plan of another grid: not flown
+        answer.ok = false;
+        answer.error = e.what();
+      }
+    }
+    if (!answer.ok) {
+      ++result.replan_failures;
+      if (result.replan_error.empty()) result.replan_error = answer.error;
+      ROS_WARN("re-plan from t = %.6g s failed, flying the plan in force: %s", from * h,
+               answer.error.c_str());
+      std::snprintf(line, sizeof line, "replan from t %.1f s failed (%d failed)", from * h,
+                    result.replan_failures);
+    } else if (at >= N) {
+      std::snprintf(line, sizeof line, "replan from t %.1f s arrived after the end", from * h);
+    } else {
+      result.replans = run.adoptions();
+      std::snprintf(line, sizeof line, "replan %d: from t %.1f s, flown from t %.1f s (%.3f s)",
+                    result.replans, from * h, at * h, answer.solve_time);
+    }
+    pb->replan_status = line;
+  }
+  const int node = static_cast<int>(std::floor(t / h + kNodeSlack));
+  if (node < state->next_node || N - node < kMinSteps) return;
+  // The state the body has at this node under the plan in force, and that plan's rest.
+  const ManeuverSample body = run.bodyAtNode(node);
+  PlanningProblem rest;
+  try {
+    rest = remainderProblem(pb->problem, node, body.attitude, body.angular_velocity);
+  } catch (const std::exception& e) {
+    ROS_WARN("re-plan from t = %.6g s not sent: %s", node * h, e.what());
+    state->next_node = N + 1;
+    return;
+  }
+  ros::ServiceClient client;
+  if (!plan_in_process_) client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
+  state->answer = std::async(std::launch::async, planRemainder, rest, pb->effects_specs, node * h,
+                             run.planRemainderAt(node), client);
+  state->pending = true;
+  state->pending_from = node;
+  state->next_node = node + state->period_steps;
+}
+
+void TrackerNode::finishReplanResult(Playback* pb) const {
+  const RecedingHorizonRun& run = *pb->horizon;
+  const Maneuver& plan = pb->reference->nodes();
+  const int N = plan.steps();
+  ReplayResult& result = pb->result;
+  const ManeuverSample end = run.bodyAt(N * plan.time_step);
+  // Against the first plan's end: every re-plan keeps its target, so the modes compare.
+  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], end.attitude);
+  result.terminal_velocity_error = (end.angular_velocity - plan.angular_velocity[N]).norm();
+  result.final_attitude = rc::attitudeToMsg(end.attitude);
+  result.effort = run.effort();
+  result.cost = result.effort / plan.time_step;  // the same units as the replay's Σ ½|τ_k|²
+  result.max_attitude_deviation = run.maxAttitudeError();
+  result.replans = run.adoptions();
+  result.message = "tracked " + std::to_string(N) + " steps with feedback (omega_n " +
+                   exactNumber(run.naturalFrequency()) + " rad/s) and re-planning every " +
+                   exactNumber(replan_period_) + " s: " + std::to_string(result.replans) +
+                   " re-plans adopted, " + std::to_string(result.replan_failures) + " failed";
 }
 
 void TrackerNode::runDriftReplay(const Replay& replay) {
@@ -798,29 +944,35 @@ void TrackerNode::runDriftReplay(const Replay& replay) {
   path_pub_.publish(pathMarker(world, "attitude_path", tips, 0.6f));
 
   const double t0 = plan.t.front();
-  ROS_INFO("replaying drift maneuver: %d steps over %.3f s (rate factor %g)", N, result.duration,
-           rate_factor_);
+  // At ~rate like a rigid-body plan: between its nodes the replay's own motion (the same cubic
+  // control and Magnus steps from the node before), exactly the replay's rows at the nodes.
+  const std::vector<double> times = sampleTimes(result.duration, N, rate_, rate_factor_);
+  ROS_INFO(
+      "replaying drift maneuver: %d steps over %.3f s, %zu samples (rate %g Hz, rate factor %g)", N,
+      result.duration, times.size(), rate_, rate_factor_);
   std::deque<Vector3> trail;
-  for (int k = 0; k <= N; ++k) {
-    const ros::Time stamp = start + ros::Duration((plan.t[k] - t0) / rate_factor_);
+  for (double t : times) {
+    const ros::Time stamp = start + ros::Duration(t / rate_factor_);
     if (!sleepUntil(stamp)) return;
-    publishPose(replayed[k], stamp, world, body, box, trace_axis, &trail);
+    const DriftTwoInputReplaySample sample =
+        replayedDriftTwoInputAt(replayed, plan.t, plan.u, t0 + t);
+    publishPose(sample.g, stamp, world, body, box, trace_axis, &trail);
 
     geometry_msgs::Vector3Stamped control;
     control.header.stamp = stamp;
     control.header.frame_id = body;
-    control.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 0.0));
+    control.vector = rc::vectorToMsg(Vector3(sample.u.x(), sample.u.y(), 0.0));
     control_pub_.publish(control);
 
     geometry_msgs::Vector3Stamped velocity;  // body rate ξ = (u1, u2, 1) [rad/s]
     velocity.header = control.header;
-    velocity.vector = rc::vectorToMsg(Vector3(plan.u[k].x(), plan.u[k].y(), 1.0));
+    velocity.vector = rc::vectorToMsg(Vector3(sample.u.x(), sample.u.y(), 1.0));
     velocity_pub_.publish(velocity);
   }
   result.success = true;
   result.message = "replayed drift maneuver, " + std::to_string(N) + " steps";
   result.header.frame_id = world;
-  result.header.stamp = start + ros::Duration((plan.t[N] - t0) / rate_factor_);
+  result.header.stamp = start + ros::Duration(times.back() / rate_factor_);
   ROS_INFO("drift replay done: terminal attitude error %.3g rad vs the plan's g(T)",
            result.terminal_attitude_error);
   publishDone(result);

@@ -330,6 +330,32 @@ TEST(RosConversions, RequestEffectsEnterThePlanningModel) {
   EXPECT_EQ(p.max_torque, Vector3(0.3, 0.4, 0.5));
 }
 
+// start_time moves the effects' clock (the tracker's re-plan of the rest of a maneuver from t_r):
+// the gravity gradient at t is the unshifted one at start_time + t; a bad value is named.
+TEST(RosConversions, StartTimeShiftsTheEffectsClock) {
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.effects.push_back(rc::effectToMsg(GravityGradientSpec{3.986004418e14, 6.778e6}));
+  SolverOptions options;
+  const PlanningProblem unshifted = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  r.start_time = 250.0;
+  const PlanningProblem shifted = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  ASSERT_TRUE(shifted.effects);
+  EXPECT_EQ(shifted.effects->names(), std::vector<std::string>{"gravity_gradient"});
+  const Matrix3 R = so3::fromAxisAngle(Vector3(0.3, -1.0, 0.4).normalized(), 0.9);
+  EXPECT_LT((shifted.effects->torque(R, 10.0) - unshifted.effects->torque(R, 260.0)).norm(), 1e-18);
+  EXPECT_GT((shifted.effects->torque(R, 10.0) - unshifted.effects->torque(R, 10.0)).norm(), 1e-6);
+  for (double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    r.start_time = bad;
+    try {
+      rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+      ADD_FAILURE() << "start_time " << bad << " accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("start_time: must be a finite number >= 0 s", 0), 0u)
+          << e.what();
+    }
+  }
+}
+
 TEST(RosConversions, DefaultsFillEmptyFields) {
   rc::PlannerDefaults d;
   d.scheme = SchemeKind::Variational;

@@ -29,7 +29,7 @@ namespace attitude_planner {
 enum class TrackingMode {
   Replay,    ///< open loop: the plan's torques, as planned (the default)
   Feedback,  ///< the geometric tracking law around the plan (simulateTracking)
-  Replan,    ///< receding-horizon re-planning from the current state (not available yet)
+  Replan,    ///< the law on plans re-planned from the current state (analysis/replanning.hpp)
 };
 
 /// The names of the modes (the tracker's ~mode, ReplayResult.mode).

@@ -1,11 +1,11 @@
 // Remsing's drift + two-input system on SO(3) (seed 001): ġ = g(E3 + u1 E1 + u2 E2),
 // cost ½∫(c1 u1² + c2 u2²) dt, and the flow of its normal extremals.
 //
-// Derivation (docs/design/drift_two_input.md): with the left-trivialized costate p ∈ so(3)* ≅ R³ the
-// maximum condition (seed 2.7, λ = −1) gives u_i = p_i/c_i and the reduced Hamiltonian
-// H(p) = ½(p1²/c1 + p2²/c2) + p3. The spatial costate μ = g p is constant along an extremal
-// (first-order optimality of the fixed-endpoint problem), so ṗ = d(gᵀμ)/dt = −ξ × p = p × ∇H(p)
-// with ξ = ∇H(p) = (u1, u2, 1): exactly seed (3.12)–(3.17). Casimir C = |p|² and H are conserved.
+// Derivation (docs/design/drift_two_input.md): with the left-trivialized costate p ∈ so(3)* ≅ R³
+// the maximum condition (seed 2.7, λ = −1) gives u_i = p_i/c_i and the reduced Hamiltonian H(p) =
+// ½(p1²/c1 + p2²/c2) + p3. The spatial costate μ = g p is constant along an extremal (first-order
+// optimality of the fixed-endpoint problem), so ṗ = d(gᵀμ)/dt = −ξ × p = p × ∇H(p) with ξ = ∇H(p) =
+// (u1, u2, 1): exactly seed (3.12)–(3.17). Casimir C = |p|² and H are conserved.
 //
 // Units: t [s]; the controls u_i are angular rates [rad/s]; the drift E3 is a unit rate
 // [rad/s] (time is scaled so); c_i [cost units·s²/rad²]; p has units of c·u.
@@ -197,5 +197,18 @@ DriftTwoInputTrajectory integrateDriftTwoInputExtremal(const Matrix3& g0, const 
 std::vector<Matrix3> replayDriftTwoInputControls(const Matrix3& g0, const std::vector<double>& t,
                                                  const std::vector<Eigen::Vector2d>& u,
                                                  int substeps = 4);
+
+/// The replay between its samples (the tracker streams a drift maneuver at its ~rate).
+struct DriftTwoInputReplaySample {
+  Matrix3 g = Matrix3::Identity();              ///< g(s), body → world
+  Eigen::Vector2d u = Eigen::Vector2d::Zero();  ///< (u1, u2)(s) [rad/s], the replay's cubic
+};
+/// g(s) and u(s) at any s ∈ [t_0, t_N] (clamped) of the replay `g` = replayDriftTwoInputControls(
+/// g0, t, u, substeps): from the sample before s, `substeps` Magnus steps of the same cubic control
+/// to s; exactly g[k], u[k] at a sample. Throws InvalidInput on mismatched sizes.
+DriftTwoInputReplaySample replayedDriftTwoInputAt(const std::vector<Matrix3>& g,
+                                                  const std::vector<double>& t,
+                                                  const std::vector<Eigen::Vector2d>& u, double s,
+                                                  int substeps = 4);
 
 }  // namespace attitude_planner

@@ -119,6 +119,10 @@ class EffectModel {
   Matrix3 jacobian(const Matrix3& R, double t) const;
   /// Σ weighted second derivatives (see TorqueEffect).
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const;
+  /// The same effects on a clock moved on by `offset` [s]: τ_e'(R, t) = τ_e(R, t + offset), names
+  /// kept. The model of a plan that starts at `offset` of the original maneuver (re-planning the
+  /// rest of it: the gravity gradient's orbit has moved on).
+  EffectModel timeShifted(double offset) const;
 
  private:
   std::vector<std::shared_ptr<const TorqueEffect>> effects_;

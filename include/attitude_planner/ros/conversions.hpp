@@ -152,6 +152,11 @@ DriftTwoInputRequest driftRequestFromMsg(const PlanDriftTwoInput::Request& req,
 AccuracyTarget accuracyTargetFromRequest(const std::string& measure, double target,
                                          const PlannerDefaults& defaults);
 
+/// The deadline [s] of a request's solve: its `time_budget`, or the node's ~time_budget when 0,
+/// capped by ~max_solve_time; 0 = none. (An invalid budget, refused by problemFromRequest, gives
+/// 0.)
+double effectiveTimeBudget(double requested, const PlannerDefaults& defaults);
+
 /// Builds the problem and solver options of a service request or action goal (both have the same
 /// fields). Throws InvalidInput naming the field and the value.
 template <class Request>
@@ -196,12 +201,15 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = default), got " +
                        exactNumber(req.time_budget));
   }
-  options->time_budget_s = req.time_budget > 0.0 ? req.time_budget : defaults.time_budget;
-  if (defaults.max_solve_time > 0.0 &&
-      (options->time_budget_s <= 0.0 || options->time_budget_s > defaults.max_solve_time)) {
-    options->time_budget_s = defaults.max_solve_time;  // the node's ~max_solve_time bounds all
-  }
+  options->time_budget_s = effectiveTimeBudget(req.time_budget, defaults);
   applyRequestEffects(req.effects, &p);
+  if (!std::isfinite(req.start_time) || req.start_time < 0.0) {
+    throw InvalidInput("start_time: must be a finite number >= 0 s, got " +
+                       exactNumber(req.start_time));
+  }
+  if (req.start_time > 0.0 && p.effects && !p.effects->empty()) {
+    p.effects = std::make_shared<const EffectModel>(p.effects->timeShifted(req.start_time));
+  }
   for (std::size_t i = 0; i < req.constraints.size(); ++i) {
     p.constraints.push_back(
         constraintFromMsg(req.constraints[i], "constraints[" + std::to_string(i) + "]"));

@@ -123,6 +123,24 @@ template <class Response>
 void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
                   const std::string& body_frame, Response* res);
 
+/// The answer to a request with a time budget B comes by B (1 + kDeadlineSlack) (issue 31 allows
+/// 10 %): the core stops at B, but turning a stopped N = 1e5 solve into a result (evaluating and
+/// replaying its plan) can take longer than the rest; a solve still running then is told to stop
+/// and its result is dropped: the answer is TIMED_OUT without a plan.
+inline constexpr double kDeadlineSlack = 0.02;
+
+/// A solve run on its own thread so that its caller can answer at the deadline without it.
+struct SolveSlot {
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;                ///< `outcome` is the solve's
+  PlanOutcome outcome;              ///< set when done
+  std::atomic<bool> cancel{false};  ///< tells the solve to stop (deadline passed, or shutdown)
+};
+
+/// The TIMED_OUT outcome of a request answered at its deadline `budget` [s] without its solve.
+PlanOutcome deadlineOutcome(double budget);
+
 /// The node: service + action around planRequest().
 class PlannerNode {
  public:
@@ -148,8 +166,16 @@ class PlannerNode {
   struct ActiveGoal {
     GoalHandle handle;
     std::shared_ptr<std::atomic<bool>> cancel;  ///< set by the goal's own cancel
+    /// Wall time [s] at which onCancel ended the goal (0: not ended by a cancel), for the log line
+    /// that says how long the worker took to stop after it (docs/ros_timing.md).
+    std::shared_ptr<std::atomic<double>> ended_at;
   };
 
+  /// planRequest for the service, answered by its deadline (kDeadlineSlack): the solve runs on a
+  /// thread of its own, left to stop (and joined later) when the deadline passes first.
+  PlanOutcome planServiceRequest(const PlanAttitudeManeuver::Request& req);
+  /// Joins the late solves that have stopped (all of them, cancelled first, when `all`).
+  void reapLateSolves(bool all);
   /// Service callback: always returns true (the outcome is in the response).
   bool onPlanService(PlanAttitudeManeuver::Request& req, PlanAttitudeManeuver::Response& res);
   /// plan_drift_two_input callback: always returns true (the outcome is in the response).
@@ -179,6 +205,9 @@ class PlannerNode {
   std::map<std::string, ActiveGoal> active_;  ///< accepted and not ended, by goal id
   bool stopping_ = false;                     ///< the node is shutting down
   std::vector<std::thread> workers_;          ///< ~action_workers threads
+  std::mutex late_mutex_;                     ///< guards late_solves_
+  /// Service solves still stopping after their request was answered at its deadline.
+  std::vector<std::pair<std::thread, std::shared_ptr<SolveSlot>>> late_solves_;
   /// plan_attitude_maneuver_action (several goals at a time); last: destroyed first
   std::unique_ptr<ActionServer> action_server_;
 };

@@ -4,12 +4,17 @@
 // the continuous body, RKMK4): open loop, what the planned torques alone do. ~mode feedback tracks
 // the plan with the geometric law on SO(3) (dynamics/tracking_controller.hpp; feed-forward τ(t)
 // plus PD on e_R, e_Ω, gyroscopic terms) closed around the continuous body
-// (analysis/tracking.hpp: simulateTracking). ~mode replan is refused at start-up (it needs the
-// planner request's initial_guess, not available yet). Either way the body acts under exactly the
-// effects of the scene (~scene, or ~replay_scene when set; none for a maneuver from the topic
-// without ~replay_scene): gravity gradient and disturbances as forcing, actuator_limits saturate,
-// torque_noise perturbs the delivered torque. The body (actual) and the plan (reference) are
-// streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
+// (analysis/tracking.hpp: simulateTracking). ~mode replan adds receding-horizon re-planning
+// (analysis/replanning.hpp): every ~replan_period of maneuver time the rest of the maneuver is
+// re-planned from the body's simulated state at the current node, warm-started with the rest of
+// the plan in force (the request's initial_guess), on a worker thread (through the service, or
+// planManeuver with ~plan_in_process) while the stream goes on; the answer is adopted at the first
+// node after it arrives and the law flies it from there; a failed re-plan keeps the plan in force
+// (ROS_WARN once per failure, the status text and `done` count it). Either way the body acts under
+// exactly the effects of the scene (~scene, or ~replay_scene when set; none for a maneuver from the
+// topic without ~replay_scene): gravity gradient and disturbances as forcing, actuator_limits
+// saturate, torque_noise perturbs the delivered torque. The body (actual) and the plan (reference)
+// are streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
 // (ManeuverInterpolation); `done` reports the terminal attitude and rate errors against the plan.
 //
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
@@ -19,12 +24,13 @@
 // maneuver's `constraints`.
 //
 // A drift + two-input maneuver (seed 001, attitude_planner/DriftTwoInputManeuver on
-// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls at its
-// nodes: ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
-// fourth order) from g(0); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity` the body
-// rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the body is
-// drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the cost
-// ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
+// `drift_maneuver`, or a ~scene with system: drift_two_input) is replayed from its controls:
+// ġ = g(E3 + u1 E1 + u2 E2) integrated on SO(3) by replayDriftTwoInputControls (exp-based,
+// fourth order) from g(0), streamed at ~rate like a rigid-body plan (between nodes the replay's own
+// motion, replayedDriftTwoInputAt); `control` carries (u1, u2, 0) [rad/s] and `angular_velocity`
+// the body rate (u1, u2, 1) [rad/s]; `torque` is not published (a kinematic system has none); the
+// body is drawn as a cube. `done` reports the replay's terminal error against the plan's g(T), the
+// cost ½∫(c1 u1² + c2 u2²) dt (trapezoid on the samples) and terminal_velocity_error = 0.
 //
 // Bandwidth is bounded: per sample a constant amount (tf, torque, rates, body markers, a trail of
 // at most kTrailPoints points, one text marker); per maneuver once (latched) the planned path
@@ -55,10 +61,11 @@
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //
 // Private parameters:
-//   ~mode             string  "replay" replay | feedback | replan (replan: refused, see above); an
-//                                      unknown or unavailable mode stops the node with an error
+//   ~mode             string  "replay" replay | feedback | replan; an unknown mode stops the node
+//                                      with an error naming it
 //   ~rate             double  50.0     samples per ROS second (>= 0); 0 = one sample per plan node
-//   ~replan_period    double  1.0      [s, maneuver time] (> 0; for replan)
+//   ~replan_period    double  1.0      [s, maneuver time] between re-plans (> 0; replan), rounded
+//                                      to whole plan steps (at least one)
 //   ~trace_axis       string  "auto"   body axis traced by the path: x | y | z | auto (the one
 //                                      most perpendicular to the maneuver's rotation axis)
 //   ~feedback_frequency double 0.0     ω_n of the law [rad/s] (>= 0; 0 = 40 / T)
@@ -84,6 +91,7 @@
 
 #include <atomic>
 #include <deque>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -97,7 +105,9 @@
 
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
+#include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
@@ -166,6 +176,25 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
 /// Plans a drift + two-input request: via plan_drift_two_input (if `client` is valid) or
 /// in-process. Fills `msg`, the planner's solve time [s] and cost; false with `error` set if
 /// planning failed.
+/// The service request that plans `problem` with the scene's `effects` (torque noise left out:
+/// the plan cannot know it), its actuator limits and constraints.
+PlanAttitudeManeuver::Request planRequestOf(const PlanningProblem& problem,
+                                            const std::vector<EffectSpec>& effects);
+
+/// A re-plan's answer (replan mode).
+struct ReplanAnswer {
+  bool ok = false;          ///< a converged plan is in `plan`
+  Maneuver plan;            ///< its nodes (rows 0..N − k from the node it was planned from)
+  double solve_time = 0.0;  ///< planner wall time [s]
+  std::string error;        ///< why not, when !ok
+};
+
+/// Plans `rest` (remainderProblem: the rest of the maneuver from t = start_time) warm-started with
+/// `guess`: through the service with `effects` and start_time when `client` is valid, else
+/// planManeuver in-process with rest's own (time-shifted) effects. Never throws.
+ReplanAnswer planRemainder(const PlanningProblem& rest, const std::vector<EffectSpec>& effects,
+                           double start_time, const Maneuver& guess, ros::ServiceClient client);
+
 bool planDriftScene(const DriftTwoInputRequest& request, ros::ServiceClient* client,
                     const std::string& world_frame, const std::string& body_frame,
                     DriftTwoInputManeuver* msg, double* solve_time, double* cost,
@@ -190,6 +219,9 @@ class TrackerNode {
     std::vector<EffectSpec> effects;  ///< effects acting during the replay (rigid body only)
     /// Cones to draw when the message carries none (~scene's, for a drift scene's frames).
     std::vector<PlanningConstraint> scene_constraints;
+    /// The problem the maneuver solves (~scene's, with its effects), for re-plans; unset for a
+    /// maneuver from the topic (rebuilt from the message and ~replay_scene's effects).
+    std::optional<PlanningProblem> problem;
   };
 
   /// What a rigid-body run streams: the plan (reference) and the body (actual), both
@@ -204,6 +236,20 @@ class TrackerNode {
     Vector3 trace_axis = Vector3::UnitX();             ///< traced body axis (unit)
     std::vector<PlanningConstraint> constraints;       ///< cones to draw
     ReplayResult result;                               ///< filled before streaming
+    /// replan mode: the closed loop whose plan is replaced (else null), the problem it re-plans
+    /// and the effects a re-plan request carries.
+    std::shared_ptr<RecedingHorizonRun> horizon;
+    PlanningProblem problem;
+    std::vector<EffectSpec> effects_specs;
+    std::string replan_status;  ///< the status text's re-plan line (replan mode)
+  };
+  /// A re-plan in flight (replan mode).
+  struct ReplanState {
+    int period_steps = 1;  ///< ~replan_period in plan steps
+    int next_node = 1;     ///< the next node to re-plan from
+    bool pending = false;  ///< a request is in flight
+    int pending_from = 0;  ///< its node
+    std::future<ReplanAnswer> answer;
   };
 
   /// `maneuver` callback: replaces the running replay.
@@ -224,10 +270,15 @@ class TrackerNode {
   /// Builds the playback of a rigid-body maneuver in ~mode (replay or closed loop) and its
   /// result (terminal errors, effort); throws InvalidInput / StepTooLarge naming what is wrong.
   Playback preparePlayback(const Replay& replay) const;
-  /// The open-loop or closed-loop run of `playback`'s plan: fills playback->actual and the
-  /// result's errors and effort.
+  /// The open-loop or closed-loop run of `playback`'s plan: fills playback->actual (or
+  /// playback->horizon) and the result's errors and effort.
   void runBody(const Replay& replay, const Maneuver& plan, const Matrix3& inertia,
                SchemeKind scheme, Playback* playback) const;
+  /// replan mode, before the sample at maneuver time t: adopts an answer that has arrived (at the
+  /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight.
+  void serviceReplans(double t, Playback* playback, ReplanState* state);
+  /// replan mode, after the stream: the terminal errors and effort of the re-planned closed loop.
+  void finishReplanResult(Playback* playback) const;
   /// Publishes one sample at maneuver time t, stamped `stamp`.
   void publishSample(const Playback& playback, double t, const ros::Time& stamp,
                      std::deque<Vector3>* trail);
@@ -278,6 +329,8 @@ class TrackerNode {
   double body_size_ = 1.0;                        ///< largest box edge [m]
   double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
   double path_radius_ = 1.2;                      ///< distance of the traced tip [m]
+  double replan_period_ = 1.0;                    ///< ~replan_period [s, maneuver time]
+  bool plan_in_process_ = false;                  ///< ~plan_in_process (also for re-plans)
   bool exit_when_done_ = false;                   ///< shut down after `done`
   /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
   std::optional<std::vector<EffectSpec>> replay_scene_effects_;

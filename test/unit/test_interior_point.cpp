@@ -35,9 +35,12 @@ ap::PlanningProblem sceneProblem(const std::string& scene, int steps) {
   return p;
 }
 
+/// One homotopy class (the nearest lift's): these tests read the trail and levels of one solve;
+/// the class survey of a free class is test_extremal_classes'.
 ap::PlanResult plan(const ap::PlanningProblem& p, const std::string& solver) {
   ap::SolverOptions o;
   o.solver = ap::parseSolver(solver, "solver");
+  o.enumerate_classes = false;
   if (solver == "nlopt") o.max_iterations = 5000;
   return ap::planManeuver(p, o);
 }

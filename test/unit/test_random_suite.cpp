@@ -112,15 +112,24 @@ TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 150);
   const PlanResult r = planManeuver(c.problem);
   ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
-  // The trail: the direct solve and the continuation in the boundary rates stalled, the coasting
-  // start converged.
-  ASSERT_GE(r.attempts.size(), 3u) << r.message;
-  EXPECT_EQ(r.attempts[0].termination, Termination::NotConverged);
-  EXPECT_EQ(r.attempts[1].stage, AttemptStage::RateContinuation);
-  EXPECT_NE(r.attempts[1].termination, Termination::Converged);
-  EXPECT_EQ(r.attempts[2].stage, AttemptStage::CoastingRetry);
-  EXPECT_EQ(r.attempts[2].start, AttemptStart::Coasting);
-  EXPECT_EQ(r.attempts[2].termination, Termination::Converged) << r.message;
+  // The trail: every class's solve (the class survey, on the requested grid) and the
+  // continuation in the boundary rates stalled, the coasting start converged.
+  const auto stage = [&r](AttemptStage s) {
+    return std::find_if(r.attempts.begin(), r.attempts.end(),
+                        [s](const Attempt& a) { return a.stage == s; });
+  };
+  const auto continuation = stage(AttemptStage::RateContinuation);
+  const auto coasting = stage(AttemptStage::CoastingRetry);
+  ASSERT_NE(continuation, r.attempts.end()) << r.extremal;
+  ASSERT_NE(coasting, r.attempts.end()) << r.extremal;
+  for (auto a = r.attempts.begin(); a != continuation; ++a) {
+    EXPECT_EQ(a->stage, AttemptStage::ClassSurvey);
+    EXPECT_EQ(a->termination, Termination::NotConverged);
+  }
+  EXPECT_NE(continuation->termination, Termination::Converged);
+  EXPECT_EQ(coasting, continuation + 1);
+  EXPECT_EQ(coasting->start, AttemptStart::Coasting);
+  EXPECT_EQ(coasting->termination, Termination::Converged) << r.message;
   EXPECT_LE(r.step_residual, measureStepResidual(c.problem, r.maneuver).tolerance);
   EXPECT_LE(r.max_residual, 1e-8) << r.message;  // relative first-order residual at the optimum
   EXPECT_LT(r.cost, 547.642) << c.label;
@@ -128,11 +137,11 @@ TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
               r.solve_time_s, r.cost);
 }
 
-// The cheapest extremal (issue 19, item 2): a spinning solve that needed more than 40 iterations
-// is solved from more structured starts (the other way round, one extra revolution, the coasting
-// start) and the cheapest kept, the others' costs reported in `extremal`. #192 (seed-like,
-// T = 17.6 s, 1.9 / 1.3 rad/s): the first start ends at 236.658 (64 iterations), the other way
-// round at IPOPT's 199.940 (docs/results/robustness_random.md).
+// The cheapest extremal (issues 19 and 30): the classes are enumerated, and a spinning class
+// that needed more than 40 iterations is solved from more starts in that class, the cheapest
+// kept, the others' costs reported in `extremal`. #192 (seed-like, T = 17.6 s, 1.9 / 1.3 rad/s):
+// the nearest lift ends at 236.658, the other way round at IPOPT's 199.940
+// (docs/results/robustness_random.md).
 TEST(RandomSuite, SlowSpinningSolveKeepsTheCheapestOfMoreStarts) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 192);
   const PlanResult r = planManeuver(c.problem);
@@ -151,48 +160,36 @@ TEST(RandomSuite, SlowSpinningSolveKeepsTheCheapestOfMoreStarts) {
               r.extremal.c_str());
 }
 
-// Four of the more starts, each reaching an extremal at least as cheap as IPOPT's where the
-// first start did not (docs/results/robustness_random.md): #86 (seed-like, T = 2.64 s, rest to
-// 0.9 rad/s) on the requested grid directly reaches IPOPT's 53926.017, where every start through
-// the coarser grids with the trust region ends at 83088.8 (the line search's reaches 53590.9);
-// #176 (seed-like, T = 23.5 s, rest to 3.2 rad/s) from the coasting start, which needs more than
-// the per-level 200 iterations (first start 11178.8, IPOPT 5681.932; the inertia homotopy goes
-// further, 5572.2); #80 (physical, T = 86 s, 4.2 / 3.6 rad/s, N = 723) with the line search
-// instead of the trust region, IPOPT's 1003.149 where the starts made for J end at 1009.461 or
-// above (the inertia homotopy: 833.8); #160 (seed-like, T = 12.2 s, 0.66 / 3.6 rad/s) by the
-// inertia homotopy from the sphere, 4002.9 where IPOPT ends at 4224.575 and every other start at
-// 4420.9 or above. The string is a candidate's entry in `extremal`, or the one kept.
+// Four cases where the first start's extremal was costlier than IPOPT's and one of the more
+// starts reached one at least as cheap (docs/results/robustness_random.md; before the class
+// survey: #86 on the requested grid directly, #176 from the coasting start, #80 with the line
+// search, #160 by the inertia homotopy, each in the nearest lift's class). With the classes
+// enumerated, the more starts search the kept class (and the nearest lift's when it converged
+// slowly): the answer must still be at least as cheap as IPOPT's, and come from a more start or
+// another class than the nearest lift's own solve.
 TEST(RandomSuite, MoreStartsReachExtremalsAsCheapAsIpopts) {
-  // Each case's start (stage MoreStarts), its cost (the measured value; 0: not asserted) and
-  // whether its plan is the one kept.
   const struct {
     int index;
-    AttemptStart start;
-    Globalization globalization;
-    double cost;
-    bool kept;
     double ipopt_cost;
-  } cases[] = {
-      {86, AttemptStart::Hermite, Globalization::TrustRegion, 53926.017279, false, 53926.01728},
-      {176, AttemptStart::Coasting, Globalization::TrustRegion, 5586.726947, false, 5681.932043},
-      {80, AttemptStart::Hermite, Globalization::LineSearch, 1003.148954, false, 1003.148954},
-      {160, AttemptStart::InertiaHomotopy, Globalization::TrustRegion, 0.0, true, 4224.575025}};
+  } cases[] = {{86, 53926.01728}, {176, 5681.932043}, {80, 1003.148954}, {160, 4224.575025}};
   for (const auto& expected : cases) {
     const RandomCase c = robustness::randomCase(kSuiteSeed, expected.index);
     const PlanResult r = planManeuver(c.problem);
-    ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
-    const auto found = std::find_if(r.attempts.begin(), r.attempts.end(), [&](const Attempt& a) {
-      return a.stage == AttemptStage::MoreStarts && a.start == expected.start &&
-             a.globalization == expected.globalization && !a.homotopy.long_way &&
-             a.homotopy.extra_revolutions == 0;
-    });
-    ASSERT_NE(found, r.attempts.end()) << c.label << ": " << r.extremal;
-    EXPECT_EQ(found->termination, Termination::Converged) << c.label;
-    if (expected.cost > 0) EXPECT_NEAR(found->cost, expected.cost, 5e-3) << c.label;
-    if (expected.kept) EXPECT_TRUE(found->kept) << c.label << ": " << r.extremal;
+    ASSERT_TRUE(r.converged()) << c.label << ": " << r.message;
+    const auto kept =
+        std::find_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; });
+    ASSERT_NE(kept, r.attempts.end());
+    const bool nearest_solve = kept->stage != AttemptStage::MoreStarts &&
+                               !kept->homotopy.long_way && kept->homotopy.extra_revolutions == 0;
+    EXPECT_FALSE(nearest_solve) << c.label << ": " << r.extremal;
+    EXPECT_TRUE(std::any_of(r.attempts.begin(), r.attempts.end(),
+                            [](const Attempt& a) { return a.stage == AttemptStage::MoreStarts; }))
+        << c.label << ": " << r.extremal;
     EXPECT_LE(r.cost, expected.ipopt_cost * (1 + 1e-8)) << c.label << ": " << r.extremal;
     EXPECT_LE(r.step_residual, measureStepResidual(c.problem, r.maneuver).tolerance);
     EXPECT_LE(r.max_residual, 1e-8) << c.label << ": " << r.message;
-    std::printf("%s: cost %.10g, %d iterations\n", c.label.c_str(), r.cost, r.iterations);
+    std::printf("%s: cost %.10g, %d iterations, kept %s from %s\n", c.label.c_str(), r.cost,
+                r.iterations, attemptStageName(kept->stage).c_str(),
+                attemptStartName(kept->start).c_str());
   }
 }

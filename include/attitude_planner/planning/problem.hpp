@@ -207,6 +207,10 @@ struct SolverOptions {
   /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
   /// is far closer to the next one than the unconstrained optimum is).
   bool constrained_from_warm_start = false;
+  /// A request that leaves its homotopy class free (direction shortest, no extra revolutions, no
+  /// warm start) is solved in every class of the class survey and the cheapest plan kept
+  /// (newton_solver.cpp); false: in the nearest lift's class only, as a named class is.
+  bool enumerate_classes = true;
 };
 
 /// The time budget withRemainingBudget leaves once the budget is spent.

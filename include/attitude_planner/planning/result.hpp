@@ -23,11 +23,12 @@ struct LevelSummary {
 
 /// What an attempt was for: the role of one solve in the planner's order of attempts.
 enum class AttemptStage {
-  Solve,              ///< the request's own solve (the first start)
-  BothWays,           ///< near π: the other way round, the cheaper kept
+  Solve,              ///< the request's own solve (a named class, or a warm start)
+  ClassSurvey,        ///< a class left free: one homotopy class solved on the survey grid
+  ClassRefine,        ///< a surveyed class carried to the requested grid, the cheapest kept
   RateContinuation,   ///< spinning ends: from rest to rest, boundary rates raised in stages
   CoastingRetry,      ///< spinning ends: from the coasting start after the others stalled
-  MoreStarts,         ///< a slow spinning solve: further starts, the cheapest kept
+  MoreStarts,         ///< a slow spinning solve: further starts in its class, the cheapest kept
   Constrained,        ///< the interior point, after the unconstrained optimum violated a bound
   ConstrainedRetry,   ///< the interior point once more (other formulation, or cones first)
   FourthOrderCoarse,  ///< fourth_order: the N solve of its Richardson pair
@@ -39,7 +40,8 @@ enum class AttemptStage {
 };
 inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::Solve, "solve"},
-    {AttemptStage::BothWays, "both_ways"},
+    {AttemptStage::ClassSurvey, "class_survey"},
+    {AttemptStage::ClassRefine, "class_refine"},
     {AttemptStage::RateContinuation, "rate_continuation"},
     {AttemptStage::CoastingRetry, "coasting_retry"},
     {AttemptStage::MoreStarts, "more_starts"},
@@ -116,10 +118,11 @@ struct Attempt {
   /// Newton's step control (interior-point attempts leave the default).
   Globalization globalization = Globalization::TrustRegion;
   HomotopyClass homotopy;  ///< the class its start was in
-  int steps = 0;           ///< N of the grid it solved on (its finest level)
+  int steps = 0;           ///< N of the grid it solved on (its finest level; a class survey's grid)
   Termination termination = Termination::NotConverged;
   int iterations = 0;  ///< iterations of this attempt, its coarser grid levels included
-  /// The scheme's Σ ½ w_k |τ_k|² of its plan [N²·m²]; NaN when it left no plan.
+  /// The scheme's Σ ½ w_k |τ_k|² of its plan [N²·m²] at `steps` (a class survey: on its coarser
+  /// grid, comparable only with the other classes' surveys); NaN when it left no plan.
   double cost = std::numeric_limits<double>::quiet_NaN();
   bool kept = false;  ///< its plan is the one returned
 };
@@ -136,7 +139,7 @@ struct ExtremalSummary {
   std::vector<Attempt> others;
 };
 
-/// "solve", "both_ways", ... (JSON, tests).
+/// "solve", "class_survey", ... (JSON, tests).
 std::string attemptStageName(AttemptStage stage);
 /// "hermite", "coarse_level", ... (JSON, tests).
 std::string attemptStartName(AttemptStart start);

@@ -51,7 +51,8 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
 /// second_order is time-symmetric, so its node values have an error expansion in even powers of
 /// h; X = X_{2N} + (X_{2N} − X_N)/3 at the N + 1 common nodes cancels the h² term. On the group,
 /// R_k = R^{2N}_{2k} exp(⅓ log((R^N_k)ᵀ R^{2N}_{2k})). Both solves get the request's solver,
-/// constraints, effects and what is left of its time budget; the coarse one its warm start. The
+/// constraints, effects and what is left of its time budget; the coarse one its warm start, the
+/// fine one the homotopy class the coarse one ended in. The
 /// fine one starts cold: its grid continuation (N/2, N/8, … with Richardson-extrapolated step
 /// rates) starts it better than the coarse plan refined at the step midpoints (torques are second
 /// differences: an O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations
@@ -75,6 +76,14 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   SolverOptions fine_options = withRemainingBudget(options, start);
   fine_options.warm_start = nullptr;
   fine_options.constrained_from_warm_start = false;
+  if (coarse.extremal_summary.known) {
+    // Richardson combines two solutions of one extremal: the 2N solve in the class the N solve
+    // chose (a class left free is enumerated once, at N).
+    const HomotopyClass& chosen = coarse.extremal_summary.homotopy;
+    sub.direction = chosen.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
+    sub.extra_revolutions = chosen.extra_revolutions;
+    fine_options.enumerate_classes = false;
+  }
   const PlanResult fine = planAtResolution(sub, fine_options);
   if (!fine.converged()) return failed(fine, 2 * N);
 

@@ -77,9 +77,18 @@ struct NewtonParameters {
   double coarse_tolerance_floor = 1e-6;
 
   // --- Starts and their order --------------------------------------------------------------------
-  /// ε_π [rad]: lifts whose distances from the coasting displacement differ by < 2ε_π are about
-  /// equally near (near π rest to rest): both ways are solved, the cheaper kept.
-  double both_ways_below_pi = 0.1;
+  /// The class survey (a request that leaves its homotopy class free): every class is solved on
+  /// the coarsest level of the request's grid continuation with at least this many steps (the
+  /// requested grid if none is coarser). Coarser grids rank the classes' costs too poorly to
+  /// choose among them (docs/notes/newton_tuning.md).
+  int class_survey_min_steps = 16;
+  /// Classes whose survey cost is within this relative margin of the cheapest are all refined to
+  /// the requested grid: coarse costs reorder on refinement (docs/notes/newton_tuning.md).
+  double class_refine_margin = 0.5;
+  /// Two surveyed classes whose costs agree to this relative difference reached the same extremal
+  /// from different starts (a survey is solved to a 1e-6 relative decrement, its cost to ~1e-12):
+  /// only the first is refined.
+  double same_extremal_cost = 1e-9;
   /// Two converged costs within this relative difference tie (the first start keeps it).
   double cheaper_tie = 1e-12;
   /// Continuation in the boundary rates: most stages, the first increment of the rate scale s,
@@ -93,8 +102,8 @@ struct NewtonParameters {
   int coasting_iteration_factor = 25;
   /// Stages of the inertia homotopy from the sphere J̄ = tr(J)/3·I to J.
   int inertia_homotopy_stages = 8;
-  /// A spinning solve that took more iterations than this wandered far from its start: it is
-  /// solved from more starts and the cheapest kept.
+  /// A spinning solve whose kept class took more iterations than this (survey and refinement)
+  /// wandered far from its start: that class is solved from more starts and the cheapest kept.
   int more_starts_above_iterations = 40;
 
   /// Relative decrement accepted as converged when the solve stalls at round-off at N steps.

@@ -1,11 +1,16 @@
-// The unconstrained solver's order of attempts, as data (kNewtonRecipe): the request's own solve
-// through the grids, then — each behind a named gate — the continuation in the boundary rates
-// and the coasting start for a spinning request that stalled, the other way round where the two
-// lifts are about equally near, and more starts for a slow spinning solve. Every attempt runs in
-// the request's SolveContext (one clock and deadline, one cancel flag, iterations numbered
-// across attempts) and is recorded in its trail; the cheapest converged plan is kept.
+// The unconstrained solver's order of attempts. A request that leaves the homotopy class free
+// (direction shortest, no extra revolutions, no warm start) is solved in every class of
+// kEnumeratedClasses on a coarse grid of its grid continuation (the class survey), the classes
+// within a margin of the cheapest survey cost are refined to the requested grid, and the cheapest
+// converged plan is kept. A request that names its class, or is warm-started, is solved in that
+// class only. Then, as data (kNewtonRecipe), each behind a named gate: the continuation in the
+// boundary rates and the coasting start for a spinning request that stalled, and more starts in
+// the kept class for a slow spinning solve. Every attempt runs in the request's SolveContext (one
+// clock and deadline, one cancel flag, iterations numbered across attempts) and is recorded in
+// its trail.
 #include "planning/newton/newton_solver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -60,66 +65,382 @@ PlanResult solveThroughGrids(const PlanningProblem& problem, SolveContext& conte
   return solveByGridContinuation(problem, context, newtonGridRule(p), settings.tolerance, level);
 }
 
-// --- The recipe --------------------------------------------------------------------------------
+PlanningProblem inClass(const PlanningProblem& problem, const HomotopyClass& homotopy) {
+  PlanningProblem out = problem;
+  out.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
+  out.extra_revolutions = homotopy.extra_revolutions;
+  return out;
+}
+
+HomotopyClass classOf(const PlanningProblem& problem) {
+  return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
+}
+
+bool sameClass(const HomotopyClass& a, const HomotopyClass& b) {
+  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
+}
+
+// --- The class survey ----------------------------------------------------------------------------
+
+/// The classes a request that leaves its class free is solved in: the two lifts nearest the
+/// coasting displacement, each with no and with one extra revolution. Measured on spinning
+/// problems (docs/results/extremal_classes.md): the cheapest extremal is in one of them.
+constexpr HomotopyClass kEnumeratedClasses[] = {{false, 0}, {true, 0}, {false, 1}, {true, 1}};
+
+/// The request asks for the default homotopy class (shortest way, no extra turns) from no
+/// guess of its own: only then are the classes enumerated (unless the caller pins the nearest).
+bool classLeftFree(const PlanningProblem& problem, const SolverOptions& options) {
+  return problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
+         !options.warm_start && options.enumerate_classes;
+}
+
+/// The lift a class's start turns through (nothing if a boundary step has no solution).
+std::optional<Vector3> liftOf(const PlanningProblem& in_class) {
+  try {
+    const ReducedProblem reduced(in_class);
+    const std::vector<Lift> lifts = nearestLifts(in_class, reduced);
+    return lifts[in_class.direction == RotationDirection::LongWay ? 1 : 0].rotation;
+  } catch (const StepTooLarge&) {
+    return std::nullopt;
+  }
+}
+
+/// The enumerated classes with distinct lifts on `start_grid` (the grid whose Hermite curve starts
+/// them): where both nearest lifts turn the same sense, the farther one is the nearer one plus a
+/// revolution, and its solve would repeat the other's.
+std::vector<HomotopyClass> distinctClasses(const PlanningProblem& start_grid) {
+  std::vector<HomotopyClass> out;
+  std::vector<Vector3> lifts;
+  for (const HomotopyClass& c : kEnumeratedClasses) {
+    const std::optional<Vector3> lift = liftOf(inClass(start_grid, c));
+    const bool repeated =
+        lift && std::any_of(lifts.begin(), lifts.end(), [&](const Vector3& other) {
+          return (other - *lift).norm() <= 1e-9 * (1.0 + lift->norm());
+        });
+    if (repeated) continue;
+    if (lift) lifts.push_back(*lift);
+    out.push_back(c);
+  }
+  return out;
+}
+
+/// One class solved on the survey grid, and what carrying it to the requested grid needs.
+struct Surveyed {
+  HomotopyClass homotopy;
+  PlanResult result;  ///< on the survey grid; its cost is C at that N (NaN unless converged)
+  bool on_requested_grid = false;  ///< the survey grid is the requested one: result is a plan
+  Steps steps;                     ///< the survey grid's final iterate (coarser survey grid)
+  Steps below;                     ///< the level below it, for extrapolation ...
+  bool below_converged = false;    ///< ... if it converged
+};
+
+/// The levels of the request's grid continuation (coarsest first) and the survey grid among
+/// them: the coarsest level with at least class_survey_min_steps steps, else the request's own.
+struct SurveyPlan {
+  std::vector<PlanningProblem> levels;
+  std::size_t survey = 0;
+};
+
+SurveyPlan surveyPlan(const PlanningProblem& problem, const NewtonParameters& p) {
+  SurveyPlan plan{gridLevels(problem, newtonGridRule(p)), 0};
+  while (plan.survey + 1 < plan.levels.size() &&
+         plan.levels[plan.survey].steps < p.class_survey_min_steps) {
+    ++plan.survey;
+  }
+  return plan;
+}
+
+/// The class through the grid continuation up to the survey grid, solved there to the coarse
+/// levels' tolerance (it only ranks the classes and starts the next level); on the requested
+/// grid, the class's whole solve.
+Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, SolveContext& context,
+                     const GridSettings& settings, const NewtonParameters& p) {
+  Surveyed s;
+  s.homotopy = homotopy;
+  const PlanningProblem at = inClass(plan.levels[plan.survey], homotopy);
+  if (plan.survey + 1 == plan.levels.size()) {
+    s.on_requested_grid = true;
+    s.result = solveThroughGrids(at, context, settings, nullptr, p);
+    return s;
+  }
+  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+    GridSettings at_level = settings;
+    at_level.tolerance = std::max(r.tolerance, p.coarse_tolerance_floor);
+    if (r.replay_only) at_level.max_iterations = 0;
+    PlanResult out = solveOnGrid(r.problem, context, at_level, {nullptr, r.coarse, r.coarser},
+                                 r.finest ? &s.steps : final_steps, p);
+    if (!r.finest) {
+      s.below = *final_steps;
+      s.below_converged = out.converged();
+    }
+    return out;
+  };
+  s.result = solveByGridContinuation(at, context, newtonGridRule(p), settings.tolerance, level);
+  s.result.cost = s.result.converged() && !s.steps.empty()
+                      ? ReducedProblem(at).cost(s.steps)
+                      : std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+
+/// A surveyed class carried from the survey grid through the finer levels to the requested one
+/// (each level from the one below, extrapolated with the one below that when it converged, as
+/// the grid continuation does). Stopped (cancel, deadline), the iterate is carried over without
+/// iterating.
+PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& context,
+                       const GridSettings& settings, const NewtonParameters& p) {
+  Steps coarse = s.steps, coarser = s.below;
+  bool coarser_usable = s.below_converged;
+  PlanResult r;
+  int iterations = 0;
+  std::vector<LevelSummary> levels;
+  std::optional<Termination> stopped;
+  for (std::size_t j = plan.survey + 1; j < plan.levels.size(); ++j) {
+    const bool finest = j + 1 == plan.levels.size();
+    GridSettings at_level = settings;
+    if (!finest) at_level.tolerance = std::max(settings.tolerance, p.coarse_tolerance_floor);
+    if (!stopped) stopped = context.stopReason();
+    if (stopped) at_level.max_iterations = 0;
+    Steps next;
+    r = solveOnGrid(inClass(plan.levels[j], s.homotopy), context, at_level,
+                    {nullptr, &coarse, coarser_usable ? &coarser : nullptr},
+                    finest ? nullptr : &next, p);
+    iterations += r.iterations;
+    levels.insert(levels.end(), r.levels.begin(), r.levels.end());
+    if (finest) break;
+    if (!r.converged() && !stopped) {
+      r.cost = std::numeric_limits<double>::quiet_NaN();  // no plan on the requested grid
+      break;
+    }
+    coarser_usable = r.converged();
+    coarser = std::move(coarse);
+    coarse = std::move(next);
+  }
+  r.iterations = iterations;
+  r.levels = levels;
+  const std::string survey_grid = "N = " + std::to_string(plan.levels[plan.survey].steps);
+  if (stopped && r.termination != Termination::Converged) {
+    r.termination = *stopped;
+    r.message =
+        std::string(*stopped == Termination::Cancelled ? "cancelled" : "time budget exceeded") +
+        "; the plan is the " + survey_grid +
+        " class survey's iterate carried over to N = " + std::to_string(plan.levels.back().steps);
+  } else {
+    r.message += "; refined from the " + survey_grid + " class survey";
+  }
+  return r;
+}
+
+// --- The walk: every attempt recorded, the cheapest converged plan kept --------------------------
+
+/// A class's own solve on the requested grid (surveyed there, refined, or the request's solve).
+struct ClassSolve {
+  HomotopyClass homotopy;
+  int iterations = 0;  ///< its own: survey and refinement, or the whole solve
+  bool converged = false;
+};
+
+class Walk {
+ public:
+  Walk(const PlanningProblem& problem, SolveContext& context, const NewtonParameters& p)
+      : problem_(problem), context_(context), p_(p), first_recorded_(context.attempts().size()) {}
+
+  /// Records an attempt; its plan competes if it is on the requested grid. `own_iterations`:
+  /// what the slow-solve gate reads if it is kept (the class's survey and refinement).
+  void add(Attempt a, PlanResult r, int own_iterations) {
+    a.termination = r.termination;
+    a.iterations = r.iterations;
+    const bool plan = r.maneuver.steps() == problem_.steps;
+    a.cost = plan || a.stage == AttemptStage::ClassSurvey
+                 ? r.cost
+                 : std::numeric_limits<double>::quiet_NaN();
+    trail_.push_back(a);
+    context_.record(a);
+    if (!plan) return;
+    if (a.stage != AttemptStage::MoreStarts) {
+      solved_.push_back({a.homotopy, own_iterations, r.converged()});
+    }
+    // The cheaper converged plan; ties go to the earlier attempt (deterministic at exactly π).
+    const bool cheaper = r.converged() && (!kept_ || !kept_->converged() ||
+                                           r.cost < kept_->cost * (1 - p_.cheaper_tie));
+    if (!kept_ || cheaper) {
+      kept_ = std::move(r);
+      kept_at_ = trail_.size() - 1;
+      kept_iterations_ = own_iterations;
+    }
+  }
+
+  const std::optional<PlanResult>& kept() const { return kept_; }
+  HomotopyClass keptClass() const { return trail_[kept_at_].homotopy; }
+  int keptIterations() const { return kept_iterations_; }
+  bool empty() const { return trail_.empty(); }
+  /// Whether `homotopy` was solved on the requested grid (not counting the more starts).
+  bool solvedOnRequestedGrid(const HomotopyClass& homotopy) const {
+    return std::any_of(solved_.begin(), solved_.end(),
+                       [&](const ClassSolve& c) { return sameClass(c.homotopy, homotopy); });
+  }
+  /// The classes the more starts may search: the kept one, and the request's own when it was
+  /// solved on the requested grid too and converged (its basins are not the kept class's).
+  std::vector<ClassSolve> searchedClasses(const HomotopyClass& request) const {
+    std::vector<ClassSolve> out;
+    for (const HomotopyClass& c : {keptClass(), request}) {
+      const auto found = std::find_if(solved_.begin(), solved_.end(), [&](const ClassSolve& s) {
+        return sameClass(s.homotopy, c) && s.converged;
+      });
+      const bool listed = std::any_of(
+          out.begin(), out.end(), [&](const ClassSolve& s) { return sameClass(s.homotopy, c); });
+      if (found != solved_.end() && !listed) out.push_back(*found);
+    }
+    return out;
+  }
+  const std::vector<Attempt>& trail() const { return trail_; }
+  /// Whether an attempt in `homotopy` started from `start`.
+  bool triedFrom(AttemptStart start, const HomotopyClass& homotopy) const {
+    return std::any_of(trail_.begin(), trail_.end(), [&](const Attempt& a) {
+      return a.start == start && sameClass(a.homotopy, homotopy);
+    });
+  }
+
+  /// The kept plan with the request's totals, the structured extremal and the brief.
+  PlanResult finish();
+
+ private:
+  const PlanningProblem& problem_;
+  SolveContext& context_;
+  const NewtonParameters& p_;
+  std::size_t first_recorded_;
+  std::vector<Attempt> trail_;
+  std::optional<PlanResult> kept_;
+  std::size_t kept_at_ = 0;
+  int kept_iterations_ = 0;
+  std::vector<ClassSolve> solved_;  ///< the classes solved on the requested grid, in order
+};
+
+Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem& problem,
+                  Globalization globalization = Globalization::TrustRegion) {
+  Attempt a;
+  a.stage = stage;
+  a.start = start;
+  a.globalization = globalization;
+  a.homotopy = classOf(problem);
+  a.steps = problem.steps;
+  return a;
+}
+
+/// Surveys every distinct class, then refines the request's own and those whose survey cost is
+/// within class_refine_margin of the cheapest. A stop (cancel, deadline) carries the class being
+/// surveyed to the requested grid and ends the enumeration.
+void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
+                      const NewtonParameters& p) {
+  const SolverOptions& options = context.options();
+  const GridSettings settings{options.tolerance, options.max_iterations,
+                              Globalization::TrustRegion};
+  const SurveyPlan plan = surveyPlan(problem, p);
+  const PlanningProblem& survey_grid = plan.levels[plan.survey];
+  const AttemptStart survey_start = usesCoarserLevel(survey_grid, newtonGridRule(p))
+                                        ? AttemptStart::CoarseLevel
+                                        : AttemptStart::Hermite;
+  std::vector<Surveyed> surveyed;
+  // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
+  for (const HomotopyClass& c : distinctClasses(plan.levels.front())) {
+    if (!walk->empty() && context.stopReason()) break;
+    Surveyed s = surveyClass(c, plan, context, settings, p);
+    walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, inClass(survey_grid, c)), s.result,
+              s.result.iterations);
+    surveyed.push_back(std::move(s));
+    // A class at zero cost (the zero maneuver) cannot be beaten: costs are sums of squares.
+    const bool unbeatable = surveyed.back().result.converged() && surveyed.back().result.cost == 0;
+    if (unbeatable && !context.stopReason()) break;
+    if (context.stopReason()) {
+      if (!surveyed.back().on_requested_grid && !surveyed.back().steps.empty()) {
+        const PlanResult carried = refineClass(surveyed.back(), plan, context, settings, p);
+        walk->add(
+            attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel, inClass(problem, c)),
+            carried, carried.iterations);
+      }
+      return;
+    }
+  }
+  if (plan.survey + 1 == plan.levels.size()) return;  // the survey was on the requested grid
+  double cheapest = std::numeric_limits<double>::infinity();
+  for (const Surveyed& s : surveyed) {
+    if (s.result.converged()) cheapest = std::min(cheapest, s.result.cost);
+  }
+  std::vector<double> refined_costs;  // the survey costs of the classes refined so far
+  for (const Surveyed& s : surveyed) {
+    if (!s.result.converged()) continue;
+    // The request's own class always (the answer is never costlier than its solve alone), the
+    // others near the cheapest; a class whose survey met one already refined (the same extremal
+    // from another start) would repeat it.
+    const bool wanted = sameClass(s.homotopy, classOf(problem)) ||
+                        s.result.cost <= cheapest * (1 + p.class_refine_margin);
+    const bool repeated = std::any_of(refined_costs.begin(), refined_costs.end(), [&](double c) {
+      return std::abs(s.result.cost - c) <= p.same_extremal_cost * c;
+    });
+    if (!wanted || repeated) continue;
+    if (context.stopReason()) return;
+    refined_costs.push_back(s.result.cost);
+    const PlanResult refined = refineClass(s, plan, context, settings, p);
+    walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
+                        inClass(problem, s.homotopy)),
+              refined, s.result.iterations + refined.iterations);
+  }
+}
+
+// --- The recipe after the first answer --------------------------------------------------------
 
 /// How an attempt reaches a plan for the requested grid.
 enum class Method {
-  ThroughGrids,       ///< grid continuation from the Hermite curve (or the warm start)
-  RequestedGridOnly,  ///< the Hermite curve on the requested grid, no coarser level
-  RateContinuation,   ///< from rest to rest, the boundary rates raised in stages
-  InertiaHomotopy,    ///< from the sphere of the same mean inertia, J reached in stages
-  Coasting,           ///< from the coasting start, with a longer iteration limit
+  ThroughGrids,          ///< grid continuation from the Hermite curve (or the warm start)
+  RequestedGridOnly,     ///< the Hermite curve on the requested grid, no coarser level
+  RateContinuation,      ///< from rest to rest, the boundary rates raised in stages
+  InertiaHomotopy,       ///< from the sphere of the same mean inertia, J reached in stages
+  Coasting,              ///< from the coasting start, with a longer iteration limit
+  CoastingThroughGrids,  ///< from the coasting start on the coarsest level, through the grids
 };
-
-/// Which homotopy class an attempt's problem asks for.
-enum class Variant { Request, OtherWay, ExtraRevolution };
 
 /// What the gates read: the request and the attempts so far.
 struct RecipeState {
   const PlanningProblem& problem;
   const SolverOptions& options;
   const NewtonParameters& p;
-  const PlanResult* kept = nullptr;  ///< the plan kept so far
-  int iterations = 0;                ///< over the attempts so far
-  bool other_way_solved = false;
-  bool lifts_about_equally_near = false;
+  const Walk& walk;
+  /// The own iterations of the class the more starts would search (its survey and refinement,
+  /// or the request's solve): the gate judges that first answer, not the further starts.
+  int class_iterations = 0;
+  bool kept_class = false;  ///< that class is the kept one
+  HomotopyClass searched;   ///< that class
 };
 
 using Gate = bool (*)(const RecipeState&);
 
-bool always(const RecipeState&) {
-  return true;
-}
-
-/// The request asks for the default homotopy class (shortest way, no extra turns) from no
-/// guess of its own: only then may other classes compete.
-bool defaultClassFromScratch(const RecipeState& s) {
-  return s.problem.direction == RotationDirection::Shortest && s.problem.extra_revolutions == 0 &&
-         !s.options.warm_start;
-}
-
 /// A spinning request that stalled from the Hermite start: fast rates over long horizons end at
 /// the iteration limit; easier problems (rest to rest, or the coasting motion) lead to it.
 bool stalledWithSpinningEnds(const RecipeState& s) {
-  return s.kept->termination == Termination::NotConverged && hasSpinningEnds(s.problem) &&
-         !s.options.warm_start;
+  return !s.walk.kept()->converged() && hasSpinningEnds(s.problem) && !s.options.warm_start;
 }
 
-/// The two nearest lifts are about equally near the coasting displacement (rest to rest: an
-/// angle near π): which way is cheaper depends on the inertia, so both are solved.
-bool liftsAboutEquallyNear(const RecipeState& s) {
-  return defaultClassFromScratch(s) && s.lifts_about_equally_near;
-}
-
-/// A converged spinning solve that took many iterations wandered far from its start: the
-/// extremal it reached may not be the cheapest, so more starts compete.
+/// A converged spinning solve of a class that took many iterations (survey and refinement, or
+/// its whole solve) wandered far from its start: within that class another start may reach a
+/// cheaper extremal (the class survey compares classes, not the basins inside one).
 bool slowSpinningSolve(const RecipeState& s) {
-  return s.kept->converged() && hasSpinningEnds(s.problem) && defaultClassFromScratch(s) &&
-         s.iterations > s.p.more_starts_above_iterations;
+  return s.walk.kept()->converged() && hasSpinningEnds(s.problem) &&
+         classLeftFree(s.problem, s.options) &&
+         s.class_iterations > s.p.more_starts_above_iterations;
 }
 
-bool slowSpinningSolveOtherWayUnsolved(const RecipeState& s) {
-  return slowSpinningSolve(s) && !s.other_way_solved;
+/// A slow class is solved from the coasting start on its requested grid with the longer
+/// iteration limit (unless a stalled request's retry already did).
+bool slowAndNotCoasted(const RecipeState& s) {
+  return slowSpinningSolve(s) && !s.walk.triedFrom(AttemptStart::Coasting, s.searched);
+}
+
+/// In the kept class of a converged spinning request that left its class free, the coasting
+/// start competes even when the solve was fast (through the grids, which keeps it cheap): it
+/// often ends in a cheaper basin than the Hermite curve's (docs/notes/newton_tuning.md).
+bool keptClassNotCoasted(const RecipeState& s) {
+  return s.walk.kept()->converged() && hasSpinningEnds(s.problem) &&
+         classLeftFree(s.problem, s.options) && s.kept_class && !slowSpinningSolve(s) &&
+         !s.walk.triedFrom(AttemptStart::Coasting, s.searched);
 }
 
 /// The first start came through coarser grids: on the requested grid directly Newton may reach
@@ -131,54 +452,27 @@ bool slowSpinningSolveThroughGrids(const RecipeState& s) {
 struct RecipeEntry {
   AttemptStage stage;
   Method method;
-  Variant variant;
   Globalization globalization;
   Gate when;
 };
 
-/// The order of attempts. The first is the request's own solve; each further one runs when its
-/// gate holds and the solve was neither cancelled nor out of time.
+/// The attempts after the class's (or classes') first answer, each when its gate holds and the
+/// solve was neither cancelled nor out of time. Stalled, they run in the request's class; the
+/// more starts in the kept class and in the request's own (Walk::searchedClasses).
 constexpr RecipeEntry kNewtonRecipe[] = {
-    {AttemptStage::Solve, Method::ThroughGrids, Variant::Request, Globalization::TrustRegion,
-     always},
-    {AttemptStage::RateContinuation, Method::RateContinuation, Variant::Request,
-     Globalization::TrustRegion, stalledWithSpinningEnds},
-    {AttemptStage::CoastingRetry, Method::Coasting, Variant::Request, Globalization::TrustRegion,
+    {AttemptStage::RateContinuation, Method::RateContinuation, Globalization::TrustRegion,
      stalledWithSpinningEnds},
-    {AttemptStage::BothWays, Method::ThroughGrids, Variant::OtherWay, Globalization::TrustRegion,
-     liftsAboutEquallyNear},
-    {AttemptStage::MoreStarts, Method::ThroughGrids, Variant::OtherWay, Globalization::TrustRegion,
-     slowSpinningSolveOtherWayUnsolved},
-    {AttemptStage::MoreStarts, Method::ThroughGrids, Variant::ExtraRevolution,
-     Globalization::TrustRegion, slowSpinningSolve},
-    {AttemptStage::MoreStarts, Method::RequestedGridOnly, Variant::Request,
-     Globalization::TrustRegion, slowSpinningSolveThroughGrids},
-    {AttemptStage::MoreStarts, Method::ThroughGrids, Variant::Request, Globalization::LineSearch,
+    {AttemptStage::CoastingRetry, Method::Coasting, Globalization::TrustRegion,
+     stalledWithSpinningEnds},
+    {AttemptStage::MoreStarts, Method::RequestedGridOnly, Globalization::TrustRegion,
+     slowSpinningSolveThroughGrids},
+    {AttemptStage::MoreStarts, Method::ThroughGrids, Globalization::LineSearch, slowSpinningSolve},
+    {AttemptStage::MoreStarts, Method::InertiaHomotopy, Globalization::TrustRegion,
      slowSpinningSolve},
-    {AttemptStage::MoreStarts, Method::InertiaHomotopy, Variant::Request,
-     Globalization::TrustRegion, slowSpinningSolve},
-    {AttemptStage::MoreStarts, Method::Coasting, Variant::Request, Globalization::TrustRegion,
-     slowSpinningSolve},
+    {AttemptStage::MoreStarts, Method::Coasting, Globalization::TrustRegion, slowAndNotCoasted},
+    {AttemptStage::MoreStarts, Method::CoastingThroughGrids, Globalization::TrustRegion,
+     keptClassNotCoasted},
 };
-
-/// The lifts' distances differ by less than 2ε_π (false if the boundary steps have no solution:
-/// the first solve reports that).
-bool liftsAmbiguous(const PlanningProblem& problem, const NewtonParameters& p) {
-  try {
-    const ReducedProblem reduced(problem);
-    const std::vector<Lift> lifts = nearestLifts(problem, reduced);
-    return std::abs(lifts[1].distance - lifts[0].distance) < 2 * p.both_ways_below_pi;
-  } catch (const StepTooLarge&) {
-    return false;
-  }
-}
-
-PlanningProblem variantOf(const PlanningProblem& problem, Variant variant) {
-  PlanningProblem out = problem;
-  if (variant == Variant::OtherWay) out.direction = RotationDirection::LongWay;
-  if (variant == Variant::ExtraRevolution) out.extra_revolutions = 1;
-  return out;
-}
 
 /// A staged continuation that did not reach the request: no plan for it.
 PlanResult unfinished(const StagedOutcome& staged, const std::string& what) {
@@ -240,23 +534,42 @@ int coastingIterationLimit(int max_iterations, const NewtonParameters& p) {
              : p.coasting_iteration_factor * max_iterations;
 }
 
-/// Runs one entry of the recipe; nothing if it has no start (no coasting motion at this h).
-std::optional<PlanResult> runEntry(const RecipeEntry& entry, const PlanningProblem& request,
+/// The coasting start made on the coarsest level of the grid continuation and carried through
+/// the finer ones (most iterations on the coarse levels); nothing if it has no start there.
+std::optional<PlanResult> coastingThroughGrids(const PlanningProblem& problem,
+                                               SolveContext& context, const GridSettings& settings,
+                                               const NewtonParameters& p) {
+  const std::vector<PlanningProblem> levels = gridLevels(problem, newtonGridRule(p));
+  const std::optional<Maneuver> coasting = coastingStart(levels.front());
+  if (!coasting) return std::nullopt;
+  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+    GridSettings at_level = settings;
+    at_level.tolerance = r.tolerance;
+    if (r.replay_only) at_level.max_iterations = 0;
+    const bool coarsest = r.problem.steps == levels.front().steps;
+    return solveOnGrid(r.problem, context, at_level,
+                       {coarsest ? &*coasting : nullptr, r.coarse, r.coarser}, final_steps, p);
+  };
+  return solveByGridContinuation(problem, context, newtonGridRule(p), settings.tolerance, level);
+}
+
+/// Runs one entry of the recipe on `problem` (the class it runs in); nothing if it has no start
+/// (no coasting motion at this h).
+std::optional<PlanResult> runEntry(const RecipeEntry& entry, const PlanningProblem& problem,
                                    SolveContext& context, const NewtonParameters& p) {
   const SolverOptions& options = context.options();
-  const PlanningProblem problem = variantOf(request, entry.variant);
   GridSettings settings{options.tolerance, options.max_iterations, entry.globalization};
   switch (entry.method) {
     case Method::ThroughGrids:
-      return solveThroughGrids(problem, context, settings,
-                               entry.stage == AttemptStage::Solve ? options.warm_start : nullptr,
-                               p);
+      return solveThroughGrids(problem, context, settings, nullptr, p);
     case Method::RequestedGridOnly:
       return solveOnGrid(problem, context, settings, {}, nullptr, p);
     case Method::RateContinuation:
       return byRateContinuation(problem, context, settings, p);
     case Method::InertiaHomotopy:
       return byInertiaHomotopy(problem, context, settings, p);
+    case Method::CoastingThroughGrids:
+      return coastingThroughGrids(problem, context, settings, p);
     case Method::Coasting: {
       const std::optional<Maneuver> coasting = coastingStart(problem);
       if (!coasting) return std::nullopt;
@@ -267,9 +580,8 @@ std::optional<PlanResult> runEntry(const RecipeEntry& entry, const PlanningProbl
   return std::nullopt;
 }
 
-AttemptStart startOf(const RecipeEntry& entry, const PlanningProblem& problem,
-                     const SolverOptions& options, const NewtonParameters& p) {
-  switch (entry.method) {
+AttemptStart startOf(Method method, const PlanningProblem& problem, const NewtonParameters& p) {
+  switch (method) {
     case Method::RequestedGridOnly:
       return AttemptStart::Hermite;
     case Method::RateContinuation:
@@ -277,28 +589,26 @@ AttemptStart startOf(const RecipeEntry& entry, const PlanningProblem& problem,
     case Method::InertiaHomotopy:
       return AttemptStart::InertiaHomotopy;
     case Method::Coasting:
+    case Method::CoastingThroughGrids:
       return AttemptStart::Coasting;
     case Method::ThroughGrids:
       break;
   }
-  if (entry.stage == AttemptStage::Solve && options.warm_start) return AttemptStart::WarmStart;
   return usesCoarserLevel(problem, newtonGridRule(p)) ? AttemptStart::CoarseLevel
                                                       : AttemptStart::Hermite;
 }
 
-Attempt attemptOf(const RecipeEntry& entry, const PlanningProblem& request,
-                  const SolverOptions& options, const PlanResult& r, const NewtonParameters& p) {
-  const PlanningProblem problem = variantOf(request, entry.variant);
-  Attempt a;
-  a.stage = entry.stage;
-  a.start = startOf(entry, problem, options, p);
-  a.globalization = entry.globalization;
-  a.homotopy = {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
-  a.steps = problem.steps;
-  a.termination = r.termination;
-  a.iterations = r.iterations;
-  a.cost = r.maneuver.steps() == problem.steps ? r.cost : std::numeric_limits<double>::quiet_NaN();
-  return a;
+/// The request's own class through the grids (from its warm start if given).
+void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, Walk* walk,
+                         const NewtonParameters& p) {
+  const SolverOptions& options = context.options();
+  const GridSettings settings{options.tolerance, options.max_iterations,
+                              Globalization::TrustRegion};
+  PlanResult r = solveThroughGrids(problem, context, settings, options.warm_start, p);
+  const AttemptStart start =
+      options.warm_start ? AttemptStart::WarmStart : startOf(Method::ThroughGrids, problem, p);
+  const int iterations = r.iterations;
+  walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations);
 }
 
 /// The one-line brief: how the kept attempt ended, what stopped the walk, which attempt it was.
@@ -319,18 +629,26 @@ std::string briefOf(const PlanResult& kept, const std::vector<Attempt>& trail, s
   return brief.str();
 }
 
-/// The kept plan with the request's totals, the structured extremal and the brief.
-PlanResult keptResult(PlanResult kept, const std::vector<Attempt>& trail, std::size_t kept_at,
-                      std::optional<Termination> stop) {
+PlanResult Walk::finish() {
+  // An attempt cancelled or out of time ends the walk; after a converged plan it only spared
+  // further attempts, otherwise the request ends with its termination.
+  std::optional<Termination> stop;
+  const Termination last = trail_.back().termination;
+  if (last == Termination::Cancelled || last == Termination::TimedOut) stop = last;
+  PlanResult kept = std::move(*kept_);
+  if (kept.converged()) stop.reset();
+  trail_[kept_at_].kept = true;
+  context_.markKept(first_recorded_ + kept_at_);
   int iterations = 0;
-  for (const Attempt& a : trail) iterations += a.iterations;
+  for (const Attempt& a : trail_) iterations += a.iterations;
   kept.iterations = iterations;
-  for (std::size_t i = 0; i < trail.size(); ++i) {
-    if (i != kept_at) kept.extremal_summary.others.push_back(trail[i]);
+  for (std::size_t i = 0; i < trail_.size(); ++i) {
+    if (i != kept_at_) kept.extremal_summary.others.push_back(trail_[i]);
   }
   kept.extremal = describeExtremal(kept.extremal_summary);
-  kept.message = briefOf(kept, trail, kept_at, stop);
+  kept.message = briefOf(kept, trail_, kept_at_, stop);
   if (stop && !kept.converged()) kept.termination = *stop;
+  kept.attempts = context_.attempts();
   return kept;
 }
 
@@ -344,43 +662,41 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 
 PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context) {
   const NewtonParameters& p = newtonDefaults();
-  RecipeState state{problem, context.options(), p};
-  state.lifts_about_equally_near = liftsAmbiguous(problem, p);
-  const std::size_t first_recorded = context.attempts().size();
-  std::vector<Attempt> trail;
-  PlanResult kept;
-  std::size_t kept_at = 0;
-  for (const RecipeEntry& entry : kNewtonRecipe) {
-    if (!trail.empty()) {
+  const SolverOptions& options = context.options();
+  Walk walk(problem, context, p);
+  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p);
+  // The request's own class when it names one or is warm-started; after the class survey, when
+  // no class converged on the requested grid and the request's class was not solved whole there.
+  const bool converged = walk.kept() && walk.kept()->converged();
+  const bool request_solved = walk.solvedOnRequestedGrid(classOf(problem));
+  if (!walk.kept() || (!converged && !request_solved && !context.stopReason())) {
+    solveRequestedClass(problem, context, &walk, p);
+  }
+  const auto run = [&](const RecipeEntry& entry, const PlanningProblem& in) {
+    std::optional<PlanResult> r = runEntry(entry, in, context, p);
+    if (!r) return;
+    const int own = r->iterations;
+    walk.add(attemptIn(entry.stage, startOf(entry.method, in, p), in, entry.globalization),
+             std::move(*r), own);
+  };
+  RecipeState state{problem, options, p, walk, walk.keptIterations()};
+  for (const RecipeEntry& entry : kNewtonRecipe) {  // stalled: in the request's class
+    if (context.stopReason()) break;
+    if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);
+  }
+  const HomotopyClass kept = walk.keptClass();
+  for (const ClassSolve& searched : walk.searchedClasses(classOf(problem))) {
+    state.class_iterations = searched.iterations;
+    state.kept_class = sameClass(searched.homotopy, kept);
+    state.searched = searched.homotopy;
+    for (const RecipeEntry& entry : kNewtonRecipe) {
       if (context.stopReason()) break;
-      if (!entry.when(state)) continue;
-    }
-    std::optional<PlanResult> r = runEntry(entry, problem, context, p);
-    if (!r) continue;
-    trail.push_back(attemptOf(entry, problem, context.options(), *r, p));
-    context.record(trail.back());
-    state.iterations += r->iterations;
-    state.other_way_solved |= entry.variant == Variant::OtherWay;
-    // The cheaper converged plan; ties go to the earlier attempt (deterministic at exactly π).
-    const bool cheaper = r->converged() && (trail.size() == 1 || !kept.converged() ||
-                                            r->cost < kept.cost * (1 - p.cheaper_tie));
-    if (trail.size() == 1 || cheaper) {
-      kept = std::move(*r);
-      kept_at = trail.size() - 1;
-      state.kept = &kept;
+      if (entry.stage == AttemptStage::MoreStarts && entry.when(state)) {
+        run(entry, inClass(problem, searched.homotopy));
+      }
     }
   }
-  // An attempt cancelled or out of time ends the walk; after a converged plan it only spared
-  // further attempts, otherwise the request ends with its termination.
-  std::optional<Termination> stop;
-  const Termination last = trail.back().termination;
-  if (last == Termination::Cancelled || last == Termination::TimedOut) stop = last;
-  if (kept.converged()) stop.reset();
-  trail[kept_at].kept = true;
-  context.markKept(first_recorded + kept_at);
-  PlanResult out = keptResult(std::move(kept), trail, kept_at, stop);
-  out.attempts = context.attempts();
-  return out;
+  return walk.finish();
 }
 
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {

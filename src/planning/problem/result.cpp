@@ -23,11 +23,26 @@ std::string globalizationName(Globalization globalization) {
 
 namespace {
 
+/// "the nearest lift", "the other way round + 1 extra turn(s)", ...
+std::string describeClass(const HomotopyClass& homotopy) {
+  std::string d = homotopy.long_way ? "the other way round" : "the nearest lift";
+  if (homotopy.extra_revolutions > 0) {
+    d += " + " + std::to_string(homotopy.extra_revolutions) + " extra turn(s)";
+  }
+  return d;
+}
+
 /// What distinguishes an attempt among the starts an extremal was chosen from.
 std::string describeCandidate(const Attempt& a) {
   if (a.stage == AttemptStage::Solve) return "the first start";
-  if (a.homotopy.long_way) return "the other way round";
-  if (a.homotopy.extra_revolutions > 0) return "one extra revolution";
+  if (a.stage == AttemptStage::ClassSurvey) {
+    return describeClass(a.homotopy) + " surveyed at N = " + std::to_string(a.steps);
+  }
+  if (a.stage == AttemptStage::ClassRefine) return describeClass(a.homotopy);
+  if (a.homotopy.long_way || a.homotopy.extra_revolutions > 0) {
+    return describeClass(a.homotopy) + ", " + attemptStageName(a.stage) + " from " +
+           attemptStartName(a.start);
+  }
   if (a.globalization == Globalization::LineSearch) {
     return "a line search instead of the trust region";
   }

@@ -1,7 +1,7 @@
 // Measures the bordered banded solve (planning/linalg/bordered_band.hpp) against the plain banded
 // Cholesky solve it extends, at N = 10³, 10⁴, 10⁵ steps (3N unknowns, half bandwidth 8: the
 // transcription's Newton system) with a border of m = 1, 2, 4 global unknowns, in double and
-// double-double. Writes docs/bordered_band.md. Usage: bordered_band_study [OUT_DIR=docs]
+// double-double. Writes docs/results/bordered_band.md. Usage: bordered_band_study [OUT_DIR=docs/results]
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
@@ -89,7 +89,7 @@ void writeRows(FILE* md, const char* precision, const std::vector<int>& borders)
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string out = argc > 1 ? argv[1] : "docs";
+  const std::string out = argc > 1 ? argv[1] : "docs/results";
   const std::vector<int> borders = {1, 2, 4};
   FILE* md = std::fopen((out + "/bordered_band.md").c_str(), "w");
   if (!md) {

@@ -94,9 +94,9 @@ AccuracyMeasures measureAccuracy(const PlanningProblem& problem, const Maneuver&
 }
 
 double measuredOrder(SchemeKind scheme, AccuracyMeasure measure) {
-  // Least-squares slopes over N = 64..16384 on both seed examples (docs/results/accuracy.md, "Observed
-  // orders"); test_accuracy.cpp checks them on a small sweep. The cost converges at order 1 in
-  // both schemes (the boundary data Ω_0, Ω_{N−1} hold over a whole step: the maneuver is
+  // Least-squares slopes over N = 64..16384 on both seed examples (docs/results/accuracy.md,
+  // "Observed orders"); test_accuracy.cpp checks them on a small sweep. The cost converges at order
+  // 1 in both schemes (the boundary data Ω_0, Ω_{N−1} hold over a whole step: the maneuver is
   // effectively h shorter); the attitude miss at order 2 only for the variational scheme.
   // second_order: order 2 in every measure; fourth_order (its Richardson extrapolation): order 4
   // in every measure (docs/results/accuracy.md, docs/design/fourth_order.md).
@@ -117,8 +117,8 @@ namespace {
 
 /// The order planToAccuracy assumes: the measured one, but for the cost error of a problem with
 /// node constraints at most 1 (the bounds' active sets start and end between nodes, so the
-/// smooth-case order need not hold; docs/design/fourth_order.md measured none on torque_limited): the
-/// Richardson estimate |ΔC|/(2^p − 1) is then an upper bound rather than an underestimate. The
+/// smooth-case order need not hold; docs/design/fourth_order.md measured none on torque_limited):
+/// the Richardson estimate |ΔC|/(2^p − 1) is then an upper bound rather than an underestimate. The
 /// terminal miss is measured by the replay whatever the order, which only steers the prediction.
 double assumedOrder(const PlanningProblem& problem, SchemeKind scheme, AccuracyMeasure measure) {
   const double order = measuredOrder(scheme, measure);
@@ -174,6 +174,59 @@ std::string formatted(const char* format, double a, double b = 0.0) {
   return buffer;
 }
 
+// Coarse resolution of each candidate scheme (N = kCoarse; its estimate uses N/2 too).
+constexpr int kCoarse = 64;
+
+/// The scheme whose predicted N costs the least work, with its coarse plan; `failed` when a
+/// coarse plan did not converge (that plan, its message saying so, in `coarse`).
+struct SchemeChoice {
+  int N = 0;
+  SchemeKind scheme = SchemeKind::Paper;
+  Rung coarse;
+  bool failed = false;
+};
+
+template <class Budgeted>
+SchemeChoice chooseScheme(const PlanningProblem& problem, const Budgeted& budgeted,
+                          AccuracyEstimate* estimate) {
+  const AccuracyTarget& target = problem.accuracy;
+  std::vector<SchemeKind> schemes = {problem.scheme};
+  if (target.choose_scheme) {
+    schemes = {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder,
+               SchemeKind::FourthOrder};
+  }
+  SchemeChoice best;
+  best.scheme = problem.scheme;
+  double best_work = 0.0;
+  for (SchemeKind scheme : schemes) {
+    PlanningProblem candidate = problem;
+    candidate.scheme = scheme;
+    const double p = assumedOrder(problem, scheme, target.measure);
+    Rung coarse = solveRung(candidate, kCoarse, budgeted(), p);
+    estimate->steps_tried.push_back(kCoarse);
+    estimate->errors_tried.push_back(coarse.error);
+    estimate->schemes_tried.push_back(schemeName(scheme));
+    if (!coarse.plan.converged()) {
+      coarse.plan.message = "coarse resolution N = 64 (" + schemeName(scheme) +
+                            ") did not converge: " + coarse.plan.message;
+      SchemeChoice failed;
+      failed.coarse = coarse;
+      failed.failed = true;
+      return failed;
+    }
+    const int N = predictSteps(kCoarse, coarse.error, target.value, p);
+    // The work of a plan is O(N) per solve; fourth_order solves second_order at N and 2N.
+    const double work = scheme == SchemeKind::FourthOrder ? 3.0 * N : double(N);
+    if (best.N == 0 || work < best_work) {
+      best.N = N;
+      best_work = work;
+      best.scheme = scheme;
+      best.coarse = coarse;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& options) {
@@ -197,40 +250,11 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
   // when nothing is).
   const auto budgeted = [&] { return withRemainingBudget(options, start); };
 
-  // Coarse resolution (N = 64; its estimate uses N = 32 too) of each candidate scheme.
-  constexpr int kCoarse = 64;
-  std::vector<SchemeKind> schemes = {problem.scheme};
-  if (target.choose_scheme) {
-    schemes = {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder,
-               SchemeKind::FourthOrder};
-  }
-  int best_N = 0;
-  double best_work = 0.0;
-  SchemeKind best_scheme = problem.scheme;
-  Rung best_coarse;
-  for (SchemeKind scheme : schemes) {
-    PlanningProblem candidate = problem;
-    candidate.scheme = scheme;
-    const double p = assumedOrder(problem, scheme, target.measure);
-    Rung coarse = solveRung(candidate, kCoarse, budgeted(), p);
-    estimate.steps_tried.push_back(kCoarse);
-    estimate.errors_tried.push_back(coarse.error);
-    estimate.schemes_tried.push_back(schemeName(scheme));
-    if (!coarse.plan.converged()) {
-      coarse.plan.message = "coarse resolution N = 64 (" + schemeName(scheme) +
-                            ") did not converge: " + coarse.plan.message;
-      return finish(coarse.plan);
-    }
-    const int N = predictSteps(kCoarse, coarse.error, target.value, p);
-    // The work of a plan is O(N) per solve; fourth_order solves second_order at N and 2N.
-    const double work = scheme == SchemeKind::FourthOrder ? 3.0 * N : double(N);
-    if (best_N == 0 || work < best_work) {
-      best_N = N;
-      best_work = work;
-      best_scheme = scheme;
-      best_coarse = coarse;
-    }
-  }
+  const SchemeChoice choice = chooseScheme(problem, budgeted, &estimate);
+  if (choice.failed) return finish(choice.coarse.plan);
+  const int best_N = choice.N;
+  const SchemeKind best_scheme = choice.scheme;
+  const Rung& best_coarse = choice.coarse;
   PlanningProblem chosen = problem;
   chosen.scheme = best_scheme;
   estimate.order = assumedOrder(problem, best_scheme, target.measure);

@@ -177,107 +177,38 @@ void propagateRigidBody(const Matrix3& inertia, const std::array<Vector3, 4>& c,
   *angular_velocity = x.segment<3>(4);
 }
 
-ContinuousReference solveContinuousReference(const PlanningProblem& problem_in,
-                                             const ReferenceOptions& options) {
-  PlanningProblem problem = problem_in;
-  problem.accuracy = AccuracyTarget{};  // the guess is a plan at a fixed N
-  validateProblem(problem);
-  if ((problem.effects && !problem.effects->empty()) || problem.hasTorqueBounds()) {
-    throw InvalidInput(
-        "continuous reference: effects and actuator limits are not supported (bare rigid body)");
-  }
-  if (options.segments < 1 || options.macro_steps_per_segment < 1) {
-    throw InvalidInput("continuous reference: segments and macro_steps_per_segment must be >= 1");
-  }
-  const int M = options.segments;
-  const int steps = options.macro_steps_per_segment;
-  const double T = problem.duration;
-  const double span = T / M;
-  const Matrix3& J = problem.inertia;
-  const Matrix3 J_inverse = J.inverse();
+namespace {
 
-  ContinuousReference ref;
-  ref.J_ = J;
-  ref.T_ = T;
-  ref.max_macro_step_ = span / steps;
+/// Multiple shooting on the extremal flow: M segments of `span` seconds, each integrated in
+/// `steps` macro steps. Unknowns: (π_0, ν_0) and the inner nodes' (δR, δΩ, δπ, δν).
+struct Shooting {
+  Shooting(const PlanningProblem& problem, int M, int steps)
+      : problem(problem),
+        J(problem.inertia),
+        J_inverse(problem.inertia.inverse()),
+        M(M),
+        steps(steps),
+        span(problem.duration / M),
+        q_final(so3::quaternionCoefficients<double>(problem.final_attitude)),
+        n(6 + kStateDim * (M - 1)) {}
 
-  Maneuver default_guess;
-  const Maneuver* guess = options.guess;
-  if (guess == nullptr || guess->steps() < 4) {
-    PlanningProblem coarse = problem;
-    coarse.steps = 256;
-    coarse.scheme = SchemeKind::Paper;
-    const PlanResult plan = planAtResolution(coarse);
-    if (!plan.converged()) {
-      ref.message = "initial guess: the discrete plan did not converge: " + plan.message;
-      return ref;
-    }
-    default_guess = plan.maneuver;
-    guess = &default_guess;
-  }
-  std::vector<ContinuousState> nodes = guessNodes(problem, *guess, M);
-  const Quaternion4 q_final = so3::quaternionCoefficients<double>(problem.final_attitude);
-
-  const int n = 6 + kStateDim * (M - 1);
-  using D = Dual<kStateDim>;
-  // Defects and their Jacobian at the current nodes.
-  const auto evaluate = [&](const std::vector<ContinuousState>& nodes, Eigen::VectorXd* defect,
-                            Eigen::MatrixXd* jacobian) {
+  /// Defects (and, given `jacobian`, their Jacobian) at the nodes.
+  void evaluate(const std::vector<ContinuousState>& nodes, Eigen::VectorXd* defect,
+                Eigen::MatrixXd* jacobian) const {
     defect->setZero(n);
     if (jacobian) jacobian->setZero(n, n);
     for (int m = 0; m < M; ++m) {
-      const Flow<double> x0 = flowOfState(nodes[m]);
-      const int row = kStateDim * m;
-      const bool last = m == M - 1;
-      const Quaternion4 q_target =
-          last ? q_final : Quaternion4(so3::quaternionCoefficients<double>(nodes[m + 1].attitude));
-      if (!jacobian) {
-        const Flow<double> x1 = integrateFlow<double>(J, J_inverse, x0, span, steps);
-        defect->segment<3>(row) = relativeRotation<double>(q_target, x1.head<4>());
-        if (last) {
-          defect->segment<3>(row + 3) = x1.segment<3>(4) - problem.final_velocity;
-        } else {
-          defect->segment<9>(row + 3) = x1.segment<9>(4) - flowOfState(nodes[m + 1]).segment<9>(4);
-        }
-        continue;
-      }
-      // Seed the start perturbation: R exp(ε_R^) (quaternion q ⊗ q(ε_R)), Ω + ε_Ω, π + ε_π, ν +
-      // ε_ν.
-      Flow<D> y;
-      so3::Vec3<D> eps_R;
-      for (int i = 0; i < 3; ++i) eps_R(i) = D(0.0, i);
-      y.head<4>() = so3::quaternionProduct<D>(x0.head<4>().cast<D>(),
-                                              so3::quaternionOfRotationVector<D>(eps_R));
-      for (int i = 0; i < 9; ++i) y(4 + i) = D(x0(4 + i), 3 + i);
-      y(13) = D(x0(13));
-      const Flow<D> y1 = integrateFlow<D>(J, J_inverse, y, span, steps);
-      Eigen::Matrix<double, kStateDim, kStateDim> block;  // ∂(defect rows)/∂ε
-      const so3::Vec3<D> dR = relativeRotation<D>(q_target, Eigen::Matrix<D, 4, 1>(y1.head<4>()));
-      const int rows = last ? 6 : kStateDim;
-      for (int i = 0; i < rows; ++i) {
-        const D& value = i < 3 ? dR(i) : y1(4 + (i - 3));
-        (*defect)(row + i) = value.v;
-        for (int j = 0; j < kStateDim; ++j) block(i, j) = value.d(j);
-      }
-      if (last) (*defect).segment<3>(row + 3) -= problem.final_velocity;
-      if (!last) (*defect).segment<9>(row + 3) -= flowOfState(nodes[m + 1]).segment<9>(4);
-      // Columns of this segment's own unknowns: segment 0 only has (π_0, ν_0).
-      if (m == 0) {
-        jacobian->block(row, 0, rows, 6) = block.block(0, 6, rows, 6);
+      if (jacobian) {
+        segmentWithJacobian(nodes, m, defect, jacobian);
       } else {
-        jacobian->block(row, 6 + kStateDim * (m - 1), rows, kStateDim) = block.topRows(rows);
-      }
-      if (!last) {
-        // d_R = log(exp(−δ) R_{m+1}ᵀ R_end) = d − Jl⁻¹(d) δ,  Jl⁻¹(d) = Jr⁻¹(−d)
-        const int col = 6 + kStateDim * m;
-        const Vector3 d = (*defect).segment<3>(row);
-        jacobian->block<3, 3>(row, col) = -so3::rightJacobianInverse(Vector3(-d));
-        jacobian->block<9, 9>(row + 3, col + 3) = -Eigen::Matrix<double, 9, 9>::Identity();
+        segmentDefect(nodes, m, defect);
       }
     }
-  };
-  const auto apply = [&](const std::vector<ContinuousState>& from, const Eigen::VectorXd& step,
-                         double alpha) {
+  }
+
+  /// The nodes moved by alpha·step (attitudes on the group).
+  std::vector<ContinuousState> apply(const std::vector<ContinuousState>& from,
+                                     const Eigen::VectorXd& step, double alpha) const {
     std::vector<ContinuousState> to = from;
     to[0].costate_attitude += alpha * step.segment<3>(0);
     to[0].costate_velocity += alpha * step.segment<3>(3);
@@ -290,13 +221,88 @@ ContinuousReference solveContinuousReference(const PlanningProblem& problem_in,
       to[m].costate_velocity += s.segment<3>(9);
     }
     return to;
-  };
+  }
 
-  Eigen::VectorXd defect;
+  const PlanningProblem& problem;
+  const Matrix3& J;
+  const Matrix3 J_inverse;
+  const int M;
+  const int steps;
+  const double span;
+  const Quaternion4 q_final;
+  const int n;
+
+ private:
+  using D = Dual<kStateDim>;
+
+  Quaternion4 target(const std::vector<ContinuousState>& nodes, int m) const {
+    return m == M - 1 ? q_final
+                      : Quaternion4(so3::quaternionCoefficients<double>(nodes[m + 1].attitude));
+  }
+
+  void segmentDefect(const std::vector<ContinuousState>& nodes, int m,
+                     Eigen::VectorXd* defect) const {
+    const int row = kStateDim * m;
+    const Flow<double> x1 = integrateFlow<double>(J, J_inverse, flowOfState(nodes[m]), span, steps);
+    defect->segment<3>(row) = relativeRotation<double>(target(nodes, m), x1.head<4>());
+    if (m == M - 1) {
+      defect->segment<3>(row + 3) = x1.segment<3>(4) - problem.final_velocity;
+    } else {
+      defect->segment<9>(row + 3) = x1.segment<9>(4) - flowOfState(nodes[m + 1]).segment<9>(4);
+    }
+  }
+
+  void segmentWithJacobian(const std::vector<ContinuousState>& nodes, int m,
+                           Eigen::VectorXd* defect, Eigen::MatrixXd* jacobian) const {
+    const Flow<double> x0 = flowOfState(nodes[m]);
+    const int row = kStateDim * m;
+    const bool last = m == M - 1;
+    // Seed the start perturbation: R exp(ε_R^) (quaternion q ⊗ q(ε_R)), Ω + ε_Ω, π + ε_π, ν +
+    // ε_ν.
+    Flow<D> y;
+    so3::Vec3<D> eps_R;
+    for (int i = 0; i < 3; ++i) eps_R(i) = D(0.0, i);
+    y.head<4>() = so3::quaternionProduct<D>(x0.head<4>().cast<D>(),
+                                            so3::quaternionOfRotationVector<D>(eps_R));
+    for (int i = 0; i < 9; ++i) y(4 + i) = D(x0(4 + i), 3 + i);
+    y(13) = D(x0(13));
+    const Flow<D> y1 = integrateFlow<D>(J, J_inverse, y, span, steps);
+    Eigen::Matrix<double, kStateDim, kStateDim> block;  // ∂(defect rows)/∂ε
+    const so3::Vec3<D> dR =
+        relativeRotation<D>(target(nodes, m), Eigen::Matrix<D, 4, 1>(y1.head<4>()));
+    const int rows = last ? 6 : kStateDim;
+    for (int i = 0; i < rows; ++i) {
+      const D& value = i < 3 ? dR(i) : y1(4 + (i - 3));
+      (*defect)(row + i) = value.v;
+      for (int j = 0; j < kStateDim; ++j) block(i, j) = value.d(j);
+    }
+    if (last) (*defect).segment<3>(row + 3) -= problem.final_velocity;
+    if (!last) (*defect).segment<9>(row + 3) -= flowOfState(nodes[m + 1]).segment<9>(4);
+    // Columns of this segment's own unknowns: segment 0 only has (π_0, ν_0).
+    if (m == 0) {
+      jacobian->block(row, 0, rows, 6) = block.block(0, 6, rows, 6);
+    } else {
+      jacobian->block(row, 6 + kStateDim * (m - 1), rows, kStateDim) = block.topRows(rows);
+    }
+    if (!last) {
+      // d_R = log(exp(−δ) R_{m+1}ᵀ R_end) = d − Jl⁻¹(d) δ,  Jl⁻¹(d) = Jr⁻¹(−d)
+      const int col = 6 + kStateDim * m;
+      const Vector3 d = (*defect).segment<3>(row);
+      jacobian->block<3, 3>(row, col) = -so3::rightJacobianInverse(Vector3(-d));
+      jacobian->block<9, 9>(row + 3, col + 3) = -Eigen::Matrix<double, 9, 9>::Identity();
+    }
+  }
+};
+
+/// Newton on the defects with backtracking on their norm, from `nodes` (updated in place).
+/// Returns the iterations taken; `defect` holds the defects at the final nodes.
+int solveDefects(const Shooting& shooting, const ReferenceOptions& options,
+                 std::vector<ContinuousState>& nodes, Eigen::VectorXd& defect) {
   Eigen::MatrixXd jacobian;
-  evaluate(nodes, &defect, &jacobian);
+  shooting.evaluate(nodes, &defect, &jacobian);
   double norm = defect.norm();
-  for (ref.iterations = 0; ref.iterations < options.max_iterations;) {
+  int iterations = 0;
+  while (iterations < options.max_iterations) {
     if (defect.lpNorm<Eigen::Infinity>() <= options.tolerance) break;
     const Eigen::VectorXd step = -jacobian.partialPivLu().solve(defect);
     if (!step.allFinite()) break;
@@ -305,43 +311,113 @@ ContinuousReference solveContinuousReference(const PlanningProblem& problem_in,
     Eigen::VectorXd trial_defect;
     bool accepted = false;
     for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
-      trial = apply(nodes, step, alpha);
-      evaluate(trial, &trial_defect, nullptr);
+      trial = shooting.apply(nodes, step, alpha);
+      shooting.evaluate(trial, &trial_defect, nullptr);
       if (trial_defect.allFinite() && trial_defect.norm() < norm) {
         accepted = true;
         break;
       }
     }
-    ++ref.iterations;
+    ++iterations;
     if (!accepted) break;  // no decrease: at the round-off floor (or lost)
     nodes = trial;
-    evaluate(nodes, &defect, &jacobian);
+    shooting.evaluate(nodes, &defect, &jacobian);
     norm = defect.norm();
   }
-  ref.max_defect = defect.lpNorm<Eigen::Infinity>();
+  return iterations;
+}
 
-  // Nodes with the running cost; the end of each interval integrated at H and H/2.
-  ref.nodes_.clear();
+/// The first guess of the nodes' costates: options.guess, or a discrete plan at N = 256.
+/// Returns null (the reason in *failure) when that plan does not converge.
+const Maneuver* referenceGuess(const PlanningProblem& problem, const ReferenceOptions& options,
+                               Maneuver* storage, std::string* failure) {
+  const Maneuver* guess = options.guess;
+  if (guess != nullptr && guess->steps() >= 4) return guess;
+  PlanningProblem coarse = problem;
+  coarse.steps = 256;
+  coarse.scheme = SchemeKind::Paper;
+  const PlanResult plan = planAtResolution(coarse);
+  if (!plan.converged()) {
+    *failure = "initial guess: the discrete plan did not converge: " + plan.message;
+    return nullptr;
+  }
+  *storage = plan.maneuver;
+  return storage;
+}
+
+/// The reference's nodes with the running cost (the last one at T), each interval's end
+/// integrated at H and H/2 for the integration error.
+struct NodeRecord {
+  std::vector<ContinuousState> nodes;
+  double cost = 0.0;
+  double hamiltonian_drift = 0.0;
+  double integration_error = 0.0;
+};
+
+NodeRecord recordNodes(const Shooting& shooting, const std::vector<ContinuousState>& nodes) {
+  NodeRecord out;
   double cost = 0.0;
   double H0 = 0.0;
-  for (int m = 0; m < M; ++m) {
+  for (int m = 0; m < shooting.M; ++m) {
     ContinuousState start = nodes[m];
-    start.t = m * span;
+    start.t = m * shooting.span;
     start.cost = cost;
-    if (m == 0) H0 = hamiltonian(J, start);
-    ref.hamiltonian_drift = std::max(ref.hamiltonian_drift, std::abs(hamiltonian(J, start) - H0));
-    ref.nodes_.push_back(start);
+    if (m == 0) H0 = hamiltonian(shooting.J, start);
+    out.hamiltonian_drift =
+        std::max(out.hamiltonian_drift, std::abs(hamiltonian(shooting.J, start) - H0));
+    out.nodes.push_back(start);
     const Flow<double> x = flowOfState(start);
-    const Flow<double> coarse = integrateFlow<double>(J, J_inverse, x, span, steps);
-    const Flow<double> fine = integrateFlow<double>(J, J_inverse, x, span, 2 * steps);
-    ref.integration_error = std::max(
-        {ref.integration_error, (coarse.head<13>() - fine.head<13>()).lpNorm<Eigen::Infinity>(),
+    const Flow<double> coarse =
+        integrateFlow<double>(shooting.J, shooting.J_inverse, x, shooting.span, shooting.steps);
+    const Flow<double> fine =
+        integrateFlow<double>(shooting.J, shooting.J_inverse, x, shooting.span, 2 * shooting.steps);
+    out.integration_error = std::max(
+        {out.integration_error, (coarse.head<13>() - fine.head<13>()).lpNorm<Eigen::Infinity>(),
          std::abs(coarse(13) - fine(13))});
     cost = fine(13);
-    if (m == M - 1) ref.nodes_.push_back(stateOfFlow(fine, T));
+    if (m == shooting.M - 1) out.nodes.push_back(stateOfFlow(fine, shooting.problem.duration));
   }
-  ref.cost = cost;
-  const double scale = 1.0 + std::max(cost / T, 1.0);
+  out.cost = cost;
+  return out;
+}
+
+}  // namespace
+
+ContinuousReference solveContinuousReference(const PlanningProblem& problem_in,
+                                             const ReferenceOptions& options) {
+  PlanningProblem problem = problem_in;
+  problem.accuracy = AccuracyTarget{};  // the guess is a plan at a fixed N
+  validateProblem(problem);
+  if ((problem.effects && !problem.effects->empty()) || problem.hasTorqueBounds()) {
+    throw InvalidInput(
+        "continuous reference: effects and actuator limits are not supported (bare rigid body)");
+  }
+  if (options.segments < 1 || options.macro_steps_per_segment < 1) {
+    throw InvalidInput("continuous reference: segments and macro_steps_per_segment must be >= 1");
+  }
+  const Shooting shooting(problem, options.segments, options.macro_steps_per_segment);
+  const double T = problem.duration;
+
+  ContinuousReference ref;
+  ref.J_ = problem.inertia;
+  ref.T_ = T;
+  ref.max_macro_step_ = shooting.span / shooting.steps;
+
+  Maneuver default_guess;
+  const Maneuver* guess = referenceGuess(problem, options, &default_guess, &ref.message);
+  if (guess == nullptr) return ref;
+  std::vector<ContinuousState> nodes = guessNodes(problem, *guess, shooting.M);
+
+  Eigen::VectorXd defect;
+  ref.iterations = solveDefects(shooting, options, nodes, defect);
+  ref.max_defect = defect.lpNorm<Eigen::Infinity>();
+
+  NodeRecord record = recordNodes(shooting, nodes);
+  ref.nodes_ = std::move(record.nodes);
+  ref.hamiltonian_drift = record.hamiltonian_drift;
+  ref.integration_error = record.integration_error;
+  ref.cost = record.cost;
+  const double scale = 1.0 + std::max(ref.cost / T, 1.0);
   ref.converged = defect.allFinite() && ref.max_defect <= 1e-10 * scale;
   std::ostringstream msg;
   msg << (ref.converged ? "converged" : "not converged") << ": " << ref.iterations

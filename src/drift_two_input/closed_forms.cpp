@@ -68,16 +68,7 @@ DriftTwoInputClosedForm::DriftTwoInputClosedForm(const Vector3& p0, const DriftT
   os.precision(17);
 
   if (w.c1 == w.c2) {
-    // Prop. 4.2 (corrected): p3 = k2 is constant, and (3.15)–(3.16) read ṗ1 = (1 − k2/c) p2,
-    // ṗ2 = −(1 − k2/c) p1, so p1 + i p2 = √k1 exp(i((k2/c − 1) t + k3)), k3 = atan2(p2(0), p1(0)).
-    case_ = DriftTwoInputCase::kCircular;
-    k1_ = p0.x() * p0.x() + p0.y() * p0.y();
-    k2_ = p0.z();
-    k3_ = std::atan2(p0.y(), p0.x());
-    omega_ = k2_ / w.c1 - 1.0;
-    lambda_ = omega_;
-    valid_ = true;
-    os << "c1 = c2 = " << w.c1 << ": circular functions (Prop. 4.2)";
+    initCircular(p0, os);
     message_ = os.str();
     return;
   }
@@ -86,14 +77,47 @@ DriftTwoInputClosedForm::DriftTwoInputClosedForm(const Vector3& p0, const DriftT
   swapped_ = w.c1 < w.c2;
   const Vector3 q0 = swapped_ ? rotateToSwapped(p0) : p0;
   const double c1 = swapped_ ? w.c2 : w.c1, c2 = swapped_ ? w.c1 : w.c2;
+  if (!initElliptic(c1, c2, form, os)) {
+    message_ = os.str();
+    return;
+  }
+  const double best = matchPhase(q0, c1, c2);
+  const double tol = 1e-10 * (1.0 + q0.norm());
+  if (!(best <= tol)) {
+    os << toString(case_) << " holds but p0 was not matched on the closed-form orbit (residual "
+       << best << ")";
+    case_ = DriftTwoInputCase::kOutsideStatedCases;
+    message_ = os.str();
+    return;
+  }
+  valid_ = true;
+  os << toString(case_) << ", phi = " << toString(form_) << ", modulus k = " << k_
+     << ", u = " << lambda_ << " t + " << u0_;
+  message_ = os.str();
+}
+
+void DriftTwoInputClosedForm::initCircular(const Vector3& p0, std::ostream& os) {
+  // Prop. 4.2 (corrected): p3 = k2 is constant, and (3.15)–(3.16) read ṗ1 = (1 − k2/c) p2,
+  // ṗ2 = −(1 − k2/c) p1, so p1 + i p2 = √k1 exp(i((k2/c − 1) t + k3)), k3 = atan2(p2(0), p1(0)).
+  case_ = DriftTwoInputCase::kCircular;
+  k1_ = p0.x() * p0.x() + p0.y() * p0.y();
+  k2_ = p0.z();
+  k3_ = std::atan2(p0.y(), p0.x());
+  omega_ = k2_ / w_.c1 - 1.0;
+  lambda_ = omega_;
+  valid_ = true;
+  os << "c1 = c2 = " << w_.c1 << ": circular functions (Prop. 4.2)";
+}
+
+bool DriftTwoInputClosedForm::initElliptic(double c1, double c2, EllipticForm form,
+                                           std::ostream& os) {
   const char* big = swapped_ ? "c2" : "c1";
   const char* small = swapped_ ? "c1" : "c2";
   os << "h0 = " << h0_ << ", c0 = " << c0_ << ", " << small << " = " << c2 << " < " << big << " = "
      << c1 << (swapped_ ? " (seed's c2 < c1 formulas after q = (p2, -p1, p3))" : "") << ": ";
   if (!(c0_ > 0.0) || !(h0_ * h0_ > c0_)) {
     os << "Prop. 4.3 needs c0 > 0 and h0^2 > c0 (h0^2 - c0 = " << h0_ * h0_ - c0_ << ")";
-    message_ = os.str();
-    return;
+    return false;
   }
   const double s = std::sqrt(h0_ * h0_ - c0_);
   alpha_ = h0_ + s;
@@ -108,8 +132,7 @@ DriftTwoInputClosedForm::DriftTwoInputClosedForm(const Vector3& p0, const DriftT
        << ", b^2 < a^2] nor (ii) [|h0 - " << big << "| < sqrt(h0^2-c0) < h0 - " << small
        << "] holds (h0 - " << big << " = " << h0_ - c1 << ", h0 - " << small << " = " << h0_ - c2
        << ", sqrt(h0^2-c0) = " << s << ")";
-    message_ = os.str();
-    return;
+    return false;
   }
   case_ = case_i ? DriftTwoInputCase::kEllipticCaseI : DriftTwoInputCase::kEllipticCaseII;
   // μ1 μ2 of the proof (4.22); M = √(μ1 μ2) (the statement's M lacks the square root).
@@ -138,8 +161,11 @@ DriftTwoInputClosedForm::DriftTwoInputClosedForm(const Vector3& p0, const DriftT
   }
   A1_ = std::sqrt(kappa1 * m1);
   A2_ = std::sqrt(kappa2 * m2);
+  return true;
+}
 
-  // Phase: find the amplitude θ0 (sn = sin θ0, cn = cos θ0) and signs (σ1, σ2) with q(θ0) = q0
+double DriftTwoInputClosedForm::matchPhase(const Vector3& q0, double c1, double c2) {
+  // Find the amplitude θ0 (sn = sin θ0, cn = cos θ0) and signs (σ1, σ2) with q(θ0) = q0
   // moving along the vector field; coarse grid, then Gauss–Newton in θ. The orbit has two
   // components (σ2 = ±1); σ1 = −1 is the time reversal θ → −θ of σ1 = +1, so the direction of
   // the flow at q0 picks σ1.
@@ -180,18 +206,7 @@ DriftTwoInputClosedForm::DriftTwoInputClosedForm(const Vector3& p0, const DriftT
       }
     }
   }
-  const double tol = 1e-10 * (1.0 + q0.norm());
-  if (!(best <= tol)) {
-    os << toString(case_) << " holds but p0 was not matched on the closed-form orbit (residual "
-       << best << ")";
-    case_ = DriftTwoInputCase::kOutsideStatedCases;
-    message_ = os.str();
-    return;
-  }
-  valid_ = true;
-  os << toString(case_) << ", phi = " << toString(form_) << ", modulus k = " << k_
-     << ", u = " << lambda_ << " t + " << u0_;
-  message_ = os.str();
+  return best;
 }
 
 Vector3 DriftTwoInputClosedForm::ellipticAt(double sn, double cn, double dn, double s1,

@@ -422,6 +422,133 @@ constexpr int kMaxWinding = 2;
 
 // ---- Multiple shooting ----------------------------------------------------------------------
 //
+// Dense output not wanted: integrateTaylor's visitor that does nothing.
+struct NoSamples {
+  template <typename Series>
+  void operator()(double, double, const Series&) const {}
+};
+constexpr NoSamples kNoSamples{};
+
+// The nodes of multiple shooting and their equations: (G_j, P_j) at t_j = j τ, G_0 = g0 fixed.
+class MultipleShooting {
+ public:
+  MultipleShooting(const DriftTwoInputRequest& rq, const Quat<double>& target_conj, int M)
+      : rq_(rq), target_conj_(target_conj), M_(M), tau_(rq.duration / M), n_(6 * (M - 1) + 3) {}
+
+  // Nodes on the single-shooting trajectory from p; false when it cannot be integrated.
+  bool initialNodes(const Vector3& p, std::vector<Quat<double>>& G, std::vector<Vector3>& P) const {
+    G.resize(M_);
+    P.resize(M_);
+    try {
+      ExtremalState<double> x{p, quaternionOf(rq_.g0), 0.0};
+      for (int j = 0; j < M_; ++j) {
+        G[j] = x.q / x.q.norm();
+        P[j] = x.p;
+        x = integrateTaylor<double>(x, tau_, rq_.weights, rq_.max_step, nullptr, kNoSamples);
+      }
+    } catch (const StepTooLarge&) {
+      return false;
+    }
+    G[0] = quaternionOf(rq_.g0);
+    return true;
+  }
+
+  // Residuals F (and, given J, their Jacobian); false when an interval cannot be integrated.
+  bool evaluate(const std::vector<Quat<double>>& Gs, const std::vector<Vector3>& Ps,
+                Eigen::VectorXd& F, Eigen::MatrixXd* J) const {
+    F.setZero(n_);
+    if (J) J->setZero(n_, n_);
+    try {
+      for (int j = 0; j < M_; ++j) {
+        if (J) {
+          intervalWithJacobian(j, Gs, Ps, F, *J);
+        } else {
+          intervalValue(j, Gs, Ps, F);
+        }
+      }
+    } catch (const StepTooLarge&) {
+      return false;
+    }
+    return F.allFinite();
+  }
+
+  // The nodes moved by a·dx: G_j exp(a δ_j), P_j + a Δp_j.
+  void retract(const std::vector<Quat<double>>& G, const std::vector<Vector3>& P,
+               const Eigen::VectorXd& dx, double a, std::vector<Quat<double>>& Gs,
+               std::vector<Vector3>& Ps) const {
+    Gs = G;
+    Ps = P;
+    Ps[0] += a * dx.segment<3>(0);
+    for (int j = 1; j < M_; ++j) {
+      Gs[j] = so3::quaternionProduct<double>(
+          G[j],
+          so3::quaternionOfRotationVector<double>(Vector3(a * dx.segment<3>(3 + 6 * (j - 1)))));
+      Ps[j] += a * dx.segment<3>(3 + 6 * (j - 1) + 3);
+    }
+  }
+
+ private:
+  using D = Dual<9>;
+
+  void intervalValue(int j, const std::vector<Quat<double>>& Gs, const std::vector<Vector3>& Ps,
+                     Eigen::VectorXd& F) const {
+    const bool last = j == M_ - 1;
+    const int row = 6 * j;
+    const ExtremalState<double> x = integrateTaylor<double>({Ps[j], Gs[j], 0.0}, tau_, rq_.weights,
+                                                            rq_.max_step, nullptr, kNoSamples);
+    const Quat<double> next_conj = last ? target_conj_ : conjugate(Gs[j + 1]);
+    F.segment<3>(row) = terminalResidual<double>(x.q, next_conj);
+    if (!last) F.segment<3>(row + 3) = x.p - Ps[j + 1];
+  }
+
+  // Interval j with Dual<9> over (δ_j, p_j, δ_{j+1}): its rows of F and J.
+  void intervalWithJacobian(int j, const std::vector<Quat<double>>& Gs,
+                            const std::vector<Vector3>& Ps, Eigen::VectorXd& F,
+                            Eigen::MatrixXd& J) const {
+    const bool last = j == M_ - 1;
+    const int row = 6 * j;
+    const int col_p = j == 0 ? 0 : 3 + 6 * (j - 1) + 3, col_d = 3 + 6 * (j - 1);
+    const int col_dn = 3 + 6 * j;  // δ_{j+1}
+    so3::Vec3<D> d0, q, dn;
+    for (int i = 0; i < 3; ++i) {
+      d0(i) = D(0.0, i);
+      q(i) = D(Ps[j](i), 3 + i);
+      dn(i) = D(0.0, 6 + i);
+    }
+    const Quat<D> start =
+        so3::quaternionProduct<D>(Gs[j].cast<D>(), so3::quaternionOfRotationVector<D>(d0));
+    const ExtremalState<D> x = integrateTaylor<D>({q, start, D(0.0)}, tau_, rq_.weights,
+                                                  rq_.max_step, nullptr, kNoSamples);
+    Quat<D> next_conj;
+    if (last) {
+      next_conj = target_conj_.cast<D>();
+    } else {
+      const Quat<D> nx =
+          so3::quaternionProduct<D>(Gs[j + 1].cast<D>(), so3::quaternionOfRotationVector<D>(dn));
+      next_conj = Quat<D>(nx(0), -nx(1), -nx(2), -nx(3));
+    }
+    const so3::Vec3<D> rg =
+        so3::logOfQuaternion<D>(so3::quaternionProduct<D>(next_conj, Quat<D>(x.q / x.q.norm())));
+    for (int i = 0; i < 3; ++i) {
+      F(row + i) = rg(i).v;
+      if (j > 0) J.block<1, 3>(row + i, col_d) = rg(i).d.segment<3>(0).transpose();
+      J.block<1, 3>(row + i, col_p) = rg(i).d.segment<3>(3).transpose();
+      if (!last) J.block<1, 3>(row + i, col_dn) = rg(i).d.segment<3>(6).transpose();
+      if (last) continue;
+      F(row + 3 + i) = x.p(i).v - Ps[j + 1](i);
+      if (j > 0) J.block<1, 3>(row + 3 + i, col_d) = x.p(i).d.segment<3>(0).transpose();
+      J.block<1, 3>(row + 3 + i, col_p) = x.p(i).d.segment<3>(3).transpose();
+      J(row + 3 + i, col_dn + 3 + i) = -1.0;  // ∂(p_end − p_{j+1})/∂p_{j+1}
+    }
+  }
+
+  const DriftTwoInputRequest& rq_;
+  const Quat<double> target_conj_;
+  const int M_;
+  const double tau_;
+  const int n_;
+};
+
 // For long horizons, where the sensitivity of g(T) to p(0) grows: [0, T] is split into M equal
 // intervals; unknowns are p(0) and, at the inner nodes, (g_j, p_j) with g_j updated on the group
 // (ĝ_j exp(δ_j)). Equations: continuity of g and p at each inner node and log(targetᵀ g_end) = 0
@@ -430,95 +557,12 @@ constexpr int kMaxWinding = 2;
 bool multipleShootingSolve(const DriftTwoInputRequest& rq, const Quat<double>& target_conj, int M,
                            double tol, int max_iterations, Vector3& p, int& iterations,
                            double& error) {
-  const double tau = rq.duration / M;
-  const int n = 6 * (M - 1) + 3;
-  std::vector<Quat<double>> G(M);
-  std::vector<Vector3> P(M);
-  const DriftTwoInputWeights& w = rq.weights;
-  auto none = [](double, double, const auto&) {};
-  try {  // initial nodes on the single-shooting trajectory from p
-    ExtremalState<double> x{p, quaternionOf(rq.g0), 0.0};
-    for (int j = 0; j < M; ++j) {
-      G[j] = x.q / x.q.norm();
-      P[j] = x.p;
-      x = integrateTaylor<double>(x, tau, w, rq.max_step, nullptr, none);
-    }
-  } catch (const StepTooLarge&) {
-    error = INFINITY;
-    return false;
-  }
-  G[0] = quaternionOf(rq.g0);
-  using D = Dual<9>;
-  auto evaluate = [&](const std::vector<Quat<double>>& Gs, const std::vector<Vector3>& Ps,
-                      Eigen::VectorXd& F, Eigen::MatrixXd* J) -> bool {
-    F.setZero(n);
-    if (J) J->setZero(n, n);
-    try {
-      for (int j = 0; j < M; ++j) {
-        const bool last = j == M - 1;
-        const int row = 6 * j;
-        const int col_p = j == 0 ? 0 : 3 + 6 * (j - 1) + 3, col_d = 3 + 6 * (j - 1);
-        const int col_dn = 3 + 6 * j;  // δ_{j+1}
-        if (!J) {
-          const ExtremalState<double> x =
-              integrateTaylor<double>({Ps[j], Gs[j], 0.0}, tau, w, rq.max_step, nullptr, none);
-          const Quat<double> next_conj = last ? target_conj : conjugate(Gs[j + 1]);
-          F.segment<3>(row) = terminalResidual<double>(x.q, next_conj);
-          if (!last) F.segment<3>(row + 3) = x.p - Ps[j + 1];
-          continue;
-        }
-        so3::Vec3<D> d0, q, dn;
-        for (int i = 0; i < 3; ++i) {
-          d0(i) = D(0.0, i);
-          q(i) = D(Ps[j](i), 3 + i);
-          dn(i) = D(0.0, 6 + i);
-        }
-        const Quat<D> start =
-            so3::quaternionProduct<D>(Gs[j].cast<D>(), so3::quaternionOfRotationVector<D>(d0));
-        const ExtremalState<D> x =
-            integrateTaylor<D>({q, start, D(0.0)}, tau, w, rq.max_step, nullptr, none);
-        Quat<D> next_conj;
-        if (last) {
-          next_conj = target_conj.cast<D>();
-        } else {
-          const Quat<D> nx = so3::quaternionProduct<D>(Gs[j + 1].cast<D>(),
-                                                       so3::quaternionOfRotationVector<D>(dn));
-          next_conj = Quat<D>(nx(0), -nx(1), -nx(2), -nx(3));
-        }
-        const so3::Vec3<D> rg = so3::logOfQuaternion<D>(
-            so3::quaternionProduct<D>(next_conj, Quat<D>(x.q / x.q.norm())));
-        for (int i = 0; i < 3; ++i) {
-          F(row + i) = rg(i).v;
-          if (j > 0) J->block<1, 3>(row + i, col_d) = rg(i).d.segment<3>(0).transpose();
-          J->block<1, 3>(row + i, col_p) = rg(i).d.segment<3>(3).transpose();
-          if (!last) J->block<1, 3>(row + i, col_dn) = rg(i).d.segment<3>(6).transpose();
-          if (last) continue;
-          F(row + 3 + i) = x.p(i).v - Ps[j + 1](i);
-          if (j > 0) J->block<1, 3>(row + 3 + i, col_d) = x.p(i).d.segment<3>(0).transpose();
-          J->block<1, 3>(row + 3 + i, col_p) = x.p(i).d.segment<3>(3).transpose();
-          (*J)(row + 3 + i, col_dn + 3 + i) = -1.0;  // ∂(p_end − p_{j+1})/∂p_{j+1}
-        }
-      }
-    } catch (const StepTooLarge&) {
-      return false;
-    }
-    return F.allFinite();
-  };
-  auto retract = [&](const Eigen::VectorXd& dx, double a, std::vector<Quat<double>>& Gs,
-                     std::vector<Vector3>& Ps) {
-    Gs = G;
-    Ps = P;
-    Ps[0] += a * dx.segment<3>(0);
-    for (int j = 1; j < M; ++j) {
-      Gs[j] = so3::quaternionProduct<double>(
-          G[j],
-          so3::quaternionOfRotationVector<double>(Vector3(a * dx.segment<3>(3 + 6 * (j - 1)))));
-      Ps[j] += a * dx.segment<3>(3 + 6 * (j - 1) + 3);
-    }
-  };
+  const MultipleShooting shooting(rq, target_conj, M);
+  std::vector<Quat<double>> G;
+  std::vector<Vector3> P;
   Eigen::VectorXd F;
   Eigen::MatrixXd J;
-  if (!evaluate(G, P, F, &J)) {
+  if (!shooting.initialNodes(p, G, P) || !shooting.evaluate(G, P, F, &J)) {
     error = INFINITY;
     return false;
   }
@@ -533,9 +577,9 @@ bool multipleShootingSolve(const DriftTwoInputRequest& rq, const Quat<double>& t
     for (int ls = 0; ls < 30; ++ls, a *= 0.5) {
       std::vector<Quat<double>> Gs;
       std::vector<Vector3> Ps;
-      retract(dx, a, Gs, Ps);
+      shooting.retract(G, P, dx, a, Gs, Ps);
       Eigen::VectorXd Ft;
-      if (!evaluate(Gs, Ps, Ft, nullptr)) continue;
+      if (!shooting.evaluate(Gs, Ps, Ft, nullptr)) continue;
       if (Ft.norm() <= (1.0 - 1e-4 * a) * error || (Ft.norm() <= 1e-13 && Ft.norm() <= error)) {
         G = Gs;
         P = Ps;
@@ -545,7 +589,7 @@ bool multipleShootingSolve(const DriftTwoInputRequest& rq, const Quat<double>& t
       }
     }
     if (!accepted || error <= tol) break;
-    if (!evaluate(G, P, F, &J)) break;
+    if (!shooting.evaluate(G, P, F, &J)) break;
   }
   p = P[0];
   return error <= tol;
@@ -739,142 +783,132 @@ DriftTwoInputTrajectory sampleDriftTwoInputExtremal(const Matrix3& g0, const Vec
   return out;
 }
 
-DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
-  validate(rq);
-  const Deadline deadline(rq.time_budget_s);
-  DriftTwoInputPlan plan;
-  Shooter sh(rq.g0, rq.duration, rq.max_step);
-  const double c_bar = 0.5 * (rq.weights.c1 + rq.weights.c2);
-  // Costate scale of a maneuver that turns by about π in T: (c/T)·π; bounds LM steps below.
-  const double p_scale = c_bar * M_PI / rq.duration;
+namespace {
 
-  std::vector<Attempt> attempts;
-  std::string start_kind;
-  if (rq.shooting_intervals > 1) {
-    // Multiple shooting finds p(0) from the guess (default: the cheapest symmetric extremal);
-    // a few single-shooting steps then polish it against the one-piece integration.
-    Vector3 start = Vector3::Zero();
-    if (rq.initial_costate) {
-      start = *rq.initial_costate;
-    } else {
-      const auto sym =
-          symmetricExtremals(Matrix3(rq.g0.transpose() * rq.g1), rq.duration, c_bar, kMaxWinding);
-      if (!sym.empty()) start = sym.front().p0;
-    }
-    Attempt a;
-    a.solve.p = start;
-    const Quat<double> g1_conj = conjugate(quaternionOf(rq.g1));
-    const bool ms_ok =
-        multipleShootingSolve(rq, g1_conj, rq.shooting_intervals, rq.tolerance, rq.max_iterations,
-                              a.solve.p, a.solve.iterations, a.solve.error);
-    if (ms_ok || a.solve.error <= 1e-6) {
-      const int ms_iterations = a.solve.iterations;
-      a.solve = levenbergMarquardt(sh, g1_conj, rq.weights, a.solve.p, rq.tolerance, 5, p_scale,
-                                   deadline);
-      a.solve.iterations += ms_iterations;
-    }
-    a.how = "multiple shooting on " + std::to_string(rq.shooting_intervals) + " intervals";
-    attempts.push_back(a);
-    start_kind = rq.initial_costate ? "the guess" : "the cheapest symmetric extremal";
-  } else if (rq.initial_costate) {
-    attempts.push_back(solveFromGuess(sh, rq, *rq.initial_costate, p_scale, deadline));
-    start_kind = "the guess";
+// Multiple shooting finds p(0) from the guess (default: the cheapest symmetric extremal); a few
+// single-shooting steps then polish it against the one-piece integration.
+Attempt multipleShootingAttempt(Shooter& sh, const DriftTwoInputRequest& rq, double c_bar,
+                                double p_scale, const Deadline& deadline) {
+  Vector3 start = Vector3::Zero();
+  if (rq.initial_costate) {
+    start = *rq.initial_costate;
   } else {
     const auto sym =
         symmetricExtremals(Matrix3(rq.g0.transpose() * rq.g1), rq.duration, c_bar, kMaxWinding);
-    const int n = std::min<int>(kMaxStarts, static_cast<int>(sym.size()));
-    // Same controls, other weights: the cost changes by a factor in [min c/c̄, max c/c̄]. A
-    // symmetric extremal whose cost times min c/c̄ exceeds the best cost found is therefore not
-    // pursued (a heuristic bound: it assumes the extremal's controls change little on the way
-    // to the requested weights). For c1 = c2 the symmetric extremals are the extremals: only
-    // the cheapest is polished.
-    const double ratio = c_bar / std::min(rq.weights.c1, rq.weights.c2);
-    double best_cost = INFINITY;
-    int skipped = 0;
-    for (int i = 0; i < n && !deadline.expired(); ++i) {
-      if (best_cost < INFINITY && sym[i].cost >= best_cost * ratio) {
-        ++skipped;
-        continue;
-      }
-      attempts.push_back(solveFromSymmetric(sh, rq, sym[i].p0, c_bar, p_scale, deadline));
-      if (attempts.back().solve.ok) best_cost = std::min(best_cost, attempts.back().solve.cost);
-    }
-    if (n < 2) {
-      // g0ᵀg1 (nearly) a rotation about e3: the symmetric extremals form circles (rotating p0
-      // about e3 is then a symmetry) that the scan above does not list. Starts from the
-      // shooting equation linearized at (0, 0, p3) instead (there the Jacobian is singular:
-      // p3 only sets the rotation rate of a zero (p1, p2)).
-      for (const Vector3& start : linearizedStarts(sh, rq, c_bar)) {
-        if (deadline.expired()) break;
-        attempts.push_back(solveFromGuess(sh, rq, start, p_scale, deadline));
-      }
-    }
-    std::ostringstream os;
-    os << attempts.size() << " start" << (attempts.size() == 1 ? "" : "s")
-       << " (extremals of the symmetric problem c1 = c2 = " << c_bar << ": " << sym.size()
-       << " listed, the " << n << " cheapest considered, " << skipped
-       << " of them not pursued by the cost bound";
-    if (n < 2) os << "; starts from the linearized shooting equation";
-    os << ")";
-    start_kind = os.str();
+    if (!sym.empty()) start = sym.front().p0;
   }
-  const bool timed_out = deadline.expired();
+  Attempt a;
+  a.solve.p = start;
+  const Quat<double> g1_conj = conjugate(quaternionOf(rq.g1));
+  const bool ms_ok =
+      multipleShootingSolve(rq, g1_conj, rq.shooting_intervals, rq.tolerance, rq.max_iterations,
+                            a.solve.p, a.solve.iterations, a.solve.error);
+  if (ms_ok || a.solve.error <= 1e-6) {
+    const int ms_iterations = a.solve.iterations;
+    a.solve =
+        levenbergMarquardt(sh, g1_conj, rq.weights, a.solve.p, rq.tolerance, 5, p_scale, deadline);
+    a.solve.iterations += ms_iterations;
+  }
+  a.how = "multiple shooting on " + std::to_string(rq.shooting_intervals) + " intervals";
+  return a;
+}
 
-  // The least-cost converged attempt; distinct extremals (p(0) apart) for the report.
+// Starts from the extremals of the symmetric problem (and, where those form circles, from the
+// linearized shooting equation), each carried to the requested weights; appends them to
+// *attempts and returns the description of where they came from.
+std::string symmetricAttempts(Shooter& sh, const DriftTwoInputRequest& rq, double c_bar,
+                              double p_scale, const Deadline& deadline,
+                              std::vector<Attempt>* attempts) {
+  const auto sym =
+      symmetricExtremals(Matrix3(rq.g0.transpose() * rq.g1), rq.duration, c_bar, kMaxWinding);
+  const int n = std::min<int>(kMaxStarts, static_cast<int>(sym.size()));
+  // Same controls, other weights: the cost changes by a factor in [min c/c̄, max c/c̄]. A
+  // symmetric extremal whose cost times min c/c̄ exceeds the best cost found is therefore not
+  // pursued (a heuristic bound: it assumes the extremal's controls change little on the way
+  // to the requested weights). For c1 = c2 the symmetric extremals are the extremals: only
+  // the cheapest is polished.
+  const double ratio = c_bar / std::min(rq.weights.c1, rq.weights.c2);
+  double best_cost = INFINITY;
+  int skipped = 0;
+  for (int i = 0; i < n && !deadline.expired(); ++i) {
+    if (best_cost < INFINITY && sym[i].cost >= best_cost * ratio) {
+      ++skipped;
+      continue;
+    }
+    attempts->push_back(solveFromSymmetric(sh, rq, sym[i].p0, c_bar, p_scale, deadline));
+    if (attempts->back().solve.ok) best_cost = std::min(best_cost, attempts->back().solve.cost);
+  }
+  if (n < 2) {
+    // g0ᵀg1 (nearly) a rotation about e3: the symmetric extremals form circles (rotating p0
+    // about e3 is then a symmetry) that the scan above does not list. Starts from the
+    // shooting equation linearized at (0, 0, p3) instead (there the Jacobian is singular:
+    // p3 only sets the rotation rate of a zero (p1, p2)).
+    for (const Vector3& start : linearizedStarts(sh, rq, c_bar)) {
+      if (deadline.expired()) break;
+      attempts->push_back(solveFromGuess(sh, rq, start, p_scale, deadline));
+    }
+  }
+  std::ostringstream os;
+  os << attempts->size() << " start" << (attempts->size() == 1 ? "" : "s")
+     << " (extremals of the symmetric problem c1 = c2 = " << c_bar << ": " << sym.size()
+     << " listed, the " << n << " cheapest considered, " << skipped
+     << " of them not pursued by the cost bound";
+  if (n < 2) os << "; starts from the linearized shooting equation";
+  os << ")";
+  return os.str();
+}
+
+// The least-cost converged attempt (or, when none converged, the one closest to g1) and the
+// distinct extremals (p(0) apart) among the converged ones.
+struct Selection {
   const Attempt* best = nullptr;
   std::vector<const Attempt*> distinct;
+};
+
+// Also counts the plan's iterations and starts and lists the other extremals' costs.
+Selection selectAttempt(const std::vector<Attempt>& attempts, DriftTwoInputPlan* plan) {
+  Selection sel;
   for (const Attempt& a : attempts) {
-    plan.iterations += a.solve.iterations;
-    ++plan.starts;
+    plan->iterations += a.solve.iterations;
+    ++plan->starts;
     if (!a.solve.ok) continue;
-    ++plan.converged_starts;
+    ++plan->converged_starts;
     bool seen = false;
-    for (const Attempt* d : distinct) {
+    for (const Attempt* d : sel.distinct) {
       seen = seen || (d->solve.p - a.solve.p).norm() <= 1e-6 * (1.0 + a.solve.p.norm());
     }
-    if (!seen) distinct.push_back(&a);
-    if (!best || a.solve.cost < best->solve.cost) best = &a;
+    if (!seen) sel.distinct.push_back(&a);
+    if (!sel.best || a.solve.cost < sel.best->solve.cost) sel.best = &a;
   }
-  if (!best) {  // nothing converged: the attempt closest to g1
+  if (!sel.best) {  // nothing converged: the attempt closest to g1
     for (const Attempt& a : attempts) {
-      if (!best || a.solve.error < best->solve.error) best = &a;
+      if (!sel.best || a.solve.error < sel.best->solve.error) sel.best = &a;
     }
   }
-  for (const Attempt* d : distinct) {
-    if (d != best) plan.other_costs.push_back(d->solve.cost);
+  for (const Attempt* d : sel.distinct) {
+    if (d != sel.best) plan->other_costs.push_back(d->solve.cost);
   }
-  std::sort(plan.other_costs.begin(), plan.other_costs.end());
+  std::sort(plan->other_costs.begin(), plan->other_costs.end());
+  return sel;
+}
 
-  const Vector3 p = best ? best->solve.p : Vector3::Zero();
-  plan.initial_costate = p;
-  plan.continuation_stages = best ? best->stages : 0;
-  {
-    std::ostringstream os;
-    os.precision(6);
-    if (best && best->solve.ok) {
-      os << "least cost of " << distinct.size() << " distinct extremal"
-         << (distinct.size() == 1 ? "" : "s") << " found from " << start_kind;
-      if (!plan.other_costs.empty()) os << "; the others cost " << costList(plan.other_costs);
-    } else {
-      os << "none found from " << start_kind;
-    }
-    plan.extremal = os.str();
+std::string extremalText(const Selection& sel, const DriftTwoInputPlan& plan,
+                         const std::string& start_kind) {
+  std::ostringstream os;
+  os.precision(6);
+  if (sel.best && sel.best->solve.ok) {
+    os << "least cost of " << sel.distinct.size() << " distinct extremal"
+       << (sel.distinct.size() == 1 ? "" : "s") << " found from " << start_kind;
+    if (!plan.other_costs.empty()) os << "; the others cost " << costList(plan.other_costs);
+  } else {
+    os << "none found from " << start_kind;
   }
-  try {
-    plan.trajectory = sampleDriftTwoInputExtremal(rq.g0, p, rq.duration, rq.steps, rq.weights,
-                                                  rq.max_step, &plan.integration_steps);
-    plan.cost = plan.trajectory.cost;
-    plan.terminal_error = so3::angleBetween(rq.g1, plan.trajectory.g.back());
-  } catch (const StepTooLarge& e) {
-    plan.termination = Termination::StepTooLarge;
-    plan.terminal_error = INFINITY;
-    plan.message = std::string("extremal could not be integrated: ") + e.what();
-    return plan;
-  }
-  const bool converged = best && best->solve.ok && plan.terminal_error <= rq.tolerance;
-  plan.termination = converged   ? Termination::Converged
-                     : timed_out ? Termination::TimedOut
-                                 : Termination::NotConverged;
+  return os.str();
+}
+
+std::string planMessage(const DriftTwoInputRequest& rq, const DriftTwoInputPlan& plan,
+                        const Attempt* best, bool converged, bool timed_out) {
+  const Vector3& p = plan.initial_costate;
   std::ostringstream os;
   os.precision(6);
   std::ostringstream budget;
@@ -894,7 +928,55 @@ DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
        << "): best p(0) = " << vec(p) << ", terminal error " << plan.terminal_error
        << " rad; try an initial_costate, multiple shooting or a shorter duration";
   }
-  plan.message = os.str();
+  return os.str();
+}
+
+}  // namespace
+
+DriftTwoInputPlan planDriftTwoInput(const DriftTwoInputRequest& rq) {
+  validate(rq);
+  const Deadline deadline(rq.time_budget_s);
+  DriftTwoInputPlan plan;
+  Shooter sh(rq.g0, rq.duration, rq.max_step);
+  const double c_bar = 0.5 * (rq.weights.c1 + rq.weights.c2);
+  // Costate scale of a maneuver that turns by about π in T: (c/T)·π; bounds LM steps below.
+  const double p_scale = c_bar * M_PI / rq.duration;
+
+  std::vector<Attempt> attempts;
+  std::string start_kind;
+  if (rq.shooting_intervals > 1) {
+    attempts.push_back(multipleShootingAttempt(sh, rq, c_bar, p_scale, deadline));
+    start_kind = rq.initial_costate ? "the guess" : "the cheapest symmetric extremal";
+  } else if (rq.initial_costate) {
+    attempts.push_back(solveFromGuess(sh, rq, *rq.initial_costate, p_scale, deadline));
+    start_kind = "the guess";
+  } else {
+    start_kind = symmetricAttempts(sh, rq, c_bar, p_scale, deadline, &attempts);
+  }
+  const bool timed_out = deadline.expired();
+
+  const Selection sel = selectAttempt(attempts, &plan);
+  const Attempt* best = sel.best;
+  const Vector3 p = best ? best->solve.p : Vector3::Zero();
+  plan.initial_costate = p;
+  plan.continuation_stages = best ? best->stages : 0;
+  plan.extremal = extremalText(sel, plan, start_kind);
+  try {
+    plan.trajectory = sampleDriftTwoInputExtremal(rq.g0, p, rq.duration, rq.steps, rq.weights,
+                                                  rq.max_step, &plan.integration_steps);
+    plan.cost = plan.trajectory.cost;
+    plan.terminal_error = so3::angleBetween(rq.g1, plan.trajectory.g.back());
+  } catch (const StepTooLarge& e) {
+    plan.termination = Termination::StepTooLarge;
+    plan.terminal_error = INFINITY;
+    plan.message = std::string("extremal could not be integrated: ") + e.what();
+    return plan;
+  }
+  const bool converged = best && best->solve.ok && plan.terminal_error <= rq.tolerance;
+  plan.termination = converged   ? Termination::Converged
+                     : timed_out ? Termination::TimedOut
+                                 : Termination::NotConverged;
+  plan.message = planMessage(rq, plan, best, converged, timed_out);
   return plan;
 }
 

@@ -159,6 +159,77 @@ struct Arguments {
   bool help = false;
 };
 
+/// Applies one option (its name without "=value") to *a; next() yields its value.
+template <class NextValue>
+void applyOption(const std::string& arg, const NextValue& next, Arguments* out) {
+  Arguments& a = *out;
+  std::string value_text;  // a flag's value as typed, for messages
+  if (arg == "--steps") {
+    // Its range is the planner's rule (validateProblem / planDriftTwoInput), checked there.
+    a.steps = parseInt(arg, next());
+  } else if (arg == "--scheme") {
+    a.scheme = next();
+    ap::PlanningProblem checked;
+    checkFlagValue([&] { ap::applySchemeName(a.scheme, arg, &checked); });
+  } else if (arg == "--solver") {
+    a.solver = next();
+    a.solver_given = true;
+    checkFlagValue([&] { ap::parseSolver(a.solver, arg); });
+  } else if (arg == "--precision") {
+    a.precision = next();
+    checkFlagValue([&] { ap::parsePrecision(a.precision, arg); });
+  } else if (arg == "--tolerance") {
+    value_text = next();
+    a.tolerance = parseDouble(arg, value_text);
+    if (!(a.tolerance > 0.0)) throw InvalidFlagValue{"--tolerance: must be > 0, got " + value_text};
+  } else if (arg == "--max-iterations") {
+    a.max_iterations = parseInt(arg, next());
+    if (a.max_iterations < 1) {
+      throw InvalidFlagValue{"--max-iterations: must be >= 1, got " +
+                             std::to_string(a.max_iterations)};
+    }
+  } else if (arg == "--time-budget") {
+    value_text = next();
+    a.time_budget = parseDouble(arg, value_text);
+    if (!(a.time_budget > 0.0))
+      throw InvalidFlagValue{"--time-budget: must be > 0 s, got " + value_text};
+  } else if (arg == "--target-miss" || arg == "--target-cost-error") {
+    if (!a.target_flag.empty()) {
+      throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
+    }
+    a.target_flag = arg;
+    const std::string text = next();
+    a.target_value = parseDouble(arg, text);
+    if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
+  } else if (arg == "--objective") {
+    a.objective = next();
+    checkFlagValue([&] { ap::parseObjective(a.objective, arg); });
+  } else if (arg == "--time-margin") {
+    value_text = next();
+    a.time_margin = parseDouble(arg, value_text);
+    if (!(a.time_margin >= 0.0) || !std::isfinite(a.time_margin)) {
+      throw InvalidFlagValue{"--time-margin: must be a finite number >= 0, got " + value_text};
+    }
+  } else if (arg == "--direction") {
+    a.direction = next();
+    checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
+  } else if (arg == "--extra-revolutions") {
+    a.extra_revolutions = parseInt(arg, next());
+    checkFlagValue([&] { ap::requireExtraRevolutions(a.extra_revolutions, arg); });
+  } else if (arg == "--initial-costate") {
+    a.initial_costate = next();
+    parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
+  } else if (arg == "--warm-start") {
+    a.warm_start = next();
+  } else if (arg == "--csv") {
+    a.csv = next();
+  } else if (arg == "--summary") {
+    a.summary = next();
+  } else {
+    throw UsageError{"unknown option '" + arg + "'"};
+  }
+}
+
 Arguments parseArguments(int argc, char** argv) {
   Arguments a;
   for (int i = 1; i < argc; ++i) {
@@ -182,77 +253,12 @@ Arguments parseArguments(int argc, char** argv) {
       arg = arg.substr(0, eq);
       has_value = true;
     }
-    std::string value_text;  // a flag's value as typed, for messages
     const auto next = [&]() -> std::string {
       if (has_value) return value;
       if (i + 1 >= argc) throw UsageError{arg + ": missing value"};
       return argv[++i];
     };
-    if (arg == "--steps") {
-      // Its range is the planner's rule (validateProblem / planDriftTwoInput), checked there.
-      a.steps = parseInt(arg, next());
-    } else if (arg == "--scheme") {
-      a.scheme = next();
-      ap::PlanningProblem checked;
-      checkFlagValue([&] { ap::applySchemeName(a.scheme, arg, &checked); });
-    } else if (arg == "--solver") {
-      a.solver = next();
-      a.solver_given = true;
-      checkFlagValue([&] { ap::parseSolver(a.solver, arg); });
-    } else if (arg == "--precision") {
-      a.precision = next();
-      checkFlagValue([&] { ap::parsePrecision(a.precision, arg); });
-    } else if (arg == "--tolerance") {
-      value_text = next();
-      a.tolerance = parseDouble(arg, value_text);
-      if (!(a.tolerance > 0.0))
-        throw InvalidFlagValue{"--tolerance: must be > 0, got " + value_text};
-    } else if (arg == "--max-iterations") {
-      a.max_iterations = parseInt(arg, next());
-      if (a.max_iterations < 1) {
-        throw InvalidFlagValue{"--max-iterations: must be >= 1, got " +
-                               std::to_string(a.max_iterations)};
-      }
-    } else if (arg == "--time-budget") {
-      value_text = next();
-      a.time_budget = parseDouble(arg, value_text);
-      if (!(a.time_budget > 0.0))
-        throw InvalidFlagValue{"--time-budget: must be > 0 s, got " + value_text};
-    } else if (arg == "--target-miss" || arg == "--target-cost-error") {
-      if (!a.target_flag.empty()) {
-        throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
-      }
-      a.target_flag = arg;
-      const std::string text = next();
-      a.target_value = parseDouble(arg, text);
-      if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
-    } else if (arg == "--objective") {
-      a.objective = next();
-      checkFlagValue([&] { ap::parseObjective(a.objective, arg); });
-    } else if (arg == "--time-margin") {
-      value_text = next();
-      a.time_margin = parseDouble(arg, value_text);
-      if (!(a.time_margin >= 0.0) || !std::isfinite(a.time_margin)) {
-        throw InvalidFlagValue{"--time-margin: must be a finite number >= 0, got " + value_text};
-      }
-    } else if (arg == "--direction") {
-      a.direction = next();
-      checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
-    } else if (arg == "--extra-revolutions") {
-      a.extra_revolutions = parseInt(arg, next());
-      checkFlagValue([&] { ap::requireExtraRevolutions(a.extra_revolutions, arg); });
-    } else if (arg == "--initial-costate") {
-      a.initial_costate = next();
-      parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
-    } else if (arg == "--warm-start") {
-      a.warm_start = next();
-    } else if (arg == "--csv") {
-      a.csv = next();
-    } else if (arg == "--summary") {
-      a.summary = next();
-    } else {
-      throw UsageError{"unknown option '" + arg + "'"};
-    }
+    applyOption(arg, next, &a);
   }
   if (!a.help && a.scene.empty()) throw UsageError{"missing SCENE.yaml"};
   if (!a.target_flag.empty() && a.steps) {

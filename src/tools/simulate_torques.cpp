@@ -40,114 +40,152 @@ struct UsageError {
   std::string message;
 };
 
+struct Arguments {
+  std::string scene_path, csv_path, scheme, out_csv;
+  double max_miss = -1.0;  ///< < 0: no bound
+  bool help = false;
+};
+
+Arguments parseArguments(int argc, char** argv) {
+  Arguments a;
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      a.help = true;
+      return a;
+    }
+    if (arg.rfind("--", 0) == 0) {
+      std::string value;
+      const std::size_t eq = arg.find('=');
+      if (eq != std::string::npos) {
+        value = arg.substr(eq + 1);
+        arg = arg.substr(0, eq);
+      } else {
+        if (i + 1 >= argc) throw UsageError{arg + ": missing value"};
+        value = argv[++i];
+      }
+      if (arg == "--scheme") {
+        a.scheme = value;
+      } else if (arg == "--csv") {
+        a.out_csv = value;
+      } else if (arg == "--max-miss") {
+        char* end = nullptr;
+        a.max_miss = std::strtod(value.c_str(), &end);
+        if (value.empty() || end != value.c_str() + value.size() || !(a.max_miss >= 0.0)) {
+          throw UsageError{"--max-miss: expected a number >= 0, got '" + value + "'"};
+        }
+      } else {
+        throw UsageError{"unknown option '" + arg + "'"};
+      }
+    } else if (a.scene_path.empty()) {
+      a.scene_path = arg;
+    } else if (a.csv_path.empty()) {
+      a.csv_path = arg;
+    } else {
+      throw UsageError{"unexpected argument '" + arg + "'"};
+    }
+  }
+  if (a.csv_path.empty()) throw UsageError{"expected SCENE.yaml and MANEUVER.csv"};
+  return a;
+}
+
+/// The replay's figures against the plan and the scene.
+struct Miss {
+  double attitude_departure = 0.0;  ///< max_k angle(R_k from CSV, R_k replayed) [rad]
+  double attitude_error = 0.0;      ///< terminal, against the scene's final attitude [rad]
+  double velocity_error = 0.0;      ///< terminal, against the scene's final velocity [rad/s]
+};
+
+Miss missOf(const ap::PlanningProblem& p, const ap::Maneuver& planned, const ap::Maneuver& replay) {
+  const int N = planned.steps();
+  Miss m;
+  for (int k = 0; k <= N; ++k) {
+    m.attitude_departure = std::max(m.attitude_departure,
+                                    ap::so3::angleBetween(planned.attitude[k], replay.attitude[k]));
+  }
+  m.attitude_error = ap::so3::angleBetween(p.final_attitude, replay.attitude[N]);
+  m.velocity_error = (replay.angular_velocity[N] - p.final_velocity).norm();
+  return m;
+}
+
+void printReport(const ap::Scene& scene, ap::SchemeKind kind, int N, double h,
+                 const ap::Maneuver& replay, const ap::SimulationReport& report, const Miss& m) {
+  std::string effect_names;
+  for (const ap::EffectSpec& e : scene.effects) {
+    effect_names += (effect_names.empty() ? "" : ", ") + ap::effectName(e);
+  }
+  if (effect_names.empty()) effect_names = "none";
+  const Eigen::Quaterniond q = ap::so3::toQuaternion(replay.attitude[N]);
+  const ap::Vector3& w = replay.angular_velocity[N];  // = Ω_{N−1} for paper, variational
+  std::printf(
+      "steps N, h               %d, %.6g s (scheme %s)\n"
+      "terminal attitude R_N    q = [%.17g, %.17g, %.17g, %.17g] (w, x, y, z)\n"
+      "terminal velocity        Omega_N = [%.17g, %.17g, %.17g] rad/s\n"
+      "terminal attitude error  %.3g rad\n"
+      "terminal velocity error  %.3g rad/s\n"
+      "departure from CSV       %.3g rad (max over k of the attitude difference)\n"
+      "dynamics residual        %.3g N m s\n"
+      "replay effects           %s\n",
+      N, h, ap::schemeName(kind).c_str(), q.w(), q.x(), q.y(), q.z(), w.x(), w.y(), w.z(),
+      m.attitude_error, m.velocity_error, m.attitude_departure, report.max_step_residual,
+      effect_names.c_str());
+}
+
+/// Loads, replays and reports; the exit status.
+int run(const Arguments& args) {
+  const ap::Scene scene = ap::loadScene(args.scene_path);
+  ap::requirePlannable(scene);  // rigid_body scenes only (drift_two_input has no torques)
+  const ap::PlanningProblem& p = scene.problem;
+  const ap::SchemeKind kind =
+      args.scheme.empty() ? p.scheme : ap::parseScheme(args.scheme, "--scheme");
+  const ap::Maneuver planned = ap::readManeuverCsv(args.csv_path);
+  const int N = planned.steps();
+  const double h = planned.time.back() / N;  // the CSV's time base
+  if (!(h > 0.0) || !std::isfinite(h)) {
+    throw ap::InvalidInput("maneuver CSV '" + args.csv_path + "': time step is not positive");
+  }
+  if (std::abs(N * h - p.duration) > 1e-9 * p.duration) {
+    std::cerr << "simulate_torques: note: CSV duration " << N * h << " s differs from the scene's "
+              << p.duration << " s; using the CSV's\n";
+  }
+  ap::SimulationInput input;
+  input.initial_attitude = p.initial_attitude;
+  input.initial_velocity = p.initial_velocity;
+  input.torque = planned.torque;
+  const std::shared_ptr<const ap::EffectModel> effects =
+      ap::plannableEffects(scene.effects, p.inertia);
+  ap::Actuation actuation = ap::actuationOf(scene.effects);
+  input.effects = effects.get();
+  input.actuation = &actuation;
+  ap::SimulationReport report;
+  const ap::Maneuver replay = ap::replayPlan(kind, p.inertia, h, input, &report);
+  const Miss m = missOf(p, planned, replay);
+  printReport(scene, kind, N, h, replay, report, m);
+  if (!args.out_csv.empty()) ap::writeManeuverCsv(replay, args.out_csv);
+  if (args.max_miss >= 0.0 &&
+      (m.attitude_error > args.max_miss || m.velocity_error > args.max_miss)) {
+    std::cerr << "simulate_torques: terminal miss exceeds --max-miss " << args.max_miss << "\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, csv_path, scheme, out_csv;
-  double max_miss = -1.0;
+  Arguments args;
   try {
-    for (int i = 1; i < argc; ++i) {
-      std::string arg = argv[i];
-      if (arg == "--help" || arg == "-h") {
-        std::cout << kUsage;
-        return 0;
-      }
-      if (arg.rfind("--", 0) == 0) {
-        std::string value;
-        const std::size_t eq = arg.find('=');
-        if (eq != std::string::npos) {
-          value = arg.substr(eq + 1);
-          arg = arg.substr(0, eq);
-        } else {
-          if (i + 1 >= argc) throw UsageError{arg + ": missing value"};
-          value = argv[++i];
-        }
-        if (arg == "--scheme") {
-          scheme = value;
-        } else if (arg == "--csv") {
-          out_csv = value;
-        } else if (arg == "--max-miss") {
-          char* end = nullptr;
-          max_miss = std::strtod(value.c_str(), &end);
-          if (value.empty() || end != value.c_str() + value.size() || !(max_miss >= 0.0)) {
-            throw UsageError{"--max-miss: expected a number >= 0, got '" + value + "'"};
-          }
-        } else {
-          throw UsageError{"unknown option '" + arg + "'"};
-        }
-      } else if (scene_path.empty()) {
-        scene_path = arg;
-      } else if (csv_path.empty()) {
-        csv_path = arg;
-      } else {
-        throw UsageError{"unexpected argument '" + arg + "'"};
-      }
-    }
-    if (csv_path.empty()) throw UsageError{"expected SCENE.yaml and MANEUVER.csv"};
+    args = parseArguments(argc, argv);
   } catch (const UsageError& e) {
     std::cerr << "simulate_torques: " << e.message << "\n\n" << kUsage;
     return 2;
   }
-
-  try {
-    const ap::Scene scene = ap::loadScene(scene_path);
-    ap::requirePlannable(scene);  // rigid_body scenes only (drift_two_input has no torques)
-    const ap::PlanningProblem& p = scene.problem;
-    const ap::SchemeKind kind = scheme.empty() ? p.scheme : ap::parseScheme(scheme, "--scheme");
-    const ap::Maneuver planned = ap::readManeuverCsv(csv_path);
-    const int N = planned.steps();
-    const double h = planned.time.back() / N;  // the CSV's time base
-    if (!(h > 0.0) || !std::isfinite(h)) {
-      throw ap::InvalidInput("maneuver CSV '" + csv_path + "': time step is not positive");
-    }
-    if (std::abs(N * h - p.duration) > 1e-9 * p.duration) {
-      std::cerr << "simulate_torques: note: CSV duration " << N * h
-                << " s differs from the scene's " << p.duration << " s; using the CSV's\n";
-    }
-    ap::SimulationInput input;
-    input.initial_attitude = p.initial_attitude;
-    input.initial_velocity = p.initial_velocity;
-    input.torque = planned.torque;
-    const std::shared_ptr<const ap::EffectModel> effects =
-        ap::plannableEffects(scene.effects, p.inertia);
-    ap::Actuation actuation = ap::actuationOf(scene.effects);
-    input.effects = effects.get();
-    input.actuation = &actuation;
-    ap::SimulationReport report;
-    const ap::Maneuver replay = ap::replayPlan(kind, p.inertia, h, input, &report);
-
-    std::string effect_names;
-    for (const ap::EffectSpec& e : scene.effects) {
-      effect_names += (effect_names.empty() ? "" : ", ") + ap::effectName(e);
-    }
-    if (effect_names.empty()) effect_names = "none";
-    double attitude_departure = 0.0;  // max_k angle(R_k from CSV, R_k replayed) [rad]
-    for (int k = 0; k <= N; ++k) {
-      attitude_departure = std::max(attitude_departure,
-                                    ap::so3::angleBetween(planned.attitude[k], replay.attitude[k]));
-    }
-    const double attitude_error = ap::so3::angleBetween(p.final_attitude, replay.attitude[N]);
-    const double velocity_error = (replay.angular_velocity[N] - p.final_velocity).norm();
-    const Eigen::Quaterniond q = ap::so3::toQuaternion(replay.attitude[N]);
-    const ap::Vector3& w = replay.angular_velocity[N];  // = Ω_{N−1} for paper, variational
-    std::printf(
-        "steps N, h               %d, %.6g s (scheme %s)\n"
-        "terminal attitude R_N    q = [%.17g, %.17g, %.17g, %.17g] (w, x, y, z)\n"
-        "terminal velocity        Omega_N = [%.17g, %.17g, %.17g] rad/s\n"
-        "terminal attitude error  %.3g rad\n"
-        "terminal velocity error  %.3g rad/s\n"
-        "departure from CSV       %.3g rad (max over k of the attitude difference)\n"
-        "dynamics residual        %.3g N m s\n"
-        "replay effects           %s\n",
-        N, h, ap::schemeName(kind).c_str(), q.w(), q.x(), q.y(), q.z(), w.x(), w.y(), w.z(),
-        attitude_error, velocity_error, attitude_departure, report.max_step_residual,
-        effect_names.c_str());
-    if (!out_csv.empty()) ap::writeManeuverCsv(replay, out_csv);
-    if (max_miss >= 0.0 && (attitude_error > max_miss || velocity_error > max_miss)) {
-      std::cerr << "simulate_torques: terminal miss exceeds --max-miss " << max_miss << "\n";
-      return 1;
-    }
+  if (args.help) {
+    std::cout << kUsage;
     return 0;
+  }
+  try {
+    return run(args);
   } catch (const ap::InvalidInput& e) {
     std::cerr << "simulate_torques: invalid input: " << e.what() << "\n";
     return 1;

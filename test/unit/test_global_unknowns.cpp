@@ -12,6 +12,7 @@
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/objective.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "support/perturbed_problem.hpp"
 
 using namespace attitude_planner;
 
@@ -36,16 +37,7 @@ PlanningProblem randomProblem(SchemeKind scheme, int N, unsigned seed) {
   return p;
 }
 
-/// The problem with its free attitudes moved off the geodesic (generic torques and curvature).
-ReducedProblem perturbedProblem(const PlanningProblem& problem, unsigned seed) {
-  ReducedProblem rp(problem);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.05);
-  Eigen::VectorXd delta(rp.unknowns());
-  for (int i = 0; i < delta.size(); ++i) delta(i) = n(rng);
-  rp.setCurrent(rp.retract(delta, 1.0));
-  return rp;
-}
+using test_support::perturbedReducedProblem;
 
 /// Effort plus a term in T² (a time penalty with a minimum in T): an objective written outside
 /// the library, as a user of the interface would.
@@ -146,7 +138,7 @@ TEST(GlobalUnknowns, TimeStepDerivativesMatchFiniteDifferences) {
                                                 &effort_plus_time_squared};
   for (SchemeKind scheme : kDiscretizations) {
     for (unsigned seed : {1u, 2u, 3u}) {
-      const ReducedProblem rp = perturbedProblem(randomProblem(scheme, 9, seed), 10 + seed);
+      const ReducedProblem rp = perturbedReducedProblem(randomProblem(scheme, 9, seed), 10 + seed);
       for (const TranscriptionObjective* objective : objectives) {
         expectDerivativesMatchFiniteDifferences(
             rp, *objective,
@@ -159,7 +151,7 @@ TEST(GlobalUnknowns, TimeStepDerivativesMatchFiniteDifferences) {
 // The torques' own h-derivative ∂r_k/∂h (what constraints on τ will need), node by node.
 TEST(GlobalUnknowns, TorqueTimeDerivativesMatchFiniteDifferences) {
   for (SchemeKind scheme : kDiscretizations) {
-    const ReducedProblem rp = perturbedProblem(randomProblem(scheme, 10, 4), 5);
+    const ReducedProblem rp = perturbedReducedProblem(randomProblem(scheme, 10, 4), 5);
     const double h = rp.timeStep(), step = 1e-6 * h;
     ReducedProblem plus = rp, minus = rp;
     plus.setTimeStep(h + step);
@@ -182,7 +174,7 @@ TEST(GlobalUnknowns, TorqueTimeDerivativesMatchFiniteDifferences) {
 // Today's objective is unchanged: the band and the node gradient are evaluate()'s, bit for bit.
 TEST(GlobalUnknowns, EffortObjectiveIsTodaysEvaluateBitForBit) {
   for (SchemeKind scheme : kDiscretizations) {
-    const ReducedProblem rp = perturbedProblem(randomProblem(scheme, 40, 6), 7);
+    const ReducedProblem rp = perturbedReducedProblem(randomProblem(scheme, 40, 6), 7);
     const int n = rp.unknowns();
     Eigen::VectorXd g_today, g, border;
     BandedSymmetricMatrix H_today(n, 8), H(n, 8);
@@ -196,7 +188,8 @@ TEST(GlobalUnknowns, EffortObjectiveIsTodaysEvaluateBitForBit) {
 }
 
 TEST(GlobalUnknowns, TimeObjectiveIsTheDuration) {
-  const ReducedProblem rp = perturbedProblem(randomProblem(SchemeKind::SecondOrder, 20, 8), 9);
+  const ReducedProblem rp =
+      perturbedReducedProblem(randomProblem(SchemeKind::SecondOrder, 20, 8), 9);
   const int n = rp.unknowns();
   Eigen::VectorXd g, border;
   BandedSymmetricMatrix H(n, 8);
@@ -215,7 +208,7 @@ TEST(GlobalUnknowns, TimeObjectiveIsTheDuration) {
 TEST(GlobalUnknowns, SetTimeStepIsTheProblemAtTheNewDuration) {
   for (SchemeKind scheme : kDiscretizations) {
     PlanningProblem problem = randomProblem(scheme, 16, 10);
-    ReducedProblem rp = perturbedProblem(problem, 11);
+    ReducedProblem rp = perturbedReducedProblem(problem, 11);
     const std::vector<Matrix3> R_before = rp.attitudes(rp.current());
     const double h = rp.timeStep(), h_new = 1.3 * h;
     rp.setTimeStep(h_new);
@@ -237,7 +230,7 @@ TEST(GlobalUnknowns, SetTimeStepIsTheProblemAtTheNewDuration) {
     // And back: the same steps to round-off.
     ReducedProblem back = rp;
     back.setTimeStep(h);
-    const ReducedProblem original = perturbedProblem(randomProblem(scheme, 16, 10), 11);
+    const ReducedProblem original = perturbedReducedProblem(randomProblem(scheme, 16, 10), 11);
     for (int j = 0; j < rp.steps(); ++j) {
       EXPECT_LE((back.current()[j] - original.current()[j]).norm(), 1e-14) << j;
     }

@@ -112,6 +112,13 @@ struct SeedCase {
 
 class SeedExamples : public ::testing::TestWithParam<SeedCase> {};
 
+/// A parameterized test's name: scene, N and scheme ("rest_to_rest_N16_paper").
+std::string seedCaseName(const ::testing::TestParamInfo<SeedCase>& info) {
+  const std::string scene = info.param.scene;
+  return scene.substr(0, scene.find('.')) + "_N" + std::to_string(info.param.steps) + "_" +
+         ap::schemeName(info.param.scheme);
+}
+
 }  // namespace
 
 TEST_P(SeedExamples, NloptReachesAFeasibleKktPoint) {
@@ -163,12 +170,7 @@ INSTANTIATE_TEST_SUITE_P(
                       SeedCase{"rest_to_rest.yaml", 16, ap::SchemeKind::Variational},
                       SeedCase{"slew_up.yaml", 16, ap::SchemeKind::Variational},
                       SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Variational}),
-    [](const auto& info) {
-      std::string name = info.param.scene;
-      name = name.substr(0, name.find('.')) + "_N" + std::to_string(info.param.steps) + "_" +
-             ap::schemeName(info.param.scheme);
-      return name;
-    });
+    seedCaseName);
 
 TEST(NloptSolver, CancellationStopsAndIsReported) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 16, ap::SchemeKind::Paper);
@@ -235,12 +237,7 @@ INSTANTIATE_TEST_SUITE_P(
                       SeedCase{"slew_up.yaml", 64, ap::SchemeKind::Paper},
                       SeedCase{"rest_to_rest.yaml", 32, ap::SchemeKind::Variational},
                       SeedCase{"slew_up.yaml", 32, ap::SchemeKind::Variational}),
-    [](const auto& info) {
-      std::string name = info.param.scene;
-      name = name.substr(0, name.find('.')) + "_N" + std::to_string(info.param.steps) + "_" +
-             ap::schemeName(info.param.scheme);
-      return name;
-    });
+    seedCaseName);
 
 TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   const ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 5000, ap::SchemeKind::Paper);

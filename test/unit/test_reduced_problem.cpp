@@ -14,6 +14,7 @@
 #include "lie/dual.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "support/perturbed_problem.hpp"
 
 using namespace attitude_planner;
 
@@ -43,13 +44,8 @@ PlanningProblem withEffects(PlanningProblem p) {
 
 // Interior attitudes moved off the geodesic, so torques and curvature are generic.
 ReducedProblem perturbedProblem(SchemeKind scheme, int N, unsigned seed, bool effects = false) {
-  ReducedProblem rp(effects ? withEffects(randomProblem(scheme, N)) : randomProblem(scheme, N));
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.05);
-  Eigen::VectorXd delta(rp.unknowns());
-  for (int i = 0; i < delta.size(); ++i) delta(i) = n(rng);
-  rp.setCurrent(rp.retract(delta, 1.0));
-  return rp;
+  return test_support::perturbedReducedProblem(
+      effects ? withEffects(randomProblem(scheme, N)) : randomProblem(scheme, N), seed);
 }
 
 using Dual3 = Dual<3>;

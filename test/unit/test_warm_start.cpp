@@ -182,7 +182,7 @@ TEST(WarmStart, MalformedGuessesAreRefusedNamingTheRowAndValue) {
 
 // Constrained re-plans: the interior point starts from the remainder (its multipliers re-derived)
 // and ends at the cold re-plan's optimum with the same constraints active, in fewer iterations
-// (counts; the times are in docs/warm_start.md).
+// (counts; the times are in docs/results/warm_start.md).
 TEST(WarmStart, ConstrainedReplanStartsFromTheGuess) {
   for (const char* name : {"torque_limited.yaml", "rate_limited.yaml", "sun_keep_out.yaml"}) {
     SCOPED_TRACE(name);

@@ -1,9 +1,11 @@
 // Closed-form extremals of the drift + two-input system (seed 001, Section 4): Prop. 4.2
 // (c1 = c2, circular functions) and Prop. 4.3 (c1 ≠ c2, Jacobi elliptic functions), with the
-// corrections listed in docs/design/drift_two_input.md. Only the cases the seed states are evaluated: an
-// initial costate outside them is reported (status kOutsideStatedCases), never evaluated.
+// corrections listed in docs/design/drift_two_input.md. Only the cases the seed states are
+// evaluated: an initial costate outside them is reported (status kOutsideStatedCases), never
+// evaluated.
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 #include "attitude_planner/drift_two_input/system.hpp"
@@ -60,6 +62,14 @@ class DriftTwoInputClosedForm {
   Vector3 evaluate(double t) const;
 
  private:
+  /// Prop. 4.2 (c1 = c2): the circular constants from p0.
+  void initCircular(const Vector3& p0, std::ostream& os);
+  /// Prop. 4.3 in the frame where c2 < c1: which case holds and its constants; false (the reason
+  /// written to os) when neither does.
+  bool initElliptic(double c1, double c2, EllipticForm form, std::ostream& os);
+  /// The phase u0 and signs (σ1, σ2) that put q0 on the orbit, moving along the flow; returns
+  /// the residual |q(u0) − q0|.
+  double matchPhase(const Vector3& q0, double c1, double c2);
   /// q (rotated frame) at the Jacobi values (sn, cn, dn) of u, for signs s1, s2 of q1, q2.
   Vector3 ellipticAt(double sn, double cn, double dn, double s1, double s2) const;
 

@@ -9,9 +9,9 @@
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "planning/transcription/direct_method.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/transcription/direct_method.hpp"
 
 namespace attitude_planner {
 
@@ -232,36 +232,26 @@ void constraints(unsigned m, double* result, unsigned n, const double* x_raw, do
 
 }  // namespace
 
-PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options) {
-  if (problem.effects && !problem.effects->empty()) {
-    PlanResult refused;
-    refused.message =
-        "solver nlopt: planning with effects is implemented in the newton solver only (its "
-        "constraint Jacobians do not include effect torques); use --solver newton";
-    return refused;
-  }
-  const int N = problem.steps;
-  if (N > kMaxNloptSteps) {  // a refusal of the request, not a solve that failed to converge
-    throw InvalidInput("steps", std::to_string(N) + " > " + std::to_string(kMaxNloptSteps) +
-                                    " is refused by solver nlopt (the cross-check is dense: "
-                                    "O(N^2) memory, O(N^3) time); use the newton solver");
-  }
-  const unsigned n = 3u * static_cast<unsigned>(N - 1);
+namespace {
 
-  // Initial guess: zero torques (SLSQP's first QP is then the linearized minimum-norm transfer),
-  // or the warm start's torques when it has the same N.
+// Initial guess: zero torques (SLSQP's first QP is then the linearized minimum-norm transfer),
+// or the warm start's torques when it has the same N.
+std::vector<double> initialUnknowns(const PlanningProblem& problem, const SolverOptions& options,
+                                    unsigned n) {
+  const int N = problem.steps;
   std::vector<double> x(n, 0.0);
   if (options.warm_start && options.warm_start->steps() == N &&
       static_cast<int>(options.warm_start->torque.size()) == N + 1) {
     const Eigen::VectorXd w = unknownsFromTorqueSequence(options.warm_start->torque);
     for (unsigned i = 0; i < n; ++i) x[i] = w(i);
   }
+  return x;
+}
 
-  nlopt::opt opt(nlopt::LD_SLSQP, n);
-  Callbacks cb;
-  cb.problem = &problem;
-  cb.options = &options;
-  cb.opt = &opt;
+// Objective, constraints, bounds (x clipped into them) and stopping rules of the SLSQP run.
+void configure(nlopt::opt& opt, Callbacks& cb, const PlanningProblem& problem,
+               const SolverOptions& options, std::vector<double>& x) {
+  const unsigned n = static_cast<unsigned>(x.size());
   opt.set_min_objective(objective, nullptr);
   opt.add_equality_mconstraint(
       constraints, &cb, std::vector<double>(kTerminalConstraints, kNloptConstraintTolerance));
@@ -284,20 +274,113 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   opt.set_ftol_rel(1e-15);
   opt.set_maxeval(std::max(options.max_iterations, 1));
   if (options.time_budget_s > 0.0) opt.set_maxtime(options.time_budget_s);
+}
 
-  nlopt::result code = nlopt::FAILURE;
-  std::string exception_text;
+// NLopt's result code; its exceptions for a stop are codes too, any other's text goes to
+// *exception_text.
+nlopt::result optimize(nlopt::opt& opt, std::vector<double>& x, std::string* exception_text) {
   double f = 0.0;
   try {
-    code = opt.optimize(x, f);
+    return opt.optimize(x, f);
   } catch (const nlopt::roundoff_limited&) {
-    code = nlopt::ROUNDOFF_LIMITED;
+    return nlopt::ROUNDOFF_LIMITED;
   } catch (const nlopt::forced_stop&) {
-    code = nlopt::FORCED_STOP;
+    return nlopt::FORCED_STOP;
   } catch (const std::exception& e) {
-    code = nlopt::FAILURE;
-    exception_text = e.what();
+    *exception_text = e.what();
+    return nlopt::FAILURE;
   }
+}
+
+// The relative stationarity residual at x, measured here, not NLopt's word: the part of the
+// cost gradient outside the span of the constraint gradients (relative to |∇f| = |τ|).
+double relativeStationarity(const PlanningProblem& problem, const Eigen::VectorXd& xv,
+                            const Eigen::MatrixXd& jacobian) {
+  // With bounds, stationarity holds on the free variables only (bound multipliers take the rest).
+  std::vector<int> free;
+  for (int i = 0; i < static_cast<int>(xv.size()); ++i) {
+    if (!problem.hasTorqueBounds() || std::abs(xv(i)) < problem.max_torque(i % 3) * (1.0 - 1e-9)) {
+      free.push_back(i);
+    }
+  }
+  Eigen::VectorXd x_free(free.size());
+  Eigen::MatrixXd jacobian_free(jacobian.rows(), free.size());
+  for (size_t j = 0; j < free.size(); ++j) {
+    x_free(j) = xv(free[j]);
+    jacobian_free.col(j) = jacobian.col(free[j]);
+  }
+  // With node constraints beyond the bounds their multipliers are not recovered here: the
+  // stationarity residual is then not measured (0), the violation still is.
+  return free.empty() || !problem.constraints.empty()
+             ? 0.0
+             : stationarityResidual(x_free, jacobian_free).cwiseAbs().maxCoeff() /
+                   std::max(xv.cwiseAbs().maxCoeff(), 1e-300);
+}
+
+// How the run ended, from NLopt's code, the callbacks' stop reason and the replayed plan.
+struct Outcome {
+  nlopt::result code = nlopt::FAILURE;
+  std::string stop_reason;
+  std::string exception_text;
+  double violation = 0.0;
+  double stationarity = 0.0;
+};
+
+void setTermination(const Outcome& o, PlanResult* result) {
+  const bool nlopt_success =
+      o.code > 0 && o.code != nlopt::MAXEVAL_REACHED && o.code != nlopt::MAXTIME_REACHED;
+  const bool feasible = result->terminal_attitude_error <= kConstraintTolerance &&
+                        result->terminal_velocity_error <= kConstraintTolerance;
+  if (o.stop_reason == "cancelled") {
+    result->termination = Termination::Cancelled;
+  } else if (nlopt_success && feasible) {
+    result->termination = Termination::Converged;
+  } else if (o.code == nlopt::MAXTIME_REACHED) {
+    result->termination = Termination::TimedOut;
+  } else {
+    result->termination = Termination::NotConverged;
+  }
+  std::string message = "nlopt SLSQP: " + resultName(o.code);
+  if (!o.stop_reason.empty()) message += " (" + o.stop_reason + ")";
+  if (!o.exception_text.empty()) message += " (" + o.exception_text + ")";
+  char figures[160];
+  std::snprintf(figures, sizeof figures,
+                "; constraint violation %.3g, relative stationarity residual %.3g", o.violation,
+                o.stationarity);
+  message += figures;
+  if (!result->converged() && nlopt_success && !feasible)
+    message += "; terminal constraints not met";
+  if (o.stop_reason == "cancelled") message = "cancelled; " + message;
+  result->message = (result->converged() ? "converged; " : "not converged; ") + message;
+}
+
+}  // namespace
+
+PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options) {
+  if (problem.effects && !problem.effects->empty()) {
+    PlanResult refused;
+    refused.message =
+        "solver nlopt: planning with effects is implemented in the newton solver only (its "
+        "constraint Jacobians do not include effect torques); use --solver newton";
+    return refused;
+  }
+  const int N = problem.steps;
+  if (N > kMaxNloptSteps) {  // a refusal of the request, not a solve that failed to converge
+    throw InvalidInput("steps", std::to_string(N) + " > " + std::to_string(kMaxNloptSteps) +
+                                    " is refused by solver nlopt (the cross-check is dense: "
+                                    "O(N^2) memory, O(N^3) time); use the newton solver");
+  }
+  const unsigned n = 3u * static_cast<unsigned>(N - 1);
+  std::vector<double> x = initialUnknowns(problem, options, n);
+  nlopt::opt opt(nlopt::LD_SLSQP, n);
+  Callbacks cb;
+  cb.problem = &problem;
+  cb.options = &options;
+  cb.opt = &opt;
+  configure(opt, cb, problem, options, x);
+  Outcome outcome;
+  outcome.code = optimize(opt, x, &outcome.exception_text);
+  outcome.stop_reason = cb.stop_reason;
 
   PlanResult result;
   result.solver = solverName(SolverKind::Nlopt);
@@ -310,61 +393,14 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
   } catch (const StepTooLarge& e) {
     result.termination = Termination::StepTooLarge;
     result.message =
-        "nlopt: " + resultName(code) + "; final torques cannot be replayed: " + e.what();
+        "nlopt: " + resultName(outcome.code) + "; final torques cannot be replayed: " + e.what();
     return result;
   }
-
-  // The optimality residual measured here, not NLopt's word: constraint violation and the part of
-  // the cost gradient outside the span of the constraint gradients (relative to |∇f| = |τ|).
   const TerminalConstraints c = evaluateTerminalConstraints(problem, xv, true);
-  const double violation = c.value.cwiseAbs().maxCoeff();
-  // With bounds, stationarity holds on the free variables only (bound multipliers take the rest).
-  std::vector<int> free;
-  for (int i = 0; i < static_cast<int>(n); ++i) {
-    if (!problem.hasTorqueBounds() || std::abs(xv(i)) < problem.max_torque(i % 3) * (1.0 - 1e-9)) {
-      free.push_back(i);
-    }
-  }
-  Eigen::VectorXd x_free(free.size());
-  Eigen::MatrixXd jacobian_free(c.jacobian.rows(), free.size());
-  for (size_t j = 0; j < free.size(); ++j) {
-    x_free(j) = xv(free[j]);
-    jacobian_free.col(j) = c.jacobian.col(free[j]);
-  }
-  // With node constraints beyond the bounds their multipliers are not recovered here: the
-  // stationarity residual is then not measured (0), the violation still is.
-  const double stationarity =
-      free.empty() || !problem.constraints.empty()
-          ? 0.0
-          : stationarityResidual(x_free, jacobian_free).cwiseAbs().maxCoeff() /
-                std::max(xv.cwiseAbs().maxCoeff(), 1e-300);
-  result.max_residual = std::max(violation, stationarity);
-
-  const bool nlopt_success =
-      code > 0 && code != nlopt::MAXEVAL_REACHED && code != nlopt::MAXTIME_REACHED;
-  const bool feasible = result.terminal_attitude_error <= kConstraintTolerance &&
-                        result.terminal_velocity_error <= kConstraintTolerance;
-  if (cb.stop_reason == "cancelled") {
-    result.termination = Termination::Cancelled;
-  } else if (nlopt_success && feasible) {
-    result.termination = Termination::Converged;
-  } else if (code == nlopt::MAXTIME_REACHED) {
-    result.termination = Termination::TimedOut;
-  } else {
-    result.termination = Termination::NotConverged;
-  }
-  std::string message = "nlopt SLSQP: " + resultName(code);
-  if (!cb.stop_reason.empty()) message += " (" + cb.stop_reason + ")";
-  if (!exception_text.empty()) message += " (" + exception_text + ")";
-  char figures[160];
-  std::snprintf(figures, sizeof figures,
-                "; constraint violation %.3g, relative stationarity residual %.3g", violation,
-                stationarity);
-  message += figures;
-  if (!result.converged() && nlopt_success && !feasible)
-    message += "; terminal constraints not met";
-  if (cb.stop_reason == "cancelled") message = "cancelled; " + message;
-  result.message = (result.converged() ? "converged; " : "not converged; ") + message;
+  outcome.violation = c.value.cwiseAbs().maxCoeff();
+  outcome.stationarity = relativeStationarity(problem, xv, c.jacobian);
+  result.max_residual = std::max(outcome.violation, outcome.stationarity);
+  setTermination(outcome, &result);
   return result;
 }
 

@@ -1,6 +1,7 @@
 // The documentation cannot rot unnoticed: scripts/check_docs.py (relative links and anchors in
 // README.md, CHANGELOG.md and docs/, docs/ paths named anywhere in the package, README.md's copy
 // of examples/*.cpp) runs in the default suite, and README.md's C++ example is built and run.
+// scripts/function_lengths keeps every function in src/ short enough to read at once.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -69,6 +70,15 @@ TEST(DocsCheck, ReportsBrokenLinksMissingHeadingsAndStalePaths) {
 }
 
 /// README.md's C++ example (examples/plan_rest_to_rest.cpp) plans the seed's slew and converges.
+// The code's shape: no function in src/ over 100 lines (docs/ARCHITECTURE.md, "Function
+// length"); scripts/function_lengths counts from the signature to the closing brace.
+TEST(CodeShape, NoFunctionInSrcIsLongerThanAHundredLines) {
+  const ToolRun r = runCommand("/usr/bin/python3 '" + kSourceDir + "/scripts/function_lengths' '" +
+                               kSourceDir + "/src' --top 3 --fail-over 100");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_FALSE(r.output.empty()) << "the scan found no function";
+}
+
 TEST(ReadmeExample, PlansTheSeedsRestToRestSlew) {
   const ToolRun r = runProgram(AP_STUDY_DIR, "plan_rest_to_rest", "", 120);
   EXPECT_EQ(r.status, 0) << r.output;

@@ -155,9 +155,16 @@ TEST_F(Tracker, InconsistentManeuverIsRejectedWithAReason) {
   Maneuver plan;
   AttitudeManeuver bad = ros_testing::testManeuver(kSteps, &plan);
   bad.torque.pop_back();
-  const size_t before = doneCount();
+  // `done` is latched: the previous test's may arrive first, stamped before this one was sent.
+  const ros::Time sent = ros::Time::now();
   maneuver_pub_.publish(bad);
-  ASSERT_TRUE(waitFor([&] { return doneCount() > before; }, 30.0)) << "no done message";
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return !done_.empty() && done_.back().header.stamp >= sent;
+      },
+      30.0))
+      << "no done message";
   std::lock_guard<std::mutex> lock(mutex_);
   EXPECT_FALSE(done_.back().success);
   EXPECT_NE(done_.back().message.find("arrays disagree"), std::string::npos)

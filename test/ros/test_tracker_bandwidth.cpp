@@ -72,18 +72,15 @@ class TrackerBandwidth : public ::testing::Test {
   }
   /// Marker bytes received while the tracker runs an N-step maneuver.
   std::size_t markerBytes(int steps) {
-    std::size_t before;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      before = done_.size();
-    }
     ros::WallDuration(0.5).sleep();  // what is still in flight from before
     bytes_ = 0;
+    // `done` is latched: an earlier maneuver's may arrive late, stamped before this one was sent.
+    const ros::Time sent = ros::Time::now();
     maneuver_pub_.publish(gentleManeuver(steps));
     EXPECT_TRUE(waitFor(
         [&] {
           std::lock_guard<std::mutex> lock(mutex_);
-          return done_.size() > before;
+          return !done_.empty() && done_.back().header.stamp >= sent;
         },
         120.0))
         << "no done for N = " << steps;

@@ -65,21 +65,22 @@ class TrackerStream : public ::testing::Test {
     ASSERT_TRUE(waitFor([&] { return maneuver_pub_.getNumSubscribers() > 0; }, 30.0));
     ASSERT_TRUE(waitFor([&] { return torque_sub_.getNumPublishers() > 0; }, 30.0));
   }
-  std::size_t doneCount() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return done_.size();
-  }
-  /// Publishes `m` and waits for the `done` it causes.
+  /// Publishes `m` and waits for the `done` it causes: `done` is latched, so a subscriber made
+  /// for this test may first receive the previous test's, stamped before this one was sent.
   ReplayResult run(const AttitudeManeuver& m) {
-    const std::size_t before = doneCount();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       torques_.clear();
       references_.clear();
       errors_.clear();
     }
+    const ros::Time sent = ros::Time::now();
     maneuver_pub_.publish(m);
-    EXPECT_TRUE(waitFor([&] { return doneCount() > before; }, 60.0)) << "no done message";
+    const auto answered = [&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return !done_.empty() && done_.back().header.stamp >= sent;
+    };
+    EXPECT_TRUE(waitFor(answered, 60.0)) << "no done message";
     ros::WallDuration(0.3).sleep();  // the last samples on the other topics
     std::lock_guard<std::mutex> lock(mutex_);
     return done_.empty() ? ReplayResult() : done_.back();

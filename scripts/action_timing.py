@@ -10,7 +10,6 @@ Needs a running master and planner.launch. Prints markdown tables.
 Usage: /usr/bin/python3 scripts/action_timing.py [--steps 100000] [--cancels 8]
 """
 import argparse
-import math
 import statistics
 import threading
 import time
@@ -21,19 +20,15 @@ from actionlib_msgs.msg import GoalStatus
 from attitude_planner.msg import (PlanAttitudeManeuverAction, PlanAttitudeManeuverGoal,
                                   PlanErrorCode)
 from attitude_planner.srv import PlanAttitudeManeuver, PlanAttitudeManeuverRequest
+from seed_request import fill_seed
 
 STATES = {v: k for k, v in GoalStatus.__dict__.items() if k.isupper() and isinstance(v, int)}
 CODES = {v: k for k, v in PlanErrorCode.__dict__.items() if k.isupper() and isinstance(v, int)}
 
 
-def fill_seed(r, steps):
-    r.inertia = [13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37]
-    r.allow_nonphysical_inertia = True
-    r.initial_attitude.w = 1.0
-    r.final_attitude.w = math.cos(math.pi / 6)
-    r.final_attitude.x = math.sin(math.pi / 6)
-    r.duration = 12.8
-    r.steps = steps
+def seed_without_plan(r, steps):
+    """The seed's slew, answered without the maneuver (the timings measure the solve)."""
+    r = fill_seed(r, steps)
     r.return_maneuver = "none"
     return r
 
@@ -41,7 +36,7 @@ def fill_seed(r, steps):
 def cancel_latency(client, steps, delay):
     """Sends an endless goal, cancels it `delay` s after its first feedback; returns
     (latency [s], state, error code, iterations at the cancel)."""
-    goal = fill_seed(PlanAttitudeManeuverGoal(), steps)
+    goal = seed_without_plan(PlanAttitudeManeuverGoal(), steps)
     goal.tolerance = 1e-300
     goal.max_iterations = 1000000
     goal.time_budget = 600.0
@@ -104,7 +99,7 @@ def main():
           "iterations |")
     print("|---|---|---|---|---|---|")
     for budget in (0.01, 0.1, 0.3, 1.0, 30.0):
-        req = fill_seed(PlanAttitudeManeuverRequest(), args.steps)
+        req = seed_without_plan(PlanAttitudeManeuverRequest(), args.steps)
         req.time_budget = budget
         t0 = time.perf_counter()
         res = proxy(req)

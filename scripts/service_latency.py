@@ -5,23 +5,16 @@ from the request to the deserialized response. Needs a running master and planne
 Usage: /usr/bin/python3 scripts/service_latency.py [--steps 128] [--calls 20]
 """
 import argparse
-import math
 import statistics
 import time
 
 import rospy
 from attitude_planner.srv import PlanAttitudeManeuver, PlanAttitudeManeuverRequest
+from seed_request import fill_seed
 
 
 def seed_request(steps):
-    r = PlanAttitudeManeuverRequest()
-    r.inertia = [13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37]
-    r.allow_nonphysical_inertia = True
-    r.initial_attitude.w = 1.0
-    r.final_attitude.w = math.cos(math.pi / 6)
-    r.final_attitude.x = math.sin(math.pi / 6)
-    r.duration = 12.8
-    r.steps = steps
+    r = fill_seed(PlanAttitudeManeuverRequest(), steps)
     r.scheme = "paper"
     return r
 

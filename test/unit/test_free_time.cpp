@@ -123,7 +123,7 @@ TEST(FreeTime, NoFeasiblePlanSlightlyFasterFromTheAnswer) {
 
 TEST(FreeTime, TStarIsInvariantUnderWorldRotationsAndAxisRelabelling) {
   // Bilimoria–Wie about x, y and z, and in seeded random world frames (both attitudes rotated):
-  // one T*, within 0.5 % of the published value (issue 30 measured +1.0 to +1.7 % spreads).
+  // one T*, within 0.5 % of the published value.
   std::mt19937 random(30);
   std::normal_distribution<double> gaussian;
   std::vector<double> found;

@@ -123,8 +123,8 @@ template <class Response>
 void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
                   const std::string& body_frame, Response* res);
 
-/// The answer to a request with a time budget B comes by B (1 + kDeadlineSlack) (issue 31 allows
-/// 10 %): the core stops at B, but turning a stopped N = 1e5 solve into a result (evaluating and
+/// The answer to a request with a time budget B comes by B (1 + kDeadlineSlack), inside the 10 %
+/// the interface promises (docs/ros_timing.md): the core stops at B, but turning a stopped N = 1e5 solve into a result (evaluating and
 /// replaying its plan) can take longer than the rest; a solve still running then is told to stop
 /// and its result is dropped: the answer is TIMED_OUT without a plan.
 inline constexpr double kDeadlineSlack = 0.02;

@@ -109,6 +109,11 @@ struct HomotopyClass {
   int extra_revolutions = 0;  ///< extra full turns in the sense of the way
 };
 
+/// The class a request asks for (its direction and extra revolutions).
+inline HomotopyClass homotopyClassOf(const PlanningProblem& problem) {
+  return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
+}
+
 /// One solve the planner ran for a request (PlanResult::attempts, JSON `attempts`), in the order
 /// the attempts ended: the structured trail from which the message is rendered.
 struct Attempt {

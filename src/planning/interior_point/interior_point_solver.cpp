@@ -300,7 +300,7 @@ Attempt attemptOf(const PlanningProblem& problem, const GridOutcome& outcome, At
   a.stage = stage;
   a.start = start;
   a.formulation = outcome.formulation;
-  a.homotopy = {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
+  a.homotopy = homotopyClassOf(problem);
   a.steps = problem.steps;
   a.termination = outcome.result.termination;
   a.iterations = outcome.result.iterations;

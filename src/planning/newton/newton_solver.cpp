@@ -72,10 +72,6 @@ PlanningProblem inClass(const PlanningProblem& problem, const HomotopyClass& hom
   return out;
 }
 
-HomotopyClass classOf(const PlanningProblem& problem) {
-  return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
-}
-
 bool sameClass(const HomotopyClass& a, const HomotopyClass& b) {
   return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
 }
@@ -321,7 +317,7 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
   a.stage = stage;
   a.start = start;
   a.globalization = globalization;
-  a.homotopy = classOf(problem);
+  a.homotopy = homotopyClassOf(problem);
   a.steps = problem.steps;
   return a;
 }
@@ -371,7 +367,7 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     // The request's own class always (the answer is never costlier than its solve alone), the
     // others near the cheapest; a class whose survey met one already refined (the same extremal
     // from another start) would repeat it.
-    const bool wanted = sameClass(s.homotopy, classOf(problem)) ||
+    const bool wanted = sameClass(s.homotopy, homotopyClassOf(problem)) ||
                         s.result.cost <= cheapest * (1 + p.class_refine_margin);
     const bool repeated = std::any_of(refined_costs.begin(), refined_costs.end(), [&](double c) {
       return std::abs(s.result.cost - c) <= p.same_extremal_cost * c;
@@ -668,7 +664,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context
   // The request's own class when it names one or is warm-started; after the class survey, when
   // no class converged on the requested grid and the request's class was not solved whole there.
   const bool converged = walk.kept() && walk.kept()->converged();
-  const bool request_solved = walk.solvedOnRequestedGrid(classOf(problem));
+  const bool request_solved = walk.solvedOnRequestedGrid(homotopyClassOf(problem));
   if (!walk.kept() || (!converged && !request_solved && !context.stopReason())) {
     solveRequestedClass(problem, context, &walk, p);
   }
@@ -685,7 +681,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context
     if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);
   }
   const HomotopyClass kept = walk.keptClass();
-  for (const ClassSolve& searched : walk.searchedClasses(classOf(problem))) {
+  for (const ClassSolve& searched : walk.searchedClasses(homotopyClassOf(problem))) {
     state.class_iterations = searched.iterations;
     state.kept_class = sameClass(searched.homotopy, kept);
     state.searched = searched.homotopy;

@@ -13,11 +13,6 @@ namespace attitude_planner {
 
 namespace {
 
-bool isTorqueFamily(ConstraintFamily f) {
-  return f == ConstraintFamily::TorqueUpper || f == ConstraintFamily::TorqueLower ||
-         f == ConstraintFamily::TorqueNorm;
-}
-
 /// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the unknowns:
 /// its offset and its free entries first..last−1 (fixed nodes skipped).
 struct LocalSlots {
@@ -76,57 +71,53 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
       np_(*np),
       parameters_(parameters),
       free_slacks_(formulation == Formulation::FreeSlacks),
-      node_rates_(np->scheme().hasEndTorques()),
       inverse_inertia_(problem.inertia.inverse()),
-      inverse_inertia_squared_(inverse_inertia_ * inverse_inertia_) {
-  // The torques are k = first..last (1..N−1; 0..N with end torques), the free attitudes
-  // first + 1..last − 1. Rates: per step (the step's own velocity) for paper and variational,
-  // whose first and last steps are boundary data; per node (J⁻¹Π_k, k = 1..N−1) for schemes
-  // with end torques, whose node velocities are the plan's.
-  const int first = np_.firstFreeNode() - 1, last = np_.lastFreeNode() + 1;
-  if (problem.hasTorqueBounds()) {
-    for (int a = 0; a < 3; ++a) {
-      for (ConstraintFamily f : {ConstraintFamily::TorqueUpper, ConstraintFamily::TorqueLower}) {
-        addGroup(f, first, last, -1, 3, problem.max_torque(a), nullptr, a);
-      }
-    }
+      inverse_inertia_squared_(inverse_inertia_ * inverse_inertia_),
+      constraints_(buildStageConstraints(problem)) {
+  // One group per stage constraint, on its quantity's support (stage_constraints.hpp): torques
+  // k = first..last (1..N−1; 0..N with end torques), free attitudes first + 1..last − 1, step
+  // rates for paper and variational (whose first and last steps are boundary data), node rates
+  // J⁻¹Π_k, k = 1..N−1, for schemes with end torques (whose node velocities are the plan's).
+  groups_.reserve(constraints_.size());
+  for (const auto& c : constraints_) {
+    const StageSupport support =
+        stageSupport(c->quantity(), np_.firstFreeNode(), np_.lastFreeNode());
+    ConstraintGroup& g = groups_.emplace_back();  // in place: `at` is ~100 bytes per node
+    g.constraint = c.get();
+    g.first_k = support.first_k;
+    g.last_k = support.last_k;
+    g.node_offset = support.node_offset;
+    g.width = support.width;
+    g.at.resize(g.last_k - g.first_k + 1);
+    constraint_count_ += static_cast<int>(g.at.size());
   }
-  for (const PlanningConstraint& c : problem.constraints) {
-    switch (c.kind) {
-      case ConstraintKind::MaxTorqueNorm:
-        addGroup(ConstraintFamily::TorqueNorm, first, last, -1, 3, c.limit, &c, 0);
-        break;
-      case ConstraintKind::MaxAngularRate:
-        if (node_rates_) {
-          addGroup(ConstraintFamily::AngularRate, first + 1, last - 1, -1, 3, c.limit, &c, 0);
-        } else {
-          addGroup(ConstraintFamily::AngularRate, first, last - 1, 0, 2, c.limit, &c, 0);
-        }
-        break;
-      case ConstraintKind::KeepOut:  // the fixed attitudes are checked up front
-        addGroup(ConstraintFamily::KeepOut, first + 1, last - 1, 0, 1, c.limit, &c, 0);
-        break;
-      case ConstraintKind::KeepIn:
-        addGroup(ConstraintFamily::KeepIn, first + 1, last - 1, 0, 1, c.limit, &c, 0);
-        break;
-    }
-  }
-  for (const ConstraintGroup& g : groups_) constraint_count_ += static_cast<int>(g.at.size());
 }
 
-void ConstrainedSystem::addGroup(ConstraintFamily family, int first_k, int last_k, int node_offset,
-                                 int width, double limit, const PlanningConstraint* spec,
-                                 int axis) {
-  ConstraintGroup& g = groups_.emplace_back();  // in place: `at` is ~100 bytes per node
-  g.family = family;
-  g.axis = axis;
-  g.limit = limit;
-  g.spec = spec;
-  g.first_k = first_k;
-  g.last_k = last_k;
-  g.node_offset = node_offset;
-  g.width = width;
-  g.at.resize(last_k - first_k + 1);
+std::vector<ConstraintGroup*> ConstrainedSystem::groupsOf(StageQuantity quantity) {
+  std::vector<ConstraintGroup*> out;
+  for (ConstraintGroup& g : groups_)
+    if (g.constraint->quantity() == quantity) out.push_back(&g);
+  return out;
+}
+
+/// The stage quantity q of group g's instance k (scalar quantities in q(0)) at `steps`, from the
+/// torques `tau` and (cones) the attitudes `R`, each formed once for all groups.
+Vector3 ConstrainedSystem::quantityAt(const ConstraintGroup& g, const ReducedProblem::Steps& steps,
+                                      const std::vector<Vector3>& tau,
+                                      const std::vector<Matrix3>& R, int k) const {
+  switch (g.constraint->quantity()) {
+    case StageQuantity::Torque:
+      return tau[k];
+    case StageQuantity::StepRate:
+      return Vector3(0.5 * np_.scheme().velocity(so3::exp(steps[k])).squaredNorm(), 0.0, 0.0);
+    case StageQuantity::NodeRate:
+      return Vector3(0.5 * nodeVelocity(steps, k).squaredNorm(), 0.0, 0.0);
+    case StageQuantity::Pointing: {
+      const PlanningConstraint& cone = *g.constraint->spec();
+      return Vector3(cone.world_direction.dot(R[k] * cone.body_axis), 0.0, 0.0);
+    }
+  }
+  return Vector3::Zero();
 }
 
 void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
@@ -134,37 +125,9 @@ void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
   const std::vector<Vector3> tau = np_.torques(steps);
   std::vector<Matrix3> R;
   for (ConstraintGroup& g : groups_) {
-    if ((g.family == ConstraintFamily::KeepOut || g.family == ConstraintFamily::KeepIn) &&
-        R.empty()) {
-      R = np_.attitudes(steps);
-    }
+    if (g.constraint->quantity() == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
     for (int k = g.first_k; k <= g.last_k; ++k) {
-      ConstraintInstance& in = g.instance(k);
-      switch (g.family) {
-        case ConstraintFamily::TorqueUpper:
-          in.c = 1.0 - tau[k](g.axis) / g.limit;
-          break;
-        case ConstraintFamily::TorqueLower:
-          in.c = 1.0 + tau[k](g.axis) / g.limit;
-          break;
-        case ConstraintFamily::TorqueNorm:
-          in.c = 1.0 - tau[k].squaredNorm() / (g.limit * g.limit);
-          break;
-        case ConstraintFamily::AngularRate: {
-          const Vector3 Omega =
-              node_rates_ ? nodeVelocity(steps, k) : np_.scheme().velocity(so3::exp(steps[k]));
-          in.c = 1.0 - Omega.squaredNorm() / (g.limit * g.limit);
-          break;
-        }
-        case ConstraintFamily::KeepOut:
-          in.c = std::cos(g.spec->nodeHalfAngle()) -
-                 g.spec->world_direction.dot(R[k] * g.spec->body_axis);
-          break;
-        case ConstraintFamily::KeepIn:
-          in.c = g.spec->world_direction.dot(R[k] * g.spec->body_axis) -
-                 std::cos(g.spec->nodeHalfAngle());
-          break;
-      }
+      g.instance(k).c = g.constraint->value(quantityAt(g, steps, tau, R, k));
     }
   }
   if (torques_out) *torques_out = tau;
@@ -235,24 +198,24 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedS
   merit_gradient->setZero(n);
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
-  if (node_rates_) assembleNodeRates(mu, rho, primal, H);
+  assembleNodeRates(mu, rho, primal, H);
   assembleNodeConstraints(mu, rho, primal, H);
   addConstraintGradients(mu, rhs, merit_gradient);
   return out;
 }
 
-/// The cost's stencils and the torque constraints on them: values and multipliers are needed for
+/// The cost's stencils and the constraints on the torques: values and multipliers are needed for
 /// the stencil's second-order weights (∇²f − Σ z ∇²c, all through ∂²τ_k), so they are formed in
 /// the weights callback. The stencils hold the residuals r_k = √w_k τ_k (w_k the cost weight, 1
-/// but at the end nodes of schemes with end torques): constraints are on τ_k = r_k/√w_k.
+/// but at the end nodes of schemes with end torques): constraints are on τ_k = r_k/√w_k, so with
+/// c' = ∂c/∂τ, ∇c = Jᵀc'/√w_k and −z∇²c = Σ_i (−z c'_i/√w_k) ∇²r_i − (z c''/w_k) JᵀJ (c'' the
+/// constraint's isotropic curvature).
 template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  std::vector<ConstraintGroup*> torque_groups;
-  for (ConstraintGroup& g : groups_)
-    if (isTorqueFamily(g.family)) torque_groups.push_back(&g);
-  double beta_k = 1.0;  // β_k = 1 + Σ_norm 2z/t², of the stencil the weights were formed for
+  const std::vector<ConstraintGroup*> torque_groups = groupsOf(StageQuantity::Torque);
+  double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
   const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
   const auto weights = [&](int k, const Vector3& residual) {
@@ -262,19 +225,10 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     double beta = 1.0;
     for (ConstraintGroup* g : torque_groups) {
       ConstraintInstance& in = g->instance(k);
-      if (g->family == ConstraintFamily::TorqueNorm) {
-        in.c = 1.0 - tau.squaredNorm() / (g->limit * g->limit);
-        if (H) prepare(in, mu, rho, primal);
-        // −z∇²c = (2z/t²) ∇²(½|τ|²) = factor ∇²(½|r|²)
-        const double factor = 2.0 * in.z / (g->limit * g->limit * r * r);
-        beta += factor;
-        w += factor * residual;
-      } else {
-        const double sign = g->family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
-        in.c = 1.0 - sign * tau(g->axis) / g->limit;
-        if (H) prepare(in, mu, rho, primal);
-        w(g->axis) += sign * in.z / (g->limit * r);  // −z∇²c = ±(z/a) ∇²τ_a = ±z/(a√w) ∇²r_a
-      }
+      in.c = g->constraint->value(tau);
+      if (H) prepare(in, mu, rho, primal);
+      w -= (in.z / r) * g->constraint->gradient(tau);
+      beta -= in.z * g->constraint->curvature() / (r * r);
     }
     beta_k = beta;
     return w;
@@ -285,25 +239,22 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
     const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
     const double r = root(st.k);
+    const Vector3 tau = st.tau / r;
     for (ConstraintGroup* g : torque_groups) {
-      ConstraintInstance& in = g->instance(st.k);
-      if (g->family == ConstraintFamily::TorqueNorm) {
-        in.g = -2.0 / (g->limit * g->limit * r * r) * grad_f;
-      } else {
-        const double sign = g->family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
-        in.g = -sign / (g->limit * r) * st.jacobian.row(g->axis).transpose();
-      }
+      g->instance(st.k).g = st.jacobian.transpose() * (g->constraint->gradient(tau) / r);
     }
     if (H) {
-      // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and the box constraints' g gᵀ/D
-      // (g = ∓J_a/(a r)) per torque axis; the norm constraints' g gᵀ/D apart.
+      // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
+      // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
       Vector3 weight = Vector3::Constant(beta_k);
       for (ConstraintGroup* g : torque_groups) {
         const ConstraintInstance& in = g->instance(st.k);
-        if (g->family == ConstraintFamily::TorqueNorm) {
+        const int a = g->constraint->axis();
+        if (a < 0) {
           addLocalRankOne(np_, H, st.k - 1, 3, in.g, 1.0 / in.D);
         } else {
-          weight(g->axis) += 1.0 / (in.D * (g->limit * r) * (g->limit * r));
+          const double slope = g->constraint->gradient(tau)(a) / r;
+          weight(a) += slope * slope / in.D;
         }
       }
       for (int a = 0; a < 3; ++a) {
@@ -321,34 +272,34 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
-/// Node rates (schemes with end torques): c = 1 − |J⁻¹Π_k|²/w², through the node momentum's
-/// stencil: ∇c = −(2/w²) J_Πᵀ J⁻²Π, −z∇²c = (2z/w²)(J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i).
+/// Node rates (schemes with end torques) on q = ½|J⁻¹Π_k|² through the node momentum's stencil:
+/// ∇q = J_Πᵀ J⁻²Π, ∇²q = J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i; ∇c = c'∇q, −z∇²c = −z c' ∇²q
+/// (the rate constraint is affine in q).
 template <typename Scalar>
 void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
                                           BandedSymmetric<Scalar>* H) {
-  std::vector<ConstraintGroup*> rate_groups;
-  for (ConstraintGroup& g : groups_)
-    if (g.family == ConstraintFamily::AngularRate) rate_groups.push_back(&g);
+  const std::vector<ConstraintGroup*> rate_groups = groupsOf(StageQuantity::NodeRate);
   if (rate_groups.empty()) return;
-  double gamma = 0.0;
+  double gamma = 0.0;  // −Σ z c', the weight of ∇²q
   const auto rate_weights = [&](int k, const Vector3& Pi) {
     const Vector3 a = inverse_inertia_squared_ * Pi;  // J⁻²Π
-    const double rate_squared = Pi.dot(a);            // |J⁻¹Π|²
+    const Vector3 q(0.5 * Pi.dot(a), 0.0, 0.0);       // ½|J⁻¹Π|²
     gamma = 0.0;
     for (ConstraintGroup* g : rate_groups) {
       ConstraintInstance& in = g->instance(k);
-      in.c = 1.0 - rate_squared / (g->limit * g->limit);
+      in.c = g->constraint->value(q);
       if (H) prepare(in, mu, rho, primal);
-      gamma += 2.0 * in.z / (g->limit * g->limit);
+      gamma -= in.z * g->constraint->gradient(q)(0);
     }
     return Vector3(gamma * a);
   };
   const auto visit = [&](const ReducedProblem::NodeMomentum& node) {
     pollEvery(node.k);
     const Vector3 a = inverse_inertia_squared_ * node.momentum;
-    const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;
+    const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;  // ∇q
+    const Vector3 q(0.5 * node.momentum.dot(a), 0.0, 0.0);
     for (ConstraintGroup* g : rate_groups) {
-      g->instance(node.k).g = -2.0 / (g->limit * g->limit) * grad;
+      g->instance(node.k).g = g->constraint->gradient(q)(0) * grad;
     }
     if (!H) return;
     const Eigen::Matrix<double, 9, 9> block =
@@ -361,40 +312,55 @@ void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
   np_.forEachNodeMomentum(visit, rate_weights);
 }
 
-/// Step rates and cone constraints: their own derivatives (node_constraints.hpp).
+/// q, ∇q, ∇²q of a step rate (angularRateTerms, on δ_k, δ_{k+1}) or a pointing cosine
+/// (pointingTerms, on δ_k) at instance k (node_constraints.hpp).
+ScalarQuantityTerms ConstrainedSystem::scalarQuantityTerms(const ConstraintGroup& g,
+                                                           const ReducedProblem::Steps& steps,
+                                                           const std::vector<Matrix3>& R,
+                                                           int k) const {
+  ScalarQuantityTerms out;
+  out.gradient.setZero();
+  out.hessian.setZero();
+  if (g.constraint->quantity() == StageQuantity::StepRate) {
+    const AngularRateTerms t = angularRateTerms(np_.scheme(), steps[k]);
+    out.value = t.half_squared_rate;
+    out.gradient.head<6>() = t.gradient;
+    out.hessian.topLeftCorner<6, 6>() = t.hessian;
+  } else {
+    const PlanningConstraint& cone = *g.constraint->spec();
+    const PointingTerms t = pointingTerms(R[k], cone.body_axis, cone.world_direction);
+    out.value = t.cosine;
+    out.gradient.head<3>() = t.gradient;
+    out.hessian.topLeftCorner<3, 3>() = t.hessian;
+  }
+  return out;
+}
+
+/// Step rates and cones: c(q) through q's own derivatives, ∇c = c'∇q, −z∇²c = −z(c'∇²q + c''∇q∇qᵀ).
 template <typename Scalar>
 void ConstrainedSystem::assembleNodeConstraints(double mu, double rho, bool primal,
                                                 BandedSymmetric<Scalar>* H) {
   const ReducedProblem::Steps& steps = np_.current();
   std::vector<Matrix3> R;
   for (ConstraintGroup& g : groups_) {
-    if (isTorqueFamily(g.family)) continue;
-    if (node_rates_ && g.family == ConstraintFamily::AngularRate) continue;
-    if (g.family != ConstraintFamily::AngularRate && R.empty()) R = np_.attitudes(steps);
+    const StageQuantity quantity = g.constraint->quantity();
+    if (quantity != StageQuantity::StepRate && quantity != StageQuantity::Pointing) continue;
+    if (quantity == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
     for (int k = g.first_k; k <= g.last_k; ++k) {
       pollEvery(k);
       ConstraintInstance& in = g.instance(k);
-      Eigen::Matrix<double, 9, 9> block = Eigen::Matrix<double, 9, 9>::Zero();
-      in.g.setZero();
-      if (g.family == ConstraintFamily::AngularRate) {
-        const AngularRateTerms t = angularRateTerms(np_.scheme(), steps[k]);
-        const double scale = 2.0 / (g.limit * g.limit);  // c = 1 − scale φ
-        in.c = 1.0 - scale * t.half_squared_rate;
-        if (H) prepare(in, mu, rho, primal);
-        in.g.head<6>() = -scale * t.gradient;
-        block.topLeftCorner<6, 6>() = (in.z * scale) * t.hessian;  // −z∇²c
-      } else {
-        const PointingTerms t = pointingTerms(R[k], g.spec->body_axis, g.spec->world_direction);
-        const double sign = g.family == ConstraintFamily::KeepOut ? -1.0 : 1.0;  // c = ±p ∓ cos α
-        in.c = sign * (t.cosine - std::cos(g.spec->nodeHalfAngle()));
-        if (H) prepare(in, mu, rho, primal);
-        in.g.head<3>() = sign * t.gradient;
-        block.topLeftCorner<3, 3>() = (-in.z * sign) * t.hessian;
-      }
-      if (H) {
-        addLocal(np_, H, k + g.node_offset, g.width, block);
-        addLocalRankOne(np_, H, k + g.node_offset, g.width, in.g, 1.0 / in.D);
-      }
+      const ScalarQuantityTerms t = scalarQuantityTerms(g, steps, R, k);
+      const Vector3 q(t.value, 0.0, 0.0);
+      const double slope = g.constraint->gradient(q)(0);
+      in.c = g.constraint->value(q);
+      if (H) prepare(in, mu, rho, primal);
+      in.g = slope * t.gradient;
+      if (!H) continue;
+      Eigen::Matrix<double, 9, 9> block = (-in.z * slope) * t.hessian;
+      const double curvature = g.constraint->curvature();
+      if (curvature != 0.0) block -= (in.z * curvature) * t.gradient * t.gradient.transpose();
+      addLocal(np_, H, k + g.node_offset, g.width, block);
+      addLocalRankOne(np_, H, k + g.node_offset, g.width, in.g, 1.0 / in.D);
     }
   }
 }
@@ -593,13 +559,13 @@ std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
   std::vector<Vector3> sigma;
   for (const ConstraintGroup& g : groups_) {
-    if (g.family != ConstraintFamily::TorqueUpper && g.family != ConstraintFamily::TorqueLower)
-      continue;
+    const int a = g.constraint->axis();
+    if (g.constraint->quantity() != StageQuantity::Torque || a < 0) continue;
     if (sigma.empty()) sigma = torque;
-    const double sign = g.family == ConstraintFamily::TorqueUpper ? 1.0 : -1.0;
     for (int k = g.first_k; k <= g.last_k; ++k) {
+      // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
       const double weight = np_.scheme().torqueWeight(k, np_.steps());
-      sigma[k](g.axis) += sign * g.at[k - g.first_k].z / (g.limit * weight);
+      sigma[k](a) -= g.at[k - g.first_k].z * g.constraint->gradient(torque[k])(a) / weight;
     }
   }
   return sigma;

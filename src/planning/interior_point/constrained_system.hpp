@@ -16,13 +16,10 @@
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
 
-/// The kinds of node constraint, each written dimensionless as c(δ) ≥ 0.
-enum class ConstraintFamily { TorqueUpper, TorqueLower, TorqueNorm, AngularRate, KeepOut, KeepIn };
-
-/// One node constraint c(δ) ≥ 0 and its primal–dual state.
 struct ConstraintInstance {
   double c = 0.0;                 ///< value (dimensionless)
   Eigen::Matrix<double, 9, 1> g;  ///< ∂c/∂δ over the group's local nodes
@@ -32,12 +29,17 @@ struct ConstraintInstance {
   double ds = 0.0;                ///< FreeSlacks: the slack's Newton step
 };
 
-/// All node constraints of one kind (one axis and sign of the torque box, or one spec).
+/// A scalar stage quantity (a step's ½|Ω|², a pointing cosine) and its derivatives over the
+/// instance's local nodes (zero beyond its width).
+struct ScalarQuantityTerms {
+  double value = 0.0;
+  Eigen::Matrix<double, 9, 1> gradient;
+  Eigen::Matrix<double, 9, 9> hessian;
+};
+
+/// The instances of one stage constraint (one side of the torque box, or one scene constraint).
 struct ConstraintGroup {
-  ConstraintFamily family;
-  int axis = 0;        ///< torque box axis
-  double limit = 0.0;  ///< a_axis, t or w
-  const PlanningConstraint* spec = nullptr;
+  const StageConstraint* constraint = nullptr;
   int first_k = 0, last_k = 0;         ///< instances k = first_k..last_k
   int node_offset = 0;                 ///< first local node = k + node_offset
   int width = 1;                       ///< local nodes (3: torque stencil, 2: step, 1: node)
@@ -139,8 +141,6 @@ class ConstrainedSystem {
   void initializeMultipliers(double mu, double rho, double cap);
 
  private:
-  void addGroup(ConstraintFamily family, int first_k, int last_k, int node_offset, int width,
-                double limit, const PlanningConstraint* spec, int axis);
   /// Slacks and (safeguarded or primal) multipliers for the instance's value c.
   void prepare(ConstraintInstance& in, double mu, double rho, bool primal) const;
   template <typename Scalar>
@@ -150,18 +150,25 @@ class ConstrainedSystem {
   void assembleNodeRates(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
   template <typename Scalar>
   void assembleNodeConstraints(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
+  /// The groups of one stage quantity.
+  std::vector<ConstraintGroup*> groupsOf(StageQuantity quantity);
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
   Vector3 nodeVelocity(const ReducedProblem::Steps& steps, int k) const;
+  ScalarQuantityTerms scalarQuantityTerms(const ConstraintGroup& g,
+                                          const ReducedProblem::Steps& steps,
+                                          const std::vector<Matrix3>& R, int k) const;
+  Vector3 quantityAt(const ConstraintGroup& g, const ReducedProblem::Steps& steps,
+                     const std::vector<Vector3>& tau, const std::vector<Matrix3>& R, int k) const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  bool node_rates_;
   Matrix3 inverse_inertia_;          ///< J⁻¹
   Matrix3 inverse_inertia_squared_;  ///< J⁻²
+  StageConstraints constraints_;     ///< buildStageConstraints(problem): one group each
   std::vector<ConstraintGroup> groups_;
   int constraint_count_ = 0;
   const Interruption* interruption_ = nullptr;

@@ -1,0 +1,89 @@
+// Stage constraints: every node constraint of a request (the actuator box and the scene's
+// `constraints:`) as one kind of object behind one interface, so that the solvers assemble them by
+// looping over a list instead of switching on kinds.
+//
+// Each constraint c ≥ 0 (dimensionless) is a function of ONE stage quantity q of the transcription
+// (StageQuantity): the torque τ_k, the half squared rate ½|Ω|² of a step or of a node, or the
+// pointing cosine sᵀR_k b. The constraint knows c(q) and its derivatives in q; the transcription
+// knows q's derivatives in the unknowns (ReducedProblem's stencils and node momenta,
+// node_constraints.hpp's angularRateTerms and pointingTerms) and, where q depends on the time step,
+// in h (ReducedProblem::forEachStencilWithTimeStep). The assemblers (interior_point/
+// constrained_system at a fixed h, interior_point/free_time_solver with h free) apply the chain
+// rule: ∇c = c'(q) ∇q, ∇²c = c'(q) ∇²q + ∇qᵀ c''(q) ∇q.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/planning/problem.hpp"
+
+namespace attitude_planner {
+
+/// What a stage constraint is a function of: its support on the band and its h dependence.
+enum class StageQuantity {
+  Torque,  ///< q = τ_k [N m] (3-vector) on R_{k−1}, R_k, R_{k+1}; moves with h
+  StepRate,  ///< q = ½|Ω_k|² [rad²/s²] of step F_k = R_kᵀR_{k+1} (paper, variational); moves with h
+  NodeRate,  ///< q = ½|J⁻¹Π_k|² [rad²/s²] of node k (schemes with end torques) on R_{k−1..k+1};
+             ///< moves with h
+  Pointing,  ///< q = sᵀR_k b (the cosine of the angle between R_k b and s) on R_k; no h
+};
+
+/// Where the instances of a quantity sit: k = first_k..last_k, each on the nodes
+/// k + node_offset .. k + node_offset + width − 1 (at most three: the band is kept).
+struct StageSupport {
+  int first_k = 0, last_k = 0;
+  int node_offset = 0;
+  int width = 1;
+};
+
+/// The support of `quantity` on a reduced problem whose free attitudes are
+/// R_first_free..R_last_free (torques k = first_free − 1..last_free + 1; step rates the steps
+/// between them and their neighbours, the boundary steps excluded (boundary data); node rates and
+/// cones the free nodes, the fixed attitudes being checked up front).
+StageSupport stageSupport(StageQuantity quantity, int first_free, int last_free);
+
+/// True where q changes with the time step at fixed free attitudes (all but Pointing).
+bool quantityDependsOnTimeStep(StageQuantity quantity);
+
+/// One node constraint c(q) ≥ 0, imposed at every instance of its quantity.
+class StageConstraint {
+ public:
+  virtual ~StageConstraint() = default;
+  StageQuantity quantity() const { return quantity_; }
+  /// The scene's constraint this one imposes (null: a side of the actuator box).
+  const PlanningConstraint* spec() const { return spec_; }
+
+  /// c(q), dimensionless (scalar quantities in q(0)).
+  virtual double value(const Vector3& q) const = 0;
+  /// ∂c/∂q (scalar quantities: in entry 0, the others 0).
+  virtual Vector3 gradient(const Vector3& q) const = 0;
+  /// ∇²_q c = curvature()·I (every kind here has an isotropic second derivative, most zero).
+  virtual double curvature() const { return 0.0; }
+  /// ≥ 0: c is affine in this one component of q (a torque box side). Its g gᵀ/D then folds into
+  /// that axis's Gauss–Newton weight of the stencil (ConstrainedSystem's precision rule: the
+  /// rank-one terms are formed in the band's precision, which a constraint at its bound needs at
+  /// N ≥ 1e4).
+  virtual int axis() const { return -1; }
+  /// One line for messages and the checker, e.g. "max_torque_norm 0.45 N m" or
+  /// "actuator_limits max_torque[1] 0.3 N m (upper)".
+  virtual std::string describe() const = 0;
+
+ protected:
+  StageConstraint(StageQuantity quantity, const PlanningConstraint* spec)
+      : quantity_(quantity), spec_(spec) {}
+
+ private:
+  StageQuantity quantity_;
+  const PlanningConstraint* spec_;
+};
+
+using StageConstraints = std::vector<std::unique_ptr<const StageConstraint>>;
+
+/// Every stage constraint of `problem`, in a fixed order: the actuator box (per finite axis a =
+/// 0, 1, 2: upper side, lower side), then `problem.constraints` in their order (the rate limit on
+/// the node rates for schemes with end torques, else on the step rates). The list points into
+/// `problem.constraints`: `problem` must outlive it.
+StageConstraints buildStageConstraints(const PlanningProblem& problem);
+
+}  // namespace attitude_planner

@@ -202,8 +202,9 @@ TEST(FreeTime, EverySchemeStaysWithinPublishedPlusOneStep) {
   }
 }
 
-TEST(FreeTime, RateLimitsAndConesFallBackToTheSearch) {
-  // Not written in h yet: the search answers, and says so (kkt_point false).
+TEST(FreeTime, RateLimitsFallBackToTheSearch) {
+  // Not written in h yet: the search answers, and says so (kkt_point false). (Cones are written
+  // in h: test_stage_constraints.cpp.)
   ap::PlanningProblem p = scene("min_time_betts", 32);
   p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.1));
   const ap::PlanResult r = ap::planManeuver(p);

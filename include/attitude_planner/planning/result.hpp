@@ -66,6 +66,8 @@ enum class AttemptStart {
   PreviousAttempt,       ///< the plan of the attempt before it (staged continuations, retries)
   EigenaxisSlew,         ///< minimum_time: the eigenaxis bang–bang slew at its closed-form T
   Excursion,             ///< minimum_time: the eigenaxis slew with an excursion off its axis
+  /// minimum_time with cones: the minimum-effort plan under every constraint (cones tightened)
+  ConstrainedMinimumEffort,
 };
 inline constexpr NamedValue<AttemptStart> kAttemptStartNames[] = {
     {AttemptStart::Hermite, "hermite"},
@@ -77,6 +79,7 @@ inline constexpr NamedValue<AttemptStart> kAttemptStartNames[] = {
     {AttemptStart::PreviousAttempt, "previous_attempt"},
     {AttemptStart::EigenaxisSlew, "eigenaxis_slew"},
     {AttemptStart::Excursion, "excursion"},
+    {AttemptStart::ConstrainedMinimumEffort, "constrained_minimum_effort"},
 };
 
 /// How the problem was posed to the solver of an attempt.

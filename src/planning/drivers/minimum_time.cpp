@@ -402,6 +402,8 @@ constexpr double kFreeTimeTolerance = 1e-9;
 constexpr int kFreeTimeMaxIterations = 500;
 /// The excursion starts: their size [rad] and first T relative to the eigenaxis slew's.
 constexpr double kFreeTimeExcursion = 0.3;
+/// With cones also excursions this large [rad]: a detour round a cone is a larger departure.
+constexpr double kFreeTimeConeExcursion = 0.8;
 constexpr double kFreeTimeStartFactor = 0.96;
 /// A body axis whose part perpendicular to the eigenaxis is shorter than this gives no start.
 constexpr double kSmallestProjection = 0.3;
@@ -468,14 +470,110 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
       so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
   std::vector<FreeTimeStart> starts{
       {"eigenaxis", AttemptStart::EigenaxisSlew, excursionSlew(at, e, 0.0).attitude, T_eigenaxis}};
-  for (const Vector3& axis : excursionAxes(e)) {
-    std::ostringstream name;
-    name << "excursion " << kFreeTimeExcursion << " rad about " << axisName(axis);
-    starts.push_back({name.str(), AttemptStart::Excursion,
-                      excursionSlew(at, axis, kFreeTimeExcursion).attitude,
-                      kFreeTimeStartFactor * T_eigenaxis});
+  // With cones both signs of each excursion: a cone is passed on one side or the other, and
+  // the sides are different local minima of T.
+  std::vector<Vector3> axes = excursionAxes(e);
+  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  if (cones) {
+    for (std::size_t i = 0, n = axes.size(); i < n; ++i) axes.push_back(-axes[i]);
+  }
+  if (cones) {
+    starts.push_back({"minimum effort under the constraints",
+                      AttemptStart::ConstrainedMinimumEffort, starts.front().attitudes,
+                      kEigenaxisStartFactor * T_eigenaxis});
+  }
+  for (const double size : {kFreeTimeExcursion, kFreeTimeConeExcursion}) {
+    if (size != kFreeTimeExcursion && !cones) break;
+    for (const Vector3& axis : axes) {
+      std::ostringstream name;
+      name << "excursion " << size << " rad about " << axisName(axis);
+      starts.push_back({name.str(), AttemptStart::Excursion, excursionSlew(at, axis, size).attitude,
+                        kFreeTimeStartFactor * T_eigenaxis});
+    }
   }
   return starts;
+}
+
+/// A free-time solve's start must clear its cones strictly: raising T moves no attitude, so the
+/// start's clearance is all the room the barrier has. Starts are taken this far [rad] inside the
+/// cones' node bounds.
+constexpr double kConeStartClearance = 0.01;
+
+/// The smallest clearance of the free attitudes R_1..R_{N−1} to their cones' node bounds [rad]
+/// (+∞ without cones).
+double coneClearance(const PlanningProblem& problem, const std::vector<Matrix3>& R) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (std::size_t k = 1; k + 1 < R.size(); ++k) {
+      smallest = std::min(smallest, coneMargin(c, R[k]) - c.margin);
+    }
+  }
+  return smallest;
+}
+
+/// R_k turned (in the world frame, about s × R_k b) just far enough to clear each cone's node
+/// bound by `clearance`: for a resampled coarse T* plan, whose new nodes between the coarse ones
+/// dip past an active bound by O(h²).
+std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vector<Matrix3> R,
+                                      double clearance) {
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    const bool keep_out = c.kind == ConstraintKind::KeepOut;
+    for (std::size_t k = 1; k + 1 < R.size(); ++k) {
+      const double turn = clearance - (coneMargin(c, R[k]) - c.margin);
+      if (turn <= 0) continue;
+      const Vector3 v = R[k] * c.body_axis;
+      Vector3 axis = c.world_direction.cross(v);  // turning about it by + moves v away from s
+      axis = axis.norm() > 1e-12 ? axis.normalized() : c.world_direction.unitOrthogonal();
+      R[k] = so3::exp((keep_out ? turn : -turn) * axis) * R[k];
+    }
+  }
+  return R;
+}
+
+/// A start that clears the cones: the minimum-effort plan at `duration` under the cones alone,
+/// their node bounds tightened by kConeStartClearance (the torque bounds left out: the free-time
+/// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
+/// side of a cone; cold if that does not converge. `every_constraint`: the other bounds kept and a
+/// cold solve (the ConstrainedMinimumEffort start). Empty if none converges.
+std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
+                                                   const std::vector<Matrix3>& attitudes,
+                                                   double duration, const SolverOptions& options,
+                                                   bool every_constraint = false) {
+  PlanningProblem effort = problem;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = duration;
+  if (!every_constraint) {
+    effort.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  }
+  effort.constraints.clear();
+  for (PlanningConstraint c : problem.constraints) {
+    if (c.isCone()) c.margin += kConeStartClearance;
+    if (c.isCone() || every_constraint) effort.constraints.push_back(c);
+  }
+  try {
+    SolverOptions o = options;
+    PlanResult r;
+    if (!every_constraint) {
+      ReducedProblem np(effort);
+      np.setInteriorFromAttitudes(attitudes);
+      const Maneuver guess = np.maneuver(np.current());
+      o.warm_start = &guess;
+      o.constrained_from_warm_start = true;
+      r = planAtResolution(effort, o);
+    }
+    if (!r.converged()) {
+      o.warm_start = nullptr;
+      o.constrained_from_warm_start = false;
+      r = planAtResolution(effort, o);
+    }
+    if (r.converged()) return r.maneuver.attitude;
+  } catch (const std::exception&) {  // a start with no step at this T: no cleared start
+  }
+  return std::nullopt;
 }
 
 /// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
@@ -521,8 +619,18 @@ class FreeTimeMinimumTime {
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& attitudes,
                         double duration, AttemptStart kind) {
     const SolverOptions remaining = withRemainingBudget(options_, start_);
-    FreeTimeOutcome o = solveFreeTime(p, attitudes, duration, kFreeTimeTolerance,
-                                      kFreeTimeMaxIterations, &remaining);
+    std::vector<Matrix3> start = attitudes;
+    if (kind == AttemptStart::ConstrainedMinimumEffort) {
+      if (auto planned = coneClearStart(p, start, duration, remaining, true)) start = *planned;
+    } else if (coneClearance(p, start) < 0.5 * kConeStartClearance) {
+      if (kind == AttemptStart::CoarseLevel) {
+        start = pushedOutOfCones(p, start, kConeStartClearance);
+      } else if (auto cleared = coneClearStart(p, start, duration, remaining)) {
+        start = *cleared;
+      }
+    }
+    FreeTimeOutcome o =
+        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, &remaining);
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;

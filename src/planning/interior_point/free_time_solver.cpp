@@ -9,7 +9,8 @@
 // C the scheme's effort Σ ½ w_k |τ_k|² and ε = ε₀ μ/μ₀ a regularization that vanishes with the
 // barrier μ (minimum time alone is bang–bang: where a torque is strictly inside its bounds, ε
 // makes the Newton system definite; at μ → 0 the answer is a KKT point of minimum time itself).
-// Every constraint is a function of one torque τ_k, so of R_{k−1}, R_k, R_{k+1} and h:
+// A pointing cone is a function of R_k alone (not of h). Every other constraint is a function of
+// one torque τ_k, so of R_{k−1}, R_k, R_{k+1} and h:
 // ∂τ_k/∂h comes from ReducedProblem::forEachStencilWithTimeStep (tau_h, with the fixed inner
 // attitudes of paper and variational moving with h), and the Hessian of the Lagrangian
 // L = f − Σ zᵢcᵢ is that stencil's `second` with the weights w_k = ε r_k − Σ zᵢ ∂cᵢ/∂r_k plus the
@@ -21,7 +22,8 @@
 // complement (linalg/bordered_band.hpp). Inertia: the band must be positive definite and the
 // Schur complement positive (else a growing shift, as IPOPT's δ_w); line search Armijo on
 // φ_μ = f − μ Σ ln cᵢ with the fraction to the boundary on c and z; barrier μ decreased
-// monotonically (IPOPT's κ_μ, θ_μ) once the barrier problem's residual is ≤ κ_ε μ.
+// monotonically (IPOPT's κ_μ, θ_μ) once the barrier problem's residual is ≤ κ_ε μ. Those
+// constants are InteriorPointParameters' (one value per idea with the fixed-h interior point).
 #include "planning/interior_point/free_time_solver.hpp"
 
 #include <algorithm>
@@ -32,16 +34,15 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/linalg/bordered_band.hpp"
+#include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
 
 namespace {
 
-/// The start's time step grows by this factor until every constraint holds with kStartMargin.
-constexpr double kStartGrowth = 1.05;
-constexpr double kStartMargin = 0.05;
-constexpr int kMaxStartGrowths = 400;
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
 /// ε₀ C₀ = this × T₀ at the start (C₀ its effort): a light regularization, gone as μ → 0.
@@ -50,86 +51,103 @@ constexpr double kInitialEffortShare = 1e-2;
 /// minimum time alone has no curvature, and a shifted Newton step stalls there (measured on
 /// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
 constexpr double kFinalEffortFraction = 1e-8;
-/// Monotone barrier update (IPOPT κ_ε, κ_μ, θ_μ).
-constexpr double kBarrierSolved = 10.0;
-constexpr double kBarrierLinear = 0.2;
-constexpr double kBarrierSuperlinear = 1.5;
-/// Fraction to the boundary (IPOPT τ) on the constraint values and the multipliers.
-constexpr double kFractionToBoundary = 0.99;
-/// z stays within [μ/(κ c), κ μ/c] (IPOPT κ_Σ).
-constexpr double kDualSafeguard = 1e10;
-constexpr double kArmijo = 1e-4;
-constexpr int kMaxHalvings = 40;
-/// Inertia correction: a relative diagonal shift, from kFirstShift growing ×kShiftGrowth.
-constexpr double kFirstShift = 1e-10;
-constexpr double kShiftGrowth = 100.0;
-constexpr double kMaxShift = 1e10;
 constexpr int kHalfBandwidth = 8;
 /// Above this N the stationarity tolerance grows like N² (round-off of second differences).
 constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
-/// Most constraints on one torque: 6 box sides and one norm bound.
-constexpr int kMaxPerTorque = 7;
 
-/// One constraint on one torque: value, gradient over (δ_{k−1}, δ_k, δ_{k+1}, η), multiplier.
-struct TorqueConstraint {
+/// One instance of a stage constraint: value, gradient over its local nodes (at most three, 9
+/// entries) and η (entry 9), multiplier and its step.
+struct FreeTimeInstance {
   double c = 1.0, z = 0.0, dz = 0.0;
   Eigen::Matrix<double, 10, 1> g = Eigen::Matrix<double, 10, 1>::Zero();
 };
 
+/// The instances of one stage constraint (stage_constraints.hpp) on its support.
+struct FreeTimeGroup {
+  const StageConstraint* constraint = nullptr;
+  StageSupport support;
+  std::vector<FreeTimeInstance> at;  ///< at[k − support.first_k]
+  FreeTimeInstance& instance(int k) { return at[k - support.first_k]; }
+  const FreeTimeInstance& instance(int k) const { return at[k - support.first_k]; }
+};
+
 class FreeTimeSolver {
  public:
-  FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np)
-      : problem_(problem), np_(*np), N_(np->steps()), n_(np->unknowns()) {
-    for (int a = 0; a < 3; ++a) {
-      if (std::isfinite(problem.max_torque(a)) && problem.max_torque(a) > 0) {
-        box_axes_.push_back(a);
-      }
+  FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
+                 const StageConstraints& constraints, const InteriorPointParameters& parameters)
+      : problem_(problem), np_(*np), parameters_(parameters), N_(np->steps()), n_(np->unknowns()) {
+    for (const auto& c : constraints) {
+      FreeTimeGroup& g = groups_.emplace_back();
+      g.constraint = c.get();
+      g.support = stageSupport(c->quantity(), np_.firstFreeNode(), np_.lastFreeNode());
+      g.at.resize(g.support.last_k - g.support.first_k + 1);
     }
-    for (const PlanningConstraint& c : problem.constraints) {
-      if (c.kind == ConstraintKind::MaxTorqueNorm) norm_ = std::min(norm_, c.limit);
-    }
-    per_torque_ = 2 * static_cast<int>(box_axes_.size()) + (std::isfinite(norm_) ? 1 : 0);
-    first_k_ = np_.firstFreeNode() - 1;
-    last_k_ = np_.lastFreeNode() + 1;
-    at_.resize(last_k_ - first_k_ + 1);
   }
 
-  /// Raises h until every constraint holds with kStartMargin; false if it never does.
-  bool startInside() {
-    for (int i = 0; i < kMaxStartGrowths; ++i) {
-      if (smallestValue(np_.current()) >= kStartMargin) {
-        h0_ = np_.timeStep();
-        return true;
-      }
-      np_.setTimeStep(np_.timeStep() * kStartGrowth);
+  /// Raises h until every constraint that moves with h holds with the start margin (the others,
+  /// the cones, must already hold strictly: raising h does not move an attitude). Empty if the
+  /// start is strictly feasible, else why not.
+  std::string startInside() {
+    const double cone_value = smallestValue(np_.current(), false);
+    if (!(cone_value > 0)) {
+      std::ostringstream why;
+      why << "the start's attitudes violate a cone (smallest value " << cone_value
+          << "; raising T does not move them)";
+      return why.str();
     }
-    return false;
+    for (int i = 0; i < parameters_.free_time_max_start_growths; ++i) {
+      if (smallestValue(np_.current(), true) >= parameters_.free_time_start_margin) {
+        h0_ = np_.timeStep();
+        return "";
+      }
+      np_.setTimeStep(np_.timeStep() * parameters_.free_time_start_growth);
+    }
+    return "no strictly feasible start: the constraints still fail at " +
+           std::to_string(std::pow(parameters_.free_time_start_growth,
+                                   parameters_.free_time_max_start_growths)) +
+           " times the start's duration";
   }
 
   FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options);
 
  private:
-  int constraintCount() const { return per_torque_ * (last_k_ - first_k_ + 1); }
+  int constraintCount() const {
+    int m = 0;
+    for (const FreeTimeGroup& g : groups_) m += static_cast<int>(g.at.size());
+    return m;
+  }
   double torqueScale(int k) const { return std::sqrt(np_.scheme().torqueWeight(k, N_)); }
 
-  /// The constraint values of torque τ (not its residual r = √w τ) into `out`.
-  void values(const Vector3& tau, std::array<TorqueConstraint, kMaxPerTorque>* out) const {
-    int i = 0;
-    for (const int a : box_axes_) {
-      (*out)[i++].c = 1.0 - tau(a) / problem_.max_torque(a);
-      (*out)[i++].c = 1.0 + tau(a) / problem_.max_torque(a);
+  /// Calls f(group, k, c) for every instance's value c at `steps` (torques and, with cones, the
+  /// attitudes formed once).
+  template <typename F>
+  void forEachValue(const ReducedProblem::Steps& steps, F&& f) const {
+    const std::vector<Vector3> tau = np_.torques(steps);
+    std::vector<Matrix3> R;
+    for (const FreeTimeGroup& g : groups_) {
+      const StageQuantity quantity = g.constraint->quantity();
+      if (quantity == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
+      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+        Vector3 q = Vector3::Zero();
+        if (quantity == StageQuantity::Torque) {
+          q = tau[k];
+        } else {  // Pointing (freeTimeUnsupported refuses the rates)
+          const PlanningConstraint& cone = *g.constraint->spec();
+          q(0) = pointingTerms(R[k], cone.body_axis, cone.world_direction).cosine;
+        }
+        f(g, k, g.constraint->value(q));
+      }
     }
-    if (std::isfinite(norm_)) (*out)[i++].c = 1.0 - tau.squaredNorm() / (norm_ * norm_);
   }
 
-  double smallestValue(const ReducedProblem::Steps& steps) const {
-    const std::vector<Vector3> tau = np_.torques(steps);
+  /// The smallest value of the constraints that move with h (time_dependent) or of the others.
+  double smallestValue(const ReducedProblem::Steps& steps, bool time_dependent) const {
     double smallest = std::numeric_limits<double>::infinity();
-    std::array<TorqueConstraint, kMaxPerTorque> row;
-    for (int k = first_k_; k <= last_k_; ++k) {
-      values(tau[k], &row);
-      for (int i = 0; i < per_torque_; ++i) smallest = std::min(smallest, row[i].c);
-    }
+    forEachValue(steps, [&](const FreeTimeGroup& g, int, double c) {
+      if (quantityDependsOnTimeStep(g.constraint->quantity()) == time_dependent) {
+        smallest = std::min(smallest, c);
+      }
+    });
     return smallest;
   }
 
@@ -137,42 +155,39 @@ class FreeTimeSolver {
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
-    std::array<TorqueConstraint, kMaxPerTorque> row;
-    for (int k = first_k_; k <= last_k_; ++k) {
-      values(tau[k], &row);
-      for (int i = 0; i < per_torque_; ++i) {
-        const double old = at_[k - first_k_][i].c;
-        if (!(row[i].c > 0) || (check_boundary && row[i].c < (1 - kFractionToBoundary) * old)) {
-          return std::numeric_limits<double>::infinity();
-        }
-        phi -= mu * std::log(row[i].c);
-      }
-    }
-    return phi;
+    bool inside = true;
+    const double fraction = 1 - parameters_.fraction_to_boundary;
+    forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
+      if (!(c > 0) || (check_boundary && c < fraction * g.instance(k).c)) inside = false;
+      if (inside) phi -= mu * std::log(c);
+    });
+    return inside ? phi : std::numeric_limits<double>::infinity();
   }
 
   double T0() const { return N_ * h0_; }
   void assemble(double mu, double epsilon);
+  void assembleCones(double mu);
+  void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
+                const Eigen::Matrix<double, 10, 1>& lagrangian);
   bool solveStep(Eigen::VectorXd* d);
   bool lineSearch(const Eigen::VectorXd& d, double mu, double epsilon, double* alpha);
   void moveTo(double h, const ReducedProblem::Steps& steps, const Eigen::VectorXd* d, double alpha);
-  double localDot(int k, const Eigen::Matrix<double, 10, 1>& g, const Eigen::VectorXd& d) const;
+  double localDot(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
+                  const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
+  double dualityGap() const;
   void initializeDuals(double mu);
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
+  const InteriorPointParameters& parameters_;
   int N_, n_;
-  std::vector<int> box_axes_;
-  double norm_ = std::numeric_limits<double>::infinity();
-  int per_torque_ = 0;
-  int first_k_ = 0, last_k_ = 0;
   double h0_ = 0.0;
-  std::vector<std::array<TorqueConstraint, kMaxPerTorque>> at_;  ///< at_[k − first_k_]
+  std::vector<FreeTimeGroup> groups_;
   // The assembled system at the current iterate.
   BandedSymmetric<double> band_{1, kHalfBandwidth};
   Eigen::VectorXd border_, rhs_, lagrangian_gradient_;
@@ -186,52 +201,47 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   rhs_.setZero(n_ + 1);
   lagrangian_gradient_.setZero(n_ + 1);
   corner_ = 0.0;
-  const double t2 = norm_ * norm_;
+  std::vector<FreeTimeGroup*> torque_groups;
+  for (FreeTimeGroup& g : groups_)
+    if (g.constraint->quantity() == StageQuantity::Torque) torque_groups.push_back(&g);
   const auto weights = [&](int k, const Vector3& r) {
     // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
     const double s = torqueScale(k);
-    const auto& row = at_[k - first_k_];
     Vector3 w = epsilon * r;
-    int i = 0;
-    for (const int a : box_axes_) {
-      w(a) += (row[i].z - row[i + 1].z) / (problem_.max_torque(a) * s);
-      i += 2;
+    for (FreeTimeGroup* g : torque_groups) {
+      w -= (g->instance(k).z / s) * g->constraint->gradient(r / s);
     }
-    if (std::isfinite(norm_)) w += 2.0 * row[i].z / (s * s * t2) * r;
     return w;
   };
   const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
   np_.forEachStencilWithTimeStep(
       [&](const ReducedProblem::TimeStepStencil& st) {
         const double s = torqueScale(st.k);
-        Eigen::Matrix<double, 3, 10> G;
+        const Vector3 tau = st.tau / s;
+        Eigen::Matrix<double, 3, 10> G;  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
         G.leftCols<9>() = st.jacobian;
         G.col(9) = st.tau_h * h0_;
-        auto& row = at_[st.k - first_k_];
-        values(st.tau / s, &row);
         Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Zero();
         H.topLeftCorner<9, 9>() = st.second;
         H.block<9, 1>(0, 9) = st.second_h * h0_;
         H.block<1, 9>(9, 0) = (st.second_h * h0_).transpose();
         H(9, 9) = st.second_hh * h0_ * h0_;
+        // Gauss–Newton: ε of the effort and −z c''/w_k of the constraints' isotropic curvature.
         double gauss_newton = epsilon;
-        int i = 0;
-        for (const int a : box_axes_) {
-          row[i].g = -G.row(a).transpose() / (problem_.max_torque(a) * s);
-          row[i + 1].g = -row[i].g;
-          i += 2;
-        }
-        if (std::isfinite(norm_)) {
-          row[i].g = -2.0 / (s * s * t2) * (G.transpose() * st.tau);
-          gauss_newton += 2.0 * row[i].z / (s * s * t2);
-        }
-        H += gauss_newton * G.transpose() * G;
         Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-        for (int j = 0; j < per_torque_; ++j) {
-          H += (row[j].z / row[j].c) * row[j].g * row[j].g.transpose();
-          rhs += (mu / row[j].c) * row[j].g;
-          lagrangian -= row[j].z * row[j].g;
+        for (FreeTimeGroup* g : torque_groups) {
+          FreeTimeInstance& in = g->instance(st.k);
+          in.c = g->constraint->value(tau);
+          in.g = G.transpose() * (g->constraint->gradient(tau) / s);
+          gauss_newton -= in.z * g->constraint->curvature() / (s * s);
+        }
+        H += gauss_newton * G.transpose() * G;
+        for (FreeTimeGroup* g : torque_groups) {
+          const FreeTimeInstance& in = g->instance(st.k);
+          H += (in.z / in.c) * in.g * in.g.transpose();
+          rhs += (mu / in.c) * in.g;
+          lagrangian -= in.z * in.g;
         }
         for (int node = 0; node < 3; ++node) {
           const int v = np_.variableIndex(st.k - 1 + node);
@@ -252,8 +262,38 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         }
       },
       weights);
+  assembleCones(mu);
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
+}
+
+/// Cones on the pointing cosine p_k = sᵀR_k b (node_constraints.hpp pointingTerms): a function of
+/// R_k alone, not of h (η's entries stay 0): ∇c = c'∇p, −z∇²c = −z c'∇²p, and the barrier's
+/// (z/c) g gᵀ, on node k's diagonal block.
+void FreeTimeSolver::assembleCones(double mu) {
+  std::vector<Matrix3> R;
+  for (FreeTimeGroup& g : groups_) {
+    if (g.constraint->quantity() != StageQuantity::Pointing) continue;
+    if (R.empty()) R = np_.attitudes(np_.current());
+    const PlanningConstraint& cone = *g.constraint->spec();
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      FreeTimeInstance& in = g.instance(k);
+      const PointingTerms t = pointingTerms(R[k], cone.body_axis, cone.world_direction);
+      const Vector3 q(t.cosine, 0.0, 0.0);
+      const double slope = g.constraint->gradient(q)(0);
+      in.c = g.constraint->value(q);
+      in.g.setZero();
+      in.g.head<3>() = slope * t.gradient;
+      const Vector3 g3 = in.g.head<3>();
+      const int v = np_.variableIndex(k);
+      if (v < 0) continue;
+      const Eigen::Matrix<double, 3, 3> block =
+          (-in.z * slope) * t.hessian + (in.z / in.c) * g3 * g3.transpose();
+      band_.addSymmetricBlock<3>(v, block, 0, 3);
+      rhs_.segment<3>(v) += (mu / in.c) * g3;
+      lagrangian_gradient_.segment<3>(v) -= in.z * g3;
+    }
+  }
 }
 
 /// The Newton step of the barrier problem (bordered band), with a shift δ·I (δ relative to the
@@ -265,9 +305,11 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
   double scale = std::abs(corner_);
   for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
   scale /= n_ + 1;
-  const double resumed = last_shift_ > 0 ? std::max(kFirstShift, last_shift_ / 3) : kFirstShift;
-  for (double shift = 0.0; shift <= kMaxShift;
-       shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : kShiftGrowth)) {
+  const double resumed = last_shift_ > 0
+                             ? std::max(parameters_.free_time_first_shift, last_shift_ / 3)
+                             : parameters_.free_time_first_shift;
+  for (double shift = 0.0; shift <= parameters_.free_time_max_shift;
+       shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : parameters_.shift_growth)) {
     BandedSymmetric<double> A = band_;
     if (shift > 0) A.addToDiagonal(shift * scale);
     Eigen::MatrixXd D(1, 1);
@@ -302,7 +344,7 @@ bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsi
   const double phi0 = merit(mu, epsilon, false);
   const double slope = -d.dot(rhs_);  // ∇φ_μᵀ d < 0
   double a = 1.0;
-  for (int i = 0; i < kMaxHalvings; ++i, a *= 0.5) {
+  for (int i = 0; i < parameters_.free_time_max_halvings; ++i, a *= 0.5) {
     if (h + a * h0_ * d(n_) <= 0) continue;
     double phi = std::numeric_limits<double>::infinity();
     try {
@@ -310,7 +352,7 @@ bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsi
       phi = merit(mu, epsilon, true);
     } catch (const std::exception&) {  // no boundary step at that h (StepTooLarge)
     }
-    if (phi <= phi0 + kArmijo * a * slope) {
+    if (phi <= phi0 + parameters_.armijo * a * slope) {
       *alpha = a;
       return true;
     }
@@ -321,12 +363,13 @@ bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsi
   return false;
 }
 
-double FreeTimeSolver::localDot(int k, const Eigen::Matrix<double, 10, 1>& g,
+double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
+                                const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
-  double sum = g(9) * d(n_);
-  for (int node = 0; node < 3; ++node) {
-    const int v = np_.variableIndex(k - 1 + node);
-    if (v >= 0) sum += g.segment<3>(3 * node).dot(d.segment<3>(v));
+  double sum = gradient(9) * d(n_);
+  for (int node = 0; node < g.support.width; ++node) {
+    const int v = np_.variableIndex(k + g.support.node_offset + node);
+    if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
   }
   return sum;
 }
@@ -335,52 +378,52 @@ double FreeTimeSolver::localDot(int k, const Eigen::Matrix<double, 10, 1>& g,
 /// to the boundary; applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   double alpha = 1.0;
-  for (int k = first_k_; k <= last_k_; ++k) {
-    for (int i = 0; i < per_torque_; ++i) {
-      TorqueConstraint& tc = at_[k - first_k_][i];
-      tc.dz = mu / tc.c - tc.z - tc.z / tc.c * localDot(k, tc.g, d);
-      if (tc.dz < 0) alpha = std::min(alpha, -kFractionToBoundary * tc.z / tc.dz);
+  for (FreeTimeGroup& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      FreeTimeInstance& in = g.instance(k);
+      in.dz = mu / in.c - in.z - in.z / in.c * localDot(g, k, in.g, d);
+      if (in.dz < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / in.dz);
     }
   }
-  for (auto& row : at_) {
-    for (int i = 0; i < per_torque_; ++i) row[i].z += alpha * row[i].dz;
+  for (FreeTimeGroup& g : groups_) {
+    for (FreeTimeInstance& in : g.at) in.z += alpha * in.dz;
   }
 }
 
-/// z within [μ/(κ c), κ μ/c] at the current values c.
+/// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c.
 void FreeTimeSolver::safeguardDuals(double mu) {
-  const std::vector<Vector3> tau = np_.torques(np_.current());
-  std::array<TorqueConstraint, kMaxPerTorque> row;
-  for (int k = first_k_; k <= last_k_; ++k) {
-    values(tau[k], &row);
-    for (int i = 0; i < per_torque_; ++i) {
-      TorqueConstraint& tc = at_[k - first_k_][i];
-      tc.c = row[i].c;
-      tc.z = std::clamp(tc.z, mu / (kDualSafeguard * tc.c), kDualSafeguard * mu / tc.c);
-    }
-  }
+  const double kappa = parameters_.dual_safeguard;
+  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
+    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+    in.c = c;
+    in.z = std::clamp(in.z, mu / (kappa * c), kappa * mu / c);
+  });
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
-  const std::vector<Vector3> tau = np_.torques(np_.current());
-  std::array<TorqueConstraint, kMaxPerTorque> row;
-  for (int k = first_k_; k <= last_k_; ++k) {
-    values(tau[k], &row);
-    for (int i = 0; i < per_torque_; ++i) {
-      at_[k - first_k_][i].c = row[i].c;
-      at_[k - first_k_][i].z = mu / row[i].c;
-    }
-  }
+  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
+    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+    in.c = c;
+    in.z = mu / c;
+  });
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point.
 double FreeTimeSolver::barrierResidual(double mu) const {
   double worst = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  for (const auto& row : at_) {
-    for (int i = 0; i < per_torque_; ++i)
-      worst = std::max(worst, std::abs(row[i].z * row[i].c - mu));
+  for (const FreeTimeGroup& g : groups_) {
+    for (const FreeTimeInstance& in : g.at) worst = std::max(worst, std::abs(in.z * in.c - mu));
   }
   return worst;
+}
+
+/// Σ zᵢcᵢ at the assembled point.
+double FreeTimeSolver::dualityGap() const {
+  double gap = 0.0;
+  for (const FreeTimeGroup& g : groups_) {
+    for (const FreeTimeInstance& in : g.at) gap += in.z * in.c;
+  }
+  return gap;
 }
 
 FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
@@ -401,15 +444,14 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
   for (;; ++iterations) {
     const double epsilon = epsilon0 * std::max(mu / mu0, kFinalEffortFraction);
     assemble(mu, epsilon);
-    double gap = 0.0;
-    for (const auto& row : at_)
-      for (int i = 0; i < per_torque_; ++i) gap += row[i].z * row[i].c;
+    const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
     if (mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
       return outcome(Termination::Converged, "converged", iterations, epsilon);
     }
-    if (mu > mu_final && barrierResidual(mu) <= kBarrierSolved * mu) {
-      mu = std::max(mu_final, std::min(kBarrierLinear * mu, std::pow(mu, kBarrierSuperlinear)));
+    if (mu > mu_final && barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu) {
+      mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
+                                       std::pow(mu, parameters_.monotone_theta_mu)));
       continue;  // the same iterate for the next barrier problem (not an iteration)
     }
     if (options && options->cancel_requested && options->cancel_requested->load()) {
@@ -451,14 +493,17 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.time_row = std::abs(lagrangian_gradient_(n_));
   out.smallest_value = std::numeric_limits<double>::infinity();
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
-  for (int k = first_k_; k <= last_k_; ++k) {
-    const auto& row = at_[k - first_k_];
-    for (int i = 0; i < per_torque_; ++i) {
-      out.complementarity += row[i].z * row[i].c;
-      out.smallest_value = std::min(out.smallest_value, row[i].c);
-    }
-    for (std::size_t j = 0; j < box_axes_.size(); ++j) {
-      out.torque_multipliers[k](box_axes_[j]) = row[2 * j].z - row[2 * j + 1].z;
+  const std::vector<Vector3> tau = np_.torques(out.steps);
+  for (const FreeTimeGroup& g : groups_) {
+    const int a = g.constraint->axis();
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FreeTimeInstance& in = g.instance(k);
+      out.complementarity += in.z * in.c;
+      out.smallest_value = std::min(out.smallest_value, in.c);
+      // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
+      if (g.constraint->quantity() == StageQuantity::Torque && a >= 0) {
+        out.torque_multipliers[k](a) -= std::copysign(in.z, g.constraint->gradient(tau[k])(a));
+      }
     }
   }
   out.maneuver = np_.maneuver(out.steps);
@@ -479,10 +524,34 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
   if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
   for (const PlanningConstraint& c : problem.constraints) {
     if (c.kind == ConstraintKind::MaxAngularRate) return "constraints: max_angular_rate";
-    if (c.isCone()) return "constraints: keep_out / keep_in cones";
   }
   return "";
 }
+
+namespace {
+
+/// A cone violated at an attitude no free-time iterate moves (R_0, R_N, and R_1, R_{N−1} where
+/// the boundary data fix them): the message, or empty.
+std::string fixedNodeConeViolation(const PlanningProblem& problem, const ReducedProblem& np) {
+  const std::vector<Matrix3> R = np.attitudes(np.current());
+  const int N = np.steps();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (int k : {0, 1, N - 1, N}) {
+      if (np.variableIndex(k) >= 0) continue;
+      const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
+      if (slack < 0.0) {
+        std::ostringstream why;
+        why << describeConstraint(c) << " is violated by " << -slack << " rad at k = " << k
+            << ", an attitude the boundary data fix";
+        return why.str();
+      }
+    }
+  }
+  return "";
+}
+
+}  // namespace
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
@@ -491,16 +560,16 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
   at.duration = start_duration;
   FreeTimeOutcome failed;
   failed.termination = Termination::NotConverged;
+  const InteriorPointParameters parameters;
   try {
     ReducedProblem np(at);
     np.setInteriorFromAttitudes(attitudes);
-    FreeTimeSolver solver(problem, &np);
-    if (!solver.startInside()) {
-      failed.message = "no strictly feasible start: the constraints still fail at " +
-                       std::to_string(std::pow(kStartGrowth, kMaxStartGrowths)) +
-                       " times the start's duration";
-      return failed;
-    }
+    failed.message = fixedNodeConeViolation(problem, np);
+    if (!failed.message.empty()) return failed;
+    const StageConstraints constraints = buildStageConstraints(problem);
+    FreeTimeSolver solver(problem, &np, constraints, parameters);
+    failed.message = solver.startInside();
+    if (!failed.message.empty()) return failed;
     return solver.run(tolerance, max_iterations, options);
   } catch (const StepTooLarge& e) {
     failed.message = std::string("the boundary rates admit no step: ") + e.what();

@@ -1,6 +1,7 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
-// node unknowns δ of the reduced problem, objective T, the torque constraints in force
-// (free_time_solver.cpp derives the method).
+// node unknowns δ of the reduced problem, objective T, the torque constraints and pointing cones
+// in force (the stage constraints, transcription/stage_constraints.hpp; free_time_solver.cpp
+// derives the method).
 #pragma once
 
 #include <string>
@@ -33,18 +34,20 @@ struct FreeTimeOutcome {
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
 };
 
-/// Why `problem` cannot be solved free-time here (empty: it can): rate limits, pointing cones
-/// and effects are not written in h yet, fourth_order has no single transcription
-/// (minimum_time.cpp falls back to the search).
+/// Why `problem` cannot be solved free-time here (empty: it can): rate limits and effects are not
+/// written in h yet, fourth_order has no single transcription (minimum_time.cpp falls back to
+/// the search).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
-/// R_N the problem's) at T = start_duration, raised until every constraint holds strictly (the
-/// iterates stay strictly feasible). Boundary rates are held at every h. Ends Converged at a KKT
-/// point of the discrete minimum-time problem (complementarity within `tolerance`, stationarity
-/// within it × max(1, (N/256)²): round-off), NotConverged at the iteration limit or a failed line
-/// search (its last iterate still feasible), Cancelled or TimedOut when `options` (may be null)
-/// asks: its cancel flag and time budget are polled every iteration.
+/// R_N the problem's) at T = start_duration, raised until every torque constraint holds strictly
+/// (the iterates stay strictly feasible; a cone must hold strictly at the start's attitudes
+/// already, and at the attitudes the boundary data fix: raising T does not move them). Boundary
+/// rates are held at every h. Ends Converged at a KKT point of the discrete minimum-time problem
+/// (complementarity within `tolerance`, stationarity within it × max(1, (N/256)²): round-off),
+/// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
+/// Cancelled or TimedOut when `options` (may be null) asks: its cancel flag and time budget are
+/// polled every iteration.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               const SolverOptions* options = nullptr);

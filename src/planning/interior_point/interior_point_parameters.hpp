@@ -135,6 +135,24 @@ struct InteriorPointParameters {
   /// ... with θ at least this [rad].
   double angle_floor = 1e-3;
 
+  // --- minimum time (free_time_solver.cpp: the feasible barrier method with h free) -----------
+  /// The start's h grows by this factor until every constraint that moves with h holds with the
+  /// start margin (torques scale like 1/h²: a few percent per growth keeps T₀ near the least
+  /// feasible T of the start's path).
+  double free_time_start_growth = 1.05;
+  /// ... with c ≥ this: a start on its bounds would begin with infinite barrier terms.
+  double free_time_start_margin = 0.05;
+  /// ... at most this many growths (1.05⁴⁰⁰ ≈ 3e8: a start no slower plan makes feasible).
+  int free_time_max_start_growths = 400;
+  /// Most halvings of its line search (fewer than the fixed-h solver's: a step of 1e-12 in η is
+  /// no progress in T).
+  int free_time_max_halvings = 40;
+  /// First relative shift of its inertia correction (relative to the mean diagonal, which the
+  /// border's corner and the barrier terms dominate, not to the largest one) ...
+  double free_time_first_shift = 1e-10;
+  /// ... and the largest before the step counts as failed.
+  double free_time_max_shift = 1e10;
+
   // --- grids -----------------------------------------------------------------------------------
   /// Above this N the constrained problem is first solved on 4× coarser grids (down to 16).
   int coarsest_grid = 256;

@@ -1,0 +1,285 @@
+// The stage constraints (planning/transcription/stage_constraints.hpp): the list one problem
+// builds, each constraint's value and derivatives composed with its quantity's (the chain rule the
+// assemblers apply) against central differences in the node unknowns δ and in the time step h;
+// and minimum time with a keep-out cone (free_time_solver.cpp): a KKT point with every node outside
+// the cone, no slower than the search on T it replaced, and the same in a rotated world.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/minimum_time.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+ap::PlanningProblem scene(const char* name, int steps) {
+  ap::PlanningProblem p =
+      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + name + ".yaml").problem;
+  p.steps = steps;
+  return p;
+}
+
+/// sun_keep_out's cone, body x at least 0.5 rad from a direction near the eigenaxis path.
+ap::PlanningConstraint sunCone() {
+  return ap::PlanningConstraint::keepOut(
+      ap::Vector3::UnitX(),
+      ap::Vector3(0.7035741925769524, 0.7035741925769523, 0.09983341664682815), 0.5);
+}
+
+/// A problem with every kind: the box, a norm bound, a rate limit and both cones.
+ap::PlanningProblem everyKind(ap::SchemeKind scheme) {
+  ap::PlanningProblem p = scene("torque_limited", 16);
+  p.scheme = scheme;
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5),
+                   ap::PlanningConstraint::maxAngularRate(0.3),
+                   ap::PlanningConstraint::keepOut(ap::Vector3::UnitZ(), ap::Vector3::UnitY(), 0.4),
+                   ap::PlanningConstraint::keepIn(ap::Vector3::UnitX(), ap::Vector3::UnitX(), 1.5)};
+  return p;
+}
+
+/// A reduced problem of `p` moved off its start by a seeded random δ (so torques, rates and
+/// pointing are all nonzero and generic).
+ap::ReducedProblem perturbed(const ap::PlanningProblem& p, int seed) {
+  ap::ReducedProblem np(p);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 0.05);
+  Eigen::VectorXd delta(np.unknowns());
+  for (int i = 0; i < delta.size(); ++i) delta(i) = normal(rng);
+  np.setCurrent(np.retract(delta, 1.0));
+  return np;
+}
+
+/// The values c_k of `constraint` at np's current iterate, k over its support (the assemblers'
+/// quantities: torques, step rates, pointing cosines).
+std::vector<double> valuesOf(const ap::StageConstraint& constraint, const ap::ReducedProblem& np) {
+  const ap::StageSupport s =
+      ap::stageSupport(constraint.quantity(), np.firstFreeNode(), np.lastFreeNode());
+  const std::vector<ap::Vector3> tau = np.torques(np.current());
+  const std::vector<ap::Matrix3> R = np.attitudes(np.current());
+  std::vector<double> out;
+  for (int k = s.first_k; k <= s.last_k; ++k) {
+    ap::Vector3 q = ap::Vector3::Zero();
+    switch (constraint.quantity()) {
+      case ap::StageQuantity::Torque:
+        q = tau[k];
+        break;
+      case ap::StageQuantity::StepRate:
+        q(0) = ap::angularRateTerms(np.scheme(), np.current()[k]).half_squared_rate;
+        break;
+      case ap::StageQuantity::Pointing:
+        q(0) = ap::pointingTerms(R[k], constraint.spec()->body_axis,
+                                 constraint.spec()->world_direction)
+                   .cosine;
+        break;
+      case ap::StageQuantity::NodeRate:
+        ADD_FAILURE() << "node rates are checked through ReducedProblem's own tests";
+        break;
+    }
+    out.push_back(constraint.value(q));
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(StageConstraints, OneListInAFixedOrderWithTheRateOnTheSchemesQuantity) {
+  const ap::PlanningProblem p = everyKind(ap::SchemeKind::Paper);
+  const ap::StageConstraints list = ap::buildStageConstraints(p);
+  ASSERT_EQ(list.size(), 10u);  // 6 box sides, norm, rate, two cones
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(list[i]->quantity(), ap::StageQuantity::Torque);
+    EXPECT_EQ(list[i]->axis(), i / 2);
+    EXPECT_EQ(list[i]->spec(), nullptr);
+  }
+  EXPECT_EQ(list[6]->axis(), -1);
+  EXPECT_EQ(list[7]->quantity(), ap::StageQuantity::StepRate);
+  EXPECT_EQ(list[8]->quantity(), ap::StageQuantity::Pointing);
+  EXPECT_EQ(list[9]->quantity(), ap::StageQuantity::Pointing);
+  EXPECT_EQ(ap::buildStageConstraints(everyKind(ap::SchemeKind::SecondOrder))[7]->quantity(),
+            ap::StageQuantity::NodeRate);
+  // Descriptions name the bound: the checker's for the box, describeConstraint's for the rest.
+  EXPECT_NE(list[0]->describe().find("tau_x <= 0.264"), std::string::npos) << list[0]->describe();
+  EXPECT_NE(list[1]->describe().find("-tau_x"), std::string::npos) << list[1]->describe();
+  EXPECT_EQ(list[6]->describe(), ap::describeConstraint(p.constraints[0]));
+  EXPECT_EQ(list[8]->describe(), ap::describeConstraint(p.constraints[2]));
+  // Zero at the bound, one at the centre (dimensionless as the interior point needs them).
+  EXPECT_NEAR(list[0]->value(ap::Vector3(0.264, 0, 0)), 0.0, 1e-15);
+  EXPECT_NEAR(list[1]->value(ap::Vector3(-0.264, 0, 0)), 0.0, 1e-15);
+  EXPECT_NEAR(list[6]->value(ap::Vector3(0.3, 0.4, 0.0)), 0.0, 1e-15);
+  EXPECT_NEAR(list[7]->value(ap::Vector3(0.5 * 0.3 * 0.3, 0, 0)), 0.0, 1e-15);
+  EXPECT_NEAR(list[8]->value(ap::Vector3(std::cos(0.4), 0, 0)), 0.0, 1e-15);
+  EXPECT_GT(list[8]->value(ap::Vector3(0.0, 0, 0)), 0.0) << "keep_out: far from s holds";
+  EXPECT_LT(list[9]->value(ap::Vector3(0.0, 0, 0)), 0.0) << "keep_in: far from s fails";
+}
+
+TEST(StageConstraints, ValueDerivativesInTheirQuantityMatchCentralDifferences) {
+  const ap::StageConstraints list = ap::buildStageConstraints(everyKind(ap::SchemeKind::Paper));
+  const ap::Vector3 q(0.11, -0.07, 0.05), e = 1e-5 * ap::Vector3::Ones();
+  for (const auto& c : list) {
+    for (int i = 0; i < 3; ++i) {
+      const ap::Vector3 d = 1e-5 * ap::Vector3::Unit(i);
+      EXPECT_NEAR(c->gradient(q)(i), (c->value(q + d) - c->value(q - d)) / 2e-5,
+                  1e-8 * (1 + c->gradient(q).norm()))
+          << c->describe();
+      // Curvature: ∇²c = c''·I.
+      const double second = (c->gradient(q + d)(i) - c->gradient(q - d)(i)) / 2e-5;
+      EXPECT_NEAR(second, c->curvature(), 1e-6 * (1 + std::abs(c->curvature()))) << c->describe();
+    }
+    if (c->axis() >= 0) {  // affine in one axis: the other entries of the gradient vanish
+      EXPECT_EQ(c->gradient(q + e).cwiseAbs().sum(), std::abs(c->gradient(q)(c->axis())));
+    }
+  }
+}
+
+TEST(StageConstraints, ChainRuleThroughTheTranscriptionMatchesCentralDifferencesInDeltaAndH) {
+  // c_k(δ, h) through the quantity's derivatives as ConstrainedSystem and the free-time solver
+  // compose them: torque constraints through the stencil's jacobian and tau_h, step rates through
+  // angularRateTerms, cones through pointingTerms (no h dependence).
+  for (const ap::SchemeKind scheme : {ap::SchemeKind::Paper, ap::SchemeKind::Variational}) {
+    const ap::PlanningProblem p = everyKind(scheme);
+    const ap::StageConstraints list = ap::buildStageConstraints(p);
+    const ap::ReducedProblem np = perturbed(p, 3);
+    const double h = np.timeStep(), dh = 1e-6 * h, e = 1e-6;
+    std::mt19937 rng(11);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(np.unknowns());
+    for (int i = 0; i < d.size(); ++i) d(i) = normal(rng);
+    ap::ReducedProblem plus = np, minus = np, later = np, earlier = np;
+    plus.setCurrent(np.retract(d, e));
+    minus.setCurrent(np.retract(d, -e));
+    later.setTimeStep(h + dh);
+    earlier.setTimeStep(h - dh);
+    const std::vector<ap::Matrix3> R = np.attitudes(np.current());
+    // The torque stencils' derivatives, per k.
+    std::vector<Eigen::Matrix<double, 3, 9>> jacobian(p.steps + 1);
+    std::vector<ap::Vector3> tau_h(p.steps + 1);
+    np.forEachStencilWithTimeStep([&](const ap::ReducedProblem::TimeStepStencil& st) {
+      jacobian[st.k] = st.jacobian;
+      tau_h[st.k] = st.tau_h;
+    });
+    const std::vector<ap::Vector3> tau = np.torques(np.current());
+    const auto localDot = [&](const Eigen::Matrix<double, 9, 1>& g, int first_node, int width) {
+      double sum = 0.0;
+      for (int n = 0; n < width; ++n) {
+        const int v = np.variableIndex(first_node + n);
+        if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
+      }
+      return sum;
+    };
+    for (const auto& c : list) {
+      const ap::StageSupport s =
+          ap::stageSupport(c->quantity(), np.firstFreeNode(), np.lastFreeNode());
+      const std::vector<double> up = valuesOf(*c, plus), down = valuesOf(*c, minus);
+      const std::vector<double> later_c = valuesOf(*c, later), earlier_c = valuesOf(*c, earlier);
+      for (int k = s.first_k; k <= s.last_k; ++k) {
+        const int i = k - s.first_k;
+        double along = 0.0, in_h = 0.0;  // ∇_δ c · d and ∂c/∂h by the chain rule
+        Eigen::Matrix<double, 9, 1> g = Eigen::Matrix<double, 9, 1>::Zero();
+        if (c->quantity() == ap::StageQuantity::Torque) {
+          g = jacobian[k].transpose() * c->gradient(tau[k]);
+          in_h = c->gradient(tau[k]).dot(tau_h[k]);
+        } else if (c->quantity() == ap::StageQuantity::StepRate) {
+          const ap::AngularRateTerms t = ap::angularRateTerms(np.scheme(), np.current()[k]);
+          g.head<6>() = c->gradient(ap::Vector3(t.half_squared_rate, 0, 0))(0) * t.gradient;
+          in_h = std::nan("");  // rates in h: not written yet (freeTimeUnsupported)
+        } else {
+          const ap::PointingTerms t =
+              ap::pointingTerms(R[k], c->spec()->body_axis, c->spec()->world_direction);
+          g.head<3>() = c->gradient(ap::Vector3(t.cosine, 0, 0))(0) * t.gradient;
+          in_h = 0.0;
+        }
+        along = localDot(g, k + s.node_offset, s.width);
+        const double fd = (up[i] - down[i]) / (2 * e);
+        EXPECT_NEAR(along, fd, 1e-6 * (1 + std::abs(fd))) << c->describe() << " k = " << k;
+        if (std::isnan(in_h)) continue;
+        const double fd_h = (later_c[i] - earlier_c[i]) / (2 * dh);
+        EXPECT_NEAR(in_h, fd_h, 1e-5 * (1 + std::abs(fd_h))) << c->describe() << " k = " << k;
+      }
+    }
+  }
+}
+
+namespace {
+
+/// sun_keep_out's body and cone as a minimum-time problem under |τ_i| ≤ 0.2 N m.
+ap::PlanningProblem minimumTimeWithCone(ap::SchemeKind scheme, int steps) {
+  ap::PlanningProblem p = scene("sun_keep_out", steps);
+  p.scheme = scheme;
+  p.objective = ap::Objective::MinimumTime;
+  p.duration = 0.0;
+  p.max_torque = ap::Vector3::Constant(0.2);
+  p.constraints = {sunCone()};
+  return p;
+}
+
+}  // namespace
+
+TEST(FreeTimeCones, KeepOutMinimumTimeIsAKktPointOutsideTheConeAndNoSlowerThanTheSearch) {
+  for (const ap::SchemeKind scheme : {ap::SchemeKind::SecondOrder, ap::SchemeKind::Variational}) {
+    const ap::PlanningProblem p = minimumTimeWithCone(scheme, 32);
+    EXPECT_EQ(ap::freeTimeUnsupported(p), "");
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8);
+    EXPECT_LE(r.minimum_time.time_stationarity, 1e-8);
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8);
+    for (const ap::Matrix3& R : r.maneuver.attitude) {
+      EXPECT_GE(ap::coneMargin(p.constraints[0], R), -1e-9) << "a node inside the cone";
+    }
+    EXPECT_LE(r.max_constraint_violation, 1e-8);
+    // The search on T (an upper bound) on the same problem: an inactive rate limit sends it
+    // there (freeTimeUnsupported).
+    ap::PlanningProblem searched = p;
+    searched.constraints.push_back(ap::PlanningConstraint::maxAngularRate(100.0));
+    const ap::PlanResult s = ap::planManeuver(searched);
+    ASSERT_TRUE(s.converged()) << s.message;
+    EXPECT_FALSE(s.minimum_time.kkt_point);
+    // The search stops within its tolerance above the T it proved feasible: equal T* within it.
+    EXPECT_LE(r.minimum_duration, s.minimum_duration * (1 + ap::kMinimumTimeTolerance))
+        << ap::schemeName(scheme) << ": " << ap::exactNumber(r.minimum_duration) << " vs "
+        << ap::exactNumber(s.minimum_duration);
+  }
+}
+
+TEST(FreeTimeCones, TStarIsInvariantUnderAWorldRotationOfAttitudesAndCone) {
+  const ap::PlanningProblem p = minimumTimeWithCone(ap::SchemeKind::SecondOrder, 32);
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
+  std::mt19937 rng(31);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 2; ++trial) {
+    const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(normal(rng), normal(rng), normal(rng)));
+    ap::PlanningProblem turned = p;
+    turned.initial_attitude = Q * p.initial_attitude;
+    turned.final_attitude = Q * p.final_attitude;
+    turned.constraints[0].world_direction = Q * p.constraints[0].world_direction;
+    const ap::PlanResult t = ap::planManeuver(turned);
+    ASSERT_TRUE(t.converged() && t.minimum_time.kkt_point) << t.message;
+    EXPECT_NEAR(t.minimum_duration, r.minimum_duration, 1e-7 * r.minimum_duration);
+  }
+}
+
+TEST(FreeTimeCones, AStartInsideTheConeIsRefusedByName) {
+  // Raising T moves no attitude: the free-time solve needs a start that already clears the cone.
+  const ap::PlanningProblem p = minimumTimeWithCone(ap::SchemeKind::SecondOrder, 16);
+  std::vector<ap::Matrix3> through;  // the eigenaxis path, straight through the cone
+  const ap::Vector3 span = ap::so3::log(p.initial_attitude.transpose() * p.final_attitude);
+  for (int k = 0; k <= p.steps; ++k) {
+    through.push_back(p.initial_attitude * ap::so3::exp(span * k / double(p.steps)));
+  }
+  const ap::FreeTimeOutcome o = ap::solveFreeTime(p, through, 40.0, 1e-9, 100);
+  EXPECT_EQ(o.termination, ap::Termination::NotConverged);
+  EXPECT_NE(o.message.find("violate a cone"), std::string::npos) << o.message;
+}

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/interior_point/free_time_solver.hpp"

@@ -131,13 +131,28 @@ class FreeTimeSolver {
         Vector3 q = Vector3::Zero();
         if (quantity == StageQuantity::Torque) {
           q = tau[k];
-        } else {  // Pointing (freeTimeUnsupported refuses the rates)
+        } else if (quantity == StageQuantity::Pointing) {
           const PlanningConstraint& cone = *g.constraint->spec();
           q(0) = pointingTerms(R[k], cone.body_axis, cone.world_direction).cosine;
+        } else {
+          q(0) = halfSquaredRate(quantity, steps, k);
         }
         f(g, k, g.constraint->value(q));
       }
     }
+  }
+
+  /// q = ½|Ω|² of step k (paper, variational: the scheme's velocity of F_k) or of node k (schemes
+  /// with end torques: J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀμ(F_{k−1}))/2) at the current h.
+  double halfSquaredRate(StageQuantity quantity, const ReducedProblem::Steps& steps, int k) const {
+    const DiscreteScheme& scheme = np_.scheme();
+    if (quantity == StageQuantity::StepRate) {
+      return 0.5 * scheme.velocity(so3::exp(steps[k])).squaredNorm();
+    }
+    const Vector3 Pi =
+        0.5 * (scheme.momentumOfStep(steps[k]) +
+               so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
+    return 0.5 * (inverse_inertia_ * Pi).squaredNorm();
   }
 
   /// The smallest value of the constraints that move with h (time_dependent) or of the others.
@@ -167,6 +182,17 @@ class FreeTimeSolver {
   double T0() const { return N_ * h0_; }
   void assemble(double mu, double epsilon);
   void assembleCones(double mu);
+  /// A rate quantity's q, ∇q and ∇²q over its local nodes at the current iterate, per instance.
+  struct RateTerms {
+    double q = 0.0;
+    Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+    Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
+  };
+  std::vector<RateTerms> rateTerms(StageQuantity quantity) const;
+  void assembleRates(double mu);
+  void scatter(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 10>& H,
+               const Eigen::Matrix<double, 10, 1>& rhs,
+               const Eigen::Matrix<double, 10, 1>& lagrangian);
   void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
                 const Eigen::Matrix<double, 10, 1>& lagrangian);
   bool solveStep(Eigen::VectorXd* d);
@@ -186,6 +212,7 @@ class FreeTimeSolver {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   int N_, n_;
+  Matrix3 inverse_inertia_ = np_.scheme().inertia().inverse();
   double h0_ = 0.0;
   std::vector<FreeTimeGroup> groups_;
   // The assembled system at the current iterate.
@@ -263,6 +290,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
       },
       weights);
   assembleCones(mu);
+  assembleRates(mu);
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
 }
@@ -293,6 +321,92 @@ void FreeTimeSolver::assembleCones(double mu) {
       rhs_.segment<3>(v) += (mu / in.c) * g3;
       lagrangian_gradient_.segment<3>(v) -= in.z * g3;
     }
+  }
+}
+
+/// q, ∇q, ∇²q of every instance of a rate quantity (k from 0, unused entries empty): a step's
+/// from angularRateTerms over (δ_k, δ_{k+1}); a node's through the node momentum's stencil,
+/// ∇q = J_Πᵀ J⁻²Π, ∇²q = J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i.
+std::vector<FreeTimeSolver::RateTerms> FreeTimeSolver::rateTerms(StageQuantity quantity) const {
+  std::vector<RateTerms> out(N_ + 1);
+  if (quantity == StageQuantity::StepRate) {
+    const StageSupport s = stageSupport(quantity, np_.firstFreeNode(), np_.lastFreeNode());
+    for (int k = s.first_k; k <= s.last_k; ++k) {
+      const AngularRateTerms t = angularRateTerms(np_.scheme(), np_.current()[k]);
+      out[k].q = t.half_squared_rate;
+      out[k].gradient.head<6>() = t.gradient;
+      out[k].hessian.topLeftCorner<6, 6>() = t.hessian;
+    }
+    return out;
+  }
+  const Matrix3 inverse_squared = inverse_inertia_ * inverse_inertia_;
+  np_.forEachNodeMomentum(
+      [&](const ReducedProblem::NodeMomentum& node) {
+        const Vector3 a = inverse_squared * node.momentum;
+        out[node.k].q = 0.5 * node.momentum.dot(a);
+        out[node.k].gradient = node.jacobian.transpose() * a;
+        out[node.k].hessian =
+            node.jacobian.transpose() * inverse_squared * node.jacobian + node.second;
+      },
+      [&](int, const Vector3& Pi) { return Vector3(inverse_squared * Pi); });
+  return out;
+}
+
+/// Rate limits on q = ½|Ω|² (of a step or a node). Rest to rest (freeTimeUnsupported) the steps do
+/// not move with h at fixed free attitudes and every momentum scales like 1/h, so q = q̃(δ)/h²:
+/// ∂q/∂h = −2q/h, ∂∇q/∂h = −2∇q/h, ∂²q/∂h² = 6q/h² (in η = h/h₀: times h₀, h₀²). c = 1 + c' q.
+void FreeTimeSolver::assembleRates(double mu) {
+  const double h = np_.timeStep();
+  for (const StageQuantity quantity : {StageQuantity::StepRate, StageQuantity::NodeRate}) {
+    std::vector<RateTerms> terms;
+    for (FreeTimeGroup& g : groups_) {
+      if (g.constraint->quantity() != quantity) continue;
+      if (terms.empty()) terms = rateTerms(quantity);
+      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+        const RateTerms& t = terms[k];
+        Eigen::Matrix<double, 10, 1> dq;  // ∇q over (local nodes, η)
+        dq.head<9>() = t.gradient;
+        dq(9) = -2.0 * t.q / h * h0_;
+        Eigen::Matrix<double, 10, 10> d2q;
+        d2q.topLeftCorner<9, 9>() = t.hessian;
+        d2q.block<9, 1>(0, 9) = -2.0 / h * h0_ * t.gradient;
+        d2q.block<1, 9>(9, 0) = d2q.block<9, 1>(0, 9).transpose();
+        d2q(9, 9) = 6.0 * t.q / (h * h) * h0_ * h0_;
+        const Vector3 q(t.q, 0.0, 0.0);
+        const double slope = g.constraint->gradient(q)(0);
+        FreeTimeInstance& in = g.instance(k);
+        in.c = g.constraint->value(q);
+        in.g = slope * dq;
+        const Eigen::Matrix<double, 10, 10> H =
+            (-in.z * slope) * d2q + (in.z / in.c) * in.g * in.g.transpose();
+        scatter(g, k, H, (mu / in.c) * in.g, -in.z * in.g);
+      }
+    }
+  }
+}
+
+/// Adds one instance's Hessian block (local nodes and η), right-hand side and Lagrangian gradient
+/// to the bordered system (fixed nodes skipped).
+void FreeTimeSolver::scatter(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 10>& H,
+                             const Eigen::Matrix<double, 10, 1>& rhs,
+                             const Eigen::Matrix<double, 10, 1>& lagrangian) {
+  const int first_node = k + g.support.node_offset, width = g.support.width;
+  for (int node = 0; node < width; ++node) {
+    const int v = np_.variableIndex(first_node + node);
+    if (v < 0) continue;
+    rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
+    lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
+    border_.segment<3>(v) += H.block<3, 1>(3 * node, 9);
+  }
+  rhs_(n_) += rhs(9);
+  lagrangian_gradient_(n_) += lagrangian(9);
+  corner_ += H(9, 9);
+  const int first_slot = std::max(0, np_.firstFreeNode() - first_node);
+  const int last_slot = std::min(width - 1, np_.lastFreeNode() - first_node);
+  if (first_slot <= last_slot) {
+    band_.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
+                               Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()), 3 * first_slot,
+                               3 * (last_slot + 1));
   }
 }
 
@@ -522,8 +636,13 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
     return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
   }
   if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
+  const bool rest_to_rest =
+      problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0);
   for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxAngularRate) return "constraints: max_angular_rate";
+    if (c.kind == ConstraintKind::MaxAngularRate && !rest_to_rest) {
+      return "constraints: max_angular_rate with nonzero boundary rates (the boundary steps move "
+             "with h)";
+    }
   }
   return "";
 }

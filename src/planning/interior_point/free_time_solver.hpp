@@ -1,7 +1,7 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
 // node unknowns δ of the reduced problem, objective T, the torque constraints, pointing cones and
-// (rest to rest) rate limits in force (the stage constraints, transcription/stage_constraints.hpp; free_time_solver.cpp
-// derives the method).
+// (rest to rest) rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
+// free_time_solver.cpp derives the method).
 #pragma once
 
 #include <string>

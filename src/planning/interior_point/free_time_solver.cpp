@@ -62,6 +62,10 @@ constexpr double kArmijo = 1e-4;
 constexpr int kMaxHalvings = 40;
 /// Inertia correction: a relative diagonal shift, from kFirstShift growing ×kShiftGrowth.
 constexpr double kFirstShift = 1e-10;
+/// A shift that worked is resumed at a third of itself down to this (IPOPT's δ_w^min): a floor at
+/// kFirstShift stalled the N = 1024 refinement of Bilimoria–Wie — relative to the mean diagonal,
+/// which the barrier terms of active bounds make ~1e11, it swamped the soft directions' curvature.
+constexpr double kSmallestShift = 1e-20;
 constexpr double kShiftGrowth = 100.0;
 constexpr double kMaxShift = 1e10;
 constexpr int kHalfBandwidth = 8;
@@ -265,7 +269,7 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
   double scale = std::abs(corner_);
   for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
   scale /= n_ + 1;
-  const double resumed = last_shift_ > 0 ? std::max(kFirstShift, last_shift_ / 3) : kFirstShift;
+  const double resumed = last_shift_ > 0 ? std::max(kSmallestShift, last_shift_ / 3) : kFirstShift;
   for (double shift = 0.0; shift <= kMaxShift;
        shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : kShiftGrowth)) {
     BandedSymmetric<double> A = band_;

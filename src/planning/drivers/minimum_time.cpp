@@ -415,7 +415,7 @@ constexpr int kFreeTimeStartGrid = 64;
 struct FreeTimeStart {
   std::string name;
   AttemptStart kind;
-  std::vector<Matrix3> attitudes;  ///< empty: the reduced problem's own start (the geodesic)
+  std::vector<Matrix3> attitudes;  ///< R_0..R_N
   double duration;
 };
 
@@ -455,13 +455,27 @@ std::string axisName(const Vector3& v) {
   return out.str();
 }
 
+/// Spinning ends: the reduced problem's own start (the geodesic between the fixed inner
+/// attitudes) at the eigenaxis guess. (An empty list of attitudes here once reached
+/// setInteriorFromAttitudes: every spinning minimum-time request ended "invalid input".)
+FreeTimeStart geodesicStart(const PlanningProblem& problem) {
+  PlanningProblem at = problem;
+  at.duration = eigenaxisDurationGuess(problem);
+  std::vector<Matrix3> attitudes;
+  try {
+    const ReducedProblem np(at);
+    attitudes = np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // no boundary step at that h: the solve reports it
+    attitudes.assign(problem.steps + 1, problem.initial_attitude);
+  }
+  return {"geodesic", AttemptStart::Hermite, attitudes, at.duration};
+}
+
 /// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
 /// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
 /// guess.
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest) {
-  if (!rest_to_rest) {
-    return {{"geodesic", AttemptStart::Hermite, {}, eigenaxisDurationGuess(problem)}};
-  }
+  if (!rest_to_rest) return {geodesicStart(problem)};
   const double T_eigenaxis = eigenaxisBangBangDuration(problem);
   PlanningProblem at = problem;
   at.duration = T_eigenaxis;

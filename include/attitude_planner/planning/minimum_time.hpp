@@ -7,7 +7,7 @@
 // the eigenaxis bang–bang slew at its closed-form T and excursions off it about the body axes'
 // parts perpendicular to the eigenaxis and their diagonals (body-fixed: the same in every world
 // frame); otherwise the geodesic. Above N = 64 the starts run on N = 64 and the best is refined
-// once on N. The least T is kept and polished (the minimum-effort plan at T* from it, for the
+// by 2 at a time up to N (each level from the coarser answer's rates interpolated in time). The least T is kept and polished (the minimum-effort plan at T* from it, for the
 // switching functions). T* is a KKT point of the discrete minimum-time problem, its residuals in
 // PlanResult::minimum_time. Rate limits, cones, fourth_order and effects are not written in h
 // yet: for them (or if no free-time solve converges) the former search answers — several starts,

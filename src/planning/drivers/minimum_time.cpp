@@ -13,6 +13,7 @@
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
 
@@ -416,7 +417,7 @@ constexpr int kFreeTimeStartGrid = 64;
 struct FreeTimeStart {
   std::string name;
   AttemptStart kind;
-  std::vector<Matrix3> attitudes;  ///< empty: the reduced problem's own start (the geodesic)
+  std::vector<Matrix3> attitudes;  ///< R_0..R_N
   double duration;
 };
 
@@ -456,13 +457,27 @@ std::string axisName(const Vector3& v) {
   return out.str();
 }
 
+/// Spinning ends: the reduced problem's own start (the geodesic between the fixed inner
+/// attitudes) at the eigenaxis guess. (An empty list of attitudes here once reached
+/// setInteriorFromAttitudes: every spinning minimum-time request ended "invalid input".)
+FreeTimeStart geodesicStart(const PlanningProblem& problem) {
+  PlanningProblem at = problem;
+  at.duration = eigenaxisDurationGuess(problem);
+  std::vector<Matrix3> attitudes;
+  try {
+    const ReducedProblem np(at);
+    attitudes = np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // no boundary step at that h: the solve reports it
+    attitudes.assign(problem.steps + 1, problem.initial_attitude);
+  }
+  return {"geodesic", AttemptStart::Hermite, attitudes, at.duration};
+}
+
 /// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
 /// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
 /// guess.
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest) {
-  if (!rest_to_rest) {
-    return {{"geodesic", AttemptStart::Hermite, {}, eigenaxisDurationGuess(problem)}};
-  }
+  if (!rest_to_rest) return {geodesicStart(problem)};
   const double T_eigenaxis = eigenaxisBangBangDuration(problem);
   PlanningProblem at = problem;
   at.duration = T_eigenaxis;
@@ -576,11 +591,29 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   return std::nullopt;
 }
 
+/// The free-time answer on a coarser grid carried to grid p at its T: the coarse rates
+/// interpolated in time (ReducedProblem::initializeFromCoarser), so the torques stay near the
+/// coarse ones. (Resampling the attitudes instead put torque spikes of ~1.5× the bound next to
+/// the switches of a bang–bang plan: the free-time start then had to raise T by ~27 % before
+/// every bound held, measured on Bilimoria–Wie, N = 512 → 1024.)
+std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse) {
+  PlanningProblem at = p;
+  at.duration = coarse.duration;
+  try {
+    ReducedProblem np(at);
+    np.initializeFromCoarser(coarse.steps);
+    return np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // the boundary rates admit no step at this h
+    return resampleAttitudes(coarse.maneuver, p.steps);
+  }
+}
+
 /// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
 /// free-time solve, the least T kept; the starts run on the coarsest of N, N/2, ... at or above
-/// kFreeTimeStartGrid and the best, resampled, is solved once on each finer grid. The answer is
-/// then polished: the minimum-effort plan at T* from the free-time plan (its multipliers give the
-/// switching functions). Empty if no solve converged (the caller falls back to the search).
+/// kFreeTimeStartGrid and the best, prolonged (its rates interpolated), is solved once on each
+/// finer grid. The answer is then polished: the minimum-effort plan at T* from the free-time plan
+/// (its multipliers give the switching functions). Empty if no solve converged (the caller falls
+/// back to the search).
 class FreeTimeMinimumTime {
  public:
   FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
@@ -603,8 +636,7 @@ class FreeTimeMinimumTime {
     std::string from = names_[best];
     for (auto level = levels.rbegin() + 1; level != levels.rend(); ++level) {
       grid.steps = *level;
-      const std::vector<Matrix3> resampled = resampleAttitudes(answer.maneuver, grid.steps);
-      answer = solve(grid, resampled, answer.duration, AttemptStart::CoarseLevel);
+      answer = solve(grid, answer, AttemptStart::CoarseLevel);
       if (answer.termination != Termination::Converged) return std::nullopt;
     }
     if (levels.size() > 1) {
@@ -616,6 +648,7 @@ class FreeTimeMinimumTime {
   }
 
  private:
+  /// One free-time solve from a start's attitudes at T = duration.
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& attitudes,
                         double duration, AttemptStart kind) {
     const SolverOptions remaining = withRemainingBudget(options_, start_);
@@ -642,6 +675,12 @@ class FreeTimeMinimumTime {
     trail_.push_back(a);
     ++solves_;
     return o;
+  }
+
+  /// One free-time solve on grid p from the answer on a coarser grid, at its T.
+  FreeTimeOutcome solve(const PlanningProblem& p, const FreeTimeOutcome& coarse,
+                        AttemptStart kind) {
+    return solve(p, prolonged(p, coarse), coarse.duration, kind);
   }
 
   /// Runs every start on `grid`; returns the index of the converged one with the least T (−1:

@@ -420,7 +420,7 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
   for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
   scale /= n_ + 1;
   const double resumed = last_shift_ > 0
-                             ? std::max(parameters_.free_time_first_shift, last_shift_ / 3)
+                             ? std::max(parameters_.free_time_smallest_shift, last_shift_ / 3)
                              : parameters_.free_time_first_shift;
   for (double shift = 0.0; shift <= parameters_.free_time_max_shift;
        shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : parameters_.shift_growth)) {
@@ -565,7 +565,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     }
     if (mu > mu_final && barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu) {
       mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
-                                       std::pow(mu, parameters_.monotone_theta_mu)));
+                                       std::pow(mu, parameters_.free_time_theta_mu)));
       continue;  // the same iterate for the next barrier problem (not an iteration)
     }
     if (options && options->cancel_requested && options->cancel_requested->load()) {

@@ -150,8 +150,16 @@ struct InteriorPointParameters {
   /// First relative shift of its inertia correction (relative to the mean diagonal, which the
   /// border's corner and the barrier terms dominate, not to the largest one) ...
   double free_time_first_shift = 1e-10;
+  /// A shift that worked is resumed at a third of itself down to this (IPOPT's δ_w^min): a floor
+  /// at the first shift swamped the soft directions' curvature once the barrier terms of active
+  /// bounds make the mean diagonal ~1e11 (N ≥ 1024) and stalled the refinement.
+  double free_time_smallest_shift = 1e-20;
   /// ... and the largest before the step counts as failed.
   double free_time_max_shift = 1e10;
+  /// θ_μ of its monotone barrier update (μ → min(κ_μ μ, μ^θ_μ)), below IPOPT's 1.5: a steeper
+  /// fall sent the next steps halving their way into the active bounds for ~6 iterations per
+  /// barrier level (one solve, Bilimoria–Wie N = 256: 50 → 38 iterations; Betts N = 64: 85 → 53).
+  double free_time_theta_mu = 1.3;
 
   // --- grids -----------------------------------------------------------------------------------
   /// Above this N the constrained problem is first solved on 4× coarser grids (down to 16).

@@ -207,7 +207,7 @@ TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
   const SeedCase sc = GetParam();
   const ap::PlanningProblem p = seedProblem(sc.scene, sc.steps, sc.scheme);
   ap::SolverOptions newton_options;
-  newton_options.solver = ap::SolverKind::Newton;
+  newton_options.solver = ap::SolverKind::Structured;
   const ap::PlanResult newton = ap::planManeuver(p, newton_options);
   ap::SolverOptions nlopt_options;
   nlopt_options.solver = ap::SolverKind::Nlopt;

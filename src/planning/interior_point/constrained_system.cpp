@@ -129,7 +129,7 @@ void ConstrainedSystem::addGroup(ConstraintFamily family, int first_k, int last_
   g.at.resize(last_k - first_k + 1);
 }
 
-void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
+void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const std::vector<Vector3> tau = np_.torques(steps);
   std::vector<Matrix3> R;
@@ -170,7 +170,7 @@ void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
   if (torques_out) *torques_out = tau;
 }
 
-double ConstrainedSystem::merit(const ReducedProblem::Steps& steps, double mu, double rho,
+double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double mu, double rho,
                                 double* cost, double slack_alpha) {
   std::vector<Vector3> tau;
   evaluateValues(steps, &tau);
@@ -365,7 +365,7 @@ void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
 template <typename Scalar>
 void ConstrainedSystem::assembleNodeConstraints(double mu, double rho, bool primal,
                                                 BandedSymmetric<Scalar>* H) {
-  const ReducedProblem::Steps& steps = np_.current();
+  const ReducedProblem::StepVectors& steps = np_.current();
   std::vector<Matrix3> R;
   for (ConstraintGroup& g : groups_) {
     if (isTorqueFamily(g.family)) continue;
@@ -415,7 +415,7 @@ void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
 
 /// J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2: the node velocity of a scheme with end
 /// torques.
-Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::Steps& steps, int k) const {
+Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::StepVectors& steps, int k) const {
   const DiscreteScheme& scheme = np_.scheme();
   const Vector3 Pi =
       0.5 * (scheme.momentumOfStep(steps[k]) +

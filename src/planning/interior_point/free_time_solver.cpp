@@ -122,7 +122,7 @@ class FreeTimeSolver {
     if (std::isfinite(norm_)) (*out)[i++].c = 1.0 - tau.squaredNorm() / (norm_ * norm_);
   }
 
-  double smallestValue(const ReducedProblem::Steps& steps) const {
+  double smallestValue(const ReducedProblem::StepVectors& steps) const {
     const std::vector<Vector3> tau = np_.torques(steps);
     double smallest = std::numeric_limits<double>::infinity();
     std::array<TorqueConstraint, kMaxPerTorque> row;
@@ -155,7 +155,8 @@ class FreeTimeSolver {
   void assemble(double mu, double epsilon);
   bool solveStep(Eigen::VectorXd* d);
   bool lineSearch(const Eigen::VectorXd& d, double mu, double epsilon, double* alpha);
-  void moveTo(double h, const ReducedProblem::Steps& steps, const Eigen::VectorXd* d, double alpha);
+  void moveTo(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd* d,
+              double alpha);
   double localDot(int k, const Eigen::Matrix<double, 10, 1>& g, const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
   void safeguardDuals(double mu);
@@ -285,8 +286,8 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
   return false;
 }
 
-void FreeTimeSolver::moveTo(double h, const ReducedProblem::Steps& steps, const Eigen::VectorXd* d,
-                            double alpha) {
+void FreeTimeSolver::moveTo(double h, const ReducedProblem::StepVectors& steps,
+                            const Eigen::VectorXd* d, double alpha) {
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
   np_.setCurrent(steps);
@@ -298,7 +299,7 @@ void FreeTimeSolver::moveTo(double h, const ReducedProblem::Steps& steps, const 
 bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsilon,
                                 double* alpha) {
   const double h = np_.timeStep();
-  const ReducedProblem::Steps steps = np_.current();
+  const ReducedProblem::StepVectors steps = np_.current();
   const double phi0 = merit(mu, epsilon, false);
   const double slope = -d.dot(rhs_);  // ∇φ_μᵀ d < 0
   double a = 1.0;

@@ -116,7 +116,7 @@ struct Solve {
 /// infeasibility certificate, else the first solve's reason; every solve's levels and
 /// iterations are kept.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
-                               const Solve& solve, const ReducedProblem::Steps* coarse_steps,
+                               const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true) {
   const FormulationRecipe& recipe =
       options.constrained_from_warm_start ? kProbeRecipe : kRequestRecipe;
@@ -155,7 +155,7 @@ namespace {
 /// What a level of the interior point's continuation hands the next: its iterate, the
 /// formulation that reached it and, when it converged, its multipliers and slacks (free slacks).
 struct LevelIterate {
-  ReducedProblem::Steps steps;
+  ReducedProblem::StepVectors steps;
   LevelDuals duals;
   Formulation formulation = Formulation::FreeSlacks;
   bool empty() const { return steps.empty(); }
@@ -191,7 +191,7 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
 /// once more through the level in between. Replaces *direct if that converges; adds every solve's
 /// iterations and levels to *total.
 void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options,
-                         const Solve& solve, const ReducedProblem::Steps& coarse,
+                         const Solve& solve, const ReducedProblem::StepVectors& coarse,
                          GridOutcome* direct, PlanResult* total) {
   PlanningProblem half = at;
   half.steps = at.steps / 2;
@@ -449,7 +449,7 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   // requested grid directly, as a converged coarser level starts a finer one: its steps, its
   // multipliers re-derived from stationarity (the guess carries none) and a small barrier.
   LevelDuals duals;
-  ReducedProblem::Steps steps;
+  ReducedProblem::StepVectors steps;
   try {
     ReducedProblem np(problem);
     np.setInteriorFromAttitudes(options.warm_start->attitude);

@@ -27,7 +27,7 @@ namespace attitude_planner {
 
 namespace {
 
-using Steps = ReducedProblem::Steps;
+using StepVectors = ReducedProblem::StepVectors;
 
 // --- Grid continuation for Newton ----------------------------------------------------------------
 
@@ -55,7 +55,8 @@ PlanResult solveThroughGrids(const PlanningProblem& problem, SolveContext& conte
                              const GridSettings& settings, const Maneuver* warm_start,
                              const NewtonParameters& p) {
   if (warm_start) return solveOnGrid(problem, context, settings, {warm_start}, nullptr, p);
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;
@@ -125,8 +126,8 @@ struct Surveyed {
   HomotopyClass homotopy;
   PlanResult result;  ///< on the survey grid; its cost is C at that N (NaN unless converged)
   bool on_requested_grid = false;  ///< the survey grid is the requested one: result is a plan
-  Steps steps;                     ///< the survey grid's final iterate (coarser survey grid)
-  Steps below;                     ///< the level below it, for extrapolation ...
+  StepVectors steps;               ///< the survey grid's final iterate (coarser survey grid)
+  StepVectors below;               ///< the level below it, for extrapolation ...
   bool below_converged = false;    ///< ... if it converged
 };
 
@@ -159,7 +160,8 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
     s.result = solveThroughGrids(at, context, settings, nullptr, p);
     return s;
   }
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = std::max(r.tolerance, p.coarse_tolerance_floor);
     if (r.replay_only) at_level.max_iterations = 0;
@@ -188,7 +190,8 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
   for (const PlanningProblem& level : plan.levels) levels.push_back(inClass(level, s.homotopy));
   GridLevelRule rule = newtonGridRule(p);
   rule.unconverged_ends = true;
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;
@@ -210,8 +213,8 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
     }
     r->message += "; refined from the " + survey_grid + " class survey";
   };
-  const SolvedLevel<Steps> survey{plan.survey, s.result.termination, s.steps, s.below,
-                                  s.below_converged};
+  const SolvedLevel<StepVectors> survey{plan.survey, s.result.termination, s.steps, s.below,
+                                        s.below_converged};
   return resumeGridContinuation(levels, survey, context, rule, settings.tolerance, level, finish);
 }
 
@@ -527,7 +530,8 @@ std::optional<PlanResult> coastingThroughGrids(const PlanningProblem& problem,
   const std::vector<PlanningProblem> levels = gridLevels(problem, newtonGridRule(p));
   const std::optional<Maneuver> coasting = coastingStart(levels.front());
   if (!coasting) return std::nullopt;
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;

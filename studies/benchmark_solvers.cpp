@@ -40,6 +40,7 @@
 #include <iomanip>
 #include <iostream>
 #include <nlopt.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -1006,80 +1007,148 @@ int solveIpoptFreeTime(ap::PlanningProblem problem, double time_budget) {
   return status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level ? 0 : 1;
 }
 
-/// --check-hessian: eval_h against central differences of ∇L = σ∇f + Jᵀλ (both from the exact
-/// first derivatives, eval_grad_f and eval_jac_g) at a random point with random multipliers.
-/// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
-/// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
-/// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
-int checkHessian(int steps, bool constrained) {
+/// The problem --check-hessian checks: nonzero boundary rates and, constrained, one constraint
+/// of every kind (two cones: both signs of their rows).
+ap::PlanningProblem hessianCheckProblem(int steps, bool constrained) {
   ap::PlanningProblem problem = seedRestToRest(steps);
   problem.initial_velocity = Vector3(0.02, -0.01, 0.03);  // nonzero boundary data too
   problem.final_velocity = Vector3(-0.01, 0.02, 0.01);
-  if (constrained) {  // one of every kind (two cones: both signs of their rows)
+  if (constrained) {
     problem.max_torque = Vector3(0.5, 0.6, 0.7);
     problem.constraints = {
         ap::PlanningConstraint::maxTorqueNorm(0.8), ap::PlanningConstraint::maxAngularRate(0.3),
         ap::PlanningConstraint::keepOut(Vector3(0, 0, 1), Vector3(0.6, 0.8, 0), 0.4, 0.01),
         ap::PlanningConstraint::keepIn(Vector3(1, 0, 0), Vector3(0, 0.6, 0.8), 1.9)};
   }
-  Ipopt::SmartPtr<TranscriptionNlp> nlp = new TranscriptionNlp(problem, true);
+  return problem;
+}
+
+/// The NLP's sizes (get_nlp_info).
+struct NlpSizes {
   Ipopt::Index n = 0, m = 0, nnz_jac = 0, nnz_h = 0;
-  Ipopt::TNLP::IndexStyleEnum style;
-  nlp->get_nlp_info(n, m, nnz_jac, nnz_h, style);
-  std::vector<double> x(n), lambda(m);
-  nlp->get_starting_point(n, true, x.data(), false, nullptr, nullptr, m, false, nullptr);
+};
+
+/// The check's point: the geodesic start perturbed (quaternions off the unit sphere, rates by
+/// up to 0.4 rad/s, one rate below the series threshold) and random multipliers.
+void randomPoint(TranscriptionNlp& nlp, int steps, const NlpSizes& size, std::vector<double>* x,
+                 std::vector<double>* lambda) {
+  x->assign(size.n, 0.0);
+  lambda->assign(size.m, 0.0);
+  nlp.get_starting_point(size.n, true, x->data(), false, nullptr, nullptr, size.m, false, nullptr);
   std::mt19937 rng(20240611);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (int k = 1; k <= steps; ++k)
-    for (int i = 0; i < 4; ++i) x[nlp->Q(k) + i] += 0.1 * uniform(rng);
+    for (int i = 0; i < 4; ++i) (*x)[nlp.Q(k) + i] += 0.1 * uniform(rng);
   for (int k = 1; k <= steps - 2; ++k)
-    for (int i = 0; i < 3; ++i) x[nlp->W(k) + i] += 0.4 * uniform(rng);
+    for (int i = 0; i < 3; ++i) (*x)[nlp.W(k) + i] += 0.4 * uniform(rng);
   if (steps >= 4) {
-    for (int i = 0; i < 3; ++i) x[nlp->W(2) + i] = 1e-7 * uniform(rng);  // series branch
+    for (int i = 0; i < 3; ++i) (*x)[nlp.W(2) + i] = 1e-7 * uniform(rng);  // series branch
   }
   for (int k = 1; k <= steps - 1; ++k)
-    for (int i = 0; i < 3; ++i) x[nlp->T(k) + i] += uniform(rng);
-  for (double& l : lambda) l = uniform(rng);
-  const double sigma = 0.7;
+    for (int i = 0; i < 3; ++i) (*x)[nlp.T(k) + i] += uniform(rng);
+  for (double& l : *lambda) l = uniform(rng);
+}
 
-  // The exact Hessian, dense and symmetric; the pattern must be the lower triangle, no repeats.
+/// The exact Hessian of the Lagrangian, dense and symmetric; `seen` marks the pattern (the lower
+/// triangle) and *pattern_errors counts entries above the diagonal, out of range or repeated.
+Eigen::MatrixXd exactHessian(TranscriptionNlp& nlp, const NlpSizes& size,
+                             const std::vector<double>& x, const std::vector<double>& lambda,
+                             double sigma, Eigen::MatrixXi* seen, int* pattern_errors) {
+  const Ipopt::Index n = size.n, nnz_h = size.nnz_h;
   std::vector<Ipopt::Index> hr(nnz_h), hc(nnz_h);
   std::vector<double> hv(nnz_h);
-  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, hr.data(), hc.data(),
-              nullptr);
-  nlp->eval_h(n, x.data(), true, sigma, m, lambda.data(), true, nnz_h, nullptr, nullptr, hv.data());
+  nlp.eval_h(n, x.data(), true, sigma, size.m, lambda.data(), true, nnz_h, hr.data(), hc.data(),
+             nullptr);
+  nlp.eval_h(n, x.data(), true, sigma, size.m, lambda.data(), true, nnz_h, nullptr, nullptr,
+             hv.data());
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
-  Eigen::MatrixXi seen = Eigen::MatrixXi::Zero(n, n);
-  int pattern_errors = 0;
+  *seen = Eigen::MatrixXi::Zero(n, n);
+  *pattern_errors = 0;
   for (int i = 0; i < nnz_h; ++i) {
-    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0 || seen(hr[i], hc[i])++) ++pattern_errors;
+    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0 || (*seen)(hr[i], hc[i])++) ++*pattern_errors;
     H(hr[i], hc[i]) = hv[i];
     H(hc[i], hr[i]) = hv[i];
   }
+  return H;
+}
 
-  // ∇L from the exact first derivatives.
+/// Central differences (step `step`) of ∇L = σ∇f + Jᵀλ, from the exact first derivatives.
+Eigen::MatrixXd differencedHessian(TranscriptionNlp& nlp, const NlpSizes& size,
+                                   const std::vector<double>& x, const std::vector<double>& lambda,
+                                   double sigma, double step) {
+  const Ipopt::Index n = size.n, m = size.m, nnz_jac = size.nnz_jac;
   std::vector<Ipopt::Index> jr(nnz_jac), jc(nnz_jac);
   std::vector<double> jv(nnz_jac), grad(n);
-  nlp->eval_jac_g(n, x.data(), true, m, nnz_jac, jr.data(), jc.data(), nullptr);
+  nlp.eval_jac_g(n, x.data(), true, m, nnz_jac, jr.data(), jc.data(), nullptr);
   const auto gradient = [&](const std::vector<double>& y) {
     Eigen::VectorXd gl(n);
-    nlp->eval_grad_f(n, y.data(), true, grad.data());
-    nlp->eval_jac_g(n, y.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
+    nlp.eval_grad_f(n, y.data(), true, grad.data());
+    nlp.eval_jac_g(n, y.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
     for (int i = 0; i < n; ++i) gl(i) = sigma * grad[i];
     for (int i = 0; i < nnz_jac; ++i) gl(jc[i]) += lambda[jr[i]] * jv[i];
     return gl;
   };
-  constexpr double kStep = 1e-5;
   Eigen::MatrixXd fd(n, n);
   std::vector<double> y = x;
   for (int j = 0; j < n; ++j) {
-    y[j] = x[j] + kStep;
+    y[j] = x[j] + step;
     const Eigen::VectorXd plus = gradient(y);
-    y[j] = x[j] - kStep;
+    y[j] = x[j] - step;
     const Eigen::VectorXd minus = gradient(y);
     y[j] = x[j];
-    fd.col(j) = (plus - minus) / (2.0 * kStep);
+    fd.col(j) = (plus - minus) / (2.0 * step);
   }
+  return fd;
+}
+
+/// The constraint Jacobian (eval_jac_g) against central differences of eval_g: the largest
+/// row-scaled error.
+double jacobianRelativeError(TranscriptionNlp& nlp, const NlpSizes& size,
+                             const std::vector<double>& x, double step) {
+  const Ipopt::Index n = size.n, m = size.m, nnz_jac = size.nnz_jac;
+  std::vector<Ipopt::Index> jr(nnz_jac), jc(nnz_jac);
+  std::vector<double> jv(nnz_jac);
+  nlp.eval_jac_g(n, x.data(), true, m, nnz_jac, jr.data(), jc.data(), nullptr);
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(m, n), jac_fd(m, n);
+  nlp.eval_jac_g(n, x.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
+  for (int i = 0; i < nnz_jac; ++i) jac(jr[i], jc[i]) += jv[i];
+  std::vector<double> g_plus(m), g_minus(m), y = x;
+  for (int j = 0; j < n; ++j) {
+    y[j] = x[j] + step;
+    nlp.eval_g(n, y.data(), true, m, g_plus.data());
+    y[j] = x[j] - step;
+    nlp.eval_g(n, y.data(), true, m, g_minus.data());
+    y[j] = x[j];
+    for (int i = 0; i < m; ++i) jac_fd(i, j) = (g_plus[i] - g_minus[i]) / (2.0 * step);
+  }
+  double worst = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double row_scale = std::max(jac.row(i).cwiseAbs().maxCoeff(), 1e-300);
+    worst = std::max(worst, (jac.row(i) - jac_fd.row(i)).cwiseAbs().maxCoeff() / row_scale);
+  }
+  return worst;
+}
+
+/// --check-hessian: eval_h against central differences of ∇L = σ∇f + Jᵀλ (both from the exact
+/// first derivatives, eval_grad_f and eval_jac_g) at a random point with random multipliers.
+/// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
+/// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
+/// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
+int checkHessian(int steps, bool constrained) {
+  Ipopt::SmartPtr<TranscriptionNlp> nlp =
+      new TranscriptionNlp(hessianCheckProblem(steps, constrained), true);
+  NlpSizes size;
+  Ipopt::TNLP::IndexStyleEnum style;
+  nlp->get_nlp_info(size.n, size.m, size.nnz_jac, size.nnz_h, style);
+  const Ipopt::Index n = size.n;
+  std::vector<double> x, lambda;
+  randomPoint(*nlp, steps, size, &x, &lambda);
+  const double sigma = 0.7;
+  constexpr double kStep = 1e-5;
+  Eigen::MatrixXi seen;
+  int pattern_errors = 0;
+  const Eigen::MatrixXd H = exactHessian(*nlp, size, x, lambda, sigma, &seen, &pattern_errors);
+  const Eigen::MatrixXd fd = differencedHessian(*nlp, size, x, lambda, sigma, kStep);
   // The FD matrix is symmetric only up to its own error: compare with its symmetric part and
   // report the asymmetry (a bound on the FD error) separately.
   const double asymmetry = (fd - fd.transpose()).cwiseAbs().maxCoeff();
@@ -1098,26 +1167,7 @@ int checkHessian(int steps, bool constrained) {
       if (std::abs(H(i, j)) > 1e-3 * scale)
         entry_error = std::max(entry_error, std::abs(H(i, j) - fd_sym(i, j)) / std::abs(H(i, j)));
   const double relative = error / scale;
-
-  // The constraint Jacobian (eval_jac_g) against central differences of eval_g, row-scaled.
-  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(m, n), jac_fd(m, n);
-  nlp->eval_jac_g(n, x.data(), true, m, nnz_jac, nullptr, nullptr, jv.data());
-  for (int i = 0; i < nnz_jac; ++i) jac(jr[i], jc[i]) += jv[i];
-  std::vector<double> g_plus(m), g_minus(m);
-  for (int j = 0; j < n; ++j) {
-    y[j] = x[j] + kStep;
-    nlp->eval_g(n, y.data(), true, m, g_plus.data());
-    y[j] = x[j] - kStep;
-    nlp->eval_g(n, y.data(), true, m, g_minus.data());
-    y[j] = x[j];
-    for (int i = 0; i < m; ++i) jac_fd(i, j) = (g_plus[i] - g_minus[i]) / (2.0 * kStep);
-  }
-  double jacobian_relative = 0.0;
-  for (int i = 0; i < m; ++i) {
-    const double row_scale = std::max(jac.row(i).cwiseAbs().maxCoeff(), 1e-300);
-    jacobian_relative =
-        std::max(jacobian_relative, (jac.row(i) - jac_fd.row(i)).cwiseAbs().maxCoeff() / row_scale);
-  }
+  const double jacobian_relative = jacobianRelativeError(*nlp, size, x, kStep);
   const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale &&
                     jacobian_relative <= 1e-6;
   std::printf(
@@ -1126,8 +1176,8 @@ int checkHessian(int steps, bool constrained) {
       "\"max_abs_entry\": %.6g, \"max_abs_error\": %.3g, \"relative_error\": %.3g, "
       "\"max_entry_relative_error\": %.3g, \"fd_outside_pattern\": %.3g, \"fd_asymmetry\": "
       "%.3g, \"jacobian_relative_error\": %.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
-      constrained ? "true" : "false", steps, static_cast<int>(n), static_cast<int>(m),
-      static_cast<int>(nnz_h), kStep, scale, error, relative, entry_error, outside, asymmetry,
+      constrained ? "true" : "false", steps, static_cast<int>(n), static_cast<int>(size.m),
+      static_cast<int>(size.nnz_h), kStep, scale, error, relative, entry_error, outside, asymmetry,
       jacobian_relative, pattern_errors, pass ? "true" : "false");
   return pass ? 0 : 1;
 }
@@ -1506,92 +1556,91 @@ std::string percent(int part, int whole) {
   return b;
 }
 
-/// Runs `count` cases of the suite seeded `seed`: ours (planManeuver, default options but the
-/// time budget) and, on paper-scheme cases, IPOPT from the same start (newtonInitialSteps).
-/// Writes a markdown section to `out_path` (stdout if empty); one JSON line per case to stderr.
-int randomSuite(int count, std::uint64_t seed, double time_budget, const std::string& out_path,
-                const std::vector<int>& only_cases) {
-  std::vector<SuiteRow> rows;
-  const auto wall_start = std::chrono::steady_clock::now();
-  for (const ap::robustness::RandomCase& c : ap::robustness::randomSuite(seed, count)) {
-    if (!only_cases.empty() &&
-        std::find(only_cases.begin(), only_cases.end(), c.index) == only_cases.end()) {
-      continue;
-    }
-    SuiteRow row;
-    row.c = c;
-    ap::SolverOptions options;
-    options.time_budget_s = time_budget;
-    row.ours = ap::planManeuver(c.problem, options);
+/// One case of the suite: ours (planManeuver, default options but the time budget) and, on a
+/// paper-scheme case, IPOPT from the same start (newtonInitialSteps); one JSON line to stderr.
+SuiteRow runSuiteCase(const ap::robustness::RandomCase& c, double time_budget) {
+  SuiteRow row;
+  row.c = c;
+  ap::SolverOptions options;
+  options.time_budget_s = time_budget;
+  row.ours = ap::planManeuver(c.problem, options);
 #ifdef AP_HAVE_IPOPT
-    if (c.problem.scheme == ap::SchemeKind::Paper) {
-      row.ipopt_ran = true;
-      const auto start = std::chrono::steady_clock::now();
-      row.ipopt = solveIpopt(c.problem, time_budget, true, ap::newtonInitialSteps(c.problem));
-      row.ipopt_time_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (row.ipopt.torque.size() == static_cast<size_t>(c.problem.steps + 1)) {
-        ap::PlanResult replay;
-        try {
-          ap::evaluatePlan(c.problem, row.ipopt.torque, &replay);
-          row.ipopt_cost = replay.cost;
-          row.ipopt_replay_miss = replay.replay_miss;
-        } catch (const ap::StepTooLarge&) {
-          row.ipopt.optimal = false;
-        }
-      } else {
+  if (c.problem.scheme == ap::SchemeKind::Paper) {
+    row.ipopt_ran = true;
+    const auto start = std::chrono::steady_clock::now();
+    row.ipopt = solveIpopt(c.problem, time_budget, true, ap::newtonInitialSteps(c.problem));
+    row.ipopt_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (row.ipopt.torque.size() == static_cast<size_t>(c.problem.steps + 1)) {
+      ap::PlanResult replay;
+      try {
+        ap::evaluatePlan(c.problem, row.ipopt.torque, &replay);
+        row.ipopt_cost = replay.cost;
+        row.ipopt_replay_miss = replay.replay_miss;
+      } catch (const ap::StepTooLarge&) {
         row.ipopt.optimal = false;
       }
+    } else {
+      row.ipopt.optimal = false;
     }
-#endif
-    std::fprintf(stderr,
-                 "{\"case\": %d, \"label\": \"%s\", \"termination\": \"%s\", \"iterations\": %d, "
-                 "\"time_s\": %.4g, \"cost\": %.17g, \"ipopt\": %s, \"ipopt_cost\": %.17g}\n",
-                 c.index, escaped(c.label).c_str(),
-                 ap::terminationName(row.ours.termination).c_str(), row.ours.iterations,
-                 row.ours.solve_time_s, row.ours.cost,
-                 row.ipopt_ran ? (row.ipopt.optimal ? "\"optimal\"" : "\"failed\"") : "null",
-                 row.ipopt_cost);
-    rows.push_back(std::move(row));
   }
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+#endif
+  std::fprintf(stderr,
+               "{\"case\": %d, \"label\": \"%s\", \"termination\": \"%s\", \"iterations\": %d, "
+               "\"time_s\": %.4g, \"cost\": %.17g, \"ipopt\": %s, \"ipopt_cost\": %.17g}\n",
+               c.index, escaped(c.label).c_str(), ap::terminationName(row.ours.termination).c_str(),
+               row.ours.iterations, row.ours.solve_time_s, row.ours.cost,
+               row.ipopt_ran ? (row.ipopt.optimal ? "\"optimal\"" : "\"failed\"") : "null",
+               row.ipopt_cost);
+  return row;
+}
 
-  // Figures, per scheme and in all.
-  struct Tally {
-    int cases = 0, converged = 0, with_ipopt = 0, ipopt_optimal = 0, ours_where_ipopt = 0;
-    int both = 0, not_costlier = 0, cheaper = 0, costlier = 0;
-    std::vector<double> iterations, times, ipopt_iterations, ipopt_times;
-    double worst_ratio = 0.0;  ///< largest ours/IPOPT cost where both converged
-  };
-  const auto tally = [&](int scheme_filter) {  // −1 all, else static_cast<int>(SchemeKind)
-    Tally t;
-    for (const SuiteRow& r : rows) {
-      if (scheme_filter >= 0 && static_cast<int>(r.c.problem.scheme) != scheme_filter) continue;
-      ++t.cases;
-      t.converged += r.ours.converged();
-      t.iterations.push_back(r.ours.iterations);
-      t.times.push_back(r.ours.solve_time_s);
-      if (!r.ipopt_ran) continue;
-      ++t.with_ipopt;
-      t.ipopt_iterations.push_back(r.ipopt.iterations);
-      t.ipopt_times.push_back(r.ipopt_time_s);
-      if (!r.ipopt.optimal) continue;
-      ++t.ipopt_optimal;
-      t.ours_where_ipopt += r.ours.converged();
-      if (!r.ours.converged()) continue;
-      ++t.both;
-      const double rel = (r.ours.cost - r.ipopt_cost) / r.ipopt_cost;
-      t.not_costlier += rel <= 1e-8;
-      t.cheaper += rel < -1e-8;
-      t.costlier += rel > 1e-8;
-      t.worst_ratio = std::max(t.worst_ratio, r.ours.cost / r.ipopt_cost);
-    }
-    return t;
-  };
-  const Tally all = tally(-1), paper = tally(static_cast<int>(ap::SchemeKind::Paper)),
-              variational = tally(static_cast<int>(ap::SchemeKind::Variational));
-  std::ostringstream md;
+/// The suite's figures over the cases of one scheme (or all).
+struct SuiteTally {
+  int cases = 0, converged = 0, with_ipopt = 0, ipopt_optimal = 0, ours_where_ipopt = 0;
+  int both = 0, not_costlier = 0, cheaper = 0, costlier = 0;
+  std::vector<double> iterations, times, ipopt_iterations, ipopt_times;
+  double worst_ratio = 0.0;  ///< largest ours/IPOPT cost where both converged
+};
+
+/// `scheme_filter`: −1 all, else static_cast<int>(SchemeKind).
+SuiteTally tallySuite(const std::vector<SuiteRow>& rows, int scheme_filter) {
+  SuiteTally t;
+  for (const SuiteRow& r : rows) {
+    if (scheme_filter >= 0 && static_cast<int>(r.c.problem.scheme) != scheme_filter) continue;
+    ++t.cases;
+    t.converged += r.ours.converged();
+    t.iterations.push_back(r.ours.iterations);
+    t.times.push_back(r.ours.solve_time_s);
+    if (!r.ipopt_ran) continue;
+    ++t.with_ipopt;
+    t.ipopt_iterations.push_back(r.ipopt.iterations);
+    t.ipopt_times.push_back(r.ipopt_time_s);
+    if (!r.ipopt.optimal) continue;
+    ++t.ipopt_optimal;
+    t.ours_where_ipopt += r.ours.converged();
+    if (!r.ours.converged()) continue;
+    ++t.both;
+    const double rel = (r.ours.cost - r.ipopt_cost) / r.ipopt_cost;
+    t.not_costlier += rel <= 1e-8;
+    t.cheaper += rel < -1e-8;
+    t.costlier += rel > 1e-8;
+    t.worst_ratio = std::max(t.worst_ratio, r.ours.cost / r.ipopt_cost);
+  }
+  return t;
+}
+
+/// "median / max" of `values` (0 for none).
+std::string medianAndMax(const std::vector<double>& values) {
+  std::ostringstream out;
+  out << std::defaultfloat << std::setprecision(3) << median(values) << " / "
+      << (values.empty() ? 0 : *std::max_element(values.begin(), values.end()));
+  return out.str();
+}
+
+/// The section's heading and how it was made.
+void writeSuiteIntro(std::ostream& md, int count, std::uint64_t seed, double time_budget,
+                     double wall) {
   const time_t now = std::time(nullptr);
   char date[64];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
@@ -1613,33 +1662,21 @@ int randomSuite(int count, std::uint64_t seed, double time_budget, const std::st
         "difference = (ours − IPOPT) / IPOPT. Wall time of the whole run "
      << std::fixed << std::setprecision(0) << wall << " s on a 2-core machine shared with other "
      << "builds (times vary ±50 % with the load).\n\n";
+}
+
+/// The figures, per scheme and in all.
+void writeSuiteFigures(std::ostream& md, const SuiteTally& all, const SuiteTally& paper,
+                       const SuiteTally& variational) {
   md << std::defaultfloat << std::setprecision(3);
   md << "| figure | all | paper | variational |\n|---|---|---|---|\n";
   md << "| cases | " << all.cases << " | " << paper.cases << " | " << variational.cases << " |\n";
   md << "| ours converged | " << percent(all.converged, all.cases) << " | "
      << percent(paper.converged, paper.cases) << " | "
      << percent(variational.converged, variational.cases) << " |\n";
-  md << "| ours median / max iterations | " << median(all.iterations) << " / "
-     << (all.iterations.empty() ? 0
-                                : *std::max_element(all.iterations.begin(), all.iterations.end()))
-     << " | " << median(paper.iterations) << " / "
-     << (paper.iterations.empty()
-             ? 0
-             : *std::max_element(paper.iterations.begin(), paper.iterations.end()))
-     << " | " << median(variational.iterations) << " / "
-     << (variational.iterations.empty()
-             ? 0
-             : *std::max_element(variational.iterations.begin(), variational.iterations.end()))
-     << " |\n";
-  md << "| ours median / max time [s] | " << median(all.times) << " / "
-     << (all.times.empty() ? 0 : *std::max_element(all.times.begin(), all.times.end())) << " | "
-     << median(paper.times) << " / "
-     << (paper.times.empty() ? 0 : *std::max_element(paper.times.begin(), paper.times.end()))
-     << " | " << median(variational.times) << " / "
-     << (variational.times.empty()
-             ? 0
-             : *std::max_element(variational.times.begin(), variational.times.end()))
-     << " |\n";
+  md << "| ours median / max iterations | " << medianAndMax(all.iterations) << " | "
+     << medianAndMax(paper.iterations) << " | " << medianAndMax(variational.iterations) << " |\n";
+  md << "| ours median / max time [s] | " << medianAndMax(all.times) << " | "
+     << medianAndMax(paper.times) << " | " << medianAndMax(variational.times) << " |\n";
   md << "| IPOPT converged | " << percent(all.ipopt_optimal, all.with_ipopt) << " | "
      << percent(paper.ipopt_optimal, paper.with_ipopt) << " | n/a |\n";
   md << "| IPOPT median iterations / time [s] | " << median(all.ipopt_iterations) << " / "
@@ -1654,7 +1691,10 @@ int randomSuite(int count, std::uint64_t seed, double time_budget, const std::st
      << all.costlier << " | " << paper.cheaper << " / " << paper.costlier << " | n/a |\n";
   md << "| both converged: worst ours / IPOPT cost | " << all.worst_ratio << " | "
      << paper.worst_ratio << " | n/a |\n\n";
-  const double conv = all.cases ? double(all.converged) / all.cases : 0.0;
+}
+
+/// The targets the suite was made for, met or not on this run.
+void writeSuiteTargets(std::ostream& md, const SuiteTally& all, const SuiteTally& paper) {
   const double cost_share = paper.with_ipopt ? double(paper.not_costlier) / paper.with_ipopt : 0.0;
   md << "Targets of issue 19 (measured on this run):\n\n"
      << "| target | measured | met |\n|---|---|---|\n"
@@ -1669,59 +1709,84 @@ int randomSuite(int count, std::uint64_t seed, double time_budget, const std::st
      << (cost_share >= 0.99 ? "yes" : "**no**") << " |\n"
      << "| median iterations ≤ 20 | " << median(all.iterations) << " | "
      << (median(all.iterations) <= 20 ? "yes" : "**no**") << " |\n\n";
-  (void)conv;
+}
+
+/// One row of the every-case table.
+void writeSuiteCase(std::ostream& md, const SuiteRow& r) {
+  const ap::PlanningProblem& p = r.c.problem;
+  char line[1024];
+  std::snprintf(
+      line, sizeof line,
+      "| %d | %s | %s | %.3g | %d | %.2f | %.2f | %s | %d | %.3f | %.10g | %.1e |", r.c.index,
+      ap::robustness::inertiaFamilyName(r.c.family).c_str(), ap::schemeName(p.scheme).c_str(),
+      p.duration, p.steps, p.initial_velocity.norm(), p.final_velocity.norm(),
+      r.ours.converged() ? "converged"
+                         : ("**" + ap::terminationName(r.ours.termination) + "**").c_str(),
+      r.ours.iterations, r.ours.solve_time_s, r.ours.cost, r.ours.replay_miss);
+  md << line;
+  if (!r.ipopt_ran) {
+    md << " – | | | | |\n";
+    return;
+  }
+  std::snprintf(line, sizeof line, " %s | %d | %.3f | %.10g |",
+                r.ipopt.optimal ? "converged" : "failed", r.ipopt.iterations, r.ipopt_time_s,
+                r.ipopt_cost);
+  md << line;
+  if (r.ipopt.optimal && r.ours.converged()) {
+    const double rel = (r.ours.cost - r.ipopt_cost) / r.ipopt_cost;
+    std::snprintf(line, sizeof line, " %.2e%s |\n", rel,
+                  rel < -1e-8  ? " (ours cheaper)"
+                  : rel > 1e-8 ? " (**IPOPT cheaper**)"
+                               : "");
+    md << line;
+  } else {
+    md << " – |\n";
+  }
+}
+
+/// `text` to `out_path`, or to stdout if it is empty; false if it cannot be written.
+bool writeText(const std::string& text, const std::string& out_path) {
+  if (out_path.empty()) {
+    std::cout << text;
+    return true;
+  }
+  std::ofstream out(out_path);
+  out << text;
+  if (!out) std::cerr << "benchmark_solvers: cannot write " << out_path << "\n";
+  return static_cast<bool>(out);
+}
+
+/// Runs `count` cases of the suite seeded `seed` (runSuiteCase). Writes a markdown section to
+/// `out_path` (stdout if empty); one JSON line per case to stderr.
+int randomSuite(int count, std::uint64_t seed, double time_budget, const std::string& out_path,
+                const std::vector<int>& only_cases) {
+  std::vector<SuiteRow> rows;
+  const auto wall_start = std::chrono::steady_clock::now();
+  for (const ap::robustness::RandomCase& c : ap::robustness::randomSuite(seed, count)) {
+    const bool chosen = only_cases.empty() || std::find(only_cases.begin(), only_cases.end(),
+                                                        c.index) != only_cases.end();
+    if (chosen) rows.push_back(runSuiteCase(c, time_budget));
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  std::ostringstream md;
+  writeSuiteIntro(md, count, seed, time_budget, wall);
+  writeSuiteFigures(md, tallySuite(rows, -1),
+                    tallySuite(rows, static_cast<int>(ap::SchemeKind::Paper)),
+                    tallySuite(rows, static_cast<int>(ap::SchemeKind::Variational)));
+  writeSuiteTargets(md, tallySuite(rows, -1),
+                    tallySuite(rows, static_cast<int>(ap::SchemeKind::Paper)));
   md << "<details><summary>Every case</summary>\n\n"
      << "| # | inertia | scheme | T [s] | N | \\|Ω_0\\| | \\|Ω_{N−1}\\| | ours | it | time [s] | "
         "cost | replay miss [rad] | IPOPT | it | time [s] | cost | (ours − IPOPT)/IPOPT |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const SuiteRow& r : rows) {
-    const ap::PlanningProblem& p = r.c.problem;
-    char line[1024];
-    std::snprintf(
-        line, sizeof line,
-        "| %d | %s | %s | %.3g | %d | %.2f | %.2f | %s | %d | %.3f | %.10g | %.1e |", r.c.index,
-        ap::robustness::inertiaFamilyName(r.c.family).c_str(), ap::schemeName(p.scheme).c_str(),
-        p.duration, p.steps, p.initial_velocity.norm(), p.final_velocity.norm(),
-        r.ours.converged() ? "converged"
-                           : ("**" + ap::terminationName(r.ours.termination) + "**").c_str(),
-        r.ours.iterations, r.ours.solve_time_s, r.ours.cost, r.ours.replay_miss);
-    md << line;
-    if (!r.ipopt_ran) {
-      md << " – | | | | |\n";
-      continue;
-    }
-    std::snprintf(line, sizeof line, " %s | %d | %.3f | %.10g |",
-                  r.ipopt.optimal ? "converged" : "failed", r.ipopt.iterations, r.ipopt_time_s,
-                  r.ipopt_cost);
-    md << line;
-    if (r.ipopt.optimal && r.ours.converged()) {
-      const double rel = (r.ours.cost - r.ipopt_cost) / r.ipopt_cost;
-      std::snprintf(line, sizeof line, " %.2e%s |\n", rel,
-                    rel < -1e-8  ? " (ours cheaper)"
-                    : rel > 1e-8 ? " (**IPOPT cheaper**)"
-                                 : "");
-      md << line;
-    } else {
-      md << " – |\n";
-    }
-  }
+  for (const SuiteRow& r : rows) writeSuiteCase(md, r);
   md << "\n</details>\n";
-  if (out_path.empty()) {
-    std::cout << md.str();
-  } else {
-    std::ofstream out(out_path);
-    out << md.str();
-    if (!out) {
-      std::cerr << "benchmark_solvers: cannot write " << out_path << "\n";
-      return 1;
-    }
-  }
-  return 0;
+  return writeText(md.str(), out_path) ? 0 : 1;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The command line.
+struct BenchmarkArgs {
   std::string solver, scene, scheme;
   bool check_hessian = false;
   bool constrained = false;
@@ -1733,6 +1798,11 @@ int main(int argc, char** argv) {
   std::string out_path;
   int in_process = 1;  // solves in this process; > 1 adds the warm median (runs 2..K)
   double time_budget = 120.0;
+};
+
+/// Parses the arguments into *args; an exit status if the program ends here (--quick, --help, a
+/// usage error).
+std::optional<int> parseArguments(int argc, char** argv, BenchmarkArgs* args) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&]() -> std::string {
@@ -1748,86 +1818,76 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (a == "--solver") {
-      solver = value();
+      args->solver = value();
     } else if (a == "--scene") {
-      scene = value();
+      args->scene = value();
     } else if (a == "--steps") {
-      steps = std::atoi(value().c_str());
+      args->steps = std::atoi(value().c_str());
     } else if (a == "--scheme") {
-      scheme = value();
+      args->scheme = value();
     } else if (a == "--check-hessian") {
-      check_hessian = true;
+      args->check_hessian = true;
     } else if (a == "--constrained") {
-      constrained = true;
+      args->constrained = true;
     } else if (a == "--start") {
       const std::string v = value();
       if (v != "geodesic" && v != "unconstrained" && v != "ours") {
         std::cerr << "--start: expected geodesic, unconstrained or ours, got '" << v << "'\n";
         return 2;
       }
-      peer_start = v == "ours"            ? PeerStart::Ours
-                   : v == "unconstrained" ? PeerStart::Unconstrained
-                                          : PeerStart::Geodesic;
+      args->peer_start = v == "ours"            ? PeerStart::Ours
+                         : v == "unconstrained" ? PeerStart::Unconstrained
+                                                : PeerStart::Geodesic;
     } else if (a == "--time-budget") {
-      time_budget = std::atof(value().c_str());
+      args->time_budget = std::atof(value().c_str());
     } else if (a == "--random-suite") {
-      suite_count = std::atoi(value().c_str());
-      if (suite_count <= 0) {
+      args->suite_count = std::atoi(value().c_str());
+      if (args->suite_count <= 0) {
         std::cerr << "--random-suite: expected a positive count, got '" << argv[i] << "'\n";
         return 1;
       }
     } else if (a == "--cases") {
       std::stringstream list(value());
       for (std::string item; std::getline(list, item, ',');)
-        only_cases.push_back(std::atoi(item.c_str()));
+        args->only_cases.push_back(std::atoi(item.c_str()));
     } else if (a == "--seed") {
-      suite_seed = std::strtoull(value().c_str(), nullptr, 10);
+      args->suite_seed = std::strtoull(value().c_str(), nullptr, 10);
     } else if (a == "--out") {
-      out_path = value();
+      args->out_path = value();
     } else if (a == "--in-process") {
-      in_process = std::atoi(value().c_str());
+      args->in_process = std::atoi(value().c_str());
     } else {
       std::cerr << "unknown argument '" << a << "'\n" << kUsage;
       return 2;
     }
   }
-  if (check_hessian) {
-#ifdef AP_HAVE_IPOPT
-    return checkHessian(steps > 0 ? steps : 16, constrained);
-#else
-    std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
-                 "(install coinor-libipopt-dev)\n";
-    return 3;
-#endif
-  }
-  if (suite_count > 0)
-    return randomSuite(suite_count, suite_seed, time_budget, out_path, only_cases);
-  if (solver.empty()) {
-    std::cerr << kUsage;
-    return 2;
-  }
+  return std::nullopt;
+}
+
+/// One solver on one problem (--solver): prints its JSON line; the exit status.
+int benchmarkOneSolver(const BenchmarkArgs& args) {
   try {
     ap::PlanningProblem problem =
-        scene.empty() ? seedRestToRest(128) : ap::loadScene(scene).problem;
-    if (steps > 0) problem.steps = steps;
-    if (!scheme.empty()) problem.scheme = ap::parseScheme(scheme, "--scheme");
-    if (solver == "free_time" || solver == "ipopt_free_time") {
+        args.scene.empty() ? seedRestToRest(128) : ap::loadScene(args.scene).problem;
+    if (args.steps > 0) problem.steps = args.steps;
+    if (!args.scheme.empty()) problem.scheme = ap::parseScheme(args.scheme, "--scheme");
+    if (args.solver == "free_time" || args.solver == "ipopt_free_time") {
 #ifdef AP_HAVE_IPOPT  // the two share the peer's start (excursionStart)
-      if (solver == "ipopt_free_time") return solveIpoptFreeTime(problem, time_budget);
+      if (args.solver == "ipopt_free_time") return solveIpoptFreeTime(problem, args.time_budget);
       problem.scheme = ap::SchemeKind::Paper;
       return solveOursFreeTime(problem);
 #else
-      std::cerr << "benchmark_solvers: " << solver << ": this build has no IPOPT\n";
+      std::cerr << "benchmark_solvers: " << args.solver << ": this build has no IPOPT\n";
       return 3;
 #endif
     }
-    Measurement m = run(solver, problem, time_budget, peer_start);
-    if (in_process > 1) {
+    Measurement m = run(args.solver, problem, args.time_budget, args.peer_start);
+    if (args.in_process > 1) {
       // Warm solves, as a node serving requests sees them (caches, pages, lazy binding warm):
       // reported apart from time_s, which stays the first, cold solve of a fresh process.
       std::vector<double> warm;
-      for (int r = 1; r < in_process; ++r)
-        warm.push_back(run(solver, problem, time_budget, peer_start).time_s);
+      for (int r = 1; r < args.in_process; ++r)
+        warm.push_back(run(args.solver, problem, args.time_budget, args.peer_start).time_s);
       std::sort(warm.begin(), warm.end());
       m.warm_time_s = warm[warm.size() / 2];
     }
@@ -1837,4 +1897,29 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BenchmarkArgs args;
+  if (const std::optional<int> status = parseArguments(argc, argv, &args)) return *status;
+  if (args.check_hessian) {
+#ifdef AP_HAVE_IPOPT
+    return checkHessian(args.steps > 0 ? args.steps : 16, args.constrained);
+#else
+    std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
+                 "(install coinor-libipopt-dev)\n";
+    return 3;
+#endif
+  }
+  if (args.suite_count > 0) {
+    return randomSuite(args.suite_count, args.suite_seed, args.time_budget, args.out_path,
+                       args.only_cases);
+  }
+  if (args.solver.empty()) {
+    std::cerr << kUsage;
+    return 2;
+  }
+  return benchmarkOneSolver(args);
 }

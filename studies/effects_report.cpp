@@ -41,15 +41,8 @@ double miss(const PlanningProblem& p, const std::vector<Vector3>& torque,
   return so3::angleBetween(p.final_attitude, m.attitude[p.steps]);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const std::string scenes = argc > 1 ? argv[1] : "scenes";
-  const std::string out = argc > 2 ? argv[2] : "docs/results";
-  FILE* md = std::fopen((out + "/effects.md").c_str(), "w");
-  if (!md) return std::fprintf(stderr, "cannot write %s/effects.md\n", out.c_str()), 1;
-  const Scene leo = loadScene(scenes + "/leo_slew.yaml");
-  const PlanningProblem& p = leo.problem;
+/// The page's heading and what the effects model.
+void writeIntro(FILE* md) {
   std::fprintf(
       md,
       "# Effects: what they cost and what they change\n\n"
@@ -66,6 +59,10 @@ int main(int argc, char** argv) {
       "`simulate()`, variational scheme, LEO inertia, 200 000 steps, median of 7 runs "
       "on this machine (other jobs may have shared the 2 cores).\n\n"
       "| effects | ns per step |\n|---|---|\n");
+}
+
+/// The per-step cost of simulate() with more and more effects.
+void writeIntegratorCost(FILE* md, const PlanningProblem& p) {
   const int steps = 200000;
   SimulationInput input;
   input.torque.assign(steps + 1, Vector3::Zero());
@@ -85,8 +82,10 @@ int main(int argc, char** argv) {
     input.effects = i == 0 ? nullptr : &models[i];
     std::fprintf(md, "| %s | %.0f |\n", labels[i], medianNanosecondsPerStep(scheme, input));
   }
+}
 
-  // ---- the LEO example: which effects matter --------------------------------------------------
+/// The LEO example: which effects matter (the miss each unplanned effect causes).
+void writeLeoMisses(FILE* md, const PlanningProblem& p, const std::string& scenes) {
   const PlanResult planned = planManeuver(p);
   PlanningProblem bare_problem = p;
   bare_problem.effects = nullptr;
@@ -120,8 +119,10 @@ int main(int argc, char** argv) {
                "\nPlanning cost with / without the effects: %.6g / %.6g N² m² (%d / %d Newton "
                "iterations).\n",
                planned.cost, ignorant.cost, planned.iterations, ignorant.iterations);
+}
 
-  // ---- torque limits ---------------------------------------------------------------------------
+/// The torque-limited scene: bounded against unbounded.
+void writeTorqueLimits(FILE* md, const std::string& scenes) {
   const Scene limited = loadScene(scenes + "/torque_limited.yaml");
   PlanningProblem unbounded = limited.problem;
   unbounded.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
@@ -142,6 +143,20 @@ int main(int argc, char** argv) {
                free.solver.c_str(), free.cost, free.terminal_attitude_error, bounded.solver.c_str(),
                bounded.cost, at_bound, limited.problem.steps + 1, over,
                bounded.terminal_attitude_error);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string scenes = argc > 1 ? argv[1] : "scenes";
+  const std::string out = argc > 2 ? argv[2] : "docs/results";
+  FILE* md = std::fopen((out + "/effects.md").c_str(), "w");
+  if (!md) return std::fprintf(stderr, "cannot write %s/effects.md\n", out.c_str()), 1;
+  const Scene leo = loadScene(scenes + "/leo_slew.yaml");
+  writeIntro(md);
+  writeIntegratorCost(md, leo.problem);
+  writeLeoMisses(md, leo.problem, scenes);
+  writeTorqueLimits(md, scenes);
   std::fclose(md);
   std::printf("wrote %s/effects.md\n", out.c_str());
   return 0;

@@ -206,16 +206,9 @@ HsOutcome solveHermiteSimpson(const PlanningProblem& problem, double tol, int pr
 }
 #endif
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr,
-                 "usage: frontier_study OUT.json SCENE.yaml... [--repeats K] [--max-steps N] "
-                 "[--max-hs-steps N] [--time-limit S] [--ipopt-tol TOL]\n");
-    return 2;
-  }
-  const std::string out_path = argv[1];
+/// The command line: the output, the scenes and the study's limits.
+struct FrontierArgs {
+  std::string out_path;
   std::vector<std::string> scenes;
   int repeats = 3;
   int max_steps = 32768;
@@ -225,31 +218,226 @@ int main(int argc, char** argv) {
   int ipopt_print = 0;  // --ipopt-print LEVEL: IPOPT's own log and timing statistics (diagnosis)
   SolverOptions ours;   // --tolerance TOL: ours' Newton tolerance (default SolverOptions, 1e-10)
   std::string only;     // --only METHOD: run one method (diagnosis)
+};
+
+FrontierArgs parseArguments(int argc, char** argv) {
+  FrontierArgs args;
+  args.out_path = argv[1];
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--repeats" && i + 1 < argc) {
-      repeats = std::max(1, std::atoi(argv[++i]));
+      args.repeats = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--max-steps" && i + 1 < argc) {
-      max_steps = std::atoi(argv[++i]);
+      args.max_steps = std::atoi(argv[++i]);
     } else if (a == "--max-hs-steps" && i + 1 < argc) {
-      max_hs_steps = std::atoi(argv[++i]);
+      args.max_hs_steps = std::atoi(argv[++i]);
     } else if (a == "--time-limit" && i + 1 < argc) {
-      time_limit = std::atof(argv[++i]);
+      args.time_limit = std::atof(argv[++i]);
     } else if (a == "--ipopt-tol" && i + 1 < argc) {
-      ipopt_tol = std::atof(argv[++i]);
+      args.ipopt_tol = std::atof(argv[++i]);
     } else if (a == "--ipopt-print" && i + 1 < argc) {
-      ipopt_print = std::atoi(argv[++i]);
+      args.ipopt_print = std::atoi(argv[++i]);
     } else if (a == "--tolerance" && i + 1 < argc) {
-      ours.tolerance = std::atof(argv[++i]);
+      args.ours.tolerance = std::atof(argv[++i]);
     } else if (a == "--only" && i + 1 < argc) {
-      only = argv[++i];
+      args.only = argv[++i];
     } else {
-      scenes.push_back(a);
+      args.scenes.push_back(a);
     }
   }
-  FILE* out = std::fopen(out_path.c_str(), "w");
+  return args;
+}
+
+/// A scene's continuous reference and its largest torque (the errors' scale).
+struct SceneReference {
+  ContinuousReference ref;
+  double tau_max = 0.0;
+};
+
+SceneReference referenceOf(const PlanningProblem& problem) {
+  SceneReference out{solveContinuousReference(problem), 0.0};
+  std::vector<double> dense(4001);
+  for (size_t i = 0; i < dense.size(); ++i)
+    dense[i] = problem.duration * static_cast<double>(i) / (dense.size() - 1);
+  for (const ContinuousState& s : out.ref.sample(dense))
+    out.tau_max = std::max(out.tau_max, s.torque().norm());
+  return out;
+}
+
+/// Ours in one scheme at N = 8, 16, ... until a solve takes longer than the time limit or the
+/// errors reach 1e-8: one JSON run per N.
+void runOurs(FILE* out, const PlanningProblem& problem, const SceneReference& reference,
+             SchemeKind scheme, const FrontierArgs& args) {
+  const std::string name = schemeName(scheme);
+  const ContinuousReference& ref = reference.ref;
+  bool first_run = true;
+  for (int N = 8; N <= args.max_steps; N *= 2) {
+    PlanningProblem at_N = problem;
+    at_N.scheme = scheme;
+    at_N.steps = N;
+    std::vector<double> times;
+    PlanResult plan;
+    for (int r = 0; r < args.repeats; ++r) {
+      plan = planManeuver(at_N, args.ours);
+      times.push_back(plan.solve_time_s);
+    }
+    const Maneuver& m = plan.maneuver;
+    const int first = schemeHasEndTorques(scheme) ? 0 : 1;
+    const int last = schemeHasEndTorques(scheme) ? N : N - 1;
+    std::vector<double> t;
+    std::vector<Vector3> tau;
+    for (int k = first; k <= last; ++k) t.push_back(m.time[k]), tau.push_back(m.torque[k]);
+    double worst = 0.0;
+    const double torque_error = torqueError(ref, t, tau, &worst) / reference.tau_max;
+    const double attitude_error = attitudeError(ref, problem.duration, m.attitude);
+    const double effort_error = std::abs(plan.effort - ref.cost) / ref.cost;
+    const double time = median(times);
+    std::fprintf(out,
+                 "   %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, \"times_s\": %s, "
+                 "\"iterations\": %d, \"effort\": %.17g, \"torque_error\": %.6e, "
+                 "\"effort_error\": %.6e, \"worst_node_time\": %.6g, "
+                 "\"attitude_error\": %.6e}",
+                 first_run ? "" : ",\n", N, plan.converged() ? "true" : "false", time,
+                 timesJson(times).c_str(), plan.iterations, plan.effort, torque_error, effort_error,
+                 worst, attitude_error);
+    first_run = false;
+    std::fprintf(stderr, "  %s N=%d %.3g ms torque %.3e effort %.3e%s\n", name.c_str(), N,
+                 1e3 * time, torque_error, effort_error,
+                 plan.converged() ? "" : " (NOT CONVERGED)");
+    std::fflush(out);
+    if (time > args.time_limit || (torque_error < 1e-8 && effort_error < 1e-8)) break;
+  }
+}
+
+#ifdef AP_HAVE_IPOPT
+/// What a Hermite–Simpson solution is measured by against the reference.
+struct HsErrors {
+  double torque_error = NAN, midpoint_error = NAN, effort_error = NAN, effort = NAN;
+  double norm_drift = NAN, worst = NAN, attitude_error = NAN;
+};
+
+HsErrors hsErrors(const peers::HermiteSimpsonTranscription& tr, const std::vector<double>& x,
+                  const PlanningProblem& problem, const SceneReference& reference) {
+  HsErrors e;
+  if (x.empty()) return e;
+  const ContinuousReference& ref = reference.ref;
+  const std::vector<Vector3> all = tr.torques(x.data());
+  std::vector<double> t_nodes, t_mid;
+  std::vector<Vector3> tau_nodes, tau_mid;
+  e.norm_drift = 0.0;
+  for (int p = 0; p < tr.points(); ++p) {
+    (p % 2 ? t_mid : t_nodes).push_back(tr.time(p));
+    (p % 2 ? tau_mid : tau_nodes).push_back(all[p]);
+    e.norm_drift =
+        std::max(e.norm_drift,
+                 std::abs(Eigen::Map<const Eigen::Vector4d>(x.data() + tr.qIndex(p)).norm() - 1));
+  }
+  e.torque_error = torqueError(ref, t_nodes, tau_nodes, &e.worst) / reference.tau_max;
+  std::vector<Matrix3> nodes;
+  for (int p = 0; p < tr.points(); p += 2)
+    nodes.push_back(so3::matrixFromQuaternion<double>(
+        Eigen::Vector4d(Eigen::Map<const Eigen::Vector4d>(x.data() + tr.qIndex(p)))));
+  e.attitude_error = attitudeError(ref, problem.duration, nodes);
+  e.midpoint_error = torqueError(ref, t_mid, tau_mid) / reference.tau_max;
+  e.effort = tr.objective(x.data());
+  e.effort_error = std::abs(e.effort - ref.cost) / ref.cost;
+  return e;
+}
+
+/// The peer: IPOPT on Hermite–Simpson collocation, N mesh intervals (2N + 1 points), at N = 4,
+/// 6, 8, 12, ... until a solve takes longer than the time limit or the errors reach 1e-8.
+void runIpoptHermiteSimpson(FILE* out, const PlanningProblem& problem,
+                            const SceneReference& reference, const FrontierArgs& args) {
+  bool first_run = true;
+  std::vector<int> grid;
+  for (int N = 4; N <= args.max_hs_steps; N *= 2) {
+    grid.push_back(N);
+    if (N * 3 / 2 <= args.max_hs_steps) grid.push_back(N * 3 / 2);
+  }
+  for (int N : grid) {
+    PlanningProblem at_N = problem;
+    at_N.steps = N;
+    std::vector<double> times;
+    HsOutcome hs;
+    for (int r = 0; r < args.repeats; ++r) {
+      hs = solveHermiteSimpson(at_N, args.ipopt_tol, args.ipopt_print);
+      times.push_back(hs.time_s);
+    }
+    const peers::HermiteSimpsonTranscription tr(at_N);
+    const HsErrors e = hsErrors(tr, hs.x, problem, reference);
+    const double time = median(times);
+    std::fprintf(out,
+                 "   %s{\"N\": %d, \"converged\": %s, \"ipopt_status\": %d, \"solve_time_s\": "
+                 "%.6g, \"times_s\": %s, \"iterations\": %d, \"variables\": %d, "
+                 "\"constraints\": %d, \"effort\": %.17g, \"torque_error\": %.6e, "
+                 "\"torque_error_midpoints\": %.6e, \"effort_error\": %.6e, "
+                 "\"quaternion_norm_drift\": %.3e, \"worst_node_time\": %.6g, "
+                 "\"attitude_error\": %.6e}",
+                 first_run ? "" : ",\n", N, hs.ok ? "true" : "false", hs.status, time,
+                 timesJson(times).c_str(), hs.iterations, tr.variables(), tr.constraints(),
+                 e.effort, e.torque_error, e.midpoint_error, e.effort_error, e.norm_drift, e.worst,
+                 e.attitude_error);
+    first_run = false;
+    std::fprintf(
+        stderr,
+        "  ipopt_hs N=%d %.3g ms (%d it, status %d) torque %.3e (worst at t=%.4g) mid %.3e "
+        "effort %.3e\n",
+        N, 1e3 * time, hs.iterations, hs.status, e.torque_error, e.worst, e.midpoint_error,
+        e.effort_error);
+    std::fflush(out);
+    if (time > args.time_limit || (e.torque_error < 1e-8 && e.effort_error < 1e-8)) break;
+  }
+}
+#endif
+
+/// One scene's JSON case: its reference, ours in every scheme of the name table (a scheme added
+/// there is picked up here) and the IPOPT peer.
+void runScene(FILE* out, const std::string& path, bool first_case, const FrontierArgs& args) {
+  const Scene scene = loadScene(path);
+  const PlanningProblem problem = scene.problem;
+  const SceneReference reference = referenceOf(problem);
+  const ContinuousReference& ref = reference.ref;
+  std::fprintf(stderr, "%s: reference %s, cost %.15g, max |tau| %.6g\n", path.c_str(),
+               ref.message.c_str(), ref.cost, reference.tau_max);
+  std::fprintf(out,
+               "%s{\"scene\": \"%s\", \"duration\": %.17g, \"reference\": {\"converged\": %s, "
+               "\"cost\": %.17g, \"max_torque\": %.17g, \"max_defect\": %.3e},\n \"methods\": [\n",
+               first_case ? "" : ",\n", sceneName(path).c_str(), problem.duration,
+               ref.converged ? "true" : "false", ref.cost, reference.tau_max, ref.max_defect);
+  bool first_method = true;
+  for (const auto& entry : kSchemeNames) {
+    const std::string name = schemeName(entry.value);
+    if (!args.only.empty() && args.only != name) continue;
+    std::fprintf(out, "%s  {\"method\": \"%s\", \"family\": \"ours\", \"runs\": [\n",
+                 first_method ? "" : ",\n", name.c_str());
+    first_method = false;
+    runOurs(out, problem, reference, entry.value, args);
+    std::fprintf(out, "\n  ]}");
+  }
+#ifdef AP_HAVE_IPOPT
+  if (args.only.empty() || args.only == "ipopt_hs") {
+    std::fprintf(out, "%s  {\"method\": \"ipopt_hs\", \"family\": \"peer\", \"runs\": [\n",
+                 first_method ? "" : ",\n");
+    runIpoptHermiteSimpson(out, problem, reference, args);
+    std::fprintf(out, "\n  ]}");
+  }
+#endif
+  std::fprintf(out, "\n ]}");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr,
+                 "usage: frontier_study OUT.json SCENE.yaml... [--repeats K] [--max-steps N] "
+                 "[--max-hs-steps N] [--time-limit S] [--ipopt-tol TOL]\n");
+    return 2;
+  }
+  const FrontierArgs args = parseArguments(argc, argv);
+  FILE* out = std::fopen(args.out_path.c_str(), "w");
   if (!out) {
-    std::fprintf(stderr, "frontier_study: cannot write %s\n", out_path.c_str());
+    std::fprintf(stderr, "frontier_study: cannot write %s\n", args.out_path.c_str());
     return 1;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -261,148 +449,12 @@ int main(int argc, char** argv) {
   std::fprintf(out,
                "{\n\"load_average_start\": \"%s\",\n\"repeats\": %d,\n\"ipopt_version\": \"%s\",\n"
                "\"ipopt_tol\": %g,\n\"tolerance\": %g,\n\"cases\": [\n",
-               loadAverage().c_str(), repeats, ipopt_version, ipopt_tol, ours.tolerance);
+               loadAverage().c_str(), args.repeats, ipopt_version, args.ipopt_tol,
+               args.ours.tolerance);
   bool first_case = true;
-  for (const std::string& path : scenes) {
-    const Scene scene = loadScene(path);
-    PlanningProblem problem = scene.problem;
-    const ContinuousReference ref = solveContinuousReference(problem);
-    std::vector<double> dense(4001);
-    for (size_t i = 0; i < dense.size(); ++i)
-      dense[i] = problem.duration * static_cast<double>(i) / (dense.size() - 1);
-    double tau_max = 0.0;
-    for (const ContinuousState& s : ref.sample(dense))
-      tau_max = std::max(tau_max, s.torque().norm());
-    std::fprintf(stderr, "%s: reference %s, cost %.15g, max |tau| %.6g\n", path.c_str(),
-                 ref.message.c_str(), ref.cost, tau_max);
-    std::fprintf(
-        out,
-        "%s{\"scene\": \"%s\", \"duration\": %.17g, \"reference\": {\"converged\": %s, "
-        "\"cost\": %.17g, \"max_torque\": %.17g, \"max_defect\": %.3e},\n \"methods\": [\n",
-        first_case ? "" : ",\n", sceneName(path).c_str(), problem.duration,
-        ref.converged ? "true" : "false", ref.cost, tau_max, ref.max_defect);
+  for (const std::string& path : args.scenes) {
+    runScene(out, path, first_case, args);
     first_case = false;
-    bool first_method = true;
-    // Ours: every scheme of the name table (a scheme added there is picked up here).
-    for (const auto& entry : kSchemeNames) {
-      const SchemeKind scheme = entry.value;
-      const std::string name = schemeName(scheme);
-      if (!only.empty() && only != name) continue;
-      std::fprintf(out, "%s  {\"method\": \"%s\", \"family\": \"ours\", \"runs\": [\n",
-                   first_method ? "" : ",\n", name.c_str());
-      first_method = false;
-      bool first_run = true;
-      for (int N = 8; N <= max_steps; N *= 2) {
-        PlanningProblem at_N = problem;
-        at_N.scheme = scheme;
-        at_N.steps = N;
-        std::vector<double> times;
-        PlanResult plan;
-        for (int r = 0; r < repeats; ++r) {
-          plan = planManeuver(at_N, ours);
-          times.push_back(plan.solve_time_s);
-        }
-        const Maneuver& m = plan.maneuver;
-        const int first = schemeHasEndTorques(scheme) ? 0 : 1;
-        const int last = schemeHasEndTorques(scheme) ? N : N - 1;
-        std::vector<double> t;
-        std::vector<Vector3> tau;
-        for (int k = first; k <= last; ++k) t.push_back(m.time[k]), tau.push_back(m.torque[k]);
-        double worst = 0.0;
-        const double torque_error = torqueError(ref, t, tau, &worst) / tau_max;
-        const double attitude_error = attitudeError(ref, problem.duration, m.attitude);
-        const double effort_error = std::abs(plan.effort - ref.cost) / ref.cost;
-        const double time = median(times);
-        std::fprintf(out,
-                     "   %s{\"N\": %d, \"converged\": %s, \"solve_time_s\": %.6g, \"times_s\": %s, "
-                     "\"iterations\": %d, \"effort\": %.17g, \"torque_error\": %.6e, "
-                     "\"effort_error\": %.6e, \"worst_node_time\": %.6g, "
-                     "\"attitude_error\": %.6e}",
-                     first_run ? "" : ",\n", N, plan.converged() ? "true" : "false", time,
-                     timesJson(times).c_str(), plan.iterations, plan.effort, torque_error,
-                     effort_error, worst, attitude_error);
-        first_run = false;
-        std::fprintf(stderr, "  %s N=%d %.3g ms torque %.3e effort %.3e%s\n", name.c_str(), N,
-                     1e3 * time, torque_error, effort_error,
-                     plan.converged() ? "" : " (NOT CONVERGED)");
-        std::fflush(out);
-        if (time > time_limit || (torque_error < 1e-8 && effort_error < 1e-8)) break;
-      }
-      std::fprintf(out, "\n  ]}");
-    }
-#ifdef AP_HAVE_IPOPT
-    // The peer: IPOPT on Hermite–Simpson collocation, N mesh intervals (2N + 1 points).
-    if (!only.empty() && only != "ipopt_hs") {
-      std::fprintf(out, "\n ]}");
-      continue;
-    }
-    std::fprintf(out, "%s  {\"method\": \"ipopt_hs\", \"family\": \"peer\", \"runs\": [\n",
-                 first_method ? "" : ",\n");
-    bool first_run = true;
-    std::vector<int> grid;
-    for (int N = 4; N <= max_hs_steps; N *= 2) {
-      grid.push_back(N);
-      if (N * 3 / 2 <= max_hs_steps) grid.push_back(N * 3 / 2);
-    }
-    for (int N : grid) {
-      PlanningProblem at_N = problem;
-      at_N.steps = N;
-      std::vector<double> times;
-      HsOutcome hs;
-      for (int r = 0; r < repeats; ++r) {
-        hs = solveHermiteSimpson(at_N, ipopt_tol, ipopt_print);
-        times.push_back(hs.time_s);
-      }
-      const peers::HermiteSimpsonTranscription tr(at_N);
-      double torque_error = NAN, midpoint_error = NAN, effort_error = NAN, effort = NAN;
-      double norm_drift = NAN, worst = NAN, attitude_error = NAN;
-      if (!hs.x.empty()) {
-        const std::vector<Vector3> all = tr.torques(hs.x.data());
-        std::vector<double> t_nodes, t_mid;
-        std::vector<Vector3> tau_nodes, tau_mid;
-        norm_drift = 0.0;
-        for (int p = 0; p < tr.points(); ++p) {
-          (p % 2 ? t_mid : t_nodes).push_back(tr.time(p));
-          (p % 2 ? tau_mid : tau_nodes).push_back(all[p]);
-          norm_drift = std::max(
-              norm_drift,
-              std::abs(Eigen::Map<const Eigen::Vector4d>(hs.x.data() + tr.qIndex(p)).norm() - 1));
-        }
-        torque_error = torqueError(ref, t_nodes, tau_nodes, &worst) / tau_max;
-        std::vector<Matrix3> nodes;
-        for (int p = 0; p < tr.points(); p += 2)
-          nodes.push_back(so3::matrixFromQuaternion<double>(
-              Eigen::Vector4d(Eigen::Map<const Eigen::Vector4d>(hs.x.data() + tr.qIndex(p)))));
-        attitude_error = attitudeError(ref, problem.duration, nodes);
-        midpoint_error = torqueError(ref, t_mid, tau_mid) / tau_max;
-        effort = tr.objective(hs.x.data());
-        effort_error = std::abs(effort - ref.cost) / ref.cost;
-      }
-      const double time = median(times);
-      std::fprintf(out,
-                   "   %s{\"N\": %d, \"converged\": %s, \"ipopt_status\": %d, \"solve_time_s\": "
-                   "%.6g, \"times_s\": %s, \"iterations\": %d, \"variables\": %d, "
-                   "\"constraints\": %d, \"effort\": %.17g, \"torque_error\": %.6e, "
-                   "\"torque_error_midpoints\": %.6e, \"effort_error\": %.6e, "
-                   "\"quaternion_norm_drift\": %.3e, \"worst_node_time\": %.6g, "
-                   "\"attitude_error\": %.6e}",
-                   first_run ? "" : ",\n", N, hs.ok ? "true" : "false", hs.status, time,
-                   timesJson(times).c_str(), hs.iterations, tr.variables(), tr.constraints(),
-                   effort, torque_error, midpoint_error, effort_error, norm_drift, worst,
-                   attitude_error);
-      first_run = false;
-      std::fprintf(
-          stderr,
-          "  ipopt_hs N=%d %.3g ms (%d it, status %d) torque %.3e (worst at t=%.4g) mid %.3e "
-          "effort %.3e\n",
-          N, 1e3 * time, hs.iterations, hs.status, torque_error, worst, midpoint_error,
-          effort_error);
-      std::fflush(out);
-      if (time > time_limit || (torque_error < 1e-8 && effort_error < 1e-8)) break;
-    }
-    std::fprintf(out, "\n  ]}");
-#endif
-    std::fprintf(out, "\n ]}");
   }
   std::fprintf(out, "\n],\n\"load_average_end\": \"%s\",\n\"wall_time_s\": %.1f\n}\n",
                loadAverage().c_str(), seconds(start));

@@ -1,7 +1,7 @@
 // robustness_report: runs the hard-case catalog of issue 7 (robustness_cases.hpp) and the
-// hostile scene corpus, and writes docs/results/robustness.md with every measured figure. The figures
-// are those the tests assert (test_hard_cases, test_hostile_inputs); scripts/robustness calls
-// this with the request table written by test_ros_conversions and the last fuzz summary.
+// hostile scene corpus, and writes docs/results/robustness.md with every measured figure. The
+// figures are those the tests assert (test_hard_cases, test_hostile_inputs); scripts/robustness
+// calls this with the request table written by test_ros_conversions and the last fuzz summary.
 //
 //   robustness_report [--all] [--case NAME]... [--hostile DIR] [--requests FILE] [--fuzz FILE]
 //                     [--random FILE] (the randomized suite's section, benchmark_solvers)
@@ -119,12 +119,16 @@ void writeCase(std::ostream& out, const rb::HardCase& c, const rb::CaseOutcome& 
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The command line: which cases and which extra sections.
+struct ReportArgs {
   bool all = false;
   std::vector<std::string> only;
   std::string hostile, requests, fuzz, random_suite, notes, out_path;
+};
+
+/// Parses the arguments; exits with status 2 on a usage error.
+ReportArgs parseArguments(int argc, char** argv) {
+  ReportArgs args;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto next = [&]() -> std::string {
@@ -135,58 +139,68 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--all") {
-      all = true;
+      args.all = true;
     } else if (a == "--case") {
-      only.push_back(next());
+      args.only.push_back(next());
     } else if (a == "--hostile") {
-      hostile = next();
+      args.hostile = next();
     } else if (a == "--requests") {
-      requests = next();
+      args.requests = next();
     } else if (a == "--fuzz") {
-      fuzz = next();
+      args.fuzz = next();
     } else if (a == "--random") {
-      random_suite = next();
+      args.random_suite = next();
     } else if (a == "--notes") {
-      notes = next();
+      args.notes = next();
     } else if (a == "--out") {
-      out_path = next();
+      args.out_path = next();
     } else {
       std::cerr << "usage: robustness_report [--all] [--case NAME]... [--hostile DIR] "
                    "[--requests FILE] [--fuzz FILE] [--random FILE] [--notes FILE] [--out FILE]\n";
-      return 2;
+      std::exit(2);
     }
   }
-  std::ostringstream out;
-  const std::string load_start = loadAverage();
-  const auto start = std::chrono::steady_clock::now();
+  return args;
+}
 
-  std::ostringstream cases_md;
-  std::ostringstream summary;
-  summary << "| case | group | pass criterion | result | time [s] |\n|---|---|---|---|---|\n";
+/// The hard cases run: the summary table, each case's section, the counts and the wall time.
+struct HardCaseRun {
+  std::ostringstream summary, cases_md;
   int passed = 0, failed = 0, not_run = 0;
+  double total_s = 0.0;
+};
+
+void runHardCases(const ReportArgs& args, HardCaseRun* run) {
+  const auto start = std::chrono::steady_clock::now();
+  run->summary << "| case | group | pass criterion | result | time [s] |\n|---|---|---|---|---|\n";
   for (const rb::HardCase& c : rb::hardCases()) {
-    if (!only.empty() && std::find(only.begin(), only.end(), c.name) == only.end()) continue;
-    if (c.slow && !all) {
-      ++not_run;
-      summary << "| " << c.name << " | " << c.group << " | " << cell(c.criterion)
-              << " | not run here (slow: `scripts/robustness --all`) | |\n";
+    if (!args.only.empty() &&
+        std::find(args.only.begin(), args.only.end(), c.name) == args.only.end())
+      continue;
+    if (c.slow && !args.all) {
+      ++run->not_run;
+      run->summary << "| " << c.name << " | " << c.group << " | " << cell(c.criterion)
+                   << " | not run here (slow: `scripts/robustness --all`) | |\n";
       continue;
     }
     std::cerr << "robustness_report: " << c.name << " ...\n";
     const rb::CaseOutcome o = rb::runCase(c);
-    (o.passed() ? passed : failed) += 1;
-    summary << "| " << c.name << " | " << c.group << " | " << cell(c.criterion) << " | "
-            << (o.passed() ? "pass" : "**FAIL**") << " | " << g(o.time_s, "%.2f") << " |\n";
-    writeCase(cases_md, c, o);
+    (o.passed() ? run->passed : run->failed) += 1;
+    run->summary << "| " << c.name << " | " << c.group << " | " << cell(c.criterion) << " | "
+                 << (o.passed() ? "pass" : "**FAIL**") << " | " << g(o.time_s, "%.2f") << " |\n";
+    writeCase(run->cases_md, c, o);
   }
-  const double total =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run->total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
+/// The page's heading, how it was made, and the hard-case section.
+void writeHardCases(std::ostream& out, const ReportArgs& args, const HardCaseRun& run,
+                    const std::string& load_start) {
   char date[64];
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
   out << "# Robustness: hard cases and hostile input (issue 7)\n\n"
-      << "Generated by `scripts/robustness" << (all ? " --all" : "")
+      << "Generated by `scripts/robustness" << (args.all ? " --all" : "")
       << "` (tool `robustness_report`) on " << date << "; do not edit by hand. The same catalog "
       << "(`test/support/robustness_cases.cpp`) is asserted by `test/unit/test_hard_cases.cpp` in "
          "`scripts/test` (slow cases under `scripts/test --all`); the bad-input tables by "
@@ -194,76 +208,90 @@ int main(int argc, char** argv) {
          "behaviour by the rostests `test_planner_service` and `test_planner_action`.\n\n"
       << "Machine: " << std::thread::hardware_concurrency()
       << " cores shared with other builds; load average (1/5/15 min) " << load_start
-      << " at the start, " << loadAverage() << " at the end; the cases took " << g(total, "%.1f")
-      << " s. Times are wall times and vary ±50 % with the load.\n\n";
-  out << "## Hard cases\n\n" << passed << " passed, " << failed << " failed";
-  if (not_run) out << ", " << not_run << " slow case(s) not run in this report";
+      << " at the start, " << loadAverage() << " at the end; the cases took "
+      << g(run.total_s, "%.1f") << " s. Times are wall times and vary ±50 % with the load.\n\n";
+  out << "## Hard cases\n\n" << run.passed << " passed, " << run.failed << " failed";
+  if (run.not_run) out << ", " << run.not_run << " slow case(s) not run in this report";
   out << ". Every run is also checked for: converged, no NaN/Inf in R_k, Ω_k, τ_k, terminal "
          "attitude and velocity errors ≤ 1e-9 (unless the case states otherwise) and finite "
          "residuals (max residual = relative first-order residual; Newton decrement = relative "
          "torque accuracy of the last step; dynamics residual = worst implicit-step residual of "
          "the replay [N m s]).\n\n"
-      << summary.str() << "\n"
-      << cases_md.str();
+      << run.summary.str() << "\n"
+      << run.cases_md.str();
+}
 
-  if (!hostile.empty()) {
-    std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(hostile)) {
-      if (e.path().extension() == ".yaml") files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    out << "## Bad input: scene files and the command line\n\n"
-        << "Each file of `test/hostile/scenes/` (" << files.size()
-        << " files) is one bad scene; `plan_maneuver FILE` exits with status 1 and prints "
-           "`plan_maneuver: invalid input: ` and the message below (checked by "
-           "`test_hostile_inputs`, which also checks that the message contains the file's "
-           "`# expect:` text). Command-line flags with bad values (`--tolerance -1e-3`, "
-           "`--time-budget -5`, `--extra-revolutions -1`, `--direction sideways`, `--tolerance "
-           "nan`) keep the documented usage-error status 2 and name the value.\n\n"
-        << "| file | what is wrong | message |\n|---|---|---|\n";
-    for (const fs::path& f : files) {
-      const std::string text = readFile(f.string());
-      std::string message = "(accepted!)";
-      try {
-        ap::loadScene(f.string());
-      } catch (const ap::InvalidInput& e) {
-        message = e.what();
-      } catch (const std::exception& e) {
-        message = std::string("UNEXPECTED ") + e.what();
-      }
-      std::string what = f.stem().string();
-      std::replace(what.begin(), what.end(), '_', ' ');
-      const std::string dir = f.parent_path().string() + "/";
-      if (message.rfind(dir, 0) == 0) message = message.substr(dir.size());
-      out << "| `" << f.filename().string() << "` | " << what << " | `" << cell(message) << "` |\n";
-    }
-    out << "\n";
+/// Every bad scene file of `dir` with the message loading it gives.
+void writeHostileScenes(std::ostream& out, const std::string& dir_path) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir_path)) {
+    if (e.path().extension() == ".yaml") files.push_back(e.path());
   }
-  if (!requests.empty()) {
-    out << "## Bad input: service and action requests\n\n"
-        << "Each row is a seed request (`plan_attitude_maneuver`) with one field spoiled, run "
-           "through the node's request path (`planRequest`: conversion, validation, solve) by "
-           "`test_ros_conversions`; the rostests check the same through the live node, that it "
-           "answers the next request, and the action's ABORTED state. Error codes: -1 "
-           "INVALID_INPUT, -5 STEP_TOO_LARGE (msg/PlanErrorCode.msg).\n\n"
-        << "| request | error code | message |\n|---|---|---|\n"
-        << readFile(requests) << "\n";
+  std::sort(files.begin(), files.end());
+  out << "## Bad input: scene files and the command line\n\n"
+      << "Each file of `test/hostile/scenes/` (" << files.size()
+      << " files) is one bad scene; `plan_maneuver FILE` exits with status 1 and prints "
+         "`plan_maneuver: invalid input: ` and the message below (checked by "
+         "`test_hostile_inputs`, which also checks that the message contains the file's "
+         "`# expect:` text). Command-line flags with bad values (`--tolerance -1e-3`, "
+         "`--time-budget -5`, `--extra-revolutions -1`, `--direction sideways`, `--tolerance "
+         "nan`) keep the documented usage-error status 2 and name the value.\n\n"
+      << "| file | what is wrong | message |\n|---|---|---|\n";
+  for (const fs::path& f : files) {
+    std::string message = "(accepted!)";
+    try {
+      ap::loadScene(f.string());
+    } catch (const ap::InvalidInput& e) {
+      message = e.what();
+    } catch (const std::exception& e) {
+      message = std::string("UNEXPECTED ") + e.what();
+    }
+    std::string what = f.stem().string();
+    std::replace(what.begin(), what.end(), '_', ' ');
+    const std::string dir = f.parent_path().string() + "/";
+    if (message.rfind(dir, 0) == 0) message = message.substr(dir.size());
+    out << "| `" << f.filename().string() << "` | " << what << " | `" << cell(message) << "` |\n";
   }
-  if (!fuzz.empty()) out << readFile(fuzz) << "\n";
-  if (!random_suite.empty()) out << readFile(random_suite) << "\n";
-  if (!notes.empty()) out << readFile(notes) << "\n";
+  out << "\n";
+}
 
-  if (out_path.empty()) {
+/// The table of spoiled requests (written by test_ros_conversions to `path`).
+void writeBadRequests(std::ostream& out, const std::string& path) {
+  out << "## Bad input: service and action requests\n\n"
+      << "Each row is a seed request (`plan_attitude_maneuver`) with one field spoiled, run "
+         "through the node's request path (`planRequest`: conversion, validation, solve) by "
+         "`test_ros_conversions`; the rostests check the same through the live node, that it "
+         "answers the next request, and the action's ABORTED state. Error codes: -1 "
+         "INVALID_INPUT, -5 STEP_TOO_LARGE (msg/PlanErrorCode.msg).\n\n"
+      << "| request | error code | message |\n|---|---|---|\n"
+      << readFile(path) << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const ReportArgs args = parseArguments(argc, argv);
+  std::ostringstream out;
+  const std::string load_start = loadAverage();
+  HardCaseRun run;
+  runHardCases(args, &run);
+  writeHardCases(out, args, run, load_start);
+  if (!args.hostile.empty()) writeHostileScenes(out, args.hostile);
+  if (!args.requests.empty()) writeBadRequests(out, args.requests);
+  if (!args.fuzz.empty()) out << readFile(args.fuzz) << "\n";
+  if (!args.random_suite.empty()) out << readFile(args.random_suite) << "\n";
+  if (!args.notes.empty()) out << readFile(args.notes) << "\n";
+  if (args.out_path.empty()) {
     std::cout << out.str();
   } else {
-    std::ofstream file(out_path);
+    std::ofstream file(args.out_path);
     file << out.str();
     if (!file) {
-      std::cerr << "robustness_report: cannot write " << out_path << "\n";
+      std::cerr << "robustness_report: cannot write " << args.out_path << "\n";
       return 1;
     }
   }
-  std::cerr << "robustness_report: " << passed << " passed, " << failed << " failed, " << not_run
-            << " not run\n";
-  return failed == 0 ? 0 : 1;
+  std::cerr << "robustness_report: " << run.passed << " passed, " << run.failed << " failed, "
+            << run.not_run << " not run\n";
+  return run.failed == 0 ? 0 : 1;
 }

@@ -365,7 +365,7 @@ TEST(RosConversions, DefaultsFillEmptyFields) {
   SolverOptions options;
   const PlanningProblem p = rc::problemFromRequest(seedRequest(), d, &options);
   EXPECT_EQ(p.scheme, SchemeKind::Variational);
-  EXPECT_EQ(options.solver, SolverKind::Newton);
+  EXPECT_EQ(options.solver, SolverKind::Structured);
   EXPECT_EQ(options.tolerance, 1e-7);
   EXPECT_EQ(options.max_iterations, 17);
   EXPECT_EQ(options.time_budget_s, 3.0);

@@ -323,10 +323,10 @@ TEST(DriftTwoInputPlanner, SameExtremalWhateverTheOutputSamplingForEveryDriftSce
 }
 
 TEST(DriftTwoInputPlanner, WorkedExampleReturnsTheCheapestExtremalFoundAndReportsTheOthers) {
-  // The worked example (scenes/drift_two_input.yaml). Before issue 19 the planner returned the
-  // extremal of cost 4.02383 at N ≤ 100 and one of cost 158.3 at N ≥ 400; it now starts from
-  // the symmetric problem's extremals and returns the cheaper one of cost 3.75294, and reports
-  // 4.02383 among the others.
+  // The worked example (scenes/drift_two_input.yaml) has extremals of cost 4.02383 (from the
+  // guess alone at N ≤ 100) and 158.3 (at N ≥ 400); started from the symmetric problem's
+  // extremals too, the planner returns the cheaper one of cost 3.75294 and reports 4.02383
+  // among the others.
   DriftTwoInputRequest rq = exampleRequest();
   rq.initial_costate.reset();
   const DriftTwoInputPlan plan = planDriftTwoInput(rq);

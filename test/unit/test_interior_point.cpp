@@ -530,25 +530,24 @@ TEST(InteriorPoint, TightTorqueNormAroundAKeepOutConeIsNotCalledInfeasible) {
   expectAgreesWithNlopt(p, 1e-8, true);
 }
 
-// Torque plus rate limits at N = 8192 (grid continuation from N = 128), answered "infeasible"
-// once main's Levenberg–Marquardt Newton (09a6d91) gave the levels other starts: the N = 8192
-// level's free-slack retry was feasible but kept its barrier for 180 full steps, its decrement
-// stuck at the round-off floor (2.5e-5) above the barrier problem's test (10 μ), until the
-// iteration limit.
+// Torque plus rate limits at N = 8192 (grid continuation from N = 128): a level whose iterate is
+// feasible can keep its barrier for many full steps with its decrement stuck at the round-off
+// floor (2.5e-5 here) above the barrier problem's test (10 μ) until the iteration limit; that is
+// the solver stopping, not a certificate, and must not be answered "infeasible".
 TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 8192);
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.11)};
   const ap::PlanResult r = plan(p, "newton");
   EXPECT_TRUE(r.converged()) << r.message;
   EXPECT_LE(r.max_constraint_violation, 1e-9);
-  // Before 09a6d91 it converged at 787.54698 (this answer lies 1e-4 above; a point at the
-  // round-off floor or a neighbouring local optimum).
+  // 1e-3 relative: other starts of the coarse levels reach 787.54698 or a point 1e-4 above it
+  // (at the round-off floor, or a neighbouring local optimum).
   EXPECT_NEAR(r.cost, 787.547, 1e-3 * 787.547);
 }
 
-// N = 10⁵ with torque and rate limits (issue 16's target case, ~8 s): converges since the Newton
-// system is formed and factored in double-double (before, in long double and double, its finest
-// level stopped: the line search failed on wrong directions, docs/notes/constraints_notes.md). The
+// N = 10⁵ with torque and rate limits (~8 s): converges because the Newton system is formed and
+// factored in double-double (in long double or double its finest level stops: the line search
+// fails on directions spoiled by round-off, docs/notes/constraints_notes.md). The
 // plan meets every node constraint, checked from its own attitudes and torques, satisfies the
 // discrete equations step by step and the first-order conditions.
 TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5Converge) {
@@ -688,8 +687,8 @@ TEST(InteriorPoint, LevelsAccountForEveryIteration) {
 TEST(InteriorPoint, PredictorCorrectorReachesIpoptsOptimumAtN2048) {
   // Up to N = 8192 every level is solved in the free-slack form with Mehrotra's predictor–
   // corrector. Its barrier floor (μ ≥ 0.01 (N/1024)² d² f/m) keeps μ from outrunning the iterate:
-  // without it torque_limited at N = 2048 stopped 2.4e-7 above the optimum (and the former
-  // elastic-first solver 2.6e-9 above). IPOPT's optimum of the same discrete problem (exact
+  // without it torque_limited at N = 2048 stops 2.4e-7 above the optimum (and the elastic form
+  // solved first stops 2.6e-9 above). IPOPT's optimum of the same discrete problem (exact
   // Hessian, tol 1e-12; docs/results/constraints.md): 133.097692032.
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
   ASSERT_TRUE(r.converged()) << r.message;

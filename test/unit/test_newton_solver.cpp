@@ -300,17 +300,16 @@ TEST(NewtonSolver, IterationsConvergeQuadratically) {
   EXPECT_LT(e2, 1e-2 * e1);
 }
 
-// Moved to the hard-case catalog of issue 7 (test/support/robustness_cases.cpp, asserted by
-// test_hard_cases): the zero maneuver (ZeroManeuverIsExactlyZero), the choice at exactly π
+// In the hard-case catalog (test/support/robustness_cases.cpp, asserted by test_hard_cases): the
+// zero maneuver (ZeroManeuverIsExactlyZero), the choice at exactly π
 // (CutLocusAboutX/CutLocusAboutDiagonal), the long way and extra revolutions
 // (BeyondPiShortWayLongWayExtraTurns) and the spinning ends (SpinningEnds).
 
 TEST(NewtonSolver, StalledFastRatesConvergeByContinuationInTheRates) {
-  // Issue 19: seed-like inertia, 3.9 and 4 rad/s at the ends over 64.7 s, variational (random
-  // suite case #1). From the Hermite guess Newton stops at the iteration limit; from rest to
-  // rest, with the boundary rates raised in stages, it converges. (Case #22, this test's case
-  // before the Levenberg–Marquardt control of the shift, now converges directly.) A cheaper
-  // extremal from one of the more starts may be kept; `extremal` then names this path.
+  // Seed-like inertia, 3.9 and 4 rad/s at the ends over 64.7 s, variational (random suite case
+  // #1). From the Hermite guess Newton stops at the iteration limit; from rest to rest, with the
+  // boundary rates raised in stages, it converges. A cheaper extremal from one of the more
+  // starts may be kept; `extremal` then names this path.
   const PlanningProblem p = robustness::randomCase(19, 1).problem;
   const PlanResult r = planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;

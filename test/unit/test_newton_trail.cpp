@@ -8,7 +8,10 @@
 #include <atomic>
 #include <cmath>
 #include <future>
+#include <map>
+#include <optional>
 #include <thread>
+#include <tuple>
 
 #include "attitude_planner/planner.hpp"
 #include "planning/strategies/grid_continuation.hpp"
@@ -252,4 +255,156 @@ TEST(GridContinuation, LevelsRunCoarsestFirstAndHandOnTheirIterates) {
   // A level that helps not: no coarser level at all.
   rule.level_helps = [](const PlanningProblem&) { return false; };
   EXPECT_EQ(gridLevels(p, rule).size(), 1u);
+}
+
+namespace {
+
+/// A stand-in level solver: each level ends as `ends` says for its N (converged otherwise) after
+/// 3 iterations and hands on {N}; `seen` records (N, whether it started from a coarse iterate,
+/// whether it only replayed).
+struct StandIn {
+  std::map<int, Termination> ends;
+  std::vector<std::tuple<int, bool, bool>> seen;
+
+  LevelSolver<std::vector<int>> solver() {
+    return [this](const LevelRequest<std::vector<int>>& r, std::vector<int>* out) {
+      seen.emplace_back(r.problem.steps, r.coarse != nullptr, r.replay_only);
+      if (out) *out = {r.problem.steps};
+      PlanResult result;
+      const auto end = ends.find(r.problem.steps);
+      result.termination = end == ends.end() ? Termination::Converged : end->second;
+      result.iterations = r.replay_only ? 0 : 3;
+      result.message = "N = " + std::to_string(r.problem.steps);
+      result.levels.push_back({r.problem.steps, result.iterations, result.termination, 0, 0, ""});
+      return result;
+    };
+  }
+};
+
+}  // namespace
+
+// The interior point's rule: levels 4× coarser only above its coarsest grid (N = 8192: 128, 512,
+// 2048, 8192; at or below the coarsest grid no coarser level).
+TEST(GridContinuation, ALevelAtOrBelowDirectUpToHasNoCoarserLevel) {
+  GridLevelRule rule;
+  rule.direct_up_to = 256;
+  std::vector<int> steps;
+  for (const PlanningProblem& l : gridLevels(restToRest(1.0, 8192), rule)) steps.push_back(l.steps);
+  EXPECT_EQ(steps, (std::vector<int>{128, 512, 2048, 8192}));
+  EXPECT_EQ(gridLevels(restToRest(1.0, 256), rule).size(), 1u);
+  EXPECT_EQ(gridLevels(restToRest(1.0, 300), rule).front().steps, 75);
+}
+
+// A level that ends infeasible under infeasible_ends answers for the finer ones: they replay its
+// iterate without iterating and the answer is infeasible; the record keeps every level's own end
+// for the caller's verdict (a coarser converged level).
+TEST(GridContinuation, AnInfeasibleLevelEndsTheContinuationWhenTheRuleSaysSo) {
+  SolverOptions options;
+  SolveContext context(options);
+  GridLevelRule rule;
+  rule.infeasible_ends = true;
+  StandIn stand_in;
+  stand_in.ends[64] = Termination::Infeasible;
+  ContinuationRecord seen_record;
+  const PlanResult r = solveByGridContinuation<std::vector<int>>(
+      restToRest(1.0, 1024), context, rule, 1e-10, stand_in.solver(),
+      [&](const ContinuationRecord& record, PlanResult*) { seen_record = record; });
+  using Seen = std::tuple<int, bool, bool>;
+  EXPECT_EQ(stand_in.seen,
+            (std::vector<Seen>{
+                {16, false, false}, {64, true, false}, {256, true, true}, {1024, true, true}}));
+  EXPECT_EQ(r.termination, Termination::Infeasible);
+  EXPECT_EQ(r.iterations, 6);
+  ASSERT_TRUE(seen_record.stop.has_value());
+  EXPECT_EQ(seen_record.stop->termination, Termination::Infeasible);
+  EXPECT_EQ(seen_record.stop->level.steps, 64);
+  EXPECT_EQ(seen_record.stopped_at, 1u);
+  EXPECT_EQ(seen_record.levels[0].termination, Termination::Converged);
+  ASSERT_EQ(r.levels.size(), 4u);
+  EXPECT_EQ(r.levels.back().termination, Termination::Infeasible);
+  // Without the rule the next level starts afresh (no coarse iterate) and iterates.
+  StandIn afresh;
+  afresh.ends[64] = Termination::Infeasible;
+  const PlanResult a = solveByGridContinuation<std::vector<int>>(
+      restToRest(1.0, 1024), context, GridLevelRule{}, 1e-10, afresh.solver());
+  EXPECT_EQ(afresh.seen[2], (Seen{256, false, false}));
+  EXPECT_TRUE(a.converged());
+  EXPECT_EQ(a.iterations, 12);
+}
+
+// Resumed from a level the caller solved, the continuation solves only the finer levels, the
+// first from that level's iterate; with unconverged_ends a coarse level that does not converge
+// ends it there (the result is that level's, not a plan on the requested grid).
+TEST(GridContinuation, AResumedContinuationStartsFromTheGivenLevelAndStopsWhereALevelFails) {
+  SolverOptions options;
+  SolveContext context(options);
+  GridLevelRule rule;
+  const std::vector<PlanningProblem> levels = gridLevels(restToRest(1.0, 1024), rule);
+  ASSERT_EQ(levels.size(), 4u);  // 16, 64, 256, 1024
+  SolvedLevel<std::vector<int>> from;
+  from.index = 1;
+  from.iterate = {64};
+  from.below = {16};
+  from.below_converged = true;
+  StandIn stand_in;
+  const LevelSolver<std::vector<int>> inner = stand_in.solver();
+  const LevelSolver<std::vector<int>> solve = [&](const LevelRequest<std::vector<int>>& r,
+                                                  std::vector<int>* out) {
+    if (r.problem.steps == 256) {
+      EXPECT_EQ(r.coarse != nullptr ? r.coarse->back() : 0, 64);
+      EXPECT_EQ(r.coarser != nullptr ? r.coarser->back() : 0, 16);  // extrapolation
+    }
+    return inner(r, out);
+  };
+  std::size_t reached = 0;
+  const ContinuationFinish finish = [&](const ContinuationRecord& record, PlanResult*) {
+    reached = record.reached;
+  };
+  const PlanResult r = resumeGridContinuation(levels, from, context, rule, 1e-10, solve, finish);
+  using Seen = std::tuple<int, bool, bool>;
+  EXPECT_EQ(stand_in.seen, (std::vector<Seen>{{256, true, false}, {1024, true, false}}));
+  EXPECT_TRUE(r.converged());
+  EXPECT_EQ(r.iterations, 6);
+  EXPECT_EQ(reached, 4u);
+
+  rule.unconverged_ends = true;
+  StandIn failing;
+  failing.ends[256] = Termination::NotConverged;
+  const PlanResult f =
+      resumeGridContinuation(levels, from, context, rule, 1e-10, failing.solver(), finish);
+  EXPECT_EQ(failing.seen, (std::vector<Seen>{{256, true, false}}));
+  EXPECT_EQ(f.termination, Termination::NotConverged);
+  EXPECT_EQ(reached, 3u);  // the requested level not reached
+}
+
+// A cancel before a level: that level and the finer ones replay the last iterate (no
+// iterations), the answer is Cancelled and the record names the level it stopped on.
+TEST(GridContinuation, ACancelCarriesTheLastIterateUpWithoutIterating) {
+  std::atomic<bool> cancel{false};
+  SolverOptions options;
+  options.cancel_requested = &cancel;
+  SolveContext context(options);
+  StandIn stand_in;
+  const LevelSolver<std::vector<int>> inner = stand_in.solver();
+  const LevelSolver<std::vector<int>> solve = [&](const LevelRequest<std::vector<int>>& r,
+                                                  std::vector<int>* out) {
+    PlanResult result = inner(r, out);
+    if (r.problem.steps == 64) cancel = true;  // after this level
+    return result;
+  };
+  std::optional<ContinuationStop> stop;
+  const PlanResult r = solveByGridContinuation<std::vector<int>>(
+      restToRest(1.0, 1024), context, GridLevelRule{}, 1e-10, solve,
+      [&](const ContinuationRecord& record, PlanResult*) { stop = record.stop; });
+  using Seen = std::tuple<int, bool, bool>;
+  EXPECT_EQ(stand_in.seen,
+            (std::vector<Seen>{
+                {16, false, false}, {64, true, false}, {256, true, true}, {1024, true, true}}));
+  EXPECT_EQ(r.termination, Termination::Cancelled);
+  EXPECT_EQ(r.iterations, 6);
+  ASSERT_TRUE(stop.has_value());
+  EXPECT_EQ(stop->termination, Termination::Cancelled);
+  EXPECT_EQ(stop->level.steps, 64);
+  ASSERT_EQ(r.levels.size(), 4u);
+  EXPECT_EQ(r.levels.back().termination, Termination::Cancelled);
 }

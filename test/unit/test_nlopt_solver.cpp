@@ -4,6 +4,7 @@
 
 #include <Eigen/QR>
 #include <algorithm>
+#include <memory>
 #include <random>
 
 #include "attitude_planner/io/scene.hpp"
@@ -207,7 +208,7 @@ TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
   const SeedCase sc = GetParam();
   const ap::PlanningProblem p = seedProblem(sc.scene, sc.steps, sc.scheme);
   ap::SolverOptions newton_options;
-  newton_options.solver = ap::SolverKind::Newton;
+  newton_options.solver = ap::SolverKind::Structured;
   const ap::PlanResult newton = ap::planManeuver(p, newton_options);
   ap::SolverOptions nlopt_options;
   nlopt_options.solver = ap::SolverKind::Nlopt;
@@ -250,6 +251,23 @@ TEST(NloptSolver, RefusesHorizonsTooLongForADenseSolverWithAReason) {
   } catch (const ap::InvalidInput& e) {
     EXPECT_EQ(e.field(), "steps") << e.what();
     EXPECT_NE(std::string(e.what()).find("5000 > 1024"), std::string::npos) << e.what();
+  }
+}
+
+// Effects are refused the same way (the cross-check's Jacobians have no effect torques): invalid
+// input naming `solver`, not a solve that failed to converge.
+TEST(NloptSolver, RefusesEffectsAsInvalidInputNamingTheSolver) {
+  ap::PlanningProblem p = seedProblem("rest_to_rest.yaml", 16, ap::SchemeKind::Paper);
+  auto effects = std::make_shared<ap::EffectModel>();
+  effects->add(std::make_unique<ap::GravityGradient>(3.986004418e14, 7.0e6, p.inertia));
+  p.effects = effects;
+  ap::SolverOptions options;
+  options.solver = ap::SolverKind::Nlopt;
+  try {
+    ap::planManeuver(p, options);
+    ADD_FAILURE() << "effects with nlopt were not refused";
+  } catch (const ap::InvalidInput& e) {
+    EXPECT_EQ(e.field(), "solver") << e.what();
   }
 }
 

@@ -452,7 +452,7 @@ TEST(ReducedProblem, StepsOfATorqueFreeMotionToItsOwnEndAreKeptExactly) {
     p.final_attitude = coast.attitude.back();
     p.final_velocity = coast.angular_velocity.back();
     ReducedProblem rp(p);
-    ReducedProblem::Steps guess(p.steps);
+    ReducedProblem::StepVectors guess(p.steps);
     for (int j = 0; j < p.steps; ++j) {
       guess[j] = so3::log(Matrix3(coast.attitude[j].transpose() * coast.attitude[j + 1]));
     }
@@ -470,6 +470,6 @@ TEST(ReducedProblem, StepsOfATorqueFreeMotionToItsOwnEndAreKeptExactly) {
     rp.initializeFromSteps(guess);
     const std::vector<Matrix3> R = rp.attitudes(rp.current());
     EXPECT_LE(so3::angleBetween(R.back(), p.final_attitude), 1e-12) << schemeName(scheme);
-    EXPECT_THROW(rp.initializeFromSteps(ReducedProblem::Steps(3)), InvalidInput);
+    EXPECT_THROW(rp.initializeFromSteps(ReducedProblem::StepVectors(3)), InvalidInput);
   }
 }

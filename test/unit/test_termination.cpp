@@ -106,7 +106,7 @@ TEST(Termination, StepTooLargeIsItsOwnStatusOrException) {
 }
 
 TEST(Report, TextSummaryKeepsEveryFieldWhateverTheMessageLength) {
-  // Defect 1 of issue 15: a 1,024-byte buffer cut the summary after `message`.
+  // A message longer than any fixed buffer (5000 bytes) must not cut the fields after it.
   const PlanningProblem p = seedRestToRest(128);
   PlanResult r;
   r.message = std::string(5000, 'x');
@@ -139,8 +139,8 @@ TEST(Report, JsonSummaryCarriesTheTerminationAndTheLevels) {
 }
 
 TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
-  // Defect 1 as the user met it: at N = 65536 with one iteration per level the message is long
-  // and the summary used to stop after it.
+  // The same through the tool: at N = 65536 with one iteration per level the message is long,
+  // and every field after it must still be printed.
   const attitude_planner_test::ToolRun r = attitude_planner_test::runTool(
       "plan_maneuver",
       std::string(AP_SOURCE_DIR) + "/scenes/rest_to_rest.yaml --steps 65536 --max-iterations 1",

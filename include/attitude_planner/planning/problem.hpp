@@ -50,13 +50,18 @@ inline RotationDirection parseDirection(const std::string& text, const std::stri
 
 /// Which solver plans the maneuver.
 enum class SolverKind {
-  Newton,  ///< ours: Newton on the optimality conditions, O(N) per iteration
-  Nlopt,   ///< NLopt SLSQP: the independent cross-check (and the bounded-torque solver)
+  /// The package's own structured solvers, O(N) per iteration: trust-region Newton on the
+  /// optimality conditions, and the interior point when node constraints are in force (named
+  /// "newton" for users: CLI, srv field, JSON).
+  Structured,
+  Nlopt,  ///< NLopt SLSQP: the independent cross-check (and the bounded-torque solver)
+  /// For downstream code written against this name.
+  Newton [[deprecated("use SolverKind::Structured")]] = Structured,
 };
 
 /// The names of the solvers (--solver, request field `solver`, ~solver, JSON `solver`).
 inline constexpr NamedValue<SolverKind> kSolverNames[] = {
-    {SolverKind::Newton, "newton"},
+    {SolverKind::Structured, "newton"},
     {SolverKind::Nlopt, "nlopt"},
 };
 
@@ -186,7 +191,7 @@ struct IterationInfo {
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.
 struct SolverOptions {
-  SolverKind solver = SolverKind::Newton;
+  SolverKind solver = SolverKind::Structured;
   double tolerance = 1e-10;  ///< relative torque accuracy (Newton decrement / |τ|₂)
   /// Newton: per grid level (coarse levels start the fine one) and start; the coasting start of a
   /// spinning solve (after the others stalled, or as one of the more starts of a slow one) may

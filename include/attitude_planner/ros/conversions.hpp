@@ -124,7 +124,7 @@ Maneuver decimatedManeuver(const Maneuver& maneuver, int max_nodes);
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
   SchemeKind scheme = SchemeKind::Paper;
-  SolverKind solver = SolverKind::Newton;
+  SolverKind solver = SolverKind::Structured;
   /// N of a request that leaves `steps` at 0 (both services): the seed's example resolution.
   int steps = 128;
   double tolerance = 1e-10;   ///< optimality tolerance (scaled residual)

@@ -357,12 +357,11 @@ void setTermination(const Outcome& o, PlanResult* result) {
 }  // namespace
 
 PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& options) {
-  if (problem.effects && !problem.effects->empty()) {
-    PlanResult refused;
-    refused.message =
-        "solver nlopt: planning with effects is implemented in the newton solver only (its "
-        "constraint Jacobians do not include effect torques); use --solver newton";
-    return refused;
+  if (problem.effects && !problem.effects->empty()) {  // a refusal of the request, as below
+    throw InvalidInput("solver",
+                       "nlopt: planning with effects is implemented in the newton solver only "
+                       "(its constraint Jacobians do not include effect torques); use --solver "
+                       "newton");
   }
   const int N = problem.steps;
   if (N > kMaxNloptSteps) {  // a refusal of the request, not a solve that failed to converge

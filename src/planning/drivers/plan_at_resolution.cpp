@@ -174,7 +174,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   PlanResult result;
   if (problem.scheme == SchemeKind::FourthOrder) {
     result = planFourthOrder(problem, options, start);
-  } else if (options.solver == SolverKind::Newton && problem.hasNodeConstraints() &&
+  } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.warm_start && !options.constrained_from_warm_start && !guess_resampled) {
     // A plan of this N given as the initial guess (e.g. the remainder of the plan being flown):
     // the interior point from it directly, its multipliers re-derived; if that stops, from it
@@ -192,10 +192,10 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
       result.message += "; after the start from the initial guess stopped: " + first.message;
     }
-  } else if (options.solver == SolverKind::Newton && problem.hasNodeConstraints() &&
+  } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {
     result = solveWithInteriorPoint(problem, options);
-  } else if (options.solver == SolverKind::Newton && problem.hasNodeConstraints()) {
+  } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
     // The unconstrained optimum first (fast path): if it meets every node constraint it is the
     // constrained optimum too; otherwise it starts the interior-point solver.
     result = solveWithNewton(problem, options);
@@ -227,12 +227,12 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     } else {
       result.message += "; constraints inactive at the unconstrained optimum";
     }
-  } else if (options.solver == SolverKind::Newton) {
+  } else if (options.solver == SolverKind::Structured) {
     result = solveWithNewton(problem, options);
   } else {
     result = solveWithNlopt(problem, options);
   }
-  if (options.solver == SolverKind::Newton && schemeIsDiscretization(problem.scheme) &&
+  if (options.solver == SolverKind::Structured && schemeIsDiscretization(problem.scheme) &&
       result.maneuver.steps() == problem.steps) {
     // The Newton and interior-point plans are their own trajectories; their open-loop replay
     // (replay_miss, the terminal errors) is measured once, here, for the plan returned.

@@ -102,7 +102,8 @@ std::vector<ConstraintGroup*> ConstrainedSystem::groupsOf(StageQuantity quantity
 
 /// The stage quantity q of group g's instance k (scalar quantities in q(0)) at `steps`, from the
 /// torques `tau` and (cones) the attitudes `R`, each formed once for all groups.
-Vector3 ConstrainedSystem::quantityAt(const ConstraintGroup& g, const ReducedProblem::Steps& steps,
+Vector3 ConstrainedSystem::quantityAt(const ConstraintGroup& g,
+                                      const ReducedProblem::StepVectors& steps,
                                       const std::vector<Vector3>& tau,
                                       const std::vector<Matrix3>& R, int k) const {
   switch (g.constraint->quantity()) {
@@ -120,7 +121,7 @@ Vector3 ConstrainedSystem::quantityAt(const ConstraintGroup& g, const ReducedPro
   return Vector3::Zero();
 }
 
-void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
+void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const std::vector<Vector3> tau = np_.torques(steps);
   std::vector<Matrix3> R;
@@ -133,7 +134,7 @@ void ConstrainedSystem::evaluateValues(const ReducedProblem::Steps& steps,
   if (torques_out) *torques_out = tau;
 }
 
-double ConstrainedSystem::merit(const ReducedProblem::Steps& steps, double mu, double rho,
+double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double mu, double rho,
                                 double* cost, double slack_alpha) {
   std::vector<Vector3> tau;
   evaluateValues(steps, &tau);
@@ -315,7 +316,7 @@ void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
 /// q, ∇q, ∇²q of a step rate (angularRateTerms, on δ_k, δ_{k+1}) or a pointing cosine
 /// (pointingTerms, on δ_k) at instance k (node_constraints.hpp).
 ScalarQuantityTerms ConstrainedSystem::scalarQuantityTerms(const ConstraintGroup& g,
-                                                           const ReducedProblem::Steps& steps,
+                                                           const ReducedProblem::StepVectors& steps,
                                                            const std::vector<Matrix3>& R,
                                                            int k) const {
   ScalarQuantityTerms out;
@@ -340,7 +341,7 @@ ScalarQuantityTerms ConstrainedSystem::scalarQuantityTerms(const ConstraintGroup
 template <typename Scalar>
 void ConstrainedSystem::assembleNodeConstraints(double mu, double rho, bool primal,
                                                 BandedSymmetric<Scalar>* H) {
-  const ReducedProblem::Steps& steps = np_.current();
+  const ReducedProblem::StepVectors& steps = np_.current();
   std::vector<Matrix3> R;
   for (ConstraintGroup& g : groups_) {
     const StageQuantity quantity = g.constraint->quantity();
@@ -381,7 +382,7 @@ void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
 
 /// J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2: the node velocity of a scheme with end
 /// torques.
-Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::Steps& steps, int k) const {
+Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::StepVectors& steps, int k) const {
   const DiscreteScheme& scheme = np_.scheme();
   const Vector3 Pi =
       0.5 * (scheme.momentumOfStep(steps[k]) +

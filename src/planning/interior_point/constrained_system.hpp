@@ -75,9 +75,9 @@ class ConstrainedSystem {
   void setInterruption(const Interruption* interruption) { interruption_ = interruption; }
 
   /// Constraint values at `steps` into each instance's c (gradients not formed).
-  void evaluateValues(const ReducedProblem::Steps& steps, std::vector<Vector3>* torques_out);
+  void evaluateValues(const ReducedProblem::StepVectors& steps, std::vector<Vector3>* torques_out);
   /// φ_μ = f + Σ ψ_μ(c_i) at `steps` (and f in *cost); FreeSlacks at s + slack_alpha ds.
-  double merit(const ReducedProblem::Steps& steps, double mu, double rho, double* cost,
+  double merit(const ReducedProblem::StepVectors& steps, double mu, double rho, double* cost,
                double slack_alpha = 0.0);
   /// The constraints' part of the merit at the current values c: Elastic Σ ψ_μ(c_i) (ρ the
   /// penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν) at s = s + α ds.
@@ -155,11 +155,11 @@ class ConstrainedSystem {
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
-  Vector3 nodeVelocity(const ReducedProblem::Steps& steps, int k) const;
+  Vector3 nodeVelocity(const ReducedProblem::StepVectors& steps, int k) const;
   ScalarQuantityTerms scalarQuantityTerms(const ConstraintGroup& g,
-                                          const ReducedProblem::Steps& steps,
+                                          const ReducedProblem::StepVectors& steps,
                                           const std::vector<Matrix3>& R, int k) const;
-  Vector3 quantityAt(const ConstraintGroup& g, const ReducedProblem::Steps& steps,
+  Vector3 quantityAt(const ConstraintGroup& g, const ReducedProblem::StepVectors& steps,
                      const std::vector<Vector3>& tau, const std::vector<Matrix3>& R, int k) const;
 
   const PlanningProblem& problem_;

@@ -121,7 +121,7 @@ class FreeTimeSolver {
   /// Calls f(group, k, c) for every instance's value c at `steps` (torques and, with cones, the
   /// attitudes formed once).
   template <typename F>
-  void forEachValue(const ReducedProblem::Steps& steps, F&& f) const {
+  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f) const {
     const std::vector<Vector3> tau = np_.torques(steps);
     std::vector<Matrix3> R;
     for (const FreeTimeGroup& g : groups_) {
@@ -144,7 +144,8 @@ class FreeTimeSolver {
 
   /// q = ½|Ω|² of step k (paper, variational: the scheme's velocity of F_k) or of node k (schemes
   /// with end torques: J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀμ(F_{k−1}))/2) at the current h.
-  double halfSquaredRate(StageQuantity quantity, const ReducedProblem::Steps& steps, int k) const {
+  double halfSquaredRate(StageQuantity quantity, const ReducedProblem::StepVectors& steps,
+                         int k) const {
     const DiscreteScheme& scheme = np_.scheme();
     if (quantity == StageQuantity::StepRate) {
       return 0.5 * scheme.velocity(so3::exp(steps[k])).squaredNorm();
@@ -156,7 +157,7 @@ class FreeTimeSolver {
   }
 
   /// The smallest value of the constraints that move with h (time_dependent) or of the others.
-  double smallestValue(const ReducedProblem::Steps& steps, bool time_dependent) const {
+  double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
     double smallest = std::numeric_limits<double>::infinity();
     forEachValue(steps, [&](const FreeTimeGroup& g, int, double c) {
       if (quantityDependsOnTimeStep(g.constraint->quantity()) == time_dependent) {
@@ -197,7 +198,8 @@ class FreeTimeSolver {
                 const Eigen::Matrix<double, 10, 1>& lagrangian);
   bool solveStep(Eigen::VectorXd* d);
   bool lineSearch(const Eigen::VectorXd& d, double mu, double epsilon, double* alpha);
-  void moveTo(double h, const ReducedProblem::Steps& steps, const Eigen::VectorXd* d, double alpha);
+  void moveTo(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd* d,
+              double alpha);
   double localDot(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
@@ -441,8 +443,8 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
   return false;
 }
 
-void FreeTimeSolver::moveTo(double h, const ReducedProblem::Steps& steps, const Eigen::VectorXd* d,
-                            double alpha) {
+void FreeTimeSolver::moveTo(double h, const ReducedProblem::StepVectors& steps,
+                            const Eigen::VectorXd* d, double alpha) {
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
   np_.setCurrent(steps);
@@ -454,7 +456,7 @@ void FreeTimeSolver::moveTo(double h, const ReducedProblem::Steps& steps, const 
 bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsilon,
                                 double* alpha) {
   const double h = np_.timeStep();
-  const ReducedProblem::Steps steps = np_.current();
+  const ReducedProblem::StepVectors steps = np_.current();
   const double phi0 = merit(mu, epsilon, false);
   const double slope = -d.dot(rhs_);  // ∇φ_μᵀ d < 0
   double a = 1.0;

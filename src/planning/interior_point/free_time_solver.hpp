@@ -18,8 +18,8 @@ namespace attitude_planner {
 struct FreeTimeOutcome {
   Termination termination = Termination::NotConverged;
   std::string message;
-  ReducedProblem::Steps steps;   ///< the iterate's steps (every iterate meets the constraints)
-  double time_step = 0.0;        ///< h at the end
+  ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
+  double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)
   double duration = 0.0;         ///< T = N h
   int iterations = 0;

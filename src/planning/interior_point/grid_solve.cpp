@@ -168,7 +168,7 @@ class GridSolve {
       return end(Termination::NotConverged, "Newton system could not be made positive definite");
     }
     const StopTest test = stoppingTest(direction);
-    ReducedProblem::Steps trial;
+    ReducedProblem::StepVectors trial;
     double alpha = 0.0;
     if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test);
     accept(trial, alpha);
@@ -309,7 +309,7 @@ class GridSolve {
 
   /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step; a predicted
   /// decrease below φ's round-off is taken. False if no step length was accepted.
-  bool lineSearch(const Direction& d, const StopTest& t, ReducedProblem::Steps* trial,
+  bool lineSearch(const Direction& d, const StopTest& t, ReducedProblem::StepVectors* trial,
                   double* alpha) {
     const double penalty = free_slacks_ ? nu_ : rho_;
     const double phi = system_.assembledMerit(d.cost, mu_, penalty);
@@ -348,7 +348,7 @@ class GridSolve {
 
   /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
   /// dual step), the iterate; relaxes the shift floor.
-  void accept(const ReducedProblem::Steps& trial, double alpha) {
+  void accept(const ReducedProblem::StepVectors& trial, double alpha) {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
     } else {
@@ -521,8 +521,9 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
 
 }  // namespace
 
-GridOutcome carryToGrid(const PlanningProblem& problem, const ReducedProblem::Steps& coarse_steps,
-                        Termination termination, const std::string& message) {
+GridOutcome carryToGrid(const PlanningProblem& problem,
+                        const ReducedProblem::StepVectors& coarse_steps, Termination termination,
+                        const std::string& message) {
   GridOutcome out;
   PlanResult& result = out.result;
   result.solver = "interior_point";

@@ -17,7 +17,7 @@ struct GridRequest {
   BarrierRule barrier = BarrierRule::Mehrotra;
   /// A coarser grid's solution to start from (with a small initial barrier); null: from
   /// options.warm_start (the unconstrained optimum), else the geodesic.
-  const ReducedProblem::Steps* coarse_steps = nullptr;
+  const ReducedProblem::StepVectors* coarse_steps = nullptr;
   /// The coarser grid's multipliers and slacks (free slacks with Mehrotra only); null: none.
   const LevelDuals* coarse_duals = nullptr;
   /// A solve stopped (cancelled, out of time) on this grid still evaluates its plan; false on a
@@ -28,7 +28,7 @@ struct GridRequest {
 /// What one grid solve leaves: its result, its iterate and (free slacks) its duals.
 struct GridOutcome {
   PlanResult result;
-  ReducedProblem::Steps steps;
+  ReducedProblem::StepVectors steps;
   LevelDuals duals;
   Formulation formulation = Formulation::FreeSlacks;  ///< of the solve whose result this is
 };
@@ -51,7 +51,8 @@ GridOutcome solveOnGrid(const PlanningProblem& problem, const SolverOptions& opt
 /// A coarser level's iterate carried to the requested grid without iterating (a solve stopped
 /// on a coarse level: cancelled or out of time), evaluated as a plan, with `termination` and
 /// `message` (StepTooLarge if the boundary data admit no step at this N).
-GridOutcome carryToGrid(const PlanningProblem& problem, const ReducedProblem::Steps& coarse_steps,
-                        Termination termination, const std::string& message);
+GridOutcome carryToGrid(const PlanningProblem& problem,
+                        const ReducedProblem::StepVectors& coarse_steps, Termination termination,
+                        const std::string& message);
 
 }  // namespace attitude_planner

@@ -162,8 +162,10 @@ struct InteriorPointParameters {
   double free_time_theta_mu = 1.3;
 
   // --- grids -----------------------------------------------------------------------------------
-  /// Above this N the constrained problem is first solved on 4× coarser grids (down to 16).
+  /// Above this N the constrained problem is first solved on coarser grids (down to 16 steps).
   int coarsest_grid = 256;
+  /// N of a level ÷ N of the next coarser one.
+  int coarsening_factor = 4;
 };
 
 }  // namespace attitude_planner

@@ -61,6 +61,7 @@
 
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/newton/newton_solver.hpp"
+#include "planning/strategies/grid_continuation.hpp"
 
 namespace attitude_planner {
 
@@ -100,11 +101,6 @@ void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
   levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
 }
 
-/// N of the grid a result was solved on (its last level).
-int levelSteps(const PlanResult& r) {
-  return r.levels.empty() ? r.maneuver.steps() : r.levels.back().steps;
-}
-
 bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
@@ -120,7 +116,7 @@ struct Solve {
 /// infeasibility certificate, else the first solve's reason; every solve's levels and
 /// iterations are kept.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
-                               const Solve& solve, const ReducedProblem::Steps* coarse_steps,
+                               const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true) {
   const FormulationRecipe& recipe =
       options.constrained_from_warm_start ? kProbeRecipe : kRequestRecipe;
@@ -156,14 +152,24 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
 
 namespace {
 
-/// The grid levels of a continuation, finest first: N, N/4, ... down to the coarsest above
-/// parameters.coarsest_grid (and at least 16 steps).
-std::vector<int> continuationLevels(int steps, const InteriorPointParameters& parameters) {
-  std::vector<int> levels{steps};
-  while (levels.back() / 4 >= 16 && levels.back() > parameters.coarsest_grid) {
-    levels.push_back(levels.back() / 4);
-  }
-  return levels;
+/// What a level of the interior point's continuation hands the next: its iterate, the
+/// formulation that reached it and, when it converged, its multipliers and slacks (free slacks).
+struct LevelIterate {
+  ReducedProblem::StepVectors steps;
+  LevelDuals duals;
+  Formulation formulation = Formulation::FreeSlacks;
+  bool empty() const { return steps.empty(); }
+};
+
+/// The interior point's levels: 4× coarser while above parameters.coarsest_grid, each solved to
+/// the request's tolerance; a level that ends infeasible answers for the finer ones.
+GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
+  GridLevelRule rule;
+  rule.coarsening_factor = parameters.coarsening_factor;
+  rule.direct_up_to = parameters.coarsest_grid;
+  rule.coarse_tolerance_floor = 0.0;
+  rule.infeasible_ends = true;
+  return rule;
 }
 
 /// The coarsest level starts from its own unconstrained optimum; Newton reaches it from the warm
@@ -182,23 +188,23 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
 }
 
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
-/// once more through the level in between. Replaces *direct (and *next) if that converges.
+/// once more through the level in between. Replaces *direct if that converges; adds every solve's
+/// iterations and levels to *total.
 void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options,
-                         const Solve& solve, const ReducedProblem::Steps& coarse,
-                         GridOutcome* direct, int* iterations,
-                         std::vector<LevelSummary>* solved_levels) {
+                         const Solve& solve, const ReducedProblem::StepVectors& coarse,
+                         GridOutcome* direct, PlanResult* total) {
   PlanningProblem half = at;
   half.steps = at.steps / 2;
   SolverOptions from_coarse = options;
   from_coarse.warm_start = nullptr;  // both start from the coarse steps
   const GridOutcome middle =
       solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr, /*final_grid=*/false);
-  *iterations += middle.result.iterations;
-  appendLevels(solved_levels, middle.result);
+  total->iterations += middle.result.iterations;
+  appendLevels(&total->levels, middle.result);
   if (!middle.result.converged()) return;
   GridOutcome fine = solveGridWithRetry(at, from_coarse, solve, &middle.steps, nullptr);
-  *iterations += fine.result.iterations;
-  appendLevels(solved_levels, fine.result);
+  total->iterations += fine.result.iterations;
+  appendLevels(&total->levels, fine.result);
   if (!fine.result.converged()) return;
   fine.result.message += "; reached through N = " + std::to_string(half.steps) +
                          " after the direct refinement stopped: " + direct->result.message;
@@ -207,83 +213,129 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   direct->formulation = fine.formulation;
 }
 
-/// The interior point on the requested grid, with grid continuation above
-/// parameters.coarsest_grid: each level starts from the coarser level's iterate and duals.
+/// Where a stopped continuation's answer comes from, for its message.
+std::string onLevel(const ContinuationStop& stop) {
+  return stop.level.message + " (on the N = " + std::to_string(stop.level.steps) +
+         " level of the grid continuation)";
+}
+
+/// A level after a stop. Cancelled or out of time: the finer levels are skipped and the last
+/// accepted iterate goes to the requested N at once. Infeasible: each finer level evaluates
+/// the carried iterate without iterating and reports the coarse level's certificate.
+GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& options,
+                        const Solve& solve, const LevelRequest<LevelIterate>& r) {
+  const ContinuationStop& stop = *r.stop;
+  if (ranOut(stop.termination)) {
+    GridOutcome carried;
+    if (r.coarse) carried.steps = r.coarse->steps;
+    if (r.coarse) carried.formulation = r.coarse->formulation;
+    if (!r.finest) return carried;  // handed on as it is
+    GridOutcome outcome = carryToGrid(r.problem, carried.steps, stop.termination, onLevel(stop));
+    outcome.formulation = carried.formulation;
+    return outcome;
+  }
+  SolverOptions level_options = options;
+  level_options.warm_start = nullptr;
+  level_options.max_iterations = 0;
+  PlanResult start;
+  Maneuver resampled;
+  if (!r.coarse) {
+    start = unconstrainedStart(problem, r.problem, options, &level_options, &resampled);
+    level_options.warm_start = start.converged() ? &start.maneuver : nullptr;
+  }
+  GridOutcome outcome = solveGridWithRetry(
+      r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
+  outcome.result.iterations += start.iterations;
+  std::vector<LevelSummary> levels = start.levels;
+  appendLevels(&levels, outcome.result);
+  outcome.result.levels = levels;
+  outcome.result.message = onLevel(stop);
+  return outcome;
+}
+
+/// One level of the continuation: from the coarser level's iterate and duals, else from its own
+/// unconstrained optimum; a 4× refinement that stops is tried once more through the level in
+/// between. The result carries every solve's iterations and levels.
+GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& options,
+                       const Solve& solve, const LevelRequest<LevelIterate>& r) {
+  if (r.replay_only) return replayLevel(problem, options, solve, r);
+  SolverOptions level_options = options;
+  level_options.warm_start = nullptr;
+  level_options.tolerance = r.tolerance;
+  PlanResult total;  // the levels and iterations of every solve on this level
+  Maneuver resampled;
+  PlanResult unconstrained;
+  if (!r.coarse) {
+    unconstrained = unconstrainedStart(problem, r.problem, options, &level_options, &resampled);
+    level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
+    total.iterations += unconstrained.iterations;
+    appendLevels(&total.levels, unconstrained);
+  }
+  const LevelDuals no_duals;
+  GridOutcome outcome =
+      solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
+                         r.coarse ? &r.coarse->duals : &no_duals, r.finest);
+  total.iterations += outcome.result.iterations;
+  appendLevels(&total.levels, outcome.result);
+  const LevelDuals direct_duals = outcome.duals;
+  if (!outcome.result.converged() && !ranOut(outcome.result.termination) && r.coarse &&
+      r.problem.steps % 2 == 0) {
+    refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome, &total);
+  }
+  outcome.duals = direct_duals;  // the direct solve's: a refinement's are not carried
+  outcome.result.iterations = total.iterations;
+  outcome.result.levels = std::move(total.levels);
+  return outcome;
+}
+
+/// A level's verdict is the continuation's, with one exception: a finer level that ends
+/// "infeasible" after a coarser grid met every constraint is its solver stopping (the ℓ1
+/// violation stalled at a local minimum), not a certificate about the request.
+void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
+  if (result->termination == Termination::Infeasible) {
+    const std::size_t last = record.stop ? record.stopped_at : record.levels.size() - 1;
+    int feasible_level = 0;  // the finest coarser level that met every constraint
+    for (std::size_t i = 0; i < last; ++i) {
+      if (record.levels[i].termination == Termination::Converged) {
+        feasible_level = record.levels[i].steps;
+      }
+    }
+    if (feasible_level > 0) {
+      result->termination = Termination::NotConverged;
+      result->message = "not converged: the N = " + std::to_string(feasible_level) +
+                        " level met every constraint, but a finer level stopped (" +
+                        result->message + ")";
+    }
+  }
+  result->message += "; grid continuation from N = " + std::to_string(record.levels.front().steps);
+}
+
+/// The interior point on the requested grid, through the grid continuation above
+/// parameters.coarsest_grid (strategies/grid_continuation.hpp).
 GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& options,
                            const Solve& solve) {
-  if (problem.steps <= solve.parameters.coarsest_grid) {
+  const GridLevelRule rule = interiorPointGridRule(solve.parameters);
+  if (!usesCoarserLevel(problem, rule)) {
     return solveGridWithRetry(problem, options, solve, nullptr, nullptr);
   }
-  const std::vector<int> levels = continuationLevels(problem.steps, solve.parameters);
-  ReducedProblem::Steps steps;  // the last level's iterate (empty: start the next from Newton)
-  LevelDuals duals;             // the last level's multipliers (free slacks), for the next one
-  int feasible_level = 0;       // the finest coarser level that met every constraint
-  int iterations = 0;
-  std::vector<LevelSummary> solved_levels;  // every solve of every level, in order
-  GridOutcome outcome;
-  bool stopped = false;  // cancelled, infeasible or out of time: the rest carry the iterate
-  for (auto level = levels.rbegin(); level != levels.rend(); ++level) {
-    PlanningProblem at = problem;
-    at.steps = *level;
-    if (stopped && ranOut(outcome.result.termination)) {
-      // Cancelled or out of time: the last accepted iterate goes to the requested N at once.
-      if (*level != problem.steps) continue;
-      const PlanResult coarse = outcome.result;
-      const Formulation formulation = outcome.formulation;
-      outcome = carryToGrid(at, steps, coarse.termination,
-                            coarse.message + " (on the N = " + std::to_string(levelSteps(coarse)) +
-                                " level of the grid continuation)");
-      outcome.formulation = formulation;
-      appendLevels(&solved_levels, outcome.result);
-      break;
+  Formulation finest = Formulation::FreeSlacks;
+  const LevelSolver<LevelIterate> level = [&](const LevelRequest<LevelIterate>& r,
+                                              LevelIterate* handed_on) {
+    GridOutcome outcome = solveLevel(problem, options, solve, r);
+    if (handed_on) {
+      const bool converged = outcome.result.converged();
+      *handed_on = {std::move(outcome.steps), converged ? std::move(outcome.duals) : LevelDuals{},
+                    outcome.formulation};
+    } else {
+      finest = outcome.formulation;
     }
-    SolverOptions level_options = options;
-    level_options.warm_start = nullptr;
-    if (stopped) level_options.max_iterations = 0;
-    Maneuver resampled;
-    PlanResult unconstrained;
-    if (steps.empty()) {
-      unconstrained = unconstrainedStart(problem, at, options, &level_options, &resampled);
-      level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
-      iterations += unconstrained.iterations;
-      appendLevels(&solved_levels, unconstrained);
-    }
-    const PlanResult coarse = outcome.result;
-    outcome = solveGridWithRetry(at, level_options, solve, steps.empty() ? nullptr : &steps, &duals,
-                                 *level == problem.steps);
-    iterations += outcome.result.iterations;
-    appendLevels(&solved_levels, outcome.result);
-    const LevelDuals direct_duals = outcome.duals;
-    if (!outcome.result.converged() && !ranOut(outcome.result.termination) && !stopped &&
-        !steps.empty() && *level % 2 == 0) {
-      refineThroughMiddle(at, options, solve, steps, &outcome, &iterations, &solved_levels);
-    }
-    if (stopped && coarse.termination == Termination::Infeasible) {
-      // Answered on a coarse level; the finer ones only carry its iterate to the requested N.
-      outcome.result.termination = coarse.termination;
-      outcome.result.message = coarse.message +
-                               " (on the N = " + std::to_string(levelSteps(coarse)) +
-                               " level of the grid continuation)";
-    }
-    const Termination t = outcome.result.termination;
-    stopped = stopped || ranOut(t) || t == Termination::Infeasible;
-    steps = outcome.result.converged() || stopped ? outcome.steps : ReducedProblem::Steps{};
-    duals = outcome.result.converged() ? direct_duals : LevelDuals{};
-    if (outcome.result.converged() && !stopped) feasible_level = *level;
-  }
-  PlanResult& result = outcome.result;
-  result.iterations = iterations;
-  result.levels = solved_levels;
-  if (result.termination == Termination::Infeasible && feasible_level > 0) {
-    // A coarser grid met every constraint: the finer level's "infeasible" is its solver stopping
-    // (the ℓ1 violation stalled at a local minimum), not a certificate about the request.
-    result.termination = Termination::NotConverged;
-    result.message = "not converged: the N = " + std::to_string(feasible_level) +
-                     " level met every constraint, but a finer level stopped (" + result.message +
-                     ")";
-  }
-  result.message += "; grid continuation from N = " + std::to_string(levels.back());
-  return outcome;
+    return std::move(outcome.result);
+  };
+  GridOutcome out;
+  out.result = solveByGridContinuation(problem, solve.context, rule, options.tolerance, level,
+                                       finishContinuation);
+  out.formulation = finest;
+  return out;
 }
 
 /// Where the interior point's iterate starts (for the trail).
@@ -397,7 +449,7 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   // requested grid directly, as a converged coarser level starts a finer one: its steps, its
   // multipliers re-derived from stationarity (the guess carries none) and a small barrier.
   LevelDuals duals;
-  ReducedProblem::Steps steps;
+  ReducedProblem::StepVectors steps;
   try {
     ReducedProblem np(problem);
     np.setInteriorFromAttitudes(options.warm_start->attitude);

@@ -294,7 +294,7 @@ class GridSolver {
     const double shift_scale = augmented_ ? augmentedShiftScale(np_) : hessian_.maxAbsDiagonal();
     step_length_ = 1.0;
     bool factored = false;
-    ReducedProblem::Steps trial;
+    ReducedProblem::StepVectors trial;
     for (int attempt = 0; attempt < p_.max_step_attempts; ++attempt) {
       factored = newtonStep(control_->shift(), shift_scale);
       if (!factored) {
@@ -393,7 +393,8 @@ std::optional<ReducedProblem> startedProblem(const PlanningProblem& problem, con
 
 PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
                        const GridSettings& settings, const GridStart& start,
-                       ReducedProblem::Steps* final_steps, const NewtonParameters& parameters) {
+                       ReducedProblem::StepVectors* final_steps,
+                       const NewtonParameters& parameters) {
   PlanResult result;
   std::optional<ReducedProblem> reduced = startedProblem(problem, start, &result);
   if (!reduced) return result;

@@ -25,8 +25,8 @@ struct GridSettings {
 /// one below it if given too).
 struct GridStart {
   const Maneuver* warm_start = nullptr;
-  const ReducedProblem::Steps* coarse = nullptr;
-  const ReducedProblem::Steps* coarser = nullptr;
+  const ReducedProblem::StepVectors* coarse = nullptr;
+  const ReducedProblem::StepVectors* coarser = nullptr;
 };
 
 /// Newton on `problem`'s grid. Iterations are reported through `context` (numbered across the
@@ -34,6 +34,7 @@ struct GridStart {
 /// (a coarse level) only the final iterate is produced, no plan figures.
 PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
                        const GridSettings& settings, const GridStart& start,
-                       ReducedProblem::Steps* final_steps, const NewtonParameters& parameters);
+                       ReducedProblem::StepVectors* final_steps,
+                       const NewtonParameters& parameters);
 
 }  // namespace attitude_planner

@@ -27,7 +27,7 @@ namespace attitude_planner {
 
 namespace {
 
-using Steps = ReducedProblem::Steps;
+using StepVectors = ReducedProblem::StepVectors;
 
 // --- Grid continuation for Newton ----------------------------------------------------------------
 
@@ -55,7 +55,8 @@ PlanResult solveThroughGrids(const PlanningProblem& problem, SolveContext& conte
                              const GridSettings& settings, const Maneuver* warm_start,
                              const NewtonParameters& p) {
   if (warm_start) return solveOnGrid(problem, context, settings, {warm_start}, nullptr, p);
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;
@@ -125,8 +126,8 @@ struct Surveyed {
   HomotopyClass homotopy;
   PlanResult result;  ///< on the survey grid; its cost is C at that N (NaN unless converged)
   bool on_requested_grid = false;  ///< the survey grid is the requested one: result is a plan
-  Steps steps;                     ///< the survey grid's final iterate (coarser survey grid)
-  Steps below;                     ///< the level below it, for extrapolation ...
+  StepVectors steps;               ///< the survey grid's final iterate (coarser survey grid)
+  StepVectors below;               ///< the level below it, for extrapolation ...
   bool below_converged = false;    ///< ... if it converged
 };
 
@@ -159,7 +160,8 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
     s.result = solveThroughGrids(at, context, settings, nullptr, p);
     return s;
   }
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = std::max(r.tolerance, p.coarse_tolerance_floor);
     if (r.replay_only) at_level.max_iterations = 0;
@@ -178,52 +180,42 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
   return s;
 }
 
-/// A surveyed class carried from the survey grid through the finer levels to the requested one
-/// (each level from the one below, extrapolated with the one below that when it converged, as
-/// the grid continuation does). Stopped (cancel, deadline), the iterate is carried over without
-/// iterating.
+/// A surveyed class carried from the survey grid through the finer levels to the requested one:
+/// the grid continuation resumed from the survey grid's iterate. A finer level that does not
+/// converge ends it with no plan (a fresh start there would be another attempt); stopped
+/// (cancel, deadline), the iterate is carried over without iterating.
 PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& context,
                        const GridSettings& settings, const NewtonParameters& p) {
-  Steps coarse = s.steps, coarser = s.below;
-  bool coarser_usable = s.below_converged;
-  PlanResult r;
-  int iterations = 0;
-  std::vector<LevelSummary> levels;
-  std::optional<Termination> stopped;
-  for (std::size_t j = plan.survey + 1; j < plan.levels.size(); ++j) {
-    const bool finest = j + 1 == plan.levels.size();
+  std::vector<PlanningProblem> levels;
+  for (const PlanningProblem& level : plan.levels) levels.push_back(inClass(level, s.homotopy));
+  GridLevelRule rule = newtonGridRule(p);
+  rule.unconverged_ends = true;
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
-    if (!finest) at_level.tolerance = std::max(settings.tolerance, p.coarse_tolerance_floor);
-    if (!stopped) stopped = context.stopReason();
-    if (stopped) at_level.max_iterations = 0;
-    Steps next;
-    r = solveOnGrid(inClass(plan.levels[j], s.homotopy), context, at_level,
-                    {nullptr, &coarse, coarser_usable ? &coarser : nullptr},
-                    finest ? nullptr : &next, p);
-    iterations += r.iterations;
-    levels.insert(levels.end(), r.levels.begin(), r.levels.end());
-    if (finest) break;
-    if (!r.converged() && !stopped) {
-      r.cost = std::numeric_limits<double>::quiet_NaN();  // no plan on the requested grid
-      break;
-    }
-    coarser_usable = r.converged();
-    coarser = std::move(coarse);
-    coarse = std::move(next);
-  }
-  r.iterations = iterations;
-  r.levels = levels;
+    at_level.tolerance = r.tolerance;
+    if (r.replay_only) at_level.max_iterations = 0;
+    return solveOnGrid(r.problem, context, at_level, {nullptr, r.coarse, r.coarser}, final_steps,
+                       p);
+  };
   const std::string survey_grid = "N = " + std::to_string(plan.levels[plan.survey].steps);
-  if (stopped && r.termination != Termination::Converged) {
-    r.termination = *stopped;
-    r.message =
-        std::string(*stopped == Termination::Cancelled ? "cancelled" : "time budget exceeded") +
-        "; the plan is the " + survey_grid +
-        " class survey's iterate carried over to N = " + std::to_string(plan.levels.back().steps);
-  } else {
-    r.message += "; refined from the " + survey_grid + " class survey";
-  }
-  return r;
+  const ContinuationFinish finish = [&](const ContinuationRecord& record, PlanResult* r) {
+    if (record.stop) {
+      r->message =
+          std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
+                                                                         : "time budget exceeded") +
+          "; the plan is the " + survey_grid +
+          " class survey's iterate carried over to N = " + std::to_string(plan.levels.back().steps);
+      return;
+    }
+    if (record.reached < record.levels.size()) {
+      r->cost = std::numeric_limits<double>::quiet_NaN();  // no plan on the requested grid
+    }
+    r->message += "; refined from the " + survey_grid + " class survey";
+  };
+  const SolvedLevel<StepVectors> survey{plan.survey, s.result.termination, s.steps, s.below,
+                                        s.below_converged};
+  return resumeGridContinuation(levels, survey, context, rule, settings.tolerance, level, finish);
 }
 
 // --- The walk: every attempt recorded, the cheapest converged plan kept --------------------------
@@ -538,7 +530,8 @@ std::optional<PlanResult> coastingThroughGrids(const PlanningProblem& problem,
   const std::vector<PlanningProblem> levels = gridLevels(problem, newtonGridRule(p));
   const std::optional<Maneuver> coasting = coastingStart(levels.front());
   if (!coasting) return std::nullopt;
-  const LevelSolver<Steps> level = [&](const LevelRequest<Steps>& r, Steps* final_steps) {
+  const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
+                                             StepVectors* final_steps) {
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;

@@ -21,12 +21,12 @@ namespace attitude_planner {
 /// One trial step as a step control judges it.
 struct StepTrial {
   const ReducedProblem& problem;
-  double cost = 0.0;             ///< C at the current iterate
-  double slope = 0.0;            ///< gᵀδ (< 0)
-  const Eigen::VectorXd& delta;  ///< the step δ
-  double shift_scale = 0.0;      ///< what the relative shift multiplies
-  ReducedProblem::Steps* trial;  ///< the full step on entry; the iterate to accept on return
-  double* step_length;           ///< 1 on entry; the step length taken on return
+  double cost = 0.0;                   ///< C at the current iterate
+  double slope = 0.0;                  ///< gᵀδ (< 0)
+  const Eigen::VectorXd& delta;        ///< the step δ
+  double shift_scale = 0.0;            ///< what the relative shift multiplies
+  ReducedProblem::StepVectors* trial;  ///< the full step on entry; the iterate to accept on return
+  double* step_length;                 ///< 1 on entry; the step length taken on return
 };
 
 class StepControl {

@@ -9,7 +9,7 @@ PlanningProblem coarserLevel(const PlanningProblem& problem, const GridLevelRule
 }
 
 bool usesCoarserLevel(const PlanningProblem& problem, const GridLevelRule& rule) {
-  return problem.steps > rule.coarsest_steps &&
+  return problem.steps > rule.coarsest_steps && problem.steps > rule.direct_up_to &&
          (!rule.level_helps || rule.level_helps(coarserLevel(problem, rule)));
 }
 
@@ -18,6 +18,25 @@ std::vector<PlanningProblem> gridLevels(const PlanningProblem& problem, const Gr
   while (usesCoarserLevel(levels.back(), rule)) levels.push_back(coarserLevel(levels.back(), rule));
   std::reverse(levels.begin(), levels.end());
   return levels;
+}
+
+void describeContinuation(const ContinuationRecord& record, PlanResult* finest) {
+  const std::size_t count = record.levels.size();
+  if (count < 2) return;
+  const std::string requested = std::to_string(record.levels.back().steps);
+  const LevelEnd& below = record.levels[count - 2];
+  if (record.stop) {
+    finest->message =
+        std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
+                                                                       : "time budget exceeded") +
+        " on the N = " + std::to_string(record.stop->level.steps) +
+        " level; the plan is its iterate carried over to N = " + requested;
+  } else if (below.termination == Termination::Converged) {
+    finest->message += "; started from the N = " + std::to_string(below.steps) + " solution";
+  } else {
+    finest->message += "; the N = " + std::to_string(below.steps) + " level ended " +
+                       terminationName(below.termination) + ", started from the geodesic";
+  }
 }
 
 }  // namespace attitude_planner

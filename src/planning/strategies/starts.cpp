@@ -77,7 +77,7 @@ std::optional<Maneuver> coastingStart(const PlanningProblem& problem) {
     input.initial_attitude = problem.final_attitude;
     input.initial_velocity = -problem.final_velocity;
     const Maneuver backward = simulate(scheme, input);
-    ReducedProblem::Steps blend(N);
+    ReducedProblem::StepVectors blend(N);
     for (int j = 0; j < N; ++j) {
       const double u = (j + 0.5) / N, w = u * u * (3 - 2 * u);
       const Vector3 ahead =

@@ -123,7 +123,7 @@ namespace {
 /// T (k + ½)/n (schemes with end torques, whose every step is free); else to T k/(n − 1) (paper
 /// and variational: the fixed first and last steps carry Ω(0) and Ω(T); see
 /// initializeFromCoarser).
-Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N, bool midpoints) {
+Vector3 interpolatedStep(const ReducedProblem::StepVectors& coarse, int j, int N, bool midpoints) {
   const int Nc = static_cast<int>(coarse.size());
   const auto slope = [&](int k) {
     if (k == 0) return Vector3(coarse[1] - coarse[0]);
@@ -148,7 +148,7 @@ Vector3 interpolatedStep(const ReducedProblem::Steps& coarse, int j, int N, bool
 
 }  // namespace
 
-void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coarser) {
+void ReducedProblem::initializeFromCoarser(const StepVectors& coarse, const StepVectors* coarser) {
   const int Nc = static_cast<int>(coarse.size());
   if (Nc < 4 || Nc >= N_ ||
       (coarser && (coarser->size() < 4 || coarser->size() >= coarse.size()))) {
@@ -183,7 +183,7 @@ void ReducedProblem::initializeFromCoarser(const Steps& coarse, const Steps* coa
   closeGap(target);
 }
 
-void ReducedProblem::initializeFromSteps(const Steps& guess) {
+void ReducedProblem::initializeFromSteps(const StepVectors& guess) {
   if (static_cast<int>(guess.size()) != N_) {
     throw InvalidInput("initial guess: has " + std::to_string(guess.size()) +
                        " steps, the problem " + std::to_string(N_));
@@ -224,14 +224,14 @@ void ReducedProblem::closeGap(const Eigen::Vector4d& target) {
   }
 }
 
-std::vector<Matrix3> ReducedProblem::attitudes(const Steps& steps) const {
+std::vector<Matrix3> ReducedProblem::attitudes(const StepVectors& steps) const {
   std::vector<Matrix3> R(N_ + 1);
   R[0] = initial_attitude_;
   for (int k = 0; k < N_; ++k) R[k + 1] = R[k] * so3::exp(steps[k]);
   return R;
 }
 
-std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
+std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
   std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
   const double h = scheme_.timeStep();
   Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
@@ -259,7 +259,7 @@ std::vector<Vector3> ReducedProblem::torques(const Steps& steps) const {
   return tau;
 }
 
-Maneuver ReducedProblem::maneuver(const Steps& steps) const {
+Maneuver ReducedProblem::maneuver(const StepVectors& steps) const {
   Maneuver m;
   m.time_step = scheme_.timeStep();
   m.attitude = attitudes(steps);
@@ -287,12 +287,13 @@ Maneuver ReducedProblem::maneuver(const Steps& steps) const {
   return m;
 }
 
-double ReducedProblem::cost(const Steps& steps) const {
+double ReducedProblem::cost(const StepVectors& steps) const {
   return scheme_.cost(torques(steps));
 }
 
-ReducedProblem::Steps ReducedProblem::retract(const Eigen::VectorXd& delta, double alpha) const {
-  Steps out = steps_;
+ReducedProblem::StepVectors ReducedProblem::retract(const Eigen::VectorXd& delta,
+                                                    double alpha) const {
+  StepVectors out = steps_;
   const auto perturbation = [&](int j) {
     const int v = variableIndex(j);
     return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));

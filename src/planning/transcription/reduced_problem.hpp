@@ -6,7 +6,8 @@
 // (discrete_scheme.hpp):  τ_k = (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h,  F_k = R_kᵀ R_{k+1}, and the
 // problem is min C = Σ_{k=1}^{N−1} ½|τ_k|² over R_2..R_{N−2} (3(N−3) unknowns: the seed's
 // 3(2N−3) unknowns τ, Ω with its 3(N−1) dynamics equations eliminated exactly). ∇C = 0 are the
-// discrete necessary conditions (docs/results/necessary_conditions.md relates them to the seed's eq. 28).
+// discrete necessary conditions (docs/results/necessary_conditions.md relates them to the seed's
+// eq. 28).
 //
 // With end torques (second_order, discrete_scheme.hpp) R_1 and R_{N−1} are free too, τ_0 and
 // τ_N are functions of F_0 and F_{N−1} (the boundary velocities enter through the Legendre
@@ -32,7 +33,7 @@ namespace attitude_planner {
 class ReducedProblem {
  public:
   /// Rotation vectors ω_k of the steps F_k = exp(ω_k^), k = 0..N−1 (ω_0, ω_{N−1} fixed).
-  using Steps = std::vector<Vector3>;
+  using StepVectors = std::vector<Vector3>;
 
   /// What one torque contributes to the Newton system: the residual r_k = √w_k τ_k of the cost
   /// Σ ½ |r_k|² (w_k = 1 but at the end nodes of a scheme with end torques).
@@ -57,8 +58,8 @@ class ReducedProblem {
   int lastFreeNode() const { return last_free_; }
   const DiscreteScheme& scheme() const { return scheme_; }
 
-  const Steps& current() const { return steps_; }
-  void setCurrent(const Steps& steps) { steps_ = steps; }
+  const StepVectors& current() const { return steps_; }
+  void setCurrent(const StepVectors& steps) { steps_ = steps; }
   /// log(R_1ᵀ R_{N−1}): the principal rotation vector between the two fixed inner attitudes.
   Vector3 principalSpan() const { return principal_span_; }
   /// Interior on the constant-rate rotation by `span` from R_1 (span ≡ principalSpan() modulo
@@ -77,26 +78,26 @@ class ReducedProblem {
   /// the coarse solution's own discretization error (resampling attitudes instead left O(1)
   /// torque jumps at the coarse nodes and the ends).
   /// With `coarser` (the solution on a still coarser grid) the two are extrapolated to this h.
-  void initializeFromCoarser(const Steps& coarse, const Steps* coarser = nullptr);
+  void initializeFromCoarser(const StepVectors& coarse, const StepVectors* coarser = nullptr);
   /// Interior from a guess of every step (N of them; the fixed boundary steps are kept): the
   /// free steps are taken from `guess` and the gap they leave at R_{N−1} is closed as in
   /// initializeFromCoarser.
-  void initializeFromSteps(const Steps& guess);
+  void initializeFromSteps(const StepVectors& guess);
 
   /// R_0..R_N of the steps (products from R_0).
-  std::vector<Matrix3> attitudes(const Steps& steps) const;
+  std::vector<Matrix3> attitudes(const StepVectors& steps) const;
   /// τ_k, k = 0..N (τ_0 = τ_N = 0 unless the scheme has end torques).
-  std::vector<Vector3> torques(const Steps& steps) const;
+  std::vector<Vector3> torques(const StepVectors& steps) const;
   /// The planned maneuver itself: R_k = R_0 F_0 ⋯ F_{k−1}, Ω_k the scheme's reported velocity
   /// (paper, variational: of step k, row N repeating Ω_{N−1}; second_order: the node velocity
   /// J⁻¹Π_k, k = 0..N), τ_k as torques(); k = 0..N on t_k = k h.
-  Maneuver maneuver(const Steps& steps) const;
+  Maneuver maneuver(const StepVectors& steps) const;
   /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
-  double cost(const Steps& steps) const;
+  double cost(const StepVectors& steps) const;
 
   /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
   /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).
-  Steps retract(const Eigen::VectorXd& delta, double alpha) const;
+  StepVectors retract(const Eigen::VectorXd& delta, double alpha) const;
 
   /// Weights w_k(τ_k) for `second` in place of τ_k (see forEachStencil).
   using SecondOrderWeights = std::function<Vector3(int k, const Vector3& tau)>;
@@ -188,7 +189,7 @@ class ReducedProblem {
   int first_free_, last_free_;                  ///< the free attitudes R_j
   Vector3 initial_momentum_, final_momentum_;   ///< J Ω(0), J Ω(T)
   Vector3 principal_span_;
-  Steps steps_;
+  StepVectors steps_;
 };
 
 }  // namespace attitude_planner

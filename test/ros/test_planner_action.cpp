@@ -257,7 +257,7 @@ TEST_F(PlannerAction, CancelInTheLastIterationEndsPreemptedNotSucceeded) {
   // The solve at N = 1e5 is deterministic: a first run tells which feedback is its last (the
   // final Newton step publishes none). The second run cancels on that feedback, so the cancel
   // arrives while the last (long, N = 1e5) iteration runs: the goal must end PREEMPTED /
-  // CANCELLED, though the solver converges (before issue 31 it ended SUCCEEDED).
+  // CANCELLED, though the solver converges: the client asked to stop, and its answer must say so.
   PlanAttitudeManeuverGoal goal = seed(100000);
   goal.return_maneuver = "none";
   auto last = std::make_shared<std::atomic<int>>(0);

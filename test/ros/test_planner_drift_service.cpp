@@ -83,8 +83,8 @@ TEST_F(PlannerDriftService, WorkedExampleReachesTheTargetAttitude) {
 }
 
 TEST_F(PlannerDriftService, GuessSelectsAnotherExtremal) {
-  // docs/design/drift_two_input.md, non-uniqueness: g1 = exp(3 E3) in T = 3 s is the uncontrolled drift
-  // (cost 0) from the default starts; the guess (2, 1, 0) selects an extremal that spends
+  // docs/design/drift_two_input.md, non-uniqueness: g1 = exp(3 E3) in T = 3 s is the uncontrolled
+  // drift (cost 0) from the default starts; the guess (2, 1, 0) selects an extremal that spends
   // control effort (cost 9.17592).
   PlanDriftTwoInput::Request r = workedExample();
   r.final_attitude = rc::attitudeToMsg(so3::exp(Vector3(0, 0, 3)));

@@ -1,5 +1,5 @@
 // rostest: what the tracker sends to rviz grows linearly with the number of samples, not
-// quadratically (issue 31: the whole path re-sent at every step made an N = 3000 bag 109 MB).
+// quadratically (a path re-sent whole at every step would make an N = 3000 bag ~100 MB).
 // tracker_bandwidth.test runs one sample per plan node (~rate 0), so N + 1 samples: the bytes of
 // every marker topic are counted (serialized length, what a bag stores) for N = 250 and N = 1000;
 // linear growth gives a ratio near 4, the old quadratic one near 16.

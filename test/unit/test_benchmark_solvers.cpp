@@ -118,10 +118,10 @@ TEST(BenchmarkSolvers, IpoptStartedFromOurConstrainedOptimumStaysThere) {
 }
 
 // Above N = 1024 the interior point's Newton system is formed and factored in extended precision
-// (kExtendedPrecisionAboveSteps: long double in session 27, double-double since). Torque and rate
+// (kExtendedPrecisionAboveSteps, double-double). Torque and rate
 // limits at N = 4096: in double ours ended 7e-8 above IPOPT's optimum with 2 fewer active
-// constraints (docs/results/constraints.md, session 26); now IPOPT started from ours stays there (same cost
-// to 1e-9, same active set).
+// constraints (docs/results/constraints.md); in extended precision IPOPT started from ours stays
+// there (same cost to 1e-9, same active set).
 TEST(BenchmarkSolvers, IpoptAgreesWithOurTorqueAndRateLimitedOptimumAtN4096) {
 #ifndef AP_BENCHMARK_HAS_IPOPT
   GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";

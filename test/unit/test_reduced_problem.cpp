@@ -227,7 +227,7 @@ TEST(ReducedProblem, BandedCholeskyFactorSolvesSeveralRightHandSides) {
 // Formed and factored in double-double (ExtendedBandedMatrix) the solve keeps it to the
 // reference's own accuracy at w = 1e12 and at w = 1e20, where long double's 64-bit significand
 // (ε = 5e-20) would keep nothing; in double only a few digits are left at w = 1e12 (measured
-// here: 7e-5 relative; long double, session 27: 4e-8).
+// here: 7e-5 relative; long double: 4e-8).
 TEST(BandedSymmetric, ExtendedPrecisionKeepsTheCurvatureUnderHugeRankOneTerms) {
   for (const double weight : {1e12, 1e20}) {
     const int n = 60, p = 8;

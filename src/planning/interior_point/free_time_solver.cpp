@@ -191,7 +191,7 @@ class FreeTimeSolver {
   };
   std::vector<RateTerms> rateTerms(StageQuantity quantity) const;
   void assembleRates(double mu);
-  void scatter(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 10>& H,
+  void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
   void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
@@ -272,23 +272,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
           rhs += (mu / in.c) * in.g;
           lagrangian -= in.z * in.g;
         }
-        for (int node = 0; node < 3; ++node) {
-          const int v = np_.variableIndex(st.k - 1 + node);
-          if (v < 0) continue;
-          rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
-          lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
-          border_.segment<3>(v) += H.block<3, 1>(3 * node, 9);
-        }
-        rhs_(n_) += rhs(9);
-        lagrangian_gradient_(n_) += lagrangian(9);
-        corner_ += H(9, 9);
-        const int first_slot = std::max(0, np_.firstFreeNode() - (st.k - 1));
-        const int last_slot = std::min(2, np_.lastFreeNode() - (st.k - 1));
-        if (first_slot <= last_slot) {
-          band_.addSymmetricBlock<9>(3 * (st.k - 1 - np_.firstFreeNode()),
-                                     Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()),
-                                     3 * first_slot, 3 * (last_slot + 1));
-        }
+        scatter(st.k - 1, 3, H, rhs, lagrangian);
       },
       weights);
   assembleCones(mu);
@@ -381,7 +365,7 @@ void FreeTimeSolver::assembleRates(double mu) {
         in.g = slope * dq;
         const Eigen::Matrix<double, 10, 10> H =
             (-in.z * slope) * d2q + (in.z / in.c) * in.g * in.g.transpose();
-        scatter(g, k, H, (mu / in.c) * in.g, -in.z * in.g);
+        scatter(k + g.support.node_offset, g.support.width, H, (mu / in.c) * in.g, -in.z * in.g);
       }
     }
   }
@@ -389,10 +373,9 @@ void FreeTimeSolver::assembleRates(double mu) {
 
 /// Adds one instance's Hessian block (local nodes and η), right-hand side and Lagrangian gradient
 /// to the bordered system (fixed nodes skipped).
-void FreeTimeSolver::scatter(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 10>& H,
+void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                              const Eigen::Matrix<double, 10, 1>& rhs,
                              const Eigen::Matrix<double, 10, 1>& lagrangian) {
-  const int first_node = k + g.support.node_offset, width = g.support.width;
   for (int node = 0; node < width; ++node) {
     const int v = np_.variableIndex(first_node + node);
     if (v < 0) continue;

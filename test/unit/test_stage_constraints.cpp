@@ -33,11 +33,11 @@ ap::PlanningProblem scene(const char* name, int steps) {
   return p;
 }
 
-/// The search on T over minimum-effort solves (an upper bound) on the same discrete problem: it
-/// still answers requests with effects, so a zero body-frame disturbance torque forces it.
 /// How far above the search's T a cone answer may sit (a missed basin, not a wrong KKT point).
 constexpr double kConeBasinTolerance = 5e-3;
 
+/// The search on T over minimum-effort solves (an upper bound) on the same discrete problem: it
+/// still answers requests with effects, so a zero body-frame disturbance torque forces it.
 ap::PlanResult searchedMinimumTime(ap::PlanningProblem p) {
   auto effects = std::make_shared<ap::EffectModel>();
   effects->add(std::make_unique<ap::DisturbanceTorque>(ap::Vector3::Zero(), ap::TorqueFrame::Body));
@@ -331,4 +331,27 @@ TEST(FreeTimeRates, RateLimitedMinimumTimeIsAKktPointWithinTheLimit) {
   // Spinning ends move the boundary steps with h: not written yet, the search answers.
   p.initial_velocity = ap::Vector3(0.01, 0, 0);
   EXPECT_NE(ap::freeTimeUnsupported(p).find("max_angular_rate"), std::string::npos);
+}
+
+TEST(StageConstraints, AConeViolatedAtAnAttitudeTheBoundaryDataFixIsNamedOnlyThere) {
+  // Paper scheme spinning about z: R_1 = R_0 exp(h Ω(0)^) is boundary data, not an unknown. A
+  // keep-out cone around R_1's body x (R_0's body x outside it) is violated there and only there.
+  ap::PlanningProblem p = scene("rest_to_rest", 16);
+  p.scheme = ap::SchemeKind::Paper;
+  p.initial_attitude = ap::Matrix3::Identity();
+  p.initial_velocity = ap::Vector3(0, 0, 1.0);
+  const double h = p.duration / p.steps;
+  const ap::Vector3 s = ap::so3::exp(ap::Vector3(0, 0, h)) * ap::Vector3::UnitX();
+  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), s, 0.5 * h)};
+  const ap::ReducedProblem np(p);
+  ASSERT_LT(np.variableIndex(1), 0) << "R_1 must be fixed for this test";
+  const std::string at_fixed = ap::fixedNodeConeViolation(p, np, {0, 1});
+  EXPECT_NE(at_fixed.find(ap::describeConstraint(p.constraints[0])), std::string::npos) << at_fixed;
+  EXPECT_NE(at_fixed.find("at k = 1"), std::string::npos) << at_fixed;
+  EXPECT_EQ(ap::fixedNodeConeViolation(p, np, {0}), "") << "R_0 clears the cone";
+  // A free node is an unknown: never reported, whatever it violates.
+  p.scheme = ap::SchemeKind::SecondOrder;
+  const ap::ReducedProblem with_end_torques(p);
+  ASSERT_GE(with_end_torques.variableIndex(1), 0);
+  EXPECT_EQ(ap::fixedNodeConeViolation(p, with_end_torques, {1}), "");
 }

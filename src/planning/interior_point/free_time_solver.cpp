@@ -632,31 +632,6 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
   return "";
 }
 
-namespace {
-
-/// A cone violated at an attitude no free-time iterate moves (R_0, R_N, and R_1, R_{N−1} where
-/// the boundary data fix them): the message, or empty.
-std::string fixedNodeConeViolation(const PlanningProblem& problem, const ReducedProblem& np) {
-  const std::vector<Matrix3> R = np.attitudes(np.current());
-  const int N = np.steps();
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (!c.isCone()) continue;
-    for (int k : {0, 1, N - 1, N}) {
-      if (np.variableIndex(k) >= 0) continue;
-      const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
-      if (slack < 0.0) {
-        std::ostringstream why;
-        why << describeConstraint(c) << " is violated by " << -slack << " rad at k = " << k
-            << ", an attitude the boundary data fix";
-        return why.str();
-      }
-    }
-  }
-  return "";
-}
-
-}  // namespace
-
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               const SolverOptions* options) {
@@ -668,8 +643,13 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
   try {
     ReducedProblem np(at);
     np.setInteriorFromAttitudes(attitudes);
-    failed.message = fixedNodeConeViolation(problem, np);
-    if (!failed.message.empty()) return failed;
+    // R_0, R_N and, where the boundary data fix them, R_1, R_{N−1}: no iterate moves them.
+    const std::string fixed =
+        fixedNodeConeViolation(problem, np, {0, 1, np.steps() - 1, np.steps()});
+    if (!fixed.empty()) {
+      failed.message = fixed + ", an attitude the boundary data fix";
+      return failed;
+    }
     const StageConstraints constraints = buildStageConstraints(problem);
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     failed.message = solver.startInside();

@@ -14,6 +14,7 @@
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
 
@@ -27,28 +28,6 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
     << so3::angleBetween(problem.initial_attitude, problem.final_attitude)
     << " rad in T = " << problem.duration << " s";
   return s.str();
-}
-
-/// Nodes fixed by the boundary data (R_1, R_{N−1}, F_0, F_{N−1}) are not unknowns: a cone they
-/// violate cannot be repaired by any plan at this N. The message, or empty.
-std::string fixedNodeViolation(const PlanningProblem& problem, const ReducedProblem& np) {
-  const std::vector<Matrix3> R = np.attitudes(np.current());
-  const int N = np.steps();
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (!c.isCone()) continue;
-    for (int k : {1, N - 1}) {
-      if (np.variableIndex(k) >= 0) continue;               // free with end torques
-      const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
-      if (slack < 0.0) {
-        std::ostringstream why;
-        why << "infeasible: " << describeConstraint(c) << " is violated by " << -slack
-            << " rad at k = " << k
-            << ", an attitude the boundary velocities fix (increase steps or move the boundary)";
-        return why.str();
-      }
-    }
-  }
-  return {};
 }
 
 /// The Newton direction of one iteration and what the line search and stopping test need of it.
@@ -510,10 +489,14 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
   } else if (request.coarse_steps) {
     np.initializeFromCoarser(*request.coarse_steps);
   }
-  const std::string fixed = fixedNodeViolation(problem, np);
+  // R_0 and R_N are checked up front (problem validation); R_1, R_{N−1} where the boundary
+  // velocities fix them are not unknowns: no plan at this N repairs a cone they violate.
+  const std::string fixed = fixedNodeConeViolation(problem, np, {1, np.steps() - 1});
   if (!fixed.empty()) {
     out.result.termination = Termination::Infeasible;
-    out.result.message = fixed;
+    out.result.message = "infeasible: " + fixed +
+                         ", an attitude the boundary velocities fix (increase steps or move the "
+                         "boundary)";
     return out;
   }
   return GridSolve<Scalar>(problem, options, parameters, context, request, &np).run();

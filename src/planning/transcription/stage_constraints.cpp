@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
 
@@ -126,6 +127,24 @@ StageConstraints buildStageConstraints(const PlanningProblem& problem) {
     }
   }
   return out;
+}
+
+std::string fixedNodeConeViolation(const PlanningProblem& problem, const ReducedProblem& np,
+                                   std::initializer_list<int> nodes) {
+  const std::vector<Matrix3> R = np.attitudes(np.current());
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (const int k : nodes) {
+      if (np.variableIndex(k) >= 0) continue;
+      const double slack = coneMargin(c, R[k]) - c.margin;  // to the node bound
+      if (slack < 0.0) {
+        std::ostringstream why;
+        why << describeConstraint(c) << " is violated by " << -slack << " rad at k = " << k;
+        return why.str();
+      }
+    }
+  }
+  return "";
 }
 
 }  // namespace attitude_planner

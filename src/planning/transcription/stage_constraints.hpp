@@ -12,6 +12,7 @@
 // rule: ∇c = c'(q) ∇q, ∇²c = c'(q) ∇²q + ∇qᵀ c''(q) ∇q.
 #pragma once
 
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,8 @@
 #include "attitude_planner/planning/problem.hpp"
 
 namespace attitude_planner {
+
+class ReducedProblem;
 
 /// What a stage constraint is a function of: its support on the band and its h dependence.
 enum class StageQuantity {
@@ -85,5 +88,11 @@ using StageConstraints = std::vector<std::unique_ptr<const StageConstraint>>;
 /// the node rates for schemes with end torques, else on the step rates). The list points into
 /// `problem.constraints`: `problem` must outlive it.
 StageConstraints buildStageConstraints(const PlanningProblem& problem);
+
+/// The first cone whose node bound (a ± its margin) is violated at one of `nodes` that the
+/// boundary data fix (no unknown of `np`): "<describeConstraint> is violated by x rad at k = K",
+/// or empty. No plan on this grid can repair it.
+std::string fixedNodeConeViolation(const PlanningProblem& problem, const ReducedProblem& np,
+                                   std::initializer_list<int> nodes);
 
 }  // namespace attitude_planner

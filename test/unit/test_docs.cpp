@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "tool_runner.hpp"
 
@@ -69,7 +70,6 @@ TEST(DocsCheck, ReportsBrokenLinksMissingHeadingsAndStalePaths) {
   EXPECT_NE(r.output.find("4 problem(s)"), std::string::npos) << r.output;
 }
 
-/// README.md's C++ example (examples/plan_rest_to_rest.cpp) plans the seed's slew and converges.
 // The code's shape: no function in src/ over 100 lines (docs/ARCHITECTURE.md, "Function
 // length"); scripts/function_lengths counts from the signature to the closing brace.
 TEST(CodeShape, NoFunctionInSrcOrStudiesIsLongerThanAHundredLines) {
@@ -81,12 +81,39 @@ TEST(CodeShape, NoFunctionInSrcOrStudiesIsLongerThanAHundredLines) {
   EXPECT_FALSE(r.output.empty()) << "the scan found no function";
 }
 
-TEST(ReadmeExample, PlansTheSeedsRestToRestSlew) {
+/// The indented block after "It prints:" in README.md, one string per line.
+std::vector<std::string> readmePrintedLines() {
+  std::ifstream readme(kSourceDir + "/README.md");
+  std::vector<std::string> lines;
+  bool in_block = false;
+  for (std::string line; std::getline(readme, line);) {
+    if (line == "It prints:") {
+      in_block = true;
+    } else if (in_block && line.rfind("    ", 0) == 0) {
+      lines.push_back(line.substr(4));
+    } else if (in_block && !lines.empty()) {
+      break;
+    }
+  }
+  return lines;
+}
+
+/// README.md's C++ example (examples/plan_rest_to_rest.cpp) plans the seed's slew, converges, and
+/// prints what the README says it prints (the replay miss, round-off, only to its order).
+TEST(ReadmeExample, PlansTheSeedsRestToRestSlewAndPrintsWhatTheReadmeShows) {
   const ToolRun r = runProgram(AP_STUDY_DIR, "plan_rest_to_rest", "", 120);
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.rfind("converged in ", 0), 0u) << r.output;
   EXPECT_NE(r.output.find("cost 7.910254"), std::string::npos) << r.output;  // the seed's optimum
-  EXPECT_NE(r.output.find("tau_1 = ["), std::string::npos) << r.output;
+  const std::vector<std::string> shown = readmePrintedLines();
+  ASSERT_EQ(shown.size(), 2u) << "README.md: no two-line block after \"It prints:\"";
+  const std::string::size_type miss = shown[0].find(", replay miss");
+  ASSERT_NE(miss, std::string::npos) << shown[0];
+  EXPECT_EQ(r.output.rfind(shown[0].substr(0, miss), 0), 0u)
+      << "README.md shows: " << shown[0] << "\nthe example prints: " << r.output;
+  EXPECT_NE(r.output.find("e-15 rad\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\n" + shown[1] + "\n"), std::string::npos)
+      << "README.md shows: " << shown[1] << "\nthe example prints: " << r.output;
 }
 
 }  // namespace

@@ -100,6 +100,31 @@ Constraint constraintToMsg(const PlanningConstraint& c) {
   return msg;
 }
 
+PlanAttempt attemptToMsg(const Attempt& a) {
+  PlanAttempt msg;
+  msg.stage = attemptStageName(a.stage);
+  msg.start = attemptStartName(a.start);
+  msg.formulation = formulationName(a.formulation);
+  msg.long_way = a.homotopy.long_way;
+  msg.extra_revolutions = a.homotopy.extra_revolutions;
+  msg.steps = a.steps;
+  msg.termination = terminationName(a.termination);
+  msg.iterations = a.iterations;
+  msg.cost = a.cost;
+  msg.kept = a.kept;
+  return msg;
+}
+
+MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& c) {
+  MinimumTimeSummary msg;
+  msg.kkt_point = c.kkt_point;
+  msg.stationarity = c.stationarity;
+  msg.time_stationarity = c.time_stationarity;
+  msg.complementarity = c.complementarity;
+  msg.solves = c.solves;
+  return msg;
+}
+
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
   std::vector<EffectSpec> specs;
   for (std::size_t i = 0; i < effects.size(); ++i) {

@@ -1,13 +1,13 @@
 // Unit tests of the ROS adapters that need no ROS master: conversions, request parsing, the box.
 #include <gtest/gtest.h>
 
-#include <set>
-
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <set>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/dynamics/simulation.hpp"
@@ -201,6 +201,47 @@ TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
   SolverOptions options;
   const PlanningProblem p = rc::problemFromRequest(near, rc::PlannerDefaults(), &options);
   EXPECT_LT(so3::angleBetween(p.initial_attitude, Matrix3::Identity()), 1e-15);
+}
+
+TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTheJson) {
+  // A minimum-time request (a torque bound, rest to rest): its trail has free-time solves, a
+  // polish and one kept attempt; every field of every attempt and of the summary is copied.
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.objective = "minimum_time";
+  r.duration = 0.0;
+  r.effects = {rc::effectToMsg(ActuatorLimitsSpec{Vector3(0.3, 0.4, 0.5)})};
+  const PlanOutcome out = planRequest(r, rc::PlannerDefaults(), nullptr);
+  ASSERT_EQ(out.error_code, PlanErrorCode::SUCCESS) << out.message;
+  PlanAttitudeManeuver::Response res;
+  fillResponse(out, "world", "body", &res);
+  const std::vector<Attempt>& trail = out.result.attempts;
+  ASSERT_FALSE(trail.empty());
+  ASSERT_EQ(res.attempts.size(), trail.size());
+  int kept = 0;
+  for (std::size_t i = 0; i < trail.size(); ++i) {
+    const PlanAttempt& m = res.attempts[i];
+    EXPECT_EQ(m.stage, attemptStageName(trail[i].stage)) << i;
+    EXPECT_EQ(m.start, attemptStartName(trail[i].start)) << i;
+    EXPECT_EQ(m.formulation, formulationName(trail[i].formulation)) << i;
+    EXPECT_EQ(m.long_way, trail[i].homotopy.long_way) << i;
+    EXPECT_EQ(m.extra_revolutions, trail[i].homotopy.extra_revolutions) << i;
+    EXPECT_EQ(m.steps, trail[i].steps) << i;
+    EXPECT_EQ(m.termination, terminationName(trail[i].termination)) << i;
+    EXPECT_EQ(m.iterations, trail[i].iterations) << i;
+    EXPECT_TRUE(m.cost == trail[i].cost || (std::isnan(m.cost) && std::isnan(trail[i].cost))) << i;
+    EXPECT_EQ(m.kept, trail[i].kept) << i;
+    kept += m.kept ? 1 : 0;
+  }
+  EXPECT_EQ(kept, 1);
+  EXPECT_TRUE(std::any_of(res.attempts.begin(), res.attempts.end(),
+                          [](const PlanAttempt& m) { return m.stage == "minimum_time_solve"; }));
+  EXPECT_EQ(res.minimum_time.kkt_point, out.result.minimum_time.kkt_point);
+  EXPECT_TRUE(res.minimum_time.kkt_point) << out.details;
+  EXPECT_EQ(res.minimum_time.stationarity, out.result.minimum_time.stationarity);
+  EXPECT_EQ(res.minimum_time.time_stationarity, out.result.minimum_time.time_stationarity);
+  EXPECT_EQ(res.minimum_time.complementarity, out.result.minimum_time.complementarity);
+  EXPECT_EQ(res.minimum_time.solves, out.result.minimum_time.solves);
+  EXPECT_GT(res.minimum_duration, 0.0);
 }
 
 TEST(RosConversions, DirectionAndExtraRevolutionsReachTheProblem) {

@@ -15,6 +15,8 @@
 #include "attitude_planner/Constraint.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/Effect.h"
+#include "attitude_planner/MinimumTimeSummary.h"
+#include "attitude_planner/PlanAttempt.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
@@ -87,6 +89,12 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
 PlanningConstraint constraintFromMsg(const Constraint& msg, const std::string& field);
 /// The Constraint message of a core constraint (the fields its kind does not use left at 0).
 Constraint constraintToMsg(const PlanningConstraint& constraint);
+
+/// One attempt of the structured trail (PlanResult::attempts) as a message, every enumeration by
+/// the name the JSON summary gives it.
+PlanAttempt attemptToMsg(const Attempt& attempt);
+/// What backs a minimum-time answer's T* (PlanResult::minimum_time) as a message.
+MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& certificate);
 
 /// The request field a core error names, in the request's own spelling: the core (and the scene)
 /// say `initial.angular_velocity`, `constraints[0].max_torque_norm`,

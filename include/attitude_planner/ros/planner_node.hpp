@@ -124,9 +124,10 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
                   const std::string& body_frame, Response* res);
 
 /// The answer to a request with a time budget B comes by B (1 + kDeadlineSlack), inside the 10 %
-/// the interface promises (docs/ros_timing.md): the core stops at B, but turning a stopped N = 1e5 solve into a result (evaluating and
-/// replaying its plan) can take longer than the rest; a solve still running then is told to stop
-/// and its result is dropped: the answer is TIMED_OUT without a plan.
+/// the interface promises (docs/ros_timing.md): the core stops at B, but turning a stopped N = 1e5
+/// solve into a result (evaluating and replaying its plan) can take longer than the rest; a solve
+/// still running then is told to stop and its result is dropped: the answer is TIMED_OUT without a
+/// plan.
 inline constexpr double kDeadlineSlack = 0.02;
 
 /// A solve run on its own thread so that its caller can answer at the deadline without it.
@@ -291,6 +292,9 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->active_constraints = r.active_constraints;
   res->replay_miss = r.replay_miss;
   res->step_residual = r.step_residual;
+  res->attempts.clear();
+  for (const Attempt& a : r.attempts) res->attempts.push_back(ros_conversions::attemptToMsg(a));
+  res->minimum_time = ros_conversions::minimumTimeToMsg(r.minimum_time);
 }
 
 }  // namespace attitude_planner

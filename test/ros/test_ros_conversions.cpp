@@ -206,6 +206,7 @@ TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
 TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTheJson) {
   // A minimum-time request (a torque bound, rest to rest): its trail has free-time solves, a
   // polish and one kept attempt; every field of every attempt and of the summary is copied.
+  ros::Time::init();  // fillResponse stamps the maneuver; no master is needed
   PlanAttitudeManeuver::Request r = seedRequest();
   r.objective = "minimum_time";
   r.duration = 0.0;

@@ -55,6 +55,7 @@
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/direct_method.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 #include "support/random_problems.hpp"
 #include "support/study_tools.hpp"
 
@@ -430,13 +431,15 @@ Eigen::Matrix4d rightProduct(const Quaternion& q) {
 /// Hessian of the Lagrangian σ f + Σ λ_i g_i (exact_hessian): per k = 1..N−2 the (q_k, Ω_k)
 /// block of the kinematics (q_k ⊗ e(hΩ_k) is bilinear in q_k and e, so no q_k q_k part) plus the
 /// Ω_k Ω_k block of the dynamics, and σ on the τ diagonal; the terminal constraint is linear.
-/// Node constraints (the problem's, as ours imposes them; rows after the equalities):
-///   per-axis limits  bounds −a ≤ τ_k ≤ a on the variables
-///   max_torque_norm  |τ_k|²/t² ≤ 1,  k = 1..N−1    (Hessian 2λ/t² on the τ_k diagonal)
-///   max_angular_rate |Ω_k|²/w² ≤ 1,  k = 1..N−2    (2λ/w² on the Ω_k diagonal; Ω_0, Ω_{N−1} data)
-///   keep_out/keep_in qᵀM q ≤ / ≥ cos a_node, k = 2..N−2 (q_1, q_{N−1} follow from the data)
+/// Node constraints (the problem's stage constraints, ap::buildStageConstraints, as ours imposes
+/// them; rows after the equalities): the box sides are bounds on the τ variables; every other one
+/// is a row lower ≤ g(r) ≤ upper of its quantity r (StageConstraint::rowValue; its gradient and
+/// curvature, stage_constraints.hpp), which this transcription forms per quantity:
+///   torque     r = τ_k,  k = 1..N−1    (Hessian λ g'' on the τ_k diagonal)
+///   step rate  r = Ω_k,  k = 1..N−2    (λ g'' on the Ω_k diagonal; Ω_0, Ω_{N−1} data)
+///   pointing   r = qᵀM q, k = 2..N−2   (q_1, q_{N−1} follow from the data)
 /// where sᵀR(q)b = qᵀMq for unit q, M = [[s·b, (b×s)ᵀ], [b×s, s bᵀ + b sᵀ − (s·b) I]]; its
-/// Hessian 2λM fills a q_k q_k block (added to the pattern only when a cone is present).
+/// Hessian λ(g' 2M + g'' 4MqqᵀM) fills a q_k q_k block (in the pattern only with a cone).
 class TranscriptionNlp : public Ipopt::TNLP {
  public:
   /// `start`: the steps ω_k to start from (empty: the geodesic start ReducedProblem begins on).
@@ -446,20 +449,32 @@ class TranscriptionNlp : public Ipopt::TNLP {
         N_(p.steps),
         h_(p.duration / p.steps),
         exact_hessian_(exact_hessian),
-        start_(std::move(start)) {
+        start_(std::move(start)),
+        stage_constraints_(ap::buildStageConstraints(p_)) {
     q0_ = ap::so3::quaternionCoefficients<double>(p.initial_attitude);
     qN_ = ap::so3::quaternionCoefficients<double>(p.final_attitude);
-    for (const ap::PlanningConstraint& c : p_.constraints) {
+    for (const auto& c : stage_constraints_) {
+      if (c->axis() >= 0) continue;  // a box side: a bound on τ (get_bounds_info)
       int first = 1, last = N_ - 1;
-      if (c.kind == ap::ConstraintKind::MaxAngularRate) last = N_ - 2;
-      if (c.isCone()) first = 2, last = N_ - 2, has_cone_ = true;
-      for (int k = first; k <= last; ++k) rows_of_constraints_.push_back({&c, k});
+      switch (c->quantity()) {
+        case ap::StageQuantity::Torque:
+          break;
+        case ap::StageQuantity::StepRate:
+          last = N_ - 2;
+          break;
+        case ap::StageQuantity::Pointing:
+          first = 2, last = N_ - 2, has_cone_ = true;
+          break;
+        case ap::StageQuantity::NodeRate:  // the paper scheme has no end torques
+          throw ap::InvalidInput("ipopt: the transcription has no node rates (paper scheme)");
+      }
+      for (int k = first; k <= last; ++k) rows_of_constraints_.push_back({c.get(), k});
     }
   }
   /// sᵀR(q)b = qᵀ M q for a unit quaternion q (w, x, y, z).
-  static Eigen::Matrix4d pointingForm(const ap::PlanningConstraint& c) {
-    const Vector3& s = c.world_direction;
-    const Vector3& b = c.body_axis;
+  static Eigen::Matrix4d pointingForm(const ap::StageConstraint& c) {
+    const Vector3& s = c.spec()->world_direction;
+    const Vector3& b = c.spec()->body_axis;
     Eigen::Matrix4d M;
     M(0, 0) = s.dot(b);
     M.block<3, 1>(1, 0) = b.cross(s);
@@ -488,23 +503,19 @@ class TranscriptionNlp : public Ipopt::TNLP {
   }
   bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
                        Ipopt::Number* gl, Ipopt::Number* gu) override {
-    for (int i = 0; i < n; ++i) xl[i] = -1e19, xu[i] = 1e19;
-    if (p_.hasTorqueBounds()) {
-      for (int k = 1; k <= N_ - 1; ++k)
-        for (int i = 0; i < 3; ++i)
-          xl[T(k) + i] = -p_.max_torque(i), xu[T(k) + i] = p_.max_torque(i);
+    for (int i = 0; i < n; ++i) xl[i] = -kInfinite, xu[i] = kInfinite;
+    for (const auto& c : stage_constraints_) {
+      if (c->axis() < 0) continue;
+      for (int k = 1; k <= N_ - 1; ++k) {
+        xl[T(k) + c->axis()] = std::max(xl[T(k) + c->axis()], c->rowLower());
+        xu[T(k) + c->axis()] = std::min(xu[T(k) + c->axis()], c->rowUpper());
+      }
     }
     for (int i = 0; i < m; ++i) gl[i] = gu[i] = 0.0;
     for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
-      const ap::PlanningConstraint& c = *rows_of_constraints_[r].constraint;
+      const ap::StageConstraint& c = *rows_of_constraints_[r].constraint;
       const int row = equalities() + static_cast<int>(r);
-      if (!c.isCone()) {
-        gl[row] = -1e19, gu[row] = 1.0;
-      } else if (c.kind == ap::ConstraintKind::KeepOut) {
-        gl[row] = -1e19, gu[row] = std::cos(c.nodeHalfAngle());
-      } else {
-        gl[row] = std::cos(c.nodeHalfAngle()), gu[row] = 1e19;
-      }
+      gl[row] = std::max(c.rowLower(), -kInfinite), gu[row] = std::min(c.rowUpper(), kInfinite);
     }
     return true;
   }
@@ -553,15 +564,7 @@ class TranscriptionNlp : public Ipopt::TNLP {
         ap::so3::quaternionProduct<double>(conj, qN).tail<3>();
     for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
       const auto& [c, k] = rows_of_constraints_[r];
-      double& value = g[equalities() + r];
-      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
-        value = Eigen::Map<const Vector3>(x + T(k)).squaredNorm() / (c->limit * c->limit);
-      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
-        value = omega(x, k).squaredNorm() / (c->limit * c->limit);
-      } else {
-        const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
-        value = q.dot(pointingForm(*c) * q);
-      }
+      g[equalities() + r] = c->rowValue(rowQuantity(*c, x, k));
     }
     return true;
   }
@@ -618,15 +621,13 @@ class TranscriptionNlp : public Ipopt::TNLP {
     for (int r = 1; r < 4; ++r)
       for (int c = 0; c < 4; ++c) values[z++] = L(r, c);
     for (const auto& [c, k] : rows_of_constraints_) {
-      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
-        const Vector3 d = 2.0 / (c->limit * c->limit) * Eigen::Map<const Vector3>(x + T(k));
+      const Vector3 d = c->rowGradient(rowQuantity(*c, x, k));
+      if (c->quantity() == ap::StageQuantity::Pointing) {  // ∂(qᵀMq)/∂q = 2Mq
+        const Quaternion dq =
+            d(0) * (2.0 * pointingForm(*c) * Eigen::Map<const Quaternion>(x + Q(k)));
+        for (int i = 0; i < 4; ++i) values[z++] = dq(i);
+      } else {  // r is the variable block itself (τ_k or Ω_k)
         for (int i = 0; i < 3; ++i) values[z++] = d(i);
-      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
-        const Vector3 d = 2.0 / (c->limit * c->limit) * omega(x, k);
-        for (int i = 0; i < 3; ++i) values[z++] = d(i);
-      } else {
-        const Quaternion d = 2.0 * pointingForm(*c) * Eigen::Map<const Quaternion>(x + Q(k));
-        for (int i = 0; i < 4; ++i) values[z++] = d(i);
       }
     }
     return true;
@@ -647,12 +648,24 @@ class TranscriptionNlp : public Ipopt::TNLP {
     for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
       const auto& [c, k] = rows_of_constraints_[r];
       const double l = lambda[equalities() + r];
-      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
-        tau_diagonal[k] += 2.0 * l / (c->limit * c->limit);
-      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
-        omega_diagonal[k] += 2.0 * l / (c->limit * c->limit);
-      } else {
-        cone_block[k] += 2.0 * l * pointingForm(*c);
+      switch (c->quantity()) {
+        case ap::StageQuantity::Torque:
+          tau_diagonal[k] += l * c->rowCurvature();
+          break;
+        case ap::StageQuantity::StepRate:
+          omega_diagonal[k] += l * c->rowCurvature();
+          break;
+        case ap::StageQuantity::Pointing: {  // g(qᵀMq): g' 2M + g'' (2Mq)(2Mq)ᵀ
+          const Eigen::Matrix4d M = pointingForm(*c);
+          const Vector3 r = rowQuantity(*c, x, k);
+          const Quaternion Mq = 2.0 * M * Eigen::Map<const Quaternion>(x + Q(k));
+          cone_block[k] += 2.0 * (l * c->rowGradient(r)(0)) * M;
+          if (c->rowCurvature() != 0.0)
+            cone_block[k] += l * c->rowCurvature() * Mq * Mq.transpose();
+          break;
+        }
+        case ap::StageQuantity::NodeRate:
+          break;  // refused in the constructor
       }
     }
     std::size_t z = 0;
@@ -717,6 +730,23 @@ class TranscriptionNlp : public Ipopt::TNLP {
     if (k == N_ - 1) return p_.final_velocity;
     return Eigen::Map<const Vector3>(x + W(k));
   }
+  /// The row quantity r of constraint `c` at node k (stage_constraints.hpp): τ_k, Ω_k or the
+  /// pointing cosine qᵀMq in r(0).
+  Vector3 rowQuantity(const ap::StageConstraint& c, const double* x, int k) const {
+    switch (c.quantity()) {
+      case ap::StageQuantity::Torque:
+        return Eigen::Map<const Vector3>(x + T(k));
+      case ap::StageQuantity::StepRate:
+        return omega(x, k);
+      case ap::StageQuantity::Pointing: {
+        const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
+        return Vector3(q.dot(pointingForm(c) * q), 0.0, 0.0);
+      }
+      case ap::StageQuantity::NodeRate:
+        break;  // refused in the constructor
+    }
+    return Vector3::Zero();
+  }
   void buildPattern() {
     rows_.clear();
     cols_.clear();
@@ -740,9 +770,9 @@ class TranscriptionNlp : public Ipopt::TNLP {
     for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
       const auto& [c, k] = rows_of_constraints_[r];
       const int row = equalities() + static_cast<int>(r);
-      if (c->kind == ap::ConstraintKind::MaxTorqueNorm) {
+      if (c->quantity() == ap::StageQuantity::Torque) {
         block(row, T(k), 1, 3, false);
-      } else if (c->kind == ap::ConstraintKind::MaxAngularRate) {
+      } else if (c->quantity() == ap::StageQuantity::StepRate) {
         block(row, W(k), 1, 3, false);
       } else {
         block(row, Q(k), 1, 4, false);
@@ -777,9 +807,12 @@ class TranscriptionNlp : public Ipopt::TNLP {
   Quaternion q0_, qN_;
   std::vector<int> rows_, cols_;
   std::vector<int> hrows_, hcols_;
+  /// IPOPT's infinite bound (nlp_upper_bound_inf).
+  static constexpr double kInfinite = 1e19;
+  ap::StageConstraints stage_constraints_;  ///< points into p_.constraints (declared after p_)
   struct ConstraintRow {
-    const ap::PlanningConstraint* constraint;  ///< into p_.constraints
-    int k;                                     ///< node
+    const ap::StageConstraint* constraint;  ///< into stage_constraints_
+    int k;                                  ///< node
   };
   std::vector<ConstraintRow> rows_of_constraints_;
   bool has_cone_ = false;

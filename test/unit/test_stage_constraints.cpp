@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
+#include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -123,9 +125,10 @@ TEST(StageConstraints, OneListInAFixedOrderWithTheRateOnTheSchemesQuantity) {
   EXPECT_EQ(list[9]->quantity(), ap::StageQuantity::Pointing);
   EXPECT_EQ(ap::buildStageConstraints(everyKind(ap::SchemeKind::SecondOrder))[7]->quantity(),
             ap::StageQuantity::NodeRate);
-  // Descriptions name the bound: the checker's for the box, describeConstraint's for the rest.
-  EXPECT_NE(list[0]->describe().find("tau_x <= 0.264"), std::string::npos) << list[0]->describe();
-  EXPECT_NE(list[1]->describe().find("-tau_x"), std::string::npos) << list[1]->describe();
+  // Descriptions name the rule, one wording each: the box's for both of its sides,
+  // describeConstraint's for the rest.
+  EXPECT_EQ(list[0]->describe(), "|tau_x| <= 0.264 N m");
+  EXPECT_EQ(list[1]->describe(), list[0]->describe());
   EXPECT_EQ(list[6]->describe(), ap::describeConstraint(p.constraints[0]));
   EXPECT_EQ(list[8]->describe(), ap::describeConstraint(p.constraints[2]));
   // Zero at the bound, one at the centre (dimensionless as the interior point needs them).
@@ -136,6 +139,146 @@ TEST(StageConstraints, OneListInAFixedOrderWithTheRateOnTheSchemesQuantity) {
   EXPECT_NEAR(list[8]->value(ap::Vector3(std::cos(0.4), 0, 0)), 0.0, 1e-15);
   EXPECT_GT(list[8]->value(ap::Vector3(0.0, 0, 0)), 0.0) << "keep_out: far from s holds";
   EXPECT_LT(list[9]->value(ap::Vector3(0.0, 0, 0)), 0.0) << "keep_in: far from s fails";
+}
+
+namespace {
+
+/// Every ConstraintKind, by its name table (a kind added to the enum and its name is in it).
+std::vector<ap::ConstraintKind> everyConstraintKind() {
+  std::vector<ap::ConstraintKind> out;
+  for (int i = 0; ap::constraintKindName(static_cast<ap::ConstraintKind>(i)) != "unknown"; ++i)
+    out.push_back(static_cast<ap::ConstraintKind>(i));
+  return out;
+}
+
+/// An example of `kind` on `plan` (rest_to_rest's unconstrained optimum): `factor` < 1 makes it
+/// violated there (its limit, or a cone about the middle node's pointing whose angle is that
+/// fraction of the plan's largest; keep_out: about that pointing), > 1 leaves it met (keep_out:
+/// about the antipode) or barely active (limits at 0.8). None for a kind this test does not know:
+/// the test then fails, naming it.
+std::optional<ap::PlanningConstraint> exampleOf(ap::ConstraintKind kind, const ap::Maneuver& plan,
+                                                double factor) {
+  const int N = plan.steps();
+  const ap::Vector3 axis =
+      ap::so3::log(ap::Matrix3(plan.attitude[0].transpose() * plan.attitude[N])).normalized();
+  const ap::Vector3 b = axis.unitOrthogonal();  // swept by the rotation
+  const ap::Vector3 s = plan.attitude[N / 2] * b;
+  double peak_torque = 0.0, peak_rate = 0.0, widest = 0.0;
+  for (int k = 0; k <= N; ++k) {
+    peak_torque = std::max(peak_torque, plan.torque[k].norm());
+    peak_rate = std::max(peak_rate, plan.angular_velocity[k].norm());
+    widest = std::max(widest, std::acos(std::min(1.0, s.dot(plan.attitude[k] * b))));
+  }
+  switch (kind) {
+    case ap::ConstraintKind::MaxTorqueNorm:
+      return ap::PlanningConstraint::maxTorqueNorm(factor * peak_torque);
+    case ap::ConstraintKind::MaxAngularRate:
+      return ap::PlanningConstraint::maxAngularRate(factor * peak_rate);
+    case ap::ConstraintKind::KeepOut:  // about the middle pointing (violated) or its antipode
+      return ap::PlanningConstraint::keepOut(b, factor < 1 ? s : ap::Vector3(-s), 0.2);
+    case ap::ConstraintKind::KeepIn:
+      return ap::PlanningConstraint::keepIn(b, s, factor * widest);
+  }
+  return std::nullopt;
+}
+
+/// The quantity q (the interior point's) of a row quantity r (the dense NLPs'): ½|Ω|² for rates.
+ap::Vector3 stageQuantityOfRow(ap::StageQuantity quantity, const ap::Vector3& r) {
+  const bool rate =
+      quantity == ap::StageQuantity::StepRate || quantity == ap::StageQuantity::NodeRate;
+  return rate ? ap::Vector3(0.5 * r.squaredNorm(), 0.0, 0.0) : r;
+}
+
+/// q of constraint `c` at instance k of a plan (the plan's torques, reported rates, attitudes).
+ap::Vector3 quantityOnPlan(const ap::StageConstraint& c, const ap::Maneuver& plan, int k) {
+  switch (c.quantity()) {
+    case ap::StageQuantity::Torque:
+      return plan.torque[k];
+    case ap::StageQuantity::StepRate:
+    case ap::StageQuantity::NodeRate:
+      return ap::Vector3(0.5 * plan.angular_velocity[k].squaredNorm(), 0.0, 0.0);
+    case ap::StageQuantity::Pointing:
+      return ap::Vector3(c.spec()->world_direction.dot(plan.attitude[k] * c.spec()->body_axis), 0.0,
+                         0.0);
+  }
+  return ap::Vector3::Zero();
+}
+
+}  // namespace
+
+// Adding a constraint is one class: the interior point (c, ∂c), the plan's check (slackOnPlan)
+// and the dense NLPs' rows (the NLopt cross-check, the IPOPT peer) all read it. For every kind:
+// the class exists, its row is one-sided with derivatives that match central differences and
+// holds exactly where c ≥ 0, the checker's slack has c's sign on a plan and names the kind, and
+// NLopt solves with it (converged, within the bound).
+TEST(StageConstraints, EveryKindIsOneClassThatTheCheckerAndTheDenseRowsRead) {
+  ap::PlanningProblem base = scene("rest_to_rest", 16);
+  const ap::PlanResult free_plan = ap::planManeuver(base);
+  ASSERT_TRUE(free_plan.converged()) << free_plan.message;
+  const ap::Maneuver& plan = free_plan.maneuver;
+  std::mt19937 rng(29);
+  std::normal_distribution<double> normal(0.0, 0.4);
+  const std::vector<ap::ConstraintKind> kinds = everyConstraintKind();
+  ASSERT_GE(kinds.size(), 4u);
+  for (const ap::ConstraintKind kind : kinds) {
+    const std::string name = ap::constraintKindName(kind);
+    const std::optional<ap::PlanningConstraint> tight = exampleOf(kind, plan, 0.5);
+    ASSERT_TRUE(tight.has_value()) << name << " has no example";
+    ap::PlanningProblem p = base;
+    p.constraints = {*tight};
+    const ap::StageConstraints list = ap::buildStageConstraints(p);
+    ASSERT_EQ(list.size(), 1u) << name;
+    const ap::StageConstraint& c = *list[0];
+    ASSERT_NE(c.spec(), nullptr) << name;
+    EXPECT_EQ(c.spec()->kind, kind);
+    EXPECT_EQ(c.describe(), ap::describeConstraint(*tight));
+    EXPECT_NE(std::isfinite(c.rowLower()), std::isfinite(c.rowUpper())) << name;
+    // The row: derivatives against central differences; it holds where c ≥ 0.
+    for (int trial = 0; trial < 20; ++trial) {
+      ap::Vector3 r(normal(rng), normal(rng), normal(rng));
+      if (c.quantity() == ap::StageQuantity::Pointing) r = ap::Vector3(std::tanh(r(0)), 0, 0);
+      const int dims = c.quantity() == ap::StageQuantity::Pointing ? 1 : 3;
+      constexpr double kStep = 1e-4;  // g is at most quadratic: no truncation error
+      for (int i = 0; i < dims; ++i) {
+        const ap::Vector3 e = kStep * ap::Vector3::Unit(i);
+        const double up = c.rowValue(r + e), down = c.rowValue(r - e), mid = c.rowValue(r);
+        const double slope = c.rowGradient(r)(i), curvature = c.rowCurvature();
+        EXPECT_NEAR(slope, (up - down) / (2 * kStep), 1e-6 * (1 + std::abs(slope))) << name;
+        EXPECT_NEAR(curvature, (up - 2 * mid + down) / (kStep * kStep),
+                    1e-4 * (1 + std::abs(curvature)))
+            << name;
+      }
+      const double value = c.value(stageQuantityOfRow(c.quantity(), r));
+      const bool holds = c.rowLower() <= c.rowValue(r) && c.rowValue(r) <= c.rowUpper();
+      if (std::abs(value) > 1e-12) EXPECT_EQ(holds, value > 0) << name << " r = " << r.transpose();
+    }
+    // The checker: slack to the node bound with c's sign at every instance; names the kind.
+    const ap::StageSupport s = ap::planSupport(c.quantity(), false, plan.steps());
+    int violated = 0;
+    for (int k = s.first_k; k <= s.last_k; ++k) {
+      const double value = c.value(quantityOnPlan(c, plan, k));
+      const double node_slack = c.slackOnPlan(plan, k) - c.nodeTightening();
+      if (std::abs(value) > 1e-12) EXPECT_EQ(node_slack > 0, value > 0) << name << " k = " << k;
+      violated += value < 0;
+    }
+    EXPECT_GT(violated, 0) << name << ": the example must be violated on the plan";
+    const ap::ConstraintCheck check = ap::checkConstraints(p, plan);
+    EXPECT_EQ(check.names, std::vector<std::string>{name});
+    EXPECT_GT(check.max_violation, 0.0) << name;
+    EXPECT_EQ(check.worst, c.describe());
+    // NLopt forms its rows from the class: solves with a milder example (met by its start).
+    const std::optional<ap::PlanningConstraint> mild =
+        exampleOf(kind, plan, kind == ap::ConstraintKind::KeepIn ? 1.2 : 0.8);
+    p.constraints = {*mild};
+    ap::SolverOptions o;
+    o.solver = ap::SolverKind::Nlopt;
+    o.max_iterations = 5000;
+    const ap::PlanResult slsqp = ap::solveWithNlopt(p, o);
+    EXPECT_TRUE(slsqp.converged()) << name << ": " << slsqp.message;
+    EXPECT_LE(ap::checkConstraints(p, slsqp.maneuver).max_relative_violation,
+              ap::kNodeConstraintTolerance)
+        << name;
+  }
 }
 
 TEST(StageConstraints, ValueDerivativesInTheirQuantityMatchCentralDifferences) {

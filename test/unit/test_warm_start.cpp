@@ -208,9 +208,10 @@ TEST(WarmStart, ConstrainedReplanStartsFromTheGuess) {
 
 // The estimate solves stationarity where it can: ∇f = 2 g_0 + 3 g_1 over two near-active
 // columns is recovered; a near-active column that would need a negative multiplier is dropped;
-// an inactive one gets a small multiplier and its value as slack.
+// an inactive one gets a small multiplier and its value as slack, and so does a near-active one
+// whose value is above the central slack (the free-slack residual c − s starts at zero).
 TEST(MultiplierEstimate, RecoversTheMultipliersOfStationarity) {
-  std::vector<ap::StationarityColumn> columns(4);
+  std::vector<ap::StationarityColumn> columns(5);
   Eigen::VectorXd gradient = Eigen::VectorXd::Zero(9);
   columns[0].value = 1e-9;
   columns[0].gradient << 1, 0, 0, 0, 1, 0, 0, 0, 0;
@@ -224,21 +225,28 @@ TEST(MultiplierEstimate, RecoversTheMultipliersOfStationarity) {
   columns[3].value = 0.5;  // inactive
   columns[3].gradient << 1, 1, 1, 0, 0, 0, 0, 0, 0;
   columns[3].index = {0, 3, 6};
+  columns[4].value = 1e-4;  // near-active, not pushed against (∇f has no component along it)
+  columns[4].gradient << 0, 0, 0, 1, 0, 0, 0, 0, 0;
+  columns[4].index = {0, 3, 6};
   gradient = 2.0 * columns[0].gradient + 3.0 * columns[1].gradient - columns[2].gradient;
   const ap::MultiplierEstimate e = ap::estimateMultipliers(gradient, columns, 1.0);
   EXPECT_EQ(e.active, 2);
-  EXPECT_NEAR(e.z[0], 2.0, 1e-8);
+  // The least-squares multipliers 2 and 3; centering keeps each at least the mean (2.5), whose
+  // central slack is the most a binding column is pushed off its bound.
+  EXPECT_NEAR(e.z[0], 2.5, 1e-8);
   EXPECT_NEAR(e.z[1], 3.0, 1e-8);
   // Centered on μ = kEstimateComplementarity × the mean active multiplier: s_i z_i = μ for
-  // every column, no slack below its value, the dropped near-active column off the corner
-  // s = z = 0 (slack kNearActiveValue), the inactive one at its value.
+  // every column, no slack below its value, the dropped near-active column at zero off the
+  // corner s = z = 0 (the central slack kEstimateComplementarity), the others at their value.
   const double mu = ap::kEstimateComplementarity * 2.5;
   EXPECT_NEAR(e.complementarity, mu, 1e-20);
   for (std::size_t i = 0; i < columns.size(); ++i) {
     EXPECT_NEAR(e.s[i] * e.z[i], mu, 1e-12 * mu) << i;
     EXPECT_GE(e.s[i], std::max(columns[i].value, 0.0)) << i;
   }
-  EXPECT_NEAR(e.s[0], mu / 2.0, 1e-20);
-  EXPECT_NEAR(e.s[2], ap::kNearActiveValue, 1e-20);
+  EXPECT_NEAR(e.s[0], ap::kEstimateComplementarity, 1e-20);
+  EXPECT_NEAR(e.s[1], mu / 3.0, 1e-20);
+  EXPECT_NEAR(e.s[2], ap::kEstimateComplementarity, 1e-20);
   EXPECT_EQ(e.s[3], 0.5);
+  EXPECT_EQ(e.s[4], 1e-4);
 }

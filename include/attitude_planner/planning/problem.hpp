@@ -268,7 +268,7 @@ constexpr double kActiveConstraintTolerance = 1e-6;
 constexpr double kNodeConstraintTolerance = 1e-8;
 
 /// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
-/// on a maneuver's own rows, independently of any solver (constraints.cpp).
+/// on a maneuver's own rows, independently of any solver (transcription/stage_constraints.cpp).
 struct ConstraintCheck {
   std::vector<std::string> names;  ///< the keys in force ("actuator_limits" first if bounded)
   double max_violation = 0.0;      ///< worst violation, each in its own unit, ≥ 0

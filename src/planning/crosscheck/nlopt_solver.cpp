@@ -12,6 +12,7 @@
 #include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/direct_method.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
 
@@ -63,25 +64,112 @@ std::string resultName(nlopt::result r) {
   return "NLOPT_UNKNOWN(" + std::to_string(static_cast<int>(r)) + ")";
 }
 
-/// The node constraints of PlanningProblem::constraints as NLopt inequalities h(x) ≤ 0 on the
-/// torques x = (τ_1..τ_{N−1}), each dimensionless: |τ_k|²/t² − 1, |Ω_k|²/w² − 1 (k = 1..N−2),
-/// ±(sᵀR_k b − cos α) (k = 1..N). Exact Jacobian by forward sensitivities of the simulation,
-/// O(N²) (direct_method.hpp: δF_k = dμ(F_k)⁻¹(dG(F_{k−1}) δF_{k−1} + h δτ_k),
+/// The node constraints of PlanningProblem::constraints (the stage constraints that are not a
+/// side of the actuator box, which are bounds on x here) as NLopt inequalities on the torques
+/// x = (τ_1..τ_{N−1}): each row g(r) ≤ upper as g − upper ≤ 0, or lower − g ≤ 0
+/// (stage_constraints.hpp, dimensionless), r = τ_k (k = 1..N−1), Ω_k (k = 1..N−2; Ω_0, Ω_{N−1} are
+/// fixed by the boundary data) or sᵀR_k b (k = 1..N). Exact Jacobian by forward sensitivities of
+/// the simulation, O(N²) (direct_method.hpp: δF_k = dμ(F_k)⁻¹(dG(F_{k−1}) δF_{k−1} + h δτ_k),
 /// δθ_{k+1} = F_kᵀ δθ_k + δF_k): independent of the interior-point solver's derivatives.
-int nodeInequalityCount(const PlanningProblem& problem) {
-  const int N = problem.steps;
+struct NodeRows {
+  const PlanningProblem* problem = nullptr;
+  StageConstraints rows;  ///< the stage constraints that are rows (not box sides)
+};
+
+/// The instances of a quantity as rows of this transcription (its unknowns are the torques).
+StageSupport rowRange(StageQuantity quantity, int N) {
+  switch (quantity) {
+    case StageQuantity::Torque:
+      return {1, N - 1, 0, 1};
+    case StageQuantity::StepRate:
+      return {1, N - 2, 0, 1};
+    case StageQuantity::Pointing:
+      return {1, N, 0, 1};
+    case StageQuantity::NodeRate:  // schemes with end torques are refused (plan_at_resolution)
+      break;
+  }
+  throw InvalidInput("scheme", "nlopt: the direct method has no node rates (no end torques)");
+}
+
+int nodeInequalityCount(const NodeRows& rows) {
   int m = 0;
-  for (const PlanningConstraint& c : problem.constraints) {
-    m += c.kind == ConstraintKind::MaxTorqueNorm    ? N - 1
-         : c.kind == ConstraintKind::MaxAngularRate ? N - 2
-                                                    : N;
+  for (const auto& c : rows.rows) {
+    const StageSupport s = rowRange(c->quantity(), rows.problem->steps);
+    m += s.last_k - s.first_k + 1;
   }
   return m;
 }
 
+/// +1 for a row with a finite upper side (g − upper ≤ 0), −1 for a lower one (lower − g ≤ 0).
+double rowSign(const StageConstraint& c) {
+  return std::isfinite(c.rowUpper()) ? 1.0 : -1.0;
+}
+
+/// The row g − upper (or lower − g) of `c` at its quantity r.
+double rowExcess(const StageConstraint& c, const Vector3& r) {
+  return std::isfinite(c.rowUpper()) ? c.rowValue(r) - c.rowUpper() : c.rowLower() - c.rowValue(r);
+}
+
+/// One node inequality: its node and the 1×3 derivative of its row w.r.t. τ_k (torque), F_k (step
+/// rate) or θ_k (cone).
+struct NodeRow {
+  int k;
+  bool on_step;  // rate: depends on F_k; cone: on θ_k; torque: on τ_k only
+  bool torque;
+  Eigen::RowVector3d d;
+};
+
+/// The node inequalities' values (into `result`) and derivatives in their quantities, on the
+/// simulated attitudes R_k and steps F_k.
+std::vector<NodeRow> nodeRowValues(const NodeRows& node_rows, const DiscreteScheme& scheme,
+                                   const std::vector<Vector3>& torque,
+                                   const std::vector<Matrix3>& R, const std::vector<Matrix3>& F,
+                                   double* result) {
+  const PlanningProblem& problem = *node_rows.problem;
+  const int N = problem.steps;
+  const double h = problem.duration / N;
+  std::vector<NodeRow> rows;
+  unsigned i = 0;
+  for (const auto& c : node_rows.rows) {
+    const StageSupport s = rowRange(c->quantity(), N);
+    const double sign = rowSign(*c);
+    for (int k = s.first_k; k <= s.last_k; ++k, ++i) {
+      switch (c->quantity()) {
+        case StageQuantity::Torque: {
+          result[i] = rowExcess(*c, torque[k]);
+          rows.push_back({k, false, true, sign * c->rowGradient(torque[k]).transpose()});
+          break;
+        }
+        case StageQuantity::StepRate: {
+          const Vector3 Omega = scheme.velocity(F[k]);
+          result[i] = rowExcess(*c, Omega);
+          const Matrix3 V =
+              problem.scheme == SchemeKind::Paper
+                  ? Matrix3(so3::rightJacobianInverse(so3::log(F[k])) / h)
+                  : Matrix3(problem.inertia.inverse() * scheme.momentumJacobian<double>(F[k]));
+          rows.push_back({k, true, false, sign * c->rowGradient(Omega).transpose() * V});
+          break;
+        }
+        case StageQuantity::Pointing: {  // p = sᵀR_k b = vᵀb, v = R_kᵀ s; ∂p/∂θ_k = (b × v)ᵀ
+          const Vector3& b = c->spec()->body_axis;
+          const Vector3 v = R[k].transpose() * c->spec()->world_direction;
+          const Vector3 p(v.dot(b), 0.0, 0.0);
+          result[i] = rowExcess(*c, p);
+          rows.push_back({k, false, false, sign * c->rowGradient(p)(0) * b.cross(v).transpose()});
+          break;
+        }
+        case StageQuantity::NodeRate:
+          break;  // refused by rowRange
+      }
+    }
+  }
+  return rows;
+}
+
 void nodeInequalities(unsigned m, double* result, unsigned n, const double* x_raw, double* grad,
                       void* data) {
-  const PlanningProblem& problem = *static_cast<const PlanningProblem*>(data);
+  const NodeRows& node_rows = *static_cast<const NodeRows*>(data);
+  const PlanningProblem& problem = *node_rows.problem;
   const int N = problem.steps;
   const double h = problem.duration / N;
   const DiscreteScheme scheme(problem.scheme, problem.inertia, h);
@@ -121,49 +209,16 @@ void nodeInequalities(unsigned m, double* result, unsigned n, const double* x_ra
       Theta[k + 1] = F[k].transpose() * Theta[k] + X[k];
     }
   };
-  // Rows: value and, per row, the 1×3 derivative of its quantity w.r.t. F_k (rate) or θ_k (cone).
-  struct Row {
-    int k;
-    bool on_step;  // rate: depends on F_k; cone: on θ_k; norm: on τ_k only
-    bool torque;
-    Eigen::RowVector3d d;
-  };
-  std::vector<Row> rows;
-  unsigned i = 0;
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxTorqueNorm) {
-      for (int k = 1; k <= N - 1; ++k, ++i) {
-        result[i] = input.torque[k].squaredNorm() / (c.limit * c.limit) - 1.0;
-        rows.push_back({k, false, true, 2.0 * input.torque[k].transpose() / (c.limit * c.limit)});
-      }
-    } else if (c.kind == ConstraintKind::MaxAngularRate) {
-      for (int k = 1; k <= N - 2; ++k, ++i) {
-        const Vector3 Omega = scheme.velocity(F[k]);
-        result[i] = Omega.squaredNorm() / (c.limit * c.limit) - 1.0;
-        const Matrix3 V =
-            problem.scheme == SchemeKind::Paper
-                ? Matrix3(so3::rightJacobianInverse(so3::log(F[k])) / h)
-                : Matrix3(problem.inertia.inverse() * scheme.momentumJacobian<double>(F[k]));
-        rows.push_back({k, true, false, 2.0 * Omega.transpose() * V / (c.limit * c.limit)});
-      }
-    } else {
-      const double sign = c.kind == ConstraintKind::KeepOut ? 1.0 : -1.0;
-      for (int k = 1; k <= N; ++k, ++i) {
-        const Vector3 v = R[k].transpose() * c.world_direction;
-        result[i] = sign * (v.dot(c.body_axis) - std::cos(c.nodeHalfAngle()));
-        rows.push_back({k, false, false, sign * c.body_axis.cross(v).transpose()});
-      }
-    }
-  }
+  const std::vector<NodeRow> rows = nodeRowValues(node_rows, scheme, input.torque, R, F, result);
   if (!grad) return;
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> G(grad, m, n);
-  for (const Row& r : rows) {
+  for (const NodeRow& r : rows) {
     if (r.torque) G.block<1, 3>(&r - rows.data(), 3 * (r.k - 1)) = r.d;
   }
   for (int j = 1; j <= N - 1; ++j) {
     sensitivities(j);
     for (std::size_t row = 0; row < rows.size(); ++row) {
-      const Row& r = rows[row];
+      const NodeRow& r = rows[row];
       if (r.torque) continue;
       G.block<1, 3>(row, 3 * (j - 1)) =
           r.on_step ? Eigen::RowVector3d(r.d * X[r.k]) : Eigen::RowVector3d(r.d * Theta[r.k]);
@@ -176,6 +231,7 @@ struct Callbacks {
   const PlanningProblem* problem = nullptr;
   const SolverOptions* options = nullptr;
   nlopt::opt* opt = nullptr;
+  NodeRows node_rows;  ///< the node inequalities' constraints (pointing into *problem)
   std::vector<IterationInfo> history;
   std::string stop_reason;     ///< set when a callback forces a stop
   int evaluations = 0;         ///< constraint Jacobian evaluations (one per SLSQP iterate)
@@ -255,16 +311,29 @@ void configure(nlopt::opt& opt, Callbacks& cb, const PlanningProblem& problem,
   opt.set_min_objective(objective, nullptr);
   opt.add_equality_mconstraint(
       constraints, &cb, std::vector<double>(kTerminalConstraints, kNloptConstraintTolerance));
-  if (!problem.constraints.empty()) {
-    const int m = nodeInequalityCount(problem);
-    opt.add_inequality_mconstraint(nodeInequalities, const_cast<PlanningProblem*>(&problem),
+  // Box sides are bounds on the torque unknowns; every other stage constraint is a row.
+  Vector3 lower_bound = Vector3::Constant(-HUGE_VAL), upper_bound = Vector3::Constant(HUGE_VAL);
+  bool bounded = false;
+  cb.node_rows.problem = &problem;
+  for (auto& c : buildStageConstraints(problem)) {
+    if (c->axis() < 0) {
+      cb.node_rows.rows.push_back(std::move(c));
+      continue;
+    }
+    bounded = true;
+    lower_bound(c->axis()) = std::max(lower_bound(c->axis()), c->rowLower());
+    upper_bound(c->axis()) = std::min(upper_bound(c->axis()), c->rowUpper());
+  }
+  if (!cb.node_rows.rows.empty()) {
+    const int m = nodeInequalityCount(cb.node_rows);
+    opt.add_inequality_mconstraint(nodeInequalities, &cb.node_rows,
                                    std::vector<double>(m, kNloptConstraintTolerance));
   }
-  if (problem.hasTorqueBounds()) {
+  if (bounded) {
     std::vector<double> lower(n), upper(n);
     for (unsigned i = 0; i < n; ++i) {
-      upper[i] = problem.max_torque(i % 3);
-      lower[i] = -upper[i];
+      upper[i] = upper_bound(i % 3);
+      lower[i] = lower_bound(i % 3);
       x[i] = std::min(std::max(x[i], lower[i]), upper[i]);
     }
     opt.set_lower_bounds(lower);

@@ -33,11 +33,11 @@ constexpr double kEstimateComplementarity = 1e-6;
 /// The multipliers z ≥ 0 (one per column) and slacks of a start, centered on one
 /// complementarity s_i z_i = μ: the near-active columns (value ≤ kNearActiveValue) take the
 /// nonnegative least-squares solution of the stationarity condition ∇f = Σ z_i ∇c_i (active-set
-/// passes dropping negative ones; a 1e-10 relative ridge keeps dependent columns determined) and
-/// slack μ/z_i (capped at kNearActiveValue); the others slack max(c, kNearActiveValue) and z = μ/s;
-/// μ = kEstimateComplementarity × the mean active multiplier (× `fallback_scale` when none is
-/// active): a strongly active column starts at the slack a finer grid level's binding one does.
-/// O(columns).
+/// passes dropping negative ones; a 1e-10 relative ridge keeps dependent columns determined);
+/// every column's slack is its value where that is at least kEstimateComplementarity (the central
+/// slack of the mean active multiplier), else an active column's μ/z_i capped at that, an
+/// inactive one's that; z = μ/s; μ = kEstimateComplementarity × the mean active multiplier
+/// (× `fallback_scale` when none is active). O(columns).
 struct MultiplierEstimate {
   std::vector<double> z, s;
   int active = 0;                ///< columns taken as active

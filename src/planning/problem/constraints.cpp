@@ -5,7 +5,6 @@
 #include <limits>
 #include <sstream>
 
-#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
@@ -160,94 +159,6 @@ std::string describeConstraint(const PlanningConstraint& c) {
     s << " " << c.limit << (c.kind == ConstraintKind::MaxTorqueNorm ? " N m" : " rad/s");
   }
   return s.str();
-}
-
-ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver) {
-  ConstraintCheck out;
-  const int N = maneuver.steps();
-  const double h = maneuver.time_step;
-  int worst_k = -1;
-  // One node constraint: `slack` to the stated limit (≥ 0: holds; violations are measured
-  // against it), `node_slack` to the bound the planner imposes (activity), against `scale`.
-  const auto visit = [&](double slack, double node_slack, double scale, const std::string& what,
-                         int k) {
-    if (node_slack <= kActiveConstraintTolerance * scale) ++out.active;
-    out.max_node_bound_violation = std::max(out.max_node_bound_violation, -node_slack);
-    out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
-    // The solver's verdict (planInconsistency) is on the bound it was asked to meet.
-    out.max_relative_violation = std::max(out.max_relative_violation, -node_slack / scale);
-    if (-slack > out.max_violation) {
-      out.max_violation = -slack;
-      out.worst = what;
-      worst_k = k;  // worst_where is written once, at the end
-    }
-  };
-  // Between nodes: torques are held (or, with end torques, interpolated linearly: the bounds are
-  // convex), so only rates and cones need more.
-  const auto between = [&](double slack) {
-    out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
-  };
-  // The torques τ_k and rates Ω_k of the plan: k = 1..N−1 and steps 0..N−1 for paper and
-  // variational (τ_0 = τ_N = 0; Ω_N repeats Ω_{N−1}); every node k = 0..N with end torques.
-  const bool end_torques = schemeHasEndTorques(problem.scheme);
-  const int first_torque = end_torques ? 0 : 1, last_torque = end_torques ? N : N - 1;
-  const int last_rate = end_torques ? N : N - 1;
-  if (problem.hasTorqueBounds()) {
-    out.names.push_back("actuator_limits");
-    static const char* axis[] = {"x", "y", "z"};
-    std::string what[3];  // formed once: a stream per node and axis cost as much as the solve's
-                          // replay (measured, N = 128)
-    for (int i = 0; i < 3; ++i) {
-      std::ostringstream s;
-      s << "|tau_" << axis[i] << "| <= " << problem.max_torque(i) << " N m";
-      what[i] = s.str();
-    }
-    for (int k = first_torque; k <= last_torque; ++k) {
-      for (int i = 0; i < 3; ++i) {
-        const double a = problem.max_torque(i);
-        const double slack = a - std::abs(maneuver.torque[k](i));
-        visit(slack, slack, a, what[i], k);
-      }
-    }
-  }
-  for (const PlanningConstraint& c : problem.constraints) {
-    out.names.push_back(constraintKindName(c.kind));
-    const std::string what = describeConstraint(c);
-    switch (c.kind) {
-      case ConstraintKind::MaxTorqueNorm:
-        for (int k = first_torque; k <= last_torque; ++k) {
-          const double slack = c.limit - maneuver.torque[k].norm();
-          visit(slack, slack, c.limit, what, k);
-        }
-        break;
-      case ConstraintKind::MaxAngularRate:
-        for (int k = 0; k <= last_rate; ++k) {
-          const double slack = c.limit - maneuver.angular_velocity[k].norm();
-          visit(slack, slack, c.limit, what, k);
-          // The motion between nodes turns at log(F_k)/h (a scheme's reported Ω_k may differ
-          // from it by O(h²)).
-          if (k < N) {
-            const Matrix3 F = maneuver.attitude[k].transpose() * maneuver.attitude[k + 1];
-            between(c.limit - so3::log(F).norm() / h);
-          }
-        }
-        break;
-      case ConstraintKind::KeepOut:
-      case ConstraintKind::KeepIn:
-        for (int k = 0; k <= N; ++k) {
-          const double slack = coneMargin(c, maneuver.attitude[k]);
-          visit(slack, slack - c.margin, 1.0, what, k);
-          if (k < N) between(coneMarginOverStep(c, maneuver.attitude[k], maneuver.attitude[k + 1]));
-        }
-        break;
-    }
-  }
-  if (worst_k >= 0) {
-    std::ostringstream w;
-    w << "by " << out.max_violation << " at k = " << worst_k << " (t = " << worst_k * h << " s)";
-    out.worst_where = w.str();
-  }
-  return out;
 }
 
 }  // namespace attitude_planner

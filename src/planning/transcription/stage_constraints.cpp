@@ -1,6 +1,7 @@
 // The stage constraints (stage_constraints.hpp): one class per kind.
 #include "planning/transcription/stage_constraints.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -26,9 +27,17 @@ class TorqueBoxSide final : public StageConstraint {
   std::string describe() const override {
     static const char* kAxis[] = {"x", "y", "z"};
     std::ostringstream s;
-    s << (sign_ > 0 ? "tau_" : "-tau_") << kAxis[axis_] << " <= " << limit_ << " N m";
+    s << "|tau_" << kAxis[axis_] << "| <= " << limit_ << " N m";
     return s.str();
   }
+  double slackOnPlan(const Maneuver& plan, int k) const override {
+    return limit_ - sign_ * plan.torque[k](axis_);
+  }
+  double slackScale() const override { return limit_; }
+  double rowValue(const Vector3& tau) const override { return tau(axis_); }
+  Vector3 rowGradient(const Vector3&) const override { return Vector3::Unit(axis_); }
+  double rowLower() const override { return sign_ > 0 ? StageConstraint::rowLower() : -limit_; }
+  double rowUpper() const override { return sign_ > 0 ? limit_ : StageConstraint::rowUpper(); }
 
  private:
   int axis_;
@@ -46,6 +55,17 @@ class TorqueNorm final : public StageConstraint {
   Vector3 gradient(const Vector3& tau) const override { return -2.0 / (limit_ * limit_) * tau; }
   double curvature() const override { return -2.0 / (limit_ * limit_); }
   std::string describe() const override { return describeConstraint(*spec()); }
+  double slackOnPlan(const Maneuver& plan, int k) const override {
+    return limit_ - plan.torque[k].norm();
+  }
+  double slackScale() const override { return limit_; }
+  /// g = |τ|²/t² ≤ 1.
+  double rowValue(const Vector3& tau) const override {
+    return tau.squaredNorm() / (limit_ * limit_);
+  }
+  Vector3 rowGradient(const Vector3& tau) const override { return 2.0 * tau / (limit_ * limit_); }
+  double rowCurvature() const override { return 2.0 / (limit_ * limit_); }
+  double rowUpper() const override { return 1.0; }
 
  private:
   double limit_;
@@ -55,12 +75,35 @@ class TorqueNorm final : public StageConstraint {
 class AngularRate final : public StageConstraint {
  public:
   AngularRate(const PlanningConstraint* spec, StageQuantity quantity)
-      : StageConstraint(quantity, spec), slope_(-2.0 / (spec->limit * spec->limit)) {}
+      : StageConstraint(quantity, spec),
+        limit_(spec->limit),
+        slope_(-2.0 / (spec->limit * spec->limit)) {}
   double value(const Vector3& q) const override { return 1.0 + slope_ * q(0); }
   Vector3 gradient(const Vector3&) const override { return Vector3(slope_, 0.0, 0.0); }
   std::string describe() const override { return describeConstraint(*spec()); }
+  /// On the plan's reported Ω_k (the scheme's node or step rate).
+  double slackOnPlan(const Maneuver& plan, int k) const override {
+    return limit_ - plan.angular_velocity[k].norm();
+  }
+  double slackScale() const override { return limit_; }
+  /// The motion between nodes turns at log(F_k)/h (a scheme's reported Ω_k may differ from it by
+  /// O(h²)).
+  double slackBetweenNodes(const Maneuver& plan, int k) const override {
+    const Matrix3 F = plan.attitude[k].transpose() * plan.attitude[k + 1];
+    return limit_ - so3::log(F).norm() / plan.time_step;
+  }
+  /// g = |Ω|²/w² ≤ 1.
+  double rowValue(const Vector3& omega) const override {
+    return omega.squaredNorm() / (limit_ * limit_);
+  }
+  Vector3 rowGradient(const Vector3& omega) const override {
+    return 2.0 * omega / (limit_ * limit_);
+  }
+  double rowCurvature() const override { return 2.0 / (limit_ * limit_); }
+  double rowUpper() const override { return 1.0; }
 
  private:
+  double limit_;  ///< w [rad/s]
   double slope_;  ///< −2/w²
 };
 
@@ -75,6 +118,21 @@ class PointingCone final : public StageConstraint {
   double value(const Vector3& p) const override { return sign_ * (p(0) - bound_); }
   Vector3 gradient(const Vector3&) const override { return Vector3(sign_, 0.0, 0.0); }
   std::string describe() const override { return describeConstraint(*spec()); }
+  /// The angle's margin (coneMargin: atan2, accurate at every angle, where acos of the cosine
+  /// would not be).
+  double slackOnPlan(const Maneuver& plan, int k) const override {
+    return coneMargin(*spec(), plan.attitude[k]);
+  }
+  double nodeTightening() const override { return spec()->margin; }
+  double slackScale() const override { return 1.0; }
+  double slackBetweenNodes(const Maneuver& plan, int k) const override {
+    return coneMarginOverStep(*spec(), plan.attitude[k], plan.attitude[k + 1]);
+  }
+  /// g = p, keep_out: p ≤ cos α; keep_in: p ≥ cos α.
+  double rowValue(const Vector3& p) const override { return p(0); }
+  Vector3 rowGradient(const Vector3&) const override { return Vector3::UnitX(); }
+  double rowLower() const override { return sign_ > 0 ? bound_ : StageConstraint::rowLower(); }
+  double rowUpper() const override { return sign_ > 0 ? StageConstraint::rowUpper() : bound_; }
 
  private:
   double sign_, bound_;
@@ -101,6 +159,20 @@ bool quantityDependsOnTimeStep(StageQuantity quantity) {
   return quantity != StageQuantity::Pointing;
 }
 
+StageSupport planSupport(StageQuantity quantity, bool end_torques, int steps) {
+  const int N = steps;
+  switch (quantity) {
+    case StageQuantity::Torque:
+      return end_torques ? StageSupport{0, N, 0, 1} : StageSupport{1, N - 1, 0, 1};
+    case StageQuantity::StepRate:
+      return {0, N - 1, 0, 2};
+    case StageQuantity::NodeRate:
+    case StageQuantity::Pointing:
+      return {0, N, 0, 1};
+  }
+  return {};
+}
+
 StageConstraints buildStageConstraints(const PlanningProblem& problem) {
   StageConstraints out;
   if (problem.hasTorqueBounds()) {
@@ -125,6 +197,61 @@ StageConstraints buildStageConstraints(const PlanningProblem& problem) {
         out.push_back(std::make_unique<PointingCone>(&c));
         break;
     }
+  }
+  return out;
+}
+
+namespace {
+
+/// The running figures of checkConstraints.
+struct CheckTally {
+  ConstraintCheck out;
+  int worst_k = -1;
+
+  /// One instance: `slack` to the stated limit (≥ 0: holds; violations are measured against
+  /// it), `node_slack` to the bound the planner imposes (activity), against `scale`.
+  void node(double slack, double node_slack, double scale, const std::string& what, int k) {
+    if (node_slack <= kActiveConstraintTolerance * scale) ++out.active;
+    out.max_node_bound_violation = std::max(out.max_node_bound_violation, -node_slack);
+    out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
+    // The solver's verdict (planInconsistency) is on the bound it was asked to meet.
+    out.max_relative_violation = std::max(out.max_relative_violation, -node_slack / scale);
+    if (-slack > out.max_violation) {
+      out.max_violation = -slack;
+      out.worst = what;
+      worst_k = k;  // worst_where is written once, at the end
+    }
+  }
+  void between(double slack) {
+    out.max_violation_between_nodes = std::max(out.max_violation_between_nodes, -slack);
+  }
+};
+
+}  // namespace
+
+ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver) {
+  CheckTally tally;
+  ConstraintCheck& out = tally.out;
+  if (problem.hasTorqueBounds()) out.names.push_back("actuator_limits");
+  for (const PlanningConstraint& c : problem.constraints)
+    out.names.push_back(constraintKindName(c.kind));
+  const int N = maneuver.steps();
+  const bool end_torques = schemeHasEndTorques(problem.scheme);
+  for (const auto& c : buildStageConstraints(problem)) {
+    // Formed once: a stream per node cost as much as the solve's replay (measured, N = 128).
+    const std::string what = c->describe();
+    const StageSupport s = planSupport(c->quantity(), end_torques, N);
+    for (int k = s.first_k; k <= s.last_k; ++k) {
+      const double slack = c->slackOnPlan(maneuver, k);
+      tally.node(slack, slack - c->nodeTightening(), c->slackScale(), what, k);
+      if (k < N) tally.between(c->slackBetweenNodes(maneuver, k));
+    }
+  }
+  if (tally.worst_k >= 0) {
+    std::ostringstream w;
+    w << "by " << out.max_violation << " at k = " << tally.worst_k
+      << " (t = " << tally.worst_k * maneuver.time_step << " s)";
+    out.worst_where = w.str();
   }
   return out;
 }

@@ -10,13 +10,22 @@
 // in h (ReducedProblem::forEachStencilWithTimeStep). The assemblers (interior_point/
 // constrained_system at a fixed h, interior_point/free_time_solver with h free) apply the chain
 // rule: ∇c = c'(q) ∇q, ∇²c = c'(q) ∇²q + ∇qᵀ c''(q) ∇q.
+//
+// The same objects serve the two other places that read constraints, so that adding a kind is one
+// class: the plan's check (checkConstraints: each constraint's slack in its physical unit on the
+// plan's torques, rates or attitudes, at the nodes and between them), and the dense NLPs (the NLopt
+// cross-check, the IPOPT peer in studies/benchmark_solvers.cpp: each constraint as a row
+// lower ≤ g(r) ≤ upper in its quantity's plain form r). Those places switch on the quantity (how
+// their own transcription forms τ_k, Ω_k or the pointing cosine), never on the kind.
 #pragma once
 
 #include <initializer_list>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/planning/problem.hpp"
 
 namespace attitude_planner {
@@ -49,6 +58,11 @@ StageSupport stageSupport(StageQuantity quantity, int first_free, int last_free)
 /// True where q changes with the time step at fixed free attitudes (all but Pointing).
 bool quantityDependsOnTimeStep(StageQuantity quantity);
 
+/// The instances k = first_k..last_k of a quantity on a plan of `steps` steps (checkConstraints):
+/// the torques the plan carries (1..N−1; 0..N with end torques), the step rates 0..N−1 (the
+/// plan's reported Ω_k), node rates and cones 0..N.
+StageSupport planSupport(StageQuantity quantity, bool end_torques, int steps);
+
 /// One node constraint c(q) ≥ 0, imposed at every instance of its quantity.
 class StageConstraint {
  public:
@@ -68,9 +82,35 @@ class StageConstraint {
   /// rank-one terms are formed in the band's precision, which a constraint at its bound needs at
   /// N ≥ 1e4).
   virtual int axis() const { return -1; }
-  /// One line for messages and the checker, e.g. "max_torque_norm 0.45 N m" or
-  /// "actuator_limits max_torque[1] 0.3 N m (upper)".
+  /// One line for messages and the checker (ConstraintCheck::worst), one wording per rule:
+  /// describeConstraint's for the scene's constraints ("max_torque_norm 0.45 N m"), the box's
+  /// rule for both of its sides ("|tau_y| <= 0.3 N m").
   virtual std::string describe() const = 0;
+
+  // The plan's check (checkConstraints), in the constraint's physical unit (N m, rad/s, rad),
+  // against the stated limit (not the dimensionless c, which a cone states at its node bound).
+  /// The slack at instance k of `plan` (planSupport), ≥ 0 where the limit holds.
+  virtual double slackOnPlan(const Maneuver& plan, int k) const = 0;
+  /// How much tighter the node bound the planner imposes is, same unit (a cone's margin).
+  virtual double nodeTightening() const { return 0.0; }
+  /// The unit a violation is relative to (the limit; 1 rad for cones).
+  virtual double slackScale() const = 0;
+  /// The least slack over the motion between instances k and k + 1, R_k exp(s ω_k^) (+∞ where
+  /// the node values bound it: torques are held, or interpolated linearly under a convex bound).
+  virtual double slackBetweenNodes(const Maneuver&, int) const {
+    return std::numeric_limits<double>::infinity();
+  }
+
+  // The constraint as a row of a dense NLP: lower ≤ g(r) ≤ upper, r the quantity's plain form
+  // (τ_k; Ω_k, not squared; the pointing cosine in r(0)), one side finite. A box side (axis() ≥ 0)
+  // is a bound on one variable there: g = τ_axis.
+  virtual double rowValue(const Vector3& r) const = 0;
+  /// ∂g/∂r (scalar quantities: in entry 0).
+  virtual Vector3 rowGradient(const Vector3& r) const = 0;
+  /// ∇²_r g = rowCurvature()·I (scalar quantities: d²g/dr²).
+  virtual double rowCurvature() const { return 0.0; }
+  virtual double rowLower() const { return -std::numeric_limits<double>::infinity(); }
+  virtual double rowUpper() const { return std::numeric_limits<double>::infinity(); }
 
  protected:
   StageConstraint(StageQuantity quantity, const PlanningConstraint* spec)

@@ -12,7 +12,9 @@
 
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/problem/solve_context.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/strategies/grid_continuation.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
@@ -569,6 +571,11 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
     if (c.isCone()) c.margin += kConeStartClearance;
     if (c.isCone() || every_constraint) effort.constraints.push_back(c);
   }
+  // A cone tightened past a cone (node half angle outside (0, π)) is no problem to solve
+  // (validateProblem would refuse it): no cleared start.
+  for (const PlanningConstraint& c : effort.constraints) {
+    if (c.isCone() && !(c.nodeHalfAngle() > 0.0 && c.nodeHalfAngle() < M_PI)) return std::nullopt;
+  }
   try {
     SolverOptions o = options;
     PlanResult r;
@@ -586,7 +593,7 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
       r = planAtResolution(effort, o);
     }
     if (r.converged()) return r.maneuver.attitude;
-  } catch (const std::exception&) {  // a start with no step at this T: no cleared start
+  } catch (const StepTooLarge&) {  // a boundary rate with no step at this T: no cleared start
   }
   return std::nullopt;
 }
@@ -595,73 +602,100 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
 /// interpolated in time (ReducedProblem::initializeFromCoarser), so the torques stay near the
 /// coarse ones. (Resampling the attitudes instead put torque spikes of ~1.5× the bound next to
 /// the switches of a bang–bang plan: the free-time start then had to raise T by ~27 % before
-/// every bound held, measured on Bilimoria–Wie, N = 512 → 1024.)
+/// every bound held, measured on Bilimoria–Wie, N = 512 → 1024.) With cones the new nodes
+/// between the coarse ones dip past an active bound by O(h²): they are turned out of the cones
+/// (pushedOutOfCones), as a free-time start must clear them strictly.
 std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse) {
   PlanningProblem at = p;
   at.duration = coarse.duration;
+  std::vector<Matrix3> attitudes;
   try {
     ReducedProblem np(at);
     np.initializeFromCoarser(coarse.steps);
-    return np.attitudes(np.current());
+    attitudes = np.attitudes(np.current());
   } catch (const StepTooLarge&) {  // the boundary rates admit no step at this h
-    return resampleAttitudes(coarse.maneuver, p.steps);
+    attitudes = resampleAttitudes(coarse.maneuver, p.steps);
   }
+  if (coneClearance(p, attitudes) < 0.5 * kConeStartClearance) {
+    attitudes = pushedOutOfCones(p, attitudes, kConeStartClearance);
+  }
+  return attitudes;
+}
+
+/// What one free-time grid level hands the next: its outcome (plan, T, steps).
+struct FreeTimeCarry {
+  FreeTimeOutcome outcome;
+  bool empty() const { return outcome.steps.empty(); }
+};
+
+/// The free-time grid levels (strategies/grid_continuation.hpp): N, N/2, ... down to the coarsest
+/// at or above kFreeTimeStartGrid, each solved to kFreeTimeTolerance. A refinement by 2 at a time:
+/// measured, a resampled N = 64 plan started N = 512 so far from its optimum that the solve slid
+/// to the eigenaxis slew's T. Below 2 kFreeTimeStartGrid a grid's half would be under the
+/// coarsest, so it is solved on its own. A refined level that does not converge ends the
+/// continuation with no answer (a fresh start there would be another attempt; the caller falls
+/// back to the search).
+GridLevelRule freeTimeGridRule() {
+  GridLevelRule rule;
+  rule.coarsest_steps = kFreeTimeStartGrid;
+  rule.coarsening_factor = 2;
+  rule.direct_up_to = 2 * kFreeTimeStartGrid - 1;
+  rule.coarse_tolerance_floor = 0.0;
+  rule.unconverged_ends = true;
+  return rule;
+}
+
+/// A free-time level's end as the continuation's result and its LevelSummary (the relative
+/// gradient: the stationarity of the minimum-time Lagrangian).
+PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
+  PlanResult r;
+  r.termination = o.termination;
+  r.message = o.message;
+  r.iterations = o.iterations;
+  LevelSummary level;
+  level.steps = steps;
+  level.iterations = o.iterations;
+  level.termination = o.termination;
+  level.relative_gradient = o.stationarity;
+  level.reason = o.message;
+  r.levels.push_back(level);
+  return r;
 }
 
 /// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
-/// free-time solve, the least T kept; the starts run on the coarsest of N, N/2, ... at or above
-/// kFreeTimeStartGrid and the best, prolonged (its rates interpolated), is solved once on each
-/// finer grid. The answer is then polished: the minimum-effort plan at T* from the free-time plan
-/// (its multipliers give the switching functions). Empty if no solve converged (the caller falls
-/// back to the search).
+/// free-time solve, the least T kept; the starts run on the coarsest level of the free-time grid
+/// continuation (freeTimeGridRule) and the best is resumed through the finer levels, each solved
+/// once from the coarser answer prolonged (its rates interpolated). The answer is then polished:
+/// the minimum-effort plan at T* from the free-time plan (its multipliers give the switching
+/// functions). Empty if no solve converged (the caller falls back to the search).
 class FreeTimeMinimumTime {
  public:
   FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
-      : problem_(problem), options_(options), start_(std::chrono::steady_clock::now()) {}
+      : problem_(problem), context_(options) {}
 
   std::optional<PlanResult> run() {
     const bool rest_to_rest =
         problem_.initial_velocity.isZero(0.0) && problem_.final_velocity.isZero(0.0) &&
         so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
-    // The grids: N, N/2, ... down to the coarsest at or above kFreeTimeStartGrid (a refinement by
-    // 2 at a time: measured, a resampled N = 64 plan started N = 512 so far from its optimum that
-    // the solve slid to the eigenaxis slew's T).
-    std::vector<int> levels{problem_.steps};
-    while (levels.back() / 2 >= kFreeTimeStartGrid) levels.push_back(levels.back() / 2);
-    PlanningProblem grid = problem_;
-    grid.steps = levels.back();
-    const int best = solveStarts(grid, freeTimeStarts(grid, rest_to_rest));
+    const std::vector<PlanningProblem> levels = gridLevels(problem_, freeTimeGridRule());
+    const PlanningProblem& coarsest = levels.front();
+    const int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
     if (best < 0) return std::nullopt;
-    FreeTimeOutcome answer = outcomes_[best];
-    std::string from = names_[best];
-    for (auto level = levels.rbegin() + 1; level != levels.rend(); ++level) {
-      grid.steps = *level;
-      answer = solve(grid, answer, AttemptStart::CoarseLevel);
-      if (answer.termination != Termination::Converged) return std::nullopt;
-    }
-    if (levels.size() > 1) {
-      best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
-      from = "coarse grid (N = " + std::to_string(levels.back()) + ", " + names_[best] +
-             "), refined by 2 at a time";
-    }
-    return polished(answer, from);
+    levels_ = levelResult(coarsest.steps, outcomes_[best]).levels;
+    if (levels.size() == 1) return polished(outcomes_[best], names_[best]);
+    std::optional<FreeTimeOutcome> refined = refine(levels, outcomes_[best]);
+    if (!refined) return std::nullopt;
+    best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
+    return polished(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
+                                  names_[best] + "), refined by 2 at a time");
   }
 
  private:
-  /// One free-time solve from a start's attitudes at T = duration.
-  FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& attitudes,
+  /// One free-time solve from `start` (N + 1 attitudes, clear of the cones) at T = duration,
+  /// recorded in the trail.
+  FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
                         double duration, AttemptStart kind) {
-    const SolverOptions remaining = withRemainingBudget(options_, start_);
-    std::vector<Matrix3> start = attitudes;
-    if (kind == AttemptStart::ConstrainedMinimumEffort) {
-      if (auto planned = coneClearStart(p, start, duration, remaining, true)) start = *planned;
-    } else if (coneClearance(p, start) < 0.5 * kConeStartClearance) {
-      if (kind == AttemptStart::CoarseLevel) {
-        start = pushedOutOfCones(p, start, kConeStartClearance);
-      } else if (auto cleared = coneClearStart(p, start, duration, remaining)) {
-        start = *cleared;
-      }
-    }
+    const SolverOptions remaining = context_.remainingOptions();
     FreeTimeOutcome o =
         solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, &remaining);
     Attempt a;
@@ -677,10 +711,16 @@ class FreeTimeMinimumTime {
     return o;
   }
 
-  /// One free-time solve on grid p from the answer on a coarser grid, at its T.
-  FreeTimeOutcome solve(const PlanningProblem& p, const FreeTimeOutcome& coarse,
-                        AttemptStart kind) {
-    return solve(p, prolonged(p, coarse), coarse.duration, kind);
+  /// A structured start made to clear the cones: the ConstrainedMinimumEffort start is the
+  /// minimum-effort plan under every constraint; any other start too close to a cone is replaced
+  /// by the minimum-effort plan under the cones alone from it (coneClearStart).
+  std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
+    const SolverOptions remaining = context_.remainingOptions();
+    if (st.kind == AttemptStart::ConstrainedMinimumEffort) {
+      return coneClearStart(p, st.attitudes, st.duration, remaining, true).value_or(st.attitudes);
+    }
+    if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
+    return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
   }
 
   /// Runs every start on `grid`; returns the index of the converged one with the least T (−1:
@@ -688,8 +728,8 @@ class FreeTimeMinimumTime {
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
     int best = -1;
     for (const FreeTimeStart& st : starts) {
-      if (budgetSpent(withRemainingBudget(options_, start_))) break;
-      outcomes_.push_back(solve(grid, st.attitudes, st.duration, st.kind));
+      if (budgetSpent(context_.remainingOptions())) break;
+      outcomes_.push_back(solve(grid, clearOfCones(grid, st), st.duration, st.kind));
       names_.push_back(st.name);
       const FreeTimeOutcome& o = outcomes_.back();
       if (o.termination == Termination::Converged &&
@@ -701,6 +741,40 @@ class FreeTimeMinimumTime {
     return best;
   }
 
+  /// The coarsest level's best answer carried through the finer `levels` (the grid continuation
+  /// resumed from it): each level one free-time solve from the coarser answer prolonged, at its
+  /// T. Empty if a level does not converge or the solve is stopped (cancel, deadline).
+  std::optional<FreeTimeOutcome> refine(const std::vector<PlanningProblem>& levels,
+                                        const FreeTimeOutcome& coarsest) {
+    std::optional<FreeTimeOutcome> finest;
+    const LevelSolver<FreeTimeCarry> level = [&](const LevelRequest<FreeTimeCarry>& r,
+                                                 FreeTimeCarry* handed_on) {
+      if (r.replay_only || !r.coarse) {  // stopped: no answer on this level
+        PlanResult stopped;
+        stopped.termination = r.stop ? r.stop->termination : Termination::NotConverged;
+        return stopped;
+      }
+      const FreeTimeOutcome& coarse = r.coarse->outcome;
+      FreeTimeOutcome o = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
+                                AttemptStart::CoarseLevel);
+      PlanResult result = levelResult(r.problem.steps, o);
+      if (handed_on) {
+        handed_on->outcome = std::move(o);
+      } else {
+        finest = std::move(o);
+      }
+      return result;
+    };
+    // The polish writes the message from the whole trail; the levels keep their own.
+    const ContinuationFinish finish = [](const ContinuationRecord&, PlanResult*) {};
+    const SolvedLevel<FreeTimeCarry> from{0, Termination::Converged, {coarsest}, {}, false};
+    const PlanResult result = resumeGridContinuation(levels, from, context_, freeTimeGridRule(),
+                                                     kFreeTimeTolerance, level, finish);
+    if (!result.converged() || !finest) return std::nullopt;
+    levels_.insert(levels_.end(), result.levels.begin(), result.levels.end());
+    return finest;
+  }
+
   /// The plan at T*: the minimum-effort plan at T* from the free-time plan if that proves T*
   /// feasible (provesFeasible), else the free-time plan itself evaluated at T* by the same solve.
   PlanResult polished(const FreeTimeOutcome& answer, const std::string& from) {
@@ -708,7 +782,7 @@ class FreeTimeMinimumTime {
     effort.objective = Objective::MinimumEffort;
     effort.time_margin = 0.0;
     effort.duration = answer.duration;
-    SolverOptions o = withRemainingBudget(options_, start_);
+    SolverOptions o = context_.remainingOptions();
     o.warm_start = &answer.maneuver;
     o.constrained_from_warm_start = true;
     PlanResult result = planAtResolution(effort, o);
@@ -756,6 +830,8 @@ class FreeTimeMinimumTime {
     result.minimum_time.complementarity = answer.complementarity;
     result.minimum_time.solves = solves_;
     result.attempts = trail_;
+    // The free-time levels first, then the polish's own.
+    result.levels.insert(result.levels.begin(), levels_.begin(), levels_.end());
     return result;
   }
 
@@ -782,9 +858,9 @@ class FreeTimeMinimumTime {
   }
 
   const PlanningProblem& problem_;
-  SolverOptions options_;
-  std::chrono::steady_clock::time_point start_;
+  SolveContext context_;
   std::vector<FreeTimeOutcome> outcomes_;
+  std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<std::string> names_;
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;

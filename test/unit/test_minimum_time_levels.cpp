@@ -140,3 +140,24 @@ TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {
   invalid.inertia(0, 0) = -1.0;
   EXPECT_THROW(ap::coneClearStart(invalid, attitudes, 30.0, options, true), ap::InvalidInput);
 }
+
+TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
+  // Around the keep-out cone most structured starts clear it to the same minimum-effort plan:
+  // each distinct start is solved once, and T* is the one every start solved gave (main 6b00274,
+  // 18 free-time solves on N = 64: 29.00779406049 s).
+  const ap::PlanningProblem p = scene("min_time_keep_out", 64);
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
+  const std::size_t starts = ap::freeTimeStarts(p, true).size();
+  const auto solves = std::count_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return a.stage == ap::AttemptStage::MinimumTimeSolve;
+  });
+  EXPECT_EQ(solves, r.minimum_time.solves);
+  EXPECT_LT(static_cast<std::size_t>(solves), starts);
+  EXPECT_LE(r.minimum_duration, 29.00779406049 * (1 + 1e-9));
+  // Without cones no start is cleared, and the structured starts are distinct: each is solved.
+  const ap::PlanningProblem box = scene("min_time_bilimoria_wie", 64);
+  const ap::PlanResult b = ap::planManeuver(box);
+  ASSERT_TRUE(b.converged()) << b.message;
+  EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves), ap::freeTimeStarts(box, true).size());
+}

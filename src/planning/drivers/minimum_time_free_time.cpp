@@ -1,5 +1,6 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -19,6 +20,10 @@ namespace {
 /// dimensionless): the duality gap Σ zc bounds T − T* relative to T₀ by this much.
 constexpr double kFreeTimeTolerance = 1e-9;
 constexpr int kFreeTimeMaxIterations = 500;
+/// Two starts at the same T whose attitudes differ by at most this much (max entry of R_k − R'_k)
+/// are one start: the free-time solve from either ends at the same KKT point (the cleared starts
+/// that repeat one another differ by ~1e-13, their answers' T by ~1e-16 relative).
+constexpr double kSameStart = 1e-8;
 
 /// What one free-time grid level hands the next: its outcome (plan, T, steps).
 struct FreeTimeCarry {
@@ -104,14 +109,34 @@ class FreeTimeMinimumTime {
     return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
   }
 
-  /// Runs every start on `grid`; returns the index of the converged one with the least T (−1:
-  /// none converged).
+  /// The earlier start whose solve this one would repeat (the same T and attitudes within
+  /// kSameStart), or −1. Around a cone most starts clear it to the same minimum-effort plan
+  /// (measured, scenes/min_time_keep_out.yaml N = 64: 18 starts, 8 distinct once cleared).
+  int sameStartAs(const std::vector<Matrix3>& start, double duration) const {
+    for (std::size_t j = 0; j < starts_.size(); ++j) {
+      if (same_as_[j] >= 0 || start_durations_[j] != duration) continue;
+      double difference = 0.0;
+      for (std::size_t k = 0; k < start.size(); ++k) {
+        difference = std::max(difference, (start[k] - starts_[j][k]).cwiseAbs().maxCoeff());
+      }
+      if (difference <= kSameStart) return static_cast<int>(j);
+    }
+    return -1;
+  }
+
+  /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
+  /// the index of the converged one with the least T (−1: none converged).
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
     int best = -1;
     for (const FreeTimeStart& st : starts) {
       if (budgetSpent(context_.remainingOptions())) break;
-      outcomes_.push_back(solve(grid, clearOfCones(grid, st), st.duration, st.kind));
+      std::vector<Matrix3> start = clearOfCones(grid, st);
+      const int same = sameStartAs(start, st.duration);
+      outcomes_.push_back(same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind));
       names_.push_back(st.name);
+      same_as_.push_back(same);
+      starts_.push_back(std::move(start));
+      start_durations_.push_back(st.duration);
       const FreeTimeOutcome& o = outcomes_.back();
       if (o.termination == Termination::Converged &&
           (best < 0 || o.duration < outcomes_[best].duration)) {
@@ -195,6 +220,7 @@ class FreeTimeMinimumTime {
          << answer.complementarity << "; starts:";
     for (std::size_t i = 0; i < outcomes_.size(); ++i) {
       note << " " << names_[i] << " ";
+      if (same_as_[i] >= 0) note << "(as " << names_[same_as_[i]] << ") ";
       if (outcomes_[i].termination == Termination::Converged) {
         note << outcomes_[i].duration << " s;";
       } else {
@@ -241,7 +267,10 @@ class FreeTimeMinimumTime {
   const PlanningProblem& problem_;
   SolveContext context_;
   std::vector<FreeTimeOutcome> outcomes_;
-  std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
+  std::vector<LevelSummary> levels_;          ///< the kept start's level and each refined level
+  std::vector<std::vector<Matrix3>> starts_;  ///< each start's attitudes as solved (cleared)
+  std::vector<double> start_durations_;       ///< and its T
+  std::vector<int> same_as_;  ///< the earlier start it repeats (its outcome taken), or −1
   std::vector<std::string> names_;
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;

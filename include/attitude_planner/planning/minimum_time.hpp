@@ -1,7 +1,7 @@
 // Minimum-time slews (objective minimum_time): the least duration T* at which the torque bounds
 // and constraints in force admit a plan, and the plan at T* (bang–bang) or at (1 + m)·T*.
 //
-// Method (src/planning/drivers/minimum_time.cpp): minimum time as ONE interior-point problem per
+// Method (src/planning/drivers/minimum_time*.cpp): minimum time as ONE interior-point problem per
 // start, the time step h (T = N h) an unknown next to the node unknowns, objective T, the
 // request's stage constraints (torque bounds, cones, and rest to rest the rate limits) as
 // constraints (src/planning/interior_point/free_time_solver.hpp). Starts, rest to rest:

@@ -1,0 +1,314 @@
+#include "planning/drivers/minimum_time_free_time.hpp"
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "attitude_planner/errors.hpp"
+#include "planning/drivers/minimum_time_search.hpp"
+#include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/problem/solve_context.hpp"
+#include "planning/problem/verdict.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// The free-time solves' tolerance on the KKT residuals (objective T/T₀, constraints
+/// dimensionless): the duality gap Σ zc bounds T − T* relative to T₀ by this much.
+constexpr double kFreeTimeTolerance = 1e-9;
+constexpr int kFreeTimeMaxIterations = 500;
+/// Two starts at the same T whose attitudes differ by at most this much (max entry of R_k − R'_k)
+/// are one start: the free-time solve from either ends at the same KKT point (the cleared starts
+/// that repeat one another differ by ~1e-13, their answers' T by ~1e-16 relative).
+constexpr double kSameStart = 1e-8;
+
+/// What one free-time grid level hands the next: its outcome (plan, T, steps).
+struct FreeTimeCarry {
+  FreeTimeOutcome outcome;
+  bool empty() const { return outcome.steps.empty(); }
+};
+
+/// A free-time level's end as the continuation's result and its LevelSummary (the relative
+/// gradient: the stationarity of the minimum-time Lagrangian).
+PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
+  PlanResult r;
+  r.termination = o.termination;
+  r.message = o.message;
+  r.iterations = o.iterations;
+  LevelSummary level;
+  level.steps = steps;
+  level.iterations = o.iterations;
+  level.termination = o.termination;
+  level.relative_gradient = o.stationarity;
+  level.reason = o.message;
+  r.levels.push_back(level);
+  return r;
+}
+
+/// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
+/// free-time solve, the least T kept; the starts run on the coarsest level of the free-time grid
+/// continuation (freeTimeGridRule) and the best is resumed through the finer levels, each solved
+/// once from the coarser answer prolonged (its rates interpolated). The answer is then polished:
+/// the minimum-effort plan at T* from the free-time plan (its multipliers give the switching
+/// functions). Empty if no solve converged (the caller falls back to the search).
+class FreeTimeMinimumTime {
+ public:
+  FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
+      : problem_(problem), context_(options) {}
+
+  std::optional<PlanResult> run() {
+    const bool rest_to_rest =
+        problem_.initial_velocity.isZero(0.0) && problem_.final_velocity.isZero(0.0) &&
+        so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
+    const std::vector<PlanningProblem> levels = gridLevels(problem_, freeTimeGridRule());
+    const PlanningProblem& coarsest = levels.front();
+    const int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
+    if (best < 0) return std::nullopt;
+    levels_ = levelResult(coarsest.steps, outcomes_[best]).levels;
+    if (levels.size() == 1) return polished(outcomes_[best], names_[best]);
+    std::optional<FreeTimeOutcome> refined = refine(levels, outcomes_[best]);
+    if (!refined) return std::nullopt;
+    best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
+    return polished(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
+                                  names_[best] + "), refined by 2 at a time");
+  }
+
+ private:
+  /// One free-time solve from `start` (N + 1 attitudes, clear of the cones) at T = duration,
+  /// recorded in the trail.
+  FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
+                        double duration, AttemptStart kind) {
+    const SolverOptions remaining = context_.remainingOptions();
+    FreeTimeOutcome o =
+        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, &remaining);
+    Attempt a;
+    a.stage = AttemptStage::MinimumTimeSolve;
+    a.start = kind;
+    a.formulation = Formulation::FreeSlacks;
+    a.steps = p.steps;
+    a.termination = o.termination;
+    a.iterations = o.iterations;
+    a.cost = o.duration;  // the free-time objective: T [s]
+    trail_.push_back(a);
+    ++solves_;
+    return o;
+  }
+
+  /// A structured start made to clear the cones: the ConstrainedMinimumEffort start is the
+  /// minimum-effort plan under every constraint; any other start too close to a cone is replaced
+  /// by the minimum-effort plan under the cones alone from it (coneClearStart).
+  std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
+    const SolverOptions remaining = context_.remainingOptions();
+    if (st.kind == AttemptStart::ConstrainedMinimumEffort) {
+      return coneClearStart(p, st.attitudes, st.duration, remaining, true).value_or(st.attitudes);
+    }
+    if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
+    return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
+  }
+
+  /// The earlier start whose solve this one would repeat (the same T and attitudes within
+  /// kSameStart), or −1. Around a cone most starts clear it to the same minimum-effort plan
+  /// (measured, scenes/min_time_keep_out.yaml N = 64: 18 starts, 8 distinct once cleared).
+  int sameStartAs(const std::vector<Matrix3>& start, double duration) const {
+    for (std::size_t j = 0; j < starts_.size(); ++j) {
+      if (same_as_[j] >= 0 || start_durations_[j] != duration) continue;
+      double difference = 0.0;
+      for (std::size_t k = 0; k < start.size(); ++k) {
+        difference = std::max(difference, (start[k] - starts_[j][k]).cwiseAbs().maxCoeff());
+      }
+      if (difference <= kSameStart) return static_cast<int>(j);
+    }
+    return -1;
+  }
+
+  /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
+  /// the index of the converged one with the least T (−1: none converged).
+  int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
+    int best = -1;
+    for (const FreeTimeStart& st : starts) {
+      if (budgetSpent(context_.remainingOptions())) break;
+      std::vector<Matrix3> start = clearOfCones(grid, st);
+      const int same = sameStartAs(start, st.duration);
+      outcomes_.push_back(same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind));
+      names_.push_back(st.name);
+      same_as_.push_back(same);
+      starts_.push_back(std::move(start));
+      start_durations_.push_back(st.duration);
+      const FreeTimeOutcome& o = outcomes_.back();
+      if (o.termination == Termination::Converged &&
+          (best < 0 || o.duration < outcomes_[best].duration)) {
+        best = static_cast<int>(outcomes_.size()) - 1;
+        best_attempt_ = trail_.size() - 1;
+      }
+    }
+    return best;
+  }
+
+  /// The coarsest level's best answer carried through the finer `levels` (the grid continuation
+  /// resumed from it): each level one free-time solve from the coarser answer prolonged, at its
+  /// T. Empty if a level does not converge or the solve is stopped (cancel, deadline).
+  std::optional<FreeTimeOutcome> refine(const std::vector<PlanningProblem>& levels,
+                                        const FreeTimeOutcome& coarsest) {
+    std::optional<FreeTimeOutcome> finest;
+    const LevelSolver<FreeTimeCarry> level = [&](const LevelRequest<FreeTimeCarry>& r,
+                                                 FreeTimeCarry* handed_on) {
+      if (r.replay_only || !r.coarse) {  // stopped: no answer on this level
+        PlanResult stopped;
+        stopped.termination = r.stop ? r.stop->termination : Termination::NotConverged;
+        return stopped;
+      }
+      const FreeTimeOutcome& coarse = r.coarse->outcome;
+      FreeTimeOutcome o = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
+                                AttemptStart::CoarseLevel);
+      PlanResult result = levelResult(r.problem.steps, o);
+      if (handed_on) {
+        handed_on->outcome = std::move(o);
+      } else {
+        finest = std::move(o);
+      }
+      return result;
+    };
+    // The polish writes the message from the whole trail; the levels keep their own.
+    const ContinuationFinish finish = [](const ContinuationRecord&, PlanResult*) {};
+    const SolvedLevel<FreeTimeCarry> from{0, Termination::Converged, {coarsest}, {}, false};
+    const PlanResult result = resumeGridContinuation(levels, from, context_, freeTimeGridRule(),
+                                                     kFreeTimeTolerance, level, finish);
+    if (!result.converged() || !finest) return std::nullopt;
+    levels_.insert(levels_.end(), result.levels.begin(), result.levels.end());
+    return finest;
+  }
+
+  /// The plan at T*: the minimum-effort plan at T* from the free-time plan if that proves T*
+  /// feasible (provesFeasible), else the free-time plan itself evaluated at T* by the same solve.
+  PlanResult polished(const FreeTimeOutcome& answer, const std::string& from) {
+    PlanningProblem effort = problem_;
+    effort.objective = Objective::MinimumEffort;
+    effort.time_margin = 0.0;
+    effort.duration = answer.duration;
+    SolverOptions o = context_.remainingOptions();
+    o.warm_start = &answer.maneuver;
+    o.constrained_from_warm_start = true;
+    PlanResult result = planAtResolution(effort, o);
+    const std::vector<Attempt> polish_attempts = result.attempts;
+    const bool feasible = provesFeasible(effort, result);
+    // A polish that stops short of optimality with a plan meeting every constraint still gives
+    // the plan at T* (provesFeasible).
+    if (feasible) result.termination = Termination::Converged;
+    std::string polish_note;
+    if (!feasible) {
+      // At T* the feasible set is (nearly) the one bang–bang plan: the polish can stop short
+      // (measured at N ≥ 512); the free-time plan itself is the answer then.
+      polish_note = "; its minimum-effort polish at T* did not converge (" + result.message +
+                    "): the plan is the free-time solve's";
+      result = freeTimePlan(effort, answer);
+    }
+    for (Attempt a : polish_attempts) {
+      a.stage = AttemptStage::MinimumTimePolish;
+      a.kept = false;
+      trail_.push_back(a);
+    }
+    if (!trail_.empty()) trail_[best_attempt_].kept = true;
+    std::ostringstream note;
+    note << "minimum time T* = " << answer.duration
+         << " s: a KKT point of the discrete minimum-time problem (one free-time interior-point "
+            "solve from the "
+         << from << " start, " << answer.iterations << " iterations; stationarity "
+         << answer.stationarity << ", h row " << answer.time_row << ", complementarity "
+         << answer.complementarity << "; starts:";
+    for (std::size_t i = 0; i < outcomes_.size(); ++i) {
+      note << " " << names_[i] << " ";
+      if (same_as_[i] >= 0) note << "(as " << names_[same_as_[i]] << ") ";
+      if (outcomes_[i].termination == Termination::Converged) {
+        note << outcomes_[i].duration << " s;";
+      } else {
+        note << terminationName(outcomes_[i].termination) << ";";
+      }
+    }
+    note << " " << solves_ << " free-time solves)";
+    note << polish_note;
+    result.message = note.str();
+    result.minimum_duration = answer.duration;
+    result.minimum_time.kkt_point = true;
+    result.minimum_time.stationarity = answer.stationarity;
+    result.minimum_time.time_stationarity = answer.time_row;
+    result.minimum_time.complementarity = answer.complementarity;
+    result.minimum_time.solves = solves_;
+    result.attempts = trail_;
+    // The free-time levels first, then the polish's own.
+    result.levels.insert(result.levels.begin(), levels_.begin(), levels_.end());
+    return result;
+  }
+
+  /// The free-time plan as the answer (at T*, measured as every plan is: evaluatePlan, the
+  /// replay, the constraint figures).
+  static PlanResult freeTimePlan(const PlanningProblem& effort, const FreeTimeOutcome& answer) {
+    PlanResult r;
+    r.solver = "interior_point";
+    r.termination = Termination::Converged;
+    r.iterations = answer.iterations;
+    evaluatePlan(effort, answer.maneuver.torque, &r, &answer.maneuver);
+    try {
+      replayFigures(effort, &r);
+    } catch (const StepTooLarge& e) {
+      r.termination = Termination::StepTooLarge;
+      r.message = std::string("replay of the planned torques failed: ") + e.what();
+    }
+    const ConstraintCheck check = checkConstraints(effort, r.maneuver);
+    r.constraints = check.names;
+    r.max_constraint_violation = check.max_violation;
+    r.max_violation_between_nodes = check.max_violation_between_nodes;
+    r.active_constraints = check.active;
+    return r;
+  }
+
+  const PlanningProblem& problem_;
+  SolveContext context_;
+  std::vector<FreeTimeOutcome> outcomes_;
+  std::vector<LevelSummary> levels_;          ///< the kept start's level and each refined level
+  std::vector<std::vector<Matrix3>> starts_;  ///< each start's attitudes as solved (cleared)
+  std::vector<double> start_durations_;       ///< and its T
+  std::vector<int> same_as_;  ///< the earlier start it repeats (its outcome taken), or −1
+  std::vector<std::string> names_;
+  std::vector<Attempt> trail_;
+  std::size_t best_attempt_ = 0;
+  int solves_ = 0;
+};
+
+}  // namespace
+
+std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse) {
+  PlanningProblem at = p;
+  at.duration = coarse.duration;
+  std::vector<Matrix3> attitudes;
+  try {
+    ReducedProblem np(at);
+    np.initializeFromCoarser(coarse.steps);
+    attitudes = np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // the boundary rates admit no step at this h
+    attitudes = resampleAttitudes(coarse.maneuver, p.steps);
+  }
+  if (coneClearance(p, attitudes) < 0.5 * kConeStartClearance) {
+    attitudes = pushedOutOfCones(p, attitudes, kConeStartClearance);
+  }
+  return attitudes;
+}
+
+GridLevelRule freeTimeGridRule() {
+  GridLevelRule rule;
+  rule.coarsest_steps = kFreeTimeStartGrid;
+  rule.coarsening_factor = 2;
+  rule.direct_up_to = 2 * kFreeTimeStartGrid - 1;
+  rule.coarse_tolerance_floor = 0.0;
+  rule.unconverged_ends = true;
+  return rule;
+}
+
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
+                                              const SolverOptions& options) {
+  return FreeTimeMinimumTime(problem, options).run();
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,46 @@
+// Minimum time as one free-time interior-point problem per start (drivers/minimum_time.cpp's
+// answer where it applies): the structured starts (minimum_time_starts.hpp) solved on the
+// coarsest level of the free-time grid continuation, the least T kept and carried through the
+// finer levels (strategies/grid_continuation.hpp), and its plan polished by a minimum-effort solve
+// at T*. T* is a KKT point of the discrete minimum-time problem
+// (interior_point/free_time_solver.hpp).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/strategies/grid_continuation.hpp"
+
+namespace attitude_planner {
+
+/// The starts run on the coarsest of N, N/2, ... at or above this N; the best is refined up.
+constexpr int kFreeTimeStartGrid = 64;
+
+/// The free-time grid levels (strategies/grid_continuation.hpp): N, N/2, ... down to the coarsest
+/// at or above kFreeTimeStartGrid, each solved to kFreeTimeTolerance. A refinement by 2 at a time:
+/// measured, a resampled N = 64 plan started N = 512 so far from its optimum that the solve slid
+/// to the eigenaxis slew's T. Below 2 kFreeTimeStartGrid a grid's half would be under the
+/// coarsest, so it is solved on its own. A refined level that does not converge ends the
+/// continuation with no answer (a fresh start there would be another attempt; the caller falls
+/// back to the search).
+GridLevelRule freeTimeGridRule();
+
+/// The free-time answer on a coarser grid carried to grid p at its T: the coarse rates
+/// interpolated in time (ReducedProblem::initializeFromCoarser), so the torques stay near the
+/// coarse ones. (Resampling the attitudes instead put torque spikes of ~1.5× the bound next to
+/// the switches of a bang–bang plan: the free-time start then had to raise T by ~27 % before
+/// every bound held, measured on Bilimoria–Wie, N = 512 → 1024.) With cones the new nodes
+/// between the coarse ones dip past an active bound by O(h²): they are turned out of the cones
+/// (pushedOutOfCones), as a free-time start must clear them strictly.
+std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse);
+
+/// The minimum-time plan from the free-time solves: the polished plan at T* (minimum_time.kkt_point
+/// true, the KKT residuals in minimum_time, every solve in attempts, the free-time levels first in
+/// levels), or empty if no start converged or a refined level did not (the caller falls back to
+/// the search).
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
+                                              const SolverOptions& options);
+
+}  // namespace attitude_planner

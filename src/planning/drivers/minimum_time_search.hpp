@@ -1,0 +1,25 @@
+// The search for T* (the fallback of minimum time, drivers/minimum_time.cpp): several starts,
+// each a continuation downwards in T over minimum-effort solves warm-started from the last
+// feasible plan, and a bisection of the best bracket; its T* is the least duration found
+// feasible, an upper bound. Used where the free-time interior point does not apply or none of its
+// solves converged.
+#pragma once
+
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+
+namespace attitude_planner {
+
+/// A plan at T proves T feasible when it meets every node constraint and the discrete equations
+/// step by step (planInconsistency): the reduced problem's iterates satisfy the dynamics and the
+/// boundary data by construction, so a minimum-effort solve that stops short of optimality (the
+/// iteration limit, a stalled line search) still proves T feasible. Whether it also minimizes the
+/// effort does not matter to the search (measured: on Bilimoria–Wie's case the solves just below
+/// the T* found stopped at the iteration limit with feasible iterates).
+bool provesFeasible(const PlanningProblem& problem, const PlanResult& r);
+
+/// The plan at the least feasible T the search finds (minimum_duration = T*, minimum_time.kkt_point
+/// false), or why there is none (Infeasible: no duration up to 2^12 times the first guess; the
+/// stop's termination when cancelled or out of time).
+PlanResult searchMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
+
+}  // namespace attitude_planner

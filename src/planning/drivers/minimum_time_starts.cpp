@@ -1,0 +1,248 @@
+#include "planning/drivers/minimum_time_starts.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "attitude_planner/planning/minimum_time.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// The excursion starts: their size [rad] and first T relative to the eigenaxis slew's.
+constexpr double kFreeTimeExcursion = 0.3;
+/// With cones also excursions this large [rad]: a detour round a cone is a larger departure.
+constexpr double kFreeTimeConeExcursion = 0.8;
+constexpr double kFreeTimeStartFactor = 0.96;
+/// A body axis whose part perpendicular to the eigenaxis is shorter than this gives no start.
+constexpr double kSmallestProjection = 0.3;
+/// Two excursion axes closer than this (cosine) are one start.
+constexpr double kSameAxis = 0.99;
+
+std::string axisName(const Vector3& v) {
+  std::ostringstream out;
+  out << "[" << std::round(v.x() * 1000) / 1000 << ", " << std::round(v.y() * 1000) / 1000 << ", "
+      << std::round(v.z() * 1000) / 1000 << "]";
+  return out.str();
+}
+
+/// Spinning ends: the reduced problem's own start (the geodesic between the fixed inner
+/// attitudes) at the eigenaxis guess. (An empty list of attitudes here once reached
+/// setInteriorFromAttitudes: every spinning minimum-time request ended "invalid input".)
+FreeTimeStart geodesicStart(const PlanningProblem& problem) {
+  PlanningProblem at = problem;
+  at.duration = eigenaxisDurationGuess(problem);
+  std::vector<Matrix3> attitudes;
+  try {
+    const ReducedProblem np(at);
+    attitudes = np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // no boundary step at that h: the solve reports it
+    attitudes.assign(problem.steps + 1, problem.initial_attitude);
+  }
+  return {"geodesic", AttemptStart::Hermite, attitudes, at.duration};
+}
+
+}  // namespace
+
+double smallestAuthority(const PlanningProblem& problem) {
+  double authority = std::numeric_limits<double>::infinity();
+  if (problem.hasTorqueBounds()) authority = problem.max_torque.minCoeff();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.kind == ConstraintKind::MaxTorqueNorm) authority = std::min(authority, c.limit);
+  }
+  return authority;
+}
+
+double eigenaxisDurationGuess(const PlanningProblem& problem) {
+  const double largest_moment =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues().maxCoeff();
+  const double acceleration = smallestAuthority(problem) / largest_moment;  // [rad/s²]
+  const double angle =
+      std::max(so3::angleBetween(problem.initial_attitude, problem.final_attitude), 1e-3);
+  // Rest to rest: accelerate half way, brake half way; boundary rates add the time to stop and
+  // to spin up at the same acceleration.
+  const double spin = (problem.initial_velocity.norm() + problem.final_velocity.norm()) /
+                      std::max(acceleration, 1e-300);
+  return 2.0 * std::sqrt(angle / acceleration) + spin;
+}
+
+Maneuver excursionSlew(const PlanningProblem& problem, const Vector3& excursion_axis,
+                       double excursion) {
+  const Vector3 rotation = so3::log(problem.initial_attitude.transpose() * problem.final_attitude);
+  const double angle = rotation.norm();
+  const Vector3 axis = angle > 0 ? Vector3(rotation / angle) : Vector3::UnitX();
+  Maneuver m;
+  const int N = problem.steps;
+  m.time_step = problem.duration / N;
+  for (int k = 0; k <= N; ++k) {
+    const double s = static_cast<double>(k) / N;
+    const double theta = s <= 0.5 ? 2.0 * angle * s * s : angle * (1.0 - 2.0 * (1 - s) * (1 - s));
+    const double bump = excursion * std::pow(std::sin(M_PI * s), 2);
+    m.time.push_back(s * problem.duration);
+    m.attitude.push_back(problem.initial_attitude * so3::exp(theta * axis) *
+                         so3::exp(bump * excursion_axis));
+    m.angular_velocity.push_back(Vector3::Zero());
+    m.torque.push_back(Vector3::Zero());
+  }
+  return m;
+}
+
+double eigenaxisBangBangDuration(const PlanningProblem& problem) {
+  const Vector3 rotation = so3::log(problem.initial_attitude.transpose() * problem.final_attitude);
+  const double angle = std::max(rotation.norm(), 1e-9);
+  const Vector3 e = rotation / angle;
+  const Matrix3& J = problem.inertia;
+  // At T = 1: θ̈ = ±4Θ, θ̇ ≤ 2Θ (peak at s = ½, where the gyroscopic term is largest).
+  const Vector3 gyroscopic = e.cross(J * e) * (4.0 * angle * angle);  // θ̇² ê × Jê at s = ½
+  const Vector3 inertial = J * e * (4.0 * angle);
+  double T_squared = 0.0;
+  for (const double sign : {1.0, -1.0}) {  // accelerating and braking at the peak rate
+    const Vector3 tau = sign * inertial + gyroscopic;
+    if (problem.hasTorqueBounds()) {
+      T_squared =
+          std::max(T_squared, (tau.cwiseAbs().array() / problem.max_torque.array()).maxCoeff());
+    }
+    for (const PlanningConstraint& c : problem.constraints)
+      if (c.kind == ConstraintKind::MaxTorqueNorm)
+        T_squared = std::max(T_squared, tau.norm() / c.limit);
+  }
+  double T = std::sqrt(T_squared);
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.kind == ConstraintKind::MaxAngularRate) T = std::max(T, 2.0 * angle / c.limit);
+  return T;
+}
+
+std::vector<Vector3> excursionAxes(const Vector3& e) {
+  std::vector<Vector3> projected;
+  for (int a = 0; a < 3; ++a) {
+    const Vector3 p = Vector3::Unit(a) - e * e(a);
+    if (p.norm() > kSmallestProjection) projected.push_back(p.normalized());
+  }
+  std::vector<Vector3> axes = projected;
+  for (std::size_t i = 0; i < projected.size(); ++i) {
+    for (std::size_t j = i + 1; j < projected.size(); ++j) {
+      for (const double sign : {1.0, -1.0}) {
+        const Vector3 d = projected[i] + sign * projected[j];
+        if (d.norm() > kSmallestProjection) axes.push_back(d.normalized());
+      }
+    }
+  }
+  std::vector<Vector3> distinct;
+  for (const Vector3& a : axes) {
+    const bool seen = std::any_of(distinct.begin(), distinct.end(),
+                                  [&](const Vector3& b) { return a.dot(b) > kSameAxis; });
+    if (!seen) distinct.push_back(a);
+  }
+  return distinct;
+}
+
+std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest) {
+  if (!rest_to_rest) return {geodesicStart(problem)};
+  const double T_eigenaxis = eigenaxisBangBangDuration(problem);
+  PlanningProblem at = problem;
+  at.duration = T_eigenaxis;
+  const Vector3 e =
+      so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
+  std::vector<FreeTimeStart> starts{
+      {"eigenaxis", AttemptStart::EigenaxisSlew, excursionSlew(at, e, 0.0).attitude, T_eigenaxis}};
+  // With cones both signs of each excursion: a cone is passed on one side or the other, and
+  // the sides are different local minima of T.
+  std::vector<Vector3> axes = excursionAxes(e);
+  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
+                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  if (cones) {
+    for (std::size_t i = 0, n = axes.size(); i < n; ++i) axes.push_back(-axes[i]);
+  }
+  if (cones) {
+    starts.push_back({"minimum effort under the constraints",
+                      AttemptStart::ConstrainedMinimumEffort, starts.front().attitudes,
+                      kEigenaxisStartFactor * T_eigenaxis});
+  }
+  for (const double size : {kFreeTimeExcursion, kFreeTimeConeExcursion}) {
+    if (size != kFreeTimeExcursion && !cones) break;
+    for (const Vector3& axis : axes) {
+      std::ostringstream name;
+      name << "excursion " << size << " rad about " << axisName(axis);
+      starts.push_back({name.str(), AttemptStart::Excursion, excursionSlew(at, axis, size).attitude,
+                        kFreeTimeStartFactor * T_eigenaxis});
+    }
+  }
+  return starts;
+}
+
+double coneClearance(const PlanningProblem& problem, const std::vector<Matrix3>& R) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (std::size_t k = 1; k + 1 < R.size(); ++k) {
+      smallest = std::min(smallest, coneMargin(c, R[k]) - c.margin);
+    }
+  }
+  return smallest;
+}
+
+std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vector<Matrix3> R,
+                                      double clearance) {
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    const bool keep_out = c.kind == ConstraintKind::KeepOut;
+    for (std::size_t k = 1; k + 1 < R.size(); ++k) {
+      const double turn = clearance - (coneMargin(c, R[k]) - c.margin);
+      if (turn <= 0) continue;
+      const Vector3 v = R[k] * c.body_axis;
+      Vector3 axis = c.world_direction.cross(v);  // turning about it by + moves v away from s
+      axis = axis.norm() > 1e-12 ? axis.normalized() : c.world_direction.unitOrthogonal();
+      R[k] = so3::exp((keep_out ? turn : -turn) * axis) * R[k];
+    }
+  }
+  return R;
+}
+
+std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
+                                                   const std::vector<Matrix3>& attitudes,
+                                                   double duration, const SolverOptions& options,
+                                                   bool every_constraint) {
+  PlanningProblem effort = problem;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = duration;
+  if (!every_constraint) {
+    effort.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  }
+  effort.constraints.clear();
+  for (PlanningConstraint c : problem.constraints) {
+    if (c.isCone()) c.margin += kConeStartClearance;
+    if (c.isCone() || every_constraint) effort.constraints.push_back(c);
+  }
+  // A cone tightened past a cone (node half angle outside (0, π)) is no problem to solve
+  // (validateProblem would refuse it): no cleared start.
+  for (const PlanningConstraint& c : effort.constraints) {
+    if (c.isCone() && !(c.nodeHalfAngle() > 0.0 && c.nodeHalfAngle() < M_PI)) return std::nullopt;
+  }
+  try {
+    SolverOptions o = options;
+    PlanResult r;
+    if (!every_constraint) {
+      ReducedProblem np(effort);
+      np.setInteriorFromAttitudes(attitudes);
+      const Maneuver guess = np.maneuver(np.current());
+      o.warm_start = &guess;
+      o.constrained_from_warm_start = true;
+      r = planAtResolution(effort, o);
+    }
+    if (!r.converged()) {
+      o.warm_start = nullptr;
+      o.constrained_from_warm_start = false;
+      r = planAtResolution(effort, o);
+    }
+    if (r.converged()) return r.maneuver.attitude;
+  } catch (const StepTooLarge&) {  // a boundary rate with no step at this T: no cleared start
+  }
+  return std::nullopt;
+}
+
+}  // namespace attitude_planner

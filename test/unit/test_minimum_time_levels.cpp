@@ -1,0 +1,163 @@
+// Minimum time's strategies (src/planning/drivers/minimum_time*): the free-time grid levels on the
+// shared grid continuation (N halved down to the coarsest at or above 64), what a refined answer
+// reports (its levels, the refined solve kept), the prolongation of a coarse answer clear of the
+// cones, and the cone-clearing start's refusals (no start, never an error the request did not
+// make).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "planning/drivers/minimum_time_free_time.hpp"
+#include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/strategies/grid_continuation.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+ap::PlanningProblem scene(const char* name, int steps) {
+  ap::PlanningProblem p =
+      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + name + ".yaml").problem;
+  p.steps = steps;
+  return p;
+}
+
+/// The free-time levels as the driver walked them before it ran on the shared continuation: N,
+/// N/2, ... while the half is at least 64, coarsest first.
+std::vector<int> halvedLevels(int N) {
+  std::vector<int> levels{N};
+  while (levels.back() / 2 >= ap::kFreeTimeStartGrid) levels.push_back(levels.back() / 2);
+  std::reverse(levels.begin(), levels.end());
+  return levels;
+}
+
+}  // namespace
+
+TEST(MinimumTimeLevels, FreeTimeLevelsHalveDownToTheCoarsestAtOrAbove64) {
+  ap::PlanningProblem p = scene("min_time_bilimoria_wie", 64);
+  for (const int N : {16, 63, 64, 65, 96, 127, 128, 129, 200, 255, 256, 257, 512, 1000, 2048}) {
+    p.steps = N;
+    std::vector<int> steps;
+    for (const ap::PlanningProblem& level : ap::gridLevels(p, ap::freeTimeGridRule())) {
+      steps.push_back(level.steps);
+    }
+    EXPECT_EQ(steps, halvedLevels(N)) << "N = " << N;
+    EXPECT_EQ(steps.back(), N);
+    EXPECT_TRUE(steps.front() >= ap::kFreeTimeStartGrid || steps.size() == 1) << "N = " << N;
+  }
+}
+
+TEST(MinimumTimeLevels, RefinedAnswerReportsItsLevelsAndKeepsTheRefinedSolve) {
+  const ap::PlanResult r = ap::planManeuver(scene("min_time_bilimoria_wie", 256));
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+  // The free-time levels come first: the kept start's on N = 64, then each refined level.
+  ASSERT_GE(r.levels.size(), 3u);
+  const int expected[] = {64, 128, 256};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(r.levels[i].steps, expected[i]);
+    EXPECT_EQ(r.levels[i].termination, ap::Termination::Converged) << r.levels[i].reason;
+    EXPECT_GT(r.levels[i].iterations, 0);
+    EXPECT_LE(r.levels[i].relative_gradient, 1e-8);  // the minimum-time stationarity
+  }
+  // The trail: every start on N = 64, then one coarse-level solve per finer level; the N = 256
+  // solve is the one kept, and its T is T*.
+  std::vector<const ap::Attempt*> solves;
+  for (const ap::Attempt& a : r.attempts) {
+    if (a.stage == ap::AttemptStage::MinimumTimeSolve) solves.push_back(&a);
+  }
+  ASSERT_GE(solves.size(), 3u);
+  EXPECT_EQ(static_cast<int>(solves.size()), r.minimum_time.solves);
+  for (std::size_t i = 0; i + 2 < solves.size(); ++i) {
+    EXPECT_EQ(solves[i]->steps, 64);
+    EXPECT_NE(solves[i]->start, ap::AttemptStart::CoarseLevel);
+  }
+  const ap::Attempt& n128 = *solves[solves.size() - 2];
+  const ap::Attempt& n256 = *solves.back();
+  EXPECT_EQ(n128.steps, 128);
+  EXPECT_EQ(n128.start, ap::AttemptStart::CoarseLevel);
+  EXPECT_EQ(n256.steps, 256);
+  EXPECT_EQ(n256.start, ap::AttemptStart::CoarseLevel);
+  EXPECT_TRUE(n256.kept);
+  EXPECT_EQ(std::count_if(r.attempts.begin(), r.attempts.end(),
+                          [](const ap::Attempt& a) { return a.kept; }),
+            1);
+  EXPECT_DOUBLE_EQ(n256.cost, r.minimum_duration);
+}
+
+TEST(MinimumTimeLevels, ProlongedConeAnswerClearsTheConesItsCoarseNodesTouch) {
+  // The N = 64 free-time answer around the keep-out cone, and the cone widened until that
+  // answer's nearest node sits 1e-4 rad off its bound: the answer's prolongation to N = 128 (the
+  // coarse rates interpolated) is turned out of the cone, as a free-time start must clear it
+  // strictly, and the N = 128 solve from it converges.
+  const ap::PlanningProblem coarse = scene("min_time_keep_out", 64);
+  const ap::PlanResult answer = ap::planManeuver(coarse);
+  ASSERT_TRUE(answer.converged() && answer.minimum_time.kkt_point) << answer.message;
+  const ap::FreeTimeOutcome o =
+      ap::solveFreeTime(coarse, answer.maneuver.attitude, answer.minimum_duration, 1e-9, 500);
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ap::PlanningProblem fine = scene("min_time_keep_out", 128);
+  fine.constraints[0].half_angle += ap::coneClearance(coarse, o.maneuver.attitude) - 1e-4;
+  ASSERT_LT(ap::coneClearance(fine, o.maneuver.attitude), 0.5 * ap::kConeStartClearance);
+  const std::vector<ap::Matrix3> start = ap::prolonged(fine, o);
+  ASSERT_EQ(start.size(), 129u);
+  EXPECT_GE(ap::coneClearance(fine, start), 0.5 * ap::kConeStartClearance);
+  EXPECT_LE((start.front() - fine.initial_attitude).norm(), 1e-12);
+  EXPECT_LE((start.back() - fine.final_attitude).norm(), 1e-12);
+  const ap::FreeTimeOutcome refined = ap::solveFreeTime(fine, start, o.duration, 1e-9, 500);
+  EXPECT_EQ(refined.termination, ap::Termination::Converged) << refined.message;
+  EXPECT_GE(ap::coneClearance(fine, refined.maneuver.attitude), -1e-9);
+}
+
+TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {
+  const ap::SolverOptions options;
+  // A keep-in cone whose node bound the 0.01 rad tightening would close: no start, no error
+  // about a margin the request did not give.
+  ap::PlanningProblem tight = scene("min_time_bilimoria_wie", 16);
+  tight.final_attitude = ap::so3::fromAxisAngle(ap::Vector3::UnitX(), 1.0);  // keeps body x
+  tight.constraints = {
+      ap::PlanningConstraint::keepIn(ap::Vector3::UnitX(), ap::Vector3::UnitX(), 0.3)};
+  tight.constraints[0].margin = 0.295;
+  std::vector<ap::Matrix3> attitudes(17, tight.initial_attitude);
+  EXPECT_FALSE(ap::coneClearStart(tight, attitudes, 4.0, options).has_value());
+  // Boundary rates with no step at this T (StepTooLarge): no start.
+  ap::PlanningProblem spinning = scene("min_time_keep_out", 16);
+  spinning.initial_velocity = ap::Vector3(40.0, 0.0, 0.0);
+  ap::PlanningProblem at = spinning;
+  at.objective = ap::Objective::MinimumEffort;
+  at.duration = 30.0;
+  EXPECT_THROW(ap::ReducedProblem{at}, ap::StepTooLarge);
+  EXPECT_FALSE(ap::coneClearStart(spinning, attitudes, 30.0, options).has_value());
+  // Anything else is not this case's to swallow: an invalid inertia is named.
+  ap::PlanningProblem invalid = scene("min_time_keep_out", 16);
+  invalid.inertia(0, 0) = -1.0;
+  EXPECT_THROW(ap::coneClearStart(invalid, attitudes, 30.0, options, true), ap::InvalidInput);
+}
+
+TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
+  // Around the keep-out cone most structured starts clear it to the same minimum-effort plan:
+  // each distinct start is solved once, and T* is the one every start solved gave (main 6b00274,
+  // 18 free-time solves on N = 64: 29.00779406049 s).
+  const ap::PlanningProblem p = scene("min_time_keep_out", 64);
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
+  const std::size_t starts = ap::freeTimeStarts(p, true).size();
+  const auto solves = std::count_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return a.stage == ap::AttemptStage::MinimumTimeSolve;
+  });
+  EXPECT_EQ(solves, r.minimum_time.solves);
+  EXPECT_LT(static_cast<std::size_t>(solves), starts);
+  EXPECT_LE(r.minimum_duration, 29.00779406049 * (1 + 1e-9));
+  // Without cones no start is cleared, and the structured starts are distinct: each is solved.
+  const ap::PlanningProblem box = scene("min_time_bilimoria_wie", 64);
+  const ap::PlanResult b = ap::planManeuver(box);
+  ASSERT_TRUE(b.converged()) << b.message;
+  EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves), ap::freeTimeStarts(box, true).size());
+}

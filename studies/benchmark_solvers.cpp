@@ -957,7 +957,8 @@ class FreeTimeNlp : public TranscriptionNlp {
 /// The eigenaxis bang–bang slew at the least T its per-axis bounds allow (rest to rest, about a
 /// principal axis: no gyroscopic torque), with a 0.3 rad sin² excursion about the diagonal of
 /// the two body axes most perpendicular to the eigenaxis — the start that reaches the published
-/// optima in ours (drivers/minimum_time_starts.cpp's structured starts). Sets problem->duration to that T.
+/// optima in ours (drivers/minimum_time_starts.cpp's structured starts). Sets problem->duration to
+/// that T.
 std::vector<Vector3> excursionStart(ap::PlanningProblem* problem) {
   const Vector3 rotation =
       ap::so3::log(Matrix3(problem->initial_attitude.transpose() * problem->final_attitude));

@@ -6,6 +6,7 @@
 // world rotations and axis relabelling, monotone in N and in the bounds, and scales with them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -211,44 +212,107 @@ TEST(FreeTime, OnlySpinningRateLimitsFallBackToTheSearch) {
   EXPECT_NE(ap::freeTimeUnsupported(p).find("max_angular_rate"), std::string::npos);
 }
 
-TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerThanTheSearch) {
-  // Nonzero boundary rates (body frame): one free-time solve from the geodesic start. The answer
-  // is a KKT point meeting the bounds, the same T* in a rotated world frame, and no slower than
-  // the former search on T over minimum-effort solves (forced here by a zero disturbance torque:
-  // the free-time solver does not take effects, the discrete problem is the same).
+namespace {
+
+/// J = I, |u_i| <= 1, 180 deg about z with nonzero boundary rates (body frame), second_order;
+/// `extra_effects` appended to the effects list.
+ap::PlanningProblem spinningRequest(int steps, const std::string& extra_effects = "") {
   const std::string scene_text =
-      "inertia: [1, 1, 1]\nsteps: 64\nscheme: second_order\nobjective: minimum_time\n"
+      "inertia: [1, 1, 1]\nsteps: " + std::to_string(steps) +
+      "\nscheme: second_order\nobjective: minimum_time\n"
       "initial: {attitude: {axis: [0, 0, 1], angle: 0.0}, angular_velocity: [0.3, -0.1, 0.2]}\n"
       "final: {attitude: {axis: [0, 0, 1], angle: 3.141592653589793}, "
       "angular_velocity: [0.1, 0.2, -0.3]}\n"
-      "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}";
-  ap::PlanningProblem p = ap::parseScene(scene_text + "]\n").problem;
-  const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
-  EXPECT_LE(r.minimum_time.stationarity, 1e-8);
-  EXPECT_LE(r.minimum_time.complementarity, 1e-8);
-  for (const ap::Vector3& t : r.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-9);
-  EXPECT_LE(r.max_constraint_violation, 1e-8);
-  std::printf("spinning ends, N = 64: T* = %.9f\n", r.minimum_duration);
+      "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}" +
+      extra_effects + "]\n";
+  return ap::parseScene(scene_text).problem;
+}
 
-  ap::PlanningProblem turned = p;
+/// The former search on T over minimum-effort solves on the same discrete problem: forced by a
+/// zero disturbance torque (the free-time solver does not take effects).
+ap::PlanResult searched(int steps) {
+  return ap::planManeuver(
+      spinningRequest(steps, ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}"));
+}
+
+}  // namespace
+
+TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerThanTheSearch) {
+  // Nonzero boundary rates: one free-time solve from the geodesic start on N = 64, refined by 2
+  // at a time. At every N the answer is a KKT point meeting the bounds, the same T* in a rotated
+  // world frame, T*(N) rises with N, and T* is no slower than the former search. (From N = 256
+  // on the refinement's start used to be raised ~50× in T before every bound held, and the solve
+  // stopped at the iteration limit: the elastic start.)
   const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
-  turned.initial_attitude = Q * p.initial_attitude;
-  turned.final_attitude = Q * p.final_attitude;
-  const ap::PlanResult in_turned = ap::planManeuver(turned);
-  ASSERT_TRUE(in_turned.converged()) << in_turned.message;
-  EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-  EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-7 * r.minimum_duration);
+  double previous = 0.0;
+  for (const int N : {64, 128, 256, 512}) {
+    const ap::PlanningProblem p = spinningRequest(N);
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
+    for (const ap::Vector3& t : r.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-9);
+    EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
+    std::printf("spinning ends, N = %d: T* = %.9f\n", N, r.minimum_duration);
+    EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "N = " << N;
+    previous = r.minimum_duration;
 
-  const ap::PlanningProblem with_effect =
-      ap::parseScene(scene_text + ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}]\n")
-          .problem;
-  const ap::PlanResult searched = ap::planManeuver(with_effect);
-  ASSERT_TRUE(searched.converged()) << searched.message;
-  EXPECT_FALSE(searched.minimum_time.kkt_point) << searched.message;
-  std::printf("the search on the same request: T = %.9f\n", searched.minimum_duration);
-  // The search's T is the least duration whose minimum-effort plan met the bounds (to their
-  // tolerance), bracketed to 1e-9 relative: T* may sit that far above it, no more.
-  EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-8));
+    ap::PlanningProblem turned = p;
+    turned.initial_attitude = Q * p.initial_attitude;
+    turned.final_attitude = Q * p.final_attitude;
+    const ap::PlanResult in_turned = ap::planManeuver(turned);
+    ASSERT_TRUE(in_turned.converged()) << in_turned.message;
+    EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
+    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration)
+        << "N = " << N;
+
+    if (N != 64 && N != 256) continue;  // the search: on the start grid and the first refined one
+    const ap::PlanResult search = searched(N);
+    ASSERT_TRUE(search.converged()) << search.message;
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    std::printf("the search on the same request: T = %.9f\n", search.minimum_duration);
+    // The search's T is the least duration whose minimum-effort plan met the bounds (to their
+    // tolerance), bracketed to 1e-9 relative: T* may sit that far above it, no more.
+    EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8)) << "N = " << N;
+  }
+}
+
+TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
+  // The refinement of minimum_time.cpp, by hand: the N = 64 answer from the geodesic, carried to
+  // N = 128 and 256 (its rates interpolated in time, ReducedProblem::initializeFromCoarser) at
+  // its own T. The carried plan is a little outside its bounds (T*(N) rises with N), and raising
+  // h at fixed attitudes makes it worse (an end torque carries the boundary momentum 2√w JΩ/h):
+  // each finer solve starts elastic at the coarse T and ends at a KKT point meeting the bounds.
+  ap::PlanningProblem p = spinningRequest(64);
+  p.duration = 3.5;
+  const ap::ReducedProblem geodesic(p);
+  ap::FreeTimeOutcome o =
+      ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, 500);
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  for (const int N : {128, 256}) {
+    ap::PlanningProblem fine = spinningRequest(N);
+    fine.duration = o.duration;
+    ap::ReducedProblem np(fine);
+    np.initializeFromCoarser(o.steps);
+    const std::vector<ap::Matrix3> start = np.attitudes(np.current());
+    for (const double raise : {1.0, 1.5, 2.0}) {
+      double worst = 0.0;
+      for (const ap::Vector3& t : torquesAt(fine, start, raise * o.duration / N))
+        worst = std::max(worst, t.cwiseAbs().maxCoeff());
+      EXPECT_GT(worst, 1.0) << "N = " << N << ", raised " << raise << "x: still outside";
+    }
+    const double coarse_T = o.duration;
+    o = ap::solveFreeTime(fine, start, coarse_T, 1e-9, 500);
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << "N = " << N << ": " << o.message;
+    EXPECT_TRUE(o.elastic_start) << "N = " << N;
+    EXPECT_NEAR(o.start_time_step * N, coarse_T, 1e-12 * coarse_T) << "no raise: T0 = coarse T";
+    EXPECT_GE(o.duration, coarse_T) << "T*(N) rises with N";
+    EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible at the end";
+    for (const ap::Vector3& t : o.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
+    EXPECT_LE(o.stationarity, 1e-8);
+    EXPECT_LE(o.complementarity, 1e-8);
+    std::printf("elastic start, N = %d: T* = %.9f after %d iterations\n", N, o.duration,
+                o.iterations);
+  }
 }

@@ -17,7 +17,9 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace ap = attitude_planner;
 
@@ -202,14 +204,16 @@ TEST(FreeTime, EverySchemeStaysWithinPublishedPlusOneStep) {
   }
 }
 
-TEST(FreeTime, OnlySpinningRateLimitsFallBackToTheSearch) {
-  // Rest to rest a rate limit is written in h (test_stage_constraints.cpp); with spinning ends the
-  // boundary steps move with h, not written yet: the search answers.
+TEST(FreeTime, OnlyFourthOrderAndEffectsFallBackToTheSearch) {
+  // Rate limits are written in h rest to rest and with spinning ends (the attitudes a boundary
+  // rate fixes move with h: ReducedProblem::nodePath; RateLimitDerivativesInHWithSpinningEnds).
   ap::PlanningProblem p = scene("min_time_betts", 32);
   p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.1));
   EXPECT_EQ(ap::freeTimeUnsupported(p), "");
   p.initial_velocity = ap::Vector3(0.01, 0, 0);
-  EXPECT_NE(ap::freeTimeUnsupported(p).find("max_angular_rate"), std::string::npos);
+  EXPECT_EQ(ap::freeTimeUnsupported(p), "");
+  p.scheme = ap::SchemeKind::FourthOrder;
+  EXPECT_NE(ap::freeTimeUnsupported(p).find("fourth_order"), std::string::npos);
 }
 
 namespace {
@@ -314,5 +318,143 @@ TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
     EXPECT_LE(o.complementarity, 1e-8);
     std::printf("elastic start, N = %d: T* = %.9f after %d iterations\n", N, o.duration,
                 o.iterations);
+  }
+}
+
+namespace {
+
+/// q = ½|Ω|² of rate-limit instance k (a step's rate for paper and variational, a node's J⁻¹Π_k
+/// for second_order) at the reduced problem's current iterate and h, with its gradient and
+/// Hessian over the instance's local nodes (as the free-time solver forms them).
+struct RateAt {
+  double q = 0.0;
+  Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
+};
+
+RateAt rateAt(const ap::ReducedProblem& np, ap::StageQuantity quantity, int k,
+              const ap::Matrix3& inertia) {
+  RateAt out;
+  if (quantity == ap::StageQuantity::StepRate) {
+    const ap::AngularRateTerms t = ap::angularRateTerms(np.scheme(), np.current()[k]);
+    out.q = t.half_squared_rate;
+    out.gradient.head<6>() = t.gradient;
+    out.hessian.topLeftCorner<6, 6>() = t.hessian;
+    return out;
+  }
+  const ap::Matrix3 J2 = inertia.inverse() * inertia.inverse();
+  np.forEachNodeMomentum(
+      [&](const ap::ReducedProblem::NodeMomentum& node) {
+        if (node.k != k) return;
+        const ap::Vector3 a = J2 * node.momentum;
+        out.q = 0.5 * node.momentum.dot(a);
+        out.gradient = node.jacobian.transpose() * a;
+        out.hessian = node.jacobian.transpose() * J2 * node.jacobian + node.second;
+      },
+      [&](int, const ap::Vector3& Pi) { return ap::Vector3(J2 * Pi); });
+  return out;
+}
+
+}  // namespace
+
+TEST(FreeTime, RateLimitDerivativesInHWithSpinningEndsMatchCentralDifferences) {
+  // With spinning ends paper's and variational's R_1, R_{N−1} move with h (their boundary steps
+  // honour Ω(0), Ω(T)): q(δ, h) = s(h) q̃(δ + d(h)), d = e Δh + ½ e₂ Δh² from nodePath. The
+  // free-time solver's ∂q/∂h, ∂²q/∂h² and ∂∇q/∂h (free nodes) against central differences of q
+  // and ∇q computed at h ± Δh with the free attitudes held, for every rate instance, every scheme.
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    ap::PlanningProblem p = spinningRequest(16);
+    p.scheme = scheme;
+    p.duration = 3.5;
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(1.0));
+    ap::ReducedProblem np(p);
+    std::mt19937 rng(32);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(np.unknowns());
+    for (int i = 0; i < d.size(); ++i) d(i) = 0.05 * normal(rng);
+    np.setCurrent(np.retract(d, 1.0));  // off the geodesic, no symmetry left
+    const double h = np.timeStep(), dh = 1e-4 * h;
+    ap::ReducedProblem later = np, earlier = np;
+    later.setTimeStep(h + dh);
+    earlier.setTimeStep(h - dh);
+    const double s1 = -2.0 / h, s2 = 6.0 / (h * h);
+    int moving = 0;
+    for (const auto& c : ap::buildStageConstraints(p)) {
+      const ap::StageQuantity quantity = c->quantity();
+      if (quantity != ap::StageQuantity::StepRate && quantity != ap::StageQuantity::NodeRate) {
+        continue;
+      }
+      const ap::StageSupport s = ap::stageSupport(quantity, np.firstFreeNode(), np.lastFreeNode());
+      for (int k = s.first_k; k <= s.last_k; ++k) {
+        const RateAt at = rateAt(np, quantity, k, p.inertia);
+        const RateAt up = rateAt(later, quantity, k, p.inertia);
+        const RateAt down = rateAt(earlier, quantity, k, p.inertia);
+        Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero(), e2 = e;
+        for (int node = 0; node < s.width; ++node) {
+          const ap::ReducedProblem::BoundaryPath path = np.nodePath(k + s.node_offset + node);
+          e.segment<3>(3 * node) = path.first;
+          e2.segment<3>(3 * node) = path.second;
+        }
+        if (e.norm() > 0) ++moving;
+        const double q_h = s1 * at.q + at.gradient.dot(e);
+        const double q_hh =
+            s2 * at.q + 2 * s1 * at.gradient.dot(e) + e.dot(at.hessian * e) + at.gradient.dot(e2);
+        const Eigen::Matrix<double, 9, 1> gradient_h = s1 * at.gradient + at.hessian * e;
+        const double fd_h = (up.q - down.q) / (2 * dh);
+        const double fd_hh = (up.q - 2 * at.q + down.q) / (dh * dh);
+        const std::string where = ap::schemeName(scheme) + " k = " + std::to_string(k);
+        EXPECT_NEAR(q_h, fd_h, 1e-6 * (std::abs(fd_h) + at.q / h)) << where;
+        EXPECT_NEAR(q_hh, fd_hh, 1e-4 * (std::abs(fd_hh) + at.q / (h * h))) << where;
+        for (int node = 0; node < s.width; ++node) {
+          if (np.variableIndex(k + s.node_offset + node) < 0) continue;  // a held node only
+          const Eigen::Vector3d fd = (up.gradient - down.gradient).segment<3>(3 * node) / (2 * dh);
+          EXPECT_LE((gradient_h.segment<3>(3 * node) - fd).norm(),
+                    1e-6 * (fd.norm() + at.gradient.norm() / h))
+              << where << " node " << node;
+        }
+      }
+    }
+    // paper and variational: the steps next to R_1 and R_{N−1} move; second_order: none.
+    EXPECT_EQ(moving, scheme == ap::SchemeKind::SecondOrder ? 0 : 2) << ap::schemeName(scheme);
+  }
+}
+
+TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
+  // The spinning request under |Ω| ≤ 1 rad/s (the unconstrained plan peaks at 2.03 rad/s): one
+  // free-time problem, a KKT point within the limit, the same T* in a rotated world frame, and
+  // no slower than the former search on the same discrete problem.
+  for (const ap::SchemeKind scheme : {ap::SchemeKind::SecondOrder, ap::SchemeKind::Paper}) {
+    ap::PlanningProblem p = spinningRequest(64);
+    p.scheme = scheme;
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(1.0));
+    EXPECT_EQ(ap::freeTimeUnsupported(p), "");
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8);
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8);
+    EXPECT_LE(r.max_constraint_violation, 1e-8);
+    double fastest = 0.0;
+    for (const ap::Vector3& w : r.maneuver.angular_velocity) fastest = std::max(fastest, w.norm());
+    EXPECT_LE(fastest, 1.0 + 1e-9);
+    EXPECT_GT(fastest, 1.0 - 1e-6) << "the limit binds";
+    ap::PlanningProblem turned = p;
+    const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
+    turned.initial_attitude = Q * p.initial_attitude;
+    turned.final_attitude = Q * p.final_attitude;
+    const ap::PlanResult in_turned = ap::planManeuver(turned);
+    ASSERT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
+    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration);
+    ap::PlanningProblem forced =
+        spinningRequest(64, ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}");
+    forced.scheme = scheme;
+    forced.constraints = p.constraints;
+    const ap::PlanResult search = ap::planManeuver(forced);
+    ASSERT_TRUE(search.converged()) << search.message;
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    std::printf("%s, |w| <= 1: T* = %.9f, the search %.9f\n", ap::schemeName(scheme).c_str(),
+                r.minimum_duration, search.minimum_duration);
+    EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8));
   }
 }

@@ -403,11 +403,17 @@ std::vector<FreeTimeSolver::RateTerms> FreeTimeSolver::rateTerms(StageQuantity q
   return out;
 }
 
-/// Rate limits on q = ½|Ω|² (of a step or a node). Rest to rest (freeTimeUnsupported) the steps do
-/// not move with h at fixed free attitudes and every momentum scales like 1/h, so q = q̃(δ)/h²:
-/// ∂q/∂h = −2q/h, ∂∇q/∂h = −2∇q/h, ∂²q/∂h² = 6q/h² (in η = h/h₀: times h₀, h₀²). c = 1 + c' q.
+/// Rate limits on q = ½|Ω|² (of a step or a node). At fixed free attitudes every momentum scales
+/// like 1/h, and the attitudes a boundary rate fixes move with h (ReducedProblem::nodePath: R_1,
+/// R_{N−1} of paper and variational, whose boundary steps honour Ω(0), Ω(T) at every h; none for
+/// second_order, whose node rates involve free attitudes and R_0, R_N only), as node
+/// perturbations d(h) = e Δh + ½ e₂ Δh². So q(δ, h) = s(h) q̃(δ + d(h)), s = (h₀/h)², and at h₀
+///     ∂q/∂h = s'q + ∇qᵀe,   ∂∇q/∂h = s'∇q + ∇²q e,   ∂²q/∂h² = s''q + 2s'∇qᵀe + eᵀ∇²q e + ∇qᵀe₂,
+/// s' = −2/h, s'' = 6/h² (rest to rest e = e₂ = 0: q = q̃/h²); in η = h/h₀ times h₀, h₀².
+/// c = 1 + c' q.
 void FreeTimeSolver::assembleRates(double mu) {
   const double h = np_.timeStep();
+  const double s1 = -2.0 / h, s2 = 6.0 / (h * h);
   for (const StageQuantity quantity : {StageQuantity::StepRate, StageQuantity::NodeRate}) {
     std::vector<RateTerms> terms;
     for (FreeTimeGroup& g : groups_) {
@@ -415,14 +421,22 @@ void FreeTimeSolver::assembleRates(double mu) {
       if (terms.empty()) terms = rateTerms(quantity);
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
         const RateTerms& t = terms[k];
+        Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero(), e2 = e;
+        for (int node = 0; node < g.support.width; ++node) {
+          const ReducedProblem::BoundaryPath path = np_.nodePath(k + g.support.node_offset + node);
+          e.segment<3>(3 * node) = path.first;
+          e2.segment<3>(3 * node) = path.second;
+        }
+        const Eigen::Matrix<double, 9, 1> He = t.hessian * e;
         Eigen::Matrix<double, 10, 1> dq;  // ∇q over (local nodes, η)
         dq.head<9>() = t.gradient;
-        dq(9) = -2.0 * t.q / h * h0_;
+        dq(9) = (s1 * t.q + t.gradient.dot(e)) * h0_;
         Eigen::Matrix<double, 10, 10> d2q;
         d2q.topLeftCorner<9, 9>() = t.hessian;
-        d2q.block<9, 1>(0, 9) = -2.0 / h * h0_ * t.gradient;
+        d2q.block<9, 1>(0, 9) = (s1 * t.gradient + He) * h0_;
         d2q.block<1, 9>(9, 0) = d2q.block<9, 1>(0, 9).transpose();
-        d2q(9, 9) = 6.0 * t.q / (h * h) * h0_ * h0_;
+        d2q(9, 9) =
+            (s2 * t.q + 2 * s1 * t.gradient.dot(e) + e.dot(He) + t.gradient.dot(e2)) * h0_ * h0_;
         const Vector3 q(t.q, 0.0, 0.0);
         const double slope = g.constraint->gradient(q)(0);
         FreeTimeInstance& in = g.instance(k);
@@ -742,14 +756,6 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
     return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
   }
   if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
-  const bool rest_to_rest =
-      problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0);
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxAngularRate && !rest_to_rest) {
-      return "constraints: max_angular_rate with nonzero boundary rates (the boundary steps move "
-             "with h)";
-    }
-  }
   return "";
 }
 

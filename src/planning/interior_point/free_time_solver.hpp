@@ -1,6 +1,6 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
 // node unknowns δ of the reduced problem, objective T, the torque constraints, pointing cones and
-// (rest to rest) rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
+// rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
 // free_time_solver.cpp derives the method).
 #pragma once
 
@@ -37,9 +37,9 @@ struct FreeTimeOutcome {
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
 };
 
-/// Why `problem` cannot be solved free-time here (empty: it can): rate limits with spinning ends
-/// (the boundary steps move with h) and effects are not written in h yet, fourth_order has no
-/// single transcription (minimum_time.cpp falls back to the search).
+/// Why `problem` cannot be solved free-time here (empty: it can): effects are not written in h
+/// yet (time-dependent torques), fourth_order has no single transcription (minimum_time.cpp falls
+/// back to the search).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and

@@ -458,3 +458,26 @@ TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
     EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8));
   }
 }
+
+TEST(FreeTime, ConeAndRateLimitRefinedToN128IsAKktPoint) {
+  // scenes/min_time_keep_out.yaml with |Ω| ≤ 0.05 rad/s, second_order: the starts on N = 64 and
+  // the best refined to 128. A sensitive case for the barrier's fall: at μ → μ^1.5 the
+  // refinement reaches μ's floor (~1e-13) within ~40 iterations, a node rate bound sits at
+  // c ~ 1e-14 and the step's curvature (~1e-8 in c) cuts every step to α ~ 1e-3 until the
+  // iteration limit (then the search answers); at μ^1.3 (free_time_theta_mu) it converges.
+  double previous = 0.0;
+  for (const int N : {64, 128}) {
+    ap::PlanningProblem p = scene("min_time_keep_out", N);
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.05));
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
+    for (const ap::Vector3& w : r.maneuver.angular_velocity) EXPECT_LE(w.norm(), 0.05 * (1 + 1e-9));
+    std::printf("keep-out cone + |w| <= 0.05, N = %d: T* = %.7f\n", N, r.minimum_duration);
+    EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "T*(N) rises with N";
+    previous = r.minimum_duration;
+  }
+}

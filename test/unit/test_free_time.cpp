@@ -6,6 +6,7 @@
 // world rotations and axis relabelling, monotone in N and in the bounds, and scales with them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -16,7 +17,9 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace ap = attitude_planner;
 
@@ -201,54 +204,280 @@ TEST(FreeTime, EverySchemeStaysWithinPublishedPlusOneStep) {
   }
 }
 
-TEST(FreeTime, OnlySpinningRateLimitsFallBackToTheSearch) {
-  // Rest to rest a rate limit is written in h (test_stage_constraints.cpp); with spinning ends the
-  // boundary steps move with h, not written yet: the search answers.
+TEST(FreeTime, OnlyFourthOrderAndEffectsFallBackToTheSearch) {
+  // Rate limits are written in h rest to rest and with spinning ends (the attitudes a boundary
+  // rate fixes move with h: ReducedProblem::nodePath; RateLimitDerivativesInHWithSpinningEnds).
   ap::PlanningProblem p = scene("min_time_betts", 32);
   p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.1));
   EXPECT_EQ(ap::freeTimeUnsupported(p), "");
   p.initial_velocity = ap::Vector3(0.01, 0, 0);
-  EXPECT_NE(ap::freeTimeUnsupported(p).find("max_angular_rate"), std::string::npos);
+  EXPECT_EQ(ap::freeTimeUnsupported(p), "");
+  p.scheme = ap::SchemeKind::FourthOrder;
+  EXPECT_NE(ap::freeTimeUnsupported(p).find("fourth_order"), std::string::npos);
 }
 
-TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerThanTheSearch) {
-  // Nonzero boundary rates (body frame): one free-time solve from the geodesic start. The answer
-  // is a KKT point meeting the bounds, the same T* in a rotated world frame, and no slower than
-  // the former search on T over minimum-effort solves (forced here by a zero disturbance torque:
-  // the free-time solver does not take effects, the discrete problem is the same).
+namespace {
+
+/// J = I, |u_i| <= 1, 180 deg about z with nonzero boundary rates (body frame), second_order;
+/// `extra_effects` appended to the effects list.
+ap::PlanningProblem spinningRequest(int steps, const std::string& extra_effects = "") {
   const std::string scene_text =
-      "inertia: [1, 1, 1]\nsteps: 64\nscheme: second_order\nobjective: minimum_time\n"
+      "inertia: [1, 1, 1]\nsteps: " + std::to_string(steps) +
+      "\nscheme: second_order\nobjective: minimum_time\n"
       "initial: {attitude: {axis: [0, 0, 1], angle: 0.0}, angular_velocity: [0.3, -0.1, 0.2]}\n"
       "final: {attitude: {axis: [0, 0, 1], angle: 3.141592653589793}, "
       "angular_velocity: [0.1, 0.2, -0.3]}\n"
-      "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}";
-  ap::PlanningProblem p = ap::parseScene(scene_text + "]\n").problem;
-  const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
-  EXPECT_LE(r.minimum_time.stationarity, 1e-8);
-  EXPECT_LE(r.minimum_time.complementarity, 1e-8);
-  for (const ap::Vector3& t : r.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-9);
-  EXPECT_LE(r.max_constraint_violation, 1e-8);
-  std::printf("spinning ends, N = 64: T* = %.9f\n", r.minimum_duration);
+      "effects: [{actuator_limits: {max_torque: [1, 1, 1]}}" +
+      extra_effects + "]\n";
+  return ap::parseScene(scene_text).problem;
+}
 
-  ap::PlanningProblem turned = p;
+/// The former search on T over minimum-effort solves on the same discrete problem: forced by a
+/// zero disturbance torque (the free-time solver does not take effects).
+ap::PlanResult searched(int steps) {
+  return ap::planManeuver(
+      spinningRequest(steps, ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}"));
+}
+
+}  // namespace
+
+TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerThanTheSearch) {
+  // Nonzero boundary rates: one free-time solve from the geodesic start on N = 64, refined by 2
+  // at a time. At every N the answer is a KKT point meeting the bounds, the same T* in a rotated
+  // world frame, T*(N) rises with N, and T* is no slower than the former search. (From N = 256
+  // on the refinement's start used to be raised ~50× in T before every bound held, and the solve
+  // stopped at the iteration limit: the elastic start.)
   const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
-  turned.initial_attitude = Q * p.initial_attitude;
-  turned.final_attitude = Q * p.final_attitude;
-  const ap::PlanResult in_turned = ap::planManeuver(turned);
-  ASSERT_TRUE(in_turned.converged()) << in_turned.message;
-  EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-  EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-7 * r.minimum_duration);
+  double previous = 0.0;
+  for (const int N : {64, 128, 256, 512}) {
+    const ap::PlanningProblem p = spinningRequest(N);
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
+    for (const ap::Vector3& t : r.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-9);
+    EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
+    std::printf("spinning ends, N = %d: T* = %.9f\n", N, r.minimum_duration);
+    EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "N = " << N;
+    previous = r.minimum_duration;
 
-  const ap::PlanningProblem with_effect =
-      ap::parseScene(scene_text + ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}]\n")
-          .problem;
-  const ap::PlanResult searched = ap::planManeuver(with_effect);
-  ASSERT_TRUE(searched.converged()) << searched.message;
-  EXPECT_FALSE(searched.minimum_time.kkt_point) << searched.message;
-  std::printf("the search on the same request: T = %.9f\n", searched.minimum_duration);
-  // The search's T is the least duration whose minimum-effort plan met the bounds (to their
-  // tolerance), bracketed to 1e-9 relative: T* may sit that far above it, no more.
-  EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-8));
+    ap::PlanningProblem turned = p;
+    turned.initial_attitude = Q * p.initial_attitude;
+    turned.final_attitude = Q * p.final_attitude;
+    const ap::PlanResult in_turned = ap::planManeuver(turned);
+    ASSERT_TRUE(in_turned.converged()) << in_turned.message;
+    EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
+    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration)
+        << "N = " << N;
+
+    if (N != 64 && N != 256) continue;  // the search: on the start grid and the first refined one
+    const ap::PlanResult search = searched(N);
+    ASSERT_TRUE(search.converged()) << search.message;
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    std::printf("the search on the same request: T = %.9f\n", search.minimum_duration);
+    // The search's T is the least duration whose minimum-effort plan met the bounds (to their
+    // tolerance), bracketed to 1e-9 relative: T* may sit that far above it, no more.
+    EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8)) << "N = " << N;
+  }
+}
+
+TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
+  // The refinement of minimum_time.cpp, by hand: the N = 64 answer from the geodesic, carried to
+  // N = 128 and 256 (its rates interpolated in time, ReducedProblem::initializeFromCoarser) at
+  // its own T. The carried plan is a little outside its bounds (T*(N) rises with N), and raising
+  // h at fixed attitudes makes it worse (an end torque carries the boundary momentum 2√w JΩ/h):
+  // each finer solve starts elastic at the coarse T and ends at a KKT point meeting the bounds.
+  ap::PlanningProblem p = spinningRequest(64);
+  p.duration = 3.5;
+  const ap::ReducedProblem geodesic(p);
+  ap::FreeTimeOutcome o =
+      ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, 500);
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  for (const int N : {128, 256}) {
+    ap::PlanningProblem fine = spinningRequest(N);
+    fine.duration = o.duration;
+    ap::ReducedProblem np(fine);
+    np.initializeFromCoarser(o.steps);
+    const std::vector<ap::Matrix3> start = np.attitudes(np.current());
+    for (const double raise : {1.0, 1.5, 2.0}) {
+      double worst = 0.0;
+      for (const ap::Vector3& t : torquesAt(fine, start, raise * o.duration / N))
+        worst = std::max(worst, t.cwiseAbs().maxCoeff());
+      EXPECT_GT(worst, 1.0) << "N = " << N << ", raised " << raise << "x: still outside";
+    }
+    const double coarse_T = o.duration;
+    o = ap::solveFreeTime(fine, start, coarse_T, 1e-9, 500);
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << "N = " << N << ": " << o.message;
+    EXPECT_TRUE(o.elastic_start) << "N = " << N;
+    EXPECT_NEAR(o.start_time_step * N, coarse_T, 1e-12 * coarse_T) << "no raise: T0 = coarse T";
+    EXPECT_GE(o.duration, coarse_T) << "T*(N) rises with N";
+    EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible at the end";
+    for (const ap::Vector3& t : o.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
+    EXPECT_LE(o.stationarity, 1e-8);
+    EXPECT_LE(o.complementarity, 1e-8);
+    std::printf("elastic start, N = %d: T* = %.9f after %d iterations\n", N, o.duration,
+                o.iterations);
+  }
+}
+
+namespace {
+
+/// q = ½|Ω|² of rate-limit instance k (a step's rate for paper and variational, a node's J⁻¹Π_k
+/// for second_order) at the reduced problem's current iterate and h, with its gradient and
+/// Hessian over the instance's local nodes (as the free-time solver forms them).
+struct RateAt {
+  double q = 0.0;
+  Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
+};
+
+RateAt rateAt(const ap::ReducedProblem& np, ap::StageQuantity quantity, int k,
+              const ap::Matrix3& inertia) {
+  RateAt out;
+  if (quantity == ap::StageQuantity::StepRate) {
+    const ap::AngularRateTerms t = ap::angularRateTerms(np.scheme(), np.current()[k]);
+    out.q = t.half_squared_rate;
+    out.gradient.head<6>() = t.gradient;
+    out.hessian.topLeftCorner<6, 6>() = t.hessian;
+    return out;
+  }
+  const ap::Matrix3 J2 = inertia.inverse() * inertia.inverse();
+  np.forEachNodeMomentum(
+      [&](const ap::ReducedProblem::NodeMomentum& node) {
+        if (node.k != k) return;
+        const ap::Vector3 a = J2 * node.momentum;
+        out.q = 0.5 * node.momentum.dot(a);
+        out.gradient = node.jacobian.transpose() * a;
+        out.hessian = node.jacobian.transpose() * J2 * node.jacobian + node.second;
+      },
+      [&](int, const ap::Vector3& Pi) { return ap::Vector3(J2 * Pi); });
+  return out;
+}
+
+}  // namespace
+
+TEST(FreeTime, RateLimitDerivativesInHWithSpinningEndsMatchCentralDifferences) {
+  // With spinning ends paper's and variational's R_1, R_{N−1} move with h (their boundary steps
+  // honour Ω(0), Ω(T)): q(δ, h) = s(h) q̃(δ + d(h)), d = e Δh + ½ e₂ Δh² from nodePath. The
+  // free-time solver's ∂q/∂h, ∂²q/∂h² and ∂∇q/∂h (free nodes) against central differences of q
+  // and ∇q computed at h ± Δh with the free attitudes held, for every rate instance, every scheme.
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    ap::PlanningProblem p = spinningRequest(16);
+    p.scheme = scheme;
+    p.duration = 3.5;
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(1.0));
+    ap::ReducedProblem np(p);
+    std::mt19937 rng(32);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(np.unknowns());
+    for (int i = 0; i < d.size(); ++i) d(i) = 0.05 * normal(rng);
+    np.setCurrent(np.retract(d, 1.0));  // off the geodesic, no symmetry left
+    const double h = np.timeStep(), dh = 1e-4 * h;
+    ap::ReducedProblem later = np, earlier = np;
+    later.setTimeStep(h + dh);
+    earlier.setTimeStep(h - dh);
+    const double s1 = -2.0 / h, s2 = 6.0 / (h * h);
+    int moving = 0;
+    for (const auto& c : ap::buildStageConstraints(p)) {
+      const ap::StageQuantity quantity = c->quantity();
+      if (quantity != ap::StageQuantity::StepRate && quantity != ap::StageQuantity::NodeRate) {
+        continue;
+      }
+      const ap::StageSupport s = ap::stageSupport(quantity, np.firstFreeNode(), np.lastFreeNode());
+      for (int k = s.first_k; k <= s.last_k; ++k) {
+        const RateAt at = rateAt(np, quantity, k, p.inertia);
+        const RateAt up = rateAt(later, quantity, k, p.inertia);
+        const RateAt down = rateAt(earlier, quantity, k, p.inertia);
+        Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero(), e2 = e;
+        for (int node = 0; node < s.width; ++node) {
+          const ap::ReducedProblem::BoundaryPath path = np.nodePath(k + s.node_offset + node);
+          e.segment<3>(3 * node) = path.first;
+          e2.segment<3>(3 * node) = path.second;
+        }
+        if (e.norm() > 0) ++moving;
+        const double q_h = s1 * at.q + at.gradient.dot(e);
+        const double q_hh =
+            s2 * at.q + 2 * s1 * at.gradient.dot(e) + e.dot(at.hessian * e) + at.gradient.dot(e2);
+        const Eigen::Matrix<double, 9, 1> gradient_h = s1 * at.gradient + at.hessian * e;
+        const double fd_h = (up.q - down.q) / (2 * dh);
+        const double fd_hh = (up.q - 2 * at.q + down.q) / (dh * dh);
+        const std::string where = ap::schemeName(scheme) + " k = " + std::to_string(k);
+        EXPECT_NEAR(q_h, fd_h, 1e-6 * (std::abs(fd_h) + at.q / h)) << where;
+        EXPECT_NEAR(q_hh, fd_hh, 1e-4 * (std::abs(fd_hh) + at.q / (h * h))) << where;
+        for (int node = 0; node < s.width; ++node) {
+          if (np.variableIndex(k + s.node_offset + node) < 0) continue;  // a held node only
+          const Eigen::Vector3d fd = (up.gradient - down.gradient).segment<3>(3 * node) / (2 * dh);
+          EXPECT_LE((gradient_h.segment<3>(3 * node) - fd).norm(),
+                    1e-6 * (fd.norm() + at.gradient.norm() / h))
+              << where << " node " << node;
+        }
+      }
+    }
+    // paper and variational: the steps next to R_1 and R_{N−1} move; second_order: none.
+    EXPECT_EQ(moving, scheme == ap::SchemeKind::SecondOrder ? 0 : 2) << ap::schemeName(scheme);
+  }
+}
+
+TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
+  // The spinning request under |Ω| ≤ 1 rad/s (the unconstrained plan peaks at 2.03 rad/s): one
+  // free-time problem, a KKT point within the limit, the same T* in a rotated world frame, and
+  // no slower than the former search on the same discrete problem.
+  for (const ap::SchemeKind scheme : {ap::SchemeKind::SecondOrder, ap::SchemeKind::Paper}) {
+    ap::PlanningProblem p = spinningRequest(64);
+    p.scheme = scheme;
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(1.0));
+    EXPECT_EQ(ap::freeTimeUnsupported(p), "");
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8);
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8);
+    EXPECT_LE(r.max_constraint_violation, 1e-8);
+    double fastest = 0.0;
+    for (const ap::Vector3& w : r.maneuver.angular_velocity) fastest = std::max(fastest, w.norm());
+    EXPECT_LE(fastest, 1.0 + 1e-9);
+    EXPECT_GT(fastest, 1.0 - 1e-6) << "the limit binds";
+    ap::PlanningProblem turned = p;
+    const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
+    turned.initial_attitude = Q * p.initial_attitude;
+    turned.final_attitude = Q * p.final_attitude;
+    const ap::PlanResult in_turned = ap::planManeuver(turned);
+    ASSERT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
+    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration);
+    ap::PlanningProblem forced =
+        spinningRequest(64, ", {disturbance_torque: {frame: body, value: [0, 0, 0]}}");
+    forced.scheme = scheme;
+    forced.constraints = p.constraints;
+    const ap::PlanResult search = ap::planManeuver(forced);
+    ASSERT_TRUE(search.converged()) << search.message;
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    std::printf("%s, |w| <= 1: T* = %.9f, the search %.9f\n", ap::schemeName(scheme).c_str(),
+                r.minimum_duration, search.minimum_duration);
+    EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8));
+  }
+}
+
+TEST(FreeTime, ConeAndRateLimitRefinedToN128IsAKktPoint) {
+  // scenes/min_time_keep_out.yaml with |Ω| ≤ 0.05 rad/s, second_order: the starts on N = 64 and
+  // the best refined to 128. A sensitive case for the barrier's fall: at μ → μ^1.5 the
+  // refinement reaches μ's floor (~1e-13) within ~40 iterations, a node rate bound sits at
+  // c ~ 1e-14 and the step's curvature (~1e-8 in c) cuts every step to α ~ 1e-3 until the
+  // iteration limit (then the search answers); at μ^1.3 (free_time_theta_mu) it converges.
+  double previous = 0.0;
+  for (const int N : {64, 128}) {
+    ap::PlanningProblem p = scene("min_time_keep_out", N);
+    p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.05));
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
+    EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
+    for (const ap::Vector3& w : r.maneuver.angular_velocity) EXPECT_LE(w.norm(), 0.05 * (1 + 1e-9));
+    std::printf("keep-out cone + |w| <= 0.05, N = %d: T* = %.7f\n", N, r.minimum_duration);
+    EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "T*(N) rises with N";
+    previous = r.minimum_duration;
+  }
 }

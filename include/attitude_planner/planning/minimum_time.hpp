@@ -3,7 +3,7 @@
 //
 // Method (src/planning/drivers/minimum_time*.cpp): minimum time as ONE interior-point problem per
 // start, the time step h (T = N h) an unknown next to the node unknowns, objective T, the
-// request's stage constraints (torque bounds, cones, and rest to rest the rate limits) as
+// request's stage constraints (torque bounds, cones and rate limits) as
 // constraints (src/planning/interior_point/free_time_solver.hpp). Starts, rest to rest:
 // the eigenaxis bang–bang slew at its closed-form T and excursions off it about the body axes'
 // parts perpendicular to the eigenaxis and their diagonals (body-fixed: the same in every world
@@ -12,7 +12,7 @@
 // least T is kept and polished (the minimum-effort plan at T* from it, for the switching
 // functions). With cones each start is first made to clear them (a minimum-effort plan under
 // the cones tightened by 0.01 rad). T* is a KKT point of the discrete minimum-time problem, its
-// residuals in PlanResult::minimum_time. Rate limits with spinning ends, fourth_order and effects
+// residuals in PlanResult::minimum_time. fourth_order and effects
 // are not written in h yet: for them (or if no free-time solve converges) the former search answers
 // — several starts, each a continuation down in T over minimum-effort solves warm-started from the
 // last feasible plan and a bisection to kMinimumTimeTolerance; its T* is the least duration found

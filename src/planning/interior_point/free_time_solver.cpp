@@ -24,6 +24,15 @@
 // φ_μ = f − μ Σ ln cᵢ with the fraction to the boundary on c and z; barrier μ decreased
 // monotonically (IPOPT's κ_μ, θ_μ) once the barrier problem's residual is ≤ κ_ε μ. Those
 // constants are InteriorPointParameters' (one value per idea with the fixed-h interior point).
+//
+// Start: h is raised until every constraint that moves with h holds with a margin (rest to rest
+// each of them falls with h). With spinning ends a raise at fixed attitudes makes an end torque
+// worse (it carries the boundary momentum, ∓2√w JΩ/h, which a slower interior no longer meets),
+// so past a raise of kLargestRaise the start stays at its own T and is made feasible by an
+// elastic phase (as IPOPT's restoration, in one problem): those constraints become c + θ ≥ 0,
+// θ ≥ 0 a second bordered unknown with the exact penalty ρθ in the objective (∂c/∂θ = 1: θ
+// enters the Hessian through the barrier terms only); the first iterate with every c > 0 drops
+// θ and the method continues as above from a strictly feasible plan.
 #include "planning/interior_point/free_time_solver.hpp"
 
 #include <algorithm>
@@ -52,6 +61,19 @@ constexpr double kInitialEffortShare = 1e-2;
 /// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
 constexpr double kFinalEffortFraction = 1e-8;
 constexpr int kHalfBandwidth = 8;
+/// The start's h is raised at most this factor before the elastic start takes over: with spinning
+/// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
+/// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
+/// outside its bounds at T was raised to 52 T before every bound held (a prolonged N = 128
+/// answer on N = 256, docs/results/minimum_time.md "Spinning ends") and the solve, started that
+/// far from T*, stopped at the iteration limit. Rest to rest every such constraint falls with h
+/// and a raise of a few percent suffices.
+constexpr double kLargestRaise = 2.0;
+/// ρ of the elastic start's penalty ρθ (objective T/T₀ = 1 at the start): above the sum of the
+/// multipliers the relaxed problem's minimum has θ = 0 (an exact penalty); raised ×10 whenever a
+/// barrier problem is solved with the iterate still outside.
+constexpr double kElasticPenalty = 100.0;
+constexpr double kElasticPenaltyGrowth = 10.0;
 /// Above this N the stationarity tolerance grows like N² (round-off of second differences).
 constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 
@@ -95,9 +117,22 @@ class FreeTimeSolver {
           << "; raising T does not move them)";
       return why.str();
     }
+    const double h_start = np_.timeStep();
+    const ReducedProblem::StepVectors steps_start = np_.current();
     for (int i = 0; i < parameters_.free_time_max_start_growths; ++i) {
       if (smallestValue(np_.current(), true) >= parameters_.free_time_start_margin) {
         h0_ = np_.timeStep();
+        return "";
+      }
+      if (allow_elastic_ &&
+          np_.timeStep() * parameters_.free_time_start_growth > kLargestRaise * h_start) {
+        // The elastic start at the start's own T: c_i + θ ≥ 0 with θ holding the start margin.
+        np_.setTimeStep(h_start);
+        np_.setCurrent(steps_start);
+        h0_ = h_start;
+        elastic_ = started_elastic_ = true;
+        theta_ = parameters_.free_time_start_margin - smallestValue(np_.current(), true);
+        rho_ = kElasticPenalty;
         return "";
       }
       np_.setTimeStep(np_.timeStep() * parameters_.free_time_start_growth);
@@ -109,6 +144,9 @@ class FreeTimeSolver {
   }
 
   FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options);
+  /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
+  bool startedElastic() const { return started_elastic_; }
+  void disallowElastic() { allow_elastic_ = false; }
 
  private:
   int constraintCount() const {
@@ -121,7 +159,7 @@ class FreeTimeSolver {
   /// Calls f(group, k, c) for every instance's value c at `steps` (torques and, with cones, the
   /// attitudes formed once).
   template <typename F>
-  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f) const {
+  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f, bool relaxed = true) const {
     const std::vector<Vector3> tau = np_.torques(steps);
     std::vector<Matrix3> R;
     for (const FreeTimeGroup& g : groups_) {
@@ -137,10 +175,17 @@ class FreeTimeSolver {
         } else {
           q(0) = halfSquaredRate(quantity, steps, k);
         }
-        f(g, k, g.constraint->value(q));
+        f(g, k, g.constraint->value(q) + (relaxed ? relaxation(quantity) : 0.0));
       }
     }
   }
+
+  /// θ added to a constraint that moves with h while the start is elastic (else 0).
+  double relaxation(StageQuantity quantity) const {
+    return elastic_ && quantityDependsOnTimeStep(quantity) ? theta_ : 0.0;
+  }
+  /// The global unknowns bordering the band: η, and θ while elastic.
+  int borderSize() const { return elastic_ ? 2 : 1; }
 
   /// q = ½|Ω|² of step k (paper, variational: the scheme's velocity of F_k) or of node k (schemes
   /// with end torques: J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀμ(F_{k−1}))/2) at the current h.
@@ -156,14 +201,18 @@ class FreeTimeSolver {
     return 0.5 * (inverse_inertia_ * Pi).squaredNorm();
   }
 
-  /// The smallest value of the constraints that move with h (time_dependent) or of the others.
+  /// The smallest value of the constraints that move with h (time_dependent) or of the others,
+  /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
     double smallest = std::numeric_limits<double>::infinity();
-    forEachValue(steps, [&](const FreeTimeGroup& g, int, double c) {
-      if (quantityDependsOnTimeStep(g.constraint->quantity()) == time_dependent) {
-        smallest = std::min(smallest, c);
-      }
-    });
+    forEachValue(
+        steps,
+        [&](const FreeTimeGroup& g, int, double c) {
+          if (quantityDependsOnTimeStep(g.constraint->quantity()) == time_dependent) {
+            smallest = std::min(smallest, c);
+          }
+        },
+        false);
     return smallest;
   }
 
@@ -172,6 +221,10 @@ class FreeTimeSolver {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
     bool inside = true;
+    if (elastic_) {
+      inside = theta_ > 0;
+      if (inside) phi += rho_ * theta_ - mu * std::log(theta_);
+    }
     const double fraction = 1 - parameters_.fraction_to_boundary;
     forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
       if (!(c > 0) || (check_boundary && c < fraction * g.instance(k).c)) inside = false;
@@ -191,6 +244,8 @@ class FreeTimeSolver {
   };
   std::vector<RateTerms> rateTerms(StageQuantity quantity) const;
   void assembleRates(double mu);
+  void assembleElastic(double mu);
+  void leaveElasticIfInside();
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
@@ -219,17 +274,25 @@ class FreeTimeSolver {
   std::vector<FreeTimeGroup> groups_;
   // The assembled system at the current iterate.
   BandedSymmetric<double> band_{1, kHalfBandwidth};
-  Eigen::VectorXd border_, rhs_, lagrangian_gradient_;
-  double corner_ = 0.0;
+  Eigen::MatrixXd border_;  ///< the band's coupling to η (column 0) and, elastic, θ (column 1)
+  Eigen::MatrixXd corner_;  ///< the (η, θ) block
+  Eigen::VectorXd rhs_, lagrangian_gradient_;
   double last_shift_ = 0.0;  ///< the last iteration's shift (0: none)
+  // The elastic start (startInside): while the iterate is outside a constraint that moves with h,
+  // that constraint is c + θ ≥ 0, θ ≥ 0 one more unknown (index n_ + 1, multiplier z_θ) and the
+  // objective gains ρθ; the first iterate strictly inside every constraint drops θ.
+  bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
+  double theta_ = 0.0, z_theta_ = 0.0, rho_ = kElasticPenalty;
+  double theta_assembled_ = 0.0;  ///< θ where the system was assembled
 };
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
   band_ = BandedSymmetric<double>(n_, kHalfBandwidth);
-  border_.setZero(n_);
-  rhs_.setZero(n_ + 1);
-  lagrangian_gradient_.setZero(n_ + 1);
-  corner_ = 0.0;
+  const int b = borderSize();
+  border_.setZero(n_, b);
+  corner_.setZero(b, b);
+  rhs_.setZero(n_ + b);
+  lagrangian_gradient_.setZero(n_ + b);
   std::vector<FreeTimeGroup*> torque_groups;
   for (FreeTimeGroup& g : groups_)
     if (g.constraint->quantity() == StageQuantity::Torque) torque_groups.push_back(&g);
@@ -261,7 +324,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
         for (FreeTimeGroup* g : torque_groups) {
           FreeTimeInstance& in = g->instance(st.k);
-          in.c = g->constraint->value(tau);
+          in.c = g->constraint->value(tau) + relaxation(StageQuantity::Torque);
           in.g = G.transpose() * (g->constraint->gradient(tau) / s);
           gauss_newton -= in.z * g->constraint->curvature() / (s * s);
         }
@@ -277,6 +340,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
       weights);
   assembleCones(mu);
   assembleRates(mu);
+  assembleElastic(mu);
+  theta_assembled_ = theta_;
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
 }
@@ -338,11 +403,17 @@ std::vector<FreeTimeSolver::RateTerms> FreeTimeSolver::rateTerms(StageQuantity q
   return out;
 }
 
-/// Rate limits on q = ½|Ω|² (of a step or a node). Rest to rest (freeTimeUnsupported) the steps do
-/// not move with h at fixed free attitudes and every momentum scales like 1/h, so q = q̃(δ)/h²:
-/// ∂q/∂h = −2q/h, ∂∇q/∂h = −2∇q/h, ∂²q/∂h² = 6q/h² (in η = h/h₀: times h₀, h₀²). c = 1 + c' q.
+/// Rate limits on q = ½|Ω|² (of a step or a node). At fixed free attitudes every momentum scales
+/// like 1/h, and the attitudes a boundary rate fixes move with h (ReducedProblem::nodePath: R_1,
+/// R_{N−1} of paper and variational, whose boundary steps honour Ω(0), Ω(T) at every h; none for
+/// second_order, whose node rates involve free attitudes and R_0, R_N only), as node
+/// perturbations d(h) = e Δh + ½ e₂ Δh². So q(δ, h) = s(h) q̃(δ + d(h)), s = (h₀/h)², and at h₀
+///     ∂q/∂h = s'q + ∇qᵀe,   ∂∇q/∂h = s'∇q + ∇²q e,   ∂²q/∂h² = s''q + 2s'∇qᵀe + eᵀ∇²q e + ∇qᵀe₂,
+/// s' = −2/h, s'' = 6/h² (rest to rest e = e₂ = 0: q = q̃/h²); in η = h/h₀ times h₀, h₀².
+/// c = 1 + c' q.
 void FreeTimeSolver::assembleRates(double mu) {
   const double h = np_.timeStep();
+  const double s1 = -2.0 / h, s2 = 6.0 / (h * h);
   for (const StageQuantity quantity : {StageQuantity::StepRate, StageQuantity::NodeRate}) {
     std::vector<RateTerms> terms;
     for (FreeTimeGroup& g : groups_) {
@@ -350,18 +421,26 @@ void FreeTimeSolver::assembleRates(double mu) {
       if (terms.empty()) terms = rateTerms(quantity);
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
         const RateTerms& t = terms[k];
+        Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero(), e2 = e;
+        for (int node = 0; node < g.support.width; ++node) {
+          const ReducedProblem::BoundaryPath path = np_.nodePath(k + g.support.node_offset + node);
+          e.segment<3>(3 * node) = path.first;
+          e2.segment<3>(3 * node) = path.second;
+        }
+        const Eigen::Matrix<double, 9, 1> He = t.hessian * e;
         Eigen::Matrix<double, 10, 1> dq;  // ∇q over (local nodes, η)
         dq.head<9>() = t.gradient;
-        dq(9) = -2.0 * t.q / h * h0_;
+        dq(9) = (s1 * t.q + t.gradient.dot(e)) * h0_;
         Eigen::Matrix<double, 10, 10> d2q;
         d2q.topLeftCorner<9, 9>() = t.hessian;
-        d2q.block<9, 1>(0, 9) = -2.0 / h * h0_ * t.gradient;
+        d2q.block<9, 1>(0, 9) = (s1 * t.gradient + He) * h0_;
         d2q.block<1, 9>(9, 0) = d2q.block<9, 1>(0, 9).transpose();
-        d2q(9, 9) = 6.0 * t.q / (h * h) * h0_ * h0_;
+        d2q(9, 9) =
+            (s2 * t.q + 2 * s1 * t.gradient.dot(e) + e.dot(He) + t.gradient.dot(e2)) * h0_ * h0_;
         const Vector3 q(t.q, 0.0, 0.0);
         const double slope = g.constraint->gradient(q)(0);
         FreeTimeInstance& in = g.instance(k);
-        in.c = g.constraint->value(q);
+        in.c = g.constraint->value(q) + relaxation(quantity);
         in.g = slope * dq;
         const Eigen::Matrix<double, 10, 10> H =
             (-in.z * slope) * d2q + (in.z / in.c) * in.g * in.g.transpose();
@@ -369,6 +448,41 @@ void FreeTimeSolver::assembleRates(double mu) {
       }
     }
   }
+}
+
+/// The elastic start's θ: every constraint that moves with h is c + θ (∂/∂θ = 1, no curvature),
+/// so θ couples through the barrier terms (z/c) g gᵀ alone; plus ρθ and θ's own barrier −μ ln θ.
+void FreeTimeSolver::assembleElastic(double mu) {
+  if (!elastic_) return;
+  const int t = n_ + 1;
+  for (const FreeTimeGroup& g : groups_) {
+    if (!quantityDependsOnTimeStep(g.constraint->quantity())) continue;
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FreeTimeInstance& in = g.instance(k);
+      const double w = in.z / in.c;
+      for (int node = 0; node < g.support.width; ++node) {
+        const int v = np_.variableIndex(k + g.support.node_offset + node);
+        if (v >= 0) border_.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
+      }
+      corner_(0, 1) += w * in.g(9);
+      corner_(1, 1) += w;
+      rhs_(t) += mu / in.c;
+      lagrangian_gradient_(t) -= in.z;
+    }
+  }
+  corner_(1, 0) = corner_(0, 1);
+  corner_(1, 1) += z_theta_ / theta_;
+  rhs_(t) += mu / theta_ - rho_;
+  lagrangian_gradient_(t) += rho_ - z_theta_;
+}
+
+/// Drops θ once every constraint holds strictly without it: from then on the iterate is a plan
+/// meeting its bounds, as a start raised inside would be.
+void FreeTimeSolver::leaveElasticIfInside() {
+  if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
+  elastic_ = false;
+  theta_ = 0.0;
+  z_theta_ = 0.0;
 }
 
 /// Adds one instance's Hessian block (local nodes and η), right-hand side and Lagrangian gradient
@@ -381,11 +495,11 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
     if (v < 0) continue;
     rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
     lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
-    border_.segment<3>(v) += H.block<3, 1>(3 * node, 9);
+    border_.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
   }
   rhs_(n_) += rhs(9);
   lagrangian_gradient_(n_) += lagrangian(9);
-  corner_ += H(9, 9);
+  corner_(0, 0) += H(9, 9);
   const int first_slot = std::max(0, np_.firstFreeNode() - first_node);
   const int last_slot = std::min(width - 1, np_.lastFreeNode() - first_node);
   if (first_slot <= last_slot) {
@@ -401,9 +515,10 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
 /// step a descent direction of φ_μ. As IPOPT's δ_w: the next iteration starts from a third of
 /// the last shift that worked.
 bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
-  double scale = std::abs(corner_);
+  const int b = borderSize();
+  double scale = corner_.diagonal().cwiseAbs().sum();
   for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
-  scale /= n_ + 1;
+  scale /= n_ + b;
   const double resumed = last_shift_ > 0
                              ? std::max(parameters_.free_time_smallest_shift, last_shift_ / 3)
                              : parameters_.free_time_first_shift;
@@ -411,11 +526,11 @@ bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
        shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : parameters_.shift_growth)) {
     BandedSymmetric<double> A = band_;
     if (shift > 0) A.addToDiagonal(shift * scale);
-    Eigen::MatrixXd D(1, 1);
-    D(0, 0) = corner_ + shift * scale;
+    Eigen::MatrixXd D = corner_;
+    D.diagonal().array() += shift * scale;
     BorderedBanded factor;
-    if (!factor.factor(A, Eigen::MatrixXd(border_), D)) continue;
-    if (factor.inertia().positive != 1) continue;
+    if (!factor.factor(A, border_, D)) continue;
+    if (factor.inertia().positive != b) continue;
     *d = rhs_;
     factor.solve(d);
     if (d->allFinite() && d->dot(rhs_) > 0) {
@@ -438,13 +553,17 @@ void FreeTimeSolver::moveTo(double h, const ReducedProblem::StepVectors& steps,
 
 bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsilon,
                                 double* alpha) {
-  const double h = np_.timeStep();
+  const double h = np_.timeStep(), theta = theta_;
   const ReducedProblem::StepVectors steps = np_.current();
   const double phi0 = merit(mu, epsilon, false);
   const double slope = -d.dot(rhs_);  // ∇φ_μᵀ d < 0
   double a = 1.0;
   for (int i = 0; i < parameters_.free_time_max_halvings; ++i, a *= 0.5) {
     if (h + a * h0_ * d(n_) <= 0) continue;
+    if (elastic_) {  // θ by the fraction to the boundary
+      theta_ = theta + a * d(n_ + 1);
+      if (theta_ < (1 - parameters_.fraction_to_boundary) * theta) continue;
+    }
     double phi = std::numeric_limits<double>::infinity();
     try {
       moveTo(h, steps, &d, a);
@@ -458,6 +577,7 @@ bool FreeTimeSolver::lineSearch(const Eigen::VectorXd& d, double mu, double epsi
     np_.setTimeStep(h);
   }
   np_.setTimeStep(h);
+  theta_ = theta;
   moveTo(h, steps, nullptr, 0.0);
   return false;
 }
@@ -466,6 +586,7 @@ double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
+  if (elastic_ && quantityDependsOnTimeStep(g.constraint->quantity())) sum += d(n_ + 1);  // ∂/∂θ
   for (int node = 0; node < g.support.width; ++node) {
     const int v = np_.variableIndex(k + g.support.node_offset + node);
     if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
@@ -484,6 +605,14 @@ void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
       if (in.dz < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / in.dz);
     }
   }
+  double dz_theta = 0.0;
+  if (elastic_) {  // at the assembled θ (the line search has moved θ already)
+    dz_theta = mu / theta_assembled_ - z_theta_ - z_theta_ / theta_assembled_ * d(n_ + 1);
+    if (dz_theta < 0) {
+      alpha = std::min(alpha, -parameters_.fraction_to_boundary * z_theta_ / dz_theta);
+    }
+  }
+  z_theta_ += alpha * dz_theta;
   for (FreeTimeGroup& g : groups_) {
     for (FreeTimeInstance& in : g.at) in.z += alpha * in.dz;
   }
@@ -497,6 +626,7 @@ void FreeTimeSolver::safeguardDuals(double mu) {
     in.c = c;
     in.z = std::clamp(in.z, mu / (kappa * c), kappa * mu / c);
   });
+  if (elastic_) z_theta_ = std::clamp(z_theta_, mu / (kappa * theta_), kappa * mu / theta_);
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
@@ -505,6 +635,7 @@ void FreeTimeSolver::initializeDuals(double mu) {
     in.c = c;
     in.z = mu / c;
   });
+  if (elastic_) z_theta_ = mu / theta_;
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point.
@@ -513,6 +644,7 @@ double FreeTimeSolver::barrierResidual(double mu) const {
   for (const FreeTimeGroup& g : groups_) {
     for (const FreeTimeInstance& in : g.at) worst = std::max(worst, std::abs(in.z * in.c - mu));
   }
+  if (elastic_) worst = std::max(worst, std::abs(z_theta_ * theta_ - mu));
   return worst;
 }
 
@@ -545,10 +677,11 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     assemble(mu, epsilon);
     const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-    if (mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
+    if (!elastic_ && mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
       return outcome(Termination::Converged, "converged", iterations, epsilon);
     }
     if (mu > mu_final && barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu) {
+      if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
       mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
                                        std::pow(mu, parameters_.free_time_theta_mu)));
       continue;  // the same iterate for the next barrier problem (not an iteration)
@@ -565,7 +698,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     Eigen::VectorXd d;
     double alpha = 0.0;
     if (!solveStep(&d) || !lineSearch(d, mu, epsilon, &alpha)) {
-      if (stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
+      if (!elastic_ && stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
         return outcome(Termination::Converged, "converged to the round-off floor", iterations,
                        epsilon);
       }
@@ -573,6 +706,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
                      epsilon);
     }
     dualStep(d, mu);
+    leaveElasticIfInside();
     safeguardDuals(mu);
   }
 }
@@ -584,6 +718,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.steps = np_.current();
   out.time_step = np_.timeStep();
   out.start_time_step = h0_;
+  out.elastic_start = started_elastic_;
   out.duration = N_ * out.time_step;
   out.iterations = iterations;
   out.effort_weight = epsilon;
@@ -621,14 +756,6 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
     return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
   }
   if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
-  const bool rest_to_rest =
-      problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0);
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxAngularRate && !rest_to_rest) {
-      return "constraints: max_angular_rate with nonzero boundary rates (the boundary steps move "
-             "with h)";
-    }
-  }
   return "";
 }
 
@@ -651,10 +778,23 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
       return failed;
     }
     const StageConstraints constraints = buildStageConstraints(problem);
+    const std::vector<Vector3> start_steps = np.current();
+    const double start_h = np.timeStep();
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     failed.message = solver.startInside();
     if (!failed.message.empty()) return failed;
-    return solver.run(tolerance, max_iterations, options);
+    FreeTimeOutcome out = solver.run(tolerance, max_iterations, options);
+    if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
+    // The elastic start did not reach a KKT point: the start raised inside instead.
+    np.setTimeStep(start_h);
+    np.setCurrent(start_steps);
+    FreeTimeSolver raised(problem, &np, constraints, parameters);
+    raised.disallowElastic();
+    failed.message = raised.startInside();
+    if (!failed.message.empty()) return out;
+    FreeTimeOutcome second = raised.run(tolerance, max_iterations, options);
+    second.iterations += out.iterations;
+    return second;
   } catch (const StepTooLarge& e) {
     failed.message = std::string("the boundary rates admit no step: ") + e.what();
     return failed;

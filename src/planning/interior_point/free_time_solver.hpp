@@ -1,6 +1,6 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
 // node unknowns δ of the reduced problem, objective T, the torque constraints, pointing cones and
-// (rest to rest) rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
+// rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
 // free_time_solver.cpp derives the method).
 #pragma once
 
@@ -21,7 +21,10 @@ struct FreeTimeOutcome {
   ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
   double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)
-  double duration = 0.0;         ///< T = N h
+  /// The start was brought inside by the elastic phase (c + θ ≥ 0, θ driven to 0) at its own T,
+  /// not by raising h (h₀ is then the start's h).
+  bool elastic_start = false;
+  double duration = 0.0;  ///< T = N h
   int iterations = 0;
   /// max-norm of ∇T − Σ zᵢ∇cᵢ over (δ, h/h₀) relative to ∂T/∂(h/h₀) = T₀ (h₀ the start's h):
   /// the stationarity of the minimum-time Lagrangian, its h row included.
@@ -34,16 +37,21 @@ struct FreeTimeOutcome {
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
 };
 
-/// Why `problem` cannot be solved free-time here (empty: it can): rate limits with spinning ends
-/// (the boundary steps move with h) and effects are not written in h yet, fourth_order has no
-/// single transcription (minimum_time.cpp falls back to the search).
+/// Why `problem` cannot be solved free-time here (empty: it can): effects are not written in h
+/// yet (time-dependent torques), fourth_order has no single transcription (minimum_time.cpp falls
+/// back to the search).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
 /// R_N the problem's) at T = start_duration, raised until every torque constraint holds strictly
-/// (the iterates stay strictly feasible; a cone must hold strictly at the start's attitudes
-/// already, and at the attitudes the boundary data fix: raising T does not move them). Boundary
-/// rates are held at every h. Ends Converged at a KKT point of the discrete minimum-time problem
+/// (a cone must hold strictly at the start's attitudes already, and at the attitudes the boundary
+/// data fix: raising T does not move them). If a raise by 2× does not suffice (spinning ends: an
+/// end torque carries the boundary momentum, which a slower interior no longer meets), the start
+/// stays at its T and is brought inside by an elastic phase instead: the constraints that move
+/// with h relaxed to c + θ ≥ 0, θ ≥ 0 one more unknown penalized in the objective, dropped at the
+/// first iterate strictly inside every constraint; from then on every iterate is strictly
+/// feasible (if that solve fails, it is retried raising h alone). Boundary rates are held at
+/// every h. Ends Converged at a KKT point of the discrete minimum-time problem
 /// (complementarity within `tolerance`, stationarity within it × max(1, (N/256)²): round-off),
 /// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
 /// Cancelled or TimedOut when `options` (may be null) asks: its cancel flag and time budget are

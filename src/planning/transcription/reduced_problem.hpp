@@ -160,6 +160,15 @@ class ReducedProblem {
                               BandedSymmetricMatrix* band, Eigen::VectorXd* border,
                               double* corner) const;
 
+  /// How attitude R_j moves with h at fixed free attitudes: R_j(h) = R_j exp(d(h)^),
+  /// d = first Δh + ½ second Δh² (the step that carries a boundary rate honours it at every h).
+  struct BoundaryPath {
+    Vector3 first = Vector3::Zero(), second = Vector3::Zero();
+  };
+  /// R_j's path: zero but for the fixed inner attitudes R_1, R_{N−1} of paper and variational
+  /// (R_1 = R_0 F_0, F_0 from Ω(0) at h); a free attitude is held, R_0 and R_N are data.
+  BoundaryPath nodePath(int j) const;
+
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
   int variableIndex(int j) const {
     return (j >= first_free_ && j <= last_free_) ? 3 * (j - first_free_) : -1;
@@ -172,10 +181,6 @@ class ReducedProblem {
   /// initializeFromCoarser).
   void closeGap(const Eigen::Vector4d& target);
 
-  /// How a fixed inner attitude moves with h: R(h) = R exp(d(h)^), d = first Δh + ½ second Δh².
-  struct BoundaryPath {
-    Vector3 first = Vector3::Zero(), second = Vector3::Zero();
-  };
   /// The path of R_1 (at_start) or R_{N−1}; zero for second_order (no fixed inner attitude).
   BoundaryPath boundaryPath(bool at_start) const;
   /// Throws InvalidInput if the time step cannot be an unknown here (effects).

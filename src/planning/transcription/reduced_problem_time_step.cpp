@@ -96,6 +96,13 @@ ReducedProblem::BoundaryPath ReducedProblem::boundaryPath(bool at_start) const {
   return path;
 }
 
+ReducedProblem::BoundaryPath ReducedProblem::nodePath(int j) const {
+  if (scheme_.hasEndTorques()) return {};
+  if (j == 1) return boundaryPath(true);
+  if (j == N_ - 1) return boundaryPath(false);
+  return {};
+}
+
 double ReducedProblem::forEachStencilWithTimeStep(
     const std::function<void(const TimeStepStencil&)>& visit,
     const SecondOrderWeights& weights) const {

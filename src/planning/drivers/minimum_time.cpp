@@ -31,8 +31,9 @@ void validateMinimumTime(const PlanningProblem& problem) {
 
 /// What T* is, for messages.
 std::string tStarKind(const PlanResult& r) {
-  return r.minimum_time.kkt_point ? "minimum time, a KKT point of the discrete minimum-time problem"
-                                  : "minimum time, the least duration found feasible";
+  return r.minimum_time.kkt_point
+             ? "minimum time, a KKT point of the discrete minimum-time problem: a local minimum"
+             : "minimum time, the least duration found feasible: an upper bound";
 }
 
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,

@@ -20,6 +20,7 @@
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
 
@@ -29,10 +30,7 @@ constexpr double kBilimoriaWie = 3.2430;  // published T* (J = I, |u_i| <= 1, 18
 constexpr double kBetts = 28.6304;        // published T* [s]
 
 ap::PlanningProblem scene(const char* name, int steps) {
-  ap::PlanningProblem p =
-      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + name + ".yaml").problem;
-  p.steps = steps;
-  return p;
+  return ap::test_support::sceneProblem(name, steps);
 }
 
 /// R_k = R_0 exp(θ(s) ê) exp(ε sin²(πs) p̂): the eigenaxis bang–bang with an excursion off it.

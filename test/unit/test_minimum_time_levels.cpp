@@ -17,16 +17,14 @@
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
 
 namespace {
 
 ap::PlanningProblem scene(const char* name, int steps) {
-  ap::PlanningProblem p =
-      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + name + ".yaml").problem;
-  p.steps = steps;
-  return p;
+  return ap::test_support::sceneProblem(name, steps);
 }
 
 /// The free-time levels as the driver walked them before it ran on the shared continuation: N,

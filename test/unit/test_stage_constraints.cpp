@@ -23,16 +23,14 @@
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
 
 namespace {
 
 ap::PlanningProblem scene(const char* name, int steps) {
-  ap::PlanningProblem p =
-      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/") + name + ".yaml").problem;
-  p.steps = steps;
-  return p;
+  return ap::test_support::sceneProblem(name, steps);
 }
 
 /// How far above the search's T a cone answer may sit (a missed basin, not a wrong KKT point).

@@ -1,16 +1,19 @@
 // Minimum time's strategies (src/planning/drivers/minimum_time*): the free-time grid levels on the
 // shared grid continuation (N halved down to the coarsest at or above 64), what a refined answer
 // reports (its levels, the refined solve kept), the prolongation of a coarse answer clear of the
-// cones, and the cone-clearing start's refusals (no start, never an error the request did not
-// make).
+// cones, the cone-clearing start's refusals (no start, never an error the request did not
+// make), and a KKT point from the search's plan where the search answers.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
@@ -158,4 +161,48 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   const ap::PlanResult b = ap::planManeuver(box);
   ASSERT_TRUE(b.converged()) << b.message;
   EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves), ap::freeTimeStarts(box, true).size());
+}
+
+TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPoint) {
+  // A spinning request under a torque-norm bound (case 13 of scripts/extremal_classes.py's seeded
+  // suite, seed 5005, the bound at 0.7x its unconstrained peak), paper at N = 128. Whatever the
+  // structured starts reach, the answer is a KKT point of the discrete minimum-time problem at or
+  // below the search's T on the same problem (the search forced by a zero disturbance torque).
+  ap::PlanningProblem p;
+  p.inertia << 93.739979181337787, -4.7429217545495224, -4.0381979888832467, -4.7429217545495224,
+      113.36887843197682, 8.1631076802271263, -4.0381979888832467, 8.1631076802271263,
+      81.147539855481128;
+  p.steps = 128;
+  p.scheme = ap::SchemeKind::Paper;
+  p.objective = ap::Objective::MinimumTime;
+  p.duration = 0.0;
+  p.initial_attitude =
+      ap::so3::fromQuaternion(Eigen::Quaterniond(0.43225076910898763, 0.66446639264490204,
+                                                 -0.6068522852491941, 0.058086052869775258)
+                                  .normalized());
+  p.final_attitude =
+      ap::so3::fromQuaternion(Eigen::Quaterniond(-0.80684655946904782, -0.25331862124071663,
+                                                 -0.3304640820275731, 0.4190725427600045)
+                                  .normalized());
+  p.initial_velocity = ap::Vector3(0.97013585872010177, -1.0660798184824838, 0.64096569823845517);
+  p.final_velocity = ap::Vector3(2.0328166382210426, -3.4094311407284201, -1.7785901451994599);
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(960.84957105509102)};
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+  EXPECT_LE(r.minimum_time.stationarity, 1e-8);
+  EXPECT_LE(r.minimum_time.complementarity, 1e-8);
+  EXPECT_LE(r.max_constraint_violation, 1e-8);
+  ap::PlanningProblem forced = p;
+  auto effects = std::make_shared<ap::EffectModel>();
+  effects->add(std::make_unique<ap::DisturbanceTorque>(ap::Vector3::Zero(), ap::TorqueFrame::Body));
+  forced.effects = effects;
+  const ap::PlanResult searched = ap::planManeuver(forced);
+  ASSERT_TRUE(searched.converged()) << searched.message;
+  EXPECT_FALSE(searched.minimum_time.kkt_point);
+  EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-9));
+  const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return a.kept && a.stage == ap::AttemptStage::MinimumTimeSolve;
+  });
+  EXPECT_NE(kept, r.attempts.end());
 }

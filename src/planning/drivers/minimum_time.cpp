@@ -37,7 +37,8 @@ std::string tStarKind(const PlanResult& r) {
 }
 
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
-/// or if none of its solves converged, the search (searchMinimumTime, an upper bound).
+/// or if none of its solves converged, the search (searchMinimumTime, an upper bound); where the
+/// free-time problem applies, the search's plan starts one more free-time solve (a KKT point).
 PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options) {
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
@@ -48,9 +49,25 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
   } else {
     why = "the free-time interior point does not take " + unsupported + " yet";
   }
+  const auto started = std::chrono::steady_clock::now();
   PlanResult result = searchMinimumTime(problem, options);
   result.message += "; searched on T (" + why + ")";
-  return result;
+  if (!unsupported.empty() || !result.converged() ||
+      result.maneuver.attitude.size() != static_cast<std::size_t>(problem.steps) + 1) {
+    return result;
+  }
+  // The search's plan meets every bound at its T (an upper bound on T*): started from it, one
+  // free-time solve can reach a KKT point at or below it where the structured starts did not.
+  std::optional<PlanResult> sharpened = freeTimeFromPlan(
+      problem, result.maneuver, result.minimum_duration, withRemainingBudget(options, started));
+  if (!sharpened || !sharpened->converged()) return result;
+  std::vector<Attempt> attempts = result.attempts;
+  for (Attempt& a : attempts) a.kept = false;
+  attempts.insert(attempts.end(), sharpened->attempts.begin(), sharpened->attempts.end());
+  sharpened->attempts = std::move(attempts);
+  sharpened->message += "; the structured starts did not converge (" + why +
+                        "), the search found T = " + exactNumber(result.minimum_duration) + " s";
+  return *sharpened;
 }
 
 /// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at

@@ -76,6 +76,21 @@ class FreeTimeMinimumTime {
                                   names_[best] + "), refined by 2 at a time");
   }
 
+  /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
+  /// duration, e.g. the search's): the polished KKT point if it converged at or below that T.
+  std::optional<PlanResult> runFrom(const Maneuver& plan, double duration,
+                                    const std::string& name) {
+    const FreeTimeOutcome o =
+        solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt);
+    outcomes_.push_back(o);
+    names_.push_back(name);
+    same_as_.push_back(-1);
+    if (o.termination != Termination::Converged || o.duration > duration) return std::nullopt;
+    best_attempt_ = trail_.size() - 1;
+    levels_ = levelResult(problem_.steps, o).levels;
+    return polished(o, name);
+  }
+
  private:
   /// One free-time solve from `start` (N + 1 attitudes, clear of the cones) at T = duration,
   /// recorded in the trail.
@@ -309,6 +324,11 @@ GridLevelRule freeTimeGridRule() {
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
                                               const SolverOptions& options) {
   return FreeTimeMinimumTime(problem, options).run();
+}
+
+std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
+                                           double duration, const SolverOptions& options) {
+  return FreeTimeMinimumTime(problem, options).runFrom(plan, duration, "search's plan");
 }
 
 }  // namespace attitude_planner

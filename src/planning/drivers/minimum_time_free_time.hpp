@@ -43,4 +43,10 @@ std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& 
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
                                               const SolverOptions& options);
 
+/// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
+/// `duration` (the search's answer where the structured starts did not converge): the polished
+/// KKT point if it converged at or below `duration`, else empty.
+std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
+                                           double duration, const SolverOptions& options);
+
 }  // namespace attitude_planner

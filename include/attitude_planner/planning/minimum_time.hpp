@@ -16,7 +16,9 @@
 // are not written in h yet: for them (or if no free-time solve converges) the former search answers
 // — several starts, each a continuation down in T over minimum-effort solves warm-started from the
 // last feasible plan and a bisection to kMinimumTimeTolerance; its T* is the least duration found
-// feasible, an upper bound (minimum_time.kkt_point false). docs/results/minimum_time.md has the
+// feasible, an upper bound (minimum_time.kkt_point false). Where the free-time problem applies,
+// the search's plan (feasible at its T) then starts one more free-time solve, and a KKT point at
+// or below the search's T is the answer if it converges. docs/results/minimum_time.md has the
 // figures.
 #pragma once
 

@@ -82,9 +82,7 @@ class FreeTimeMinimumTime {
                                     const std::string& name) {
     const FreeTimeOutcome o =
         solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt);
-    outcomes_.push_back(o);
-    names_.push_back(name);
-    same_as_.push_back(-1);
+    recordStart(plan.attitude, duration, name, o, -1);
     if (o.termination != Termination::Converged || o.duration > duration) return std::nullopt;
     best_attempt_ = trail_.size() - 1;
     levels_ = levelResult(problem_.steps, o).levels;
@@ -139,6 +137,17 @@ class FreeTimeMinimumTime {
     return -1;
   }
 
+  /// Records a start (its attitudes as solved, T, name) with its outcome and the earlier start it
+  /// repeats (−1: none): the per-start lists stay aligned for sameStartAs and the message.
+  void recordStart(const std::vector<Matrix3>& start, double duration, const std::string& name,
+                   FreeTimeOutcome outcome, int same) {
+    starts_.push_back(start);
+    start_durations_.push_back(duration);
+    names_.push_back(name);
+    same_as_.push_back(same);
+    outcomes_.push_back(std::move(outcome));
+  }
+
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
   /// the index of the converged one with the least T (−1: none converged).
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
@@ -147,11 +156,9 @@ class FreeTimeMinimumTime {
       if (budgetSpent(context_.remainingOptions())) break;
       std::vector<Matrix3> start = clearOfCones(grid, st);
       const int same = sameStartAs(start, st.duration);
-      outcomes_.push_back(same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind));
-      names_.push_back(st.name);
-      same_as_.push_back(same);
-      starts_.push_back(std::move(start));
-      start_durations_.push_back(st.duration);
+      FreeTimeOutcome outcome =
+          same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind);
+      recordStart(start, st.duration, st.name, std::move(outcome), same);
       const FreeTimeOutcome& o = outcomes_.back();
       if (o.termination == Termination::Converged &&
           (best < 0 || o.duration < outcomes_[best].duration)) {

@@ -178,3 +178,101 @@ TEST(ExtremalClasses, TheDefaultIsNoCostlierThanAnyClassOnSeededSpinningProblems
   EXPECT_GE(compared, kCases - 2);
   EXPECT_GE(cheapest, 0.99 * compared);
 }
+
+namespace {
+
+/// Rest to rest, 3 rad about z; a keep-out cone of half angle 0.9 rad round the direction body x
+/// points along half way round the short way (1.5 rad about z): the short way's unconstrained
+/// optimum runs through the cone's axis, the other way round (3.28 rad) clears it.
+PlanningProblem coneAcrossTheShortWay() {
+  PlanningProblem p;
+  p.inertia = Vector3(1.0, 1.2, 1.4).asDiagonal();
+  p.final_attitude = so3::exp(Vector3(0, 0, 3.0));
+  p.duration = 10.0;
+  p.steps = 64;
+  p.constraints.push_back(PlanningConstraint::keepOut(
+      Vector3::UnitX(), Vector3(std::cos(1.5), std::sin(1.5), 0.0), 0.9));
+  return p;
+}
+
+/// The least cost of the classes solved one by one (each in its own class) whose plans hold the
+/// constraints between the nodes too, +∞ if none did.
+double leastClassCost(const PlanningProblem& p) {
+  SolverOptions nearest_only;
+  nearest_only.enumerate_classes = false;
+  double least = std::numeric_limits<double>::infinity();
+  for (const HomotopyClass& c : kClasses) {
+    const PlanResult own = planManeuver(inClass(p, c), nearest_only);
+    if (own.converged() && own.max_violation_between_nodes <= 1e-3) {
+      least = std::min(least, own.cost);
+    }
+  }
+  return least;
+}
+
+bool triedConstrainedClasses(const PlanResult& r) {
+  return std::any_of(r.attempts.begin(), r.attempts.end(),
+                     [](const Attempt& a) { return a.stage == AttemptStage::ConstrainedClass; });
+}
+
+}  // namespace
+
+// Under constraints the classes are solved too (issue 30, items 2 and 3): where the unconstrained
+// optimum's class cannot clear a cone, the answer is another class's plan, never "infeasible",
+// and it is the cheapest of the classes; the extremal names it.
+TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasibleClass) {
+  const PlanningProblem p = coneAcrossTheShortWay();
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(triedConstrainedClasses(r));
+  EXPECT_LE(r.max_constraint_violation, 0.0);
+  EXPECT_LE(r.max_violation_between_nodes, 1e-3);
+  const double least = leastClassCost(p);
+  ASSERT_TRUE(std::isfinite(least));
+  EXPECT_LE(r.cost, least * (1 + 1e-6)) << r.extremal;
+  ASSERT_TRUE(r.extremal_summary.known);
+  SolverOptions nearest_only;
+  nearest_only.enumerate_classes = false;
+  const PlanResult own = planManeuver(inClass(p, r.extremal_summary.homotopy), nearest_only);
+  ASSERT_TRUE(own.converged()) << own.message;
+  EXPECT_NEAR(r.cost, own.cost, 1e-8 * own.cost) << r.extremal;
+}
+
+// A constrained request pinned to a class (by name, or by SolverOptions::enumerate_classes) is
+// solved in that class alone, whatever its verdict there.
+TEST(ExtremalClasses, AConstrainedRequestPinnedToItsClassIsNotEnumerated) {
+  SolverOptions nearest_only;
+  nearest_only.enumerate_classes = false;
+  const PlanResult nearest = planManeuver(coneAcrossTheShortWay(), nearest_only);
+  EXPECT_FALSE(triedConstrainedClasses(nearest));
+  EXPECT_FALSE(nearest.converged());  // the cone sits on the nearest lift's unconstrained path
+  const PlanResult named = planManeuver(inClass(coneAcrossTheShortWay(), kClasses[3]));
+  EXPECT_FALSE(triedConstrainedClasses(named));
+  EXPECT_TRUE(std::all_of(named.attempts.begin(), named.attempts.end(),
+                          [](const Attempt& a) { return sameClass(a.homotopy, kClasses[3]); }));
+}
+
+// Seeded spinning problems under a torque-norm bound at 0.85× the peak of their unconstrained plan:
+// wherever some class converges, the default converges too and costs no more than the cheapest.
+TEST(ExtremalClasses, UnderATorqueNormBoundTheDefaultIsNoCostlierThanAnyClass) {
+  constexpr int kCases = 6;
+  Draw draw(5050);
+  int compared = 0;
+  for (int i = 0; i < kCases; ++i) {
+    PlanningProblem p = spinningProblem(draw);
+    p.steps = 64;
+    const PlanResult free = planManeuver(p);
+    ASSERT_TRUE(free.converged()) << i << ": " << free.message;
+    double peak = 0.0;
+    for (const Vector3& tau : free.maneuver.torque) peak = std::max(peak, tau.norm());
+    p.constraints.push_back(PlanningConstraint::maxTorqueNorm(0.85 * peak));
+    const double least = leastClassCost(p);
+    if (!std::isfinite(least)) continue;
+    ++compared;
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << i << ": " << r.message;
+    EXPECT_LE(r.cost, least * (1 + 1e-6)) << i << ": " << r.extremal;
+  }
+  std::printf("%d of %d cases compared\n", compared, kCases);
+  EXPECT_GE(compared, 2);
+}

@@ -218,6 +218,15 @@ struct SolverOptions {
   bool enumerate_classes = true;
 };
 
+/// The request asks for the default homotopy class (shortest way, no extra turns) from no guess
+/// of its own: only then are the classes enumerated (unless the caller pins the nearest), by
+/// Newton for the unconstrained optimum and, under constraints, by the constrained class search
+/// (drivers/constrained_classes.hpp).
+inline bool classLeftFree(const PlanningProblem& problem, const SolverOptions& options) {
+  return problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
+         !options.warm_start && options.enumerate_classes;
+}
+
 /// The time budget withRemainingBudget leaves once the budget is spent.
 constexpr double kSpentBudget = 1e-300;
 

@@ -37,6 +37,7 @@ enum class AttemptStage {
   MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
   MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
   MinimumTimePolish,  ///< minimum_time: the minimum-effort plan at T* from the free-time plan
+  ConstrainedClass,   ///< under constraints, a class left free: another class's whole solve
 };
 inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::Solve, "solve"},
@@ -53,6 +54,7 @@ inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::MinimumTimeMargin, "minimum_time_margin"},
     {AttemptStage::MinimumTimeSolve, "minimum_time_solve"},
     {AttemptStage::MinimumTimePolish, "minimum_time_polish"},
+    {AttemptStage::ConstrainedClass, "constrained_class"},
 };
 
 /// Where an attempt's iterate started.

@@ -225,6 +225,7 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   }
   try {
     SolverOptions o = options;
+    o.enumerate_classes = false;  // a start keeps its class (the free-time solves compare them)
     PlanResult r;
     if (!every_constraint) {
       ReducedProblem np(effort);

@@ -11,6 +11,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
+#include "planning/drivers/constrained_classes.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
@@ -154,6 +155,55 @@ std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<
   return earlier;
 }
 
+/// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
+/// it meets every node constraint it is the constrained optimum too; otherwise it starts the
+/// interior point, in its class, and a request that left its class free has the other classes
+/// solved under the constraints too (constrained_classes.hpp).
+PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOptions& options,
+                                std::chrono::steady_clock::time_point start) {
+  PlanResult result = solveWithNewton(problem, options);
+  const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
+                                            ? checkConstraints(problem, result.maneuver)
+                                            : ConstraintCheck{};
+  if (result.converged() && unconstrained.max_node_bound_violation <= 0.0) {
+    result.message += "; constraints inactive at the unconstrained optimum";
+    return result;
+  }
+  SolverOptions constrained = withRemainingBudget(options, start);
+  const int newton_iterations = result.iterations;
+  std::ostringstream note;
+  if (result.converged()) {
+    note << "; the unconstrained optimum (cost " << result.cost << ") violates ";
+    if (unconstrained.worst.empty()) {
+      note << "a cone's margin";  // the stated limits hold, a tightened node bound does not
+    } else {
+      note << unconstrained.worst << " " << unconstrained.worst_where;
+    }
+    note << " and started it (" << newton_iterations << " Newton iterations)";
+  }
+  const Maneuver unconstrained_plan = result.maneuver;
+  constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
+  const std::vector<LevelSummary> newton_levels = result.levels;
+  const std::vector<Attempt> newton_attempts = result.attempts;
+  // The interior point keeps the class it starts in: the unconstrained optimum's.
+  ExtremalSummary survey = result.extremal_summary;
+  result = solveWithInteriorPoint(problem, constrained);
+  result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
+  result.iterations += newton_iterations;
+  result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
+  result.message += note.str();
+  if (survey.known && constrained.warm_start == &unconstrained_plan) {
+    result.extremal_summary = survey;
+    result.extremal_summary.others.clear();
+    result.extremal = describeExtremal(result.extremal_summary);
+  }
+  if (classLeftFree(problem, options)) {
+    result = cheapestConstrainedClass(problem, withRemainingBudget(options, start), survey,
+                                      std::move(result));
+  }
+  return result;
+}
+
 }  // namespace
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested) {
@@ -186,8 +236,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
       result = solveWithInteriorPoint(problem, withRemainingBudget(options, start));
-      result.attempts =
-          followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
+      result.attempts = followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
       result.iterations += first.iterations;
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
       result.message += "; after the start from the initial guess stopped: " + first.message;
@@ -196,37 +245,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
              options.constrained_from_warm_start && options.warm_start) {
     result = solveWithInteriorPoint(problem, options);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
-    // The unconstrained optimum first (fast path): if it meets every node constraint it is the
-    // constrained optimum too; otherwise it starts the interior-point solver.
-    result = solveWithNewton(problem, options);
-    const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
-                                              ? checkConstraints(problem, result.maneuver)
-                                              : ConstraintCheck{};
-    if (!result.converged() || unconstrained.max_node_bound_violation > 0.0) {
-      SolverOptions constrained = withRemainingBudget(options, start);
-      const int newton_iterations = result.iterations;
-      std::ostringstream note;
-      if (result.converged()) {
-        note << "; the unconstrained optimum (cost " << result.cost << ") violates ";
-        if (unconstrained.worst.empty()) {
-          note << "a cone's margin";  // the stated limits hold, a tightened node bound does not
-        } else {
-          note << unconstrained.worst << " " << unconstrained.worst_where;
-        }
-        note << " and started it (" << newton_iterations << " Newton iterations)";
-      }
-      const Maneuver unconstrained_plan = result.maneuver;
-      constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
-      const std::vector<LevelSummary> newton_levels = result.levels;
-      const std::vector<Attempt> newton_attempts = result.attempts;
-      result = solveWithInteriorPoint(problem, constrained);
-      result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
-      result.iterations += newton_iterations;
-      result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
-      result.message += note.str();
-    } else {
-      result.message += "; constraints inactive at the unconstrained optimum";
-    }
+    result = planUnderConstraints(problem, options, start);
   } else if (options.solver == SolverKind::Structured) {
     result = solveWithNewton(problem, options);
   } else {

@@ -84,13 +84,6 @@ bool sameClass(const HomotopyClass& a, const HomotopyClass& b) {
 /// problems (docs/results/extremal_classes.md): the cheapest extremal is in one of them.
 constexpr HomotopyClass kEnumeratedClasses[] = {{false, 0}, {true, 0}, {false, 1}, {true, 1}};
 
-/// The request asks for the default homotopy class (shortest way, no extra turns) from no
-/// guess of its own: only then are the classes enumerated (unless the caller pins the nearest).
-bool classLeftFree(const PlanningProblem& problem, const SolverOptions& options) {
-  return problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
-         !options.warm_start && options.enumerate_classes;
-}
-
 /// The lift a class's start turns through (nothing if a boundary step has no solution).
 std::optional<Vector3> liftOf(const PlanningProblem& in_class) {
   try {

@@ -39,6 +39,9 @@ std::string describeCandidate(const Attempt& a) {
     return describeClass(a.homotopy) + " surveyed at N = " + std::to_string(a.steps);
   }
   if (a.stage == AttemptStage::ClassRefine) return describeClass(a.homotopy);
+  if (a.stage == AttemptStage::ConstrainedClass) {
+    return describeClass(a.homotopy) + " under the constraints";
+  }
   if (a.homotopy.long_way || a.homotopy.extra_revolutions > 0) {
     return describeClass(a.homotopy) + ", " + attemptStageName(a.stage) + " from " +
            attemptStartName(a.start);

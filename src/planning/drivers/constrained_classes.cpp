@@ -1,0 +1,202 @@
+#include "planning/drivers/constrained_classes.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/plan_at_resolution.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+bool sameClassAs(const HomotopyClass& a, const HomotopyClass& b) {
+  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
+}
+
+PlanningProblem pinnedTo(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps) {
+  PlanningProblem out = problem;
+  out.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
+  out.extra_revolutions = homotopy.extra_revolutions;
+  out.steps = steps;
+  return out;
+}
+
+/// The classes the survey solved to convergence, `first_class` first, and its grid (the fewest
+/// steps among its class_survey attempts; the requested N if none).
+struct SurveyedClasses {
+  std::vector<HomotopyClass> classes;
+  int steps = 0;
+};
+
+SurveyedClasses surveyedClasses(const ExtremalSummary& survey, const HomotopyClass& first_class,
+                                int requested_steps) {
+  SurveyedClasses out{{first_class}, requested_steps};
+  for (const Attempt& a : survey.others) {
+    if (a.stage == AttemptStage::ClassSurvey) out.steps = std::min(out.steps, a.steps);
+    if (a.termination != Termination::Converged) continue;
+    const bool listed =
+        std::any_of(out.classes.begin(), out.classes.end(),
+                    [&](const HomotopyClass& c) { return sameClassAs(c, a.homotopy); });
+    if (!listed) out.classes.push_back(a.homotopy);
+  }
+  return out;
+}
+
+/// Whether plan r is better than `best`: it converged and either holds the constraints between
+/// the nodes where `best` does not, or holds them as well and costs less. (A plan can meet a
+/// cone at every node and still jump across it between two: measured, the nearest lift + 1 extra
+/// turn round a cone on the path, 0.9 rad into the cone between nodes at a lower cost.)
+bool better(const PlanResult& r, const PlanResult& best) {
+  if (!r.converged()) return false;
+  if (!best.converged()) return true;
+  const double jump = r.max_violation_between_nodes;
+  const double best_jump = best.max_violation_between_nodes;
+  if (jump > best_jump + kBetweenNodesSlack) return false;
+  if (best_jump > jump + kBetweenNodesSlack) return true;
+  return r.cost < best.cost;
+}
+
+/// One class's constrained solve, as the extremal's entry.
+Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int steps) {
+  Attempt a;
+  a.stage = AttemptStage::ConstrainedClass;
+  a.start = AttemptStart::UnconstrainedOptimum;
+  a.formulation = Formulation::FreeSlacks;
+  a.homotopy = homotopy;
+  a.steps = steps;
+  a.termination = r.termination;
+  a.iterations = r.iterations;
+  a.cost = r.converged() ? r.cost : std::numeric_limits<double>::quiet_NaN();
+  return a;
+}
+
+/// The classes' solves and the trail they leave.
+class ClassSearch {
+ public:
+  ClassSearch(const PlanningProblem& problem, const SolverOptions& options, PlanResult first)
+      : problem_(problem),
+        options_(options),
+        trail_(first.attempts),
+        first_iterations_(first.iterations),
+        best_(std::move(first)) {
+    options_.enumerate_classes = false;  // each solve in its own class
+    kept_ = std::find_if(trail_.begin(), trail_.end(), [](const Attempt& a) { return a.kept; }) -
+            trail_.begin();
+  }
+
+  /// One solve of `homotopy` on `steps` steps, its trail appended (first-stage attempts marked
+  /// constrained_class, none kept). A grid with no boundary step at its h gives no plan.
+  PlanResult solve(const HomotopyClass& homotopy, int steps) {
+    PlanResult r;
+    r.termination = Termination::NotConverged;
+    try {
+      r = planAtResolution(pinnedTo(problem_, homotopy, steps),
+                           withRemainingBudget(options_, start_));
+    } catch (const StepTooLarge& e) {
+      r.message = e.what();
+    }
+    iterations_ += r.iterations;
+    appendTrail(r.attempts);
+    tried_.push_back(classAttempt(homotopy, r, steps));
+    return r;
+  }
+
+  /// Keeps r (a plan on the requested grid) if it is better than the best so far.
+  void offer(PlanResult r) {
+    if (!better(r, best_)) return;
+    best_ = std::move(r);
+    best_tried_ = tried_.size() - 1;
+    kept_ = last_kept_;
+  }
+
+  bool stopped() const {
+    return budgetSpent(withRemainingBudget(options_, start_)) ||
+           (options_.cancel_requested && options_.cancel_requested->load());
+  }
+
+  /// The best plan with the whole trail, the classes tried in its extremal.
+  PlanResult finish(const ExtremalSummary& survey, const HomotopyClass& first_class) {
+    for (std::size_t i = 0; i < trail_.size(); ++i) trail_[i].kept = i == kept_;
+    best_.attempts = trail_;
+    best_.iterations = first_iterations_ + iterations_;
+    ExtremalSummary& extremal = best_.extremal_summary;
+    if (firstKept()) extremal.homotopy = first_class;
+    extremal.others = survey.others;
+    for (std::size_t i = 0; i < tried_.size(); ++i) {
+      if (!best_tried_ || i != *best_tried_) extremal.others.push_back(tried_[i]);
+    }
+    best_.extremal = describeExtremal(extremal);
+    return best_;
+  }
+
+  bool firstKept() const { return !best_tried_; }
+
+ private:
+  void appendTrail(const std::vector<Attempt>& solve) {
+    if (solve.empty()) return;
+    last_kept_ = trail_.size() + solve.size() - 1;
+    for (Attempt a : solve) {
+      if (a.kept) last_kept_ = trail_.size();
+      if (a.stage == AttemptStage::Solve) a.stage = AttemptStage::ConstrainedClass;
+      a.kept = false;
+      trail_.push_back(a);
+    }
+  }
+
+  const PlanningProblem& problem_;
+  SolverOptions options_;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::vector<Attempt> trail_;
+  std::vector<Attempt> tried_;
+  int first_iterations_ = 0;
+  PlanResult best_;
+  std::size_t kept_ = 0;
+  std::size_t last_kept_ = 0;
+  std::optional<std::size_t> best_tried_;  ///< empty: `first` is kept
+  int iterations_ = 0;
+};
+
+}  // namespace
+
+PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
+                                    const ExtremalSummary& survey, PlanResult first) {
+  const HomotopyClass first_class = survey.known ? survey.homotopy : homotopyClassOf(problem);
+  const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
+  if (surveyed.classes.size() < 2) return first;
+  const std::string first_message = first.message;
+  ClassSearch search(problem, options, std::move(first));
+  const bool on_requested_grid = surveyed.steps >= problem.steps;
+  std::optional<HomotopyClass> cheapest;  // on the survey grid
+  PlanResult cheapest_plan;
+  for (const HomotopyClass& c : surveyed.classes) {
+    if (search.stopped()) break;
+    if (on_requested_grid && sameClassAs(c, first_class)) continue;  // `first` is that solve
+    PlanResult r = search.solve(c, on_requested_grid ? problem.steps : surveyed.steps);
+    if (on_requested_grid) {
+      search.offer(std::move(r));
+    } else if (!cheapest || better(r, cheapest_plan)) {
+      cheapest = c;
+      cheapest_plan = std::move(r);
+    }
+  }
+  const bool refine = !on_requested_grid && cheapest && cheapest_plan.converged() &&
+                      !sameClassAs(*cheapest, first_class) && !search.stopped();
+  if (refine) search.offer(search.solve(*cheapest, problem.steps));
+  const bool first_kept = search.firstKept();
+  PlanResult result = search.finish(survey, first_class);
+  if (!first_kept) {
+    result.message +=
+        "; the cheapest homotopy class under the constraints (after the unconstrained "
+        "optimum's class: " +
+        first_message + ")";
+  }
+  return result;
+}
+
+}  // namespace attitude_planner

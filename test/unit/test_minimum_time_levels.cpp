@@ -291,4 +291,3 @@ TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
   EXPECT_TRUE(isProbe(r.attempts.back())) << r.message;
   EXPECT_EQ(r.attempts.back().iterations, 0) << r.message;
 }
-}

@@ -277,8 +277,8 @@ TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
   // A budget the structured starts spend (Betts at N = 64, 1 ms: its free-time starts take tens
   // of ms): they stop at the deadline and the search, given what is left (nothing), stops at its
   // first solve: one probe, no iteration, the answer timed_out, the free-time stage first. (On
-  // main the search got the 1 ms afresh, which at this size also ends at once: the arithmetic
-  // above is what changed.)
+  // main 2026798 the search got the 1 ms afresh: its probe ran 21 iterations, and the trail had
+  // no free-time attempt.)
   ap::SolverOptions budgeted;
   budgeted.time_budget_s = 1e-3;
   const ap::PlanResult r = ap::planManeuver(scene("min_time_betts", 64), budgeted);

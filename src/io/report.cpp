@@ -83,6 +83,25 @@ std::string levelJson(const LevelSummary& level) {
   return out.str();
 }
 
+std::string vectorJson(const Vector3& v) {
+  return "[" + jsonNumber(v.x()) + ", " + jsonNumber(v.y()) + ", " + jsonNumber(v.z()) + "]";
+}
+
+/// An attempt's start parameters (StartDetail): a duration of the request's own is null, a zero
+/// axis is none.
+std::string startDetailJson(const Attempt& a) {
+  const StartDetail& d = a.start_detail;
+  std::ostringstream out;
+  out << "{\"duration\": " << jsonNumber(d.duration)
+      << ", \"eigenaxis\": " << vectorJson(d.eigenaxis)
+      << ", \"excursion_axis\": " << vectorJson(d.excursion_axis)
+      << ", \"excursion\": " << jsonNumber(d.excursion)
+      << ", \"cleared_of_cones\": " << (d.cleared_of_cones ? "true" : "false")
+      << ", \"coarse_steps\": " << d.coarse_steps
+      << ", \"origin\": " << jsonString(attemptStartName(originOf(a))) << "}";
+  return out.str();
+}
+
 /// One attempt of the trail (PlanResult::attempts) as a JSON object; a cost without a plan is
 /// null.
 std::string attemptJson(const Attempt& a) {
@@ -94,7 +113,8 @@ std::string attemptJson(const Attempt& a) {
       << ", \"extra_revolutions\": " << a.homotopy.extra_revolutions << ", \"steps\": " << a.steps
       << ", \"termination\": " << jsonString(terminationName(a.termination))
       << ", \"iterations\": " << a.iterations << ", \"cost\": " << jsonNumber(a.cost)
-      << ", \"kept\": " << (a.kept ? "true" : "false") << "}";
+      << ", \"kept\": " << (a.kept ? "true" : "false")
+      << ", \"start_detail\": " << startDetailJson(a) << "}";
   return out.str();
 }
 

@@ -112,6 +112,14 @@ PlanAttempt attemptToMsg(const Attempt& a) {
   msg.iterations = a.iterations;
   msg.cost = a.cost;
   msg.kept = a.kept;
+  const StartDetail& d = a.start_detail;
+  msg.start_detail.duration = d.duration;
+  msg.start_detail.eigenaxis = vectorToMsg(d.eigenaxis);
+  msg.start_detail.excursion_axis = vectorToMsg(d.excursion_axis);
+  msg.start_detail.excursion = d.excursion;
+  msg.start_detail.cleared_of_cones = d.cleared_of_cones;
+  msg.start_detail.coarse_steps = d.coarse_steps;
+  msg.start_detail.origin = attemptStartName(originOf(a));
   return msg;
 }
 

@@ -232,8 +232,26 @@ TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTh
     EXPECT_TRUE(m.cost == trail[i].cost || (std::isnan(m.cost) && std::isnan(trail[i].cost))) << i;
     EXPECT_EQ(m.kept, trail[i].kept) << i;
     kept += m.kept ? 1 : 0;
+    const StartDetail& d = trail[i].start_detail;
+    const PlanAttemptStart& ms = m.start_detail;
+    EXPECT_TRUE(ms.duration == d.duration || (std::isnan(ms.duration) && std::isnan(d.duration)))
+        << i;
+    EXPECT_EQ(ms.eigenaxis.x, d.eigenaxis.x()) << i;
+    EXPECT_EQ(ms.eigenaxis.y, d.eigenaxis.y()) << i;
+    EXPECT_EQ(ms.eigenaxis.z, d.eigenaxis.z()) << i;
+    EXPECT_EQ(ms.excursion_axis.x, d.excursion_axis.x()) << i;
+    EXPECT_EQ(ms.excursion_axis.y, d.excursion_axis.y()) << i;
+    EXPECT_EQ(ms.excursion_axis.z, d.excursion_axis.z()) << i;
+    EXPECT_EQ(ms.excursion, d.excursion) << i;
+    EXPECT_EQ(ms.cleared_of_cones, d.cleared_of_cones) << i;
+    EXPECT_EQ(ms.coarse_steps, d.coarse_steps) << i;
+    EXPECT_EQ(ms.origin, attemptStartName(originOf(trail[i]))) << i;
   }
   EXPECT_EQ(kept, 1);
+  // The structured starts carry their parameters: an excursion names its axis and size.
+  EXPECT_TRUE(std::any_of(res.attempts.begin(), res.attempts.end(), [](const PlanAttempt& m) {
+    return m.start == "excursion" && m.start_detail.excursion > 0 && m.start_detail.duration > 0;
+  }));
   EXPECT_TRUE(std::any_of(res.attempts.begin(), res.attempts.end(),
                           [](const PlanAttempt& m) { return m.stage == "minimum_time_solve"; }));
   EXPECT_EQ(res.minimum_time.kkt_point, out.result.minimum_time.kkt_point);

@@ -117,6 +117,15 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
   });
   ASSERT_NE(kept, r.attempts.end()) << r.message;
   EXPECT_EQ(kept->start, ap::AttemptStart::Excursion) << r.message;
+  // Its parameters as data (start_detail): the eigenaxis is the rotation's (body x), the
+  // excursion turns about a unit body axis perpendicular to it, by 0.3 rad.
+  const ap::StartDetail& detail = kept->start_detail;
+  EXPECT_NEAR(std::abs(detail.eigenaxis.x()), 1.0, 1e-12);
+  EXPECT_NEAR(detail.excursion_axis.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(detail.excursion_axis.dot(ap::Vector3::UnitX()), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(detail.excursion, 0.3);
+  EXPECT_GT(detail.duration, 0.0);
+  EXPECT_EQ(ap::originOf(*kept), ap::AttemptStart::Excursion);
   // Bang–bang: at most nodes some torque component is at its bound.
   int saturated = 0;
   for (const ap::Vector3& t : r.maneuver.torque)
@@ -139,6 +148,35 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
       EXPECT_LE(second.cwiseAbs().maxCoeff(), 0.05 * largest) << k;
     }
   }
+}
+
+TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {
+  // Betts at N = 128: the starts run on N = 64 and the best is refined. The kept solve is the
+  // refinement (coarse_level from N = 64); its start_detail carries the excursion it descends
+  // from, the same axis as the kept N = 64 solve's, perpendicular to the rotation axis.
+  ap::PlanningProblem p = ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_betts.yaml").problem;
+  p.steps = 128;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return a.kept && a.stage == ap::AttemptStage::MinimumTimeSolve;
+  });
+  ASSERT_NE(kept, r.attempts.end()) << r.message;
+  EXPECT_EQ(kept->start, ap::AttemptStart::CoarseLevel);
+  EXPECT_EQ(kept->steps, 128);
+  const ap::StartDetail& detail = kept->start_detail;
+  EXPECT_EQ(detail.coarse_steps, 64);
+  EXPECT_EQ(ap::originOf(*kept), ap::AttemptStart::Excursion);
+  EXPECT_NEAR(detail.excursion_axis.dot(ap::Vector3::UnitX()), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(detail.excursion, 0.3);
+  // The coarse solve it descends from: an excursion on N = 64 about the same axis, at the T the
+  // refinement started from.
+  const auto coarse = std::find_if(r.attempts.begin(), r.attempts.end(), [&](const ap::Attempt& a) {
+    return a.stage == ap::AttemptStage::MinimumTimeSolve && a.steps == 64 &&
+           a.start == ap::AttemptStart::Excursion && a.cost == detail.duration;
+  });
+  ASSERT_NE(coarse, r.attempts.end()) << r.message;
+  EXPECT_EQ(coarse->start_detail.excursion_axis, detail.excursion_axis);
 }
 
 TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {

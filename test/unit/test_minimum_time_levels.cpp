@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -163,11 +164,12 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves), ap::freeTimeStarts(box, true).size());
 }
 
-TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPoint) {
-  // A spinning request under a torque-norm bound (case 13 of scripts/extremal_classes.py's seeded
-  // suite, seed 5005, the bound at 0.7x its unconstrained peak), paper at N = 128. Whatever the
-  // structured starts reach, the answer is a KKT point of the discrete minimum-time problem at or
-  // below the search's T on the same problem (the search forced by a zero disturbance torque).
+namespace {
+
+/// A spinning request under a torque-norm bound (case 13 of scripts/extremal_classes.py's seeded
+/// suite, seed 5005, the bound at 0.7x its unconstrained peak), paper at N = 128, where the
+/// structured free-time start does not converge and the search answers.
+ap::PlanningProblem searchAnswersCase() {
   ap::PlanningProblem p;
   p.inertia << 93.739979181337787, -4.7429217545495224, -4.0381979888832467, -4.7429217545495224,
       113.36887843197682, 8.1631076802271263, -4.0381979888832467, 8.1631076802271263,
@@ -187,6 +189,23 @@ TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPo
   p.initial_velocity = ap::Vector3(0.97013585872010177, -1.0660798184824838, 0.64096569823845517);
   p.final_velocity = ap::Vector3(2.0328166382210426, -3.4094311407284201, -1.7785901451994599);
   p.constraints = {ap::PlanningConstraint::maxTorqueNorm(960.84957105509102)};
+  return p;
+}
+
+bool isFreeTimeSolve(const ap::Attempt& a) {
+  return a.stage == ap::AttemptStage::MinimumTimeSolve;
+}
+bool isProbe(const ap::Attempt& a) {
+  return a.stage == ap::AttemptStage::MinimumTimeProbe;
+}
+
+}  // namespace
+
+TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPoint) {
+  // Whatever the structured starts reach, the answer is a KKT point of the discrete minimum-time
+  // problem at or below the search's T on the same problem (the search forced by a zero
+  // disturbance torque).
+  const ap::PlanningProblem p = searchAnswersCase();
   const ap::PlanResult r = ap::planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
@@ -205,4 +224,70 @@ TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPo
     return a.kept && a.stage == ap::AttemptStage::MinimumTimeSolve;
   });
   EXPECT_NE(kept, r.attempts.end());
+}
+
+TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBeforeIt) {
+  // The trail keeps every stage in the order it ran: the structured starts' free-time solves
+  // (none gave the answer: at least one did not converge, none is kept), the search's starts,
+  // then the one free-time solve from the search's plan (kept, started at the search's T) and its
+  // polish.
+  const ap::PlanResult r = ap::planManeuver(searchAnswersCase());
+  ASSERT_TRUE(r.converged()) << r.message;
+  const std::vector<ap::Attempt>& trail = r.attempts;
+  const auto first_probe = std::find_if(trail.begin(), trail.end(), isProbe);
+  ASSERT_NE(first_probe, trail.end()) << r.message;
+  ASSERT_NE(first_probe, trail.begin()) << "no free-time solve before the search";
+  EXPECT_TRUE(std::all_of(trail.begin(), first_probe, isFreeTimeSolve));
+  EXPECT_TRUE(
+      std::none_of(trail.begin(), first_probe, [](const ap::Attempt& a) { return a.kept; }));
+  EXPECT_TRUE(std::any_of(trail.begin(), first_probe, [](const ap::Attempt& a) {
+    return a.termination != ap::Termination::Converged;
+  }));
+  const auto last_probe =
+      std::find_if(trail.rbegin(), trail.rend(), isProbe).base();  // one past the last probe
+  EXPECT_TRUE(std::all_of(first_probe, last_probe, isProbe));
+  ASSERT_NE(last_probe, trail.end());
+  const ap::Attempt& from_search = *last_probe;
+  EXPECT_EQ(from_search.stage, ap::AttemptStage::MinimumTimeSolve);
+  EXPECT_EQ(from_search.start, ap::AttemptStart::PreviousAttempt);
+  EXPECT_TRUE(from_search.kept);
+  EXPECT_GE(from_search.start_detail.duration, r.minimum_duration);
+  EXPECT_TRUE(std::all_of(last_probe + 1, trail.end(), [](const ap::Attempt& a) {
+    return a.stage == ap::AttemptStage::MinimumTimePolish;
+  }));
+  EXPECT_EQ(std::count_if(trail.begin(), trail.end(), [](const ap::Attempt& a) { return a.kept; }),
+            1);
+}
+
+TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
+  // The budget arithmetic the stages share (withRemainingBudget): what is left after the time
+  // used, a spent budget the smallest positive one (the next solve ends TimedOut at once), no
+  // budget stays none.
+  ap::SolverOptions options;
+  options.time_budget_s = 10.0;
+  const auto now = std::chrono::steady_clock::now();
+  const double left = ap::withRemainingBudget(options, now - std::chrono::seconds(4)).time_budget_s;
+  EXPECT_GT(left, 5.0);
+  EXPECT_LE(left, 6.0);
+  const ap::SolverOptions spent = ap::withRemainingBudget(options, now - std::chrono::seconds(11));
+  EXPECT_EQ(spent.time_budget_s, ap::kSpentBudget);
+  EXPECT_TRUE(ap::budgetSpent(spent));
+  options.time_budget_s = 0.0;
+  EXPECT_EQ(ap::withRemainingBudget(options, now - std::chrono::seconds(11)).time_budget_s, 0.0);
+  // A budget the structured starts spend (Betts at N = 64, 1 ms: its free-time starts take tens
+  // of ms): they stop at the deadline and the search, given what is left (nothing), stops at its
+  // first solve: one probe, no iteration, the answer timed_out, the free-time stage first. (On
+  // main 2026798 the search got the 1 ms afresh: its probe ran 21 iterations, and the trail had
+  // no free-time attempt.)
+  ap::SolverOptions budgeted;
+  budgeted.time_budget_s = 1e-3;
+  const ap::PlanResult r = ap::planManeuver(scene("min_time_betts", 64), budgeted);
+  EXPECT_EQ(r.termination, ap::Termination::TimedOut) << r.message;
+  EXPECT_TRUE(std::none_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return isFreeTimeSolve(a) && a.termination == ap::Termination::Converged;
+  })) << r.message;
+  EXPECT_EQ(std::count_if(r.attempts.begin(), r.attempts.end(), isProbe), 1) << r.message;
+  ASSERT_FALSE(r.attempts.empty());
+  EXPECT_TRUE(isProbe(r.attempts.back())) << r.message;
+  EXPECT_EQ(r.attempts.back().iterations, 0) << r.message;
 }

@@ -138,6 +138,46 @@ TEST(Report, JsonSummaryCarriesTheTerminationAndTheLevels) {
   EXPECT_TRUE(contains(json, "{\"steps\": 128, \"iterations\": "));
 }
 
+TEST(Report, JsonSummaryCarriesEachAttemptsStartDetail) {
+  // attempts[i].start_detail: the start's parameters as data, every number exact (exactNumber
+  // reads back to the same double), a duration of the request's own null, the origin of a
+  // refinement its coarsest start's.
+  const PlanningProblem p = seedRestToRest(16);
+  PlanResult r;
+  Attempt excursion;
+  excursion.stage = AttemptStage::MinimumTimeSolve;
+  excursion.start = AttemptStart::Excursion;
+  excursion.start_detail.duration = 27.463018551948521;
+  excursion.start_detail.eigenaxis = Vector3::UnitX();
+  excursion.start_detail.excursion_axis = Vector3(0, 1, 1).normalized();
+  excursion.start_detail.excursion = 0.3;
+  Attempt refined = excursion;
+  refined.start = AttemptStart::CoarseLevel;
+  refined.start_detail.coarse_steps = 64;
+  refined.start_detail.origin = AttemptStart::Excursion;
+  refined.kept = true;
+  Attempt plain;  // a start without parameters
+  r.attempts = {excursion, refined, plain};
+  const std::string json = planResultJson(p, r);
+  const std::string axis = "[0, " + exactNumber(excursion.start_detail.excursion_axis.y()) + ", " +
+                           exactNumber(excursion.start_detail.excursion_axis.z()) + "]";
+  EXPECT_EQ(std::stod(exactNumber(excursion.start_detail.excursion_axis.y())),
+            excursion.start_detail.excursion_axis.y());
+  const StartDetail& d = excursion.start_detail;
+  const std::string detail = "\"start_detail\": {\"duration\": " + exactNumber(d.duration) +
+                             ", \"eigenaxis\": [1, 0, 0], \"excursion_axis\": " + axis +
+                             ", \"excursion\": " + exactNumber(d.excursion) +
+                             ", \"cleared_of_cones\": false, \"coarse_steps\": ";
+  EXPECT_TRUE(contains(json, detail + "0, \"origin\": \"excursion\"}")) << json;
+  EXPECT_TRUE(contains(json, "\"start\": \"coarse_level\"")) << json;
+  EXPECT_TRUE(contains(json, detail + "64, \"origin\": \"excursion\"}")) << json;
+  EXPECT_TRUE(contains(json,
+                       "\"start_detail\": {\"duration\": null, \"eigenaxis\": [0, 0, 0], "
+                       "\"excursion_axis\": [0, 0, 0], \"excursion\": 0, \"cleared_of_cones\": "
+                       "false, \"coarse_steps\": 0, \"origin\": \"hermite\"}"))
+      << json;
+}
+
 TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
   // The same through the tool: at N = 65536 with one iteration per level the message is long,
   // and every field after it must still be printed.

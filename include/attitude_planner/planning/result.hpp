@@ -119,6 +119,33 @@ inline HomotopyClass homotopyClassOf(const PlanningProblem& problem) {
   return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
 }
 
+/// The parameters of an attempt's start, structured (JSON `attempts[i].start_detail`, PlanAttempt's
+/// `start_detail`): what the message's start name ("excursion 0.3 rad about [0, 0.707, 0.707]",
+/// "coarse grid (N = 64, ...)") is rendered from. Filled by minimum time's free-time solves and
+/// its search; every field keeps its "none" value where it does not apply.
+struct StartDetail {
+  /// T [s] the start was posed at (minimum time: the structured start's first T, a refined
+  /// level's coarser T*, the search's T for its plan; the search's probes: their first T); NaN:
+  /// the request's own duration.
+  double duration = std::numeric_limits<double>::quiet_NaN();
+  /// The rotation axis of the eigenaxis slew the start was built on, body frame, unit (minimum
+  /// time's eigenaxis and excursion starts); zero: none.
+  Vector3 eigenaxis = Vector3::Zero();
+  /// Excursion: the body-frame axis it turns about (unit, ⟂ `eigenaxis`) and its size [rad]
+  /// (R(t) = R_0 exp(θ(s) ê) exp(ε sin²(πs) p̂), minimum_time_starts.hpp); zero: none.
+  Vector3 excursion_axis = Vector3::Zero();
+  double excursion = 0.0;
+  /// The start was replaced by the minimum-effort plan under the cones from it (a free-time start
+  /// must clear its cones strictly: coneClearStart).
+  bool cleared_of_cones = false;
+  /// CoarseLevel: N of the coarser grid whose answer started it; 0: none.
+  int coarse_steps = 0;
+  /// CoarseLevel with coarse_steps > 0: the start of the coarsest grid's solve the refinement
+  /// descends from (its eigenaxis, excursion and cone clearing are carried above); else unused
+  /// (JSON and msg write the attempt's own start).
+  AttemptStart origin = AttemptStart::Hermite;
+};
+
 /// One solve the planner ran for a request (PlanResult::attempts, JSON `attempts`), in the order
 /// the attempts ended: the structured trail from which the message is rendered.
 struct Attempt {
@@ -134,7 +161,8 @@ struct Attempt {
   /// The scheme's Σ ½ w_k |τ_k|² of its plan [N²·m²] at `steps` (a class survey: on its coarser
   /// grid, comparable only with the other classes' surveys); NaN when it left no plan.
   double cost = std::numeric_limits<double>::quiet_NaN();
-  bool kept = false;  ///< its plan is the one returned
+  bool kept = false;         ///< its plan is the one returned
+  StartDetail start_detail;  ///< its start's parameters (where the start has any)
 };
 
 /// The extremal a solve returned, structured: its homotopy class, the rotation its start turned
@@ -157,6 +185,9 @@ std::string attemptStartName(AttemptStart start);
 std::string formulationName(Formulation formulation);
 /// "trust_region", "line_search" (JSON, tests).
 std::string globalizationName(Globalization globalization);
+/// The start an attempt descends from: StartDetail::origin for a refinement of a coarser grid's
+/// answer (coarse_steps > 0), else the attempt's own start (JSON and msg `start_detail.origin`).
+AttemptStart originOf(const Attempt& attempt);
 /// PlanResult::extremal, e.g. "nearest lift: 3.14159 rad about [1, 0, 0] from R_1 to R_{N-1}",
 /// then the others' costs: the one place the structure becomes prose.
 std::string describeExtremal(const ExtremalSummary& extremal);

@@ -36,35 +36,54 @@ std::string tStarKind(const PlanResult& r) {
              : "minimum time, the least duration found feasible: an upper bound";
 }
 
+/// `before`, none kept, then `after`: one trail in the order the attempts ran.
+std::vector<Attempt> joined(std::vector<Attempt> before, const std::vector<Attempt>& after) {
+  for (Attempt& a : before) a.kept = false;
+  before.insert(before.end(), after.begin(), after.end());
+  return before;
+}
+
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
-/// or if none of its solves converged, the search (searchMinimumTime, an upper bound); where the
-/// free-time problem applies, the search's plan starts one more free-time solve (a KKT point).
+/// or if none of its solves converged, the search (searchMinimumTime, an upper bound) with what is
+/// left of the time budget; where the free-time problem applies, the search's plan starts one more
+/// free-time solve (a KKT point). The trail keeps every stage in order: the free-time solves that
+/// did not give the answer, the search's starts, the solve from the search's plan.
 PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
+  std::vector<Attempt> free_time_trail;
   if (unsupported.empty()) {
-    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, options);
+    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, options, &free_time_trail);
     if (free_time && free_time->converged()) return *free_time;
+    if (free_time) free_time_trail = free_time->attempts;
     why = free_time ? "the free-time plan's replay failed" : "no free-time solve converged";
   } else {
     why = "the free-time interior point does not take " + unsupported + " yet";
   }
-  const auto started = std::chrono::steady_clock::now();
-  PlanResult result = searchMinimumTime(problem, options);
+  PlanResult result = searchMinimumTime(problem, withRemainingBudget(options, started));
   result.message += "; searched on T (" + why + ")";
+  result.attempts = joined(free_time_trail, result.attempts);
   if (!unsupported.empty() || !result.converged() ||
       result.maneuver.attitude.size() != static_cast<std::size_t>(problem.steps) + 1) {
     return result;
   }
   // The search's plan meets every bound at its T (an upper bound on T*): started from it, one
   // free-time solve can reach a KKT point at or below it where the structured starts did not.
-  std::optional<PlanResult> sharpened = freeTimeFromPlan(
-      problem, result.maneuver, result.minimum_duration, withRemainingBudget(options, started));
-  if (!sharpened || !sharpened->converged()) return result;
-  std::vector<Attempt> attempts = result.attempts;
-  for (Attempt& a : attempts) a.kept = false;
-  attempts.insert(attempts.end(), sharpened->attempts.begin(), sharpened->attempts.end());
-  sharpened->attempts = std::move(attempts);
+  std::vector<Attempt> sharpening_trail;
+  std::optional<PlanResult> sharpened =
+      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration,
+                       withRemainingBudget(options, started), &sharpening_trail);
+  if (sharpened && !sharpened->converged()) sharpening_trail = sharpened->attempts;
+  if (!sharpened || !sharpened->converged()) {
+    // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
+    for (Attempt a : sharpening_trail) {
+      a.kept = false;
+      result.attempts.push_back(a);
+    }
+    return result;
+  }
+  sharpened->attempts = joined(result.attempts, sharpened->attempts);
   sharpened->message += "; the structured starts did not converge (" + why +
                         "), the search found T = " + exactNumber(result.minimum_duration) + " s";
   return *sharpened;

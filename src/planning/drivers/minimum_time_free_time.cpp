@@ -76,12 +76,17 @@ class FreeTimeMinimumTime {
                                   names_[best] + "), refined by 2 at a time");
   }
 
+  /// Every free-time solve run so far (for the caller's trail when none gave the answer).
+  const std::vector<Attempt>& trail() const { return trail_; }
+
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
   /// duration, e.g. the search's): the polished KKT point if it converged at or below that T.
   std::optional<PlanResult> runFrom(const Maneuver& plan, double duration,
                                     const std::string& name) {
+    StartDetail detail;
+    detail.duration = duration;
     const FreeTimeOutcome o =
-        solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt);
+        solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt, detail);
     recordStart(plan.attitude, duration, name, o, -1);
     if (o.termination != Termination::Converged || o.duration > duration) return std::nullopt;
     best_attempt_ = trail_.size() - 1;
@@ -91,9 +96,9 @@ class FreeTimeMinimumTime {
 
  private:
   /// One free-time solve from `start` (N + 1 attitudes, clear of the cones) at T = duration,
-  /// recorded in the trail.
+  /// recorded in the trail with its start's parameters.
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
-                        double duration, AttemptStart kind) {
+                        double duration, AttemptStart kind, const StartDetail& detail) {
     const SolverOptions remaining = context_.remainingOptions();
     FreeTimeOutcome o =
         solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, &remaining);
@@ -104,7 +109,9 @@ class FreeTimeMinimumTime {
     a.steps = p.steps;
     a.termination = o.termination;
     a.iterations = o.iterations;
-    a.cost = o.duration;  // the free-time objective: T [s]
+    // The free-time objective: T [s]; NaN where the solve left no plan (no start inside).
+    if (!o.maneuver.attitude.empty()) a.cost = o.duration;
+    a.start_detail = detail;
     trail_.push_back(a);
     ++solves_;
     return o;
@@ -156,8 +163,10 @@ class FreeTimeMinimumTime {
       if (budgetSpent(context_.remainingOptions())) break;
       std::vector<Matrix3> start = clearOfCones(grid, st);
       const int same = sameStartAs(start, st.duration);
+      StartDetail detail = st.detail;
+      detail.cleared_of_cones = start != st.attitudes;
       FreeTimeOutcome outcome =
-          same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind);
+          same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind, detail);
       recordStart(start, st.duration, st.name, std::move(outcome), same);
       const FreeTimeOutcome& o = outcomes_.back();
       if (o.termination == Termination::Converged &&
@@ -175,6 +184,7 @@ class FreeTimeMinimumTime {
   std::optional<FreeTimeOutcome> refine(const std::vector<PlanningProblem>& levels,
                                         const FreeTimeOutcome& coarsest) {
     std::optional<FreeTimeOutcome> finest;
+    const Attempt origin = trail_[best_attempt_];  // the coarsest level's kept solve
     const LevelSolver<FreeTimeCarry> level = [&](const LevelRequest<FreeTimeCarry>& r,
                                                  FreeTimeCarry* handed_on) {
       if (r.replay_only || !r.coarse) {  // stopped: no answer on this level
@@ -183,8 +193,12 @@ class FreeTimeMinimumTime {
         return stopped;
       }
       const FreeTimeOutcome& coarse = r.coarse->outcome;
+      StartDetail detail = origin.start_detail;
+      detail.duration = coarse.duration;
+      detail.coarse_steps = coarse.maneuver.steps();
+      detail.origin = originOf(origin);
       FreeTimeOutcome o = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
-                                AttemptStart::CoarseLevel);
+                                AttemptStart::CoarseLevel, detail);
       PlanResult result = levelResult(r.problem.steps, o);
       if (handed_on) {
         handed_on->outcome = std::move(o);
@@ -329,13 +343,21 @@ GridLevelRule freeTimeGridRule() {
 }
 
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
-                                              const SolverOptions& options) {
-  return FreeTimeMinimumTime(problem, options).run();
+                                              const SolverOptions& options,
+                                              std::vector<Attempt>* tried) {
+  FreeTimeMinimumTime solver(problem, options);
+  std::optional<PlanResult> answer = solver.run();
+  if (!answer && tried) *tried = solver.trail();
+  return answer;
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, const SolverOptions& options) {
-  return FreeTimeMinimumTime(problem, options).runFrom(plan, duration, "search's plan");
+                                           double duration, const SolverOptions& options,
+                                           std::vector<Attempt>* tried) {
+  FreeTimeMinimumTime solver(problem, options);
+  std::optional<PlanResult> answer = solver.runFrom(plan, duration, "search's plan");
+  if (!answer && tried) *tried = solver.trail();
+  return answer;
 }
 
 }  // namespace attitude_planner

@@ -39,14 +39,17 @@ std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& 
 /// The minimum-time plan from the free-time solves: the polished plan at T* (minimum_time.kkt_point
 /// true, the KKT residuals in minimum_time, every solve in attempts, the free-time levels first in
 /// levels), or empty if no start converged or a refined level did not (the caller falls back to
-/// the search).
+/// the search; `tried`, if given, then receives the free-time solves that ran, for its trail).
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
-                                              const SolverOptions& options);
+                                              const SolverOptions& options,
+                                              std::vector<Attempt>* tried = nullptr);
 
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
 /// `duration` (the search's answer where the structured starts did not converge): the polished
-/// KKT point if it converged at or below `duration`, else empty.
+/// KKT point if it converged at or below `duration`, else empty (`tried`, if given, then receives
+/// its solve, for the caller's trail).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, const SolverOptions& options);
+                                           double duration, const SolverOptions& options,
+                                           std::vector<Attempt>* tried = nullptr);
 
 }  // namespace attitude_planner

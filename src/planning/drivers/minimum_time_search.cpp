@@ -31,10 +31,12 @@ constexpr double kCoarseStartFactor = 1.01;
 
 /// One search on T from one start.
 struct SearchOutcome {
-  std::string start;      ///< which start
-  PlanResult best;        ///< the plan at the least feasible T (if feasible)
-  bool feasible = false;  ///< some T was found feasible
-  double T_lo = 0.0;      ///< the bracket [T_lo infeasible, T_hi feasible]
+  std::string start;                          ///< which start
+  AttemptStart kind = AttemptStart::Hermite;  ///< its kind (the trail's `start`)
+  StartDetail detail;                         ///< its parameters (the trail's start_detail)
+  PlanResult best;                            ///< the plan at the least feasible T (if feasible)
+  bool feasible = false;                      ///< some T was found feasible
+  double T_lo = 0.0;                          ///< the bracket [T_lo infeasible, T_hi feasible]
   double T_hi = 0.0;
   int solves = 0;
   int iterations = 0;  ///< iterations of all its solves
@@ -57,7 +59,10 @@ class MinimumTimeSearch {
         problem_.duration > 0 ? problem_.duration : eigenaxisDurationGuess(problem_);
     searchFromCoarseGrid();
     const bool searched_coarse = !outcomes_.empty() && outcomes_.back().feasible;
-    if (!searched_coarse) outcomes_.push_back(search("continuation", nullptr, guess));
+    if (!searched_coarse) {
+      outcomes_.push_back(search("continuation", nullptr, guess));
+      outcomes_.back().detail.duration = guess;
+    }
     if (!searched_coarse && isRestToRest()) searchStructuredStarts();
     SearchOutcome* found = leastFeasible();
     if (found) bisect(found);
@@ -144,6 +149,16 @@ class MinimumTimeSearch {
     outcomes_.push_back(search("coarse grid (N = " + std::to_string(coarse_problem.steps) + ")",
                                &resampled, coarse.minimum_duration * kCoarseStartFactor));
     coarse_minimum_duration_ = coarse.minimum_duration;
+    // Its start's parameters: the coarse search's kept start's, refined from N/2.
+    SearchOutcome& refined = outcomes_.back();
+    refined.kind = AttemptStart::CoarseLevel;
+    for (const Attempt& a : coarse.attempts) {
+      if (!a.kept) continue;
+      refined.detail = a.start_detail;
+      refined.detail.origin = originOf(a);
+    }
+    refined.detail.duration = coarse.minimum_duration * kCoarseStartFactor;
+    refined.detail.coarse_steps = coarse_problem.steps;
   }
 
   bool isRestToRest() const {
@@ -163,6 +178,7 @@ class MinimumTimeSearch {
         so3::log(problem_.initial_attitude.transpose() * problem_.final_attitude).normalized();
     const Vector3 p1 = e.unitOrthogonal(), p2 = e.cross(p1);
     std::vector<StructuredStart> starts{{"eigenaxis", e, 0.0, kEigenaxisStartFactor}};
+    // Their parameters: body frame (e and the excursion axes are R_0's body axes).
     for (const double angle : kExcursionAngles) {
       for (const double factor : kExcursionStartFactors) {
         for (const auto& [name, axis] : {std::pair<std::string, Vector3>{"+p1", p1},
@@ -181,6 +197,14 @@ class MinimumTimeSearch {
       shaped.duration = T_eigenaxis * st.duration_factor;
       const Maneuver slew = excursionSlew(shaped, st.axis, st.angle);
       outcomes_.push_back(search(st.name, &slew, shaped.duration));
+      SearchOutcome& o = outcomes_.back();
+      o.kind = st.angle > 0 ? AttemptStart::Excursion : AttemptStart::EigenaxisSlew;
+      o.detail.duration = shaped.duration;
+      o.detail.eigenaxis = e;
+      if (st.angle > 0) {
+        o.detail.excursion_axis = st.axis;
+        o.detail.excursion = st.angle;
+      }
     }
   }
 
@@ -217,7 +241,8 @@ class MinimumTimeSearch {
     for (const SearchOutcome& o : outcomes_) {
       Attempt a;
       a.stage = AttemptStage::MinimumTimeProbe;
-      a.start = o.start == "continuation" ? AttemptStart::Hermite : AttemptStart::WarmStart;
+      a.start = o.kind;
+      a.start_detail = o.detail;
       a.formulation = Formulation::FreeSlacks;
       a.steps = problem_.steps;
       a.termination = o.feasible ? Termination::Converged : Termination::Infeasible;

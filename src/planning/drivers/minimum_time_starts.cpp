@@ -43,7 +43,9 @@ FreeTimeStart geodesicStart(const PlanningProblem& problem) {
   } catch (const StepTooLarge&) {  // no boundary step at that h: the solve reports it
     attitudes.assign(problem.steps + 1, problem.initial_attitude);
   }
-  return {"geodesic", AttemptStart::Hermite, attitudes, at.duration};
+  FreeTimeStart start{"geodesic", AttemptStart::Hermite, attitudes, at.duration};
+  start.detail.duration = at.duration;
+  return start;
 }
 
 }  // namespace
@@ -149,6 +151,8 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
       so3::log(problem.initial_attitude.transpose() * problem.final_attitude).normalized();
   std::vector<FreeTimeStart> starts{
       {"eigenaxis", AttemptStart::EigenaxisSlew, excursionSlew(at, e, 0.0).attitude, T_eigenaxis}};
+  starts.back().detail.duration = T_eigenaxis;
+  starts.back().detail.eigenaxis = e;
   // With cones both signs of each excursion: a cone is passed on one side or the other, and
   // the sides are different local minima of T.
   std::vector<Vector3> axes = excursionAxes(e);
@@ -161,6 +165,7 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
     starts.push_back({"minimum effort under the constraints",
                       AttemptStart::ConstrainedMinimumEffort, starts.front().attitudes,
                       kEigenaxisStartFactor * T_eigenaxis});
+    starts.back().detail.duration = starts.back().duration;
   }
   for (const double size : {kFreeTimeExcursion, kFreeTimeConeExcursion}) {
     if (size != kFreeTimeExcursion && !cones) break;
@@ -169,6 +174,11 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
       name << "excursion " << size << " rad about " << axisName(axis);
       starts.push_back({name.str(), AttemptStart::Excursion, excursionSlew(at, axis, size).attitude,
                         kFreeTimeStartFactor * T_eigenaxis});
+      StartDetail& detail = starts.back().detail;
+      detail.duration = starts.back().duration;
+      detail.eigenaxis = e;
+      detail.excursion_axis = axis;
+      detail.excursion = size;
     }
   }
   return starts;

@@ -43,6 +43,7 @@ struct FreeTimeStart {
   AttemptStart kind;
   std::vector<Matrix3> attitudes;  ///< R_0..R_N
   double duration;
+  StartDetail detail = {};  ///< its parameters, structured (Attempt::start_detail)
 };
 
 /// The axes ⟂ ê the excursions turn about: the body axes' parts perpendicular to the eigenaxis

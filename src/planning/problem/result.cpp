@@ -21,6 +21,10 @@ std::string globalizationName(Globalization globalization) {
   return nameIn(kGlobalizationNames, globalization);
 }
 
+AttemptStart originOf(const Attempt& attempt) {
+  return attempt.start_detail.coarse_steps > 0 ? attempt.start_detail.origin : attempt.start;
+}
+
 namespace {
 
 /// "the nearest lift", "the other way round + 1 extra turn(s)", ...

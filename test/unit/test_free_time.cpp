@@ -495,7 +495,7 @@ ap::PlanningProblem withEffect(ap::PlanningProblem p, std::unique_ptr<ap::Torque
 }
 
 /// Betts's body on a fast "orbit" (n = 0.05 rad/s: n T* ≈ 1.4 rad, gravity-gradient torques up
-/// to ~20 N m against the 50 N m bounds), second_order.
+/// to 3n²(J_x − J_z)/2 ≈ 12 N m against the 50 N m bounds), second_order.
 ap::PlanningProblem bettsWithGravityGradient(int steps) {
   const ap::PlanningProblem p = scene("min_time_betts", steps);
   return withEffect(p, std::make_unique<ap::GravityGradient>(2.5e-3, 1.0, p.inertia));

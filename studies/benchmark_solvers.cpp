@@ -18,6 +18,10 @@
 //   ipopt_free_time  minimum time: the same transcription with h an unknown, objective N h, from
 //                 the eigenaxis slew with an excursion (L-BFGS Hessian; one JSON line of its own:
 //                 time_s, minimum_duration, status; docs/results/minimum_time.md's peer row)
+//   minimum_time_search  minimum time by the former search on T over minimum-effort solves
+//                 (drivers/minimum_time_search.hpp) on the scene's request as it is (any scheme,
+//                 constraints, effects): the upper bound the free-time answer is checked against
+//                 (one JSON line: time_s, minimum_duration, status)
 //   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
 //                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
 //                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
@@ -50,6 +54,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "lie/dual.hpp"
+#include "planning/drivers/minimum_time_search.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
@@ -268,7 +273,8 @@ using attitude_planner::study::median;
 
 const char* const kUsage =
     "usage: benchmark_solvers --solver newton|slsqp|auglag|ipopt|ipopt_lbfgs|complex_step|\n"
-    "                                  free_time|ipopt_free_time (minimum time, own JSON line)\n"
+    "                                  free_time|ipopt_free_time|minimum_time_search (minimum\n"
+    "                                  time, own JSON line)\n"
     "                         [--scene SCENE.yaml] [--steps N] [--scheme paper|variational]\n"
     "                         [--time-budget S] [--in-process K]\n"
     "                         [--start geodesic|unconstrained|ours]  the peers' start (ipopt):\n"
@@ -1898,6 +1904,23 @@ std::optional<int> parseArguments(int argc, char** argv, BenchmarkArgs* args) {
   return std::nullopt;
 }
 
+/// --solver minimum_time_search: the search on T over minimum-effort solves on the request as it
+/// is (planManeuver answers minimum time by the free-time interior point wherever it applies).
+/// Prints one JSON line: time_s, minimum_duration (the least T found feasible), status.
+int searchMinimumTimeOnce(const ap::PlanningProblem& problem) {
+  ap::validateProblem(problem);
+  const auto start = std::chrono::steady_clock::now();
+  const ap::PlanResult r = ap::searchMinimumTime(problem, ap::SolverOptions());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "{\"solver\": \"minimum_time_search\", \"scheme\": \"%s\", \"steps\": %d, "
+      "\"time_s\": %.6g, \"minimum_duration\": %.17g, \"status\": \"%s\"}\n",
+      ap::schemeName(problem.scheme).c_str(), problem.steps, seconds, r.minimum_duration,
+      ap::terminationName(r.termination).c_str());
+  return r.converged() ? 0 : 1;
+}
+
 /// One solver on one problem (--solver): prints its JSON line; the exit status.
 int benchmarkOneSolver(const BenchmarkArgs& args) {
   try {
@@ -1905,6 +1928,7 @@ int benchmarkOneSolver(const BenchmarkArgs& args) {
         args.scene.empty() ? seedRestToRest(128) : ap::loadScene(args.scene).problem;
     if (args.steps > 0) problem.steps = args.steps;
     if (!args.scheme.empty()) problem.scheme = ap::parseScheme(args.scheme, "--scheme");
+    if (args.solver == "minimum_time_search") return searchMinimumTimeOnce(problem);
     if (args.solver == "free_time" || args.solver == "ipopt_free_time") {
 #ifdef AP_HAVE_IPOPT  // the two share the peer's start (excursionStart)
       if (args.solver == "ipopt_free_time") return solveIpoptFreeTime(problem, args.time_budget);

@@ -24,4 +24,8 @@ Matrix3 DisturbanceTorque::weightedSecondDerivative(const Matrix3& R, double,
   return 0.5 * (T + T.transpose());
 }
 
+EffectTimeDerivatives DisturbanceTorque::timeDerivatives(const Matrix3&, double) const {
+  return {};
+}
+
 }  // namespace attitude_planner

@@ -19,6 +19,9 @@ class TimeShiftedEffect : public TorqueEffect {
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override {
     return effect_->weightedSecondDerivative(R, t + offset_, w);
   }
+  EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override {
+    return effect_->timeDerivatives(R, t + offset_);
+  }
 
  private:
   std::shared_ptr<const TorqueEffect> effect_;
@@ -54,6 +57,17 @@ Matrix3 EffectModel::jacobian(const Matrix3& R, double t) const {
 Matrix3 EffectModel::weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const {
   Matrix3 sum = Matrix3::Zero();
   for (const auto& e : effects_) sum += e->weightedSecondDerivative(R, t, w);
+  return sum;
+}
+
+EffectTimeDerivatives EffectModel::timeDerivatives(const Matrix3& R, double t) const {
+  EffectTimeDerivatives sum;
+  for (const auto& e : effects_) {
+    const EffectTimeDerivatives d = e->timeDerivatives(R, t);
+    sum.torque_rate += d.torque_rate;
+    sum.torque_acceleration += d.torque_acceleration;
+    sum.jacobian_rate += d.jacobian_rate;
+  }
   return sum;
 }
 

@@ -59,4 +59,21 @@ Matrix3 GravityGradient::weightedSecondDerivative(const Matrix3& R, double t,
   return 0.5 * (T + T.transpose());
 }
 
+EffectTimeDerivatives GravityGradient::timeDerivatives(const Matrix3& R, double t) const {
+  // b = Rᵀr̂(t) moves as b' = Rᵀr̂', b'' = −n² b. τ = c b × Jb (c = 3n²) is bilinear in b:
+  // τ' = c (b' × Jb + b × Jb'), τ'' = c (b'' × Jb + 2 b' × Jb' + b × Jb''); the Jacobian
+  // c (b^J − (Jb)^) b^ likewise: ∂/∂t = c ((b'^J − (Jb')^) b^ + (b^J − (Jb)^) b'^).
+  const double c = 3.0 * n_ * n_;
+  const Vector3 b = R.transpose() * radial(t);
+  const Vector3 db = R.transpose() * Vector3(-n_ * std::sin(n_ * t), n_ * std::cos(n_ * t), 0.0);
+  const Vector3 ddb = -n_ * n_ * b;
+  const auto hat = [](const Vector3& v) { return so3::hat<double>(v); };
+  EffectTimeDerivatives d;
+  d.torque_rate = c * (db.cross(J_ * b) + b.cross(J_ * db));
+  d.torque_acceleration = c * (ddb.cross(J_ * b) + 2.0 * db.cross(J_ * db) + b.cross(J_ * ddb));
+  d.jacobian_rate =
+      c * ((hat(db) * J_ - hat(J_ * db)) * hat(b) + (hat(b) * J_ - hat(J_ * b)) * hat(db));
+  return d;
+}
+
 }  // namespace attitude_planner

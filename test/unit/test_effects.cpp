@@ -107,6 +107,47 @@ TEST(Effects, WeightedSecondDerivativesMatchSecondDifferences) {
   }
 }
 
+TEST(Effects, TimeDerivativesMatchCentralDifferencesInTime) {
+  // ∂τ_e/∂t, ∂²τ_e/∂t² and ∂(∂τ_e/∂δ)/∂t at fixed R (minimum time: t_k = k h moves with h)
+  // against central differences of torque() and jacobian() in t, also through a shifted clock.
+  // The gravity gradient's r̂(t) turns (nonzero rates); a constant torque has none in either frame.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<std::unique_ptr<TorqueEffect>> effects = sampleEffects();
+  const double n = std::sqrt(kMu / (kRadius * kRadius * kRadius));
+  EffectModel shifted_source;
+  shifted_source.add(std::make_unique<GravityGradient>(kMu, kRadius, kInertia));
+  const EffectModel shifted = shifted_source.timeShifted(321.0);
+  for (std::size_t i = 0; i <= effects.size(); ++i) {
+    const bool model = i == effects.size();
+    const auto torque = [&](const Matrix3& R, double t) {
+      return model ? shifted.torque(R, t) : effects[i]->torque(R, t);
+    };
+    const auto jacobian = [&](const Matrix3& R, double t) {
+      return model ? shifted.jacobian(R, t) : effects[i]->jacobian(R, t);
+    };
+    const std::string name = model ? "time-shifted gravity_gradient" : effects[i]->name();
+    for (int trial = 0; trial < 3; ++trial) {
+      const Matrix3 R = so3::exp(Vector3(g(rng), g(rng), g(rng)));
+      const double t = 700.0 * trial + 13.0;
+      const EffectTimeDerivatives d =
+          model ? shifted.timeDerivatives(R, t) : effects[i]->timeDerivatives(R, t);
+      const double dt = 1e-4 / n;  // a small fraction of the orbit's time scale
+      const Vector3 rate_fd = (torque(R, t + dt) - torque(R, t - dt)) / (2 * dt);
+      const Vector3 acceleration_fd =
+          (torque(R, t + dt) - 2 * torque(R, t) + torque(R, t - dt)) / (dt * dt);
+      const Matrix3 jacobian_fd = (jacobian(R, t + dt) - jacobian(R, t - dt)) / (2 * dt);
+      const double scale = std::max(torque(R, t).norm(), jacobian(R, t).norm());
+      EXPECT_LE((d.torque_rate - rate_fd).norm(), 1e-6 * n * scale) << name;
+      EXPECT_LE((d.torque_acceleration - acceleration_fd).norm(), 1e-5 * n * n * scale) << name;
+      EXPECT_LE((d.jacobian_rate - jacobian_fd).norm(), 1e-6 * n * scale) << name;
+      const bool turning = name != "disturbance_torque";
+      EXPECT_EQ(d.torque_rate.norm() > 1e-3 * n * scale, turning) << name;
+      EXPECT_EQ(d.jacobian_rate.norm() > 1e-3 * n * scale, turning) << name;
+    }
+  }
+}
+
 TEST(Effects, AnEmptyEffectListIsBitIdenticalToTheBareIntegrator) {
   const auto torque = someTorques(200);
   EffectModel none;

@@ -39,6 +39,17 @@ PlanningProblem randomProblem(SchemeKind scheme, int N, unsigned seed) {
 
 using test_support::perturbedReducedProblem;
 
+/// `p` with external effects strong against its torques and moving in time (T ≈ 6 s): a fast
+/// "orbit" (n = 1 rad/s) and constant torques in the world and the body frame.
+PlanningProblem withEffects(PlanningProblem p) {
+  auto model = std::make_shared<EffectModel>();
+  model->add(std::make_unique<GravityGradient>(1.0, 1.0, p.inertia));
+  model->add(std::make_unique<DisturbanceTorque>(Vector3(0.5, -0.2, 0.3), TorqueFrame::World));
+  model->add(std::make_unique<DisturbanceTorque>(Vector3(-0.1, 0.4, 0.2), TorqueFrame::Body));
+  p.effects = model;
+  return p;
+}
+
 /// Effort plus a term in T² (a time penalty with a minimum in T): an objective written outside
 /// the library, as a user of the interface would.
 class EffortPlusTimeSquared : public TranscriptionObjective {
@@ -138,36 +149,83 @@ TEST(GlobalUnknowns, TimeStepDerivativesMatchFiniteDifferences) {
                                                 &effort_plus_time_squared};
   for (SchemeKind scheme : kDiscretizations) {
     for (unsigned seed : {1u, 2u, 3u}) {
-      const ReducedProblem rp = perturbedReducedProblem(randomProblem(scheme, 9, seed), 10 + seed);
-      for (const TranscriptionObjective* objective : objectives) {
-        expectDerivativesMatchFiniteDifferences(
-            rp, *objective,
-            schemeName(scheme) + " seed " + std::to_string(seed) + " " + objective->name());
+      for (const bool effects : {false, true}) {
+        const PlanningProblem problem = randomProblem(scheme, 9, seed);
+        const ReducedProblem rp =
+            perturbedReducedProblem(effects ? withEffects(problem) : problem, 10 + seed);
+        for (const TranscriptionObjective* objective : objectives) {
+          expectDerivativesMatchFiniteDifferences(
+              rp, *objective,
+              schemeName(scheme) + " seed " + std::to_string(seed) + " " + objective->name() +
+                  (effects ? " with effects" : ""));
+        }
       }
     }
   }
 }
 
-// The torques' own h-derivative ∂r_k/∂h (what constraints on τ will need), node by node.
+// The torques' own h-derivative ∂r_k/∂h (what constraints on τ will need), node by node, and
+// with weights w unrelated to the torques (a constraint's multipliers) ∂²(wᵀr_k)/∂h² and
+// ∂²(wᵀr_k)/∂δ∂h on the free nodes; with and without effects (whose time t_k = k h moves).
 TEST(GlobalUnknowns, TorqueTimeDerivativesMatchFiniteDifferences) {
   for (SchemeKind scheme : kDiscretizations) {
-    const ReducedProblem rp = perturbedReducedProblem(randomProblem(scheme, 10, 4), 5);
-    const double h = rp.timeStep(), step = 1e-6 * h;
-    ReducedProblem plus = rp, minus = rp;
-    plus.setTimeStep(h + step);
-    minus.setTimeStep(h - step);
-    const std::vector<Vector3> tau_plus = plus.torques(plus.current());
-    const std::vector<Vector3> tau_minus = minus.torques(minus.current());
-    double scale = 0.0;
-    for (const Vector3& t : rp.torques(rp.current())) scale = std::max(scale, t.norm() / h);
-    int visited = 0;
-    rp.forEachStencilWithTimeStep([&](const ReducedProblem::TimeStepStencil& st) {
-      const double root = std::sqrt(rp.scheme().torqueWeight(st.k, rp.steps()));
-      const Vector3 fd = root * (tau_plus[st.k] - tau_minus[st.k]) / (2 * step);
-      EXPECT_LE((st.tau_h - fd).norm(), 1e-7 * scale) << schemeName(scheme) << " k " << st.k;
-      ++visited;
-    });
-    EXPECT_EQ(visited, scheme == SchemeKind::SecondOrder ? rp.steps() + 1 : rp.steps() - 1);
+    for (const bool effects : {false, true}) {
+      const PlanningProblem problem = randomProblem(scheme, 10, 4);
+      const ReducedProblem rp =
+          perturbedReducedProblem(effects ? withEffects(problem) : problem, 5);
+      const std::string label = schemeName(scheme) + (effects ? " with effects" : "");
+      const double h = rp.timeStep(), step = 1e-6 * h, wide = 1e-4 * h;
+      const auto at = [&](double dh) {
+        ReducedProblem q = rp;
+        q.setTimeStep(h + dh);
+        return q;
+      };
+      const ReducedProblem plus = at(step), minus = at(-step), wide_plus = at(wide),
+                           wide_minus = at(-wide);
+      const std::vector<Vector3> tau = rp.torques(rp.current());
+      const std::vector<Vector3> tau_plus = plus.torques(plus.current());
+      const std::vector<Vector3> tau_minus = minus.torques(minus.current());
+      const std::vector<Vector3> tau_wide_plus = wide_plus.torques(wide_plus.current());
+      const std::vector<Vector3> tau_wide_minus = wide_minus.torques(wide_minus.current());
+      std::mt19937 rng(6);
+      std::normal_distribution<double> normal;
+      std::vector<Vector3> weight(rp.steps() + 1);
+      for (Vector3& w : weight) w = Vector3(normal(rng), normal(rng), normal(rng));
+      // Jᵀw of every stencil at h ± step, over (δ_{k−1}, δ_k, δ_{k+1}).
+      const auto weighted_jacobians = [&](const ReducedProblem& q) {
+        std::vector<Eigen::Matrix<double, 9, 1>> out(q.steps() + 1);
+        q.forEachStencil(false, [&](const ReducedProblem::Stencil& st) {
+          out[st.k] = st.jacobian.transpose() * weight[st.k];
+        });
+        return out;
+      };
+      const auto jw_plus = weighted_jacobians(plus), jw_minus = weighted_jacobians(minus);
+      double scale = 0.0;
+      for (const Vector3& t : tau) scale = std::max(scale, t.norm() / h);
+      int visited = 0;
+      rp.forEachStencilWithTimeStep(
+          [&](const ReducedProblem::TimeStepStencil& st) {
+            const int k = st.k;
+            const double root = std::sqrt(rp.scheme().torqueWeight(k, rp.steps()));
+            const Vector3 fd = root * (tau_plus[k] - tau_minus[k]) / (2 * step);
+            EXPECT_LE((st.tau_h - fd).norm(), 1e-7 * scale) << label << " k " << k;
+            const double fd_hh = root *
+                                 weight[k].dot(tau_wide_plus[k] - 2 * tau[k] + tau_wide_minus[k]) /
+                                 (wide * wide);
+            EXPECT_NEAR(st.second_hh, fd_hh, 1e-5 * weight[k].norm() * scale / h)
+                << label << " k " << k;
+            for (int s = 0; s < 3; ++s) {
+              if (rp.variableIndex(k - 1 + s) < 0) continue;  // free nodes: held as h moves
+              const Vector3 fd_h = (jw_plus[k] - jw_minus[k]).segment<3>(3 * s) / (2 * step);
+              EXPECT_LE((st.second_h.segment<3>(3 * s) - fd_h).norm(),
+                        1e-6 * (fd_h.norm() + weight[k].norm() * st.jacobian.norm() / h))
+                  << label << " k " << k << " node " << k - 1 + s;
+            }
+            ++visited;
+          },
+          [&](int k, const Vector3&) { return weight[k]; });
+      EXPECT_EQ(visited, scheme == SchemeKind::SecondOrder ? rp.steps() + 1 : rp.steps() - 1);
+    }
   }
 }
 
@@ -204,52 +262,50 @@ TEST(GlobalUnknowns, TimeObjectiveIsTheDuration) {
 }
 
 // setTimeStep keeps the free attitudes and honours the boundary velocities at the new h: its
-// torques are those of a problem built at that duration through the same attitudes.
+// torques are those of a problem built at that duration through the same attitudes (with
+// effects too: read at t_k = k h_new).
 TEST(GlobalUnknowns, SetTimeStepIsTheProblemAtTheNewDuration) {
   for (SchemeKind scheme : kDiscretizations) {
-    PlanningProblem problem = randomProblem(scheme, 16, 10);
-    ReducedProblem rp = perturbedReducedProblem(problem, 11);
-    const std::vector<Matrix3> R_before = rp.attitudes(rp.current());
-    const double h = rp.timeStep(), h_new = 1.3 * h;
-    rp.setTimeStep(h_new);
-    problem.duration = problem.steps * h_new;
-    ReducedProblem fresh(problem);
-    fresh.setInteriorFromAttitudes(R_before);
-    const std::vector<Matrix3> R_after = rp.attitudes(rp.current());
-    for (int j = rp.firstFreeNode(); j <= rp.lastFreeNode(); ++j) {
-      EXPECT_LE((R_after[j] - R_before[j]).cwiseAbs().maxCoeff(), 1e-14) << j;
-    }
-    const std::vector<Vector3> tau = rp.torques(rp.current());
-    const std::vector<Vector3> tau_fresh = fresh.torques(fresh.current());
-    double scale = 0.0, difference = 0.0;
-    for (size_t k = 0; k < tau.size(); ++k) {
-      scale = std::max(scale, tau_fresh[k].norm());
-      difference = std::max(difference, (tau[k] - tau_fresh[k]).norm());
-    }
-    EXPECT_LE(difference, 1e-10 * scale) << schemeName(scheme);
-    // And back: the same steps to round-off.
-    ReducedProblem back = rp;
-    back.setTimeStep(h);
-    const ReducedProblem original = perturbedReducedProblem(randomProblem(scheme, 16, 10), 11);
-    for (int j = 0; j < rp.steps(); ++j) {
-      EXPECT_LE((back.current()[j] - original.current()[j]).norm(), 1e-14) << j;
+    for (const bool effects : {false, true}) {
+      PlanningProblem problem =
+          effects ? withEffects(randomProblem(scheme, 16, 10)) : randomProblem(scheme, 16, 10);
+      ReducedProblem rp = perturbedReducedProblem(problem, 11);
+      const std::vector<Matrix3> R_before = rp.attitudes(rp.current());
+      const double h = rp.timeStep(), h_new = 1.3 * h;
+      rp.setTimeStep(h_new);
+      problem.duration = problem.steps * h_new;
+      ReducedProblem fresh(problem);
+      fresh.setInteriorFromAttitudes(R_before);
+      const std::vector<Matrix3> R_after = rp.attitudes(rp.current());
+      for (int j = rp.firstFreeNode(); j <= rp.lastFreeNode(); ++j) {
+        EXPECT_LE((R_after[j] - R_before[j]).cwiseAbs().maxCoeff(), 1e-14) << j;
+      }
+      const std::vector<Vector3> tau = rp.torques(rp.current());
+      const std::vector<Vector3> tau_fresh = fresh.torques(fresh.current());
+      double scale = 0.0, difference = 0.0;
+      for (size_t k = 0; k < tau.size(); ++k) {
+        scale = std::max(scale, tau_fresh[k].norm());
+        difference = std::max(difference, (tau[k] - tau_fresh[k]).norm());
+      }
+      EXPECT_LE(difference, 1e-10 * scale) << schemeName(scheme) << " effects " << effects;
+      // And back: the same steps to round-off.
+      ReducedProblem back = rp;
+      back.setTimeStep(h);
+      const ReducedProblem original = perturbedReducedProblem(randomProblem(scheme, 16, 10), 11);
+      for (int j = 0; j < rp.steps(); ++j) {
+        EXPECT_LE((back.current()[j] - original.current()[j]).norm(), 1e-14) << j;
+      }
     }
   }
 }
 
-TEST(GlobalUnknowns, RefusedWithEffectsAndForANonPositiveTimeStep) {
-  PlanningProblem problem = randomProblem(SchemeKind::Variational, 12, 12);
+TEST(GlobalUnknowns, RefusedForANonPositiveTimeStep) {
+  const PlanningProblem problem = randomProblem(SchemeKind::Variational, 12, 12);
   ReducedProblem plain(problem);
   EXPECT_THROW(plain.setTimeStep(0.0), InvalidInput);
   EXPECT_THROW(plain.setTimeStep(std::nan("")), InvalidInput);
-  auto model = std::make_shared<EffectModel>();
-  model->add(std::make_unique<DisturbanceTorque>(Vector3(0.5, -0.2, 0.3), TorqueFrame::World));
-  problem.effects = model;
-  ReducedProblem with_effects(problem);
-  EXPECT_THROW(with_effects.setTimeStep(0.1), InvalidInput);
-  Eigen::VectorXd g;
-  EXPECT_THROW(with_effects.evaluateWithTimeStep(EffortObjective(), &g, nullptr, nullptr, nullptr),
-               InvalidInput);
+  ReducedProblem with_effects(withEffects(problem));
+  EXPECT_THROW(with_effects.setTimeStep(-0.1), InvalidInput);
 }
 
 namespace {

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/lie/so3.hpp"
@@ -22,6 +21,7 @@
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/scene_problem.hpp"
+#include "support/searched_minimum_time.hpp"
 
 namespace ap = attitude_planner;
 
@@ -212,11 +212,7 @@ TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPo
   EXPECT_LE(r.minimum_time.stationarity, 1e-8);
   EXPECT_LE(r.minimum_time.complementarity, 1e-8);
   EXPECT_LE(r.max_constraint_violation, 1e-8);
-  ap::PlanningProblem forced = p;
-  auto effects = std::make_shared<ap::EffectModel>();
-  effects->add(std::make_unique<ap::DisturbanceTorque>(ap::Vector3::Zero(), ap::TorqueFrame::Body));
-  forced.effects = effects;
-  const ap::PlanResult searched = ap::planManeuver(forced);
+  const ap::PlanResult searched = ap::test_support::searchedMinimumTime(p);
   ASSERT_TRUE(searched.converged()) << searched.message;
   EXPECT_FALSE(searched.minimum_time.kkt_point);
   EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-9));

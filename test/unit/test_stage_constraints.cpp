@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -24,6 +23,7 @@
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "support/scene_problem.hpp"
+#include "support/searched_minimum_time.hpp"
 
 namespace ap = attitude_planner;
 
@@ -36,14 +36,8 @@ ap::PlanningProblem scene(const char* name, int steps) {
 /// How far above the search's T a cone answer may sit (a missed basin, not a wrong KKT point).
 constexpr double kConeBasinTolerance = 5e-3;
 
-/// The search on T over minimum-effort solves (an upper bound) on the same discrete problem: it
-/// still answers requests with effects, so a zero body-frame disturbance torque forces it.
-ap::PlanResult searchedMinimumTime(ap::PlanningProblem p) {
-  auto effects = std::make_shared<ap::EffectModel>();
-  effects->add(std::make_unique<ap::DisturbanceTorque>(ap::Vector3::Zero(), ap::TorqueFrame::Body));
-  p.effects = effects;
-  return ap::planManeuver(p);
-}
+/// The search on T over minimum-effort solves (an upper bound) on the same discrete problem.
+using ap::test_support::searchedMinimumTime;
 
 /// sun_keep_out's cone, body x at least 0.5 rad from a direction near the eigenaxis path.
 ap::PlanningConstraint sunCone() {

@@ -56,6 +56,14 @@ inline TorqueFrame parseTorqueFrame(const std::string& text, const std::string& 
   return parseIn(kTorqueFrameNames, text, field);
 }
 
+/// How an effect's torque and Jacobian change with time at a fixed attitude: what the
+/// transcription needs when the time step h is an unknown (t_k = k h moves with h).
+struct EffectTimeDerivatives {
+  Vector3 torque_rate = Vector3::Zero();          ///< ∂τ_e/∂t [N m/s]
+  Vector3 torque_acceleration = Vector3::Zero();  ///< ∂²τ_e/∂t² [N m/s²]
+  Matrix3 jacobian_rate = Matrix3::Zero();        ///< ∂(∂τ_e/∂δ)/∂t [N m/(rad s)]
+};
+
 /// A known external torque on the body.
 class TorqueEffect {
  public:
@@ -69,6 +77,8 @@ class TorqueEffect {
   /// sym(Σ_i w_i ∂(jacobian row i)(R exp(δ^))/∂δ) at δ = 0: the w-weighted second derivative
   /// the Newton solver's exact Hessian needs (the antisymmetric rest is the retraction's term).
   virtual Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const = 0;
+  /// The exact time derivatives of torque() and jacobian() at fixed R (minimum time: h unknown).
+  virtual EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const = 0;
 };
 
 /// Gravity gradient of a circular orbit in the world x–y plane:
@@ -81,6 +91,8 @@ class GravityGradient : public TorqueEffect {
   Vector3 torque(const Matrix3& R, double t) const override;
   Matrix3 jacobian(const Matrix3& R, double t) const override;
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
+  /// From r̂'(t) = n (−sin nt, cos nt, 0), r̂'' = −n² r̂.
+  EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override;
   /// The orbit's mean motion n [rad/s].
   double meanMotion() const { return n_; }
   /// r̂(t), the unit vector from the Earth to the body, world frame.
@@ -100,6 +112,8 @@ class DisturbanceTorque : public TorqueEffect {
   Vector3 torque(const Matrix3& R, double t) const override;
   Matrix3 jacobian(const Matrix3& R, double t) const override;
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
+  /// Zero: constant in time in either frame (in the world frame it moves with R only).
+  EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override;
 
  private:
   Vector3 value_;
@@ -119,6 +133,8 @@ class EffectModel {
   Matrix3 jacobian(const Matrix3& R, double t) const;
   /// Σ weighted second derivatives (see TorqueEffect).
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const;
+  /// Σ time derivatives (see TorqueEffect).
+  EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const;
   /// The same effects on a clock moved on by `offset` [s]: τ_e'(R, t) = τ_e(R, t + offset), names
   /// kept. The model of a plan that starts at `offset` of the original maneuver (re-planning the
   /// rest of it: the gravity gradient's orbit has moved on).

@@ -12,8 +12,9 @@
 // least T is kept and polished (the minimum-effort plan at T* from it, for the switching
 // functions). With cones each start is first made to clear them (a minimum-effort plan under
 // the cones tightened by 0.01 rad). T* is a KKT point of the discrete minimum-time problem, its
-// residuals in PlanResult::minimum_time. fourth_order and effects
-// are not written in h yet: for them (or if no free-time solve converges) the former search answers
+// residuals in PlanResult::minimum_time; with effects too (their time t_k = k h moves with h).
+// fourth_order is not written in h yet: for it (or if no free-time solve converges) the former
+// search answers
 // — several starts, each a continuation down in T over minimum-effort solves warm-started from the
 // last feasible plan and a bisection to kMinimumTimeTolerance; its T* is the least duration found
 // feasible, an upper bound (minimum_time.kkt_point false). Where the free-time problem applies,

@@ -755,7 +755,6 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
   if (problem.scheme == SchemeKind::FourthOrder) {
     return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
   }
-  if (problem.effects && !problem.effects->empty()) return "effects (time-dependent torques)";
   return "";
 }
 

@@ -37,9 +37,9 @@ struct FreeTimeOutcome {
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
 };
 
-/// Why `problem` cannot be solved free-time here (empty: it can): effects are not written in h
-/// yet (time-dependent torques), fourth_order has no single transcription (minimum_time.cpp falls
-/// back to the search).
+/// Why `problem` cannot be solved free-time here (empty: it can): fourth_order has no single
+/// transcription (minimum_time.cpp falls back to the search). Effects are written in h (their
+/// time t_k = k h moves with h: ReducedProblem::forEachStencilWithTimeStep).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and

@@ -132,12 +132,13 @@ class ReducedProblem {
   // (R_0, R_N, Ω(0), Ω(T)). Torque-free, μ(F) = μ̃(F)/h for every scheme, so at fixed steps the
   // interior torques scale as 1/h² and the end torques of second_order as a/h² + b/h; paper and
   // variational also move their fixed inner attitudes R_1, R_{N−1} with h (the first and last
-  // steps honour Ω(0), Ω(T) at the new h). Not with external effects (time-dependent: refused).
+  // steps honour Ω(0), Ω(T) at the new h). External effects enter as −τ_e(R_k, k h): they do not
+  // scale with h but move with their time t_k = k h (EffectModel::timeDerivatives) and with
+  // R_1, R_{N−1} where those move.
 
   double timeStep() const { return scheme_.timeStep(); }
   /// Sets h, keeping the free attitudes: the boundary steps are recomputed at the new h and the
-  /// steps next to them follow. Throws StepTooLarge as the constructor, InvalidInput for h ≤ 0
-  /// or with effects.
+  /// steps next to them follow. Throws StepTooLarge as the constructor, InvalidInput for h ≤ 0.
   void setTimeStep(double h);
 
   /// A stencil with its derivatives in h at fixed free attitudes: ∂r_k/∂h, and with the weights w
@@ -148,7 +149,7 @@ class ReducedProblem {
     Eigen::Matrix<double, 9, 1> second_h;  ///< ∂²(wᵀr_k)/∂δ∂h
     double second_hh = 0.0;                ///< ∂²(wᵀr_k)/∂h²
   };
-  /// As forEachStencil(true, …, weights) with the h-derivatives (throws InvalidInput with effects).
+  /// As forEachStencil(true, …, weights) with the h-derivatives.
   double forEachStencilWithTimeStep(const std::function<void(const TimeStepStencil&)>& visit,
                                     const SecondOrderWeights& weights = nullptr) const;
 
@@ -183,8 +184,6 @@ class ReducedProblem {
 
   /// The path of R_1 (at_start) or R_{N−1}; zero for second_order (no fixed inner attitude).
   BoundaryPath boundaryPath(bool at_start) const;
-  /// Throws InvalidInput if the time step cannot be an unknown here (effects).
-  void requireTimeStepUnknown(const char* what) const;
 
   int N_;
   DiscreteScheme scheme_;

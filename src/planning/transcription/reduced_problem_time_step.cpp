@@ -1,12 +1,16 @@
 // ReducedProblem with the time step h as a global unknown (declarations and the model in
 // reduced_problem.hpp). At fixed steps every scheme's momentum is μ̃(F)/h, so a torque is
 //
-//     r_k(δ, h) = s(h) ρ_k(δ + d(h)) + (t(h) − s(h)) β_k,   s = (h₀/h)², t = h₀/h,
+//     r_k(δ, h) = s(h) ρ_k(δ + d(h)) + (t(h) − s(h)) β_k + ε_k(δ + d(h), h),
+//     s = (h₀/h)², t = h₀/h,
 //
-// with ρ_k the torque at h₀ as a function of the node perturbations, d(h) the motion of the fixed
-// inner attitudes R_1, R_{N−1} (paper, variational: boundaryPath) and β_k the part of an end
-// torque (second_order) carried by a boundary momentum, (∓2√w J Ω)/h₀, which scales as 1/h. Its
-// derivatives in h therefore follow from the stencil's Jacobian and curvature at h₀.
+// with ρ_k the dynamics' part of the torque at h₀ as a function of the node perturbations, d(h)
+// the motion of the fixed inner attitudes R_1, R_{N−1} (paper, variational: boundaryPath), β_k
+// the part of an end torque (second_order) carried by a boundary momentum, (∓2√w J Ω)/h₀, which
+// scales as 1/h, and ε_k = −√w_k τ_e(R_k, k h) the external effects' part (EffectModel), which
+// moves with h through R_k (where d moves it) and through its time t_k = k h. Its derivatives
+// in h therefore follow from the stencil's Jacobian and curvature at h₀ and the effects' time
+// derivatives.
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -16,14 +20,6 @@
 
 namespace attitude_planner {
 
-void ReducedProblem::requireTimeStepUnknown(const char* what) const {
-  if (effects_) {
-    throw InvalidInput(std::string(what) +
-                       ": the time step cannot be an unknown with external effects (their "
-                       "torques depend on the time t_k = k h); plan at a fixed duration");
-  }
-}
-
 namespace {
 Eigen::Vector4d inverseQuaternion(Eigen::Vector4d q) {
   q.tail<3>() *= -1.0;
@@ -32,7 +28,6 @@ Eigen::Vector4d inverseQuaternion(Eigen::Vector4d q) {
 }  // namespace
 
 void ReducedProblem::setTimeStep(double h) {
-  requireTimeStepUnknown("setTimeStep");
   if (!(std::isfinite(h) && h > 0.0)) {
     throw InvalidInput("time step: must be finite and > 0, got " + std::to_string(h));
   }
@@ -103,15 +98,42 @@ ReducedProblem::BoundaryPath ReducedProblem::nodePath(int j) const {
   return {};
 }
 
+namespace {
+
+/// The effects' part ε_k = −√w_k τ_e(R_k, k h) of torque k and its derivatives in h through its
+/// time t_k = k h at fixed R_k: ∂ε/∂h = −√w k τ̇_e, ∂²ε/∂h² = −√w k² τ̈_e, and of its Jacobian
+/// block on R_k (interior torques only: the end torques' R_0, R_N are data), ∂/∂h = −√w k ∂J_e/∂t.
+struct EffectPart {
+  Vector3 value = Vector3::Zero(), first = Vector3::Zero(), second = Vector3::Zero();
+  Matrix3 jacobian = Matrix3::Zero(), jacobian_h = Matrix3::Zero();
+};
+
+EffectPart effectPart(const EffectModel& effects, const Matrix3& R_k, int k, double h, double root,
+                      bool interior) {
+  const double t = k * h;
+  const EffectTimeDerivatives d = effects.timeDerivatives(R_k, t);
+  EffectPart part;
+  part.value = -root * effects.torque(R_k, t);
+  part.first = -root * k * d.torque_rate;
+  part.second = -root * double(k) * k * d.torque_acceleration;
+  if (interior) {
+    part.jacobian = -root * effects.jacobian(R_k, t);
+    part.jacobian_h = -root * k * d.jacobian_rate;
+  }
+  return part;
+}
+
+}  // namespace
+
 double ReducedProblem::forEachStencilWithTimeStep(
     const std::function<void(const TimeStepStencil&)>& visit,
     const SecondOrderWeights& weights) const {
-  requireTimeStepUnknown("forEachStencilWithTimeStep");
   const double h = scheme_.timeStep();
   // s = (h₀/h)², t = h₀/h at h = h₀: s' = −2/h, s'' = 6/h², t' = −1/h, t'' = 2/h².
   const double s1 = -2.0 / h, s2 = 6.0 / (h * h), t1 = -1.0 / h, t2 = 2.0 / (h * h);
   const BoundaryPath start = boundaryPath(true), end = boundaryPath(false);
   const bool end_torques = scheme_.hasEndTorques();
+  const std::vector<Matrix3> R = effects_ ? attitudes(steps_) : std::vector<Matrix3>();
   TimeStepStencil ts;
   return forEachStencil(
       true,
@@ -131,18 +153,28 @@ double ReducedProblem::forEachStencilWithTimeStep(
             e2.segment<3>(3 * s) += end.second;
           }
         }
+        const double root = std::sqrt(scheme_.torqueWeight(st.k, N_));
         Vector3 beta = Vector3::Zero();
         if (end_torques && (st.k == 0 || st.k == N_)) {
-          const double root = std::sqrt(scheme_.torqueWeight(st.k, N_));
           beta = st.k == 0 ? Vector3(-2.0 * root * initial_momentum_ / h)
                            : Vector3(2.0 * root * final_momentum_ / h);
         }
+        // The dynamics' part ρ (scaled by s(h)) apart from the effects' ε (moved by t_k = k h).
+        const EffectPart effect =
+            effects_ ? effectPart(*effects_, R[st.k], st.k, h, root, st.k >= 1 && st.k < N_)
+                     : EffectPart();
+        const Vector3 rho = st.tau - effect.value;
+        Eigen::Matrix<double, 3, 9> rho_jacobian = st.jacobian;
+        rho_jacobian.block<3, 3>(0, 3) -= effect.jacobian;
+        Eigen::Matrix<double, 9, 1> effect_h = Eigen::Matrix<double, 9, 1>::Zero();
+        effect_h.segment<3>(3) = effect.jacobian_h.transpose() * w;  // ∂²(wᵀε)/∂δ_k∂h
         const Vector3 Je = st.jacobian * e;
         const Eigen::Matrix<double, 9, 1> He = st.second * e;
-        ts.tau_h = s1 * st.tau + Je + (t1 - s1) * beta;
-        ts.second_h = s1 * (st.jacobian.transpose() * w) + He;
-        ts.second_hh = s2 * w.dot(st.tau) + 2.0 * s1 * w.dot(Je) + e.dot(He) +
-                       w.dot(st.jacobian * e2) + (t2 - s2) * w.dot(beta);
+        ts.tau_h = s1 * rho + Je + (t1 - s1) * beta + effect.first;
+        ts.second_h = s1 * (rho_jacobian.transpose() * w) + He + effect_h;
+        ts.second_hh = s2 * w.dot(rho) + 2.0 * s1 * w.dot(rho_jacobian * e) + e.dot(He) +
+                       w.dot(st.jacobian * e2) + (t2 - s2) * w.dot(beta) + 2.0 * effect_h.dot(e) +
+                       w.dot(effect.second);
         visit(ts);
       },
       weights);

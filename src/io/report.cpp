@@ -136,7 +136,8 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"stationarity\": " << jsonNumber(r.minimum_time.stationarity)
       << ", \"time_stationarity\": " << jsonNumber(r.minimum_time.time_stationarity)
       << ", \"complementarity\": " << jsonNumber(r.minimum_time.complementarity)
-      << ", \"solves\": " << r.minimum_time.solves << "},\n"
+      << ", \"solves\": " << r.minimum_time.solves << ", \"second_order_sufficient\": "
+      << (r.minimum_time.second_order_sufficient ? "true" : "false") << "},\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"

@@ -202,6 +202,10 @@ struct MinimumTimeCertificate {
   double time_stationarity = 0.0;  ///< its η row alone
   double complementarity = 0.0;    ///< Σ zᵢcᵢ (the duality gap, relative to T₀)
   int solves = 0;                  ///< free-time solves run (one per start)
+  /// With kkt_point: the reduced Hessian on the tangent of the active constraints is positive
+  /// definite there (a strict local minimum of the discrete problem); false: a saddle or a
+  /// degenerate KKT point (FreeTimeOutcome::second_order_sufficient).
+  bool second_order_sufficient = false;
 };
 
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),

@@ -1,6 +1,7 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -24,6 +25,30 @@ constexpr int kFreeTimeMaxIterations = 500;
 /// are one start: the free-time solve from either ends at the same KKT point (the cleared starts
 /// that repeat one another differ by ~1e-13, their answers' T by ~1e-16 relative).
 constexpr double kSameStart = 1e-8;
+/// A KKT point that is not second-order sufficient (a saddle: FreeTimeOutcome) is left along its
+/// negative-curvature direction, both signs, by this much [rad, the largest node turn]: one
+/// free-time solve from each. Measured on scenes/min_time_keep_out.yaml: the structured starts
+/// are symmetric in time and so is the KKT point they reach, a saddle whose descent is the
+/// time-asymmetric passage of the cone.
+constexpr double kSaddleEscape = 0.05;
+/// A saddle's descent followed at most this many times (each to a lower saddle).
+constexpr int kMaxSaddleEscapes = 3;
+/// Two saddles whose T agree within this (relative) are one KKT point: left once; and a descent
+/// from a saddle that ends within it of the saddle's T went nowhere (not followed further).
+/// Measured with the keep-out cone and max_angular_rate 0.05 (N = 64): a KKT point at 44.2472 s
+/// whose least curvature is at round-off, left either way, ends at the same T to 1e-9; followed
+/// on, it cost 8 solves for nothing.
+constexpr double kSameSaddle = 1e-6;
+
+/// One start of the free-time solves: its attitudes as solved (cleared of the cones), T, name,
+/// the outcome, and the earlier start it repeats (its outcome taken; −1: none).
+struct StartRecord {
+  std::vector<Matrix3> attitudes;
+  double duration = 0.0;
+  std::string name;
+  FreeTimeOutcome outcome;
+  int same_as = -1;
+};
 
 /// What one free-time grid level hands the next: its outcome (plan, T, steps).
 struct FreeTimeCarry {
@@ -65,15 +90,23 @@ class FreeTimeMinimumTime {
         so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
     const std::vector<PlanningProblem> levels = gridLevels(problem_, freeTimeGridRule());
     const PlanningProblem& coarsest = levels.front();
-    const int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
+    int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
+    // Saddles are left where cones are present: without them the excursion axes reach the least
+    // basin (Bilimoria–Wie, Betts: no descent went lower), and the descent from a far saddle
+    // (Betts's eigenaxis slew, 20 % above T*) ran to the iteration limit (0.08 → 0.77 s at N = 64).
+    if (best >= 0 && hasCones(coarsest)) best = leaveSaddles(coarsest, best, 0);
+    if (coarsest.steps < kFreeTimeStartGrid && hasCones(coarsest)) {
+      best = fromStartGrid(coarsest, rest_to_rest, best);
+    }
     if (best < 0) return std::nullopt;
-    levels_ = levelResult(coarsest.steps, outcomes_[best]).levels;
-    if (levels.size() == 1) return polished(outcomes_[best], names_[best]);
-    std::optional<FreeTimeOutcome> refined = refine(levels, outcomes_[best]);
+    const StartRecord& kept = starts_[best];
+    levels_ = levelResult(coarsest.steps, kept.outcome).levels;
+    if (levels.size() == 1) return polished(kept.outcome, kept.name);
+    std::optional<FreeTimeOutcome> refined = refine(levels, kept.outcome);
     if (!refined) return std::nullopt;
     best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
     return polished(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
-                                  names_[best] + "), refined by 2 at a time");
+                                  kept.name + "), refined by 2 at a time");
   }
 
   /// Every free-time solve run so far (for the caller's trail when none gave the answer).
@@ -134,10 +167,14 @@ class FreeTimeMinimumTime {
   /// (measured, scenes/min_time_keep_out.yaml N = 64: 18 starts, 8 distinct once cleared).
   int sameStartAs(const std::vector<Matrix3>& start, double duration) const {
     for (std::size_t j = 0; j < starts_.size(); ++j) {
-      if (same_as_[j] >= 0 || start_durations_[j] != duration) continue;
+      const StartRecord& earlier = starts_[j];
+      if (earlier.same_as >= 0 || earlier.duration != duration ||
+          earlier.attitudes.size() != start.size()) {
+        continue;
+      }
       double difference = 0.0;
       for (std::size_t k = 0; k < start.size(); ++k) {
-        difference = std::max(difference, (start[k] - starts_[j][k]).cwiseAbs().maxCoeff());
+        difference = std::max(difference, (start[k] - earlier.attitudes[k]).cwiseAbs().maxCoeff());
       }
       if (difference <= kSameStart) return static_cast<int>(j);
     }
@@ -145,14 +182,10 @@ class FreeTimeMinimumTime {
   }
 
   /// Records a start (its attitudes as solved, T, name) with its outcome and the earlier start it
-  /// repeats (−1: none): the per-start lists stay aligned for sameStartAs and the message.
+  /// repeats (−1: none), for sameStartAs and the message.
   void recordStart(const std::vector<Matrix3>& start, double duration, const std::string& name,
                    FreeTimeOutcome outcome, int same) {
-    starts_.push_back(start);
-    start_durations_.push_back(duration);
-    names_.push_back(name);
-    same_as_.push_back(same);
-    outcomes_.push_back(std::move(outcome));
+    starts_.push_back({start, duration, name, std::move(outcome), same});
   }
 
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
@@ -166,14 +199,123 @@ class FreeTimeMinimumTime {
       StartDetail detail = st.detail;
       detail.cleared_of_cones = start != st.attitudes;
       FreeTimeOutcome outcome =
-          same >= 0 ? outcomes_[same] : solve(grid, start, st.duration, st.kind, detail);
+          same >= 0 ? starts_[same].outcome : solve(grid, start, st.duration, st.kind, detail);
       recordStart(start, st.duration, st.name, std::move(outcome), same);
-      const FreeTimeOutcome& o = outcomes_.back();
-      if (o.termination == Termination::Converged &&
-          (best < 0 || o.duration < outcomes_[best].duration)) {
-        best = static_cast<int>(outcomes_.size()) - 1;
-        best_attempt_ = trail_.size() - 1;
+      keepIfLeast(&best);
+    }
+    return best;
+  }
+
+  /// The last recorded start kept (best, best_attempt_) if it converged below the best's T.
+  void keepIfLeast(int* best) {
+    const FreeTimeOutcome& o = starts_.back().outcome;
+    if (o.termination == Termination::Converged &&
+        (*best < 0 || o.duration < starts_[*best].outcome.duration)) {
+      *best = static_cast<int>(starts_.size()) - 1;
+      best_attempt_ = trail_.size() - 1;
+    }
+  }
+
+  static bool hasCones(const PlanningProblem& p) {
+    return std::any_of(p.constraints.begin(), p.constraints.end(),
+                       [](const PlanningConstraint& c) { return c.isCone(); });
+  }
+
+  /// A request below the start grid, with cones: the structured starts and their saddles solved
+  /// on kFreeTimeStartGrid too, and that answer restricted to `grid` (every (kFreeTimeStartGrid /
+  /// N)th node, turned out of the cones where it dips in) one more free-time solve on `grid` at
+  /// its T. Measured on scenes/min_time_keep_out.yaml N = 32: the starts and saddles of N = 32
+  /// end at 28.9937 s at best, the restricted N = 64 answer (28.7743 s) at 28.7643 s, below the
+  /// search's 28.9825 s (T*(N) rises with N: 28.7643, 28.7743, 28.7807 at 32, 64, 128). Returns
+  /// the least converged start on `grid` (best: the least so far, −1: none).
+  int fromStartGrid(const PlanningProblem& grid, bool rest_to_rest, int best) {
+    PlanningProblem fine = grid;
+    fine.steps = kFreeTimeStartGrid;
+    std::vector<FreeTimeStart> starts = freeTimeStarts(fine, rest_to_rest);
+    for (FreeTimeStart& st : starts) st.name = "N = " + std::to_string(fine.steps) + " " + st.name;
+    const std::size_t kept_attempt = best_attempt_;
+    const std::size_t first = starts_.size();
+    int fine_best = solveStarts(fine, starts);
+    if (fine_best >= 0) fine_best = leaveSaddles(fine, fine_best, first);
+    best_attempt_ = kept_attempt;
+    if (fine_best < 0 || fine.steps % grid.steps != 0) return best;
+    const StartRecord& answer = starts_[fine_best];
+    const int ratio = fine.steps / grid.steps;
+    std::vector<Matrix3> start;
+    for (int k = 0; k <= grid.steps; ++k)
+      start.push_back(answer.outcome.maneuver.attitude[k * ratio]);
+    if (coneClearance(grid, start) < 0.5 * kConeStartClearance) {
+      start = pushedOutOfCones(grid, start, kConeStartClearance);
+    }
+    const double T = answer.outcome.duration;
+    StartDetail detail;
+    detail.duration = T;
+    FreeTimeOutcome o = solve(grid, start, T, AttemptStart::PreviousAttempt, detail);
+    recordStart(start, T, "restricted (" + answer.name + ")", std::move(o), -1);
+    keepIfLeast(&best);
+    return best;
+  }
+
+  /// Every distinct saddle the starts on `grid` reached (those recorded from `first` on) (a
+  /// converged KKT point that is not second-order sufficient, FreeTimeOutcome; saddles at the same
+  /// T within kSameSaddle taken as one) left along its negative-curvature direction (leaveSaddle).
+  /// Returns the least converged start. Measured on scenes/min_time_keep_out.yaml N = 64: the
+  /// structured starts are symmetric in time and so are the KKT points most of them reach, saddles
+  /// at 29.0081 s and 30.8839 s; the least answer among them, 29.0078 s, is a local minimum on the
+  /// far side of the cone's passage; the eigenaxis saddle left either way descends to 28.7743 s (a
+  /// time-asymmetric passage).
+  int leaveSaddles(const PlanningProblem& grid, int best, std::size_t first) {
+    std::vector<double> left;  // the T of the saddles left
+    const std::size_t structured = starts_.size();
+    for (std::size_t i = first; i < structured; ++i) {
+      const FreeTimeOutcome& o = starts_[i].outcome;
+      if (starts_[i].same_as >= 0 || o.termination != Termination::Converged ||
+          o.second_order_sufficient) {
+        continue;
       }
+      const bool seen = std::any_of(left.begin(), left.end(), [&](double T) {
+        return std::abs(T - o.duration) <= kSameSaddle * o.duration;
+      });
+      if (seen) continue;
+      left.push_back(o.duration);
+      best = leaveSaddle(grid, static_cast<int>(i), best);
+    }
+    return best;
+  }
+
+  /// One free-time solve from the saddle `from` displaced along its negative-curvature direction
+  /// by ±kSaddleEscape (turned out of the cones where it dips in), at its T; if the lower of the
+  /// two is a saddle again, the same from there (at most kMaxSaddleEscapes). Returns the least
+  /// converged start so far.
+  int leaveSaddle(const PlanningProblem& grid, int from, int best) {
+    for (int escape = 0; escape < kMaxSaddleEscapes; ++escape) {
+      const StartRecord saddle = starts_[from];
+      int lower = -1;
+      for (const double sign : {1.0, -1.0}) {
+        if (budgetSpent(context_.remainingOptions())) return best;
+        std::vector<Matrix3> start =
+            displacedAlongNegativeCurvature(grid, saddle.outcome, sign * kSaddleEscape);
+        if (start.empty()) continue;
+        if (coneClearance(grid, start) < 0.5 * kConeStartClearance) {
+          start = pushedOutOfCones(grid, start, kConeStartClearance);
+        }
+        StartDetail detail;
+        detail.duration = saddle.outcome.duration;
+        FreeTimeOutcome o =
+            solve(grid, start, saddle.outcome.duration, AttemptStart::PreviousAttempt, detail);
+        recordStart(start, saddle.outcome.duration,
+                    std::string(sign > 0 ? "+" : "-") + "off the saddle of " + saddle.name,
+                    std::move(o), -1);
+        keepIfLeast(&best);
+        const FreeTimeOutcome& got = starts_.back().outcome;
+        if (got.termination == Termination::Converged &&
+            got.duration < saddle.outcome.duration * (1 - kSameSaddle) &&
+            (lower < 0 || got.duration < starts_[lower].outcome.duration)) {
+          lower = static_cast<int>(starts_.size()) - 1;
+        }
+      }
+      if (lower < 0 || starts_[lower].outcome.second_order_sufficient) break;
+      from = lower;
     }
     return best;
   }
@@ -249,18 +391,21 @@ class FreeTimeMinimumTime {
     if (!trail_.empty()) trail_[best_attempt_].kept = true;
     std::ostringstream note;
     note << "minimum time T* = " << answer.duration
-         << " s: a KKT point of the discrete minimum-time problem (one free-time interior-point "
-            "solve from the "
-         << from << " start, " << answer.iterations << " iterations; stationarity "
-         << answer.stationarity << ", h row " << answer.time_row << ", complementarity "
-         << answer.complementarity << "; starts:";
-    for (std::size_t i = 0; i < outcomes_.size(); ++i) {
-      note << " " << names_[i] << " ";
-      if (same_as_[i] >= 0) note << "(as " << names_[same_as_[i]] << ") ";
-      if (outcomes_[i].termination == Termination::Converged) {
-        note << outcomes_[i].duration << " s;";
+         << " s: a KKT point of the discrete minimum-time problem, "
+         << (answer.second_order_sufficient ? "second-order sufficient (a strict local minimum)"
+                                            : "not second-order sufficient (not shown a local "
+                                              "minimum)")
+         << " (one free-time interior-point solve from the " << from << " start, "
+         << answer.iterations << " iterations; stationarity " << answer.stationarity << ", h row "
+         << answer.time_row << ", complementarity " << answer.complementarity << "; starts:";
+    for (const StartRecord& st : starts_) {
+      note << " " << st.name << " ";
+      if (st.same_as >= 0) note << "(as " << starts_[st.same_as].name << ") ";
+      if (st.outcome.termination == Termination::Converged) {
+        note << st.outcome.duration << " s"
+             << (st.outcome.second_order_sufficient ? "" : " (saddle)") << ";";
       } else {
-        note << terminationName(outcomes_[i].termination) << ";";
+        note << terminationName(st.outcome.termination) << ";";
       }
     }
     note << " " << solves_ << " free-time solves)";
@@ -272,6 +417,7 @@ class FreeTimeMinimumTime {
     result.minimum_time.time_stationarity = answer.time_row;
     result.minimum_time.complementarity = answer.complementarity;
     result.minimum_time.solves = solves_;
+    result.minimum_time.second_order_sufficient = answer.second_order_sufficient;
     result.attempts = trail_;
     // The free-time levels first, then the polish's own.
     result.levels.insert(result.levels.begin(), levels_.begin(), levels_.end());
@@ -302,12 +448,8 @@ class FreeTimeMinimumTime {
 
   const PlanningProblem& problem_;
   SolveContext context_;
-  std::vector<FreeTimeOutcome> outcomes_;
-  std::vector<LevelSummary> levels_;          ///< the kept start's level and each refined level
-  std::vector<std::vector<Matrix3>> starts_;  ///< each start's attitudes as solved (cleared)
-  std::vector<double> start_durations_;       ///< and its T
-  std::vector<int> same_as_;  ///< the earlier start it repeats (its outcome taken), or −1
-  std::vector<std::string> names_;
+  std::vector<StartRecord> starts_;   ///< every start solved (or repeated), in order
+  std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;
   int solves_ = 0;

@@ -35,6 +35,7 @@
 // θ and the method continues as above from a strictly feasible plan.
 #include "planning/interior_point/free_time_solver.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -264,6 +265,7 @@ class FreeTimeSolver {
   void initializeDuals(double mu);
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
+  void checkSecondOrder(FreeTimeOutcome* out) const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
@@ -678,7 +680,9 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
     if (!elastic_ && mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
-      return outcome(Termination::Converged, "converged", iterations, epsilon);
+      FreeTimeOutcome out = outcome(Termination::Converged, "converged", iterations, epsilon);
+      checkSecondOrder(&out);
+      return out;
     }
     if (mu > mu_final && barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu) {
       if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
@@ -699,8 +703,10 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     double alpha = 0.0;
     if (!solveStep(&d) || !lineSearch(d, mu, epsilon, &alpha)) {
       if (!elastic_ && stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
-        return outcome(Termination::Converged, "converged to the round-off floor", iterations,
-                       epsilon);
+        FreeTimeOutcome out = outcome(Termination::Converged, "converged to the round-off floor",
+                                      iterations, epsilon);
+        checkSecondOrder(&out);
+        return out;
       }
       return outcome(Termination::NotConverged, "no descent step (line search failed)", iterations,
                      epsilon);
@@ -749,7 +755,42 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   return out;
 }
 
+/// The second-order check at the assembled (converged) point: the condensed barrier Hessian
+/// factored without a shift (FreeTimeOutcome::second_order_sufficient). Where it is not positive
+/// definite, its least eigenpair from the dense matrix (n ≤ a few hundred at the start grid; this
+/// runs once per converged solve, and only there).
+void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
+  BorderedBanded factor;
+  const bool definite = factor.factor(band_, border_, corner_) &&
+                        factor.inertia().positive == borderSize() && factor.inertia().negative == 0;
+  out->second_order_sufficient = definite;
+  if (definite) return;
+  const int b = borderSize();
+  Eigen::MatrixXd K(n_ + b, n_ + b);
+  K.topLeftCorner(n_, n_) = band_.toDense();
+  K.topRightCorner(n_, b) = border_;
+  K.bottomLeftCorner(b, n_) = border_.transpose();
+  K.bottomRightCorner(b, b) = corner_;
+  const double scale = K.diagonal().cwiseAbs().mean();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+  out->least_curvature = eigen.eigenvalues()(0) / scale;
+  const Eigen::VectorXd v = eigen.eigenvectors().col(0).head(n_);
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (largest > 0) out->negative_curvature = v / largest;
+}
+
 }  // namespace
+
+std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
+                                                     const FreeTimeOutcome& outcome, double size) {
+  if (outcome.negative_curvature.size() == 0) return {};
+  PlanningProblem at = problem;
+  at.duration = outcome.duration;
+  ReducedProblem np(at);
+  np.setCurrent(outcome.steps);
+  if (np.unknowns() != outcome.negative_curvature.size()) return {};
+  return np.attitudes(np.retract(outcome.negative_curvature, size));
+}
 
 std::string freeTimeUnsupported(const PlanningProblem& problem) {
   if (problem.scheme == SchemeKind::FourthOrder) {

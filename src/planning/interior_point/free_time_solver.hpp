@@ -35,6 +35,19 @@ struct FreeTimeOutcome {
   double effort_weight = 0.0;               ///< ε of T + ε C at the end (→ 0 with the barrier)
   Maneuver maneuver;                        ///< the plan at the end (N + 1 nodes on t = k h)
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
+  /// Converged only: the second-order check at the KKT point. The condensed Hessian of the last
+  /// barrier problem, W + Σ (zᵢ/cᵢ) gᵢgᵢᵀ over (δ, η) (W the Lagrangian's), factors without a
+  /// shift (positive definite): at μ → 0 the barrier terms of the active bounds grow like zᵢ²/μ,
+  /// so this is the reduced Hessian on the tangent of the active constraints being positive
+  /// definite, the second-order sufficient condition (a strict local minimum). False: a saddle
+  /// (or a degenerate point) of the discrete minimum-time problem, not a local minimum.
+  bool second_order_sufficient = false;
+  /// Where second_order_sufficient is false: the eigenvector of that matrix's least eigenvalue
+  /// over δ (n entries, the reduced problem's unknowns), scaled to max |δ_j| = 1 rad; a
+  /// direction of negative curvature (displacedAlongNegativeCurvature).
+  Eigen::VectorXd negative_curvature;
+  /// That least eigenvalue relative to the matrix's mean |diagonal| (0 where sufficient).
+  double least_curvature = 0.0;
 };
 
 /// Why `problem` cannot be solved free-time here (empty: it can): fourth_order has no single
@@ -56,6 +69,13 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 /// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
 /// Cancelled or TimedOut when `options` (may be null) asks: its cancel flag and time budget are
 /// polled every iteration.
+/// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
+/// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a
+/// saddle, one free-time solve from it descends into a basin on either side. Empty where the
+/// outcome has no such direction.
+std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
+                                                     const FreeTimeOutcome& outcome, double size);
+
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               const SolverOptions* options = nullptr);

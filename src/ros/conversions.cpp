@@ -130,6 +130,7 @@ MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& c) {
   msg.time_stationarity = c.time_stationarity;
   msg.complementarity = c.complementarity;
   msg.solves = c.solves;
+  msg.second_order_sufficient = c.second_order_sufficient;
   return msg;
 }
 

@@ -260,6 +260,8 @@ TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTh
   EXPECT_EQ(res.minimum_time.time_stationarity, out.result.minimum_time.time_stationarity);
   EXPECT_EQ(res.minimum_time.complementarity, out.result.minimum_time.complementarity);
   EXPECT_EQ(res.minimum_time.solves, out.result.minimum_time.solves);
+  EXPECT_EQ(res.minimum_time.second_order_sufficient,
+            out.result.minimum_time.second_order_sufficient);
   EXPECT_GT(res.minimum_duration, 0.0);
 }
 

@@ -13,8 +13,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <regex>

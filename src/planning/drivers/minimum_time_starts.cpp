@@ -60,6 +60,16 @@ FreeTimeStart geodesicStart(const PlanningProblem& problem) {
   return start;
 }
 
+/// An excursion start's parameters as data (Attempt::start_detail).
+void describeExcursion(const Vector3& eigenaxis, const Vector3& axis, double size,
+                       FreeTimeStart* start) {
+  StartDetail& detail = start->detail;
+  detail.duration = start->duration;
+  detail.eigenaxis = eigenaxis;
+  detail.excursion_axis = axis;
+  detail.excursion = size;
+}
+
 }  // namespace
 
 double smallestAuthority(const PlanningProblem& problem) {
@@ -199,6 +209,7 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
       starts.push_back({name.str(), AttemptStart::Excursion,
                         excursionSlew(at, axis, kFreeTimeExcursion).attitude,
                         kFreeTimeStartFactor * T_eigenaxis});
+      describeExcursion(e, axis, kFreeTimeExcursion, &starts.back());
     }
     return starts;
   }
@@ -215,11 +226,7 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
       starts.push_back({name.str(), AttemptStart::Excursion,
                         skewedExcursionSlew(at, axis, kFreeTimeConeExcursion, peak).attitude,
                         kFreeTimeStartFactor * T_eigenaxis});
-      StartDetail& detail = starts.back().detail;
-      detail.duration = starts.back().duration;
-      detail.eigenaxis = e;
-      detail.excursion_axis = axis;
-      detail.excursion = size;
+      describeExcursion(e, axis, kFreeTimeConeExcursion, &starts.back());
     }
   }
   return starts;

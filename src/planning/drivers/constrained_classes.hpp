@@ -1,8 +1,9 @@
 // The cheapest homotopy class under constraints: a constrained request that leaves its class free
 // (classLeftFree) is first solved from the unconstrained optimum's class (the class survey's
-// cheapest). The classes the survey solved are then solved under the constraints on the survey
-// grid, and the cheapest there, if it is not the first, is solved on the requested grid too; the
-// better plan is kept. (A class's unconstrained cost is no bound on what its constrained solve
+// cheapest). Where that ends without a plan (infeasible or unconverged: a verdict about one class
+// only), the classes the survey solved are solved under the constraints on the survey grid, and
+// the cheapest there, if it is not the first, is solved on the requested grid too; the better
+// plan is kept. (A class's unconstrained cost is no bound on what its constrained solve
 // reaches: a class is a lift of the rotation, and lifts two turns apart are one homotopy class on
 // SO(3), whose loops are Z₂, so the interior point can slide from one to the other.)
 #pragma once
@@ -16,13 +17,13 @@ namespace attitude_planner {
 /// differs by more than this are told apart by it before their cost.
 constexpr double kBetweenNodesSlack = 1e-3;
 
-/// The better of `first` (the constrained solve from the unconstrained optimum's class, on the
-/// requested grid) and the cheapest other class under the constraints: every class `survey` (the
-/// unconstrained solve's structured extremal) solved is solved under the constraints on its
-/// survey grid (the requested grid if that is no finer), and the cheapest there carried to the
-/// requested grid by a solve in its class. The result's extremal lists each class tried (stage
-/// constrained_class) after the survey's attempts; its attempts append each solve's trail.
-/// `first` is returned as it is when the survey solved no other class.
+/// `first` (the constrained solve from the unconstrained optimum's class, on the requested grid)
+/// if it converged; else the better of it and the cheapest other class under the constraints: every
+/// class `survey` (the unconstrained solve's structured extremal) solved is solved under the
+/// constraints on its survey grid (the requested grid if that is no finer), and the cheapest there
+/// carried to the requested grid by a solve in its class. The result's extremal lists each class
+/// tried (stage constrained_class) after the survey's attempts; its attempts append each solve's
+/// trail. `first` is returned as it is when the survey solved no other class.
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
                                     const ExtremalSummary& survey, PlanResult first);
 

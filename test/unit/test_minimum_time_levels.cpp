@@ -218,8 +218,8 @@ bool isProbe(const ap::Attempt& a) {
 
 TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPoint) {
   // Whatever the structured starts reach, the answer is a KKT point of the discrete minimum-time
-  // problem at or below the search's T on the same problem (the search forced by a zero
-  // disturbance torque).
+  // problem at or below the search's T on the same problem (the search called directly,
+  // test/support/searched_minimum_time.hpp).
   const ap::PlanningProblem p = searchAnswersCase();
   const ap::PlanResult r = ap::planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;

@@ -131,23 +131,31 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
   for (const ap::Vector3& t : r.maneuver.torque)
     saturated += t.cwiseAbs().maxCoeff() >= 50 * (1 - 1e-3);
   EXPECT_GE(saturated, static_cast<int>(r.maneuver.torque.size()) - 4);
-  // The switching function σ_k (PMP, from the bounds' multipliers): τ_k = sat(σ_k) at every node
-  // (KKT: a multiplier only where its bound is active, and on its side), and σ is smooth where τ
-  // jumps (its second differences small against its range).
+  // The switching function of minimum time σ_k = (z⁺ − z⁻)/(a w_k) (PMP, from the free-time
+  // solve's bound multipliers): τ_k = +a where σ_k > 0 and −a where σ_k < 0 (complementarity:
+  // a multiplier only where its bound is active, and on its side), and σ is smooth where τ jumps
+  // (its second differences small against its range: the costate crosses zero at a switch).
   ASSERT_EQ(r.switching_function.size(), r.maneuver.torque.size());
   double largest = 0.0;
   for (const ap::Vector3& s : r.switching_function)
     largest = std::max(largest, s.cwiseAbs().maxCoeff());
+  ASSERT_GT(largest, 0.0);
+  int signed_nodes = 0;
   for (std::size_t k = 0; k < r.maneuver.torque.size(); ++k) {
-    const ap::Vector3 saturated_sigma = r.switching_function[k].cwiseMax(-50.0).cwiseMin(50.0);
-    EXPECT_LE((r.maneuver.torque[k] - saturated_sigma).cwiseAbs().maxCoeff(), 1e-5 * 50)
-        << k;  // barrier: z = μ/s
+    for (int a = 0; a < 3; ++a) {
+      const double sigma = r.switching_function[k](a);
+      if (std::abs(sigma) < 1e-6 * largest) continue;  // a switch node: σ crosses zero here
+      ++signed_nodes;
+      EXPECT_NEAR(r.maneuver.torque[k](a), std::copysign(50.0, sigma), 1e-5 * 50)
+          << "k = " << k << ", axis " << a;
+    }
     if (k > 0 && k + 1 < r.maneuver.torque.size()) {
       const ap::Vector3 second =
           r.switching_function[k + 1] - 2.0 * r.switching_function[k] + r.switching_function[k - 1];
       EXPECT_LE(second.cwiseAbs().maxCoeff(), 0.05 * largest) << k;
     }
   }
+  EXPECT_GE(signed_nodes, 3 * static_cast<int>(r.maneuver.torque.size()) - 12);
 }
 
 TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {

@@ -240,8 +240,7 @@ TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPo
 TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBeforeIt) {
   // The trail keeps every stage in the order it ran: the structured starts' free-time solves
   // (none gave the answer: at least one did not converge, none is kept), the search's starts,
-  // then the one free-time solve from the search's plan (kept, started at the search's T) and its
-  // polish.
+  // then the one free-time solve from the search's plan (kept, started at the search's T), last.
   const ap::PlanResult r = ap::planManeuver(searchAnswersCase());
   ASSERT_TRUE(r.converged()) << r.message;
   const std::vector<ap::Attempt>& trail = r.attempts;
@@ -263,9 +262,7 @@ TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBefor
   EXPECT_EQ(from_search.start, ap::AttemptStart::PreviousAttempt);
   EXPECT_TRUE(from_search.kept);
   EXPECT_GE(from_search.start_detail.duration, r.minimum_duration);
-  EXPECT_TRUE(std::all_of(last_probe + 1, trail.end(), [](const ap::Attempt& a) {
-    return a.stage == ap::AttemptStage::MinimumTimePolish;
-  }));
+  EXPECT_EQ(last_probe + 1, trail.end()) << "the solve from the search's plan is the last";
   EXPECT_EQ(std::count_if(trail.begin(), trail.end(), [](const ap::Attempt& a) { return a.kept; }),
             1);
 }

@@ -8,9 +8,10 @@
 // the eigenaxis bang–bang slew at its closed-form T and excursions off it about the body axes'
 // parts perpendicular to the eigenaxis and their diagonals (body-fixed: the same in every world
 // frame); otherwise the geodesic. Above N = 64 the starts run on N = 64 and the best is refined
-// by 2 at a time up to N (each level from the coarser answer's rates interpolated in time). The
-// least T is kept and polished (the minimum-effort plan at T* from it, for the switching
-// functions). With cones each start is first made to clear them (a minimum-effort plan under
+// by 2 at a time up to N (each level from the coarser answer's rates interpolated in time). Each
+// start's solve is stopped where it can no longer end below the least T so far, or where it
+// joins an earlier start's central path. The least T is kept; its free-time plan is the answer
+// (the switching functions from its bound multipliers). With cones each start is first made to clear them (a minimum-effort plan under
 // the cones tightened by 0.01 rad). T* is a KKT point of the discrete minimum-time problem, its
 // residuals in PlanResult::minimum_time; with effects too (their time t_k = k h moves with h).
 // fourth_order is not written in h yet: for it (or if no free-time solve converges) the former

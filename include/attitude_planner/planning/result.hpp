@@ -36,8 +36,11 @@ enum class AttemptStage {
   MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
   MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
   MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
-  MinimumTimePolish,  ///< minimum_time: the minimum-effort plan at T* from the free-time plan
-  ConstrainedClass,   ///< under constraints, a class left free: another class's whole solve
+  /// minimum_time: a minimum-effort solve at T* from the free-time plan. No longer run (the
+  /// free-time plan is the answer); the value stays, as readers of "minimum_time_polish" may
+  /// know it.
+  MinimumTimePolish,
+  ConstrainedClass,  ///< under constraints, a class left free: another class's whole solve
 };
 inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::Solve, "solve"},
@@ -281,7 +284,9 @@ struct PlanResult {
   /// σ_k = τ_k + (z⁺_k − z⁻_k)/(a w_k) per axis [N m], k = 0..N (z± the multipliers of the upper
   /// and lower bound, a the bound, w_k the cost weight): the minimizer of the Lagrangian in τ_k
   /// without the bound, so τ_k = sat(σ_k) at a KKT point, and a bang–bang plan switches where σ_k
-  /// changes sign. Empty otherwise.
+  /// changes sign. A minimum-time answer (free-time solve) carries minimum time's own:
+  /// σ_k = (z⁺_k − z⁻_k)/(a w_k) (dimensionless, the multipliers of T/T₀), τ_k = ±a where σ_k ≷ 0,
+  /// crossing zero at a switch. Empty otherwise.
   std::vector<Vector3> switching_function;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -39,6 +40,18 @@ constexpr int kMaxSaddleEscapes = 3;
 /// whose least curvature is at round-off, left either way, ends at the same T to 1e-9; followed
 /// on, it cost 8 solves for nothing.
 constexpr double kSameSaddle = 1e-6;
+/// Two solves whose solved barrier problems at the same μ have attitudes within this (max entry
+/// of R_k − R'_k) are on one central path (sameCentralPath).
+constexpr double kSamePath = 1e-3;
+
+/// The largest entry of R_k − R'_k over two lists of attitudes of one length.
+double largestDifference(const std::vector<Matrix3>& a, const std::vector<Matrix3>& b) {
+  double largest = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    largest = std::max(largest, (a[k] - b[k]).cwiseAbs().maxCoeff());
+  }
+  return largest;
+}
 
 /// One start of the free-time solves: its attitudes as solved (cleared of the cones), T, name,
 /// the outcome, and the earlier start it repeats (its outcome taken; −1: none).
@@ -48,6 +61,7 @@ struct StartRecord {
   std::string name;
   FreeTimeOutcome outcome;
   int same_as = -1;
+  std::vector<BarrierPoint> path;  ///< its solve's solved barrier problems (sameCentralPath)
 };
 
 /// What one free-time grid level hands the next: its outcome (plan, T, steps).
@@ -76,9 +90,8 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
 /// Minimum time as one interior-point problem per start (free_time_solver.hpp): each start one
 /// free-time solve, the least T kept; the starts run on the coarsest level of the free-time grid
 /// continuation (freeTimeGridRule) and the best is resumed through the finer levels, each solved
-/// once from the coarser answer prolonged (its rates interpolated). The answer is then polished:
-/// the minimum-effort plan at T* from the free-time plan (its multipliers give the switching
-/// functions). Empty if no solve converged (the caller falls back to the search).
+/// once from the coarser answer prolonged (its rates interpolated). The answer is the kept
+/// free-time plan (answerAt). Empty if no solve converged (the caller falls back to the search).
 class FreeTimeMinimumTime {
  public:
   FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
@@ -101,11 +114,11 @@ class FreeTimeMinimumTime {
     if (best < 0) return std::nullopt;
     const StartRecord& kept = starts_[best];
     levels_ = levelResult(coarsest.steps, kept.outcome).levels;
-    if (levels.size() == 1) return polished(kept.outcome, kept.name);
+    if (levels.size() == 1) return answerAt(kept.outcome, kept.name);
     std::optional<FreeTimeOutcome> refined = refine(levels, kept.outcome);
     if (!refined) return std::nullopt;
     best_attempt_ = trail_.size() - 1;  // the refined solve is the one returned
-    return polished(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
+    return answerAt(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
                                   kept.name + "), refined by 2 at a time");
   }
 
@@ -113,7 +126,7 @@ class FreeTimeMinimumTime {
   const std::vector<Attempt>& trail() const { return trail_; }
 
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
-  /// duration, e.g. the search's): the polished KKT point if it converged at or below that T.
+  /// duration, e.g. the search's): its KKT point if it converged at or below that T.
   std::optional<PlanResult> runFrom(const Maneuver& plan, double duration,
                                     const std::string& name) {
     StartDetail detail;
@@ -124,17 +137,18 @@ class FreeTimeMinimumTime {
     if (o.termination != Termination::Converged || o.duration > duration) return std::nullopt;
     best_attempt_ = trail_.size() - 1;
     levels_ = levelResult(problem_.steps, o).levels;
-    return polished(o, name);
+    return answerAt(o, name);
   }
 
  private:
   /// One free-time solve from `start` (N + 1 attitudes, clear of the cones) at T = duration,
   /// recorded in the trail with its start's parameters.
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
-                        double duration, AttemptStart kind, const StartDetail& detail) {
+                        double duration, AttemptStart kind, const StartDetail& detail,
+                        const BarrierWatch& watch = {}) {
     const SolverOptions remaining = context_.remainingOptions();
-    FreeTimeOutcome o =
-        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, &remaining);
+    FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
+                                      kFreeTimeMaxIterations, &remaining, watch);
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;
@@ -172,11 +186,7 @@ class FreeTimeMinimumTime {
           earlier.attitudes.size() != start.size()) {
         continue;
       }
-      double difference = 0.0;
-      for (std::size_t k = 0; k < start.size(); ++k) {
-        difference = std::max(difference, (start[k] - earlier.attitudes[k]).cwiseAbs().maxCoeff());
-      }
-      if (difference <= kSameStart) return static_cast<int>(j);
+      if (largestDifference(start, earlier.attitudes) <= kSameStart) return static_cast<int>(j);
     }
     return -1;
   }
@@ -198,9 +208,11 @@ class FreeTimeMinimumTime {
       const int same = sameStartAs(start, st.duration);
       StartDetail detail = st.detail;
       detail.cleared_of_cones = start != st.attitudes;
-      FreeTimeOutcome outcome =
-          same >= 0 ? starts_[same].outcome : solve(grid, start, st.duration, st.kind, detail);
-      recordStart(start, st.duration, st.name, std::move(outcome), same);
+      if (same >= 0) {
+        recordStart(start, st.duration, st.name, starts_[same].outcome, same);
+        continue;
+      }
+      solveWatched(grid, start, st.duration, st.kind, detail, st.name, best);
       keepIfLeast(&best);
     }
     return best;
@@ -214,6 +226,66 @@ class FreeTimeMinimumTime {
       *best = static_cast<int>(starts_.size()) - 1;
       best_attempt_ = trail_.size() - 1;
     }
+  }
+
+  /// One start's free-time solve on `grid`, watched (BarrierWatch): stopped where it can no
+  /// longer end below the least T so far (`best`'s; its lower bound above it at a locally convex
+  /// barrier point, where the bound holds), or where it joins
+  /// the central path of an earlier start on the grid (sameCentralPath: that start's end is its
+  /// end, taken as its outcome). Recorded as a start.
+  void solveWatched(const PlanningProblem& grid, const std::vector<Matrix3>& start, double duration,
+                    AttemptStart kind, const StartDetail& detail, const std::string& name,
+                    int best) {
+    const double least =
+        best < 0 ? std::numeric_limits<double>::infinity() : starts_[best].outcome.duration;
+    std::vector<BarrierPoint> path;
+    int joined = -1;
+    const BarrierWatch watch = [&](const BarrierPoint& point) -> std::string {
+      std::ostringstream why;
+      if (point.locally_convex && point.lower_bound > least) {
+        why << "stopped at T = " << point.duration << " s: it can no longer end below " << least
+            << " s, the least T so far (its T less the duality gap at mu = " << point.mu << ": "
+            << point.lower_bound << " s)";
+        return why.str();
+      }
+      joined = sameCentralPath(point);
+      if (joined >= 0) {
+        why << "stopped at T = " << point.duration << " s: on the central path of the start "
+            << starts_[joined].name << " (the same barrier problem's point, mu = " << point.mu
+            << ")";
+        return why.str();
+      }
+      path.push_back(point);
+      return "";
+    };
+    FreeTimeOutcome o = solve(grid, start, duration, kind, detail, watch);
+    if (joined >= 0) {
+      recordStart(start, duration, name, starts_[joined].outcome, joined);
+    } else {
+      recordStart(start, duration, name, std::move(o), -1);
+    }
+    starts_.back().path = std::move(path);
+  }
+
+  /// The earlier start whose solve passed through `point` (the same μ, every attitude within
+  /// kSamePath), or −1: one barrier problem's local solution is one point of one central path,
+  /// so the two solves go on to the same end.
+  int sameCentralPath(const BarrierPoint& point) const {
+    int closest = -1;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < starts_.size(); ++j) {
+      // A path that ended without a KKT point is not followed to its end by joining it.
+      if (starts_[j].outcome.termination != Termination::Converged) continue;
+      for (const BarrierPoint& q : starts_[j].path) {
+        if (q.mu != point.mu || q.attitudes.size() != point.attitudes.size()) continue;
+        const double difference = largestDifference(q.attitudes, point.attitudes);
+        if (difference < nearest) {
+          nearest = difference;
+          closest = static_cast<int>(j);
+        }
+      }
+    }
+    return nearest <= kSamePath ? closest : -1;
   }
 
   static bool hasCones(const PlanningProblem& p) {
@@ -301,11 +373,8 @@ class FreeTimeMinimumTime {
         }
         StartDetail detail;
         detail.duration = saddle.outcome.duration;
-        FreeTimeOutcome o =
-            solve(grid, start, saddle.outcome.duration, AttemptStart::PreviousAttempt, detail);
-        recordStart(start, saddle.outcome.duration,
-                    std::string(sign > 0 ? "+" : "-") + "off the saddle of " + saddle.name,
-                    std::move(o), -1);
+        solveWatched(grid, start, saddle.outcome.duration, AttemptStart::PreviousAttempt, detail,
+                     std::string(sign > 0 ? "+" : "-") + "off the saddle of " + saddle.name, best);
         keepIfLeast(&best);
         const FreeTimeOutcome& got = starts_.back().outcome;
         if (got.termination == Termination::Converged &&
@@ -349,7 +418,7 @@ class FreeTimeMinimumTime {
       }
       return result;
     };
-    // The polish writes the message from the whole trail; the levels keep their own.
+    // answerAt writes the message from the whole trail; the levels keep their own.
     const ContinuationFinish finish = [](const ContinuationRecord&, PlanResult*) {};
     const SolvedLevel<FreeTimeCarry> from{0, Termination::Converged, {coarsest}, {}, false};
     const PlanResult result = resumeGridContinuation(levels, from, context_, freeTimeGridRule(),
@@ -359,35 +428,17 @@ class FreeTimeMinimumTime {
     return finest;
   }
 
-  /// The plan at T*: the minimum-effort plan at T* from the free-time plan if that proves T*
-  /// feasible (provesFeasible), else the free-time plan itself evaluated at T* by the same solve.
-  PlanResult polished(const FreeTimeOutcome& answer, const std::string& from) {
-    PlanningProblem effort = problem_;
-    effort.objective = Objective::MinimumEffort;
-    effort.time_margin = 0.0;
-    effort.duration = answer.duration;
-    SolverOptions o = context_.remainingOptions();
-    o.warm_start = &answer.maneuver;
-    o.constrained_from_warm_start = true;
-    PlanResult result = planAtResolution(effort, o);
-    const std::vector<Attempt> polish_attempts = result.attempts;
-    const bool feasible = provesFeasible(effort, result);
-    // A polish that stops short of optimality with a plan meeting every constraint still gives
-    // the plan at T* (provesFeasible).
-    if (feasible) result.termination = Termination::Converged;
-    std::string polish_note;
-    if (!feasible) {
-      // At T* the feasible set is (nearly) the one bang–bang plan: the polish can stop short
-      // (measured at N ≥ 512); the free-time plan itself is the answer then.
-      polish_note = "; its minimum-effort polish at T* did not converge (" + result.message +
-                    "): the plan is the free-time solve's";
-      result = freeTimePlan(effort, answer);
-    }
-    for (Attempt a : polish_attempts) {
-      a.stage = AttemptStage::MinimumTimePolish;
-      a.kept = false;
-      trail_.push_back(a);
-    }
+  /// The answer: the free-time plan at T* itself, measured as every plan is (freeTimePlan), its
+  /// switching functions from the solve's own bound multipliers. No minimum-effort solve at T*
+  /// follows: at T* the feasible set is that one plan to the tolerance, so such a solve is
+  /// degenerate and ends where it starts (measured: 40–150 interior-point iterations at N = 128
+  /// for the same plan, more than every start together around a cone).
+  PlanResult answerAt(const FreeTimeOutcome& answer, const std::string& from) {
+    PlanningProblem at = problem_;
+    at.objective = Objective::MinimumEffort;
+    at.time_margin = 0.0;
+    at.duration = answer.duration;
+    PlanResult result = freeTimePlan(at, answer);
     if (!trail_.empty()) trail_[best_attempt_].kept = true;
     std::ostringstream note;
     note << "minimum time T* = " << answer.duration
@@ -409,8 +460,8 @@ class FreeTimeMinimumTime {
       }
     }
     note << " " << solves_ << " free-time solves)";
-    note << polish_note;
-    result.message = note.str();
+    // A replay that failed (freeTimePlan) says so after the answer's account.
+    result.message = note.str() + (result.message.empty() ? "" : "; " + result.message);
     result.minimum_duration = answer.duration;
     result.minimum_time.kkt_point = true;
     result.minimum_time.stationarity = answer.stationarity;
@@ -419,8 +470,7 @@ class FreeTimeMinimumTime {
     result.minimum_time.solves = solves_;
     result.minimum_time.second_order_sufficient = answer.second_order_sufficient;
     result.attempts = trail_;
-    // The free-time levels first, then the polish's own.
-    result.levels.insert(result.levels.begin(), levels_.begin(), levels_.end());
+    result.levels = levels_;
     return result;
   }
 
@@ -431,6 +481,7 @@ class FreeTimeMinimumTime {
     r.solver = "interior_point";
     r.termination = Termination::Converged;
     r.iterations = answer.iterations;
+    r.switching_function = answer.switching_function;
     evaluatePlan(effort, answer.maneuver.torque, &r, &answer.maneuver);
     try {
       replayFigures(effort, &r);

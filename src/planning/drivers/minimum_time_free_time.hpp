@@ -1,8 +1,7 @@
 // Minimum time as one free-time interior-point problem per start (drivers/minimum_time.cpp's
 // answer where it applies): the structured starts (minimum_time_starts.hpp) solved on the
 // coarsest level of the free-time grid continuation, the least T kept and carried through the
-// finer levels (strategies/grid_continuation.hpp), and its plan polished by a minimum-effort solve
-// at T*. T* is a KKT point of the discrete minimum-time problem
+// finer levels (strategies/grid_continuation.hpp); its free-time plan is the answer. T* is a KKT point of the discrete minimum-time problem
 // (interior_point/free_time_solver.hpp).
 #pragma once
 
@@ -36,7 +35,7 @@ GridLevelRule freeTimeGridRule();
 /// (pushedOutOfCones), as a free-time start must clear them strictly.
 std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse);
 
-/// The minimum-time plan from the free-time solves: the polished plan at T* (minimum_time.kkt_point
+/// The minimum-time plan from the free-time solves: the kept plan at T* (minimum_time.kkt_point
 /// true, the KKT residuals in minimum_time, every solve in attempts, the free-time levels first in
 /// levels), or empty if no start converged or a refined level did not (the caller falls back to
 /// the search; `tried`, if given, then receives the free-time solves that ran, for its trail).
@@ -45,7 +44,7 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
                                               std::vector<Attempt>* tried = nullptr);
 
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
-/// `duration` (the search's answer where the structured starts did not converge): the polished
+/// `duration` (the search's answer where the structured starts did not converge): its
 /// KKT point if it converged at or below `duration`, else empty (`tried`, if given, then receives
 /// its solve, for the caller's trail).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,

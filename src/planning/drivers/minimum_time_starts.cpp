@@ -25,13 +25,12 @@ constexpr double kFreeTimeStartFactor = 0.96;
 constexpr double kSmallestProjection = 0.3;
 /// Two excursion axes closer than this (cosine) are one start.
 constexpr double kSameAxis = 0.99;
-/// With cones the excursions' bumps peak at these s = t/T (sin²(π s^a), a = ln ½ / ln peak):
-/// skewed in time. A symmetric start meets the time-symmetric KKT points (saddles on
-/// second_order, poorer local minima on paper), a skewed one the passage of the cone that is not
-/// symmetric. Measured on scenes/min_time_keep_out.yaml, 0.8 rad excursions: peaks 0.4 and 0.6
-/// each reach 28.7743 s on second_order N = 64 (0.5: 29.0078), 29.7113 s and 29.2354 s on paper
-/// N = 32 and 64 (0.5: 29.7404, 29.2470, above the search's 29.7113, 29.2354), 29.2371 s on
-/// variational N = 64 (0.5: 29.4732); both together doubled the starts for no lower T, so one.
+/// With cones the excursions' bumps peak at these s = t/T (skewedExcursionSlew): skewed in time.
+/// A symmetric start meets the time-symmetric KKT points (saddles on second_order, poorer local
+/// minima on paper), a skewed one the passage of the cone that is not symmetric. Measured on
+/// scenes/min_time_keep_out.yaml, 0.8 rad excursions, paper: 29.7113 s at N = 32 and 29.2354 s at
+/// N = 64 with peak 0.4, 29.7404 s and 29.2470 s with 0.5 (above the search's 29.7113, 29.2354);
+/// second_order reaches the same T* either way (its symmetric saddle is left, leaveSaddles).
 constexpr double kConeExcursionPeaks[] = {0.4};
 
 std::string axisName(const Vector3& v) {
@@ -96,11 +95,14 @@ double eigenaxisDurationGuess(const PlanningProblem& problem) {
 
 namespace {
 
-/// excursionSlew with the bump sin²(π s^a) peaking at s = `peak` (a = ln ½ / ln
-/// peak; ½: a = 1).
+/// excursionSlew with the bump sin²(π φ(s)) peaking at s = `peak`: φ(s) = s + c s(1 − s), c =
+/// (½ − peak)/(peak (1 − peak)), a smooth monotone warp of time (|c| < 1) with φ(peak) = ½. Its
+/// slope at the ends is finite (1 ± c), so the start's end torques are of the bump's size: the
+/// former warp s^a (a = ln ½ / ln peak) had an infinite slope at s = 0 and the starts' first
+/// torques 7–14× their bounds (every skewed start then began elastic).
 Maneuver skewedExcursionSlew(const PlanningProblem& problem, const Vector3& excursion_axis,
                              double excursion, double peak) {
-  const double skew = std::log(0.5) / std::log(peak);
+  const double warp = (0.5 - peak) / (peak * (1 - peak));
   const Vector3 rotation = so3::log(problem.initial_attitude.transpose() * problem.final_attitude);
   const double angle = rotation.norm();
   const Vector3 axis = angle > 0 ? Vector3(rotation / angle) : Vector3::UnitX();
@@ -110,7 +112,7 @@ Maneuver skewedExcursionSlew(const PlanningProblem& problem, const Vector3& excu
   for (int k = 0; k <= N; ++k) {
     const double s = static_cast<double>(k) / N;
     const double theta = s <= 0.5 ? 2.0 * angle * s * s : angle * (1.0 - 2.0 * (1 - s) * (1 - s));
-    const double bump = excursion * std::pow(std::sin(M_PI * std::pow(s, skew)), 2);
+    const double bump = excursion * std::pow(std::sin(M_PI * (s + warp * s * (1 - s))), 2);
     m.time.push_back(s * problem.duration);
     m.attitude.push_back(problem.initial_attitude * so3::exp(theta * axis) *
                          so3::exp(bump * excursion_axis));

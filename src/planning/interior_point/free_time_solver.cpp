@@ -144,7 +144,8 @@ class FreeTimeSolver {
            " times the start's duration";
   }
 
-  FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options);
+  FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options,
+                      const BarrierWatch& watch);
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
   void disallowElastic() { allow_elastic_ = false; }
@@ -155,7 +156,14 @@ class FreeTimeSolver {
     for (const FreeTimeGroup& g : groups_) m += static_cast<int>(g.at.size());
     return m;
   }
-  double torqueScale(int k) const { return std::sqrt(np_.scheme().torqueWeight(k, N_)); }
+  double torqueScale(int k) const { return std::sqrt(torqueWeight(k)); }
+  double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
+  /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
+  bool hasTorqueBox() const {
+    return std::any_of(groups_.begin(), groups_.end(), [](const FreeTimeGroup& g) {
+      return g.constraint->quantity() == StageQuantity::Torque && g.constraint->axis() >= 0;
+    });
+  }
 
   /// Calls f(group, k, c) for every instance's value c at `steps` (torques and, with cones, the
   /// attitudes formed once).
@@ -262,6 +270,12 @@ class FreeTimeSolver {
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
   double dualityGap() const;
+  double localLowerBound(double gap, double epsilon) const;
+  /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
+  bool barrierHessianDefinite() const;
+  /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
+  std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
+                      int iterations) const;
   void initializeDuals(double mu);
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
@@ -659,8 +673,29 @@ double FreeTimeSolver::dualityGap() const {
   return gap;
 }
 
+/// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
+/// duality gap Σ zc below the iterate's value (weak duality of the barrier problem's Lagrangian,
+/// local), and εC, which vanishes with μ, at most its own size: T − T₀ (Σ zc + εC) [s].
+double FreeTimeSolver::localLowerBound(double gap, double epsilon) const {
+  const double T0 = N_ * h0_;
+  return N_ * np_.timeStep() - T0 * (gap + epsilon * np_.cost(np_.current()));
+}
+
+std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double gap,
+                                    double epsilon, int iterations) const {
+  if (!watch || elastic_) return "";
+  BarrierPoint point;
+  point.mu = mu;
+  point.duration = N_ * np_.timeStep();
+  point.lower_bound = localLowerBound(gap, epsilon);
+  point.attitudes = np_.attitudes(np_.current());
+  point.iterations = iterations;
+  point.locally_convex = barrierHessianDefinite();
+  return watch(point);
+}
+
 FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
-                                    const SolverOptions* options) {
+                                    const SolverOptions* options, const BarrierWatch& watch) {
   const auto started = std::chrono::steady_clock::now();
   const int m = constraintCount();
   const double mu0 = kInitialBarrier / m;
@@ -685,6 +720,12 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
       return out;
     }
     if (mu > mu_final && barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu) {
+      const std::string stop = watched(watch, mu, gap, epsilon, iterations);
+      if (!stop.empty()) {
+        FreeTimeOutcome out = outcome(Termination::NotConverged, stop, iterations, epsilon);
+        out.stopped_by_watch = true;
+        return out;
+      }
       if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
       mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
                                        std::pow(mu, parameters_.free_time_theta_mu)));
@@ -734,6 +775,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.smallest_value = std::numeric_limits<double>::infinity();
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
   const std::vector<Vector3> tau = np_.torques(out.steps);
+  if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
   for (const FreeTimeGroup& g : groups_) {
     const int a = g.constraint->axis();
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
@@ -742,7 +784,11 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
       out.smallest_value = std::min(out.smallest_value, in.c);
       // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
       if (g.constraint->quantity() == StageQuantity::Torque && a >= 0) {
-        out.torque_multipliers[k](a) -= std::copysign(in.z, g.constraint->gradient(tau[k])(a));
+        const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
+        out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
+        if (!out.switching_function.empty()) {
+          out.switching_function[k](a) -= in.z * slope / torqueWeight(k);
+        }
       }
     }
   }
@@ -759,10 +805,14 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
 /// factored without a shift (FreeTimeOutcome::second_order_sufficient). Where it is not positive
 /// definite, its least eigenpair from the dense matrix (n ≤ a few hundred at the start grid; this
 /// runs once per converged solve, and only there).
-void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
+bool FreeTimeSolver::barrierHessianDefinite() const {
   BorderedBanded factor;
-  const bool definite = factor.factor(band_, border_, corner_) &&
-                        factor.inertia().positive == borderSize() && factor.inertia().negative == 0;
+  return factor.factor(band_, border_, corner_) && factor.inertia().positive == borderSize() &&
+         factor.inertia().negative == 0;
+}
+
+void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
+  const bool definite = barrierHessianDefinite();
   out->second_order_sufficient = definite;
   if (definite) return;
   const int b = borderSize();
@@ -801,7 +851,7 @@ std::string freeTimeUnsupported(const PlanningProblem& problem) {
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              const SolverOptions* options) {
+                              const SolverOptions* options, const BarrierWatch& watch) {
   PlanningProblem at = problem;
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -823,7 +873,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     failed.message = solver.startInside();
     if (!failed.message.empty()) return failed;
-    FreeTimeOutcome out = solver.run(tolerance, max_iterations, options);
+    FreeTimeOutcome out = solver.run(tolerance, max_iterations, options, watch);
     if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
     // The elastic start did not reach a KKT point: the start raised inside instead.
     np.setTimeStep(start_h);
@@ -832,7 +882,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     raised.disallowElastic();
     failed.message = raised.startInside();
     if (!failed.message.empty()) return out;
-    FreeTimeOutcome second = raised.run(tolerance, max_iterations, options);
+    FreeTimeOutcome second = raised.run(tolerance, max_iterations, options, watch);
     second.iterations += out.iterations;
     return second;
   } catch (const StepTooLarge& e) {

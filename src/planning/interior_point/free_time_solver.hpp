@@ -4,6 +4,7 @@
 // free_time_solver.cpp derives the method).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,11 @@ struct FreeTimeOutcome {
   double effort_weight = 0.0;               ///< ε of T + ε C at the end (→ 0 with the barrier)
   Maneuver maneuver;                        ///< the plan at the end (N + 1 nodes on t = k h)
   std::vector<Vector3> torque_multipliers;  ///< z⁺ − z⁻ per node and axis (box bounds)
+  /// σ_k = (z⁺ − z⁻)/(a w_k) per axis (box bounds; empty without): minus the τ_k-gradient of
+  /// Σ zc per unit weight, the discrete PMP switching function of minimum time (the costate's
+  /// projection): τ_k = +a where σ_k > 0, −a where σ_k < 0 (complementarity), crossing zero at
+  /// a switch (PlanResult::switching_function).
+  std::vector<Vector3> switching_function;
   /// Converged only: the second-order check at the KKT point. The condensed Hessian of the last
   /// barrier problem, W + Σ (zᵢ/cᵢ) gᵢgᵢᵀ over (δ, η) (W the Lagrangian's), factors without a
   /// shift (positive definite): at μ → 0 the barrier terms of the active bounds grow like zᵢ²/μ,
@@ -48,12 +54,43 @@ struct FreeTimeOutcome {
   Eigen::VectorXd negative_curvature;
   /// That least eigenvalue relative to the matrix's mean |diagonal| (0 where sufficient).
   double least_curvature = 0.0;
+  /// NotConverged because the caller's BarrierWatch stopped it at a solved barrier problem (the
+  /// message says why).
+  bool stopped_by_watch = false;
 };
+
+/// A solved barrier problem of a free-time solve: its point on the central path at μ.
+struct BarrierPoint {
+  double mu = 0.0;
+  double duration = 0.0;  ///< T [s] of the iterate
+  /// T − T₀ (Σ zc + εC) [s]: what the solve can still reach, locally (the local minimum of
+  /// T/T₀ + εC lies at most the duality gap below the iterate's value on the central path).
+  double lower_bound = 0.0;
+  std::vector<Matrix3> attitudes;  ///< R_0 … R_N of the iterate
+  int iterations = 0;
+  /// The condensed barrier Hessian over (δ, η) factors without a shift at the iterate: a strict
+  /// local minimum of this barrier problem, where lower_bound holds locally. (Where it does not,
+  /// the solve may still slide to a lower point: measured on Bilimoria–Wie N = 32, a bound of
+  /// 3.27871 s at μ = 2.7e-6, then 68 iterations at that μ, the end 3.27774 s.)
+  bool locally_convex = false;
+};
+
+/// Called at every solved barrier problem of a feasible free-time solve (not while elastic);
+/// a non-empty answer stops the solve there, NotConverged with that message and
+/// FreeTimeOutcome::stopped_by_watch.
+using BarrierWatch = std::function<std::string(const BarrierPoint&)>;
 
 /// Why `problem` cannot be solved free-time here (empty: it can): fourth_order has no single
 /// transcription (minimum_time.cpp falls back to the search). Effects are written in h (their
 /// time t_k = k h moves with h: ReducedProblem::forEachStencilWithTimeStep).
 std::string freeTimeUnsupported(const PlanningProblem& problem);
+
+/// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
+/// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a
+/// saddle, one free-time solve from it descends into a basin on either side. Empty where the
+/// outcome has no such direction.
+std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
+                                                     const FreeTimeOutcome& outcome, double size);
 
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
 /// R_N the problem's) at T = start_duration, raised until every torque constraint holds strictly
@@ -68,16 +105,10 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 /// (complementarity within `tolerance`, stationarity within it × max(1, (N/256)²): round-off),
 /// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
 /// Cancelled or TimedOut when `options` (may be null) asks: its cancel flag and time budget are
-/// polled every iteration.
-/// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
-/// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a
-/// saddle, one free-time solve from it descends into a basin on either side. Empty where the
-/// outcome has no such direction.
-std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
-                                                     const FreeTimeOutcome& outcome, double size);
-
+/// polled every iteration, and NotConverged (stopped_by_watch) where `watch` stops it.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              const SolverOptions* options = nullptr);
+                              const SolverOptions* options = nullptr,
+                              const BarrierWatch& watch = {});
 
 }  // namespace attitude_planner

@@ -797,6 +797,11 @@ TEST(FreeTime, SecondOrderCheckAgreesWithTheReducedHessianByFiniteDifferences) {
     if (!start) continue;
     const ap::FreeTimeOutcome o = ap::solveFreeTime(p, *start, st.duration, 1e-9, 500);
     if (!check(o, st.name) || o.second_order_sufficient) continue;
+    // The saddle's least eigenpair (from banded factorizations: a bisection on positive
+    // definiteness, then inverse iteration): a negative value, a direction scaled to max 1.
+    EXPECT_LT(o.least_curvature, 0.0) << st.name;
+    ASSERT_EQ(o.negative_curvature.size(), p.steps * 3 - 3) << st.name;
+    EXPECT_DOUBLE_EQ(o.negative_curvature.cwiseAbs().maxCoeff(), 1.0) << st.name;
     double lowest = o.duration;
     for (const double size : {0.05, -0.05}) {
       std::vector<ap::Matrix3> off = ap::displacedAlongNegativeCurvature(p, o, size);

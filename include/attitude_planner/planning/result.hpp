@@ -119,6 +119,19 @@ inline HomotopyClass homotopyClassOf(const PlanningProblem& problem) {
   return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
 }
 
+/// Whether a and b are one class: the same way round and the same extra turns.
+inline bool sameHomotopyClass(const HomotopyClass& a, const HomotopyClass& b) {
+  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
+}
+
+/// `problem` asking for class `homotopy` (its direction and extra revolutions; the inverse of
+/// homotopyClassOf).
+inline PlanningProblem pinnedToClass(PlanningProblem problem, const HomotopyClass& homotopy) {
+  problem.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
+  problem.extra_revolutions = homotopy.extra_revolutions;
+  return problem;
+}
+
 /// The parameters of an attempt's start, structured (JSON `attempts[i].start_detail`, PlanAttempt's
 /// `start_detail`): what the message's start name ("excursion 0.3 rad about [0, 0.707, 0.707]",
 /// "coarse grid (N = 64, ...)") is rendered from. Filled by minimum time's free-time solves and

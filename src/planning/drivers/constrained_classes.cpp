@@ -15,14 +15,9 @@ namespace attitude_planner {
 
 namespace {
 
-bool sameClassAs(const HomotopyClass& a, const HomotopyClass& b) {
-  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
-}
-
+/// `problem` in class `homotopy` on `steps` steps.
 PlanningProblem pinnedTo(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps) {
-  PlanningProblem out = problem;
-  out.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
-  out.extra_revolutions = homotopy.extra_revolutions;
+  PlanningProblem out = pinnedToClass(problem, homotopy);
   out.steps = steps;
   return out;
 }
@@ -42,7 +37,7 @@ SurveyedClasses surveyedClasses(const ExtremalSummary& survey, const HomotopyCla
     if (a.termination != Termination::Converged) continue;
     const bool listed =
         std::any_of(out.classes.begin(), out.classes.end(),
-                    [&](const HomotopyClass& c) { return sameClassAs(c, a.homotopy); });
+                    [&](const HomotopyClass& c) { return sameHomotopyClass(c, a.homotopy); });
     if (!listed) out.classes.push_back(a.homotopy);
   }
   return out;
@@ -181,7 +176,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   PlanResult cheapest_plan;
   for (const HomotopyClass& c : surveyed.classes) {
     if (search.stopped()) break;
-    if (on_requested_grid && sameClassAs(c, first_class)) continue;  // `first` is that solve
+    if (on_requested_grid && sameHomotopyClass(c, first_class)) continue;  // `first` is that solve
     PlanResult r = search.solve(c, on_requested_grid ? problem.steps : surveyed.steps);
     if (on_requested_grid) {
       search.offer(std::move(r));
@@ -191,7 +186,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
     }
   }
   const bool refine = !on_requested_grid && cheapest && cheapest_plan.converged() &&
-                      !sameClassAs(*cheapest, first_class) && !search.stopped();
+                      !sameHomotopyClass(*cheapest, first_class) && !search.stopped();
   if (refine) search.offer(search.solve(*cheapest, problem.steps));
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);

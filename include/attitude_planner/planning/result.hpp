@@ -148,6 +148,10 @@ struct StartDetail {
   /// (R(t) = R_0 exp(θ(s) ê) exp(ε sin²(πs) p̂), minimum_time_starts.hpp); zero: none.
   Vector3 excursion_axis = Vector3::Zero();
   double excursion = 0.0;
+  /// Excursion: the fraction s = t/T where its bump peaks (sin²(π s^a), a = ln ½ / ln peak):
+  /// ½ for the symmetric ones, 0.4 for those skewed in time around cones; ½ also where there is
+  /// no excursion.
+  double excursion_peak = 0.5;
   /// The start was replaced by the minimum-effort plan under the cones from it (a free-time start
   /// must clear its cones strictly: coneClearStart).
   bool cleared_of_cones = false;

@@ -220,6 +220,19 @@ TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasible
   const double least = leastClassCost(p);
   ASSERT_TRUE(std::isfinite(least));
   EXPECT_LE(r.cost, least * (1 + 1e-6)) << r.extremal;
+  // Each class's constrained solve starts from the class survey's plan of it on its grid: its
+  // unconstrained Newton attempt polishes that plan (started from that earlier attempt) instead
+  // of solving the class through the grids again. Here the survey has every class on N = 16 and
+  // the two nearest refined on N = 64.
+  int from_survey = 0;
+  for (const Attempt& a : r.attempts) {
+    if (a.stage != AttemptStage::ConstrainedClass || a.formulation != Formulation::Unconstrained) {
+      continue;
+    }
+    ++from_survey;
+    EXPECT_EQ(a.start, AttemptStart::PreviousAttempt) << a.steps << ": " << r.message;
+  }
+  EXPECT_GE(from_survey, 4) << r.message;
   ASSERT_TRUE(r.extremal_summary.known);
   SolverOptions nearest_only;
   nearest_only.enumerate_classes = false;

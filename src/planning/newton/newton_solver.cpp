@@ -162,6 +162,13 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
   return s;
 }
 
+/// A converged surveyed class's plan on the survey grid (on a coarser one only its iterate is
+/// kept).
+Maneuver surveyedPlan(const Surveyed& s, const PlanningProblem& survey_grid) {
+  if (s.on_requested_grid) return s.result.maneuver;
+  return ReducedProblem(pinnedToClass(survey_grid, s.homotopy)).maneuver(s.steps);
+}
+
 /// A surveyed class carried from the survey grid through the finer levels to the requested one:
 /// the grid continuation resumed from the survey grid's iterate. A finer level that does not
 /// converge ends it with no plan (a fresh start there would be another attempt); stopped
@@ -302,9 +309,10 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
 
 /// Surveys every distinct class, then refines the request's own and those whose survey cost is
 /// within class_refine_margin of the cheapest. A stop (cancel, deadline) carries the class being
-/// surveyed to the requested grid and ends the enumeration.
+/// surveyed to the requested grid and ends the enumeration. `plans` (optional) receives each
+/// converged survey's and refinement's plan.
 void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
-                      const NewtonParameters& p) {
+                      const NewtonParameters& p, std::vector<ClassPlan>* plans) {
   const SolverOptions& options = context.options();
   const GridSettings settings{options.tolerance, options.max_iterations,
                               Globalization::TrustRegion};
@@ -320,6 +328,7 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     Surveyed s = surveyClass(c, plan, context, settings, p);
     walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, pinnedToClass(survey_grid, c)),
               s.result, s.result.iterations);
+    if (plans && s.result.converged()) plans->push_back({c, surveyedPlan(s, survey_grid)});
     surveyed.push_back(std::move(s));
     // A class at zero cost (the zero maneuver) cannot be beaten: costs are sums of squares.
     const bool unbeatable = surveyed.back().result.converged() && surveyed.back().result.cost == 0;
@@ -357,6 +366,9 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),
               refined, s.result.iterations + refined.iterations);
+    if (plans && refined.converged() && refined.maneuver.steps() == problem.steps) {
+      plans->push_back({s.homotopy, refined.maneuver});
+    }
   }
 }
 
@@ -635,11 +647,12 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
   return np.current();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context) {
+PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context,
+                           std::vector<ClassPlan>* survey_plans) {
   const NewtonParameters& p = newtonDefaults();
   const SolverOptions& options = context.options();
   Walk walk(problem, context, p);
-  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p);
+  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
   // The request's own class when it names one or is warm-started; after the class survey, when
   // no class converged on the requested grid and the request's class was not solved whole there.
   const bool converged = walk.kept() && walk.kept()->converged();
@@ -674,9 +687,10 @@ PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context
   return walk.finish();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options,
+                           std::vector<ClassPlan>* survey_plans) {
   SolveContext context(options);
-  return solveWithNewton(problem, context);
+  return solveWithNewton(problem, context, survey_plans);
 }
 
 }  // namespace attitude_planner

@@ -96,6 +96,7 @@ std::string startDetailJson(const Attempt& a) {
       << ", \"eigenaxis\": " << vectorJson(d.eigenaxis)
       << ", \"excursion_axis\": " << vectorJson(d.excursion_axis)
       << ", \"excursion\": " << jsonNumber(d.excursion)
+      << ", \"excursion_peak\": " << jsonNumber(d.excursion_peak)
       << ", \"cleared_of_cones\": " << (d.cleared_of_cones ? "true" : "false")
       << ", \"coarse_steps\": " << d.coarse_steps
       << ", \"origin\": " << jsonString(attemptStartName(originOf(a))) << "}";

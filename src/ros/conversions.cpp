@@ -120,6 +120,7 @@ PlanAttempt attemptToMsg(const Attempt& a) {
   msg.start_detail.cleared_of_cones = d.cleared_of_cones;
   msg.start_detail.coarse_steps = d.coarse_steps;
   msg.start_detail.origin = attemptStartName(originOf(a));
+  msg.start_detail.excursion_peak = d.excursion_peak;
   return msg;
 }
 

@@ -243,6 +243,7 @@ TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTh
     EXPECT_EQ(ms.excursion_axis.y, d.excursion_axis.y()) << i;
     EXPECT_EQ(ms.excursion_axis.z, d.excursion_axis.z()) << i;
     EXPECT_EQ(ms.excursion, d.excursion) << i;
+    EXPECT_EQ(ms.excursion_peak, d.excursion_peak) << i;
     EXPECT_EQ(ms.cleared_of_cones, d.cleared_of_cones) << i;
     EXPECT_EQ(ms.coarse_steps, d.coarse_steps) << i;
     EXPECT_EQ(ms.origin, attemptStartName(originOf(trail[i]))) << i;

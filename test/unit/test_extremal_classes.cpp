@@ -22,16 +22,6 @@ namespace {
 
 const HomotopyClass kClasses[] = {{false, 0}, {true, 0}, {false, 1}, {true, 1}};
 
-PlanningProblem inClass(PlanningProblem p, const HomotopyClass& c) {
-  p.direction = c.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
-  p.extra_revolutions = c.extra_revolutions;
-  return p;
-}
-
-bool sameClass(const HomotopyClass& a, const HomotopyClass& b) {
-  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
-}
-
 /// Uniform draws from a seeded 64-bit Mersenne twister (the same sequence on every platform).
 class Draw {
  public:
@@ -75,11 +65,11 @@ TEST(ExtremalClasses, ARequestThatNamesItsClassGetsExactlyThatClass) {
   Draw draw(30);
   const PlanningProblem base = spinningProblem(draw);
   for (const HomotopyClass& c : {kClasses[1], kClasses[2], kClasses[3]}) {
-    const PlanResult r = planManeuver(inClass(base, c));
+    const PlanResult r = planManeuver(pinnedToClass(base, c));
     ASSERT_TRUE(r.converged()) << r.message;
-    EXPECT_TRUE(sameClass(r.extremal_summary.homotopy, c)) << r.extremal;
+    EXPECT_TRUE(sameHomotopyClass(r.extremal_summary.homotopy, c)) << r.extremal;
     for (const Attempt& a : r.attempts) {
-      EXPECT_TRUE(sameClass(a.homotopy, c)) << attemptStageName(a.stage);
+      EXPECT_TRUE(sameHomotopyClass(a.homotopy, c)) << attemptStageName(a.stage);
       EXPECT_NE(a.stage, AttemptStage::ClassSurvey);
     }
   }
@@ -89,7 +79,7 @@ TEST(ExtremalClasses, ARequestThatNamesItsClassGetsExactlyThatClass) {
 TEST(ExtremalClasses, AWarmStartedRequestIsNotEnumerated) {
   Draw draw(31);
   const PlanningProblem p = spinningProblem(draw);
-  const PlanResult first = planManeuver(inClass(p, kClasses[1]));
+  const PlanResult first = planManeuver(pinnedToClass(p, kClasses[1]));
   ASSERT_TRUE(first.converged()) << first.message;
   SolverOptions warm;
   warm.warm_start = &first.maneuver;
@@ -115,7 +105,7 @@ TEST(ExtremalClasses, ASpinHandedOverBetweenAxesTakesTheCheapestClass) {
   nearest_only.enumerate_classes = false;
   std::vector<PlanResult> own;
   for (const HomotopyClass& c : kClasses) {
-    own.push_back(planManeuver(inClass(p, c), nearest_only));
+    own.push_back(planManeuver(pinnedToClass(p, c), nearest_only));
     ASSERT_TRUE(own.back().converged()) << own.back().message;
     ASSERT_EQ(own.back().attempts.size(), 1u);  // each class alone, no survey
   }
@@ -127,20 +117,20 @@ TEST(ExtremalClasses, ASpinHandedOverBetweenAxesTakesTheCheapestClass) {
   const PlanResult r = planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_LE(r.cost, cheapest->cost * (1 + 1e-9)) << r.extremal;
-  EXPECT_TRUE(sameClass(r.extremal_summary.homotopy, cheapest->extremal_summary.homotopy))
+  EXPECT_TRUE(sameHomotopyClass(r.extremal_summary.homotopy, cheapest->extremal_summary.homotopy))
       << r.extremal;
   // The trail lists every class surveyed with its (coarse) cost, and every refined class with
   // the cost of that class's own solve: the survey and refinement are its grid continuation.
   for (std::size_t i = 0; i < own.size(); ++i) {
     const HomotopyClass& c = kClasses[i];
     const auto surveyed = std::find_if(r.attempts.begin(), r.attempts.end(), [&](auto& a) {
-      return a.stage == AttemptStage::ClassSurvey && sameClass(a.homotopy, c);
+      return a.stage == AttemptStage::ClassSurvey && sameHomotopyClass(a.homotopy, c);
     });
     ASSERT_NE(surveyed, r.attempts.end()) << i;
     EXPECT_TRUE(std::isfinite(surveyed->cost)) << i;
     EXPECT_LT(surveyed->steps, p.steps) << i;
     const auto refined = std::find_if(r.attempts.begin(), r.attempts.end(), [&](auto& a) {
-      return a.stage == AttemptStage::ClassRefine && sameClass(a.homotopy, c);
+      return a.stage == AttemptStage::ClassRefine && sameHomotopyClass(a.homotopy, c);
     });
     if (refined != r.attempts.end()) EXPECT_NEAR(refined->cost, own[i].cost, 1e-9 * own[i].cost);
   }
@@ -163,7 +153,7 @@ TEST(ExtremalClasses, TheDefaultIsNoCostlierThanAnyClassOnSeededSpinningProblems
     ASSERT_TRUE(r.converged()) << i << ": " << r.message;
     double least = std::numeric_limits<double>::infinity();
     for (const HomotopyClass& c : kClasses) {
-      const PlanResult own = planManeuver(inClass(p, c), nearest_only);
+      const PlanResult own = planManeuver(pinnedToClass(p, c), nearest_only);
       if (own.converged()) least = std::min(least, own.cost);
     }
     if (!std::isfinite(least)) continue;
@@ -202,7 +192,7 @@ double leastClassCost(const PlanningProblem& p) {
   nearest_only.enumerate_classes = false;
   double least = std::numeric_limits<double>::infinity();
   for (const HomotopyClass& c : kClasses) {
-    const PlanResult own = planManeuver(inClass(p, c), nearest_only);
+    const PlanResult own = planManeuver(pinnedToClass(p, c), nearest_only);
     if (own.converged() && own.max_violation_between_nodes <= 1e-3) {
       least = std::min(least, own.cost);
     }
@@ -230,10 +220,23 @@ TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasible
   const double least = leastClassCost(p);
   ASSERT_TRUE(std::isfinite(least));
   EXPECT_LE(r.cost, least * (1 + 1e-6)) << r.extremal;
+  // Each class's constrained solve starts from the class survey's plan of it on its grid: its
+  // unconstrained Newton attempt polishes that plan (started from that earlier attempt) instead
+  // of solving the class through the grids again. Here the survey has every class on N = 16 and
+  // the two nearest refined on N = 64.
+  int from_survey = 0;
+  for (const Attempt& a : r.attempts) {
+    if (a.stage != AttemptStage::ConstrainedClass || a.formulation != Formulation::Unconstrained) {
+      continue;
+    }
+    ++from_survey;
+    EXPECT_EQ(a.start, AttemptStart::PreviousAttempt) << a.steps << ": " << r.message;
+  }
+  EXPECT_GE(from_survey, 4) << r.message;
   ASSERT_TRUE(r.extremal_summary.known);
   SolverOptions nearest_only;
   nearest_only.enumerate_classes = false;
-  const PlanResult own = planManeuver(inClass(p, r.extremal_summary.homotopy), nearest_only);
+  const PlanResult own = planManeuver(pinnedToClass(p, r.extremal_summary.homotopy), nearest_only);
   ASSERT_TRUE(own.converged()) << own.message;
   EXPECT_NEAR(r.cost, own.cost, 1e-8 * own.cost) << r.extremal;
 }
@@ -246,10 +249,11 @@ TEST(ExtremalClasses, AConstrainedRequestPinnedToItsClassIsNotEnumerated) {
   const PlanResult nearest = planManeuver(coneAcrossTheShortWay(), nearest_only);
   EXPECT_FALSE(triedConstrainedClasses(nearest));
   EXPECT_FALSE(nearest.converged());  // the cone sits on the nearest lift's unconstrained path
-  const PlanResult named = planManeuver(inClass(coneAcrossTheShortWay(), kClasses[3]));
+  const PlanResult named = planManeuver(pinnedToClass(coneAcrossTheShortWay(), kClasses[3]));
   EXPECT_FALSE(triedConstrainedClasses(named));
-  EXPECT_TRUE(std::all_of(named.attempts.begin(), named.attempts.end(),
-                          [](const Attempt& a) { return sameClass(a.homotopy, kClasses[3]); }));
+  EXPECT_TRUE(std::all_of(named.attempts.begin(), named.attempts.end(), [](const Attempt& a) {
+    return sameHomotopyClass(a.homotopy, kClasses[3]);
+  }));
 }
 
 // Seeded spinning problems under a torque-norm bound at 0.85× the peak of their unconstrained plan:

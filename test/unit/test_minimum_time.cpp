@@ -124,6 +124,7 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
   EXPECT_NEAR(detail.excursion_axis.norm(), 1.0, 1e-12);
   EXPECT_NEAR(detail.excursion_axis.dot(ap::Vector3::UnitX()), 0.0, 1e-12);
   EXPECT_DOUBLE_EQ(detail.excursion, 0.3);
+  EXPECT_DOUBLE_EQ(detail.excursion_peak, 0.5);  // no cone: its bump is symmetric in time
   EXPECT_GT(detail.duration, 0.0);
   EXPECT_EQ(ap::originOf(*kept), ap::AttemptStart::Excursion);
   // Bang–bang: at most nodes some torque component is at its bound.
@@ -185,6 +186,31 @@ TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {
   });
   ASSERT_NE(coarse, r.attempts.end()) << r.message;
   EXPECT_EQ(coarse->start_detail.excursion_axis, detail.excursion_axis);
+}
+
+TEST(MinimumTime, AroundAConeTheExcursionStartsCarryTheirSkewedPeak) {
+  // scenes/min_time_keep_out.yaml (N = 64): with a cone the excursions (0.8 rad, both signs of
+  // each axis) have their bumps skewed in time, peaking at s = 0.4 (minimum_time_starts.cpp).
+  // Each of those free-time solves carries it in start_detail.excursion_peak (the data, not the
+  // start's name); the eigenaxis start, which has no bump, keeps ½.
+  const ap::PlanningProblem p =
+      ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_keep_out.yaml").problem;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  int excursions = 0;
+  for (const ap::Attempt& a : r.attempts) {
+    if (a.stage != ap::AttemptStage::MinimumTimeSolve) continue;
+    if (ap::originOf(a) == ap::AttemptStart::Excursion) {
+      ++excursions;
+      EXPECT_DOUBLE_EQ(a.start_detail.excursion, 0.8);
+      EXPECT_DOUBLE_EQ(a.start_detail.excursion_peak, 0.4);
+      EXPECT_NEAR(a.start_detail.excursion_axis.norm(), 1.0, 1e-12);
+    } else if (a.start == ap::AttemptStart::EigenaxisSlew) {
+      EXPECT_DOUBLE_EQ(a.start_detail.excursion, 0.0);
+      EXPECT_DOUBLE_EQ(a.start_detail.excursion_peak, 0.5);
+    }
+  }
+  EXPECT_GE(excursions, 4) << r.message;  // body x and y off the eigenaxis (z), both signs
 }
 
 TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {

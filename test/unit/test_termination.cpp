@@ -151,6 +151,7 @@ TEST(Report, JsonSummaryCarriesEachAttemptsStartDetail) {
   excursion.start_detail.eigenaxis = Vector3::UnitX();
   excursion.start_detail.excursion_axis = Vector3(0, 1, 1).normalized();
   excursion.start_detail.excursion = 0.3;
+  excursion.start_detail.excursion_peak = 0.4;  // skewed in time (around cones)
   Attempt refined = excursion;
   refined.start = AttemptStart::CoarseLevel;
   refined.start_detail.coarse_steps = 64;
@@ -167,14 +168,16 @@ TEST(Report, JsonSummaryCarriesEachAttemptsStartDetail) {
   const std::string detail = "\"start_detail\": {\"duration\": " + exactNumber(d.duration) +
                              ", \"eigenaxis\": [1, 0, 0], \"excursion_axis\": " + axis +
                              ", \"excursion\": " + exactNumber(d.excursion) +
+                             ", \"excursion_peak\": " + exactNumber(d.excursion_peak) +
                              ", \"cleared_of_cones\": false, \"coarse_steps\": ";
   EXPECT_TRUE(contains(json, detail + "0, \"origin\": \"excursion\"}")) << json;
   EXPECT_TRUE(contains(json, "\"start\": \"coarse_level\"")) << json;
   EXPECT_TRUE(contains(json, detail + "64, \"origin\": \"excursion\"}")) << json;
-  EXPECT_TRUE(contains(json,
-                       "\"start_detail\": {\"duration\": null, \"eigenaxis\": [0, 0, 0], "
-                       "\"excursion_axis\": [0, 0, 0], \"excursion\": 0, \"cleared_of_cones\": "
-                       "false, \"coarse_steps\": 0, \"origin\": \"hermite\"}"))
+  EXPECT_TRUE(
+      contains(json,
+               "\"start_detail\": {\"duration\": null, \"eigenaxis\": [0, 0, 0], "
+               "\"excursion_axis\": [0, 0, 0], \"excursion\": 0, \"excursion_peak\": 0.5, "
+               "\"cleared_of_cones\": false, \"coarse_steps\": 0, \"origin\": \"hermite\"}"))
       << json;
 }
 

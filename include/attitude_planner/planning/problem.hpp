@@ -212,6 +212,11 @@ struct SolverOptions {
   /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
   /// is far closer to the next one than the unconstrained optimum is).
   bool constrained_from_warm_start = false;
+  /// With node constraints and no warm start: the request's unconstrained optimum, already
+  /// solved on its grid in its class (the class survey's plan, drivers/constrained_classes.cpp).
+  /// Newton polishes it (an iteration or two) instead of solving the class again through the
+  /// grids, and it starts the interior point as that solve would. Null, or another N: none.
+  const Maneuver* unconstrained_optimum = nullptr;
   /// A request that leaves its homotopy class free (direction shortest, no extra revolutions, no
   /// warm start) is solved in every class of the class survey and the cheapest plan kept
   /// (newton_solver.cpp); false: in the nearest lift's class only, as a named class is.

@@ -122,6 +122,19 @@ inline HomotopyClass homotopyClassOf(const PlanningProblem& problem) {
   return {problem.direction == RotationDirection::LongWay, problem.extra_revolutions};
 }
 
+/// Whether a and b are one class: the same way round and the same extra turns.
+inline bool sameHomotopyClass(const HomotopyClass& a, const HomotopyClass& b) {
+  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
+}
+
+/// `problem` asking for class `homotopy` (its direction and extra revolutions; the inverse of
+/// homotopyClassOf).
+inline PlanningProblem pinnedToClass(PlanningProblem problem, const HomotopyClass& homotopy) {
+  problem.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
+  problem.extra_revolutions = homotopy.extra_revolutions;
+  return problem;
+}
+
 /// The parameters of an attempt's start, structured (JSON `attempts[i].start_detail`, PlanAttempt's
 /// `start_detail`): what the message's start name ("excursion 0.3 rad about [0, 0.707, 0.707]",
 /// "coarse grid (N = 64, ...)") is rendered from. Filled by minimum time's free-time solves and
@@ -138,6 +151,10 @@ struct StartDetail {
   /// (R(t) = R_0 exp(θ(s) ê) exp(ε sin²(πs) p̂), minimum_time_starts.hpp); zero: none.
   Vector3 excursion_axis = Vector3::Zero();
   double excursion = 0.0;
+  /// Excursion: the fraction s = t/T where its bump peaks (sin²(π s^a), a = ln ½ / ln peak):
+  /// ½ for the symmetric ones, 0.4 for those skewed in time around cones; ½ also where there is
+  /// no excursion.
+  double excursion_peak = 0.5;
   /// The start was replaced by the minimum-effort plan under the cones from it (a free-time start
   /// must clear its cones strictly: coneClearStart).
   bool cleared_of_cones = false;

@@ -15,14 +15,9 @@ namespace attitude_planner {
 
 namespace {
 
-bool sameClassAs(const HomotopyClass& a, const HomotopyClass& b) {
-  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
-}
-
+/// `problem` in class `homotopy` on `steps` steps.
 PlanningProblem pinnedTo(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps) {
-  PlanningProblem out = problem;
-  out.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
-  out.extra_revolutions = homotopy.extra_revolutions;
+  PlanningProblem out = pinnedToClass(problem, homotopy);
   out.steps = steps;
   return out;
 }
@@ -42,7 +37,7 @@ SurveyedClasses surveyedClasses(const ExtremalSummary& survey, const HomotopyCla
     if (a.termination != Termination::Converged) continue;
     const bool listed =
         std::any_of(out.classes.begin(), out.classes.end(),
-                    [&](const HomotopyClass& c) { return sameClassAs(c, a.homotopy); });
+                    [&](const HomotopyClass& c) { return sameHomotopyClass(c, a.homotopy); });
     if (!listed) out.classes.push_back(a.homotopy);
   }
   return out;
@@ -79,9 +74,11 @@ Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int ste
 /// The classes' solves and the trail they leave.
 class ClassSearch {
  public:
-  ClassSearch(const PlanningProblem& problem, const SolverOptions& options, PlanResult first)
+  ClassSearch(const PlanningProblem& problem, const SolverOptions& options,
+              const std::vector<ClassPlan>& survey_plans, PlanResult first)
       : problem_(problem),
         options_(options),
+        survey_plans_(survey_plans),
         trail_(first.attempts),
         first_iterations_(first.iterations),
         best_(std::move(first)) {
@@ -90,14 +87,20 @@ class ClassSearch {
             trail_.begin();
   }
 
-  /// One solve of `homotopy` on `steps` steps, its trail appended (first-stage attempts marked
-  /// constrained_class, none kept). A grid with no boundary step at its h gives no plan.
+  /// One solve of `homotopy` on `steps` steps, from the survey's plan of it on that grid if there
+  /// is one, its trail appended (first-stage attempts marked constrained_class, none kept). A grid
+  /// with no boundary step at its h gives no plan.
   PlanResult solve(const HomotopyClass& homotopy, int steps) {
     PlanResult r;
     r.termination = Termination::NotConverged;
+    SolverOptions options = withRemainingBudget(options_, start_);
+    const auto surveyed =
+        std::find_if(survey_plans_.begin(), survey_plans_.end(), [&](const ClassPlan& c) {
+          return sameHomotopyClass(c.homotopy, homotopy) && c.plan.steps() == steps;
+        });
+    options.unconstrained_optimum = surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
     try {
-      r = planAtResolution(pinnedTo(problem_, homotopy, steps),
-                           withRemainingBudget(options_, start_));
+      r = planAtResolution(pinnedTo(problem_, homotopy, steps), options);
     } catch (const StepTooLarge& e) {
       r.message = e.what();
     }
@@ -151,6 +154,7 @@ class ClassSearch {
 
   const PlanningProblem& problem_;
   SolverOptions options_;
+  const std::vector<ClassPlan>& survey_plans_;
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::vector<Attempt> trail_;
   std::vector<Attempt> tried_;
@@ -165,7 +169,8 @@ class ClassSearch {
 }  // namespace
 
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
-                                    const ExtremalSummary& survey, PlanResult first) {
+                                    const ExtremalSummary& survey,
+                                    const std::vector<ClassPlan>& survey_plans, PlanResult first) {
   // A class that converged answers: solving the others costs more than the whole request on
   // a constrained scene (measured, min_time_keep_out.yaml at N = 128 and 1.05 T*: 9 → 69 ms, the
   // other classes infeasible on the survey grid after hundreds of iterations) for a cheaper plan
@@ -175,13 +180,13 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
   if (surveyed.classes.size() < 2) return first;
   const std::string first_message = first.message;
-  ClassSearch search(problem, options, std::move(first));
+  ClassSearch search(problem, options, survey_plans, std::move(first));
   const bool on_requested_grid = surveyed.steps >= problem.steps;
   std::optional<HomotopyClass> cheapest;  // on the survey grid
   PlanResult cheapest_plan;
   for (const HomotopyClass& c : surveyed.classes) {
     if (search.stopped()) break;
-    if (on_requested_grid && sameClassAs(c, first_class)) continue;  // `first` is that solve
+    if (on_requested_grid && sameHomotopyClass(c, first_class)) continue;  // `first` is that solve
     PlanResult r = search.solve(c, on_requested_grid ? problem.steps : surveyed.steps);
     if (on_requested_grid) {
       search.offer(std::move(r));
@@ -191,7 +196,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
     }
   }
   const bool refine = !on_requested_grid && cheapest && cheapest_plan.converged() &&
-                      !sameClassAs(*cheapest, first_class) && !search.stopped();
+                      !sameHomotopyClass(*cheapest, first_class) && !search.stopped();
   if (refine) search.offer(search.solve(*cheapest, problem.steps));
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);

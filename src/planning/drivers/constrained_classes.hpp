@@ -8,8 +8,11 @@
 // SO(3), whose loops are Z₂, so the interior point can slide from one to the other.)
 #pragma once
 
+#include <vector>
+
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/newton/newton_solver.hpp"
 
 namespace attitude_planner {
 
@@ -23,8 +26,11 @@ constexpr double kBetweenNodesSlack = 1e-3;
 /// constraints on its survey grid (the requested grid if that is no finer), and the cheapest there
 /// carried to the requested grid by a solve in its class. The result's extremal lists each class
 /// tried (stage constrained_class) after the survey's attempts; its attempts append each solve's
-/// trail. `first` is returned as it is when the survey solved no other class.
+/// trail. `first` is returned as it is when the survey solved no other class. A class with a plan
+/// in `survey_plans` (solveWithNewton's) on the grid of its solve starts from it: its
+/// unconstrained Newton solve is not run again (SolverOptions::unconstrained_optimum).
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
-                                    const ExtremalSummary& survey, PlanResult first);
+                                    const ExtremalSummary& survey,
+                                    const std::vector<ClassPlan>& survey_plans, PlanResult first);
 
 }  // namespace attitude_planner

@@ -229,6 +229,7 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
                         skewedExcursionSlew(at, axis, kFreeTimeConeExcursion, peak).attitude,
                         kFreeTimeStartFactor * T_eigenaxis});
       describeExcursion(e, axis, kFreeTimeConeExcursion, &starts.back());
+      starts.back().detail.excursion_peak = peak;
     }
   }
   return starts;

@@ -158,10 +158,22 @@ std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<
 /// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
 /// it meets every node constraint it is the constrained optimum too; otherwise it starts the
 /// interior point, in its class, and a request that left its class free has the other classes
-/// solved under the constraints too (constrained_classes.hpp).
+/// solved under the constraints too (constrained_classes.hpp), each from its class survey's plan.
 PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOptions& options,
                                 std::chrono::steady_clock::time_point start) {
-  PlanResult result = solveWithNewton(problem, options);
+  // The unconstrained optimum, already solved (SolverOptions::unconstrained_optimum): polished
+  // from it, the Newton attempt named as started from that earlier attempt's plan.
+  SolverOptions newton_options = options;
+  const bool solved_before =
+      options.unconstrained_optimum && options.unconstrained_optimum->steps() == problem.steps;
+  if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
+  std::vector<ClassPlan> survey_plans;
+  PlanResult result = solveWithNewton(problem, newton_options, &survey_plans);
+  if (solved_before) {
+    for (Attempt& a : result.attempts) {
+      if (a.start == AttemptStart::WarmStart) a.start = AttemptStart::PreviousAttempt;
+    }
+  }
   const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
                                             ? checkConstraints(problem, result.maneuver)
                                             : ConstraintCheck{};
@@ -199,7 +211,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   }
   if (classLeftFree(problem, options)) {
     result = cheapestConstrainedClass(problem, withRemainingBudget(options, start), survey,
-                                      std::move(result));
+                                      survey_plans, std::move(result));
   }
   return result;
 }

@@ -66,17 +66,6 @@ PlanResult solveThroughGrids(const PlanningProblem& problem, SolveContext& conte
   return solveByGridContinuation(problem, context, newtonGridRule(p), settings.tolerance, level);
 }
 
-PlanningProblem inClass(const PlanningProblem& problem, const HomotopyClass& homotopy) {
-  PlanningProblem out = problem;
-  out.direction = homotopy.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
-  out.extra_revolutions = homotopy.extra_revolutions;
-  return out;
-}
-
-bool sameClass(const HomotopyClass& a, const HomotopyClass& b) {
-  return a.long_way == b.long_way && a.extra_revolutions == b.extra_revolutions;
-}
-
 // --- The class survey ----------------------------------------------------------------------------
 
 /// The classes a request that leaves its class free is solved in: the two lifts nearest the
@@ -102,7 +91,7 @@ std::vector<HomotopyClass> distinctClasses(const PlanningProblem& start_grid) {
   std::vector<HomotopyClass> out;
   std::vector<Vector3> lifts;
   for (const HomotopyClass& c : kEnumeratedClasses) {
-    const std::optional<Vector3> lift = liftOf(inClass(start_grid, c));
+    const std::optional<Vector3> lift = liftOf(pinnedToClass(start_grid, c));
     const bool repeated =
         lift && std::any_of(lifts.begin(), lifts.end(), [&](const Vector3& other) {
           return (other - *lift).norm() <= 1e-9 * (1.0 + lift->norm());
@@ -147,7 +136,7 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
                      const GridSettings& settings, const NewtonParameters& p) {
   Surveyed s;
   s.homotopy = homotopy;
-  const PlanningProblem at = inClass(plan.levels[plan.survey], homotopy);
+  const PlanningProblem at = pinnedToClass(plan.levels[plan.survey], homotopy);
   if (plan.survey + 1 == plan.levels.size()) {
     s.on_requested_grid = true;
     s.result = solveThroughGrids(at, context, settings, nullptr, p);
@@ -173,6 +162,13 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
   return s;
 }
 
+/// A converged surveyed class's plan on the survey grid (on a coarser one only its iterate is
+/// kept).
+Maneuver surveyedPlan(const Surveyed& s, const PlanningProblem& survey_grid) {
+  if (s.on_requested_grid) return s.result.maneuver;
+  return ReducedProblem(pinnedToClass(survey_grid, s.homotopy)).maneuver(s.steps);
+}
+
 /// A surveyed class carried from the survey grid through the finer levels to the requested one:
 /// the grid continuation resumed from the survey grid's iterate. A finer level that does not
 /// converge ends it with no plan (a fresh start there would be another attempt); stopped
@@ -180,7 +176,9 @@ Surveyed surveyClass(const HomotopyClass& homotopy, const SurveyPlan& plan, Solv
 PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& context,
                        const GridSettings& settings, const NewtonParameters& p) {
   std::vector<PlanningProblem> levels;
-  for (const PlanningProblem& level : plan.levels) levels.push_back(inClass(level, s.homotopy));
+  for (const PlanningProblem& level : plan.levels) {
+    levels.push_back(pinnedToClass(level, s.homotopy));
+  }
   GridLevelRule rule = newtonGridRule(p);
   rule.unconverged_ends = true;
   const LevelSolver<StepVectors> level = [&](const LevelRequest<StepVectors>& r,
@@ -256,8 +254,9 @@ class Walk {
   bool empty() const { return trail_.empty(); }
   /// Whether `homotopy` was solved on the requested grid (not counting the more starts).
   bool solvedOnRequestedGrid(const HomotopyClass& homotopy) const {
-    return std::any_of(solved_.begin(), solved_.end(),
-                       [&](const ClassSolve& c) { return sameClass(c.homotopy, homotopy); });
+    return std::any_of(solved_.begin(), solved_.end(), [&](const ClassSolve& c) {
+      return sameHomotopyClass(c.homotopy, homotopy);
+    });
   }
   /// The classes the more starts may search: the kept one, and the request's own when it was
   /// solved on the requested grid too and converged (its basins are not the kept class's).
@@ -265,10 +264,11 @@ class Walk {
     std::vector<ClassSolve> out;
     for (const HomotopyClass& c : {keptClass(), request}) {
       const auto found = std::find_if(solved_.begin(), solved_.end(), [&](const ClassSolve& s) {
-        return sameClass(s.homotopy, c) && s.converged;
+        return sameHomotopyClass(s.homotopy, c) && s.converged;
       });
-      const bool listed = std::any_of(
-          out.begin(), out.end(), [&](const ClassSolve& s) { return sameClass(s.homotopy, c); });
+      const bool listed = std::any_of(out.begin(), out.end(), [&](const ClassSolve& s) {
+        return sameHomotopyClass(s.homotopy, c);
+      });
       if (found != solved_.end() && !listed) out.push_back(*found);
     }
     return out;
@@ -277,7 +277,7 @@ class Walk {
   /// Whether an attempt in `homotopy` started from `start`.
   bool triedFrom(AttemptStart start, const HomotopyClass& homotopy) const {
     return std::any_of(trail_.begin(), trail_.end(), [&](const Attempt& a) {
-      return a.start == start && sameClass(a.homotopy, homotopy);
+      return a.start == start && sameHomotopyClass(a.homotopy, homotopy);
     });
   }
 
@@ -309,9 +309,10 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
 
 /// Surveys every distinct class, then refines the request's own and those whose survey cost is
 /// within class_refine_margin of the cheapest. A stop (cancel, deadline) carries the class being
-/// surveyed to the requested grid and ends the enumeration.
+/// surveyed to the requested grid and ends the enumeration. `plans` (optional) receives each
+/// converged survey's and refinement's plan.
 void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
-                      const NewtonParameters& p) {
+                      const NewtonParameters& p, std::vector<ClassPlan>* plans) {
   const SolverOptions& options = context.options();
   const GridSettings settings{options.tolerance, options.max_iterations,
                               Globalization::TrustRegion};
@@ -325,8 +326,9 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   for (const HomotopyClass& c : distinctClasses(plan.levels.front())) {
     if (!walk->empty() && context.stopReason()) break;
     Surveyed s = surveyClass(c, plan, context, settings, p);
-    walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, inClass(survey_grid, c)), s.result,
-              s.result.iterations);
+    walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, pinnedToClass(survey_grid, c)),
+              s.result, s.result.iterations);
+    if (plans && s.result.converged()) plans->push_back({c, surveyedPlan(s, survey_grid)});
     surveyed.push_back(std::move(s));
     // A class at zero cost (the zero maneuver) cannot be beaten: costs are sums of squares.
     const bool unbeatable = surveyed.back().result.converged() && surveyed.back().result.cost == 0;
@@ -334,9 +336,9 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     if (context.stopReason()) {
       if (!surveyed.back().on_requested_grid && !surveyed.back().steps.empty()) {
         const PlanResult carried = refineClass(surveyed.back(), plan, context, settings, p);
-        walk->add(
-            attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel, inClass(problem, c)),
-            carried, carried.iterations);
+        walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
+                            pinnedToClass(problem, c)),
+                  carried, carried.iterations);
       }
       return;
     }
@@ -352,7 +354,7 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     // The request's own class always (the answer is never costlier than its solve alone), the
     // others near the cheapest; a class whose survey met one already refined (the same extremal
     // from another start) would repeat it.
-    const bool wanted = sameClass(s.homotopy, homotopyClassOf(problem)) ||
+    const bool wanted = sameHomotopyClass(s.homotopy, homotopyClassOf(problem)) ||
                         s.result.cost <= cheapest * (1 + p.class_refine_margin);
     const bool repeated = std::any_of(refined_costs.begin(), refined_costs.end(), [&](double c) {
       return std::abs(s.result.cost - c) <= p.same_extremal_cost * c;
@@ -362,8 +364,11 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     refined_costs.push_back(s.result.cost);
     const PlanResult refined = refineClass(s, plan, context, settings, p);
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
-                        inClass(problem, s.homotopy)),
+                        pinnedToClass(problem, s.homotopy)),
               refined, s.result.iterations + refined.iterations);
+    if (plans && refined.converged() && refined.maneuver.steps() == problem.steps) {
+      plans->push_back({s.homotopy, refined.maneuver});
+    }
   }
 }
 
@@ -642,11 +647,12 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
   return np.current();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context) {
+PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context,
+                           std::vector<ClassPlan>* survey_plans) {
   const NewtonParameters& p = newtonDefaults();
   const SolverOptions& options = context.options();
   Walk walk(problem, context, p);
-  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p);
+  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
   // The request's own class when it names one or is warm-started; after the class survey, when
   // no class converged on the requested grid and the request's class was not solved whole there.
   const bool converged = walk.kept() && walk.kept()->converged();
@@ -669,21 +675,22 @@ PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context
   const HomotopyClass kept = walk.keptClass();
   for (const ClassSolve& searched : walk.searchedClasses(homotopyClassOf(problem))) {
     state.class_iterations = searched.iterations;
-    state.kept_class = sameClass(searched.homotopy, kept);
+    state.kept_class = sameHomotopyClass(searched.homotopy, kept);
     state.searched = searched.homotopy;
     for (const RecipeEntry& entry : kNewtonRecipe) {
       if (context.stopReason()) break;
       if (entry.stage == AttemptStage::MoreStarts && entry.when(state)) {
-        run(entry, inClass(problem, searched.homotopy));
+        run(entry, pinnedToClass(problem, searched.homotopy));
       }
     }
   }
   return walk.finish();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options) {
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options,
+                           std::vector<ClassPlan>* survey_plans) {
   SolveContext context(options);
-  return solveWithNewton(problem, context);
+  return solveWithNewton(problem, context, survey_plans);
 }
 
 }  // namespace attitude_planner

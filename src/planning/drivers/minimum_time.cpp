@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/drivers/fourth_order.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
@@ -43,12 +44,172 @@ std::vector<Attempt> joined(std::vector<Attempt> before, const std::vector<Attem
   return before;
 }
 
+/// fourth_order's minimum-time answer keeps its two second_order plans at T* (each meeting its
+/// bounds there): a plan at T ≥ T* starts each sub-solve from its own (fourthOrderFromPair).
+struct RichardsonPair {
+  Maneuver coarse;  ///< the second_order plan at T*, N steps
+  Maneuver fine;    ///< the second_order plan at T*, 2N steps
+};
+
+PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options,
+                           RichardsonPair* pair = nullptr);
+
+/// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
+/// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
+/// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
+/// strictly inside instead of from the unconstrained optimum.
+PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
+                                   const Maneuver& at_minimum_time, const SolverOptions& options) {
+  PlanningProblem effort = problem;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = T;
+  SolverOptions o = options;
+  o.warm_start = &at_minimum_time;
+  o.constrained_from_warm_start = true;
+  return planAtResolution(effort, o);
+}
+
+/// fourth_order at T ≥ T*: each second_order sub-solve from its own plan at T*
+/// (planFromMinimumTimePlan: time-scaled, inside the bounds), the two plans combined. (Through
+/// planFourthOrder the 2N solve starts cold: measured on Betts at N = 64 with time_margin 0.005,
+/// 0.02 and 0.1, it ended a false "infeasible" each time.)
+PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const RichardsonPair& pair,
+                               const SolverOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  PlanningProblem sub = problem;
+  sub.scheme = SchemeKind::SecondOrder;
+  const PlanResult coarse =
+      planFromMinimumTimePlan(sub, T, pair.coarse, withRemainingBudget(options, started));
+  PlanResult fine;
+  if (coarse.converged()) {
+    sub.steps = 2 * problem.steps;
+    fine = planFromMinimumTimePlan(sub, T, pair.fine, withRemainingBudget(options, started));
+  }
+  std::vector<Attempt> trail = coarse.attempts;
+  for (Attempt& a : trail) a.kept = false;
+  trail.insert(trail.end(), fine.attempts.begin(), fine.attempts.end());
+  const std::string what = "fourth_order (Richardson extrapolation of second_order at N = " +
+                           std::to_string(problem.steps) +
+                           " and 2N = " + std::to_string(2 * problem.steps) +
+                           ", each from its plan at T*)";
+  if (!coarse.converged() || !fine.converged()) {
+    PlanResult failed = coarse.converged() ? fine : coarse;
+    failed.message = what + ": the second_order solve at N = " +
+                     std::to_string(coarse.converged() ? 2 * problem.steps : problem.steps) +
+                     " did not converge (its plan is returned): " + failed.message;
+    failed.attempts = trail;
+    return failed;
+  }
+  PlanningProblem at = problem;
+  at.objective = Objective::MinimumEffort;
+  at.time_margin = 0.0;
+  at.duration = T;
+  PlanResult result = richardsonCombination(at, coarse, fine);
+  result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
+  result.attempts = trail;
+  return result;
+}
+
+/// A plan at T ≥ T* from the minimum-time answer (its plan, and for fourth_order its pair).
+PlanResult planFromMinimumTime(const PlanningProblem& problem, double T,
+                               const Maneuver& at_minimum_time, const RichardsonPair& pair,
+                               const SolverOptions& options) {
+  if (problem.scheme == SchemeKind::FourthOrder) {
+    return fourthOrderFromPair(problem, T, pair, options);
+  }
+  return planFromMinimumTimePlan(problem, T, at_minimum_time, options);
+}
+
+/// The attempts of `r`, none kept but its kept one if `keep`, each with `stage` where given.
+void appendTrail(const PlanResult& r, bool keep, std::optional<AttemptStage> stage,
+                 std::vector<Attempt>* trail) {
+  for (Attempt a : r.attempts) {
+    a.kept = a.kept && keep;
+    if (stage) a.stage = *stage;
+    trail->push_back(a);
+  }
+}
+
+/// fourth_order (docs/design/fourth_order.md, "Minimum time"): a fourth_order plan at T exists
+/// exactly when both second_order plans, at N and at 2N, do. So its minimum-time problem is
+/// min T s.t. both transcriptions are feasible at T: T* = max(T*_N, T*_2N), each the second_order
+/// minimum-time answer (minimumTimePlan: its starts, refinement, polish and fallback). Where the
+/// larger (the binding one) is a KKT point, so is the pair: the binding problem's multipliers,
+/// zero ones on the other's constraints, which its minimum-effort plan at T* (from its own plan
+/// at its T*, time-scaled: inside the bounds) meets. The plan is the two plans' Richardson
+/// combination (richardsonCombination, as every fourth_order plan).
+PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOptions& options,
+                                  RichardsonPair* pair) {
+  const auto started = std::chrono::steady_clock::now();
+  const int N = problem.steps;
+  PlanningProblem coarse_problem = problem;
+  coarse_problem.scheme = SchemeKind::SecondOrder;
+  coarse_problem.time_margin = 0.0;
+  PlanningProblem fine_problem = coarse_problem;
+  fine_problem.steps = 2 * N;
+  const std::string what =
+      "fourth_order minimum time (the second_order minimum-time problems at N = " +
+      std::to_string(N) + " and 2N = " + std::to_string(2 * N) + ")";
+  PlanResult fine = minimumTimePlan(fine_problem, withRemainingBudget(options, started));
+  const auto failed = [&](PlanResult sub, const std::string& which) {
+    sub.scheme = SchemeKind::FourthOrder;
+    sub.message = what + ": " + which + " did not converge (its plan is returned): " + sub.message;
+    return sub;
+  };
+  if (!fine.converged()) return failed(fine, "the one at 2N");
+  PlanResult coarse = minimumTimePlan(coarse_problem, withRemainingBudget(options, started));
+  if (!coarse.converged()) return failed(coarse, "the one at N");
+  const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
+  const PlanResult& binding = fine_binds ? fine : coarse;
+  PlanResult& other = fine_binds ? coarse : fine;
+  const double T_star = binding.minimum_duration;
+  const double T_other = other.minimum_duration;
+  const int solves = fine.minimum_time.solves + coarse.minimum_time.solves;
+  std::vector<Attempt> trail;
+  appendTrail(fine, fine_binds, std::nullopt, &trail);
+  appendTrail(coarse, !fine_binds, std::nullopt, &trail);
+  if (T_other < T_star) {
+    PlanResult at_T_star =
+        planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem, T_star, other.maneuver,
+                                withRemainingBudget(options, started));
+    appendTrail(at_T_star, false, AttemptStage::MinimumTimePolish, &trail);
+    if (!at_T_star.converged()) {
+      at_T_star.attempts = trail;
+      return failed(at_T_star,
+                    std::string("the minimum-effort plan at T* at ") + (fine_binds ? "N" : "2N"));
+    }
+    other = at_T_star;
+  }
+  PlanningProblem at = problem;
+  at.duration = T_star;
+  PlanResult result = richardsonCombination(at, coarse, fine);
+  if (pair) *pair = RichardsonPair{coarse.maneuver, fine.maneuver};
+  result.minimum_duration = T_star;
+  result.minimum_time = binding.minimum_time;
+  result.minimum_time.solves = solves;
+  result.attempts = trail;
+  std::ostringstream note;
+  note << what << ": T* = " << exactNumber(T_star) << " s, the one at "
+       << (fine_binds ? "2N = " : "N = ") << (fine_binds ? 2 * N : N)
+       << " binds (T* at N = " << exactNumber(fine_binds ? T_other : T_star)
+       << " s, at 2N = " << exactNumber(fine_binds ? T_star : T_other)
+       << " s); the plan combines its plan and the other's minimum-effort plan at T* | 2N: "
+       << fine.message << " | N: " << coarse.message;
+  result.message = note.str();
+  return result;
+}
+
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
 /// or if none of its solves converged, the search (searchMinimumTime, an upper bound) with what is
 /// left of the time budget; where the free-time problem applies, the search's plan starts one more
 /// free-time solve (a KKT point). The trail keeps every stage in order: the free-time solves that
 /// did not give the answer, the search's starts, the solve from the search's plan.
-PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options) {
+PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options,
+                           RichardsonPair* pair) {
+  if (problem.scheme == SchemeKind::FourthOrder) {
+    return fourthOrderMinimumTime(problem, options, pair);
+  }
   const auto started = std::chrono::steady_clock::now();
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
@@ -89,29 +250,14 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
   return *sharpened;
 }
 
-/// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
-/// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
-/// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
-/// strictly inside instead of from the unconstrained optimum.
-PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
-                                   const Maneuver& at_minimum_time, const SolverOptions& options) {
-  PlanningProblem effort = problem;
-  effort.objective = Objective::MinimumEffort;
-  effort.time_margin = 0.0;
-  effort.duration = T;
-  SolverOptions o = options;
-  o.warm_start = &at_minimum_time;
-  o.constrained_from_warm_start = true;
-  return planAtResolution(effort, o);
-}
-
 }  // namespace
 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateMinimumTime(problem);
   const auto start = std::chrono::steady_clock::now();
-  PlanResult result = minimumTimePlan(problem, options);
+  RichardsonPair pair;
+  PlanResult result = minimumTimePlan(problem, options, &pair);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
   if (problem.duration > 0 && T_star > problem.duration * (1.0 + kMinimumTimeTolerance)) {
@@ -126,8 +272,8 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   if (problem.time_margin > 0.0) {
     const std::vector<Attempt> search_trail = result.attempts;
     const Maneuver at_minimum_time = result.maneuver;
-    result = planFromMinimumTimePlan(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
-                                     withRemainingBudget(options, start));
+    result = planFromMinimumTime(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
+                                 pair, withRemainingBudget(options, start));
     std::vector<Attempt> attempts = search_trail;
     for (Attempt& a : attempts) a.kept = false;
     for (Attempt a : result.attempts) {
@@ -159,7 +305,9 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   fastest.objective = Objective::MinimumTime;
   fastest.time_margin = 0.0;
   fastest.duration = 0.0;
-  const PlanResult minimum_time = minimumTimePlan(fastest, withRemainingBudget(options, start));
+  RichardsonPair pair;
+  const PlanResult minimum_time =
+      minimumTimePlan(fastest, withRemainingBudget(options, start), &pair);
   const auto finish = [&](PlanResult r) {
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     r.solve_time_s =
@@ -181,8 +329,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
     result.message = why.str();
     return finish(result);
   }
-  PlanResult again = planFromMinimumTimePlan(problem, problem.duration, minimum_time.maneuver,
-                                             withRemainingBudget(options, start));
+  PlanResult again = planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair,
+                                         withRemainingBudget(options, start));
   why << "; started from the minimum-time plan (T* = " << T_star
       << " s) after the first solve ended infeasible";
   if (again.termination == Termination::Infeasible) {

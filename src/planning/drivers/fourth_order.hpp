@@ -1,0 +1,24 @@
+// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md).
+// The combination of a second_order plan at N and one at 2N is written here once; the
+// minimum-effort plan (plan_at_resolution.cpp, planFourthOrder) and the minimum-time plan
+// (minimum_time.cpp: the pair of second_order minimum-time problems) both use it.
+#pragma once
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+
+namespace attitude_planner {
+
+/// The fourth_order plan at problem.duration (problem.scheme fourth_order, problem.steps = N) from
+/// two converged second_order plans of one extremal at that duration, `coarse` at N and `fine` at
+/// 2N. second_order is time-symmetric, so its node values have an error expansion in even powers
+/// of h; X = X_{2N} + (X_{2N} − X_N)/3 at the N + 1 common nodes cancels the h² term. On the
+/// group, R_k = R^{2N}_{2k} exp(⅓ log((R^N_k)ᵀ R^{2N}_{2k})); R_0, R_N are the boundary data.
+/// The result also carries the scheme's effort quadrature, the replay (cubic hold, RKMK4), the
+/// node constraint figures measured on the combined plan, the worse of the two solves' residuals,
+/// both solves' levels, history and iterations, and the fine solve's extremal. The caller writes
+/// the message and the trail.
+PlanResult richardsonCombination(const PlanningProblem& problem, const PlanResult& coarse,
+                                 const PlanResult& fine);
+
+}  // namespace attitude_planner

@@ -7,6 +7,35 @@
 
 namespace attitude_planner {
 
+namespace {
+
+/// The figures of a fourth_order plan (result->maneuver, N + 1 nodes at problem.duration): the
+/// scheme's effort quadrature, the replay (cubic hold, RKMK4) and the node constraint figures.
+void measureFourthOrderPlan(const PlanningProblem& problem, PlanResult* result) {
+  const int N = problem.steps;
+  const Maneuver& m = result->maneuver;
+  result->cost = schemeCost(SchemeKind::FourthOrder, m.torque);
+  result->effort = problem.duration / N * result->cost;
+  SimulationInput input;
+  input.initial_attitude = problem.initial_attitude;
+  input.initial_velocity = problem.initial_velocity;
+  input.torque = m.torque;
+  input.effects = problem.effects.get();
+  setReplayMiss(problem,
+                replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input),
+                result);
+  // The combination is not re-solved under the constraints: its node figures are measured.
+  if (problem.hasNodeConstraints()) {
+    const ConstraintCheck check = checkConstraints(problem, m);
+    result->constraints = check.names;
+    result->max_constraint_violation = check.max_violation;
+    result->max_violation_between_nodes = check.max_violation_between_nodes;
+    result->active_constraints = check.active;
+  }
+}
+
+}  // namespace
+
 PlanResult richardsonCombination(const PlanningProblem& problem, const PlanResult& coarse,
                                  const PlanResult& fine) {
   const int N = problem.steps;
@@ -50,26 +79,25 @@ PlanResult richardsonCombination(const PlanningProblem& problem, const PlanResul
     }
   }
 
-  result.cost = schemeCost(SchemeKind::FourthOrder, m.torque);
-  result.effort = problem.duration / N * result.cost;
   result.effects = fine.effects;
-  SimulationInput input;
-  input.initial_attitude = problem.initial_attitude;
-  input.initial_velocity = problem.initial_velocity;
-  input.torque = m.torque;
-  input.effects = problem.effects.get();
-  setReplayMiss(problem,
-                replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input),
-                &result);
-  // The combination is not re-solved under the constraints: its node figures are measured
-  // (near a bound it can leave it, docs/design/fourth_order.md "Minimum time").
-  if (problem.hasNodeConstraints()) {
-    const ConstraintCheck check = checkConstraints(problem, m);
-    result.constraints = check.names;
-    result.max_constraint_violation = check.max_violation;
-    result.max_violation_between_nodes = check.max_violation_between_nodes;
-    result.active_constraints = check.active;
+  measureFourthOrderPlan(problem, &result);
+  return result;
+}
+
+PlanResult richardsonCombinationWithinTheBounds(const PlanningProblem& problem,
+                                                const PlanResult& coarse, const PlanResult& fine,
+                                                bool* replaced) {
+  PlanResult result = richardsonCombination(problem, coarse, fine);
+  if (replaced) *replaced = false;
+  if (!problem.hasNodeConstraints() ||
+      checkConstraints(problem, result.maneuver).max_relative_violation <=
+          kNodeConstraintTolerance) {
+    return result;
   }
+  result.maneuver = coarse.maneuver;
+  result.switching_function = coarse.switching_function;
+  measureFourthOrderPlan(problem, &result);
+  if (replaced) *replaced = true;
   return result;
 }
 

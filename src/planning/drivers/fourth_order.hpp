@@ -21,4 +21,17 @@ namespace attitude_planner {
 PlanResult richardsonCombination(const PlanningProblem& problem, const PlanResult& coarse,
                                  const PlanResult& fine);
 
+/// richardsonCombination, unless the combination leaves a node bound (beyond
+/// kNodeConstraintTolerance relative) that both plans meet: then the `coarse` plan itself, measured
+/// as a fourth_order plan (`*replaced` true). Near a bound the combination has no h² expansion to
+/// cancel: a bang–bang plan's switches move by O(h) from N to 2N, and where the 2N torque is at
+/// its bound a and the N torque c is inside, the combination reaches a + (a − c)/3. Used where
+/// one plan sits on its bounds by construction (minimum time and the plans from it); measured on
+/// Bilimoria–Wie and Betts at N = 32 … 128 (docs/design/fourth_order.md, "Minimum time"), the N
+/// plan at T* (a minimum-effort plan with slack) meets every bound and replays with a 4–40×
+/// smaller terminal miss than the combination.
+PlanResult richardsonCombinationWithinTheBounds(const PlanningProblem& problem,
+                                                const PlanResult& coarse, const PlanResult& fine,
+                                                bool* replaced = nullptr);
+
 }  // namespace attitude_planner

@@ -1,5 +1,6 @@
 #include "attitude_planner/planning/minimum_time.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -105,8 +106,20 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   at.objective = Objective::MinimumEffort;
   at.time_margin = 0.0;
   at.duration = T;
-  PlanResult result = richardsonCombination(at, coarse, fine);
-  result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
+  bool replaced = false;
+  PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
+  result.message = what +
+                   (replaced ? ": the plan is the second_order plan at N (the Richardson "
+                               "combination left a bound both meet)"
+                             : "") +
+                   ": N: " + coarse.message + " | 2N: " + fine.message;
+  if (replaced) {  // the N solve's plan is the one returned
+    trail = coarse.attempts;
+    for (Attempt a : fine.attempts) {
+      a.kept = false;
+      trail.push_back(a);
+    }
+  }
   result.attempts = trail;
   return result;
 }
@@ -121,12 +134,10 @@ PlanResult planFromMinimumTime(const PlanningProblem& problem, double T,
   return planFromMinimumTimePlan(problem, T, at_minimum_time, options);
 }
 
-/// The attempts of `r`, none kept but its kept one if `keep`, each with `stage` where given.
-void appendTrail(const PlanResult& r, bool keep, std::optional<AttemptStage> stage,
-                 std::vector<Attempt>* trail) {
-  for (Attempt a : r.attempts) {
+/// `attempts` appended to `trail`, none kept but its kept one if `keep`.
+void appendTrail(const std::vector<Attempt>& attempts, bool keep, std::vector<Attempt>* trail) {
+  for (Attempt a : attempts) {
     a.kept = a.kept && keep;
-    if (stage) a.stage = *stage;
     trail->push_back(a);
   }
 }
@@ -138,7 +149,7 @@ void appendTrail(const PlanResult& r, bool keep, std::optional<AttemptStage> sta
 /// larger (the binding one) is a KKT point, so is the pair: the binding problem's multipliers,
 /// zero ones on the other's constraints, which its minimum-effort plan at T* (from its own plan
 /// at its T*, time-scaled: inside the bounds) meets. The plan is the two plans' Richardson
-/// combination (richardsonCombination, as every fourth_order plan).
+/// combination, or the N plan where that leaves a bound (richardsonCombinationWithinTheBounds).
 PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOptions& options,
                                   RichardsonPair* pair) {
   const auto started = std::chrono::steady_clock::now();
@@ -161,20 +172,24 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
   PlanResult coarse = minimumTimePlan(coarse_problem, withRemainingBudget(options, started));
   if (!coarse.converged()) return failed(coarse, "the one at N");
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
-  const PlanResult& binding = fine_binds ? fine : coarse;
-  PlanResult& other = fine_binds ? coarse : fine;
-  const double T_star = binding.minimum_duration;
-  const double T_other = other.minimum_duration;
+  const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
+  const double T_N = coarse.minimum_duration, T_2N = fine.minimum_duration;
+  const MinimumTimeCertificate certificate = (fine_binds ? fine : coarse).minimum_time;
   const int solves = fine.minimum_time.solves + coarse.minimum_time.solves;
-  std::vector<Attempt> trail;
-  appendTrail(fine, fine_binds, std::nullopt, &trail);
-  appendTrail(coarse, !fine_binds, std::nullopt, &trail);
-  if (T_other < T_star) {
+  const std::vector<Attempt> fine_trail = fine.attempts, coarse_trail = coarse.attempts;
+  // The other one's minimum-effort plan at T* (at its own T*: its plan already).
+  std::vector<Attempt> other_trail;
+  PlanResult& other = fine_binds ? coarse : fine;
+  if (other.minimum_duration < T_star) {
     PlanResult at_T_star =
         planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem, T_star, other.maneuver,
                                 withRemainingBudget(options, started));
-    appendTrail(at_T_star, false, AttemptStage::MinimumTimePolish, &trail);
+    other_trail = at_T_star.attempts;
     if (!at_T_star.converged()) {
+      std::vector<Attempt> trail;
+      appendTrail(fine_trail, false, &trail);
+      appendTrail(coarse_trail, false, &trail);
+      appendTrail(other_trail, false, &trail);
       at_T_star.attempts = trail;
       return failed(at_T_star,
                     std::string("the minimum-effort plan at T* at ") + (fine_binds ? "N" : "2N"));
@@ -183,19 +198,30 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
   }
   PlanningProblem at = problem;
   at.duration = T_star;
-  PlanResult result = richardsonCombination(at, coarse, fine);
+  bool replaced = false;
+  PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
   if (pair) *pair = RichardsonPair{coarse.maneuver, fine.maneuver};
   result.minimum_duration = T_star;
-  result.minimum_time = binding.minimum_time;
+  result.minimum_time = certificate;
   result.minimum_time.solves = solves;
-  result.attempts = trail;
+  // Kept: the plan returned, the binding one's (the combination) or the N plan's (replaced).
+  const bool keep_fine = fine_binds && !replaced;
+  const bool keep_coarse_solve = !fine_binds && replaced;
+  appendTrail(fine_trail, keep_fine, &result.attempts);
+  appendTrail(coarse_trail, keep_coarse_solve, &result.attempts);
+  for (Attempt a : other_trail) {
+    a.kept = a.kept && fine_binds && replaced;
+    a.stage = AttemptStage::MinimumTimePolish;
+    result.attempts.push_back(a);
+  }
   std::ostringstream note;
-  note << what << ": T* = " << exactNumber(T_star) << " s, the one at "
-       << (fine_binds ? "2N = " : "N = ") << (fine_binds ? 2 * N : N)
-       << " binds (T* at N = " << exactNumber(fine_binds ? T_other : T_star)
-       << " s, at 2N = " << exactNumber(fine_binds ? T_star : T_other)
-       << " s); the plan combines its plan and the other's minimum-effort plan at T* | 2N: "
-       << fine.message << " | N: " << coarse.message;
+  note << what << ": T* = " << exactNumber(T_star) << " s, the one at " << (fine_binds ? "2N" : "N")
+       << " binds (T* at N = " << exactNumber(T_N) << " s, at 2N = " << exactNumber(T_2N) << " s); "
+       << (replaced ? "the plan is the second_order plan at N at T*: the Richardson combination "
+                      "with the 2N plan left a bound both meet"
+                    : "the plan combines the binding plan and the other's minimum-effort plan "
+                      "at T*")
+       << " | 2N: " << fine.message << " | N: " << coarse.message;
   result.message = note.str();
   return result;
 }

@@ -21,7 +21,7 @@
 //   minimum_time_search  minimum time by the former search on T over minimum-effort solves
 //                 (drivers/minimum_time_search.hpp) on the scene's request as it is (any scheme,
 //                 constraints, effects): the upper bound the free-time answer is checked against
-//                 (one JSON line: time_s, minimum_duration, status)
+//                 (one JSON line: time_s, minimum_duration, status, max_constraint_violation)
 //   complex_step  the seed's own approach: Newton on the necessary conditions (corrected eq. (28),
 //                 dynamics, terminal attitude) in 3(2N−3) unknowns τ, Ω with a dense
 //                 complex-step Jacobian and a dense LU per iteration (as the seed did with fsolve)
@@ -1906,7 +1906,8 @@ std::optional<int> parseArguments(int argc, char** argv, BenchmarkArgs* args) {
 
 /// --solver minimum_time_search: the search on T over minimum-effort solves on the request as it
 /// is (planManeuver answers minimum time by the free-time interior point wherever it applies).
-/// Prints one JSON line: time_s, minimum_duration (the least T found feasible), status.
+/// Prints one JSON line: time_s, minimum_duration (the least T found feasible), status,
+/// max_constraint_violation (of its plan at that T).
 int searchMinimumTimeOnce(const ap::PlanningProblem& problem) {
   ap::validateProblem(problem);
   const auto start = std::chrono::steady_clock::now();
@@ -1915,9 +1916,10 @@ int searchMinimumTimeOnce(const ap::PlanningProblem& problem) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
       "{\"solver\": \"minimum_time_search\", \"scheme\": \"%s\", \"steps\": %d, "
-      "\"time_s\": %.6g, \"minimum_duration\": %.17g, \"status\": \"%s\"}\n",
+      "\"time_s\": %.6g, \"minimum_duration\": %.17g, \"status\": \"%s\", "
+      "\"max_constraint_violation\": %.6g}\n",
       ap::schemeName(problem.scheme).c_str(), problem.steps, seconds, r.minimum_duration,
-      ap::terminationName(r.termination).c_str());
+      ap::terminationName(r.termination).c_str(), r.max_constraint_violation);
   return r.converged() ? 0 : 1;
 }
 

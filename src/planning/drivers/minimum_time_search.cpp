@@ -315,7 +315,10 @@ class MinimumTimeSearch {
 
 bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
   if (r.converged()) return true;
-  if (r.termination != Termination::NotConverged || r.maneuver.steps() != problem.steps) {
+  // fourth_order solves no discrete equations of its own: an unconverged one returns the
+  // second_order sub-plan that stopped, no fourth_order plan to check.
+  if (r.termination != Termination::NotConverged || r.maneuver.steps() != problem.steps ||
+      !schemeIsDiscretization(problem.scheme)) {
     return false;
   }
   return planInconsistency(problem, r, true).empty();

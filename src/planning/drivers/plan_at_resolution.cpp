@@ -12,6 +12,7 @@
 #include "attitude_planner/planning/warm_start.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/drivers/constrained_classes.hpp"
+#include "planning/drivers/fourth_order.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
@@ -48,16 +49,14 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
   }
 }
 
-/// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md).
-/// second_order is time-symmetric, so its node values have an error expansion in even powers of
-/// h; X = X_{2N} + (X_{2N} − X_N)/3 at the N + 1 common nodes cancels the h² term. On the group,
-/// R_k = R^{2N}_{2k} exp(⅓ log((R^N_k)ᵀ R^{2N}_{2k})). Both solves get the request's solver,
-/// constraints, effects and what is left of its time budget; the coarse one its warm start, the
-/// fine one the homotopy class the coarse one ended in. The
-/// fine one starts cold: its grid continuation (N/2, N/8, … with Richardson-extrapolated step
-/// rates) starts it better than the coarse plan refined at the step midpoints (torques are second
-/// differences: an O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations
-/// instead of 2). The result converges only if both do.
+/// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md),
+/// the combination of the two plans in richardsonCombination (drivers/fourth_order.hpp). Both
+/// solves get the request's solver, constraints, effects and what is left of its time budget; the
+/// coarse one its warm start, the fine one the homotopy class the coarse one ended in. The fine one
+/// starts cold: its grid continuation (N/2, N/8, … with Richardson-extrapolated step rates) starts
+/// it better than the coarse plan refined at the step midpoints (torques are second differences: an
+/// O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations instead of 2). The
+/// result converges only if both do.
 PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& options,
                            std::chrono::steady_clock::time_point start) {
   const int N = problem.steps;
@@ -88,58 +87,8 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   const PlanResult fine = planAtResolution(sub, fine_options);
   if (!fine.converged()) return failed(fine, 2 * N);
 
-  PlanResult result;
-  result.termination = Termination::Converged;
-  result.solver = fine.solver;
-  result.scheme = SchemeKind::FourthOrder;
-  result.levels = coarse.levels;
-  result.levels.insert(result.levels.end(), fine.levels.begin(), fine.levels.end());
-  result.iterations = coarse.iterations + fine.iterations;
-  result.max_residual = std::max(coarse.max_residual, fine.max_residual);
-  result.newton_decrement = std::max(coarse.newton_decrement, fine.newton_decrement);
-  result.step_residual = std::max(coarse.step_residual, fine.step_residual);
-  result.dynamics_residual = std::max(coarse.dynamics_residual, fine.dynamics_residual);
-  result.history = coarse.history;
-  result.history.insert(result.history.end(), fine.history.begin(), fine.history.end());
-  result.extremal = fine.extremal;
-  result.extremal_summary = fine.extremal_summary;
-  result.duration = problem.duration;
+  PlanResult result = richardsonCombination(problem, coarse, fine);
   result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
-
-  Maneuver& m = result.maneuver;
-  m = coarse.maneuver;
-  const Maneuver& f = fine.maneuver;
-  for (int k = 0; k <= N; ++k) {
-    const Matrix3& R_fine = f.attitude[2 * k];
-    const Vector3 d = so3::log(Matrix3(m.attitude[k].transpose() * R_fine));
-    m.attitude[k] = R_fine * so3::exp(Vector3(d / 3.0));
-    m.angular_velocity[k] =
-        f.angular_velocity[2 * k] + (f.angular_velocity[2 * k] - m.angular_velocity[k]) / 3.0;
-    m.torque[k] = f.torque[2 * k] + (f.torque[2 * k] - m.torque[k]) / 3.0;
-  }
-  m.attitude.front() = problem.initial_attitude;  // the boundary data exactly
-  m.attitude.back() = problem.final_attitude;
-  // The switching function (per-axis torque bounds) is a node quantity like τ_k: combined alike.
-  if (coarse.switching_function.size() == static_cast<size_t>(N + 1) &&
-      fine.switching_function.size() == static_cast<size_t>(2 * N + 1)) {
-    result.switching_function.resize(N + 1);
-    for (int k = 0; k <= N; ++k) {
-      const Vector3& s_fine = fine.switching_function[2 * k];
-      result.switching_function[k] = s_fine + (s_fine - coarse.switching_function[k]) / 3.0;
-    }
-  }
-
-  result.cost = schemeCost(SchemeKind::FourthOrder, m.torque);
-  result.effort = problem.duration / N * result.cost;
-  result.effects = fine.effects;
-  SimulationInput input;
-  input.initial_attitude = problem.initial_attitude;
-  input.initial_velocity = problem.initial_velocity;
-  input.torque = m.torque;
-  input.effects = problem.effects.get();
-  setReplayMiss(problem,
-                replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input),
-                &result);
   return result;
 }
 

@@ -910,10 +910,7 @@ std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& prob
   return np.attitudes(np.retract(outcome.negative_curvature, size));
 }
 
-std::string freeTimeUnsupported(const PlanningProblem& problem) {
-  if (problem.scheme == SchemeKind::FourthOrder) {
-    return "scheme: fourth_order (a Richardson pair of second_order plans, no one transcription)";
-  }
+std::string freeTimeUnsupported(const PlanningProblem&) {
   return "";
 }
 

@@ -80,9 +80,11 @@ struct BarrierPoint {
 /// FreeTimeOutcome::stopped_by_watch.
 using BarrierWatch = std::function<std::string(const BarrierPoint&)>;
 
-/// Why `problem` cannot be solved free-time here (empty: it can): fourth_order has no single
-/// transcription (minimum_time.cpp falls back to the search). Effects are written in h (their
-/// time t_k = k h moves with h: ReducedProblem::forEachStencilWithTimeStep).
+/// Why `problem` cannot be solved free-time here (empty: it can; minimum_time.cpp falls back to
+/// the search otherwise). Every request can today: effects are written in h (their time
+/// t_k = k h moves with h: ReducedProblem::forEachStencilWithTimeStep), and fourth_order, which
+/// has no single transcription, is the pair of its second_order problems at N and 2N
+/// (minimum_time.cpp, fourthOrderMinimumTime). Kept as the one place a future case names itself.
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its

@@ -779,6 +779,41 @@ TEST(FreeTime, ADisturbanceNearItsBoundGivesAKktPointBelowTheSearch) {
   EXPECT_NEAR(in_turned.minimum_duration, answer.minimum_duration, 1e-8 * answer.minimum_duration);
 }
 
+TEST(FreeTime, ADisturbanceBeyondItsBoundOnASymmetricBodyIsInfeasibleAtEveryDuration) {
+  // J = I, 1.2 N m about body x against |u_x| ≤ 1: ω̇_x = u_x + 1.2 ≥ 0.2 at every instant, so no
+  // rest-to-rest plan exists at any T. The answer is `infeasible` at once, naming the
+  // disturbance and the bound (before: the search's local verdict after ~16 000 iterations).
+  const ap::PlanningProblem p =
+      bilimoriaWieDisturbed(64, ap::Vector3(1.2, 0, 0), ap::TorqueFrame::Body);
+  const ap::PlanResult r = ap::planManeuver(p);
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_NE(r.message.find("disturbance_torque"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("max_torque"), std::string::npos) << r.message;
+  EXPECT_EQ(r.iterations, 0) << "no solve ran";
+  // Shown wherever the argument holds, and only there.
+  EXPECT_FALSE(ap::infeasibleAtEveryDuration(
+                   bilimoriaWieDisturbed(64, ap::Vector3(0, -1.5, 0.3), ap::TorqueFrame::Body))
+                   .empty())
+      << "a negative component beyond its bound, about y";
+  const auto shown = [](ap::PlanningProblem q) {
+    return !ap::infeasibleAtEveryDuration(q).empty();
+  };
+  EXPECT_FALSE(shown(bilimoriaWieDisturbed(64, ap::Vector3(1.0, 0, 0), ap::TorqueFrame::Body)))
+      << "at the bound: u_x = −1 throughout is feasible";
+  EXPECT_FALSE(shown(bilimoriaWieDisturbed(64, ap::Vector3(0.96, 0, 0), ap::TorqueFrame::Body)));
+  EXPECT_FALSE(shown(bilimoriaWieDisturbed(64, ap::Vector3(1.2, 0, 0), ap::TorqueFrame::World)))
+      << "a world torque turns with the body";
+  ap::PlanningProblem asymmetric = p;
+  asymmetric.inertia = ap::Vector3(1, 2, 3).asDiagonal();
+  EXPECT_FALSE(shown(asymmetric)) << "the gyroscopic torque about x can oppose the disturbance";
+  ap::PlanningProblem symmetric_about_x = p;
+  symmetric_about_x.inertia = ap::Vector3(3, 2, 2).asDiagonal();
+  EXPECT_TRUE(shown(symmetric_about_x));
+  ap::PlanningProblem spinning_up = p;
+  spinning_up.final_velocity = ap::Vector3(1, 0, 0);
+  EXPECT_FALSE(shown(spinning_up)) << "the rate about x may grow: only long T are excluded";
+}
+
 TEST(FreeTime, SecondOrderCheckAgreesWithTheReducedHessianByFiniteDifferences) {
   // Around the keep-out cone the structured starts cleared of it reach saddles (the eigenaxis
   // slew's, symmetric in time) and local minima of the discrete problem; the free-time solves

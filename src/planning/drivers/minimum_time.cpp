@@ -110,6 +110,13 @@ PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateMinimumTime(problem);
+  const std::string impossible = infeasibleAtEveryDuration(problem);
+  if (!impossible.empty()) {
+    PlanResult none;
+    none.termination = Termination::Infeasible;
+    none.message = "infeasible: " + impossible;
+    return none;
+  }
   const auto start = std::chrono::steady_clock::now();
   PlanResult result = minimumTimePlan(problem, options);
   if (!result.converged()) return result;

@@ -42,6 +42,16 @@ std::vector<std::string> EffectModel::names() const {
   return out;
 }
 
+std::optional<Vector3> EffectModel::constantBodyTorque() const {
+  Vector3 sum = Vector3::Zero();
+  for (const auto& e : effects_) {
+    const std::optional<Vector3> t = e->constantBodyTorque();
+    if (!t) return std::nullopt;
+    sum += *t;
+  }
+  return sum;
+}
+
 Vector3 EffectModel::torque(const Matrix3& R, double t) const {
   Vector3 sum = Vector3::Zero();
   for (const auto& e : effects_) sum += e->torque(R, t);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -79,6 +80,9 @@ class TorqueEffect {
   virtual Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const = 0;
   /// The exact time derivatives of torque() and jacobian() at fixed R (minimum time: h unknown).
   virtual EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const = 0;
+  /// The torque when it is one constant vector in the body frame at every attitude and time (a
+  /// verdict that must hold along every plan can use it); none otherwise.
+  virtual std::optional<Vector3> constantBodyTorque() const { return std::nullopt; }
 };
 
 /// Gravity gradient of a circular orbit in the world x–y plane:
@@ -114,6 +118,8 @@ class DisturbanceTorque : public TorqueEffect {
   Matrix3 weightedSecondDerivative(const Matrix3& R, double t, const Vector3& w) const override;
   /// Zero: constant in time in either frame (in the world frame it moves with R only).
   EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override;
+  /// The value in the body frame (none in the world frame: it turns with the attitude).
+  std::optional<Vector3> constantBodyTorque() const override;
 
  private:
   Vector3 value_;
@@ -129,6 +135,9 @@ class EffectModel {
   std::vector<std::string> names() const;
   /// Σ τ_e(R, t) [N m].
   Vector3 torque(const Matrix3& R, double t) const;
+  /// Σ of the effects' constant body torques when every effect has one (zero when empty); none
+  /// otherwise.
+  std::optional<Vector3> constantBodyTorque() const;
   /// Σ ∂τ_e/∂δ.
   Matrix3 jacobian(const Matrix3& R, double t) const;
   /// Σ weighted second derivatives (see TorqueEffect).

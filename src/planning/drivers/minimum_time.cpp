@@ -281,6 +281,13 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateMinimumTime(problem);
+  const std::string impossible = infeasibleAtEveryDuration(problem);
+  if (!impossible.empty()) {
+    PlanResult none;
+    none.termination = Termination::Infeasible;
+    none.message = "infeasible: " + impossible;
+    return none;
+  }
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
   PlanResult result = minimumTimePlan(problem, options, &pair);

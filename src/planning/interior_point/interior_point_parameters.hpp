@@ -156,6 +156,24 @@ struct InteriorPointParameters {
   double free_time_smallest_shift = 1e-20;
   /// ... and the largest before the step counts as failed.
   double free_time_max_shift = 1e10;
+  /// Steps the line search cut below this length ...
+  double free_time_cut_step = 1.0 / 16;
+  /// ... this many times in a row damp the next Newton steps (a shift from the first shift up,
+  /// free_time_solver.cpp dampAfterCutSteps): where minimum time is flat along an arc the
+  /// undamped step runs into the constraints' curvature (0.96 N m about body x against
+  /// |u_x| ≤ 1, N = 64: 500 iterations without converging; damped, a KKT point in 380). Two: one
+  /// damped after a single cut step, common on the way. Measured (N = 64, plan_maneuver): T* the
+  /// same to the last digit on Bilimoria–Wie, Betts, the cone and the cone + rate rows,
+  /// iterations 397 → 292, 188 → 188, 1123 → 1129, 1117 → 1127.
+  int free_time_cut_steps_before_damping = 2;
+  /// ... once the barrier μ is at most this × its start μ₀ (the end game: where the basin is
+  /// chosen, at the first barrier levels, damped steps took paper on min_time_keep_out.yaml
+  /// N = 32 to a higher KKT point, 29.7404 s instead of 29.7113 s).
+  double free_time_damped_barrier = 1e-2;
+  /// The damping grows by this factor per further cut step and falls by it per full step ...
+  double free_time_damping_growth = 10.0;
+  /// ... down to this, then none.
+  double free_time_smallest_damping = 1e-14;
   /// θ_μ of its monotone barrier update (μ → min(κ_μ μ, μ^θ_μ)), below IPOPT's 1.5: a steeper
   /// fall sent the next steps halving their way into the active bounds for ~6 iterations per
   /// barrier level (one solve, Bilimoria–Wie N = 256: 50 → 38 iterations; Betts N = 64: 85 → 53).

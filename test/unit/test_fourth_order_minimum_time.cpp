@@ -15,6 +15,7 @@
 #include "planning/interior_point/free_time_solver.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
+#include "support/turned_world.hpp"
 
 namespace ap = attitude_planner;
 
@@ -90,14 +91,8 @@ TEST(FourthOrderMinimumTime, IsTheLargerSecondOrderTStarAKktPointNoSlowerThanThe
           r.max_constraint_violation, r.replay_miss, search.minimum_duration,
           search.max_constraint_violation, search.replay_miss);
 
-      ap::PlanningProblem turned = p;
-      turned.initial_attitude = Q * p.initial_attitude;
-      turned.final_attitude = Q * p.final_attitude;
-      const ap::PlanResult in_turned = ap::planManeuver(turned);
-      ASSERT_TRUE(in_turned.converged()) << in_turned.message;
-      EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-      EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration)
-          << name << " N = " << N;
+      ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-8,
+                                                  std::string(name) + " N = " + std::to_string(N));
     }
   }
 }

@@ -33,6 +33,7 @@
 #include "planning/transcription/stage_constraints.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
+#include "support/turned_world.hpp"
 
 namespace ap = attitude_planner;
 
@@ -277,14 +278,8 @@ TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerT
     EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "N = " << N;
     previous = r.minimum_duration;
 
-    ap::PlanningProblem turned = p;
-    turned.initial_attitude = Q * p.initial_attitude;
-    turned.final_attitude = Q * p.final_attitude;
-    const ap::PlanResult in_turned = ap::planManeuver(turned);
-    ASSERT_TRUE(in_turned.converged()) << in_turned.message;
-    EXPECT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration)
-        << "N = " << N;
+    ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-8,
+                                                "N = " + std::to_string(N));
 
     if (N != 64 && N != 256) continue;  // the search: on the start grid and the first refined one
     const ap::PlanResult search = searched(N);
@@ -454,13 +449,9 @@ TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
     for (const ap::Vector3& w : r.maneuver.angular_velocity) fastest = std::max(fastest, w.norm());
     EXPECT_LE(fastest, 1.0 + 1e-9);
     EXPECT_GT(fastest, 1.0 - 1e-6) << "the limit binds";
-    ap::PlanningProblem turned = p;
     const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
-    turned.initial_attitude = Q * p.initial_attitude;
-    turned.final_attitude = Q * p.final_attitude;
-    const ap::PlanResult in_turned = ap::planManeuver(turned);
-    ASSERT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-    EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration);
+    ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-8,
+                                                "turned");
     const ap::PlanResult search = ap::test_support::searchedMinimumTime(p);
     ASSERT_TRUE(search.converged()) << search.message;
     EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
@@ -770,13 +761,9 @@ TEST(FreeTime, ADisturbanceNearItsBoundGivesAKktPointBelowTheSearch) {
   const ap::PlanningProblem p64 =
       bilimoriaWieDisturbed(64, ap::Vector3(0.96, 0, 0), ap::TorqueFrame::Body);
   const ap::PlanResult answer = expectKktAnswerNoSlowerThanTheSearch(p64, "0.96 about x, N = 64");
-  ap::PlanningProblem turned = p64;
   const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
-  turned.initial_attitude = Q * p64.initial_attitude;
-  turned.final_attitude = Q * p64.final_attitude;
-  const ap::PlanResult in_turned = ap::planManeuver(turned);
-  ASSERT_TRUE(in_turned.minimum_time.kkt_point) << in_turned.message;
-  EXPECT_NEAR(in_turned.minimum_duration, answer.minimum_duration, 1e-8 * answer.minimum_duration);
+  ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p64, Q), answer,
+                                              1e-8, "0.96 about x, N = 64, turned");
 }
 
 TEST(FreeTime, ADisturbanceBeyondItsBoundOnASymmetricBodyIsInfeasibleAtEveryDuration) {
@@ -898,13 +885,8 @@ TEST(FreeTime, AroundAConeTStarIsALocalMinimumMonotoneInNInvariantAndNoSlowerTha
     EXPECT_LE(r.minimum_duration, s.minimum_duration * (1 + 1e-8)) << "N = " << N;
     if (N != 64) continue;
     const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(0.4, -1.1, 0.7));
-    ap::PlanningProblem turned = p;
-    turned.initial_attitude = Q * p.initial_attitude;
-    turned.final_attitude = Q * p.final_attitude;
-    for (ap::PlanningConstraint& c : turned.constraints) c.world_direction = Q * c.world_direction;
-    const ap::PlanResult t = ap::planManeuver(turned);
-    ASSERT_TRUE(t.converged() && t.minimum_time.kkt_point) << t.message;
-    EXPECT_NEAR(t.minimum_duration, r.minimum_duration, 1e-7 * r.minimum_duration);
+    ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-7,
+                                                "cone, turned");
   }
   // paper, whose time-symmetric KKT points are local minima above the least (main 2026798:
   // 29.7404 and 29.2470 s at N = 32 and 64, above the search's 29.7113 and 29.2354): the skewed

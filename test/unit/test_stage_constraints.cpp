@@ -24,6 +24,7 @@
 #include "planning/transcription/stage_constraints.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
+#include "support/turned_world.hpp"
 
 namespace ap = attitude_planner;
 
@@ -425,13 +426,8 @@ TEST(FreeTimeCones, TStarIsInvariantUnderAWorldRotationOfAttitudesAndCone) {
   std::normal_distribution<double> normal;
   for (int trial = 0; trial < 2; ++trial) {
     const ap::Matrix3 Q = ap::so3::exp(ap::Vector3(normal(rng), normal(rng), normal(rng)));
-    ap::PlanningProblem turned = p;
-    turned.initial_attitude = Q * p.initial_attitude;
-    turned.final_attitude = Q * p.final_attitude;
-    turned.constraints[0].world_direction = Q * p.constraints[0].world_direction;
-    const ap::PlanResult t = ap::planManeuver(turned);
-    ASSERT_TRUE(t.converged() && t.minimum_time.kkt_point) << t.message;
-    EXPECT_NEAR(t.minimum_duration, r.minimum_duration, 1e-7 * r.minimum_duration);
+    ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-7,
+                                                "trial " + std::to_string(trial));
   }
 }
 

@@ -36,9 +36,8 @@ enum class AttemptStage {
   MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
   MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
   MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
-  /// minimum_time: a minimum-effort solve at T* from the free-time plan. No longer run (the
-  /// free-time plan is the answer); the value stays, as readers of "minimum_time_polish" may
-  /// know it.
+  /// minimum_time: a minimum-effort solve at T*: fourth_order's non-binding second_order plan at
+  /// the pair's T* (the free-time plan itself is every other scheme's answer).
   MinimumTimePolish,
   ConstrainedClass,  ///< under constraints, a class left free: another class's whole solve
 };

@@ -28,7 +28,10 @@ double DiscreteScheme::cost(const std::vector<Vector3>& torque) const {
 }
 
 Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega) const {
-  const Matrix3 E = so3::expMinusIdentity(omega);  // F − I
+  return momentumOfStep(omega, so3::expMinusIdentity(omega));
+}
+
+Vector3 DiscreteScheme::momentumOfStep(const Vector3& omega, const Matrix3& E) const {
   if (kind_ == SchemeKind::Paper) {
     const Vector3 Jw = J_ * omega;
     return (Jw + E * Jw) / h_;  // F J ω / h

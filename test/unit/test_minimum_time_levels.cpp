@@ -140,7 +140,7 @@ TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {
   // Anything else is not this case's to swallow: an invalid inertia is named.
   ap::PlanningProblem invalid = scene("min_time_keep_out", 16);
   invalid.inertia(0, 0) = -1.0;
-  EXPECT_THROW(ap::coneClearStart(invalid, attitudes, 30.0, options, true), ap::InvalidInput);
+  EXPECT_THROW(ap::coneClearStart(invalid, attitudes, 30.0, options), ap::InvalidInput);
 }
 
 TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {

@@ -199,6 +199,23 @@ TEST(So3, ExpMinusIdentityKeepsRelativePrecisionForSmallRotations) {
   }
 }
 
+TEST(So3, ExpWithMinusIdentityAgreesWithExpAndExpMinusIdentity) {
+  // One Rodrigues evaluation for both (the torques and the stencils use it): the values of the
+  // two separate maps to round-off (E to full relative precision), from 0 through π.
+  std::mt19937 rng(19);
+  for (double theta : kAngles) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const Vector3 w = theta * randomUnit(rng);
+      Matrix3 F, E;
+      so3::expWithMinusIdentity<double>(w, &F, &E);
+      EXPECT_LE((F - so3::exp(w)).cwiseAbs().maxCoeff(), 4e-16) << "theta = " << theta;
+      const Matrix3 reference = so3::expMinusIdentity(w);
+      EXPECT_LE((E - reference).cwiseAbs().maxCoeff(), 4e-16 * reference.cwiseAbs().maxCoeff())
+          << "theta = " << theta;
+    }
+  }
+}
+
 TEST(So3, QuaternionCompositionOfSmallStepsKeepsRelativePrecision) {
   // log(exp(a) exp(b)) for tiny a, b: the quaternion route keeps ~1e-16 relative precision,
   // where the matrix route keeps only ~eps/|a| (here 1e-8).

@@ -19,10 +19,11 @@
 //                    Π_k = μ(F_k) − (h/2) τ_k = F_{k−1}ᵀ μ(F_{k−1}) + (h/2) τ_k,
 //                and the boundary velocities are imposed at the instants 0 and T themselves:
 //                Π_0 = J Ω(0), Π_N = J Ω(T) (τ_0, τ_N are unknowns, not zero). The cost is the
-//                trapezoidal rule, weights ½ at the end nodes. Derivation: docs/design/second_order.md.
+//                trapezoidal rule, weights ½ at the end nodes. Derivation:
+//                docs/design/second_order.md.
 //   fourth_order not a discretization: one Richardson extrapolation step of second_order (plans
-//                at N and 2N combined node by node, planAtResolution; docs/design/fourth_order.md). No
-//                DiscreteScheme is built for it (the constructor refuses it); its node torques
+//                at N and 2N combined node by node, planAtResolution; docs/design/fourth_order.md).
+//                No DiscreteScheme is built for it (the constructor refuses it); its node torques
 //                are replayed with a cubic hold (replayPlan, simulation.hpp) and its effort is the
 //                end-corrected trapezoidal rule (schemeTorqueWeight).
 //
@@ -129,6 +130,9 @@ class DiscreteScheme {
   /// difference). Torques are second differences of the attitude, so this is what keeps them
   /// accurate over long horizons.
   Vector3 momentumOfStep(const Vector3& omega) const;
+  /// The same from E = exp(ω^) − I already formed (so3::expMinusIdentity(ω)), where the caller
+  /// needs E too (a torque needs F_{k−1} − I of the step whose momentum it carries).
+  Vector3 momentumOfStep(const Vector3& omega, const Matrix3& E) const;
 
   /// dμ(F exp(ε^))/dε at ε = 0 (3×3).
   template <typename S>

@@ -1,7 +1,7 @@
 // SO(3) toolkit: hat/vee, exp, log, Jacobians, quaternions, projection.
 //
-// Conventions (docs/DESIGN.md): R maps body vectors to the world; quaternions are Hamilton (w, x, y, z);
-// perturbations are on the right, R exp(ε^), so Jacobians act on body-frame tangent vectors.
+// Conventions (docs/DESIGN.md): R maps body vectors to the world; quaternions are Hamilton (w, x,
+// y, z); perturbations are on the right, R exp(ε^), so Jacobians act on body-frame tangent vectors.
 // Every function is a template on the scalar type so that the solvers can evaluate the same code
 // with forward-mode dual numbers (exact derivatives); the double versions are the everyday API.
 #pragma once
@@ -74,6 +74,18 @@ Mat3<S> expMinusIdentity(const Vec3<S>& w) {
   rodriguesCoefficients<S>(w.squaredNorm(), &a, &b);
   const Mat3<S> W = hat(w);
   return a * W + b * (W * W);
+}
+
+/// exp(w^) and exp(w^) − I from one evaluation of the Rodrigues coefficients, each formed by the
+/// same expression as exp and expMinusIdentity (the same values: a plan does not depend on which
+/// of them a caller used).
+template <typename S>
+void expWithMinusIdentity(const Vec3<S>& w, Mat3<S>* F, Mat3<S>* E) {
+  S a, b;
+  rodriguesCoefficients<S>(w.squaredNorm(), &a, &b);
+  const Mat3<S> W = hat(w);
+  *F = Mat3<S>::Identity() + a * W + b * (W * W);
+  *E = a * W + b * (W * W);
 }
 
 /// Unit quaternion (w, x, y, z) of exp(v^): (cos θ/2, sin(θ/2)/θ · v), full relative precision in

@@ -164,14 +164,10 @@ class FreeTimeMinimumTime {
     return o;
   }
 
-  /// A structured start made to clear the cones: the ConstrainedMinimumEffort start is the
-  /// minimum-effort plan under every constraint; any other start too close to a cone is replaced
-  /// by the minimum-effort plan under the cones alone from it (coneClearStart).
+  /// A structured start made to clear the cones: a start too close to a cone is replaced by the
+  /// minimum-effort plan under the cones alone from it (coneClearStart).
   std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
     const SolverOptions remaining = context_.remainingOptions();
-    if (st.kind == AttemptStart::ConstrainedMinimumEffort) {
-      return coneClearStart(p, st.attitudes, st.duration, remaining, true).value_or(st.attitudes);
-    }
     if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
     return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
   }

@@ -198,12 +198,6 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
   if (cones) {
     for (std::size_t i = 0, n = axes.size(); i < n; ++i) axes.push_back(-axes[i]);
   }
-  if (cones) {
-    starts.push_back({"minimum effort under the constraints",
-                      AttemptStart::ConstrainedMinimumEffort, starts.front().attitudes,
-                      kEigenaxisStartFactor * T_eigenaxis});
-    starts.back().detail.duration = starts.back().duration;
-  }
   if (!cones) {
     for (const Vector3& axis : axes) {
       std::ostringstream name;
@@ -265,19 +259,17 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
-                                                   double duration, const SolverOptions& options,
-                                                   bool every_constraint) {
+                                                   double duration, const SolverOptions& options) {
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
   effort.duration = duration;
-  if (!every_constraint) {
-    effort.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
-  }
+  effort.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   effort.constraints.clear();
   for (PlanningConstraint c : problem.constraints) {
-    if (c.isCone()) c.margin += kConeStartClearance;
-    if (c.isCone() || every_constraint) effort.constraints.push_back(c);
+    if (!c.isCone()) continue;
+    c.margin += kConeStartClearance;
+    effort.constraints.push_back(c);
   }
   // A cone tightened past a cone (node half angle outside (0, π)) is no problem
   // to solve (validateProblem would refuse it): no cleared start.
@@ -287,15 +279,12 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   try {
     SolverOptions o = options;
     o.enumerate_classes = false;  // a start keeps its class (the free-time solves compare them)
-    PlanResult r;
-    if (!every_constraint) {
-      ReducedProblem np(effort);
-      np.setInteriorFromAttitudes(attitudes);
-      const Maneuver guess = np.maneuver(np.current());
-      o.warm_start = &guess;
-      o.constrained_from_warm_start = true;
-      r = planAtResolution(effort, o);
-    }
+    ReducedProblem np(effort);
+    np.setInteriorFromAttitudes(attitudes);
+    const Maneuver guess = np.maneuver(np.current());
+    o.warm_start = &guess;
+    o.constrained_from_warm_start = true;
+    PlanResult r = planAtResolution(effort, o);
     if (!r.converged()) {
       o.warm_start = nullptr;
       o.constrained_from_warm_start = false;

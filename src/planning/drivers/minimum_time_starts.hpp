@@ -71,11 +71,9 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 /// A start that clears the cones: the minimum-effort plan at `duration` under the cones alone,
 /// their node bounds tightened by kConeStartClearance (the torque bounds left out: the free-time
 /// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
-/// side of a cone; cold if that does not converge. `every_constraint`: the other bounds kept and a
-/// cold solve (the ConstrainedMinimumEffort start). Empty if none converges.
+/// side of a cone; cold if that does not converge. Empty if none converges.
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
-                                                   double duration, const SolverOptions& options,
-                                                   bool every_constraint = false);
+                                                   double duration, const SolverOptions& options);
 
 }  // namespace attitude_planner

@@ -350,23 +350,23 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         H.block<9, 1>(0, 9) = st.second_h * h0_;
         H.block<1, 9>(9, 0) = (st.second_h * h0_).transpose();
         H(9, 9) = st.second_hh * h0_ * h0_;
-        // Gauss–Newton: ε of the effort and −z c''/w_k of the constraints' isotropic curvature.
-        double gauss_newton = epsilon;
+        // The torque's 3×3 weight W, so that the stencil's block is H + Gᵀ W G: Gauss–Newton's
+        // ε of the effort and −z c''/w_k of the constraints' isotropic curvature, and the
+        // barrier's (z/c) a aᵀ of each bound, a = ∂c/∂r (one product instead of one per bound).
+        Matrix3 W = epsilon * Matrix3::Identity();
         Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
         for (FreeTimeGroup* g : torque_groups) {
           FreeTimeInstance& in = g->instance(st.k);
           in.c = g->constraint->value(tau) + relaxation(StageQuantity::Torque);
-          in.g = G.transpose() * (g->constraint->gradient(tau) / s);
-          gauss_newton -= in.z * g->constraint->curvature() / (s * s);
-        }
-        H += gauss_newton * G.transpose() * G;
-        for (FreeTimeGroup* g : torque_groups) {
-          const FreeTimeInstance& in = g->instance(st.k);
-          H += (in.z / in.c) * in.g * in.g.transpose();
+          const Vector3 a = g->constraint->gradient(tau) / s;
+          in.g = G.transpose() * a;
+          W.diagonal().array() -= in.z * g->constraint->curvature() / (s * s);
+          W.noalias() += (in.z / in.c) * a * a.transpose();
           rhs += (mu / in.c) * in.g;
           lagrangian -= in.z * in.g;
         }
+        H.noalias() += G.transpose() * W * G;
         scatter(st.k - 1, 3, H, rhs, lagrangian);
       },
       weights);

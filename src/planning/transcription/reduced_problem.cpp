@@ -19,9 +19,10 @@ struct StepTerms {
   Vector3 mu, G;
   Matrix3 D, dG, DFt, dGFt;
 
-  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in)
-      : omega(omega_in), F(so3::exp(omega_in)) {
-    mu = scheme.momentumOfStep(omega);
+  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
+    Matrix3 E;  // F − I
+    so3::expWithMinusIdentity<double>(omega, &F, &E);
+    mu = scheme.momentumOfStep(omega, E);
     G = F.transpose() * mu;
     D = scheme.momentumJacobianOfStep(F, omega);
     dG = so3::hat<double>(G) + F.transpose() * D;
@@ -234,18 +235,21 @@ std::vector<Matrix3> ReducedProblem::attitudes(const StepVectors& steps) const {
 std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
   std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
   const double h = scheme_.timeStep();
-  Vector3 mu_prev = scheme_.momentumOfStep(steps[0]);
+  Matrix3 E_prev = so3::expMinusIdentity(steps[0]);  // F_{k−1} − I
+  Vector3 mu_prev = scheme_.momentumOfStep(steps[0], E_prev);
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
-    const Vector3 mu = scheme_.momentumOfStep(steps[k]);
+    const Matrix3 E = so3::expMinusIdentity(steps[k]);
+    const Vector3 mu = scheme_.momentumOfStep(steps[k], E);
     // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
     // cancel in a difference of accurately formed momenta.
-    tau[k] = ((mu - mu_prev) - so3::expMinusIdentity(steps[k - 1]).transpose() * mu_prev) / h;
+    tau[k] = ((mu - mu_prev) - E_prev.transpose() * mu_prev) / h;
     if (effects_) {
       R = R * so3::exp(steps[k - 1]);
       tau[k] -= effects_->torque(R, k * h);  // the control supplies what the effects do not
     }
     mu_prev = mu;
+    E_prev = E;
   }
   if (scheme_.hasEndTorques()) {
     // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N

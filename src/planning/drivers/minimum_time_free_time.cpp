@@ -22,10 +22,14 @@ namespace {
 /// dimensionless): the duality gap Σ zc bounds T − T* relative to T₀ by this much.
 constexpr double kFreeTimeTolerance = 1e-9;
 constexpr int kFreeTimeMaxIterations = 500;
+/// Two solves whose solved barrier problems at the same μ have attitudes within this (max entry
+/// of R_k − R'_k) are on one central path (sameCentralPath).
+constexpr double kSamePath = 1e-3;
 /// Two starts at the same T whose attitudes differ by at most this much (max entry of R_k − R'_k)
-/// are one start: the free-time solve from either ends at the same KKT point (the cleared starts
-/// that repeat one another differ by ~1e-13, their answers' T by ~1e-16 relative).
-constexpr double kSameStart = 1e-8;
+/// are one start: the free-time solve from either would join the other's central path at its
+/// first barrier problem (kSamePath). Starts cleared of the cones to the same minimum-effort plan
+/// differ by the clearing solve's tolerance (kConeClearTolerance).
+constexpr double kSameStart = kSamePath;
 /// A KKT point that is not second-order sufficient (a saddle: FreeTimeOutcome) is left along its
 /// negative-curvature direction, both signs, by this much [rad, the largest node turn]: one
 /// free-time solve from each. Measured on scenes/min_time_keep_out.yaml: the structured starts
@@ -40,10 +44,6 @@ constexpr int kMaxSaddleEscapes = 3;
 /// whose least curvature is at round-off, left either way, ends at the same T to 1e-9; followed
 /// on, it cost 8 solves for nothing.
 constexpr double kSameSaddle = 1e-6;
-/// Two solves whose solved barrier problems at the same μ have attitudes within this (max entry
-/// of R_k − R'_k) are on one central path (sameCentralPath).
-constexpr double kSamePath = 1e-3;
-
 /// The largest entry of R_k − R'_k over two lists of attitudes of one length.
 double largestDifference(const std::vector<Matrix3>& a, const std::vector<Matrix3>& b) {
   double largest = 0.0;

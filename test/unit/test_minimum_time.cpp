@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "attitude_planner/io/scene.hpp"
@@ -327,6 +328,60 @@ TEST(MinimumTime, NoDurationAboveTStarIsAnsweredInfeasible) {
       EXPECT_LE(r.max_constraint_violation, 1e-8) << "m = " << m;
     }
   }
+}
+
+TEST(MinimumTime, BilimoriaWieNearTStarConvergesBothWays) {
+  // Bilimoria–Wie at N = 128 and 1.02 T* (and fourth_order at N = 64, whose 2N sub-solve is the
+  // same problem) ended at the iteration limit, asked either way: the margin solve from the T*
+  // plan took the search probes' recipe (elastic form, LOQO's barrier), whose μ collapsed at the
+  // well-centred start and left the solve crawling (docs/results/near_minimum_time.md).
+  // fourth_order at N = 256: its 2N = 512 sub-solve went through the grid continuation, whose
+  // coarsest level started from its unconstrained optimum instead of the T* plan ("infeasible").
+  const double m = 0.02;
+  for (const auto& [scheme, steps] :
+       {std::pair{ap::SchemeKind::SecondOrder, 128}, std::pair{ap::SchemeKind::FourthOrder, 64},
+        std::pair{ap::SchemeKind::FourthOrder, 256}}) {
+    ap::PlanningProblem p = minimumTimeCases()[1];
+    p.steps = steps;
+    p.scheme = scheme;
+    p.time_margin = m;
+    const ap::PlanResult margin = ap::planManeuver(p);  // (a) minimum time with a margin
+    ASSERT_TRUE(margin.converged()) << steps << ": " << margin.message;
+    const double T_star = margin.minimum_duration;
+    EXPECT_NEAR(margin.duration, (1.0 + m) * T_star, 1e-9 * T_star);
+    EXPECT_LE(margin.max_constraint_violation, 1e-8);
+    EXPECT_EQ(margin.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);
+    ap::PlanningProblem effort = p;  // (b) minimum effort at that duration, T* not given
+    effort.objective = ap::Objective::MinimumEffort;
+    effort.time_margin = 0.0;
+    effort.duration = (1.0 + m) * T_star;
+    const ap::PlanResult r = ap::planManeuver(effort);
+    ASSERT_TRUE(r.converged()) << steps << ": " << r.message;
+    EXPECT_NEAR(r.duration, effort.duration, 1e-12 * effort.duration);
+    EXPECT_LE(r.max_constraint_violation, 1e-8);
+    // Both ways answer the same minimum-effort problem from the same start: the same plan.
+    EXPECT_NEAR(r.cost, margin.cost, 1e-8 * margin.cost);
+  }
+}
+
+TEST(MinimumTime, AFourthOrderPlanOutsideItsBoundsStartsAgainFromTheMinimumTimePlans) {
+  // fourth_order's Richardson combination of two cold sub-solves may leave a bound (here the
+  // torque norm, by 1.6e-8 of it; at 1.02 T* on Betts with gravity gradient by 33 N m): no
+  // answer to a bounded request. It is planned again from the minimum-time pair, inside.
+  ap::PlanningProblem p =
+      ap::loadScene(std::string(AP_SOURCE_DIR "/scenes/torque_norm_limited.yaml")).problem;
+  p.steps = 64;
+  p.scheme = ap::SchemeKind::FourthOrder;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(ap::checkConstraints(p, r.maneuver).max_relative_violation,
+            ap::kNodeConstraintTolerance)
+      << r.message;
+  EXPECT_NE(r.message.find("after the first solve left a bound by"), std::string::npos)
+      << r.message;
+  EXPECT_GT(r.minimum_duration, 0.0);
+  EXPECT_LE(r.minimum_duration, p.duration);
+  EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::ConstrainedRetry);
 }
 
 TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndNamesTStar) {

@@ -78,10 +78,10 @@ inline SolverKind parseSolver(const std::string& text, const std::string& field)
 /// a bound the system's condition grows like N⁴/μ; the smooth modes need more than double above
 /// about N = 1024 (interior_point_solver.cpp).
 enum class Precision {
-  Auto,          ///< double to kAutoDoubleMaxSteps, extended to kAutoExtendedMaxSteps, then
-                 ///< double-double (extended only where long double is the x87 format)
-  Double,        ///< IEEE double throughout
-  Extended,      ///< long double where it is the x87 format (64-bit significand), else double-double
+  Auto,      ///< double to kAutoDoubleMaxSteps, extended to kAutoExtendedMaxSteps, then
+             ///< double-double (extended only where long double is the x87 format)
+  Double,    ///< IEEE double throughout
+  Extended,  ///< long double where it is the x87 format (64-bit significand), else double-double
   DoubleDouble,  ///< double-double arithmetic (~106-bit significand, software)
 };
 
@@ -135,8 +135,8 @@ inline constexpr const char* kAutoSchemeName = "auto";
 /// Fewest steps N of a rigid-body plan (validateProblem).
 constexpr int kMinSteps = 4;
 /// Most steps N of a rigid-body plan: the Newton solver holds ~2.3 kB per step (measured at
-/// N = 1e6, 2.3 GB peak; docs/results/performance.md), so N = 2e6 needs ~4.6 GB. The former limit, 1e7,
-/// would need ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
+/// N = 1e6, 2.3 GB peak; docs/results/performance.md), so N = 2e6 needs ~4.6 GB. The former limit,
+/// 1e7, would need ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
 constexpr int kMaxSteps = 2000000;
 
 /// A rest-to-rest / slew problem for the fully actuated rigid body.
@@ -212,6 +212,11 @@ struct SolverOptions {
   /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
   /// is far closer to the next one than the unconstrained optimum is).
   bool constrained_from_warm_start = false;
+  /// With constrained_from_warm_start: the warm start meets every constraint with room (a plan at
+  /// T* time-scaled to a longer T), so the interior point takes a request's own recipe (free
+  /// slacks, Mehrotra) rather than the probes' (elastic form first, LOQO's barrier), which is
+  /// for starts that may be infeasible (interior_point_solver.cpp).
+  bool warm_start_strictly_inside = false;
   /// With node constraints and no warm start: the request's unconstrained optimum, already
   /// solved on its grid in its class (the class survey's plan, drivers/constrained_classes.cpp).
   /// Newton polishes it (an iteration or two) instead of solving the class again through the

@@ -58,7 +58,8 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
 /// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
 /// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
 /// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
-/// strictly inside instead of from the unconstrained optimum.
+/// strictly inside instead of from the unconstrained optimum, with a request's own recipe
+/// (SolverOptions::warm_start_strictly_inside).
 PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
                                    const Maneuver& at_minimum_time, const SolverOptions& options) {
   PlanningProblem effort = problem;
@@ -68,6 +69,7 @@ PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
   SolverOptions o = options;
   o.warm_start = &at_minimum_time;
   o.constrained_from_warm_start = true;
+  o.warm_start_strictly_inside = true;
   return planAtResolution(effort, o);
 }
 
@@ -325,15 +327,73 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   return result;
 }
 
+namespace {
+
+/// Why a bounded minimum-effort answer needs the minimum-time phase (empty: it does not): it
+/// ended infeasible (a local verdict), stopped (near T* the feasible set is thin and a cold start
+/// may not find it), or converged outside a bound (fourth_order's Richardson combination of two
+/// cold sub-solves: up to 33 N m beyond on Betts with gravity gradient at 1.02 T*).
+std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResult& result) {
+  if (result.termination == Termination::Infeasible) return "ended infeasible";
+  if (result.termination == Termination::NotConverged) return "did not converge";
+  if (!result.converged() || !problem.hasNodeConstraints()) return "";
+  const double outside = checkConstraints(problem, result.maneuver).max_relative_violation;
+  if (outside <= kNodeConstraintTolerance) return "";
+  return "left a bound by " + exactNumber(outside) + " (relative)";
+}
+
+/// A bounded minimum-effort answer from the minimum-time plan at T* ≤ T (`first` the solve
+/// that needed it, `why` how it ended): the plan from T*'s, else `first` with what was tried.
+PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult& first,
+                               const std::string& why, const PlanResult& minimum_time,
+                               const RichardsonPair& pair, const SolverOptions& options) {
+  const double T_star = minimum_time.minimum_duration;
+  PlanResult again =
+      planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, options);
+  const std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
+                           " s) after the first solve " + why;
+  const bool was_infeasible = first.termination == Termination::Infeasible;
+  if (!again.converged() && !was_infeasible) {
+    // Nothing better than the first answer: it stays, with what was tried.
+    PlanResult kept = first;
+    kept.message += note + ": " + terminationName(again.termination) + " (" + again.message + ")";
+    return kept;
+  }
+  if (again.termination == Termination::Infeasible) {
+    // Feasible at T* ≤ T, yet not reached from T*'s plan: not a proof of infeasibility.
+    again.termination = Termination::NotConverged;
+    again.message = "not converged (feasible: T* = " + exactNumber(T_star) +
+                    " s <= the requested duration, but the minimum-effort solve from the "
+                    "minimum-time plan ended at an infeasible point): " +
+                    again.message;
+  }
+  again.message += note;
+  std::vector<Attempt> attempts = first.attempts;
+  for (Attempt a : minimum_time.attempts) {
+    a.kept = false;
+    attempts.push_back(a);
+  }
+  for (Attempt a : again.attempts) {
+    a.stage = AttemptStage::ConstrainedRetry;
+    a.start = AttemptStart::WarmStart;
+    attempts.push_back(a);
+  }
+  again.attempts = attempts;
+  return again;
+}
+
+}  // namespace
+
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   PlanResult result = planAtResolution(problem, options);
-  if (result.termination != Termination::Infeasible || !std::isfinite(smallestAuthority(problem)) ||
-      problem.accuracy.active()) {
+  const std::string why = needsMinimumTimeStart(problem, result);
+  if (why.empty() || !std::isfinite(smallestAuthority(problem)) || problem.accuracy.active()) {
     return result;
   }
   // The interior point's "infeasible" is local (its elastic form stopped at a minimum of the
-  // violation): the minimum-time problem under the same bounds backs it or refutes it.
+  // violation), and a stop or a plan outside a bound is no answer: the minimum-time problem
+  // under the same bounds backs the verdict or gives a start strictly inside.
   PlanningProblem fastest = problem;
   fastest.objective = Objective::MinimumTime;
   fastest.time_margin = 0.0;
@@ -347,46 +407,30 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return r;
   };
-  std::ostringstream why;
+  std::ostringstream verdict;
   if (!minimum_time.converged()) {
-    why << "infeasible (a local verdict: the minimum-time problem under the same bounds found "
-           "no feasible duration either, "
-        << terminationName(minimum_time.termination) << "): " << result.message;
-    result.message = why.str();
+    if (result.termination == Termination::Infeasible) {
+      verdict << "infeasible (a local verdict: the minimum-time problem under the same bounds "
+                 "found no feasible duration either, "
+              << terminationName(minimum_time.termination) << "): " << result.message;
+      result.message = verdict.str();
+    } else {
+      result.message += "; the first solve " + why +
+                        " and the minimum-time problem under the same bounds did not converge (" +
+                        terminationName(minimum_time.termination) + ")";
+    }
     return finish(result);
   }
   const double T_star = minimum_time.minimum_duration;
   if (T_star > problem.duration) {
-    why << "infeasible: needs T >= " << T_star << " s under these bounds ("
-        << tStarKind(minimum_time) << "), requested " << problem.duration << " s";
-    result.message = why.str();
+    verdict << "infeasible: needs T >= " << T_star << " s under these bounds ("
+            << tStarKind(minimum_time) << "), requested " << problem.duration << " s";
+    result.termination = Termination::Infeasible;
+    result.message = verdict.str();
     return finish(result);
   }
-  PlanResult again = planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair,
-                                         withRemainingBudget(options, start));
-  why << "; started from the minimum-time plan (T* = " << T_star
-      << " s) after the first solve ended infeasible";
-  if (again.termination == Termination::Infeasible) {
-    // Feasible at T* ≤ T, yet not reached from T*'s plan: not a proof of infeasibility.
-    again.termination = Termination::NotConverged;
-    again.message = "not converged (feasible: T* = " + exactNumber(T_star) +
-                    " s <= the requested duration, but the minimum-effort solve from the "
-                    "minimum-time plan ended at an infeasible point): " +
-                    again.message;
-  }
-  again.message += why.str();
-  std::vector<Attempt> attempts = result.attempts;
-  for (Attempt a : minimum_time.attempts) {
-    a.kept = false;
-    attempts.push_back(a);
-  }
-  for (Attempt a : again.attempts) {
-    a.stage = AttemptStage::ConstrainedRetry;
-    a.start = AttemptStart::WarmStart;
-    attempts.push_back(a);
-  }
-  again.attempts = attempts;
-  return finish(again);
+  return finish(fromMinimumTimePlan(problem, result, why, minimum_time, pair,
+                                    withRemainingBudget(options, start)));
 }
 
 }  // namespace attitude_planner

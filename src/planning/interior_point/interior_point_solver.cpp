@@ -90,7 +90,14 @@ constexpr FormulationRecipe kRequestRecipe = {
 };
 /// The minimum-time search's feasibility probes (started from its last feasible plan,
 /// SolverOptions::constrained_from_warm_start): the elastic form first (an infeasible probe then
-/// pays one form), the free slacks with a monotone barrier as the retry.
+/// pays one form), the free slacks with a monotone barrier as the retry. Not for a start strictly
+/// inside every bound (SolverOptions::warm_start_strictly_inside: the plan at T* time-scaled to
+/// (1 + m) T*), which takes kRequestRecipe: from such a well-centred start LOQO's σ = 0.1 (0.05
+/// (1 − ξ)/ξ)³ is ~1e-8 (ξ ≈ 0.9), μ fell from 0.43 to 6e-9 (× f/m) in one step with the
+/// decrement still 0.1, and the elastic solve crawled with steps cut to 1/64 … 1/128 to the
+/// iteration limit (Bilimoria–Wie N = 128 at 1.02 T*; the monotone retry likewise, at μ = 8e-8).
+/// Mehrotra's predictor–corrector from the same start converges in 12 iterations to the same
+/// plan (docs/results/near_minimum_time.md).
 constexpr FormulationRecipe kProbeRecipe = {
     {Formulation::Elastic, BarrierRule::Loqo, "the elastic form"},
     {Formulation::FreeSlacks, BarrierRule::Monotone, "free slacks"},
@@ -119,7 +126,8 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
                                const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true) {
   const FormulationRecipe& recipe =
-      options.constrained_from_warm_start ? kProbeRecipe : kRequestRecipe;
+      options.constrained_from_warm_start && !options.warm_start_strictly_inside ? kProbeRecipe
+                                                                                 : kRequestRecipe;
   GridOutcome first = solveOnGrid(
       problem, options, solve.parameters, solve.context,
       {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals, final_grid});
@@ -310,12 +318,22 @@ void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
   result->message += "; grid continuation from N = " + std::to_string(record.levels.front().steps);
 }
 
+/// A warm start on the requested grid strictly inside every bound (the time-scaled T* plan):
+/// the requested grid's own start, which a coarser level's (its unconstrained optimum) is not.
+bool startsInsideOnThisGrid(const PlanningProblem& problem, const SolverOptions& options) {
+  return options.constrained_from_warm_start && options.warm_start_strictly_inside &&
+         options.warm_start && options.warm_start->steps() == problem.steps;
+}
+
 /// The interior point on the requested grid, through the grid continuation above
-/// parameters.coarsest_grid (strategies/grid_continuation.hpp).
+/// parameters.coarsest_grid (strategies/grid_continuation.hpp), except from a start strictly
+/// inside on this grid: the continuation's coarsest level starts from its unconstrained optimum,
+/// not from that plan (Bilimoria–Wie at 1.02 T*, N = 512 and 1024: "infeasible" on the N = 128
+/// level, 0.43 beyond |τ_z| ≤ 1; from the plan, converged).
 GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& options,
                            const Solve& solve) {
   const GridLevelRule rule = interiorPointGridRule(solve.parameters);
-  if (!usesCoarserLevel(problem, rule)) {
+  if (!usesCoarserLevel(problem, rule) || startsInsideOnThisGrid(problem, options)) {
     return solveGridWithRetry(problem, options, solve, nullptr, nullptr);
   }
   Formulation finest = Formulation::FreeSlacks;

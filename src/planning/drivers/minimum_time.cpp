@@ -45,6 +45,14 @@ std::vector<Attempt> joined(std::vector<Attempt> before, const std::vector<Attem
   return before;
 }
 
+/// `attempts` appended to `trail`, none kept but its kept one if `keep`.
+void appendTrail(const std::vector<Attempt>& attempts, bool keep, std::vector<Attempt>* trail) {
+  for (Attempt a : attempts) {
+    a.kept = a.kept && keep;
+    trail->push_back(a);
+  }
+}
+
 /// fourth_order's minimum-time answer keeps its two second_order plans at T* (each meeting its
 /// bounds there): a plan at T ≥ T* starts each sub-solve from its own (fourthOrderFromPair).
 struct RichardsonPair {
@@ -89,9 +97,7 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
     sub.steps = 2 * problem.steps;
     fine = planFromMinimumTimePlan(sub, T, pair.fine, withRemainingBudget(options, started));
   }
-  std::vector<Attempt> trail = coarse.attempts;
-  for (Attempt& a : trail) a.kept = false;
-  trail.insert(trail.end(), fine.attempts.begin(), fine.attempts.end());
+  std::vector<Attempt> trail = joined(coarse.attempts, fine.attempts);
   const std::string what = "fourth_order (Richardson extrapolation of second_order at N = " +
                            std::to_string(problem.steps) +
                            " and 2N = " + std::to_string(2 * problem.steps) +
@@ -117,10 +123,7 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
                    ": N: " + coarse.message + " | 2N: " + fine.message;
   if (replaced) {  // the N solve's plan is the one returned
     trail = coarse.attempts;
-    for (Attempt a : fine.attempts) {
-      a.kept = false;
-      trail.push_back(a);
-    }
+    appendTrail(fine.attempts, false, &trail);
   }
   result.attempts = trail;
   return result;
@@ -134,14 +137,6 @@ PlanResult planFromMinimumTime(const PlanningProblem& problem, double T,
     return fourthOrderFromPair(problem, T, pair, options);
   }
   return planFromMinimumTimePlan(problem, T, at_minimum_time, options);
-}
-
-/// `attempts` appended to `trail`, none kept but its kept one if `keep`.
-void appendTrail(const std::vector<Attempt>& attempts, bool keep, std::vector<Attempt>* trail) {
-  for (Attempt a : attempts) {
-    a.kept = a.kept && keep;
-    trail->push_back(a);
-  }
 }
 
 /// fourth_order (docs/design/fourth_order.md, "Minimum time"): a fourth_order plan at T exists
@@ -266,10 +261,7 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
   if (sharpened && !sharpened->converged()) sharpening_trail = sharpened->attempts;
   if (!sharpened || !sharpened->converged()) {
     // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
-    for (Attempt a : sharpening_trail) {
-      a.kept = false;
-      result.attempts.push_back(a);
-    }
+    appendTrail(sharpening_trail, false, &result.attempts);
     return result;
   }
   sharpened->attempts = joined(result.attempts, sharpened->attempts);
@@ -369,10 +361,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
   }
   again.message += note;
   std::vector<Attempt> attempts = first.attempts;
-  for (Attempt a : minimum_time.attempts) {
-    a.kept = false;
-    attempts.push_back(a);
-  }
+  appendTrail(minimum_time.attempts, false, &attempts);
   for (Attempt a : again.attempts) {
     a.stage = AttemptStage::ConstrainedRetry;
     a.start = AttemptStart::WarmStart;

@@ -139,6 +139,11 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"complementarity\": " << jsonNumber(r.minimum_time.complementarity)
       << ", \"solves\": " << r.minimum_time.solves << ", \"second_order_sufficient\": "
       << (r.minimum_time.second_order_sufficient ? "true" : "false") << "},\n"
+      << "  \"duration_verdict\": {\"lower_bound\": " << jsonNumber(r.duration_verdict.lower_bound)
+      << ", \"lower_bound_basis\": " << jsonString(r.duration_verdict.lower_bound_basis)
+      << ", \"proven_infeasible\": " << (r.duration_verdict.proven_infeasible ? "true" : "false")
+      << ", \"least_duration_found\": " << jsonNumber(r.duration_verdict.least_duration_found)
+      << "},\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"

@@ -135,6 +135,15 @@ MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& c) {
   return msg;
 }
 
+DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& v) {
+  DurationVerdictSummary msg;
+  msg.lower_bound = v.lower_bound;
+  msg.lower_bound_basis = v.lower_bound_basis;
+  msg.proven_infeasible = v.proven_infeasible;
+  msg.least_duration_found = v.least_duration_found;
+  return msg;
+}
+
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
   std::vector<EffectSpec> specs;
   for (std::size_t i = 0; i < effects.size(); ++i) {

@@ -33,6 +33,12 @@ int errorCodeOf(Termination termination) {
 std::string infeasibleSummary(const PlanningProblem& problem, const PlanResult& result) {
   std::ostringstream s;
   s << "infeasible: ";
+  if (result.duration_verdict.proven_infeasible) {
+    // The core's message opens with the bound and the bounds in force, then how it is proven.
+    const std::string& m = result.message;
+    return m.substr(0, m.find(" (proven")) +
+           " (proven; duration_verdict); details has the solver's account";
+  }
   const ConstraintCheck check = result.maneuver.attitude.empty()
                                     ? ConstraintCheck()
                                     : checkConstraints(problem, result.maneuver);

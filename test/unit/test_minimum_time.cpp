@@ -384,7 +384,7 @@ TEST(MinimumTime, AFourthOrderPlanOutsideItsBoundsStartsAgainFromTheMinimumTimeP
   EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::ConstrainedRetry);
 }
 
-TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndNamesTStar) {
+TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndReportsTStarAsTheLeastFound) {
   // `duration` with minimum_time is an upper bound; below T* the answer names T*, and so does a
   // minimum-effort request at that duration.
   ap::PlanningProblem p = minimumTimeCases()[1];  // Bilimoria–Wie
@@ -394,13 +394,17 @@ TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndNamesTStar) {
   const ap::PlanResult bounded = ap::planManeuver(p);
   EXPECT_EQ(bounded.termination, ap::Termination::Infeasible) << bounded.message;
   EXPECT_NEAR(bounded.minimum_duration, free.minimum_duration, 1e-9 * free.minimum_duration);
-  std::ostringstream named;
-  named << "needs T >= " << bounded.minimum_duration << " s";
-  EXPECT_NE(bounded.message.find(named.str()), std::string::npos) << bounded.message;
+  // T* is a local minimum: named as the least duration found, not as a proven requirement,
+  // beside the proven bound, which lies below it.
+  EXPECT_EQ(bounded.duration_verdict.least_duration_found, bounded.minimum_duration);
+  EXPECT_FALSE(bounded.duration_verdict.proven_infeasible);
+  EXPECT_GT(bounded.duration_verdict.lower_bound, 0.0);
+  EXPECT_LE(bounded.duration_verdict.lower_bound, free.minimum_duration);
   p.objective = ap::Objective::MinimumEffort;
   const ap::PlanResult effort = ap::planManeuver(p);
   EXPECT_EQ(effort.termination, ap::Termination::Infeasible) << effort.message;
   EXPECT_GT(effort.minimum_duration, p.duration) << effort.message;
+  EXPECT_EQ(effort.duration_verdict.least_duration_found, effort.minimum_duration);
 }
 
 TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {

@@ -138,6 +138,12 @@ constexpr int kMinSteps = 4;
 /// N = 1e6, 2.3 GB peak; docs/results/performance.md), so N = 2e6 needs ~4.6 GB. The former limit,
 /// 1e7, would need ~23 GB and be killed for memory on a 24 GB machine instead of being refused.
 constexpr int kMaxSteps = 2000000;
+/// The magnitudes the planner works in, in SI units: every moment of inertia, duration, step,
+/// bound and the torque scale J/T² within [1/kMagnitudeRange, kMagnitudeRange]. The solvers form
+/// squares and fourth powers of them (the cost, the Hessian's h⁻⁴ terms), which stay normal
+/// doubles there; outside it a "converged" answer could rest on an overflowed cost or a denormal
+/// step, so such a request is refused by name (validateProblem).
+constexpr double kMagnitudeRange = 1e50;
 
 /// A rest-to-rest / slew problem for the fully actuated rigid body.
 struct PlanningProblem {
@@ -266,6 +272,12 @@ void validateProblem(const PlanningProblem& problem);
 
 /// Throws InvalidInput naming `field` and the value unless extra_revolutions ≥ 0.
 void requireExtraRevolutions(int extra_revolutions, const std::string& field);
+
+/// Throws StepTooLarge ("increase steps") naming extra_revolutions, the steps and the least N
+/// that can represent them, unless a plan of `steps` steps can turn K extra times (2K < N − 2: each
+/// step turns less than π rad). A class the grid cannot represent is refused, never answered with
+/// another.
+void requireRepresentableTurns(int extra_revolutions, int steps);
 
 /// Sets the scheme of `problem` from its name, or lets the planner choose it for "auto"
 /// (accuracy.choose_scheme; validateProblem requires an accuracy target then). Throws

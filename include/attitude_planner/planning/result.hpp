@@ -227,6 +227,22 @@ struct MinimumTimeCertificate {
   bool second_order_sufficient = false;
 };
 
+/// What backs a verdict on durations (bounded requests, minimum time): a proven lower bound on
+/// the duration any plan needs, and the least duration at which this request found a plan. An
+/// "infeasible" answer rests on one of them, and says which (docs/design/planner_behaviour.md).
+struct DurationVerdict {
+  /// T_c [s]: no plan of the continuous problem is shorter (proven from the momentum the torque
+  /// bounds allow and the angle to turn; the grid is held to it within O(h)); 0: none applies.
+  double lower_bound = 0.0;
+  std::string lower_bound_basis;  ///< how lower_bound is proven (empty with none)
+  /// The answer "infeasible" is proven (the request's T is below lower_bound on its grid), not
+  /// the local verdict of a solve.
+  bool proven_infeasible = false;
+  /// The least T [s] at which a plan meeting the bounds was found (a local minimum-time plan:
+  /// not a requirement); 0: none was found or sought.
+  double least_duration_found = 0.0;
+};
+
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
 /// and the figures that judge it.
 struct PlanResult {
@@ -247,6 +263,8 @@ struct PlanResult {
   double minimum_duration = 0.0;
   /// minimum_time: what backs T* (the free-time interior point's KKT residuals, or the search).
   MinimumTimeCertificate minimum_time;
+  /// Bounded requests: what backs a verdict on the duration (DurationVerdict).
+  DurationVerdict duration_verdict;
   /// Σ_k ½ w_k |τ_k|² [N²·m²]: the scheme's own objective (w_k = 1, k = 1..N−1, for paper and
   /// variational, as in the seed; second_order: k = 0..N with w_0 = w_N = ½; fourth_order:
   /// Gregory's end-corrected weights, schemeTorqueWeight).

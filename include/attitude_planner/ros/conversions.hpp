@@ -14,6 +14,7 @@
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/Constraint.h"
 #include "attitude_planner/DriftTwoInputManeuver.h"
+#include "attitude_planner/DurationVerdictSummary.h"
 #include "attitude_planner/Effect.h"
 #include "attitude_planner/MinimumTimeSummary.h"
 #include "attitude_planner/PlanAttempt.h"
@@ -95,6 +96,8 @@ Constraint constraintToMsg(const PlanningConstraint& constraint);
 PlanAttempt attemptToMsg(const Attempt& attempt);
 /// What backs a minimum-time answer's T* (PlanResult::minimum_time) as a message.
 MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& certificate);
+/// The verdict on durations of a result (PlanResult::duration_verdict) as a message.
+DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& verdict);
 
 /// The request field a core error names, in the request's own spelling: the core (and the scene)
 /// say `initial.angular_velocity`, `constraints[0].max_torque_norm`,

@@ -295,6 +295,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->attempts.clear();
   for (const Attempt& a : r.attempts) res->attempts.push_back(ros_conversions::attemptToMsg(a));
   res->minimum_time = ros_conversions::minimumTimeToMsg(r.minimum_time);
+  res->duration_verdict = ros_conversions::durationVerdictToMsg(r.duration_verdict);
 }
 
 }  // namespace attitude_planner

@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/fourth_order.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/strategies/starts.hpp"
 
 namespace attitude_planner {
 
@@ -223,16 +225,82 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
   return result;
 }
 
+/// Spinning ends: how far below T* the probe asks (probedBelow), and how many probes descend.
+constexpr double kProbeBelow = 0.01;
+constexpr int kMaxProbes = 4;
+
+/// Minimum time with spinning ends has local minima that the structured starts miss (issue 45:
+/// from the geodesic alone T* was 3 % to over 11 % too long on random problems, a minimum-effort
+/// plan existing just below it). So a free-time answer with spinning ends is probed: a cold
+/// minimum-effort solve at (1 − kProbeBelow) T*; where it proves that T feasible
+/// (provesFeasible), the free-time solve from its plan descends to a lower KKT point, which is
+/// probed again. A probe that finds nothing ends it; the trail keeps every probe.
+PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer,
+                       const SolverOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
+    PlanningProblem effort = problem;
+    effort.objective = Objective::MinimumEffort;
+    effort.time_margin = 0.0;
+    effort.duration = (1.0 - kProbeBelow) * answer.minimum_duration;
+    const SolverOptions remaining = withRemainingBudget(options, started);
+    if (budgetSpent(remaining)) break;
+    const PlanResult below =
+        runInternalPhase("the probe below T*", [&] { return planAtResolution(effort, remaining); });
+    std::vector<Attempt> tried;
+    std::optional<PlanResult> lower;
+    if (provesFeasible(effort, below)) {
+      lower = freeTimeFromPlan(problem, below.maneuver, effort.duration,
+                               withRemainingBudget(options, started), &tried);
+    }
+    if (!provesFeasible(effort, below)) {
+      appendTrail(below.attempts, false, &answer.attempts);
+      break;
+    }
+    const std::string found = "; a plan was found at " + exactNumber(effort.duration) +
+                              " s, below the T* = " + exactNumber(answer.minimum_duration) +
+                              " s reached before";
+    if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
+      lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
+      lower->message += found + ", and the free-time solve from it descended";
+      answer = std::move(*lower);
+      continue;
+    }
+    // No lower KKT point from it: the probe's plan is the answer, an upper bound on T*.
+    PlanResult upper = below;
+    upper.attempts = joined(answer.attempts, below.attempts);
+    appendTrail(lower ? lower->attempts : tried, false, &upper.attempts);
+    upper.minimum_duration = effort.duration;
+    upper.minimum_time = MinimumTimeCertificate{};
+    upper.minimum_time.solves = answer.minimum_time.solves;
+    upper.message = "minimum time T* <= " + exactNumber(effort.duration) +
+                    " s, the least duration found feasible (an upper bound)" + found +
+                    " (its minimum-effort plan is returned): " + below.message;
+    answer = std::move(upper);
+  }
+  return answer;
+}
+
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
 /// or if none of its solves converged, the search (searchMinimumTime, an upper bound) with what is
 /// left of the time budget; where the free-time problem applies, the search's plan starts one more
 /// free-time solve (a KKT point). The trail keeps every stage in order: the free-time solves that
 /// did not give the answer, the search's starts, the solve from the search's plan.
+PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
+
 PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options,
                            RichardsonPair* pair) {
   if (problem.scheme == SchemeKind::FourthOrder) {
     return fourthOrderMinimumTime(problem, options, pair);
   }
+  const auto started = std::chrono::steady_clock::now();
+  PlanResult answer = structuredMinimumTime(problem, options);
+  if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
+  return probedBelow(problem, std::move(answer), withRemainingBudget(options, started));
+}
+
+/// minimumTimePlan of a discretization before the probe below T* (probedBelow).
+PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
@@ -275,6 +343,8 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   validateProblem(problem);
   validateMinimumTime(problem);
+  const DurationLowerBound bound = durationLowerBound(problem);
+  if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
   const std::string impossible = infeasibleAtEveryDuration(problem);
   if (!impossible.empty()) {
     PlanResult none;
@@ -284,23 +354,27 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   }
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
-  PlanResult result = minimumTimePlan(problem, options, &pair);
+  PlanResult result =
+      runInternalPhase("minimum time", [&] { return minimumTimePlan(problem, options, &pair); });
+  recordLowerBound(bound, &result);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
   if (problem.duration > 0 && T_star > problem.duration * (1.0 + kMinimumTimeTolerance)) {
-    // `duration` is an upper bound: the request asked for T ≤ duration.
+    // `duration` is an upper bound: the request asked for T ≤ duration. T* is local.
     result.termination = Termination::Infeasible;
-    std::ostringstream why;
-    why << "infeasible: needs T >= " << T_star << " s under these bounds (" << tStarKind(result)
-        << "), requested duration <= " << problem.duration << " s";
-    result.message = why.str() + result.message;
+    result.duration_verdict.least_duration_found = T_star;
+    result.message = localInfeasibility(problem.duration, T_star, tStarKind(result), bound) + "; " +
+                     result.message;
     return result;
   }
   if (problem.time_margin > 0.0) {
     const std::vector<Attempt> search_trail = result.attempts;
     const Maneuver at_minimum_time = result.maneuver;
-    result = planFromMinimumTime(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
+    result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
+      return planFromMinimumTime(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
                                  pair, withRemainingBudget(options, start));
+    });
+    recordLowerBound(bound, &result);
     std::vector<Attempt> attempts = search_trail;
     for (Attempt& a : attempts) a.kept = false;
     for (Attempt a : result.attempts) {
@@ -374,8 +448,12 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
 }  // namespace
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
+  validateProblem(problem);
+  const DurationLowerBound bound = durationLowerBound(problem);
+  if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
   const auto start = std::chrono::steady_clock::now();
   PlanResult result = planAtResolution(problem, options);
+  recordLowerBound(bound, &result);
   const std::string why = needsMinimumTimeStart(problem, result);
   if (why.empty() || !std::isfinite(smallestAuthority(problem)) || problem.accuracy.active()) {
     return result;
@@ -388,9 +466,11 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   fastest.time_margin = 0.0;
   fastest.duration = 0.0;
   RichardsonPair pair;
-  const PlanResult minimum_time =
-      minimumTimePlan(fastest, withRemainingBudget(options, start), &pair);
+  const PlanResult minimum_time = runInternalPhase("the minimum-time phase", [&] {
+    return minimumTimePlan(fastest, withRemainingBudget(options, start), &pair);
+  });
   const auto finish = [&](PlanResult r) {
+    recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     r.solve_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -412,14 +492,17 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   }
   const double T_star = minimum_time.minimum_duration;
   if (T_star > problem.duration) {
-    verdict << "infeasible: needs T >= " << T_star << " s under these bounds ("
-            << tStarKind(minimum_time) << "), requested " << problem.duration << " s";
     result.termination = Termination::Infeasible;
-    result.message = verdict.str();
+    result.duration_verdict.least_duration_found = T_star;
+    result.message = localInfeasibility(problem.duration, T_star, tStarKind(minimum_time), bound) +
+                     " (" + terminationName(Termination::Infeasible) + " at T: " + result.message +
+                     ")";
     return finish(result);
   }
-  return finish(fromMinimumTimePlan(problem, result, why, minimum_time, pair,
-                                    withRemainingBudget(options, start)));
+  return finish(runInternalPhase("the restart from the minimum-time plan", [&] {
+    return fromMinimumTimePlan(problem, result, why, minimum_time, pair,
+                               withRemainingBudget(options, start));
+  }));
 }
 
 }  // namespace attitude_planner

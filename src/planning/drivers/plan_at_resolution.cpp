@@ -16,6 +16,7 @@
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
+#include "planning/strategies/starts.hpp"
 
 namespace attitude_planner {
 
@@ -90,6 +91,21 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   PlanResult result = richardsonCombination(problem, coarse, fine);
   result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
   return result;
+}
+
+/// A rest-to-rest request that names its class (long_way, extra turns) is never answered with a
+/// plan of another class: such a plan ends NotConverged, saying so (classInconsistency). With
+/// spinning ends the lifts are counted from the coasting displacement, and a converged plan of a
+/// class's basin may turn far less than its lift (measured: a spin handed over between axes,
+/// 9.4 rad against a lift of 19.7): the rule is not applied there.
+void refuseAnotherClass(const PlanningProblem& problem, PlanResult* result) {
+  const bool class_named =
+      problem.direction == RotationDirection::LongWay || problem.extra_revolutions > 0;
+  if (!class_named || !result->converged() || hasSpinningEnds(problem)) return;
+  const std::string why = classInconsistency(*result);
+  if (why.empty()) return;
+  result->termination = Termination::NotConverged;
+  result->message = "not converged in the requested class: " + why + " (" + result->message + ")";
 }
 
 /// The trail of a solve that `earlier` attempts led to: those (none kept any more), then the
@@ -225,6 +241,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);
+  refuseAnotherClass(problem, &result);
   if (problem.hasNodeConstraints() && result.maneuver.steps() == problem.steps) {
     const ConstraintCheck check = checkConstraints(problem, result.maneuver);
     result.constraints = check.names;

@@ -234,7 +234,10 @@ class Walk {
                  : std::numeric_limits<double>::quiet_NaN();
     trail_.push_back(a);
     context_.record(a);
-    if (!plan) return;
+    if (!plan) {
+      if (!kept_) unplanned_ = std::move(r);  // how the walk ends if no attempt plans
+      return;
+    }
     if (a.stage != AttemptStage::MoreStarts) {
       solved_.push_back({a.homotopy, own_iterations, r.converged()});
     }
@@ -291,6 +294,9 @@ class Walk {
   std::size_t first_recorded_;
   std::vector<Attempt> trail_;
   std::optional<PlanResult> kept_;
+  /// The last attempt that produced no plan on the requested grid (e.g. a boundary rate with no
+  /// step on a coarser one), while none did: the answer if none ever does.
+  PlanResult unplanned_;
   std::size_t kept_at_ = 0;
   int kept_iterations_ = 0;
   std::vector<ClassSolve> solved_;  ///< the classes solved on the requested grid, in order
@@ -622,6 +628,14 @@ PlanResult Walk::finish() {
   std::optional<Termination> stop;
   const Termination last = trail_.back().termination;
   if (last == Termination::Cancelled || last == Termination::TimedOut) stop = last;
+  if (!kept_) {  // no attempt planned on the requested grid: nothing is kept
+    PlanResult none = std::move(unplanned_);
+    if (none.termination == Termination::Converged) none.termination = Termination::NotConverged;
+    none.message = "no attempt produced a plan on the requested grid (" +
+                   std::to_string(trail_.size()) + " tried); the last: " + none.message;
+    none.attempts = context_.attempts();
+    return none;
+  }
   PlanResult kept = std::move(*kept_);
   if (kept.converged()) stop.reset();
   trail_[kept_at_].kept = true;

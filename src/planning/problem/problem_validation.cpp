@@ -9,6 +9,7 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
+#include "planning/problem/duration_bound.hpp"
 
 namespace attitude_planner {
 
@@ -68,6 +69,49 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
       }
     }
   }
+}
+
+/// `value` (> 0, finite) within the magnitudes the planner works in, else InvalidInput naming
+/// `field`, the value and the cause (the floating-point range, not the physics).
+void requireMagnitude(double value, const std::string& field, const std::string& what) {
+  if (!(value > 0.0) || !std::isfinite(value)) return;  // their own rules name these
+  if (value <= kMagnitudeRange && value >= 1.0 / kMagnitudeRange) return;
+  throw InvalidInput(field, what + " = " + exactNumber(value) +
+                                " is outside the floating-point range the planner works in ([" +
+                                exactNumber(1.0 / kMagnitudeRange) + ", " +
+                                exactNumber(kMagnitudeRange) +
+                                "] in SI units: the solvers form squares and fourth powers of "
+                                "these magnitudes); state the problem in other units");
+}
+
+/// Every magnitude the solvers scale by, checked up front (requireMagnitude): the principal
+/// moments, T and h, the bounds, and the torque scale J/T² of the duration (minimum time: of
+/// the proven least duration, durationLowerBound). Boundary rates are left to the step check,
+/// which names them (step too large).
+void requireFloatingPointRange(const PlanningProblem& p, const Vector3& moments) {
+  requireMagnitude(moments(0), "inertia", "the least principal moment [kg m^2]");
+  requireMagnitude(moments(2), "inertia", "the largest principal moment [kg m^2]");
+  for (int i = 0; i < 3; ++i) {
+    requireMagnitude(p.max_torque(i), "actuator_limits.max_torque", "a bound [N m]");
+  }
+  for (std::size_t i = 0; i < p.constraints.size(); ++i) {
+    const PlanningConstraint& c = p.constraints[i];
+    if (c.isCone()) continue;
+    requireMagnitude(c.limit,
+                     "constraints[" + std::to_string(i) + "]." + constraintKindName(c.kind),
+                     "the limit");
+  }
+  double T = p.duration;
+  std::string field = "duration";
+  if (p.objective == Objective::MinimumTime && !(T > 0.0)) {
+    T = durationLowerBound(p).seconds;
+    field = "objective";
+    requireMagnitude(T, field, "the least duration any plan needs [s] (proven)");
+  }
+  if (!(T > 0.0)) return;
+  requireMagnitude(T, field, "T [s]");
+  if (!p.accuracy.active()) requireMagnitude(T / p.steps, field, "the step h = T/N [s]");
+  requireMagnitude(moments(2) / (T * T), field, "the torque scale J/T^2 [N m]");
 }
 
 }  // namespace
@@ -134,6 +178,9 @@ void validateProblem(const PlanningProblem& p) {
                        "requested accuracy");
   }
   validateConstraints(p.constraints, "constraints");
+  if (p.duration > 0.0 || p.objective == Objective::MinimumTime) {
+    requireFloatingPointRange(p, moments);
+  }
   if (p.accuracy.active()) {
     if (!std::isfinite(p.accuracy.value) || !(p.accuracy.value > 0.0)) {
       throw InvalidInput("accuracy_target: must be a finite number > 0 (" +
@@ -151,6 +198,7 @@ void validateProblem(const PlanningProblem& p) {
     }
   }
   requireExtraRevolutions(p.extra_revolutions, "extra_revolutions");
+  if (!p.accuracy.active()) requireRepresentableTurns(p.extra_revolutions, p.steps);
   requireRotation(p.initial_attitude, "initial.attitude");
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
@@ -176,6 +224,20 @@ void requireExtraRevolutions(int extra_revolutions, const std::string& field) {
                        " (whole extra turns in the sense of the chosen way; use direction "
                        "long_way to turn the other way)");
   }
+}
+
+void requireRepresentableTurns(int extra_revolutions, int steps) {
+  // The class with K extra turns has a lift of at least 2πK from R_1 to R_{N−1}; a plan in it
+  // turns at least that far (classInconsistency) in N − 2 steps of less than π each.
+  if (extra_revolutions == 0 || 2 * static_cast<long>(extra_revolutions) < steps - 2) return;
+  throw StepTooLarge("extra_revolutions",
+                     "step too large, increase steps: " + std::to_string(extra_revolutions) +
+                         " extra turns need a path of at least " +
+                         exactNumber(2 * M_PI * extra_revolutions) + " rad, which the " +
+                         std::to_string(steps - 2) +
+                         " inner steps (each less than pi rad) cannot turn: needs steps > " +
+                         std::to_string(2 * static_cast<long>(extra_revolutions) + 2) + ", got " +
+                         std::to_string(steps));
 }
 
 void validateOptions(const SolverOptions& o) {

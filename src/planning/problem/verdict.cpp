@@ -152,4 +152,25 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   result->step_residual = measureStepResidual(problem, result->maneuver).relative;
 }
 
+std::string classInconsistency(const PlanResult& result) {
+  const Maneuver& plan = result.maneuver;
+  const ExtremalSummary& extremal = result.extremal_summary;
+  if (!extremal.known || plan.steps() < 3) return "";
+  double turned = 0.0;  // Σ |log(R_kᵀR_{k+1})|, k = 1..N−2: the path from R_1 to R_{N−1}
+  for (int k = 1; k + 1 < plan.steps(); ++k) {
+    turned += so3::log(Matrix3(plan.attitude[k].transpose() * plan.attitude[k + 1])).norm();
+  }
+  // Within half a turn short of its lift a plan still counts as its class: the lift classes
+  // are finer than the topology (lifts two turns apart are one homotopy class), and the solve
+  // may end on a plan a little short of the lift (measured: θ = 2π − 0.1 + 1 turn on the seed's
+  // body, 6.364 rad against 6.383). More than half a turn short, its turns round to another
+  // class's.
+  if (turned >= extremal.angle - M_PI) return "";
+  std::ostringstream why;
+  why << "the plan turns " << exactNumber(turned) << " rad from R_1 to R_{N-1}, more than half "
+      << "a turn less than the " << exactNumber(extremal.angle)
+      << " rad of its class's lift, so it is in another class";
+  return why.str();
+}
+
 }  // namespace attitude_planner

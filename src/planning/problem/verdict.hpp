@@ -31,6 +31,14 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
                               bool constraints);
 
+/// Why a plan is not in the homotopy class its extremal names (empty: nothing says it is not).
+/// The class is the lift φ of R_1ᵀR_{N−1} its solve started on (ExtremalSummary::angle = |φ|);
+/// along a continuous lift of the plan's path, |φ| grows at most as fast as the body turns, so a
+/// plan ending on that lift turns at least |φ| between R_1 and R_{N−1}. A path more than half a
+/// turn shorter is in another class (e.g. the nearest one, after a solve labelled with extra
+/// turns slid back); within half a turn it counts as its class (see the definition).
+std::string classInconsistency(const PlanResult& result);
+
 /// Sets the terminal errors of an open-loop replay and replay_miss, the larger of the attitude
 /// miss and T × the velocity miss (one rule for every scheme's replay).
 void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result);

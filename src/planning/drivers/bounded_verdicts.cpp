@@ -1,0 +1,128 @@
+#include "planning/drivers/bounded_verdicts.hpp"
+
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/planning/constraints.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// The body at rest at R_0 for the request's N steps over `T` (zero torques and rates).
+Maneuver restingPlan(const PlanningProblem& problem, double T) {
+  Maneuver plan;
+  const int N = problem.steps;
+  plan.time_step = T / N;
+  for (int k = 0; k <= N; ++k) {
+    plan.time.push_back(k * plan.time_step);
+    plan.attitude.push_back(problem.initial_attitude);
+    plan.angular_velocity.push_back(Vector3::Zero());
+    plan.torque.push_back(Vector3::Zero());
+  }
+  return plan;
+}
+
+bool identicalRestStates(const PlanningProblem& problem) {
+  return problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) &&
+         so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0 &&
+         problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
+         (!problem.effects || problem.effects->empty());
+}
+
+/// Minimum time between identical rest states: T* = 0, the body is already there; the plan at
+/// (1 + margin) T* = 0 s is the body at rest (every node at t = 0, zero torques).
+PlanResult alreadyThere(const PlanningProblem& problem) {
+  PlanResult r;
+  r.termination = Termination::Converged;
+  r.scheme = problem.scheme;
+  r.solver = solverName(SolverKind::Structured);
+  r.maneuver = restingPlan(problem, 0.0);
+  r.duration = 0.0;
+  r.minimum_duration = 0.0;
+  r.message =
+      "converged: the initial and final states are the same state at rest, so T* = 0 s (no "
+      "motion is needed; the plan holds the body at rest, zero torques)";
+  return r;
+}
+
+/// "actuator_limits [0.1, 0.1, 0.1] N m, max_angular_rate 0.05 rad/s": the bounds in force.
+std::string boundsInForce(const PlanningProblem& problem) {
+  std::ostringstream out;
+  const char* separator = "";
+  if (problem.hasTorqueBounds()) {
+    out << "actuator_limits [" << problem.max_torque(0) << ", " << problem.max_torque(1) << ", "
+        << problem.max_torque(2) << "] N m";
+    separator = ", ";
+  }
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.isCone()) continue;
+    out << separator << describeConstraint(c);
+    separator = ", ";
+  }
+  return out.str();
+}
+
+PlanResult provenInfeasible(const PlanningProblem& problem, const DurationLowerBound& bound,
+                            double grid_bound) {
+  PlanResult r;
+  r.termination = Termination::Infeasible;
+  r.scheme = problem.scheme;
+  r.solver = solverName(SolverKind::Structured);
+  recordLowerBound(bound, &r);
+  r.duration_verdict.proven_infeasible = true;
+  std::ostringstream why;
+  why << "infeasible: any plan needs T >= " << exactNumber(bound.seconds) << " s under "
+      << boundsInForce(problem) << " (" << bound.basis << "; on " << problem.steps
+      << " steps at least " << exactNumber(grid_bound) << " s), requested "
+      << (problem.objective == Objective::MinimumTime ? "duration <= " : "T = ")
+      << exactNumber(problem.duration) << " s; answered before any solve";
+  r.message = why.str();
+  return r;
+}
+
+}  // namespace
+
+std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
+                                              const DurationLowerBound& bound) {
+  if (problem.objective == Objective::MinimumTime && identicalRestStates(problem)) {
+    return alreadyThere(problem);
+  }
+  if (!(bound.seconds > 0.0) || !(problem.duration > 0.0) || problem.accuracy.active()) {
+    return std::nullopt;
+  }
+  const double grid_bound = discreteDurationLowerBound(bound, problem.steps);
+  if (problem.duration >= grid_bound) return std::nullopt;
+  return provenInfeasible(problem, bound, grid_bound);
+}
+
+PlanResult runInternalPhase(const std::string& phase, const std::function<PlanResult()>& solve) {
+  try {
+    return solve();
+  } catch (const FieldError& e) {  // InvalidInput or StepTooLarge of a problem built here
+    PlanResult r;
+    r.termination = Termination::NotConverged;
+    r.message = phase + " failed on a problem the planner built (not the request): " + e.what();
+    return r;
+  }
+}
+
+void recordLowerBound(const DurationLowerBound& bound, PlanResult* result) {
+  result->duration_verdict.lower_bound = bound.seconds;
+  result->duration_verdict.lower_bound_basis = bound.basis;
+}
+
+std::string localInfeasibility(double requested, double least_found, const std::string& what_found,
+                               const DurationLowerBound& bound) {
+  std::ostringstream why;
+  why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
+      << exactNumber(requested) << " s; the least duration at which one was found is "
+      << exactNumber(least_found) << " s (" << what_found << ", not a requirement)";
+  if (bound.seconds > 0.0) {
+    why << "; any plan needs T >= " << exactNumber(bound.seconds) << " s (" << bound.basis << ")";
+  }
+  return why.str();
+}
+
+}  // namespace attitude_planner

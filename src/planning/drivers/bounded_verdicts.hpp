@@ -1,0 +1,37 @@
+// The verdicts of bounded requests as data (issue "honest verdicts"): what is answered before
+// any solve (identical rest states; a duration below the proven lower bound), how an internal
+// phase's failure is kept from reaching the user as an input error, and how a local
+// "infeasible" is worded next to the proven bound.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/problem/duration_bound.hpp"
+
+namespace attitude_planner {
+
+/// The answer to `problem` that needs no solve, if any: minimum time between identical rest
+/// states without effects (T* = 0: the body is there), or a bounded request whose duration lies
+/// below the proven lower bound on its grid (Infeasible, DurationVerdict::proven_infeasible).
+std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
+                                              const DurationLowerBound& bound);
+
+/// `solve()` for a problem the planner built itself (a fallback, a probe, a restart): an
+/// InvalidInput or StepTooLarge it throws is about that internal problem, not the user's
+/// request, so it ends the phase NotConverged with the reason, "<phase> failed: ...".
+PlanResult runInternalPhase(const std::string& phase, const std::function<PlanResult()>& solve);
+
+/// Sets `result->duration_verdict`'s bound from `bound`.
+void recordLowerBound(const DurationLowerBound& bound, PlanResult* result);
+
+/// The words of a local "infeasible" at the requested T: no plan found at T, the least duration
+/// at which one was found (`least_found`, a local minimum-time plan, not a requirement), and the
+/// proven bound where one applies.
+std::string localInfeasibility(double requested, double least_found, const std::string& what_found,
+                               const DurationLowerBound& bound);
+
+}  // namespace attitude_planner

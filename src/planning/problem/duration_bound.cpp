@@ -1,0 +1,111 @@
+#include "planning/problem/duration_bound.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/lie/so3.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// The largest |τ| the bounds allow: the norm bound, or the box's corner (+∞: no bound).
+double largestTorque(const PlanningProblem& problem) {
+  double a = problem.hasTorqueBounds() ? problem.max_torque.norm()
+                                       : std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.kind == ConstraintKind::MaxTorqueNorm) a = std::min(a, c.limit);
+  }
+  return a;
+}
+
+/// The least rate limit w (+∞: none).
+double smallestRateLimit(const PlanningProblem& problem) {
+  double w = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.kind == ConstraintKind::MaxAngularRate) w = std::min(w, c.limit);
+  }
+  return w;
+}
+
+/// The data of g(T): ∫₀ᵀ min(w, min(p0 + a t, pT + a (T − t)) / λ) dt.
+struct PathLengthBound {
+  double a, w, lambda, p0, pT;
+
+  /// Midpoint rule on a concave integrand: never below the integral, so the T it gives stays a
+  /// lower bound.
+  double operator()(double T) const {
+    constexpr int kPanels = 4096;
+    const double dt = T / kPanels;
+    double sum = 0.0;
+    for (int i = 0; i < kPanels; ++i) {
+      const double t = (i + 0.5) * dt;
+      const double momentum = std::min(p0 + a * t, pT + a * (T - t));
+      sum += std::min(w, momentum / lambda);
+    }
+    return sum * dt;
+  }
+};
+
+/// The least T with g(T) ≥ θ (bisection on the increasing g), or 0 for θ = 0.
+double leastDurationForAngle(const PathLengthBound& g, double theta) {
+  if (!(theta > 0.0)) return 0.0;
+  double lo = 0.0, hi = 1.0;
+  // g(T) ≥ T·min(w, max(p0, pT)/λ) grows at least linearly once the rates are bounded away
+  // from 0, and like T² from rest: doubling reaches θ in a few dozen steps at any scale.
+  for (int i = 0; i < 4000 && std::isfinite(hi) && g(hi) < theta; ++i) {
+    lo = hi;
+    hi *= 2.0;
+  }
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (g(mid) >= theta ? hi : lo) = mid;
+  }
+  return lo;
+}
+
+}  // namespace
+
+DurationLowerBound durationLowerBound(const PlanningProblem& problem) {
+  DurationLowerBound bound;
+  if (problem.effects && !problem.effects->empty()) return bound;
+  const double a = largestTorque(problem), w = smallestRateLimit(problem);
+  if (!std::isfinite(a) && !std::isfinite(w)) return bound;
+  const double lambda =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues().minCoeff();
+  const Vector3 pi0 = problem.initial_attitude * problem.inertia * problem.initial_velocity;
+  const Vector3 piT = problem.final_attitude * problem.inertia * problem.final_velocity;
+  const double theta = so3::angleBetween(problem.initial_attitude, problem.final_attitude);
+  const PathLengthBound g{a, w, lambda, pi0.norm(), piT.norm()};
+  const double for_angle = leastDurationForAngle(g, theta);
+  const double for_momentum = std::isfinite(a) ? (piT - pi0).norm() / a : 0.0;
+  bound.seconds = std::max(for_angle, for_momentum);
+  if (!(bound.seconds > 0.0)) return bound;
+  std::ostringstream basis;
+  basis << "proven: ";
+  if (std::isfinite(a)) {
+    basis << "the spatial momentum R J Omega changes at most at the rate " << exactNumber(a)
+          << " N m the torque bounds allow, the rate |Omega| is at most |R J Omega| / "
+          << exactNumber(lambda) << " kg m^2 (the least principal moment)";
+  }
+  if (std::isfinite(w)) {
+    basis << (std::isfinite(a) ? " and " : "the rate |Omega| is at most ") << exactNumber(w)
+          << " rad/s";
+  }
+  basis << ", and the body must turn " << exactNumber(theta) << " rad"
+        << (for_momentum > for_angle
+                ? " and change its momentum by " + exactNumber((piT - pi0).norm()) + " N m s"
+                : "");
+  bound.basis = basis.str();
+  return bound;
+}
+
+double discreteDurationLowerBound(const DurationLowerBound& bound, int steps) {
+  return bound.seconds / (1.0 + kDiscreteMargin / std::max(steps, 1));
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,163 @@
+#include "support/bounded_requests.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "attitude_planner/analysis/replanning.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
+#include "support/random_problems.hpp"
+
+namespace attitude_planner {
+namespace robustness {
+
+namespace {
+
+/// A converged plan may leave a bound by this much (relative) before the check calls it wrong.
+constexpr double kPlanOutsideBounds = 1e-6;
+
+/// f in [lo, hi], from the case's seed (deterministic, no std::*_distribution).
+double fractionOf(std::uint64_t seed, double lo, double hi) {
+  const double u = static_cast<double>((seed >> 11) % 1000003) / 1000003.0;
+  return lo + (hi - lo) * u;
+}
+
+double peakNorm(const std::vector<Vector3>& v) {
+  double peak = 0.0;
+  for (const Vector3& x : v) peak = std::max(peak, x.norm());
+  return peak;
+}
+
+Vector3 peakPerAxis(const std::vector<Vector3>& v) {
+  Vector3 peak = Vector3::Zero();
+  for (const Vector3& x : v) peak = peak.cwiseMax(x.cwiseAbs());
+  return peak;
+}
+
+}  // namespace
+
+std::optional<BoundedRequest> boundedRequest(std::uint64_t suite_seed, int index) {
+  const RandomCase base = randomCase(suite_seed, index);
+  PlanResult unbounded;
+  try {
+    unbounded = planManeuver(base.problem);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (!unbounded.converged()) return std::nullopt;
+  BoundedRequest r;
+  r.index = index;
+  r.problem = base.problem;
+  r.fraction = fractionOf(base.seed, 0.6, 0.9);
+  const Maneuver& plan = unbounded.maneuver;
+  static const char* kKinds[] = {"norm", "box", "norm+rate", "replan"};
+  r.kind = kKinds[index % 4];
+  if (r.kind == "replan") {
+    const int k = plan.steps() / 3;
+    r.problem = remainderProblem(base.problem, k, plan.attitude[k], plan.angular_velocity[k]);
+    const std::vector<Vector3> rest(plan.torque.begin() + k, plan.torque.end());
+    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * peakNorm(rest))};
+  } else if (r.kind == "box") {
+    r.problem.max_torque = r.fraction * peakPerAxis(plan.torque);
+  } else {
+    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * peakNorm(plan.torque))};
+  }
+  if (r.kind == "norm+rate") {
+    const double boundary =
+        std::max(base.problem.initial_velocity.norm(), base.problem.final_velocity.norm());
+    const double rate = fractionOf(base.seed >> 7, 0.8, 1.0) * peakNorm(plan.angular_velocity);
+    r.problem.constraints.push_back(PlanningConstraint::maxAngularRate(std::max(rate, boundary)));
+  }
+  if ((index / 4) % 4 == 3) {
+    r.problem.objective = Objective::MinimumTime;
+    r.problem.duration = 0.0;
+  }
+  char label[300];
+  std::snprintf(label, sizeof label, "%s, %s f=%.2f%s", base.label.c_str(), r.kind.c_str(),
+                r.fraction, r.problem.objective == Objective::MinimumTime ? " minimum_time" : "");
+  r.label = label;
+  return r;
+}
+
+namespace {
+
+/// Minimum effort at T, cold: converged within the bounds.
+bool planFoundAt(const PlanningProblem& problem, double T, const SolverOptions& options) {
+  PlanningProblem at = problem;
+  at.objective = Objective::MinimumEffort;
+  at.time_margin = 0.0;
+  at.duration = T;
+  try {
+    const PlanResult r = planManeuver(at, options);
+    return r.converged() &&
+           checkConstraints(at, r.maneuver).max_relative_violation <= kPlanOutsideBounds;
+  } catch (const FieldError&) {
+    return false;
+  }
+}
+
+/// The least T of the minimum-time problem under the same bounds (0: none converged).
+double minimumTimeOf(const PlanningProblem& problem, const SolverOptions& options) {
+  PlanningProblem fastest = problem;
+  fastest.objective = Objective::MinimumTime;
+  fastest.time_margin = 0.0;
+  fastest.duration = 0.0;
+  try {
+    const PlanResult r = planManeuver(fastest, options);
+    return r.converged() ? r.minimum_duration : 0.0;
+  } catch (const FieldError&) {
+    return 0.0;
+  }
+}
+
+void checkVerdict(const PlanningProblem& p, const SolverOptions& options, VerdictCheck* check) {
+  const PlanResult& r = check->result;
+  const DurationVerdict& v = r.duration_verdict;
+  if (r.converged() && p.objective == Objective::MinimumEffort) {
+    const double outside = checkConstraints(p, r.maneuver).max_relative_violation;
+    if (outside > kPlanOutsideBounds) check->wrong = "converged";
+  } else if (r.converged() && r.minimum_duration > 0.0) {
+    check->check_duration = 0.99 * r.minimum_duration;
+    if (planFoundAt(p, check->check_duration, options)) check->wrong = "minimum time";
+  } else if (r.termination == Termination::Infeasible && v.proven_infeasible) {
+    const double T_star = minimumTimeOf(p, options);
+    check->check_duration = T_star;
+    if (T_star > 0.0 && T_star < p.duration) check->wrong = "proven";
+  } else if (r.termination == Termination::Infeasible && v.least_duration_found > 0.0) {
+    check->check_duration = 0.98 * v.least_duration_found;
+    if (p.objective == Objective::MinimumEffort && check->check_duration > p.duration &&
+        planFoundAt(p, check->check_duration, options)) {
+      check->wrong = "local";
+    }
+  }
+}
+
+}  // namespace
+
+VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& options) {
+  VerdictCheck check;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    check.result = planManeuver(request.problem, options);
+  } catch (const FieldError& e) {
+    check.input_error = e.what();
+    return check;
+  }
+  check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  checkVerdict(request.problem, options, &check);
+  return check;
+}
+
+std::string outcomeName(const VerdictCheck& check) {
+  if (!check.input_error.empty()) return "input error";
+  const PlanResult& r = check.result;
+  if (r.termination == Termination::Infeasible) {
+    return r.duration_verdict.proven_infeasible ? "infeasible (proven)" : "infeasible (local)";
+  }
+  return terminationName(r.termination);
+}
+
+}  // namespace robustness
+}  // namespace attitude_planner

@@ -1,0 +1,62 @@
+// Seeded bounded requests like the held-out ones of issue 45 ("honest verdicts"), shared by the
+// CI-sized gtest (test/unit/test_bounded_verdicts.cpp) and the full-size study
+// (studies/bounded_verdicts_study.cpp, scripts/bounded_verdicts →
+// docs/results/bounded_verdicts.md).
+//
+// Request `index` starts from robustness::randomCase(suite_seed, index) (random body, attitudes,
+// spinning or resting ends, horizon, N) and its unbounded minimum-effort plan, then bounds it by
+// kind (index mod 4):
+//   norm       |τ| ≤ f·(the plan's peak |τ_k|)
+//   box        |τ_i| ≤ f·(the plan's peak |τ_i|), each axis
+//   norm+rate  the norm bound and |Ω| ≤ max(boundary rates, f'·(the plan's peak |Ω_k|))
+//   replan     the rest of the plan from node N/3 (analysis/replanning's remainderProblem, a
+//              spinning start), under the norm bound of the rest's peak
+// with f drawn in [0.6, 0.9] (f' in [0.8, 1.0]). Every fourth request of a kind is asked as
+// minimum time instead (the bound in force, no duration).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+
+namespace attitude_planner {
+namespace robustness {
+
+struct BoundedRequest {
+  int index = 0;
+  PlanningProblem problem;
+  std::string kind;     ///< "norm", "box", "norm+rate", "replan"
+  double fraction = 0;  ///< f
+  std::string label;    ///< the random case's label, the kind and f
+};
+
+/// Request `index` of the suite, or nothing where its unbounded plan does not converge (no peak
+/// to bound by).
+std::optional<BoundedRequest> boundedRequest(std::uint64_t suite_seed, int index);
+
+/// One request planned and its verdict checked independently of the planner's own words.
+struct VerdictCheck {
+  PlanResult result;
+  double seconds = 0.0;  ///< planManeuver's wall time
+  /// The planner threw InvalidInput / StepTooLarge for this valid request (its text).
+  std::string input_error;
+  /// What was found wrong with the verdict (empty: nothing):
+  ///   converged      its plan leaves a bound by more than 1e-6 (relative)
+  ///   proven         a minimum-time plan exists below the proven bound on the grid
+  ///   local          least_duration_found X, yet a minimum-effort plan converges at 0.98 X
+  ///   minimum time   a minimum-effort plan converges at 0.99 T*
+  std::string wrong;
+  double check_duration = 0.0;  ///< the T the check solved at (0: none)
+};
+
+/// Plans `request` (planManeuver with `options`) and checks its verdict as above.
+VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& options = {});
+
+/// "converged", "infeasible (proven)", "infeasible (local)", "input error", or the termination.
+std::string outcomeName(const VerdictCheck& check);
+
+}  // namespace robustness
+}  // namespace attitude_planner

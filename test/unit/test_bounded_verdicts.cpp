@@ -1,0 +1,247 @@
+// Issue 45, "honest verdicts on bounded requests": the proven lower bound on the duration
+// against closed forms, invariances and every scheme's minimum time; the requests answered
+// before any solve; the floating-point range refused by name; classes the grid cannot represent
+// refused and a plan never answered as a class it is not in; and a seeded suite of bounded
+// requests whose every verdict is checked independently (test/support/bounded_requests.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
+#include "planning/problem/duration_bound.hpp"
+#include "support/bounded_requests.hpp"
+#include "support/random_problems.hpp"
+#include "support/scene_problem.hpp"
+
+using namespace attitude_planner;
+using test_support::sceneProblem;
+
+namespace {
+
+/// θ about `axis`, rest to rest, the body J = diag(moments).
+PlanningProblem slew(const Vector3& moments, double theta, const Vector3& axis) {
+  PlanningProblem p;
+  p.inertia = moments.asDiagonal();
+  p.allow_nonphysical_inertia = true;
+  p.final_attitude = so3::fromAxisAngle(axis.normalized(), theta);
+  p.duration = 10.0;
+  p.steps = 64;
+  return p;
+}
+
+PlanningProblem minimumTime(PlanningProblem p) {
+  p.objective = Objective::MinimumTime;
+  p.duration = 0.0;
+  return p;
+}
+
+}  // namespace
+
+TEST(DurationBound, IsTheEigenaxisBangBangTimeOfASphericalBody) {
+  // J = jI, |τ| ≤ a: the eigenaxis bang–bang slew is optimal, T* = 2√(θj/a); with |Ω| ≤ w below
+  // its peak √(aθ/j), bang–coast–bang, T* = θ/w + wj/a. The bound meets both.
+  const double j = 2.5, a = 0.3, theta = 2.2;
+  PlanningProblem p = slew(Vector3::Constant(j), theta, Vector3(1, -2, 0.5));
+  p.constraints = {PlanningConstraint::maxTorqueNorm(a)};
+  EXPECT_NEAR(durationLowerBound(p).seconds, 2 * std::sqrt(theta * j / a), 1e-9);
+  const double w = 0.5 * std::sqrt(a * theta / j);
+  p.constraints.push_back(PlanningConstraint::maxAngularRate(w));
+  EXPECT_NEAR(durationLowerBound(p).seconds, theta / w + w * j / a, 1e-5);
+}
+
+TEST(DurationBound, BoundsTheMomentumChangeOfASpinUp) {
+  // From rest to a spin of Ω about x, no turn asked for (θ = 0 up to the final attitude at
+  // rest): the momentum J Ω must be supplied at |τ| ≤ a, so T ≥ |JΩ|/a.
+  PlanningProblem p = slew(Vector3(1, 2, 3), 0.0, Vector3::UnitX());
+  p.final_velocity = Vector3(0.4, 0, 0);
+  p.max_torque = Vector3::Constant(0.1);
+  EXPECT_NEAR(durationLowerBound(p).seconds, 0.4 / (0.1 * std::sqrt(3.0)), 1e-12);
+}
+
+TEST(DurationBound, IsInvariantUnderWorldRotationAndScalesWithTimeAndInertia) {
+  PlanningProblem p = slew(Vector3(1, 2, 3.5), 2.0, Vector3(1, 1, 0));
+  p.initial_velocity = Vector3(0.1, -0.2, 0.05);
+  p.constraints = {PlanningConstraint::maxTorqueNorm(0.2), PlanningConstraint::maxAngularRate(0.6)};
+  const double base = durationLowerBound(p).seconds;
+  ASSERT_GT(base, 0.0);
+  PlanningProblem turned = p;
+  const Matrix3 Q = so3::fromAxisAngle(Vector3(0.3, -1, 2).normalized(), 2.7);
+  turned.initial_attitude = Q * p.initial_attitude;
+  turned.final_attitude = Q * p.final_attitude;
+  EXPECT_NEAR(durationLowerBound(turned).seconds, base, 1e-12 * base);
+  // t → s t: rates / s, torques / s²; J → j J: torques × j.
+  const double s = 7.0, jscale = 40.0;
+  PlanningProblem scaled = p;
+  scaled.inertia *= jscale;
+  scaled.initial_velocity /= s;
+  scaled.constraints = {PlanningConstraint::maxTorqueNorm(0.2 * jscale / (s * s)),
+                        PlanningConstraint::maxAngularRate(0.6 / s)};
+  EXPECT_NEAR(durationLowerBound(scaled).seconds, s * base, 1e-9 * s * base);
+}
+
+TEST(DurationBound, NoSchemesMinimumTimePlanIsShorter) {
+  // The bound holds for the continuous problem and, within kDiscreteMargin / N, for every
+  // transcription: checked against the minimum time of random bodies and slews, rest and
+  // spinning ends, norm and box bounds, every scheme.
+  const SchemeKind schemes[] = {SchemeKind::Paper, SchemeKind::Variational,
+                                SchemeKind::SecondOrder};
+  int checked = 0;
+  for (int i = 0; i < 9; ++i) {
+    PlanningProblem p = robustness::randomCase(4501, i).problem;
+    p.scheme = schemes[i % 3];
+    p.steps = 32;
+    p.initial_velocity *= (i % 2 == 0) ? 0.0 : 0.05;
+    p.final_velocity *= (i % 4 == 1) ? 0.05 : 0.0;
+    const double j = p.inertia.trace() / 3.0;
+    if (i % 2 == 0) {
+      p.constraints = {PlanningConstraint::maxTorqueNorm(0.05 * j)};
+    } else {
+      p.max_torque = Vector3::Constant(0.04 * j);
+    }
+    p = minimumTime(p);
+    SCOPED_TRACE(robustness::randomCase(4501, i).label + " " + schemeName(p.scheme));
+    const PlanResult r = planManeuver(p);
+    if (!r.converged()) continue;
+    ++checked;
+    const double bound = discreteDurationLowerBound(durationLowerBound(p), p.steps);
+    EXPECT_GE(r.minimum_duration, bound);
+    EXPECT_DOUBLE_EQ(r.duration_verdict.lower_bound, durationLowerBound(p).seconds);
+  }
+  EXPECT_GE(checked, 7);
+}
+
+TEST(BoundedVerdicts, AHopelessRequestAtTwoMillionStepsIsProvenInfeasibleBeforeAnySolve) {
+  // 3 rad with |τ| ≤ 0.1 N m on J = diag(10, 20, 30): T ≥ 2√(3·10/0.1) = 34.6 s, asked for 20 s.
+  PlanningProblem p = slew(Vector3(10, 20, 30), 3.0, Vector3::UnitZ());
+  p.constraints = {PlanningConstraint::maxTorqueNorm(0.1)};
+  p.duration = 20.0;
+  p.steps = 2000000;
+  const PlanResult r = planManeuver(p);
+  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message;
+  EXPECT_TRUE(r.duration_verdict.proven_infeasible);
+  EXPECT_GT(r.duration_verdict.lower_bound, p.duration);
+  EXPECT_EQ(r.iterations, 0);
+  EXPECT_TRUE(r.attempts.empty());
+  // The same as minimum time with that duration as its upper bound.
+  p.objective = Objective::MinimumTime;
+  const PlanResult fastest = planManeuver(p);
+  EXPECT_EQ(fastest.termination, Termination::Infeasible) << fastest.message;
+  EXPECT_TRUE(fastest.duration_verdict.proven_infeasible);
+}
+
+TEST(BoundedVerdicts, JustAboveTheBoundIsNotDeclaredInfeasibleByIt) {
+  // Spherical body: the bound is T*; 1 % above it a plan exists and converges.
+  PlanningProblem p = slew(Vector3::Constant(2.0), 2.0, Vector3(0, 1, 1));
+  p.constraints = {PlanningConstraint::maxTorqueNorm(0.2)};
+  p.duration = 1.05 * durationLowerBound(p).seconds;
+  const PlanResult r = planManeuver(p);
+  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_FALSE(r.duration_verdict.proven_infeasible);
+}
+
+TEST(BoundedVerdicts, MinimumTimeBetweenIdenticalRestStatesIsAnsweredAtOnce) {
+  PlanningProblem p = minimumTime(slew(Vector3(1, 2, 3), 0.0, Vector3::UnitX()));
+  p.initial_attitude = p.final_attitude = so3::fromAxisAngle(Vector3(1, 2, 2).normalized(), 1.0);
+  p.max_torque = Vector3::Constant(0.1);
+  const PlanResult r = planManeuver(p);
+  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.minimum_duration, 0.0);
+  EXPECT_EQ(r.iterations, 0);
+  ASSERT_EQ(r.maneuver.steps(), p.steps);
+  for (const Matrix3& R : r.maneuver.attitude) EXPECT_EQ(R, p.initial_attitude);
+  for (const Vector3& tau : r.maneuver.torque) EXPECT_TRUE(tau.isZero(0.0));
+}
+
+TEST(BoundedVerdicts, MagnitudesOutsideTheFloatingPointRangeAreRefusedByField) {
+  const PlanningProblem base = [] {
+    PlanningProblem p = slew(Vector3(1, 2, 3), 3.0, Vector3::UnitZ());
+    p.constraints = {PlanningConstraint::maxTorqueNorm(0.1)};
+    return p;
+  }();
+  struct Case {
+    const char* what;
+    PlanningProblem problem;
+    const char* field;
+  };
+  std::vector<Case> cases;
+  PlanningProblem huge_bound = minimumTime(base);
+  huge_bound.constraints = {};
+  huge_bound.max_torque = Vector3::Constant(1e300);
+  cases.push_back({"|tau_i| <= 1e300, minimum time", huge_bound, "actuator_limits.max_torque"});
+  PlanningProblem slow = minimumTime(base);
+  slow.constraints.push_back(PlanningConstraint::maxAngularRate(1e-300));
+  cases.push_back({"|Omega| <= 1e-300, minimum time", slow, "constraints[1].max_angular_rate"});
+  PlanningProblem heavy = base;
+  heavy.inertia *= 1e300;
+  cases.push_back({"J x 1e300", heavy, "inertia"});
+  PlanningProblem light = base;
+  light.inertia *= 1e-300;
+  cases.push_back({"J x 1e-300", light, "inertia"});
+  PlanningProblem brief = base;
+  brief.duration = 1e-300;
+  cases.push_back({"T = 1e-300 s", brief, "duration"});
+  PlanningProblem long_one = base;
+  long_one.duration = 1e300;
+  cases.push_back({"T = 1e300 s", long_one, "duration"});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    try {
+      const PlanResult r = planManeuver(c.problem);
+      ADD_FAILURE() << "answered " << terminationName(r.termination) << ": " << r.message;
+    } catch (const InvalidInput& e) {
+      EXPECT_EQ(e.field(), c.field) << e.what();
+    }
+  }
+}
+
+TEST(HomotopyClasses, ExtraTurnsTheStepsCannotTurnAreRefused) {
+  PlanningProblem p = sceneProblem("rest_to_rest", 128);
+  for (int turns : {63, 64, 1000}) {
+    p.extra_revolutions = turns;
+    try {
+      planManeuver(p);
+      ADD_FAILURE() << turns << " extra turns on 128 steps were planned";
+    } catch (const StepTooLarge& e) {
+      EXPECT_EQ(e.field(), "extra_revolutions") << e.what();
+    }
+  }
+  p.extra_revolutions = 62;  // 2K < N − 2: representable, so not refused up front
+  EXPECT_NO_THROW(validateProblem(p));
+}
+
+TEST(HomotopyClasses, APlanIsNeverAnsweredAsAClassItIsNotIn) {
+  // Each converged answer to a named class turns at least its lift between R_1 and R_{N−1}
+  // (measured here on the plan, independently of classInconsistency).
+  PlanningProblem p = sceneProblem("rest_to_rest", 128);
+  for (int turns : {1, 2, 5, 8, 20}) {
+    p.extra_revolutions = turns;
+    SCOPED_TRACE(std::to_string(turns) + " extra turns");
+    const PlanResult r = planManeuver(p);
+    if (!r.converged()) continue;
+    double turned = 0.0;
+    for (int k = 1; k + 1 < r.maneuver.steps(); ++k) {
+      turned += so3::angleBetween(r.maneuver.attitude[k], r.maneuver.attitude[k + 1]);
+    }
+    EXPECT_GE(turned, 2 * M_PI * turns) << r.message;
+    ASSERT_TRUE(r.extremal_summary.known);
+    EXPECT_EQ(r.extremal_summary.homotopy.extra_revolutions, turns);
+  }
+}
+
+TEST(BoundedVerdicts, SeededBoundedRequestsHaveHonestVerdicts) {
+  // A CI-sized slice of the study's suite (scripts/bounded_verdicts, 200 requests): no internal
+  // error reaches the user as an input error, and no verdict is contradicted by its check.
+  int requests = 0;
+  for (int i = 0; i < 16; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(4545, i);
+    if (!request) continue;
+    ++requests;
+    SCOPED_TRACE(request->label);
+    const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+    EXPECT_EQ(check.input_error, "");
+    EXPECT_EQ(check.wrong, "") << check.result.message;
+  }
+  EXPECT_GE(requests, 12);
+}

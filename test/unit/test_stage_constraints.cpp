@@ -642,6 +642,9 @@ TEST_P(StageQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH)
         const ap::Vector3 slope = t.jacobian * d, fd = (up[i] - down[i]) / (2 * e);
         EXPECT_LE((slope - fd).norm(), 1e-6 * (1 + fd.norm())) << where;
         const ap::Vector3 l = contracted();
+        const double second = d.dot(t.curvature * d);  // h entry of d is 0: the δδ block
+        const double fd2 = l.dot(up[i] - 2 * q0[i] + down[i]) / (e * e);
+        EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
         const double fd_hh = l.dot(later[i] - 2 * q0[i] + earlier[i]) / (dh * dh);
         EXPECT_NEAR(t.curvature(9, 9), fd_hh, 1e-4 * (1 + std::abs(fd_hh))) << where;
         const double fd_mixed = l.dot(pp[i] - pm[i] - mp[i] + mm[i]) / (4 * e * dh);

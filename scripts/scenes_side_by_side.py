@@ -5,7 +5,7 @@ AFTER / BEFORE pair by pair (each run BEFORE then AFTER, `repeats` times in turn
 same load). Prints a Markdown table. A smaller companion of scripts/before_after, for the scenes
 the benchmark scripts do not run (minimum time, cones under minimum time).
 
-  scripts/scenes_side_by_side.py --before BIN --after BIN [--repeats R] [--steps N ...]
+  scripts/scenes_side_by_side.py --before BIN --after BIN [--repeats R] [--steps N]...
                                  SCENE.yaml ...
 BIN is a plan_maneuver binary; --steps adds runs at other N (default: the scene's own).
 """
@@ -41,9 +41,11 @@ def main():
     ap.add_argument("--before", required=True)
     ap.add_argument("--after", required=True)
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--steps", type=int, nargs="*", default=[0])
+    ap.add_argument("--steps", type=int, action="append",
+                    help="N to run at (repeatable; default: the scene's own)")
     ap.add_argument("scenes", nargs="+")
     a = ap.parse_args()
+    a.steps = a.steps or [0]
     print("| scene | N | verdict before → after | cost before | rel. cost diff | T* before |"
           " rel. T* diff | iterations before → after | time ratio after/before |")
     print("|---|---|---|---|---|---|---|---|---|")

@@ -279,7 +279,6 @@ class FreeTimeSolver {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   int N_, n_;
-  Matrix3 inverse_inertia_ = np_.scheme().inertia().inverse();
   double h0_ = 0.0;
   std::vector<FreeTimeGroup> groups_;
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
@@ -391,10 +390,16 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
       np_, first.support, h0_, contract, [&](const QuantityTermsWithTimeStep& t) {
         Eigen::Matrix<double, 10, 10> H = t.curvature;
         Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
+        const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
         for (const int i : block) {
           FreeTimeInstance& in = groups_[i].instance(t.k);
           in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
-          H.noalias() += (in.z / in.c) * in.g * in.g.transpose();
+          // (z/c) g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
+          const double w = in.z / in.c;
+          H.topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
+          H.block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
+          H.block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
+          H(9, 9) += (w * in.g(9)) * in.g(9);
           rhs += (mu / in.c) * in.g;
           lagrangian -= in.z * in.g;
         }

@@ -283,33 +283,32 @@ class PointingQuantity final : public StageQuantityModel {
   }
   void forEachTerms(const ReducedProblem& np, const StageSupport& support,
                     const QuantityContraction& contract, const TermsVisitor& visit) const override {
-    const std::vector<Matrix3> R = np.attitudes(np.current());
-    for (int k = support.first_k; k <= support.last_k; ++k) {
-      const PointingTerms p = pointingTerms(R[k], body_axis_, world_direction_);
-      QuantityTerms t;
-      t.k = k;
-      t.value(0) = p.cosine;
-      t.jacobian.block<1, 3>(0, 0) = p.gradient.transpose();
-      t.curvature.topLeftCorner<3, 3>() = contract(k, t.value)(0) * p.hessian;
-      visit(t);
-    }
+    forEachInstance<QuantityTerms>(np, support, contract, visit);
   }
   /// h does not move R_k: the h row and column stay zero.
   void forEachTermsWithTimeStep(const ReducedProblem& np, const StageSupport& support,
                                 double /*time_scale: h does not move R_k*/,
                                 const QuantityContraction& contract,
                                 const TimeStepTermsVisitor& visit) const override {
-    forEachTerms(np, support, contract, [&](const QuantityTerms& t) {
-      QuantityTermsWithTimeStep out;
-      out.k = t.k;
-      out.value = t.value;
-      out.jacobian.leftCols<9>() = t.jacobian;
-      out.curvature.topLeftCorner<9, 9>() = t.curvature;
-      visit(out);
-    });
+    forEachInstance<QuantityTermsWithTimeStep>(np, support, contract, visit);
   }
 
  private:
+  /// The instances' terms on node k alone (the first three entries of either kind of terms).
+  template <typename Terms, typename Visit>
+  void forEachInstance(const ReducedProblem& np, const StageSupport& support,
+                       const QuantityContraction& contract, const Visit& visit) const {
+    const std::vector<Matrix3> R = np.attitudes(np.current());
+    for (int k = support.first_k; k <= support.last_k; ++k) {
+      const PointingTerms p = pointingTerms(R[k], body_axis_, world_direction_);
+      Terms t;
+      t.k = k;
+      t.value(0) = p.cosine;
+      t.jacobian.template block<1, 3>(0, 0) = p.gradient.transpose();
+      t.curvature.template topLeftCorner<3, 3>() = contract(k, t.value)(0) * p.hessian;
+      visit(t);
+    }
+  }
   /// As pointingTerms forms it (v = Rᵀs, p = vᵀb), so that a value and its terms agree bit for bit.
   double cosine(const Matrix3& R) const {
     const Vector3 v = R.transpose() * world_direction_;

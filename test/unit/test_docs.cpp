@@ -81,6 +81,53 @@ TEST(CodeShape, NoFunctionInSrcOrStudiesIsLongerThanAHundredLines) {
   EXPECT_FALSE(r.output.empty()) << "the scan found no function";
 }
 
+/// The lines of C++ sources under `dir` (recursive) that switch or branch on a stage quantity's
+/// name (StageQuantity::…, quantity() == / !=), "path:line: text" each, skipping the files whose
+/// path contains one of `exempt`. `files` counts the sources read.
+std::vector<std::string> quantityBranches(const std::string& dir,
+                                          const std::vector<std::string>& exempt, int* files) {
+  std::vector<std::string> out;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    const std::string path = entry.path().string();
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".hpp")) continue;
+    bool skip = false;
+    for (const std::string& e : exempt) skip = skip || path.find(e) != std::string::npos;
+    if (skip) continue;
+    ++*files;
+    std::ifstream in(path);
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++number;
+      if (line.find("StageQuantity::") != std::string::npos ||
+          line.find("quantity() ==") != std::string::npos ||
+          line.find("quantity() !=") != std::string::npos) {
+        out.push_back(path.substr(dir.size()) + ":" + std::to_string(number) + ": " + line);
+      }
+    }
+  }
+  return out;
+}
+
+// Stage quantities are objects (src/planning/transcription/stage_quantities.hpp): the solvers and
+// the plan's check ask them and never switch on a quantity's name. Only the quantity classes and
+// the dense NLPs (crosscheck/: independent derivatives on purpose) may name one.
+TEST(CodeShape, NoSwitchOnAStageQuantityOutsideTheQuantityClasses) {
+  int files = 0;
+  const std::vector<std::string> found = quantityBranches(
+      kSourceDir + "/src/planning", {"/crosscheck/", "/transcription/stage_quantities."}, &files);
+  EXPECT_GT(files, 20) << "the scan read no sources";
+  std::string listed;
+  for (const std::string& line : found) listed += line + "\n";
+  EXPECT_TRUE(found.empty()) << listed;
+  // The scan itself finds what it looks for: the quantity classes and the cross-check name them.
+  int exempt_files = 0;
+  EXPECT_FALSE(
+      quantityBranches(kSourceDir + "/src/planning/transcription", {}, &exempt_files).empty());
+  EXPECT_FALSE(
+      quantityBranches(kSourceDir + "/src/planning/crosscheck", {}, &exempt_files).empty());
+}
+
 /// The indented block after "It prints:" in README.md, one string per line.
 std::vector<std::string> readmePrintedLines() {
   std::ifstream readme(kSourceDir + "/README.md");

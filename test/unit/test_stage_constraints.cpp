@@ -5,6 +5,7 @@
 // the constraints, no slower than the search on T it replaced, and the same in a rotated world.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -486,3 +487,211 @@ TEST(StageConstraints, AConeViolatedAtAnAttitudeTheBoundaryDataFixIsNamedOnlyThe
   ASSERT_GE(with_end_torques.variableIndex(1), 0);
   EXPECT_EQ(ap::fixedNodeConeViolation(p, with_end_torques, {1}), "");
 }
+
+// ---- The quantity objects (stage_quantities.hpp) on their own: value, node Jacobian, contracted
+// curvature and h derivatives against central differences, for every quantity each scheme
+// transcribes (paper and variational: torque, step rate, two cones; second_order: torque, node
+// rate, two cones), rest to rest and with spinning ends (the boundary paths of paper and
+// variational move R_1, R_{N−1} with h).
+
+namespace {
+
+struct QuantityCase {
+  ap::SchemeKind scheme;
+  int quantity;   ///< index among the distinct quantity objects of everyKind(scheme)
+  bool spinning;  ///< nonzero boundary rates
+};
+
+std::string caseName(const testing::TestParamInfo<QuantityCase>& info) {
+  static const char* kNames[] = {"Torque", "Rate", "KeepOutCone", "KeepInCone"};
+  return ap::schemeName(info.param.scheme) + kNames[info.param.quantity] +
+         (info.param.spinning ? "Spinning" : "RestToRest");
+}
+
+std::vector<QuantityCase> quantityCases() {
+  std::vector<QuantityCase> out;
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    for (int q = 0; q < 4; ++q) {
+      for (const bool spinning : {false, true}) out.push_back({scheme, q, spinning});
+    }
+  }
+  return out;
+}
+
+/// δ restricted to the local nodes first_node.. of an instance (fixed nodes 0).
+Eigen::Matrix<double, 9, 1> localPart(const ap::ReducedProblem& np, const Eigen::VectorXd& d,
+                                      int first_node, int width) {
+  Eigen::Matrix<double, 9, 1> out = Eigen::Matrix<double, 9, 1>::Zero();
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) out.segment<3>(3 * n) = d.segment<3>(v);
+  }
+  return out;
+}
+
+class StageQuantityDerivatives : public testing::TestWithParam<QuantityCase> {
+ protected:
+  void SetUp() override {
+    problem_ = everyKind(GetParam().scheme);
+    if (GetParam().spinning) {
+      problem_.initial_velocity = ap::Vector3(0.05, -0.03, 0.08);
+      problem_.final_velocity = ap::Vector3(-0.04, 0.06, 0.02);
+    }
+    constraints_ = ap::buildStageConstraints(problem_);
+    std::vector<const ap::StageQuantityModel*> distinct;
+    for (const auto& c : constraints_) {
+      const ap::StageQuantityModel* m = &c->quantityModel();
+      if (std::find(distinct.begin(), distinct.end(), m) == distinct.end()) distinct.push_back(m);
+    }
+    ASSERT_EQ(distinct.size(), 4u) << "torque, rate and two cones";
+    quantity_ = distinct[GetParam().quantity];
+    np_.emplace(perturbed(problem_, 5));
+    support_ = quantity_->support(np_->firstFreeNode(), np_->lastFreeNode());
+    std::mt19937 rng(17);
+    std::normal_distribution<double> normal;
+    direction_.resize(np_->unknowns());
+    for (int i = 0; i < direction_.size(); ++i) direction_(i) = normal(rng);
+    lambda_ = ap::Vector3(normal(rng), normal(rng), normal(rng));
+  }
+
+  /// q_k for every instance at `np`'s current iterate.
+  std::vector<ap::Vector3> values(const ap::ReducedProblem& np) const {
+    const ap::QuantityInputs at(np, np.current());
+    std::vector<ap::Vector3> out;
+    for (int k = support_.first_k; k <= support_.last_k; ++k)
+      out.push_back(quantity_->value(at, k));
+    return out;
+  }
+  /// The iterate moved by α·direction (the retraction the terms are derivatives of).
+  ap::ReducedProblem moved(double alpha, double h) const {
+    ap::ReducedProblem out = *np_;
+    out.setTimeStep(h);
+    out.setCurrent(out.retract(direction_, alpha));
+    return out;
+  }
+  /// λ as the quantity contracts it (scalar quantities: λ(0) alone).
+  ap::Vector3 contracted() const {
+    return quantity_->kind() == ap::StageQuantity::Torque ? lambda_
+                                                          : ap::Vector3(lambda_(0), 0.0, 0.0);
+  }
+
+  ap::PlanningProblem problem_;
+  ap::StageConstraints constraints_;
+  const ap::StageQuantityModel* quantity_ = nullptr;
+  std::optional<ap::ReducedProblem> np_;
+  ap::StageSupport support_;
+  Eigen::VectorXd direction_;
+  ap::Vector3 lambda_;
+};
+
+TEST_P(StageQuantityDerivatives, TermsMatchCentralDifferencesAtAFixedTimeStep) {
+  const ap::ReducedProblem& np = *np_;
+  const double h = np.timeStep(), e = 1e-6, e2 = 1e-4;
+  const std::vector<ap::Vector3> q0 = values(np);
+  const std::vector<ap::Vector3> up = values(moved(e, h)), down = values(moved(-e, h));
+  const std::vector<ap::Vector3> up2 = values(moved(e2, h)), down2 = values(moved(-e2, h));
+  int visited = 0;
+  quantity_->forEachTerms(
+      np, support_, [&](int, const ap::Vector3&) { return lambda_; },
+      [&](const ap::QuantityTerms& t) {
+        const int i = t.k - support_.first_k;
+        const std::string where = "k = " + std::to_string(t.k);
+        ++visited;
+        EXPECT_LE((t.value - q0[i]).norm(), 1e-13 * (1 + q0[i].norm())) << where;
+        const Eigen::Matrix<double, 9, 1> d =
+            localPart(np, direction_, t.k + support_.node_offset, support_.width);
+        const ap::Vector3 slope = t.jacobian * d, fd = (up[i] - down[i]) / (2 * e);
+        EXPECT_LE((slope - fd).norm(), 1e-6 * (1 + fd.norm())) << where;
+        // d²/dα² λᵀq(R exp(α d)) = dᵀ(Σ λ_i ∇²q_i)d: the retraction is a straight line in δ.
+        const ap::Vector3 l = contracted();
+        const double second = d.dot(t.curvature * d);
+        const double fd2 = l.dot(up2[i] - 2 * q0[i] + down2[i]) / (e2 * e2);
+        EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
+      });
+  EXPECT_EQ(visited, support_.last_k - support_.first_k + 1);
+}
+
+TEST_P(StageQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH) {
+  const ap::ReducedProblem& np = *np_;
+  const double h = np.timeStep(), dh = 1e-5 * h, e = 1e-4;
+  const std::vector<ap::Vector3> q0 = values(np);
+  const std::vector<ap::Vector3> later = values(moved(0, h + dh)),
+                                 earlier = values(moved(0, h - dh));
+  // Mixed: λᵀq at (α, h) = (±e, h ± dh).
+  const std::vector<ap::Vector3> pp = values(moved(e, h + dh)), pm = values(moved(e, h - dh)),
+                                 mp = values(moved(-e, h + dh)), mm = values(moved(-e, h - dh));
+  const std::vector<ap::Vector3> up = values(moved(e, h)), down = values(moved(-e, h));
+  EXPECT_EQ(quantity_->dependsOnTimeStep(), quantity_->kind() != ap::StageQuantity::Pointing);
+  int visited = 0;
+  quantity_->forEachTermsWithTimeStep(
+      np, support_, 1.0, [&](int, const ap::Vector3&) { return lambda_; },
+      [&](const ap::QuantityTermsWithTimeStep& t) {
+        const int i = t.k - support_.first_k;
+        const std::string where = "k = " + std::to_string(t.k);
+        ++visited;
+        EXPECT_LE((t.value - q0[i]).norm(), 1e-13 * (1 + q0[i].norm())) << where;
+        const ap::Vector3 fd_h = (later[i] - earlier[i]) / (2 * dh);
+        const ap::Vector3 in_h = t.jacobian.col(9);
+        EXPECT_LE((in_h - fd_h).norm(), 1e-6 * (1 + fd_h.norm())) << where;
+        if (!quantity_->dependsOnTimeStep()) {
+          EXPECT_EQ(in_h.norm(), 0.0) << where;
+        }
+        Eigen::Matrix<double, 10, 1> d = Eigen::Matrix<double, 10, 1>::Zero();
+        d.head<9>() = localPart(np, direction_, t.k + support_.node_offset, support_.width);
+        const ap::Vector3 slope = t.jacobian * d, fd = (up[i] - down[i]) / (2 * e);
+        EXPECT_LE((slope - fd).norm(), 1e-6 * (1 + fd.norm())) << where;
+        const ap::Vector3 l = contracted();
+        const double second = d.dot(t.curvature * d);  // h entry of d is 0: the δδ block
+        const double fd2 = l.dot(up[i] - 2 * q0[i] + down[i]) / (e * e);
+        EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
+        const double fd_hh = l.dot(later[i] - 2 * q0[i] + earlier[i]) / (dh * dh);
+        EXPECT_NEAR(t.curvature(9, 9), fd_hh, 1e-4 * (1 + std::abs(fd_hh))) << where;
+        const double fd_mixed = l.dot(pp[i] - pm[i] - mp[i] + mm[i]) / (4 * e * dh);
+        const double mixed = d.head<9>().dot(t.curvature.block<9, 1>(0, 9));
+        EXPECT_NEAR(mixed, fd_mixed, 1e-4 * (1 + std::abs(fd_mixed))) << where;
+      });
+  EXPECT_EQ(visited, support_.last_k - support_.first_k + 1);
+}
+
+/// The value on a plan is the plain form the constraints' slacks read: τ_k, the plan's reported
+/// Ω_k, the pointing cosine of R_k.
+TEST_P(StageQuantityDerivatives, ValueOnAPlanIsItsPlainForm) {
+  const ap::Maneuver plan = np_->maneuver(np_->current());
+  const ap::StageSupport s =
+      quantity_->planSupport(ap::schemeHasEndTorques(problem_.scheme), plan.steps());
+  ASSERT_LE(s.first_k, s.last_k);
+  const ap::QuantityInputs at(*np_, np_->current());
+  for (int k = s.first_k; k <= s.last_k; ++k) {
+    const ap::Vector3 r = quantity_->valueOnPlan(plan, k);
+    switch (quantity_->kind()) {
+      case ap::StageQuantity::Torque:
+        EXPECT_EQ(r, plan.torque[k]);
+        break;
+      case ap::StageQuantity::StepRate:
+      case ap::StageQuantity::NodeRate:
+        EXPECT_EQ(r, plan.angular_velocity[k]);
+        break;
+      case ap::StageQuantity::Pointing: {
+        const ap::PlanningConstraint& cone = problem_.constraints[GetParam().quantity];
+        EXPECT_NEAR(r(0), cone.world_direction.dot(plan.attitude[k] * cone.body_axis), 1e-15);
+        break;
+      }
+    }
+  }
+  // Where the transcription has the instance too, the two agree (½|Ω|² for the rates).
+  for (int k = std::max(s.first_k, support_.first_k); k <= std::min(s.last_k, support_.last_k);
+       ++k) {
+    const ap::Vector3 r = quantity_->valueOnPlan(plan, k), q = quantity_->value(at, k);
+    const double expected = quantity_->kind() == ap::StageQuantity::Torque ? r(0)
+                            : quantity_->kind() == ap::StageQuantity::Pointing
+                                ? r(0)
+                                : 0.5 * r.squaredNorm();
+    EXPECT_NEAR(q(0), expected, 1e-12 * (1 + std::abs(expected))) << "k = " << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryQuantityAndScheme, StageQuantityDerivatives,
+                         testing::ValuesIn(quantityCases()), caseName);
+
+}  // namespace

@@ -71,19 +71,16 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
       np_(*np),
       parameters_(parameters),
       free_slacks_(formulation == Formulation::FreeSlacks),
-      inverse_inertia_(problem.inertia.inverse()),
-      inverse_inertia_squared_(inverse_inertia_ * inverse_inertia_),
       constraints_(buildStageConstraints(problem)) {
-  // One group per stage constraint, on its quantity's support (stage_constraints.hpp): torques
-  // k = first..last (1..N−1; 0..N with end torques), free attitudes first + 1..last − 1, step
-  // rates for paper and variational (whose first and last steps are boundary data), node rates
-  // J⁻¹Π_k, k = 1..N−1, for schemes with end torques (whose node velocities are the plan's).
+  // One group per stage constraint, on its quantity's support (stage_quantities.hpp); the
+  // groups on one quantity object form one block, assembled in one pass.
   groups_.reserve(constraints_.size());
   for (const auto& c : constraints_) {
     const StageSupport support =
-        stageSupport(c->quantity(), np_.firstFreeNode(), np_.lastFreeNode());
+        c->quantityModel().support(np_.firstFreeNode(), np_.lastFreeNode());
     ConstraintGroup& g = groups_.emplace_back();  // in place: `at` is ~100 bytes per node
     g.constraint = c.get();
+    g.quantity = &c->quantityModel();
     g.first_k = support.first_k;
     g.last_k = support.last_k;
     g.node_offset = support.node_offset;
@@ -91,47 +88,20 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
     g.at.resize(g.last_k - g.first_k + 1);
     constraint_count_ += static_cast<int>(g.at.size());
   }
-}
-
-std::vector<ConstraintGroup*> ConstrainedSystem::groupsOf(StageQuantity quantity) {
-  std::vector<ConstraintGroup*> out;
-  for (ConstraintGroup& g : groups_)
-    if (g.constraint->quantity() == quantity) out.push_back(&g);
-  return out;
-}
-
-/// The stage quantity q of group g's instance k (scalar quantities in q(0)) at `steps`, from the
-/// torques `tau` and (cones) the attitudes `R`, each formed once for all groups.
-Vector3 ConstrainedSystem::quantityAt(const ConstraintGroup& g,
-                                      const ReducedProblem::StepVectors& steps,
-                                      const std::vector<Vector3>& tau,
-                                      const std::vector<Matrix3>& R, int k) const {
-  switch (g.constraint->quantity()) {
-    case StageQuantity::Torque:
-      return tau[k];
-    case StageQuantity::StepRate:
-      return Vector3(0.5 * np_.scheme().velocity(so3::exp(steps[k])).squaredNorm(), 0.0, 0.0);
-    case StageQuantity::NodeRate:
-      return Vector3(0.5 * nodeVelocity(steps, k).squaredNorm(), 0.0, 0.0);
-    case StageQuantity::Pointing: {
-      const PlanningConstraint& cone = *g.constraint->spec();
-      return Vector3(cone.world_direction.dot(R[k] * cone.body_axis), 0.0, 0.0);
-    }
-  }
-  return Vector3::Zero();
+  QuantityBlocks blocks = quantityBlocks(constraints_);
+  stencil_groups_ = std::move(blocks.on_cost_stencil);
+  quantity_blocks_ = std::move(blocks.blocks);
 }
 
 void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
-  const std::vector<Vector3> tau = np_.torques(steps);
-  std::vector<Matrix3> R;
+  const QuantityInputs at(np_, steps);
   for (ConstraintGroup& g : groups_) {
-    if (g.constraint->quantity() == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
     for (int k = g.first_k; k <= g.last_k; ++k) {
-      g.instance(k).c = g.constraint->value(quantityAt(g, steps, tau, R, k));
+      g.instance(k).c = g.constraint->value(g.quantity->value(at, k));
     }
   }
-  if (torques_out) *torques_out = tau;
+  if (torques_out) *torques_out = at.torques();
 }
 
 double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double mu, double rho,
@@ -199,8 +169,8 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedS
   merit_gradient->setZero(n);
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
-  assembleNodeRates(mu, rho, primal, H);
-  assembleNodeConstraints(mu, rho, primal, H);
+  for (const std::vector<int>& block : quantity_blocks_)
+    assembleQuantity(block, mu, rho, primal, H);
   addConstraintGradients(mu, rhs, merit_gradient);
   return out;
 }
@@ -215,7 +185,8 @@ template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  const std::vector<ConstraintGroup*> torque_groups = groupsOf(StageQuantity::Torque);
+  std::vector<ConstraintGroup*> torque_groups;
+  for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
   const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
@@ -273,97 +244,45 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
-/// Node rates (schemes with end torques) on q = ½|J⁻¹Π_k|² through the node momentum's stencil:
-/// ∇q = J_Πᵀ J⁻²Π, ∇²q = J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i; ∇c = c'∇q, −z∇²c = −z c' ∇²q
-/// (the rate constraint is affine in q).
+/// The groups of one quantity (a rate, a cone) through the quantity's terms: c(q) and the
+/// multipliers in the contraction, λ = −Σ z c'(q); then ∇c = Jᵀc'(q), and −Σ z∇²c = λ·∇²q (the
+/// quantity's curvature) − Σ z c'' JᵀJ (the constraints' isotropic curvature), with each
+/// constraint's barrier term g gᵀ/D.
 template <typename Scalar>
-void ConstrainedSystem::assembleNodeRates(double mu, double rho, bool primal,
-                                          BandedSymmetric<Scalar>* H) {
-  const std::vector<ConstraintGroup*> rate_groups = groupsOf(StageQuantity::NodeRate);
-  if (rate_groups.empty()) return;
-  double gamma = 0.0;  // −Σ z c', the weight of ∇²q
-  const auto rate_weights = [&](int k, const Vector3& Pi) {
-    const Vector3 a = inverse_inertia_squared_ * Pi;  // J⁻²Π
-    const Vector3 q(0.5 * Pi.dot(a), 0.0, 0.0);       // ½|J⁻¹Π|²
-    gamma = 0.0;
-    for (ConstraintGroup* g : rate_groups) {
-      ConstraintInstance& in = g->instance(k);
-      in.c = g->constraint->value(q);
+void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
+                                         bool primal, BandedSymmetric<Scalar>* H) {
+  const ConstraintGroup& first = groups_[block.front()];
+  const StageSupport support{first.first_k, first.last_k, first.node_offset, first.width};
+  const auto contract = [&](int k, const Vector3& q) {
+    pollEvery(k);
+    Vector3 lambda = Vector3::Zero();
+    for (const int i : block) {
+      ConstraintInstance& in = groups_[i].instance(k);
+      in.c = groups_[i].constraint->value(q);
       if (H) prepare(in, mu, rho, primal);
-      gamma -= in.z * g->constraint->gradient(q)(0);
+      lambda -= in.z * groups_[i].constraint->gradient(q);
     }
-    return Vector3(gamma * a);
+    return lambda;
   };
-  const auto visit = [&](const ReducedProblem::NodeMomentum& node) {
-    pollEvery(node.k);
-    const Vector3 a = inverse_inertia_squared_ * node.momentum;
-    const Eigen::Matrix<double, 9, 1> grad = node.jacobian.transpose() * a;  // ∇q
-    const Vector3 q(0.5 * node.momentum.dot(a), 0.0, 0.0);
-    for (ConstraintGroup* g : rate_groups) {
-      g->instance(node.k).g = g->constraint->gradient(q)(0) * grad;
+  const auto visit = [&](const QuantityTerms& t) {
+    const int node = t.k + support.node_offset;
+    Eigen::Matrix<double, 9, 9> curvature = t.curvature;
+    for (const int i : block) {
+      const StageConstraint& c = *groups_[i].constraint;
+      ConstraintInstance& in = groups_[i].instance(t.k);
+      in.g = t.jacobian.transpose() * c.gradient(t.value);
+      if (H && c.curvature() != 0.0) {
+        curvature -= (in.z * c.curvature()) * t.jacobian.transpose() * t.jacobian;
+      }
     }
     if (!H) return;
-    const Eigen::Matrix<double, 9, 9> block =
-        gamma * node.jacobian.transpose() * inverse_inertia_squared_ * node.jacobian + node.second;
-    addLocal(np_, H, node.k - 1, 3, block);
-    for (ConstraintGroup* g : rate_groups) {
-      addLocalRankOne(np_, H, node.k - 1, 3, g->instance(node.k).g, 1.0 / g->instance(node.k).D);
+    addLocal(np_, H, node, support.width, curvature);
+    for (const int i : block) {
+      const ConstraintInstance& in = groups_[i].instance(t.k);
+      addLocalRankOne(np_, H, node, support.width, in.g, 1.0 / in.D);
     }
   };
-  np_.forEachNodeMomentum(visit, rate_weights);
-}
-
-/// q, ∇q, ∇²q of a step rate (angularRateTerms, on δ_k, δ_{k+1}) or a pointing cosine
-/// (pointingTerms, on δ_k) at instance k (node_constraints.hpp).
-ScalarQuantityTerms ConstrainedSystem::scalarQuantityTerms(const ConstraintGroup& g,
-                                                           const ReducedProblem::StepVectors& steps,
-                                                           const std::vector<Matrix3>& R,
-                                                           int k) const {
-  ScalarQuantityTerms out;
-  out.gradient.setZero();
-  out.hessian.setZero();
-  if (g.constraint->quantity() == StageQuantity::StepRate) {
-    const AngularRateTerms t = angularRateTerms(np_.scheme(), steps[k]);
-    out.value = t.half_squared_rate;
-    out.gradient.head<6>() = t.gradient;
-    out.hessian.topLeftCorner<6, 6>() = t.hessian;
-  } else {
-    const PlanningConstraint& cone = *g.constraint->spec();
-    const PointingTerms t = pointingTerms(R[k], cone.body_axis, cone.world_direction);
-    out.value = t.cosine;
-    out.gradient.head<3>() = t.gradient;
-    out.hessian.topLeftCorner<3, 3>() = t.hessian;
-  }
-  return out;
-}
-
-/// Step rates and cones: c(q) through q's own derivatives, ∇c = c'∇q, −z∇²c = −z(c'∇²q + c''∇q∇qᵀ).
-template <typename Scalar>
-void ConstrainedSystem::assembleNodeConstraints(double mu, double rho, bool primal,
-                                                BandedSymmetric<Scalar>* H) {
-  const ReducedProblem::StepVectors& steps = np_.current();
-  std::vector<Matrix3> R;
-  for (ConstraintGroup& g : groups_) {
-    const StageQuantity quantity = g.constraint->quantity();
-    if (quantity != StageQuantity::StepRate && quantity != StageQuantity::Pointing) continue;
-    if (quantity == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      pollEvery(k);
-      ConstraintInstance& in = g.instance(k);
-      const ScalarQuantityTerms t = scalarQuantityTerms(g, steps, R, k);
-      const Vector3 q(t.value, 0.0, 0.0);
-      const double slope = g.constraint->gradient(q)(0);
-      in.c = g.constraint->value(q);
-      if (H) prepare(in, mu, rho, primal);
-      in.g = slope * t.gradient;
-      if (!H) continue;
-      Eigen::Matrix<double, 9, 9> block = (-in.z * slope) * t.hessian;
-      const double curvature = g.constraint->curvature();
-      if (curvature != 0.0) block -= (in.z * curvature) * t.gradient * t.gradient.transpose();
-      addLocal(np_, H, k + g.node_offset, g.width, block);
-      addLocalRankOne(np_, H, k + g.node_offset, g.width, in.g, 1.0 / in.D);
-    }
-  }
+  first.quantity->forEachTerms(np_, support, contract, visit);
 }
 
 /// ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is the slack step's
@@ -378,16 +297,6 @@ void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
       addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.width, rhs);
     }
   }
-}
-
-/// J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀ μ(F_{k−1}))/2: the node velocity of a scheme with end
-/// torques.
-Vector3 ConstrainedSystem::nodeVelocity(const ReducedProblem::StepVectors& steps, int k) const {
-  const DiscreteScheme& scheme = np_.scheme();
-  const Vector3 Pi =
-      0.5 * (scheme.momentumOfStep(steps[k]) +
-             so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
-  return inverse_inertia_ * Pi;
 }
 
 /// FreeSlacks, Mehrotra's predictor: from the affine-scaling step dδ_aff (solved with μ = 0,
@@ -561,7 +470,7 @@ std::vector<Vector3> ConstrainedSystem::switchingFunction(
   std::vector<Vector3> sigma;
   for (const ConstraintGroup& g : groups_) {
     const int a = g.constraint->axis();
-    if (g.constraint->quantity() != StageQuantity::Torque || a < 0) continue;
+    if (a < 0) continue;  // only a box side is affine in one torque axis
     if (sigma.empty()) sigma = torque;
     for (int k = g.first_k; k <= g.last_k; ++k) {
       // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.

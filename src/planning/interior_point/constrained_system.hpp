@@ -29,19 +29,12 @@ struct ConstraintInstance {
   double ds = 0.0;                ///< FreeSlacks: the slack's Newton step
 };
 
-/// A scalar stage quantity (a step's ½|Ω|², a pointing cosine) and its derivatives over the
-/// instance's local nodes (zero beyond its width).
-struct ScalarQuantityTerms {
-  double value = 0.0;
-  Eigen::Matrix<double, 9, 1> gradient;
-  Eigen::Matrix<double, 9, 9> hessian;
-};
-
 /// The instances of one stage constraint (one side of the torque box, or one scene constraint).
 struct ConstraintGroup {
   const StageConstraint* constraint = nullptr;
-  int first_k = 0, last_k = 0;         ///< instances k = first_k..last_k
-  int node_offset = 0;                 ///< first local node = k + node_offset
+  const StageQuantityModel* quantity = nullptr;  ///< &constraint->quantityModel()
+  int first_k = 0, last_k = 0;                   ///< instances k = first_k..last_k
+  int node_offset = 0;                           ///< first local node = k + node_offset
   int width = 1;                       ///< local nodes (3: torque stencil, 2: step, 1: node)
   std::vector<ConstraintInstance> at;  ///< at[k − first_k]
   ConstraintInstance& instance(int k) { return at[k - first_k]; }
@@ -147,29 +140,22 @@ class ConstrainedSystem {
   void assembleTorques(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
                        Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, Assembly* out);
   template <typename Scalar>
-  void assembleNodeRates(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
-  template <typename Scalar>
-  void assembleNodeConstraints(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H);
-  /// The groups of one stage quantity.
-  std::vector<ConstraintGroup*> groupsOf(StageQuantity quantity);
+  void assembleQuantity(const std::vector<int>& block, double mu, double rho, bool primal,
+                        BandedSymmetric<Scalar>* H);
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
-  Vector3 nodeVelocity(const ReducedProblem::StepVectors& steps, int k) const;
-  ScalarQuantityTerms scalarQuantityTerms(const ConstraintGroup& g,
-                                          const ReducedProblem::StepVectors& steps,
-                                          const std::vector<Matrix3>& R, int k) const;
-  Vector3 quantityAt(const ConstraintGroup& g, const ReducedProblem::StepVectors& steps,
-                     const std::vector<Vector3>& tau, const std::vector<Matrix3>& R, int k) const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  Matrix3 inverse_inertia_;          ///< J⁻¹
-  Matrix3 inverse_inertia_squared_;  ///< J⁻²
-  StageConstraints constraints_;     ///< buildStageConstraints(problem): one group each
+  StageConstraints constraints_;  ///< buildStageConstraints(problem): one group each
   std::vector<ConstraintGroup> groups_;
+  /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
+  std::vector<int> stencil_groups_;
+  /// The other groups by quantity (indices into groups_): one pass over the band per quantity.
+  std::vector<std::vector<int>> quantity_blocks_;
   int constraint_count_ = 0;
   const Interruption* interruption_ = nullptr;
 };

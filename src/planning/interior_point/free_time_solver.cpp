@@ -97,6 +97,7 @@ struct FreeTimeInstance {
 /// The instances of one stage constraint (stage_constraints.hpp) on its support.
 struct FreeTimeGroup {
   const StageConstraint* constraint = nullptr;
+  const StageQuantityModel* quantity = nullptr;  ///< &constraint->quantityModel()
   StageSupport support;
   std::vector<FreeTimeInstance> at;  ///< at[k − support.first_k]
   FreeTimeInstance& instance(int k) { return at[k - support.first_k]; }
@@ -111,9 +112,13 @@ class FreeTimeSolver {
     for (const auto& c : constraints) {
       FreeTimeGroup& g = groups_.emplace_back();
       g.constraint = c.get();
-      g.support = stageSupport(c->quantity(), np_.firstFreeNode(), np_.lastFreeNode());
+      g.quantity = &c->quantityModel();
+      g.support = g.quantity->support(np_.firstFreeNode(), np_.lastFreeNode());
       g.at.resize(g.support.last_k - g.support.first_k + 1);
     }
+    QuantityBlocks blocks = quantityBlocks(constraints);
+    stencil_groups_ = std::move(blocks.on_cost_stencil);
+    quantity_blocks_ = std::move(blocks.blocks);
   }
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
@@ -169,55 +174,30 @@ class FreeTimeSolver {
   double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
   /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
   bool hasTorqueBox() const {
-    return std::any_of(groups_.begin(), groups_.end(), [](const FreeTimeGroup& g) {
-      return g.constraint->quantity() == StageQuantity::Torque && g.constraint->axis() >= 0;
-    });
+    // Only a box side is affine in one torque axis.
+    return std::any_of(groups_.begin(), groups_.end(),
+                       [](const FreeTimeGroup& g) { return g.constraint->axis() >= 0; });
   }
 
-  /// Calls f(group, k, c) for every instance's value c at `steps` (torques and, with cones, the
-  /// attitudes formed once).
+  /// Calls f(group, k, c) for every instance's value c at `steps` (the quantities' shared
+  /// products, torques and attitudes, formed once).
   template <typename F>
   void forEachValue(const ReducedProblem::StepVectors& steps, F&& f, bool relaxed = true) const {
-    const std::vector<Vector3> tau = np_.torques(steps);
-    std::vector<Matrix3> R;
+    const QuantityInputs at(np_, steps);
     for (const FreeTimeGroup& g : groups_) {
-      const StageQuantity quantity = g.constraint->quantity();
-      if (quantity == StageQuantity::Pointing && R.empty()) R = np_.attitudes(steps);
+      const double relax = relaxed ? relaxation(g) : 0.0;
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-        Vector3 q = Vector3::Zero();
-        if (quantity == StageQuantity::Torque) {
-          q = tau[k];
-        } else if (quantity == StageQuantity::Pointing) {
-          const PlanningConstraint& cone = *g.constraint->spec();
-          q(0) = pointingTerms(R[k], cone.body_axis, cone.world_direction).cosine;
-        } else {
-          q(0) = halfSquaredRate(quantity, steps, k);
-        }
-        f(g, k, g.constraint->value(q) + (relaxed ? relaxation(quantity) : 0.0));
+        f(g, k, g.constraint->value(g.quantity->value(at, k)) + relax);
       }
     }
   }
 
   /// θ added to a constraint that moves with h while the start is elastic (else 0).
-  double relaxation(StageQuantity quantity) const {
-    return elastic_ && quantityDependsOnTimeStep(quantity) ? theta_ : 0.0;
+  double relaxation(const FreeTimeGroup& g) const {
+    return elastic_ && g.quantity->dependsOnTimeStep() ? theta_ : 0.0;
   }
   /// The global unknowns bordering the band: η, and θ while elastic.
   int borderSize() const { return elastic_ ? 2 : 1; }
-
-  /// q = ½|Ω|² of step k (paper, variational: the scheme's velocity of F_k) or of node k (schemes
-  /// with end torques: J⁻¹Π_k, Π_k = (μ(F_k) + F_{k−1}ᵀμ(F_{k−1}))/2) at the current h.
-  double halfSquaredRate(StageQuantity quantity, const ReducedProblem::StepVectors& steps,
-                         int k) const {
-    const DiscreteScheme& scheme = np_.scheme();
-    if (quantity == StageQuantity::StepRate) {
-      return 0.5 * scheme.velocity(so3::exp(steps[k])).squaredNorm();
-    }
-    const Vector3 Pi =
-        0.5 * (scheme.momentumOfStep(steps[k]) +
-               so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
-    return 0.5 * (inverse_inertia_ * Pi).squaredNorm();
-  }
 
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
@@ -226,7 +206,7 @@ class FreeTimeSolver {
     forEachValue(
         steps,
         [&](const FreeTimeGroup& g, int, double c) {
-          if (quantityDependsOnTimeStep(g.constraint->quantity()) == time_dependent) {
+          if (g.quantity->dependsOnTimeStep() == time_dependent) {
             smallest = std::min(smallest, c);
           }
         },
@@ -253,15 +233,7 @@ class FreeTimeSolver {
 
   double T0() const { return N_ * h0_; }
   void assemble(double mu, double epsilon);
-  void assembleCones(double mu);
-  /// A rate quantity's q, ∇q and ∇²q over its local nodes at the current iterate, per instance.
-  struct RateTerms {
-    double q = 0.0;
-    Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
-    Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
-  };
-  std::vector<RateTerms> rateTerms(StageQuantity quantity) const;
-  void assembleRates(double mu);
+  void assembleQuantity(const std::vector<int>& block, double mu);
   void assembleElastic(double mu);
   void leaveElasticIfInside();
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
@@ -307,9 +279,12 @@ class FreeTimeSolver {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   int N_, n_;
-  Matrix3 inverse_inertia_ = np_.scheme().inertia().inverse();
   double h0_ = 0.0;
   std::vector<FreeTimeGroup> groups_;
+  /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
+  std::vector<int> stencil_groups_;
+  /// The other groups by quantity (indices into groups_): one pass per quantity.
+  std::vector<std::vector<int>> quantity_blocks_;
   // The assembled system at the current iterate.
   BandedSymmetric<double> band_{1, kHalfBandwidth};
   Eigen::MatrixXd border_;  ///< the band's coupling to η (column 0) and, elastic, θ (column 1)
@@ -340,8 +315,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
   std::vector<FreeTimeGroup*> torque_groups;
-  for (FreeTimeGroup& g : groups_)
-    if (g.constraint->quantity() == StageQuantity::Torque) torque_groups.push_back(&g);
+  for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
   const auto weights = [&](int k, const Vector3& r) {
     // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
     const double s = torqueScale(k);
@@ -372,7 +346,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
         for (FreeTimeGroup* g : torque_groups) {
           FreeTimeInstance& in = g->instance(st.k);
-          in.c = g->constraint->value(tau) + relaxation(StageQuantity::Torque);
+          in.c = g->constraint->value(tau) + relaxation(*g);
           const Vector3 a = g->constraint->gradient(tau) / s;
           in.g = G.transpose() * a;
           W.diagonal().array() -= in.z * g->constraint->curvature() / (s * s);
@@ -384,116 +358,53 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         scatter(st.k - 1, 3, H, rhs, lagrangian);
       },
       weights);
-  assembleCones(mu);
-  assembleRates(mu);
+  // The quantities that do not move with h first (the order the band's sums were formed in).
+  for (const bool moves_with_h : {false, true}) {
+    for (const std::vector<int>& block : quantity_blocks_) {
+      if (groups_[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
+        assembleQuantity(block, mu);
+      }
+    }
+  }
   assembleElastic(mu);
   theta_assembled_ = theta_;
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
 }
 
-/// Cones on the pointing cosine p_k = sᵀR_k b (node_constraints.hpp pointingTerms): a function of
-/// R_k alone, not of h (η's entries stay 0): ∇c = c'∇p, −z∇²c = −z c'∇²p, and the barrier's
-/// (z/c) g gᵀ, on node k's diagonal block.
-void FreeTimeSolver::assembleCones(double mu) {
-  std::vector<Matrix3> R;
-  for (FreeTimeGroup& g : groups_) {
-    if (g.constraint->quantity() != StageQuantity::Pointing) continue;
-    if (R.empty()) R = np_.attitudes(np_.current());
-    const PlanningConstraint& cone = *g.constraint->spec();
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      FreeTimeInstance& in = g.instance(k);
-      const PointingTerms t = pointingTerms(R[k], cone.body_axis, cone.world_direction);
-      const Vector3 q(t.cosine, 0.0, 0.0);
-      const double slope = g.constraint->gradient(q)(0);
-      in.c = g.constraint->value(q);
-      in.g.setZero();
-      in.g.head<3>() = slope * t.gradient;
-      const Vector3 g3 = in.g.head<3>();
-      const int v = np_.variableIndex(k);
-      if (v < 0) continue;
-      const Eigen::Matrix<double, 3, 3> block =
-          (-in.z * slope) * t.hessian + (in.z / in.c) * g3 * g3.transpose();
-      band_.addSymmetricBlock<3>(v, block, 0, 3);
-      rhs_.segment<3>(v) += (mu / in.c) * g3;
-      lagrangian_gradient_.segment<3>(v) -= in.z * g3;
+/// The groups of one quantity (a cone, a rate) through the quantity's terms in (local nodes, h):
+/// c(q) and λ = −Σ z c'(q) in the contraction; ∇c = c'∇q, −Σ z∇²c = λ·∇²q (the constraints on
+/// these quantities are affine in q), and each constraint's barrier term (z/c) g gᵀ, in η = h/h₀.
+void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
+  const FreeTimeGroup& first = groups_[block.front()];
+  const auto contract = [&](int k, const Vector3& q) {
+    Vector3 lambda = Vector3::Zero();
+    for (const int i : block) {
+      FreeTimeInstance& in = groups_[i].instance(k);
+      in.c = groups_[i].constraint->value(q) + relaxation(groups_[i]);
+      lambda -= in.z * groups_[i].constraint->gradient(q);
     }
-  }
-}
-
-/// q, ∇q, ∇²q of every instance of a rate quantity (k from 0, unused entries empty): a step's
-/// from angularRateTerms over (δ_k, δ_{k+1}); a node's through the node momentum's stencil,
-/// ∇q = J_Πᵀ J⁻²Π, ∇²q = J_Πᵀ J⁻² J_Π + Σ_i (J⁻²Π)_i ∇²Π_i.
-std::vector<FreeTimeSolver::RateTerms> FreeTimeSolver::rateTerms(StageQuantity quantity) const {
-  std::vector<RateTerms> out(N_ + 1);
-  if (quantity == StageQuantity::StepRate) {
-    const StageSupport s = stageSupport(quantity, np_.firstFreeNode(), np_.lastFreeNode());
-    for (int k = s.first_k; k <= s.last_k; ++k) {
-      const AngularRateTerms t = angularRateTerms(np_.scheme(), np_.current()[k]);
-      out[k].q = t.half_squared_rate;
-      out[k].gradient.head<6>() = t.gradient;
-      out[k].hessian.topLeftCorner<6, 6>() = t.hessian;
-    }
-    return out;
-  }
-  const Matrix3 inverse_squared = inverse_inertia_ * inverse_inertia_;
-  np_.forEachNodeMomentum(
-      [&](const ReducedProblem::NodeMomentum& node) {
-        const Vector3 a = inverse_squared * node.momentum;
-        out[node.k].q = 0.5 * node.momentum.dot(a);
-        out[node.k].gradient = node.jacobian.transpose() * a;
-        out[node.k].hessian =
-            node.jacobian.transpose() * inverse_squared * node.jacobian + node.second;
-      },
-      [&](int, const Vector3& Pi) { return Vector3(inverse_squared * Pi); });
-  return out;
-}
-
-/// Rate limits on q = ½|Ω|² (of a step or a node). At fixed free attitudes every momentum scales
-/// like 1/h, and the attitudes a boundary rate fixes move with h (ReducedProblem::nodePath: R_1,
-/// R_{N−1} of paper and variational, whose boundary steps honour Ω(0), Ω(T) at every h; none for
-/// second_order, whose node rates involve free attitudes and R_0, R_N only), as node
-/// perturbations d(h) = e Δh + ½ e₂ Δh². So q(δ, h) = s(h) q̃(δ + d(h)), s = (h₀/h)², and at h₀
-///     ∂q/∂h = s'q + ∇qᵀe,   ∂∇q/∂h = s'∇q + ∇²q e,   ∂²q/∂h² = s''q + 2s'∇qᵀe + eᵀ∇²q e + ∇qᵀe₂,
-/// s' = −2/h, s'' = 6/h² (rest to rest e = e₂ = 0: q = q̃/h²); in η = h/h₀ times h₀, h₀².
-/// c = 1 + c' q.
-void FreeTimeSolver::assembleRates(double mu) {
-  const double h = np_.timeStep();
-  const double s1 = -2.0 / h, s2 = 6.0 / (h * h);
-  for (const StageQuantity quantity : {StageQuantity::StepRate, StageQuantity::NodeRate}) {
-    std::vector<RateTerms> terms;
-    for (FreeTimeGroup& g : groups_) {
-      if (g.constraint->quantity() != quantity) continue;
-      if (terms.empty()) terms = rateTerms(quantity);
-      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-        const RateTerms& t = terms[k];
-        Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero(), e2 = e;
-        for (int node = 0; node < g.support.width; ++node) {
-          const ReducedProblem::BoundaryPath path = np_.nodePath(k + g.support.node_offset + node);
-          e.segment<3>(3 * node) = path.first;
-          e2.segment<3>(3 * node) = path.second;
+    return lambda;
+  };
+  first.quantity->forEachTermsWithTimeStep(
+      np_, first.support, h0_, contract, [&](const QuantityTermsWithTimeStep& t) {
+        Eigen::Matrix<double, 10, 10> H = t.curvature;
+        Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
+        const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
+        for (const int i : block) {
+          FreeTimeInstance& in = groups_[i].instance(t.k);
+          in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
+          // (z/c) g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
+          const double w = in.z / in.c;
+          H.topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
+          H.block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
+          H.block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
+          H(9, 9) += (w * in.g(9)) * in.g(9);
+          rhs += (mu / in.c) * in.g;
+          lagrangian -= in.z * in.g;
         }
-        const Eigen::Matrix<double, 9, 1> He = t.hessian * e;
-        Eigen::Matrix<double, 10, 1> dq;  // ∇q over (local nodes, η)
-        dq.head<9>() = t.gradient;
-        dq(9) = (s1 * t.q + t.gradient.dot(e)) * h0_;
-        Eigen::Matrix<double, 10, 10> d2q;
-        d2q.topLeftCorner<9, 9>() = t.hessian;
-        d2q.block<9, 1>(0, 9) = (s1 * t.gradient + He) * h0_;
-        d2q.block<1, 9>(9, 0) = d2q.block<9, 1>(0, 9).transpose();
-        d2q(9, 9) =
-            (s2 * t.q + 2 * s1 * t.gradient.dot(e) + e.dot(He) + t.gradient.dot(e2)) * h0_ * h0_;
-        const Vector3 q(t.q, 0.0, 0.0);
-        const double slope = g.constraint->gradient(q)(0);
-        FreeTimeInstance& in = g.instance(k);
-        in.c = g.constraint->value(q) + relaxation(quantity);
-        in.g = slope * dq;
-        const Eigen::Matrix<double, 10, 10> H =
-            (-in.z * slope) * d2q + (in.z / in.c) * in.g * in.g.transpose();
-        scatter(k + g.support.node_offset, g.support.width, H, (mu / in.c) * in.g, -in.z * in.g);
-      }
-    }
-  }
+        scatter(t.k + first.support.node_offset, first.support.width, H, rhs, lagrangian);
+      });
 }
 
 /// The elastic start's θ: every constraint that moves with h is c + θ (∂/∂θ = 1, no curvature),
@@ -502,7 +413,7 @@ void FreeTimeSolver::assembleElastic(double mu) {
   if (!elastic_) return;
   const int t = n_ + 1;
   for (const FreeTimeGroup& g : groups_) {
-    if (!quantityDependsOnTimeStep(g.constraint->quantity())) continue;
+    if (!g.quantity->dependsOnTimeStep()) continue;
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       const FreeTimeInstance& in = g.instance(k);
       const double w = in.z / in.c;
@@ -719,7 +630,7 @@ double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
-  if (elastic_ && quantityDependsOnTimeStep(g.constraint->quantity())) sum += d(n_ + 1);  // ∂/∂θ
+  if (elastic_ && g.quantity->dependsOnTimeStep()) sum += d(n_ + 1);  // ∂/∂θ
   for (int node = 0; node < g.support.width; ++node) {
     const int v = np_.variableIndex(k + g.support.node_offset + node);
     if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
@@ -916,7 +827,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
       out.complementarity += in.z * in.c;
       out.smallest_value = std::min(out.smallest_value, in.c);
       // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
-      if (g.constraint->quantity() == StageQuantity::Torque && a >= 0) {
+      if (a >= 0) {  // only a box side is affine in one torque axis
         const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
         out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
         if (!out.switching_function.empty()) {

@@ -15,8 +15,9 @@ namespace {
 /// One side of the actuator box: c = 1 − σ τ_a/a (σ = +1 upper, −1 lower).
 class TorqueBoxSide final : public StageConstraint {
  public:
-  TorqueBoxSide(int axis, double limit, double sign)
-      : StageConstraint(StageQuantity::Torque, nullptr), axis_(axis), limit_(limit), sign_(sign) {}
+  TorqueBoxSide(std::shared_ptr<const StageQuantityModel> torque, int axis, double limit,
+                double sign)
+      : StageConstraint(std::move(torque), nullptr), axis_(axis), limit_(limit), sign_(sign) {}
   double value(const Vector3& tau) const override { return 1.0 - sign_ * tau(axis_) / limit_; }
   Vector3 gradient(const Vector3&) const override {
     Vector3 g = Vector3::Zero();
@@ -31,7 +32,7 @@ class TorqueBoxSide final : public StageConstraint {
     return s.str();
   }
   double slackOnPlan(const Maneuver& plan, int k) const override {
-    return limit_ - sign_ * plan.torque[k](axis_);
+    return limit_ - sign_ * quantityModel().valueOnPlan(plan, k)(axis_);
   }
   double slackScale() const override { return limit_; }
   double rowValue(const Vector3& tau) const override { return tau(axis_); }
@@ -47,8 +48,8 @@ class TorqueBoxSide final : public StageConstraint {
 /// max_torque_norm t: c = 1 − |τ|²/t².
 class TorqueNorm final : public StageConstraint {
  public:
-  explicit TorqueNorm(const PlanningConstraint* spec)
-      : StageConstraint(StageQuantity::Torque, spec), limit_(spec->limit) {}
+  TorqueNorm(std::shared_ptr<const StageQuantityModel> torque, const PlanningConstraint* spec)
+      : StageConstraint(std::move(torque), spec), limit_(spec->limit) {}
   double value(const Vector3& tau) const override {
     return 1.0 - tau.squaredNorm() / (limit_ * limit_);
   }
@@ -56,7 +57,7 @@ class TorqueNorm final : public StageConstraint {
   double curvature() const override { return -2.0 / (limit_ * limit_); }
   std::string describe() const override { return describeConstraint(*spec()); }
   double slackOnPlan(const Maneuver& plan, int k) const override {
-    return limit_ - plan.torque[k].norm();
+    return limit_ - quantityModel().valueOnPlan(plan, k).norm();
   }
   double slackScale() const override { return limit_; }
   /// g = |τ|²/t² ≤ 1.
@@ -74,8 +75,8 @@ class TorqueNorm final : public StageConstraint {
 /// max_angular_rate w on q = ½|Ω|² (a step's or a node's): c = 1 − 2q/w².
 class AngularRate final : public StageConstraint {
  public:
-  AngularRate(const PlanningConstraint* spec, StageQuantity quantity)
-      : StageConstraint(quantity, spec),
+  AngularRate(std::shared_ptr<const StageQuantityModel> rate, const PlanningConstraint* spec)
+      : StageConstraint(std::move(rate), spec),
         limit_(spec->limit),
         slope_(-2.0 / (spec->limit * spec->limit)) {}
   double value(const Vector3& q) const override { return 1.0 + slope_ * q(0); }
@@ -83,7 +84,7 @@ class AngularRate final : public StageConstraint {
   std::string describe() const override { return describeConstraint(*spec()); }
   /// On the plan's reported Ω_k (the scheme's node or step rate).
   double slackOnPlan(const Maneuver& plan, int k) const override {
-    return limit_ - plan.angular_velocity[k].norm();
+    return limit_ - quantityModel().valueOnPlan(plan, k).norm();
   }
   double slackScale() const override { return limit_; }
   /// The motion between nodes turns at log(F_k)/h (a scheme's reported Ω_k may differ from it by
@@ -112,14 +113,14 @@ class AngularRate final : public StageConstraint {
 class PointingCone final : public StageConstraint {
  public:
   explicit PointingCone(const PlanningConstraint* spec)
-      : StageConstraint(StageQuantity::Pointing, spec),
+      : StageConstraint(makePointingQuantity(spec->body_axis, spec->world_direction), spec),
         sign_(spec->kind == ConstraintKind::KeepOut ? -1.0 : 1.0),
         bound_(std::cos(spec->nodeHalfAngle())) {}
   double value(const Vector3& p) const override { return sign_ * (p(0) - bound_); }
   Vector3 gradient(const Vector3&) const override { return Vector3(sign_, 0.0, 0.0); }
   std::string describe() const override { return describeConstraint(*spec()); }
-  /// The angle's margin (coneMargin: atan2, accurate at every angle, where acos of the cosine
-  /// would not be).
+  /// The angle's margin (coneMargin on the attitude: atan2, accurate at every angle, where acos
+  /// of the quantity's cosine would not be).
   double slackOnPlan(const Maneuver& plan, int k) const override {
     return coneMargin(*spec(), plan.attitude[k]);
   }
@@ -140,62 +141,51 @@ class PointingCone final : public StageConstraint {
 
 }  // namespace
 
-StageSupport stageSupport(StageQuantity quantity, int first_free, int last_free) {
-  const int first = first_free - 1, last = last_free + 1;  // the torques' range
-  switch (quantity) {
-    case StageQuantity::Torque:
-      return {first, last, -1, 3};
-    case StageQuantity::StepRate:
-      return {first, last - 1, 0, 2};
-    case StageQuantity::NodeRate:
-      return {first + 1, last - 1, -1, 3};
-    case StageQuantity::Pointing:
-      return {first + 1, last - 1, 0, 1};
-  }
-  return {};
-}
-
-bool quantityDependsOnTimeStep(StageQuantity quantity) {
-  return quantity != StageQuantity::Pointing;
-}
-
-StageSupport planSupport(StageQuantity quantity, bool end_torques, int steps) {
-  const int N = steps;
-  switch (quantity) {
-    case StageQuantity::Torque:
-      return end_torques ? StageSupport{0, N, 0, 1} : StageSupport{1, N - 1, 0, 1};
-    case StageQuantity::StepRate:
-      return {0, N - 1, 0, 2};
-    case StageQuantity::NodeRate:
-    case StageQuantity::Pointing:
-      return {0, N, 0, 1};
-  }
-  return {};
-}
-
 StageConstraints buildStageConstraints(const PlanningProblem& problem) {
   StageConstraints out;
+  // One quantity object per quantity: the constraints on it share one pass over the band.
+  const std::shared_ptr<const StageQuantityModel> torque = makeTorqueQuantity();
+  const std::shared_ptr<const StageQuantityModel> rate =
+      makeRateQuantity(schemeHasEndTorques(problem.scheme), problem.inertia);
   if (problem.hasTorqueBounds()) {
     for (int a = 0; a < 3; ++a) {
       for (const double sign : {1.0, -1.0}) {
-        out.push_back(std::make_unique<TorqueBoxSide>(a, problem.max_torque(a), sign));
+        out.push_back(std::make_unique<TorqueBoxSide>(torque, a, problem.max_torque(a), sign));
       }
     }
   }
-  const StageQuantity rate =
-      schemeHasEndTorques(problem.scheme) ? StageQuantity::NodeRate : StageQuantity::StepRate;
   for (const PlanningConstraint& c : problem.constraints) {
     switch (c.kind) {
       case ConstraintKind::MaxTorqueNorm:
-        out.push_back(std::make_unique<TorqueNorm>(&c));
+        out.push_back(std::make_unique<TorqueNorm>(torque, &c));
         break;
       case ConstraintKind::MaxAngularRate:
-        out.push_back(std::make_unique<AngularRate>(&c, rate));
+        out.push_back(std::make_unique<AngularRate>(rate, &c));
         break;
       case ConstraintKind::KeepOut:
       case ConstraintKind::KeepIn:
         out.push_back(std::make_unique<PointingCone>(&c));
         break;
+    }
+  }
+  return out;
+}
+
+QuantityBlocks quantityBlocks(const StageConstraints& constraints) {
+  QuantityBlocks out;
+  std::vector<const StageQuantityModel*> quantities;  // one per block
+  for (std::size_t i = 0; i < constraints.size(); ++i) {
+    const StageQuantityModel* q = &constraints[i]->quantityModel();
+    if (q->formedByCostStencil()) {
+      out.on_cost_stencil.push_back(static_cast<int>(i));
+      continue;
+    }
+    const auto known = std::find(quantities.begin(), quantities.end(), q);
+    if (known == quantities.end()) {
+      quantities.push_back(q);
+      out.blocks.push_back({static_cast<int>(i)});
+    } else {
+      out.blocks[known - quantities.begin()].push_back(static_cast<int>(i));
     }
   }
   return out;
@@ -240,7 +230,7 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   for (const auto& c : buildStageConstraints(problem)) {
     // Formed once: a stream per node cost as much as the solve's replay (measured, N = 128).
     const std::string what = c->describe();
-    const StageSupport s = planSupport(c->quantity(), end_torques, N);
+    const StageSupport s = c->quantityModel().planSupport(end_torques, N);
     for (int k = s.first_k; k <= s.last_k; ++k) {
       const double slack = c->slackOnPlan(maneuver, k);
       tally.node(slack, slack - c->nodeTightening(), c->slackScale(), what, k);

@@ -3,20 +3,20 @@
 // looping over a list instead of switching on kinds.
 //
 // Each constraint c ≥ 0 (dimensionless) is a function of ONE stage quantity q of the transcription
-// (StageQuantity): the torque τ_k, the half squared rate ½|Ω|² of a step or of a node, or the
-// pointing cosine sᵀR_k b. The constraint knows c(q) and its derivatives in q; the transcription
-// knows q's derivatives in the unknowns (ReducedProblem's stencils and node momenta,
-// node_constraints.hpp's angularRateTerms and pointingTerms) and, where q depends on the time step,
-// in h (ReducedProblem::forEachStencilWithTimeStep). The assemblers (interior_point/
-// constrained_system at a fixed h, interior_point/free_time_solver with h free) apply the chain
-// rule: ∇c = c'(q) ∇q, ∇²c = c'(q) ∇²q + ∇qᵀ c''(q) ∇q.
+// (StageQuantityModel, stage_quantities.hpp): the torque τ_k, the half squared rate ½|Ω|² of a
+// step or of a node, or the pointing cosine sᵀR_k b. The constraint knows c(q) and its
+// derivatives in q; the quantity knows q's value, support and derivatives in the unknowns and in
+// h. The assemblers (interior_point/constrained_system at a fixed h, interior_point/
+// free_time_solver with h free) apply the chain rule: ∇c = c'(q) ∇q, ∇²c = c'(q) ∇²q +
+// ∇qᵀ c''(q) ∇q, asking the quantity, never switching on it.
 //
 // The same objects serve the two other places that read constraints, so that adding a kind is one
 // class: the plan's check (checkConstraints: each constraint's slack in its physical unit on the
 // plan's torques, rates or attitudes, at the nodes and between them), and the dense NLPs (the NLopt
 // cross-check, the IPOPT peer in studies/benchmark_solvers.cpp: each constraint as a row
-// lower ≤ g(r) ≤ upper in its quantity's plain form r). Those places switch on the quantity (how
-// their own transcription forms τ_k, Ω_k or the pointing cosine), never on the kind.
+// lower ≤ g(r) ≤ upper in its quantity's plain form r). Those dense NLPs switch on the quantity's
+// name (their own transcription forms τ_k, Ω_k or the pointing cosine: independent derivatives on
+// purpose), never on the kind.
 #pragma once
 
 #include <initializer_list>
@@ -27,47 +27,19 @@
 
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/planning/problem.hpp"
+#include "planning/transcription/stage_quantities.hpp"
 
 namespace attitude_planner {
 
 class ReducedProblem;
 
-/// What a stage constraint is a function of: its support on the band and its h dependence.
-enum class StageQuantity {
-  Torque,  ///< q = τ_k [N m] (3-vector) on R_{k−1}, R_k, R_{k+1}; moves with h
-  StepRate,  ///< q = ½|Ω_k|² [rad²/s²] of step F_k = R_kᵀR_{k+1} (paper, variational); moves with h
-  NodeRate,  ///< q = ½|J⁻¹Π_k|² [rad²/s²] of node k (schemes with end torques) on R_{k−1..k+1};
-             ///< moves with h
-  Pointing,  ///< q = sᵀR_k b (the cosine of the angle between R_k b and s) on R_k; no h
-};
-
-/// Where the instances of a quantity sit: k = first_k..last_k, each on the nodes
-/// k + node_offset .. k + node_offset + width − 1 (at most three: the band is kept).
-struct StageSupport {
-  int first_k = 0, last_k = 0;
-  int node_offset = 0;
-  int width = 1;
-};
-
-/// The support of `quantity` on a reduced problem whose free attitudes are
-/// R_first_free..R_last_free (torques k = first_free − 1..last_free + 1; step rates the steps
-/// between them and their neighbours, the boundary steps excluded (boundary data); node rates and
-/// cones the free nodes, the fixed attitudes being checked up front).
-StageSupport stageSupport(StageQuantity quantity, int first_free, int last_free);
-
-/// True where q changes with the time step at fixed free attitudes (all but Pointing).
-bool quantityDependsOnTimeStep(StageQuantity quantity);
-
-/// The instances k = first_k..last_k of a quantity on a plan of `steps` steps (checkConstraints):
-/// the torques the plan carries (1..N−1; 0..N with end torques), the step rates 0..N−1 (the
-/// plan's reported Ω_k), node rates and cones 0..N.
-StageSupport planSupport(StageQuantity quantity, bool end_torques, int steps);
-
 /// One node constraint c(q) ≥ 0, imposed at every instance of its quantity.
 class StageConstraint {
  public:
   virtual ~StageConstraint() = default;
-  StageQuantity quantity() const { return quantity_; }
+  StageQuantity quantity() const { return quantity_->kind(); }
+  /// The quantity q this constraint is a function of (shared with the other constraints on it).
+  const StageQuantityModel& quantityModel() const { return *quantity_; }
   /// The scene's constraint this one imposes (null: a side of the actuator box).
   const PlanningConstraint* spec() const { return spec_; }
 
@@ -113,11 +85,12 @@ class StageConstraint {
   virtual double rowUpper() const { return std::numeric_limits<double>::infinity(); }
 
  protected:
-  StageConstraint(StageQuantity quantity, const PlanningConstraint* spec)
-      : quantity_(quantity), spec_(spec) {}
+  StageConstraint(std::shared_ptr<const StageQuantityModel> quantity,
+                  const PlanningConstraint* spec)
+      : quantity_(std::move(quantity)), spec_(spec) {}
 
  private:
-  StageQuantity quantity_;
+  std::shared_ptr<const StageQuantityModel> quantity_;
   const PlanningConstraint* spec_;
 };
 
@@ -128,6 +101,15 @@ using StageConstraints = std::vector<std::unique_ptr<const StageConstraint>>;
 /// the node rates for schemes with end torques, else on the step rates). The list points into
 /// `problem.constraints`: `problem` must outlive it.
 StageConstraints buildStageConstraints(const PlanningProblem& problem);
+
+/// A list's constraints by quantity object, as indices into the list: those on the cost's stencil
+/// residuals (formedByCostStencil: the torques, assembled in the cost's own pass), and the others
+/// in one block per quantity (first appearance order), each block assembled in one pass.
+struct QuantityBlocks {
+  std::vector<int> on_cost_stencil;
+  std::vector<std::vector<int>> blocks;
+};
+QuantityBlocks quantityBlocks(const StageConstraints& constraints);
 
 /// The first cone whose node bound (a ± its margin) is violated at one of `nodes` that the
 /// boundary data fix (no unknown of `np`): "<describeConstraint> is violated by x rad at k = K",

@@ -53,7 +53,8 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
 RecedingHorizonRun::RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme,
                                        const Matrix3& inertia,
                                        std::shared_ptr<const EffectModel> effects,
-                                       const Actuation& actuation, TrackingOptions options)
+                                       const Actuation& actuation, TrackingOptions options,
+                                       std::optional<RigidBodyState> start)
     : scheme_(scheme),
       inertia_(inertia),
       effects_(std::move(effects)),
@@ -64,7 +65,8 @@ RecedingHorizonRun::RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme,
   if (options_.natural_frequency == 0.0) {
     options_.natural_frequency = defaultTrackingFrequency(steps_ * time_step_);
   }
-  segments_.push_back(fly(plan, 0, plan.attitude.front(), plan.angular_velocity.front()));
+  if (!start) start = RigidBodyState{plan.attitude.front(), plan.angular_velocity.front()};
+  segments_.push_back(fly(plan, 0, start->attitude, start->angular_velocity));
 }
 
 RecedingHorizonRun::Segment RecedingHorizonRun::fly(const Maneuver& rows, int k,

@@ -15,6 +15,7 @@ namespace {
 
 const std::string kPlanner = AP_TOOL_DIR "attitude_planner_node";
 const std::string kTracker = AP_TOOL_DIR "attitude_tracker_node";
+const std::string kPlant = AP_TOOL_DIR "attitude_plant_node";
 constexpr int kExitInvalidParameter = 78;  // parameters.hpp: EX_CONFIG
 constexpr int kTimeoutExit = 124;          // timeout(1): the node was still running
 
@@ -77,6 +78,43 @@ TEST(NodeParameters, OutOfRangeValueStopsTheTrackerNamingIt) {
   EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
   EXPECT_TRUE(contains(run.output, "/bad_rate/rate_factor = 0 is invalid: must be > 0"))
       << run.output;
+}
+
+TEST(NodeParameters, UnknownPlantStopsTheTrackerListingTheNames) {
+  const NodeRun run = runNode(kTracker + " __name:=bad_plant _plant:=outside", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_plant/plant = outside is invalid")) << run.output;
+  EXPECT_TRUE(contains(run.output, "external")) << run.output;
+}
+
+TEST(NodeParameters, UnknownModeStopsTheTrackerWithExit78) {
+  const NodeRun run = runNode(kTracker + " __name:=bad_mode _mode:=autopilot", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/bad_mode/mode = autopilot is invalid")) << run.output;
+  EXPECT_TRUE(contains(run.output, "feedback")) << run.output;
+}
+
+TEST(NodeParameters, ExternalPlantInReplanModeStopsTheTracker) {
+  const NodeRun run =
+      runNode(kTracker + " __name:=external_replan _plant:=external _mode:=replan", 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
+  EXPECT_TRUE(contains(run.output, "/external_replan/plant = external works with ~mode replay or "
+                                   "feedback, not with ~mode replan"))
+      << run.output;
+}
+
+TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
+  const NodeRun missing = runNode(kPlant + " __name:=sceneless_plant", 60);
+  EXPECT_EQ(missing.status, kExitInvalidParameter) << missing.output;
+  EXPECT_TRUE(contains(missing.output, "/sceneless_plant/scene is required")) << missing.output;
+  const NodeRun bad_rate = runNode(kPlant + " __name:=bad_plant_rate _rate:=0 _scene:=" +
+                                       AP_SOURCE_DIR "/scenes/leo_slew.yaml",
+                                   60);
+  EXPECT_EQ(bad_rate.status, kExitInvalidParameter) << bad_rate.output;
+  EXPECT_TRUE(contains(bad_rate.output, "/bad_plant_rate/rate = 0 is invalid")) << bad_rate.output;
+  const NodeRun good =
+      runNode(kPlant + " __name:=good_plant _scene:=" AP_SOURCE_DIR "/scenes/leo_slew.yaml", 5);
+  EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
 }
 
 TEST(NodeParameters, MissingRelativeSceneNamesTheCallersDirectory) {

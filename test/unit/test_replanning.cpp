@@ -19,6 +19,15 @@ Scene disturbedScene() {
   return loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
 }
 
+/// scenes/disturbed_replay.yaml and its plan (the gravity gradient and the disturbance planned
+/// for, the torque noise not).
+struct DisturbedPlan {
+  Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
+  PlanResult plan = planManeuver(scene.problem);
+  Matrix3 J = scene.problem.inertia;
+  std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+};
+
 }  // namespace
 
 TEST(EffectModelTimeShifted, ReadsTheEffectsLaterByTheOffsetWithTheirNames) {
@@ -58,12 +67,10 @@ TEST(RemainderProblem, KeepsTheGridTargetAndConstraintsFromTheState) {
 // t_k with the noise stream where it was, under the effects at the right time. So the segmented
 // run is the single closed-loop run (to round-off), which is what makes re-plans comparable.
 TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
-  const Scene scene = disturbedScene();
-  const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
-  const Matrix3& J = scene.problem.inertia;
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
-  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
   const Maneuver& nodes = plan.maneuver;
   const ManeuverInterpolation reference(nodes, scheme, J, effects.get());
   Actuation actuation = actuationOf(scene.effects);  // with noise: the stream must continue
@@ -95,12 +102,10 @@ TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
 // one node later (what the tracker does through the service): every re-plan converges, and the
 // body lands far better than open loop, as the law alone does.
 TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
-  const Scene scene = disturbedScene();
-  const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
-  const Matrix3& J = scene.problem.inertia;
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
-  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
   const Maneuver& nodes = plan.maneuver;
   const int N = nodes.steps();
 
@@ -133,4 +138,27 @@ TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
   const double miss = so3::angleBetween(end.attitude, nodes.attitude.back());
   EXPECT_GT(replay_miss, 1e-3);
   EXPECT_LT(miss, 0.1 * replay_miss) << "replan " << miss << " rad, replay " << replay_miss;
+}
+
+// A run that takes over from another (a new maneuver mid-run, the tracker) starts at the given
+// state, not at the plan's R_0: exactly simulateTracking's run from that state.
+TEST(RecedingHorizonRun, StartsFromTheGivenStateAsSimulateTrackingDoes) {
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
+  const SchemeKind scheme = scene.problem.scheme;
+  const Maneuver& nodes = plan.maneuver;
+  const RigidBodyState start{nodes.attitude[0] * so3::exp(Vector3(0.05, -0.1, 0.02)),
+                             Vector3(1e-3, 0.0, -2e-3)};
+  const ManeuverInterpolation reference(nodes, scheme, J, effects.get());
+  Actuation actuation = actuationOf(scene.effects);
+  const TrackingRun single = simulateTracking(reference, start.attitude, start.angular_velocity,
+                                              effects.get(), &actuation, {});
+  const RecedingHorizonRun run(nodes, scheme, J, effects, actuationOf(scene.effects), {}, start);
+  EXPECT_LT(so3::angleBetween(run.bodyAt(0.0).attitude, start.attitude), 1e-15);
+  EXPECT_LT((run.bodyAt(0.0).angular_velocity - start.angular_velocity).norm(), 1e-15);
+  const double T = reference.duration();
+  EXPECT_LT(so3::angleBetween(run.bodyAt(T).attitude, single.actual.attitude.back()), 1e-12);
+  EXPECT_GT(so3::angleBetween(start.attitude, nodes.attitude[0]), 0.1);  // a real offset ...
+  EXPECT_LT(single.terminal_attitude_error, 1e-3);                       // ... pulled in
 }

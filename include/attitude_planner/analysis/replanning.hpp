@@ -36,13 +36,14 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
 /// with the actuator noise stream continued where it was).
 class RecedingHorizonRun {
  public:
-  /// Starts by flying `plan` (the first plan, rows 0..N) from its R_0, Ω_0: until the first
-  /// adoption this is simulateTracking's run. `effects` (may be null) act on the body on the
-  /// maneuver's clock; `actuation` is copied fresh (saturation and noise from its first sample);
-  /// options.natural_frequency 0 = defaultTrackingFrequency(T) of the first plan, kept for all.
+  /// Starts by flying `plan` (the first plan, rows 0..N) from `start` (default: its R_0, Ω_0):
+  /// until the first adoption this is simulateTracking's run. `effects` (may be null) act on the
+  /// body on the maneuver's clock; `actuation` is copied fresh (saturation and noise from its
+  /// first sample); options.natural_frequency 0 = defaultTrackingFrequency(T) of the first plan,
+  /// kept for all.
   RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme, const Matrix3& inertia,
                      std::shared_ptr<const EffectModel> effects, const Actuation& actuation,
-                     TrackingOptions options);
+                     TrackingOptions options, std::optional<RigidBodyState> start = std::nullopt);
 
   /// Adopts `plan`, planned from node `planned_from` (its row 0 is node planned_from), from node
   /// `at` (planned_from ≤ at < N) on. Throws InvalidInput if its grid does not fit (steps

@@ -50,6 +50,17 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
   return rest;
 }
 
+int replanPeriodSteps(double period, int steps, double time_step) {
+  if (!(std::isfinite(period) && period >= 0.0)) {
+    throw InvalidInput("~replan_period: must be >= 0 s (0 = T / " +
+                       std::to_string(kDefaultReplansPerManeuver) + "), got " +
+                       exactNumber(period));
+  }
+  const double raw =
+      period == 0.0 ? static_cast<double>(steps) / kDefaultReplansPerManeuver : period / time_step;
+  return std::max(1, static_cast<int>(std::lround(raw)));
+}
+
 RecedingHorizonRun::RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme,
                                        const Matrix3& inertia,
                                        std::shared_ptr<const EffectModel> effects,

@@ -381,7 +381,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
   rate_ = readParam<double>(pnh, "rate", 50.0, non_negative, ">= 0 Hz, 0 = at the plan nodes");
-  replan_period_ = readParam<double>(pnh, "replan_period", 1.0, positive, "> 0 s");
+  replan_period_ = readParam<double>(pnh, "replan_period", 0.0, non_negative, ">= 0 s, 0 = T / 10");
   tracking_.natural_frequency =
       readParam<double>(pnh, "feedback_frequency", 0.0, non_negative, ">= 0 rad/s, 0 = 40 / T");
   tracking_.damping = readParam<double>(pnh, "feedback_damping", 1.0, positive, "> 0");
@@ -458,6 +458,10 @@ void TrackerNode::advertiseTopics() {
   done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
   constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
   control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
+  body_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("body_pose", 10);
+  error_vector_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("attitude_error_vector", 10);
+  rate_error_vector_pub_ =
+      nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity_error_vector", 10);
   if (plant_ == PlantKind::External) {
     command_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque_command", 10);
     // Only the newest state matters: a queue of one never feeds the law an old measurement.
@@ -701,6 +705,7 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
   const RigidBodyState start =
       replay.takeover.value_or(RigidBodyState{plan.attitude[0], plan.angular_velocity[0]});
   if (mode_ == TrackingMode::Replan) {
+    pb->replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
     // The closed loop on the first plan until a re-plan is adopted (serviceReplans).
     pb->horizon = std::make_shared<RecedingHorizonRun>(
         plan, scheme, inertia, pb->effects, actuationOf(replay.effects), tracking_, start);
@@ -838,6 +843,24 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   publishState(pb, body, plan, t, stamp, trail);
 }
 
+void TrackerNode::publishStampedErrors(const Playback& pb, const Matrix3& body,
+                                       const Matrix3& reference, const TrackingErrors& e,
+                                       const ros::Time& stamp) {
+  // For rqt_plot and bag analysis: the body's attitude and the error vectors, stamped.
+  geometry_msgs::PoseStamped pose;
+  pose.header.stamp = stamp;
+  pose.header.frame_id = pb.world_frame;
+  pose.pose.orientation = rc::attitudeToMsg(body);
+  body_pose_pub_.publish(pose);
+  geometry_msgs::Vector3Stamped error;
+  error.header.stamp = stamp;
+  error.header.frame_id = pb.body_frame;
+  error.vector = rc::vectorToMsg(so3::log(Matrix3(reference.transpose() * body)));
+  error_vector_pub_.publish(error);
+  error.vector = rc::vectorToMsg(e.rate);
+  rate_error_vector_pub_.publish(error);
+}
+
 void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
                                const ManeuverSample& plan, double t, const ros::Time& stamp,
                                std::deque<Vector3>* trail) {
@@ -867,6 +890,7 @@ void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
   error_pub_.publish(value);
   value.data = e.rate.norm();
   rate_error_pub_.publish(value);
+  publishStampedErrors(pb, body.attitude, plan.attitude, e, stamp);
 
   const Matrix3& target = pb.reference->nodes().attitude.back();
   char text[160];
@@ -912,8 +936,7 @@ void TrackerNode::runReplay(Replay replay) {
            rate_factor_, pb.world_frame.c_str(), pb.body_frame.c_str());
   std::deque<Vector3> trail;
   ReplanState replans;
-  replans.period_steps =
-      std::max(1, static_cast<int>(std::lround(replan_period_ / pb.reference->nodes().time_step)));
+  replans.period_steps = pb.replan_period_steps;
   replans.next_node = replans.period_steps;
   if (plant_ == PlantKind::External) {
     if (!runExternal(start, &pb)) return;
@@ -1187,8 +1210,9 @@ void TrackerNode::finishReplanResult(Playback* pb) const {
   result.replans = run.adoptions();
   result.message = "tracked " + std::to_string(N) + " steps with feedback (omega_n " +
                    exactNumber(run.naturalFrequency()) + " rad/s) and re-planning every " +
-                   exactNumber(replan_period_) + " s: " + std::to_string(result.replans) +
-                   " re-plans adopted, " + std::to_string(result.replan_failures) + " failed";
+                   exactNumber(pb->replan_period_steps * plan.time_step) +
+                   " s: " + std::to_string(result.replans) + " re-plans adopted, " +
+                   std::to_string(result.replan_failures) + " failed";
 }
 
 void TrackerNode::runDriftReplay(const Replay& replay) {

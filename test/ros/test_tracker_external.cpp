@@ -7,11 +7,15 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/Vector3Stamped.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <nav_msgs/Odometry.h>
+#include <std_msgs/Float64.h>
 
 #include <atomic>
 #include <mutex>
+#include <vector>
 
 #include "attitude_planner/ReplayResult.h"
 #include "ros_test_helpers.hpp"
@@ -43,7 +47,21 @@ struct CommandCounter {
 TEST(TrackerExternal, MeasuredLoopLandsWithinTwiceTheInternalFeedbackError) {
   ros::NodeHandle internal_nh("internal"), external_nh("external"), unmeasured_nh("unmeasured");
   CommandCounter external_commands(external_nh), unmeasured_commands(unmeasured_nh);
-  std::atomic<int> odometry{0};
+  std::atomic<int> odometry{0}, poses{0};
+  std::mutex errors_mutex;
+  std::vector<double> error_norms, error_vector_norms;  // attitude_error, |attitude_error_vector|
+  ros::Subscriber error_sub = external_nh.subscribe<std_msgs::Float64>(
+      "attitude_error", 1000, [&](const std_msgs::Float64::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        error_norms.push_back(m->data);
+      });
+  ros::Subscriber error_vector_sub = external_nh.subscribe<geometry_msgs::Vector3Stamped>(
+      "attitude_error_vector", 1000, [&](const geometry_msgs::Vector3Stamped::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        error_vector_norms.push_back(ros_conversions::vectorFromMsg(m->vector).norm());
+      });
+  ros::Subscriber pose_sub = external_nh.subscribe<geometry_msgs::PoseStamped>(
+      "body_pose", 1000, [&](const geometry_msgs::PoseStamped::ConstPtr&) { ++poses; });
   ros::Subscriber odometry_sub = external_nh.subscribe<nav_msgs::Odometry>(
       "odometry", 1000, [&](const nav_msgs::Odometry::ConstPtr&) { ++odometry; });
   ros_testing::DoneListener internal_done(internal_nh), external_done(external_nh),
@@ -77,6 +95,16 @@ TEST(TrackerExternal, MeasuredLoopLandsWithinTwiceTheInternalFeedbackError) {
     EXPECT_GT(external_commands.largest, 0.0);
   }
   EXPECT_GT(odometry, 100);
+  // The stamped topics (body_pose, the error vector) go out with every sample; the vector's norm
+  // is attitude_error.
+  EXPECT_EQ(poses, 301);
+  {
+    std::lock_guard<std::mutex> lock(errors_mutex);
+    ASSERT_EQ(error_vector_norms.size(), 301u);
+    ASSERT_EQ(error_norms.size(), error_vector_norms.size());
+    for (std::size_t i = 0; i < error_norms.size(); ++i)
+      EXPECT_NEAR(error_vector_norms[i], error_norms[i], 1e-12) << "sample " << i;
+  }
 
   // No measurement: every sample still goes out, with a zero command, and `done` fails saying so.
   EXPECT_FALSE(unmeasured->success);

@@ -162,3 +162,16 @@ TEST(RecedingHorizonRun, StartsFromTheGivenStateAsSimulateTrackingDoes) {
   EXPECT_GT(so3::angleBetween(start.attitude, nodes.attitude[0]), 0.1);  // a real offset ...
   EXPECT_LT(single.terminal_attitude_error, 1e-3);                       // ... pulled in
 }
+
+// ~replan_period in plan steps: a period rounds to whole steps (at least one); 0, the default,
+// is T / 10 whatever the step (the old default of 1 s re-planned at every node of h = 2 s).
+TEST(ReplanPeriodSteps, RoundsAPeriodAndDerivesTheDefaultFromThePlan) {
+  EXPECT_EQ(replanPeriodSteps(60.0, 300, 2.0), 30);
+  EXPECT_EQ(replanPeriodSteps(1.0, 300, 2.0), 1);   // shorter than a step: every node
+  EXPECT_EQ(replanPeriodSteps(3.1, 300, 2.0), 2);   // rounded
+  EXPECT_EQ(replanPeriodSteps(0.0, 300, 2.0), 30);  // T / 10
+  EXPECT_EQ(replanPeriodSteps(0.0, 1200, 0.5), 120);
+  EXPECT_EQ(replanPeriodSteps(0.0, 8, 0.1), 1);  // at least one step
+  EXPECT_THROW(replanPeriodSteps(-1.0, 300, 2.0), InvalidInput);
+  EXPECT_THROW(replanPeriodSteps(std::nan(""), 300, 2.0), InvalidInput);
+}

@@ -34,6 +34,15 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
 /// The closed loop of the `replan` mode: the tracking law flies the newest adopted plan; the body
 /// is continuous across adoptions (one simulation per adopted plan, from the state at its node,
 /// with the actuator noise stream continued where it was).
+/// Re-plans per maneuver when no period is given: every T/10 (tracking_study's default; the
+/// measured table in docs/ros_tracker.md).
+inline constexpr int kDefaultReplansPerManeuver = 10;
+
+/// Plan steps between re-plans: `period` [s] > 0 rounded to whole steps of `time_step`; `period`
+/// 0 = steps / kDefaultReplansPerManeuver rounded (T/10, whatever the plan's step); at least one
+/// step either way. Throws InvalidInput naming `~replan_period` for a negative or non-finite one.
+int replanPeriodSteps(double period, int steps, double time_step);
+
 class RecedingHorizonRun {
  public:
   /// Starts by flying `plan` (the first plan, rows 0..N) from `start` (default: its R_0, Ω_0):

@@ -46,6 +46,10 @@
 //             reference_pose     geometry_msgs/PoseStamped, world    R_d(t), the plan [rigid body]
 //             attitude_error     std_msgs/Float64   ‖log(R_d(t)ᵀ R(t))‖ [rad] (rqt_plot)
 //             angular_velocity_error std_msgs/Float64  |Ω − RᵀR_d Ω_d| [rad/s] (rqt_plot)
+//             body_pose          geometry_msgs/PoseStamped, world   R(t), the body (stamped state)
+//             attitude_error_vector geometry_msgs/Vector3Stamped, body   log(R_dᵀR) [rad], the
+//                                rotation from the reference to the body (norm: attitude_error)
+//             angular_velocity_error_vector geometry_msgs/Vector3Stamped, body   e_Ω [rad/s]
 //             body_marker        visualization_msgs/MarkerArray, body   box, principal axes, traced
 //             axis attitude_trail     visualization_msgs/Marker, world   the traced axis' last
 //             kTrailPoints tips status_text        visualization_msgs/Marker, world   "t / T, angle
@@ -64,8 +68,8 @@
 //   ~mode             string  "replay" replay | feedback | replan; an unknown mode stops the node
 //                                      with an error naming it (exit 78, as every bad parameter)
 //   ~rate             double  50.0     samples per ROS second (>= 0); 0 = one sample per plan node
-//   ~replan_period    double  1.0      [s, maneuver time] between re-plans (> 0; replan), rounded
-//                                      to whole plan steps (at least one)
+//   ~replan_period    double  0.0      [s, maneuver time] between re-plans (>= 0; replan), rounded
+//                                      to whole plan steps (at least one); 0 = T / 10
 //   ~trace_axis       string  "auto"   body axis traced by the path: x | y | z | auto (the one
 //                                      most perpendicular to the maneuver's rotation axis)
 //   ~feedback_frequency double 0.0     ω_n of the law [rad/s] (>= 0; 0 = 40 / T)
@@ -297,7 +301,8 @@ class TrackerNode {
     std::shared_ptr<RecedingHorizonRun> horizon;
     PlanningProblem problem;
     std::vector<EffectSpec> effects_specs;
-    std::string replan_status;  ///< the status text's re-plan line (replan mode)
+    std::string replan_status;    ///< the status text's re-plan line (replan mode)
+    int replan_period_steps = 1;  ///< plan steps between re-plans (replanPeriodSteps)
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -357,6 +362,10 @@ class TrackerNode {
   void publishState(const Playback& playback, const ManeuverSample& body,
                     const ManeuverSample& plan, double t, const ros::Time& stamp,
                     std::deque<Vector3>* trail);
+  /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
+  /// (e_Ω), stamped `stamp`.
+  void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,
+                            const TrackingErrors& errors, const ros::Time& stamp);
   /// replan mode, after the stream: the terminal errors and effort of the re-planned closed loop.
   void finishReplanResult(Playback* playback) const;
   /// Publishes one sample at maneuver time t, stamped `stamp`.
@@ -385,26 +394,29 @@ class TrackerNode {
   void noteNextSample(bool running, const RigidBodyState& body = {},
                       const ros::Time& stamp = ros::Time());
 
-  ros::NodeHandle nh_;             ///< public handle: topics and the service resolve here
-  ros::Subscriber maneuver_sub_;   ///< `maneuver`
-  ros::Subscriber drift_sub_;      ///< `drift_maneuver`
-  ros::Publisher control_pub_;     ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
-  ros::Publisher torque_pub_;      ///< `torque` τ(t) [N·m], frame body
-  ros::Publisher velocity_pub_;    ///< `angular_velocity` Ω(t) [rad/s], frame body
-  ros::Publisher reference_pub_;   ///< `reference_pose` R_d(t)
-  ros::Publisher error_pub_;       ///< `attitude_error` [rad]
-  ros::Publisher rate_error_pub_;  ///< `angular_velocity_error` [rad/s]
-  ros::Publisher marker_pub_;      ///< `body_marker`
-  ros::Publisher trail_pub_;       ///< `attitude_trail`
-  ros::Publisher text_pub_;        ///< `status_text`
-  ros::Publisher path_pub_;        ///< `attitude_path` (latched)
-  ros::Publisher ghost_pub_;       ///< `ghost_markers` (latched)
-  ros::Publisher done_pub_;        ///< `done` (latched)
-  ros::Publisher constraint_pub_;  ///< `constraint_markers` (latched)
-  ros::Publisher command_pub_;     ///< `torque_command` (~plant external) [N·m], frame body
-  ros::Subscriber odometry_sub_;   ///< `odometry` (~plant external)
-  ros::Subscriber tf_sub_;         ///< /tf: who else publishes our body transform
-  std::mutex frames_mutex_;        ///< guards the three below
+  ros::NodeHandle nh_;               ///< public handle: topics and the service resolve here
+  ros::Subscriber maneuver_sub_;     ///< `maneuver`
+  ros::Subscriber drift_sub_;        ///< `drift_maneuver`
+  ros::Publisher control_pub_;       ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
+  ros::Publisher torque_pub_;        ///< `torque` τ(t) [N·m], frame body
+  ros::Publisher velocity_pub_;      ///< `angular_velocity` Ω(t) [rad/s], frame body
+  ros::Publisher reference_pub_;     ///< `reference_pose` R_d(t)
+  ros::Publisher error_pub_;         ///< `attitude_error` [rad]
+  ros::Publisher rate_error_pub_;    ///< `angular_velocity_error` [rad/s]
+  ros::Publisher marker_pub_;        ///< `body_marker`
+  ros::Publisher trail_pub_;         ///< `attitude_trail`
+  ros::Publisher text_pub_;          ///< `status_text`
+  ros::Publisher path_pub_;          ///< `attitude_path` (latched)
+  ros::Publisher ghost_pub_;         ///< `ghost_markers` (latched)
+  ros::Publisher done_pub_;          ///< `done` (latched)
+  ros::Publisher constraint_pub_;    ///< `constraint_markers` (latched)
+  ros::Publisher command_pub_;       ///< `torque_command` (~plant external) [N·m], frame body
+  ros::Publisher body_pose_pub_;     ///< `body_pose` R(t), frame world
+  ros::Publisher error_vector_pub_;  ///< `attitude_error_vector` log(R_dᵀR) [rad], body
+  ros::Publisher rate_error_vector_pub_;  ///< `angular_velocity_error_vector` e_Ω [rad/s], body
+  ros::Subscriber odometry_sub_;          ///< `odometry` (~plant external)
+  ros::Subscriber tf_sub_;                ///< /tf: who else publishes our body transform
+  std::mutex frames_mutex_;               ///< guards the three below
   std::string claimed_world_, claimed_body_;      ///< the pair the current run publishes
   std::string frame_conflict_;                    ///< another publisher of it, when seen
   tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
@@ -419,7 +431,7 @@ class TrackerNode {
   double body_size_ = 1.0;                        ///< largest box edge [m]
   double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
   double path_radius_ = 1.2;                      ///< distance of the traced tip [m]
-  double replan_period_ = 1.0;                    ///< ~replan_period [s, maneuver time]
+  double replan_period_ = 0.0;                    ///< ~replan_period [s]; 0 = T / 10
   bool plan_in_process_ = false;                  ///< ~plan_in_process (also for re-plans)
   bool exit_when_done_ = false;                   ///< shut down after `done`
   double planner_timeout_ = 30.0;                 ///< ~planner_timeout [s, wall]

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 namespace {
@@ -80,40 +81,30 @@ TEST(NodeParameters, OutOfRangeValueStopsTheTrackerNamingIt) {
       << run.output;
 }
 
-TEST(NodeParameters, UnknownPlantStopsTheTrackerListingTheNames) {
-  const NodeRun run = runNode(kTracker + " __name:=bad_plant _plant:=outside", 60);
-  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
-  EXPECT_TRUE(contains(run.output, "/bad_plant/plant = outside is invalid")) << run.output;
-  EXPECT_TRUE(contains(run.output, "external")) << run.output;
+/// Runs `command`; expects it to stop with exit 78 and every one of `parts` in its output.
+void expectStopped(const std::string& command, std::initializer_list<std::string> parts) {
+  const NodeRun run = runNode(command, 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << command << ":\n" << run.output;
+  for (const std::string& part : parts) EXPECT_TRUE(contains(run.output, part)) << run.output;
 }
 
-TEST(NodeParameters, UnknownModeStopsTheTrackerWithExit78) {
-  const NodeRun run = runNode(kTracker + " __name:=bad_mode _mode:=autopilot", 60);
-  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
-  EXPECT_TRUE(contains(run.output, "/bad_mode/mode = autopilot is invalid")) << run.output;
-  EXPECT_TRUE(contains(run.output, "feedback")) << run.output;
-}
-
-TEST(NodeParameters, ExternalPlantInReplanModeStopsTheTracker) {
-  const NodeRun run =
-      runNode(kTracker + " __name:=external_replan _plant:=external _mode:=replan", 60);
-  EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
-  EXPECT_TRUE(contains(run.output, "/external_replan/plant = external works with ~mode replay or "
-                                   "feedback, not with ~mode replan"))
-      << run.output;
+TEST(NodeParameters, UnknownPlantOrModeStopsTheTrackerListingTheNames) {
+  expectStopped(kTracker + " __name:=bad_plant _plant:=outside",
+                {"/bad_plant/plant = outside is invalid", "external"});
+  // Before issue 43 a bad ~mode printed FATAL and exited 0.
+  expectStopped(kTracker + " __name:=bad_mode _mode:=autopilot",
+                {"/bad_mode/mode = autopilot is invalid", "feedback"});
+  expectStopped(kTracker + " __name:=external_replan _plant:=external _mode:=replan",
+                {"/external_replan/plant = external works with ~mode replay or feedback, not "
+                 "with ~mode replan"});
 }
 
 TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
-  const NodeRun missing = runNode(kPlant + " __name:=sceneless_plant", 60);
-  EXPECT_EQ(missing.status, kExitInvalidParameter) << missing.output;
-  EXPECT_TRUE(contains(missing.output, "/sceneless_plant/scene is required")) << missing.output;
-  const NodeRun bad_rate = runNode(kPlant + " __name:=bad_plant_rate _rate:=0 _scene:=" +
-                                       AP_SOURCE_DIR "/scenes/leo_slew.yaml",
-                                   60);
-  EXPECT_EQ(bad_rate.status, kExitInvalidParameter) << bad_rate.output;
-  EXPECT_TRUE(contains(bad_rate.output, "/bad_plant_rate/rate = 0 is invalid")) << bad_rate.output;
-  const NodeRun good =
-      runNode(kPlant + " __name:=good_plant _scene:=" AP_SOURCE_DIR "/scenes/leo_slew.yaml", 5);
+  const std::string scene = " _scene:=" AP_SOURCE_DIR "/scenes/leo_slew.yaml";
+  expectStopped(kPlant + " __name:=sceneless_plant", {"/sceneless_plant/scene is required"});
+  expectStopped(kPlant + " __name:=bad_plant_rate _rate:=0" + scene,
+                {"/bad_plant_rate/rate = 0 is invalid"});
+  const NodeRun good = runNode(kPlant + " __name:=good_plant" + scene, 5);
   EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
 }
 

@@ -156,6 +156,12 @@ ManeuverSample RecedingHorizonRun::referenceAt(double t) const {
   return sample;
 }
 
+Vector3 RecedingHorizonRun::commandAt(const RigidBodyState& state, double t) const {
+  const Segment& s = segmentAt(t);
+  const TrackingLaw law(*s.reference, s.effects.get(), options_);
+  return law.command(state.attitude, state.angular_velocity, t - s.node * time_step_);
+}
+
 Maneuver RecedingHorizonRun::planRemainderAt(int k) const {
   const Segment& s = segmentAt(k * time_step_);
   return remainderOf(s.reference->nodes(), k - s.node);

@@ -403,11 +403,6 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   plant_ = readNamedParam(pnh, "plant", PlantKind::Internal, kPlantNames);
   measurement_timeout_ =
       readParam<double>(pnh, "measurement_timeout", 0.5, positive, "> 0 s (ROS time)");
-  if (plant_ == PlantKind::External && mode_ == TrackingMode::Replan) {
-    throw InvalidParameter("parameter " + pnh.resolveName("plant") +
-                           " = external works with ~mode replay or feedback, not with ~mode "
-                           "replan (re-planning on the measured state is not implemented yet)");
-  }
 
   advertiseTopics();
 
@@ -793,7 +788,14 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.effects = plannableEffects(replay.effects, inertia);
   pb.reference =
       std::make_unique<ManeuverInterpolation>(plan, problem.scheme, inertia, pb.effects.get());
-  if (plant_ == PlantKind::Internal) runBody(replay, plan, inertia, problem.scheme, &pb);
+  if (plant_ == PlantKind::Internal) {
+    runBody(replay, plan, inertia, problem.scheme, &pb);
+  } else if (mode_ == TrackingMode::Replan) {
+    // External: the plans in force and their laws; its own simulated body is not flown.
+    pb.replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
+    pb.horizon = std::make_shared<RecedingHorizonRun>(plan, problem.scheme, inertia, pb.effects,
+                                                      Actuation(), tracking_);
+  }
   pb.times = sampleTimes(problem.duration, N, rate_, rate_factor_);
   ReplayResult& result = pb.result;
   result.mode = trackingModeName(mode_);
@@ -939,7 +941,7 @@ void TrackerNode::runReplay(Replay replay) {
   replans.period_steps = pb.replan_period_steps;
   replans.next_node = replans.period_steps;
   if (plant_ == PlantKind::External) {
-    if (!runExternal(start, &pb)) return;
+    if (!runExternal(start, &pb, &replans)) return;
   } else {
     for (std::size_t j = 0; j < pb.times.size(); ++j) {
       const double t = pb.times[j];
@@ -970,7 +972,8 @@ void TrackerNode::runReplay(Replay replay) {
   publishDone(result);
 }
 
-void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
+void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
+                                 const std::function<RigidBodyState(int)>& state_at_node) {
   RecedingHorizonRun& run = *pb->horizon;
   const int N = run.steps();
   const double h = run.timeStep();
@@ -1022,7 +1025,13 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
   const int node = static_cast<int>(std::floor(t / h + kNodeSlack));
   if (node < state->next_node || N - node < kMinSteps) return;
   // The state the body has at this node under the plan in force, and that plan's rest.
-  const ManeuverSample body = run.bodyAtNode(node);
+  RigidBodyState body;
+  if (state_at_node) {
+    body = state_at_node(node);  // external plant: the measured state moved to the node
+  } else {
+    const ManeuverSample simulated = run.bodyAtNode(node);
+    body = RigidBodyState{simulated.attitude, simulated.angular_velocity};
+  }
   PlanningProblem rest;
   try {
     rest = remainderProblem(pb->problem, node, body.attitude, body.angular_velocity);
@@ -1124,10 +1133,11 @@ MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Ti
   return m;
 }
 
-bool TrackerNode::runExternal(const ros::Time& start, Playback* pb) {
+bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState* replans) {
   const Maneuver& plan = pb->reference->nodes();
   const int N = plan.steps();
   const TrackingLaw law(*pb->reference, pb->effects.get(), tracking_);
+  const Matrix3 plan_inertia = pb->reference->inertia();
   last_measured_.attitude = plan.attitude[0];  // drawn until a measurement arrives
   last_measured_.angular_velocity = plan.angular_velocity[0];
   ReplayResult& result = pb->result;
@@ -1146,7 +1156,14 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb) {
     body.time = t;
     body.attitude = measured.state.attitude;
     body.angular_velocity = measured.state.angular_velocity;
-    if (measured.fresh) {
+    if (measured.fresh && pb->horizon) {  // replan: re-planned from the measured state
+      const double h = plan.time_step;
+      serviceReplans(t, pb, replans, [&](int k) {
+        return predictState(plan_inertia, pb->effects.get(), measured.state, held_command, t,
+                            k * h - t);
+      });
+      body.torque = pb->horizon->commandAt(measured.state, t);
+    } else if (measured.fresh) {
       body.torque = mode_ == TrackingMode::Feedback
                         ? law.command(body.attitude, body.angular_velocity, t)
                         : pb->reference->at(t).torque;  // replay: the plan's torque, open loop
@@ -1160,7 +1177,8 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb) {
     command.wrench.torque = rc::vectorToMsg(body.torque);
     command_pub_.publish(command);
     held_command = body.torque;
-    const ManeuverSample reference = pb->reference->at(t);
+    const ManeuverSample reference =
+        pb->horizon ? pb->horizon->referenceAt(t) : pb->reference->at(t);
     if (measured.fresh) {
       result.max_attitude_deviation = std::max(
           result.max_attitude_deviation, so3::angleBetween(reference.attitude, body.attitude));
@@ -1181,6 +1199,7 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb) {
       (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
   result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
   result.cost = result.effort / plan.time_step;
+  if (pb->horizon) result.replans = pb->horizon->adoptions();
   result.success = stale == 0;
   result.message = (mode_ == TrackingMode::Feedback ? "tracked " : "commanded ") +
                    std::to_string(N) + " steps on the measured state of " +

@@ -94,9 +94,6 @@ TEST(NodeParameters, UnknownPlantOrModeStopsTheTrackerListingTheNames) {
   // Before issue 43 a bad ~mode printed FATAL and exited 0.
   expectStopped(kTracker + " __name:=bad_mode _mode:=autopilot",
                 {"/bad_mode/mode = autopilot is invalid", "feedback"});
-  expectStopped(kTracker + " __name:=external_replan _plant:=external _mode:=replan",
-                {"/external_replan/plant = external works with ~mode replay or feedback, not "
-                 "with ~mode replan"});
 }
 
 TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {

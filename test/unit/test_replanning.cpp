@@ -175,3 +175,28 @@ TEST(ReplanPeriodSteps, RoundsAPeriodAndDerivesTheDefaultFromThePlan) {
   EXPECT_THROW(replanPeriodSteps(-1.0, 300, 2.0), InvalidInput);
   EXPECT_THROW(replanPeriodSteps(std::nan(""), 300, 2.0), InvalidInput);
 }
+
+// commandAt is the law on the plan in force: before an adoption the first plan's TrackingLaw; after
+// one, the law on the adopted rows at the segment's own clock, which for the plan's own rest is
+// the same command again (the same reference, the effects' clock shifted by t_k).
+TEST(RecedingHorizonRun, CommandAtIsTheLawOnThePlanInForce) {
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const Maneuver& nodes = disturbed.plan.maneuver;
+  const SchemeKind scheme = disturbed.scene.problem.scheme;
+  const ManeuverInterpolation reference(nodes, scheme, disturbed.J, disturbed.effects.get());
+  const TrackingLaw law(reference, disturbed.effects.get(), {});
+  RecedingHorizonRun run(nodes, scheme, disturbed.J, disturbed.effects, Actuation(), {});
+  const RigidBodyState off{nodes.attitude[0] * so3::exp(Vector3(0.01, -0.02, 0.005)),
+                           Vector3(1e-4, 0.0, 2e-4)};
+  for (double t : {0.0, 33.0, 301.0}) {
+    EXPECT_LT((run.commandAt(off, t) - law.command(off.attitude, off.angular_velocity, t)).norm(),
+              1e-15)
+        << "t = " << t;
+  }
+  run.adopt(run.planRemainderAt(100), 100, 100);
+  for (double t : {201.0, 450.0}) {
+    const Vector3 expected = law.command(off.attitude, off.angular_velocity, t);
+    EXPECT_LT((run.commandAt(off, t) - expected).norm(), 1e-9 * expected.norm()) << "t = " << t;
+  }
+}

@@ -64,6 +64,10 @@ class RecedingHorizonRun {
   /// The body and the reference (the plan in force) at maneuver time t ∈ [0, T].
   ManeuverSample bodyAt(double t) const;
   ManeuverSample referenceAt(double t) const;
+  /// The law's command on the state (R, Ω) at maneuver time t against the plan in force (its
+  /// TrackingLaw, on its segment's clock and effects, gains of naturalFrequency()): what the
+  /// tracker sends an external plant in replan mode.
+  Vector3 commandAt(const RigidBodyState& state, double t) const;
   /// Rows k..N of the plan in force at node k (its warm start for a re-plan from k).
   Maneuver planRemainderAt(int k) const;
 

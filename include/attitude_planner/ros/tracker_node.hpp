@@ -108,19 +108,21 @@
 //   ~measurement_timeout double 0.5    [s, ROS time] an `odometry` older than this at a sample
 //                                      is stale: zero command, a warning, `done` fails (external)
 //
-// ~plant external (modes replay and feedback): at every sample the tracker takes the newest
+// ~plant external (every mode): at every sample the tracker takes the newest
 // `odometry` (nav_msgs/Odometry: pose.orientation the body → world attitude, twist.angular the
 // body rate; header.frame_id must be the maneuver's world frame and child_frame_id its body
 // frame, empty ones are taken as those), moves it to the sample's time under the command held
 // meanwhile and the known effects (predictState: the measurement's age is transport and sampling
 // lag), and publishes on
 // `torque_command` (geometry_msgs/WrenchStamped, body frame) the law's command on it
-// (TrackingLaw, feedback) or the plan's torque τ(t) (replay). tf, markers and errors show the
+// (TrackingLaw, feedback; the law on the plan in force, replan, re-planned from the measured
+// state) or the plan's torque τ(t) (replay). tf, markers and errors show the
 // measured body. After the last sample a zero command is sent.
 #pragma once
 
 #include <atomic>
 #include <deque>
+#include <functional>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -340,12 +342,14 @@ class TrackerNode {
   void runBody(const Replay& replay, const Maneuver& plan, const Matrix3& inertia,
                SchemeKind scheme, Playback* playback) const;
   /// replan mode, before the sample at maneuver time t: adopts an answer that has arrived (at the
-  /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight.
-  void serviceReplans(double t, Playback* playback, ReplanState* state);
+  /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight,
+  /// from the state `state_at_node` gives at that node (default: the simulated body's).
+  void serviceReplans(double t, Playback* playback, ReplanState* state,
+                      const std::function<RigidBodyState(int)>& state_at_node = nullptr);
   /// ~plant external: streams `playback` from `start`, commanding the measured body; fills the
   /// result (terminal errors of the last measurement, effort of the commands, stale samples).
   /// False if stopped meanwhile.
-  bool runExternal(const ros::Time& start, Playback* playback);
+  bool runExternal(const ros::Time& start, Playback* playback, ReplanState* replans);
   /// `/tf` callback: notes another node that publishes this tracker's body transform.
   void onTf(const ros::MessageEvent<tf2_msgs::TFMessage const>& event);
   /// Sets the frame pair the current run publishes; returns the conflict seen since the last

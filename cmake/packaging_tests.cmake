@@ -6,7 +6,7 @@ set(AP_PACKAGING_RESULTS ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME})
 # What `rosrun attitude_planner <TAB>` offers: exactly the nodes and the installed tools (plus
 # the scripts/ entry points of the source tree); no find loop; replay.launch sets no global
 # parameter.
-set(AP_ROSRUN_EXECUTABLES attitude_planner_node attitude_tracker_node)
+set(AP_ROSRUN_EXECUTABLES attitude_planner_node attitude_tracker_node attitude_plant_node)
 foreach(tool_source ${AP_TOOL_SOURCES})
   get_filename_component(tool_name ${tool_source} NAME_WE)
   list(APPEND AP_ROSRUN_EXECUTABLES ${tool_name})

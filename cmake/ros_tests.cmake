@@ -75,6 +75,25 @@ target_link_libraries(test_tracker_replan ${PROJECT_NAME}_ros ${catkin_LIBRARIES
 add_dependencies(test_tracker_replan attitude_planner_node attitude_tracker_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_replan)
 
+# ~plant external: the law on the measured state of attitude_plant_node (odometry in,
+# torque_command out) lands as the internal feedback mode does; no measurement: zero commands and
+# a failed done, the stream at its rate.
+add_rostest_gtest(test_tracker_external test/ros/tracker_external.test
+                  test/ros/test_tracker_external.cpp)
+target_link_libraries(test_tracker_external ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_external attitude_tracker_node attitude_plant_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_external)
+
+# A new maneuver mid-run (issue 43): with a planner that never answers (hung_planner_node) the
+# stream keeps its rate and both runs get `done`; the body is flown on from its state (no jump).
+add_executable(hung_planner_node EXCLUDE_FROM_ALL test/ros/hung_planner_node.cpp)
+target_link_libraries(hung_planner_node ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_rostest_gtest(test_tracker_takeover test/ros/tracker_takeover.test
+                  test/ros/test_tracker_takeover.cpp)
+target_link_libraries(test_tracker_takeover ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_takeover attitude_tracker_node hung_planner_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_takeover)
+
 # Start-up parameter checks: a bad private parameter stops each node with a named error (exit
 # 78); scene paths relative to the caller or package://; /use_sim_time through a remap (as
 # replay.launch gives it to rviz) and the tracker's one warning while /clock is silent.
@@ -83,5 +102,6 @@ add_rostest_gtest(test_node_parameters test/ros/node_parameters.test
 target_link_libraries(test_node_parameters gtest_main)  # no ROS client code: it runs the nodes
 target_compile_definitions(test_node_parameters PRIVATE AP_TOOL_DIR="${AP_TOOL_DIR}/"
                            AP_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
-add_dependencies(test_node_parameters attitude_planner_node attitude_tracker_node)
+add_dependencies(test_node_parameters attitude_planner_node attitude_tracker_node
+                 attitude_plant_node)
 list(APPEND AP_EXPECTED_TESTS test_node_parameters)

@@ -27,6 +27,7 @@ DEBIAN_PACKAGES=(
   python3-numpy python3-matplotlib python3-yaml
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
   python3-visualization-msgs python3-rostopic python3-rosservice
+  libnav-msgs-dev ros-nav-msgs python3-nav-msgs libtf2-msgs-dev
 )
 
 log() { printf '[attitude_planner] %s\n' "$*" >&2; }

@@ -50,10 +50,22 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
   return rest;
 }
 
+int replanPeriodSteps(double period, int steps, double time_step) {
+  if (!(std::isfinite(period) && period >= 0.0)) {
+    throw InvalidInput("~replan_period: must be >= 0 s (0 = T / " +
+                       std::to_string(kDefaultReplansPerManeuver) + "), got " +
+                       exactNumber(period));
+  }
+  const double raw =
+      period == 0.0 ? static_cast<double>(steps) / kDefaultReplansPerManeuver : period / time_step;
+  return std::max(1, static_cast<int>(std::lround(raw)));
+}
+
 RecedingHorizonRun::RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme,
                                        const Matrix3& inertia,
                                        std::shared_ptr<const EffectModel> effects,
-                                       const Actuation& actuation, TrackingOptions options)
+                                       const Actuation& actuation, TrackingOptions options,
+                                       std::optional<RigidBodyState> start)
     : scheme_(scheme),
       inertia_(inertia),
       effects_(std::move(effects)),
@@ -64,7 +76,8 @@ RecedingHorizonRun::RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme,
   if (options_.natural_frequency == 0.0) {
     options_.natural_frequency = defaultTrackingFrequency(steps_ * time_step_);
   }
-  segments_.push_back(fly(plan, 0, plan.attitude.front(), plan.angular_velocity.front()));
+  if (!start) start = RigidBodyState{plan.attitude.front(), plan.angular_velocity.front()};
+  segments_.push_back(fly(plan, 0, start->attitude, start->angular_velocity));
 }
 
 RecedingHorizonRun::Segment RecedingHorizonRun::fly(const Maneuver& rows, int k,
@@ -141,6 +154,12 @@ ManeuverSample RecedingHorizonRun::referenceAt(double t) const {
   ManeuverSample sample = s.reference->at(t - s.node * time_step_);
   sample.time = t;
   return sample;
+}
+
+Vector3 RecedingHorizonRun::commandAt(const RigidBodyState& state, double t) const {
+  const Segment& s = segmentAt(t);
+  const TrackingLaw law(*s.reference, s.effects.get(), options_);
+  return law.command(state.attitude, state.angular_velocity, t - s.node * time_step_);
 }
 
 Maneuver RecedingHorizonRun::planRemainderAt(int k) const {

@@ -203,20 +203,40 @@ void measureErrors(const ManeuverInterpolation& reference, TrackingRun* run) {
 
 }  // namespace
 
+TrackingLaw::TrackingLaw(const ManeuverInterpolation& reference, const EffectModel* effects,
+                         const TrackingOptions& options)
+    : reference_(reference),
+      effects_(effects && !effects->empty() ? effects : nullptr),
+      natural_frequency_(options.natural_frequency == 0.0
+                             ? defaultTrackingFrequency(reference.duration())
+                             : options.natural_frequency),
+      gains_(trackingGains(reference.inertia(), natural_frequency_, options.damping)) {}
+
+Vector3 TrackingLaw::command(const Matrix3& attitude, const Vector3& angular_velocity,
+                             double t) const {
+  Vector3 u = trackingTorque(reference_.inertia(), gains_, attitude, angular_velocity,
+                             reference_.referenceAt(t));
+  if (effects_) u -= effects_->torque(attitude, t);  // the known effects are compensated
+  return u;
+}
+
+int TrackingLaw::substepsPerPlanStep() const {
+  const double h = reference_.nodes().time_step;
+  return std::max(1,
+                  static_cast<int>(std::ceil(natural_frequency_ * h / kMaxControlPhasePerSample)));
+}
+
 TrackingRun simulateTracking(const ManeuverInterpolation& reference,
                              const Matrix3& initial_attitude, const Vector3& initial_velocity,
                              const EffectModel* effects, Actuation* actuation,
                              const TrackingOptions& options) {
   const double T = reference.duration();
   const int N = reference.steps();
+  const TrackingLaw law(reference, effects, options);
   TrackingRun run;
-  run.natural_frequency =
-      options.natural_frequency == 0.0 ? defaultTrackingFrequency(T) : options.natural_frequency;
+  run.natural_frequency = law.naturalFrequency();
   const Matrix3& inertia = reference.inertia();
-  const TrackingGains gains = trackingGains(inertia, run.natural_frequency, options.damping);
-  const double h = reference.nodes().time_step;
-  run.substeps = std::max(
-      1, static_cast<int>(std::ceil(run.natural_frequency * h / kMaxControlPhasePerSample)));
+  run.substeps = law.substepsPerPlanStep();
   const int M = N * run.substeps;
   const double dt = T / M;
   const bool with_effects = effects && !effects->empty();
@@ -235,8 +255,7 @@ TrackingRun simulateTracking(const ManeuverInterpolation& reference,
     a.time[j] = t;
     a.attitude[j] = R;
     a.angular_velocity[j] = W;
-    Vector3 u = trackingTorque(inertia, gains, R, W, reference.referenceAt(t));
-    if (with_effects) u -= effects->torque(R, t);  // the known effects are compensated
+    Vector3 u = law.command(R, W, t);
     if (actuation && !actuation->empty()) u = actuation->apply(u);
     a.torque[j] = u;
     if (j == M) break;
@@ -248,6 +267,55 @@ TrackingRun simulateTracking(const ManeuverInterpolation& reference,
   }
   measureErrors(reference, &run);
   return run;
+}
+
+RigidBodyState predictState(const Matrix3& inertia, const EffectModel* effects,
+                            const RigidBodyState& state, const Vector3& torque, double t,
+                            double dt) {
+  RigidBodyState out = state;
+  if (dt == 0.0) return out;
+  const bool with_effects = effects && !effects->empty();
+  const auto total = [&](const Matrix3& R_s, double s) {
+    return with_effects ? Vector3(torque + effects->torque(R_s, t + s)) : torque;
+  };
+  rigidBodyStep(inertia, inertia.inverse(), dt, total, &out.attitude, &out.angular_velocity);
+  return out;
+}
+
+RigidBodyPlant::RigidBodyPlant(const Matrix3& inertia, const Matrix3& initial_attitude,
+                               const Vector3& initial_velocity,
+                               std::shared_ptr<const EffectModel> effects, Actuation actuation,
+                               double max_step)
+    : inertia_(inertia),
+      inertia_inverse_(inertia.inverse()),
+      effects_(effects && !effects->empty() ? std::move(effects) : nullptr),
+      actuation_(std::move(actuation)),
+      max_step_(max_step),
+      attitude_(initial_attitude),
+      velocity_(initial_velocity) {
+  if (!(std::isfinite(max_step) && max_step > 0.0)) {
+    throw InvalidInput("max_step: must be a finite time > 0 s, got " + exactNumber(max_step));
+  }
+}
+
+Vector3 RigidBodyPlant::command(const Vector3& commanded) {
+  delivered_ = actuation_.empty() ? commanded : actuation_.apply(commanded);
+  return delivered_;
+}
+
+void RigidBodyPlant::advanceTo(double t) {
+  if (!(t > time_)) return;
+  // Equal steps of at most max_step: the held torque plus the effects at every RKMK4 stage.
+  const int steps = std::max(1, static_cast<int>(std::ceil((t - time_) / max_step_)));
+  const double dt = (t - time_) / steps;
+  for (int i = 0; i < steps; ++i) {
+    const double t_step = time_ + i * dt;
+    const auto torque = [&](const Matrix3& R_s, double s) {
+      return effects_ ? Vector3(delivered_ + effects_->torque(R_s, t_step + s)) : delivered_;
+    };
+    rigidBodyStep(inertia_, inertia_inverse_, dt, torque, &attitude_, &velocity_);
+  }
+  time_ = t;
 }
 
 double openLoopEffort(SchemeKind scheme, const Maneuver& replayed) {

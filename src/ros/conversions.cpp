@@ -159,6 +159,26 @@ void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* pr
   applyEffects(specs, problem);
 }
 
+MeasuredState measuredStateFromMsg(const nav_msgs::Odometry& msg) {
+  MeasuredState state;
+  state.attitude = attitudeFromMsg(msg.pose.pose.orientation, "odometry.pose.pose.orientation");
+  state.angular_velocity =
+      finiteVectorFromMsg(msg.twist.twist.angular, "odometry.twist.twist.angular");
+  return state;
+}
+
+nav_msgs::Odometry odometryToMsg(const Matrix3& attitude, const Vector3& angular_velocity,
+                                 const ros::Time& stamp, const std::string& frame,
+                                 const std::string& child_frame) {
+  nav_msgs::Odometry msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  msg.child_frame_id = child_frame;
+  msg.pose.pose.orientation = attitudeToMsg(attitude);
+  msg.twist.twist.angular = vectorToMsg(angular_velocity);
+  return msg;
+}
+
 Matrix3 attitudeFromMsg(const geometry_msgs::Quaternion& q, const std::string& field) {
   return attitudeFromQuaternion(Eigen::Vector4d(q.w, q.x, q.y, q.z), field);
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <type_traits>
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -44,6 +45,24 @@ geometry_msgs::Point point(const Vector3& v) {
   p.y = v.y();
   p.z = v.z();
   return p;
+}
+
+/// Runs `work` on a detached thread; its future never blocks in its destructor (unlike
+/// std::async's), so an answer nobody waits for any more (a new maneuver, a timeout) is simply
+/// dropped. roscpp cannot cancel a service call: a hung one keeps its thread, not the caller.
+template <class Work>
+std::future<std::invoke_result_t<Work>> startDetached(Work work) {
+  using Result = std::invoke_result_t<Work>;
+  auto promise = std::make_shared<std::promise<Result>>();
+  std::future<Result> future = promise->get_future();
+  std::thread([promise, work = std::move(work)]() mutable {
+    try {
+      promise->set_value(work());
+    } catch (...) {
+      promise->set_exception(std::current_exception());  // rethrown by get()
+    }
+  }).detach();
+  return future;
 }
 
 /// The traced axis, its planned path and its trail: orange (no principal axis is).
@@ -181,6 +200,13 @@ Vector3 traceAxis(const std::string& name, const Matrix3& initial, const Matrix3
   Eigen::Index least = 0;
   rotation.cwiseAbs().minCoeff(&least);  // the axis most perpendicular to the rotation axis
   return Vector3::Unit(least);
+}
+
+std::string defaultBodyFrame(const std::string& ns) {
+  std::string stripped = ns;
+  while (!stripped.empty() && stripped.front() == '/') stripped.erase(stripped.begin());
+  while (!stripped.empty() && stripped.back() == '/') stripped.pop_back();
+  return stripped.empty() ? "body" : stripped + "/body";
 }
 
 std::vector<int> decimatedIndices(int n, int max_points) {
@@ -349,57 +375,39 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   rate_factor_ = readParam<double>(pnh, "rate_factor", 1.0, positive, "> 0");
   start_delay_ = readParam<double>(pnh, "start_delay", 0.5, non_negative, ">= 0 s");
   world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
-  body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
+  body_frame_ = readParam<std::string>(pnh, "body_frame", "");
+  if (body_frame_.empty()) body_frame_ = defaultBodyFrame(nh_.getNamespace());
   body_size_ = readParam<double>(pnh, "body_size", 1.0, positive, "> 0 m");
   axis_length_ = readParam<double>(pnh, "axis_length", 0.9, positive, "> 0 m");
   path_radius_ = readParam<double>(pnh, "path_radius", 1.2, positive, "> 0 m");
   rate_ = readParam<double>(pnh, "rate", 50.0, non_negative, ">= 0 Hz, 0 = at the plan nodes");
-  replan_period_ = readParam<double>(pnh, "replan_period", 1.0, positive, "> 0 s");
+  replan_period_ = readParam<double>(pnh, "replan_period", 0.0, non_negative, ">= 0 s, 0 = T / 10");
   tracking_.natural_frequency =
       readParam<double>(pnh, "feedback_frequency", 0.0, non_negative, ">= 0 rad/s, 0 = 40 / T");
   tracking_.damping = readParam<double>(pnh, "feedback_damping", 1.0, positive, "> 0");
   exit_when_done_ = readParam<bool>(pnh, "exit_when_done", false);
   std::string scene = readFileParam(pnh, "scene");  // absolute, package:// or relative
   std::string replay_scene = readFileParam(pnh, "replay_scene");
-  const std::string mode =
-      readParam<std::string>(pnh, "mode", trackingModeName(TrackingMode::Replay));
-  trace_axis_name_ = readParam<std::string>(pnh, "trace_axis", "auto");
+  // A run in another mode than the one asked for would be silently wrong: a bad name stops the
+  // node (exit 78, naming the parameter and the accepted names).
+  mode_ = readNamedParam(pnh, "mode", TrackingMode::Replay, kTrackingModeNames);
+  const std::string mode = trackingModeName(mode_);
+  trace_axis_name_ = readParam<std::string>(
+      pnh, "trace_axis", "auto",
+      [](const std::string& s) { return s == "x" || s == "y" || s == "z" || s == "auto"; },
+      "one of x, y, z, auto");
   plan_in_process_ = readParam<bool>(pnh, "plan_in_process", false);
   const double planner_timeout = readParam<double>(pnh, "planner_timeout", 30.0, positive, "> 0 s");
+  planner_timeout_ = planner_timeout;
+  takeover_tolerance_ = readParam<double>(pnh, "takeover_tolerance", 0.25, positive, "> 0 rad");
+  plant_ = readNamedParam(pnh, "plant", PlantKind::Internal, kPlantNames);
+  measurement_timeout_ =
+      readParam<double>(pnh, "measurement_timeout", 0.5, positive, "> 0 s (ROS time)");
 
-  torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
-  velocity_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity", 10);
-  reference_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("reference_pose", 10);
-  error_pub_ = nh_.advertise<std_msgs::Float64>("attitude_error", 10);
-  rate_error_pub_ = nh_.advertise<std_msgs::Float64>("angular_velocity_error", 10);
-  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 10, true);
-  trail_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_trail", 10);
-  text_pub_ = nh_.advertise<visualization_msgs::Marker>("status_text", 10);
-  path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
-  ghost_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("ghost_markers", 1, true);
-  done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
-  constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
-  control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
+  advertiseTopics();
 
-  // A run in another mode than the one asked for would be silently wrong: refuse, and stop.
-  std::string refusal;
-  try {
-    mode_ = parseIn(kTrackingModeNames, mode, "~mode");
-    traceAxis(trace_axis_name_, Matrix3::Identity(), Matrix3::Identity());  // checks the name
-  } catch (const std::exception& e) {
-    refusal = e.what();
-  }
-  if (!refusal.empty()) {
-    ROS_FATAL("attitude_tracker_node: %s", refusal.c_str());
-    ReplayResult failed;
-    failed.success = false;
-    failed.mode = mode;
-    failed.message = refusal;
-    done_pub_.publish(failed);
-    ros::requestShutdown();
-    return;
-  }
   maneuver_sub_ = nh_.subscribe("maneuver", 1, &TrackerNode::onManeuver, this);
+  tf_sub_ = nh_.subscribe("/tf", 100, &TrackerNode::onTf, this);
   drift_sub_ = nh_.subscribe("drift_maneuver", 1, &TrackerNode::onDriftManeuver, this);
 
   if (!replay_scene.empty()) {
@@ -431,6 +439,32 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   publishDone(failed);
 }
 
+void TrackerNode::advertiseTopics() {
+  torque_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque", 10);
+  velocity_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity", 10);
+  reference_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("reference_pose", 10);
+  error_pub_ = nh_.advertise<std_msgs::Float64>("attitude_error", 10);
+  rate_error_pub_ = nh_.advertise<std_msgs::Float64>("angular_velocity_error", 10);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("body_marker", 10, true);
+  trail_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_trail", 10);
+  text_pub_ = nh_.advertise<visualization_msgs::Marker>("status_text", 10);
+  path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
+  ghost_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("ghost_markers", 1, true);
+  done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
+  constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
+  control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
+  body_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("body_pose", 10);
+  error_vector_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("attitude_error_vector", 10);
+  rate_error_vector_pub_ =
+      nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity_error_vector", 10);
+  if (plant_ == PlantKind::External) {
+    command_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque_command", 10);
+    // Only the newest state matters: a queue of one never feeds the law an old measurement.
+    odometry_sub_ = nh_.subscribe("odometry", 1, &TrackerNode::onOdometry, this,
+                                  ros::TransportHints().tcpNoDelay());
+  }
+}
+
 bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_process,
                                     double planner_timeout, std::string* error) {
   try {
@@ -451,15 +485,38 @@ bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_proce
     } else {
       ROS_INFO("planning %s in-process", scene.c_str());
     }
-    ros::ServiceClient* via = plan_in_process ? nullptr : &client;
-    Replay replay;
-    replay.drift = drift;
-    const bool planned =
-        drift ? planDriftScene(*drift_request, via, world_frame_, body_frame_, &replay.drift_msg,
-                               &replay.plan_solve_time, &replay.plan_cost, error)
-              : planScene(parsed.problem, parsed.effects, via, world_frame_, body_frame_,
-                          &replay.msg, &replay.plan_solve_time, &replay.plan_cost, error);
-    if (!planned) return false;
+    // On a detached thread with copies of everything, bounded by ~planner_timeout: a planner
+    // that never answers leaves its call behind, not the node.
+    struct Planned {
+      bool ok = false;
+      Replay replay;
+      std::string error;
+    };
+    std::future<Planned> call =
+        startDetached([drift, drift_request, parsed, plan_in_process, client, world = world_frame_,
+                       body = body_frame_]() mutable {
+          Planned out;
+          out.replay.drift = drift;
+          ros::ServiceClient* via = plan_in_process ? nullptr : &client;
+          Replay& r = out.replay;
+          out.ok = drift ? planDriftScene(*drift_request, via, world, body, &r.drift_msg,
+                                          &r.plan_solve_time, &r.plan_cost, &out.error)
+                         : planScene(parsed.problem, parsed.effects, via, world, body, &r.msg,
+                                     &r.plan_solve_time, &r.plan_cost, &out.error);
+          return out;
+        });
+    if (!plan_in_process && call.wait_for(std::chrono::duration<double>(planner_timeout)) !=
+                                std::future_status::ready) {
+      *error = "planner service " + client.getService() + " did not answer within " +
+               exactNumber(planner_timeout) + " s (~planner_timeout)";
+      return false;
+    }
+    Planned planned = call.get();
+    if (!planned.ok) {
+      *error = planned.error;
+      return false;
+    }
+    Replay& replay = planned.replay;
     ROS_INFO("planned %s: cost %.6g, solve time %.3f s", scene.c_str(), replay.plan_cost,
              replay.plan_solve_time);
     replay.effects = parsed.effects;
@@ -480,6 +537,39 @@ TrackerNode::~TrackerNode() {
 void TrackerNode::onManeuver(const AttitudeManeuver::ConstPtr& msg) {
   Replay replay;
   replay.msg = *msg;
+  std::optional<RigidBodyState> body;
+  ros::Time next;
+  {
+    std::lock_guard<std::mutex> lock(body_mutex_);
+    if (run_active_) body = next_body_;
+    next = next_stamp_;
+  }
+  if (body && !msg->attitude.empty()) {
+    Matrix3 start;
+    try {
+      start = rc::attitudeFromMsg(msg->attitude[0], "maneuver.attitude[0]");
+    } catch (const std::exception&) {
+      startReplay(replay);  // refused by preparePlayback, naming the field
+      return;
+    }
+    const double gap = so3::angleBetween(start, body->attitude);
+    if (gap > takeover_tolerance_) {
+      // Flying it would first pull the body across the gap: refused, the run in progress goes on.
+      ReplayResult refused;
+      refused.success = false;
+      refused.mode = trackingModeName(mode_);
+      refused.message = "maneuver refused: its start attitude[0] is " + exactNumber(gap) +
+                        " rad from the body (~takeover_tolerance " +
+                        exactNumber(takeover_tolerance_) + " rad); the run in progress goes on";
+      refused.header.stamp = ros::Time::now();
+      refused.header.frame_id = world_frame_;
+      ROS_WARN("%s", refused.message.c_str());
+      done_pub_.publish(refused);
+      return;
+    }
+    replay.takeover = body;  // flown from where the body is: no jump to the new plan's R_0
+    replay.continue_at = next;
+  }
   startReplay(replay);
 }
 
@@ -499,9 +589,32 @@ void TrackerNode::stopReplay() {
 
 void TrackerNode::startReplay(Replay replay) {
   if (replay_scene_effects_) replay.effects = *replay_scene_effects_;
-  stopReplay();
+  replacing_ = true;
+  stopReplay();  // returns within a sample: nothing in the stream waits for a planner
+  replacing_ = false;
   std::lock_guard<std::mutex> lock(replay_mutex_);
-  replay_thread_ = std::thread([this, replay]() { runReplay(replay); });
+  replay_thread_ = std::thread([this, replay]() {
+    done_published_ = false;
+    runReplay(replay);
+    noteNextSample(false);
+    if (!done_published_ && replacing_) {
+      ReplayResult replaced;
+      replaced.success = false;
+      replaced.mode = trackingModeName(mode_);
+      replaced.message = "replaced by a new maneuver before the end of the run";
+      replaced.header.stamp = ros::Time::now();
+      replaced.header.frame_id = world_frame_;
+      done_pub_.publish(replaced);  // not publishDone: ~exit_when_done waits for the last run
+    }
+  });
+}
+
+void TrackerNode::noteNextSample(bool running, const RigidBodyState& body, const ros::Time& stamp) {
+  std::lock_guard<std::mutex> lock(body_mutex_);
+  run_active_ = running;
+  if (!running) return;
+  next_body_ = body;
+  next_stamp_ = stamp;
 }
 
 bool TrackerNode::sleepUntil(const ros::Time& t) {
@@ -567,6 +680,7 @@ void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp,
 }
 
 void TrackerNode::publishDone(ReplayResult result) {
+  done_published_ = true;
   if (result.header.frame_id.empty()) result.header.frame_id = world_frame_;
   if (result.header.stamp.isZero()) result.header.stamp = ros::Time::now();
   done_pub_.publish(result);
@@ -582,18 +696,21 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
                           SchemeKind scheme, Playback* pb) const {
   ReplayResult& result = pb->result;
   const int N = plan.steps();
+  // A maneuver that replaced a running one starts where that body is; else at the plan's start.
+  const RigidBodyState start =
+      replay.takeover.value_or(RigidBodyState{plan.attitude[0], plan.angular_velocity[0]});
   if (mode_ == TrackingMode::Replan) {
+    pb->replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
     // The closed loop on the first plan until a re-plan is adopted (serviceReplans).
-    pb->horizon = std::make_shared<RecedingHorizonRun>(plan, scheme, inertia, pb->effects,
-                                                       actuationOf(replay.effects), tracking_);
+    pb->horizon = std::make_shared<RecedingHorizonRun>(
+        plan, scheme, inertia, pb->effects, actuationOf(replay.effects), tracking_, start);
     finishReplanResult(pb);
     return;
   }
   if (mode_ == TrackingMode::Feedback) {
     Actuation actuation = actuationOf(replay.effects);
-    const TrackingRun run =
-        simulateTracking(*pb->reference, plan.attitude[0], plan.angular_velocity[0],
-                         pb->effects.get(), &actuation, tracking_);
+    const TrackingRun run = simulateTracking(*pb->reference, start.attitude, start.angular_velocity,
+                                             pb->effects.get(), &actuation, tracking_);
     result.effort = run.effort;
     result.cost = run.effort / plan.time_step;  // the same units as the replay's Σ ½|τ_k|²
     result.max_attitude_deviation = run.max_attitude_error;
@@ -606,8 +723,8 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
     // Exactly the effects of the run's scene: forcing on the body, then what the actuators do.
     Actuation actuation = actuationOf(replay.effects);
     SimulationInput input;
-    input.initial_attitude = plan.attitude[0];
-    input.initial_velocity = plan.angular_velocity[0];
+    input.initial_attitude = start.attitude;
+    input.initial_velocity = start.angular_velocity;
     input.torque = plan.torque;
     input.effects = pb->effects.get();
     input.actuation = &actuation;
@@ -671,7 +788,14 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.effects = plannableEffects(replay.effects, inertia);
   pb.reference =
       std::make_unique<ManeuverInterpolation>(plan, problem.scheme, inertia, pb.effects.get());
-  runBody(replay, plan, inertia, problem.scheme, &pb);
+  if (plant_ == PlantKind::Internal) {
+    runBody(replay, plan, inertia, problem.scheme, &pb);
+  } else if (mode_ == TrackingMode::Replan) {
+    // External: the plans in force and their laws; its own simulated body is not flown.
+    pb.replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
+    pb.horizon = std::make_shared<RecedingHorizonRun>(plan, problem.scheme, inertia, pb.effects,
+                                                      Actuation(), tracking_);
+  }
   pb.times = sampleTimes(problem.duration, N, rate_, rate_factor_);
   ReplayResult& result = pb.result;
   result.mode = trackingModeName(mode_);
@@ -718,6 +842,30 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   // replan: the body under the plans adopted so far, the reference the plan in force.
   const ManeuverSample body = pb.horizon ? pb.horizon->bodyAt(t) : pb.actual->at(t);
   const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
+  publishState(pb, body, plan, t, stamp, trail);
+}
+
+void TrackerNode::publishStampedErrors(const Playback& pb, const Matrix3& body,
+                                       const Matrix3& reference, const TrackingErrors& e,
+                                       const ros::Time& stamp) {
+  // For rqt_plot and bag analysis: the body's attitude and the error vectors, stamped.
+  geometry_msgs::PoseStamped pose;
+  pose.header.stamp = stamp;
+  pose.header.frame_id = pb.world_frame;
+  pose.pose.orientation = rc::attitudeToMsg(body);
+  body_pose_pub_.publish(pose);
+  geometry_msgs::Vector3Stamped error;
+  error.header.stamp = stamp;
+  error.header.frame_id = pb.body_frame;
+  error.vector = rc::vectorToMsg(so3::log(Matrix3(reference.transpose() * body)));
+  error_vector_pub_.publish(error);
+  error.vector = rc::vectorToMsg(e.rate);
+  rate_error_vector_pub_.publish(error);
+}
+
+void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
+                               const ManeuverSample& plan, double t, const ros::Time& stamp,
+                               std::deque<Vector3>* trail) {
   publishPose(body.attitude, stamp, pb.world_frame, pb.body_frame, pb.box, pb.trace_axis, trail);
 
   geometry_msgs::WrenchStamped wrench;
@@ -744,6 +892,7 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   error_pub_.publish(value);
   value.data = e.rate.norm();
   rate_error_pub_.publish(value);
+  publishStampedErrors(pb, body.attitude, plan.attitude, e, stamp);
 
   const Matrix3& target = pb.reference->nodes().attitude.back();
   char text[160];
@@ -779,24 +928,43 @@ void TrackerNode::runReplay(Replay replay) {
   }
   ros::Time start;
   if (!waitForClock(replay.msg.header.stamp, &start)) return;
+  claimFrames(pb.world_frame, pb.body_frame);
+  if (replay.takeover && replay.msg.header.stamp <= ros::Time::now()) {
+    start = std::max(replay.continue_at, ros::Time::now());  // the stream goes on at its rate
+  }
   publishManeuverMarkers(pb);
   ROS_INFO("%s: %d steps over %.3f s, %zu samples (rate %g Hz, rate factor %g), frames %s -> %s",
            pb.result.mode.c_str(), pb.result.steps, pb.result.duration, pb.times.size(), rate_,
            rate_factor_, pb.world_frame.c_str(), pb.body_frame.c_str());
   std::deque<Vector3> trail;
   ReplanState replans;
-  replans.period_steps =
-      std::max(1, static_cast<int>(std::lround(replan_period_ / pb.reference->nodes().time_step)));
+  replans.period_steps = pb.replan_period_steps;
   replans.next_node = replans.period_steps;
-  for (double t : pb.times) {
-    const ros::Time stamp = start + ros::Duration(t / rate_factor_);
-    if (!sleepUntil(stamp)) return;
-    if (pb.horizon) serviceReplans(t, &pb, &replans);
-    publishSample(pb, t, stamp, &trail);
+  if (plant_ == PlantKind::External) {
+    if (!runExternal(start, &pb, &replans)) return;
+  } else {
+    for (std::size_t j = 0; j < pb.times.size(); ++j) {
+      const double t = pb.times[j];
+      const ros::Time stamp = start + ros::Duration(t / rate_factor_);
+      if (!sleepUntil(stamp)) return;
+      if (pb.horizon) serviceReplans(t, &pb, &replans);
+      publishSample(pb, t, stamp, &trail);
+      if (j + 1 < pb.times.size()) {  // what a new maneuver would start from
+        const double next = pb.times[j + 1];
+        const ManeuverSample body = pb.horizon ? pb.horizon->bodyAt(next) : pb.actual->at(next);
+        noteNextSample(true, RigidBodyState{body.attitude, body.angular_velocity},
+                       start + ros::Duration(next / rate_factor_));
+      }
+    }
+    if (pb.horizon) finishReplanResult(&pb);  // a re-plan still in flight is not adopted
+    pb.result.success = true;
   }
-  if (pb.horizon) finishReplanResult(&pb);  // a re-plan still in flight is not adopted
   ReplayResult result = pb.result;
-  result.success = true;
+  const std::string conflict = claimFrames(pb.world_frame, pb.body_frame);
+  if (!conflict.empty()) {  // the run was shown on a transform another node also moved
+    result.success = false;
+    result.message += "; " + conflict;
+  }
   result.header.frame_id = pb.world_frame;
   result.header.stamp = start + ros::Duration(pb.times.back() / rate_factor_);
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
@@ -804,19 +972,29 @@ void TrackerNode::runReplay(Replay replay) {
   publishDone(result);
 }
 
-void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
+void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
+                                 const std::function<RigidBodyState(int)>& state_at_node) {
   RecedingHorizonRun& run = *pb->horizon;
   const int N = run.steps();
   const double h = run.timeStep();
   ReplayResult& result = pb->result;
   constexpr double kNodeSlack = 1e-9;  // a sample time k h in floating point is node k
   if (state->pending) {
-    if (state->answer.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    const double waited = (ros::WallTime::now() - state->sent).toSec();
+    const bool ready = state->answer.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    if (!ready && waited <= planner_timeout_) {
       ++result.samples_during_replans;  // this sample goes out while the planner works
       return;
     }
     state->pending = false;
-    ReplanAnswer answer = state->answer.get();
+    ReplanAnswer answer;
+    if (ready) {
+      answer = state->answer.get();
+    } else {  // abandoned: the detached call may go on, its answer is dropped
+      state->answer = std::future<ReplanAnswer>();
+      answer.error =
+          "no answer within ~planner_timeout " + exactNumber(planner_timeout_) + " s (abandoned)";
+    }
     const int from = state->pending_from;
     const int at = std::max(from, static_cast<int>(std::ceil(t / h - kNodeSlack)));
     char line[200];
@@ -847,7 +1025,13 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
   const int node = static_cast<int>(std::floor(t / h + kNodeSlack));
   if (node < state->next_node || N - node < kMinSteps) return;
   // The state the body has at this node under the plan in force, and that plan's rest.
-  const ManeuverSample body = run.bodyAtNode(node);
+  RigidBodyState body;
+  if (state_at_node) {
+    body = state_at_node(node);  // external plant: the measured state moved to the node
+  } else {
+    const ManeuverSample simulated = run.bodyAtNode(node);
+    body = RigidBodyState{simulated.attitude, simulated.angular_velocity};
+  }
   PlanningProblem rest;
   try {
     rest = remainderProblem(pb->problem, node, body.attitude, body.angular_velocity);
@@ -858,11 +1042,175 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state) {
   }
   ros::ServiceClient client;
   if (!plan_in_process_) client = nh_.serviceClient<PlanAttitudeManeuver>("plan_attitude_maneuver");
-  state->answer = std::async(std::launch::async, planRemainder, rest, pb->effects_specs, node * h,
-                             run.planRemainderAt(node), client);
+  state->answer = startDetached(
+      [rest, effects = pb->effects_specs, start_time = node * h, guess = run.planRemainderAt(node),
+       client]() { return planRemainder(rest, effects, start_time, guess, client); });
+  state->sent = ros::WallTime::now();
   state->pending = true;
   state->pending_from = node;
   state->next_node = node + state->period_steps;
+}
+
+void TrackerNode::onTf(const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
+  const std::string& sender = event.getPublisherName();
+  if (sender == ros::this_node::getName()) return;
+  std::lock_guard<std::mutex> lock(frames_mutex_);
+  if (claimed_body_.empty()) return;
+  for (const geometry_msgs::TransformStamped& t : event.getMessage()->transforms) {
+    if (t.child_frame_id != claimed_body_) continue;
+    if (frame_conflict_.empty()) {
+      frame_conflict_ = "node " + sender + " also publishes the transform " + t.header.frame_id +
+                        " -> " + claimed_body_ + " (give each tracker its own ~body_frame; " +
+                        "the default is NS/body in namespace /NS)";
+      ROS_ERROR("%s", frame_conflict_.c_str());
+    }
+  }
+}
+
+std::string TrackerNode::claimFrames(const std::string& world_frame,
+                                     const std::string& body_frame) {
+  std::lock_guard<std::mutex> lock(frames_mutex_);
+  claimed_world_ = world_frame;
+  claimed_body_ = body_frame;
+  std::string conflict;
+  conflict.swap(frame_conflict_);
+  return conflict;
+}
+
+void TrackerNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  odometry_ = msg;
+  odometry_received_ = ros::Time::now();
+}
+
+MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Time& start,
+                                               const ros::Time& stamp,
+                                               const Vector3& held_command) {
+  nav_msgs::Odometry::ConstPtr msg;
+  ros::Time received;
+  {
+    std::lock_guard<std::mutex> lock(odometry_mutex_);
+    msg = odometry_;
+    received = odometry_received_;
+  }
+  MeasurementAtSample m;
+  m.state = last_measured_;
+  if (!msg) {
+    m.problem = "no measurement on " + odometry_sub_.getTopic() + " yet";
+    return m;
+  }
+  // Empty frames are taken as the maneuver's; others must be its frames (no tf lookup: the
+  // measured attitude is body -> world as the maneuver's is).
+  const std::string& frame = msg->header.frame_id;
+  const std::string& child = msg->child_frame_id;
+  if ((!frame.empty() && frame != pb.world_frame) || (!child.empty() && child != pb.body_frame)) {
+    m.problem = "odometry frames " + frame + " -> " + child + " are not the maneuver's " +
+                pb.world_frame + " -> " + pb.body_frame;
+    return m;
+  }
+  const ros::Time measured_at = msg->header.stamp.isZero() ? received : msg->header.stamp;
+  const double age = (stamp - measured_at).toSec();  // [s, ROS time]
+  if (age > measurement_timeout_) {
+    char text[160];
+    std::snprintf(text, sizeof text, "newest odometry is %.3f s old (~measurement_timeout %g s)",
+                  age, measurement_timeout_);
+    m.problem = text;
+    return m;
+  }
+  try {
+    m.state = rc::measuredStateFromMsg(*msg);
+  } catch (const std::exception& e) {
+    m.problem = e.what();
+    return m;
+  }
+  // To the sample's time under the command held meanwhile and the known effects: the age is
+  // transport and sampling lag (left in, the rate's lag biases the law's damping term).
+  const double t_measured = (measured_at - start).toSec() * rate_factor_;
+  m.state = predictState(pb.reference->inertia(), pb.effects.get(), m.state, held_command,
+                         t_measured, age * rate_factor_);
+  m.fresh = true;
+  last_measured_ = m.state;
+  return m;
+}
+
+bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState* replans) {
+  const Maneuver& plan = pb->reference->nodes();
+  const int N = plan.steps();
+  const TrackingLaw law(*pb->reference, pb->effects.get(), tracking_);
+  const Matrix3 plan_inertia = pb->reference->inertia();
+  last_measured_.attitude = plan.attitude[0];  // drawn until a measurement arrives
+  last_measured_.angular_velocity = plan.angular_velocity[0];
+  ReplayResult& result = pb->result;
+  int stale = 0;
+  std::string first_problem;
+  std::deque<Vector3> trail;
+  geometry_msgs::WrenchStamped command;
+  command.header.frame_id = pb->body_frame;
+  Vector3 held_command = Vector3::Zero();  // what the body receives until the next command
+  for (std::size_t j = 0; j < pb->times.size(); ++j) {
+    const double t = pb->times[j];
+    const ros::Time stamp = start + ros::Duration(t / rate_factor_);
+    if (!sleepUntil(stamp)) return false;
+    const MeasurementAtSample measured = measurementAt(*pb, start, stamp, held_command);
+    ManeuverSample body;
+    body.time = t;
+    body.attitude = measured.state.attitude;
+    body.angular_velocity = measured.state.angular_velocity;
+    if (measured.fresh && pb->horizon) {  // replan: re-planned from the measured state
+      const double h = plan.time_step;
+      serviceReplans(t, pb, replans, [&](int k) {
+        return predictState(plan_inertia, pb->effects.get(), measured.state, held_command, t,
+                            k * h - t);
+      });
+      body.torque = pb->horizon->commandAt(measured.state, t);
+    } else if (measured.fresh) {
+      body.torque = mode_ == TrackingMode::Feedback
+                        ? law.command(body.attitude, body.angular_velocity, t)
+                        : pb->reference->at(t).torque;  // replay: the plan's torque, open loop
+    } else {
+      ++stale;  // a zero command: nothing is known about the body to act on
+      if (first_problem.empty()) first_problem = measured.problem;
+      ROS_WARN_THROTTLE(1.0, "external plant: zero command at t = %.6g s: %s", t,
+                        measured.problem.c_str());
+    }
+    command.header.stamp = stamp;
+    command.wrench.torque = rc::vectorToMsg(body.torque);
+    command_pub_.publish(command);
+    held_command = body.torque;
+    const ManeuverSample reference =
+        pb->horizon ? pb->horizon->referenceAt(t) : pb->reference->at(t);
+    if (measured.fresh) {
+      result.max_attitude_deviation = std::max(
+          result.max_attitude_deviation, so3::angleBetween(reference.attitude, body.attitude));
+    }
+    if (j + 1 < pb->times.size()) {  // held until the next sample
+      result.effort += 0.5 * body.torque.squaredNorm() * (pb->times[j + 1] - t);
+    }
+    publishState(*pb, body, reference, t, stamp, &trail);
+    if (j + 1 < pb->times.size()) {
+      noteNextSample(true, measured.state, start + ros::Duration(pb->times[j + 1] / rate_factor_));
+    }
+  }
+  command.header.stamp = ros::Time::now();
+  command.wrench.torque = rc::vectorToMsg(Vector3::Zero());  // the run is over: nothing held
+  command_pub_.publish(command);
+  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
+  result.terminal_velocity_error =
+      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
+  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
+  result.cost = result.effort / plan.time_step;
+  if (pb->horizon) result.replans = pb->horizon->adoptions();
+  result.success = stale == 0;
+  result.message = (mode_ == TrackingMode::Feedback ? "tracked " : "commanded ") +
+                   std::to_string(N) + " steps on the measured state of " +
+                   odometry_sub_.getTopic() + " (external plant, omega_n " +
+                   exactNumber(law.naturalFrequency()) + " rad/s)";
+  if (stale > 0) {
+    result.message +=
+        ": " + std::to_string(stale) + " of " + std::to_string(pb->times.size()) +
+        " samples had no fresh measurement and got a zero command (first: " + first_problem + ")";
+  }
+  return true;
 }
 
 void TrackerNode::finishReplanResult(Playback* pb) const {
@@ -881,8 +1229,9 @@ void TrackerNode::finishReplanResult(Playback* pb) const {
   result.replans = run.adoptions();
   result.message = "tracked " + std::to_string(N) + " steps with feedback (omega_n " +
                    exactNumber(run.naturalFrequency()) + " rad/s) and re-planning every " +
-                   exactNumber(replan_period_) + " s: " + std::to_string(result.replans) +
-                   " re-plans adopted, " + std::to_string(result.replan_failures) + " failed";
+                   exactNumber(pb->replan_period_steps * plan.time_step) +
+                   " s: " + std::to_string(result.replans) + " re-plans adopted, " +
+                   std::to_string(result.replan_failures) + " failed";
 }
 
 void TrackerNode::runDriftReplay(const Replay& replay) {

@@ -9,12 +9,14 @@
 
 #include <array>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 namespace {
 
 const std::string kPlanner = AP_TOOL_DIR "attitude_planner_node";
 const std::string kTracker = AP_TOOL_DIR "attitude_tracker_node";
+const std::string kPlant = AP_TOOL_DIR "attitude_plant_node";
 constexpr int kExitInvalidParameter = 78;  // parameters.hpp: EX_CONFIG
 constexpr int kTimeoutExit = 124;          // timeout(1): the node was still running
 
@@ -77,6 +79,30 @@ TEST(NodeParameters, OutOfRangeValueStopsTheTrackerNamingIt) {
   EXPECT_EQ(run.status, kExitInvalidParameter) << run.output;
   EXPECT_TRUE(contains(run.output, "/bad_rate/rate_factor = 0 is invalid: must be > 0"))
       << run.output;
+}
+
+/// Runs `command`; expects it to stop with exit 78 and every one of `parts` in its output.
+void expectStopped(const std::string& command, std::initializer_list<std::string> parts) {
+  const NodeRun run = runNode(command, 60);
+  EXPECT_EQ(run.status, kExitInvalidParameter) << command << ":\n" << run.output;
+  for (const std::string& part : parts) EXPECT_TRUE(contains(run.output, part)) << run.output;
+}
+
+TEST(NodeParameters, UnknownPlantOrModeStopsTheTrackerListingTheNames) {
+  expectStopped(kTracker + " __name:=bad_plant _plant:=outside",
+                {"/bad_plant/plant = outside is invalid", "external"});
+  // Before issue 43 a bad ~mode printed FATAL and exited 0.
+  expectStopped(kTracker + " __name:=bad_mode _mode:=autopilot",
+                {"/bad_mode/mode = autopilot is invalid", "feedback"});
+}
+
+TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
+  const std::string scene = " _scene:=" AP_SOURCE_DIR "/scenes/leo_slew.yaml";
+  expectStopped(kPlant + " __name:=sceneless_plant", {"/sceneless_plant/scene is required"});
+  expectStopped(kPlant + " __name:=bad_plant_rate _rate:=0" + scene,
+                {"/bad_plant_rate/rate = 0 is invalid"});
+  const NodeRun good = runNode(kPlant + " __name:=good_plant" + scene, 5);
+  EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
 }
 
 TEST(NodeParameters, MissingRelativeSceneNamesTheCallersDirectory) {

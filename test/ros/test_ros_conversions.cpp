@@ -741,3 +741,39 @@ TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {
   EXPECT_EQ(invalidMessage(r).rfind("steps: 1025 > 1024 is refused by solver nlopt", 0), 0u)
       << invalidMessage(r);
 }
+
+// The tracker's default body frame: one per namespace, "body" in the root one (issue 43).
+TEST(TrackerFrames, DefaultBodyFrameComesFromTheNamespace) {
+  EXPECT_EQ(defaultBodyFrame("/"), "body");
+  EXPECT_EQ(defaultBodyFrame(""), "body");
+  EXPECT_EQ(defaultBodyFrame("/sat1"), "sat1/body");
+  EXPECT_EQ(defaultBodyFrame("/fleet/sat2/"), "fleet/sat2/body");
+}
+
+// Odometry (the external plant's measured state): attitude and body rate round-trip; a quaternion
+// that is not unit and a non-finite rate are refused naming the field.
+TEST(Odometry, RoundTripsTheStateAndNamesABadField) {
+  const Matrix3 R = so3::exp(Vector3(0.3, -0.2, 0.9));
+  const Vector3 W(0.01, -0.02, 0.03);
+  const nav_msgs::Odometry m = rc::odometryToMsg(R, W, ros::Time(4.0), "world", "sat1/body");
+  EXPECT_EQ(m.header.frame_id, "world");
+  EXPECT_EQ(m.child_frame_id, "sat1/body");
+  EXPECT_EQ(m.header.stamp, ros::Time(4.0));
+  const rc::MeasuredState s = rc::measuredStateFromMsg(m);
+  EXPECT_LT(so3::angleBetween(s.attitude, R), 1e-15);
+  EXPECT_EQ(s.angular_velocity, W);
+  const auto expectRefusedNaming = [](const nav_msgs::Odometry& bad, const std::string& field) {
+    try {
+      rc::measuredStateFromMsg(bad);
+      ADD_FAILURE() << "accepted; expected a refusal naming " << field;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  nav_msgs::Odometry bad = m;
+  bad.pose.pose.orientation.w = 3.0;  // not a unit quaternion
+  expectRefusedNaming(bad, "odometry.pose.pose.orientation");
+  bad = m;
+  bad.twist.twist.angular.y = std::nan("");
+  expectRefusedNaming(bad, "odometry.twist.twist.angular");
+}

@@ -1,14 +1,19 @@
 // rostest: the same plan of scenes/disturbed_replay.yaml (gravity gradient and a disturbance,
 // planned for; actuator noise, not) driven open loop (/replay) and with the tracking law
 // (/feedback), two trackers side by side in their own namespaces (tracker_feedback.test). The
-// closed loop's terminal errors are an order of magnitude below the open loop's.
+// closed loop's terminal errors are an order of magnitude below the open loop's. Each tracker
+// publishes its own body transform (replay/body, feedback/body: the namespace's default).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <std_msgs/Float64.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <atomic>
+#include <map>
+#include <mutex>
+#include <set>
 
 #include "attitude_planner/ReplayResult.h"
 #include "ros_test_helpers.hpp"
@@ -22,6 +27,17 @@ TEST(TrackerFeedback, ClosedLoopTerminalErrorsAreAnOrderOfMagnitudeBelowOpenLoop
       "torque", 1000, [&](const geometry_msgs::WrenchStamped::ConstPtr&) { ++samples; });
   ros::Subscriber error_sub = feedback_nh.subscribe<std_msgs::Float64>(
       "attitude_error", 1000, [&](const std_msgs::Float64::ConstPtr&) { ++error_samples; });
+  // Who publishes which body transform on /tf: each tracker its own (issue 43: both published
+  // world -> body before the default body frame came from the namespace).
+  std::mutex tf_mutex;
+  std::map<std::string, std::set<std::string>> publishers_of;  // child frame -> publishers
+  using TfEvent = const ros::MessageEvent<tf2_msgs::TFMessage const>&;
+  ros::Subscriber tf_sub = replay_nh.subscribe<tf2_msgs::TFMessage, TfEvent>(
+      "/tf", 1000, boost::function<void(TfEvent)>([&](TfEvent event) {
+        std::lock_guard<std::mutex> lock(tf_mutex);
+        for (const auto& t : event.getMessage()->transforms)
+          publishers_of[t.child_frame_id].insert(event.getPublisherName());
+      }));
   ros_testing::DoneListener replay_done(replay_nh), feedback_done(feedback_nh);
   const ReplayResult::ConstPtr open_loop = replay_done.wait(120.0);
   const ReplayResult::ConstPtr closed_loop = feedback_done.wait(120.0);
@@ -52,6 +68,12 @@ TEST(TrackerFeedback, ClosedLoopTerminalErrorsAreAnOrderOfMagnitudeBelowOpenLoop
   EXPECT_GE(samples, 0.8 * expected);
   EXPECT_LE(samples, 1.2 * expected + 2);
   EXPECT_EQ(error_samples, samples);
+  std::lock_guard<std::mutex> lock(tf_mutex);
+  EXPECT_EQ(publishers_of.count("replay/body"), 1u);
+  EXPECT_EQ(publishers_of.count("feedback/body"), 1u);
+  for (const auto& [frame, publishers] : publishers_of) {
+    EXPECT_EQ(publishers.size(), 1u) << publishers.size() << " nodes publish " << frame;
+  }
 }
 
 int main(int argc, char** argv) {

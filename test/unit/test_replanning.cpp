@@ -19,6 +19,15 @@ Scene disturbedScene() {
   return loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
 }
 
+/// scenes/disturbed_replay.yaml and its plan (the gravity gradient and the disturbance planned
+/// for, the torque noise not).
+struct DisturbedPlan {
+  Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
+  PlanResult plan = planManeuver(scene.problem);
+  Matrix3 J = scene.problem.inertia;
+  std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+};
+
 }  // namespace
 
 TEST(EffectModelTimeShifted, ReadsTheEffectsLaterByTheOffsetWithTheirNames) {
@@ -58,12 +67,10 @@ TEST(RemainderProblem, KeepsTheGridTargetAndConstraintsFromTheState) {
 // t_k with the noise stream where it was, under the effects at the right time. So the segmented
 // run is the single closed-loop run (to round-off), which is what makes re-plans comparable.
 TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
-  const Scene scene = disturbedScene();
-  const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
-  const Matrix3& J = scene.problem.inertia;
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
-  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
   const Maneuver& nodes = plan.maneuver;
   const ManeuverInterpolation reference(nodes, scheme, J, effects.get());
   Actuation actuation = actuationOf(scene.effects);  // with noise: the stream must continue
@@ -95,12 +102,10 @@ TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
 // one node later (what the tracker does through the service): every re-plan converges, and the
 // body lands far better than open loop, as the law alone does.
 TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
-  const Scene scene = disturbedScene();
-  const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
-  const Matrix3& J = scene.problem.inertia;
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
-  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
   const Maneuver& nodes = plan.maneuver;
   const int N = nodes.steps();
 
@@ -133,4 +138,65 @@ TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
   const double miss = so3::angleBetween(end.attitude, nodes.attitude.back());
   EXPECT_GT(replay_miss, 1e-3);
   EXPECT_LT(miss, 0.1 * replay_miss) << "replan " << miss << " rad, replay " << replay_miss;
+}
+
+// A run that takes over from another (a new maneuver mid-run, the tracker) starts at the given
+// state, not at the plan's R_0: exactly simulateTracking's run from that state.
+TEST(RecedingHorizonRun, StartsFromTheGivenStateAsSimulateTrackingDoes) {
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
+  const SchemeKind scheme = scene.problem.scheme;
+  const Maneuver& nodes = plan.maneuver;
+  const RigidBodyState start{nodes.attitude[0] * so3::exp(Vector3(0.05, -0.1, 0.02)),
+                             Vector3(1e-3, 0.0, -2e-3)};
+  const ManeuverInterpolation reference(nodes, scheme, J, effects.get());
+  Actuation actuation = actuationOf(scene.effects);
+  const TrackingRun single = simulateTracking(reference, start.attitude, start.angular_velocity,
+                                              effects.get(), &actuation, {});
+  const RecedingHorizonRun run(nodes, scheme, J, effects, actuationOf(scene.effects), {}, start);
+  EXPECT_LT(so3::angleBetween(run.bodyAt(0.0).attitude, start.attitude), 1e-15);
+  EXPECT_LT((run.bodyAt(0.0).angular_velocity - start.angular_velocity).norm(), 1e-15);
+  const double T = reference.duration();
+  EXPECT_LT(so3::angleBetween(run.bodyAt(T).attitude, single.actual.attitude.back()), 1e-12);
+  EXPECT_GT(so3::angleBetween(start.attitude, nodes.attitude[0]), 0.1);  // a real offset ...
+  EXPECT_LT(single.terminal_attitude_error, 1e-3);                       // ... pulled in
+}
+
+// ~replan_period in plan steps: a period rounds to whole steps (at least one); 0, the default,
+// is T / 10 whatever the step (the old default of 1 s re-planned at every node of h = 2 s).
+TEST(ReplanPeriodSteps, RoundsAPeriodAndDerivesTheDefaultFromThePlan) {
+  EXPECT_EQ(replanPeriodSteps(60.0, 300, 2.0), 30);
+  EXPECT_EQ(replanPeriodSteps(1.0, 300, 2.0), 1);   // shorter than a step: every node
+  EXPECT_EQ(replanPeriodSteps(3.1, 300, 2.0), 2);   // rounded
+  EXPECT_EQ(replanPeriodSteps(0.0, 300, 2.0), 30);  // T / 10
+  EXPECT_EQ(replanPeriodSteps(0.0, 1200, 0.5), 120);
+  EXPECT_EQ(replanPeriodSteps(0.0, 8, 0.1), 1);  // at least one step
+  EXPECT_THROW(replanPeriodSteps(-1.0, 300, 2.0), InvalidInput);
+  EXPECT_THROW(replanPeriodSteps(std::nan(""), 300, 2.0), InvalidInput);
+}
+
+// commandAt is the law on the plan in force: before an adoption the first plan's TrackingLaw; after
+// one, the law on the adopted rows at the segment's own clock, which for the plan's own rest is
+// the same command again (the same reference, the effects' clock shifted by t_k).
+TEST(RecedingHorizonRun, CommandAtIsTheLawOnThePlanInForce) {
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const Maneuver& nodes = disturbed.plan.maneuver;
+  const SchemeKind scheme = disturbed.scene.problem.scheme;
+  const ManeuverInterpolation reference(nodes, scheme, disturbed.J, disturbed.effects.get());
+  const TrackingLaw law(reference, disturbed.effects.get(), {});
+  RecedingHorizonRun run(nodes, scheme, disturbed.J, disturbed.effects, Actuation(), {});
+  const RigidBodyState off{nodes.attitude[0] * so3::exp(Vector3(0.01, -0.02, 0.005)),
+                           Vector3(1e-4, 0.0, 2e-4)};
+  for (double t : {0.0, 33.0, 301.0}) {
+    EXPECT_LT((run.commandAt(off, t) - law.command(off.attitude, off.angular_velocity, t)).norm(),
+              1e-15)
+        << "t = " << t;
+  }
+  run.adopt(run.planRemainderAt(100), 100, 100);
+  for (double t : {201.0, 450.0}) {
+    const Vector3 expected = law.command(off.attitude, off.angular_velocity, t);
+    EXPECT_LT((run.commandAt(off, t) - expected).norm(), 1e-9 * expected.norm()) << "t = " << t;
+  }
 }

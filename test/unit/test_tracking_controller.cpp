@@ -40,6 +40,15 @@ double errorSize(const Matrix3& R, const Vector3& W, const AttitudeReference& re
   return e.attitude.norm() + e.rate.norm() / w_n;
 }
 
+/// scenes/disturbed_replay.yaml and its plan (the gravity gradient and the disturbance planned
+/// for, the torque noise not).
+struct DisturbedPlan {
+  Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
+  PlanResult plan = planManeuver(scene.problem);
+  Matrix3 J = scene.problem.inertia;
+  std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+};
+
 }  // namespace
 
 TEST(TrackingController, ZeroErrorGivesExactlyTheFeedForwardTorque) {
@@ -210,11 +219,9 @@ TEST(SimulateTracking, TracksAPlanFromAPerturbedStart) {
 // scenes/disturbed_replay.yaml: the plan knows the gravity gradient and the disturbance, not the
 // actuator noise. Open loop misses by the noise's random walk; closed loop by far less.
 TEST(SimulateTracking, FeedbackBeatsOpenLoopReplayUnderNoiseByAnOrderOfMagnitude) {
-  const Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/disturbed_replay.yaml");
-  const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
-  const Matrix3& J = scene.problem.inertia;
-  const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
   const Maneuver& nodes = plan.maneuver;
 
   Actuation open_loop_actuation = actuationOf(scene.effects);
@@ -234,4 +241,94 @@ TEST(SimulateTracking, FeedbackBeatsOpenLoopReplayUnderNoiseByAnOrderOfMagnitude
   EXPECT_GT(replay_miss, 1e-3);  // the noise matters open loop (~1.5e-3 rad, docs/ros_tracker.md)
   EXPECT_LT(run.terminal_attitude_error, 0.1 * replay_miss)
       << "feedback " << run.terminal_attitude_error << " rad, replay " << replay_miss << " rad";
+}
+
+// The plant (attitude_plant_node's core) against closed forms: a torque-free spin about a
+// principal axis keeps Ω and turns R by exp(t Ω^); a constant torque about a principal axis from
+// rest turns the body by ½ (τ/J) t² about it (Euler's equation decouples on that axis).
+TEST(RigidBodyPlant, MatchesTheClosedFormsOfASpinAndAConstantTorque) {
+  const Matrix3 J = Vector3(800.0, 1200.0, 1500.0).asDiagonal();
+  const Vector3 spin(0.0, 0.03, 0.0);  // about the middle principal axis: an equilibrium
+  RigidBodyPlant spinning(J, Matrix3::Identity(), spin, nullptr, Actuation(), 0.5);
+  spinning.advanceTo(40.0);
+  EXPECT_NEAR(so3::angleBetween(spinning.attitude(), so3::exp(Vector3(40.0 * spin))), 0.0, 1e-12);
+  EXPECT_NEAR((spinning.angularVelocity() - spin).norm(), 0.0, 1e-15);
+
+  RigidBodyPlant pushed(J, Matrix3::Identity(), Vector3::Zero(), nullptr, Actuation(), 0.25);
+  const Vector3 torque(0.0, 0.0, 0.3);  // [N m] about the largest moment
+  EXPECT_EQ(pushed.command(torque), torque);
+  pushed.advanceTo(7.0);
+  pushed.advanceTo(20.0);
+  pushed.advanceTo(19.0);  // the past: nothing happens
+  EXPECT_DOUBLE_EQ(pushed.time(), 20.0);
+  const double angle = 0.5 * 0.3 / 1500.0 * 20.0 * 20.0;
+  EXPECT_NEAR(so3::angleBetween(pushed.attitude(), so3::fromAxisAngle(Vector3::UnitZ(), angle)),
+              0.0, 1e-13);
+  EXPECT_NEAR(pushed.angularVelocity().z(), 0.3 / 1500.0 * 20.0, 1e-15);
+  EXPECT_THROW(RigidBodyPlant(J, Matrix3::Identity(), spin, nullptr, Actuation(), 0.0),
+               InvalidInput);
+}
+
+// predictState (a measurement moved to the time of the command) is the body's motion: forward
+// and back again by the same dt is the identity to RKMK4's error; on a principal-axis spin under
+// a torque about that axis it is the closed form (R = exp(θ e_z), θ = Ω_0 dt + ½ (τ/J) dt²); and
+// it agrees with the plant (the same integrator) over one step, effects included.
+TEST(RigidBodyPlant, PredictStateIsTheBodysMotion) {
+  const Matrix3 J = Vector3(800.0, 1200.0, 1500.0).asDiagonal();
+  const RigidBodyState spin{Matrix3::Identity(), Vector3(0.0, 0.0, 0.02)};
+  const Vector3 torque(0.0, 0.0, 0.15);
+  const double dt = 3.0;
+  const RigidBodyState ahead = predictState(J, nullptr, spin, torque, 0.0, dt);
+  const double angle = 0.02 * dt + 0.5 * 0.15 / 1500.0 * dt * dt;
+  EXPECT_LT(so3::angleBetween(ahead.attitude, so3::fromAxisAngle(Vector3::UnitZ(), angle)), 1e-14);
+  EXPECT_NEAR(ahead.angular_velocity.z(), 0.02 + 0.15 / 1500.0 * dt, 1e-15);
+
+  const DisturbedPlan disturbed;
+  const RigidBodyState tumbling{so3::exp(Vector3(0.3, -0.1, 0.7)), Vector3(0.002, -0.005, 0.001)};
+  const Vector3 u(0.01, -0.02, 0.005);
+  const RigidBodyState there =
+      predictState(disturbed.J, disturbed.effects.get(), tumbling, u, 100.0, 0.5);
+  const RigidBodyState back =
+      predictState(disturbed.J, disturbed.effects.get(), there, u, 100.5, -0.5);
+  EXPECT_LT(so3::angleBetween(back.attitude, tumbling.attitude), 1e-12);
+  EXPECT_LT((back.angular_velocity - tumbling.angular_velocity).norm(), 1e-12);
+  // The plant's clock starts at 0: its effects shifted by 100 s are those at t = 100.
+  RigidBodyPlant at_100(disturbed.J, tumbling.attitude, tumbling.angular_velocity,
+                        std::make_shared<const EffectModel>(disturbed.effects->timeShifted(100.0)),
+                        Actuation(), 1.0);
+  at_100.command(u);
+  at_100.advanceTo(0.5);
+  EXPECT_LT(so3::angleBetween(at_100.attitude(), there.attitude), 1e-15);
+  EXPECT_LT((at_100.angularVelocity() - there.angular_velocity).norm(), 1e-15);
+}
+
+// The plant driven by the law's command at simulateTracking's control samples, on its clock, with
+// the same effects and actuation (noise stream), is the internal feedback mode's run: what
+// ~plant external with attitude_plant_node reproduces over ROS topics.
+TEST(RigidBodyPlant, DrivenByTheLawAtTheControlSamplesReproducesSimulateTracking) {
+  const DisturbedPlan disturbed;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  const auto& [scene, plan, J, effects] = disturbed;
+  const Maneuver& nodes = plan.maneuver;
+  const ManeuverInterpolation reference(nodes, scene.problem.scheme, J, effects.get());
+  Actuation internal_actuation = actuationOf(scene.effects);
+  const TrackingRun internal =
+      simulateTracking(reference, nodes.attitude[0], nodes.angular_velocity[0], effects.get(),
+                       &internal_actuation, {});
+
+  const TrackingLaw law(reference, effects.get(), {});
+  EXPECT_EQ(law.substepsPerPlanStep(), internal.substeps);
+  const double dt = internal.actual.time_step;
+  RigidBodyPlant plant(J, nodes.attitude[0], nodes.angular_velocity[0], effects,
+                       actuationOf(scene.effects), dt);
+  const int M = internal.actual.steps();
+  for (int j = 0; j < M; ++j) {
+    const Vector3 delivered =
+        plant.command(law.command(plant.attitude(), plant.angularVelocity(), j * dt));
+    EXPECT_NEAR((delivered - internal.actual.torque[j]).norm(), 0.0, 1e-12) << "sample " << j;
+    plant.advanceTo((j + 1) * dt);
+  }
+  EXPECT_NEAR(so3::angleBetween(plant.attitude(), internal.actual.attitude[M]), 0.0, 1e-10);
+  const double miss = so3::angleBetween(plant.attitude(), nodes.attitude.back());
+  EXPECT_NEAR(miss, internal.terminal_attitude_error, 1e-10);
 }

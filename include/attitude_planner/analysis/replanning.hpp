@@ -34,15 +34,25 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
 /// The closed loop of the `replan` mode: the tracking law flies the newest adopted plan; the body
 /// is continuous across adoptions (one simulation per adopted plan, from the state at its node,
 /// with the actuator noise stream continued where it was).
+/// Re-plans per maneuver when no period is given: every T/10 (tracking_study's default; the
+/// measured table in docs/ros_tracker.md).
+inline constexpr int kDefaultReplansPerManeuver = 10;
+
+/// Plan steps between re-plans: `period` [s] > 0 rounded to whole steps of `time_step`; `period`
+/// 0 = steps / kDefaultReplansPerManeuver rounded (T/10, whatever the plan's step); at least one
+/// step either way. Throws InvalidInput naming `~replan_period` for a negative or non-finite one.
+int replanPeriodSteps(double period, int steps, double time_step);
+
 class RecedingHorizonRun {
  public:
-  /// Starts by flying `plan` (the first plan, rows 0..N) from its R_0, Ω_0: until the first
-  /// adoption this is simulateTracking's run. `effects` (may be null) act on the body on the
-  /// maneuver's clock; `actuation` is copied fresh (saturation and noise from its first sample);
-  /// options.natural_frequency 0 = defaultTrackingFrequency(T) of the first plan, kept for all.
+  /// Starts by flying `plan` (the first plan, rows 0..N) from `start` (default: its R_0, Ω_0):
+  /// until the first adoption this is simulateTracking's run. `effects` (may be null) act on the
+  /// body on the maneuver's clock; `actuation` is copied fresh (saturation and noise from its
+  /// first sample); options.natural_frequency 0 = defaultTrackingFrequency(T) of the first plan,
+  /// kept for all.
   RecedingHorizonRun(const Maneuver& plan, SchemeKind scheme, const Matrix3& inertia,
                      std::shared_ptr<const EffectModel> effects, const Actuation& actuation,
-                     TrackingOptions options);
+                     TrackingOptions options, std::optional<RigidBodyState> start = std::nullopt);
 
   /// Adopts `plan`, planned from node `planned_from` (its row 0 is node planned_from), from node
   /// `at` (planned_from ≤ at < N) on. Throws InvalidInput if its grid does not fit (steps
@@ -54,6 +64,10 @@ class RecedingHorizonRun {
   /// The body and the reference (the plan in force) at maneuver time t ∈ [0, T].
   ManeuverSample bodyAt(double t) const;
   ManeuverSample referenceAt(double t) const;
+  /// The law's command on the state (R, Ω) at maneuver time t against the plan in force (its
+  /// TrackingLaw, on its segment's clock and effects, gains of naturalFrequency()): what the
+  /// tracker sends an external plant in replan mode.
+  Vector3 commandAt(const RigidBodyState& state, double t) const;
   /// Rows k..N of the plan in force at node k (its warm start for a re-plan from k).
   Maneuver planRemainderAt(int k) const;
 

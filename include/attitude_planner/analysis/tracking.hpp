@@ -14,6 +14,8 @@
 #pragma once
 
 #include <array>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,13 @@ void requireUniformTimeGrid(const Maneuver& maneuver);
 
 /// Relative tolerance of requireUniformTimeGrid (times are k h in floating point, up to round-off).
 inline constexpr double kTimeGridTolerance = 1e-9;
+
+/// The state of a rigid body: where a run starts when it takes over from another (a new maneuver
+/// mid-run is flown from the body's state, not from its plan's R_0), or a measurement.
+struct RigidBodyState {
+  Matrix3 attitude = Matrix3::Identity();      ///< R, body → world
+  Vector3 angular_velocity = Vector3::Zero();  ///< Ω [rad/s], body frame
+};
 
 /// One sample of an interpolated maneuver.
 struct ManeuverSample {
@@ -137,6 +146,69 @@ TrackingRun simulateTracking(const ManeuverInterpolation& reference,
                              const Matrix3& initial_attitude, const Vector3& initial_velocity,
                              const EffectModel* effects, Actuation* actuation,
                              const TrackingOptions& options);
+
+/// The sampled tracking law around a plan, evaluated on any state: what simulateTracking applies
+/// at every control sample, and what the tracker sends to an external plant (~plant external)
+/// from the measured state.
+class TrackingLaw {
+ public:
+  /// `reference` and `effects` (may be null) must outlive the law; options.natural_frequency
+  /// 0 = defaultTrackingFrequency(T). Throws InvalidInput for bad options (naming them).
+  TrackingLaw(const ManeuverInterpolation& reference, const EffectModel* effects,
+              const TrackingOptions& options);
+  /// u = τ(R, Ω; reference at t) − τ_e(R, t) [N·m], body frame: the actuator command (the known
+  /// effects compensated; at zero error the plan's τ(t)).
+  Vector3 command(const Matrix3& attitude, const Vector3& angular_velocity, double t) const;
+  double naturalFrequency() const { return natural_frequency_; }  ///< ω_n [rad/s]
+  /// Control samples per plan step of simulateTracking: ω_n Δt ≤ kMaxControlPhasePerSample.
+  int substepsPerPlanStep() const;
+
+ private:
+  const ManeuverInterpolation& reference_;
+  const EffectModel* effects_;
+  double natural_frequency_;
+  TrackingGains gains_;
+};
+
+/// The state `dt` [s] after `state` (at maneuver time t) of the continuous rigid body under the
+/// held torque u and the known `effects` (may be null): one RKMK4 step, dt may be negative. The
+/// tracker moves a measurement to the time of its command with it (the measurement's age is
+/// transport and sampling lag; moving only the attitude at the measured rate leaves the rate
+/// Ω̇ · age behind, which the law's damping turns into an attitude offset of order 2ζ Ω̇ age / ω_n).
+RigidBodyState predictState(const Matrix3& inertia, const EffectModel* effects,
+                            const RigidBodyState& state, const Vector3& torque, double t,
+                            double dt);
+
+/// The continuous rigid body as a plant (attitude_plant_node): Ṙ = RΩ^, JΩ̇ = JΩ × Ω + u + τ_e(R, t)
+/// with the delivered torque u held between commands (zero-order hold) and the effects on the
+/// maneuver's clock t, integrated by RKMK4 (simulateTracking's integrator) in steps of at most
+/// `max_step`. Commands pass through `actuation` (saturation, then noise) once each.
+class RigidBodyPlant {
+ public:
+  /// At t = 0 in (R_0, Ω_0). `effects` may be null; `max_step` > 0 [s] (throws InvalidInput
+  /// naming it otherwise).
+  RigidBodyPlant(const Matrix3& inertia, const Matrix3& initial_attitude,
+                 const Vector3& initial_velocity, std::shared_ptr<const EffectModel> effects,
+                 Actuation actuation, double max_step);
+  /// Holds the commanded torque τ [N·m] (body) from now on; returns the torque delivered.
+  Vector3 command(const Vector3& commanded);
+  /// Integrates to maneuver time t; a t at or before time() changes nothing.
+  void advanceTo(double t);
+  double time() const { return time_; }                          ///< t [s]
+  const Matrix3& attitude() const { return attitude_; }          ///< R(t), body → world
+  const Vector3& angularVelocity() const { return velocity_; }   ///< Ω(t) [rad/s], body
+  const Vector3& deliveredTorque() const { return delivered_; }  ///< u [N·m], body
+
+ private:
+  Matrix3 inertia_, inertia_inverse_;
+  std::shared_ptr<const EffectModel> effects_;
+  Actuation actuation_;
+  double max_step_;
+  double time_ = 0.0;
+  Matrix3 attitude_;
+  Vector3 velocity_;
+  Vector3 delivered_ = Vector3::Zero();
+};
 
 /// The open-loop effort ½∫|τ|² dt [N²·m²·s] of node torques under their scheme's weights
 /// (h · schemeCost): the replay's counterpart of TrackingRun::effort.

@@ -8,6 +8,7 @@
 
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/time.h>
 #include <boost/array.hpp>
 
@@ -19,6 +20,7 @@
 #include "attitude_planner/MinimumTimeSummary.h"
 #include "attitude_planner/PlanAttempt.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
+#include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/errors.hpp"
@@ -27,6 +29,22 @@
 
 namespace attitude_planner {
 namespace ros_conversions {
+
+/// A measured rigid-body state (nav_msgs/Odometry, the tracker's ~plant external input):
+/// pose.pose.orientation the attitude body → header.frame_id, twist.twist.angular the body rate
+/// [rad/s] in child_frame_id.
+using MeasuredState = RigidBodyState;
+
+/// The attitude and body rate of an Odometry message (the position, the linear velocity and the
+/// covariances are not used); throws InvalidInput naming the field for a quaternion that is not
+/// unit or a non-finite rate. Frames are the caller's to check.
+MeasuredState measuredStateFromMsg(const nav_msgs::Odometry& msg);
+
+/// An Odometry message of the state (R, Ω): orientation R (body `child_frame` → `frame`), angular
+/// twist Ω in the body frame, position and linear velocity zero (attitude_plant_node).
+nav_msgs::Odometry odometryToMsg(const Matrix3& attitude, const Vector3& angular_velocity,
+                                 const ros::Time& stamp, const std::string& frame,
+                                 const std::string& child_frame);
 
 /// Rotation matrix (body → world) of a message quaternion; throws InvalidInput naming `field` if
 /// the quaternion has a non-finite entry, is zero or is not unit within kQuaternionNormTolerance

@@ -46,6 +46,10 @@
 //             reference_pose     geometry_msgs/PoseStamped, world    R_d(t), the plan [rigid body]
 //             attitude_error     std_msgs/Float64   ‖log(R_d(t)ᵀ R(t))‖ [rad] (rqt_plot)
 //             angular_velocity_error std_msgs/Float64  |Ω − RᵀR_d Ω_d| [rad/s] (rqt_plot)
+//             body_pose          geometry_msgs/PoseStamped, world   R(t), the body (stamped state)
+//             attitude_error_vector geometry_msgs/Vector3Stamped, body   log(R_dᵀR) [rad], the
+//                                rotation from the reference to the body (norm: attitude_error)
+//             angular_velocity_error_vector geometry_msgs/Vector3Stamped, body   e_Ω [rad/s]
 //             body_marker        visualization_msgs/MarkerArray, body   box, principal axes, traced
 //             axis attitude_trail     visualization_msgs/Marker, world   the traced axis' last
 //             kTrailPoints tips status_text        visualization_msgs/Marker, world   "t / T, angle
@@ -62,10 +66,10 @@
 //
 // Private parameters:
 //   ~mode             string  "replay" replay | feedback | replan; an unknown mode stops the node
-//                                      with an error naming it
+//                                      with an error naming it (exit 78, as every bad parameter)
 //   ~rate             double  50.0     samples per ROS second (>= 0); 0 = one sample per plan node
-//   ~replan_period    double  1.0      [s, maneuver time] between re-plans (> 0; replan), rounded
-//                                      to whole plan steps (at least one)
+//   ~replan_period    double  0.0      [s, maneuver time] between re-plans (>= 0; replan), rounded
+//                                      to whole plan steps (at least one); 0 = T / 10
 //   ~trace_axis       string  "auto"   body axis traced by the path: x | y | z | auto (the one
 //                                      most perpendicular to the maneuver's rotation axis)
 //   ~feedback_frequency double 0.0     ω_n of the law [rad/s] (>= 0; 0 = 40 / T)
@@ -78,19 +82,47 @@
 //                                      not made for, and in feedback mode how much of it the law
 //                                      removes
 //   ~plan_in_process  bool    false    plan the scene with planManeuver() instead of the service
-//   ~planner_timeout  double  30.0     wait for the planner service [s, wall]
+//   ~planner_timeout  double  30.0     [s, wall] wait for the planner service; also the bound
+//                                      on the start-up plan call and on each re-plan (a planner
+//                                      that does not answer in time is abandoned: roscpp cannot
+//                                      cancel a call, its thread is left waiting)
+//   ~takeover_tolerance double 0.25    [rad] a maneuver arriving mid-run whose R_0 is farther than
+//                                      this from the body is refused (`done` says so; the run
+//                                      goes on); a nearer one is flown from the body's state
 //   ~rate_factor      double  1.0      maneuver seconds per ROS second (> 0; 2 = twice as fast)
 //   ~start_delay      double  0.5      ROS seconds between receiving a maneuver and t_0 (>= 0)
 //   ~world_frame      string  "world"  fixed frame when the maneuver's header.frame_id is empty
-//   ~body_frame       string  "body"   body frame when the maneuver's child_frame_id is empty
+//   ~body_frame       string  ""       body frame when the maneuver's child_frame_id is empty;
+//                                      "" = defaultBodyFrame(namespace): "body" in the root
+//                                      namespace, "NS/body" in namespace /NS (one per vehicle).
+//                                      Another node publishing the same transform (seen on /tf)
+//                                      is an error: ROS_ERROR and the run's `done` fails
 //   ~body_size        double  1.0      largest edge of the drawn box [m] (> 0)
 //   ~axis_length      double  0.9      length of the principal-axis arrows [m] (> 0)
 //   ~path_radius      double  1.2      distance of the traced tip from the origin [m] (> 0)
 //   ~exit_when_done   bool    false    shut the node down after publishing `done` (demo/CI)
+//   ~plant            string  "internal" internal: the tracker simulates the body itself (above);
+//                                      external: the body is the user's — the tracker subscribes
+//                                      to its measured state (`odometry`) and publishes the
+//                                      command (`torque_command`) at ~rate (docs/ros_tracker.md)
+//   ~measurement_timeout double 0.5    [s, ROS time] an `odometry` older than this at a sample
+//                                      is stale: zero command, a warning, `done` fails (external)
+//
+// ~plant external (every mode): at every sample the tracker takes the newest
+// `odometry` (nav_msgs/Odometry: pose.orientation the body → world attitude, twist.angular the
+// body rate; header.frame_id must be the maneuver's world frame and child_frame_id its body
+// frame, empty ones are taken as those), moves it to the sample's time under the command held
+// meanwhile and the known effects (predictState: the measurement's age is transport and sampling
+// lag), and publishes on
+// `torque_command` (geometry_msgs/WrenchStamped, body frame) the law's command on it
+// (TrackingLaw, feedback; the law on the plan in force, replan, re-planned from the measured
+// state) or the plan's torque τ(t) (replay). tf, markers and errors show the
+// measured body. After the last sample a zero command is sent.
 #pragma once
 
 #include <atomic>
 #include <deque>
+#include <functional>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -99,7 +131,9 @@
 #include <thread>
 #include <vector>
 
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -113,6 +147,7 @@
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/ros/conversions.hpp"
 
 namespace attitude_planner {
 
@@ -157,6 +192,11 @@ visualization_msgs::MarkerArray constraintMarkers(
 /// the turn shows (e_x if R_N = R_0). Throws InvalidInput naming ~trace_axis for another name.
 Vector3 traceAxis(const std::string& name, const Matrix3& initial, const Matrix3& final);
 
+/// The default body frame of a tracker in namespace `ns`: "body" in the root namespace, else the
+/// namespace without its leading slash followed by "/body" ("/sat1" -> "sat1/body"), so that two
+/// trackers in two namespaces never publish the same world -> body transform.
+std::string defaultBodyFrame(const std::string& ns);
+
 /// Up to `max_points` indices of 0..n, evenly spread, 0 and n always included, increasing.
 std::vector<int> decimatedIndices(int n, int max_points);
 
@@ -180,6 +220,23 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
 /// the plan cannot know it), its actuator limits and constraints.
 PlanAttitudeManeuver::Request planRequestOf(const PlanningProblem& problem,
                                             const std::vector<EffectSpec>& effects);
+
+/// Where the body the tracker drives lives (~plant).
+enum class PlantKind {
+  Internal,  ///< simulated by the tracker itself (the default; the behaviour before ~plant)
+  External,  ///< the user's: measured state in (`odometry`), command out (`torque_command`)
+};
+inline constexpr NamedValue<PlantKind> kPlantNames[] = {
+    {PlantKind::Internal, "internal"},
+    {PlantKind::External, "external"},
+};
+
+/// The newest measured state as the tracker saw it at a sample (~plant external).
+struct MeasurementAtSample {
+  bool fresh = false;    ///< received, frames right, not older than ~measurement_timeout
+  RigidBodyState state;  ///< moved to the sample's time (when fresh; else the last usable one)
+  std::string problem;   ///< why not fresh (for the warning and `done`)
+};
 
 /// A re-plan's answer (replan mode).
 struct ReplanAnswer {
@@ -222,6 +279,11 @@ class TrackerNode {
     /// The problem the maneuver solves (~scene's, with its effects), for re-plans; unset for a
     /// maneuver from the topic (rebuilt from the message and ~replay_scene's effects).
     std::optional<PlanningProblem> problem;
+    /// A maneuver that replaces a running one: the body's state at the running one's next sample
+    /// (the internal body starts there, not at the plan's R_0) and that sample's stamp (the new
+    /// run's t_0 unless its header.stamp is in the future: the stream goes on at its rate).
+    std::optional<RigidBodyState> takeover;
+    ros::Time continue_at;
   };
 
   /// What a rigid-body run streams: the plan (reference) and the body (actual), both
@@ -241,7 +303,8 @@ class TrackerNode {
     std::shared_ptr<RecedingHorizonRun> horizon;
     PlanningProblem problem;
     std::vector<EffectSpec> effects_specs;
-    std::string replan_status;  ///< the status text's re-plan line (replan mode)
+    std::string replan_status;    ///< the status text's re-plan line (replan mode)
+    int replan_period_steps = 1;  ///< plan steps between re-plans (replanPeriodSteps)
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -249,9 +312,13 @@ class TrackerNode {
     int next_node = 1;     ///< the next node to re-plan from
     bool pending = false;  ///< a request is in flight
     int pending_from = 0;  ///< its node
+    ros::WallTime sent;    ///< when it was sent (abandoned after ~planner_timeout)
+    /// Set by a detached thread: dropping it abandons the answer (never waits for it).
     std::future<ReplanAnswer> answer;
   };
 
+  /// Advertises the topics (and, with ~plant external, `torque_command` and `odometry`).
+  void advertiseTopics();
   /// `maneuver` callback: replaces the running replay.
   void onManeuver(const AttitudeManeuver::ConstPtr& msg);
   /// `drift_maneuver` callback: replaces the running replay.
@@ -275,8 +342,34 @@ class TrackerNode {
   void runBody(const Replay& replay, const Maneuver& plan, const Matrix3& inertia,
                SchemeKind scheme, Playback* playback) const;
   /// replan mode, before the sample at maneuver time t: adopts an answer that has arrived (at the
-  /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight.
-  void serviceReplans(double t, Playback* playback, ReplanState* state);
+  /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight,
+  /// from the state `state_at_node` gives at that node (default: the simulated body's).
+  void serviceReplans(double t, Playback* playback, ReplanState* state,
+                      const std::function<RigidBodyState(int)>& state_at_node = nullptr);
+  /// ~plant external: streams `playback` from `start`, commanding the measured body; fills the
+  /// result (terminal errors of the last measurement, effort of the commands, stale samples).
+  /// False if stopped meanwhile.
+  bool runExternal(const ros::Time& start, Playback* playback, ReplanState* replans);
+  /// `/tf` callback: notes another node that publishes this tracker's body transform.
+  void onTf(const ros::MessageEvent<tf2_msgs::TFMessage const>& event);
+  /// Sets the frame pair the current run publishes; returns the conflict seen since the last
+  /// call ("" if none) and clears it.
+  std::string claimFrames(const std::string& world_frame, const std::string& body_frame);
+  /// `odometry` callback: keeps the newest measurement.
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  /// The newest measurement at the sample stamped `stamp` of the run started at `start`, moved
+  /// to the sample's time under `held_command` (the last command sent) and the known effects.
+  MeasurementAtSample measurementAt(const Playback& playback, const ros::Time& start,
+                                    const ros::Time& stamp, const Vector3& held_command);
+  /// Publishes the body (`body`, its torque the delivered or commanded one) and the reference
+  /// (`plan`) at maneuver time t, stamped `stamp`.
+  void publishState(const Playback& playback, const ManeuverSample& body,
+                    const ManeuverSample& plan, double t, const ros::Time& stamp,
+                    std::deque<Vector3>* trail);
+  /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
+  /// (e_Ω), stamped `stamp`.
+  void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,
+                            const TrackingErrors& errors, const ros::Time& stamp);
   /// replan mode, after the stream: the terminal errors and effort of the re-planned closed loop.
   void finishReplanResult(Playback* playback) const;
   /// Publishes one sample at maneuver time t, stamped `stamp`.
@@ -300,23 +393,36 @@ class TrackerNode {
                    const Vector3& trace_axis, std::deque<Vector3>* trail);
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
+  /// Remembers the body's state at the running run's next sample and that sample's stamp (what a
+  /// new maneuver takes over from); `running` false: no run in progress.
+  void noteNextSample(bool running, const RigidBodyState& body = {},
+                      const ros::Time& stamp = ros::Time());
 
-  ros::NodeHandle nh_;             ///< public handle: topics and the service resolve here
-  ros::Subscriber maneuver_sub_;   ///< `maneuver`
-  ros::Subscriber drift_sub_;      ///< `drift_maneuver`
-  ros::Publisher control_pub_;     ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
-  ros::Publisher torque_pub_;      ///< `torque` τ(t) [N·m], frame body
-  ros::Publisher velocity_pub_;    ///< `angular_velocity` Ω(t) [rad/s], frame body
-  ros::Publisher reference_pub_;   ///< `reference_pose` R_d(t)
-  ros::Publisher error_pub_;       ///< `attitude_error` [rad]
-  ros::Publisher rate_error_pub_;  ///< `angular_velocity_error` [rad/s]
-  ros::Publisher marker_pub_;      ///< `body_marker`
-  ros::Publisher trail_pub_;       ///< `attitude_trail`
-  ros::Publisher text_pub_;        ///< `status_text`
-  ros::Publisher path_pub_;        ///< `attitude_path` (latched)
-  ros::Publisher ghost_pub_;       ///< `ghost_markers` (latched)
-  ros::Publisher done_pub_;        ///< `done` (latched)
-  ros::Publisher constraint_pub_;  ///< `constraint_markers` (latched)
+  ros::NodeHandle nh_;               ///< public handle: topics and the service resolve here
+  ros::Subscriber maneuver_sub_;     ///< `maneuver`
+  ros::Subscriber drift_sub_;        ///< `drift_maneuver`
+  ros::Publisher control_pub_;       ///< `control` (u1, u2, 0) [rad/s], frame body (drift only)
+  ros::Publisher torque_pub_;        ///< `torque` τ(t) [N·m], frame body
+  ros::Publisher velocity_pub_;      ///< `angular_velocity` Ω(t) [rad/s], frame body
+  ros::Publisher reference_pub_;     ///< `reference_pose` R_d(t)
+  ros::Publisher error_pub_;         ///< `attitude_error` [rad]
+  ros::Publisher rate_error_pub_;    ///< `angular_velocity_error` [rad/s]
+  ros::Publisher marker_pub_;        ///< `body_marker`
+  ros::Publisher trail_pub_;         ///< `attitude_trail`
+  ros::Publisher text_pub_;          ///< `status_text`
+  ros::Publisher path_pub_;          ///< `attitude_path` (latched)
+  ros::Publisher ghost_pub_;         ///< `ghost_markers` (latched)
+  ros::Publisher done_pub_;          ///< `done` (latched)
+  ros::Publisher constraint_pub_;    ///< `constraint_markers` (latched)
+  ros::Publisher command_pub_;       ///< `torque_command` (~plant external) [N·m], frame body
+  ros::Publisher body_pose_pub_;     ///< `body_pose` R(t), frame world
+  ros::Publisher error_vector_pub_;  ///< `attitude_error_vector` log(R_dᵀR) [rad], body
+  ros::Publisher rate_error_vector_pub_;  ///< `angular_velocity_error_vector` e_Ω [rad/s], body
+  ros::Subscriber odometry_sub_;          ///< `odometry` (~plant external)
+  ros::Subscriber tf_sub_;                ///< /tf: who else publishes our body transform
+  std::mutex frames_mutex_;               ///< guards the three below
+  std::string claimed_world_, claimed_body_;      ///< the pair the current run publishes
+  std::string frame_conflict_;                    ///< another publisher of it, when seen
   tf2_ros::TransformBroadcaster tf_broadcaster_;  ///< world → body
   TrackingMode mode_ = TrackingMode::Replay;      ///< ~mode
   double rate_ = 50.0;                            ///< ~rate [Hz]; 0 = at the nodes
@@ -329,15 +435,29 @@ class TrackerNode {
   double body_size_ = 1.0;                        ///< largest box edge [m]
   double axis_length_ = 0.9;                      ///< principal-axis arrow length [m]
   double path_radius_ = 1.2;                      ///< distance of the traced tip [m]
-  double replan_period_ = 1.0;                    ///< ~replan_period [s, maneuver time]
+  double replan_period_ = 0.0;                    ///< ~replan_period [s]; 0 = T / 10
   bool plan_in_process_ = false;                  ///< ~plan_in_process (also for re-plans)
   bool exit_when_done_ = false;                   ///< shut down after `done`
+  double planner_timeout_ = 30.0;                 ///< ~planner_timeout [s, wall]
+  double takeover_tolerance_ = 0.25;              ///< ~takeover_tolerance [rad]
+  PlantKind plant_ = PlantKind::Internal;         ///< ~plant
+  double measurement_timeout_ = 0.5;              ///< ~measurement_timeout [s, ROS time]
+  std::mutex odometry_mutex_;                     ///< guards odometry_ (callback vs stream)
+  nav_msgs::Odometry::ConstPtr odometry_;         ///< newest `odometry`, null before the first
+  ros::Time odometry_received_;                   ///< when it arrived (for an unstamped one)
+  RigidBodyState last_measured_;                  ///< the last usable measurement (for display)
   /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
   std::optional<std::vector<EffectSpec>> replay_scene_effects_;
 
-  std::mutex replay_mutex_;        ///< guards replay_thread_ (start/stop from callbacks)
-  std::thread replay_thread_;      ///< runs runReplay()
-  std::atomic<bool> stop_{false};  ///< asks the replay thread to return
+  std::mutex replay_mutex_;                  ///< guards replay_thread_ (start/stop from callbacks)
+  std::thread replay_thread_;                ///< runs runReplay()
+  std::atomic<bool> stop_{false};            ///< asks the replay thread to return
+  std::atomic<bool> replacing_{false};       ///< the stop is for a new maneuver
+  std::atomic<bool> done_published_{false};  ///< the replay thread's run has its `done`
+  std::mutex body_mutex_;                    ///< guards the three below (stream vs callbacks)
+  bool run_active_ = false;                  ///< a rigid-body run is streaming
+  RigidBodyState next_body_;                 ///< the body at its next sample
+  ros::Time next_stamp_;                     ///< that sample's stamp
 };
 
 }  // namespace attitude_planner

@@ -1,0 +1,91 @@
+#include "attitude_planner/ros/plant_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nav_msgs/Odometry.h>
+
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/ros/parameters.hpp"
+
+namespace attitude_planner {
+
+namespace rc = ros_conversions;
+
+PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  auto non_empty = [](const std::string& s) { return !s.empty(); };
+  const std::string scene_path = readFileParam(pnh, "scene");
+  if (scene_path.empty()) {
+    throw InvalidParameter("parameter " + pnh.resolveName("scene") +
+                           " is required: the scene whose body, initial state and effects "
+                           "the plant simulates");
+  }
+  const double rate = readParam<double>(pnh, "rate", 100.0, positive, "> 0 Hz");
+  rate_factor_ = readParam<double>(pnh, "rate_factor", 1.0, positive, "> 0");
+  double max_step = readParam<double>(pnh, "max_step", 0.0, non_negative, ">= 0 s, 0 = h / 4");
+  world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
+  body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
+  Scene scene;
+  try {
+    scene = loadScene(scene_path);
+  } catch (const std::exception& e) {
+    throw InvalidParameter("parameter " + pnh.resolveName("scene") + " = " + scene_path + ": " +
+                           e.what());
+  }
+  const PlanningProblem& p = scene.problem;
+  if (max_step == 0.0) max_step = 0.25 * p.duration / p.steps;
+  plant_ = std::make_unique<RigidBodyPlant>(p.inertia, p.initial_attitude, p.initial_velocity,
+                                            plannableEffects(scene.effects, p.inertia),
+                                            actuationOf(scene.effects), max_step);
+  odometry_pub_ = nh.advertise<nav_msgs::Odometry>("odometry", 10);
+  command_sub_ = nh.subscribe("torque_command", 10, &PlantNode::onCommand, this,
+                              ros::TransportHints().tcpNoDelay());
+  timer_ = nh.createTimer(ros::Duration(1.0 / rate), &PlantNode::onTimer, this);
+  ROS_INFO(
+      "attitude_plant_node: %s, %zu effects, odometry at %g Hz (rate factor %g), waiting for "
+      "%s",
+      scene_path.c_str(), scene.effects.size(), rate, rate_factor_,
+      command_sub_.getTopic().c_str());
+}
+
+double PlantNode::maneuverTime(const ros::Time& stamp) const {
+  if (!released_) return 0.0;
+  return std::max(0.0, (stamp - *released_).toSec() * rate_factor_);
+}
+
+void PlantNode::onCommand(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != body_frame_) {
+    ROS_WARN_THROTTLE(1.0,
+                      "torque_command refused: header.frame_id '%s' is not the body frame '%s'",
+                      msg->header.frame_id.c_str(), body_frame_.c_str());
+    return;
+  }
+  Vector3 torque;
+  try {
+    torque = rc::finiteVectorFromMsg(msg->wrench.torque, "torque_command.wrench.torque");
+  } catch (const std::exception& e) {
+    ROS_WARN_THROTTLE(1.0, "torque_command refused: %s", e.what());
+    return;
+  }
+  const ros::Time now = ros::Time::now();
+  const ros::Time stamp = msg->header.stamp.isZero() ? now : std::min(msg->header.stamp, now);
+  if (!released_) {
+    released_ = stamp;  // t = 0: the body is released by its first command
+    ROS_INFO("attitude_plant_node: released at %.3f s", stamp.toSec());
+  }
+  // The held command acts up to this one's time; a late one acts from the plant's time.
+  plant_->advanceTo(maneuverTime(stamp));
+  plant_->command(torque);
+}
+
+void PlantNode::onTimer(const ros::TimerEvent&) {
+  const ros::Time now = ros::Time::now();
+  plant_->advanceTo(maneuverTime(now));
+  odometry_pub_.publish(rc::odometryToMsg(plant_->attitude(), plant_->angularVelocity(), now,
+                                          world_frame_, body_frame_));
+}
+
+}  // namespace attitude_planner

@@ -1,0 +1,140 @@
+// rostest (tracker_external.test): the tracker's external plant mode. The same plan of
+// scenes/leo_slew.yaml under scenes/disturbed_replay.yaml's torque noise (a disturbance the plan
+// never saw) flown by the internal feedback mode (/internal) and by the same law on the measured
+// state of attitude_plant_node over ROS topics (/external): the external loop lands within 2x
+// the internal one's terminal attitude error. A tracker with no measurement (/unmeasured) sends
+// zero commands at its rate, warns, and ends with a failed `done`: nothing blocks.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/Vector3Stamped.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <std_msgs/Float64.h>
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "attitude_planner/ReplayResult.h"
+#include "ros_test_helpers.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+/// Counts the commands on `torque_command` and the largest |τ| among them.
+struct CommandCounter {
+  explicit CommandCounter(ros::NodeHandle& nh)
+      : sub(nh.subscribe("torque_command", 1000, &CommandCounter::onCommand, this)) {}
+  void onCommand(const geometry_msgs::WrenchStamped::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++count;
+    const Vector3 tau = ros_conversions::vectorFromMsg(m->wrench.torque);
+    largest = std::max(largest, tau.norm());
+    frame = m->header.frame_id;
+  }
+  std::mutex mutex;
+  int count = 0;
+  double largest = 0.0;
+  std::string frame;
+  ros::Subscriber sub;
+};
+
+}  // namespace
+
+TEST(TrackerExternal, MeasuredLoopLandsWithinTwiceTheInternalFeedbackError) {
+  ros::NodeHandle internal_nh("internal"), external_nh("external"), unmeasured_nh("unmeasured");
+  CommandCounter external_commands(external_nh), unmeasured_commands(unmeasured_nh);
+  std::atomic<int> odometry{0}, poses{0};
+  std::mutex errors_mutex;
+  std::vector<double> error_norms, error_vector_norms;  // attitude_error, |attitude_error_vector|
+  ros::Subscriber error_sub = external_nh.subscribe<std_msgs::Float64>(
+      "attitude_error", 1000, [&](const std_msgs::Float64::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        error_norms.push_back(m->data);
+      });
+  ros::Subscriber error_vector_sub = external_nh.subscribe<geometry_msgs::Vector3Stamped>(
+      "attitude_error_vector", 1000, [&](const geometry_msgs::Vector3Stamped::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        error_vector_norms.push_back(ros_conversions::vectorFromMsg(m->vector).norm());
+      });
+  ros::Subscriber pose_sub = external_nh.subscribe<geometry_msgs::PoseStamped>(
+      "body_pose", 1000, [&](const geometry_msgs::PoseStamped::ConstPtr&) { ++poses; });
+  ros::Subscriber odometry_sub = external_nh.subscribe<nav_msgs::Odometry>(
+      "odometry", 1000, [&](const nav_msgs::Odometry::ConstPtr&) { ++odometry; });
+  ros::NodeHandle replan_nh("external_replan");
+  ros_testing::DoneListener internal_done(internal_nh), external_done(external_nh),
+      unmeasured_done(unmeasured_nh), replan_done(replan_nh);
+  const ReplayResult::ConstPtr internal = internal_done.wait(150.0);
+  const ReplayResult::ConstPtr external = external_done.wait(30.0);
+  const ReplayResult::ConstPtr unmeasured = unmeasured_done.wait(30.0);
+  const ReplayResult::ConstPtr replanned = replan_done.wait(30.0);
+  ASSERT_TRUE(internal && external && unmeasured && replanned) << "no done from every tracker";
+  ASSERT_TRUE(internal->success) << internal->message;
+  ASSERT_TRUE(external->success) << external->message;
+  EXPECT_EQ(external->mode, "feedback");
+  std::printf(
+      "terminal attitude error: internal %.3g rad, external %.3g rad (ratio %.3g); rate error: "
+      "internal %.3g, external %.3g rad/s; effort: internal %.5g, external %.5g N^2 m^2 s\n",
+      internal->terminal_attitude_error, external->terminal_attitude_error,
+      external->terminal_attitude_error / internal->terminal_attitude_error,
+      internal->terminal_velocity_error, external->terminal_velocity_error, internal->effort,
+      external->effort);
+  // The unplanned noise moves the body: the internal loop's miss is not zero (docs: ~8e-6 rad).
+  EXPECT_GT(internal->terminal_attitude_error, 1e-7);
+  EXPECT_LE(external->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
+  EXPECT_LT(external->terminal_velocity_error, 1e-3);  // [rad/s], a slew of ~5e-3 rad/s
+  EXPECT_NEAR(external->effort, internal->effort, 0.05 * internal->effort);
+
+  // Replan mode on the measured state: re-plans from it (every 120 s: from nodes 60, 120, 180,
+  // 240) adopted, none failed, and the body lands as tracker_replan.test's bound asks (1e-4 rad;
+  // re-planning leaves a discretization mismatch the law removes, docs/ros_tracker.md).
+  ASSERT_TRUE(replanned->success) << replanned->message;
+  std::printf("external replan: %d re-plans, %d failed, terminal attitude error %.3g rad\n",
+              replanned->replans, replanned->replan_failures, replanned->terminal_attitude_error);
+  EXPECT_EQ(replanned->mode, "replan");
+  EXPECT_GE(replanned->replans, 1);
+  EXPECT_EQ(replanned->replan_failures, 0) << replanned->replan_error;
+  EXPECT_LT(replanned->terminal_attitude_error, 1e-4);
+
+  // The stream: one command per sample (T / (rate_factor / rate) + 1 = 301) and the final zero.
+  ros::WallDuration(0.5).sleep();
+  {
+    std::lock_guard<std::mutex> lock(external_commands.mutex);
+    EXPECT_EQ(external_commands.count, 302);
+    EXPECT_EQ(external_commands.frame, "external_body");
+    EXPECT_GT(external_commands.largest, 0.0);
+  }
+  EXPECT_GT(odometry, 100);
+  // The stamped topics (body_pose, the error vector) go out with every sample; the vector's norm
+  // is attitude_error.
+  EXPECT_EQ(poses, 301);
+  {
+    std::lock_guard<std::mutex> lock(errors_mutex);
+    ASSERT_EQ(error_vector_norms.size(), 301u);
+    ASSERT_EQ(error_norms.size(), error_vector_norms.size());
+    for (std::size_t i = 0; i < error_norms.size(); ++i)
+      EXPECT_NEAR(error_vector_norms[i], error_norms[i], 1e-12) << "sample " << i;
+  }
+
+  // No measurement: every sample still goes out, with a zero command, and `done` fails saying so.
+  EXPECT_FALSE(unmeasured->success);
+  EXPECT_NE(unmeasured->message.find("no fresh measurement"), std::string::npos)
+      << unmeasured->message;
+  EXPECT_NE(unmeasured->message.find("/unmeasured/odometry"), std::string::npos)
+      << unmeasured->message;
+  std::lock_guard<std::mutex> lock(unmeasured_commands.mutex);
+  EXPECT_EQ(unmeasured_commands.count, 302);
+  EXPECT_EQ(unmeasured_commands.largest, 0.0);
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_external");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -27,6 +27,8 @@ DEBIAN_PACKAGES=(
   python3-numpy python3-matplotlib python3-yaml
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
   python3-visualization-msgs python3-rostopic python3-rosservice
+  pybind11-dev python3-pybind11 python3-dev python3-setuptools
+  python3-distributed python3-dask python3-tqdm
 )
 
 log() { printf '[attitude_planner] %s\n' "$*" >&2; }

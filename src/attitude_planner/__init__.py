@@ -42,6 +42,12 @@ StepTooLargeError.__doc__ = ("An implicit step of the scheme has no solution at 
                              "too large): increase steps. A subclass of InputError.")
 
 
+# libyaml's emitter and parser where PyYAML has them (Debian's does): the Python ones take
+# milliseconds for a scene, a tenth of a small solve in a batch worker.
+_YAML_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 def _input_error(field, detail):
     """InputError("field: detail") with its field and detail set (as the core's errors have)."""
     error = InputError("%s: %s" % (field, detail))
@@ -90,7 +96,7 @@ class Problem:
                 self._set(text, source)
                 return
             source += " with keywords"  # the text parsed is the file's keys and the keywords
-            scene = yaml.safe_load(text) or {}
+            scene = yaml.load(text, Loader=_YAML_LOADER) or {}
             if not isinstance(scene, dict):
                 raise _input_error("scene", "'%s' is not a mapping of scene keys" % source)
         elif not isinstance(scene, dict):
@@ -98,7 +104,7 @@ class Problem:
                                % (scene,))
         merged = dict(scene)
         merged.update(keys)
-        self._set(yaml.safe_dump(_plain(merged), sort_keys=False), source)
+        self._set(yaml.dump(_plain(merged), Dumper=_YAML_DUMPER, sort_keys=False), source)
 
     @classmethod
     def from_yaml(cls, text, source="<yaml>"):
@@ -121,7 +127,7 @@ class Problem:
     @property
     def scene(self):
         """The scene keys as a dict (the YAML parsed)."""
-        return yaml.safe_load(self.yaml) or {}
+        return yaml.load(self.yaml, Loader=_YAML_LOADER) or {}
 
     def __eq__(self, other):
         return isinstance(other, Problem) and (self.yaml, self.source) == (other.yaml, other.source)
@@ -149,7 +155,9 @@ class Result(_Trajectory):
     """What plan() returns: the maneuver's arrays (see below), how the solve ended and why.
 
     termination: "converged", "not_converged", "infeasible", "step_too_large", "timed_out",
-    "cancelled"; message: why; converged: termination == "converged"; summary: the JSON summary
+    "cancelled"; message: why; converged: termination == "converged"; cost [N^2 m^2], duration
+    T [s], minimum_duration T* [s] (0 unless minimum_time), solve_time_s: the summary's figures
+    of the same names; summary: the JSON summary
     of plan_maneuver --summary as a dict (cost, duration, minimum_duration, attempts, ...);
     attempts: summary["attempts"], the solves the planner ran. Arrays: t, quaternions (w, x, y,
     z), rotations, rates, torques, time_step. A Result pickles, and warm-starts a later plan()
@@ -158,16 +166,29 @@ class Result(_Trajectory):
 
     def __init__(self, arrays):
         self._take(arrays)
-        self.summary = json.loads(arrays["summary_json"])
         self.termination = arrays["termination"]
         self.message = arrays["message"]
+        for name in ("cost", "duration", "minimum_duration", "solve_time_s"):
+            setattr(self, name, arrays[name])  # the summary's numbers, without the JSON
+        self._plan_call_s = arrays["plan_call_s"]  # planManeuver's wall time (the benchmark's)
+        self._held = arrays["summary"]  # the C++ plan, until the summary is asked for
+        self._summary = None
+
+    @property
+    def summary(self):
+        """The JSON summary of plan_maneuver --summary, as a dict (written on first use)."""
+        if self._summary is None:
+            self._summary = json.loads(self._held.json())
+            self._held = None
+        return self._summary
+
+    def __getstate__(self):
+        state = dict(self.__dict__, _held=None)
+        state["_summary"] = self.summary
+        return state
 
     converged = property(lambda self: self.termination == "converged")
     attempts = property(lambda self: self.summary.get("attempts", []))
-    cost = property(lambda self: self.summary["cost"])
-    duration = property(lambda self: self.summary["duration"])
-    minimum_duration = property(lambda self: self.summary.get("minimum_duration"))
-    solve_time_s = property(lambda self: self.summary["solve_time_s"])
 
     def __repr__(self):
         return "Result(%s, N=%d, cost=%r)" % (self.termination, self.steps, self.cost)

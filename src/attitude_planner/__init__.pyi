@@ -35,21 +35,18 @@ class _Trajectory:
     def steps(self) -> int: ...
 
 class Result(_Trajectory):
-    summary: Dict[str, Any]
+    @property
+    def summary(self) -> Dict[str, Any]: ...
     termination: str
     message: str
     @property
     def converged(self) -> bool: ...
     @property
     def attempts(self) -> List[Dict[str, Any]]: ...
-    @property
-    def cost(self) -> float: ...
-    @property
-    def duration(self) -> float: ...
-    @property
-    def minimum_duration(self) -> Optional[float]: ...
-    @property
-    def solve_time_s(self) -> float: ...
+    cost: float
+    duration: float
+    minimum_duration: float
+    solve_time_s: float
 
 class Simulation(_Trajectory):
     max_step_residual: float

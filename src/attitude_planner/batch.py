@@ -134,11 +134,10 @@ def solve_row(job):
     except ap.InputError as e:
         row.update(termination="invalid_input", message=str(e))
     else:
-        summary = result.summary
         row.update(termination=result.termination, message=result.message,
-                   cost=_number(summary.get("cost")),
-                   minimum_duration=_number(summary.get("minimum_duration")),
-                   solve_time_s=_number(summary.get("solve_time_s")))
+                   cost=_number(result.cost),
+                   minimum_duration=_number(result.minimum_duration or None),
+                   solve_time_s=_number(result.solve_time_s))
     return row
 
 

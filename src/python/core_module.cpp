@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <utility>
@@ -85,6 +86,13 @@ ap::Scene plannableScene(const std::string& yaml_text, const std::string& source
   ap::requirePlannable(scene);
   return scene;
 }
+
+/// A plan's problem and result, kept for the JSON summary (io/report's planResultJson).
+struct HeldSummary {
+  ap::PlanningProblem problem;
+  ap::PlanResult result;
+  std::string json() const { return ap::planResultJson(problem, result); }
+};
 
 /// rows × columns array of doubles filled by fill(row, column).
 template <class Fill>
@@ -167,7 +175,8 @@ ap::Maneuver guessOf(const py::dict& warm) {
 }
 
 /// plan(): the parsed scene, the flags ("--steps" → "64", as plan_maneuver takes them) and an
-/// optional warm start → dict of arrays, summary_json, termination, message.
+/// optional warm start → dict of arrays, termination, message, the figures a table needs, summary
+/// (a HeldSummary: the JSON written on request), plan_call_s.
 py::dict plan(const ap::Scene& parsed,
               const std::vector<std::pair<std::string, std::string>>& flags,
               const py::object& warm) {
@@ -184,14 +193,24 @@ py::dict plan(const ap::Scene& parsed,
       options.warm_start = &guess;
     }
     ap::PlanResult result;
+    double call_s = 0.0;  // planManeuver's own wall time, for the overhead benchmark
     {
       py::gil_scoped_release released;  // other Python threads run during the solve
+      const auto start = std::chrono::steady_clock::now();
       result = ap::planManeuver(scene.problem, options);
+      call_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     py::dict out = maneuverArrays(result.maneuver);
-    out["summary_json"] = ap::planResultJson(scene.problem, result);
+    out["plan_call_s"] = call_s;
+    out["cost"] = result.cost;
+    out["duration"] = result.duration;
+    out["minimum_duration"] = result.minimum_duration;
+    out["solve_time_s"] = result.solve_time_s;
     out["termination"] = ap::terminationName(result.termination);
     out["message"] = result.message;
+    // The JSON summary is written when Python first asks for it (Result.summary): it costs as
+    // much as the rest of the call's overhead together, and a batch row needs three numbers.
+    out["summary"] = std::make_shared<HeldSummary>(HeldSummary{scene.problem, std::move(result)});
     return out;
   });
 }
@@ -251,6 +270,9 @@ PYBIND11_MODULE(_core, m) {
             [&] { return std::make_shared<ap::Scene>(plannableScene(yaml_text, source)); });
       },
       py::arg("yaml_text"), py::arg("source"), "Parses and checks a scene; raises InputError.");
+  py::class_<HeldSummary, std::shared_ptr<HeldSummary>>(m, "HeldSummary",
+                                                        "A plan's summary, written on request.")
+      .def("json", &HeldSummary::json, "The JSON summary of plan_maneuver --summary.");
   m.def("plan", &plan, py::arg("scene"), py::arg("flags"), py::arg("warm_start"),
         "Plans a scene (see attitude_planner.plan).");
   m.def("simulate", &simulate, py::arg("scene"), py::arg("torques"), py::arg("time_step"),

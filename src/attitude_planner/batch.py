@@ -133,6 +133,8 @@ def solve_row(job):
         row.update(termination="step_too_large", message=str(e))
     except ap.InputError as e:
         row.update(termination="invalid_input", message=str(e))
+    except Exception as e:  # noqa: BLE001 -- a row with the error, never a lost table
+        row.update(termination="not_converged", message="error: %s: %s" % (type(e).__name__, e))
     else:
         row.update(termination=result.termination, message=result.message,
                    cost=_number(result.cost),
@@ -182,10 +184,9 @@ class Table:
         os.replace(temporary, self.path)
 
 
-def _lost_row(job):
+def _lost_row(job, why="the worker running this solve was lost %d times" % MAX_WORKER_LOSSES):
     return {"from": job.row_from, "to": job.row_to, "termination": "not_converged", "cost": "",
-            "minimum_duration": "", "solve_time_s": "",
-            "message": "the worker running this solve was lost %d times" % MAX_WORKER_LOSSES}
+            "minimum_duration": "", "solve_time_s": "", "message": why}
 
 
 def _run_local(jobs, workers, done):
@@ -227,10 +228,15 @@ def _run_dask(jobs, scheduler, done):
     client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
     try:
         futures = client.map(solve_row, jobs, pure=False)
+        job_of = dict(zip(futures, jobs))
         for future in as_completed(futures):
-            row = future.result()
+            job = job_of[future]
+            try:
+                row = future.result()
+            except Exception as e:  # noqa: BLE001 -- e.g. KilledWorker: its workers kept dying
+                row = _lost_row(job, "error on the cluster: %s: %s" % (type(e).__name__, e))
             yield row
-            done.add((row["from"], row["to"]))
+            done.add(job.key)
     finally:
         if client is not scheduler:
             client.close()

@@ -14,8 +14,8 @@ import yaml
 
 import attitude_planner as ap
 from attitude_planner import batch
+from support import REPO, tool
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 BASE = {"inertia": [10, 12, 14], "steps": 16, "scheme": "second_order",
         "objective": "minimum_time", "constraints": [{"max_torque_norm": 1.0}]}
@@ -95,7 +95,7 @@ class LocalTables(unittest.TestCase):
         path = os.path.join(self.directory.name, "requests.yaml")
         with open(path, "w") as f:
             yaml.safe_dump(requests, f)
-        done = subprocess.run([tool_path("plan_batch"), path, "--out", self.out, "--workers", "2",
+        done = subprocess.run([tool("plan_batch"), path, "--out", self.out, "--workers", "2",
                                "--no-progress"], stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, universal_newlines=True)
         self.assertEqual(done.returncode, 0, done.stdout)
@@ -123,13 +123,6 @@ class LocalTables(unittest.TestCase):
         _, rows = read(self.out)
         self.assertEqual(len(killed), 1)
         self.assertEqual(comparable(rows), comparable(reference))
-
-
-def tool_path(name):
-    libexec = subprocess.run(["catkin_find", "--first-only", "--without-underlays", "--libexec",
-                              "attitude_planner"], stdout=subprocess.PIPE,
-                             universal_newlines=True, check=True).stdout.strip()
-    return os.path.join(libexec, name)
 
 
 class DaskCluster(unittest.TestCase):

@@ -19,19 +19,11 @@ import unittest
 import numpy as np
 
 import attitude_planner as ap
+from support import REPO, tool
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENES = os.path.join(REPO, "scenes")
 REST_TO_REST = os.path.join(SCENES, "rest_to_rest.yaml")
 MIN_TIME_SPHERE = os.path.join(SCENES, "min_time_sphere.yaml")
-
-
-def tool(name):
-    """The built command-line tool `name` (devel/lib/attitude_planner, found as rosrun finds it)."""
-    libexec = subprocess.run(["catkin_find", "--first-only", "--without-underlays", "--libexec",
-                              "attitude_planner"], stdout=subprocess.PIPE,
-                             universal_newlines=True, check=True).stdout.strip()
-    return os.path.join(libexec, name)
 
 
 def run_cli(scene, flags, directory):

@@ -12,7 +12,8 @@ foreach(tool_source ${AP_TOOL_SOURCES})
   list(APPEND AP_ROSRUN_EXECUTABLES ${tool_name})
 endforeach()
 # (catkin's run_tests.py runs each COMMAND argument as one shell command line: one string each.)
-string(REPLACE ";" " " AP_ROSRUN_EXECUTABLES_TEXT "${AP_ROSRUN_EXECUTABLES}")
+# plan_batch is a Python tool (catkin_install_python): offered, but not a build target.
+string(REPLACE ";" " " AP_ROSRUN_EXECUTABLES_TEXT "${AP_ROSRUN_EXECUTABLES};plan_batch")
 catkin_run_tests_target(packaging rosrun_offers packaging-rosrun_offers.xml
   COMMAND "${PYTHON_EXECUTABLE} ${AP_PACKAGING_DIR}/rosrun_offers.py --results ${AP_PACKAGING_RESULTS}/packaging-rosrun_offers.xml --expect ${AP_ROSRUN_EXECUTABLES_TEXT}"
   DEPENDENCIES ${AP_ROSRUN_EXECUTABLES})

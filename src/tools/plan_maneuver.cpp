@@ -3,7 +3,6 @@
 // planDriftTwoInput() (system: drift_two_input, seed 001), prints a summary and writes the
 // trajectory CSV / JSON summary. Exit status: 0 converged, 1 not converged or invalid input,
 // 2 usage error.
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +14,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/csv.hpp"
+#include "attitude_planner/io/plan_flags.hpp"
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -89,37 +89,6 @@ struct InvalidFlagValue {
   std::string message;
 };
 
-/// Runs a core name check on a flag's value: a refused name is a bad flag value (exit 1).
-template <class Check>
-void checkFlagValue(const Check& check) {
-  try {
-    check();
-  } catch (const ap::InvalidInput& e) {
-    throw InvalidFlagValue{e.what()};
-  }
-}
-
-int parseInt(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  errno = 0;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || v > 2147483647L ||
-      v < -2147483647L) {
-    throw InvalidFlagValue{flag + ": expected an integer, got '" + text + "'"};
-  }
-  return static_cast<int>(v);
-}
-
-double parseDouble(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v)) {
-    throw InvalidFlagValue{flag + ": expected a finite number, got '" + text + "'"};
-  }
-  return v;
-}
-
 /// "p1,p2,p3" → the three finite numbers.
 ap::Vector3 parseCostate(const std::string& text) {
   ap::Vector3 p;
@@ -130,7 +99,12 @@ ap::Vector3 parseCostate(const std::string& text) {
       throw InvalidFlagValue{"--initial-costate: expected P1,P2,P3 (three numbers), got '" + text +
                              "'"};
     }
-    p(i) = parseDouble("--initial-costate", text.substr(start, comma - start));
+    const std::string number = text.substr(start, comma - start);
+    char* end = nullptr;
+    p(i) = std::strtod(number.c_str(), &end);
+    if (number.empty() || end != number.c_str() + number.size() || !std::isfinite(p(i))) {
+      throw InvalidFlagValue{"--initial-costate: expected a finite number, got '" + number + "'"};
+    }
     start = comma + 1;
   }
   return p;
@@ -138,22 +112,9 @@ ap::Vector3 parseCostate(const std::string& text) {
 
 struct Arguments {
   std::string scene;
-  std::optional<int> steps;  ///< absent: the scene's
-  std::string scheme;
-  std::string solver = "newton";
-  bool solver_given = false;  ///< --solver was on the command line
-  std::string precision = "auto";
+  ap::PlanFlags flags;          ///< the planning flags (io/plan_flags.hpp)
   std::string initial_costate;  ///< --initial-costate text, "" if absent
-  double tolerance = -1.0;      ///< < 0: the default
-  int max_iterations = -1;      ///< < 0: the default
-  double time_budget = 0.0;
-  std::string target_flag;     ///< "--target-miss" / "--target-cost-error", "" if absent
-  double target_value = 0.0;   ///< its value (> 0)
-  std::string objective;       ///< "" : the scene's
-  double time_margin = -1.0;   ///< < 0: the scene's
-  std::string direction;       ///< "" : the scene's
-  int extra_revolutions = -1;  ///< < 0: the scene's
-  std::string warm_start;      ///< --warm-start PLAN.csv, "" if absent
+  std::string warm_start;       ///< --warm-start PLAN.csv, "" if absent
   std::string csv;
   std::string summary;
   bool help = false;
@@ -163,59 +124,16 @@ struct Arguments {
 template <class NextValue>
 void applyOption(const std::string& arg, const NextValue& next, Arguments* out) {
   Arguments& a = *out;
-  std::string value_text;  // a flag's value as typed, for messages
-  if (arg == "--steps") {
-    // Its range is the planner's rule (validateProblem / planDriftTwoInput), checked there.
-    a.steps = parseInt(arg, next());
-  } else if (arg == "--scheme") {
-    a.scheme = next();
-    ap::PlanningProblem checked;
-    checkFlagValue([&] { ap::applySchemeName(a.scheme, arg, &checked); });
-  } else if (arg == "--solver") {
-    a.solver = next();
-    a.solver_given = true;
-    checkFlagValue([&] { ap::parseSolver(a.solver, arg); });
-  } else if (arg == "--precision") {
-    a.precision = next();
-    checkFlagValue([&] { ap::parsePrecision(a.precision, arg); });
-  } else if (arg == "--tolerance") {
-    value_text = next();
-    a.tolerance = parseDouble(arg, value_text);
-    if (!(a.tolerance > 0.0)) throw InvalidFlagValue{"--tolerance: must be > 0, got " + value_text};
-  } else if (arg == "--max-iterations") {
-    a.max_iterations = parseInt(arg, next());
-    if (a.max_iterations < 1) {
-      throw InvalidFlagValue{"--max-iterations: must be >= 1, got " +
-                             std::to_string(a.max_iterations)};
+  if (ap::isPlanFlag(arg)) {
+    if ((arg == "--target-miss" || arg == "--target-cost-error") && !a.flags.target_flag.empty()) {
+      throw UsageError{arg + ": only one target (" + a.flags.target_flag + " was given)"};
     }
-  } else if (arg == "--time-budget") {
-    value_text = next();
-    a.time_budget = parseDouble(arg, value_text);
-    if (!(a.time_budget > 0.0))
-      throw InvalidFlagValue{"--time-budget: must be > 0 s, got " + value_text};
-  } else if (arg == "--target-miss" || arg == "--target-cost-error") {
-    if (!a.target_flag.empty()) {
-      throw UsageError{arg + ": only one target (" + a.target_flag + " was given)"};
+    const std::string value = next();
+    try {
+      ap::applyPlanFlag(arg, value, &a.flags);
+    } catch (const ap::InvalidInput& e) {
+      throw InvalidFlagValue{e.what()};
     }
-    a.target_flag = arg;
-    const std::string text = next();
-    a.target_value = parseDouble(arg, text);
-    if (!(a.target_value > 0.0)) throw InvalidFlagValue{arg + ": must be > 0, got " + text};
-  } else if (arg == "--objective") {
-    a.objective = next();
-    checkFlagValue([&] { ap::parseObjective(a.objective, arg); });
-  } else if (arg == "--time-margin") {
-    value_text = next();
-    a.time_margin = parseDouble(arg, value_text);
-    if (!(a.time_margin >= 0.0) || !std::isfinite(a.time_margin)) {
-      throw InvalidFlagValue{"--time-margin: must be a finite number >= 0, got " + value_text};
-    }
-  } else if (arg == "--direction") {
-    a.direction = next();
-    checkFlagValue([&] { ap::parseDirection(a.direction, arg); });
-  } else if (arg == "--extra-revolutions") {
-    a.extra_revolutions = parseInt(arg, next());
-    checkFlagValue([&] { ap::requireExtraRevolutions(a.extra_revolutions, arg); });
   } else if (arg == "--initial-costate") {
     a.initial_costate = next();
     parseCostate(a.initial_costate);  // checked here: a bad value, exit status 1
@@ -261,19 +179,19 @@ Arguments parseArguments(int argc, char** argv) {
     applyOption(arg, next, &a);
   }
   if (!a.help && a.scene.empty()) throw UsageError{"missing SCENE.yaml"};
-  if (!a.target_flag.empty() && a.steps) {
-    throw UsageError{a.target_flag + " chooses N: do not give --steps with it"};
-  }
-  if (a.scheme == ap::kAutoSchemeName && a.target_flag.empty()) {
-    throw UsageError{"--scheme auto needs --target-miss or --target-cost-error"};
+  try {
+    ap::checkPlanFlagCombination(a.flags);
+  } catch (const ap::InvalidInput& e) {
+    throw UsageError{e.what()};
   }
   return a;
 }
 
 /// The drift + two-input path of main (seed 001): same flags where they apply, same exit codes.
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
-  if (!args.scheme.empty() || args.solver_given || !args.target_flag.empty() ||
-      !args.direction.empty() || args.extra_revolutions >= 0 || !args.warm_start.empty()) {
+  const ap::PlanFlags& flags = args.flags;
+  if (!flags.scheme.empty() || flags.solver_given || !flags.target_flag.empty() ||
+      !flags.direction.empty() || flags.extra_revolutions >= 0 || !args.warm_start.empty()) {
     std::cerr << "plan_maneuver: --scheme, --solver, --direction, "
                  "--extra-revolutions, --warm-start and --target-* apply to system: rigid_body "
                  "only (this "
@@ -282,10 +200,10 @@ int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
     return 2;
   }
   ap::DriftTwoInputRequest request = ap::driftTwoInputRequest(scene);
-  if (args.steps) request.steps = *args.steps;
-  if (args.tolerance > 0.0) request.tolerance = args.tolerance;
-  if (args.max_iterations > 0) request.max_iterations = args.max_iterations;
-  request.time_budget_s = args.time_budget;
+  if (flags.steps) request.steps = *flags.steps;
+  if (flags.tolerance > 0.0) request.tolerance = flags.tolerance;
+  if (flags.max_iterations > 0) request.max_iterations = flags.max_iterations;
+  request.time_budget_s = flags.time_budget;
   if (!args.initial_costate.empty()) request.initial_costate = parseCostate(args.initial_costate);
 
   const auto start = std::chrono::steady_clock::now();
@@ -337,28 +255,8 @@ int main(int argc, char** argv) {
     }
     ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
     ap::PlanningProblem& problem = scene.problem;
-    if (args.steps) problem.steps = *args.steps;
-    if (!args.scheme.empty()) ap::applySchemeName(args.scheme, "--scheme", &problem);
-    if (!args.target_flag.empty()) {
-      problem.accuracy.measure = args.target_flag == "--target-miss"
-                                     ? ap::AccuracyMeasure::TerminalMiss
-                                     : ap::AccuracyMeasure::CostError;
-      problem.accuracy.value = args.target_value;
-    }
-    if (!args.objective.empty()) {
-      problem.objective = ap::parseObjective(args.objective, "--objective");
-    }
-    if (args.time_margin >= 0.0) problem.time_margin = args.time_margin;
-    if (!args.direction.empty())
-      problem.direction = ap::parseDirection(args.direction, "--direction");
-    if (args.extra_revolutions >= 0) problem.extra_revolutions = args.extra_revolutions;
-
     ap::SolverOptions options;
-    options.solver = ap::parseSolver(args.solver, "--solver");
-    options.precision = ap::parsePrecision(args.precision, "--precision");
-    if (args.tolerance > 0.0) options.tolerance = args.tolerance;
-    if (args.max_iterations > 0) options.max_iterations = args.max_iterations;
-    options.time_budget_s = args.time_budget;
+    ap::applyPlanFlags(args.flags, &problem, &options);
     ap::Maneuver guess;
     if (!args.warm_start.empty()) {
       try {

@@ -28,9 +28,7 @@ namespace st = attitude_planner::study;
 namespace {
 
 std::string g(double v, const char* format = "%.4g") {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
+  return st::formatted(v, format);
 }
 
 struct Options {

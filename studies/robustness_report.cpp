@@ -34,9 +34,7 @@ namespace {
 using attitude_planner::study::loadAverage;
 
 std::string g(double v, const char* format = "%.3g") {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
+  return attitude_planner::study::formatted(v, format);
 }
 
 /// Text for a markdown table cell: pipes escaped, one line.

@@ -22,6 +22,13 @@ inline double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/// `v` printed with the printf `format` (e.g. "%.3g").
+inline std::string formatted(double v, const char* format) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
+
 /// The 1, 5 and 15 min load averages, "%.2f %.2f %.2f" (−1 each if /proc/loadavg is unreadable).
 inline std::string loadAverage() {
   double a[3] = {-1, -1, -1};

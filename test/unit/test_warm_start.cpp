@@ -1,4 +1,4 @@
-// Warm starts (issue 30, item 4): re-planning from a state on a plan with the plan's remainder as
+// Warm starts: re-planning from a state on a plan with the plan's remainder as
 // the initial guess recovers the remainder (the target: its cost to 1e-8 in ≤ 2 iterations), a
 // warm-started re-plan stays in the guess's homotopy class, guesses of another N are resampled,
 // guesses that only start are not refused while malformed ones are (naming the field and the

@@ -229,9 +229,8 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
 constexpr double kProbeBelow = 0.01;
 constexpr int kMaxProbes = 4;
 
-/// Minimum time with spinning ends has local minima that the structured starts miss (issue 45:
-/// from the geodesic alone T* was 3 % to over 11 % too long on random problems, a minimum-effort
-/// plan existing just below it). So a free-time answer with spinning ends is probed: a cold
+/// Minimum time with spinning ends has local minima that the structured starts miss, with a
+/// minimum-effort plan just below their T* (docs/results/bounded_verdicts.md). So a free-time answer with spinning ends is probed: a cold
 /// minimum-effort solve at (1 − kProbeBelow) T*; where it proves that T feasible
 /// (provesFeasible), the free-time solve from its plan descends to a lower KKT point, which is
 /// probed again. A probe that finds nothing ends it; the trail keeps every probe.

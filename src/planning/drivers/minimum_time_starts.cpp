@@ -72,8 +72,8 @@ constexpr HomotopyClass kSpinningStartClasses[] = {{false, 0}, {true, 0}, {false
 /// Spinning ends: the geodesic (geodesicStart), the rate-honouring Hermite curves to the lifts of
 /// kSpinningStartClasses and the coasting start (the torque-free motions from both ends,
 /// blended), all at the eigenaxis guess. Minimum time with spinning ends has local minima in
-/// several classes: from the geodesic alone T* was 3 % to over 11 % too long on 2 of 10 random
-/// problems (issue 45). The watch stops the starts that cannot beat the least T found.
+/// several classes, which one geodesic start misses (docs/results/bounded_verdicts.md). The
+/// watch stops the starts that cannot beat the least T found.
 std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem) {
   std::vector<FreeTimeStart> starts{geodesicStart(problem)};
   PlanningProblem at = problem;

@@ -54,6 +54,17 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
+/// The attempts of a plan, one line each (for --only).
+std::string trailOf(const ap::PlanResult& r) {
+  std::ostringstream out;
+  for (const ap::Attempt& a : r.attempts) {
+    out << "  " << ap::attemptStageName(a.stage) << " " << ap::attemptStartName(a.start)
+        << " N=" << a.steps << " " << ap::terminationName(a.termination) << " it=" << a.iterations
+        << " cost=" << a.cost << (a.kept ? " kept" : "") << "\n";
+  }
+  return out.str();
+}
+
 /// The suite: one row per request, and the counts by outcome and by what was found wrong.
 std::string suiteSection(const Options& o) {
   std::ostringstream rows, out;
@@ -83,6 +94,7 @@ std::string suiteSection(const Options& o) {
                              : "**" + c.wrong + "**")
          << " | " << g(c.seconds, "%.3f") << " |\n";
     std::cerr << i << " " << outcome << " " << c.wrong << " " << g(c.seconds, "%.2f") << " s\n";
+    if (o.only >= 0) std::cerr << c.result.message << "\n" << trailOf(c.result);
   }
   out << "## The seeded suite (seed " << o.seed << ", " << requests << " requests; " << skipped
       << " drawn cases skipped: their unbounded plan did not converge)\n\n";

@@ -15,6 +15,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
@@ -182,13 +183,13 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
 
 namespace {
 
-/// A spinning request under a torque-norm bound at 0.7x its unconstrained plan's peak (case 1 of
-/// the seeded random suite, seed 5005), paper at N = 128, where no structured free-time start
-/// converges (the geodesic, the four classes' Hermite curves, the coasting start) and the search
-/// answers. (The former case, 13 of scripts/extremal_classes.py's suite, is now answered by a
-/// class's Hermite start.)
+/// A spinning request under a torque-norm bound at 0.7x its unconstrained plan's peak (case 18 of
+/// the seeded random suite, seed 5006), paper at N = 128, where no structured free-time start
+/// converges (the four classes' unconstrained optima, the geodesic, the coasting start) and the
+/// search answers. Found by a scan of the suite: the structured starts answer most such requests
+/// (cases of earlier versions of this test moved to them, see the CHANGELOG).
 ap::PlanningProblem searchAnswersCase() {
-  ap::PlanningProblem p = ap::robustness::randomCase(5005, 1).problem;
+  ap::PlanningProblem p = ap::robustness::randomCase(5006, 18).problem;
   p.scheme = ap::SchemeKind::Paper;
   p.steps = 128;
   const ap::PlanResult unconstrained = ap::planManeuver(p);
@@ -254,7 +255,10 @@ TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBefor
   const ap::Attempt& from_search = *last_probe;
   EXPECT_EQ(from_search.stage, ap::AttemptStage::MinimumTimeSolve);
   EXPECT_EQ(from_search.start, ap::AttemptStart::PreviousAttempt);
-  EXPECT_GE(from_search.start_detail.duration, r.minimum_duration);
+  // At or below the search's T, to the search's tolerance (a KKT point a rounding above it is the
+  // same answer, sharpened).
+  EXPECT_GE(from_search.start_detail.duration * (1 + ap::kMinimumTimeTolerance),
+            r.minimum_duration);
   // After it only the probes below T* (spinning ends: probedBelow's minimum-effort solves and the
   // free-time solves from their plans); the kept attempt is the solve from the search's plan or
   // one of those free-time solves, and it is the only one kept.

@@ -11,17 +11,16 @@
 // by 2 at a time up to N (each level from the coarser answer's rates interpolated in time). Each
 // start's solve is stopped where it can no longer end below the least T so far, or where it
 // joins an earlier start's central path. The least T is kept; its free-time plan is the answer
-// (the switching functions from its bound multipliers). With cones each start is first made to clear them (a minimum-effort plan under
-// the cones tightened by 0.01 rad). T* is a KKT point of the discrete minimum-time problem, its
-// residuals in PlanResult::minimum_time; with effects too (their time t_k = k h moves with h).
-// fourth_order is not written in h yet: for it (or if no free-time solve converges) the former
-// search answers
-// — several starts, each a continuation down in T over minimum-effort solves warm-started from the
-// last feasible plan and a bisection to kMinimumTimeTolerance; its T* is the least duration found
-// feasible, an upper bound (minimum_time.kkt_point false). Where the free-time problem applies,
-// the search's plan (feasible at its T) then starts one more free-time solve, and a KKT point at
-// or below the search's T is the answer if it converges. docs/results/minimum_time.md has the
-// figures.
+// (the switching functions from its bound multipliers). With cones each start is first made to
+// clear them (a minimum-effort plan under the cones tightened by 0.01 rad). T* is a KKT point of
+// the discrete minimum-time problem, its residuals in PlanResult::minimum_time; with effects too
+// (their time t_k = k h moves with h). fourth_order is not written in h yet: for it (or if no
+// free-time solve converges) the former search answers — several starts, each a continuation down
+// in T over minimum-effort solves warm-started from the last feasible plan and a bisection to
+// kMinimumTimeTolerance; its T* is the least duration found feasible, an upper bound
+// (minimum_time.kkt_point false). Where the free-time problem applies, the search's plan (feasible
+// at its T) then starts one more free-time solve, and a KKT point at or below the search's T is the
+// answer if it converges. docs/results/minimum_time.md has the figures.
 #pragma once
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
@@ -46,7 +45,13 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options);
 
 /// A duration at which an eigenaxis bang–bang slew would need the smallest authority of the
-/// bounds in force (the first guess when the problem gives none) [s].
+/// bounds in force, boundary rates shed and gained at that authority (the first guess when the
+/// problem gives none) [s]: never below the proven lower bound (durationLowerBound), and with
+/// spinning ends at most representableDuration unless that is below the proven bound.
 double eigenaxisDurationGuess(const PlanningProblem& problem);
+
+/// The longest T at which the grid's boundary steps turn at most 1 rad at the boundary rates
+/// (infinity at rest): a start longer than this may have no boundary step at all [s].
+double representableDuration(const PlanningProblem& problem);
 
 }  // namespace attitude_planner

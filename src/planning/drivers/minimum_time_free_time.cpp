@@ -8,8 +8,10 @@
 #include <utility>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/problem/duration_bound.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -101,7 +103,7 @@ class FreeTimeMinimumTime {
     const bool rest_to_rest =
         problem_.initial_velocity.isZero(0.0) && problem_.final_velocity.isZero(0.0) &&
         so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
-    const std::vector<PlanningProblem> levels = gridLevels(problem_, freeTimeGridRule());
+    const std::vector<PlanningProblem> levels = freeTimeLevels(problem_);
     const PlanningProblem& coarsest = levels.front();
     int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
     // Saddles are left where cones are present: without them the excursion axes reach the least
@@ -134,7 +136,12 @@ class FreeTimeMinimumTime {
     const FreeTimeOutcome o =
         solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt, detail);
     recordStart(plan.attitude, duration, name, o, -1);
-    if (o.termination != Termination::Converged || o.duration > duration) return std::nullopt;
+    // The plan's T is known to the search's tolerance: a KKT point a rounding above it is the
+    // same answer, sharpened (measured: 2.4e-11 relative above).
+    if (o.termination != Termination::Converged ||
+        o.duration > duration * (1.0 + kMinimumTimeTolerance)) {
+      return std::nullopt;
+    }
     best_attempt_ = trail_.size() - 1;
     levels_ = levelResult(problem_.steps, o).levels;
     return answerAt(o, name);
@@ -529,6 +536,15 @@ GridLevelRule freeTimeGridRule() {
   rule.coarse_tolerance_floor = 0.0;
   rule.unconverged_ends = true;
   return rule;
+}
+
+std::vector<PlanningProblem> freeTimeLevels(const PlanningProblem& problem) {
+  std::vector<PlanningProblem> levels = gridLevels(problem, freeTimeGridRule());
+  const double least = durationLowerBound(problem).seconds;
+  while (levels.size() > 1 && representableDuration(levels.front()) < least) {
+    levels.erase(levels.begin());
+  }
+  return levels;
 }
 
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,

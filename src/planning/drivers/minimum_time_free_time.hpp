@@ -1,8 +1,8 @@
 // Minimum time as one free-time interior-point problem per start (drivers/minimum_time.cpp's
 // answer where it applies): the structured starts (minimum_time_starts.hpp) solved on the
 // coarsest level of the free-time grid continuation, the least T kept and carried through the
-// finer levels (strategies/grid_continuation.hpp); its free-time plan is the answer. T* is a KKT point of the discrete minimum-time problem
-// (interior_point/free_time_solver.hpp).
+// finer levels (strategies/grid_continuation.hpp); its free-time plan is the answer. T* is a KKT
+// point of the discrete minimum-time problem (interior_point/free_time_solver.hpp).
 #pragma once
 
 #include <optional>
@@ -25,6 +25,12 @@ constexpr int kFreeTimeStartGrid = 64;
 /// continuation with no answer (a fresh start there would be another attempt; the caller falls
 /// back to the search).
 GridLevelRule freeTimeGridRule();
+
+/// The grid levels a free-time solve continues over (freeTimeGridRule), less the coarse ones
+/// whose boundary steps would turn more than representableDuration allows at the proven least
+/// duration (durationLowerBound): a start there has no boundary step, so the continuation starts
+/// on the first grid that has one.
+std::vector<PlanningProblem> freeTimeLevels(const PlanningProblem& problem);
 
 /// The free-time answer on a coarser grid carried to grid p at its T: the coarse rates
 /// interpolated in time (ReducedProblem::initializeFromCoarser), so the torques stay near the

@@ -1,6 +1,9 @@
 #include "planning/drivers/minimum_time_search.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -83,7 +86,14 @@ class MinimumTimeSearch {
       o.warm_start = warm;
       o.constrained_from_warm_start = true;
     }
-    PlanResult r = planAtResolution(effort_, o);
+    PlanResult r;
+    try {
+      r = planAtResolution(effort_, o);
+    } catch (const StepTooLarge&) {  // no boundary step on this grid at T: nothing shown at T
+      ++out->solves;
+      unrepresentable_from_ = std::min(unrepresentable_from_, T);
+      return false;
+    }
     ++out->solves;
     out->iterations += r.iterations;
     if (r.termination == Termination::TimedOut || r.termination == Termination::Cancelled) {
@@ -107,7 +117,7 @@ class MinimumTimeSearch {
       return tryDuration(T, out.feasible ? &out.best.maneuver : from, &out);
     };
     double T = T_first;
-    for (int doublings = 0; !feasible(T) && !stopped(); T *= 2.0) {
+    for (int doublings = 0; !feasible(T) && !stopped() && T < unrepresentable_from_; T *= 2.0) {
       if (++doublings > kMaxDoublings) return out;
     }
     if (!out.feasible) return out;
@@ -224,6 +234,14 @@ class MinimumTimeSearch {
     if (stopped_) {
       none.termination = *stopped_;
       none.message = terminationName(*stopped_) + " before any duration was found feasible";
+    } else if (std::isfinite(unrepresentable_from_)) {
+      // Longer plans are not shown infeasible: this grid cannot hold them.
+      none.termination = Termination::StepTooLarge;
+      none.message =
+          "step too large, increase steps: no plan was found below T = " +
+          exactNumber(unrepresentable_from_) + " s, and from there on one step of " +
+          exactNumber(unrepresentable_from_ / problem_.steps) +
+          " s at the boundary rates has no solution (N = " + std::to_string(problem_.steps) + ")";
     } else {
       none.termination = Termination::Infeasible;
       none.message = "infeasible: no duration up to 2^" + std::to_string(kMaxDoublings) +
@@ -307,6 +325,8 @@ class MinimumTimeSearch {
   PlanningProblem effort_;
   std::vector<SearchOutcome> outcomes_;
   std::optional<Termination> stopped_;
+  /// The least T at which this grid had no boundary step (tryDuration); infinity: none.
+  double unrepresentable_from_ = std::numeric_limits<double>::infinity();
   double coarse_minimum_duration_ = 0.0;
   int solves_ = 0;
 };

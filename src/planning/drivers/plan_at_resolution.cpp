@@ -235,9 +235,15 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     try {
       replayFigures(problem, &result);
     } catch (const StepTooLarge& e) {
-      result.termination = Termination::StepTooLarge;
-      result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
-                       result.message + ")";
+      // Only a converged plan's failed replay is the verdict; an iterate that is no answer
+      // (infeasible, stopped) keeps its own, with the replay's failure said after it.
+      if (result.converged()) {
+        result.termination = Termination::StepTooLarge;
+        result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
+                         result.message + ")";
+      } else {
+        result.message += std::string("; its last iterate's torques do not replay: ") + e.what();
+      }
     }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);

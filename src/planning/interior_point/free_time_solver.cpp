@@ -139,23 +139,41 @@ class FreeTimeSolver {
         h0_ = np_.timeStep();
         return "";
       }
-      if (allow_elastic_ &&
-          np_.timeStep() * parameters_.free_time_start_growth > kLargestRaise * h_start) {
-        // The elastic start at the start's own T: c_i + θ ≥ 0 with θ holding the start margin.
-        np_.setTimeStep(h_start);
-        np_.setCurrent(steps_start);
-        h0_ = h_start;
-        elastic_ = started_elastic_ = true;
-        theta_ = parameters_.free_time_start_margin - smallestValue(np_.current(), true);
-        rho_ = kElasticPenalty;
-        return "";
+      const double raised = np_.timeStep() * parameters_.free_time_start_growth;
+      if (allow_elastic_ && raised > kLargestRaise * h_start) {
+        return startElastic(h_start, steps_start);
       }
-      np_.setTimeStep(np_.timeStep() * parameters_.free_time_start_growth);
+      if (!raisedTo(raised)) {
+        if (allow_elastic_) return startElastic(h_start, steps_start);
+        return "no strictly feasible start: at T = " + std::to_string(raised * N_) +
+               " s the boundary rates admit no step before the constraints hold";
+      }
     }
     return "no strictly feasible start: the constraints still fail at " +
            std::to_string(std::pow(parameters_.free_time_start_growth,
                                    parameters_.free_time_max_start_growths)) +
            " times the start's duration";
+  }
+
+  /// The elastic start at the start's own T: c_i + θ ≥ 0 with θ holding the start margin.
+  std::string startElastic(double h_start, const ReducedProblem::StepVectors& steps_start) {
+    np_.setTimeStep(h_start);
+    np_.setCurrent(steps_start);
+    h0_ = h_start;
+    elastic_ = started_elastic_ = true;
+    theta_ = parameters_.free_time_start_margin - smallestValue(np_.current(), true);
+    rho_ = kElasticPenalty;
+    return "";
+  }
+
+  /// h raised for the start; false (h unchanged) where the boundary rates admit no step at it.
+  bool raisedTo(double h) {
+    try {
+      np_.setTimeStep(h);
+      return true;
+    } catch (const StepTooLarge&) {
+      return false;
+    }
   }
 
   FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options,

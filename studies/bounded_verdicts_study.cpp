@@ -7,9 +7,11 @@
 // (scripts/bounded_verdicts).
 //
 //   bounded_verdicts_study [--count K] [--seed S] [--out FILE] [--only I]
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -65,50 +67,76 @@ std::string trailOf(const ap::PlanResult& r) {
   return out.str();
 }
 
-/// The suite: one row per request, and the counts by outcome and by what was found wrong.
-std::string suiteSection(const Options& o) {
-  std::ostringstream rows, out;
+/// The suite's rows so far and their counts by outcome and by what was found wrong.
+struct SuiteTally {
+  std::ostringstream rows;
   std::map<std::string, int> outcomes, wrong;
-  int requests = 0, skipped = 0, input_errors = 0;
+  int drawn = 0, requests = 0, skipped = 0, input_errors = 0;
   std::vector<double> times;
-  for (int i = 0; i < o.count; ++i) {
-    if (o.only >= 0 && i != o.only) continue;
-    const std::optional<rb::BoundedRequest> request = rb::boundedRequest(o.seed, i);
-    if (request && o.only >= 0) std::cerr << request->label << "\n";
-    if (!request) {
-      ++skipped;
-      continue;
-    }
-    ++requests;
-    const rb::VerdictCheck c = rb::planAndCheck(*request);
+
+  void add(int i, const rb::BoundedRequest& request, const rb::VerdictCheck& c) {
     const std::string outcome = rb::outcomeName(c);
+    ++requests;
     ++outcomes[outcome];
     if (!c.input_error.empty()) ++input_errors;
     if (!c.wrong.empty()) ++wrong[c.wrong];
     times.push_back(c.seconds);
     const ap::DurationVerdict& v = c.result.duration_verdict;
-    rows << "| " << i << " | " << request->label << " | " << outcome << " | "
-         << g(request->problem.duration) << " | " << g(v.lower_bound) << " | "
+    rows << "| " << i << " | " << request.label << " | " << outcome << " | "
+         << g(request.problem.duration) << " | " << g(v.lower_bound) << " | "
          << g(v.least_duration_found) << " | " << g(c.result.minimum_duration) << " | "
          << (c.wrong.empty() ? (c.input_error.empty() ? "ok" : c.input_error)
                              : "**" + c.wrong + "**")
          << " | " << g(c.seconds, "%.3f") << " |\n";
-    std::cerr << i << " " << outcome << " " << c.wrong << " " << g(c.seconds, "%.2f") << " s\n";
-    if (o.only >= 0) std::cerr << c.result.message << "\n" << trailOf(c.result);
   }
-  out << "## The seeded suite (seed " << o.seed << ", " << requests << " requests; " << skipped
-      << " drawn cases skipped: their unbounded plan did not converge)\n\n";
-  out << "| outcome | requests |\n|---|---|\n";
-  for (const auto& [name, n] : outcomes) out << "| " << name << " | " << n << " |\n";
-  out << "\nInternal errors reported as input errors: **" << input_errors << "**. Verdicts found "
-      << "wrong by the independent check:";
-  if (wrong.empty()) out << " **none**";
-  for (const auto& [name, n] : wrong) out << " " << name << ": **" << n << "**;";
-  out << "\n\nMedian wall time per request " << g(st::median(times), "%.3f") << " s.\n\n";
-  out << "| # | request | outcome | T [s] | proven T_c [s] | least T found [s] | T* [s] | check | "
-         "wall [s] |\n|---|---|---|---|---|---|---|---|---|\n"
-      << rows.str();
-  return out.str();
+
+  /// The section; `count` the requests asked for (fewer drawn so far: a run still going, or
+  /// stopped, says so).
+  std::string render(const Options& o) const {
+    std::ostringstream out;
+    out << "## The seeded suite (seed " << o.seed << ", " << requests << " requests; " << skipped
+        << " drawn cases skipped: their unbounded plan did not converge)\n\n";
+    if (drawn < o.count && o.only < 0) {
+      out << "**Partial: " << drawn << " of the " << o.count
+          << " requests asked for were drawn when this page was written** (the study rewrites it "
+             "after each request; a run stopped early leaves this).\n\n";
+    }
+    out << "| outcome | requests |\n|---|---|\n";
+    for (const auto& [name, n] : outcomes) out << "| " << name << " | " << n << " |\n";
+    out << "\nInternal errors reported as input errors: **" << input_errors
+        << "**. Verdicts found wrong by the independent check:";
+    if (wrong.empty()) out << " **none**";
+    for (const auto& [name, n] : wrong) out << " " << name << ": **" << n << "**;";
+    const double longest = times.empty() ? 0.0 : *std::max_element(times.begin(), times.end());
+    out << "\n\nWall time per request: median " << g(st::median(times), "%.3f") << " s, longest "
+        << g(longest, "%.1f") << " s.\n\n";
+    out << "| # | request | outcome | T [s] | proven T_c [s] | least T found [s] | T* [s] | check "
+           "| wall [s] |\n|---|---|---|---|---|---|---|---|---|\n"
+        << rows.str();
+    return out.str();
+  }
+};
+
+/// The suite, request by request; `written` gets the section after each request.
+void runSuite(const Options& o, const std::function<void(const std::string&)>& written) {
+  SuiteTally tally;
+  for (int i = 0; i < o.count; ++i) {
+    if (o.only >= 0 && i != o.only) continue;
+    ++tally.drawn;
+    const std::optional<rb::BoundedRequest> request = rb::boundedRequest(o.seed, i);
+    if (request && o.only >= 0) std::cerr << request->label << "\n";
+    if (!request) {
+      ++tally.skipped;
+      continue;
+    }
+    const rb::VerdictCheck c = rb::planAndCheck(*request);
+    tally.add(i, *request, c);
+    std::cerr << i << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
+              << " s\n";
+    if (o.only >= 0) std::cerr << c.result.message << "\n" << trailOf(c.result);
+    written(tally.render(o));
+  }
+  written(tally.render(o));
 }
 
 /// One special request: its outcome and wall time (an exception is an outcome too).
@@ -164,18 +192,18 @@ std::string specialSection() {
 
 int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
-  std::ostringstream page;
-  page << "# Honest verdicts on bounded requests\n\nGenerated by `scripts/bounded_verdicts` "
+  std::ostringstream head;
+  head << "# Honest verdicts on bounded requests\n\nGenerated by `scripts/bounded_verdicts` "
           "(studies/bounded_verdicts_study.cpp; `--count "
        << o.count << " --seed " << o.seed << "`), load average " << st::loadAverage()
        << ". What each check means: test/support/bounded_requests.hpp; the design: "
           "docs/design/planner_behaviour.md#verdicts-on-durations.\n\n"
-       << specialSection() << "\n"
-       << suiteSection(o);
-  if (o.out.empty()) {
-    std::cout << page.str();
-  } else {
-    std::ofstream(o.out) << page.str();
-  }
+       << specialSection() << "\n";
+  std::string last;
+  runSuite(o, [&](const std::string& suite) {
+    last = head.str() + suite;
+    if (!o.out.empty()) std::ofstream(o.out) << last;
+  });
+  if (o.out.empty()) std::cout << last;
   return 0;
 }

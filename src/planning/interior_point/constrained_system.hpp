@@ -3,7 +3,7 @@
 //   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i)
 // assembled at the current iterate in O(N) (interior_point_solver.cpp's header comment derives
 // it). Each constraint is stage-local: g_i lives on at most three consecutive nodes, so g_i g_iᵀ
-// keeps the unconstrained Hessian's band (half bandwidth 8).
+// keeps the unconstrained Hessian's band (half bandwidth ReducedProblem::kHalfBandwidth).
 #pragma once
 
 #include <vector>

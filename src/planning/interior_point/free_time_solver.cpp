@@ -45,7 +45,9 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -67,7 +69,6 @@ constexpr double kInitialEffortShare = 1e-2;
 /// minimum time alone has no curvature, and a shifted Newton step stalls there (measured on
 /// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
 constexpr double kFinalEffortFraction = 1e-8;
-constexpr int kHalfBandwidth = 8;
 /// The start's h is raised at most this factor before the elastic start takes over: with spinning
 /// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
 /// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
@@ -108,7 +109,12 @@ class FreeTimeSolver {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
                  const StageConstraints& constraints, const InteriorPointParameters& parameters)
-      : problem_(problem), np_(*np), parameters_(parameters), N_(np->steps()), n_(np->unknowns()) {
+      : problem_(problem),
+        np_(*np),
+        parameters_(parameters),
+        N_(np->steps()),
+        n_(np->unknowns()),
+        inertia_(parameters) {
     for (const auto& c : constraints) {
       FreeTimeGroup& g = groups_.emplace_back();
       g.constraint = c.get();
@@ -241,8 +247,6 @@ class FreeTimeSolver {
                const Eigen::Matrix<double, 10, 1>& lagrangian);
   void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
                 const Eigen::Matrix<double, 10, 1>& lagrangian);
-  bool solveStep(Eigen::VectorXd* d);
-  void dampAfterCutSteps(double alpha, bool late);
   bool lineSearch(Eigen::VectorXd* d, double mu, double epsilon, bool late, double* alpha);
   /// φ_μ at the iterate moved by α d from (h, steps), +∞ where no boundary step exists there
   /// (`moved` false then: the iterate is not at the trial point).
@@ -285,20 +289,15 @@ class FreeTimeSolver {
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
   std::vector<std::vector<int>> quantity_blocks_;
-  // The assembled system at the current iterate.
-  BandedSymmetric<double> band_{1, kHalfBandwidth};
-  Eigen::MatrixXd border_;  ///< the band's coupling to η (column 0) and, elastic, θ (column 1)
-  Eigen::MatrixXd corner_;  ///< the (η, θ) block
+  /// The assembled system at the current iterate: the band, its border (η in column 0 and,
+  /// elastic, θ in column 1) and the (η, θ) corner.
+  KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
-  double last_shift_ = 0.0;     ///< the last iteration's shift (0: none)
-  BorderedBanded step_factor_;  ///< the factorization of the last step (the correction reuses it)
+  PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
+  BorderedBandKkt<double> step_factor_;  ///< the last step's factor (the correction reuses it)
   /// The last step's predicted decrease of φ_μ was round-off (merit_round_off): no step of it
   /// can be told from no step.
   bool step_at_round_off_ = false;
-  /// The damping of the Newton step after steps cut short (dampAfterCutSteps; 0: none) and how
-  /// many steps in a row were cut.
-  double damping_ = 0.0;
-  int cut_steps_ = 0;
   // The elastic start (startInside): while the iterate is outside a constraint that moves with h,
   // that constraint is c + θ ≥ 0, θ ≥ 0 one more unknown (index n_ + 1, multiplier z_θ) and the
   // objective gains ρθ; the first iterate strictly inside every constraint drops θ.
@@ -308,10 +307,10 @@ class FreeTimeSolver {
 };
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
-  band_ = BandedSymmetric<double>(n_, kHalfBandwidth);
+  kkt_.band = BandedSymmetric<double>(n_, ReducedProblem::kHalfBandwidth);
   const int b = borderSize();
-  border_.setZero(n_, b);
-  corner_.setZero(b, b);
+  kkt_.border.setZero(n_, b);
+  kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
   std::vector<FreeTimeGroup*> torque_groups;
@@ -419,16 +418,16 @@ void FreeTimeSolver::assembleElastic(double mu) {
       const double w = in.z / in.c;
       for (int node = 0; node < g.support.width; ++node) {
         const int v = np_.variableIndex(k + g.support.node_offset + node);
-        if (v >= 0) border_.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
+        if (v >= 0) kkt_.border.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
       }
-      corner_(0, 1) += w * in.g(9);
-      corner_(1, 1) += w;
+      kkt_.corner(0, 1) += w * in.g(9);
+      kkt_.corner(1, 1) += w;
       rhs_(t) += mu / in.c;
       lagrangian_gradient_(t) -= in.z;
     }
   }
-  corner_(1, 0) = corner_(0, 1);
-  corner_(1, 1) += z_theta_ / theta_;
+  kkt_.corner(1, 0) = kkt_.corner(0, 1);
+  kkt_.corner(1, 1) += z_theta_ / theta_;
   rhs_(t) += mu / theta_ - rho_;
   lagrangian_gradient_(t) += rho_ - z_theta_;
 }
@@ -452,68 +451,17 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
     if (v < 0) continue;
     rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
     lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
-    border_.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
+    kkt_.border.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
   }
   rhs_(n_) += rhs(9);
   lagrangian_gradient_(n_) += lagrangian(9);
-  corner_(0, 0) += H(9, 9);
+  kkt_.corner(0, 0) += H(9, 9);
   const int first_slot = std::max(0, np_.firstFreeNode() - first_node);
   const int last_slot = std::min(width - 1, np_.lastFreeNode() - first_node);
   if (first_slot <= last_slot) {
-    band_.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
-                               Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()), 3 * first_slot,
-                               3 * (last_slot + 1));
-  }
-}
-
-/// The Newton step of the barrier problem (bordered band), with a shift δ·I (δ relative to the
-/// mean diagonal: a row-relative shift would scale with the barrier terms of active bounds and
-/// stall the step) until the band is positive definite, the Schur complement positive and the
-/// step a descent direction of φ_μ. As IPOPT's δ_w: the next iteration starts from a third of
-/// the last shift that worked.
-bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
-  const int b = borderSize();
-  double scale = corner_.diagonal().cwiseAbs().sum();
-  for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
-  scale /= n_ + b;
-  const double resumed = last_shift_ > 0
-                             ? std::max(parameters_.free_time_smallest_shift, last_shift_ / 3)
-                             : parameters_.free_time_first_shift;
-  for (double shift = damping_; shift <= parameters_.free_time_max_shift;
-       shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : parameters_.shift_growth)) {
-    BandedSymmetric<double> A = band_;
-    if (shift > 0) A.addToDiagonal(shift * scale);
-    Eigen::MatrixXd D = corner_;
-    D.diagonal().array() += shift * scale;
-    BorderedBanded& factor = step_factor_;
-    if (!factor.factor(A, border_, D)) continue;
-    if (factor.inertia().positive != b) continue;
-    *d = rhs_;
-    factor.solve(d);
-    if (d->allFinite() && d->dot(rhs_) > 0) {
-      last_shift_ = shift;
-      return true;
-    }
-  }
-  return false;
-}
-
-/// A Levenberg–Marquardt damping of the Newton step (the shift δ·I of solveStep, from the first
-/// shift, ×growth per further cut step, ÷growth per full step, 0 below the smallest shift):
-/// where minimum time is flat (a torque strictly inside its bounds along an arc: only the
-/// vanishing ε C curves it) the Newton step is long in those directions, and the constraints'
-/// curvature along it cuts it at the boundary again and again (measured: 0.96 N m about body x
-/// against |u_x| ≤ 1, N = 64: 500 iterations at steps of 1/512 … 1/8 with the stationarity stuck
-/// at 3e-5). The residuals that decide convergence are the undamped ones: the KKT point is the
-/// same, only the path to it is shorter.
-void FreeTimeSolver::dampAfterCutSteps(double alpha, bool late) {
-  cut_steps_ = late && alpha < parameters_.free_time_cut_step ? cut_steps_ + 1 : 0;
-  const double growth = parameters_.free_time_damping_growth;
-  if (cut_steps_ >= parameters_.free_time_cut_steps_before_damping) {
-    damping_ = std::max(growth * damping_, parameters_.free_time_first_shift);
-  } else if (alpha == 1.0) {
-    damping_ =
-        damping_ / growth >= parameters_.free_time_smallest_damping ? damping_ / growth : 0.0;
+    kkt_.band.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
+                                   Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()),
+                                   3 * first_slot, 3 * (last_slot + 1));
   }
 }
 
@@ -776,7 +724,8 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     double alpha = 0.0;
     const bool late = mu <= parameters_.free_time_damped_barrier * mu0;
     step_at_round_off_ = false;
-    if (!solveStep(&d) || !lineSearch(&d, mu, epsilon, late, &alpha)) {
+    if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d) ||
+        !lineSearch(&d, mu, epsilon, late, &alpha)) {
       // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
       // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
       // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
@@ -796,7 +745,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
                      epsilon);
     }
     dualStep(d, mu);
-    dampAfterCutSteps(alpha, late);
+    inertia_.afterStep(alpha, late);
     leaveElasticIfInside();
     safeguardDuals(mu);
   }
@@ -850,8 +799,8 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
 /// definite, its least eigenpair from the dense matrix (n ≤ a few hundred at the start grid; this
 /// runs once per converged solve, and only there).
 bool FreeTimeSolver::barrierHessianDefinite() const {
-  BorderedBanded factor;
-  return factor.factor(band_, border_, corner_) && factor.inertia().positive == borderSize() &&
+  BorderedBandKkt<double> factor;
+  return factor.factor(kkt_, Shift{}) && factor.inertia().positive == borderSize() &&
          factor.inertia().negative == 0;
 }
 
@@ -883,22 +832,22 @@ std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() c
   double radius = 0.0, scale = 0.0;  // Gershgorin: every eigenvalue ≥ min_i (K_ii − Σ|K_ij|)
   for (int i = 0; i < size; ++i) {
     double off = 0.0;
-    for (int j = std::max(0, i - band_.bandwidth()); j <= std::min(n_ - 1, i + band_.bandwidth());
-         ++j) {
-      if (i < n_ && j != i) off += std::abs(band_(i, j));
+    for (int j = std::max(0, i - kkt_.band.bandwidth());
+         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
+      if (i < n_ && j != i) off += std::abs(kkt_.band(i, j));
     }
-    off += i < n_ ? border_.row(i).cwiseAbs().sum() : border_.col(i - n_).cwiseAbs().sum();
-    const double diagonal = i < n_ ? band_(i, i) : corner_(i - n_, i - n_);
-    if (i >= n_) off += corner_.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
+    off += i < n_ ? kkt_.border.row(i).cwiseAbs().sum() : kkt_.border.col(i - n_).cwiseAbs().sum();
+    const double diagonal = i < n_ ? kkt_.band(i, i) : kkt_.corner(i - n_, i - n_);
+    if (i >= n_) off += kkt_.corner.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
     radius = std::max(radius, std::abs(diagonal) + off);
     scale += std::abs(diagonal) / size;
   }
   const auto shifted = [&](double sigma, BorderedBanded* factor) {
-    BandedSymmetric<double> A = band_;
+    BandedSymmetric<double> A = kkt_.band;
     A.addToDiagonal(-sigma);
-    Eigen::MatrixXd D = corner_;
+    Eigen::MatrixXd D = kkt_.corner;
     D.diagonal().array() -= sigma;
-    return factor->factor(A, border_, D) && factor->inertia().positive == b &&
+    return factor->factor(A, kkt_.border, D) && factor->inertia().positive == b &&
            factor->inertia().negative == 0;
   };
   BorderedBanded factor;
@@ -917,13 +866,13 @@ std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() c
   LeastEigenpair least;
   Eigen::VectorXd Kx = Eigen::VectorXd::Zero(size);
   for (int i = 0; i < n_; ++i) {
-    for (int j = std::max(0, i - band_.bandwidth()); j <= std::min(n_ - 1, i + band_.bandwidth());
-         ++j) {
-      Kx(i) += band_(i, j) * x(j);
+    for (int j = std::max(0, i - kkt_.band.bandwidth());
+         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
+      Kx(i) += kkt_.band(i, j) * x(j);
     }
   }
-  Kx.head(n_) += border_ * x.tail(b);
-  Kx.tail(b) = border_.transpose() * x.head(n_) + corner_ * x.tail(b);
+  Kx.head(n_) += kkt_.border * x.tail(b);
+  Kx.tail(b) = kkt_.border.transpose() * x.head(n_) + kkt_.corner * x.tail(b);
   least.value = x.dot(Kx);  // the Rayleigh quotient
   least.vector = x;
   least.scale = scale;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "attitude_planner/planning/constraints.hpp"
+#include "attitude_planner/planning/problem.hpp"  // kNodeConstraintTolerance
 
 namespace attitude_planner {
 

@@ -45,6 +45,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
@@ -85,26 +86,6 @@ constexpr double kElasticPenaltyGrowth = 10.0;
 /// Above this N the stationarity tolerance grows like N² (round-off of second differences).
 constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 
-/// One instance of a stage constraint: value, gradient over its local nodes (at most three, 9
-/// entries) and η (entry 9), multiplier and its step.
-struct FreeTimeInstance {
-  double c = 1.0, z = 0.0, dz = 0.0;
-  /// The second-order correction's curvature term c(x + d) − c − gᵀd at the rejected full step
-  /// (secondOrderCorrection; 0 when the step taken is not a corrected one).
-  double r = 0.0;
-  Eigen::Matrix<double, 10, 1> g = Eigen::Matrix<double, 10, 1>::Zero();
-};
-
-/// The instances of one stage constraint (stage_constraints.hpp) on its support.
-struct FreeTimeGroup {
-  const StageConstraint* constraint = nullptr;
-  const StageQuantityModel* quantity = nullptr;  ///< &constraint->quantityModel()
-  StageSupport support;
-  std::vector<FreeTimeInstance> at;  ///< at[k − support.first_k]
-  FreeTimeInstance& instance(int k) { return at[k - support.first_k]; }
-  const FreeTimeInstance& instance(int k) const { return at[k - support.first_k]; }
-};
-
 class FreeTimeSolver {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
@@ -114,13 +95,10 @@ class FreeTimeSolver {
         parameters_(parameters),
         N_(np->steps()),
         n_(np->unknowns()),
+        form_(parameters),
         inertia_(parameters) {
     for (const auto& c : constraints) {
-      FreeTimeGroup& g = groups_.emplace_back();
-      g.constraint = c.get();
-      g.quantity = &c->quantityModel();
-      g.support = g.quantity->support(np_.firstFreeNode(), np_.lastFreeNode());
-      g.at.resize(g.support.last_k - g.support.first_k + 1);
+      groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
     }
     QuantityBlocks blocks = quantityBlocks(constraints);
     stencil_groups_ = std::move(blocks.on_cost_stencil);
@@ -173,7 +151,7 @@ class FreeTimeSolver {
  private:
   int constraintCount() const {
     int m = 0;
-    for (const FreeTimeGroup& g : groups_) m += static_cast<int>(g.at.size());
+    for (const FreeTimeRows& g : groups_) m += static_cast<int>(g.at.size());
     return m;
   }
   double torqueScale(int k) const { return std::sqrt(torqueWeight(k)); }
@@ -182,7 +160,7 @@ class FreeTimeSolver {
   bool hasTorqueBox() const {
     // Only a box side is affine in one torque axis.
     return std::any_of(groups_.begin(), groups_.end(),
-                       [](const FreeTimeGroup& g) { return g.constraint->axis() >= 0; });
+                       [](const FreeTimeRows& g) { return g.constraint->axis() >= 0; });
   }
 
   /// Calls f(group, k, c) for every instance's value c at `steps` (the quantities' shared
@@ -190,7 +168,7 @@ class FreeTimeSolver {
   template <typename F>
   void forEachValue(const ReducedProblem::StepVectors& steps, F&& f, bool relaxed = true) const {
     const QuantityInputs at(np_, steps);
-    for (const FreeTimeGroup& g : groups_) {
+    for (const FreeTimeRows& g : groups_) {
       const double relax = relaxed ? relaxation(g) : 0.0;
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
         f(g, k, g.constraint->value(g.quantity->value(at, k)) + relax);
@@ -199,7 +177,7 @@ class FreeTimeSolver {
   }
 
   /// θ added to a constraint that moves with h while the start is elastic (else 0).
-  double relaxation(const FreeTimeGroup& g) const {
+  double relaxation(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep() ? theta_ : 0.0;
   }
   /// The global unknowns bordering the band: η, and θ while elastic.
@@ -211,7 +189,7 @@ class FreeTimeSolver {
     double smallest = std::numeric_limits<double>::infinity();
     forEachValue(
         steps,
-        [&](const FreeTimeGroup& g, int, double c) {
+        [&](const FreeTimeRows& g, int, double c) {
           if (g.quantity->dependsOnTimeStep() == time_dependent) {
             smallest = std::min(smallest, c);
           }
@@ -229,10 +207,8 @@ class FreeTimeSolver {
       inside = theta_ > 0;
       if (inside) phi += rho_ * theta_ - mu * std::log(theta_);
     }
-    const double fraction = 1 - parameters_.fraction_to_boundary;
-    forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-      if (!(c > 0) || (check_boundary && c < fraction * g.instance(k).c)) inside = false;
-      if (inside) phi -= mu * std::log(c);
+    forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+      form_.addRowMerit(c, g.instance(k).c, mu, check_boundary, &inside, &phi);
     });
     return inside ? phi : std::numeric_limits<double>::infinity();
   }
@@ -245,8 +221,6 @@ class FreeTimeSolver {
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
-  void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
-                const Eigen::Matrix<double, 10, 1>& lagrangian);
   bool lineSearch(Eigen::VectorXd* d, double mu, double epsilon, bool late, double* alpha);
   /// φ_μ at the iterate moved by α d from (h, steps), +∞ where no boundary step exists there
   /// (`moved` false then: the iterate is not at the trial point).
@@ -256,7 +230,7 @@ class FreeTimeSolver {
   void clearCorrection();
   void moveTo(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd* d,
               double alpha);
-  double localDot(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
+  double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
   void safeguardDuals(double mu);
@@ -284,7 +258,8 @@ class FreeTimeSolver {
   const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  std::vector<FreeTimeGroup> groups_;
+  std::vector<FreeTimeRows> groups_;
+  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
@@ -313,13 +288,13 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
-  std::vector<FreeTimeGroup*> torque_groups;
+  std::vector<FreeTimeRows*> torque_groups;
   for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
   const auto weights = [&](int k, const Vector3& r) {
     // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
     const double s = torqueScale(k);
     Vector3 w = epsilon * r;
-    for (FreeTimeGroup* g : torque_groups) {
+    for (FreeTimeRows* g : torque_groups) {
       w -= (g->instance(k).z / s) * g->constraint->gradient(r / s);
     }
     return w;
@@ -343,8 +318,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         Matrix3 W = epsilon * Matrix3::Identity();
         Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-        for (FreeTimeGroup* g : torque_groups) {
-          FreeTimeInstance& in = g->instance(st.k);
+        for (FreeTimeRows* g : torque_groups) {
+          FreeTimeRow& in = g->instance(st.k);
           in.c = g->constraint->value(tau) + relaxation(*g);
           const Vector3 a = g->constraint->gradient(tau) / s;
           in.g = G.transpose() * a;
@@ -375,11 +350,11 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// c(q) and λ = −Σ z c'(q) in the contraction; ∇c = c'∇q, −Σ z∇²c = λ·∇²q (the constraints on
 /// these quantities are affine in q), and each constraint's barrier term (z/c) g gᵀ, in η = h/h₀.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
-  const FreeTimeGroup& first = groups_[block.front()];
+  const FreeTimeRows& first = groups_[block.front()];
   const auto contract = [&](int k, const Vector3& q) {
     Vector3 lambda = Vector3::Zero();
     for (const int i : block) {
-      FreeTimeInstance& in = groups_[i].instance(k);
+      FreeTimeRow& in = groups_[i].instance(k);
       in.c = groups_[i].constraint->value(q) + relaxation(groups_[i]);
       lambda -= in.z * groups_[i].constraint->gradient(q);
     }
@@ -391,7 +366,7 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
         Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
         const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
         for (const int i : block) {
-          FreeTimeInstance& in = groups_[i].instance(t.k);
+          FreeTimeRow& in = groups_[i].instance(t.k);
           in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
           // (z/c) g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
           const double w = in.z / in.c;
@@ -411,10 +386,10 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
 void FreeTimeSolver::assembleElastic(double mu) {
   if (!elastic_) return;
   const int t = n_ + 1;
-  for (const FreeTimeGroup& g : groups_) {
+  for (const FreeTimeRows& g : groups_) {
     if (!g.quantity->dependsOnTimeStep()) continue;
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeInstance& in = g.instance(k);
+      const FreeTimeRow& in = g.instance(k);
       const double w = in.z / in.c;
       for (int node = 0; node < g.support.width; ++node) {
         const int v = np_.variableIndex(k + g.support.node_offset + node);
@@ -549,8 +524,8 @@ bool FreeTimeSolver::lineSearch(Eigen::VectorXd* step, double mu, double epsilon
 bool FreeTimeSolver::secondOrderCorrection(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
-  forEachValue(np_.current(), [&](const FreeTimeGroup& group, int k, double c_at_step) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(group).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& group, int k, double c_at_step) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(group).instance(k);
     in.r = c_at_step - in.c - localDot(group, k, in.g, d);
     const double w = -(in.z / in.c) * in.r;
     if (w == 0.0) return;
@@ -569,12 +544,12 @@ bool FreeTimeSolver::secondOrderCorrection(const Eigen::VectorXd& d, Eigen::Vect
 }
 
 void FreeTimeSolver::clearCorrection() {
-  for (FreeTimeGroup& g : groups_) {
-    for (FreeTimeInstance& in : g.at) in.r = 0.0;
+  for (FreeTimeRows& g : groups_) {
+    for (FreeTimeRow& in : g.at) in.r = 0.0;
   }
 }
 
-double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
+double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
@@ -591,63 +566,51 @@ double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
 /// boundary; applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   double alpha = 1.0;
-  for (FreeTimeGroup& g : groups_) {
+  for (FreeTimeRows& g : groups_) {
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      FreeTimeInstance& in = g.instance(k);
-      in.dz = mu / in.c - in.z - in.z / in.c * (localDot(g, k, in.g, d) + in.r);
-      if (in.dz < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / in.dz);
+      FreeTimeRow& in = g.instance(k);
+      in.dz = form_.dualDirection(in.z, in.c, mu, localDot(g, k, in.g, d) + in.r, &alpha);
     }
   }
   double dz_theta = 0.0;
   if (elastic_) {  // at the assembled θ (the line search has moved θ already)
-    dz_theta = mu / theta_assembled_ - z_theta_ - z_theta_ / theta_assembled_ * d(n_ + 1);
-    if (dz_theta < 0) {
-      alpha = std::min(alpha, -parameters_.fraction_to_boundary * z_theta_ / dz_theta);
-    }
+    dz_theta = form_.dualDirection(z_theta_, theta_assembled_, mu, d(n_ + 1), &alpha);
   }
   z_theta_ += alpha * dz_theta;
-  for (FreeTimeGroup& g : groups_) {
-    for (FreeTimeInstance& in : g.at) in.z += alpha * in.dz;
+  for (FreeTimeRows& g : groups_) {
+    for (FreeTimeRow& in : g.at) in.z += alpha * in.dz;
   }
 }
 
 /// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c.
 void FreeTimeSolver::safeguardDuals(double mu) {
-  const double kappa = parameters_.dual_safeguard;
-  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = std::clamp(in.z, mu / (kappa * c), kappa * mu / c);
+    in.z = form_.safeguarded(in.z, c, mu);
   });
-  if (elastic_) z_theta_ = std::clamp(z_theta_, mu / (kappa * theta_), kappa * mu / theta_);
+  if (elastic_) z_theta_ = form_.safeguarded(z_theta_, theta_, mu);
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
-  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = mu / c;
+    in.z = form_.initialMultiplier(c, mu);
   });
-  if (elastic_) z_theta_ = mu / theta_;
+  if (elastic_) z_theta_ = form_.initialMultiplier(theta_, mu);
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point.
 double FreeTimeSolver::barrierResidual(double mu) const {
-  double worst = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  for (const FreeTimeGroup& g : groups_) {
-    for (const FreeTimeInstance& in : g.at) worst = std::max(worst, std::abs(in.z * in.c - mu));
-  }
+  double worst = form_.residual(groups_, lagrangian_gradient_.lpNorm<Eigen::Infinity>(), mu);
   if (elastic_) worst = std::max(worst, std::abs(z_theta_ * theta_ - mu));
   return worst;
 }
 
 /// Σ zᵢcᵢ at the assembled point.
 double FreeTimeSolver::dualityGap() const {
-  double gap = 0.0;
-  for (const FreeTimeGroup& g : groups_) {
-    for (const FreeTimeInstance& in : g.at) gap += in.z * in.c;
-  }
-  return gap;
+  return form_.dualityGap(groups_);
 }
 
 /// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
@@ -769,10 +732,10 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
   const std::vector<Vector3> tau = np_.torques(out.steps);
   if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  for (const FreeTimeGroup& g : groups_) {
+  for (const FreeTimeRows& g : groups_) {
     const int a = g.constraint->axis();
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeInstance& in = g.instance(k);
+      const FreeTimeRow& in = g.instance(k);
       out.complementarity += in.z * in.c;
       out.smallest_value = std::min(out.smallest_value, in.c);
       // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).

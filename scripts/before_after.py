@@ -4,14 +4,19 @@ before/after table (docs/results/refactor_before_after.md). Run through scripts/
 
 The problems are those of scripts/benchmark (rest_to_rest at N = 32..8192 on both schemes,
 slew_up, the scaling runs), scripts/constraints_benchmark (every constrained scene, torque limits
-at N = 64..2048, SLSQP), scripts/robustness --random (the seeded random suite, case by case) and
-scripts/accuracy (accuracy_study). Both builds read the same scene files (the BEFORE commit's:
-scene keys are only ever extended). Every problem runs BEFORE then AFTER, `repeats` times in
+at N = 64..2048, SLSQP), scripts/robustness --random (the seeded random suite, case by case),
+scripts/accuracy (accuracy_study) and minimum time: `plan_maneuver --objective minimum_time` on
+the min_time_* scenes x {paper, second_order} x N in {32, 64, 128} (T*, termination,
+iterations), the bounded minimum effort (objective minimum_effort) of each at 1.02 T* (T* the
+BEFORE build's), and `benchmark_solvers --solver free_time` (one free-time solve, paper) on
+FREE_TIME_SCENES and the same N. Both builds read the same scene files (the BEFORE commit's: scene
+keys are only ever extended). Every problem runs BEFORE then AFTER, `repeats` times in
 turn, so both see the same load; times are each process's own solver time (the structured
 `time_s` of benchmark_solvers, the whole process for accuracy_study), quoted as the median of
 the pair-by-pair ratios AFTER / BEFORE.
 
-Same optimum: |cost_after − cost_before| ≤ 1e-9 |cost_before|. Same verdict: the same
+Same optimum: |cost_after − cost_before| ≤ 1e-9 |cost_before| (minimum time: T* in place of the
+cost). Same verdict: the same
 `converged` (benchmark_solvers) or `termination` (random suite). Iterations are reported too.
 """
 import argparse
@@ -23,11 +28,22 @@ import subprocess
 import tempfile
 import time
 
+import yaml
+
 REL_TOL = 1e-9  # optima equal to this relative tolerance count as the same
 RANDOM_BUDGET_S = 60.0  # the random suite's time budget per case (as scripts/robustness)
 # A case whose time reaches this fraction of the budget was stopped by the clock: what it did
 # (iterations, which starts ran) depends on the machine's speed at that moment.
 AT_BUDGET_FRACTION = 0.95
+MIN_TIME_SCENES = ["min_time_betts", "min_time_bilimoria_wie", "min_time_keep_out",
+                   "min_time_sphere"]
+MIN_TIME_SCHEMES = ["paper", "second_order"]
+MIN_TIME_STEPS = [32, 64, 128]
+# benchmark_solvers --solver free_time starts from an excursion sized by the torque box: on
+# min_time_sphere (a norm bound, no box) and min_time_keep_out (a pointing cone) it ends before
+# any iteration (measured: not_converged, 0 iterations), so those compare nothing: no rows.
+FREE_TIME_SCENES = ["min_time_betts", "min_time_bilimoria_wie"]
+BOUNDED_FACTOR = 1.02  # the bounded minimum-effort rows plan at this multiple of T*
 
 
 def cell(text):
@@ -61,6 +77,32 @@ def run_random_case(binary, count, case, budget):
                               os.path.join(tmp, "r.md")],
                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     return last_json_line(out.stderr) or {"error": "no JSON line (exit %d)" % out.returncode}
+
+
+def run_plan(binary, scene, args):
+    """plan_maneuver SCENE ARGS --summary: its JSON summary (time: solve_time_s)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "s.json")
+        out = subprocess.run([binary, scene] + args + ["--summary", path],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            with open(path) as f:
+                summary = json.load(f)
+        except (OSError, ValueError):
+            return {"error": "no summary (exit %d)" % out.returncode}
+    summary["time_s"] = summary.get("solve_time_s", 0.0)
+    return summary
+
+
+def scene_with(scene, tmp, name, **keys):
+    """A copy of the scene file with some top-level keys replaced (scene keys never change)."""
+    with open(scene) as f:
+        data = yaml.safe_load(f)
+    data.update(keys)
+    path = os.path.join(tmp, name)
+    with open(path, "w") as f:
+        yaml.safe_dump(data, f)
+    return path
 
 
 def run_accuracy(binary, scenes, max_steps):
@@ -128,6 +170,52 @@ def benchmark_cases(scenes, quick):
     return cases
 
 
+def paired_runs(run_side, repeats):
+    """BEFORE then AFTER, `repeats` times in turn: the first run of each and the time ratios."""
+    runs = {"before": [], "after": []}
+    for _ in range(repeats):
+        for side in ("before", "after"):
+            runs[side].append(run_side(side))
+    ratios = [a["time_s"] / b["time_s"] for b, a in zip(runs["before"], runs["after"])
+              if a.get("time_s") and b.get("time_s")]
+    return runs["before"][0], runs["after"][0], ratios
+
+
+def minimum_time_rows(args, plan, bench, tmp):
+    """(source, problem, before, after, ratios, figure): the figure compared is T*
+    (minimum_duration) or the cost; the verdict is `termination` (`status` of benchmark_solvers)."""
+    rows = []
+    for name in MIN_TIME_SCENES:
+        scene = os.path.join(args.scenes, name + ".yaml")
+        for scheme in MIN_TIME_SCHEMES:
+            for n in MIN_TIME_STEPS:
+                grid = ["--scheme", scheme, "--steps", str(n)]
+                label = "%s %s N=%d" % (name, scheme, n)
+                b, a, ratios = paired_runs(
+                    lambda side: run_plan(plan[side], scene, ["--objective", "minimum_time"] + grid),
+                    args.repeats)
+                rows.append(("minimum_time", label, b, a, ratios, "minimum_duration"))
+                print(json.dumps({"case": label, "ratios": ratios}), flush=True)
+                t_star = b.get("minimum_duration")
+                if b.get("termination") != "converged" or not t_star:
+                    continue
+                bounded = scene_with(scene, tmp, "%s_%s_%d.yaml" % (name, scheme, n),
+                                     objective="minimum_effort", duration=BOUNDED_FACTOR * t_star)
+                b, a, ratios = paired_runs(lambda side: run_plan(plan[side], bounded, grid),
+                                           args.repeats)
+                rows.append(("bounded_effort", "%s at %g T*" % (label, BOUNDED_FACTOR), b, a, ratios,
+                             "cost"))
+        for n in MIN_TIME_STEPS if name in FREE_TIME_SCENES else []:
+            cmd = ["--solver", "free_time", "--scene", scene, "--steps", str(n)]
+            b, a, ratios = paired_runs(lambda side: run_benchmark(bench[side], cmd), args.repeats)
+            for run in (b, a):
+                if "status" in run:
+                    run["termination"] = run["status"]
+            rows.append(("free_time", "%s paper N=%d" % (name, n), b, a, ratios,
+                         "minimum_duration"))
+    return rows
+
+
 def ratio_text(ratios):
     if not ratios:
         return "—"
@@ -151,6 +239,7 @@ def main():
     sides = {"before": args.before_ws, "after": args.after_ws}
     bench = {s: find_binary(ws, "benchmark_solvers") for s, ws in sides.items()}
     acc = {s: find_binary(ws, "accuracy_study") for s, ws in sides.items()}
+    plan = {s: find_binary(ws, "plan_maneuver") for s, ws in sides.items()}
     started = time.time()
     load_start = "%.2f %.2f %.2f" % os.getloadavg()
 
@@ -165,6 +254,9 @@ def main():
         rows.append((group, label, runs["before"][0], runs["after"][0], ratios))
         print(json.dumps({"case": label, "ratios": ratios}), flush=True)
 
+    with tempfile.TemporaryDirectory() as tmp:
+        min_time = minimum_time_rows(args, plan, bench, tmp)
+
     random_rows = []
     for case in range(args.random):
         b = run_random_case(bench["before"], args.random, case, RANDOM_BUDGET_S)
@@ -178,7 +270,7 @@ def main():
     acc_before = run_accuracy(acc["before"], scenes, args.accuracy_max_steps)
     acc_after = run_accuracy(acc["after"], scenes, args.accuracy_max_steps)
 
-    write_page(args, rows, random_rows, acc_before, acc_after, load_start,
+    write_page(args, rows, min_time, random_rows, acc_before, acc_after, load_start,
                time.time() - started)
 
 
@@ -187,7 +279,40 @@ def verdict_cell(b, a, key):
     return ("%s" % vb) if vb == va else "**%s → %s**" % (vb, va)
 
 
-def write_page(args, rows, random_rows, acc_before, acc_after, load_start, wall):
+def minimum_time_table(min_time, differ):
+    L = ["## Minimum time: plan_maneuver and benchmark_solvers --solver free_time\n"]
+    L.append("minimum_time: `plan_maneuver SCENE --objective minimum_time --scheme S --steps N`, "
+             "figure T* (`minimum_duration`); bounded_effort: the same scene as objective "
+             "minimum_effort at duration %g T* (T* BEFORE's), figure the cost; free_time: "
+             "`benchmark_solvers --solver free_time --scene SCENE --steps N` (one free-time solve, "
+             "paper; on %s), figure T*.\n" % (BOUNDED_FACTOR, ", ".join(FREE_TIME_SCENES)))
+    L.append("| source | problem | figure before | relative difference | termination before → "
+             "after | iterations before → after | time ratio after/before |")
+    L.append("|---|---|---|---|---|---|---|")
+    for source, label, b, a, ratios, key in min_time:
+        if "error" in b or "error" in a:
+            L.append("| %s | %s | error: %s / %s | | | | |" % (source, label, b.get("error", "ok"),
+                                                                a.get("error", "ok")))
+            differ.append(label)
+            continue
+        vb, va = b.get(key), a.get(key)
+        rel = (abs(va - vb) / max(abs(vb), 1e-300)) if vb is not None and va is not None \
+            else math.nan
+        if not (same_cost(va, vb) and b.get("termination") == a.get("termination")
+                and b.get("iterations") == a.get("iterations")):
+            differ.append(label)
+        L.append("| %s | %s | %s | %s | %s | %s | %s |" % (
+            source, cell(label), "%.12g" % vb if vb is not None else "—",
+            "%.1e" % rel if not rel <= REL_TOL else "%.1e (same)" % rel,
+            verdict_cell(b, a, "termination"),
+            "%s" % b.get("iterations") if b.get("iterations") == a.get("iterations")
+            else "**%s → %s**" % (b.get("iterations"), a.get("iterations")), ratio_text(ratios)))
+    L.append("\nAll time ratios of this table together: %s.\n"
+             % ratio_text([r for row in min_time for r in row[4]]))
+    return L
+
+
+def write_page(args, rows, min_time, random_rows, acc_before, acc_after, load_start, wall):
     L = ["# Refactor before/after: the benchmarks' problems on two builds\n"]
     L.append("Generated by `%s` (scripts/before_after.py); do not edit by hand. BEFORE = `%s`, "
              "AFTER = `%s`. Both read the same scene files (BEFORE's). Every problem ran BEFORE "
@@ -220,6 +345,7 @@ def write_page(args, rows, random_rows, acc_before, acc_after, load_start, wall)
             "%d" % b["iterations"] if b["iterations"] == a["iterations"]
             else "%d → %d" % (b["iterations"], a["iterations"]), ratio_text(ratios)))
     L.append("\nAll time ratios of this table together: %s.\n" % ratio_text(all_ratios))
+    L.extend(minimum_time_table(min_time, differ))
 
     L.append("## scripts/robustness --random problems (seed 19, cases 0..%d)\n" % (args.random - 1))
     same_verdict = sum(1 for _, b, a in random_rows if b.get("termination") == a.get("termination"))
@@ -279,7 +405,8 @@ def write_page(args, rows, random_rows, acc_before, acc_after, load_start, wall)
         if len(diffs) > 40:
             L.append("\n(%d more)\n" % (len(diffs) - 40))
     L.append("\n## Differences\n")
-    L.append("Benchmark rows whose optimum or verdict differ: %s.\n"
+    L.append("Benchmark and minimum-time rows whose optimum or verdict differ (minimum time: "
+             "or iterations): %s.\n"
              % (", ".join(differ) if differ else "none"))
     with open(args.out, "w") as f:
         f.write("\n".join(L) + "\n")

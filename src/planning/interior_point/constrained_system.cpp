@@ -71,21 +71,14 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
       np_(*np),
       parameters_(parameters),
       free_slacks_(formulation == Formulation::FreeSlacks),
+      form_(makeSlackForm(formulation, parameters)),
       constraints_(buildStageConstraints(problem)) {
   // One group per stage constraint, on its quantity's support (stage_quantities.hpp); the
   // groups on one quantity object form one block, assembled in one pass.
   groups_.reserve(constraints_.size());
   for (const auto& c : constraints_) {
-    const StageSupport support =
-        c->quantityModel().support(np_.firstFreeNode(), np_.lastFreeNode());
-    ConstraintGroup& g = groups_.emplace_back();  // in place: `at` is ~100 bytes per node
-    g.constraint = c.get();
-    g.quantity = &c->quantityModel();
-    g.first_k = support.first_k;
-    g.last_k = support.last_k;
-    g.node_offset = support.node_offset;
-    g.width = support.width;
-    g.at.resize(g.last_k - g.first_k + 1);
+    // In place: `at` is ~150 bytes per node.
+    const FixedStepRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
     constraint_count_ += static_cast<int>(g.at.size());
   }
   QuantityBlocks blocks = quantityBlocks(constraints_);
@@ -96,8 +89,8 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
 void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const QuantityInputs at(np_, steps);
-  for (ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
+  for (FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       g.instance(k).c = g.constraint->value(g.quantity->value(at, k));
     }
   }
@@ -115,45 +108,10 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
 
 double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
   double phi = 0.0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) {
-      if (free_slacks_) {
-        const double s = in.s + alpha * in.ds;
-        phi += -mu * std::log(s) + rho * std::abs(in.c - s);
-      } else {
-        phi += elasticSlacks(in.c, mu, rho).psi;
-      }
-    }
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) phi += form_->rowMerit(in, mu, rho, alpha);
   }
   return phi;
-}
-
-void ConstrainedSystem::prepare(ConstraintInstance& in, double mu, double rho, bool primal) const {
-  const double kappa = parameters_.dual_safeguard;
-  if (free_slacks_) {
-    // s is a variable: the multiplier stays near μ/s, and the condensation is that of c − s = 0
-    // (q = μ/z − c makes ds = gᵀdδ + c − s and dz = (q − gᵀdδ)/D).
-    const double z_primal = mu / in.s;
-    in.z = primal ? z_primal : std::min(std::max(in.z, mu / (kappa * in.s)), kappa * z_primal);
-    in.D = in.s / in.z;
-    in.q = mu / in.z - in.c;
-    return;
-  }
-  const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
-  in.s = sl.s;
-  in.v = sl.v;
-  const double z_primal = mu / in.s;
-  if (primal) {
-    in.z = z_primal;
-  } else {
-    in.z = std::min(std::max(in.z, mu / (kappa * in.s)), kappa * z_primal);
-    // u = ρ − z stays positive (u → 0 would make D and q infinite).
-    const double u_min = std::max(mu / (kappa * in.v), parameters_.elastic_dual_floor * rho);
-    in.z = std::min(in.z, rho - u_min);
-  }
-  const double u = rho - in.z;
-  in.D = in.s / in.z + in.v / u;
-  in.q = mu / in.z - in.s - mu / u + in.v;
 }
 
 void ConstrainedSystem::pollEvery(int k) const {
@@ -185,7 +143,7 @@ template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  std::vector<ConstraintGroup*> torque_groups;
+  std::vector<FixedStepRows*> torque_groups;
   for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
@@ -195,10 +153,10 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     const Vector3 tau = residual / r;
     Vector3 w = residual;
     double beta = 1.0;
-    for (ConstraintGroup* g : torque_groups) {
-      ConstraintInstance& in = g->instance(k);
+    for (FixedStepRows* g : torque_groups) {
+      FixedStepRow& in = g->instance(k);
       in.c = g->constraint->value(tau);
-      if (H) prepare(in, mu, rho, primal);
+      if (H) form_->prepare(in, mu, rho, primal);
       w -= (in.z / r) * g->constraint->gradient(tau);
       beta -= in.z * g->constraint->curvature() / (r * r);
     }
@@ -212,15 +170,15 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
     const double r = root(st.k);
     const Vector3 tau = st.tau / r;
-    for (ConstraintGroup* g : torque_groups) {
+    for (FixedStepRows* g : torque_groups) {
       g->instance(st.k).g = st.jacobian.transpose() * (g->constraint->gradient(tau) / r);
     }
     if (H) {
       // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
       // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
       Vector3 weight = Vector3::Constant(beta_k);
-      for (ConstraintGroup* g : torque_groups) {
-        const ConstraintInstance& in = g->instance(st.k);
+      for (FixedStepRows* g : torque_groups) {
+        const FixedStepRow& in = g->instance(st.k);
         const int a = g->constraint->axis();
         if (a < 0) {
           addLocalRankOne(np_, H, st.k - 1, 3, in.g, 1.0 / in.D);
@@ -251,15 +209,15 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, BandedSymmetric<Scalar>* H) {
-  const ConstraintGroup& first = groups_[block.front()];
-  const StageSupport support{first.first_k, first.last_k, first.node_offset, first.width};
+  const FixedStepRows& first = groups_[block.front()];
+  const StageSupport support = first.support;
   const auto contract = [&](int k, const Vector3& q) {
     pollEvery(k);
     Vector3 lambda = Vector3::Zero();
     for (const int i : block) {
-      ConstraintInstance& in = groups_[i].instance(k);
+      FixedStepRow& in = groups_[i].instance(k);
       in.c = groups_[i].constraint->value(q);
-      if (H) prepare(in, mu, rho, primal);
+      if (H) form_->prepare(in, mu, rho, primal);
       lambda -= in.z * groups_[i].constraint->gradient(q);
     }
     return lambda;
@@ -269,7 +227,7 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
     Eigen::Matrix<double, 9, 9> curvature = t.curvature;
     for (const int i : block) {
       const StageConstraint& c = *groups_[i].constraint;
-      ConstraintInstance& in = groups_[i].instance(t.k);
+      FixedStepRow& in = groups_[i].instance(t.k);
       in.g = t.jacobian.transpose() * c.gradient(t.value);
       if (H && c.curvature() != 0.0) {
         curvature -= (in.z * c.curvature()) * t.jacobian.transpose() * t.jacobian;
@@ -278,7 +236,7 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
     if (!H) return;
     addLocal(np_, H, node, support.width, curvature);
     for (const int i : block) {
-      const ConstraintInstance& in = groups_[i].instance(t.k);
+      const FixedStepRow& in = groups_[i].instance(t.k);
       addLocalRankOne(np_, H, node, support.width, in.g, 1.0 / in.D);
     }
   };
@@ -289,12 +247,14 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
 /// slope); rhs = −∇f + Σ g (z + q/D).
 void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) const {
-  for (const ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      const ConstraintInstance& in = g.instance(k);
-      const int first = k + g.node_offset;
-      if (!free_slacks_) addLocalVector(np_, in.g, -mu / in.s, first, g.width, merit_gradient);
-      addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.width, rhs);
+  for (const FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FixedStepRow& in = g.instance(k);
+      const int first = k + g.support.node_offset;
+      if (form_->barrierInMeritGradient()) {
+        addLocalVector(np_, in.g, -mu / in.s, first, g.support.width, merit_gradient);
+      }
+      addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.support.width, rhs);
     }
   }
 }
@@ -308,10 +268,10 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   products->clear();
   double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
   std::vector<double> ds, dz;
-  for (const ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      const ConstraintInstance& in = g.at[k - g.first_k];
-      const double lin = localDot(np_, in.g, k + g.node_offset, g.width, d);
+  for (const FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FixedStepRow& in = g.at[k - g.support.first_k];
+      const double lin = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
       ds.push_back(lin + in.c - in.s);
       dz.push_back((-in.c - lin) / in.D);
       if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
@@ -321,8 +281,8 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   }
   double affine = 0.0;
   std::size_t i = 0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) {
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) {
       affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
       products->push_back(ds[i] * dz[i]);
       ++i;
@@ -338,11 +298,11 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
 void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* products,
                                                   Eigen::VectorXd* out) const {
   std::size_t i = 0;
-  for (const ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k, ++i) {
-      const ConstraintInstance& in = g.at[k - g.first_k];
+  for (const FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k, ++i) {
+      const FixedStepRow& in = g.at[k - g.support.first_k];
       const double weight = products ? -(*products)[i] / in.s : 1.0 / in.s;
-      addLocalVector(np_, in.g, weight, k + g.node_offset, g.width, out);
+      addLocalVector(np_, in.g, weight, k + g.support.node_offset, g.support.width, out);
     }
   }
 }
@@ -351,8 +311,8 @@ void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* pro
 /// `products` may be null: the plain barrier μ).
 void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<double>* products) {
   std::size_t i = 0;
-  for (ConstraintGroup& g : groups_) {
-    for (ConstraintInstance& in : g.at) {
+  for (FixedStepRows& g : groups_) {
+    for (FixedStepRow& in : g.at) {
       in.q = (mu - (products ? (*products)[i] : 0.0)) / in.z - in.c;
       ++i;
     }
@@ -364,15 +324,13 @@ void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<do
 double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
   dz->clear();
   double alpha = 1.0;
-  for (ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      const ConstraintInstance& in = g.instance(k);
-      const double step = (in.q - localDot(np_, in.g, k + g.node_offset, g.width, d)) / in.D;
+  for (FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FixedStepRow& in = g.instance(k);
+      const double step =
+          (in.q - localDot(np_, in.g, k + g.support.node_offset, g.support.width, d)) / in.D;
       dz->push_back(step);
-      if (step < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / step);
-      if (free_slacks_) continue;  // z has no upper bound
-      const double u = rho - in.z;
-      if (step > 0) alpha = std::min(alpha, parameters_.fraction_to_boundary * u / step);
+      alpha = form_->dualStepLimit(in, step, rho, alpha);
     }
   }
   return alpha;
@@ -380,17 +338,17 @@ double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double rho, std::ve
 
 void ConstrainedSystem::applyDualStep(const std::vector<double>& dz, double alpha) {
   std::size_t i = 0;
-  for (ConstraintGroup& g : groups_) {
-    for (ConstraintInstance& in : g.at) in.z += alpha * dz[i++];
+  for (FixedStepRows& g : groups_) {
+    for (FixedStepRow& in : g.at) in.z += alpha * dz[i++];
   }
 }
 
 ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
   SlackStep step;
-  for (ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      ConstraintInstance& in = g.instance(k);
-      in.ds = localDot(np_, in.g, k + g.node_offset, g.width, d) + in.c - in.s;
+  for (FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      FixedStepRow& in = g.instance(k);
+      in.ds = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d) + in.c - in.s;
       if (in.ds < 0) {
         step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
       }
@@ -405,8 +363,8 @@ ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd&
 }
 
 void ConstrainedSystem::applySlackStep(double alpha) {
-  for (ConstraintGroup& g : groups_) {
-    for (ConstraintInstance& in : g.at) in.s += alpha * in.ds;
+  for (FixedStepRows& g : groups_) {
+    for (FixedStepRow& in : g.at) in.s += alpha * in.ds;
   }
 }
 
@@ -414,8 +372,8 @@ void ConstrainedSystem::applySlackStep(double alpha) {
 double ConstrainedSystem::largestMultiplier(const std::vector<double>& dz, double alpha) const {
   double largest = 0.0;
   std::size_t i = 0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) largest = std::max(largest, in.z + alpha * dz[i++]);
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) largest = std::max(largest, in.z + alpha * dz[i++]);
   }
   return largest;
 }
@@ -423,8 +381,8 @@ double ConstrainedSystem::largestMultiplier(const std::vector<double>& dz, doubl
 /// FreeSlacks: max |c − s| at the last evaluated c.
 double ConstrainedSystem::maxSlackResidual() const {
   double worst = 0.0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) worst = std::max(worst, std::abs(in.c - in.s));
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) worst = std::max(worst, std::abs(in.c - in.s));
   }
   return worst;
 }
@@ -435,20 +393,8 @@ void ConstrainedSystem::complementarity(double mu, double rho, double* average,
                                         double* smallest) const {
   double sum = 0.0, low = std::numeric_limits<double>::infinity();
   int count = 0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) {
-      if (free_slacks_) {
-        sum += in.s * in.z;
-        low = std::min(low, in.s * in.z);
-        ++count;
-        continue;
-      }
-      const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
-      const double a = sl.s * in.z, b = sl.v * (rho - in.z);
-      sum += a + b;
-      low = std::min(low, std::min(a, b));
-      count += 2;
-    }
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) form_->addComplementarity(in, mu, rho, &sum, &low, &count);
   }
   *average = sum / std::max(count, 1);
   *smallest = low;
@@ -457,8 +403,8 @@ void ConstrainedSystem::complementarity(double mu, double rho, double* average,
 /// Largest elastic violation max v_i (constraint units) at the last assembly or merit.
 double ConstrainedSystem::maxViolation() const {
   double worst = 0.0;
-  for (const ConstraintGroup& g : groups_) {
-    for (const ConstraintInstance& in : g.at) worst = std::max(worst, -in.c);
+  for (const FixedStepRows& g : groups_) {
+    for (const FixedStepRow& in : g.at) worst = std::max(worst, -in.c);
   }
   return worst;
 }
@@ -468,14 +414,14 @@ double ConstrainedSystem::maxViolation() const {
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
   std::vector<Vector3> sigma;
-  for (const ConstraintGroup& g : groups_) {
+  for (const FixedStepRows& g : groups_) {
     const int a = g.constraint->axis();
     if (a < 0) continue;  // only a box side is affine in one torque axis
     if (sigma.empty()) sigma = torque;
-    for (int k = g.first_k; k <= g.last_k; ++k) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
       const double weight = np_.scheme().torqueWeight(k, np_.steps());
-      sigma[k](a) -= g.at[k - g.first_k].z * g.constraint->gradient(torque[k])(a) / weight;
+      sigma[k](a) -= g.at[k - g.support.first_k].z * g.constraint->gradient(torque[k])(a) / weight;
     }
   }
   return sigma;
@@ -492,10 +438,10 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
       assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient).gradient_scale;
   Eigen::VectorXd residual;
   np_.evaluate(&residual, nullptr, &unused);  // ∇f
-  for (const ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
-      const ConstraintInstance& in = g.at[k - g.first_k];
-      addLocalVector(np_, in.g, -in.z, k + g.node_offset, g.width, &residual);
+  for (const FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FixedStepRow& in = g.at[k - g.support.first_k];
+      addLocalVector(np_, in.g, -in.z, k + g.support.node_offset, g.support.width, &residual);
     }
   }
   return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
@@ -505,11 +451,11 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
 LevelDuals ConstrainedSystem::duals() const {
   LevelDuals d;
   d.steps = np_.steps();
-  for (const ConstraintGroup& g : groups_) {
-    d.first_k.push_back(g.first_k);
+  for (const FixedStepRows& g : groups_) {
+    d.first_k.push_back(g.support.first_k);
     d.z.emplace_back();
     d.s.emplace_back();
-    for (const ConstraintInstance& in : g.at) {
+    for (const FixedStepRow& in : g.at) {
       d.z.back().push_back(in.z);
       d.s.back().push_back(in.s);
     }
@@ -526,13 +472,13 @@ double ConstrainedSystem::warmStartDuals(const LevelDuals& coarse) {
   double sum = 0.0;
   int count = 0;
   for (std::size_t gi = 0; gi < groups_.size() && gi < coarse.z.size(); ++gi) {
-    ConstraintGroup& g = groups_[gi];
+    FixedStepRows& g = groups_[gi];
     const std::vector<double>& zc = coarse.z[gi];
     if (zc.empty()) continue;
-    for (int k = g.first_k; k <= g.last_k; ++k) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       const int kc = static_cast<int>(std::lround(double(k) * coarse.steps / np_.steps()));
       const int i = std::min<int>(zc.size() - 1, std::max(0, kc - coarse.first_k[gi]));
-      ConstraintInstance& in = g.instance(k);
+      FixedStepRow& in = g.instance(k);
       const bool binding = coarse.s[gi][i] < parameters_.warm_slack_push;
       in.z = zc[i];
       in.s = std::max(in.c, binding ? parameters_.warm_slack_push : parameters_.slack_push);
@@ -555,10 +501,11 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   double gradient_scale = 0.0;
   const double cost = np_.evaluate(&cost_gradient, nullptr, &gradient_scale);
   std::vector<StationarityColumn> columns;
-  for (const ConstraintGroup& g : groups_) {
-    for (int k = g.first_k; k <= g.last_k; ++k) {
+  for (const FixedStepRows& g : groups_) {
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       StationarityColumn column{g.instance(k).c, g.instance(k).g};
-      for (int n = 0; n < g.width; ++n) column.index[n] = np_.variableIndex(k + g.node_offset + n);
+      for (int n = 0; n < g.support.width; ++n)
+        column.index[n] = np_.variableIndex(k + g.support.node_offset + n);
       columns.push_back(column);
     }
   }
@@ -569,8 +516,8 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   LevelDuals d;
   d.steps = np_.steps();
   std::size_t i = 0;
-  for (const ConstraintGroup& g : groups_) {
-    d.first_k.push_back(g.first_k);
+  for (const FixedStepRows& g : groups_) {
+    d.first_k.push_back(g.support.first_k);
     d.z.emplace_back(e.z.begin() + i, e.z.begin() + i + g.at.size());
     d.s.emplace_back(e.s.begin() + i, e.s.begin() + i + g.at.size());
     i += g.at.size();
@@ -581,17 +528,8 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
 /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
 /// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
 void ConstrainedSystem::initializeMultipliers(double mu, double rho, double cap) {
-  for (ConstraintGroup& g : groups_) {
-    for (ConstraintInstance& in : g.at) {
-      if (free_slacks_) {
-        in.s = std::max(in.c, parameters_.slack_push);
-        in.ds = 0.0;
-        in.z = std::min(mu / in.s, cap);
-        continue;
-      }
-      const ElasticSlacks sl = elasticSlacks(in.c, mu, rho);
-      in.z = std::min(mu / sl.s, std::min(cap, 0.5 * rho));
-    }
+  for (FixedStepRows& g : groups_) {
+    for (FixedStepRow& in : g.at) form_->initialize(in, mu, rho, cap);
   }
 }
 

@@ -3,7 +3,7 @@
 //   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i)
 // assembled at the current iterate in O(N) (interior_point_solver.cpp's header comment derives
 // it). Each constraint is stage-local: g_i lives on at most three consecutive nodes, so g_i g_iᵀ
-// keeps the unconstrained Hessian's band (half bandwidth 8).
+// keeps the unconstrained Hessian's band (half bandwidth ReducedProblem::kHalfBandwidth).
 #pragma once
 
 #include <vector>
@@ -12,6 +12,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"
@@ -19,27 +20,6 @@
 #include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
-
-struct ConstraintInstance {
-  double c = 0.0;                 ///< value (dimensionless)
-  Eigen::Matrix<double, 9, 1> g;  ///< ∂c/∂δ over the group's local nodes
-  double z = 0.0;                 ///< multiplier of c + v − s = 0 (0 < z < ρ)
-  double s = 0.0, v = 0.0;        ///< slacks (Elastic: elasticSlacks of c; FreeSlacks: s free)
-  double D = 1.0, q = 0.0;        ///< condensation terms
-  double ds = 0.0;                ///< FreeSlacks: the slack's Newton step
-};
-
-/// The instances of one stage constraint (one side of the torque box, or one scene constraint).
-struct ConstraintGroup {
-  const StageConstraint* constraint = nullptr;
-  const StageQuantityModel* quantity = nullptr;  ///< &constraint->quantityModel()
-  int first_k = 0, last_k = 0;                   ///< instances k = first_k..last_k
-  int node_offset = 0;                           ///< first local node = k + node_offset
-  int width = 1;                       ///< local nodes (3: torque stencil, 2: step, 1: node)
-  std::vector<ConstraintInstance> at;  ///< at[k − first_k]
-  ConstraintInstance& instance(int k) { return at[k - first_k]; }
-  const ConstraintInstance& instance(int k) const { return at[k - first_k]; }
-};
 
 /// A grid level's multipliers z and slacks s (free-slack form), per group and instance, to start
 /// the next finer level from (carried by the instances' times).
@@ -134,8 +114,6 @@ class ConstrainedSystem {
   void initializeMultipliers(double mu, double rho, double cap);
 
  private:
-  /// Slacks and (safeguarded or primal) multipliers for the instance's value c.
-  void prepare(ConstraintInstance& in, double mu, double rho, bool primal) const;
   template <typename Scalar>
   void assembleTorques(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
                        Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, Assembly* out);
@@ -150,8 +128,9 @@ class ConstrainedSystem {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  StageConstraints constraints_;  ///< buildStageConstraints(problem): one group each
-  std::vector<ConstraintGroup> groups_;
+  std::unique_ptr<SlackForm> form_;  ///< FreeSlacks or L1Elastic: how a row enters φ_μ
+  StageConstraints constraints_;     ///< buildStageConstraints(problem): one group each
+  std::vector<FixedStepRows> groups_;
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass over the band per quantity.

@@ -45,7 +45,10 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -67,7 +70,6 @@ constexpr double kInitialEffortShare = 1e-2;
 /// minimum time alone has no curvature, and a shifted Newton step stalls there (measured on
 /// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
 constexpr double kFinalEffortFraction = 1e-8;
-constexpr int kHalfBandwidth = 8;
 /// The start's h is raised at most this factor before the elastic start takes over: with spinning
 /// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
 /// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
@@ -84,37 +86,19 @@ constexpr double kElasticPenaltyGrowth = 10.0;
 /// Above this N the stationarity tolerance grows like N² (round-off of second differences).
 constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 
-/// One instance of a stage constraint: value, gradient over its local nodes (at most three, 9
-/// entries) and η (entry 9), multiplier and its step.
-struct FreeTimeInstance {
-  double c = 1.0, z = 0.0, dz = 0.0;
-  /// The second-order correction's curvature term c(x + d) − c − gᵀd at the rejected full step
-  /// (secondOrderCorrection; 0 when the step taken is not a corrected one).
-  double r = 0.0;
-  Eigen::Matrix<double, 10, 1> g = Eigen::Matrix<double, 10, 1>::Zero();
-};
-
-/// The instances of one stage constraint (stage_constraints.hpp) on its support.
-struct FreeTimeGroup {
-  const StageConstraint* constraint = nullptr;
-  const StageQuantityModel* quantity = nullptr;  ///< &constraint->quantityModel()
-  StageSupport support;
-  std::vector<FreeTimeInstance> at;  ///< at[k − support.first_k]
-  FreeTimeInstance& instance(int k) { return at[k - support.first_k]; }
-  const FreeTimeInstance& instance(int k) const { return at[k - support.first_k]; }
-};
-
 class FreeTimeSolver {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
                  const StageConstraints& constraints, const InteriorPointParameters& parameters)
-      : problem_(problem), np_(*np), parameters_(parameters), N_(np->steps()), n_(np->unknowns()) {
+      : problem_(problem),
+        np_(*np),
+        parameters_(parameters),
+        N_(np->steps()),
+        n_(np->unknowns()),
+        form_(parameters),
+        inertia_(parameters) {
     for (const auto& c : constraints) {
-      FreeTimeGroup& g = groups_.emplace_back();
-      g.constraint = c.get();
-      g.quantity = &c->quantityModel();
-      g.support = g.quantity->support(np_.firstFreeNode(), np_.lastFreeNode());
-      g.at.resize(g.support.last_k - g.support.first_k + 1);
+      groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
     }
     QuantityBlocks blocks = quantityBlocks(constraints);
     stencil_groups_ = std::move(blocks.on_cost_stencil);
@@ -185,7 +169,7 @@ class FreeTimeSolver {
  private:
   int constraintCount() const {
     int m = 0;
-    for (const FreeTimeGroup& g : groups_) m += static_cast<int>(g.at.size());
+    for (const FreeTimeRows& g : groups_) m += static_cast<int>(g.at.size());
     return m;
   }
   double torqueScale(int k) const { return std::sqrt(torqueWeight(k)); }
@@ -194,7 +178,7 @@ class FreeTimeSolver {
   bool hasTorqueBox() const {
     // Only a box side is affine in one torque axis.
     return std::any_of(groups_.begin(), groups_.end(),
-                       [](const FreeTimeGroup& g) { return g.constraint->axis() >= 0; });
+                       [](const FreeTimeRows& g) { return g.constraint->axis() >= 0; });
   }
 
   /// Calls f(group, k, c) for every instance's value c at `steps` (the quantities' shared
@@ -202,7 +186,7 @@ class FreeTimeSolver {
   template <typename F>
   void forEachValue(const ReducedProblem::StepVectors& steps, F&& f, bool relaxed = true) const {
     const QuantityInputs at(np_, steps);
-    for (const FreeTimeGroup& g : groups_) {
+    for (const FreeTimeRows& g : groups_) {
       const double relax = relaxed ? relaxation(g) : 0.0;
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
         f(g, k, g.constraint->value(g.quantity->value(at, k)) + relax);
@@ -211,7 +195,7 @@ class FreeTimeSolver {
   }
 
   /// θ added to a constraint that moves with h while the start is elastic (else 0).
-  double relaxation(const FreeTimeGroup& g) const {
+  double relaxation(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep() ? theta_ : 0.0;
   }
   /// The global unknowns bordering the band: η, and θ while elastic.
@@ -223,7 +207,7 @@ class FreeTimeSolver {
     double smallest = std::numeric_limits<double>::infinity();
     forEachValue(
         steps,
-        [&](const FreeTimeGroup& g, int, double c) {
+        [&](const FreeTimeRows& g, int, double c) {
           if (g.quantity->dependsOnTimeStep() == time_dependent) {
             smallest = std::min(smallest, c);
           }
@@ -241,10 +225,8 @@ class FreeTimeSolver {
       inside = theta_ > 0;
       if (inside) phi += rho_ * theta_ - mu * std::log(theta_);
     }
-    const double fraction = 1 - parameters_.fraction_to_boundary;
-    forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-      if (!(c > 0) || (check_boundary && c < fraction * g.instance(k).c)) inside = false;
-      if (inside) phi -= mu * std::log(c);
+    forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+      form_.addRowMerit(c, g.instance(k).c, mu, check_boundary, &inside, &phi);
     });
     return inside ? phi : std::numeric_limits<double>::infinity();
   }
@@ -257,10 +239,6 @@ class FreeTimeSolver {
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
-  void addLocal(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& rhs,
-                const Eigen::Matrix<double, 10, 1>& lagrangian);
-  bool solveStep(Eigen::VectorXd* d);
-  void dampAfterCutSteps(double alpha, bool late);
   bool lineSearch(Eigen::VectorXd* d, double mu, double epsilon, bool late, double* alpha);
   /// φ_μ at the iterate moved by α d from (h, steps), +∞ where no boundary step exists there
   /// (`moved` false then: the iterate is not at the trial point).
@@ -270,7 +248,7 @@ class FreeTimeSolver {
   void clearCorrection();
   void moveTo(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd* d,
               double alpha);
-  double localDot(const FreeTimeGroup& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
+  double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
   void safeguardDuals(double mu);
@@ -298,25 +276,21 @@ class FreeTimeSolver {
   const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  std::vector<FreeTimeGroup> groups_;
+  std::vector<FreeTimeRows> groups_;
+  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
   std::vector<std::vector<int>> quantity_blocks_;
-  // The assembled system at the current iterate.
-  BandedSymmetric<double> band_{1, kHalfBandwidth};
-  Eigen::MatrixXd border_;  ///< the band's coupling to η (column 0) and, elastic, θ (column 1)
-  Eigen::MatrixXd corner_;  ///< the (η, θ) block
+  /// The assembled system at the current iterate: the band, its border (η in column 0 and,
+  /// elastic, θ in column 1) and the (η, θ) corner.
+  KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
-  double last_shift_ = 0.0;     ///< the last iteration's shift (0: none)
-  BorderedBanded step_factor_;  ///< the factorization of the last step (the correction reuses it)
+  PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
+  BorderedBandKkt<double> step_factor_;  ///< the last step's factor (the correction reuses it)
   /// The last step's predicted decrease of φ_μ was round-off (merit_round_off): no step of it
   /// can be told from no step.
   bool step_at_round_off_ = false;
-  /// The damping of the Newton step after steps cut short (dampAfterCutSteps; 0: none) and how
-  /// many steps in a row were cut.
-  double damping_ = 0.0;
-  int cut_steps_ = 0;
   // The elastic start (startInside): while the iterate is outside a constraint that moves with h,
   // that constraint is c + θ ≥ 0, θ ≥ 0 one more unknown (index n_ + 1, multiplier z_θ) and the
   // objective gains ρθ; the first iterate strictly inside every constraint drops θ.
@@ -326,19 +300,19 @@ class FreeTimeSolver {
 };
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
-  band_ = BandedSymmetric<double>(n_, kHalfBandwidth);
+  kkt_.band = BandedSymmetric<double>(n_, ReducedProblem::kHalfBandwidth);
   const int b = borderSize();
-  border_.setZero(n_, b);
-  corner_.setZero(b, b);
+  kkt_.border.setZero(n_, b);
+  kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
-  std::vector<FreeTimeGroup*> torque_groups;
+  std::vector<FreeTimeRows*> torque_groups;
   for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
   const auto weights = [&](int k, const Vector3& r) {
     // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
     const double s = torqueScale(k);
     Vector3 w = epsilon * r;
-    for (FreeTimeGroup* g : torque_groups) {
+    for (FreeTimeRows* g : torque_groups) {
       w -= (g->instance(k).z / s) * g->constraint->gradient(r / s);
     }
     return w;
@@ -362,8 +336,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         Matrix3 W = epsilon * Matrix3::Identity();
         Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-        for (FreeTimeGroup* g : torque_groups) {
-          FreeTimeInstance& in = g->instance(st.k);
+        for (FreeTimeRows* g : torque_groups) {
+          FreeTimeRow& in = g->instance(st.k);
           in.c = g->constraint->value(tau) + relaxation(*g);
           const Vector3 a = g->constraint->gradient(tau) / s;
           in.g = G.transpose() * a;
@@ -394,11 +368,11 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// c(q) and λ = −Σ z c'(q) in the contraction; ∇c = c'∇q, −Σ z∇²c = λ·∇²q (the constraints on
 /// these quantities are affine in q), and each constraint's barrier term (z/c) g gᵀ, in η = h/h₀.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
-  const FreeTimeGroup& first = groups_[block.front()];
+  const FreeTimeRows& first = groups_[block.front()];
   const auto contract = [&](int k, const Vector3& q) {
     Vector3 lambda = Vector3::Zero();
     for (const int i : block) {
-      FreeTimeInstance& in = groups_[i].instance(k);
+      FreeTimeRow& in = groups_[i].instance(k);
       in.c = groups_[i].constraint->value(q) + relaxation(groups_[i]);
       lambda -= in.z * groups_[i].constraint->gradient(q);
     }
@@ -410,7 +384,7 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
         Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
         const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
         for (const int i : block) {
-          FreeTimeInstance& in = groups_[i].instance(t.k);
+          FreeTimeRow& in = groups_[i].instance(t.k);
           in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
           // (z/c) g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
           const double w = in.z / in.c;
@@ -430,23 +404,23 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
 void FreeTimeSolver::assembleElastic(double mu) {
   if (!elastic_) return;
   const int t = n_ + 1;
-  for (const FreeTimeGroup& g : groups_) {
+  for (const FreeTimeRows& g : groups_) {
     if (!g.quantity->dependsOnTimeStep()) continue;
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeInstance& in = g.instance(k);
+      const FreeTimeRow& in = g.instance(k);
       const double w = in.z / in.c;
       for (int node = 0; node < g.support.width; ++node) {
         const int v = np_.variableIndex(k + g.support.node_offset + node);
-        if (v >= 0) border_.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
+        if (v >= 0) kkt_.border.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
       }
-      corner_(0, 1) += w * in.g(9);
-      corner_(1, 1) += w;
+      kkt_.corner(0, 1) += w * in.g(9);
+      kkt_.corner(1, 1) += w;
       rhs_(t) += mu / in.c;
       lagrangian_gradient_(t) -= in.z;
     }
   }
-  corner_(1, 0) = corner_(0, 1);
-  corner_(1, 1) += z_theta_ / theta_;
+  kkt_.corner(1, 0) = kkt_.corner(0, 1);
+  kkt_.corner(1, 1) += z_theta_ / theta_;
   rhs_(t) += mu / theta_ - rho_;
   lagrangian_gradient_(t) += rho_ - z_theta_;
 }
@@ -470,68 +444,17 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
     if (v < 0) continue;
     rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
     lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
-    border_.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
+    kkt_.border.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
   }
   rhs_(n_) += rhs(9);
   lagrangian_gradient_(n_) += lagrangian(9);
-  corner_(0, 0) += H(9, 9);
+  kkt_.corner(0, 0) += H(9, 9);
   const int first_slot = std::max(0, np_.firstFreeNode() - first_node);
   const int last_slot = std::min(width - 1, np_.lastFreeNode() - first_node);
   if (first_slot <= last_slot) {
-    band_.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
-                               Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()), 3 * first_slot,
-                               3 * (last_slot + 1));
-  }
-}
-
-/// The Newton step of the barrier problem (bordered band), with a shift δ·I (δ relative to the
-/// mean diagonal: a row-relative shift would scale with the barrier terms of active bounds and
-/// stall the step) until the band is positive definite, the Schur complement positive and the
-/// step a descent direction of φ_μ. As IPOPT's δ_w: the next iteration starts from a third of
-/// the last shift that worked.
-bool FreeTimeSolver::solveStep(Eigen::VectorXd* d) {
-  const int b = borderSize();
-  double scale = corner_.diagonal().cwiseAbs().sum();
-  for (int i = 0; i < n_; ++i) scale += std::abs(band_(i, i));
-  scale /= n_ + b;
-  const double resumed = last_shift_ > 0
-                             ? std::max(parameters_.free_time_smallest_shift, last_shift_ / 3)
-                             : parameters_.free_time_first_shift;
-  for (double shift = damping_; shift <= parameters_.free_time_max_shift;
-       shift = shift == 0.0 ? resumed : shift * (last_shift_ > 0 ? 8 : parameters_.shift_growth)) {
-    BandedSymmetric<double> A = band_;
-    if (shift > 0) A.addToDiagonal(shift * scale);
-    Eigen::MatrixXd D = corner_;
-    D.diagonal().array() += shift * scale;
-    BorderedBanded& factor = step_factor_;
-    if (!factor.factor(A, border_, D)) continue;
-    if (factor.inertia().positive != b) continue;
-    *d = rhs_;
-    factor.solve(d);
-    if (d->allFinite() && d->dot(rhs_) > 0) {
-      last_shift_ = shift;
-      return true;
-    }
-  }
-  return false;
-}
-
-/// A Levenberg–Marquardt damping of the Newton step (the shift δ·I of solveStep, from the first
-/// shift, ×growth per further cut step, ÷growth per full step, 0 below the smallest shift):
-/// where minimum time is flat (a torque strictly inside its bounds along an arc: only the
-/// vanishing ε C curves it) the Newton step is long in those directions, and the constraints'
-/// curvature along it cuts it at the boundary again and again (measured: 0.96 N m about body x
-/// against |u_x| ≤ 1, N = 64: 500 iterations at steps of 1/512 … 1/8 with the stationarity stuck
-/// at 3e-5). The residuals that decide convergence are the undamped ones: the KKT point is the
-/// same, only the path to it is shorter.
-void FreeTimeSolver::dampAfterCutSteps(double alpha, bool late) {
-  cut_steps_ = late && alpha < parameters_.free_time_cut_step ? cut_steps_ + 1 : 0;
-  const double growth = parameters_.free_time_damping_growth;
-  if (cut_steps_ >= parameters_.free_time_cut_steps_before_damping) {
-    damping_ = std::max(growth * damping_, parameters_.free_time_first_shift);
-  } else if (alpha == 1.0) {
-    damping_ =
-        damping_ / growth >= parameters_.free_time_smallest_damping ? damping_ / growth : 0.0;
+    kkt_.band.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
+                                   Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()),
+                                   3 * first_slot, 3 * (last_slot + 1));
   }
 }
 
@@ -619,8 +542,8 @@ bool FreeTimeSolver::lineSearch(Eigen::VectorXd* step, double mu, double epsilon
 bool FreeTimeSolver::secondOrderCorrection(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
-  forEachValue(np_.current(), [&](const FreeTimeGroup& group, int k, double c_at_step) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(group).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& group, int k, double c_at_step) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(group).instance(k);
     in.r = c_at_step - in.c - localDot(group, k, in.g, d);
     const double w = -(in.z / in.c) * in.r;
     if (w == 0.0) return;
@@ -639,12 +562,12 @@ bool FreeTimeSolver::secondOrderCorrection(const Eigen::VectorXd& d, Eigen::Vect
 }
 
 void FreeTimeSolver::clearCorrection() {
-  for (FreeTimeGroup& g : groups_) {
-    for (FreeTimeInstance& in : g.at) in.r = 0.0;
+  for (FreeTimeRows& g : groups_) {
+    for (FreeTimeRow& in : g.at) in.r = 0.0;
   }
 }
 
-double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
+double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
@@ -661,63 +584,51 @@ double FreeTimeSolver::localDot(const FreeTimeGroup& g, int k,
 /// boundary; applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   double alpha = 1.0;
-  for (FreeTimeGroup& g : groups_) {
+  for (FreeTimeRows& g : groups_) {
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      FreeTimeInstance& in = g.instance(k);
-      in.dz = mu / in.c - in.z - in.z / in.c * (localDot(g, k, in.g, d) + in.r);
-      if (in.dz < 0) alpha = std::min(alpha, -parameters_.fraction_to_boundary * in.z / in.dz);
+      FreeTimeRow& in = g.instance(k);
+      in.dz = form_.dualDirection(in.z, in.c, mu, localDot(g, k, in.g, d) + in.r, &alpha);
     }
   }
   double dz_theta = 0.0;
   if (elastic_) {  // at the assembled θ (the line search has moved θ already)
-    dz_theta = mu / theta_assembled_ - z_theta_ - z_theta_ / theta_assembled_ * d(n_ + 1);
-    if (dz_theta < 0) {
-      alpha = std::min(alpha, -parameters_.fraction_to_boundary * z_theta_ / dz_theta);
-    }
+    dz_theta = form_.dualDirection(z_theta_, theta_assembled_, mu, d(n_ + 1), &alpha);
   }
   z_theta_ += alpha * dz_theta;
-  for (FreeTimeGroup& g : groups_) {
-    for (FreeTimeInstance& in : g.at) in.z += alpha * in.dz;
+  for (FreeTimeRows& g : groups_) {
+    for (FreeTimeRow& in : g.at) in.z += alpha * in.dz;
   }
 }
 
 /// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c.
 void FreeTimeSolver::safeguardDuals(double mu) {
-  const double kappa = parameters_.dual_safeguard;
-  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = std::clamp(in.z, mu / (kappa * c), kappa * mu / c);
+    in.z = form_.safeguarded(in.z, c, mu);
   });
-  if (elastic_) z_theta_ = std::clamp(z_theta_, mu / (kappa * theta_), kappa * mu / theta_);
+  if (elastic_) z_theta_ = form_.safeguarded(z_theta_, theta_, mu);
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
-  forEachValue(np_.current(), [&](const FreeTimeGroup& g, int k, double c) {
-    FreeTimeInstance& in = const_cast<FreeTimeGroup&>(g).instance(k);
+  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = mu / c;
+    in.z = form_.initialMultiplier(c, mu);
   });
-  if (elastic_) z_theta_ = mu / theta_;
+  if (elastic_) z_theta_ = form_.initialMultiplier(theta_, mu);
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point.
 double FreeTimeSolver::barrierResidual(double mu) const {
-  double worst = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  for (const FreeTimeGroup& g : groups_) {
-    for (const FreeTimeInstance& in : g.at) worst = std::max(worst, std::abs(in.z * in.c - mu));
-  }
+  double worst = form_.residual(groups_, lagrangian_gradient_.lpNorm<Eigen::Infinity>(), mu);
   if (elastic_) worst = std::max(worst, std::abs(z_theta_ * theta_ - mu));
   return worst;
 }
 
 /// Σ zᵢcᵢ at the assembled point.
 double FreeTimeSolver::dualityGap() const {
-  double gap = 0.0;
-  for (const FreeTimeGroup& g : groups_) {
-    for (const FreeTimeInstance& in : g.at) gap += in.z * in.c;
-  }
-  return gap;
+  return form_.dualityGap(groups_);
 }
 
 /// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
@@ -794,7 +705,8 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     double alpha = 0.0;
     const bool late = mu <= parameters_.free_time_damped_barrier * mu0;
     step_at_round_off_ = false;
-    if (!solveStep(&d) || !lineSearch(&d, mu, epsilon, late, &alpha)) {
+    if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d) ||
+        !lineSearch(&d, mu, epsilon, late, &alpha)) {
       // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
       // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
       // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
@@ -814,7 +726,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
                      epsilon);
     }
     dualStep(d, mu);
-    dampAfterCutSteps(alpha, late);
+    inertia_.afterStep(alpha, late);
     leaveElasticIfInside();
     safeguardDuals(mu);
   }
@@ -838,10 +750,10 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
   const std::vector<Vector3> tau = np_.torques(out.steps);
   if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  for (const FreeTimeGroup& g : groups_) {
+  for (const FreeTimeRows& g : groups_) {
     const int a = g.constraint->axis();
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeInstance& in = g.instance(k);
+      const FreeTimeRow& in = g.instance(k);
       out.complementarity += in.z * in.c;
       out.smallest_value = std::min(out.smallest_value, in.c);
       // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
@@ -868,8 +780,8 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
 /// definite, its least eigenpair from the dense matrix (n ≤ a few hundred at the start grid; this
 /// runs once per converged solve, and only there).
 bool FreeTimeSolver::barrierHessianDefinite() const {
-  BorderedBanded factor;
-  return factor.factor(band_, border_, corner_) && factor.inertia().positive == borderSize() &&
+  BorderedBandKkt<double> factor;
+  return factor.factor(kkt_, Shift{}) && factor.inertia().positive == borderSize() &&
          factor.inertia().negative == 0;
 }
 
@@ -901,22 +813,22 @@ std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() c
   double radius = 0.0, scale = 0.0;  // Gershgorin: every eigenvalue ≥ min_i (K_ii − Σ|K_ij|)
   for (int i = 0; i < size; ++i) {
     double off = 0.0;
-    for (int j = std::max(0, i - band_.bandwidth()); j <= std::min(n_ - 1, i + band_.bandwidth());
-         ++j) {
-      if (i < n_ && j != i) off += std::abs(band_(i, j));
+    for (int j = std::max(0, i - kkt_.band.bandwidth());
+         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
+      if (i < n_ && j != i) off += std::abs(kkt_.band(i, j));
     }
-    off += i < n_ ? border_.row(i).cwiseAbs().sum() : border_.col(i - n_).cwiseAbs().sum();
-    const double diagonal = i < n_ ? band_(i, i) : corner_(i - n_, i - n_);
-    if (i >= n_) off += corner_.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
+    off += i < n_ ? kkt_.border.row(i).cwiseAbs().sum() : kkt_.border.col(i - n_).cwiseAbs().sum();
+    const double diagonal = i < n_ ? kkt_.band(i, i) : kkt_.corner(i - n_, i - n_);
+    if (i >= n_) off += kkt_.corner.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
     radius = std::max(radius, std::abs(diagonal) + off);
     scale += std::abs(diagonal) / size;
   }
   const auto shifted = [&](double sigma, BorderedBanded* factor) {
-    BandedSymmetric<double> A = band_;
+    BandedSymmetric<double> A = kkt_.band;
     A.addToDiagonal(-sigma);
-    Eigen::MatrixXd D = corner_;
+    Eigen::MatrixXd D = kkt_.corner;
     D.diagonal().array() -= sigma;
-    return factor->factor(A, border_, D) && factor->inertia().positive == b &&
+    return factor->factor(A, kkt_.border, D) && factor->inertia().positive == b &&
            factor->inertia().negative == 0;
   };
   BorderedBanded factor;
@@ -935,13 +847,13 @@ std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() c
   LeastEigenpair least;
   Eigen::VectorXd Kx = Eigen::VectorXd::Zero(size);
   for (int i = 0; i < n_; ++i) {
-    for (int j = std::max(0, i - band_.bandwidth()); j <= std::min(n_ - 1, i + band_.bandwidth());
-         ++j) {
-      Kx(i) += band_(i, j) * x(j);
+    for (int j = std::max(0, i - kkt_.band.bandwidth());
+         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
+      Kx(i) += kkt_.band(i, j) * x(j);
     }
   }
-  Kx.head(n_) += border_ * x.tail(b);
-  Kx.tail(b) = border_.transpose() * x.head(n_) + corner_ * x.tail(b);
+  Kx.head(n_) += kkt_.border * x.tail(b);
+  Kx.tail(b) = kkt_.border.transpose() * x.head(n_) + kkt_.corner * x.tail(b);
   least.value = x.dot(Kx);  // the Rayleigh quotient
   least.vector = x;
   least.scale = scale;

@@ -11,6 +11,8 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/interior_point/inertia_correction.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/problem/verdict.hpp"
@@ -69,7 +71,8 @@ class GridSolve {
         system_(problem, np, request.formulation, parameters),
         barrier_(makeBarrierUpdate(request.barrier, parameters)),
         free_slacks_(system_.freeSlacks()),
-        hessian_(np->unknowns(), 8) {
+        inertia_(parameters),
+        kkt_blocks_(np->unknowns()) {
     system_.setInterruption(&context);
   }
 
@@ -173,12 +176,12 @@ class GridSolve {
     Direction d;
     bool primal = false;
     for (int attempt = 0; attempt < 2 && !d.factored; ++attempt) {
-      d.cost = system_.assemble(mu_, rho_, primal, &hessian_, &rhs_, &merit_gradient_).cost;
+      d.cost = system_.assemble(mu_, rho_, primal, &kkt_blocks_.band, &rhs_, &merit_gradient_).cost;
       if (!std::isfinite(d.cost)) break;
-      d.factored = factorWithInertiaCorrection(&d.shift);
+      d.factored = inertia_.factorAndSolve(kkt_, kkt_blocks_, rhs_, &delta_, &d.shift, &context_);
       if (d.factored && !primal && mu_ > scales_.mu_final) {
         barrier_->beforeStep(
-            system_, [this](Eigen::VectorXd* b) { cholesky_.solve(b); }, rhs_, scales_,
+            system_, [this](Eigen::VectorXd* b) { kkt_.solve(b); }, rhs_, scales_,
             previous_decrement_, &mu_, &delta_);
       }
       d.slope = merit_gradient_.dot(delta_);
@@ -189,27 +192,6 @@ class GridSolve {
       }
     }
     return d;
-  }
-
-  /// Inertia correction: a shift relative to each row's scale, grown until the Cholesky
-  /// factorization succeeds (at the final barrier the active constraints' rows are ~1/μ larger
-  /// than the others, and a uniform shift sized by them damps the free directions into linear
-  /// convergence). Solves delta_ = H⁻¹ rhs_.
-  bool factorWithInertiaCorrection(double* shift) {
-    *shift = shift_floor_;
-    for (int tries = 0; tries < p_.max_inertia_corrections; ++tries) {
-      delta_ = rhs_;
-      BandedSymmetric<Scalar> trial = hessian_;
-      if (*shift > 0) {
-        trial.addRelativeToDiagonal(*shift, p_.shift_row_floor * hessian_.maxAbsDiagonal());
-      }
-      if (cholesky_.factor(trial, &context_)) {
-        cholesky_.solve(&delta_);
-        if (delta_.allFinite()) return true;
-      }
-      *shift = *shift == 0.0 ? p_.first_shift : p_.shift_growth * *shift;
-    }
-    return false;
   }
 
   /// Free slacks: the slack and dual steps, the ℓ1 merit's ν (at least the multipliers after the
@@ -318,10 +300,7 @@ class GridSolve {
       return end(Termination::Converged, why.str(), t.relative_decrement);
     }
     relative_decrement_ = t.relative_decrement;
-    if (shift_floor_ < p_.max_shift_floor) {
-      shift_floor_ = std::max(p_.line_search_shift, p_.shift_growth * shift_floor_);
-      return Next::Continue;
-    }
+    if (inertia_.raiseFloor()) return Next::Continue;
     return end(Termination::NotConverged, "line search failed");
   }
 
@@ -335,7 +314,7 @@ class GridSolve {
     }
     system_.applyDualStep(dz_, std::min(alpha_dual_, 1.0));
     np_.setCurrent(trial);
-    shift_floor_ = shift_floor_ > p_.line_search_shift ? shift_floor_ / p_.shift_growth : 0.0;
+    inertia_.relax();
   }
 
   /// Records the iteration and reports it; false if the caller asked to stop.
@@ -439,8 +418,10 @@ class GridSolve {
   ConstrainedSystem system_;
   std::unique_ptr<BarrierUpdate> barrier_;
   const bool free_slacks_;
-  BandedSymmetric<Scalar> hessian_;
-  BandedCholeskyFactor<Scalar> cholesky_;
+  RowRelativeShift
+      inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
+  KktBlocks<Scalar> kkt_blocks_;  ///< the condensed system (a band: no global unknowns at fixed h)
+  BandKkt<Scalar> kkt_;
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;
   double stall_acceptance_ = 0.0;
@@ -449,7 +430,6 @@ class GridSolve {
   double nu_ = 0.0;   ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
   std::vector<double> dz_;
   double alpha_dual_ = 1.0, alpha_slack_ = 1.0;
-  double shift_floor_ = 0.0;  ///< raised after a failed line search, relaxed after a success
   // The stopping test's memory.
   int iteration_ = 0;
   double relative_decrement_ = 0.0;

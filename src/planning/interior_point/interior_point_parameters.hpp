@@ -5,6 +5,7 @@
 #pragma once
 
 #include "attitude_planner/planning/constraints.hpp"
+#include "attitude_planner/planning/problem.hpp"  // kNodeConstraintTolerance
 
 namespace attitude_planner {
 
@@ -86,7 +87,9 @@ struct InteriorPointParameters {
   double shift_row_floor = 1e-8;
   /// After a failed line search the shift floor rises to max(this, 100 × floor) ...
   double line_search_shift = 1e-8;
-  /// ... up to this; a direction still rejected ends the solve.
+  /// ... while it is below this; a direction rejected once it is not ends the solve. (1e-8 × 100³
+  /// rounds to just below 1e-2, so with these defaults the last raise takes the floor to about 1:
+  /// test_kkt_system measures the schedule.)
   double max_shift_floor = 1e-2;
   /// A shift this small is round-off, not a change of the step.
   double negligible_shift = 1e-12;

@@ -204,7 +204,7 @@ class GridSolver {
         settings_(settings),
         p_(p),
         augmented_(np.steps() > p.normal_equations_max_steps),
-        hessian_(np.unknowns(), p.hessian_bandwidth),
+        hessian_(np.unknowns(), ReducedProblem::kHalfBandwidth),
         gradient_(np.unknowns()),
         delta_(np.unknowns()),
         stopping_(p, settings.tolerance, np.steps()),

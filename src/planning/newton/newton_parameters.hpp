@@ -15,8 +15,6 @@ struct NewtonParameters {
   int normal_equations_max_steps = 256;
   /// Half bandwidth of the augmented system ordered by node (y_k before δ_k).
   int augmented_bandwidth = 14;
-  /// Half bandwidth of the block-pentadiagonal Hessian in the unknowns.
-  int hessian_bandwidth = 8;
 
   // --- Stopping test -----------------------------------------------------------------------------
   /// Least relative torque accuracy (decrement / |τ|₂) a round-off stall counts as converged at.

@@ -49,6 +49,10 @@ class ReducedProblem {
   /// StepTooLarge if a boundary velocity has no step.
   explicit ReducedProblem(const PlanningProblem& problem);
 
+  /// Half bandwidth of the Newton systems in the unknowns δ (the one owner of this fact): a torque
+  /// τ_k couples δ_{k−1}, δ_k, δ_{k+1}, 9 unknowns, so a row reaches 8 others on either side.
+  static constexpr int kHalfBandwidth = 8;
+
   int steps() const { return N_; }
   /// Number of unknowns, 3(N − 3) (3(N − 1) with end torques).
   int unknowns() const { return 3 * (last_free_ - first_free_ + 1); }

@@ -1,0 +1,153 @@
+// The constraint rows of the interior point and the barrier forms that say how a row c(x) ≥ 0
+// enters the barrier problem: its multiplier's safeguard, its merit term, its dual step.
+//   FreeSlacks (fixed h): c − s = 0, s > 0 a variable, −μ ln s + ν|c − s| in the merit.
+//   L1Elastic  (fixed h): c + v − s = 0, s, v ≥ 0 eliminated for c (elasticSlacks), the merit
+//                         ψ_μ(c) = ρ v − μ ln s − μ ln v; its multiplier z < ρ (u = ρ − z > 0).
+//   Feasible   (free time): −μ ln c, every iterate strictly inside; the feasible dual step
+//                         dz = μ/c − z − (z/c) gᵀd.
+// κ_Σ (dual_safeguard) keeps each form's moment: the slack forms clamp z where a row is prepared
+// for an assembly (with the new μ), Feasible after a step is accepted (with the step's μ).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/transcription/stage_constraints.hpp"
+#include "planning/transcription/stage_quantities.hpp"
+
+namespace attitude_planner {
+
+/// One row c ≥ 0 of the interior point (one instance of a stage constraint): value c, gradient g
+/// over its local nodes (at most three: 9 entries) and, with a global unknown, η (Entries = 10,
+/// entry 9), multiplier z, and what its barrier form keeps.
+template <int Entries>
+struct ConstraintRow {
+  double c = 0.0;  ///< value (dimensionless)
+  Eigen::Matrix<double, Entries, 1> g = Eigen::Matrix<double, Entries, 1>::Zero();  ///< ∂c/∂x
+  double z = 0.0;                                                                   ///< multiplier
+  // FreeSlacks, L1Elastic:
+  double s = 0.0, v = 0.0;  ///< slacks (L1Elastic: elasticSlacks of c; FreeSlacks: s free)
+  double D = 1.0, q = 0.0;  ///< condensation terms
+  double ds = 0.0;          ///< FreeSlacks: the slack's Newton step
+  // Feasible:
+  double dz = 0.0;  ///< the multiplier's step
+  /// The second-order correction's curvature term c(x + d) − c − gᵀd at the rejected full step
+  /// (0 when the step taken is not a corrected one).
+  double r = 0.0;
+};
+
+/// The rows of one stage constraint on its quantity's support (stage_quantities.hpp).
+template <int Entries>
+struct ConstraintRows {
+  ConstraintRows(const StageConstraint& c, int first_free_node, int last_free_node)
+      : constraint(&c),
+        quantity(&c.quantityModel()),
+        support(quantity->support(first_free_node, last_free_node)),
+        at(support.last_k - support.first_k + 1) {}
+  ConstraintRow<Entries>& instance(int k) { return at[k - support.first_k]; }
+  const ConstraintRow<Entries>& instance(int k) const { return at[k - support.first_k]; }
+
+  const StageConstraint* constraint;
+  const StageQuantityModel* quantity;  ///< &constraint->quantityModel()
+  StageSupport support;
+  std::vector<ConstraintRow<Entries>> at;  ///< at[k − support.first_k]
+};
+
+/// The fixed-h interior point's rows (the node unknowns only).
+using FixedStepRow = ConstraintRow<9>;
+using FixedStepRows = ConstraintRows<9>;
+
+/// How a row enters the fixed-h barrier problem (Formulation::FreeSlacks or Elastic).
+class SlackForm {
+ public:
+  explicit SlackForm(const InteriorPointParameters& parameters) : p_(parameters) {}
+  virtual ~SlackForm() = default;
+  /// Slacks, the (κ_Σ-safeguarded, or primal μ/s) multiplier and the condensation terms D, q for
+  /// the row's value c.
+  virtual void prepare(FixedStepRow& row, double mu, double rho, bool primal) const = 0;
+  /// The row's term of the merit (ρ: the elastic penalty; FreeSlacks: the merit's ν, at the slack
+  /// s + α ds).
+  virtual double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const = 0;
+  /// Whether ∇_δ φ_μ carries the row's barrier term −(μ/s) g (L1Elastic: the slacks are
+  /// functions of c; FreeSlacks: the slack step's slope carries it).
+  virtual bool barrierInMeritGradient() const = 0;
+  /// `alpha` limited by the fraction to the boundary after the row's dual step dz.
+  virtual double dualStepLimit(const FixedStepRow& row, double dz, double rho,
+                               double alpha) const = 0;
+  /// The first multiplier (and FreeSlacks' slack) at the row's value c: the primal one μ/s,
+  /// capped at `cap`.
+  virtual void initialize(FixedStepRow& row, double mu, double rho, double cap) const = 0;
+  /// Adds the row's complementarity products (s z; L1Elastic also v u) to *sum and *count and
+  /// their least to *low.
+  virtual void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum,
+                                  double* low, int* count) const = 0;
+
+ protected:
+  /// z ≥ 0 kept at least (1 − τ) of itself.
+  double multiplierLimit(const FixedStepRow& row, double dz, double alpha) const;
+  const InteriorPointParameters& p_;
+};
+
+/// c − s = 0 with s > 0 free: the multiplier stays near μ/s, the condensation that of c − s = 0.
+class FreeSlacks final : public SlackForm {
+ public:
+  using SlackForm::SlackForm;
+  void prepare(FixedStepRow& row, double mu, double rho, bool primal) const override;
+  double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const override;
+  bool barrierInMeritGradient() const override { return false; }
+  double dualStepLimit(const FixedStepRow& row, double dz, double rho, double alpha) const override;
+  void initialize(FixedStepRow& row, double mu, double rho, double cap) const override;
+  void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum, double* low,
+                          int* count) const override;
+};
+
+/// c + v − s = 0, ℓ1-penalized v (the certificate of local infeasibility at fixed h).
+class L1Elastic final : public SlackForm {
+ public:
+  using SlackForm::SlackForm;
+  void prepare(FixedStepRow& row, double mu, double rho, bool primal) const override;
+  double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const override;
+  bool barrierInMeritGradient() const override { return true; }
+  double dualStepLimit(const FixedStepRow& row, double dz, double rho, double alpha) const override;
+  void initialize(FixedStepRow& row, double mu, double rho, double cap) const override;
+  void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum, double* low,
+                          int* count) const override;
+};
+
+std::unique_ptr<SlackForm> makeSlackForm(Formulation formulation,
+                                         const InteriorPointParameters& parameters);
+
+/// The free-time interior point's rows (the node unknowns and η).
+using FreeTimeRow = ConstraintRow<10>;
+using FreeTimeRows = ConstraintRows<10>;
+
+/// −μ Σ ln c with every iterate strictly inside (free time). A scalar barrier unknown (the elastic
+/// start's θ ≥ 0) is one more such row with c = θ: the same functions on (z, c).
+class Feasible {
+ public:
+  explicit Feasible(const InteriorPointParameters& parameters) : p_(parameters) {}
+  /// The primal multiplier μ/c.
+  double initialMultiplier(double c, double mu) const { return mu / c; }
+  /// z within [μ/(κ_Σ c), κ_Σ μ/c].
+  double safeguarded(double z, double c, double mu) const;
+  /// −μ ln c added to *phi while *inside: false (and *inside false) where c ≤ 0 or, checking the
+  /// boundary, c < (1 − τ) c_old.
+  void addRowMerit(double c, double c_old, double mu, bool check_boundary, bool* inside,
+                   double* phi) const;
+  /// dz = μ/c − z − (z/c) slope (slope = gᵀd + r at the assembled point), and `alpha` limited
+  /// by the fraction to the boundary on z.
+  double dualDirection(double z, double c, double mu, double slope, double* alpha) const;
+  /// max(‖∇L‖∞, max |zc − μ|) over the rows (the barrier problem's KKT residual without θ).
+  double residual(const std::vector<FreeTimeRows>& rows, double stationarity, double mu) const;
+  /// Σ zᵢcᵢ at the assembled point.
+  double dualityGap(const std::vector<FreeTimeRows>& rows) const;
+
+ private:
+  const InteriorPointParameters& p_;
+};
+
+}  // namespace attitude_planner

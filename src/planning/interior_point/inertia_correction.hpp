@@ -1,0 +1,77 @@
+// Inertia correction: the diagonal shift δ_w that makes the KKT system (kkt_system.hpp) factor
+// with the inertia a descent step needs, in the two schedules the solvers use (both IPOPT's δ_w
+// in spirit, measured separately; docs/design/one_interior_point.md §1 compares them).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/interior_point/kkt_system.hpp"
+#include "planning/linalg/interruption.hpp"
+
+namespace attitude_planner {
+
+/// IPOPT's perturbation handler (Wächter & Biegler 2006, §3.1): after a system that needed a
+/// shift δ_w, the next one resumes at κ_w⁻ δ_w and grows by κ_w⁺ (κ_w⁻ = 1/3, κ_w⁺ = 8). κ_w⁻
+/// is applied as a division by 3: multiplying by the rounded 1/3 would move the iterates.
+constexpr double kIpoptShiftGrowth = 8.0;         ///< κ_w⁺
+constexpr double kIpoptShiftResumeDivisor = 3.0;  ///< 1/κ_w⁻
+
+/// Fixed h: a shift relative to each row's scale (Shift::Rule::RowRelative, the row floor
+/// `shift_row_floor` × the largest diagonal), from the current floor, first `first_shift`, then
+/// ×`shift_growth`, at most `max_inertia_corrections` factorizations, until the band factors
+/// positive definite (at the final barrier the active constraints' rows are ~1/μ larger than the
+/// others, and a uniform shift sized by them damps the free directions into linear
+/// convergence). After a rejected line search the floor rises (Levenberg–Marquardt), and it is
+/// relaxed after every accepted step.
+class RowRelativeShift {
+ public:
+  explicit RowRelativeShift(const InteriorPointParameters& parameters) : p_(parameters) {}
+  /// Factors K + shift and solves *d = K⁻¹ rhs; *shift is the shift used. False if no shift
+  /// within the tries factors with a finite solution.
+  template <typename Scalar>
+  bool factorAndSolve(KktSystem<Scalar>& kkt, const KktBlocks<Scalar>& k,
+                      const Eigen::VectorXd& rhs, Eigen::VectorXd* d, double* shift,
+                      const Interruption* interruption);
+  /// After a rejected line search: the floor rises to max(line_search_shift, growth × floor);
+  /// false when it is at max_shift_floor already (the direction cannot be regularized further).
+  bool raiseFloor();
+  /// After an accepted step: the floor falls by the growth factor, to 0 below line_search_shift.
+  void relax();
+
+ private:
+  const InteriorPointParameters& p_;
+  double floor_ = 0.0;
+};
+
+/// Free time: a shift times the mean |diagonal| of K (Shift::Rule::Uniform, the globals' corner
+/// included: a row-relative shift would scale with the barrier terms of active bounds and stall
+/// the step), from the damping (afterStep) or 0, then the first shift or, after a system that
+/// needed one, that shift resumed (IPOPT's κ_w⁻, floor free_time_smallest_shift) and grown by
+/// κ_w⁺ (else by shift_growth), at most free_time_max_shift; accepted where K's inertia is
+/// (n + m, 0, 0) and the step is a descent direction (dᵀrhs > 0). Plus the damping after steps
+/// cut short (afterStep).
+class PerturbationHandler {
+ public:
+  explicit PerturbationHandler(const InteriorPointParameters& parameters) : p_(parameters) {}
+  template <typename Scalar>
+  bool factorAndSolve(KktSystem<Scalar>& kkt, const KktBlocks<Scalar>& k,
+                      const Eigen::VectorXd& rhs, Eigen::VectorXd* d);
+  /// A Levenberg–Marquardt damping of the Newton step (the shift of factorAndSolve, from the
+  /// first shift, ×growth per further cut step, ÷growth per full step, 0 below the smallest
+  /// damping): where minimum time is flat (a torque strictly inside its bounds along an arc:
+  /// only the vanishing ε C curves it) the Newton step is long in those directions, and the
+  /// constraints' curvature along it cuts it at the boundary again and again (measured: 0.96 N m
+  /// about body x against |u_x| ≤ 1, N = 64: 500 iterations at steps of 1/512 … 1/8 with the
+  /// stationarity stuck at 3e-5). The residuals that decide convergence are the undamped ones:
+  /// the KKT point is the same, only the path to it is shorter. `late`: μ ≤ the damped barrier.
+  void afterStep(double alpha, bool late);
+
+ private:
+  const InteriorPointParameters& p_;
+  double last_shift_ = 0.0;  ///< the last system's shift (0: none)
+  double damping_ = 0.0;     ///< the damping (0: none)
+  int cut_steps_ = 0;        ///< steps in a row cut below free_time_cut_step
+};
+
+}  // namespace attitude_planner

@@ -1,0 +1,94 @@
+// The interior point's Newton (KKT) system behind one interface: the band of the node unknowns
+// alone (fixed h), or that band bordered by a few global unknowns (free time: η = h/h₀ and, while
+// the start is elastic, θ),
+//
+//     K = [ A   B ]     A  n×n banded, half bandwidth ReducedProblem::kHalfBandwidth,
+//         [ Bᵀ  D ],    B  n×m dense, D m×m (m = 0 at fixed h).
+//
+// One assembly fills KktBlocks; a KktSystem factors K plus a diagonal shift (the inertia
+// correction's, inertia_correction.hpp), reads its inertia, and solves with the last factor
+// (Mehrotra's corrector and the second-order correction reuse it).
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "planning/linalg/banded_matrix.hpp"
+#include "planning/linalg/bordered_band.hpp"
+#include "planning/linalg/interruption.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// What one assembly fills: A (the node unknowns' band), B and D (the global unknowns in force;
+/// empty at fixed h).
+template <typename Scalar>
+struct KktBlocks {
+  explicit KktBlocks(int n) : band(n, ReducedProblem::kHalfBandwidth) {}
+  int globals() const { return static_cast<int>(corner.rows()); }
+  BandedSymmetric<Scalar> band;
+  Eigen::MatrixXd border;  ///< B: n × m
+  Eigen::MatrixXd corner;  ///< D: m × m
+};
+
+/// The diagonal shift added before a factorization. RowRelative (fixed h): A(i, i) += value ·
+/// (|A(i, i)| + row_floor) on the band's rows (BandedSymmetric::addRelativeToDiagonal); Uniform
+/// (free time): value on every diagonal entry of A and D. A zero value leaves the band as it is.
+struct Shift {
+  enum class Rule { RowRelative, Uniform };
+  double value = 0.0;
+  Rule rule = Rule::Uniform;
+  double row_floor = 0.0;
+};
+
+/// K's inertia: the band positive definite or not, and the signs of the Schur complement's
+/// eigenvalues (BorderedInertia; all zero counts at m = 0).
+using KktInertia = BorderedInertia;
+
+template <typename Scalar>
+class KktSystem {
+ public:
+  virtual ~KktSystem() = default;
+  /// Factors K + shift. False where the band is not numerically positive definite or the Schur
+  /// complement is singular (then solve must not be called). `interruption` (optional) is polled
+  /// inside the band's factorization and may throw.
+  virtual bool factor(const KktBlocks<Scalar>& k, const Shift& shift,
+                      const Interruption* interruption = nullptr) = 0;
+  virtual const KktInertia& inertia() const = 0;
+  /// Solves with the last successful factor, in place: n entries then m.
+  virtual void solve(Eigen::VectorXd* rhs) const = 0;
+};
+
+/// m = 0: the band's Cholesky factor (fixed h).
+template <typename Scalar>
+class BandKkt final : public KktSystem<Scalar> {
+ public:
+  bool factor(const KktBlocks<Scalar>& k, const Shift& shift,
+              const Interruption* interruption = nullptr) override;
+  const KktInertia& inertia() const override { return inertia_; }
+  void solve(Eigen::VectorXd* rhs) const override { cholesky_.solve(rhs); }
+
+ private:
+  BandedCholeskyFactor<Scalar> cholesky_;
+  KktInertia inertia_;
+};
+
+/// m ≥ 1: the Schur complement on the border (linalg/bordered_band.hpp; free time).
+template <typename Scalar>
+class BorderedBandKkt final : public KktSystem<Scalar> {
+ public:
+  bool factor(const KktBlocks<Scalar>& k, const Shift& shift,
+              const Interruption* interruption = nullptr) override;
+  const KktInertia& inertia() const override { return factor_.inertia(); }
+  void solve(Eigen::VectorXd* rhs) const override { factor_.solve(rhs); }
+
+ private:
+  BorderedBandedFactor<Scalar> factor_;
+};
+
+/// The implementation for m global unknowns (the loop never asks which).
+template <typename Scalar>
+std::unique_ptr<KktSystem<Scalar>> makeKkt(int globals);
+
+}  // namespace attitude_planner

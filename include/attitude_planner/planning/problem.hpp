@@ -190,9 +190,11 @@ struct IterationInfo {
   int iteration = 0;
   double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
   double gradient_norm = 0.0;  ///< optimality residual (Newton: relative Newton decrement)
-  double step_length = 0.0;    ///< step accepted (Newton: 1, damped by its shift instead)
-  int steps = 0;               ///< N of the grid level iterated on (0: not reported)
-  double effort = 0.0;         ///< h · cost at that level [N²·m²·s], comparable across levels
+  /// step accepted (Newton: 1, damped by its shift instead; the free-time interior point: 0 for
+  /// an iteration that lowered the barrier parameter at the same iterate)
+  double step_length = 0.0;
+  int steps = 0;        ///< N of the grid level iterated on (0: not reported)
+  double effort = 0.0;  ///< h · cost at that level [N²·m²·s], comparable across levels
 };
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.

@@ -94,8 +94,8 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
 /// free-time plan (answerAt). Empty if no solve converged (the caller falls back to the search).
 class FreeTimeMinimumTime {
  public:
-  FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
-      : problem_(problem), context_(options) {}
+  FreeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context)
+      : problem_(problem), context_(context) {}
 
   std::optional<PlanResult> run() {
     const bool rest_to_rest =
@@ -146,9 +146,8 @@ class FreeTimeMinimumTime {
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
                         double duration, AttemptStart kind, const StartDetail& detail,
                         const BarrierWatch& watch = {}) {
-    const SolverOptions remaining = context_.remainingOptions();
     FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
-                                      kFreeTimeMaxIterations, &remaining, watch);
+                                      kFreeTimeMaxIterations, context_, watch);
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;
@@ -199,7 +198,7 @@ class FreeTimeMinimumTime {
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
     int best = -1;
     for (const FreeTimeStart& st : starts) {
-      if (budgetSpent(context_.remainingOptions())) break;
+      if (context_.stopReason()) break;
       std::vector<Matrix3> start = clearOfCones(grid, st);
       const int same = sameStartAs(start, st.duration);
       StartDetail detail = st.detail;
@@ -360,7 +359,7 @@ class FreeTimeMinimumTime {
       const StartRecord saddle = starts_[from];
       int lower = -1;
       for (const double sign : {1.0, -1.0}) {
-        if (budgetSpent(context_.remainingOptions())) return best;
+        if (context_.stopReason()) return best;
         std::vector<Matrix3> start =
             displacedAlongNegativeCurvature(grid, saddle.outcome, sign * kSaddleEscape);
         if (start.empty()) continue;
@@ -494,7 +493,7 @@ class FreeTimeMinimumTime {
   }
 
   const PlanningProblem& problem_;
-  SolveContext context_;
+  SolveContext& context_;
   std::vector<StartRecord> starts_;   ///< every start solved (or repeated), in order
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
@@ -534,7 +533,8 @@ GridLevelRule freeTimeGridRule() {
 std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
                                               const SolverOptions& options,
                                               std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, options);
+  SolveContext context(options);
+  FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.run();
   if (!answer && tried) *tried = solver.trail();
   return answer;
@@ -543,7 +543,8 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
                                            double duration, const SolverOptions& options,
                                            std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, options);
+  SolveContext context(options);
+  FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.runFrom(plan, duration, "search's plan");
   if (!answer && tried) *tried = solver.trail();
   return answer;

@@ -46,6 +46,9 @@ class SolveContext : public Interruption {
   /// request (1, 2, ...); returns false if the caller asked to stop (then stopReason() is
   /// Cancelled from here on).
   bool reportIteration(const IterationInfo& info);
+  /// Whether a caller reads the reports (options().on_iteration set): figures that cost a pass
+  /// over the grid are formed only then.
+  bool hasIterationCallback() const { return static_cast<bool>(options_.on_iteration); }
   /// Iterations reported so far.
   int iterations() const { return iterations_; }
 

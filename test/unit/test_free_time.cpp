@@ -1116,6 +1116,9 @@ TEST(FreeTime, AMinimumTimeRequestReportsEveryFreeTimeIteration) {
     }
     ASSERT_GT(free_time_iterations, 0) << name;
     EXPECT_GE(numbers.size(), static_cast<std::size_t>(free_time_iterations)) << name;
+    for (std::size_t i = 0; i < numbers.size(); ++i) {
+      ASSERT_EQ(numbers[i], static_cast<int>(i) + 1) << name << ": numbered once per request";
+    }
     // The same request without a callback: the same answer (reports read, never steer).
     const ap::PlanResult quiet = ap::planManeuver(scene(name, 64));
     EXPECT_EQ(quiet.minimum_duration, r.minimum_duration) << name;

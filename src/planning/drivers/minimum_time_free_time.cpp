@@ -166,9 +166,8 @@ class FreeTimeMinimumTime {
   /// A structured start made to clear the cones: a start too close to a cone is replaced by the
   /// minimum-effort plan under the cones alone from it (coneClearStart).
   std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
-    const SolverOptions remaining = context_.remainingOptions();
     if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
-    return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
+    return coneClearStart(p, st.attitudes, st.duration, context_).value_or(st.attitudes);
   }
 
   /// The earlier start whose solve this one would repeat (the same T and attitudes within
@@ -530,10 +529,8 @@ GridLevelRule freeTimeGridRule() {
   return rule;
 }
 
-std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
-                                              const SolverOptions& options,
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                               std::vector<Attempt>* tried) {
-  SolveContext context(options);
   FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.run();
   if (!answer && tried) *tried = solver.trail();
@@ -541,9 +538,8 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, const SolverOptions& options,
+                                           double duration, SolveContext& context,
                                            std::vector<Attempt>* tried) {
-  SolveContext context(options);
   FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.runFrom(plan, duration, "search's plan");
   if (!answer && tried) *tried = solver.trail();

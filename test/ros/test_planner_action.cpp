@@ -29,6 +29,24 @@ PlanAttitudeManeuverGoal seed(int steps = 32) {
   return g;
 }
 
+/// Minimum time on a sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration, N = 32
+/// (second_order): T* = 2√10 s, the eigenaxis bang–bang slew.
+PlanAttitudeManeuverGoal sphereMinimumTimeGoal() {
+  PlanAttitudeManeuverGoal goal = seed(32);
+  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
+  goal.duration = 0.0;
+  goal.scheme = "second_order";
+  goal.objective = "minimum_time";
+  goal.final_attitude.w = std::cos(0.5);
+  goal.final_attitude.x = std::sin(0.5);
+  goal.final_attitude.y = goal.final_attitude.z = 0.0;
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = 1.0;
+  goal.constraints.push_back(norm);
+  return goal;
+}
+
 /// Waits (wall time, generous) until `pred` holds; returns it.
 template <class Pred>
 bool waitFor(Pred pred, double seconds) {
@@ -201,19 +219,8 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
 TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
   // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration: T* = 2√10 s (eigenaxis
   // bang–bang), the plan at (1 + 0.2) T*.
-  PlanAttitudeManeuverGoal goal = seed(32);
-  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
-  goal.duration = 0.0;
-  goal.scheme = "second_order";
-  goal.objective = "minimum_time";
+  PlanAttitudeManeuverGoal goal = sphereMinimumTimeGoal();
   goal.time_margin = 0.2;
-  goal.final_attitude.w = std::cos(0.5);
-  goal.final_attitude.x = std::sin(0.5);
-  goal.final_attitude.y = goal.final_attitude.z = 0.0;
-  Constraint norm;
-  norm.type = Constraint::MAX_TORQUE_NORM;
-  norm.limit = 1.0;
-  goal.constraints.push_back(norm);
   client_->sendGoal(goal);
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::SUCCEEDED);
@@ -227,18 +234,7 @@ TEST_F(PlannerAction, MinimumTimeGoalGetsFeedbackAtEveryFreeTimeIteration) {
   // The goal above at T* itself (no margin): the free-time interior point reports each of its
   // iterations, so the feedback numbers rise by one with no gap (at least one message every 10
   // iterations, the floor) and count at least the free-time solves' iterations.
-  PlanAttitudeManeuverGoal goal = seed(32);
-  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
-  goal.duration = 0.0;
-  goal.scheme = "second_order";
-  goal.objective = "minimum_time";
-  goal.final_attitude.w = std::cos(0.5);
-  goal.final_attitude.x = std::sin(0.5);
-  goal.final_attitude.y = goal.final_attitude.z = 0.0;
-  Constraint norm;
-  norm.type = Constraint::MAX_TORQUE_NORM;
-  norm.limit = 1.0;
-  goal.constraints.push_back(norm);
+  const PlanAttitudeManeuverGoal goal = sphereMinimumTimeGoal();
   struct Seen {
     std::atomic<int> feedbacks{0};
     std::atomic<int> last_iteration{0};

@@ -416,8 +416,8 @@ void setTermination(const Outcome& o, PlanResult* result) {
                 o.stationarity);
   std::ostringstream message;
   message << (result->converged() ? "converged; " : "not converged; ")
-          << (o.stop_reason == "cancelled" ? "cancelled; " : "") << "nlopt SLSQP: "
-          << resultName(o.code);
+          << (o.stop_reason == "cancelled" ? "cancelled; " : "")
+          << "nlopt SLSQP: " << resultName(o.code);
   if (!o.stop_reason.empty()) message << " (" << o.stop_reason << ")";
   if (!o.exception_text.empty()) message << " (" << o.exception_text << ")";
   message << figures;

@@ -1,21 +1,25 @@
 // planManeuver(): the one entry point. It sits above the analysis layer because a requested
-// accuracy makes it choose N (planToAccuracy) before planning at that resolution.
+// accuracy makes it choose N (planToAccuracy) before planning at that resolution. It builds the
+// request's SolveContext (clock and deadline, cancel flag, iteration numbering, trail), which every
+// driver and solver of the request shares (planning/drivers/requests.hpp).
 #include "attitude_planner/planner.hpp"
 
 #include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/drivers/requests.hpp"
 
 namespace attitude_planner {
 
 PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options) {
-  if (problem.objective == Objective::MinimumTime) return planMinimumTime(problem, options);
-  if (problem.accuracy.active()) {
+  if (problem.accuracy.active() && problem.objective != Objective::MinimumTime) {
     validateProblem(problem);
     validateOptions(options);
-    return planToAccuracy(problem, options);
+    return planToAccuracy(problem, options);  // one request per resolution it tries
   }
-  return planBoundedMinimumEffort(problem, options);
+  SolveContext context(options);
+  if (problem.objective == Objective::MinimumTime) return planMinimumTime(problem, context);
+  return planBoundedMinimumEffort(problem, context);
 }
 
 }  // namespace attitude_planner

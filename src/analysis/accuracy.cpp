@@ -8,6 +8,7 @@
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
+#include "planning/drivers/requests.hpp"
 
 namespace attitude_planner {
 
@@ -135,18 +136,18 @@ struct Rung {
 };
 
 /// Solves `problem` at N and estimates its error for `measure` (cost: Richardson with N/2).
-Rung solveRung(PlanningProblem problem, int N, const SolverOptions& options, double order) {
+Rung solveRung(PlanningProblem problem, int N, SolveContext& context, double order) {
   const AccuracyMeasure measure = problem.accuracy.measure;
   problem.accuracy = AccuracyTarget{};
   problem.steps = N;
   Rung rung;
-  rung.plan = planAtResolution(problem, options);
+  rung.plan = planAtResolution(problem, context.options(), context);
   if (!rung.plan.converged()) return rung;
   if (measure == AccuracyMeasure::TerminalMiss) {
     rung.error = replayZeroOrderHold(problem, rung.plan.maneuver).attitude_miss;
   } else {
     problem.steps = N / 2;
-    const PlanResult half = planAtResolution(problem, options);
+    const PlanResult half = planAtResolution(problem, context.options(), context);
     if (!half.converged()) {
       rung.plan.termination = half.termination;
       rung.plan.message =
@@ -186,8 +187,7 @@ struct SchemeChoice {
   bool failed = false;
 };
 
-template <class Budgeted>
-SchemeChoice chooseScheme(const PlanningProblem& problem, const Budgeted& budgeted,
+SchemeChoice chooseScheme(const PlanningProblem& problem, SolveContext& context,
                           AccuracyEstimate* estimate) {
   const AccuracyTarget& target = problem.accuracy;
   std::vector<SchemeKind> schemes = {problem.scheme};
@@ -202,7 +202,7 @@ SchemeChoice chooseScheme(const PlanningProblem& problem, const Budgeted& budget
     PlanningProblem candidate = problem;
     candidate.scheme = scheme;
     const double p = assumedOrder(problem, scheme, target.measure);
-    Rung coarse = solveRung(candidate, kCoarse, budgeted(), p);
+    Rung coarse = solveRung(candidate, kCoarse, context, p);
     estimate->steps_tried.push_back(kCoarse);
     estimate->errors_tried.push_back(coarse.error);
     estimate->schemes_tried.push_back(schemeName(scheme));
@@ -246,11 +246,10 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
-  // One time budget for all resolutions: each solve gets what is left of it (and ends TimedOut
-  // when nothing is).
-  const auto budgeted = [&] { return withRemainingBudget(options, start); };
-
-  const SchemeChoice choice = chooseScheme(problem, budgeted, &estimate);
+  // One request for all resolutions: one time budget (each solve gets what is left of it, and
+  // ends TimedOut when nothing is), one iteration numbering, one cancel flag.
+  SolveContext context(options);
+  const SchemeChoice choice = chooseScheme(problem, context, &estimate);
   if (choice.failed) return finish(choice.coarse.plan);
   const int best_N = choice.N;
   const SchemeKind best_scheme = choice.scheme;
@@ -273,7 +272,7 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
                        " > max_steps = " + std::to_string(target.max_steps);
       return finish(failed);
     }
-    Rung rung = solveRung(chosen, N, budgeted(), estimate.order);
+    Rung rung = solveRung(chosen, N, context, estimate.order);
     estimate.steps_tried.push_back(N);
     estimate.errors_tried.push_back(rung.error);
     estimate.schemes_tried.push_back(schemeName(best_scheme));

@@ -29,6 +29,24 @@ PlanAttitudeManeuverGoal seed(int steps = 32) {
   return g;
 }
 
+/// Minimum time on a sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration, N = 32
+/// (second_order): T* = 2√10 s, the eigenaxis bang–bang slew.
+PlanAttitudeManeuverGoal sphereMinimumTimeGoal() {
+  PlanAttitudeManeuverGoal goal = seed(32);
+  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
+  goal.duration = 0.0;
+  goal.scheme = "second_order";
+  goal.objective = "minimum_time";
+  goal.final_attitude.w = std::cos(0.5);
+  goal.final_attitude.x = std::sin(0.5);
+  goal.final_attitude.y = goal.final_attitude.z = 0.0;
+  Constraint norm;
+  norm.type = Constraint::MAX_TORQUE_NORM;
+  norm.limit = 1.0;
+  goal.constraints.push_back(norm);
+  return goal;
+}
+
 /// Waits (wall time, generous) until `pred` holds; returns it.
 template <class Pred>
 bool waitFor(Pred pred, double seconds) {
@@ -201,19 +219,8 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
 TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
   // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration: T* = 2√10 s (eigenaxis
   // bang–bang), the plan at (1 + 0.2) T*.
-  PlanAttitudeManeuverGoal goal = seed(32);
-  goal.inertia = {10, 0, 0, 0, 10, 0, 0, 0, 10};
-  goal.duration = 0.0;
-  goal.scheme = "second_order";
-  goal.objective = "minimum_time";
+  PlanAttitudeManeuverGoal goal = sphereMinimumTimeGoal();
   goal.time_margin = 0.2;
-  goal.final_attitude.w = std::cos(0.5);
-  goal.final_attitude.x = std::sin(0.5);
-  goal.final_attitude.y = goal.final_attitude.z = 0.0;
-  Constraint norm;
-  norm.type = Constraint::MAX_TORQUE_NORM;
-  norm.limit = 1.0;
-  goal.constraints.push_back(norm);
   client_->sendGoal(goal);
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::SUCCEEDED);
@@ -221,6 +228,38 @@ TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
   ASSERT_TRUE(result->success) << result->message;
   EXPECT_NEAR(result->minimum_duration, 2 * std::sqrt(10.0), 2e-3 * result->minimum_duration);
   EXPECT_NEAR(result->duration, 1.2 * result->minimum_duration, 1e-9 * result->duration);
+}
+
+TEST_F(PlannerAction, MinimumTimeGoalGetsFeedbackAtEveryFreeTimeIteration) {
+  // The goal above at T* itself (no margin): the free-time interior point reports each of its
+  // iterations, so the feedback numbers rise by one with no gap (at least one message every 10
+  // iterations, the floor) and count at least the free-time solves' iterations.
+  const PlanAttitudeManeuverGoal goal = sphereMinimumTimeGoal();
+  struct Seen {
+    std::atomic<int> feedbacks{0};
+    std::atomic<int> last_iteration{0};
+    std::atomic<int> largest_gap{0};
+  };
+  auto seen = std::make_shared<Seen>();
+  client_->sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [seen](const PlanAttitudeManeuverFeedbackConstPtr& f) {
+                      const int gap = f->iteration - seen->last_iteration.load();
+                      seen->largest_gap = std::max(seen->largest_gap.load(), gap);
+                      seen->last_iteration = f->iteration;
+                      ++seen->feedbacks;
+                    });
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  const auto result = client_->getResult();
+  ASSERT_TRUE(result->success) << result->message;
+  int free_time_iterations = 0;
+  for (const PlanAttempt& a : result->attempts) {
+    if (a.stage == "minimum_time_solve") free_time_iterations += a.iterations;
+  }
+  ASSERT_GT(free_time_iterations, 0);
+  waitFor([&] { return seen->feedbacks.load() >= free_time_iterations; }, 5.0);
+  EXPECT_GE(seen->feedbacks.load(), free_time_iterations);
+  EXPECT_GE(seen->largest_gap.load(), 1);
+  EXPECT_LE(seen->largest_gap.load(), 10);
 }
 
 // The action's scheme field reaches fourth_order (Richardson extrapolation of second_order at N

@@ -962,8 +962,9 @@ TEST(FreeTime, EachSolvedBarrierProblemBoundsTheTTheSolveReaches) {
       points.push_back(point);
       return std::string();
     };
+    ap::SolveContext context{ap::SolverOptions{}};
     const ap::FreeTimeOutcome o =
-        ap::solveFreeTime(c.problem, c.start, c.duration, 1e-9, 500, nullptr, record);
+        ap::solveFreeTime(c.problem, c.start, c.duration, 1e-9, 500, context, record);
     ASSERT_EQ(o.termination, ap::Termination::Converged) << c.label << ": " << o.message;
     ASSERT_GE(points.size(), 3u) << c.label;
     for (const ap::BarrierPoint& point : points) {
@@ -993,8 +994,9 @@ TEST(FreeTime, AWatchThatStopsASolveEndsItThereWithItsPlan) {
     stopped_at = point;
     return std::string("the watch's reason");
   };
+  ap::SolveContext context{ap::SolverOptions{}};
   const ap::FreeTimeOutcome o = ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4,
-                                                  1e-9, 500, nullptr, stop_second);
+                                                  1e-9, 500, context, stop_second);
   EXPECT_EQ(calls, 2);
   EXPECT_EQ(o.termination, ap::Termination::NotConverged);
   EXPECT_TRUE(o.stopped_by_watch);
@@ -1034,5 +1036,92 @@ TEST(FreeTime, TheMinimumTimeAnswerIsTheKeptFreeTimeSolvesPlan) {
         EXPECT_LE(std::abs(r.maneuver.torque[k](a)), bound(a) * (1 + 1e-12)) << name;
       }
     }
+  }
+}
+
+TEST(FreeTime, EveryIterationIsReportedToTheContextNumberedOnce) {
+  // One free-time solve reports each iteration it counts once (an accepted step, or a barrier
+  // update at the same iterate with step length 0): as many callbacks as the outcome's
+  // iterations, numbered 1, 2, ... without a gap, each on the solve's grid with a step in [0, 1]
+  // (most of them steps), a positive cost (Σ ½|τ|² of a plan that turns the body) and effort
+  // h · cost.
+  const ap::PlanningProblem p = scene("min_time_bilimoria_wie", 32);
+  const double r = std::sqrt(0.5);
+  std::vector<ap::IterationInfo> reports;
+  ap::SolverOptions options;
+  options.on_iteration = [&](const ap::IterationInfo& info) {
+    reports.push_back(info);
+    return true;
+  };
+  ap::SolveContext context(options);
+  const ap::FreeTimeOutcome o =
+      ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500, context);
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_GT(o.iterations, 0);
+  ASSERT_EQ(reports.size(), static_cast<std::size_t>(o.iterations));
+  EXPECT_EQ(context.iterations(), o.iterations);
+  int steps_taken = 0;
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    EXPECT_EQ(reports[i].iteration, static_cast<int>(i) + 1);
+    EXPECT_EQ(reports[i].steps, p.steps);
+    EXPECT_GE(reports[i].step_length, 0.0);
+    EXPECT_LE(reports[i].step_length, 1.0);
+    if (reports[i].step_length > 0) ++steps_taken;
+    EXPECT_GT(reports[i].cost, 0.0);
+    EXPECT_GT(reports[i].effort, 0.0);
+  }
+  EXPECT_GT(2 * steps_taken, o.iterations) << "most iterations are steps";
+  // The same solve without a callback: the same iterates (the report only reads them).
+  ap::SolveContext quiet{ap::SolverOptions{}};
+  const ap::FreeTimeOutcome same =
+      ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500, quiet);
+  EXPECT_EQ(same.iterations, o.iterations);
+  EXPECT_EQ(same.duration, o.duration);
+  EXPECT_EQ(quiet.iterations(), o.iterations);
+}
+
+TEST(FreeTime, ACallbackThatRefusesEndsTheSolveCancelledAtOnce) {
+  // on_iteration answering false at the 3rd report: the solve ends Cancelled with 3 iterations,
+  // its last iterate still strictly feasible.
+  const ap::PlanningProblem p = scene("min_time_bilimoria_wie", 32);
+  const double r = std::sqrt(0.5);
+  int calls = 0;
+  ap::SolverOptions options;
+  options.on_iteration = [&](const ap::IterationInfo&) { return ++calls < 3; };
+  ap::SolveContext context(options);
+  const ap::FreeTimeOutcome o =
+      ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500, context);
+  EXPECT_EQ(o.termination, ap::Termination::Cancelled) << o.message;
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(o.iterations, 3);
+  EXPECT_GT(o.smallest_value, 0.0);
+}
+
+TEST(FreeTime, AMinimumTimeRequestReportsEveryFreeTimeIteration) {
+  // A minimum-time request (what an action goal runs): its callbacks count at least the
+  // free-time solves' iterations of its trail, so an action gets feedback at every
+  // interior-point iteration; numbered 1, 2, ... and the largest number is the count.
+  for (const char* name : {"min_time_betts", "min_time_keep_out"}) {
+    std::vector<int> numbers;
+    ap::SolverOptions options;
+    options.on_iteration = [&](const ap::IterationInfo& info) {
+      numbers.push_back(info.iteration);
+      return true;
+    };
+    const ap::PlanResult r = ap::planManeuver(scene(name, 64), options);
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message;
+    int free_time_iterations = 0;
+    for (const ap::Attempt& a : r.attempts) {
+      if (a.stage == ap::AttemptStage::MinimumTimeSolve) free_time_iterations += a.iterations;
+    }
+    ASSERT_GT(free_time_iterations, 0) << name;
+    EXPECT_GE(numbers.size(), static_cast<std::size_t>(free_time_iterations)) << name;
+    for (std::size_t i = 0; i < numbers.size(); ++i) {
+      ASSERT_EQ(numbers[i], static_cast<int>(i) + 1) << name << ": numbered once per request";
+    }
+    // The same request without a callback: the same answer (reports read, never steer).
+    const ap::PlanResult quiet = ap::planManeuver(scene(name, 64));
+    EXPECT_EQ(quiet.minimum_duration, r.minimum_duration) << name;
+    EXPECT_EQ(quiet.attempts.size(), r.attempts.size()) << name;
   }
 }

@@ -273,9 +273,11 @@ TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBefor
 }
 
 TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
-  // The budget arithmetic the stages share (withRemainingBudget): what is left after the time
-  // used, a spent budget the smallest positive one (the next solve ends TimedOut at once), no
-  // budget stays none.
+  // The budget arithmetic of the deprecated public helper (withRemainingBudget, kept for API
+  // users): what is left after the time used, a spent budget the smallest positive one (the next
+  // solve ends TimedOut at once), no budget stays none.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
   ap::SolverOptions options;
   options.time_budget_s = 10.0;
   const auto now = std::chrono::steady_clock::now();
@@ -287,6 +289,7 @@ TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
   EXPECT_TRUE(ap::budgetSpent(spent));
   options.time_budget_s = 0.0;
   EXPECT_EQ(ap::withRemainingBudget(options, now - std::chrono::seconds(11)).time_budget_s, 0.0);
+#pragma GCC diagnostic pop
   // A budget the structured starts spend (Betts at N = 64, 1 ms: its free-time starts take tens
   // of ms): they stop at the deadline and the search, given what is left (nothing), stops at its
   // first solve: one probe, no iteration, the answer timed_out, the free-time stage first. (On

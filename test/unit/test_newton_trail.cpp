@@ -16,6 +16,7 @@
 #include "attitude_planner/planner.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "support/robustness_cases.hpp"
+#include "support/scene_problem.hpp"
 
 using namespace attitude_planner;
 
@@ -407,4 +408,28 @@ TEST(GridContinuation, ACancelCarriesTheLastIterateUpWithoutIterating) {
   EXPECT_EQ(stop->level.steps, 64);
   ASSERT_EQ(r.levels.size(), 4u);
   EXPECT_EQ(r.levels.back().termination, Termination::Cancelled);
+}
+
+// One request, one iteration numbering (SolveContext): a constrained request runs Newton (the
+// unconstrained optimum, its classes) and then the interior point (whose coarse levels run Newton
+// again); every solve reports to the request's one context, so the callback sees 1, 2, ... without
+// a restart, and as many reports as the result counts iterations.
+TEST(SolveContext, OneRequestNumbersItsIterationsOnce) {
+  for (const char* name : {"torque_limited", "sun_keep_out", "rate_limited", "min_time_keep_out"}) {
+    const PlanningProblem p = test_support::sceneProblem(name, 64);
+    std::vector<int> numbers;
+    SolverOptions options;
+    options.on_iteration = [&](const IterationInfo& info) {
+      numbers.push_back(info.iteration);
+      return true;
+    };
+    const PlanResult r = planManeuver(p, options);
+    ASSERT_FALSE(numbers.empty()) << name;
+    for (std::size_t i = 0; i < numbers.size(); ++i) {
+      ASSERT_EQ(numbers[i], static_cast<int>(i) + 1) << name << ": report " << i;
+    }
+    if (p.objective == Objective::MinimumEffort) {
+      EXPECT_EQ(static_cast<int>(numbers.size()), r.iterations) << name << ": " << r.message;
+    }
+  }
 }

@@ -190,9 +190,11 @@ struct IterationInfo {
   int iteration = 0;
   double cost = 0.0;           ///< Σ ½|τ_k|² [N²·m²]
   double gradient_norm = 0.0;  ///< optimality residual (Newton: relative Newton decrement)
-  double step_length = 0.0;    ///< step accepted (Newton: 1, damped by its shift instead)
-  int steps = 0;               ///< N of the grid level iterated on (0: not reported)
-  double effort = 0.0;         ///< h · cost at that level [N²·m²·s], comparable across levels
+  /// step accepted (Newton: 1, damped by its shift instead; the free-time interior point: 0 for
+  /// an iteration that lowered the barrier parameter at the same iterate)
+  double step_length = 0.0;
+  int steps = 0;        ///< N of the grid level iterated on (0: not reported)
+  double effort = 0.0;  ///< h · cost at that level [N²·m²·s], comparable across levels
 };
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.
@@ -247,10 +249,11 @@ inline bool classLeftFree(const PlanningProblem& problem, const SolverOptions& o
 constexpr double kSpentBudget = 1e-300;
 
 /// `options` with what is left of its time budget after `start` (several solves sharing one
-/// budget: grid levels, accuracy resolutions, the minimum-time search). A budget of 0 (none) stays
-/// 0; a spent one becomes kSpentBudget, so the next solve ends TimedOut at once.
-inline SolverOptions withRemainingBudget(const SolverOptions& options,
-                                         std::chrono::steady_clock::time_point start) {
+/// budget). A budget of 0 (none) stays 0; a spent one becomes kSpentBudget, so the next solve ends
+/// TimedOut at once. Deprecated: kept for API users for one release; the planner itself keeps
+/// one budget per request in its solve context (src/planning/problem/solve_context.hpp).
+[[deprecated("one budget per request: the planner's SolveContext keeps it")]] inline SolverOptions
+withRemainingBudget(const SolverOptions& options, std::chrono::steady_clock::time_point start) {
   SolverOptions remaining = options;
   if (options.time_budget_s > 0) {
     const double used =
@@ -260,8 +263,10 @@ inline SolverOptions withRemainingBudget(const SolverOptions& options,
   return remaining;
 }
 
-/// `remaining` (from withRemainingBudget) has a budget, and nothing of it is left.
-inline bool budgetSpent(const SolverOptions& remaining) {
+/// `remaining` (from withRemainingBudget) has a budget, and nothing of it is left. Deprecated
+/// with withRemainingBudget.
+[[deprecated("one budget per request: the planner's SolveContext keeps it")]] inline bool
+budgetSpent(const SolverOptions& remaining) {
   return remaining.time_budget_s > 0 && remaining.time_budget_s <= kSpentBudget;
 }
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <nlopt.hpp>
+#include <sstream>
 #include <string>
 
 #include "attitude_planner/dynamics/simulation.hpp"
@@ -409,18 +410,21 @@ void setTermination(const Outcome& o, PlanResult* result) {
   } else {
     result->termination = Termination::NotConverged;
   }
-  std::string message = "nlopt SLSQP: " + resultName(o.code);
-  if (!o.stop_reason.empty()) message += " (" + o.stop_reason + ")";
-  if (!o.exception_text.empty()) message += " (" + o.exception_text + ")";
   char figures[160];
   std::snprintf(figures, sizeof figures,
                 "; constraint violation %.3g, relative stationarity residual %.3g", o.violation,
                 o.stationarity);
-  message += figures;
-  if (!result->converged() && nlopt_success && !feasible)
-    message += "; terminal constraints not met";
-  if (o.stop_reason == "cancelled") message = "cancelled; " + message;
-  result->message = (result->converged() ? "converged; " : "not converged; ") + message;
+  std::ostringstream message;
+  message << (result->converged() ? "converged; " : "not converged; ")
+          << (o.stop_reason == "cancelled" ? "cancelled; " : "")
+          << "nlopt SLSQP: " << resultName(o.code);
+  if (!o.stop_reason.empty()) message << " (" << o.stop_reason << ")";
+  if (!o.exception_text.empty()) message << " (" << o.exception_text << ")";
+  message << figures;
+  if (!result->converged() && nlopt_success && !feasible) {
+    message << "; terminal constraints not met";
+  }
+  result->message = message.str();
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 #include "planning/drivers/constrained_classes.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -10,6 +9,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/drivers/requests.hpp"
 
 namespace attitude_planner {
 
@@ -74,10 +74,11 @@ Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int ste
 /// The classes' solves and the trail they leave.
 class ClassSearch {
  public:
-  ClassSearch(const PlanningProblem& problem, const SolverOptions& options,
+  ClassSearch(const PlanningProblem& problem, const SolverOptions& options, SolveContext& context,
               const std::vector<ClassPlan>& survey_plans, PlanResult first)
       : problem_(problem),
         options_(options),
+        context_(context),
         survey_plans_(survey_plans),
         trail_(first.attempts),
         first_iterations_(first.iterations),
@@ -93,14 +94,14 @@ class ClassSearch {
   PlanResult solve(const HomotopyClass& homotopy, int steps) {
     PlanResult r;
     r.termination = Termination::NotConverged;
-    SolverOptions options = withRemainingBudget(options_, start_);
+    SolverOptions options = options_;
     const auto surveyed =
         std::find_if(survey_plans_.begin(), survey_plans_.end(), [&](const ClassPlan& c) {
           return sameHomotopyClass(c.homotopy, homotopy) && c.plan.steps() == steps;
         });
     options.unconstrained_optimum = surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
     try {
-      r = planAtResolution(pinnedTo(problem_, homotopy, steps), options);
+      r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
     } catch (const StepTooLarge& e) {
       r.message = e.what();
     }
@@ -118,10 +119,7 @@ class ClassSearch {
     kept_ = last_kept_;
   }
 
-  bool stopped() const {
-    return budgetSpent(withRemainingBudget(options_, start_)) ||
-           (options_.cancel_requested && options_.cancel_requested->load());
-  }
+  bool stopped() const { return context_.stopReason().has_value(); }
 
   /// The best plan with the whole trail, the classes tried in its extremal.
   PlanResult finish(const ExtremalSummary& survey, const HomotopyClass& first_class) {
@@ -154,8 +152,8 @@ class ClassSearch {
 
   const PlanningProblem& problem_;
   SolverOptions options_;
+  SolveContext& context_;
   const std::vector<ClassPlan>& survey_plans_;
-  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::vector<Attempt> trail_;
   std::vector<Attempt> tried_;
   int first_iterations_ = 0;
@@ -169,7 +167,7 @@ class ClassSearch {
 }  // namespace
 
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
-                                    const ExtremalSummary& survey,
+                                    SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first) {
   // A class that converged answers: solving the others costs more than the whole request on
   // a constrained scene (measured, min_time_keep_out.yaml at N = 128 and 1.05 T*: 9 → 69 ms, the
@@ -180,7 +178,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
   if (surveyed.classes.size() < 2) return first;
   const std::string first_message = first.message;
-  ClassSearch search(problem, options, survey_plans, std::move(first));
+  ClassSearch search(problem, options, context, survey_plans, std::move(first));
   const bool on_requested_grid = surveyed.steps >= problem.steps;
   std::optional<HomotopyClass> cheapest;  // on the survey grid
   PlanResult cheapest_plan;

@@ -30,7 +30,7 @@ constexpr double kBetweenNodesSlack = 1e-3;
 /// in `survey_plans` (solveWithNewton's) on the grid of its solve starts from it: its
 /// unconstrained Newton solve is not run again (SolverOptions::unconstrained_optimum).
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
-                                    const ExtremalSummary& survey,
+                                    SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first);
 
 }  // namespace attitude_planner

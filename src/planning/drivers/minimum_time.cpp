@@ -14,6 +14,7 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -62,7 +63,7 @@ struct RichardsonPair {
   Maneuver fine;    ///< the second_order plan at T*, 2N steps
 };
 
-PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context,
                            RichardsonPair* pair = nullptr);
 
 /// `problem` as a minimum-effort problem at T from the plan `at_minimum_time` (attitudes at
@@ -71,16 +72,16 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& 
 /// strictly inside instead of from the unconstrained optimum, with a request's own recipe
 /// (SolverOptions::warm_start_strictly_inside).
 PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
-                                   const Maneuver& at_minimum_time, const SolverOptions& options) {
+                                   const Maneuver& at_minimum_time, SolveContext& context) {
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
   effort.duration = T;
-  SolverOptions o = options;
+  SolverOptions o = context.options();
   o.warm_start = &at_minimum_time;
   o.constrained_from_warm_start = true;
   o.warm_start_strictly_inside = true;
-  return planAtResolution(effort, o);
+  return planAtResolution(effort, o, context);
 }
 
 /// fourth_order at T ≥ T*: each second_order sub-solve from its own plan at T*
@@ -88,16 +89,14 @@ PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
 /// planFourthOrder the 2N solve starts cold: measured on Betts at N = 64 with time_margin 0.005,
 /// 0.02 and 0.1, it ended a false "infeasible" each time.)
 PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const RichardsonPair& pair,
-                               const SolverOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
+                               SolveContext& context) {
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
-  const PlanResult coarse =
-      planFromMinimumTimePlan(sub, T, pair.coarse, withRemainingBudget(options, started));
+  const PlanResult coarse = planFromMinimumTimePlan(sub, T, pair.coarse, context);
   PlanResult fine;
   if (coarse.converged()) {
     sub.steps = 2 * problem.steps;
-    fine = planFromMinimumTimePlan(sub, T, pair.fine, withRemainingBudget(options, started));
+    fine = planFromMinimumTimePlan(sub, T, pair.fine, context);
   }
   std::vector<Attempt> trail = joined(coarse.attempts, fine.attempts);
   const std::string what = "fourth_order (Richardson extrapolation of second_order at N = " +
@@ -134,11 +133,11 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
 /// A plan at T ≥ T* from the minimum-time answer (its plan, and for fourth_order its pair).
 PlanResult planFromMinimumTime(const PlanningProblem& problem, double T,
                                const Maneuver& at_minimum_time, const RichardsonPair& pair,
-                               const SolverOptions& options) {
+                               SolveContext& context) {
   if (problem.scheme == SchemeKind::FourthOrder) {
-    return fourthOrderFromPair(problem, T, pair, options);
+    return fourthOrderFromPair(problem, T, pair, context);
   }
-  return planFromMinimumTimePlan(problem, T, at_minimum_time, options);
+  return planFromMinimumTimePlan(problem, T, at_minimum_time, context);
 }
 
 /// fourth_order (docs/design/fourth_order.md, "Minimum time"): a fourth_order plan at T exists
@@ -149,9 +148,8 @@ PlanResult planFromMinimumTime(const PlanningProblem& problem, double T,
 /// zero ones on the other's constraints, which its minimum-effort plan at T* (from its own plan
 /// at its T*, time-scaled: inside the bounds) meets. The plan is the two plans' Richardson
 /// combination, or the N plan where that leaves a bound (richardsonCombinationWithinTheBounds).
-PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                   RichardsonPair* pair) {
-  const auto started = std::chrono::steady_clock::now();
   const int N = problem.steps;
   PlanningProblem coarse_problem = problem;
   coarse_problem.scheme = SchemeKind::SecondOrder;
@@ -161,14 +159,14 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
   const std::string what =
       "fourth_order minimum time (the second_order minimum-time problems at N = " +
       std::to_string(N) + " and 2N = " + std::to_string(2 * N) + ")";
-  PlanResult fine = minimumTimePlan(fine_problem, withRemainingBudget(options, started));
+  PlanResult fine = minimumTimePlan(fine_problem, context);
   const auto failed = [&](PlanResult sub, const std::string& which) {
     sub.scheme = SchemeKind::FourthOrder;
     sub.message = what + ": " + which + " did not converge (its plan is returned): " + sub.message;
     return sub;
   };
   if (!fine.converged()) return failed(fine, "the one at 2N");
-  PlanResult coarse = minimumTimePlan(coarse_problem, withRemainingBudget(options, started));
+  PlanResult coarse = minimumTimePlan(coarse_problem, context);
   if (!coarse.converged()) return failed(coarse, "the one at N");
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
   const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
@@ -180,9 +178,8 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, const SolverOp
   std::vector<Attempt> other_trail;
   PlanResult& other = fine_binds ? coarse : fine;
   if (other.minimum_duration < T_star) {
-    PlanResult at_T_star =
-        planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem, T_star, other.maneuver,
-                                withRemainingBudget(options, started));
+    PlanResult at_T_star = planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem,
+                                                   T_star, other.maneuver, context);
     other_trail = at_T_star.attempts;
     if (!at_T_star.converged()) {
       std::vector<Attempt> trail;
@@ -230,27 +227,24 @@ constexpr double kProbeBelow = 0.01;
 constexpr int kMaxProbes = 4;
 
 /// Minimum time with spinning ends has local minima that the structured starts miss, with a
-/// minimum-effort plan just below their T* (docs/results/bounded_verdicts.md). So a free-time answer with spinning ends is probed: a cold
-/// minimum-effort solve at (1 − kProbeBelow) T*; where it proves that T feasible
-/// (provesFeasible), the free-time solve from its plan descends to a lower KKT point, which is
-/// probed again. A probe that finds nothing ends it; the trail keeps every probe.
-PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer,
-                       const SolverOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
+/// minimum-effort plan just below their T* (docs/results/bounded_verdicts.md). So a free-time
+/// answer with spinning ends is probed: a cold minimum-effort solve at (1 − kProbeBelow) T*; where
+/// it proves that T feasible (provesFeasible), the free-time solve from its plan descends to a
+/// lower KKT point, which is probed again. A probe that finds nothing ends it; the trail keeps
+/// every probe.
+PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, SolveContext& context) {
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
     PlanningProblem effort = problem;
     effort.objective = Objective::MinimumEffort;
     effort.time_margin = 0.0;
     effort.duration = (1.0 - kProbeBelow) * answer.minimum_duration;
-    const SolverOptions remaining = withRemainingBudget(options, started);
-    if (budgetSpent(remaining)) break;
-    const PlanResult below =
-        runInternalPhase("the probe below T*", [&] { return planAtResolution(effort, remaining); });
+    if (context.stopReason()) break;
+    const PlanResult below = runInternalPhase(
+        "the probe below T*", [&] { return planAtResolution(effort, context.options(), context); });
     std::vector<Attempt> tried;
     std::optional<PlanResult> lower;
     if (provesFeasible(effort, below)) {
-      lower = freeTimeFromPlan(problem, below.maneuver, effort.duration,
-                               withRemainingBudget(options, started), &tried);
+      lower = freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
     }
     if (!provesFeasible(effort, below)) {
       appendTrail(below.attempts, false, &answer.attempts);
@@ -285,34 +279,32 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer,
 /// left of the time budget; where the free-time problem applies, the search's plan starts one more
 /// free-time solve (a KKT point). The trail keeps every stage in order: the free-time solves that
 /// did not give the answer, the search's starts, the solve from the search's plan.
-PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
+PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context);
 
-PlanResult minimumTimePlan(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context,
                            RichardsonPair* pair) {
   if (problem.scheme == SchemeKind::FourthOrder) {
-    return fourthOrderMinimumTime(problem, options, pair);
+    return fourthOrderMinimumTime(problem, context, pair);
   }
-  const auto started = std::chrono::steady_clock::now();
-  PlanResult answer = structuredMinimumTime(problem, options);
+  PlanResult answer = structuredMinimumTime(problem, context);
   if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
-  return probedBelow(problem, std::move(answer), withRemainingBudget(options, started));
+  return probedBelow(problem, std::move(answer), context);
 }
 
 /// minimumTimePlan of a discretization before the probe below T* (probedBelow).
-PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
+PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
   std::vector<Attempt> free_time_trail;
   if (unsupported.empty()) {
-    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, options, &free_time_trail);
+    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, context, &free_time_trail);
     if (free_time && free_time->converged()) return *free_time;
     if (free_time) free_time_trail = free_time->attempts;
     why = free_time ? "the free-time plan's replay failed" : "no free-time solve converged";
   } else {
     why = "the free-time interior point does not take " + unsupported + " yet";
   }
-  PlanResult result = searchMinimumTime(problem, withRemainingBudget(options, started));
+  PlanResult result = searchMinimumTime(problem, context);
   result.message += "; searched on T (" + why + ")";
   result.attempts = joined(free_time_trail, result.attempts);
   if (!unsupported.empty() || !result.converged() ||
@@ -322,9 +314,8 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOpt
   // The search's plan meets every bound at its T (an upper bound on T*): started from it, one
   // free-time solve can reach a KKT point at or below it where the structured starts did not.
   std::vector<Attempt> sharpening_trail;
-  std::optional<PlanResult> sharpened =
-      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration,
-                       withRemainingBudget(options, started), &sharpening_trail);
+  std::optional<PlanResult> sharpened = freeTimeFromPlan(
+      problem, result.maneuver, result.minimum_duration, context, &sharpening_trail);
   if (sharpened && !sharpened->converged()) sharpening_trail = sharpened->attempts;
   if (!sharpened || !sharpened->converged()) {
     // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
@@ -340,6 +331,11 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, const SolverOpt
 }  // namespace
 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
+  SolveContext context(options);
+  return planMinimumTime(problem, context);
+}
+
+PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   validateProblem(problem);
   validateMinimumTime(problem);
   const DurationLowerBound bound = durationLowerBound(problem);
@@ -354,7 +350,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
   PlanResult result =
-      runInternalPhase("minimum time", [&] { return minimumTimePlan(problem, options, &pair); });
+      runInternalPhase("minimum time", [&] { return minimumTimePlan(problem, context, &pair); });
   recordLowerBound(bound, &result);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
@@ -371,7 +367,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
     const Maneuver at_minimum_time = result.maneuver;
     result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
       return planFromMinimumTime(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
-                                 pair, withRemainingBudget(options, start));
+                                 pair, context);
     });
     recordLowerBound(bound, &result);
     std::vector<Attempt> attempts = search_trail;
@@ -411,10 +407,10 @@ std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResu
 /// that needed it, `why` how it ended): the plan from T*'s, else `first` with what was tried.
 PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult& first,
                                const std::string& why, const PlanResult& minimum_time,
-                               const RichardsonPair& pair, const SolverOptions& options) {
+                               const RichardsonPair& pair, SolveContext& context) {
   const double T_star = minimum_time.minimum_duration;
   PlanResult again =
-      planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, options);
+      planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, context);
   const std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
                            " s) after the first solve " + why;
   const bool was_infeasible = first.termination == Termination::Infeasible;
@@ -447,11 +443,16 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
 }  // namespace
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
+  SolveContext context(options);
+  return planBoundedMinimumEffort(problem, context);
+}
+
+PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context) {
   validateProblem(problem);
   const DurationLowerBound bound = durationLowerBound(problem);
   if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
   const auto start = std::chrono::steady_clock::now();
-  PlanResult result = planAtResolution(problem, options);
+  PlanResult result = planAtResolution(problem, context.options(), context);
   recordLowerBound(bound, &result);
   const std::string why = needsMinimumTimeStart(problem, result);
   if (why.empty() || !std::isfinite(smallestAuthority(problem)) || problem.accuracy.active()) {
@@ -465,9 +466,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
   fastest.time_margin = 0.0;
   fastest.duration = 0.0;
   RichardsonPair pair;
-  const PlanResult minimum_time = runInternalPhase("the minimum-time phase", [&] {
-    return minimumTimePlan(fastest, withRemainingBudget(options, start), &pair);
-  });
+  const PlanResult minimum_time = runInternalPhase(
+      "the minimum-time phase", [&] { return minimumTimePlan(fastest, context, &pair); });
   const auto finish = [&](PlanResult r) {
     recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
@@ -499,8 +499,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const Solver
     return finish(result);
   }
   return finish(runInternalPhase("the restart from the minimum-time plan", [&] {
-    return fromMinimumTimePlan(problem, result, why, minimum_time, pair,
-                               withRemainingBudget(options, start));
+    return fromMinimumTimePlan(problem, result, why, minimum_time, pair, context);
   }));
 }
 

@@ -96,8 +96,8 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
 /// free-time plan (answerAt). Empty if no solve converged (the caller falls back to the search).
 class FreeTimeMinimumTime {
  public:
-  FreeTimeMinimumTime(const PlanningProblem& problem, const SolverOptions& options)
-      : problem_(problem), context_(options) {}
+  FreeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context)
+      : problem_(problem), context_(context) {}
 
   std::optional<PlanResult> run() {
     const bool rest_to_rest =
@@ -153,9 +153,8 @@ class FreeTimeMinimumTime {
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
                         double duration, AttemptStart kind, const StartDetail& detail,
                         const BarrierWatch& watch = {}) {
-    const SolverOptions remaining = context_.remainingOptions();
     FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
-                                      kFreeTimeMaxIterations, &remaining, watch);
+                                      kFreeTimeMaxIterations, context_, watch);
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;
@@ -174,9 +173,8 @@ class FreeTimeMinimumTime {
   /// A structured start made to clear the cones: a start too close to a cone is replaced by the
   /// minimum-effort plan under the cones alone from it (coneClearStart).
   std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
-    const SolverOptions remaining = context_.remainingOptions();
     if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
-    return coneClearStart(p, st.attitudes, st.duration, remaining).value_or(st.attitudes);
+    return coneClearStart(p, st.attitudes, st.duration, context_).value_or(st.attitudes);
   }
 
   /// The earlier start whose solve this one would repeat (the same T and attitudes within
@@ -206,7 +204,7 @@ class FreeTimeMinimumTime {
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
     int best = -1;
     for (const FreeTimeStart& st : starts) {
-      if (budgetSpent(context_.remainingOptions())) break;
+      if (context_.stopReason()) break;
       std::vector<Matrix3> start = clearOfCones(grid, st);
       const int same = sameStartAs(start, st.duration);
       StartDetail detail = st.detail;
@@ -367,7 +365,7 @@ class FreeTimeMinimumTime {
       const StartRecord saddle = starts_[from];
       int lower = -1;
       for (const double sign : {1.0, -1.0}) {
-        if (budgetSpent(context_.remainingOptions())) return best;
+        if (context_.stopReason()) return best;
         std::vector<Matrix3> start =
             displacedAlongNegativeCurvature(grid, saddle.outcome, sign * kSaddleEscape);
         if (start.empty()) continue;
@@ -501,7 +499,7 @@ class FreeTimeMinimumTime {
   }
 
   const PlanningProblem& problem_;
-  SolveContext context_;
+  SolveContext& context_;
   std::vector<StartRecord> starts_;   ///< every start solved (or repeated), in order
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
@@ -547,19 +545,18 @@ std::vector<PlanningProblem> freeTimeLevels(const PlanningProblem& problem) {
   return levels;
 }
 
-std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
-                                              const SolverOptions& options,
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                               std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, options);
+  FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.run();
   if (!answer && tried) *tried = solver.trail();
   return answer;
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, const SolverOptions& options,
+                                           double duration, SolveContext& context,
                                            std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, options);
+  FreeTimeMinimumTime solver(problem, context);
   std::optional<PlanResult> answer = solver.runFrom(plan, duration, "search's plan");
   if (!answer && tried) *tried = solver.trail();
   return answer;

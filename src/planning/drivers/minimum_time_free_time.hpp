@@ -45,8 +45,7 @@ std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& 
 /// true, the KKT residuals in minimum_time, every solve in attempts, the free-time levels first in
 /// levels), or empty if no start converged or a refined level did not (the caller falls back to
 /// the search; `tried`, if given, then receives the free-time solves that ran, for its trail).
-std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
-                                              const SolverOptions& options,
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                               std::vector<Attempt>* tried = nullptr);
 
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
@@ -54,7 +53,7 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 /// KKT point if it converged at or below `duration`, else empty (`tried`, if given, then receives
 /// its solve, for the caller's trail).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, const SolverOptions& options,
+                                           double duration, SolveContext& context,
                                            std::vector<Attempt>* tried = nullptr);
 
 }  // namespace attitude_planner

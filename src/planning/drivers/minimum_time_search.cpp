@@ -13,6 +13,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
@@ -49,8 +50,8 @@ struct SearchOutcome {
 /// solves warm-started from the last feasible plan, and a bisection of the best bracket.
 class MinimumTimeSearch {
  public:
-  MinimumTimeSearch(const PlanningProblem& problem, const SolverOptions& options)
-      : problem_(problem), options_(options), start_(std::chrono::steady_clock::now()) {
+  MinimumTimeSearch(const PlanningProblem& problem, SolveContext& context)
+      : problem_(problem), context_(context) {
     effort_ = problem;
     effort_.objective = Objective::MinimumEffort;
     effort_.time_margin = 0.0;
@@ -75,20 +76,18 @@ class MinimumTimeSearch {
   }
 
  private:
-  SolverOptions remaining() const { return withRemainingBudget(options_, start_); }
-
   /// One minimum-effort solve at T from `warm`: true, with the plan kept in `out`, if it proves
   /// T feasible (provesFeasible).
   bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out) {
     effort_.duration = T;
-    SolverOptions o = remaining();
+    SolverOptions o = context_.options();
     if (warm) {
       o.warm_start = warm;
       o.constrained_from_warm_start = true;
     }
     PlanResult r;
     try {
-      r = planAtResolution(effort_, o);
+      r = planAtResolution(effort_, o, context_);
     } catch (const StepTooLarge&) {  // no boundary step on this grid at T: nothing shown at T
       ++out->solves;
       unrepresentable_from_ = std::min(unrepresentable_from_, T);
@@ -152,7 +151,7 @@ class MinimumTimeSearch {
     PlanningProblem coarse_problem = problem_;
     coarse_problem.steps = problem_.steps / 2;
     coarse_problem.time_margin = 0.0;
-    const PlanResult coarse = MinimumTimeSearch(coarse_problem, remaining()).run();
+    const PlanResult coarse = MinimumTimeSearch(coarse_problem, context_).run();
     if (!coarse.converged()) return;
     Maneuver resampled = coarse.maneuver;
     resampled.attitude = resampleAttitudes(coarse.maneuver, problem_.steps);
@@ -320,8 +319,7 @@ class MinimumTimeSearch {
   };
 
   const PlanningProblem& problem_;
-  SolverOptions options_;
-  std::chrono::steady_clock::time_point start_;
+  SolveContext& context_;
   PlanningProblem effort_;
   std::vector<SearchOutcome> outcomes_;
   std::optional<Termination> stopped_;
@@ -344,8 +342,13 @@ bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
   return planInconsistency(problem, r, true).empty();
 }
 
+PlanResult searchMinimumTime(const PlanningProblem& problem, SolveContext& context) {
+  return MinimumTimeSearch(problem, context).run();
+}
+
 PlanResult searchMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
-  return MinimumTimeSearch(problem, options).run();
+  SolveContext context(options);
+  return searchMinimumTime(problem, context);
 }
 
 }  // namespace attitude_planner

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/problem/solve_context.hpp"
 
 namespace attitude_planner {
 
@@ -19,7 +20,10 @@ bool provesFeasible(const PlanningProblem& problem, const PlanResult& r);
 
 /// The plan at the least feasible T the search finds (minimum_duration = T*, minimum_time.kkt_point
 /// false), or why there is none (Infeasible: no duration up to 2^12 times the first guess; the
-/// stop's termination when cancelled or out of time).
+/// stop's termination when cancelled or out of time). Its solves run in `context` with its
+/// options().
+PlanResult searchMinimumTime(const PlanningProblem& problem, SolveContext& context);
+/// The same as a request of its own (tests, studies).
 PlanResult searchMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
 
 }  // namespace attitude_planner

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "attitude_planner/planning/minimum_time.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
@@ -94,7 +95,10 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at,
   options.enumerate_classes = false;
   options.tolerance = kClassOptimumTolerance;
   try {
-    const PlanResult r = solveWithNewton(in_class, options);
+    // A start, not an attempt of the request: its own context (a few Newton steps at the
+    // coarsest grid), outside the request's trail and iteration numbering.
+    SolveContext context(options);
+    const PlanResult r = solveWithNewton(in_class, options, context);
     if (r.converged()) return r.maneuver.attitude;
   } catch (const StepTooLarge& e) {  // no boundary step at the guess's h
   }
@@ -345,7 +349,7 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
-                                                   double duration, const SolverOptions& options) {
+                                                   double duration, SolveContext& context) {
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
@@ -363,24 +367,31 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
     if (c.isCone() && !(c.nodeHalfAngle() > 0.0 && c.nodeHalfAngle() < M_PI)) return std::nullopt;
   }
   try {
-    SolverOptions o = options;
-    o.tolerance = std::max(options.tolerance, kConeClearTolerance);
+    SolverOptions o = context.options();
+    o.tolerance = std::max(o.tolerance, kConeClearTolerance);
     o.enumerate_classes = false;  // a start keeps its class (the free-time solves compare them)
     ReducedProblem np(effort);
     np.setInteriorFromAttitudes(attitudes);
     const Maneuver guess = np.maneuver(np.current());
     o.warm_start = &guess;
     o.constrained_from_warm_start = true;
-    PlanResult r = planAtResolution(effort, o);
+    PlanResult r = planAtResolution(effort, o, context);
     if (!r.converged()) {
       o.warm_start = nullptr;
       o.constrained_from_warm_start = false;
-      r = planAtResolution(effort, o);
+      r = planAtResolution(effort, o, context);
     }
     if (r.converged()) return r.maneuver.attitude;
   } catch (const StepTooLarge&) {  // a boundary rate with no step at this T: no cleared start
   }
   return std::nullopt;
+}
+
+std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
+                                                   const std::vector<Matrix3>& attitudes,
+                                                   double duration, const SolverOptions& options) {
+  SolveContext context(options);
+  return coneClearStart(problem, attitudes, duration, context);
 }
 
 }  // namespace attitude_planner

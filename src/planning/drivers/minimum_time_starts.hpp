@@ -11,6 +11,7 @@
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/problem/solve_context.hpp"
 
 namespace attitude_planner {
 
@@ -71,7 +72,12 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 /// A start that clears the cones: the minimum-effort plan at `duration` under the cones alone,
 /// their node bounds tightened by kConeStartClearance (the torque bounds left out: the free-time
 /// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
-/// side of a cone; cold if that does not converge. Empty if none converges.
+/// side of a cone; cold if that does not converge. Empty if none converges. Its solves run in
+/// `context` with its options().
+std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
+                                                   const std::vector<Matrix3>& attitudes,
+                                                   double duration, SolveContext& context);
+/// The same as a request of its own (tests).
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
                                                    double duration, const SolverOptions& options);

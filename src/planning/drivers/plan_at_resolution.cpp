@@ -13,6 +13,7 @@
 #include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/drivers/constrained_classes.hpp"
 #include "planning/drivers/fourth_order.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/verdict.hpp"
@@ -59,14 +60,14 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
 /// O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations instead of 2). The
 /// result converges only if both do.
 PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& options,
-                           std::chrono::steady_clock::time_point start) {
+                           SolveContext& context) {
   const int N = problem.steps;
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
   const std::string what =
       "fourth_order (Richardson extrapolation of second_order at N = " + std::to_string(N) +
       " and 2N = " + std::to_string(2 * N) + ")";
-  const PlanResult coarse = planAtResolution(sub, withRemainingBudget(options, start));
+  const PlanResult coarse = planAtResolution(sub, options, context);
   const auto failed = [&](PlanResult sub_result, int steps) {
     sub_result.message = what + ": the second_order solve at N = " + std::to_string(steps) +
                          " did not converge (its plan is returned): " + sub_result.message;
@@ -74,7 +75,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   };
   if (!coarse.converged()) return failed(coarse, N);
   sub.steps = 2 * N;
-  SolverOptions fine_options = withRemainingBudget(options, start);
+  SolverOptions fine_options = options;
   fine_options.warm_start = nullptr;
   fine_options.constrained_from_warm_start = false;
   if (coarse.extremal_summary.known) {
@@ -85,7 +86,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
     sub.extra_revolutions = chosen.extra_revolutions;
     fine_options.enumerate_classes = false;
   }
-  const PlanResult fine = planAtResolution(sub, fine_options);
+  const PlanResult fine = planAtResolution(sub, fine_options, context);
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
@@ -125,7 +126,7 @@ std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<
 /// interior point, in its class, and a request that left its class free has the other classes
 /// solved under the constraints too (constrained_classes.hpp), each from its class survey's plan.
 PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOptions& options,
-                                std::chrono::steady_clock::time_point start) {
+                                SolveContext& context) {
   // The unconstrained optimum, already solved (SolverOptions::unconstrained_optimum): polished
   // from it, the Newton attempt named as started from that earlier attempt's plan.
   SolverOptions newton_options = options;
@@ -133,7 +134,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
       options.unconstrained_optimum && options.unconstrained_optimum->steps() == problem.steps;
   if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
   std::vector<ClassPlan> survey_plans;
-  PlanResult result = solveWithNewton(problem, newton_options, &survey_plans);
+  PlanResult result = solveWithNewton(problem, newton_options, context, &survey_plans);
   if (solved_before) {
     for (Attempt& a : result.attempts) {
       if (a.start == AttemptStart::WarmStart) a.start = AttemptStart::PreviousAttempt;
@@ -146,7 +147,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
     result.message += "; constraints inactive at the unconstrained optimum";
     return result;
   }
-  SolverOptions constrained = withRemainingBudget(options, start);
+  SolverOptions constrained = options;
   const int newton_iterations = result.iterations;
   std::ostringstream note;
   if (result.converged()) {
@@ -164,7 +165,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   const std::vector<Attempt> newton_attempts = result.attempts;
   // The interior point keeps the class it starts in: the unconstrained optimum's.
   ExtremalSummary survey = result.extremal_summary;
-  result = solveWithInteriorPoint(problem, constrained);
+  result = solveWithInteriorPoint(problem, constrained, context);
   result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
   result.iterations += newton_iterations;
   result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
@@ -175,15 +176,21 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
     result.extremal = describeExtremal(result.extremal_summary);
   }
   if (classLeftFree(problem, options)) {
-    result = cheapestConstrainedClass(problem, withRemainingBudget(options, start), survey,
-                                      survey_plans, std::move(result));
+    result = cheapestConstrainedClass(problem, options, context, survey, survey_plans,
+                                      std::move(result));
   }
   return result;
 }
 
 }  // namespace
 
-PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested) {
+PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
+  SolveContext context(options);
+  return planAtResolution(problem, options, context);
+}
+
+PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,
+                            SolveContext& context) {
   validateProblem(problem);
   validateOptions(requested);
   requireSchemeSupported(problem, requested);
@@ -200,7 +207,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
   if (problem.scheme == SchemeKind::FourthOrder) {
-    result = planFourthOrder(problem, options, start);
+    result = planFourthOrder(problem, options, context);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.warm_start && !options.constrained_from_warm_start && !guess_resampled) {
     // A plan of this N given as the initial guess (e.g. the remainder of the plan being flown):
@@ -208,11 +215,11 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     // through the usual continuation. A resampled guess (another N) is off the bounds it rode
     // on by O(h) and starts the unconstrained optimum instead, as below (measured: torque_limited
     // 64 → 256, 29 interior-point iterations from the guess, 25 cold).
-    result = solveWithInteriorPointFromGuess(problem, options);
+    result = solveWithInteriorPointFromGuess(problem, options, context);
     if (result.termination == Termination::NotConverged ||
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
-      result = solveWithInteriorPoint(problem, withRemainingBudget(options, start));
+      result = solveWithInteriorPoint(problem, options, context);
       result.attempts = followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
       result.iterations += first.iterations;
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
@@ -220,13 +227,14 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {
-    result = solveWithInteriorPoint(problem, options);
+    result = solveWithInteriorPoint(problem, options, context);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
-    result = planUnderConstraints(problem, options, start);
+    result = planUnderConstraints(problem, options, context);
   } else if (options.solver == SolverKind::Structured) {
-    result = solveWithNewton(problem, options);
+    result = solveWithNewton(problem, options, context);
   } else {
-    result = solveWithNlopt(problem, options);
+    const SolveContext::Call call(context, options);
+    result = solveWithNlopt(problem, context.remainingOptions());
   }
   if (options.solver == SolverKind::Structured && schemeIsDiscretization(problem.scheme) &&
       result.maneuver.steps() == problem.steps) {

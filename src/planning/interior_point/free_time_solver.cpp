@@ -38,7 +38,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -160,7 +159,7 @@ class FreeTimeSolver {
     }
   }
 
-  FreeTimeOutcome run(double tolerance, int max_iterations, const SolverOptions* options,
+  FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
                       const BarrierWatch& watch);
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
@@ -261,6 +260,13 @@ class FreeTimeSolver {
   std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
                       int iterations) const;
   void initializeDuals(double mu);
+  /// Reports one pass of the loop (one counted iteration) to the context: an accepted step of
+  /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
+  /// iterate the pass started from.
+  void report(double alpha, double stationarity) const;
+  /// The outcome of a solve stopped (cancel, deadline) during an assembly: the iterate's system
+  /// assembled once more without polling, so the residuals reported are the iterate's.
+  FreeTimeOutcome interrupted(Termination t, int iterations, double mu, double epsilon);
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
   void checkSecondOrder(FreeTimeOutcome* out) const;
@@ -297,6 +303,9 @@ class FreeTimeSolver {
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
   double theta_ = 0.0, z_theta_ = 0.0, rho_ = kElasticPenalty;
   double theta_assembled_ = 0.0;  ///< θ where the system was assembled
+  /// The request's context while run() is in progress: polled inside the assembly (null: no
+  /// polls), reported to after every accepted step.
+  SolveContext* context_ = nullptr;
 };
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
@@ -320,6 +329,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
   np_.forEachStencilWithTimeStep(
       [&](const ReducedProblem::TimeStepStencil& st) {
+        if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
         const double s = torqueScale(st.k);
         const Vector3 tau = st.tau / s;
         Eigen::Matrix<double, 3, 10> G;  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
@@ -652,9 +662,33 @@ std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double
   return watch(point);
 }
 
-FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
-                                    const SolverOptions* options, const BarrierWatch& watch) {
-  const auto started = std::chrono::steady_clock::now();
+/// The word a stopped solve's message starts with.
+const char* stopWord(Termination t) {
+  return t == Termination::Cancelled ? "cancelled" : "out of time";
+}
+
+void FreeTimeSolver::report(double alpha, double stationarity) const {
+  IterationInfo info;
+  info.gradient_norm = stationarity;
+  info.step_length = alpha;
+  info.steps = N_;
+  if (context_->hasIterationCallback()) {  // the cost, O(N), only where a callback reads it
+    info.cost = np_.cost(np_.current());
+    info.effort = np_.timeStep() * info.cost;
+  }
+  context_->reportIteration(info);
+}
+
+FreeTimeOutcome FreeTimeSolver::interrupted(Termination t, int iterations, double mu,
+                                            double epsilon) {
+  context_ = nullptr;
+  assemble(mu, epsilon);
+  return outcome(t, stopWord(t), iterations, epsilon);
+}
+
+FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveContext& context,
+                                    const BarrierWatch& watch) {
+  context_ = &context;
   const int m = constraintCount();
   const double mu0 = kInitialBarrier / m;
   const double mu_final = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
@@ -670,7 +704,11 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
   bool solved_to_round_off = false;  // the barrier problem: its Newton step is round-off
   for (;; ++iterations) {
     const double epsilon = epsilon0 * std::max(mu / mu0, kFinalEffortFraction);
-    assemble(mu, epsilon);
+    try {
+      assemble(mu, epsilon);
+    } catch (const SolveInterrupted& stop) {
+      return interrupted(stop.termination, iterations, mu, epsilon);
+    }
     const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
     if (!elastic_ && mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
@@ -690,13 +728,11 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
       if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
       mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
                                        std::pow(mu, parameters_.free_time_theta_mu)));
-      continue;  // the same iterate for the next barrier problem (not an iteration)
+      report(0.0, stationarity);  // counted as an iteration (the loop's increment), no step
+      continue;                   // the same iterate for the next barrier problem
     }
-    if (options && options->cancel_requested && options->cancel_requested->load()) {
-      return outcome(Termination::Cancelled, "cancelled", iterations, epsilon);
-    }
-    if (options && budgetSpent(withRemainingBudget(*options, started))) {
-      return outcome(Termination::TimedOut, "out of time", iterations, epsilon);
+    if (const std::optional<Termination> stop = context.stopReason()) {
+      return outcome(*stop, stopWord(*stop), iterations, epsilon);
     }
     if (iterations >= max_iterations) {
       return outcome(Termination::NotConverged, "iteration limit", iterations, epsilon);
@@ -714,6 +750,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
       // above its T*.
       if (!elastic_ && mu > mu_final && step_at_round_off_) {
         solved_to_round_off = true;
+        report(0.0, stationarity);
         continue;
       }
       if (!elastic_ && stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
@@ -729,6 +766,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations,
     inertia_.afterStep(alpha, late);
     leaveElasticIfInside();
     safeguardDuals(mu);
+    report(alpha, stationarity);
   }
 }
 
@@ -918,7 +956,7 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              const SolverOptions* options, const BarrierWatch& watch) {
+                              SolveContext& context, const BarrierWatch& watch) {
   PlanningProblem at = problem;
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -940,7 +978,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     failed.message = solver.startInside();
     if (!failed.message.empty()) return failed;
-    FreeTimeOutcome out = solver.run(tolerance, max_iterations, options, watch);
+    FreeTimeOutcome out = solver.run(tolerance, max_iterations, context, watch);
     if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
     // The elastic start did not reach a KKT point: the start raised inside instead.
     np.setTimeStep(start_h);
@@ -949,13 +987,19 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     raised.disallowElastic();
     failed.message = raised.startInside();
     if (!failed.message.empty()) return out;
-    FreeTimeOutcome second = raised.run(tolerance, max_iterations, options, watch);
+    FreeTimeOutcome second = raised.run(tolerance, max_iterations, context, watch);
     second.iterations += out.iterations;
     return second;
   } catch (const StepTooLarge& e) {
     failed.message = std::string("the boundary rates admit no step: ") + e.what();
     return failed;
   }
+}
+
+FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
+                              double start_duration, double tolerance, int max_iterations) {
+  SolveContext context{SolverOptions{}};
+  return solveFreeTime(problem, attitudes, start_duration, tolerance, max_iterations, context);
 }
 
 }  // namespace attitude_planner

@@ -10,6 +10,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
@@ -116,11 +117,17 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem);
 /// every h. Ends Converged at a KKT point of the discrete minimum-time problem
 /// (complementarity within `tolerance`, stationarity within it × max(1, (N/256)²): round-off),
 /// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
-/// Cancelled or TimedOut when `options` (may be null) asks: its cancel flag and time budget are
-/// polled every iteration, and NotConverged (stopped_by_watch) where `watch` stops it.
+/// Cancelled or TimedOut when `context` asks (SolveContext::stopReason every iteration, polled
+/// inside the assembly too), and NotConverged (stopped_by_watch) where `watch` stops it. Every
+/// iteration counted in FreeTimeOutcome::iterations (an accepted step, or a barrier update at the
+/// same iterate: step length 0) is reported to `context` (SolveContext::reportIteration: the
+/// request's iteration callback, and so an action's feedback); a refusal ends the solve Cancelled.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              const SolverOptions* options = nullptr,
-                              const BarrierWatch& watch = {});
+                              SolveContext& context, const BarrierWatch& watch = {});
+/// The same in a context of its own with default options (no budget, no callback): for tests and
+/// studies that run one free-time solve outside a request.
+FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
+                              double start_duration, double tolerance, int max_iterations);
 
 }  // namespace attitude_planner

@@ -184,13 +184,13 @@ GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
 /// start (the requested grid's unconstrained optimum) resampled, instead of repeating the grid
 /// continuation that found the warm start. Sets level_options->warm_start to it (or null).
 PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProblem& at,
-                              const SolverOptions& options, SolverOptions* level_options,
-                              Maneuver* resampled) {
+                              const SolverOptions& options, SolveContext& context,
+                              SolverOptions* level_options, Maneuver* resampled) {
   if (options.warm_start && options.warm_start->steps() == problem.steps) {
     resampled->attitude = resampleAttitudes(*options.warm_start, at.steps);
     level_options->warm_start = resampled;
   }
-  PlanResult unconstrained = solveWithNewton(at, *level_options);
+  PlanResult unconstrained = solveWithNewton(at, *level_options, context);
   level_options->warm_start = nullptr;
   return unconstrained;
 }
@@ -248,7 +248,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   PlanResult start;
   Maneuver resampled;
   if (!r.coarse) {
-    start = unconstrainedStart(problem, r.problem, options, &level_options, &resampled);
+    start =
+        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = start.converged() ? &start.maneuver : nullptr;
   }
   GridOutcome outcome = solveGridWithRetry(
@@ -274,7 +275,8 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& opti
   Maneuver resampled;
   PlanResult unconstrained;
   if (!r.coarse) {
-    unconstrained = unconstrainedStart(problem, r.problem, options, &level_options, &resampled);
+    unconstrained =
+        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
     total.iterations += unconstrained.iterations;
     appendLevels(&total.levels, unconstrained);
@@ -387,10 +389,13 @@ GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options
   return outcome;
 }
 
-/// Records the trail in the context, the attempt at `kept` marked as the one returned.
-void recordTrail(SolveContext& context, std::vector<Attempt> trail, std::size_t kept) {
+/// Records the trail in the context, the attempt at `kept` marked as the one returned; returns
+/// it (the solve's PlanResult::attempts).
+std::vector<Attempt> recordTrail(SolveContext& context, std::vector<Attempt> trail,
+                                 std::size_t kept) {
   if (kept < trail.size()) trail[kept].kept = true;
   for (const Attempt& a : trail) context.record(a);
+  return trail;
 }
 
 }  // namespace
@@ -414,7 +419,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                       std::any_of(problem.constraints.begin(), problem.constraints.end(),
                                   [](const PlanningConstraint& c) { return !c.isCone(); });
   if (!stuck || !cones || !others) {
-    recordTrail(context, trail, 0);
+    result.attempts = recordTrail(context, trail, 0);
     return result;
   }
   PlanningProblem cones_only = problem;
@@ -427,7 +432,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
           .result;
   int iterations = result.iterations + around.iterations;
   if (!around.converged()) {
-    recordTrail(context, trail, 0);
+    result.attempts = recordTrail(context, trail, 0);
     return result;
   }
   SolverOptions staged = options;
@@ -444,7 +449,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   appendLevels(&solved_levels, second);
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
   if (take_second) result = second;
-  recordTrail(context, trail, take_second ? 2 : 0);
+  result.attempts = recordTrail(context, trail, take_second ? 2 : 0);
   result.iterations = iterations;
   result.levels = solved_levels;
   result.message +=
@@ -454,15 +459,8 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   return result;
 }
 
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options) {
-  SolveContext context(options);
-  PlanResult result = solveWithInteriorPoint(problem, options, context, InteriorPointParameters{});
-  result.attempts = context.attempts();
-  return result;
-}
-
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
-                                           const SolverOptions& options) {
+                                           const SolverOptions& options, SolveContext& context) {
   // The guess (a plan of this N, e.g. the remainder of the plan being flown) starts the
   // requested grid directly, as a converged coarser level starts a finer one: its steps, its
   // multipliers re-derived from stationarity (the guess carries none) and a small barrier.
@@ -475,19 +473,18 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
     duals = ConstrainedSystem(problem, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
     steps = np.current();
   } catch (const StepTooLarge&) {
-    return solveWithInteriorPoint(problem, options);  // reports it
+    return solveWithInteriorPoint(problem, options, context);  // reports it
   }
-  SolveContext context(options);
   const InteriorPointParameters parameters;
   const Solve solve{parameters, context};
   SolverOptions from = options;
   from.warm_start = nullptr;  // the guess's steps start the grid
   from.constrained_from_warm_start = false;
   GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
-  recordTrail(context,
-              {attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart)}, 0);
   PlanResult result = std::move(outcome.result);
-  result.attempts = context.attempts();
+  result.attempts = recordTrail(
+      context, {attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart)},
+      0);
   result.message += "; from the initial guess, its multipliers re-derived";
   return result;
 }

@@ -13,18 +13,15 @@ namespace attitude_planner {
 /// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
 /// from options.warm_start if given. Ends Infeasible when the constraints cannot be met. Polls
 /// `context` (cancel flag, deadline) inside its long loops, reports its iterations and records
-/// its attempts there (the kept one marked). Fills everything but solve_time_s and the
-/// constraint figures.
+/// its attempts there (the kept one marked; they are its PlanResult::attempts too). Fills
+/// everything but solve_time_s and the constraint figures.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
                                   SolveContext& context,
                                   const InteriorPointParameters& parameters = {});
 
-/// The same with a context of its own (clock started now); its attempts in PlanResult::attempts.
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options);
-
 /// The interior point from options.warm_start (a plan given as the initial guess, with the
 /// problem's N: initialGuessOnGrid) rather than from the unconstrained optimum.
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
-                                           const SolverOptions& options);
+                                           const SolverOptions& options, SolveContext& context);
 
 }  // namespace attitude_planner

@@ -633,7 +633,7 @@ PlanResult Walk::finish() {
     if (none.termination == Termination::Converged) none.termination = Termination::NotConverged;
     none.message = "no attempt produced a plan on the requested grid (" +
                    std::to_string(trail_.size()) + " tried); the last: " + none.message;
-    none.attempts = context_.attempts();
+    none.attempts = trail_;
     return none;
   }
   PlanResult kept = std::move(*kept_);
@@ -649,7 +649,7 @@ PlanResult Walk::finish() {
   kept.extremal = describeExtremal(kept.extremal_summary);
   kept.message = briefOf(kept, trail_, kept_at_, stop);
   if (stop && !kept.converged()) kept.termination = *stop;
-  kept.attempts = context_.attempts();
+  kept.attempts = trail_;
   return kept;
 }
 
@@ -661,8 +661,9 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
   return np.current();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context,
-                           std::vector<ClassPlan>* survey_plans) {
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& call_options,
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans) {
+  const SolveContext::Call call(context, call_options);
   const NewtonParameters& p = newtonDefaults();
   const SolverOptions& options = context.options();
   Walk walk(problem, context, p);
@@ -699,12 +700,6 @@ PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context
     }
   }
   return walk.finish();
-}
-
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options,
-                           std::vector<ClassPlan>* survey_plans) {
-  SolveContext context(options);
-  return solveWithNewton(problem, context, survey_plans);
 }
 
 }  // namespace attitude_planner

@@ -19,17 +19,14 @@ struct ClassPlan {
 
 /// Newton's method on the first-order optimality conditions, O(N) per iteration, every attempt
 /// of the recipe in `context` (its deadline, cancel flag, iteration numbering; each attempt is
-/// recorded in its trail, the kept one marked). Fills everything but solve_time_s; `attempts` is
-/// the context's trail. `survey_plans` (optional) receives the class survey's converged plans (a
-/// request that leaves its class free): each class on the survey grid, and those refined on the
-/// requested grid there too; they start the constrained class search
+/// recorded in its trail, the kept one marked), with the solve's own `options` (warm start,
+/// tolerance, class policy: SolveContext::Call). Fills everything but solve_time_s; `attempts`
+/// is this solve's part of the context's trail. `survey_plans` (optional) receives the class
+/// survey's converged plans (a request that leaves its class free): each class on the survey grid,
+/// and those refined on the requested grid there too; they start the constrained class search
 /// (drivers/constrained_classes.hpp) instead of solving each class again.
-PlanResult solveWithNewton(const PlanningProblem& problem, SolveContext& context,
-                           std::vector<ClassPlan>* survey_plans = nullptr);
-
-/// The same in a context of its own.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options,
-                           std::vector<ClassPlan>* survey_plans = nullptr);
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr);
 
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
 /// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before

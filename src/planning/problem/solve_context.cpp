@@ -5,32 +5,33 @@
 
 namespace attitude_planner {
 
-SolveContext::SolveContext(const SolverOptions& options)
-    : options_(options), start_(Clock::now()) {}
+SolveContext::SolveContext(const SolverOptions& request)
+    : request_(request), call_(&request_), start_(Clock::now()) {}
 
 double SolveContext::elapsedSeconds() const {
   return std::chrono::duration<double>(Clock::now() - start_).count();
 }
 
 double SolveContext::remainingSeconds() const {
-  if (options_.time_budget_s <= 0) return std::numeric_limits<double>::infinity();
-  return std::max(options_.time_budget_s - elapsedSeconds(), 0.0);
+  if (request_.time_budget_s <= 0) return std::numeric_limits<double>::infinity();
+  return std::max(request_.time_budget_s - elapsedSeconds(), 0.0);
 }
 
 SolverOptions SolveContext::remainingOptions() const {
-  SolverOptions remaining = options_;
-  if (options_.time_budget_s > 0) {
-    remaining.time_budget_s = std::max(remainingSeconds(), kSpentBudget);
-  }
+  SolverOptions remaining = *call_;
+  remaining.on_iteration = request_.on_iteration;
+  remaining.cancel_requested = request_.cancel_requested;
+  remaining.time_budget_s =
+      request_.time_budget_s > 0 ? std::max(remainingSeconds(), kSpentBudget) : 0.0;
   return remaining;
 }
 
 std::optional<Termination> SolveContext::stopReason() const {
   if (refused_by_callback_) return Termination::Cancelled;
-  if (options_.cancel_requested && options_.cancel_requested->load(std::memory_order_relaxed)) {
+  if (request_.cancel_requested && request_.cancel_requested->load(std::memory_order_relaxed)) {
     return Termination::Cancelled;
   }
-  if (options_.time_budget_s > 0 && elapsedSeconds() >= options_.time_budget_s) {
+  if (request_.time_budget_s > 0 && elapsedSeconds() >= request_.time_budget_s) {
     return Termination::TimedOut;
   }
   return std::nullopt;
@@ -42,10 +43,10 @@ void SolveContext::poll() const {
 
 bool SolveContext::reportIteration(const IterationInfo& info) {
   ++iterations_;
-  if (!options_.on_iteration) return true;
+  if (!request_.on_iteration) return true;
   IterationInfo numbered = info;
   numbered.iteration = iterations_;
-  if (!options_.on_iteration(numbered)) refused_by_callback_ = true;
+  if (!request_.on_iteration(numbered)) refused_by_callback_ = true;
   return !refused_by_callback_;
 }
 

@@ -1,0 +1,23 @@
+// The drivers' entry points inside one request. Each takes the request's SolveContext (built
+// once: by planManeuver, or by a public entry point called on its own), so every solve of the
+// request shares its clock and deadline, its cancel flag, one iteration numbering and one trail;
+// a driver hands its solvers their own options (warm start, class policy) beside it.
+#pragma once
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/problem/solve_context.hpp"
+
+namespace attitude_planner {
+
+/// planAtResolution (plan_at_resolution.hpp) with `options` for this solve, in `context`.
+PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options,
+                            SolveContext& context);
+
+/// planMinimumTime (minimum_time.hpp) with the request's options, context.options().
+PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context);
+
+/// planBoundedMinimumEffort (minimum_time.hpp) with the request's options, context.options().
+PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context);
+
+}  // namespace attitude_planner

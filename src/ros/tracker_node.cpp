@@ -293,6 +293,18 @@ ReplanAnswer planRemainder(const PlanningProblem& rest, const std::vector<Effect
   return answer;
 }
 
+void reportConstraintHealth(const ConstraintHealth& health, ReplayResult* result) {
+  result->constraint_names = health.names();
+  result->constraint_violations = health.worstViolations();
+  std::string past;
+  for (std::size_t i = 0; i < health.names().size(); ++i) {
+    const double v = health.worstViolations()[i];
+    if (v > 0.0) past += (past.empty() ? "" : ", ") + health.names()[i] + " by " + exactNumber(v);
+  }
+  // Said in words too: a run that went past a constraint is not what was planned.
+  if (!past.empty()) result->message += "; past constraints along the flown path: " + past;
+}
+
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
@@ -403,6 +415,10 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   plant_ = readNamedParam(pnh, "plant", PlantKind::Internal, kPlantNames);
   measurement_timeout_ =
       readParam<double>(pnh, "measurement_timeout", 0.5, positive, "> 0 s (ROS time)");
+  projection_tolerance_.cone_angle = readParam<double>(pnh, "projection_tolerance", 0.01,
+                                                       non_negative, ">= 0 rad, 0 = never move");
+  projection_tolerance_.rate_fraction = readParam<double>(
+      pnh, "rate_projection_tolerance", 0.01, non_negative, ">= 0 (a fraction of the rate limit)");
 
   advertiseTopics();
 
@@ -780,6 +796,7 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.problem.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   applyEffects(replay.effects, &pb.problem);
   pb.effects_specs = replay.effects;
+  pb.health = std::make_shared<ConstraintHealth>(pb.problem.max_torque, pb.problem.constraints);
 
   pb.world_frame = msg.header.frame_id.empty() ? world_frame_ : msg.header.frame_id;
   pb.body_frame = msg.child_frame_id.empty() ? body_frame_ : msg.child_frame_id;
@@ -842,6 +859,7 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   // replan: the body under the plans adopted so far, the reference the plan in force.
   const ManeuverSample body = pb.horizon ? pb.horizon->bodyAt(t) : pb.actual->at(t);
   const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
+  pb.health->observe(body.attitude, body.angular_velocity, body.torque);
   publishState(pb, body, plan, t, stamp, trail);
 }
 
@@ -960,6 +978,7 @@ void TrackerNode::runReplay(Replay replay) {
     pb.result.success = true;
   }
   ReplayResult result = pb.result;
+  reportConstraintHealth(*pb.health, &result);
   const std::string conflict = claimFrames(pb.world_frame, pb.body_frame);
   if (!conflict.empty()) {  // the run was shown on a transform another node also moved
     result.success = false;
@@ -1023,7 +1042,7 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
     pb->replan_status = line;
   }
   const int node = static_cast<int>(std::floor(t / h + kNodeSlack));
-  if (node < state->next_node || N - node < kMinSteps) return;
+  if (node < state->next_node || node > lastReplanNode(N, h, run.naturalFrequency())) return;
   // The state the body has at this node under the plan in force, and that plan's rest.
   RigidBodyState body;
   if (state_at_node) {
@@ -1031,6 +1050,14 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
   } else {
     const ManeuverSample simulated = run.bodyAtNode(node);
     body = RigidBodyState{simulated.attitude, simulated.angular_velocity};
+  }
+  // As the scheme's boundary data (its Ω_0 may be the first step's rate), then onto the
+  // constraints: the two moves a start needs so that the planner can fly on from it.
+  body = schemeStartOf(pb->problem.scheme, pb->reference->inertia(), pb->effects.get(), body,
+                       run.commandAt(body, node * h), node * h, h);
+  if (!projectReplanStart(node * h, &body, pb)) {
+    state->next_node = node + state->period_steps;  // the next node may be back within bounds
+    return;
   }
   PlanningProblem rest;
   try {
@@ -1049,6 +1076,32 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
   state->pending = true;
   state->pending_from = node;
   state->next_node = node + state->period_steps;
+}
+
+bool TrackerNode::projectReplanStart(double t, RigidBodyState* body, Playback* pb) const {
+  ReplayResult& result = pb->result;
+  const double h = pb->reference->nodes().time_step;
+  const ProjectedStart start =
+      projectOntoConstraints(*body, pb->problem.constraints, projection_tolerance_,
+                             firstStepFixedByStart(pb->problem.scheme) ? h : 0.0);
+  if (!start.feasible) {
+    // The planner would refuse this start (boundary data past a constraint): not sent, counted.
+    const std::string error = "re-plan from t = " + exactNumber(t) +
+                              " s not sent: " + start.refusal + " (~projection_tolerance)";
+    ++result.replan_failures;
+    if (result.replan_error.empty()) result.replan_error = error;
+    ROS_WARN("%s", error.c_str());
+    return false;
+  }
+  if (start.moved > 0.0 || start.slowed > 0.0) {
+    ++result.projected_replans;
+    ROS_INFO(
+        "re-plan from t = %.6g s starts on the constraints: the body's attitude turned by "
+        "%.3g rad, its rate reduced by %.3g rad/s",
+        t, start.moved, start.slowed);
+  }
+  *body = start.state;
+  return true;
 }
 
 void TrackerNode::onTf(const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
@@ -1182,6 +1235,7 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
     if (measured.fresh) {
       result.max_attitude_deviation = std::max(
           result.max_attitude_deviation, so3::angleBetween(reference.attitude, body.attitude));
+      pb->health->observe(body.attitude, body.angular_velocity, body.torque);
     }
     if (j + 1 < pb->times.size()) {  // held until the next sample
       result.effort += 0.5 * body.torque.squaredNorm() * (pb->times[j + 1] - t);

@@ -192,6 +192,14 @@ PlannerNode::~PlannerNode() {
   }
   goal_ready_.notify_all();
   for (std::thread& worker : workers_) worker.join();
+  // The goals' deadline watches stop (joined) while the action server still exists.
+  std::map<std::string, ActiveGoal> left;
+  std::deque<ActiveGoal> queued;
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    left.swap(active_);
+    queued.swap(queued_);
+  }
 }
 
 PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request& req) {
@@ -278,6 +286,48 @@ bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
   return true;
 }
 
+/// Calls `on_deadline` once `seconds` [s] of wall time have passed, unless destroyed before (the
+/// action's deadline: the worker holds one while it solves).
+class DeadlineWatch {
+ public:
+  DeadlineWatch(double seconds, std::function<void()> on_deadline) {
+    if (!(seconds > 0.0)) return;
+    thread_ = std::thread([this, seconds, on_deadline = std::move(on_deadline)] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (ended_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return over_; }))
+        return;
+      lock.unlock();
+      on_deadline();
+    });
+  }
+  ~DeadlineWatch() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      over_ = true;
+    }
+    ended_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  DeadlineWatch(const DeadlineWatch&) = delete;
+  DeadlineWatch& operator=(const DeadlineWatch&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ended_;
+  bool over_ = false;
+  std::thread thread_;
+};
+
+void PlannerNode::onGoalDeadline(const ActiveGoal& goal) {
+  goal.cancel->store(true);
+  GoalHandle handle = goal.handle;
+  boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+  if (handle.getGoalStatus().status != actionlib_msgs::GoalStatus::ACTIVE) return;
+  PlanAttitudeManeuverResult late;
+  fillResponse(deadlineOutcome(goal.budget), world_frame_, body_frame_, &late);
+  handle.setAborted(late, late.message);
+}
+
 void PlannerNode::onGoal(GoalHandle goal) {
   const std::string id = goal.getGoalID().id;
   ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false),
@@ -299,6 +349,18 @@ void PlannerNode::onGoal(GoalHandle goal) {
     return;
   }
   goal.setAccepted();  // a cancel already received turns this into PREEMPTING: served as such
+  // The deadline counts from here, not from when a worker takes the goal: a goal queued behind
+  // workers still stopping cancelled N = 1e5 solves is answered by its budget all the same.
+  active.accepted = ros::WallTime::now();
+  active.budget = ros_conversions::effectiveTimeBudget(goal.getGoal()->time_budget, defaults_);
+  active.deadline = std::make_shared<DeadlineWatch>(
+      active.budget * (1.0 + kDeadlineSlack),
+      [this, watched = ActiveGoal{active.handle, active.cancel, active.ended_at, nullptr,
+                                  active.accepted, active.budget}] { onGoalDeadline(watched); });
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    active_[id] = active;  // with its deadline
+  }
   {
     std::lock_guard<std::mutex> lock(goals_mutex_);
     queued_.push_back(active);
@@ -337,38 +399,6 @@ bool goalEnded(unsigned status) {
          status != GoalStatus::PREEMPTING && status != GoalStatus::RECALLING;
 }
 
-/// Calls `on_deadline` once `seconds` [s] of wall time have passed, unless destroyed before (the
-/// action's deadline: the worker holds one while it solves).
-class DeadlineWatch {
- public:
-  DeadlineWatch(double seconds, std::function<void()> on_deadline) {
-    if (!(seconds > 0.0)) return;
-    thread_ = std::thread([this, seconds, on_deadline = std::move(on_deadline)] {
-      std::unique_lock<std::mutex> lock(mutex_);
-      if (ended_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return over_; }))
-        return;
-      lock.unlock();
-      on_deadline();
-    });
-  }
-  ~DeadlineWatch() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      over_ = true;
-    }
-    ended_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-  DeadlineWatch(const DeadlineWatch&) = delete;
-  DeadlineWatch& operator=(const DeadlineWatch&) = delete;
-
- private:
-  std::mutex mutex_;
-  std::condition_variable ended_;
-  bool over_ = false;
-  std::thread thread_;
-};
-
 }  // namespace
 
 void PlannerNode::workerLoop() {
@@ -391,25 +421,26 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   const std::string id = handle.getGoalID().id;
   // A cancel that arrived before the goal was in active_ (so onCancel found no flag to set).
   const unsigned status = handle.getGoalStatus().status;
-  if (goalEnded(status)) return;  // cancelled while it waited: onCancel ended it and freed its slot
+  if (goalEnded(status)) {  // cancelled (onCancel) or past its deadline while it waited
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    active_.erase(id);  // its slot (onCancel freed it already)
+    return;
+  }
   if (status == actionlib_msgs::GoalStatus::PREEMPTING) goal.cancel->store(true);
   PlanAttitudeManeuverResult result;
   try {
     const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
-    // The deadline: an answer by budget (1 + kDeadlineSlack) even when the stopped solve takes
-    // longer to return; the solve is told to stop and its late result is discarded below.
-    const double budget = ros_conversions::effectiveTimeBudget(request->time_budget, defaults_);
-    const DeadlineWatch deadline(budget * (1.0 + kDeadlineSlack), [&] {
-      goal.cancel->store(true);
-      boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
-      if (handle.getGoalStatus().status != actionlib_msgs::GoalStatus::ACTIVE) return;
-      PlanAttitudeManeuverResult late;
-      fillResponse(deadlineOutcome(budget), world_frame_, body_frame_, &late);
-      handle.setAborted(late, late.message);
-    });
+    // The deadline (goal.deadline, armed at acceptance) answers by budget (1 + kDeadlineSlack)
+    // even when the stopped solve takes longer to return; its late result is discarded below.
+    // The solve gets what is left of the budget after the wait in the queue.
+    PlanAttitudeManeuverGoal solve_request = *request;
+    if (goal.budget > 0.0) {
+      const double waited = (ros::WallTime::now() - goal.accepted).toSec();
+      solve_request.time_budget = std::max(goal.budget - waited, 1e-6);
+    }
     PlanAttitudeManeuverFeedback feedback;
     const PlanOutcome outcome = planRequest(
-        *request, defaults_,
+        solve_request, defaults_,
         [&](const IterationInfo& info, double elapsed) {
           feedback.iteration = info.iteration;
           feedback.cost = info.cost;

@@ -317,6 +317,17 @@ TEST_F(PlannerAction, TwoConcurrentGoalsBothSucceedWithTheirOwnAnswers) {
   }
 }
 
+/// Sends an endless goal on each client and waits until both report feedback (both workers
+/// busy); false if not within two minutes.
+bool startEndlessGoals(Client* a, Client* b) {
+  auto fed_a = std::make_shared<std::atomic<int>>(0), fed_b = std::make_shared<std::atomic<int>>(0);
+  a->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+              [fed_a](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed_a; });
+  b->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+              [fed_b](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed_b; });
+  return waitFor([&] { return *fed_a > 0 && *fed_b > 0; }, 120.0);
+}
+
 TEST_F(PlannerAction, GoalBeyondTheWorkersIsRejectedAndTheRunningOnesAreUntouched) {
   // The node runs ~action_workers = 2 (default): two endless goals occupy both; a third is
   // refused explicitly (REJECTED, error REJECTED); the two keep running until their own clients
@@ -325,12 +336,7 @@ TEST_F(PlannerAction, GoalBeyondTheWorkersIsRejectedAndTheRunningOnesAreUntouche
       third("plan_attitude_maneuver_action", true);
   ASSERT_TRUE(second.waitForServer(ros::Duration(30.0)));
   ASSERT_TRUE(third.waitForServer(ros::Duration(30.0)));
-  auto fed1 = std::make_shared<std::atomic<int>>(0), fed2 = std::make_shared<std::atomic<int>>(0);
-  client_->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                    [fed1](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed1; });
-  second.sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                  [fed2](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed2; });
-  ASSERT_TRUE(waitFor([&] { return *fed1 > 0 && *fed2 > 0; }, 120.0)) << "both not running";
+  ASSERT_TRUE(startEndlessGoals(client_.get(), &second)) << "both not running";
   third.sendGoal(seed(16));
   ASSERT_TRUE(third.waitForResult(ros::Duration(30.0)));
   EXPECT_EQ(third.getState(), State::REJECTED);
@@ -389,12 +395,7 @@ TEST_F(PlannerAction, QueuedGoalsDeadlineCountsFromItsAcceptance) {
   ASSERT_TRUE(third.waitForServer(ros::Duration(30.0)));
   // Both workers free (the previous test's cancelled solves may still be stopping).
   ASSERT_TRUE(waitForIdleWorkers(client_.get(), &second)) << "the workers did not become free";
-  auto fed1 = std::make_shared<std::atomic<int>>(0), fed2 = std::make_shared<std::atomic<int>>(0);
-  client_->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                    [fed1](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed1; });
-  second.sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
-                  [fed2](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed2; });
-  ASSERT_TRUE(waitFor([&] { return *fed1 > 0 && *fed2 > 0; }, 120.0)) << "both not running";
+  ASSERT_TRUE(startEndlessGoals(client_.get(), &second)) << "both not running";
   ASSERT_EQ(client_->getState(), State::ACTIVE);
   ASSERT_EQ(second.getState(), State::ACTIVE);
   client_->cancelGoal();

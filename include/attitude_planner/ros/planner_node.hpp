@@ -142,6 +142,10 @@ struct SolveSlot {
 /// The TIMED_OUT outcome of a request answered at its deadline `budget` [s] without its solve.
 PlanOutcome deadlineOutcome(double budget);
 
+/// Hands the memory freed by finished solves back to the system (glibc keeps it in the solving
+/// threads' malloc arenas otherwise).
+void returnFreedMemory();
+
 /// Calls a function once a wall time has passed unless destroyed before (planner_node.cpp): an
 /// action goal's deadline, armed when the goal is accepted.
 class DeadlineWatch;

@@ -611,6 +611,7 @@ void TrackerNode::startReplay(Replay replay) {
   std::lock_guard<std::mutex> lock(replay_mutex_);
   replay_thread_ = std::thread([this, replay]() {
     done_published_ = false;
+    held_.reset();
     runReplay(replay);
     noteNextSample(false);
     if (!done_published_ && replacing_) {
@@ -622,6 +623,7 @@ void TrackerNode::startReplay(Replay replay) {
       replaced.header.frame_id = world_frame_;
       done_pub_.publish(replaced);  // not publishDone: ~exit_when_done waits for the last run
     }
+    holdFinalAttitude();
   });
 }
 
@@ -989,6 +991,27 @@ void TrackerNode::runReplay(Replay replay) {
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
            result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
+  held_ = HeldPose{pb.world_frame, pb.body_frame,
+                   rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
+}
+
+void TrackerNode::holdFinalAttitude() {
+  if (!held_) return;
+  // After a run the body stays where it ended: rviz and tf listeners keep the frame (before, tf
+  // stopped with the last sample and the body's frame expired from every buffer).
+  constexpr double kHoldPeriod = 0.1;  // [s, wall]
+  geometry_msgs::TransformStamped tf;
+  tf.header.frame_id = held_->world_frame;
+  tf.child_frame_id = held_->body_frame;
+  tf.transform.rotation = rc::attitudeToMsg(held_->attitude);
+  while (!stop_ && ros::ok()) {
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero() && now > tf.header.stamp) {  // sim time may pause: never a repeated stamp
+      tf.header.stamp = now;
+      tf_broadcaster_.sendTransform(tf);
+    }
+    ros::WallDuration(kHoldPeriod).sleep();
+  }
 }
 
 void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,

@@ -12,6 +12,7 @@
 #include <ros/ros.h>
 
 #include <geometry_msgs/PoseStamped.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <mutex>
 
@@ -26,14 +27,21 @@ using namespace attitude_planner;
 
 namespace {
 
-/// The body attitudes a tracker publishes on `body_pose`, in order.
+/// The body attitudes a tracker publishes on `body_pose`, in order, and the newest /tf stamp of
+/// its body frame.
 class PoseRecorder {
  public:
-  explicit PoseRecorder(ros::NodeHandle& nh)
-      : sub_(nh.subscribe("body_pose", 5000, &PoseRecorder::onPose, this)) {}
+  PoseRecorder(ros::NodeHandle& nh, std::string body_frame)
+      : body_frame_(std::move(body_frame)),
+        sub_(nh.subscribe("body_pose", 5000, &PoseRecorder::onPose, this)),
+        tf_sub_(nh.subscribe("/tf", 1000, &PoseRecorder::onTf, this)) {}
   std::vector<Matrix3> attitudes() {
     std::lock_guard<std::mutex> lock(mutex_);
     return attitudes_;
+  }
+  ros::Time newestTf() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return newest_tf_;
   }
 
  private:
@@ -41,9 +49,17 @@ class PoseRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     attitudes_.push_back(ros_conversions::attitudeFromMsg(m->pose.orientation, "body_pose"));
   }
+  void onTf(const tf2_msgs::TFMessage::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const geometry_msgs::TransformStamped& t : m->transforms) {
+      if (t.child_frame_id == body_frame_) newest_tf_ = std::max(newest_tf_, t.header.stamp);
+    }
+  }
+  std::string body_frame_;
   std::mutex mutex_;
   std::vector<Matrix3> attitudes_;
-  ros::Subscriber sub_;
+  ros::Time newest_tf_;
+  ros::Subscriber sub_, tf_sub_;
 };
 
 /// /cone_replan's poses, subscribed from the start of the process (before its stream starts).
@@ -125,6 +141,13 @@ TEST(TrackerConstraintHealth, ProjectsAStartInsideAConeAndReportsTheWorstViolati
   EXPECT_NE(result->message.find("past constraints along the flown path: keep_out by"),
             std::string::npos)
       << result->message;
+  // After the run the body's frame stays in tf at its final attitude (a condition: a transform
+  // stamped a second after the last sample arrives).
+  const ros::Time after = result->header.stamp + ros::Duration(1.0);
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(15.0);
+  while (cone_poses->newestTf() <= after && ros::WallTime::now() < give_up)
+    ros::WallDuration(0.02).sleep();
+  EXPECT_GT(cone_poses->newestTf(), after) << "no tf of cone_replan/body after the run";
 }
 
 int main(int argc, char** argv) {
@@ -133,7 +156,7 @@ int main(int argc, char** argv) {
   ros::AsyncSpinner spinner(1);
   spinner.start();
   ros::NodeHandle cone_nh("cone_replan");
-  PoseRecorder poses(cone_nh);
+  PoseRecorder poses(cone_nh, "cone_replan/body");
   cone_poses = &poses;
   return RUN_ALL_TESTS();
 }

@@ -403,6 +403,9 @@ class TrackerNode {
   void publishPose(const Matrix3& R, const ros::Time& stamp, const std::string& world_frame,
                    const std::string& body_frame, const PrincipalBox& box,
                    const Vector3& trace_axis, std::deque<Vector3>* trail);
+  /// After a rigid-body run: publishes world → body at the run's final attitude every 0.1 s (wall)
+  /// until the next maneuver or shutdown (the replay thread's last job).
+  void holdFinalAttitude();
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
   /// Remembers the body's state at the running run's next sample and that sample's stamp (what a
@@ -472,7 +475,14 @@ class TrackerNode {
   std::mutex body_mutex_;                    ///< guards the three below (stream vs callbacks)
   bool run_active_ = false;                  ///< a rigid-body run is streaming
   RigidBodyState next_body_;                 ///< the body at its next sample
-  ros::Time next_stamp_;                     ///< that sample's stamp
+  /// The frames and final attitude of the last finished rigid-body run (holdFinalAttitude);
+  /// owned by the replay thread.
+  struct HeldPose {
+    std::string world_frame, body_frame;
+    Matrix3 attitude;
+  };
+  std::optional<HeldPose> held_;
+  ros::Time next_stamp_;  ///< that sample's stamp
 };
 
 }  // namespace attitude_planner

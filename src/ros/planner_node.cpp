@@ -166,6 +166,7 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
   action_workers_ = readParam<int>(
       pnh, "action_workers", 2, [](int v) { return v >= 1; }, ">= 1");
+  warnUnknownParameters(pnh);
   for (int i = 0; i < action_workers_; ++i) workers_.emplace_back([this] { workerLoop(); });
 
   service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);

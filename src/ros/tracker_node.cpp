@@ -419,6 +419,7 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
                                                        non_negative, ">= 0 rad, 0 = never move");
   projection_tolerance_.rate_fraction = readParam<double>(
       pnh, "rate_projection_tolerance", 0.01, non_negative, ">= 0 (a fraction of the rate limit)");
+  warnUnknownParameters(pnh);
 
   advertiseTopics();
 

@@ -992,8 +992,12 @@ void TrackerNode::runReplay(Replay replay) {
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
            result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
-  held_ = HeldPose{pb.world_frame, pb.body_frame,
-                   rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
+  // The simulated body stays where it ended; an external body goes on moving (its measurements,
+  // not a held pose, say where).
+  if (plant_ == PlantKind::Internal) {
+    held_ = HeldPose{pb.world_frame, pb.body_frame,
+                     rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
+  }
 }
 
 void TrackerNode::holdFinalAttitude() {

@@ -852,9 +852,17 @@ void TrackerNode::publishManeuverMarkers(const Playback& pb) {
         Vector3(0.015, 0.04, 0.06) * path_radius_, color(1.0f, 0.6f, 0.0f, 0.4f)));
   }
   ghost_pub_.publish(ghosts);
-  const visualization_msgs::MarkerArray cones =
-      constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time());
-  if (!cones.markers.empty()) constraint_pub_.publish(cones);
+  // The previous maneuver's cones go first (DELETEALL), also when this one has none: before,
+  // they stayed on the latched topic and in rviz for the next maneuver.
+  visualization_msgs::MarkerArray cones;
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  cones.markers.push_back(clear);
+  for (const visualization_msgs::Marker& m :
+       constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time())
+           .markers)
+    cones.markers.push_back(m);
+  constraint_pub_.publish(cones);
 }
 
 void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& stamp,

@@ -75,6 +75,15 @@ target_link_libraries(test_tracker_replan ${PROJECT_NAME}_ros ${catkin_LIBRARIES
 add_dependencies(test_tracker_replan attitude_planner_node attitude_tracker_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_replan)
 
+# Constraint health: re-plans under active torque limits none failed and no worse than the law
+# alone, a start just inside a keep-out cone projected onto it, `done`'s worst violations against
+# the published path.
+add_rostest_gtest(test_tracker_constraint_health test/ros/tracker_constraint_health.test
+                  test/ros/test_tracker_constraint_health.cpp)
+target_link_libraries(test_tracker_constraint_health ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_constraint_health attitude_tracker_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_constraint_health)
+
 # ~plant external: the law on the measured state of attitude_plant_node (odometry in,
 # torque_command out) lands as the internal feedback mode does; no measurement: zero commands and
 # a failed done, the stream at its rate.

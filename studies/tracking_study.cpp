@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "attitude_planner/analysis/constraint_health.hpp"
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/dynamics/simulation.hpp"
@@ -68,8 +69,8 @@ struct ReplanSettings {
   int delay_steps = 1;
 };
 
-/// The replan mode's closed loop: re-plans from nodes period, 2 period, ... while at least
-/// kMinSteps steps are left, each flown from `delay` nodes later. Adds the terminal errors against
+/// The replan mode's closed loop: re-plans from nodes period, 2 period, ... up to
+/// lastReplanNode, each flown from `delay` nodes later. Adds the terminal errors against
 /// `reference`'s end and the effort to `figures`; returns the re-plans that failed.
 int flyReplanned(const PlanningProblem& problem, const ManeuverInterpolation& reference,
                  SchemeKind scheme, const std::shared_ptr<const EffectModel>& effects,
@@ -80,9 +81,24 @@ int flyReplanned(const PlanningProblem& problem, const ManeuverInterpolation& re
   RecedingHorizonRun run(nodes, scheme, problem.inertia, effects, actuation, options);
   const int period = std::max(1, static_cast<int>(std::lround(settings.period_fraction * N)));
   int failures = 0;
-  for (int k = period; N - k >= kMinSteps; k += period) {
-    const ManeuverSample body = run.bodyAtNode(k);
-    const PlanningProblem rest = remainderProblem(problem, k, body.attitude, body.angular_velocity);
+  const int last = lastReplanNode(N, nodes.time_step, run.naturalFrequency());
+  for (int k = period; k <= last; k += period) {
+    const ManeuverSample at_node = run.bodyAtNode(k);
+    const RigidBodyState node_state{at_node.attitude, at_node.angular_velocity};
+    // The start the tracker sends: the scheme's boundary data, then onto the constraints.
+    const double t_k = k * nodes.time_step;
+    const RigidBodyState scheme_start =
+        schemeStartOf(scheme, problem.inertia, effects.get(), node_state,
+                      run.commandAt(node_state, t_k), t_k, nodes.time_step);
+    const ProjectedStart body =
+        projectOntoConstraints(scheme_start, problem.constraints, ProjectionTolerance(),
+                               firstStepFixedByStart(scheme) ? nodes.time_step : 0.0);
+    if (!body.feasible) {
+      ++failures;
+      continue;
+    }
+    const PlanningProblem rest =
+        remainderProblem(problem, k, body.state.attitude, body.state.angular_velocity);
     const Maneuver guess = run.planRemainderAt(k);
     SolverOptions solver;
     solver.warm_start = &guess;

@@ -50,6 +50,21 @@ PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Ma
   return rest;
 }
 
+RigidBodyState schemeStartOf(SchemeKind scheme, const Matrix3& inertia, const EffectModel* effects,
+                             const RigidBodyState& body, const Vector3& command, double t,
+                             double time_step) {
+  if (scheme != SchemeKind::Paper && scheme != SchemeKind::Variational) return body;
+  const RigidBodyState midpoint = predictState(inertia, effects, body, command, t, 0.5 * time_step);
+  return RigidBodyState{body.attitude, midpoint.angular_velocity};  // R_0 is the node's R(t_k)
+}
+
+int lastReplanNode(int steps, double time_step, double natural_frequency) {
+  const double settling = kReplanSettlingTimeConstants / natural_frequency;  // [s]
+  const int steps_left =
+      std::max(kMinSteps, static_cast<int>(std::ceil(settling / time_step - 1e-9)));
+  return steps - steps_left;
+}
+
 int replanPeriodSteps(double period, int steps, double time_step) {
   if (!(std::isfinite(period) && period >= 0.0)) {
     throw InvalidInput("~replan_period: must be >= 0 s (0 = T / " +

@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -164,6 +166,7 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       pnh, "threads", 4, [](int v) { return v >= 2; }, ">= 2");
   action_workers_ = readParam<int>(
       pnh, "action_workers", 2, [](int v) { return v >= 1; }, ">= 1");
+  warnUnknownParameters(pnh);
   for (int i = 0; i < action_workers_; ++i) workers_.emplace_back([this] { workerLoop(); });
 
   service_ = nh_.advertiseService("plan_attitude_maneuver", &PlannerNode::onPlanService, this);
@@ -192,6 +195,14 @@ PlannerNode::~PlannerNode() {
   }
   goal_ready_.notify_all();
   for (std::thread& worker : workers_) worker.join();
+  // The goals' deadline watches stop (joined) while the action server still exists.
+  std::map<std::string, ActiveGoal> left;
+  std::deque<ActiveGoal> queued;
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    left.swap(active_);
+    queued.swap(queued_);
+  }
 }
 
 PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request& req) {
@@ -212,6 +223,7 @@ PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request&
   if (slot->finished.wait_for(lock, deadline, [&] { return slot->done; })) {
     lock.unlock();
     solve.join();
+    returnFreedMemory();
     return std::move(slot->outcome);
   }
   lock.unlock();
@@ -221,8 +233,16 @@ PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request&
   return deadlineOutcome(budget);
 }
 
+void returnFreedMemory() {
+  // A solve's memory is freed into its thread's malloc arena, which glibc keeps: after 20 stopped
+  // N = 1e5 solves the node held 698 MB it no longer used (docs/ros_timing.md). malloc_trim(0)
+  // hands the free pages of every arena back to the system (milliseconds; nothing is in use).
+  malloc_trim(0);
+}
+
 void PlannerNode::reapLateSolves(bool all) {
   std::lock_guard<std::mutex> late(late_mutex_);
+  const std::size_t before = late_solves_.size();
   for (auto it = late_solves_.begin(); it != late_solves_.end();) {
     bool done = false;
     {
@@ -237,6 +257,7 @@ void PlannerNode::reapLateSolves(bool all) {
     it->first.join();
     it = late_solves_.erase(it);
   }
+  if (late_solves_.size() < before) returnFreedMemory();  // the joined solves' memory
 }
 
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
@@ -278,6 +299,48 @@ bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
   return true;
 }
 
+/// Calls `on_deadline` once `seconds` [s] of wall time have passed, unless destroyed before (the
+/// action's deadline: the worker holds one while it solves).
+class DeadlineWatch {
+ public:
+  DeadlineWatch(double seconds, std::function<void()> on_deadline) {
+    if (!(seconds > 0.0)) return;
+    thread_ = std::thread([this, seconds, on_deadline = std::move(on_deadline)] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (ended_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return over_; }))
+        return;
+      lock.unlock();
+      on_deadline();
+    });
+  }
+  ~DeadlineWatch() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      over_ = true;
+    }
+    ended_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  DeadlineWatch(const DeadlineWatch&) = delete;
+  DeadlineWatch& operator=(const DeadlineWatch&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ended_;
+  bool over_ = false;
+  std::thread thread_;
+};
+
+void PlannerNode::onGoalDeadline(const ActiveGoal& goal) {
+  goal.cancel->store(true);
+  GoalHandle handle = goal.handle;
+  boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
+  if (handle.getGoalStatus().status != actionlib_msgs::GoalStatus::ACTIVE) return;
+  PlanAttitudeManeuverResult late;
+  fillResponse(deadlineOutcome(goal.budget), world_frame_, body_frame_, &late);
+  handle.setAborted(late, late.message);
+}
+
 void PlannerNode::onGoal(GoalHandle goal) {
   const std::string id = goal.getGoalID().id;
   ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false),
@@ -299,6 +362,18 @@ void PlannerNode::onGoal(GoalHandle goal) {
     return;
   }
   goal.setAccepted();  // a cancel already received turns this into PREEMPTING: served as such
+  // The deadline counts from here, not from when a worker takes the goal: a goal queued behind
+  // workers still stopping cancelled N = 1e5 solves is answered by its budget all the same.
+  active.accepted = ros::WallTime::now();
+  active.budget = ros_conversions::effectiveTimeBudget(goal.getGoal()->time_budget, defaults_);
+  active.deadline = std::make_shared<DeadlineWatch>(
+      active.budget * (1.0 + kDeadlineSlack),
+      [this, watched = ActiveGoal{active.handle, active.cancel, active.ended_at, nullptr,
+                                  active.accepted, active.budget}] { onGoalDeadline(watched); });
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    active_[id] = active;  // with its deadline
+  }
   {
     std::lock_guard<std::mutex> lock(goals_mutex_);
     queued_.push_back(active);
@@ -337,38 +412,6 @@ bool goalEnded(unsigned status) {
          status != GoalStatus::PREEMPTING && status != GoalStatus::RECALLING;
 }
 
-/// Calls `on_deadline` once `seconds` [s] of wall time have passed, unless destroyed before (the
-/// action's deadline: the worker holds one while it solves).
-class DeadlineWatch {
- public:
-  DeadlineWatch(double seconds, std::function<void()> on_deadline) {
-    if (!(seconds > 0.0)) return;
-    thread_ = std::thread([this, seconds, on_deadline = std::move(on_deadline)] {
-      std::unique_lock<std::mutex> lock(mutex_);
-      if (ended_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return over_; }))
-        return;
-      lock.unlock();
-      on_deadline();
-    });
-  }
-  ~DeadlineWatch() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      over_ = true;
-    }
-    ended_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-  DeadlineWatch(const DeadlineWatch&) = delete;
-  DeadlineWatch& operator=(const DeadlineWatch&) = delete;
-
- private:
-  std::mutex mutex_;
-  std::condition_variable ended_;
-  bool over_ = false;
-  std::thread thread_;
-};
-
 }  // namespace
 
 void PlannerNode::workerLoop() {
@@ -391,25 +434,26 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   const std::string id = handle.getGoalID().id;
   // A cancel that arrived before the goal was in active_ (so onCancel found no flag to set).
   const unsigned status = handle.getGoalStatus().status;
-  if (goalEnded(status)) return;  // cancelled while it waited: onCancel ended it and freed its slot
+  if (goalEnded(status)) {  // cancelled (onCancel) or past its deadline while it waited
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    active_.erase(id);  // its slot (onCancel freed it already)
+    return;
+  }
   if (status == actionlib_msgs::GoalStatus::PREEMPTING) goal.cancel->store(true);
   PlanAttitudeManeuverResult result;
   try {
     const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
-    // The deadline: an answer by budget (1 + kDeadlineSlack) even when the stopped solve takes
-    // longer to return; the solve is told to stop and its late result is discarded below.
-    const double budget = ros_conversions::effectiveTimeBudget(request->time_budget, defaults_);
-    const DeadlineWatch deadline(budget * (1.0 + kDeadlineSlack), [&] {
-      goal.cancel->store(true);
-      boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
-      if (handle.getGoalStatus().status != actionlib_msgs::GoalStatus::ACTIVE) return;
-      PlanAttitudeManeuverResult late;
-      fillResponse(deadlineOutcome(budget), world_frame_, body_frame_, &late);
-      handle.setAborted(late, late.message);
-    });
+    // The deadline (goal.deadline, armed at acceptance) answers by budget (1 + kDeadlineSlack)
+    // even when the stopped solve takes longer to return; its late result is discarded below.
+    // The solve gets what is left of the budget after the wait in the queue.
+    PlanAttitudeManeuverGoal solve_request = *request;
+    if (goal.budget > 0.0) {
+      const double waited = (ros::WallTime::now() - goal.accepted).toSec();
+      solve_request.time_budget = std::max(goal.budget - waited, 1e-6);
+    }
     PlanAttitudeManeuverFeedback feedback;
     const PlanOutcome outcome = planRequest(
-        *request, defaults_,
+        solve_request, defaults_,
         [&](const IterationInfo& info, double elapsed) {
           feedback.iteration = info.iteration;
           feedback.cost = info.cost;
@@ -428,6 +472,7 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
     result.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     result.message = std::string("internal error: ") + e.what();
   }
+  returnFreedMemory();  // the solve's arena, before the worker takes the next goal
   {
     std::lock_guard<std::mutex> lock(goals_mutex_);
     active_.erase(id);  // the worker is free for the next goal

@@ -28,6 +28,7 @@ PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   double max_step = readParam<double>(pnh, "max_step", 0.0, non_negative, ">= 0 s, 0 = h / 4");
   world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
   body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
+  warnUnknownParameters(pnh);
   Scene scene;
   try {
     scene = loadScene(scene_path);

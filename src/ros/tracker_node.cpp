@@ -293,6 +293,18 @@ ReplanAnswer planRemainder(const PlanningProblem& rest, const std::vector<Effect
   return answer;
 }
 
+void reportConstraintHealth(const ConstraintHealth& health, ReplayResult* result) {
+  result->constraint_names = health.names();
+  result->constraint_violations = health.worstViolations();
+  std::string past;
+  for (std::size_t i = 0; i < health.names().size(); ++i) {
+    const double v = health.worstViolations()[i];
+    if (v > 0.0) past += (past.empty() ? "" : ", ") + health.names()[i] + " by " + exactNumber(v);
+  }
+  // Said in words too: a run that went past a constraint is not what was planned.
+  if (!past.empty()) result->message += "; past constraints along the flown path: " + past;
+}
+
 bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& effects,
                ros::ServiceClient* client, const std::string& world_frame,
                const std::string& body_frame, AttitudeManeuver* msg, double* solve_time,
@@ -403,6 +415,11 @@ TrackerNode::TrackerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   plant_ = readNamedParam(pnh, "plant", PlantKind::Internal, kPlantNames);
   measurement_timeout_ =
       readParam<double>(pnh, "measurement_timeout", 0.5, positive, "> 0 s (ROS time)");
+  projection_tolerance_.cone_angle = readParam<double>(pnh, "projection_tolerance", 0.01,
+                                                       non_negative, ">= 0 rad, 0 = never move");
+  projection_tolerance_.rate_fraction = readParam<double>(
+      pnh, "rate_projection_tolerance", 0.01, non_negative, ">= 0 (a fraction of the rate limit)");
+  warnUnknownParameters(pnh);
 
   advertiseTopics();
 
@@ -595,6 +612,7 @@ void TrackerNode::startReplay(Replay replay) {
   std::lock_guard<std::mutex> lock(replay_mutex_);
   replay_thread_ = std::thread([this, replay]() {
     done_published_ = false;
+    held_.reset();
     runReplay(replay);
     noteNextSample(false);
     if (!done_published_ && replacing_) {
@@ -606,6 +624,7 @@ void TrackerNode::startReplay(Replay replay) {
       replaced.header.frame_id = world_frame_;
       done_pub_.publish(replaced);  // not publishDone: ~exit_when_done waits for the last run
     }
+    holdFinalAttitude();
   });
 }
 
@@ -780,6 +799,7 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.problem.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   applyEffects(replay.effects, &pb.problem);
   pb.effects_specs = replay.effects;
+  pb.health = std::make_shared<ConstraintHealth>(pb.problem.max_torque, pb.problem.constraints);
 
   pb.world_frame = msg.header.frame_id.empty() ? world_frame_ : msg.header.frame_id;
   pb.body_frame = msg.child_frame_id.empty() ? body_frame_ : msg.child_frame_id;
@@ -832,9 +852,17 @@ void TrackerNode::publishManeuverMarkers(const Playback& pb) {
         Vector3(0.015, 0.04, 0.06) * path_radius_, color(1.0f, 0.6f, 0.0f, 0.4f)));
   }
   ghost_pub_.publish(ghosts);
-  const visualization_msgs::MarkerArray cones =
-      constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time());
-  if (!cones.markers.empty()) constraint_pub_.publish(cones);
+  // The previous maneuver's cones go first (DELETEALL), also when this one has none: before,
+  // they stayed on the latched topic and in rviz for the next maneuver.
+  visualization_msgs::MarkerArray cones;
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  cones.markers.push_back(clear);
+  for (const visualization_msgs::Marker& m :
+       constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time())
+           .markers)
+    cones.markers.push_back(m);
+  constraint_pub_.publish(cones);
 }
 
 void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& stamp,
@@ -842,6 +870,7 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   // replan: the body under the plans adopted so far, the reference the plan in force.
   const ManeuverSample body = pb.horizon ? pb.horizon->bodyAt(t) : pb.actual->at(t);
   const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
+  pb.health->observe(body.attitude, body.angular_velocity, body.torque);
   publishState(pb, body, plan, t, stamp, trail);
 }
 
@@ -960,6 +989,7 @@ void TrackerNode::runReplay(Replay replay) {
     pb.result.success = true;
   }
   ReplayResult result = pb.result;
+  reportConstraintHealth(*pb.health, &result);
   const std::string conflict = claimFrames(pb.world_frame, pb.body_frame);
   if (!conflict.empty()) {  // the run was shown on a transform another node also moved
     result.success = false;
@@ -970,6 +1000,31 @@ void TrackerNode::runReplay(Replay replay) {
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
            result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
+  // The simulated body stays where it ended; an external body goes on moving (its measurements,
+  // not a held pose, say where).
+  if (plant_ == PlantKind::Internal) {
+    held_ = HeldPose{pb.world_frame, pb.body_frame,
+                     rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
+  }
+}
+
+void TrackerNode::holdFinalAttitude() {
+  if (!held_) return;
+  // After a run the body stays where it ended: rviz and tf listeners keep the frame (before, tf
+  // stopped with the last sample and the body's frame expired from every buffer).
+  constexpr double kHoldPeriod = 0.1;  // [s, wall]
+  geometry_msgs::TransformStamped tf;
+  tf.header.frame_id = held_->world_frame;
+  tf.child_frame_id = held_->body_frame;
+  tf.transform.rotation = rc::attitudeToMsg(held_->attitude);
+  while (!stop_ && ros::ok()) {
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero() && now > tf.header.stamp) {  // sim time may pause: never a repeated stamp
+      tf.header.stamp = now;
+      tf_broadcaster_.sendTransform(tf);
+    }
+    ros::WallDuration(kHoldPeriod).sleep();
+  }
 }
 
 void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
@@ -1023,7 +1078,7 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
     pb->replan_status = line;
   }
   const int node = static_cast<int>(std::floor(t / h + kNodeSlack));
-  if (node < state->next_node || N - node < kMinSteps) return;
+  if (node < state->next_node || node > lastReplanNode(N, h, run.naturalFrequency())) return;
   // The state the body has at this node under the plan in force, and that plan's rest.
   RigidBodyState body;
   if (state_at_node) {
@@ -1031,6 +1086,14 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
   } else {
     const ManeuverSample simulated = run.bodyAtNode(node);
     body = RigidBodyState{simulated.attitude, simulated.angular_velocity};
+  }
+  // As the scheme's boundary data (its Ω_0 may be the first step's rate), then onto the
+  // constraints: the two moves a start needs so that the planner can fly on from it.
+  body = schemeStartOf(pb->problem.scheme, pb->reference->inertia(), pb->effects.get(), body,
+                       run.commandAt(body, node * h), node * h, h);
+  if (!projectReplanStart(node * h, &body, pb)) {
+    state->next_node = node + state->period_steps;  // the next node may be back within bounds
+    return;
   }
   PlanningProblem rest;
   try {
@@ -1049,6 +1112,32 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
   state->pending = true;
   state->pending_from = node;
   state->next_node = node + state->period_steps;
+}
+
+bool TrackerNode::projectReplanStart(double t, RigidBodyState* body, Playback* pb) const {
+  ReplayResult& result = pb->result;
+  const double h = pb->reference->nodes().time_step;
+  const ProjectedStart start =
+      projectOntoConstraints(*body, pb->problem.constraints, projection_tolerance_,
+                             firstStepFixedByStart(pb->problem.scheme) ? h : 0.0);
+  if (!start.feasible) {
+    // The planner would refuse this start (boundary data past a constraint): not sent, counted.
+    const std::string error = "re-plan from t = " + exactNumber(t) +
+                              " s not sent: " + start.refusal + " (~projection_tolerance)";
+    ++result.replan_failures;
+    if (result.replan_error.empty()) result.replan_error = error;
+    ROS_WARN("%s", error.c_str());
+    return false;
+  }
+  if (start.moved > 0.0 || start.slowed > 0.0) {
+    ++result.projected_replans;
+    ROS_INFO(
+        "re-plan from t = %.6g s starts on the constraints: the body's attitude turned by "
+        "%.3g rad, its rate reduced by %.3g rad/s",
+        t, start.moved, start.slowed);
+  }
+  *body = start.state;
+  return true;
 }
 
 void TrackerNode::onTf(const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
@@ -1182,6 +1271,7 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
     if (measured.fresh) {
       result.max_attitude_deviation = std::max(
           result.max_attitude_deviation, so3::angleBetween(reference.attitude, body.attitude));
+      pb->health->observe(body.attitude, body.angular_velocity, body.torque);
     }
     if (j + 1 < pb->times.size()) {  // held until the next sample
       result.effort += 0.5 * body.torque.squaredNorm() * (pb->times[j + 1] - t);

@@ -136,6 +136,21 @@ TEST(NodeParameters, RelativeSceneIsPlannedFromTheCallersDirectory) {
       << run.output;
 }
 
+TEST(NodeParameters, AnUnknownPrivateParameterIsWarnedAndTheNodeRuns) {
+  // `~rat` (meant: `~rate`) would leave the rate at its default without a word: warned, named,
+  // with the node's parameters listed; the node runs on (a warning, not a stop).
+  const NodeRun run = runNode(kTracker + " __name:=misspelt _rat:=30.0 _rate:=20.0", 5);
+  EXPECT_EQ(run.status, kTimeoutExit) << run.output;
+  EXPECT_TRUE(contains(run.output, "parameter /misspelt/rat is not one of this node's"))
+      << run.output;
+  EXPECT_TRUE(contains(run.output, "measurement_timeout")) << run.output;  // the list
+  EXPECT_FALSE(contains(run.output, "parameter /misspelt/rate is not")) << run.output;
+  const NodeRun planner = runNode(kPlanner + " __name:=misspelt_planner _thread:=3", 5);
+  EXPECT_EQ(planner.status, kTimeoutExit) << planner.output;
+  EXPECT_TRUE(contains(planner.output, "parameter /misspelt_planner/thread is not one of"))
+      << planner.output;
+}
+
 TEST(NodeParameters, SimTimeThroughARemapAndOneWarningWhileClockIsSilent) {
   // As replay.launch does for rviz: /use_sim_time remapped to a private parameter. Nothing
   // publishes /clock here, so the replay waits and the tracker says so, once.

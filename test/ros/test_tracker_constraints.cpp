@@ -54,8 +54,10 @@ TEST(TrackerConstraints, ConeAndBodyAxisMarkersHaveTheConstraintsGeometry) {
   }
   std::lock_guard<std::mutex> lock(mutex);
   ASSERT_TRUE(got) << "no constraint_markers";
-  ASSERT_EQ(got->markers.size(), 2u);
-  const visualization_msgs::Marker& c = got->markers[0];
+  // A DELETEALL first (the previous maneuver's cones go), then the cone and its body axis.
+  ASSERT_EQ(got->markers.size(), 3u);
+  EXPECT_EQ(got->markers[0].action, visualization_msgs::Marker::DELETEALL);
+  const visualization_msgs::Marker& c = got->markers[1];
   EXPECT_EQ(c.header.frame_id, "world");
   EXPECT_EQ(c.ns, "keep_out");
   EXPECT_EQ(c.type, visualization_msgs::Marker::TRIANGLE_LIST);
@@ -76,7 +78,7 @@ TEST(TrackerConstraints, ConeAndBodyAxisMarkersHaveTheConstraintsGeometry) {
   }
   // Rim points spread evenly around the axis: their mean lies on the world direction.
   EXPECT_LT((rim_sum.normalized() - cone.world_direction).norm(), 1e-9);
-  const visualization_msgs::Marker& a = got->markers[1];
+  const visualization_msgs::Marker& a = got->markers[2];
   EXPECT_EQ(a.header.frame_id, "body");
   EXPECT_EQ(a.ns, "keep_out_body_axis");
   EXPECT_EQ(a.type, visualization_msgs::Marker::ARROW);

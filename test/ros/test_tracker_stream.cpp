@@ -129,10 +129,11 @@ TEST_F(TrackerStream, FramesStampAndConstraintsComeFromTheMessage) {
   ASSERT_TRUE(tf_buffer.canTransform("map", "base_link", done.header.stamp, ros::Duration(5.0)));
   EXPECT_FALSE(tf_buffer._frameExists("body")) << "the default frame was published";
   ASSERT_TRUE(cones_) << "no constraint_markers for a maneuver that carries a keep_out cone";
-  ASSERT_EQ(cones_->markers.size(), 2u);
-  EXPECT_EQ(cones_->markers[0].header.frame_id, "map");
-  EXPECT_EQ(cones_->markers[0].ns, "keep_out");
-  EXPECT_EQ(cones_->markers[1].header.frame_id, "base_link");
+  ASSERT_EQ(cones_->markers.size(), 3u);  // the previous maneuver's cleared, the cone, its axis
+  EXPECT_EQ(cones_->markers[0].action, visualization_msgs::Marker::DELETEALL);
+  EXPECT_EQ(cones_->markers[1].header.frame_id, "map");
+  EXPECT_EQ(cones_->markers[1].ns, "keep_out");
+  EXPECT_EQ(cones_->markers[2].header.frame_id, "base_link");
   // Open loop on its own plan: the error topic reads zero to round-off all along.
   ASSERT_FALSE(errors_.empty());
   for (double e : errors_) EXPECT_LT(e, 1e-9);
@@ -147,6 +148,10 @@ TEST_F(TrackerStream, SamplesAreStreamedAtTheRateNotAtTheNodes) {
   EXPECT_GE(torques_.size(), 0.8 * expected);
   EXPECT_LE(torques_.size(), 1.2 * expected + 2);
   EXPECT_NE(torques_.size(), std::size_t(kSteps + 1));  // not one per node
+  // A maneuver without cones after one with: the stale cones are deleted (a DELETEALL alone).
+  ASSERT_TRUE(cones_);
+  ASSERT_EQ(cones_->markers.size(), 1u);
+  EXPECT_EQ(cones_->markers[0].action, visualization_msgs::Marker::DELETEALL);
   // Evenly spaced in ROS time, 1 / rate apart (the last one at T).
   for (std::size_t j = 1; j + 1 < torques_.size(); ++j) {
     EXPECT_NEAR((torques_[j].header.stamp - torques_[j - 1].header.stamp).toSec(), 1.0 / kRate,

@@ -31,6 +31,33 @@ Maneuver remainderOf(const Maneuver& maneuver, int k);
 PlanningProblem remainderProblem(const PlanningProblem& problem, int k, const Matrix3& attitude,
                                  const Vector3& angular_velocity);
 
+/// The body's state at node k (t = t_k, continuous: R(t_k), Ω(t_k)) as the boundary data of a
+/// re-plan in `scheme`. second_order and fourth_order impose Ω_0 at the instant t_k: Ω(t_k) itself.
+/// paper and variational take Ω_0 as the rate of the first step (paper: log(F_0)/h; variational:
+/// the rate just after the node's impulse), whose value is the body's rate at the step's midpoint
+/// to second order (ManeuverInterpolation reads their rows so): Ω(t_k + h/2), predicted by
+/// predictState under `command` [N·m] held and the known `effects` (may be null). Planning from
+/// Ω(t_k) instead gives the new plan a first step off by (h/2)Ω̇, which its torque at node 1 must
+/// undo: about half the torque in force, beyond the actuator limits when they are active
+/// (torque_limited.yaml: 4 of 9 re-plans "infeasible", docs/ros_tracker.md).
+RigidBodyState schemeStartOf(SchemeKind scheme, const Matrix3& inertia, const EffectModel* effects,
+                             const RigidBodyState& body, const Vector3& command, double t,
+                             double time_step);
+
+/// Re-plans are not sent once less than this many of the law's time constants 1/ω_n are left:
+/// an answer adopted then has little time to be flown, and under active actuator limits the rest
+/// is too short to absorb the body's offset (the last re-plan of torque_limited.yaml, 0.8 s =
+/// 2.5/ω_n before the end, needed 5 % more torque than the limit: "infeasible from here"); the
+/// law alone finishes the maneuver. 3 rather than 4 (about the law's settling time): at 4 the
+/// paper scheme's seed example loses the last re-plan's restart from the body's own rate
+/// (terminal rate error 1.5e-4 → 3.7e-3 rad/s, tracking_study; docs/ros_tracker.md).
+inline constexpr double kReplanSettlingTimeConstants = 3.0;
+
+/// The last node a re-plan may start from: the largest k with at least kMinSteps steps and
+/// kReplanSettlingTimeConstants / ω_n of maneuver time left (ω_n = `natural_frequency` > 0);
+/// −1 if none.
+int lastReplanNode(int steps, double time_step, double natural_frequency);
+
 /// The closed loop of the `replan` mode: the tracking law flies the newest adopted plan; the body
 /// is continuous across adoptions (one simulation per adopted plan, from the state at its node,
 /// with the actuator noise stream continued where it was).

@@ -11,11 +11,15 @@
 #include <sysexits.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "attitude_planner/name_table.hpp"
 
@@ -61,13 +65,57 @@ inline std::string storedValue(const ros::NodeHandle& nh, const std::string& nam
   return out.str();
 }
 
+/// The fully resolved names the read*Param functions were asked for (set or not): the node's
+/// parameters, for warnUnknownParameters.
+inline std::set<std::string>& readNames() {
+  static std::set<std::string> names;
+  return names;
+}
+inline std::mutex& readNamesMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
 }  // namespace parameter_detail
+
+/// Warns (ROS_WARN, one line each) about every private parameter of `nh` on the parameter server
+/// that no read*Param call asked for: a misspelt `~rat` would otherwise leave `~rate` at its
+/// default without a word. Call it after the node has read all its parameters. `use_sim_time`
+/// is roscpp's (replay.launch remaps /use_sim_time to a private one). Returns the unknown names.
+inline std::vector<std::string> warnUnknownParameters(const ros::NodeHandle& nh) {
+  std::vector<std::string> unknown, all;
+  if (!ros::param::getParamNames(all)) return unknown;
+  const std::string prefix = nh.getNamespace() + "/";
+  std::lock_guard<std::mutex> lock(parameter_detail::readNamesMutex());
+  const std::set<std::string>& read = parameter_detail::readNames();
+  std::string known;
+  for (const std::string& name : read) {
+    if (name.compare(0, prefix.size(), prefix) == 0)
+      known += (known.empty() ? "" : ", ") + name.substr(prefix.size());
+  }
+  for (const std::string& name : all) {
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string key =
+        name.substr(prefix.size(), name.find('/', prefix.size()) - prefix.size());
+    if (key == "use_sim_time" || read.count(prefix + key) ||
+        std::find(unknown.begin(), unknown.end(), key) != unknown.end())
+      continue;
+    unknown.push_back(key);
+    ROS_WARN("parameter %s%s is not one of this node's and is ignored (its parameters: %s)",
+             prefix.c_str(), key.c_str(), known.c_str());
+  }
+  return unknown;
+}
 
 /// Reads a private parameter: `fallback` if it is not set; throws InvalidParameter if it is set
 /// with the wrong type or `valid` rejects it (`requirement` says what is accepted, e.g. "> 0").
 template <class T, class Valid>
 T readParam(const ros::NodeHandle& nh, const std::string& name, const T& fallback, Valid valid,
             const std::string& requirement) {
+  {
+    std::lock_guard<std::mutex> lock(parameter_detail::readNamesMutex());
+    parameter_detail::readNames().insert(nh.resolveName(name));
+  }
   if (!nh.hasParam(name)) return fallback;
   T value;
   if (!nh.getParam(name, value)) {

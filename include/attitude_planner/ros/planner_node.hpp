@@ -142,6 +142,14 @@ struct SolveSlot {
 /// The TIMED_OUT outcome of a request answered at its deadline `budget` [s] without its solve.
 PlanOutcome deadlineOutcome(double budget);
 
+/// Hands the memory freed by finished solves back to the system (glibc keeps it in the solving
+/// threads' malloc arenas otherwise).
+void returnFreedMemory();
+
+/// Calls a function once a wall time has passed unless destroyed before (planner_node.cpp): an
+/// action goal's deadline, armed when the goal is accepted.
+class DeadlineWatch;
+
 /// The node: service + action around planRequest().
 class PlannerNode {
  public:
@@ -170,7 +178,15 @@ class PlannerNode {
     /// Wall time [s] at which onCancel ended the goal (0: not ended by a cancel), for the log line
     /// that says how long the worker took to stop after it (docs/ros_timing.md).
     std::shared_ptr<std::atomic<double>> ended_at;
+    /// The goal's deadline, from its acceptance (a goal queued behind busy workers counts its
+    /// wait): ends it ABORTED / TIMED_OUT at budget (1 + kDeadlineSlack), queued or solving.
+    std::shared_ptr<DeadlineWatch> deadline;
+    ros::WallTime accepted;  ///< when it was accepted
+    double budget = 0.0;     ///< its effective time budget [s] (0 = none)
   };
+  /// The deadline of an accepted goal passed: tells its solve to stop and ends it ABORTED with
+  /// TIMED_OUT (unless it has ended); frees its slot if no worker has taken it.
+  void onGoalDeadline(const ActiveGoal& goal);
 
   /// planRequest for the service, answered by its deadline (kDeadlineSlack): the solve runs on a
   /// thread of its own, left to stop (and joined later) when the deadline passes first.

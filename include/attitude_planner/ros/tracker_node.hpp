@@ -141,6 +141,7 @@
 #include "attitude_planner/DriftTwoInputManeuver.h"
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/analysis/constraint_health.hpp"
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
@@ -203,6 +204,10 @@ std::vector<int> decimatedIndices(int n, int max_points);
 /// Maneuver times [s] of the published samples: t_j = j · rate_factor / rate while below T, then
 /// T itself; with rate = 0 the node times k h, k = 0..N.
 std::vector<double> sampleTimes(double duration, int steps, double rate, double rate_factor);
+
+/// `done`'s constraint health: the names and worst violations of `health`, and the message
+/// extended with the constraints the flown path went past (by how much).
+void reportConstraintHealth(const ConstraintHealth& health, ReplayResult* result);
 
 /// Plans a scene: via the service (if `client` is valid; the request carries the scene's
 /// plannable `effects`, actuator limits and constraints) or in-process (`problem` already holds
@@ -303,7 +308,10 @@ class TrackerNode {
     std::shared_ptr<RecedingHorizonRun> horizon;
     PlanningProblem problem;
     std::vector<EffectSpec> effects_specs;
-    std::string replan_status;    ///< the status text's re-plan line (replan mode)
+    std::string replan_status;  ///< the status text's re-plan line (replan mode)
+    /// The worst violation of each constraint at the published samples (fresh measurements when
+    /// the plant is external); shared so the const publishing path can update it.
+    std::shared_ptr<ConstraintHealth> health;
     int replan_period_steps = 1;  ///< plan steps between re-plans (replanPeriodSteps)
   };
   /// A re-plan in flight (replan mode).
@@ -346,6 +354,10 @@ class TrackerNode {
   /// from the state `state_at_node` gives at that node (default: the simulated body's).
   void serviceReplans(double t, Playback* playback, ReplanState* state,
                       const std::function<RigidBodyState(int)>& state_at_node = nullptr);
+  /// replan mode: moves a re-plan's start `body` (at maneuver time t) onto the constraints when it
+  /// is past them within ~projection_tolerance (counted in done.projected_replans); false, with a
+  /// failed re-plan counted and said, when it is farther (the planner would refuse that start).
+  bool projectReplanStart(double t, RigidBodyState* body, Playback* playback) const;
   /// ~plant external: streams `playback` from `start`, commanding the measured body; fills the
   /// result (terminal errors of the last measurement, effort of the commands, stale samples).
   /// False if stopped meanwhile.
@@ -391,6 +403,9 @@ class TrackerNode {
   void publishPose(const Matrix3& R, const ros::Time& stamp, const std::string& world_frame,
                    const std::string& body_frame, const PrincipalBox& box,
                    const Vector3& trace_axis, std::deque<Vector3>* trail);
+  /// After a rigid-body run: publishes world → body at the run's final attitude every 0.1 s (wall)
+  /// until the next maneuver or shutdown (the replay thread's last job).
+  void holdFinalAttitude();
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
   /// Remembers the body's state at the running run's next sample and that sample's stamp (what a
@@ -442,10 +457,13 @@ class TrackerNode {
   double takeover_tolerance_ = 0.25;              ///< ~takeover_tolerance [rad]
   PlantKind plant_ = PlantKind::Internal;         ///< ~plant
   double measurement_timeout_ = 0.5;              ///< ~measurement_timeout [s, ROS time]
-  std::mutex odometry_mutex_;                     ///< guards odometry_ (callback vs stream)
-  nav_msgs::Odometry::ConstPtr odometry_;         ///< newest `odometry`, null before the first
-  ros::Time odometry_received_;                   ///< when it arrived (for an unstamped one)
-  RigidBodyState last_measured_;                  ///< the last usable measurement (for display)
+  /// ~projection_tolerance [rad], ~rate_projection_tolerance: how far past a constraint a re-plan's
+  /// start is moved onto it (farther: the re-plan is not sent)
+  ProjectionTolerance projection_tolerance_;
+  std::mutex odometry_mutex_;              ///< guards odometry_ (callback vs stream)
+  nav_msgs::Odometry::ConstPtr odometry_;  ///< newest `odometry`, null before the first
+  ros::Time odometry_received_;            ///< when it arrived (for an unstamped one)
+  RigidBodyState last_measured_;           ///< the last usable measurement (for display)
   /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
   std::optional<std::vector<EffectSpec>> replay_scene_effects_;
 
@@ -457,7 +475,14 @@ class TrackerNode {
   std::mutex body_mutex_;                    ///< guards the three below (stream vs callbacks)
   bool run_active_ = false;                  ///< a rigid-body run is streaming
   RigidBodyState next_body_;                 ///< the body at its next sample
-  ros::Time next_stamp_;                     ///< that sample's stamp
+  /// The frames and final attitude of the last finished rigid-body run (holdFinalAttitude);
+  /// owned by the replay thread.
+  struct HeldPose {
+    std::string world_frame, body_frame;
+    Matrix3 attitude;
+  };
+  std::optional<HeldPose> held_;
+  ros::Time next_stamp_;  ///< that sample's stamp
 };
 
 }  // namespace attitude_planner

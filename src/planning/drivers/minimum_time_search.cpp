@@ -14,6 +14,7 @@
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/problem/duration_bound.hpp"
 #include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
@@ -234,13 +235,19 @@ class MinimumTimeSearch {
       none.termination = *stopped_;
       none.message = terminationName(*stopped_) + " before any duration was found feasible";
     } else if (std::isfinite(unrepresentable_from_)) {
-      // Longer plans are not shown infeasible: this grid cannot hold them.
-      none.termination = Termination::StepTooLarge;
+      // Longer plans are not shown infeasible: this grid cannot hold them. Only where the grid
+      // is too coarse at the proven least duration is the step count the cause.
+      const bool coarse = representableDuration(problem_) < durationLowerBound(problem_).seconds;
+      none.termination = coarse ? Termination::StepTooLarge : Termination::NotConverged;
       none.message =
-          "step too large, increase steps: no plan was found below T = " +
-          exactNumber(unrepresentable_from_) + " s, and from there on one step of " +
+          std::string(coarse ? "step too large, increase steps" : "not converged") +
+          ": no plan was found below T = " + exactNumber(unrepresentable_from_) +
+          " s, and from there on one step of " +
           exactNumber(unrepresentable_from_ / problem_.steps) +
-          " s at the boundary rates has no solution (N = " + std::to_string(problem_.steps) + ")";
+          " s at the boundary rates has no solution (N = " + std::to_string(problem_.steps) + ")" +
+          (coarse ? "; even at the proven least duration a boundary step turns more "
+                    "than 1 rad"
+                  : "");
     } else {
       none.termination = Termination::Infeasible;
       none.message = "infeasible: no duration up to 2^" + std::to_string(kMaxDoublings) +

@@ -252,7 +252,9 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
     options.on_iteration = [&](const IterationInfo& info) {
       const double elapsed = (ros::WallTime::now() - start).toSec();
       const bool cancelled = cancel && cancel->load();
-      return ros::ok() && !cancelled && (!keep_going || keep_going(info, elapsed));
+      // Without ros::init (a test, a tool) there is no shutdown to honour: ros::ok() is false.
+      const bool shutting_down = ros::isInitialized() && !ros::ok();
+      return !shutting_down && !cancelled && (!keep_going || keep_going(info, elapsed));
     };
     out.result = planManeuver(out.problem, options);
     out.wall_time_s = (ros::WallTime::now() - start).toSec();

@@ -2,7 +2,7 @@
 // closed forms, the worst along a path, and the projection of a re-plan's start onto the
 // constraints — the smallest turn (an independent check: no rotation by less moves R b by that
 // much), and a body 2e-4 rad inside a keep-out cone that the planner refuses before and plans
-// from after the projection (issue 43: "refused near a keep-out cone").
+// from after the projection.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The Newton solver on the discrete optimal control problem (issue 3).
+// The Newton solver on the discrete optimal control problem.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The Newton solver's structured trail (issue 29): every attempt recorded with its stage, start,
+// The Newton solver's structured trail: every attempt recorded with its stage, start,
 // class, termination, iterations and cost; one kept; iterations numbered across attempts; the
 // extremal structured; a cancel from another thread ends a large solve promptly; and the grid
 // continuation, which takes any solver as a callable.

@@ -16,6 +16,7 @@
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
 
 namespace attitude_planner {
@@ -23,7 +24,7 @@ namespace attitude_planner {
 namespace {
 
 void validateMinimumTime(const PlanningProblem& problem) {
-  if (!std::isfinite(smallestAuthority(problem))) {
+  if (!std::isfinite(torqueAuthority(problem).smallest_about_any_axis)) {
     throw InvalidInput(
         "objective: 'minimum_time' needs a torque bound (effects: [actuator_limits: ...] or "
         "constraints: [max_torque_norm: ...]); without one any duration > 0 is feasible");
@@ -222,54 +223,90 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   return result;
 }
 
-/// Spinning ends: how far below T* the probe asks (probedBelow), and how many probes descend.
+/// Spinning ends: the probes below T* (probedBelow). A probe asks (1 − δ 2^j) T for the least
+/// duration T found so far, δ = kProbeBelow: j grows while probes succeed (a descent by doubling
+/// steps), falls back by one after a failure (bisection), and the descent stops where the probes
+/// at both δ and 2δ below T found nothing: a cold minimum-effort solve's failure is local, and the
+/// seeded bounded suite had requests where 0.99 T failed and 0.98 T converged. kMaxProbes bounds
+/// the time (each probe is one constrained minimum-effort solve and one free-time solve).
 constexpr double kProbeBelow = 0.01;
-constexpr int kMaxProbes = 4;
+constexpr int kLargestProbeExponent = 5;  ///< at most 32 δ = 32 % below T per probe
+constexpr int kMaxProbes = 12;
 
-/// Minimum time with spinning ends has local minima that the structured starts miss, with a
-/// minimum-effort plan just below their T* (docs/results/bounded_verdicts.md). So a free-time
-/// answer with spinning ends is probed: a cold minimum-effort solve at (1 − kProbeBelow) T*; where
-/// it proves that T feasible (provesFeasible), the free-time solve from its plan descends to a
-/// lower KKT point, which is probed again. A probe that finds nothing ends it; the trail keeps
-/// every probe.
+/// What the probes below the current T have shown: which steps δ 2^j found nothing.
+struct ProbeSteps {
+  int exponent = 0;
+  bool failed_at_one = false, failed_at_two = false;  ///< j = 0, j = 1 found nothing
+
+  double fraction() const { return kProbeBelow * std::ldexp(1.0, exponent); }
+  /// After a probe that found a plan (a lower T): `descended` if a free-time KKT point came of it
+  /// (a new basin: start again at δ), else larger steps.
+  void found(bool descended) {
+    exponent = descended ? 0 : std::min(exponent + 1, kLargestProbeExponent);
+    failed_at_one = failed_at_two = false;
+  }
+  /// After a probe that found nothing: false when the descent stops.
+  bool nothingFound() {
+    if (exponent == 0) failed_at_one = true;
+    if (exponent == 1) failed_at_two = true;
+    if (failed_at_one && failed_at_two) return false;
+    exponent = exponent > 1 ? exponent - 1 : (failed_at_one ? 1 : 0);
+    return true;
+  }
+};
+
+/// The answer from a probe at `effort.duration` that found a plan (`below`): the free-time KKT
+/// point from its plan where one lies lower, else the probe's plan as an upper bound on T*.
+PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
+                       PlanResult answer, const PlanResult& below, SolveContext& context) {
+  std::vector<Attempt> tried;
+  std::optional<PlanResult> lower =
+      freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
+  const std::string found = "; a plan was found at " + exactNumber(effort.duration) +
+                            " s, below the T* = " + exactNumber(answer.minimum_duration) +
+                            " s reached before";
+  if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
+    lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
+    lower->message = lower->message + found + ", and the free-time solve from it descended";
+    return *lower;
+  }
+  PlanResult upper = below;
+  upper.attempts = joined(answer.attempts, below.attempts);
+  appendTrail(lower ? lower->attempts : tried, false, &upper.attempts);
+  upper.minimum_duration = effort.duration;
+  upper.minimum_time = MinimumTimeCertificate{};
+  upper.minimum_time.solves = answer.minimum_time.solves;
+  upper.message = "minimum time T* <= " + exactNumber(effort.duration) +
+                  " s, the least duration found feasible (an upper bound)" + found +
+                  " (its minimum-effort plan is returned): " + below.message;
+  return upper;
+}
+
+/// Minimum time with spinning ends has local minima that the structured starts miss, with
+/// minimum-effort plans below their T* (docs/results/bounded_verdicts.md). So a free-time answer
+/// with spinning ends is probed: cold minimum-effort solves below T* (ProbeSteps); where one
+/// finds a plan (provesFeasible), the free-time solve from it descends to a lower KKT point or
+/// its plan is the answer, an upper bound. No probe goes below the proven bound T_c on the grid.
+/// The trail keeps every probe.
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, SolveContext& context) {
+  const double floor =
+      discreteDurationLowerBound(durationLowerBound(problem), problem.steps);  // 0: no bound
+  ProbeSteps steps;
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
     PlanningProblem effort = problem;
     effort.objective = Objective::MinimumEffort;
     effort.time_margin = 0.0;
-    effort.duration = (1.0 - kProbeBelow) * answer.minimum_duration;
-    if (context.stopReason()) break;
+    effort.duration = std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor);
+    if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
     const PlanResult below = runInternalPhase(
         "the probe below T*", [&] { return planAtResolution(effort, context.options(), context); });
-    std::vector<Attempt> tried;
-    std::optional<PlanResult> lower;
-    if (provesFeasible(effort, below)) {
-      lower = freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
-    }
     if (!provesFeasible(effort, below)) {
       appendTrail(below.attempts, false, &answer.attempts);
-      break;
-    }
-    const std::string found = "; a plan was found at " + exactNumber(effort.duration) +
-                              " s, below the T* = " + exactNumber(answer.minimum_duration) +
-                              " s reached before";
-    if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
-      lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
-      lower->message += found + ", and the free-time solve from it descended";
-      answer = std::move(*lower);
+      if (!steps.nothingFound()) break;
       continue;
     }
-    // No lower KKT point from it: the probe's plan is the answer, an upper bound on T*.
-    PlanResult upper = below;
-    upper.attempts = joined(answer.attempts, below.attempts);
-    appendTrail(lower ? lower->attempts : tried, false, &upper.attempts);
-    upper.minimum_duration = effort.duration;
-    upper.minimum_time = MinimumTimeCertificate{};
-    upper.minimum_time.solves = answer.minimum_time.solves;
-    upper.message = "minimum time T* <= " + exactNumber(effort.duration) +
-                    " s, the least duration found feasible (an upper bound)" + found +
-                    " (its minimum-effort plan is returned): " + below.message;
-    answer = std::move(upper);
+    answer = lowerAnswer(problem, effort, std::move(answer), below, context);
+    steps.found(answer.minimum_duration < effort.duration);
   }
   return answer;
 }
@@ -455,7 +492,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   PlanResult result = planAtResolution(problem, context.options(), context);
   recordLowerBound(bound, &result);
   const std::string why = needsMinimumTimeStart(problem, result);
-  if (why.empty() || !std::isfinite(smallestAuthority(problem)) || problem.accuracy.active()) {
+  if (why.empty() || !std::isfinite(torqueAuthority(problem).smallest_about_any_axis) ||
+      problem.accuracy.active()) {
     return result;
   }
   // The interior point's "infeasible" is local (its elastic form stopped at a minimum of the

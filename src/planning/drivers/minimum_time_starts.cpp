@@ -152,19 +152,11 @@ void describeExcursion(const Vector3& eigenaxis, const Vector3& axis, double siz
 
 }  // namespace
 
-double smallestAuthority(const PlanningProblem& problem) {
-  double authority = std::numeric_limits<double>::infinity();
-  if (problem.hasTorqueBounds()) authority = problem.max_torque.minCoeff();
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxTorqueNorm) authority = std::min(authority, c.limit);
-  }
-  return authority;
-}
-
 double eigenaxisDurationGuess(const PlanningProblem& problem) {
   const Matrix3& J = problem.inertia;
   const double largest_moment = Eigen::SelfAdjointEigenSolver<Matrix3>(J).eigenvalues().maxCoeff();
-  const double authority = std::max(smallestAuthority(problem), 1e-300);  // [N m]
+  const double authority =
+      std::max(torqueAuthority(problem).smallest_about_any_axis, 1e-300);  // [N m]
   const double angle =
       std::max(so3::angleBetween(problem.initial_attitude, problem.final_attitude), 1e-3);
   // Rest to rest: accelerate half way, brake half way. Boundary rates add the time to shed and

@@ -23,9 +23,6 @@ constexpr double kEigenaxisStartFactor = 1.02;
 /// cones' node bounds.
 constexpr double kConeStartClearance = 0.01;
 
-/// The smallest torque every bound in force allows about any axis [N m].
-double smallestAuthority(const PlanningProblem& problem);
-
 /// A rest-to-rest slew R(t) = R_0 exp(θ(s) ê) exp(b(s) p̂), s = t/T: the eigenaxis bang–bang
 /// θ(s) = 2Θs² (s ≤ ½), Θ(1 − 2(1 − s)²) (s > ½) about ê = log(R_0ᵀR_T)/Θ, and an excursion
 /// b(s) = ε sin²(πs) about a unit p̂ ⟂ ê (ε = 0: the eigenaxis slew itself), which leaves both

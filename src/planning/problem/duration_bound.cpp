@@ -13,16 +13,6 @@ namespace attitude_planner {
 
 namespace {
 
-/// The largest |τ| the bounds allow: the norm bound, or the box's corner (+∞: no bound).
-double largestTorque(const PlanningProblem& problem) {
-  double a = problem.hasTorqueBounds() ? problem.max_torque.norm()
-                                       : std::numeric_limits<double>::infinity();
-  for (const PlanningConstraint& c : problem.constraints) {
-    if (c.kind == ConstraintKind::MaxTorqueNorm) a = std::min(a, c.limit);
-  }
-  return a;
-}
-
 /// The least rate limit w (+∞: none).
 double smallestRateLimit(const PlanningProblem& problem) {
   double w = std::numeric_limits<double>::infinity();
@@ -70,10 +60,25 @@ double leastDurationForAngle(const PathLengthBound& g, double theta) {
 
 }  // namespace
 
+TorqueAuthority torqueAuthority(const PlanningProblem& problem) {
+  constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+  TorqueAuthority authority{kUnbounded, kUnbounded};
+  if (problem.hasTorqueBounds()) {
+    authority.largest_magnitude = problem.max_torque.norm();
+    authority.smallest_about_any_axis = problem.max_torque.minCoeff();
+  }
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.kind != ConstraintKind::MaxTorqueNorm) continue;
+    authority.largest_magnitude = std::min(authority.largest_magnitude, c.limit);
+    authority.smallest_about_any_axis = std::min(authority.smallest_about_any_axis, c.limit);
+  }
+  return authority;
+}
+
 DurationLowerBound durationLowerBound(const PlanningProblem& problem) {
   DurationLowerBound bound;
   if (problem.effects && !problem.effects->empty()) return bound;
-  const double a = largestTorque(problem), w = smallestRateLimit(problem);
+  const double a = torqueAuthority(problem).largest_magnitude, w = smallestRateLimit(problem);
   if (!std::isfinite(a) && !std::isfinite(w)) return bound;
   const double lambda =
       Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues().minCoeff();

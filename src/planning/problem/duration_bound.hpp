@@ -22,6 +22,16 @@
 
 namespace attitude_planner {
 
+/// What the torque bounds in force allow [N m], +∞ where nothing bounds the torque. Two figures
+/// of one reading of the bounds: the largest |τ| any allowed torque has (the norm bound, or the
+/// box's corner), which the proof of T_c needs, and the least torque available about every axis
+/// (the smallest box side, or the norm bound), which duration guesses need.
+struct TorqueAuthority {
+  double largest_magnitude;
+  double smallest_about_any_axis;
+};
+TorqueAuthority torqueAuthority(const PlanningProblem& problem);
+
 /// T_c and what proves it.
 struct DurationLowerBound {
   double seconds = 0.0;  ///< T_c [s]: no plan of the continuous problem is shorter (0: no bound)

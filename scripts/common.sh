@@ -28,6 +28,7 @@ DEBIAN_PACKAGES=(
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
   python3-visualization-msgs python3-rostopic python3-rosservice
   libnav-msgs-dev ros-nav-msgs python3-nav-msgs libtf2-msgs-dev
+  libdiagnostic-msgs-dev ros-diagnostic-msgs python3-diagnostic-msgs
   pybind11-dev python3-pybind11 python3-dev python3-setuptools
   python3-distributed python3-dask python3-tqdm
 )

@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/planner_node.hpp"
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+
 #include <malloc.h>
 
 #include <algorithm>
@@ -176,6 +178,10 @@ PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
       nh_, "plan_attitude_maneuver_action", [this](GoalHandle goal) { onGoal(goal); },
       [this](GoalHandle goal) { onCancel(goal); }, false);
   action_server_->start();
+  diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+  diagnostics_timer_ =
+      nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
+                          [this](const ros::WallTimerEvent&) { publishDiagnostics(); });
   ROS_INFO_STREAM("attitude_planner_node ready: services "
                   << service_.getService() << ", " << drift_service_.getService() << ", action "
                   << nh_.resolveName("plan_attitude_maneuver_action") << " (scheme "
@@ -262,6 +268,7 @@ void PlannerNode::reapLateSolves(bool all) {
 
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
                                 PlanAttitudeManeuver::Response& res) {
+  const ros::WallTime received = ros::WallTime::now();
   try {
     const PlanOutcome outcome = planServiceRequest(req);
     fillResponse(outcome, world_frame_, body_frame_, &res);
@@ -277,11 +284,13 @@ bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
     res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     res.message = std::string("internal error: ") + e.what();
   }
+  answers_.record(res.error_code.val, (ros::WallTime::now() - received).toSec());
   return true;
 }
 
 bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
                                      PlanDriftTwoInput::Response& res) {
+  const ros::WallTime received = ros::WallTime::now();
   try {
     fillDriftResponse(planDriftRequest(req, defaults_), world_frame_, body_frame_, &res);
     if (res.success) {
@@ -296,6 +305,7 @@ bool PlannerNode::onPlanDriftService(PlanDriftTwoInput::Request& req,
     res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     res.message = std::string("internal error: ") + e.what();
   }
+  answers_.record(res.error_code.val, (ros::WallTime::now() - received).toSec());
   return true;
 }
 
@@ -339,6 +349,7 @@ void PlannerNode::onGoalDeadline(const ActiveGoal& goal) {
   PlanAttitudeManeuverResult late;
   fillResponse(deadlineOutcome(goal.budget), world_frame_, body_frame_, &late);
   handle.setAborted(late, late.message);
+  answers_.record(late.error_code.val, (ros::WallTime::now() - goal.accepted).toSec());
 }
 
 void PlannerNode::onGoal(GoalHandle goal) {
@@ -359,6 +370,7 @@ void PlannerNode::onGoal(GoalHandle goal) {
                      "when one ends, or call the service plan_attitude_maneuver";
     ROS_WARN("goal %s %s", id.c_str(), result.message.c_str());
     goal.setRejected(result, result.message);
+    answers_.record(result.error_code.val, 0.0);
     return;
   }
   goal.setAccepted();  // a cancel already received turns this into PREEMPTING: served as such
@@ -394,13 +406,17 @@ void PlannerNode::onCancel(GoalHandle goal) {
   result.success = false;
   result.error_code.val = PlanErrorCode::CANCELLED;
   result.message = "cancelled by its client (the solve was stopped; no plan is returned)";
+  double waited = 0.0;
   if (it != active_.end()) {
     // Its slot is free before the result goes out: a goal sent on receiving it is accepted
     // (queued for the worker, which is stopping this solve).
     it->second.ended_at->store(ros::WallTime::now().toSec());
+    if (!it->second.accepted.isZero())
+      waited = (ros::WallTime::now() - it->second.accepted).toSec();
     active_.erase(it);
   }
   goal.setCanceled(result, result.message);
+  answers_.record(result.error_code.val, waited);
 }
 
 namespace {
@@ -502,6 +518,28 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   } else {
     handle.setAborted(result, result.message);
   }
+  answers_.record(result.error_code.val, (ros::WallTime::now() - goal.accepted).toSec());
+}
+
+void PlannerNode::publishDiagnostics() {
+  PlannerLoad load;
+  load.action_workers = action_workers_;
+  {
+    std::lock_guard<std::mutex> lock(goals_mutex_);
+    load.busy_workers = static_cast<int>(active_.size());
+  }
+  {
+    std::lock_guard<std::mutex> late(late_mutex_);
+    for (const auto& [thread, slot] : late_solves_) {
+      std::lock_guard<std::mutex> lock(slot->mutex);
+      if (!slot->done) ++load.stopping_solves;
+    }
+  }
+  diagnostic_msgs::DiagnosticArray array;
+  array.header.stamp = ros::Time::now();
+  array.status.push_back(
+      plannerStatus(ros::this_node::getName() + ": planner", answers_.summary(), load));
+  diagnostics_pub_.publish(array);
 }
 
 }  // namespace attitude_planner

@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/tracker_node.hpp"
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+
 #include "attitude_planner/ros/parameters.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -468,6 +470,10 @@ void TrackerNode::advertiseTopics() {
   path_pub_ = nh_.advertise<visualization_msgs::Marker>("attitude_path", 1, true);
   ghost_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("ghost_markers", 1, true);
   done_pub_ = nh_.advertise<ReplayResult>("done", 1, true);
+  diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
+  diagnostics_timer_ =
+      nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
+                          [this](const ros::WallTimerEvent&) { publishDiagnostics(); });
   constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
   control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
   body_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("body_pose", 10);
@@ -700,6 +706,11 @@ void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp,
 
 void TrackerNode::publishDone(ReplayResult result) {
   done_published_ = true;
+  {
+    std::lock_guard<std::mutex> lock(health_mutex_);
+    health_.running = false;
+    ++health_.runs_finished;
+  }
   if (result.header.frame_id.empty()) result.header.frame_id = world_frame_;
   if (result.header.stamp.isZero()) result.header.stamp = ros::Time::now();
   done_pub_.publish(result);
@@ -922,6 +933,16 @@ void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
   value.data = e.rate.norm();
   rate_error_pub_.publish(value);
   publishStampedErrors(pb, body.attitude, plan.attitude, e, stamp);
+  {
+    std::lock_guard<std::mutex> lock(health_mutex_);
+    health_.running = true;
+    health_.time = t;
+    health_.duration = pb.result.duration;
+    health_.attitude_error = e.angle;
+    health_.rate_error = e.rate.norm();
+    health_.replans = pb.result.replans;
+    health_.replan_failures = pb.result.replan_failures;
+  }
 
   const Matrix3& target = pb.reference->nodes().attitude.back();
   char text[160];
@@ -1166,6 +1187,24 @@ std::string TrackerNode::claimFrames(const std::string& world_frame,
   return conflict;
 }
 
+void TrackerNode::publishDiagnostics() {
+  TrackerHealth health;
+  {
+    std::lock_guard<std::mutex> lock(health_mutex_);
+    health = health_;
+  }
+  health.mode = trackingModeName(mode_);
+  health.plant = plant_ == PlantKind::External ? "external" : "internal";
+  {
+    std::lock_guard<std::mutex> lock(frames_mutex_);
+    health.frame_conflict = frame_conflict_;
+  }
+  diagnostic_msgs::DiagnosticArray array;
+  array.header.stamp = ros::Time::now();
+  array.status.push_back(trackerStatus(ros::this_node::getName() + ": tracker", health));
+  diagnostics_pub_.publish(array);
+}
+
 void TrackerNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(odometry_mutex_);
   odometry_ = msg;
@@ -1199,6 +1238,10 @@ MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Ti
   }
   const ros::Time measured_at = msg->header.stamp.isZero() ? received : msg->header.stamp;
   const double age = (stamp - measured_at).toSec();  // [s, ROS time]
+  {
+    std::lock_guard<std::mutex> lock(health_mutex_);
+    health_.measurement_age = age;
+  }
   if (age > measurement_timeout_) {
     char text[160];
     std::snprintf(text, sizeof text, "newest odometry is %.3f s old (~measurement_timeout %g s)",
@@ -1241,6 +1284,10 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
     const ros::Time stamp = start + ros::Duration(t / rate_factor_);
     if (!sleepUntil(stamp)) return false;
     const MeasurementAtSample measured = measurementAt(*pb, start, stamp, held_command);
+    {
+      std::lock_guard<std::mutex> lock(health_mutex_);
+      health_.measurement_problem = measured.problem;
+    }
     ManeuverSample body;
     body.time = t;
     body.attitude = measured.state.attitude;

@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <mutex>
+#include <string>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 
 #include "attitude_planner/AttitudeManeuver.h"
@@ -127,6 +130,44 @@ inline AttitudeManeuver testManeuver(int steps, Maneuver* plan) {
   *plan = simulate(scheme, input);
   return ros_conversions::maneuverToMsg(*plan, p, "world", "body", ros::Time::now());
 }
+
+/// The newest /diagnostics status named `name` (empty name: none yet), kept by a subscription.
+class StatusWatch {
+ public:
+  explicit StatusWatch(std::string name) : name_(std::move(name)) {
+    sub_ = nh_.subscribe("/diagnostics", 10, &StatusWatch::onArray, this);
+  }
+  /// The named status's value of `key` once `accept` holds for it, waiting up to `seconds`.
+  std::string waitFor(const std::string& key, const std::function<bool(const std::string&)>& accept,
+                      double seconds) {
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(seconds);
+    for (;;) {  // looks at least once, even with no time to wait
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const diagnostic_msgs::KeyValue& pair : newest_.values) {
+          if (pair.key == key && accept(pair.value)) return pair.value;
+        }
+      }
+      if (ros::WallTime::now() >= until) break;
+      ros::WallDuration(0.05).sleep();
+    }
+    return "(not seen)";
+  }
+
+ private:
+  void onArray(const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+    for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
+      if (status.name != name_) continue;
+      std::lock_guard<std::mutex> lock(mutex_);
+      newest_ = status;
+    }
+  }
+  std::string name_;
+  ros::NodeHandle nh_;
+  ros::Subscriber sub_;
+  std::mutex mutex_;
+  diagnostic_msgs::DiagnosticStatus newest_;
+};
 
 }  // namespace ros_testing
 }  // namespace attitude_planner

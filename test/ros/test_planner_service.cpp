@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <limits>
+#include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -683,6 +686,30 @@ TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
             std::string::npos)
       << one_row.message;
   EXPECT_TRUE(call(seed(16)).success);
+}
+
+TEST_F(PlannerService, DiagnosticsCountTheAnswersByErrorCode) {
+  // Each planner node publishes its status on /diagnostics every second; a bad request shows up
+  // as one more INVALID_INPUT answer of this node (not of the /capped one).
+  ros_testing::StatusWatch watch("/attitude_planner: planner");
+  const auto any = [](const std::string&) { return true; };
+  const std::string before = watch.waitFor("answered", any, 5.0);
+  ASSERT_NE(before, "(not seen)") << "no status named '/attitude_planner: planner' on /diagnostics";
+  const int answered = std::stoi(before);
+  const std::string failed = watch.waitFor("failed INVALID_INPUT", any, 0.0);
+  const int invalid = failed == "(not seen)" ? 0 : std::stoi(failed);
+  PlanAttitudeManeuver::Request bad = seed();
+  bad.steps = 2;
+  EXPECT_EQ(call(bad).error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(watch.waitFor(
+                "failed INVALID_INPUT",
+                [&](const std::string& v) { return std::stoi(v) == invalid + 1; }, 5.0),
+            "(not seen)");
+  EXPECT_NE(
+      watch.waitFor(
+          "answered", [&](const std::string& v) { return std::stoi(v) >= answered + 1; }, 5.0),
+      "(not seen)");
+  EXPECT_EQ(watch.waitFor("last answer", any, 5.0), "INVALID_INPUT");
 }
 
 int main(int argc, char** argv) {

@@ -13,6 +13,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/ros/diagnostics.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
 #include "attitude_planner/ros/tracker_node.hpp"
 
@@ -776,4 +777,81 @@ TEST(Odometry, RoundTripsTheStateAndNamesABadField) {
   bad = m;
   bad.twist.twist.angular.y = std::nan("");
   expectRefusedNaming(bad, "odometry.twist.twist.angular");
+}
+
+// /diagnostics: the answer counts and wall-time figures, and the level rules of both nodes'
+// statuses (docs/ros_tracker.md, "Diagnostics").
+namespace {
+std::string valueOf(const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
+  for (const diagnostic_msgs::KeyValue& pair : status.values) {
+    if (pair.key == key) return pair.value;
+  }
+  return "(missing)";
+}
+}  // namespace
+
+TEST(Diagnostics, AnswerStatisticsCountByCodeAndTakeTheMedianOfTheRecentAnswers) {
+  AnswerStatistics answers;
+  EXPECT_EQ(answers.summary().answered, 0);
+  for (int i = 1; i <= 5; ++i) answers.record(PlanErrorCode::SUCCESS, 0.1 * i);
+  answers.record(PlanErrorCode::INVALID_INPUT, 0.001);
+  answers.record(PlanErrorCode::TIMED_OUT, 2.0);
+  const AnswerStatistics::Summary s = answers.summary();
+  EXPECT_EQ(s.answered, 7);
+  EXPECT_EQ(s.succeeded, 5);
+  EXPECT_EQ(s.failed.at(PlanErrorCode::INVALID_INPUT), 1);
+  EXPECT_EQ(s.failed.at(PlanErrorCode::TIMED_OUT), 1);
+  EXPECT_EQ(s.last_code, PlanErrorCode::TIMED_OUT);
+  EXPECT_DOUBLE_EQ(s.median_s, 0.3);  // of {0.001, 0.1, ..., 0.5, 2}
+  EXPECT_DOUBLE_EQ(s.max_s, 2.0);
+  // Only the last kRecent answers count for the wall times; the counts keep every answer.
+  for (std::size_t i = 0; i < AnswerStatistics::kRecent; ++i) answers.record(1, 1.0);
+  EXPECT_DOUBLE_EQ(answers.summary().max_s, 1.0);
+  EXPECT_EQ(answers.summary().answered, 7 + static_cast<int>(AnswerStatistics::kRecent));
+}
+
+TEST(Diagnostics, PlannerStatusWarnsWhenGoalsWouldBeRejectedAndErrsOnAnInternalError) {
+  AnswerStatistics answers;
+  answers.record(PlanErrorCode::SUCCESS, 0.2);
+  PlannerLoad load{2, 1, 0};
+  diagnostic_msgs::DiagnosticStatus status = plannerStatus("/p: planner", answers.summary(), load);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK) << status.message;
+  EXPECT_EQ(status.name, "/p: planner");
+  EXPECT_EQ(valueOf(status, "answered"), "1");
+  EXPECT_EQ(valueOf(status, "busy action workers"), "1");
+  load.busy_workers = 2;
+  status = plannerStatus("/p: planner", answers.summary(), load);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  load = PlannerLoad{2, 0, 1};
+  EXPECT_EQ(plannerStatus("/p", answers.summary(), load).level,
+            diagnostic_msgs::DiagnosticStatus::WARN);
+  answers.record(PlanErrorCode::INTERNAL_ERROR, 0.01);
+  status = plannerStatus("/p", answers.summary(), PlannerLoad{2, 0, 0});
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(valueOf(status, "failed INTERNAL_ERROR"), "1");
+  EXPECT_EQ(valueOf(status, "last answer"), "INTERNAL_ERROR");
+  // The next good answer clears the error: the level says how the node is now.
+  answers.record(PlanErrorCode::SUCCESS, 0.2);
+  EXPECT_EQ(plannerStatus("/p", answers.summary(), PlannerLoad{2, 0, 0}).level,
+            diagnostic_msgs::DiagnosticStatus::OK);
+}
+
+TEST(Diagnostics, TrackerStatusWarnsOnAStaleMeasurementOrAFailedReplanAndErrsOnAFrameConflict) {
+  TrackerHealth health;
+  health.mode = "feedback";
+  health.plant = "external";
+  health.running = true;
+  health.attitude_error = 0.25;
+  EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::OK);
+  EXPECT_EQ(valueOf(trackerStatus("/t", health), "attitude error [rad]"), "0.25");
+  health.measurement_problem = "newest odometry is 0.9 s old (~measurement_timeout 0.5 s)";
+  diagnostic_msgs::DiagnosticStatus status = trackerStatus("/t", health);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(status.message.find(health.measurement_problem), std::string::npos) << status.message;
+  health.running = false;  // idle: no measurement is expected
+  EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::OK);
+  health.replan_failures = 1;
+  EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::WARN);
+  health.frame_conflict = "node /other also publishes the transform world -> body";
+  EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::ERROR);
 }

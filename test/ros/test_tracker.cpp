@@ -151,6 +151,25 @@ TEST_F(Tracker, ReplayEndsAtThePlannedAttitudeAndIsRecorded) {
   bag.close();
 }
 
+TEST_F(Tracker, DiagnosticsSayTheModeAndCountTheFinishedRuns) {
+  // The tracker's status on /diagnostics (every second): its mode and plant, and one more finished
+  // run once a maneuver's `done` is out, the body idle again.
+  ros_testing::StatusWatch watch("/attitude_tracker: tracker");
+  const auto any = [](const std::string&) { return true; };
+  const std::string before = watch.waitFor("runs finished", any, 5.0);
+  ASSERT_NE(before, "(not seen)") << "no status named '/attitude_tracker: tracker' on /diagnostics";
+  EXPECT_EQ(watch.waitFor("mode", any, 0.0), "replay");
+  EXPECT_EQ(watch.waitFor("plant", any, 0.0), "internal");
+  Maneuver plan;
+  maneuver_pub_.publish(ros_testing::testManeuver(kSteps, &plan));
+  const int finished = std::stoi(before) + 1;
+  EXPECT_NE(
+      watch.waitFor(
+          "runs finished", [&](const std::string& v) { return std::stoi(v) == finished; }, 60.0),
+      "(not seen)");
+  EXPECT_EQ(watch.waitFor("running", any, 0.0), "false");
+}
+
 TEST_F(Tracker, InconsistentManeuverIsRejectedWithAReason) {
   Maneuver plan;
   AttitudeManeuver bad = ros_testing::testManeuver(kSteps, &plan);

@@ -4,6 +4,8 @@
 //
 //   service  plan_attitude_maneuver         (attitude_planner/PlanAttitudeManeuver)   rigid body
 //   action   plan_attitude_maneuver_action  (attitude_planner/PlanAttitudeManeuverAction)
+//   topic    /diagnostics                   (diagnostic_msgs/DiagnosticArray) every second: the
+//            status `<node>: planner` (answers by error code, wall times, busy workers)
 //   service  plan_drift_two_input           (attitude_planner/PlanDriftTwoInput)  seed 001's
 //            drift + two-input system; a service of its own rather than a `system` field in
 //            PlanAttitudeManeuver: the two problems share no request field but the attitudes and
@@ -57,6 +59,7 @@
 #include "attitude_planner/PlanErrorCode.h"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/ros/diagnostics.hpp"
 
 namespace attitude_planner {
 
@@ -206,6 +209,8 @@ class PlannerNode {
   /// Solves one goal (feedback per iteration) and ends it: PREEMPTED if its cancel arrived at
   /// any time before the end, else SUCCEEDED or ABORTED by its error code.
   void serveGoal(const ActiveGoal& goal);
+  /// Publishes the node's status on /diagnostics (the wall timer's callback).
+  void publishDiagnostics();
 
   ros::NodeHandle nh_;  ///< public handle: the service and action resolve here
   ros_conversions::PlannerDefaults defaults_;  ///< read once in the constructor, then const
@@ -227,6 +232,9 @@ class PlannerNode {
   std::vector<std::pair<std::thread, std::shared_ptr<SolveSlot>>> late_solves_;
   /// plan_attitude_maneuver_action (several goals at a time); last: destroyed first
   std::unique_ptr<ActionServer> action_server_;
+  AnswerStatistics answers_;          ///< every answer sent, for /diagnostics
+  ros::Publisher diagnostics_pub_;    ///< /diagnostics
+  ros::WallTimer diagnostics_timer_;  ///< every kDiagnosticsPeriod
 };
 
 // ---- templates ----------------------------------------------------------------------------------

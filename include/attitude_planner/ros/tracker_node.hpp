@@ -61,6 +61,8 @@
 //                                ~scene) has keep_out / keep_in constraints: each cone (world) and
 //                                its body axis (body, frame-locked)
 //             done               attitude_planner/ReplayResult, latched when a run ends
+//             /diagnostics       diagnostic_msgs/DiagnosticArray, every second (wall): the status
+//                                `<node>: tracker` (ros/diagnostics.hpp)
 // Calls       plan_attitude_maneuver (service) when ~scene is set and ~plan_in_process is false
 //             plan_drift_two_input   (service) the same, for a scene with system: drift_two_input
 //
@@ -149,6 +151,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/ros/conversions.hpp"
+#include "attitude_planner/ros/diagnostics.hpp"
 
 namespace attitude_planner {
 
@@ -408,6 +411,8 @@ class TrackerNode {
   void holdFinalAttitude();
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);
+  /// Publishes the node's status on /diagnostics (the wall timer's callback).
+  void publishDiagnostics();
   /// Remembers the body's state at the running run's next sample and that sample's stamp (what a
   /// new maneuver takes over from); `running` false: no run in progress.
   void noteNextSample(bool running, const RigidBodyState& body = {},
@@ -434,6 +439,10 @@ class TrackerNode {
   ros::Publisher error_vector_pub_;  ///< `attitude_error_vector` log(R_dᵀR) [rad], body
   ros::Publisher rate_error_vector_pub_;  ///< `angular_velocity_error_vector` e_Ω [rad/s], body
   ros::Subscriber odometry_sub_;          ///< `odometry` (~plant external)
+  ros::Publisher diagnostics_pub_;        ///< /diagnostics
+  ros::WallTimer diagnostics_timer_;      ///< every kDiagnosticsPeriod
+  std::mutex health_mutex_;               ///< guards health_ (stream vs timer)
+  TrackerHealth health_;                  ///< the newest sample's figures, for /diagnostics
   ros::Subscriber tf_sub_;                ///< /tf: who else publishes our body transform
   std::mutex frames_mutex_;               ///< guards the three below
   std::string claimed_world_, claimed_body_;      ///< the pair the current run publishes

@@ -1,0 +1,144 @@
+#include "planning/newton/twist_newton.hpp"
+
+#include <cmath>
+
+#include "planning/linalg/bordered_band.hpp"
+
+namespace attitude_planner {
+
+namespace {
+
+/// The loop's state at one iterate: C, ∇C over (δ, ψ), and the bordered Hessian.
+struct TwistModel {
+  explicit TwistModel(const ReducedProblem& np)
+      : band(np.unknowns(), ReducedProblem::kHalfBandwidth) {}
+  double cost = 0.0, corner = 0.0, gradient_scale = 0.0;
+  Eigen::VectorXd gradient, border;
+  BandedSymmetricMatrix band;
+};
+
+/// The Newton step of (H + λ s I) Δ = −g into `step` (s: the larger of H's diagonal scales);
+/// false unless the shifted bordered matrix is positive definite (band definite, Schur
+/// complement positive) and Δ descends.
+bool shiftedStep(const TwistModel& m, double shift, Eigen::VectorXd* step) {
+  const double scale = std::max(m.band.maxAbsDiagonal(), std::abs(m.corner));
+  BandedSymmetricMatrix A = m.band;
+  if (shift > 0.0) A.addToDiagonal(shift * scale);
+  Eigen::MatrixXd D(1, 1);
+  D(0, 0) = m.corner + shift * scale;
+  BorderedBanded factor;
+  if (!factor.factor(A, Eigen::MatrixXd(m.border), D) || factor.inertia().negative > 0) {
+    return false;
+  }
+  *step = -m.gradient;
+  factor.solve(step);
+  return step->allFinite() && m.gradient.dot(*step) < 0.0;
+}
+
+/// A trial along Δ accepted by Armijo's test at the largest α = 1, ½, ¼, … (p.max_halvings);
+/// the step taken unjudged when `unjudged` (a final step, or a decrease below round-off).
+bool acceptStep(ReducedProblem& np, const TwistModel& m, const Eigen::VectorXd& step, bool unjudged,
+                const NewtonParameters& p, double* twist) {
+  const int n = np.unknowns();
+  const double slope = m.gradient.dot(step);
+  double alpha = 1.0;
+  for (int halving = 0; halving <= p.max_halvings; ++halving, alpha *= p.backtrack_factor) {
+    const ReducedProblem::StepVectors trial = np.retractWithTwist(step.head(n), step(n), alpha);
+    const double trial_cost = np.cost(trial);
+    if (unjudged ||
+        (std::isfinite(trial_cost) && trial_cost <= m.cost + p.armijo * alpha * slope)) {
+      np.setCurrentWithTwist(trial, alpha * step(n));
+      *twist += alpha * step(n);
+      return true;
+    }
+    if (halving >= 8 && alpha * std::abs(slope) < p.negligible_decrease * m.cost) break;
+  }
+  return false;
+}
+
+/// Evaluates the model at np's iterate; false (with `out` saying why) if the solve ends there.
+bool evaluateModel(const ReducedProblem& np, TwistModel* m, TwistSolve* out) {
+  m->cost =
+      np.evaluateWithTwist(&m->gradient, &m->band, &m->border, &m->corner, &m->gradient_scale);
+  out->cost = m->cost;
+  out->twist_gradient = m->gradient(np.unknowns());
+  out->relative_gradient = m->gradient.cwiseAbs().maxCoeff() / m->gradient_scale;
+  if (!std::isfinite(m->cost) || !std::isfinite(out->relative_gradient)) {
+    out->termination = Termination::StepTooLarge;
+    out->reason = "non-finite cost or gradient (step too large for this h? increase steps)";
+    return false;
+  }
+  if (m->gradient.cwiseAbs().maxCoeff() == 0.0) {
+    out->termination = Termination::Converged;
+    out->reason = "converged";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
+                            double tolerance, int max_iterations, const NewtonParameters& p,
+                            std::vector<IterationInfo>* history) {
+  TwistSolve out;
+  TwistModel m(np);
+  Eigen::VectorXd step;
+  const double floor = p.roundOffFloor(np.steps()), acceptance = p.roundOffAcceptance(np.steps());
+  double shift = 0.0, best_decrement = INFINITY;
+  int stalled = 0;
+  while (evaluateModel(np, &m, &out) && out.iterations < max_iterations) {
+    if (const auto stop = context.stopReason()) {
+      out.termination = *stop;
+      out.reason = *stop == Termination::Cancelled ? "cancelled" : "time budget exceeded";
+      break;
+    }
+    bool moved = false;
+    bool final_step = false;
+    for (int attempt = 0; attempt < p.max_step_attempts && !moved; ++attempt) {
+      if (!shiftedStep(m, shift, &step)) {
+        shift = shift == 0.0 ? p.smallest_shift : p.indefinite_shift_growth * shift;
+        continue;
+      }
+      const double slope = m.gradient.dot(step);
+      out.relative_decrement = std::sqrt(-slope) / std::sqrt(std::max(2.0 * m.cost, p.cost_floor));
+      final_step = shift == 0.0 && out.relative_decrement <= std::max(tolerance, floor);
+      const bool unjudged = final_step || -slope <= p.negligible_decrease * m.cost ||
+                            out.relative_decrement <= acceptance;
+      moved = acceptStep(np, m, step, unjudged, p, &twist);
+      if (!moved) shift = shift == 0.0 ? p.first_rejection_shift : 10.0 * shift;
+    }
+    if (!moved) {
+      out.reason = "no step decreased the cost";
+      break;
+    }
+    ++out.iterations;
+    shift = shift * p.shift_min_factor < p.negligible_shift ? 0.0 : shift * p.shift_min_factor;
+    IterationInfo info{context.iterations() + 1, m.cost, out.relative_decrement, 1.0};
+    info.steps = np.steps();
+    info.effort = m.cost * np.scheme().timeStep();
+    if (history) history->push_back(info);
+    const bool go_on = context.reportIteration(info);
+    stalled = out.relative_decrement <= acceptance &&
+                      out.relative_decrement > p.stall_decrement_ratio * best_decrement
+                  ? stalled + 1
+                  : 0;
+    best_decrement = std::min(best_decrement, out.relative_decrement);
+    if (final_step || stalled >= p.stall_iterations) {
+      out.termination = Termination::Converged;
+      out.reason = final_step ? "converged" : "converged to the round-off floor";
+      evaluateModel(np, &m, &out);  // the figures at the final iterate
+      out.termination = Termination::Converged;
+      break;
+    }
+    if (!go_on) {
+      out.termination = Termination::Cancelled;
+      out.reason = "cancelled";
+      break;
+    }
+  }
+  out.twist = twist;
+  return out;
+}
+
+}  // namespace attitude_planner

@@ -37,8 +37,9 @@ bool shiftedStep(const TwistModel& m, double shift, Eigen::VectorXd* step) {
 
 /// A trial along Δ accepted by Armijo's test at the largest α = 1, ½, ¼, … (p.max_halvings);
 /// the step taken unjudged when `unjudged` (a final step, or a decrease below round-off).
-bool acceptStep(ReducedProblem& np, const TwistModel& m, const Eigen::VectorXd& step, bool unjudged,
-                const NewtonParameters& p, double* twist) {
+/// Returns the α taken, 0 if none.
+double acceptStep(ReducedProblem& np, const TwistModel& m, const Eigen::VectorXd& step,
+                  bool unjudged, const NewtonParameters& p, double* twist) {
   const int n = np.unknowns();
   const double slope = m.gradient.dot(step);
   double alpha = 1.0;
@@ -49,11 +50,11 @@ bool acceptStep(ReducedProblem& np, const TwistModel& m, const Eigen::VectorXd& 
         (std::isfinite(trial_cost) && trial_cost <= m.cost + p.armijo * alpha * slope)) {
       np.setCurrentWithTwist(trial, alpha * step(n));
       *twist += alpha * step(n);
-      return true;
+      return alpha;
     }
     if (halving >= 8 && alpha * std::abs(slope) < p.negligible_decrease * m.cost) break;
   }
-  return false;
+  return 0.0;
 }
 
 /// Evaluates the model at np's iterate; false (with `out` saying why) if the solve ends there.
@@ -86,6 +87,7 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
   Eigen::VectorXd step;
   const double floor = p.roundOffFloor(np.steps()), acceptance = p.roundOffAcceptance(np.steps());
   double shift = 0.0, best_decrement = INFINITY;
+  double previous_full_step = 0.0;  ///< the last iteration's decrement if it was a full Newton step
   int stalled = 0;
   while (evaluateModel(np, &m, &out) && out.iterations < max_iterations) {
     if (const auto stop = context.stopReason()) {
@@ -93,28 +95,35 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
       out.reason = *stop == Termination::Cancelled ? "cancelled" : "time budget exceeded";
       break;
     }
-    bool moved = false;
+    double alpha = 0.0;
     bool final_step = false;
-    for (int attempt = 0; attempt < p.max_step_attempts && !moved; ++attempt) {
+    for (int attempt = 0; attempt < p.max_step_attempts && alpha == 0.0; ++attempt) {
       if (!shiftedStep(m, shift, &step)) {
         shift = shift == 0.0 ? p.smallest_shift : p.indefinite_shift_growth * shift;
         continue;
       }
       const double slope = m.gradient.dot(step);
       out.relative_decrement = std::sqrt(-slope) / std::sqrt(std::max(2.0 * m.cost, p.cost_floor));
-      final_step = shift == 0.0 && out.relative_decrement <= std::max(tolerance, floor);
+      // As grid_solve.cpp's StoppingTest: the last full step took d₋ to d, so this one leaves
+      // about d³/d₋² (quadratic convergence): well inside the tolerance, this step is the last.
+      const double d = out.relative_decrement;
+      const bool predicted = previous_full_step > 0.0 && d < previous_full_step &&
+                             d * d * d / (previous_full_step * previous_full_step) <=
+                                 p.final_step_prediction_margin * tolerance;
+      final_step = shift == 0.0 && (d <= std::max(tolerance, floor) || predicted);
       const bool unjudged = final_step || -slope <= p.negligible_decrease * m.cost ||
                             out.relative_decrement <= acceptance;
-      moved = acceptStep(np, m, step, unjudged, p, &twist);
-      if (!moved) shift = shift == 0.0 ? p.first_rejection_shift : 10.0 * shift;
+      alpha = acceptStep(np, m, step, unjudged, p, &twist);
+      if (alpha == 0.0) shift = shift == 0.0 ? p.first_rejection_shift : 10.0 * shift;
     }
-    if (!moved) {
+    if (alpha == 0.0) {
       out.reason = "no step decreased the cost";
       break;
     }
     ++out.iterations;
+    previous_full_step = shift == 0.0 && alpha == 1.0 ? out.relative_decrement : 0.0;
     shift = shift * p.shift_min_factor < p.negligible_shift ? 0.0 : shift * p.shift_min_factor;
-    IterationInfo info{context.iterations() + 1, m.cost, out.relative_decrement, 1.0};
+    IterationInfo info{context.iterations() + 1, m.cost, out.relative_decrement, alpha};
     info.steps = np.steps();
     info.effort = m.cost * np.scheme().timeStep();
     if (history) history->push_back(info);

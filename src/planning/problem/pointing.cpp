@@ -55,8 +55,8 @@ double nearestTwist(const Matrix3& from, const EndCondition& end) {
 
 void requirePointingVector(const Vector3& v, const std::string& field) {
   if (!v.allFinite() || v.norm() == 0.0 || !std::isfinite(v.norm())) {
-    throw InvalidInput(field + ": must be a finite nonzero vector, got [" + std::to_string(v(0)) +
-                       ", " + std::to_string(v(1)) + ", " + std::to_string(v(2)) + "]");
+    throw InvalidInput(field, "must be a finite nonzero vector, got [" + exactNumber(v(0)) + ", " +
+                                  exactNumber(v(1)) + ", " + exactNumber(v(2)) + "]");
   }
 }
 

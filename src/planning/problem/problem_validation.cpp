@@ -122,9 +122,10 @@ void requirePointingServed(const PlanningProblem& p) {
   requirePointingVector(p.end_condition.body_axis, "final.pointing.body_axis");
   requirePointingVector(p.end_condition.world_direction, "final.pointing.world_direction");
   const auto refuse = [](const std::string& what) {
-    throw InvalidInput("final.pointing: not supported with " + what +
-                       " yet (the twist is a global unknown of the unconstrained minimum-effort "
-                       "solver only); give final.attitude instead");
+    throw InvalidInput("final.pointing", "not supported with " + what +
+                                             " yet (the twist is a global unknown of the "
+                                             "unconstrained minimum-effort solver only); give "
+                                             "a final attitude instead");
   };
   if (p.objective == Objective::MinimumTime) refuse("objective minimum_time");
   if (p.hasTorqueBounds()) refuse("actuator_limits (max_torque)");
@@ -133,10 +134,11 @@ void requirePointingServed(const PlanningProblem& p) {
   if (p.effects && !p.effects->empty()) refuse("effects");
   if (p.accuracy.active()) refuse("an accuracy target");
   if (p.direction != RotationDirection::Shortest || p.extra_revolutions != 0) {
-    throw InvalidInput(
-        "final.pointing: direction and extra_revolutions do not apply (a whole turn of the free "
-        "twist joins the ways round: the planner starts from both), got direction " +
-        directionName(p.direction) + ", extra_revolutions " + std::to_string(p.extra_revolutions));
+    throw InvalidInput("final.pointing",
+                       "direction and extra_revolutions do not apply (a whole turn of the free "
+                       "twist joins the ways round: the planner starts from both), got direction " +
+                           directionName(p.direction) + ", extra_revolutions " +
+                           std::to_string(p.extra_revolutions));
   }
 }
 

@@ -75,8 +75,9 @@ second_order, N = %d, minimum effort without constraints. Load while measuring: 
 Each request is planned once as a pointing request (`final.pointing`), and judged against the
 fixed-attitude optimum over the twist psi (R_N = R_ref exp(psi b^)): a sweep every 5 degrees
 (planManeuver, homotopy classes enumerated), the best bracket refined by golden section to 1e-7
-rad. Times: median of %d runs each, the pointing solve beside one fixed-attitude solve at the
-twist it chose (same N, scheme and machine, one after the other).
+rad. Times: the median thread CPU time of %d runs each (immune to the other processes of a
+shared machine, which made wall times vary 4x between repeats), the pointing solve beside one
+fixed-attitude solve at the twist it chose (same N and scheme, one after the other).
 
 ## Summary
 
@@ -89,7 +90,7 @@ twist it chose (same N, scheme and machine, one after the other).
 
 ## Requests
 
-| # | seed | scheme | start | pointing cost | sweep best | sweep worst | excess | psi | sweep psi | angle(R_N b, d) | stationarity | pointing [ms] | fixed [ms] | ratio |
+| # | seed | scheme | start | pointing cost | sweep best | sweep worst | excess | psi | sweep psi | angle(R_N b, d) | stationarity | pointing [ms CPU] | fixed [ms CPU] | ratio |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|
 %s
 """ % (command, len(cases), data["seed"], data["steps"], data["load"], data["repeats"], met_cost, len(cases),

@@ -238,4 +238,14 @@ TEST(PointingScene, ParsesFormatsAndRefusesBadKeys) {
   EXPECT_NE(error(neither).find("final.pointing"), std::string::npos) << error(neither);
 }
 
+TEST(PointingScene, ExampleSceneAimsTheBoresight) {
+  const Scene scene = loadScene(AP_SOURCE_DIR "/scenes/point_boresight.yaml");
+  const PlanResult r = planManeuver(scene.problem);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const Vector3 aimed = r.maneuver.attitude.back() * Vector3::UnitZ();
+  EXPECT_LT((aimed - Vector3(1, 1, 0).normalized()).norm(), 1e-12);
+  EXPECT_NEAR(r.pointing.final_twist,
+              twistOf(r.maneuver.attitude.back(), scene.problem.end_condition), 1e-9);
+}
+
 }  // namespace

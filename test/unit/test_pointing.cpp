@@ -174,6 +174,21 @@ TEST(PointingPlan, EverySchemeMeetsTheEndCondition) {
   }
 }
 
+TEST(PointingPlan, WithoutConvergenceTheStartsOnTheRequestedGridAreTriedAndNamed) {
+  // One iteration per start: no survey answer to refine, so the starts run on the requested grid
+  // too; the answer is not converged, carries an iterate there and lists all 16 starts.
+  const PlanningProblem p = randomPointingRequest(51, 64, false, SchemeKind::Paper);
+  SolverOptions options;
+  options.max_iterations = 1;
+  const PlanResult r = planManeuver(p, options);
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.maneuver.steps(), 64);
+  ASSERT_EQ(r.attempts.size(), 16u);
+  EXPECT_EQ(r.attempts.front().stage, AttemptStage::ClassSurvey);
+  EXPECT_EQ(r.attempts.back().stage, AttemptStage::Solve);
+  EXPECT_EQ(r.attempts.back().steps, 64);
+}
+
 TEST(PointingPlan, RequestsItCannotServeAreRefusedByName) {
   PlanningProblem p = randomPointingRequest(41, 32, false, SchemeKind::Paper);
   const auto refusal = [&](const PlanningProblem& q) {

@@ -91,12 +91,16 @@ std::size_t record(const TwistRun& run, AttemptStage stage, AttemptStart start, 
   return context.attempts().size() - 1;
 }
 
+/// Survey answers (solved to the coarse tolerance, ~1e-6 relative in the torques) within these of
+/// each other in cost (relative) and twist [rad] are one extremal: refining both would repeat it.
+constexpr double kSameSurveyCost = 1e-6, kSameSurveyTwist = 1e-4;
+
 /// Whether two converged answers are one extremal: the same cost and R_N (ψ modulo 2π).
-bool sameAnswer(const TwistRun& a, const TwistRun& b, const NewtonParameters& p) {
+bool sameAnswer(const TwistRun& a, const TwistRun& b) {
   const double dpsi = std::remainder(a.solve.twist - b.solve.twist, 2.0 * M_PI);
   return std::abs(a.solve.cost - b.solve.cost) <=
-             1e3 * p.same_extremal_cost * std::max(a.solve.cost, b.solve.cost) &&
-         std::abs(dpsi) < 1e-4;
+             kSameSurveyCost * std::max(a.solve.cost, b.solve.cost) &&
+         std::abs(dpsi) < kSameSurveyTwist;
 }
 
 /// The survey's converged answers worth refining: distinct, cheapest first, within the class
@@ -112,8 +116,8 @@ std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey,
   std::vector<const TwistRun*> out;
   for (const TwistRun* r : sorted) {
     if (r->solve.cost > (1.0 + p.class_refine_margin) * sorted.front()->solve.cost) break;
-    const bool repeated = std::any_of(out.begin(), out.end(),
-                                      [&](const TwistRun* o) { return sameAnswer(*o, *r, p); });
+    const bool repeated =
+        std::any_of(out.begin(), out.end(), [&](const TwistRun* o) { return sameAnswer(*o, *r); });
     if (!repeated) out.push_back(r);
   }
   return out;
@@ -184,6 +188,28 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
   return result;
 }
 
+/// Every start (kPointingStartTwists twists from the one of least rotation × the ways round) solved
+/// on `steps` steps, each recorded as a `stage` attempt; with `finals`, each appended there too (a
+/// plan on the requested grid). Stops at a cancel or the deadline.
+std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, double tolerance,
+                                AttemptStage stage, SolveContext& context,
+                                const NewtonParameters& p,
+                                std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  const double base = nearestTwist(problem.initial_attitude, problem.end_condition);
+  std::vector<TwistRun> runs;
+  for (int i = 0; i < kPointingStartTwists; ++i) {
+    const double twist = std::remainder(base + 2.0 * M_PI * i / kPointingStartTwists, 2.0 * M_PI);
+    for (const HomotopyClass& c : kPointingClasses) {
+      if (context.stopReason()) return runs;
+      runs.push_back(
+          runTwist(posedAt(problem, steps, twist, c), twist, c, nullptr, tolerance, context, p));
+      const std::size_t at = record(runs.back(), stage, AttemptStart::Hermite, 0, context);
+      if (finals) finals->emplace_back(runs.back(), at);
+    }
+  }
+  return runs;
+}
+
 /// The kept answer: the cheapest converged plan on the requested grid (else the first with an
 /// iterate there, not converged), with the request's trail and totals.
 PlanResult finishPointing(const PlanningProblem& problem, const std::vector<TwistRun>& survey,
@@ -240,29 +266,24 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   const bool on_requested = survey_steps == problem.steps;
   const double survey_tolerance =
       on_requested ? options.tolerance : std::max(options.tolerance, p.coarse_tolerance_floor);
-  const double base = nearestTwist(problem.initial_attitude, problem.end_condition);
-  std::vector<TwistRun> survey;
-  for (int i = 0; i < kPointingStartTwists && !context.stopReason(); ++i) {
-    const double twist = std::remainder(base + 2.0 * M_PI * i / kPointingStartTwists, 2.0 * M_PI);
-    for (const HomotopyClass& c : kPointingClasses) {
-      if (context.stopReason()) break;
-      survey.push_back(runTwist(posedAt(problem, survey_steps, twist, c), twist, c, nullptr,
-                                survey_tolerance, context, p));
-      record(survey.back(), on_requested ? AttemptStage::Solve : AttemptStage::ClassSurvey,
-             AttemptStart::Hermite, 0, context);
-    }
-  }
   std::vector<std::pair<TwistRun, std::size_t>> finals;  // on the requested grid, trail index
-  for (const TwistRun* r : worthRefining(survey, p)) {
-    if (on_requested) {
-      finals.emplace_back(*r, first_recorded + (r - survey.data()));
-      continue;
-    }
+  const std::vector<TwistRun> survey =
+      runStarts(problem, survey_steps, survey_tolerance,
+                on_requested ? AttemptStage::Solve : AttemptStage::ClassSurvey, context, p,
+                on_requested ? &finals : nullptr);
+  for (const TwistRun* r :
+       on_requested ? std::vector<const TwistRun*>() : worthRefining(survey, p)) {
     if (context.stopReason()) break;
     TwistRun refined = refine(problem, *r, context, p);
     const std::size_t at = record(refined, AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                                   survey_steps, context);
     finals.emplace_back(std::move(refined), at);
+  }
+  const bool planned =
+      std::any_of(finals.begin(), finals.end(), [](const auto& f) { return f.first.converged(); });
+  if (!planned && !on_requested && !context.stopReason()) {
+    // Nothing of the survey grid's reached the requested one: the starts on the requested grid.
+    runStarts(problem, problem.steps, options.tolerance, AttemptStage::Solve, context, p, &finals);
   }
   return finishPointing(problem, survey, finals, first_recorded, context);
 }

@@ -8,6 +8,9 @@ namespace attitude_planner {
 
 namespace {
 
+/// Halvings of the step always tried before the round-off stop of acceptStep.
+constexpr int kHalvingsBeforeRoundOffStop = 8;
+
 /// The loop's state at one iterate: C, ∇C over (δ, ψ), and the bordered Hessian.
 struct TwistModel {
   explicit TwistModel(const ReducedProblem& np)
@@ -52,7 +55,12 @@ double acceptStep(ReducedProblem& np, const TwistModel& m, const Eigen::VectorXd
       *twist += alpha * step(n);
       return alpha;
     }
-    if (halving >= 8 && alpha * std::abs(slope) < p.negligible_decrease * m.cost) break;
+    // A step whose predicted decrease is below the cost's round-off cannot pass Armijo's test:
+    // stop halving (the caller raises the shift) after a few tries.
+    if (halving >= kHalvingsBeforeRoundOffStop &&
+        alpha * std::abs(slope) < p.negligible_decrease * m.cost) {
+      break;
+    }
   }
   return 0.0;
 }

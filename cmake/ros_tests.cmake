@@ -24,8 +24,9 @@ add_dependencies(test_tracker_scene attitude_planner_node attitude_tracker_node)
 add_rostest(test/ros/tracker_scene_in_process.test DEPENDENCIES test_tracker_scene)
 add_rostest(test/ros/tracker_scene_second_order.test DEPENDENCIES test_tracker_scene)
 add_rostest(test/ros/tracker_scene_fourth_order.test DEPENDENCIES test_tracker_scene)
+add_rostest(test/ros/tracker_scene_pointing.test DEPENDENCIES test_tracker_scene)
 list(APPEND AP_EXPECTED_TESTS test_tracker_scene tracker_scene_in_process
-     tracker_scene_second_order tracker_scene_fourth_order)
+     tracker_scene_second_order tracker_scene_fourth_order tracker_scene_pointing)
 
 # The tracker drawing a scene's pointing constraints (and planning it with them via the service).
 add_rostest_gtest(test_tracker_constraints test/ros/tracker_constraints.test

@@ -10,10 +10,21 @@ namespace attitude_planner {
 
 namespace {
 
-const char* const kPlanFlagNames[] = {
-    "--steps",          "--scheme",      "--solver",           "--precision",         "--tolerance",
-    "--max-iterations", "--time-budget", "--target-miss",      "--target-cost-error", "--objective",
-    "--time-margin",    "--direction",   "--extra-revolutions"};
+const char* const kPlanFlagNames[] = {"--steps",
+                                      "--scheme",
+                                      "--solver",
+                                      "--precision",
+                                      "--tolerance",
+                                      "--max-iterations",
+                                      "--time-budget",
+                                      "--target-miss",
+                                      "--target-cost-error",
+                                      "--objective",
+                                      "--time-margin",
+                                      "--direction",
+                                      "--extra-revolutions",
+                                      "--point-body-axis",
+                                      "--point-world-direction"};
 
 int parseInteger(const std::string& flag, const std::string& text) {
   char* end = nullptr;
@@ -40,6 +51,22 @@ double parseFinite(const std::string& flag, const std::string& text) {
 double parsePositive(const std::string& flag, const std::string& text, const char* unit = "") {
   const double v = parseFinite(flag, text);
   if (!(v > 0.0)) throw InvalidInput(flag, std::string("must be > 0") + unit + ", got " + text);
+  return v;
+}
+
+/// "X,Y,Z": a finite nonzero vector (a pointing flag's value).
+Vector3 parseDirectionVector(const std::string& flag, const std::string& text) {
+  Vector3 v;
+  std::size_t at = 0;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t comma = i < 2 ? text.find(',', at) : text.size();
+    if (comma == std::string::npos) {
+      throw InvalidInput(flag, "expected three numbers X,Y,Z, got '" + text + "'");
+    }
+    v(i) = parseFinite(flag, text.substr(at, comma - at));
+    at = comma + 1;
+  }
+  if (v.norm() == 0.0) throw InvalidInput(flag, "zero vector '" + text + "' has no direction");
   return v;
 }
 
@@ -104,6 +131,10 @@ void applyPlanFlag(const std::string& flag, const std::string& value, PlanFlags*
   } else if (flag == "--extra-revolutions") {
     f.extra_revolutions = parseInteger(flag, value);
     requireExtraRevolutions(f.extra_revolutions, flag);
+  } else if (flag == "--point-body-axis") {
+    f.point_body_axis = parseDirectionVector(flag, value);
+  } else if (flag == "--point-world-direction") {
+    f.point_world_direction = parseDirectionVector(flag, value);
   } else {
     throw InvalidInput(flag, "not a planning flag (value '" + value + "')");
   }
@@ -112,6 +143,11 @@ void applyPlanFlag(const std::string& flag, const std::string& value, PlanFlags*
 void checkPlanFlagCombination(const PlanFlags& flags) {
   if (!flags.target_flag.empty() && flags.steps) {
     throw InvalidInput(flags.target_flag + " chooses N: do not give --steps with it");
+  }
+  if (flags.point_body_axis.has_value() != flags.point_world_direction.has_value()) {
+    throw InvalidInput(
+        "--point-body-axis and --point-world-direction: give both (a pointing end condition) or "
+        "neither");
   }
   if (flags.scheme == kAutoSchemeName && flags.target_flag.empty()) {
     throw InvalidInput("--scheme auto needs --target-miss or --target-cost-error");
@@ -131,6 +167,11 @@ void applyPlanFlags(const PlanFlags& flags, PlanningProblem* problem, SolverOpti
   if (flags.time_margin >= 0.0) p.time_margin = flags.time_margin;
   if (!flags.direction.empty()) p.direction = parseDirection(flags.direction, "--direction");
   if (flags.extra_revolutions >= 0) p.extra_revolutions = flags.extra_revolutions;
+  if (flags.point_body_axis && flags.point_world_direction) {
+    p.end_condition.kind = EndConditionKind::Pointing;
+    p.end_condition.body_axis = *flags.point_body_axis;
+    p.end_condition.world_direction = *flags.point_world_direction;
+  }
 
   options->solver = parseSolver(flags.solver, "--solver");
   options->precision = parsePrecision(flags.precision, "--precision");

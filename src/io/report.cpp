@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/lie/so3.hpp"
 
 namespace attitude_planner {
 
@@ -99,7 +100,33 @@ std::string startDetailJson(const Attempt& a) {
       << ", \"excursion_peak\": " << jsonNumber(d.excursion_peak)
       << ", \"cleared_of_cones\": " << (d.cleared_of_cones ? "true" : "false")
       << ", \"coarse_steps\": " << d.coarse_steps
-      << ", \"origin\": " << jsonString(attemptStartName(originOf(a))) << "}";
+      << ", \"origin\": " << jsonString(attemptStartName(originOf(a)))
+      << ", \"twist\": " << jsonNumber(d.twist) << "}";
+  return out.str();
+}
+
+std::string jsonVector(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + jsonNumber(v(i));
+  return s + "]";
+}
+
+/// The pointing answer (PlanResult::pointing): the end condition, the twist chosen about the
+/// boresight, the final attitude [w, x, y, z] (the returned maneuver's R_N), the residual and the
+/// stationarity in the twist.
+std::string pointingJson(const PlanningProblem& problem, const PlanResult& r) {
+  const Eigen::Quaterniond q = r.maneuver.attitude.empty()
+                                   ? Eigen::Quaterniond::Identity()
+                                   : so3::toQuaternion(r.maneuver.attitude.back());
+  std::ostringstream out;
+  out << "{\"body_axis\": " << jsonVector(problem.end_condition.body_axis)
+      << ", \"world_direction\": " << jsonVector(problem.end_condition.world_direction)
+      << ", \"final_twist\": " << jsonNumber(r.pointing.final_twist)
+      << ", \"final_attitude\": " << jsonVector(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()))
+      << ", \"error\": " << jsonNumber(r.pointing.error)
+      << ", \"twist_gradient\": " << jsonNumber(r.pointing.twist_gradient)
+      << ", \"twist_stationarity\": " << jsonNumber(r.pointing.twist_stationarity)
+      << ", \"starts\": " << r.pointing.starts << "}";
   return out.str();
 }
 
@@ -170,6 +197,10 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ",\n  \"active_constraints\": " << r.active_constraints
       << ",\n  \"max_violation_between_nodes\": " << jsonNumber(r.max_violation_between_nodes);
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
+  if (r.pointing.active) {
+    out << ",\n  \"final_twist\": " << jsonNumber(r.pointing.final_twist)
+        << ",\n  \"pointing\": " << pointingJson(problem, r);
+  }
   out << "\n}\n";
   return out.str();
 }
@@ -221,6 +252,10 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   for (const std::string& e : r.effects) effects += (effects.empty() ? "" : ", ") + e;
   text += line("planned effects", effects.empty() ? std::string("none") : effects);
   if (!r.extremal.empty()) text += line("extremal", r.extremal);
+  if (r.pointing.active) {
+    text += line("final twist", general(r.pointing.final_twist, 12) + " rad about the boresight");
+    text += line("pointing error", general(r.pointing.error, 3) + " rad");
+  }
   if (r.levels.size() > 1) {
     std::string levels;
     for (const LevelSummary& level : r.levels) {
@@ -252,16 +287,6 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   }
   return text;
 }
-
-namespace {
-
-std::string jsonVector(const Eigen::VectorXd& v) {
-  std::string s = "[";
-  for (int i = 0; i < v.size(); ++i) s += (i ? ", " : "") + jsonNumber(v(i));
-  return s + "]";
-}
-
-}  // namespace
 
 std::string driftTwoInputPlanJson(const DriftTwoInputRequest& request,
                                   const DriftTwoInputPlan& plan, double solve_time_s) {

@@ -115,7 +115,8 @@ class SceneParser {
     if (root["time_margin"]) p.time_margin = number(root["time_margin"], "time_margin");
     p.steps = integer(root["steps"], "steps");
     readState(root["initial"], "initial", rigid, &p.initial_attitude, &p.initial_velocity);
-    readState(root["final"], "final", rigid, &p.final_attitude, &p.final_velocity);
+    readState(root["final"], "final", rigid, &p.final_attitude, &p.final_velocity,
+              rigid ? &p.end_condition : nullptr);
     if (root["scheme"]) p.scheme = named(root["scheme"], "scheme", kSchemeNames);
     if (root["direction"]) {
       p.direction = named(root["direction"], "direction", kRotationDirectionNames);
@@ -330,10 +331,27 @@ class SceneParser {
     return so3::fromAxisAngle(axis, angle);
   }
 
+  /// `final.pointing: {body_axis: [..], world_direction: [..]}` (nonzero vectors).
+  EndCondition pointingCondition(const YAML::Node& node, const std::string& path) const {
+    requireMap(node, path);
+    checkKeys(node, path, {"body_axis", "world_direction"}, {"body_axis", "world_direction"});
+    EndCondition end;
+    end.kind = EndConditionKind::Pointing;
+    for (const auto& [key, target] : {std::pair<const char*, Vector3*>{"body_axis", &end.body_axis},
+                                      {"world_direction", &end.world_direction}}) {
+      *target = vector3(node[key], path + "." + key);
+      if (target->norm() == 0.0) {
+        fail(node[key], path + "." + key, "zero vector " + show(node[key]) + " has no direction");
+      }
+    }
+    return end;
+  }
+
   /// `rigid`: the rigid body's state (attitude and angular velocity, both required); otherwise
   /// the kinematic drift system's, whose only boundary value is the attitude.
+  /// With `end` (the rigid body's final state): `pointing` may stand instead of `attitude`.
   void readState(const YAML::Node& node, const std::string& path, bool rigid, Matrix3* attitude_out,
-                 Vector3* velocity_out) const {
+                 Vector3* velocity_out, EndCondition* end = nullptr) const {
     requireMap(node, path);
     if (!rigid && node["angular_velocity"]) {
       // Not ignored: the body rate of ġ = g(E3 + u1 E1 + u2 E2) is (u1, u2, 1), set by the
@@ -342,10 +360,25 @@ class SceneParser {
            "not allowed with system: drift_two_input (a kinematic system: the body rate "
            "(u1, u2, 1) is set by the controls, only the attitude is a boundary condition)");
     }
-    std::vector<std::string> required = {"attitude"};
+    const bool pointing = end && node["pointing"];
+    std::vector<std::string> required = {pointing ? "pointing" : "attitude"};
     if (rigid) required.push_back("angular_velocity");
-    checkKeys(node, path, {"attitude", "angular_velocity"}, required);
-    *attitude_out = attitude(node["attitude"], path + ".attitude");
+    std::vector<std::string> allowed = {"attitude", "angular_velocity"};
+    if (end) allowed.push_back("pointing");
+    if (end && !node["pointing"] && !node["attitude"]) {
+      fail(node, path + ".attitude",
+           "missing: give " + path + ".attitude or " + path + ".pointing (one is required)");
+    }
+    if (pointing && node["attitude"]) {
+      fail(node["pointing"], path + ".pointing",
+           "give either " + path + ".attitude or " + path + ".pointing, not both");
+    }
+    checkKeys(node, path, allowed, required);
+    if (pointing) {
+      *end = pointingCondition(node["pointing"], path + ".pointing");
+    } else {
+      *attitude_out = attitude(node["attitude"], path + ".attitude");
+    }
     if (node["angular_velocity"]) {
       *velocity_out = vector3(node["angular_velocity"], path + ".angular_velocity");
     }
@@ -578,7 +611,12 @@ std::string formatScene(const Scene& scene) {
   out << "initial: {attitude: " << quaternionOf(p.initial_attitude);
   if (rigid) out << ", angular_velocity: " << vec(p.initial_velocity);
   out << "}\n";
-  out << "final: {attitude: " << quaternionOf(p.final_attitude);
+  if (p.end_condition.pointing()) {
+    out << "final: {pointing: {body_axis: " << vec(p.end_condition.body_axis)
+        << ", world_direction: " << vec(p.end_condition.world_direction) << "}";
+  } else {
+    out << "final: {attitude: " << quaternionOf(p.final_attitude);
+  }
   if (rigid) out << ", angular_velocity: " << vec(p.final_velocity);
   out << "}\n";
   out << "effects:";

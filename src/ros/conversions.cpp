@@ -121,6 +121,7 @@ PlanAttempt attemptToMsg(const Attempt& a) {
   msg.start_detail.coarse_steps = d.coarse_steps;
   msg.start_detail.origin = attemptStartName(originOf(a));
   msg.start_detail.excursion_peak = d.excursion_peak;
+  msg.start_detail.twist = d.twist;
   return msg;
 }
 
@@ -212,6 +213,21 @@ geometry_msgs::Vector3 vectorToMsg(const Vector3& v) {
   m.y = v.y();
   m.z = v.z();
   return m;
+}
+
+EndCondition endConditionFromRequest(const std::string& name,
+                                     const geometry_msgs::Vector3& body_axis,
+                                     const geometry_msgs::Vector3& world_direction) {
+  EndCondition end;
+  if (name.empty() || name == "attitude") return end;
+  if (name != "pointing") {
+    throw InvalidInput("end_condition: expected \"\", \"attitude\" or \"pointing\", got \"" + name +
+                       "\"");
+  }
+  end.kind = EndConditionKind::Pointing;
+  end.body_axis = finiteVectorFromMsg(body_axis, "pointing_body_axis");
+  end.world_direction = finiteVectorFromMsg(world_direction, "pointing_world_direction");
+  return end;
 }
 
 Matrix3 inertiaFromMsg(const boost::array<double, 9>& j) {
@@ -412,6 +428,9 @@ const std::map<std::string, std::string> kRenamedFields = {
     {"initial.attitude", "initial_attitude"},
     {"initial.angular_velocity", "initial_angular_velocity"},
     {"final.attitude", "final_attitude"},
+    {"final.pointing.body_axis", "pointing_body_axis"},
+    {"final.pointing.world_direction", "pointing_world_direction"},
+    {"final.pointing", "end_condition"},
     {"final.angular_velocity", "final_angular_velocity"},
 };
 

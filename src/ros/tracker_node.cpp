@@ -249,6 +249,11 @@ PlanAttitudeManeuver::Request planRequestOf(const PlanningProblem& problem,
   request.extra_revolutions = problem.extra_revolutions;
   request.objective = objectiveName(problem.objective);
   request.time_margin = problem.time_margin;
+  if (problem.end_condition.pointing()) {
+    request.end_condition = "pointing";
+    request.pointing_body_axis = rc::vectorToMsg(problem.end_condition.body_axis);
+    request.pointing_world_direction = rc::vectorToMsg(problem.end_condition.world_direction);
+  }
   for (const EffectSpec& e : effects) {
     // Noise is random: the replay adds it, the plan cannot know it.
     if (!std::holds_alternative<TorqueNoiseSpec>(e)) request.effects.push_back(rc::effectToMsg(e));
@@ -545,6 +550,11 @@ bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_proce
     replay.effects = parsed.effects;
     replay.scene_constraints = parsed.problem.constraints;
     replay.problem = parsed.problem;
+    if (parsed.problem.end_condition.pointing() && !replay.msg.attitude.empty()) {
+      // A pointing scene is flown, and re-planned, to the end attitude its plan chose.
+      replay.problem->end_condition = EndCondition();
+      replay.problem->final_attitude = rc::attitudeFromMsg(replay.msg.attitude.back(), "attitude");
+    }
     startReplay(replay);
     return true;
   } catch (const std::exception& e) {

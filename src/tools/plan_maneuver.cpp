@@ -63,6 +63,11 @@ const char* const kUsage =
     "                            shortest with no extra turns (the default): the cheapest of\n"
     "                            the homotopy classes (both ways, 0 or 1 extra turn)\n"
     "  --extra-revolutions K     K >= 0 extra full turns (rigid_body; overrides the scene)\n"
+    "  --point-body-axis BX,BY,BZ  with --point-world-direction DX,DY,DZ: aim the body axis b\n"
+    "                            at the world direction d instead of the scene's final attitude,\n"
+    "                            the twist about b chosen by the planner (JSON final_twist;\n"
+    "                            rigid_body, minimum effort without constraints)\n"
+    "  --point-world-direction DX,DY,DZ  the world direction d of --point-body-axis\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
     "  --warm-start PLAN.csv     start from a previous plan (a CSV this tool wrote with --csv,\n"
     "                            e.g. the remainder of the plan being flown): resampled to N\n"
@@ -191,9 +196,11 @@ Arguments parseArguments(int argc, char** argv) {
 int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
   const ap::PlanFlags& flags = args.flags;
   if (!flags.scheme.empty() || flags.solver_given || !flags.target_flag.empty() ||
-      !flags.direction.empty() || flags.extra_revolutions >= 0 || !args.warm_start.empty()) {
+      !flags.direction.empty() || flags.extra_revolutions >= 0 || !args.warm_start.empty() ||
+      flags.point_body_axis) {
     std::cerr << "plan_maneuver: --scheme, --solver, --direction, "
-                 "--extra-revolutions, --warm-start and --target-* apply to system: rigid_body "
+                 "--extra-revolutions, --warm-start, --point-* and --target-* apply to system: "
+                 "rigid_body "
                  "only (this "
                  "scene is drift_two_input)\n\n"
               << kUsage;

@@ -80,6 +80,17 @@ class SameAsTheCommandLine(unittest.TestCase):
                                  {"steps": 32, "scheme": "variational"})
         self.assertTrue(result.converged, result.message)
 
+    def test_pointing_flags(self):
+        # A pointing target from the flags: the same plan and final_twist as the CLI's.
+        result = self.check_same(REST_TO_REST,
+                                 ["--steps", "32", "--point-body-axis", "0,0,1",
+                                  "--point-world-direction", "1,1,0"],
+                                 {"steps": 32, "point_body_axis": "0,0,1",
+                                  "point_world_direction": "1,1,0"})
+        self.assertTrue(result.converged, result.message)
+        self.assertLess(result.summary["pointing"]["error"], 1e-12)
+        self.assertEqual(result.summary["final_twist"], result.summary["pointing"]["final_twist"])
+
     def test_minimum_time_with_a_float_flag(self):
         # time_margin goes through Python's repr and strtod: the same double as the CLI's text.
         result = self.check_same(MIN_TIME_SPHERE, ["--steps", "32", "--time-margin", "0.1"],

@@ -855,3 +855,35 @@ TEST(Diagnostics, TrackerStatusWarnsOnAStaleMeasurementOrAFailedReplanAndErrsOnA
   health.frame_conflict = "node /other also publishes the transform world -> body";
   EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::ERROR);
 }
+
+TEST(RosConversions, PointingRequestIsPlannedAndReportsItsTwist) {
+  ros::Time::init();  // fillResponse stamps the maneuver; no master is needed
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.end_condition = "pointing";
+  r.pointing_body_axis = rc::vectorToMsg(Vector3(0, 0, 1));
+  r.pointing_world_direction = rc::vectorToMsg(Vector3(1, 1, 0));
+  SolverOptions options;
+  const PlanningProblem p = rc::problemFromRequest(r, rc::PlannerDefaults(), &options);
+  EXPECT_TRUE(p.end_condition.pointing());
+  const PlanOutcome out = planRequest(r, rc::PlannerDefaults(), nullptr);
+  ASSERT_EQ(out.error_code, PlanErrorCode::SUCCESS) << out.message;
+  PlanAttitudeManeuver::Response res;
+  fillResponse(out, "world", "body", &res);
+  EXPECT_EQ(res.final_twist, out.result.pointing.final_twist);
+  EXPECT_LT(res.pointing_error, 1e-12);
+  EXPECT_LT(res.twist_stationarity, 1e-8);
+  const Vector3 aimed =
+      rc::attitudeFromMsg(res.maneuver.attitude.back(), "attitude") * Vector3::UnitZ();
+  EXPECT_LT((aimed - Vector3(1, 1, 0).normalized()).norm(), 1e-9);
+  EXPECT_TRUE(std::isfinite(res.attempts.front().start_detail.twist));
+  // A name it does not know, a zero vector and an unserved combination are named.
+  r.end_condition = "aim";
+  EXPECT_NE(invalidMessage(r).find("end_condition"), std::string::npos);
+  r.end_condition = "pointing";
+  r.pointing_world_direction = rc::vectorToMsg(Vector3::Zero());
+  EXPECT_NE(invalidMessage(r).find("pointing_world_direction"), std::string::npos)
+      << invalidMessage(r);
+  r.pointing_world_direction = rc::vectorToMsg(Vector3(1, 0, 0));
+  r.objective = "minimum_time";
+  EXPECT_NE(invalidMessage(r).find("minimum_time"), std::string::npos) << invalidMessage(r);
+}

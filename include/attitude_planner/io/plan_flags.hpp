@@ -26,6 +26,9 @@ struct PlanFlags {
   double time_margin = -1.0;   ///< < 0: the scene's
   std::string direction;       ///< "" : the scene's
   int extra_revolutions = -1;  ///< < 0: the scene's
+  /// --point-body-axis / --point-world-direction "X,Y,Z": a pointing end condition replacing the
+  /// scene's final attitude (both or neither).
+  std::optional<Vector3> point_body_axis, point_world_direction;
 };
 
 /// Whether `flag` ("--steps") is one of the planning flags.

@@ -145,6 +145,23 @@ constexpr int kMaxSteps = 2000000;
 /// step, so such a request is refused by name (validateProblem).
 constexpr double kMagnitudeRange = 1e50;
 
+/// How the end attitude is asked for (scene `final.attitude` or `final.pointing`).
+enum class EndConditionKind {
+  FixedAttitude,  ///< R_N = PlanningProblem::final_attitude (default)
+  /// R_N b = d: a body axis b aimed at a world direction d, the twist ψ about b free (the planner
+  /// chooses it; planning/pointing.hpp): R_N = R_ref(b, d) exp(ψ b^).
+  Pointing,
+};
+
+/// The end condition of a plan. With Pointing, PlanningProblem::final_attitude is ignored as a
+/// target (the planner writes the chosen R_N into the result's maneuver).
+struct EndCondition {
+  EndConditionKind kind = EndConditionKind::FixedAttitude;
+  Vector3 body_axis = Vector3::UnitZ();        ///< b, body frame (any nonzero length; normalized)
+  Vector3 world_direction = Vector3::UnitZ();  ///< d, world frame (any nonzero length; normalized)
+  bool pointing() const { return kind == EndConditionKind::Pointing; }
+};
+
 /// A rest-to-rest / slew problem for the fully actuated rigid body.
 struct PlanningProblem {
   Matrix3 inertia = Matrix3::Identity();           ///< J [kg·m²], body frame, SPD
@@ -152,8 +169,10 @@ struct PlanningProblem {
   int steps = 64;                                  ///< N (h = T/N)
   Matrix3 initial_attitude = Matrix3::Identity();  ///< R_0
   Vector3 initial_velocity = Vector3::Zero();      ///< Ω_0 [rad/s], body
-  Matrix3 final_attitude = Matrix3::Identity();    ///< R_N
-  Vector3 final_velocity = Vector3::Zero();        ///< Ω_{N−1} [rad/s], body
+  Matrix3 final_attitude = Matrix3::Identity();    ///< R_N (EndConditionKind::FixedAttitude)
+  /// What R_N must satisfy: final_attitude (default), or a pointing condition with a free twist.
+  EndCondition end_condition;
+  Vector3 final_velocity = Vector3::Zero();  ///< Ω_{N−1} [rad/s], body
   SchemeKind scheme = SchemeKind::Paper;
   /// Accept an inertia whose principal moments violate J1 + J2 ≥ J3 (no rigid body has one).
   /// The seed's example inertia is such a matrix (moments 3.146, 12.538, 32.186), so its scenes

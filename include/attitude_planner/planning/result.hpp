@@ -163,6 +163,9 @@ struct StartDetail {
   /// descends from (its eigenaxis, excursion and cone clearing are carried above); else unused
   /// (JSON and msg write the attempt's own start).
   AttemptStart origin = AttemptStart::Hermite;
+  /// Pointing end condition: the twist ψ [rad] about the boresight the start was posed at
+  /// (planning/pointing.hpp); NaN: none.
+  double twist = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// One solve the planner ran for a request (PlanResult::attempts, JSON `attempts`), in the order
@@ -241,6 +244,19 @@ struct DurationVerdict {
   /// The least T [s] at which a plan meeting the bounds was found (a local minimum-time plan:
   /// not a requirement); 0: none was found or sought.
   double least_duration_found = 0.0;
+};
+
+/// A pointing end condition's answer (PlanningProblem::end_condition); `active` false otherwise.
+struct PointingSummary {
+  bool active = false;
+  /// ψ [rad] chosen: R_N = R_ref(b, d) exp(ψ b^) (planning/pointing.hpp: pointingReference).
+  double final_twist = 0.0;
+  /// The end condition's residual: angle(R_N b, d) [rad] on the returned maneuver's R_N.
+  double error = 0.0;
+  double twist_gradient = 0.0;  ///< ∂C/∂ψ at the answer [N²·m²/rad]
+  /// |∂C/∂ψ| relative as max_residual is (to max|∂τ/∂δ|·max|τ|): the stationarity in ψ.
+  double twist_stationarity = 0.0;
+  int starts = 0;  ///< twist × class starts surveyed
 };
 
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
@@ -322,6 +338,8 @@ struct PlanResult {
   /// σ_k = (z⁺_k − z⁻_k)/(a w_k) (dimensionless, the multipliers of T/T₀), τ_k = ±a where σ_k ≷ 0,
   /// crossing zero at a switch. Empty otherwise.
   std::vector<Vector3> switching_function;
+  /// The twist chosen and the end condition's residual for a pointing request.
+  PointingSummary pointing;
 };
 
 }  // namespace attitude_planner

@@ -192,6 +192,13 @@ template <class Request>
 PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& defaults,
                                    SolverOptions* options);
 
+/// The request's end condition: "" or "attitude" (final_attitude), or "pointing" with its two
+/// vectors (finite; nonzero is the core's rule, validateProblem). Throws InvalidInput naming
+/// end_condition and the value for another name.
+EndCondition endConditionFromRequest(const std::string& name,
+                                     const geometry_msgs::Vector3& body_axis,
+                                     const geometry_msgs::Vector3& world_direction);
+
 // ---- templates ----------------------------------------------------------------------------------
 
 template <class Request>
@@ -244,6 +251,8 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
         constraintFromMsg(req.constraints[i], "constraints[" + std::to_string(i) + "]"));
   }
   validateConstraints(p.constraints, "constraints");
+  p.end_condition = endConditionFromRequest(req.end_condition, req.pointing_body_axis,
+                                            req.pointing_world_direction);
   return p;
 }
 

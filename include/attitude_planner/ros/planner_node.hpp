@@ -318,6 +318,9 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->active_constraints = r.active_constraints;
   res->replay_miss = r.replay_miss;
   res->step_residual = r.step_residual;
+  res->final_twist = r.pointing.active ? r.pointing.final_twist : 0.0;
+  res->pointing_error = r.pointing.active ? r.pointing.error : 0.0;
+  res->twist_stationarity = r.pointing.active ? r.pointing.twist_stationarity : 0.0;
   res->attempts.clear();
   for (const Attempt& a : r.attempts) res->attempts.push_back(ros_conversions::attemptToMsg(a));
   res->minimum_time = ros_conversions::minimumTimeToMsg(r.minimum_time);

@@ -9,10 +9,12 @@
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
 #include "planning/drivers/constrained_classes.hpp"
 #include "planning/drivers/fourth_order.hpp"
+#include "planning/drivers/pointing.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
@@ -206,7 +208,12 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   }
   const auto start = std::chrono::steady_clock::now();
   PlanResult result;
-  if (problem.scheme == SchemeKind::FourthOrder) {
+  // A pointing request is judged (replay, terminal errors) against the end attitude it chose.
+  PlanningProblem judged = problem;
+  if (problem.end_condition.pointing()) {
+    result = planPointing(problem, options, context);
+    judged.final_attitude = pointingAttitude(problem.end_condition, result.pointing.final_twist);
+  } else if (problem.scheme == SchemeKind::FourthOrder) {
     result = planFourthOrder(problem, options, context);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.warm_start && !options.constrained_from_warm_start && !guess_resampled) {
@@ -241,7 +248,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     // The Newton and interior-point plans are their own trajectories; their open-loop replay
     // (replay_miss, the terminal errors) is measured once, here, for the plan returned.
     try {
-      replayFigures(problem, &result);
+      replayFigures(judged, &result);
     } catch (const StepTooLarge& e) {
       // Only a converged plan's failed replay is the verdict; an iterate that is no answer
       // (infeasible, stopped) keeps its own, with the replay's failure said after it.

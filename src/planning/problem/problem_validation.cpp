@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
@@ -114,6 +115,33 @@ void requireFloatingPointRange(const PlanningProblem& p, const Vector3& moments)
   requireMagnitude(moments(2) / (T * T), field, "the torque scale J/T^2 [N m]");
 }
 
+/// A pointing end condition: its vectors, and the requests the pointing solver serves (minimum
+/// effort, unconstrained, no effects, a direct scheme, the class left to the planner). The others
+/// are refused by name until the twist joins the interior point (issue 40's one transcription).
+void requirePointingServed(const PlanningProblem& p) {
+  requirePointingVector(p.end_condition.body_axis, "final.pointing.body_axis");
+  requirePointingVector(p.end_condition.world_direction, "final.pointing.world_direction");
+  const auto refuse = [](const std::string& what) {
+    throw InvalidInput("final.pointing", "not supported with " + what +
+                                             " yet (the twist is a global unknown of the "
+                                             "unconstrained minimum-effort solver only); give "
+                                             "a final attitude instead");
+  };
+  if (p.objective == Objective::MinimumTime) refuse("objective minimum_time");
+  if (p.hasTorqueBounds()) refuse("actuator_limits (max_torque)");
+  if (!p.constraints.empty()) refuse("constraints");
+  if (p.scheme == SchemeKind::FourthOrder) refuse("scheme fourth_order");
+  if (p.effects && !p.effects->empty()) refuse("effects");
+  if (p.accuracy.active()) refuse("an accuracy target");
+  if (p.direction != RotationDirection::Shortest || p.extra_revolutions != 0) {
+    throw InvalidInput("final.pointing",
+                       "direction and extra_revolutions do not apply (a whole turn of the free "
+                       "twist joins the ways round: the planner starts from both), got direction " +
+                           directionName(p.direction) + ", extra_revolutions " +
+                           std::to_string(p.extra_revolutions));
+  }
+}
+
 }  // namespace
 
 void validateProblem(const PlanningProblem& p) {
@@ -203,6 +231,7 @@ void validateProblem(const PlanningProblem& p) {
   requireRotation(p.final_attitude, "final.attitude");
   requireFinite(p.initial_velocity, "initial.angular_velocity");
   requireFinite(p.final_velocity, "final.angular_velocity");
+  if (p.end_condition.pointing()) requirePointingServed(p);
   requireBoundaryWithinConstraints(p);
 }
 

@@ -62,7 +62,9 @@ ReducedProblem::ReducedProblem(const PlanningProblem& problem)
       first_free_(scheme_.hasEndTorques() ? 1 : 2),
       last_free_(scheme_.hasEndTorques() ? problem.steps - 1 : problem.steps - 2),
       initial_momentum_(problem.inertia * problem.initial_velocity),
-      final_momentum_(problem.inertia * problem.final_velocity) {
+      final_momentum_(problem.inertia * problem.final_velocity),
+      twist_axis_(problem.end_condition.pointing() ? problem.end_condition.body_axis.normalized()
+                                                   : Vector3::Zero()) {
   const Matrix3 F_first = scheme_.stepFromVelocity(problem.initial_velocity);
   const Matrix3 F_last = scheme_.stepFromVelocity(problem.final_velocity);
   steps_.assign(N_, Vector3::Zero());
@@ -297,11 +299,15 @@ double ReducedProblem::cost(const StepVectors& steps) const {
 
 ReducedProblem::StepVectors ReducedProblem::retract(const Eigen::VectorXd& delta,
                                                     double alpha) const {
-  StepVectors out = steps_;
-  const auto perturbation = [&](int j) {
+  return movedSteps([&](int j) {
     const int v = variableIndex(j);
     return v < 0 ? Vector3::Zero().eval() : Vector3(alpha * delta.segment<3>(v));
-  };
+  });
+}
+
+ReducedProblem::StepVectors ReducedProblem::movedSteps(
+    const std::function<Vector3(int j)>& perturbation) const {
+  StepVectors out = steps_;
   for (int j = first_free_ - 1; j <= last_free_; ++j) {  // the steps next to a free attitude
     const Eigen::Vector4d q = so3::quaternionProduct<double>(
         so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),

@@ -174,6 +174,29 @@ class ReducedProblem {
   /// (R_1 = R_0 F_0, F_0 from Ω(0) at h); a free attitude is held, R_0 and R_N are data.
   BoundaryPath nodePath(int j) const;
 
+  // ---- the twist of a pointing end condition as a global unknown (reduced_problem_twist.cpp) ----
+  // R_N = R_ref exp(ψ b^) (planning/pointing.hpp): ψ moves R_N by exp(Δψ b^) on the right and,
+  // for paper and variational, R_{N−1} = R_N F_{N−1}ᵀ by exp(Δψ (F_{N−1} b)^) (F_{N−1}, from Ω(T),
+  // is kept). Ω(T) is in the body frame and does not move. The motion is exactly linear in the
+  // right-perturbation coordinates of those nodes, so the derivatives in ψ are the stencils'
+  // Jacobian and Hessian contracted with it: no curvature term (unlike h's path).
+
+  /// Whether the problem's end condition is a pointing one (ψ is an unknown).
+  bool hasTwist() const { return twist_axis_.squaredNorm() > 0.0; }
+  /// e_j: R_j(ψ + Δψ) = R_j exp(Δψ e_j^) at fixed free attitudes (zero but for R_N, and R_{N−1}
+  /// of paper and variational); zero for all j without a pointing end condition.
+  Vector3 twistMotion(int j) const;
+  /// C at δ = 0 and the current ψ with `gradient` (unknowns() + 1 entries, ∂C/∂ψ last), the
+  /// band of evaluate() (may be null: then border and corner are not formed), the border
+  /// ∂²C/∂δ∂ψ and the corner ∂²C/∂ψ². `gradient_scale` as evaluate()'s (the node part).
+  double evaluateWithTwist(Eigen::VectorXd* gradient, BandedSymmetricMatrix* band,
+                           Eigen::VectorXd* border, double* corner, double* gradient_scale) const;
+  /// The iterate moved by α δ (as retract) with ψ moved by α twist_step: the steps next to the
+  /// twist-moved nodes follow, composed in quaternions.
+  StepVectors retractWithTwist(const Eigen::VectorXd& delta, double twist_step, double alpha) const;
+  /// Accepts steps from retractWithTwist(…, twist_step, 1) (R_N moved by exp(twist_step b^)).
+  void setCurrentWithTwist(const StepVectors& steps, double twist_step);
+
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
   int variableIndex(int j) const {
     return (j >= first_free_ && j <= last_free_) ? 3 * (j - first_free_) : -1;
@@ -188,6 +211,8 @@ class ReducedProblem {
 
   /// The path of R_1 (at_start) or R_{N−1}; zero for second_order (no fixed inner attitude).
   BoundaryPath boundaryPath(bool at_start) const;
+  /// retract's step update with a perturbation per node (zero for nodes that do not move).
+  StepVectors movedSteps(const std::function<Vector3(int j)>& perturbation) const;
 
   int N_;
   DiscreteScheme scheme_;
@@ -198,6 +223,7 @@ class ReducedProblem {
   Vector3 initial_momentum_, final_momentum_;   ///< J Ω(0), J Ω(T)
   Vector3 principal_span_;
   StepVectors steps_;
+  Vector3 twist_axis_;  ///< b (unit) of a pointing end condition; zero for a fixed R_N
 };
 
 }  // namespace attitude_planner

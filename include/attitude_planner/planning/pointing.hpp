@@ -1,0 +1,33 @@
+// The pointing end condition R_N b = d (a body axis b aimed at a world direction d) and its free
+// twist. Every attitude that meets it is R_N(ψ) = R_ref exp(ψ b^), ψ the twist about b from a
+// documented reference R_ref (pointingReference): the planner solves for ψ as a global unknown
+// of the transcription (transcription/reduced_problem.hpp), and reports ψ as `final_twist`.
+#pragma once
+
+#include "attitude_planner/planning/problem.hpp"
+
+namespace attitude_planner {
+
+/// R_ref(b, d): the shortest-arc rotation taking the unit b to the unit d (about b × d by their
+/// angle). For b = −d (no shortest arc) a half turn about the unit axis b × e_i / |b × e_i|, e_i
+/// the basis vector along b's smallest-magnitude component (the first of equal ones).
+Matrix3 pointingReference(const Vector3& body_axis, const Vector3& world_direction);
+
+/// R_N(ψ) = R_ref exp(ψ b^) for `end` (b and d normalized).
+Matrix3 pointingAttitude(const EndCondition& end, double twist);
+
+/// The twist ψ ∈ (−π, π] of R about `end`'s body axis from R_ref: atan2 of the b-component of
+/// vee(R_refᵀ R) and its cosine part; exact for R = pointingAttitude(end, ψ).
+double twistOf(const Matrix3& attitude, const EndCondition& end);
+
+/// The end condition's residual: the angle [rad] between R b and d (atan2 form, exact near 0).
+double pointingError(const Matrix3& attitude, const EndCondition& end);
+
+/// The twist whose R_N(ψ) is nearest `from` (least rotation angle of fromᵀ R_N(ψ)), in closed
+/// form: tr(fromᵀ R_ref exp(ψ b^)) = c + α sin ψ − β cos ψ is largest at ψ = atan2(α, −β).
+double nearestTwist(const Matrix3& from, const EndCondition& end);
+
+/// Throws InvalidInput naming `field` and the value unless `v` is finite and nonzero.
+void requirePointingVector(const Vector3& v, const std::string& field);
+
+}  // namespace attitude_planner

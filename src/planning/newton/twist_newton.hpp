@@ -1,0 +1,34 @@
+// Newton on one grid for a pointing end condition: the unknowns are the free attitudes' δ and the
+// twist ψ about the boresight (transcription/reduced_problem.hpp, evaluateWithTwist), the Newton
+// matrix the band bordered by ψ's column (linalg/bordered_band.hpp), O(N) per iteration.
+// Globalized by the least shift λ that makes the bordered matrix definite and an Armijo
+// backtracking on the cost; stops on the relative Newton decrement as grid_solve.cpp does.
+#pragma once
+
+#include "attitude_planner/planning/result.hpp"
+#include "planning/newton/newton_parameters.hpp"
+#include "planning/problem/solve_context.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+
+namespace attitude_planner {
+
+/// How one twist Newton solve ended.
+struct TwistSolve {
+  Termination termination = Termination::NotConverged;
+  std::string reason = "iteration limit reached";
+  int iterations = 0;
+  double twist = 0.0;               ///< ψ [rad] at the end
+  double cost = 0.0;                ///< C at the end
+  double twist_gradient = 0.0;      ///< ∂C/∂ψ at the end [N²·m²/rad]
+  double relative_gradient = 0.0;   ///< max|∇C| (δ and ψ) / (|∂τ/∂δ|·max|τ|) at the end
+  double relative_decrement = 0.0;  ///< √(−gᵀΔ)/|τ|₂ of the last step
+};
+
+/// Newton on (δ, ψ) from `np`'s iterate and `twist` (np built for R_N = pointingAttitude(twist));
+/// `np` ends at the last accepted iterate. Iterations are reported through `context`; a cancel or
+/// the deadline ends the solve with that termination.
+TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
+                            double tolerance, int max_iterations, const NewtonParameters& p,
+                            std::vector<IterationInfo>* history);
+
+}  // namespace attitude_planner

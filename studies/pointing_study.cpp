@@ -1,0 +1,138 @@
+// pointing_study (issue 41, pointing targets): seeded random pointing requests (random inertia,
+// b, d, R_0; rest and spinning starts; paper and second_order), each planned as one pointing
+// request and judged against a 5° sweep of fixed-attitude solves over the twist refined by golden
+// section (test_support::sweepTwist); the time of one pointing solve beside one fixed-attitude
+// solve at the chosen twist (median thread CPU time of `--repeats` runs each, side by side). Writes
+// the raw data as JSON for scripts/plot_pointing.py (docs/results/pointing.md, scripts/pointing).
+//
+//   pointing_study [--count K] [--seed S] [--steps N] [--repeats R] --out RAW.json
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+#include "support/pointing_requests.hpp"
+#include "support/study_tools.hpp"
+
+namespace ap = attitude_planner;
+namespace st = attitude_planner::study;
+
+namespace {
+
+struct Options {
+  int count = 32, steps = 64, repeats = 5;
+  unsigned seed = 41;
+  std::string out;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i], value = argv[i + 1];
+    if (flag == "--count")
+      o.count = std::stoi(value);
+    else if (flag == "--seed")
+      o.seed = static_cast<unsigned>(std::stoul(value));
+    else if (flag == "--steps")
+      o.steps = std::stoi(value);
+    else if (flag == "--repeats")
+      o.repeats = std::stoi(value);
+    else if (flag == "--out")
+      o.out = value;
+    else
+      throw std::runtime_error("unknown flag " + flag);
+  }
+  if (o.out.empty()) throw std::runtime_error("--out RAW.json is required");
+  return o;
+}
+
+/// The CPU time [s] of this thread: a solve's own work, not the time other processes on a shared
+/// machine took from it (wall times here varied 4x between repeats at a load of 7 on 2 cores).
+double threadSeconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/// The median thread CPU time of `repeats` plans of `problem` (planManeuver, single-threaded) and
+/// the last result.
+ap::PlanResult timed(const ap::PlanningProblem& problem, int repeats, double* seconds) {
+  std::vector<double> times;
+  ap::PlanResult r;
+  for (int i = 0; i < repeats; ++i) {
+    const double start = threadSeconds();
+    r = ap::planManeuver(problem);
+    times.push_back(threadSeconds() - start);
+  }
+  *seconds = st::median(times);
+  return r;
+}
+
+std::string number(double v) {
+  return std::isfinite(v) ? st::formatted(v, "%.17g") : "null";
+}
+
+std::string list(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + number(v[i]);
+  return s + "]";
+}
+
+/// One request's JSON object: the pointing answer, its sweep and the two times.
+std::string caseJson(unsigned seed, bool spinning, const ap::PlanningProblem& p, int repeats) {
+  double pointing_time = 0.0, fixed_time = 0.0;
+  const ap::PlanResult r = timed(p, repeats, &pointing_time);
+  ap::PlanningProblem fixed = p;
+  fixed.end_condition = ap::EndCondition();
+  fixed.final_attitude = ap::pointingAttitude(p.end_condition, r.pointing.final_twist);
+  const ap::PlanResult f = timed(fixed, repeats, &fixed_time);
+  const attitude_planner::test_support::TwistSweep sweep =
+      attitude_planner::test_support::sweepTwist(p);
+  std::ostringstream out;
+  out << "{\"seed\": " << seed << ", \"spinning\": " << (spinning ? "true" : "false")
+      << ", \"scheme\": \"" << ap::schemeName(p.scheme) << "\", \"steps\": " << p.steps
+      << ", \"converged\": " << (r.converged() ? "true" : "false")
+      << ", \"cost\": " << number(r.cost) << ", \"twist\": " << number(r.pointing.final_twist)
+      << ", \"error\": " << number(r.pointing.error)
+      << ", \"stationarity\": " << number(r.pointing.twist_stationarity)
+      << ", \"iterations\": " << r.iterations << ", \"attempts\": " << r.attempts.size()
+      << ", \"time\": " << number(pointing_time) << ", \"fixed_time\": " << number(fixed_time)
+      << ", \"fixed_cost\": " << number(f.cost) << ", \"fixed_iterations\": " << f.iterations
+      << ", \"sweep_best\": " << number(sweep.best)
+      << ", \"sweep_best_twist\": " << number(sweep.best_twist)
+      << ", \"sweep_worst\": " << number(sweep.worst)
+      << ", \"sweep_twists\": " << list(sweep.twists) << ", \"sweep_costs\": " << list(sweep.costs)
+      << "}";
+  return out.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options o = parse(argc, argv);
+    std::ofstream out(o.out);
+    out << "{\"steps\": " << o.steps << ", \"seed\": " << o.seed << ", \"repeats\": " << o.repeats
+        << ", \"load\": \"" << st::loadAverage() << "\", \"cases\": [\n";
+    for (int i = 0; i < o.count; ++i) {
+      const unsigned seed = o.seed * 1000 + i;
+      const bool spinning = i % 2 == 1;
+      const ap::SchemeKind scheme = i % 4 < 2 ? ap::SchemeKind::Paper : ap::SchemeKind::SecondOrder;
+      const ap::PlanningProblem p =
+          attitude_planner::test_support::randomPointingRequest(seed, o.steps, spinning, scheme);
+      out << (i ? ",\n" : "") << caseJson(seed, spinning, p, o.repeats);
+      out.flush();
+      std::cerr << "request " << i + 1 << " of " << o.count << " done\n";
+    }
+    out << "\n]}\n";
+  } catch (const std::exception& e) {
+    std::cerr << "pointing_study: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,77 @@
+#include "support/pointing_requests.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+
+namespace attitude_planner::test_support {
+
+namespace {
+Vector3 randomUnit(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Vector3(n(rng), n(rng), n(rng)).normalized();
+}
+}  // namespace
+
+PlanningProblem randomPointingRequest(unsigned seed, int steps, bool spinning, SchemeKind scheme) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  PlanningProblem p;
+  const Vector3 moments(1.0 + u(rng), 1.0 + u(rng), 1.0 + u(rng));
+  const Matrix3 Q = so3::exp(Vector3(3.0 * randomUnit(rng)));
+  const Matrix3 J = Q * moments.asDiagonal() * Q.transpose();
+  p.inertia = 0.5 * (J + J.transpose());
+  p.duration = 8.0 + 4.0 * u(rng);
+  p.steps = steps;
+  p.scheme = scheme;
+  p.initial_attitude = so3::exp(Vector3(3.0 * u(rng) * randomUnit(rng)));
+  if (spinning) {
+    p.initial_velocity = 0.2 * randomUnit(rng);
+    p.final_velocity = 0.1 * randomUnit(rng);
+  }
+  p.end_condition.kind = EndConditionKind::Pointing;
+  p.end_condition.body_axis = randomUnit(rng);
+  p.end_condition.world_direction = randomUnit(rng);
+  return p;
+}
+
+TwistSweep sweepTwist(const PlanningProblem& pointing) {
+  PlanningProblem fixed = pointing;
+  fixed.end_condition = EndCondition();
+  const auto cost = [&](double twist) {
+    fixed.final_attitude = pointingAttitude(pointing.end_condition, twist);
+    const PlanResult r = planManeuver(fixed);
+    return r.converged() ? r.cost : std::numeric_limits<double>::infinity();
+  };
+  TwistSweep s;
+  const double step = 5.0 * M_PI / 180.0;
+  s.best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 72; ++k) {
+    const double c = cost(k * step);
+    s.twists.push_back(k * step);
+    s.costs.push_back(std::isfinite(c) ? c : std::numeric_limits<double>::quiet_NaN());
+    if (c < s.best) s.best = c, s.best_twist = k * step;
+    if (std::isfinite(c)) s.worst = std::max(s.worst, c);
+  }
+  // Golden section on the bracket around the best sample.
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  double a = s.best_twist - step, b = s.best_twist + step;
+  double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a), f1 = cost(x1), f2 = cost(x2);
+  while (b - a > 1e-7) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - ratio * (b - a), f1 = cost(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + ratio * (b - a), f2 = cost(x2);
+    }
+  }
+  if (std::min(f1, f2) < s.best) {
+    s.best = std::min(f1, f2);
+    s.best_twist = f1 < f2 ? x1 : x2;
+  }
+  return s;
+}
+
+}  // namespace attitude_planner::test_support

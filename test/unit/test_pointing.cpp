@@ -1,0 +1,266 @@
+// The pointing end condition R_N b = d with the twist ψ about b free: the reference and twist
+// conventions (planning/pointing.hpp), the twist's derivatives in the transcription
+// (ReducedProblem::evaluateWithTwist) against central differences of the cost for every scheme,
+// and the planned answer against a sweep of fixed-attitude solves over ψ refined by golden section.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "attitude_planner/io/report.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "support/perturbed_problem.hpp"
+#include "support/pointing_requests.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+constexpr SchemeKind kDiscretizations[] = {SchemeKind::Paper, SchemeKind::Variational,
+                                           SchemeKind::SecondOrder};
+
+Vector3 randomUnit(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Vector3(n(rng), n(rng), n(rng)).normalized();
+}
+
+EndCondition pointingAt(const Vector3& b, const Vector3& d) {
+  EndCondition end;
+  end.kind = EndConditionKind::Pointing;
+  end.body_axis = b;
+  end.world_direction = d;
+  return end;
+}
+
+using test_support::randomPointingRequest;
+
+TEST(PointingConventions, ReferenceTakesTheAxisToTheDirection) {
+  std::mt19937 rng(3);
+  for (int i = 0; i < 50; ++i) {
+    const Vector3 b = randomUnit(rng), d = randomUnit(rng);
+    EXPECT_LT((pointingReference(b, d) * b - d).norm(), 1e-14);
+    EXPECT_LT((pointingReference(2.0 * b, 0.5 * d) * b - d).norm(), 1e-14);  // lengths free
+    EXPECT_LT((pointingReference(b, -b) * b + b).norm(), 1e-14);             // b = −d
+    EXPECT_LT((pointingReference(b, b) - Matrix3::Identity()).norm(), 1e-15);
+  }
+  // b = −d: a half turn about b × e_i, e_i along b's smallest component (here e_y).
+  const Matrix3 R = pointingReference(Vector3(1, 0.1, 0.3), Vector3(-1, -0.1, -0.3));
+  const Vector3 axis = Vector3(1, 0.1, 0.3).cross(Vector3::UnitY()).normalized();
+  EXPECT_LT((R - so3::exp(Vector3(M_PI * axis))).norm(), 1e-14);
+}
+
+TEST(PointingConventions, TwistOfInvertsPointingAttitude) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-M_PI + 1e-9, M_PI);
+  for (int i = 0; i < 50; ++i) {
+    const EndCondition end = pointingAt(randomUnit(rng), randomUnit(rng));
+    const double psi = u(rng);
+    const Matrix3 R = pointingAttitude(end, psi);
+    EXPECT_NEAR(twistOf(R, end), psi, 1e-13);
+    EXPECT_LT(pointingError(R, end), 1e-14);
+  }
+}
+
+TEST(PointingConventions, NearestTwistHasTheLeastRotationAngle) {
+  std::mt19937 rng(5);
+  for (int i = 0; i < 20; ++i) {
+    const EndCondition end = pointingAt(randomUnit(rng), randomUnit(rng));
+    const Matrix3 from = so3::exp(Vector3(2.0 * randomUnit(rng)));
+    const auto angle = [&](double psi) {
+      return so3::log(Matrix3(from.transpose() * pointingAttitude(end, psi))).norm();
+    };
+    const double best = angle(nearestTwist(from, end));
+    for (int k = 0; k < 720; ++k) EXPECT_LE(best, angle(2.0 * M_PI * k / 720) + 1e-12);
+  }
+}
+
+/// C at the free attitudes of `rp` (δ = 0) with R_N moved by exp(Δψ b^): a problem built anew for
+/// the rotated end and given the same free attitudes, its cost from the torques themselves (not
+/// from the stencils or the retraction the derivatives use).
+double costAtTwist(const PlanningProblem& problem, const ReducedProblem& rp, double dpsi) {
+  PlanningProblem moved = problem;
+  moved.final_attitude = problem.final_attitude *
+                         so3::exp(Vector3(dpsi * problem.end_condition.body_axis.normalized()));
+  ReducedProblem q(moved);
+  q.setInteriorFromAttitudes(rp.attitudes(rp.current()));
+  return q.cost(q.current());
+}
+
+TEST(TwistUnknown, DerivativesMatchCentralDifferencesForEveryScheme) {
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    PlanningProblem p = randomPointingRequest(11, 24, true, scheme);
+    p.final_attitude = pointingAttitude(p.end_condition, 0.7);
+    const ReducedProblem rp = test_support::perturbedReducedProblem(p, 12);
+    const int n = rp.unknowns();
+    Eigen::VectorXd g, border;
+    BandedSymmetricMatrix band(n, ReducedProblem::kHalfBandwidth);
+    double corner = 0.0, scale = 0.0;
+    const double C = rp.evaluateWithTwist(&g, &band, &border, &corner, &scale);
+    EXPECT_DOUBLE_EQ(C, rp.cost(rp.current()));
+    const double e = 1e-4;
+    const double cp = costAtTwist(p, rp, e), cm = costAtTwist(p, rp, -e);
+    EXPECT_NEAR(g(n), (cp - cm) / (2 * e), 1e-6 * (std::abs(g(n)) + C));
+    EXPECT_NEAR(corner, (cp - 2 * C + cm) / (e * e), 1e-4 * (std::abs(corner) + C));
+    // The border: ∂/∂ψ of the node gradient, by central differences of evaluate() at ±Δψ.
+    Eigen::VectorXd gp, gm, unused_border;
+    double unused_corner, unused_scale;
+    const auto movedBy = [&](double dpsi) {
+      ReducedProblem q = rp;
+      q.setCurrentWithTwist(q.retractWithTwist(Eigen::VectorXd::Zero(n), dpsi, 1.0), dpsi);
+      return q;
+    };
+    movedBy(e).evaluateWithTwist(&gp, nullptr, &unused_border, &unused_corner, &unused_scale);
+    movedBy(-e).evaluateWithTwist(&gm, nullptr, &unused_border, &unused_corner, &unused_scale);
+    const Eigen::VectorXd fd = (gp - gm).head(n) / (2 * e);
+    EXPECT_LT((fd - border).cwiseAbs().maxCoeff(), 1e-5 * (border.cwiseAbs().maxCoeff() + 1.0));
+    // A mixed direction (v, s): the second derivative of C along the retraction is the bordered
+    // Hessian's quadratic form (the motion is linear in the coordinates: no curvature term).
+    std::mt19937 rng(13);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    Eigen::VectorXd v(n);
+    for (int i = 0; i < n; ++i) v(i) = normal(rng);
+    const double s = 0.8;
+    const auto along = [&](double t) { return rp.cost(rp.retractWithTwist(v, s, t)); };
+    const double quadratic = v.dot(band.toDense() * v) + 2 * s * border.dot(v) + s * s * corner;
+    EXPECT_NEAR(quadratic, (along(e) - 2 * C + along(-e)) / (e * e), 1e-4 * (quadratic + C));
+    const double slope = g.head(n).dot(v) + s * g(n);
+    EXPECT_NEAR(slope, (along(e) - along(-e)) / (2 * e), 1e-6 * (std::abs(slope) + C));
+  }
+}
+
+TEST(TwistUnknown, FixedEndProblemHasNoTwist) {
+  PlanningProblem p = randomPointingRequest(21, 16, false, SchemeKind::Paper);
+  p.end_condition = EndCondition();
+  const ReducedProblem rp(p);
+  EXPECT_FALSE(rp.hasTwist());
+  EXPECT_EQ(rp.twistMotion(p.steps), Vector3::Zero());
+}
+
+TEST(PointingPlan, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
+  for (unsigned seed : {101u, 102u, 103u, 104u}) {
+    const bool spinning = seed % 2 == 0;
+    const PlanningProblem p = randomPointingRequest(seed, 32, spinning, SchemeKind::Paper);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.pointing.active);
+    const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+    EXPECT_LE(r.cost, sweep.best * (1.0 + 1e-6)) << "swept best at twist " << sweep.best_twist;
+    EXPECT_LT(r.pointing.error, 1e-12);
+    EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-12);
+    EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    EXPECT_NEAR(twistOf(r.maneuver.attitude.back(), p.end_condition), r.pointing.final_twist, 1e-9);
+    EXPECT_EQ(r.pointing.starts, 8);
+    EXPECT_GE(r.attempts.size(), 8u);
+    EXPECT_TRUE(std::isfinite(r.attempts.front().start_detail.twist));
+  }
+}
+
+TEST(PointingPlan, EverySchemeMeetsTheEndCondition) {
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    const PlanningProblem p = randomPointingRequest(31, 48, true, scheme);
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_LT(r.pointing.error, 1e-12);
+    EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    const std::string json = planResultJson(p, r);
+    EXPECT_NE(json.find("\"final_twist\": "), std::string::npos);
+    EXPECT_NE(json.find("\"pointing\": {\"body_axis\""), std::string::npos);
+  }
+}
+
+TEST(PointingPlan, WithoutConvergenceTheStartsOnTheRequestedGridAreTriedAndNamed) {
+  // One iteration per start: no survey answer to refine, so the starts run on the requested grid
+  // too; the answer is not converged, carries an iterate there and lists all 16 starts.
+  const PlanningProblem p = randomPointingRequest(51, 64, false, SchemeKind::Paper);
+  SolverOptions options;
+  options.max_iterations = 1;
+  const PlanResult r = planManeuver(p, options);
+  EXPECT_FALSE(r.converged());
+  EXPECT_EQ(r.maneuver.steps(), 64);
+  ASSERT_EQ(r.attempts.size(), 16u);
+  EXPECT_EQ(r.attempts.front().stage, AttemptStage::ClassSurvey);
+  EXPECT_EQ(r.attempts.back().stage, AttemptStage::Solve);
+  EXPECT_EQ(r.attempts.back().steps, 64);
+}
+
+TEST(PointingPlan, RequestsItCannotServeAreRefusedByName) {
+  PlanningProblem p = randomPointingRequest(41, 32, false, SchemeKind::Paper);
+  const auto refusal = [&](const PlanningProblem& q) {
+    try {
+      planManeuver(q);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("not refused");
+  };
+  PlanningProblem timed = p;
+  timed.objective = Objective::MinimumTime;
+  timed.max_torque = Vector3::Constant(1.0);
+  EXPECT_NE(refusal(timed).find("final.pointing: not supported with objective minimum_time"),
+            std::string::npos)
+      << refusal(timed);
+  PlanningProblem coned = p;
+  coned.constraints.push_back(PlanningConstraint::maxAngularRate(1.0));
+  EXPECT_NE(refusal(coned).find("final.pointing: not supported with constraints"),
+            std::string::npos)
+      << refusal(coned);
+  PlanningProblem fourth = p;
+  fourth.scheme = SchemeKind::FourthOrder;
+  EXPECT_NE(refusal(fourth).find("scheme fourth_order"), std::string::npos);
+  PlanningProblem zero = p;
+  zero.end_condition.world_direction = Vector3::Zero();
+  EXPECT_NE(refusal(zero).find("final.pointing.world_direction"), std::string::npos);
+}
+
+const char* const kPointingScene = R"(
+inertia: [2, 3, 4]
+duration: 10
+steps: 32
+initial: {attitude: {axis: [1, 0, 0], angle: 0}, angular_velocity: [0, 0, 0]}
+final: {pointing: {body_axis: [0, 0, 1], world_direction: [1, 0, 0]}, angular_velocity: [0, 0, 0]}
+)";
+
+TEST(PointingScene, ParsesFormatsAndRefusesBadKeys) {
+  const Scene scene = parseScene(kPointingScene);
+  EXPECT_TRUE(scene.problem.end_condition.pointing());
+  EXPECT_EQ(scene.problem.end_condition.world_direction, Vector3(1, 0, 0));
+  const Scene again = parseScene(formatScene(scene));
+  EXPECT_TRUE(again.problem.end_condition.pointing());
+  EXPECT_EQ(again.problem.end_condition.body_axis, Vector3(0, 0, 1));
+  const auto error = [](const std::string& text) {
+    try {
+      parseScene(text);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::string both = kPointingScene;
+  both.replace(both.find("final: {"), 8, "final: {attitude: {quaternion: [1, 0, 0, 0]}, ");
+  EXPECT_NE(error(both).find("not both"), std::string::npos) << error(both);
+  std::string zero = kPointingScene;
+  zero.replace(zero.find("world_direction: [1, 0, 0]"), 26, "world_direction: [0, 0, 0]");
+  EXPECT_NE(error(zero).find("final.pointing.world_direction"), std::string::npos) << error(zero);
+  std::string neither = kPointingScene;
+  neither.replace(neither.find("pointing: {body_axis: [0, 0, 1], world_direction: [1, 0, 0]}, "),
+                  62, "");
+  EXPECT_NE(error(neither).find("final.pointing"), std::string::npos) << error(neither);
+}
+
+TEST(PointingScene, ExampleSceneAimsTheBoresight) {
+  const Scene scene = loadScene(AP_SOURCE_DIR "/scenes/point_boresight.yaml");
+  const PlanResult r = planManeuver(scene.problem);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const Vector3 aimed = r.maneuver.attitude.back() * Vector3::UnitZ();
+  EXPECT_LT((aimed - Vector3(1, 1, 0).normalized()).norm(), 1e-12);
+  EXPECT_NEAR(r.pointing.final_twist,
+              twistOf(r.maneuver.attitude.back(), scene.problem.end_condition), 1e-9);
+}
+
+}  // namespace

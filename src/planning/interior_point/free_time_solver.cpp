@@ -45,9 +45,11 @@
 
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -82,8 +84,6 @@ constexpr double kLargestRaise = 2.0;
 /// barrier problem is solved with the iterate still outside.
 constexpr double kElasticPenalty = 100.0;
 constexpr double kElasticPenaltyGrowth = 10.0;
-/// Above this N the stationarity tolerance grows like N² (round-off of second differences).
-constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 
 class FreeTimeSolver {
  public:
@@ -95,6 +95,7 @@ class FreeTimeSolver {
         N_(np->steps()),
         n_(np->unknowns()),
         form_(parameters),
+        barrier_(parameters, freeTimeMonotone(parameters)),
         inertia_(parameters) {
     for (const auto& c : constraints) {
       groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
@@ -283,7 +284,8 @@ class FreeTimeSolver {
   int N_, n_;
   double h0_ = 0.0;
   std::vector<FreeTimeRows> groups_;
-  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  Feasible form_;            ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  MonotoneBarrier barrier_;  ///< the monotone μ rule in its free-time profile
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
@@ -694,10 +696,9 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   const double mu_final = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
   const double C0 = np_.cost(np_.current());
   const double epsilon0 = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
-  // Torques are second differences of the attitudes: their round-off, and so the stationarity's
-  // floor, grows like N² (measured: 2e-10 at N = 512, above 1e-9 at 1024).
-  const double stationarity_tolerance =
-      tolerance * std::max(1.0, std::pow(static_cast<double>(N_) / kRoundOffSteps, 2));
+  const KktResidualTest test(tolerance, N_);
+  // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
+  const BarrierScales scales{1.0, 1, N_, mu_final};
   double mu = mu0;
   initializeDuals(mu);
   int iterations = 0;
@@ -711,13 +712,13 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
     }
     const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-    if (!elastic_ && mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
+    if (!elastic_ && mu <= mu_final && test.converged(stationarity, gap)) {
       FreeTimeOutcome out = outcome(Termination::Converged, "converged", iterations, epsilon);
       checkSecondOrder(&out);
       return out;
     }
     if (mu > mu_final &&
-        (solved_to_round_off || barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu)) {
+        (solved_to_round_off || barrier_.solved(barrierResidual(mu), mu, scales))) {
       solved_to_round_off = false;
       const std::string stop = watched(watch, mu, gap, epsilon, iterations);
       if (!stop.empty()) {
@@ -726,8 +727,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
         return out;
       }
       if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
-      mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
-                                       std::pow(mu, parameters_.free_time_theta_mu)));
+      mu = barrier_.decreased(mu, scales);
       report(0.0, stationarity);  // counted as an iteration (the loop's increment), no step
       continue;                   // the same iterate for the next barrier problem
     }
@@ -753,7 +753,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
         report(0.0, stationarity);
         continue;
       }
-      if (!elastic_ && stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
+      if (!elastic_ && test.atRoundOffFloor(stationarity, gap)) {
         FreeTimeOutcome out = outcome(Termination::Converged, "converged to the round-off floor",
                                       iterations, epsilon);
         checkSecondOrder(&out);

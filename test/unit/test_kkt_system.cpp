@@ -1,12 +1,14 @@
 // The interior point's strategy objects: the KKT-system interface and its two inertia corrections
 // (interior_point/kkt_system.hpp, inertia_correction.hpp) against dense Eigen solves of the same
-// shifted matrices; the monotone barrier rule's two profiles (barrier_update.hpp) and the two
-// stopping tests (stopping_tests.hpp) against their closed forms.
+// shifted matrices, the least eigenpair against Eigen's dense eigensolver; the monotone barrier
+// rule's two profiles (barrier_update.hpp) and the two stopping tests (stopping_tests.hpp) against
+// their closed forms.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -153,6 +155,21 @@ TEST(InertiaCorrection, PerturbationHandlerRestoresTheInertiaAndADescentStep) {
   ap::PerturbationHandler fresh(p);
   ASSERT_TRUE(fresh.factorAndSolve(kkt, definite, rhs, &d));
   EXPECT_LT((dense(definite) * d - rhs).lpNorm<Eigen::Infinity>(), 1e-12);
+}
+
+TEST(KktSystem, LeastEigenpairOfAnIndefiniteBorderedBandMatchesTheDenseEigensolver) {
+  for (const int globals : {1, 2}) {
+    ap::KktBlocks<double> k = randomBlocks(globals, -30.0, 8 + globals);  // A(0, 0) < 0
+    k.corner(0, 0) = -2.0;
+    const std::optional<ap::LeastEigenpair> least = ap::leastEigenpair(k);
+    ASSERT_TRUE(least.has_value());
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> dense_solver(dense(k));
+    const double lambda = dense_solver.eigenvalues()(0);
+    ASSERT_LT(lambda, 0.0);
+    EXPECT_NEAR(least->value, lambda, 1e-9 * std::abs(lambda)) << globals;
+    EXPECT_NEAR(std::abs(least->vector.dot(dense_solver.eigenvectors().col(0))), 1.0, 1e-9);
+    EXPECT_NEAR(least->scale, dense(k).diagonal().cwiseAbs().mean(), 1e-12);
+  }
 }
 
 namespace {

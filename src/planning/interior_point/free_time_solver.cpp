@@ -60,11 +60,6 @@ namespace {
 
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
-/// leastEigenpair: bisections of the shift down to this fraction of the Gershgorin radius (at
-/// most kEigenBisections), then this many inverse iterations.
-constexpr double kEigenBisectionPrecision = 1e-12;
-constexpr int kEigenBisections = 60;
-constexpr int kInverseIterations = 4;
 /// ε₀ C₀ = this × T₀ at the start (C₀ its effort): a light regularization, gone as μ → 0.
 constexpr double kInitialEffortShare = 1e-2;
 /// ε never falls below this × ε₀: where the plan is strictly inside its bounds (the switches)
@@ -271,12 +266,6 @@ class FreeTimeSolver {
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
   void checkSecondOrder(FreeTimeOutcome* out) const;
-  struct LeastEigenpair {
-    double value = 0.0;
-    Eigen::VectorXd vector;  ///< unit, over (δ, η[, θ])
-    double scale = 0.0;      ///< the matrix's mean |diagonal|
-  };
-  std::optional<LeastEigenpair> leastEigenpair() const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
@@ -827,7 +816,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
   const bool definite = barrierHessianDefinite();
   out->second_order_sufficient = definite;
   if (definite) return;
-  const std::optional<LeastEigenpair> least = leastEigenpair();
+  const std::optional<LeastEigenpair> least = leastEigenpair(kkt_);
   if (!least) return;
   out->least_curvature = least->value / least->scale;
   const Eigen::VectorXd v = least->vector.head(n_);
@@ -837,65 +826,6 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
     return i;
   }();
   if (v(at) != 0) out->negative_curvature = v / v(at);  // max |δ_j| = 1, that entry positive
-}
-
-/// The least eigenpair of K = [band border; borderᵀ corner] from its banded factorizations
-/// alone (O(n b²) each, where a dense eigensolver costs O(n³): 13 ms at n = 190): λ_min =
-/// sup {σ : K − σI positive definite}, found by bisection on whether the shifted matrix factors
-/// positive definite (BorderedBanded reports it), between a Gershgorin bound below and 0; then
-/// inverse iteration with the shift just below λ_min, where (K − σI)⁻¹ is dominated by the
-/// least eigenvector (ratio (λ₁ − σ)/(λ₂ − σ) per step).
-std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() const {
-  const int b = borderSize();
-  const int size = n_ + b;
-  double radius = 0.0, scale = 0.0;  // Gershgorin: every eigenvalue ≥ min_i (K_ii − Σ|K_ij|)
-  for (int i = 0; i < size; ++i) {
-    double off = 0.0;
-    for (int j = std::max(0, i - kkt_.band.bandwidth());
-         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
-      if (i < n_ && j != i) off += std::abs(kkt_.band(i, j));
-    }
-    off += i < n_ ? kkt_.border.row(i).cwiseAbs().sum() : kkt_.border.col(i - n_).cwiseAbs().sum();
-    const double diagonal = i < n_ ? kkt_.band(i, i) : kkt_.corner(i - n_, i - n_);
-    if (i >= n_) off += kkt_.corner.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
-    radius = std::max(radius, std::abs(diagonal) + off);
-    scale += std::abs(diagonal) / size;
-  }
-  const auto shifted = [&](double sigma, BorderedBanded* factor) {
-    BandedSymmetric<double> A = kkt_.band;
-    A.addToDiagonal(-sigma);
-    Eigen::MatrixXd D = kkt_.corner;
-    D.diagonal().array() -= sigma;
-    return factor->factor(A, kkt_.border, D) && factor->inertia().positive == b &&
-           factor->inertia().negative == 0;
-  };
-  BorderedBanded factor;
-  double below = -radius, above = 0.0;  // K − below·I positive definite, K − above·I not
-  if (!shifted(below, &factor)) return std::nullopt;
-  for (int i = 0; i < kEigenBisections && above - below > kEigenBisectionPrecision * radius; ++i) {
-    const double middle = 0.5 * (below + above);
-    (shifted(middle, &factor) ? below : above) = middle;
-  }
-  shifted(below, &factor);
-  Eigen::VectorXd x = Eigen::VectorXd::Ones(size);
-  for (int i = 0; i < kInverseIterations; ++i) {
-    factor.solve(&x);
-    x.normalize();
-  }
-  LeastEigenpair least;
-  Eigen::VectorXd Kx = Eigen::VectorXd::Zero(size);
-  for (int i = 0; i < n_; ++i) {
-    for (int j = std::max(0, i - kkt_.band.bandwidth());
-         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
-      Kx(i) += kkt_.band(i, j) * x(j);
-    }
-  }
-  Kx.head(n_) += kkt_.border * x.tail(b);
-  Kx.tail(b) = kkt_.border.transpose() * x.head(n_) + kkt_.corner * x.tail(b);
-  least.value = x.dot(Kx);  // the Rayleigh quotient
-  least.vector = x;
-  least.scale = scale;
-  return least;
 }
 
 }  // namespace

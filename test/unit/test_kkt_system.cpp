@@ -1,16 +1,22 @@
-// The interior point's KKT-system interface and its two inertia corrections
+// The interior point's strategy objects: the KKT-system interface and its two inertia corrections
 // (interior_point/kkt_system.hpp, inertia_correction.hpp) against dense Eigen solves of the same
-// shifted matrices.
+// shifted matrices, the least eigenpair against Eigen's dense eigensolver; the monotone barrier
+// rule's two profiles (barrier_update.hpp) and the two stopping tests (stopping_tests.hpp) against
+// their closed forms.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <vector>
 
+#include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 
 namespace ap = attitude_planner;
 
@@ -149,4 +155,122 @@ TEST(InertiaCorrection, PerturbationHandlerRestoresTheInertiaAndADescentStep) {
   ap::PerturbationHandler fresh(p);
   ASSERT_TRUE(fresh.factorAndSolve(kkt, definite, rhs, &d));
   EXPECT_LT((dense(definite) * d - rhs).lpNorm<Eigen::Infinity>(), 1e-12);
+}
+
+TEST(KktSystem, LeastEigenpairOfAnIndefiniteBorderedBandMatchesTheDenseEigensolver) {
+  for (const int globals : {1, 2}) {
+    ap::KktBlocks<double> k = randomBlocks(globals, -30.0, 8 + globals);  // A(0, 0) < 0
+    k.corner(0, 0) = -2.0;
+    const std::optional<ap::LeastEigenpair> least = ap::leastEigenpair(k);
+    ASSERT_TRUE(least.has_value());
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> dense_solver(dense(k));
+    const double lambda = dense_solver.eigenvalues()(0);
+    ASSERT_LT(lambda, 0.0);
+    EXPECT_NEAR(least->value, lambda, 1e-9 * std::abs(lambda)) << globals;
+    EXPECT_NEAR(std::abs(least->vector.dot(dense_solver.eigenvectors().col(0))), 1.0, 1e-9);
+    EXPECT_NEAR(least->scale, dense(k).diagonal().cwiseAbs().mean(), 1e-12);
+  }
+}
+
+namespace {
+
+/// A barrier state with a given slack residual (the monotone decrement test reads nothing else).
+class SlackResidualState final : public ap::BarrierState {
+ public:
+  explicit SlackResidualState(double residual) : residual_(residual) {}
+  double affineComplementarity(const Eigen::VectorXd&, double*,
+                               std::vector<double>*) const override {
+    throw std::logic_error("not read by the monotone rule");
+  }
+  void addSlackWeightedGradients(const std::vector<double>*, Eigen::VectorXd*) const override {
+    throw std::logic_error("not read by the monotone rule");
+  }
+  void setComplementarityTarget(double, const std::vector<double>*) override {
+    throw std::logic_error("not set by the monotone rule");
+  }
+  double maxSlackResidual() const override { return residual_; }
+  void complementarity(double, double, double*, double*) const override {
+    throw std::logic_error("not read by the monotone rule");
+  }
+
+ private:
+  double residual_;
+};
+
+}  // namespace
+
+TEST(MonotoneBarrier, FreeTimeProfileFallsToTheSmallerOfKappaMuAndThetaMuUnsnapped) {
+  const ap::InteriorPointParameters p;
+  ap::MonotoneBarrier rule(p, ap::freeTimeMonotone(p));
+  const ap::BarrierScales scales{1.0, 1, 64, 2e-5};
+  // μ^1.3 = 1.2589e-4 < κ_μ μ = 2e-4, within 10 μ_final: the free-time profile keeps it.
+  EXPECT_DOUBLE_EQ(rule.decreased(1e-3, scales), std::pow(1e-3, 1.3));
+  EXPECT_DOUBLE_EQ(rule.decreased(0.5, scales), 0.2 * 0.5);         // κ_μ μ the smaller
+  EXPECT_DOUBLE_EQ(rule.decreased(3e-5, scales), scales.mu_final);  // never below μ_final
+  // Solved where the KKT residual is at most κ_ε μ.
+  EXPECT_TRUE(rule.solved(10.0 * 1e-3, 1e-3, scales));
+  EXPECT_FALSE(rule.solved(1.0001 * 10.0 * 1e-3, 1e-3, scales));
+  // The decrement test is the other profile's: a step leaves μ as it is.
+  double mu = 1e-3;
+  rule.afterStep(SlackResidualState(0.0), scales, {0.0, 1.0, 1.0, 0.0}, &mu);
+  EXPECT_EQ(mu, 1e-3);
+}
+
+TEST(MonotoneBarrier, FixedStepProfileScalesMuSnapsAndTestsTheDecrement) {
+  const ap::InteriorPointParameters p;
+  ap::MonotoneBarrier rule(p, ap::fixedStepMonotone(p));
+  const ap::BarrierScales unit{1.0, 1, 64, 2e-5};
+  // The same μ^θ as above would be 3.2e-5 at θ_μ 1.5: within 10 μ_final, snapped to μ_final.
+  EXPECT_EQ(rule.decreased(1e-3, unit), unit.mu_final);
+  // Scaled μ = μ m / f_scale: μ⁺ = (μ m/f)^1.5 f/m where that is below κ_μ μ.
+  const ap::BarrierScales scaled{4.0, 8, 64, 1e-9};
+  const double mu = 1e-2, s = mu * 8 / 4.0;
+  EXPECT_DOUBLE_EQ(rule.decreased(mu, scaled), std::pow(s, 1.5) * 4.0 / 8);
+  // After a step: μ falls only where the decrement and the slack residual are ≤ κ_ε μ (scaled).
+  const double bound = p.monotone_kappa_epsilon * s;
+  double at = mu;
+  rule.afterStep(SlackResidualState(2.0 * bound), scaled, {0.5 * bound, 1.0, 0.5, 0.0}, &at);
+  EXPECT_EQ(at, mu);  // the slack residual too large
+  rule.afterStep(SlackResidualState(0.5 * bound), scaled, {2.0 * bound, 1.0, 0.5, 0.0}, &at);
+  EXPECT_EQ(at, mu);  // the decrement too large, the step cut (not a stall)
+  rule.afterStep(SlackResidualState(0.5 * bound), scaled, {0.5 * bound, 1.0, 0.5, 0.0}, &at);
+  EXPECT_DOUBLE_EQ(at, std::pow(s, 1.5) * 4.0 / 8);
+}
+
+TEST(StoppingTests, KktResidualToleranceGrowsLikeNSquaredAbove256) {
+  const ap::KktResidualTest small(1e-9, 128), large(1e-9, 512);
+  EXPECT_TRUE(small.converged(1e-9, 1e-9));
+  EXPECT_FALSE(small.converged(1.01e-9, 0.0));
+  EXPECT_FALSE(small.converged(0.0, 1.01e-9));
+  EXPECT_TRUE(large.converged(3.99e-9, 1e-9));  // (512/256)² = 4
+  EXPECT_FALSE(large.converged(4.01e-9, 1e-9));
+  EXPECT_FALSE(large.converged(1e-9, 1.01e-9));  // the gap's tolerance does not grow
+  EXPECT_TRUE(small.atRoundOffFloor(99e-9, 99e-9));
+  EXPECT_FALSE(small.atRoundOffFloor(101e-9, 0.0));
+}
+
+TEST(StoppingTests, DecrementTestEndsAtTheToleranceAndOnAStalledViolation) {
+  const ap::InteriorPointParameters p;
+  const double tolerance = 1e-8, f_scale = 2.0;
+  ap::DecrementTest test(p, tolerance, 64, /*mehrotra=*/false, /*free_slacks=*/false);
+  EXPECT_EQ(test.previousDecrement(), std::numeric_limits<double>::infinity());
+  // The relative decrement √(−slope)/√(2 f): at the final barrier, unshifted, ≤ tolerance ends.
+  const double slope = -std::pow(0.5 * tolerance, 2) * 2.0 * f_scale;
+  ap::StopVerdict v = test.check({slope, 0.0, true, 0.0, 0, f_scale});
+  EXPECT_NEAR(v.relative_decrement, 0.5 * tolerance, 1e-12 * tolerance);
+  EXPECT_TRUE(v.final_step);
+  EXPECT_FALSE(test.check({slope, 1e-3, true, 0.0, 1, f_scale}).final_step);  // shifted
+  EXPECT_FALSE(test.check({slope, 0.0, false, 0.0, 2, f_scale}).final_step);  // μ above μ_final
+  test.accepted(v, 1.0);
+  EXPECT_EQ(test.previousDecrement(), v.relative_decrement);
+  // A violation that does not fall for violation_stall iterations ends the barrier problem.
+  ap::DecrementTest stalled(p, tolerance, 64, false, false);
+  const double violation = 10.0 * p.feasibility_tolerance;
+  for (int i = 0; i < p.violation_stall; ++i) {
+    EXPECT_FALSE(stalled.check({-1.0, 0.0, false, violation, i, f_scale}).final_step) << i;
+  }
+  EXPECT_TRUE(stalled.check({-1.0, 0.0, false, violation, p.violation_stall, f_scale}).final_step);
+  stalled.restart(p.violation_stall);  // a penalty raise: the patience starts again
+  EXPECT_FALSE(
+      stalled.check({-1.0, 0.0, false, violation, p.violation_stall + 1, f_scale}).final_step);
 }

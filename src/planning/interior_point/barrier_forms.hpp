@@ -57,6 +57,27 @@ struct ConstraintRows {
   std::vector<ConstraintRow<Entries>> at;  ///< at[k − support.first_k]
 };
 
+/// What a barrier rule (barrier_update.hpp) reads of the barrier problem's rows, and Mehrotra's
+/// corrector sets: a view the problem implements (ConstrainedSystem at fixed h), so that the rules
+/// do not depend on the problem they update.
+class BarrierState {
+ public:
+  virtual ~BarrierState() = default;
+  /// Mehrotra's predictor: from the affine-scaling step d (μ = 0), μ_aff = mean((s + α_p ds)(z +
+  /// α_d dz)), and the mean complementarity now (*average); ds_aff·dz_aff in `products`.
+  virtual double affineComplementarity(const Eigen::VectorXd& d, double* average,
+                                       std::vector<double>* products) const = 0;
+  /// Adds Σ_i g_i/s_i or, with `products`, Σ_i −g_i·products_i/s_i, to `out`.
+  virtual void addSlackWeightedGradients(const std::vector<double>* products,
+                                         Eigen::VectorXd* out) const = 0;
+  /// The complementarity target s z = μ − ds_aff dz_aff (`products` null: μ).
+  virtual void setComplementarityTarget(double mu, const std::vector<double>* products) = 0;
+  /// max |c − s| at the last evaluated c (the barrier problem's primal residual).
+  virtual double maxSlackResidual() const = 0;
+  /// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z).
+  virtual void complementarity(double mu, double rho, double* average, double* smallest) const = 0;
+};
+
 /// The fixed-h interior point's rows (the node unknowns only).
 using FixedStepRow = ConstraintRow<9>;
 using FixedStepRows = ConstraintRows<9>;

@@ -22,25 +22,25 @@ class MehrotraPredictorCorrector : public BarrierUpdate {
       : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Mehrotra; }
 
-  void beforeStep(ConstrainedSystem& system, const FactorSolve& solve, const Eigen::VectorXd& rhs,
+  void beforeStep(BarrierState& state, const FactorSolve& solve, const Eigen::VectorXd& rhs,
                   const BarrierScales& scales, double previous_decrement, double* mu,
                   Eigen::VectorXd* delta) override {
     Eigen::VectorXd barrier_part = Eigen::VectorXd::Zero(rhs.size());  // Σ g/s
-    system.addSlackWeightedGradients(nullptr, &barrier_part);
+    state.addSlackWeightedGradients(nullptr, &barrier_part);
     const Eigen::VectorXd affine_rhs = rhs - *mu * barrier_part;
     Eigen::VectorXd affine = affine_rhs;
     solve(&affine);
     double average = 0.0;
-    const double mu_affine = system.affineComplementarity(affine, &average, &products_);
+    const double mu_affine = state.affineComplementarity(affine, &average, &products_);
     const double sigma =
         std::pow(std::min(1.0, mu_affine / average), parameters_.mehrotra_exponent);
     *mu = std::max(
         scales.mu_final,
         std::min(*mu, std::max(sigma * average, progressFloor(scales, previous_decrement, *mu))));
     *mu = snapToFinalBarrier(*mu, scales.mu_final, parameters_);
-    system.setComplementarityTarget(*mu, &products_);
+    state.setComplementarityTarget(*mu, &products_);
     *delta = affine_rhs + *mu * barrier_part;
-    system.addSlackWeightedGradients(&products_, delta);
+    state.addSlackWeightedGradients(&products_, delta);
     solve(delta);
   }
 
@@ -65,39 +65,6 @@ class MehrotraPredictorCorrector : public BarrierUpdate {
   std::vector<double> products_;  ///< ds_aff·dz_aff per constraint
 };
 
-/// Monotone (Fiacco–McCormick, as IPOPT's): μ falls only once the barrier problem is solved to
-/// κ_ε μ, feasibility included, to min(κ_μ μ, μ^θ_μ); an adaptive rule would drive μ to μ_final
-/// while the iterate is still far from feasible, and the slacks' fraction to the boundary then
-/// stalls. A barrier problem whose decrement stalls at the round-off floor above κ_ε μ (full
-/// steps that no longer halve it) is solved as far as it can be.
-class MonotoneBarrier : public BarrierUpdate {
- public:
-  explicit MonotoneBarrier(const InteriorPointParameters& parameters) : parameters_(parameters) {}
-  BarrierRule rule() const override { return BarrierRule::Monotone; }
-
-  void afterStep(const ConstrainedSystem& system, const BarrierScales& scales,
-                 const AcceptedStep& step, double* mu) override {
-    const InteriorPointParameters& p = parameters_;
-    const double scaled_mu = *mu * scales.constraints / scales.f_scale;
-    const bool stalled =
-        step.alpha == 1.0 && step.relative_decrement > p.stall_ratio * step.previous_decrement;
-    stalled_steps_ = stalled ? stalled_steps_ + 1 : 0;
-    const bool solved = step.relative_decrement <= p.monotone_kappa_epsilon * scaled_mu ||
-                        stalled_steps_ >= p.monotone_stalled_steps;
-    if (system.maxSlackResidual() <= p.monotone_kappa_epsilon * scaled_mu && solved) {
-      *mu = std::max(scales.mu_final,
-                     std::min(p.monotone_kappa_mu * *mu, std::pow(scaled_mu, p.monotone_theta_mu) *
-                                                             scales.f_scale / scales.constraints));
-      *mu = snapToFinalBarrier(*mu, scales.mu_final, p);
-      stalled_steps_ = 0;
-    }
-  }
-
- private:
-  const InteriorPointParameters& parameters_;
-  int stalled_steps_ = 0;  ///< full steps in a row that did not halve the decrement
-};
-
 /// LOQO's adaptive rule: μ ← σ · mean(s z, v u), σ = 0.1 min(0.05 (1 − ξ)/ξ, 2)³, ξ = smallest /
 /// mean product (how far from central), never increasing.
 class LoqoBarrier : public BarrierUpdate {
@@ -105,11 +72,11 @@ class LoqoBarrier : public BarrierUpdate {
   explicit LoqoBarrier(const InteriorPointParameters& parameters) : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Loqo; }
 
-  void afterStep(const ConstrainedSystem& system, const BarrierScales& scales,
-                 const AcceptedStep& step, double* mu) override {
+  void afterStep(const BarrierState& state, const BarrierScales& scales, const AcceptedStep& step,
+                 double* mu) override {
     const InteriorPointParameters& p = parameters_;
     double average = 0.0, smallest = 0.0;
-    system.complementarity(*mu, step.rho, &average, &smallest);
+    state.complementarity(*mu, step.rho, &average, &smallest);
     const double xi = smallest / average;
     const double sigma =
         p.loqo_scale * std::pow(std::min(p.loqo_centrality * (1 - xi) / xi, p.loqo_cap), 3);
@@ -123,13 +90,51 @@ class LoqoBarrier : public BarrierUpdate {
 
 }  // namespace
 
+MonotoneProfile fixedStepMonotone(const InteriorPointParameters& parameters) {
+  return {parameters.monotone_theta_mu, BarrierProblemTest::Decrement, true};
+}
+
+MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters) {
+  return {parameters.free_time_theta_mu, BarrierProblemTest::KktResidual, false};
+}
+
+void MonotoneBarrier::afterStep(const BarrierState& state, const BarrierScales& scales,
+                                const AcceptedStep& step, double* mu) {
+  if (profile_.test != BarrierProblemTest::Decrement) return;
+  const InteriorPointParameters& p = parameters_;
+  const double scaled_mu = *mu * scales.constraints / scales.f_scale;
+  const bool stalled =
+      step.alpha == 1.0 && step.relative_decrement > p.stall_ratio * step.previous_decrement;
+  stalled_steps_ = stalled ? stalled_steps_ + 1 : 0;
+  const bool solved = step.relative_decrement <= p.monotone_kappa_epsilon * scaled_mu ||
+                      stalled_steps_ >= p.monotone_stalled_steps;
+  if (state.maxSlackResidual() <= p.monotone_kappa_epsilon * scaled_mu && solved) {
+    *mu = decreased(*mu, scales);
+    stalled_steps_ = 0;
+  }
+}
+
+bool MonotoneBarrier::solved(double kkt_residual, double mu, const BarrierScales& scales) const {
+  return kkt_residual <=
+         parameters_.monotone_kappa_epsilon * (mu * scales.constraints / scales.f_scale);
+}
+
+double MonotoneBarrier::decreased(double mu, const BarrierScales& scales) const {
+  const InteriorPointParameters& p = parameters_;
+  const double scaled_mu = mu * scales.constraints / scales.f_scale;
+  const double next = std::max(
+      scales.mu_final, std::min(p.monotone_kappa_mu * mu, std::pow(scaled_mu, profile_.theta_mu) *
+                                                              scales.f_scale / scales.constraints));
+  return profile_.snap_to_final ? snapToFinalBarrier(next, scales.mu_final, p) : next;
+}
+
 std::unique_ptr<BarrierUpdate> makeBarrierUpdate(BarrierRule rule,
                                                  const InteriorPointParameters& parameters) {
   switch (rule) {
     case BarrierRule::Mehrotra:
       return std::make_unique<MehrotraPredictorCorrector>(parameters);
     case BarrierRule::Monotone:
-      return std::make_unique<MonotoneBarrier>(parameters);
+      return std::make_unique<MonotoneBarrier>(parameters, fixedStepMonotone(parameters));
     case BarrierRule::Loqo:
       return std::make_unique<LoqoBarrier>(parameters);
   }

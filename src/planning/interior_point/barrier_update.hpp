@@ -11,7 +11,7 @@
 
 #include <Eigen/Dense>
 
-#include "planning/interior_point/constrained_system.hpp"
+#include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 
 namespace attitude_planner {
@@ -48,15 +48,63 @@ class BarrierUpdate {
   /// Before a primal–dual step, the system factored and `delta` solved for `rhs` at μ: may set μ
   /// for this step and replace `delta` (the predictor–corrector). `previous_decrement` is the
   /// last step's relative decrement (+∞ at the first).
-  virtual void beforeStep(ConstrainedSystem& /*system*/, const FactorSolve& /*solve*/,
+  virtual void beforeStep(BarrierState& /*state*/, const FactorSolve& /*solve*/,
                           const Eigen::VectorXd& /*rhs*/, const BarrierScales& /*scales*/,
                           double /*previous_decrement*/, double* /*mu*/,
                           Eigen::VectorXd* /*delta*/) {}
   /// After an accepted step above μ_final: the next μ.
-  virtual void afterStep(const ConstrainedSystem& /*system*/, const BarrierScales& /*scales*/,
+  virtual void afterStep(const BarrierState& /*state*/, const BarrierScales& /*scales*/,
                          const AcceptedStep& /*step*/, double* /*mu*/) {}
 };
 
+/// How the monotone rule tells that a barrier problem is solved (IPOPT's κ_ε μ test, on one of two
+/// residuals).
+enum class BarrierProblemTest {
+  /// After each accepted step: the relative decrement and the slack residual ≤ κ_ε μ (scaled), or
+  /// the decrement stalled at round-off (fixed h).
+  Decrement,
+  /// Before each step: the barrier problem's KKT residual max(‖∇L‖∞, |zc − μ|) ≤ κ_ε μ; the
+  /// caller then lowers μ at the same iterate (free time).
+  KktResidual,
+};
+
+/// One monotone rule, two parameter profiles: θ_μ, the test, and whether a μ near μ_final snaps
+/// to it.
+struct MonotoneProfile {
+  double theta_mu = 1.5;
+  BarrierProblemTest test = BarrierProblemTest::Decrement;
+  bool snap_to_final = true;
+};
+/// Fixed h: IPOPT's θ_μ (monotone_theta_mu), the decrement test, snapped.
+MonotoneProfile fixedStepMonotone(const InteriorPointParameters& parameters);
+/// Free time: free_time_theta_mu, the KKT residual test, not snapped.
+MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters);
+
+/// Monotone (Fiacco–McCormick, as IPOPT's): μ falls only once the barrier problem is solved to
+/// κ_ε μ, to min(κ_μ μ, μ^θ_μ) in the scaled μ (μ m/f_scale); an adaptive rule would drive μ to
+/// μ_final while the iterate is still far from feasible, and the slacks' fraction to the boundary
+/// then stalls. With the decrement test a barrier problem whose decrement stalls at the round-off
+/// floor above κ_ε μ (full steps that no longer halve it) is solved as far as it can be.
+class MonotoneBarrier final : public BarrierUpdate {
+ public:
+  MonotoneBarrier(const InteriorPointParameters& parameters, const MonotoneProfile& profile)
+      : parameters_(parameters), profile_(profile) {}
+  BarrierRule rule() const override { return BarrierRule::Monotone; }
+  /// The decrement test (BarrierProblemTest::Decrement): μ falls after a step that solves it.
+  void afterStep(const BarrierState& state, const BarrierScales& scales, const AcceptedStep& step,
+                 double* mu) override;
+  /// The KKT residual test (BarrierProblemTest::KktResidual) at μ.
+  bool solved(double kkt_residual, double mu, const BarrierScales& scales) const;
+  /// The next barrier: max(μ_final, min(κ_μ μ, μ^θ_μ)), snapped where the profile says.
+  double decreased(double mu, const BarrierScales& scales) const;
+
+ private:
+  const InteriorPointParameters& parameters_;
+  MonotoneProfile profile_;
+  int stalled_steps_ = 0;  ///< full steps in a row that did not halve the decrement
+};
+
+/// Mehrotra and Loqo; Monotone in the fixed-h profile.
 std::unique_ptr<BarrierUpdate> makeBarrierUpdate(BarrierRule rule,
                                                  const InteriorPointParameters& parameters);
 

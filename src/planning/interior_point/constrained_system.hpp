@@ -37,7 +37,7 @@ struct Assembly {
 };
 
 /// The node constraints of one problem in one formulation, and the condensed Newton system.
-class ConstrainedSystem {
+class ConstrainedSystem final : public BarrierState {
  public:
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
                     const InteriorPointParameters& parameters);
@@ -67,14 +67,12 @@ class ConstrainedSystem {
   Assembly assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
                     Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient);
 
-  /// Mehrotra's predictor: from the affine-scaling step d (μ = 0), μ_aff = mean((s + α_p ds)(z +
-  /// α_d dz)), and the mean complementarity now (*average); ds_aff·dz_aff in `products`.
+  // BarrierState (the predictor–corrector's part; q for the complementarity target).
   double affineComplementarity(const Eigen::VectorXd& d, double* average,
-                               std::vector<double>* products) const;
-  /// Adds Σ_i g_i/s_i or, with `products`, Σ_i −g_i·products_i/s_i, to `out`.
-  void addSlackWeightedGradients(const std::vector<double>* products, Eigen::VectorXd* out) const;
-  /// q for the complementarity target s z = μ − ds_aff dz_aff (`products` null: μ).
-  void setComplementarityTarget(double mu, const std::vector<double>* products);
+                               std::vector<double>* products) const override;
+  void addSlackWeightedGradients(const std::vector<double>* products,
+                                 Eigen::VectorXd* out) const override;
+  void setComplementarityTarget(double mu, const std::vector<double>* products) override;
   /// The largest dual step in (0, 1] by the fraction to the boundary, and the steps dz.
   double dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz);
   void applyDualStep(const std::vector<double>& dz, double alpha);
@@ -91,10 +89,9 @@ class ConstrainedSystem {
   void applySlackStep(double alpha);
   /// FreeSlacks: the largest multiplier after the dual step dz.
   double largestMultiplier(const std::vector<double>& dz, double alpha) const;
-  /// FreeSlacks: max |c − s| at the last evaluated c.
-  double maxSlackResidual() const;
-  /// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z).
-  void complementarity(double mu, double rho, double* average, double* smallest) const;
+  // BarrierState (FreeSlacks' max |c − s|; the complementarity products).
+  double maxSlackResidual() const override;
+  void complementarity(double mu, double rho, double* average, double* smallest) const override;
   /// Largest elastic violation max(−c_i) at the last assembly or merit.
   double maxViolation() const;
   /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function).

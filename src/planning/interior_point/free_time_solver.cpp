@@ -45,9 +45,11 @@
 
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -58,11 +60,6 @@ namespace {
 
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
-/// leastEigenpair: bisections of the shift down to this fraction of the Gershgorin radius (at
-/// most kEigenBisections), then this many inverse iterations.
-constexpr double kEigenBisectionPrecision = 1e-12;
-constexpr int kEigenBisections = 60;
-constexpr int kInverseIterations = 4;
 /// ε₀ C₀ = this × T₀ at the start (C₀ its effort): a light regularization, gone as μ → 0.
 constexpr double kInitialEffortShare = 1e-2;
 /// ε never falls below this × ε₀: where the plan is strictly inside its bounds (the switches)
@@ -82,8 +79,6 @@ constexpr double kLargestRaise = 2.0;
 /// barrier problem is solved with the iterate still outside.
 constexpr double kElasticPenalty = 100.0;
 constexpr double kElasticPenaltyGrowth = 10.0;
-/// Above this N the stationarity tolerance grows like N² (round-off of second differences).
-constexpr double kRoundOffSteps = 256;  ///< the reduced problem's Hessian band
 
 class FreeTimeSolver {
  public:
@@ -95,6 +90,7 @@ class FreeTimeSolver {
         N_(np->steps()),
         n_(np->unknowns()),
         form_(parameters),
+        barrier_(parameters, freeTimeMonotone(parameters)),
         inertia_(parameters) {
     for (const auto& c : constraints) {
       groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
@@ -270,12 +266,6 @@ class FreeTimeSolver {
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
   void checkSecondOrder(FreeTimeOutcome* out) const;
-  struct LeastEigenpair {
-    double value = 0.0;
-    Eigen::VectorXd vector;  ///< unit, over (δ, η[, θ])
-    double scale = 0.0;      ///< the matrix's mean |diagonal|
-  };
-  std::optional<LeastEigenpair> leastEigenpair() const;
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
@@ -283,7 +273,8 @@ class FreeTimeSolver {
   int N_, n_;
   double h0_ = 0.0;
   std::vector<FreeTimeRows> groups_;
-  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  Feasible form_;            ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  MonotoneBarrier barrier_;  ///< the monotone μ rule in its free-time profile
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
@@ -694,10 +685,9 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   const double mu_final = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
   const double C0 = np_.cost(np_.current());
   const double epsilon0 = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
-  // Torques are second differences of the attitudes: their round-off, and so the stationarity's
-  // floor, grows like N² (measured: 2e-10 at N = 512, above 1e-9 at 1024).
-  const double stationarity_tolerance =
-      tolerance * std::max(1.0, std::pow(static_cast<double>(N_) / kRoundOffSteps, 2));
+  const KktResidualTest test(tolerance, N_);
+  // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
+  const BarrierScales scales{1.0, 1, N_, mu_final};
   double mu = mu0;
   initializeDuals(mu);
   int iterations = 0;
@@ -711,13 +701,13 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
     }
     const double gap = dualityGap();
     const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-    if (!elastic_ && mu <= mu_final && stationarity <= stationarity_tolerance && gap <= tolerance) {
+    if (!elastic_ && mu <= mu_final && test.converged(stationarity, gap)) {
       FreeTimeOutcome out = outcome(Termination::Converged, "converged", iterations, epsilon);
       checkSecondOrder(&out);
       return out;
     }
     if (mu > mu_final &&
-        (solved_to_round_off || barrierResidual(mu) <= parameters_.monotone_kappa_epsilon * mu)) {
+        (solved_to_round_off || barrier_.solved(barrierResidual(mu), mu, scales))) {
       solved_to_round_off = false;
       const std::string stop = watched(watch, mu, gap, epsilon, iterations);
       if (!stop.empty()) {
@@ -726,8 +716,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
         return out;
       }
       if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
-      mu = std::max(mu_final, std::min(parameters_.monotone_kappa_mu * mu,
-                                       std::pow(mu, parameters_.free_time_theta_mu)));
+      mu = barrier_.decreased(mu, scales);
       report(0.0, stationarity);  // counted as an iteration (the loop's increment), no step
       continue;                   // the same iterate for the next barrier problem
     }
@@ -753,7 +742,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
         report(0.0, stationarity);
         continue;
       }
-      if (!elastic_ && stationarity <= 100 * stationarity_tolerance && gap <= 100 * tolerance) {
+      if (!elastic_ && test.atRoundOffFloor(stationarity, gap)) {
         FreeTimeOutcome out = outcome(Termination::Converged, "converged to the round-off floor",
                                       iterations, epsilon);
         checkSecondOrder(&out);
@@ -827,7 +816,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
   const bool definite = barrierHessianDefinite();
   out->second_order_sufficient = definite;
   if (definite) return;
-  const std::optional<LeastEigenpair> least = leastEigenpair();
+  const std::optional<LeastEigenpair> least = leastEigenpair(kkt_);
   if (!least) return;
   out->least_curvature = least->value / least->scale;
   const Eigen::VectorXd v = least->vector.head(n_);
@@ -837,65 +826,6 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
     return i;
   }();
   if (v(at) != 0) out->negative_curvature = v / v(at);  // max |δ_j| = 1, that entry positive
-}
-
-/// The least eigenpair of K = [band border; borderᵀ corner] from its banded factorizations
-/// alone (O(n b²) each, where a dense eigensolver costs O(n³): 13 ms at n = 190): λ_min =
-/// sup {σ : K − σI positive definite}, found by bisection on whether the shifted matrix factors
-/// positive definite (BorderedBanded reports it), between a Gershgorin bound below and 0; then
-/// inverse iteration with the shift just below λ_min, where (K − σI)⁻¹ is dominated by the
-/// least eigenvector (ratio (λ₁ − σ)/(λ₂ − σ) per step).
-std::optional<FreeTimeSolver::LeastEigenpair> FreeTimeSolver::leastEigenpair() const {
-  const int b = borderSize();
-  const int size = n_ + b;
-  double radius = 0.0, scale = 0.0;  // Gershgorin: every eigenvalue ≥ min_i (K_ii − Σ|K_ij|)
-  for (int i = 0; i < size; ++i) {
-    double off = 0.0;
-    for (int j = std::max(0, i - kkt_.band.bandwidth());
-         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
-      if (i < n_ && j != i) off += std::abs(kkt_.band(i, j));
-    }
-    off += i < n_ ? kkt_.border.row(i).cwiseAbs().sum() : kkt_.border.col(i - n_).cwiseAbs().sum();
-    const double diagonal = i < n_ ? kkt_.band(i, i) : kkt_.corner(i - n_, i - n_);
-    if (i >= n_) off += kkt_.corner.row(i - n_).cwiseAbs().sum() - std::abs(diagonal);
-    radius = std::max(radius, std::abs(diagonal) + off);
-    scale += std::abs(diagonal) / size;
-  }
-  const auto shifted = [&](double sigma, BorderedBanded* factor) {
-    BandedSymmetric<double> A = kkt_.band;
-    A.addToDiagonal(-sigma);
-    Eigen::MatrixXd D = kkt_.corner;
-    D.diagonal().array() -= sigma;
-    return factor->factor(A, kkt_.border, D) && factor->inertia().positive == b &&
-           factor->inertia().negative == 0;
-  };
-  BorderedBanded factor;
-  double below = -radius, above = 0.0;  // K − below·I positive definite, K − above·I not
-  if (!shifted(below, &factor)) return std::nullopt;
-  for (int i = 0; i < kEigenBisections && above - below > kEigenBisectionPrecision * radius; ++i) {
-    const double middle = 0.5 * (below + above);
-    (shifted(middle, &factor) ? below : above) = middle;
-  }
-  shifted(below, &factor);
-  Eigen::VectorXd x = Eigen::VectorXd::Ones(size);
-  for (int i = 0; i < kInverseIterations; ++i) {
-    factor.solve(&x);
-    x.normalize();
-  }
-  LeastEigenpair least;
-  Eigen::VectorXd Kx = Eigen::VectorXd::Zero(size);
-  for (int i = 0; i < n_; ++i) {
-    for (int j = std::max(0, i - kkt_.band.bandwidth());
-         j <= std::min(n_ - 1, i + kkt_.band.bandwidth()); ++j) {
-      Kx(i) += kkt_.band(i, j) * x(j);
-    }
-  }
-  Kx.head(n_) += kkt_.border * x.tail(b);
-  Kx.tail(b) = kkt_.border.transpose() * x.head(n_) + kkt_.corner * x.tail(b);
-  least.value = x.dot(Kx);  // the Rayleigh quotient
-  least.vector = x;
-  least.scale = scale;
-  return least;
 }
 
 }  // namespace

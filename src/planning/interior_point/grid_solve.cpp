@@ -13,6 +13,7 @@
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/problem/verdict.hpp"
@@ -21,8 +22,6 @@
 namespace attitude_planner {
 
 namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 std::string describeManeuverSpan(const PlanningProblem& problem) {
   std::ostringstream s;
@@ -39,15 +38,6 @@ struct Direction {
   double slope = 0.0;  ///< ∇φ·dδ (free slacks: with the slacks' and the penalty's part)
   double shift = 0.0;  ///< the inertia correction used
   double decrement_slope = 0.0;  ///< free slacks: the slope the decrement is measured on
-};
-
-/// The stopping test's verdict on one direction.
-struct StopTest {
-  double relative_decrement = 0.0;
-  bool at_final_barrier = false;
-  bool violated = false;
-  bool at_floor = false;    ///< at μ_final, feasible, at the round-off floor of the decrement
-  bool final_step = false;  ///< this step is the barrier problem's last
 };
 
 enum class Next { Continue, Stop };
@@ -72,7 +62,9 @@ class GridSolve {
         barrier_(makeBarrierUpdate(request.barrier, parameters)),
         free_slacks_(system_.freeSlacks()),
         inertia_(parameters),
-        kkt_blocks_(np->unknowns()) {
+        kkt_blocks_(np->unknowns()),
+        test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
+              free_slacks_) {
     system_.setInterruption(&context);
   }
 
@@ -127,8 +119,6 @@ class GridSolve {
     scales_.mu_final =
         std::min(mu_, p_.final_barrier_fraction * options_.tolerance * f / m *
                           std::max(1.0, static_cast<double>(N) / p_.final_barrier_round_off_steps));
-    stall_acceptance_ =
-        p_.stall_acceptance * std::max(1.0, N / static_cast<double>(p_.stall_acceptance_steps));
     system_.evaluateValues(np_.current(), nullptr);
     system_.initializeMultipliers(mu_, rho_, p_.initial_multiplier_cap * f / m);
     if (request_.barrier == BarrierRule::Mehrotra && request_.coarse_duals &&
@@ -149,7 +139,9 @@ class GridSolve {
     if (!direction.factored) {
       return end(Termination::NotConverged, "Newton system could not be made positive definite");
     }
-    const StopTest test = stoppingTest(direction);
+    const StopVerdict test =
+        test_.check({free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift,
+                     mu_ <= scales_.mu_final, system_.maxViolation(), iteration_, scales_.f_scale});
     ReducedProblem::StepVectors trial;
     double alpha = 0.0;
     if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test);
@@ -161,11 +153,9 @@ class GridSolve {
     if (test.final_step) return endBarrierProblem();
     if (!test.at_final_barrier) {
       barrier_->afterStep(system_, scales_,
-                          {test.relative_decrement, previous_decrement_, alpha, rho_}, &mu_);
+                          {test.relative_decrement, test_.previousDecrement(), alpha, rho_}, &mu_);
     }
-    previous_decrement_ = test.relative_decrement;
-    previous_alpha_ = alpha;
-    previous_at_final_barrier_ = test.at_final_barrier;
+    test_.accepted(test, alpha);
     return Next::Continue;
   }
 
@@ -182,7 +172,7 @@ class GridSolve {
       if (d.factored && !primal && mu_ > scales_.mu_final) {
         barrier_->beforeStep(
             system_, [this](Eigen::VectorXd* b) { kkt_.solve(b); }, rhs_, scales_,
-            previous_decrement_, &mu_, &delta_);
+            test_.previousDecrement(), &mu_, &delta_);
       }
       d.slope = merit_gradient_.dot(delta_);
       if (d.factored && free_slacks_) addSlackTerms(&d);
@@ -213,64 +203,9 @@ class GridSolve {
     d->decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
   }
 
-  /// The decrement, the stall counters and whether this step ends the barrier problem.
-  StopTest stoppingTest(const Direction& d) {
-    StopTest t;
-    t.relative_decrement = std::sqrt(std::max(0.0, -(free_slacks_ ? d.decrement_slope : d.slope))) /
-                           std::sqrt(2.0 * scales_.f_scale);
-    const double decrement = t.relative_decrement;
-    t.at_final_barrier = mu_ <= scales_.mu_final;
-    t.violated = system_.maxViolation() > p_.feasibility_tolerance;
-    countStalls(t);
-    const bool violation_stalled = violationStalled(t.violated);
-    const bool unshifted = d.shift <= p_.negligible_shift;
-    const bool mehrotra = request_.barrier == BarrierRule::Mehrotra;
-    // Quadratic convergence seen at the final barrier: this step leaves about d·(d/d₋)².
-    const bool quadratic_finish =
-        mehrotra && t.at_final_barrier && previous_at_final_barrier_ && !t.violated && unshifted &&
-        previous_alpha_ >= p_.quadratic_step && decrement < previous_decrement_ &&
-        decrement * std::pow(decrement / previous_decrement_, 2) <=
-            p_.quadratic_margin * stall_acceptance_;
-    const double reachable_tolerance =
-        mehrotra ? std::max(options_.tolerance, p_.reachable_fraction * stall_acceptance_)
-                 : options_.tolerance;
-    t.final_step =
-        violation_stalled ||
-        (t.at_final_barrier && ((unshifted && decrement <= reachable_tolerance) ||
-                                stalled_iterations_ >= p_.stalled_iterations || quadratic_finish));
-    t.at_floor =
-        t.at_final_barrier && !t.violated && decrement <= p_.floor_factor * stall_acceptance_;
-    return t;
-  }
-
-  /// At μ_final the condensed system's condition limits the decrement: full steps that no longer
-  /// halve it (below the stall acceptance, or with the constraints still violated) stall.
-  void countStalls(const StopTest& t) {
-    if (!t.at_final_barrier) return;
-    const double decrement = t.relative_decrement;
-    if ((decrement <= stall_acceptance_ || t.violated) &&
-        decrement > p_.stall_ratio * best_final_decrement_) {
-      ++stalled_iterations_;
-    } else {
-      stalled_iterations_ = 0;
-    }
-    best_final_decrement_ = std::min(best_final_decrement_, decrement);
-  }
-
-  /// A violation that no iteration reduces any more is a local minimum of the ℓ1 infeasibility.
-  bool violationStalled(bool violated) {
-    const double violation = system_.maxViolation();
-    if (!violated || violation < best_violation_ * (1.0 - p_.violation_progress)) {
-      best_violation_ = violated ? violation : kInfinity;
-      last_violation_progress_ = iteration_;
-    }
-    const int patience = free_slacks_ ? p_.free_slack_violation_stall : p_.violation_stall;
-    return violated && iteration_ - last_violation_progress_ >= patience;
-  }
-
   /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step; a predicted
   /// decrease below φ's round-off is taken. False if no step length was accepted.
-  bool lineSearch(const Direction& d, const StopTest& t, ReducedProblem::StepVectors* trial,
+  bool lineSearch(const Direction& d, const StopVerdict& t, ReducedProblem::StepVectors* trial,
                   double* alpha) {
     const double penalty = free_slacks_ ? nu_ : rho_;
     const double phi = system_.assembledMerit(d.cost, mu_, penalty);
@@ -292,7 +227,7 @@ class GridSolve {
 
   /// A direction the line search rejects: at the round-off floor the iterate is as good as it
   /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times.
-  Next rejected(const StopTest& t) {
+  Next rejected(const StopVerdict& t) {
     if (t.at_floor) {
       std::ostringstream why;
       why << "converged to the round-off floor (relative Newton decrement " << t.relative_decrement
@@ -339,10 +274,7 @@ class GridSolve {
       ++penalty_raises_;
       rho_ *= p_.penalty_growth;
       mu_ = mu_start_;
-      best_violation_ = kInfinity;
-      last_violation_progress_ = iteration_;
-      best_final_decrement_ = kInfinity;
-      stalled_iterations_ = 0;
+      test_.restart(iteration_);
       system_.initializeMultipliers(
           mu_, rho_, p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
       return Next::Continue;
@@ -422,9 +354,9 @@ class GridSolve {
       inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
   KktBlocks<Scalar> kkt_blocks_;  ///< the condensed system (a band: no global unknowns at fixed h)
   BandKkt<Scalar> kkt_;
+  DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;
-  double stall_acceptance_ = 0.0;
   double mu_ = 0.0, mu_start_ = 0.0;
   double rho_ = 0.0;  ///< elastic penalty ρ
   double nu_ = 0.0;   ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
@@ -434,13 +366,6 @@ class GridSolve {
   int iteration_ = 0;
   double relative_decrement_ = 0.0;
   int penalty_raises_ = 0;
-  int stalled_iterations_ = 0;
-  double best_violation_ = kInfinity;
-  int last_violation_progress_ = 0;
-  double best_final_decrement_ = kInfinity;
-  double previous_decrement_ = kInfinity;
-  double previous_alpha_ = 0.0;  ///< the last accepted step length
-  bool previous_at_final_barrier_ = false;
   std::vector<IterationInfo> history_;
   Termination ending_ = Termination::NotConverged;
   std::string reason_ = "iteration limit reached";

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include <Eigen/Core>
 
@@ -90,5 +91,17 @@ class BorderedBandKkt final : public KktSystem<Scalar> {
 /// The implementation for m global unknowns (the loop never asks which).
 template <typename Scalar>
 std::unique_ptr<KktSystem<Scalar>> makeKkt(int globals);
+
+/// The least eigenpair of a K (m ≥ 1: the bordered band) that is not positive definite, from
+/// banded factorizations alone: λ_min ≤ 0 as the largest σ ≤ 0 with K − σI positive definite
+/// (bisection from a Gershgorin bound), then inverse iteration just below it (kkt_system.cpp).
+/// nullopt where even the Gershgorin shift does not factor. Free time's second-order check calls
+/// it once per converged solve whose barrier Hessian is not definite.
+struct LeastEigenpair {
+  double value = 0.0;      ///< the Rayleigh quotient of `vector`
+  Eigen::VectorXd vector;  ///< unit, n + m entries
+  double scale = 0.0;      ///< K's mean |diagonal|
+};
+std::optional<LeastEigenpair> leastEigenpair(const KktBlocks<double>& kkt);
 
 }  // namespace attitude_planner

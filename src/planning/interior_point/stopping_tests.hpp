@@ -1,0 +1,82 @@
+// The interior point's stopping tests, one per profile: the decrement test (fixed h: the Newton
+// decrement of φ_μ at μ_final, with its stall and round-off rules) and the KKT residual test (free
+// time: stationarity and duality gap of the Lagrangian at μ_final).
+#pragma once
+
+#include "planning/interior_point/interior_point_parameters.hpp"
+
+namespace attitude_planner {
+
+/// The decrement test's verdict on one direction.
+struct StopVerdict {
+  double relative_decrement = 0.0;
+  bool at_final_barrier = false;
+  bool violated = false;
+  bool at_floor = false;    ///< at μ_final, feasible, at the round-off floor of the decrement
+  bool final_step = false;  ///< this step is the barrier problem's last
+};
+
+/// What the decrement test reads of one direction and the iterate.
+struct DecrementProbe {
+  double decrement_slope = 0.0;  ///< the slope the decrement is measured on (≤ 0)
+  double shift = 0.0;            ///< the inertia correction used
+  bool at_final_barrier = false;
+  double max_violation = 0.0;  ///< the largest elastic violation at the iterate
+  int iteration = 0;
+  double f_scale = 1.0;  ///< the start's cost (floored): the decrement's scale
+};
+
+/// Fixed h: the relative Newton decrement √(−slope / 2 f_scale) of φ_μ. A barrier problem at
+/// μ_final ends when the decrement reaches the tolerance on an unshifted system, when full steps
+/// stall at the condensed system's round-off, when quadratic convergence is seen (Mehrotra), or
+/// when a violation no iteration reduces any more (a local minimum of the ℓ1 infeasibility).
+class DecrementTest {
+ public:
+  DecrementTest(const InteriorPointParameters& parameters, double tolerance, int steps,
+                bool mehrotra, bool free_slacks);
+  StopVerdict check(const DecrementProbe& probe);
+  /// After an accepted step of length `alpha` with verdict `v`.
+  void accepted(const StopVerdict& v, double alpha);
+  /// After a penalty raise (a new barrier problem from μ₀): the stall memory starts again.
+  void restart(int iteration);
+  /// The last accepted step's relative decrement (+∞ before the first).
+  double previousDecrement() const { return previous_decrement_; }
+
+ private:
+  void countStalls(const StopVerdict& t);
+  bool violationStalled(bool violated, double violation, int iteration);
+
+  const InteriorPointParameters& p_;
+  double tolerance_, stall_acceptance_;
+  bool mehrotra_, free_slacks_;
+  int stalled_iterations_ = 0;
+  double best_violation_;
+  int last_violation_progress_ = 0;
+  double best_final_decrement_;
+  double previous_decrement_;
+  double previous_alpha_ = 0.0;  ///< the last accepted step length
+  bool previous_at_final_barrier_ = false;
+};
+
+/// Free time: converged at μ_final where the Lagrangian's stationarity is within the tolerance
+/// (× max(1, (N/256)²): torques are second differences of the attitudes, so their round-off and
+/// the stationarity's floor grow like N²; measured 2e-10 at N = 512, above 1e-9 at 1024) and the
+/// duality gap Σ zc within the tolerance.
+class KktResidualTest {
+ public:
+  KktResidualTest(double tolerance, int steps);
+  bool converged(double stationarity, double gap) const {
+    return stationarity <= stationarity_tolerance_ && gap <= tolerance_;
+  }
+  /// Where no descent step is left: both residuals within kRoundOffFloor of their tolerances.
+  bool atRoundOffFloor(double stationarity, double gap) const {
+    return stationarity <= kRoundOffFloor * stationarity_tolerance_ &&
+           gap <= kRoundOffFloor * tolerance_;
+  }
+
+ private:
+  static constexpr double kRoundOffFloor = 100.0;
+  double tolerance_, stationarity_tolerance_;
+};
+
+}  // namespace attitude_planner

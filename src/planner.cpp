@@ -18,8 +18,14 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
     return planToAccuracy(problem, options);  // one request per resolution it tries
   }
   SolveContext context(options);
-  if (problem.objective == Objective::MinimumTime) return planMinimumTime(problem, context);
-  return planBoundedMinimumEffort(problem, context);
+  PlanResult result = problem.objective == Objective::MinimumTime
+                          ? planMinimumTime(problem, context)
+                          : planBoundedMinimumEffort(problem, context);
+  // The request's iterations are the ones its context numbered (every solve of the package's own
+  // solvers reports there), not the drivers' sums, which dropped the solves a later phase
+  // replaced (measured: minimum time 30 counted of 1,542 run). NLopt counts its own.
+  if (options.solver == SolverKind::Structured) result.iterations = context.iterations();
+  return result;
 }
 
 }  // namespace attitude_planner

@@ -119,6 +119,45 @@ DriftPlanOutcome planDriftRequest(const PlanDriftTwoInput::Request& req,
   return out;
 }
 
+PlanAttitudeManeuverFeedback iterationFeedback(const IterationInfo& info, double elapsed_s) {
+  PlanAttitudeManeuverFeedback feedback;
+  feedback.iteration = info.iteration;
+  feedback.cost = info.cost;
+  feedback.residual = info.gradient_norm;
+  feedback.step_length = info.step_length;
+  feedback.elapsed = elapsed_s;
+  feedback.steps = info.steps;
+  feedback.effort = info.effort;
+  feedback.attempt = info.attempt.number;
+  feedback.stage = info.attempt.number > 0 ? attemptStageName(info.attempt.stage) : "";
+  feedback.long_way = info.attempt.homotopy.long_way;
+  feedback.extra_revolutions = info.attempt.homotopy.extra_revolutions;
+  return feedback;
+}
+
+std::optional<PlanAttitudeManeuverFeedback> keptAttemptFeedback(const PlanOutcome& outcome,
+                                                                int last_iteration) {
+  if (!outcome.solver_ran) return std::nullopt;
+  const PlanResult& r = outcome.result;
+  PlanAttitudeManeuverFeedback feedback;
+  feedback.iteration = last_iteration;
+  feedback.cost = r.cost;
+  feedback.residual = r.max_residual;
+  feedback.elapsed = outcome.wall_time_s;
+  feedback.steps = r.maneuver.steps();
+  feedback.effort = r.effort;
+  feedback.kept = true;
+  const auto kept =
+      std::find_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; });
+  if (kept != r.attempts.end()) {
+    feedback.attempt = static_cast<int>(kept - r.attempts.begin()) + 1;
+    feedback.stage = attemptStageName(kept->stage);
+    feedback.long_way = kept->homotopy.long_way;
+    feedback.extra_revolutions = kept->homotopy.extra_revolutions;
+  }
+  return feedback;
+}
+
 void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world_frame,
                        const std::string& body_frame, PlanDriftTwoInput::Response* res) {
   res->success = outcome.error_code == PlanErrorCode::SUCCESS;
@@ -467,21 +506,18 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
       const double waited = (ros::WallTime::now() - goal.accepted).toSec();
       solve_request.time_budget = std::max(goal.budget - waited, 1e-6);
     }
-    PlanAttitudeManeuverFeedback feedback;
+    int last_iteration = 0;
     const PlanOutcome outcome = planRequest(
         solve_request, defaults_,
         [&](const IterationInfo& info, double elapsed) {
-          feedback.iteration = info.iteration;
-          feedback.cost = info.cost;
-          feedback.residual = info.gradient_norm;
-          feedback.step_length = info.step_length;
-          feedback.elapsed = elapsed;
-          feedback.steps = info.steps;
-          feedback.effort = info.effort;
-          handle.publishFeedback(feedback);
+          last_iteration = info.iteration;
+          handle.publishFeedback(iterationFeedback(info, elapsed));
           return true;  // the cancel reaches the core through goal.cancel
         },
         goal.cancel.get());
+    if (const auto kept = keptAttemptFeedback(outcome, last_iteration)) {
+      handle.publishFeedback(*kept);
+    }
     fillResponse(outcome, world_frame_, body_frame_, &result);
   } catch (const std::exception& e) {
     result = PlanAttitudeManeuverResult();

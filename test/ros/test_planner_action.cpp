@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -71,11 +72,20 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   struct Seen {
     std::atomic<int> feedbacks{0};
     std::atomic<int> last_iteration{0};
+    std::mutex mutex;
+    std::vector<PlanAttitudeManeuverFeedback> kept;  ///< the messages marked kept
   };
   auto seen = std::make_shared<Seen>();
   client_->sendGoal(seed(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
                     [seen](const PlanAttitudeManeuverFeedbackConstPtr& f) {
+                      if (f->kept) {  // the last message: the returned plan's figures
+                        std::lock_guard<std::mutex> lock(seen->mutex);
+                        seen->kept.push_back(*f);
+                        return;
+                      }
                       EXPECT_GT(f->iteration, seen->last_iteration.load());  // increasing
+                      EXPECT_GT(f->attempt, 0);
+                      EXPECT_FALSE(f->stage.empty());
                       EXPECT_TRUE(std::isfinite(f->cost));
                       EXPECT_GE(f->residual, 0.0);
                       // The grid level (continuation from N = 16 up to the requested 32) and
@@ -98,9 +108,25 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_GE(result->replay_miss, result->terminal_attitude_error);
   EXPECT_LT(result->replay_miss, 1e-8);
   // Feedback and result travel on different topics: allow the last feedback to land.
-  waitFor([&] { return seen->last_iteration >= result->iterations; }, 5.0);
+  waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(seen->mutex);
+        return !seen->kept.empty();
+      },
+      5.0);
   EXPECT_GT(seen->feedbacks.load(), 0) << "no feedback received";
   EXPECT_LE(seen->last_iteration.load(), result->iterations);
+  // Issue 43: the feedback ends on the kept attempt, with the result's figures.
+  std::lock_guard<std::mutex> lock(seen->mutex);
+  ASSERT_EQ(seen->kept.size(), 1u);
+  const PlanAttitudeManeuverFeedback& kept = seen->kept.front();
+  EXPECT_EQ(kept.iteration, seen->last_iteration.load());
+  EXPECT_EQ(kept.cost, result->cost);
+  EXPECT_EQ(kept.effort, result->effort);
+  ASSERT_GE(kept.attempt, 1);
+  ASSERT_LE(kept.attempt, static_cast<int>(result->attempts.size()));
+  EXPECT_TRUE(result->attempts[kept.attempt - 1].kept);
+  EXPECT_EQ(kept.stage, result->attempts[kept.attempt - 1].stage);
 }
 
 TEST_F(PlannerAction, CancelEndsPreemptedWithCancelled) {

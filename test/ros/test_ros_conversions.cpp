@@ -887,3 +887,45 @@ TEST(RosConversions, PointingRequestIsPlannedAndReportsItsTwist) {
   r.objective = "minimum_time";
   EXPECT_NE(invalidMessage(r).find("minimum_time"), std::string::npos) << invalidMessage(r);
 }
+
+TEST(ActionFeedback, IterationsNameTheirAttemptAndTheLastMessageIsTheKeptAttempts) {
+  // Issue 43: the feedback ended on a discarded attempt's iterate (effort 44 % above the
+  // result's). Each iteration's message carries its attempt's number, stage and class; the last
+  // one is the returned plan's, tagged with the kept attempt.
+  PlanAttitudeManeuver::Request r = seedRequest();
+  r.final_attitude = rc::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), M_PI - 0.05));
+  std::vector<PlanAttitudeManeuverFeedback> feedback;
+  const PlanOutcome out =
+      planRequest(r, rc::PlannerDefaults(), [&](const IterationInfo& info, double elapsed) {
+        feedback.push_back(iterationFeedback(info, elapsed));
+        return true;
+      });
+  ASSERT_EQ(out.error_code, PlanErrorCode::SUCCESS) << out.message;
+  ASSERT_FALSE(feedback.empty());
+  std::set<int> attempts;
+  for (const PlanAttitudeManeuverFeedback& f : feedback) {
+    EXPECT_GT(f.attempt, 0);
+    EXPECT_FALSE(f.kept);
+    EXPECT_TRUE(findByName(kAttemptStageNames, f.stage).has_value()) << f.stage;
+    attempts.insert(f.attempt);
+  }
+  EXPECT_GT(attempts.size(), 1u) << "near a half turn the survey solves more than one class";
+  const auto kept = keptAttemptFeedback(out, feedback.back().iteration);
+  ASSERT_TRUE(kept.has_value());
+  EXPECT_TRUE(kept->kept);
+  EXPECT_EQ(kept->iteration, feedback.back().iteration);
+  EXPECT_EQ(kept->cost, out.result.cost);
+  EXPECT_EQ(kept->effort, out.result.effort);
+  EXPECT_EQ(kept->steps, 32);
+  const std::vector<Attempt>& trail = out.result.attempts;
+  ASSERT_GE(kept->attempt, 1);
+  ASSERT_LE(kept->attempt, static_cast<int>(trail.size()));
+  const Attempt& a = trail[kept->attempt - 1];
+  EXPECT_TRUE(a.kept);
+  EXPECT_EQ(kept->stage, attemptStageName(a.stage));
+  EXPECT_EQ(kept->long_way, a.homotopy.long_way);
+  EXPECT_EQ(kept->extra_revolutions, a.homotopy.extra_revolutions);
+  // A request refused before solving has no kept attempt to report.
+  r.steps = -1;
+  EXPECT_FALSE(keptAttemptFeedback(planRequest(r, rc::PlannerDefaults(), nullptr), 0));
+}

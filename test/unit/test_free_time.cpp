@@ -844,7 +844,8 @@ TEST(FreeTime, SecondOrderCheckAgreesWithTheReducedHessianByFiniteDifferences) {
     ++(o.second_order_sufficient ? minima : saddles);
     return true;
   };
-  for (const ap::FreeTimeStart& st : ap::freeTimeStarts(p, true)) {
+  ap::SolveContext starts_context{options};
+  for (const ap::FreeTimeStart& st : ap::freeTimeStarts(p, true, starts_context)) {
     const std::optional<std::vector<ap::Matrix3>> start =
         ap::coneClearStart(p, st.attitudes, st.duration, options);
     if (!start) continue;

@@ -152,7 +152,8 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   const ap::PlanningProblem p = scene("min_time_keep_out", 64);
   const ap::PlanResult r = ap::planManeuver(p);
   ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
-  const std::size_t starts = ap::freeTimeStarts(p, true).size();
+  ap::SolveContext starts_context{ap::SolverOptions{}};
+  const std::size_t starts = ap::freeTimeStarts(p, true, starts_context).size();
   const auto solves = std::count_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return a.stage == ap::AttemptStage::MinimumTimeSolve;
   });
@@ -177,7 +178,7 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
       });
   EXPECT_EQ(box_escapes, 0);
   EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves - box_escapes),
-            ap::freeTimeStarts(box, true).size());
+            ap::freeTimeStarts(box, true, starts_context).size());
   EXPECT_TRUE(b.minimum_time.second_order_sufficient) << b.message;
 }
 

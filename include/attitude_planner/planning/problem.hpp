@@ -204,6 +204,62 @@ struct PlanningProblem {
   double time_margin = 0.0;
 };
 
+/// What an attempt was for: the role of one solve in the planner's order of attempts.
+enum class AttemptStage {
+  Solve,              ///< the request's own solve (a named class, or a warm start)
+  ClassSurvey,        ///< a class left free: one homotopy class solved on the survey grid
+  ClassRefine,        ///< a surveyed class carried to the requested grid, the cheapest kept
+  RateContinuation,   ///< spinning ends: from rest to rest, boundary rates raised in stages
+  CoastingRetry,      ///< spinning ends: from the coasting start after the others stalled
+  MoreStarts,         ///< a slow spinning solve: further starts in its class, the cheapest kept
+  Constrained,        ///< the interior point, after the unconstrained optimum violated a bound
+  ConstrainedRetry,   ///< the interior point once more (other formulation, or cones first)
+  FourthOrderCoarse,  ///< fourth_order: the N solve of its Richardson pair
+  FourthOrderFine,    ///< fourth_order: the 2N solve of its Richardson pair
+  MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
+  MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
+  MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
+  /// minimum_time: a minimum-effort solve at T*: fourth_order's non-binding second_order plan at
+  /// the pair's T* (the free-time plan itself is every other scheme's answer).
+  MinimumTimePolish,
+  ConstrainedClass,  ///< under constraints, a class left free: another class's whole solve
+};
+inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
+    {AttemptStage::Solve, "solve"},
+    {AttemptStage::ClassSurvey, "class_survey"},
+    {AttemptStage::ClassRefine, "class_refine"},
+    {AttemptStage::RateContinuation, "rate_continuation"},
+    {AttemptStage::CoastingRetry, "coasting_retry"},
+    {AttemptStage::MoreStarts, "more_starts"},
+    {AttemptStage::Constrained, "constrained"},
+    {AttemptStage::ConstrainedRetry, "constrained_retry"},
+    {AttemptStage::FourthOrderCoarse, "fourth_order_coarse"},
+    {AttemptStage::FourthOrderFine, "fourth_order_fine"},
+    {AttemptStage::MinimumTimeProbe, "minimum_time_probe"},
+    {AttemptStage::MinimumTimeMargin, "minimum_time_margin"},
+    {AttemptStage::MinimumTimeSolve, "minimum_time_solve"},
+    {AttemptStage::MinimumTimePolish, "minimum_time_polish"},
+    {AttemptStage::ConstrainedClass, "constrained_class"},
+};
+
+/// Which homotopy class a maneuver belongs to: the way round and the extra whole turns.
+struct HomotopyClass {
+  /// The other way round: the second-nearest lift of the rotation between the ends
+  /// (RotationDirection::LongWay); rest to rest, the other way than the shortest rotation.
+  bool long_way = false;
+  int extra_revolutions = 0;  ///< extra full turns in the sense of the way
+};
+
+/// The attempt an iteration belongs to (SolveContext::Scope), so that a convergence plot (the
+/// action's feedback) tells one attempt from the next and a discarded attempt from the kept one.
+struct AttemptTag {
+  /// 1, 2, ... in the order the request's attempts began (nested solves included); 0: outside
+  /// any attempt.
+  int number = 0;
+  AttemptStage stage = AttemptStage::Solve;
+  HomotopyClass homotopy;  ///< the class its start was in
+};
+
 /// Progress of one iteration, for feedback (action) and logging.
 struct IterationInfo {
   int iteration = 0;
@@ -214,6 +270,7 @@ struct IterationInfo {
   double step_length = 0.0;
   int steps = 0;        ///< N of the grid level iterated on (0: not reported)
   double effort = 0.0;  ///< h · cost at that level [N²·m²·s], comparable across levels
+  AttemptTag attempt;   ///< which attempt iterated (filled by SolveContext::reportIteration)
 };
 
 /// Solver settings. Defaults solve to round-off on the seed's examples.

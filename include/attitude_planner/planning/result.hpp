@@ -21,44 +21,6 @@ struct LevelSummary {
   std::string reason;             ///< why the level ended, one sentence
 };
 
-/// What an attempt was for: the role of one solve in the planner's order of attempts.
-enum class AttemptStage {
-  Solve,              ///< the request's own solve (a named class, or a warm start)
-  ClassSurvey,        ///< a class left free: one homotopy class solved on the survey grid
-  ClassRefine,        ///< a surveyed class carried to the requested grid, the cheapest kept
-  RateContinuation,   ///< spinning ends: from rest to rest, boundary rates raised in stages
-  CoastingRetry,      ///< spinning ends: from the coasting start after the others stalled
-  MoreStarts,         ///< a slow spinning solve: further starts in its class, the cheapest kept
-  Constrained,        ///< the interior point, after the unconstrained optimum violated a bound
-  ConstrainedRetry,   ///< the interior point once more (other formulation, or cones first)
-  FourthOrderCoarse,  ///< fourth_order: the N solve of its Richardson pair
-  FourthOrderFine,    ///< fourth_order: the 2N solve of its Richardson pair
-  MinimumTimeProbe,   ///< minimum_time: one duration tried by the search
-  MinimumTimeMargin,  ///< minimum_time with time_margin: the plan at (1 + m) T*
-  MinimumTimeSolve,   ///< minimum_time: one free-time interior-point solve from one start
-  /// minimum_time: a minimum-effort solve at T*: fourth_order's non-binding second_order plan at
-  /// the pair's T* (the free-time plan itself is every other scheme's answer).
-  MinimumTimePolish,
-  ConstrainedClass,  ///< under constraints, a class left free: another class's whole solve
-};
-inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
-    {AttemptStage::Solve, "solve"},
-    {AttemptStage::ClassSurvey, "class_survey"},
-    {AttemptStage::ClassRefine, "class_refine"},
-    {AttemptStage::RateContinuation, "rate_continuation"},
-    {AttemptStage::CoastingRetry, "coasting_retry"},
-    {AttemptStage::MoreStarts, "more_starts"},
-    {AttemptStage::Constrained, "constrained"},
-    {AttemptStage::ConstrainedRetry, "constrained_retry"},
-    {AttemptStage::FourthOrderCoarse, "fourth_order_coarse"},
-    {AttemptStage::FourthOrderFine, "fourth_order_fine"},
-    {AttemptStage::MinimumTimeProbe, "minimum_time_probe"},
-    {AttemptStage::MinimumTimeMargin, "minimum_time_margin"},
-    {AttemptStage::MinimumTimeSolve, "minimum_time_solve"},
-    {AttemptStage::MinimumTimePolish, "minimum_time_polish"},
-    {AttemptStage::ConstrainedClass, "constrained_class"},
-};
-
 /// Where an attempt's iterate started.
 enum class AttemptStart {
   Hermite,          ///< the rate-honouring Hermite curve to the chosen lift (newtonInitialSteps)
@@ -106,14 +68,6 @@ enum class Globalization {
 inline constexpr NamedValue<Globalization> kGlobalizationNames[] = {
     {Globalization::TrustRegion, "trust_region"},
     {Globalization::LineSearch, "line_search"},
-};
-
-/// Which homotopy class a maneuver belongs to: the way round and the extra whole turns.
-struct HomotopyClass {
-  /// The other way round: the second-nearest lift of the rotation between the ends
-  /// (RotationDirection::LongWay); rest to rest, the other way than the shortest rotation.
-  bool long_way = false;
-  int extra_revolutions = 0;  ///< extra full turns in the sense of the way
 };
 
 /// The class a request asks for (its direction and extra revolutions).

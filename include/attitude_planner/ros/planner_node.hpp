@@ -46,6 +46,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -96,6 +97,19 @@ template <class Request>
 PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaults& defaults,
                         const std::function<bool(const IterationInfo&, double)>& keep_going,
                         const std::atomic<bool>* cancel = nullptr);
+
+/// The action feedback of one reported iteration: its figures and the attempt it belongs to
+/// (IterationInfo::attempt), so that a convergence plot tells one attempt from the next.
+PlanAttitudeManeuverFeedback iterationFeedback(const IterationInfo& info, double elapsed_s);
+
+/// A goal's last feedback: the returned plan's cost, effort and N (residual: its max_residual),
+/// tagged with the attempt kept (kept true; attempt = its 1-based place in the result's
+/// attempts, 0 when the trail marks none) and numbered `last_iteration` (the last iteration
+/// reported: this message adds none). The feedback then ends on what the result holds, not on
+/// the last iterate of a discarded attempt; elapsed: the solve's wall time. Nothing when the
+/// solver did not run.
+std::optional<PlanAttitudeManeuverFeedback> keptAttemptFeedback(const PlanOutcome& outcome,
+                                                                int last_iteration);
 
 /// The error code and message of the exception being handled (call only inside a catch block):
 /// InvalidInput and StepTooLarge through errorCodeOf, named in the request's fields

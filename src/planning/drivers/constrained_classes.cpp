@@ -101,6 +101,7 @@ class ClassSearch {
         });
     options.unconstrained_optimum = surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
     try {
+      const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
       r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
     } catch (const StepTooLarge& e) {
       r.message = e.what();

@@ -179,6 +179,8 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   std::vector<Attempt> other_trail;
   PlanResult& other = fine_binds ? coarse : fine;
   if (other.minimum_duration < T_star) {
+    const SolveContext::Scope scope(context, AttemptStage::MinimumTimePolish,
+                                    homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
     PlanResult at_T_star = planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem,
                                                    T_star, other.maneuver, context);
     other_trail = at_T_star.attempts;
@@ -403,6 +405,8 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
     const std::vector<Attempt> search_trail = result.attempts;
     const Maneuver at_minimum_time = result.maneuver;
     result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
+      const SolveContext::Scope scope(context, AttemptStage::MinimumTimeMargin,
+                                      homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
       return planFromMinimumTime(problem, (1.0 + problem.time_margin) * T_star, at_minimum_time,
                                  pair, context);
     });
@@ -446,8 +450,11 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
                                const std::string& why, const PlanResult& minimum_time,
                                const RichardsonPair& pair, SolveContext& context) {
   const double T_star = minimum_time.minimum_duration;
-  PlanResult again =
-      planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, context);
+  PlanResult again = [&] {
+    const SolveContext::Scope scope(context, AttemptStage::ConstrainedRetry,
+                                    homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
+    return planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, context);
+  }();
   const std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
                            " s) after the first solve " + why;
   const bool was_infeasible = first.termination == Termination::Infeasible;

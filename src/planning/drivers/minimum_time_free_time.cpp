@@ -105,7 +105,7 @@ class FreeTimeMinimumTime {
         so3::angleBetween(problem_.initial_attitude, problem_.final_attitude) > 0;
     const std::vector<PlanningProblem> levels = freeTimeLevels(problem_);
     const PlanningProblem& coarsest = levels.front();
-    int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest));
+    int best = solveStarts(coarsest, freeTimeStarts(coarsest, rest_to_rest, context_));
     // Saddles are left where cones are present: without them the excursion axes reach the least
     // basin (Bilimoria–Wie, Betts: no descent went lower), and the descent from a far saddle
     // (Betts's eigenaxis slew, 20 % above T*) ran to the iteration limit (0.08 → 0.77 s at N = 64).
@@ -153,6 +153,7 @@ class FreeTimeMinimumTime {
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
                         double duration, AttemptStart kind, const StartDetail& detail,
                         const BarrierWatch& watch = {}) {
+    const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
     FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
                                       kFreeTimeMaxIterations, context_, watch);
     Attempt a;
@@ -304,7 +305,7 @@ class FreeTimeMinimumTime {
   int fromStartGrid(const PlanningProblem& grid, bool rest_to_rest, int best) {
     PlanningProblem fine = grid;
     fine.steps = kFreeTimeStartGrid;
-    std::vector<FreeTimeStart> starts = freeTimeStarts(fine, rest_to_rest);
+    std::vector<FreeTimeStart> starts = freeTimeStarts(fine, rest_to_rest, context_);
     for (FreeTimeStart& st : starts) st.name = "N = " + std::to_string(fine.steps) + " " + st.name;
     const std::size_t kept_attempt = best_attempt_;
     const std::size_t first = starts_.size();

@@ -81,6 +81,8 @@ class MinimumTimeSearch {
   /// T feasible (provesFeasible).
   bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out) {
     effort_.duration = T;
+    const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeProbe,
+                                    homotopyClassOf(effort_));
     SolverOptions o = context_.options();
     if (warm) {
       o.warm_start = warm;

@@ -82,8 +82,8 @@ FreeTimeStart geodesicStart(const PlanningProblem& problem) {
 /// free-time solve from it starts inside the bounds far more often than from the Hermite curve
 /// Newton starts from (measured: from the Hermite curves every start of several spinning
 /// requests went elastic and ran to the iteration limit, docs/results/bounded_verdicts.md).
-std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at,
-                                                 const HomotopyClass& c) {
+std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at, const HomotopyClass& c,
+                                                 SolveContext& context) {
   PlanningProblem in_class = at;
   in_class.objective = Objective::MinimumEffort;
   in_class.constraints.clear();
@@ -95,9 +95,10 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at,
   options.enumerate_classes = false;
   options.tolerance = kClassOptimumTolerance;
   try {
-    // A start, not an attempt of the request: its own context (a few Newton steps at the
-    // coarsest grid), outside the request's trail and iteration numbering.
-    SolveContext context(options);
+    // A start of the free-time solves (a few Newton steps at the coarsest grid), in the request's
+    // context: its iterations are reported and numbered with the request's, and its budget and
+    // cancel flag stop it (then it gives no start). Its attempts stay out of the answer's trail.
+    const SolveContext::Scope scope(context, AttemptStage::MinimumTimeSolve, c);
     const PlanResult r = solveWithNewton(in_class, options, context);
     if (r.converged()) return r.maneuver.attitude;
   } catch (const StepTooLarge& e) {  // no boundary step at the guess's h
@@ -115,7 +116,7 @@ constexpr HomotopyClass kSpinningStartClasses[] = {{false, 0}, {true, 0}, {false
 /// local minima in several classes, which one geodesic start misses
 /// (docs/results/bounded_verdicts.md). The class optima come first: they start inside the bounds
 /// most often, and the watch then stops the later starts that cannot beat the least T found.
-std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem) {
+std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem, SolveContext& context) {
   std::vector<FreeTimeStart> starts;
   PlanningProblem at = problem;
   at.duration = eigenaxisDurationGuess(problem);
@@ -124,7 +125,7 @@ std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem) {
     starts.back().detail.duration = at.duration;
   };
   for (const HomotopyClass& c : kSpinningStartClasses) {
-    if (std::optional<std::vector<Matrix3>> attitudes = classOptimum(at, c)) {
+    if (std::optional<std::vector<Matrix3>> attitudes = classOptimum(at, c, context)) {
       add(std::string("unconstrained optimum in the ") + (c.long_way ? "other-way" : "nearest") +
               " lift + " + std::to_string(c.extra_revolutions) + " turn(s)",
           AttemptStart::UnconstrainedOptimum, std::move(*attitudes));
@@ -261,8 +262,9 @@ std::vector<Vector3> excursionAxes(const Vector3& e) {
   return distinct;
 }
 
-std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest) {
-  if (!rest_to_rest) return spinningStarts(problem);
+std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,
+                                          SolveContext& context) {
+  if (!rest_to_rest) return spinningStarts(problem, context);
   const double T_eigenaxis = eigenaxisBangBangDuration(problem);
   PlanningProblem at = problem;
   at.duration = T_eigenaxis;

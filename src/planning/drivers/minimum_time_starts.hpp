@@ -53,8 +53,10 @@ std::vector<Vector3> excursionAxes(const Vector3& e);
 
 /// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
 /// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
-/// guess.
-std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest);
+/// guess, and the unconstrained optima of its classes, solved in `context` (the request's: its
+/// budget, cancel flag and iteration numbering).
+std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,
+                                          SolveContext& context);
 
 /// The smallest clearance of the free attitudes R_1..R_{N−1} to their cones' node bounds [rad]
 /// (+∞ without cones).

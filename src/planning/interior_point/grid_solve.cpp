@@ -144,7 +144,7 @@ class GridSolve {
                      mu_ <= scales_.mu_final, system_.maxViolation(), iteration_, scales_.f_scale});
     ReducedProblem::StepVectors trial;
     double alpha = 0.0;
-    if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test);
+    if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test, direction.cost);
     accept(trial, alpha);
     if (!report(direction.cost, test.relative_decrement, alpha)) {
       ++iteration_;
@@ -226,16 +226,21 @@ class GridSolve {
   }
 
   /// A direction the line search rejects: at the round-off floor the iterate is as good as it
-  /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times.
-  Next rejected(const StopVerdict& t) {
+  /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times. A retry is an
+  /// iteration (counted): it is reported too, at the same iterate (step 0).
+  Next rejected(const StopVerdict& t, double cost) {
     if (t.at_floor) {
       std::ostringstream why;
       why << "converged to the round-off floor (relative Newton decrement " << t.relative_decrement
           << ", the line search can no longer decrease the merit)";
       return end(Termination::Converged, why.str(), t.relative_decrement);
     }
+    if (inertia_.raiseFloor()) {
+      if (report(cost, t.relative_decrement, 0.0)) return Next::Continue;
+      ++iteration_;
+      return end(Termination::Cancelled, "cancelled");
+    }
     relative_decrement_ = t.relative_decrement;
-    if (inertia_.raiseFloor()) return Next::Continue;
     return end(Termination::NotConverged, "line search failed");
   }
 

@@ -384,6 +384,7 @@ Attempt attemptOf(const PlanningProblem& problem, const GridOutcome& outcome, At
 GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options,
                     const Solve& solve, AttemptStage stage, AttemptStart start,
                     std::vector<Attempt>* trail) {
+  const SolveContext::Scope scope(solve.context, stage, homotopyClassOf(problem));
   GridOutcome outcome = solveContinued(problem, options, solve);
   trail->push_back(attemptOf(problem, outcome, stage, start));
   return outcome;

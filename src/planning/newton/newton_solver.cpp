@@ -331,7 +331,10 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
   for (const HomotopyClass& c : distinctClasses(plan.levels.front())) {
     if (!walk->empty() && context.stopReason()) break;
-    Surveyed s = surveyClass(c, plan, context, settings, p);
+    Surveyed s = [&] {
+      const SolveContext::Scope scope(context, AttemptStage::ClassSurvey, c);
+      return surveyClass(c, plan, context, settings, p);
+    }();
     walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, pinnedToClass(survey_grid, c)),
               s.result, s.result.iterations);
     if (plans && s.result.converged()) plans->push_back({c, surveyedPlan(s, survey_grid)});
@@ -341,6 +344,7 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     if (unbeatable && !context.stopReason()) break;
     if (context.stopReason()) {
       if (!surveyed.back().on_requested_grid && !surveyed.back().steps.empty()) {
+        const SolveContext::Scope scope(context, AttemptStage::ClassRefine, c);
         const PlanResult carried = refineClass(surveyed.back(), plan, context, settings, p);
         walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                             pinnedToClass(problem, c)),
@@ -368,6 +372,7 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     if (!wanted || repeated) continue;
     if (context.stopReason()) return;
     refined_costs.push_back(s.result.cost);
+    const SolveContext::Scope scope(context, AttemptStage::ClassRefine, s.homotopy);
     const PlanResult refined = refineClass(s, plan, context, settings, p);
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),
@@ -597,6 +602,7 @@ void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, 
   const SolverOptions& options = context.options();
   const GridSettings settings{options.tolerance, options.max_iterations,
                               Globalization::TrustRegion};
+  const SolveContext::Scope scope(context, AttemptStage::Solve, homotopyClassOf(problem));
   PlanResult r = solveThroughGrids(problem, context, settings, options.warm_start, p);
   const AttemptStart start =
       options.warm_start ? AttemptStart::WarmStart : startOf(Method::ThroughGrids, problem, p);
@@ -676,6 +682,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
     solveRequestedClass(problem, context, &walk, p);
   }
   const auto run = [&](const RecipeEntry& entry, const PlanningProblem& in) {
+    const SolveContext::Scope scope(context, entry.stage, homotopyClassOf(in));
     std::optional<PlanResult> r = runEntry(entry, in, context, p);
     if (!r) return;
     const int own = r->iterations;

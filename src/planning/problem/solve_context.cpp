@@ -46,8 +46,21 @@ bool SolveContext::reportIteration(const IterationInfo& info) {
   if (!request_.on_iteration) return true;
   IterationInfo numbered = info;
   numbered.iteration = iterations_;
+  numbered.attempt = attempt_;
   if (!request_.on_iteration(numbered)) refused_by_callback_ = true;
   return !refused_by_callback_;
+}
+
+SolveContext::Scope::Scope(SolveContext& context, AttemptStage stage, const HomotopyClass& homotopy,
+                           Nested nested)
+    : context_(context),
+      previous_(context.attempt_),
+      previous_names_nested_(context.scope_names_nested_),
+      iterations_at_open_(context.iterations_) {
+  const bool inside = previous_.number > 0;
+  const bool renamed = inside && (previous_names_nested_ || stage == AttemptStage::Solve);
+  context_.attempt_ = {++context_.attempts_begun_, renamed ? previous_.stage : stage, homotopy};
+  context_.scope_names_nested_ = previous_names_nested_ || nested == Nested::ScopeStage;
 }
 
 void SolveContext::markKept(std::size_t index) {

@@ -55,6 +55,41 @@ class SolveContext : public Interruption {
     const SolverOptions* previous_;
   };
 
+  /// How a scope names the attempts begun inside it (the trail relabels them the same way).
+  enum class Nested {
+    /// Theirs, but an attempt of stage Solve (a solver's own solve) takes the scope's stage (a
+    /// minimum-time probe's Newton solve is a `minimum_time_probe`).
+    OwnStages,
+    /// The scope's stage, whatever they call themselves (the plan at (1 + margin) T* is a
+    /// `minimum_time_margin` however it was reached).
+    ScopeStage,
+  };
+  /// While alive, the iterations reported belong to a new attempt of `stage` in `homotopy`
+  /// (IterationInfo::attempt), numbered after every attempt begun before it, its stage named by
+  /// the enclosing scopes (Nested); when it ends the enclosing attempt's tag comes back.
+  class Scope {
+   public:
+    Scope(SolveContext& context, AttemptStage stage, const HomotopyClass& homotopy,
+          Nested nested = Nested::OwnStages);
+    ~Scope() {
+      context_.attempt_ = previous_;
+      context_.scope_names_nested_ = previous_names_nested_;
+    }
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+    /// Iterations reported while it was open, its nested attempts' included.
+    int iterations() const { return context_.iterations_ - iterations_at_open_; }
+
+   private:
+    SolveContext& context_;
+    AttemptTag previous_;
+    bool previous_names_nested_;
+    int iterations_at_open_;
+  };
+  /// The attempt the iterations reported now belong to (number 0 outside every Scope).
+  const AttemptTag& currentAttempt() const { return attempt_; }
+
   Clock::time_point start() const { return start_; }
   double elapsedSeconds() const;
   /// Seconds left before the deadline (+∞ without a budget, 0 once spent).
@@ -70,8 +105,8 @@ class SolveContext : public Interruption {
   void poll() const override;
 
   /// Reports one iteration to request().on_iteration, numbered across every attempt of the
-  /// request (1, 2, ...); returns false if the caller asked to stop (then stopReason() is
-  /// Cancelled from here on).
+  /// request (1, 2, ...) and tagged with the current attempt (currentAttempt()); returns false if
+  /// the caller asked to stop (then stopReason() is Cancelled from here on).
   bool reportIteration(const IterationInfo& info);
   /// Whether a caller reads the reports (options().on_iteration set): figures that cost a pass
   /// over the grid are formed only then.
@@ -92,6 +127,9 @@ class SolveContext : public Interruption {
   Clock::time_point start_;
   int iterations_ = 0;
   bool refused_by_callback_ = false;
+  int attempts_begun_ = 0;
+  AttemptTag attempt_;
+  bool scope_names_nested_ = false;  ///< an open scope is Nested::ScopeStage
   std::vector<Attempt> attempts_;
 };
 

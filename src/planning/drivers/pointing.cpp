@@ -128,7 +128,8 @@ std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey,
 TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveContext& context,
                 const NewtonParameters& p) {
   TwistRun run = from;
-  run.solve.iterations = 0;  // the refinement's own levels (the survey is its own attempt)
+  // The refinement's own levels, as the context counted them (the survey is its own attempt).
+  const int counted_before = context.iterations();
   run.history.clear();
   int steps = from.steps;
   while (steps < problem.steps && !context.stopReason()) {
@@ -140,9 +141,9 @@ TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveConte
     TwistRun next =
         runTwist(at, run.solve.twist, from.homotopy, &run.iterate, tolerance, context, p);
     next.start_twist = from.start_twist;
-    next.solve.iterations += run.solve.iterations;
     next.history.insert(next.history.begin(), run.history.begin(), run.history.end());
     run = std::move(next);
+    run.solve.iterations = context.iterations() - counted_before;
     if (!run.converged()) break;
   }
   return run;
@@ -234,8 +235,6 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     result.cost = std::numeric_limits<double>::quiet_NaN();
   }
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());
-  result.iterations = 0;
-  for (const Attempt& a : result.attempts) result.iterations += a.iterations;
   result.pointing.starts = static_cast<int>(survey.size());
   if (result.attempts.size() > 1 && kept) {
     std::ostringstream brief;
@@ -262,6 +261,7 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   const SolveContext::Call call(context, options);
   const NewtonParameters& p = newtonDefaults();
   const std::size_t first_recorded = context.attempts().size();
+  const int counted_at_start = context.iterations();
   const int survey_steps = surveySteps(problem, p);
   const bool on_requested = survey_steps == problem.steps;
   const double survey_tolerance =
@@ -285,7 +285,9 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
     // Nothing of the survey grid's reached the requested one: the starts on the requested grid.
     runStarts(problem, problem.steps, options.tolerance, AttemptStage::Solve, context, p, &finals);
   }
-  return finishPointing(problem, survey, finals, first_recorded, context);
+  PlanResult result = finishPointing(problem, survey, finals, first_recorded, context);
+  result.iterations = context.iterations() - counted_at_start;  // every start, as reported
+  return result;
 }
 
 }  // namespace attitude_planner

@@ -1,4 +1,4 @@
-// accuracy_study: what accuracy costs in time (issue 6). For each scene and scheme, solves the
+// accuracy_study: what accuracy costs in time. For each scene and scheme, solves the
 // continuous reference, then plans at N = 16, 32, ..., max and records the three accuracy
 // measures (accuracy.hpp) and the median solve time; then plans to requested accuracies and
 // compares the planner's estimate with the actual error. Writes one JSON object (raw data for

@@ -1580,7 +1580,7 @@ int quick() {
   return failures == 0 ? 0 : 1;
 }
 
-// ---- the seeded randomized suite (issue 19, item 5) ------------------------------------------
+// ---- the seeded randomized suite ------------------------------------------
 
 struct SuiteRow {
   ap::robustness::RandomCase c;

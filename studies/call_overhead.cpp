@@ -1,5 +1,5 @@
-// call_overhead: the C++ side of the Python call-overhead benchmark (issue 44;
-// scripts/python_benchmark, docs/results/python.md). Loads a scene, applies planning flags as
+// call_overhead: the C++ side of the Python call-overhead benchmark
+// (scripts/python_benchmark, docs/results/python.md). Loads a scene, applies planning flags as
 // plan_maneuver does and times planManeuver R times in this process; prints one wall time [s] per
 // line. The Python side times attitude_planner.plan on the same scene and flags in its own process,
 // in interleaved rounds.

@@ -1,4 +1,4 @@
-// Measures what the effects cost and what they change (issue 8). Writes docs/results/effects.md.
+// Measures what the effects cost and what they change. Writes docs/results/effects.md.
 // Usage: effects_report [SCENE_DIR=scenes] [OUT_DIR=docs/results]
 #include <algorithm>
 #include <chrono>

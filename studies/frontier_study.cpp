@@ -1,4 +1,4 @@
-// frontier_study: the accuracy-versus-solve-time frontier (issue 18). For each scene, solves the
+// frontier_study: the accuracy-versus-solve-time frontier. For each scene, solves the
 // continuous reference (continuous_reference.hpp), then, side by side in one process,
 //   ours      planManeuver (Newton) with every scheme of the scheme name table (kSchemeNames) at
 //             N = 8, 16, ..., --max-steps;

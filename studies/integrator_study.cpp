@@ -1,4 +1,4 @@
-// Measures the integrators (issue 2): long-run energy and momentum behaviour of both schemes on the
+// Measures the integrators: long-run energy and momentum behaviour of both schemes on the
 // free rigid body, and the seed's SO(2) check (Fig. 1). Writes docs/results/integrators.md and CSVs for
 // the plot script. Usage: integrator_study [OUT_DIR=docs/results]
 #include <chrono>
@@ -21,7 +21,7 @@ struct LongRun {
   double seconds = 0;
 };
 
-// Free rigid body J = diag(1,2,3), Ω0 = (0.6,0.5,0.4), h = 0.01, T = 2000 s (issue 2).
+// Free rigid body J = diag(1,2,3), Ω0 = (0.6,0.5,0.4), h = 0.01, T = 2000 s.
 LongRun longRun(SchemeKind kind, const std::string& csv_path) {
   const Matrix3 J = Vector3(1, 2, 3).asDiagonal();
   const double h = 0.01;

@@ -1,4 +1,4 @@
-// pointing_study (issue 41, pointing targets): seeded random pointing requests (random inertia,
+// pointing_study (pointing targets): seeded random pointing requests (random inertia,
 // b, d, R_0; rest and spinning starts; paper and second_order), each planned as one pointing
 // request and judged against a 5° sweep of fixed-attitude solves over the twist refined by golden
 // section (test_support::sweepTwist); the time of one pointing solve beside one fixed-attitude

@@ -1,4 +1,4 @@
-// robustness_report: runs the hard-case catalog of issue 7 (robustness_cases.hpp) and the
+// robustness_report: runs the hard-case catalog (robustness_cases.hpp) and the
 // hostile scene corpus, and writes docs/results/robustness.md with every measured figure. The
 // figures are those the tests assert (test_hard_cases, test_hostile_inputs); scripts/robustness
 // calls this with the request table written by test_ros_conversions and the last fuzz summary.

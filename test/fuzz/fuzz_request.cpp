@@ -1,4 +1,4 @@
-// libFuzzer target (issue 7): arbitrary bytes as a planning request, decoded the way the node
+// libFuzzer target: arbitrary bytes as a planning request, decoded the way the node
 // decodes PlanAttitudeManeuver (float64[9] inertia, quaternions checked for finiteness and unit
 // norm within 1e-3, then the core's validateProblem / validateOptions) and, if valid and small,
 // planned with a bounded budget. Only InvalidInput / StepTooLarge may escape validation; a

@@ -1,4 +1,4 @@
-// libFuzzer target (issue 7): arbitrary bytes as a scene file. The parser must either return a
+// libFuzzer target: arbitrary bytes as a scene file. The parser must either return a
 // scene or throw InvalidInput; a parsed rigid-body scene must survive validation, a formatScene
 // round trip and (small N only) a bounded plan whose result is finite. Anything else — another
 // exception type, a crash, a sanitizer report, a hang, a broken invariant (abort) — is a bug.

@@ -91,7 +91,7 @@ void expectStopped(const std::string& command, std::initializer_list<std::string
 TEST(NodeParameters, UnknownPlantOrModeStopsTheTrackerListingTheNames) {
   expectStopped(kTracker + " __name:=bad_plant _plant:=outside",
                 {"/bad_plant/plant = outside is invalid", "external"});
-  // Before issue 43 a bad ~mode printed FATAL and exited 0.
+  // Before, a bad ~mode printed FATAL and exited 0.
   expectStopped(kTracker + " __name:=bad_mode _mode:=autopilot",
                 {"/bad_mode/mode = autopilot is invalid", "feedback"});
 }

@@ -306,7 +306,7 @@ TEST_F(PlannerAction, FourthOrderGoalSucceeds) {
   EXPECT_NEAR(result->effort, goal.duration / 32 * result->cost, 1e-12 * result->effort);
 }
 
-// ---- issue 31: an action that keeps its promises ---------------------------------------------
+// ---- an action that keeps its promises ---------------------------------------------
 
 /// A goal the solver never finishes: N = 1e5 with an unreachable tolerance and a long budget; it
 /// ends only when cancelled.

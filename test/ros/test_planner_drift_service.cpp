@@ -75,7 +75,7 @@ TEST_F(PlannerDriftService, WorkedExampleReachesTheTargetAttitude) {
     EXPECT_EQ(m.control[k].z, 0.0);
   }
   EXPECT_EQ(rc::vectorFromMsg(m.costate.front()), rc::vectorFromMsg(res.initial_costate));
-  // The worked example's least-cost extremal found (docs/design/drift_two_input.md, issue 19): cost
+  // The worked example's least-cost extremal found (docs/design/drift_two_input.md): cost
   // 3.752939785 at every N; the extremal of cost 4.02383 returned before is reported among the
   // others.
   EXPECT_NEAR(res.cost, 3.752939785104, 1e-9);

@@ -467,7 +467,7 @@ TEST_F(PlannerService, MinimumTimeReturnsTStarAndTheMarginPlan) {
   EXPECT_TRUE(call(seed(16)).success);
 }
 
-// ---- issue 31: a service for people and programs --------------------------------------------
+// ---- a service for people and programs --------------------------------------------
 
 TEST_F(PlannerService, OutputStepsDecimatesToTheAskedSizeWithBothEnds) {
   // N = 1000, at most 11 nodes: stride ceil(1000 / 10) = 100, k = 0, 100, ..., 1000.

@@ -641,7 +641,7 @@ TEST(PrincipalBox, NonPhysicalInertiaStillGetsAVisibleBox) {
   EXPECT_NEAR(box.dimensions.minCoeff(), 0.1, 1e-12);
 }
 
-// ---- issue 31: errors in the request's fields, decimated answers, the deadline -----------------
+// ---- errors in the request's fields, decimated answers, the deadline -----------------
 
 TEST(RequestFieldNames, SceneKeysMapToTheRequestsFields) {
   const std::pair<const char*, const char*> cases[] = {

@@ -1,4 +1,4 @@
-// rostest (tracker_constraint_health.test): constraint health of the tracker (issue 43).
+// rostest (tracker_constraint_health.test): constraint health of the tracker.
 // - scenes/torque_limited.yaml re-planned with its torque limits active (/limited_replan) beside
 //   the law alone (/limited_feedback): no failed re-plan and a terminal error no worse than
 //   feedback's (before: 4 of 9 re-plans "infeasible" — planned from the body's rate at the node

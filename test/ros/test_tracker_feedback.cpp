@@ -27,7 +27,7 @@ TEST(TrackerFeedback, ClosedLoopTerminalErrorsAreAnOrderOfMagnitudeBelowOpenLoop
       "torque", 1000, [&](const geometry_msgs::WrenchStamped::ConstPtr&) { ++samples; });
   ros::Subscriber error_sub = feedback_nh.subscribe<std_msgs::Float64>(
       "attitude_error", 1000, [&](const std_msgs::Float64::ConstPtr&) { ++error_samples; });
-  // Who publishes which body transform on /tf: each tracker its own (issue 43: both published
+  // Who publishes which body transform on /tf: each tracker its own (both published
   // world -> body before the default body frame came from the namespace).
   std::mutex tf_mutex;
   std::map<std::string, std::set<std::string>> publishers_of;  // child frame -> publishers

@@ -1,4 +1,4 @@
-// The hard-case catalog of issue 7 (robustness_cases.hpp). Each case states its pass criterion
+// The hard-case catalog (robustness_cases.hpp). Each case states its pass criterion
 // in words (HardCase::criterion) and checks exactly that in code next to it; bounds that differ
 // from the issue's defaults (terminal error ≤ 1e-9) say why.
 #include "support/robustness_cases.hpp"
@@ -339,7 +339,7 @@ void intermediateAxisSpin(Recorder& r) {
     // T = 60 s: the Newton iteration converges as fast, and the plan satisfies the discrete
     // equations step by step; only its open-loop replay (forward integration of the torques
     // from R_0, Ω_0) amplifies round-off by e^{λT} ≈ 1e15. That is a property of the motion,
-    // reported as replay_miss, not a reason to refuse the optimum (issue 19, item 3).
+    // reported as replay_miss, not a reason to refuse the optimum.
     const PlanResult res = planManeuver(p, one_class);
     r.record(label, p, res);
     iterations.push_back(res.iterations);

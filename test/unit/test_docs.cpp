@@ -137,7 +137,7 @@ TEST(CodeShape, NoSwitchOnAStageQuantityOutsideTheQuantityClasses) {
       quantityBranches(kSourceDir + "/src/planning/crosscheck", {}, &exempt_files).empty());
 }
 
-// One SolveContext per request (issue 40): the result's message and iteration count are to be
+// One SolveContext per request: the result's message and iteration count are to be
 // rendered from the context, not concatenated by drivers. Not there yet: this holds the count of
 // hand merges in src/planning at what is left (it may only fall; lower it when you remove some),
 // the target being 0 outside the context.

@@ -1,4 +1,4 @@
-// Effect models (issue 8): torques, Jacobians and second derivatives against definitions and
+// Effect models: torques, Jacobians and second derivatives against definitions and
 // finite differences; only the listed effects change a simulation.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The cheapest extremal by enumeration of homotopy classes (issue 30, item 3): a request that
+// The cheapest extremal by enumeration of homotopy classes: a request that
 // leaves its class free (direction shortest, no extra revolutions, no warm start) is answered by
 // the cheapest of the classes {nearest lift, the other way round} × {0, 1 extra revolution};
 // a request that names its class gets that class only; the trail lists each class with its cost.
@@ -207,7 +207,7 @@ bool triedConstrainedClasses(const PlanResult& r) {
 
 }  // namespace
 
-// Under constraints the classes are solved too (issue 30, items 2 and 3): where the unconstrained
+// Under constraints the classes are solved too: where the unconstrained
 // optimum's class cannot clear a cone, the answer is another class's plan, never "infeasible",
 // and it is the cheapest of the classes; the extremal names it.
 TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasibleClass) {

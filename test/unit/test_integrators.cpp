@@ -1,4 +1,4 @@
-// Integrators (issue 2): each scheme satisfies its defining equations, Jacobians match finite
+// Integrators: each scheme satisfies its defining equations, Jacobians match finite
 // differences, long runs stay on SO(3) and conserve what they should.
 #include <gtest/gtest.h>
 
@@ -92,7 +92,7 @@ TEST(Integrators, MomentumJacobianMatchesFiniteDifferences) {
   }
 }
 
-// The 1e6-step torque-free drift test lives in the hard-case catalog of issue 7
+// The 1e6-step torque-free drift test lives in the hard-case catalog
 // (TorqueFreeMillionSteps in test/support/robustness_cases.cpp, asserted by test_hard_cases).
 
 TEST(Integrators, VariationalEnergyDoesNotDriftOver2000Seconds) {

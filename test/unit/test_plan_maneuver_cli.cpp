@@ -484,7 +484,7 @@ TEST_F(CliTest, SimulateTorquesRejectsABadCsvNamingTheLine) {
   EXPECT_CONTAINS(r.output, "line 3");
 }
 
-// --warm-start PLAN.csv (issue 30): the re-plan from node k of a plan (a scene written from its
+// --warm-start PLAN.csv: the re-plan from node k of a plan (a scene written from its
 // row k) warm-started with the plan's remainder CSV returns the remainder (cost to 1e-8, ≤ 2
 // iterations); a plan of another N is resampled; a broken CSV is named with the flag; the
 // drift + two-input system refuses the flag.

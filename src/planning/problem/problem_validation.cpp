@@ -117,7 +117,7 @@ void requireFloatingPointRange(const PlanningProblem& p, const Vector3& moments)
 
 /// A pointing end condition: its vectors, and the requests the pointing solver serves (minimum
 /// effort, unconstrained, no effects, a direct scheme, the class left to the planner). The others
-/// are refused by name until the twist joins the interior point (issue 40's one transcription).
+/// are refused by name until the twist joins the interior point.
 void requirePointingServed(const PlanningProblem& p) {
   requirePointingVector(p.end_condition.body_axis, "final.pointing.body_axis");
   requirePointingVector(p.end_condition.world_direction, "final.pointing.world_direction");

@@ -170,6 +170,7 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"lower_bound_basis\": " << jsonString(r.duration_verdict.lower_bound_basis)
       << ", \"proven_infeasible\": " << (r.duration_verdict.proven_infeasible ? "true" : "false")
       << ", \"least_duration_found\": " << jsonNumber(r.duration_verdict.least_duration_found)
+      << ", \"longest_duration_found\": " << jsonNumber(r.duration_verdict.longest_duration_found)
       << "},\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"

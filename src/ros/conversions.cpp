@@ -142,6 +142,7 @@ DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& v) {
   msg.lower_bound_basis = v.lower_bound_basis;
   msg.proven_infeasible = v.proven_infeasible;
   msg.least_duration_found = v.least_duration_found;
+  msg.longest_duration_found = v.longest_duration_found;
   return msg;
 }
 

@@ -5,6 +5,7 @@
 // requests whose every verdict is checked independently (test/support/bounded_requests.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -244,4 +245,37 @@ TEST(BoundedVerdicts, SeededBoundedRequestsHaveHonestVerdicts) {
     EXPECT_EQ(check.wrong, "") << check.result.message;
   }
   EXPECT_GE(requests, 12);
+}
+
+TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
+  // Requests of the seeded suite (seed 45) whose T lies several times above T* with spinning
+  // ends, where the minimum-time plan time-scaled to T is no start. The answer either converges
+  // within its bounds at T (the ladder of durations from T*, in the trail), or is a local verdict
+  // that names T* and the longest duration it reached, below T, or says it did not converge;
+  // never "feasible" claimed from T* <= T alone (spinning ends: longer need not be feasible).
+  for (int i : {161, 168}) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    ASSERT_TRUE(request.has_value());
+    SCOPED_TRACE(request->label);
+    const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+    const PlanResult& r = check.result;
+    EXPECT_EQ(check.wrong, "") << r.message;
+    const bool climbed = std::any_of(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
+      return a.stage == AttemptStage::DurationLadder;
+    });
+    EXPECT_TRUE(climbed) << r.message;
+    const DurationVerdict& v = r.duration_verdict;
+    if (r.converged()) {
+      EXPECT_LE(checkConstraints(request->problem, r.maneuver).max_relative_violation, 1e-6);
+      EXPECT_EQ(v.longest_duration_found, 0.0);
+    } else if (r.termination == Termination::Infeasible) {
+      EXPECT_FALSE(v.proven_infeasible);
+      EXPECT_GT(v.least_duration_found, 0.0);
+      EXPECT_GE(v.longest_duration_found, v.least_duration_found);
+      EXPECT_LT(v.longest_duration_found, request->problem.duration);
+    } else {
+      EXPECT_EQ(r.termination, Termination::NotConverged) << r.message;
+      EXPECT_EQ(r.message.find("(feasible:"), std::string::npos) << r.message;
+    }
+  }
 }

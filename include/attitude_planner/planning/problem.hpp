@@ -223,6 +223,9 @@ enum class AttemptStage {
   /// the pair's T* (the free-time plan itself is every other scheme's answer).
   MinimumTimePolish,
   ConstrainedClass,  ///< under constraints, a class left free: another class's whole solve
+  /// bounded minimum effort at T > T*: one duration of the ladder climbed from the minimum-time
+  /// plan when the direct start from it did not converge
+  DurationLadder,
 };
 inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::Solve, "solve"},
@@ -240,6 +243,7 @@ inline constexpr NamedValue<AttemptStage> kAttemptStageNames[] = {
     {AttemptStage::MinimumTimeSolve, "minimum_time_solve"},
     {AttemptStage::MinimumTimePolish, "minimum_time_polish"},
     {AttemptStage::ConstrainedClass, "constrained_class"},
+    {AttemptStage::DurationLadder, "duration_ladder"},
 };
 
 /// Which homotopy class a maneuver belongs to: the way round and the extra whole turns.

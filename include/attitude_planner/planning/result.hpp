@@ -198,6 +198,10 @@ struct DurationVerdict {
   /// The least T [s] at which a plan meeting the bounds was found (a local minimum-time plan:
   /// not a requirement); 0: none was found or sought.
   double least_duration_found = 0.0;
+  /// With spinning ends, a request's T above the durations at which plans were found from the
+  /// minimum-time plan: the longest T [s] at which one was (where the ladder of durations from
+  /// T* stopped: not a limit); 0: none was sought.
+  double longest_duration_found = 0.0;
 };
 
 /// A pointing end condition's answer (PlanningProblem::end_condition); `active` false otherwise.

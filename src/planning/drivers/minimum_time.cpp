@@ -17,6 +17,7 @@
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
+#include "planning/strategies/staged_continuation.hpp"
 #include "planning/strategies/starts.hpp"
 
 namespace attitude_planner {
@@ -444,19 +445,153 @@ std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResu
   return "left a bound by " + exactNumber(outside) + " (relative)";
 }
 
+/// The duration ladder's rungs: a first step of 15 % in T, up to 30 % after converged rungs,
+/// a failed rung's step halved down to 0.4 %, at most 24 rungs.
+constexpr double kLadderFirstRatio = 1.15;
+constexpr double kLadderLargestRatio = 1.3;
+constexpr double kLadderLeastRatio = 1.004;
+constexpr int kLadderRungs = 24;
+
+/// Where the duration ladder got: the plan at the requested T if it converged there, else the
+/// last solve's; `reached` the longest duration at which a rung converged within the bounds;
+/// every rung's attempts, the last rung's kept one marked.
+struct LadderClimb {
+  PlanResult plan;
+  double reached = 0.0;
+  std::vector<Attempt> attempts;
+};
+
+/// One rung: minimum effort at the stage's T from the last rung's plan, continued once from its
+/// own iterate where the iteration limit stopped it inside the bounds (the reduced problem's
+/// iterates meet the dynamics and the boundary data, so such an iterate is a start).
+PlanResult ladderRung(const PlanningProblem& rung, const Maneuver& from, SolveContext& context,
+                      std::vector<Attempt>* trail) {
+  const auto solve = [&](const Maneuver& start) {
+    const SolveContext::Scope scope(context, AttemptStage::DurationLadder, homotopyClassOf(rung),
+                                    SolveContext::Nested::ScopeStage);
+    PlanResult r = runInternalPhase("a rung of the duration ladder", [&] {
+      return planFromMinimumTimePlan(rung, rung.duration, start, context);
+    });
+    for (Attempt& a : *trail) a.kept = false;  // only the last rung's plan can be kept
+    appendTrail(r.attempts, true, trail);
+    return r;
+  };
+  PlanResult r = solve(from);
+  if (r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
+      checkConstraints(rung, r.maneuver).max_relative_violation <= kNodeConstraintTolerance) {
+    const Maneuver inside = r.maneuver;
+    r = solve(inside);
+  }
+  return r;
+}
+
+/// Minimum effort at T from the minimum-time plan at T* < T by a continuation in the duration,
+/// T(s) = T* (T/T*)^s (solveByAdaptiveStages; s = 0 is the minimum-time plan itself), each rung
+/// started from the last converged one (time-scaled). With spinning ends the plan at T* scaled
+/// to a T several times longer is no start: its end rates are off by T/T*; near each rung the
+/// last plan is.
+LadderClimb climbDurationLadder(const PlanningProblem& problem, const PlanResult& minimum_time,
+                                SolveContext& context) {
+  const double T_star = minimum_time.minimum_duration;
+  const double log_ratio = std::log(problem.duration / T_star);
+  const auto share = [&](double ratio) { return std::min(1.0, std::log(ratio) / log_ratio); };
+  AdaptiveSchedule schedule;
+  schedule.first_increment = share(kLadderFirstRatio);
+  schedule.max_increment = share(kLadderLargestRatio);
+  schedule.min_increment = share(kLadderLeastRatio);
+  schedule.max_stages = kLadderRungs;
+  const auto duration = [&](double s) {
+    return s >= 1.0 ? problem.duration : T_star * std::exp(s * log_ratio);
+  };
+  LadderClimb climb;
+  const StagedOutcome staged = solveByAdaptiveStages(
+      context,
+      [&](double s) {
+        PlanningProblem rung = problem;
+        rung.duration = duration(s);
+        return rung;
+      },
+      schedule,
+      [&](const PlanningProblem& rung, const Maneuver* from) {
+        return from ? ladderRung(rung, *from, context, &climb.attempts) : minimum_time;
+      });
+  climb.plan = staged.plan;
+  climb.reached = staged.reached > 0.0 ? duration(staged.reached) : 0.0;
+  for (Attempt& a : climb.attempts) a.stage = AttemptStage::DurationLadder;
+  return climb;
+}
+
+/// The ladder when the direct start did not converge (nothing climbed otherwise).
+LadderClimb climbIfStuck(const PlanningProblem& problem, const PlanResult& direct,
+                         const PlanResult& minimum_time, SolveContext& context) {
+  if (direct.converged() || problem.scheme == SchemeKind::FourthOrder ||
+      !(minimum_time.minimum_duration > 0.0)) {
+    return {};
+  }
+  return climbDurationLadder(problem, minimum_time, context);
+}
+
+bool restToRest(const PlanningProblem& problem) {
+  return problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0);
+}
+
+/// The answer when neither the direct start nor the ladder converged at T and the last solve
+/// ended at a local minimum of the violation. Rest to rest the plan at T* followed by rest is a
+/// plan at T: not converged, never "infeasible". With spinning ends a longer duration need not
+/// be feasible in the class of the plan at T* (the ladder's plans stop where the class folds):
+/// a local verdict naming the durations where plans were found.
+void labelStuckAnswer(const PlanningProblem& problem, double T_star, const LadderClimb& climb,
+                      PlanResult* again) {
+  std::ostringstream why;
+  if (restToRest(problem)) {
+    again->termination = Termination::NotConverged;
+    why << "not converged (feasible: T* = " << exactNumber(T_star)
+        << " s <= the requested duration and the ends are at rest, but the minimum-effort solve "
+           "from the minimum-time plan ended at an infeasible point): ";
+  } else if (climb.reached > 0.0) {
+    again->duration_verdict.least_duration_found = T_star;
+    again->duration_verdict.longest_duration_found = climb.reached;
+    why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
+        << exactNumber(problem.duration)
+        << " s; from the minimum-time plan (T* = " << exactNumber(T_star)
+        << " s) plans within the bounds were found up to T = " << exactNumber(climb.reached)
+        << " s, where the ladder of durations stopped (spinning ends: not a limit, other classes "
+           "may hold plans at T): ";
+  } else {
+    again->termination = Termination::NotConverged;
+    why << "not converged (a plan within the bounds exists at T* = " << exactNumber(T_star)
+        << " s < T, but with spinning ends a longer duration need not be feasible in its class; "
+           "the solves from it ended at infeasible points): ";
+  }
+  again->message = why.str() + again->message;
+}
+
 /// A bounded minimum-effort answer from the minimum-time plan at T* ≤ T (`first` the solve
-/// that needed it, `why` how it ended): the plan from T*'s, else `first` with what was tried.
+/// that needed it, `why` how it ended): the plan from T*'s, else the duration ladder's from
+/// there, else `first` with what was tried.
 PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult& first,
                                const std::string& why, const PlanResult& minimum_time,
                                const RichardsonPair& pair, SolveContext& context) {
   const double T_star = minimum_time.minimum_duration;
-  PlanResult again = [&] {
+  const PlanResult direct = [&] {
     const SolveContext::Scope scope(context, AttemptStage::ConstrainedRetry,
                                     homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
     return planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, context);
   }();
-  const std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
-                           " s) after the first solve " + why;
+  const LadderClimb climb = climbIfStuck(problem, direct, minimum_time, context);
+  const bool from_ladder = climb.plan.converged() && climb.reached == problem.duration;
+  PlanResult again = from_ladder ? climb.plan : direct;
+  std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
+                     " s) after the first solve " + why;
+  if (from_ladder) {
+    note += ", reached by a ladder of durations from T* (the direct start ended " +
+            terminationName(direct.termination) + ")";
+  } else if (!climb.attempts.empty()) {
+    note += "; a ladder of durations from T* " +
+            (climb.reached > 0.0 ? "found plans within the bounds up to T = " +
+                                       exactNumber(climb.reached) + " s, not at T"
+                                 : std::string("found no plan within the bounds above T*"));
+  }
   const bool was_infeasible = first.termination == Termination::Infeasible;
   if (!again.converged() && !was_infeasible) {
     // Nothing better than the first answer: it stays, with what was tried.
@@ -464,22 +599,18 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
     kept.message += note + ": " + terminationName(again.termination) + " (" + again.message + ")";
     return kept;
   }
-  if (again.termination == Termination::Infeasible) {
-    // Feasible at T* ≤ T, yet not reached from T*'s plan: not a proof of infeasibility.
-    again.termination = Termination::NotConverged;
-    again.message = "not converged (feasible: T* = " + exactNumber(T_star) +
-                    " s <= the requested duration, but the minimum-effort solve from the "
-                    "minimum-time plan ended at an infeasible point): " +
-                    again.message;
-  }
+  if (again.termination == Termination::Infeasible)
+    labelStuckAnswer(problem, T_star, climb, &again);
   again.message += note;
   std::vector<Attempt> attempts = first.attempts;
   appendTrail(minimum_time.attempts, false, &attempts);
-  for (Attempt a : again.attempts) {
+  for (Attempt a : direct.attempts) {
     a.stage = AttemptStage::ConstrainedRetry;
     a.start = AttemptStart::WarmStart;
+    a.kept = a.kept && !from_ladder;
     attempts.push_back(a);
   }
+  appendTrail(climb.attempts, from_ladder, &attempts);
   again.attempts = attempts;
   return again;
 }

@@ -2,20 +2,24 @@
 // (interior_point/kkt_system.hpp, inertia_correction.hpp) against dense Eigen solves of the same
 // shifted matrices, the least eigenpair against Eigen's dense eigensolver; the monotone barrier
 // rule's two profiles (barrier_update.hpp) and the two stopping tests (stopping_tests.hpp) against
-// their closed forms.
+// their closed forms; the Armijo line search (line_search.hpp) on one-dimensional merits whose
+// accepted step length is found by enumerating the halvings independently.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/line_search.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 
 namespace ap = attitude_planner;
@@ -273,4 +277,144 @@ TEST(StoppingTests, DecrementTestEndsAtTheToleranceAndOnAStalledViolation) {
   stalled.restart(p.violation_stall);  // a penalty raise: the patience starts again
   EXPECT_FALSE(
       stalled.check({-1.0, 0.0, false, violation, p.violation_stall + 1, f_scale}).final_step);
+}
+
+namespace {
+
+/// A one-dimensional barrier problem φ(x) with admissible region x < wall, recording what the line
+/// search asked of it. `corrected`: the second-order correction it offers (none if 0).
+class LineProblem final : public ap::BarrierProblem {
+ public:
+  LineProblem(std::function<double(double)> phi, double wall, double corrected = 0.0)
+      : phi_(std::move(phi)), wall_(wall), corrected_(corrected) {}
+  double merit() override { return phi_(accepted_); }
+  double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
+    ++trials;
+    if (moved) *moved = false;
+    if (accepted_ + alpha * d(0) >= wall_) return std::numeric_limits<double>::infinity();
+    moveTo(d, alpha);
+    if (moved) *moved = true;
+    return phi_(x);
+  }
+  void moveTo(const Eigen::VectorXd& d, double alpha) override { x = accepted_ + alpha * d(0); }
+  void restore() override {
+    ++restores;
+    x = accepted_;
+  }
+  bool correctedStep(const Eigen::VectorXd&, Eigen::VectorXd* corrected) override {
+    if (corrected_ == 0.0) return false;
+    *corrected = Eigen::VectorXd::Constant(1, corrected_);
+    return true;
+  }
+  void clearCorrection() override { ++clears; }
+  double x = 0.0;
+  int trials = 0, restores = 0, clears = 0;
+
+ private:
+  std::function<double(double)> phi_;
+  double wall_, corrected_;
+  double accepted_ = 0.0;
+};
+
+/// The first of α₀, α₀/2, … (at most `halvings`) meeting Armijo's condition for φ along d from 0,
+/// or NaN: the closed form of a backtracking search, enumerated.
+double firstArmijoStep(const std::function<double(double)>& phi, double d, double slope,
+                       double alpha0, int halvings, double wall) {
+  const double armijo = ap::InteriorPointParameters{}.armijo;
+  double alpha = alpha0;
+  for (int i = 0; i < halvings; ++i, alpha /= 2) {
+    if (alpha * d < wall && phi(alpha * d) <= phi(0.0) + armijo * alpha * slope) return alpha;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+TEST(LineSearch, ArmijoBacktrackingTakesTheFirstHalvingThatDecreasesEnough) {
+  const ap::InteriorPointParameters p;
+  const ap::ArmijoBacktracking search(ap::fixedStepLineSearch(p));
+  // φ = x⁴ − x along d = 4 (slope −1): the full step overshoots, some halving is accepted; a
+  // wall at 0.9 rejects the steps that cross it.
+  const auto phi = [](double x) { return std::pow(x, 4) - x; };
+  for (const double wall : {100.0, 0.9}) {
+    LineProblem problem(phi, wall);
+    Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 4.0);
+    const ap::LineSearchResult r = search.search(problem, {-4.0, 1.0, false, false, false}, &d);
+    const double expected = firstArmijoStep(phi, 4.0, -4.0, 1.0, p.max_halvings, wall);
+    ASSERT_TRUE(r.accepted) << wall;
+    EXPECT_EQ(r.alpha, expected) << wall;
+    EXPECT_LT(r.alpha, 1.0);
+    EXPECT_EQ(problem.x, r.alpha * 4.0);  // left at the accepted trial point
+    EXPECT_EQ(problem.restores, 0);
+  }
+}
+
+TEST(LineSearch, AnAscentDirectionIsRejectedAfterEveryHalvingAndTheIterateRestored) {
+  const ap::InteriorPointParameters p;
+  const auto phi = [](double x) { return x * x + x; };  // d = +1 ascends from 0
+  for (const bool at_floor : {false, true}) {
+    LineProblem problem(phi, 100.0);
+    Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 1.0);
+    const ap::LineSearchResult r = ap::ArmijoBacktracking(ap::fixedStepLineSearch(p))
+                                       .search(problem, {-1.0, 1.0, false, at_floor, false}, &d);
+    EXPECT_FALSE(r.accepted);
+    EXPECT_EQ(problem.trials, at_floor ? p.floor_halvings : p.max_halvings);
+    EXPECT_EQ(problem.restores, 1);
+    EXPECT_EQ(problem.x, 0.0);
+  }
+}
+
+TEST(LineSearch, ARoundOffDecreaseIsTakenAtFixedStepAndOnlyFlaggedInFreeTime) {
+  const ap::InteriorPointParameters p;
+  // φ rises along d (by more than its round-off at every trial length): only a step taken as
+  // round-off is accepted.
+  const auto phi = [](double x) { return 1.0 + x; };
+  const double slope = -0.5 * p.merit_round_off;  // |slope| below round-off of φ(0) = 1
+  LineProblem fixed(phi, 100.0);
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 1e-3);
+  const ap::LineSearchResult taken = ap::ArmijoBacktracking(ap::fixedStepLineSearch(p))
+                                         .search(fixed, {slope, 0.25, false, false, false}, &d);
+  EXPECT_TRUE(taken.accepted && taken.at_round_off);
+  EXPECT_EQ(taken.alpha, 0.25);  // α₀, not searched
+  EXPECT_EQ(fixed.trials, 0);
+  EXPECT_EQ(fixed.x, 0.25e-3);
+  LineProblem free_time(phi, 100.0);
+  const ap::LineSearchResult flagged =
+      ap::ArmijoBacktracking(ap::freeTimeLineSearch(p))
+          .search(free_time, {slope, 1.0, false, false, false}, &d);
+  EXPECT_TRUE(flagged.at_round_off);
+  EXPECT_FALSE(flagged.accepted);
+  EXPECT_EQ(free_time.trials, p.free_time_max_halvings);
+}
+
+TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeProfile) {
+  const ap::InteriorPointParameters p;
+  // φ = (x − 2)²: the full step d = 4.5 overshoots the minimum at 2 (φ(4.5) > φ(0)), the
+  // corrected step 2 lands on it.
+  const auto phi = [](double x) { return (x - 2.0) * (x - 2.0); };
+  const double slope = -4.0 * 4.5;  // φ'(0) d
+  LineProblem problem(phi, 100.0, 2.0);
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 4.5);
+  const ap::ArmijoBacktracking search(ap::freeTimeLineSearch(p));
+  ap::LineSearchResult r = search.search(problem, {slope, 1.0, false, false, true}, &d);
+  EXPECT_TRUE(r.accepted);
+  EXPECT_EQ(r.alpha, 1.0);
+  EXPECT_EQ(d(0), 2.0);  // the corrected step is the step taken
+  EXPECT_EQ(problem.x, 2.0);
+  EXPECT_EQ(problem.trials, 2);
+  // Without a correction on offer (or not late, or the fixed-h profile) the full step is
+  // followed by halvings from 1/2, and the correction's terms are cleared.
+  LineProblem plain(phi, 100.0);
+  d(0) = 4.5;
+  r = search.search(plain, {slope, 1.0, false, false, true}, &d);
+  EXPECT_EQ(plain.clears, 1);
+  EXPECT_EQ(plain.trials, 2);  // the full step, then α = 1/2 (accepted: φ(2.25) is small)
+  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 0.5, p.free_time_max_halvings, 100.0));
+  EXPECT_EQ(d(0), 4.5);
+  LineProblem fixed(phi, 100.0, 2.0);
+  r = ap::ArmijoBacktracking(ap::fixedStepLineSearch(p))
+          .search(fixed, {slope, 1.0, false, false, true}, &d);
+  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 1.0, p.max_halvings, 100.0));
+  EXPECT_EQ(d(0), 4.5);
+  EXPECT_EQ(fixed.clears, 0);
 }

@@ -49,6 +49,7 @@
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/line_search.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
@@ -80,7 +81,7 @@ constexpr double kLargestRaise = 2.0;
 constexpr double kElasticPenalty = 100.0;
 constexpr double kElasticPenaltyGrowth = 10.0;
 
-class FreeTimeSolver {
+class FreeTimeSolver final : public BarrierProblem {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
                  const StageConstraints& constraints, const InteriorPointParameters& parameters)
@@ -91,7 +92,8 @@ class FreeTimeSolver {
         n_(np->unknowns()),
         form_(parameters),
         barrier_(parameters, freeTimeMonotone(parameters)),
-        inertia_(parameters) {
+        inertia_(parameters),
+        search_(freeTimeLineSearch(parameters)) {
     for (const auto& c : constraints) {
       groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
     }
@@ -235,14 +237,15 @@ class FreeTimeSolver {
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
   bool lineSearch(Eigen::VectorXd* d, double mu, double epsilon, bool late, double* alpha);
-  /// φ_μ at the iterate moved by α d from (h, steps), +∞ where no boundary step exists there
-  /// (`moved` false then: the iterate is not at the trial point).
-  double trialMerit(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd& d,
-                    double alpha, double mu, double epsilon, bool* moved = nullptr);
-  bool secondOrderCorrection(const Eigen::VectorXd& d, Eigen::VectorXd* corrected);
-  void clearCorrection();
-  void moveTo(double h, const ReducedProblem::StepVectors& steps, const Eigen::VectorXd* d,
-              double alpha);
+  // BarrierProblem, from the point the line search started at (accepted_).
+  double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
+  /// φ_μ at the iterate moved by α d (θ by its fraction to the boundary while elastic), +∞ where
+  /// h ≤ 0 or no boundary step exists there (`moved` false then: the iterate is not there).
+  double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override;
+  void moveTo(const Eigen::VectorXd& d, double alpha) override;
+  void restore() override;
+  bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override;
+  void clearCorrection() override;
   double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
@@ -285,6 +288,12 @@ class FreeTimeSolver {
   Eigen::VectorXd rhs_, lagrangian_gradient_;
   PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
   BorderedBandKkt<double> step_factor_;  ///< the last step's factor (the correction reuses it)
+  ArmijoBacktracking search_;
+  /// The accepted iterate a line search starts from, and its barrier problem.
+  struct SearchStart {
+    double h = 0.0, theta = 0.0, mu = 0.0, epsilon = 0.0;
+    ReducedProblem::StepVectors steps;
+  } accepted_;
   /// The last step's predicted decrease of φ_μ was round-off (merit_round_off): no step of it
   /// can be told from no step.
   bool step_at_round_off_ = false;
@@ -459,76 +468,50 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
   }
 }
 
-void FreeTimeSolver::moveTo(double h, const ReducedProblem::StepVectors& steps,
-                            const Eigen::VectorXd* d, double alpha) {
+void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
-  np_.setCurrent(steps);
-  if (!d) return;
-  np_.setTimeStep(h + alpha * h0_ * (*d)(n_));
-  np_.setCurrent(np_.retract(d->head(n_), alpha));
+  np_.setCurrent(accepted_.steps);
+  np_.setTimeStep(accepted_.h + alpha * h0_ * d(n_));
+  np_.setCurrent(np_.retract(d.head(n_), alpha));
 }
 
-double FreeTimeSolver::trialMerit(double h, const ReducedProblem::StepVectors& steps,
-                                  const Eigen::VectorXd& d, double alpha, double mu, double epsilon,
-                                  bool* moved) {
+double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
   if (moved) *moved = false;
-  if (h + alpha * h0_ * d(n_) <= 0) return std::numeric_limits<double>::infinity();
+  if (accepted_.h + alpha * h0_ * d(n_) <= 0) return std::numeric_limits<double>::infinity();
+  if (elastic_) {  // θ by the fraction to the boundary
+    theta_ = accepted_.theta + alpha * d(n_ + 1);
+    if (theta_ < (1 - parameters_.fraction_to_boundary) * accepted_.theta) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
   try {
-    moveTo(h, steps, &d, alpha);
+    moveTo(d, alpha);
     if (moved) *moved = true;
-    return merit(mu, epsilon, true);
+    return merit(accepted_.mu, accepted_.epsilon, true);
   } catch (const std::exception&) {  // no boundary step at that h (StepTooLarge)
     return std::numeric_limits<double>::infinity();
   }
 }
 
-/// Armijo on φ_μ with the fraction to the boundary, halving α. In the end game (`late`) a
-/// rejected full step is first retried with its second-order correction (secondOrderCorrection),
-/// which replaces *d when it is taken.
+void FreeTimeSolver::restore() {
+  np_.setTimeStep(accepted_.h);
+  theta_ = accepted_.theta;
+  np_.setCurrent(accepted_.steps);
+}
+
+/// Armijo on φ_μ with the fraction to the boundary, halving α (ArmijoBacktracking in the free-time
+/// profile). In the end game (`late`) a rejected full step is first retried with its second-order
+/// correction (correctedStep), which replaces *d when it is taken.
 bool FreeTimeSolver::lineSearch(Eigen::VectorXd* step, double mu, double epsilon, bool late,
                                 double* alpha) {
-  const Eigen::VectorXd& d = *step;
-  const double h = np_.timeStep(), theta = theta_;
-  const ReducedProblem::StepVectors steps = np_.current();
-  const double phi0 = merit(mu, epsilon, false);
-  const double slope = -d.dot(rhs_);  // ∇φ_μᵀ d < 0
-  step_at_round_off_ = -slope <= parameters_.merit_round_off * std::abs(phi0);
+  accepted_ = {np_.timeStep(), theta_, mu, epsilon, np_.current()};
   clearCorrection();
-  double a = 1.0;
-  if (late && !elastic_) {
-    bool moved = false;
-    if (trialMerit(h, steps, d, 1.0, mu, epsilon, &moved) <= phi0 + parameters_.armijo * slope) {
-      *alpha = 1.0;
-      return true;
-    }
-    Eigen::VectorXd corrected;
-    if (moved && secondOrderCorrection(d, &corrected) &&
-        trialMerit(h, steps, corrected, 1.0, mu, epsilon) <= phi0 + parameters_.armijo * slope) {
-      *step = corrected;
-      *alpha = 1.0;
-      return true;
-    }
-    clearCorrection();
-    np_.setTimeStep(h);
-    a = 0.5;
-  }
-  for (int i = 0; i < parameters_.free_time_max_halvings; ++i, a *= 0.5) {
-    if (h + a * h0_ * d(n_) <= 0) continue;
-    if (elastic_) {  // θ by the fraction to the boundary
-      theta_ = theta + a * d(n_ + 1);
-      if (theta_ < (1 - parameters_.fraction_to_boundary) * theta) continue;
-    }
-    if (trialMerit(h, steps, d, a, mu, epsilon) <= phi0 + parameters_.armijo * a * slope) {
-      *alpha = a;
-      return true;
-    }
-    np_.setTimeStep(h);
-  }
-  np_.setTimeStep(h);
-  theta_ = theta;
-  moveTo(h, steps, nullptr, 0.0);
-  return false;
+  const LineSearchResult result =
+      search_.search(*this, {-step->dot(rhs_), 1.0, false, false, late && !elastic_}, step);
+  step_at_round_off_ = result.at_round_off;
+  *alpha = result.alpha;
+  return result.accepted;
 }
 
 /// The second-order correction of a rejected full step d (IPOPT's, Wächter & Biegler 2006 §2.4,
@@ -540,7 +523,7 @@ bool FreeTimeSolver::lineSearch(Eigen::VectorXd* step, double mu, double epsilon
 /// barrier's linearization c + gᵀd + r: d' = d − K⁻¹ Σ (z/c) r g, one more solve with the step's
 /// factorization; its dual step uses the same model (dualStep). False where no r is nonzero or
 /// the corrected step is not finite.
-bool FreeTimeSolver::secondOrderCorrection(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
+bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
   forEachValue(np_.current(), [&](const FreeTimeRows& group, int k, double c_at_step) {

@@ -13,6 +13,7 @@
 #include "attitude_planner/errors.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
+#include "planning/interior_point/line_search.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
@@ -47,7 +48,7 @@ bool ranOut(Termination t) {
 }
 
 template <typename Scalar>
-class GridSolve {
+class GridSolve final : public BarrierProblem {
  public:
   GridSolve(const PlanningProblem& problem, const SolverOptions& options,
             const InteriorPointParameters& parameters, SolveContext& context,
@@ -62,6 +63,7 @@ class GridSolve {
         barrier_(makeBarrierUpdate(request.barrier, parameters)),
         free_slacks_(system_.freeSlacks()),
         inertia_(parameters),
+        search_(fixedStepLineSearch(parameters)),
         kkt_blocks_(np->unknowns()),
         test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
               free_slacks_) {
@@ -142,10 +144,9 @@ class GridSolve {
     const StopVerdict test =
         test_.check({free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift,
                      mu_ <= scales_.mu_final, system_.maxViolation(), iteration_, scales_.f_scale});
-    ReducedProblem::StepVectors trial;
     double alpha = 0.0;
-    if (!lineSearch(direction, test, &trial, &alpha)) return rejected(test, direction.cost);
-    accept(trial, alpha);
+    if (!lineSearch(direction, test, &alpha)) return rejected(test, direction.cost);
+    accept(trial_, alpha);
     if (!report(direction.cost, test.relative_decrement, alpha)) {
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
@@ -203,27 +204,29 @@ class GridSolve {
     d->decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
   }
 
-  /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step; a predicted
-  /// decrease below φ's round-off is taken. False if no step length was accepted.
-  bool lineSearch(const Direction& d, const StopVerdict& t, ReducedProblem::StepVectors* trial,
-                  double* alpha) {
-    const double penalty = free_slacks_ ? nu_ : rho_;
-    const double phi = system_.assembledMerit(d.cost, mu_, penalty);
-    *alpha = free_slacks_ ? alpha_slack_ : 1.0;
-    bool accepted = t.final_step || -d.slope <= p_.merit_round_off * std::abs(phi);
-    const int max_halvings = t.at_floor ? p_.floor_halvings : p_.max_halvings;
-    *trial = np_.retract(delta_, *alpha);
-    for (int back = 0; !accepted && back < max_halvings; ++back) {
-      const double trial_phi = system_.merit(*trial, mu_, penalty, nullptr, *alpha);
-      if (std::isfinite(trial_phi) && trial_phi <= phi + p_.armijo * *alpha * d.slope) {
-        accepted = true;
-        break;
-      }
-      *alpha *= 0.5;
-      *trial = np_.retract(delta_, *alpha);
-    }
-    return accepted;
+  /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step (the free slacks'
+  /// α, else 1); a predicted decrease below φ's round-off is taken. False if no step length was
+  /// accepted; else trial_ is the accepted point.
+  bool lineSearch(const Direction& d, const StopVerdict& t, double* alpha) {
+    cost_ = d.cost;
+    const LineSearchResult result = search_.search(
+        *this, {d.slope, free_slacks_ ? alpha_slack_ : 1.0, t.final_step, t.at_floor, false},
+        &delta_);
+    *alpha = result.alpha;
+    return result.accepted;
   }
+
+  // BarrierProblem: φ_μ with the penalty of the form (free slacks: ν, elastic: ρ) at the
+  // iterate's slacks moved with the step.
+  double merit() override { return system_.assembledMerit(cost_, mu_, penalty()); }
+  double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
+    trial_ = np_.retract(d, alpha);
+    if (moved) *moved = true;
+    return system_.merit(trial_, mu_, penalty(), nullptr, alpha);
+  }
+  void moveTo(const Eigen::VectorXd& d, double alpha) override { trial_ = np_.retract(d, alpha); }
+  void restore() override {}  // the trials never moved the accepted iterate
+  double penalty() const { return free_slacks_ ? nu_ : rho_; }
 
   /// A direction the line search rejects: at the round-off floor the iterate is as good as it
   /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times. A retry is an
@@ -357,14 +360,17 @@ class GridSolve {
   const bool free_slacks_;
   RowRelativeShift
       inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
+  ArmijoBacktracking search_;
   KktBlocks<Scalar> kkt_blocks_;  ///< the condensed system (a band: no global unknowns at fixed h)
   BandKkt<Scalar> kkt_;
   DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;
   double mu_ = 0.0, mu_start_ = 0.0;
-  double rho_ = 0.0;  ///< elastic penalty ρ
-  double nu_ = 0.0;   ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
+  double rho_ = 0.0;   ///< elastic penalty ρ
+  double nu_ = 0.0;    ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
+  double cost_ = 0.0;  ///< f at the iterate (the line search's φ_μ)
+  ReducedProblem::StepVectors trial_;  ///< the line search's trial point
   std::vector<double> dz_;
   double alpha_dual_ = 1.0, alpha_slack_ = 1.0;
   // The stopping test's memory.

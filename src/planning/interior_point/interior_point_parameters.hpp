@@ -173,7 +173,7 @@ struct InteriorPointParameters {
   /// chosen, at the first barrier levels, damped steps took paper on min_time_keep_out.yaml
   /// N = 32 to a higher KKT point, 29.7404 s instead of 29.7113 s). In the end game too a
   /// rejected full step is retried with its second-order correction (free_time_solver.cpp
-  /// secondOrderCorrection): there the torque bounds' curvature, not the basin, cuts the steps.
+  /// correctedStep): there the torque bounds' curvature, not the basin, cuts the steps.
   /// Measured (plan_maneuver, free-time iterations of all starts): 0.96 N m about body x
   /// against |u_x| ≤ 1, N = 64: 1188 → 520, N = 128: a KKT point in 867 (before: the iteration
   /// limit, the search's answer); 0.99 N m, N = 64: a KKT point in 673 (before: the search). At

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <sstream>
 
@@ -12,20 +13,58 @@ namespace attitude_planner {
 
 namespace {
 constexpr const char* kCsvHeader = "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz";
+
+/// The header of writeManeuverCsv, with or without wheel columns (",u1,...,un,h1,...,hn").
+bool isManeuverHeader(const std::string& line) {
+  const std::string base = kCsvHeader;
+  if (line.compare(0, base.size(), base) != 0) return false;
+  if (line.size() == base.size()) return true;
+  std::string expected = base;
+  int n = 1;
+  while (expected.size() < line.size()) {
+    expected = base;
+    for (const char* column : {"u", "h"})
+      for (int i = 1; i <= n; ++i) expected += "," + std::string(column) + std::to_string(i);
+    if (expected == line) return true;
+    ++n;
+  }
+  return false;
 }
 
-void writeManeuverCsv(const Maneuver& m, const std::string& path) {
+/// The file's rows, each followed by `extra(k)` (empty, or ",..." columns) before the newline.
+void writeRows(const Maneuver& m, const std::string& path, const std::string& header,
+               const std::function<std::string(int)>& extra) {
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
   if (!file) throw InvalidInput("--csv: cannot write '" + path + "'");
-  std::fprintf(file.get(), "%s\n", kCsvHeader);
+  std::fprintf(file.get(), "%s\n", header.c_str());
   for (int k = 0; k <= m.steps(); ++k) {
     const Eigen::Quaterniond q = so3::toQuaternion(m.attitude[k]);
     const Vector3& w = m.angular_velocity[k];
     const Vector3& t = m.torque[k];
     std::fprintf(file.get(),
-                 "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
-                 m.time[k], q.w(), q.x(), q.y(), q.z(), w.x(), w.y(), w.z(), t.x(), t.y(), t.z());
+                 "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g%s\n", k,
+                 m.time[k], q.w(), q.x(), q.y(), q.z(), w.x(), w.y(), w.z(), t.x(), t.y(), t.z(),
+                 extra(k).c_str());
   }
+}
+
+}  // namespace
+
+void writeManeuverCsv(const Maneuver& m, const std::string& path) {
+  writeRows(m, path, kCsvHeader, [](int) { return std::string(); });
+}
+
+void writeManeuverCsv(const Maneuver& m, const WheelStates& wheels, const std::string& path) {
+  const int n = wheels.momentum.empty() ? 0 : static_cast<int>(wheels.momentum[0].size());
+  std::string header = kCsvHeader;
+  for (const char* column : {"u", "h"})
+    for (int i = 1; i <= n; ++i) header += "," + std::string(column) + std::to_string(i);
+  writeRows(m, path, header, [&](int k) {
+    std::string cells;
+    for (const auto* values : {&wheels.torque[k], &wheels.momentum[k]})
+      for (int i = 0; i < n; ++i) cells += "," + exactNumber((*values)(i));
+    return cells;
+  });
 }
 
 Maneuver readManeuverCsv(const std::string& path) {
@@ -34,7 +73,7 @@ Maneuver readManeuverCsv(const std::string& path) {
   std::string line;
   std::getline(in, line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
-  if (line != kCsvHeader) {
+  if (!isManeuverHeader(line)) {
     throw InvalidInput("maneuver CSV '" + path + "': header is '" + line + "', expected '" +
                        kCsvHeader + "'");
   }

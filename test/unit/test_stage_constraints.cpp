@@ -96,6 +96,10 @@ std::vector<double> valuesOf(const ap::StageConstraint& constraint, const ap::Re
       case ap::StageQuantity::NodeRate:  // the plan's node velocity J⁻¹Π_k
         q(0) = 0.5 * np.maneuver(np.current()).angular_velocity[k].squaredNorm();
         break;
+      case ap::StageQuantity::WheelMomentum:  // their own suite: test_reaction_wheels
+      case ap::StageQuantity::WheelTorque:
+        q = constraint.quantityModel().value(ap::QuantityInputs(np, np.current()), k);
+        break;
     }
     out.push_back(constraint.value(q));
   }
@@ -194,6 +198,9 @@ ap::Vector3 quantityOnPlan(const ap::StageConstraint& c, const ap::Maneuver& pla
     case ap::StageQuantity::Pointing:
       return ap::Vector3(c.spec()->world_direction.dot(plan.attitude[k] * c.spec()->body_axis), 0.0,
                          0.0);
+    case ap::StageQuantity::WheelMomentum:  // their own suite: test_reaction_wheels
+    case ap::StageQuantity::WheelTorque:
+      return c.quantityModel().valueOnPlan(plan, k);
   }
   return ap::Vector3::Zero();
 }
@@ -677,6 +684,10 @@ TEST_P(StageQuantityDerivatives, ValueOnAPlanIsItsPlainForm) {
         EXPECT_NEAR(r(0), cone.world_direction.dot(plan.attitude[k] * cone.body_axis), 1e-15);
         break;
       }
+      case ap::StageQuantity::WheelMomentum:  // not in everyKind: test_reaction_wheels
+      case ap::StageQuantity::WheelTorque:
+        ADD_FAILURE() << "no wheels in this suite's problem";
+        break;
     }
   }
   // Where the transcription has the instance too, the two agree (½|Ω|² for the rates).

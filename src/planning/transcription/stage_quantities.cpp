@@ -335,7 +335,7 @@ const StageQuantityModel& prototype(StageQuantity quantity) {
   static const NodeRateQuantity node_rate{Matrix3::Identity()};
   static const PointingQuantity pointing{Vector3::UnitX(), Vector3::UnitX()};
   static const std::shared_ptr<const StageQuantityModel> wheel_momentum =
-      makeWheelMomentumQuantity(threeWheelProblem());
+      makeWheelMomentumQuantity(threeWheelProblem(), false);
   static const std::shared_ptr<const StageQuantityModel> wheel_torque =
       makeWheelTorqueQuantity(threeWheelProblem());
   switch (quantity) {

@@ -173,10 +173,13 @@ class WheelQuantity : public StageQuantityModel {
   Vector3 start_momentum_, end_momentum_;  ///< J Ω(0), J Ω(T)
 };
 
-/// q_k = R_kᵀπ₀ − Π_k, the array's momentum A h_w,k.
+/// q_k = R_kᵀπ₀ − Π_k, the array's momentum A h_w,k; or, with `half_squared_norm`, ½|q_k|² in
+/// entry 0 (the envelope's quantity: its constraint is then affine in it, so the free-time
+/// solver, whose quantity assembly takes the constraints as affine, needs no curvature term).
 class WheelMomentumQuantity final : public WheelQuantity {
  public:
-  using WheelQuantity::WheelQuantity;
+  WheelMomentumQuantity(const PlanningProblem& p, bool half_squared_norm)
+      : WheelQuantity(p), half_squared_norm_(half_squared_norm) {}
   StageQuantity kind() const override { return StageQuantity::WheelMomentum; }
   /// The nodes with a free attitude in their window, but 0 and N (their q is boundary data).
   StageSupport support(int first_free, int last_free) const override {
@@ -184,8 +187,10 @@ class WheelMomentumQuantity final : public WheelQuantity {
   }
   StageSupport planSupport(bool, int steps) const override { return {0, steps, 0, 1}; }
   Vector3 value(const QuantityInputs& at, int k) const override {
-    return bodyTotal(at, k) - nodeMomentum(at, k);
+    const Vector3 q = bodyTotal(at, k) - nodeMomentum(at, k);
+    return half_squared_norm_ ? Vector3(0.5 * q.squaredNorm(), 0.0, 0.0) : q;
   }
+  /// q_k itself (the plain form, also for the half squared norm).
   Vector3 valueOnPlan(const Maneuver& plan, int k) const override {
     return planArrayMomentum(scheme_, inertia_, array_, plan, k);
   }
@@ -214,24 +219,37 @@ class WheelMomentumQuantity final : public WheelQuantity {
   }
 
  private:
+  /// The parts' weights carry λ (q), or λ q (½|q|²: λ∇²s = λ ∂qᵀ∂q + Σ (λq)_i ∇²q_i).
   void forEachJet(const ReducedProblem& np, const StageSupport& support, bool with_h,
                   double time_scale, const QuantityContraction& contract,
                   const std::function<void(int, const Jet&)>& visit) const {
     const QuantityInputs at(np, np.current());
-    std::vector<std::pair<Vector3, Vector3>> weights;  // (Π's, v's) = (−λ, λ)
+    std::vector<std::pair<Vector3, Vector3>> weights;  // (Π's, v's) = (−w, w)
+    std::vector<double> scalar;                        // λ of ½|q|²
     for (int k = support.first_k; k <= support.last_k; ++k) {
       const Vector3 lambda = contract(k, value(at, k));
-      weights.emplace_back(-lambda, lambda);
+      const Vector3 q = bodyTotal(at, k) - nodeMomentum(at, k);
+      const Vector3 w = half_squared_norm_ ? Vector3(lambda(0) * q) : lambda;
+      scalar.push_back(lambda(0));
+      weights.emplace_back(-w, w);
     }
     forEachMomentumParts(np, support, with_h, weights, [&](int k, const Jet& Pi, const Jet& v) {
       Jet q;
       q.value = v.value - Pi.value;
       q.d = v.d - Pi.d;
-      q.s = v.s + Pi.s;  // each formed with its own sign of λ
+      q.s = v.s + Pi.s;  // each formed with its own sign of the weights
+      if (half_squared_norm_) {
+        Jet s;
+        s.value(0) = 0.5 * q.value.squaredNorm();
+        s.d.row(0) = q.value.transpose() * q.d;
+        s.s = scalar[k - support.first_k] * q.d.transpose() * q.d + q.s;
+        q = s;
+      }
       if (with_h) scaleTimeStep(&q, time_scale);
       visit(k, q);
     });
   }
+  bool half_squared_norm_;
 };
 
 /// a_k = −(τ_k + J⁻¹Π_k × q_k), the array's torque A u_k.
@@ -387,39 +405,41 @@ class WheelLimitSide final : public StageConstraint {
   const char* unit_;
 };
 
-/// max_momentum_norm H: c = 1 − |q|²/H².
+/// max_momentum_norm H on s = ½|q|²: c = 1 − 2s/H² (affine in its quantity).
 class WheelMomentumEnvelope final : public StageConstraint {
  public:
-  WheelMomentumEnvelope(std::shared_ptr<const StageQuantityModel> momentum, double limit)
-      : StageConstraint(std::move(momentum), nullptr), limit_(limit) {}
-  double value(const Vector3& q) const override {
-    return 1.0 - q.squaredNorm() / (limit_ * limit_);
-  }
-  Vector3 gradient(const Vector3& q) const override { return -2.0 / (limit_ * limit_) * q; }
-  double curvature() const override { return -2.0 / (limit_ * limit_); }
+  WheelMomentumEnvelope(std::shared_ptr<const StageQuantityModel> half_squared_norm, double limit)
+      : StageConstraint(std::move(half_squared_norm), nullptr),
+        limit_(limit),
+        slope_(-2.0 / (limit * limit)) {}
+  double value(const Vector3& s) const override { return 1.0 + slope_ * s(0); }
+  Vector3 gradient(const Vector3&) const override { return Vector3(slope_, 0.0, 0.0); }
   std::string describe() const override {
     std::ostringstream s;
     s << "reaction_wheels |A h_w| <= " << limit_ << " N m s";
     return s.str();
   }
+  /// On the plan's q_k (the quantity's plain form).
   double slackOnPlan(const Maneuver& plan, int k) const override {
     return limit_ - quantityModel().valueOnPlan(plan, k).norm();
   }
   double slackScale() const override { return limit_; }
+  /// g = |q|²/H² ≤ 1 in the plain form q.
   double rowValue(const Vector3& q) const override { return q.squaredNorm() / (limit_ * limit_); }
   Vector3 rowGradient(const Vector3& q) const override { return 2.0 * q / (limit_ * limit_); }
   double rowCurvature() const override { return 2.0 / (limit_ * limit_); }
   double rowUpper() const override { return 1.0; }
 
  private:
-  double limit_;
+  double limit_;  ///< H [N m s]
+  double slope_;  ///< −2/H²
 };
 
 }  // namespace
 
-std::shared_ptr<const StageQuantityModel> makeWheelMomentumQuantity(
-    const PlanningProblem& problem) {
-  return std::make_shared<WheelMomentumQuantity>(problem);
+std::shared_ptr<const StageQuantityModel> makeWheelMomentumQuantity(const PlanningProblem& problem,
+                                                                    bool half_squared_norm) {
+  return std::make_shared<WheelMomentumQuantity>(problem, half_squared_norm);
 }
 
 std::shared_ptr<const StageQuantityModel> makeWheelTorqueQuantity(const PlanningProblem& problem) {
@@ -429,7 +449,7 @@ std::shared_ptr<const StageQuantityModel> makeWheelTorqueQuantity(const Planning
 void appendWheelConstraints(const PlanningProblem& problem, StageConstraints* out) {
   const ReactionWheels& wheels = problem.reaction_wheels;
   if (!wheels.present()) return;
-  const auto momentum = makeWheelMomentumQuantity(problem);
+  const auto momentum = makeWheelMomentumQuantity(problem, false);
   const auto torque = makeWheelTorqueQuantity(problem);
   const WheelArray array = wheelArray(wheels);
   for (int i = 0; i < wheels.count(); ++i) {
@@ -446,7 +466,8 @@ void appendWheelConstraints(const PlanningProblem& problem, StageConstraints* ou
     }
   }
   if (std::isfinite(wheels.max_momentum_norm)) {
-    out->push_back(std::make_unique<WheelMomentumEnvelope>(momentum, wheels.max_momentum_norm));
+    out->push_back(std::make_unique<WheelMomentumEnvelope>(makeWheelMomentumQuantity(problem, true),
+                                                           wheels.max_momentum_norm));
   }
 }
 

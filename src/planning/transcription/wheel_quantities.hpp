@@ -8,7 +8,8 @@
 //   WheelTorque    a_k = −(τ_k + J⁻¹Π_k × q_k)   the array's torque A u_k [N m]
 // Π_k the node momentum (ReducedProblem::forEachNodeMomentum), π₀ = R_0 (J Ω(0) + A h_w(0)).
 // Each wheel's limits are two linear sides in q (or a): h_w,i = (A⁺q)_i + (null part)_i,
-// u_i = (A⁺a)_i; the envelope is |q| ≤ H. So n wheels cost two quantities, not 2n.
+// u_i = (A⁺a)_i; the envelope |q| ≤ H is affine in a third object, ½|q|². So n wheels cost two
+// quantities (three with the envelope), not 2n.
 #pragma once
 
 #include <memory>
@@ -18,8 +19,10 @@
 
 namespace attitude_planner {
 
-/// The two wheel quantities of `problem` (reaction_wheels present).
-std::shared_ptr<const StageQuantityModel> makeWheelMomentumQuantity(const PlanningProblem& problem);
+/// The wheel quantities of `problem` (reaction_wheels present): q_k, or ½|q_k|² in entry 0 with
+/// `half_squared_norm` (the envelope's: kind WheelMomentum, the same plain form q_k on a plan).
+std::shared_ptr<const StageQuantityModel> makeWheelMomentumQuantity(const PlanningProblem& problem,
+                                                                    bool half_squared_norm);
 std::shared_ptr<const StageQuantityModel> makeWheelTorqueQuantity(const PlanningProblem& problem);
 
 /// Appends the wheel constraints of `problem` to `out`: per wheel the two momentum sides and the

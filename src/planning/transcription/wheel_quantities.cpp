@@ -116,8 +116,37 @@ class WheelQuantity : public StageQuantityModel {
         end_momentum_(p.inertia * p.final_velocity) {}
   bool dependsOnTimeStep() const override { return true; }
   const WheelArray& array() const { return array_; }
+  void forEachTerms(const ReducedProblem& np, const StageSupport& support,
+                    const QuantityContraction& contract, const TermsVisitor& visit) const override {
+    forEachJet(np, support, false, 1.0, contract, [&](int k, const Jet& jet) {
+      QuantityTerms t;
+      t.k = k;
+      t.value = jet.value;
+      t.jacobian = jet.d.leftCols<9>();
+      t.curvature = jet.s.topLeftCorner<9, 9>();
+      visit(t);
+    });
+  }
+  void forEachTermsWithTimeStep(const ReducedProblem& np, const StageSupport& support,
+                                double time_scale, const QuantityContraction& contract,
+                                const TimeStepTermsVisitor& visit) const override {
+    forEachJet(np, support, true, time_scale, contract, [&](int k, const Jet& jet) {
+      QuantityTermsWithTimeStep t;
+      t.k = k;
+      t.value = jet.value;
+      t.jacobian = jet.d;
+      t.curvature = jet.s;
+      visit(t);
+    });
+  }
 
  protected:
+  /// The quantity's jets over `support`: in (x, h) with h in η = h/time_scale if `with_h`, else
+  /// in x alone (column 9 and the h entries zero), the curvature contracted with `contract`.
+  virtual void forEachJet(const ReducedProblem& np, const StageSupport& support, bool with_h,
+                          double time_scale, const QuantityContraction& contract,
+                          const std::function<void(int, const Jet&)>& visit) const = 0;
+
   /// Π_k at the iterate `at` (the end nodes' J Ω(0), J Ω(T)).
   Vector3 nodeMomentum(const QuantityInputs& at, int k) const {
     const int N = at.problem().steps();
@@ -194,35 +223,12 @@ class WheelMomentumQuantity final : public WheelQuantity {
   Vector3 valueOnPlan(const Maneuver& plan, int k) const override {
     return planArrayMomentum(scheme_, inertia_, array_, plan, k);
   }
-  void forEachTerms(const ReducedProblem& np, const StageSupport& support,
-                    const QuantityContraction& contract, const TermsVisitor& visit) const override {
-    forEachJet(np, support, false, 1.0, contract, [&](int k, const Jet& q) {
-      QuantityTerms t;
-      t.k = k;
-      t.value = q.value;
-      t.jacobian = q.d.leftCols<9>();
-      t.curvature = q.s.topLeftCorner<9, 9>();
-      visit(t);
-    });
-  }
-  void forEachTermsWithTimeStep(const ReducedProblem& np, const StageSupport& support,
-                                double time_scale, const QuantityContraction& contract,
-                                const TimeStepTermsVisitor& visit) const override {
-    forEachJet(np, support, true, time_scale, contract, [&](int k, const Jet& q) {
-      QuantityTermsWithTimeStep t;
-      t.k = k;
-      t.value = q.value;
-      t.jacobian = q.d;
-      t.curvature = q.s;
-      visit(t);
-    });
-  }
 
  private:
   /// The parts' weights carry λ (q), or λ q (½|q|²: λ∇²s = λ ∂qᵀ∂q + Σ (λq)_i ∇²q_i).
   void forEachJet(const ReducedProblem& np, const StageSupport& support, bool with_h,
                   double time_scale, const QuantityContraction& contract,
-                  const std::function<void(int, const Jet&)>& visit) const {
+                  const std::function<void(int, const Jet&)>& visit) const override {
     const QuantityInputs at(np, np.current());
     std::vector<std::pair<Vector3, Vector3>> weights;  // (Π's, v's) = (−w, w)
     std::vector<double> scalar;                        // λ of ½|q|²
@@ -271,29 +277,6 @@ class WheelTorqueQuantity final : public WheelQuantity {
   Vector3 valueOnPlan(const Maneuver& plan, int k) const override {
     return planArrayTorque(scheme_, inertia_, array_, plan, k);
   }
-  void forEachTerms(const ReducedProblem& np, const StageSupport& support,
-                    const QuantityContraction& contract, const TermsVisitor& visit) const override {
-    forEachJet(np, support, false, 1.0, contract, [&](int k, const Jet& a) {
-      QuantityTerms t;
-      t.k = k;
-      t.value = a.value;
-      t.jacobian = a.d.leftCols<9>();
-      t.curvature = a.s.topLeftCorner<9, 9>();
-      visit(t);
-    });
-  }
-  void forEachTermsWithTimeStep(const ReducedProblem& np, const StageSupport& support,
-                                double time_scale, const QuantityContraction& contract,
-                                const TimeStepTermsVisitor& visit) const override {
-    forEachJet(np, support, true, time_scale, contract, [&](int k, const Jet& a) {
-      QuantityTermsWithTimeStep t;
-      t.k = k;
-      t.value = a.value;
-      t.jacobian = a.d;
-      t.curvature = a.s;
-      visit(t);
-    });
-  }
 
  private:
   Vector3 torqueOf(const Vector3& tau, const Vector3& Pi, const Vector3& q) const {
@@ -335,7 +318,7 @@ class WheelTorqueQuantity final : public WheelQuantity {
   }
   void forEachJet(const ReducedProblem& np, const StageSupport& support, bool with_h,
                   double time_scale, const QuantityContraction& contract,
-                  const std::function<void(int, const Jet&)>& visit) const;
+                  const std::function<void(int, const Jet&)>& visit) const override;
 };
 
 void WheelTorqueQuantity::forEachJet(const ReducedProblem& np, const StageSupport& support,

@@ -8,14 +8,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "attitude_planner/dynamics/wheel_replay.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/csv.hpp"
+#include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -449,4 +453,37 @@ TEST(ReactionWheelReplay, WheelTorquesFlyThePlanWithinTheLimitsToSecondOrder) {
   EXPECT_GT(misses[1] / misses[2], 3.0);
   EXPECT_LT(overshoots[0], 1e-2);
   EXPECT_LE(overshoots[2], overshoots[0] / 8.0 + 1e-12);
+}
+
+// ---- outputs -----------------------------------------------------------------------------------
+
+/// The CSV carries u1..un, h1..hn after tx,ty,tz (and reads back as a plan); the JSON summary
+/// carries each wheel's peaks, limits and margins.
+TEST(ReactionWheelOutputs, CsvColumnsAndJsonMarginsPerWheel) {
+  const ap::PlanningProblem p = closedFormSlew(32);
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+  const std::string csv = std::string(AP_BINARY_DIR) + "/test_reaction_wheels.csv";
+  ap::writeManeuverCsv(r.maneuver, w, csv);
+  std::ifstream in(csv);
+  std::string header, row;
+  std::getline(in, header);
+  EXPECT_EQ(header, "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz,u1,u2,u3,h1,h2,h3");
+  for (int k = 0; k <= 16; ++k) std::getline(in, row);  // row k = 16: mid-slew
+  std::vector<double> cells;
+  std::stringstream cells_in(row);
+  for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(std::stod(cell));
+  ASSERT_EQ(cells.size(), 18u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(cells[12 + i], w.torque[16](i));
+    EXPECT_EQ(cells[15 + i], w.momentum[16](i));
+  }
+  EXPECT_EQ(ap::readManeuverCsv(csv).steps(), 32);
+  const std::string json = ap::planResultJson(p, r);
+  EXPECT_NE(json.find("\"reaction_wheels\": {\"wheels\": [{\"name\": \"wheel_1\""),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"momentum_norm_margin\": "), std::string::npos);
+  EXPECT_NE(json.find("\"reaction_wheels\"]"), std::string::npos) << "constraints names it";
 }

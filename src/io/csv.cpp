@@ -1,5 +1,6 @@
 #include "attitude_planner/io/csv.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -67,16 +68,28 @@ void writeManeuverCsv(const Maneuver& m, const WheelStates& wheels, const std::s
   });
 }
 
-Maneuver readManeuverCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InvalidInput("maneuver CSV: cannot read '" + path + "'");
+namespace {
+
+/// Opens a maneuver CSV and reads its header (checked), which it returns.
+std::string openManeuverCsv(const std::string& path, std::ifstream* in) {
+  in->open(path);
+  if (!*in) throw InvalidInput("maneuver CSV: cannot read '" + path + "'");
   std::string line;
-  std::getline(in, line);
+  std::getline(*in, line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (!isManeuverHeader(line)) {
     throw InvalidInput("maneuver CSV '" + path + "': header is '" + line + "', expected '" +
-                       kCsvHeader + "'");
+                       kCsvHeader + "' (and wheel columns u1..un,h1..hn)");
   }
+  return line;
+}
+
+}  // namespace
+
+Maneuver readManeuverCsv(const std::string& path) {
+  std::ifstream in;
+  openManeuverCsv(path, &in);
+  std::string line;
   Maneuver m;
   int line_number = 1;
   while (std::getline(in, line)) {
@@ -118,6 +131,37 @@ Maneuver readManeuverCsv(const std::string& path) {
   if (m.time.size() < 2) throw InvalidInput("maneuver CSV '" + path + "': fewer than 2 rows");
   m.time_step = m.time[1] - m.time[0];
   return m;
+}
+
+std::vector<Eigen::VectorXd> readWheelTorquesCsv(const std::string& path) {
+  std::ifstream in;
+  std::string line = openManeuverCsv(path, &in);
+  // 12 plan columns, then n torques and n momenta.
+  const int n = static_cast<int>((std::count(line.begin(), line.end(), ',') + 1 - 12) / 2);
+  std::vector<Eigen::VectorXd> out;
+  if (n == 0) return out;
+  for (int line_number = 2; std::getline(in, line); ++line_number) {
+    if (line.empty()) continue;
+    std::stringstream ss(line);
+    std::string cell;
+    Eigen::VectorXd u(n);
+    for (int column = 0; column < 12 + n; ++column) {
+      if (!std::getline(ss, cell, ',')) {
+        throw InvalidInput("maneuver CSV '" + path + "' line " + std::to_string(line_number) +
+                           ": expected " + std::to_string(12 + 2 * n) + " columns");
+      }
+      if (column < 12) continue;
+      try {
+        u(column - 12) = std::stod(cell);
+      } catch (const std::exception&) {
+        throw InvalidInput("maneuver CSV '" + path + "' line " + std::to_string(line_number) +
+                           ": column u" + std::to_string(column - 11) + " is not a number: '" +
+                           cell + "'");
+      }
+    }
+    out.push_back(u);
+  }
+  return out;
 }
 
 void writeDriftTwoInputCsv(const DriftTwoInputTrajectory& tr, const std::string& path) {

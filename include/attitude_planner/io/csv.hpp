@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
@@ -19,6 +20,9 @@ void writeManeuverCsv(const Maneuver& maneuver, const WheelStates& wheels, const
 /// Reads a CSV written by writeManeuverCsv (header checked; wheel columns are accepted and not
 /// read: they follow from the plan and the array); throws InvalidInput naming the line.
 Maneuver readManeuverCsv(const std::string& path);
+/// The wheel torques u1..un [N m] of each row of a CSV writeManeuverCsv wrote with wheel states
+/// (empty if it has no wheel columns); throws InvalidInput naming the line.
+std::vector<Eigen::VectorXd> readWheelTorquesCsv(const std::string& path);
 
 /// Header of the drift + two-input trajectory CSV (seed 001).
 constexpr const char* kDriftTwoInputCsvHeader = "k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3";

@@ -473,6 +473,9 @@ class TranscriptionNlp : public Ipopt::TNLP {
           break;
         case ap::StageQuantity::NodeRate:  // the paper scheme has no end torques
           throw ap::InvalidInput("ipopt: the transcription has no node rates (paper scheme)");
+        case ap::StageQuantity::WheelMomentum:
+        case ap::StageQuantity::WheelTorque:
+          throw ap::InvalidInput("ipopt: the peer has no reaction-wheel rows yet");
       }
       for (int k = first; k <= last; ++k) rows_of_constraints_.push_back({c.get(), k});
     }
@@ -671,6 +674,8 @@ class TranscriptionNlp : public Ipopt::TNLP {
           break;
         }
         case ap::StageQuantity::NodeRate:
+        case ap::StageQuantity::WheelMomentum:
+        case ap::StageQuantity::WheelTorque:
           break;  // refused in the constructor
       }
     }
@@ -749,6 +754,8 @@ class TranscriptionNlp : public Ipopt::TNLP {
         return Vector3(q.dot(pointingForm(c) * q), 0.0, 0.0);
       }
       case ap::StageQuantity::NodeRate:
+      case ap::StageQuantity::WheelMomentum:
+      case ap::StageQuantity::WheelTorque:
         break;  // refused in the constructor
     }
     return Vector3::Zero();

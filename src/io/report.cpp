@@ -146,6 +146,42 @@ std::string attemptJson(const Attempt& a) {
   return out.str();
 }
 
+/// Per wheel: the plan's peak |h_w,i| and |u_i|, their limits and margins (limit − peak, < 0 where
+/// the plan exceeds it), and the array's peak |A h_w| with the envelope's margin (null: none).
+/// Torque peaks over the nodes the plan carries torques at (1..N−1; 0..N with end torques).
+std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
+  const ReactionWheels& wheels = problem.reaction_wheels;
+  const WheelStates states = wheelStates(problem.scheme, problem.inertia, wheels, r.maneuver);
+  const WheelArray array = wheelArray(wheels);
+  const int N = r.maneuver.steps();
+  const bool ends = schemeHasEndTorques(problem.scheme);
+  std::ostringstream out;
+  double peak_norm = 0.0;
+  for (int k = 0; k <= N; ++k)
+    peak_norm = std::max(peak_norm, (array.axes * states.momentum[k]).norm());
+  out << "{\"wheels\": [";
+  for (int i = 0; i < wheels.count(); ++i) {
+    double peak_h = 0.0, peak_u = 0.0;
+    for (int k = 0; k <= N; ++k) {
+      peak_h = std::max(peak_h, std::abs(states.momentum[k](i)));
+      if (ends || (k > 0 && k < N)) peak_u = std::max(peak_u, std::abs(states.torque[k](i)));
+    }
+    out << (i ? ", " : "") << "{\"name\": " << jsonString("wheel_" + std::to_string(i + 1))
+        << ", \"peak_momentum\": " << jsonNumber(peak_h)
+        << ", \"max_momentum\": " << jsonNumber(wheels.momentumLimit(i))
+        << ", \"momentum_margin\": " << jsonNumber(wheels.momentumLimit(i) - peak_h)
+        << ", \"peak_torque\": " << jsonNumber(peak_u)
+        << ", \"max_torque\": " << jsonNumber(wheels.torqueLimit(i))
+        << ", \"torque_margin\": " << jsonNumber(wheels.torqueLimit(i) - peak_u) << "}";
+  }
+  const double envelope = wheels.max_momentum_norm;
+  out << "], \"peak_momentum_norm\": " << jsonNumber(peak_norm)
+      << ", \"max_momentum_norm\": " << (std::isfinite(envelope) ? jsonNumber(envelope) : "null")
+      << ", \"momentum_norm_margin\": "
+      << (std::isfinite(envelope) ? jsonNumber(envelope - peak_norm) : "null") << "}";
+  return out.str();
+}
+
 }  // namespace
 
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
@@ -198,6 +234,9 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ",\n  \"active_constraints\": " << r.active_constraints
       << ",\n  \"max_violation_between_nodes\": " << jsonNumber(r.max_violation_between_nodes);
   if (r.accuracy.requested) out << ",\n  \"accuracy\": " << accuracyJson(r.accuracy);
+  if (problem.reaction_wheels.present() && r.maneuver.steps() > 0) {
+    out << ",\n  \"reaction_wheels\": " << wheelsJson(problem, r);
+  }
   if (r.pointing.active) {
     out << ",\n  \"final_twist\": " << jsonNumber(r.pointing.final_twist)
         << ",\n  \"pointing\": " << pointingJson(problem, r);

@@ -96,7 +96,7 @@ class SceneParser {
       checkKeys(root, "",
                 {"inertia", "duration", "steps", "initial", "final", "effects", "scheme", "system",
                  "allow_nonphysical_inertia", "direction", "extra_revolutions", "constraints",
-                 "objective", "time_margin"},
+                 "objective", "time_margin", "actuators"},
                 timed
                     ? std::vector<std::string>{"inertia", "steps", "initial", "final"}
                     : std::vector<std::string>{"inertia", "duration", "steps", "initial", "final"});
@@ -138,6 +138,7 @@ class SceneParser {
     }
     if (root["effects"]) scene.effects = effects(root["effects"], "effects");
     if (root["constraints"]) p.constraints = constraints(root["constraints"], "constraints");
+    if (root["actuators"]) p.reaction_wheels = actuators(root["actuators"], "actuators");
     if (root["allow_nonphysical_inertia"]) {
       scene.allow_nonphysical_inertia =
           boolean(root["allow_nonphysical_inertia"], "allow_nonphysical_inertia");
@@ -146,6 +147,20 @@ class SceneParser {
 
     // Physical checks (SPD inertia, T > 0, N range, ...) live in validateProblem, shared with the
     // planner node; here they gain the file name and the line of the key they name.
+    validateAt(root, p);
+    applyEffects(scene.effects, &p);
+    // The wheels' combinations with effects (actuator_limits) are known only now.
+    if (p.reaction_wheels.present()) validateAt(root, p);
+    return scene;
+  }
+
+ private:
+  std::string where(const YAML::Node& node) const {
+    return source_ + ":" + std::to_string(node.Mark().line + 1) + ": ";
+  }
+
+  /// validateProblem, its error placed at the line of the top-level key it names.
+  void validateAt(const YAML::Node& root, const PlanningProblem& p) const {
     try {
       validateProblem(p);
     } catch (const InvalidInput& e) {
@@ -155,13 +170,50 @@ class SceneParser {
       if (node) throw InvalidInput(where(node) + what);
       throw InvalidInput(source_ + ": " + what);
     }
-    applyEffects(scene.effects, &p);
-    return scene;
   }
 
- private:
-  std::string where(const YAML::Node& node) const {
-    return source_ + ":" + std::to_string(node.Mark().line + 1) + ": ";
+  /// A list of numbers (any length) at `path`; a scalar gives one entry if `scalar_allowed`.
+  std::vector<double> numbers(const YAML::Node& node, const std::string& path,
+                              bool scalar_allowed) const {
+    if (scalar_allowed && node.IsScalar()) return {number(node, path)};
+    if (!node.IsSequence()) {
+      fail(node, path,
+           std::string("expected ") + (scalar_allowed ? "a number or " : "") +
+               "a list of numbers (one per wheel), got " + show(node));
+    }
+    std::vector<double> out;
+    for (std::size_t i = 0; i < node.size(); ++i)
+      out.push_back(number(node[i], path + "[" + std::to_string(i) + "]"));
+    return out;
+  }
+
+  /// `actuators: {reaction_wheels: {spin_axes, max_torque, max_momentum, initial_momentum,
+  /// max_momentum_norm}}` (the values are checked by validateProblem).
+  ReactionWheels actuators(const YAML::Node& node, const std::string& path) const {
+    requireMap(node, path);
+    checkKeys(node, path, {"reaction_wheels"}, {"reaction_wheels"});
+    const std::string wpath = path + ".reaction_wheels";
+    const YAML::Node w = node["reaction_wheels"];
+    requireMap(w, wpath);
+    checkKeys(w, wpath,
+              {"spin_axes", "max_torque", "max_momentum", "initial_momentum", "max_momentum_norm"},
+              {"spin_axes", "max_torque", "max_momentum"});
+    ReactionWheels out;
+    const YAML::Node axes = w["spin_axes"];
+    if (!axes.IsSequence()) {
+      fail(axes, wpath + ".spin_axes", "expected a list of axes [x, y, z], got " + show(axes));
+    }
+    for (std::size_t i = 0; i < axes.size(); ++i)
+      out.spin_axes.push_back(vector3(axes[i], wpath + ".spin_axes[" + std::to_string(i) + "]"));
+    out.max_torque = numbers(w["max_torque"], wpath + ".max_torque", true);
+    out.max_momentum = numbers(w["max_momentum"], wpath + ".max_momentum", true);
+    if (w["initial_momentum"]) {
+      out.initial_momentum = numbers(w["initial_momentum"], wpath + ".initial_momentum", false);
+    }
+    if (w["max_momentum_norm"]) {
+      out.max_momentum_norm = number(w["max_momentum_norm"], wpath + ".max_momentum_norm");
+    }
+    return out;
   }
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
@@ -619,6 +671,20 @@ std::string formatScene(const Scene& scene) {
   }
   if (rigid) out << ", angular_velocity: " << vec(p.final_velocity);
   out << "}\n";
+  if (p.reaction_wheels.present()) {
+    const ReactionWheels& w = p.reaction_wheels;
+    const auto list = [](const std::vector<double>& v) {
+      return vec(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size())));
+    };
+    out << "actuators: {reaction_wheels: {spin_axes: [";
+    for (int i = 0; i < w.count(); ++i) out << (i ? ", " : "") << vec(w.spin_axes[i]);
+    out << "], max_torque: " << list(w.max_torque) << ", max_momentum: " << list(w.max_momentum);
+    if (!w.initial_momentum.empty()) out << ", initial_momentum: " << list(w.initial_momentum);
+    if (std::isfinite(w.max_momentum_norm)) {
+      out << ", max_momentum_norm: " << exactNumber(w.max_momentum_norm);
+    }
+    out << "}}\n";
+  }
   out << "effects:";
   if (scene.effects.empty()) out << " []";
   out << "\n";

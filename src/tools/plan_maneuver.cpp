@@ -75,7 +75,8 @@ const char* const kUsage =
     "                            solve stays in its homotopy class (no other starts); with\n"
     "                            constraints the interior point starts from it (rigid_body)\n"
     "  --csv OUT.csv             write the trajectory: rigid_body "
-    "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz;\n"
+    "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz\n"
+    "                            (+ u1..un,h1..hn with reaction wheels);\n"
     "                            drift_two_input k,t,qw,qx,qy,qz,u1,u2,p1,p2,p3\n"
     "  --summary OUT.json        write the result figures as JSON\n"
     "  --help                    show this help\n"
@@ -279,7 +280,14 @@ int main(int argc, char** argv) {
     std::cout << "scene                    " << args.scene << "\n"
               << ap::planResultText(problem, result);
     if (!args.csv.empty() && !result.maneuver.attitude.empty()) {
-      ap::writeManeuverCsv(result.maneuver, args.csv);
+      if (problem.reaction_wheels.present()) {
+        ap::writeManeuverCsv(result.maneuver,
+                             ap::wheelStates(problem.scheme, problem.inertia,
+                                             problem.reaction_wheels, result.maneuver),
+                             args.csv);
+      } else {
+        ap::writeManeuverCsv(result.maneuver, args.csv);
+      }
     }
     if (!args.summary.empty()) {
       std::ofstream out(args.summary);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/dynamics/wheel_replay.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/csv.hpp"
 #include "attitude_planner/io/scene.hpp"
@@ -131,6 +132,34 @@ void printReport(const ap::Scene& scene, ap::SchemeKind kind, int N, double h,
       effect_names.c_str());
 }
 
+/// With reaction wheels: body + wheels replayed from the CSV's wheel torques alone
+/// (replayWithWheels), the terminal miss and each wheel's peaks against its limits.
+void replayWheels(const ap::PlanningProblem& p, const std::string& csv_path, double h) {
+  const std::vector<Eigen::VectorXd> u = ap::readWheelTorquesCsv(csv_path);
+  const ap::ReactionWheels& wheels = p.reaction_wheels;
+  if (static_cast<int>(u.empty() ? 0 : u[0].size()) != wheels.count()) {
+    throw ap::InvalidInput("maneuver CSV '" + csv_path + "': the scene has " +
+                           std::to_string(wheels.count()) +
+                           " reaction wheels; the CSV needs their columns u1..un, h1..hn "
+                           "(plan_maneuver --csv writes them)");
+  }
+  Eigen::VectorXd h0(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) h0(i) = wheels.initialMomentum(i);
+  const ap::WheelReplay replay = ap::replayWithWheels(
+      p.inertia, ap::wheelArray(wheels).axes, p.initial_attitude, p.initial_velocity, h0, h, u);
+  std::printf(
+      "wheel replay             terminal attitude error %.3g rad, velocity error %.3g rad/s\n",
+      ap::so3::angleBetween(replay.attitude.back(), p.final_attitude),
+      (replay.angular_velocity.back() - p.final_velocity).norm());
+  for (int i = 0; i < wheels.count(); ++i) {
+    double peak_u = 0.0;
+    for (const Eigen::VectorXd& row : u) peak_u = std::max(peak_u, std::abs(row(i)));
+    std::printf(
+        "  wheel_%d                peak |h| %.6g of %.6g N m s, peak |u| %.6g of %.6g N m\n", i + 1,
+        replay.peak_momentum(i), wheels.momentumLimit(i), peak_u, wheels.torqueLimit(i));
+  }
+}
+
 /// Loads, replays and reports; the exit status.
 int run(const Arguments& args) {
   const ap::Scene scene = ap::loadScene(args.scene_path);
@@ -161,6 +190,7 @@ int run(const Arguments& args) {
   const ap::Maneuver replay = ap::replayPlan(kind, p.inertia, h, input, &report);
   const Miss m = missOf(p, planned, replay);
   printReport(scene, kind, N, h, replay, report, m);
+  if (p.reaction_wheels.present()) replayWheels(p, args.csv_path, h);
   if (!args.out_csv.empty()) ap::writeManeuverCsv(replay, args.out_csv);
   if (args.max_miss >= 0.0 &&
       (m.attitude_error > args.max_miss || m.velocity_error > args.max_miss)) {

@@ -124,7 +124,9 @@ std::vector<std::string> quantityBranches(const std::string& dir,
 TEST(CodeShape, NoSwitchOnAStageQuantityOutsideTheQuantityClasses) {
   int files = 0;
   const std::vector<std::string> found = quantityBranches(
-      kSourceDir + "/src/planning", {"/crosscheck/", "/transcription/stage_quantities."}, &files);
+      kSourceDir + "/src/planning",
+      {"/crosscheck/", "/transcription/stage_quantities.", "/transcription/wheel_quantities."},
+      &files);
   EXPECT_GT(files, 20) << "the scan read no sources";
   std::string listed;
   for (const std::string& line : found) listed += line + "\n";

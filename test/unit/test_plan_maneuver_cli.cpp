@@ -548,3 +548,16 @@ TEST_F(CliTest, WarmStartFromAPlanCsvRecoversTheRemainder) {
   EXPECT_CONTAINS(drift.output, "--warm-start");
   EXPECT_CONTAINS(run("plan_maneuver", "--help").output, "--warm-start PLAN.csv");
 }
+
+// Reaction wheels through the tools: the CSV's wheel columns, and simulate_torques replaying body
+// + wheels from them (docs/reaction_wheels.md).
+TEST_F(CliTest, WheelScenePlansAndReplaysBodyAndWheels) {
+  const std::string csv = dir_ + "/wheels.csv";
+  const ToolRun plan = run("plan_maneuver", kScenes + "reaction_wheels_min_time.yaml --csv " + csv);
+  EXPECT_EQ(plan.status, 0) << plan.output;
+  EXPECT_CONTAINS(plan.output, "reaction_wheels");
+  const ToolRun replay = run("simulate_torques", kScenes + "reaction_wheels_min_time.yaml " + csv);
+  EXPECT_EQ(replay.status, 0) << replay.output;
+  EXPECT_CONTAINS(replay.output, "wheel replay             terminal attitude error");
+  EXPECT_CONTAINS(replay.output, "wheel_3");
+}

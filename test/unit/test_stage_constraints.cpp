@@ -23,6 +23,7 @@
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "support/quantity_differences.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
 #include "support/turned_world.hpp"
@@ -95,6 +96,10 @@ std::vector<double> valuesOf(const ap::StageConstraint& constraint, const ap::Re
         break;
       case ap::StageQuantity::NodeRate:  // the plan's node velocity J⁻¹Π_k
         q(0) = 0.5 * np.maneuver(np.current()).angular_velocity[k].squaredNorm();
+        break;
+      case ap::StageQuantity::WheelMomentum:  // their own suite: test_reaction_wheels
+      case ap::StageQuantity::WheelTorque:
+        q = constraint.quantityModel().value(ap::QuantityInputs(np, np.current()), k);
         break;
     }
     out.push_back(constraint.value(q));
@@ -194,6 +199,9 @@ ap::Vector3 quantityOnPlan(const ap::StageConstraint& c, const ap::Maneuver& pla
     case ap::StageQuantity::Pointing:
       return ap::Vector3(c.spec()->world_direction.dot(plan.attitude[k] * c.spec()->body_axis), 0.0,
                          0.0);
+    case ap::StageQuantity::WheelMomentum:  // their own suite: test_reaction_wheels
+    case ap::StageQuantity::WheelTorque:
+      return c.quantityModel().valueOnPlan(plan, k);
   }
   return ap::Vector3::Zero();
 }
@@ -519,17 +527,6 @@ std::vector<QuantityCase> quantityCases() {
   return out;
 }
 
-/// δ restricted to the local nodes first_node.. of an instance (fixed nodes 0).
-Eigen::Matrix<double, 9, 1> localPart(const ap::ReducedProblem& np, const Eigen::VectorXd& d,
-                                      int first_node, int width) {
-  Eigen::Matrix<double, 9, 1> out = Eigen::Matrix<double, 9, 1>::Zero();
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) out.segment<3>(3 * n) = d.segment<3>(v);
-  }
-  return out;
-}
-
 class StageQuantityDerivatives : public testing::TestWithParam<QuantityCase> {
  protected:
   void SetUp() override {
@@ -555,21 +552,6 @@ class StageQuantityDerivatives : public testing::TestWithParam<QuantityCase> {
     lambda_ = ap::Vector3(normal(rng), normal(rng), normal(rng));
   }
 
-  /// q_k for every instance at `np`'s current iterate.
-  std::vector<ap::Vector3> values(const ap::ReducedProblem& np) const {
-    const ap::QuantityInputs at(np, np.current());
-    std::vector<ap::Vector3> out;
-    for (int k = support_.first_k; k <= support_.last_k; ++k)
-      out.push_back(quantity_->value(at, k));
-    return out;
-  }
-  /// The iterate moved by α·direction (the retraction the terms are derivatives of).
-  ap::ReducedProblem moved(double alpha, double h) const {
-    ap::ReducedProblem out = *np_;
-    out.setTimeStep(h);
-    out.setCurrent(out.retract(direction_, alpha));
-    return out;
-  }
   /// λ as the quantity contracts it (scalar quantities: λ(0) alone).
   ap::Vector3 contracted() const {
     return quantity_->kind() == ap::StageQuantity::Torque ? lambda_
@@ -586,72 +568,16 @@ class StageQuantityDerivatives : public testing::TestWithParam<QuantityCase> {
 };
 
 TEST_P(StageQuantityDerivatives, TermsMatchCentralDifferencesAtAFixedTimeStep) {
-  const ap::ReducedProblem& np = *np_;
-  const double h = np.timeStep(), e = 1e-6, e2 = 1e-4;
-  const std::vector<ap::Vector3> q0 = values(np);
-  const std::vector<ap::Vector3> up = values(moved(e, h)), down = values(moved(-e, h));
-  const std::vector<ap::Vector3> up2 = values(moved(e2, h)), down2 = values(moved(-e2, h));
-  int visited = 0;
-  quantity_->forEachTerms(
-      np, support_, [&](int, const ap::Vector3&) { return lambda_; },
-      [&](const ap::QuantityTerms& t) {
-        const int i = t.k - support_.first_k;
-        const std::string where = "k = " + std::to_string(t.k);
-        ++visited;
-        EXPECT_LE((t.value - q0[i]).norm(), 1e-13 * (1 + q0[i].norm())) << where;
-        const Eigen::Matrix<double, 9, 1> d =
-            localPart(np, direction_, t.k + support_.node_offset, support_.width);
-        const ap::Vector3 slope = t.jacobian * d, fd = (up[i] - down[i]) / (2 * e);
-        EXPECT_LE((slope - fd).norm(), 1e-6 * (1 + fd.norm())) << where;
-        // d²/dα² λᵀq(R exp(α d)) = dᵀ(Σ λ_i ∇²q_i)d: the retraction is a straight line in δ.
-        const ap::Vector3 l = contracted();
-        const double second = d.dot(t.curvature * d);
-        const double fd2 = l.dot(up2[i] - 2 * q0[i] + down2[i]) / (e2 * e2);
-        EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
-      });
-  EXPECT_EQ(visited, support_.last_k - support_.first_k + 1);
+  const ap::test_support::QuantityDifferences check{*quantity_, *np_,         support_, direction_,
+                                                    lambda_,    contracted(), 1e-13};
+  EXPECT_EQ(check.checkAtFixedTimeStep(), support_.last_k - support_.first_k + 1);
 }
 
 TEST_P(StageQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH) {
-  const ap::ReducedProblem& np = *np_;
-  const double h = np.timeStep(), dh = 1e-5 * h, e = 1e-4;
-  const std::vector<ap::Vector3> q0 = values(np);
-  const std::vector<ap::Vector3> later = values(moved(0, h + dh)),
-                                 earlier = values(moved(0, h - dh));
-  // Mixed: λᵀq at (α, h) = (±e, h ± dh).
-  const std::vector<ap::Vector3> pp = values(moved(e, h + dh)), pm = values(moved(e, h - dh)),
-                                 mp = values(moved(-e, h + dh)), mm = values(moved(-e, h - dh));
-  const std::vector<ap::Vector3> up = values(moved(e, h)), down = values(moved(-e, h));
   EXPECT_EQ(quantity_->dependsOnTimeStep(), quantity_->kind() != ap::StageQuantity::Pointing);
-  int visited = 0;
-  quantity_->forEachTermsWithTimeStep(
-      np, support_, 1.0, [&](int, const ap::Vector3&) { return lambda_; },
-      [&](const ap::QuantityTermsWithTimeStep& t) {
-        const int i = t.k - support_.first_k;
-        const std::string where = "k = " + std::to_string(t.k);
-        ++visited;
-        EXPECT_LE((t.value - q0[i]).norm(), 1e-13 * (1 + q0[i].norm())) << where;
-        const ap::Vector3 fd_h = (later[i] - earlier[i]) / (2 * dh);
-        const ap::Vector3 in_h = t.jacobian.col(9);
-        EXPECT_LE((in_h - fd_h).norm(), 1e-6 * (1 + fd_h.norm())) << where;
-        if (!quantity_->dependsOnTimeStep()) {
-          EXPECT_EQ(in_h.norm(), 0.0) << where;
-        }
-        Eigen::Matrix<double, 10, 1> d = Eigen::Matrix<double, 10, 1>::Zero();
-        d.head<9>() = localPart(np, direction_, t.k + support_.node_offset, support_.width);
-        const ap::Vector3 slope = t.jacobian * d, fd = (up[i] - down[i]) / (2 * e);
-        EXPECT_LE((slope - fd).norm(), 1e-6 * (1 + fd.norm())) << where;
-        const ap::Vector3 l = contracted();
-        const double second = d.dot(t.curvature * d);  // h entry of d is 0: the δδ block
-        const double fd2 = l.dot(up[i] - 2 * q0[i] + down[i]) / (e * e);
-        EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
-        const double fd_hh = l.dot(later[i] - 2 * q0[i] + earlier[i]) / (dh * dh);
-        EXPECT_NEAR(t.curvature(9, 9), fd_hh, 1e-4 * (1 + std::abs(fd_hh))) << where;
-        const double fd_mixed = l.dot(pp[i] - pm[i] - mp[i] + mm[i]) / (4 * e * dh);
-        const double mixed = d.head<9>().dot(t.curvature.block<9, 1>(0, 9));
-        EXPECT_NEAR(mixed, fd_mixed, 1e-4 * (1 + std::abs(fd_mixed))) << where;
-      });
-  EXPECT_EQ(visited, support_.last_k - support_.first_k + 1);
+  const ap::test_support::QuantityDifferences check{*quantity_, *np_,         support_, direction_,
+                                                    lambda_,    contracted(), 1e-13};
+  EXPECT_EQ(check.checkWithTimeStep(1.0), support_.last_k - support_.first_k + 1);
 }
 
 /// The value on a plan is the plain form the constraints' slacks read: τ_k, the plan's reported
@@ -677,6 +603,10 @@ TEST_P(StageQuantityDerivatives, ValueOnAPlanIsItsPlainForm) {
         EXPECT_NEAR(r(0), cone.world_direction.dot(plan.attitude[k] * cone.body_axis), 1e-15);
         break;
       }
+      case ap::StageQuantity::WheelMomentum:  // not in everyKind: test_reaction_wheels
+      case ap::StageQuantity::WheelTorque:
+        ADD_FAILURE() << "no wheels in this suite's problem";
+        break;
     }
   }
   // Where the transcription has the instance too, the two agree (½|Ω|² for the rates).

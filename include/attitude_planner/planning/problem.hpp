@@ -22,6 +22,7 @@
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
 #include "attitude_planner/planning/constraints.hpp"
+#include "attitude_planner/planning/reaction_wheels.hpp"
 
 namespace attitude_planner {
 
@@ -191,8 +192,13 @@ struct PlanningProblem {
   bool hasTorqueBounds() const { return max_torque.allFinite(); }
   /// Constraints at every node (scene key `constraints:`, constraints.hpp); empty: none.
   std::vector<PlanningConstraint> constraints;
-  /// Any per-axis bound or node constraint.
-  bool hasNodeConstraints() const { return hasTorqueBounds() || !constraints.empty(); }
+  /// Reaction wheels (scene `actuators: {reaction_wheels: …}`, reaction_wheels.hpp): their
+  /// torque and momentum limits are node constraints of the plan. Empty: none.
+  ReactionWheels reaction_wheels;
+  /// Any per-axis bound, node constraint or reaction-wheel limit.
+  bool hasNodeConstraints() const {
+    return hasTorqueBounds() || !constraints.empty() || reaction_wheels.present();
+  }
   /// A requested accuracy instead of `steps`: planManeuver chooses N (and the scheme if asked)
   /// from the measured order and a two-resolution estimate (accuracy.hpp). Inactive by default.
   AccuracyTarget accuracy;

@@ -88,6 +88,9 @@ StageSupport rowRange(StageQuantity quantity, int N) {
       return {1, N, 0, 1};
     case StageQuantity::NodeRate:  // schemes with end torques are refused (plan_at_resolution)
       break;
+    case StageQuantity::WheelMomentum:
+    case StageQuantity::WheelTorque:
+      throw InvalidInput("solver", "nlopt: reaction wheels are planned by solver newton only");
   }
   throw InvalidInput("scheme", "nlopt: the direct method has no node rates (no end torques)");
 }
@@ -160,6 +163,8 @@ std::vector<NodeRow> nodeRowValues(const NodeRows& node_rows, const DiscreteSche
           break;
         }
         case StageQuantity::NodeRate:
+        case StageQuantity::WheelMomentum:
+        case StageQuantity::WheelTorque:
           break;  // refused by rowRange
       }
     }

@@ -1,6 +1,7 @@
 #include "planning/problem/duration_bound.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -66,6 +67,17 @@ TorqueAuthority torqueAuthority(const PlanningProblem& problem) {
   if (problem.hasTorqueBounds()) {
     authority.largest_magnitude = problem.max_torque.norm();
     authority.smallest_about_any_axis = problem.max_torque.minCoeff();
+  }
+  const ReactionWheels& wheels = problem.reaction_wheels;
+  if (wheels.present()) {
+    // About every axis the array makes at least σ_min(A) min U_i (a guess's figure only: the
+    // body torque −A u − Ω × A h_w has no bound from the wheels' limits alone, so
+    // largest_magnitude, which the proof of T_c needs, is left to the body-torque bounds).
+    const WheelArray array = wheelArray(wheels);
+    double least = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < wheels.count(); ++i) least = std::min(least, wheels.torqueLimit(i));
+    const double sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(array.axes).singularValues().minCoeff();
+    authority.smallest_about_any_axis = std::min(authority.smallest_about_any_axis, sigma * least);
   }
   for (const PlanningConstraint& c : problem.constraints) {
     if (c.kind != ConstraintKind::MaxTorqueNorm) continue;

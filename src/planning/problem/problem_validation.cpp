@@ -72,6 +72,51 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
   }
 }
 
+/// Reaction wheels: the array valid, the combinations the wheel model does not plan refused by
+/// name, and the end state's wheel momenta (fixed by the boundary data: q_N = R_Nᵀπ₀ − J Ω(T))
+/// within their limits, else no plan exists.
+void requireWheelsServed(const PlanningProblem& p) {
+  const std::string field = "actuators.reaction_wheels";
+  validateReactionWheels(p.reaction_wheels, field);
+  const auto refuse = [&](const std::string& what, const std::string& why) {
+    throw InvalidInput(field, "not supported with " + what + ": " + why);
+  };
+  if (p.hasTorqueBounds()) {
+    refuse("effects actuator_limits",
+           "the wheels' max_torque bounds the actuators (a body-torque box beside it would "
+           "bound a torque no actuator makes); give per-wheel max_torque, or max_torque_norm "
+           "under constraints for a body-torque bound");
+  }
+  if (p.effects && !p.effects->empty()) {
+    refuse("effects",
+           "an external torque changes the total angular momentum the wheel "
+           "momenta are computed from (not modelled yet)");
+  }
+  if (p.end_condition.pointing()) refuse("final.pointing", "give a final attitude");
+  if (p.accuracy.active()) refuse("an accuracy target", "give steps");
+  const WheelArray array = wheelArray(p.reaction_wheels);
+  const Vector3 total =
+      p.initial_attitude * (p.inertia * p.initial_velocity + array.initial_array_momentum);
+  const Vector3 final_array = p.final_attitude.transpose() * total - p.inertia * p.final_velocity;
+  const Eigen::VectorXd final_wheels = array.wheelMomenta(final_array);
+  for (int i = 0; i < p.reaction_wheels.count(); ++i) {
+    const double limit = p.reaction_wheels.momentumLimit(i);
+    if (std::abs(final_wheels(i)) > limit) {
+      throw InvalidInput(field + ".max_momentum",
+                         "the final state (attitude and angular velocity) leaves wheel " +
+                             std::to_string(i + 1) + " with " + exactNumber(final_wheels(i)) +
+                             " N m s, beyond its limit " + exactNumber(limit) +
+                             " N m s: no plan can end there");
+    }
+  }
+  if (final_array.norm() > p.reaction_wheels.max_momentum_norm) {
+    throw InvalidInput(
+        field + ".max_momentum_norm",
+        "the final state leaves the array with |A h_w| = " + exactNumber(final_array.norm()) +
+            " N m s, beyond " + exactNumber(p.reaction_wheels.max_momentum_norm) + " N m s");
+  }
+}
+
 /// `value` (> 0, finite) within the magnitudes the planner works in, else InvalidInput naming
 /// `field`, the value and the cause (the floating-point range, not the physics).
 void requireMagnitude(double value, const std::string& field, const std::string& what) {
@@ -233,6 +278,7 @@ void validateProblem(const PlanningProblem& p) {
   requireFinite(p.final_velocity, "final.angular_velocity");
   if (p.end_condition.pointing()) requirePointingServed(p);
   requireBoundaryWithinConstraints(p);
+  if (p.reaction_wheels.present()) requireWheelsServed(p);
 }
 
 void applySchemeName(const std::string& text, const std::string& field, PlanningProblem* problem) {

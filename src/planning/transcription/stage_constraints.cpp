@@ -7,6 +7,7 @@
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/wheel_quantities.hpp"
 
 namespace attitude_planner {
 
@@ -168,6 +169,7 @@ StageConstraints buildStageConstraints(const PlanningProblem& problem) {
         break;
     }
   }
+  appendWheelConstraints(problem, &out);
   return out;
 }
 
@@ -225,6 +227,7 @@ ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver&
   if (problem.hasTorqueBounds()) out.names.push_back("actuator_limits");
   for (const PlanningConstraint& c : problem.constraints)
     out.names.push_back(constraintKindName(c.kind));
+  if (problem.reaction_wheels.present()) out.names.push_back("reaction_wheels");
   const int N = maneuver.steps();
   const bool end_torques = schemeHasEndTorques(problem.scheme);
   for (const auto& c : buildStageConstraints(problem)) {

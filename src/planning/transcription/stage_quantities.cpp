@@ -5,6 +5,7 @@
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/wheel_quantities.hpp"
 
 namespace attitude_planner {
 
@@ -317,6 +318,15 @@ class PointingQuantity final : public StageQuantityModel {
   Vector3 body_axis_, world_direction_;
 };
 
+/// The wheel kinds' prototypes' problem: three orthogonal wheels, the paper scheme.
+PlanningProblem threeWheelProblem() {
+  PlanningProblem p;
+  p.reaction_wheels.spin_axes = {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()};
+  p.reaction_wheels.max_torque = {1.0};
+  p.reaction_wheels.max_momentum = {1.0};
+  return p;
+}
+
 /// One object per kind for the kind-level questions (support, h dependence) the tests and the
 /// dense NLPs ask by name.
 const StageQuantityModel& prototype(StageQuantity quantity) {
@@ -324,7 +334,15 @@ const StageQuantityModel& prototype(StageQuantity quantity) {
   static const StepRateQuantity step_rate;
   static const NodeRateQuantity node_rate{Matrix3::Identity()};
   static const PointingQuantity pointing{Vector3::UnitX(), Vector3::UnitX()};
+  static const std::shared_ptr<const StageQuantityModel> wheel_momentum =
+      makeWheelMomentumQuantity(threeWheelProblem(), false);
+  static const std::shared_ptr<const StageQuantityModel> wheel_torque =
+      makeWheelTorqueQuantity(threeWheelProblem());
   switch (quantity) {
+    case StageQuantity::WheelMomentum:
+      return *wheel_momentum;
+    case StageQuantity::WheelTorque:
+      return *wheel_torque;
     case StageQuantity::Torque:
       return torque;
     case StageQuantity::StepRate:

@@ -33,6 +33,12 @@ enum class StageQuantity {
   NodeRate,  ///< q = ½|J⁻¹Π_k|² [rad²/s²] of node k (schemes with end torques) on R_{k−1..k+1};
              ///< moves with h
   Pointing,  ///< q = sᵀR_k b (the cosine of the angle between R_k b and s) on R_k; no h
+  /// q = R_kᵀπ₀ − Π_k [N m s]: the reaction wheels' momentum A h_w in the body frame
+  /// (wheel_quantities.hpp) on R_{k−1..k+1}; moves with h
+  WheelMomentum,
+  /// q = −(τ_k + J⁻¹Π_k × (R_kᵀπ₀ − Π_k)) [N m]: the wheels' torque A u on the body frame's
+  /// axes (wheel_quantities.hpp) on R_{k−1..k+1}; moves with h
+  WheelTorque,
 };
 
 /// Where the instances of a quantity sit: k = first_k..last_k, each on the nodes
@@ -136,7 +142,8 @@ std::shared_ptr<const StageQuantityModel> makePointingQuantity(const Vector3& bo
 
 /// The support of a quantity of this kind (StageQuantityModel::support).
 StageSupport stageSupport(StageQuantity quantity, int first_free, int last_free);
-/// True where a quantity of this kind moves with h (all but Pointing).
+/// True where a quantity of this kind moves with h (all but Pointing). The wheel kinds answer
+/// for a scheme without end torques (their support depends on the scheme: ask the object).
 bool quantityDependsOnTimeStep(StageQuantity quantity);
 /// The instances on a plan (StageQuantityModel::planSupport): the torques the plan carries
 /// (1..N−1; 0..N with end torques), the step rates 0..N−1, node rates and cones 0..N.

@@ -1,0 +1,489 @@
+// Reaction wheels (planning/reaction_wheels.hpp, transcription/wheel_quantities.hpp): the input's
+// validation; the wheel quantities' derivatives against central differences at a fixed h and in
+// h, every scheme, at rest and spinning, with a momentum bias; the discrete wheel states against
+// the plan's discrete dynamics (exact conservation, O(h²) torques); minimum time against the
+// closed-form bang–coast–bang slew; random converged plans meet every wheel limit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "attitude_planner/dynamics/wheel_replay.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/csv.hpp"
+#include "attitude_planner/io/report.hpp"
+#include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/planner.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
+#include "planning/transcription/wheel_quantities.hpp"
+#include "support/quantity_differences.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+/// Four wheels in a pyramid about body z (54.74° from it: the classic NASA-style skew).
+std::vector<ap::Vector3> pyramid() {
+  const double s = std::sqrt(2.0 / 3.0), c = std::sqrt(1.0 / 3.0);
+  return {ap::Vector3(s, 0, c), ap::Vector3(0, s, c), ap::Vector3(-s, 0, c), ap::Vector3(0, -s, c)};
+}
+
+/// A generic body with a biased pyramid: every term of the quantities nonzero.
+ap::PlanningProblem wheelProblem(ap::SchemeKind scheme, bool spinning, int steps = 16) {
+  ap::PlanningProblem p;
+  p.inertia << 13.0, -2.0, 1.0, -2.0, 16.0, 0.5, 1.0, 0.5, 18.0;
+  p.duration = 8.0;
+  p.steps = steps;
+  p.scheme = scheme;
+  p.final_attitude = ap::so3::exp(ap::Vector3(0.4, -0.7, 0.9));
+  if (spinning) {
+    p.initial_velocity = ap::Vector3(0.05, -0.03, 0.08);
+    p.final_velocity = ap::Vector3(-0.04, 0.06, 0.02);
+  }
+  p.reaction_wheels.spin_axes = pyramid();
+  p.reaction_wheels.max_torque = {0.3};
+  p.reaction_wheels.max_momentum = {3.0};
+  p.reaction_wheels.initial_momentum = {0.3, -0.2, 0.5, 0.1};
+  p.reaction_wheels.max_momentum_norm = 4.0;
+  return p;
+}
+
+/// An InvalidInput's message, or "" if `f` did not throw one.
+template <typename F>
+std::string refusal(F f) {
+  try {
+    f();
+  } catch (const ap::InvalidInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string refusalOf(const ap::PlanningProblem& p) {
+  return refusal([&] { ap::validateProblem(p); });
+}
+
+}  // namespace
+
+TEST(ReactionWheelInput, BadArraysAreRefusedByName) {
+  const ap::PlanningProblem good = wheelProblem(ap::SchemeKind::SecondOrder, false);
+  EXPECT_EQ(refusalOf(good), "");
+  ap::PlanningProblem p = good;
+  p.reaction_wheels.spin_axes = {ap::Vector3::UnitX(), ap::Vector3::UnitY(), ap::Vector3(1, 1, 0)};
+  EXPECT_NE(refusalOf(p).find("spin_axes: the axes do not span R^3"), std::string::npos)
+      << refusalOf(p);
+  p = good;
+  p.reaction_wheels.spin_axes.resize(2);
+  p.reaction_wheels.initial_momentum.resize(2);
+  EXPECT_NE(refusalOf(p).find("spin_axes: need at least 3 wheels"), std::string::npos);
+  p = good;
+  p.reaction_wheels.max_torque = {0.3, 0.3, -0.1, 0.3};
+  EXPECT_NE(refusalOf(p).find("max_torque: each limit must be a finite number > 0 N m, got -0.1"),
+            std::string::npos)
+      << refusalOf(p);
+  p = good;
+  p.reaction_wheels.max_momentum = {3.0, 3.0};
+  EXPECT_NE(refusalOf(p).find("max_momentum: give one value or one per wheel (4)"),
+            std::string::npos);
+  p = good;
+  p.reaction_wheels.initial_momentum = {0.3, -3.5, 0.5, 0.1};
+  EXPECT_NE(refusalOf(p).find("initial_momentum: wheel 2 starts at -3.5 N m s, beyond its "
+                              "max_momentum 3 N m s"),
+            std::string::npos)
+      << refusalOf(p);
+  p = good;
+  p.reaction_wheels.initial_momentum = {0.3, 0.5};
+  EXPECT_NE(refusalOf(p).find("initial_momentum: give one value per wheel (4)"), std::string::npos);
+  p = good;
+  p.reaction_wheels.max_momentum_norm = 0.1;
+  EXPECT_NE(refusalOf(p).find("max_momentum_norm: the initial momenta give"), std::string::npos);
+}
+
+TEST(ReactionWheelInput, CombinationsTheModelDoesNotPlanAreRefusedByName) {
+  ap::PlanningProblem p = wheelProblem(ap::SchemeKind::SecondOrder, false);
+  p.max_torque = ap::Vector3::Constant(0.5);
+  EXPECT_NE(refusalOf(p).find("reaction_wheels: not supported with effects actuator_limits"),
+            std::string::npos)
+      << refusalOf(p);
+  // The end state fixes the wheels' final momenta: a spin the array cannot absorb is refused.
+  p = wheelProblem(ap::SchemeKind::SecondOrder, false);
+  p.final_velocity = ap::Vector3(0.0, 0.0, 0.5);  // J Ω(T) ≈ 9 N m s about z
+  EXPECT_NE(refusalOf(p).find("the final state (attitude and angular velocity) leaves wheel"),
+            std::string::npos)
+      << refusalOf(p);
+}
+
+TEST(ReactionWheelInput, SceneKeysParseAndRoundTrip) {
+  const std::string text =
+      "inertia: [10, 10, 10]\nduration: 8\nsteps: 32\nscheme: second_order\n"
+      "initial: {attitude: {axis: [0, 0, 1], angle: 0}, angular_velocity: [0, 0, 0]}\n"
+      "final: {attitude: {axis: [0, 0, 1], angle: 1}, angular_velocity: [0, 0, 0]}\n"
+      "actuators: {reaction_wheels: {spin_axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "
+      "max_torque: 1, max_momentum: [2, 2, 2.5], initial_momentum: [0.1, 0, 0], "
+      "max_momentum_norm: 3}}\n";
+  const ap::Scene scene = ap::parseScene(text, "wheels.yaml");
+  const ap::ReactionWheels& w = scene.problem.reaction_wheels;
+  ASSERT_EQ(w.count(), 3);
+  EXPECT_EQ(w.torqueLimit(2), 1.0);
+  EXPECT_EQ(w.momentumLimit(2), 2.5);
+  EXPECT_EQ(w.initialMomentum(0), 0.1);
+  EXPECT_EQ(w.max_momentum_norm, 3.0);
+  const ap::Scene again = ap::parseScene(ap::formatScene(scene), "again.yaml");
+  EXPECT_EQ(again.problem.reaction_wheels.momentumLimit(2), 2.5);
+  EXPECT_EQ(again.problem.reaction_wheels.max_momentum_norm, 3.0);
+  std::string bad = text;
+  bad.replace(bad.find("max_torque: 1"), 13, "max_torque: [1, 1]");
+  EXPECT_NE(refusal([&] {
+              ap::parseScene(bad, "bad.yaml");
+            }).find("actuators.reaction_wheels.max_torque: give one value or one per wheel"),
+            std::string::npos);
+  bad = text;
+  bad.replace(bad.find("max_torque"), 10, "max_torqe");
+  EXPECT_NE(refusal([&] {
+              ap::parseScene(bad, "bad.yaml");
+            }).find("actuators.reaction_wheels.max_torqe: unknown key"),
+            std::string::npos);
+}
+
+// ---- derivatives -------------------------------------------------------------------------------
+
+namespace {
+
+struct WheelCase {
+  ap::SchemeKind scheme;
+  bool spinning;
+  int quantity;  ///< 0: the array momentum q, 1: its half squared norm, 2: the array torque
+};
+
+std::vector<WheelCase> wheelCases() {
+  std::vector<WheelCase> out;
+  for (const ap::SchemeKind s :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder})
+    for (const bool spinning : {false, true})
+      for (const int quantity : {0, 1, 2}) out.push_back({s, spinning, quantity});
+  return out;
+}
+
+std::string wheelCaseName(const testing::TestParamInfo<WheelCase>& info) {
+  return ap::schemeName(info.param.scheme) + (info.param.spinning ? "_spinning" : "_rest") +
+         (info.param.quantity == 2   ? "_torque"
+          : info.param.quantity == 1 ? "_momentum_norm"
+                                     : "_momentum");
+}
+
+class WheelQuantityDerivatives : public testing::TestWithParam<WheelCase> {
+ protected:
+  void SetUp() override {
+    problem_ = wheelProblem(GetParam().scheme, GetParam().spinning);
+    quantity_ = GetParam().quantity == 2
+                    ? ap::makeWheelTorqueQuantity(problem_)
+                    : ap::makeWheelMomentumQuantity(problem_, GetParam().quantity == 1);
+    np_.emplace(problem_);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> normal(0.0, 0.05);
+    Eigen::VectorXd start(np_->unknowns());
+    for (int i = 0; i < start.size(); ++i) start(i) = normal(rng);
+    np_->setCurrent(np_->retract(start, 1.0));
+    support_ = quantity_->support(np_->firstFreeNode(), np_->lastFreeNode());
+    std::normal_distribution<double> unit;
+    direction_.resize(np_->unknowns());
+    for (int i = 0; i < direction_.size(); ++i) direction_(i) = unit(rng);
+    lambda_ = ap::Vector3(unit(rng), unit(rng), unit(rng));
+  }
+  ap::test_support::QuantityDifferences check() const {
+    // The contraction λ: all three entries for the vectors, λ(0) for ½|q|² (entries 1, 2 of
+    // its value are 0, so λ·Δ²q reads λ(0) alone either way).
+    return {*quantity_, *np_, support_, direction_, lambda_, lambda_, 1e-12};
+  }
+
+  ap::PlanningProblem problem_;
+  std::shared_ptr<const ap::StageQuantityModel> quantity_;
+  std::optional<ap::ReducedProblem> np_;
+  ap::StageSupport support_;
+  Eigen::VectorXd direction_;
+  ap::Vector3 lambda_;
+};
+
+}  // namespace
+
+TEST_P(WheelQuantityDerivatives, TermsMatchCentralDifferencesAtAFixedTimeStep) {
+  const int visited = check().checkAtFixedTimeStep();
+  EXPECT_EQ(visited, support_.last_k - support_.first_k + 1);
+  EXPECT_GE(visited, problem_.steps - 3);
+}
+
+/// In η = h/2.5: the h column times the scale, the hh corner times its square.
+TEST_P(WheelQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH) {
+  EXPECT_EQ(check().checkWithTimeStep(2.5), support_.last_k - support_.first_k + 1);
+}
+
+/// The transcription's value and the plan's (what the checker and the outputs read) agree.
+TEST_P(WheelQuantityDerivatives, ValueOnAPlanIsTheTranscriptionsValue) {
+  const ap::Maneuver plan = np_->maneuver(np_->current());
+  const ap::QuantityInputs at(*np_, np_->current());
+  for (int k = support_.first_k; k <= support_.last_k; ++k) {
+    const ap::Vector3 on_plan = quantity_->valueOnPlan(plan, k), q = quantity_->value(at, k);
+    if (GetParam().quantity == 1) {  // the plain form q of ½|q|²
+      EXPECT_NEAR(0.5 * on_plan.squaredNorm(), q(0), 1e-10 * (1 + q(0))) << "k = " << k;
+      continue;
+    }
+    EXPECT_LE((on_plan - q).norm(), 1e-10 * (1 + q.norm())) << "k = " << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryScheme, WheelQuantityDerivatives, testing::ValuesIn(wheelCases()),
+                         wheelCaseName);
+
+// ---- the discrete wheel states against the plan's discrete dynamics ---------------------------
+
+/// Body and array together conserve π₀ exactly on every step between interior nodes: the spatial
+/// array momentum R_k q_k changes by minus the body's trapezoidal impulse (and, with end torques,
+/// on the end steps too). Any iterate is a plan of its own torques, so a perturbed one serves.
+TEST(ReactionWheelPhysics, BodyAndArrayConserveTheTotalMomentumExactly) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    const ap::PlanningProblem p = wheelProblem(scheme, true);
+    ap::ReducedProblem np(p);
+    std::mt19937 rng(11);
+    std::normal_distribution<double> normal(0.0, 0.05);
+    Eigen::VectorXd delta(np.unknowns());
+    for (int i = 0; i < delta.size(); ++i) delta(i) = normal(rng);
+    np.setCurrent(np.retract(delta, 1.0));
+    const ap::Maneuver plan = np.maneuver(np.current());
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    const int N = plan.steps();
+    const double h = plan.time_step;
+    const bool ends = ap::schemeHasEndTorques(scheme);
+    double worst = 0.0, scale = 0.0;
+    for (int k = ends ? 0 : 1; k <= (ends ? N - 1 : N - 2); ++k) {
+      const ap::Vector3 now =
+          plan.attitude[k] * ap::planArrayMomentum(scheme, p.inertia, array, plan, k);
+      const ap::Vector3 next =
+          plan.attitude[k + 1] * ap::planArrayMomentum(scheme, p.inertia, array, plan, k + 1);
+      const ap::Vector3 impulse =
+          0.5 * h * (plan.attitude[k] * plan.torque[k] + plan.attitude[k + 1] * plan.torque[k + 1]);
+      worst = std::max(worst, (next - now + impulse).norm());
+      scale = std::max(scale, now.norm() + impulse.norm());
+    }
+    EXPECT_LE(worst, 1e-12 * scale) << ap::schemeName(scheme);
+    EXPECT_GT(scale, 0.1);
+  }
+}
+
+/// u_k = A⁺(−τ_k − Ω_k × q_k) is the wheel momenta's rate to O(h²): against their central
+/// difference on smooth (converged minimum-effort) plans of a biased, spinning slew.
+TEST(ReactionWheelPhysics, WheelTorquesAreTheMomentaRateToSecondOrder) {
+  for (const ap::SchemeKind scheme : {ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    std::vector<double> errors;
+    for (const int N : {32, 64, 128}) {
+      ap::PlanningProblem p = wheelProblem(scheme, true, N);
+      const ap::ReactionWheels wheels = p.reaction_wheels;
+      p.reaction_wheels = {};  // the plan without limits; the wheels only read it
+      const ap::PlanResult r = ap::planManeuver(p);
+      ASSERT_TRUE(r.converged()) << r.message;
+      const ap::WheelStates w = ap::wheelStates(scheme, p.inertia, wheels, r.maneuver);
+      double worst = 0.0;
+      for (int k = 2; k < N - 1; ++k) {
+        const Eigen::VectorXd rate =
+            (w.momentum[k + 1] - w.momentum[k - 1]) / (2 * r.maneuver.time_step);
+        worst = std::max(worst, (w.torque[k] - rate).cwiseAbs().maxCoeff());
+      }
+      errors.push_back(worst);
+      std::printf("%s N = %d: max |u_k - central difference of h_w| = %.3g N m\n",
+                  ap::schemeName(scheme).c_str(), N, worst);
+    }
+    EXPECT_GT(errors[0] / errors[1], 3.0)
+        << ap::schemeName(scheme) << " " << errors[0] << " " << errors[1];
+    EXPECT_GT(errors[1] / errors[2], 3.0)
+        << ap::schemeName(scheme) << " " << errors[1] << " " << errors[2];
+  }
+}
+
+// ---- planning ----------------------------------------------------------------------------------
+
+namespace {
+
+/// J = 10 I, three orthogonal wheels, zero bias, |τ| ≤ 1 N m, |A h_w| ≤ 2 N m s, rest to rest
+/// through 1 rad: the eigenaxis bang–coast–bang slew takes T* = θJ/H + H/U = 5 + 2 = 7 s.
+ap::PlanningProblem closedFormSlew(int steps) {
+  ap::PlanningProblem p;
+  p.inertia = 10.0 * ap::Matrix3::Identity();
+  p.steps = steps;
+  p.scheme = ap::SchemeKind::SecondOrder;
+  p.objective = ap::Objective::MinimumTime;
+  p.duration = 0.0;
+  p.final_attitude = ap::so3::exp(ap::Vector3(1.0, 2.0, -2.0).normalized());
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(1.0)};
+  p.reaction_wheels.spin_axes = {ap::Vector3::UnitX(), ap::Vector3::UnitY(), ap::Vector3::UnitZ()};
+  p.reaction_wheels.max_torque = {10.0};    // not binding: the body-torque norm is
+  p.reaction_wheels.max_momentum = {10.0};  // not binding: the envelope is
+  p.reaction_wheels.max_momentum_norm = 2.0;
+  return p;
+}
+
+}  // namespace
+
+TEST(ReactionWheelMinimumTime, MomentumLimitedSlewMeetsTheBangCoastBangClosedForm) {
+  constexpr double kClosedForm = 7.0;
+  std::vector<double> errors;
+  for (const int N : {32, 64, 128}) {
+    const ap::PlanResult r = ap::planManeuver(closedFormSlew(N));
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    // Free time's KKT point, not the fallback search on T (a curvature term the free-time
+    // assembly omits for non-stencil quantities once made the envelope stall it).
+    EXPECT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    // On the bound to the interior point's tolerance (N m and N m s, limits 1 and 2).
+    EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
+    errors.push_back(std::abs(r.minimum_duration - kClosedForm) / kClosedForm);
+    std::printf(
+        "N = %d: T* = %.9f s (relative error %.3g), violation %.3g, %d iterations, %.3g s\n", N,
+        r.minimum_duration, errors.back(), r.max_constraint_violation, r.iterations,
+        r.solve_time_s);
+  }
+  EXPECT_LE(errors.back(), 5e-3);
+  EXPECT_LT(errors[1], errors[0]);
+  EXPECT_LT(errors[2], errors[1]);
+}
+
+namespace {
+
+/// The peak wheel momentum and torque [N m s, N m] of `p` planned without the wheels' limits.
+struct WheelPeaks {
+  double momentum = 0.0, torque = 0.0;
+};
+WheelPeaks unconstrainedPeaks(ap::PlanningProblem p) {
+  const ap::ReactionWheels wheels = p.reaction_wheels;
+  p.reaction_wheels = {};
+  const ap::PlanResult free = ap::planManeuver(p);
+  EXPECT_TRUE(free.converged()) << free.message;
+  const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, wheels, free.maneuver);
+  WheelPeaks out;
+  for (int k = 0; k <= p.steps; ++k) {
+    out.momentum = std::max(out.momentum, w.momentum[k].cwiseAbs().maxCoeff());
+    out.torque = std::max(out.torque, w.torque[k].cwiseAbs().maxCoeff());
+  }
+  return out;
+}
+
+}  // namespace
+
+/// Seeded random biased pyramid slews whose wheel momentum limit is below the unconstrained
+/// plan's peak: converged plans meet every wheel limit on their own wheel states.
+TEST(ReactionWheelMinimumEffort, ConvergedPlansMeetEveryWheelLimit) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int converged = 0;
+  for (int c = 0; c < 6; ++c) {
+    ap::PlanningProblem p = wheelProblem(ap::SchemeKind::SecondOrder, false, 64);
+    p.inertia = ap::Vector3(10 + 4 * uniform(rng), 12 + 4 * uniform(rng), 14 + 4 * uniform(rng))
+                    .asDiagonal();
+    p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)) * 1.2);
+    p.duration = 20.0;
+    const WheelPeaks peaks = unconstrainedPeaks(p);
+    const double peak_h = peaks.momentum, peak_u = peaks.torque;
+    p.reaction_wheels.max_momentum = {0.85 * peak_h};
+    p.reaction_wheels.max_torque = {2.0 * peak_u};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    if (!refusalOf(p).empty()) continue;  // the end state beyond the limit
+    const ap::PlanResult r = ap::planManeuver(p);
+    if (!r.converged()) continue;
+    ++converged;
+    const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    for (int k = 0; k <= p.steps; ++k) {
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(std::abs(w.momentum[k](i)), 0.85 * peak_h * (1 + 1e-9))
+            << "case " << c << " k " << k;
+        EXPECT_LE(std::abs(w.torque[k](i)), 2.0 * peak_u * (1 + 1e-9))
+            << "case " << c << " k " << k;
+      }
+    }
+    EXPECT_GT(r.active_constraints, 0) << "case " << c;
+  }
+  std::printf("%d of 6 wheel-limited requests converged\n", converged);
+  EXPECT_GE(converged, 4);
+}
+
+// ---- the independent replay --------------------------------------------------------------------
+
+/// A wheel-limited biased pyramid slew, replayed as body + wheels from its wheel torques alone
+/// (replayWithWheels: continuous dynamics, RK4): the torques fly the plan (the terminal attitude
+/// miss and the wheels' momentum overshoot of the limit between and at the nodes both O(h²)).
+TEST(ReactionWheelReplay, WheelTorquesFlyThePlanWithinTheLimitsToSecondOrder) {
+  ap::PlanningProblem base = wheelProblem(ap::SchemeKind::SecondOrder, false, 64);
+  base.duration = 20.0;
+  const ap::ReactionWheels wheels = base.reaction_wheels;
+  const double peak = unconstrainedPeaks(base).momentum;
+  std::vector<double> misses, overshoots;
+  for (const int N : {64, 128, 256}) {
+    ap::PlanningProblem p = base;
+    p.steps = N;
+    p.reaction_wheels.max_momentum = {0.85 * peak};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    Eigen::VectorXd h0(4);
+    for (int i = 0; i < 4; ++i) h0(i) = p.reaction_wheels.initialMomentum(i);
+    const ap::WheelReplay replay =
+        ap::replayWithWheels(p.inertia, array.axes, p.initial_attitude, p.initial_velocity, h0,
+                             r.maneuver.time_step, w.torque);
+    misses.push_back(ap::so3::angleBetween(replay.attitude.back(), p.final_attitude));
+    overshoots.push_back(std::max(0.0, replay.peak_momentum.maxCoeff() / (0.85 * peak) - 1.0));
+    std::printf("N = %d: terminal miss %.3g rad, momentum overshoot %.3g (relative)\n", N,
+                misses.back(), overshoots.back());
+    // The plan's own wheel states meet the limits at the nodes to round-off.
+    for (int k = 0; k <= N; ++k) {
+      EXPECT_LE(w.momentum[k].cwiseAbs().maxCoeff(), 0.85 * peak * (1 + 1e-9)) << "k = " << k;
+      EXPECT_LE(w.torque[k].cwiseAbs().maxCoeff(), wheels.torqueLimit(0) * (1 + 1e-9))
+          << "k = " << k;
+    }
+  }
+  EXPECT_LT(misses[0], 1e-2);
+  EXPECT_GT(misses[0] / misses[1], 3.0);
+  EXPECT_GT(misses[1] / misses[2], 3.0);
+  EXPECT_LT(overshoots[0], 1e-2);
+  EXPECT_LE(overshoots[2], overshoots[0] / 8.0 + 1e-12);
+}
+
+// ---- outputs -----------------------------------------------------------------------------------
+
+/// The CSV carries u1..un, h1..hn after tx,ty,tz (and reads back as a plan); the JSON summary
+/// carries each wheel's peaks, limits and margins.
+TEST(ReactionWheelOutputs, CsvColumnsAndJsonMarginsPerWheel) {
+  const ap::PlanningProblem p = closedFormSlew(32);
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+  const std::string csv = std::string(AP_BINARY_DIR) + "/test_reaction_wheels.csv";
+  ap::writeManeuverCsv(r.maneuver, w, csv);
+  std::ifstream in(csv);
+  std::string header, row;
+  std::getline(in, header);
+  EXPECT_EQ(header, "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz,u1,u2,u3,h1,h2,h3");
+  for (int k = 0; k <= 16; ++k) std::getline(in, row);  // row k = 16: mid-slew
+  std::vector<double> cells;
+  std::stringstream cells_in(row);
+  for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(std::stod(cell));
+  ASSERT_EQ(cells.size(), 18u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(cells[12 + i], w.torque[16](i));
+    EXPECT_EQ(cells[15 + i], w.momentum[16](i));
+  }
+  EXPECT_EQ(ap::readManeuverCsv(csv).steps(), 32);
+  const std::string json = ap::planResultJson(p, r);
+  EXPECT_NE(json.find("\"reaction_wheels\": {\"wheels\": [{\"name\": \"wheel_1\""),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"momentum_norm_margin\": "), std::string::npos);
+  EXPECT_NE(json.find("\"reaction_wheels\"]"), std::string::npos) << "constraints names it";
+}

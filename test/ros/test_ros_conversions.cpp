@@ -735,6 +735,42 @@ TEST(Deadline, APlanThatConvergedAfterItsBudgetIsTimedOut) {
   EXPECT_EQ(unbounded.error_code, PlanErrorCode::SUCCESS);
 }
 
+TEST(Deadline, TheAnswerLeavesTheStoppedSolveTimeWithinTheContract) {
+  // Issue 43's bound for a deadline answer, 1.1 B + 0.05 s, holds for every budget, and a stopped
+  // solve has at least kHandoverFloor after B to hand over the plan it reached.
+  for (double budget : {1e-6, 0.01, 0.1, 0.5, 1.0, 30.0, 300.0}) {
+    EXPECT_LE(answerDeadline(budget), 1.1 * budget + 0.05) << budget;
+    EXPECT_GE(answerDeadline(budget) - budget, kHandoverFloor) << budget;
+  }
+}
+
+TEST(AnytimePlan, AStoppedSolveFillsTheResponseWithItsPlanFlaggedUnconverged) {
+  // The adapter carries the core's stopped plan: cancelled at the second iteration (no master
+  // needed), the response has the plan's N + 1 rows, unconverged_plan and its residuals; a
+  // converged answer is not flagged.
+  ros::Time::init();  // the response's stamps, without a master
+  PlanAttitudeManeuver::Request req = seedRequest();
+  req.steps = 64;
+  req.tolerance = 1e-300;
+  const PlanOutcome stopped =
+      planRequest(req, rc::PlannerDefaults(),
+                  [](const IterationInfo& info, double) { return info.iteration < 2; });
+  ASSERT_TRUE(stopped.solver_ran) << stopped.message;
+  EXPECT_EQ(stopped.error_code, PlanErrorCode::CANCELLED) << stopped.message;
+  PlanAttitudeManeuver::Response res;
+  fillResponse(stopped, "world", "body", &res);
+  EXPECT_FALSE(res.success);
+  EXPECT_TRUE(res.unconverged_plan);
+  EXPECT_EQ(res.maneuver.attitude.size(), 65u);
+  EXPECT_GT(res.max_residual, req.tolerance);
+  EXPECT_LE(res.step_residual, 1e-8);
+  req.tolerance = 0.0;  // the node's default
+  PlanAttitudeManeuver::Response converged;
+  fillResponse(planRequest(req, rc::PlannerDefaults(), nullptr), "world", "body", &converged);
+  EXPECT_TRUE(converged.success) << converged.message;
+  EXPECT_FALSE(converged.unconverged_plan);
+}
+
 TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {
   PlanAttitudeManeuver::Request r = seedRequest();
   r.steps = 1025;

@@ -2,17 +2,11 @@
 
 #include <stdexcept>
 
+#include "attitude_planner/ros/conversions.hpp"
+
 namespace attitude_planner {
 
 namespace {
-
-geometry_msgs::Point pointOf(const Vector3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
 
 /// An ARROW from the origin to `tip` in `frame`, coloured by its namespace's meaning.
 visualization_msgs::Marker worldArrow(const std::string& frame, const ros::Time& stamp,
@@ -26,8 +20,8 @@ visualization_msgs::Marker worldArrow(const std::string& frame, const ros::Time&
   a.type = visualization_msgs::Marker::ARROW;
   a.action = visualization_msgs::Marker::ADD;
   a.pose.orientation.w = 1.0;
-  a.points.push_back(pointOf(Vector3::Zero()));
-  a.points.push_back(pointOf(tip));
+  a.points.push_back(ros_conversions::xyzToMsg<geometry_msgs::Point>(Vector3::Zero()));
+  a.points.push_back(ros_conversions::xyzToMsg<geometry_msgs::Point>(tip));
   a.scale.x = 0.03 * length;  // shaft diameter [m]
   a.scale.y = 0.05 * length;  // head diameter [m]
   a.scale.z = 0.08 * length;  // head length [m]

@@ -34,14 +34,6 @@ namespace rc = ros_conversions;
 
 namespace {
 
-geometry_msgs::Point point(const Vector3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
-
 /// Runs `work` on a detached thread; its future never blocks in its destructor (unlike
 /// std::async's), so an answer nobody waits for any more (a new maneuver, a timeout) is simply
 /// dropped. roscpp cannot cancel a service call: a hung one keeps its thread, not the caller.
@@ -99,8 +91,8 @@ visualization_msgs::Marker arrowMarker(const std::string& frame, const ros::Time
                                        const Vector3& shaft_head_length,
                                        const std_msgs::ColorRGBA& tint) {
   visualization_msgs::Marker a = newMarker(frame, stamp, ns, id, visualization_msgs::Marker::ARROW);
-  a.points.push_back(point(Vector3::Zero()));
-  a.points.push_back(point(tip));
+  a.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(Vector3::Zero()));
+  a.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(tip));
   a.scale.x = shaft_head_length.x();
   a.scale.y = shaft_head_length.y();
   a.scale.z = shaft_head_length.z();
@@ -159,9 +151,9 @@ visualization_msgs::MarkerArray constraintMarkers(
                                std::sin(c.half_angle) * (std::cos(phi) * e1 + std::sin(phi) * e2)));
     };
     for (int i = 0; i < kSegments; ++i) {
-      cone.points.push_back(point(Vector3::Zero()));
-      cone.points.push_back(point(rim(i)));
-      cone.points.push_back(point(rim(i + 1)));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(Vector3::Zero()));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(rim(i)));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(rim(i + 1)));
     }
     array.markers.push_back(cone);
     ++id;
@@ -667,7 +659,7 @@ visualization_msgs::Marker TrackerNode::pathMarker(const std::string& frame, con
       newMarker(frame, ros::Time(), ns, 0, visualization_msgs::Marker::LINE_STRIP);
   path.scale.x = 0.02 * path_radius_;  // line width [m]
   path.color = meaningColour(ns, alpha);
-  for (const Vector3& tip : tips) path.points.push_back(point(tip));
+  for (const Vector3& tip : tips) path.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(tip));
   return path;
 }
 

@@ -30,6 +30,14 @@ PlanAttitudeManeuverGoal seed(int steps = 32) {
   return g;
 }
 
+/// The seed's slew at N steps with a tolerance no solve meets: only a stop ends it.
+PlanAttitudeManeuverGoal unreachableTolerance(int steps) {
+  PlanAttitudeManeuverGoal goal = seed(steps);
+  goal.tolerance = 1e-300;
+  goal.max_iterations = 1000000;
+  return goal;
+}
+
 /// Minimum time on a sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration, N = 32
 /// (second_order): T* = 2√10 s, the eigenaxis bang–bang slew.
 PlanAttitudeManeuverGoal sphereMinimumTimeGoal() {
@@ -166,9 +174,7 @@ TEST_F(PlannerAction, TimedOutGoalCarriesThePlanReached) {
   // The budget is spent before the first iteration: ABORTED / TIMED_OUT with the solve's start,
   // flagged unconverged, on the group and with the boundary data (before: no plan).
   const int N = 512;
-  PlanAttitudeManeuverGoal goal = seed(N);
-  goal.tolerance = 1e-300;
-  goal.max_iterations = 1000000;
+  PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
   goal.time_budget = 1e-6;
   client_->sendGoal(goal);
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
@@ -182,9 +188,7 @@ TEST_F(PlannerAction, CancelledGoalCarriesThePlanReached) {
   // Cancelled as soon as it is sent: the solve stops at its first check and its worker ends the
   // goal within kCancelGrace, PREEMPTED / CANCELLED with the plan reached (before: none).
   const int N = 512;
-  PlanAttitudeManeuverGoal goal = seed(N);
-  goal.tolerance = 1e-300;
-  goal.max_iterations = 1000000;
+  PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
   client_->sendGoal(goal);
   client_->cancelGoal();
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));

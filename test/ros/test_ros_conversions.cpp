@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <regex>
 #include <set>
 #include <tuple>
 
@@ -741,6 +742,35 @@ TEST(MarkerColours, TheShippedRvizConfigHidesTheTfAxesAndShowsTheLegend) {
                 static_cast<int>(std::lround(255 * torque.g)),
                 static_cast<int>(std::lround(255 * torque.b)));
   EXPECT_NE(text.find(expected), std::string::npos) << expected;
+}
+
+TEST(LaunchFiles, EveryPrivateParameterOfANodeIsAnArgumentOfItsLaunchFile) {
+  // Every name a node reads with readParam / readNamedParam is set from an <arg> by its launch
+  // file (before: planner.launch had no action_workers).
+  const auto text = [](const std::string& path) {
+    std::ifstream file(std::string(AP_SOURCE_DIR) + "/" + path);
+    EXPECT_TRUE(file) << path;
+    return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  };
+  const std::regex read(R"re(read(?:Named)?Param(?:<[^>]*>)?\(\s*\w+,\s*"([a-z_]+)")re");
+  const std::pair<const char*, const char*> nodes[] = {
+      {"src/ros/planner_node.cpp", "launch/planner.launch"},
+      {"src/ros/tracker_node.cpp", "launch/tracker.launch"},
+      {"src/ros/plant_node.cpp", "launch/plant.launch"}};
+  for (const auto& [source, launch] : nodes) {
+    const std::string code = text(source);
+    const std::string xml = text(launch);
+    int names = 0;
+    for (std::sregex_iterator it(code.begin(), code.end(), read), end; it != end; ++it) {
+      const std::string name = (*it)[1];
+      ++names;
+      EXPECT_NE(xml.find("<param name=\"" + name + "\""), std::string::npos)
+          << launch << " does not set ~" << name;
+      EXPECT_NE(xml.find("<arg name=\"" + name + "\""), std::string::npos)
+          << launch << " has no arg " << name;
+    }
+    EXPECT_GE(names, 5) << source;  // the pattern still finds the node's parameters
+  }
 }
 
 TEST(BodyAxisMarkers, DrawnInTheWorldFrameFromTheAttitudeNeedingNoTf) {

@@ -95,9 +95,12 @@ visualization_msgs::MarkerArray legendMarkers(const std::string& world_frame, do
     line.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     line.action = visualization_msgs::Marker::ADD;
     line.pose.orientation.w = 1.0;
-    line.pose.position.y = -1.6 * path_radius;
-    line.pose.position.z = (1.5 - 0.12 * static_cast<double>(i)) * path_radius;
-    line.scale.z = 0.08 * path_radius;  // text height [m]
+    // To the left of the body in the shipped view (rviz/maneuver.rviz: yaw 0.4, pitch 0.8),
+    // below the status text.
+    line.pose.position.x = 0.4 * path_radius;
+    line.pose.position.y = -0.7 * path_radius;
+    line.pose.position.z = (0.95 - 0.085 * static_cast<double>(i)) * path_radius;
+    line.scale.z = 0.05 * path_radius;  // text height [m]
     line.color.r = meanings[i].r;
     line.color.g = meanings[i].g;
     line.color.b = meanings[i].b;

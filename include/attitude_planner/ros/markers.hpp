@@ -32,8 +32,8 @@ const std::vector<MarkerMeaning>& markerMeanings();
 std_msgs::ColorRGBA meaningColour(const std::string& ns, float alpha = 1.0f);
 
 /// The legend: one TEXT_VIEW_FACING line per meaning, in its colour, stacked in `world_frame`
-/// beside the body (x = 0, y = −1.6 `path_radius`, from z = 1.5 `path_radius` down), ns "legend",
-/// ids 0.. (published latched once).
+/// beside the body (x = 0.4, y = −0.7 `path_radius`, from z = 0.95 `path_radius` down), ns
+/// "legend", ids 0.. (published latched once).
 visualization_msgs::MarkerArray legendMarkers(const std::string& world_frame, double path_radius);
 
 /// Arrows from the origin to `length` · R b in `world_frame` at `stamp`, drawn from the attitude

@@ -4,6 +4,7 @@
 set(AP_ROS_SOURCES
   src/ros/conversions.cpp
   src/ros/diagnostics.cpp
+  src/ros/markers.cpp
   src/ros/planner_node.cpp
   src/ros/plant_node.cpp
   src/ros/tracker_node.cpp)

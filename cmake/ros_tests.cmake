@@ -5,6 +5,7 @@ find_package(rostest REQUIRED)
 
 catkin_add_gtest(test_ros_conversions test/ros/test_ros_conversions.cpp)
 target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
+target_compile_definitions(test_ros_conversions PRIVATE AP_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
 
 # rostest gtests: each launches the node(s) under test and a gtest client, which roslaunch finds

@@ -209,11 +209,7 @@ Vector3 finiteVectorFromMsg(const geometry_msgs::Vector3& v, const std::string& 
 }
 
 geometry_msgs::Vector3 vectorToMsg(const Vector3& v) {
-  geometry_msgs::Vector3 m;
-  m.x = v.x();
-  m.y = v.y();
-  m.z = v.z();
-  return m;
+  return xyzToMsg<geometry_msgs::Vector3>(v);
 }
 
 EndCondition endConditionFromRequest(const std::string& name,

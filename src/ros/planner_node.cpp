@@ -79,7 +79,8 @@ PlanOutcome deadlineOutcome(double budget) {
   out.time_budget_s = budget;
   std::ostringstream s;
   s << "timed out: no plan within the time budget of " << budget
-    << " s (the solve was told to stop; its late result is dropped)";
+    << " s (the solve was told to stop at it and had not returned the plan it reached "
+    << answerDeadline(budget) - budget << " s later; its late result is dropped)";
   out.message = s.str();
   return out;
 }
@@ -264,7 +265,7 @@ PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request&
     slot->finished.notify_all();
   });
   std::unique_lock<std::mutex> lock(slot->mutex);
-  const auto deadline = std::chrono::duration<double>(budget * (1.0 + kDeadlineSlack));
+  const auto deadline = std::chrono::duration<double>(answerDeadline(budget));
   if (slot->finished.wait_for(lock, deadline, [&] { return slot->done; })) {
     lock.unlock();
     solve.join();
@@ -418,7 +419,7 @@ void PlannerNode::onGoal(GoalHandle goal) {
   active.accepted = ros::WallTime::now();
   active.budget = ros_conversions::effectiveTimeBudget(goal.getGoal()->time_budget, defaults_);
   active.deadline = std::make_shared<DeadlineWatch>(
-      active.budget * (1.0 + kDeadlineSlack),
+      answerDeadline(active.budget),
       [this, watched = ActiveGoal{active.handle, active.cancel, active.ended_at, nullptr,
                                   active.accepted, active.budget}] { onGoalDeadline(watched); });
   {
@@ -432,19 +433,39 @@ void PlannerNode::onGoal(GoalHandle goal) {
   goal_ready_.notify_one();
 }
 
+namespace {
+
+/// The goal has ended (PREEMPTED by onCancel, RECALLED, ...): nothing more may be sent for it.
+bool goalEnded(unsigned status) {
+  using actionlib_msgs::GoalStatus;
+  return status != GoalStatus::PENDING && status != GoalStatus::ACTIVE &&
+         status != GoalStatus::PREEMPTING && status != GoalStatus::RECALLING;
+}
+
+}  // namespace
+
 void PlannerNode::onCancel(GoalHandle goal) {
-  std::lock_guard<std::mutex> goals(goals_mutex_);
-  const auto it = active_.find(goal.getGoalID().id);
-  if (it != active_.end()) it->second.cancel->store(true);  // this goal only: the solver stops
-  // The goal ends now, not when the solver has stopped and its N = 1e5 plan has been evaluated:
-  // the worker's late result is discarded (serveGoal). Under the server's lock, so that the
-  // worker cannot end it in between. A goal not yet accepted (RECALLING) is ended by its worker.
+  std::unique_lock<std::mutex> goals(goals_mutex_);
+  auto it = active_.find(goal.getGoalID().id);
+  if (it == active_.end()) return;  // ended already, or not yet accepted (its worker ends it)
+  it->second.cancel->store(true);   // this goal only: the solver stops
+  // A solver that stops within kCancelGrace ends the goal itself, with the plan it had reached
+  // (serveGoal); the wait holds no lock (goal_ended_ is notified under goals_mutex_).
+  // (A goal still queued behind busy workers ends after the grace, without a plan.)
+  goal_ended_.wait_for(goals, std::chrono::duration<double>(kCancelGrace),
+                       [&] { return goalEnded(goal.getGoalStatus().status); });
+  // Else the goal ends now, not when the solver has stopped and its N = 1e5 plan has been
+  // evaluated: the worker's late result is discarded (serveGoal). Under the server's lock, so
+  // that the worker cannot end it in between.
+  it = active_.find(goal.getGoalID().id);
   boost::recursive_mutex::scoped_lock lock(action_server_->statusMutex());
   if (goal.getGoalStatus().status != actionlib_msgs::GoalStatus::PREEMPTING) return;
   PlanAttitudeManeuverResult result;
   result.success = false;
   result.error_code.val = PlanErrorCode::CANCELLED;
-  result.message = "cancelled by its client (the solve was stopped; no plan is returned)";
+  result.message =
+      "cancelled by its client (the solve was stopped; it had not returned its plan within " +
+      exactNumber(kCancelGrace) + " s, so no plan is returned)";
   double waited = 0.0;
   if (it != active_.end()) {
     // Its slot is free before the result goes out: a goal sent on receiving it is accepted
@@ -457,17 +478,6 @@ void PlannerNode::onCancel(GoalHandle goal) {
   goal.setCanceled(result, result.message);
   answers_.record(result.error_code.val, waited);
 }
-
-namespace {
-
-/// The goal has ended (PREEMPTED by onCancel, RECALLED, ...): nothing more may be sent for it.
-bool goalEnded(unsigned status) {
-  using actionlib_msgs::GoalStatus;
-  return status != GoalStatus::PENDING && status != GoalStatus::ACTIVE &&
-         status != GoalStatus::PREEMPTING && status != GoalStatus::RECALLING;
-}
-
-}  // namespace
 
 void PlannerNode::workerLoop() {
   for (;;) {
@@ -498,7 +508,7 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   PlanAttitudeManeuverResult result;
   try {
     const PlanAttitudeManeuverGoalConstPtr request = handle.getGoal();
-    // The deadline (goal.deadline, armed at acceptance) answers by budget (1 + kDeadlineSlack)
+    // The deadline (goal.deadline, armed at acceptance) answers by answerDeadline(budget)
     // even when the stopped solve takes longer to return; its late result is discarded below.
     // The solve gets what is left of the budget after the wait in the queue.
     PlanAttitudeManeuverGoal solve_request = *request;
@@ -554,7 +564,12 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
   } else {
     handle.setAborted(result, result.message);
   }
+  lock.unlock();
   answers_.record(result.error_code.val, (ros::WallTime::now() - goal.accepted).toSec());
+  {
+    std::lock_guard<std::mutex> goals(goals_mutex_);  // a cancel waiting for this end (onCancel)
+  }
+  goal_ended_.notify_all();
 }
 
 void PlannerNode::publishDiagnostics() {

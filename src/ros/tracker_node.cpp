@@ -2,6 +2,7 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
+#include "attitude_planner/ros/markers.hpp"
 #include "attitude_planner/ros/parameters.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -24,6 +25,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 
 namespace attitude_planner {
@@ -31,23 +33,6 @@ namespace attitude_planner {
 namespace rc = ros_conversions;
 
 namespace {
-
-std_msgs::ColorRGBA color(float r, float g, float b, float a) {
-  std_msgs::ColorRGBA c;
-  c.r = r;
-  c.g = g;
-  c.b = b;
-  c.a = a;
-  return c;
-}
-
-geometry_msgs::Point point(const Vector3& v) {
-  geometry_msgs::Point p;
-  p.x = v.x();
-  p.y = v.y();
-  p.z = v.z();
-  return p;
-}
 
 /// Runs `work` on a detached thread; its future never blocks in its destructor (unlike
 /// std::async's), so an answer nobody waits for any more (a new maneuver, a timeout) is simply
@@ -66,9 +51,6 @@ std::future<std::invoke_result_t<Work>> startDetached(Work work) {
   }).detach();
   return future;
 }
-
-/// The traced axis, its planned path and its trail: orange (no principal axis is).
-const std_msgs::ColorRGBA kTraceColour = color(1.0f, 0.6f, 0.0f, 1.0f);
 
 }  // namespace
 
@@ -109,8 +91,8 @@ visualization_msgs::Marker arrowMarker(const std::string& frame, const ros::Time
                                        const Vector3& shaft_head_length,
                                        const std_msgs::ColorRGBA& tint) {
   visualization_msgs::Marker a = newMarker(frame, stamp, ns, id, visualization_msgs::Marker::ARROW);
-  a.points.push_back(point(Vector3::Zero()));
-  a.points.push_back(point(tip));
+  a.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(Vector3::Zero()));
+  a.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(tip));
   a.scale.x = shaft_head_length.x();
   a.scale.y = shaft_head_length.y();
   a.scale.z = shaft_head_length.z();
@@ -128,41 +110,39 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
   m.scale.x = box.dimensions.x();
   m.scale.y = box.dimensions.y();
   m.scale.z = box.dimensions.z();
-  m.color = color(0.55f, 0.7f, 0.95f, 0.85f);
+  m.color = meaningColour("body", 0.85f);
   array.markers.push_back(m);
-  const std_msgs::ColorRGBA colors[3] = {
-      color(0.9f, 0.1f, 0.1f, 1.0f), color(0.1f, 0.8f, 0.1f, 1.0f), color(0.1f, 0.3f, 1.0f, 1.0f)};
+  const char* axes[3] = {"principal_axis_smallest", "principal_axis_middle",
+                         "principal_axis_largest"};
   for (int i = 0; i < 3; ++i) {
-    array.markers.push_back(arrowMarker(body_frame, stamp, "principal_axes", i + 1,
-                                        axis_length * box.axes.col(i),
-                                        Vector3(0.04, 0.08, 0.15) * axis_length, colors[i]));
+    array.markers.push_back(
+        arrowMarker(body_frame, stamp, axes[i], i + 1, axis_length * box.axes.col(i),
+                    Vector3(0.04, 0.08, 0.15) * axis_length, meaningColour(axes[i])));
   }
   // The traced body axis up to the traced tip, linking the body to `attitude_path` (same colour).
-  array.markers.push_back(arrowMarker(body_frame, stamp, "body_x_axis", 4,
-                                      path_radius * trace_axis.normalized(),
-                                      Vector3(0.015, 0.04, 0.06) * path_radius, kTraceColour));
+  array.markers.push_back(
+      arrowMarker(body_frame, stamp, "traced_axis", 4, path_radius * trace_axis.normalized(),
+                  Vector3(0.015, 0.04, 0.06) * path_radius, meaningColour("traced_axis")));
   return array;
 }
 
 visualization_msgs::MarkerArray constraintMarkers(
     const std::vector<PlanningConstraint>& constraints, double length,
-    const std::string& world_frame, const std::string& body_frame, const ros::Time& stamp) {
+    const std::string& world_frame, const ros::Time& stamp) {
   visualization_msgs::MarkerArray array;
   constexpr int kSegments = 48;  // triangles around the cone
   int id = 0;
   for (const PlanningConstraint& c : constraints) {
     if (!c.isCone()) continue;
     const bool out = c.kind == ConstraintKind::KeepOut;
-    // Magenta and cyan: no principal axis (red, green, blue) or trace (orange) shares them.
-    const std_msgs::ColorRGBA tint =
-        out ? color(0.9f, 0.1f, 0.85f, 0.35f) : color(0.1f, 0.8f, 0.9f, 0.35f);
     // The cone: a fan of triangles from the apex (the body origin) to the circle of points at
     // slant distance `length` whose direction makes the half angle with s (any a in (0, π)).
-    visualization_msgs::Marker cone = newMarker(world_frame, stamp, out ? "keep_out" : "keep_in",
-                                                id, visualization_msgs::Marker::TRIANGLE_LIST);
+    const std::string ns = out ? "keep_out" : "keep_in";
+    visualization_msgs::Marker cone =
+        newMarker(world_frame, stamp, ns, id, visualization_msgs::Marker::TRIANGLE_LIST);
     cone.scale.x = cone.scale.y = cone.scale.z = 1.0;
-    cone.color = tint;
-    const Vector3& s = c.world_direction;
+    cone.color = meaningColour(ns, 0.35f);  // translucent: the body shows through
+    const Vector3 s = c.world_direction.normalized();
     const Vector3 e1 = s.unitOrthogonal();
     const Vector3 e2 = s.cross(e1);
     const auto rim = [&](int i) {
@@ -171,20 +151,11 @@ visualization_msgs::MarkerArray constraintMarkers(
                                std::sin(c.half_angle) * (std::cos(phi) * e1 + std::sin(phi) * e2)));
     };
     for (int i = 0; i < kSegments; ++i) {
-      cone.points.push_back(point(Vector3::Zero()));
-      cone.points.push_back(point(rim(i)));
-      cone.points.push_back(point(rim(i + 1)));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(Vector3::Zero()));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(rim(i)));
+      cone.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(rim(i + 1)));
     }
     array.markers.push_back(cone);
-    // The constrained body axis b, in the body frame, as long as the cone's slant.
-    // (shaft twice the body x arrow's: drawn around it)
-    std_msgs::ColorRGBA opaque = tint;
-    opaque.a = 1.0f;
-    visualization_msgs::Marker axis =
-        arrowMarker(body_frame, stamp, out ? "keep_out_body_axis" : "keep_in_body_axis", id,
-                    length * c.body_axis, Vector3(0.03, 0.05, 0.08) * length, opaque);
-    axis.frame_locked = true;  // published once: rviz moves it with the body frame
-    array.markers.push_back(axis);
     ++id;
   }
   return array;
@@ -480,6 +451,7 @@ void TrackerNode::advertiseTopics() {
       nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
                           [this](const ros::WallTimerEvent&) { publishDiagnostics(); });
   constraint_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("constraint_markers", 1, true);
+  legend_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("legend", 1, true);
   control_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("control", 10);
   body_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("body_pose", 10);
   error_vector_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("attitude_error_vector", 10);
@@ -551,6 +523,7 @@ bool TrackerNode::planAndStartScene(const std::string& scene, bool plan_in_proce
     replay.scene_constraints = parsed.problem.constraints;
     replay.problem = parsed.problem;
     if (parsed.problem.end_condition.pointing() && !replay.msg.attitude.empty()) {
+      replay.pointing = parsed.problem.end_condition;  // drawn, and its error reported
       // A pointing scene is flown, and re-planned, to the end attitude its plan chose.
       replay.problem->end_condition = EndCondition();
       replay.problem->final_attitude = rc::attitudeFromMsg(replay.msg.attitude.back(), "attitude");
@@ -685,30 +658,33 @@ visualization_msgs::Marker TrackerNode::pathMarker(const std::string& frame, con
   visualization_msgs::Marker path =
       newMarker(frame, ros::Time(), ns, 0, visualization_msgs::Marker::LINE_STRIP);
   path.scale.x = 0.02 * path_radius_;  // line width [m]
-  path.color = kTraceColour;
-  path.color.a = alpha;
-  for (const Vector3& tip : tips) path.points.push_back(point(tip));
+  path.color = meaningColour(ns, alpha);
+  for (const Vector3& tip : tips) path.points.push_back(rc::xyzToMsg<geometry_msgs::Point>(tip));
   return path;
 }
 
 void TrackerNode::publishPose(const Matrix3& R, const ros::Time& stamp,
                               const std::string& world_frame, const std::string& body_frame,
                               const PrincipalBox& box, const Vector3& trace_axis,
-                              std::deque<Vector3>* trail) {
+                              std::deque<Vector3>* trail,
+                              const visualization_msgs::MarkerArray& world_axes) {
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = stamp;
   tf.header.frame_id = world_frame;
   tf.child_frame_id = body_frame;
   tf.transform.rotation = rc::attitudeToMsg(R);
   tf_broadcaster_.sendTransform(tf);
-  marker_pub_.publish(bodyMarkers(box, axis_length_, path_radius_, body_frame, stamp, trace_axis));
+  visualization_msgs::MarkerArray markers =
+      bodyMarkers(box, axis_length_, path_radius_, body_frame, stamp, trace_axis);
+  markers.markers.insert(markers.markers.end(), world_axes.markers.begin(),
+                         world_axes.markers.end());
+  marker_pub_.publish(markers);
   trail->push_back(path_radius_ * (R * trace_axis));
   while (trail->size() > static_cast<std::size_t>(kTrailPoints)) trail->pop_front();
   if (trail->size() >= 2) {
     visualization_msgs::Marker m = pathMarker(
         world_frame, "attitude_trail", std::vector<Vector3>(trail->begin(), trail->end()), 1.0f);
     m.header.stamp = stamp;
-    m.color = color(1.0f, 0.9f, 0.2f, 1.0f);  // the trail: yellow over the orange plan
     m.scale.x = 0.03 * path_radius_;
     trail_pub_.publish(m);
   }
@@ -820,6 +796,7 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.problem.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   applyEffects(replay.effects, &pb.problem);
   pb.effects_specs = replay.effects;
+  pb.pointing = replay.pointing;
   pb.health = std::make_shared<ConstraintHealth>(pb.problem.max_torque, pb.problem.constraints);
 
   pb.world_frame = msg.header.frame_id.empty() ? world_frame_ : msg.header.frame_id;
@@ -858,6 +835,10 @@ void TrackerNode::publishManeuverMarkers(const Playback& pb) {
   path_pub_.publish(pathMarker(pb.world_frame, "attitude_path", tips, 0.6f));
   // Start and target ghosts: the box at R_0 (grey) and R_N (white), translucent, in the world.
   visualization_msgs::MarkerArray ghosts;
+  // The previous maneuver's ghosts and cones go first (DELETEALL), also when this one has none.
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  ghosts.markers.push_back(clear);
   const std::pair<const char*, int> ends[2] = {{"start_ghost", 0}, {"target_ghost", plan.steps()}};
   for (const auto& [ns, k] : ends) {
     visualization_msgs::Marker box =
@@ -866,24 +847,24 @@ void TrackerNode::publishManeuverMarkers(const Playback& pb) {
     box.scale.x = pb.box.dimensions.x();
     box.scale.y = pb.box.dimensions.y();
     box.scale.z = pb.box.dimensions.z();
-    box.color = k == 0 ? color(0.5f, 0.5f, 0.5f, 0.25f) : color(0.95f, 0.95f, 0.95f, 0.3f);
+    box.color = meaningColour(ns, 0.3f);
     ghosts.markers.push_back(box);
-    ghosts.markers.push_back(arrowMarker(
-        pb.world_frame, ros::Time(), ns, 1, path_radius_ * (nodes.attitude[k] * pb.trace_axis),
-        Vector3(0.015, 0.04, 0.06) * path_radius_, color(1.0f, 0.6f, 0.0f, 0.4f)));
+    ghosts.markers.push_back(arrowMarker(pb.world_frame, ros::Time(), std::string(ns) + "_axis", 1,
+                                         path_radius_ * (nodes.attitude[k] * pb.trace_axis),
+                                         Vector3(0.015, 0.04, 0.06) * path_radius_,
+                                         meaningColour(std::string(ns) + "_axis", 0.4f)));
   }
   ghost_pub_.publish(ghosts);
-  // The previous maneuver's cones go first (DELETEALL), also when this one has none: before,
-  // they stayed on the latched topic and in rviz for the next maneuver.
+  // The cones and the world directions they and a pointing target refer to (the Sun arrow).
   visualization_msgs::MarkerArray cones;
-  visualization_msgs::Marker clear;
-  clear.action = visualization_msgs::Marker::DELETEALL;
   cones.markers.push_back(clear);
-  for (const visualization_msgs::Marker& m :
-       constraintMarkers(pb.constraints, path_radius_, pb.world_frame, pb.body_frame, ros::Time())
-           .markers)
-    cones.markers.push_back(m);
+  for (const visualization_msgs::MarkerArray& part :
+       {constraintMarkers(pb.constraints, path_radius_, pb.world_frame, ros::Time()),
+        worldDirectionMarkers(pb.constraints, pb.pointing, path_radius_, pb.world_frame)}) {
+    cones.markers.insert(cones.markers.end(), part.markers.begin(), part.markers.end());
+  }
   constraint_pub_.publish(cones);
+  legend_pub_.publish(legendMarkers(pb.world_frame, path_radius_));
 }
 
 void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& stamp,
@@ -916,7 +897,12 @@ void TrackerNode::publishStampedErrors(const Playback& pb, const Matrix3& body,
 void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
                                const ManeuverSample& plan, double t, const ros::Time& stamp,
                                std::deque<Vector3>* trail) {
-  publishPose(body.attitude, stamp, pb.world_frame, pb.body_frame, pb.box, pb.trace_axis, trail);
+  // The constrained body axes and the boresight in the world frame, from the attitude itself:
+  // drawn whatever the order in which tf and markers reach rviz (a frame-locked marker in the body
+  // frame, latched before the body frame existed, was never drawn).
+  publishPose(body.attitude, stamp, pb.world_frame, pb.body_frame, pb.box, pb.trace_axis, trail,
+              bodyAxisMarkers(pb.constraints, pb.pointing, body.attitude, path_radius_,
+                              pb.world_frame, stamp));
 
   geometry_msgs::WrenchStamped wrench;
   wrench.header.stamp = stamp;
@@ -963,8 +949,14 @@ void TrackerNode::publishState(const Playback& pb, const ManeuverSample& body,
                                                visualization_msgs::Marker::TEXT_VIEW_FACING);
   label.pose.position.z = 1.1 * body_size_ + 0.3 * path_radius_;
   label.scale.z = 0.12 * path_radius_;  // text height [m]
-  label.color = color(1.0f, 1.0f, 1.0f, 1.0f);
+  label.color = meaningColour("status_text");
   label.text = text;
+  if (pb.pointing) {
+    char line[80];
+    std::snprintf(line, sizeof line, "\npointing error %.3g rad",
+                  pointingError(body.attitude, *pb.pointing));
+    label.text += line;
+  }
   if (!pb.replan_status.empty()) label.text += "\n" + pb.replan_status;
   text_pub_.publish(label);
 }
@@ -1021,6 +1013,10 @@ void TrackerNode::runReplay(Replay replay) {
   }
   ReplayResult result = pb.result;
   reportConstraintHealth(*pb.health, &result);
+  if (pb.pointing) {
+    result.pointing_error =
+        pointingError(rc::attitudeFromMsg(result.final_attitude, "final_attitude"), *pb.pointing);
+  }
   const std::string conflict = claimFrames(pb.world_frame, pb.body_frame);
   if (!conflict.empty()) {  // the run was shown on a transform another node also moved
     result.success = false;

@@ -11,6 +11,7 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 
+#include "../support/paper_equations.hpp"
 #include "attitude_planner/AttitudeManeuver.h"
 #include "attitude_planner/Constraint.h"
 #include "attitude_planner/ReplayResult.h"
@@ -63,6 +64,37 @@ void fillSeedRequest(Request* r, int steps = 32, double angle = M_PI / 3) {
   r->final_attitude = ros_conversions::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), angle));
   r->duration = 12.8;
   r->steps = steps;
+}
+
+/// An anytime answer to fillSeedRequest's slew at `steps` steps (TIMED_OUT or CANCELLED with the
+/// plan the solve had reached): flagged unconverged, N + 1 unit quaternions, the request's boundary
+/// data R_0 = I, Ω_0 = 0, R_N, Ω_{N−1} = 0, the paper scheme's equations of motion to round-off
+/// (checked here from the rows, seed 000 eq. 18) and its residuals: step_residual met, max_residual
+/// above the request's tolerance.
+template <class Response>
+void expectSeedAnytimePlan(const Response& res, int steps, double tolerance,
+                           double angle = M_PI / 3) {
+  namespace rc = ros_conversions;
+  EXPECT_FALSE(res.success);
+  EXPECT_TRUE(res.unconverged_plan) << res.message;
+  const AttitudeManeuver& m = res.maneuver;
+  ASSERT_EQ(m.attitude.size(), static_cast<std::size_t>(steps + 1)) << res.message;
+  for (const geometry_msgs::Quaternion& q : m.attitude) {
+    EXPECT_NEAR(std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z), 1.0, 1e-12);
+  }
+  const Maneuver plan = rc::maneuverFromMsg(m);
+  EXPECT_LT(so3::angleBetween(plan.attitude.front(), Matrix3::Identity()), 1e-12);
+  EXPECT_LT(so3::angleBetween(plan.attitude.back(), so3::fromAxisAngle(Vector3::UnitX(), angle)),
+            1e-12);
+  EXPECT_LT(plan.angular_velocity.front().norm(), 1e-12);
+  EXPECT_LT(plan.angular_velocity[steps - 1].norm(), 1e-12);
+  Matrix3 inertia;
+  for (int i = 0; i < 9; ++i) inertia(i / 3, i % 3) = seedInertia()[i];
+  EXPECT_LT(test_support::paperEquationMiss(inertia, plan), 1e-11);
+  EXPECT_LE(res.step_residual, 1e-8);
+  EXPECT_TRUE(std::isfinite(res.max_residual));
+  EXPECT_GT(res.max_residual, tolerance);
+  EXPECT_GT(res.cost, 0.0);
 }
 
 /// scenes/sun_keep_out.yaml as a request at `steps` steps, plus |τ_k| ≤ 0.095 N m: a π/2 slew

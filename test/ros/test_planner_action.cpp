@@ -30,6 +30,14 @@ PlanAttitudeManeuverGoal seed(int steps = 32) {
   return g;
 }
 
+/// The seed's slew at N steps with a tolerance no solve meets: only a stop ends it.
+PlanAttitudeManeuverGoal unreachableTolerance(int steps) {
+  PlanAttitudeManeuverGoal goal = seed(steps);
+  goal.tolerance = 1e-300;
+  goal.max_iterations = 1000000;
+  return goal;
+}
+
 /// Minimum time on a sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration, N = 32
 /// (second_order): T* = 2√10 s, the eigenaxis bang–bang slew.
 PlanAttitudeManeuverGoal sphereMinimumTimeGoal() {
@@ -160,6 +168,34 @@ TEST_F(PlannerAction, TimeBudgetEndsAbortedWithTimedOut) {
   const auto result = client_->getResult();
   EXPECT_FALSE(result->success);
   EXPECT_EQ(result->error_code.val, PlanErrorCode::TIMED_OUT) << result->message;
+}
+
+TEST_F(PlannerAction, TimedOutGoalCarriesThePlanReached) {
+  // The budget is spent before the first iteration: ABORTED / TIMED_OUT with the solve's start,
+  // flagged unconverged, on the group and with the boundary data (before: no plan).
+  const int N = 512;
+  PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
+  goal.time_budget = 1e-6;
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  const auto result = client_->getResult();
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::TIMED_OUT) << result->message;
+  ros_testing::expectSeedAnytimePlan(*result, N, goal.tolerance);
+}
+
+TEST_F(PlannerAction, CancelledGoalCarriesThePlanReached) {
+  // Cancelled as soon as it is sent: the solve stops at its first check and its worker ends the
+  // goal within kCancelGrace, PREEMPTED / CANCELLED with the plan reached (before: none).
+  const int N = 512;
+  PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
+  client_->sendGoal(goal);
+  client_->cancelGoal();
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::PREEMPTED);
+  const auto result = client_->getResult();
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::CANCELLED) << result->message;
+  ros_testing::expectSeedAnytimePlan(*result, N, goal.tolerance);
 }
 
 TEST_F(PlannerAction, InvalidGoalIsAbortedWithTheField) {
@@ -451,7 +487,7 @@ TEST_F(PlannerAction, QueuedGoalsDeadlineCountsFromItsAcceptance) {
   // within 1.1 x its budget + 0.05 s of being sent. The two endless goals hold both workers
   // (~action_workers = 2); once both are PREEMPTED (their slots freed at the cancel) the third is
   // accepted at once and queued while the workers are still stopping the N = 1e5 solves. Its
-  // deadline is the node's contract (budget (1 + kDeadlineSlack) from acceptance), so the bound
+  // deadline is the node's contract (answerDeadline(budget) from acceptance), so the bound
   // holds whatever the machine's speed; before, it counted from when a worker took the goal
   // (1.5-1.85 x the budget measured after a cancel).
   Client second("plan_attitude_maneuver_action", true),

@@ -639,6 +639,21 @@ TEST_F(PlannerService, BudgetFarBelowTheSolveIsTimedOut) {
               res.message.c_str());
 }
 
+TEST_F(PlannerService, BudgetTooSmallToConvergeAnswersWithThePlanReached) {
+  // An anytime plan: a budget spent before the first iteration stops the solve at its start, a
+  // plan of the dynamics with the request's boundary data. The answer is TIMED_OUT with that plan,
+  // flagged unconverged, with its residuals (before: no plan, the deadline at B (1 + 2 %) came
+  // before the stopped solve had measured it).
+  const int N = 512;
+  PlanAttitudeManeuver::Request req = seed(N);
+  req.tolerance = 1e-300;
+  req.max_iterations = 1000000;
+  req.time_budget = 1e-6;
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
+  ros_testing::expectSeedAnytimePlan(res, N, req.tolerance);
+}
+
 TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
   // Issue 30: the seed's slew, then the re-plan from its node k (spinning) to the same end with
   // the plan's remainder as initial_guess: the remainder comes back, cost to 1e-8, in <= 2

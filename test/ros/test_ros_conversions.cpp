@@ -7,13 +7,16 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <regex>
 #include <set>
+#include <tuple>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/diagnostics.hpp"
+#include "attitude_planner/ros/markers.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
 #include "attitude_planner/ros/tracker_node.hpp"
 
@@ -634,6 +637,175 @@ TEST(PrincipalBox, MarkersAreTheBoxThreeAxesAndTheTracedAxisInTheBodyFrame) {
   EXPECT_DOUBLE_EQ(a.markers[4].points[1].x, 1.2);  // tip of body x at path_radius [m]
 }
 
+namespace {
+
+/// A keep_out and a keep_in cone and a pointing end condition, all with unnormalized vectors.
+std::vector<PlanningConstraint> twoCones() {
+  PlanningConstraint out;
+  out.kind = ConstraintKind::KeepOut;
+  out.body_axis = Vector3(2, 0, 0);
+  out.world_direction = Vector3(0.7, 0.7, 0.1);
+  out.half_angle = 0.5;
+  PlanningConstraint in = out;
+  in.kind = ConstraintKind::KeepIn;
+  in.body_axis = Vector3(0, 0, 1);
+  in.world_direction = Vector3(0, 0, -3);
+  in.half_angle = 1.2;
+  return {out, in};
+}
+
+EndCondition pointingAt() {
+  EndCondition end;
+  end.kind = EndConditionKind::Pointing;
+  end.body_axis = Vector3(0, 1, 1);
+  end.world_direction = Vector3(1, -2, 0.5);
+  return end;
+}
+
+Vector3 tipOf(const visualization_msgs::Marker& arrow) {
+  return Vector3(arrow.points[1].x, arrow.points[1].y, arrow.points[1].z);
+}
+
+}  // namespace
+
+TEST(MarkerColours, OneColourPerMeaningAndEveryMarkerDrawnInItsMeaningsColour) {
+  // Before: red, green and blue meant both the principal axes and the TF display's frame axes,
+  // and the colours were literals scattered over the node; now one table, read by every marker.
+  const std::vector<MarkerMeaning>& meanings = markerMeanings();
+  std::set<std::string> namespaces;
+  for (std::size_t i = 0; i < meanings.size(); ++i) {
+    for (std::size_t j = i + 1; j < meanings.size(); ++j) {
+      const double distance = std::abs(meanings[i].r - meanings[j].r) +
+                              std::abs(meanings[i].g - meanings[j].g) +
+                              std::abs(meanings[i].b - meanings[j].b);
+      EXPECT_GT(distance, 0.15) << meanings[i].legend << " / " << meanings[j].legend;
+    }
+    for (const std::string& ns : meanings[i].namespaces) {
+      EXPECT_TRUE(namespaces.insert(ns).second) << ns << " has two meanings";
+    }
+  }
+  // Every marker the node builds is in its meaning's colour.
+  const PrincipalBox box = principalBox(Vector3(5, 10, 13).asDiagonal().toDenseMatrix(), 1.0);
+  const Matrix3 R = so3::fromAxisAngle(Vector3(1, 2, 3).normalized(), 0.7);
+  std::vector<visualization_msgs::Marker> drawn;
+  for (const visualization_msgs::MarkerArray& a :
+       {bodyMarkers(box, 0.9, 1.2, "body", ros::Time(3.0)),
+        constraintMarkers(twoCones(), 1.2, "world", ros::Time()),
+        worldDirectionMarkers(twoCones(), pointingAt(), 1.2, "world"),
+        bodyAxisMarkers(twoCones(), pointingAt(), R, 1.2, "world", ros::Time(3.0))}) {
+    drawn.insert(drawn.end(), a.markers.begin(), a.markers.end());
+  }
+  ASSERT_EQ(drawn.size(), 5u + 2u + 3u + 3u);
+  std::set<std::string> seen;
+  for (const visualization_msgs::Marker& m : drawn) {
+    ASSERT_EQ(namespaces.count(m.ns), 1u) << m.ns << " is in no meaning (not in the legend)";
+    const std_msgs::ColorRGBA c = meaningColour(m.ns);
+    EXPECT_EQ(std::make_tuple(m.color.r, m.color.g, m.color.b), std::make_tuple(c.r, c.g, c.b))
+        << m.ns;
+    seen.insert(m.ns);
+  }
+  EXPECT_GE(seen.size(), 12u);
+  EXPECT_THROW(meaningColour("no_such_marker"), std::out_of_range);
+  // The legend: one line per meaning, in order, in its colour, saying it.
+  const visualization_msgs::MarkerArray legend = legendMarkers("world", 1.2);
+  ASSERT_EQ(legend.markers.size(), meanings.size());
+  for (std::size_t i = 0; i < meanings.size(); ++i) {
+    const visualization_msgs::Marker& line = legend.markers[i];
+    EXPECT_EQ(line.type, visualization_msgs::Marker::TEXT_VIEW_FACING);
+    EXPECT_EQ(line.header.frame_id, "world");
+    EXPECT_EQ(line.text, meanings[i].legend);
+    EXPECT_EQ(line.color.r, meanings[i].r);
+    EXPECT_EQ(line.color.g, meanings[i].g);
+    EXPECT_EQ(line.color.b, meanings[i].b);
+    if (i > 0) EXPECT_LT(line.pose.position.z, legend.markers[i - 1].pose.position.z);
+  }
+}
+
+TEST(MarkerColours, TheShippedRvizConfigHidesTheTfAxesAndShowsTheLegend) {
+  // The TF display's own red-green-blue frame axes would give the principal axes' colours a
+  // second meaning: the shipped config shows frame names instead, and displays `legend`.
+  std::ifstream file(std::string(AP_SOURCE_DIR) + "/rviz/maneuver.rviz");
+  ASSERT_TRUE(file) << "rviz/maneuver.rviz";
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::size_t tf = text.find("Class: rviz/TF");
+  ASSERT_NE(tf, std::string::npos);
+  const std::size_t next = text.find("- Class:", tf);
+  const std::string tf_display = text.substr(tf, next - tf);
+  EXPECT_NE(tf_display.find("Show Axes: false"), std::string::npos) << tf_display;
+  EXPECT_NE(tf_display.find("Show Names: true"), std::string::npos) << tf_display;
+  EXPECT_NE(text.find("Marker Topic: legend"), std::string::npos);
+  // The torque display draws in the colour the legend gives it.
+  const std_msgs::ColorRGBA torque = meaningColour("torque_display");
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "Torque Color: %d; %d; %d",
+                static_cast<int>(std::lround(255 * torque.r)),
+                static_cast<int>(std::lround(255 * torque.g)),
+                static_cast<int>(std::lround(255 * torque.b)));
+  EXPECT_NE(text.find(expected), std::string::npos) << expected;
+}
+
+TEST(LaunchFiles, EveryPrivateParameterOfANodeIsAnArgumentOfItsLaunchFile) {
+  // Every name a node reads with readParam / readNamedParam is set from an <arg> by its launch
+  // file (before: planner.launch had no action_workers).
+  const auto text = [](const std::string& path) {
+    std::ifstream file(std::string(AP_SOURCE_DIR) + "/" + path);
+    EXPECT_TRUE(file) << path;
+    return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  };
+  const std::regex read(R"re(read(?:Named)?Param(?:<[^>]*>)?\(\s*\w+,\s*"([a-z_]+)")re");
+  const std::pair<const char*, const char*> nodes[] = {
+      {"src/ros/planner_node.cpp", "launch/planner.launch"},
+      {"src/ros/tracker_node.cpp", "launch/tracker.launch"},
+      {"src/ros/plant_node.cpp", "launch/plant.launch"}};
+  for (const auto& [source, launch] : nodes) {
+    const std::string code = text(source);
+    const std::string xml = text(launch);
+    int names = 0;
+    for (std::sregex_iterator it(code.begin(), code.end(), read), end; it != end; ++it) {
+      const std::string name = (*it)[1];
+      ++names;
+      EXPECT_NE(xml.find("<param name=\"" + name + "\""), std::string::npos)
+          << launch << " does not set ~" << name;
+      EXPECT_NE(xml.find("<arg name=\"" + name + "\""), std::string::npos)
+          << launch << " has no arg " << name;
+    }
+    EXPECT_GE(names, 5) << source;  // the pattern still finds the node's parameters
+  }
+}
+
+TEST(BodyAxisMarkers, DrawnInTheWorldFrameFromTheAttitudeNeedingNoTf) {
+  // The constrained body axes and the boresight: R b in the world frame at the sample's stamp
+  // (before: a frame-locked arrow in the body frame, latched before tf had the body frame).
+  const Matrix3 R = so3::fromAxisAngle(Vector3(-1, 2, 0.5).normalized(), 2.1);
+  const std::vector<PlanningConstraint> cones = twoCones();
+  const EndCondition end = pointingAt();
+  const visualization_msgs::MarkerArray a =
+      bodyAxisMarkers(cones, end, R, 1.2, "map", ros::Time(7.0));
+  ASSERT_EQ(a.markers.size(), 3u);
+  const Vector3 axes[3] = {cones[0].body_axis, cones[1].body_axis, end.body_axis};
+  const char* ns[3] = {"keep_out_body_axis", "keep_in_body_axis", "pointing_boresight"};
+  for (int i = 0; i < 3; ++i) {
+    const visualization_msgs::Marker& m = a.markers[i];
+    EXPECT_EQ(m.ns, ns[i]);
+    EXPECT_EQ(m.header.frame_id, "map");
+    EXPECT_EQ(m.header.stamp, ros::Time(7.0));
+    EXPECT_FALSE(m.frame_locked);
+    EXPECT_LT((tipOf(m) - 1.2 * R * axes[i].normalized()).norm(), 1e-12) << ns[i];
+  }
+  // The world directions (the Sun arrow, the pointing target), once per maneuver.
+  const visualization_msgs::MarkerArray d = worldDirectionMarkers(cones, end, 1.2, "map");
+  ASSERT_EQ(d.markers.size(), 3u);
+  const Vector3 directions[3] = {cones[0].world_direction, cones[1].world_direction,
+                                 end.world_direction};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.markers[i].header.frame_id, "map");
+    EXPECT_LT((tipOf(d.markers[i]) - 1.8 * directions[i].normalized()).norm(), 1e-12);
+  }
+  // Without cones or a pointing end condition: nothing.
+  EXPECT_TRUE(bodyAxisMarkers({}, std::nullopt, R, 1.2, "map", ros::Time()).markers.empty());
+  EXPECT_TRUE(worldDirectionMarkers({}, EndCondition(), 1.2, "map").markers.empty());
+}
+
 TEST(PrincipalBox, NonPhysicalInertiaStillGetsAVisibleBox) {
   // The seed's J violates J1 + J2 >= J3: the third edge would be imaginary; it is clamped.
   const PrincipalBox box = principalBox(rc::inertiaFromMsg(seedRequest().inertia), 1.0);
@@ -733,6 +905,42 @@ TEST(Deadline, APlanThatConvergedAfterItsBudgetIsTimedOut) {
   unbounded.time_budget_s = 0.0;  // none
   enforceDeadline(&unbounded);
   EXPECT_EQ(unbounded.error_code, PlanErrorCode::SUCCESS);
+}
+
+TEST(Deadline, TheAnswerLeavesTheStoppedSolveTimeWithinTheContract) {
+  // Issue 43's bound for a deadline answer, 1.1 B + 0.05 s, holds for every budget, and a stopped
+  // solve has at least kHandoverFloor after B to hand over the plan it reached.
+  for (double budget : {1e-6, 0.01, 0.1, 0.5, 1.0, 30.0, 300.0}) {
+    EXPECT_LE(answerDeadline(budget), 1.1 * budget + 0.05) << budget;
+    EXPECT_GE(answerDeadline(budget) - budget, kHandoverFloor) << budget;
+  }
+}
+
+TEST(AnytimePlan, AStoppedSolveFillsTheResponseWithItsPlanFlaggedUnconverged) {
+  // The adapter carries the core's stopped plan: cancelled at the second iteration (no master
+  // needed), the response has the plan's N + 1 rows, unconverged_plan and its residuals; a
+  // converged answer is not flagged.
+  ros::Time::init();  // the response's stamps, without a master
+  PlanAttitudeManeuver::Request req = seedRequest();
+  req.steps = 64;
+  req.tolerance = 1e-300;
+  const PlanOutcome stopped =
+      planRequest(req, rc::PlannerDefaults(),
+                  [](const IterationInfo& info, double) { return info.iteration < 2; });
+  ASSERT_TRUE(stopped.solver_ran) << stopped.message;
+  EXPECT_EQ(stopped.error_code, PlanErrorCode::CANCELLED) << stopped.message;
+  PlanAttitudeManeuver::Response res;
+  fillResponse(stopped, "world", "body", &res);
+  EXPECT_FALSE(res.success);
+  EXPECT_TRUE(res.unconverged_plan);
+  EXPECT_EQ(res.maneuver.attitude.size(), 65u);
+  EXPECT_GT(res.max_residual, req.tolerance);
+  EXPECT_LE(res.step_residual, 1e-8);
+  req.tolerance = 0.0;  // the node's default
+  PlanAttitudeManeuver::Response converged;
+  fillResponse(planRequest(req, rc::PlannerDefaults(), nullptr), "world", "body", &converged);
+  EXPECT_TRUE(converged.success) << converged.message;
+  EXPECT_FALSE(converged.unconverged_plan);
 }
 
 TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {

@@ -1,12 +1,14 @@
 // rostest: attitude_tracker_node with a ~scene that has a keep_out cone (scenes/sun_keep_out.yaml,
 // planned through the planner service): `constraint_markers` carries the cone (world frame, apex
-// at the origin, axis the world direction, the half angle at every rim point) and the constrained
-// body axis (body frame), and the plan it replays is the constrained one.
+// at the origin, axis the world direction, the half angle at every rim point) and its direction,
+// `body_marker` the constrained body axis (world frame, every sample), and the plan it replays is
+// the constrained one.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <visualization_msgs/MarkerArray.h>
 #include <mutex>
+#include <vector>
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -54,7 +56,7 @@ TEST(TrackerConstraints, ConeAndBodyAxisMarkersHaveTheConstraintsGeometry) {
   }
   std::lock_guard<std::mutex> lock(mutex);
   ASSERT_TRUE(got) << "no constraint_markers";
-  // A DELETEALL first (the previous maneuver's cones go), then the cone and its body axis.
+  // A DELETEALL first (the previous maneuver's cones go), then the cone and its world direction.
   ASSERT_EQ(got->markers.size(), 3u);
   EXPECT_EQ(got->markers[0].action, visualization_msgs::Marker::DELETEALL);
   const visualization_msgs::Marker& c = got->markers[1];
@@ -78,13 +80,51 @@ TEST(TrackerConstraints, ConeAndBodyAxisMarkersHaveTheConstraintsGeometry) {
   }
   // Rim points spread evenly around the axis: their mean lies on the world direction.
   EXPECT_LT((rim_sum.normalized() - cone.world_direction).norm(), 1e-9);
-  const visualization_msgs::Marker& a = got->markers[2];
-  EXPECT_EQ(a.header.frame_id, "body");
-  EXPECT_EQ(a.ns, "keep_out_body_axis");
+  const visualization_msgs::Marker& a = got->markers[2];  // the Sun arrow
+  EXPECT_EQ(a.header.frame_id, "world");
+  EXPECT_EQ(a.ns, "keep_out_direction");
   EXPECT_EQ(a.type, visualization_msgs::Marker::ARROW);
   ASSERT_EQ(a.points.size(), 2u);
   EXPECT_EQ(vec(a.points[0]), Vector3::Zero());
-  EXPECT_LT((vec(a.points[1]) - kPathRadius * cone.body_axis).norm(), 1e-12);
+  EXPECT_LT((vec(a.points[1]).normalized() - cone.world_direction.normalized()).norm(), 1e-12);
+}
+
+TEST(TrackerConstraints, TheConstrainedBodyAxisIsDrawnInTheWorldAtEverySample) {
+  // Drawn from the body's attitude in the world frame, so rviz needs no transform of the body
+  // frame for it (before: a frame-locked arrow in the body frame, latched before tf had that
+  // frame, never drawn). Along the constrained plan it stays outside the cone.
+  const Scene scene = testScene();
+  const PlanningConstraint& cone = scene.problem.constraints[0];
+  ros::NodeHandle nh;
+  std::mutex mutex;
+  std::vector<visualization_msgs::Marker> axes;
+  ros::Subscriber sub = nh.subscribe<visualization_msgs::MarkerArray>(
+      "body_marker", 100, [&](const visualization_msgs::MarkerArray::ConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const visualization_msgs::Marker& m : array->markers) {
+          if (m.ns == "keep_out_body_axis") axes.push_back(m);
+        }
+      });
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+  while (ros::WallTime::now() < deadline) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (axes.size() >= 20) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GE(axes.size(), 20u) << "the constrained body axis is not streamed on body_marker";
+  for (const visualization_msgs::Marker& a : axes) {
+    EXPECT_EQ(a.header.frame_id, "world");
+    EXPECT_FALSE(a.frame_locked);
+    ASSERT_EQ(a.points.size(), 2u);
+    const Vector3 tip = vec(a.points[1]);
+    EXPECT_NEAR(tip.norm(), kPathRadius, 1e-9);
+    const double angle =
+        std::atan2(tip.cross(cone.world_direction).norm(), tip.dot(cone.world_direction));
+    EXPECT_GE(angle, cone.half_angle - 1e-6);  // the constrained plan keeps out of the cone
+  }
 }
 
 TEST(TrackerConstraints, TheServicePlanIsTheConstrainedOne) {

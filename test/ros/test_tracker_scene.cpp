@@ -5,7 +5,9 @@
 #include <ros/ros.h>
 #include <vector>
 
+#include <ros/topic.h>
 #include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "attitude_planner/ReplayResult.h"
 #include "attitude_planner/ros/conversions.hpp"
@@ -50,9 +52,27 @@ TEST(TrackerScene, FinalTransformIsTheScenesTargetAttitude) {
     ASSERT_EQ(b.size(), 3u);
     ASSERT_EQ(d.size(), 3u);
     const Vector3 aimed = flown * Vector3(b[0], b[1], b[2]).normalized();
-    EXPECT_LT((aimed - Vector3(d[0], d[1], d[2]).normalized()).norm(), target_tolerance);
+    const Vector3 direction = Vector3(d[0], d[1], d[2]).normalized();
+    EXPECT_LT((aimed - direction).norm(), target_tolerance);
+    // `done` reports the pointing error of the flown body, and the target direction is drawn
+    // (latched with the maneuver's world markers), along d.
+    EXPECT_NEAR(done->pointing_error,
+                std::atan2(aimed.cross(direction).norm(), aimed.dot(direction)), 1e-9);
+    const auto world = ros::topic::waitForMessage<visualization_msgs::MarkerArray>(
+        "constraint_markers", nh, ros::Duration(10.0));
+    ASSERT_TRUE(world) << "no constraint_markers";
+    int targets = 0;
+    for (const visualization_msgs::Marker& m : world->markers) {
+      if (m.ns != "pointing_target") continue;
+      ++targets;
+      ASSERT_EQ(m.points.size(), 2u);
+      const Vector3 tip(m.points[1].x, m.points[1].y, m.points[1].z);
+      EXPECT_LT((tip.normalized() - direction).norm(), 1e-12);
+    }
+    EXPECT_EQ(targets, 1);
     return;
   }
+  EXPECT_EQ(done->pointing_error, 0.0);  // not a pointing scene
   EXPECT_LT(so3::angleBetween(flown, target), target_tolerance);
 }
 

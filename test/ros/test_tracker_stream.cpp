@@ -129,11 +129,14 @@ TEST_F(TrackerStream, FramesStampAndConstraintsComeFromTheMessage) {
   ASSERT_TRUE(tf_buffer.canTransform("map", "base_link", done.header.stamp, ros::Duration(5.0)));
   EXPECT_FALSE(tf_buffer._frameExists("body")) << "the default frame was published";
   ASSERT_TRUE(cones_) << "no constraint_markers for a maneuver that carries a keep_out cone";
-  ASSERT_EQ(cones_->markers.size(), 3u);  // the previous maneuver's cleared, the cone, its axis
+  // The previous maneuver's cleared, the cone, its world direction (the Sun arrow); the body
+  // axis is drawn per sample in the world frame (body_marker), needing no tf.
+  ASSERT_EQ(cones_->markers.size(), 3u);
   EXPECT_EQ(cones_->markers[0].action, visualization_msgs::Marker::DELETEALL);
   EXPECT_EQ(cones_->markers[1].header.frame_id, "map");
   EXPECT_EQ(cones_->markers[1].ns, "keep_out");
-  EXPECT_EQ(cones_->markers[2].header.frame_id, "base_link");
+  EXPECT_EQ(cones_->markers[2].header.frame_id, "map");
+  EXPECT_EQ(cones_->markers[2].ns, "keep_out_direction");
   // Open loop on its own plan: the error topic reads zero to round-off all along.
   ASSERT_FALSE(errors_.empty());
   for (double e : errors_) EXPECT_LT(e, 1e-9);

@@ -59,6 +59,15 @@ Vector3 vectorFromMsg(const geometry_msgs::Vector3& v);
 Vector3 finiteVectorFromMsg(const geometry_msgs::Vector3& v, const std::string& field);
 /// Message vector of an Eigen vector.
 geometry_msgs::Vector3 vectorToMsg(const Vector3& v);
+/// Any message with fields x, y, z (geometry_msgs Vector3, Point) from v.
+template <class Msg>
+Msg xyzToMsg(const Vector3& v) {
+  Msg m;
+  m.x = v.x();
+  m.y = v.y();
+  m.z = v.z();
+  return m;
+}
 /// J [kg·m²] from a row-major float64[9] (symmetry and definiteness are checked by the core).
 Matrix3 inertiaFromMsg(const boost::array<double, 9>& j);
 /// Row-major float64[9] of J [kg·m²].

@@ -172,9 +172,10 @@ struct PrincipalBox {
 /// needed). Flat or non-physical inertias (J1 + J2 < J3) get a minimum edge of 10 % of `size`.
 PrincipalBox principalBox(const Matrix3& inertia, double size);
 
-/// Markers of the body: id 0 the box, ids 1..3 arrows along the principal axes (red, green, blue
-/// for the smallest, middle, largest moment), id 4 the traced body axis `trace_axis` (unit) up to
-/// the traced tip at `path_radius` [m] (orange, as `attitude_path`); all in `body_frame`.
+/// Markers of the body: id 0 the box (ns "body"), ids 1..3 arrows along the principal axes (ns
+/// "principal_axis_smallest" / "_middle" / "_largest": red, green, blue), id 4 the traced body axis
+/// `trace_axis` (unit) up to the traced tip at `path_radius` [m] (ns "traced_axis", orange, as
+/// `attitude_path`); all in `body_frame`, coloured by markerMeanings() (markers.hpp).
 visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis_length,
                                             double path_radius, const std::string& body_frame,
                                             const ros::Time& stamp,
@@ -182,14 +183,13 @@ visualization_msgs::MarkerArray bodyMarkers(const PrincipalBox& box, double axis
 
 /// Markers of the pointing constraints (keep_out, keep_in; others are skipped), cone i (in the
 /// order of `constraints`, counting cones only) as id i: a TRIANGLE_LIST cone in `world_frame`
-/// (ns "keep_out" magenta / "keep_in" cyan, translucent: colours no principal axis has), apex at
-/// the origin, axis the world direction s, every rim point at slant distance `length` [m] and at
-/// the half angle from s; and a frame-locked ARROW in `body_frame` (ns "keep_out_body_axis" /
-/// "keep_in_body_axis") from the origin to `length` · b. Stamp zero: rviz draws the body axis at
-/// the latest transform, so the array is published once (latched).
+/// (ns "keep_out" / "keep_in", translucent, their legend colours: markers.hpp), apex at the
+/// origin, axis the world direction s, every rim point at slant distance `length` [m] and at the
+/// half angle from s. The constrained body axes are drawn per sample in the world frame
+/// (bodyAxisMarkers), the directions once (worldDirectionMarkers).
 visualization_msgs::MarkerArray constraintMarkers(
     const std::vector<PlanningConstraint>& constraints, double length,
-    const std::string& world_frame, const std::string& body_frame, const ros::Time& stamp);
+    const std::string& world_frame, const ros::Time& stamp);
 
 /// The body axis to trace: e_x, e_y, e_z for `name` "x", "y", "z"; for "auto" the principal
 /// direction e_i least aligned with the maneuver's rotation axis log(R_0ᵀ R_N) (body frame), so
@@ -292,6 +292,9 @@ class TrackerNode {
     /// run's t_0 unless its header.stamp is in the future: the stream goes on at its rate).
     std::optional<RigidBodyState> takeover;
     ros::Time continue_at;
+    /// A pointing scene's end condition (the boresight and target drawn, the pointing error on
+    /// the status text and in `done`); the maneuver itself flies to the attitude its plan chose.
+    std::optional<EndCondition> pointing;
   };
 
   /// What a rigid-body run streams: the plan (reference) and the body (actual), both
@@ -315,7 +318,8 @@ class TrackerNode {
     /// The worst violation of each constraint at the published samples (fresh measurements when
     /// the plant is external); shared so the const publishing path can update it.
     std::shared_ptr<ConstraintHealth> health;
-    int replan_period_steps = 1;  ///< plan steps between re-plans (replanPeriodSteps)
+    int replan_period_steps = 1;           ///< plan steps between re-plans (replanPeriodSteps)
+    std::optional<EndCondition> pointing;  ///< Replay::pointing
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -405,7 +409,8 @@ class TrackerNode {
   /// tf frame → body, the body markers and the trail at `stamp`.
   void publishPose(const Matrix3& R, const ros::Time& stamp, const std::string& world_frame,
                    const std::string& body_frame, const PrincipalBox& box,
-                   const Vector3& trace_axis, std::deque<Vector3>* trail);
+                   const Vector3& trace_axis, std::deque<Vector3>* trail,
+                   const visualization_msgs::MarkerArray& world_axes = {});
   /// After a rigid-body run: publishes world → body at the run's final attitude every 0.1 s (wall)
   /// until the next maneuver or shutdown (the replay thread's last job).
   void holdFinalAttitude();
@@ -434,6 +439,7 @@ class TrackerNode {
   ros::Publisher ghost_pub_;         ///< `ghost_markers` (latched)
   ros::Publisher done_pub_;          ///< `done` (latched)
   ros::Publisher constraint_pub_;    ///< `constraint_markers` (latched)
+  ros::Publisher legend_pub_;        ///< `legend` (latched): one text line per colour
   ros::Publisher command_pub_;       ///< `torque_command` (~plant external) [N·m], frame body
   ros::Publisher body_pose_pub_;     ///< `body_pose` R(t), frame world
   ros::Publisher error_vector_pub_;  ///< `attitude_error_vector` log(R_dᵀR) [rad], body

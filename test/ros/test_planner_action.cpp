@@ -185,12 +185,12 @@ TEST_F(PlannerAction, TimedOutGoalCarriesThePlanReached) {
 }
 
 TEST_F(PlannerAction, CancelledGoalCarriesThePlanReached) {
-  // Cancelled as soon as it is sent: the solve stops at its first check and its worker ends the
+  // Cancelled as soon as the server accepts it (a cancel sent before that recalls the goal, with
+  // no result: actionlib's RECALLED): the solve stops at its first check and its worker ends the
   // goal within kCancelGrace, PREEMPTED / CANCELLED with the plan reached (before: none).
   const int N = 512;
   PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
-  client_->sendGoal(goal);
-  client_->cancelGoal();
+  client_->sendGoal(goal, Client::SimpleDoneCallback(), [this] { client_->cancelGoal(); });
   ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
   EXPECT_EQ(client_->getState(), State::PREEMPTED);
   const auto result = client_->getResult();

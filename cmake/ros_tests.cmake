@@ -60,7 +60,7 @@ add_rostest(test/ros/tracker_effects_limited.test DEPENDENCIES test_tracker_effe
 list(APPEND AP_EXPECTED_TESTS test_tracker_effects tracker_effects_unplanned
      tracker_effects_limited)
 
-# The tracker as issue 31 asks: the message honoured and streamed at ~rate (tracker_stream), marker
+# The tracker: the message honoured and streamed at ~rate (tracker_stream), marker
 # bandwidth linear in the samples (tracker_bandwidth), closed loop against open loop under the
 # disturbed scene (tracker_feedback: two trackers in their own namespaces).
 foreach(name tracker_stream tracker_bandwidth tracker_feedback)
@@ -95,7 +95,7 @@ target_link_libraries(test_tracker_external ${PROJECT_NAME}_ros ${catkin_LIBRARI
 add_dependencies(test_tracker_external attitude_tracker_node attitude_plant_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_external)
 
-# A new maneuver mid-run (issue 43): with a planner that never answers (hung_planner_node) the
+# A new maneuver mid-run: with a planner that never answers (hung_planner_node) the
 # stream keeps its rate and both runs get `done`; the body is flown on from its state (no jump).
 add_executable(hung_planner_node EXCLUDE_FROM_ALL test/ros/hung_planner_node.cpp)
 target_link_libraries(hung_planner_node ${PROJECT_NAME}_ros ${catkin_LIBRARIES})

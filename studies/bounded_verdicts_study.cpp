@@ -1,4 +1,4 @@
-// bounded_verdicts_study (issue 45, "honest verdicts on bounded requests"): seeded bounded
+// bounded_verdicts_study (honest verdicts on bounded requests): seeded bounded
 // requests like the held-out ones (test/support/bounded_requests.hpp: random bodies and slews,
 // spinning ends, norm and box bounds at 0.6–0.9 of the unbounded plan's peak, rate limits,
 // re-plans cut from plans, a quarter as minimum time), each verdict checked independently

@@ -111,7 +111,7 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_EQ(result->error_code.val, PlanErrorCode::SUCCESS);
   EXPECT_EQ(result->maneuver.attitude.size(), 33u);
   EXPECT_LT(result->terminal_attitude_error, 1e-8);
-  // Issue 19: the verdict's step residual and the replay's sensitivity travel in the result.
+  // The verdict's step residual and the replay's sensitivity travel in the result.
   EXPECT_LE(result->step_residual, 1e-8);
   EXPECT_GE(result->replay_miss, result->terminal_attitude_error);
   EXPECT_LT(result->replay_miss, 1e-8);
@@ -124,7 +124,7 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
       5.0);
   EXPECT_GT(seen->feedbacks.load(), 0) << "no feedback received";
   EXPECT_LE(seen->last_iteration.load(), result->iterations);
-  // Issue 43: the feedback ends on the kept attempt, with the result's figures.
+  // The feedback ends on the kept attempt, with the result's figures.
   std::lock_guard<std::mutex> lock(seen->mutex);
   ASSERT_EQ(seen->kept.size(), 1u);
   const PlanAttitudeManeuverFeedback& kept = seen->kept.front();
@@ -483,7 +483,7 @@ bool waitForIdleWorkers(Client* a, Client* b) {
 }  // namespace
 
 TEST_F(PlannerAction, QueuedGoalsDeadlineCountsFromItsAcceptance) {
-  // Issue 43's target: a 0.5 s-budget goal queued behind two cancelled N = 1e5 goals is answered
+  // A 0.5 s-budget goal queued behind two cancelled N = 1e5 goals is answered
   // within 1.1 x its budget + 0.05 s of being sent. The two endless goals hold both workers
   // (~action_workers = 2); once both are PREEMPTED (their slots freed at the cancel) the third is
   // accepted at once and queued while the workers are still stopping the N = 1e5 solves. Its
@@ -539,7 +539,7 @@ TEST_F(PlannerAction, BudgetFarBelowTheSolveEndsTimedOut) {
       << client_->getResult()->message;
 }
 
-// Issue 30: a constrained goal (keep-out cone and torque-norm bound, both binding), then the
+// A constrained goal (keep-out cone and torque-norm bound, both binding), then the
 // re-plan from its node k with the plan's remainder as initial_guess: the interior point starts
 // from the guess and ends at the cold re-plan's optimum; a malformed guess is aborted by name.
 TEST_F(PlannerAction, InitialGuessStartsTheConstrainedReplan) {

@@ -80,8 +80,8 @@ TEST_F(PlannerService, SeedSlewMeetsTheBoundaryData) {
 }
 
 TEST_F(PlannerService, NanosecondHorizonIsJudgedByThePlanAndReportsItsReplayMiss) {
-  // Issue 19: T = 1e-9 s, π about x (rates ~3e9 rad/s) was refused NOT_CONVERGED for an absolute
-  // replay miss; relative thresholds judge it like the same shape at T = 12.8 s.
+  // T = 1e-9 s, π about x (rates ~3e9 rad/s): relative thresholds judge the replay like the same
+  // shape at T = 12.8 s (an absolute miss would refuse it NOT_CONVERGED).
   PlanAttitudeManeuver::Request req = seed(64, M_PI);
   req.duration = 1e-9;
   const PlanAttitudeManeuver::Response res = call(req);
@@ -144,7 +144,7 @@ TEST_F(PlannerService, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
 }
 
 TEST_F(PlannerService, StepsLeftAtZeroTakeTheNodesDefaultSteps) {
-  // Issue 15, defect 3: empty/0 fields take the node's defaults (README), steps included; the
+  // Empty/0 fields take the node's defaults (README), steps included; the
   // node here runs with ~default_steps = 128 (launch/planner.launch).
   const PlanAttitudeManeuver::Response res = call(seed(0));
   ASSERT_TRUE(res.success) << res.message;
@@ -655,7 +655,7 @@ TEST_F(PlannerService, BudgetTooSmallToConvergeAnswersWithThePlanReached) {
 }
 
 TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
-  // Issue 30: the seed's slew, then the re-plan from its node k (spinning) to the same end with
+  // The seed's slew, then the re-plan from its node k (spinning) to the same end with
   // the plan's remainder as initial_guess: the remainder comes back, cost to 1e-8, in <= 2
   // iterations. A guess of another N is resampled; malformed guesses are named by row.
   const int N = 32, k = 8;

@@ -101,7 +101,7 @@ TEST(RosConversions, BadFieldsAreNamedWithTheirValue) {
 }
 
 TEST(RosConversions, HostileRequestsGetTheirErrorCodeNamingFieldAndValue) {
-  // Issue 7: every bad request is refused with a specific message and code, never a crash. With
+  // Every bad request is refused with a specific message and code, never a crash. With
   // AP_BAD_INPUT_TABLE=<file> the rows are also written as markdown (docs/results/robustness.md).
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -442,8 +442,8 @@ TEST(RosConversions, DefaultsFillEmptyFields) {
 }
 
 TEST(RosConversions, StepsLeftAtZeroTakeTheNodesDefaultSteps) {
-  // Issue 15, defect 3: a request that leaves steps at 0 was refused ("steps: must be >= 4, got
-  // 0") although empty/0 fields take the node's defaults.
+  // A request that leaves steps at 0 takes the node's default (empty/0 fields do), not a refusal
+  // ("steps: must be >= 4, got 0").
   rc::PlannerDefaults d;
   EXPECT_EQ(d.steps, 128);
   PlanAttitudeManeuver::Request r = seedRequest();
@@ -908,7 +908,7 @@ TEST(Deadline, APlanThatConvergedAfterItsBudgetIsTimedOut) {
 }
 
 TEST(Deadline, TheAnswerLeavesTheStoppedSolveTimeWithinTheContract) {
-  // Issue 43's bound for a deadline answer, 1.1 B + 0.05 s, holds for every budget, and a stopped
+  // The bound for a deadline answer, 1.1 B + 0.05 s, holds for every budget, and a stopped
   // solve has at least kHandoverFloor after B to hand over the plan it reached.
   for (double budget : {1e-6, 0.01, 0.1, 0.5, 1.0, 30.0, 300.0}) {
     EXPECT_LE(answerDeadline(budget), 1.1 * budget + 0.05) << budget;
@@ -951,7 +951,7 @@ TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {
       << invalidMessage(r);
 }
 
-// The tracker's default body frame: one per namespace, "body" in the root one (issue 43).
+// The tracker's default body frame: one per namespace, "body" in the root one.
 TEST(TrackerFrames, DefaultBodyFrameComesFromTheNamespace) {
   EXPECT_EQ(defaultBodyFrame("/"), "body");
   EXPECT_EQ(defaultBodyFrame(""), "body");
@@ -1097,7 +1097,7 @@ TEST(RosConversions, PointingRequestIsPlannedAndReportsItsTwist) {
 }
 
 TEST(ActionFeedback, IterationsNameTheirAttemptAndTheLastMessageIsTheKeptAttempts) {
-  // Issue 43: the feedback ended on a discarded attempt's iterate (effort 44 % above the
+  // The feedback must not end on a discarded attempt's iterate (its effort can be far above the
   // result's). Each iteration's message carries its attempt's number, stage and class; the last
   // one is the returned plan's, tagged with the kept attempt.
   PlanAttitudeManeuver::Request r = seedRequest();

@@ -1,4 +1,4 @@
-// Issue 45, "honest verdicts on bounded requests": the proven lower bound on the duration
+// Honest verdicts on bounded requests: the proven lower bound on the duration
 // against closed forms, invariances and every scheme's minimum time; the requests answered
 // before any solve; the floating-point range refused by name; classes the grid cannot represent
 // refused and a plan never answered as a class it is not in; and a seeded suite of bounded

@@ -247,8 +247,8 @@ TEST_F(CliTest, InvalidSceneExitsOneNamingTheKey) {
 }
 
 TEST_F(CliTest, StepsAreCheckedByThePlannersRuleOnly) {
-  // Issue 15, defect 2: the CLI had its own copy of the rule (`< 1`, worded ">= 4"): --steps 0
-  // was refused with the wrong bound for both systems. Now each planner's rule decides.
+  // The CLI keeps no copy of the steps rule: --steps 0 is refused with each planner's own bound
+  // (the bound a copy would get wrong for one of the two systems).
   for (const char* bad : {"0", "-5", "3"}) {
     const ToolRun r = run("plan_maneuver", kScenes + "rest_to_rest.yaml --steps " + bad);
     EXPECT_EQ(r.status, 1) << r.output;

@@ -144,7 +144,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
                   const std::string& body_frame, Response* res);
 
 /// The answer to a request with a time budget B comes by answerDeadline(B) = B + max(B
-/// kDeadlineSlack, kHandoverFloor) [s]: within issue 43's 1.1 B + 0.05 s (docs/ros_timing.md). The
+/// kDeadlineSlack, kHandoverFloor) [s]: within 1.1 B + 0.05 s (docs/ros_timing.md). The
 /// core stops at B and returns the plan it had reached (an anytime plan: unconverged_plan); the
 /// time after B is what it has to measure that plan and hand it over (about 7 us per node here:
 /// 0.15 s at N = 20,000). A solve still running then is told to stop and its result is dropped: the

@@ -405,6 +405,9 @@ struct ConstraintCheck {
   /// Worst violation of the stated limits over the continuous motion between the nodes too
   /// (R_k exp(s ω_k^), torques held; constraints.hpp), each in its own unit, ≥ max_violation.
   double max_violation_between_nodes = 0.0;
+  /// The plan meets its node constraints (every relative violation within
+  /// kNodeConstraintTolerance): the one test drivers and verdicts apply to a plan.
+  bool withinBounds() const { return max_relative_violation <= kNodeConstraintTolerance; }
 };
 ConstraintCheck checkConstraints(const PlanningProblem& problem, const Maneuver& maneuver);
 

@@ -89,9 +89,7 @@ PlanResult richardsonCombinationWithinTheBounds(const PlanningProblem& problem,
                                                 bool* replaced) {
   PlanResult result = richardsonCombination(problem, coarse, fine);
   if (replaced) *replaced = false;
-  if (!problem.hasNodeConstraints() ||
-      checkConstraints(problem, result.maneuver).max_relative_violation <=
-          kNodeConstraintTolerance) {
+  if (!problem.hasNodeConstraints() || checkConstraints(problem, result.maneuver).withinBounds()) {
     return result;
   }
   result.maneuver = coarse.maneuver;

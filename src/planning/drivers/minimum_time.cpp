@@ -440,9 +440,9 @@ std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResu
   if (result.termination == Termination::Infeasible) return "ended infeasible";
   if (result.termination == Termination::NotConverged) return "did not converge";
   if (!result.converged() || !problem.hasNodeConstraints()) return "";
-  const double outside = checkConstraints(problem, result.maneuver).max_relative_violation;
-  if (outside <= kNodeConstraintTolerance) return "";
-  return "left a bound by " + exactNumber(outside) + " (relative)";
+  const ConstraintCheck check = checkConstraints(problem, result.maneuver);
+  if (check.withinBounds()) return "";
+  return "left a bound by " + exactNumber(check.max_relative_violation) + " (relative)";
 }
 
 /// The duration ladder's rungs: a first step of 15 % in T, up to 30 % after converged rungs,
@@ -478,7 +478,7 @@ PlanResult ladderRung(const PlanningProblem& rung, const Maneuver& from, SolveCo
   };
   PlanResult r = solve(from);
   if (r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
-      checkConstraints(rung, r.maneuver).max_relative_violation <= kNodeConstraintTolerance) {
+      checkConstraints(rung, r.maneuver).withinBounds()) {
     const Maneuver inside = r.maneuver;
     r = solve(inside);
   }

@@ -136,6 +136,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
       options.unconstrained_optimum && options.unconstrained_optimum->steps() == problem.steps;
   if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
   std::vector<ClassPlan> survey_plans;
+  const SolveContext::IterationTally tally(context);  // Newton, then the interior point
   PlanResult result = solveWithNewton(problem, newton_options, context, &survey_plans);
   if (solved_before) {
     for (Attempt& a : result.attempts) {
@@ -169,7 +170,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   ExtremalSummary survey = result.extremal_summary;
   result = solveWithInteriorPoint(problem, constrained, context);
   result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
-  result.iterations += newton_iterations;
+  result.iterations = tally.iterations();
   result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
   result.message += note.str();
   if (survey.known && constrained.warm_start == &unconstrained_plan) {
@@ -222,13 +223,14 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     // through the usual continuation. A resampled guess (another N) is off the bounds it rode
     // on by O(h) and starts the unconstrained optimum instead, as below (measured: torque_limited
     // 64 → 256, 29 interior-point iterations from the guess, 25 cold).
+    const SolveContext::IterationTally tally(context);  // from the guess, then the retry
     result = solveWithInteriorPointFromGuess(problem, options, context);
     if (result.termination == Termination::NotConverged ||
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
       result = solveWithInteriorPoint(problem, options, context);
       result.attempts = followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
-      result.iterations += first.iterations;
+      result.iterations = tally.iterations();
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
       result.message += "; after the start from the initial guess stopped: " + first.message;
     }

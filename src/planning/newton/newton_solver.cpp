@@ -221,7 +221,11 @@ struct ClassSolve {
 class Walk {
  public:
   Walk(const PlanningProblem& problem, SolveContext& context, const NewtonParameters& p)
-      : problem_(problem), context_(context), p_(p), first_recorded_(context.attempts().size()) {}
+      : problem_(problem),
+        context_(context),
+        p_(p),
+        first_recorded_(context.attempts().size()),
+        tally_(context) {}
 
   /// Records an attempt; its plan competes if it is on the requested grid. `own_iterations`:
   /// what the slow-solve gate reads if it is kept (the class's survey and refinement).
@@ -292,6 +296,7 @@ class Walk {
   SolveContext& context_;
   const NewtonParameters& p_;
   std::size_t first_recorded_;
+  SolveContext::IterationTally tally_;  ///< the walk's iterations, every attempt's
   std::vector<Attempt> trail_;
   std::optional<PlanResult> kept_;
   /// The last attempt that produced no plan on the requested grid (e.g. a boundary rate with no
@@ -514,10 +519,11 @@ PlanResult byInertiaHomotopy(const PlanningProblem& problem, SolveContext& conte
     stage.inertia = (1.0 - s) * sphere + s * problem.inertia;
     return stage;
   };
-  const StagedOutcome staged = solveByFixedStages(
-      at, p.inertia_homotopy_stages, [&](const PlanningProblem& stage, const Maneuver* from) {
-        return solveThroughGrids(stage, context, settings, from, p);
-      });
+  const StagedOutcome staged =
+      solveByFixedStages(context, at, p.inertia_homotopy_stages,
+                         [&](const PlanningProblem& stage, const Maneuver* from) {
+                           return solveThroughGrids(stage, context, settings, from, p);
+                         });
   if (!staged.complete()) return unfinished(staged, "the inertia homotopy");
   PlanResult r = staged.plan;
   r.iterations = staged.iterations;
@@ -646,9 +652,7 @@ PlanResult Walk::finish() {
   if (kept.converged()) stop.reset();
   trail_[kept_at_].kept = true;
   context_.markKept(first_recorded_ + kept_at_);
-  int iterations = 0;
-  for (const Attempt& a : trail_) iterations += a.iterations;
-  kept.iterations = iterations;
+  kept.iterations = tally_.iterations();
   for (std::size_t i = 0; i < trail_.size(); ++i) {
     if (i != kept_at_) kept.extremal_summary.others.push_back(trail_[i]);
   }

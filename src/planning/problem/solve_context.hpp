@@ -87,6 +87,20 @@ class SolveContext : public Interruption {
     bool previous_names_nested_;
     int iterations_at_open_;
   };
+  /// The iterations reported from its construction on: a phase's count (a continuation's
+  /// stages, a Newton start then the interior point) read from the one numbering, instead of
+  /// summed from its solves' results.
+  class IterationTally {
+   public:
+    explicit IterationTally(const SolveContext& context)
+        : context_(context), at_open_(context.iterations_) {}
+    int iterations() const { return context_.iterations_ - at_open_; }
+
+   private:
+    const SolveContext& context_;
+    int at_open_;
+  };
+
   /// The attempt the iterations reported now belong to (number 0 outside every Scope).
   const AttemptTag& currentAttempt() const { return attempt_; }
 

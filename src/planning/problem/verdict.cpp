@@ -98,7 +98,7 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
   }
   if (constraints && problem.hasNodeConstraints()) {
     const ConstraintCheck check = checkConstraints(problem, result.maneuver);
-    if (!(check.max_relative_violation <= kNodeConstraintTolerance)) {
+    if (!check.withinBounds()) {
       why << "stationary point found, but it violates " << check.worst << " " << check.worst_where
           << " (" << check.max_relative_violation << " relative, tolerance "
           << kNodeConstraintTolerance << ")";

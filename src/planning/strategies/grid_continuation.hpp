@@ -129,7 +129,7 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
                      const LevelSolver<Carry>& solve, const ContinuationFinish& finish) {
   const std::size_t count = levels.size();
   std::vector<LevelSummary> summaries;
-  int iterations = 0;
+  const SolveContext::IterationTally tally(context);
   PlanResult result;
   record.first = first;
   for (std::size_t i = first; i < count; ++i) {
@@ -158,7 +158,6 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
     record.levels[i].termination = result.termination;
     record.levels[i].message = result.message;
     record.reached = i + 1;
-    iterations += result.iterations;
     if (record.stop) {
       result.termination = record.stop->termination;
       if (!result.levels.empty()) result.levels.back().termination = record.stop->termination;
@@ -166,7 +165,7 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
     summaries.insert(summaries.end(), result.levels.begin(), result.levels.end());
     if (!finest && !record.stop && rule.unconverged_ends && !result.converged()) break;
   }
-  result.iterations = iterations;
+  result.iterations = tally.iterations();
   result.levels = std::move(summaries);
   finish(record, &result);
   return result;

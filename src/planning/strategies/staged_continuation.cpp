@@ -17,8 +17,9 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
   StagedOutcome out;
   out.reached = -1;
   if (context.stopReason()) return out;
+  const SolveContext::IterationTally tally(context);
   out.plan = solve(at(0.0), nullptr);
-  out.iterations += out.plan.iterations;
+  out.iterations = tally.iterations();
   if (stoppedEarly(out.plan)) {
     out.stopped = out.plan.termination;
     return out;
@@ -31,7 +32,7 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
     const Maneuver from = out.plan.maneuver;
     PlanResult r = solve(at(next), &from);
     ++out.stages;
-    out.iterations += r.iterations;
+    out.iterations = tally.iterations();
     if (stoppedEarly(r)) {
       out.stopped = r.termination;
       out.plan = std::move(r);
@@ -49,14 +50,16 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
   return out;
 }
 
-StagedOutcome solveByFixedStages(const StageProblem& at, int stages, const StageSolver& solve) {
+StagedOutcome solveByFixedStages(const SolveContext& context, const StageProblem& at, int stages,
+                                 const StageSolver& solve) {
   StagedOutcome out;
   out.reached = -1;
+  const SolveContext::IterationTally tally(context);
   Maneuver previous;
   for (int i = 0; i <= stages; ++i) {
     const double s = static_cast<double>(i) / stages;
     out.plan = solve(at(s), i > 0 ? &previous : nullptr);
-    out.iterations += out.plan.iterations;
+    out.iterations = tally.iterations();
     if (stoppedEarly(out.plan)) out.stopped = out.plan.termination;
     if (!out.plan.converged()) break;
     out.reached = s;

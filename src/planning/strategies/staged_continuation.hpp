@@ -25,7 +25,7 @@ struct StagedOutcome {
   PlanResult plan;     ///< the last converged stage's (s = reached), or the stage that stopped
   double reached = 0;  ///< the s of the last converged stage (−1: not even s = 0)
   int stages = 0;      ///< stages solved after s = 0
-  int iterations = 0;  ///< over every stage
+  int iterations = 0;  ///< over every stage (the context's count while they ran)
   std::optional<Termination> stopped;  ///< a stage was cancelled or ran out of time
   bool complete() const { return !stopped && reached == 1.0 && plan.converged(); }
 };
@@ -43,6 +43,7 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
                                     const AdaptiveSchedule& schedule, const StageSolver& solve);
 
 /// `stages` equal steps of s after s = 0, ending at the first stage that does not converge.
-StagedOutcome solveByFixedStages(const StageProblem& at, int stages, const StageSolver& solve);
+StagedOutcome solveByFixedStages(const SolveContext& context, const StageProblem& at, int stages,
+                                 const StageSolver& solve);
 
 }  // namespace attitude_planner

@@ -245,6 +245,7 @@ TEST(GridContinuation, LevelsRunCoarsestFirstAndHandOnTheirIterates) {
     PlanResult result;
     result.termination = Termination::Converged;
     result.iterations = 3;
+    for (int i = 0; i < 3; ++i) context.reportIteration(IterationInfo{});  // as solvers do
     result.levels.push_back({r.problem.steps, 3, Termination::Converged, 0, 0, "converged"});
     return result;
   };
@@ -261,20 +262,21 @@ TEST(GridContinuation, LevelsRunCoarsestFirstAndHandOnTheirIterates) {
 namespace {
 
 /// A stand-in level solver: each level ends as `ends` says for its N (converged otherwise) after
-/// 3 iterations and hands on {N}; `seen` records (N, whether it started from a coarse iterate,
-/// whether it only replayed).
+/// 3 iterations, reported to the request's context as solvers do, and hands on {N}; `seen`
+/// records (N, whether it started from a coarse iterate, whether it only replayed).
 struct StandIn {
   std::map<int, Termination> ends;
   std::vector<std::tuple<int, bool, bool>> seen;
 
-  LevelSolver<std::vector<int>> solver() {
-    return [this](const LevelRequest<std::vector<int>>& r, std::vector<int>* out) {
+  LevelSolver<std::vector<int>> solver(SolveContext& context) {
+    return [this, &context](const LevelRequest<std::vector<int>>& r, std::vector<int>* out) {
       seen.emplace_back(r.problem.steps, r.coarse != nullptr, r.replay_only);
       if (out) *out = {r.problem.steps};
       PlanResult result;
       const auto end = ends.find(r.problem.steps);
       result.termination = end == ends.end() ? Termination::Converged : end->second;
       result.iterations = r.replay_only ? 0 : 3;
+      for (int i = 0; i < result.iterations; ++i) context.reportIteration(IterationInfo{});
       result.message = "N = " + std::to_string(r.problem.steps);
       result.levels.push_back({r.problem.steps, result.iterations, result.termination, 0, 0, ""});
       return result;
@@ -308,7 +310,7 @@ TEST(GridContinuation, AnInfeasibleLevelEndsTheContinuationWhenTheRuleSaysSo) {
   stand_in.ends[64] = Termination::Infeasible;
   ContinuationRecord seen_record;
   const PlanResult r = solveByGridContinuation<std::vector<int>>(
-      restToRest(1.0, 1024), context, rule, 1e-10, stand_in.solver(),
+      restToRest(1.0, 1024), context, rule, 1e-10, stand_in.solver(context),
       [&](const ContinuationRecord& record, PlanResult*) { seen_record = record; });
   using Seen = std::tuple<int, bool, bool>;
   EXPECT_EQ(stand_in.seen,
@@ -327,7 +329,7 @@ TEST(GridContinuation, AnInfeasibleLevelEndsTheContinuationWhenTheRuleSaysSo) {
   StandIn afresh;
   afresh.ends[64] = Termination::Infeasible;
   const PlanResult a = solveByGridContinuation<std::vector<int>>(
-      restToRest(1.0, 1024), context, GridLevelRule{}, 1e-10, afresh.solver());
+      restToRest(1.0, 1024), context, GridLevelRule{}, 1e-10, afresh.solver(context));
   EXPECT_EQ(afresh.seen[2], (Seen{256, false, false}));
   EXPECT_TRUE(a.converged());
   EXPECT_EQ(a.iterations, 12);
@@ -348,7 +350,7 @@ TEST(GridContinuation, AResumedContinuationStartsFromTheGivenLevelAndStopsWhereA
   from.below = {16};
   from.below_converged = true;
   StandIn stand_in;
-  const LevelSolver<std::vector<int>> inner = stand_in.solver();
+  const LevelSolver<std::vector<int>> inner = stand_in.solver(context);
   const LevelSolver<std::vector<int>> solve = [&](const LevelRequest<std::vector<int>>& r,
                                                   std::vector<int>* out) {
     if (r.problem.steps == 256) {
@@ -372,7 +374,7 @@ TEST(GridContinuation, AResumedContinuationStartsFromTheGivenLevelAndStopsWhereA
   StandIn failing;
   failing.ends[256] = Termination::NotConverged;
   const PlanResult f =
-      resumeGridContinuation(levels, from, context, rule, 1e-10, failing.solver(), finish);
+      resumeGridContinuation(levels, from, context, rule, 1e-10, failing.solver(context), finish);
   EXPECT_EQ(failing.seen, (std::vector<Seen>{{256, true, false}}));
   EXPECT_EQ(f.termination, Termination::NotConverged);
   EXPECT_EQ(reached, 3u);  // the requested level not reached
@@ -386,7 +388,7 @@ TEST(GridContinuation, ACancelCarriesTheLastIterateUpWithoutIterating) {
   options.cancel_requested = &cancel;
   SolveContext context(options);
   StandIn stand_in;
-  const LevelSolver<std::vector<int>> inner = stand_in.solver();
+  const LevelSolver<std::vector<int>> inner = stand_in.solver(context);
   const LevelSolver<std::vector<int>> solve = [&](const LevelRequest<std::vector<int>>& r,
                                                   std::vector<int>* out) {
     PlanResult result = inner(r, out);

@@ -1,7 +1,8 @@
-// The interior point on one grid as a short loop over named pieces: the step (assembly, inertia
-// correction, the barrier rule's predictor), the stopping test, the line search with the
-// fraction to the boundary, the step's acceptance, the end of a barrier problem at μ_final
-// (converged, penalty raise or infeasible) and the barrier rule's update.
+// The interior point on one grid on the PrimalDualLoop (primal_dual_loop.hpp), its hooks named
+// pieces: the step (assembly, inertia correction, the barrier rule's predictor), the stopping
+// test, the step's acceptance, a rejection (the round-off floor, the Levenberg–Marquardt retry),
+// the end of a barrier problem at μ_final (converged, penalty raise or infeasible) and the
+// barrier rule's update.
 #include "planning/interior_point/grid_solve.hpp"
 
 #include <algorithm>
@@ -299,15 +300,15 @@ class GridSolve final : public PrimalDualProblem {
     result.history = history_;
     out.steps = np_.current();
     if (free_slacks_) out.duals = system_.duals();
-    // Stopped: answer at once (the stationarity residual costs a gradient at N: not measured;
-    // on a coarser level the plan is evaluated once carried to the requested grid).
+    // A solve stopped on a coarser level of a continuation is not evaluated here: its iterate is
+    // carried to the requested grid and evaluated there (carryToGrid). Otherwise the plan's
+    // residuals are measured, a stopped one's too (one more gradient at N: what a user reads to
+    // tell a stopped iterate from an answer).
     result.max_residual = std::numeric_limits<double>::quiet_NaN();
     if (!ranOut(ending_) || request_.evaluate_when_stopped) {
       const Maneuver planned = np_.maneuver(np_.current());
       result.switching_function = system_.switchingFunction(planned.torque);
-      if (!ranOut(ending_)) {
-        result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
-      }
+      result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
       evaluatePlan(problem_, planned.torque, &result, &planned);
     }
     std::ostringstream msg;

@@ -3,16 +3,20 @@
 // shifted matrices, the least eigenpair against Eigen's dense eigensolver; the monotone barrier
 // rule's two profiles (barrier_update.hpp) and the two stopping tests (stopping_tests.hpp) against
 // their closed forms; the Armijo line search (line_search.hpp) on one-dimensional merits whose
-// accepted step length is found by enumerating the halvings independently.
+// accepted step length is found by enumerating the halvings independently; the primal–dual loop
+// (primal_dual_loop.hpp) on a scripted problem whose log is the order of the loop's calls.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -20,6 +24,7 @@
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
+#include "planning/interior_point/primal_dual_loop.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 
 namespace ap = attitude_planner;
@@ -417,4 +422,108 @@ TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeP
   EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 1.0, p.max_halvings, 100.0));
   EXPECT_EQ(d(0), 4.5);
   EXPECT_EQ(fixed.clears, 0);
+}
+
+namespace {
+
+/// A problem on φ(x) = (x − 1)² from x = 0 whose hooks log their calls (b: before the direction,
+/// d: the direction, a: a step accepted, r: rejected, L: the iteration limit, S/I: stopped
+/// between passes / inside one), one pass a '|'. Its direction is Newton's (1 − x), or the ascent
+/// direction −1000 (1 − x) where `ascent`; `before` scripts beforeDirection's answer per pass.
+class ScriptedProblem final : public ap::PrimalDualProblem {
+ public:
+  double merit() override { return phi(accepted_); }
+  double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
+    moveTo(d, alpha);
+    if (moved) *moved = true;
+    return phi(x_);
+  }
+  void moveTo(const Eigen::VectorXd& d, double alpha) override { x_ = accepted_ + alpha * d(0); }
+  void restore() override { x_ = accepted_; }
+  ap::Pass beforeDirection() override {
+    log += 'b';
+    const int pass = static_cast<int>(std::count(log.begin(), log.end(), 'b')) - 1;
+    return pass < static_cast<int>(before.size()) ? before[pass] : ap::Pass::Step;
+  }
+  ap::Pass direction(ap::LineSearchRequest* request, Eigen::VectorXd** d) override {
+    log += 'd';
+    if (throw_in_direction) throw ap::SolveInterrupted{ap::Termination::TimedOut};
+    // The ascent is steep enough that even the last halving rises above φ's round-off.
+    d_ = Eigen::VectorXd::Constant(1, (ascent ? -1000.0 : 1.0) * (1.0 - accepted_));
+    *request = {-2.0 * (1.0 - accepted_) * std::abs(d_(0)), 1.0, false, false, false};
+    *d = &d_;
+    return ap::Pass::Step;
+  }
+  ap::Pass accept(const ap::LineSearchResult&) override {
+    log += "a|";
+    accepted_ = x_;
+    return ap::Pass::Continue;
+  }
+  ap::Pass rejected(const ap::LineSearchResult&) override {
+    log += 'r';
+    return ap::Pass::Stop;
+  }
+  void iterationLimit() override { log += 'L'; }
+  void stopped(ap::Termination t, bool inside) override {
+    log += inside ? 'I' : 'S';
+    ending = t;
+  }
+  static double phi(double x) { return (x - 1.0) * (x - 1.0); }
+
+  std::string log;
+  std::vector<ap::Pass> before;
+  bool ascent = false, throw_in_direction = false;
+  ap::Termination ending = ap::Termination::Converged;
+
+ private:
+  double x_ = 0.0, accepted_ = 0.0;
+  Eigen::VectorXd d_;
+};
+
+/// Runs the loop in the fixed-h (limits first) or free-time order; returns the passes counted.
+int runLoop(ScriptedProblem* problem, bool limits_first, int max_iterations,
+            const std::atomic<bool>* cancel = nullptr) {
+  ap::SolverOptions options;
+  options.cancel_requested = cancel;
+  ap::SolveContext context(options);
+  const ap::InteriorPointParameters p;
+  int iteration = 0;
+  ap::PrimalDualLoop(*problem, {ap::fixedStepLineSearch(p), limits_first}, context)
+      .run(max_iterations, &iteration);
+  return iteration;
+}
+
+}  // namespace
+
+TEST(PrimalDualLoop, FixedStepTestsTheLimitBeforeAPassAndFreeTimeAfterWhatComesBeforeTheDirection) {
+  ScriptedProblem fixed, free_time;
+  EXPECT_EQ(runLoop(&fixed, true, 2), 2);
+  EXPECT_EQ(fixed.log, "bda|bda|L");
+  EXPECT_EQ(runLoop(&free_time, false, 2), 2);
+  EXPECT_EQ(free_time.log, "bda|bda|bL");
+}
+
+TEST(PrimalDualLoop, APassEndedBeforeItsDirectionCountsAndARejectedStepEndsWhereTheProblemSays) {
+  ScriptedProblem problem;
+  problem.before = {ap::Pass::Continue, ap::Pass::Step, ap::Pass::Stop};
+  EXPECT_EQ(runLoop(&problem, true, 5), 2);  // the Continue and the step count, the Stop not
+  EXPECT_EQ(problem.log, "bbda|b");
+  ScriptedProblem ascent;
+  ascent.ascent = true;  // every halving of an ascent direction is rejected
+  EXPECT_EQ(runLoop(&ascent, true, 5), 0);
+  EXPECT_EQ(ascent.log, "bdr");
+}
+
+TEST(PrimalDualLoop, AStopReasonEndsTheSolveInTheProfilesPlaceAndAnInterruptionInsideAPass) {
+  const std::atomic<bool> cancel{true};
+  ScriptedProblem fixed, free_time, inside;
+  EXPECT_EQ(runLoop(&fixed, true, 5, &cancel), 0);
+  EXPECT_EQ(fixed.log, "S");
+  EXPECT_EQ(fixed.ending, ap::Termination::Cancelled);
+  EXPECT_EQ(runLoop(&free_time, false, 5, &cancel), 0);
+  EXPECT_EQ(free_time.log, "bS");
+  inside.throw_in_direction = true;
+  EXPECT_EQ(runLoop(&inside, true, 5), 0);
+  EXPECT_EQ(inside.log, "bdI");
+  EXPECT_EQ(inside.ending, ap::Termination::TimedOut);
 }

@@ -6,7 +6,19 @@
 
 #include <Eigen/Core>
 
+#include "attitude_planner/termination.hpp"
+
 namespace attitude_planner {
+
+struct LineSearchRequest;  // line_search.hpp
+struct LineSearchResult;
+
+/// What a pass of the primal–dual loop (primal_dual_loop.hpp) does next.
+enum class Pass {
+  Step,      ///< go on within this pass (to the direction, to the line search)
+  Continue,  ///< the pass is over and counted: the next iteration
+  Stop,      ///< the solve has ended (the problem holds its termination and why)
+};
 
 class BarrierProblem {
  public:
@@ -29,6 +41,30 @@ class BarrierProblem {
   }
   /// Drops the curvature terms of a correction not taken (the dual step reads them).
   virtual void clearCorrection() {}
+};
+
+/// What the primal–dual loop (primal_dual_loop.hpp) asks beyond the line search. The problem owns
+/// the count of passes (the loop advances it after each counted pass; a hook that ends the solve
+/// on a pass it has reported counts that pass itself) and the termination.
+class PrimalDualProblem : public BarrierProblem {
+ public:
+  /// Before the direction: free time assembles here and tests convergence and its barrier
+  /// problem (solved: μ falls, a counted pass without a step); fixed h has nothing to do.
+  virtual Pass beforeDirection() { return Pass::Step; }
+  /// The Newton direction at the iterate (assembly where not done, inertia correction, the
+  /// barrier rule's predictor, the stopping test) and the line search's request; *d the step.
+  virtual Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) = 0;
+  /// The line search accepted a step of length result.alpha (the iterate at the trial point):
+  /// the dual step, the strategies' updates after a step, the report.
+  virtual Pass accept(const LineSearchResult& result) = 0;
+  /// The line search accepted no step (or no direction was found): a retry, a round-off end
+  /// or a failure.
+  virtual Pass rejected(const LineSearchResult& result) = 0;
+  /// The solve ends at the iteration limit.
+  virtual void iterationLimit() = 0;
+  /// The solve ends cancelled or out of time; `inside_pass`: interrupted inside an assembly or a
+  /// factorization (the assembled system is not the iterate's).
+  virtual void stopped(Termination termination, bool inside_pass) = 0;
 };
 
 }  // namespace attitude_planner

@@ -50,6 +50,7 @@
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
+#include "planning/interior_point/primal_dual_loop.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/transcription/node_constraints.hpp"
@@ -81,7 +82,7 @@ constexpr double kLargestRaise = 2.0;
 constexpr double kElasticPenalty = 100.0;
 constexpr double kElasticPenaltyGrowth = 10.0;
 
-class FreeTimeSolver final : public BarrierProblem {
+class FreeTimeSolver final : public PrimalDualProblem {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
                  const StageConstraints& constraints, const InteriorPointParameters& parameters)
@@ -92,8 +93,7 @@ class FreeTimeSolver final : public BarrierProblem {
         n_(np->unknowns()),
         form_(parameters),
         barrier_(parameters, freeTimeMonotone(parameters)),
-        inertia_(parameters),
-        search_(freeTimeLineSearch(parameters)) {
+        inertia_(parameters) {
     for (const auto& c : constraints) {
       groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
     }
@@ -236,7 +236,6 @@ class FreeTimeSolver final : public BarrierProblem {
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
-  bool lineSearch(Eigen::VectorXd* d, double mu, double epsilon, bool late, double* alpha);
   // BarrierProblem, from the point the line search started at (accepted_).
   double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
   /// φ_μ at the iterate moved by α d (θ by its fraction to the boundary while elastic), +∞ where
@@ -246,6 +245,17 @@ class FreeTimeSolver final : public BarrierProblem {
   void restore() override;
   bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override;
   void clearCorrection() override;
+  // PrimalDualProblem: the free-time profile's pass (free_time_solver.cpp).
+  Pass beforeDirection() override;
+  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) override;
+  Pass accept(const LineSearchResult& result) override;
+  Pass rejected(const LineSearchResult& result) override;
+  void iterationLimit() override { end(Termination::NotConverged, "iteration limit"); }
+  void stopped(Termination t, bool inside_pass) override;
+  /// Ends the solve: the outcome at the iterate, with `why`.
+  Pass end(Termination t, const std::string& why);
+  /// Ends the solve converged, with the second-order check.
+  Pass converged(const std::string& why);
   double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
@@ -263,9 +273,6 @@ class FreeTimeSolver final : public BarrierProblem {
   /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
   /// iterate the pass started from.
   void report(double alpha, double stationarity) const;
-  /// The outcome of a solve stopped (cancel, deadline) during an assembly: the iterate's system
-  /// assembled once more without polling, so the residuals reported are the iterate's.
-  FreeTimeOutcome interrupted(Termination t, int iterations, double mu, double epsilon);
   FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
                           double epsilon) const;
   void checkSecondOrder(FreeTimeOutcome* out) const;
@@ -288,15 +295,26 @@ class FreeTimeSolver final : public BarrierProblem {
   Eigen::VectorXd rhs_, lagrangian_gradient_;
   PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
   BorderedBandKkt<double> step_factor_;  ///< the last step's factor (the correction reuses it)
-  ArmijoBacktracking search_;
+  // The run (run()): its barrier problems and the stopping test.
+  double mu0_ = 0.0, mu_final_ = 0.0, epsilon0_ = 0.0;
+  double mu_ = 0.0, epsilon_ = 0.0;  ///< the barrier problem of this pass: μ, ε(μ)
+  BarrierScales scales_;
+  KktResidualTest test_{0.0, 1};
+  const BarrierWatch* watch_ = nullptr;
+  int iterations_ = 0;  ///< counted passes (the loop advances it)
+  /// What this pass measured at the assembled iterate, and its step.
+  double gap_ = 0.0, stationarity_ = 0.0;
+  bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
+  Eigen::VectorXd d_;
+  /// The barrier problem is solved as far as round-off allows (its Newton step no longer
+  /// changes φ_μ): the next pass lowers μ.
+  bool solved_to_round_off_ = false;
+  FreeTimeOutcome out_;  ///< the outcome, once the solve has ended
   /// The accepted iterate a line search starts from, and its barrier problem.
   struct SearchStart {
     double h = 0.0, theta = 0.0, mu = 0.0, epsilon = 0.0;
     ReducedProblem::StepVectors steps;
   } accepted_;
-  /// The last step's predicted decrease of φ_μ was round-off (merit_round_off): no step of it
-  /// can be told from no step.
-  bool step_at_round_off_ = false;
   // The elastic start (startInside): while the iterate is outside a constraint that moves with h,
   // that constraint is c + θ ≥ 0, θ ≥ 0 one more unknown (index n_ + 1, multiplier z_θ) and the
   // objective gains ρθ; the first iterate strictly inside every constraint drops θ.
@@ -500,20 +518,6 @@ void FreeTimeSolver::restore() {
   np_.setCurrent(accepted_.steps);
 }
 
-/// Armijo on φ_μ with the fraction to the boundary, halving α (ArmijoBacktracking in the free-time
-/// profile). In the end game (`late`) a rejected full step is first retried with its second-order
-/// correction (correctedStep), which replaces *d when it is taken.
-bool FreeTimeSolver::lineSearch(Eigen::VectorXd* step, double mu, double epsilon, bool late,
-                                double* alpha) {
-  accepted_ = {np_.timeStep(), theta_, mu, epsilon, np_.current()};
-  clearCorrection();
-  const LineSearchResult result =
-      search_.search(*this, {-step->dot(rhs_), 1.0, false, false, late && !elastic_}, step);
-  step_at_round_off_ = result.at_round_off;
-  *alpha = result.alpha;
-  return result.accepted;
-}
-
 /// The second-order correction of a rejected full step d (IPOPT's, Wächter & Biegler 2006 §2.4,
 /// for this feasible barrier method): at x + d (the iterate on entry) each constraint misses its
 /// linear model by r = c(x + d) − c − gᵀd, its curvature along d. Where minimum time is flat
@@ -653,93 +657,111 @@ void FreeTimeSolver::report(double alpha, double stationarity) const {
   context_->reportIteration(info);
 }
 
-FreeTimeOutcome FreeTimeSolver::interrupted(Termination t, int iterations, double mu,
-                                            double epsilon) {
-  context_ = nullptr;
-  assemble(mu, epsilon);
-  return outcome(t, stopWord(t), iterations, epsilon);
-}
-
 FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveContext& context,
                                     const BarrierWatch& watch) {
   context_ = &context;
+  watch_ = &watch;
   const int m = constraintCount();
-  const double mu0 = kInitialBarrier / m;
-  const double mu_final = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
+  mu0_ = kInitialBarrier / m;
+  mu_final_ = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
   const double C0 = np_.cost(np_.current());
-  const double epsilon0 = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
-  const KktResidualTest test(tolerance, N_);
+  epsilon0_ = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
+  test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
-  const BarrierScales scales{1.0, 1, N_, mu_final};
-  double mu = mu0;
-  initializeDuals(mu);
-  int iterations = 0;
-  bool solved_to_round_off = false;  // the barrier problem: its Newton step is round-off
-  for (;; ++iterations) {
-    const double epsilon = epsilon0 * std::max(mu / mu0, kFinalEffortFraction);
-    try {
-      assemble(mu, epsilon);
-    } catch (const SolveInterrupted& stop) {
-      return interrupted(stop.termination, iterations, mu, epsilon);
-    }
-    const double gap = dualityGap();
-    const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-    if (!elastic_ && mu <= mu_final && test.converged(stationarity, gap)) {
-      FreeTimeOutcome out = outcome(Termination::Converged, "converged", iterations, epsilon);
-      checkSecondOrder(&out);
-      return out;
-    }
-    if (mu > mu_final &&
-        (solved_to_round_off || barrier_.solved(barrierResidual(mu), mu, scales))) {
-      solved_to_round_off = false;
-      const std::string stop = watched(watch, mu, gap, epsilon, iterations);
-      if (!stop.empty()) {
-        FreeTimeOutcome out = outcome(Termination::NotConverged, stop, iterations, epsilon);
-        out.stopped_by_watch = true;
-        return out;
-      }
-      if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
-      mu = barrier_.decreased(mu, scales);
-      report(0.0, stationarity);  // counted as an iteration (the loop's increment), no step
-      continue;                   // the same iterate for the next barrier problem
-    }
-    if (const std::optional<Termination> stop = context.stopReason()) {
-      return outcome(*stop, stopWord(*stop), iterations, epsilon);
-    }
-    if (iterations >= max_iterations) {
-      return outcome(Termination::NotConverged, "iteration limit", iterations, epsilon);
-    }
-    Eigen::VectorXd d;
-    double alpha = 0.0;
-    const bool late = mu <= parameters_.free_time_damped_barrier * mu0;
-    step_at_round_off_ = false;
-    if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d) ||
-        !lineSearch(&d, mu, epsilon, late, &alpha)) {
-      // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
-      // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
-      // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
-      // Bilimoria–Wie disturbance start stopped at μ = 2e-7 μ₀ on the round-off floor, 1.3e-8
-      // above its T*.
-      if (!elastic_ && mu > mu_final && step_at_round_off_) {
-        solved_to_round_off = true;
-        report(0.0, stationarity);
-        continue;
-      }
-      if (!elastic_ && test.atRoundOffFloor(stationarity, gap)) {
-        FreeTimeOutcome out = outcome(Termination::Converged, "converged to the round-off floor",
-                                      iterations, epsilon);
-        checkSecondOrder(&out);
-        return out;
-      }
-      return outcome(Termination::NotConverged, "no descent step (line search failed)", iterations,
-                     epsilon);
-    }
-    dualStep(d, mu);
-    inertia_.afterStep(alpha, late);
-    leaveElasticIfInside();
-    safeguardDuals(mu);
-    report(alpha, stationarity);
+  scales_ = {1.0, 1, N_, mu_final_};
+  mu_ = mu0_;
+  initializeDuals(mu_);
+  PrimalDualLoop(*this, {freeTimeLineSearch(parameters_), false}, context)
+      .run(max_iterations, &iterations_);
+  return out_;
+}
+
+/// Assembles at the iterate (every pass: the limits are tested after it), then the convergence
+/// test at μ_final and, above it, whether the barrier problem is solved: then the watch, the
+/// elastic penalty, the next μ, a pass counted without a step at the same iterate.
+Pass FreeTimeSolver::beforeDirection() {
+  epsilon_ = epsilon0_ * std::max(mu_ / mu0_, kFinalEffortFraction);
+  assemble(mu_, epsilon_);
+  gap_ = dualityGap();
+  stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
+  if (!elastic_ && mu_ <= mu_final_ && test_.converged(stationarity_, gap_)) {
+    return converged("converged");
   }
+  if (mu_ > mu_final_ &&
+      (solved_to_round_off_ || barrier_.solved(barrierResidual(mu_), mu_, scales_))) {
+    solved_to_round_off_ = false;
+    const std::string stop = watched(*watch_, mu_, gap_, epsilon_, iterations_);
+    if (!stop.empty()) {
+      end(Termination::NotConverged, stop);
+      out_.stopped_by_watch = true;
+      return Pass::Stop;
+    }
+    if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
+    mu_ = barrier_.decreased(mu_, scales_);
+    report(0.0, stationarity_);
+    return Pass::Continue;  // the same iterate for the next barrier problem
+  }
+  return Pass::Step;
+}
+
+/// The shifted Newton step (PerturbationHandler) and the search from the accepted iterate: in the
+/// end game a rejected full step is first retried with its second-order correction.
+Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d) {
+  late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
+  if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return rejected({});
+  accepted_ = {np_.timeStep(), theta_, mu_, epsilon_, np_.current()};
+  clearCorrection();
+  *request = {-d_.dot(rhs_), 1.0, false, false, late_ && !elastic_};
+  *d = &d_;
+  return Pass::Step;
+}
+
+/// The order is the method's: dual step, damping, leaving the elastic phase, κ_Σ.
+Pass FreeTimeSolver::accept(const LineSearchResult& result) {
+  dualStep(d_, mu_);
+  inertia_.afterStep(result.alpha, late_);
+  leaveElasticIfInside();
+  safeguardDuals(mu_);
+  report(result.alpha, stationarity_);
+  return Pass::Continue;
+}
+
+Pass FreeTimeSolver::rejected(const LineSearchResult& result) {
+  // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
+  // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
+  // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
+  // Bilimoria–Wie disturbance start stopped at μ = 2e-7 μ₀ on the round-off floor, 1.3e-8
+  // above its T*.
+  if (!elastic_ && mu_ > mu_final_ && result.at_round_off) {
+    solved_to_round_off_ = true;
+    report(0.0, stationarity_);
+    return Pass::Continue;
+  }
+  if (!elastic_ && test_.atRoundOffFloor(stationarity_, gap_)) {
+    return converged("converged to the round-off floor");
+  }
+  return end(Termination::NotConverged, "no descent step (line search failed)");
+}
+
+/// Stopped inside an assembly: the iterate's system is assembled once more without polling, so
+/// the residuals reported are the iterate's.
+void FreeTimeSolver::stopped(Termination t, bool inside_pass) {
+  if (inside_pass) {
+    context_ = nullptr;
+    assemble(mu_, epsilon_);
+  }
+  end(t, stopWord(t));
+}
+
+Pass FreeTimeSolver::end(Termination t, const std::string& why) {
+  out_ = outcome(t, why, iterations_, epsilon_);
+  return Pass::Stop;
+}
+
+Pass FreeTimeSolver::converged(const std::string& why) {
+  end(Termination::Converged, why);
+  checkSecondOrder(&out_);
+  return Pass::Stop;
 }
 
 FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, int iterations,

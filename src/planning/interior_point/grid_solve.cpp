@@ -1,7 +1,8 @@
-// The interior point on one grid as a short loop over named pieces: the step (assembly, inertia
-// correction, the barrier rule's predictor), the stopping test, the line search with the
-// fraction to the boundary, the step's acceptance, the end of a barrier problem at μ_final
-// (converged, penalty raise or infeasible) and the barrier rule's update.
+// The interior point on one grid on the PrimalDualLoop (primal_dual_loop.hpp), its hooks named
+// pieces: the step (assembly, inertia correction, the barrier rule's predictor), the stopping
+// test, the step's acceptance, a rejection (the round-off floor, the Levenberg–Marquardt retry),
+// the end of a barrier problem at μ_final (converged, penalty raise or infeasible) and the
+// barrier rule's update.
 #include "planning/interior_point/grid_solve.hpp"
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
+#include "planning/interior_point/primal_dual_loop.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
@@ -41,14 +43,12 @@ struct Direction {
   double decrement_slope = 0.0;  ///< free slacks: the slope the decrement is measured on
 };
 
-enum class Next { Continue, Stop };
-
 bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
 
 template <typename Scalar>
-class GridSolve final : public BarrierProblem {
+class GridSolve final : public PrimalDualProblem {
  public:
   GridSolve(const PlanningProblem& problem, const SolverOptions& options,
             const InteriorPointParameters& parameters, SolveContext& context,
@@ -63,7 +63,6 @@ class GridSolve final : public BarrierProblem {
         barrier_(makeBarrierUpdate(request.barrier, parameters)),
         free_slacks_(system_.freeSlacks()),
         inertia_(parameters),
-        search_(fixedStepLineSearch(parameters)),
         kkt_blocks_(np->unknowns()),
         test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
               free_slacks_) {
@@ -72,22 +71,8 @@ class GridSolve final : public BarrierProblem {
 
   GridOutcome run() {
     initialize();
-    for (;; ++iteration_) {
-      if (iteration_ >= options_.max_iterations) break;
-      if (const auto stop = context_.stopReason()) {
-        end(*stop, *stop == Termination::Cancelled ? "cancelled" : "time budget exceeded");
-        break;
-      }
-      try {
-        if (iterate() == Next::Stop) break;
-      } catch (const SolveInterrupted& interrupted) {
-        // Inside an assembly or factorization: the iterate is the last accepted one.
-        end(interrupted.termination, interrupted.termination == Termination::Cancelled
-                                         ? "cancelled"
-                                         : "time budget exceeded");
-        break;
-      }
-    }
+    PrimalDualLoop(*this, {fixedStepLineSearch(p_), true}, context_)
+        .run(options_.max_iterations, &iteration_);
     system_.setInterruption(nullptr);
     return finish();
   }
@@ -131,8 +116,8 @@ class GridSolve final : public BarrierProblem {
     }
   }
 
-  /// One iteration: direction, stopping test, line search, acceptance, barrier update.
-  Next iterate() {
+  // PrimalDualProblem: the direction with its stopping test, the step, a rejection, the ends.
+  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) override {
     const Direction direction = computeDirection();
     if (!std::isfinite(direction.cost)) {
       return end(Termination::StepTooLarge,
@@ -141,23 +126,38 @@ class GridSolve final : public BarrierProblem {
     if (!direction.factored) {
       return end(Termination::NotConverged, "Newton system could not be made positive definite");
     }
-    const StopVerdict test =
+    verdict_ =
         test_.check({free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift,
                      mu_ <= scales_.mu_final, system_.maxViolation(), iteration_, scales_.f_scale});
-    double alpha = 0.0;
-    if (!lineSearch(direction, test, &alpha)) return rejected(test, direction.cost);
-    accept(trial_, alpha);
-    if (!report(direction.cost, test.relative_decrement, alpha)) {
+    cost_ = direction.cost;
+    *request = {direction.slope, free_slacks_ ? alpha_slack_ : 1.0, verdict_.final_step,
+                verdict_.at_floor, false};
+    *d = &delta_;
+    return Pass::Step;
+  }
+
+  /// Takes the step, reports it; the barrier problem's last step ends it, else the barrier rule
+  /// updates μ.
+  Pass accept(const LineSearchResult& result) override {
+    const double alpha = result.alpha;
+    takeStep(trial_, alpha);
+    if (!report(cost_, verdict_.relative_decrement, alpha)) {
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
-    if (test.final_step) return endBarrierProblem();
-    if (!test.at_final_barrier) {
+    if (verdict_.final_step) return endBarrierProblem();
+    if (!verdict_.at_final_barrier) {
       barrier_->afterStep(system_, scales_,
-                          {test.relative_decrement, test_.previousDecrement(), alpha, rho_}, &mu_);
+                          {verdict_.relative_decrement, test_.previousDecrement(), alpha, rho_},
+                          &mu_);
     }
-    test_.accepted(test, alpha);
-    return Next::Continue;
+    test_.accepted(verdict_, alpha);
+    return Pass::Continue;
+  }
+
+  void iterationLimit() override {}  // ending_ and reason_ say so from the start
+  void stopped(Termination termination, bool) override {
+    end(termination, termination == Termination::Cancelled ? "cancelled" : "time budget exceeded");
   }
 
   /// Assembles and factors the condensed system, lets the barrier rule choose μ (Mehrotra),
@@ -204,18 +204,9 @@ class GridSolve final : public BarrierProblem {
     d->decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
   }
 
-  /// Armijo on φ_μ along the retraction from the fraction-to-the-boundary step (the free slacks'
-  /// α, else 1); a predicted decrease below φ's round-off is taken. False if no step length was
-  /// accepted; else trial_ is the accepted point.
-  bool lineSearch(const Direction& d, const StopVerdict& t, double* alpha) {
-    cost_ = d.cost;
-    const LineSearchResult result = search_.search(
-        *this, {d.slope, free_slacks_ ? alpha_slack_ : 1.0, t.final_step, t.at_floor, false},
-        &delta_);
-    *alpha = result.alpha;
-    return result.accepted;
-  }
-
+  // The line search (ArmijoBacktracking in the fixed-h profile) is Armijo on φ_μ along the
+  // retraction from the fraction-to-the-boundary step (the free slacks' α, else 1); a predicted
+  // decrease below φ's round-off is taken. trial_ is the accepted point.
   // BarrierProblem: φ_μ with the penalty of the form (free slacks: ν, elastic: ρ) at the
   // iterate's slacks moved with the step.
   double merit() override { return system_.assembledMerit(cost_, mu_, penalty()); }
@@ -231,7 +222,8 @@ class GridSolve final : public BarrierProblem {
   /// A direction the line search rejects: at the round-off floor the iterate is as good as it
   /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times. A retry is an
   /// iteration (counted): it is reported too, at the same iterate (step 0).
-  Next rejected(const StopVerdict& t, double cost) {
+  Pass rejected(const LineSearchResult&) override {
+    const StopVerdict& t = verdict_;
     if (t.at_floor) {
       std::ostringstream why;
       why << "converged to the round-off floor (relative Newton decrement " << t.relative_decrement
@@ -239,7 +231,7 @@ class GridSolve final : public BarrierProblem {
       return end(Termination::Converged, why.str(), t.relative_decrement);
     }
     if (inertia_.raiseFloor()) {
-      if (report(cost, t.relative_decrement, 0.0)) return Next::Continue;
+      if (report(cost_, t.relative_decrement, 0.0)) return Pass::Continue;
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
@@ -249,7 +241,7 @@ class GridSolve final : public BarrierProblem {
 
   /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
   /// dual step), the iterate; relaxes the shift floor.
-  void accept(const ReducedProblem::StepVectors& trial, double alpha) {
+  void takeStep(const ReducedProblem::StepVectors& trial, double alpha) {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
     } else {
@@ -273,7 +265,7 @@ class GridSolve final : public BarrierProblem {
   /// The last step of a barrier problem at μ_final: converged if feasible; a small violation may
   /// be a penalty below a multiplier (elastic: raise ρ once and re-solve from here); else
   /// infeasible.
-  Next endBarrierProblem() {
+  Pass endBarrierProblem() {
     ++iteration_;
     system_.evaluateValues(np_.current(), nullptr);
     const double violation = system_.maxViolation();
@@ -285,17 +277,17 @@ class GridSolve final : public BarrierProblem {
       test_.restart(iteration_);
       system_.initializeMultipliers(
           mu_, rho_, p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
-      return Next::Continue;
+      return Pass::Continue;
     }
     return end(Termination::Infeasible, "infeasible");
   }
 
-  Next end(Termination termination, std::string reason,
+  Pass end(Termination termination, std::string reason,
            std::optional<double> decrement = std::nullopt) {
     ending_ = termination;
     reason_ = std::move(reason);
     if (decrement) relative_decrement_ = *decrement;
-    return Next::Stop;
+    return Pass::Stop;
   }
 
   /// The result: the plan at the last accepted iterate, its figures and the message.
@@ -308,15 +300,15 @@ class GridSolve final : public BarrierProblem {
     result.history = history_;
     out.steps = np_.current();
     if (free_slacks_) out.duals = system_.duals();
-    // Stopped: answer at once (the stationarity residual costs a gradient at N: not measured;
-    // on a coarser level the plan is evaluated once carried to the requested grid).
+    // A solve stopped on a coarser level of a continuation is not evaluated here: its iterate is
+    // carried to the requested grid and evaluated there (carryToGrid). Otherwise the plan's
+    // residuals are measured, a stopped one's too (one more gradient at N: what a user reads to
+    // tell a stopped iterate from an answer).
     result.max_residual = std::numeric_limits<double>::quiet_NaN();
     if (!ranOut(ending_) || request_.evaluate_when_stopped) {
       const Maneuver planned = np_.maneuver(np_.current());
       result.switching_function = system_.switchingFunction(planned.torque);
-      if (!ranOut(ending_)) {
-        result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
-      }
+      result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
       evaluatePlan(problem_, planned.torque, &result, &planned);
     }
     std::ostringstream msg;
@@ -360,10 +352,10 @@ class GridSolve final : public BarrierProblem {
   const bool free_slacks_;
   RowRelativeShift
       inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
-  ArmijoBacktracking search_;
   KktBlocks<Scalar> kkt_blocks_;  ///< the condensed system (a band: no global unknowns at fixed h)
   BandKkt<Scalar> kkt_;
-  DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
+  DecrementTest test_;   ///< the stopping test and its memory (stalls, the last step)
+  StopVerdict verdict_;  ///< its verdict on the current direction
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;
   double mu_ = 0.0, mu_start_ = 0.0;

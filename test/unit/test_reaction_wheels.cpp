@@ -412,6 +412,82 @@ TEST(ReactionWheelMinimumEffort, ConvergedPlansMeetEveryWheelLimit) {
   EXPECT_GE(converged, 4);
 }
 
+/// The seeded suite widened: every scheme the wheels plan with, a random bias, spinning ends on
+/// every other request, per-wheel limits and the envelope on every third (each limit below the
+/// unconstrained plan's peak unless the end nodes' boundary momenta lie above it). Every
+/// converged plan meets every wheel limit and the envelope on its own wheel states to 1e-9
+/// relative; the refusals (an end state beyond the envelope) and the unconverged requests are
+/// counted, not hidden.
+TEST(ReactionWheelMinimumEffort, SeededSuiteAcrossSchemesMeetsEveryWheelLimit) {
+  std::mt19937 rng(4201);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const ap::SchemeKind schemes[] = {ap::SchemeKind::Paper, ap::SchemeKind::Variational,
+                                    ap::SchemeKind::SecondOrder};
+  int planned = 0, converged = 0, refused = 0, binding = 0;
+  for (int c = 0; c < 12; ++c) {
+    ap::PlanningProblem p = wheelProblem(schemes[c % 3], c % 2 == 1, 48);
+    p.duration = 20.0;
+    p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)));
+    p.reaction_wheels.initial_momentum.clear();
+    for (int i = 0; i < 4; ++i) p.reaction_wheels.initial_momentum.push_back(0.3 * uniform(rng));
+    p.reaction_wheels.max_momentum = {100.0};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    const WheelPeaks peaks = unconstrainedPeaks(p);
+    // The end nodes' wheel momenta are boundary data (the same on every plan): a limit below
+    // them is refused by name, so each limit stays 5 % above them.
+    ap::Maneuver ends;
+    ends.attitude = {p.initial_attitude, p.final_attitude};
+    ends.angular_velocity = {p.initial_velocity, p.final_velocity};
+    ends.torque.assign(2, ap::Vector3::Zero());
+    ends.time_step = p.duration;
+    const ap::WheelStates end_states =
+        ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, ends);
+    p.reaction_wheels.max_momentum.clear();
+    p.reaction_wheels.max_torque.clear();
+    for (int i = 0; i < 4; ++i) {
+      const double at_ends =
+          std::max(std::abs(end_states.momentum[0](i)), std::abs(end_states.momentum[1](i)));
+      p.reaction_wheels.max_momentum.push_back(
+          std::max((0.8 + 0.1 * uniform(rng)) * peaks.momentum, 1.05 * at_ends));
+      p.reaction_wheels.max_torque.push_back((1.5 + 0.3 * uniform(rng)) * peaks.torque);
+    }
+    if (c % 3 == 0) p.reaction_wheels.max_momentum_norm = 1.2 * peaks.momentum;
+    if (!refusalOf(p).empty()) {
+      ++refused;
+      continue;
+    }
+    ++planned;
+    const ap::PlanResult r = ap::planManeuver(p);
+    if (!r.converged()) {
+      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message.c_str());
+      continue;
+    }
+    ++converged;
+    const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    const int first = ap::schemeHasEndTorques(p.scheme) ? 0 : 1;
+    for (int k = 0; k <= p.steps; ++k) {
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(std::abs(w.momentum[k](i)), p.reaction_wheels.momentumLimit(i) * (1 + 1e-9))
+            << "case " << c << " k " << k << " wheel " << i;
+        if (k >= first && k <= p.steps - first) {
+          EXPECT_LE(std::abs(w.torque[k](i)), p.reaction_wheels.torqueLimit(i) * (1 + 1e-9))
+              << "case " << c << " k " << k << " wheel " << i;
+        }
+      }
+      EXPECT_LE((array.axes * w.momentum[k]).norm(),
+                p.reaction_wheels.max_momentum_norm * (1 + 1e-9))
+          << "case " << c << " k " << k;
+    }
+    if (r.active_constraints > 0) ++binding;  // none where the end nodes set every limit
+  }
+  std::printf("%d planned (%d refused by name), %d converged, %d with active limits\n", planned,
+              refused, converged, binding);
+  EXPECT_GE(planned, 8);
+  EXPECT_GE(converged, planned * 3 / 4);
+  EXPECT_GE(binding, converged / 2);
+}
+
 // ---- the independent replay --------------------------------------------------------------------
 
 /// A wheel-limited biased pyramid slew, replayed as body + wheels from its wheel torques alone

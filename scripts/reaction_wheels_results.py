@@ -13,7 +13,8 @@ benchmark_solvers (ours and the IPOPT peer on the same discrete problem, paper s
   3. ours against IPOPT on the same discrete problem (cost, iterations, time; ratios);
   4. held-out-style seeded biased pyramid slews whose unconstrained plan saturates a wheel:
      converged fraction, every wheel limit met at the nodes and in the independent replay, the cost
-     against IPOPT's.
+     against IPOPT's;
+  5. speed: a wheel-limited solve against the same slew under a body-torque norm (N = 128).
 """
 import argparse
 import json
@@ -40,6 +41,9 @@ LIMIT_TARGET = 1e-9  # relative, the plan's own wheel states at the nodes
 
 
 def scene_text(axis, angle, max_momentum, bias, steps, scheme, duration=20.0, max_torque=0.19):
+    if max_momentum is None:  # the body-torque bound instead of the wheels (the speed baseline)
+        return "\n".join(scene_text(axis, angle, 1.0, bias, steps, scheme, duration).split(
+            "\n")[:6] + ["constraints:", "  - max_torque_norm: 0.25", ""])
     return "\n".join([
         "inertia: %s" % INERTIA, "duration: %g" % duration, "steps: %d" % steps,
         "scheme: %s" % scheme,
@@ -68,7 +72,9 @@ class Tools:
 
     def plan_scene(self, scene, steps=None):
         """plan_maneuver --summary --csv: (summary, csv path); summary None if it wrote none."""
-        summary, csv = scene + ".json", scene + ".csv"
+        self.count += 1  # outputs in the temporary directory, also for a scene of the repo
+        base = os.path.join(self.tmp, "plan_%d_%s" % (self.count, os.path.basename(scene)))
+        summary, csv = base + ".json", base + ".csv"
         cmd = [self.plan, scene, "--summary", summary, "--csv", csv]
         if steps:
             cmd += ["--steps", str(steps)]
@@ -134,12 +140,14 @@ def slew_figure(tools, steps, png):
         "## A momentum-limited slew, with and without a bias", "",
         "J = %s kg m², 1.2 rad about (0.4, −0.7, 0.9), rest to rest in 20 s, second_order, N = %d;"
         " the pyramid of four wheels (54.7° from body z), |u_i| ≤ 0.19 N m, |h_w,i| ≤ %g N m s "
-        "(0.85 of the biased slew's unlimited peak). The same limit without the bias: the bias "
-        "moves each wheel's momentum by its constant share, so the limit binds elsewhere." % (
+        "(0.85 of the biased slew's unlimited peak), and the same slew and limit without the "
+        "bias. The bias enters the wheel momenta twice: its null-space part stays constant and "
+        "its array part turns with the body (q = Rᵀπ₀ − Π), so the limit binds on other wheels "
+        "and for other times." % (
             INERTIA, steps, limit), "",
         "![wheel momenta against time](reaction_wheels.png)", "",
-        "| bias | unlimited peak max |h_i| | limited: converged | iterations | cost | active |"
-        " peak max |h_i| | momentum margin (min) |",
+        "| bias | unlimited: peak max \\|h_i\\| [N m s] | limited: converged | iterations | cost |"
+        " active | peak max \\|h_i\\| [N m s] | least momentum margin [N m s] |",
         "|---|---|---|---|---|---|---|---|"]
     for name, bias, free_peak, s in rows:
         margin = min(w["momentum_margin"] for w in s["reaction_wheels"]["wheels"])
@@ -173,10 +181,12 @@ def peer_rows(tools, cases, steps):
     """Section 3: ours and IPOPT (exact Hessian, from the geodesic) on the same paper problem."""
     lines = [
         "## IPOPT on the same discrete problem", "",
-        "`benchmark_solvers --solver newton|ipopt --scene S` (paper scheme, N = %d: the peer "
-        "transcribes the paper scheme; its wheel rows are its own derivation, "
-        "studies/benchmark_solvers.cpp). Time: one process each, wall time of the solve. "
-        "Cost difference relative to ours (target ≤ %g)." % (steps, COST_TARGET), "",
+        "`benchmark_solvers --solver newton|ipopt --scene S` (the paper scheme: the peer "
+        "transcribes it; its wheel rows are its own derivation, studies/benchmark_solvers.cpp; "
+        "IPOPT with its exact Hessian from the geodesic). The biased pyramid slew above with "
+        "|h_w,i| ≤ 0.9 N m s at N = 32, 64, 128, then held-out cases below (N = %d). Time: one "
+        "process each, wall time of the solve. Cost difference relative to ours (target ≤ %g)."
+        % (steps, COST_TARGET), "",
         "| case | ours: cost | iterations | time [s] | IPOPT: cost | iterations | time [s] |"
         " cost difference | time ratio IPOPT/ours |", "|---|---|---|---|---|---|---|---|---|"]
     for name, scene in cases:
@@ -274,6 +284,36 @@ def held_out_lines(rows, count, seed, steps):
     return lines + [""]
 
 
+def speed_lines(tools, repeats):
+    """Section 5: a wheel-limited minimum-effort solve against the same slew under a body-torque
+    norm only, N = 128, second_order; median solve_time_s of `repeats` runs each, A and B
+    alternated, and the median of the pairwise ratios."""
+    axis, angle = [0.4, -0.7, 0.9], 1.2
+    cases = [("`max_torque_norm: 0.25` (body torque only)", None),
+             ("wheels U = 0.19 N m, H = 0.9 N m s", 0.9), ("wheels U = 0.19 N m, H = 10 N m s", 10.0)]
+    scenes = [tools.write(scene_text(axis, angle, h, BIAS, 128, "second_order")) for _, h in cases]
+    runs = [[] for _ in cases]
+    for _ in range(repeats):
+        for i, scene in enumerate(scenes):
+            runs[i].append(tools.plan_scene(scene)[0])
+    base = runs[0]
+    lines = [
+        "## Speed: wheel limits against a body-torque bound", "",
+        "The biased pyramid slew above (1.2 rad, 20 s, second_order, N = 128), minimum effort; "
+        "`plan_maneuver SCENE --summary`, %d runs of each, alternated; median `solve_time_s` and "
+        "the median of the run-by-run ratios to the body-torque row (issue 42's target: at most "
+        "3x)." % repeats, "",
+        "| limits | converged | iterations | active | solve time [s] | ratio |",
+        "|---|---|---|---|---|---|"]
+    for (name, _), rows in zip(cases, runs):
+        ratio = statistics.median(r["solve_time_s"] / b["solve_time_s"] for r, b in zip(rows, base))
+        lines.append("| %s | %s | %d | %d | %.3g | %.2f |" % (
+            name, "yes" if rows[0]["converged"] else "no", rows[0]["iterations"],
+            rows[0]["active_constraints"], statistics.median(r["solve_time_s"] for r in rows),
+            ratio))
+    return lines + [""]
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("tool_dir")
@@ -283,7 +323,7 @@ def main():
     parser.add_argument("--seed", type=int, default=42)
     parser.add_argument("--steps", type=int, default=64)
     parser.add_argument("--command", default="scripts/reaction_wheels")
-    parser.add_argument("--speed", default="", help="a markdown file with the speed section")
+    parser.add_argument("--repeats", type=int, default=7)
     args = parser.parse_args()
     source_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     with tempfile.TemporaryDirectory() as tmp:
@@ -301,8 +341,7 @@ def main():
         base = [("pyramid N = %d" % n, tools.write(
             scene_text([0.4, -0.7, 0.9], 1.2, 0.9, BIAS, n, "paper"))) for n in (32, 64, 128)]
         lines += peer_rows(tools, base + peer_cases[:4], args.steps)
-        if args.speed and os.path.exists(args.speed):
-            lines += open(args.speed).read().splitlines() + [""]
+        lines += speed_lines(tools, args.repeats)
     with open(os.path.join(args.docs_dir, "reaction_wheels.md"), "w") as f:
         f.write("\n".join(lines))
 

@@ -302,16 +302,37 @@ def speed_lines(tools, repeats):
         "The biased pyramid slew above (1.2 rad, 20 s, second_order, N = 128), minimum effort; "
         "`plan_maneuver SCENE --summary`, %d runs of each, alternated; median `solve_time_s` and "
         "the median of the run-by-run ratios to the body-torque row (issue 42's target: at most "
-        "3x)." % repeats, "",
-        "| limits | converged | iterations | active | solve time [s] | ratio |",
-        "|---|---|---|---|---|---|"]
-    for (name, _), rows in zip(cases, runs):
+        "3x). Instructions: those executed inside `planManeuver` in one run (`valgrind "
+        "--tool=callgrind`, inclusive, `callgrind_annotate --inclusive=yes`), with their ratio to "
+        "the body-torque row: unlike the times, unchanged by the load of a shared machine."
+        % repeats, "",
+        "| limits | converged | iterations | active | solve time [s] | ratio | instructions |",
+        "|---|---|---|---|---|---|---|"]
+    instructions = [planner_instructions(tools, scene) for scene in scenes]
+    for (name, _), rows, count in zip(cases, runs, instructions):
         ratio = statistics.median(r["solve_time_s"] / b["solve_time_s"] for r, b in zip(rows, base))
-        lines.append("| %s | %s | %d | %d | %.3g | %.2f |" % (
+        lines.append("| %s | %s | %d | %d | %.3g | %.2f | %s |" % (
             name, "yes" if rows[0]["converged"] else "no", rows[0]["iterations"],
             rows[0]["active_constraints"], statistics.median(r["solve_time_s"] for r in rows),
-            ratio))
+            ratio, "%.1f M (%.2f)" % (count / 1e6, count / instructions[0])
+            if count and instructions[0] else "no valgrind"))
     return lines + [""]
+
+
+def planner_instructions(tools, scene):
+    """Instructions executed inside planManeuver (valgrind's callgrind, inclusive): a count that
+    the load of a shared machine does not change, unlike the times beside it."""
+    out = os.path.join(tools.tmp, "callgrind.out")
+    try:
+        subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + out, tools.plan,
+                        scene, "--summary", os.path.join(tools.tmp, "callgrind.json")],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+        report = subprocess.run(["callgrind_annotate", "--inclusive=yes", out],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    match = re.search(r"^\s*([\d,]+) .*attitude_planner::planManeuver\(", report, re.MULTILINE)
+    return int(match.group(1).replace(",", "")) if match else None
 
 
 def main():

@@ -152,10 +152,7 @@ class WheelQuantity : public StageQuantityModel {
     const int N = at.problem().steps();
     if (k <= 0) return start_momentum_;
     if (k >= N) return end_momentum_;
-    const DiscreteScheme& scheme = at.problem().scheme();
-    const ReducedProblem::StepVectors& steps = at.steps();
-    return 0.5 * (scheme.momentumOfStep(steps[k]) +
-                  so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
+    return at.nodeMomenta()[k];
   }
   Vector3 bodyTotal(const QuantityInputs& at, int k) const {
     return at.attitudes()[k].transpose() * total_;

@@ -35,6 +35,7 @@ PYRAMID = [[0.816496580927726, 0, 0.5773502691896258], [0, 0.816496580927726, 0.
            [-0.816496580927726, 0, 0.5773502691896258], [0, -0.816496580927726, 0.5773502691896258]]
 INERTIA = "[[13, -2, 1], [-2, 16, 0.5], [1, 0.5, 18]]"
 BIAS = [0.3, -0.2, 0.5, 0.1]
+DISTURBANCE = [0.004, -0.006, 0.003]  # N m, world frame: pi(t) = pi_0 + t tau_d
 CLOSED_FORM = 7.0  # theta J / H + H / U with theta 1 rad, J 10, H 2, U 1
 COST_TARGET = 1e-6  # relative, against IPOPT
 LIMIT_TARGET = 1e-9  # relative, the plan's own wheel states at the nodes
@@ -132,6 +133,14 @@ def slew_figure(tools, steps, png):
         panel.set_title("%s: h_w(0) = %s N m s" % (name, bias))
         panel.set_xlabel("t [s]")
         rows.append((name, bias, peak_momentum(free), summary))
+    disturbed = tools.write(scene_text(axis, angle, limit, BIAS, steps, "second_order") +
+                            "effects:\n  - disturbance_torque: {value: %s, frame: world}\n"
+                            % json.dumps(DISTURBANCE))
+    free, _ = tools.plan_scene(tools.write(
+        scene_text(axis, angle, 100.0, BIAS, steps, "second_order") +
+        "effects:\n  - disturbance_torque: {value: %s, frame: world}\n" % json.dumps(DISTURBANCE)))
+    rows.append(("biased, world disturbance %s N m" % DISTURBANCE, BIAS, peak_momentum(free),
+                 tools.plan_scene(disturbed)[0]))
     panels[0].set_ylabel("wheel momentum h_i [N m s] (dashed: limit %g)" % limit)
     panels[0].legend(loc="best", fontsize=8)
     fig.tight_layout()
@@ -141,7 +150,8 @@ def slew_figure(tools, steps, png):
         "J = %s kg m², 1.2 rad about (0.4, −0.7, 0.9), rest to rest in 20 s, second_order, N = %d;"
         " the pyramid of four wheels (54.7° from body z), |u_i| ≤ 0.19 N m, |h_w,i| ≤ %g N m s "
         "(0.85 of the biased slew's unlimited peak), and the same slew and limit without the "
-        "bias. The bias enters the wheel momenta twice: its null-space part stays constant and "
+        "bias (plotted) and with the bias and a constant world-frame disturbance (the table's "
+        "last row: the wheels absorb its impulse t τ_d). The bias enters the wheel momenta twice: its null-space part stays constant and "
         "its array part turns with the body (q = Rᵀπ₀ − Π), so the limit binds on other wheels "
         "and for other times." % (
             INERTIA, steps, limit), "",

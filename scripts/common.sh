@@ -24,7 +24,7 @@ DEBIAN_PACKAGES=(
   librosbag-dev python3-rosbag librostest-dev python3-rostest rosbash rosout python3-roslaunch
   libeigen3-dev libnlopt-cxx-dev libyaml-cpp-dev libboost-math-dev libgtest-dev
   coinor-libipopt-dev
-  python3-numpy python3-matplotlib python3-yaml
+  python3-numpy python3-matplotlib python3-yaml valgrind
   ros-std-msgs ros-geometry-msgs ros-actionlib-msgs ros-visualization-msgs
   python3-visualization-msgs python3-rostopic python3-rosservice
   libnav-msgs-dev ros-nav-msgs python3-nav-msgs libtf2-msgs-dev

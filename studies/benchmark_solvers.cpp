@@ -11,7 +11,8 @@
 //                 τ_1..τ_{N−1}; kinematics, dynamics and terminal constraints), exact sparse
 //                 Jacobian and exact sparse Hessian of the Lagrangian (only if built with IPOPT);
 //                 with the scene's node constraints too (per-axis torque limits as variable bounds,
-//                 max_torque_norm, max_angular_rate, keep_out, keep_in as exact constraint rows)
+//                 max_torque_norm, max_angular_rate, keep_out, keep_in and reaction-wheel
+//                 limits as exact constraint rows; the wheel rows' derivation is its own)
 //   ipopt_lbfgs   the same, with IPOPT's limited-memory (L-BFGS) Hessian instead (for comparison)
 //   free_time     minimum time, ours: ONE free-time interior-point solve (free_time_solver.hpp)
 //                 from ipopt_free_time's start, the scheme paper (its own JSON line too)
@@ -33,6 +34,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -286,7 +288,8 @@ const char* const kUsage =
     "                         [--cases I,J,...]  (only these case indices, e.g. to re-plan one)\n"
     "                         ours and IPOPT (exact Hessian, paper scheme, same start) on the\n"
     "                         seeded random problems of test/support/random_problems.hpp\n"
-    "       benchmark_solvers --check-hessian [--steps N] [--constrained]   IPOPT's exact Hessian\n"
+    "       benchmark_solvers --check-hessian [--steps N] [--constrained] [--wheels]   IPOPT's\n"
+    "                         exact Hessian (--wheels: with a biased pyramid's wheel rows)\n"
     "                         against central differences of its exact gradients, its Jacobian\n"
     "                         against differences of its constraints (exit 0 iff relative errors\n"
     "                         <= 1e-6; --constrained: with one node constraint of every kind;\n"
@@ -428,6 +431,40 @@ Eigen::Matrix4d rightProduct(const Quaternion& q) {
   return R;
 }
 
+/// The reaction-wheel data the transcription's wheel rows need, formed here from the scene's
+/// array (not from the planner's quantities): π₀ = R_0 (J Ω(0) + Σ_i a_i h_w,i(0)) with the unit
+/// spin axes a_i, and the array quantities of one node as functions of its local unknowns.
+struct PeerWheels {
+  PeerWheels() = default;
+  explicit PeerWheels(const ap::PlanningProblem& p)
+      : inertia(p.inertia), inverse_inertia(p.inertia.inverse()) {
+    Vector3 array = Vector3::Zero();
+    const ap::ReactionWheels& w = p.reaction_wheels;
+    for (int i = 0; i < w.count(); ++i) array += w.spin_axes[i].normalized() * w.initialMomentum(i);
+    total = p.initial_attitude * (p.inertia * p.initial_velocity + array);
+  }
+  /// q (torque false) or a (torque true) at a node with quaternion `q`, the step rate before it
+  /// and its torque: R(q)ᵀπ₀ = (w² − |u|²)π₀ + 2u(u·π₀) − 2w u×π₀ (q = (w, u), the rotation for
+  /// unit q), Π = J Ω_{k−1} + h τ_k/2, q = R(q)ᵀπ₀ − Π, a = −(τ + J⁻¹Π × q).
+  template <typename S>
+  Eigen::Matrix<S, 3, 1> quantity(bool torque, const Eigen::Matrix<S, 4, 1>& q,
+                                  const Eigen::Matrix<S, 3, 1>& omega_before,
+                                  const Eigen::Matrix<S, 3, 1>& tau, const S& h) const {
+    using V = Eigen::Matrix<S, 3, 1>;
+    const S w = q(0);
+    const V u = q.template tail<3>();
+    const V pi = total.cast<S>();
+    const V body_total =
+        (w * w - u.dot(u)) * pi + S(2.0) * u.dot(pi) * u - S(2.0) * w * u.cross(pi);
+    const V node_momentum = inertia.cast<S>() * omega_before + S(0.5) * h * tau;
+    const V array_momentum = body_total - node_momentum;
+    if (!torque) return array_momentum;
+    return -(tau + (inverse_inertia.cast<S>() * node_momentum).cross(array_momentum));
+  }
+  Matrix3 inertia = Matrix3::Identity(), inverse_inertia = Matrix3::Identity();
+  Vector3 total = Vector3::Zero();  ///< π₀, world
+};
+
 /// Simultaneous transcription of the paper scheme. Unknowns: q_1..q_N (4 each), Ω_1..Ω_{N−2}
 /// (3 each), τ_1..τ_{N−1} (3 each). Constraints:
 ///   kinematics  q_{k+1} − q_k ⊗ e(hΩ_k) = 0,                 k = 0..N−1 (4 each)
@@ -459,6 +496,7 @@ class TranscriptionNlp : public Ipopt::TNLP {
         stage_constraints_(ap::buildStageConstraints(p_)) {
     q0_ = ap::so3::quaternionCoefficients<double>(p.initial_attitude);
     qN_ = ap::so3::quaternionCoefficients<double>(p.final_attitude);
+    if (p.reaction_wheels.present()) wheels_ = PeerWheels(p);
     for (const auto& c : stage_constraints_) {
       if (c->axis() >= 0) continue;  // a box side: a bound on τ (get_bounds_info)
       int first = 1, last = N_ - 1;
@@ -473,9 +511,10 @@ class TranscriptionNlp : public Ipopt::TNLP {
           break;
         case ap::StageQuantity::NodeRate:  // the paper scheme has no end torques
           throw ap::InvalidInput("ipopt: the transcription has no node rates (paper scheme)");
-        case ap::StageQuantity::WheelMomentum:
-        case ap::StageQuantity::WheelTorque:
-          throw ap::InvalidInput("ipopt: the peer has no reaction-wheel rows yet");
+        case ap::StageQuantity::WheelMomentum:  // q_0, q_N: boundary data
+        case ap::StageQuantity::WheelTorque:    // the paper scheme has no end torques
+          has_wheels_ = true;
+          break;
       }
       for (int k = first; k <= last; ++k) rows_of_constraints_.push_back({c.get(), k});
     }
@@ -629,12 +668,18 @@ class TranscriptionNlp : public Ipopt::TNLP {
     const Eigen::Matrix4d L = leftProduct(conj);
     for (int r = 1; r < 4; ++r)
       for (int c = 0; c < 4; ++c) values[z++] = L(r, c);
+    const std::vector<std::array<WheelJet, 2>> wheel_jets = wheelJets(x);
     for (const auto& [c, k] : rows_of_constraints_) {
       const Vector3 d = c->rowGradient(rowQuantity(*c, x, k));
       if (c->quantity() == ap::StageQuantity::Pointing) {  // ∂(qᵀMq)/∂q = 2Mq
         const Quaternion dq =
             d(0) * (2.0 * pointingForm(*c) * Eigen::Map<const Quaternion>(x + Q(k)));
         for (int i = 0; i < 4; ++i) values[z++] = dq(i);
+      } else if (isWheelRow(*c)) {  // gᵀ ∂r over the node's local unknowns
+        const Eigen::Matrix<double, 1, kWheelLocals> row =
+            d.transpose() * wheel_jets[k][isTorqueRow(*c)].d;
+        for (int a = 0; a < kWheelLocals; ++a)
+          if (wheelLocal(k, a) >= 0) values[z++] = row(a);
       } else {  // r is the variable block itself (τ_k or Ω_k)
         for (int i = 0; i < 3; ++i) values[z++] = d(i);
       }
@@ -654,6 +699,8 @@ class TranscriptionNlp : public Ipopt::TNLP {
     // The node constraints' terms: λ-weighted, per node (τ and Ω diagonals, q_k q_k blocks).
     std::vector<double> tau_diagonal(N_ + 1, obj_factor), omega_diagonal(N_ + 1, 0.0);
     std::vector<Eigen::Matrix4d> cone_block(has_cone_ ? N_ + 1 : 0, Eigen::Matrix4d::Zero());
+    std::vector<WheelBlock> wheel_block(has_wheels_ ? N_ + 1 : 0, WheelBlock::Zero());
+    const std::vector<std::array<WheelJet, 2>> wheel_jets = wheelJets(x);
     for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r) {
       const auto& [c, k] = rows_of_constraints_[r];
       const double l = lambda[equalities() + r];
@@ -673,9 +720,11 @@ class TranscriptionNlp : public Ipopt::TNLP {
             cone_block[k] += l * c->rowCurvature() * Mq * Mq.transpose();
           break;
         }
-        case ap::StageQuantity::NodeRate:
         case ap::StageQuantity::WheelMomentum:
         case ap::StageQuantity::WheelTorque:
+          addWheelRowCurvature(*c, wheel_jets[k][isTorqueRow(*c)], l, &wheel_block[k]);
+          break;
+        case ap::StageQuantity::NodeRate:
           break;  // refused in the constructor
       }
     }
@@ -717,6 +766,7 @@ class TranscriptionNlp : public Ipopt::TNLP {
         for (int i = 0; i < 4; ++i)
           for (int j = 0; j <= i; ++j) values[z++] = cone_block[k](i, j);
     }
+    for (const WheelHessianEntry& e : wheel_hessian_) values[z++] = wheel_block[e.k](e.a, e.b);
     return true;
   }
   bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
@@ -753,12 +803,76 @@ class TranscriptionNlp : public Ipopt::TNLP {
         const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
         return Vector3(q.dot(pointingForm(c) * q), 0.0, 0.0);
       }
-      case ap::StageQuantity::NodeRate:
       case ap::StageQuantity::WheelMomentum:
-      case ap::StageQuantity::WheelTorque:
+      case ap::StageQuantity::WheelTorque: {
+        const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
+        return wheels_.quantity<double>(isTorqueRow(c), q, omega(x, k - 1),
+                                        Eigen::Map<const Vector3>(x + T(k)), h_);
+      }
+      case ap::StageQuantity::NodeRate:
         break;  // refused in the constructor
     }
     return Vector3::Zero();
+  }
+  // ---- reaction-wheel rows (this transcription's own derivation) ----
+  // At node k = 1..N−1 of the paper scheme the body's node momentum is the mean of the two
+  // steps' momenta seen from node k, Π_k = (F_k J Ω_k + J Ω_{k−1})/2, and the dynamics row
+  // F_k J Ω_k = J Ω_{k−1} + h τ_k makes it Π_k = J Ω_{k−1} + h τ_k/2: affine in the unknowns.
+  // The array's momentum q_k = R(q_k)ᵀπ₀ − Π_k (R(q)ᵀπ₀ homogeneous quadratic in the
+  // quaternion), its torque a_k = −(τ_k + J⁻¹Π_k × q_k). Their derivatives in the node's local
+  // unknowns (q_k, Ω_{k−1}, τ_k) by second-order forward mode (HyperDual): a row g(r) has
+  // gradient g'ᵀ∂r and curvature Σ g'_j ∇²r_j + g''·∂rᵀ∂r (g'' = rowCurvature()).
+  static constexpr int kWheelLocals = 10;
+  using WheelBlock = Eigen::Matrix<double, kWheelLocals, kWheelLocals>;
+  struct WheelJet {
+    Vector3 value;
+    Eigen::Matrix<double, 3, kWheelLocals> d;
+    WheelBlock second[3];
+  };
+  static bool isWheelRow(const ap::StageConstraint& c) {
+    return c.quantity() == ap::StageQuantity::WheelMomentum ||
+           c.quantity() == ap::StageQuantity::WheelTorque;
+  }
+  /// The unknown behind local a of node k: q_k (0..3), Ω_{k−1} (4..6; data at k = 1: −1),
+  /// τ_k (7..9). Increasing in a, so local a ≥ b is the Hessian's lower triangle.
+  int wheelLocal(int k, int a) const {
+    if (a < 4) return Q(k) + a;
+    if (a < 7) return k >= 2 ? W(k - 1) + a - 4 : -1;
+    return T(k) + a - 7;
+  }
+  static bool isTorqueRow(const ap::StageConstraint& c) {
+    return c.quantity() == ap::StageQuantity::WheelTorque;
+  }
+  /// The jets of node k's array momentum (entry 0) and torque (entry 1), k = 1..N−1 (entry k).
+  std::vector<std::array<WheelJet, 2>> wheelJets(const double* x) const {
+    std::vector<std::array<WheelJet, 2>> out(has_wheels_ ? N_ : 0);
+    for (int k = 1; k < static_cast<int>(out.size()); ++k)
+      out[k] = {wheelJet(false, x, k), wheelJet(true, x, k)};
+    return out;
+  }
+  WheelJet wheelJet(bool torque, const double* x, int k) const {
+    using HD = benchmark_ad::HyperDual<kWheelLocals>;
+    Eigen::Matrix<HD, 4, 1> q;
+    Eigen::Matrix<HD, 3, 1> omega_before, tau;
+    const Vector3 w = omega(x, k - 1);
+    for (int i = 0; i < 4; ++i) q(i) = HD(x[Q(k) + i], i);
+    for (int i = 0; i < 3; ++i) omega_before(i) = HD(w(i), 4 + i);
+    for (int i = 0; i < 3; ++i) tau(i) = HD(x[T(k) + i], 7 + i);
+    const Eigen::Matrix<HD, 3, 1> r = wheels_.quantity(torque, q, omega_before, tau, HD(h_));
+    WheelJet jet;
+    for (int j = 0; j < 3; ++j) {
+      jet.value(j) = r(j).v;
+      for (int a = 0; a < kWheelLocals; ++a) jet.d(j, a) = r(j).g[a];
+      for (int a = 0; a < kWheelLocals; ++a)
+        for (int b = 0; b < kWheelLocals; ++b) jet.second[j](a, b) = r(j).H[a][b];
+    }
+    return jet;
+  }
+  static void addWheelRowCurvature(const ap::StageConstraint& c, const WheelJet& jet, double lambda,
+                                   WheelBlock* block) {
+    const Vector3 g = c.rowGradient(jet.value);
+    for (int j = 0; j < 3; ++j) *block += lambda * g(j) * jet.second[j];
+    if (c.rowCurvature() != 0.0) *block += lambda * c.rowCurvature() * jet.d.transpose() * jet.d;
   }
   void buildPattern() {
     rows_.clear();
@@ -787,6 +901,9 @@ class TranscriptionNlp : public Ipopt::TNLP {
         block(row, T(k), 1, 3, false);
       } else if (c->quantity() == ap::StageQuantity::StepRate) {
         block(row, W(k), 1, 3, false);
+      } else if (isWheelRow(*c)) {
+        for (int a = 0; a < kWheelLocals; ++a)
+          if (wheelLocal(k, a) >= 0) rows_.push_back(row), cols_.push_back(wheelLocal(k, a));
       } else {
         block(row, Q(k), 1, 4, false);
       }
@@ -809,6 +926,19 @@ class TranscriptionNlp : public Ipopt::TNLP {
         for (int i = 0; i < 4; ++i)
           for (int j = 0; j <= i; ++j) hrows_.push_back(Q(k) + i), hcols_.push_back(Q(k) + j);
     }
+    // The wheel rows' (q_k, Ω_{k−1}, τ_k) blocks, k = 1..N−1, lower triangles. They overlap the
+    // entries above (Ω Ω, τ diagonal, q_k q_k): IPOPT adds repeated triplet entries
+    // (TripletToCSRConverter), so each term stays where it is formed.
+    wheel_hessian_.clear();
+    for (int k = 1; has_wheels_ && k <= N_ - 1; ++k) {
+      for (int a = 0; a < kWheelLocals; ++a) {
+        for (int b = 0; b <= a; ++b) {
+          if (wheelLocal(k, a) < 0 || wheelLocal(k, b) < 0) continue;
+          hrows_.push_back(wheelLocal(k, a)), hcols_.push_back(wheelLocal(k, b));
+          wheel_hessian_.push_back({k, a, b});
+        }
+      }
+    }
   }
 
  protected:
@@ -829,6 +959,12 @@ class TranscriptionNlp : public Ipopt::TNLP {
   };
   std::vector<ConstraintRow> rows_of_constraints_;
   bool has_cone_ = false;
+  bool has_wheels_ = false;
+  PeerWheels wheels_;
+  struct WheelHessianEntry {
+    int k, a, b;  ///< node, local row ≥ local column
+  };
+  std::vector<WheelHessianEntry> wheel_hessian_;
 };
 
 /// exact_hessian: IPOPT's Newton steps use eval_h; otherwise its L-BFGS approximation.
@@ -876,7 +1012,10 @@ PeerOutcome solveIpopt(const ap::PlanningProblem& problem, double time_budget, b
 class FreeTimeNlp : public TranscriptionNlp {
  public:
   FreeTimeNlp(const ap::PlanningProblem& p, std::vector<Vector3> start)
-      : TranscriptionNlp(p, false, std::move(start)) {}
+      : TranscriptionNlp(p, false, std::move(start)) {
+    // The wheel rows depend on h (Π_k = J Ω_{k−1} + h τ_k/2); their h column is not formed here.
+    if (has_wheels_) throw ap::InvalidInput("ipopt_free_time: no reaction-wheel rows in free time");
+  }
   int H() const { return n(); }  ///< the index of h
   double time_step = 0.0;        ///< h at the end
 
@@ -1055,8 +1194,9 @@ int solveIpoptFreeTime(ap::PlanningProblem problem, double time_budget) {
 }
 
 /// The problem --check-hessian checks: nonzero boundary rates and, constrained, one constraint
-/// of every kind (two cones: both signs of their rows).
-ap::PlanningProblem hessianCheckProblem(int steps, bool constrained) {
+/// of every kind (two cones: both signs of their rows); with wheels a biased four-wheel pyramid
+/// with per-wheel momentum and torque limits and the envelope (every wheel row kind).
+ap::PlanningProblem hessianCheckProblem(int steps, bool constrained, bool wheels) {
   ap::PlanningProblem problem = seedRestToRest(steps);
   problem.initial_velocity = Vector3(0.02, -0.01, 0.03);  // nonzero boundary data too
   problem.final_velocity = Vector3(-0.01, 0.02, 0.01);
@@ -1066,6 +1206,15 @@ ap::PlanningProblem hessianCheckProblem(int steps, bool constrained) {
         ap::PlanningConstraint::maxTorqueNorm(0.8), ap::PlanningConstraint::maxAngularRate(0.3),
         ap::PlanningConstraint::keepOut(Vector3(0, 0, 1), Vector3(0.6, 0.8, 0), 0.4, 0.01),
         ap::PlanningConstraint::keepIn(Vector3(1, 0, 0), Vector3(0, 0.6, 0.8), 1.9)};
+  }
+  if (wheels) {
+    const double s = std::sqrt(2.0 / 3.0), c = std::sqrt(1.0 / 3.0);
+    problem.reaction_wheels.spin_axes = {Vector3(s, 0, c), Vector3(0, s, c), Vector3(-s, 0, c),
+                                         Vector3(0, -s, c)};
+    problem.reaction_wheels.max_torque = {0.3, 0.25, 0.3, 0.35};
+    problem.reaction_wheels.max_momentum = {3.0};
+    problem.reaction_wheels.initial_momentum = {0.3, -0.2, 0.5, 0.1};
+    problem.reaction_wheels.max_momentum_norm = 4.0;
   }
   return problem;
 }
@@ -1097,7 +1246,8 @@ void randomPoint(TranscriptionNlp& nlp, int steps, const NlpSizes& size, std::ve
 }
 
 /// The exact Hessian of the Lagrangian, dense and symmetric; `seen` marks the pattern (the lower
-/// triangle) and *pattern_errors counts entries above the diagonal, out of range or repeated.
+/// triangle) and *pattern_errors counts entries above the diagonal or out of range. Repeated
+/// entries are added, as IPOPT adds them (the wheel rows' node blocks overlap other terms).
 Eigen::MatrixXd exactHessian(TranscriptionNlp& nlp, const NlpSizes& size,
                              const std::vector<double>& x, const std::vector<double>& lambda,
                              double sigma, Eigen::MatrixXi* seen, int* pattern_errors) {
@@ -1112,9 +1262,13 @@ Eigen::MatrixXd exactHessian(TranscriptionNlp& nlp, const NlpSizes& size,
   *seen = Eigen::MatrixXi::Zero(n, n);
   *pattern_errors = 0;
   for (int i = 0; i < nnz_h; ++i) {
-    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0 || (*seen)(hr[i], hc[i])++) ++*pattern_errors;
-    H(hr[i], hc[i]) = hv[i];
-    H(hc[i], hr[i]) = hv[i];
+    if (hr[i] < hc[i] || hr[i] >= n || hc[i] < 0) {
+      ++*pattern_errors;
+      continue;
+    }
+    (*seen)(hr[i], hc[i]) = 1;
+    H(hr[i], hc[i]) += hv[i];
+    if (hr[i] != hc[i]) H(hc[i], hr[i]) += hv[i];
   }
   return H;
 }
@@ -1181,9 +1335,9 @@ double jacobianRelativeError(TranscriptionNlp& nlp, const NlpSizes& size,
 /// The point perturbs the geodesic start (rates by up to 0.4 rad/s, i.e. |hΩ| up to ~0.5 rad at
 /// N = 16, quaternions off the unit sphere) and puts one rate below the series threshold of
 /// quaternionOfRotationVector/exp, so both branches are exercised. Prints one JSON line.
-int checkHessian(int steps, bool constrained) {
+int checkHessian(int steps, bool constrained, bool wheels) {
   Ipopt::SmartPtr<TranscriptionNlp> nlp =
-      new TranscriptionNlp(hessianCheckProblem(steps, constrained), true);
+      new TranscriptionNlp(hessianCheckProblem(steps, constrained, wheels), true);
   NlpSizes size;
   Ipopt::TNLP::IndexStyleEnum style;
   nlp->get_nlp_info(size.n, size.m, size.nnz_jac, size.nnz_h, style);
@@ -1218,14 +1372,15 @@ int checkHessian(int steps, bool constrained) {
   const bool pass = pattern_errors == 0 && relative <= 1e-6 && outside <= 1e-6 * scale &&
                     jacobian_relative <= 1e-6;
   std::printf(
-      "{\"check\": \"hessian\", \"constrained\": %s, \"steps\": %d, \"n\": %d, \"m\": %d, "
+      "{\"check\": \"hessian\", \"constrained\": %s, \"wheels\": %s, \"steps\": %d, "
+      "\"n\": %d, \"m\": %d, "
       "\"nnz_h\": %d, \"fd_step\": %g, "
       "\"max_abs_entry\": %.6g, \"max_abs_error\": %.3g, \"relative_error\": %.3g, "
       "\"max_entry_relative_error\": %.3g, \"fd_outside_pattern\": %.3g, \"fd_asymmetry\": "
       "%.3g, \"jacobian_relative_error\": %.3g, \"pattern_errors\": %d, \"pass\": %s}\n",
-      constrained ? "true" : "false", steps, static_cast<int>(n), static_cast<int>(size.m),
-      static_cast<int>(size.nnz_h), kStep, scale, error, relative, entry_error, outside, asymmetry,
-      jacobian_relative, pattern_errors, pass ? "true" : "false");
+      constrained ? "true" : "false", wheels ? "true" : "false", steps, static_cast<int>(n),
+      static_cast<int>(size.m), static_cast<int>(size.nnz_h), kStep, scale, error, relative,
+      entry_error, outside, asymmetry, jacobian_relative, pattern_errors, pass ? "true" : "false");
   return pass ? 0 : 1;
 }
 #endif
@@ -1837,6 +1992,7 @@ struct BenchmarkArgs {
   std::string solver, scene, scheme;
   bool check_hessian = false;
   bool constrained = false;
+  bool wheels = false;  ///< --check-hessian --wheels
   PeerStart peer_start = PeerStart::Geodesic;
   int steps = 0;
   int suite_count = 0;
@@ -1876,6 +2032,8 @@ std::optional<int> parseArguments(int argc, char** argv, BenchmarkArgs* args) {
       args->check_hessian = true;
     } else if (a == "--constrained") {
       args->constrained = true;
+    } else if (a == "--wheels") {
+      args->wheels = true;
     } else if (a == "--start") {
       const std::string v = value();
       if (v != "geodesic" && v != "unconstrained" && v != "ours") {
@@ -1973,7 +2131,7 @@ int main(int argc, char** argv) {
   if (const std::optional<int> status = parseArguments(argc, argv, &args)) return *status;
   if (args.check_hessian) {
 #ifdef AP_HAVE_IPOPT
-    return checkHessian(args.steps > 0 ? args.steps : 16, args.constrained);
+    return checkHessian(args.steps > 0 ? args.steps : 16, args.constrained, args.wheels);
 #else
     std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "
                  "(install coinor-libipopt-dev)\n";

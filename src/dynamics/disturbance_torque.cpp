@@ -9,6 +9,11 @@ Vector3 DisturbanceTorque::torque(const Matrix3& R, double) const {
   return in_world_ ? Vector3(R.transpose() * value_) : value_;
 }
 
+std::optional<Vector3> DisturbanceTorque::constantWorldTorque() const {
+  if (!in_world_) return std::nullopt;
+  return value_;
+}
+
 std::optional<Vector3> DisturbanceTorque::constantBodyTorque() const {
   if (in_world_) return std::nullopt;
   return value_;

@@ -22,6 +22,10 @@ class TimeShiftedEffect : public TorqueEffect {
   EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override {
     return effect_->timeDerivatives(R, t + offset_);
   }
+  /// A constant in the world frame stays one on a shifted clock.
+  std::optional<Vector3> constantWorldTorque() const override {
+    return effect_->constantWorldTorque();
+  }
 
  private:
   std::shared_ptr<const TorqueEffect> effect_;
@@ -42,14 +46,28 @@ std::vector<std::string> EffectModel::names() const {
   return out;
 }
 
-std::optional<Vector3> EffectModel::constantBodyTorque() const {
+namespace {
+/// Σ of every effect's constant (`constant` one of TorqueEffect's constant…Torque) when each
+/// has one; none otherwise.
+std::optional<Vector3> sumOfConstants(
+    const std::vector<std::shared_ptr<const TorqueEffect>>& effects,
+    std::optional<Vector3> (TorqueEffect::*constant)() const) {
   Vector3 sum = Vector3::Zero();
-  for (const auto& e : effects_) {
-    const std::optional<Vector3> t = e->constantBodyTorque();
+  for (const auto& e : effects) {
+    const std::optional<Vector3> t = ((*e).*constant)();
     if (!t) return std::nullopt;
     sum += *t;
   }
   return sum;
+}
+}  // namespace
+
+std::optional<Vector3> EffectModel::constantBodyTorque() const {
+  return sumOfConstants(effects_, &TorqueEffect::constantBodyTorque);
+}
+
+std::optional<Vector3> EffectModel::constantWorldTorque() const {
+  return sumOfConstants(effects_, &TorqueEffect::constantWorldTorque);
 }
 
 Vector3 EffectModel::torque(const Matrix3& R, double t) const {

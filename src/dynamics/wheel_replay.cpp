@@ -14,7 +14,7 @@ struct State {
   Eigen::VectorXd momentum;
 };
 
-/// d/dt of the state: q̇ = ½ q ⊗ (0, Ω), J Ω̇ = −Ω × (J Ω + A h_w) − A u, ḣ_w = u.
+/// d/dt of the state: q̇ = ½ q ⊗ (0, Ω), J Ω̇ = −Ω × (J Ω + A h_w) − A u + Rᵀτ_d, ḣ_w = u.
 struct Derivative {
   Eigen::Vector4d attitude;  ///< (w, x, y, z)
   Vector3 rate;
@@ -22,13 +22,16 @@ struct Derivative {
 };
 
 Derivative derivative(const State& s, const Eigen::VectorXd& u, const Matrix3& J,
-                      const Matrix3& J_inverse, const Eigen::Matrix<double, 3, Eigen::Dynamic>& A) {
+                      const Matrix3& J_inverse, const Eigen::Matrix<double, 3, Eigen::Dynamic>& A,
+                      const Vector3& world_disturbance) {
   Derivative d;
   const Eigen::Quaterniond omega(0.0, s.rate.x(), s.rate.y(), s.rate.z());
   const Eigen::Quaterniond q_dot = s.attitude * omega;
   d.attitude = 0.5 * Eigen::Vector4d(q_dot.w(), q_dot.x(), q_dot.y(), q_dot.z());
   const Vector3 total = J * s.rate + A * s.momentum;
-  d.rate = J_inverse * (-s.rate.cross(total) - A * u);
+  const Vector3 external =
+      s.attitude.normalized().toRotationMatrix().transpose() * world_disturbance;
+  d.rate = J_inverse * (-s.rate.cross(total) - A * u + external);
   d.momentum = u;
   return d;
 }
@@ -50,7 +53,8 @@ WheelReplay replayWithWheels(const Matrix3& inertia,
                              const Eigen::Matrix<double, 3, Eigen::Dynamic>& axes,
                              const Matrix3& initial_attitude, const Vector3& initial_velocity,
                              const Eigen::VectorXd& initial_momentum, double time_step,
-                             const std::vector<Eigen::VectorXd>& torque, int substeps) {
+                             const std::vector<Eigen::VectorXd>& torque,
+                             const Vector3& world_disturbance, int substeps) {
   const Matrix3 J_inverse = inertia.inverse();
   State s{Eigen::Quaterniond(initial_attitude), initial_velocity, initial_momentum};
   WheelReplay out;
@@ -70,10 +74,13 @@ WheelReplay replayWithWheels(const Matrix3& inertia,
     for (int j = 0; j < substeps; ++j) {
       const double f0 = static_cast<double>(j) / substeps, f1 = (j + 1.0) / substeps;
       const double fm = 0.5 * (f0 + f1);
-      const Derivative k1 = derivative(s, u(f0), inertia, J_inverse, axes);
-      const Derivative k2 = derivative(advanced(s, k1, 0.5 * dt), u(fm), inertia, J_inverse, axes);
-      const Derivative k3 = derivative(advanced(s, k2, 0.5 * dt), u(fm), inertia, J_inverse, axes);
-      const Derivative k4 = derivative(advanced(s, k3, dt), u(f1), inertia, J_inverse, axes);
+      const Derivative k1 = derivative(s, u(f0), inertia, J_inverse, axes, world_disturbance);
+      const Derivative k2 =
+          derivative(advanced(s, k1, 0.5 * dt), u(fm), inertia, J_inverse, axes, world_disturbance);
+      const Derivative k3 =
+          derivative(advanced(s, k2, 0.5 * dt), u(fm), inertia, J_inverse, axes, world_disturbance);
+      const Derivative k4 =
+          derivative(advanced(s, k3, dt), u(f1), inertia, J_inverse, axes, world_disturbance);
       Derivative sum;
       sum.attitude = (k1.attitude + 2 * k2.attitude + 2 * k3.attitude + k4.attitude) / 6.0;
       sum.rate = (k1.rate + 2 * k2.rate + 2 * k3.rate + k4.rate) / 6.0;

@@ -151,7 +151,8 @@ std::string attemptJson(const Attempt& a) {
 /// Torque peaks over the nodes the plan carries torques at (1..N−1; 0..N with end torques).
 std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
   const ReactionWheels& wheels = problem.reaction_wheels;
-  const WheelStates states = wheelStates(problem.scheme, problem.inertia, wheels, r.maneuver);
+  const WheelStates states =
+      wheelStates(problem.scheme, problem.inertia, wheels, r.maneuver, problem.worldDisturbance());
   const WheelArray array = wheelArray(wheels);
   const int N = r.maneuver.steps();
   const bool ends = schemeHasEndTorques(problem.scheme);

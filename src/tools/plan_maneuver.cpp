@@ -281,10 +281,11 @@ int main(int argc, char** argv) {
               << ap::planResultText(problem, result);
     if (!args.csv.empty() && !result.maneuver.attitude.empty()) {
       if (problem.reaction_wheels.present()) {
-        ap::writeManeuverCsv(result.maneuver,
-                             ap::wheelStates(problem.scheme, problem.inertia,
-                                             problem.reaction_wheels, result.maneuver),
-                             args.csv);
+        ap::writeManeuverCsv(
+            result.maneuver,
+            ap::wheelStates(problem.scheme, problem.inertia, problem.reaction_wheels,
+                            result.maneuver, problem.worldDisturbance()),
+            args.csv);
       } else {
         ap::writeManeuverCsv(result.maneuver, args.csv);
       }

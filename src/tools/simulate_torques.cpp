@@ -145,8 +145,9 @@ void replayWheels(const ap::PlanningProblem& p, const std::string& csv_path, dou
   }
   Eigen::VectorXd h0(wheels.count());
   for (int i = 0; i < wheels.count(); ++i) h0(i) = wheels.initialMomentum(i);
-  const ap::WheelReplay replay = ap::replayWithWheels(
-      p.inertia, ap::wheelArray(wheels).axes, p.initial_attitude, p.initial_velocity, h0, h, u);
+  const ap::WheelReplay replay =
+      ap::replayWithWheels(p.inertia, ap::wheelArray(wheels).axes, p.initial_attitude,
+                           p.initial_velocity, h0, h, u, p.worldDisturbance());
   std::printf(
       "wheel replay             terminal attitude error %.3g rad, velocity error %.3g rad/s\n",
       ap::so3::angleBetween(replay.attitude.back(), p.final_attitude),

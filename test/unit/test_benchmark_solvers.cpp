@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -61,8 +63,9 @@ TEST(BenchmarkSolvers, IpoptExactHessianAgreesWithFiniteDifferencesOfGradients) 
   // N = 5 (smallest with every block), 16 and 64; relative error ≤ 1e-6 against the largest
   // entry, no pattern errors, nothing outside the pattern, and the constraint Jacobian against
   // differences of the constraints (the binary's exit status says so); without and with one node
-  // constraint of every kind (torque norm and rate rows, keep_out and keep_in q_k q_k blocks).
-  for (const char* constrained : {"", " --constrained"}) {
+  // constraint of every kind (torque norm and rate rows, keep_out and keep_in q_k q_k blocks),
+  // and with a biased pyramid's wheel rows too (per-wheel momentum and torque sides, envelope).
+  for (const char* constrained : {"", " --constrained", " --constrained --wheels"}) {
     for (const char* steps : {"5", "16", "64"}) {
       std::string output;
       EXPECT_EQ(runTool(std::string("--check-hessian --steps ") + steps + constrained, &output), 0)
@@ -133,6 +136,62 @@ TEST(BenchmarkSolvers, IpoptAgreesWithOurTorqueAndRateLimitedOptimumAtN4096) {
     out << in.rdbuf() << "constraints:\n  - max_angular_rate: 0.11\n";
   }
   expectIpoptStaysAtOurOptimum(scene, 4096, 1e-9);
+#endif
+}
+
+// The IPOPT peer's reaction-wheel rows (their own derivation: Π_k = J Ω_{k−1} + h τ_k/2 from the
+// transcription's dynamics row, R(q)ᵀπ₀ quadratic in the quaternion) against ours on seeded
+// biased four-wheel pyramid slews (paper scheme, the peer's transcription): where ours converges,
+// IPOPT from the geodesic converges to a plan that meets every wheel limit, with our cost to 1e-6
+// relative (issue 42's held-out target); where ours answers infeasible, IPOPT finds no plan
+// either. Every request is planned; none is left out.
+TEST(BenchmarkSolvers, IpoptWithWheelRowsReachesOurWheelLimitedOptimum) {
+#ifndef AP_BENCHMARK_HAS_IPOPT
+  GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";
+#else
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int compared = 0, active = 0, infeasible = 0;
+  for (int c = 0; c < 4; ++c) {
+    const std::string scene = ::testing::TempDir() + "wheel_peer_" + std::to_string(c) + ".yaml";
+    {
+      std::ofstream out(scene);
+      out << "inertia: [[13, -2, 1], [-2, 16, 0.5], [1, 0.5, 18]]\nduration: 20\nsteps: 32\n"
+          << "scheme: paper\n"
+          << "initial: {attitude: {axis: [1, 0, 0], angle: 0}, angular_velocity: [0, 0, 0]}\n"
+          << "final: {attitude: {axis: [" << uniform(rng) << ", " << uniform(rng) << ", "
+          << uniform(rng) << "], angle: " << 1.3 + 0.2 * uniform(rng)
+          << "}, angular_velocity: [0, 0, 0]}\n"
+          << "actuators:\n  reaction_wheels:\n"
+          << "    spin_axes: [[0.816496580927726, 0, 0.5773502691896258], [0, "
+             "0.816496580927726, 0.5773502691896258], [-0.816496580927726, 0, "
+             "0.5773502691896258], [0, -0.816496580927726, 0.5773502691896258]]\n"
+          << "    max_torque: 0.19\n    max_momentum: " << 0.8 + 0.1 * uniform(rng) << "\n"
+          << "    initial_momentum: [" << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << ", "
+          << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << "]\n";
+    }
+    std::string ours, peer;
+    ASSERT_EQ(runTool("--solver newton --scene '" + scene + "'", &ours), 0) << ours;
+    EXPECT_EQ(runTool("--solver ipopt --scene '" + scene + "'", &peer), 0) << peer;
+    if (ours.find("\"message\": \"infeasible") != std::string::npos) {
+      // Ours found the limits infeasible: the peer must not find a plan within them.
+      EXPECT_NE(peer.find("\"converged\": false"), std::string::npos) << ours << peer;
+      ++infeasible;
+      continue;
+    }
+    ASSERT_NE(ours.find("\"converged\": true"), std::string::npos) << ours;
+    EXPECT_NE(peer.find("\"converged\": true"), std::string::npos) << ours << peer;
+    const double cost = jsonNumber(ours, "cost");
+    EXPECT_NEAR(jsonNumber(peer, "cost"), cost, 1e-6 * cost) << ours << peer;
+    EXPECT_LE(jsonNumber(peer, "max_constraint_violation"), 1e-8) << peer;
+    ++compared;
+    if (jsonNumber(ours, "active_constraints") > 0) ++active;
+    std::printf("%s%s", ours.c_str(), peer.c_str());
+  }
+  std::printf("%d of 4 compared, %d with active wheel limits, %d infeasible for both\n", compared,
+              active, infeasible);
+  EXPECT_GE(compared, 2);
+  EXPECT_GE(active, 1);
 #endif
 }
 

@@ -57,6 +57,14 @@ ap::PlanningProblem wheelProblem(ap::SchemeKind scheme, bool spinning, int steps
   return p;
 }
 
+/// A constant world-frame disturbance torque on `p` (scene effects: disturbance_torque, frame
+/// world): the one effect the wheels plan with (its impulse t τ_d is independent of the path).
+void disturb(ap::PlanningProblem* p, const ap::Vector3& world_torque) {
+  auto model = std::make_shared<ap::EffectModel>();
+  model->add(std::make_unique<ap::DisturbanceTorque>(world_torque, ap::TorqueFrame::World));
+  p->effects = model;
+}
+
 /// An InvalidInput's message, or "" if `f` did not throw one.
 template <typename F>
 std::string refusal(F f) {
@@ -114,6 +122,27 @@ TEST(ReactionWheelInput, CombinationsTheModelDoesNotPlanAreRefusedByName) {
   EXPECT_NE(refusalOf(p).find("reaction_wheels: not supported with effects actuator_limits"),
             std::string::npos)
       << refusalOf(p);
+  // Effects whose impulse depends on the path are refused by name; a world-frame disturbance is
+  // planned, but not in minimum time (the end state's wheel momenta would depend on T).
+  p = wheelProblem(ap::SchemeKind::SecondOrder, false);
+  auto body_frame = std::make_shared<ap::EffectModel>();
+  body_frame->add(
+      std::make_unique<ap::DisturbanceTorque>(ap::Vector3(0, 0, 0.01), ap::TorqueFrame::Body));
+  p.effects = body_frame;
+  EXPECT_NE(refusalOf(p).find("not supported with effects (disturbance_torque)"), std::string::npos)
+      << refusalOf(p);
+  auto gravity = std::make_shared<ap::EffectModel>();
+  gravity->add(std::make_unique<ap::GravityGradient>(3.986e14, 7.0e6, p.inertia));
+  p.effects = gravity;
+  EXPECT_NE(refusalOf(p).find("not supported with effects (gravity_gradient)"), std::string::npos)
+      << refusalOf(p);
+  disturb(&p, ap::Vector3(0, 0, 0.01));
+  EXPECT_EQ(refusalOf(p), "");
+  p.objective = ap::Objective::MinimumTime;
+  p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.3)};
+  EXPECT_NE(refusalOf(p).find("not supported with effects and objective minimum_time"),
+            std::string::npos)
+      << refusalOf(p);
   // The end state fixes the wheels' final momenta: a spin the array cannot absorb is refused.
   p = wheelProblem(ap::SchemeKind::SecondOrder, false);
   p.final_velocity = ap::Vector3(0.0, 0.0, 0.5);  // J Ω(T) ≈ 9 N m s about z
@@ -162,6 +191,7 @@ struct WheelCase {
   ap::SchemeKind scheme;
   bool spinning;
   int quantity;  ///< 0: the array momentum q, 1: its half squared norm, 2: the array torque
+  bool disturbed = false;  ///< with a world-frame disturbance (π_k = π₀ + k h τ_d)
 };
 
 std::vector<WheelCase> wheelCases() {
@@ -169,12 +199,14 @@ std::vector<WheelCase> wheelCases() {
   for (const ap::SchemeKind s :
        {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder})
     for (const bool spinning : {false, true})
-      for (const int quantity : {0, 1, 2}) out.push_back({s, spinning, quantity});
+      for (const bool disturbed : {false, true})
+        for (const int quantity : {0, 1, 2}) out.push_back({s, spinning, quantity, disturbed});
   return out;
 }
 
 std::string wheelCaseName(const testing::TestParamInfo<WheelCase>& info) {
   return ap::schemeName(info.param.scheme) + (info.param.spinning ? "_spinning" : "_rest") +
+         (info.param.disturbed ? "_disturbed" : "") +
          (info.param.quantity == 2   ? "_torque"
           : info.param.quantity == 1 ? "_momentum_norm"
                                      : "_momentum");
@@ -184,6 +216,7 @@ class WheelQuantityDerivatives : public testing::TestWithParam<WheelCase> {
  protected:
   void SetUp() override {
     problem_ = wheelProblem(GetParam().scheme, GetParam().spinning);
+    if (GetParam().disturbed) disturb(&problem_, ap::Vector3(0.02, -0.03, 0.015));
     quantity_ = GetParam().quantity == 2
                     ? ap::makeWheelTorqueQuantity(problem_)
                     : ap::makeWheelMomentumQuantity(problem_, GetParam().quantity == 1);
@@ -250,33 +283,40 @@ INSTANTIATE_TEST_SUITE_P(EveryScheme, WheelQuantityDerivatives, testing::ValuesI
 /// on the end steps too). Any iterate is a plan of its own torques, so a perturbed one serves.
 TEST(ReactionWheelPhysics, BodyAndArrayConserveTheTotalMomentumExactly) {
   for (const ap::SchemeKind scheme :
-       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
-    const ap::PlanningProblem p = wheelProblem(scheme, true);
-    ap::ReducedProblem np(p);
-    std::mt19937 rng(11);
-    std::normal_distribution<double> normal(0.0, 0.05);
-    Eigen::VectorXd delta(np.unknowns());
-    for (int i = 0; i < delta.size(); ++i) delta(i) = normal(rng);
-    np.setCurrent(np.retract(delta, 1.0));
-    const ap::Maneuver plan = np.maneuver(np.current());
-    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
-    const int N = plan.steps();
-    const double h = plan.time_step;
-    const bool ends = ap::schemeHasEndTorques(scheme);
-    double worst = 0.0, scale = 0.0;
-    for (int k = ends ? 0 : 1; k <= (ends ? N - 1 : N - 2); ++k) {
-      const ap::Vector3 now =
-          plan.attitude[k] * ap::planArrayMomentum(scheme, p.inertia, array, plan, k);
-      const ap::Vector3 next =
-          plan.attitude[k + 1] * ap::planArrayMomentum(scheme, p.inertia, array, plan, k + 1);
-      const ap::Vector3 impulse =
-          0.5 * h * (plan.attitude[k] * plan.torque[k] + plan.attitude[k + 1] * plan.torque[k + 1]);
-      worst = std::max(worst, (next - now + impulse).norm());
-      scale = std::max(scale, now.norm() + impulse.norm());
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder})
+    for (const bool disturbed : {false, true}) {
+      ap::PlanningProblem p = wheelProblem(scheme, true);
+      // With a world-frame disturbance τ_d the total is π_k = π₀ + k h τ_d, and the identity is
+      // the same: the control's impulse alone moves the array (the body takes τ_d's).
+      if (disturbed) disturb(&p, ap::Vector3(0.02, -0.03, 0.015));
+      const ap::Vector3 tau_d = p.worldDisturbance();
+      ap::ReducedProblem np(p);
+      std::mt19937 rng(11);
+      std::normal_distribution<double> normal(0.0, 0.05);
+      Eigen::VectorXd delta(np.unknowns());
+      for (int i = 0; i < delta.size(); ++i) delta(i) = normal(rng);
+      np.setCurrent(np.retract(delta, 1.0));
+      const ap::Maneuver plan = np.maneuver(np.current());
+      const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+      const int N = plan.steps();
+      const double h = plan.time_step;
+      const bool ends = ap::schemeHasEndTorques(scheme);
+      double worst = 0.0, scale = 0.0;
+      for (int k = ends ? 0 : 1; k <= (ends ? N - 1 : N - 2); ++k) {
+        const ap::Vector3 now =
+            plan.attitude[k] * ap::planArrayMomentum(scheme, p.inertia, array, plan, k, tau_d);
+        const ap::Vector3 next =
+            plan.attitude[k + 1] *
+            ap::planArrayMomentum(scheme, p.inertia, array, plan, k + 1, tau_d);
+        const ap::Vector3 impulse =
+            0.5 * h *
+            (plan.attitude[k] * plan.torque[k] + plan.attitude[k + 1] * plan.torque[k + 1]);
+        worst = std::max(worst, (next - now + impulse).norm());
+        scale = std::max(scale, now.norm() + impulse.norm());
+      }
+      EXPECT_LE(worst, 1e-12 * scale) << ap::schemeName(scheme) << (disturbed ? " disturbed" : "");
+      EXPECT_GT(scale, 0.1);
     }
-    EXPECT_LE(worst, 1e-12 * scale) << ap::schemeName(scheme);
-    EXPECT_GT(scale, 0.1);
-  }
 }
 
 /// u_k = A⁺(−τ_k − Ω_k × q_k) is the wheel momenta's rate to O(h²): against their central
@@ -412,6 +452,82 @@ TEST(ReactionWheelMinimumEffort, ConvergedPlansMeetEveryWheelLimit) {
   EXPECT_GE(converged, 4);
 }
 
+/// The seeded suite widened: every scheme the wheels plan with, a random bias, spinning ends on
+/// every other request, per-wheel limits and the envelope on every third (each limit below the
+/// unconstrained plan's peak unless the end nodes' boundary momenta lie above it). Every
+/// converged plan meets every wheel limit and the envelope on its own wheel states to 1e-9
+/// relative; the refusals (an end state beyond the envelope) and the unconverged requests are
+/// counted, not hidden.
+TEST(ReactionWheelMinimumEffort, SeededSuiteAcrossSchemesMeetsEveryWheelLimit) {
+  std::mt19937 rng(4201);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const ap::SchemeKind schemes[] = {ap::SchemeKind::Paper, ap::SchemeKind::Variational,
+                                    ap::SchemeKind::SecondOrder};
+  int planned = 0, converged = 0, refused = 0, binding = 0;
+  for (int c = 0; c < 12; ++c) {
+    ap::PlanningProblem p = wheelProblem(schemes[c % 3], c % 2 == 1, 48);
+    p.duration = 20.0;
+    p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)));
+    p.reaction_wheels.initial_momentum.clear();
+    for (int i = 0; i < 4; ++i) p.reaction_wheels.initial_momentum.push_back(0.3 * uniform(rng));
+    p.reaction_wheels.max_momentum = {100.0};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    const WheelPeaks peaks = unconstrainedPeaks(p);
+    // The end nodes' wheel momenta are boundary data (the same on every plan): a limit below
+    // them is refused by name, so each limit stays 5 % above them.
+    ap::Maneuver ends;
+    ends.attitude = {p.initial_attitude, p.final_attitude};
+    ends.angular_velocity = {p.initial_velocity, p.final_velocity};
+    ends.torque.assign(2, ap::Vector3::Zero());
+    ends.time_step = p.duration;
+    const ap::WheelStates end_states =
+        ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, ends);
+    p.reaction_wheels.max_momentum.clear();
+    p.reaction_wheels.max_torque.clear();
+    for (int i = 0; i < 4; ++i) {
+      const double at_ends =
+          std::max(std::abs(end_states.momentum[0](i)), std::abs(end_states.momentum[1](i)));
+      p.reaction_wheels.max_momentum.push_back(
+          std::max((0.8 + 0.1 * uniform(rng)) * peaks.momentum, 1.05 * at_ends));
+      p.reaction_wheels.max_torque.push_back((1.5 + 0.3 * uniform(rng)) * peaks.torque);
+    }
+    if (c % 3 == 0) p.reaction_wheels.max_momentum_norm = 1.2 * peaks.momentum;
+    if (!refusalOf(p).empty()) {
+      ++refused;
+      continue;
+    }
+    ++planned;
+    const ap::PlanResult r = ap::planManeuver(p);
+    if (!r.converged()) {
+      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message.c_str());
+      continue;
+    }
+    ++converged;
+    const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    const int first = ap::schemeHasEndTorques(p.scheme) ? 0 : 1;
+    for (int k = 0; k <= p.steps; ++k) {
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(std::abs(w.momentum[k](i)), p.reaction_wheels.momentumLimit(i) * (1 + 1e-9))
+            << "case " << c << " k " << k << " wheel " << i;
+        if (k >= first && k <= p.steps - first) {
+          EXPECT_LE(std::abs(w.torque[k](i)), p.reaction_wheels.torqueLimit(i) * (1 + 1e-9))
+              << "case " << c << " k " << k << " wheel " << i;
+        }
+      }
+      EXPECT_LE((array.axes * w.momentum[k]).norm(),
+                p.reaction_wheels.max_momentum_norm * (1 + 1e-9))
+          << "case " << c << " k " << k;
+    }
+    if (r.active_constraints > 0) ++binding;  // none where the end nodes set every limit
+  }
+  std::printf("%d planned (%d refused by name), %d converged, %d with active limits\n", planned,
+              refused, converged, binding);
+  EXPECT_GE(planned, 8);
+  EXPECT_GE(converged, planned * 3 / 4);
+  EXPECT_GE(binding, converged / 2);
+}
+
 // ---- the independent replay --------------------------------------------------------------------
 
 /// A wheel-limited biased pyramid slew, replayed as body + wheels from its wheel torques alone
@@ -453,6 +569,60 @@ TEST(ReactionWheelReplay, WheelTorquesFlyThePlanWithinTheLimitsToSecondOrder) {
   EXPECT_GT(misses[1] / misses[2], 3.0);
   EXPECT_LT(overshoots[0], 1e-2);
   EXPECT_LE(overshoots[2], overshoots[0] / 8.0 + 1e-12);
+}
+
+/// With a constant world-frame disturbance τ_d the wheel-limited plan (π_k = π₀ + t_k τ_d) is
+/// flown by its wheel torques: the independent replay of body + wheels + τ_d from u alone reaches
+/// the target to O(h²) and keeps the momentum limit to O(h²); the same torques replayed without
+/// τ_d miss by far more (the plan carries the disturbance, it does not ignore it).
+TEST(ReactionWheelReplay, WorldDisturbanceIsFlownByTheWheelTorquesToSecondOrder) {
+  ap::PlanningProblem base = wheelProblem(ap::SchemeKind::SecondOrder, false, 64);
+  base.duration = 20.0;
+  base.reaction_wheels.max_momentum = {3.0};
+  base.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+  disturb(&base, ap::Vector3(0.004, -0.006, 0.003));
+  const ap::Vector3 tau_d = base.worldDisturbance();
+  const ap::PlanResult free = ap::planManeuver(base);
+  ASSERT_TRUE(free.converged()) << free.message;
+  double peak = 0.0;
+  for (const Eigen::VectorXd& h :
+       ap::wheelStates(base.scheme, base.inertia, base.reaction_wheels, free.maneuver, tau_d)
+           .momentum)
+    peak = std::max(peak, h.cwiseAbs().maxCoeff());
+  const double limit = 0.85 * peak;
+  std::vector<double> misses, overshoots, undisturbed;
+  for (const int N : {64, 128, 256}) {
+    ap::PlanningProblem p = base;
+    p.steps = N;
+    p.reaction_wheels.max_momentum = {limit};
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    EXPECT_GT(r.active_constraints, 0);
+    const ap::WheelStates w =
+        ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver, tau_d);
+    for (int k = 0; k <= N; ++k)
+      EXPECT_LE(w.momentum[k].cwiseAbs().maxCoeff(), limit * (1 + 1e-9)) << "k = " << k;
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    Eigen::VectorXd h0(4);
+    for (int i = 0; i < 4; ++i) h0(i) = p.reaction_wheels.initialMomentum(i);
+    const auto fly = [&](const ap::Vector3& disturbance) {
+      return ap::replayWithWheels(p.inertia, array.axes, p.initial_attitude, p.initial_velocity, h0,
+                                  r.maneuver.time_step, w.torque, disturbance);
+    };
+    const ap::WheelReplay replay = fly(tau_d);
+    misses.push_back(ap::so3::angleBetween(replay.attitude.back(), p.final_attitude));
+    overshoots.push_back(std::max(0.0, replay.peak_momentum.maxCoeff() / limit - 1.0));
+    undisturbed.push_back(
+        ap::so3::angleBetween(fly(ap::Vector3::Zero()).attitude.back(), p.final_attitude));
+    std::printf("N = %d: terminal miss %.3g rad (without the disturbance %.3g), overshoot %.3g\n",
+                N, misses.back(), undisturbed.back(), overshoots.back());
+  }
+  EXPECT_LT(misses[0], 1e-2);
+  EXPECT_GT(misses[0] / misses[1], 3.0);
+  EXPECT_GT(misses[1] / misses[2], 3.0);
+  EXPECT_LT(overshoots[0], 1e-2);
+  EXPECT_LE(overshoots[2], overshoots[0] / 8.0 + 1e-12);
+  EXPECT_GT(undisturbed[2], 100.0 * misses[2]);
 }
 
 // ---- outputs -----------------------------------------------------------------------------------

@@ -83,6 +83,10 @@ class TorqueEffect {
   /// The torque when it is one constant vector in the body frame at every attitude and time (a
   /// verdict that must hold along every plan can use it); none otherwise.
   virtual std::optional<Vector3> constantBodyTorque() const { return std::nullopt; }
+  /// The torque when it is one constant vector in the world frame at every attitude and time
+  /// (its impulse over [0, t] is t times it, whatever the path: what the reaction wheels'
+  /// total momentum needs); none otherwise.
+  virtual std::optional<Vector3> constantWorldTorque() const { return std::nullopt; }
 };
 
 /// Gravity gradient of a circular orbit in the world x–y plane:
@@ -120,6 +124,8 @@ class DisturbanceTorque : public TorqueEffect {
   EffectTimeDerivatives timeDerivatives(const Matrix3& R, double t) const override;
   /// The value in the body frame (none in the world frame: it turns with the attitude).
   std::optional<Vector3> constantBodyTorque() const override;
+  /// The value in the world frame (none in the body frame: it turns with the attitude).
+  std::optional<Vector3> constantWorldTorque() const override;
 
  private:
   Vector3 value_;
@@ -138,6 +144,9 @@ class EffectModel {
   /// Σ of the effects' constant body torques when every effect has one (zero when empty); none
   /// otherwise.
   std::optional<Vector3> constantBodyTorque() const;
+  /// Σ of the effects' constant world torques when every effect has one (zero when empty); none
+  /// otherwise.
+  std::optional<Vector3> constantWorldTorque() const;
   /// Σ ∂τ_e/∂δ.
   Matrix3 jacobian(const Matrix3& R, double t) const;
   /// Σ weighted second derivatives (see TorqueEffect).

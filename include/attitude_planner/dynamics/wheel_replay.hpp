@@ -2,10 +2,11 @@
 // coupled system, integrated by classical RK4, independent of the planner's discrete algebra
 // (node momenta, π₀, A⁺): the check that a plan's wheel torques fly the plan within the limits.
 //
-//     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u,     ḣ_w = u
+//     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u + Rᵀτ_d,     ḣ_w = u
 //
-// (no external torques; A the unit spin axes as columns). u(t) is the node values held linearly
-// between the nodes (a box limit met at the nodes holds between them).
+// (τ_d a constant world-frame disturbance, zero without; A the unit spin axes as columns). u(t)
+// is the node values held linearly between the nodes (a box limit met at the nodes holds
+// between them).
 #pragma once
 
 #include <vector>
@@ -26,11 +27,13 @@ struct WheelReplay {
 };
 
 /// Replays N = torque.size() − 1 steps of `time_step` from R_0, Ω_0 and h_w(0) with wheel torques
-/// u_k (one vector of n per node), `substeps` RK4 steps per step.
+/// u_k (one vector of n per node) and the world-frame disturbance τ_d [N m], `substeps` RK4
+/// steps per step.
 WheelReplay replayWithWheels(const Matrix3& inertia,
                              const Eigen::Matrix<double, 3, Eigen::Dynamic>& axes,
                              const Matrix3& initial_attitude, const Vector3& initial_velocity,
                              const Eigen::VectorXd& initial_momentum, double time_step,
-                             const std::vector<Eigen::VectorXd>& torque, int substeps = 16);
+                             const std::vector<Eigen::VectorXd>& torque,
+                             const Vector3& world_disturbance = Vector3::Zero(), int substeps = 16);
 
 }  // namespace attitude_planner

@@ -185,6 +185,12 @@ struct PlanningProblem {
   /// Known external torques the plan must account for (gravity gradient, disturbances); null or
   /// empty: none. Shared, immutable: several solves may use one model.
   std::shared_ptr<const EffectModel> effects;
+  /// τ_d [N m], world: the effects' torque when it is constant in the world frame (zero without
+  /// effects or with any other; reaction wheels plan with this kind only, validateProblem).
+  Vector3 worldDisturbance() const {
+    if (!effects) return Vector3::Zero();
+    return effects->constantWorldTorque().value_or(Vector3::Zero());
+  }
   /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
   /// A problem whose unconstrained optimum violates a bound or a constraint is solved by the
   /// interior-point solver (interior_point_solver.cpp), O(N) per iteration.

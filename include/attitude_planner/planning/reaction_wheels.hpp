@@ -86,12 +86,16 @@ struct WheelStates {
 Vector3 planNodeMomentum(SchemeKind scheme, const Matrix3& inertia, const Maneuver& plan, int k);
 /// π₀ = R_0 (J Ω(0) + A h_w(0)) of a plan.
 Vector3 totalMomentum(const Matrix3& inertia, const WheelArray& array, const Maneuver& plan);
-/// The array momentum q_k = R_kᵀπ₀ − Π_k and torque A u_k = −(τ_k + J⁻¹Π_k × q_k) of node k.
+/// The array momentum q_k = R_kᵀπ_k − Π_k and torque A u_k = −(τ_k + J⁻¹Π_k × q_k) of node k,
+/// π_k = π₀ + t_k τ_d with a constant world-frame disturbance τ_d (PlanningProblem::
+/// worldDisturbance; t_k = k h): its impulse is t_k τ_d whatever the path.
 Vector3 planArrayMomentum(SchemeKind scheme, const Matrix3& inertia, const WheelArray& array,
-                          const Maneuver& plan, int k);
+                          const Maneuver& plan, int k,
+                          const Vector3& world_disturbance = Vector3::Zero());
 Vector3 planArrayTorque(SchemeKind scheme, const Matrix3& inertia, const WheelArray& array,
-                        const Maneuver& plan, int k);
+                        const Maneuver& plan, int k,
+                        const Vector3& world_disturbance = Vector3::Zero());
 WheelStates wheelStates(SchemeKind scheme, const Matrix3& inertia, const ReactionWheels& wheels,
-                        const Maneuver& plan);
+                        const Maneuver& plan, const Vector3& world_disturbance = Vector3::Zero());
 
 }  // namespace attitude_planner

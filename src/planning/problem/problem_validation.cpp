@@ -73,8 +73,9 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
 }
 
 /// Reaction wheels: the array valid, the combinations the wheel model does not plan refused by
-/// name, and the end state's wheel momenta (fixed by the boundary data: q_N = R_Nᵀπ₀ − J Ω(T))
-/// within their limits, else no plan exists.
+/// name (every effect but a world-frame disturbance_torque; that one with minimum time), and the
+/// end state's wheel momenta (fixed by the boundary data: q_N = R_Nᵀ(π₀ + T τ_d) − J Ω(T)) within
+/// their limits, else no plan exists.
 void requireWheelsServed(const PlanningProblem& p) {
   const std::string field = "actuators.reaction_wheels";
   validateReactionWheels(p.reaction_wheels, field);
@@ -87,16 +88,27 @@ void requireWheelsServed(const PlanningProblem& p) {
            "bound a torque no actuator makes); give per-wheel max_torque, or max_torque_norm "
            "under constraints for a body-torque bound");
   }
-  if (p.effects && !p.effects->empty()) {
-    refuse("effects",
-           "an external torque changes the total angular momentum the wheel "
-           "momenta are computed from (not modelled yet)");
+  const bool disturbed = p.effects && !p.effects->empty();
+  if (disturbed && !p.effects->constantWorldTorque()) {
+    std::string names;
+    for (const std::string& name : p.effects->names()) names += (names.empty() ? "" : ", ") + name;
+    refuse("effects (" + names + ")",
+           "the wheel momenta follow from the total angular momentum, which an external torque "
+           "changes by its impulse; only a disturbance_torque in the world frame has an impulse "
+           "independent of the path (t tau_d); gravity_gradient and a body-frame disturbance "
+           "depend on the path");
+  }
+  if (disturbed && p.objective == Objective::MinimumTime) {
+    refuse("effects and objective minimum_time",
+           "the end state's wheel momenta depend on the duration through the disturbance's "
+           "impulse; give a duration (minimum effort)");
   }
   if (p.end_condition.pointing()) refuse("final.pointing", "give a final attitude");
   if (p.accuracy.active()) refuse("an accuracy target", "give steps");
   const WheelArray array = wheelArray(p.reaction_wheels);
   const Vector3 total =
-      p.initial_attitude * (p.inertia * p.initial_velocity + array.initial_array_momentum);
+      p.initial_attitude * (p.inertia * p.initial_velocity + array.initial_array_momentum) +
+      p.duration * p.worldDisturbance();  // π(T) = π₀ + T τ_d
   const Vector3 final_array = p.final_attitude.transpose() * total - p.inertia * p.final_velocity;
   const Eigen::VectorXd final_wheels = array.wheelMomenta(final_array);
   for (int i = 0; i < p.reaction_wheels.count(); ++i) {

@@ -127,26 +127,38 @@ Vector3 totalMomentum(const Matrix3& inertia, const WheelArray& array, const Man
   return plan.attitude[0] * (inertia * plan.angular_velocity[0] + array.initial_array_momentum);
 }
 
+namespace {
+/// R_kᵀπ_k, π_k = π₀ + k h τ_d.
+Vector3 bodyTotalMomentum(const Matrix3& inertia, const WheelArray& array, const Maneuver& plan,
+                          int k, const Vector3& world_disturbance) {
+  const Vector3 total =
+      totalMomentum(inertia, array, plan) + (k * plan.time_step) * world_disturbance;
+  return plan.attitude[k].transpose() * total;
+}
+}  // namespace
+
 Vector3 planArrayMomentum(SchemeKind scheme, const Matrix3& inertia, const WheelArray& array,
-                          const Maneuver& plan, int k) {
-  return plan.attitude[k].transpose() * totalMomentum(inertia, array, plan) -
+                          const Maneuver& plan, int k, const Vector3& world_disturbance) {
+  return bodyTotalMomentum(inertia, array, plan, k, world_disturbance) -
          planNodeMomentum(scheme, inertia, plan, k);
 }
 
 Vector3 planArrayTorque(SchemeKind scheme, const Matrix3& inertia, const WheelArray& array,
-                        const Maneuver& plan, int k) {
+                        const Maneuver& plan, int k, const Vector3& world_disturbance) {
   const Vector3 Pi = planNodeMomentum(scheme, inertia, plan, k);
-  const Vector3 q = plan.attitude[k].transpose() * totalMomentum(inertia, array, plan) - Pi;
+  const Vector3 q = bodyTotalMomentum(inertia, array, plan, k, world_disturbance) - Pi;
   return -(plan.torque[k] + (inertia.inverse() * Pi).cross(q));
 }
 
 WheelStates wheelStates(SchemeKind scheme, const Matrix3& inertia, const ReactionWheels& wheels,
-                        const Maneuver& plan) {
+                        const Maneuver& plan, const Vector3& world_disturbance) {
   WheelStates out;
   const WheelArray array = wheelArray(wheels);
   for (int k = 0; k <= plan.steps(); ++k) {
-    out.momentum.push_back(array.wheelMomenta(planArrayMomentum(scheme, inertia, array, plan, k)));
-    out.torque.push_back(array.pseudo_inverse * planArrayTorque(scheme, inertia, array, plan, k));
+    out.momentum.push_back(
+        array.wheelMomenta(planArrayMomentum(scheme, inertia, array, plan, k, world_disturbance)));
+    out.torque.push_back(array.pseudo_inverse *
+                         planArrayTorque(scheme, inertia, array, plan, k, world_disturbance));
   }
   return out;
 }

@@ -19,6 +19,20 @@ const std::vector<Matrix3>& QuantityInputs::attitudes() const {
   return *attitudes_;
 }
 
+const std::vector<Vector3>& QuantityInputs::nodeMomenta() const {
+  if (node_momenta_) return *node_momenta_;
+  const int N = np_.steps();
+  const DiscreteScheme& scheme = np_.scheme();
+  std::vector<Vector3> step_momenta(N);
+  for (int k = 0; k < N; ++k) step_momenta[k] = scheme.momentumOfStep(steps_[k]);
+  node_momenta_.emplace(N + 1, Vector3::Zero());
+  for (int k = 1; k < N; ++k) {
+    (*node_momenta_)[k] =
+        0.5 * (step_momenta[k] + so3::exp(steps_[k - 1]).transpose() * step_momenta[k - 1]);
+  }
+  return *node_momenta_;
+}
+
 namespace {
 
 /// The support every kind shares: the torques' range k = first_free − 1..last_free + 1.

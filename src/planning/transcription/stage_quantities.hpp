@@ -50,7 +50,7 @@ struct StageSupport {
 };
 
 /// The products of one iterate that the quantities share, each formed on first use: the torques
-/// τ_0..τ_N and the attitudes R_0..R_N of `steps`.
+/// τ_0..τ_N, the attitudes R_0..R_N of `steps` and the interior node momenta.
 class QuantityInputs {
  public:
   QuantityInputs(const ReducedProblem& np, const ReducedProblem::StepVectors& steps)
@@ -59,12 +59,17 @@ class QuantityInputs {
   const ReducedProblem::StepVectors& steps() const { return steps_; }
   const std::vector<Vector3>& torques() const;
   const std::vector<Matrix3>& attitudes() const;
+  /// Π_k, k = 1..N−1 (entries 0 and N unset): the mean of the two adjacent steps' momenta seen
+  /// from node k, ½(μ(ω_k) + exp(ω_{k−1}^)ᵀ μ(ω_{k−1})). Every constraint on a wheel quantity
+  /// reads it at every node, so it is formed once per iterate, not once per constraint.
+  const std::vector<Vector3>& nodeMomenta() const;
 
  private:
   const ReducedProblem& np_;
   const ReducedProblem::StepVectors& steps_;
   mutable std::optional<std::vector<Vector3>> torques_;
   mutable std::optional<std::vector<Matrix3>> attitudes_;
+  mutable std::optional<std::vector<Vector3>> node_momenta_;
 };
 
 /// λ_k = ∂L/∂q at instance k with value q: the caller forms its constraints' values and

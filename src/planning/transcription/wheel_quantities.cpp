@@ -77,8 +77,10 @@ Jet momentumJet(const ReducedProblem::NodeMomentum& node, const Vector3& w, cons
   return out;
 }
 
-/// v = R_kᵀπ₀ on the window's middle node, weights c.
-Jet bodyTotalJet(const Vector3& v, const Vector3& c, const WindowPath* path) {
+/// v = R_kᵀπ_k on the window's middle node, weights c; `rate` = R_kᵀ ∂π_k/∂h = R_kᵀ k τ_d (π_k =
+/// π₀ + k h τ_d): ∂v/∂h = v^e + rate, ∂²(cᵀv)/∂δ∂h = H e + c × rate (cᵀexp(−δ^)g =
+/// cᵀg + δ·(c × g)), ∂²(cᵀv)/∂h² = eᵀHe + cᵀv^e₂ + 2 (c × rate)·e (π is affine in h).
+Jet bodyTotalJet(const Vector3& v, const Vector3& c, const WindowPath* path, const Vector3& rate) {
   Jet out;
   out.value = v;
   const Matrix3 G = so3::hat(v);
@@ -87,10 +89,11 @@ Jet bodyTotalJet(const Vector3& v, const Vector3& c, const WindowPath* path) {
   out.s.block<3, 3>(3, 3) = H;
   if (!path) return out;
   const Vector3 e = path->first.segment<3>(3), e2 = path->second.segment<3>(3);
-  out.d.col(9) = G * e;
-  out.s.block<3, 1>(3, 9) = H * e;
-  out.s.block<1, 3>(9, 3) = (H * e).transpose();
-  out.s(9, 9) = e.dot(H * e) + c.dot(G * e2);
+  const Vector3 turn = c.cross(rate);
+  out.d.col(9) = G * e + rate;
+  out.s.block<3, 1>(3, 9) = H * e + turn;
+  out.s.block<1, 3>(9, 3) = (H * e + turn).transpose();
+  out.s(9, 9) = e.dot(H * e) + c.dot(G * e2) + 2.0 * turn.dot(e);
   return out;
 }
 
@@ -112,6 +115,7 @@ class WheelQuantity : public StageQuantityModel {
         array_(wheelArray(p.reaction_wheels)),
         total_(p.initial_attitude *
                (p.inertia * p.initial_velocity + array_.initial_array_momentum)),
+        disturbance_(p.worldDisturbance()),
         start_momentum_(p.inertia * p.initial_velocity),
         end_momentum_(p.inertia * p.final_velocity) {}
   bool dependsOnTimeStep() const override { return true; }
@@ -152,13 +156,11 @@ class WheelQuantity : public StageQuantityModel {
     const int N = at.problem().steps();
     if (k <= 0) return start_momentum_;
     if (k >= N) return end_momentum_;
-    const DiscreteScheme& scheme = at.problem().scheme();
-    const ReducedProblem::StepVectors& steps = at.steps();
-    return 0.5 * (scheme.momentumOfStep(steps[k]) +
-                  so3::exp(steps[k - 1]).transpose() * scheme.momentumOfStep(steps[k - 1]));
+    return at.nodeMomenta()[k];
   }
+  /// v_k = R_kᵀπ_k, π_k = π₀ + k h τ_d.
   Vector3 bodyTotal(const QuantityInputs& at, int k) const {
-    return at.attitudes()[k].transpose() * total_;
+    return at.attitudes()[k].transpose() * (total_ + (k * at.problem().timeStep()) * disturbance_);
   }
   /// The Π and v jets of every instance of `support` (weights from `weights_of(k)`: first Π's,
   /// then v's), visited in k order with the instance's index.
@@ -170,7 +172,9 @@ class WheelQuantity : public StageQuantityModel {
     const auto partsAt = [&](int k, Jet Pi) {
       const int i = k - support.first_k;
       const WindowPath path = windowPath(np, k);
-      const Jet v = bodyTotalJet(bodyTotal(at, k), weights[i].second, with_h ? &path : nullptr);
+      const Vector3 rate = at.attitudes()[k].transpose() * (k * disturbance_);
+      const Jet v =
+          bodyTotalJet(bodyTotal(at, k), weights[i].second, with_h ? &path : nullptr, rate);
       visit(k, Pi, v);
     };
     const auto constantMomentum = [&](int k) {
@@ -199,6 +203,7 @@ class WheelQuantity : public StageQuantityModel {
   Matrix3 inertia_, inverse_inertia_;
   WheelArray array_;
   Vector3 total_;                          ///< π₀, world
+  Vector3 disturbance_;                    ///< τ_d, world: π_k = π₀ + k h τ_d
   Vector3 start_momentum_, end_momentum_;  ///< J Ω(0), J Ω(T)
 };
 
@@ -221,7 +226,7 @@ class WheelMomentumQuantity final : public WheelQuantity {
   }
   /// q_k itself (the plain form, also for the half squared norm).
   Vector3 valueOnPlan(const Maneuver& plan, int k) const override {
-    return planArrayMomentum(scheme_, inertia_, array_, plan, k);
+    return planArrayMomentum(scheme_, inertia_, array_, plan, k, disturbance_);
   }
 
  private:
@@ -275,7 +280,7 @@ class WheelTorqueQuantity final : public WheelQuantity {
     return torqueOf(at.torques()[k], Pi, bodyTotal(at, k) - Pi);
   }
   Vector3 valueOnPlan(const Maneuver& plan, int k) const override {
-    return planArrayTorque(scheme_, inertia_, array_, plan, k);
+    return planArrayTorque(scheme_, inertia_, array_, plan, k, disturbance_);
   }
 
  private:

@@ -146,6 +146,7 @@
 #include "attitude_planner/analysis/constraint_health.hpp"
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/analysis/wheel_flight.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
@@ -320,6 +321,10 @@ class TrackerNode {
     std::shared_ptr<ConstraintHealth> health;
     int replan_period_steps = 1;           ///< plan steps between re-plans (replanPeriodSteps)
     std::optional<EndCondition> pointing;  ///< Replay::pointing
+    /// The maneuver's reaction wheels (empty: none) and, with them, the flight of the body and
+    /// the wheels from the plan's wheel torques (what `actual` shows; null without wheels).
+    ReactionWheels wheels;
+    std::shared_ptr<const WheelFlight> wheel_flight;
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -385,6 +390,19 @@ class TrackerNode {
   void publishState(const Playback& playback, const ManeuverSample& body,
                     const ManeuverSample& plan, double t, const ros::Time& stamp,
                     std::deque<Vector3>* trail);
+  /// A maneuver with reaction wheels: refuses, naming the setting, what is not flown with wheels
+  /// (~mode other than replay, ~plant external, effects during the run) and checks the array
+  /// (validateReactionWheels, field maneuver.reaction_wheels).
+  void requireWheelFlight(const ReactionWheels& wheels,
+                          const std::vector<EffectSpec>& effects) const;
+  /// replay mode with wheels: flies the plan's wheel torques (the message's wheel_torque, or the
+  /// plan's own wheelStates when it carries none) through body + wheels from `start`; fills
+  /// playback->actual, wheel_flight and the result (errors, effort, the wheels' peaks and margins).
+  void flyWheels(const AttitudeManeuver& msg, const Maneuver& plan, const Matrix3& inertia,
+                 SchemeKind scheme, const RigidBodyState& start, Playback* playback) const;
+  /// With wheels: `wheel_states` (JointState: effort u_i(t)), `wheel_momentum` (h_w(t)) and the
+  /// momentum bars at maneuver time t, stamped `stamp`.
+  void publishWheels(const Playback& playback, double t, const ros::Time& stamp);
   /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
   /// (e_Ω), stamped `stamp`.
   void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,
@@ -446,6 +464,9 @@ class TrackerNode {
   ros::Publisher rate_error_vector_pub_;  ///< `angular_velocity_error_vector` e_Ω [rad/s], body
   ros::Subscriber odometry_sub_;          ///< `odometry` (~plant external)
   ros::Publisher diagnostics_pub_;        ///< /diagnostics
+  ros::Publisher wheel_state_pub_;        ///< `wheel_states` sensor_msgs/JointState (with wheels)
+  ros::Publisher wheel_momentum_pub_;     ///< `wheel_momentum` h_w(t) [N m s] (with wheels)
+  ros::Publisher wheel_marker_pub_;       ///< `wheel_momentum_markers` bars (with wheels)
   ros::WallTimer diagnostics_timer_;      ///< every kDiagnosticsPeriod
   std::mutex health_mutex_;               ///< guards health_ (stream vs timer)
   TrackerHealth health_;                  ///< the newest sample's figures, for /diagnostics

@@ -54,8 +54,9 @@ visualization_msgs::MarkerArray worldDirectionMarkers(
     double length, const std::string& world_frame);
 
 /// Where the wheel-momentum bars stand, in units of `path_radius` (world frame): beside the body
-/// in the shipped view, clear of the legend (x 0.4, y −0.7) and the traced path (radius 1).
-inline constexpr double kWheelBarsX = 0.4, kWheelBarsY = 1.15, kWheelBarsZ = -0.5;
+/// in the shipped view, behind it (x −1.3), clear of the legend (x 0.4, y −0.7) and the traced
+/// path (radius 1).
+inline constexpr double kWheelBarsX = -1.3, kWheelBarsY = 0.2, kWheelBarsZ = -0.4;
 inline constexpr double kWheelBarWidth = 0.1;         ///< bar edge
 inline constexpr double kWheelBarHeight = 0.8;        ///< a bar at its limit H_i
 inline constexpr double kWheelBarMostFraction = 1.5;  ///< taller bars (past 1.5 H_i) are cut

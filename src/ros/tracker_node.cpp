@@ -1103,6 +1103,11 @@ void TrackerNode::runReplay(Replay replay) {
   }
   ReplayResult result = pb.result;
   reportConstraintHealth(*pb.health, &result);
+  if (pb.wheel_flight) {  // the wheels' limits as one more constraint of the flown path
+    result.constraint_names.push_back("reaction_wheels");
+    result.constraint_violations.push_back(
+        std::max(0.0, pb.wheel_flight->peaks.worstExcess(pb.wheels)));
+  }
   if (pb.pointing) {
     result.pointing_error =
         pointingError(rc::attitudeFromMsg(result.final_attitude, "final_attitude"), *pb.pointing);

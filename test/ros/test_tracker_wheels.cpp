@@ -86,6 +86,14 @@ TEST(TrackerWheels, TheWheelTorquesFlyTheSceneWithinTheLimitsAndDoneReportsThePe
     closest = std::min(closest, std::abs(w.momentum_margin));
   }
   EXPECT_LT(closest, 1e-3) << "the momentum limit binds on the flown path too";
+  // The constraint health lists the wheels last, with the worst excess over every wheel limit.
+  ASSERT_FALSE(done->constraint_names.empty());
+  EXPECT_EQ(done->constraint_names.back(), "reaction_wheels");
+  ASSERT_EQ(done->constraint_violations.size(), done->constraint_names.size());
+  double worst = 0.0;
+  for (const WheelPeak& w : done->reaction_wheels.wheels)
+    worst = std::max({worst, -w.momentum_margin, -w.torque_margin});
+  EXPECT_EQ(done->constraint_violations.back(), worst);
   std::lock_guard<std::mutex> lock(seen.mutex);
   // 20 s / rate_factor 2 at 20 Hz: 200 samples (each topic's first ones may precede this
   // subscriber's connection on a loaded machine).

@@ -17,6 +17,9 @@
 // are streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
 // (ManeuverInterpolation); `done` reports the terminal attitude and rate errors against the plan.
 //
+// A maneuver with reaction wheels (its `reaction_wheels`, ~mode replay, internal plant) is flown
+// with its wheel torques through body + wheels (analysis/wheel_flight.hpp: flyWithWheels); other
+// modes, the external plant and effects during the run are refused by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -60,6 +63,11 @@
 //             constraint_markers visualization_msgs/MarkerArray, latched, when the maneuver (or
 //                                ~scene) has keep_out / keep_in constraints: each cone (world) and
 //                                its body axis (body, frame-locked)
+//             wheel_states       sensor_msgs/JointState, body   a maneuver with reaction wheels
+//                                (replay mode): names wheel_1.., effort = wheel torque [N·m]
+//             wheel_momentum     std_msgs/Float64MultiArray   the wheel momenta [N·m·s]
+//             wheel_momentum_markers visualization_msgs/MarkerArray, world   a bar per wheel
+//                                against its limit (markers.hpp: wheelMomentumMarkers)
 //             done               attitude_planner/ReplayResult, latched when a run ends
 //             /diagnostics       diagnostic_msgs/DiagnosticArray, every second (wall): the status
 //                                `<node>: tracker` (ros/diagnostics.hpp)

@@ -116,3 +116,10 @@ target_compile_definitions(test_node_parameters PRIVATE AP_TOOL_DIR="${AP_TOOL_D
 add_dependencies(test_node_parameters attitude_planner_node attitude_tracker_node
                  attitude_plant_node)
 list(APPEND AP_EXPECTED_TESTS test_node_parameters)
+
+# The tracker flying a reaction-wheel scene (planned through the service) with its wheel torques
+# through body + wheels; a feedback-mode tracker refusing it by name.
+add_rostest_gtest(test_tracker_wheels test/ros/tracker_wheels.test test/ros/test_tracker_wheels.cpp)
+target_link_libraries(test_tracker_wheels ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_wheels attitude_planner_node attitude_tracker_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_wheels)

@@ -29,6 +29,7 @@ DEBIAN_PACKAGES=(
   python3-visualization-msgs python3-rostopic python3-rosservice
   libnav-msgs-dev ros-nav-msgs python3-nav-msgs libtf2-msgs-dev
   libdiagnostic-msgs-dev ros-diagnostic-msgs python3-diagnostic-msgs
+  libsensor-msgs-dev ros-sensor-msgs python3-sensor-msgs
   pybind11-dev python3-pybind11 python3-dev python3-setuptools
   python3-distributed python3-dask python3-tqdm
 )

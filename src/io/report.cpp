@@ -7,6 +7,7 @@
 #include <memory>
 #include <sstream>
 
+#include "attitude_planner/analysis/wheel_peaks.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
 
@@ -151,23 +152,16 @@ std::string attemptJson(const Attempt& a) {
 /// Torque peaks over the nodes the plan carries torques at (1..N−1; 0..N with end torques).
 std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
   const ReactionWheels& wheels = problem.reaction_wheels;
-  const WheelStates states =
-      wheelStates(problem.scheme, problem.inertia, wheels, r.maneuver, problem.worldDisturbance());
-  const WheelArray array = wheelArray(wheels);
-  const int N = r.maneuver.steps();
-  const bool ends = schemeHasEndTorques(problem.scheme);
+  const WheelPeaks peaks = planWheelPeaks(
+      wheels,
+      wheelStates(problem.scheme, problem.inertia, wheels, r.maneuver, problem.worldDisturbance()),
+      schemeHasEndTorques(problem.scheme));
+  const double peak_norm = peaks.peak_momentum_norm;
   std::ostringstream out;
-  double peak_norm = 0.0;
-  for (int k = 0; k <= N; ++k)
-    peak_norm = std::max(peak_norm, (array.axes * states.momentum[k]).norm());
   out << "{\"wheels\": [";
   for (int i = 0; i < wheels.count(); ++i) {
-    double peak_h = 0.0, peak_u = 0.0;
-    for (int k = 0; k <= N; ++k) {
-      peak_h = std::max(peak_h, std::abs(states.momentum[k](i)));
-      if (ends || (k > 0 && k < N)) peak_u = std::max(peak_u, std::abs(states.torque[k](i)));
-    }
-    out << (i ? ", " : "") << "{\"name\": " << jsonString("wheel_" + std::to_string(i + 1))
+    const double peak_h = peaks.peak_momentum(i), peak_u = peaks.peak_torque(i);
+    out << (i ? ", " : "") << "{\"name\": " << jsonString(wheelName(i))
         << ", \"peak_momentum\": " << jsonNumber(peak_h)
         << ", \"max_momentum\": " << jsonNumber(wheels.momentumLimit(i))
         << ", \"momentum_margin\": " << jsonNumber(wheels.momentumLimit(i) - peak_h)

@@ -245,7 +245,7 @@ boost::array<double, 9> inertiaToMsg(const Matrix3& J) {
 
 AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& problem,
                                const std::string& world_frame, const std::string& body_frame,
-                               const ros::Time& stamp) {
+                               const ros::Time& stamp, const WheelStates* wheel_states) {
   AttitudeManeuver m;
   m.header.stamp = stamp;
   m.header.frame_id = world_frame;
@@ -259,7 +259,89 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
   for (const Vector3& t : maneuver.torque) m.torque.push_back(vectorToMsg(t));
   for (const PlanningConstraint& c : problem.constraints)
     m.constraints.push_back(constraintToMsg(c));
+  m.reaction_wheels = reactionWheelsToMsg(problem.reaction_wheels);
+  if (wheel_states) {
+    for (const Eigen::VectorXd& u : wheel_states->torque)
+      m.wheel_torque.insert(m.wheel_torque.end(), u.data(), u.data() + u.size());
+    for (const Eigen::VectorXd& h : wheel_states->momentum)
+      m.wheel_momentum.insert(m.wheel_momentum.end(), h.data(), h.data() + h.size());
+  }
   return m;
+}
+
+ReactionWheels reactionWheelsFromMsg(const ReactionWheelArray& msg, const std::string& field) {
+  ReactionWheels out;
+  if (msg.spin_axes.empty()) {
+    if (!msg.max_torque.empty() || !msg.max_momentum.empty() || !msg.initial_momentum.empty() ||
+        msg.max_momentum_norm != 0.0) {
+      throw InvalidInput(field +
+                         ".spin_axes: empty (no wheels) while the array's other fields "
+                         "are set: give the spin axes, or leave every field empty / 0");
+    }
+    return out;
+  }
+  for (std::size_t i = 0; i < msg.spin_axes.size(); ++i) {
+    out.spin_axes.push_back(
+        finiteVectorFromMsg(msg.spin_axes[i], field + ".spin_axes[" + std::to_string(i) + "]"));
+  }
+  out.max_torque = msg.max_torque;
+  out.max_momentum = msg.max_momentum;
+  out.initial_momentum = msg.initial_momentum;
+  // 0 means no envelope; any other value (negative, NaN) is the core's to refuse by name.
+  if (msg.max_momentum_norm != 0.0) out.max_momentum_norm = msg.max_momentum_norm;
+  return out;
+}
+
+ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels) {
+  ReactionWheelArray m;
+  for (const Vector3& a : wheels.spin_axes) m.spin_axes.push_back(vectorToMsg(a));
+  m.max_torque = wheels.max_torque;
+  m.max_momentum = wheels.max_momentum;
+  m.initial_momentum = wheels.initial_momentum;
+  m.max_momentum_norm = std::isfinite(wheels.max_momentum_norm) ? wheels.max_momentum_norm : 0.0;
+  return m;
+}
+
+ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const WheelPeaks& peaks) {
+  ReactionWheelsSummary m;
+  for (int i = 0; i < wheels.count(); ++i) {
+    WheelPeak w;
+    w.name = wheelName(i);
+    w.peak_momentum = peaks.peak_momentum(i);
+    w.max_momentum = wheels.momentumLimit(i);
+    w.momentum_margin = w.max_momentum - w.peak_momentum;
+    w.peak_torque = peaks.peak_torque(i);
+    w.max_torque = wheels.torqueLimit(i);
+    w.torque_margin = w.max_torque - w.peak_torque;
+    m.wheels.push_back(w);
+  }
+  m.peak_momentum_norm = peaks.peak_momentum_norm;
+  m.has_momentum_norm_limit = std::isfinite(wheels.max_momentum_norm);
+  if (m.has_momentum_norm_limit) {
+    m.max_momentum_norm = wheels.max_momentum_norm;
+    m.momentum_norm_margin = wheels.max_momentum_norm - peaks.peak_momentum_norm;
+  }
+  return m;
+}
+
+std::vector<Eigen::VectorXd> wheelRowsFromMsg(const std::vector<double>& values, int rows,
+                                              int wheels, const std::string& field) {
+  if (static_cast<long>(values.size()) != static_cast<long>(rows) * wheels) {
+    throw InvalidInput(field + ": needs (N + 1) * n = " + std::to_string(rows) + " * " +
+                       std::to_string(wheels) + " values, got " + std::to_string(values.size()));
+  }
+  std::vector<Eigen::VectorXd> out(rows, Eigen::VectorXd(wheels));
+  for (int k = 0; k < rows; ++k) {
+    for (int i = 0; i < wheels; ++i) {
+      const double v = values[static_cast<std::size_t>(k) * wheels + i];
+      if (!std::isfinite(v)) {
+        throw InvalidInput(field + "[" + std::to_string(k * wheels + i) +
+                           "]: must be finite, got " + exactNumber(v));
+      }
+      out[k](i) = v;
+    }
+  }
+  return out;
 }
 
 Maneuver maneuverFromMsg(const AttitudeManeuver& msg) {
@@ -431,6 +513,10 @@ const std::map<std::string, std::string> kRenamedFields = {
     {"final.angular_velocity", "final_angular_velocity"},
 };
 
+/// The scene's (and the core's) path of the wheel array and the length of its `actuators.` part.
+const std::string kSceneWheelsField = "actuators.reaction_wheels";
+constexpr std::size_t kSceneWheelsPrefix = sizeof("actuators.") - 1;
+
 bool startsWith(const std::string& s, const std::string& prefix) {
   return s.compare(0, prefix.size(), prefix) == 0;
 }
@@ -464,6 +550,8 @@ std::string effectRequestField(const std::string& item, const std::string& key) 
 std::string requestFieldName(const std::string& core_field) {
   const auto renamed = kRenamedFields.find(core_field);
   if (renamed != kRenamedFields.end()) return renamed->second;
+  // The scene nests the array under `actuators`; the request has it at the top level.
+  if (startsWith(core_field, kSceneWheelsField)) return core_field.substr(kSceneWheelsPrefix);
   // Paths of list items: `<list>[i].<kind>[.<key>]` (the scene nests a constraint's or effect's
   // values under its kind; the message has flat fields and a `type`).
   const std::size_t first = core_field.find('.');
@@ -501,20 +589,38 @@ OutputSelection outputSelectionFromRequest(const std::string& return_maneuver, i
   return out;
 }
 
+std::vector<int> decimatedRows(int steps, int max_nodes) {
+  std::vector<int> rows;
+  const int stride = max_nodes <= 0 || max_nodes >= steps + 1
+                         ? 1
+                         : (steps + max_nodes - 2) / (max_nodes - 1);  // ceil(N / (max_nodes − 1))
+  for (int k = 0; k < steps; k += stride) rows.push_back(k);
+  rows.push_back(steps);
+  return rows;
+}
+
 Maneuver decimatedManeuver(const Maneuver& m, int max_nodes) {
   const int N = m.steps();
   if (max_nodes <= 0 || max_nodes >= N + 1) return m;
-  const int stride = (N + max_nodes - 2) / (max_nodes - 1);  // ceil(N / (max_nodes − 1))
   Maneuver out;
   out.time_step = m.time_step;
-  const auto keep = [&](int k) {
+  for (int k : decimatedRows(N, max_nodes)) {
     out.time.push_back(m.time[k]);
     out.attitude.push_back(m.attitude[k]);
     out.angular_velocity.push_back(m.angular_velocity[k]);
     out.torque.push_back(m.torque[k]);
-  };
-  for (int k = 0; k < N; k += stride) keep(k);
-  keep(N);
+  }
+  return out;
+}
+
+WheelStates decimatedWheelStates(const WheelStates& states, int max_nodes) {
+  const int N = static_cast<int>(states.momentum.size()) - 1;
+  if (max_nodes <= 0 || max_nodes >= N + 1) return states;
+  WheelStates out;
+  for (int k : decimatedRows(N, max_nodes)) {
+    out.momentum.push_back(states.momentum[k]);
+    out.torque.push_back(states.torque[k]);
+  }
   return out;
 }
 

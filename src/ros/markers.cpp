@@ -1,5 +1,7 @@
 #include "attitude_planner/ros/markers.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "attitude_planner/ros/conversions.hpp"
@@ -63,6 +65,16 @@ const std::vector<MarkerMeaning>& markerMeanings() {
        1.0f,
        {"pointing_boresight", "pointing_target"}},
       {"status (t / T, angle to go, |tau|, pointing error)", 0.75f, 0.95f, 0.75f, {"status_text"}},
+      {"wheel momentum |h_i| / H_i (bars: wheel_1, wheel_2, ... left to right)",
+       0.8f,
+       0.55f,
+       0.3f,
+       {"wheel_momentum"}},
+      {"wheel momentum limit H_i (slab over each bar)",
+       1.0f,
+       0.35f,
+       0.45f,
+       {"wheel_momentum_limit"}},
       // Not a marker: rviz's WrenchStamped display of `torque` (rviz/maneuver.rviz's Torque Color).
       {"delivered torque (body)", 240.0f / 255, 240.0f / 255, 240.0f / 255, {"torque_display"}},
   };
@@ -152,6 +164,42 @@ visualization_msgs::MarkerArray worldDirectionMarkers(
     array.markers.push_back(worldArrow(
         world_frame, ros::Time(), "pointing_target", 0,
         kBeyondTheCone * length * pointing->world_direction.normalized(), 0.6 * length, 0.6f));
+  }
+  return array;
+}
+
+visualization_msgs::MarkerArray wheelMomentumMarkers(const ReactionWheels& wheels,
+                                                     const Eigen::VectorXd& momentum,
+                                                     double path_radius,
+                                                     const std::string& world_frame,
+                                                     const ros::Time& stamp) {
+  visualization_msgs::MarkerArray array;
+  const double width = kWheelBarWidth * path_radius, full = kWheelBarHeight * path_radius;
+  for (int i = 0; i < wheels.count(); ++i) {
+    const double fraction =
+        std::min(std::abs(momentum(i)) / wheels.momentumLimit(i), kWheelBarMostFraction);
+    const Vector3 base(kWheelBarsX * path_radius,
+                       (kWheelBarsY + 1.5 * kWheelBarWidth * i) * path_radius,
+                       kWheelBarsZ * path_radius);
+    for (const bool limit : {false, true}) {
+      visualization_msgs::Marker bar;
+      bar.header.frame_id = world_frame;
+      bar.header.stamp = stamp;
+      bar.ns = limit ? "wheel_momentum_limit" : "wheel_momentum";
+      bar.id = i;
+      bar.type = visualization_msgs::Marker::CUBE;
+      bar.action = visualization_msgs::Marker::ADD;
+      bar.pose.orientation.w = 1.0;
+      const double height = limit ? 0.04 * full : std::max(fraction * full, 1e-3 * full);
+      const double centre = limit ? full : 0.5 * height;
+      bar.pose.position =
+          ros_conversions::xyzToMsg<geometry_msgs::Point>(base + Vector3(0.0, 0.0, centre));
+      bar.scale.x = width;
+      bar.scale.y = width;
+      bar.scale.z = height;
+      bar.color = meaningColour(bar.ns, limit ? 0.9f : 1.0f);
+      array.markers.push_back(bar);
+    }
   }
   return array;
 }

@@ -17,7 +17,9 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Vector3Stamped.h>
 #include <geometry_msgs/WrenchStamped.h>
+#include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
@@ -231,6 +233,7 @@ PlanAttitudeManeuver::Request planRequestOf(const PlanningProblem& problem,
   }
   for (const PlanningConstraint& c : problem.constraints)
     request.constraints.push_back(rc::constraintToMsg(c));
+  request.reaction_wheels = rc::reactionWheelsToMsg(problem.reaction_wheels);
   return request;
 }
 
@@ -311,7 +314,13 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
     *error = "planner: " + result.message;
     return false;
   }
-  *msg = rc::maneuverToMsg(result.maneuver, problem, world_frame, body_frame, ros::Time::now());
+  const bool wheels = problem.reaction_wheels.present();
+  const WheelStates states =
+      wheels ? wheelStates(problem.scheme, problem.inertia, problem.reaction_wheels,
+                           result.maneuver, problem.worldDisturbance())
+             : WheelStates();
+  *msg = rc::maneuverToMsg(result.maneuver, problem, world_frame, body_frame, ros::Time::now(),
+                           wheels ? &states : nullptr);
   *solve_time = result.solve_time_s;
   *cost = result.cost;
   return true;
@@ -457,6 +466,9 @@ void TrackerNode::advertiseTopics() {
   error_vector_pub_ = nh_.advertise<geometry_msgs::Vector3Stamped>("attitude_error_vector", 10);
   rate_error_vector_pub_ =
       nh_.advertise<geometry_msgs::Vector3Stamped>("angular_velocity_error_vector", 10);
+  wheel_state_pub_ = nh_.advertise<sensor_msgs::JointState>("wheel_states", 10);
+  wheel_momentum_pub_ = nh_.advertise<std_msgs::Float64MultiArray>("wheel_momentum", 10);
+  wheel_marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("wheel_momentum_markers", 10);
   if (plant_ == PlantKind::External) {
     command_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("torque_command", 10);
     // Only the newest state matters: a queue of one never feeds the law an old measurement.
@@ -735,6 +747,8 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
                      std::to_string(run.substeps) + " control samples per step)";
     pb->actual = std::make_unique<ManeuverInterpolation>(run.actual, scheme, inertia, nullptr,
                                                          TorqueHold::StepStart);
+  } else if (pb->wheels.present()) {
+    flyWheels(replay.msg, plan, inertia, scheme, start, pb);
   } else {
     // Exactly the effects of the run's scene: forcing on the body, then what the actuators do.
     Actuation actuation = actuationOf(replay.effects);
@@ -785,6 +799,8 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   }
   validateConstraints(pb.constraints, "maneuver.constraints");
   validateProblem(problem);
+  pb.wheels = rc::reactionWheelsFromMsg(msg.reaction_wheels, "maneuver.reaction_wheels");
+  if (pb.wheels.present()) requireWheelFlight(pb.wheels, replay.effects);
   if (pb.constraints.empty()) pb.constraints = replay.scene_constraints;
   // What a re-plan solves: the scene's problem, or the message's own; either way under the
   // effects of the run (the body's environment), so a re-plan also corrects a model mismatch.
@@ -874,6 +890,81 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
   pb.health->observe(body.attitude, body.angular_velocity, body.torque);
   publishState(pb, body, plan, t, stamp, trail);
+  if (pb.wheel_flight) publishWheels(pb, t, stamp);
+}
+
+void TrackerNode::requireWheelFlight(const ReactionWheels& wheels,
+                                     const std::vector<EffectSpec>& effects) const {
+  const std::string field = "maneuver.reaction_wheels";
+  validateReactionWheels(wheels, field);
+  if (mode_ != TrackingMode::Replay) {
+    throw InvalidInput(field +
+                       ": a maneuver with reaction wheels is flown in ~mode replay only "
+                       "(its wheel torques through body + wheels), got ~mode " +
+                       trackingModeName(mode_));
+  }
+  if (plant_ != PlantKind::Internal) {
+    throw InvalidInput(field +
+                       ": a maneuver with reaction wheels is flown with ~plant internal "
+                       "only (no wheel command or measured wheel state yet), got ~plant external");
+  }
+  if (!effects.empty()) {
+    throw InvalidInput(field + ": effects during the run (" + effectName(effects.front()) +
+                       ") on a body with wheels are not modelled (docs/reaction_wheels.md)");
+  }
+}
+
+void TrackerNode::flyWheels(const AttitudeManeuver& msg, const Maneuver& plan,
+                            const Matrix3& inertia, SchemeKind scheme, const RigidBodyState& start,
+                            Playback* pb) const {
+  const int N = plan.steps();
+  std::vector<Eigen::VectorXd> wheel_torque;
+  if (!msg.wheel_torque.empty()) {
+    wheel_torque =
+        rc::wheelRowsFromMsg(msg.wheel_torque, N + 1, pb->wheels.count(), "maneuver.wheel_torque");
+  }
+  auto flight = std::make_shared<WheelFlight>(
+      flyWithWheels(inertia, scheme, pb->wheels, plan, std::move(wheel_torque), start));
+  ReplayResult& result = pb->result;
+  result.cost = schemeCost(scheme, flight->body.torque);
+  result.effort = openLoopEffort(scheme, flight->body);
+  for (int k = 0; k <= N; ++k) {
+    result.max_attitude_deviation =
+        std::max(result.max_attitude_deviation,
+                 so3::angleBetween(plan.attitude[k], flight->body.attitude[k]));
+  }
+  result.message = "flew " + std::to_string(N) + " steps with " +
+                   std::to_string(pb->wheels.count()) +
+                   " reaction wheels (body + wheels from the wheel torques)";
+  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, flight->peaks);
+  std::string which;
+  const double excess = flight->peaks.worstExcess(pb->wheels, &which);
+  if (excess > 0.0)
+    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
+  pb->actual = std::make_unique<ManeuverInterpolation>(flight->body, scheme, inertia, nullptr);
+  pb->wheel_flight = std::move(flight);
+}
+
+void TrackerNode::publishWheels(const Playback& pb, double t, const ros::Time& stamp) {
+  const Eigen::VectorXd torque = pb.wheel_flight->torqueAt(t);
+  const Eigen::VectorXd momentum = pb.wheel_flight->momentumAt(t);
+  sensor_msgs::JointState joints;
+  joints.header.stamp = stamp;
+  joints.header.frame_id = pb.body_frame;
+  std_msgs::Float64MultiArray momenta;
+  momenta.layout.dim.resize(1);
+  momenta.layout.dim[0].label = "wheel";
+  momenta.layout.dim[0].size = pb.wheels.count();
+  momenta.layout.dim[0].stride = pb.wheels.count();
+  for (int i = 0; i < pb.wheels.count(); ++i) {
+    joints.name.push_back(wheelName(i));
+    joints.effort.push_back(torque(i));  // u_i [N m]; no spin inertia: no speed (velocity empty)
+    momenta.data.push_back(momentum(i));
+  }
+  wheel_state_pub_.publish(joints);
+  wheel_momentum_pub_.publish(momenta);
+  wheel_marker_pub_.publish(
+      wheelMomentumMarkers(pb.wheels, momentum, path_radius_, pb.world_frame, stamp));
 }
 
 void TrackerNode::publishStampedErrors(const Playback& pb, const Matrix3& body,
@@ -1013,6 +1104,11 @@ void TrackerNode::runReplay(Replay replay) {
   }
   ReplayResult result = pb.result;
   reportConstraintHealth(*pb.health, &result);
+  if (pb.wheel_flight) {  // the wheels' limits as one more constraint of the flown path
+    result.constraint_names.push_back("reaction_wheels");
+    result.constraint_violations.push_back(
+        std::max(0.0, pb.wheel_flight->peaks.worstExcess(pb.wheels)));
+  }
   if (pb.pointing) {
     result.pointing_error =
         pointingError(rc::attitudeFromMsg(result.final_attitude, "final_attitude"), *pb.pointing);

@@ -126,6 +126,70 @@ void fillConstrainedRequest(Request* r, int steps = 32) {
   r->constraints = {norm, sun};
 }
 
+/// The wheel limits of fillWheelRequest (test/ros/wheel_pyramid.yaml): U [N m], H [N m s].
+inline constexpr double kWheelTorqueLimit = 0.3, kWheelMomentumLimit = 0.9;
+
+/// The momentum-limited slew of test/ros/wheel_pyramid.yaml as a request: J = [[13, −2, 1],
+/// [−2, 16, 0.5], [1, 0.5, 18]], rest to rest through exp((0.4, −0.7, 0.9)^) in 20 s,
+/// second_order, a four-wheel pyramid with U = 0.3 N m, H = 0.9 N m s and the bias h_w(0) =
+/// (0.3, −0.2, 0.5, 0.1) N m s (the momentum limit binds).
+template <class Request>
+void fillWheelRequest(Request* r, int steps = 128) {
+  r->inertia = {13, -2, 1, -2, 16, 0.5, 1, 0.5, 18};
+  r->initial_attitude.w = 1.0;
+  r->final_attitude = ros_conversions::attitudeToMsg(so3::exp(Vector3(0.4, -0.7, 0.9)));
+  r->duration = 20.0;
+  r->steps = steps;
+  r->scheme = "second_order";
+  const double s = std::sqrt(2.0 / 3.0), c = std::sqrt(1.0 / 3.0);
+  for (const Vector3& a :
+       {Vector3(s, 0, c), Vector3(0, s, c), Vector3(-s, 0, c), Vector3(0, -s, c)})
+    r->reaction_wheels.spin_axes.push_back(ros_conversions::vectorToMsg(a));
+  r->reaction_wheels.max_torque = {kWheelTorqueLimit};
+  r->reaction_wheels.max_momentum = {kWheelMomentumLimit};
+  r->reaction_wheels.initial_momentum = {0.3, -0.2, 0.5, 0.1};
+}
+
+/// Checks a wheel answer (fillWheelRequest, every node returned): the wheel rows' shape, the
+/// initial momenta, every wheel within its limits at every row, the momentum limit binding, and
+/// the summary's peaks and margins equal to the ones scanned here from the rows.
+template <class Response>
+void expectWheelAnswer(const Response& res, int steps) {
+  ASSERT_TRUE(res.success) << res.message;
+  EXPECT_NE(std::find(res.constraints.begin(), res.constraints.end(), "reaction_wheels"),
+            res.constraints.end());
+  const AttitudeManeuver& m = res.maneuver;
+  const std::size_t rows = steps + 1, n = 4;
+  ASSERT_EQ(m.reaction_wheels.spin_axes.size(), n);
+  ASSERT_EQ(m.wheel_torque.size(), rows * n);
+  ASSERT_EQ(m.wheel_momentum.size(), rows * n);
+  const double bias[4] = {0.3, -0.2, 0.5, 0.1};
+  for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(m.wheel_momentum[i], bias[i], 1e-12);
+  ASSERT_EQ(res.reaction_wheels.wheels.size(), n);
+  double closest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    double peak_h = 0.0, peak_u = 0.0;
+    for (std::size_t k = 0; k < rows; ++k) {
+      peak_h = std::max(peak_h, std::abs(m.wheel_momentum[k * n + i]));
+      peak_u = std::max(peak_u, std::abs(m.wheel_torque[k * n + i]));  // second_order: every row
+    }
+    const WheelPeak& w = res.reaction_wheels.wheels[i];
+    EXPECT_EQ(w.name, "wheel_" + std::to_string(i + 1));
+    EXPECT_EQ(w.peak_momentum, peak_h) << w.name;
+    EXPECT_EQ(w.peak_torque, peak_u) << w.name;
+    EXPECT_EQ(w.max_momentum, kWheelMomentumLimit);
+    EXPECT_EQ(w.max_torque, kWheelTorqueLimit);
+    EXPECT_EQ(w.momentum_margin, kWheelMomentumLimit - peak_h);
+    EXPECT_EQ(w.torque_margin, kWheelTorqueLimit - peak_u);
+    EXPECT_LE(peak_h, kWheelMomentumLimit * (1 + 1e-9)) << w.name;
+    EXPECT_LE(peak_u, kWheelTorqueLimit * (1 + 1e-9)) << w.name;
+    closest = std::min(closest, w.momentum_margin);
+  }
+  EXPECT_LT(closest, 1e-6) << "the momentum limit binds on some wheel";
+  EXPECT_FALSE(res.reaction_wheels.has_momentum_norm_limit);
+  EXPECT_GT(res.reaction_wheels.peak_momentum_norm, 0.0);
+}
+
 /// The smallest slacks of fillConstrainedRequest's constraints over a returned maneuver's nodes,
 /// computed here from its rows: 0.095 N m − |τ_k| and angle(R_k x, Sun) − 0.5 rad (≥ 0: met).
 struct ConstrainedSlacks {

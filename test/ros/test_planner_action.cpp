@@ -278,6 +278,22 @@ TEST_F(PlannerAction, ConstrainedGoalSucceedsWithItsFiguresAndABadConstraintIsNa
   EXPECT_GE(ros_testing::constrainedRequestSlacks(client_->getResult()->maneuver).cone, -1e-9);
 }
 
+TEST_F(PlannerAction, ReactionWheelGoalSucceedsWithTheWheelStatesAndPeaks) {
+  PlanAttitudeManeuverGoal goal;
+  ros_testing::fillWheelRequest(&goal, 128);
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::SUCCEEDED);
+  ros_testing::expectWheelAnswer(*client_->getResult(), 128);
+  goal.reaction_wheels.max_torque = {0.0};
+  client_->sendGoal(goal);
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(client_->getState(), State::ABORTED);
+  EXPECT_EQ(client_->getResult()->error_code.val, PlanErrorCode::INVALID_INPUT);
+  EXPECT_NE(client_->getResult()->message.find("reaction_wheels.max_torque"), std::string::npos)
+      << client_->getResult()->message;
+}
+
 TEST_F(PlannerAction, MinimumTimeGoalSucceedsWithTStar) {
   // A sphere J = 10 I, 1 rad about x, |τ|₂ ≤ 1 N m, no duration: T* = 2√10 s (eigenaxis
   // bang–bang), the plan at (1 + 0.2) T*.

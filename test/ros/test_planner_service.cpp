@@ -401,6 +401,83 @@ TEST_F(PlannerService, KeepOutAndTorqueNormBindAreEchoedAndMetAtEveryNode) {
   EXPECT_GT(res.cost, free.cost);
 }
 
+TEST_F(PlannerService, ReactionWheelsArePlannedWithTheirStatesAndPeaksPerWheel) {
+  // The biased pyramid slew with a binding momentum limit: the answer carries each row's wheel
+  // torques and momenta and the per-wheel peaks and margins (checked from the rows).
+  PlanAttitudeManeuver::Request req;
+  ros_testing::fillWheelRequest(&req, 128);
+  const PlanAttitudeManeuver::Response res = call(req);
+  ros_testing::expectWheelAnswer(res, 128);
+  EXPECT_LE(res.max_constraint_violation, 1e-9);
+  // The same request decimated to 9 rows: the wheel rows of the kept nodes k = 0, 16, ..., 128.
+  req.output_steps = 9;
+  const PlanAttitudeManeuver::Response few = call(req);
+  ASSERT_TRUE(few.success) << few.message;
+  ASSERT_EQ(few.maneuver.wheel_momentum.size(), 9u * 4u);
+  ASSERT_EQ(few.maneuver.wheel_torque.size(), 9u * 4u);
+  for (std::size_t j = 0; j < 9; ++j) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      EXPECT_NEAR(few.maneuver.wheel_momentum[j * 4 + i],
+                  res.maneuver.wheel_momentum[16 * j * 4 + i], 1e-9)
+          << "row " << j;
+      EXPECT_NEAR(few.maneuver.wheel_torque[j * 4 + i], res.maneuver.wheel_torque[16 * j * 4 + i],
+                  1e-9)
+          << "row " << j;
+    }
+  }
+  // Without wheels: no wheel rows, no summary.
+  const PlanAttitudeManeuver::Response plain = call(seed(16));
+  ASSERT_TRUE(plain.success) << plain.message;
+  EXPECT_TRUE(plain.maneuver.wheel_torque.empty());
+  EXPECT_TRUE(plain.maneuver.reaction_wheels.spin_axes.empty());
+  EXPECT_TRUE(plain.reaction_wheels.wheels.empty());
+}
+
+TEST_F(PlannerService, BadReactionWheelsAreNamedByTheRequestsField) {
+  const auto refusal = [](const std::function<void(PlanAttitudeManeuver::Request*)>& spoil) {
+    PlanAttitudeManeuver::Request req;
+    ros_testing::fillWheelRequest(&req, 32);
+    spoil(&req);
+    const PlanAttitudeManeuver::Response res = call(req);
+    EXPECT_EQ(res.error_code.val, PlanErrorCode::INVALID_INPUT) << res.message;
+    return res.message;
+  };
+  const auto has = [](const std::string& message, const std::string& part) {
+    return message.find(part) != std::string::npos;
+  };
+  std::string m = refusal([](auto* r) { r->reaction_wheels.spin_axes.resize(2); });
+  EXPECT_TRUE(has(m, "reaction_wheels.spin_axes: need at least 3 wheels")) << m;
+  EXPECT_FALSE(has(m, "actuators.")) << "the request's own spelling: " << m;
+  m = refusal([](auto* r) {
+    r->reaction_wheels.spin_axes[3] = r->reaction_wheels.spin_axes[1];
+    r->reaction_wheels.spin_axes[2] = r->reaction_wheels.spin_axes[0];
+  });
+  EXPECT_TRUE(has(m, "reaction_wheels.spin_axes: the axes do not span R^3")) << m;
+  m = refusal([](auto* r) { r->reaction_wheels.max_momentum = {-1.0}; });
+  EXPECT_TRUE(has(m, "reaction_wheels.max_momentum")) << m;
+  EXPECT_TRUE(has(m, "-1")) << m;
+  m = refusal([](auto* r) { r->reaction_wheels.max_torque = {0.3, 0.3}; });
+  EXPECT_TRUE(has(m, "reaction_wheels.max_torque")) << m;
+  m = refusal([](auto* r) { r->reaction_wheels.initial_momentum = {0.3, -0.2, 1.5, 0.1}; });
+  EXPECT_TRUE(has(m, "reaction_wheels.initial_momentum")) << m;
+  m = refusal([](auto* r) { r->reaction_wheels.max_momentum_norm = -2.0; });
+  EXPECT_TRUE(has(m, "reaction_wheels.max_momentum_norm")) << m;
+  m = refusal([](auto* r) { r->reaction_wheels.spin_axes[1].y = std::nan(""); });
+  EXPECT_TRUE(has(m, "reaction_wheels.spin_axes[1]")) << m;
+  m = refusal([](auto* r) {
+    r->reaction_wheels.spin_axes.clear();  // no wheels, yet limits given
+  });
+  EXPECT_TRUE(has(m, "reaction_wheels.spin_axes: empty")) << m;
+  m = refusal([](auto* r) {
+    Effect limits;
+    limits.type = Effect::ACTUATOR_LIMITS;
+    limits.value.x = limits.value.y = limits.value.z = 1.0;
+    r->effects.push_back(limits);
+  });
+  EXPECT_TRUE(has(m, "actuator_limits")) << m;
+  EXPECT_TRUE(call(seed(16)).success) << "the node keeps serving";
+}
+
 TEST_F(PlannerService, BadConstraintValuesAreNamedAndTheNodeKeepsServing) {
   struct Case {
     const char* what;

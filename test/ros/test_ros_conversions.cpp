@@ -662,11 +662,113 @@ EndCondition pointingAt() {
   return end;
 }
 
+/// Three orthogonal wheels, H = (1, 2, 1) N m s, U = (0.2, 0.3, 0.4) N m, a small bias.
+ReactionWheels threeWheels() {
+  ReactionWheels w;
+  w.spin_axes = {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()};
+  w.max_torque = {0.2, 0.3, 0.4};
+  w.max_momentum = {1.0, 2.0, 1.0};
+  w.initial_momentum = {0.1, -0.2, 0.0};
+  return w;
+}
+
 Vector3 tipOf(const visualization_msgs::Marker& arrow) {
   return Vector3(arrow.points[1].x, arrow.points[1].y, arrow.points[1].z);
 }
 
 }  // namespace
+
+TEST(WheelMarkers, BarsStandInProportionToTheMomentumWithTheLimitSlabAtFullHeight) {
+  const ReactionWheels wheels = threeWheels();  // H = 1, 2, 1 N m s
+  const visualization_msgs::MarkerArray bars =
+      wheelMomentumMarkers(wheels, Eigen::Vector3d(0.5, -1.0, 2.0), 1.0, "world", ros::Time(2.0));
+  ASSERT_EQ(bars.markers.size(), 6u);
+  const double full = kWheelBarHeight;
+  const double expected[3] = {0.5 * full, 0.5 * full, kWheelBarMostFraction * full};  // 2 > 1.5 H
+  double previous_y = -1e9;
+  for (int i = 0; i < 3; ++i) {
+    const visualization_msgs::Marker& bar = bars.markers[2 * i];
+    const visualization_msgs::Marker& slab = bars.markers[2 * i + 1];
+    EXPECT_EQ(bar.ns, "wheel_momentum");
+    EXPECT_EQ(slab.ns, "wheel_momentum_limit");
+    EXPECT_EQ(bar.id, i);
+    EXPECT_NEAR(bar.scale.z, expected[i], 1e-12) << "wheel " << i;
+    EXPECT_NEAR(bar.pose.position.z - kWheelBarsZ, 0.5 * bar.scale.z, 1e-12);  // on the base
+    EXPECT_NEAR(slab.pose.position.z - kWheelBarsZ, full, 1e-12);              // at the limit
+    EXPECT_GT(bar.pose.position.y, previous_y);  // left to right in wheel order
+    previous_y = bar.pose.position.y;
+  }
+}
+
+TEST(ReactionWheelMessages, RoundTripAndEncodingErrorsAreNamed) {
+  const ReactionWheels wheels = threeWheels();
+  const ReactionWheelArray msg = rc::reactionWheelsToMsg(wheels);
+  EXPECT_EQ(msg.max_momentum_norm, 0.0) << "no envelope: 0";
+  const ReactionWheels back = rc::reactionWheelsFromMsg(msg, "reaction_wheels");
+  ASSERT_EQ(back.count(), 3);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(back.spin_axes[i], wheels.spin_axes[i]);
+  EXPECT_EQ(back.max_torque, wheels.max_torque);
+  EXPECT_EQ(back.max_momentum, wheels.max_momentum);
+  EXPECT_EQ(back.initial_momentum, wheels.initial_momentum);
+  EXPECT_TRUE(std::isinf(back.max_momentum_norm));
+  ReactionWheels enveloped = wheels;
+  enveloped.max_momentum_norm = 2.5;
+  EXPECT_EQ(rc::reactionWheelsFromMsg(rc::reactionWheelsToMsg(enveloped), "w").max_momentum_norm,
+            2.5);
+  EXPECT_FALSE(rc::reactionWheelsFromMsg(ReactionWheelArray(), "reaction_wheels").present());
+  const auto refusal = [](const ReactionWheelArray& m) {
+    try {
+      rc::reactionWheelsFromMsg(m, "reaction_wheels");
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  ReactionWheelArray limits_only;
+  limits_only.max_torque = {0.1};
+  EXPECT_NE(refusal(limits_only).find("reaction_wheels.spin_axes: empty"), std::string::npos)
+      << refusal(limits_only);
+  ReactionWheelArray nan_axis = msg;
+  nan_axis.spin_axes[2].z = std::nan("");
+  EXPECT_NE(refusal(nan_axis).find("reaction_wheels.spin_axes[2]"), std::string::npos)
+      << refusal(nan_axis);
+  // The core names the scene's path; the request says reaction_wheels.
+  EXPECT_EQ(rc::requestFieldName("actuators.reaction_wheels.max_momentum"),
+            "reaction_wheels.max_momentum");
+  EXPECT_EQ(rc::requestFieldName("actuators.reaction_wheels"), "reaction_wheels");
+  // Wheel rows: (N + 1) * n values, finite.
+  EXPECT_EQ(rc::wheelRowsFromMsg({1, 2, 3, 4, 5, 6}, 2, 3, "maneuver.wheel_torque")[1](2), 6.0);
+  try {
+    rc::wheelRowsFromMsg({1, 2, 3, 4, 5}, 2, 3, "maneuver.wheel_torque");
+    ADD_FAILURE() << "a short array was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("maneuver.wheel_torque: needs (N + 1) * n = 2 * 3"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(rc::wheelRowsFromMsg({1, 2, std::nan(""), 4, 5, 6}, 2, 3, "maneuver.wheel_torque"),
+               InvalidInput);
+}
+
+TEST(ReactionWheelMessages, SummaryCarriesEachWheelsPeaksLimitsAndMargins) {
+  ReactionWheels wheels = threeWheels();
+  WheelPeaks peaks(3);
+  peaks.peak_momentum << 0.5, 2.5, 0.25;
+  peaks.peak_torque << 0.1, 0.2, 0.3;
+  peaks.peak_momentum_norm = 2.6;
+  ReactionWheelsSummary s = rc::wheelSummaryToMsg(wheels, peaks);
+  ASSERT_EQ(s.wheels.size(), 3u);
+  EXPECT_EQ(s.wheels[1].name, "wheel_2");
+  EXPECT_EQ(s.wheels[1].max_momentum, 2.0);
+  EXPECT_EQ(s.wheels[1].momentum_margin, -0.5);  // past its limit
+  EXPECT_EQ(s.wheels[2].torque_margin, wheels.torqueLimit(2) - 0.3);
+  EXPECT_FALSE(s.has_momentum_norm_limit);
+  EXPECT_EQ(s.max_momentum_norm, 0.0);
+  wheels.max_momentum_norm = 3.0;
+  s = rc::wheelSummaryToMsg(wheels, peaks);
+  EXPECT_TRUE(s.has_momentum_norm_limit);
+  EXPECT_NEAR(s.momentum_norm_margin, 0.4, 1e-15);
+}
 
 TEST(MarkerColours, OneColourPerMeaningAndEveryMarkerDrawnInItsMeaningsColour) {
   // Before: red, green and blue meant both the principal axes and the TF display's frame axes,
@@ -692,10 +794,12 @@ TEST(MarkerColours, OneColourPerMeaningAndEveryMarkerDrawnInItsMeaningsColour) {
        {bodyMarkers(box, 0.9, 1.2, "body", ros::Time(3.0)),
         constraintMarkers(twoCones(), 1.2, "world", ros::Time()),
         worldDirectionMarkers(twoCones(), pointingAt(), 1.2, "world"),
-        bodyAxisMarkers(twoCones(), pointingAt(), R, 1.2, "world", ros::Time(3.0))}) {
+        bodyAxisMarkers(twoCones(), pointingAt(), R, 1.2, "world", ros::Time(3.0)),
+        wheelMomentumMarkers(threeWheels(), Eigen::Vector3d(0.1, -0.5, 2.0), 1.2, "world",
+                             ros::Time(3.0))}) {
     drawn.insert(drawn.end(), a.markers.begin(), a.markers.end());
   }
-  ASSERT_EQ(drawn.size(), 5u + 2u + 3u + 3u);
+  ASSERT_EQ(drawn.size(), 5u + 2u + 3u + 3u + 6u);
   std::set<std::string> seen;
   for (const visualization_msgs::Marker& m : drawn) {
     ASSERT_EQ(namespaces.count(m.ns), 1u) << m.ns << " is in no meaning (not in the legend)";
@@ -704,7 +808,7 @@ TEST(MarkerColours, OneColourPerMeaningAndEveryMarkerDrawnInItsMeaningsColour) {
         << m.ns;
     seen.insert(m.ns);
   }
-  EXPECT_GE(seen.size(), 12u);
+  EXPECT_GE(seen.size(), 14u);
   EXPECT_THROW(meaningColour("no_such_marker"), std::out_of_range);
   // The legend: one line per meaning, in order, in its colour, saying it.
   const visualization_msgs::MarkerArray legend = legendMarkers("world", 1.2);
@@ -733,6 +837,8 @@ TEST(MarkerColours, TheShippedRvizConfigHidesTheTfAxesAndShowsTheLegend) {
   const std::string tf_display = text.substr(tf, next - tf);
   EXPECT_NE(tf_display.find("Show Axes: false"), std::string::npos) << tf_display;
   EXPECT_NE(tf_display.find("Show Names: true"), std::string::npos) << tf_display;
+  // The wheel-momentum bars are displayed (a maneuver with reaction wheels publishes them).
+  EXPECT_NE(text.find("Marker Topic: wheel_momentum_markers"), std::string::npos);
   EXPECT_NE(text.find("Marker Topic: legend"), std::string::npos);
   // The torque display draws in the colour the legend gives it.
   const std_msgs::ColorRGBA torque = meaningColour("torque_display");

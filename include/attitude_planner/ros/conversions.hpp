@@ -20,7 +20,10 @@
 #include "attitude_planner/MinimumTimeSummary.h"
 #include "attitude_planner/PlanAttempt.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
+#include "attitude_planner/ReactionWheelArray.h"
+#include "attitude_planner/ReactionWheelsSummary.h"
 #include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/analysis/wheel_peaks.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/errors.hpp"
@@ -74,10 +77,27 @@ Matrix3 inertiaFromMsg(const boost::array<double, 9>& j);
 boost::array<double, 9> inertiaToMsg(const Matrix3& J);
 
 /// Message of a maneuver planned for `problem`; header.frame_id = world_frame, child_frame_id =
-/// body_frame, header.stamp = stamp (the time t_0 refers to); `constraints` = problem.constraints.
+/// body_frame, header.stamp = stamp (the time t_0 refers to); `constraints` = problem.constraints,
+/// `reaction_wheels` = problem.reaction_wheels; `wheel_states` (one row per maneuver row; null:
+/// none) fills wheel_torque and wheel_momentum row-major.
 AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& problem,
                                const std::string& world_frame, const std::string& body_frame,
-                               const ros::Time& stamp);
+                               const ros::Time& stamp, const WheelStates* wheel_states = nullptr);
+
+/// The core array of a ReactionWheels message (`field` names it in errors, e.g.
+/// "reaction_wheels"): empty spin_axes = none (then every other field must be empty / 0: throws
+/// InvalidInput naming `field`.spin_axes otherwise); a non-finite axis is refused naming
+/// `field`.spin_axes[i]; max_momentum_norm 0 = no envelope. The values (span, limits, initial
+/// momenta) are the core's to check (validateReactionWheels, through validateProblem).
+ReactionWheels reactionWheelsFromMsg(const ReactionWheelArray& msg, const std::string& field);
+/// The message of a core array (no envelope: max_momentum_norm 0).
+ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels);
+/// The peaks of `wheels` against their limits as a message (the JSON summary's reaction_wheels).
+ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const WheelPeaks& peaks);
+/// `rows` vectors of `wheels` entries from a row-major array (AttitudeManeuver.wheel_torque /
+/// wheel_momentum); throws InvalidInput naming `field` for a wrong length or a non-finite entry.
+std::vector<Eigen::VectorXd> wheelRowsFromMsg(const std::vector<double>& values, int rows,
+                                              int wheels, const std::string& field);
 /// Core maneuver of a message; throws InvalidInput if the arrays disagree in length, N < 1, or an
 /// entry is not finite / not a unit quaternion.
 Maneuver maneuverFromMsg(const AttitudeManeuver& msg);
@@ -158,6 +178,10 @@ OutputSelection outputSelectionFromRequest(const std::string& return_maneuver, i
 /// k = 0, s, 2s, ..., N with the stride s = ceil(N / (max_nodes - 1)), so both ends are kept and
 /// the last interval may be shorter. time[] keeps each row's t_k; time_step stays the plan's h.
 Maneuver decimatedManeuver(const Maneuver& maneuver, int max_nodes);
+/// The rows k decimatedManeuver keeps of a plan of `steps` steps (all for max_nodes 0).
+std::vector<int> decimatedRows(int steps, int max_nodes);
+/// The same rows of a plan's wheel states.
+WheelStates decimatedWheelStates(const WheelStates& states, int max_nodes);
 
 /// Planner defaults that fill the empty/zero fields of a request (the node's private params).
 struct PlannerDefaults {
@@ -262,6 +286,7 @@ PlanningProblem problemFromRequest(const Request& req, const PlannerDefaults& de
   validateConstraints(p.constraints, "constraints");
   p.end_condition = endConditionFromRequest(req.end_condition, req.pointing_body_axis,
                                             req.pointing_world_direction);
+  p.reaction_wheels = reactionWheelsFromMsg(req.reaction_wheels, "reaction_wheels");
   return p;
 }
 

@@ -53,4 +53,22 @@ visualization_msgs::MarkerArray worldDirectionMarkers(
     const std::vector<PlanningConstraint>& constraints, const std::optional<EndCondition>& pointing,
     double length, const std::string& world_frame);
 
+/// Where the wheel-momentum bars stand, in units of `path_radius` (world frame): beside the body
+/// in the shipped view, behind it (x −1.3), clear of the legend (x 0.4, y −0.7) and the traced
+/// path (radius 1).
+inline constexpr double kWheelBarsX = -1.3, kWheelBarsY = 0.2, kWheelBarsZ = -0.4;
+inline constexpr double kWheelBarWidth = 0.1;         ///< bar edge
+inline constexpr double kWheelBarHeight = 0.8;        ///< a bar at its limit H_i
+inline constexpr double kWheelBarMostFraction = 1.5;  ///< taller bars (past 1.5 H_i) are cut
+
+/// The wheel momenta as bars (`wheel_momentum_markers`, per sample): wheel i (0-based) a CUBE of
+/// height |h_i| / H_i · kWheelBarHeight · path_radius standing on the base (ns "wheel_momentum",
+/// id i) and a flat slab at the limit's height (ns "wheel_momentum_limit", id i), left to right
+/// in `world_frame`, coloured by markerMeanings(): a bar reaching its slab is at its limit.
+visualization_msgs::MarkerArray wheelMomentumMarkers(const ReactionWheels& wheels,
+                                                     const Eigen::VectorXd& momentum,
+                                                     double path_radius,
+                                                     const std::string& world_frame,
+                                                     const ros::Time& stamp);
+
 }  // namespace attitude_planner

@@ -331,10 +331,22 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   if (r.accuracy.requested) planned.scheme = r.scheme;
   if (!r.maneuver.attitude.empty()) {
     planned.steps = r.maneuver.steps();
+    const bool wheels = planned.reaction_wheels.present();
+    const WheelStates states =
+        wheels ? wheelStates(planned.scheme, planned.inertia, planned.reaction_wheels, r.maneuver,
+                             planned.worldDisturbance())
+               : WheelStates();
     if (outcome.output.output == ros_conversions::ManeuverOutput::Nodes) {
+      const WheelStates shown =
+          ros_conversions::decimatedWheelStates(states, outcome.output.max_nodes);
       res->maneuver = ros_conversions::maneuverToMsg(
           ros_conversions::decimatedManeuver(r.maneuver, outcome.output.max_nodes), planned,
-          world_frame, body_frame, ros::Time::now());
+          world_frame, body_frame, ros::Time::now(), wheels ? &shown : nullptr);
+    }
+    if (wheels) {
+      res->reaction_wheels = ros_conversions::wheelSummaryToMsg(
+          planned.reaction_wheels,
+          planWheelPeaks(planned.reaction_wheels, states, schemeHasEndTorques(planned.scheme)));
     }
   }
   res->steps = planned.steps;

@@ -17,6 +17,9 @@
 // are streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
 // (ManeuverInterpolation); `done` reports the terminal attitude and rate errors against the plan.
 //
+// A maneuver with reaction wheels (its `reaction_wheels`, ~mode replay, internal plant) is flown
+// with its wheel torques through body + wheels (analysis/wheel_flight.hpp: flyWithWheels); other
+// modes, the external plant and effects during the run are refused by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -60,6 +63,11 @@
 //             constraint_markers visualization_msgs/MarkerArray, latched, when the maneuver (or
 //                                ~scene) has keep_out / keep_in constraints: each cone (world) and
 //                                its body axis (body, frame-locked)
+//             wheel_states       sensor_msgs/JointState, body   a maneuver with reaction wheels
+//                                (replay mode): names wheel_1.., effort = wheel torque [N·m]
+//             wheel_momentum     std_msgs/Float64MultiArray   the wheel momenta [N·m·s]
+//             wheel_momentum_markers visualization_msgs/MarkerArray, world   a bar per wheel
+//                                against its limit (markers.hpp: wheelMomentumMarkers)
 //             done               attitude_planner/ReplayResult, latched when a run ends
 //             /diagnostics       diagnostic_msgs/DiagnosticArray, every second (wall): the status
 //                                `<node>: tracker` (ros/diagnostics.hpp)
@@ -146,6 +154,7 @@
 #include "attitude_planner/analysis/constraint_health.hpp"
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/analysis/wheel_flight.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
@@ -320,6 +329,10 @@ class TrackerNode {
     std::shared_ptr<ConstraintHealth> health;
     int replan_period_steps = 1;           ///< plan steps between re-plans (replanPeriodSteps)
     std::optional<EndCondition> pointing;  ///< Replay::pointing
+    /// The maneuver's reaction wheels (empty: none) and, with them, the flight of the body and
+    /// the wheels from the plan's wheel torques (what `actual` shows; null without wheels).
+    ReactionWheels wheels;
+    std::shared_ptr<const WheelFlight> wheel_flight;
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -385,6 +398,19 @@ class TrackerNode {
   void publishState(const Playback& playback, const ManeuverSample& body,
                     const ManeuverSample& plan, double t, const ros::Time& stamp,
                     std::deque<Vector3>* trail);
+  /// A maneuver with reaction wheels: refuses, naming the setting, what is not flown with wheels
+  /// (~mode other than replay, ~plant external, effects during the run) and checks the array
+  /// (validateReactionWheels, field maneuver.reaction_wheels).
+  void requireWheelFlight(const ReactionWheels& wheels,
+                          const std::vector<EffectSpec>& effects) const;
+  /// replay mode with wheels: flies the plan's wheel torques (the message's wheel_torque, or the
+  /// plan's own wheelStates when it carries none) through body + wheels from `start`; fills
+  /// playback->actual, wheel_flight and the result (errors, effort, the wheels' peaks and margins).
+  void flyWheels(const AttitudeManeuver& msg, const Maneuver& plan, const Matrix3& inertia,
+                 SchemeKind scheme, const RigidBodyState& start, Playback* playback) const;
+  /// With wheels: `wheel_states` (JointState: effort u_i(t)), `wheel_momentum` (h_w(t)) and the
+  /// momentum bars at maneuver time t, stamped `stamp`.
+  void publishWheels(const Playback& playback, double t, const ros::Time& stamp);
   /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
   /// (e_Ω), stamped `stamp`.
   void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,
@@ -446,6 +472,9 @@ class TrackerNode {
   ros::Publisher rate_error_vector_pub_;  ///< `angular_velocity_error_vector` e_Ω [rad/s], body
   ros::Subscriber odometry_sub_;          ///< `odometry` (~plant external)
   ros::Publisher diagnostics_pub_;        ///< /diagnostics
+  ros::Publisher wheel_state_pub_;        ///< `wheel_states` sensor_msgs/JointState (with wheels)
+  ros::Publisher wheel_momentum_pub_;     ///< `wheel_momentum` h_w(t) [N m s] (with wheels)
+  ros::Publisher wheel_marker_pub_;       ///< `wheel_momentum_markers` bars (with wheels)
   ros::WallTimer diagnostics_timer_;      ///< every kDiagnosticsPeriod
   std::mutex health_mutex_;               ///< guards health_ (stream vs timer)
   TrackerHealth health_;                  ///< the newest sample's figures, for /diagnostics

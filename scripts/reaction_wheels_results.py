@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/results/reaction_wheels.md and docs/results/reaction_wheels.png (issue 42).
+"""Writes docs/results/reaction_wheels.md and docs/results/reaction_wheels.png.
 
 usage: reaction_wheels_results.py TOOL_DIR STUDY_DIR DOCS_DIR [--count K] [--seed S] [--steps N]
        [--repeats R] [--command TEXT]

@@ -143,7 +143,7 @@ TEST(BenchmarkSolvers, IpoptAgreesWithOurTorqueAndRateLimitedOptimumAtN4096) {
 // transcription's dynamics row, R(q)ᵀπ₀ quadratic in the quaternion) against ours on seeded
 // biased four-wheel pyramid slews (paper scheme, the peer's transcription): where ours converges,
 // IPOPT from the geodesic converges to a plan that meets every wheel limit, with our cost to 1e-6
-// relative (issue 42's held-out target); where ours answers infeasible, IPOPT finds no plan
+// relative (the held-out comparison's tolerance); where ours answers infeasible, IPOPT finds no plan
 // either. Every request is planned; none is left out.
 TEST(BenchmarkSolvers, IpoptWithWheelRowsReachesOurWheelLimitedOptimum) {
 #ifndef AP_BENCHMARK_HAS_IPOPT

@@ -37,9 +37,10 @@ WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const React
   if (wheel_torque.empty()) wheel_torque = wheelStates(scheme, inertia, wheels, plan).torque;
   Eigen::VectorXd initial(wheels.count());
   for (int i = 0; i < wheels.count(); ++i) initial(i) = wheels.initialMomentum(i);
+  // No world disturbance: the tracker refuses effects during a flight with wheels.
   const WheelReplay replay =
       replayWithWheels(inertia, array.axes, start.attitude, start.angular_velocity, initial,
-                       plan.time_step, wheel_torque, kWheelFlightSubsteps);
+                       plan.time_step, wheel_torque, Vector3::Zero(), kWheelFlightSubsteps);
   WheelFlight out;
   out.torque = std::move(wheel_torque);
   out.momentum = replay.momentum;

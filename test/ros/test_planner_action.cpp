@@ -442,7 +442,14 @@ bool startEndlessGoals(Client* a, Client* b) {
               [fed_a](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed_a; });
   b->sendGoal(endlessGoal(), Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
               [fed_b](const PlanAttitudeManeuverFeedbackConstPtr&) { ++*fed_b; });
-  return waitFor([&] { return *fed_a > 0 && *fed_b > 0; }, 120.0);
+  // Feedback and the goal status arrive on separate topics: a client can hold feedback while its
+  // state still reads PENDING, so running means both.
+  return waitFor(
+      [&] {
+        return *fed_a > 0 && *fed_b > 0 && a->getState() == State::ACTIVE &&
+               b->getState() == State::ACTIVE;
+      },
+      120.0);
 }
 
 TEST_F(PlannerAction, GoalBeyondTheWorkersIsRejectedAndTheRunningOnesAreUntouched) {

@@ -247,7 +247,7 @@ def write_doc(args, sizes, rows, slew_rows, scale_rows, repeats, load_before, lo
 
 
 def targets(sizes, rows, scale_rows, limit):
-    """Issue 9's targets, judged from this run's figures (nothing typed by hand)."""
+    """The benchmark's targets, judged from this run's figures (nothing typed by hand)."""
     L = ["## Targets (issue 9) against this run\n",
          "| target | measured | met? |", "|---|---|---|"]
 

@@ -101,7 +101,7 @@ def main():
     large = [1024, 2048] if args.quick else [1024, 2048, 8192]
     large_rows = [(N, median_ip(scene, N)) for N in large]
 
-    # Torque and rate limits together up to N = 1e5 (issue 16: ≤ 10 s, memory linear in N). IPOPT
+    # Torque and rate limits together up to N = 1e5 (the target: ≤ 10 s, memory linear in N). IPOPT
     # (benchmark_solvers) at N = 128: feasible for w ≥ 0.11 rad/s, locally infeasible at 0.1.
     huge_rows = []
     with tempfile.TemporaryDirectory() as tmp:

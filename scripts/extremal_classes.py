@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The cheapest extremal by enumeration of homotopy classes (issue 30, item 3): a held-out suite.
+"""The cheapest extremal by enumeration of homotopy classes: a held-out suite.
 
 Draws a seeded suite of physical problems with spinning ends (boundary rates up to 5 rad/s, N = 256,
 paper scheme so that IPOPT transcribes the same problem), writes each as a scene, and runs on it:

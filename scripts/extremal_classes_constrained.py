@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Constrained requests and homotopy classes (issue 30, item 4, a measurement only): for seeded
+"""Constrained requests and homotopy classes (a measurement only): for seeded
 cases of scripts/extremal_classes.py's suite, the unconstrained default plan's peak |tau|, then the
 same request under max_torque_norm = FRACTION x that peak, planned by default and in each forced
 class (--direction, --extra-revolutions); prints how often the default is costlier than a class.

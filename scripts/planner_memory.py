@@ -1,5 +1,5 @@
-"""Resident memory of attitude_planner_node around timed-out N = 1e5 solves (issue 43: "memory
-returned after stopped solves"). Needs a running planner node (scripts/planner_memory starts one on
+"""Resident memory of attitude_planner_node around timed-out N = 1e5 solves (is the
+memory returned after stopped solves?). Needs a running planner node (scripts/planner_memory starts one on
 a private master). Calls the service `--solves` times with the seed's slew at N = `--steps` and a
 budget far below the solve (each answered TIMED_OUT, its solve told to stop), then one small
 request (which joins the stopped solves), and prints the node's VmRSS / VmHWM (/proc) after each

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/results/accuracy.md and its plots from the raw data of accuracy_study (issue 6).
+"""Writes docs/results/accuracy.md and its plots from the raw data of accuracy_study.
 
 usage: plot_accuracy.py RAW.json DOCS_DIR
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/results/frontier.md and docs/results/frontier.png from the raw data of frontier_study (issue 18).
+"""Writes docs/results/frontier.md and docs/results/frontier.png from the raw data of frontier_study.
 
 usage: plot_frontier.py RAW.json DOCS_DIR [COMMAND]
 

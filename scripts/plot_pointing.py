@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes docs/results/pointing.md and docs/results/pointing.png from the raw data of pointing_study (issue 41).
+"""Writes docs/results/pointing.md and docs/results/pointing.png from the raw data of pointing_study.
 
 usage: plot_pointing.py RAW.json DOCS_DIR [COMMAND]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots the PMP switching functions of minimum-time plans (issue 17).
+"""Plots the PMP switching functions of minimum-time plans.
 
 usage: plot_switching.py OUT.png TITLE1 CSV1 [TITLE2 CSV2 ...]
 Each CSV is switching_functions' output (k, t, tau, sigma, bounds). One column per plan, one row

@@ -1,5 +1,5 @@
 """The slew table of scripts/slew_table_example, scripts/python_benchmark and
-scripts/slew_table_at_scale (issue 44): the base scene and the target attitudes."""
+scripts/slew_table_at_scale: the base scene and the target attitudes."""
 import math
 
 # A small imaging satellite: principal moments 9..14 kg m^2 with small products of inertia,

@@ -1,4 +1,4 @@
-// warm_start_study (issue 30, "warm starts everywhere"): re-planning from a state on a plan being
+// warm_start_study: re-planning from a state on a plan being
 // flown, cold and warm-started with the plan's remainder, side by side in one run; writes
 // docs/results/warm_start.md (scripts/warm_start).
 //

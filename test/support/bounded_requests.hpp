@@ -1,5 +1,5 @@
-// Seeded bounded requests like the held-out ones of issue 45 ("honest verdicts"), shared by the
-// CI-sized gtest (test/unit/test_bounded_verdicts.cpp) and the full-size study
+// Seeded bounded requests (torque and rate bounds, spinning ends, extreme magnitudes), shared by
+// the CI-sized gtest (test/unit/test_bounded_verdicts.cpp) and the full-size study
 // (studies/bounded_verdicts_study.cpp, scripts/bounded_verdicts →
 // docs/results/bounded_verdicts.md).
 //

@@ -1,4 +1,4 @@
-// Issue 18: the peer a user would pick instead of our discrete schemes, a standard direct
+// The peer a user would pick instead of our discrete schemes, a standard direct
 // collocation of the *continuous* problem (seed 000, Problem 2.2), as a plain NLP (no solver
 // here: studies/frontier_study.cpp hands it to IPOPT; test/unit/test_hermite_simpson.cpp checks
 // its derivatives against finite differences).

@@ -1,4 +1,4 @@
-// Issue 19, item 5: a seeded generator of random planning problems, shared by the CI-sized gtest
+// A seeded generator of random planning problems, shared by the CI-sized gtest
 // (test/unit/test_random_suite.cpp) and the full-size study (benchmark_solvers --random-suite,
 // run by scripts/robustness --random, which writes the table in docs/results/robustness.md).
 //

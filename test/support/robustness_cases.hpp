@@ -1,8 +1,9 @@
-// The named hard cases of issue 7 ("hard cases stay numerically stable"): each case plans (or
+// The named hard cases (each must stay numerically stable): each case plans (or
 // integrates) one or more problems and checks its pass criterion, recording every figure it
 // measured. One catalog, two readers: test/unit/test_hard_cases.cpp asserts every check (the
 // slow cases only under ATTITUDE_PLANNER_SLOW_TESTS=1, i.e. `scripts/test --all`), and the tool
-// `robustness_report` writes the same figures into docs/results/robustness.md (`scripts/robustness`).
+// `robustness_report` writes the same figures into docs/results/robustness.md
+// (`scripts/robustness`).
 #pragma once
 
 #include <functional>

@@ -282,7 +282,7 @@ TEST(DriftTwoInputPlanner, TaylorIntegratorMatchesTheStructurePreservingFlow) {
 }
 
 TEST(DriftTwoInputPlanner, SameExtremalWhateverTheOutputSamplingForEveryDriftScene) {
-  // Issue 19: N sets only where the extremal is sampled. Every drift scene of scenes/ is
+  // N sets only where the extremal is sampled. Every drift scene of scenes/ is
   // planned with its default starts at N = 60 … 4000: the same p(0) and cost to 1e-12 (the
   // solve never sees N; only the dense output does), g(T) = g1, and the samples of one N are
   // those of another at common times.

@@ -1,4 +1,4 @@
-// Issue 7: the fuzz targets (test/fuzz/) replayed over their corpus in the normal suite, so they
+// The fuzz targets (test/fuzz/) replayed over their corpus in the normal suite, so they
 // cannot rot: the shipped scenes, the hostile scenes, the request seeds and every input a fuzz
 // run found to crash (test/fuzz/regressions/, kept after the fix). A target that crashes, throws
 // or aborts on one of them fails this test (gtest reports the exception; an abort kills the

@@ -1,8 +1,9 @@
-// Issue 7: the named hard cases (test/support/robustness_cases.hpp). One test per
+// The named hard cases (test/support/robustness_cases.hpp). One test per
 // case; each case's pass criterion is written next to its code in test/support/robustness_cases.cpp
 // and printed here on failure, with every check that failed. Cases tagged slow (N = 1e5, 1e6)
 // run only under ATTITUDE_PLANNER_SLOW_TESTS=1 (`scripts/test --all`); otherwise they are
-// reported as skipped, saying how to run them. docs/results/robustness.md lists the measured figures
+// reported as skipped, saying how to run them. docs/results/robustness.md lists the measured
+// figures
 // (`scripts/robustness`).
 #include <gtest/gtest.h>
 

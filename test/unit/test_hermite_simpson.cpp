@@ -1,4 +1,4 @@
-// Issue 18: the Hermite–Simpson peer of frontier_study (test/support/hermite_simpson.hpp). Its
+// The Hermite–Simpson peer of frontier_study (test/support/hermite_simpson.hpp). Its
 // exact derivatives against central differences (the objective's gradient, the constraint
 // Jacobian, the Hessian of the Lagrangian against differences of the exact gradient of the
 // Lagrangian), its sparsity patterns, and its constraints on the continuous optimum (they must

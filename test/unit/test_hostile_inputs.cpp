@@ -1,4 +1,4 @@
-// Issue 7, bad input: every file in test/hostile/scenes/ (first line "# expect: <text>") is
+// Every file in test/hostile/scenes/ (first line "# expect: <text>") is
 // refused by the scene parser with InvalidInput naming the file, the field and the value, and by
 // plan_maneuver with exit status 1 and the same message, never a crash or a hang. Solver options
 // and the time budget are checked at the core. The same files seed the fuzz corpus (scripts/fuzz)

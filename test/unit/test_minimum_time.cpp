@@ -313,7 +313,7 @@ std::vector<ap::PlanningProblem> minimumTimeCases() {
 }  // namespace
 
 TEST(MinimumTime, NoDurationAboveTStarIsAnsweredInfeasible) {
-  // Issue 30's target: minimum effort at (1 + m) T* converges for m in {0.005, 0.02, 0.1}
+  // Minimum effort at (1 + m) T* converges for m in {0.005, 0.02, 0.1}
   // (answered "infeasible" in ~15 ms before the feasibility phase backed such verdicts).
   for (const ap::PlanningProblem& p : minimumTimeCases()) {
     const ap::PlanResult fastest = ap::planManeuver(p);

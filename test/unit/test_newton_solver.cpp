@@ -347,7 +347,7 @@ TEST(NewtonSolver, StalledFastRatesConvergeByContinuationInTheRates) {
 }
 
 TEST(NewtonSolver, EveryThresholdIsScaleFree) {
-  // Issue 19, item 1: thresholds mean the same at every scale. J → sJ, T → cT with the boundary
+  // Thresholds mean the same at every scale. J → sJ, T → cT with the boundary
   // rates Ω → Ω/c leaves the steps' rotations unchanged and scales every torque by s/c², so a
   // solver whose tests are all relative takes the same iterations to the same plan, cost
   // s²/c⁴ times (random suite cases with spinning ends, both schemes, and the seed's example).

@@ -1,4 +1,4 @@
-// Issue 19, item 3: a plan is judged by what it is — first-order optimality and the discrete
+// A plan is judged by what it is — first-order optimality and the discrete
 // equations of motion step by step, relative to the problem's own scales — and the open-loop
 // replay of its torques is a reported sensitivity (replay_miss), not a verdict.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 19, item 5: the seeded randomized suite at CI size. Every generated problem
+// The seeded randomized suite at CI size. Every generated problem
 // (test/support/random_problems.hpp: physical and seed-like inertias, random attitudes, boundary
 // rates up to 5 rad/s with h|Ω| ≤ 0.5, horizons up to 100 s, both schemes) must converge.
 // The full-size run with the IPOPT comparison is `scripts/robustness --random`

@@ -424,7 +424,7 @@ TEST(SceneFiles, MissingFileIsNamed) {
 }
 
 TEST(SceneFiles, AbsentEffectsKeyMeansNone) {
-  // Issue 15, defect 4: a scene without `effects:` was refused ("effects: missing (required)").
+  // A scene without `effects:` means no effects (not "effects: missing (required)").
   const ap::Scene absent = ap::parseScene(withLine("effects", ""), "no_effects.yaml");
   EXPECT_TRUE(absent.effects.empty());
   EXPECT_FALSE(absent.problem.effects);

@@ -1,4 +1,4 @@
-// Issue 15: one Termination per result, per-level progress as data, reports of any length.
+// One Termination per result, per-level progress as data, reports of any length.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -56,7 +56,7 @@ SolveContext::Scope::Scope(SolveContext& context, AttemptStage stage, const Homo
     : context_(context),
       previous_(context.attempt_),
       previous_names_nested_(context.scope_names_nested_),
-      iterations_at_open_(context.iterations_) {
+      tally_(context) {
   const bool inside = previous_.number > 0;
   const bool renamed = inside && (previous_names_nested_ || stage == AttemptStage::Solve);
   context_.attempt_ = {++context_.attempts_begun_, renamed ? previous_.stage : stage, homotopy};

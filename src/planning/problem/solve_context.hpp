@@ -55,6 +55,20 @@ class SolveContext : public Interruption {
     const SolverOptions* previous_;
   };
 
+  /// The iterations reported from its construction on: a phase's count (a continuation's
+  /// stages, a Newton start then the interior point) read from the one numbering, instead of
+  /// summed from its solves' results.
+  class IterationTally {
+   public:
+    explicit IterationTally(const SolveContext& context)
+        : context_(context), at_open_(context.iterations_) {}
+    int iterations() const { return context_.iterations_ - at_open_; }
+
+   private:
+    const SolveContext& context_;
+    int at_open_;
+  };
+
   /// How a scope names the attempts begun inside it (the trail relabels them the same way).
   enum class Nested {
     /// Theirs, but an attempt of stage Solve (a solver's own solve) takes the scope's stage (a
@@ -79,28 +93,14 @@ class SolveContext : public Interruption {
     Scope& operator=(const Scope&) = delete;
 
     /// Iterations reported while it was open, its nested attempts' included.
-    int iterations() const { return context_.iterations_ - iterations_at_open_; }
+    int iterations() const { return tally_.iterations(); }
 
    private:
     SolveContext& context_;
     AttemptTag previous_;
     bool previous_names_nested_;
-    int iterations_at_open_;
+    IterationTally tally_;
   };
-  /// The iterations reported from its construction on: a phase's count (a continuation's
-  /// stages, a Newton start then the interior point) read from the one numbering, instead of
-  /// summed from its solves' results.
-  class IterationTally {
-   public:
-    explicit IterationTally(const SolveContext& context)
-        : context_(context), at_open_(context.iterations_) {}
-    int iterations() const { return context_.iterations_ - at_open_; }
-
-   private:
-    const SolveContext& context_;
-    int at_open_;
-  };
-
   /// The attempt the iterations reported now belong to (number 0 outside every Scope).
   const AttemptTag& currentAttempt() const { return attempt_; }
 

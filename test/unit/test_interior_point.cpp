@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -18,6 +19,7 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/direct_method.hpp"
@@ -250,6 +252,42 @@ TEST(ElasticSlacks, SolveTheirDefiningEquationsWithoutCancellation) {
     EXPECT_GT(e.v, 0.0);
     EXPECT_NEAR(e.s - e.v, c, 1e-15 * std::max(1.0, std::abs(c)));
     EXPECT_NEAR(mu / e.s + mu / e.v, rho, 1e-9 * rho) << c;
+  }
+}
+
+TEST(ElasticSlacks, AnElasticRowsNewtonTermsAtItsPrimalMultiplierAreItsMeritsDerivatives) {
+  // prepareElasticRow (the fixed-h L1Elastic rows and the free-time elastic start): at the primal
+  // multiplier z = mu/s the row's right-hand side coefficient z + q/D is -psi'(c) and its weight
+  // 1/D is psi''(c), psi the merit term rho v - mu ln s - mu ln v of the eliminated slacks:
+  // checked by central differences of elasticSlacks(c).psi (psi' = -mu/s, then psi'' from it), on
+  // both sides of c = 0 and far out.
+  const ap::InteriorPointParameters parameters;
+  for (const double rho : {1e2, 1e4}) {
+    for (const double mu : {1e-2, 1e-5}) {
+      for (const double c : {-50.0, -1.0, -1e-3, 0.0, 1e-3, 1.0, 50.0}) {
+        ap::ConstraintRow<10> row;
+        row.c = c;
+        ap::prepareElasticRow(row, mu, rho, true, parameters);
+        // ψ'' varies on the scale of max(|c|, μ/ρ) (s = 2μ/ρ at c = 0); the difference of ψ' ≈ −ρ
+        // loses ε ρ / step to round-off.
+        const double step = 1e-3 * std::max(std::abs(c), mu / rho);
+        const auto psi = [&](double x) { return ap::elasticSlacks(x, mu, rho).psi; };
+        const auto slope = [&](double x) { return -mu / ap::elasticSlacks(x, mu, rho).s; };
+        const double first = (psi(c + step) - psi(c - step)) / (2 * step);
+        const double second = (slope(c + step) - slope(c - step)) / (2 * step);
+        const double round_off = 8 * std::numeric_limits<double>::epsilon() * rho / step;
+        const std::string at = "c = " + std::to_string(c) + ", mu = " + std::to_string(mu);
+        EXPECT_NEAR(slope(c), first, 1e-6 * std::abs(first)) << "psi' = -mu/s, " << at;
+        EXPECT_NEAR(row.z + row.q / row.D, -slope(c), 1e-12 * std::abs(slope(c))) << at;
+        const ap::ElasticSlacks e = ap::elasticSlacks(c, mu, rho);
+        // u = ρ − z cancels where z → ρ (c far below 0): D keeps ε ρ/u of relative round-off.
+        const double u_round_off = 8 * std::numeric_limits<double>::epsilon() * rho / (rho - row.z);
+        EXPECT_NEAR(1.0 / row.D, mu / (e.s * e.s + e.v * e.v), (1e-12 + u_round_off) / row.D) << at;
+        EXPECT_NEAR(1.0 / row.D, second, 1e-4 * std::abs(second) + round_off) << at;
+        EXPECT_GT(row.z, 0.0) << at;
+        EXPECT_LT(row.z, rho) << at;
+      }
+    }
   }
 }
 

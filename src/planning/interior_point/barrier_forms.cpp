@@ -44,8 +44,10 @@ void FreeSlacks::addComplementarity(const FixedStepRow& row, double, double, dou
   ++*count;
 }
 
-void L1Elastic::prepare(FixedStepRow& row, double mu, double rho, bool primal) const {
-  const double kappa = p_.dual_safeguard;
+template <int Entries>
+void prepareElasticRow(ConstraintRow<Entries>& row, double mu, double rho, bool primal,
+                       const InteriorPointParameters& p) {
+  const double kappa = p.dual_safeguard;
   const ElasticSlacks sl = elasticSlacks(row.c, mu, rho);
   row.s = sl.s;
   row.v = sl.v;
@@ -55,12 +57,28 @@ void L1Elastic::prepare(FixedStepRow& row, double mu, double rho, bool primal) c
   } else {
     row.z = std::min(std::max(row.z, mu / (kappa * row.s)), kappa * z_primal);
     // u = ρ − z stays positive (u → 0 would make D and q infinite).
-    const double u_min = std::max(mu / (kappa * row.v), p_.elastic_dual_floor * rho);
+    const double u_min = std::max(mu / (kappa * row.v), p.elastic_dual_floor * rho);
     row.z = std::min(row.z, rho - u_min);
   }
   const double u = rho - row.z;
   row.D = row.s / row.z + row.v / u;
   row.q = mu / row.z - row.s - mu / u + row.v;
+}
+template void prepareElasticRow<9>(ConstraintRow<9>&, double, double, bool,
+                                   const InteriorPointParameters&);
+template void prepareElasticRow<10>(ConstraintRow<10>&, double, double, bool,
+                                    const InteriorPointParameters&);
+
+double elasticDualStepLimit(double z, double dz, double rho, double alpha,
+                            const InteriorPointParameters& p) {
+  if (dz < 0) alpha = std::min(alpha, -p.fraction_to_boundary * z / dz);
+  const double u = rho - z;  // u = ρ − z keeps (1 − τ) of itself too
+  if (dz > 0) alpha = std::min(alpha, p.fraction_to_boundary * u / dz);
+  return alpha;
+}
+
+void L1Elastic::prepare(FixedStepRow& row, double mu, double rho, bool primal) const {
+  prepareElasticRow(row, mu, rho, primal, p_);
 }
 
 double L1Elastic::rowMerit(const FixedStepRow& row, double mu, double rho, double) const {
@@ -69,10 +87,7 @@ double L1Elastic::rowMerit(const FixedStepRow& row, double mu, double rho, doubl
 
 double L1Elastic::dualStepLimit(const FixedStepRow& row, double dz, double rho,
                                 double alpha) const {
-  alpha = multiplierLimit(row, dz, alpha);
-  const double u = rho - row.z;  // u = ρ − z keeps (1 − τ) of itself too
-  if (dz > 0) alpha = std::min(alpha, p_.fraction_to_boundary * u / dz);
-  return alpha;
+  return elasticDualStepLimit(row.z, dz, rho, alpha, p_);
 }
 
 void L1Elastic::initialize(FixedStepRow& row, double mu, double rho, double cap) const {

@@ -82,6 +82,18 @@ class BarrierState {
 using FixedStepRow = ConstraintRow<9>;
 using FixedStepRows = ConstraintRows<9>;
 
+/// The ℓ1-elastic row c + v − s = 0 at its value c: the slacks s, v (elasticSlacks), the
+/// multiplier z (the primal μ/s, or κ_Σ-safeguarded and kept below ρ so that u = ρ − z > 0) and
+/// the condensation terms D = s/z + v/u, q = μ/z − s − μ/u + v: the row adds g gᵀ/D to the
+/// Newton matrix, (z + q/D) g to its right-hand side, and dz = (q − gᵀd)/D. One rule for the
+/// fixed-h L1Elastic form and the free-time solver's elastic start.
+template <int Entries>
+void prepareElasticRow(ConstraintRow<Entries>& row, double mu, double rho, bool primal,
+                       const InteriorPointParameters& p);
+/// `alpha` limited by the fraction to the boundary on z and on u = ρ − z after the step dz.
+double elasticDualStepLimit(double z, double dz, double rho, double alpha,
+                            const InteriorPointParameters& p);
+
 /// How a row enters the fixed-h barrier problem (Formulation::FreeSlacks or Elastic).
 class SlackForm {
  public:

@@ -395,6 +395,45 @@ TEST(ReactionWheelMinimumTime, MomentumLimitedSlewMeetsTheBangCoastBangClosedFor
   EXPECT_LT(errors[2], errors[1]);
 }
 
+/// Minimum time whose only torque bound is the wheels' (a biased pyramid, per-wheel torque and
+/// momentum limits, no body-torque bound), on every scheme: a converged plan (the structured
+/// starts once began at T = 0 here, the eigenaxis duration not reading the wheel limits, and
+/// every request failed), every wheel limit met at the nodes and, from its wheel torques, in the
+/// discrete replay on its scheme to 1e-9 relative.
+TEST(ReactionWheelMinimumTime, WheelTorqueLimitsAloneBoundMinimumTime) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    ap::PlanningProblem p = wheelProblem(scheme, false, 32);
+    p.objective = ap::Objective::MinimumTime;
+    p.duration = 0.0;
+    p.reaction_wheels.max_torque = {0.19};
+    p.reaction_wheels.max_momentum = {0.6};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << ap::schemeName(scheme) << ": " << r.message;
+    EXPECT_GT(r.minimum_duration, 0.0);
+    const double h = r.maneuver.time_step;
+    const ap::WheelStates w = ap::wheelStates(scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    Eigen::VectorXd h0(4);
+    for (int i = 0; i < 4; ++i) h0(i) = p.reaction_wheels.initialMomentum(i);
+    const ap::DiscreteWheelReplay replay =
+        ap::replayWithWheelsOnTheScheme(scheme, p.inertia, ap::wheelArray(p.reaction_wheels).axes,
+                                        p.initial_attitude, p.initial_velocity, h0, h, w.torque);
+    const int first = ap::schemeHasEndTorques(scheme) ? 0 : 1;
+    double peak_momentum = 0.0, peak_torque = 0.0;
+    for (int k = 0; k <= p.steps; ++k) {
+      peak_momentum = std::max(peak_momentum, replay.momentum[k].cwiseAbs().maxCoeff());
+      if (k >= first && k <= p.steps - first)
+        peak_torque = std::max(peak_torque, w.torque[k].cwiseAbs().maxCoeff());
+    }
+    std::printf("%s: T* = %.9f s, %d iterations, replay peak |h| %.12g, peak |u| %.12g\n",
+                ap::schemeName(scheme).c_str(), r.minimum_duration, r.iterations, peak_momentum,
+                peak_torque);
+    EXPECT_LE(peak_momentum, 0.6 * (1 + 1e-9)) << ap::schemeName(scheme);
+    EXPECT_LE(peak_torque, 0.19 * (1 + 1e-9)) << ap::schemeName(scheme);
+  }
+}
+
 namespace {
 
 /// The peak wheel momentum and torque [N m s, N m] of `p` planned without the wheels' limits.

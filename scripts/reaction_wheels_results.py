@@ -235,12 +235,11 @@ def minimum_time_peer_lines(tools, source_dir, seed):
         "free-time interior-point solve) and IPOPT's free-time peer (the time step an unknown, "
         "objective N h; its wheel rows and their h column its own derivation, "
         "studies/benchmark_solvers.cpp; L-BFGS Hessian), the paper scheme, from the same start "
-        "(an eigenaxis profile over the planner's eigenaxis duration guess). The closed-form slew above (paper "
-        "instead of second_order), then seeded biased pyramid slews (seed %d: J and the pyramid "
-        "as above, a random axis and 0.8–1.4 rad, rest to rest, a random bias |h_w,i(0)| ≤ 0.3 N "
-        "m s, |u_i| ≤ 0.19 N m, |h_w,i| ≤ 0.6 N m s and no other torque bound, N = 32). Relative "
-        "difference of "
-        "the minimum durations against ours." % seed, "",
+        "(an eigenaxis profile over the planner's eigenaxis duration guess). The closed-form "
+        "slew above (paper instead of second_order), then seeded biased pyramid slews (seed %d: "
+        "J and the pyramid as above, a random axis and 0.8–1.4 rad, rest to rest, a random bias "
+        "|h_w,i(0)| ≤ 0.3 N m s, |u_i| ≤ 0.19 N m, |h_w,i| ≤ 0.6 N m s and no other torque "
+        "bound, N = 32). Relative difference of the minimum durations against ours." % seed, "",
         "| case | N | ours: T [s] | status | iterations | time [s] | IPOPT: T [s] | status | "
         "iterations | time [s] | relative difference |",
         "|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -751,6 +751,37 @@ TEST(ReactionWheelReplay, DiscreteReplayFromTheWheelTorquesReproducesThePlanToRo
   EXPECT_GE(binding, replayed / 2);
 }
 
+/// The discrete replay refuses by name what it cannot replay: fourth_order (not a discretization),
+/// fewer than two torque rows, a row or an initial momentum with the wrong number of wheels.
+TEST(ReactionWheelReplay, DiscreteReplayRefusesWhatItCannotReplayByName) {
+  const ap::PlanningProblem p = wheelProblem(ap::SchemeKind::SecondOrder, false, 4);
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> axes = ap::wheelArray(p.reaction_wheels).axes;
+  const Eigen::VectorXd h0 = Eigen::VectorXd::Zero(4);
+  const auto replay = [&](ap::SchemeKind scheme, const Eigen::VectorXd& initial,
+                          const std::vector<Eigen::VectorXd>& u) {
+    return refusal([&] {
+      ap::replayWithWheelsOnTheScheme(scheme, p.inertia, axes, p.initial_attitude,
+                                      p.initial_velocity, initial, 0.5, u);
+    });
+  };
+  const std::vector<Eigen::VectorXd> rows(5, Eigen::VectorXd::Zero(4));
+  EXPECT_NE(replay(ap::SchemeKind::FourthOrder, h0, rows).find("scheme: "), std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::FourthOrder, h0, rows).find("got fourth_order"),
+            std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::SecondOrder, h0, {rows[0]}).find("torque: need at least 2"),
+            std::string::npos);
+  std::vector<Eigen::VectorXd> short_row = rows;
+  short_row[2] = Eigen::VectorXd::Zero(3);
+  EXPECT_NE(replay(ap::SchemeKind::Paper, h0, short_row)
+                .find("torque[2]: expected 4 wheel "
+                      "torques, got 3"),
+            std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::Variational, Eigen::VectorXd::Zero(3), rows)
+                .find("initial_momentum: expected 4 values (one per wheel), got 3"),
+            std::string::npos);
+  EXPECT_EQ(replay(ap::SchemeKind::SecondOrder, h0, rows), "");  // at rest: nothing to refuse
+}
+
 // ---- outputs -----------------------------------------------------------------------------------
 
 /// The CSV carries u1..un, h1..hn after tx,ty,tz (and reads back as a plan); the JSON summary

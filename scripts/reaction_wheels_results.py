@@ -9,15 +9,17 @@ Every figure comes from the installed tools, one process per solve: plan_maneuve
 benchmark_solvers (ours and the IPOPT peer on the same discrete problem, paper scheme):
   1. a momentum-limited biased pyramid slew with and without the bias: wheel momenta against time
      with their limit (PNG);
-  2. minimum time against the closed form T* = theta J / H + H / U = 7.0 s at N = 32..256;
-  3. minimum time, ours against IPOPT's free-time peer on the same discrete problem (the
+  2. that slew replayed from its wheel torques at N = 32..256: the discrete replay on the plan's
+     scheme (round-off) against the continuous RK4 replay (O(h^2));
+  3. minimum time against the closed form T* = theta J / H + H / U = 7.0 s at N = 32..256;
+  4. minimum time, ours against IPOPT's free-time peer on the same discrete problem (the
      closed-form slew at N = 32..256, seeded biased pyramid slews);
-  4. held-out-style seeded biased pyramid slews whose unconstrained plan saturates a wheel:
+  5. held-out-style seeded biased pyramid slews whose unconstrained plan saturates a wheel:
      converged fraction, every wheel limit met at the nodes and in the independent replays (the
      discrete one on the plan's scheme to round-off, the continuous RK4 one to O(h^2)), the cost
      against IPOPT's;
-  5. ours against IPOPT on the same discrete problem (cost, iterations, time; ratios);
-  6. speed: a wheel-limited solve against the same slew under a body-torque norm (N = 128).
+  6. ours against IPOPT on the same discrete problem (cost, iterations, time; ratios);
+  7. speed: a wheel-limited solve against the same slew under a body-torque norm (N = 128).
 """
 import argparse
 import json
@@ -179,8 +181,39 @@ def slew_figure(tools, steps, png):
     return lines + [""]
 
 
+def replay_convergence_lines(tools):
+    """Section 2: the biased slew of section 1 replayed from its wheel torques at N = 32..256:
+    the discrete replay on the plan's scheme (round-off at every N) against the continuous RK4
+    replay (between the nodes, O(h^2))."""
+    axis, angle = [0.4, -0.7, 0.9], 1.2
+    unlimited, _ = tools.plan_scene(tools.write(
+        scene_text(axis, angle, 100.0, BIAS, 128, "second_order")))
+    limit = round(0.85 * peak_momentum(unlimited), 3)
+    lines = [
+        "## The independent replays against N", "",
+        "The biased slew above (second_order, |h_w,i| ≤ %g N m s) planned at N = 32..256 and "
+        "replayed by `simulate_torques` from the CSV's u1..un alone: on the plan's scheme "
+        "(replayWithWheelsOnTheScheme) and continuously (RK4, u held linearly). Excess: the "
+        "largest (peak − limit)/limit over the wheels' momenta and torques (negative: inside; "
+        "target ≤ %g); the RK4 replay's falls like h² (its momenta between the nodes)."
+        % (limit, LIMIT_TARGET), "",
+        "| N | converged | discrete replay: departure [rad] | discrete replay excess | "
+        "RK4 excess |", "|---|---|---|---|---|"]
+    for steps in (32, 64, 128, 256):
+        scene = tools.write(scene_text(axis, angle, limit, BIAS, steps, "second_order"))
+        s, csv = tools.plan_scene(scene)
+        if not s or not s["converged"]:
+            lines.append("| %d | no | | | |" % steps)
+            continue
+        discrete, continuous, departure = tools.replay_peaks(scene, csv)
+        lines.append("| %d | yes | %.2g | %.2g | %.2g |" % (
+            steps, departure, max(max(p[0] / p[1], p[2] / p[3]) for p in discrete) - 1.0,
+            max(max(p[0] / p[1], p[2] / p[3]) for p in continuous) - 1.0))
+    return lines + [""]
+
+
 def minimum_time_table(tools, source_dir):
-    """Section 2: the closed-form bang-coast-bang slew at N = 32..256."""
+    """Section 3: the closed-form bang-coast-bang slew at N = 32..256."""
     lines = [
         "## Minimum time against the closed form", "",
         "`scenes/reaction_wheels_min_time.yaml` (J = 10 I, three orthogonal wheels, zero bias, "
@@ -200,7 +233,7 @@ def minimum_time_table(tools, source_dir):
 
 
 def peer_rows(tools, cases, steps):
-    """Section 5: ours and IPOPT (exact Hessian, from the geodesic) on the same paper problem."""
+    """Section 6: ours and IPOPT (exact Hessian, from the geodesic) on the same paper problem."""
     lines = [
         "## IPOPT on the same discrete problem", "",
         "`benchmark_solvers --solver newton|ipopt --scene S` (the paper scheme: the peer "
@@ -225,7 +258,7 @@ def peer_rows(tools, cases, steps):
 
 
 def minimum_time_peer_lines(tools, source_dir, seed):
-    """Section 3: minimum time, ours (one free-time interior-point solve) against IPOPT's
+    """Section 4: minimum time, ours (one free-time interior-point solve) against IPOPT's
     free-time peer (h an unknown, objective N h, its own wheel rows and their h column) on the same
     discrete problem (paper scheme, the same start): the closed-form slew at N = 32..256 and
     seeded biased pyramid slews."""
@@ -269,7 +302,7 @@ def minimum_time_peer_lines(tools, source_dir, seed):
 
 
 def held_out(tools, count, seed, steps):
-    """Section 4: seeded biased pyramid slews whose unlimited plan saturates a wheel."""
+    """Section 5: seeded biased pyramid slews whose unlimited plan saturates a wheel."""
     rng = random.Random(seed)
     rows, peer_cases = [], []
     for i in range(count):
@@ -361,7 +394,7 @@ def held_out_lines(rows, count, seed, steps):
 
 
 def speed_lines(tools, repeats):
-    """Section 6: a wheel-limited minimum-effort solve against the same slew under a body-torque
+    """Section 7: a wheel-limited minimum-effort solve against the same slew under a body-torque
     norm only, N = 128, second_order; median solve_time_s of `repeats` runs each, A and B
     alternated, and the median of the pairwise ratios."""
     axis, angle = [0.4, -0.7, 0.9], 1.2
@@ -432,6 +465,7 @@ def main():
             "[docs/reaction_wheels.md](../reaction_wheels.md). Times on 2 cores shared with "
             "other builds." % args.command, ""]
         lines += slew_figure(tools, 128, os.path.join(args.docs_dir, "reaction_wheels.png"))
+        lines += replay_convergence_lines(tools)
         lines += minimum_time_table(tools, source_dir)
         lines += minimum_time_peer_lines(tools, source_dir, args.seed)
         rows, peer_cases = held_out(tools, args.count, args.seed, args.steps)

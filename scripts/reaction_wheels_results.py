@@ -9,12 +9,17 @@ Every figure comes from the installed tools, one process per solve: plan_maneuve
 benchmark_solvers (ours and the IPOPT peer on the same discrete problem, paper scheme):
   1. a momentum-limited biased pyramid slew with and without the bias: wheel momenta against time
      with their limit (PNG);
-  2. minimum time against the closed form T* = theta J / H + H / U = 7.0 s at N = 32..256;
-  3. ours against IPOPT on the same discrete problem (cost, iterations, time; ratios);
-  4. held-out-style seeded biased pyramid slews whose unconstrained plan saturates a wheel:
-     converged fraction, every wheel limit met at the nodes and in the independent replay, the cost
+  2. that slew replayed from its wheel torques at N = 32..256: the discrete replay on the plan's
+     scheme (round-off) against the continuous RK4 replay (O(h^2));
+  3. minimum time against the closed form T* = theta J / H + H / U = 7.0 s at N = 32..256;
+  4. minimum time, ours against IPOPT's free-time peer on the same discrete problem (the
+     closed-form slew at N = 32..256, seeded biased pyramid slews);
+  5. held-out-style seeded biased pyramid slews whose unconstrained plan saturates a wheel:
+     converged fraction, every wheel limit met at the nodes and in the independent replays (the
+     discrete one on the plan's scheme to round-off, the continuous RK4 one to O(h^2)), the cost
      against IPOPT's;
-  5. speed: a wheel-limited solve against the same slew under a body-torque norm (N = 128).
+  6. ours against IPOPT on the same discrete problem (cost, iterations, time; ratios);
+  7. speed: a wheel-limited solve against the same slew under a body-torque norm (N = 128).
 """
 import argparse
 import json
@@ -86,14 +91,23 @@ class Tools:
             return json.load(f), csv
 
     def replay_peaks(self, scene, csv):
-        """simulate_torques: each wheel's replayed peak |h| and |u| with their limits."""
+        """simulate_torques: each wheel's peak |h| and |u| with their limits, in the discrete
+        replay on the plan's scheme (at the nodes) and in the continuous RK4 replay (between the
+        nodes too), and the discrete replay's departure from the CSV's attitudes [rad]."""
         out = subprocess.run([self.simulate, scene, csv], stdout=subprocess.PIPE,
                              stderr=subprocess.STDOUT, text=True).stdout
-        pattern = r"wheel_(\d+)\s+peak \|h\| (\S+) of (\S+) N m s, peak \|u\| (\S+) of (\S+) N m"
-        return [tuple(float(v) for v in m[1:]) for m in re.findall(pattern, out)]
+        peaks = r" peak \|h\| (\S+) of (\S+) N m s, peak \|u\| (\S+) of (\S+) N m"
+        discrete = [tuple(float(v) for v in m[1:])
+                    for m in re.findall(r"wheel_(\d+) at the nodes" + peaks, out)]
+        continuous = [tuple(float(v) for v in m[1:])
+                      for m in re.findall(r"wheel_(\d+)\s+" + peaks, out)]
+        departure = re.search(r"wheel replay on \S+\s+departure from CSV (\S+) rad", out)
+        return discrete, continuous, float(departure.group(1)) if departure else None
 
-    def solver_line(self, solver, scene, budget=60):
+    def solver_line(self, solver, scene, budget=60, steps=None):
         cmd = [self.benchmark, "--solver", solver, "--scene", scene, "--time-budget", str(budget)]
+        if steps:
+            cmd += ["--steps", str(steps)]
         out = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
         return json.loads(lines[-1]) if lines else None
@@ -167,8 +181,39 @@ def slew_figure(tools, steps, png):
     return lines + [""]
 
 
+def replay_convergence_lines(tools):
+    """Section 2: the biased slew of section 1 replayed from its wheel torques at N = 32..256:
+    the discrete replay on the plan's scheme (round-off at every N) against the continuous RK4
+    replay (between the nodes, O(h^2))."""
+    axis, angle = [0.4, -0.7, 0.9], 1.2
+    unlimited, _ = tools.plan_scene(tools.write(
+        scene_text(axis, angle, 100.0, BIAS, 128, "second_order")))
+    limit = round(0.85 * peak_momentum(unlimited), 3)
+    lines = [
+        "## The independent replays against N", "",
+        "The biased slew above (second_order, |h_w,i| ≤ %g N m s) planned at N = 32..256 and "
+        "replayed by `simulate_torques` from the CSV's u1..un alone: on the plan's scheme "
+        "(replayWithWheelsOnTheScheme) and continuously (RK4, u held linearly). Excess: the "
+        "largest (peak − limit)/limit over the wheels' momenta and torques (negative: inside; "
+        "target ≤ %g); the RK4 replay's falls like h² (its momenta between the nodes)."
+        % (limit, LIMIT_TARGET), "",
+        "| N | converged | discrete replay: departure [rad] | discrete replay excess | "
+        "RK4 excess |", "|---|---|---|---|---|"]
+    for steps in (32, 64, 128, 256):
+        scene = tools.write(scene_text(axis, angle, limit, BIAS, steps, "second_order"))
+        s, csv = tools.plan_scene(scene)
+        if not s or not s["converged"]:
+            lines.append("| %d | no | | | |" % steps)
+            continue
+        discrete, continuous, departure = tools.replay_peaks(scene, csv)
+        lines.append("| %d | yes | %.2g | %.2g | %.2g |" % (
+            steps, departure, max(max(p[0] / p[1], p[2] / p[3]) for p in discrete) - 1.0,
+            max(max(p[0] / p[1], p[2] / p[3]) for p in continuous) - 1.0))
+    return lines + [""]
+
+
 def minimum_time_table(tools, source_dir):
-    """Section 2: the closed-form bang-coast-bang slew at N = 32..256."""
+    """Section 3: the closed-form bang-coast-bang slew at N = 32..256."""
     lines = [
         "## Minimum time against the closed form", "",
         "`scenes/reaction_wheels_min_time.yaml` (J = 10 I, three orthogonal wheels, zero bias, "
@@ -188,7 +233,7 @@ def minimum_time_table(tools, source_dir):
 
 
 def peer_rows(tools, cases, steps):
-    """Section 3: ours and IPOPT (exact Hessian, from the geodesic) on the same paper problem."""
+    """Section 6: ours and IPOPT (exact Hessian, from the geodesic) on the same paper problem."""
     lines = [
         "## IPOPT on the same discrete problem", "",
         "`benchmark_solvers --solver newton|ipopt --scene S` (the paper scheme: the peer "
@@ -212,8 +257,52 @@ def peer_rows(tools, cases, steps):
     return lines + [""]
 
 
+def minimum_time_peer_lines(tools, source_dir, seed):
+    """Section 4: minimum time, ours (one free-time interior-point solve) against IPOPT's
+    free-time peer (h an unknown, objective N h, its own wheel rows and their h column) on the same
+    discrete problem (paper scheme, the same start): the closed-form slew at N = 32..256 and
+    seeded biased pyramid slews."""
+    lines = [
+        "## Minimum time: IPOPT on the same discrete problem", "",
+        "`benchmark_solvers --solver free_time|ipopt_free_time --scene S --steps N`: ours (ONE "
+        "free-time interior-point solve) and IPOPT's free-time peer (the time step an unknown, "
+        "objective N h; its wheel rows and their h column its own derivation, "
+        "studies/benchmark_solvers.cpp; L-BFGS Hessian), the paper scheme, from the same start "
+        "(an eigenaxis profile over the planner's eigenaxis duration guess). The closed-form "
+        "slew above (paper instead of second_order), then seeded biased pyramid slews (seed %d: "
+        "J and the pyramid as above, a random axis and 0.8–1.4 rad, rest to rest, a random bias "
+        "|h_w,i(0)| ≤ 0.3 N m s, |u_i| ≤ 0.19 N m, |h_w,i| ≤ 0.6 N m s and no other torque "
+        "bound, N = 32). Relative difference of the minimum durations against ours." % seed, "",
+        "| case | N | ours: T [s] | status | iterations | time [s] | IPOPT: T [s] | status | "
+        "iterations | time [s] | relative difference |",
+        "|---|---|---|---|---|---|---|---|---|---|---|"]
+    with open(os.path.join(source_dir, "scenes", "reaction_wheels_min_time.yaml")) as f:
+        closed = tools.write(f.read().replace("scheme: second_order", "scheme: paper"))
+    cases = [("closed form", closed, n) for n in (32, 64, 128, 256)]
+    rng = random.Random(seed)
+    for i in range(4):
+        axis = [rng.uniform(-1, 1) for _ in range(3)]
+        angle = rng.uniform(0.8, 1.4)
+        bias = [round(rng.uniform(-0.3, 0.3), 4) for _ in range(4)]
+        text = "\n".join(line for line in scene_text(axis, angle, 0.6, bias, 32, "paper").split(
+            "\n") if not line.startswith("duration:")) + "objective: minimum_time\n"
+        cases.append(("biased pyramid %d" % i, tools.write(text), 32))
+    for name, scene, steps in cases:
+        ours = tools.solver_line("free_time", scene, steps=steps)
+        peer = tools.solver_line("ipopt_free_time", scene, steps=steps)
+        if not ours or not peer:
+            lines.append("| %s | %d | no answer | | | | | | | | |" % (name, steps))
+            continue
+        lines.append("| %s | %d | %.10g | %s | %d | %.3g | %.10g | %s | %d | %.3g | %.2g |" % (
+            name, steps, ours["minimum_duration"], ours["status"], ours["iterations"],
+            ours["time_s"], peer["minimum_duration"], peer["status"], peer["iterations"],
+            peer["time_s"], abs(peer["minimum_duration"] - ours["minimum_duration"])
+            / ours["minimum_duration"]))
+    return lines + [""]
+
+
 def held_out(tools, count, seed, steps):
-    """Section 4: seeded biased pyramid slews whose unlimited plan saturates a wheel."""
+    """Section 5: seeded biased pyramid slews whose unlimited plan saturates a wheel."""
     rng = random.Random(seed)
     rows, peer_cases = [], []
     for i in range(count):
@@ -240,8 +329,10 @@ def held_out(tools, count, seed, steps):
             row["node_excess"] = max(-w["momentum_margin"] / w["max_momentum"] for w in wheels)
             row["node_excess"] = max(row["node_excess"], max(
                 -w["torque_margin"] / w["max_torque"] for w in wheels))
-            replay = tools.replay_peaks(scene, csv)
-            row["replay_excess"] = max(max(p[0] / p[1], p[2] / p[3]) for p in replay) - 1.0
+            discrete, continuous, departure = tools.replay_peaks(scene, csv)
+            row["discrete_excess"] = max(max(p[0] / p[1], p[2] / p[3]) for p in discrete) - 1.0
+            row["replay_excess"] = max(max(p[0] / p[1], p[2] / p[3]) for p in continuous) - 1.0
+            row["departure"] = departure
             ours, peer = tools.solver_line("newton", scene), tools.solver_line("ipopt", scene)
             row["peer"] = peer
             row["ours"] = ours
@@ -256,6 +347,7 @@ def held_out_lines(rows, count, seed, steps):
     tried = [r for r in rows if "skipped" not in r]
     converged = [r for r in tried if r["converged"]]
     within = [r for r in converged if r["node_excess"] <= LIMIT_TARGET]
+    replayed = [r for r in converged if r["discrete_excess"] <= LIMIT_TARGET]
     compared = [r for r in converged if "cost_difference" in r]
     agree = [r for r in compared if r["cost_difference"] <= COST_TARGET]
     lines = [
@@ -264,38 +356,45 @@ def held_out_lines(rows, count, seed, steps):
         " to rest in 20 s, paper scheme, N = %d, a random bias |h_w,i(0)| ≤ 0.3 N m s, |u_i| ≤ "
         "0.19 N m and |h_w,i| ≤ 0.85 of the unlimited plan's peak (so that plan saturates a "
         "wheel). Node excess: the largest (peak − limit)/limit of the plan's own wheel states "
-        "(target ≤ %g; negative: inside). Replay excess: the same for the independent replay "
-        "(simulate_torques: continuous body + wheels, RK4, from the CSV's u1..un alone; between "
-        "nodes the wheel momenta integrate u, so they exceed the limit by the discretization "
-        "error, O(h²)). IPOPT: the peer from the geodesic on the same discrete problem." % (
-            count, seed, steps, LIMIT_TARGET), "",
+        "(target ≤ %g; negative: inside). Discrete replay: the independent replay on the plan's "
+        "scheme (simulate_torques, replayWithWheelsOnTheScheme: the discrete body + wheels from "
+        "the CSV's u1..un alone), its largest departure from the CSV's attitudes and its excess "
+        "over the limits at the nodes (target ≤ %g). RK4 excess: the continuous body + wheels "
+        "(RK4, u held linearly), whose wheel momenta between the nodes exceed the limit by the "
+        "discretization error, O(h²). IPOPT: the peer from the geodesic on the same discrete "
+        "problem." % (count, seed, steps, LIMIT_TARGET, LIMIT_TARGET), "",
         "Converged: %d of %d requests planned (%d skipped: %s); limits met at the nodes to %g: "
-        "%d of %d; cost within %g of IPOPT's: %d of %d compared." % (
+        "%d of %d; in the discrete replay to %g: %d of %d; cost within %g of IPOPT's: %d of %d "
+        "compared." % (
             len(converged), len(tried), len(rows) - len(tried),
             ", ".join(sorted({r["skipped"] for r in rows if "skipped" in r})) or "none",
-            LIMIT_TARGET, len(within), len(converged), COST_TARGET, len(agree), len(compared)),
+            LIMIT_TARGET, len(within), len(converged), LIMIT_TARGET, len(replayed),
+            len(converged), COST_TARGET, len(agree), len(compared)),
         "",
-        "| case | converged | iterations | active | node excess | replay excess |"
-        " IPOPT converged | cost difference |", "|---|---|---|---|---|---|---|---|"]
+        "| case | converged | iterations | active | node excess | discrete replay: departure "
+        "[rad] | discrete replay excess | RK4 excess | IPOPT converged | cost difference |",
+        "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if "skipped" in r:
-            lines.append("| %d | skipped: %s | | | | | | |" % (r["case"], r["skipped"]))
+            lines.append("| %d | skipped: %s | | | | | | | | |" % (r["case"], r["skipped"]))
             continue
         s = r["summary"]
         if not r["converged"]:
-            lines.append("| %d | no: %s | %d | | | | | |" % (r["case"], s["message"][:80],
-                                                             s["iterations"]))
+            lines.append("| %d | no: %s | %d | | | | | | | |" % (
+                r["case"], s["message"][:80], s["iterations"]))
             continue
         peer = r.get("peer")
-        lines.append("| %d | yes | %d | %d | %.2g | %.2g | %s | %s |" % (
+        lines.append("| %d | yes | %d | %d | %.2g | %s | %.2g | %.2g | %s | %s |" % (
             r["case"], s["iterations"], s["active_constraints"], r["node_excess"],
-            r["replay_excess"], ("yes" if peer["converged"] else "no") if peer else "no answer",
+            "%.2g" % r["departure"] if r["departure"] is not None else "none",
+            r["discrete_excess"], r["replay_excess"],
+            ("yes" if peer["converged"] else "no") if peer else "no answer",
             "%.2g" % r["cost_difference"] if "cost_difference" in r else ""))
     return lines + [""]
 
 
 def speed_lines(tools, repeats):
-    """Section 5: a wheel-limited minimum-effort solve against the same slew under a body-torque
+    """Section 7: a wheel-limited minimum-effort solve against the same slew under a body-torque
     norm only, N = 128, second_order; median solve_time_s of `repeats` runs each, A and B
     alternated, and the median of the pairwise ratios."""
     axis, angle = [0.4, -0.7, 0.9], 1.2
@@ -366,7 +465,9 @@ def main():
             "[docs/reaction_wheels.md](../reaction_wheels.md). Times on 2 cores shared with "
             "other builds." % args.command, ""]
         lines += slew_figure(tools, 128, os.path.join(args.docs_dir, "reaction_wheels.png"))
+        lines += replay_convergence_lines(tools)
         lines += minimum_time_table(tools, source_dir)
+        lines += minimum_time_peer_lines(tools, source_dir, args.seed)
         rows, peer_cases = held_out(tools, args.count, args.seed, args.steps)
         lines += held_out_lines(rows, args.count, args.seed, args.steps)
         base = [("pyramid N = %d" % n, tools.write(

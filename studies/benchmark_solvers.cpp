@@ -55,6 +55,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/minimum_time.hpp"
 #include "lie/dual.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
@@ -288,8 +289,11 @@ const char* const kUsage =
     "                         [--cases I,J,...]  (only these case indices, e.g. to re-plan one)\n"
     "                         ours and IPOPT (exact Hessian, paper scheme, same start) on the\n"
     "                         seeded random problems of test/support/random_problems.hpp\n"
-    "       benchmark_solvers --check-hessian [--steps N] [--constrained] [--wheels]   IPOPT's\n"
-    "                         exact Hessian (--wheels: with a biased pyramid's wheel rows)\n"
+    "       benchmark_solvers --check-hessian [--steps N] [--constrained] [--wheels]\n"
+    "                         [--free-time]   IPOPT's exact Hessian (--wheels: with a biased\n"
+    "                         pyramid's wheel rows; --free-time: the Jacobian of\n"
+    "                         ipopt_free_time's NLP with its h column, which has no exact "
+    "Hessian)\n"
     "                         against central differences of its exact gradients, its Jacobian\n"
     "                         against differences of its constraints (exit 0 iff relative errors\n"
     "                         <= 1e-6; --constrained: with one node constraint of every kind;\n"
@@ -1013,8 +1017,8 @@ class FreeTimeNlp : public TranscriptionNlp {
  public:
   FreeTimeNlp(const ap::PlanningProblem& p, std::vector<Vector3> start)
       : TranscriptionNlp(p, false, std::move(start)) {
-    // The wheel rows depend on h (Π_k = J Ω_{k−1} + h τ_k/2); their h column is not formed here.
-    if (has_wheels_) throw ap::InvalidInput("ipopt_free_time: no reaction-wheel rows in free time");
+    for (std::size_t r = 0; r < rows_of_constraints_.size(); ++r)
+      if (isWheelRow(*rows_of_constraints_[r].constraint)) wheel_rows_.push_back(r);
   }
   int H() const { return n(); }  ///< the index of h
   double time_step = 0.0;        ///< h at the end
@@ -1025,6 +1029,7 @@ class FreeTimeNlp : public TranscriptionNlp {
     base_nnz_ = nnz_jac;
     n += 1;
     nnz_jac += 4 * N_ + 3 * (N_ - 1);  // the h column: kinematics and dynamics rows
+    nnz_jac += static_cast<Ipopt::Index>(wheel_rows_.size());  // and the wheel rows
     nnz_h = 0;
     return true;
   }
@@ -1064,6 +1069,11 @@ class FreeTimeNlp : public TranscriptionNlp {
         iRow[base_nnz_ + r] = r;
         jCol[base_nnz_ + r] = H();
       }
+      for (std::size_t i = 0; i < wheel_rows_.size(); ++i) {
+        iRow[base_nnz_ + 4 * N_ + 3 * (N_ - 1) + i] =
+            equalities() + static_cast<int>(wheel_rows_[i]);
+        jCol[base_nnz_ + 4 * N_ + 3 * (N_ - 1) + i] = H();
+      }
       return true;
     }
     h_ = x[H()];
@@ -1091,6 +1101,7 @@ class FreeTimeNlp : public TranscriptionNlp {
       const Vector3 tau(Eigen::Map<const Vector3>(x + T(k)));
       for (int r = 0; r < 3; ++r) column[4 * N_ + 3 * (k - 1) + r] = f(r).d(0) - tau(r);
     }
+    wheelTimeStepColumn(x, column + 4 * N_ + 3 * (N_ - 1));
     return true;
   }
   void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
@@ -1103,21 +1114,44 @@ class FreeTimeNlp : public TranscriptionNlp {
   }
 
  private:
+  /// ∂g/∂h of the wheel rows: g'(r)ᵀ ∂r/∂h, where h enters r (q_k, a_k) only through the node
+  /// momentum Π_k = J Ω_{k−1} + h τ_k/2 (∂Π/∂h = τ_k/2; the quaternion, Ω_{k−1} and τ_k are
+  /// unknowns of their own), by a forward-mode dual in h of the same PeerWheels::quantity.
+  void wheelTimeStepColumn(const double* x, double* column) const {
+    using Dual1 = ap::Dual<1>;
+    for (std::size_t i = 0; i < wheel_rows_.size(); ++i) {
+      const auto& [c, k] = rows_of_constraints_[wheel_rows_[i]];
+      const Quaternion q(Eigen::Map<const Quaternion>(x + Q(k)));
+      const Vector3 tau(Eigen::Map<const Vector3>(x + T(k)));
+      const Eigen::Matrix<Dual1, 3, 1> r =
+          wheels_.quantity<Dual1>(isTorqueRow(*c), q.cast<Dual1>(), omega(x, k - 1).cast<Dual1>(),
+                                  tau.cast<Dual1>(), Dual1(h_, 0));
+      Vector3 value, dh;
+      for (int j = 0; j < 3; ++j) value(j) = r(j).v, dh(j) = r(j).d(0);
+      column[i] = c->rowGradient(value).dot(dh);
+    }
+  }
+
   Ipopt::Index base_nnz_ = 0;
+  std::vector<std::size_t> wheel_rows_;  ///< indices into rows_of_constraints_
 };
 
 /// The eigenaxis bang–bang slew at the least T its per-axis bounds allow (rest to rest, about a
 /// principal axis: no gyroscopic torque), with a 0.3 rad sin² excursion about the diagonal of
 /// the two body axes most perpendicular to the eigenaxis — the start that reaches the published
 /// optima in ours (drivers/minimum_time_starts.cpp's structured starts). Sets problem->duration to
-/// that T.
+/// that T; without a per-axis box (a torque norm, reaction-wheel limits) T is the planner's
+/// eigenaxis guess (eigenaxisDurationGuess).
 std::vector<Vector3> excursionStart(ap::PlanningProblem* problem) {
   const Vector3 rotation =
       ap::so3::log(Matrix3(problem->initial_attitude.transpose() * problem->final_attitude));
   const double angle = rotation.norm();
   const Vector3 e = rotation / angle;
   const Vector3 Je = (problem->inertia * e).cwiseAbs();
-  const double T = std::sqrt(4 * angle * (Je.array() / problem->max_torque.array()).maxCoeff());
+  // Without a per-axis box (a torque norm, wheel limits): the planner's eigenaxis guess.
+  const double box = (Je.array() / problem->max_torque.array()).maxCoeff();
+  const double T = box > 0.0 && std::isfinite(box) ? std::sqrt(4 * angle * box)
+                                                   : ap::eigenaxisDurationGuess(*problem);
   problem->duration = T;
   std::vector<Vector3> projected;
   for (int a = 0; a < 3; ++a) {
@@ -1381,6 +1415,32 @@ int checkHessian(int steps, bool constrained, bool wheels) {
       constrained ? "true" : "false", wheels ? "true" : "false", steps, static_cast<int>(n),
       static_cast<int>(size.m), static_cast<int>(size.nnz_h), kStep, scale, error, relative,
       entry_error, outside, asymmetry, jacobian_relative, pattern_errors, pass ? "true" : "false");
+  return pass ? 0 : 1;
+}
+
+/// --check-hessian --free-time: the free-time NLP (ipopt_free_time: h the last unknown) has no
+/// exact Hessian (IPOPT's L-BFGS), so its Jacobian is what is checked, the h column included
+/// (kinematics, dynamics and, with --wheels, the wheel rows' ∂g/∂h), against central differences
+/// of eval_g at the same random point. Prints one JSON line.
+int checkFreeTimeJacobian(int steps, bool constrained, bool wheels) {
+  Ipopt::SmartPtr<FreeTimeNlp> nlp =
+      new FreeTimeNlp(hessianCheckProblem(steps, constrained, wheels), {});
+  NlpSizes size;
+  Ipopt::TNLP::IndexStyleEnum style;
+  nlp->get_nlp_info(size.n, size.m, size.nnz_jac, size.nnz_h, style);
+  std::vector<double> x, lambda;
+  randomPoint(*nlp, steps, size, &x, &lambda);
+  constexpr double kStep = 1e-6;
+  x[nlp->H()] *= 1.1;  // off the start's h, which the rest of the point was built for
+  const double relative = jacobianRelativeError(*nlp, size, x, kStep);
+  const bool pass = relative <= 1e-6;
+  std::printf(
+      "{\"check\": \"free_time_jacobian\", \"constrained\": %s, \"wheels\": %s, \"steps\": %d, "
+      "\"n\": %d, \"m\": %d, \"nnz_jac\": %d, \"fd_step\": %g, \"hessian\": \"limited-memory "
+      "(none formed)\", \"jacobian_relative_error\": %.3g, \"pass\": %s}\n",
+      constrained ? "true" : "false", wheels ? "true" : "false", steps, static_cast<int>(size.n),
+      static_cast<int>(size.m), static_cast<int>(size.nnz_jac), kStep, relative,
+      pass ? "true" : "false");
   return pass ? 0 : 1;
 }
 #endif
@@ -1992,7 +2052,8 @@ struct BenchmarkArgs {
   std::string solver, scene, scheme;
   bool check_hessian = false;
   bool constrained = false;
-  bool wheels = false;  ///< --check-hessian --wheels
+  bool wheels = false;     ///< --check-hessian --wheels
+  bool free_time = false;  ///< --check-hessian --free-time
   PeerStart peer_start = PeerStart::Geodesic;
   int steps = 0;
   int suite_count = 0;
@@ -2034,6 +2095,8 @@ std::optional<int> parseArguments(int argc, char** argv, BenchmarkArgs* args) {
       args->constrained = true;
     } else if (a == "--wheels") {
       args->wheels = true;
+    } else if (a == "--free-time") {
+      args->free_time = true;
     } else if (a == "--start") {
       const std::string v = value();
       if (v != "geodesic" && v != "unconstrained" && v != "ours") {
@@ -2131,6 +2194,9 @@ int main(int argc, char** argv) {
   if (const std::optional<int> status = parseArguments(argc, argv, &args)) return *status;
   if (args.check_hessian) {
 #ifdef AP_HAVE_IPOPT
+    if (args.free_time) {
+      return checkFreeTimeJacobian(args.steps > 0 ? args.steps : 16, args.constrained, args.wheels);
+    }
     return checkHessian(args.steps > 0 ? args.steps : 16, args.constrained, args.wheels);
 #else
     std::cerr << "benchmark_solvers: --check-hessian: this build has no IPOPT "

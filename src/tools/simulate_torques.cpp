@@ -11,6 +11,7 @@
 #include <iostream>
 #include <string>
 
+#include "attitude_planner/dynamics/discrete_wheel_replay.hpp"
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/dynamics/wheel_replay.hpp"
 #include "attitude_planner/errors.hpp"
@@ -30,6 +31,9 @@ const char* const kUsage =
     "under exactly the scene's effects: gravity gradient and disturbances act on the body,\n"
     "actuator_limits saturate and torque_noise perturbs the applied torques. Replaying a plan\n"
     "under a scene with more effects than it was planned for shows their terminal miss.\n"
+    "With reaction wheels also body + wheels from the CSV's wheel torques u1..un alone: on the\n"
+    "plan's discrete scheme (reproduces a plan's nodes to round-off) and continuously (RK4),\n"
+    "each wheel's peaks against its limits.\n"
     "\n"
     "options:\n"
     "  --scheme paper|variational|second_order|fourth_order  override the scene's scheme\n"
@@ -132,9 +136,49 @@ void printReport(const ap::Scene& scene, ap::SchemeKind kind, int N, double h,
       effect_names.c_str());
 }
 
-/// With reaction wheels: body + wheels replayed from the CSV's wheel torques alone
-/// (replayWithWheels), the terminal miss and each wheel's peaks against its limits.
-void replayWheels(const ap::PlanningProblem& p, const std::string& csv_path, double h) {
+/// Each wheel's peak |h_w,i| over `momentum` and |u_i| over `torque`, printed against the
+/// limits, `label` naming the replay in each line.
+void printWheelPeaks(const ap::ReactionWheels& wheels, const char* label,
+                     const Eigen::VectorXd& peak_momentum, const std::vector<Eigen::VectorXd>& u) {
+  for (int i = 0; i < wheels.count(); ++i) {
+    double peak_u = 0.0;
+    for (const Eigen::VectorXd& row : u) peak_u = std::max(peak_u, std::abs(row(i)));
+    std::printf("  wheel_%d%s peak |h| %.17g of %.17g N m s, peak |u| %.17g of %.17g N m\n", i + 1,
+                label, peak_momentum(i), wheels.momentumLimit(i), peak_u, wheels.torqueLimit(i));
+  }
+}
+
+/// The discrete replay on the plan's scheme (replayWithWheelsOnTheScheme): reproduces the plan's
+/// nodes to round-off if u1..un are the plan's; its wheel peaks at the nodes against the limits.
+void replayWheelsOnTheScheme(const ap::PlanningProblem& p, ap::SchemeKind kind,
+                             const ap::Maneuver& planned, const std::vector<Eigen::VectorXd>& u,
+                             const Eigen::VectorXd& h0, double h) {
+  const ap::ReactionWheels& wheels = p.reaction_wheels;
+  const ap::WheelArray array = ap::wheelArray(wheels);
+  const ap::DiscreteWheelReplay replay =
+      ap::replayWithWheelsOnTheScheme(kind, p.inertia, array.axes, p.initial_attitude,
+                                      p.initial_velocity, h0, h, u, p.worldDisturbance());
+  double departure = 0.0, envelope = 0.0;
+  Eigen::VectorXd peak = Eigen::VectorXd::Zero(wheels.count());
+  for (std::size_t k = 0; k < replay.attitude.size(); ++k) {
+    departure = std::max(departure, ap::so3::angleBetween(replay.attitude[k], planned.attitude[k]));
+    peak = peak.cwiseMax(replay.momentum[k].cwiseAbs());
+    envelope = std::max(envelope, (array.axes * replay.momentum[k]).norm());
+  }
+  std::printf(
+      "wheel replay on %s     departure from CSV %.3g rad, terminal attitude error %.3g rad, "
+      "velocity error %.3g rad/s, peak |A h_w| %.17g of %.17g N m s\n",
+      ap::schemeName(kind).c_str(), departure,
+      ap::so3::angleBetween(replay.attitude.back(), p.final_attitude),
+      (replay.node_velocity.back() - p.final_velocity).norm(), envelope, wheels.max_momentum_norm);
+  printWheelPeaks(wheels, " at the nodes", peak, u);
+}
+
+/// With reaction wheels: body + wheels replayed from the CSV's wheel torques alone, on the plan's
+/// discrete scheme (the nodes, to round-off) and continuously (RK4 between the nodes: the
+/// momentum between them, O(h²)); each wheel's peaks against its limits.
+void replayWheels(const ap::PlanningProblem& p, ap::SchemeKind kind, const ap::Maneuver& planned,
+                  const std::string& csv_path, double h) {
   const std::vector<Eigen::VectorXd> u = ap::readWheelTorquesCsv(csv_path);
   const ap::ReactionWheels& wheels = p.reaction_wheels;
   if (static_cast<int>(u.empty() ? 0 : u[0].size()) != wheels.count()) {
@@ -145,20 +189,20 @@ void replayWheels(const ap::PlanningProblem& p, const std::string& csv_path, dou
   }
   Eigen::VectorXd h0(wheels.count());
   for (int i = 0; i < wheels.count(); ++i) h0(i) = wheels.initialMomentum(i);
+  if (ap::schemeIsDiscretization(kind)) {
+    replayWheelsOnTheScheme(p, kind, planned, u, h0, h);
+  } else {
+    std::printf("wheel replay on %s     none: %s is not a discretization (RK4 below only)\n",
+                ap::schemeName(kind).c_str(), ap::schemeName(kind).c_str());
+  }
   const ap::WheelReplay replay =
       ap::replayWithWheels(p.inertia, ap::wheelArray(wheels).axes, p.initial_attitude,
                            p.initial_velocity, h0, h, u, p.worldDisturbance());
   std::printf(
-      "wheel replay             terminal attitude error %.3g rad, velocity error %.3g rad/s\n",
+      "wheel replay (RK4)       terminal attitude error %.3g rad, velocity error %.3g rad/s\n",
       ap::so3::angleBetween(replay.attitude.back(), p.final_attitude),
       (replay.angular_velocity.back() - p.final_velocity).norm());
-  for (int i = 0; i < wheels.count(); ++i) {
-    double peak_u = 0.0;
-    for (const Eigen::VectorXd& row : u) peak_u = std::max(peak_u, std::abs(row(i)));
-    std::printf(
-        "  wheel_%d                peak |h| %.6g of %.6g N m s, peak |u| %.6g of %.6g N m\n", i + 1,
-        replay.peak_momentum(i), wheels.momentumLimit(i), peak_u, wheels.torqueLimit(i));
-  }
+  printWheelPeaks(wheels, "               ", replay.peak_momentum, u);
 }
 
 /// Loads, replays and reports; the exit status.
@@ -191,7 +235,7 @@ int run(const Arguments& args) {
   const ap::Maneuver replay = ap::replayPlan(kind, p.inertia, h, input, &report);
   const Miss m = missOf(p, planned, replay);
   printReport(scene, kind, N, h, replay, report, m);
-  if (p.reaction_wheels.present()) replayWheels(p, args.csv_path, h);
+  if (p.reaction_wheels.present()) replayWheels(p, kind, planned, args.csv_path, h);
   if (!args.out_csv.empty()) ap::writeManeuverCsv(replay, args.out_csv);
   if (args.max_miss >= 0.0 &&
       (m.attitude_error > args.max_miss || m.velocity_error > args.max_miss)) {

@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -87,6 +88,30 @@ double jsonNumber(const std::string& line, const std::string& key) {
 }
 
 #ifdef AP_BENCHMARK_HAS_IPOPT
+/// A biased pyramid slew's scene text: J = [[13, -2, 1], [-2, 16, 0.5], [1, 0.5, 18]], `header`
+/// (duration, steps, scheme, objective lines), rest to rest from the identity through angle
+/// mid + spread u about a random axis, four pyramid wheels with |u_i| <= 0.19 N m, |h_w,i| <=
+/// momentum mid + spread u and random initial momenta up to 0.3 N m s (u uniform in [-1, 1],
+/// drawn from `rng` in that order).
+std::string randomPyramidScene(const std::string& header, double angle_mid, double angle_spread,
+                               double momentum_mid, double momentum_spread, std::mt19937& rng) {
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::ostringstream out;
+  out << "inertia: [[13, -2, 1], [-2, 16, 0.5], [1, 0.5, 18]]\n"
+      << header << "initial: {attitude: {axis: [1, 0, 0], angle: 0}, angular_velocity: [0, 0, 0]}\n"
+      << "final: {attitude: {axis: [" << uniform(rng) << ", " << uniform(rng) << ", "
+      << uniform(rng) << "], angle: " << angle_mid + angle_spread * uniform(rng)
+      << "}, angular_velocity: [0, 0, 0]}\n"
+      << "actuators:\n  reaction_wheels:\n"
+      << "    spin_axes: [[0.816496580927726, 0, 0.5773502691896258], [0, "
+         "0.816496580927726, 0.5773502691896258], [-0.816496580927726, 0, "
+         "0.5773502691896258], [0, -0.816496580927726, 0.5773502691896258]]\n"
+      << "    max_torque: 0.19\n    max_momentum: " << momentum_mid + momentum_spread * uniform(rng)
+      << "\n    initial_momentum: [" << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << ", "
+      << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << "]\n";
+  return out.str();
+}
+
 /// Ours on `scene` at `steps`, then IPOPT started from our plan (`--start ours`): IPOPT must
 /// converge and stay there (the same cost to `tolerance` relative, the same active constraints).
 /// Returns our JSON line.
@@ -143,33 +168,18 @@ TEST(BenchmarkSolvers, IpoptAgreesWithOurTorqueAndRateLimitedOptimumAtN4096) {
 // transcription's dynamics row, R(q)ᵀπ₀ quadratic in the quaternion) against ours on seeded
 // biased four-wheel pyramid slews (paper scheme, the peer's transcription): where ours converges,
 // IPOPT from the geodesic converges to a plan that meets every wheel limit, with our cost to 1e-6
-// relative (the held-out comparison's tolerance); where ours answers infeasible, IPOPT finds no plan
-// either. Every request is planned; none is left out.
+// relative (the held-out comparison's tolerance); where ours answers infeasible, IPOPT finds no
+// plan either. Every request is planned; none is left out.
 TEST(BenchmarkSolvers, IpoptWithWheelRowsReachesOurWheelLimitedOptimum) {
 #ifndef AP_BENCHMARK_HAS_IPOPT
   GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";
 #else
   std::mt19937 rng(4242);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   int compared = 0, active = 0, infeasible = 0;
   for (int c = 0; c < 4; ++c) {
     const std::string scene = ::testing::TempDir() + "wheel_peer_" + std::to_string(c) + ".yaml";
-    {
-      std::ofstream out(scene);
-      out << "inertia: [[13, -2, 1], [-2, 16, 0.5], [1, 0.5, 18]]\nduration: 20\nsteps: 32\n"
-          << "scheme: paper\n"
-          << "initial: {attitude: {axis: [1, 0, 0], angle: 0}, angular_velocity: [0, 0, 0]}\n"
-          << "final: {attitude: {axis: [" << uniform(rng) << ", " << uniform(rng) << ", "
-          << uniform(rng) << "], angle: " << 1.3 + 0.2 * uniform(rng)
-          << "}, angular_velocity: [0, 0, 0]}\n"
-          << "actuators:\n  reaction_wheels:\n"
-          << "    spin_axes: [[0.816496580927726, 0, 0.5773502691896258], [0, "
-             "0.816496580927726, 0.5773502691896258], [-0.816496580927726, 0, "
-             "0.5773502691896258], [0, -0.816496580927726, 0.5773502691896258]]\n"
-          << "    max_torque: 0.19\n    max_momentum: " << 0.8 + 0.1 * uniform(rng) << "\n"
-          << "    initial_momentum: [" << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << ", "
-          << 0.3 * uniform(rng) << ", " << 0.3 * uniform(rng) << "]\n";
-    }
+    std::ofstream(scene) << randomPyramidScene("duration: 20\nsteps: 32\nscheme: paper\n", 1.3, 0.2,
+                                               0.8, 0.1, rng);
     std::string ours, peer;
     ASSERT_EQ(runTool("--solver newton --scene '" + scene + "'", &ours), 0) << ours;
     EXPECT_EQ(runTool("--solver ipopt --scene '" + scene + "'", &peer), 0) << peer;
@@ -192,6 +202,60 @@ TEST(BenchmarkSolvers, IpoptWithWheelRowsReachesOurWheelLimitedOptimum) {
               active, infeasible);
   EXPECT_GE(compared, 2);
   EXPECT_GE(active, 1);
+#endif
+}
+
+// IPOPT's free-time peer with the wheel rows (ipopt_free_time: h an unknown, objective N h; the
+// wheel rows' h column its own derivation): its Jacobian, h column included, against central
+// differences (N = 5, 16, 64; its Hessian is L-BFGS, none formed); then minimum time against ours
+// (one free-time interior-point solve, the same paper problem and start) on the closed-form slew
+// (J = 10 I, three orthogonal wheels, |tau| <= 1, |A h_w| <= 2, 1 rad) at N = 32 and on seeded
+// biased pyramid slews with per-wheel limits only (N = 16): the same T* to 1e-6 relative.
+TEST(BenchmarkSolvers, IpoptFreeTimeWithWheelRowsReachesOurMinimumTime) {
+#ifndef AP_BENCHMARK_HAS_IPOPT
+  GTEST_SKIP() << "IPOPT not found when configuring (coinor-libipopt-dev)";
+#else
+  for (const char* steps : {"5", "16", "64"}) {
+    std::string output;
+    EXPECT_EQ(
+        runTool(std::string("--check-hessian --free-time --constrained --wheels --steps ") + steps,
+                &output),
+        0)
+        << output;
+    EXPECT_NE(output.find("\"check\": \"free_time_jacobian\""), std::string::npos) << output;
+    EXPECT_NE(output.find("\"pass\": true"), std::string::npos) << output;
+    std::printf("%s", output.c_str());
+  }
+  std::vector<std::pair<std::string, std::string> > scenes;  // (scene text, steps)
+  scenes.push_back(
+      {"inertia: [10, 10, 10]\nsteps: 32\nscheme: paper\nobjective: minimum_time\n"
+       "initial: {attitude: {axis: [0, 0, 1], angle: 0}, angular_velocity: [0, 0, 0]}\n"
+       "final: {attitude: {axis: [0.3333333333333333, 0.6666666666666666, -0.6666666666666666], "
+       "angle: 1}, angular_velocity: [0, 0, 0]}\n"
+       "constraints:\n  - max_torque_norm: 1\n"
+       "actuators:\n  reaction_wheels: {spin_axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "
+       "max_torque: 10, max_momentum: 10, max_momentum_norm: 2}\n",
+       "32"});
+  std::mt19937 rng(4243);
+  for (int c = 0; c < 2; ++c) {
+    scenes.push_back({randomPyramidScene("steps: 16\nscheme: paper\nobjective: minimum_time\n", 1.1,
+                                         0.3, 0.6, 0.0, rng),
+                      "16"});
+  }
+  for (std::size_t c = 0; c < scenes.size(); ++c) {
+    const std::string scene =
+        ::testing::TempDir() + "wheel_free_time_" + std::to_string(c) + ".yaml";
+    std::ofstream(scene) << scenes[c].first;
+    const std::string common = " --scene '" + scene + "' --steps " + scenes[c].second;
+    std::string ours, peer;
+    ASSERT_EQ(runTool("--solver free_time" + common, &ours), 0) << ours;
+    EXPECT_EQ(runTool("--solver ipopt_free_time --time-budget 60" + common, &peer), 0) << peer;
+    EXPECT_NE(ours.find("\"status\": \"converged\""), std::string::npos) << ours;
+    const double T = jsonNumber(ours, "minimum_duration");
+    EXPECT_GT(T, 0.0) << ours;
+    EXPECT_NEAR(jsonNumber(peer, "minimum_duration"), T, 1e-6 * T) << ours << peer;
+    std::printf("%s%s", ours.c_str(), peer.c_str());
+  }
 #endif
 }
 

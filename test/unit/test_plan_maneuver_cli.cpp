@@ -558,6 +558,12 @@ TEST_F(CliTest, WheelScenePlansAndReplaysBodyAndWheels) {
   EXPECT_CONTAINS(plan.output, "reaction_wheels");
   const ToolRun replay = run("simulate_torques", kScenes + "reaction_wheels_min_time.yaml " + csv);
   EXPECT_EQ(replay.status, 0) << replay.output;
-  EXPECT_CONTAINS(replay.output, "wheel replay             terminal attitude error");
+  EXPECT_CONTAINS(replay.output, "wheel replay (RK4)       terminal attitude error");
   EXPECT_CONTAINS(replay.output, "wheel_3");
+  // The replay on the plan's scheme from u1..un alone reproduces the plan's nodes to round-off.
+  const std::string on_scheme = "wheel replay on second_order     departure from CSV ";
+  const std::size_t at = replay.output.find(on_scheme);
+  ASSERT_NE(at, std::string::npos) << replay.output;
+  EXPECT_LT(std::stod(replay.output.substr(at + on_scheme.size())), 1e-10) << replay.output;
+  EXPECT_CONTAINS(replay.output, "wheel_3 at the nodes peak |h|");
 }

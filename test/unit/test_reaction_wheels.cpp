@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "attitude_planner/dynamics/discrete_wheel_replay.hpp"
 #include "attitude_planner/dynamics/wheel_replay.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/csv.hpp"
@@ -394,6 +395,45 @@ TEST(ReactionWheelMinimumTime, MomentumLimitedSlewMeetsTheBangCoastBangClosedFor
   EXPECT_LT(errors[2], errors[1]);
 }
 
+/// Minimum time whose only torque bound is the wheels' (a biased pyramid, per-wheel torque and
+/// momentum limits, no body-torque bound), on every scheme: a converged plan (the structured
+/// starts once began at T = 0 here, the eigenaxis duration not reading the wheel limits, and
+/// every request failed), every wheel limit met at the nodes and, from its wheel torques, in the
+/// discrete replay on its scheme to 1e-9 relative.
+TEST(ReactionWheelMinimumTime, WheelTorqueLimitsAloneBoundMinimumTime) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    ap::PlanningProblem p = wheelProblem(scheme, false, 32);
+    p.objective = ap::Objective::MinimumTime;
+    p.duration = 0.0;
+    p.reaction_wheels.max_torque = {0.19};
+    p.reaction_wheels.max_momentum = {0.6};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << ap::schemeName(scheme) << ": " << r.message;
+    EXPECT_GT(r.minimum_duration, 0.0);
+    const double h = r.maneuver.time_step;
+    const ap::WheelStates w = ap::wheelStates(scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    Eigen::VectorXd h0(4);
+    for (int i = 0; i < 4; ++i) h0(i) = p.reaction_wheels.initialMomentum(i);
+    const ap::DiscreteWheelReplay replay =
+        ap::replayWithWheelsOnTheScheme(scheme, p.inertia, ap::wheelArray(p.reaction_wheels).axes,
+                                        p.initial_attitude, p.initial_velocity, h0, h, w.torque);
+    const int first = ap::schemeHasEndTorques(scheme) ? 0 : 1;
+    double peak_momentum = 0.0, peak_torque = 0.0;
+    for (int k = 0; k <= p.steps; ++k) {
+      peak_momentum = std::max(peak_momentum, replay.momentum[k].cwiseAbs().maxCoeff());
+      if (k >= first && k <= p.steps - first)
+        peak_torque = std::max(peak_torque, w.torque[k].cwiseAbs().maxCoeff());
+    }
+    std::printf("%s: T* = %.9f s, %d iterations, replay peak |h| %.12g, peak |u| %.12g\n",
+                ap::schemeName(scheme).c_str(), r.minimum_duration, r.iterations, peak_momentum,
+                peak_torque);
+    EXPECT_LE(peak_momentum, 0.6 * (1 + 1e-9)) << ap::schemeName(scheme);
+    EXPECT_LE(peak_torque, 0.19 * (1 + 1e-9)) << ap::schemeName(scheme);
+  }
+}
+
 namespace {
 
 /// The peak wheel momentum and torque [N m s, N m] of `p` planned without the wheels' limits.
@@ -623,6 +663,123 @@ TEST(ReactionWheelReplay, WorldDisturbanceIsFlownByTheWheelTorquesToSecondOrder)
   EXPECT_LT(overshoots[0], 1e-2);
   EXPECT_LE(overshoots[2], overshoots[0] / 8.0 + 1e-12);
   EXPECT_GT(undisturbed[2], 100.0 * misses[2]);
+}
+
+/// A converged wheel plan's wheel torques u_k replayed alone on the plan's own scheme
+/// (replayWithWheelsOnTheScheme: the discrete mechanics of body + wheels, independent of the
+/// planner's wheel quantities) for seeded biased pyramid slews of every scheme, spinning ends on
+/// every other, a world disturbance on one (second_order): the replay reproduces the plan's
+/// attitudes and wheel momenta to round-off, so every wheel limit (and the envelope) holds in it to
+/// 1e-9 relative; a torque perturbed at one node by 1e-3 of its limit is caught (the replay leaves
+/// the plan).
+TEST(ReactionWheelReplay, DiscreteReplayFromTheWheelTorquesReproducesThePlanToRoundOff) {
+  std::mt19937 rng(4202);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const ap::SchemeKind schemes[] = {ap::SchemeKind::Paper, ap::SchemeKind::Variational,
+                                    ap::SchemeKind::SecondOrder};
+  int replayed = 0, binding = 0;
+  for (int c = 0; c < 7; ++c) {
+    ap::PlanningProblem p = wheelProblem(schemes[c % 3], c % 2 == 1, 64);
+    p.duration = 20.0;
+    p.final_attitude = ap::so3::exp(ap::Vector3(uniform(rng), uniform(rng), uniform(rng)));
+    for (double& h0 : p.reaction_wheels.initial_momentum) h0 = 0.3 * uniform(rng);
+    p.reaction_wheels.max_momentum = {100.0};
+    p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+    if (c == 5) disturb(&p, ap::Vector3(0.004, -0.006, 0.003));
+    const ap::Vector3 tau_d = p.worldDisturbance();
+    const WheelPeaks peaks = unconstrainedPeaks(p);
+    p.reaction_wheels.max_momentum = {0.85 * peaks.momentum};
+    p.reaction_wheels.max_torque = {1.5 * peaks.torque};
+    if (c % 3 == 2) p.reaction_wheels.max_momentum_norm = 1.1 * peaks.momentum;
+    if (!refusalOf(p).empty()) continue;  // an end state beyond a limit: nothing to replay
+    const ap::PlanResult r = ap::planManeuver(p);
+    if (!r.converged()) {
+      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message.c_str());
+      continue;
+    }
+    ++replayed;
+    if (r.active_constraints > 0) ++binding;
+    const ap::WheelStates w =
+        ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver, tau_d);
+    const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+    Eigen::VectorXd h0(4);
+    for (int i = 0; i < 4; ++i) h0(i) = p.reaction_wheels.initialMomentum(i);
+    const auto replayOf = [&](const std::vector<Eigen::VectorXd>& u) {
+      return ap::replayWithWheelsOnTheScheme(p.scheme, p.inertia, array.axes, p.initial_attitude,
+                                             p.initial_velocity, h0, r.maneuver.time_step, u,
+                                             tau_d);
+    };
+    const auto departure = [&](const ap::DiscreteWheelReplay& replay) {
+      double attitude = 0.0, momentum = 0.0;
+      for (int k = 0; k <= p.steps; ++k) {
+        attitude =
+            std::max(attitude, ap::so3::angleBetween(replay.attitude[k], r.maneuver.attitude[k]));
+        momentum = std::max(momentum, (replay.momentum[k] - w.momentum[k]).cwiseAbs().maxCoeff());
+      }
+      return std::make_pair(attitude, momentum);
+    };
+    const ap::DiscreteWheelReplay replay = replayOf(w.torque);
+    const auto [attitude, momentum] = departure(replay);
+    const double velocity = (replay.node_velocity.back() - p.final_velocity).norm();
+    std::printf(
+        "case %d (%s): attitude departure %.3g rad, wheel momentum departure %.3g N m s, "
+        "terminal velocity %.3g rad/s, %d active\n",
+        c, ap::schemeName(p.scheme).c_str(), attitude, momentum, velocity, r.active_constraints);
+    EXPECT_LT(attitude, 1e-11) << "case " << c;
+    EXPECT_LT(momentum, 1e-11 * peaks.momentum) << "case " << c;
+    EXPECT_LT(velocity, 1e-11) << "case " << c;
+    for (int k = 0; k <= p.steps; ++k) {
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(std::abs(replay.momentum[k](i)), p.reaction_wheels.momentumLimit(i) * (1 + 1e-9))
+            << "case " << c << " k " << k << " wheel " << i;
+      }
+      EXPECT_LE((array.axes * replay.momentum[k]).norm(),
+                p.reaction_wheels.max_momentum_norm * (1 + 1e-9))
+          << "case " << c << " k " << k;
+    }
+    // One wheel's torque off by 1e-3 of its limit at one interior node: the replay leaves the plan.
+    std::vector<Eigen::VectorXd> wrong = w.torque;
+    wrong[p.steps / 3](c % 4) += 1e-3 * p.reaction_wheels.torqueLimit(0);
+    const auto [wrong_attitude, wrong_momentum] = departure(replayOf(wrong));
+    std::printf("  u perturbed at k = %d: departure %.3g rad, %.3g N m s\n", p.steps / 3,
+                wrong_attitude, wrong_momentum);
+    EXPECT_GT(wrong_attitude, 1e4 * std::max(attitude, 1e-16)) << "case " << c;
+    EXPECT_GT(wrong_momentum, 1e-6 * peaks.momentum) << "case " << c;
+  }
+  std::printf("%d replayed, %d with active limits\n", replayed, binding);
+  EXPECT_GE(replayed, 6);
+  EXPECT_GE(binding, replayed / 2);
+}
+
+/// The discrete replay refuses by name what it cannot replay: fourth_order (not a discretization),
+/// fewer than two torque rows, a row or an initial momentum with the wrong number of wheels.
+TEST(ReactionWheelReplay, DiscreteReplayRefusesWhatItCannotReplayByName) {
+  const ap::PlanningProblem p = wheelProblem(ap::SchemeKind::SecondOrder, false, 4);
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> axes = ap::wheelArray(p.reaction_wheels).axes;
+  const Eigen::VectorXd h0 = Eigen::VectorXd::Zero(4);
+  const auto replay = [&](ap::SchemeKind scheme, const Eigen::VectorXd& initial,
+                          const std::vector<Eigen::VectorXd>& u) {
+    return refusal([&] {
+      ap::replayWithWheelsOnTheScheme(scheme, p.inertia, axes, p.initial_attitude,
+                                      p.initial_velocity, initial, 0.5, u);
+    });
+  };
+  const std::vector<Eigen::VectorXd> rows(5, Eigen::VectorXd::Zero(4));
+  EXPECT_NE(replay(ap::SchemeKind::FourthOrder, h0, rows).find("scheme: "), std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::FourthOrder, h0, rows).find("got fourth_order"),
+            std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::SecondOrder, h0, {rows[0]}).find("torque: need at least 2"),
+            std::string::npos);
+  std::vector<Eigen::VectorXd> short_row = rows;
+  short_row[2] = Eigen::VectorXd::Zero(3);
+  EXPECT_NE(replay(ap::SchemeKind::Paper, h0, short_row)
+                .find("torque[2]: expected 4 wheel "
+                      "torques, got 3"),
+            std::string::npos);
+  EXPECT_NE(replay(ap::SchemeKind::Variational, Eigen::VectorXd::Zero(3), rows)
+                .find("initial_momentum: expected 4 values (one per wheel), got 3"),
+            std::string::npos);
+  EXPECT_EQ(replay(ap::SchemeKind::SecondOrder, h0, rows), "");  // at rest: nothing to refuse
 }
 
 // ---- outputs -----------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "attitude_planner/planning/minimum_time.hpp"
+#include "attitude_planner/planning/reaction_wheels.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
@@ -221,6 +222,8 @@ double eigenaxisBangBangDuration(const PlanningProblem& problem) {
   // largest).
   const Vector3 gyroscopic = e.cross(J * e) * (4.0 * angle * angle);  // θ̇² ê × Jê at s = ½
   const Vector3 inertial = J * e * (4.0 * angle);
+  const ReactionWheels& wheels = problem.reaction_wheels;
+  const WheelArray wheel_array = wheels.present() ? wheelArray(wheels) : WheelArray{};
   double T_squared = 0.0;
   for (const double sign : {1.0, -1.0}) {  // accelerating and braking at the peak rate
     const Vector3 tau = sign * inertial + gyroscopic;
@@ -231,6 +234,14 @@ double eigenaxisBangBangDuration(const PlanningProblem& problem) {
     for (const PlanningConstraint& c : problem.constraints)
       if (c.kind == ConstraintKind::MaxTorqueNorm)
         T_squared = std::max(T_squared, tau.norm() / c.limit);
+    // With reaction wheels their torque limits bound it too (a wheel-limited request may have no
+    // other torque bound; T was then 0): the array's torque −τ by the minimum-norm law, u = −A⁺τ
+    // (the gyroscopic term of the wheels' momentum left out of a start's figure).
+    if (wheels.present()) {
+      const Eigen::VectorXd u = wheel_array.pseudo_inverse * tau;
+      for (int i = 0; i < wheels.count(); ++i)
+        T_squared = std::max(T_squared, std::abs(u(i)) / wheels.torqueLimit(i));
+    }
   }
   double T = std::sqrt(T_squared);
   for (const PlanningConstraint& c : problem.constraints)

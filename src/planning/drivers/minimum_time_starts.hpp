@@ -30,9 +30,10 @@ constexpr double kConeStartClearance = 0.01;
 Maneuver excursionSlew(const PlanningProblem& problem, const Vector3& excursion_axis,
                        double excursion);
 
-/// The least T at which the eigenaxis bang–bang slew keeps the torque bounds (per axis and norm)
-/// and rate limits in force: its torques τ = J ê θ̈ + θ̇² ê × J ê scale like 1/T² and its peak
-/// rate 2Θ/T like 1/T, so T follows in closed form from the profile at T = 1.
+/// The least T at which the eigenaxis bang–bang slew keeps the torque bounds (per axis, norm and
+/// the reaction wheels' torque limits under the minimum-norm law) and rate limits in force: its
+/// torques τ = J ê θ̈ + θ̇² ê × J ê scale like 1/T² and its peak rate 2Θ/T like 1/T, so T follows in
+/// closed form from the profile at T = 1.
 double eigenaxisBangBangDuration(const PlanningProblem& problem);
 
 /// One start of the free-time solve.

@@ -36,6 +36,9 @@ struct TwistRun {
   /// A constrained request's interior-point plan (on `steps`) and its multipliers and slacks.
   std::optional<PlanResult> plan;
   LevelDuals duals;
+  /// Where its iterate started (a constrained start: the fixed-twist solve's plan, the attempts
+  /// just before it, else the unconstrained optimum or the geodesic).
+  AttemptStart start = AttemptStart::Hermite;
   bool converged() const { return solve.termination == Termination::Converged; }
 };
 
@@ -150,12 +153,14 @@ TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const Homo
         ConstrainedSystem(at, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
     const ReducedProblem::StepVectors steps = np.current();
     takeInteriorPoint(solveInteriorPointOnGrid(at, options, context, &steps, &duals), &run);
+    run.start = AttemptStart::PreviousAttempt;
   } else {
     // No fixed-twist plan: from the unconstrained twist Newton's answer (re-posed at its twist),
     // else from the geodesic.
     const TwistRun unconstrained = runTwist(at, twist, homotopy, nullptr, tolerance, context, p);
     run.lift = unconstrained.lift;
     const bool from_optimum = unconstrained.converged();
+    if (from_optimum) run.start = AttemptStart::UnconstrainedOptimum;
     PlanningProblem posed = at;
     if (from_optimum) {
       posed.final_attitude = pointingAttitude(at.end_condition, unconstrained.solve.twist);
@@ -326,7 +331,7 @@ std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, doubl
         runs.push_back(
             runTwist(posedAt(problem, steps, twist, c), twist, c, nullptr, tolerance, context, p));
       }
-      const std::size_t at = record(runs.back(), stage, AttemptStart::Hermite, 0, context);
+      const std::size_t at = record(runs.back(), stage, runs.back().start, 0, context);
       if (finals) finals->emplace_back(runs.back(), at);
     }
   }

@@ -125,10 +125,11 @@ fixed-attitude solve at the twist it chose (same N and scheme, one after the oth
 %s
 %s
 With constraints the stationarity is the Lagrangian's, |dL/dpsi| relative. A constrained pointing
-request starts each of 4 twists from the fixed-twist constrained optimum (every way round solved
-under the constraints there) and frees psi in the interior point from it: its time is at least 4
-fixed-attitude solves (at twists where a torque bound is infeasible, each runs until its verdict)
-plus the free-twist solves, against one fixed solve at the chosen twist.
+request starts each of 4 twists from the unconstrained twist optimum (the twist Newton) with psi free
+in the interior point; a start that does not converge so is started again from the fixed-twist
+constrained optimum (every way round solved under the constraints there). The second kind of start
+is what makes a request slow: at twists where a torque bound is infeasible, its fixed-twist solve
+runs until its verdict.
 
 ![cost against the twist](pointing.png)
 

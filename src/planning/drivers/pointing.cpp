@@ -98,9 +98,9 @@ std::optional<PlanResult> fixedTwistPlan(const PlanningProblem& at, const Solver
 
 /// A constrained request's start (stage constraints, torque bounds): the interior point with ψ
 /// free on `at`'s grid, from `coarse` (a coarser level's run: its iterate and duals, `at` posed
-/// at its twist), else from the fixed-attitude constrained optimum at `twist` (fixedTwistPlan),
-/// else from the unconstrained twist Newton's answer on this grid (`at` re-posed at its twist;
-/// the geodesic if it did not converge either).
+/// at its twist), else from the unconstrained twist Newton's answer on this grid (`at` re-posed
+/// at its twist; the geodesic if it did not converge) and, where that does not converge, from
+/// the fixed-attitude constrained optimum at `twist` (fixedTwistPlan).
 TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const HomotopyClass& homotopy,
                              const TwistRun* coarse, double tolerance, SolveContext& context,
                              const NewtonParameters& p);
@@ -127,6 +127,46 @@ TwistRun runTwist(const PlanningProblem& at, double twist, const HomotopyClass& 
   return run;
 }
 
+/// The interior point with ψ free from the unconstrained twist Newton's answer on `at`'s grid (`at`
+/// re-posed at its twist), else from the geodesic at `twist`.
+void fromUnconstrainedOptimum(const PlanningProblem& at, double twist,
+                              const HomotopyClass& homotopy, const SolverOptions& options,
+                              SolveContext& context, const NewtonParameters& p, TwistRun* run) {
+  const TwistRun unconstrained =
+      runTwist(at, twist, homotopy, nullptr, options.tolerance, context, p);
+  run->lift = unconstrained.lift;
+  const bool from_optimum = unconstrained.converged();
+  run->start = from_optimum ? AttemptStart::UnconstrainedOptimum : AttemptStart::Hermite;
+  PlanningProblem posed = at;
+  if (from_optimum) {
+    posed.final_attitude = pointingAttitude(at.end_condition, unconstrained.solve.twist);
+    run->solve.twist = unconstrained.solve.twist;
+  }
+  takeInteriorPoint(
+      solveInteriorPointOnGrid(posed, options, context,
+                               from_optimum ? &unconstrained.iterate : nullptr, nullptr),
+      run);
+}
+
+/// The interior point with ψ free from the constrained optimum at `at`'s twist (every class tried
+/// there): its attitudes, and multipliers re-derived from stationarity (it carries none), as an
+/// initial guess starts. False (run untouched) where that fixed-twist solve has no plan.
+bool fromFixedTwistPlan(const PlanningProblem& at, const SolverOptions& options,
+                        SolveContext& context, TwistRun* run) {
+  const std::optional<PlanResult> fixed = fixedTwistPlan(at, options, context);
+  if (!fixed) return false;
+  ReducedProblem np(at);
+  np.setInteriorFromAttitudes(fixed->maneuver.attitude);
+  const InteriorPointParameters parameters;
+  const LevelDuals duals =
+      ConstrainedSystem(at, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
+  const ReducedProblem::StepVectors steps = np.current();
+  run->solve.twist = twistOf(at.final_attitude, at.end_condition);
+  takeInteriorPoint(solveInteriorPointOnGrid(at, options, context, &steps, &duals), run);
+  run->start = AttemptStart::PreviousAttempt;
+  return true;
+}
+
 TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const HomotopyClass& homotopy,
                              const TwistRun* coarse, double tolerance, SolveContext& context,
                              const NewtonParameters& p) {
@@ -143,33 +183,14 @@ TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const Homo
                                                coarse->duals.empty() ? nullptr : &coarse->duals),
                       &run);
     run.lift = coarse->lift;
-  } else if (const std::optional<PlanResult> fixed = fixedTwistPlan(at, options, context)) {
-    // From the constrained optimum at this twist (every class tried there): its attitudes, and
-    // multipliers re-derived from stationarity (it carries none), as an initial guess starts.
-    ReducedProblem np(at);
-    np.setInteriorFromAttitudes(fixed->maneuver.attitude);
-    const InteriorPointParameters parameters;
-    const LevelDuals duals =
-        ConstrainedSystem(at, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
-    const ReducedProblem::StepVectors steps = np.current();
-    takeInteriorPoint(solveInteriorPointOnGrid(at, options, context, &steps, &duals), &run);
-    run.start = AttemptStart::PreviousAttempt;
   } else {
-    // No fixed-twist plan: from the unconstrained twist Newton's answer (re-posed at its twist),
-    // else from the geodesic.
-    const TwistRun unconstrained = runTwist(at, twist, homotopy, nullptr, tolerance, context, p);
-    run.lift = unconstrained.lift;
-    const bool from_optimum = unconstrained.converged();
-    if (from_optimum) run.start = AttemptStart::UnconstrainedOptimum;
-    PlanningProblem posed = at;
-    if (from_optimum) {
-      posed.final_attitude = pointingAttitude(at.end_condition, unconstrained.solve.twist);
-      run.solve.twist = unconstrained.solve.twist;
+    // The cheap start first; the fixed-twist constrained solve (its classes enumerated) only
+    // where that does not converge.
+    fromUnconstrainedOptimum(at, twist, homotopy, options, context, p, &run);
+    if (!run.converged() && !context.stopReason()) {
+      TwistRun again = run;
+      if (fromFixedTwistPlan(at, options, context, &again)) run = std::move(again);
     }
-    takeInteriorPoint(
-        solveInteriorPointOnGrid(posed, options, context,
-                                 from_optimum ? &unconstrained.iterate : nullptr, nullptr),
-        &run);
   }
   run.solve.iterations = context.iterations() - counted_before;
   return run;
@@ -375,7 +396,8 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     brief << "; attempt " << kept->second - first_recorded + 1 << " of " << result.attempts.size()
           << " kept (" << kPointingStartTwists << " start twists";
     if (problem.hasNodeConstraints()) {
-      brief << ", each from the fixed-twist constrained optimum, its ways round solved there)";
+      brief << ", each from the unconstrained twist optimum, or from the fixed-twist "
+               "constrained optimum where that did not converge)";
     } else {
       brief << " x " << std::size(kPointingClasses) << " ways round)";
     }

@@ -5,7 +5,11 @@
 // solve at the chosen twist (median thread CPU time of `--repeats` runs each, side by side). Writes
 // the raw data as JSON for scripts/plot_pointing.py (docs/results/pointing.md, scripts/pointing).
 //
-//   pointing_study [--count K] [--seed S] [--steps N] [--repeats R] --out RAW.json
+// With `--constrained C`, C more requests with one binding constraint each (in turn a keep-out cone
+// between R_0 b and d, a torque box, a torque norm bound: randomConstrainedPointingRequest).
+//
+//   pointing_study [--count K] [--constrained C] [--seed S] [--steps N] [--repeats R] --out
+//   RAW.json
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -25,7 +29,7 @@ namespace st = attitude_planner::study;
 namespace {
 
 struct Options {
-  int count = 32, steps = 64, repeats = 5;
+  int count = 32, constrained = 12, steps = 64, repeats = 5;
   unsigned seed = 41;
   std::string out;
 };
@@ -36,6 +40,8 @@ Options parse(int argc, char** argv) {
     const std::string flag = argv[i], value = argv[i + 1];
     if (flag == "--count")
       o.count = std::stoi(value);
+    else if (flag == "--constrained")
+      o.constrained = std::stoi(value);
     else if (flag == "--seed")
       o.seed = static_cast<unsigned>(std::stoul(value));
     else if (flag == "--steps")
@@ -84,7 +90,8 @@ std::string list(const std::vector<double>& v) {
 }
 
 /// One request's JSON object: the pointing answer, its sweep and the two times.
-std::string caseJson(unsigned seed, bool spinning, const ap::PlanningProblem& p, int repeats) {
+std::string caseJson(unsigned seed, bool spinning, const std::string& binding,
+                     const ap::PlanningProblem& p, int repeats) {
   double pointing_time = 0.0, fixed_time = 0.0;
   const ap::PlanResult r = timed(p, repeats, &pointing_time);
   ap::PlanningProblem fixed = p;
@@ -95,6 +102,7 @@ std::string caseJson(unsigned seed, bool spinning, const ap::PlanningProblem& p,
       attitude_planner::test_support::sweepTwist(p);
   std::ostringstream out;
   out << "{\"seed\": " << seed << ", \"spinning\": " << (spinning ? "true" : "false")
+      << ", \"binding\": \"" << binding << "\""
       << ", \"scheme\": \"" << ap::schemeName(p.scheme) << "\", \"steps\": " << p.steps
       << ", \"converged\": " << (r.converged() ? "true" : "false")
       << ", \"cost\": " << number(r.cost) << ", \"twist\": " << number(r.pointing.final_twist)
@@ -125,9 +133,26 @@ int main(int argc, char** argv) {
       const ap::SchemeKind scheme = i % 4 < 2 ? ap::SchemeKind::Paper : ap::SchemeKind::SecondOrder;
       const ap::PlanningProblem p =
           attitude_planner::test_support::randomPointingRequest(seed, o.steps, spinning, scheme);
-      out << (i ? ",\n" : "") << caseJson(seed, spinning, p, o.repeats);
+      out << (i ? ",\n" : "") << caseJson(seed, spinning, "none", p, o.repeats);
       out.flush();
       std::cerr << "request " << i + 1 << " of " << o.count << " done\n";
+    }
+    using attitude_planner::test_support::PointingBinding;
+    const std::pair<PointingBinding, const char*> bindings[] = {
+        {PointingBinding::KeepOut, "keep_out"},
+        {PointingBinding::TorqueBox, "torque_box"},
+        {PointingBinding::TorqueNorm, "torque_norm"}};
+    for (int i = 0; i < o.constrained; ++i) {
+      const unsigned seed = o.seed * 1000 + 500 + i;
+      const bool spinning = i % 2 == 1;
+      const ap::SchemeKind scheme = i % 4 < 2 ? ap::SchemeKind::Paper : ap::SchemeKind::SecondOrder;
+      const auto& [binding, name] = bindings[i % 3];
+      const ap::PlanningProblem p =
+          attitude_planner::test_support::randomConstrainedPointingRequest(seed, o.steps, spinning,
+                                                                           scheme, binding);
+      out << (o.count + i ? ",\n" : "") << caseJson(seed, spinning, name, p, o.repeats);
+      out.flush();
+      std::cerr << "constrained request " << i + 1 << " of " << o.constrained << " done\n";
     }
     out << "\n]}\n";
   } catch (const std::exception& e) {

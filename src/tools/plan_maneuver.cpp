@@ -66,7 +66,7 @@ const char* const kUsage =
     "  --point-body-axis BX,BY,BZ  with --point-world-direction DX,DY,DZ: aim the body axis b\n"
     "                            at the world direction d instead of the scene's final attitude,\n"
     "                            the twist about b chosen by the planner (JSON final_twist;\n"
-    "                            rigid_body, minimum effort without constraints)\n"
+    "                            rigid_body, minimum effort, constraints allowed)\n"
     "  --point-world-direction DX,DY,DZ  the world direction d of --point-body-axis\n"
     "  --initial-costate P1,P2,P3  drift_two_input: guess for p(0) (overrides initial_costate)\n"
     "  --warm-start PLAN.csv     start from a previous plan (a CSV this tool wrote with --csv,\n"

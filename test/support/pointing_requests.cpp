@@ -1,8 +1,10 @@
 #include "support/pointing_requests.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/pointing.hpp"
@@ -36,6 +38,35 @@ PlanningProblem randomPointingRequest(unsigned seed, int steps, bool spinning, S
   p.end_condition.body_axis = randomUnit(rng);
   p.end_condition.world_direction = randomUnit(rng);
   return p;
+}
+
+PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool spinning,
+                                                 SchemeKind scheme, PointingBinding binding) {
+  if (binding != PointingBinding::KeepOut) {
+    PlanningProblem p = randomPointingRequest(seed, steps, spinning, scheme);
+    const PlanResult free = planManeuver(p);
+    if (!free.converged()) throw std::runtime_error("unconstrained pointing: " + free.message);
+    Vector3 largest = Vector3::Zero();
+    for (const Vector3& tau : free.maneuver.torque) largest = largest.cwiseMax(tau.cwiseAbs());
+    double largest_norm = 0.0;
+    for (const Vector3& tau : free.maneuver.torque)
+      largest_norm = std::max(largest_norm, tau.norm());
+    if (binding == PointingBinding::TorqueBox) p.max_torque = 0.7 * largest;
+    if (binding == PointingBinding::TorqueNorm) {
+      p.constraints.push_back(PlanningConstraint::maxTorqueNorm(0.7 * largest_norm));
+    }
+    return p;
+  }
+  for (unsigned attempt = 0;; ++attempt) {
+    PlanningProblem p = randomPointingRequest(seed + 1000 * attempt, steps, spinning, scheme);
+    const Vector3 b = p.end_condition.body_axis, d = p.end_condition.world_direction;
+    const Vector3 start = p.initial_attitude * b;
+    const double angle = std::atan2(start.cross(d).norm(), start.dot(d));
+    if (angle < 0.8 || angle > 2.6) continue;
+    const Vector3 between = (start + d).normalized();
+    p.constraints.push_back(PlanningConstraint::keepOut(b, between, 0.35 * angle));
+    return p;
+  }
 }
 
 TwistSweep sweepTwist(const PlanningProblem& pointing) {

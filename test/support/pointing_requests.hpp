@@ -14,6 +14,20 @@ namespace attitude_planner::test_support {
 /// random directions, else rest to rest.
 PlanningProblem randomPointingRequest(unsigned seed, int steps, bool spinning, SchemeKind scheme);
 
+/// What binds in a constrained pointing request (randomConstrainedPointingRequest).
+enum class PointingBinding {
+  KeepOut,     ///< a keep-out cone about the boresight b, between R_0 b and the target d
+  TorqueBox,   ///< |τ_i| ≤ 0.7 × the unconstrained pointing answer's largest |τ_i|
+  TorqueNorm,  ///< |τ| ≤ 0.7 × the unconstrained pointing answer's largest |τ|
+};
+
+/// randomPointingRequest (seed, seed + 1000, … until R_0 b is 0.8 … 2.6 rad from d, for a cone)
+/// with one constraint that binds: the keep-out cone's world direction is the bisector of R_0 b
+/// and d, its half angle 0.35 of their angle (the target and the start clear of it); the torque
+/// bounds are 0.7 of the unconstrained pointing answer's largest torque.
+PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool spinning,
+                                                 SchemeKind scheme, PointingBinding binding);
+
 /// The fixed-attitude optimum (planManeuver, classes enumerated) over the twist ψ of `pointing`'s
 /// end condition: every 5° (`sweep` receives the 72 costs, NaN where a solve did not converge),
 /// the best bracket refined by golden section to |Δψ| < 1e-7 rad.

@@ -205,11 +205,12 @@ TEST(PointingPlan, RequestsItCannotServeAreRefusedByName) {
   EXPECT_NE(refusal(timed).find("final.pointing: not supported with objective minimum_time"),
             std::string::npos)
       << refusal(timed);
-  PlanningProblem coned = p;
-  coned.constraints.push_back(PlanningConstraint::maxAngularRate(1.0));
-  EXPECT_NE(refusal(coned).find("final.pointing: not supported with constraints"),
-            std::string::npos)
-      << refusal(coned);
+  PlanningProblem effected = p;
+  auto effects = std::make_shared<EffectModel>();
+  effects->add(std::make_unique<DisturbanceTorque>(Vector3(0.0, 0.0, 1e-3), TorqueFrame::Body));
+  effected.effects = effects;
+  EXPECT_NE(refusal(effected).find("final.pointing: not supported with effects"), std::string::npos)
+      << refusal(effected);
   PlanningProblem fourth = p;
   fourth.scheme = SchemeKind::FourthOrder;
   EXPECT_NE(refusal(fourth).find("scheme fourth_order"), std::string::npos);

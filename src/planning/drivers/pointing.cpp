@@ -8,6 +8,9 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/drivers/requests.hpp"
+#include "planning/interior_point/constrained_system.hpp"
+#include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/problem/verdict.hpp"
@@ -30,8 +33,22 @@ struct TwistRun {
   ReducedProblem::StepVectors iterate;
   Lift lift;
   std::vector<IterationInfo> history;
+  /// A constrained request's interior-point plan (on `steps`) and its multipliers and slacks.
+  std::optional<PlanResult> plan;
+  LevelDuals duals;
+  /// Where its iterate started (a constrained start: the fixed-twist solve's plan, the attempts
+  /// just before it, else the unconstrained optimum or the geodesic).
+  AttemptStart start = AttemptStart::Hermite;
   bool converged() const { return solve.termination == Termination::Converged; }
 };
+
+/// `problem` on `steps` steps with R_N at `twist` (its way round left free).
+PlanningProblem posedAt(const PlanningProblem& problem, int steps, double twist) {
+  PlanningProblem at = problem;
+  at.steps = steps;
+  at.final_attitude = pointingAttitude(problem.end_condition, twist);
+  return at;
+}
 
 /// `problem` on `steps` steps with R_N at `twist`, in `homotopy`.
 PlanningProblem posedAt(const PlanningProblem& problem, int steps, double twist,
@@ -50,6 +67,43 @@ int surveySteps(const PlanningProblem& problem, const NewtonParameters& p) {
   }
   return problem.steps;
 }
+
+/// The interior point's outcome as a twist run: ψ, cost and stationarity from its plan.
+void takeInteriorPoint(GridOutcome outcome, TwistRun* run) {
+  const PlanResult& r = outcome.result;
+  run->solve.termination = r.termination;
+  run->solve.reason = r.message;
+  run->solve.iterations = r.iterations;
+  run->solve.twist = r.pointing.active ? r.pointing.final_twist : run->solve.twist;
+  run->solve.cost = r.cost;
+  run->solve.twist_gradient = r.pointing.twist_gradient;
+  run->solve.relative_gradient = r.max_residual;
+  run->solve.relative_decrement = r.newton_decrement;
+  run->history = r.history;
+  run->iterate = std::move(outcome.steps);
+  run->duals = std::move(outcome.duals);
+  run->plan = std::move(outcome.result);
+}
+
+/// The fixed-attitude constrained plan at `at`'s end attitude (the request's own driver: its
+/// classes enumerated under the constraints), if it converged.
+std::optional<PlanResult> fixedTwistPlan(const PlanningProblem& at, const SolverOptions& options,
+                                         SolveContext& context) {
+  PlanningProblem fixed = at;
+  fixed.end_condition = EndCondition();
+  PlanResult plan = planAtResolution(fixed, options, context);
+  if (!plan.converged() || plan.maneuver.steps() != at.steps) return std::nullopt;
+  return plan;
+}
+
+/// A constrained request's start (stage constraints, torque bounds): the interior point with ψ
+/// free on `at`'s grid, from `coarse` (a coarser level's run: its iterate and duals, `at` posed
+/// at its twist), else from the fixed-attitude constrained optimum at `twist` (fixedTwistPlan)
+/// and, where that has no plan or does not converge, from the unconstrained twist Newton's answer
+/// on this grid (`at` re-posed at its twist; the geodesic if it did not converge).
+TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const HomotopyClass& homotopy,
+                             const TwistRun* coarse, double tolerance, SolveContext& context,
+                             const NewtonParameters& p);
 
 /// One twist Newton solve on `at` from `coarse` (a coarser grid's iterate) or the Hermite curve.
 TwistRun runTwist(const PlanningProblem& at, double twist, const HomotopyClass& homotopy,
@@ -70,6 +124,78 @@ TwistRun runTwist(const PlanningProblem& at, double twist, const HomotopyClass& 
     run.solve.termination = Termination::StepTooLarge;
     run.solve.reason = std::string("boundary velocity: ") + e.what();
   }
+  return run;
+}
+
+/// The interior point with ψ free from the unconstrained twist Newton's answer on `at`'s grid (`at`
+/// re-posed at its twist), else from the geodesic at `twist`.
+void fromUnconstrainedOptimum(const PlanningProblem& at, double twist,
+                              const HomotopyClass& homotopy, const SolverOptions& options,
+                              SolveContext& context, const NewtonParameters& p, TwistRun* run) {
+  const TwistRun unconstrained =
+      runTwist(at, twist, homotopy, nullptr, options.tolerance, context, p);
+  run->lift = unconstrained.lift;
+  const bool from_optimum = unconstrained.converged();
+  run->start = from_optimum ? AttemptStart::UnconstrainedOptimum : AttemptStart::Hermite;
+  PlanningProblem posed = at;
+  if (from_optimum) {
+    posed.final_attitude = pointingAttitude(at.end_condition, unconstrained.solve.twist);
+    run->solve.twist = unconstrained.solve.twist;
+  }
+  takeInteriorPoint(
+      solveInteriorPointOnGrid(posed, options, context,
+                               from_optimum ? &unconstrained.iterate : nullptr, nullptr),
+      run);
+}
+
+/// The interior point with ψ free from the constrained optimum at `at`'s twist (every class tried
+/// there): its attitudes, and multipliers re-derived from stationarity (it carries none), as an
+/// initial guess starts. False (run untouched) where that fixed-twist solve has no plan.
+bool fromFixedTwistPlan(const PlanningProblem& at, const SolverOptions& options,
+                        SolveContext& context, TwistRun* run) {
+  const std::optional<PlanResult> fixed = fixedTwistPlan(at, options, context);
+  if (!fixed) return false;
+  ReducedProblem np(at);
+  np.setInteriorFromAttitudes(fixed->maneuver.attitude);
+  const InteriorPointParameters parameters;
+  const LevelDuals duals =
+      ConstrainedSystem(at, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
+  const ReducedProblem::StepVectors steps = np.current();
+  run->solve.twist = twistOf(at.final_attitude, at.end_condition);
+  takeInteriorPoint(solveInteriorPointOnGrid(at, options, context, &steps, &duals), run);
+  run->start = AttemptStart::PreviousAttempt;
+  return true;
+}
+
+TwistRun runConstrainedTwist(const PlanningProblem& at, double twist, const HomotopyClass& homotopy,
+                             const TwistRun* coarse, double tolerance, SolveContext& context,
+                             const NewtonParameters& p) {
+  SolverOptions options = context.options();
+  options.tolerance = tolerance;
+  TwistRun run;
+  run.homotopy = homotopy;
+  run.start_twist = twist;
+  run.steps = at.steps;
+  run.solve.twist = twist;
+  const int counted_before = context.iterations();
+  if (coarse) {
+    takeInteriorPoint(solveInteriorPointOnGrid(at, options, context, &coarse->iterate,
+                                               coarse->duals.empty() ? nullptr : &coarse->duals),
+                      &run);
+    run.lift = coarse->lift;
+  } else {
+    // From the fixed-twist constrained optimum first: its solve enumerates the ways round under
+    // the constraints (the free-ψ interior point keeps the class it starts in, and from the
+    // unconstrained optimum it ended in a costlier class on seeded requests: 0.1059 against the
+    // swept 0.1031, 0.2916 against 0.2466). The unconstrained optimum where that has no plan.
+    const bool fixed = fromFixedTwistPlan(at, options, context, &run);
+    if ((!fixed || !run.converged()) && !context.stopReason()) {
+      TwistRun again = run;
+      fromUnconstrainedOptimum(at, twist, homotopy, options, context, p, &again);
+      if (!fixed || again.converged()) run = std::move(again);
+    }
+  }
+  run.solve.iterations = context.iterations() - counted_before;
   return run;
 }
 
@@ -139,7 +265,9 @@ TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveConte
                                   : std::max(context.options().tolerance, p.coarse_tolerance_floor);
     const PlanningProblem at = posedAt(problem, steps, run.solve.twist, from.homotopy);
     TwistRun next =
-        runTwist(at, run.solve.twist, from.homotopy, &run.iterate, tolerance, context, p);
+        at.hasNodeConstraints()
+            ? runConstrainedTwist(at, run.solve.twist, from.homotopy, &run, tolerance, context, p)
+            : runTwist(at, run.solve.twist, from.homotopy, &run.iterate, tolerance, context, p);
     next.start_twist = from.start_twist;
     next.history.insert(next.history.begin(), run.history.begin(), run.history.end());
     run = std::move(next);
@@ -149,9 +277,25 @@ TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveConte
   return run;
 }
 
+/// A constrained run's plan (the interior point's, judged against the end attitude it chose) with
+/// the pointing part of its message.
+PlanResult constrainedResultOf(const TwistRun& run) {
+  PlanResult result = *run.plan;
+  result.iterations = run.solve.iterations;
+  result.history = run.history;
+  result.extremal_summary = extremalOf(run.lift);
+  std::ostringstream msg;
+  msg << result.message << "; pointing: twist " << result.pointing.final_twist
+      << " rad, d L/d twist " << result.pointing.twist_gradient << " (relative "
+      << result.pointing.twist_stationarity << ")";
+  result.message = msg.str();
+  return result;
+}
+
 /// The plan of `run` (on the requested grid) with its figures, the pointing summary and the
 /// message.
 PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
+  if (run.plan) return constrainedResultOf(run);
   PlanResult result;
   PlanningProblem chosen = posedAt(problem, problem.steps, run.solve.twist, run.homotopy);
   ReducedProblem np(chosen);
@@ -202,9 +346,16 @@ std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, doubl
     const double twist = std::remainder(base + 2.0 * M_PI * i / kPointingStartTwists, 2.0 * M_PI);
     for (const HomotopyClass& c : kPointingClasses) {
       if (context.stopReason()) return runs;
-      runs.push_back(
-          runTwist(posedAt(problem, steps, twist, c), twist, c, nullptr, tolerance, context, p));
-      const std::size_t at = record(runs.back(), stage, AttemptStart::Hermite, 0, context);
+      if (problem.hasNodeConstraints()) {
+        // The fixed-twist solve enumerates the ways round under the constraints itself.
+        if (&c != &kPointingClasses[0]) continue;
+        runs.push_back(runConstrainedTwist(posedAt(problem, steps, twist), twist, c, nullptr,
+                                           tolerance, context, p));
+      } else {
+        runs.push_back(
+            runTwist(posedAt(problem, steps, twist, c), twist, c, nullptr, tolerance, context, p));
+      }
+      const std::size_t at = record(runs.back(), stage, runs.back().start, 0, context);
       if (finals) finals->emplace_back(runs.back(), at);
     }
   }
@@ -236,11 +387,23 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
   }
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());
   result.pointing.starts = static_cast<int>(survey.size());
-  if (result.attempts.size() > 1 && kept) {
+  if (kept) {
     std::ostringstream brief;
-    brief << result.message << "; attempt " << kept->second - first_recorded + 1 << " of "
-          << result.attempts.size() << " kept (" << kPointingStartTwists << " start twists x "
-          << std::size(kPointingClasses) << " ways round)";
+    brief << result.message;
+    // Each start's verdict is local (its ψ and way round): no start converged, which is not a
+    // proof that no twist admits a plan.
+    if (!kept->first.converged()) {
+      brief << "; no twist start converged (" << survey.size()
+            << " starts; each verdict is local to its start twist)";
+    }
+    brief << "; attempt " << kept->second - first_recorded + 1 << " of " << result.attempts.size()
+          << " kept (" << kPointingStartTwists << " start twists";
+    if (problem.hasNodeConstraints()) {
+      brief << ", each from the fixed-twist constrained optimum, its ways round solved there, "
+               "or from the unconstrained twist optimum where that did not converge)";
+    } else {
+      brief << " x " << std::size(kPointingClasses) << " ways round)";
+    }
     result.message = brief.str();
   }
   return result;
@@ -262,7 +425,9 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   const NewtonParameters& p = newtonDefaults();
   const std::size_t first_recorded = context.attempts().size();
   const int counted_at_start = context.iterations();
-  const int survey_steps = surveySteps(problem, p);
+  // Constrained: the starts on the requested grid (coarse grids tighten the cones' margins and
+  // change which torque bounds are feasible: a coarse survey's answers need not carry over).
+  const int survey_steps = problem.hasNodeConstraints() ? problem.steps : surveySteps(problem, p);
   const bool on_requested = survey_steps == problem.steps;
   const double survey_tolerance =
       on_requested ? options.tolerance : std::max(options.tolerance, p.coarse_tolerance_floor);

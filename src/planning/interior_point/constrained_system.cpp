@@ -26,24 +26,55 @@ LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
   return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
 }
 
-/// Adds M (local 9×9, lower triangle used) to the banded Hessian.
+/// The twist ψ's motion of the local nodes first_node..first_node+width−1 (ReducedProblem::
+/// twistMotion; zero without a pointing end condition): a local 9-vector g has ψ-component gᵀe.
+Eigen::Matrix<double, 9, 1> localTwist(const ReducedProblem& np, int first_node, int width) {
+  Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero();
+  if (!np.hasTwist()) return e;
+  for (int n = 0; n < width; ++n) e.segment<3>(3 * n) = np.twistMotion(first_node + n);
+  return e;
+}
+
+/// Adds M (local 9×9, lower triangle used) to the banded Hessian and, with a twist, (M e)_free to
+/// its border column and eᵀM e to its corner (ψ moves R_N and R_{N−1} linearly in their
+/// perturbation coordinates: reduced_problem_twist.cpp).
 template <typename Scalar>
-void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node, int width,
-              const Eigen::Matrix<double, 9, 9>& M) {
+void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, TwistBorder* border,
+              int first_node, int width, const Eigen::Matrix<double, 9, 9>& M) {
   const LocalSlots l = localSlots(np, first_node, width);
   if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
+  if (!border) return;
+  const Eigen::Matrix<double, 9, 1> e = localTwist(np, first_node, width);
+  if (e.isZero()) return;
+  const Eigen::Matrix<double, 9, 1> Me = M.selfadjointView<Eigen::Lower>() * e;
+  border->corner += e.dot(Me);
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) border->column.segment<3>(v) += Me.segment<3>(3 * n);
+  }
 }
 
 /// Adds weight·g gᵀ (local) to the banded Hessian, each product formed in its own precision (see
-/// interior_point_solver.cpp: the precision rule). Rounding the weight only scales the term.
+/// interior_point_solver.cpp: the precision rule). Rounding the weight only scales the term. With
+/// a twist, weight·(gᵀe)·g_free to the border and weight·(gᵀe)² to the corner.
 template <typename Scalar>
-void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node,
-                     int width, const Eigen::Matrix<double, 9, 1>& g, double weight) {
+void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, TwistBorder* border,
+                     int first_node, int width, const Eigen::Matrix<double, 9, 1>& g,
+                     double weight) {
   const LocalSlots l = localSlots(np, first_node, width);
   if (!l.empty()) H->template addRankOne<9>(l.offset, g, weight, l.first, l.last);
+  if (!border) return;
+  const double ge = g.dot(localTwist(np, first_node, width));
+  if (ge == 0.0) return;
+  border->corner += weight * ge * ge;
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) border->column.segment<3>(v) += (weight * ge) * g.segment<3>(3 * n);
+  }
 }
 
-/// gᵀ dδ over the local nodes (fixed nodes contribute nothing).
+/// gᵀ dδ over the local nodes (fixed nodes contribute nothing), plus gᵀe dψ with a twist (the
+/// last entry of d).
 double localDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, int first_node,
                 int width, const Eigen::VectorXd& d) {
   double sum = 0.0;
@@ -51,6 +82,7 @@ double localDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, 
     const int v = np.variableIndex(first_node + n);
     if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
   }
+  if (np.hasTwist()) sum += g.dot(localTwist(np, first_node, width)) * d(np.unknowns());
   return sum;
 }
 
@@ -60,6 +92,7 @@ void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>&
     const int v = np.variableIndex(first_node + n);
     if (v >= 0) out->segment<3>(v) += weight * g.segment<3>(3 * n);
   }
+  if (np.hasTwist()) (*out)(np.unknowns()) += weight * g.dot(localTwist(np, first_node, width));
 }
 
 }  // namespace
@@ -78,7 +111,13 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
   groups_.reserve(constraints_.size());
   for (const auto& c : constraints_) {
     // In place: `at` is ~150 bytes per node.
-    const FixedStepRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
+    FixedStepRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
+    // A free twist moves R_N (and R_{N−1} of paper and variational): rows on them too.
+    if (np_.hasTwist()) {
+      g.support =
+          g.quantity->supportWithTwist(np_.firstFreeNode(), np_.lastFreeNode(), np_.steps());
+      g.at.resize(g.support.last_k - g.support.first_k + 1);
+    }
     constraint_count_ += static_cast<int>(g.at.size());
   }
   QuantityBlocks blocks = quantityBlocks(constraints_);
@@ -123,8 +162,9 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedS
                                      Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient) {
   const int n = np_.unknowns();
   if (H) H->setZero();
-  rhs->setZero(n);
-  merit_gradient->setZero(n);
+  if (H && np_.hasTwist()) twist_border_ = {Eigen::VectorXd::Zero(n), 0.0};
+  rhs->setZero(n + globals());
+  merit_gradient->setZero(n + globals());
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
   for (const std::vector<int>& block : quantity_blocks_)
@@ -181,16 +221,17 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
         const FixedStepRow& in = g->instance(st.k);
         const int a = g->constraint->axis();
         if (a < 0) {
-          addLocalRankOne(np_, H, st.k - 1, 3, in.g, 1.0 / in.D);
+          addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
         } else {
           const double slope = g->constraint->gradient(tau)(a) / r;
           weight(a) += slope * slope / in.D;
         }
       }
       for (int a = 0; a < 3; ++a) {
-        addLocalRankOne(np_, H, st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
+        addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, st.jacobian.row(a).transpose(),
+                        weight(a));
       }
-      addLocal(np_, H, st.k - 1, 3, st.second);
+      addLocal(np_, H, twistSink(), st.k - 1, 3, st.second);
     }
     addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
     addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
@@ -234,10 +275,10 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
       }
     }
     if (!H) return;
-    addLocal(np_, H, node, support.width, curvature);
+    addLocal(np_, H, twistSink(), node, support.width, curvature);
     for (const int i : block) {
       const FixedStepRow& in = groups_[i].instance(t.k);
-      addLocalRankOne(np_, H, node, support.width, in.g, 1.0 / in.D);
+      addLocalRankOne(np_, H, twistSink(), node, support.width, in.g, 1.0 / in.D);
     }
   };
   first.quantity->forEachTerms(np_, support, contract, visit);
@@ -437,13 +478,19 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
   const double scale =
       assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient).gradient_scale;
   Eigen::VectorXd residual;
-  np_.evaluate(&residual, nullptr, &unused);  // ∇f
+  if (np_.hasTwist()) {
+    np_.evaluateWithTwist(&residual, nullptr, nullptr, nullptr, &unused);  // ∇f, ∂f/∂ψ last
+  } else {
+    np_.evaluate(&residual, nullptr, &unused);  // ∇f
+  }
   for (const FixedStepRows& g : groups_) {
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       const FixedStepRow& in = g.at[k - g.support.first_k];
       addLocalVector(np_, in.g, -in.z, k + g.support.node_offset, g.support.width, &residual);
     }
   }
+  twist_gradient_ = np_.hasTwist() ? residual(np_.unknowns()) : 0.0;
+  twist_stationarity_ = scale > 0 ? std::abs(twist_gradient_) / scale : 0.0;
   return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
 }
 

@@ -36,13 +36,30 @@ struct Assembly {
   double gradient_scale = 0.0;  ///< max|∂τ/∂δ| · max|τ|
 };
 
+/// The twist ψ's border of the condensed system (a pointing end condition, ψ a global unknown):
+/// the column ∂²φ/∂δ∂ψ over the node unknowns and the corner ∂²φ/∂ψ².
+struct TwistBorder {
+  Eigen::VectorXd column;
+  double corner = 0.0;
+};
+
 /// The node constraints of one problem in one formulation, and the condensed Newton system.
+/// With a pointing end condition (ReducedProblem::hasTwist) the unknowns are (δ, ψ): every vector
+/// has unknowns() + 1 entries, ψ last, and an assembly with H fills twistBorder() too.
 class ConstrainedSystem final : public BarrierState {
  public:
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
                     const InteriorPointParameters& parameters);
 
   int constraintCount() const { return constraint_count_; }
+  /// Global unknowns beside the node unknowns: 1 (ψ) with a pointing end condition, else 0.
+  int globals() const { return np_.hasTwist() ? 1 : 0; }
+  /// The last assembly's ψ border (globals() == 1 only).
+  const TwistBorder& twistBorder() const { return twist_border_; }
+  /// ∂L/∂ψ = ∂f/∂ψ − Σ zᵢ∂cᵢ/∂ψ [N²·m²/rad] and its size relative as relativeStationarity's
+  /// (set by it; 0 without a twist).
+  double twistGradient() const { return twist_gradient_; }
+  double twistStationarity() const { return twist_stationarity_; }
   bool freeSlacks() const { return free_slacks_; }
   /// Polled every kColumnsBetweenPolls nodes during an assembly (null: never).
   void setInterruption(const Interruption* interruption) { interruption_ = interruption; }
@@ -120,6 +137,8 @@ class ConstrainedSystem final : public BarrierState {
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
+  /// Where the assembly's ψ border goes (null without a twist).
+  TwistBorder* twistSink() { return np_.hasTwist() ? &twist_border_ : nullptr; }
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
@@ -134,6 +153,8 @@ class ConstrainedSystem final : public BarrierState {
   std::vector<std::vector<int>> quantity_blocks_;
   int constraint_count_ = 0;
   const Interruption* interruption_ = nullptr;
+  TwistBorder twist_border_;
+  double twist_gradient_ = 0.0, twist_stationarity_ = 0.0;
 };
 
 }  // namespace attitude_planner

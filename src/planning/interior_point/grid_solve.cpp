@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
@@ -64,6 +65,7 @@ class GridSolve final : public PrimalDualProblem {
         free_slacks_(system_.freeSlacks()),
         inertia_(parameters),
         kkt_blocks_(np->unknowns()),
+        kkt_(makeKkt<Scalar>(system_.globals())),
         test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
               free_slacks_) {
     system_.setInterruption(&context);
@@ -169,10 +171,14 @@ class GridSolve final : public PrimalDualProblem {
     for (int attempt = 0; attempt < 2 && !d.factored; ++attempt) {
       d.cost = system_.assemble(mu_, rho_, primal, &kkt_blocks_.band, &rhs_, &merit_gradient_).cost;
       if (!std::isfinite(d.cost)) break;
-      d.factored = inertia_.factorAndSolve(kkt_, kkt_blocks_, rhs_, &delta_, &d.shift, &context_);
+      if (system_.globals() == 1) {  // the twist ψ's border (a pointing end condition)
+        kkt_blocks_.border = system_.twistBorder().column;
+        kkt_blocks_.corner = Eigen::MatrixXd::Constant(1, 1, system_.twistBorder().corner);
+      }
+      d.factored = inertia_.factorAndSolve(*kkt_, kkt_blocks_, rhs_, &delta_, &d.shift, &context_);
       if (d.factored && !primal && mu_ > scales_.mu_final) {
         barrier_->beforeStep(
-            system_, [this](Eigen::VectorXd* b) { kkt_.solve(b); }, rhs_, scales_,
+            system_, [this](Eigen::VectorXd* b) { kkt_->solve(b); }, rhs_, scales_,
             test_.previousDecrement(), &mu_, &delta_);
       }
       d.slope = merit_gradient_.dot(delta_);
@@ -211,11 +217,16 @@ class GridSolve final : public PrimalDualProblem {
   // iterate's slacks moved with the step.
   double merit() override { return system_.assembledMerit(cost_, mu_, penalty()); }
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
-    trial_ = np_.retract(d, alpha);
+    trial_ = retracted(d, alpha);
     if (moved) *moved = true;
     return system_.merit(trial_, mu_, penalty(), nullptr, alpha);
   }
-  void moveTo(const Eigen::VectorXd& d, double alpha) override { trial_ = np_.retract(d, alpha); }
+  void moveTo(const Eigen::VectorXd& d, double alpha) override { trial_ = retracted(d, alpha); }
+  /// The iterate moved by α d; with a twist, ψ by α d(n) too (R_N and the steps next to it).
+  ReducedProblem::StepVectors retracted(const Eigen::VectorXd& d, double alpha) const {
+    if (!np_.hasTwist()) return np_.retract(d, alpha);
+    return np_.retractWithTwist(d, d(np_.unknowns()), alpha);
+  }
   void restore() override {}  // the trials never moved the accepted iterate
   double penalty() const { return free_slacks_ ? nu_ : rho_; }
 
@@ -248,7 +259,11 @@ class GridSolve final : public PrimalDualProblem {
       alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
     }
     system_.applyDualStep(dz_, std::min(alpha_dual_, 1.0));
-    np_.setCurrent(trial);
+    if (np_.hasTwist()) {
+      np_.setCurrentWithTwist(trial, alpha * delta_(np_.unknowns()));
+    } else {
+      np_.setCurrent(trial);
+    }
     inertia_.relax();
   }
 
@@ -290,6 +305,29 @@ class GridSolve final : public PrimalDualProblem {
     return Pass::Stop;
   }
 
+  /// The problem as the iterate poses it: with a pointing end condition, R_N at the iterate's
+  /// twist (the plan is judged against the end attitude it chose).
+  PlanningProblem posedAtIterate() const {
+    PlanningProblem posed = problem_;
+    if (np_.hasTwist()) {
+      const Matrix3 end = np_.attitudes(np_.current()).back();
+      posed.final_attitude =
+          pointingAttitude(problem_.end_condition, twistOf(end, problem_.end_condition));
+    }
+    return posed;
+  }
+
+  /// The pointing summary of the plan: ψ, the end condition's residual, ∂L/∂ψ and its relative
+  /// size (relativeStationarity formed them).
+  void reportTwist(const Maneuver& planned, PlanResult* result) const {
+    PointingSummary& p = result->pointing;
+    p.active = true;
+    p.final_twist = twistOf(planned.attitude.back(), problem_.end_condition);
+    p.error = pointingError(planned.attitude.back(), problem_.end_condition);
+    p.twist_gradient = system_.twistGradient();
+    p.twist_stationarity = system_.twistStationarity();
+  }
+
   /// The result: the plan at the last accepted iterate, its figures and the message.
   GridOutcome finish() {
     GridOutcome out;
@@ -305,22 +343,24 @@ class GridSolve final : public PrimalDualProblem {
     // residuals are measured, a stopped one's too (one more gradient at N: what a user reads to
     // tell a stopped iterate from an answer).
     result.max_residual = std::numeric_limits<double>::quiet_NaN();
+    const PlanningProblem posed = posedAtIterate();
     if (!ranOut(ending_) || request_.evaluate_when_stopped) {
       const Maneuver planned = np_.maneuver(np_.current());
       result.switching_function = system_.switchingFunction(planned.torque);
       result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
-      evaluatePlan(problem_, planned.torque, &result, &planned);
+      evaluatePlan(posed, planned.torque, &result, &planned);
+      if (np_.hasTwist()) reportTwist(planned, &result);
     }
     std::ostringstream msg;
     if (ending_ == Termination::Infeasible) {
-      const ConstraintCheck check = checkConstraints(problem_, result.maneuver);
+      const ConstraintCheck check = checkConstraints(posed, result.maneuver);
       msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
           << " " << describeManeuverSpan(problem_)
           << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
           << ")";
     } else {
       if (ending_ == Termination::Converged) {
-        const std::string inconsistent = planInconsistency(problem_, result, true);
+        const std::string inconsistent = planInconsistency(posed, result, true);
         if (!inconsistent.empty()) {
           ending_ = Termination::NotConverged;
           reason_ = inconsistent;
@@ -352,8 +392,9 @@ class GridSolve final : public PrimalDualProblem {
   const bool free_slacks_;
   RowRelativeShift
       inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
-  KktBlocks<Scalar> kkt_blocks_;  ///< the condensed system (a band: no global unknowns at fixed h)
-  BandKkt<Scalar> kkt_;
+  /// The condensed system: a band, bordered by the twist ψ with a pointing end condition.
+  KktBlocks<Scalar> kkt_blocks_;
+  std::unique_ptr<KktSystem<Scalar>> kkt_;
   DecrementTest test_;   ///< the stopping test and its memory (stalls, the last step)
   StopVerdict verdict_;  ///< its verdict on the current direction
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
@@ -399,7 +440,10 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
   }
   // R_0 and R_N are checked up front (problem validation); R_1, R_{N−1} where the boundary
   // velocities fix them are not unknowns: no plan at this N repairs a cone they violate.
-  const std::string fixed = fixedNodeConeViolation(problem, np, {1, np.steps() - 1});
+  // A free twist moves R_{N−1} (paper, variational): its cone is a row then, not data.
+  const std::string fixed = np.hasTwist()
+                                ? fixedNodeConeViolation(problem, np, {1})
+                                : fixedNodeConeViolation(problem, np, {1, np.steps() - 1});
   if (!fixed.empty()) {
     out.result.termination = Termination::Infeasible;
     out.result.message = "infeasible: " + fixed +

@@ -15,7 +15,9 @@ bool RowRelativeShift::factorAndSolve(KktSystem<Scalar>& kkt, const KktBlocks<Sc
   *shift = floor_;
   for (int tries = 0; tries < p_.max_inertia_corrections; ++tries) {
     *d = rhs;
-    if (kkt.factor(k, {*shift, Shift::Rule::RowRelative, row_floor}, interruption)) {
+    // With global unknowns (a twist) the Schur complement must be positive too: a descent step.
+    if (kkt.factor(k, {*shift, Shift::Rule::RowRelative, row_floor}, interruption) &&
+        kkt.inertia().negative == 0) {
       kkt.solve(d);
       if (d->allFinite()) return true;
     }

@@ -460,6 +460,17 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   return result;
 }
 
+GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                                     SolveContext& context,
+                                     const ReducedProblem::StepVectors* start_steps,
+                                     const LevelDuals* start_duals) {
+  const InteriorPointParameters parameters;
+  SolverOptions from = options;
+  from.warm_start = nullptr;  // the start is start_steps
+  from.constrained_from_warm_start = false;
+  return solveGridWithRetry(problem, from, {parameters, context}, start_steps, start_duals);
+}
+
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
                                            const SolverOptions& options, SolveContext& context) {
   // The guess (a plan of this N, e.g. the remainder of the plan being flown) starts the

@@ -4,6 +4,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/grid_solve.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
 
@@ -18,6 +19,16 @@ namespace attitude_planner {
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
                                   SolveContext& context,
                                   const InteriorPointParameters& parameters = {});
+
+/// The interior point on `problem`'s own grid alone (no grid continuation, no staged retry), for a
+/// driver that runs its own levels (pointing): from `start_steps` (steps of this N, or of a coarser
+/// grid's solution) with `start_duals` (free slacks; may be null), else from the geodesic, in the
+/// request's formulation with its retry. Reports its iterations through `context`; records no
+/// attempt.
+GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const SolverOptions& options,
+                                     SolveContext& context,
+                                     const ReducedProblem::StepVectors* start_steps,
+                                     const LevelDuals* start_duals);
 
 /// The interior point from options.warm_start (a plan given as the initial guess, with the
 /// problem's N: initialGuessOnGrid) rather than from the unconstrained optimum.

@@ -50,9 +50,13 @@ bool BorderedBandKkt<Scalar>::factor(const KktBlocks<Scalar>& k, const Shift& sh
                                      const Interruption*) {
   std::optional<BandedSymmetric<Scalar>> copy;
   const BandedSymmetric<Scalar>& A = shiftedBand(k.band, shift, &copy);
-  // The uniform shift reaches the globals' diagonal too (a zero shift adds nothing).
+  // The shift reaches the globals' diagonal too (a zero shift adds nothing): uniform, or relative
+  // to each global's own diagonal entry as to a band row's.
   Eigen::MatrixXd D = k.corner;
   if (shift.rule == Shift::Rule::Uniform) D.diagonal().array() += shift.value;
+  if (shift.rule == Shift::Rule::RowRelative) {
+    D.diagonal().array() += shift.value * (D.diagonal().array().abs() + shift.row_floor);
+  }
   return factor_.factor(A, k.border, D);
 }
 

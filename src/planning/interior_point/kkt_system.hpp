@@ -33,7 +33,8 @@ struct KktBlocks {
   Eigen::MatrixXd corner;  ///< D: m × m
 };
 
-/// The diagonal shift added before a factorization. RowRelative (fixed h): A(i, i) += value ·
+/// The diagonal shift added before a factorization. RowRelative (fixed h; a twist's corner alike):
+/// A(i, i) += value ·
 /// (|A(i, i)| + row_floor) on the band's rows (BandedSymmetric::addRelativeToDiagonal); Uniform
 /// (free time): value on every diagonal entry of A and D. A zero value leaves the band as it is.
 struct Shift {

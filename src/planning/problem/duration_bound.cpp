@@ -96,10 +96,19 @@ DurationLowerBound durationLowerBound(const PlanningProblem& problem) {
       Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues().minCoeff();
   const Vector3 pi0 = problem.initial_attitude * problem.inertia * problem.initial_velocity;
   const Vector3 piT = problem.final_attitude * problem.inertia * problem.final_velocity;
-  const double theta = so3::angleBetween(problem.initial_attitude, problem.final_attitude);
+  double theta = so3::angleBetween(problem.initial_attitude, problem.final_attitude);
+  double momentum_change = (piT - pi0).norm();
+  if (problem.end_condition.pointing()) {
+    // R_N is any R_N(ψ): every one turns R_0 b onto d (at least their angle), and |R_N JΩ(T)| is
+    // the same for every ψ (the change at least the difference of the norms).
+    const Vector3 from = problem.initial_attitude * problem.end_condition.body_axis.normalized();
+    const Vector3 to = problem.end_condition.world_direction.normalized();
+    theta = std::atan2(from.cross(to).norm(), from.dot(to));
+    momentum_change = std::abs(piT.norm() - pi0.norm());
+  }
   const PathLengthBound g{a, w, lambda, pi0.norm(), piT.norm()};
   const double for_angle = leastDurationForAngle(g, theta);
-  const double for_momentum = std::isfinite(a) ? (piT - pi0).norm() / a : 0.0;
+  const double for_momentum = std::isfinite(a) ? momentum_change / a : 0.0;
   bound.seconds = std::max(for_angle, for_momentum);
   if (!(bound.seconds > 0.0)) return bound;
   std::ostringstream basis;
@@ -115,7 +124,7 @@ DurationLowerBound durationLowerBound(const PlanningProblem& problem) {
   }
   basis << ", and the body must turn " << exactNumber(theta) << " rad"
         << (for_momentum > for_angle
-                ? " and change its momentum by " + exactNumber((piT - pi0).norm()) + " N m s"
+                ? " and change its momentum by " + exactNumber(momentum_change) + " N m s"
                 : "");
   bound.basis = basis.str();
   return bound;

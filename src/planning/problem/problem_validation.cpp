@@ -48,6 +48,8 @@ void requireBoundaryWithinConstraints(const PlanningProblem& p) {
       const std::pair<const char*, const Matrix3*> ends[] = {
           {"initial.attitude", &p.initial_attitude}, {"final.attitude", &p.final_attitude}};
       for (const auto& [field, R] : ends) {
+        // A pointing end's R_N moves with its free twist: its cone is a row of the solve.
+        if (R == &p.final_attitude && p.end_condition.pointing()) continue;
         const double margin = coneMargin(c, *R);
         if (margin < 0.0) {
           throw InvalidInput(
@@ -181,12 +183,10 @@ void requirePointingServed(const PlanningProblem& p) {
   const auto refuse = [](const std::string& what) {
     throw InvalidInput("final.pointing", "not supported with " + what +
                                              " yet (the twist is a global unknown of the "
-                                             "unconstrained minimum-effort solver only); give "
+                                             "minimum-effort solvers only); give "
                                              "a final attitude instead");
   };
   if (p.objective == Objective::MinimumTime) refuse("objective minimum_time");
-  if (p.hasTorqueBounds()) refuse("actuator_limits (max_torque)");
-  if (!p.constraints.empty()) refuse("constraints");
   if (p.scheme == SchemeKind::FourthOrder) refuse("scheme fourth_order");
   if (p.effects && !p.effects->empty()) refuse("effects");
   if (p.accuracy.active()) refuse("an accuracy target");

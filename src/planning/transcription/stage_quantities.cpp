@@ -288,6 +288,10 @@ class PointingQuantity final : public StageQuantityModel {
     const FreeRange r(first_free, last_free);
     return {r.first + 1, r.last - 1, 0, 1};
   }
+  /// The twist moves R_N (and R_{N−1}): their cones are instances up to node N.
+  StageSupport supportWithTwist(int first_free, int, int steps) const override {
+    return {first_free, steps, 0, 1};
+  }
   StageSupport planSupport(bool, int steps) const override { return {0, steps, 0, 1}; }
   bool dependsOnTimeStep() const override { return false; }
   Vector3 value(const QuantityInputs& at, int k) const override {

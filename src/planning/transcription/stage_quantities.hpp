@@ -108,6 +108,12 @@ class StageQuantityModel {
 
   /// The instances on a reduced problem whose free attitudes are R_first_free..R_last_free.
   virtual StageSupport support(int first_free, int last_free) const = 0;
+  /// The instances when a pointing end condition's free twist moves R_N (and R_{N−1} of paper and
+  /// variational: ReducedProblem::twistMotion) on a plan of `steps` steps: support() but where an
+  /// instance on those nodes is excluded as boundary data (a cone's).
+  virtual StageSupport supportWithTwist(int first_free, int last_free, int /*steps*/) const {
+    return support(first_free, last_free);
+  }
   /// The instances on a plan of `steps` steps (checkConstraints).
   virtual StageSupport planSupport(bool end_torques, int steps) const = 0;
   /// True where q changes with the time step at fixed free attitudes.

@@ -1,0 +1,149 @@
+// The pointing end condition under stage constraints and torque bounds: the twist ψ as a global
+// unknown of the fixed-h interior point (ConstrainedSystem's border column and corner, every
+// constraint row's ψ-derivative through R_{N−1} and R_N) against central differences for every
+// scheme, and the planned answer against a 5° sweep of fixed-attitude constrained solves refined by
+// golden section on seeded random requests (a keep-out cone, torque bounds, a spinning start).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+#include "planning/interior_point/constrained_system.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "support/perturbed_problem.hpp"
+#include "support/pointing_requests.hpp"
+
+using namespace attitude_planner;
+using test_support::PointingBinding;
+
+namespace {
+
+constexpr SchemeKind kDiscretizations[] = {SchemeKind::Paper, SchemeKind::Variational,
+                                           SchemeKind::SecondOrder};
+
+/// A pointing request at ψ = 0.7 with every kind of row, each near R_N so that ψ moves it: a
+/// keep-out cone on an axis other than the boresight (its value at R_N depends on ψ), a rate
+/// limit, a torque norm and a torque box, all below what the perturbed iterate does (violated rows
+/// exercise the elastic terms).
+PlanningProblem everyRowRequest(SchemeKind scheme) {
+  PlanningProblem p = test_support::randomPointingRequest(61, 24, true, scheme);
+  p.final_attitude = pointingAttitude(p.end_condition, 0.7);
+  const Vector3 axis = p.end_condition.body_axis.cross(Vector3(0.3, -0.5, 0.8)).normalized();
+  const Vector3 near_end = p.final_attitude * so3::exp(Vector3(0.4, 0.2, -0.3)) * axis;
+  p.constraints.push_back(PlanningConstraint::keepOut(axis, near_end, 0.6));
+  p.constraints.push_back(PlanningConstraint::maxAngularRate(0.5));
+  p.constraints.push_back(PlanningConstraint::maxTorqueNorm(0.05));
+  p.max_torque = Vector3::Constant(0.04);
+  return p;
+}
+
+/// The elastic merit φ_μ and its gradient (δ, ψ) at `rp` moved by Δψ, with a system built anew
+/// (an assembly with the matrix: the elastic slacks are formed there).
+struct MeritAt {
+  double merit = 0.0;
+  Eigen::VectorXd gradient;
+};
+MeritAt meritAt(const PlanningProblem& p, const ReducedProblem& rp, double dpsi, double mu,
+                double rho) {
+  ReducedProblem q = rp;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(q.unknowns());
+  q.setCurrentWithTwist(q.retractWithTwist(zero, dpsi, 1.0), dpsi);
+  const InteriorPointParameters parameters;
+  ConstrainedSystem system(p, &q, Formulation::Elastic, parameters);
+  MeritAt out;
+  out.merit = system.merit(q.current(), mu, rho, nullptr);
+  Eigen::VectorXd rhs;
+  BandedSymmetricMatrix band(q.unknowns(), ReducedProblem::kHalfBandwidth);
+  system.assemble<double>(mu, rho, true, &band, &rhs, &out.gradient);  // slacks formed
+  return out;
+}
+
+}  // namespace
+
+// With the elastic form's primal multipliers (μ/s) the condensed matrix is the exact Hessian of
+// φ_μ (interior_point_solver.cpp): its ψ border and corner are the central differences of the
+// assembled gradient, whose ψ entry is the central difference of φ_μ itself (a fresh system on the
+// twisted problem each time: the rows on R_{N−1}, R_N are re-evaluated from the moved attitudes).
+TEST(ConstrainedTwist, BorderAndGradientMatchCentralDifferencesForEveryScheme) {
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    const PlanningProblem p = everyRowRequest(scheme);
+    ReducedProblem rp = test_support::perturbedReducedProblem(p, 17);
+    const int n = rp.unknowns();
+    const double mu = 1e-3, rho = 10.0;
+    const InteriorPointParameters parameters;
+    ConstrainedSystem system(p, &rp, Formulation::Elastic, parameters);
+    ASSERT_EQ(system.globals(), 1);
+    const double merit = system.merit(rp.current(), mu, rho, nullptr);
+    BandedSymmetricMatrix band(n, ReducedProblem::kHalfBandwidth);
+    Eigen::VectorXd rhs, gradient;
+    system.assemble<double>(mu, rho, true, &band, &rhs, &gradient);
+    ASSERT_EQ(gradient.size(), n + 1);
+    const Eigen::VectorXd border = system.twistBorder().column;
+    const double corner = system.twistBorder().corner;
+    EXPECT_GT(std::abs(gradient(n)), 1e-6);  // ψ matters here: the test can fail
+    const double e = 1e-5;
+    const MeritAt plus = meritAt(p, rp, e, mu, rho), minus = meritAt(p, rp, -e, mu, rho);
+    const double slope = (plus.merit - minus.merit) / (2 * e);
+    EXPECT_NEAR(gradient(n), slope, 1e-6 * (std::abs(slope) + std::abs(merit)));
+    const Eigen::VectorXd fd = (plus.gradient - minus.gradient) / (2 * e);
+    const double size = border.cwiseAbs().maxCoeff() + std::abs(corner);
+    EXPECT_LT((fd.head(n) - border).cwiseAbs().maxCoeff(), 1e-5 * size);
+    EXPECT_NEAR(corner, fd(n), 1e-5 * size);
+    EXPECT_GT(border.cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
+TEST(ConstrainedTwist, FixedEndHasNoBorder) {
+  PlanningProblem p = everyRowRequest(SchemeKind::Paper);
+  p.end_condition = EndCondition();
+  ReducedProblem rp(p);
+  const InteriorPointParameters parameters;
+  ConstrainedSystem system(p, &rp, Formulation::FreeSlacks, parameters);
+  EXPECT_EQ(system.globals(), 0);
+}
+
+namespace {
+
+/// The answer against the sweep: cost at most its best + 1e-6 relative, the end condition met,
+/// the constraints held and ψ stationary.
+void expectAtMostTheSweep(const PlanningProblem& p) {
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.pointing.active);
+  const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+  EXPECT_LE(r.cost, sweep.best * (1.0 + 1e-6))
+      << "swept best " << sweep.best << " at twist " << sweep.best_twist << ", answer twist "
+      << r.pointing.final_twist;
+  EXPECT_LT(r.pointing.error, 1e-9);
+  EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-9);
+  EXPECT_LT(r.max_constraint_violation, 1e-6);
+  EXPECT_LT(r.pointing.twist_stationarity, 1e-6);
+  EXPECT_EQ(r.pointing.starts, 4);  // the start twists (ways round inside each fixed solve)
+}
+
+}  // namespace
+
+TEST(ConstrainedPointingPlan, KeepOutConeAtMostTheSweepsBest) {
+  for (unsigned seed : {201u, 202u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    expectAtMostTheSweep(test_support::randomConstrainedPointingRequest(
+        seed, 32, false, SchemeKind::Paper, PointingBinding::KeepOut));
+  }
+}
+
+TEST(ConstrainedPointingPlan, TorqueBoundsAtMostTheSweepsBest) {
+  SCOPED_TRACE("box");
+  expectAtMostTheSweep(test_support::randomConstrainedPointingRequest(
+      211, 32, false, SchemeKind::Paper, PointingBinding::TorqueBox));
+  SCOPED_TRACE("norm, second_order");
+  expectAtMostTheSweep(test_support::randomConstrainedPointingRequest(
+      212, 32, false, SchemeKind::SecondOrder, PointingBinding::TorqueNorm));
+}
+
+TEST(ConstrainedPointingPlan, SpinningStartUnderAConeAtMostTheSweepsBest) {
+  expectAtMostTheSweep(test_support::randomConstrainedPointingRequest(
+      221, 32, true, SchemeKind::Paper, PointingBinding::KeepOut));
+}

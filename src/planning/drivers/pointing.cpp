@@ -10,6 +10,7 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -231,7 +232,7 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     result.termination = context.stopReason().value_or(Termination::NotConverged);
     result.message = "no start converged (" + std::to_string(survey.size()) +
                      " twist and way-round starts tried)";
-    if (!survey.empty()) result.message += "; the last: " + survey.back().solve.reason;
+    if (!survey.empty()) addNote(&result, notes::LastPointingStart{survey.back().solve.reason});
     result.cost = std::numeric_limits<double>::quiet_NaN();
   }
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());

@@ -108,6 +108,26 @@ TEST(AttemptTags, AClassSurveysIterationsAreTaggedWithTheTrailsStagesAndClasses)
   EXPECT_GT(surveys, 0) << r.message;
 }
 
+TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
+  // Under node constraints the trail's per-attempt counts (the interior point's levels,
+  // formulation retries and two-stage retry, read from the context) are the reports of each
+  // stage and class, and they add up to the request's count: every iteration a solver counts is
+  // reported (the elastic penalty raise included), none is summed from results.
+  for (const char* scene : {"torque_limited", "rate_limited", "sun_keep_out", "leo_slew_limited"}) {
+    SCOPED_TRACE(scene);
+    const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, 64);
+    ap::PlanResult r;
+    const std::vector<ap::IterationInfo> infos = reported(p, &r);
+    ASSERT_FALSE(infos.empty()) << r.message;
+    EXPECT_TRUE(std::any_of(
+        r.attempts.begin(), r.attempts.end(),
+        [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
+        << "the interior point ran: " << r.message;
+    EXPECT_EQ(byTag(infos), byTrail(r.attempts)) << r.message;
+    EXPECT_EQ(static_cast<int>(infos.size()), r.iterations);
+  }
+}
+
 TEST(AttemptTags, TheKeptAttemptOfAConstrainedRequestIsAmongTheTagsReported) {
   // Under a torque bound the interior point follows Newton's optimum: its iterations are tagged
   // `constrained`, and the kept attempt's stage and class were reported.

@@ -10,6 +10,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -200,10 +201,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);
   if (!first_kept) {
-    result.message +=
-        "; the cheapest homotopy class under the constraints (after the unconstrained "
-        "optimum's class: " +
-        first_message + ")";
+    addNote(&result, notes::CheapestClass{first_message});
   }
   return result;
 }

@@ -17,6 +17,7 @@
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/strategies/staged_continuation.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -345,7 +346,7 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
     why = "the free-time interior point does not take " + unsupported + " yet";
   }
   PlanResult result = searchMinimumTime(problem, context);
-  result.message += "; searched on T (" + why + ")";
+  addNote(&result, notes::SearchedOnT{why});
   result.attempts = joined(free_time_trail, result.attempts);
   if (!unsupported.empty() || !result.converged() ||
       result.maneuver.attitude.size() != static_cast<std::size_t>(problem.steps) + 1) {
@@ -363,8 +364,7 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
     return result;
   }
   sharpened->attempts = joined(result.attempts, sharpened->attempts);
-  sharpened->message += "; the structured starts did not converge (" + why +
-                        "), the search found T = " + exactNumber(result.minimum_duration) + " s";
+  addNote(&*sharpened, notes::SharpenedFromSearch{why, result.minimum_duration});
   return *sharpened;
 }
 
@@ -419,10 +419,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
       attempts.push_back(a);
     }
     result.attempts = attempts;
-    std::ostringstream note;
-    note << "; planned at (1 + " << problem.time_margin << ") T* = " << result.duration
-         << " s from the T* plan (minimum time T* = " << T_star << " s)";
-    result.message += note.str();
+    addNote(&result, notes::PlannedAtMargin{problem.time_margin, result.duration, T_star});
   }
   result.minimum_duration = T_star;
   result.solve_time_s =
@@ -581,27 +578,19 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
   const LadderClimb climb = climbIfStuck(problem, direct, minimum_time, context);
   const bool from_ladder = climb.plan.converged() && climb.reached == problem.duration;
   PlanResult again = from_ladder ? climb.plan : direct;
-  std::string note = "; started from the minimum-time plan (T* = " + exactNumber(T_star) +
-                     " s) after the first solve " + why;
-  if (from_ladder) {
-    note += ", reached by a ladder of durations from T* (the direct start ended " +
-            terminationName(direct.termination) + ")";
-  } else if (!climb.attempts.empty()) {
-    note += "; a ladder of durations from T* " +
-            (climb.reached > 0.0 ? "found plans within the bounds up to T = " +
-                                       exactNumber(climb.reached) + " s, not at T"
-                                 : std::string("found no plan within the bounds above T*"));
-  }
+  const notes::MinimumTimeRestart restart{
+      T_star, why, from_ladder, direct.termination, !climb.attempts.empty(), climb.reached};
   const bool was_infeasible = first.termination == Termination::Infeasible;
   if (!again.converged() && !was_infeasible) {
     // Nothing better than the first answer: it stays, with what was tried.
     PlanResult kept = first;
-    kept.message += note + ": " + terminationName(again.termination) + " (" + again.message + ")";
+    addNote(&kept, restart);
+    addNote(&kept, notes::RestartEnded{again.termination, again.message});
     return kept;
   }
   if (again.termination == Termination::Infeasible)
     labelStuckAnswer(problem, T_star, climb, &again);
-  again.message += note;
+  addNote(&again, restart);
   std::vector<Attempt> attempts = first.attempts;
   appendTrail(minimum_time.attempts, false, &attempts);
   for (Attempt a : direct.attempts) {
@@ -659,9 +648,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
               << terminationName(minimum_time.termination) << "): " << result.message;
       result.message = verdict.str();
     } else {
-      result.message += "; the first solve " + why +
-                        " and the minimum-time problem under the same bounds did not converge (" +
-                        terminationName(minimum_time.termination) + ")";
+      addNote(&result, notes::MinimumTimeUnsolved{why, minimum_time.termination});
     }
     return finish(result);
   }

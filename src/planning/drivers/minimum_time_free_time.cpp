@@ -156,6 +156,7 @@ class FreeTimeMinimumTime {
     const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
     FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
                                       kFreeTimeMaxIterations, context_, watch);
+    o.iterations = scope.iterations();  // an elastic start's run and the raised one's
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;

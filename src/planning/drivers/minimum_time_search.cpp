@@ -15,6 +15,7 @@
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/duration_bound.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 
 namespace attitude_planner {
@@ -36,6 +37,7 @@ constexpr double kCoarseStartFactor = 1.01;
 
 /// One search on T from one start.
 struct SearchOutcome {
+  explicit SearchOutcome(const SolveContext& context) : tally(context) {}
   std::string start;                          ///< which start
   AttemptStart kind = AttemptStart::Hermite;  ///< its kind (the trail's `start`)
   StartDetail detail;                         ///< its parameters (the trail's start_detail)
@@ -44,7 +46,9 @@ struct SearchOutcome {
   double T_lo = 0.0;                          ///< the bracket [T_lo infeasible, T_hi feasible]
   double T_hi = 0.0;
   int solves = 0;
-  int iterations = 0;  ///< iterations of all its solves
+  /// The iterations of all its solves: counting while it searches down, then while its bracket
+  /// is bisected (paused in between: the other starts' searches run there).
+  SolveContext::IterationTally tally;
 };
 
 /// The search for T*: several starts, each a continuation downwards in T over minimum-effort
@@ -97,7 +101,6 @@ class MinimumTimeSearch {
       return false;
     }
     ++out->solves;
-    out->iterations += r.iterations;
     if (r.termination == Termination::TimedOut || r.termination == Termination::Cancelled) {
       stopped_ = r.termination;
     }
@@ -113,16 +116,24 @@ class MinimumTimeSearch {
   /// null: the minimum-effort problem's own start (its unconstrained optimum). Each later solve
   /// starts from the last feasible plan (same N).
   SearchOutcome search(const std::string& name, const Maneuver* from, double T_first) {
-    SearchOutcome out;
+    SearchOutcome out(context_);
     out.start = name;
+    descend(from, T_first, &out);
+    out.tally.pause();
+    return out;
+  }
+
+  /// The search of `search`: doubling T from T_first until feasible, then down from there.
+  void descend(const Maneuver* from, double T_first, SearchOutcome* found) {
+    SearchOutcome& out = *found;
     const auto feasible = [&](double T) {
       return tryDuration(T, out.feasible ? &out.best.maneuver : from, &out);
     };
     double T = T_first;
     for (int doublings = 0; !feasible(T) && !stopped() && T < unrepresentable_from_; T *= 2.0) {
-      if (++doublings > kMaxDoublings) return out;
+      if (++doublings > kMaxDoublings) return;
     }
-    if (!out.feasible) return out;
+    if (!out.feasible) return;
     // Down from the first feasible T in small steps, each warm-started from the last feasible
     // plan: a large step leaves the interior point far outside the bounds (torques grow like
     // 1/T²), where it can stop at a local minimum of the violation.
@@ -132,16 +143,17 @@ class MinimumTimeSearch {
       out.T_hi = out.T_lo;
       out.T_lo *= kContinuationFactor;
     }
-    return out;
   }
 
   /// Bisection of a search's bracket [T_lo infeasible, T_hi feasible], from its plans.
   void bisect(SearchOutcome* out) {
+    out->tally.resume();
     while (!stopped() && out->T_hi - out->T_lo > kMinimumTimeTolerance * out->T_hi) {
       const double mid = 0.5 * (out->T_lo + out->T_hi);
       const Maneuver from = out->best.maneuver;
       (tryDuration(mid, &from, out) ? out->T_hi : out->T_lo) = mid;
     }
+    out->tally.pause();
   }
 
   /// Above kCoarsestSearchGrid the starts are searched on a coarser grid (N/2, recursively) and
@@ -272,7 +284,7 @@ class MinimumTimeSearch {
       a.formulation = Formulation::FreeSlacks;
       a.steps = problem_.steps;
       a.termination = o.feasible ? Termination::Converged : Termination::Infeasible;
-      a.iterations = o.iterations;
+      a.iterations = o.tally.iterations();
       if (o.feasible) a.cost = o.best.cost;
       attempts.push_back(a);
     }
@@ -293,7 +305,7 @@ class MinimumTimeSearch {
     for (std::size_t i = 0; i < outcomes_.size(); ++i) {
       result.attempts[i].kept = &outcomes_[i] == &found;
     }
-    result.message += searchNote(found);
+    addNote(&result, notes::SearchSummary{searchNote(found)});
     return result;
   }
 

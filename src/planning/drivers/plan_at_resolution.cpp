@@ -18,6 +18,7 @@
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_solver.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -147,21 +148,14 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
                                             ? checkConstraints(problem, result.maneuver)
                                             : ConstraintCheck{};
   if (result.converged() && unconstrained.max_node_bound_violation <= 0.0) {
-    result.message += "; constraints inactive at the unconstrained optimum";
+    addNote(&result, notes::ConstraintsInactive{});
     return result;
   }
   SolverOptions constrained = options;
   const int newton_iterations = result.iterations;
-  std::ostringstream note;
-  if (result.converged()) {
-    note << "; the unconstrained optimum (cost " << result.cost << ") violates ";
-    if (unconstrained.worst.empty()) {
-      note << "a cone's margin";  // the stated limits hold, a tightened node bound does not
-    } else {
-      note << unconstrained.worst << " " << unconstrained.worst_where;
-    }
-    note << " and started it (" << newton_iterations << " Newton iterations)";
-  }
+  const notes::UnconstrainedStart started{result.cost, unconstrained.worst,
+                                          unconstrained.worst_where, newton_iterations};
+  const bool started_from_optimum = result.converged();
   const Maneuver unconstrained_plan = result.maneuver;
   constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
   const std::vector<LevelSummary> newton_levels = result.levels;
@@ -172,7 +166,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
   result.iterations = tally.iterations();
   result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
-  result.message += note.str();
+  if (started_from_optimum) addNote(&result, started);
   if (survey.known && constrained.warm_start == &unconstrained_plan) {
     result.extremal_summary = survey;
     result.extremal_summary.others.clear();
@@ -232,7 +226,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       result.attempts = followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
       result.iterations = tally.iterations();
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
-      result.message += "; after the start from the initial guess stopped: " + first.message;
+      addNote(&result, notes::AfterGuessStopped{first.message});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {
@@ -259,7 +253,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
         result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
                          result.message + ")";
       } else {
-        result.message += std::string("; its last iterate's torques do not replay: ") + e.what();
+        addNote(&result, notes::LastIterateDoesNotReplay{e.what()});
       }
     }
   }

@@ -13,6 +13,7 @@
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -382,7 +383,7 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     result.termination = context.stopReason().value_or(Termination::NotConverged);
     result.message = "no start converged (" + std::to_string(survey.size()) +
                      " twist and way-round starts tried)";
-    if (!survey.empty()) result.message += "; the last: " + survey.back().solve.reason;
+    if (!survey.empty()) addNote(&result, notes::LastPointingStart{survey.back().solve.reason});
     result.cost = std::numeric_limits<double>::quiet_NaN();
   }
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());

@@ -931,9 +931,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     raised.disallowElastic();
     failed.message = raised.startInside();
     if (!failed.message.empty()) return out;
-    FreeTimeOutcome second = raised.run(tolerance, max_iterations, context, watch);
-    second.iterations += out.iterations;
-    return second;
+    return raised.run(tolerance, max_iterations, context, watch);
   } catch (const StepTooLarge& e) {
     failed.message = std::string("the boundary rates admit no step: ") + e.what();
     return failed;
@@ -943,7 +941,10 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations) {
   SolveContext context{SolverOptions{}};
-  return solveFreeTime(problem, attitudes, start_duration, tolerance, max_iterations, context);
+  FreeTimeOutcome outcome =
+      solveFreeTime(problem, attitudes, start_duration, tolerance, max_iterations, context);
+  outcome.iterations = context.iterations();  // both runs' where the start was raised inside
+  return outcome;
 }
 
 }  // namespace attitude_planner

@@ -119,14 +119,16 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem);
 /// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
 /// Cancelled or TimedOut when `context` asks (SolveContext::stopReason every iteration, polled
 /// inside the assembly too), and NotConverged (stopped_by_watch) where `watch` stops it. Every
-/// iteration counted in FreeTimeOutcome::iterations (an accepted step, or a barrier update at the
-/// same iterate: step length 0) is reported to `context` (SolveContext::reportIteration: the
-/// request's iteration callback, and so an action's feedback); a refusal ends the solve Cancelled.
+/// iteration (an accepted step, or a barrier update at the same iterate: step length 0) is
+/// reported to `context` (SolveContext::reportIteration: the request's iteration callback, and so
+/// an action's feedback); a refusal ends the solve Cancelled. FreeTimeOutcome::iterations counts
+/// the last run's (the raised one's after an elastic start failed); the solve's are the context's
+/// (SolveContext::IterationTally).
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch = {});
 /// The same in a context of its own with default options (no budget, no callback): for tests and
-/// studies that run one free-time solve outside a request.
+/// studies that run one free-time solve outside a request. Its iterations: every run's.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations);
 

@@ -292,7 +292,11 @@ class GridSolve final : public PrimalDualProblem {
       test_.restart(iteration_);
       system_.initializeMultipliers(
           mu_, rho_, p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
-      return Pass::Continue;
+      // The raise is counted as an iteration (the step before it ended a pass too): reported,
+      // at the same iterate, so that the context's count is the solve's.
+      if (report(cost_, relative_decrement_, 0.0)) return Pass::Continue;
+      ++iteration_;
+      return end(Termination::Cancelled, "cancelled");
     }
     return end(Termination::Infeasible, "infeasible");
   }

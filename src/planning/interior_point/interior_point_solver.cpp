@@ -61,6 +61,7 @@
 
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/newton/newton_solver.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 
 namespace attitude_planner {
@@ -128,6 +129,7 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
   const FormulationRecipe& recipe =
       options.constrained_from_warm_start && !options.warm_start_strictly_inside ? kProbeRecipe
                                                                                  : kRequestRecipe;
+  const SolveContext::IterationTally tally(solve.context);  // both solves'
   GridOutcome first = solveOnGrid(
       problem, options, solve.parameters, solve.context,
       {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals, final_grid});
@@ -147,11 +149,9 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
   std::vector<LevelSummary> levels = take_second ? other.levels : answer.result.levels;
   appendLevels(&levels, take_second ? answer.result : other);
   answer.result.levels = levels;
-  answer.result.iterations += other.iterations;
-  answer.result.message += take_second ? std::string("; solved with ") + recipe.retry.name +
-                                             " after " + recipe.first.name + " stopped: "
-                                       : std::string("; retried with ") + recipe.retry.name + ": ";
-  answer.result.message += other.message;
+  answer.result.iterations = tally.iterations();
+  addNote(&answer.result, notes::FormulationRetry{recipe.retry.name, recipe.first.name, take_second,
+                                                  other.message});
   answer.duals = LevelDuals{};  // the retry's are not carried
   return answer;
 }
@@ -197,7 +197,7 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
 
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
 /// once more through the level in between. Replaces *direct if that converges; adds every solve's
-/// iterations and levels to *total.
+/// levels to *total (the level's tally counts their iterations).
 void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options,
                          const Solve& solve, const ReducedProblem::StepVectors& coarse,
                          GridOutcome* direct, PlanResult* total) {
@@ -207,15 +207,12 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   from_coarse.warm_start = nullptr;  // both start from the coarse steps
   const GridOutcome middle =
       solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr, /*final_grid=*/false);
-  total->iterations += middle.result.iterations;
   appendLevels(&total->levels, middle.result);
   if (!middle.result.converged()) return;
   GridOutcome fine = solveGridWithRetry(at, from_coarse, solve, &middle.steps, nullptr);
-  total->iterations += fine.result.iterations;
   appendLevels(&total->levels, fine.result);
   if (!fine.result.converged()) return;
-  fine.result.message += "; reached through N = " + std::to_string(half.steps) +
-                         " after the direct refinement stopped: " + direct->result.message;
+  addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, direct->result.message});
   direct->result = fine.result;
   direct->steps = fine.steps;
   direct->formulation = fine.formulation;
@@ -233,6 +230,7 @@ std::string onLevel(const ContinuationStop& stop) {
 GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& options,
                         const Solve& solve, const LevelRequest<LevelIterate>& r) {
   const ContinuationStop& stop = *r.stop;
+  const SolveContext::IterationTally tally(solve.context);  // the start's and the level's
   if (ranOut(stop.termination)) {
     GridOutcome carried;
     if (r.coarse) carried.steps = r.coarse->steps;
@@ -254,7 +252,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   }
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
-  outcome.result.iterations += start.iterations;
+  outcome.result.iterations = tally.iterations();
   std::vector<LevelSummary> levels = start.levels;
   appendLevels(&levels, outcome.result);
   outcome.result.levels = levels;
@@ -271,21 +269,20 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& opti
   SolverOptions level_options = options;
   level_options.warm_start = nullptr;
   level_options.tolerance = r.tolerance;
-  PlanResult total;  // the levels and iterations of every solve on this level
+  PlanResult total;  // the levels of every solve on this level
+  const SolveContext::IterationTally tally(solve.context);  // the iterations of every solve on it
   Maneuver resampled;
   PlanResult unconstrained;
   if (!r.coarse) {
     unconstrained =
         unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
-    total.iterations += unconstrained.iterations;
     appendLevels(&total.levels, unconstrained);
   }
   const LevelDuals no_duals;
   GridOutcome outcome =
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
                          r.coarse ? &r.coarse->duals : &no_duals, r.finest);
-  total.iterations += outcome.result.iterations;
   appendLevels(&total.levels, outcome.result);
   const LevelDuals direct_duals = outcome.duals;
   if (!outcome.result.converged() && !ranOut(outcome.result.termination) && r.coarse &&
@@ -293,7 +290,7 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& opti
     refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome, &total);
   }
   outcome.duals = direct_duals;  // the direct solve's: a refinement's are not carried
-  outcome.result.iterations = total.iterations;
+  outcome.result.iterations = tally.iterations();
   outcome.result.levels = std::move(total.levels);
   return outcome;
 }
@@ -317,7 +314,7 @@ void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
                         result->message + ")";
     }
   }
-  result->message += "; grid continuation from N = " + std::to_string(record.levels.front().steps);
+  addNote(result, notes::GridContinuation{record.levels.front().steps});
 }
 
 /// A warm start on the requested grid strictly inside every bound (the time-scaled T* plan):
@@ -406,6 +403,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                                   const InteriorPointParameters& parameters) {
   const Solve solve{parameters, context};
   std::vector<Attempt> trail;
+  const SolveContext::IterationTally tally(context);  // every attempt's
   PlanResult result =
       attempt(problem, options, solve, AttemptStage::Constrained, startOf(options), &trail).result;
   // Pointing cones together with torque or rate limits, from a start inside a cone: the
@@ -431,7 +429,6 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   const PlanResult around =
       attempt(cones_only, options, solve, AttemptStage::ConstrainedRetry, startOf(options), &trail)
           .result;
-  int iterations = result.iterations + around.iterations;
   if (!around.converged()) {
     result.attempts = recordTrail(context, trail, 0);
     return result;
@@ -441,7 +438,6 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   PlanResult second = attempt(problem, staged, solve, AttemptStage::ConstrainedRetry,
                               AttemptStart::PreviousAttempt, &trail)
                           .result;
-  iterations += second.iterations;
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
@@ -451,12 +447,9 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
   if (take_second) result = second;
   result.attempts = recordTrail(context, trail, take_second ? 2 : 0);
-  result.iterations = iterations;
+  result.iterations = tally.iterations();
   result.levels = solved_levels;
-  result.message +=
-      "; retried in two stages (the cones alone, then every constraint from that "
-      "path) after: " +
-      first_message;
+  addNote(&result, notes::RetriedInTwoStages{first_message});
   return result;
 }
 
@@ -497,7 +490,7 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   result.attempts = recordTrail(
       context, {attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart)},
       0);
-  result.message += "; from the initial guess, its multipliers re-derived";
+  addNote(&result, notes::FromInitialGuess{});
   return result;
 }
 

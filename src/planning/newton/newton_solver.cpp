@@ -19,6 +19,7 @@
 #include "attitude_planner/errors.hpp"
 #include "planning/newton/grid_solve.hpp"
 #include "planning/newton/newton_parameters.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/strategies/staged_continuation.hpp"
 #include "planning/strategies/starts.hpp"
@@ -202,7 +203,7 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
     if (record.reached < record.levels.size()) {
       r->cost = std::numeric_limits<double>::quiet_NaN();  // no plan on the requested grid
     }
-    r->message += "; refined from the " + survey_grid + " class survey";
+    addNote(r, notes::RefinedFromSurvey{plan.levels[plan.survey].steps});
   };
   const SolvedLevel<StepVectors> survey{plan.survey, s.result.termination, s.steps, s.below,
                                         s.below_converged};

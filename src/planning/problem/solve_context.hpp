@@ -57,16 +57,31 @@ class SolveContext : public Interruption {
 
   /// The iterations reported from its construction on: a phase's count (a continuation's
   /// stages, a Newton start then the interior point) read from the one numbering, instead of
-  /// summed from its solves' results.
+  /// summed from its solves' results. A phase run in separate spans (a minimum-time search's
+  /// start, bisected after the other starts ran) pauses it between them.
   class IterationTally {
    public:
     explicit IterationTally(const SolveContext& context)
-        : context_(context), at_open_(context.iterations_) {}
-    int iterations() const { return context_.iterations_ - at_open_; }
+        : context_(&context), at_open_(context.iterations_) {}
+    /// Iterations reported while it counted (up to now if it counts now).
+    int iterations() const { return counted_ + (counting_ ? context_->iterations_ - at_open_ : 0); }
+    /// Stops counting; what it counted stays.
+    void pause() {
+      counted_ = iterations();
+      counting_ = false;
+    }
+    /// Counts again from now on, after what it counted before.
+    void resume() {
+      if (counting_) return;
+      at_open_ = context_->iterations_;
+      counting_ = true;
+    }
 
    private:
-    const SolveContext& context_;
+    const SolveContext* context_;
     int at_open_;
+    int counted_ = 0;
+    bool counting_ = true;
   };
 
   /// How a scope names the attempts begun inside it (the trail relabels them the same way).

@@ -1,5 +1,7 @@
 #include "planning/strategies/grid_continuation.hpp"
 
+#include "planning/problem/message_notes.hpp"
+
 namespace attitude_planner {
 
 PlanningProblem coarserLevel(const PlanningProblem& problem, const GridLevelRule& rule) {
@@ -31,11 +33,8 @@ void describeContinuation(const ContinuationRecord& record, PlanResult* finest) 
                                                                        : "time budget exceeded") +
         " on the N = " + std::to_string(record.stop->level.steps) +
         " level; the plan is its iterate carried over to N = " + requested;
-  } else if (below.termination == Termination::Converged) {
-    finest->message += "; started from the N = " + std::to_string(below.steps) + " solution";
   } else {
-    finest->message += "; the N = " + std::to_string(below.steps) + " level ended " +
-                       terminationName(below.termination) + ", started from the geodesic";
+    addNote(finest, notes::CoarserLevel{below.steps, below.termination});
   }
 }
 

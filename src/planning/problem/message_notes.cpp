@@ -1,0 +1,122 @@
+// The wording of every clause of message_notes.hpp, in one place.
+#include "planning/problem/message_notes.hpp"
+
+#include <sstream>
+
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+namespace {
+
+using namespace notes;
+
+std::string grid(int steps) {
+  return "N = " + std::to_string(steps);
+}
+
+std::string words(const FormulationRetry& n) {
+  return (n.solved ? "; solved with " + n.retry + " after " + n.first + " stopped: "
+                   : "; retried with " + n.retry + ": ") +
+         n.reason;
+}
+std::string words(const ReachedThroughMiddle& n) {
+  return "; reached through " + grid(n.steps) + " after the direct refinement stopped: " + n.reason;
+}
+std::string words(const GridContinuation& n) {
+  return "; grid continuation from " + grid(n.steps);
+}
+std::string words(const RetriedInTwoStages& n) {
+  return "; retried in two stages (the cones alone, then every constraint from that path) "
+         "after: " +
+         n.reason;
+}
+std::string words(const FromInitialGuess&) {
+  return "; from the initial guess, its multipliers re-derived";
+}
+std::string words(const CoarserLevel& n) {
+  if (n.termination == Termination::Converged)
+    return "; started from the " + grid(n.steps) + " solution";
+  return "; the " + grid(n.steps) + " level ended " + terminationName(n.termination) +
+         ", started from the geodesic";
+}
+std::string words(const RefinedFromSurvey& n) {
+  return "; refined from the " + grid(n.steps) + " class survey";
+}
+std::string words(const ConstraintsInactive&) {
+  return "; constraints inactive at the unconstrained optimum";
+}
+std::string words(const UnconstrainedStart& n) {
+  std::ostringstream s;
+  s << "; the unconstrained optimum (cost " << n.cost << ") violates ";
+  if (n.worst.empty()) {
+    s << "a cone's margin";  // the stated limits hold, a tightened node bound does not
+  } else {
+    s << n.worst << " " << n.where;
+  }
+  s << " and started it (" << n.newton_iterations << " Newton iterations)";
+  return s.str();
+}
+std::string words(const AfterGuessStopped& n) {
+  return "; after the start from the initial guess stopped: " + n.reason;
+}
+std::string words(const LastIterateDoesNotReplay& n) {
+  return "; its last iterate's torques do not replay: " + n.reason;
+}
+std::string words(const CheapestClass& n) {
+  return "; the cheapest homotopy class under the constraints (after the unconstrained "
+         "optimum's class: " +
+         n.reason + ")";
+}
+std::string words(const LastPointingStart& n) {
+  return "; the last: " + n.reason;
+}
+std::string words(const SearchSummary& n) {
+  return n.summary;
+}
+std::string words(const SearchedOnT& n) {
+  return "; searched on T (" + n.why + ")";
+}
+std::string words(const SharpenedFromSearch& n) {
+  return "; the structured starts did not converge (" + n.why +
+         "), the search found T = " + exactNumber(n.duration) + " s";
+}
+std::string words(const PlannedAtMargin& n) {
+  std::ostringstream s;
+  s << "; planned at (1 + " << n.margin << ") T* = " << n.duration
+    << " s from the T* plan (minimum time T* = " << n.minimum_duration << " s)";
+  return s.str();
+}
+std::string words(const MinimumTimeRestart& n) {
+  std::string s = "; started from the minimum-time plan (T* = " + exactNumber(n.minimum_duration) +
+                  " s) after the first solve " + n.why;
+  if (n.ladder_reached) {
+    s += ", reached by a ladder of durations from T* (the direct start ended " +
+         terminationName(n.direct) + ")";
+  } else if (n.ladder_tried) {
+    s += "; a ladder of durations from T* " +
+         (n.ladder_longest > 0.0 ? "found plans within the bounds up to T = " +
+                                       exactNumber(n.ladder_longest) + " s, not at T"
+                                 : std::string("found no plan within the bounds above T*"));
+  }
+  return s;
+}
+std::string words(const RestartEnded& n) {
+  return ": " + terminationName(n.termination) + " (" + n.reason + ")";
+}
+std::string words(const MinimumTimeUnsolved& n) {
+  return "; the first solve " + n.why +
+         " and the minimum-time problem under the same bounds did not converge (" +
+         terminationName(n.termination) + ")";
+}
+
+}  // namespace
+
+std::string renderNote(const Note& note) {
+  return std::visit([](const auto& n) { return words(n); }, note);
+}
+
+void addNote(PlanResult* result, const Note& note) {
+  result->message.append(renderNote(note));
+}
+
+}  // namespace attitude_planner

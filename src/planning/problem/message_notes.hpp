@@ -1,0 +1,133 @@
+// The clauses a solver or a driver adds to an answer's message after its first reason, as data:
+// what happened, on which grid, how the solve it names ended, its figures, and the message of the
+// solve it refers to. addNote is the one place they are worded (renderNote), so a clause reads
+// the same wherever it is recorded; the figures a caller needs are fields of the answer
+// (PlanResult, its trail `attempts`, its `levels`), never parsed from these words.
+#pragma once
+
+#include <string>
+#include <variant>
+
+#include "attitude_planner/planning/result.hpp"
+
+namespace attitude_planner {
+namespace notes {
+
+/// The interior point's other formulation tried from the same start after the first stopped
+/// (interior_point_solver.cpp: the formulation recipe). `solved`: its answer is returned, else
+/// the first's is, and `reason` is the other solve's message.
+struct FormulationRetry {
+  std::string retry;  ///< the retry's formulation ("elastic", ...)
+  std::string first;  ///< the first one's
+  bool solved = false;
+  std::string reason;
+};
+/// A 4x refinement that stopped, reached once more through the level in between (N = `steps`).
+struct ReachedThroughMiddle {
+  int steps = 0;
+  std::string reason;  ///< the direct refinement's message
+};
+/// The interior point's levels: the coarsest one's N.
+struct GridContinuation {
+  int steps = 0;
+};
+/// Cones with other limits, from a start inside a cone: the cones alone, then every constraint.
+struct RetriedInTwoStages {
+  std::string reason;  ///< the first solve's message
+};
+/// The interior point from the caller's plan of this N, its multipliers re-derived.
+struct FromInitialGuess {};
+/// Newton's grid continuation: the level below the requested grid (N = `steps`) and how it ended:
+/// converged, its plan started the requested grid, else the geodesic did.
+struct CoarserLevel {
+  int steps = 0;
+  Termination termination = Termination::Converged;
+};
+/// Newton's class survey on a coarser grid (N = `steps`), its chosen class refined.
+struct RefinedFromSurvey {
+  int steps = 0;
+};
+/// The unconstrained optimum met every node constraint: it is the answer.
+struct ConstraintsInactive {};
+/// The unconstrained optimum (cost `cost`) violates `worst` at `where` (empty `worst`: only a
+/// cone's margin) and started the interior point after `newton_iterations`.
+struct UnconstrainedStart {
+  double cost = 0.0;
+  std::string worst;
+  std::string where;
+  int newton_iterations = 0;
+};
+/// The interior point from the caller's guess stopped; the answer is the usual start's.
+struct AfterGuessStopped {
+  std::string reason;  ///< the solve from the guess's message
+};
+/// An answer that is no plan (infeasible, stopped) whose torques also fail the replay.
+struct LastIterateDoesNotReplay {
+  std::string reason;  ///< the replay's failure
+};
+/// A request with its class left free: another class under the constraints is cheaper.
+struct CheapestClass {
+  std::string reason;  ///< the first class's (the unconstrained optimum's) message
+};
+/// A pointing request where no start converged: the last start's reason.
+struct LastPointingStart {
+  std::string reason;
+};
+/// The minimum-time search's summary (drivers/minimum_time_search.cpp renders its bracket, the
+/// starts' least durations and the solves from its outcomes).
+struct SearchSummary {
+  std::string summary;
+};
+/// Minimum time searched on T instead of solved free-time, and `why`.
+struct SearchedOnT {
+  std::string why;
+};
+/// The search's plan (T = `duration`) started the free-time solve that answers.
+struct SharpenedFromSearch {
+  std::string why;  ///< why the structured starts did not answer
+  double duration = 0.0;
+};
+/// The plan at (1 + `margin`) T* (T = `duration`) from the T* plan.
+struct PlannedAtMargin {
+  double margin = 0.0;
+  double duration = 0.0;
+  double minimum_duration = 0.0;  ///< T*
+};
+/// A bounded minimum-effort request restarted from the minimum-time plan at T* after its first
+/// solve `why`: directly, else through a ladder of durations from T*.
+struct MinimumTimeRestart {
+  double minimum_duration = 0.0;  ///< T*
+  std::string why;
+  bool ladder_reached = false;                     ///< the ladder reached T (its plan answers)
+  Termination direct = Termination::NotConverged;  ///< the direct start's end
+  bool ladder_tried = false;
+  double ladder_longest = 0.0;  ///< the longest T it found a plan at (0: none)
+};
+/// How a restart that did not beat the first answer ended (after MinimumTimeRestart).
+struct RestartEnded {
+  Termination termination = Termination::NotConverged;
+  std::string reason;
+};
+/// The first solve `why` and the minimum-time problem under the same bounds ended `termination`.
+struct MinimumTimeUnsolved {
+  std::string why;
+  Termination termination = Termination::NotConverged;
+};
+
+}  // namespace notes
+
+using Note =
+    std::variant<notes::FormulationRetry, notes::ReachedThroughMiddle, notes::GridContinuation,
+                 notes::RetriedInTwoStages, notes::FromInitialGuess, notes::CoarserLevel,
+                 notes::RefinedFromSurvey, notes::ConstraintsInactive, notes::UnconstrainedStart,
+                 notes::AfterGuessStopped, notes::LastIterateDoesNotReplay, notes::CheapestClass,
+                 notes::LastPointingStart, notes::SearchSummary, notes::SearchedOnT,
+                 notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
+                 notes::RestartEnded, notes::MinimumTimeUnsolved>;
+
+/// The clause's words ("; grid continuation from N = 8", ...), each starting with its separator.
+std::string renderNote(const Note& note);
+/// Adds the clause to result->message (after what it says already).
+void addNote(PlanResult* result, const Note& note);
+
+}  // namespace attitude_planner

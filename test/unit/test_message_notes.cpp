@@ -1,0 +1,104 @@
+// The clauses drivers add to a message are recorded as notes and worded in one place
+// (problem/message_notes.hpp): each is one line after the message it extends, begins with its
+// separator, and says the figures and the nested reason it was given, in the branch its fields
+// choose.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "attitude_planner/errors.hpp"
+#include "planning/problem/message_notes.hpp"
+
+namespace ap = attitude_planner;
+namespace notes = attitude_planner::notes;
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
+  const std::vector<ap::Note> all = {
+      notes::FormulationRetry{"elastic", "free slacks", true, "r"},
+      notes::ReachedThroughMiddle{64, "r"},
+      notes::GridContinuation{8},
+      notes::RetriedInTwoStages{"r"},
+      notes::FromInitialGuess{},
+      notes::CoarserLevel{32, ap::Termination::Converged},
+      notes::RefinedFromSurvey{16},
+      notes::ConstraintsInactive{},
+      notes::UnconstrainedStart{1.5, "w", "at k = 3", 7},
+      notes::AfterGuessStopped{"r"},
+      notes::LastIterateDoesNotReplay{"r"},
+      notes::CheapestClass{"r"},
+      notes::LastPointingStart{"r"},
+      notes::SearchedOnT{"why"},
+      notes::SharpenedFromSearch{"why", 2.5},
+      notes::PlannedAtMargin{0.1, 3.3, 3.0},
+      notes::MinimumTimeRestart{3.0, "why", false, ap::Termination::Infeasible, false, 0.0},
+      notes::MinimumTimeUnsolved{"why", ap::Termination::NotConverged},
+  };
+  for (const ap::Note& note : all) {
+    const std::string words = ap::renderNote(note);
+    SCOPED_TRACE(words);
+    EXPECT_EQ(words.rfind("; ", 0), 0u);
+    EXPECT_GT(words.size(), 4u);
+    EXPECT_EQ(words.find('\n'), std::string::npos);
+  }
+  EXPECT_EQ(ap::renderNote(notes::RestartEnded{ap::Termination::Infeasible, "r"}).rfind(": ", 0),
+            0u);
+  // The search's summary is its own rendering (minimum_time_search.cpp), kept as given.
+  EXPECT_EQ(ap::renderNote(notes::SearchSummary{"; minimum time T* = 1 s"}),
+            "; minimum time T* = 1 s");
+}
+
+TEST(MessageNotes, AddNoteExtendsTheMessageWithTheNotesFiguresAndReason) {
+  ap::PlanResult r;
+  r.message = "converged after 12 interior-point iterations";
+  ap::addNote(&r, notes::GridContinuation{8});
+  ap::addNote(&r, notes::FormulationRetry{"elastic", "free slacks", false, "infeasible at N = 8"});
+  EXPECT_EQ(r.message,
+            "converged after 12 interior-point iterations; grid continuation from N = 8; retried "
+            "with elastic: infeasible at N = 8");
+}
+
+TEST(MessageNotes, TheFieldsChooseTheBranchOfTheWording) {
+  // A converged coarser level started the grid; another ending names it and the geodesic.
+  EXPECT_TRUE(contains(ap::renderNote(notes::CoarserLevel{32, ap::Termination::Converged}),
+                       "started from the N = 32 solution"));
+  const std::string stopped =
+      ap::renderNote(notes::CoarserLevel{32, ap::Termination::NotConverged});
+  EXPECT_TRUE(contains(stopped,
+                       "N = 32 level ended " + ap::terminationName(ap::Termination::NotConverged)));
+  EXPECT_TRUE(contains(stopped, "geodesic"));
+  // A retry that answers names both formulations; one that did not, the retry's.
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", true, ""}),
+                       "solved with elastic after free slacks stopped"));
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", false, ""}),
+                       "retried with elastic: "));
+  // Only the cone's margin is violated when no stated limit is.
+  EXPECT_TRUE(contains(ap::renderNote(notes::UnconstrainedStart{2.0, "", "", 5}),
+                       "violates a cone's margin and started it (5 Newton iterations)"));
+  EXPECT_TRUE(contains(ap::renderNote(notes::UnconstrainedStart{2.0, "|tau_x| <= 1", "by 0.1", 5}),
+                       "(cost 2) violates |tau_x| <= 1 by 0.1"));
+  // The restart from the minimum-time plan: T* exactly, and what the ladder of durations did.
+  const double T_star = 3.0 + 1.0 / 3.0;
+  const std::string direct = ap::renderNote(notes::MinimumTimeRestart{
+      T_star, "ended infeasible", false, ap::Termination::Converged, false, 0.0});
+  EXPECT_TRUE(contains(direct, "(T* = " + ap::exactNumber(T_star) + " s)"));
+  EXPECT_FALSE(contains(direct, "ladder"));
+  EXPECT_TRUE(contains(ap::renderNote(notes::MinimumTimeRestart{
+                           T_star, "w", true, ap::Termination::Infeasible, true, T_star}),
+                       "reached by a ladder of durations from T* (the direct start ended " +
+                           ap::terminationName(ap::Termination::Infeasible) + ")"));
+  EXPECT_TRUE(contains(ap::renderNote(notes::MinimumTimeRestart{
+                           T_star, "w", false, ap::Termination::Infeasible, true, 4.5}),
+                       "up to T = " + ap::exactNumber(4.5) + " s, not at T"));
+  EXPECT_TRUE(contains(ap::renderNote(notes::MinimumTimeRestart{
+                           T_star, "w", false, ap::Termination::Infeasible, true, 0.0}),
+                       "found no plan within the bounds above T*"));
+}

@@ -91,6 +91,8 @@ void addStencil(const ReducedProblem& np, const AugmentedLayout& at, double alph
 bool solveAugmented(const ReducedProblem& np, double relative_shift, int bandwidth,
                     const Interruption& interruption, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
+  // Polled before the system is allocated or zeroed (~100 MB at N = 1e5, not interruptible).
+  interruption.poll();
   const AugmentedLayout at{np.firstFreeNode(), np.lastFreeNode()};
   const int n = at.size();
   if (!*workspace) workspace->reset(new BandedLinearSystem(n, bandwidth));

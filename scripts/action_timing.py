@@ -33,10 +33,13 @@ def seed_without_plan(r, steps):
     return r
 
 
-def cancel_latency(client, steps, delay):
+def cancel_latency(client, steps, delay, with_plan=False):
     """Sends an endless goal, cancels it `delay` s after its first feedback; returns
-    (latency [s], state, error code, iterations at the cancel)."""
+    (latency [s], state, error code, iterations at the cancel, whether the stopped plan was
+    handed over, rows of it in the result). `with_plan`: the goal asks for every node."""
     goal = seed_without_plan(PlanAttitudeManeuverGoal(), steps)
+    if with_plan:
+        goal.return_maneuver = ""
     goal.tolerance = 1e-300
     goal.max_iterations = 1000000
     goal.time_budget = 600.0
@@ -64,7 +67,9 @@ def cancel_latency(client, steps, delay):
     client.cancel_goal()
     client.wait_for_result(rospy.Duration(120.0))
     latency = time.perf_counter() - t0
-    return latency, client.get_state(), client.get_result().error_code.val, at
+    result = client.get_result()
+    return (latency, client.get_state(), result.error_code.val, at, result.unconverged_plan,
+            len(result.maneuver.attitude))
 
 
 def main():
@@ -79,18 +84,22 @@ def main():
         raise SystemExit("no action server")
 
     print("### Cancel latency, N = %d\n" % args.steps)
-    print("| cancel sent after first feedback [s] | iteration at cancel | cancel -> result [ms] "
-          "| state | error |")
-    print("|---|---|---|---|---|")
-    latencies = []
-    for i in range(args.cancels):
-        delay = 0.05 + 0.137 * i  # spread over several iterations' phases
-        latency, state, code, at = cancel_latency(client, args.steps, delay)
-        latencies.append(latency)
-        print("| %.3f | %d | %.1f | %s | %s |" % (delay, at, 1e3 * latency,
-                                                 STATES.get(state, state), CODES.get(code, code)))
-    print("\nmedian %.1f ms, max %.1f ms over %d cancels\n" %
-          (1e3 * statistics.median(latencies), 1e3 * max(latencies), len(latencies)))
+    for with_plan in (False, True):
+        print("return_maneuver %s:\n" % ('"" (every node)' if with_plan else '"none"'))
+        print("| cancel sent after first feedback [s] | iteration at cancel | cancel -> result "
+              "[ms] | state | error | plan handed over | rows in the result |")
+        print("|---|---|---|---|---|---|---|")
+        latencies = []
+        for i in range(args.cancels if not with_plan else max(1, args.cancels // 2)):
+            delay = 0.05 + 0.137 * i  # spread over several iterations' phases
+            latency, state, code, at, handed, rows = cancel_latency(client, args.steps, delay,
+                                                                    with_plan)
+            latencies.append(latency)
+            print("| %.3f | %d | %.1f | %s | %s | %s | %d |" %
+                  (delay, at, 1e3 * latency, STATES.get(state, state), CODES.get(code, code),
+                   "yes" if handed else "no", rows))
+        print("\nmedian %.1f ms, max %.1f ms over %d cancels\n" %
+              (1e3 * statistics.median(latencies), 1e3 * max(latencies), len(latencies)))
 
     rospy.wait_for_service("plan_attitude_maneuver", timeout=30)
     proxy = rospy.ServiceProxy("plan_attitude_maneuver", PlanAttitudeManeuver)

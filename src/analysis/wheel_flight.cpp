@@ -60,4 +60,71 @@ WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const React
   return out;
 }
 
+namespace {
+
+/// The wheel torques that make the body torque `body_torque` (minimum norm), cut to the array's
+/// limits at wheel momenta `momentum`; `cut` is set when a wheel's command was changed.
+Eigen::VectorXd wheelCommand(const ReactionWheels& wheels, const WheelArray& array,
+                             const Vector3& body_torque, const Vector3& rate,
+                             const Eigen::VectorXd& momentum, bool* cut) {
+  // τ = −A u − Ω × A h_w  ⇒  A u = −(τ + Ω × A h_w); u = A⁺(A u) carries no null-space part.
+  const Vector3 array_torque = -(body_torque + rate.cross(array.axes * momentum));
+  Eigen::VectorXd u = array.pseudo_inverse * array_torque;
+  for (int i = 0; i < wheels.count(); ++i) {
+    const double limit = wheels.torqueLimit(i), H = wheels.momentumLimit(i);
+    double wanted = std::clamp(u(i), -limit, limit);
+    if ((momentum(i) >= H && wanted > 0.0) || (momentum(i) <= -H && wanted < 0.0)) wanted = 0.0;
+    if (wanted != u(i)) *cut = true;
+    u(i) = wanted;
+  }
+  return u;
+}
+
+}  // namespace
+
+WheelTracking trackWithWheels(const ManeuverInterpolation& reference, const Matrix3& inertia,
+                              const ReactionWheels& wheels, const RigidBodyState& start,
+                              const TrackingOptions& options) {
+  const TrackingLaw law(reference, nullptr, options);
+  const WheelArray array = wheelArray(wheels);
+  WheelTracking out;
+  out.substeps = law.substepsPerPlanStep();
+  out.natural_frequency = law.naturalFrequency();
+  out.samples = reference.steps() * out.substeps;  // simulateTracking's control grid
+  const double dt = reference.duration() / out.samples;
+  WheelFlight& flight = out.flight;
+  flight.body.time_step = dt;
+  flight.peaks = WheelPeaks(wheels.count());
+  Matrix3 R = start.attitude;
+  Vector3 rate = start.angular_velocity;
+  Eigen::VectorXd h(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) h(i) = wheels.initialMomentum(i);
+  flight.peaks.peak_momentum = h.cwiseAbs();
+  for (int j = 0; j <= out.samples; ++j) {
+    const double t = j * dt;
+    bool cut = false;
+    const Eigen::VectorXd u = wheelCommand(wheels, array, law.command(R, rate, t), rate, h, &cut);
+    const Vector3 delivered = -array.axes * u - rate.cross(array.axes * h);
+    flight.body.time.push_back(t);
+    flight.body.attitude.push_back(R);
+    flight.body.angular_velocity.push_back(rate);
+    flight.body.torque.push_back(delivered);
+    flight.torque.push_back(u);
+    flight.momentum.push_back(h);
+    flight.peaks.observeMomentum(array.axes, h);
+    flight.peaks.observeTorque(u);
+    if (j == out.samples) break;
+    out.saturated_samples += cut ? 1 : 0;
+    out.effort += 0.5 * delivered.squaredNorm() * dt;
+    // u held over the period: the replay's linear hold between two equal rows.
+    const WheelReplay period = replayWithWheels(inertia, array.axes, R, rate, h, dt, {u, u},
+                                                Vector3::Zero(), kWheelFlightSubsteps);
+    R = period.attitude.back();
+    rate = period.angular_velocity.back();
+    h = period.momentum.back();
+    flight.peaks.peak_momentum = flight.peaks.peak_momentum.cwiseMax(period.peak_momentum);
+  }
+  return out;
+}
+
 }  // namespace attitude_planner

@@ -212,6 +212,7 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << "  \"dynamics_residual\": " << jsonNumber(r.dynamics_residual) << ",\n"
       << "  \"step_residual\": " << jsonNumber(r.step_residual) << ",\n"
       << "  \"replay_miss\": " << jsonNumber(r.replay_miss) << ",\n"
+      << "  \"replay_measured\": " << (r.replay_measured ? "true" : "false") << ",\n"
       << "  \"solve_time_s\": " << jsonNumber(r.solve_time_s) << ",\n"
       << "  \"extremal\": " << jsonString(r.extremal) << ",\n"
       << "  \"effects\": [";
@@ -279,7 +280,10 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   text += line("max residual", general(r.max_residual, 3));
   text += line("dynamics residual", general(r.dynamics_residual, 3) + " N m s");
   text += line("step residual", general(r.step_residual, 3) + " (relative)");
-  text += line("replay miss", general(r.replay_miss, 3) + " rad (open-loop replay, sensitivity)");
+  text +=
+      line("replay miss", r.replay_measured
+                              ? general(r.replay_miss, 3) + " rad (open-loop replay, sensitivity)"
+                              : "not measured (a stopped plan is handed over without its replay)");
   std::ostringstream time;
   time << std::fixed << std::setprecision(3) << r.solve_time_s << " s";
   text += line("solve time", time.str());

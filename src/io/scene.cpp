@@ -188,7 +188,7 @@ class SceneParser {
   }
 
   /// `actuators: {reaction_wheels: {spin_axes, max_torque, max_momentum, initial_momentum,
-  /// max_momentum_norm}}` (the values are checked by validateProblem).
+  /// max_momentum_norm, spin_inertia}}` (the values are checked by validateProblem).
   ReactionWheels actuators(const YAML::Node& node, const std::string& path) const {
     requireMap(node, path);
     checkKeys(node, path, {"reaction_wheels"}, {"reaction_wheels"});
@@ -196,7 +196,8 @@ class SceneParser {
     const YAML::Node w = node["reaction_wheels"];
     requireMap(w, wpath);
     checkKeys(w, wpath,
-              {"spin_axes", "max_torque", "max_momentum", "initial_momentum", "max_momentum_norm"},
+              {"spin_axes", "max_torque", "max_momentum", "initial_momentum", "max_momentum_norm",
+               "spin_inertia"},
               {"spin_axes", "max_torque", "max_momentum"});
     ReactionWheels out;
     const YAML::Node axes = w["spin_axes"];
@@ -212,6 +213,9 @@ class SceneParser {
     }
     if (w["max_momentum_norm"]) {
       out.max_momentum_norm = number(w["max_momentum_norm"], wpath + ".max_momentum_norm");
+    }
+    if (w["spin_inertia"]) {
+      out.spin_inertia = numbers(w["spin_inertia"], wpath + ".spin_inertia", true);
     }
     return out;
   }
@@ -683,6 +687,7 @@ std::string formatScene(const Scene& scene) {
     if (std::isfinite(w.max_momentum_norm)) {
       out << ", max_momentum_norm: " << exactNumber(w.max_momentum_norm);
     }
+    if (w.hasSpinInertia()) out << ", spin_inertia: " << list(w.spin_inertia);
     out << "}}\n";
   }
   out << "effects:";

@@ -254,6 +254,10 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
   m.scheme = schemeName(problem.scheme);
   m.time_step = maneuver.time_step;
   m.time = maneuver.time;
+  // Reserved: an N = 1e5 plan is handed over after a cancel, where every millisecond counts.
+  m.attitude.reserve(maneuver.attitude.size());
+  m.angular_velocity.reserve(maneuver.angular_velocity.size());
+  m.torque.reserve(maneuver.torque.size());
   for (const Matrix3& R : maneuver.attitude) m.attitude.push_back(attitudeToMsg(R));
   for (const Vector3& w : maneuver.angular_velocity) m.angular_velocity.push_back(vectorToMsg(w));
   for (const Vector3& t : maneuver.torque) m.torque.push_back(vectorToMsg(t));
@@ -273,7 +277,7 @@ ReactionWheels reactionWheelsFromMsg(const ReactionWheelArray& msg, const std::s
   ReactionWheels out;
   if (msg.spin_axes.empty()) {
     if (!msg.max_torque.empty() || !msg.max_momentum.empty() || !msg.initial_momentum.empty() ||
-        msg.max_momentum_norm != 0.0) {
+        !msg.spin_inertia.empty() || msg.max_momentum_norm != 0.0) {
       throw InvalidInput(field +
                          ".spin_axes: empty (no wheels) while the array's other fields "
                          "are set: give the spin axes, or leave every field empty / 0");
@@ -287,6 +291,7 @@ ReactionWheels reactionWheelsFromMsg(const ReactionWheelArray& msg, const std::s
   out.max_torque = msg.max_torque;
   out.max_momentum = msg.max_momentum;
   out.initial_momentum = msg.initial_momentum;
+  out.spin_inertia = msg.spin_inertia;  // checked by the core (validateReactionWheels)
   // 0 means no envelope; any other value (negative, NaN) is the core's to refuse by name.
   if (msg.max_momentum_norm != 0.0) out.max_momentum_norm = msg.max_momentum_norm;
   return out;
@@ -298,6 +303,7 @@ ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels) {
   m.max_torque = wheels.max_torque;
   m.max_momentum = wheels.max_momentum;
   m.initial_momentum = wheels.initial_momentum;
+  m.spin_inertia = wheels.spin_inertia;
   m.max_momentum_norm = std::isfinite(wheels.max_momentum_norm) ? wheels.max_momentum_norm : 0.0;
   return m;
 }

@@ -251,12 +251,20 @@ PlannerNode::~PlannerNode() {
   }
 }
 
-PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request& req) {
+PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request& req,
+                                            ServiceTimes* times) {
+  const ros::WallTime entered = ros::WallTime::now();
   reapLateSolves(false);
+  times->reap_s = (ros::WallTime::now() - entered).toSec();
   const double budget = ros_conversions::effectiveTimeBudget(req.time_budget, defaults_);
+  times->budget_s = budget;
   if (!(budget > 0.0)) return planRequest(req, defaults_, nullptr);
   auto slot = std::make_shared<SolveSlot>();
-  auto request = std::make_shared<const PlanAttitudeManeuver::Request>(req);
+  // The deadline counts from the callback's entry, as an action goal's from its acceptance: the
+  // reaping above is part of the budget, and the solve gets what is left of it.
+  auto copy = std::make_shared<PlanAttitudeManeuver::Request>(req);
+  copy->time_budget = std::max(budget - times->reap_s, 1e-6);
+  std::shared_ptr<const PlanAttitudeManeuver::Request> request = copy;
   std::thread solve([slot, request, defaults = defaults_] {
     PlanOutcome outcome = planRequest(*request, defaults, nullptr, &slot->cancel);
     std::lock_guard<std::mutex> lock(slot->mutex);
@@ -265,8 +273,11 @@ PlanOutcome PlannerNode::planServiceRequest(const PlanAttitudeManeuver::Request&
     slot->finished.notify_all();
   });
   std::unique_lock<std::mutex> lock(slot->mutex);
-  const auto deadline = std::chrono::duration<double>(answerDeadline(budget));
-  if (slot->finished.wait_for(lock, deadline, [&] { return slot->done; })) {
+  const auto deadline = std::chrono::duration<double>(answerDeadline(budget) - times->reap_s);
+  const ros::WallTime waiting = ros::WallTime::now();
+  const bool solved = slot->finished.wait_for(lock, deadline, [&] { return slot->done; });
+  times->wait_s = (ros::WallTime::now() - waiting).toSec();
+  if (solved) {
     lock.unlock();
     solve.join();
     returnFreedMemory();
@@ -309,9 +320,12 @@ void PlannerNode::reapLateSolves(bool all) {
 bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
                                 PlanAttitudeManeuver::Response& res) {
   const ros::WallTime received = ros::WallTime::now();
+  ServiceTimes times;
   try {
-    const PlanOutcome outcome = planServiceRequest(req);
+    const PlanOutcome outcome = planServiceRequest(req, &times);
+    const ros::WallTime filling = ros::WallTime::now();
     fillResponse(outcome, world_frame_, body_frame_, &res);
+    times.fill_s = (ros::WallTime::now() - filling).toSec();
     if (res.success) {
       ROS_INFO("plan: N = %d converged in %d iterations, %.3f s, cost %.6g", res.steps,
                res.iterations, res.solve_time, res.cost);
@@ -324,7 +338,16 @@ bool PlannerNode::onPlanService(PlanAttitudeManeuver::Request& req,
     res.error_code.val = PlanErrorCode::INTERNAL_ERROR;
     res.message = std::string("internal error: ") + e.what();
   }
-  answers_.record(res.error_code.val, (ros::WallTime::now() - received).toSec());
+  const double in_callback = (ros::WallTime::now() - received).toSec();
+  answers_.record(res.error_code.val, in_callback);
+  if (times.budget_s > 0.0) {
+    // Where an answer's time goes inside the node (docs/ros_timing.md reads these lines).
+    ROS_INFO(
+        "service timing: budget %.3f s, answered by %.3f s: reaping stopped solves %.1f ms, "
+        "solve or deadline wait %.1f ms, response fill %.1f ms, in the callback %.1f ms",
+        times.budget_s, answerDeadline(times.budget_s), 1e3 * times.reap_s, 1e3 * times.wait_s,
+        1e3 * times.fill_s, 1e3 * in_callback);
+  }
   return true;
 }
 
@@ -449,11 +472,15 @@ void PlannerNode::onCancel(GoalHandle goal) {
   auto it = active_.find(goal.getGoalID().id);
   if (it == active_.end()) return;  // ended already, or not yet accepted (its worker ends it)
   it->second.cancel->store(true);   // this goal only: the solver stops
-  // A solver that stops within kCancelGrace ends the goal itself, with the plan it had reached
-  // (serveGoal); the wait holds no lock (goal_ended_ is notified under goals_mutex_).
-  // (A goal still queued behind busy workers ends after the grace, without a plan.)
-  goal_ended_.wait_for(goals, std::chrono::duration<double>(kCancelGrace),
-                       [&] { return goalEnded(goal.getGoalStatus().status); });
+  // A solver that hands its plan over within kCancelGrace has its worker end the goal, with the
+  // plan it had reached (serveGoal: filling and sending an N = 1e5 plan takes longer than the
+  // grace, and is no solve to wait for); the wait holds no lock (goal_ended_ is notified under
+  // goals_mutex_). (A goal still queued behind busy workers ends after the grace, without a plan.)
+  const std::shared_ptr<std::atomic<bool>> handed_over = it->second.handed_over;
+  goal_ended_.wait_for(goals, std::chrono::duration<double>(kCancelGrace), [&] {
+    return goalEnded(goal.getGoalStatus().status) || handed_over->load();
+  });
+  if (handed_over->load()) return;  // its worker ends it, PREEMPTED with the plan
   // Else the goal ends now, not when the solver has stopped and its N = 1e5 plan has been
   // evaluated: the worker's late result is discarded (serveGoal). Under the server's lock, so
   // that the worker cannot end it in between.
@@ -525,6 +552,11 @@ void PlannerNode::serveGoal(const ActiveGoal& goal) {
           return true;  // the cancel reaches the core through goal.cancel
         },
         goal.cancel.get());
+    {
+      std::lock_guard<std::mutex> goals(goals_mutex_);  // a cancel waiting for the plan (onCancel)
+      goal.handed_over->store(true);
+    }
+    goal_ended_.notify_all();
     if (const auto kept = keptAttemptFeedback(outcome, last_iteration)) {
       handle.publishFeedback(*kept);
     }

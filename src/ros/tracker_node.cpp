@@ -735,7 +735,9 @@ void TrackerNode::runBody(const Replay& replay, const Maneuver& plan, const Matr
     finishReplanResult(pb);
     return;
   }
-  if (mode_ == TrackingMode::Feedback) {
+  if (mode_ == TrackingMode::Feedback && pb->wheels.present()) {
+    trackWheels(N, inertia, scheme, start, pb);
+  } else if (mode_ == TrackingMode::Feedback) {
     Actuation actuation = actuationOf(replay.effects);
     const TrackingRun run = simulateTracking(*pb->reference, start.attitude, start.angular_velocity,
                                              pb->effects.get(), &actuation, tracking_);
@@ -890,17 +892,17 @@ void TrackerNode::publishSample(const Playback& pb, double t, const ros::Time& s
   const ManeuverSample plan = pb.horizon ? pb.horizon->referenceAt(t) : pb.reference->at(t);
   pb.health->observe(body.attitude, body.angular_velocity, body.torque);
   publishState(pb, body, plan, t, stamp, trail);
-  if (pb.wheel_flight) publishWheels(pb, t, stamp);
+  if (pb.wheel_flight) publishWheels(pb, t, body.angular_velocity, stamp);
 }
 
 void TrackerNode::requireWheelFlight(const ReactionWheels& wheels,
                                      const std::vector<EffectSpec>& effects) const {
   const std::string field = "maneuver.reaction_wheels";
   validateReactionWheels(wheels, field);
-  if (mode_ != TrackingMode::Replay) {
+  if (mode_ == TrackingMode::Replan) {
     throw InvalidInput(field +
-                       ": a maneuver with reaction wheels is flown in ~mode replay only "
-                       "(its wheel torques through body + wheels), got ~mode " +
+                       ": a maneuver with reaction wheels is flown in ~mode replay or feedback "
+                       "only (a re-plan's answer is not yet flown by the wheels), got ~mode " +
                        trackingModeName(mode_));
   }
   if (plant_ != PlantKind::Internal) {
@@ -936,18 +938,54 @@ void TrackerNode::flyWheels(const AttitudeManeuver& msg, const Maneuver& plan,
   result.message = "flew " + std::to_string(N) + " steps with " +
                    std::to_string(pb->wheels.count()) +
                    " reaction wheels (body + wheels from the wheel torques)";
-  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, flight->peaks);
-  std::string which;
-  const double excess = flight->peaks.worstExcess(pb->wheels, &which);
-  if (excess > 0.0)
-    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
+  reportWheelPeaks(*flight, pb);
   pb->actual = std::make_unique<ManeuverInterpolation>(flight->body, scheme, inertia, nullptr);
   pb->wheel_flight = std::move(flight);
 }
 
-void TrackerNode::publishWheels(const Playback& pb, double t, const ros::Time& stamp) {
+void TrackerNode::trackWheels(int steps, const Matrix3& inertia, SchemeKind scheme,
+                              const RigidBodyState& start, Playback* pb) const {
+  auto run = std::make_shared<WheelTracking>(
+      trackWithWheels(*pb->reference, inertia, pb->wheels, start, tracking_));
+  ReplayResult& result = pb->result;
+  result.effort = run->effort;
+  result.cost = run->effort / pb->reference->nodes().time_step;  // as the feedback mode's
+  for (int j = 0; j <= run->samples; ++j) {
+    const double t = j * run->flight.body.time_step;
+    result.max_attitude_deviation =
+        std::max(result.max_attitude_deviation,
+                 so3::angleBetween(pb->reference->at(t).attitude, run->flight.body.attitude[j]));
+  }
+  result.message = "tracked " + std::to_string(steps) + " steps with feedback through " +
+                   std::to_string(pb->wheels.count()) + " reaction wheels (omega_n " +
+                   exactNumber(run->natural_frequency) + " rad/s, " +
+                   std::to_string(run->substeps) + " control samples per step, minimum-norm " +
+                   "distribution; " + std::to_string(run->saturated_samples) + " of " +
+                   std::to_string(run->samples) + " samples cut at a wheel limit)";
+  reportWheelPeaks(run->flight, pb);
+  pb->actual = std::make_unique<ManeuverInterpolation>(run->flight.body, scheme, inertia, nullptr,
+                                                       TorqueHold::StepStart);
+  pb->wheel_flight = std::shared_ptr<const WheelFlight>(run, &run->flight);
+}
+
+void TrackerNode::reportWheelPeaks(const WheelFlight& flight, Playback* pb) const {
+  ReplayResult& result = pb->result;
+  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, flight.peaks);
+  std::string which;
+  const double excess = flight.peaks.worstExcess(pb->wheels, &which);
+  if (excess > 0.0)
+    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
+}
+
+void TrackerNode::publishWheels(const Playback& pb, double t, const Vector3& body_rate,
+                                const ros::Time& stamp) {
   const Eigen::VectorXd torque = pb.wheel_flight->torqueAt(t);
   const Eigen::VectorXd momentum = pb.wheel_flight->momentumAt(t);
+  // Spin rates relative to the body need the wheels' spin inertia; without it velocity stays
+  // empty (a JointState field may be empty).
+  const Eigen::VectorXd spin = pb.wheels.hasSpinInertia()
+                                   ? wheelSpinRates(pb.wheels, momentum, body_rate)
+                                   : Eigen::VectorXd();
   sensor_msgs::JointState joints;
   joints.header.stamp = stamp;
   joints.header.frame_id = pb.body_frame;
@@ -958,7 +996,8 @@ void TrackerNode::publishWheels(const Playback& pb, double t, const ros::Time& s
   momenta.layout.dim[0].stride = pb.wheels.count();
   for (int i = 0; i < pb.wheels.count(); ++i) {
     joints.name.push_back(wheelName(i));
-    joints.effort.push_back(torque(i));  // u_i [N m]; no spin inertia: no speed (velocity empty)
+    joints.effort.push_back(torque(i));                       // u_i [N m]
+    if (spin.size() > 0) joints.velocity.push_back(spin(i));  // w_i [rad/s] relative to the body
     momenta.data.push_back(momentum(i));
   }
   wheel_state_pub_.publish(joints);

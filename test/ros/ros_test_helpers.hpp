@@ -95,6 +95,9 @@ void expectSeedAnytimePlan(const Response& res, int steps, double tolerance,
   EXPECT_TRUE(std::isfinite(res.max_residual));
   EXPECT_GT(res.max_residual, tolerance);
   EXPECT_GT(res.cost, 0.0);
+  // Handed over without its open-loop replay, said as data: the replay figures not measured.
+  EXPECT_FALSE(res.replay_measured);
+  EXPECT_TRUE(std::isnan(res.replay_miss));
 }
 
 /// scenes/sun_keep_out.yaml as a request at `steps` steps, plus |τ_k| ≤ 0.095 N m: a π/2 slew

@@ -115,6 +115,7 @@ TEST_F(PlannerAction, FeedbackArrivesAndTheGoalSucceeds) {
   EXPECT_LE(result->step_residual, 1e-8);
   EXPECT_GE(result->replay_miss, result->terminal_attitude_error);
   EXPECT_LT(result->replay_miss, 1e-8);
+  EXPECT_TRUE(result->replay_measured);
   // Feedback and result travel on different topics: allow the last feedback to land.
   waitFor(
       [&] {

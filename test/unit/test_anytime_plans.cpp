@@ -53,6 +53,12 @@ void expectAnytimePlan(const PlanningProblem& p, const PlanResult& r, double tol
   EXPECT_GT(r.max_residual, tolerance) << r.message;
   EXPECT_TRUE(std::isfinite(r.cost));
   EXPECT_GT(r.cost, 0.0);
+  // Handed over without its open-loop replay (N implicit steps), and said so as data.
+  EXPECT_FALSE(r.replay_measured);
+  EXPECT_TRUE(std::isnan(r.replay_miss));
+  EXPECT_TRUE(std::isnan(r.terminal_attitude_error));
+  EXPECT_TRUE(std::isnan(r.terminal_velocity_error));
+  EXPECT_TRUE(std::isnan(r.dynamics_residual));
 }
 
 /// Options whose callback stops the solve at its `stop_at`-th reported iteration: by refusing to go
@@ -123,4 +129,22 @@ TEST(AnytimePlan, StoppedUnderConstraintsReturnsTheIterateWithItsViolations) {
     EXPECT_GE(r.max_constraint_violation, 0.0);
     EXPECT_NEAR(r.max_constraint_violation, checkConstraints(p, r.maneuver).max_violation, 1e-15);
   }
+}
+
+TEST(AnytimePlan, OnlyAStoppedPlanIsHandedOverWithoutItsReplay) {
+  // A converged plan (and one stopped short of its tolerance by the iteration limit) keeps its
+  // replay figures, measured: only TimedOut and Cancelled skip the replay.
+  const PlanningProblem p = sceneProblem("rest_to_rest.yaml", 64);
+  const PlanResult converged = planManeuver(p, SolverOptions());
+  ASSERT_TRUE(converged.converged()) << converged.message;
+  EXPECT_TRUE(converged.replay_measured);
+  EXPECT_TRUE(std::isfinite(converged.replay_miss));
+  EXPECT_LT(converged.replay_miss, 1e-8);
+  SolverOptions limited;
+  limited.tolerance = 1e-300;
+  limited.max_iterations = 2;
+  const PlanResult not_converged = planManeuver(p, limited);
+  ASSERT_EQ(not_converged.termination, Termination::NotConverged) << not_converged.message;
+  EXPECT_TRUE(not_converged.replay_measured);
+  EXPECT_TRUE(std::isfinite(not_converged.replay_miss));
 }

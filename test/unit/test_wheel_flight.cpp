@@ -11,6 +11,8 @@
 
 #include "attitude_planner/analysis/wheel_flight.hpp"
 #include "attitude_planner/analysis/wheel_peaks.hpp"
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 
 namespace ap = attitude_planner;
@@ -122,14 +124,20 @@ TEST(WheelFlight, FliesThePlansWheelTorquesAndFollowsThePlanToSecondOrder) {
   EXPECT_GT(momentum_gaps[1] / momentum_gaps[2], 3.0);
 }
 
+/// Plans `p` (which must converge) and flies the plan's own wheel torques from its start.
+void planAndFly(const ap::PlanningProblem& p, ap::PlanResult* r, ap::WheelFlight* flight) {
+  *r = ap::planManeuver(p);
+  ASSERT_TRUE(r->converged()) << r->message;
+  *flight = ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r->maneuver, {},
+                              ap::RigidBodyState{p.initial_attitude, p.initial_velocity});
+}
+
 /// The body torque of the flight is the array's reaction, τ = −A u − Ω × A h_w, at every node.
 TEST(WheelFlight, BodyTorqueIsTheArraysReaction) {
   const ap::PlanningProblem p = pyramidSlew(32);
-  const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  const ap::WheelFlight flight =
-      ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r.maneuver, {},
-                        ap::RigidBodyState{p.initial_attitude, p.initial_velocity});
+  ap::PlanResult r;
+  ap::WheelFlight flight;
+  ASSERT_NO_FATAL_FAILURE(planAndFly(p, &r, &flight));
   const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
   for (int k = 0; k <= 32; ++k) {
     const ap::Vector3 Omega = flight.body.angular_velocity[k];
@@ -142,4 +150,130 @@ TEST(WheelFlight, BodyTorqueIsTheArraysReaction) {
     // and the plan's body torque to O(h): the array makes the torque the plan asked for
     EXPECT_LT((flight.body.torque[k] - r.maneuver.torque[k]).norm(), 0.05) << "k = " << k;
   }
+}
+
+/// A wheel's spin rate relative to the body (wheelSpinRates) against the gyrostat written with
+/// relative rates: the body with its wheels locked has the inertia J_total = J + Σ J_s,i a_i a_iᵀ
+/// (J excludes the wheels' axial inertia), and the wheels add Σ a_i J_s,i w_i. Its momentum must
+/// be the package's J Ω + A h_w at every node of a flight; a wheel turning with the body (w = 0)
+/// carries h = J_s a·Ω.
+TEST(WheelSpinRates, GyrostatWithRelativeRatesHasTheArraysMomentum) {
+  ap::PlanningProblem p = pyramidSlew(32);
+  p.reaction_wheels.spin_inertia = {0.02, 0.03, 0.025, 0.04};
+  ap::PlanResult r;
+  ap::WheelFlight flight;
+  ASSERT_NO_FATAL_FAILURE(planAndFly(p, &r, &flight));
+  const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+  ap::Matrix3 locked = p.inertia;
+  for (int i = 0; i < 4; ++i) {
+    const ap::Vector3 a = array.axes.col(i);
+    locked += p.reaction_wheels.spin_inertia[i] * a * a.transpose();
+  }
+  double largest_rate = 0.0;
+  for (int k = 0; k <= 32; ++k) {
+    const ap::Vector3 Omega = flight.body.angular_velocity[k];
+    const Eigen::VectorXd w = ap::wheelSpinRates(p.reaction_wheels, flight.momentum[k], Omega);
+    ap::Vector3 gyrostat = locked * Omega;
+    for (int i = 0; i < 4; ++i)
+      gyrostat += array.axes.col(i) * p.reaction_wheels.spin_inertia[i] * w(i);
+    const ap::Vector3 package = p.inertia * Omega + array.axes * flight.momentum[k];
+    EXPECT_LT((gyrostat - package).norm(), 1e-13 * package.norm()) << "k = " << k;
+    largest_rate = std::max(largest_rate, w.cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(largest_rate, 1.0);  // [rad/s]: the wheels spin (biased), so the check has teeth
+  // Locked wheels: h_i = J_s,i a_i·Ω gives w = 0 (the scalar spin inertia for every wheel).
+  p.reaction_wheels.spin_inertia = {0.05};
+  const ap::Vector3 Omega(0.3, -0.2, 0.1);
+  Eigen::VectorXd locked_momenta(4);
+  for (int i = 0; i < 4; ++i) locked_momenta(i) = 0.05 * array.axes.col(i).dot(Omega);
+  EXPECT_LT(ap::wheelSpinRates(p.reaction_wheels, locked_momenta, Omega).norm(), 1e-15);
+}
+
+/// spin_inertia: one value or one per wheel, each finite and > 0 [kg m^2], checked once by the
+/// core (validateProblem), named by its scene key; a scene writes and reads it back.
+TEST(WheelSpinRates, SpinInertiaIsValidatedByNameAndRoundTrips) {
+  const std::string base = std::string(AP_SOURCE_DIR) + "/test/ros/wheel_pyramid.yaml";
+  ap::Scene scene = ap::loadScene(base);
+  const auto refused = [&](std::vector<double> spin, const std::string& expected) {
+    ap::PlanningProblem p = scene.problem;
+    p.reaction_wheels.spin_inertia = std::move(spin);
+    try {
+      ap::validateProblem(p);
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const ap::InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("actuators.reaction_wheels.spin_inertia"),
+                std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused({0.01, 0.02}, "got 2 values [0.01, 0.02]");
+  refused({0.01, -0.02, 0.01, 0.01}, "got -0.02 at index 1");
+  refused({std::nan("")}, "got nan at index 0");
+  refused({0.0}, "got 0 at index 0");
+  scene.problem.reaction_wheels.spin_inertia = {0.01, 0.02, 0.03, 0.04};
+  EXPECT_NO_THROW(ap::validateProblem(scene.problem));
+  const ap::Scene back = ap::parseScene(ap::formatScene(scene));
+  EXPECT_EQ(back.problem.reaction_wheels.spin_inertia, scene.problem.reaction_wheels.spin_inertia);
+  // The scene key itself, as a scalar.
+  std::string text = ap::formatScene(scene);
+  const std::size_t at = text.find(", spin_inertia:");
+  ASSERT_NE(at, std::string::npos) << text;
+  text = text.substr(0, at) + ", spin_inertia: 0.015}}" + text.substr(text.find("}}", at) + 2);
+  EXPECT_EQ(ap::parseScene(text).problem.reaction_wheels.spin_inertia, std::vector<double>{0.015});
+}
+
+/// The feedback mode with wheels (trackWithWheels): from a start off the plan the wheels fly the
+/// law's torque (delivered body torque = the law's command, recomputed here, at every sample no
+/// wheel was cut; the wheel torques carry no null-space part), the loop lands on the target, and
+/// with a torque limit below what the law asks the commands are cut to exactly ±U.
+TEST(WheelTracking, WheelsDeliverTheLawsTorqueAndAreCutAtTheirLimits) {
+  ap::PlanningProblem p = pyramidSlew(64);
+  p.reaction_wheels.max_momentum = {3.0};  // room for the correction
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  const ap::ManeuverInterpolation reference(r.maneuver, p.scheme, p.inertia, nullptr);
+  const ap::RigidBodyState start{ap::so3::exp(ap::Vector3(0.02, -0.01, 0.015)),
+                                 ap::Vector3(0.002, 0.0, -0.001)};
+  const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
+  const auto check = [&](const ap::ReactionWheels& wheels, bool expect_cut) {
+    const ap::WheelTracking run =
+        ap::trackWithWheels(reference, p.inertia, wheels, start, ap::TrackingOptions());
+    const ap::TrackingLaw law(reference, nullptr, ap::TrackingOptions());
+    ASSERT_EQ(run.samples, 64 * run.substeps);
+    ASSERT_EQ(static_cast<int>(run.flight.torque.size()), run.samples + 1);
+    int delivered_as_commanded = 0;
+    double peak_u = 0.0;
+    for (int j = 0; j < run.samples; ++j) {
+      const ap::Maneuver& body = run.flight.body;
+      const Eigen::VectorXd& u = run.flight.torque[j];
+      peak_u = std::max(peak_u, u.cwiseAbs().maxCoeff());
+      const ap::Vector3 commanded =
+          law.command(body.attitude[j], body.angular_velocity[j], j * body.time_step);
+      if ((body.torque[j] - commanded).norm() < 1e-12 * (1.0 + commanded.norm())) {
+        ++delivered_as_commanded;
+        // minimum norm: u = A⁺A u (no part in A's null space)
+        EXPECT_LT((u - array.pseudo_inverse * (array.axes * u)).norm(), 1e-14) << j;
+      }
+    }
+    if (expect_cut) {
+      EXPECT_GT(run.saturated_samples, 0);
+      EXPECT_DOUBLE_EQ(peak_u, wheels.max_torque[0]);
+    } else {
+      EXPECT_EQ(run.saturated_samples, 0);
+      EXPECT_EQ(delivered_as_commanded, run.samples);
+      const ap::Matrix3 end = run.flight.body.attitude.back();
+      EXPECT_LT(ap::so3::angleBetween(end, p.final_attitude), 1e-3);
+    }
+    EXPECT_LE(peak_u, wheels.max_torque[0]);
+    std::printf("U = %g N m: %d of %d samples cut, %d delivered as commanded, terminal %.3g rad\n",
+                wheels.max_torque[0], run.saturated_samples, run.samples, delivered_as_commanded,
+                ap::so3::angleBetween(run.flight.body.attitude.back(), p.final_attitude));
+  };
+  ap::ReactionWheels roomy = p.reaction_wheels;
+  roomy.max_torque = {5.0};  // above the law's first correction of the 0.027 rad offset
+  check(roomy, false);
+  ap::ReactionWheels tight = p.reaction_wheels;
+  tight.max_torque = {0.05};
+  check(tight, true);
 }

@@ -42,4 +42,32 @@ WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const React
                           const Maneuver& plan, std::vector<Eigen::VectorXd> wheel_torque,
                           const RigidBodyState& start);
 
+/// A closed loop flown by the wheels (the tracker's ~mode feedback with wheels).
+struct WheelTracking {
+  /// The body and wheels on the control grid t_j = j Δt (body.time_step = Δt), `torque` the
+  /// wheel torques delivered over [t_j, t_{j+1}) (row M: the last one, held).
+  WheelFlight flight;
+  int substeps = 1;                ///< control samples per plan step
+  double natural_frequency = 0.0;  ///< ω_n of the law [rad/s]
+  /// ½∫|τ|² dt of the body torque the array delivered (the left sum on the control grid)
+  /// [N²·m²·s]: what the feedback mode's `effort` is without wheels.
+  double effort = 0.0;
+  /// Control samples at which a wheel's command was cut: by its torque limit U_i, or to 0 because
+  /// its momentum was at its limit H_i and the command would drive it further.
+  int saturated_samples = 0;
+  int samples = 0;  ///< control samples flown (M)
+};
+
+/// Tracks `reference` with the geometric law (TrackingLaw, its ω_n and control grid as
+/// simulateTracking) through the wheels: at every control sample the law's body torque τ_c is
+/// distributed over the wheels by the array's minimum-norm law, A u = −(τ_c + Ω × A h_w),
+/// u = A⁺(A u) (docs/reaction_wheels.md); each u_i is then cut to ±U_i, and to 0 in the
+/// direction that drives a wheel already at ±H_i further. The cut u is held over the period and
+/// flies the continuous body + wheels (replayWithWheels, kWheelFlightSubsteps RK4 steps): the body
+/// gets τ = −A u − Ω × A h_w, the array's reaction. No effects (the tracker refuses them with
+/// wheels). Throws InvalidInput for bad options (naming them).
+WheelTracking trackWithWheels(const ManeuverInterpolation& reference, const Matrix3& inertia,
+                              const ReactionWheels& wheels, const RigidBodyState& start,
+                              const TrackingOptions& options);
+
 }  // namespace attitude_planner

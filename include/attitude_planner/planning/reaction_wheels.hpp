@@ -42,12 +42,20 @@ struct ReactionWheels {
   /// The array's envelope as a sphere [N m s]: |A h_w| ≤ this (the norm of the array's momentum
   /// vector in the body frame; for orthonormal axes the same as |h_w|); +∞: none.
   double max_momentum_norm = std::numeric_limits<double>::infinity();
+  /// J_s,i [kg m^2]: each wheel's moment of inertia about its spin axis; one entry (every wheel)
+  /// or one per wheel; empty: not given (the wheel momenta are planned without it; only a
+  /// wheel's spin rate needs it, wheelSpinRates).
+  std::vector<double> spin_inertia;
 
   bool present() const { return !spin_axes.empty(); }
   int count() const { return static_cast<int>(spin_axes.size()); }
   double torqueLimit(int i) const { return max_torque.size() == 1 ? max_torque[0] : max_torque[i]; }
   double momentumLimit(int i) const {
     return max_momentum.size() == 1 ? max_momentum[0] : max_momentum[i];
+  }
+  bool hasSpinInertia() const { return !spin_inertia.empty(); }
+  double spinInertia(int i) const {
+    return spin_inertia.size() == 1 ? spin_inertia[0] : spin_inertia[i];
   }
   double initialMomentum(int i) const {
     return initial_momentum.empty() ? 0.0 : initial_momentum[i];
@@ -69,8 +77,17 @@ WheelArray wheelArray(const ReactionWheels& wheels);
 
 /// Checks the array: ≥ 3 finite nonzero axes spanning R³ (the smallest singular value of the
 /// normalized A above 1e-6), limits finite and > 0 with 1 or n entries, n initial momenta within
-/// their limits and the norm envelope. Throws InvalidInput naming `field`.<key> and the value.
+/// their limits and the norm envelope, spin inertias (when given) finite and > 0 with 1 or n
+/// entries. Throws InvalidInput naming `field`.<key> and the value.
 void validateReactionWheels(const ReactionWheels& wheels, const std::string& field);
+
+/// Each wheel's spin rate relative to the body [rad/s] from its momentum h_w,i [N m s] and the
+/// body rate Ω [rad/s]: a wheel spinning at w_i relative to the body turns at a_i·Ω + w_i about
+/// its axis, so h_w,i = J_s,i (a_i·Ω + w_i) and w_i = h_w,i / J_s,i − a_i·Ω (a_i the unit axis).
+/// (With that h_w the total momentum is R (J Ω + A h_w) when J excludes the wheels' axial
+/// inertia Σ J_s,i a_i a_iᵀ, docs/reaction_wheels.md.) Needs ReactionWheels::spin_inertia.
+Eigen::VectorXd wheelSpinRates(const ReactionWheels& wheels, const Eigen::VectorXd& momenta,
+                               const Vector3& body_rate);
 
 /// The wheel states of a plan: per node k = 0..N the wheel momenta h_w,k and torques u_k (the
 /// definitions above; u at k = 0 and N of schemes without end torques is formed with τ = 0, what

@@ -157,9 +157,10 @@ inline double answerDeadline(double budget) {
 }
 
 /// An action goal cancelled while a worker solves it ends when the worker has stopped, with the
-/// plan the solve had reached, if that takes at most kCancelGrace [s]; else the cancel ends it
-/// then, without a plan (the worker's result is dropped): a cancel is answered within kCancelGrace
-/// plus transport, inside the 50 ms docs/ros_timing.md measures against.
+/// plan the solve had reached, if the solve returns it within kCancelGrace [s]; else the cancel
+/// ends it then, without a plan (the worker's result is dropped). A cancel is answered within
+/// kCancelGrace plus the plan's fill and transfer (about 0.1 s for the 8.8 MB of N = 1e5 plan,
+/// docs/ros_planner.md) plus transport.
 inline constexpr double kCancelGrace = 0.03;
 
 /// Whether a result's plan is an unconverged iterate (the response's unconverged_plan): the solver
@@ -221,14 +222,25 @@ class PlannerNode {
     std::shared_ptr<DeadlineWatch> deadline;
     ros::WallTime accepted;  ///< when it was accepted
     double budget = 0.0;     ///< its effective time budget [s] (0 = none)
+    /// Set (under goals_mutex_, goal_ended_ notified) when its solve has returned: from then on
+    /// the worker ends the goal with the plan whatever a cancel says, so a cancel waits
+    /// kCancelGrace for the core's hand-over, not for the plan's fill and transfer.
+    std::shared_ptr<std::atomic<bool>> handed_over = std::make_shared<std::atomic<bool>>(false);
   };
   /// The deadline of an accepted goal passed: tells its solve to stop and ends it ABORTED with
   /// TIMED_OUT (unless it has ended); frees its slot if no worker has taken it.
   void onGoalDeadline(const ActiveGoal& goal);
 
+  /// Where a service answer's wall time went inside the node [s] (logged for budgeted requests).
+  struct ServiceTimes {
+    double budget_s = 0.0;  ///< the effective time budget (0 = none)
+    double reap_s = 0.0;    ///< joining the stopped solves of earlier requests
+    double wait_s = 0.0;    ///< the solve, or the wait up to its answer deadline
+    double fill_s = 0.0;    ///< filling the response
+  };
   /// planRequest for the service, answered by its deadline (answerDeadline): the solve runs on a
   /// thread of its own, left to stop (and joined later) when the deadline passes first.
-  PlanOutcome planServiceRequest(const PlanAttitudeManeuver::Request& req);
+  PlanOutcome planServiceRequest(const PlanAttitudeManeuver::Request& req, ServiceTimes* times);
   /// Joins the late solves that have stopped (all of them, cancelled first, when `all`).
   void reapLateSolves(bool all);
   /// Service callback: always returns true (the outcome is in the response).
@@ -339,9 +351,14 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
     if (outcome.output.output == ros_conversions::ManeuverOutput::Nodes) {
       const WheelStates shown =
           ros_conversions::decimatedWheelStates(states, outcome.output.max_nodes);
-      res->maneuver = ros_conversions::maneuverToMsg(
-          ros_conversions::decimatedManeuver(r.maneuver, outcome.output.max_nodes), planned,
-          world_frame, body_frame, ros::Time::now(), wheels ? &shown : nullptr);
+      // Decimated only when asked: a full plan goes to the message without a copy of its rows.
+      const int max_nodes = outcome.output.max_nodes;
+      const bool decimate = max_nodes > 0 && max_nodes < r.maneuver.steps() + 1;
+      const Maneuver decimated =
+          decimate ? ros_conversions::decimatedManeuver(r.maneuver, max_nodes) : Maneuver();
+      res->maneuver =
+          ros_conversions::maneuverToMsg(decimate ? decimated : r.maneuver, planned, world_frame,
+                                         body_frame, ros::Time::now(), wheels ? &shown : nullptr);
     }
     if (wheels) {
       res->reaction_wheels = ros_conversions::wheelSummaryToMsg(
@@ -368,6 +385,7 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->max_violation_between_nodes = r.max_violation_between_nodes;
   res->active_constraints = r.active_constraints;
   res->replay_miss = r.replay_miss;
+  res->replay_measured = r.replay_measured;
   res->step_residual = r.step_residual;
   res->final_twist = r.pointing.active ? r.pointing.final_twist : 0.0;
   res->pointing_error = r.pointing.active ? r.pointing.error : 0.0;

@@ -17,9 +17,11 @@
 // are streamed at ~rate [Hz of ROS time] with the scheme's own interpolation between nodes
 // (ManeuverInterpolation); `done` reports the terminal attitude and rate errors against the plan.
 //
-// A maneuver with reaction wheels (its `reaction_wheels`, ~mode replay, internal plant) is flown
-// with its wheel torques through body + wheels (analysis/wheel_flight.hpp: flyWithWheels); other
-// modes, the external plant and effects during the run are refused by name.
+// A maneuver with reaction wheels (its `reaction_wheels`, internal plant) is flown with its wheel
+// torques through body + wheels in ~mode replay (analysis/wheel_flight.hpp: flyWithWheels), and
+// with the tracking law's torque distributed over the wheels and cut to their limits in ~mode
+// feedback (trackWithWheels); replan, the external plant and effects during the run are refused
+// by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -408,9 +410,19 @@ class TrackerNode {
   /// playback->actual, wheel_flight and the result (errors, effort, the wheels' peaks and margins).
   void flyWheels(const AttitudeManeuver& msg, const Maneuver& plan, const Matrix3& inertia,
                  SchemeKind scheme, const RigidBodyState& start, Playback* playback) const;
-  /// With wheels: `wheel_states` (JointState: effort u_i(t)), `wheel_momentum` (h_w(t)) and the
-  /// momentum bars at maneuver time t, stamped `stamp`.
-  void publishWheels(const Playback& playback, double t, const ros::Time& stamp);
+  /// feedback mode with wheels: the tracking law's torque distributed over the wheels and cut to
+  /// their limits (trackWithWheels) from `start`; fills playback->actual, wheel_flight and the
+  /// result (effort, deviation, the samples cut at a limit, the wheels' peaks and margins).
+  void trackWheels(int steps, const Matrix3& inertia, SchemeKind scheme,
+                   const RigidBodyState& start, Playback* playback) const;
+  /// The wheels' peaks and margins of a flight into the result, and a limit it went past into
+  /// its message.
+  void reportWheelPeaks(const WheelFlight& flight, Playback* playback) const;
+  /// With wheels: `wheel_states` (JointState: effort u_i(t); velocity the spin rates relative to
+  /// the body, wheelSpinRates with the body rate `body_rate`, when the array has spin_inertia),
+  /// `wheel_momentum` (h_w(t)) and the momentum bars at maneuver time t, stamped `stamp`.
+  void publishWheels(const Playback& playback, double t, const Vector3& body_rate,
+                     const ros::Time& stamp);
   /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
   /// (e_Ω), stamped `stamp`.
   void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,

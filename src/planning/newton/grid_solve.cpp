@@ -91,6 +91,8 @@ void addStencil(const ReducedProblem& np, const AugmentedLayout& at, double alph
 bool solveAugmented(const ReducedProblem& np, double relative_shift, int bandwidth,
                     const Interruption& interruption, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
+  // Polled before the system is allocated or zeroed (~100 MB at N = 1e5, not interruptible).
+  interruption.poll();
   const AugmentedLayout at{np.firstFreeNode(), np.lastFreeNode()};
   const int n = at.size();
   if (!*workspace) workspace->reset(new BandedLinearSystem(n, bandwidth));
@@ -389,6 +391,29 @@ std::optional<ReducedProblem> startedProblem(const PlanningProblem& problem, con
   return reduced;
 }
 
+/// A level reached after the solve was stopped (budget, cancel): its iterate is only carried
+/// on, without the solver's Newton systems (at N = 1e5 each level's allocation and evaluation
+/// was most of a cancelled solve's 1-3 s hand-over). On the requested grid the plan is built in
+/// place and judged as any plan, its first-order residual measured from one gradient.
+PlanResult carriedWhenStopped(const PlanningProblem& problem, ReducedProblem& np, Termination stop,
+                              ReducedProblem::StepVectors* final_steps) {
+  PlanResult result;
+  const std::string reason = stop == Termination::Cancelled ? "cancelled" : "time budget exceeded";
+  if (final_steps) {
+    *final_steps = np.current();
+    result.max_residual = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    Eigen::VectorXd gradient(np.unknowns());
+    double scale = 0.0;
+    np.evaluate(&gradient, nullptr, &scale);
+    result.max_residual = gradient.size() ? gradient.cwiseAbs().maxCoeff() / scale : 0.0;
+    result.maneuver = np.maneuver(np.current());
+    evaluatePlan(problem, result.maneuver.torque, &result, &result.maneuver);
+  }
+  const double residual = result.max_residual;
+  return finished(std::move(result), np.steps(), 0, stop, reason, residual, 0.0);
+}
+
 }  // namespace
 
 PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
@@ -399,6 +424,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
   std::optional<ReducedProblem> reduced = startedProblem(problem, start, &result);
   if (!reduced) return result;
   ReducedProblem& np = *reduced;
+  if (const auto stop = context.stopReason())
+    return carriedWhenStopped(problem, np, *stop, final_steps);
   GridSolver solver(np, context, settings, parameters);
   const int iterations = solver.run(&result.history);
   Termination termination = solver.termination();
@@ -411,9 +438,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
     result.max_residual = solver.relativeGradient();
   } else {
     if (termination == Termination::Converged && iterations > 0) solver.evaluateAtFinalIterate();
-    const Maneuver planned = np.maneuver(np.current());
+    // Built in place: the plan's N + 1 rows are not copied (at N = 1e5 the copies were most of
+    // a stopped solve's hand-over).
+    result.maneuver = np.maneuver(np.current());
     result.max_residual = solver.relativeGradient();
-    evaluatePlan(problem, planned.torque, &result, &planned);
+    evaluatePlan(problem, result.maneuver.torque, &result, &result.maneuver);
     // Judged by what the plan is: the open-loop replay's miss is a sensitivity, not a verdict.
     if (termination == Termination::Converged) {
       const std::string inconsistent = planInconsistency(problem, result, false);

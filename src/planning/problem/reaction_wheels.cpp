@@ -24,18 +24,19 @@ std::string listed(const std::vector<double>& values) {
   return s.str();
 }
 
-/// A limit list: 1 or n entries, each finite and > 0.
-void requireLimits(const std::vector<double>& limits, int n, const std::string& field,
-                   const char* unit) {
+/// A per-wheel list (limits, spin inertias): 1 or n entries, each finite and > 0; `noun` says
+/// what an entry is in the message ("limit", "value").
+void requirePositiveValues(const std::vector<double>& limits, int n, const std::string& field,
+                           const char* unit, const char* noun = "limit") {
   if (limits.size() != 1 && static_cast<int>(limits.size()) != n) {
     throw InvalidInput(field, "give one value or one per wheel (" + std::to_string(n) + "), got " +
                                   std::to_string(limits.size()) + " values " + listed(limits));
   }
   for (std::size_t i = 0; i < limits.size(); ++i) {
     if (!std::isfinite(limits[i]) || !(limits[i] > 0.0)) {
-      throw InvalidInput(field, "each limit must be a finite number > 0 " + std::string(unit) +
-                                    ", got " + exactNumber(limits[i]) + " at index " +
-                                    std::to_string(i));
+      throw InvalidInput(field, "each " + std::string(noun) + " must be a finite number > 0 " +
+                                    std::string(unit) + ", got " + exactNumber(limits[i]) +
+                                    " at index " + std::to_string(i));
     }
   }
 }
@@ -84,8 +85,8 @@ WheelArray wheelArray(const ReactionWheels& wheels) {
 void validateReactionWheels(const ReactionWheels& wheels, const std::string& field) {
   requireSpanningAxes(wheels, field);
   const int n = wheels.count();
-  requireLimits(wheels.max_torque, n, field + ".max_torque", "N m");
-  requireLimits(wheels.max_momentum, n, field + ".max_momentum", "N m s");
+  requirePositiveValues(wheels.max_torque, n, field + ".max_torque", "N m");
+  requirePositiveValues(wheels.max_momentum, n, field + ".max_momentum", "N m s");
   if (!wheels.initial_momentum.empty() && static_cast<int>(wheels.initial_momentum.size()) != n) {
     throw InvalidInput(field + ".initial_momentum", "give one value per wheel (" +
                                                         std::to_string(n) + "), got " +
@@ -110,6 +111,24 @@ void validateReactionWheels(const ReactionWheels& wheels, const std::string& fie
                        "the initial momenta give |A h_w| = " + exactNumber(start) +
                            " N m s, beyond the envelope " + exactNumber(envelope) + " N m s");
   }
+  if (wheels.hasSpinInertia()) {
+    requirePositiveValues(wheels.spin_inertia, n, field + ".spin_inertia", "kg m^2", "value");
+  }
+}
+
+Eigen::VectorXd wheelSpinRates(const ReactionWheels& wheels, const Eigen::VectorXd& momenta,
+                               const Vector3& body_rate) {
+  if (!wheels.hasSpinInertia()) {
+    throw InvalidInput("actuators.reaction_wheels.spin_inertia",
+                       "not given: a wheel's spin rate needs its spin inertia");
+  }
+  const int n = wheels.count();
+  Eigen::VectorXd rates(n);
+  for (int i = 0; i < n; ++i) {
+    // h_w,i = J_s,i (a_i·Ω + w_i): the wheel's axial rate is the body's about a_i plus its own.
+    rates(i) = momenta(i) / wheels.spinInertia(i) - wheels.spin_axes[i].normalized().dot(body_rate);
+  }
+  return rates;
 }
 
 Vector3 planNodeMomentum(SchemeKind scheme, const Matrix3& inertia, const Maneuver& plan, int k) {

@@ -142,7 +142,7 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
   result->cost = scheme.cost(torque);
   result->effort = scheme.timeStep() * result->cost;
   if (planned) {
-    result->maneuver = *planned;
+    if (planned != &result->maneuver) result->maneuver = *planned;  // else built in place
   } else {
     result->maneuver.torque = torque;
     Maneuver replay;

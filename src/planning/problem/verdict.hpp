@@ -7,7 +7,8 @@
 
 namespace attitude_planner {
 
-/// Fills result->maneuver with `planned` (the solver's own trajectory) and its cost and
+/// Fills result->maneuver with `planned` (the solver's own trajectory; `planned` may be
+/// &result->maneuver itself, built in place, then nothing is copied) and its cost and
 /// step_residual; without `planned`, with the replay of `torque` (replayFigures), which is then
 /// also the plan. Every solver finishes through here, so every figure is measured the same way.
 /// The replay of a planned trajectory is left to replayFigures, which planAtResolution calls once

@@ -56,17 +56,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-/// The attempts of a plan, one line each (for --only).
-std::string trailOf(const ap::PlanResult& r) {
-  std::ostringstream out;
-  for (const ap::Attempt& a : r.attempts) {
-    out << "  " << ap::attemptStageName(a.stage) << " " << ap::attemptStartName(a.start)
-        << " N=" << a.steps << " " << ap::terminationName(a.termination) << " it=" << a.iterations
-        << " cost=" << a.cost << (a.kept ? " kept" : "") << "\n";
-  }
-  return out.str();
-}
-
 /// The suite's rows so far and their counts by outcome and by what was found wrong.
 struct SuiteTally {
   std::ostringstream rows;
@@ -134,7 +123,7 @@ void runSuite(const Options& o, const std::function<void(const std::string&)>& w
     tally.add(i, *request, c);
     std::cerr << i << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
               << " s\n";
-    if (o.only >= 0) std::cerr << c.result.message << "\n" << trailOf(c.result);
+    if (o.only >= 0) std::cerr << c.result.message << "\n" << rb::attemptLines(c.result);
     written(tally.render(o));
   }
   written(tally.render(o));

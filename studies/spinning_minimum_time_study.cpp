@@ -79,14 +79,14 @@ std::optional<rb::BoundedRequest> drawn(const Options& o, int index) {
   return r;
 }
 
-std::string trailOf(const ap::PlanResult& r) {
-  std::ostringstream out;
-  for (const ap::Attempt& a : r.attempts) {
-    out << "  " << ap::attemptStageName(a.stage) << " " << ap::attemptStartName(a.start)
-        << " N=" << a.steps << " " << ap::terminationName(a.termination) << " it=" << a.iterations
-        << " cost=" << a.cost << (a.kept ? " kept" : "") << "\n";
+/// The label in a table cell: its |Ω| bars escaped.
+std::string escapedPipes(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
   }
-  return out.str();
+  return out;
 }
 
 struct Tally {
@@ -110,12 +110,13 @@ struct Tally {
     free_time_attempts += attempts;
     free_time_converged += converged;
     const ap::PlanningProblem& p = request.problem;
-    rows << "| " << index << " | " << request.label << " | " << ap::schemeName(p.scheme) << " | "
-         << p.steps << " | " << g(p.initial_velocity.norm(), "%.3g") << " / "
-         << g(p.final_velocity.norm(), "%.3g") << " | " << outcome << " | "
-         << g(c.result.minimum_duration) << " | " << converged << " / " << attempts << " | "
-         << c.result.iterations << " | " << (c.wrong.empty() ? "ok" : "**" + c.wrong + "**")
-         << " | " << g(c.seconds, "%.3f") << " |\n";
+    rows << "| " << index << " | " << escapedPipes(request.label) << " | "
+         << ap::schemeName(p.scheme) << " | " << p.steps << " | "
+         << g(p.initial_velocity.norm(), "%.3g") << " / " << g(p.final_velocity.norm(), "%.3g")
+         << " | " << outcome << " | " << g(c.result.minimum_duration) << " | " << converged << " / "
+         << attempts << " | " << c.result.iterations << " | "
+         << (c.wrong.empty() ? "ok" : "**" + c.wrong + "**") << " | " << g(c.seconds, "%.3f")
+         << " |\n";
   }
 
   std::string render(const Options& o) const {
@@ -157,7 +158,7 @@ int main(int argc, char** argv) {
     std::cerr << index << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
               << " s\n";
     if (o.only >= 0) {
-      std::cerr << request->label << "\n" << c.result.message << "\n" << trailOf(c.result);
+      std::cerr << request->label << "\n" << c.result.message << "\n" << rb::attemptLines(c.result);
       break;
     }
     if (!o.out.empty()) std::ofstream(o.out) << tally.render(o);

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/errors.hpp"
@@ -148,6 +149,16 @@ VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& op
   check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   checkVerdict(request.problem, options, &check);
   return check;
+}
+
+std::string attemptLines(const PlanResult& result) {
+  std::ostringstream out;
+  for (const Attempt& a : result.attempts) {
+    out << "  " << attemptStageName(a.stage) << " " << attemptStartName(a.start) << " N=" << a.steps
+        << " " << terminationName(a.termination) << " it=" << a.iterations << " cost=" << a.cost
+        << (a.kept ? " kept" : "") << "\n";
+  }
+  return out.str();
 }
 
 std::string outcomeName(const VerdictCheck& check) {

@@ -55,6 +55,9 @@ struct VerdictCheck {
 /// Plans `request` (planManeuver with `options`) and checks its verdict as above.
 VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& options = {});
 
+/// The attempts of a plan, one line each (a study's --only output).
+std::string attemptLines(const PlanResult& result);
+
 /// "converged", "infeasible (proven)", "infeasible (local)", "input error", or the termination.
 std::string outcomeName(const VerdictCheck& check);
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "attitude_planner/planner.hpp"
+#include "planning/strategies/starts.hpp"
 #include "support/bounded_requests.hpp"
 #include "support/study_tools.hpp"
 
@@ -66,8 +67,7 @@ Options parse(int argc, char** argv) {
 }
 
 bool spinningMinimumTime(const ap::PlanningProblem& p) {
-  return p.objective == ap::Objective::MinimumTime &&
-         (p.initial_velocity.norm() > 0 || p.final_velocity.norm() > 0);
+  return p.objective == ap::Objective::MinimumTime && ap::hasSpinningEnds(p);
 }
 
 /// Request `index` of the bounded suite if it is a spinning minimum-time request, re-posed.

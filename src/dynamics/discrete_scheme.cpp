@@ -45,6 +45,10 @@ Matrix3 DiscreteScheme::momentumJacobianOfStep(const Matrix3& F, const Vector3& 
                                     : momentumJacobian<double>(F);
 }
 
+bool DiscreteScheme::onPrincipalBranch(const Vector3& omega) const {
+  return momentumJacobianOfStep(so3::exp(omega), omega).determinant() > 0.0;
+}
+
 Matrix3 DiscreteScheme::momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
                                                     const Vector3& tau) const {
   using so3::hat;

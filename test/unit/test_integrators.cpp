@@ -92,6 +92,32 @@ TEST(Integrators, MomentumJacobianMatchesFiniteDifferences) {
   }
 }
 
+TEST(Integrators, PrincipalBranchEndsAtTheFoldOfTheMomentum) {
+  // Isotropic J = jI, ω = θa: variational and second_order μ = (j/h) sin θ a, so the branch
+  // through the identity ends at θ = π/2 and the step π − φ aliases the step φ (the same μ);
+  // paper μ = (j/h) θ a, invertible for every θ < π.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Matrix3 J = 3.0 * Matrix3::Identity();
+  for (int trial = 0; trial < 20; ++trial) {
+    const Vector3 a = Vector3(n(rng), n(rng), n(rng)).normalized();
+    const double phi = 0.05 + 1.4 * std::abs(std::sin(n(rng)));  // in (0.05, 1.45)
+    for (SchemeKind kind : {SchemeKind::Variational, SchemeKind::SecondOrder}) {
+      const DiscreteScheme scheme(kind, J, 0.2);
+      EXPECT_TRUE(scheme.onPrincipalBranch(Vector3((M_PI / 2 - 1e-6) * a)));
+      EXPECT_FALSE(scheme.onPrincipalBranch(Vector3((M_PI / 2 + 1e-6) * a)));
+      EXPECT_TRUE(scheme.onPrincipalBranch(Vector3(phi * a)));
+      EXPECT_FALSE(scheme.onPrincipalBranch(Vector3((M_PI - phi) * a)));
+      const Vector3 slow = scheme.momentumOfStep(Vector3(phi * a));
+      const Vector3 aliased = scheme.momentumOfStep(Vector3((M_PI - phi) * a));
+      EXPECT_LE((slow - aliased).norm(), 1e-12 * slow.norm()) << schemeName(kind);
+    }
+    const DiscreteScheme paper(SchemeKind::Paper, J, 0.2);
+    EXPECT_TRUE(paper.onPrincipalBranch(Vector3((M_PI - 1e-3) * a)));
+    EXPECT_TRUE(paper.onPrincipalBranch(Vector3(phi * a)));
+  }
+}
+
 // The 1e6-step torque-free drift test lives in the hard-case catalog
 // (TorqueFreeMillionSteps in test/support/robustness_cases.cpp, asserted by test_hard_cases).
 
@@ -107,8 +133,8 @@ TEST(Integrators, VariationalEnergyDoesNotDriftOver2000Seconds) {
 }
 
 TEST(Integrators, PaperEnergyDecaysToMajorAxisSpin) {
-  // Finding (docs/results/integrators.md): the printed scheme conserves momentum but dissipates energy;
-  // the body ends in pure spin about the major axis, E = |π|²/(2 J_max).
+  // Finding (docs/results/integrators.md): the printed scheme conserves momentum but dissipates
+  // energy; the body ends in pure spin about the major axis, E = |π|²/(2 J_max).
   const Matrix3 J = Vector3(1, 2, 3).asDiagonal();
   const int N = 200000;
   const Maneuver m = run(SchemeKind::Paper, J, 0.01, Vector3(0.6, 0.5, 0.4),
@@ -148,7 +174,8 @@ TEST(Integrators, So2CheckErrorDecreasesAtObservedOrder) {
       theta_error.push_back(et);
       omega_error.push_back(ew);
     }
-    // Measured (docs/results/integrators.md): θ converges at order 2, ω at order 1 (left-point torque).
+    // Measured (docs/results/integrators.md): θ converges at order 2, ω at order 1 (left-point
+    // torque).
     EXPECT_NEAR(std::log2(theta_error[0] / theta_error[1]), 2.0, 0.1) << schemeName(kind);
     EXPECT_NEAR(std::log2(omega_error[0] / omega_error[1]), 1.0, 0.1) << schemeName(kind);
   }

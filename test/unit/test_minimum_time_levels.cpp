@@ -185,12 +185,13 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
 namespace {
 
 /// A spinning request under a torque-norm bound at 0.7x its unconstrained plan's peak (case 18 of
-/// the seeded random suite, seed 5006), paper at N = 128, where no structured free-time start
+/// the seeded random suite, seed 5031), paper at N = 128, where no structured free-time start
 /// converges (the four classes' unconstrained optima, the geodesic, the coasting start) and the
-/// search answers. Found by a scan of the suite: the structured starts answer most such requests
-/// (cases of earlier versions of this test moved to them, see the CHANGELOG).
+/// search answers. Found by a scan of the suite's seeds 5000-5039, the only such one: the
+/// structured starts answer the others (cases of earlier versions of this test moved to them,
+/// see the CHANGELOG).
 ap::PlanningProblem searchAnswersCase() {
-  ap::PlanningProblem p = ap::robustness::randomCase(5006, 18).problem;
+  ap::PlanningProblem p = ap::robustness::randomCase(5031, 18).problem;
   p.scheme = ap::SchemeKind::Paper;
   p.steps = 128;
   const ap::PlanResult unconstrained = ap::planManeuver(p);

@@ -141,6 +141,13 @@ class DiscreteScheme {
   /// momentumJacobian(F) of the step F = exp(ω^) given as both (no log map to recover ω).
   Matrix3 momentumJacobianOfStep(const Matrix3& F, const Vector3& omega) const;
 
+  /// Whether the step ω lies where μ is invertible on the branch through the identity:
+  /// det(∂μ/∂ε) > 0, the sign it has at ω = 0 (J/h). Past the fold μ aliases a slow motion
+  /// (variational and second_order: sin|ω| Ja + (1 − cos|ω|) a × Ja for ω = |ω| a, so an isotropic
+  /// body folds at |ω| = π/2 and a step turning by nearly π carries almost no momentum): a plan
+  /// with such a step is not reproduced from its own velocities and torques.
+  bool onPrincipalBranch(const Vector3& omega) const;
+
   /// The τ-weighted derivative of the momentum Jacobian of the step F = exp(ω^), in closed form:
   ///   C(m, e) = Σ_i τ_i ∂D(i, m)/∂ε_e,  D = momentumJacobian(F exp(ε^)) at ε = 0,
   /// i.e. the mixed second derivative ∂²/∂ε_e∂η_m of τᵀμ(F exp(ε^) exp(η^)). The Newton solver's

@@ -30,10 +30,13 @@
 // each of them falls with h). With spinning ends a raise at fixed attitudes makes an end torque
 // worse (it carries the boundary momentum, ∓2√w JΩ/h, which a slower interior no longer meets),
 // so past a raise of kLargestRaise the start stays at its own T and is made feasible by an
-// elastic phase (as IPOPT's restoration, in one problem): those constraints become c + θ ≥ 0,
-// θ ≥ 0 a second bordered unknown with the exact penalty ρθ in the objective (∂c/∂θ = 1: θ
-// enters the Hessian through the barrier terms only); the first iterate with every c > 0 drops
-// θ and the method continues as above from a strictly feasible plan.
+// elastic phase (as IPOPT's restoration, in one problem): each of those constraints becomes
+// c + v − s = 0 with its own s, v ≥ 0 and the exact ℓ1 penalty ρ Σ v in the objective, s and v
+// eliminated for c (the fixed-h solver's L1Elastic rows: prepareElasticRow, barrier_forms.hpp);
+// the first iterate with every c > 0 leaves the phase and the method continues as above from a
+// strictly feasible plan. One relaxation per row, not one shared by all: with a single shared
+// θ (c + θ ≥ 0) every active row's gradient carried the same θ column, the Newton systems were
+// degenerate, and spinning starts stayed elastic for 500 iterations.
 #include "planning/interior_point/free_time_solver.hpp"
 
 #include <algorithm>
@@ -76,8 +79,8 @@ constexpr double kFinalEffortFraction = 1e-8;
 /// far from T*, stopped at the iteration limit. Rest to rest every such constraint falls with h
 /// and a raise of a few percent suffices.
 constexpr double kLargestRaise = 2.0;
-/// ρ of the elastic start's penalty ρθ (objective T/T₀ = 1 at the start): above the sum of the
-/// multipliers the relaxed problem's minimum has θ = 0 (an exact penalty); raised ×10 whenever a
+/// ρ of the elastic start's penalty ρ Σ v (objective T/T₀ = 1 at the start): above every
+/// multiplier the relaxed problem's minimum has v = 0 (an exact penalty); raised ×10 whenever a
 /// barrier problem is solved with the iterate still outside.
 constexpr double kElasticPenalty = 100.0;
 constexpr double kElasticPenaltyGrowth = 10.0;
@@ -136,13 +139,12 @@ class FreeTimeSolver final : public PrimalDualProblem {
            " times the start's duration";
   }
 
-  /// The elastic start at the start's own T: c_i + θ ≥ 0 with θ holding the start margin.
+  /// The elastic start at the start's own T: every constraint that moves with h ℓ1-elastic.
   std::string startElastic(double h_start, const ReducedProblem::StepVectors& steps_start) {
     np_.setTimeStep(h_start);
     np_.setCurrent(steps_start);
     h0_ = h_start;
     elastic_ = started_elastic_ = true;
-    theta_ = parameters_.free_time_start_margin - smallestValue(np_.current(), true);
     rho_ = kElasticPenalty;
     return "";
   }
@@ -181,35 +183,46 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// Calls f(group, k, c) for every instance's value c at `steps` (the quantities' shared
   /// products, torques and attitudes, formed once).
   template <typename F>
-  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f, bool relaxed = true) const {
+  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f) const {
     const QuantityInputs at(np_, steps);
     for (const FreeTimeRows& g : groups_) {
-      const double relax = relaxed ? relaxation(g) : 0.0;
       for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-        f(g, k, g.constraint->value(g.quantity->value(at, k)) + relax);
+        f(g, k, g.constraint->value(g.quantity->value(at, k)));
       }
     }
   }
 
-  /// θ added to a constraint that moves with h while the start is elastic (else 0).
-  double relaxation(const FreeTimeRows& g) const {
-    return elastic_ && g.quantity->dependsOnTimeStep() ? theta_ : 0.0;
+  /// Whether the group's rows are ℓ1-elastic now: the constraints that move with h, while the
+  /// start is elastic (the others, the cones, hold strictly at every iterate).
+  bool elasticRows(const FreeTimeRows& g) const {
+    return elastic_ && g.quantity->dependsOnTimeStep();
   }
-  /// The global unknowns bordering the band: η, and θ while elastic.
-  int borderSize() const { return elastic_ ? 2 : 1; }
+  /// An elastic row prepared at its value in.c: z safeguarded (as the fixed-h slack forms do where
+  /// a row is prepared for an assembly), D and q (prepareElasticRow).
+  void prepareRow(const FreeTimeRows& g, FreeTimeRow& in, double mu) const {
+    if (elasticRows(g)) prepareElasticRow(in, mu, rho_, false, parameters_);
+  }
+  /// How a prepared row enters the condensed Newton system [W + Σ ω g gᵀ] dx = −∇f + Σ β g:
+  /// feasible ω = z/c, β = μ/c; elastic ω = 1/D, β = z + q/D.
+  struct RowTerms {
+    double weight, rhs;
+  };
+  RowTerms rowTerms(const FreeTimeRows& g, const FreeTimeRow& in, double mu) const {
+    if (!elasticRows(g)) return {in.z / in.c, mu / in.c};
+    return {1.0 / in.D, in.z + in.q / in.D};
+  }
+  /// The global unknown bordering the band: η.
+  static constexpr int borderSize() { return 1; }
 
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
     double smallest = std::numeric_limits<double>::infinity();
-    forEachValue(
-        steps,
-        [&](const FreeTimeRows& g, int, double c) {
-          if (g.quantity->dependsOnTimeStep() == time_dependent) {
-            smallest = std::min(smallest, c);
-          }
-        },
-        false);
+    forEachValue(steps, [&](const FreeTimeRows& g, int, double c) {
+      if (g.quantity->dependsOnTimeStep() == time_dependent) {
+        smallest = std::min(smallest, c);
+      }
+    });
     return smallest;
   }
 
@@ -218,12 +231,12 @@ class FreeTimeSolver final : public PrimalDualProblem {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
     bool inside = true;
-    if (elastic_) {
-      inside = theta_ > 0;
-      if (inside) phi += rho_ * theta_ - mu * std::log(theta_);
-    }
     forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
-      form_.addRowMerit(c, g.instance(k).c, mu, check_boundary, &inside, &phi);
+      if (elasticRows(g)) {
+        phi += elasticSlacks(c, mu, rho_).psi;
+      } else {
+        form_.addRowMerit(c, g.instance(k).c, mu, check_boundary, &inside, &phi);
+      }
     });
     return inside ? phi : std::numeric_limits<double>::infinity();
   }
@@ -231,15 +244,14 @@ class FreeTimeSolver final : public PrimalDualProblem {
   double T0() const { return N_ * h0_; }
   void assemble(double mu, double epsilon);
   void assembleQuantity(const std::vector<int>& block, double mu);
-  void assembleElastic(double mu);
   void leaveElasticIfInside();
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
   // BarrierProblem, from the point the line search started at (accepted_).
   double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
-  /// φ_μ at the iterate moved by α d (θ by its fraction to the boundary while elastic), +∞ where
-  /// h ≤ 0 or no boundary step exists there (`moved` false then: the iterate is not there).
+  /// φ_μ at the iterate moved by α d, +∞ where h ≤ 0 or no boundary step exists there (`moved`
+  /// false then: the iterate is not there) or a step has left the scheme's principal branch.
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override;
   void moveTo(const Eigen::VectorXd& d, double alpha) override;
   void restore() override;
@@ -259,6 +271,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
                   const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
+  double meritSlope(const Eigen::VectorXd& d) const;
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
   double dualityGap() const;
@@ -289,8 +302,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
   std::vector<std::vector<int>> quantity_blocks_;
-  /// The assembled system at the current iterate: the band, its border (η in column 0 and,
-  /// elastic, θ in column 1) and the (η, θ) corner.
+  /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
   PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
@@ -312,15 +324,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   FreeTimeOutcome out_;  ///< the outcome, once the solve has ended
   /// The accepted iterate a line search starts from, and its barrier problem.
   struct SearchStart {
-    double h = 0.0, theta = 0.0, mu = 0.0, epsilon = 0.0;
+    double h = 0.0, mu = 0.0, epsilon = 0.0;
     ReducedProblem::StepVectors steps;
   } accepted_;
-  // The elastic start (startInside): while the iterate is outside a constraint that moves with h,
-  // that constraint is c + θ ≥ 0, θ ≥ 0 one more unknown (index n_ + 1, multiplier z_θ) and the
-  // objective gains ρθ; the first iterate strictly inside every constraint drops θ.
+  // The elastic start (startInside): until the iterate is strictly inside every constraint that
+  // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
-  double theta_ = 0.0, z_theta_ = 0.0, rho_ = kElasticPenalty;
-  double theta_assembled_ = 0.0;  ///< θ where the system was assembled
+  double rho_ = kElasticPenalty;
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -366,12 +376,14 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
         for (FreeTimeRows* g : torque_groups) {
           FreeTimeRow& in = g->instance(st.k);
-          in.c = g->constraint->value(tau) + relaxation(*g);
+          in.c = g->constraint->value(tau);
+          prepareRow(*g, in, mu);
+          const RowTerms row = rowTerms(*g, in, mu);
           const Vector3 a = g->constraint->gradient(tau) / s;
           in.g = G.transpose() * a;
           W.diagonal().array() -= in.z * g->constraint->curvature() / (s * s);
-          W.noalias() += (in.z / in.c) * a * a.transpose();
-          rhs += (mu / in.c) * in.g;
+          W.noalias() += row.weight * a * a.transpose();
+          rhs += row.rhs * in.g;
           lagrangian -= in.z * in.g;
         }
         H.noalias() += G.transpose() * W * G;
@@ -386,8 +398,6 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
       }
     }
   }
-  assembleElastic(mu);
-  theta_assembled_ = theta_;
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
 }
@@ -401,7 +411,8 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
     Vector3 lambda = Vector3::Zero();
     for (const int i : block) {
       FreeTimeRow& in = groups_[i].instance(k);
-      in.c = groups_[i].constraint->value(q) + relaxation(groups_[i]);
+      in.c = groups_[i].constraint->value(q);
+      prepareRow(groups_[i], in, mu);
       lambda -= in.z * groups_[i].constraint->gradient(q);
     }
     return lambda;
@@ -414,52 +425,26 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
         for (const int i : block) {
           FreeTimeRow& in = groups_[i].instance(t.k);
           in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
-          // (z/c) g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-          const double w = in.z / in.c;
+          // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
+          const RowTerms row = rowTerms(groups_[i], in, mu);
+          const double w = row.weight;
           H.topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
           H.block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
           H.block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
           H(9, 9) += (w * in.g(9)) * in.g(9);
-          rhs += (mu / in.c) * in.g;
+          rhs += row.rhs * in.g;
           lagrangian -= in.z * in.g;
         }
         scatter(t.k + first.support.node_offset, first.support.width, H, rhs, lagrangian);
       });
 }
 
-/// The elastic start's θ: every constraint that moves with h is c + θ (∂/∂θ = 1, no curvature),
-/// so θ couples through the barrier terms (z/c) g gᵀ alone; plus ρθ and θ's own barrier −μ ln θ.
-void FreeTimeSolver::assembleElastic(double mu) {
-  if (!elastic_) return;
-  const int t = n_ + 1;
-  for (const FreeTimeRows& g : groups_) {
-    if (!g.quantity->dependsOnTimeStep()) continue;
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeRow& in = g.instance(k);
-      const double w = in.z / in.c;
-      for (int node = 0; node < g.support.width; ++node) {
-        const int v = np_.variableIndex(k + g.support.node_offset + node);
-        if (v >= 0) kkt_.border.col(1).segment<3>(v) += w * in.g.segment<3>(3 * node);
-      }
-      kkt_.corner(0, 1) += w * in.g(9);
-      kkt_.corner(1, 1) += w;
-      rhs_(t) += mu / in.c;
-      lagrangian_gradient_(t) -= in.z;
-    }
-  }
-  kkt_.corner(1, 0) = kkt_.corner(0, 1);
-  kkt_.corner(1, 1) += z_theta_ / theta_;
-  rhs_(t) += mu / theta_ - rho_;
-  lagrangian_gradient_(t) += rho_ - z_theta_;
-}
-
-/// Drops θ once every constraint holds strictly without it: from then on the iterate is a plan
-/// meeting its bounds, as a start raised inside would be.
+/// Leaves the elastic phase once every constraint holds strictly: from then on the iterate is a
+/// plan meeting its bounds, as a start raised inside would be (the rows' multipliers carry over,
+/// safeguarded for the feasible form).
 void FreeTimeSolver::leaveElasticIfInside() {
   if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
   elastic_ = false;
-  theta_ = 0.0;
-  z_theta_ = 0.0;
 }
 
 /// Adds one instance's Hessian block (local nodes and η), right-hand side and Lagrangian gradient
@@ -497,15 +482,10 @@ void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
 double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
   if (moved) *moved = false;
   if (accepted_.h + alpha * h0_ * d(n_) <= 0) return std::numeric_limits<double>::infinity();
-  if (elastic_) {  // θ by the fraction to the boundary
-    theta_ = accepted_.theta + alpha * d(n_ + 1);
-    if (theta_ < (1 - parameters_.fraction_to_boundary) * accepted_.theta) {
-      return std::numeric_limits<double>::infinity();
-    }
-  }
   try {
     moveTo(d, alpha);
     if (moved) *moved = true;
+    if (!np_.onPrincipalBranch(np_.current())) return std::numeric_limits<double>::infinity();
     return merit(accepted_.mu, accepted_.epsilon, true);
   } catch (const std::exception&) {  // no boundary step at that h (StepTooLarge)
     return std::numeric_limits<double>::infinity();
@@ -514,7 +494,6 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
 
 void FreeTimeSolver::restore() {
   np_.setTimeStep(accepted_.h);
-  theta_ = accepted_.theta;
   np_.setCurrent(accepted_.steps);
 }
 
@@ -533,7 +512,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
   forEachValue(np_.current(), [&](const FreeTimeRows& group, int k, double c_at_step) {
     FreeTimeRow& in = const_cast<FreeTimeRows&>(group).instance(k);
     in.r = c_at_step - in.c - localDot(group, k, in.g, d);
-    const double w = -(in.z / in.c) * in.r;
+    const double w = -rowTerms(group, in, 0.0).weight * in.r;
     if (w == 0.0) return;
     curved = true;
     v(n_) += w * in.g(9);
@@ -559,7 +538,6 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
-  if (elastic_ && g.quantity->dependsOnTimeStep()) sum += d(n_ + 1);  // ∂/∂θ
   for (int node = 0; node < g.support.width; ++node) {
     const int v = np_.variableIndex(k + g.support.node_offset + node);
     if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
@@ -568,49 +546,81 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
 }
 
 /// dz = μ/c − z − (z/c) (gᵀd + r) at the assembled point (r: the second-order correction's
-/// curvature term, 0 for an uncorrected step), and the largest dual step by the fraction to the
-/// boundary; applied to z.
+/// curvature term, 0 for an uncorrected step; an elastic row: dz = (q − gᵀd)/D), and the largest
+/// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   double alpha = 1.0;
   for (FreeTimeRows& g : groups_) {
+    const bool elastic = elasticRows(g);
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
       FreeTimeRow& in = g.instance(k);
-      in.dz = form_.dualDirection(in.z, in.c, mu, localDot(g, k, in.g, d) + in.r, &alpha);
+      const double slope = localDot(g, k, in.g, d) + in.r;
+      if (elastic) {
+        in.dz = (in.q - slope) / in.D;
+        alpha = elasticDualStepLimit(in.z, in.dz, rho_, alpha, parameters_);
+      } else {
+        in.dz = form_.dualDirection(in.z, in.c, mu, slope, &alpha);
+      }
     }
   }
-  double dz_theta = 0.0;
-  if (elastic_) {  // at the assembled θ (the line search has moved θ already)
-    dz_theta = form_.dualDirection(z_theta_, theta_assembled_, mu, d(n_ + 1), &alpha);
-  }
-  z_theta_ += alpha * dz_theta;
   for (FreeTimeRows& g : groups_) {
     for (FreeTimeRow& in : g.at) in.z += alpha * in.dz;
   }
 }
 
-/// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c.
+/// ∇φ_μ·d at the assembled point. The right-hand side is −∇φ_μ where every row's coefficient β
+/// is its barrier's −ψ'(c): so for a feasible row (μ/c); an elastic row's β = z + q/D equals
+/// ψ'(c) = −μ/s only at its primal multiplier, so the difference is taken out here.
+double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
+  double slope = -d.dot(rhs_);
+  if (!elastic_) return slope;
+  for (const FreeTimeRows& g : groups_) {
+    if (!elasticRows(g)) continue;
+    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+      const FreeTimeRow& in = g.instance(k);
+      slope += (rowTerms(g, in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
+    }
+  }
+  return slope;
+}
+
+/// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c (an elastic row's multiplier is
+/// safeguarded where it is prepared for the next assembly).
 void FreeTimeSolver::safeguardDuals(double mu) {
   forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
     FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = form_.safeguarded(in.z, c, mu);
+    if (!elasticRows(g)) in.z = form_.safeguarded(in.z, c, mu);
   });
-  if (elastic_) z_theta_ = form_.safeguarded(z_theta_, theta_, mu);
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
   forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
     FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
     in.c = c;
-    in.z = form_.initialMultiplier(c, mu);
+    if (elasticRows(g)) {
+      prepareElasticRow(in, mu, rho_, true, parameters_);
+    } else {
+      in.z = form_.initialMultiplier(c, mu);
+    }
   });
-  if (elastic_) z_theta_ = form_.initialMultiplier(theta_, mu);
 }
 
-/// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point.
+/// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point (an
+/// elastic row: |zs − μ| and |(ρ − z)v − μ|).
 double FreeTimeSolver::barrierResidual(double mu) const {
-  double worst = form_.residual(groups_, lagrangian_gradient_.lpNorm<Eigen::Infinity>(), mu);
-  if (elastic_) worst = std::max(worst, std::abs(z_theta_ * theta_ - mu));
+  const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
+  if (!elastic_) return form_.residual(groups_, stationarity, mu);
+  double worst = stationarity;
+  for (const FreeTimeRows& g : groups_) {
+    for (const FreeTimeRow& in : g.at) {
+      if (!elasticRows(g)) {
+        worst = std::max(worst, std::abs(in.z * in.c - mu));
+      } else {
+        worst = std::max({worst, std::abs(in.z * in.s - mu), std::abs((rho_ - in.z) * in.v - mu)});
+      }
+    }
+  }
   return worst;
 }
 
@@ -696,7 +706,7 @@ Pass FreeTimeSolver::beforeDirection() {
       out_.stopped_by_watch = true;
       return Pass::Stop;
     }
-    if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved with θ > 0: the penalty was too low
+    if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved still outside: the penalty was too low
     mu_ = barrier_.decreased(mu_, scales_);
     report(0.0, stationarity_);
     return Pass::Continue;  // the same iterate for the next barrier problem
@@ -709,9 +719,9 @@ Pass FreeTimeSolver::beforeDirection() {
 Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d) {
   late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
   if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return rejected({});
-  accepted_ = {np_.timeStep(), theta_, mu_, epsilon_, np_.current()};
+  accepted_ = {np_.timeStep(), mu_, epsilon_, np_.current()};
   clearCorrection();
-  *request = {-d_.dot(rhs_), 1.0, false, false, late_ && !elastic_};
+  *request = {meritSlope(d_), 1.0, false, false, late_ && !elastic_};
   *d = &d_;
   return Pass::Step;
 }

@@ -219,6 +219,8 @@ class GridSolve final : public PrimalDualProblem {
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
     trial_ = retracted(d, alpha);
     if (moved) *moved = true;
+    // The domain, as the barrier's c > 0: a step past the scheme's fold aliases a slow motion.
+    if (!np_.onPrincipalBranch(trial_)) return std::numeric_limits<double>::infinity();
     return system_.merit(trial_, mu_, penalty(), nullptr, alpha);
   }
   void moveTo(const Eigen::VectorXd& d, double alpha) override { trial_ = retracted(d, alpha); }

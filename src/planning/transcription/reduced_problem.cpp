@@ -1,5 +1,6 @@
 #include "planning/transcription/reduced_problem.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "attitude_planner/errors.hpp"
@@ -263,6 +264,11 @@ std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
     }
   }
   return tau;
+}
+
+bool ReducedProblem::onPrincipalBranch(const StepVectors& steps) const {
+  return std::all_of(steps.begin(), steps.end(),
+                     [&](const Vector3& omega) { return scheme_.onPrincipalBranch(omega); });
 }
 
 Maneuver ReducedProblem::maneuver(const StepVectors& steps) const {

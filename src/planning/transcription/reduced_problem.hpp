@@ -98,6 +98,9 @@ class ReducedProblem {
   Maneuver maneuver(const StepVectors& steps) const;
   /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
   double cost(const StepVectors& steps) const;
+  /// Whether every step lies on the scheme's principal branch (DiscreteScheme::onPrincipalBranch):
+  /// the interior points' domain, as h > 0 is (a trial iterate outside it has merit +∞).
+  bool onPrincipalBranch(const StepVectors& steps) const;
 
   /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
   /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).

@@ -98,6 +98,10 @@ class ReducedProblem {
   Maneuver maneuver(const StepVectors& steps) const;
   /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
   double cost(const StepVectors& steps) const;
+  /// The torques C sums: the body's τ_k (torques()), with reaction wheels too (their torques u_k
+  /// are functions of the body's motion, constrained, not summed: reaction_wheels.hpp). The one
+  /// statement of it; planManeuver reports it (PlanResult::minimized_effort).
+  static constexpr MinimizedEffort kMinimizedEffort = MinimizedEffort::BodyTorque;
 
   /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
   /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).

@@ -1,0 +1,104 @@
+// rostest (tracker_external_wheels.test): the tracker's external plant mode with reaction wheels.
+// The plan of test/ros/wheel_pyramid_spin.yaml flown by the tracking law through the wheels on
+// the tracker's own body (/internal_wheels) and on the measured state of attitude_plant_node over
+// ROS topics (/external_wheels: odometry and the wheels' spin rates in, wheel torques out): the
+// external loop lands within 2x the internal one's terminal attitude error, every command within
+// the wheels' torque limits, named wheel_1..4; without spin inertias (/nospin) the external mode
+// is refused by name.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <sensor_msgs/JointState.h>
+
+#include <algorithm>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "attitude_planner/ReplayResult.h"
+#include "ros_test_helpers.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+/// Counts the JointStates on `topic`: messages, the names seen, the largest |effort|, and
+/// whether every message carried one velocity per name.
+struct JointCounter {
+  JointCounter(ros::NodeHandle& nh, const std::string& topic)
+      : sub(nh.subscribe(topic, 1000, &JointCounter::onJoints, this)) {}
+  void onJoints(const sensor_msgs::JointState::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++count;
+    names.insert(m->name.begin(), m->name.end());
+    for (double e : m->effort) largest_effort = std::max(largest_effort, std::abs(e));
+    if (m->velocity.size() != m->name.size()) velocity_per_name = false;
+  }
+  std::mutex mutex;
+  int count = 0;
+  std::set<std::string> names;
+  double largest_effort = 0.0;
+  bool velocity_per_name = true;
+  ros::Subscriber sub;
+};
+
+}  // namespace
+
+TEST(TrackerExternalWheels, MeasuredWheelLoopLandsWithinTwiceTheInternalError) {
+  ros::NodeHandle internal_nh("internal_wheels"), external_nh("external_wheels");
+  JointCounter commands(external_nh, "wheel_command"), measured(external_nh, "wheel_measurement");
+  ros_testing::DoneListener internal_done(internal_nh), external_done(external_nh);
+  const ReplayResult::ConstPtr internal = internal_done.wait(120.0);
+  const ReplayResult::ConstPtr external = external_done.wait(30.0);
+  ASSERT_TRUE(internal && external) << "no done from both trackers";
+  ASSERT_TRUE(internal->success) << internal->message;
+  ASSERT_TRUE(external->success) << external->message;
+  EXPECT_EQ(external->mode, "feedback");
+  EXPECT_NE(external->message.find("through 4 reaction wheels on the measured state"),
+            std::string::npos)
+      << external->message;
+  std::printf(
+      "wheels, terminal attitude error: internal %.3g rad, external %.3g rad (ratio %.3g); rate "
+      "error: internal %.3g, external %.3g rad/s; effort: internal %.5g, external %.5g\n",
+      internal->terminal_attitude_error, external->terminal_attitude_error,
+      external->terminal_attitude_error / internal->terminal_attitude_error,
+      internal->terminal_velocity_error, external->terminal_velocity_error, internal->effort,
+      external->effort);
+  EXPECT_LE(external->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
+  EXPECT_LT(external->terminal_attitude_error, 1e-2);
+  ASSERT_EQ(external->reaction_wheels.wheels.size(), 4u);
+  for (const WheelPeak& w : external->reaction_wheels.wheels) {
+    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
+    EXPECT_GT(w.peak_momentum, 0.0) << w.name;
+  }
+  ASSERT_FALSE(external->constraint_names.empty());
+  EXPECT_EQ(external->constraint_names.back(), "reaction_wheels");
+  std::lock_guard<std::mutex> c(commands.mutex), m(measured.mutex);
+  const std::set<std::string> wheels{"wheel_1", "wheel_2", "wheel_3", "wheel_4"};
+  EXPECT_EQ(commands.names, wheels);
+  EXPECT_GT(commands.count, 200) << "one command per sample (20 s at 12.5 samples per s)";
+  EXPECT_LE(commands.largest_effort, ros_testing::kWheelTorqueLimit * (1 + 1e-12));
+  EXPECT_GT(commands.largest_effort, 0.0);
+  EXPECT_EQ(measured.names, wheels);
+  EXPECT_GT(measured.count, 200) << "the plant measures at its rate";
+  EXPECT_TRUE(measured.velocity_per_name) << "a spin rate per wheel";
+}
+
+TEST(TrackerExternalWheels, WithoutSpinInertiasTheExternalModeIsRefusedByName) {
+  ros::NodeHandle nh("nospin");
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(60.0);
+  ASSERT_TRUE(done) << "no done from /nospin";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("maneuver.reaction_wheels.spin_inertia"), std::string::npos)
+      << done->message;
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_external_wheels");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -4,7 +4,8 @@
 // ROS topics (/external_wheels: odometry and the wheels' spin rates in, wheel torques out): the
 // external loop lands within 2x the internal one's terminal attitude error, every command within
 // the wheels' torque limits, named wheel_1..4; without spin inertias (/nospin) the external mode
-// is refused by name.
+// is refused by name; without a plant (/unmeasured_wheels) every wheel command is zero and `done`
+// fails: nothing blocks.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -42,11 +43,21 @@ struct JointCounter {
   ros::Subscriber sub;
 };
 
+/// The topics every test reads, subscribed in main before any run starts (the runs go on while
+/// the tests before one wait).
+struct Counters {
+  ros::NodeHandle external{"external_wheels"}, unmeasured{"unmeasured_wheels"};
+  JointCounter commands{external, "wheel_command"}, measured{external, "wheel_measurement"};
+  JointCounter unmeasured_commands{unmeasured, "wheel_command"};
+};
+Counters* counters = nullptr;
+
 }  // namespace
 
 TEST(TrackerExternalWheels, MeasuredWheelLoopLandsWithinTwiceTheInternalError) {
   ros::NodeHandle internal_nh("internal_wheels"), external_nh("external_wheels");
-  JointCounter commands(external_nh, "wheel_command"), measured(external_nh, "wheel_measurement");
+  JointCounter& commands = counters->commands;
+  JointCounter& measured = counters->measured;
   ros_testing::DoneListener internal_done(internal_nh), external_done(external_nh);
   const ReplayResult::ConstPtr internal = internal_done.wait(120.0);
   const ReplayResult::ConstPtr external = external_done.wait(30.0);
@@ -94,11 +105,30 @@ TEST(TrackerExternalWheels, WithoutSpinInertiasTheExternalModeIsRefusedByName) {
       << done->message;
 }
 
+TEST(TrackerExternalWheels, WithoutMeasurementsEveryWheelCommandIsZeroAndDoneFails) {
+  ros::NodeHandle nh("unmeasured_wheels");
+  JointCounter& commands = counters->unmeasured_commands;
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(90.0);
+  ASSERT_TRUE(done) << "no done from /unmeasured_wheels";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("had no fresh measurement and got a zero command"),
+            std::string::npos)
+      << done->message;
+  EXPECT_NE(done->message.find("/unmeasured_wheels/odometry"), std::string::npos) << done->message;
+  std::lock_guard<std::mutex> lock(commands.mutex);
+  EXPECT_GT(commands.count, 200) << "the stream keeps its rate without measurements";
+  EXPECT_EQ(commands.largest_effort, 0.0);
+  EXPECT_EQ(commands.names, (std::set<std::string>{"wheel_1", "wheel_2", "wheel_3", "wheel_4"}));
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_tracker_external_wheels");
   ros::NodeHandle nh;
   ros::AsyncSpinner spinner(2);
   spinner.start();
+  Counters subscribed;
+  counters = &subscribed;
   return RUN_ALL_TESTS();
 }

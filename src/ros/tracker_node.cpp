@@ -1594,7 +1594,10 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
               ? wheelTorquesFor(pb->wheels, array,
                                 law.command(state.attitude, state.angular_velocity, t),
                                 state.angular_velocity, momentum, &cut)
-              : heldLinearly(pb->plan_wheel_torque, plan.time_step, t);  // replay: u(t)
+              // replay: the plan's u over the hold to the next sample, its mean (the midpoint
+              // of the linear hold): u(t) itself, held, would lag the plan by half a sample
+              : heldLinearly(pb->plan_wheel_torque, plan.time_step,
+                             0.5 * (t + pb->times[std::min(j + 1, pb->times.size() - 1)]));
       cut_samples += cut ? 1 : 0;
       peaks.observeMomentum(array.axes, momentum);
       peaks.observeTorque(u);

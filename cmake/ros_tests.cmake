@@ -123,3 +123,12 @@ add_rostest_gtest(test_tracker_wheels test/ros/tracker_wheels.test test/ros/test
 target_link_libraries(test_tracker_wheels ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
 add_dependencies(test_tracker_wheels attitude_planner_node attitude_tracker_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_wheels)
+
+# ~plant external with reaction wheels: the law through the wheels on attitude_plant_node's body +
+# wheels (odometry and wheel_measurement in, wheel_command out) lands as the internal loop does;
+# without spin inertias the mode is refused by name.
+add_rostest_gtest(test_tracker_external_wheels test/ros/tracker_external_wheels.test
+                  test/ros/test_tracker_external_wheels.cpp)
+target_link_libraries(test_tracker_external_wheels ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
+add_dependencies(test_tracker_external_wheels attitude_tracker_node attitude_plant_node)
+list(APPEND AP_EXPECTED_TESTS test_tracker_external_wheels)

@@ -8,10 +8,13 @@
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
 
-PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options) {
+namespace {
+
+PlanResult planRequest(const PlanningProblem& problem, const SolverOptions& options) {
   if (problem.accuracy.active() && problem.objective != Objective::MinimumTime) {
     validateProblem(problem);
     validateOptions(options);
@@ -25,6 +28,15 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
   // solvers reports there), not the drivers' sums, which dropped the solves a later phase
   // replaced (measured: minimum time 30 counted of 1,542 run). NLopt counts its own.
   if (options.solver == SolverKind::Structured) result.iterations = context.iterations();
+  return result;
+}
+
+}  // namespace
+
+PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& options) {
+  PlanResult result = planRequest(problem, options);
+  // What the transcription's cost sums (NLopt's dense transcription minimizes the same τ_k).
+  result.minimized_effort = ReducedProblem::kMinimizedEffort;
   return result;
 }
 

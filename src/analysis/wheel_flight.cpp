@@ -4,14 +4,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "attitude_planner/analysis/wheel_plant.hpp"
+#include "attitude_planner/dynamics/discrete_wheel_replay.hpp"
 #include "attitude_planner/dynamics/wheel_replay.hpp"
 
 namespace attitude_planner {
 
-namespace {
-
-/// Rows k and k + 1 and the fraction between them of time t on a grid of `rows` rows, step h.
-Eigen::VectorXd linearAt(const std::vector<Eigen::VectorXd>& rows, double time_step, double t) {
+Eigen::VectorXd heldLinearly(const std::vector<Eigen::VectorXd>& rows, double time_step, double t) {
   const int N = static_cast<int>(rows.size()) - 1;
   const double s = std::clamp(t / time_step, 0.0, static_cast<double>(N));
   const int k = std::min(static_cast<int>(std::floor(s)), N - 1);
@@ -19,68 +18,87 @@ Eigen::VectorXd linearAt(const std::vector<Eigen::VectorXd>& rows, double time_s
   return (1.0 - f) * rows[k] + f * rows[k + 1];
 }
 
-}  // namespace
-
 Eigen::VectorXd WheelFlight::torqueAt(double t) const {
-  return linearAt(torque, body.time_step, t);
+  return heldLinearly(torque, body.time_step, t);
 }
 
 Eigen::VectorXd WheelFlight::momentumAt(double t) const {
-  return linearAt(momentum, body.time_step, t);
-}
-
-WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const ReactionWheels& wheels,
-                          const Maneuver& plan, std::vector<Eigen::VectorXd> wheel_torque,
-                          const RigidBodyState& start) {
-  const WheelArray array = wheelArray(wheels);
-  const int N = plan.steps();
-  if (wheel_torque.empty()) wheel_torque = wheelStates(scheme, inertia, wheels, plan).torque;
-  Eigen::VectorXd initial(wheels.count());
-  for (int i = 0; i < wheels.count(); ++i) initial(i) = wheels.initialMomentum(i);
-  // No world disturbance: the tracker refuses effects during a flight with wheels.
-  const WheelReplay replay =
-      replayWithWheels(inertia, array.axes, start.attitude, start.angular_velocity, initial,
-                       plan.time_step, wheel_torque, Vector3::Zero(), kWheelFlightSubsteps);
-  WheelFlight out;
-  out.torque = std::move(wheel_torque);
-  out.momentum = replay.momentum;
-  out.body.time_step = plan.time_step;
-  out.peaks = WheelPeaks(wheels.count());
-  out.peaks.peak_momentum = replay.peak_momentum;
-  for (int k = 0; k <= N; ++k) {
-    const Vector3 array_momentum = array.axes * replay.momentum[k];
-    out.body.time.push_back(k * plan.time_step);
-    out.body.attitude.push_back(replay.attitude[k]);
-    out.body.angular_velocity.push_back(replay.angular_velocity[k]);
-    out.body.torque.push_back(-array.axes * out.torque[k] -
-                              replay.angular_velocity[k].cross(array_momentum));
-    out.peaks.observeMomentum(array.axes, replay.momentum[k]);
-    out.peaks.observeTorque(out.torque[k]);  // every node's u is flown (held linearly)
-  }
-  return out;
+  return heldLinearly(momentum, body.time_step, t);
 }
 
 namespace {
 
-/// The wheel torques that make the body torque `body_torque` (minimum norm), cut to the array's
-/// limits at wheel momenta `momentum`; `cut` is set when a wheel's command was changed.
-Eigen::VectorXd wheelCommand(const ReactionWheels& wheels, const WheelArray& array,
-                             const Vector3& body_torque, const Vector3& rate,
-                             const Eigen::VectorXd& momentum, bool* cut) {
-  // τ = −A u − Ω × A h_w  ⇒  A u = −(τ + Ω × A h_w); u = A⁺(A u) carries no null-space part.
-  const Vector3 array_torque = -(body_torque + rate.cross(array.axes * momentum));
-  Eigen::VectorXd u = array.pseudo_inverse * array_torque;
-  for (int i = 0; i < wheels.count(); ++i) {
-    const double limit = wheels.torqueLimit(i), H = wheels.momentumLimit(i);
-    double wanted = std::clamp(u(i), -limit, limit);
-    if ((momentum(i) >= H && wanted > 0.0) || (momentum(i) <= -H && wanted < 0.0)) wanted = 0.0;
-    if (wanted != u(i)) *cut = true;
-    u(i) = wanted;
+/// The flight's body at node k from its state and the array's reaction on it.
+void appendNode(const WheelArray& array, const Matrix3& attitude, const Vector3& rate,
+                const Vector3& body_torque, const Eigen::VectorXd& momentum, WheelFlight* out) {
+  const int k = static_cast<int>(out->body.attitude.size());
+  out->body.time.push_back(k * out->body.time_step);
+  out->body.attitude.push_back(attitude);
+  out->body.angular_velocity.push_back(rate);
+  out->body.torque.push_back(body_torque);
+  out->momentum.push_back(momentum);
+  out->peaks.observeMomentum(array.axes, momentum);
+  out->peaks.observeTorque(out->torque[k]);  // every node's u is flown (held linearly)
+}
+
+/// The continuous body + wheels (RK4) from the wheel torques already in `out`.
+void flyContinuously(const Matrix3& inertia, const WheelArray& array,
+                     const Eigen::VectorXd& initial, double time_step, const RigidBodyState& start,
+                     WheelFlight* out) {
+  // No world disturbance: the tracker refuses effects during a flight with wheels.
+  const WheelReplay replay =
+      replayWithWheels(inertia, array.axes, start.attitude, start.angular_velocity, initial,
+                       time_step, out->torque, Vector3::Zero(), kWheelFlightSubsteps);
+  out->peaks.peak_momentum = replay.peak_momentum;
+  for (std::size_t k = 0; k < replay.attitude.size(); ++k) {
+    const Vector3& rate = replay.angular_velocity[k];
+    appendNode(array, replay.attitude[k], rate,
+               arrayReaction(array, out->torque[k], rate, replay.momentum[k]), replay.momentum[k],
+               out);
   }
-  return u;
+}
+
+/// Body + wheels on the plan's discrete scheme from the wheel torques already in `out`; the
+/// body's velocities reported as the scheme reports a plan's.
+void flyOnTheScheme(SchemeKind scheme, const Matrix3& inertia, const WheelArray& array,
+                    const Eigen::VectorXd& initial, double time_step, const RigidBodyState& start,
+                    WheelFlight* out) {
+  const DiscreteWheelReplay replay =
+      replayWithWheelsOnTheScheme(scheme, inertia, array.axes, start.attitude,
+                                  start.angular_velocity, initial, time_step, out->torque);
+  const DiscreteScheme discrete(scheme, inertia, time_step);
+  const int N = static_cast<int>(replay.attitude.size()) - 1;
+  for (int k = 0; k <= N; ++k) {
+    Vector3 rate = replay.node_velocity[k];
+    if (!discrete.hasEndTorques()) {  // each step's reported velocity, row N repeating N − 1
+      const int step = std::min(k, N - 1);
+      rate =
+          discrete.velocity(Matrix3(replay.attitude[step].transpose() * replay.attitude[step + 1]));
+    }
+    appendNode(array, replay.attitude[k], rate, replay.body_torque[k], replay.momentum[k], out);
+  }
 }
 
 }  // namespace
+
+WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const ReactionWheels& wheels,
+                          const Maneuver& plan, std::vector<Eigen::VectorXd> wheel_torque,
+                          const RigidBodyState& start, WheelFlightModel model) {
+  const WheelArray array = wheelArray(wheels);
+  if (wheel_torque.empty()) wheel_torque = wheelStates(scheme, inertia, wheels, plan).torque;
+  Eigen::VectorXd initial(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) initial(i) = wheels.initialMomentum(i);
+  WheelFlight out;
+  out.torque = std::move(wheel_torque);
+  out.body.time_step = plan.time_step;
+  out.peaks = WheelPeaks(wheels.count());
+  if (model == WheelFlightModel::PlanScheme && schemeIsDiscretization(scheme)) {
+    flyOnTheScheme(scheme, inertia, array, initial, plan.time_step, start, &out);
+  } else {
+    flyContinuously(inertia, array, initial, plan.time_step, start, &out);
+  }
+  return out;
+}
 
 WheelTracking trackWithWheels(const ManeuverInterpolation& reference, const Matrix3& inertia,
                               const ReactionWheels& wheels, const RigidBodyState& start,
@@ -103,8 +121,9 @@ WheelTracking trackWithWheels(const ManeuverInterpolation& reference, const Matr
   for (int j = 0; j <= out.samples; ++j) {
     const double t = j * dt;
     bool cut = false;
-    const Eigen::VectorXd u = wheelCommand(wheels, array, law.command(R, rate, t), rate, h, &cut);
-    const Vector3 delivered = -array.axes * u - rate.cross(array.axes * h);
+    const Eigen::VectorXd u =
+        wheelTorquesFor(wheels, array, law.command(R, rate, t), rate, h, &cut);
+    const Vector3 delivered = arrayReaction(array, u, rate, h);
     flight.body.time.push_back(t);
     flight.body.attitude.push_back(R);
     flight.body.angular_velocity.push_back(rate);

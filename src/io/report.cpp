@@ -148,7 +148,8 @@ std::string attemptJson(const Attempt& a) {
 }
 
 /// Per wheel: the plan's peak |h_w,i| and |u_i|, their limits and margins (limit − peak, < 0 where
-/// the plan exceeds it), and the array's peak |A h_w| with the envelope's margin (null: none).
+/// the plan exceeds it), the array's peak |A h_w| with the envelope's margin (null: none), and
+/// which torques the plan's effort sums (PlanResult::minimized_effort).
 /// Torque peaks over the nodes the plan carries torques at (1..N−1; 0..N with end torques).
 std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
   const ReactionWheels& wheels = problem.reaction_wheels;
@@ -173,7 +174,8 @@ std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
   out << "], \"peak_momentum_norm\": " << jsonNumber(peak_norm)
       << ", \"max_momentum_norm\": " << (std::isfinite(envelope) ? jsonNumber(envelope) : "null")
       << ", \"momentum_norm_margin\": "
-      << (std::isfinite(envelope) ? jsonNumber(envelope - peak_norm) : "null") << "}";
+      << (std::isfinite(envelope) ? jsonNumber(envelope - peak_norm) : "null")
+      << ", \"effort_minimized\": " << jsonString(minimizedEffortName(r.minimized_effort)) << "}";
   return out.str();
 }
 

@@ -308,8 +308,10 @@ ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels) {
   return m;
 }
 
-ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const WheelPeaks& peaks) {
+ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const WheelPeaks& peaks,
+                                        std::optional<MinimizedEffort> effort_minimized) {
   ReactionWheelsSummary m;
+  if (effort_minimized) m.effort_minimized = minimizedEffortName(*effort_minimized);
   for (int i = 0; i < wheels.count(); ++i) {
     WheelPeak w;
     w.name = wheelName(i);
@@ -328,6 +330,42 @@ ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const Whee
     m.momentum_norm_margin = wheels.max_momentum_norm - peaks.peak_momentum_norm;
   }
   return m;
+}
+
+Eigen::VectorXd wheelJointValues(const std::vector<std::string>& names,
+                                 const std::vector<double>& values, int wheels,
+                                 const std::string& field) {
+  Eigen::VectorXd out(wheels);
+  for (int i = 0; i < wheels; ++i) {
+    const std::string wheel = wheelName(i);
+    const auto at = std::find(names.begin(), names.end(), wheel);
+    if (at == names.end()) throw InvalidInput(field + ": no joint named " + wheel);
+    const std::size_t j = static_cast<std::size_t>(at - names.begin());
+    if (j >= values.size()) {
+      throw InvalidInput(field + ": " + std::to_string(values.size()) + " values for " +
+                         std::to_string(names.size()) + " names (" + wheel + " has none)");
+    }
+    if (!std::isfinite(values[j])) {
+      throw InvalidInput(field + "[" + std::to_string(j) + "] (" + wheel +
+                         "): must be finite, got " + exactNumber(values[j]));
+    }
+    out(i) = values[j];
+  }
+  return out;
+}
+
+sensor_msgs::JointState wheelJointState(const Eigen::VectorXd& effort,
+                                        const Eigen::VectorXd& velocity, const std::string& frame,
+                                        const ros::Time& stamp) {
+  sensor_msgs::JointState joints;
+  joints.header.stamp = stamp;
+  joints.header.frame_id = frame;
+  for (int i = 0; i < effort.size(); ++i) {
+    joints.name.push_back(wheelName(i));
+    joints.effort.push_back(effort(i));
+    if (velocity.size() > 0) joints.velocity.push_back(velocity(i));
+  }
+  return joints;
 }
 
 std::vector<Eigen::VectorXd> wheelRowsFromMsg(const std::vector<double>& values, int rows,

@@ -38,12 +38,30 @@ PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   const PlanningProblem& p = scene.problem;
   if (max_step == 0.0) max_step = 0.25 * p.duration / p.steps;
-  plant_ = std::make_unique<RigidBodyPlant>(p.inertia, p.initial_attitude, p.initial_velocity,
-                                            plannableEffects(scene.effects, p.inertia),
-                                            actuationOf(scene.effects), max_step);
   odometry_pub_ = nh.advertise<nav_msgs::Odometry>("odometry", 10);
-  command_sub_ = nh.subscribe("torque_command", 10, &PlantNode::onCommand, this,
-                              ros::TransportHints().tcpNoDelay());
+  if (p.reaction_wheels.present()) {
+    const std::string field = "parameter " + pnh.resolveName("scene") + " = " + scene_path +
+                              ": actuators.reaction_wheels";
+    if (!scene.effects.empty()) {
+      throw InvalidParameter(field + ": effects on a body with wheels are not modelled, got " +
+                             effectName(scene.effects.front()));
+    }
+    if (!p.reaction_wheels.hasSpinInertia()) {
+      throw InvalidParameter(field + ".spin_inertia: needed to measure the wheels' spin rates");
+    }
+    wheel_plant_ = std::make_unique<WheelPlant>(
+        p.inertia, p.reaction_wheels, RigidBodyState{p.initial_attitude, p.initial_velocity},
+        max_step);
+    wheel_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_measurement", 10);
+    command_sub_ = nh.subscribe("wheel_command", 10, &PlantNode::onWheelCommand, this,
+                                ros::TransportHints().tcpNoDelay());
+  } else {
+    plant_ = std::make_unique<RigidBodyPlant>(p.inertia, p.initial_attitude, p.initial_velocity,
+                                              plannableEffects(scene.effects, p.inertia),
+                                              actuationOf(scene.effects), max_step);
+    command_sub_ = nh.subscribe("torque_command", 10, &PlantNode::onCommand, this,
+                                ros::TransportHints().tcpNoDelay());
+  }
   timer_ = nh.createTimer(ros::Duration(1.0 / rate), &PlantNode::onTimer, this);
   ROS_INFO(
       "attitude_plant_node: %s, %zu effects, odometry at %g Hz (rate factor %g), waiting for "
@@ -71,22 +89,61 @@ void PlantNode::onCommand(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "torque_command refused: %s", e.what());
     return;
   }
-  const ros::Time now = ros::Time::now();
-  const ros::Time stamp = msg->header.stamp.isZero() ? now : std::min(msg->header.stamp, now);
-  if (!released_) {
-    released_ = stamp;  // t = 0: the body is released by its first command
-    ROS_INFO("attitude_plant_node: released at %.3f s", stamp.toSec());
-  }
   // The held command acts up to this one's time; a late one acts from the plant's time.
-  plant_->advanceTo(maneuverTime(stamp));
+  plant_->advanceTo(maneuverTime(commandTime(msg->header.stamp)));
   plant_->command(torque);
+}
+
+void PlantNode::onWheelCommand(const sensor_msgs::JointState::ConstPtr& msg) {
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != body_frame_) {
+    ROS_WARN_THROTTLE(1.0, "wheel_command refused: header.frame_id '%s' is not the body frame '%s'",
+                      msg->header.frame_id.c_str(), body_frame_.c_str());
+    return;
+  }
+  Eigen::VectorXd torque;
+  try {
+    torque = rc::wheelJointValues(msg->name, msg->effort, wheel_plant_->wheels().count(),
+                                  "wheel_command.effort");
+  } catch (const std::exception& e) {
+    ROS_WARN_THROTTLE(1.0, "wheel_command refused: %s", e.what());
+    return;
+  }
+  wheel_plant_->advanceTo(maneuverTime(commandTime(msg->header.stamp)));
+  wheel_plant_->command(torque);
+}
+
+ros::Time PlantNode::commandTime(const ros::Time& stamp) {
+  const ros::Time now = ros::Time::now();
+  const ros::Time at = stamp.isZero() ? now : std::min(stamp, now);
+  if (!released_) {
+    released_ = at;  // t = 0: the body is released by its first command
+    ROS_INFO("attitude_plant_node: released at %.3f s", at.toSec());
+  }
+  return at;
+}
+
+void PlantNode::advanceTo(double t) {
+  if (wheel_plant_) {
+    wheel_plant_->advanceTo(t);
+  } else {
+    plant_->advanceTo(t);
+  }
 }
 
 void PlantNode::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
-  plant_->advanceTo(maneuverTime(now));
-  odometry_pub_.publish(rc::odometryToMsg(plant_->attitude(), plant_->angularVelocity(), now,
-                                          world_frame_, body_frame_));
+  advanceTo(maneuverTime(now));
+  if (!wheel_plant_) {
+    odometry_pub_.publish(rc::odometryToMsg(plant_->attitude(), plant_->angularVelocity(), now,
+                                            world_frame_, body_frame_));
+    return;
+  }
+  const WheelPlant& w = *wheel_plant_;
+  odometry_pub_.publish(
+      rc::odometryToMsg(w.attitude(), w.angularVelocity(), now, world_frame_, body_frame_));
+  wheel_pub_.publish(rc::wheelJointState(
+      w.deliveredTorque(), wheelSpinRates(w.wheels(), w.momentum(), w.angularVelocity()),
+      body_frame_, now));
 }
 
 }  // namespace attitude_planner

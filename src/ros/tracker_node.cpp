@@ -24,6 +24,7 @@
 #include "attitude_planner/PlanAttitudeManeuver.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/PlanErrorCode.h"
+#include "attitude_planner/analysis/wheel_plant.hpp"
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -52,6 +53,16 @@ std::future<std::invoke_result_t<Work>> startDetached(Work work) {
     }
   }).detach();
   return future;
+}
+
+/// The plan's wheel torques u_k: the message's wheel_torque rows (named in errors), or the
+/// plan's own (wheelStates) when it carries none.
+std::vector<Eigen::VectorXd> wheelTorqueRows(const AttitudeManeuver& msg, const Maneuver& plan,
+                                             const Matrix3& inertia, SchemeKind scheme,
+                                             const ReactionWheels& wheels) {
+  if (msg.wheel_torque.empty()) return wheelStates(scheme, inertia, wheels, plan).torque;
+  return rc::wheelRowsFromMsg(msg.wheel_torque, plan.steps() + 1, wheels.count(),
+                              "maneuver.wheel_torque");
 }
 
 }  // namespace
@@ -474,6 +485,10 @@ void TrackerNode::advertiseTopics() {
     // Only the newest state matters: a queue of one never feeds the law an old measurement.
     odometry_sub_ = nh_.subscribe("odometry", 1, &TrackerNode::onOdometry, this,
                                   ros::TransportHints().tcpNoDelay());
+    // A maneuver with reaction wheels commands the wheels and measures their speeds.
+    wheel_command_pub_ = nh_.advertise<sensor_msgs::JointState>("wheel_command", 10);
+    wheel_measurement_sub_ = nh_.subscribe("wheel_measurement", 1, &TrackerNode::onWheelMeasurement,
+                                           this, ros::TransportHints().tcpNoDelay());
   }
 }
 
@@ -826,6 +841,10 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
       std::make_unique<ManeuverInterpolation>(plan, problem.scheme, inertia, pb.effects.get());
   if (plant_ == PlantKind::Internal) {
     runBody(replay, plan, inertia, problem.scheme, &pb);
+  } else if (pb.wheels.present()) {
+    // External with wheels: the plan's wheel torques (replay's command) and the measured peaks.
+    pb.plan_wheel_torque = wheelTorqueRows(msg, plan, inertia, problem.scheme, pb.wheels);
+    pb.measured_wheel_peaks = WheelPeaks(pb.wheels.count());
   } else if (mode_ == TrackingMode::Replan) {
     // External: the plans in force and their laws; its own simulated body is not flown.
     pb.replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
@@ -905,10 +924,11 @@ void TrackerNode::requireWheelFlight(const ReactionWheels& wheels,
                        "only (a re-plan's answer is not yet flown by the wheels), got ~mode " +
                        trackingModeName(mode_));
   }
-  if (plant_ != PlantKind::Internal) {
-    throw InvalidInput(field +
-                       ": a maneuver with reaction wheels is flown with ~plant internal "
-                       "only (no wheel command or measured wheel state yet), got ~plant external");
+  if (plant_ == PlantKind::External && !wheels.hasSpinInertia()) {
+    throw InvalidInput(field + ".spin_inertia",
+                       "~plant external measures the wheels' spin rates (wheel_measurement "
+                       "velocity) and needs each wheel's spin inertia to turn them into momenta, "
+                       "got none");
   }
   if (!effects.empty()) {
     throw InvalidInput(field + ": effects during the run (" + effectName(effects.front()) +
@@ -920,13 +940,9 @@ void TrackerNode::flyWheels(const AttitudeManeuver& msg, const Maneuver& plan,
                             const Matrix3& inertia, SchemeKind scheme, const RigidBodyState& start,
                             Playback* pb) const {
   const int N = plan.steps();
-  std::vector<Eigen::VectorXd> wheel_torque;
-  if (!msg.wheel_torque.empty()) {
-    wheel_torque =
-        rc::wheelRowsFromMsg(msg.wheel_torque, N + 1, pb->wheels.count(), "maneuver.wheel_torque");
-  }
   auto flight = std::make_shared<WheelFlight>(
-      flyWithWheels(inertia, scheme, pb->wheels, plan, std::move(wheel_torque), start));
+      flyWithWheels(inertia, scheme, pb->wheels, plan,
+                    wheelTorqueRows(msg, plan, inertia, scheme, pb->wheels), start));
   ReplayResult& result = pb->result;
   result.cost = schemeCost(scheme, flight->body.torque);
   result.effort = openLoopEffort(scheme, flight->body);
@@ -937,7 +953,10 @@ void TrackerNode::flyWheels(const AttitudeManeuver& msg, const Maneuver& plan,
   }
   result.message = "flew " + std::to_string(N) + " steps with " +
                    std::to_string(pb->wheels.count()) +
-                   " reaction wheels (body + wheels from the wheel torques)";
+                   " reaction wheels (body + wheels from the wheel torques, " +
+                   (schemeIsDiscretization(scheme) ? "on the plan's scheme " + schemeName(scheme)
+                                                   : std::string("continuous, RK4")) +
+                   ")";
   reportWheelPeaks(*flight, pb);
   pb->actual = std::make_unique<ManeuverInterpolation>(flight->body, scheme, inertia, nullptr);
   pb->wheel_flight = std::move(flight);
@@ -979,28 +998,26 @@ void TrackerNode::reportWheelPeaks(const WheelFlight& flight, Playback* pb) cons
 
 void TrackerNode::publishWheels(const Playback& pb, double t, const Vector3& body_rate,
                                 const ros::Time& stamp) {
-  const Eigen::VectorXd torque = pb.wheel_flight->torqueAt(t);
-  const Eigen::VectorXd momentum = pb.wheel_flight->momentumAt(t);
+  publishWheelValues(pb, pb.wheel_flight->torqueAt(t), pb.wheel_flight->momentumAt(t), body_rate,
+                     stamp);
+}
+
+void TrackerNode::publishWheelValues(const Playback& pb, const Eigen::VectorXd& torque,
+                                     const Eigen::VectorXd& momentum, const Vector3& body_rate,
+                                     const ros::Time& stamp) {
   // Spin rates relative to the body need the wheels' spin inertia; without it velocity stays
   // empty (a JointState field may be empty).
   const Eigen::VectorXd spin = pb.wheels.hasSpinInertia()
                                    ? wheelSpinRates(pb.wheels, momentum, body_rate)
                                    : Eigen::VectorXd();
-  sensor_msgs::JointState joints;
-  joints.header.stamp = stamp;
-  joints.header.frame_id = pb.body_frame;
   std_msgs::Float64MultiArray momenta;
   momenta.layout.dim.resize(1);
   momenta.layout.dim[0].label = "wheel";
   momenta.layout.dim[0].size = pb.wheels.count();
   momenta.layout.dim[0].stride = pb.wheels.count();
-  for (int i = 0; i < pb.wheels.count(); ++i) {
-    joints.name.push_back(wheelName(i));
-    joints.effort.push_back(torque(i));                       // u_i [N m]
-    if (spin.size() > 0) joints.velocity.push_back(spin(i));  // w_i [rad/s] relative to the body
-    momenta.data.push_back(momentum(i));
-  }
-  wheel_state_pub_.publish(joints);
+  for (int i = 0; i < pb.wheels.count(); ++i) momenta.data.push_back(momentum(i));
+  // effort u_i [N m]; velocity w_i [rad/s] relative to the body
+  wheel_state_pub_.publish(rc::wheelJointState(torque, spin, pb.body_frame, stamp));
   wheel_momentum_pub_.publish(momenta);
   wheel_marker_pub_.publish(
       wheelMomentumMarkers(pb.wheels, momentum, path_radius_, pb.world_frame, stamp));
@@ -1143,10 +1160,12 @@ void TrackerNode::runReplay(Replay replay) {
   }
   ReplayResult result = pb.result;
   reportConstraintHealth(*pb.health, &result);
-  if (pb.wheel_flight) {  // the wheels' limits as one more constraint of the flown path
+  const WheelPeaks* wheel_peaks = pb.wheel_flight           ? &pb.wheel_flight->peaks
+                                  : pb.measured_wheel_peaks ? &*pb.measured_wheel_peaks
+                                                            : nullptr;
+  if (wheel_peaks) {  // the wheels' limits as one more constraint of the flown path
     result.constraint_names.push_back("reaction_wheels");
-    result.constraint_violations.push_back(
-        std::max(0.0, pb.wheel_flight->peaks.worstExcess(pb.wheels)));
+    result.constraint_violations.push_back(std::max(0.0, wheel_peaks->worstExcess(pb.wheels)));
   }
   if (pb.pointing) {
     result.pointing_error =
@@ -1352,9 +1371,15 @@ void TrackerNode::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   odometry_received_ = ros::Time::now();
 }
 
+void TrackerNode::onWheelMeasurement(const sensor_msgs::JointState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(odometry_mutex_);
+  wheel_measurement_ = msg;
+  wheel_received_ = ros::Time::now();
+}
+
 MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Time& start,
-                                               const ros::Time& stamp,
-                                               const Vector3& held_command) {
+                                               const ros::Time& stamp, const Vector3& held_command,
+                                               bool predict) {
   nav_msgs::Odometry::ConstPtr msg;
   ros::Time received;
   {
@@ -1398,15 +1423,18 @@ MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Ti
   }
   // To the sample's time under the command held meanwhile and the known effects: the age is
   // transport and sampling lag (left in, the rate's lag biases the law's damping term).
-  const double t_measured = (measured_at - start).toSec() * rate_factor_;
-  m.state = predictState(pb.reference->inertia(), pb.effects.get(), m.state, held_command,
-                         t_measured, age * rate_factor_);
+  m.time = (measured_at - start).toSec() * rate_factor_;
+  m.age = age * rate_factor_;
   m.fresh = true;
+  if (!predict) return m;
+  m.state =
+      predictState(pb.reference->inertia(), pb.effects.get(), m.state, held_command, m.time, m.age);
   last_measured_ = m.state;
   return m;
 }
 
 bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState* replans) {
+  if (pb->wheels.present()) return runExternalWheels(start, pb);
   const Maneuver& plan = pb->reference->nodes();
   const int N = plan.steps();
   const TrackingLaw law(*pb->reference, pb->effects.get(), tracking_);
@@ -1488,6 +1516,142 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
         ": " + std::to_string(stale) + " of " + std::to_string(pb->times.size()) +
         " samples had no fresh measurement and got a zero command (first: " + first_problem + ")";
   }
+  return true;
+}
+
+MeasurementAtSample TrackerNode::wheelMeasurementAt(const Playback& pb, const ros::Time& start,
+                                                    const ros::Time& stamp,
+                                                    const Eigen::VectorXd& held,
+                                                    Eigen::VectorXd* momentum) {
+  const RigidBodyState last = last_measured_;
+  MeasurementAtSample m = measurementAt(pb, start, stamp, Vector3::Zero(), false);
+  if (!m.fresh) return m;
+  sensor_msgs::JointState::ConstPtr wheels;
+  ros::Time received;
+  {
+    std::lock_guard<std::mutex> lock(odometry_mutex_);
+    wheels = wheel_measurement_;
+    received = wheel_received_;
+  }
+  const auto unusable = [&](const std::string& why) {
+    m.fresh = false;
+    m.problem = why;
+    m.state = last;
+    last_measured_ = last;
+    return m;
+  };
+  if (!wheels) return unusable("no measurement on " + wheel_measurement_sub_.getTopic() + " yet");
+  const ros::Time taken = wheels->header.stamp.isZero() ? received : wheels->header.stamp;
+  const double age = (stamp - taken).toSec();
+  if (age > measurement_timeout_) {
+    return unusable("newest wheel_measurement is " + exactNumber(age) +
+                    " s old (~measurement_timeout " + exactNumber(measurement_timeout_) + " s)");
+  }
+  try {
+    // The tachometers read spin rates relative to the body: momenta with the measured body rate
+    // (the plant stamps both alike, so they are taken as one instant).
+    const Eigen::VectorXd rates = rc::wheelJointValues(
+        wheels->name, wheels->velocity, pb.wheels.count(), "wheel_measurement.velocity");
+    *momentum = wheelMomentaFromSpinRates(pb.wheels, rates, m.state.angular_velocity);
+  } catch (const std::exception& e) {
+    return unusable(e.what());
+  }
+  // To the sample's time under the wheel torques held meanwhile (transport and sampling lag).
+  const WheelBodyState moved = predictWheelState(pb.reference->inertia(), wheelArray(pb.wheels),
+                                                 {m.state, *momentum}, held, m.age);
+  m.state = moved.body;
+  *momentum = moved.momentum;
+  last_measured_ = m.state;
+  return m;
+}
+
+bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
+  const Maneuver& plan = pb->reference->nodes();
+  const int N = plan.steps(), n = pb->wheels.count();
+  const TrackingLaw law(*pb->reference, nullptr, tracking_);
+  const WheelArray array = wheelArray(pb->wheels);
+  last_measured_ = {plan.attitude[0], plan.angular_velocity[0]};  // drawn until measured
+  ReplayResult& result = pb->result;
+  WheelPeaks& peaks = *pb->measured_wheel_peaks;
+  int stale = 0, cut_samples = 0;
+  std::string first_problem;
+  std::deque<Vector3> trail;
+  Eigen::VectorXd held = Eigen::VectorXd::Zero(n), momentum = Eigen::VectorXd::Zero(n);
+  for (std::size_t j = 0; j < pb->times.size(); ++j) {
+    const double t = pb->times[j];
+    const ros::Time stamp = start + ros::Duration(t / rate_factor_);
+    if (!sleepUntil(stamp)) return false;
+    const MeasurementAtSample measured = wheelMeasurementAt(*pb, start, stamp, held, &momentum);
+    {
+      std::lock_guard<std::mutex> lock(health_mutex_);
+      health_.measurement_problem = measured.problem;
+    }
+    const RigidBodyState& state = measured.state;
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);  // stale: nothing known to act on
+    if (measured.fresh) {
+      bool cut = false;
+      u = mode_ == TrackingMode::Feedback
+              ? wheelTorquesFor(pb->wheels, array,
+                                law.command(state.attitude, state.angular_velocity, t),
+                                state.angular_velocity, momentum, &cut)
+              // replay: the plan's u over the hold to the next sample, its mean (the midpoint
+              // of the linear hold): u(t) itself, held, would lag the plan by half a sample
+              : heldLinearly(pb->plan_wheel_torque, plan.time_step,
+                             0.5 * (t + pb->times[std::min(j + 1, pb->times.size() - 1)]));
+      cut_samples += cut ? 1 : 0;
+      peaks.observeMomentum(array.axes, momentum);
+      peaks.observeTorque(u);
+    } else {
+      ++stale;
+      if (first_problem.empty()) first_problem = measured.problem;
+      ROS_WARN_THROTTLE(1.0, "external plant: zero wheel command at t = %.6g s: %s", t,
+                        measured.problem.c_str());
+    }
+    wheel_command_pub_.publish(rc::wheelJointState(u, Eigen::VectorXd(), pb->body_frame, stamp));
+    held = u;
+    ManeuverSample body;
+    body.time = t;
+    body.attitude = state.attitude;
+    body.angular_velocity = state.angular_velocity;
+    body.torque = arrayReaction(array, u, state.angular_velocity, momentum);
+    const ManeuverSample reference = pb->reference->at(t);
+    if (measured.fresh) {
+      result.max_attitude_deviation = std::max(
+          result.max_attitude_deviation, so3::angleBetween(reference.attitude, body.attitude));
+      pb->health->observe(body.attitude, body.angular_velocity, body.torque);
+    }
+    if (j + 1 < pb->times.size()) {
+      result.effort += 0.5 * body.torque.squaredNorm() * (pb->times[j + 1] - t);
+      noteNextSample(true, state, start + ros::Duration(pb->times[j + 1] / rate_factor_));
+    }
+    publishState(*pb, body, reference, t, stamp, &trail);
+    publishWheelValues(*pb, u, momentum, body.angular_velocity, stamp);
+  }
+  wheel_command_pub_.publish(  // the run is over: nothing held
+      rc::wheelJointState(Eigen::VectorXd::Zero(n), Eigen::VectorXd(), pb->body_frame,
+                          ros::Time::now()));
+  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
+  result.terminal_velocity_error =
+      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
+  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
+  result.cost = result.effort / plan.time_step;
+  result.success = stale == 0;
+  result.message = (mode_ == TrackingMode::Feedback ? "tracked " : "commanded ") +
+                   std::to_string(N) + " steps through " + std::to_string(n) +
+                   " reaction wheels on the measured state of " + odometry_sub_.getTopic() +
+                   " and " + wheel_measurement_sub_.getTopic() + " (external plant; " +
+                   std::to_string(cut_samples) + " of " + std::to_string(pb->times.size()) +
+                   " samples cut at a wheel limit)";
+  if (stale > 0) {
+    result.message +=
+        ": " + std::to_string(stale) + " of " + std::to_string(pb->times.size()) +
+        " samples had no fresh measurement and got a zero command (first: " + first_problem + ")";
+  }
+  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, peaks);
+  std::string which;
+  const double excess = peaks.worstExcess(pb->wheels, &which);
+  if (excess > 0.0)
+    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
   return true;
 }
 

@@ -191,6 +191,17 @@ void expectWheelAnswer(const Response& res, int steps) {
   EXPECT_LT(closest, 1e-6) << "the momentum limit binds on some wheel";
   EXPECT_FALSE(res.reaction_wheels.has_momentum_norm_limit);
   EXPECT_GT(res.reaction_wheels.peak_momentum_norm, 0.0);
+  // The effort named minimized is the one the answer's cost sums (second_order's trapezoidal
+  // weights), computed here from the rows: the body torques', not the wheels'.
+  double body = 0.0, wheel = 0.0;
+  for (std::size_t k = 0; k < rows; ++k) {
+    const double w = (k == 0 || k + 1 == rows) ? 0.5 : 1.0;
+    body += w * 0.5 * ros_conversions::vectorFromMsg(m.torque[k]).squaredNorm();
+    for (std::size_t i = 0; i < n; ++i) wheel += w * 0.5 * std::pow(m.wheel_torque[k * n + i], 2);
+  }
+  EXPECT_EQ(res.reaction_wheels.effort_minimized, "body_torque");
+  EXPECT_NEAR(res.cost, body, 1e-9 * body);
+  EXPECT_GT(std::abs(res.cost - wheel), 1e-3 * body) << "the wheels' effort differs";
 }
 
 /// The smallest slacks of fillConstrainedRequest's constraints over a returned maneuver's nodes,

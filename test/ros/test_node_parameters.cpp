@@ -105,6 +105,18 @@ TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
   EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
 }
 
+TEST(NodeParameters, PlantNodeWithWheelsNeedsSpinInertiasAndNoEffects) {
+  const std::string dir = " _scene:=" AP_SOURCE_DIR "/test/ros/";
+  expectStopped(kPlant + " __name:=nospin_plant" + dir + "wheel_pyramid.yaml",
+                {"actuators.reaction_wheels.spin_inertia", "spin rates"});
+  expectStopped(kPlant + " __name:=disturbed_wheel_plant" + dir + "wheel_pyramid_disturbed.yaml",
+                {"actuators.reaction_wheels: effects on a body with wheels are not modelled",
+                 "disturbance_torque"});
+  const NodeRun good =
+      runNode(kPlant + " __name:=wheel_plant" + dir + "wheel_pyramid_spin.yaml", 5);
+  EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
+}
+
 TEST(NodeParameters, MissingRelativeSceneNamesTheCallersDirectory) {
   const NodeRun run =
       runNode(kTracker + " __name:=bad_scene _scene:=scenes/no_such_scene.yaml", 60, AP_SOURCE_DIR);

@@ -764,10 +764,14 @@ TEST(ReactionWheelMessages, SummaryCarriesEachWheelsPeaksLimitsAndMargins) {
   EXPECT_EQ(s.wheels[2].torque_margin, wheels.torqueLimit(2) - 0.3);
   EXPECT_FALSE(s.has_momentum_norm_limit);
   EXPECT_EQ(s.max_momentum_norm, 0.0);
+  EXPECT_EQ(s.effort_minimized, "") << "a flown path (no plan's objective) leaves it empty";
   wheels.max_momentum_norm = 3.0;
-  s = rc::wheelSummaryToMsg(wheels, peaks);
+  s = rc::wheelSummaryToMsg(wheels, peaks, MinimizedEffort::BodyTorque);
   EXPECT_TRUE(s.has_momentum_norm_limit);
   EXPECT_NEAR(s.momentum_norm_margin, 0.4, 1e-15);
+  EXPECT_EQ(s.effort_minimized, "body_torque");
+  EXPECT_EQ(rc::wheelSummaryToMsg(wheels, peaks, MinimizedEffort::WheelTorque).effort_minimized,
+            "wheel_torque");
 }
 
 TEST(MarkerColours, OneColourPerMeaningAndEveryMarkerDrawnInItsMeaningsColour) {

@@ -782,6 +782,58 @@ TEST(ReactionWheelReplay, DiscreteReplayRefusesWhatItCannotReplayByName) {
   EXPECT_EQ(replay(ap::SchemeKind::SecondOrder, h0, rows), "");  // at rest: nothing to refuse
 }
 
+/// The effort the result reports as minimized (PlanResult::minimized_effort) is the one the plan
+/// minimizes: on a biased pyramid slew with generous limits (an unconstrained minimum of the
+/// transcription), the plan's cost is the body torques' Σ ½ w_k |τ_k|², stationary to round-off
+/// along seeded random moves of the interior attitudes, while the wheels' Σ ½ w_k |u_k|² is not
+/// (its slope is orders of magnitude larger): had the planner minimized the wheel torques, the
+/// two would swap.
+TEST(ReactionWheelMinimumEffort, TheReportedEffortIsTheOneThePlanMinimizes) {
+  ap::PlanningProblem p = wheelProblem(ap::SchemeKind::SecondOrder, false, 32);
+  p.reaction_wheels.max_torque = {10.0};
+  p.reaction_wheels.max_momentum = {30.0};
+  p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_EQ(r.active_constraints, 0);
+  const auto costs = [&](const ap::Maneuver& m) {
+    const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, m);
+    double wheel = 0.0;
+    for (int k = 0; k <= p.steps; ++k) {
+      wheel += ap::schemeTorqueWeight(p.scheme, k, p.steps) * 0.5 * w.torque[k].squaredNorm();
+    }
+    return std::make_pair(ap::schemeCost(p.scheme, m.torque), wheel);
+  };
+  const auto [body0, wheel0] = costs(r.maneuver);
+  EXPECT_NEAR(r.cost, body0, 1e-12 * body0) << "the result's cost sums the body torques";
+  EXPECT_GT(std::abs(wheel0 - body0), 1e-3 * body0) << "the two efforts differ on this slew";
+  EXPECT_EQ(ap::minimizedEffortName(r.minimized_effort), "body_torque");
+
+  ap::ReducedProblem rp(p);
+  rp.setInteriorFromAttitudes(r.maneuver.attitude);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  const double eps = 1e-5;
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd direction(rp.unknowns());
+    for (int i = 0; i < direction.size(); ++i) direction(i) = normal(rng);
+    direction.normalize();
+    const auto [body_plus, wheel_plus] = costs(rp.maneuver(rp.retract(direction, eps)));
+    const auto [body_minus, wheel_minus] = costs(rp.maneuver(rp.retract(direction, -eps)));
+    const double body_slope = (body_plus - body_minus) / (2 * eps);
+    const double wheel_slope = (wheel_plus - wheel_minus) / (2 * eps);
+    const double minimized =
+        r.minimized_effort == ap::MinimizedEffort::BodyTorque ? body_slope : wheel_slope;
+    const double other =
+        r.minimized_effort == ap::MinimizedEffort::BodyTorque ? wheel_slope : body_slope;
+    std::printf("trial %d: slope of the reported effort %.3g, of the other %.3g\n", trial,
+                minimized, other);
+    EXPECT_LT(std::abs(minimized), 1e-3 * std::abs(other))
+        << "trial " << trial << ": slope of the reported effort " << minimized << ", of the other "
+        << other;
+  }
+}
+
 // ---- outputs -----------------------------------------------------------------------------------
 
 /// The CSV carries u1..un, h1..hn after tx,ty,tz (and reads back as a plan); the JSON summary
@@ -812,5 +864,9 @@ TEST(ReactionWheelOutputs, CsvColumnsAndJsonMarginsPerWheel) {
             std::string::npos)
       << json;
   EXPECT_NE(json.find("\"momentum_norm_margin\": "), std::string::npos);
+  EXPECT_NE(
+      json.find("\"effort_minimized\": \"" + ap::minimizedEffortName(r.minimized_effort) + "\"}"),
+      std::string::npos)
+      << json;
   EXPECT_NE(json.find("\"reaction_wheels\"]"), std::string::npos) << "constraints names it";
 }

@@ -1,6 +1,7 @@
 // Reaction-wheel peaks (analysis/wheel_peaks.hpp) against a brute-force scan, and a plan flown
 // with its wheel torques (analysis/wheel_flight.hpp: the tracker's body + wheels) against the
-// plan: the flight follows it to O(h²), its wheel torques are exactly the plan's at the nodes.
+// plan: on the plan's scheme the flight reproduces it to round-off, continuously (RK4) it follows
+// it to O(h²); its wheel torques are exactly the plan's at the nodes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +12,7 @@
 
 #include "attitude_planner/analysis/wheel_flight.hpp"
 #include "attitude_planner/analysis/wheel_peaks.hpp"
+#include "attitude_planner/analysis/wheel_plant.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
@@ -90,9 +92,63 @@ TEST(WheelPeaks, MatchABruteForceScanAndNameTheWorstExcess) {
   EXPECT_LT(peaks.worstExcess(wheels, &which), 0.0) << "every limit holds";
 }
 
-/// The flight's wheel torques are the plan's (held linearly); its body and wheel momenta follow
-/// the plan to O(h²) (the planner's discrete algebra against the continuous body + wheels).
-TEST(WheelFlight, FliesThePlansWheelTorquesAndFollowsThePlanToSecondOrder) {
+/// ~mode replay's flight (the plan's scheme, the default model): the plan's wheel torques,
+/// flown from its start through the scheme's own body + wheels, reproduce every node of the plan
+/// to round-off (attitude, reported velocity, body torque, wheel momenta) on paper, variational
+/// and second_order, so every wheel limit the plan meets holds in the flight to 1e-9; one wheel
+/// torque off by 1e-3 of its limit at one node departs by orders of magnitude more.
+TEST(WheelFlight, ReplayOnThePlansSchemeReproducesThePlanToRoundOff) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    ap::PlanningProblem p = pyramidSlew(32);
+    p.scheme = scheme;
+    p.reaction_wheels.max_momentum = {0.9};  // binding on some wheel (checked below)
+    const std::string name = ap::schemeName(scheme);
+    const ap::PlanResult r = ap::planManeuver(p);
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message;
+    ASSERT_GT(r.active_constraints, 0) << name;
+    const ap::WheelStates planned =
+        ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
+    const ap::RigidBodyState start{r.maneuver.attitude[0], r.maneuver.angular_velocity[0]};
+    const ap::WheelFlight flight =
+        ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r.maneuver, {}, start);
+    ASSERT_EQ(flight.body.steps(), 32);
+    const double h = r.maneuver.time_step;
+    double attitude = 0.0, rate = 0.0, torque = 0.0, momentum = 0.0;
+    for (int k = 0; k <= 32; ++k) {
+      EXPECT_EQ(flight.torqueAt(k * h), planned.torque[k]) << name << " k = " << k;
+      attitude = std::max(attitude,
+                          ap::so3::angleBetween(flight.body.attitude[k], r.maneuver.attitude[k]));
+      rate =
+          std::max(rate, (flight.body.angular_velocity[k] - r.maneuver.angular_velocity[k]).norm());
+      momentum = std::max(momentum, (flight.momentum[k] - planned.momentum[k]).norm());
+      if (ap::schemeHasEndTorques(scheme) || (k > 0 && k < 32)) {
+        torque = std::max(torque, (flight.body.torque[k] - r.maneuver.torque[k]).norm());
+      }
+    }
+    std::printf("%s: departure %.3g rad, %.3g rad/s, %.3g N m, %.3g N m s\n", name.c_str(),
+                attitude, rate, torque, momentum);
+    EXPECT_LT(attitude, 1e-12) << name;
+    EXPECT_LT(rate, 1e-12) << name;
+    EXPECT_LT(torque, 1e-10) << name;
+    EXPECT_LT(momentum, 1e-12) << name;
+    std::string which;
+    EXPECT_LT(flight.peaks.worstExcess(p.reaction_wheels, &which), 1e-9 * 0.9) << which;
+    EXPECT_GT(flight.peaks.worstExcess(p.reaction_wheels), -1e-6) << name << ": a limit binds";
+
+    std::vector<Eigen::VectorXd> nudged = planned.torque;
+    nudged[16](1) += 1e-3 * p.reaction_wheels.max_torque[0];
+    const ap::WheelFlight off =
+        ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r.maneuver, nudged, start);
+    const double miss = ap::so3::angleBetween(off.body.attitude.back(), r.maneuver.attitude.back());
+    EXPECT_GT(miss, 1e3 * std::max(attitude, 1e-15)) << name << ": a wrong torque departs";
+  }
+}
+
+/// The continuous flight (WheelFlightModel::Continuous, what fourth_order plans get): the
+/// flight's wheel torques are the plan's (held linearly); its body and wheel momenta follow the
+/// plan to O(h²) (the planner's discrete algebra against the continuous body + wheels).
+TEST(WheelFlight, ContinuousFlightFollowsThePlanToSecondOrder) {
   std::vector<double> misses, momentum_gaps;
   for (const int N : {32, 64, 128}) {
     const ap::PlanningProblem p = pyramidSlew(N);
@@ -102,7 +158,8 @@ TEST(WheelFlight, FliesThePlansWheelTorquesAndFollowsThePlanToSecondOrder) {
         ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
     const ap::WheelFlight flight =
         ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r.maneuver, {},
-                          ap::RigidBodyState{p.initial_attitude, p.initial_velocity});
+                          ap::RigidBodyState{p.initial_attitude, p.initial_velocity},
+                          ap::WheelFlightModel::Continuous);
     ASSERT_EQ(flight.body.steps(), N);
     const double h = r.maneuver.time_step;
     double gap = 0.0;
@@ -147,8 +204,8 @@ TEST(WheelFlight, BodyTorqueIsTheArraysReaction) {
       expected -= a * flight.torque[k](i) + Omega.cross(a * flight.momentum[k](i));
     }
     EXPECT_LT((flight.body.torque[k] - expected).norm(), 1e-13) << "k = " << k;
-    // and the plan's body torque to O(h): the array makes the torque the plan asked for
-    EXPECT_LT((flight.body.torque[k] - r.maneuver.torque[k]).norm(), 0.05) << "k = " << k;
+    // and the plan's body torque: the array makes the torque the plan asked for
+    EXPECT_LT((flight.body.torque[k] - r.maneuver.torque[k]).norm(), 1e-10) << "k = " << k;
   }
 }
 
@@ -179,6 +236,9 @@ TEST(WheelSpinRates, GyrostatWithRelativeRatesHasTheArraysMomentum) {
     const ap::Vector3 package = p.inertia * Omega + array.axes * flight.momentum[k];
     EXPECT_LT((gyrostat - package).norm(), 1e-13 * package.norm()) << "k = " << k;
     largest_rate = std::max(largest_rate, w.cwiseAbs().maxCoeff());
+    // A tachometer's reading back to the momenta (the external plant's measurement): the inverse.
+    const Eigen::VectorXd back = ap::wheelMomentaFromSpinRates(p.reaction_wheels, w, Omega);
+    EXPECT_LT((back - flight.momentum[k]).norm(), 1e-14 * (1 + flight.momentum[k].norm()));
   }
   EXPECT_GT(largest_rate, 1.0);  // [rad/s]: the wheels spin (biased), so the check has teeth
   // Locked wheels: h_i = J_s,i a_i·Ω gives w = 0 (the scalar spin inertia for every wheel).
@@ -276,4 +336,63 @@ TEST(WheelTracking, WheelsDeliverTheLawsTorqueAndAreCutAtTheirLimits) {
   ap::ReactionWheels tight = p.reaction_wheels;
   tight.max_torque = {0.05};
   check(tight, true);
+}
+
+/// WheelPlant (attitude_plant_node with wheels) against closed forms: three orthogonal wheels on
+/// a principal-axis body at rest, wheel_1 (along x) commanded a constant u: the body turns about
+/// x alone with J_x Ω̇ = −u, so Ω_x = −u t / J_x, the angle −u t² / (2 J_x), and h_1 = u t; a
+/// command past its limit is cut to ±U; torque-free, R (J Ω + A h_w) stays put.
+TEST(WheelPlant, MatchesClosedFormsAndConservesTheTotalMomentum) {
+  ap::ReactionWheels wheels;
+  wheels.spin_axes = {ap::Vector3::UnitX(), ap::Vector3::UnitY(), ap::Vector3::UnitZ()};
+  wheels.max_torque = {0.2};
+  wheels.max_momentum = {5.0};
+  const ap::Matrix3 J = ap::Vector3(10.0, 12.0, 14.0).asDiagonal();
+  ap::WheelPlant plant(J, wheels, {ap::Matrix3::Identity(), ap::Vector3::Zero()}, 0.05);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(3);
+  u(0) = 0.5;  // past U = 0.2: delivered 0.2
+  EXPECT_EQ(plant.command(u)(0), 0.2);
+  plant.advanceTo(3.0);
+  const double t = 3.0, delivered = 0.2;
+  EXPECT_NEAR(plant.angularVelocity().x(), -delivered * t / 10.0, 1e-14);
+  EXPECT_LT(plant.angularVelocity().tail<2>().norm(), 1e-15);
+  EXPECT_NEAR(plant.momentum()(0), delivered * t, 1e-14);
+  const ap::Vector3 turned = ap::so3::log(plant.attitude());
+  EXPECT_NEAR(turned.x(), -delivered * t * t / 20.0, 1e-12);
+  EXPECT_THROW(plant.command(Eigen::VectorXd::Zero(2)), ap::InvalidInput);
+
+  // Torque-free tumbling with a biased pyramid: the total momentum is conserved to RK4's error.
+  ap::WheelPlant free(ap::Matrix3(pyramidSlew(8).inertia), pyramidWheels(),
+                      {ap::so3::exp(ap::Vector3(0.3, -0.2, 0.1)), ap::Vector3(0.2, -0.1, 0.15)},
+                      0.01);
+  const ap::WheelArray array = ap::wheelArray(pyramidWheels());
+  const auto total = [&](const ap::WheelPlant& p) {
+    return ap::Vector3(p.attitude() *
+                       (pyramidSlew(8).inertia * p.angularVelocity() + array.axes * p.momentum()));
+  };
+  const ap::Vector3 before = total(free);
+  free.advanceTo(20.0);
+  EXPECT_LT((total(free) - before).norm(), 1e-9 * before.norm());
+  EXPECT_GT(ap::so3::angleBetween(free.attitude(), ap::Matrix3::Identity()), 0.5) << "it moved";
+}
+
+/// predictWheelState moves a state as the plant does: the same equations under the held torques.
+TEST(WheelPlant, PredictionIsThePlantsMotion) {
+  const ap::ReactionWheels wheels = pyramidWheels();
+  const ap::Matrix3 J = pyramidSlew(8).inertia;
+  const ap::RigidBodyState start{ap::so3::exp(ap::Vector3(0.1, 0.2, -0.3)),
+                                 ap::Vector3(0.05, -0.02, 0.03)};
+  ap::WheelPlant plant(J, wheels, start, 0.0125);
+  Eigen::VectorXd u(4);
+  u << 0.1, -0.05, 0.02, 0.15;
+  plant.command(u);
+  plant.advanceTo(0.2);
+  ap::WheelBodyState state{start, Eigen::VectorXd(4)};
+  state.momentum << 0.3, -0.2, 0.5, 0.1;
+  const ap::WheelBodyState predicted =
+      ap::predictWheelState(J, ap::wheelArray(wheels), state, u, 0.2);
+  EXPECT_LT(ap::so3::angleBetween(predicted.body.attitude, plant.attitude()), 1e-13);
+  EXPECT_LT((predicted.body.angular_velocity - plant.angularVelocity()).norm(), 1e-13);
+  EXPECT_LT((predicted.momentum - plant.momentum()).norm(), 1e-13);
+  EXPECT_GT((predicted.momentum - state.momentum).norm(), 1e-3) << "the wheels moved";
 }

@@ -1,7 +1,10 @@
 // A plan flown with reaction wheels (the tracker's ~mode replay of a maneuver with wheels): the
-// plan's wheel torques u_k drive the continuous body + wheels (replayWithWheels: RK4, u held
-// linearly between nodes, independent of the planner's algebra), and the flown path's wheel
-// peaks are measured against the array's limits (WheelPeaks).
+// plan's wheel torques u_k drive body + wheels through the plan's own discrete scheme
+// (replayWithWheelsOnTheScheme: the Lie group integrator of the plan, derived independently of
+// the planner's wheel quantities, so the plan comes back to round-off, as replayPlan does without
+// wheels), or for fourth_order (not a discretization) the continuous body + wheels
+// (replayWithWheels: RK4, u held linearly between nodes); the flown path's wheel peaks are
+// measured against the array's limits (WheelPeaks).
 #pragma once
 
 #include <vector>
@@ -18,6 +21,10 @@ namespace attitude_planner {
 /// RK4 steps per plan step of the wheel flight (the replay's default).
 inline constexpr int kWheelFlightSubsteps = 16;
 
+/// Node rows (k = 0..N on t_k = k h) at time t ∈ [0, T], linear between the nodes (clamped to the
+/// ends): how wheel torques are held between nodes.
+Eigen::VectorXd heldLinearly(const std::vector<Eigen::VectorXd>& rows, double time_step, double t);
+
 /// The body and wheels flown from a plan's wheel torques.
 struct WheelFlight {
   /// The body at the nodes t_k: R, Ω and, in the torque column, the torque the array exerts on
@@ -25,8 +32,9 @@ struct WheelFlight {
   Maneuver body;
   std::vector<Eigen::VectorXd> torque;    ///< u_k [N m], the wheel torques flown
   std::vector<Eigen::VectorXd> momentum;  ///< h_w(t_k) [N m s] of the flight
-  /// Peaks along the flight: |h_w,i| at every RK4 substep, |A h_w| at the nodes, |u_i| at every
-  /// node (all are flown; a linear hold between nodes never exceeds its ends).
+  /// Peaks along the flight: |h_w,i| at the nodes (and at every RK4 substep of a continuous
+  /// flight), |A h_w| at the nodes, |u_i| at every node (all are flown; a linear hold between
+  /// nodes never exceeds its ends).
   WheelPeaks peaks;
 
   /// u(t), h_w(t) at t ∈ [0, T]: linear between the nodes (u exactly as flown; h_w to O(h²)).
@@ -34,13 +42,29 @@ struct WheelFlight {
   Eigen::VectorXd momentumAt(double t) const;
 };
 
+/// What a wheel flight integrates.
+enum class WheelFlightModel {
+  /// The plan's discrete scheme (paper, variational, second_order; replayWithWheelsOnTheScheme):
+  /// the plan's own wheel torques reproduce its nodes to round-off. fourth_order, not a
+  /// discretization, is flown Continuous.
+  PlanScheme,
+  /// The continuous body + wheels (replayWithWheels, kWheelFlightSubsteps RK4 steps per plan
+  /// step, u held linearly between the nodes): follows a plan to O(h²).
+  Continuous,
+};
+
 /// Flies `plan` (scheme `scheme`, inertia J) with the array `wheels` from `start` (the plan's
-/// R_0, Ω_0 unless a running body takes it over) and the wheels at their initial_momentum:
-/// `wheel_torque` (one vector of n per node; empty: the plan's own, wheelStates) through
-/// replayWithWheels. The array must be valid (validateReactionWheels).
+/// R_0, Ω_0 unless a running body takes it over; with PlanScheme the start velocity is the
+/// scheme's boundary velocity Ω(0), as replayPlan takes it) and the wheels at their
+/// initial_momentum: `wheel_torque` (one vector of n per node; empty: the plan's own,
+/// wheelStates) through `model`. The body's rows are in the scheme's convention (paper,
+/// variational: each step's reported velocity, row N repeating N − 1; second_order: the node
+/// velocities J⁻¹Π_k), so ManeuverInterpolation reads them as a plan of `scheme`. The array must
+/// be valid (validateReactionWheels). Throws StepTooLarge when a step solve of the scheme fails.
 WheelFlight flyWithWheels(const Matrix3& inertia, SchemeKind scheme, const ReactionWheels& wheels,
                           const Maneuver& plan, std::vector<Eigen::VectorXd> wheel_torque,
-                          const RigidBodyState& start);
+                          const RigidBodyState& start,
+                          WheelFlightModel model = WheelFlightModel::PlanScheme);
 
 /// A closed loop flown by the wheels (the tracker's ~mode feedback with wheels).
 struct WheelTracking {

@@ -88,6 +88,11 @@ void validateReactionWheels(const ReactionWheels& wheels, const std::string& fie
 /// inertia Σ J_s,i a_i a_iᵀ, docs/reaction_wheels.md.) Needs ReactionWheels::spin_inertia.
 Eigen::VectorXd wheelSpinRates(const ReactionWheels& wheels, const Eigen::VectorXd& momenta,
                                const Vector3& body_rate);
+/// The inverse of wheelSpinRates: h_w,i = J_s,i (a_i·Ω + w_i) [N m s] from the spin rates w_i
+/// relative to the body [rad/s] (what a wheel's tachometer reads) and the body rate Ω. Needs
+/// ReactionWheels::spin_inertia.
+Eigen::VectorXd wheelMomentaFromSpinRates(const ReactionWheels& wheels,
+                                          const Eigen::VectorXd& rates, const Vector3& body_rate);
 
 /// The wheel states of a plan: per node k = 0..N the wheel momenta h_w,k and torques u_k (the
 /// definitions above; u at k = 0 and N of schemes without end torques is formed with τ = 0, what

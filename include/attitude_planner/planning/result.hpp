@@ -217,6 +217,20 @@ struct PointingSummary {
   int starts = 0;  ///< twist × class starts surveyed
 };
 
+/// Which torques the effort a plan minimizes is made of (JSON `reaction_wheels.effort_minimized`,
+/// ReactionWheelsSummary.effort_minimized). With reaction wheels the two differ: the body torque τ
+/// the array exerts, or the wheels' own torques u (A u = −(τ + Ω × A h_w)).
+enum class MinimizedEffort {
+  BodyTorque,   ///< Σ ½ w_k |τ_k|², τ_k the torque on the body
+  WheelTorque,  ///< Σ ½ w_k |u_k|², u_k the wheels' torques
+};
+inline constexpr NamedValue<MinimizedEffort> kMinimizedEffortNames[] = {
+    {MinimizedEffort::BodyTorque, "body_torque"},
+    {MinimizedEffort::WheelTorque, "wheel_torque"},
+};
+/// "body_torque", "wheel_torque" (JSON, messages).
+std::string minimizedEffortName(MinimizedEffort effort);
+
 /// What a solve returns: the plan, how the solve ended (`termination`, explained by `message`),
 /// and the figures that judge it.
 struct PlanResult {
@@ -246,6 +260,10 @@ struct PlanResult {
   /// h · cost [N²·m²·s]: the scheme's quadrature of ½∫₀ᵀ|τ|²dt, comparable across schemes and
   /// with the continuous optimum.
   double effort = 0.0;
+  /// Which torques `cost` sums and the objective minimizes (minimum effort; minimum time's effort
+  /// term and its time_margin plan): set by planManeuver from the transcription's cost
+  /// (ReducedProblem::kMinimizedEffort), which every writer reads from here.
+  MinimizedEffort minimized_effort = MinimizedEffort::BodyTorque;
   int iterations = 0;  ///< Newton iterations, coarser continuation levels included
   /// First-order optimality residual at the end: max-norm of ∇C relative to |∂τ/∂R|·max|τ|
   /// (the interior point: of the KKT stationarity residual ∇C − Σ zᵢ∇cᵢ with its multipliers).

@@ -4,12 +4,14 @@
 // the core (validateProblem).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/time.h>
+#include <sensor_msgs/JointState.h>
 #include <boost/array.hpp>
 
 #include "attitude_planner/AttitudeManeuver.h"
@@ -92,8 +94,24 @@ AttitudeManeuver maneuverToMsg(const Maneuver& maneuver, const PlanningProblem& 
 ReactionWheels reactionWheelsFromMsg(const ReactionWheelArray& msg, const std::string& field);
 /// The message of a core array (no envelope: max_momentum_norm 0).
 ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels);
-/// The peaks of `wheels` against their limits as a message (the JSON summary's reaction_wheels).
-ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const WheelPeaks& peaks);
+/// The peaks of `wheels` against their limits as a message (the JSON summary's reaction_wheels);
+/// `effort_minimized` the plan's PlanResult::minimized_effort (a flown path minimizes nothing:
+/// none, the field left empty).
+ReactionWheelsSummary wheelSummaryToMsg(
+    const ReactionWheels& wheels, const WheelPeaks& peaks,
+    std::optional<MinimizedEffort> effort_minimized = std::nullopt);
+/// One value per wheel from a sensor_msgs/JointState's `names` and one of its value arrays
+/// (`values`: effort for a wheel command, velocity for a wheel measurement), looked up by the
+/// names wheel_1 .. wheel_n (any order; other joints ignored). Throws InvalidInput naming
+/// `field` for a missing wheel, a value array shorter than the names, or a non-finite value.
+Eigen::VectorXd wheelJointValues(const std::vector<std::string>& names,
+                                 const std::vector<double>& values, int wheels,
+                                 const std::string& field);
+/// A JointState of n wheels (names wheel_1 .. wheel_n, frame `frame`, stamped `stamp`) carrying
+/// `effort` and, when not empty, `velocity`.
+sensor_msgs::JointState wheelJointState(const Eigen::VectorXd& effort,
+                                        const Eigen::VectorXd& velocity, const std::string& frame,
+                                        const ros::Time& stamp);
 /// `rows` vectors of `wheels` entries from a row-major array (AttitudeManeuver.wheel_torque /
 /// wheel_momentum); throws InvalidInput naming `field` for a wrong length or a non-finite entry.
 std::vector<Eigen::VectorXd> wheelRowsFromMsg(const std::vector<double>& values, int rows,

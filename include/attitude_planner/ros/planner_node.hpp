@@ -363,7 +363,8 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
     if (wheels) {
       res->reaction_wheels = ros_conversions::wheelSummaryToMsg(
           planned.reaction_wheels,
-          planWheelPeaks(planned.reaction_wheels, states, schemeHasEndTorques(planned.scheme)));
+          planWheelPeaks(planned.reaction_wheels, states, schemeHasEndTorques(planned.scheme)),
+          r.minimized_effort);
     }
   }
   res->steps = planned.steps;

@@ -11,6 +11,13 @@
 // maneuver time runs at ~rate_factor maneuver seconds per ROS second. A command acts from its
 // header.stamp (clamped to [the plant's time, now]) until the next one: zero-order hold.
 //
+// A scene with reaction wheels (actuators.reaction_wheels, with spin_inertia) is body + wheels
+// instead: the core's WheelPlant (analysis/wheel_plant.hpp: Ṙ = RΩ^, JΩ̇ = −Ω × (JΩ + A h_w) −
+// A u, ḣ_w = u, RK4), commanded by wheel torques u on `wheel_command` (each cut to its
+// max_torque), measured by the wheels' spin rates relative to the body on `wheel_measurement`
+// beside `odometry` (same stamp); effects on a body with wheels are refused by name (as the
+// planner and the tracker refuse them), torque_command is not subscribed.
+//
 // Subscribes  torque_command  geometry_msgs/WrenchStamped, body frame   u [N·m] (wrench.torque;
 //                             the force is ignored); a frame_id other than ~body_frame or empty
 //                             is refused with a warning naming it
@@ -18,6 +25,11 @@
 //                             child_frame_id ~body_frame, pose.orientation R (body → world),
 //                             twist.angular Ω (body frame) [rad/s]; position, linear velocity
 //                             and covariances zero
+//             (wheels) wheel_command  sensor_msgs/JointState   u_i [N m] in `effort`, by the
+//                             names wheel_1 .. wheel_n; a bad one is refused with a warning
+//             (wheels) wheel_measurement  sensor_msgs/JointState at ~rate, frame ~body_frame:
+//                             `velocity` the spin rates w_i = h_w,i / J_s,i − a_i·Ω [rad/s],
+//                             `effort` the torques delivered [N m]
 //
 // Private parameters (a bad value stops the node with exit status 78, naming it):
 //   ~scene        string  (required)  scene YAML: inertia, initial state, effects
@@ -35,8 +47,10 @@
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 
 #include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/analysis/wheel_plant.hpp"
 
 namespace attitude_planner {
 
@@ -50,6 +64,12 @@ class PlantNode {
  private:
   /// `torque_command`: integrates up to the command's time, then holds the new command.
   void onCommand(const geometry_msgs::WrenchStamped::ConstPtr& msg);
+  /// `wheel_command` (a scene with wheels): integrates up to its time, then holds the torques.
+  void onWheelCommand(const sensor_msgs::JointState::ConstPtr& msg);
+  /// The time a command of `stamp` acts from (clamped to now), releasing the body at the first.
+  ros::Time commandTime(const ros::Time& stamp);
+  /// Integrates whichever plant there is to maneuver time t.
+  void advanceTo(double t);
   /// ~rate timer: integrates up to now and publishes `odometry`.
   void onTimer(const ros::TimerEvent& event);
   /// Maneuver time [s] of ROS time `stamp` (0 before the first command).
@@ -58,8 +78,10 @@ class PlantNode {
   ros::Subscriber command_sub_;
   ros::Publisher odometry_pub_;
   ros::Timer timer_;
-  std::unique_ptr<RigidBodyPlant> plant_;
-  std::optional<ros::Time> released_;  ///< ROS time of t = 0 (the first command's stamp)
+  std::unique_ptr<RigidBodyPlant> plant_;    ///< a scene without wheels
+  std::unique_ptr<WheelPlant> wheel_plant_;  ///< a scene with wheels (body + wheels)
+  ros::Publisher wheel_pub_;                 ///< `wheel_measurement` (wheels)
+  std::optional<ros::Time> released_;        ///< ROS time of t = 0 (the first command's stamp)
   double rate_factor_ = 1.0;
   std::string world_frame_, body_frame_;
 };

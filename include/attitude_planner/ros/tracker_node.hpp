@@ -20,8 +20,9 @@
 // A maneuver with reaction wheels (its `reaction_wheels`, internal plant) is flown with its wheel
 // torques through body + wheels in ~mode replay (analysis/wheel_flight.hpp: flyWithWheels), and
 // with the tracking law's torque distributed over the wheels and cut to their limits in ~mode
-// feedback (trackWithWheels); replan, the external plant and effects during the run are refused
-// by name.
+// feedback (trackWithWheels); with ~plant external the wheel torques go out on `wheel_command`
+// and the wheels' speeds come in on `wheel_measurement` (runExternalWheels); replan and effects
+// during the run are refused by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -145,6 +146,7 @@
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -255,6 +257,8 @@ struct MeasurementAtSample {
   bool fresh = false;    ///< received, frames right, not older than ~measurement_timeout
   RigidBodyState state;  ///< moved to the sample's time (when fresh; else the last usable one)
   std::string problem;   ///< why not fresh (for the warning and `done`)
+  double time = 0.0;     ///< maneuver time [s] of the measurement (when fresh)
+  double age = 0.0;      ///< maneuver seconds from the measurement to the sample (when fresh)
 };
 
 /// A re-plan's answer (replan mode).
@@ -335,6 +339,10 @@ class TrackerNode {
     /// the wheels from the plan's wheel torques (what `actual` shows; null without wheels).
     ReactionWheels wheels;
     std::shared_ptr<const WheelFlight> wheel_flight;
+    /// ~plant external with wheels: the plan's wheel torques u_k (replay mode's command, held
+    /// linearly between nodes) and the peaks of the measured momenta and the commanded torques.
+    std::vector<Eigen::VectorXd> plan_wheel_torque;
+    std::optional<WheelPeaks> measured_wheel_peaks;
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -393,8 +401,23 @@ class TrackerNode {
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   /// The newest measurement at the sample stamped `stamp` of the run started at `start`, moved
   /// to the sample's time under `held_command` (the last command sent) and the known effects.
+  /// `predict` false: the measurement as taken (time and age set), not moved.
   MeasurementAtSample measurementAt(const Playback& playback, const ros::Time& start,
-                                    const ros::Time& stamp, const Vector3& held_command);
+                                    const ros::Time& stamp, const Vector3& held_command,
+                                    bool predict = true);
+  /// ~plant external with wheels: the newest odometry and `wheel_measurement` (spin rates
+  /// relative to the body, turned into momenta with the measured rate), moved together to the
+  /// sample's time under the wheel torques held meanwhile (predictWheelState).
+  MeasurementAtSample wheelMeasurementAt(const Playback& playback, const ros::Time& start,
+                                         const ros::Time& stamp, const Eigen::VectorXd& held,
+                                         Eigen::VectorXd* momentum);
+  /// ~plant external with wheels (replay, feedback): at every sample the wheel torques u on the
+  /// measured body and wheels (the law's torque distributed and cut, wheelTorquesFor; or the
+  /// plan's u(t)) out on `wheel_command`; stale measurements give a zero command. False if
+  /// stopped meanwhile.
+  bool runExternalWheels(const ros::Time& start, Playback* playback);
+  /// `wheel_measurement` callback: keeps the newest.
+  void onWheelMeasurement(const sensor_msgs::JointState::ConstPtr& msg);
   /// Publishes the body (`body`, its torque the delivered or commanded one) and the reference
   /// (`plan`) at maneuver time t, stamped `stamp`.
   void publishState(const Playback& playback, const ManeuverSample& body,
@@ -423,6 +446,10 @@ class TrackerNode {
   /// `wheel_momentum` (h_w(t)) and the momentum bars at maneuver time t, stamped `stamp`.
   void publishWheels(const Playback& playback, double t, const Vector3& body_rate,
                      const ros::Time& stamp);
+  /// The same topics for wheel torques u and momenta h_w given directly (external plant).
+  void publishWheelValues(const Playback& playback, const Eigen::VectorXd& torque,
+                          const Eigen::VectorXd& momentum, const Vector3& body_rate,
+                          const ros::Time& stamp);
   /// `body_pose` (R), `attitude_error_vector` (log(R_dᵀR)) and `angular_velocity_error_vector`
   /// (e_Ω), stamped `stamp`.
   void publishStampedErrors(const Playback& playback, const Matrix3& body, const Matrix3& reference,
@@ -520,6 +547,10 @@ class TrackerNode {
   nav_msgs::Odometry::ConstPtr odometry_;  ///< newest `odometry`, null before the first
   ros::Time odometry_received_;            ///< when it arrived (for an unstamped one)
   RigidBodyState last_measured_;           ///< the last usable measurement (for display)
+  ros::Publisher wheel_command_pub_;       ///< `wheel_command` (~plant external, wheels)
+  ros::Subscriber wheel_measurement_sub_;  ///< `wheel_measurement` (~plant external)
+  sensor_msgs::JointState::ConstPtr wheel_measurement_;  ///< newest, guarded by odometry_mutex_
+  ros::Time wheel_received_;                             ///< when it arrived
   /// ~replay_scene's effects, if set: they act during every replay instead of ~scene's own.
   std::optional<std::vector<EffectSpec>> replay_scene_effects_;
 

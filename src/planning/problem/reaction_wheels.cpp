@@ -131,6 +131,21 @@ Eigen::VectorXd wheelSpinRates(const ReactionWheels& wheels, const Eigen::Vector
   return rates;
 }
 
+Eigen::VectorXd wheelMomentaFromSpinRates(const ReactionWheels& wheels,
+                                          const Eigen::VectorXd& rates, const Vector3& body_rate) {
+  if (!wheels.hasSpinInertia()) {
+    throw InvalidInput("actuators.reaction_wheels.spin_inertia",
+                       "not given: a wheel's momentum from its spin rate needs its spin inertia");
+  }
+  const int n = wheels.count();
+  Eigen::VectorXd momenta(n);
+  for (int i = 0; i < n; ++i) {
+    momenta(i) =
+        wheels.spinInertia(i) * (wheels.spin_axes[i].normalized().dot(body_rate) + rates(i));
+  }
+  return momenta;
+}
+
 Vector3 planNodeMomentum(SchemeKind scheme, const Matrix3& inertia, const Maneuver& plan, int k) {
   const int N = plan.steps();
   if (k == 0 || k == N || schemeHasEndTorques(scheme)) return inertia * plan.angular_velocity[k];

@@ -5,6 +5,10 @@
 
 namespace attitude_planner {
 
+std::string minimizedEffortName(MinimizedEffort effort) {
+  return nameIn(kMinimizedEffortNames, effort);
+}
+
 std::string attemptStageName(AttemptStage stage) {
   return nameIn(kAttemptStageNames, stage);
 }

@@ -101,6 +101,10 @@ class ReducedProblem {
   /// Whether every step lies on the scheme's principal branch (DiscreteScheme::onPrincipalBranch):
   /// the interior points' domain, as h > 0 is (a trial iterate outside it has merit +∞).
   bool onPrincipalBranch(const StepVectors& steps) const;
+  /// The torques C sums: the body's τ_k (torques()), with reaction wheels too (their torques u_k
+  /// are functions of the body's motion, constrained, not summed: reaction_wheels.hpp). The one
+  /// statement of it; planManeuver reports it (PlanResult::minimized_effort).
+  static constexpr MinimizedEffort kMinimizedEffort = MinimizedEffort::BodyTorque;
 
   /// The current iterate moved by R_j → R_j exp(α δ_j^) for the free attitudes j = 2..N−2,
   /// i.e. F_j → exp(−α δ_j^) F_j exp(α δ_{j+1}^), composed in quaternions (full precision).

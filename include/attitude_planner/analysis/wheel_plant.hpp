@@ -1,0 +1,71 @@
+// Body + reaction wheels as a plant driven by wheel-torque commands: what attitude_plant_node
+// integrates for a scene with wheels, and what the tracker's external plant mode commands and
+// predicts with (docs/ros_tracker.md, "External plant with wheels"). The equations are
+// replayWithWheels' (dynamics/wheel_replay.hpp):
+//
+//     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u,     ḣ_w = u,
+//
+// u held between commands (zero-order hold), RK4 in steps of at most max_step.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "attitude_planner/analysis/tracking.hpp"
+#include "attitude_planner/planning/reaction_wheels.hpp"
+
+namespace attitude_planner {
+
+/// The wheel torques that make the body torque `body_torque` [N m] at body rate Ω and wheel
+/// momenta h_w by the array's minimum-norm law (A u = −(τ + Ω × A h_w), u = A⁺(A u)), each then
+/// cut to ±U_i, and to 0 in the direction that would drive a wheel already at ±H_i further;
+/// `cut` (if not null) is set when a wheel's torque was changed.
+Eigen::VectorXd wheelTorquesFor(const ReactionWheels& wheels, const WheelArray& array,
+                                const Vector3& body_torque, const Vector3& rate,
+                                const Eigen::VectorXd& momentum, bool* cut = nullptr);
+
+/// The torque the array exerts on the body, τ = −A u − Ω × A h_w [N m].
+Vector3 arrayReaction(const WheelArray& array, const Eigen::VectorXd& torque, const Vector3& rate,
+                      const Eigen::VectorXd& momentum);
+
+/// Body and wheels at one instant.
+struct WheelBodyState {
+  RigidBodyState body;
+  Eigen::VectorXd momentum;  ///< h_w [N m s]
+};
+
+/// `state` moved on by dt [s] (≥ 0) under the wheel torques u held (kWheelFlightSubsteps RK4
+/// steps): the tracker moves a measurement to its sample's time with it.
+WheelBodyState predictWheelState(const Matrix3& inertia, const WheelArray& array,
+                                 const WheelBodyState& state, const Eigen::VectorXd& torque,
+                                 double dt);
+
+/// Body + wheels integrated from wheel-torque commands (zero-order hold).
+class WheelPlant {
+ public:
+  /// At t = 0 in `start` (the wheels at their initial_momentum). The array must be valid
+  /// (validateReactionWheels); `max_step` > 0 [s] (throws InvalidInput naming it otherwise).
+  WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels, const RigidBodyState& start,
+             double max_step);
+  /// Holds the wheel torques u [N m] from now on, each cut to its torque limit ±U_i (the
+  /// motor's); returns the torques delivered. Throws InvalidInput for a wrong count.
+  const Eigen::VectorXd& command(const Eigen::VectorXd& torque);
+  /// Integrates to maneuver time t; a t at or before time() changes nothing.
+  void advanceTo(double t);
+  double time() const { return time_; }                             ///< t [s]
+  const Matrix3& attitude() const { return state_.body.attitude; }  ///< R(t), body → world
+  const Vector3& angularVelocity() const { return state_.body.angular_velocity; }  ///< Ω [rad/s]
+  const Eigen::VectorXd& momentum() const { return state_.momentum; }    ///< h_w(t) [N m s]
+  const Eigen::VectorXd& deliveredTorque() const { return delivered_; }  ///< u [N m]
+  const ReactionWheels& wheels() const { return wheels_; }
+
+ private:
+  Matrix3 inertia_;
+  ReactionWheels wheels_;
+  WheelArray array_;
+  double max_step_;
+  double time_ = 0.0;
+  WheelBodyState state_;
+  Eigen::VectorXd delivered_;
+};
+
+}  // namespace attitude_planner

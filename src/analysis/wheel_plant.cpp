@@ -1,0 +1,82 @@
+// Body + reaction wheels as a plant (wheel_plant.hpp).
+#include "attitude_planner/analysis/wheel_plant.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "attitude_planner/analysis/wheel_flight.hpp"
+#include "attitude_planner/dynamics/wheel_replay.hpp"
+#include "attitude_planner/errors.hpp"
+
+namespace attitude_planner {
+
+Eigen::VectorXd wheelTorquesFor(const ReactionWheels& wheels, const WheelArray& array,
+                                const Vector3& body_torque, const Vector3& rate,
+                                const Eigen::VectorXd& momentum, bool* cut) {
+  // τ = −A u − Ω × A h_w  ⇒  A u = −(τ + Ω × A h_w); u = A⁺(A u) carries no null-space part.
+  const Vector3 array_torque = -(body_torque + rate.cross(array.axes * momentum));
+  Eigen::VectorXd u = array.pseudo_inverse * array_torque;
+  for (int i = 0; i < wheels.count(); ++i) {
+    const double limit = wheels.torqueLimit(i), H = wheels.momentumLimit(i);
+    double wanted = std::clamp(u(i), -limit, limit);
+    if ((momentum(i) >= H && wanted > 0.0) || (momentum(i) <= -H && wanted < 0.0)) wanted = 0.0;
+    if (wanted != u(i) && cut) *cut = true;
+    u(i) = wanted;
+  }
+  return u;
+}
+
+Vector3 arrayReaction(const WheelArray& array, const Eigen::VectorXd& torque, const Vector3& rate,
+                      const Eigen::VectorXd& momentum) {
+  return -array.axes * torque - rate.cross(array.axes * momentum);
+}
+
+WheelBodyState predictWheelState(const Matrix3& inertia, const WheelArray& array,
+                                 const WheelBodyState& state, const Eigen::VectorXd& torque,
+                                 double dt) {
+  if (!(dt > 0.0)) return state;
+  const WheelReplay step =
+      replayWithWheels(inertia, array.axes, state.body.attitude, state.body.angular_velocity,
+                       state.momentum, dt, {torque, torque}, Vector3::Zero(), kWheelFlightSubsteps);
+  return {{step.attitude.back(), step.angular_velocity.back()}, step.momentum.back()};
+}
+
+WheelPlant::WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels,
+                       const RigidBodyState& start, double max_step)
+    : inertia_(inertia),
+      wheels_(wheels),
+      array_(wheelArray(wheels)),
+      max_step_(max_step),
+      delivered_(Eigen::VectorXd::Zero(wheels.count())) {
+  if (!(std::isfinite(max_step) && max_step > 0.0)) {
+    throw InvalidInput("max_step: must be a finite time > 0 s, got " + exactNumber(max_step));
+  }
+  state_.body = start;
+  state_.momentum.resize(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) state_.momentum(i) = wheels.initialMomentum(i);
+}
+
+const Eigen::VectorXd& WheelPlant::command(const Eigen::VectorXd& torque) {
+  if (torque.size() != wheels_.count()) {
+    throw InvalidInput("wheel command: needs one torque per wheel (" +
+                       std::to_string(wheels_.count()) + "), got " + std::to_string(torque.size()));
+  }
+  for (int i = 0; i < wheels_.count(); ++i) {
+    delivered_(i) = std::clamp(torque(i), -wheels_.torqueLimit(i), wheels_.torqueLimit(i));
+  }
+  return delivered_;
+}
+
+void WheelPlant::advanceTo(double t) {
+  if (!(t > time_)) return;
+  // Equal steps of at most max_step, the held torques at every RK4 stage.
+  const int steps = std::max(1, static_cast<int>(std::ceil((t - time_) / max_step_)));
+  const WheelReplay replay = replayWithWheels(
+      inertia_, array_.axes, state_.body.attitude, state_.body.angular_velocity, state_.momentum,
+      t - time_, {delivered_, delivered_}, Vector3::Zero(), steps);
+  state_ = {{replay.attitude.back(), replay.angular_velocity.back()}, replay.momentum.back()};
+  time_ = t;
+}
+
+}  // namespace attitude_planner

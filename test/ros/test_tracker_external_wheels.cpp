@@ -1,0 +1,155 @@
+// rostest (tracker_external_wheels.test): the tracker's external plant mode with reaction wheels.
+// The plan of test/ros/wheel_pyramid_spin.yaml flown by the tracking law through the wheels on
+// the tracker's own body (/internal_wheels) and on the measured state of attitude_plant_node over
+// ROS topics (/external_wheels: odometry and the wheels' spin rates in, wheel torques out): the
+// external loop lands within 2x the internal one's terminal attitude error, every command within
+// the wheels' torque limits, named wheel_1..4; without spin inertias (/nospin) the external mode
+// is refused by name; without a plant (/unmeasured_wheels) every wheel command is zero and `done`
+// fails: nothing blocks.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <sensor_msgs/JointState.h>
+
+#include <algorithm>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "attitude_planner/ReplayResult.h"
+#include "ros_test_helpers.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+/// Counts the JointStates on `topic`: messages, the names seen, the largest |effort|, and
+/// whether every message carried one velocity per name.
+struct JointCounter {
+  JointCounter(ros::NodeHandle& nh, const std::string& topic)
+      : sub(nh.subscribe(topic, 1000, &JointCounter::onJoints, this)) {}
+  void onJoints(const sensor_msgs::JointState::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++count;
+    names.insert(m->name.begin(), m->name.end());
+    for (double e : m->effort) largest_effort = std::max(largest_effort, std::abs(e));
+    if (m->velocity.size() != m->name.size()) velocity_per_name = false;
+  }
+  std::mutex mutex;
+  int count = 0;
+  std::set<std::string> names;
+  double largest_effort = 0.0;
+  bool velocity_per_name = true;
+  ros::Subscriber sub;
+};
+
+/// The topics every test reads, subscribed in main before any run starts (the runs go on while
+/// the tests before one wait).
+struct Counters {
+  ros::NodeHandle external{"external_wheels"}, unmeasured{"unmeasured_wheels"};
+  JointCounter commands{external, "wheel_command"}, measured{external, "wheel_measurement"};
+  JointCounter unmeasured_commands{unmeasured, "wheel_command"};
+};
+Counters* counters = nullptr;
+
+}  // namespace
+
+TEST(TrackerExternalWheels, MeasuredWheelLoopLandsWithinTwiceTheInternalError) {
+  ros::NodeHandle internal_nh("internal_wheels"), external_nh("external_wheels");
+  JointCounter& commands = counters->commands;
+  JointCounter& measured = counters->measured;
+  ros_testing::DoneListener internal_done(internal_nh), external_done(external_nh);
+  const ReplayResult::ConstPtr internal = internal_done.wait(120.0);
+  const ReplayResult::ConstPtr external = external_done.wait(30.0);
+  ASSERT_TRUE(internal && external) << "no done from both trackers";
+  ASSERT_TRUE(internal->success) << internal->message;
+  ASSERT_TRUE(external->success) << external->message;
+  EXPECT_EQ(external->mode, "feedback");
+  EXPECT_NE(external->message.find("through 4 reaction wheels on the measured state"),
+            std::string::npos)
+      << external->message;
+  std::printf(
+      "wheels, terminal attitude error: internal %.3g rad, external %.3g rad (ratio %.3g); rate "
+      "error: internal %.3g, external %.3g rad/s; effort: internal %.5g, external %.5g\n",
+      internal->terminal_attitude_error, external->terminal_attitude_error,
+      external->terminal_attitude_error / internal->terminal_attitude_error,
+      internal->terminal_velocity_error, external->terminal_velocity_error, internal->effort,
+      external->effort);
+  EXPECT_LE(external->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
+  EXPECT_LT(external->terminal_attitude_error, 1e-2);
+  ASSERT_EQ(external->reaction_wheels.wheels.size(), 4u);
+  for (const WheelPeak& w : external->reaction_wheels.wheels) {
+    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
+    EXPECT_GT(w.peak_momentum, 0.0) << w.name;
+  }
+  ASSERT_FALSE(external->constraint_names.empty());
+  EXPECT_EQ(external->constraint_names.back(), "reaction_wheels");
+  std::lock_guard<std::mutex> c(commands.mutex), m(measured.mutex);
+  const std::set<std::string> wheels{"wheel_1", "wheel_2", "wheel_3", "wheel_4"};
+  EXPECT_EQ(commands.names, wheels);
+  EXPECT_GT(commands.count, 200) << "one command per sample (20 s at 12.5 samples per s)";
+  EXPECT_LE(commands.largest_effort, ros_testing::kWheelTorqueLimit * (1 + 1e-12));
+  EXPECT_GT(commands.largest_effort, 0.0);
+  EXPECT_EQ(measured.names, wheels);
+  EXPECT_GT(measured.count, 200) << "the plant measures at its rate";
+  EXPECT_TRUE(measured.velocity_per_name) << "a spin rate per wheel";
+}
+
+TEST(TrackerExternalWheels, ReplayModeCommandsThePlansWheelTorquesOpenLoop) {
+  ros::NodeHandle nh("external_replay");
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(90.0);
+  ASSERT_TRUE(done) << "no done from /external_replay";
+  ASSERT_TRUE(done->success) << done->message;
+  EXPECT_EQ(done->mode, "replay");
+  EXPECT_NE(done->message.find("commanded 128 steps through 4 reaction wheels"), std::string::npos)
+      << done->message;
+  std::printf("wheels, open loop on the plant: terminal attitude error %.3g rad\n",
+              done->terminal_attitude_error);
+  // Open loop, the plant's continuous body against the plan's discrete one: no feedback removes
+  // the gap. Each sample commands the mean of the plan's u over its hold (measured 2.6e-4, 5.2e-5
+  // rad); commanding u(t) at the sample and holding it lagged half a sample (1.65e-2 rad).
+  EXPECT_LT(done->terminal_attitude_error, 2e-3);
+  ASSERT_EQ(done->reaction_wheels.wheels.size(), 4u);
+  for (const WheelPeak& w : done->reaction_wheels.wheels) {
+    EXPECT_GE(w.torque_margin, -1e-9 * w.max_torque) << w.name << ": the plan's u meets U";
+  }
+}
+
+TEST(TrackerExternalWheels, WithoutSpinInertiasTheExternalModeIsRefusedByName) {
+  ros::NodeHandle nh("nospin");
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(60.0);
+  ASSERT_TRUE(done) << "no done from /nospin";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("maneuver.reaction_wheels.spin_inertia"), std::string::npos)
+      << done->message;
+}
+
+TEST(TrackerExternalWheels, WithoutMeasurementsEveryWheelCommandIsZeroAndDoneFails) {
+  ros::NodeHandle nh("unmeasured_wheels");
+  JointCounter& commands = counters->unmeasured_commands;
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(90.0);
+  ASSERT_TRUE(done) << "no done from /unmeasured_wheels";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("had no fresh measurement and got a zero command"),
+            std::string::npos)
+      << done->message;
+  EXPECT_NE(done->message.find("/unmeasured_wheels/odometry"), std::string::npos) << done->message;
+  std::lock_guard<std::mutex> lock(commands.mutex);
+  EXPECT_GT(commands.count, 200) << "the stream keeps its rate without measurements";
+  EXPECT_EQ(commands.largest_effort, 0.0);
+  EXPECT_EQ(commands.names, (std::set<std::string>{"wheel_1", "wheel_2", "wheel_3", "wheel_4"}));
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_external_wheels");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  Counters subscribed;
+  counters = &subscribed;
+  return RUN_ALL_TESTS();
+}

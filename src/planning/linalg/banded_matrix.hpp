@@ -126,7 +126,7 @@ namespace attitude_planner {
 class BandedLinearSystem {
  public:
   /// An n × n zero matrix. `interruption` (optional) is polled every kColumnsBetweenPolls rows
-  /// while its storage is zeroed: at N = 1e5 the augmented Newton system is ~160 MB, whose first
+  /// while its storage is zeroed: at N = 1e5 the augmented Newton system is ~200 MB, whose first
   /// touch (page faults) took 0.1-0.3 s of a cancelled solve's hand-over.
   BandedLinearSystem(int n, int bandwidth, const Interruption* interruption = nullptr);
   int size() const { return n_; }

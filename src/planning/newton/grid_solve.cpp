@@ -91,7 +91,7 @@ void addStencil(const ReducedProblem& np, const AugmentedLayout& at, double alph
 bool solveAugmented(const ReducedProblem& np, double relative_shift, int bandwidth,
                     const Interruption& interruption, Eigen::VectorXd* delta,
                     std::unique_ptr<BandedLinearSystem>* workspace) {
-  // Allocated and zeroed with polls (~160 MB at N = 1e5): a stop is not held up by it.
+  // Allocated and zeroed with polls (~200 MB at N = 1e5): a stop is not held up by it.
   const AugmentedLayout at{np.firstFreeNode(), np.lastFreeNode()};
   const int n = at.size();
   if (*workspace) {

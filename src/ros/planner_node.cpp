@@ -415,6 +415,12 @@ void PlannerNode::onGoalDeadline(const ActiveGoal& goal) {
   answers_.record(late.error_code.val, (ros::WallTime::now() - goal.accepted).toSec());
 }
 
+int largestPlannedSteps(const PlanAttitudeManeuverGoal& goal,
+                        const ros_conversions::PlannerDefaults& defaults) {
+  if (!goal.accuracy_measure.empty()) return defaults.max_steps;  // the planner chooses N
+  return goal.steps > 0 ? std::min(goal.steps, defaults.max_steps) : defaults.steps;
+}
+
 void PlannerNode::onGoal(GoalHandle goal) {
   const std::string id = goal.getGoalID().id;
   ActiveGoal active{goal, std::make_shared<std::atomic<bool>>(false),
@@ -441,6 +447,7 @@ void PlannerNode::onGoal(GoalHandle goal) {
   // workers still stopping cancelled N = 1e5 solves is answered by its budget all the same.
   active.accepted = ros::WallTime::now();
   active.budget = ros_conversions::effectiveTimeBudget(goal.getGoal()->time_budget, defaults_);
+  active.cancel_grace = cancelGrace(largestPlannedSteps(*goal.getGoal(), defaults_));
   active.deadline = std::make_shared<DeadlineWatch>(
       answerDeadline(active.budget),
       [this, watched = ActiveGoal{active.handle, active.cancel, active.ended_at, nullptr,
@@ -472,12 +479,14 @@ void PlannerNode::onCancel(GoalHandle goal) {
   auto it = active_.find(goal.getGoalID().id);
   if (it == active_.end()) return;  // ended already, or not yet accepted (its worker ends it)
   it->second.cancel->store(true);   // this goal only: the solver stops
-  // A solver that hands its plan over within kCancelGrace has its worker end the goal, with the
-  // plan it had reached (serveGoal: filling and sending an N = 1e5 plan takes longer than the
-  // grace, and is no solve to wait for); the wait holds no lock (goal_ended_ is notified under
-  // goals_mutex_). (A goal still queued behind busy workers ends after the grace, without a plan.)
+  // A solver that hands its plan over within the goal's grace (cancelGrace of its N) has its
+  // worker end the goal, with the plan it had reached (serveGoal: the plan's fill and transfer
+  // follow the hand-over, and are no solve to wait for); the wait holds no lock (goal_ended_ is
+  // notified under goals_mutex_). (A goal still queued behind busy workers ends after the grace,
+  // without a plan.)
   const std::shared_ptr<std::atomic<bool>> handed_over = it->second.handed_over;
-  goal_ended_.wait_for(goals, std::chrono::duration<double>(kCancelGrace), [&] {
+  const double grace = it->second.cancel_grace;
+  goal_ended_.wait_for(goals, std::chrono::duration<double>(grace), [&] {
     return goalEnded(goal.getGoalStatus().status) || handed_over->load();
   });
   if (handed_over->load()) return;  // its worker ends it, PREEMPTED with the plan
@@ -492,7 +501,7 @@ void PlannerNode::onCancel(GoalHandle goal) {
   result.error_code.val = PlanErrorCode::CANCELLED;
   result.message =
       "cancelled by its client (the solve was stopped; it had not returned its plan within " +
-      exactNumber(kCancelGrace) + " s, so no plan is returned)";
+      exactNumber(grace) + " s, so no plan is returned)";
   double waited = 0.0;
   if (it != active_.end()) {
     // Its slot is free before the result goes out: a goal sent on receiving it is accepted

@@ -9,7 +9,10 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <initializer_list>
+#include <regex>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -177,4 +180,41 @@ TEST(NodeParameters, SimTimeThroughARemapAndOneWarningWhileClockIsSilent) {
   EXPECT_NE(first, std::string::npos) << run.output;
   EXPECT_EQ(run.output.find(warning, first + 1), std::string::npos) << "warned twice:\n"
                                                                     << run.output;
+}
+
+TEST(NodeParameters, RosArgsListsEveryLaunchArgAndSaysWhichListedAsRequiredAreOptional) {
+  // `roslaunch --ros-args` lists every arg of each shipped launch file; an arg whose default is
+  // empty it lists under "Required Arguments" (roslaunch's arg_dump reads "" as no default), so
+  // the doc of each such arg says whether it is optional, required, or derived.
+  NodeRun found = runNode("rospack find attitude_planner", 60);
+  ASSERT_EQ(found.status, 0) << found.output;
+  const std::string package = found.output.substr(0, found.output.find('\n'));
+  for (const std::string name : {"planner", "tracker", "plant", "demo", "replay"}) {
+    const NodeRun run = runNode("roslaunch --ros-args attitude_planner " + name + ".launch", 120);
+    ASSERT_EQ(run.status, 0) << name << ":\n" << run.output;
+    std::ifstream file(package + "/launch/" + name + ".launch");
+    std::stringstream text;
+    text << file.rdbuf();
+    const std::string launch = text.str();
+    // Declared args (a default or a doc); an include's <arg name= value=> only passes one on.
+    const std::regex arg_name("<arg name=\"([a-z_]+)\"[^>]*(default|doc)=");
+    int args = 0;
+    for (auto it = std::sregex_iterator(launch.begin(), launch.end(), arg_name);
+         it != std::sregex_iterator(); ++it, ++args) {
+      EXPECT_TRUE(contains(run.output, "  " + (*it)[1].str())) << name << ": " << (*it)[1];
+    }
+    EXPECT_GT(args, 0) << name;
+    const std::size_t required = run.output.find("Required Arguments:");
+    if (required == std::string::npos) continue;
+    std::istringstream lines(
+        run.output.substr(required, run.output.find("Optional Arguments:") - required));
+    std::string line;
+    std::getline(lines, line);  // the heading
+    while (std::getline(lines, line)) {
+      if (line.empty()) continue;
+      EXPECT_TRUE(contains(line, "optional") || contains(line, "(required)") ||
+                  contains(line, "(derived)"))
+          << name << ".launch lists an arg as required without saying which it is: " << line;
+    }
+  }
 }

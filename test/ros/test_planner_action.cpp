@@ -199,6 +199,28 @@ TEST_F(PlannerAction, CancelledGoalCarriesThePlanReached) {
   ros_testing::expectSeedAnytimePlan(*result, N, goal.tolerance);
 }
 
+TEST_F(PlannerAction, CancelledLargeGoalCarriesThePlanReached) {
+  // N = 1e5, cancelled once its iterations run on a fine level of the grid continuation: the
+  // stopped solve carries its iterate to the requested grid, builds the 100,001 rows and measures
+  // their residuals, which takes longer than a fixed 30 ms; the cancel waits for it
+  // (cancelGrace of the goal's N), and the result carries that plan (before: none at N = 1e5).
+  const int N = 100000;
+  PlanAttitudeManeuverGoal goal = unreachableTolerance(N);
+  goal.time_budget = 600.0;
+  auto finest = std::make_shared<std::atomic<int>>(0);  // outlives late callbacks
+  client_->sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [finest](const PlanAttitudeManeuverFeedbackConstPtr& f) {
+                      *finest = std::max(finest->load(), static_cast<int>(f->steps));
+                    });
+  ASSERT_TRUE(waitFor([&] { return *finest >= 1000; }, 120.0)) << "no feedback on a fine level";
+  client_->cancelGoal();
+  ASSERT_TRUE(client_->waitForResult(ros::Duration(60.0)));
+  EXPECT_EQ(client_->getState(), State::PREEMPTED);
+  const auto result = client_->getResult();
+  EXPECT_EQ(result->error_code.val, PlanErrorCode::CANCELLED) << result->message;
+  ros_testing::expectSeedAnytimePlan(*result, N, goal.tolerance);
+}
+
 TEST_F(PlannerAction, InvalidGoalIsAbortedWithTheField) {
   PlanAttitudeManeuverGoal goal = seed();
   goal.initial_attitude = geometry_msgs::Quaternion();

@@ -1026,6 +1026,31 @@ TEST(Deadline, TheAnswerLeavesTheStoppedSolveTimeWithinTheContract) {
   }
 }
 
+TEST(Deadline, ACancelWaitsForTheHandOverOfTheLargestGridTheGoalMayBePlannedOn) {
+  // The wait grows with the goal's N (the hand-over is a few passes over the grid) and is
+  // kCancelGrace at no steps; the N is the goal's, its default, or ~max_steps when the planner
+  // chooses it (an accuracy target).
+  ros_conversions::PlannerDefaults defaults;
+  defaults.steps = 128;
+  defaults.max_steps = 100000;
+  PlanAttitudeManeuverGoal goal;
+  EXPECT_EQ(largestPlannedSteps(goal, defaults), 128);
+  goal.steps = 4096;
+  EXPECT_EQ(largestPlannedSteps(goal, defaults), 4096);
+  goal.steps = 200000;  // refused by the planner; the wait is still bounded by ~max_steps
+  EXPECT_EQ(largestPlannedSteps(goal, defaults), 100000);
+  goal.steps = 64;
+  goal.accuracy_measure = "terminal_miss";
+  EXPECT_EQ(largestPlannedSteps(goal, defaults), 100000);
+  EXPECT_EQ(cancelGrace(0), kCancelGrace);
+  double previous = cancelGrace(0);
+  for (int steps : {4, 128, 4096, 100000}) {
+    EXPECT_GT(cancelGrace(steps), previous) << steps;
+    previous = cancelGrace(steps);
+  }
+  EXPECT_NEAR(cancelGrace(100000) - cancelGrace(50000), 50000 * kHandoverPerNode, 1e-15);
+}
+
 TEST(AnytimePlan, AStoppedSolveFillsTheResponseWithItsPlanFlaggedUnconverged) {
   // The adapter carries the core's stopped plan: cancelled at the second iteration (no master
   // needed), the response has the plan's N + 1 rows, unconverged_plan and its residuals; a

@@ -2,7 +2,9 @@
 // planned for; actuator noise, not) driven open loop (/replay) and with the tracking law
 // (/feedback), two trackers side by side in their own namespaces (tracker_feedback.test). The
 // closed loop's terminal errors are an order of magnitude below the open loop's. Each tracker
-// publishes its own body transform (replay/body, feedback/body: the namespace's default).
+// publishes its own body transform (replay/body, feedback/body: the namespace's default) and holds
+// the final attitude there after its run; two more given one body frame (twin) both report the
+// other and fail their runs.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -38,9 +40,22 @@ TEST(TrackerFeedback, ClosedLoopTerminalErrorsAreAnOrderOfMagnitudeBelowOpenLoop
         for (const auto& t : event.getMessage()->transforms)
           publishers_of[t.child_frame_id].insert(event.getPublisherName());
       }));
+  // After its run a tracker holds the final attitude on /tf (every 0.1 s): transforms of
+  // feedback/body counted from its done on.
+  std::atomic<bool> feedback_ended{false};
+  std::atomic<int> held_after_done{0};
+  ros::Subscriber held_sub = feedback_nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 1000, [&](const tf2_msgs::TFMessage::ConstPtr& m) {
+        for (const auto& t : m->transforms) {
+          if (t.child_frame_id == "feedback/body" && feedback_ended) ++held_after_done;
+        }
+      });
+  ros::NodeHandle twin_a_nh("twin_a"), twin_b_nh("twin_b");
+  ros_testing::DoneListener twin_a_done(twin_a_nh), twin_b_done(twin_b_nh);
   ros_testing::DoneListener replay_done(replay_nh), feedback_done(feedback_nh);
   const ReplayResult::ConstPtr open_loop = replay_done.wait(120.0);
   const ReplayResult::ConstPtr closed_loop = feedback_done.wait(120.0);
+  feedback_ended = true;
   ASSERT_TRUE(open_loop && closed_loop) << "no done from both trackers";
   ASSERT_TRUE(open_loop->success) << open_loop->message;
   ASSERT_TRUE(closed_loop->success) << closed_loop->message;
@@ -68,10 +83,22 @@ TEST(TrackerFeedback, ClosedLoopTerminalErrorsAreAnOrderOfMagnitudeBelowOpenLoop
   EXPECT_GE(samples, 0.8 * expected);
   EXPECT_LE(samples, 1.2 * expected + 2);
   EXPECT_EQ(error_samples, samples);
+  // Two trackers on one body frame: both runs fail, each naming the other node and the frame.
+  for (ros_testing::DoneListener* twin : {&twin_a_done, &twin_b_done}) {
+    const ReplayResult::ConstPtr done = twin->wait(120.0);
+    ASSERT_TRUE(done) << "no done from a twin";
+    EXPECT_FALSE(done->success) << done->message;
+    EXPECT_NE(done->message.find("also publishes the transform world -> twin"), std::string::npos)
+        << done->message;
+  }
+  ros::WallDuration(0.5).sleep();
+  EXPECT_GE(held_after_done, 2) << "the final attitude is not held on /tf after the run";
   std::lock_guard<std::mutex> lock(tf_mutex);
   EXPECT_EQ(publishers_of.count("replay/body"), 1u);
   EXPECT_EQ(publishers_of.count("feedback/body"), 1u);
+  EXPECT_EQ(publishers_of["twin"].size(), 2u);
   for (const auto& [frame, publishers] : publishers_of) {
+    if (frame == "twin") continue;
     EXPECT_EQ(publishers.size(), 1u) << publishers.size() << " nodes publish " << frame;
   }
 }

@@ -207,6 +207,33 @@ TEST(TrackerTakeover, NewManeuverIsFlownFromTheBodyOrRefused) {
   expectNoJump(&takeover);
 }
 
+TEST(TrackerTakeover, StartUpPlanOfAHungPlannerFailsAfterPlannerTimeout) {
+  // /hung_startup plans its ~scene at start-up through the hung planner's service: the call is
+  // abandoned after ~planner_timeout (5 s) and `done` fails naming the service, instead of the
+  // tracker waiting for ever.
+  ros::NodeHandle nh("hung_startup");
+  std::mutex mutex;
+  ReplayResult::ConstPtr done;
+  ros::Subscriber sub = nh.subscribe<ReplayResult>("done", 1, [&](const ReplayResult::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    done = m;
+  });
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+  while (ros::WallTime::now() < deadline) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (done) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_TRUE(done) << "no done from the tracker whose start-up plan call hangs";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("/hung/plan_attitude_maneuver did not answer within 5 s"),
+            std::string::npos)
+      << done->message;
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_tracker_takeover");

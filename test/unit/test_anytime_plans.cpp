@@ -148,3 +148,40 @@ TEST(AnytimePlan, OnlyAStoppedPlanIsHandedOverWithoutItsReplay) {
   EXPECT_TRUE(not_converged.replay_measured);
   EXPECT_TRUE(std::isfinite(not_converged.replay_miss));
 }
+
+TEST(AnytimePlan, ARefinementStoppedOnACoarseLevelHandsOverItsOwnIterate) {
+  // The class survey ranks the classes on N = 16; the kept class is refined through 64, 256,
+  // 1024 to 4096. Stopped inside a coarse level of that refinement (by its cancel or its budget),
+  // the refinement's iterate is carried to the requested grid and is the plan: no other attempt
+  // runs after the stop (before, the stopped refinement ended with no plan and the request's
+  // class was carried through every level again, a second pass over the requested grid).
+  const int N = 4096;
+  const PlanningProblem p = sceneProblem("rest_to_rest.yaml", N);
+  for (const double budget : {0.0, 0.2}) {
+    SolverOptions options;
+    options.tolerance = 1e-300;  // never met: only the stop ends the solve
+    options.max_iterations = 100000;
+    options.on_iteration = [budget](const IterationInfo& info) {
+      const bool coarse_refinement =
+          info.attempt.stage == AttemptStage::ClassRefine && info.steps > 16 && info.steps < N;
+      if (!coarse_refinement) return true;
+      if (budget <= 0.0) return false;  // cancelled by its caller
+      std::this_thread::sleep_for(std::chrono::duration<double>(budget));
+      return true;  // the budget is spent: the solve ends TimedOut at its next poll
+    };
+    options.time_budget_s = budget;
+    const PlanResult r = planManeuver(p, options);
+    EXPECT_EQ(r.termination, budget > 0.0 ? Termination::TimedOut : Termination::Cancelled)
+        << r.message;
+    expectAnytimePlan(p, r, 1e-10);
+    ASSERT_FALSE(r.attempts.empty());
+    const Attempt& last = r.attempts.back();
+    EXPECT_EQ(last.stage, AttemptStage::ClassRefine) << r.message;
+    EXPECT_TRUE(last.kept) << r.message;
+    EXPECT_EQ(last.termination, r.termination);
+    for (const Attempt& a : r.attempts) {
+      EXPECT_NE(a.stage, AttemptStage::Solve)
+          << "a second attempt ran after the stop: " << r.message;
+    }
+  }
+}

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/planner.hpp"
@@ -472,4 +473,43 @@ TEST(ReducedProblem, StepsOfATorqueFreeMotionToItsOwnEndAreKeptExactly) {
     EXPECT_LE(so3::angleBetween(R.back(), p.final_attitude), 1e-12) << schemeName(scheme);
     EXPECT_THROW(rp.initializeFromSteps(ReducedProblem::StepVectors(3)), InvalidInput);
   }
+}
+
+namespace {
+/// Stops (throws) at its `stop_at`-th poll; counts the polls.
+class StopAtPoll : public Interruption {
+ public:
+  explicit StopAtPoll(int stop_at) : stop_at_(stop_at) {}
+  void poll() const override {
+    if (++polls_ >= stop_at_) throw std::runtime_error("stopped");
+  }
+  int polls() const { return polls_; }
+
+ private:
+  int stop_at_;
+  mutable int polls_ = 0;
+};
+}  // namespace
+
+TEST(BandedLinearSystem, StorageIsZeroedInPolledChunksSoAStopIsNotHeldUpByIt) {
+  // Allocating and zeroing the augmented Newton system (~160 MB at N = 1e5) polls the stop
+  // every kColumnsBetweenPolls rows: a stop raised meanwhile ends it there.
+  const int size = 10 * kColumnsBetweenPolls + 7, p = 3;
+  const StopAtPoll never(1 << 30);
+  BandedLinearSystem A(size, p, &never);
+  EXPECT_EQ(never.polls(), 11);  // one poll per chunk of rows, the last chunk partial
+  for (int i = 0; i < size; i += 97) {
+    for (int j = std::max(0, i - p); j <= std::min(size - 1, i + p); ++j) EXPECT_EQ(A(i, j), 0.0);
+  }
+  for (int i = 0; i < size; ++i) A.add(i, i, 1.0 + i);
+  const StopAtPoll never_again(1 << 30);
+  A.setZero(&never_again);
+  EXPECT_EQ(never_again.polls(), 11);
+  for (int i = 0; i < size; ++i) ASSERT_EQ(A(i, i), 0.0) << i;
+  const StopAtPoll third(3);
+  EXPECT_THROW(BandedLinearSystem(size, p, &third), std::runtime_error);
+  EXPECT_EQ(third.polls(), 3);
+  const StopAtPoll fifth(5);
+  EXPECT_THROW(A.setZero(&fifth), std::runtime_error);
+  EXPECT_EQ(fifth.polls(), 5);
 }

@@ -38,7 +38,7 @@
 // A request's time_budget is a deadline: a solve whose wall time exceeded it answers TIMED_OUT,
 // never SUCCESS. A solve stopped by its budget or its cancel answers with the plan it had reached
 // (unconverged_plan true: the dynamics and boundary data hold, optimality does not) when it hands
-// it over in time (answerDeadline, kCancelGrace).
+// it over in time (answerDeadline, cancelGrace).
 #pragma once
 
 #include <algorithm>
@@ -157,11 +157,27 @@ inline double answerDeadline(double budget) {
 }
 
 /// An action goal cancelled while a worker solves it ends when the worker has stopped, with the
-/// plan the solve had reached, if the solve returns it within kCancelGrace [s]; else the cancel
+/// plan the solve had reached, if the solve returns it within cancelGrace(N) [s]; else the cancel
 /// ends it then, without a plan (the worker's result is dropped). A cancel is answered within
-/// kCancelGrace plus the plan's fill and transfer (about 0.1 s for the 8.8 MB of N = 1e5 plan,
-/// docs/ros_planner.md) plus transport.
-inline constexpr double kCancelGrace = 0.03;
+/// that wait plus the plan's fill and transfer (30-90 ms for the 8.8 MB of an N = 1e5 plan)
+/// plus transport.
+///
+/// The wait grows with N because the hand-over does: a stopped solve carries its iterate to the
+/// requested grid, builds its N + 1 rows and measures its residuals (one gradient and the step
+/// residual), each a pass over the grid. Measured in-process (studies/cancel_handover_study.cpp,
+/// docs/ros_planner.md "Handing a cancelled N = 1e5 plan over"): 1.1-2.3 us per node at N = 1e5
+/// on the 2 shared cores under a load of 8.5. kHandoverPerNode allows about twice the worst of
+/// those: 0.53 s at N = 1e5, 31 ms at N = 128 (where kCancelGrace, the scheduling of the worker
+/// thread, dominates).
+inline constexpr double kCancelGrace = 0.03;      ///< [s]
+inline constexpr double kHandoverPerNode = 5e-6;  ///< [s] per node of the requested grid
+inline double cancelGrace(int steps) {
+  return kCancelGrace + kHandoverPerNode * steps;
+}
+/// The largest N a goal may be planned at: its steps (0: ~default_steps), or ~max_steps when an
+/// accuracy target lets the planner choose N.
+int largestPlannedSteps(const PlanAttitudeManeuverGoal& goal,
+                        const ros_conversions::PlannerDefaults& defaults);
 
 /// Whether a result's plan is an unconverged iterate (the response's unconverged_plan): the solver
 /// ran, returned a maneuver, and did not converge.
@@ -224,8 +240,10 @@ class PlannerNode {
     double budget = 0.0;     ///< its effective time budget [s] (0 = none)
     /// Set (under goals_mutex_, goal_ended_ notified) when its solve has returned: from then on
     /// the worker ends the goal with the plan whatever a cancel says, so a cancel waits
-    /// kCancelGrace for the core's hand-over, not for the plan's fill and transfer.
+    /// cancel_grace for the core's hand-over, not for the plan's fill and transfer.
     std::shared_ptr<std::atomic<bool>> handed_over = std::make_shared<std::atomic<bool>>(false);
+    /// How long its cancel waits for the stopped solve's plan [s]: cancelGrace of its N.
+    double cancel_grace = kCancelGrace;
   };
   /// The deadline of an accepted goal passed: tells its solve to stop and ends it ABORTED with
   /// TIMED_OUT (unless it has ended); frees its slot if no worker has taken it.
@@ -250,7 +268,7 @@ class PlannerNode {
   /// New goal: accepted and queued for a worker, or REJECTED when every worker is busy.
   void onGoal(GoalHandle goal);
   /// Cancel of one goal (only that goal's flag is set): ended by its worker with the plan the
-  /// solve had reached if that comes within kCancelGrace, else here without a plan.
+  /// solve had reached if that comes within the goal's cancel_grace, else here without a plan.
   void onCancel(GoalHandle goal);
   /// Worker thread: takes accepted goals until shutdown.
   void workerLoop();
@@ -272,7 +290,7 @@ class PlannerNode {
   std::mutex goals_mutex_;  ///< guards the four members below
   std::condition_variable goal_ready_;
   /// Notified (under goals_mutex_) when a worker has ended a goal: a cancel waits on it for the
-  /// stopped solve's plan (kCancelGrace).
+  /// stopped solve's plan (ActiveGoal::cancel_grace).
   std::condition_variable goal_ended_;
   std::deque<ActiveGoal> queued_;             ///< accepted, not yet on a worker
   std::map<std::string, ActiveGoal> active_;  ///< accepted and not ended, by goal id

@@ -160,8 +160,25 @@ template class BandedCholeskyFactor<DoubleDouble>;
 
 namespace attitude_planner {
 
-BandedLinearSystem::BandedLinearSystem(int n, int bandwidth)
-    : n_(n), p_(bandwidth), data_(static_cast<size_t>(n) * (3 * bandwidth + 1), 0.0) {}
+BandedLinearSystem::BandedLinearSystem(int n, int bandwidth, const Interruption* interruption)
+    : n_(n), p_(bandwidth) {
+  const size_t rows_per_poll = kColumnsBetweenPolls * (3 * static_cast<size_t>(bandwidth) + 1);
+  const size_t total = static_cast<size_t>(n) * (3 * bandwidth + 1);
+  data_.reserve(total);  // address space only: the pages are touched below, chunk by chunk
+  while (data_.size() < total) {
+    if (interruption) interruption->poll();
+    data_.resize(std::min(total, data_.size() + rows_per_poll), 0.0);
+  }
+}
+
+void BandedLinearSystem::setZero(const Interruption* interruption) {
+  const size_t rows_per_poll = kColumnsBetweenPolls * (3 * static_cast<size_t>(p_) + 1);
+  for (size_t begin = 0; begin < data_.size(); begin += rows_per_poll) {
+    if (interruption) interruption->poll();
+    std::fill(data_.begin() + begin, data_.begin() + std::min(data_.size(), begin + rows_per_poll),
+              0.0);
+  }
+}
 
 double BandedLinearSystem::operator()(int i, int j) const {
   const int offset = j - i + p_;

@@ -39,7 +39,8 @@ struct GridLevelRule {
   bool infeasible_ends = false;
   /// A coarse level that does not converge ends the continuation there, with no plan on the
   /// requested grid (a refinement from a given iterate, where a fresh start would be another
-  /// attempt); otherwise the next level starts afresh.
+  /// attempt); otherwise the next level starts afresh. A level stopped by a cancel or the
+  /// deadline does not end it: its iterate is carried on.
   bool unconverged_ends = false;
 };
 
@@ -163,7 +164,13 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
       if (!result.levels.empty()) result.levels.back().termination = record.stop->termination;
     }
     summaries.insert(summaries.end(), result.levels.begin(), result.levels.end());
-    if (!finest && !record.stop && rule.unconverged_ends && !result.converged()) break;
+    // A level stopped inside its solve (cancel, deadline) is not an unconverged end: its
+    // iterate is carried on to the requested grid as after a stop between levels, so that a
+    // stopped refinement still hands over its plan (and no other attempt is run to get one).
+    const bool stopped_inside =
+        result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
+    if (!finest && !record.stop && rule.unconverged_ends && !result.converged() && !stopped_inside)
+      break;
   }
   result.iterations = tally.iterations();
   result.levels = std::move(summaries);

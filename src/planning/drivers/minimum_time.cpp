@@ -14,6 +14,7 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/drivers/pointing_minimum_time.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
@@ -389,8 +390,12 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   }
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
-  PlanResult result =
-      runInternalPhase("minimum time", [&] { return minimumTimePlan(problem, context, &pair); });
+  PlanResult result = runInternalPhase("minimum time", [&] {
+    if (!problem.end_condition.pointing()) return minimumTimePlan(problem, context, &pair);
+    return pointingMinimumTime(problem, context, [&](const PlanningProblem& posed) {
+      return minimumTimePlan(posed, context);
+    });
+  });
   recordLowerBound(bound, &result);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;

@@ -134,6 +134,8 @@ converge) measured 4.4x median on these requests with the same optima, but the f
 point keeps the way round it starts in, and on seeded test requests it ended in costlier classes
 (0.1059 against the swept 0.1031, 0.2916 against 0.2466) once identical starts were not repeated.
 
+Minimum time to a pointing target (Betts's body, T* against a swept twist): [pointing_minimum_time.md](pointing_minimum_time.md).
+
 ![cost against the twist](pointing.png)
 
 ## Requests

@@ -135,4 +135,21 @@ TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
   }
 }
 
+TEST(PointingMinimumTime, BacksABoundedPointingVerdictWithTheTwistFree) {
+  // Minimum effort under the same torque bounds below and above T* (the twist free): below, the
+  // verdict is infeasible with T* as the least duration found; above, never infeasible.
+  PlanningProblem p = test_support::randomBettsPointingRequest(4203, 32, SchemeKind::SecondOrder);
+  const PlanResult fastest = planManeuver(p);
+  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  const double T_star = fastest.minimum_duration;
+  p.objective = Objective::MinimumEffort;
+  p.duration = 0.97 * T_star;
+  const PlanResult below = planManeuver(p);
+  EXPECT_EQ(below.termination, Termination::Infeasible) << below.message;
+  EXPECT_NEAR(below.duration_verdict.least_duration_found, T_star, 1e-6 * T_star);
+  p.duration = 1.05 * T_star;
+  const PlanResult above = planManeuver(p);
+  EXPECT_NE(above.termination, Termination::Infeasible) << above.message;
+}
+
 }  // namespace

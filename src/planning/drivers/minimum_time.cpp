@@ -333,6 +333,16 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
   return probedBelow(problem, std::move(answer), context);
 }
 
+/// minimumTimePlan, from several start twists where the end condition is a pointing one (its
+/// R_N then posed at each: pointingMinimumTime).
+PlanResult minimumTimeOverTwists(const PlanningProblem& problem, SolveContext& context,
+                                 RichardsonPair* pair) {
+  if (!problem.end_condition.pointing()) return minimumTimePlan(problem, context, pair);
+  return pointingMinimumTime(problem, context, [&](const PlanningProblem& posed) {
+    return minimumTimePlan(posed, context);
+  });
+}
+
 /// minimumTimePlan of a discretization before the probe below T* (probedBelow).
 PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   const std::string unsupported = freeTimeUnsupported(problem);
@@ -390,12 +400,8 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   }
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
-  PlanResult result = runInternalPhase("minimum time", [&] {
-    if (!problem.end_condition.pointing()) return minimumTimePlan(problem, context, &pair);
-    return pointingMinimumTime(problem, context, [&](const PlanningProblem& posed) {
-      return minimumTimePlan(posed, context);
-    });
-  });
+  PlanResult result = runInternalPhase(
+      "minimum time", [&] { return minimumTimeOverTwists(problem, context, &pair); });
   recordLowerBound(bound, &result);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
@@ -637,7 +643,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   fastest.duration = 0.0;
   RichardsonPair pair;
   const PlanResult minimum_time = runInternalPhase(
-      "the minimum-time phase", [&] { return minimumTimePlan(fastest, context, &pair); });
+      "the minimum-time phase", [&] { return minimumTimeOverTwists(fastest, context, &pair); });
   const auto finish = [&](PlanResult r) {
     recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
@@ -664,6 +670,15 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
     result.message = localInfeasibility(problem.duration, T_star, tStarKind(minimum_time), bound) +
                      " (" + terminationName(Termination::Infeasible) + " at T: " + result.message +
                      ")";
+    return finish(result);
+  }
+  if (problem.end_condition.pointing()) {
+    // T* (the twist free) <= T: a plan exists at some twist, so no "infeasible"; the restart from
+    // the minimum-time plan would be a warm-started pointing solve, which planPointing does not
+    // serve yet.
+    if (result.termination == Termination::Infeasible)
+      result.termination = Termination::NotConverged;
+    addNote(&result, notes::PointingRestartNotServed{T_star});
     return finish(result);
   }
   return finish(runInternalPhase("the restart from the minimum-time plan", [&] {

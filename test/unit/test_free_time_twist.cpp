@@ -115,10 +115,13 @@ TEST(FreeTimeTwist, WithoutPointingNoEntries) {
 }
 
 TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
-  for (unsigned seed : {4201u, 4202u}) {
-    SCOPED_TRACE("seed " + std::to_string(seed));
-    const PlanningProblem p =
-        test_support::randomBettsPointingRequest(seed, 32, SchemeKind::SecondOrder);
+  // Every discretization: h and ψ both move R_{N−1} of paper and variational.
+  const std::pair<unsigned, SchemeKind> requests[] = {{4201u, SchemeKind::SecondOrder},
+                                                      {4202u, SchemeKind::Paper},
+                                                      {4204u, SchemeKind::Variational}};
+  for (const auto& [seed, scheme] : requests) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", " + schemeName(scheme));
+    const PlanningProblem p = test_support::randomBettsPointingRequest(seed, 32, scheme);
     const PlanResult r = planManeuver(p);
     ASSERT_TRUE(r.converged()) << r.message;
     ASSERT_TRUE(r.pointing.active);

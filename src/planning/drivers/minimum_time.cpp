@@ -333,13 +333,37 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
   return probedBelow(problem, std::move(answer), context);
 }
 
+/// One start twist of a pointing request (`posed`: R_N at the start twist): the fixed-attitude
+/// minimum time there (its starts, ways round and saddles), then one free-time solve with ψ free
+/// from its plan, a KKT point at or below it in its basin; where either does not converge, the
+/// recipe with ψ free from the posed start. (From the posed starts alone the ψ-free solves of all
+/// 4 start twists slid into one basin: measured on seed 4204, variational, N = 32, 20.9055 s
+/// against the swept and refined 20.8307 s.)
+PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
+  PlanningProblem fixed = posed;
+  fixed.end_condition = EndCondition();
+  const PlanResult at_twist = minimumTimePlan(fixed, context);
+  if (at_twist.converged() &&
+      at_twist.maneuver.attitude.size() == static_cast<std::size_t>(posed.steps) + 1) {
+    std::optional<PlanResult> freed =
+        freeTimeFromPlan(posed, at_twist.maneuver, at_twist.minimum_duration, context);
+    if (freed && freed->converged()) {
+      freed->attempts = joined(at_twist.attempts, freed->attempts);
+      return *freed;
+    }
+  }
+  PlanResult free_start = minimumTimePlan(posed, context);
+  free_start.attempts = joined(at_twist.attempts, free_start.attempts);
+  return free_start;
+}
+
 /// minimumTimePlan, from several start twists where the end condition is a pointing one (its
-/// R_N then posed at each: pointingMinimumTime).
+/// R_N then posed at each: pointingMinimumTime, each start fromFixedTwist).
 PlanResult minimumTimeOverTwists(const PlanningProblem& problem, SolveContext& context,
                                  RichardsonPair* pair) {
   if (!problem.end_condition.pointing()) return minimumTimePlan(problem, context, pair);
   return pointingMinimumTime(problem, context, [&](const PlanningProblem& posed) {
-    return minimumTimePlan(posed, context);
+    return fromFixedTwist(posed, context);
   });
 }
 

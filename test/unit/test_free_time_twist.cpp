@@ -134,6 +134,7 @@ TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
     EXPECT_NEAR(twistOf(r.maneuver.attitude.back(), p.end_condition), r.pointing.final_twist, 1e-9);
     EXPECT_EQ(r.pointing.starts, 4);
+    EXPECT_GE(r.minimum_time.solves, 8);  // per start: the fixed twist's, then ψ freed
     EXPECT_TRUE(std::isfinite(r.attempts.front().start_detail.twist));
   }
 }

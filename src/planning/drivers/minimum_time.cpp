@@ -349,11 +349,13 @@ PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
         freeTimeFromPlan(posed, at_twist.maneuver, at_twist.minimum_duration, context);
     if (freed && freed->converged()) {
       freed->attempts = joined(at_twist.attempts, freed->attempts);
+      freed->minimum_time.solves += at_twist.minimum_time.solves;
       return *freed;
     }
   }
   PlanResult free_start = minimumTimePlan(posed, context);
   free_start.attempts = joined(at_twist.attempts, free_start.attempts);
+  free_start.minimum_time.solves += at_twist.minimum_time.solves;
   return free_start;
 }
 

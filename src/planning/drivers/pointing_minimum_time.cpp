@@ -79,7 +79,9 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
   const int kept = leastDuration(starts);
   PlanResult result = starts[kept >= 0 ? kept : static_cast<int>(starts.size()) - 1].result;
   result.attempts.clear();
+  result.minimum_time.solves = 0;  // every start's free-time solves
   for (std::size_t i = 0; i < starts.size(); ++i) {
+    result.minimum_time.solves += starts[i].result.minimum_time.solves;
     for (Attempt a : starts[i].result.attempts) {
       a.kept = a.kept && static_cast<int>(i) == kept;
       result.attempts.push_back(a);

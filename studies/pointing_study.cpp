@@ -22,6 +22,7 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "support/bounded_requests.hpp"
 #include "support/pointing_requests.hpp"
 #include "support/study_tools.hpp"
 
@@ -38,26 +39,18 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--count")
-      o.count = std::stoi(value);
-    else if (flag == "--constrained")
-      o.constrained = std::stoi(value);
-    else if (flag == "--minimum-time")
-      o.minimum_time = std::stoi(value);
-    else if (flag == "--seed")
-      o.seed = static_cast<unsigned>(std::stoul(value));
-    else if (flag == "--steps")
-      o.steps = std::stoi(value);
-    else if (flag == "--repeats")
-      o.repeats = std::stoi(value);
-    else if (flag == "--out")
-      o.out = value;
-    else
-      throw std::runtime_error("unknown flag " + flag);
-  }
-  if (o.out.empty()) throw std::runtime_error("--out RAW.json is required");
+  st::FlagReader flags;
+  flags.add("--count", &o.count)
+      .add("--constrained", &o.constrained)
+      .add("--minimum-time", &o.minimum_time)
+      .add("--seed", &o.seed)
+      .add("--steps", &o.steps)
+      .add("--repeats", &o.repeats)
+      .add("--out", &o.out)
+      .require("--out");
+  st::readFlagsOrExit(flags, argc, argv, "pointing_study",
+                      "[--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N] "
+                      "[--repeats R] --out RAW.json");
   return o;
 }
 
@@ -112,7 +105,10 @@ std::string caseJson(unsigned seed, bool spinning, const std::string& binding,
   out << "{\"seed\": " << seed << ", \"spinning\": " << (spinning ? "true" : "false")
       << ", \"binding\": \"" << binding << "\""
       << ", \"scheme\": \"" << ap::schemeName(p.scheme) << "\", \"steps\": " << p.steps
-      << ", \"converged\": " << (r.converged() ? "true" : "false") << ", \"objective\": \""
+      << ", \"converged\": " << (r.converged() ? "true" : "false") << ", \"outcome\": \""
+      << attitude_planner::robustness::outcomeName(r)
+      << "\", \"least_duration_found\": " << number(r.duration_verdict.least_duration_found)
+      << ", \"duration\": " << number(p.duration) << ", \"objective\": \""
       << (timed_request ? "minimum_time" : "minimum_effort") << "\""
       << ", \"cost\": " << number(value) << ", \"twist\": " << number(r.pointing.final_twist)
       << ", \"error\": " << number(r.pointing.error)

@@ -43,13 +43,23 @@ def ms(t):
     return "%.3g" % (1e3 * t)
 
 
+def answered(c):
+    """yes, or no with the answer's outcome (an infeasible verdict names the least T found)."""
+    if c["converged"]:
+        return "yes"
+    outcome = c.get("outcome", "not converged")
+    if outcome.startswith("infeasible") and c.get("least_duration_found"):
+        return "no: %s, least T found %.6g s (T = %.6g s)" % (outcome, c["least_duration_found"], c["duration"])
+    return "no: %s" % outcome
+
+
 rows = []
 for i, c in enumerate(cases):
     ratio = c["time"] / c["fixed_time"]
     best_twist = c["sweep_best_twist"] if c["sweep_best_twist"] <= math.pi else c["sweep_best_twist"] - 2 * math.pi
     rows.append("| %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1e | %.1e | %s | %s | %.2f |" % (
         i + 1, c["seed"], c["scheme"], "spinning" if c["spinning"] else "rest", c.get("binding", "none"),
-        "yes" if c["converged"] else "no", fmt("%.10g", c["cost"]), fmt("%.10g", c["sweep_best"]),
+        answered(c), fmt("%.10g", c["cost"]), fmt("%.10g", c["sweep_best"]),
         fmt("%.4g", c["sweep_worst"] if c["sweep_best"] is not None else None),
         fmt("%+.2e", excess(c) if c["sweep_best"] is not None else None), fmt("%.3f", c["twist"]),
         fmt("%.3f", best_twist if c["sweep_best"] is not None else None), c["error"], c["stationarity"], ms(c["time"]),
@@ -68,8 +78,10 @@ def summary(group, what):
     worst_over_best = [c["sweep_worst"] / c["sweep_best"] for c in referenced]
     note = ""
     if unreferenced:
+        infeasible = sum(c.get("outcome", "").startswith("infeasible") for c in unreferenced)
         note = (" %d more: no swept twist converged (every 5 degrees, planManeuver); the pointing "
-                "answer converged in %d of them." % (len(unreferenced), sum(c["converged"] for c in unreferenced)))
+                "answer converged in %d of them, and was infeasible (naming the least T found) in %d." % (
+                    len(unreferenced), sum(c["converged"] for c in unreferenced), infeasible))
     return """%s (%d requests):
 - Cost: %d of %d at most the sweep's best + %g relative (largest excess %+.2e).%s
   The worst fixed twist costs %.3g-%.3gx the best (median %.3g).
@@ -133,6 +145,8 @@ Starting from the unconstrained twist optimum instead (the fixed solve only wher
 converge) measured 4.4x median on these requests with the same optima, but the free-psi interior
 point keeps the way round it starts in, and on seeded test requests it ended in costlier classes
 (0.1059 against the swept 0.1031, 0.2916 against 0.2466) once identical starts were not repeated.
+
+Minimum time to a pointing target (Betts's body, T* against a swept twist): [pointing_minimum_time.md](pointing_minimum_time.md).
 
 ![cost against the twist](pointing.png)
 

@@ -42,17 +42,10 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--count")
-      o.count = std::stoi(argv[i + 1]);
-    else if (flag == "--seed")
-      o.seed = std::stoull(argv[i + 1]);
-    else if (flag == "--out")
-      o.out = argv[i + 1];
-    else if (flag == "--only")
-      o.only = std::stoi(argv[i + 1]);
-  }
+  st::FlagReader flags;
+  flags.add("--count", &o.count).add("--seed", &o.seed).add("--out", &o.out).add("--only", &o.only);
+  st::readFlagsOrExit(flags, argc, argv, "bounded_verdicts_study",
+                      "[--count K] [--seed S] [--out FILE] [--only I]");
   return o;
 }
 

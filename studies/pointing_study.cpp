@@ -6,10 +6,12 @@
 // the raw data as JSON for scripts/plot_pointing.py (docs/results/pointing.md, scripts/pointing).
 //
 // With `--constrained C`, C more requests with one binding constraint each (in turn a keep-out cone
-// between R_0 b and d, a torque box, a torque norm bound: randomConstrainedPointingRequest).
+// between R_0 b and d, a torque box, a torque norm bound: randomConstrainedPointingRequest). With
+// `--minimum-time M`, M minimum-time requests on Betts's body (randomBettsPointingRequest; rest
+// to rest, second_order), their "cost" T* and the sweep's fixed-twist T*.
 //
-//   pointing_study [--count K] [--constrained C] [--seed S] [--steps N] [--repeats R] --out
-//   RAW.json
+//   pointing_study [--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N]
+//   [--repeats R] --out RAW.json
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -20,6 +22,7 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "support/bounded_requests.hpp"
 #include "support/pointing_requests.hpp"
 #include "support/study_tools.hpp"
 
@@ -29,31 +32,25 @@ namespace st = attitude_planner::study;
 namespace {
 
 struct Options {
-  int count = 32, constrained = 12, steps = 64, repeats = 5;
+  int count = 32, constrained = 12, minimum_time = 0, steps = 64, repeats = 5;
   unsigned seed = 41;
   std::string out;
 };
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--count")
-      o.count = std::stoi(value);
-    else if (flag == "--constrained")
-      o.constrained = std::stoi(value);
-    else if (flag == "--seed")
-      o.seed = static_cast<unsigned>(std::stoul(value));
-    else if (flag == "--steps")
-      o.steps = std::stoi(value);
-    else if (flag == "--repeats")
-      o.repeats = std::stoi(value);
-    else if (flag == "--out")
-      o.out = value;
-    else
-      throw std::runtime_error("unknown flag " + flag);
-  }
-  if (o.out.empty()) throw std::runtime_error("--out RAW.json is required");
+  st::FlagReader flags;
+  flags.add("--count", &o.count)
+      .add("--constrained", &o.constrained)
+      .add("--minimum-time", &o.minimum_time)
+      .add("--seed", &o.seed)
+      .add("--steps", &o.steps)
+      .add("--repeats", &o.repeats)
+      .add("--out", &o.out)
+      .require("--out");
+  st::readFlagsOrExit(flags, argc, argv, "pointing_study",
+                      "[--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N] "
+                      "[--repeats R] --out RAW.json");
   return o;
 }
 
@@ -100,17 +97,25 @@ std::string caseJson(unsigned seed, bool spinning, const std::string& binding,
   const ap::PlanResult f = timed(fixed, repeats, &fixed_time);
   const attitude_planner::test_support::TwistSweep sweep =
       attitude_planner::test_support::sweepTwist(p);
+  // What the sweep compares: the effort, or T* for a minimum-time request.
+  const bool timed_request = p.objective == ap::Objective::MinimumTime;
+  const double value = timed_request ? r.minimum_duration : r.cost;
+  const double fixed_value = timed_request ? f.minimum_duration : f.cost;
   std::ostringstream out;
   out << "{\"seed\": " << seed << ", \"spinning\": " << (spinning ? "true" : "false")
       << ", \"binding\": \"" << binding << "\""
       << ", \"scheme\": \"" << ap::schemeName(p.scheme) << "\", \"steps\": " << p.steps
-      << ", \"converged\": " << (r.converged() ? "true" : "false")
-      << ", \"cost\": " << number(r.cost) << ", \"twist\": " << number(r.pointing.final_twist)
+      << ", \"converged\": " << (r.converged() ? "true" : "false") << ", \"outcome\": \""
+      << attitude_planner::robustness::outcomeName(r)
+      << "\", \"least_duration_found\": " << number(r.duration_verdict.least_duration_found)
+      << ", \"duration\": " << number(p.duration) << ", \"objective\": \""
+      << (timed_request ? "minimum_time" : "minimum_effort") << "\""
+      << ", \"cost\": " << number(value) << ", \"twist\": " << number(r.pointing.final_twist)
       << ", \"error\": " << number(r.pointing.error)
       << ", \"stationarity\": " << number(r.pointing.twist_stationarity)
       << ", \"iterations\": " << r.iterations << ", \"attempts\": " << r.attempts.size()
       << ", \"time\": " << number(pointing_time) << ", \"fixed_time\": " << number(fixed_time)
-      << ", \"fixed_cost\": " << number(f.cost) << ", \"fixed_iterations\": " << f.iterations
+      << ", \"fixed_cost\": " << number(fixed_value) << ", \"fixed_iterations\": " << f.iterations
       << ", \"sweep_best\": " << number(sweep.best)
       << ", \"sweep_best_twist\": " << number(sweep.best_twist)
       << ", \"sweep_worst\": " << number(sweep.worst)
@@ -153,6 +158,15 @@ int main(int argc, char** argv) {
       out << (o.count + i ? ",\n" : "") << caseJson(seed, spinning, name, p, o.repeats);
       out.flush();
       std::cerr << "constrained request " << i + 1 << " of " << o.constrained << " done\n";
+    }
+    for (int i = 0; i < o.minimum_time; ++i) {
+      const unsigned seed = o.seed * 1000 + 800 + i;
+      const ap::PlanningProblem p = attitude_planner::test_support::randomBettsPointingRequest(
+          seed, o.steps, ap::SchemeKind::SecondOrder);
+      const bool first = o.count + o.constrained + i == 0;
+      out << (first ? "" : ",\n") << caseJson(seed, false, "torque_box", p, o.repeats);
+      out.flush();
+      std::cerr << "minimum-time request " << i + 1 << " of " << o.minimum_time << " done\n";
     }
     out << "\n]}\n";
   } catch (const std::exception& e) {

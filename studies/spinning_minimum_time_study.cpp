@@ -44,25 +44,15 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--count")
-      o.count = std::stoi(value);
-    else if (flag == "--seed")
-      o.seed = std::stoull(value);
-    else if (flag == "--scheme")
-      o.scheme = value;
-    else if (flag == "--steps")
-      o.steps = std::stoi(value);
-    else if (flag == "--out")
-      o.out = value;
-    else if (flag == "--only")
-      o.only = std::stoi(value);
-    else {
-      std::cerr << "unknown flag " << flag << "\n";
-      std::exit(2);
-    }
-  }
+  st::FlagReader flags;
+  flags.add("--count", &o.count)
+      .add("--seed", &o.seed)
+      .add("--scheme", &o.scheme)
+      .add("--steps", &o.steps)
+      .add("--out", &o.out)
+      .add("--only", &o.only);
+  st::readFlagsOrExit(flags, argc, argv, "spinning_minimum_time_study",
+                      "[--count K] [--seed S] [--scheme NAME] [--steps N] [--out FILE] [--only I]");
   return o;
 }
 

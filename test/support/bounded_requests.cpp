@@ -163,7 +163,10 @@ std::string attemptLines(const PlanResult& result) {
 
 std::string outcomeName(const VerdictCheck& check) {
   if (!check.input_error.empty()) return "input error";
-  const PlanResult& r = check.result;
+  return outcomeName(check.result);
+}
+
+std::string outcomeName(const PlanResult& r) {
   if (r.termination == Termination::Infeasible) {
     return r.duration_verdict.proven_infeasible ? "infeasible (proven)" : "infeasible (local)";
   }

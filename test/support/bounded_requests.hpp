@@ -60,6 +60,9 @@ std::string attemptLines(const PlanResult& result);
 
 /// "converged", "infeasible (proven)", "infeasible (local)", "input error", or the termination.
 std::string outcomeName(const VerdictCheck& check);
+/// A result's outcome: "converged", "infeasible (proven)", "infeasible (local)", or the
+/// termination.
+std::string outcomeName(const PlanResult& result);
 
 }  // namespace robustness
 }  // namespace attitude_planner

@@ -69,13 +69,31 @@ PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool 
   }
 }
 
+PlanningProblem randomBettsPointingRequest(unsigned seed, int steps, SchemeKind scheme) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  PlanningProblem p;
+  p.inertia = Vector3(5621.0, 4547.0, 2364.0).asDiagonal();
+  p.max_torque = Vector3::Constant(50.0);
+  p.objective = Objective::MinimumTime;
+  p.duration = 0.0;
+  p.steps = steps;
+  p.scheme = scheme;
+  p.initial_attitude = so3::exp(Vector3(3.0 * u(rng) * randomUnit(rng)));
+  p.end_condition.kind = EndConditionKind::Pointing;
+  p.end_condition.body_axis = randomUnit(rng);
+  p.end_condition.world_direction = randomUnit(rng);
+  return p;
+}
+
 TwistSweep sweepTwist(const PlanningProblem& pointing) {
   PlanningProblem fixed = pointing;
   fixed.end_condition = EndCondition();
   const auto cost = [&](double twist) {
     fixed.final_attitude = pointingAttitude(pointing.end_condition, twist);
     const PlanResult r = planManeuver(fixed);
-    return r.converged() ? r.cost : std::numeric_limits<double>::infinity();
+    if (!r.converged()) return std::numeric_limits<double>::infinity();
+    return pointing.objective == Objective::MinimumTime ? r.minimum_duration : r.cost;
   };
   TwistSweep s;
   const double step = 5.0 * M_PI / 180.0;

@@ -28,9 +28,14 @@ enum class PointingBinding {
 PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool spinning,
                                                  SchemeKind scheme, PointingBinding binding);
 
+/// A seeded random minimum-time pointing request on Betts's body (scenes/min_time_betts.yaml: J =
+/// diag(5621, 4547, 2364) kg m², |τ_i| ≤ 50 N m), rest to rest: random b, d and R_0.
+PlanningProblem randomBettsPointingRequest(unsigned seed, int steps, SchemeKind scheme);
+
 /// The fixed-attitude optimum (planManeuver, classes enumerated) over the twist ψ of `pointing`'s
 /// end condition: every 5° (`sweep` receives the 72 costs, NaN where a solve did not converge),
-/// the best bracket refined by golden section to |Δψ| < 1e-7 rad.
+/// the best bracket refined by golden section to |Δψ| < 1e-7 rad. The cost; with objective
+/// minimum time, T*.
 struct TwistSweep {
   std::vector<double> twists, costs;
   double best = 0.0, best_twist = 0.0;  ///< the refined minimum

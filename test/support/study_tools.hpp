@@ -1,9 +1,18 @@
-// Small tools the studies (studies/*.cpp) share: wall time, median, the machine's load average.
+// Small tools the studies (studies/*.cpp) share: wall time, median, the machine's load average,
+// and the `--flag value` command line.
 #pragma once
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +48,79 @@ inline std::string loadAverage() {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.2f %.2f %.2f", a[0], a[1], a[2]);
   return buffer;
+}
+
+/// A study's command line that cannot be read; the message names the flag and the value.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// `value` of `flag` as a whole number of type `Integer`: all of it, in the type's range (a seed
+/// is unsigned, so "-1" is refused rather than wrapped).
+template <class Integer>
+Integer integerFlag(const std::string& flag, const std::string& value) {
+  Integer parsed{};
+  const char* end = value.data() + value.size();
+  const auto [stop, error] = std::from_chars(value.data(), end, parsed);
+  if (value.empty() || error != std::errc() || stop != end) {
+    throw UsageError(flag + " " + value + ": not a whole number in [" +
+                     std::to_string(std::numeric_limits<Integer>::min()) + ", " +
+                     std::to_string(std::numeric_limits<Integer>::max()) + "]");
+  }
+  return parsed;
+}
+
+/// The `--flag value` pairs of a study's command line, each bound to the option it sets (which
+/// keeps its default when the flag is absent). Unknown flags and a flag without a value are
+/// usage errors, never ignored: a mistyped flag would otherwise run the default study silently.
+class FlagReader {
+ public:
+  template <class Integer>
+  FlagReader& add(const std::string& flag, Integer* target) {
+    setters_[flag] = [flag, target](const std::string& v) {
+      *target = integerFlag<Integer>(flag, v);
+    };
+    return *this;
+  }
+  FlagReader& add(const std::string& flag, std::string* target) {
+    setters_[flag] = [target](const std::string& v) { *target = v; };
+    return *this;
+  }
+  /// `flag` must be given (it has no default).
+  FlagReader& require(const std::string& flag) {
+    required_.insert(flag);
+    return *this;
+  }
+
+  /// Sets the options from `argv`; throws UsageError.
+  void read(int argc, char** argv) const {
+    std::set<std::string> missing = required_;
+    for (int i = 1; i < argc; i += 2) {
+      const std::string flag = argv[i];
+      const auto setter = setters_.find(flag);
+      if (setter == setters_.end()) throw UsageError("unknown flag " + flag);
+      if (i + 1 == argc) throw UsageError(flag + " needs a value");
+      setter->second(argv[i + 1]);
+      missing.erase(flag);
+    }
+    if (!missing.empty()) throw UsageError(*missing.begin() + " is required");
+  }
+
+ private:
+  std::map<std::string, std::function<void(const std::string&)>> setters_;
+  std::set<std::string> required_;
+};
+
+/// `reader.read(argc, argv)`, and on a usage error "`program`: error" and `usage` on stderr and
+/// exit status 2, the same for every study.
+inline void readFlagsOrExit(const FlagReader& reader, int argc, char** argv, const char* program,
+                            const char* usage) {
+  try {
+    reader.read(argc, argv);
+  } catch (const UsageError& e) {
+    std::cerr << program << ": " << e.what() << "\nusage: " << program << " " << usage << "\n";
+    std::exit(2);
+  }
 }
 
 }  // namespace attitude_planner::study

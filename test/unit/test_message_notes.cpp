@@ -36,6 +36,8 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
       notes::LastIterateDoesNotReplay{"r"},
       notes::CheapestClass{"r"},
       notes::LastPointingStart{"r"},
+      notes::FixedTwistFallback{0.5, "r"},
+      notes::PointingRestartNotServed{3.5},
       notes::SearchedOnT{"why"},
       notes::SharpenedFromSearch{"why", 2.5},
       notes::PlannedAtMargin{0.1, 3.3, 3.0},

@@ -27,6 +27,11 @@ double pointingError(const Matrix3& attitude, const EndCondition& end);
 /// form: tr(fromᵀ R_ref exp(ψ b^)) = c + α sin ψ − β cos ψ is largest at ψ = atan2(α, −β).
 double nearestTwist(const Matrix3& from, const EndCondition& end);
 
+/// `problem` with R_N = `final_attitude` where its end condition is a pointing one (the twist a
+/// plan or a start chose: a solve from that plan starts there, and the plan is judged there),
+/// else `problem` unchanged.
+PlanningProblem endingAt(const PlanningProblem& problem, const Matrix3& final_attitude);
+
 /// Throws InvalidInput naming `field` and the value unless `v` is finite and nonzero.
 void requirePointingVector(const Vector3& v, const std::string& field);
 

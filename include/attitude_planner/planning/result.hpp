@@ -211,8 +211,12 @@ struct PointingSummary {
   double final_twist = 0.0;
   /// The end condition's residual: angle(R_N b, d) [rad] on the returned maneuver's R_N.
   double error = 0.0;
-  double twist_gradient = 0.0;  ///< ∂C/∂ψ at the answer [N²·m²/rad]
-  /// |∂C/∂ψ| relative as max_residual is (to max|∂τ/∂δ|·max|τ|): the stationarity in ψ.
+  /// The Lagrangian's ∂L/∂ψ at the answer: unconstrained minimum effort ∂C/∂ψ [N²·m²/rad];
+  /// with stage constraints or torque bounds ∂L/∂ψ, L = C − Σ zᵢcᵢ [N²·m²/rad]; minimum time
+  /// ∂L/∂ψ of L = T/T₀ + εC − Σ zᵢcᵢ [1/rad] (T₀ the free-time start's duration, ε → 0).
+  double twist_gradient = 0.0;
+  /// |twist_gradient| relative: minimum effort as max_residual is (to max|∂τ/∂δ|·max|τ|),
+  /// minimum time as the free-time residuals are (already relative to T₀): the stationarity in ψ.
   double twist_stationarity = 0.0;
   int starts = 0;  ///< twist × class starts surveyed
 };

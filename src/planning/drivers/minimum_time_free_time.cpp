@@ -9,6 +9,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/problem/duration_bound.hpp"
@@ -437,7 +438,7 @@ class FreeTimeMinimumTime {
   /// degenerate and ends where it starts (measured: 40–150 interior-point iterations at N = 128
   /// for the same plan, more than every start together around a cone).
   PlanResult answerAt(const FreeTimeOutcome& answer, const std::string& from) {
-    PlanningProblem at = problem_;
+    PlanningProblem at = endingAt(problem_, answer.maneuver.attitude.back());
     at.objective = Objective::MinimumEffort;
     at.time_margin = 0.0;
     at.duration = answer.duration;
@@ -472,9 +473,22 @@ class FreeTimeMinimumTime {
     result.minimum_time.complementarity = answer.complementarity;
     result.minimum_time.solves = solves_;
     result.minimum_time.second_order_sufficient = answer.second_order_sufficient;
+    recordTwist(at, answer, &result);
     result.attempts = trail_;
     result.levels = levels_;
     return result;
+  }
+
+  /// A pointing answer's twist, end-condition residual and stationarity in ψ (∂L/∂ψ of the
+  /// minimum-time Lagrangian, relative to T₀ as the other residuals).
+  static void recordTwist(const PlanningProblem& at, const FreeTimeOutcome& answer,
+                          PlanResult* result) {
+    if (!at.end_condition.pointing()) return;
+    result->pointing.active = true;
+    result->pointing.final_twist = twistOf(at.final_attitude, at.end_condition);
+    result->pointing.error = pointingError(answer.maneuver.attitude.back(), at.end_condition);
+    result->pointing.twist_gradient = answer.twist_gradient;
+    result->pointing.twist_stationarity = std::abs(answer.twist_gradient);
   }
 
   /// The free-time plan as the answer (at T*, measured as every plan is: evaluatePlan, the
@@ -512,7 +526,7 @@ class FreeTimeMinimumTime {
 }  // namespace
 
 std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse) {
-  PlanningProblem at = p;
+  PlanningProblem at = endingAt(p, coarse.maneuver.attitude.back());
   at.duration = coarse.duration;
   std::vector<Matrix3> attitudes;
   try {

@@ -36,6 +36,9 @@ struct TwistRun {
   std::vector<IterationInfo> history;
   /// A constrained request's interior-point plan (on `steps`) and its multipliers and slacks.
   std::optional<PlanResult> plan;
+  /// A constrained start's converged fixed-twist optimum (fromFixedTwistPlan): the answer's
+  /// fallback where no free-twist solve converges (fixedTwistFallback).
+  std::optional<PlanResult> fixed_plan;
   LevelDuals duals;
   /// Where its iterate started (a constrained start: the fixed-twist solve's plan, the attempts
   /// just before it, else the unconstrained optimum or the geodesic).
@@ -156,6 +159,7 @@ bool fromFixedTwistPlan(const PlanningProblem& at, const SolverOptions& options,
                         SolveContext& context, TwistRun* run) {
   const std::optional<PlanResult> fixed = fixedTwistPlan(at, options, context);
   if (!fixed) return false;
+  run->fixed_plan = fixed;
   ReducedProblem np(at);
   np.setInteriorFromAttitudes(fixed->maneuver.attitude);
   const InteriorPointParameters parameters;
@@ -363,8 +367,44 @@ std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, doubl
   return runs;
 }
 
-/// The kept answer: the cheapest converged plan on the requested grid (else the first with an
-/// iterate there, not converged), with the request's trail and totals.
+/// A constrained request none of whose free-twist runs converged: the cheapest converged
+/// fixed-attitude plan among the starts' fixed-twist optima and one bounded fixed-attitude request
+/// at the twist of `unconverged` (the run that would be answered, not converged), labelled (the
+/// twist not optimized: its stationarity not measured, NaN). Empty where none converged.
+std::optional<PlanResult> fixedTwistFallback(
+    const PlanningProblem& problem, const std::vector<std::pair<TwistRun, std::size_t>>& finals,
+    const TwistRun* unconverged, SolveContext& context) {
+  if (!problem.hasNodeConstraints() || context.stopReason()) return std::nullopt;
+  std::optional<PlanResult> best;
+  std::string reason;
+  const auto consider = [&](const PlanResult& plan, const std::string& why) {
+    if (plan.converged() && (!best || plan.cost < best->cost)) best = plan, reason = why;
+  };
+  for (const auto& f : finals) {
+    if (f.first.fixed_plan) consider(*f.first.fixed_plan, f.first.solve.reason);
+  }
+  if (unconverged && std::isfinite(unconverged->solve.twist) && !context.stopReason()) {
+    // The request's own bounded driver at that twist (its minimum-time restart included: measured,
+    // seed 41501 of docs/results/pointing.md converges there, not from the constrained starts).
+    PlanningProblem at = posedAt(problem, problem.steps, unconverged->solve.twist);
+    at.end_condition = EndCondition();
+    const PlanResult plan = planBoundedMinimumEffort(at, context);
+    if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
+  }
+  if (!best) return std::nullopt;
+  const Matrix3 end = best->maneuver.attitude.back();
+  best->pointing.active = true;
+  best->pointing.final_twist = twistOf(end, problem.end_condition);
+  best->pointing.error = pointingError(end, problem.end_condition);
+  best->pointing.twist_gradient = std::numeric_limits<double>::quiet_NaN();
+  best->pointing.twist_stationarity = std::numeric_limits<double>::quiet_NaN();
+  addNote(&*best, notes::FixedTwistFallback{best->pointing.final_twist, reason});
+  return best;
+}
+
+/// The kept answer: the cheapest converged plan on the requested grid (else, constrained, the
+/// fixed-twist fallback, else the first with an iterate there, not converged), with the request's
+/// trail and totals.
 PlanResult finishPointing(const PlanningProblem& problem, const std::vector<TwistRun>& survey,
                           const std::vector<std::pair<TwistRun, std::size_t>>& finals,
                           std::size_t first_recorded, SolveContext& context) {
@@ -376,7 +416,13 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     if (f.first.iterate.size() == std::size_t(problem.steps) && cheaper) kept = &f;
   }
   PlanResult result;
-  if (kept) {
+  std::optional<PlanResult> fallback;
+  if (!kept || !kept->first.converged()) {
+    fallback = fixedTwistFallback(problem, finals, kept ? &kept->first : nullptr, context);
+  }
+  if (fallback) {
+    result = std::move(*fallback);
+  } else if (kept) {
     result = resultOf(problem, kept->first);
     context.markKept(kept->second);
   } else {
@@ -388,7 +434,7 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
   }
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());
   result.pointing.starts = static_cast<int>(survey.size());
-  if (kept) {
+  if (kept && !fallback) {
     std::ostringstream brief;
     brief << result.message;
     // Each start's verdict is local (its ψ and way round): no start converged, which is not a

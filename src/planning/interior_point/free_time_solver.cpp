@@ -47,8 +47,10 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_update.hpp"
+#include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
@@ -211,8 +213,17 @@ class FreeTimeSolver final : public PrimalDualProblem {
     if (!elasticRows(g)) return {in.z / in.c, mu / in.c};
     return {1.0 / in.D, in.z + in.q / in.D};
   }
-  /// The global unknown bordering the band: η.
-  static constexpr int borderSize() { return 1; }
+  /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
+  int borderSize() const { return 1 + (np_.hasTwist() ? 1 : 0); }
+  /// ψ's column of the border (the last; its unknown is n_ + twistColumn()).
+  int twistColumn() const { return borderSize() - 1; }
+  /// The ψ-component gᵀe of a row's local gradient (0 without a pointing end condition).
+  double twistComponent(const FreeTimeRows& g, int k,
+                        const Eigen::Matrix<double, 10, 1>& gradient) const {
+    if (!np_.hasTwist()) return 0.0;
+    return gradient.head<9>().dot(
+        localTwistMotion(np_, k + g.support.node_offset, g.support.width));
+  }
 
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
@@ -248,6 +259,14 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
+  /// A pointing end's ψ entries of one local block (free_time_twist.hpp).
+  void scatterTwist(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
+                    const Eigen::Matrix<double, 10, 1>& rhs,
+                    const Eigen::Matrix<double, 10, 1>& lagrangian);
+  /// The iterate's nodes moved by α d (and R_N by α dψ with a pointing end).
+  void moveNodes(const Eigen::VectorXd& d, double alpha);
+  /// Back to the accepted R_N with the accepted steps (a trial's twist moved it).
+  void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
   double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
   /// φ_μ at the iterate moved by α d, +∞ where h ≤ 0 or no boundary step exists there (`moved`
@@ -327,6 +346,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
     double h = 0.0, mu = 0.0, epsilon = 0.0;
     ReducedProblem::StepVectors steps;
   } accepted_;
+  Matrix3 accepted_end_ = Matrix3::Identity();  ///< R_N at the accepted iterate
   // The elastic start (startInside): until the iterate is strictly inside every constraint that
   // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
@@ -469,14 +489,48 @@ void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<doub
                                    Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()),
                                    3 * first_slot, 3 * (last_slot + 1));
   }
+  scatterTwist(first_node, width, H, rhs, lagrangian);
+}
+
+void FreeTimeSolver::scatterTwist(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
+                                  const Eigen::Matrix<double, 10, 1>& rhs,
+                                  const Eigen::Matrix<double, 10, 1>& lagrangian) {
+  if (!np_.hasTwist()) return;
+  const TwistEntries t = twistEntries(np_, first_node, width, h0_, H, rhs, lagrangian);
+  if (!t.any) return;
+  const int p = twistColumn();
+  for (int node = 0; node < width; ++node) {
+    const int v = np_.variableIndex(first_node + node);
+    if (v >= 0) kkt_.border.col(p).segment<3>(v) += t.nodes.segment<3>(3 * node);
+  }
+  rhs_(n_ + p) += t.rhs;
+  lagrangian_gradient_(n_ + p) += t.lagrangian;
+  kkt_.corner(0, p) += t.time;
+  kkt_.corner(p, 0) += t.time;
+  kkt_.corner(p, p) += t.twist;
+}
+
+void FreeTimeSolver::moveNodes(const Eigen::VectorXd& d, double alpha) {
+  if (!np_.hasTwist()) {
+    np_.setCurrent(np_.retract(d.head(n_), alpha));
+    return;
+  }
+  const double twist_step = alpha * d(n_ + twistColumn());
+  np_.setCurrentWithTwist(np_.retractWithTwist(d.head(n_), d(n_ + twistColumn()), alpha),
+                          twist_step);
+}
+
+void FreeTimeSolver::restoreAcceptedEnd() {
+  if (np_.hasTwist()) np_.setCurrentWithFinalAttitude(accepted_.steps, accepted_end_);
 }
 
 void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
   np_.setCurrent(accepted_.steps);
+  restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h + alpha * h0_ * d(n_));
-  np_.setCurrent(np_.retract(d.head(n_), alpha));
+  moveNodes(d, alpha);
 }
 
 double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
@@ -493,6 +547,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
 }
 
 void FreeTimeSolver::restore() {
+  restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h);
   np_.setCurrent(accepted_.steps);
 }
@@ -516,6 +571,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
     if (w == 0.0) return;
     curved = true;
     v(n_) += w * in.g(9);
+    if (np_.hasTwist()) v(n_ + twistColumn()) += w * twistComponent(group, k, in.g);
     for (int node = 0; node < group.support.width; ++node) {
       const int index = np_.variableIndex(k + group.support.node_offset + node);
       if (index >= 0) v.segment<3>(index) += w * in.g.segment<3>(3 * node);
@@ -538,6 +594,7 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
                                 const Eigen::Matrix<double, 10, 1>& gradient,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
+  if (np_.hasTwist()) sum += twistComponent(g, k, gradient) * d(n_ + twistColumn());
   for (int node = 0; node < g.support.width; ++node) {
     const int v = np_.variableIndex(k + g.support.node_offset + node);
     if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
@@ -720,6 +777,7 @@ Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d) 
   late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
   if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return rejected({});
   accepted_ = {np_.timeStep(), mu_, epsilon_, np_.current()};
+  accepted_end_ = np_.finalAttitude();
   clearCorrection();
   *request = {meritSlope(d_), 1.0, false, false, late_ && !elastic_};
   *d = &d_;
@@ -788,6 +846,9 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   // Residuals of the Lagrangian T/T₀ + εC − Σ z c (ε → 0 with μ: minimum time at the end).
   out.stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   out.time_row = std::abs(lagrangian_gradient_(n_));
+  if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
+    out.twist_gradient = lagrangian_gradient_(n_ + twistColumn());
+  }
   out.smallest_value = std::numeric_limits<double>::infinity();
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
   const std::vector<Vector3> tau = np_.torques(out.steps);
@@ -848,7 +909,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
 std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
                                                      const FreeTimeOutcome& outcome, double size) {
   if (outcome.negative_curvature.size() == 0) return {};
-  PlanningProblem at = problem;
+  PlanningProblem at = endingAt(problem, outcome.maneuver.attitude.back());
   at.duration = outcome.duration;
   ReducedProblem np(at);
   np.setCurrent(outcome.steps);
@@ -902,7 +963,7 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch) {
-  PlanningProblem at = problem;
+  PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
   at.duration = start_duration;
   FreeTimeOutcome failed;
   failed.termination = Termination::NotConverged;
@@ -920,12 +981,14 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     const StageConstraints constraints = buildStageConstraints(problem);
     const std::vector<Vector3> start_steps = np.current();
     const double start_h = np.timeStep();
+    const Matrix3 start_end = np.finalAttitude();
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     failed.message = solver.startInside();
     if (!failed.message.empty()) return failed;
     FreeTimeOutcome out = solver.run(tolerance, max_iterations, context, watch);
     if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
     // The elastic start did not reach a KKT point: the start raised inside instead.
+    np.setCurrentWithFinalAttitude(start_steps, start_end);  // R_N where the twist started
     np.setTimeStep(start_h);
     np.setCurrent(start_steps);
     FreeTimeSolver raised(problem, &np, constraints, parameters);

@@ -28,10 +28,14 @@ struct FreeTimeOutcome {
   bool elastic_start = false;
   double duration = 0.0;  ///< T = N h
   int iterations = 0;
-  /// max-norm of ∇T − Σ zᵢ∇cᵢ over (δ, h/h₀) relative to ∂T/∂(h/h₀) = T₀ (h₀ the start's h):
-  /// the stationarity of the minimum-time Lagrangian, its h row included.
+  /// max-norm of ∇T − Σ zᵢ∇cᵢ over (δ, h/h₀, and a pointing end's twist ψ) relative to
+  /// ∂T/∂(h/h₀) = T₀ (h₀ the start's h): the stationarity of the minimum-time Lagrangian, its h
+  /// row (and ψ row) included.
   double stationarity = 0.0;
-  double time_row = 0.0;                    ///< the h row of that residual alone, same scale
+  double time_row = 0.0;  ///< the h row of that residual alone, same scale
+  /// A pointing end's ψ row of that residual, signed (∂L/∂ψ per rad, same scale; 0 without):
+  /// the stationarity in the free twist.
+  double twist_gradient = 0.0;
   double complementarity = 0.0;             ///< Σ zᵢcᵢ: the duality gap, relative to T₀
   double smallest_value = 0.0;              ///< min cᵢ (> 0: strictly feasible)
   double effort_weight = 0.0;               ///< ε of T + ε C at the end (→ 0 with the barrier)

@@ -70,6 +70,17 @@ std::string words(const CheapestClass& n) {
 std::string words(const LastPointingStart& n) {
   return "; the last: " + n.reason;
 }
+std::string words(const FixedTwistFallback& n) {
+  return "; answered with the fixed-attitude plan at twist " + exactNumber(n.twist) +
+         " rad (converged there; the twist is not optimized: the free-twist solves did not "
+         "converge, the last: " +
+         n.reason + ")";
+}
+std::string words(const PointingRestartNotServed& n) {
+  return "; not infeasible: minimum time with the twist free reaches T* = " +
+         exactNumber(n.minimum_duration) +
+         " s <= T, but the restart from its plan (a warm-started pointing solve) is not served yet";
+}
 std::string words(const SearchSummary& n) {
   return n.summary;
 }

@@ -73,6 +73,17 @@ struct CheapestClass {
 struct LastPointingStart {
   std::string reason;
 };
+/// A constrained pointing request whose free-twist solves did not converge, answered with the
+/// cheapest converged fixed-attitude plan at one twist (the twist not optimized).
+struct FixedTwistFallback {
+  double twist = 0.0;  ///< ψ [rad] of the plan returned
+  std::string reason;  ///< the free-twist solve's message there
+};
+/// A bounded pointing request not converged at T where minimum time with the twist free found
+/// T* <= T: plans exist, the restart from the minimum-time plan is not served for pointing yet.
+struct PointingRestartNotServed {
+  double minimum_duration = 0.0;  ///< T* [s]
+};
 /// The minimum-time search's summary (drivers/minimum_time_search.cpp renders its bracket, the
 /// starts' least durations and the solves from its outcomes).
 struct SearchSummary {
@@ -121,7 +132,8 @@ using Note =
                  notes::RetriedInTwoStages, notes::FromInitialGuess, notes::CoarserLevel,
                  notes::RefinedFromSurvey, notes::ConstraintsInactive, notes::UnconstrainedStart,
                  notes::AfterGuessStopped, notes::LastIterateDoesNotReplay, notes::CheapestClass,
-                 notes::LastPointingStart, notes::SearchSummary, notes::SearchedOnT,
+                 notes::LastPointingStart, notes::FixedTwistFallback,
+                 notes::PointingRestartNotServed, notes::SearchSummary, notes::SearchedOnT,
                  notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
                  notes::RestartEnded, notes::MinimumTimeUnsolved>;
 

@@ -53,6 +53,12 @@ double nearestTwist(const Matrix3& from, const EndCondition& end) {
   return std::atan2(alpha, -beta);
 }
 
+PlanningProblem endingAt(const PlanningProblem& problem, const Matrix3& final_attitude) {
+  PlanningProblem at = problem;
+  if (problem.end_condition.pointing()) at.final_attitude = final_attitude;
+  return at;
+}
+
 void requirePointingVector(const Vector3& v, const std::string& field) {
   if (!v.allFinite() || v.norm() == 0.0 || !std::isfinite(v.norm())) {
     throw InvalidInput(field, "must be a finite nonzero vector, got [" + exactNumber(v(0)) + ", " +

@@ -203,6 +203,14 @@ class ReducedProblem {
   StepVectors retractWithTwist(const Eigen::VectorXd& delta, double twist_step, double alpha) const;
   /// Accepts steps from retractWithTwist(…, twist_step, 1) (R_N moved by exp(twist_step b^)).
   void setCurrentWithTwist(const StepVectors& steps, double twist_step);
+  /// R_N as the current iterate has it (moved by every accepted twist step).
+  const Matrix3& finalAttitude() const { return final_attitude_; }
+  /// Steps and the R_N they compose to, as finalAttitude() and current() returned them (a line
+  /// search's way back to its start point when the twist moved R_N).
+  void setCurrentWithFinalAttitude(const StepVectors& steps, const Matrix3& final_attitude) {
+    steps_ = steps;
+    final_attitude_ = final_attitude;
+  }
 
   /// Index of R_j's first unknown, or −1 if R_j is fixed.
   int variableIndex(int j) const {

@@ -1,0 +1,27 @@
+// Minimum time to a pointing end condition (R_N b = d, the twist ψ about b free): the request's
+// minimum-time recipe (drivers/minimum_time.cpp) run from several start twists, ψ a global
+// unknown of every free-time solve (interior_point/free_time_twist.hpp), the least T* kept.
+#pragma once
+
+#include <functional>
+
+#include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
+#include "planning/problem/solve_context.hpp"
+
+namespace attitude_planner {
+
+/// The minimum-time recipe for one posed problem (its R_N at a start twist, the end condition
+/// still a pointing one: the twist stays free in its solves).
+using MinimumTimeRecipe = std::function<PlanResult(const PlanningProblem& posed)>;
+
+/// Plans `problem` (end_condition.pointing(), objective minimum time) with `recipe` from
+/// kPointingStartTwists start twists, ψ₀ + 2πi/kPointingStartTwists (ψ₀ the twist of least
+/// rotation from R_0: nearestTwist); the ways round are the recipe's own starts. The kept answer is
+/// the converged one with the least T* (else the last start's), with every start's trail (each
+/// attempt's start_detail.twist its start twist) and the pointing summary (final_twist, the end
+/// condition's residual, ∂L/∂ψ at the KKT point). Stops at a cancel or the deadline.
+PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
+                               const MinimumTimeRecipe& recipe);
+
+}  // namespace attitude_planner

@@ -1,0 +1,159 @@
+// The twist ψ of a pointing end condition as a global unknown of the free-time interior point:
+// its entries of the Newton system against central differences, and minimum-time pointing answers
+// against a sweep of fixed twists on seeded random requests on Betts's body.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+#include "planning/interior_point/free_time_twist.hpp"
+#include "planning/transcription/reduced_problem.hpp"
+#include "support/perturbed_problem.hpp"
+#include "support/pointing_requests.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+constexpr SchemeKind kDiscretizations[] = {SchemeKind::Paper, SchemeKind::Variational,
+                                           SchemeKind::SecondOrder};
+
+/// ψ's entries of the free-time system of L = C (the effort alone: weights r), summed over the
+/// stencils as the solver scatters them: ∂C/∂ψ, ∂²C/∂ψ∂η, ∂²C/∂ψ² and ∂²C/∂δ∂ψ (η = h/h₀).
+struct SummedEntries {
+  double gradient = 0.0, time = 0.0, twist = 0.0;
+  Eigen::VectorXd nodes;
+  double path_term = 0.0;  ///< the part of `time` from the path's curvature at R_{N−1}
+};
+
+SummedEntries summedEntries(const ReducedProblem& rp) {
+  const double h0 = rp.timeStep();
+  SummedEntries sum;
+  sum.nodes = Eigen::VectorXd::Zero(rp.unknowns());
+  rp.forEachStencilWithTimeStep([&](const ReducedProblem::TimeStepStencil& st) {
+    Eigen::Matrix<double, 3, 10> G;
+    G.leftCols<9>() = st.jacobian;
+    G.col(9) = st.tau_h * h0;
+    Eigen::Matrix<double, 10, 10> H = G.transpose() * G;
+    H.topLeftCorner<9, 9>() += st.second;
+    H.block<9, 1>(0, 9) += st.second_h * h0;
+    H.block<1, 9>(9, 0) += (st.second_h * h0).transpose();
+    H(9, 9) += st.second_hh * h0 * h0;
+    const Eigen::Matrix<double, 10, 1> lagrangian = G.transpose() * st.tau;
+    const TwistEntries t = twistEntries(rp, st.k - 1, 3, h0, H, -lagrangian, lagrangian);
+    sum.gradient += t.lagrangian;
+    sum.time += t.time;
+    sum.twist += t.twist;
+    const int slot = rp.steps() - 1 - (st.k - 1);
+    if (slot >= 0 && slot < 3) {
+      const Vector3 e = rp.twistMotion(rp.steps() - 1), d = rp.nodePath(rp.steps() - 1).first * h0;
+      sum.path_term += lagrangian.segment<3>(3 * slot).dot(0.5 * e.cross(d));
+    }
+    for (int s = 0; s < 3; ++s) {
+      const int v = rp.variableIndex(st.k - 1 + s);
+      if (v >= 0) sum.nodes.segment<3>(v) += t.nodes.segment<3>(3 * s);
+    }
+  });
+  return sum;
+}
+
+/// rp with h = h₀(1 + a) and ψ moved by b, the free attitudes held.
+ReducedProblem movedTo(const ReducedProblem& rp, double a, double b) {
+  ReducedProblem q = rp;
+  q.setCurrentWithTwist(q.retractWithTwist(Eigen::VectorXd::Zero(q.unknowns()), b, 1.0), b);
+  q.setTimeStep(rp.timeStep() * (1.0 + a));
+  return q;
+}
+
+double costAt(const ReducedProblem& rp, double a, double b) {
+  const ReducedProblem q = movedTo(rp, a, b);
+  return q.cost(q.current());
+}
+
+TEST(FreeTimeTwist, EntriesMatchCentralDifferencesForEveryScheme) {
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    // Spinning ends: h moves R_1 and R_{N−1} of paper and variational (the path's curvature term).
+    PlanningProblem p = test_support::randomPointingRequest(17, 24, true, scheme);
+    p.final_attitude = pointingAttitude(p.end_condition, 0.4);
+    const ReducedProblem rp = test_support::perturbedReducedProblem(p, 5);
+    const SummedEntries got = summedEntries(rp);
+    const double C = rp.cost(rp.current()), e = 1e-4;
+    const double slope = (costAt(rp, 0, e) - costAt(rp, 0, -e)) / (2 * e);
+    EXPECT_NEAR(got.gradient, slope, 1e-6 * (std::abs(slope) + C));
+    const double curvature = (costAt(rp, 0, e) - 2 * C + costAt(rp, 0, -e)) / (e * e);
+    EXPECT_NEAR(got.twist, curvature, 1e-4 * (std::abs(curvature) + C));
+    const double mixed =
+        (costAt(rp, e, e) - costAt(rp, e, -e) - costAt(rp, -e, e) + costAt(rp, -e, -e)) /
+        (4 * e * e);
+    EXPECT_NEAR(got.time, mixed, 1e-4 * (std::abs(mixed) + C));
+    if (scheme != SchemeKind::SecondOrder) {  // the curvature term: 10x the tolerance above
+      EXPECT_GT(std::abs(got.path_term), 1e-3 * (std::abs(mixed) + C));
+    }
+    // The border: ∂/∂ψ of the node gradient (evaluateWithTwist's node part) at ±Δψ.
+    const auto nodeGradient = [&](double b) {
+      Eigen::VectorXd g, unused_border;
+      double unused_corner = 0.0, unused_scale = 0.0;
+      movedTo(rp, 0, b).evaluateWithTwist(&g, nullptr, &unused_border, &unused_corner,
+                                          &unused_scale);
+      return Eigen::VectorXd(g.head(rp.unknowns()));
+    };
+    const Eigen::VectorXd fd = (nodeGradient(e) - nodeGradient(-e)) / (2 * e);
+    EXPECT_LT((fd - got.nodes).cwiseAbs().maxCoeff(),
+              1e-5 * (got.nodes.cwiseAbs().maxCoeff() + 1.0));
+  }
+}
+
+TEST(FreeTimeTwist, WithoutPointingNoEntries) {
+  PlanningProblem p = test_support::randomPointingRequest(19, 16, true, SchemeKind::Paper);
+  p.end_condition = EndCondition();
+  const ReducedProblem rp(p);
+  const Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Identity();
+  const Eigen::Matrix<double, 10, 1> g = Eigen::Matrix<double, 10, 1>::Ones();
+  EXPECT_FALSE(twistEntries(rp, p.steps - 2, 3, rp.timeStep(), H, g, g).any);
+}
+
+TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
+  // Every discretization: h and ψ both move R_{N−1} of paper and variational.
+  const std::pair<unsigned, SchemeKind> requests[] = {{4201u, SchemeKind::SecondOrder},
+                                                      {4202u, SchemeKind::Paper},
+                                                      {4204u, SchemeKind::Variational}};
+  for (const auto& [seed, scheme] : requests) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", " + schemeName(scheme));
+    const PlanningProblem p = test_support::randomBettsPointingRequest(seed, 32, scheme);
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.pointing.active);
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+    EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
+        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+    EXPECT_LT(r.pointing.error, 1e-9);
+    EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-9);
+    EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    EXPECT_NEAR(twistOf(r.maneuver.attitude.back(), p.end_condition), r.pointing.final_twist, 1e-9);
+    EXPECT_EQ(r.pointing.starts, 4);
+    EXPECT_GE(r.minimum_time.solves, 8);  // per start: the fixed twist's, then ψ freed
+    EXPECT_TRUE(std::isfinite(r.attempts.front().start_detail.twist));
+  }
+}
+
+TEST(PointingMinimumTime, BacksABoundedPointingVerdictWithTheTwistFree) {
+  // Minimum effort under the same torque bounds below and above T* (the twist free): below, the
+  // verdict is infeasible with T* as the least duration found; above, never infeasible.
+  PlanningProblem p = test_support::randomBettsPointingRequest(4203, 32, SchemeKind::SecondOrder);
+  const PlanResult fastest = planManeuver(p);
+  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  const double T_star = fastest.minimum_duration;
+  p.objective = Objective::MinimumEffort;
+  p.duration = 0.97 * T_star;
+  const PlanResult below = planManeuver(p);
+  EXPECT_EQ(below.termination, Termination::Infeasible) << below.message;
+  EXPECT_NEAR(below.duration_verdict.least_duration_found, T_star, 1e-6 * T_star);
+  p.duration = 1.05 * T_star;
+  const PlanResult above = planManeuver(p);
+  EXPECT_NE(above.termination, Termination::Infeasible) << above.message;
+}
+
+}  // namespace

@@ -102,3 +102,43 @@ TEST(MessageNotes, TheFieldsChooseTheBranchOfTheWording) {
                            T_star, "w", false, ap::Termination::Infeasible, true, 0.0}),
                        "found no plan within the bounds above T*"));
 }
+
+TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
+  const std::string reason = "converged after 3 iterations";
+  const ap::frames::RichardsonPair pair{32};
+  const ap::frames::RichardsonPair from_t_star{32, true};
+  const std::vector<ap::Frame> all = {
+      ap::frames::PairSolveStopped{pair, 64},
+      ap::frames::PairCombined{pair, false, "2N's"},
+      ap::frames::PairCombined{from_t_star, true, "2N's"},
+      ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
+      ap::frames::ReplayFailed{"step 7 too large"},
+  };
+  for (const ap::Frame& frame : all) {
+    const std::string words = ap::renderFrame(frame, reason);
+    SCOPED_TRACE(words);
+    const std::size_t at = words.find(reason);
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_GT(at, 0u);  // the frame's words come first
+    EXPECT_EQ(words.find(reason, at + 1), std::string::npos);
+    EXPECT_EQ(words.find('\n'), std::string::npos);
+  }
+  // The pair names N and 2N, where each solve started, and which one stopped.
+  const std::string stopped = ap::renderFrame(ap::frames::PairSolveStopped{pair, 64}, reason);
+  EXPECT_TRUE(contains(stopped, "second_order at N = 32 and 2N = 64)"));
+  EXPECT_TRUE(contains(stopped, "the second_order solve at N = 64 did not converge"));
+  const std::string combined =
+      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, "2N's"}, reason);
+  EXPECT_TRUE(contains(combined, "2N = 64, each from its plan at T*)"));
+  EXPECT_TRUE(contains(combined, "the plan is the second_order plan at N"));
+  EXPECT_TRUE(contains(combined, ": N: " + reason + " | 2N: 2N's"));
+  EXPECT_FALSE(
+      contains(ap::renderFrame(ap::frames::PairCombined{pair, false, "x"}, reason), "the plan is"));
+  // The class and replay frames put the plan's own message in parentheses after their reason.
+  EXPECT_EQ(ap::renderFrame(ap::frames::OutsideRequestedClass{"w"}, reason),
+            "not converged in the requested class: w (" + reason + ")");
+  ap::PlanResult r;
+  r.message = reason;
+  ap::frameMessage(&r, ap::frames::ReplayFailed{"e"});
+  EXPECT_EQ(r.message, "replay of the planned torques failed: e (" + reason + ")");
+}

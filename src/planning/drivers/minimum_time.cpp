@@ -102,15 +102,11 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
     fine = planFromMinimumTimePlan(sub, T, pair.fine, context);
   }
   std::vector<Attempt> trail = joined(coarse.attempts, fine.attempts);
-  const std::string what = "fourth_order (Richardson extrapolation of second_order at N = " +
-                           std::to_string(problem.steps) +
-                           " and 2N = " + std::to_string(2 * problem.steps) +
-                           ", each from its plan at T*)";
+  const frames::RichardsonPair each_from_its_plan{problem.steps, true};
   if (!coarse.converged() || !fine.converged()) {
     PlanResult failed = coarse.converged() ? fine : coarse;
-    failed.message = what + ": the second_order solve at N = " +
-                     std::to_string(coarse.converged() ? 2 * problem.steps : problem.steps) +
-                     " did not converge (its plan is returned): " + failed.message;
+    const int stopped = coarse.converged() ? 2 * problem.steps : problem.steps;
+    frameMessage(&failed, frames::PairSolveStopped{each_from_its_plan, stopped});
     failed.attempts = trail;
     return failed;
   }
@@ -120,11 +116,8 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   at.duration = T;
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
-  result.message = what +
-                   (replaced ? ": the plan is the second_order plan at N (the Richardson "
-                               "combination left a bound both meet)"
-                             : "") +
-                   ": N: " + coarse.message + " | 2N: " + fine.message;
+  result.message =
+      renderFrame(frames::PairCombined{each_from_its_plan, replaced, fine.message}, coarse.message);
   if (replaced) {  // the N solve's plan is the one returned
     trail = coarse.attempts;
     appendTrail(fine.attempts, false, &trail);

@@ -81,15 +81,12 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   const int N = problem.steps;
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
-  const std::string what =
-      "fourth_order (Richardson extrapolation of second_order at N = " + std::to_string(N) +
-      " and 2N = " + std::to_string(2 * N) + ")";
+  const frames::RichardsonPair pair{N};
   const PlanResult coarse = planAtResolution(sub, options, context);
   // The trail: the N solve's attempts, then the 2N solve's (the one kept is the 2N solve's).
   std::vector<Attempt> trail = followedBy({}, coarse.attempts, AttemptStage::FourthOrderCoarse);
   const auto failed = [&](PlanResult sub_result, int steps) {
-    sub_result.message = what + ": the second_order solve at N = " + std::to_string(steps) +
-                         " did not converge (its plan is returned): " + sub_result.message;
+    frameMessage(&sub_result, frames::PairSolveStopped{pair, steps});
     sub_result.attempts = trail;
     return sub_result;
   };
@@ -111,7 +108,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
-  result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
+  result.message = renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message);
   result.attempts = std::move(trail);
   return result;
 }
@@ -136,7 +133,7 @@ void refuseAnotherClass(const PlanningProblem& problem, PlanResult* result) {
   const std::string why = classInconsistency(*result);
   if (why.empty()) return;
   result->termination = Termination::NotConverged;
-  result->message = "not converged in the requested class: " + why + " (" + result->message + ")";
+  frameMessage(result, frames::OutsideRequestedClass{why});
 }
 
 /// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
@@ -273,8 +270,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       // (infeasible, stopped) keeps its own, with the replay's failure said after it.
       if (result.converged()) {
         result.termination = Termination::StepTooLarge;
-        result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
-                         result.message + ")";
+        frameMessage(&result, frames::ReplayFailed{e.what()});
       } else {
         addNote(&result, notes::LastIterateDoesNotReplay{e.what()});
       }

@@ -109,6 +109,29 @@ std::string words(const MinimumTimeUnsolved& n) {
          terminationName(n.termination) + ")";
 }
 
+std::string words(const frames::RichardsonPair& p) {
+  return "fourth_order (Richardson extrapolation of second_order at " + grid(p.steps) +
+         " and 2N = " + std::to_string(2 * p.steps) +
+         (p.from_plans_at_minimum_time ? ", each from its plan at T*)" : ")");
+}
+std::string framed(const frames::PairSolveStopped& f, const std::string& reason) {
+  return words(f.pair) + ": the second_order solve at " + grid(f.stopped_steps) +
+         " did not converge (its plan is returned): " + reason;
+}
+std::string framed(const frames::PairCombined& f, const std::string& reason) {
+  return words(f.pair) +
+         (f.replaced ? ": the plan is the second_order plan at N (the Richardson combination left "
+                       "a bound both meet)"
+                     : "") +
+         ": N: " + reason + " | 2N: " + f.fine_reason;
+}
+std::string framed(const frames::OutsideRequestedClass& f, const std::string& reason) {
+  return "not converged in the requested class: " + f.why + " (" + reason + ")";
+}
+std::string framed(const frames::ReplayFailed& f, const std::string& reason) {
+  return "replay of the planned torques failed: " + f.what + " (" + reason + ")";
+}
+
 }  // namespace
 
 std::string renderNote(const Note& note) {
@@ -117,6 +140,14 @@ std::string renderNote(const Note& note) {
 
 void addNote(PlanResult* result, const Note& note) {
   result->message.append(renderNote(note));
+}
+
+std::string renderFrame(const Frame& frame, const std::string& reason) {
+  return std::visit([&](const auto& f) { return framed(f, reason); }, frame);
+}
+
+void frameMessage(PlanResult* result, const Frame& frame) {
+  result->message = renderFrame(frame, result->message);
 }
 
 }  // namespace attitude_planner

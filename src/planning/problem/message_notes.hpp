@@ -130,4 +130,47 @@ std::string renderNote(const Note& note);
 /// Adds the clause to result->message (after what it says already).
 void addNote(PlanResult* result, const Note& note);
 
+// The clauses that frame a message instead of following it: said before the reason they are
+// given (and around it), worded here as the notes are (renderFrame).
+namespace frames {
+
+/// fourth_order's pair of second_order solves at N = `steps` and 2N; `from_plans_at_minimum_time`:
+/// each solve started from its own plan at T* (minimum_time.cpp), else from the usual starts.
+struct RichardsonPair {
+  int steps = 0;
+  bool from_plans_at_minimum_time = false;
+};
+/// A solve of the pair did not converge (the one at N = `stopped_steps`): its plan is returned,
+/// the reason it is given is that solve's message.
+struct PairSolveStopped {
+  RichardsonPair pair;
+  int stopped_steps = 0;
+};
+/// Both solves converged and were combined; the reason it is given is the N solve's message.
+/// `replaced`: the plan is the N solve's (the combination left a bound both meet).
+struct PairCombined {
+  RichardsonPair pair;
+  bool replaced = false;
+  std::string fine_reason;  ///< the 2N solve's message
+};
+/// A converged plan outside the class the request named: `why` (classInconsistency), around the
+/// plan's own message.
+struct OutsideRequestedClass {
+  std::string why;
+};
+/// The replay of a converged plan's torques failed (`what`), around the plan's own message.
+struct ReplayFailed {
+  std::string what;
+};
+
+}  // namespace frames
+
+using Frame = std::variant<frames::PairSolveStopped, frames::PairCombined,
+                           frames::OutsideRequestedClass, frames::ReplayFailed>;
+
+/// The message `frame` makes of `reason` (the message it is given).
+std::string renderFrame(const Frame& frame, const std::string& reason);
+/// result->message framed by `frame`.
+void frameMessage(PlanResult* result, const Frame& frame);
+
 }  // namespace attitude_planner

@@ -111,6 +111,9 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
       ap::frames::PairSolveStopped{pair, 64},
       ap::frames::PairCombined{pair, false, "2N's"},
       ap::frames::PairCombined{from_t_star, true, "2N's"},
+      ap::frames::MinimumTimePairStopped{32, true, false},
+      ap::frames::MinimumTimePairStopped{32, false, true},
+      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, "2N's"},
       ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
       ap::frames::ReplayFailed{"step 7 too large"},
   };
@@ -134,6 +137,19 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   EXPECT_TRUE(contains(combined, ": N: " + reason + " | 2N: 2N's"));
   EXPECT_FALSE(
       contains(ap::renderFrame(ap::frames::PairCombined{pair, false, "x"}, reason), "the plan is"));
+  // fourth_order minimum time: which solve stopped, and T* with the two it is the larger of.
+  EXPECT_TRUE(contains(
+      ap::renderFrame(ap::frames::MinimumTimePairStopped{32, false, true}, reason),
+      "problems at N = 32 and 2N = 64): the minimum-effort plan at T* at N did not converge"));
+  EXPECT_TRUE(contains(ap::renderFrame(ap::frames::MinimumTimePairStopped{32, true, false}, reason),
+                       "): the one at 2N did not converge (its plan is returned): " + reason));
+  const double T_star = 2.0 + 1.0 / 3.0;
+  const std::string pair_t_star = ap::renderFrame(
+      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, "2N's"}, reason);
+  EXPECT_TRUE(contains(pair_t_star, "T* = " + ap::exactNumber(T_star) + " s, the one at 2N binds"));
+  EXPECT_TRUE(contains(pair_t_star, "(T* at N = " + ap::exactNumber(2.0) + " s"));
+  EXPECT_TRUE(contains(pair_t_star, "the plan is the second_order plan at N at T*"));
+  EXPECT_TRUE(contains(pair_t_star, " | 2N: 2N's | N: " + reason));
   // The class and replay frames put the plan's own message in parentheses after their reason.
   EXPECT_EQ(ap::renderFrame(ap::frames::OutsideRequestedClass{"w"}, reason),
             "not converged in the requested class: w (" + reason + ")");

@@ -152,18 +152,15 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   coarse_problem.time_margin = 0.0;
   PlanningProblem fine_problem = coarse_problem;
   fine_problem.steps = 2 * N;
-  const std::string what =
-      "fourth_order minimum time (the second_order minimum-time problems at N = " +
-      std::to_string(N) + " and 2N = " + std::to_string(2 * N) + ")";
   PlanResult fine = minimumTimePlan(fine_problem, context);
-  const auto failed = [&](PlanResult sub, const std::string& which) {
+  const auto failed = [&](PlanResult sub, bool at_fine, bool effort_at_minimum_time) {
     sub.scheme = SchemeKind::FourthOrder;
-    sub.message = what + ": " + which + " did not converge (its plan is returned): " + sub.message;
+    frameMessage(&sub, frames::MinimumTimePairStopped{N, at_fine, effort_at_minimum_time});
     return sub;
   };
-  if (!fine.converged()) return failed(fine, "the one at 2N");
+  if (!fine.converged()) return failed(fine, true, false);
   PlanResult coarse = minimumTimePlan(coarse_problem, context);
-  if (!coarse.converged()) return failed(coarse, "the one at N");
+  if (!coarse.converged()) return failed(coarse, false, false);
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
   const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
   const double T_N = coarse.minimum_duration, T_2N = fine.minimum_duration;
@@ -185,8 +182,7 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
       appendTrail(coarse_trail, false, &trail);
       appendTrail(other_trail, false, &trail);
       at_T_star.attempts = trail;
-      return failed(at_T_star,
-                    std::string("the minimum-effort plan at T* at ") + (fine_binds ? "N" : "2N"));
+      return failed(at_T_star, !fine_binds, true);
     }
     other = at_T_star;
   }
@@ -208,15 +204,9 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
     a.stage = AttemptStage::MinimumTimePolish;
     result.attempts.push_back(a);
   }
-  std::ostringstream note;
-  note << what << ": T* = " << exactNumber(T_star) << " s, the one at " << (fine_binds ? "2N" : "N")
-       << " binds (T* at N = " << exactNumber(T_N) << " s, at 2N = " << exactNumber(T_2N) << " s); "
-       << (replaced ? "the plan is the second_order plan at N at T*: the Richardson combination "
-                      "with the 2N plan left a bound both meet"
-                    : "the plan combines the binding plan and the other's minimum-effort plan "
-                      "at T*")
-       << " | 2N: " << fine.message << " | N: " << coarse.message;
-  result.message = note.str();
+  result.message = renderFrame(
+      frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced, fine.message},
+      coarse.message);
   return result;
 }
 

@@ -125,6 +125,29 @@ std::string framed(const frames::PairCombined& f, const std::string& reason) {
                      : "") +
          ": N: " + reason + " | 2N: " + f.fine_reason;
 }
+std::string minimumTimePair(int steps) {
+  return "fourth_order minimum time (the second_order minimum-time problems at " + grid(steps) +
+         " and 2N = " + std::to_string(2 * steps) + ")";
+}
+std::string framed(const frames::MinimumTimePairStopped& f, const std::string& reason) {
+  const std::string at = f.at_fine ? "2N" : "N";
+  return minimumTimePair(f.steps) + ": " +
+         (f.effort_at_minimum_time ? "the minimum-effort plan at T* at " + at
+                                   : "the one at " + at) +
+         " did not converge (its plan is returned): " + reason;
+}
+std::string framed(const frames::MinimumTimePairCombined& f, const std::string& reason) {
+  std::ostringstream s;
+  s << minimumTimePair(f.steps) << ": T* = " << exactNumber(f.minimum_duration) << " s, the one at "
+    << (f.fine_binds ? "2N" : "N") << " binds (T* at N = " << exactNumber(f.at_coarse)
+    << " s, at 2N = " << exactNumber(f.at_fine) << " s); "
+    << (f.replaced ? "the plan is the second_order plan at N at T*: the Richardson combination "
+                     "with the 2N plan left a bound both meet"
+                   : "the plan combines the binding plan and the other's minimum-effort plan "
+                     "at T*")
+    << " | 2N: " << f.fine_reason << " | N: " << reason;
+  return s.str();
+}
 std::string framed(const frames::OutsideRequestedClass& f, const std::string& reason) {
   return "not converged in the requested class: " + f.why + " (" + reason + ")";
 }

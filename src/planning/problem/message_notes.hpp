@@ -153,6 +153,27 @@ struct PairCombined {
   bool replaced = false;
   std::string fine_reason;  ///< the 2N solve's message
 };
+/// fourth_order minimum time: a solve of its pair of second_order problems (N = `steps` and 2N)
+/// did not converge, the one at 2N (`at_fine`) or at N: its minimum-time problem, or
+/// (`effort_at_minimum_time`) the other one's minimum-effort plan at the binding T*; its plan is
+/// returned, the reason it is given is that solve's message.
+struct MinimumTimePairStopped {
+  int steps = 0;
+  bool at_fine = false;
+  bool effort_at_minimum_time = false;
+};
+/// fourth_order minimum time from its pair: T* = max(T* at N, T* at 2N), the one at 2N binds
+/// (`fine_binds`) or the one at N; `replaced`: the plan is the N plan at T* (see PairCombined).
+/// The reason it is given is the N solve's message, said last.
+struct MinimumTimePairCombined {
+  int steps = 0;
+  double minimum_duration = 0.0;  ///< T*
+  double at_coarse = 0.0;         ///< T* at N
+  double at_fine = 0.0;           ///< T* at 2N
+  bool fine_binds = false;
+  bool replaced = false;
+  std::string fine_reason;  ///< the 2N solve's message
+};
 /// A converged plan outside the class the request named: `why` (classInconsistency), around the
 /// plan's own message.
 struct OutsideRequestedClass {
@@ -166,6 +187,7 @@ struct ReplayFailed {
 }  // namespace frames
 
 using Frame = std::variant<frames::PairSolveStopped, frames::PairCombined,
+                           frames::MinimumTimePairStopped, frames::MinimumTimePairCombined,
                            frames::OutsideRequestedClass, frames::ReplayFailed>;
 
 /// The message `frame` makes of `reason` (the message it is given).

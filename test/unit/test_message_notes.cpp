@@ -41,6 +41,7 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
       notes::PlannedAtMargin{0.1, 3.3, 3.0},
       notes::MinimumTimeRestart{3.0, "why", false, ap::Termination::Infeasible, false, 0.0},
       notes::MinimumTimeUnsolved{"why", ap::Termination::NotConverged},
+      notes::DescendedFromProbe{2.5, 3.0},
   };
   for (const ap::Note& note : all) {
     const std::string words = ap::renderNote(note);
@@ -114,6 +115,10 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
       ap::frames::MinimumTimePairStopped{32, true, false},
       ap::frames::MinimumTimePairStopped{32, false, true},
       ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, "2N's"},
+      ap::frames::UpperBoundFromProbe{2.5, 3.0},
+      ap::frames::StuckAtMinimumTimePlan{true, 2.0, 3.0, 0.0},
+      ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 2.5},
+      ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 0.0},
       ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
       ap::frames::ReplayFailed{"step 7 too large"},
   };
@@ -157,4 +162,39 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   r.message = reason;
   ap::frameMessage(&r, ap::frames::ReplayFailed{"e"});
   EXPECT_EQ(r.message, "replay of the planned torques failed: e (" + reason + ")");
+}
+
+TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {
+  // Spinning ends: a probe below T* found a plan; the free-time solve descended from it, or not.
+  const double below = 2.0 + 1.0 / 3.0, previous = 2.5;
+  const std::string found = "; a plan was found at " + ap::exactNumber(below) +
+                            " s, below the T* = " + ap::exactNumber(previous) + " s reached before";
+  EXPECT_EQ(ap::renderNote(notes::DescendedFromProbe{below, previous}),
+            found + ", and the free-time solve from it descended");
+  EXPECT_EQ(ap::renderFrame(ap::frames::UpperBoundFromProbe{below, previous}, "r"),
+            "minimum time T* <= " + ap::exactNumber(below) +
+                " s, the least duration found feasible (an upper bound)" + found +
+                " (its minimum-effort plan is returned): r");
+  // Stuck at the minimum-time plan: the branch its fields choose, the durations exact.
+  const std::string rest =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{true, below, 3, 2.9}, "r");
+  EXPECT_EQ(rest.rfind("not converged (feasible: T* = " + ap::exactNumber(below) + " s <= ", 0),
+            0u);
+  EXPECT_FALSE(contains(rest, "ladder"));
+  const std::string ladder =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{false, below, 3.0, 2.75}, "r");
+  EXPECT_EQ(ladder.rfind("infeasible from here (a local verdict): no plan within the bounds was "
+                         "found at T = " +
+                             ap::exactNumber(3.0) + " s",
+                         0),
+            0u);
+  EXPECT_TRUE(
+      contains(ladder, "found up to T = " + ap::exactNumber(2.75) + " s, where the ladder"));
+  const std::string none =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{false, below, 3, 0}, "r");
+  EXPECT_EQ(none.rfind("not converged (a plan within the bounds exists at T* = " +
+                           ap::exactNumber(below) + " s < T",
+                       0),
+            0u);
+  for (const std::string& s : {rest, ladder, none}) EXPECT_EQ(s.substr(s.size() - 4), "): r");
 }

@@ -249,12 +249,9 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   std::vector<Attempt> tried;
   std::optional<PlanResult> lower =
       freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
-  const std::string found = "; a plan was found at " + exactNumber(effort.duration) +
-                            " s, below the T* = " + exactNumber(answer.minimum_duration) +
-                            " s reached before";
   if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
     lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
-    lower->message = lower->message + found + ", and the free-time solve from it descended";
+    addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
     return *lower;
   }
   PlanResult upper = below;
@@ -263,9 +260,8 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
   upper.minimum_time.solves = answer.minimum_time.solves;
-  upper.message = "minimum time T* <= " + exactNumber(effort.duration) +
-                  " s, the least duration found feasible (an upper bound)" + found +
-                  " (its minimum-effort plan is returned): " + below.message;
+  upper.message = renderFrame(frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration},
+                              below.message);
   return upper;
 }
 
@@ -522,28 +518,15 @@ bool restToRest(const PlanningProblem& problem) {
 /// a local verdict naming the durations where plans were found.
 void labelStuckAnswer(const PlanningProblem& problem, double T_star, const LadderClimb& climb,
                       PlanResult* again) {
-  std::ostringstream why;
-  if (restToRest(problem)) {
+  const bool rest_to_rest = restToRest(problem);
+  if (rest_to_rest || !(climb.reached > 0.0)) {
     again->termination = Termination::NotConverged;
-    why << "not converged (feasible: T* = " << exactNumber(T_star)
-        << " s <= the requested duration and the ends are at rest, but the minimum-effort solve "
-           "from the minimum-time plan ended at an infeasible point): ";
-  } else if (climb.reached > 0.0) {
+  } else {
     again->duration_verdict.least_duration_found = T_star;
     again->duration_verdict.longest_duration_found = climb.reached;
-    why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
-        << exactNumber(problem.duration)
-        << " s; from the minimum-time plan (T* = " << exactNumber(T_star)
-        << " s) plans within the bounds were found up to T = " << exactNumber(climb.reached)
-        << " s, where the ladder of durations stopped (spinning ends: not a limit, other classes "
-           "may hold plans at T): ";
-  } else {
-    again->termination = Termination::NotConverged;
-    why << "not converged (a plan within the bounds exists at T* = " << exactNumber(T_star)
-        << " s < T, but with spinning ends a longer duration need not be feasible in its class; "
-           "the solves from it ended at infeasible points): ";
   }
-  again->message = why.str() + again->message;
+  frameMessage(
+      again, frames::StuckAtMinimumTimePlan{rest_to_rest, T_star, problem.duration, climb.reached});
 }
 
 /// A bounded minimum-effort answer from the minimum-time plan at T* ≤ T (`first` the solve

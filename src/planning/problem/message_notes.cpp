@@ -73,6 +73,13 @@ std::string words(const LastPointingStart& n) {
 std::string words(const SearchSummary& n) {
   return n.summary;
 }
+std::string foundBelow(double duration, double previous) {
+  return "; a plan was found at " + exactNumber(duration) +
+         " s, below the T* = " + exactNumber(previous) + " s reached before";
+}
+std::string words(const DescendedFromProbe& n) {
+  return foundBelow(n.duration, n.previous) + ", and the free-time solve from it descended";
+}
 std::string words(const SearchedOnT& n) {
   return "; searched on T (" + n.why + ")";
 }
@@ -147,6 +154,32 @@ std::string framed(const frames::MinimumTimePairCombined& f, const std::string& 
                      "at T*")
     << " | 2N: " << f.fine_reason << " | N: " << reason;
   return s.str();
+}
+std::string framed(const frames::UpperBoundFromProbe& f, const std::string& reason) {
+  return "minimum time T* <= " + exactNumber(f.duration) +
+         " s, the least duration found feasible (an upper bound)" +
+         foundBelow(f.duration, f.previous) + " (its minimum-effort plan is returned): " + reason;
+}
+std::string framed(const frames::StuckAtMinimumTimePlan& f, const std::string& reason) {
+  std::ostringstream why;
+  if (f.rest_to_rest) {
+    why << "not converged (feasible: T* = " << exactNumber(f.minimum_duration)
+        << " s <= the requested duration and the ends are at rest, but the minimum-effort solve "
+           "from the minimum-time plan ended at an infeasible point): ";
+  } else if (f.ladder_reached > 0.0) {
+    why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
+        << exactNumber(f.requested)
+        << " s; from the minimum-time plan (T* = " << exactNumber(f.minimum_duration)
+        << " s) plans within the bounds were found up to T = " << exactNumber(f.ladder_reached)
+        << " s, where the ladder of durations stopped (spinning ends: not a limit, other classes "
+           "may hold plans at T): ";
+  } else {
+    why << "not converged (a plan within the bounds exists at T* = "
+        << exactNumber(f.minimum_duration)
+        << " s < T, but with spinning ends a longer duration need not be feasible in its class; "
+           "the solves from it ended at infeasible points): ";
+  }
+  return why.str() + reason;
 }
 std::string framed(const frames::OutsideRequestedClass& f, const std::string& reason) {
   return "not converged in the requested class: " + f.why + " (" + reason + ")";

@@ -78,6 +78,12 @@ struct LastPointingStart {
 struct SearchSummary {
   std::string summary;
 };
+/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration`, and the free-time
+/// solve from it descended to a lower KKT point.
+struct DescendedFromProbe {
+  double duration = 0.0;
+  double previous = 0.0;
+};
 /// Minimum time searched on T instead of solved free-time, and `why`.
 struct SearchedOnT {
   std::string why;
@@ -123,7 +129,7 @@ using Note =
                  notes::AfterGuessStopped, notes::LastIterateDoesNotReplay, notes::CheapestClass,
                  notes::LastPointingStart, notes::SearchSummary, notes::SearchedOnT,
                  notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
-                 notes::RestartEnded, notes::MinimumTimeUnsolved>;
+                 notes::RestartEnded, notes::MinimumTimeUnsolved, notes::DescendedFromProbe>;
 
 /// The clause's words ("; grid continuation from N = 8", ...), each starting with its separator.
 std::string renderNote(const Note& note);
@@ -174,6 +180,23 @@ struct MinimumTimePairCombined {
   bool replaced = false;
   std::string fine_reason;  ///< the 2N solve's message
 };
+/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration` from which the
+/// free-time solve did not descend: T* ≤ `duration`, an upper bound; the reason it is given is the
+/// probe's message.
+struct UpperBoundFromProbe {
+  double duration = 0.0;
+  double previous = 0.0;
+};
+/// A bounded minimum-effort request at T (`requested`) ≥ T* = `minimum_duration` whose solves
+/// from the minimum-time plan ended at infeasible points: rest to rest, feasible but not
+/// converged; else, where the ladder of durations found plans up to `ladder_reached` (> 0), a
+/// local "infeasible from here"; else not converged. The reason it is given is the last solve's.
+struct StuckAtMinimumTimePlan {
+  bool rest_to_rest = false;
+  double minimum_duration = 0.0;
+  double requested = 0.0;
+  double ladder_reached = 0.0;
+};
 /// A converged plan outside the class the request named: `why` (classInconsistency), around the
 /// plan's own message.
 struct OutsideRequestedClass {
@@ -188,6 +211,7 @@ struct ReplayFailed {
 
 using Frame = std::variant<frames::PairSolveStopped, frames::PairCombined,
                            frames::MinimumTimePairStopped, frames::MinimumTimePairCombined,
+                           frames::UpperBoundFromProbe, frames::StuckAtMinimumTimePlan,
                            frames::OutsideRequestedClass, frames::ReplayFailed>;
 
 /// The message `frame` makes of `reason` (the message it is given).

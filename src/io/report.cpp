@@ -204,7 +204,8 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"proven_infeasible\": " << (r.duration_verdict.proven_infeasible ? "true" : "false")
       << ", \"least_duration_found\": " << jsonNumber(r.duration_verdict.least_duration_found)
       << ", \"longest_duration_found\": " << jsonNumber(r.duration_verdict.longest_duration_found)
-      << "},\n"
+      << ", \"rate_limit\": " << jsonNumber(r.duration_verdict.rate_limit)
+      << ", \"torque_limit\": " << jsonNumber(r.duration_verdict.torque_limit) << "},\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"

@@ -143,6 +143,8 @@ DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& v) {
   msg.proven_infeasible = v.proven_infeasible;
   msg.least_duration_found = v.least_duration_found;
   msg.longest_duration_found = v.longest_duration_found;
+  msg.rate_limit = v.rate_limit;
+  msg.torque_limit = v.torque_limit;
   return msg;
 }
 

@@ -172,6 +172,7 @@ void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world
   }
   res->initial_costate = ros_conversions::vectorToMsg(p.initial_costate);
   res->cost = p.cost;
+  res->other_costs = p.other_costs;
   res->iterations = p.iterations;
   res->continuation_stages = p.continuation_stages;
   res->terminal_attitude_error = p.terminal_error;

@@ -695,7 +695,11 @@ TEST_F(PlannerService, InfeasibleAnswerIsOneLineWithTheAccountInDetails) {
   ASSERT_EQ(res.error_code.val, PlanErrorCode::INFEASIBLE) << res.message;
   EXPECT_EQ(res.message.rfind("infeasible: ", 0), 0u) << res.message;
   EXPECT_EQ(res.message.find('\n'), std::string::npos) << res.message;
-  EXPECT_NE(res.message.find("0.05 rad/s"), std::string::npos) << res.message;  // the binding one
+  // The binding limit, as the proof's figure (the message is worded from it).
+  EXPECT_TRUE(res.duration_verdict.proven_infeasible);
+  EXPECT_EQ(res.duration_verdict.rate_limit, 0.05) << res.message;
+  EXPECT_EQ(res.duration_verdict.torque_limit, 0.0) << res.message;  // no torque bound
+  EXPECT_NEAR(res.duration_verdict.lower_bound, M_PI / 3 / 0.05, 1e-9);
   EXPECT_LE(res.message.size(), 200u) << res.message;
   EXPECT_GT(res.details.size(), res.message.size()) << res.details;
   // Below the proven bound θ/w = 20.9 s the answer needs no solve, and says it is proven.

@@ -47,9 +47,16 @@ TEST(DurationBound, IsTheEigenaxisBangBangTimeOfASphericalBody) {
   PlanningProblem p = slew(Vector3::Constant(j), theta, Vector3(1, -2, 0.5));
   p.constraints = {PlanningConstraint::maxTorqueNorm(a)};
   EXPECT_NEAR(durationLowerBound(p).seconds, 2 * std::sqrt(theta * j / a), 1e-9);
+  EXPECT_EQ(durationLowerBound(p).torque_limit, a);  // the proof's figures, as fields
+  EXPECT_EQ(durationLowerBound(p).rate_limit, 0.0);
   const double w = 0.5 * std::sqrt(a * theta / j);
   p.constraints.push_back(PlanningConstraint::maxAngularRate(w));
-  EXPECT_NEAR(durationLowerBound(p).seconds, theta / w + w * j / a, 1e-5);
+  const DurationLowerBound both = durationLowerBound(p);
+  EXPECT_NEAR(both.seconds, theta / w + w * j / a, 1e-5);
+  EXPECT_NEAR(both.seconds, theta / both.rate_limit + both.rate_limit * j / both.torque_limit,
+              1e-5);
+  EXPECT_EQ(both.rate_limit, w);
+  EXPECT_EQ(both.torque_limit, a);
 }
 
 TEST(DurationBound, BoundsTheMomentumChangeOfASpinUp) {
@@ -59,6 +66,9 @@ TEST(DurationBound, BoundsTheMomentumChangeOfASpinUp) {
   p.final_velocity = Vector3(0.4, 0, 0);
   p.max_torque = Vector3::Constant(0.1);
   EXPECT_NEAR(durationLowerBound(p).seconds, 0.4 / (0.1 * std::sqrt(3.0)), 1e-12);
+  // The box's corner is the largest torque magnitude; no rate limit.
+  EXPECT_NEAR(durationLowerBound(p).torque_limit, 0.1 * std::sqrt(3.0), 1e-15);
+  EXPECT_EQ(durationLowerBound(p).rate_limit, 0.0);
 }
 
 TEST(DurationBound, IsInvariantUnderWorldRotationAndScalesWithTimeAndInertia) {
@@ -109,6 +119,8 @@ TEST(DurationBound, NoSchemesMinimumTimePlanIsShorter) {
     const double bound = discreteDurationLowerBound(durationLowerBound(p), p.steps);
     EXPECT_GE(r.minimum_duration, bound);
     EXPECT_DOUBLE_EQ(r.duration_verdict.lower_bound, durationLowerBound(p).seconds);
+    EXPECT_DOUBLE_EQ(r.duration_verdict.torque_limit, durationLowerBound(p).torque_limit);
+    EXPECT_EQ(r.duration_verdict.rate_limit, 0.0);
   }
   EXPECT_GE(checked, 7);
 }

@@ -167,6 +167,23 @@ TEST(CodeShape, HandMergedMessagesAndIterationCountsOnlyFall) {
   RecordProperty("iteration_sums", static_cast<int>(iterations.size()));
 }
 
+// The message is to be rendered once from a structured verdict and its notes; until then the
+// lines that assign one (a solver's first reason, a driver's verdict, a copy, a frame built by
+// hand) only fall: wrappers are frames worded in problem/message_notes (renderFrame).
+TEST(CodeShape, MessageAssignmentsOnlyFall) {
+  constexpr std::size_t kMessageAssignmentsLeft = 41;  // main 5e2b279: 49
+  const std::vector<std::string> owners = {"/problem/solve_context.", "/problem/message_notes."};
+  int files = 0;
+  const auto assigned =
+      linesContaining(kSourceDir + "/src/planning", {"message = "}, owners, &files);
+  EXPECT_GT(files, 40) << "the scan read no sources";
+  std::string listed;
+  for (const std::string& line : assigned) listed += line + "\n";
+  EXPECT_LE(assigned.size(), kMessageAssignmentsLeft) << listed;
+  EXPECT_GT(assigned.size(), 0u) << "the scan finds what it looks for";
+  RecordProperty("message_assignments", static_cast<int>(assigned.size()));
+}
+
 /// The indented block after "It prints:" in README.md, one string per line.
 std::vector<std::string> readmePrintedLines() {
   std::ifstream readme(kSourceDir + "/README.md");

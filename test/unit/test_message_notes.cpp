@@ -43,6 +43,7 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
       notes::PlannedAtMargin{0.1, 3.3, 3.0},
       notes::MinimumTimeRestart{3.0, "why", false, ap::Termination::Infeasible, false, 0.0},
       notes::MinimumTimeUnsolved{"why", ap::Termination::NotConverged},
+      notes::DescendedFromProbe{2.5, 3.0},
   };
   for (const ap::Note& note : all) {
     const std::string words = ap::renderNote(note);
@@ -103,4 +104,99 @@ TEST(MessageNotes, TheFieldsChooseTheBranchOfTheWording) {
   EXPECT_TRUE(contains(ap::renderNote(notes::MinimumTimeRestart{
                            T_star, "w", false, ap::Termination::Infeasible, true, 0.0}),
                        "found no plan within the bounds above T*"));
+}
+
+TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
+  const std::string reason = "converged after 3 iterations";
+  const ap::frames::RichardsonPair pair{32};
+  const ap::frames::RichardsonPair from_t_star{32, true};
+  const std::vector<ap::Frame> all = {
+      ap::frames::PairSolveStopped{pair, 64},
+      ap::frames::PairCombined{pair, false, "2N's"},
+      ap::frames::PairCombined{from_t_star, true, "2N's"},
+      ap::frames::MinimumTimePairStopped{32, true, false},
+      ap::frames::MinimumTimePairStopped{32, false, true},
+      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, "2N's"},
+      ap::frames::UpperBoundFromProbe{2.5, 3.0},
+      ap::frames::StuckAtMinimumTimePlan{true, 2.0, 3.0, 0.0},
+      ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 2.5},
+      ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 0.0},
+      ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
+      ap::frames::ReplayFailed{"step 7 too large"},
+  };
+  for (const ap::Frame& frame : all) {
+    const std::string words = ap::renderFrame(frame, reason);
+    SCOPED_TRACE(words);
+    const std::size_t at = words.find(reason);
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_GT(at, 0u);  // the frame's words come first
+    EXPECT_EQ(words.find(reason, at + 1), std::string::npos);
+    EXPECT_EQ(words.find('\n'), std::string::npos);
+  }
+  // The pair names N and 2N, where each solve started, and which one stopped.
+  const std::string stopped = ap::renderFrame(ap::frames::PairSolveStopped{pair, 64}, reason);
+  EXPECT_TRUE(contains(stopped, "second_order at N = 32 and 2N = 64)"));
+  EXPECT_TRUE(contains(stopped, "the second_order solve at N = 64 did not converge"));
+  const std::string combined =
+      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, "2N's"}, reason);
+  EXPECT_TRUE(contains(combined, "2N = 64, each from its plan at T*)"));
+  EXPECT_TRUE(contains(combined, "the plan is the second_order plan at N"));
+  EXPECT_TRUE(contains(combined, ": N: " + reason + " | 2N: 2N's"));
+  EXPECT_FALSE(
+      contains(ap::renderFrame(ap::frames::PairCombined{pair, false, "x"}, reason), "the plan is"));
+  // fourth_order minimum time: which solve stopped, and T* with the two it is the larger of.
+  EXPECT_TRUE(contains(
+      ap::renderFrame(ap::frames::MinimumTimePairStopped{32, false, true}, reason),
+      "problems at N = 32 and 2N = 64): the minimum-effort plan at T* at N did not converge"));
+  EXPECT_TRUE(contains(ap::renderFrame(ap::frames::MinimumTimePairStopped{32, true, false}, reason),
+                       "): the one at 2N did not converge (its plan is returned): " + reason));
+  const double T_star = 2.0 + 1.0 / 3.0;
+  const std::string pair_t_star = ap::renderFrame(
+      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, "2N's"}, reason);
+  EXPECT_TRUE(contains(pair_t_star, "T* = " + ap::exactNumber(T_star) + " s, the one at 2N binds"));
+  EXPECT_TRUE(contains(pair_t_star, "(T* at N = " + ap::exactNumber(2.0) + " s"));
+  EXPECT_TRUE(contains(pair_t_star, "the plan is the second_order plan at N at T*"));
+  EXPECT_TRUE(contains(pair_t_star, " | 2N: 2N's | N: " + reason));
+  // The class and replay frames put the plan's own message in parentheses after their reason.
+  EXPECT_EQ(ap::renderFrame(ap::frames::OutsideRequestedClass{"w"}, reason),
+            "not converged in the requested class: w (" + reason + ")");
+  ap::PlanResult r;
+  r.message = reason;
+  ap::frameMessage(&r, ap::frames::ReplayFailed{"e"});
+  EXPECT_EQ(r.message, "replay of the planned torques failed: e (" + reason + ")");
+}
+
+TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {
+  // Spinning ends: a probe below T* found a plan; the free-time solve descended from it, or not.
+  const double below = 2.0 + 1.0 / 3.0, previous = 2.5;
+  const std::string found = "; a plan was found at " + ap::exactNumber(below) +
+                            " s, below the T* = " + ap::exactNumber(previous) + " s reached before";
+  EXPECT_EQ(ap::renderNote(notes::DescendedFromProbe{below, previous}),
+            found + ", and the free-time solve from it descended");
+  EXPECT_EQ(ap::renderFrame(ap::frames::UpperBoundFromProbe{below, previous}, "r"),
+            "minimum time T* <= " + ap::exactNumber(below) +
+                " s, the least duration found feasible (an upper bound)" + found +
+                " (its minimum-effort plan is returned): r");
+  // Stuck at the minimum-time plan: the branch its fields choose, the durations exact.
+  const std::string rest =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{true, below, 3, 2.9}, "r");
+  EXPECT_EQ(rest.rfind("not converged (feasible: T* = " + ap::exactNumber(below) + " s <= ", 0),
+            0u);
+  EXPECT_FALSE(contains(rest, "ladder"));
+  const std::string ladder =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{false, below, 3.0, 2.75}, "r");
+  EXPECT_EQ(ladder.rfind("infeasible from here (a local verdict): no plan within the bounds was "
+                         "found at T = " +
+                             ap::exactNumber(3.0) + " s",
+                         0),
+            0u);
+  EXPECT_TRUE(
+      contains(ladder, "found up to T = " + ap::exactNumber(2.75) + " s, where the ladder"));
+  const std::string none =
+      ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{false, below, 3, 0}, "r");
+  EXPECT_EQ(none.rfind("not converged (a plan within the bounds exists at T* = " +
+                           ap::exactNumber(below) + " s < T",
+                       0),
+            0u);
+  for (const std::string& s : {rest, ladder, none}) EXPECT_EQ(s.substr(s.size() - 4), "): r");
 }

@@ -192,6 +192,10 @@ struct DurationVerdict {
   /// bounds allow and the angle to turn; the grid is held to it within O(h)); 0: none applies.
   double lower_bound = 0.0;
   std::string lower_bound_basis;  ///< how lower_bound is proven (empty with none)
+  /// The figures of that proof (lower_bound_basis renders them): the rate limit w [rad/s] and the
+  /// largest torque magnitude a [N m] the torque bounds allow; 0 where none bounds it.
+  double rate_limit = 0.0;
+  double torque_limit = 0.0;
   /// The answer "infeasible" is proven (the request's T is below lower_bound on its grid), not
   /// the local verdict of a solve.
   bool proven_infeasible = false;

@@ -111,6 +111,8 @@ PlanResult runInternalPhase(const std::string& phase, const std::function<PlanRe
 void recordLowerBound(const DurationLowerBound& bound, PlanResult* result) {
   result->duration_verdict.lower_bound = bound.seconds;
   result->duration_verdict.lower_bound_basis = bound.basis;
+  result->duration_verdict.rate_limit = bound.rate_limit;
+  result->duration_verdict.torque_limit = bound.torque_limit;
 }
 
 std::string localInfeasibility(double requested, double least_found, const std::string& what_found,

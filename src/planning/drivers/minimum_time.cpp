@@ -103,15 +103,11 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
     fine = planFromMinimumTimePlan(sub, T, pair.fine, context);
   }
   std::vector<Attempt> trail = joined(coarse.attempts, fine.attempts);
-  const std::string what = "fourth_order (Richardson extrapolation of second_order at N = " +
-                           std::to_string(problem.steps) +
-                           " and 2N = " + std::to_string(2 * problem.steps) +
-                           ", each from its plan at T*)";
+  const frames::RichardsonPair each_from_its_plan{problem.steps, true};
   if (!coarse.converged() || !fine.converged()) {
     PlanResult failed = coarse.converged() ? fine : coarse;
-    failed.message = what + ": the second_order solve at N = " +
-                     std::to_string(coarse.converged() ? 2 * problem.steps : problem.steps) +
-                     " did not converge (its plan is returned): " + failed.message;
+    const int stopped = coarse.converged() ? 2 * problem.steps : problem.steps;
+    frameMessage(&failed, frames::PairSolveStopped{each_from_its_plan, stopped});
     failed.attempts = trail;
     return failed;
   }
@@ -121,11 +117,8 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   at.duration = T;
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
-  result.message = what +
-                   (replaced ? ": the plan is the second_order plan at N (the Richardson "
-                               "combination left a bound both meet)"
-                             : "") +
-                   ": N: " + coarse.message + " | 2N: " + fine.message;
+  result.message =
+      renderFrame(frames::PairCombined{each_from_its_plan, replaced, fine.message}, coarse.message);
   if (replaced) {  // the N solve's plan is the one returned
     trail = coarse.attempts;
     appendTrail(fine.attempts, false, &trail);
@@ -160,18 +153,15 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   coarse_problem.time_margin = 0.0;
   PlanningProblem fine_problem = coarse_problem;
   fine_problem.steps = 2 * N;
-  const std::string what =
-      "fourth_order minimum time (the second_order minimum-time problems at N = " +
-      std::to_string(N) + " and 2N = " + std::to_string(2 * N) + ")";
   PlanResult fine = minimumTimePlan(fine_problem, context);
-  const auto failed = [&](PlanResult sub, const std::string& which) {
+  const auto failed = [&](PlanResult sub, bool at_fine, bool effort_at_minimum_time) {
     sub.scheme = SchemeKind::FourthOrder;
-    sub.message = what + ": " + which + " did not converge (its plan is returned): " + sub.message;
+    frameMessage(&sub, frames::MinimumTimePairStopped{N, at_fine, effort_at_minimum_time});
     return sub;
   };
-  if (!fine.converged()) return failed(fine, "the one at 2N");
+  if (!fine.converged()) return failed(fine, true, false);
   PlanResult coarse = minimumTimePlan(coarse_problem, context);
-  if (!coarse.converged()) return failed(coarse, "the one at N");
+  if (!coarse.converged()) return failed(coarse, false, false);
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
   const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
   const double T_N = coarse.minimum_duration, T_2N = fine.minimum_duration;
@@ -193,8 +183,7 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
       appendTrail(coarse_trail, false, &trail);
       appendTrail(other_trail, false, &trail);
       at_T_star.attempts = trail;
-      return failed(at_T_star,
-                    std::string("the minimum-effort plan at T* at ") + (fine_binds ? "N" : "2N"));
+      return failed(at_T_star, !fine_binds, true);
     }
     other = at_T_star;
   }
@@ -216,15 +205,9 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
     a.stage = AttemptStage::MinimumTimePolish;
     result.attempts.push_back(a);
   }
-  std::ostringstream note;
-  note << what << ": T* = " << exactNumber(T_star) << " s, the one at " << (fine_binds ? "2N" : "N")
-       << " binds (T* at N = " << exactNumber(T_N) << " s, at 2N = " << exactNumber(T_2N) << " s); "
-       << (replaced ? "the plan is the second_order plan at N at T*: the Richardson combination "
-                      "with the 2N plan left a bound both meet"
-                    : "the plan combines the binding plan and the other's minimum-effort plan "
-                      "at T*")
-       << " | 2N: " << fine.message << " | N: " << coarse.message;
-  result.message = note.str();
+  result.message = renderFrame(
+      frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced, fine.message},
+      coarse.message);
   return result;
 }
 
@@ -267,12 +250,9 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   std::vector<Attempt> tried;
   std::optional<PlanResult> lower =
       freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
-  const std::string found = "; a plan was found at " + exactNumber(effort.duration) +
-                            " s, below the T* = " + exactNumber(answer.minimum_duration) +
-                            " s reached before";
   if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
     lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
-    lower->message = lower->message + found + ", and the free-time solve from it descended";
+    addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
     return *lower;
   }
   PlanResult upper = below;
@@ -281,9 +261,8 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
   upper.minimum_time.solves = answer.minimum_time.solves;
-  upper.message = "minimum time T* <= " + exactNumber(effort.duration) +
-                  " s, the least duration found feasible (an upper bound)" + found +
-                  " (its minimum-effort plan is returned): " + below.message;
+  upper.message = renderFrame(frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration},
+                              below.message);
   return upper;
 }
 
@@ -576,28 +555,15 @@ bool restToRest(const PlanningProblem& problem) {
 /// a local verdict naming the durations where plans were found.
 void labelStuckAnswer(const PlanningProblem& problem, double T_star, const LadderClimb& climb,
                       PlanResult* again) {
-  std::ostringstream why;
-  if (restToRest(problem)) {
+  const bool rest_to_rest = restToRest(problem);
+  if (rest_to_rest || !(climb.reached > 0.0)) {
     again->termination = Termination::NotConverged;
-    why << "not converged (feasible: T* = " << exactNumber(T_star)
-        << " s <= the requested duration and the ends are at rest, but the minimum-effort solve "
-           "from the minimum-time plan ended at an infeasible point): ";
-  } else if (climb.reached > 0.0) {
+  } else {
     again->duration_verdict.least_duration_found = T_star;
     again->duration_verdict.longest_duration_found = climb.reached;
-    why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
-        << exactNumber(problem.duration)
-        << " s; from the minimum-time plan (T* = " << exactNumber(T_star)
-        << " s) plans within the bounds were found up to T = " << exactNumber(climb.reached)
-        << " s, where the ladder of durations stopped (spinning ends: not a limit, other classes "
-           "may hold plans at T): ";
-  } else {
-    again->termination = Termination::NotConverged;
-    why << "not converged (a plan within the bounds exists at T* = " << exactNumber(T_star)
-        << " s < T, but with spinning ends a longer duration need not be feasible in its class; "
-           "the solves from it ended at infeasible points): ";
   }
-  again->message = why.str() + again->message;
+  frameMessage(
+      again, frames::StuckAtMinimumTimePlan{rest_to_rest, T_star, problem.duration, climb.reached});
 }
 
 /// A bounded minimum-effort answer from the minimum-time plan at T* ≤ T (`first` the solve

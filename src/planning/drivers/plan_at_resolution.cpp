@@ -54,6 +54,18 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
   }
 }
 
+/// The trail of a solve that `earlier` attempts led to: those (none kept any more), then the
+/// later solve's own, whose first-stage attempts are marked `stage`.
+std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<Attempt>& later,
+                                AttemptStage stage) {
+  for (Attempt& a : earlier) a.kept = false;
+  for (Attempt a : later) {
+    if (a.stage == AttemptStage::Solve) a.stage = stage;
+    earlier.push_back(a);
+  }
+  return earlier;
+}
+
 /// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md),
 /// the combination of the two plans in richardsonCombination (drivers/fourth_order.hpp). Both
 /// solves get the request's solver, constraints, effects and what is left of its time budget; the
@@ -61,19 +73,21 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
 /// starts cold: its grid continuation (N/2, N/8, … with Richardson-extrapolated step rates) starts
 /// it better than the coarse plan refined at the step midpoints (torques are second differences: an
 /// O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations instead of 2). The
-/// result converges only if both do.
+/// result converges only if both do; its trail is the N solve's attempts (stage
+/// fourth_order_coarse where they were the solver's own solve), then the 2N solve's
+/// (fourth_order_fine), the 2N solve's kept one kept.
 PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& options,
                            SolveContext& context) {
   const int N = problem.steps;
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
-  const std::string what =
-      "fourth_order (Richardson extrapolation of second_order at N = " + std::to_string(N) +
-      " and 2N = " + std::to_string(2 * N) + ")";
+  const frames::RichardsonPair pair{N};
   const PlanResult coarse = planAtResolution(sub, options, context);
+  // The trail: the N solve's attempts, then the 2N solve's (the one kept is the 2N solve's).
+  std::vector<Attempt> trail = followedBy({}, coarse.attempts, AttemptStage::FourthOrderCoarse);
   const auto failed = [&](PlanResult sub_result, int steps) {
-    sub_result.message = what + ": the second_order solve at N = " + std::to_string(steps) +
-                         " did not converge (its plan is returned): " + sub_result.message;
+    frameMessage(&sub_result, frames::PairSolveStopped{pair, steps});
+    sub_result.attempts = trail;
     return sub_result;
   };
   if (!coarse.converged()) return failed(coarse, N);
@@ -90,10 +104,12 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
     fine_options.enumerate_classes = false;
   }
   const PlanResult fine = planAtResolution(sub, fine_options, context);
+  trail = followedBy(std::move(trail), fine.attempts, AttemptStage::FourthOrderFine);
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
-  result.message = what + ": N: " + coarse.message + " | 2N: " + fine.message;
+  result.message = renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message);
+  result.attempts = std::move(trail);
   return result;
 }
 
@@ -117,19 +133,7 @@ void refuseAnotherClass(const PlanningProblem& problem, PlanResult* result) {
   const std::string why = classInconsistency(*result);
   if (why.empty()) return;
   result->termination = Termination::NotConverged;
-  result->message = "not converged in the requested class: " + why + " (" + result->message + ")";
-}
-
-/// The trail of a solve that `earlier` attempts led to: those (none kept any more), then the
-/// later solve's own, whose first-stage attempts are marked `stage`.
-std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<Attempt>& later,
-                                AttemptStage stage) {
-  for (Attempt& a : earlier) a.kept = false;
-  for (Attempt a : later) {
-    if (a.stage == AttemptStage::Solve) a.stage = stage;
-    earlier.push_back(a);
-  }
-  return earlier;
+  frameMessage(result, frames::OutsideRequestedClass{why});
 }
 
 /// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
@@ -266,8 +270,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       // (infeasible, stopped) keeps its own, with the replay's failure said after it.
       if (result.converged()) {
         result.termination = Termination::StepTooLarge;
-        result.message = std::string("replay of the planned torques failed: ") + e.what() + " (" +
-                         result.message + ")";
+        frameMessage(&result, frames::ReplayFailed{e.what()});
       } else {
         addNote(&result, notes::LastIterateDoesNotReplay{e.what()});
       }

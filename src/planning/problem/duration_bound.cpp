@@ -111,6 +111,8 @@ DurationLowerBound durationLowerBound(const PlanningProblem& problem) {
   const double for_momentum = std::isfinite(a) ? momentum_change / a : 0.0;
   bound.seconds = std::max(for_angle, for_momentum);
   if (!(bound.seconds > 0.0)) return bound;
+  bound.rate_limit = std::isfinite(w) ? w : 0.0;
+  bound.torque_limit = std::isfinite(a) ? a : 0.0;
   std::ostringstream basis;
   basis << "proven: ";
   if (std::isfinite(a)) {

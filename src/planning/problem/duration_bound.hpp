@@ -38,6 +38,10 @@ struct DurationLowerBound {
   /// How it is proven, for messages: "momentum (|tau| <= a ...)". Empty where no bound applies
   /// (no torque or rate bound, or effects: their torques are not bounded by the request).
   std::string basis;
+  /// The figures the proof used, rendered in `basis`: the rate limit w [rad/s] and the largest
+  /// torque magnitude a [N m] the bounds allow (0 where none bounds it, or no bound applies).
+  double rate_limit = 0.0;
+  double torque_limit = 0.0;
 };
 
 /// The bound T_c for `problem` (its boundary data, inertia, torque bounds and rate limits).

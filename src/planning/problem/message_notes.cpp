@@ -84,6 +84,13 @@ std::string words(const PointingRestartNotServed& n) {
 std::string words(const SearchSummary& n) {
   return n.summary;
 }
+std::string foundBelow(double duration, double previous) {
+  return "; a plan was found at " + exactNumber(duration) +
+         " s, below the T* = " + exactNumber(previous) + " s reached before";
+}
+std::string words(const DescendedFromProbe& n) {
+  return foundBelow(n.duration, n.previous) + ", and the free-time solve from it descended";
+}
 std::string words(const SearchedOnT& n) {
   return "; searched on T (" + n.why + ")";
 }
@@ -120,6 +127,78 @@ std::string words(const MinimumTimeUnsolved& n) {
          terminationName(n.termination) + ")";
 }
 
+std::string words(const frames::RichardsonPair& p) {
+  return "fourth_order (Richardson extrapolation of second_order at " + grid(p.steps) +
+         " and 2N = " + std::to_string(2 * p.steps) +
+         (p.from_plans_at_minimum_time ? ", each from its plan at T*)" : ")");
+}
+std::string framed(const frames::PairSolveStopped& f, const std::string& reason) {
+  return words(f.pair) + ": the second_order solve at " + grid(f.stopped_steps) +
+         " did not converge (its plan is returned): " + reason;
+}
+std::string framed(const frames::PairCombined& f, const std::string& reason) {
+  return words(f.pair) +
+         (f.replaced ? ": the plan is the second_order plan at N (the Richardson combination left "
+                       "a bound both meet)"
+                     : "") +
+         ": N: " + reason + " | 2N: " + f.fine_reason;
+}
+std::string minimumTimePair(int steps) {
+  return "fourth_order minimum time (the second_order minimum-time problems at " + grid(steps) +
+         " and 2N = " + std::to_string(2 * steps) + ")";
+}
+std::string framed(const frames::MinimumTimePairStopped& f, const std::string& reason) {
+  const std::string at = f.at_fine ? "2N" : "N";
+  return minimumTimePair(f.steps) + ": " +
+         (f.effort_at_minimum_time ? "the minimum-effort plan at T* at " + at
+                                   : "the one at " + at) +
+         " did not converge (its plan is returned): " + reason;
+}
+std::string framed(const frames::MinimumTimePairCombined& f, const std::string& reason) {
+  std::ostringstream s;
+  s << minimumTimePair(f.steps) << ": T* = " << exactNumber(f.minimum_duration) << " s, the one at "
+    << (f.fine_binds ? "2N" : "N") << " binds (T* at N = " << exactNumber(f.at_coarse)
+    << " s, at 2N = " << exactNumber(f.at_fine) << " s); "
+    << (f.replaced ? "the plan is the second_order plan at N at T*: the Richardson combination "
+                     "with the 2N plan left a bound both meet"
+                   : "the plan combines the binding plan and the other's minimum-effort plan "
+                     "at T*")
+    << " | 2N: " << f.fine_reason << " | N: " << reason;
+  return s.str();
+}
+std::string framed(const frames::UpperBoundFromProbe& f, const std::string& reason) {
+  return "minimum time T* <= " + exactNumber(f.duration) +
+         " s, the least duration found feasible (an upper bound)" +
+         foundBelow(f.duration, f.previous) + " (its minimum-effort plan is returned): " + reason;
+}
+std::string framed(const frames::StuckAtMinimumTimePlan& f, const std::string& reason) {
+  std::ostringstream why;
+  if (f.rest_to_rest) {
+    why << "not converged (feasible: T* = " << exactNumber(f.minimum_duration)
+        << " s <= the requested duration and the ends are at rest, but the minimum-effort solve "
+           "from the minimum-time plan ended at an infeasible point): ";
+  } else if (f.ladder_reached > 0.0) {
+    why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
+        << exactNumber(f.requested)
+        << " s; from the minimum-time plan (T* = " << exactNumber(f.minimum_duration)
+        << " s) plans within the bounds were found up to T = " << exactNumber(f.ladder_reached)
+        << " s, where the ladder of durations stopped (spinning ends: not a limit, other classes "
+           "may hold plans at T): ";
+  } else {
+    why << "not converged (a plan within the bounds exists at T* = "
+        << exactNumber(f.minimum_duration)
+        << " s < T, but with spinning ends a longer duration need not be feasible in its class; "
+           "the solves from it ended at infeasible points): ";
+  }
+  return why.str() + reason;
+}
+std::string framed(const frames::OutsideRequestedClass& f, const std::string& reason) {
+  return "not converged in the requested class: " + f.why + " (" + reason + ")";
+}
+std::string framed(const frames::ReplayFailed& f, const std::string& reason) {
+  return "replay of the planned torques failed: " + f.what + " (" + reason + ")";
+}
+
 }  // namespace
 
 std::string renderNote(const Note& note) {
@@ -128,6 +207,14 @@ std::string renderNote(const Note& note) {
 
 void addNote(PlanResult* result, const Note& note) {
   result->message.append(renderNote(note));
+}
+
+std::string renderFrame(const Frame& frame, const std::string& reason) {
+  return std::visit([&](const auto& f) { return framed(f, reason); }, frame);
+}
+
+void frameMessage(PlanResult* result, const Frame& frame) {
+  result->message = renderFrame(frame, result->message);
 }
 
 }  // namespace attitude_planner

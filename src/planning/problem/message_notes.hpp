@@ -89,6 +89,12 @@ struct PointingRestartNotServed {
 struct SearchSummary {
   std::string summary;
 };
+/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration`, and the free-time
+/// solve from it descended to a lower KKT point.
+struct DescendedFromProbe {
+  double duration = 0.0;
+  double previous = 0.0;
+};
 /// Minimum time searched on T instead of solved free-time, and `why`.
 struct SearchedOnT {
   std::string why;
@@ -135,11 +141,94 @@ using Note =
                  notes::LastPointingStart, notes::FixedTwistFallback,
                  notes::PointingRestartNotServed, notes::SearchSummary, notes::SearchedOnT,
                  notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
-                 notes::RestartEnded, notes::MinimumTimeUnsolved>;
+                 notes::RestartEnded, notes::MinimumTimeUnsolved, notes::DescendedFromProbe>;
 
 /// The clause's words ("; grid continuation from N = 8", ...), each starting with its separator.
 std::string renderNote(const Note& note);
 /// Adds the clause to result->message (after what it says already).
 void addNote(PlanResult* result, const Note& note);
+
+// The clauses that frame a message instead of following it: said before the reason they are
+// given (and around it), worded here as the notes are (renderFrame).
+namespace frames {
+
+/// fourth_order's pair of second_order solves at N = `steps` and 2N; `from_plans_at_minimum_time`:
+/// each solve started from its own plan at T* (minimum_time.cpp), else from the usual starts.
+struct RichardsonPair {
+  int steps = 0;
+  bool from_plans_at_minimum_time = false;
+};
+/// A solve of the pair did not converge (the one at N = `stopped_steps`): its plan is returned,
+/// the reason it is given is that solve's message.
+struct PairSolveStopped {
+  RichardsonPair pair;
+  int stopped_steps = 0;
+};
+/// Both solves converged and were combined; the reason it is given is the N solve's message.
+/// `replaced`: the plan is the N solve's (the combination left a bound both meet).
+struct PairCombined {
+  RichardsonPair pair;
+  bool replaced = false;
+  std::string fine_reason;  ///< the 2N solve's message
+};
+/// fourth_order minimum time: a solve of its pair of second_order problems (N = `steps` and 2N)
+/// did not converge, the one at 2N (`at_fine`) or at N: its minimum-time problem, or
+/// (`effort_at_minimum_time`) the other one's minimum-effort plan at the binding T*; its plan is
+/// returned, the reason it is given is that solve's message.
+struct MinimumTimePairStopped {
+  int steps = 0;
+  bool at_fine = false;
+  bool effort_at_minimum_time = false;
+};
+/// fourth_order minimum time from its pair: T* = max(T* at N, T* at 2N), the one at 2N binds
+/// (`fine_binds`) or the one at N; `replaced`: the plan is the N plan at T* (see PairCombined).
+/// The reason it is given is the N solve's message, said last.
+struct MinimumTimePairCombined {
+  int steps = 0;
+  double minimum_duration = 0.0;  ///< T*
+  double at_coarse = 0.0;         ///< T* at N
+  double at_fine = 0.0;           ///< T* at 2N
+  bool fine_binds = false;
+  bool replaced = false;
+  std::string fine_reason;  ///< the 2N solve's message
+};
+/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration` from which the
+/// free-time solve did not descend: T* ≤ `duration`, an upper bound; the reason it is given is the
+/// probe's message.
+struct UpperBoundFromProbe {
+  double duration = 0.0;
+  double previous = 0.0;
+};
+/// A bounded minimum-effort request at T (`requested`) ≥ T* = `minimum_duration` whose solves
+/// from the minimum-time plan ended at infeasible points: rest to rest, feasible but not
+/// converged; else, where the ladder of durations found plans up to `ladder_reached` (> 0), a
+/// local "infeasible from here"; else not converged. The reason it is given is the last solve's.
+struct StuckAtMinimumTimePlan {
+  bool rest_to_rest = false;
+  double minimum_duration = 0.0;
+  double requested = 0.0;
+  double ladder_reached = 0.0;
+};
+/// A converged plan outside the class the request named: `why` (classInconsistency), around the
+/// plan's own message.
+struct OutsideRequestedClass {
+  std::string why;
+};
+/// The replay of a converged plan's torques failed (`what`), around the plan's own message.
+struct ReplayFailed {
+  std::string what;
+};
+
+}  // namespace frames
+
+using Frame = std::variant<frames::PairSolveStopped, frames::PairCombined,
+                           frames::MinimumTimePairStopped, frames::MinimumTimePairCombined,
+                           frames::UpperBoundFromProbe, frames::StuckAtMinimumTimePlan,
+                           frames::OutsideRequestedClass, frames::ReplayFailed>;
+
+/// The message `frame` makes of `reason` (the message it is given).
+std::string renderFrame(const Frame& frame, const std::string& reason);
+/// result->message framed by `frame`.
+void frameMessage(PlanResult* result, const Frame& frame);
 
 }  // namespace attitude_planner

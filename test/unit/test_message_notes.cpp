@@ -123,6 +123,7 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
       ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 0.0},
       ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
       ap::frames::ReplayFailed{"step 7 too large"},
+      ap::frames::PointingStarts{{{0.5, ap::Termination::Converged, 21.8363}}, 0},
   };
   for (const ap::Frame& frame : all) {
     const std::string words = ap::renderFrame(frame, reason);
@@ -133,6 +134,16 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
     EXPECT_EQ(words.find(reason, at + 1), std::string::npos);
     EXPECT_EQ(words.find('\n'), std::string::npos);
   }
+  // Pointing starts: each start's twist with its T* or termination, the kept one, then the reason
+  // (the words of the former hand-built expression).
+  const ap::frames::PointingStarts starts{
+      {{0.5, ap::Termination::Converged, 21.8363}, {2.1, ap::Termination::NotConverged, 0.0}}, 0};
+  EXPECT_EQ(ap::renderFrame(starts, reason),
+            "pointing: 2 start twists (T* per start: 0.5 rad 21.8363 s; 2.1 rad not_converged;), "
+            "the start from 0.5 rad kept; " +
+                reason);
+  EXPECT_EQ(ap::renderFrame(ap::frames::PointingStarts{}, reason),
+            "pointing: no start twist was solved");
   // The pair names N and 2N, where each solve started, and which one stopped.
   const std::string stopped = ap::renderFrame(ap::frames::PairSolveStopped{pair, 64}, reason);
   EXPECT_TRUE(contains(stopped, "second_order at N = 32 and 2N = 64)"));

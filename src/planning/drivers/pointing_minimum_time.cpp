@@ -1,12 +1,12 @@
 #include "planning/drivers/pointing_minimum_time.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 #include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/termination.hpp"
 #include "planning/drivers/pointing.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -41,21 +41,14 @@ void summarizePointing(const PlanningProblem& problem, int starts, PlanResult* r
   r->pointing.starts = starts;
 }
 
-/// The message: the kept start's twist and T* per start, then the kept answer's own message.
-std::string startsNote(const std::vector<TwistStart>& starts, int kept) {
-  std::ostringstream note;
-  note << "pointing: " << starts.size() << " start twists (T* per start:";
+/// The frame of the message: each start's twist and T* (or termination), the one kept.
+frames::PointingStarts startsFrame(const std::vector<TwistStart>& starts, int kept) {
+  frames::PointingStarts frame;
+  frame.kept = kept;
   for (const TwistStart& s : starts) {
-    note << " " << s.twist << " rad ";
-    if (s.result.converged()) {
-      note << s.result.minimum_duration << " s;";
-    } else {
-      note << terminationName(s.result.termination) << ";";
-    }
+    frame.starts.push_back({s.twist, s.result.termination, s.result.minimum_duration});
   }
-  note << ")";
-  if (kept >= 0) note << ", the start from " << starts[kept].twist << " rad kept";
-  return note.str();
+  return frame;
 }
 
 }  // namespace
@@ -73,7 +66,7 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
   if (starts.empty()) {
     PlanResult none;
     none.termination = context.stopReason().value_or(Termination::NotConverged);
-    none.message = "pointing: no start twist was solved";
+    frameMessage(&none, frames::PointingStarts{});
     return none;
   }
   const int kept = leastDuration(starts);
@@ -88,7 +81,7 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
     }
   }
   summarizePointing(problem, static_cast<int>(starts.size()), &result);
-  result.message = startsNote(starts, kept) + "; " + result.message;
+  frameMessage(&result, startsFrame(starts, kept));
   return result;
 }
 

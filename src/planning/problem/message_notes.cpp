@@ -198,6 +198,22 @@ std::string framed(const frames::OutsideRequestedClass& f, const std::string& re
 std::string framed(const frames::ReplayFailed& f, const std::string& reason) {
   return "replay of the planned torques failed: " + f.what + " (" + reason + ")";
 }
+std::string framed(const frames::PointingStarts& f, const std::string& reason) {
+  if (f.starts.empty()) return "pointing: no start twist was solved";
+  std::ostringstream note;
+  note << "pointing: " << f.starts.size() << " start twists (T* per start:";
+  for (const frames::PointingStarts::Start& s : f.starts) {
+    note << " " << s.twist << " rad ";
+    if (s.termination == Termination::Converged) {
+      note << s.minimum_duration << " s;";
+    } else {
+      note << terminationName(s.termination) << ";";
+    }
+  }
+  note << ")";
+  if (f.kept >= 0) note << ", the start from " << f.starts[f.kept].twist << " rad kept";
+  return note.str() + "; " + reason;
+}
 
 }  // namespace
 

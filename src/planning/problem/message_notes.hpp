@@ -7,6 +7,7 @@
 
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "attitude_planner/planning/result.hpp"
 
@@ -218,13 +219,26 @@ struct OutsideRequestedClass {
 struct ReplayFailed {
   std::string what;
 };
+/// Minimum time to a pointing end: the start twists solved (none: no start was solved), each
+/// with its T* or its termination, and the one kept (-1: none); the reason it is given is the
+/// kept answer's message, said last.
+struct PointingStarts {
+  struct Start {
+    double twist = 0.0;  ///< ψ [rad]
+    Termination termination = Termination::NotConverged;
+    double minimum_duration = 0.0;  ///< T* [s] where converged
+  };
+  std::vector<Start> starts;
+  int kept = -1;
+};
 
 }  // namespace frames
 
-using Frame = std::variant<frames::PairSolveStopped, frames::PairCombined,
-                           frames::MinimumTimePairStopped, frames::MinimumTimePairCombined,
-                           frames::UpperBoundFromProbe, frames::StuckAtMinimumTimePlan,
-                           frames::OutsideRequestedClass, frames::ReplayFailed>;
+using Frame =
+    std::variant<frames::PairSolveStopped, frames::PairCombined, frames::MinimumTimePairStopped,
+                 frames::MinimumTimePairCombined, frames::UpperBoundFromProbe,
+                 frames::StuckAtMinimumTimePlan, frames::OutsideRequestedClass,
+                 frames::ReplayFailed, frames::PointingStarts>;
 
 /// The message `frame` makes of `reason` (the message it is given).
 std::string renderFrame(const Frame& frame, const std::string& reason);

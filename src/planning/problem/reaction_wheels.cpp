@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "attitude_planner/errors.hpp"
 
@@ -116,33 +117,41 @@ void validateReactionWheels(const ReactionWheels& wheels, const std::string& fie
   }
 }
 
+namespace {
+
+/// a_i·Ω of every wheel, after checking the spin inertias a rate ↔ momentum conversion needs
+/// (`needed_for` says which): h_w,i = J_s,i (a_i·Ω + w_i), the wheel's axial rate being the
+/// body's about a_i plus its own w_i.
+Eigen::VectorXd axialBodyRates(const ReactionWheels& wheels, const Vector3& body_rate,
+                               const std::string& needed_for) {
+  if (!wheels.hasSpinInertia()) {
+    throw InvalidInput("actuators.reaction_wheels.spin_inertia", "not given: " + needed_for);
+  }
+  Eigen::VectorXd axial(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) {
+    axial(i) = wheels.spin_axes[i].normalized().dot(body_rate);
+  }
+  return axial;
+}
+
+}  // namespace
+
 Eigen::VectorXd wheelSpinRates(const ReactionWheels& wheels, const Eigen::VectorXd& momenta,
                                const Vector3& body_rate) {
-  if (!wheels.hasSpinInertia()) {
-    throw InvalidInput("actuators.reaction_wheels.spin_inertia",
-                       "not given: a wheel's spin rate needs its spin inertia");
-  }
-  const int n = wheels.count();
-  Eigen::VectorXd rates(n);
-  for (int i = 0; i < n; ++i) {
-    // h_w,i = J_s,i (a_i·Ω + w_i): the wheel's axial rate is the body's about a_i plus its own.
-    rates(i) = momenta(i) / wheels.spinInertia(i) - wheels.spin_axes[i].normalized().dot(body_rate);
-  }
+  const Eigen::VectorXd axial =
+      axialBodyRates(wheels, body_rate, "a wheel's spin rate needs its spin inertia");
+  Eigen::VectorXd rates(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i) rates(i) = momenta(i) / wheels.spinInertia(i) - axial(i);
   return rates;
 }
 
 Eigen::VectorXd wheelMomentaFromSpinRates(const ReactionWheels& wheels,
                                           const Eigen::VectorXd& rates, const Vector3& body_rate) {
-  if (!wheels.hasSpinInertia()) {
-    throw InvalidInput("actuators.reaction_wheels.spin_inertia",
-                       "not given: a wheel's momentum from its spin rate needs its spin inertia");
-  }
-  const int n = wheels.count();
-  Eigen::VectorXd momenta(n);
-  for (int i = 0; i < n; ++i) {
-    momenta(i) =
-        wheels.spinInertia(i) * (wheels.spin_axes[i].normalized().dot(body_rate) + rates(i));
-  }
+  const Eigen::VectorXd axial = axialBodyRates(
+      wheels, body_rate, "a wheel's momentum from its spin rate needs its spin inertia");
+  Eigen::VectorXd momenta(wheels.count());
+  for (int i = 0; i < wheels.count(); ++i)
+    momenta(i) = wheels.spinInertia(i) * (axial(i) + rates(i));
   return momenta;
 }
 

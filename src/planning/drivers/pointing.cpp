@@ -321,9 +321,7 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
   result.max_residual = run.solve.relative_gradient;
   result.newton_decrement = run.solve.relative_decrement;
   result.extremal_summary = extremalOf(run.lift);
-  result.pointing.active = true;
-  result.pointing.final_twist = twistOf(chosen.final_attitude, problem.end_condition);
-  result.pointing.error = pointingError(planned.attitude.back(), problem.end_condition);
+  summarizePointingEnd(planned.attitude.back(), problem.end_condition, &result.pointing);
   result.pointing.twist_gradient = run.solve.twist_gradient;
   double scale = 0.0;
   Eigen::VectorXd gradient;
@@ -392,10 +390,7 @@ std::optional<PlanResult> fixedTwistFallback(
     if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
   }
   if (!best) return std::nullopt;
-  const Matrix3 end = best->maneuver.attitude.back();
-  best->pointing.active = true;
-  best->pointing.final_twist = twistOf(end, problem.end_condition);
-  best->pointing.error = pointingError(end, problem.end_condition);
+  summarizePointingEnd(best->maneuver.attitude.back(), problem.end_condition, &best->pointing);
   best->pointing.twist_gradient = std::numeric_limits<double>::quiet_NaN();
   best->pointing.twist_stationarity = std::numeric_limits<double>::quiet_NaN();
   addNote(&*best, notes::FixedTwistFallback{best->pointing.final_twist, reason});

@@ -459,8 +459,9 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
           << " ways round";
     if (problem.hasNodeConstraints()) {
       brief << " unconstrained, each distinct optimum below the cheapest constrained answer "
-               "starting the interior point with the twist free; from each twist's fixed-twist "
-               "constrained optimum where none of those converged)";
+               "starting the interior point with the twist free; where none converged, each "
+               "the other way round and the fixed-twist unconstrained optima; then each twist's "
+               "fixed-twist constrained optimum)";
     } else {
       brief << ")";
     }

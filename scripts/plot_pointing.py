@@ -137,14 +137,17 @@ fixed-attitude solve at the twist it chose (same N and scheme, one after the oth
 %s
 %s
 With constraints the stationarity is the Lagrangian's, |dL/dpsi| relative. A constrained pointing
-request starts each of 4 twists from the fixed-twist constrained optimum (every way round solved
-under the constraints there) and frees psi in the interior point from it (from the unconstrained
-twist optimum where that has no plan): its time is at least 4 fixed-attitude solves (at twists
-where a torque bound is infeasible, each runs until its verdict) plus the free-twist solves.
-Starting from the unconstrained twist optimum instead (the fixed solve only where that does not
-converge) measured 4.4x median on these requests with the same optima, but the free-psi interior
-point keeps the way round it starts in, and on seeded test requests it ended in costlier classes
-(0.1059 against the swept 0.1031, 0.2916 against 0.2466) once identical starts were not repeated.
+request is one problem: the twist Newton's starts (4 twists x 2 ways round, the constraints not
+seen) give the unconstrained twist optima, and the interior point with psi free starts from each
+distinct one, cheapest first, while its unconstrained cost is below the cheapest constrained
+answer found (constraints only add cost within a start's basin, and the interior point keeps the
+way round it starts in). Where none of those converges (a cone across the optimum's path): the
+same from each optimum the other way round at its psi and from the fixed-twist unconstrained
+optima at the 4 start twists (a path that passes the cone on one side); only where none of those
+converges either, each start twist from its fixed-twist constrained optimum (every way round
+solved under the constraints there) frees psi from that plan. The fixed solve it is timed
+against is one request's whole driver: the class survey, the interior point from the
+unconstrained optimum and, where that has no plan, the other classes under the constraints.
 
 Minimum time to a pointing target (Betts's body, T* against a swept twist): [pointing_minimum_time.md](pointing_minimum_time.md).
 

@@ -64,6 +64,34 @@ TEST(PointingConventions, TwistOfInvertsPointingAttitude) {
   }
 }
 
+// The summary every driver fills: ψ and the residual of the plan's own R_N, an R_N off the end
+// condition by a tilt about an axis perpendicular to b reported as that tilt, and the solver's
+// fields left alone.
+TEST(PointingConventions, SummaryOfAnEndReportsItsTwistAndResidual) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-M_PI + 1e-9, M_PI), tilt(1e-6, 0.5);
+  for (int i = 0; i < 20; ++i) {
+    const EndCondition end = pointingAt(randomUnit(rng), randomUnit(rng));
+    const double psi = u(rng), angle = tilt(rng);
+    PointingSummary s;
+    s.twist_gradient = 0.25;
+    s.twist_stationarity = 0.5;
+    s.starts = 3;
+    summarizePointingEnd(pointingAttitude(end, psi), end, &s);
+    EXPECT_TRUE(s.active);
+    EXPECT_NEAR(s.final_twist, psi, 1e-13);
+    EXPECT_LT(s.error, 1e-14);
+    EXPECT_EQ(s.twist_gradient, 0.25);
+    EXPECT_EQ(s.twist_stationarity, 0.5);
+    EXPECT_EQ(s.starts, 3);
+    // Tilted in the world about an axis perpendicular to d: R b leaves d by exactly that angle.
+    const Vector3 d = end.world_direction.normalized();
+    const Vector3 across = d.cross(randomUnit(rng)).normalized();
+    summarizePointingEnd(so3::exp(Vector3(angle * across)) * pointingAttitude(end, psi), end, &s);
+    EXPECT_NEAR(s.error, angle, 1e-12);
+  }
+}
+
 TEST(PointingConventions, NearestTwistHasTheLeastRotationAngle) {
   std::mt19937 rng(5);
   for (int i = 0; i < 20; ++i) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "attitude_planner/planning/problem.hpp"
+#include "attitude_planner/planning/result.hpp"
 
 namespace attitude_planner {
 
@@ -26,6 +27,13 @@ double pointingError(const Matrix3& attitude, const EndCondition& end);
 /// The twist whose R_N(ψ) is nearest `from` (least rotation angle of fromᵀ R_N(ψ)), in closed
 /// form: tr(fromᵀ R_ref exp(ψ b^)) = c + α sin ψ − β cos ψ is largest at ψ = atan2(α, −β).
 double nearestTwist(const Matrix3& from, const EndCondition& end);
+
+/// A pointing plan's end in its summary, the one rule every driver follows: `active`,
+/// `final_twist` = twistOf(R_N) and `error` = pointingError(R_N), R_N = `planned_end` (the returned
+/// maneuver's last attitude). The stationarity fields and `starts` (the solver's and the driver's)
+/// are left as they are.
+void summarizePointingEnd(const Matrix3& planned_end, const EndCondition& end,
+                          PointingSummary* summary);
 
 /// `problem` with R_N = `final_attitude` where its end condition is a pointing one (the twist a
 /// plan or a start chose: a solve from that plan starts there, and the plan is judged there),

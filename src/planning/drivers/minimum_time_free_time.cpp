@@ -484,9 +484,7 @@ class FreeTimeMinimumTime {
   static void recordTwist(const PlanningProblem& at, const FreeTimeOutcome& answer,
                           PlanResult* result) {
     if (!at.end_condition.pointing()) return;
-    result->pointing.active = true;
-    result->pointing.final_twist = twistOf(at.final_attitude, at.end_condition);
-    result->pointing.error = pointingError(answer.maneuver.attitude.back(), at.end_condition);
+    summarizePointingEnd(answer.maneuver.attitude.back(), at.end_condition, &result->pointing);
     result->pointing.twist_gradient = answer.twist_gradient;
     result->pointing.twist_stationarity = std::abs(answer.twist_gradient);
   }

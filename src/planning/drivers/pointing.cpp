@@ -12,6 +12,7 @@
 #include "planning/interior_point/constrained_system.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/newton/newton_parameters.hpp"
+#include "planning/newton/newton_solver.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
@@ -40,6 +41,8 @@ struct TwistRun {
   /// fallback where no free-twist solve converges (fixedTwistFallback).
   std::optional<PlanResult> fixed_plan;
   LevelDuals duals;
+  /// The interior point's formulation of its plan (Unconstrained: a twist Newton run).
+  Formulation formulation = Formulation::Unconstrained;
   /// Where its iterate started (a constrained start: the fixed-twist solve's plan, the attempts
   /// just before it, else the unconstrained optimum or the geodesic).
   AttemptStart start = AttemptStart::Hermite;
@@ -86,6 +89,7 @@ void takeInteriorPoint(GridOutcome outcome, TwistRun* run) {
   run->history = r.history;
   run->iterate = std::move(outcome.steps);
   run->duals = std::move(outcome.duals);
+  run->formulation = outcome.formulation;
   run->plan = std::move(outcome.result);
 }
 
@@ -131,13 +135,11 @@ TwistRun runTwist(const PlanningProblem& at, double twist, const HomotopyClass& 
   return run;
 }
 
-/// The interior point with ψ free from the unconstrained twist Newton's answer on `at`'s grid (`at`
-/// re-posed at its twist), else from the geodesic at `twist`.
-void fromUnconstrainedOptimum(const PlanningProblem& at, double twist,
-                              const HomotopyClass& homotopy, const SolverOptions& options,
-                              SolveContext& context, const NewtonParameters& p, TwistRun* run) {
-  const TwistRun unconstrained =
-      runTwist(at, twist, homotopy, nullptr, options.tolerance, context, p);
+/// The interior point with ψ free on `at`'s grid from `unconstrained` (a twist Newton run on that
+/// grid: `at` re-posed at its twist), else, where that did not converge, from the geodesic at
+/// `at`'s twist.
+void fromUnconstrainedRun(const PlanningProblem& at, const TwistRun& unconstrained,
+                          const SolverOptions& options, SolveContext& context, TwistRun* run) {
   run->lift = unconstrained.lift;
   const bool from_optimum = unconstrained.converged();
   run->start = from_optimum ? AttemptStart::UnconstrainedOptimum : AttemptStart::Hermite;
@@ -150,6 +152,16 @@ void fromUnconstrainedOptimum(const PlanningProblem& at, double twist,
       solveInteriorPointOnGrid(posed, options, context,
                                from_optimum ? &unconstrained.iterate : nullptr, nullptr),
       run);
+}
+
+/// The interior point with ψ free from the unconstrained twist Newton's answer on `at`'s grid,
+/// solved here from `twist` (fromUnconstrainedRun).
+void fromUnconstrainedOptimum(const PlanningProblem& at, double twist,
+                              const HomotopyClass& homotopy, const SolverOptions& options,
+                              SolveContext& context, const NewtonParameters& p, TwistRun* run) {
+  const TwistRun unconstrained =
+      runTwist(at, twist, homotopy, nullptr, options.tolerance, context, p);
+  fromUnconstrainedRun(at, unconstrained, options, context, run);
 }
 
 /// The interior point with ψ free from the constrained optimum at `at`'s twist (every class tried
@@ -211,6 +223,7 @@ std::size_t record(const TwistRun& run, AttemptStage stage, AttemptStart start, 
   a.stage = stage;
   a.start = start;
   a.globalization = Globalization::LineSearch;
+  a.formulation = run.formulation;
   a.homotopy = run.homotopy;
   a.steps = run.steps;
   a.termination = run.solve.termination;
@@ -234,10 +247,9 @@ bool sameAnswer(const TwistRun& a, const TwistRun& b) {
          std::abs(dpsi) < kSameSurveyTwist;
 }
 
-/// The survey's converged answers worth refining: distinct, cheapest first, within the class
-/// survey's margin of the cheapest.
-std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey,
-                                           const NewtonParameters& p) {
+/// The survey's converged answers worth refining: distinct, cheapest first, within `margin`
+/// (relative) of the cheapest.
+std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey, double margin) {
   std::vector<const TwistRun*> sorted;
   for (const TwistRun& r : survey) {
     if (r.converged()) sorted.push_back(&r);
@@ -246,7 +258,7 @@ std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey,
             [](const TwistRun* a, const TwistRun* b) { return a->solve.cost < b->solve.cost; });
   std::vector<const TwistRun*> out;
   for (const TwistRun* r : sorted) {
-    if (r->solve.cost > (1.0 + p.class_refine_margin) * sorted.front()->solve.cost) break;
+    if (r->solve.cost > (1.0 + margin) * sorted.front()->solve.cost) break;
     const bool repeated =
         std::any_of(out.begin(), out.end(), [&](const TwistRun* o) { return sameAnswer(*o, *r); });
     if (!repeated) out.push_back(r);
@@ -255,9 +267,10 @@ std::vector<const TwistRun*> worthRefining(const std::vector<TwistRun>& survey,
 }
 
 /// A survey answer carried to the requested grid through factor-4 levels (each level's solve to
-/// the coarse tolerance but the last); the attempt is the last level's solve.
+/// the coarse tolerance but the last), under the request's node constraints unless
+/// `unconstrained`; the attempt is the last level's solve.
 TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveContext& context,
-                const NewtonParameters& p) {
+                const NewtonParameters& p, bool unconstrained = false) {
   TwistRun run = from;
   // The refinement's own levels, as the context counted them (the survey is its own attempt).
   const int counted_before = context.iterations();
@@ -270,7 +283,7 @@ TwistRun refine(const PlanningProblem& problem, const TwistRun& from, SolveConte
                                   : std::max(context.options().tolerance, p.coarse_tolerance_floor);
     const PlanningProblem at = posedAt(problem, steps, run.solve.twist, from.homotopy);
     TwistRun next =
-        at.hasNodeConstraints()
+        at.hasNodeConstraints() && !unconstrained
             ? runConstrainedTwist(at, run.solve.twist, from.homotopy, &run, tolerance, context, p)
             : runTwist(at, run.solve.twist, from.homotopy, &run.iterate, tolerance, context, p);
     next.start_twist = from.start_twist;
@@ -321,9 +334,7 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
   result.max_residual = run.solve.relative_gradient;
   result.newton_decrement = run.solve.relative_decrement;
   result.extremal_summary = extremalOf(run.lift);
-  result.pointing.active = true;
-  result.pointing.final_twist = twistOf(chosen.final_attitude, problem.end_condition);
-  result.pointing.error = pointingError(planned.attitude.back(), problem.end_condition);
+  summarizePointingEnd(planned.attitude.back(), problem.end_condition, &result.pointing);
   result.pointing.twist_gradient = run.solve.twist_gradient;
   double scale = 0.0;
   Eigen::VectorXd gradient;
@@ -340,18 +351,21 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
 
 /// Every start (kPointingStartTwists twists from the one of least rotation × the ways round) solved
 /// on `steps` steps, each recorded as a `stage` attempt; with `finals`, each appended there too (a
-/// plan on the requested grid). Stops at a cancel or the deadline.
+/// plan on the requested grid). Under the request's node constraints (each twist from its
+/// fixed-twist constrained optimum, runConstrainedTwist) unless `unconstrained` (the twist Newton,
+/// the constraints not seen). Stops at a cancel or the deadline.
 std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, double tolerance,
                                 AttemptStage stage, SolveContext& context,
                                 const NewtonParameters& p,
-                                std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+                                std::vector<std::pair<TwistRun, std::size_t>>* finals,
+                                bool unconstrained = false) {
   const double base = nearestTwist(problem.initial_attitude, problem.end_condition);
   std::vector<TwistRun> runs;
   for (int i = 0; i < kPointingStartTwists; ++i) {
     const double twist = std::remainder(base + 2.0 * M_PI * i / kPointingStartTwists, 2.0 * M_PI);
     for (const HomotopyClass& c : kPointingClasses) {
       if (context.stopReason()) return runs;
-      if (problem.hasNodeConstraints()) {
+      if (problem.hasNodeConstraints() && !unconstrained) {
         // The fixed-twist solve enumerates the ways round under the constraints itself.
         if (&c != &kPointingClasses[0]) continue;
         runs.push_back(runConstrainedTwist(posedAt(problem, steps, twist), twist, c, nullptr,
@@ -392,10 +406,7 @@ std::optional<PlanResult> fixedTwistFallback(
     if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
   }
   if (!best) return std::nullopt;
-  const Matrix3 end = best->maneuver.attitude.back();
-  best->pointing.active = true;
-  best->pointing.final_twist = twistOf(end, problem.end_condition);
-  best->pointing.error = pointingError(end, problem.end_condition);
+  summarizePointingEnd(best->maneuver.attitude.back(), problem.end_condition, &best->pointing);
   best->pointing.twist_gradient = std::numeric_limits<double>::quiet_NaN();
   best->pointing.twist_stationarity = std::numeric_limits<double>::quiet_NaN();
   addNote(&*best, notes::FixedTwistFallback{best->pointing.final_twist, reason});
@@ -444,16 +455,197 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
             << " starts; each verdict is local to its start twist)";
     }
     brief << "; attempt " << kept->second - first_recorded + 1 << " of " << result.attempts.size()
-          << " kept (" << kPointingStartTwists << " start twists";
+          << " kept (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
+          << " ways round";
     if (problem.hasNodeConstraints()) {
-      brief << ", each from the fixed-twist constrained optimum, its ways round solved there, "
-               "or from the unconstrained twist optimum where that did not converge)";
+      brief << " unconstrained, each distinct optimum below the cheapest constrained answer "
+               "starting the interior point with the twist free; where none converged, each "
+               "the other way round and the fixed-twist unconstrained optima; then each twist's "
+               "fixed-twist constrained optimum)";
     } else {
-      brief << " x " << std::size(kPointingClasses) << " ways round)";
+      brief << ")";
     }
     result.message = brief.str();
   }
   return result;
+}
+
+/// Whether any of `finals` converged.
+bool anyConverged(const std::vector<std::pair<TwistRun, std::size_t>>& finals) {
+  return std::any_of(finals.begin(), finals.end(),
+                     [](const auto& f) { return f.first.converged(); });
+}
+
+/// The survey's tolerance: the request's on the requested grid, else the coarse levels' floor.
+double surveyTolerance(const PlanningProblem& problem, int survey_steps, SolveContext& context,
+                       const NewtonParameters& p) {
+  const double tolerance = context.options().tolerance;
+  return survey_steps == problem.steps ? tolerance : std::max(tolerance, p.coarse_tolerance_floor);
+}
+
+/// An unconstrained request: the starts on the survey grid, the distinct converged answers within
+/// the class survey's margin of the cheapest carried to the requested grid (appended to `finals`),
+/// and where none reached it, the starts on the requested grid. Returns the survey.
+std::vector<TwistRun> unconstrainedStarts(const PlanningProblem& problem, SolveContext& context,
+                                          const NewtonParameters& p,
+                                          std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  const int survey_steps = surveySteps(problem, p);
+  const bool on_requested = survey_steps == problem.steps;
+  const std::vector<TwistRun> survey =
+      runStarts(problem, survey_steps, surveyTolerance(problem, survey_steps, context, p),
+                on_requested ? AttemptStage::Solve : AttemptStage::ClassSurvey, context, p,
+                on_requested ? finals : nullptr);
+  if (on_requested) return survey;
+  for (const TwistRun* r : worthRefining(survey, p.class_refine_margin)) {
+    if (context.stopReason()) break;
+    TwistRun refined = refine(problem, *r, context, p);
+    const std::size_t at = record(refined, AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
+                                  survey_steps, context);
+    finals->emplace_back(std::move(refined), at);
+  }
+  if (!anyConverged(*finals) && !context.stopReason()) {
+    // Nothing of the survey grid's reached the requested one: the starts on the requested grid.
+    runStarts(problem, problem.steps, context.options().tolerance, AttemptStage::Solve, context, p,
+              finals);
+  }
+  return survey;
+}
+
+/// The unconstrained fixed-attitude optimum at `twist` in `way` on the requested grid (Newton on
+/// that problem, its class pinned), as a run posed at `twist`; not converged where it has no plan.
+TwistRun fixedTwistOptimum(const PlanningProblem& problem, double twist, const HomotopyClass& way,
+                           SolveContext& context) {
+  SolverOptions options = context.options();
+  options.enumerate_classes = false;
+  PlanningProblem fixed = posedAt(problem, problem.steps, twist, way);
+  fixed.end_condition = EndCondition();
+  const PlanResult plan = solveWithNewton(fixed, options, context);
+  TwistRun run;
+  run.homotopy = way;
+  run.start_twist = twist;
+  run.steps = problem.steps;
+  run.solve.twist = twist;
+  run.solve.termination =
+      plan.maneuver.steps() == problem.steps ? plan.termination : Termination::NotConverged;
+  run.solve.cost = plan.cost;
+  if (run.converged()) {
+    ReducedProblem np(posedAt(problem, problem.steps, twist));
+    np.setInteriorFromAttitudes(plan.maneuver.attitude);
+    run.iterate = np.current();
+  }
+  return run;
+}
+
+/// Two plans' costs within this (relative) are one extremal (cf. NewtonParameters::
+/// same_extremal_cost).
+constexpr double kSameCost = 1e-9;
+
+/// The unconstrained optimum `optimum` (ψ* on the requested grid) the other way round: the
+/// fixed-attitude optimum at ψ* in the way round `optimum` did not end in (the one whose cost
+/// differs from its own: the free-ψ twist Newton slides from either way round to the cheaper one
+/// through a whole turn of ψ, where a cone may block the interior point). Not converged where
+/// neither has another plan.
+TwistRun otherWayRound(const PlanningProblem& problem, const TwistRun& optimum,
+                       SolveContext& context) {
+  TwistRun run;
+  for (const HomotopyClass& way : kPointingClasses) {
+    if (context.stopReason()) break;
+    run = fixedTwistOptimum(problem, optimum.solve.twist, way, context);
+    const bool same = std::abs(run.solve.cost - optimum.solve.cost) <=
+                      kSameCost * std::max(run.solve.cost, optimum.solve.cost);
+    if (run.converged() && !same) return run;
+  }
+  run.solve.termination = Termination::NotConverged;
+  return run;
+}
+
+/// `runs` cheapest first, the converged before the others.
+void sortByCost(std::vector<TwistRun>* runs) {
+  std::stable_sort(runs->begin(), runs->end(), [](const TwistRun& a, const TwistRun& b) {
+    return a.converged() && (!b.converged() || a.solve.cost < b.solve.cost);
+  });
+}
+
+/// The twist Newton's distinct converged answers (ψ free; the starts on `survey_steps`) carried
+/// to the requested grid (each refinement recorded), cheapest first.
+std::vector<TwistRun> freeTwistOptima(const PlanningProblem& problem, int survey_steps,
+                                      const std::vector<TwistRun>& survey, SolveContext& context,
+                                      const NewtonParameters& p) {
+  std::vector<TwistRun> optima;
+  for (const TwistRun* r : worthRefining(survey, std::numeric_limits<double>::infinity())) {
+    if (context.stopReason()) break;
+    TwistRun refined = *r;
+    if (survey_steps != problem.steps) {
+      refined = refine(problem, *r, context, p, true);
+      record(refined, AttemptStage::ClassRefine, AttemptStart::CoarseLevel, survey_steps, context);
+    }
+    if (refined.converged()) optima.push_back(std::move(refined));
+  }
+  sortByCost(&optima);
+  return optima;
+}
+
+/// The unconstrained optima that start a constrained request where none from `optima` (the
+/// free-ψ ones) converged under the constraints: each of those the other way round at its ψ
+/// (otherWayRound), and the fixed-attitude optimum at each start twist the nearest way round
+/// (fixedTwistOptimum: a cone across the free-ψ optimum's path leaves the twists whose paths pass
+/// it, and the interior point keeps the side of a cone its start passes). Cheapest first.
+std::vector<TwistRun> fixedTwistOptima(const PlanningProblem& problem,
+                                       const std::vector<TwistRun>& optima, SolveContext& context) {
+  std::vector<TwistRun> starts;
+  for (const TwistRun& optimum : optima) {
+    if (!context.stopReason()) starts.push_back(otherWayRound(problem, optimum, context));
+  }
+  const double base = nearestTwist(problem.initial_attitude, problem.end_condition);
+  for (int i = 0; i < kPointingStartTwists && !context.stopReason(); ++i) {
+    const double twist = std::remainder(base + 2.0 * M_PI * i / kPointingStartTwists, 2.0 * M_PI);
+    starts.push_back(fixedTwistOptimum(problem, twist, kPointingClasses[0], context));
+  }
+  sortByCost(&starts);
+  return starts;
+}
+
+/// The interior point with ψ free (fromUnconstrainedRun) from each of `starts` (cheapest first) in
+/// turn, each run appended to `finals`, until a start's unconstrained cost is at least
+/// `*cheapest` (the least converged constrained cost so far, updated): constraints only add cost
+/// to the plans of a start's basin, and the interior point keeps the way round it starts in (a
+/// bound as long as the solve stays in that basin; a class's cost is no bound across classes).
+void solveFromOptima(const PlanningProblem& problem, const std::vector<TwistRun>& starts,
+                     SolveContext& context, double* cheapest,
+                     std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  for (const TwistRun& start : starts) {
+    if (!start.converged() || start.solve.cost >= *cheapest || context.stopReason()) return;
+    TwistRun run = start;  // its way round, start twist and grid
+    const int counted_before = context.iterations();
+    fromUnconstrainedRun(posedAt(problem, problem.steps, start.solve.twist), start,
+                         context.options(), context, &run);
+    run.solve.iterations = context.iterations() - counted_before;
+    const std::size_t at = record(run, AttemptStage::Constrained, run.start, 0, context);
+    if (run.converged()) *cheapest = std::min(*cheapest, run.solve.cost);
+    finals->emplace_back(std::move(run), at);
+  }
+}
+
+/// A constrained request (stage constraints, torque bounds) as one problem: the interior point
+/// with ψ free from the unconstrained twist optima (the twist Newton's survey, the constraints not
+/// seen: freeTwistOptima), and where none of those converged, from the fixed-twist ones
+/// (fixedTwistOptima), each set cheapest first and pruned by its unconstrained cost
+/// (solveFromOptima). Returns the survey.
+std::vector<TwistRun> constrainedFromTwistOptima(
+    const PlanningProblem& problem, SolveContext& context, const NewtonParameters& p,
+    std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  const int survey_steps = surveySteps(problem, p);
+  const std::vector<TwistRun> survey =
+      runStarts(problem, survey_steps, surveyTolerance(problem, survey_steps, context, p),
+                AttemptStage::ClassSurvey, context, p, nullptr, true);
+  double cheapest = std::numeric_limits<double>::infinity();
+  const std::vector<TwistRun> optima = freeTwistOptima(problem, survey_steps, survey, context, p);
+  solveFromOptima(problem, optima, context, &cheapest, finals);
+  if (!anyConverged(*finals) && !context.stopReason()) {
+    solveFromOptima(problem, fixedTwistOptima(problem, optima, context), context, &cheapest,
+                    finals);
+  }
+  return survey;
 }
 
 }  // namespace
@@ -472,30 +664,17 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   const NewtonParameters& p = newtonDefaults();
   const std::size_t first_recorded = context.attempts().size();
   const int counted_at_start = context.iterations();
-  // Constrained: the starts on the requested grid (coarse grids tighten the cones' margins and
-  // change which torque bounds are feasible: a coarse survey's answers need not carry over).
-  const int survey_steps = problem.hasNodeConstraints() ? problem.steps : surveySteps(problem, p);
-  const bool on_requested = survey_steps == problem.steps;
-  const double survey_tolerance =
-      on_requested ? options.tolerance : std::max(options.tolerance, p.coarse_tolerance_floor);
   std::vector<std::pair<TwistRun, std::size_t>> finals;  // on the requested grid, trail index
-  const std::vector<TwistRun> survey =
-      runStarts(problem, survey_steps, survey_tolerance,
-                on_requested ? AttemptStage::Solve : AttemptStage::ClassSurvey, context, p,
-                on_requested ? &finals : nullptr);
-  for (const TwistRun* r :
-       on_requested ? std::vector<const TwistRun*>() : worthRefining(survey, p)) {
-    if (context.stopReason()) break;
-    TwistRun refined = refine(problem, *r, context, p);
-    const std::size_t at = record(refined, AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
-                                  survey_steps, context);
-    finals.emplace_back(std::move(refined), at);
-  }
-  const bool planned =
-      std::any_of(finals.begin(), finals.end(), [](const auto& f) { return f.first.converged(); });
-  if (!planned && !on_requested && !context.stopReason()) {
-    // Nothing of the survey grid's reached the requested one: the starts on the requested grid.
-    runStarts(problem, problem.steps, options.tolerance, AttemptStage::Solve, context, p, &finals);
+  std::vector<TwistRun> survey = problem.hasNodeConstraints()
+                                     ? constrainedFromTwistOptima(problem, context, p, &finals)
+                                     : unconstrainedStarts(problem, context, p, &finals);
+  if (problem.hasNodeConstraints() && !anyConverged(finals) && !context.stopReason()) {
+    // No interior point from an unconstrained optimum converged: each twist from its fixed-twist
+    // constrained optimum, every way round solved under the constraints there (on the requested
+    // grid: coarse grids tighten the cones' margins and change which torque bounds are feasible).
+    const std::vector<TwistRun> fixed = runStarts(problem, problem.steps, options.tolerance,
+                                                  AttemptStage::Solve, context, p, &finals);
+    survey.insert(survey.end(), fixed.begin(), fixed.end());
   }
   PlanResult result = finishPointing(problem, survey, finals, first_recorded, context);
   result.iterations = context.iterations() - counted_at_start;  // every start, as reported

@@ -34,10 +34,7 @@ int leastDuration(const std::vector<TwistStart>& starts) {
 /// solver filled it: the free-time answer carries ∂L/∂ψ).
 void summarizePointing(const PlanningProblem& problem, int starts, PlanResult* r) {
   if (r->maneuver.attitude.empty()) return;
-  const Matrix3& end = r->maneuver.attitude.back();
-  r->pointing.active = true;
-  r->pointing.final_twist = twistOf(end, problem.end_condition);
-  r->pointing.error = pointingError(end, problem.end_condition);
+  summarizePointingEnd(r->maneuver.attitude.back(), problem.end_condition, &r->pointing);
   r->pointing.starts = starts;
 }
 

@@ -53,6 +53,13 @@ double nearestTwist(const Matrix3& from, const EndCondition& end) {
   return std::atan2(alpha, -beta);
 }
 
+void summarizePointingEnd(const Matrix3& planned_end, const EndCondition& end,
+                          PointingSummary* summary) {
+  summary->active = true;
+  summary->final_twist = twistOf(planned_end, end);
+  summary->error = pointingError(planned_end, end);
+}
+
 PlanningProblem endingAt(const PlanningProblem& problem, const Matrix3& final_attitude) {
   PlanningProblem at = problem;
   if (problem.end_condition.pointing()) at.final_attitude = final_attitude;

@@ -65,6 +65,11 @@ std::vector<Eigen::VectorXd> wheelTorqueRows(const AttitudeManeuver& msg, const 
                               "maneuver.wheel_torque");
 }
 
+/// The end of sample j's hold: the next sample's time (the last sample's own: an empty hold).
+double nextSampleTime(const std::vector<double>& times, std::size_t j) {
+  return times[std::min(j + 1, times.size() - 1)];
+}
+
 }  // namespace
 
 PrincipalBox principalBox(const Matrix3& inertia, double size) {
@@ -1469,9 +1474,10 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
       });
       body.torque = pb->horizon->commandAt(measured.state, t);
     } else if (measured.fresh) {
+      // replay: the plan's torque open loop, its mean over the hold to the next sample
       body.torque = mode_ == TrackingMode::Feedback
                         ? law.command(body.attitude, body.angular_velocity, t)
-                        : pb->reference->at(t).torque;  // replay: the plan's torque, open loop
+                        : pb->reference->meanTorque(t, nextSampleTime(pb->times, j));
     } else {
       ++stale;  // a zero command: nothing is known about the body to act on
       if (first_problem.empty()) first_problem = measured.problem;
@@ -1594,10 +1600,13 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
               ? wheelTorquesFor(pb->wheels, array,
                                 law.command(state.attitude, state.angular_velocity, t),
                                 state.angular_velocity, momentum, &cut)
-              // replay: the plan's u over the hold to the next sample, its mean (the midpoint
-              // of the linear hold): u(t) itself, held, would lag the plan by half a sample
-              : heldLinearly(pb->plan_wheel_torque, plan.time_step,
-                             0.5 * (t + pb->times[std::min(j + 1, pb->times.size() - 1)]));
+              // replay: the plan's u, its mean over the hold to the next sample (u(t) itself,
+              // held, would lag the plan by half a sample)
+              : meanOverHold<Eigen::VectorXd>(
+                    [&](double s) {
+                      return heldLinearly(pb->plan_wheel_torque, plan.time_step, s);
+                    },
+                    t, nextSampleTime(pb->times, j), plan.time_step);
       cut_samples += cut ? 1 : 0;
       peaks.observeMomentum(array.axes, momentum);
       peaks.observeTorque(u);

@@ -77,8 +77,9 @@ struct PlanOutcome {
   PlanResult result;        ///< the core's result
   PlanningProblem problem;  ///< the parsed problem (if parsing succeeded)
   ros_conversions::OutputSelection output;  ///< how much of the maneuver to return
-  double time_budget_s = 0.0;               ///< the budget the solve ran under [s] (0 = none)
-  double wall_time_s = 0.0;                 ///< wall time of planManeuver [s]
+  double time_budget_s = 0.0;  ///< the request's budget, its deadline [s] (0 = none); the core ran
+                               ///< under solveBudget of it
+  double wall_time_s = 0.0;    ///< wall time of planManeuver [s]
 };
 
 /// The one-line message of an infeasible result, built from its figures (the worst violated

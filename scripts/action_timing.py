@@ -5,9 +5,10 @@
    cancelled at a spread of moments after its first feedback; the latency is the wall time from
    cancel_goal() to the result arriving in this client (transport both ways included).
 2. Deadline: service calls at N = 1e5 with a time_budget below, near and above what the solve
-   needs; the answer's status and its round trip against the budget.
+   needs; the answer's status, its round trip against the budget, and whether it carries the
+   plan the stopped solve reached (unconverged_plan, with its residuals).
 Needs a running master and planner.launch. Prints markdown tables.
-Usage: /usr/bin/python3 scripts/action_timing.py [--steps 100000] [--cancels 8]
+Usage: /usr/bin/python3 scripts/action_timing.py [--steps 100000] [--cancels 8] [--deadline-only]
 """
 import argparse
 import statistics
@@ -76,6 +77,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--steps", type=int, default=100000)
     ap.add_argument("--cancels", type=int, default=8)
+    ap.add_argument("--deadline-only", action="store_true", help="skip the cancels")
     args = ap.parse_args()
     rospy.init_node("action_timing", anonymous=True)
     client = actionlib.SimpleActionClient("plan_attitude_maneuver_action",
@@ -84,7 +86,7 @@ def main():
         raise SystemExit("no action server")
 
     print("### Cancel latency, N = %d\n" % args.steps)
-    for with_plan in (False, True):
+    for with_plan in (() if args.deadline_only else (False, True)):
         print("return_maneuver %s:\n" % ('"" (every node)' if with_plan else '"none"'))
         print("| cancel sent after first feedback [s] | iteration at cancel | cancel -> result "
               "[ms] | state | error | plan handed over | rows in the result |")
@@ -105,17 +107,18 @@ def main():
     proxy = rospy.ServiceProxy("plan_attitude_maneuver", PlanAttitudeManeuver)
     print("### Deadline, N = %d (service; the seed slew, default tolerance)\n" % args.steps)
     print("| time_budget [s] | round trip [s] | solve_time [s] | over budget | status | "
-          "iterations |")
-    print("|---|---|---|---|---|---|")
-    for budget in (0.01, 0.1, 0.3, 1.0, 30.0):
+          "iterations | plan handed over | step residual | max residual |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for budget in (0.01, 0.1, 0.3, 1.0, 2.0, 5.0, 30.0):
         req = seed_without_plan(PlanAttitudeManeuverRequest(), args.steps)
         req.time_budget = budget
         t0 = time.perf_counter()
         res = proxy(req)
         total = time.perf_counter() - t0
-        print("| %g | %.3f | %.3f | %+.0f %% | %s | %d |" %
+        print("| %g | %.3f | %.3f | %+.0f %% | %s | %d | %s | %.2g | %.3g |" %
               (budget, total, res.solve_time, 100.0 * (total - budget) / budget,
-               CODES.get(res.error_code.val, res.error_code.val), res.iterations))
+               CODES.get(res.error_code.val, res.error_code.val), res.iterations,
+               "yes" if res.unconverged_plan else "no", res.step_residual, res.max_residual))
 
 
 if __name__ == "__main__":

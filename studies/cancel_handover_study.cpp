@@ -1,7 +1,7 @@
-// cancel_handover_study: how long a cancelled solve takes to hand its plan over, in-process
-// (docs/ros_planner.md, "Handing a cancelled N = 1e5 plan over"; scripts/cancel_handover).
+// cancel_handover_study: how long a stopped solve takes to hand its plan over, in-process
+// (docs/ros_planner.md, "Handing a stopped N = 1e5 plan over"; scripts/cancel_handover).
 //
-//   cancel_handover_study [--steps N] [--delays 0.5,1,2] [--repeats R]
+//   cancel_handover_study [--steps N] [--delays 0.5,1,2] [--budgets 1e-6,0.3,1] [--repeats R]
 //
 // The seed slew (π/3 about x in 12.8 s, the seed's inertia) at N steps with a tolerance no solve
 // meets (1e-300), so only the cancel ends it. For each delay d the cancel flag
@@ -9,6 +9,10 @@
 // after the first reported iteration; the hand-over is the wall time from raising the flag to
 // planManeuver returning. The table also says what ran at the cancel (the last reported
 // iteration's attempt stage and grid N) and what came back (rows, termination, residuals).
+// With --budgets the solves are stopped by their time budget B instead (SolverOptions::
+// time_budget_s, as the planner node's deadline does): the hand-over is the wall time from B to
+// planManeuver returning, with the solving thread's CPU time over the whole call beside it.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +22,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <time.h>
 
 #include "attitude_planner/planner.hpp"
 #include "support/seed_examples.hpp"
@@ -32,6 +38,7 @@ namespace {
 struct Settings {
   int steps = 100000;
   std::vector<double> delays{0.5, 1.0, 2.0};
+  std::vector<double> budgets;  ///< when given: stopped by these budgets, not by cancels
   int repeats = 1;
 };
 
@@ -45,9 +52,38 @@ struct AtCancel {
 struct Handover {
   double delay = 0.0;
   AtCancel at_cancel;
-  double seconds = 0.0;  ///< cancel → planManeuver returned [s]
+  double seconds = 0.0;      ///< cancel (or the budget) → planManeuver returned [s]
+  double cpu_seconds = 0.0;  ///< the solving thread's CPU time over the whole call [s]
   ap::PlanResult result;
 };
+
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/// The seed slew stopped by its time budget `budget` [s] (tolerance 1e-300: nothing else ends it).
+Handover budgetedRun(const ap::PlanningProblem& problem, double budget) {
+  AtCancel last;
+  ap::SolverOptions options;
+  options.tolerance = 1e-300;
+  options.max_iterations = 1000000;
+  options.time_budget_s = budget;
+  options.on_iteration = [&](const ap::IterationInfo& info) {
+    last = {ap::attemptStageName(info.attempt.stage), info.steps, info.iteration};
+    return true;
+  };
+  Handover h;
+  h.delay = budget;
+  const double cpu = threadCpuSeconds();
+  const Clock::time_point start = Clock::now();
+  h.result = ap::planManeuver(problem, options);
+  h.seconds = std::chrono::duration<double>(Clock::now() - start).count() - budget;
+  h.cpu_seconds = threadCpuSeconds() - cpu;
+  h.at_cancel = last;
+  return h;
+}
 
 Handover cancelledRun(const ap::PlanningProblem& problem, double delay) {
   std::atomic<bool> cancel{false};
@@ -67,6 +103,7 @@ Handover cancelledRun(const ap::PlanningProblem& problem, double delay) {
   };
   Handover h;
   h.delay = delay;
+  const double cpu = threadCpuSeconds();
   Clock::time_point cancelled_at;
   std::thread canceller([&] {
     while (!started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -78,6 +115,7 @@ Handover cancelledRun(const ap::PlanningProblem& problem, double delay) {
   });
   h.result = ap::planManeuver(problem, options);
   const Clock::time_point returned = Clock::now();
+  h.cpu_seconds = threadCpuSeconds() - cpu;
   canceller.join();
   h.seconds = std::chrono::duration<double>(returned - cancelled_at).count();
   if (std::getenv("CANCEL_HANDOVER_TIMESTAMPS")) {  // for perf record -k CLOCK_MONOTONIC windows
@@ -104,6 +142,8 @@ Settings parseArguments(int argc, char** argv) {
       s.steps = std::atoi(argv[i + 1]);
     } else if (flag == "--delays") {
       s.delays = parseList(argv[i + 1]);
+    } else if (flag == "--budgets") {
+      s.budgets = parseList(argv[i + 1]);
     } else if (flag == "--repeats") {
       s.repeats = std::atoi(argv[i + 1]);
     } else {
@@ -126,11 +166,12 @@ std::string trail(const ap::PlanResult& r) {
 
 void printRow(const Handover& h) {
   const ap::PlanResult& r = h.result;
-  std::printf("| %.2f | %s | %d | %d | %.1f | %s | %d | %.2g | %.3g | %s |\n", h.delay,
-              h.at_cancel.stage.c_str(), h.at_cancel.steps, h.at_cancel.iteration, 1e3 * h.seconds,
-              ap::terminationName(r.termination).c_str(),
-              static_cast<int>(r.maneuver.attitude.size()), r.step_residual, r.max_residual,
-              trail(r).c_str());
+  std::printf(
+      "| %.3g | %s | %d | %d | %.1f | %.2f | %.1f | %s | %d | %.2g | %.3g | %s |\n", h.delay,
+      h.at_cancel.stage.c_str(), h.at_cancel.steps, h.at_cancel.iteration, 1e3 * h.seconds,
+      1e6 * h.seconds / std::max<std::size_t>(r.maneuver.attitude.size(), 1), 1e3 * h.cpu_seconds,
+      ap::terminationName(r.termination).c_str(), static_cast<int>(r.maneuver.attitude.size()),
+      r.step_residual, r.max_residual, trail(r).c_str());
 }
 
 }  // namespace
@@ -139,25 +180,29 @@ int main(int argc, char** argv) {
   const Settings s = parseArguments(argc, argv);
   ap::PlanningProblem problem = ap::test_support::seedProblem(false);
   problem.steps = s.steps;
+  const bool budgets = !s.budgets.empty();
   std::printf("cancel_handover_study: the seed slew at N = %d, tolerance 1e-300; load %s\n\n",
               s.steps, st::loadAverage().c_str());
-  std::printf(
-      "| cancel after first iteration [s] | stage at cancel | grid N at cancel | iteration | "
-      "cancel -> plan returned [ms] | termination | rows | step residual | max residual | attempts "
-      "|\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(budgets ? "| time budget B [s] | stage at B | grid N at B | iteration | "
+                        "B -> plan returned [ms] | per row [us] | CPU of the call [ms] | "
+                      : "| cancel after first iteration [s] | stage at cancel | grid N at cancel | "
+                        "iteration | cancel -> plan returned [ms] | per row [us] | CPU of the "
+                        "call [ms] | ");
+  std::printf("termination | rows | step residual | max residual | attempts |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  const ap::Termination stopped = budgets ? ap::Termination::TimedOut : ap::Termination::Cancelled;
   std::vector<double> seconds;
   for (int repeat = 0; repeat < s.repeats; ++repeat) {
-    for (double delay : s.delays) {
-      const Handover h = cancelledRun(problem, delay);
+    for (double value : budgets ? s.budgets : s.delays) {
+      const Handover h = budgets ? budgetedRun(problem, value) : cancelledRun(problem, value);
       printRow(h);
-      if (h.result.termination == ap::Termination::Cancelled) seconds.push_back(h.seconds);
+      if (h.result.termination == stopped) seconds.push_back(h.seconds);
       std::fflush(stdout);
     }
   }
   std::vector<double> sorted = seconds;
   std::sort(sorted.begin(), sorted.end());
-  std::printf("\ncancelled runs: %zu, hand-over median %.1f ms, max %.1f ms; load %s\n",
+  std::printf("\nstopped runs: %zu, hand-over median %.1f ms, max %.1f ms; load %s\n",
               seconds.size(), 1e3 * st::median(seconds), sorted.empty() ? 0.0 : 1e3 * sorted.back(),
               st::loadAverage().c_str());
   return 0;

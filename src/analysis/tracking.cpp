@@ -101,6 +101,16 @@ Vector3 ManeuverInterpolation::torqueOnStep(int k, double t) const {
   return tau[k];
 }
 
+Vector3 ManeuverInterpolation::meanTorque(double t0, double t1) const {
+  const double a = std::clamp(t0, 0.0, duration()), b = std::clamp(t1, 0.0, duration());
+  if (!(b > a)) return at(a).torque;
+  const double h = maneuver_.time_step;
+  const auto hold = [&](double t) {  // t inside a piece: its step is the one that holds it
+    return torqueOnStep(std::clamp(static_cast<int>(std::floor(t / h)), 0, steps() - 1), t);
+  };
+  return meanOverHold<Vector3>(hold, a, b, h);
+}
+
 Vector3 ManeuverInterpolation::paperRateAt(double t) const {
   // paper: row k is the rate of step k (log(F_k)/h), its value at the step's midpoint to second
   // order; linear between the midpoints, its derivative is the node-centred torque's

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "attitude_planner/analysis/wheel_flight.hpp"
@@ -48,7 +49,9 @@ WheelPlant::WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels,
       wheels_(wheels),
       array_(wheelArray(wheels)),
       max_step_(max_step),
-      delivered_(Eigen::VectorXd::Zero(wheels.count())) {
+      commanded_(Eigen::VectorXd::Zero(wheels.count())),
+      delivered_(Eigen::VectorXd::Zero(wheels.count())),
+      saturated_at_(wheels.count(), std::numeric_limits<double>::quiet_NaN()) {
   if (!(std::isfinite(max_step) && max_step > 0.0)) {
     throw InvalidInput("max_step: must be a finite time > 0 s, got " + exactNumber(max_step));
   }
@@ -63,20 +66,54 @@ const Eigen::VectorXd& WheelPlant::command(const Eigen::VectorXd& torque) {
                        std::to_string(wheels_.count()) + "), got " + std::to_string(torque.size()));
   }
   for (int i = 0; i < wheels_.count(); ++i) {
-    delivered_(i) = std::clamp(torque(i), -wheels_.torqueLimit(i), wheels_.torqueLimit(i));
+    commanded_(i) = std::clamp(torque(i), -wheels_.torqueLimit(i), wheels_.torqueLimit(i));
   }
+  updateDelivered();
   return delivered_;
 }
 
-void WheelPlant::advanceTo(double t) {
-  if (!(t > time_)) return;
+void WheelPlant::updateDelivered() {
+  for (int i = 0; i < wheels_.count(); ++i) {
+    const double h = state_.momentum(i), H = wheels_.momentumLimit(i), u = commanded_(i);
+    const bool stopped = (h >= H && u > 0.0) || (h <= -H && u < 0.0);
+    delivered_(i) = stopped ? 0.0 : u;
+  }
+}
+
+void WheelPlant::integrate(double dt) {
   // Equal steps of at most max_step, the held torques at every RK4 stage.
-  const int steps = std::max(1, static_cast<int>(std::ceil((t - time_) / max_step_)));
-  const WheelReplay replay = replayWithWheels(
-      inertia_, array_.axes, state_.body.attitude, state_.body.angular_velocity, state_.momentum,
-      t - time_, {delivered_, delivered_}, Vector3::Zero(), steps);
+  const int steps = std::max(1, static_cast<int>(std::ceil(dt / max_step_)));
+  const WheelReplay replay =
+      replayWithWheels(inertia_, array_.axes, state_.body.attitude, state_.body.angular_velocity,
+                       state_.momentum, dt, {delivered_, delivered_}, Vector3::Zero(), steps);
   state_ = {{replay.attitude.back(), replay.angular_velocity.back()}, replay.momentum.back()};
-  time_ = t;
+}
+
+void WheelPlant::advanceTo(double t) {
+  while (t > time_) {
+    updateDelivered();
+    // ḣ_w = u: each momentum is linear in time, so the first wheel to reach its limit ends
+    // this stretch exactly where it does.
+    double end = t;
+    int stopping = -1;
+    for (int i = 0; i < wheels_.count(); ++i) {
+      const double u = delivered_(i);
+      if (u == 0.0) continue;
+      const double limit = std::copysign(wheels_.momentumLimit(i), u);
+      const double reached = time_ + (limit - state_.momentum(i)) / u;
+      if (reached < end) {
+        end = reached;
+        stopping = i;
+      }
+    }
+    if (end > time_) integrate(end - time_);
+    time_ = end;
+    if (stopping < 0) continue;
+    state_.momentum(stopping) =
+        std::copysign(wheels_.momentumLimit(stopping), delivered_(stopping));
+    if (std::isnan(saturated_at_[stopping])) saturated_at_[stopping] = time_;
+  }
+  updateDelivered();
 }
 
 }  // namespace attitude_planner

@@ -79,8 +79,8 @@ PlanOutcome deadlineOutcome(double budget) {
   out.time_budget_s = budget;
   std::ostringstream s;
   s << "timed out: no plan within the time budget of " << budget
-    << " s (the solve was told to stop at it and had not returned the plan it reached "
-    << answerDeadline(budget) - budget << " s later; its late result is dropped)";
+    << " s (the solve, stopped early for the hand-over, had not returned the plan it reached "
+    << answerDeadline(budget) - budget << " s after it; its late result is dropped)";
   out.message = s.str();
   return out;
 }
@@ -180,6 +180,7 @@ void fillDriftResponse(const DriftPlanOutcome& outcome, const std::string& world
 }
 
 PlannerNode::PlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  configureAllocator();  // before any solve: what stopped solves free goes back to the system
   ros_conversions::PlannerDefaults d;
   d.scheme = readNamedParam(pnh, "default_scheme", d.scheme, kSchemeNames);
   d.solver = readNamedParam(pnh, "solver", d.solver, kSolverNames);
@@ -298,6 +299,10 @@ void returnFreedMemory() {
   malloc_trim(0);
 }
 
+void configureAllocator() {
+  mallopt(M_MMAP_THRESHOLD, kMmapThreshold);  // a fixed threshold: no dynamic raise
+}
+
 void PlannerNode::reapLateSolves(bool all) {
   std::lock_guard<std::mutex> late(late_mutex_);
   const std::size_t before = late_solves_.size();
@@ -414,12 +419,6 @@ void PlannerNode::onGoalDeadline(const ActiveGoal& goal) {
   fillResponse(deadlineOutcome(goal.budget), world_frame_, body_frame_, &late);
   handle.setAborted(late, late.message);
   answers_.record(late.error_code.val, (ros::WallTime::now() - goal.accepted).toSec());
-}
-
-int largestPlannedSteps(const PlanAttitudeManeuverGoal& goal,
-                        const ros_conversions::PlannerDefaults& defaults) {
-  if (!goal.accuracy_measure.empty()) return defaults.max_steps;  // the planner chooses N
-  return goal.steps > 0 ? std::min(goal.steps, defaults.max_steps) : defaults.steps;
 }
 
 void PlannerNode::onGoal(GoalHandle goal) {

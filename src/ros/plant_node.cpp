@@ -108,7 +108,7 @@ void PlantNode::onWheelCommand(const sensor_msgs::JointState::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "wheel_command refused: %s", e.what());
     return;
   }
-  wheel_plant_->advanceTo(maneuverTime(commandTime(msg->header.stamp)));
+  advanceTo(maneuverTime(commandTime(msg->header.stamp)));
   wheel_plant_->command(torque);
 }
 
@@ -125,6 +125,16 @@ ros::Time PlantNode::commandTime(const ros::Time& stamp) {
 void PlantNode::advanceTo(double t) {
   if (wheel_plant_) {
     wheel_plant_->advanceTo(t);
+    const std::vector<double>& stopped = wheel_plant_->saturatedAt();
+    saturation_warned_.resize(stopped.size(), false);
+    for (std::size_t i = 0; i < stopped.size(); ++i) {
+      if (std::isnan(stopped[i]) || saturation_warned_[i]) continue;
+      saturation_warned_[i] = true;
+      ROS_WARN(
+          "attitude_plant_node: wheel_%zu reached its momentum limit %g N m s at t = %.6g s: "
+          "held there, the torque it cannot absorb acts on the body",
+          i + 1, wheel_plant_->wheels().momentumLimit(static_cast<int>(i)), stopped[i]);
+    }
   } else {
     plant_->advanceTo(t);
   }

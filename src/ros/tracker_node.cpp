@@ -65,6 +65,21 @@ std::vector<Eigen::VectorXd> wheelTorqueRows(const AttitudeManeuver& msg, const 
                               "maneuver.wheel_torque");
 }
 
+/// Measured wheel momenta as a re-plan's initial_momentum: each within its ±H_i (a measurement
+/// past a limit by round-off or noise would be refused by the planner).
+std::vector<double> withinLimits(const ReactionWheels& wheels, const Eigen::VectorXd& momentum) {
+  std::vector<double> out(momentum.size());
+  for (int i = 0; i < momentum.size(); ++i) {
+    out[i] = std::clamp(momentum(i), -wheels.momentumLimit(i), wheels.momentumLimit(i));
+  }
+  return out;
+}
+
+/// The end of sample j's hold: the next sample's time (the last sample's own: an empty hold).
+double nextSampleTime(const std::vector<double>& times, std::size_t j) {
+  return times[std::min(j + 1, times.size() - 1)];
+}
+
 }  // namespace
 
 PrincipalBox principalBox(const Matrix3& inertia, double size) {
@@ -845,7 +860,9 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
     // External with wheels: the plan's wheel torques (replay's command) and the measured peaks.
     pb.plan_wheel_torque = wheelTorqueRows(msg, plan, inertia, problem.scheme, pb.wheels);
     pb.measured_wheel_peaks = WheelPeaks(pb.wheels.count());
-  } else if (mode_ == TrackingMode::Replan) {
+    pb.problem.reaction_wheels = pb.wheels;  // a re-plan's array (its momenta: the measured)
+  }
+  if (plant_ == PlantKind::External && mode_ == TrackingMode::Replan) {
     // External: the plans in force and their laws; its own simulated body is not flown.
     pb.replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
     pb.horizon = std::make_shared<RecedingHorizonRun>(plan, problem.scheme, inertia, pb.effects,
@@ -918,11 +935,11 @@ void TrackerNode::requireWheelFlight(const ReactionWheels& wheels,
                                      const std::vector<EffectSpec>& effects) const {
   const std::string field = "maneuver.reaction_wheels";
   validateReactionWheels(wheels, field);
-  if (mode_ == TrackingMode::Replan) {
+  if (mode_ == TrackingMode::Replan && plant_ == PlantKind::Internal) {
     throw InvalidInput(field +
-                       ": a maneuver with reaction wheels is flown in ~mode replay or feedback "
-                       "only (a re-plan's answer is not yet flown by the wheels), got ~mode " +
-                       trackingModeName(mode_));
+                       ": a maneuver with reaction wheels is re-planned with ~plant external only "
+                       "(the tracker's own body is not flown through the wheels under re-plans), "
+                       "got ~mode replan with ~plant internal");
   }
   if (plant_ == PlantKind::External && !wheels.hasSpinInertia()) {
     throw InvalidInput(field + ".spin_inertia",
@@ -1209,7 +1226,8 @@ void TrackerNode::holdFinalAttitude() {
 }
 
 void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
-                                 const std::function<RigidBodyState(int)>& state_at_node) {
+                                 const std::function<RigidBodyState(int)>& state_at_node,
+                                 const std::function<Eigen::VectorXd(int)>& momentum_at_node) {
   RecedingHorizonRun& run = *pb->horizon;
   const int N = run.steps();
   const double h = run.timeStep();
@@ -1279,6 +1297,9 @@ void TrackerNode::serviceReplans(double t, Playback* pb, ReplanState* state,
   PlanningProblem rest;
   try {
     rest = remainderProblem(pb->problem, node, body.attitude, body.angular_velocity);
+    if (momentum_at_node)
+      rest.reaction_wheels.initial_momentum =
+          withinLimits(rest.reaction_wheels, momentum_at_node(node));
   } catch (const std::exception& e) {
     ROS_WARN("re-plan from t = %.6g s not sent: %s", node * h, e.what());
     state->next_node = N + 1;
@@ -1434,7 +1455,7 @@ MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Ti
 }
 
 bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState* replans) {
-  if (pb->wheels.present()) return runExternalWheels(start, pb);
+  if (pb->wheels.present()) return runExternalWheels(start, pb, replans);
   const Maneuver& plan = pb->reference->nodes();
   const int N = plan.steps();
   const TrackingLaw law(*pb->reference, pb->effects.get(), tracking_);
@@ -1469,9 +1490,10 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
       });
       body.torque = pb->horizon->commandAt(measured.state, t);
     } else if (measured.fresh) {
+      // replay: the plan's torque open loop, its mean over the hold to the next sample
       body.torque = mode_ == TrackingMode::Feedback
                         ? law.command(body.attitude, body.angular_velocity, t)
-                        : pb->reference->at(t).torque;  // replay: the plan's torque, open loop
+                        : pb->reference->meanTorque(t, nextSampleTime(pb->times, j));
     } else {
       ++stale;  // a zero command: nothing is known about the body to act on
       if (first_problem.empty()) first_problem = measured.problem;
@@ -1565,9 +1587,40 @@ MeasurementAtSample TrackerNode::wheelMeasurementAt(const Playback& pb, const ro
   return m;
 }
 
-bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
+void TrackerNode::finishExternalWheelsResult(Playback* pb, int stale, int cut_samples,
+                                             const std::string& first_problem) const {
   const Maneuver& plan = pb->reference->nodes();
   const int N = plan.steps(), n = pb->wheels.count();
+  ReplayResult& result = pb->result;
+  const WheelPeaks& peaks = *pb->measured_wheel_peaks;
+  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
+  result.terminal_velocity_error =
+      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
+  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
+  result.cost = result.effort / plan.time_step;
+  if (pb->horizon) result.replans = pb->horizon->adoptions();
+  result.success = stale == 0;
+  result.message = (mode_ != TrackingMode::Replay ? "tracked " : "commanded ") + std::to_string(N) +
+                   " steps through " + std::to_string(n) +
+                   " reaction wheels on the measured state of " + odometry_sub_.getTopic() +
+                   " and " + wheel_measurement_sub_.getTopic() + " (external plant; " +
+                   std::to_string(cut_samples) + " of " + std::to_string(pb->times.size()) +
+                   " samples cut at a wheel limit)";
+  if (stale > 0) {
+    result.message +=
+        ": " + std::to_string(stale) + " of " + std::to_string(pb->times.size()) +
+        " samples had no fresh measurement and got a zero command (first: " + first_problem + ")";
+  }
+  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, peaks);
+  std::string which;
+  const double excess = peaks.worstExcess(pb->wheels, &which);
+  if (excess > 0.0)
+    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
+}
+
+bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb, ReplanState* replans) {
+  const Maneuver& plan = pb->reference->nodes();
+  const int n = pb->wheels.count();
   const TrackingLaw law(*pb->reference, nullptr, tracking_);
   const WheelArray array = wheelArray(pb->wheels);
   last_measured_ = {plan.attitude[0], plan.angular_velocity[0]};  // drawn until measured
@@ -1588,16 +1641,32 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
     }
     const RigidBodyState& state = measured.state;
     Eigen::VectorXd u = Eigen::VectorXd::Zero(n);  // stale: nothing known to act on
+    if (measured.fresh && pb->horizon) {           // replan: from the measured body and wheels
+      const double h = plan.time_step;
+      const auto at_node = [&](int k) {
+        return predictWheelState(pb->reference->inertia(), array, {state, momentum}, held,
+                                 k * h - t);
+      };
+      serviceReplans(
+          t, pb, replans, [&](int k) { return at_node(k).body; },
+          [&](int k) { return at_node(k).momentum; });
+    }
     if (measured.fresh) {
       bool cut = false;
-      u = mode_ == TrackingMode::Feedback
-              ? wheelTorquesFor(pb->wheels, array,
-                                law.command(state.attitude, state.angular_velocity, t),
-                                state.angular_velocity, momentum, &cut)
-              // replay: the plan's u over the hold to the next sample, its mean (the midpoint
-              // of the linear hold): u(t) itself, held, would lag the plan by half a sample
-              : heldLinearly(pb->plan_wheel_torque, plan.time_step,
-                             0.5 * (t + pb->times[std::min(j + 1, pb->times.size() - 1)]));
+      const auto lawTorque = [&] {
+        return pb->horizon ? pb->horizon->commandAt(state, t)
+                           : law.command(state.attitude, state.angular_velocity, t);
+      };
+      u = mode_ != TrackingMode::Replay
+              ? wheelTorquesFor(pb->wheels, array, lawTorque(), state.angular_velocity, momentum,
+                                &cut)
+              // replay: the plan's u, its mean over the hold to the next sample (u(t) itself,
+              // held, would lag the plan by half a sample)
+              : meanOverHold<Eigen::VectorXd>(
+                    [&](double s) {
+                      return heldLinearly(pb->plan_wheel_torque, plan.time_step, s);
+                    },
+                    t, nextSampleTime(pb->times, j), plan.time_step);
       cut_samples += cut ? 1 : 0;
       peaks.observeMomentum(array.axes, momentum);
       peaks.observeTorque(u);
@@ -1630,28 +1699,7 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb) {
   wheel_command_pub_.publish(  // the run is over: nothing held
       rc::wheelJointState(Eigen::VectorXd::Zero(n), Eigen::VectorXd(), pb->body_frame,
                           ros::Time::now()));
-  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
-  result.terminal_velocity_error =
-      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
-  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
-  result.cost = result.effort / plan.time_step;
-  result.success = stale == 0;
-  result.message = (mode_ == TrackingMode::Feedback ? "tracked " : "commanded ") +
-                   std::to_string(N) + " steps through " + std::to_string(n) +
-                   " reaction wheels on the measured state of " + odometry_sub_.getTopic() +
-                   " and " + wheel_measurement_sub_.getTopic() + " (external plant; " +
-                   std::to_string(cut_samples) + " of " + std::to_string(pb->times.size()) +
-                   " samples cut at a wheel limit)";
-  if (stale > 0) {
-    result.message +=
-        ": " + std::to_string(stale) + " of " + std::to_string(pb->times.size()) +
-        " samples had no fresh measurement and got a zero command (first: " + first_problem + ")";
-  }
-  result.reaction_wheels = rc::wheelSummaryToMsg(pb->wheels, peaks);
-  std::string which;
-  const double excess = peaks.worstExcess(pb->wheels, &which);
-  if (excess > 0.0)
-    result.message += "; past a wheel limit: " + which + " by " + exactNumber(excess);
+  finishExternalWheelsResult(pb, stale, cut_samples, first_problem);
   return true;
 }
 

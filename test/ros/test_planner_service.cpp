@@ -735,6 +735,22 @@ TEST_F(PlannerService, BudgetTooSmallToConvergeAnswersWithThePlanReached) {
   ros_testing::expectSeedAnytimePlan(res, N, req.tolerance);
 }
 
+TEST_F(PlannerService, LargeRequestTimedOutAtItsDeadlineCarriesThePlanReached) {
+  // Issue 43's case: N = 1e5 with a budget of 1 s, where the stopped solve's hand-over (carrying
+  // the iterate to N = 1e5, building and judging the rows) takes longer than the answer's slack
+  // after B. The core now stops a hand-over's time before the deadline (solveBudget), so the
+  // answer is TIMED_OUT with the plan reached, flagged unconverged, with its residuals (before:
+  // TIMED_OUT without a plan). States only: no time is asserted.
+  const int N = 100000;
+  PlanAttitudeManeuver::Request req = seed(N);
+  req.tolerance = 1e-300;  // only the budget ends it
+  req.max_iterations = 1000000;
+  req.time_budget = 1.0;
+  const PlanAttitudeManeuver::Response res = call(req);
+  EXPECT_EQ(res.error_code.val, PlanErrorCode::TIMED_OUT) << res.message;
+  ros_testing::expectSeedAnytimePlan(res, N, req.tolerance);
+}
+
 TEST_F(PlannerService, InitialGuessWarmStartsTheReplanFromAStateOnThePlan) {
   // The seed's slew, then the re-plan from its node k (spinning) to the same end with
   // the plan's remainder as initial_guess: the remainder comes back, cost to 1e-8, in <= 2

@@ -95,6 +95,31 @@ TEST(TrackerExternalWheels, MeasuredWheelLoopLandsWithinTwiceTheInternalError) {
   EXPECT_TRUE(measured.velocity_per_name) << "a spin rate per wheel";
 }
 
+TEST(TrackerExternalWheels, ReplanModeReplansFromTheMeasuredBodyAndWheelMomenta) {
+  // ~mode replan with wheels on the plant: re-plans from the measured body and wheel momenta
+  // (the planner's initial_momentum) every 5 s, adopted, none failed, and the law on the plan in
+  // force, distributed over the wheels, lands within twice the internal feedback mode's error.
+  ros::NodeHandle internal_nh("internal_wheels"), nh("external_wheels_replan");
+  ros_testing::DoneListener internal_done(internal_nh), listener(nh);
+  const ReplayResult::ConstPtr internal = internal_done.wait(120.0);
+  const ReplayResult::ConstPtr done = listener.wait(60.0);
+  ASSERT_TRUE(internal && done) << "no done from /internal_wheels and /external_wheels_replan";
+  ASSERT_TRUE(done->success) << done->message;
+  EXPECT_EQ(done->mode, "replan");
+  std::printf(
+      "wheels, external replan: %d re-plans, %d failed, terminal attitude error %.3g rad "
+      "(internal feedback %.3g rad)\n",
+      done->replans, done->replan_failures, done->terminal_attitude_error,
+      internal->terminal_attitude_error);
+  EXPECT_GE(done->replans, 1);
+  EXPECT_EQ(done->replan_failures, 0) << done->replan_error;
+  EXPECT_LE(done->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
+  ASSERT_EQ(done->reaction_wheels.wheels.size(), 4u);
+  for (const WheelPeak& w : done->reaction_wheels.wheels) {
+    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
+  }
+}
+
 TEST(TrackerExternalWheels, ReplayModeCommandsThePlansWheelTorquesOpenLoop) {
   ros::NodeHandle nh("external_replay");
   ros_testing::DoneListener listener(nh);

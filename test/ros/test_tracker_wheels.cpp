@@ -180,7 +180,7 @@ TEST(TrackerWheels, ReplanModeRefusesAWheelManeuverByName) {
   ASSERT_TRUE(done) << "no done from /replan";
   EXPECT_FALSE(done->success);
   EXPECT_NE(done->message.find("maneuver.reaction_wheels"), std::string::npos) << done->message;
-  EXPECT_NE(done->message.find("~mode replay or feedback only"), std::string::npos)
+  EXPECT_NE(done->message.find("re-planned with ~plant external only"), std::string::npos)
       << done->message;
   EXPECT_NE(done->message.find("replan"), std::string::npos) << done->message;
 }

@@ -376,6 +376,44 @@ TEST(WheelPlant, MatchesClosedFormsAndConservesTheTotalMomentum) {
   EXPECT_GT(ap::so3::angleBetween(free.attitude(), ap::Matrix3::Identity()), 0.5) << "it moved";
 }
 
+/// A wheel that reaches its momentum limit stops there: the closed form of a saturated wheel on a
+/// principal axis (J_x Ω̇_x = −ḣ, ḣ = u until h = H at t_s = H/u, then ḣ = 0 and Ω_x holds
+/// −H/J_x), whether the plant is advanced in one call or in many; the torque it can no longer
+/// absorb is not delivered, the total momentum stays zero, and a torque back off the limit is
+/// delivered again.
+TEST(WheelPlant, AWheelAtItsMomentumLimitStopsThereAndTheBodyKeepsItsMomentum) {
+  ap::ReactionWheels wheels;
+  wheels.spin_axes = {ap::Vector3::UnitX(), ap::Vector3::UnitY(), ap::Vector3::UnitZ()};
+  wheels.max_torque = {0.2};
+  wheels.max_momentum = {0.5};
+  const ap::Matrix3 J = ap::Vector3(10.0, 12.0, 14.0).asDiagonal();
+  const double u = 0.2, H = 0.5, Jx = 10.0, t_s = H / u, t = 4.0;
+  Eigen::VectorXd command = Eigen::VectorXd::Zero(3);
+  command(0) = u;
+  for (int calls : {1, 7, 64}) {
+    ap::WheelPlant plant(J, wheels, {ap::Matrix3::Identity(), ap::Vector3::Zero()}, 0.05);
+    plant.command(command);
+    for (int c = 1; c <= calls; ++c) plant.advanceTo(t * c / calls);
+    EXPECT_NEAR(plant.saturatedAt()[0], t_s, 1e-12) << calls;
+    EXPECT_TRUE(std::isnan(plant.saturatedAt()[1])) << "the other wheels never moved";
+    EXPECT_EQ(plant.momentum()(0), H) << calls;
+    EXPECT_EQ(plant.deliveredTorque()(0), 0.0) << "the wheel cannot absorb more";
+    EXPECT_NEAR(plant.angularVelocity().x(), -H / Jx, 1e-14) << calls;
+    EXPECT_LT(plant.angularVelocity().tail<2>().norm(), 1e-15);
+    const double angle = -u * t_s * t_s / (2 * Jx) - H / Jx * (t - t_s);
+    EXPECT_NEAR(ap::so3::log(plant.attitude()).x(), angle, 1e-12) << calls;
+    // The total momentum R (J Ω + A h_w) stays what it was: zero.
+    EXPECT_LT((J * plant.angularVelocity() + plant.momentum()).norm(), 1e-14) << calls;
+    // Back off the limit: delivered again, the momentum leaves H linearly.
+    EXPECT_EQ(plant.command(-command)(0), -u);
+    plant.advanceTo(t + 1.0);
+    EXPECT_NEAR(plant.momentum()(0), H - u, 1e-14);
+    EXPECT_NEAR(plant.angularVelocity().x(), -(H - u) / Jx, 1e-14);
+  }
+  // Without the stop, the unsaturated closed form would have gone on: the difference is visible.
+  EXPECT_GT(u * t - H, 0.1);
+}
+
 /// predictWheelState moves a state as the plant does: the same equations under the held torques.
 TEST(WheelPlant, PredictionIsThePlantsMotion) {
   const ap::ReactionWheels wheels = pyramidWheels();

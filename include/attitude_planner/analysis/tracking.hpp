@@ -13,7 +13,9 @@
 // node, as replayPlan does).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -68,6 +70,27 @@ struct ManeuverSample {
   Vector3 torque = Vector3::Zero();            ///< τ(t) [N·m], body (the hold's value)
 };
 
+/// The mean over [t0, t1] [s] of a hold f(t) that is a polynomial of degree ≤ 3 between the
+/// half-steps j h/2 (every TorqueHold: the node-centred hold breaks at the step midpoints, the
+/// others at the nodes; a linear hold of wheel torques too): two-point Gauss–Legendre on each
+/// piece, exact there. A sampled command that holds this mean over [t0, t1) follows the plan
+/// without lag; f(t0) held would lag it by half a sample. t1 ≤ t0: f(t0).
+template <class Value, class Hold>
+Value meanOverHold(const Hold& f, double t0, double t1, double time_step) {
+  if (!(t1 > t0)) return f(t0);
+  const double half = 0.5 * time_step;
+  const double gauss = 0.5 / std::sqrt(3.0);  // the points: the middle ± gauss × the length
+  Value sum = 0.0 * f(t0);
+  for (double a = t0; a < t1;) {
+    double b = std::min(t1, (std::floor(a / half) + 1.0) * half);
+    if (!(b > a)) b = std::min(t1, a + half);  // a on a break, up to round-off
+    const double middle = 0.5 * (a + b), length = b - a;
+    sum += (0.5 * length) * (f(middle - gauss * length) + f(middle + gauss * length));
+    a = b;
+  }
+  return sum / (t1 - t0);
+}
+
 /// A maneuver on its uniform node grid, evaluated at any t ∈ [0, T].
 class ManeuverInterpolation {
  public:
@@ -92,6 +115,9 @@ class ManeuverInterpolation {
   AttitudeReference referenceAt(double t) const;
   /// τ(t) of the hold on node step k (t_k ≤ t ≤ t_{k+1}).
   Vector3 torqueOnStep(int k, double t) const;
+  /// The mean of the hold's τ over [t0, t1] (both clamped to [0, T]; τ(t0) when empty): what
+  /// an open-loop command held over a sample delivers without lagging the plan (meanOverHold).
+  Vector3 meanTorque(double t0, double t1) const;
 
  private:
   /// paper's Ω(t): the step rates Ω_k at the midpoints t_k + h/2, linear in between.

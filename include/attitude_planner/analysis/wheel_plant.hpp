@@ -5,10 +5,14 @@
 //
 //     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u,     ḣ_w = u,
 //
-// u held between commands (zero-order hold), RK4 in steps of at most max_step.
+// u held between commands (zero-order hold), RK4 in steps of at most max_step. A wheel stops at
+// its momentum limit: once |h_w,i| reaches H_i, a torque that would drive it further is not
+// delivered (ḣ_w,i = 0: the wheel cannot absorb it, so its reaction on the body is missing,
+// which is the commanded torque acting back on the body); one that brings it back is.
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/planning/reaction_wheels.hpp"
@@ -47,9 +51,12 @@ class WheelPlant {
   WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels, const RigidBodyState& start,
              double max_step);
   /// Holds the wheel torques u [N m] from now on, each cut to its torque limit ±U_i (the
-  /// motor's); returns the torques delivered. Throws InvalidInput for a wrong count.
+  /// motor's); returns the torques delivered now (0 for a wheel at its momentum limit that u
+  /// would drive further). Throws InvalidInput for a wrong count.
   const Eigen::VectorXd& command(const Eigen::VectorXd& torque);
-  /// Integrates to maneuver time t; a t at or before time() changes nothing.
+  /// Integrates to maneuver time t; a t at or before time() changes nothing. A wheel that
+  /// reaches its momentum limit on the way stops there at that instant (ḣ_w = u is linear in
+  /// time under the hold, so the instant is exact) and the rest is integrated without its torque.
   void advanceTo(double t);
   double time() const { return time_; }                             ///< t [s]
   const Matrix3& attitude() const { return state_.body.attitude; }  ///< R(t), body → world
@@ -57,6 +64,8 @@ class WheelPlant {
   const Eigen::VectorXd& momentum() const { return state_.momentum; }    ///< h_w(t) [N m s]
   const Eigen::VectorXd& deliveredTorque() const { return delivered_; }  ///< u [N m]
   const ReactionWheels& wheels() const { return wheels_; }
+  /// Per wheel: the time [s] it first stopped at its momentum limit (NaN: never).
+  const std::vector<double>& saturatedAt() const { return saturated_at_; }
 
  private:
   Matrix3 inertia_;
@@ -65,7 +74,14 @@ class WheelPlant {
   double max_step_;
   double time_ = 0.0;
   WheelBodyState state_;
-  Eigen::VectorXd delivered_;
+  Eigen::VectorXd commanded_;  ///< u held, cut to ±U_i [N m]
+  Eigen::VectorXd delivered_;  ///< u held, less the wheels stopped at their momentum limit
+  std::vector<double> saturated_at_;
+
+  /// delivered_ from commanded_ and the momenta now.
+  void updateDelivered();
+  /// Integrates dt [s] under delivered_.
+  void integrate(double dt);
 };
 
 }  // namespace attitude_planner

@@ -38,7 +38,8 @@
 // A request's time_budget is a deadline: a solve whose wall time exceeded it answers TIMED_OUT,
 // never SUCCESS. A solve stopped by its budget or its cancel answers with the plan it had reached
 // (unconverged_plan true: the dynamics and boundary data hold, optimality does not) when it hands
-// it over in time (answerDeadline, cancelGrace).
+// it over in time: the core stops a hand-over's time before the deadline (solveBudget), and a
+// cancel waits for it (cancelGrace).
 #pragma once
 
 #include <algorithm>
@@ -76,8 +77,9 @@ struct PlanOutcome {
   PlanResult result;        ///< the core's result
   PlanningProblem problem;  ///< the parsed problem (if parsing succeeded)
   ros_conversions::OutputSelection output;  ///< how much of the maneuver to return
-  double time_budget_s = 0.0;               ///< the budget the solve ran under [s] (0 = none)
-  double wall_time_s = 0.0;                 ///< wall time of planManeuver [s]
+  double time_budget_s = 0.0;  ///< the request's budget, its deadline [s] (0 = none); the core ran
+                               ///< under solveBudget of it
+  double wall_time_s = 0.0;    ///< wall time of planManeuver [s]
 };
 
 /// The one-line message of an infeasible result, built from its figures (the worst violated
@@ -144,40 +146,60 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
                   const std::string& body_frame, Response* res);
 
 /// The answer to a request with a time budget B comes by answerDeadline(B) = B + max(B
-/// kDeadlineSlack, kHandoverFloor) [s]: within 1.1 B + 0.05 s (docs/ros_timing.md). The
-/// core stops at B and returns the plan it had reached (an anytime plan: unconverged_plan); the
-/// time after B is what it has to measure that plan and hand it over (about 7 us per node here:
-/// 0.15 s at N = 20,000). A solve still running then is told to stop and its result is dropped: the
-/// answer is TIMED_OUT without a plan. (Before anytime plans: B (1 + 2 %), which most stopped plans
-/// missed.)
+/// kDeadlineSlack, kHandoverFloor) [s]: within 1.1 B + 0.05 s (docs/ros_timing.md). The core
+/// stops at its own budget, solveBudget(B, N) <= B, and returns the plan it had reached (an
+/// anytime plan: unconverged_plan); the time from there to answerDeadline(B) is what it has to
+/// carry that plan to N, measure it and hand it over. A solve still running at answerDeadline(B)
+/// is told to stop and its result is dropped: the answer is TIMED_OUT without a plan.
 inline constexpr double kDeadlineSlack = 0.08;
 inline constexpr double kHandoverFloor = 0.04;  ///< [s]
 inline double answerDeadline(double budget) {
   return budget + std::max(budget * kDeadlineSlack, kHandoverFloor);
 }
 
+/// What a stopped solve needs, at most, to hand its plan over at N nodes [s]: it carries its
+/// iterate to the requested grid (a ReducedProblem on each finer level), builds the N + 1 rows
+/// and measures its residuals (one gradient and the step residual), each a pass over the grid.
+/// Measured in-process (studies/cancel_handover_study.cpp, docs/ros_planner.md "Handing a
+/// stopped N = 1e5 plan over"): 0.7-0.9 us of CPU per node, and in wall time on the 2 shared
+/// cores up to 2.3 us per node after a cancel (load 8.5) and 7.7 us per node after a budget
+/// that stopped the class survey on its coarsest grid (load 10.7: every level up to N built).
+/// kHandoverPerNode allows about 1.3 times the worst of those: 1 s at N = 1e5, 1.3 ms at N = 128.
+inline constexpr double kHandoverPerNode = 1e-5;  ///< [s] per node of the requested grid
+inline double handoverEstimate(int steps) {
+  return kHandoverPerNode * steps;
+}
+
+/// The core's own time budget for a request with budget B [s] (0 = none) planned at up to N
+/// nodes: B, less what the hand-over needs beyond the answer's slack, so that the stopped solve's
+/// plan is handed over by answerDeadline(B): min(B, answerDeadline(B) - handoverEstimate(N)),
+/// at least kLeastSolveBudget (then the solve stops at its start: its plan is the first iterate).
+/// At N = 128 nothing is taken (the hand-over fits in the slack); at N = 1e5 a budget below
+/// about 12.5 s loses up to 1 s (a solve that would have converged in that second answers
+/// TIMED_OUT with its iterate instead).
+inline constexpr double kLeastSolveBudget = 1e-6;  ///< [s]
+inline double solveBudget(double budget, int steps) {
+  if (!(budget > 0.0)) return budget;
+  return std::max(kLeastSolveBudget,
+                  std::min(budget, answerDeadline(budget) - handoverEstimate(steps)));
+}
+
 /// An action goal cancelled while a worker solves it ends when the worker has stopped, with the
 /// plan the solve had reached, if the solve returns it within cancelGrace(N) [s]; else the cancel
 /// ends it then, without a plan (the worker's result is dropped). A cancel is answered within
 /// that wait plus the plan's fill and transfer (30-90 ms for the 8.8 MB of an N = 1e5 plan)
-/// plus transport.
-///
-/// The wait grows with N because the hand-over does: a stopped solve carries its iterate to the
-/// requested grid, builds its N + 1 rows and measures its residuals (one gradient and the step
-/// residual), each a pass over the grid. Measured in-process (studies/cancel_handover_study.cpp,
-/// docs/ros_planner.md "Handing a cancelled N = 1e5 plan over"): 1.1-2.3 us per node at N = 1e5
-/// on the 2 shared cores under a load of 8.5. kHandoverPerNode allows about twice the worst of
-/// those: 0.53 s at N = 1e5, 31 ms at N = 128 (where kCancelGrace, the scheduling of the worker
-/// thread, dominates).
-inline constexpr double kCancelGrace = 0.03;      ///< [s]
-inline constexpr double kHandoverPerNode = 5e-6;  ///< [s] per node of the requested grid
+/// plus transport. kCancelGrace is the scheduling of the worker thread (it dominates at small N).
+inline constexpr double kCancelGrace = 0.03;  ///< [s]
 inline double cancelGrace(int steps) {
-  return kCancelGrace + kHandoverPerNode * steps;
+  return kCancelGrace + handoverEstimate(steps);
 }
-/// The largest N a goal may be planned at: its steps (0: ~default_steps), or ~max_steps when an
-/// accuracy target lets the planner choose N.
-int largestPlannedSteps(const PlanAttitudeManeuverGoal& goal,
-                        const ros_conversions::PlannerDefaults& defaults);
+/// The largest N a request (service request or action goal) may be planned at: its steps
+/// (0: ~default_steps), or ~max_steps when an accuracy target lets the planner choose N.
+template <class Request>
+int largestPlannedSteps(const Request& request, const ros_conversions::PlannerDefaults& defaults) {
+  if (!request.accuracy_measure.empty()) return defaults.max_steps;  // the planner chooses N
+  return request.steps > 0 ? std::min(request.steps, defaults.max_steps) : defaults.steps;
+}
 
 /// Whether a result's plan is an unconverged iterate (the response's unconverged_plan): the solver
 /// ran, returned a maneuver, and did not converge.
@@ -200,6 +222,15 @@ PlanOutcome deadlineOutcome(double budget);
 /// Hands the memory freed by finished solves back to the system (glibc keeps it in the solving
 /// threads' malloc arenas otherwise).
 void returnFreedMemory();
+
+/// Sets the allocator up for solves on many threads (the node calls it once, at start): blocks
+/// of kMmapThreshold and more are mapped on their own and unmapped when freed. glibc's default
+/// raises that threshold after the first large free (up to 32 MB), so a solve's row arrays and
+/// Newton pieces then come from the solving thread's arena, which malloc_trim does not shrink:
+/// 13 stopped N = 2e4 solves on 4 threads kept 38 MB (docs/ros_timing.md, test
+/// Memory.StoppedSolvesLeaveNothingBehindOnceJoined).
+void configureAllocator();
+inline constexpr int kMmapThreshold = 4 << 20;  ///< [bytes]
 
 /// Calls a function once a wall time has passed unless destroyed before (planner_node.cpp): an
 /// action goal's deadline, armed when the goal is accepted.
@@ -317,7 +348,10 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
     out.output = ros_conversions::outputSelectionFromRequest(req.return_maneuver, req.output_steps);
     SolverOptions options;
     out.problem = ros_conversions::problemFromRequest(req, defaults, &options);
+    // The deadline is the request's budget (enforceDeadline); the core stops early enough to
+    // hand its plan over by the answer's deadline (solveBudget).
     out.time_budget_s = options.time_budget_s;
+    options.time_budget_s = solveBudget(options.time_budget_s, largestPlannedSteps(req, defaults));
     Maneuver guess;  // the request's warm start, if any (lives through the solve)
     if (ros_conversions::initialGuessFromMsg(req.initial_guess, "initial_guess", &guess)) {
       options.warm_start = &guess;

@@ -14,9 +14,10 @@
 // A scene with reaction wheels (actuators.reaction_wheels, with spin_inertia) is body + wheels
 // instead: the core's WheelPlant (analysis/wheel_plant.hpp: Ṙ = RΩ^, JΩ̇ = −Ω × (JΩ + A h_w) −
 // A u, ḣ_w = u, RK4), commanded by wheel torques u on `wheel_command` (each cut to its
-// max_torque), measured by the wheels' spin rates relative to the body on `wheel_measurement`
-// beside `odometry` (same stamp); effects on a body with wheels are refused by name (as the
-// planner and the tracker refuse them), torque_command is not subscribed.
+// max_torque; a wheel stops at its max_momentum, the torque it cannot absorb acting on the body,
+// with a warning once per wheel), measured by the wheels' spin rates relative to the body on
+// `wheel_measurement` beside `odometry` (same stamp); effects on a body with wheels are refused by
+// name (as the planner and the tracker refuse them), torque_command is not subscribed.
 //
 // Subscribes  torque_command  geometry_msgs/WrenchStamped, body frame   u [N·m] (wrench.torque;
 //                             the force is ignored); a frame_id other than ~body_frame or empty
@@ -68,7 +69,8 @@ class PlantNode {
   void onWheelCommand(const sensor_msgs::JointState::ConstPtr& msg);
   /// The time a command of `stamp` acts from (clamped to now), releasing the body at the first.
   ros::Time commandTime(const ros::Time& stamp);
-  /// Integrates whichever plant there is to maneuver time t.
+  /// Integrates whichever plant there is to maneuver time t; warns once per wheel that stops at
+  /// its momentum limit.
   void advanceTo(double t);
   /// ~rate timer: integrates up to now and publishes `odometry`.
   void onTimer(const ros::TimerEvent& event);
@@ -80,6 +82,7 @@ class PlantNode {
   ros::Timer timer_;
   std::unique_ptr<RigidBodyPlant> plant_;    ///< a scene without wheels
   std::unique_ptr<WheelPlant> wheel_plant_;  ///< a scene with wheels (body + wheels)
+  std::vector<bool> saturation_warned_;      ///< per wheel: its stop at H_i was logged
   ros::Publisher wheel_pub_;                 ///< `wheel_measurement` (wheels)
   std::optional<ros::Time> released_;        ///< ROS time of t = 0 (the first command's stamp)
   double rate_factor_ = 1.0;

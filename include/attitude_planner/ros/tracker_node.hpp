@@ -21,8 +21,10 @@
 // torques through body + wheels in ~mode replay (analysis/wheel_flight.hpp: flyWithWheels), and
 // with the tracking law's torque distributed over the wheels and cut to their limits in ~mode
 // feedback (trackWithWheels); with ~plant external the wheel torques go out on `wheel_command`
-// and the wheels' speeds come in on `wheel_measurement` (runExternalWheels); replan and effects
-// during the run are refused by name.
+// and the wheels' speeds come in on `wheel_measurement` (runExternalWheels; in ~mode replan the
+// re-plans start from the measured body and wheel momenta and the law on the plan in force is
+// distributed over the wheels); replan with the internal plant and effects during the run are
+// refused by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -381,9 +383,11 @@ class TrackerNode {
                SchemeKind scheme, Playback* playback) const;
   /// replan mode, before the sample at maneuver time t: adopts an answer that has arrived (at the
   /// first node ≥ t), or sends the next re-plan when its node has passed and none is in flight,
-  /// from the state `state_at_node` gives at that node (default: the simulated body's).
+  /// from the state `state_at_node` gives at that node (default: the simulated body's), with
+  /// the wheels' momenta `momentum_at_node` gives as its initial_momentum (a maneuver with wheels).
   void serviceReplans(double t, Playback* playback, ReplanState* state,
-                      const std::function<RigidBodyState(int)>& state_at_node = nullptr);
+                      const std::function<RigidBodyState(int)>& state_at_node = nullptr,
+                      const std::function<Eigen::VectorXd(int)>& momentum_at_node = nullptr);
   /// replan mode: moves a re-plan's start `body` (at maneuver time t) onto the constraints when it
   /// is past them within ~projection_tolerance (counted in done.projected_replans); false, with a
   /// failed re-plan counted and said, when it is farther (the planner would refuse that start).
@@ -411,11 +415,16 @@ class TrackerNode {
   MeasurementAtSample wheelMeasurementAt(const Playback& playback, const ros::Time& start,
                                          const ros::Time& stamp, const Eigen::VectorXd& held,
                                          Eigen::VectorXd* momentum);
-  /// ~plant external with wheels (replay, feedback): at every sample the wheel torques u on the
-  /// measured body and wheels (the law's torque distributed and cut, wheelTorquesFor; or the
-  /// plan's u(t)) out on `wheel_command`; stale measurements give a zero command. False if
-  /// stopped meanwhile.
-  bool runExternalWheels(const ros::Time& start, Playback* playback);
+  /// ~plant external with wheels: at every sample the wheel torques u on the measured body and
+  /// wheels (the law's torque distributed and cut, wheelTorquesFor, on the plan, or in replan
+  /// mode on the plan in force, re-planned from the measured body and momenta; or the plan's u
+  /// averaged over the sample) out on `wheel_command`; stale measurements give a zero command.
+  /// False if stopped meanwhile.
+  bool runExternalWheels(const ros::Time& start, Playback* playback, ReplanState* replans);
+  /// runExternalWheels' `done` after the stream: terminal errors of the last measurement, the
+  /// samples that were stale or cut at a wheel limit, the measured wheel peaks.
+  void finishExternalWheelsResult(Playback* playback, int stale, int cut_samples,
+                                  const std::string& first_problem) const;
   /// `wheel_measurement` callback: keeps the newest.
   void onWheelMeasurement(const sensor_msgs::JointState::ConstPtr& msg);
   /// Publishes the body (`body`, its torque the delivered or commanded one) and the reference

@@ -926,57 +926,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
 
 }  // namespace
 
-std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
-                                                     const FreeTimeOutcome& outcome, double size) {
-  if (outcome.negative_curvature.size() == 0) return {};
-  PlanningProblem at = endingAt(problem, outcome.maneuver.attitude.back());
-  at.duration = outcome.duration;
-  ReducedProblem np(at);
-  np.setCurrent(outcome.steps);
-  if (np.unknowns() != outcome.negative_curvature.size()) return {};
-  return np.attitudes(np.retract(outcome.negative_curvature, size));
-}
-
 std::string freeTimeUnsupported(const PlanningProblem&) {
-  return "";
-}
-
-namespace {
-
-/// Whether the gyroscopic torque −Ω × JΩ has no component about body axis i for every Ω: the
-/// axis is principal and the other two moments are equal (to round-off of J's entries).
-bool gyroscopicFreeAxis(const Matrix3& J, int i) {
-  const int j = (i + 1) % 3, k = (i + 2) % 3;
-  const double tolerance = 1e-12 * J.cwiseAbs().maxCoeff();
-  return std::abs(J(i, j)) <= tolerance && std::abs(J(i, k)) <= tolerance &&
-         std::abs(J(j, k)) <= tolerance && std::abs(J(j, j) - J(k, k)) <= tolerance;
-}
-
-}  // namespace
-
-std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
-  if (!problem.effects || !problem.hasTorqueBounds()) return "";
-  const std::optional<Vector3> d = problem.effects->constantBodyTorque();
-  if (!d) return "";
-  static const char* const kAxis[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    const double excess = std::abs((*d)(i)) - problem.max_torque(i);
-    if (!(excess > 0) || !gyroscopicFreeAxis(problem.inertia, i)) continue;
-    // The rate about the axis must change by sign(d_i) (|d_i| − a_i) T / J_i or more.
-    const double change =
-        std::copysign(1.0, (*d)(i)) * (problem.final_velocity(i) - problem.initial_velocity(i));
-    if (change > 0) continue;  // then only durations above a bound are excluded
-    std::ostringstream why;
-    why << "disturbance_torque about body " << kAxis[i] << " (" << (*d)(i)
-        << " N m in all, body frame) exceeds actuator_limits max_torque " << kAxis[i] << " ("
-        << problem.max_torque(i) << " N m): on this body (its " << kAxis[i]
-        << " axis principal, the other two moments equal: no gyroscopic torque about it) the net "
-        << "torque about " << kAxis[i] << " keeps the sign of the disturbance, at least " << excess
-        << " N m, at every instant, so the rate about body " << kAxis[i] << " cannot go from "
-        << problem.initial_velocity(i) << " to " << problem.final_velocity(i)
-        << " rad/s in any duration";
-    return why.str();
-  }
   return "";
 }
 

@@ -26,6 +26,8 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/drivers/bounded_verdicts.hpp"
+#include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/transcription/node_constraints.hpp"

@@ -184,7 +184,7 @@ TEST(KktSystem, LeastEigenpairOfAnIndefiniteBorderedBandMatchesTheDenseEigensolv
 namespace {
 
 /// A barrier state with a given slack residual (the monotone decrement test reads nothing else).
-class SlackResidualState final : public ap::BarrierState {
+class SlackResidualState final : public ap::BarrierRows {
  public:
   explicit SlackResidualState(double residual) : residual_(residual) {}
   double affineComplementarity(const Eigen::VectorXd&, double*,
@@ -268,10 +268,11 @@ TEST(StoppingTests, DecrementTestEndsAtTheToleranceAndOnAStalledViolation) {
   ap::StopVerdict v = test.check({slope, 0.0, true, 0.0, 0, f_scale});
   EXPECT_NEAR(v.relative_decrement, 0.5 * tolerance, 1e-12 * tolerance);
   EXPECT_TRUE(v.final_step);
-  EXPECT_FALSE(test.check({slope, 1e-3, true, 0.0, 1, f_scale}).final_step);  // shifted
+  const ap::StopVerdict shifted = test.check({slope, 1e-3, true, 0.0, 1, f_scale});
+  EXPECT_FALSE(shifted.final_step);
   EXPECT_FALSE(test.check({slope, 0.0, false, 0.0, 2, f_scale}).final_step);  // μ above μ_final
-  test.accepted(v, 1.0);
-  EXPECT_EQ(test.previousDecrement(), v.relative_decrement);
+  test.accepted(shifted, 1.0);
+  EXPECT_EQ(test.previousDecrement(), shifted.relative_decrement);
   // A violation that does not fall for violation_stall iterations ends the barrier problem.
   ap::DecrementTest stalled(p, tolerance, 64, false, false);
   const double violation = 10.0 * p.feasibility_tolerance;
@@ -427,8 +428,9 @@ TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeP
 namespace {
 
 /// A problem on φ(x) = (x − 1)² from x = 0 whose hooks log their calls (b: before the direction,
-/// d: the direction, a: a step accepted, r: rejected, L: the iteration limit, S/I: stopped
-/// between passes / inside one), one pass a '|'. Its direction is Newton's (1 − x), or the ascent
+/// d: the direction, a: a step accepted (A: one the stopping test marked final), r: rejected,
+/// E: ended by the stopping test, L: the iteration limit, S/I: stopped between passes / inside
+/// one), one pass a '|'. Its direction is Newton's (1 − x), or the ascent
 /// direction −1000 (1 − x) where `ascent`; `before` scripts beforeDirection's answer per pass.
 class ScriptedProblem final : public ap::PrimalDualProblem {
  public:
@@ -445,7 +447,13 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
     const int pass = static_cast<int>(std::count(log.begin(), log.end(), 'b')) - 1;
     return pass < static_cast<int>(before.size()) ? before[pass] : ap::Pass::Step;
   }
-  ap::Pass direction(ap::LineSearchRequest* request, Eigen::VectorXd** d) override {
+  ap::BarrierState state() const override {
+    ap::BarrierState s;
+    s.iteration = static_cast<int>(std::count(log.begin(), log.end(), '|'));
+    return s;
+  }
+  ap::Pass direction(ap::LineSearchRequest* request, Eigen::VectorXd** d,
+                     ap::DirectionMeasures*) override {
     log += 'd';
     if (throw_in_direction) throw ap::SolveInterrupted{ap::Termination::TimedOut};
     // The ascent is steep enough that even the last halving rises above φ's round-off.
@@ -454,13 +462,18 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
     *d = &d_;
     return ap::Pass::Step;
   }
-  ap::Pass accept(const ap::LineSearchResult&) override {
-    log += "a|";
+  ap::Pass accept(const ap::LineSearchResult&, const ap::StopVerdict& verdict) override {
+    log += verdict.final_step ? "A|" : "a|";
     accepted_ = x_;
     return ap::Pass::Continue;
   }
-  ap::Pass rejected(const ap::LineSearchResult&) override {
+  ap::Pass rejected(const ap::LineSearchResult&, const ap::StopVerdict&) override {
     log += 'r';
+    return ap::Pass::Stop;
+  }
+  ap::Pass ended(const ap::LoopEnd& end) override {
+    log += 'E';
+    ending = end.termination;
     return ap::Pass::Stop;
   }
   void iterationLimit() override { log += 'L'; }
@@ -480,15 +493,41 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
   Eigen::VectorXd d_;
 };
 
+/// A stopping test scripted by pass (the state's iteration): converged before the direction at
+/// `converge_at`, a final step at `final_at`, the round-off floor on a rejection where `floor`;
+/// it logs the steps it is told of (`accepted`).
+class ScriptedCheck final : public ap::ConvergenceCheck {
+ public:
+  std::optional<ap::LoopEnd> beforeDirection(const ap::BarrierState& s) override {
+    if (s.iteration != converge_at) return std::nullopt;
+    return ap::LoopEnd{ap::Termination::Converged, "converged", std::nullopt};
+  }
+  ap::StopVerdict afterDirection(const ap::BarrierState& s, const ap::DirectionMeasures&) override {
+    ap::StopVerdict v;
+    v.final_step = s.iteration == final_at;
+    return v;
+  }
+  void accepted(const ap::StopVerdict&, double alpha) override { accepted_steps.push_back(alpha); }
+  std::optional<ap::LoopEnd> onRejected(const ap::BarrierState&, const ap::StopVerdict&) override {
+    if (!floor) return std::nullopt;
+    return ap::LoopEnd{ap::Termination::Converged, "converged to the round-off floor", 0.0};
+  }
+  int converge_at = -1, final_at = -1;
+  bool floor = false;
+  std::vector<double> accepted_steps;
+};
+
 /// Runs the loop in the fixed-h (limits first) or free-time order; returns the passes counted.
 int runLoop(ScriptedProblem* problem, bool limits_first, int max_iterations,
-            const std::atomic<bool>* cancel = nullptr) {
+            const std::atomic<bool>* cancel = nullptr, ScriptedCheck* check = nullptr) {
   ap::SolverOptions options;
   options.cancel_requested = cancel;
   ap::SolveContext context(options);
   const ap::InteriorPointParameters p;
   int iteration = 0;
-  ap::PrimalDualLoop(*problem, {ap::fixedStepLineSearch(p), limits_first}, context)
+  ScriptedCheck never;
+  ap::PrimalDualLoop(*problem, check ? *check : never, {ap::fixedStepLineSearch(p), limits_first},
+                     context)
       .run(max_iterations, &iteration);
   return iteration;
 }
@@ -526,4 +565,69 @@ TEST(PrimalDualLoop, AStopReasonEndsTheSolveInTheProfilesPlaceAndAnInterruptionI
   EXPECT_EQ(runLoop(&inside, true, 5), 0);
   EXPECT_EQ(inside.log, "bdI");
   EXPECT_EQ(inside.ending, ap::Termination::TimedOut);
+}
+
+TEST(PrimalDualLoop, TheLoopCallsTheStoppingTestBeforeTheDirectionOnItAndOnARejection) {
+  ScriptedProblem problem;
+  ScriptedCheck check;
+  check.converge_at = 2;
+  check.final_at = 1;
+  EXPECT_EQ(runLoop(&problem, true, 5, nullptr, &check), 2);
+  EXPECT_EQ(problem.log, "bda|bdA|E");  // the verdict reaches the step; converged before pass 3
+  EXPECT_EQ(problem.ending, ap::Termination::Converged);
+  ASSERT_EQ(check.accepted_steps.size(), 2u);  // told of both steps whose pass goes on
+  EXPECT_EQ(check.accepted_steps[0], 1.0);     // Newton's full step on the parabola
+  ScriptedProblem ascent, at_floor;
+  ascent.ascent = at_floor.ascent = true;
+  ScriptedCheck floor;
+  floor.floor = true;
+  EXPECT_EQ(runLoop(&at_floor, true, 5, nullptr, &floor), 0);
+  EXPECT_EQ(at_floor.log, "bdE");  // the test ends the solve before the problem's retry
+  EXPECT_EQ(at_floor.ending, ap::Termination::Converged);
+  EXPECT_TRUE(floor.accepted_steps.empty());
+}
+
+TEST(StoppingTests, EachTestEndsTheSolveWhereItsProfileSays) {
+  const ap::KktResidualTest kkt(1e-9, 128);
+  ap::KktResidualTest test = kkt;
+  ap::BarrierState s;
+  s.stationarity = s.gap = 1e-10;
+  EXPECT_FALSE(test.beforeDirection(s));  // above μ_final
+  s.at_final_barrier = true;
+  ASSERT_TRUE(test.beforeDirection(s));
+  EXPECT_EQ(test.beforeDirection(s)->termination, ap::Termination::Converged);
+  s.elastic = true;  // never inside the elastic start
+  EXPECT_FALSE(test.beforeDirection(s));
+  EXPECT_FALSE(test.onRejected(s, {}));
+  s.elastic = false;
+  s.stationarity = 99e-9;  // not converged, but within the round-off floor (100 × tolerance)
+  EXPECT_FALSE(test.beforeDirection(s));
+  EXPECT_TRUE(test.onRejected(s, {}));
+  s.stationarity = 101e-9;
+  EXPECT_FALSE(test.onRejected(s, {}));
+  // The decrement test: converged at the floor it found on the direction, with its decrement.
+  const ap::InteriorPointParameters p;
+  ap::DecrementTest decrement(p, 1e-8, 64, false, false);
+  ap::StopVerdict v;
+  v.relative_decrement = 3e-9;
+  EXPECT_FALSE(decrement.onRejected({}, v));
+  v.at_floor = true;
+  const std::optional<ap::LoopEnd> end = decrement.onRejected({}, v);
+  ASSERT_TRUE(end);
+  EXPECT_EQ(end->termination, ap::Termination::Converged);
+  EXPECT_EQ(end->decrement, std::optional<double>(3e-9));
+  // A barrier problem's last step is not remembered (the solve ends or starts over).
+  v.final_step = true;
+  decrement.accepted(v, 1.0);
+  EXPECT_EQ(decrement.previousDecrement(), std::numeric_limits<double>::infinity());
+  v.final_step = false;
+  decrement.accepted(v, 1.0);
+  EXPECT_EQ(decrement.previousDecrement(), 3e-9);
+  // The verdict on a direction is check() on the state and the direction's measures.
+  ap::BarrierState at;
+  at.at_final_barrier = true;
+  at.f_scale = 2.0;
+  const double slope = -std::pow(0.5e-8, 2) * 2.0 * 2.0;
+  EXPECT_TRUE(decrement.afterDirection(at, {slope, 0.0}).final_step);
+  EXPECT_FALSE(decrement.afterDirection(at, {slope, 1e-3}).final_step);  // shifted
 }

@@ -1,7 +1,10 @@
 #include "planning/drivers/bounded_verdicts.hpp"
 
+#include <cmath>
+#include <optional>
 #include <sstream>
 
+#include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/constraints.hpp"
@@ -125,6 +128,45 @@ std::string localInfeasibility(double requested, double least_found, const std::
     why << "; any plan needs T >= " << exactNumber(bound.seconds) << " s (" << bound.basis << ")";
   }
   return why.str();
+}
+
+namespace {
+
+/// Whether the gyroscopic torque −Ω × JΩ has no component about body axis i for every Ω: the
+/// axis is principal and the other two moments are equal (to round-off of J's entries).
+bool gyroscopicFreeAxis(const Matrix3& J, int i) {
+  const int j = (i + 1) % 3, k = (i + 2) % 3;
+  const double tolerance = 1e-12 * J.cwiseAbs().maxCoeff();
+  return std::abs(J(i, j)) <= tolerance && std::abs(J(i, k)) <= tolerance &&
+         std::abs(J(j, k)) <= tolerance && std::abs(J(j, j) - J(k, k)) <= tolerance;
+}
+
+}  // namespace
+
+std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
+  if (!problem.effects || !problem.hasTorqueBounds()) return "";
+  const std::optional<Vector3> d = problem.effects->constantBodyTorque();
+  if (!d) return "";
+  static const char* const kAxis[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    const double excess = std::abs((*d)(i)) - problem.max_torque(i);
+    if (!(excess > 0) || !gyroscopicFreeAxis(problem.inertia, i)) continue;
+    // The rate about the axis must change by sign(d_i) (|d_i| − a_i) T / J_i or more.
+    const double change =
+        std::copysign(1.0, (*d)(i)) * (problem.final_velocity(i) - problem.initial_velocity(i));
+    if (change > 0) continue;  // then only durations above a bound are excluded
+    std::ostringstream why;
+    why << "disturbance_torque about body " << kAxis[i] << " (" << (*d)(i)
+        << " N m in all, body frame) exceeds actuator_limits max_torque " << kAxis[i] << " ("
+        << problem.max_torque(i) << " N m): on this body (its " << kAxis[i]
+        << " axis principal, the other two moments equal: no gyroscopic torque about it) the net "
+        << "torque about " << kAxis[i] << " keeps the sign of the disturbance, at least " << excess
+        << " N m, at every instant, so the rate about body " << kAxis[i] << " cannot go from "
+        << problem.initial_velocity(i) << " to " << problem.final_velocity(i)
+        << " rad/s in any duration";
+    return why.str();
+  }
+  return "";
 }
 
 }  // namespace attitude_planner

@@ -523,6 +523,17 @@ class FreeTimeMinimumTime {
 
 }  // namespace
 
+std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
+                                                     const FreeTimeOutcome& outcome, double size) {
+  if (outcome.negative_curvature.size() == 0) return {};
+  PlanningProblem at = endingAt(problem, outcome.maneuver.attitude.back());
+  at.duration = outcome.duration;
+  ReducedProblem np(at);
+  np.setCurrent(outcome.steps);
+  if (np.unknowns() != outcome.negative_curvature.size()) return {};
+  return np.attitudes(np.retract(outcome.negative_curvature, size));
+}
+
 std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& coarse) {
   PlanningProblem at = endingAt(p, coarse.maneuver.attitude.back());
   at.duration = coarse.duration;

@@ -56,4 +56,10 @@ std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const
                                            double duration, SolveContext& context,
                                            std::vector<Attempt>* tried = nullptr);
 
+/// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
+/// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a
+/// saddle, one free-time solve from it descends into a basin on either side. Empty where the
+/// outcome has no such direction.
+std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
+                                                     const FreeTimeOutcome& outcome, double size);
 }  // namespace attitude_planner

@@ -60,9 +60,9 @@ struct ConstraintRows {
 /// What a barrier rule (barrier_update.hpp) reads of the barrier problem's rows, and Mehrotra's
 /// corrector sets: a view the problem implements (ConstrainedSystem at fixed h), so that the rules
 /// do not depend on the problem they update.
-class BarrierState {
+class BarrierRows {
  public:
-  virtual ~BarrierState() = default;
+  virtual ~BarrierRows() = default;
   /// Mehrotra's predictor: from the affine-scaling step d (μ = 0), μ_aff = mean((s + α_p ds)(z +
   /// α_d dz)), and the mean complementarity now (*average); ds_aff·dz_aff in `products`.
   virtual double affineComplementarity(const Eigen::VectorXd& d, double* average,

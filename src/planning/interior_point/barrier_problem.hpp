@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "attitude_planner/termination.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 
 namespace attitude_planner {
 
@@ -18,6 +19,7 @@ enum class Pass {
   Step,      ///< go on within this pass (to the direction, to the line search)
   Continue,  ///< the pass is over and counted: the next iteration
   Stop,      ///< the solve has ended (the problem holds its termination and why)
+  Reject,    ///< no direction: the pass goes on as after a line search that took no step
 };
 
 class BarrierProblem {
@@ -43,23 +45,35 @@ class BarrierProblem {
   virtual void clearCorrection() {}
 };
 
-/// What the primal–dual loop (primal_dual_loop.hpp) asks beyond the line search. The problem owns
-/// the count of passes (the loop advances it after each counted pass; a hook that ends the solve
-/// on a pass it has reported counts that pass itself) and the termination.
+/// What the primal–dual loop (primal_dual_loop.hpp) asks beyond the line search; the loop calls
+/// the stopping test (ConvergenceCheck) on what `state` says. The problem owns the count of
+/// passes (the loop advances it after each counted pass; a hook that ends the solve on a pass it
+/// has reported counts that pass itself) and the termination.
 class PrimalDualProblem : public BarrierProblem {
  public:
-  /// Before the direction: free time assembles here and tests convergence and its barrier
-  /// problem (solved: μ falls, a counted pass without a step); fixed h has nothing to do.
+  /// Before the stopping test: free time assembles at the iterate and measures its residuals;
+  /// fixed h assembles in direction().
+  virtual void prepare() {}
+  /// What the stopping test reads of the iterate.
+  virtual BarrierState state() const = 0;
+  /// After the stopping test, before the direction: free time's barrier problem solved (μ falls,
+  /// a counted pass without a step); fixed h has nothing to do.
   virtual Pass beforeDirection() { return Pass::Step; }
   /// The Newton direction at the iterate (assembly where not done, inertia correction, the
-  /// barrier rule's predictor, the stopping test) and the line search's request; *d the step.
-  virtual Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) = 0;
-  /// The line search accepted a step of length result.alpha (the iterate at the trial point):
-  /// the dual step, the strategies' updates after a step, the report.
-  virtual Pass accept(const LineSearchResult& result) = 0;
-  /// The line search accepted no step (or no direction was found): a retry, a round-off end
-  /// or a failure.
-  virtual Pass rejected(const LineSearchResult& result) = 0;
+  /// barrier rule's predictor), the line search's request and what the stopping test reads of
+  /// the direction; *d the step.
+  virtual Pass direction(LineSearchRequest* request, Eigen::VectorXd** d,
+                         DirectionMeasures* measures) = 0;
+  /// The line search accepted a step of length result.alpha (the iterate at the trial point) with
+  /// the stopping test's verdict: the dual step, the strategies' updates after a step, the report.
+  virtual Pass accept(const LineSearchResult& result, const StopVerdict& verdict) = 0;
+  /// The line search took no step at a barrier problem it has solved as far as round-off allows
+  /// (free time: the next μ, a counted pass); Step: the stopping test, then rejected().
+  virtual Pass solvedToRoundOff(const LineSearchResult& /*result*/) { return Pass::Step; }
+  /// No step and the stopping test did not end the solve: a retry or a failure.
+  virtual Pass rejected(const LineSearchResult& result, const StopVerdict& verdict) = 0;
+  /// The stopping test ends the solve.
+  virtual Pass ended(const LoopEnd& end) = 0;
   /// The solve ends at the iteration limit.
   virtual void iterationLimit() = 0;
   /// The solve ends cancelled or out of time; `inside_pass`: interrupted inside an assembly or a

@@ -22,7 +22,7 @@ class MehrotraPredictorCorrector : public BarrierUpdate {
       : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Mehrotra; }
 
-  void beforeStep(BarrierState& state, const FactorSolve& solve, const Eigen::VectorXd& rhs,
+  void beforeStep(BarrierRows& state, const FactorSolve& solve, const Eigen::VectorXd& rhs,
                   const BarrierScales& scales, double previous_decrement, double* mu,
                   Eigen::VectorXd* delta) override {
     Eigen::VectorXd barrier_part = Eigen::VectorXd::Zero(rhs.size());  // Σ g/s
@@ -72,7 +72,7 @@ class LoqoBarrier : public BarrierUpdate {
   explicit LoqoBarrier(const InteriorPointParameters& parameters) : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Loqo; }
 
-  void afterStep(const BarrierState& state, const BarrierScales& scales, const AcceptedStep& step,
+  void afterStep(const BarrierRows& state, const BarrierScales& scales, const AcceptedStep& step,
                  double* mu) override {
     const InteriorPointParameters& p = parameters_;
     double average = 0.0, smallest = 0.0;
@@ -98,7 +98,7 @@ MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters) {
   return {parameters.free_time_theta_mu, BarrierProblemTest::KktResidual, false};
 }
 
-void MonotoneBarrier::afterStep(const BarrierState& state, const BarrierScales& scales,
+void MonotoneBarrier::afterStep(const BarrierRows& state, const BarrierScales& scales,
                                 const AcceptedStep& step, double* mu) {
   if (profile_.test != BarrierProblemTest::Decrement) return;
   const InteriorPointParameters& p = parameters_;

@@ -48,12 +48,12 @@ class BarrierUpdate {
   /// Before a primal–dual step, the system factored and `delta` solved for `rhs` at μ: may set μ
   /// for this step and replace `delta` (the predictor–corrector). `previous_decrement` is the
   /// last step's relative decrement (+∞ at the first).
-  virtual void beforeStep(BarrierState& /*state*/, const FactorSolve& /*solve*/,
+  virtual void beforeStep(BarrierRows& /*state*/, const FactorSolve& /*solve*/,
                           const Eigen::VectorXd& /*rhs*/, const BarrierScales& /*scales*/,
                           double /*previous_decrement*/, double* /*mu*/,
                           Eigen::VectorXd* /*delta*/) {}
   /// After an accepted step above μ_final: the next μ.
-  virtual void afterStep(const BarrierState& /*state*/, const BarrierScales& /*scales*/,
+  virtual void afterStep(const BarrierRows& /*state*/, const BarrierScales& /*scales*/,
                          const AcceptedStep& /*step*/, double* /*mu*/) {}
 };
 
@@ -91,7 +91,7 @@ class MonotoneBarrier final : public BarrierUpdate {
       : parameters_(parameters), profile_(profile) {}
   BarrierRule rule() const override { return BarrierRule::Monotone; }
   /// The decrement test (BarrierProblemTest::Decrement): μ falls after a step that solves it.
-  void afterStep(const BarrierState& state, const BarrierScales& scales, const AcceptedStep& step,
+  void afterStep(const BarrierRows& state, const BarrierScales& scales, const AcceptedStep& step,
                  double* mu) override;
   /// The KKT residual test (BarrierProblemTest::KktResidual) at μ.
   bool solved(double kkt_residual, double mu, const BarrierScales& scales) const;

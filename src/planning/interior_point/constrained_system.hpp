@@ -46,7 +46,7 @@ struct TwistBorder {
 /// The node constraints of one problem in one formulation, and the condensed Newton system.
 /// With a pointing end condition (ReducedProblem::hasTwist) the unknowns are (δ, ψ): every vector
 /// has unknowns() + 1 entries, ψ last, and an assembly with H fills twistBorder() too.
-class ConstrainedSystem final : public BarrierState {
+class ConstrainedSystem final : public BarrierRows {
  public:
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
                     const InteriorPointParameters& parameters);
@@ -84,7 +84,7 @@ class ConstrainedSystem final : public BarrierState {
   Assembly assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
                     Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient);
 
-  // BarrierState (the predictor–corrector's part; q for the complementarity target).
+  // BarrierRows (the predictor–corrector's part; q for the complementarity target).
   double affineComplementarity(const Eigen::VectorXd& d, double* average,
                                std::vector<double>* products) const override;
   void addSlackWeightedGradients(const std::vector<double>* products,
@@ -106,7 +106,7 @@ class ConstrainedSystem final : public BarrierState {
   void applySlackStep(double alpha);
   /// FreeSlacks: the largest multiplier after the dual step dz.
   double largestMultiplier(const std::vector<double>& dz, double alpha) const;
-  // BarrierState (FreeSlacks' max |c − s|; the complementarity products).
+  // BarrierRows (FreeSlacks' max |c − s|; the complementarity products).
   double maxSlackResidual() const override;
   void complementarity(double mu, double rho, double* average, double* smallest) const override;
   /// Largest elastic violation max(−c_i) at the last assembly or merit.

@@ -277,10 +277,26 @@ class FreeTimeSolver final : public PrimalDualProblem {
   bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override;
   void clearCorrection() override;
   // PrimalDualProblem: the free-time profile's pass (free_time_solver.cpp).
+  void prepare() override;
+  BarrierState state() const override {
+    BarrierState s;
+    s.iteration = iterations_;
+    s.at_final_barrier = mu_ <= mu_final_;
+    s.elastic = elastic_;
+    s.stationarity = stationarity_;
+    s.gap = gap_;
+    return s;
+  }
   Pass beforeDirection() override;
-  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) override;
-  Pass accept(const LineSearchResult& result) override;
-  Pass rejected(const LineSearchResult& result) override;
+  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d,
+                 DirectionMeasures* measures) override;
+  Pass accept(const LineSearchResult& result, const StopVerdict& verdict) override;
+  Pass solvedToRoundOff(const LineSearchResult& result) override;
+  Pass rejected(const LineSearchResult& result, const StopVerdict& verdict) override;
+  Pass ended(const LoopEnd& e) override {
+    return e.termination == Termination::Converged ? converged(e.reason)
+                                                   : end(e.termination, e.reason);
+  }
   void iterationLimit() override { end(Termination::NotConverged, "iteration limit"); }
   void stopped(Termination t, bool inside_pass) override;
   /// Ends the solve: the outcome at the iterate, with `why`.
@@ -738,22 +754,23 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   scales_ = {1.0, 1, N_, mu_final_};
   mu_ = mu0_;
   initializeDuals(mu_);
-  PrimalDualLoop(*this, {freeTimeLineSearch(parameters_), false}, context)
+  PrimalDualLoop(*this, test_, {freeTimeLineSearch(parameters_), false}, context)
       .run(max_iterations, &iterations_);
   return out_;
 }
 
-/// Assembles at the iterate (every pass: the limits are tested after it), then the convergence
-/// test at μ_final and, above it, whether the barrier problem is solved: then the watch, the
-/// elastic penalty, the next μ, a pass counted without a step at the same iterate.
-Pass FreeTimeSolver::beforeDirection() {
+/// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
+/// test reads what it measures).
+void FreeTimeSolver::prepare() {
   epsilon_ = epsilon0_ * std::max(mu_ / mu0_, kFinalEffortFraction);
   assemble(mu_, epsilon_);
   gap_ = dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  if (!elastic_ && mu_ <= mu_final_ && test_.converged(stationarity_, gap_)) {
-    return converged("converged");
-  }
+}
+
+/// Above μ_final, whether the barrier problem is solved: then the watch, the elastic penalty, the
+/// next μ, a pass counted without a step at the same iterate.
+Pass FreeTimeSolver::beforeDirection() {
   if (mu_ > mu_final_ &&
       (solved_to_round_off_ || barrier_.solved(barrierResidual(mu_), mu_, scales_))) {
     solved_to_round_off_ = false;
@@ -773,9 +790,10 @@ Pass FreeTimeSolver::beforeDirection() {
 
 /// The shifted Newton step (PerturbationHandler) and the search from the accepted iterate: in the
 /// end game a rejected full step is first retried with its second-order correction.
-Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d) {
+Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d,
+                               DirectionMeasures*) {
   late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
-  if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return rejected({});
+  if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return Pass::Reject;
   accepted_ = {np_.timeStep(), mu_, epsilon_, np_.current()};
   accepted_end_ = np_.finalAttitude();
   clearCorrection();
@@ -785,7 +803,7 @@ Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d) 
 }
 
 /// The order is the method's: dual step, damping, leaving the elastic phase, κ_Σ.
-Pass FreeTimeSolver::accept(const LineSearchResult& result) {
+Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
   dualStep(d_, mu_);
   inertia_.afterStep(result.alpha, late_);
   leaveElasticIfInside();
@@ -794,7 +812,7 @@ Pass FreeTimeSolver::accept(const LineSearchResult& result) {
   return Pass::Continue;
 }
 
-Pass FreeTimeSolver::rejected(const LineSearchResult& result) {
+Pass FreeTimeSolver::solvedToRoundOff(const LineSearchResult& result) {
   // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
   // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
   // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
@@ -805,9 +823,11 @@ Pass FreeTimeSolver::rejected(const LineSearchResult& result) {
     report(0.0, stationarity_);
     return Pass::Continue;
   }
-  if (!elastic_ && test_.atRoundOffFloor(stationarity_, gap_)) {
-    return converged("converged to the round-off floor");
-  }
+  return Pass::Step;
+}
+
+/// Not at the round-off floor (the KKT residual test ends the solve there).
+Pass FreeTimeSolver::rejected(const LineSearchResult&, const StopVerdict&) {
   return end(Termination::NotConverged, "no descent step (line search failed)");
 }
 
@@ -906,57 +926,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
 
 }  // namespace
 
-std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
-                                                     const FreeTimeOutcome& outcome, double size) {
-  if (outcome.negative_curvature.size() == 0) return {};
-  PlanningProblem at = endingAt(problem, outcome.maneuver.attitude.back());
-  at.duration = outcome.duration;
-  ReducedProblem np(at);
-  np.setCurrent(outcome.steps);
-  if (np.unknowns() != outcome.negative_curvature.size()) return {};
-  return np.attitudes(np.retract(outcome.negative_curvature, size));
-}
-
 std::string freeTimeUnsupported(const PlanningProblem&) {
-  return "";
-}
-
-namespace {
-
-/// Whether the gyroscopic torque −Ω × JΩ has no component about body axis i for every Ω: the
-/// axis is principal and the other two moments are equal (to round-off of J's entries).
-bool gyroscopicFreeAxis(const Matrix3& J, int i) {
-  const int j = (i + 1) % 3, k = (i + 2) % 3;
-  const double tolerance = 1e-12 * J.cwiseAbs().maxCoeff();
-  return std::abs(J(i, j)) <= tolerance && std::abs(J(i, k)) <= tolerance &&
-         std::abs(J(j, k)) <= tolerance && std::abs(J(j, j) - J(k, k)) <= tolerance;
-}
-
-}  // namespace
-
-std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
-  if (!problem.effects || !problem.hasTorqueBounds()) return "";
-  const std::optional<Vector3> d = problem.effects->constantBodyTorque();
-  if (!d) return "";
-  static const char* const kAxis[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    const double excess = std::abs((*d)(i)) - problem.max_torque(i);
-    if (!(excess > 0) || !gyroscopicFreeAxis(problem.inertia, i)) continue;
-    // The rate about the axis must change by sign(d_i) (|d_i| − a_i) T / J_i or more.
-    const double change =
-        std::copysign(1.0, (*d)(i)) * (problem.final_velocity(i) - problem.initial_velocity(i));
-    if (change > 0) continue;  // then only durations above a bound are excluded
-    std::ostringstream why;
-    why << "disturbance_torque about body " << kAxis[i] << " (" << (*d)(i)
-        << " N m in all, body frame) exceeds actuator_limits max_torque " << kAxis[i] << " ("
-        << problem.max_torque(i) << " N m): on this body (its " << kAxis[i]
-        << " axis principal, the other two moments equal: no gyroscopic torque about it) the net "
-        << "torque about " << kAxis[i] << " keeps the sign of the disturbance, at least " << excess
-        << " N m, at every instant, so the rate about body " << kAxis[i] << " cannot go from "
-        << problem.initial_velocity(i) << " to " << problem.final_velocity(i)
-        << " rad/s in any duration";
-    return why.str();
-  }
   return "";
 }
 

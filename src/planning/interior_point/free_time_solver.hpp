@@ -92,23 +92,6 @@ using BarrierWatch = std::function<std::string(const BarrierPoint&)>;
 /// (minimum_time.cpp, fourthOrderMinimumTime). Kept as the one place a future case names itself.
 std::string freeTimeUnsupported(const PlanningProblem& problem);
 
-/// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
-/// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a
-/// saddle, one free-time solve from it descends into a basin on either side. Empty where the
-/// outcome has no such direction.
-std::vector<Matrix3> displacedAlongNegativeCurvature(const PlanningProblem& problem,
-                                                     const FreeTimeOutcome& outcome, double size);
-/// Why no plan exists at any duration, where that follows from the bounds alone (empty: not
-/// shown; the problem may still be infeasible). Shown for a constant body-frame disturbance whose
-/// component about a body axis exceeds that axis's torque bound, on a body whose gyroscopic
-/// torque about that axis vanishes (the axis principal, the other two moments equal: J = I, an
-/// axisymmetric body about it): there J_i ω̇_i = u_i + d_i has the sign of d_i at every
-/// instant, so the rate about the axis must move that way by at least (|d_i| − a_i) T / J_i,
-/// which boundary rates with no such change (rest to rest) forbid at every T. A start from the
-/// free-time solver's raise never gets inside there, and the search ends "infeasible" only after
-/// every start has failed (about 16 000 iterations at N = 64).
-std::string infeasibleAtEveryDuration(const PlanningProblem& problem);
-
 /// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
 /// R_N the problem's) at T = start_duration, raised until every torque constraint holds strictly
 /// (a cone must hold strictly at the start's attitudes already, and at the attitudes the boundary

@@ -1,6 +1,6 @@
-// The interior point on one grid on the PrimalDualLoop (primal_dual_loop.hpp), its hooks named
-// pieces: the step (assembly, inertia correction, the barrier rule's predictor), the stopping
-// test, the step's acceptance, a rejection (the round-off floor, the Levenberg–Marquardt retry),
+// The interior point on one grid on the PrimalDualLoop (primal_dual_loop.hpp) with the decrement
+// test (the loop calls it), its hooks named pieces: the step (assembly, inertia correction, the
+// barrier rule's predictor), the step's acceptance, a rejection (the Levenberg–Marquardt retry),
 // the end of a barrier problem at μ_final (converged, penalty raise or infeasible) and the
 // barrier rule's update.
 #include "planning/interior_point/grid_solve.hpp"
@@ -73,7 +73,7 @@ class GridSolve final : public PrimalDualProblem {
 
   GridOutcome run() {
     initialize();
-    PrimalDualLoop(*this, {fixedStepLineSearch(p_), true}, context_)
+    PrimalDualLoop(*this, test_, {fixedStepLineSearch(p_), true}, context_)
         .run(options_.max_iterations, &iteration_);
     system_.setInterruption(nullptr);
     return finish();
@@ -118,8 +118,19 @@ class GridSolve final : public PrimalDualProblem {
     }
   }
 
-  // PrimalDualProblem: the direction with its stopping test, the step, a rejection, the ends.
-  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d) override {
+  // PrimalDualProblem: what the decrement test reads, the direction, the step, a rejection, the
+  // ends.
+  BarrierState state() const override {
+    BarrierState s;
+    s.iteration = iteration_;
+    s.at_final_barrier = mu_ <= scales_.mu_final;
+    s.max_violation = system_.maxViolation();
+    s.f_scale = scales_.f_scale;
+    return s;
+  }
+
+  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d,
+                 DirectionMeasures* measures) override {
     const Direction direction = computeDirection();
     if (!std::isfinite(direction.cost)) {
       return end(Termination::StepTooLarge,
@@ -128,32 +139,29 @@ class GridSolve final : public PrimalDualProblem {
     if (!direction.factored) {
       return end(Termination::NotConverged, "Newton system could not be made positive definite");
     }
-    verdict_ =
-        test_.check({free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift,
-                     mu_ <= scales_.mu_final, system_.maxViolation(), iteration_, scales_.f_scale});
+    *measures = {free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift};
     cost_ = direction.cost;
-    *request = {direction.slope, free_slacks_ ? alpha_slack_ : 1.0, verdict_.final_step,
-                verdict_.at_floor, false};
+    request->slope = direction.slope;
+    request->alpha0 = free_slacks_ ? alpha_slack_ : 1.0;
     *d = &delta_;
     return Pass::Step;
   }
 
   /// Takes the step, reports it; the barrier problem's last step ends it, else the barrier rule
   /// updates μ.
-  Pass accept(const LineSearchResult& result) override {
+  Pass accept(const LineSearchResult& result, const StopVerdict& verdict) override {
     const double alpha = result.alpha;
     takeStep(trial_, alpha);
-    if (!report(cost_, verdict_.relative_decrement, alpha)) {
+    if (!report(cost_, verdict.relative_decrement, alpha)) {
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
-    if (verdict_.final_step) return endBarrierProblem();
-    if (!verdict_.at_final_barrier) {
+    if (verdict.final_step) return endBarrierProblem();
+    if (!verdict.at_final_barrier) {
       barrier_->afterStep(system_, scales_,
-                          {verdict_.relative_decrement, test_.previousDecrement(), alpha, rho_},
+                          {verdict.relative_decrement, test_.previousDecrement(), alpha, rho_},
                           &mu_);
     }
-    test_.accepted(verdict_, alpha);
     return Pass::Continue;
   }
 
@@ -232,25 +240,19 @@ class GridSolve final : public PrimalDualProblem {
   void restore() override {}  // the trials never moved the accepted iterate
   double penalty() const { return free_slacks_ ? nu_ : rho_; }
 
-  /// A direction the line search rejects: at the round-off floor the iterate is as good as it
-  /// gets; else regularize more (Levenberg–Marquardt) and retry, a few times. A retry is an
-  /// iteration (counted): it is reported too, at the same iterate (step 0).
-  Pass rejected(const LineSearchResult&) override {
-    const StopVerdict& t = verdict_;
-    if (t.at_floor) {
-      std::ostringstream why;
-      why << "converged to the round-off floor (relative Newton decrement " << t.relative_decrement
-          << ", the line search can no longer decrease the merit)";
-      return end(Termination::Converged, why.str(), t.relative_decrement);
-    }
+  /// A direction the line search rejects (not at the round-off floor: the decrement test ends
+  /// the solve there): regularize more (Levenberg–Marquardt) and retry, a few times. A retry is
+  /// an iteration (counted): it is reported too, at the same iterate (step 0).
+  Pass rejected(const LineSearchResult&, const StopVerdict& verdict) override {
     if (inertia_.raiseFloor()) {
-      if (report(cost_, t.relative_decrement, 0.0)) return Pass::Continue;
+      if (report(cost_, verdict.relative_decrement, 0.0)) return Pass::Continue;
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
-    relative_decrement_ = t.relative_decrement;
+    relative_decrement_ = verdict.relative_decrement;
     return end(Termination::NotConverged, "line search failed");
   }
+  Pass ended(const LoopEnd& e) override { return end(e.termination, e.reason, e.decrement); }
 
   /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
   /// dual step), the iterate; relaxes the shift floor.
@@ -401,8 +403,7 @@ class GridSolve final : public PrimalDualProblem {
   /// The condensed system: a band, bordered by the twist ψ with a pointing end condition.
   KktBlocks<Scalar> kkt_blocks_;
   std::unique_ptr<KktSystem<Scalar>> kkt_;
-  DecrementTest test_;   ///< the stopping test and its memory (stalls, the last step)
-  StopVerdict verdict_;  ///< its verdict on the current direction
+  DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;
   double mu_ = 0.0, mu_start_ = 0.0;

@@ -16,20 +16,45 @@ void PrimalDualLoop::run(int max_iterations, int* iteration) {
   }
 }
 
-/// One pass: what comes before the direction, the limits (free time), the direction, the line
-/// search, the step or the rejection.
+/// One pass: the problem prepared, the stopping test, what comes before the direction, the
+/// limits (free time), the step.
 Pass PrimalDualLoop::pass(int iteration, int max_iterations) {
+  problem_.prepare();
+  if (const std::optional<LoopEnd> end = stop_.beforeDirection(problem_.state())) {
+    return problem_.ended(*end);
+  }
   const Pass before = problem_.beforeDirection();
   if (before != Pass::Step) return before;
   if (!profile_.limits_before_direction_work && limitReached(iteration, max_iterations)) {
     return Pass::Stop;
   }
+  return step();
+}
+
+Pass PrimalDualLoop::step() {
   LineSearchRequest request;
   Eigen::VectorXd* d = nullptr;
-  const Pass direction = problem_.direction(&request, &d);
+  DirectionMeasures measures;
+  const Pass direction = problem_.direction(&request, &d, &measures);
+  if (direction == Pass::Reject) return rejected({}, {});
   if (direction != Pass::Step) return direction;
+  const StopVerdict verdict = stop_.afterDirection(problem_.state(), measures);
+  request.take_outright = verdict.final_step;
+  request.at_floor = verdict.at_floor;
   const LineSearchResult result = search_.search(problem_, request, d);
-  return result.accepted ? problem_.accept(result) : problem_.rejected(result);
+  if (!result.accepted) return rejected(result, verdict);
+  const Pass after = problem_.accept(result, verdict);
+  if (after == Pass::Continue) stop_.accepted(verdict, result.alpha);
+  return after;
+}
+
+Pass PrimalDualLoop::rejected(const LineSearchResult& result, const StopVerdict& verdict) {
+  const Pass solved = problem_.solvedToRoundOff(result);
+  if (solved != Pass::Step) return solved;
+  if (const std::optional<LoopEnd> end = stop_.onRejected(problem_.state(), verdict)) {
+    return problem_.ended(*end);
+  }
+  return problem_.rejected(result, verdict);
 }
 
 bool PrimalDualLoop::limitReached(int iteration, int max_iterations) {

@@ -1,6 +1,7 @@
-// The one primal–dual interior-point loop: the order of a pass (limits, direction, line search,
-// step or rejection) over a PrimalDualProblem, which holds the iterate, its strategies (barrier
-// rule, inertia correction, stopping test) and the termination. Two profiles: fixed h
+// The one primal–dual interior-point loop: the order of a pass (limits, the stopping test,
+// direction, line search, step or rejection) over a PrimalDualProblem, which holds the iterate,
+// its barrier rule and inertia correction, and the termination; the loop calls the stopping test
+// (ConvergenceCheck) itself. Two profiles: fixed h
 // (grid_solve.cpp) and free time (free_time_solver.cpp).
 #pragma once
 
@@ -21,8 +22,13 @@ struct LoopProfile {
 
 class PrimalDualLoop {
  public:
-  PrimalDualLoop(PrimalDualProblem& problem, const LoopProfile& profile, SolveContext& context)
-      : problem_(problem), profile_(profile), search_(profile.search), context_(context) {}
+  PrimalDualLoop(PrimalDualProblem& problem, ConvergenceCheck& stop, const LoopProfile& profile,
+                 SolveContext& context)
+      : problem_(problem),
+        stop_(stop),
+        profile_(profile),
+        search_(profile.search),
+        context_(context) {}
   /// Passes until the problem stops, the iteration limit or the context's stop reason, counted
   /// in *iteration (the problem's count, which its hooks read). The iterate and the termination
   /// stay in the problem.
@@ -30,10 +36,16 @@ class PrimalDualLoop {
 
  private:
   Pass pass(int iteration, int max_iterations);
+  /// The direction, the stopping test's verdict on it, the line search, the step or rejection.
+  Pass step();
+  /// No step: a barrier problem solved to round-off, the stopping test, else the problem's retry
+  /// or failure.
+  Pass rejected(const LineSearchResult& result, const StopVerdict& verdict);
   /// Ends the solve (in the problem) at the iteration limit or a stop reason; false: go on.
   bool limitReached(int iteration, int max_iterations);
 
   PrimalDualProblem& problem_;
+  ConvergenceCheck& stop_;
   const LoopProfile profile_;
   const ArmijoBacktracking search_;
   SolveContext& context_;

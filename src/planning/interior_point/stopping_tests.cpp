@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace attitude_planner {
 
@@ -55,9 +56,18 @@ StopVerdict DecrementTest::check(const DecrementProbe& d) {
 }
 
 void DecrementTest::accepted(const StopVerdict& v, double alpha) {
+  if (v.final_step) return;
   previous_decrement_ = v.relative_decrement;
   previous_alpha_ = alpha;
   previous_at_final_barrier_ = v.at_final_barrier;
+}
+
+std::optional<LoopEnd> DecrementTest::onRejected(const BarrierState&, const StopVerdict& v) {
+  if (!v.at_floor) return std::nullopt;
+  std::ostringstream why;
+  why << "converged to the round-off floor (relative Newton decrement " << v.relative_decrement
+      << ", the line search can no longer decrease the merit)";
+  return LoopEnd{Termination::Converged, why.str(), v.relative_decrement};
 }
 
 void DecrementTest::restart(int iteration) {
@@ -95,5 +105,15 @@ KktResidualTest::KktResidualTest(double tolerance, int steps)
     : tolerance_(tolerance),
       stationarity_tolerance_(
           tolerance * std::max(1.0, std::pow(static_cast<double>(steps) / kRoundOffSteps, 2))) {}
+
+std::optional<LoopEnd> KktResidualTest::beforeDirection(const BarrierState& s) {
+  if (s.elastic || !s.at_final_barrier || !converged(s.stationarity, s.gap)) return std::nullopt;
+  return LoopEnd{Termination::Converged, "converged", std::nullopt};
+}
+
+std::optional<LoopEnd> KktResidualTest::onRejected(const BarrierState& s, const StopVerdict&) {
+  if (s.elastic || !atRoundOffFloor(s.stationarity, s.gap)) return std::nullopt;
+  return LoopEnd{Termination::Converged, "converged to the round-off floor", std::nullopt};
+}
 
 }  // namespace attitude_planner

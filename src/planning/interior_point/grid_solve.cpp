@@ -329,9 +329,7 @@ class GridSolve final : public PrimalDualProblem {
   /// size (relativeStationarity formed them).
   void reportTwist(const Maneuver& planned, PlanResult* result) const {
     PointingSummary& p = result->pointing;
-    p.active = true;
-    p.final_twist = twistOf(planned.attitude.back(), problem_.end_condition);
-    p.error = pointingError(planned.attitude.back(), problem_.end_condition);
+    summarizePointingEnd(planned.attitude.back(), problem_.end_condition, &p);
     p.twist_gradient = system_.twistGradient();
     p.twist_stationarity = system_.twistStationarity();
   }

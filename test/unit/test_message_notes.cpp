@@ -310,7 +310,8 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
                                         v::SearchUnrepresentable{},
                                         v::SearchInfeasible{},
                                         v::FeasibleAtMinimumTime{},
-                                        v::NoPointingStartConverged{}};
+                                        v::NoPointingStartConverged{},
+                                        v::NloptEnded{}};
   std::vector<std::string> kinds;
   for (const ap::Verdict& verdict : all) {
     const std::string kind = ap::verdictKindName(verdict);
@@ -323,4 +324,27 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
     }
   }
   EXPECT_EQ(kinds.size(), std::variant_size_v<ap::Verdict>);
+}
+
+TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
+  // The cross-check's first reason as data: the words of its former expression, %.3g figures.
+  namespace v = ap::verdicts;
+  EXPECT_EQ(ap::renderVerdict(
+                v::NloptEnded{"XTOL_REACHED", "", "", true, false, 1.234567e-9, 4.5e-7}, ""),
+            "converged; nlopt SLSQP: XTOL_REACHED; constraint violation 1.23e-09, relative "
+            "stationarity residual 4.5e-07");
+  EXPECT_EQ(
+      ap::renderVerdict(v::NloptEnded{"FORCED_STOP", "cancelled", "", false, false, 0.5, 0.25}, ""),
+      "not converged; cancelled; nlopt SLSQP: FORCED_STOP (cancelled); constraint violation 0.5, "
+      "relative stationarity residual 0.25");
+  EXPECT_EQ(ap::renderVerdict(v::NloptEnded{"FAILURE", "", "roundoff", false, true, 2.0, 3.0}, ""),
+            "not converged; nlopt SLSQP: FAILURE (roundoff); constraint violation 2, relative "
+            "stationarity residual 3; terminal constraints not met");
+  const v::NloptEnded ended{"XTOL_REACHED", "", "", true, false, 0.125, 0.0625};
+  const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(ended);
+  ASSERT_EQ(figures.size(), 2u);
+  EXPECT_EQ(figures[0].name, "constraint_violation");
+  EXPECT_EQ(figures[0].value, 0.125);
+  EXPECT_EQ(figures[1].name, "relative_stationarity");
+  EXPECT_EQ(figures[1].value, 0.0625);
 }

@@ -130,15 +130,34 @@ struct NoPointingStartConverged {
   std::vector<VerdictFigure> figures() const { return {{"starts", double(starts)}}; }
 };
 
+/// The NLopt SLSQP cross-check ended (its first reason, crosscheck/nlopt_solver.cpp): NLopt's
+/// result, the callbacks' stop reason, and the figures of the replayed plan.
+struct NloptEnded {
+  static constexpr const char* kKind = "nlopt_ended";
+  std::string code;            ///< NLopt's result ("XTOL_REACHED", ...)
+  std::string stop_reason;     ///< the callbacks' ("cancelled", ...); empty: none
+  std::string exception_text;  ///< what NLopt threw; empty: nothing
+  bool converged = false;
+  /// NLopt reported success, but the replayed plan misses the terminal constraints.
+  bool terminal_unmet = false;
+  double violation = 0.0;     ///< the constraint violation of its last iterate
+  double stationarity = 0.0;  ///< its relative stationarity residual
+  std::vector<VerdictFigure> figures() const {
+    return {{"constraint_violation", violation}, {"relative_stationarity", stationarity}};
+  }
+};
+
 }  // namespace verdicts
 
-/// What a driver answered, as data (PlanResult::verdict): the kind and its figures.
-using Verdict = std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest,
-                             verdicts::BelowProvenBound, verdicts::InternalPhaseFailed,
-                             verdicts::InfeasibleAtEveryDuration, verdicts::LocallyInfeasible,
-                             verdicts::MinimumTimeFoundNone, verdicts::SearchStopped,
-                             verdicts::SearchUnrepresentable, verdicts::SearchInfeasible,
-                             verdicts::FeasibleAtMinimumTime, verdicts::NoPointingStartConverged>;
+/// What a driver answered, as data (PlanResult::verdict): the kind and its figures (NloptEnded:
+/// the cross-check solver's own reason, the first of the solvers' reasons made data).
+using Verdict =
+    std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
+                 verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
+                 verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
+                 verdicts::SearchStopped, verdicts::SearchUnrepresentable,
+                 verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
+                 verdicts::NoPointingStartConverged, verdicts::NloptEnded>;
 
 /// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
 inline std::string verdictKindName(const Verdict& verdict) {

@@ -1,6 +1,7 @@
 // The wording of every clause of message_notes.hpp, in one place.
 #include "planning/problem/message_notes.hpp"
 
+#include <cstdio>
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
@@ -281,6 +282,20 @@ std::string judged(const verdicts::FeasibleAtMinimumTime&, const std::string& re
 }
 std::string judged(const verdicts::NoPointingStartConverged& v, const std::string&) {
   return "no start converged (" + std::to_string(v.starts) + " twist and way-round starts tried)";
+}
+std::string judged(const verdicts::NloptEnded& v, const std::string&) {
+  char figures[160];
+  std::snprintf(figures, sizeof figures,
+                "; constraint violation %.3g, relative stationarity residual %.3g", v.violation,
+                v.stationarity);
+  std::ostringstream message;
+  message << (v.converged ? "converged; " : "not converged; ")
+          << (v.stop_reason == "cancelled" ? "cancelled; " : "") << "nlopt SLSQP: " << v.code;
+  if (!v.stop_reason.empty()) message << " (" << v.stop_reason << ")";
+  if (!v.exception_text.empty()) message << " (" << v.exception_text << ")";
+  message << figures;
+  if (v.terminal_unmet) message << "; terminal constraints not met";
+  return message.str();
 }
 
 }  // namespace

@@ -179,6 +179,18 @@ std::string wheelsJson(const PlanningProblem& problem, const PlanResult& r) {
   return out.str();
 }
 
+/// {"kind": ..., "figures": {name: value, ...}}: the driver's verdict as data (driver_verdict.hpp).
+std::string verdictJson(const Verdict& verdict) {
+  std::ostringstream out;
+  out << "{\"kind\": " << jsonString(verdictKindName(verdict)) << ", \"figures\": {";
+  const std::vector<VerdictFigure> figures = verdictFigures(verdict);
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    out << (i ? ", " : "") << jsonString(figures[i].name) << ": " << jsonNumber(figures[i].value);
+  }
+  out << "}}";
+  return out.str();
+}
+
 }  // namespace
 
 std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) {
@@ -206,6 +218,7 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"longest_duration_found\": " << jsonNumber(r.duration_verdict.longest_duration_found)
       << ", \"rate_limit\": " << jsonNumber(r.duration_verdict.rate_limit)
       << ", \"torque_limit\": " << jsonNumber(r.duration_verdict.torque_limit) << "},\n"
+      << "  \"verdict\": " << verdictJson(r.verdict) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"
       << "  \"effort\": " << jsonNumber(r.effort) << ",\n"

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "attitude_planner/planner.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "support/scene_problem.hpp"
 
@@ -125,6 +126,42 @@ TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
         << "the interior point ran: " << r.message;
     EXPECT_EQ(byTag(infos), byTrail(r.attempts)) << r.message;
     EXPECT_EQ(static_cast<int>(infos.size()), r.iterations);
+  }
+}
+
+TEST(AttemptTags, AConstrainedRequestsTrailIsTheContextsTrail) {
+  // Newton's walk, then the interior point from its optimum: the result's trail is what the
+  // request's context recorded, attempt for attempt, with one kept attempt in both (the context
+  // names an attempt as its scopes do and keeps one mark).
+  for (const char* scene : {"torque_limited", "rate_limited", "sun_keep_out", "leo_slew_limited"}) {
+    SCOPED_TRACE(scene);
+    const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, 64);
+    const ap::SolverOptions options;
+    ap::SolveContext context(options);
+    const ap::PlanResult r = ap::planAtResolution(p, options, context);
+    ASSERT_TRUE(std::any_of(
+        r.attempts.begin(), r.attempts.end(),
+        [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
+        << "the interior point ran: " << r.message;
+    const std::vector<ap::Attempt>& trail = context.attempts();
+    ASSERT_EQ(trail.size(), r.attempts.size()) << r.message;
+    for (std::size_t i = 0; i < trail.size(); ++i) {
+      SCOPED_TRACE(i);
+      const ap::Attempt &a = r.attempts[i], &b = trail[i];
+      EXPECT_EQ(a.stage, b.stage);
+      EXPECT_EQ(a.start, b.start);
+      EXPECT_EQ(a.formulation, b.formulation);
+      EXPECT_TRUE(ap::sameHomotopyClass(a.homotopy, b.homotopy));
+      EXPECT_EQ(a.steps, b.steps);
+      EXPECT_EQ(a.termination, b.termination);
+      EXPECT_EQ(a.iterations, b.iterations);
+      EXPECT_EQ(a.kept, b.kept);
+    }
+    const auto kept = [](const std::vector<ap::Attempt>& t) {
+      return std::count_if(t.begin(), t.end(), [](const ap::Attempt& a) { return a.kept; });
+    };
+    EXPECT_EQ(kept(r.attempts), 1);
+    EXPECT_EQ(kept(trail), 1);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <variant>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
@@ -137,11 +138,24 @@ TEST(BoundedVerdicts, AHopelessRequestAtTwoMillionStepsIsProvenInfeasibleBeforeA
   EXPECT_GT(r.duration_verdict.lower_bound, p.duration);
   EXPECT_EQ(r.iterations, 0);
   EXPECT_TRUE(r.attempts.empty());
+  // The verdict as data: the bound, the request's T below the bound on its grid, which the
+  // grid holds within O(h) of the continuous one.
+  ASSERT_TRUE(std::holds_alternative<verdicts::BelowProvenBound>(r.verdict)) << r.message;
+  const auto& below = std::get<verdicts::BelowProvenBound>(r.verdict);
+  EXPECT_EQ(below.lower_bound, r.duration_verdict.lower_bound);
+  EXPECT_EQ(below.basis, r.duration_verdict.lower_bound_basis);
+  EXPECT_EQ(below.steps, p.steps);
+  EXPECT_EQ(below.requested, p.duration);
+  EXPECT_LT(below.requested, below.grid_lower_bound);
+  EXPECT_NEAR(below.grid_lower_bound, below.lower_bound, 1e-3 * below.lower_bound);
+  EXPECT_FALSE(below.upper_limit);
   // The same as minimum time with that duration as its upper bound.
   p.objective = Objective::MinimumTime;
   const PlanResult fastest = planManeuver(p);
   EXPECT_EQ(fastest.termination, Termination::Infeasible) << fastest.message;
   EXPECT_TRUE(fastest.duration_verdict.proven_infeasible);
+  ASSERT_TRUE(std::holds_alternative<verdicts::BelowProvenBound>(fastest.verdict));
+  EXPECT_TRUE(std::get<verdicts::BelowProvenBound>(fastest.verdict).upper_limit);
 }
 
 TEST(BoundedVerdicts, JustAboveTheBoundIsNotDeclaredInfeasibleByIt) {
@@ -162,6 +176,7 @@ TEST(BoundedVerdicts, MinimumTimeBetweenIdenticalRestStatesIsAnsweredAtOnce) {
   EXPECT_TRUE(r.converged()) << r.message;
   EXPECT_EQ(r.minimum_duration, 0.0);
   EXPECT_EQ(r.iterations, 0);
+  EXPECT_TRUE(std::holds_alternative<verdicts::AlreadyAtRest>(r.verdict)) << r.message;
   ASSERT_EQ(r.maneuver.steps(), p.steps);
   for (const Matrix3& R : r.maneuver.attitude) EXPECT_EQ(R, p.initial_attitude);
   for (const Vector3& tau : r.maneuver.torque) EXPECT_TRUE(tau.isZero(0.0));

@@ -4,7 +4,9 @@
 // choose.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
@@ -210,4 +212,139 @@ TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {
                        0),
             0u);
   for (const std::string& s : {rest, ladder, none}) EXPECT_EQ(s.substr(s.size() - 4), "): r");
+}
+
+// A driver's verdict is data on the result (kind and figures); its words are rendered in one
+// place and are, kind by kind, the words the drivers wrote by hand before (their former
+// expressions, copied here with figures that print differently in every digit).
+TEST(DriverVerdicts, EachKindSaysTheWordsOfItsFormerExpression) {
+  namespace v = ap::verdicts;
+  const std::string reason = "converged after 3 iterations";
+  const double T = 2.0 + 1.0 / 3.0, least = 2.5 + 1.0 / 7.0, bound = 1.0 + 1.0 / 9.0;
+  EXPECT_EQ(ap::renderVerdict(v::SolverReason{}, reason), reason);
+  EXPECT_EQ(ap::renderVerdict(v::AlreadyAtRest{}, ""),
+            "converged: the initial and final states are the same state at rest, so T* = 0 s (no "
+            "motion is needed; the plan holds the body at rest, zero torques)");
+  for (const bool minimum_time : {false, true}) {
+    EXPECT_EQ(ap::renderVerdict(v::BelowProvenBound{bound, "proven: b", "max_angular_rate 0.05", 32,
+                                                    least, T, minimum_time},
+                                ""),
+              "infeasible: any plan needs T >= " + ap::exactNumber(bound) +
+                  " s under max_angular_rate 0.05 (proven: b; on 32 steps at least " +
+                  ap::exactNumber(least) + " s), requested " +
+                  (minimum_time ? "duration <= " : "T = ") + ap::exactNumber(T) +
+                  " s; answered before any solve");
+  }
+  EXPECT_EQ(ap::renderVerdict(v::InternalPhaseFailed{"the minimum-time phase", "e"}, ""),
+            "the minimum-time phase failed on a problem the planner built (not the request): e");
+  EXPECT_EQ(ap::renderVerdict(v::InfeasibleAtEveryDuration{"why"}, ""), "infeasible: why");
+  const std::string local =
+      "infeasible from here (a local verdict): no plan within the bounds was found at T = " +
+      ap::exactNumber(T) + " s; the least duration at which one was found is " +
+      ap::exactNumber(least) + " s (what, not a requirement)";
+  const std::string proven = "; any plan needs T >= " + ap::exactNumber(bound) + " s (b)";
+  EXPECT_EQ(ap::renderVerdict(v::LocallyInfeasible{T, least, "what", bound, "b", false}, reason),
+            local + proven + "; " + reason);
+  EXPECT_EQ(ap::renderVerdict(v::LocallyInfeasible{T, least, "what", bound, "b", true}, reason),
+            local + proven + " (" + ap::terminationName(ap::Termination::Infeasible) +
+                " at T: " + reason + ")");
+  EXPECT_EQ(ap::renderVerdict(v::LocallyInfeasible{T, least, "what", 0.0, "", false}, reason),
+            local + "; " + reason);  // no proven bound applies
+  EXPECT_EQ(ap::renderVerdict(v::MinimumTimeFoundNone{ap::Termination::TimedOut}, reason),
+            "infeasible (a local verdict: the minimum-time problem under the same bounds found no "
+            "feasible duration either, " +
+                ap::terminationName(ap::Termination::TimedOut) + "): " + reason);
+  EXPECT_EQ(
+      ap::renderVerdict(v::SearchStopped{ap::Termination::Cancelled}, ""),
+      ap::terminationName(ap::Termination::Cancelled) + " before any duration was found feasible");
+  for (const bool coarse : {false, true}) {
+    EXPECT_EQ(ap::renderVerdict(v::SearchUnrepresentable{T, 48, coarse}, ""),
+              std::string(coarse ? "step too large, increase steps" : "not converged") +
+                  ": no plan was found below T = " + ap::exactNumber(T) +
+                  " s, and from there on one step of " + ap::exactNumber(T / 48) +
+                  " s at the boundary rates has no solution (N = 48)" +
+                  (coarse ? "; even at the proven least duration a boundary step turns more "
+                            "than 1 rad"
+                          : ""));
+  }
+  EXPECT_EQ(ap::renderVerdict(v::SearchInfeasible{12, T}, ""),
+            "infeasible: no duration up to 2^12 times the first guess " + ap::exactNumber(T) +
+                " s admits a plan under the bounds and constraints in force (a local search: "
+                "every start's solves ended infeasible or unconverged)");
+  EXPECT_EQ(
+      ap::renderVerdict(v::FeasibleAtMinimumTime{T}, reason),
+      "feasible at T* (its minimum-effort solve stopped short of optimality: " + reason + ")");
+  EXPECT_EQ(ap::renderVerdict(v::NoPointingStartConverged{16}, ""),
+            "no start converged (16 twist and way-round starts tried)");
+}
+
+TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
+  namespace v = ap::verdicts;
+  ap::PlanResult r;
+  EXPECT_EQ(ap::verdictKindName(r.verdict), "solver_reason");  // a solver's reason stands
+  EXPECT_TRUE(ap::verdictFigures(r.verdict).empty());
+  r.message = "infeasible at N = 32";
+  ap::recordVerdict(&r, v::LocallyInfeasible{3.0, 3.25, "what", 2.75, "b", true});
+  EXPECT_EQ(ap::verdictKindName(r.verdict), "locally_infeasible");
+  ASSERT_TRUE(std::holds_alternative<v::LocallyInfeasible>(r.verdict));
+  EXPECT_EQ(std::get<v::LocallyInfeasible>(r.verdict).least_found, 3.25);
+  EXPECT_EQ(r.message.rfind("infeasible from here", 0), 0u);
+  EXPECT_NE(r.message.find("(infeasible at T: infeasible at N = 32)"), std::string::npos);
+  // The figures by name carry the fields' values, each name once.
+  const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(r.verdict);
+  ASSERT_EQ(figures.size(), 3u);
+  EXPECT_EQ(figures[0].name, "requested_duration");
+  EXPECT_EQ(figures[0].value, 3.0);
+  EXPECT_EQ(figures[1].name, "least_duration_found");
+  EXPECT_EQ(figures[1].value, 3.25);
+  EXPECT_EQ(figures[2].name, "lower_bound");
+  EXPECT_EQ(figures[2].value, 2.75);
+  const std::vector<ap::Verdict> all = {v::SolverReason{},
+                                        v::AlreadyAtRest{},
+                                        v::BelowProvenBound{},
+                                        v::InternalPhaseFailed{},
+                                        v::InfeasibleAtEveryDuration{},
+                                        v::LocallyInfeasible{},
+                                        v::MinimumTimeFoundNone{},
+                                        v::SearchStopped{},
+                                        v::SearchUnrepresentable{},
+                                        v::SearchInfeasible{},
+                                        v::FeasibleAtMinimumTime{},
+                                        v::NoPointingStartConverged{},
+                                        v::NloptEnded{}};
+  std::vector<std::string> kinds;
+  for (const ap::Verdict& verdict : all) {
+    const std::string kind = ap::verdictKindName(verdict);
+    EXPECT_EQ(std::count(kinds.begin(), kinds.end(), kind), 0) << kind;
+    kinds.push_back(kind);
+    std::vector<std::string> names;
+    for (const ap::VerdictFigure& f : ap::verdictFigures(verdict)) {
+      EXPECT_EQ(std::count(names.begin(), names.end(), f.name), 0) << kind << " " << f.name;
+      names.push_back(f.name);
+    }
+  }
+  EXPECT_EQ(kinds.size(), std::variant_size_v<ap::Verdict>);
+}
+
+TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
+  // The cross-check's first reason as data: the words of its former expression, %.3g figures.
+  namespace v = ap::verdicts;
+  EXPECT_EQ(ap::renderVerdict(
+                v::NloptEnded{"XTOL_REACHED", "", "", true, false, 1.234567e-9, 4.5e-7}, ""),
+            "converged; nlopt SLSQP: XTOL_REACHED; constraint violation 1.23e-09, relative "
+            "stationarity residual 4.5e-07");
+  EXPECT_EQ(
+      ap::renderVerdict(v::NloptEnded{"FORCED_STOP", "cancelled", "", false, false, 0.5, 0.25}, ""),
+      "not converged; cancelled; nlopt SLSQP: FORCED_STOP (cancelled); constraint violation 0.5, "
+      "relative stationarity residual 0.25");
+  EXPECT_EQ(ap::renderVerdict(v::NloptEnded{"FAILURE", "", "roundoff", false, true, 2.0, 3.0}, ""),
+            "not converged; nlopt SLSQP: FAILURE (roundoff); constraint violation 2, relative "
+            "stationarity residual 3; terminal constraints not met");
+  const v::NloptEnded ended{"XTOL_REACHED", "", "", true, false, 0.125, 0.0625};
+  const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(ended);
+  ASSERT_EQ(figures.size(), 2u);
+  EXPECT_EQ(figures[0].name, "constraint_violation");
+  EXPECT_EQ(figures[0].value, 0.125);
+  EXPECT_EQ(figures[1].name, "relative_stationarity");
+  EXPECT_EQ(figures[1].value, 0.0625);
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "attitude_planner/io/scene.hpp"
@@ -400,11 +401,27 @@ TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndReportsTStarAsTheLeastFound) 
   EXPECT_FALSE(bounded.duration_verdict.proven_infeasible);
   EXPECT_GT(bounded.duration_verdict.lower_bound, 0.0);
   EXPECT_LE(bounded.duration_verdict.lower_bound, free.minimum_duration);
+  // The verdict as data: the requested T, T* as the least found, the bound beside it; the reason
+  // it is given is the minimum-time solve's (not a solve at T).
+  namespace verdicts = ap::verdicts;
+  ASSERT_TRUE(std::holds_alternative<verdicts::LocallyInfeasible>(bounded.verdict))
+      << bounded.message;
+  const auto& local = std::get<verdicts::LocallyInfeasible>(bounded.verdict);
+  EXPECT_EQ(local.requested, p.duration);
+  EXPECT_EQ(local.least_found, bounded.minimum_duration);
+  EXPECT_EQ(local.lower_bound, bounded.duration_verdict.lower_bound);
+  EXPECT_FALSE(local.solved_at_requested);
   p.objective = ap::Objective::MinimumEffort;
   const ap::PlanResult effort = ap::planManeuver(p);
   EXPECT_EQ(effort.termination, ap::Termination::Infeasible) << effort.message;
   EXPECT_GT(effort.minimum_duration, p.duration) << effort.message;
   EXPECT_EQ(effort.duration_verdict.least_duration_found, effort.minimum_duration);
+  // A minimum-effort request: the verdict judges its solve at T.
+  ASSERT_TRUE(std::holds_alternative<verdicts::LocallyInfeasible>(effort.verdict))
+      << effort.message;
+  EXPECT_EQ(std::get<verdicts::LocallyInfeasible>(effort.verdict).least_found,
+            effort.minimum_duration);
+  EXPECT_TRUE(std::get<verdicts::LocallyInfeasible>(effort.verdict).solved_at_requested);
 }
 
 TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {

@@ -182,6 +182,23 @@ TEST(Report, JsonSummaryCarriesEachAttemptsStartDetail) {
       << json;
 }
 
+TEST(Report, JsonSummaryCarriesTheVerdictsKindAndFigures) {
+  // `verdict`: the driver's verdict as data, its figures exact (exactNumber reads back to the
+  // same double); a solver's own reason writes its kind and no figures.
+  const PlanningProblem p = seedRestToRest(16);
+  PlanResult r;
+  EXPECT_TRUE(contains(planResultJson(p, r),
+                       "\"verdict\": {\"kind\": \"solver_reason\", \"figures\": {}},"));
+  const double T = 2.0 + 1.0 / 3.0, least = 2.5 + 1.0 / 7.0;
+  r.verdict = verdicts::LocallyInfeasible{T, least, "what", 0.0, "", true};
+  EXPECT_TRUE(contains(planResultJson(p, r),
+                       "\"verdict\": {\"kind\": \"locally_infeasible\", \"figures\": "
+                       "{\"requested_duration\": " +
+                           exactNumber(T) + ", \"least_duration_found\": " + exactNumber(least) +
+                           ", \"lower_bound\": 0}},"))
+      << planResultJson(p, r);
+}
+
 TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
   // The same through the tool: at N = 65536 with one iteration per level the message is long,
   // and every field after it must still be printed.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "attitude_planner/name_table.hpp"
+#include "attitude_planner/planning/driver_verdict.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/termination.hpp"
 
@@ -245,6 +246,10 @@ struct PlanResult {
   Termination termination = Termination::NotConverged;
   bool converged() const { return termination == Termination::Converged; }
   std::string message;  ///< human-readable explanation of `termination`
+  /// A driver's verdict as data (kind and figures; JSON `verdict`): where a driver answered
+  /// (before any solve, a local "infeasible", the search's end, ...), its first clause of
+  /// `message` is rendered from it (recordVerdict); SolverReason where a solver's reason stands.
+  Verdict verdict;
   /// Every solve run for this request, in order (the trail); the kept one has `kept`.
   std::vector<Attempt> attempts;
   /// The grid levels solved, coarsest first (continuation); empty for solvers without levels.

@@ -11,6 +11,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/direct_method.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -415,21 +416,10 @@ void setTermination(const Outcome& o, PlanResult* result) {
   } else {
     result->termination = Termination::NotConverged;
   }
-  char figures[160];
-  std::snprintf(figures, sizeof figures,
-                "; constraint violation %.3g, relative stationarity residual %.3g", o.violation,
-                o.stationarity);
-  std::ostringstream message;
-  message << (result->converged() ? "converged; " : "not converged; ")
-          << (o.stop_reason == "cancelled" ? "cancelled; " : "")
-          << "nlopt SLSQP: " << resultName(o.code);
-  if (!o.stop_reason.empty()) message << " (" << o.stop_reason << ")";
-  if (!o.exception_text.empty()) message << " (" << o.exception_text << ")";
-  message << figures;
-  if (!result->converged() && nlopt_success && !feasible) {
-    message << "; terminal constraints not met";
-  }
-  result->message = message.str();
+  recordVerdict(result, verdicts::NloptEnded{resultName(o.code), o.stop_reason, o.exception_text,
+                                             result->converged(),
+                                             !result->converged() && nlopt_success && !feasible,
+                                             o.violation, o.stationarity});
 }
 
 }  // namespace

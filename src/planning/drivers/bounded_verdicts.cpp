@@ -8,6 +8,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/constraints.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -44,9 +45,7 @@ PlanResult alreadyThere(const PlanningProblem& problem) {
   r.maneuver = restingPlan(problem, 0.0);
   r.duration = 0.0;
   r.minimum_duration = 0.0;
-  r.message =
-      "converged: the initial and final states are the same state at rest, so T* = 0 s (no "
-      "motion is needed; the plan holds the body at rest, zero torques)";
+  recordVerdict(&r, verdicts::AlreadyAtRest{});
   return r;
 }
 
@@ -75,13 +74,9 @@ PlanResult provenInfeasible(const PlanningProblem& problem, const DurationLowerB
   r.solver = solverName(SolverKind::Structured);
   recordLowerBound(bound, &r);
   r.duration_verdict.proven_infeasible = true;
-  std::ostringstream why;
-  why << "infeasible: any plan needs T >= " << exactNumber(bound.seconds) << " s under "
-      << boundsInForce(problem) << " (" << bound.basis << "; on " << problem.steps
-      << " steps at least " << exactNumber(grid_bound) << " s), requested "
-      << (problem.objective == Objective::MinimumTime ? "duration <= " : "T = ")
-      << exactNumber(problem.duration) << " s; answered before any solve";
-  r.message = why.str();
+  recordVerdict(&r, verdicts::BelowProvenBound{bound.seconds, bound.basis, boundsInForce(problem),
+                                               problem.steps, grid_bound, problem.duration,
+                                               problem.objective == Objective::MinimumTime});
   return r;
 }
 
@@ -106,7 +101,7 @@ PlanResult runInternalPhase(const std::string& phase, const std::function<PlanRe
   } catch (const FieldError& e) {  // InvalidInput or StepTooLarge of a problem built here
     PlanResult r;
     r.termination = Termination::NotConverged;
-    r.message = phase + " failed on a problem the planner built (not the request): " + e.what();
+    recordVerdict(&r, verdicts::InternalPhaseFailed{phase, e.what()});
     return r;
   }
 }
@@ -118,16 +113,16 @@ void recordLowerBound(const DurationLowerBound& bound, PlanResult* result) {
   result->duration_verdict.torque_limit = bound.torque_limit;
 }
 
-std::string localInfeasibility(double requested, double least_found, const std::string& what_found,
-                               const DurationLowerBound& bound) {
-  std::ostringstream why;
-  why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
-      << exactNumber(requested) << " s; the least duration at which one was found is "
-      << exactNumber(least_found) << " s (" << what_found << ", not a requirement)";
-  if (bound.seconds > 0.0) {
-    why << "; any plan needs T >= " << exactNumber(bound.seconds) << " s (" << bound.basis << ")";
-  }
-  return why.str();
+verdicts::LocallyInfeasible localInfeasibility(double requested, double least_found,
+                                               const std::string& what_found,
+                                               const DurationLowerBound& bound,
+                                               bool solved_at_requested) {
+  return {requested,
+          least_found,
+          what_found,
+          bound.seconds,
+          bound.seconds > 0.0 ? bound.basis : "",
+          solved_at_requested};
 }
 
 namespace {

@@ -1,7 +1,7 @@
 // The verdicts of bounded requests as data (issue "honest verdicts"): what is answered before
 // any solve (identical rest states; a duration below the proven lower bound), how an internal
-// phase's failure is kept from reaching the user as an input error, and how a local
-// "infeasible" is worded next to the proven bound.
+// phase's failure is kept from reaching the user as an input error, and what a local
+// "infeasible" records next to the proven bound (verdicts worded by renderVerdict).
 #pragma once
 
 #include <functional>
@@ -28,11 +28,14 @@ PlanResult runInternalPhase(const std::string& phase, const std::function<PlanRe
 /// Sets `result->duration_verdict`'s bound from `bound`.
 void recordLowerBound(const DurationLowerBound& bound, PlanResult* result);
 
-/// The words of a local "infeasible" at the requested T: no plan found at T, the least duration
-/// at which one was found (`least_found`, a local minimum-time plan, not a requirement), and the
-/// proven bound where one applies.
-std::string localInfeasibility(double requested, double least_found, const std::string& what_found,
-                               const DurationLowerBound& bound);
+/// The verdict of a local "infeasible" at the requested T (its words: renderVerdict): no plan
+/// found at T, the least duration at which one was found (`least_found`, a local minimum-time
+/// plan, not a requirement), and the proven bound where one applies; `solved_at_requested`: the
+/// reason it is given is the minimum-effort solve's at T.
+verdicts::LocallyInfeasible localInfeasibility(double requested, double least_found,
+                                               const std::string& what_found,
+                                               const DurationLowerBound& bound,
+                                               bool solved_at_requested);
 
 /// Why no plan exists at any duration, where that follows from the bounds alone (empty: not
 /// shown; the problem may still be infeasible). Shown for a constant body-frame disturbance whose

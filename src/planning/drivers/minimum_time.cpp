@@ -400,7 +400,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   if (!impossible.empty()) {
     PlanResult none;
     none.termination = Termination::Infeasible;
-    none.message = "infeasible: " + impossible;
+    recordVerdict(&none, verdicts::InfeasibleAtEveryDuration{impossible});
     return none;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -414,8 +414,8 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
     // `duration` is an upper bound: the request asked for T ≤ duration. T* is local.
     result.termination = Termination::Infeasible;
     result.duration_verdict.least_duration_found = T_star;
-    result.message = localInfeasibility(problem.duration, T_star, tStarKind(result), bound) + "; " +
-                     result.message;
+    recordVerdict(&result,
+                  localInfeasibility(problem.duration, T_star, tStarKind(result), bound, false));
     return result;
   }
   if (problem.time_margin > 0.0) {
@@ -643,13 +643,9 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return r;
   };
-  std::ostringstream verdict;
   if (!minimum_time.converged()) {
     if (result.termination == Termination::Infeasible) {
-      verdict << "infeasible (a local verdict: the minimum-time problem under the same bounds "
-                 "found no feasible duration either, "
-              << terminationName(minimum_time.termination) << "): " << result.message;
-      result.message = verdict.str();
+      recordVerdict(&result, verdicts::MinimumTimeFoundNone{minimum_time.termination});
     } else {
       addNote(&result, notes::MinimumTimeUnsolved{why, minimum_time.termination});
     }
@@ -659,9 +655,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   if (T_star > problem.duration) {
     result.termination = Termination::Infeasible;
     result.duration_verdict.least_duration_found = T_star;
-    result.message = localInfeasibility(problem.duration, T_star, tStarKind(minimum_time), bound) +
-                     " (" + terminationName(Termination::Infeasible) + " at T: " + result.message +
-                     ")";
+    recordVerdict(&result, localInfeasibility(problem.duration, T_star, tStarKind(minimum_time),
+                                              bound, true));
     return finish(result);
   }
   if (problem.end_condition.pointing()) {

@@ -247,27 +247,17 @@ class MinimumTimeSearch {
     PlanResult none;
     if (stopped_) {
       none.termination = *stopped_;
-      none.message = terminationName(*stopped_) + " before any duration was found feasible";
+      recordVerdict(&none, verdicts::SearchStopped{*stopped_});
     } else if (std::isfinite(unrepresentable_from_)) {
       // Longer plans are not shown infeasible: this grid cannot hold them. Only where the grid
       // is too coarse at the proven least duration is the step count the cause.
       const bool coarse = representableDuration(problem_) < durationLowerBound(problem_).seconds;
       none.termination = coarse ? Termination::StepTooLarge : Termination::NotConverged;
-      none.message =
-          std::string(coarse ? "step too large, increase steps" : "not converged") +
-          ": no plan was found below T = " + exactNumber(unrepresentable_from_) +
-          " s, and from there on one step of " +
-          exactNumber(unrepresentable_from_ / problem_.steps) +
-          " s at the boundary rates has no solution (N = " + std::to_string(problem_.steps) + ")" +
-          (coarse ? "; even at the proven least duration a boundary step turns more "
-                    "than 1 rad"
-                  : "");
+      recordVerdict(&none,
+                    verdicts::SearchUnrepresentable{unrepresentable_from_, problem_.steps, coarse});
     } else {
       none.termination = Termination::Infeasible;
-      none.message = "infeasible: no duration up to 2^" + std::to_string(kMaxDoublings) +
-                     " times the first guess " + exactNumber(guess) +
-                     " s admits a plan under the bounds and constraints in force (a local "
-                     "search: every start's solves ended infeasible or unconverged)";
+      recordVerdict(&none, verdicts::SearchInfeasible{kMaxDoublings, guess});
     }
     none.attempts = trail();
     return none;
@@ -297,8 +287,7 @@ class MinimumTimeSearch {
       // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
       // short of optimality while its plan meets every constraint, which is what T* rests on.
       result.termination = Termination::Converged;
-      result.message = "feasible at T* (its minimum-effort solve stopped short of optimality: " +
-                       result.message + ")";
+      recordVerdict(&result, verdicts::FeasibleAtMinimumTime{found.T_hi});
     }
     result.minimum_duration = found.T_hi;
     result.attempts = trail();

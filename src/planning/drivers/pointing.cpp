@@ -438,8 +438,7 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
     context.markKept(kept->second);
   } else {
     result.termination = context.stopReason().value_or(Termination::NotConverged);
-    result.message = "no start converged (" + std::to_string(survey.size()) +
-                     " twist and way-round starts tried)";
+    recordVerdict(&result, verdicts::NoPointingStartConverged{static_cast<int>(survey.size())});
     if (!survey.empty()) addNote(&result, notes::LastPointingStart{survey.back().solve.reason});
     result.cost = std::numeric_limits<double>::quiet_NaN();
   }

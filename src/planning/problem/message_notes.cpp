@@ -1,6 +1,7 @@
 // The wording of every clause of message_notes.hpp, in one place.
 #include "planning/problem/message_notes.hpp"
 
+#include <cstdio>
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
@@ -215,6 +216,88 @@ std::string framed(const frames::PointingStarts& f, const std::string& reason) {
   return note.str() + "; " + reason;
 }
 
+// The words of the drivers' verdicts (driver_verdict.hpp).
+std::string judged(const verdicts::SolverReason&, const std::string& reason) {
+  return reason;
+}
+std::string judged(const verdicts::AlreadyAtRest&, const std::string&) {
+  return "converged: the initial and final states are the same state at rest, so T* = 0 s (no "
+         "motion is needed; the plan holds the body at rest, zero torques)";
+}
+std::string judged(const verdicts::BelowProvenBound& v, const std::string&) {
+  std::ostringstream why;
+  why << "infeasible: any plan needs T >= " << exactNumber(v.lower_bound) << " s under " << v.bounds
+      << " (" << v.basis << "; on " << v.steps << " steps at least "
+      << exactNumber(v.grid_lower_bound) << " s), requested "
+      << (v.upper_limit ? "duration <= " : "T = ") << exactNumber(v.requested)
+      << " s; answered before any solve";
+  return why.str();
+}
+std::string judged(const verdicts::InternalPhaseFailed& v, const std::string&) {
+  return v.phase + " failed on a problem the planner built (not the request): " + v.what;
+}
+std::string judged(const verdicts::InfeasibleAtEveryDuration& v, const std::string&) {
+  return "infeasible: " + v.why;
+}
+std::string judged(const verdicts::LocallyInfeasible& v, const std::string& reason) {
+  std::ostringstream why;
+  why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "
+      << exactNumber(v.requested) << " s; the least duration at which one was found is "
+      << exactNumber(v.least_found) << " s (" << v.what_found << ", not a requirement)";
+  if (v.lower_bound > 0.0) {
+    why << "; any plan needs T >= " << exactNumber(v.lower_bound) << " s (" << v.basis << ")";
+  }
+  if (v.solved_at_requested) {
+    why << " (" << terminationName(Termination::Infeasible) << " at T: " << reason << ")";
+  } else {
+    why << "; " << reason;
+  }
+  return why.str();
+}
+std::string judged(const verdicts::MinimumTimeFoundNone& v, const std::string& reason) {
+  return "infeasible (a local verdict: the minimum-time problem under the same bounds found no "
+         "feasible duration either, " +
+         terminationName(v.minimum_time) + "): " + reason;
+}
+std::string judged(const verdicts::SearchStopped& v, const std::string&) {
+  return terminationName(v.stop) + " before any duration was found feasible";
+}
+std::string judged(const verdicts::SearchUnrepresentable& v, const std::string&) {
+  // Longer plans are not shown infeasible: this grid cannot hold them.
+  return std::string(v.coarse ? "step too large, increase steps" : "not converged") +
+         ": no plan was found below T = " + exactNumber(v.from) +
+         " s, and from there on one step of " + exactNumber(v.from / v.steps) +
+         " s at the boundary rates has no solution (N = " + std::to_string(v.steps) + ")" +
+         (v.coarse ? "; even at the proven least duration a boundary step turns more than 1 rad"
+                   : "");
+}
+std::string judged(const verdicts::SearchInfeasible& v, const std::string&) {
+  return "infeasible: no duration up to 2^" + std::to_string(v.doublings) +
+         " times the first guess " + exactNumber(v.first_guess) +
+         " s admits a plan under the bounds and constraints in force (a local search: every "
+         "start's solves ended infeasible or unconverged)";
+}
+std::string judged(const verdicts::FeasibleAtMinimumTime&, const std::string& reason) {
+  return "feasible at T* (its minimum-effort solve stopped short of optimality: " + reason + ")";
+}
+std::string judged(const verdicts::NoPointingStartConverged& v, const std::string&) {
+  return "no start converged (" + std::to_string(v.starts) + " twist and way-round starts tried)";
+}
+std::string judged(const verdicts::NloptEnded& v, const std::string&) {
+  char figures[160];
+  std::snprintf(figures, sizeof figures,
+                "; constraint violation %.3g, relative stationarity residual %.3g", v.violation,
+                v.stationarity);
+  std::ostringstream message;
+  message << (v.converged ? "converged; " : "not converged; ")
+          << (v.stop_reason == "cancelled" ? "cancelled; " : "") << "nlopt SLSQP: " << v.code;
+  if (!v.stop_reason.empty()) message << " (" << v.stop_reason << ")";
+  if (!v.exception_text.empty()) message << " (" << v.exception_text << ")";
+  message << figures;
+  if (v.terminal_unmet) message << "; terminal constraints not met";
+  return message.str();
+}
+
 }  // namespace
 
 std::string renderNote(const Note& note) {
@@ -231,6 +314,15 @@ std::string renderFrame(const Frame& frame, const std::string& reason) {
 
 void frameMessage(PlanResult* result, const Frame& frame) {
   result->message = renderFrame(frame, result->message);
+}
+
+std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
+  return std::visit([&](const auto& v) { return judged(v, reason); }, verdict);
+}
+
+void recordVerdict(PlanResult* result, const Verdict& verdict) {
+  result->verdict = verdict;
+  result->message = renderVerdict(verdict, result->message);
 }
 
 }  // namespace attitude_planner

@@ -245,4 +245,13 @@ std::string renderFrame(const Frame& frame, const std::string& reason);
 /// result->message framed by `frame`.
 void frameMessage(PlanResult* result, const Frame& frame);
 
+/// The message a driver's `verdict` makes (include/attitude_planner/planning/driver_verdict.hpp):
+/// its words, then, for the kinds that judge a solve (LocallyInfeasible, MinimumTimeFoundNone,
+/// FeasibleAtMinimumTime, SolverReason), `reason`, the message of that solve; the kinds that
+/// answer without one (before any solve, the search's end, no pointing start) do not read it.
+std::string renderVerdict(const Verdict& verdict, const std::string& reason);
+/// Records `verdict` on the result and renders result->message from it (the reason it is given
+/// is the message the result carried).
+void recordVerdict(PlanResult* result, const Verdict& verdict);
+
 }  // namespace attitude_planner

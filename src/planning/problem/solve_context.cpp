@@ -63,6 +63,18 @@ SolveContext::Scope::Scope(SolveContext& context, AttemptStage stage, const Homo
   context_.scope_names_nested_ = previous_names_nested_ || nested == Nested::ScopeStage;
 }
 
+void SolveContext::record(Attempt attempt) {
+  // The rule of Scope's constructor, for an attempt that ends (rather than begins) inside it.
+  const bool inside = attempt_.number > 0;
+  if (inside && (scope_names_nested_ || attempt.stage == AttemptStage::Solve)) {
+    attempt.stage = attempt_.stage;
+  }
+  if (attempt.kept) {
+    for (Attempt& a : attempts_) a.kept = false;
+  }
+  attempts_.push_back(attempt);
+}
+
 void SolveContext::markKept(std::size_t index) {
   for (std::size_t i = 0; i < attempts_.size(); ++i) attempts_[i].kept = i == index;
 }

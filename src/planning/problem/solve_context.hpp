@@ -143,8 +143,11 @@ class SolveContext : public Interruption {
   /// Iterations reported so far.
   int iterations() const { return iterations_; }
 
-  /// Appends an attempt to the trail (in the order attempts end).
-  void record(const Attempt& attempt) { attempts_.push_back(attempt); }
+  /// Appends an attempt to the trail (in the order attempts end), named as the open scopes name
+  /// an attempt begun inside them (Nested: a solver's `solve` takes the scope's stage, and any
+  /// stage does under Nested::ScopeStage); a kept attempt clears the others' mark, so the trail
+  /// holds one kept attempt, the last one recorded or marked (markKept).
+  void record(Attempt attempt);
   /// Marks the attempt at `index` as the one whose plan is returned, clearing the others' mark
   /// (a later solve of the same request, e.g. the interior point after Newton, marks its own).
   void markKept(std::size_t index);

@@ -1,0 +1,171 @@
+// A driver's verdict on a request as data: which kind of answer it is and the figures it rests
+// on (PlanResult::verdict, JSON `verdict`). The words of the message are rendered from it in one
+// place (renderVerdict, src/planning/problem/message_notes); a caller reads the figures here,
+// never from the words.
+#pragma once
+
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "attitude_planner/termination.hpp"
+
+namespace attitude_planner {
+
+/// One figure of a verdict by name (JSON `verdict.figures`), in the unit its field states.
+struct VerdictFigure {
+  std::string name;
+  double value = 0.0;
+};
+
+namespace verdicts {
+
+/// No driver's verdict: the message is the solver's own reason (and the notes after it).
+struct SolverReason {
+  static constexpr const char* kKind = "solver_reason";
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// Minimum time between identical rest states: T* = 0 s, the body is there (no solve).
+struct AlreadyAtRest {
+  static constexpr const char* kKind = "already_at_rest";
+  std::vector<VerdictFigure> figures() const { return {{"minimum_duration", 0.0}}; }
+};
+/// The requested duration lies below the proven lower bound on its grid: infeasible, answered
+/// before any solve (DurationVerdict::proven_infeasible).
+struct BelowProvenBound {
+  static constexpr const char* kKind = "below_proven_bound";
+  double lower_bound = 0.0;  ///< T_c [s], the continuous problem's (DurationVerdict::lower_bound)
+  std::string basis;         ///< how it is proven (DurationVerdict::lower_bound_basis)
+  std::string bounds;        ///< the bounds in force, in the scene's words
+  int steps = 0;             ///< N
+  double grid_lower_bound = 0.0;  ///< the bound on N steps [s] (≥ lower_bound)
+  double requested = 0.0;         ///< the request's T [s] (minimum time: its upper limit)
+  bool upper_limit = false;       ///< minimum time: the request asked for T ≤ `requested`
+  std::vector<VerdictFigure> figures() const {
+    return {{"lower_bound", lower_bound},
+            {"steps", double(steps)},
+            {"grid_lower_bound", grid_lower_bound},
+            {"requested_duration", requested}};
+  }
+};
+/// A phase run on a problem the planner built (a fallback, a probe, a restart) threw an input
+/// error: about that problem, not the request (runInternalPhase), so NotConverged.
+struct InternalPhaseFailed {
+  static constexpr const char* kKind = "internal_phase_failed";
+  std::string phase;  ///< "the minimum-time phase", ...
+  std::string what;   ///< the error's message
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// Minimum time: no duration admits a plan (`why`: what rules every duration out).
+struct InfeasibleAtEveryDuration {
+  static constexpr const char* kKind = "infeasible_at_every_duration";
+  std::string why;
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// A local "infeasible" at the requested T: no plan was found at T; the least duration at which
+/// one was found (a local minimum-time plan, not a requirement) and the proven bound where one
+/// applies. The reason it is given follows: the minimum-time solve's (minimum time with T as
+/// its upper limit), or in parentheses the minimum-effort solve's at T (`solved_at_requested`).
+struct LocallyInfeasible {
+  static constexpr const char* kKind = "locally_infeasible";
+  double requested = 0.0;    ///< T [s]
+  double least_found = 0.0;  ///< T* [s] (DurationVerdict::least_duration_found)
+  std::string what_found;    ///< what T* is ("minimum time, a KKT point of ...")
+  double lower_bound = 0.0;  ///< T_c [s]; 0: none applies
+  std::string basis;         ///< its proof's name (empty with none)
+  bool solved_at_requested = false;
+  std::vector<VerdictFigure> figures() const {
+    return {{"requested_duration", requested},
+            {"least_duration_found", least_found},
+            {"lower_bound", lower_bound}};
+  }
+};
+/// A bounded minimum-effort request ended infeasible at T, and the minimum-time problem under
+/// the same bounds found no feasible duration either (it ended `minimum_time`): a local verdict.
+struct MinimumTimeFoundNone {
+  static constexpr const char* kKind = "minimum_time_found_none";
+  Termination minimum_time = Termination::NotConverged;
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// The minimum-time search was stopped (`stop`: timed out, cancelled) before any duration was
+/// found feasible.
+struct SearchStopped {
+  static constexpr const char* kKind = "search_stopped";
+  Termination stop = Termination::TimedOut;
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// The minimum-time search found no plan below T = `from`, and from there on one step at the
+/// boundary rates has no solution on N steps; `coarse`: even at the proven least duration a
+/// boundary step turns more than 1 rad (StepTooLarge), else NotConverged.
+struct SearchUnrepresentable {
+  static constexpr const char* kKind = "search_unrepresentable";
+  double from = 0.0;  ///< [s]
+  int steps = 0;      ///< N
+  bool coarse = false;
+  std::vector<VerdictFigure> figures() const {
+    return {{"unrepresentable_from", from}, {"steps", double(steps)}};
+  }
+};
+/// The minimum-time search doubled its first guess `doublings` times and found no duration that
+/// admits a plan (a local search: every start's solves ended infeasible or unconverged).
+struct SearchInfeasible {
+  static constexpr const char* kKind = "search_infeasible";
+  int doublings = 0;
+  double first_guess = 0.0;  ///< [s]
+  std::vector<VerdictFigure> figures() const {
+    return {{"doublings", double(doublings)}, {"first_guess", first_guess}};
+  }
+};
+/// The search's plan at T* meets every bound while its minimum-effort solve stopped short of
+/// optimality: feasible at T*, which is what T* rests on (its reason follows in parentheses).
+struct FeasibleAtMinimumTime {
+  static constexpr const char* kKind = "feasible_at_minimum_time";
+  double minimum_duration = 0.0;  ///< T* [s]
+  std::vector<VerdictFigure> figures() const { return {{"minimum_duration", minimum_duration}}; }
+};
+/// A pointing request where no start converged (`starts` twist and way-round starts tried).
+struct NoPointingStartConverged {
+  static constexpr const char* kKind = "no_pointing_start_converged";
+  int starts = 0;
+  std::vector<VerdictFigure> figures() const { return {{"starts", double(starts)}}; }
+};
+
+/// The NLopt SLSQP cross-check ended (its first reason, crosscheck/nlopt_solver.cpp): NLopt's
+/// result, the callbacks' stop reason, and the figures of the replayed plan.
+struct NloptEnded {
+  static constexpr const char* kKind = "nlopt_ended";
+  std::string code;            ///< NLopt's result ("XTOL_REACHED", ...)
+  std::string stop_reason;     ///< the callbacks' ("cancelled", ...); empty: none
+  std::string exception_text;  ///< what NLopt threw; empty: nothing
+  bool converged = false;
+  /// NLopt reported success, but the replayed plan misses the terminal constraints.
+  bool terminal_unmet = false;
+  double violation = 0.0;     ///< the constraint violation of its last iterate
+  double stationarity = 0.0;  ///< its relative stationarity residual
+  std::vector<VerdictFigure> figures() const {
+    return {{"constraint_violation", violation}, {"relative_stationarity", stationarity}};
+  }
+};
+
+}  // namespace verdicts
+
+/// What a driver answered, as data (PlanResult::verdict): the kind and its figures (NloptEnded:
+/// the cross-check solver's own reason, the first of the solvers' reasons made data).
+using Verdict =
+    std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
+                 verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
+                 verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
+                 verdicts::SearchStopped, verdicts::SearchUnrepresentable,
+                 verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
+                 verdicts::NoPointingStartConverged, verdicts::NloptEnded>;
+
+/// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
+inline std::string verdictKindName(const Verdict& verdict) {
+  return std::visit([](const auto& v) { return std::string(v.kKind); }, verdict);
+}
+/// The verdict's figures by name (JSON `verdict.figures`); the words say them, not more.
+inline std::vector<VerdictFigure> verdictFigures(const Verdict& verdict) {
+  return std::visit([](const auto& v) { return v.figures(); }, verdict);
+}
+
+}  // namespace attitude_planner

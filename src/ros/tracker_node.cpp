@@ -1522,13 +1522,7 @@ bool TrackerNode::runExternal(const ros::Time& start, Playback* pb, ReplanState*
   command.header.stamp = ros::Time::now();
   command.wrench.torque = rc::vectorToMsg(Vector3::Zero());  // the run is over: nothing held
   command_pub_.publish(command);
-  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
-  result.terminal_velocity_error =
-      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
-  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
-  result.cost = result.effort / plan.time_step;
-  if (pb->horizon) result.replans = pb->horizon->adoptions();
-  result.success = stale == 0;
+  finishFromMeasuredEnd(*pb, stale, &result);
   result.message = (mode_ == TrackingMode::Feedback ? "tracked " : "commanded ") +
                    std::to_string(N) + " steps on the measured state of " +
                    odometry_sub_.getTopic() + " (external plant, omega_n " +
@@ -1587,19 +1581,25 @@ MeasurementAtSample TrackerNode::wheelMeasurementAt(const Playback& pb, const ro
   return m;
 }
 
+void TrackerNode::finishFromMeasuredEnd(const Playback& pb, int stale, ReplayResult* result) const {
+  const Maneuver& plan = pb.reference->nodes();
+  const int N = plan.steps();
+  result->terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
+  result->terminal_velocity_error =
+      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
+  result->final_attitude = rc::attitudeToMsg(last_measured_.attitude);
+  result->cost = result->effort / plan.time_step;
+  if (pb.horizon) result->replans = pb.horizon->adoptions();
+  result->success = stale == 0;
+}
+
 void TrackerNode::finishExternalWheelsResult(Playback* pb, int stale, int cut_samples,
                                              const std::string& first_problem) const {
   const Maneuver& plan = pb->reference->nodes();
   const int N = plan.steps(), n = pb->wheels.count();
   ReplayResult& result = pb->result;
   const WheelPeaks& peaks = *pb->measured_wheel_peaks;
-  result.terminal_attitude_error = so3::angleBetween(plan.attitude[N], last_measured_.attitude);
-  result.terminal_velocity_error =
-      (last_measured_.angular_velocity - plan.angular_velocity[N]).norm();
-  result.final_attitude = rc::attitudeToMsg(last_measured_.attitude);
-  result.cost = result.effort / plan.time_step;
-  if (pb->horizon) result.replans = pb->horizon->adoptions();
-  result.success = stale == 0;
+  finishFromMeasuredEnd(*pb, stale, &result);
   result.message = (mode_ != TrackingMode::Replay ? "tracked " : "commanded ") + std::to_string(N) +
                    " steps through " + std::to_string(n) +
                    " reaction wheels on the measured state of " + odometry_sub_.getTopic() +

@@ -421,6 +421,10 @@ class TrackerNode {
   /// averaged over the sample) out on `wheel_command`; stale measurements give a zero command.
   /// False if stopped meanwhile.
   bool runExternalWheels(const ros::Time& start, Playback* playback, ReplanState* replans);
+  /// An external run's `done` figures from the last measured state: the terminal errors against
+  /// the plan's R_N and Ω_N, the final attitude, the cost, the re-plans adopted, success (no
+  /// stale sample).
+  void finishFromMeasuredEnd(const Playback& playback, int stale, ReplayResult* result) const;
   /// runExternalWheels' `done` after the stream: terminal errors of the last measurement, the
   /// samples that were stale or cut at a wheel limit, the measured wheel peaks.
   void finishExternalWheelsResult(Playback* playback, int stale, int cut_samples,

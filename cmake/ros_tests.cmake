@@ -7,6 +7,10 @@ catkin_add_gtest(test_ros_conversions test/ros/test_ros_conversions.cpp)
 target_link_libraries(test_ros_conversions ${PROJECT_NAME}_ros gtest_main)
 target_compile_definitions(test_ros_conversions PRIVATE AP_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 list(APPEND AP_EXPECTED_TESTS test_ros_conversions)
+# The planner node's memory after stopped solves, in a process of its own (as the node is).
+catkin_add_gtest(test_planner_memory test/ros/test_planner_memory.cpp)
+target_link_libraries(test_planner_memory ${PROJECT_NAME}_ros gtest_main)
+list(APPEND AP_EXPECTED_TESTS test_planner_memory)
 
 # rostest gtests: each launches the node(s) under test and a gtest client, which roslaunch finds
 # by package and type in devel/share/attitude_planner/test_nodes (not offered by rosrun).

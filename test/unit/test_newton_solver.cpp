@@ -3,14 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <random>
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/planning/verdict.hpp"
 #include "support/random_problems.hpp"
 #include "support/robustness_cases.hpp"
 
@@ -370,16 +368,14 @@ TEST(NewtonSolver, EveryThresholdIsScaleFree) {
       // A slow spinning solve is also solved from more starts (the cheapest kept): the same
       // attempts run, its first start takes the same iterations; the extra starts are long solves
       // of their own whose counts may differ by round-off in their paths (measured: #13, 208
-      // extra iterations ± 2; #3, whose class surveys at N = 16 reach the fold of the momentum
-      // map, where a trial on its edge is rejected at one scale and taken at another: 246 ± 7),
-      // while the attempt kept and every attempt's cost are the same.
+      // extra iterations ± 2), while the attempt kept and every attempt's cost are the same.
       ASSERT_EQ(r.attempts.size(), base.attempts.size()) << r.message;
       ASSERT_FALSE(base.attempts.empty());
       EXPECT_EQ(r.attempts[0].iterations, base.attempts[0].iterations) << index;
       if (base.attempts.size() == 1) {
         EXPECT_EQ(r.iterations, base.iterations) << index << " s = " << s << " c = " << c;
       } else {
-        EXPECT_NEAR(r.iterations, base.iterations, 0.03 * base.iterations) << r.extremal;
+        EXPECT_NEAR(r.iterations, base.iterations, 0.02 * base.iterations) << r.extremal;
       }
       const double scale = s * s / std::pow(c, 4);
       for (std::size_t i = 0; i < base.attempts.size(); ++i) {
@@ -394,32 +390,4 @@ TEST(NewtonSolver, EveryThresholdIsScaleFree) {
       }
     }
   }
-}
-
-TEST(NewtonSolver, AnswersKeepEveryStepOnThePrincipalBranch) {
-  // Coarse grids at short horizons: before the domain check, 12 of 32 such requests (seeded
-  // random bodies and slews, N = 8, T halved, variational and second_order) "converged" to plans
-  // with steps of 2.7-3.1 rad past the fold of the momentum map, aliasing a slower motion.
-  // Every answer must keep its steps on the branch; one that cannot says it did not converge.
-  int converged = 0;
-  for (int i = 0; i < 24; ++i) {
-    PlanningProblem p = robustness::randomCase(4321, i).problem;
-    p.constraints.clear();
-    p.objective = Objective::MinimumEffort;
-    p.scheme = i % 2 ? SchemeKind::Variational : SchemeKind::SecondOrder;
-    p.steps = 8;
-    p.duration *= 0.5;
-    PlanResult r;
-    try {
-      r = planManeuver(p);
-    } catch (const FieldError&) {  // a boundary step past π at this h: refused by name
-      continue;
-    }
-    if (!r.converged()) continue;
-    ++converged;
-    EXPECT_EQ(firstStepPastTheFold(p, r.maneuver), -1) << robustness::randomCase(4321, i).label;
-  }
-  EXPECT_GE(converged, 12);
-  std::printf("N = 8, T halved: %d of 24 requests converged, every step on the branch\n",
-              converged);
 }

@@ -8,7 +8,6 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
-#include "attitude_planner/planning/verdict.hpp"
 #include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
@@ -146,26 +145,4 @@ TEST(PlanVerdict, ZeroManeuverHasZeroResidual) {
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_EQ(r.step_residual, 0.0);
   EXPECT_EQ(r.replay_miss, 0.0);
-}
-
-TEST(PlanVerdict, AStepPastTheFoldOfTheMomentumIsNotAPlan) {
-  // An isotropic body's variational (and second_order) momentum folds at a step of π/2
-  // (test_integrators); the paper scheme's has no fold below π. Attitudes about one axis in steps
-  // of 1 rad, then one of 2 rad at step 3.
-  const Vector3 axis = Vector3(1, -2, 2).normalized();
-  Maneuver m;
-  m.attitude.push_back(Matrix3::Identity());
-  for (const double angle : {1.0, 1.0, 1.0, 2.0, 1.0})
-    m.attitude.push_back(m.attitude.back() * so3::fromAxisAngle(axis, angle));
-  PlanningProblem p = piAboutX(5.0, 5);
-  p.inertia = 3.0 * Matrix3::Identity();
-  for (const SchemeKind scheme : {SchemeKind::Variational, SchemeKind::SecondOrder}) {
-    p.scheme = scheme;
-    EXPECT_EQ(firstStepPastTheFold(p, m), 3) << schemeName(scheme);
-    Maneuver slower = m;
-    slower.attitude[4] = slower.attitude[3] * so3::fromAxisAngle(axis, 1.5);
-    EXPECT_EQ(firstStepPastTheFold(p, slower), -1) << schemeName(scheme);
-  }
-  p.scheme = SchemeKind::Paper;
-  EXPECT_EQ(firstStepPastTheFold(p, m), -1);
 }

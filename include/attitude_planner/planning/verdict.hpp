@@ -26,11 +26,6 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
 /// so a step of angle h·W carries its momentum to ~eps/(hW), and R_N is a product of N steps).
 double stepResidualTolerance(int steps, double step_angle);
 
-/// The first step of `m` past the fold of the scheme's momentum map (not on its principal
-/// branch: DiscreteScheme::onPrincipalBranch), or −1: such a plan satisfies the scheme's algebra
-/// but aliases a slower motion, so no replay from its velocities reproduces it.
-int firstStepPastTheFold(const PlanningProblem& problem, const Maneuver& m);
-
 /// Relative step residual a converged plan must meet (above the round-off floor).
 constexpr double kStepResidualTolerance = 1e-8;
 

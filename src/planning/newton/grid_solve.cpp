@@ -299,7 +299,6 @@ class GridSolver {
     step_length_ = 1.0;
     bool factored = false;
     ReducedProblem::StepVectors trial;
-    const bool on_branch = np_.onPrincipalBranch(np_.current());
     for (int attempt = 0; attempt < p_.max_step_attempts; ++attempt) {
       factored = newtonStep(control_->shift(), shift_scale);
       if (!factored) {
@@ -309,13 +308,11 @@ class GridSolver {
       const double slope = gradient_.dot(delta_);
       assessment_ = stopping_.assess(slope, cost_, control_->shift());
       trial = np_.retract(delta_, 1.0);  // steps are taken in full; λ does the damping
-      // A final step is taken unjudged, but never off the branch (judged there: rejected).
-      bool accepted = assessment_.take_unjudged && (!on_branch || np_.onPrincipalBranch(trial));
+      bool accepted = assessment_.take_unjudged;
       if (accepted) {
         control_->acceptUnjudged();
       } else {
-        accepted = control_->judge(
-            {np_, cost_, slope, delta_, shift_scale, &trial, &step_length_, on_branch});
+        accepted = control_->judge({np_, cost_, slope, delta_, shift_scale, &trial, &step_length_});
       }
       if (accepted) {
         np_.setCurrent(trial);

@@ -27,15 +27,7 @@ struct StepTrial {
   double shift_scale = 0.0;            ///< what the relative shift multiplies
   ReducedProblem::StepVectors* trial;  ///< the full step on entry; the iterate to accept on return
   double* step_length;                 ///< 1 on entry; the step length taken on return
-  /// The iterate's steps lie on the scheme's principal branch, so a trial must stay there
-  /// (trialCost); a start past the fold is not held to it until it comes back.
-  bool on_principal_branch = false;
 };
-
-/// The trial's cost, +∞ where it leaves the principal branch its iterate is on: past the fold of
-/// the momentum map a step aliases a slow motion (DiscreteScheme::onPrincipalBranch), so the
-/// branch is the cost's domain, as h > 0 is the free-time interior point's.
-double trialCost(const StepTrial& trial);
 
 class StepControl {
  public:

@@ -9,10 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/verdict.hpp"
 
 namespace attitude_planner {
@@ -88,17 +86,6 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
   return out;
 }
 
-int firstStepPastTheFold(const PlanningProblem& problem, const Maneuver& m) {
-  if (!schemeIsDiscretization(problem.scheme) || m.steps() < 1) return -1;
-  const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / m.steps());
-  for (int k = 0; k < m.steps(); ++k) {
-    if (!scheme.onPrincipalBranch(so3::log(m.attitude[k].transpose() * m.attitude[k + 1]))) {
-      return k;
-    }
-  }
-  return -1;
-}
-
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
                               bool constraints) {
   std::ostringstream why;
@@ -107,15 +94,6 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
     why << "stationary point found, but its attitudes, velocities and torques miss the discrete "
            "equations of motion by "
         << residual.relative << " relative (tolerance " << residual.tolerance << ")";
-    return why.str();
-  }
-  const int fold = firstStepPastTheFold(problem, result.maneuver);
-  if (fold >= 0) {
-    const Maneuver& m = result.maneuver;
-    why << "stationary point found, but step " << fold << " turns by "
-        << so3::angleBetween(m.attitude[fold], m.attitude[fold + 1])
-        << " rad, past the fold of the scheme's momentum map, where a step aliases a slower "
-           "motion (increase steps)";
     return why.str();
   }
   if (constraints && problem.hasNodeConstraints()) {

@@ -26,8 +26,7 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step
-/// (measureStepResidual within its tolerance) with every step on the scheme's principal branch
-/// (firstStepPastTheFold) and, with `constraints`, its node constraints
+/// (measureStepResidual within its tolerance) and, with `constraints`, its node constraints
 /// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
 /// it does. The open-loop replay (replay_miss) is not part of it.
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,

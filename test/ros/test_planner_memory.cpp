@@ -17,24 +17,12 @@
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/planner_node.hpp"
+#include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
 namespace rc = attitude_planner::ros_conversions;
 
 namespace {
-
-/// The seed's rest-to-rest request (J of seed 000, 60 degrees about x, T = 12.8 s).
-PlanAttitudeManeuver::Request seedRequest() {
-  PlanAttitudeManeuver::Request r;
-  const double J[9] = {13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37};
-  for (int i = 0; i < 9; ++i) r.inertia[i] = J[i];
-  r.allow_nonphysical_inertia = true;  // the seed J violates J1 + J2 >= J3
-  r.initial_attitude.w = 1.0;
-  r.final_attitude = rc::attitudeToMsg(so3::fromAxisAngle(Vector3::UnitX(), M_PI / 3));
-  r.duration = 12.8;
-  r.steps = 32;
-  return r;
-}
 
 /// This process's resident size [MB] (/proc/self/status VmRSS).
 double residentMegabytes() {
@@ -58,7 +46,8 @@ TEST(Memory, StoppedSolvesLeaveNothingBehindOnceJoined) {
   // 38 MB after the trims (28 -> 66 MB); with one arena (MALLOC_ARENA_MAX=1) nothing: no leak.
   ros::Time::init();
   configureAllocator();  // as the node does at start
-  PlanAttitudeManeuver::Request req = seedRequest();
+  PlanAttitudeManeuver::Request req;
+  ros_testing::fillSeedRequest(&req);
   req.steps = 20000;
   req.tolerance = 1e-300;
   req.time_budget = 0.3;

@@ -40,10 +40,10 @@ TEST(Memory, StoppedSolvesLeaveNothingBehindOnceJoined) {
   // stopped by the budget inside its Newton iterations (N = 20,000, 0.3 s: the core's share,
   // solveBudget, is 0.14 s), joined, then returnFreedMemory. Four such solves at a time (each
   // thread its own malloc arena), three times: the resident size comes back to within 24 MB of
-  // what one solve left (one stopped solve's Newton system alone is 40 MB at this N; session 37
-  // saw 480 MB after 20 at N = 1e5). What the arenas keep before the trims is printed: the
-  // allocator's. Without configureAllocator (glibc's dynamic mmap threshold) the same run kept
-  // 38 MB after the trims (28 -> 66 MB); with one arena (MALLOC_ARENA_MAX=1) nothing: no leak.
+  // what one solve left (one stopped solve's Newton system alone is 40 MB at this N). What the
+  // arenas keep before the trims is printed: the allocator's. Without configureAllocator (glibc's
+  // dynamic mmap threshold) the same run kept 38 MB after the trims (28 -> 66 MB); with one arena
+  // (MALLOC_ARENA_MAX=1) nothing: no leak.
   ros::Time::init();
   configureAllocator();  // as the node does at start
   PlanAttitudeManeuver::Request req;

@@ -736,11 +736,11 @@ TEST_F(PlannerService, BudgetTooSmallToConvergeAnswersWithThePlanReached) {
 }
 
 TEST_F(PlannerService, LargeRequestTimedOutAtItsDeadlineCarriesThePlanReached) {
-  // Issue 43's case: N = 1e5 with a budget of 1 s, where the stopped solve's hand-over (carrying
+  // N = 1e5 with a budget of 1 s, where the stopped solve's hand-over (carrying
   // the iterate to N = 1e5, building and judging the rows) takes longer than the answer's slack
-  // after B. The core now stops a hand-over's time before the deadline (solveBudget), so the
-  // answer is TIMED_OUT with the plan reached, flagged unconverged, with its residuals (before:
-  // TIMED_OUT without a plan). States only: no time is asserted.
+  // after B. The core stops a hand-over's time before the deadline (solveBudget), so the
+  // answer is TIMED_OUT with the plan reached, flagged unconverged, with its residuals. States
+  // only: no time is asserted.
   const int N = 100000;
   PlanAttitudeManeuver::Request req = seed(N);
   req.tolerance = 1e-300;  // only the budget ends it

@@ -102,7 +102,8 @@ std::string startDetailJson(const Attempt& a) {
       << ", \"cleared_of_cones\": " << (d.cleared_of_cones ? "true" : "false")
       << ", \"coarse_steps\": " << d.coarse_steps
       << ", \"origin\": " << jsonString(attemptStartName(originOf(a)))
-      << ", \"twist\": " << jsonNumber(d.twist) << "}";
+      << ", \"twist\": " << jsonNumber(d.twist)
+      << ", \"elastic_from_violations\": " << (d.elastic_from_violations ? "true" : "false") << "}";
   return out.str();
 }
 

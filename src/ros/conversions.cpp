@@ -122,6 +122,7 @@ PlanAttempt attemptToMsg(const Attempt& a) {
   msg.start_detail.origin = attemptStartName(originOf(a));
   msg.start_detail.excursion_peak = d.excursion_peak;
   msg.start_detail.twist = d.twist;
+  msg.start_detail.elastic_from_violations = d.elastic_from_violations;
   return msg;
 }
 

@@ -252,6 +252,7 @@ TEST(RosConversions, TheTrailAndTheMinimumTimeSummaryReachTheResponseNamedAsInTh
     EXPECT_EQ(ms.excursion_peak, d.excursion_peak) << i;
     EXPECT_EQ(ms.cleared_of_cones, d.cleared_of_cones) << i;
     EXPECT_EQ(ms.coarse_steps, d.coarse_steps) << i;
+    EXPECT_EQ(ms.elastic_from_violations, d.elastic_from_violations) << i;
     EXPECT_EQ(ms.origin, attemptStartName(originOf(trail[i]))) << i;
   }
   EXPECT_EQ(kept, 1);

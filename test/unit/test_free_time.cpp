@@ -333,6 +333,45 @@ TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
   }
 }
 
+TEST(FreeTime, AnElasticPhaseBegunFromItsViolationsEndsAtAKktPointAndAFeasibleStartIgnoresIt) {
+  // ElasticBarrier::FromViolations: the elastic start's first μ on the scale of its violations.
+  // From the carried spinning start above (outside its bounds, elastic) the solve still ends at a
+  // KKT point meeting the bounds; from a start raised inside (rest to rest, no elastic phase) it
+  // is the same solve as at μ₀, iterate for iterate.
+  ap::PlanningProblem p = spinningRequest(64);
+  p.duration = 3.5;
+  const ap::ReducedProblem geodesic(p);
+  const ap::FreeTimeOutcome coarse =
+      ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, 500);
+  ASSERT_EQ(coarse.termination, ap::Termination::Converged) << coarse.message;
+  ap::PlanningProblem fine = spinningRequest(128);
+  fine.duration = coarse.duration;
+  ap::ReducedProblem np(fine);
+  np.initializeFromCoarser(coarse.steps);
+  ap::SolveContext context{ap::SolverOptions{}};
+  const ap::FreeTimeOutcome o =
+      ap::solveFreeTime(fine, np.attitudes(np.current()), coarse.duration, 1e-9, 500, context, {},
+                        ap::ElasticBarrier::FromViolations);
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  EXPECT_TRUE(o.elastic_start);
+  EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible at the end";
+  for (const ap::Vector3& t : o.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
+  EXPECT_LE(o.stationarity, 1e-8);
+  EXPECT_LE(o.complementarity, 1e-8);
+
+  const ap::PlanningProblem rest = scene("min_time_bilimoria_wie", 32);
+  const double r = std::sqrt(0.5);
+  const std::vector<ap::Matrix3> start = excursion(rest, ap::Vector3(r, r, 0), 0.3);
+  ap::SolveContext at_mu0{ap::SolverOptions{}}, from_violations{ap::SolverOptions{}};
+  const ap::FreeTimeOutcome a = ap::solveFreeTime(rest, start, 3.4, 1e-9, 500, at_mu0);
+  const ap::FreeTimeOutcome b = ap::solveFreeTime(rest, start, 3.4, 1e-9, 500, from_violations, {},
+                                                  ap::ElasticBarrier::FromViolations);
+  ASSERT_EQ(a.termination, ap::Termination::Converged) << a.message;
+  EXPECT_FALSE(a.elastic_start);
+  EXPECT_EQ(b.duration, a.duration);
+  EXPECT_EQ(b.iterations, a.iterations);
+}
+
 namespace {
 
 /// q = ½|Ω|² of rate-limit instance k (a step's rate for paper and variational, a node's J⁻¹Π_k

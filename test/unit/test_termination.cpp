@@ -171,14 +171,18 @@ TEST(Report, JsonSummaryCarriesEachAttemptsStartDetail) {
                              ", \"excursion_peak\": " + exactNumber(d.excursion_peak) +
                              ", \"cleared_of_cones\": false, \"coarse_steps\": ";
   // A start without a twist (not a pointing request) writes it null.
-  EXPECT_TRUE(contains(json, detail + "0, \"origin\": \"excursion\", \"twist\": null}")) << json;
+  EXPECT_TRUE(contains(json, detail + "0, \"origin\": \"excursion\", \"twist\": null, "
+                                      "\"elastic_from_violations\": false}"))
+      << json;
   EXPECT_TRUE(contains(json, "\"start\": \"coarse_level\"")) << json;
-  EXPECT_TRUE(contains(json, detail + "64, \"origin\": \"excursion\", \"twist\": null}")) << json;
+  EXPECT_TRUE(contains(json, detail + "64, \"origin\": \"excursion\", \"twist\": null, "
+                                      "\"elastic_from_violations\": false}"))
+      << json;
   EXPECT_TRUE(contains(json,
                        "\"start_detail\": {\"duration\": null, \"eigenaxis\": [0, 0, 0], "
                        "\"excursion_axis\": [0, 0, 0], \"excursion\": 0, \"excursion_peak\": 0.5, "
                        "\"cleared_of_cones\": false, \"coarse_steps\": 0, \"origin\": \"hermite\", "
-                       "\"twist\": null}"))
+                       "\"twist\": null, \"elastic_from_violations\": false}"))
       << json;
 }
 

@@ -121,6 +121,10 @@ struct StartDetail {
   /// Pointing end condition: the twist ψ [rad] about the boresight the start was posed at
   /// (planning/pointing.hpp); NaN: none.
   double twist = std::numeric_limits<double>::quiet_NaN();
+  /// Minimum time with spinning ends: the free-time solve's elastic phase, where it had one,
+  /// began at a barrier μ on the scale of the start's violations, not at μ₀ (the second solve
+  /// from the same start: ElasticBarrier::FromViolations, free_time_solver.hpp).
+  bool elastic_from_violations = false;
 };
 
 /// One solve the planner ran for a request (PlanResult::attempts, JSON `attempts`), in the order

@@ -85,6 +85,13 @@ constexpr double kLargestRaise = 2.0;
 /// multiplier the relaxed problem's minimum has v = 0 (an exact penalty); raised ×10 whenever a
 /// barrier problem is solved with the iterate still outside.
 constexpr double kElasticPenalty = 100.0;
+/// ElasticBarrier::FromViolations: the elastic phase's first μ puts the width μ/ρ of an elastic
+/// row's kink (where its merit turns from ρ|c| to −μ ln c) at this fraction of the largest
+/// violation. At μ₀ (about 0.1/m) the kink is far narrower than the violations of a spinning
+/// start (c down to −50), the merit is ℓ1 in all but name and its Newton model sees no curvature
+/// there (measured: 500 iterations of steps α ≈ 1e-4–1e-2); at the wider kink the starts reach
+/// KKT points more often, in other basins (docs/design/planner_behaviour.md).
+constexpr double kElasticKinkWidth = 0.1;
 constexpr double kElasticPenaltyGrowth = 10.0;
 
 class FreeTimeSolver final : public PrimalDualProblem {
@@ -163,6 +170,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
 
   FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
                       const BarrierWatch& watch);
+  void setElasticBarrier(ElasticBarrier b) { elastic_barrier_ = b; }
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
   void disallowElastic() { allow_elastic_ = false; }
@@ -253,6 +261,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   }
 
   double T0() const { return N_ * h0_; }
+  double firstBarrier() const;
   void assemble(double mu, double epsilon);
   void assembleQuantity(const std::vector<int>& block, double mu);
   void leaveElasticIfInside();
@@ -367,6 +376,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
   double rho_ = kElasticPenalty;
+  ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -752,17 +762,25 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
   scales_ = {1.0, 1, N_, mu_final_};
-  mu_ = mu0_;
+  mu_ = firstBarrier();
   initializeDuals(mu_);
   PrimalDualLoop(*this, test_, {freeTimeLineSearch(parameters_), false}, context)
       .run(max_iterations, &iterations_);
   return out_;
 }
 
+/// μ₀, or in an elastic phase begun FromViolations the μ that widens its rows' kinks to
+/// kElasticKinkWidth of the largest violation (never below μ₀; the effort weight ε stays at ε₀
+/// while μ is above μ₀: prepare).
+double FreeTimeSolver::firstBarrier() const {
+  if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
+  return std::max(mu0_, kElasticKinkWidth * rho_ * -smallestValue(np_.current(), true));
+}
+
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
 /// test reads what it measures).
 void FreeTimeSolver::prepare() {
-  epsilon_ = epsilon0_ * std::max(mu_ / mu0_, kFinalEffortFraction);
+  epsilon_ = epsilon0_ * std::clamp(mu_ / mu0_, kFinalEffortFraction, 1.0);
   assemble(mu_, epsilon_);
   gap_ = dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
@@ -932,7 +950,8 @@ std::string freeTimeUnsupported(const PlanningProblem&) {
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              SolveContext& context, const BarrierWatch& watch) {
+                              SolveContext& context, const BarrierWatch& watch,
+                              ElasticBarrier elastic_barrier) {
   PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -953,6 +972,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     const double start_h = np.timeStep();
     const Matrix3 start_end = np.finalAttitude();
     FreeTimeSolver solver(problem, &np, constraints, parameters);
+    solver.setElasticBarrier(elastic_barrier);
     failed.message = solver.startInside();
     if (!failed.message.empty()) return failed;
     FreeTimeOutcome out = solver.run(tolerance, max_iterations, context, watch);

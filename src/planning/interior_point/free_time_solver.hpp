@@ -64,6 +64,11 @@ struct FreeTimeOutcome {
   bool stopped_by_watch = false;
 };
 
+/// Where an elastic start (FreeTimeOutcome::elastic_start) begins its barrier: at μ₀, as every
+/// free-time solve does, or at a μ on the scale of the start's violations (FromViolations:
+/// free_time_solver.cpp kElasticKinkWidth). The two reach different KKT points from one start.
+enum class ElasticBarrier { Initial, FromViolations };
+
 /// A solved barrier problem of a free-time solve: its point on the central path at μ.
 struct BarrierPoint {
   double mu = 0.0;
@@ -113,7 +118,8 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 /// (SolveContext::IterationTally).
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
-                              SolveContext& context, const BarrierWatch& watch = {});
+                              SolveContext& context, const BarrierWatch& watch = {},
+                              ElasticBarrier elastic_barrier = ElasticBarrier::Initial);
 /// The same in a context of its own with default options (no budget, no callback): for tests and
 /// studies that run one free-time solve outside a request. Its iterations: every run's.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,

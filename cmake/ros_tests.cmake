@@ -136,3 +136,6 @@ add_rostest_gtest(test_tracker_external_wheels test/ros/tracker_external_wheels.
 target_link_libraries(test_tracker_external_wheels ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
 add_dependencies(test_tracker_external_wheels attitude_tracker_node attitude_plant_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_external_wheels)
+# The same binary (TrackerWheelsLoop.*): wheels under a disturbance the plan never saw, on
+# attitude_plant_node and on the tracker's own body + wheels, and internal replan with wheels.
+add_rostest(test/ros/tracker_wheels_loop.test DEPENDENCIES test_tracker_external_wheels)

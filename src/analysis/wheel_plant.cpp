@@ -33,20 +33,32 @@ Vector3 arrayReaction(const WheelArray& array, const Eigen::VectorXd& torque, co
   return -array.axes * torque - rate.cross(array.axes * momentum);
 }
 
+namespace {
+
+/// The effects' torque on the body over a replay that starts at maneuver time t0 (none: null).
+ExternalTorque effectTorqueFrom(const EffectModel* effects, double t0) {
+  if (!effects || effects->empty()) return nullptr;
+  return [effects, t0](const Matrix3& R, double s) { return effects->torque(R, t0 + s); };
+}
+
+}  // namespace
+
 WheelBodyState predictWheelState(const Matrix3& inertia, const WheelArray& array,
                                  const WheelBodyState& state, const Eigen::VectorXd& torque,
-                                 double dt) {
+                                 double dt, const EffectModel* effects, double t) {
   if (!(dt > 0.0)) return state;
-  const WheelReplay step =
-      replayWithWheels(inertia, array.axes, state.body.attitude, state.body.angular_velocity,
-                       state.momentum, dt, {torque, torque}, Vector3::Zero(), kWheelFlightSubsteps);
+  const WheelReplay step = replayWithWheelsUnder(
+      inertia, array.axes, state.body.attitude, state.body.angular_velocity, state.momentum, dt,
+      {torque, torque}, effectTorqueFrom(effects, t), kWheelFlightSubsteps);
   return {{step.attitude.back(), step.angular_velocity.back()}, step.momentum.back()};
 }
 
 WheelPlant::WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels,
-                       const RigidBodyState& start, double max_step)
+                       const RigidBodyState& start, double max_step,
+                       std::shared_ptr<const EffectModel> effects)
     : inertia_(inertia),
       wheels_(wheels),
+      effects_(effects && !effects->empty() ? std::move(effects) : nullptr),
       array_(wheelArray(wheels)),
       max_step_(max_step),
       commanded_(Eigen::VectorXd::Zero(wheels.count())),
@@ -83,9 +95,9 @@ void WheelPlant::updateDelivered() {
 void WheelPlant::integrate(double dt) {
   // Equal steps of at most max_step, the held torques at every RK4 stage.
   const int steps = std::max(1, static_cast<int>(std::ceil(dt / max_step_)));
-  const WheelReplay replay =
-      replayWithWheels(inertia_, array_.axes, state_.body.attitude, state_.body.angular_velocity,
-                       state_.momentum, dt, {delivered_, delivered_}, Vector3::Zero(), steps);
+  const WheelReplay replay = replayWithWheelsUnder(
+      inertia_, array_.axes, state_.body.attitude, state_.body.angular_velocity, state_.momentum,
+      dt, {delivered_, delivered_}, effectTorqueFrom(effects_.get(), time_), steps);
   state_ = {{replay.attitude.back(), replay.angular_velocity.back()}, replay.momentum.back()};
 }
 

@@ -335,6 +335,18 @@ ReactionWheelsSummary wheelSummaryToMsg(const ReactionWheels& wheels, const Whee
   return m;
 }
 
+void requireWheelBodyEffects(const std::vector<EffectSpec>& effects, const std::string& field) {
+  for (const EffectSpec& e : effects) {
+    const EffectKind kind = effectKindOf(e);
+    if (kind == EffectKind::ActuatorLimits || kind == EffectKind::TorqueNoise) {
+      throw InvalidInput(field + ": " + effectName(e) +
+                         " acts on a body torque, which no reaction wheel makes (the wheels' "
+                         "max_torque bounds them); with wheels only gravity_gradient and "
+                         "disturbance_torque act");
+    }
+  }
+}
+
 Eigen::VectorXd wheelJointValues(const std::vector<std::string>& names,
                                  const std::vector<double>& values, int wheels,
                                  const std::string& field) {

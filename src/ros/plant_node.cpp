@@ -42,16 +42,17 @@ PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (p.reaction_wheels.present()) {
     const std::string field = "parameter " + pnh.resolveName("scene") + " = " + scene_path +
                               ": actuators.reaction_wheels";
-    if (!scene.effects.empty()) {
-      throw InvalidParameter(field + ": effects on a body with wheels are not modelled, got " +
-                             effectName(scene.effects.front()));
+    try {
+      rc::requireWheelBodyEffects(scene.effects, field);
+    } catch (const std::exception& e) {
+      throw InvalidParameter(e.what());
     }
     if (!p.reaction_wheels.hasSpinInertia()) {
       throw InvalidParameter(field + ".spin_inertia: needed to measure the wheels' spin rates");
     }
     wheel_plant_ = std::make_unique<WheelPlant>(
         p.inertia, p.reaction_wheels, RigidBodyState{p.initial_attitude, p.initial_velocity},
-        max_step);
+        max_step, plannableEffects(scene.effects, p.inertia));
     wheel_pub_ = nh.advertise<sensor_msgs::JointState>("wheel_measurement", 10);
     command_sub_ = nh.subscribe("wheel_command", 10, &PlantNode::onWheelCommand, this,
                                 ros::TransportHints().tcpNoDelay());

@@ -854,15 +854,26 @@ TrackerNode::Playback TrackerNode::preparePlayback(const Replay& replay) const {
   pb.effects = plannableEffects(replay.effects, inertia);
   pb.reference =
       std::make_unique<ManeuverInterpolation>(plan, problem.scheme, inertia, pb.effects.get());
-  if (plant_ == PlantKind::Internal) {
+  // Wheels on a plant read at every sample: the user's (external), or the tracker's own when
+  // re-plans or effects act on it (the flights of runBody have neither).
+  const bool wheel_loop =
+      pb.wheels.present() &&
+      (plant_ == PlantKind::External || mode_ == TrackingMode::Replan || !replay.effects.empty());
+  if (!wheel_loop && plant_ == PlantKind::Internal) {
     runBody(replay, plan, inertia, problem.scheme, &pb);
-  } else if (pb.wheels.present()) {
-    // External with wheels: the plan's wheel torques (replay's command) and the measured peaks.
+  } else if (wheel_loop) {
+    // The plan's wheel torques (replay's command) and the peaks along the loop.
     pb.plan_wheel_torque = wheelTorqueRows(msg, plan, inertia, problem.scheme, pb.wheels);
     pb.measured_wheel_peaks = WheelPeaks(pb.wheels.count());
-    pb.problem.reaction_wheels = pb.wheels;  // a re-plan's array (its momenta: the measured)
+    pb.problem.reaction_wheels = pb.wheels;  // a re-plan's array (its momenta: the plant's)
+    if (plant_ == PlantKind::Internal) {
+      const RigidBodyState start =
+          replay.takeover.value_or(RigidBodyState{plan.attitude[0], plan.angular_velocity[0]});
+      pb.wheel_plant = std::make_shared<WheelPlant>(inertia, pb.wheels, start,
+                                                    0.25 * plan.time_step, pb.effects);
+    }
   }
-  if (plant_ == PlantKind::External && mode_ == TrackingMode::Replan) {
+  if ((plant_ == PlantKind::External || pb.wheel_plant) && mode_ == TrackingMode::Replan) {
     // External: the plans in force and their laws; its own simulated body is not flown.
     pb.replan_period_steps = replanPeriodSteps(replan_period_, N, plan.time_step);
     pb.horizon = std::make_shared<RecedingHorizonRun>(plan, problem.scheme, inertia, pb.effects,
@@ -935,22 +946,13 @@ void TrackerNode::requireWheelFlight(const ReactionWheels& wheels,
                                      const std::vector<EffectSpec>& effects) const {
   const std::string field = "maneuver.reaction_wheels";
   validateReactionWheels(wheels, field);
-  if (mode_ == TrackingMode::Replan && plant_ == PlantKind::Internal) {
-    throw InvalidInput(field +
-                       ": a maneuver with reaction wheels is re-planned with ~plant external only "
-                       "(the tracker's own body is not flown through the wheels under re-plans), "
-                       "got ~mode replan with ~plant internal");
-  }
   if (plant_ == PlantKind::External && !wheels.hasSpinInertia()) {
     throw InvalidInput(field + ".spin_inertia",
                        "~plant external measures the wheels' spin rates (wheel_measurement "
                        "velocity) and needs each wheel's spin inertia to turn them into momenta, "
                        "got none");
   }
-  if (!effects.empty()) {
-    throw InvalidInput(field + ": effects during the run (" + effectName(effects.front()) +
-                       ") on a body with wheels are not modelled (docs/reaction_wheels.md)");
-  }
+  rc::requireWheelBodyEffects(effects, field + ", effects during the run");
 }
 
 void TrackerNode::flyWheels(const AttitudeManeuver& msg, const Maneuver& plan,
@@ -1156,7 +1158,7 @@ void TrackerNode::runReplay(Replay replay) {
   ReplanState replans;
   replans.period_steps = pb.replan_period_steps;
   replans.next_node = replans.period_steps;
-  if (plant_ == PlantKind::External) {
+  if (plant_ == PlantKind::External || pb.wheel_plant) {
     if (!runExternal(start, &pb, &replans)) return;
   } else {
     for (std::size_t j = 0; j < pb.times.size(); ++j) {
@@ -1573,8 +1575,9 @@ MeasurementAtSample TrackerNode::wheelMeasurementAt(const Playback& pb, const ro
     return unusable(e.what());
   }
   // To the sample's time under the wheel torques held meanwhile (transport and sampling lag).
-  const WheelBodyState moved = predictWheelState(pb.reference->inertia(), wheelArray(pb.wheels),
-                                                 {m.state, *momentum}, held, m.age);
+  const WheelBodyState moved =
+      predictWheelState(pb.reference->inertia(), wheelArray(pb.wheels), {m.state, *momentum}, held,
+                        m.age, pb.effects.get(), m.time);
   m.state = moved.body;
   *momentum = moved.momentum;
   last_measured_ = m.state;
@@ -1600,10 +1603,12 @@ void TrackerNode::finishExternalWheelsResult(Playback* pb, int stale, int cut_sa
   ReplayResult& result = pb->result;
   const WheelPeaks& peaks = *pb->measured_wheel_peaks;
   finishFromMeasuredEnd(*pb, stale, &result);
+  const std::string flown =
+      pb->wheel_plant ? std::string("on the tracker's own body + wheels (internal plant; ")
+                      : "on the measured state of " + odometry_sub_.getTopic() + " and " +
+                            wheel_measurement_sub_.getTopic() + " (external plant; ";
   result.message = (mode_ != TrackingMode::Replay ? "tracked " : "commanded ") + std::to_string(N) +
-                   " steps through " + std::to_string(n) +
-                   " reaction wheels on the measured state of " + odometry_sub_.getTopic() +
-                   " and " + wheel_measurement_sub_.getTopic() + " (external plant; " +
+                   " steps through " + std::to_string(n) + " reaction wheels " + flown +
                    std::to_string(cut_samples) + " of " + std::to_string(pb->times.size()) +
                    " samples cut at a wheel limit)";
   if (stale > 0) {
@@ -1634,7 +1639,9 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb, Replan
     const double t = pb->times[j];
     const ros::Time stamp = start + ros::Duration(t / rate_factor_);
     if (!sleepUntil(stamp)) return false;
-    const MeasurementAtSample measured = wheelMeasurementAt(*pb, start, stamp, held, &momentum);
+    const MeasurementAtSample measured =
+        pb->wheel_plant ? simulatedWheelState(pb->wheel_plant.get(), t, &momentum)
+                        : wheelMeasurementAt(*pb, start, stamp, held, &momentum);
     {
       std::lock_guard<std::mutex> lock(health_mutex_);
       health_.measurement_problem = measured.problem;
@@ -1645,7 +1652,7 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb, Replan
       const double h = plan.time_step;
       const auto at_node = [&](int k) {
         return predictWheelState(pb->reference->inertia(), array, {state, momentum}, held,
-                                 k * h - t);
+                                 k * h - t, pb->effects.get(), t);
       };
       serviceReplans(
           t, pb, replans, [&](int k) { return at_node(k).body; },
@@ -1676,13 +1683,18 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb, Replan
       ROS_WARN_THROTTLE(1.0, "external plant: zero wheel command at t = %.6g s: %s", t,
                         measured.problem.c_str());
     }
-    wheel_command_pub_.publish(rc::wheelJointState(u, Eigen::VectorXd(), pb->body_frame, stamp));
+    if (pb->wheel_plant) {
+      pb->wheel_plant->command(u);  // the torque the body feels: the delivered one
+    } else {
+      wheel_command_pub_.publish(rc::wheelJointState(u, Eigen::VectorXd(), pb->body_frame, stamp));
+    }
     held = u;
     ManeuverSample body;
     body.time = t;
     body.attitude = state.attitude;
     body.angular_velocity = state.angular_velocity;
-    body.torque = arrayReaction(array, u, state.angular_velocity, momentum);
+    body.torque = arrayReaction(array, pb->wheel_plant ? pb->wheel_plant->deliveredTorque() : u,
+                                state.angular_velocity, momentum);
     const ManeuverSample reference = pb->reference->at(t);
     if (measured.fresh) {
       result.max_attitude_deviation = std::max(
@@ -1696,11 +1708,26 @@ bool TrackerNode::runExternalWheels(const ros::Time& start, Playback* pb, Replan
     publishState(*pb, body, reference, t, stamp, &trail);
     publishWheelValues(*pb, u, momentum, body.angular_velocity, stamp);
   }
-  wheel_command_pub_.publish(  // the run is over: nothing held
-      rc::wheelJointState(Eigen::VectorXd::Zero(n), Eigen::VectorXd(), pb->body_frame,
-                          ros::Time::now()));
+  if (!pb->wheel_plant) {
+    wheel_command_pub_.publish(  // the run is over: nothing held
+        rc::wheelJointState(Eigen::VectorXd::Zero(n), Eigen::VectorXd(), pb->body_frame,
+                            ros::Time::now()));
+  }
   finishExternalWheelsResult(pb, stale, cut_samples, first_problem);
   return true;
+}
+
+MeasurementAtSample TrackerNode::simulatedWheelState(WheelPlant* plant, double t,
+                                                     Eigen::VectorXd* momentum) {
+  plant->advanceTo(t);
+  MeasurementAtSample m;
+  m.state = {plant->attitude(), plant->angularVelocity()};
+  m.time = t;
+  m.age = 0.0;
+  m.fresh = true;
+  *momentum = plant->momentum();
+  last_measured_ = m.state;
+  return m;
 }
 
 void TrackerNode::finishReplanResult(Playback* pb) const {

@@ -108,16 +108,16 @@ TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
   EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
 }
 
-TEST(NodeParameters, PlantNodeWithWheelsNeedsSpinInertiasAndNoEffects) {
+TEST(NodeParameters, PlantNodeWithWheelsNeedsSpinInertiasAndNoActuatorEffects) {
   const std::string dir = " _scene:=" AP_SOURCE_DIR "/test/ros/";
   expectStopped(kPlant + " __name:=nospin_plant" + dir + "wheel_pyramid.yaml",
                 {"actuators.reaction_wheels.spin_inertia", "spin rates"});
-  expectStopped(kPlant + " __name:=disturbed_wheel_plant" + dir + "wheel_pyramid_disturbed.yaml",
-                {"actuators.reaction_wheels: effects on a body with wheels are not modelled",
-                 "disturbance_torque"});
-  const NodeRun good =
-      runNode(kPlant + " __name:=wheel_plant" + dir + "wheel_pyramid_spin.yaml", 5);
-  EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
+  expectStopped(kPlant + " __name:=noisy_wheel_plant" + dir + "wheel_pyramid_noisy.yaml",
+                {"actuators.reaction_wheels: torque_noise acts on a body torque"});
+  for (const char* scene : {"wheel_pyramid_spin.yaml", "wheel_pyramid_disturbed.yaml"}) {
+    const NodeRun good = runNode(kPlant + " __name:=wheel_plant" + dir + scene, 5);
+    EXPECT_EQ(good.status, kTimeoutExit) << scene << ": the plant should run:\n" << good.output;
+  }
 }
 
 TEST(NodeParameters, MissingRelativeSceneNamesTheCallersDirectory) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Vector3Stamped.h>
 #include <geometry_msgs/WrenchStamped.h>
@@ -15,6 +16,7 @@
 
 #include <atomic>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "attitude_planner/ReplayResult.h"
@@ -41,6 +43,58 @@ struct CommandCounter {
   std::string frame;
   ros::Subscriber sub;
 };
+
+/// /stale's measurement: odometry of the right frames at 50 Hz, each stamped `age` seconds
+/// before it is sent (older than the tracker's ~measurement_timeout of 0.5 s); and the
+/// tracker's /diagnostics status while it flies (level, measurement age).
+struct StaleSource {
+  static constexpr double kAge = 1.5;  // [s], three times the timeout
+  StaleSource()
+      : nh("stale"),
+        pub(nh.advertise<nav_msgs::Odometry>("odometry", 10)),
+        diagnostics(ros::NodeHandle().subscribe("/diagnostics", 100, &StaleSource::onStatus, this)),
+        thread([this] { publish(); }) {}
+  ~StaleSource() {
+    stop = true;
+    thread.join();
+  }
+  void publish() {
+    nav_msgs::Odometry m;
+    m.header.frame_id = "world";
+    m.child_frame_id = "stale_body";
+    m.pose.pose.orientation.w = 1.0;
+    while (!stop && ros::ok()) {
+      m.header.stamp = ros::Time::now() - ros::Duration(kAge);
+      pub.publish(m);
+      ros::WallDuration(0.02).sleep();
+    }
+  }
+  void onStatus(const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+    for (const diagnostic_msgs::DiagnosticStatus& s : array->status) {
+      if (s.name.find("/stale/") != 0) continue;
+      bool running = false;
+      double age = -1.0;
+      for (const diagnostic_msgs::KeyValue& kv : s.values) {
+        if (kv.key == "running") running = kv.value == "true";
+        if (kv.key == "measurement age [s]") age = std::stod(kv.value);
+      }
+      if (!running) continue;
+      std::lock_guard<std::mutex> lock(mutex);
+      levels.push_back(s.level);
+      ages.push_back(age);
+    }
+  }
+  ros::NodeHandle nh;
+  ros::Publisher pub;
+  ros::Subscriber diagnostics;
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::vector<int> levels;   ///< the tracker's status levels while it flew
+  std::vector<double> ages;  ///< and the measurement ages it reported [s]
+  std::thread thread;
+};
+StaleSource* stale_source = nullptr;
+CommandCounter* stale_commands = nullptr;
 
 }  // namespace
 
@@ -151,11 +205,44 @@ TEST(TrackerExternal, ReplayModeCommandsThePlansMeanTorqueOverEachSampleOpenLoop
   EXPECT_LT(done->terminal_attitude_error, 1e-3);
 }
 
+TEST(TrackerExternal, AStaleMeasurementGivesZeroCommandsAWarningAndAFailedDone) {
+  // Odometry keeps arriving, each stamped 1.5 s old (~measurement_timeout 0.5 s): the same as
+  // none at all. Every sample commands zero, the tracker's status warns with the measurement's
+  // age, `done` fails; the stream keeps its rate.
+  ros::NodeHandle nh("stale");
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(150.0);
+  ASSERT_TRUE(done) << "no done from /stale";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("had no fresh measurement"), std::string::npos) << done->message;
+  ros::WallDuration(0.5).sleep();  // the final zero command
+  {
+    std::lock_guard<std::mutex> lock(stale_commands->mutex);
+    EXPECT_EQ(stale_commands->count, 302) << "one command per sample and the final zero";
+    EXPECT_EQ(stale_commands->largest, 0.0);
+  }
+  std::lock_guard<std::mutex> lock(stale_source->mutex);
+  // About 10 statuses over the 10 s run (1 Hz); the first may precede the first sample.
+  ASSERT_GE(stale_source->levels.size(), 4u) << "too few /diagnostics statuses from /stale";
+  for (std::size_t i = 1; i < stale_source->levels.size(); ++i) {
+    EXPECT_EQ(stale_source->levels[i], diagnostic_msgs::DiagnosticStatus::WARN) << "status " << i;
+    // The age of the stamps it got (not a missing measurement): past the timeout.
+    EXPECT_GT(stale_source->ages[i], 0.5) << "status " << i;
+    EXPECT_LT(stale_source->ages[i], 2.0 * StaleSource::kAge) << "status " << i;
+  }
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_tracker_external");
   ros::NodeHandle nh;
   ros::AsyncSpinner spinner(2);
   spinner.start();
+  // Subscribed and publishing before any run starts (the tests before one wait for theirs).
+  ros::NodeHandle stale_nh("stale");
+  CommandCounter commands(stale_nh);
+  StaleSource source;
+  stale_commands = &commands;
+  stale_source = &source;
   return RUN_ALL_TESTS();
 }

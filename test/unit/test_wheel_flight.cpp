@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -412,6 +413,75 @@ TEST(WheelPlant, AWheelAtItsMomentumLimitStopsThereAndTheBodyKeepsItsMomentum) {
   }
   // Without the stop, the unsaturated closed form would have gone on: the difference is visible.
   EXPECT_GT(u * t - H, 0.1);
+}
+
+/// Effects act on the body, and the wheels only move momentum between body and wheels: under a
+/// constant world-frame disturbance τ_d the total angular momentum R (J Ω + A h_w) grows by
+/// exactly its impulse t τ_d (closed form), whatever the wheels are commanded, in one call or many.
+TEST(WheelPlant, AWorldDisturbanceChangesTheTotalMomentumByItsImpulse) {
+  const ap::ReactionWheels wheels = pyramidWheels();
+  const ap::Matrix3 J = pyramidSlew(8).inertia;
+  const ap::WheelArray array = ap::wheelArray(wheels);
+  const ap::Vector3 tau_d(0.02, -0.015, 0.01);
+  auto effects = std::make_shared<ap::EffectModel>();
+  effects->add(std::make_unique<ap::DisturbanceTorque>(tau_d, ap::TorqueFrame::World));
+  const ap::RigidBodyState start{ap::so3::exp(ap::Vector3(0.3, -0.2, 0.1)),
+                                 ap::Vector3(0.05, -0.04, 0.03)};
+  const auto total = [&](const ap::WheelPlant& p) {
+    return ap::Vector3(p.attitude() * (J * p.angularVelocity() + array.axes * p.momentum()));
+  };
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> torque(-0.1, 0.1);
+  for (int calls : {1, 5, 40}) {
+    ap::WheelPlant plant(J, wheels, start, 0.01, effects);
+    ap::WheelPlant undisturbed(J, wheels, start, 0.01);
+    const ap::Vector3 before = total(plant);
+    const double T = 20.0;
+    for (int c = 1; c <= calls; ++c) {
+      Eigen::VectorXd u(4);
+      for (int i = 0; i < 4; ++i) u(i) = torque(rng);
+      plant.command(u);
+      undisturbed.command(u);
+      plant.advanceTo(T * c / calls);
+      undisturbed.advanceTo(T * c / calls);
+    }
+    EXPECT_LT((total(plant) - (before + T * tau_d)).norm(), 1e-9 * (T * tau_d).norm()) << calls;
+    // It acted: without it the total stays where it was and the body ends elsewhere.
+    EXPECT_LT((total(undisturbed) - before).norm(), 1e-9 * before.norm()) << calls;
+    EXPECT_GT(ap::so3::angleBetween(plant.attitude(), undisturbed.attitude()), 1e-2) << calls;
+  }
+}
+
+/// With the wheels at rest (no momentum, no command) the body is a rigid body: under a gravity
+/// gradient (a fast orbit, so its clock matters) and a body-frame disturbance the plant moves as
+/// RigidBodyPlant does (an independent integrator, RKMK4 on the rotation group), advanced in one
+/// call or many: the effects see the attitude, the body frame and the plant's time.
+TEST(WheelPlant, EffectsActOnTheBodyAsOnARigidBodyWhenTheWheelsRest) {
+  ap::ReactionWheels wheels = pyramidWheels();
+  wheels.initial_momentum = {0.0, 0.0, 0.0, 0.0};
+  const ap::Matrix3 J = pyramidSlew(8).inertia;
+  const double r = 7.0e6, n = 0.05;  // mean motion [rad/s]: an orbit in about 2 minutes
+  auto effects = std::make_shared<ap::EffectModel>();
+  effects->add(std::make_unique<ap::GravityGradient>(n * n * r * r * r, r, J));
+  effects->add(std::make_unique<ap::DisturbanceTorque>(ap::Vector3(1e-3, 0.0, -2e-3),
+                                                       ap::TorqueFrame::Body));
+  const ap::Matrix3 R0 = ap::so3::exp(ap::Vector3(0.4, 0.1, -0.3));
+  const ap::Vector3 W0(0.02, -0.03, 0.01);
+  for (int calls : {1, 9}) {
+    ap::WheelPlant plant(J, wheels, {R0, W0}, 0.005, effects);
+    ap::RigidBodyPlant body(J, R0, W0, effects, ap::Actuation(), 0.005);
+    ap::RigidBodyPlant free(J, R0, W0, nullptr, ap::Actuation(), 0.005);
+    const double T = 60.0;
+    for (int c = 1; c <= calls; ++c) {
+      plant.advanceTo(T * c / calls);
+      body.advanceTo(T * c / calls);
+      free.advanceTo(T * c / calls);
+    }
+    EXPECT_LT(ap::so3::angleBetween(plant.attitude(), body.attitude()), 1e-8) << calls;
+    EXPECT_LT((plant.angularVelocity() - body.angularVelocity()).norm(), 1e-9) << calls;
+    EXPECT_LT(plant.momentum().norm(), 1e-15) << "the wheels stay at rest";
+    EXPECT_GT(ap::so3::angleBetween(body.attitude(), free.attitude()), 0.05) << "the effects acted";
+  }
 }
 
 /// predictWheelState moves a state as the plant does: the same equations under the held torques.

@@ -3,15 +3,19 @@
 // predicts with (docs/ros_tracker.md, "External plant with wheels"). The equations are
 // replayWithWheels' (dynamics/wheel_replay.hpp):
 //
-//     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u,     ḣ_w = u,
+//     Ṙ = R Ω^,     J Ω̇ = −Ω × (J Ω + A h_w) − A u + τ_e(R, t),     ḣ_w = u,
 //
-// u held between commands (zero-order hold), RK4 in steps of at most max_step. A wheel stops at
+// u held between commands (zero-order hold), RK4 in steps of at most max_step. τ_e is the sum
+// of the known effects (gravity gradient, disturbance torques: EffectModel, body frame) acting on
+// the body: they change the total angular momentum R (J Ω + A h_w) by their impulse, the wheels
+// only move it between body and wheels. A wheel stops at
 // its momentum limit: once |h_w,i| reaches H_i, a torque that would drive it further is not
 // delivered (ḣ_w,i = 0: the wheel cannot absorb it, so its reaction on the body is missing,
 // which is the commanded torque acting back on the body); one that brings it back is.
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "attitude_planner/analysis/tracking.hpp"
@@ -37,19 +41,21 @@ struct WheelBodyState {
   Eigen::VectorXd momentum;  ///< h_w [N m s]
 };
 
-/// `state` moved on by dt [s] (≥ 0) under the wheel torques u held (kWheelFlightSubsteps RK4
-/// steps): the tracker moves a measurement to its sample's time with it.
+/// `state` at maneuver time t moved on by dt [s] (≥ 0) under the wheel torques u held and the
+/// known effects (null: none; kWheelFlightSubsteps RK4 steps): the tracker moves a measurement
+/// to its sample's time with it.
 WheelBodyState predictWheelState(const Matrix3& inertia, const WheelArray& array,
                                  const WheelBodyState& state, const Eigen::VectorXd& torque,
-                                 double dt);
+                                 double dt, const EffectModel* effects = nullptr, double t = 0.0);
 
 /// Body + wheels integrated from wheel-torque commands (zero-order hold).
 class WheelPlant {
  public:
-  /// At t = 0 in `start` (the wheels at their initial_momentum). The array must be valid
-  /// (validateReactionWheels); `max_step` > 0 [s] (throws InvalidInput naming it otherwise).
+  /// At t = 0 in `start` (the wheels at their initial_momentum), under `effects` (null or empty:
+  /// none; their clock is the plant's t). The array must be valid (validateReactionWheels);
+  /// `max_step` > 0 [s] (throws InvalidInput naming it otherwise).
   WheelPlant(const Matrix3& inertia, const ReactionWheels& wheels, const RigidBodyState& start,
-             double max_step);
+             double max_step, std::shared_ptr<const EffectModel> effects = nullptr);
   /// Holds the wheel torques u [N m] from now on, each cut to its torque limit ±U_i (the
   /// motor's); returns the torques delivered now (0 for a wheel at its momentum limit that u
   /// would drive further). Throws InvalidInput for a wrong count.
@@ -70,6 +76,7 @@ class WheelPlant {
  private:
   Matrix3 inertia_;
   ReactionWheels wheels_;
+  std::shared_ptr<const EffectModel> effects_;  ///< null: none
   WheelArray array_;
   double max_step_;
   double time_ = 0.0;

@@ -100,6 +100,12 @@ ReactionWheelArray reactionWheelsToMsg(const ReactionWheels& wheels);
 ReactionWheelsSummary wheelSummaryToMsg(
     const ReactionWheels& wheels, const WheelPeaks& peaks,
     std::optional<MinimizedEffort> effort_minimized = std::nullopt);
+/// The effects a body with reaction wheels is flown under (attitude_plant_node's ~scene, the
+/// tracker's run): gravity_gradient and disturbance_torque act on the body, the wheels only move
+/// momentum between body and wheels; actuator_limits and torque_noise act on a body torque that
+/// no wheel makes (the wheels' own max_torque bounds them). Throws InvalidInput naming `field`
+/// and the first of those.
+void requireWheelBodyEffects(const std::vector<EffectSpec>& effects, const std::string& field);
 /// One value per wheel from a sensor_msgs/JointState's `names` and one of its value arrays
 /// (`values`: effort for a wheel command, velocity for a wheel measurement), looked up by the
 /// names wheel_1 .. wheel_n (any order; other joints ignored). Throws InvalidInput naming

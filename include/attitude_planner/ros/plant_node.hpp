@@ -13,11 +13,13 @@
 //
 // A scene with reaction wheels (actuators.reaction_wheels, with spin_inertia) is body + wheels
 // instead: the core's WheelPlant (analysis/wheel_plant.hpp: Ṙ = RΩ^, JΩ̇ = −Ω × (JΩ + A h_w) −
-// A u, ḣ_w = u, RK4), commanded by wheel torques u on `wheel_command` (each cut to its
+// A u + τ_e, ḣ_w = u, RK4), commanded by wheel torques u on `wheel_command` (each cut to its
 // max_torque; a wheel stops at its max_momentum, the torque it cannot absorb acting on the body,
 // with a warning once per wheel), measured by the wheels' spin rates relative to the body on
-// `wheel_measurement` beside `odometry` (same stamp); effects on a body with wheels are refused by
-// name (as the planner and the tracker refuse them), torque_command is not subscribed.
+// `wheel_measurement` beside `odometry` (same stamp), under ~scene's gravity gradient and
+// disturbance torques acting on the body (τ_e(R, t) in the body equation: they change the total
+// momentum by their impulse); actuator_limits and torque_noise (on a body torque no wheel makes)
+// are refused by name; torque_command is not subscribed.
 //
 // Subscribes  torque_command  geometry_msgs/WrenchStamped, body frame   u [N·m] (wrench.torque;
 //                             the force is ignored); a frame_id other than ~body_frame or empty

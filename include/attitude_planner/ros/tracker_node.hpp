@@ -23,8 +23,10 @@
 // feedback (trackWithWheels); with ~plant external the wheel torques go out on `wheel_command`
 // and the wheels' speeds come in on `wheel_measurement` (runExternalWheels; in ~mode replan the
 // re-plans start from the measured body and wheel momenta and the law on the plan in force is
-// distributed over the wheels); replan with the internal plant and effects during the run are
-// refused by name.
+// distributed over the wheels). With the internal plant, ~mode replan or effects during the run
+// (gravity gradient, disturbance torques) fly the same loop on the tracker's own body + wheels
+// (a WheelPlant under the run's effects, read exactly at every sample instead of measured);
+// actuator_limits and torque_noise with wheels are refused by name.
 // The message is honoured: tf, markers and topics use header.frame_id / child_frame_id
 // (~world_frame / ~body_frame only when they are empty); a header.stamp in the future is the start
 // of the maneuver (else now + ~start_delay); time[] must be the uniform grid k · time_step (refused
@@ -161,6 +163,7 @@
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/analysis/wheel_flight.hpp"
+#include "attitude_planner/analysis/wheel_plant.hpp"
 #include "attitude_planner/drift_two_input/planner.hpp"
 #include "attitude_planner/dynamics/maneuver.hpp"
 #include "attitude_planner/io/scene.hpp"
@@ -345,6 +348,9 @@ class TrackerNode {
     /// linearly between nodes) and the peaks of the measured momenta and the commanded torques.
     std::vector<Eigen::VectorXd> plan_wheel_torque;
     std::optional<WheelPeaks> measured_wheel_peaks;
+    /// ~plant internal with wheels in replan mode or under effects: the tracker's own body +
+    /// wheels, flown by the external plant's loop (runExternalWheels) instead of measured.
+    std::shared_ptr<WheelPlant> wheel_plant;
   };
   /// A re-plan in flight (replan mode).
   struct ReplanState {
@@ -419,8 +425,12 @@ class TrackerNode {
   /// wheels (the law's torque distributed and cut, wheelTorquesFor, on the plan, or in replan
   /// mode on the plan in force, re-planned from the measured body and momenta; or the plan's u
   /// averaged over the sample) out on `wheel_command`; stale measurements give a zero command.
-  /// False if stopped meanwhile.
+  /// With playback->wheel_plant (internal plant) the same loop on that plant: its state at the
+  /// sample instead of a measurement, u commanded to it instead of published. False if stopped
+  /// meanwhile.
   bool runExternalWheels(const ros::Time& start, Playback* playback, ReplanState* replans);
+  /// The internal wheel plant at maneuver time t, as a measurement: exact, fresh, no age.
+  MeasurementAtSample simulatedWheelState(WheelPlant* plant, double t, Eigen::VectorXd* momentum);
   /// An external run's `done` figures from the last measured state: the terminal errors against
   /// the plan's R_N and Ω_N, the final attitude, the cost, the re-plans adopted, success (no
   /// stale sample).
@@ -437,8 +447,9 @@ class TrackerNode {
                     const ManeuverSample& plan, double t, const ros::Time& stamp,
                     std::deque<Vector3>* trail);
   /// A maneuver with reaction wheels: refuses, naming the setting, what is not flown with wheels
-  /// (~mode other than replay, ~plant external, effects during the run) and checks the array
-  /// (validateReactionWheels, field maneuver.reaction_wheels).
+  /// (~plant external without spin inertias, actuator effects during the run:
+  /// requireWheelBodyEffects) and checks the array (validateReactionWheels, field
+  /// maneuver.reaction_wheels).
   void requireWheelFlight(const ReactionWheels& wheels,
                           const std::vector<EffectSpec>& effects) const;
   /// replay mode with wheels: flies the plan's wheel torques (the message's wheel_torque, or the

@@ -149,6 +149,17 @@ DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& v) {
   return msg;
 }
 
+std::vector<NamedFigure> verdictFiguresToMsg(const Verdict& verdict) {
+  std::vector<NamedFigure> figures;
+  for (const VerdictFigure& f : verdictFigures(verdict)) {
+    NamedFigure msg;
+    msg.name = f.name;
+    msg.value = f.value;
+    figures.push_back(msg);
+  }
+  return figures;
+}
+
 void applyRequestEffects(const std::vector<Effect>& effects, PlanningProblem* problem) {
   std::vector<EffectSpec> specs;
   for (std::size_t i = 0; i < effects.size(); ++i) {

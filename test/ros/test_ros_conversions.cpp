@@ -14,7 +14,9 @@
 #include <tuple>
 
 #include "attitude_planner/PlanAttitudeManeuver.h"
+#include "attitude_planner/PlanAttitudeManeuverAction.h"
 #include "attitude_planner/dynamics/simulation.hpp"
+#include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/diagnostics.hpp"
@@ -1113,6 +1115,44 @@ TEST(AnytimePlan, AStoppedSolveFillsTheResponseWithItsPlanFlaggedUnconverged) {
   fillResponse(planRequest(req, rc::PlannerDefaults(), nullptr), "world", "body", &converged);
   EXPECT_TRUE(converged.success) << converged.message;
   EXPECT_FALSE(converged.unconverged_plan);
+}
+
+TEST(RosConversions, TheVerdictIsInTheResponseAndTheActionResultAsInTheJsonSummary) {
+  // verdict_kind and verdict_figures carry the result's verdict as data, by the JSON summary's
+  // names: the seed request's (the Newton solver's ending) and a local infeasibility's, in the
+  // service's response and the action's result alike.
+  ros::Time::init();  // the response's stamps, without a master
+  PlanOutcome outcome = planRequest(seedRequest(), rc::PlannerDefaults(), nullptr);
+  ASSERT_TRUE(outcome.solver_ran) << outcome.message;
+  const auto expectTheVerdict = [&](const std::string& kind,
+                                    const std::vector<NamedFigure>& figures) {
+    const Verdict& verdict = outcome.result.verdict;
+    EXPECT_EQ(kind, verdictKindName(verdict));
+    const std::string json = planResultJson(outcome.problem, outcome.result);
+    EXPECT_NE(json.find("\"verdict\": {\"kind\": \"" + kind + "\""), std::string::npos) << json;
+    const std::vector<VerdictFigure> expected = verdictFigures(verdict);
+    ASSERT_EQ(figures.size(), expected.size());
+    for (std::size_t i = 0; i < figures.size(); ++i) {
+      EXPECT_EQ(figures[i].name, expected[i].name);
+      EXPECT_EQ(figures[i].value, expected[i].value);
+      EXPECT_NE(json.find("\"" + figures[i].name + "\": " + exactNumber(figures[i].value)),
+                std::string::npos)
+          << figures[i].name << " in " << json;
+    }
+  };
+  PlanAttitudeManeuver::Response res;
+  fillResponse(outcome, "world", "body", &res);
+  EXPECT_EQ(res.verdict_kind, "newton_ended");
+  expectTheVerdict(res.verdict_kind, res.verdict_figures);
+  outcome.result.verdict =
+      verdicts::LocallyInfeasible{12.8, 13.0 + 1.0 / 3.0, "what", 11.5, "", true};
+  PlanAttitudeManeuverResult result;
+  fillResponse(outcome, "world", "body", &result);
+  EXPECT_EQ(result.verdict_kind, "locally_infeasible");
+  ASSERT_EQ(result.verdict_figures.size(), 3u);
+  EXPECT_EQ(result.verdict_figures[1].name, "least_duration_found");
+  EXPECT_EQ(result.verdict_figures[1].value, 13.0 + 1.0 / 3.0);
+  expectTheVerdict(result.verdict_kind, result.verdict_figures);
 }
 
 TEST(NloptRefusal, AboveItsLimitIsInvalidInputNamingSteps) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <map>
 #include <set>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "support/pointing_requests.hpp"
 #include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
@@ -129,40 +131,154 @@ TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
   }
 }
 
+/// The result's trail is what the request's context recorded, attempt for attempt (every field),
+/// with one kept attempt in both when `one_kept`.
+void expectTheContextsTrail(const ap::PlanResult& r, const ap::SolveContext& context,
+                            bool one_kept = true) {
+  const std::vector<ap::Attempt>& trail = context.attempts();
+  ASSERT_EQ(trail.size(), r.attempts.size()) << r.message;
+  for (std::size_t i = 0; i < trail.size(); ++i) {
+    SCOPED_TRACE(i);
+    const ap::Attempt &a = r.attempts[i], &b = trail[i];
+    EXPECT_EQ(a.stage, b.stage);
+    EXPECT_EQ(a.start, b.start);
+    EXPECT_EQ(a.formulation, b.formulation);
+    EXPECT_EQ(a.globalization, b.globalization);
+    EXPECT_TRUE(ap::sameHomotopyClass(a.homotopy, b.homotopy));
+    EXPECT_EQ(a.steps, b.steps);
+    EXPECT_EQ(a.termination, b.termination);
+    EXPECT_EQ(a.iterations, b.iterations);
+    EXPECT_TRUE(a.cost == b.cost || (std::isnan(a.cost) && std::isnan(b.cost)));
+    EXPECT_EQ(a.kept, b.kept);
+    EXPECT_EQ(a.start_detail.coarse_steps, b.start_detail.coarse_steps);
+    EXPECT_EQ(a.start_detail.origin, b.start_detail.origin);
+    const double ta = a.start_detail.twist, tb = b.start_detail.twist;
+    EXPECT_TRUE(ta == tb || (std::isnan(ta) && std::isnan(tb)));
+    const double da = a.start_detail.duration, db = b.start_detail.duration;
+    EXPECT_TRUE(da == db || (std::isnan(da) && std::isnan(db)));
+  }
+  const auto kept = [](const std::vector<ap::Attempt>& t) {
+    return std::count_if(t.begin(), t.end(), [](const ap::Attempt& a) { return a.kept; });
+  };
+  if (one_kept) EXPECT_EQ(kept(r.attempts), 1) << r.message;
+  EXPECT_EQ(kept(trail), kept(r.attempts));
+}
+
 TEST(AttemptTags, AConstrainedRequestsTrailIsTheContextsTrail) {
-  // Newton's walk, then the interior point from its optimum: the result's trail is what the
-  // request's context recorded, attempt for attempt, with one kept attempt in both (the context
-  // names an attempt as its scopes do and keeps one mark).
-  for (const char* scene : {"torque_limited", "rate_limited", "sun_keep_out", "leo_slew_limited"}) {
+  // Newton's walk, then the interior point from its optimum (at N = 512 through its grid
+  // continuation, whose levels' unconstrained starts are parts of its attempt), and the other
+  // classes where the first stops: the result's trail is what the request's context recorded.
+  for (const int steps : {64, 512}) {
+    for (const char* scene :
+         {"torque_limited", "rate_limited", "sun_keep_out", "leo_slew_limited"}) {
+      SCOPED_TRACE(scene);
+      SCOPED_TRACE(steps);
+      const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, steps);
+      const ap::SolverOptions options;
+      ap::SolveContext context(options);
+      const ap::PlanResult r = ap::planAtResolution(p, options, context);
+      ASSERT_TRUE(std::any_of(
+          r.attempts.begin(), r.attempts.end(),
+          [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
+          << "the interior point ran: " << r.message;
+      expectTheContextsTrail(r, context);
+      // The interior point's continuation is one attempt: the Newton solve that starts its
+      // coarsest level (which its scope would name `constrained`) is no attempt of the trail.
+      EXPECT_TRUE(std::none_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+        return a.formulation == ap::Formulation::Unconstrained &&
+               (a.stage == ap::AttemptStage::Constrained ||
+                a.stage == ap::AttemptStage::ConstrainedRetry);
+      })) << r.message;
+    }
+  }
+}
+
+TEST(AttemptTags, AFourthOrderRequestsTrailIsTheContextsTrail) {
+  // The N and the 2N second_order solves, a solver's own solve named fourth_order_coarse or
+  // fourth_order_fine by the scope it runs in (the N solve's class survey keeps its stages; the
+  // 2N solve, pinned to the class the N solve chose, is one): the 2N solve's kept attempt kept.
+  for (const char* scene : {"rest_to_rest", "torque_limited"}) {
     SCOPED_TRACE(scene);
-    const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, 64);
+    ap::PlanningProblem p = ap::test_support::sceneProblem(scene, 32);
+    p.scheme = ap::SchemeKind::FourthOrder;
     const ap::SolverOptions options;
     ap::SolveContext context(options);
     const ap::PlanResult r = ap::planAtResolution(p, options, context);
-    ASSERT_TRUE(std::any_of(
-        r.attempts.begin(), r.attempts.end(),
-        [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
-        << "the interior point ran: " << r.message;
-    const std::vector<ap::Attempt>& trail = context.attempts();
-    ASSERT_EQ(trail.size(), r.attempts.size()) << r.message;
-    for (std::size_t i = 0; i < trail.size(); ++i) {
-      SCOPED_TRACE(i);
-      const ap::Attempt &a = r.attempts[i], &b = trail[i];
-      EXPECT_EQ(a.stage, b.stage);
-      EXPECT_EQ(a.start, b.start);
-      EXPECT_EQ(a.formulation, b.formulation);
-      EXPECT_TRUE(ap::sameHomotopyClass(a.homotopy, b.homotopy));
-      EXPECT_EQ(a.steps, b.steps);
-      EXPECT_EQ(a.termination, b.termination);
-      EXPECT_EQ(a.iterations, b.iterations);
-      EXPECT_EQ(a.kept, b.kept);
-    }
-    const auto kept = [](const std::vector<ap::Attempt>& t) {
-      return std::count_if(t.begin(), t.end(), [](const ap::Attempt& a) { return a.kept; });
+    ASSERT_TRUE(r.converged()) << r.message;
+    expectTheContextsTrail(r, context);
+    const auto named = [&](ap::AttemptStage stage) {
+      return std::any_of(r.attempts.begin(), r.attempts.end(),
+                         [&](const ap::Attempt& a) { return a.stage == stage; });
     };
-    EXPECT_EQ(kept(r.attempts), 1);
-    EXPECT_EQ(kept(trail), 1);
+    EXPECT_TRUE(named(ap::AttemptStage::FourthOrderFine));
+    EXPECT_FALSE(named(ap::AttemptStage::Solve));
+    EXPECT_TRUE(std::any_of(r.attempts.begin(), r.attempts.end(),
+                            [](const ap::Attempt& a) { return a.steps == 32; }));
+    const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(),
+                                   [](const ap::Attempt& a) { return a.kept; });
+    ASSERT_NE(kept, r.attempts.end());
+    EXPECT_EQ(kept->steps, 64);
   }
+}
+
+TEST(AttemptTags, AMinimumTimeRequestsTrailIsTheContextsTrail) {
+  // The free-time solves (their starts' helper solves left out), the search where they fail,
+  // the probes below T* with spinning ends, the plan at the margin: rest to rest, spinning, and
+  // with a time margin, the trail is what the context recorded, the answer's attempt kept.
+  ap::PlanningProblem rest = ap::test_support::sceneProblem("min_time_bilimoria_wie", 32);
+  ap::PlanningProblem spinning = ap::test_support::sceneProblem("min_time_sphere", 32);
+  spinning.initial_velocity = ap::Vector3(0.2, 0.0, 0.0);
+  ap::PlanningProblem margin = rest;
+  margin.time_margin = 0.05;
+  ap::PlanningProblem keep_out = ap::test_support::sceneProblem("min_time_keep_out", 32);
+  const std::pair<const char*, const ap::PlanningProblem*> requests[] = {
+      {"rest to rest", &rest},
+      {"spinning", &spinning},
+      {"margin", &margin},
+      {"keep-out cone", &keep_out}};
+  for (const auto& [name, problem] : requests) {
+    SCOPED_TRACE(name);
+    ap::PlanningProblem p = *problem;
+    p.objective = ap::Objective::MinimumTime;
+    const ap::SolverOptions options;
+    ap::SolveContext context(options);
+    const ap::PlanResult r = ap::planMinimumTime(p, context);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_FALSE(r.attempts.empty());
+    expectTheContextsTrail(r, context);
+  }
+}
+
+TEST(AttemptTags, ABoundedRequestsTrailIsTheContextsTrail) {
+  // Minimum effort at 0.9 T*: the interior point ends infeasible, the minimum-time phase backs
+  // the verdict; the trail holds both, as the context recorded them.
+  ap::PlanningProblem p = ap::test_support::sceneProblem("min_time_bilimoria_wie", 32);
+  p.objective = ap::Objective::MinimumTime;
+  const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
+  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  p.objective = ap::Objective::MinimumEffort;
+  p.duration = 0.9 * fastest.minimum_duration;
+  const ap::SolverOptions options;
+  ap::SolveContext context(options);
+  const ap::PlanResult r = ap::planBoundedMinimumEffort(p, context);
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  const bool minimum_time_phase = std::any_of(
+      r.attempts.begin(), r.attempts.end(),
+      [](const ap::Attempt& a) { return a.stage == ap::AttemptStage::MinimumTimeSolve; });
+  EXPECT_TRUE(minimum_time_phase) << r.message;
+  expectTheContextsTrail(r, context, false);
+}
+
+TEST(AttemptTags, APointingRequestsTrailIsTheContextsTrail) {
+  // A pointing request under a keep-out cone: its twist runs and the fixed-twist solves they
+  // start from, as the context recorded them.
+  const ap::PlanningProblem p = ap::test_support::randomConstrainedPointingRequest(
+      7, 32, false, ap::SchemeKind::SecondOrder, ap::test_support::PointingBinding::KeepOut);
+  const ap::SolverOptions options;
+  ap::SolveContext context(options);
+  const ap::PlanResult r = ap::planAtResolution(p, options, context);
+  ASSERT_FALSE(r.attempts.empty()) << r.message;
+  expectTheContextsTrail(r, context, r.converged());
 }
 
 TEST(AttemptTags, TheKeptAttemptOfAConstrainedRequestIsAmongTheTagsReported) {

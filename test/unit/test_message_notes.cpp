@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <sstream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -311,7 +312,11 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
                                         v::SearchInfeasible{},
                                         v::FeasibleAtMinimumTime{},
                                         v::NoPointingStartConverged{},
-                                        v::NloptEnded{}};
+                                        v::NloptEnded{},
+                                        v::NewtonEnded{},
+                                        v::InteriorPointEnded{},
+                                        v::NoBoundaryStep{},
+                                        v::ConeAtFixedNode{}};
   std::vector<std::string> kinds;
   for (const ap::Verdict& verdict : all) {
     const std::string kind = ap::verdictKindName(verdict);
@@ -324,6 +329,37 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
     }
   }
   EXPECT_EQ(kinds.size(), std::variant_size_v<ap::Verdict>);
+}
+
+TEST(DriverVerdicts, TheSolversFirstReasonsSayTheWordsOfTheirFormerExpressions) {
+  // Newton's and the interior point's endings on one grid, as data: the words the solvers wrote
+  // themselves before (their ostringstream expressions, repeated here), and the figures by name.
+  namespace v = ap::verdicts;
+  const double g = 1.0 / 3.0 * 1e-9, d = 2.0 / 7.0 * 1e-11, mu = 1.0 / 9.0 * 1e-12, e = 0.125;
+  std::ostringstream newton;
+  newton << "converged"
+         << " after " << 7 << " iterations (relative gradient " << g
+         << ", relative Newton decrement " << d << ")";
+  EXPECT_EQ(ap::renderVerdict(v::NewtonEnded{"converged", 7, g, d}, "ignored"), newton.str());
+  std::ostringstream interior;
+  interior << "line search failed"
+           << " after " << 41 << " interior-point iterations (relative Newton decrement " << d
+           << ", barrier " << mu << " x cost, max elastic violation " << e << ")";
+  EXPECT_EQ(ap::renderVerdict(v::InteriorPointEnded{"line search failed", 41, d, mu, e}, ""),
+            interior.str());
+  EXPECT_EQ(ap::renderVerdict(v::NoBoundaryStep{"no step from 9 rad/s"}, ""),
+            std::string("boundary velocity: ") + "no step from 9 rad/s");
+  EXPECT_EQ(ap::renderVerdict(v::ConeAtFixedNode{"keep_out at R_1 by 0.1 rad"}, ""),
+            "infeasible: " + std::string("keep_out at R_1 by 0.1 rad") +
+                ", an attitude the boundary velocities fix (increase steps or move the "
+                "boundary)");
+  const std::vector<ap::VerdictFigure> figures =
+      ap::verdictFigures(v::InteriorPointEnded{"converged", 41, d, mu, e});
+  ASSERT_EQ(figures.size(), 4u);
+  EXPECT_EQ(figures[0].name, "iterations");
+  EXPECT_EQ(figures[0].value, 41.0);
+  EXPECT_EQ(figures[2].name, "barrier_over_cost");
+  EXPECT_EQ(figures[2].value, mu);
 }
 
 TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {

@@ -4,11 +4,13 @@
 #include <cmath>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "tool_runner.hpp"
 
 using namespace attitude_planner;
@@ -215,5 +217,32 @@ TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
        {"solver / scheme", "steps N, duration T      65536", "iterations", "cost sum 1/2|tau_k|^2",
         "terminal attitude error", "solve time", "grid levels"}) {
     EXPECT_TRUE(contains(r.output, label)) << label << "\n" << r.output;
+  }
+}
+
+TEST(Verdicts, ASolversFirstReasonIsItsVerdictKind) {
+  // The Newton solver's and the interior point's own endings are verdict kinds with their
+  // figures: the message begins with the verdict's words, and the figures are the solve's.
+  struct Case {
+    const char* scene;
+    const char* kind;
+  };
+  for (const Case& c :
+       {Case{"rest_to_rest", "newton_ended"}, Case{"torque_limited", "interior_point_ended"},
+        Case{"sun_keep_out", "interior_point_ended"}}) {
+    SCOPED_TRACE(c.scene);
+    PlanningProblem p =
+        loadScene(std::string(AP_SOURCE_DIR) + "/scenes/" + c.scene + ".yaml").problem;
+    p.steps = 32;
+    const PlanResult r = planManeuver(p, SolverOptions());
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_EQ(verdictKindName(r.verdict), c.kind);
+    const std::string words = renderVerdict(r.verdict, "");
+    EXPECT_EQ(r.message.rfind(words, 0), 0u) << r.message << "\n" << words;
+    const std::vector<VerdictFigure> figures = verdictFigures(r.verdict);
+    ASSERT_FALSE(figures.empty());
+    EXPECT_EQ(figures[0].name, "iterations");
+    EXPECT_GT(figures[0].value, 0.0);
+    EXPECT_LE(figures[0].value, r.iterations);  // one grid's solve among the request's
   }
 }

@@ -147,17 +147,65 @@ struct NloptEnded {
   }
 };
 
+/// A Newton solve on one grid ended (newton/grid_solve): how, after how many iterations, and its
+/// first-order figures there.
+struct NewtonEnded {
+  static constexpr const char* kKind = "newton_ended";
+  std::string how;  ///< "converged", "iteration limit reached", ...
+  int iterations = 0;
+  double relative_gradient = 0.0;
+  double relative_decrement = 0.0;  ///< the relative Newton decrement
+  std::vector<VerdictFigure> figures() const {
+    return {{"iterations", double(iterations)},
+            {"relative_gradient", relative_gradient},
+            {"relative_newton_decrement", relative_decrement}};
+  }
+};
+/// The interior point on one grid ended (interior_point/grid_solve): how (an infeasible end: the
+/// constraint whose violation stopped decreasing and where), after how many iterations, and its
+/// figures there.
+struct InteriorPointEnded {
+  static constexpr const char* kKind = "interior_point_ended";
+  std::string how;  ///< "converged", "line search failed ...", "infeasible: ...", ...
+  int iterations = 0;
+  double relative_decrement = 0.0;  ///< the relative Newton decrement
+  double barrier = 0.0;             ///< μ relative to the cost scale
+  double max_elastic_violation = 0.0;
+  std::vector<VerdictFigure> figures() const {
+    return {{"iterations", double(iterations)},
+            {"relative_newton_decrement", relative_decrement},
+            {"barrier_over_cost", barrier},
+            {"max_elastic_violation", max_elastic_violation}};
+  }
+};
+/// A boundary velocity has no step at this h (no reduced problem on this grid): StepTooLarge,
+/// before any iteration (Newton or the interior point).
+struct NoBoundaryStep {
+  static constexpr const char* kKind = "no_boundary_step";
+  std::string what;  ///< which velocity and why
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// A keep-out or keep-in cone is violated at a node the boundary velocities fix (R_1, R_{N−1}):
+/// infeasible on this grid before any iteration (the interior point).
+struct ConeAtFixedNode {
+  static constexpr const char* kKind = "cone_at_fixed_node";
+  std::string violation;  ///< the cone, the node and by how much
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+
 }  // namespace verdicts
 
-/// What a driver answered, as data (PlanResult::verdict): the kind and its figures (NloptEnded:
-/// the cross-check solver's own reason, the first of the solvers' reasons made data).
+/// What a driver answered, as data (PlanResult::verdict): the kind and its figures. A solver's
+/// first reason is a kind too (NloptEnded, NewtonEnded, InteriorPointEnded, NoBoundaryStep,
+/// ConeAtFixedNode); SolverReason where a solver's reason is still words only.
 using Verdict =
     std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
                  verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
                  verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
                  verdicts::SearchStopped, verdicts::SearchUnrepresentable,
                  verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
-                 verdicts::NoPointingStartConverged, verdicts::NloptEnded>;
+                 verdicts::NoPointingStartConverged, verdicts::NloptEnded, verdicts::NewtonEnded,
+                 verdicts::InteriorPointEnded, verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode>;
 
 /// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
 inline std::string verdictKindName(const Verdict& verdict) {

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
@@ -20,6 +21,7 @@
 #include "attitude_planner/DurationVerdictSummary.h"
 #include "attitude_planner/Effect.h"
 #include "attitude_planner/MinimumTimeSummary.h"
+#include "attitude_planner/NamedFigure.h"
 #include "attitude_planner/PlanAttempt.h"
 #include "attitude_planner/PlanDriftTwoInput.h"
 #include "attitude_planner/ReactionWheelArray.h"
@@ -169,6 +171,9 @@ PlanAttempt attemptToMsg(const Attempt& attempt);
 MinimumTimeSummary minimumTimeToMsg(const MinimumTimeCertificate& certificate);
 /// The verdict on durations of a result (PlanResult::duration_verdict) as a message.
 DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& verdict);
+/// A result's verdict's figures (PlanResult::verdict) as messages, by the names and in the order
+/// of the JSON summary's `verdict.figures` (the kind is verdictKindName).
+std::vector<NamedFigure> verdictFiguresToMsg(const Verdict& verdict);
 
 /// The request field a core error names, in the request's own spelling: the core (and the scene)
 /// say `initial.angular_velocity`, `constraints[0].max_torque_norm`,

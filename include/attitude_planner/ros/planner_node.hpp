@@ -448,6 +448,8 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   for (const Attempt& a : r.attempts) res->attempts.push_back(ros_conversions::attemptToMsg(a));
   res->minimum_time = ros_conversions::minimumTimeToMsg(r.minimum_time);
   res->duration_verdict = ros_conversions::durationVerdictToMsg(r.duration_verdict);
+  res->verdict_kind = verdictKindName(r.verdict);
+  res->verdict_figures = ros_conversions::verdictFiguresToMsg(r.verdict);
 }
 
 }  // namespace attitude_planner

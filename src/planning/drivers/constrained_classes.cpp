@@ -72,25 +72,26 @@ Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int ste
   return a;
 }
 
-/// The classes' solves and the trail they leave.
+/// The classes' solves and the trail they leave in the context (after `first`'s, which begins
+/// at `first_recorded`).
 class ClassSearch {
  public:
   ClassSearch(const PlanningProblem& problem, const SolverOptions& options, SolveContext& context,
-              const std::vector<ClassPlan>& survey_plans, PlanResult first)
+              const std::vector<ClassPlan>& survey_plans, PlanResult first,
+              std::size_t first_recorded)
       : problem_(problem),
         options_(options),
         context_(context),
         survey_plans_(survey_plans),
-        trail_(first.attempts),
+        first_recorded_(first_recorded),
         first_iterations_(first.iterations),
-        best_(std::move(first)) {
+        best_(std::move(first)),
+        kept_(context.keptAttempt()) {
     options_.enumerate_classes = false;  // each solve in its own class
-    kept_ = std::find_if(trail_.begin(), trail_.end(), [](const Attempt& a) { return a.kept; }) -
-            trail_.begin();
   }
 
   /// One solve of `homotopy` on `steps` steps, from the survey's plan of it on that grid if there
-  /// is one, its trail appended (first-stage attempts marked constrained_class, none kept). A grid
+  /// is one (its attempts named constrained_class where they were the solver's own solve). A grid
   /// with no boundary step at its h gives no plan.
   PlanResult solve(const HomotopyClass& homotopy, int steps) {
     PlanResult r;
@@ -101,6 +102,7 @@ class ClassSearch {
           return sameHomotopyClass(c.homotopy, homotopy) && c.plan.steps() == steps;
         });
     options.unconstrained_optimum = surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
+    const std::size_t before = context_.attempts().size();
     try {
       const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
       r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
@@ -108,7 +110,10 @@ class ClassSearch {
       r.message = e.what();
     }
     iterations_ += r.iterations;
-    appendTrail(r.attempts);
+    // The attempt whose plan r is: its kept one, else its last.
+    const std::optional<std::size_t> kept = context_.keptAttempt();
+    const std::size_t end = context_.attempts().size();
+    if (end > before) last_kept_ = kept && *kept >= before ? *kept : end - 1;
     tried_.push_back(classAttempt(homotopy, r, steps));
     return r;
   }
@@ -125,8 +130,8 @@ class ClassSearch {
 
   /// The best plan with the whole trail, the classes tried in its extremal.
   PlanResult finish(const ExtremalSummary& survey, const HomotopyClass& first_class) {
-    for (std::size_t i = 0; i < trail_.size(); ++i) trail_[i].kept = i == kept_;
-    best_.attempts = trail_;
+    context_.restoreKept(kept_);
+    best_.attempts = context_.attemptsFrom(first_recorded_);
     best_.iterations = first_iterations_ + iterations_;
     ExtremalSummary& extremal = best_.extremal_summary;
     if (firstKept()) extremal.homotopy = first_class;
@@ -141,27 +146,16 @@ class ClassSearch {
   bool firstKept() const { return !best_tried_; }
 
  private:
-  void appendTrail(const std::vector<Attempt>& solve) {
-    if (solve.empty()) return;
-    last_kept_ = trail_.size() + solve.size() - 1;
-    for (Attempt a : solve) {
-      if (a.kept) last_kept_ = trail_.size();
-      if (a.stage == AttemptStage::Solve) a.stage = AttemptStage::ConstrainedClass;
-      a.kept = false;
-      trail_.push_back(a);
-    }
-  }
-
   const PlanningProblem& problem_;
   SolverOptions options_;
   SolveContext& context_;
   const std::vector<ClassPlan>& survey_plans_;
-  std::vector<Attempt> trail_;
+  std::size_t first_recorded_;
   std::vector<Attempt> tried_;
   int first_iterations_ = 0;
   PlanResult best_;
-  std::size_t kept_ = 0;
-  std::size_t last_kept_ = 0;
+  std::optional<std::size_t> kept_;        ///< the best plan's attempt in the context's trail
+  std::optional<std::size_t> last_kept_;   ///< the last solve's
   std::optional<std::size_t> best_tried_;  ///< empty: `first` is kept
   int iterations_ = 0;
 };
@@ -170,7 +164,8 @@ class ClassSearch {
 
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
                                     SolveContext& context, const ExtremalSummary& survey,
-                                    const std::vector<ClassPlan>& survey_plans, PlanResult first) {
+                                    const std::vector<ClassPlan>& survey_plans, PlanResult first,
+                                    std::size_t first_recorded) {
   // A class that converged answers: solving the others costs more than the whole request on
   // a constrained scene (measured, min_time_keep_out.yaml at N = 128 and 1.05 T*: 9 → 69 ms, the
   // other classes infeasible on the survey grid after hundreds of iterations) for a cheaper plan
@@ -180,7 +175,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
   if (surveyed.classes.size() < 2) return first;
   const std::string first_message = first.message;
-  ClassSearch search(problem, options, context, survey_plans, std::move(first));
+  ClassSearch search(problem, options, context, survey_plans, std::move(first), first_recorded);
   const bool on_requested_grid = surveyed.steps >= problem.steps;
   std::optional<HomotopyClass> cheapest;  // on the survey grid
   PlanResult cheapest_plan;

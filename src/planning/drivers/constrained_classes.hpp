@@ -25,12 +25,14 @@ constexpr double kBetweenNodesSlack = 1e-3;
 /// class `survey` (the unconstrained solve's structured extremal) solved is solved under the
 /// constraints on its survey grid (the requested grid if that is no finer), and the cheapest there
 /// carried to the requested grid by a solve in its class. The result's extremal lists each class
-/// tried (stage constrained_class) after the survey's attempts; its attempts append each solve's
-/// trail. `first` is returned as it is when the survey solved no other class. A class with a plan
-/// in `survey_plans` (solveWithNewton's) on the grid of its solve starts from it: its
-/// unconstrained Newton solve is not run again (SolverOptions::unconstrained_optimum).
+/// tried (stage constrained_class) after the survey's attempts; its attempts are the context's
+/// from `first_recorded` (where `first`'s began), the best plan's attempt kept. `first` is returned
+/// as it is when the survey solved no other class. A class with a plan in `survey_plans`
+/// (solveWithNewton's) on the grid of its solve starts from it: its unconstrained Newton solve is
+/// not run again (SolverOptions::unconstrained_optimum).
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
                                     SolveContext& context, const ExtremalSummary& survey,
-                                    const std::vector<ClassPlan>& survey_plans, PlanResult first);
+                                    const std::vector<ClassPlan>& survey_plans, PlanResult first,
+                                    std::size_t first_recorded);
 
 }  // namespace attitude_planner

@@ -45,19 +45,12 @@ std::string tStarKind(const PlanResult& r) {
              : "minimum time, the least duration found feasible: an upper bound";
 }
 
-/// `before`, none kept, then `after`: one trail in the order the attempts ran.
-std::vector<Attempt> joined(std::vector<Attempt> before, const std::vector<Attempt>& after) {
-  for (Attempt& a : before) a.kept = false;
-  before.insert(before.end(), after.begin(), after.end());
-  return before;
-}
-
-/// `attempts` appended to `trail`, none kept but its kept one if `keep`.
-void appendTrail(const std::vector<Attempt>& attempts, bool keep, std::vector<Attempt>* trail) {
-  for (Attempt a : attempts) {
-    a.kept = a.kept && keep;
-    trail->push_back(a);
-  }
+/// The kept attempt of the context's trail if it is one recorded from `first` on (a sub-solve's
+/// kept attempt, read after it returned).
+std::optional<std::size_t> keptSince(const SolveContext& context, std::size_t first) {
+  const std::optional<std::size_t> kept = context.keptAttempt();
+  if (kept && *kept >= first) return kept;
+  return std::nullopt;
 }
 
 /// fourth_order's minimum-time answer keeps its two second_order plans at T* (each meeting its
@@ -96,19 +89,20 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
                                SolveContext& context) {
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
+  const std::size_t first = context.attempts().size();
   const PlanResult coarse = planFromMinimumTimePlan(sub, T, pair.coarse, context);
+  const std::optional<std::size_t> coarse_kept = keptSince(context, first);
   PlanResult fine;
   if (coarse.converged()) {
     sub.steps = 2 * problem.steps;
     fine = planFromMinimumTimePlan(sub, T, pair.fine, context);
   }
-  std::vector<Attempt> trail = joined(coarse.attempts, fine.attempts);
   const frames::RichardsonPair each_from_its_plan{problem.steps, true};
   if (!coarse.converged() || !fine.converged()) {
     PlanResult failed = coarse.converged() ? fine : coarse;
     const int stopped = coarse.converged() ? 2 * problem.steps : problem.steps;
     frameMessage(&failed, frames::PairSolveStopped{each_from_its_plan, stopped});
-    failed.attempts = trail;
+    failed.attempts = context.attemptsFrom(first);
     return failed;
   }
   PlanningProblem at = problem;
@@ -119,11 +113,8 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
   result.message =
       renderFrame(frames::PairCombined{each_from_its_plan, replaced, fine.message}, coarse.message);
-  if (replaced) {  // the N solve's plan is the one returned
-    trail = coarse.attempts;
-    appendTrail(fine.attempts, false, &trail);
-  }
-  result.attempts = trail;
+  if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
+  result.attempts = context.attemptsFrom(first);
   return result;
 }
 
@@ -153,36 +144,39 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   coarse_problem.time_margin = 0.0;
   PlanningProblem fine_problem = coarse_problem;
   fine_problem.steps = 2 * N;
+  const std::size_t first = context.attempts().size();
   PlanResult fine = minimumTimePlan(fine_problem, context);
+  const std::optional<std::size_t> fine_kept = keptSince(context, first);
   const auto failed = [&](PlanResult sub, bool at_fine, bool effort_at_minimum_time) {
     sub.scheme = SchemeKind::FourthOrder;
     frameMessage(&sub, frames::MinimumTimePairStopped{N, at_fine, effort_at_minimum_time});
     return sub;
   };
   if (!fine.converged()) return failed(fine, true, false);
+  const std::size_t coarse_first = context.attempts().size();
   PlanResult coarse = minimumTimePlan(coarse_problem, context);
+  const std::optional<std::size_t> coarse_kept = keptSince(context, coarse_first);
   if (!coarse.converged()) return failed(coarse, false, false);
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
   const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
   const double T_N = coarse.minimum_duration, T_2N = fine.minimum_duration;
   const MinimumTimeCertificate certificate = (fine_binds ? fine : coarse).minimum_time;
   const int solves = fine.minimum_time.solves + coarse.minimum_time.solves;
-  const std::vector<Attempt> fine_trail = fine.attempts, coarse_trail = coarse.attempts;
   // The other one's minimum-effort plan at T* (at its own T*: its plan already).
-  std::vector<Attempt> other_trail;
+  std::optional<std::size_t> other_kept;
   PlanResult& other = fine_binds ? coarse : fine;
   if (other.minimum_duration < T_star) {
-    const SolveContext::Scope scope(context, AttemptStage::MinimumTimePolish,
-                                    homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
-    PlanResult at_T_star = planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem,
-                                                   T_star, other.maneuver, context);
-    other_trail = at_T_star.attempts;
+    const std::size_t other_first = context.attempts().size();
+    PlanResult at_T_star = [&] {
+      const SolveContext::Scope scope(context, AttemptStage::MinimumTimePolish,
+                                      homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
+      return planFromMinimumTimePlan(fine_binds ? coarse_problem : fine_problem, T_star,
+                                     other.maneuver, context);
+    }();
+    other_kept = keptSince(context, other_first);
     if (!at_T_star.converged()) {
-      std::vector<Attempt> trail;
-      appendTrail(fine_trail, false, &trail);
-      appendTrail(coarse_trail, false, &trail);
-      appendTrail(other_trail, false, &trail);
-      at_T_star.attempts = trail;
+      context.restoreKept(std::nullopt);
+      at_T_star.attempts = context.attemptsFrom(first);
       return failed(at_T_star, !fine_binds, true);
     }
     other = at_T_star;
@@ -195,16 +189,14 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   result.minimum_duration = T_star;
   result.minimum_time = certificate;
   result.minimum_time.solves = solves;
-  // Kept: the plan returned, the binding one's (the combination) or the N plan's (replaced).
-  const bool keep_fine = fine_binds && !replaced;
-  const bool keep_coarse_solve = !fine_binds && replaced;
-  appendTrail(fine_trail, keep_fine, &result.attempts);
-  appendTrail(coarse_trail, keep_coarse_solve, &result.attempts);
-  for (Attempt a : other_trail) {
-    a.kept = a.kept && fine_binds && replaced;
-    a.stage = AttemptStage::MinimumTimePolish;
-    result.attempts.push_back(a);
+  // Kept: the plan returned, the binding one's (the combination) or the N plan's (replaced):
+  // the 2N minimum time's, the N minimum time's, or the N plan's polish at T*.
+  if (fine_binds) {
+    context.restoreKept(replaced ? other_kept : fine_kept);
+  } else {
+    context.restoreKept(replaced ? coarse_kept : std::nullopt);
   }
+  result.attempts = context.attemptsFrom(first);
   result.message = renderFrame(
       frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced, fine.message},
       coarse.message);
@@ -243,21 +235,23 @@ struct ProbeSteps {
   }
 };
 
-/// The answer from a probe at `effort.duration` that found a plan (`below`): the free-time KKT
-/// point from its plan where one lies lower, else the probe's plan as an upper bound on T*.
+/// The answer from a probe at `effort.duration` that found a plan (`below`, its attempt kept
+/// `below_kept`): the free-time KKT point from its plan where one lies lower, else the probe's
+/// plan as an upper bound on T*. Its trail: the context's from `first`.
 PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
-                       PlanResult answer, const PlanResult& below, SolveContext& context) {
-  std::vector<Attempt> tried;
+                       const PlanResult& answer, const PlanResult& below,
+                       std::optional<std::size_t> below_kept, std::size_t first,
+                       SolveContext& context) {
   std::optional<PlanResult> lower =
-      freeTimeFromPlan(problem, below.maneuver, effort.duration, context, &tried);
+      freeTimeFromPlan(problem, below.maneuver, effort.duration, context);
   if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
-    lower->attempts = joined(joined(answer.attempts, below.attempts), lower->attempts);
+    lower->attempts = context.attemptsFrom(first);
     addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
     return *lower;
   }
   PlanResult upper = below;
-  upper.attempts = joined(answer.attempts, below.attempts);
-  appendTrail(lower ? lower->attempts : tried, false, &upper.attempts);
+  context.restoreKept(below_kept);
+  upper.attempts = context.attemptsFrom(first);
   upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
   upper.minimum_time.solves = answer.minimum_time.solves;
@@ -271,8 +265,9 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
 /// with spinning ends is probed: cold minimum-effort solves below T* (ProbeSteps); where one
 /// finds a plan (provesFeasible), the free-time solve from it descends to a lower KKT point or
 /// its plan is the answer, an upper bound. No probe goes below the proven bound T_c on the grid.
-/// The trail keeps every probe.
-PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, SolveContext& context) {
+/// The trail keeps every probe (the context's from `first`, where `answer`'s began).
+PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
+                       SolveContext& context) {
   const double floor =
       discreteDurationLowerBound(durationLowerBound(problem), problem.steps);  // 0: no bound
   ProbeSteps steps;
@@ -282,14 +277,18 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, SolveC
     effort.time_margin = 0.0;
     effort.duration = std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor);
     if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
+    const std::optional<std::size_t> answer_kept = context.keptAttempt();
+    const std::size_t probe_first = context.attempts().size();
     const PlanResult below = runInternalPhase(
         "the probe below T*", [&] { return planAtResolution(effort, context.options(), context); });
     if (!provesFeasible(effort, below)) {
-      appendTrail(below.attempts, false, &answer.attempts);
+      context.restoreKept(answer_kept);
+      answer.attempts = context.attemptsFrom(first);
       if (!steps.nothingFound()) break;
       continue;
     }
-    answer = lowerAnswer(problem, effort, std::move(answer), below, context);
+    answer = lowerAnswer(problem, effort, answer, below, keptSince(context, probe_first), first,
+                         context);
     steps.found(answer.minimum_duration < effort.duration);
   }
   return answer;
@@ -307,9 +306,10 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
   if (problem.scheme == SchemeKind::FourthOrder) {
     return fourthOrderMinimumTime(problem, context, pair);
   }
+  const std::size_t first = context.attempts().size();
   PlanResult answer = structuredMinimumTime(problem, context);
   if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
-  return probedBelow(problem, std::move(answer), context);
+  return probedBelow(problem, std::move(answer), first, context);
 }
 
 /// One start twist of a pointing request (`posed`: R_N at the start twist): the fixed-attitude
@@ -321,19 +321,21 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
 PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
   PlanningProblem fixed = posed;
   fixed.end_condition = EndCondition();
+  const std::size_t first = context.attempts().size();
   const PlanResult at_twist = minimumTimePlan(fixed, context);
   if (at_twist.converged() &&
       at_twist.maneuver.attitude.size() == static_cast<std::size_t>(posed.steps) + 1) {
     std::optional<PlanResult> freed =
         freeTimeFromPlan(posed, at_twist.maneuver, at_twist.minimum_duration, context);
     if (freed && freed->converged()) {
-      freed->attempts = joined(at_twist.attempts, freed->attempts);
+      freed->attempts = context.attemptsFrom(first);
       freed->minimum_time.solves += at_twist.minimum_time.solves;
       return *freed;
     }
   }
+  context.restoreKept(std::nullopt);  // the plan returned is the one from the free twist
   PlanResult free_start = minimumTimePlan(posed, context);
-  free_start.attempts = joined(at_twist.attempts, free_start.attempts);
+  free_start.attempts = context.attemptsFrom(first);
   free_start.minimum_time.solves += at_twist.minimum_time.solves;
   return free_start;
 }
@@ -352,34 +354,34 @@ PlanResult minimumTimeOverTwists(const PlanningProblem& problem, SolveContext& c
 PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
-  std::vector<Attempt> free_time_trail;
+  const std::size_t first = context.attempts().size();
   if (unsupported.empty()) {
-    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, context, &free_time_trail);
+    std::optional<PlanResult> free_time = freeTimeMinimumTime(problem, context);
     if (free_time && free_time->converged()) return *free_time;
-    if (free_time) free_time_trail = free_time->attempts;
     why = free_time ? "the free-time plan's replay failed" : "no free-time solve converged";
   } else {
     why = "the free-time interior point does not take " + unsupported + " yet";
   }
+  context.restoreKept(std::nullopt);  // a free-time plan whose replay failed is not the answer
   PlanResult result = searchMinimumTime(problem, context);
   addNote(&result, notes::SearchedOnT{why});
-  result.attempts = joined(free_time_trail, result.attempts);
+  result.attempts = context.attemptsFrom(first);
   if (!unsupported.empty() || !result.converged() ||
       result.maneuver.attitude.size() != static_cast<std::size_t>(problem.steps) + 1) {
     return result;
   }
   // The search's plan meets every bound at its T (an upper bound on T*): started from it, one
   // free-time solve can reach a KKT point at or below it where the structured starts did not.
-  std::vector<Attempt> sharpening_trail;
-  std::optional<PlanResult> sharpened = freeTimeFromPlan(
-      problem, result.maneuver, result.minimum_duration, context, &sharpening_trail);
-  if (sharpened && !sharpened->converged()) sharpening_trail = sharpened->attempts;
+  const std::optional<std::size_t> search_kept = context.keptAttempt();
+  std::optional<PlanResult> sharpened =
+      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration, context);
   if (!sharpened || !sharpened->converged()) {
     // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
-    appendTrail(sharpening_trail, false, &result.attempts);
+    context.restoreKept(search_kept);
+    result.attempts = context.attemptsFrom(first);
     return result;
   }
-  sharpened->attempts = joined(result.attempts, sharpened->attempts);
+  sharpened->attempts = context.attemptsFrom(first);
   addNote(&*sharpened, notes::SharpenedFromSearch{why, result.minimum_duration});
   return *sharpened;
 }
@@ -405,6 +407,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   }
   const auto start = std::chrono::steady_clock::now();
   RichardsonPair pair;
+  const std::size_t first = context.attempts().size();
   PlanResult result = runInternalPhase(
       "minimum time", [&] { return minimumTimeOverTwists(problem, context, &pair); });
   recordLowerBound(bound, &result);
@@ -419,8 +422,13 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
     return result;
   }
   if (problem.time_margin > 0.0) {
-    const std::vector<Attempt> search_trail = result.attempts;
+    // A pointing request's minimum-time trail carries each start's twist (pointingMinimumTime),
+    // which the context's does not.
+    const std::vector<Attempt> minimum_time_trail =
+        problem.end_condition.pointing() ? result.attempts : std::vector<Attempt>{};
+    const std::size_t margin_first = context.attempts().size();
     const Maneuver at_minimum_time = result.maneuver;
+    context.restoreKept(std::nullopt);  // the plan returned is the one at the margin
     result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
       const SolveContext::Scope scope(context, AttemptStage::MinimumTimeMargin,
                                       homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
@@ -428,13 +436,14 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
                                  pair, context);
     });
     recordLowerBound(bound, &result);
-    std::vector<Attempt> attempts = search_trail;
-    for (Attempt& a : attempts) a.kept = false;
-    for (Attempt a : result.attempts) {
-      a.stage = AttemptStage::MinimumTimeMargin;
-      attempts.push_back(a);
+    if (problem.end_condition.pointing()) {
+      result.attempts = minimum_time_trail;
+      for (Attempt& a : result.attempts) a.kept = false;
+      const std::vector<Attempt> margin = context.attemptsFrom(margin_first);
+      result.attempts.insert(result.attempts.end(), margin.begin(), margin.end());
+    } else {
+      result.attempts = context.attemptsFrom(first);
     }
-    result.attempts = attempts;
     addNote(&result, notes::PlannedAtMargin{problem.time_margin, result.duration, T_star});
   }
   result.minimum_duration = T_star;
@@ -467,27 +476,26 @@ constexpr int kLadderRungs = 24;
 
 /// Where the duration ladder got: the plan at the requested T if it converged there, else the
 /// last solve's; `reached` the longest duration at which a rung converged within the bounds;
-/// every rung's attempts, the last rung's kept one marked.
+/// `solves` its rungs' solves (each recorded in the context, stage duration_ladder).
 struct LadderClimb {
   PlanResult plan;
   double reached = 0.0;
-  std::vector<Attempt> attempts;
+  int solves = 0;
 };
 
 /// One rung: minimum effort at the stage's T from the last rung's plan, continued once from its
 /// own iterate where the iteration limit stopped it inside the bounds (the reduced problem's
 /// iterates meet the dynamics and the boundary data, so such an iterate is a start).
 PlanResult ladderRung(const PlanningProblem& rung, const Maneuver& from, SolveContext& context,
-                      std::vector<Attempt>* trail) {
+                      int* solves) {
   const auto solve = [&](const Maneuver& start) {
     const SolveContext::Scope scope(context, AttemptStage::DurationLadder, homotopyClassOf(rung),
                                     SolveContext::Nested::ScopeStage);
-    PlanResult r = runInternalPhase("a rung of the duration ladder", [&] {
+    context.restoreKept(std::nullopt);  // only the last rung's plan can be kept
+    ++*solves;
+    return runInternalPhase("a rung of the duration ladder", [&] {
       return planFromMinimumTimePlan(rung, rung.duration, start, context);
     });
-    for (Attempt& a : *trail) a.kept = false;  // only the last rung's plan can be kept
-    appendTrail(r.attempts, true, trail);
-    return r;
   };
   PlanResult r = solve(from);
   if (r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
@@ -526,11 +534,10 @@ LadderClimb climbDurationLadder(const PlanningProblem& problem, const PlanResult
       },
       schedule,
       [&](const PlanningProblem& rung, const Maneuver* from) {
-        return from ? ladderRung(rung, *from, context, &climb.attempts) : minimum_time;
+        return from ? ladderRung(rung, *from, context, &climb.solves) : minimum_time;
       });
   climb.plan = staged.plan;
   climb.reached = staged.reached > 0.0 ? duration(staged.reached) : 0.0;
-  for (Attempt& a : climb.attempts) a.stage = AttemptStage::DurationLadder;
   return climb;
 }
 
@@ -571,21 +578,26 @@ void labelStuckAnswer(const PlanningProblem& problem, double T_star, const Ladde
 /// there, else `first` with what was tried.
 PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult& first,
                                const std::string& why, const PlanResult& minimum_time,
-                               const RichardsonPair& pair, SolveContext& context) {
+                               const RichardsonPair& pair, std::optional<std::size_t> first_kept,
+                               SolveContext& context) {
   const double T_star = minimum_time.minimum_duration;
+  context.restoreKept(std::nullopt);  // the plans at T follow
+  const std::size_t direct_first = context.attempts().size();
   const PlanResult direct = [&] {
     const SolveContext::Scope scope(context, AttemptStage::ConstrainedRetry,
                                     homotopyClassOf(problem), SolveContext::Nested::ScopeStage);
     return planFromMinimumTime(problem, problem.duration, minimum_time.maneuver, pair, context);
   }();
+  const std::optional<std::size_t> direct_kept = keptSince(context, direct_first);
   const LadderClimb climb = climbIfStuck(problem, direct, minimum_time, context);
   const bool from_ladder = climb.plan.converged() && climb.reached == problem.duration;
   PlanResult again = from_ladder ? climb.plan : direct;
   const notes::MinimumTimeRestart restart{
-      T_star, why, from_ladder, direct.termination, !climb.attempts.empty(), climb.reached};
+      T_star, why, from_ladder, direct.termination, climb.solves > 0, climb.reached};
   const bool was_infeasible = first.termination == Termination::Infeasible;
   if (!again.converged() && !was_infeasible) {
     // Nothing better than the first answer: it stays, with what was tried.
+    context.restoreKept(first_kept);
     PlanResult kept = first;
     addNote(&kept, restart);
     addNote(&kept, notes::RestartEnded{again.termination, again.message});
@@ -594,16 +606,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
   if (again.termination == Termination::Infeasible)
     labelStuckAnswer(problem, T_star, climb, &again);
   addNote(&again, restart);
-  std::vector<Attempt> attempts = first.attempts;
-  appendTrail(minimum_time.attempts, false, &attempts);
-  for (Attempt a : direct.attempts) {
-    a.stage = AttemptStage::ConstrainedRetry;
-    a.start = AttemptStart::WarmStart;
-    a.kept = a.kept && !from_ladder;
-    attempts.push_back(a);
-  }
-  appendTrail(climb.attempts, from_ladder, &attempts);
-  again.attempts = attempts;
+  if (!from_ladder) context.restoreKept(direct_kept);  // else the last rung's is kept
   return again;
 }
 
@@ -619,7 +622,9 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   const DurationLowerBound bound = durationLowerBound(problem);
   if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
   const auto start = std::chrono::steady_clock::now();
+  const std::size_t first = context.attempts().size();
   PlanResult result = planAtResolution(problem, context.options(), context);
+  const std::optional<std::size_t> first_kept = keptSince(context, first);
   recordLowerBound(bound, &result);
   const std::string why = needsMinimumTimeStart(problem, result);
   if (why.empty() || !std::isfinite(torqueAuthority(problem).smallest_about_any_axis) ||
@@ -636,7 +641,13 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   RichardsonPair pair;
   const PlanResult minimum_time = runInternalPhase(
       "the minimum-time phase", [&] { return minimumTimeOverTwists(fastest, context, &pair); });
+  context.restoreKept(first_kept);  // the first answer's, until a plan from T* replaces it
+  // Every answer below has the whole trail: the first solve's, the minimum-time phase's, the
+  // plans from T*'s (the context's from `first`), the first solve's attempt kept unless a later
+  // plan is returned. A pointing request's minimum-time attempts carry twists the context's do
+  // not: it keeps the first solve's trail.
   const auto finish = [&](PlanResult r) {
+    if (!problem.end_condition.pointing()) r.attempts = context.attemptsFrom(first);
     recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     r.solve_time_s =
@@ -669,7 +680,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
     return finish(result);
   }
   return finish(runInternalPhase("the restart from the minimum-time plan", [&] {
-    return fromMinimumTimePlan(problem, result, why, minimum_time, pair, context);
+    return fromMinimumTimePlan(problem, result, why, minimum_time, pair, first_kept, context);
   }));
 }
 

@@ -98,7 +98,7 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
 class FreeTimeMinimumTime {
  public:
   FreeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context)
-      : problem_(problem), context_(context) {}
+      : problem_(problem), context_(context), first_recorded_(context.attempts().size()) {}
 
   std::optional<PlanResult> run() {
     const bool rest_to_rest =
@@ -127,9 +127,6 @@ class FreeTimeMinimumTime {
     return answerAt(*refined, "coarse grid (N = " + std::to_string(coarsest.steps) + ", " +
                                   kept.name + "), refined by 2 at a time");
   }
-
-  /// Every free-time solve run so far (for the caller's trail when none gave the answer).
-  const std::vector<Attempt>& trail() const { return trail_; }
 
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
   /// duration, e.g. the search's): its KKT point if it converged at or below that T.
@@ -174,6 +171,7 @@ class FreeTimeMinimumTime {
     if (!o.maneuver.attitude.empty()) a.cost = o.duration;
     a.start_detail = detail;
     trail_.push_back(a);
+    context_.record(a);
     ++solves_;
     return o;
   }
@@ -472,6 +470,7 @@ class FreeTimeMinimumTime {
     at.duration = answer.duration;
     PlanResult result = freeTimePlan(at, answer);
     if (!trail_.empty()) trail_[best_attempt_].kept = true;
+    if (!trail_.empty()) context_.markKept(first_recorded_ + best_attempt_);
     std::ostringstream note;
     note << "minimum time T* = " << answer.duration
          << " s: a KKT point of the discrete minimum-time problem, "
@@ -502,7 +501,7 @@ class FreeTimeMinimumTime {
     result.minimum_time.solves = solves_;
     result.minimum_time.second_order_sufficient = answer.second_order_sufficient;
     recordTwist(at, answer, &result);
-    result.attempts = trail_;
+    result.attempts = context_.attemptsFrom(first_recorded_);
     result.levels = levels_;
     return result;
   }
@@ -542,6 +541,7 @@ class FreeTimeMinimumTime {
 
   const PlanningProblem& problem_;
   SolveContext& context_;
+  std::size_t first_recorded_;        ///< where its solves begin in the context's trail
   std::vector<StartRecord> starts_;   ///< every start solved (or repeated), in order
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
@@ -598,21 +598,14 @@ std::vector<PlanningProblem> freeTimeLevels(const PlanningProblem& problem) {
   return levels;
 }
 
-std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context,
-                                              std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, context);
-  std::optional<PlanResult> answer = solver.run();
-  if (!answer && tried) *tried = solver.trail();
-  return answer;
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
+                                              SolveContext& context) {
+  return FreeTimeMinimumTime(problem, context).run();
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context,
-                                           std::vector<Attempt>* tried) {
-  FreeTimeMinimumTime solver(problem, context);
-  std::optional<PlanResult> answer = solver.runFrom(plan, duration, "search's plan");
-  if (!answer && tried) *tried = solver.trail();
-  return answer;
+                                           double duration, SolveContext& context) {
+  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, "search's plan");
 }
 
 }  // namespace attitude_planner

@@ -44,17 +44,16 @@ std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& 
 /// The minimum-time plan from the free-time solves: the kept plan at T* (minimum_time.kkt_point
 /// true, the KKT residuals in minimum_time, every solve in attempts, the free-time levels first in
 /// levels), or empty if no start converged or a refined level did not (the caller falls back to
-/// the search; `tried`, if given, then receives the free-time solves that ran, for its trail).
-std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem, SolveContext& context,
-                                              std::vector<Attempt>* tried = nullptr);
+/// the search). Every solve is recorded in the context's trail, the one returned kept.
+std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
+                                              SolveContext& context);
 
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
 /// `duration` (the search's answer where the structured starts did not converge): its
-/// KKT point if it converged at or below `duration`, else empty (`tried`, if given, then receives
-/// its solve, for the caller's trail).
+/// KKT point if it converged at or below `duration`, else empty (its solve is in the context's
+/// trail either way).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context,
-                                           std::vector<Attempt>* tried = nullptr);
+                                           double duration, SolveContext& context);
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
 /// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a

@@ -66,18 +66,26 @@ class MinimumTimeSearch {
   PlanResult run() {
     const double guess =
         problem_.duration > 0 ? problem_.duration : eigenaxisDurationGuess(problem_);
-    searchFromCoarseGrid();
-    const bool searched_coarse = !outcomes_.empty() && outcomes_.back().feasible;
-    if (!searched_coarse) {
-      outcomes_.push_back(search("continuation", nullptr, guess));
-      outcomes_.back().detail.duration = guess;
+    SearchOutcome* found = nullptr;
+    {
+      // The probes' own attempts are parts of the search's: it records one per start (below).
+      const SolveContext::Aside probes(context_);
+      searchFromCoarseGrid();
+      const bool searched_coarse = !outcomes_.empty() && outcomes_.back().feasible;
+      if (!searched_coarse) {
+        outcomes_.push_back(search("continuation", nullptr, guess));
+        outcomes_.back().detail.duration = guess;
+      }
+      if (!searched_coarse && isRestToRest()) searchStructuredStarts();
+      found = leastFeasible();
+      if (found) bisect(found);
     }
-    if (!searched_coarse && isRestToRest()) searchStructuredStarts();
-    SearchOutcome* found = leastFeasible();
-    if (found) bisect(found);
     for (const SearchOutcome& o : outcomes_) solves_ += o.solves;
-    if (!found) return noneFeasible(guess);
-    return atMinimumTime(*found);
+    const std::size_t first = context_.attempts().size();
+    for (const Attempt& a : trail()) context_.record(a);
+    if (!found) return noneFeasible(guess, first);
+    context_.markKept(first + static_cast<std::size_t>(found - outcomes_.data()));
+    return atMinimumTime(*found, first);
   }
 
  private:
@@ -243,7 +251,7 @@ class MinimumTimeSearch {
     return found;
   }
 
-  PlanResult noneFeasible(double guess) const {
+  PlanResult noneFeasible(double guess, std::size_t first) const {
     PlanResult none;
     if (stopped_) {
       none.termination = *stopped_;
@@ -259,7 +267,7 @@ class MinimumTimeSearch {
       none.termination = Termination::Infeasible;
       recordVerdict(&none, verdicts::SearchInfeasible{kMaxDoublings, guess});
     }
-    none.attempts = trail();
+    none.attempts = context_.attemptsFrom(first);
     return none;
   }
 
@@ -281,7 +289,7 @@ class MinimumTimeSearch {
     return attempts;
   }
 
-  PlanResult atMinimumTime(const SearchOutcome& found) const {
+  PlanResult atMinimumTime(const SearchOutcome& found, std::size_t first) const {
     PlanResult result = found.best;
     if (!result.converged()) {
       // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
@@ -290,10 +298,7 @@ class MinimumTimeSearch {
       recordVerdict(&result, verdicts::FeasibleAtMinimumTime{found.T_hi});
     }
     result.minimum_duration = found.T_hi;
-    result.attempts = trail();
-    for (std::size_t i = 0; i < outcomes_.size(); ++i) {
-      result.attempts[i].kept = &outcomes_[i] == &found;
-    }
+    result.attempts = context_.attemptsFrom(first);
     addNote(&result, notes::SearchSummary{searchNote(found)});
     return result;
   }

@@ -99,6 +99,7 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at, cons
     // A start of the free-time solves (a few Newton steps at the coarsest grid), in the request's
     // context: its iterations are reported and numbered with the request's, and its budget and
     // cancel flag stop it (then it gives no start). Its attempts stay out of the answer's trail.
+    const SolveContext::Aside start_only(context);
     const SolveContext::Scope scope(context, AttemptStage::MinimumTimeSolve, c);
     const PlanResult r = solveWithNewton(in_class, options, context);
     if (r.converged()) return r.maneuver.attitude;
@@ -371,6 +372,8 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   for (const PlanningConstraint& c : effort.constraints) {
     if (c.isCone() && !(c.nodeHalfAngle() > 0.0 && c.nodeHalfAngle() < M_PI)) return std::nullopt;
   }
+  // A start, not an attempt: its solves stay out of the answer's trail.
+  const SolveContext::Aside start_only(context);
   try {
     SolverOptions o = context.options();
     o.tolerance = std::max(o.tolerance, kConeClearTolerance);

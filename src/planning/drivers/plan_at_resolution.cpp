@@ -54,18 +54,6 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
   }
 }
 
-/// The trail of a solve that `earlier` attempts led to: those (none kept any more), then the
-/// later solve's own, whose first-stage attempts are marked `stage`.
-std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<Attempt>& later,
-                                AttemptStage stage) {
-  for (Attempt& a : earlier) a.kept = false;
-  for (Attempt a : later) {
-    if (a.stage == AttemptStage::Solve) a.stage = stage;
-    earlier.push_back(a);
-  }
-  return earlier;
-}
-
 /// fourth_order: one Richardson extrapolation step of second_order (docs/design/fourth_order.md),
 /// the combination of the two plans in richardsonCombination (drivers/fourth_order.hpp). Both
 /// solves get the request's solver, constraints, effects and what is left of its time budget; the
@@ -75,19 +63,19 @@ std::vector<Attempt> followedBy(std::vector<Attempt> earlier, const std::vector<
 /// O(h²) attitude guess is an O(1) torque guess; measured 9 Newton iterations instead of 2). The
 /// result converges only if both do; its trail is the N solve's attempts (stage
 /// fourth_order_coarse where they were the solver's own solve), then the 2N solve's
-/// (fourth_order_fine), the 2N solve's kept one kept.
+/// (fourth_order_fine), the 2N solve's kept one kept (the N solve's if it stopped).
 PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& options,
                            SolveContext& context) {
   const int N = problem.steps;
   PlanningProblem sub = problem;
   sub.scheme = SchemeKind::SecondOrder;
   const frames::RichardsonPair pair{N};
-  const PlanResult coarse = planAtResolution(sub, options, context);
-  // The trail: the N solve's attempts, then the 2N solve's (the one kept is the 2N solve's).
-  std::vector<Attempt> trail = followedBy({}, coarse.attempts, AttemptStage::FourthOrderCoarse);
+  const PlanResult coarse = [&] {
+    const SolveContext::Scope scope(context, AttemptStage::FourthOrderCoarse, homotopyClassOf(sub));
+    return planAtResolution(sub, options, context);
+  }();
   const auto failed = [&](PlanResult sub_result, int steps) {
     frameMessage(&sub_result, frames::PairSolveStopped{pair, steps});
-    sub_result.attempts = trail;
     return sub_result;
   };
   if (!coarse.converged()) return failed(coarse, N);
@@ -103,13 +91,14 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
     sub.extra_revolutions = chosen.extra_revolutions;
     fine_options.enumerate_classes = false;
   }
-  const PlanResult fine = planAtResolution(sub, fine_options, context);
-  trail = followedBy(std::move(trail), fine.attempts, AttemptStage::FourthOrderFine);
+  const PlanResult fine = [&] {
+    const SolveContext::Scope scope(context, AttemptStage::FourthOrderFine, homotopyClassOf(sub));
+    return planAtResolution(sub, fine_options, context);
+  }();
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
   result.message = renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message);
-  result.attempts = std::move(trail);
   return result;
 }
 
@@ -149,13 +138,9 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
       options.unconstrained_optimum && options.unconstrained_optimum->steps() == problem.steps;
   if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
   std::vector<ClassPlan> survey_plans;
+  const std::size_t first_recorded = context.attempts().size();
   const SolveContext::IterationTally tally(context);  // Newton, then the interior point
   PlanResult result = solveWithNewton(problem, newton_options, context, &survey_plans);
-  if (solved_before) {
-    for (Attempt& a : result.attempts) {
-      if (a.start == AttemptStart::WarmStart) a.start = AttemptStart::PreviousAttempt;
-    }
-  }
   const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
                                             ? checkConstraints(problem, result.maneuver)
                                             : ConstraintCheck{};
@@ -171,11 +156,9 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   const Maneuver unconstrained_plan = result.maneuver;
   constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
   const std::vector<LevelSummary> newton_levels = result.levels;
-  const std::vector<Attempt> newton_attempts = result.attempts;
   // The interior point keeps the class it starts in: the unconstrained optimum's.
   ExtremalSummary survey = result.extremal_summary;
   result = solveWithInteriorPoint(problem, constrained, context);
-  result.attempts = followedBy(newton_attempts, result.attempts, AttemptStage::Constrained);
   result.iterations = tally.iterations();
   result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
   if (started_from_optimum) addNote(&result, started);
@@ -186,7 +169,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   }
   if (classLeftFree(problem, options)) {
     result = cheapestConstrainedClass(problem, options, context, survey, survey_plans,
-                                      std::move(result));
+                                      std::move(result), first_recorded);
   }
   return result;
 }
@@ -214,6 +197,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     options.warm_start = &on_grid;
   }
   const auto start = std::chrono::steady_clock::now();
+  const std::size_t first_attempt = context.attempts().size();
   PlanResult result;
   // A pointing request is judged (replay, terminal errors) against the end attitude it chose.
   PlanningProblem judged = problem;
@@ -235,7 +219,6 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
       result = solveWithInteriorPoint(problem, options, context);
-      result.attempts = followedBy(first.attempts, result.attempts, AttemptStage::ConstrainedRetry);
       result.iterations = tally.iterations();
       result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
       addNote(&result, notes::AfterGuessStopped{first.message});
@@ -277,6 +260,8 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);
+  // The trail: every attempt the request's solves recorded in the context, in order.
+  result.attempts = context.attemptsFrom(first_attempt);
   refuseAnotherClass(problem, &result);
   if (problem.hasNodeConstraints() && result.maneuver.steps() == problem.steps) {
     const ConstraintCheck check = checkConstraints(problem, result.maneuver);

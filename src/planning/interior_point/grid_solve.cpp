@@ -20,6 +20,7 @@
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/double_double.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 
@@ -375,10 +376,9 @@ class GridSolve final : public PrimalDualProblem {
       msg << reason_;
     }
     result.termination = ending_;
-    msg << " after " << iteration_ << " interior-point iterations (relative Newton decrement "
-        << relative_decrement_ << ", barrier " << mu_ / scales_.f_scale
-        << " x cost, max elastic violation " << system_.maxViolation() << ")";
-    result.message = msg.str();
+    recordVerdict(&result,
+                  verdicts::InteriorPointEnded{msg.str(), iteration_, relative_decrement_,
+                                               mu_ / scales_.f_scale, system_.maxViolation()});
     result.levels.push_back({np_.steps(), iteration_, ending_, result.max_residual,
                              relative_decrement_,
                              std::string(free_slacks_ ? "interior point (free slacks): "
@@ -430,7 +430,7 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
   try {
     reduced.emplace(problem);
   } catch (const StepTooLarge& e) {
-    out.result.message = std::string("boundary velocity: ") + e.what();
+    recordVerdict(&out.result, verdicts::NoBoundaryStep{e.what()});
     out.result.termination = Termination::StepTooLarge;
     return out;
   }
@@ -451,9 +451,7 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
                                 : fixedNodeConeViolation(problem, np, {1, np.steps() - 1});
   if (!fixed.empty()) {
     out.result.termination = Termination::Infeasible;
-    out.result.message = "infeasible: " + fixed +
-                         ", an attitude the boundary velocities fix (increase steps or move the "
-                         "boundary)";
+    recordVerdict(&out.result, verdicts::ConeAtFixedNode{fixed});
     return out;
   }
   return GridSolve<Scalar>(problem, options, parameters, context, request, &np).run();
@@ -474,7 +472,7 @@ GridOutcome carryToGrid(const PlanningProblem& problem,
     reduced.emplace(problem);
   } catch (const StepTooLarge& e) {
     result.termination = Termination::StepTooLarge;
-    result.message = std::string("boundary velocity: ") + e.what();
+    recordVerdict(&result, verdicts::NoBoundaryStep{e.what()});
     return out;
   }
   ReducedProblem& np = *reduced;

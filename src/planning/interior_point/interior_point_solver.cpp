@@ -377,23 +377,26 @@ Attempt attemptOf(const PlanningProblem& problem, const GridOutcome& outcome, At
   return a;
 }
 
-/// Runs one continuation and appends it to `trail` as an attempt (not kept).
+/// Runs one continuation and records it in the context as one attempt (not kept); the levels'
+/// unconstrained starts are parts of it. Returns its index in the context's trail.
 GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options,
                     const Solve& solve, AttemptStage stage, AttemptStart start,
-                    std::vector<Attempt>* trail) {
-  const SolveContext::Scope scope(solve.context, stage, homotopyClassOf(problem));
-  GridOutcome outcome = solveContinued(problem, options, solve);
-  trail->push_back(attemptOf(problem, outcome, stage, start));
+                    std::size_t* recorded_at) {
+  GridOutcome outcome = [&] {
+    const SolveContext::Aside parts(solve.context);
+    const SolveContext::Scope scope(solve.context, stage, homotopyClassOf(problem));
+    return solveContinued(problem, options, solve);
+  }();
+  *recorded_at = solve.context.attempts().size();
+  solve.context.record(attemptOf(problem, outcome, stage, start));
   return outcome;
 }
 
-/// Records the trail in the context, the attempt at `kept` marked as the one returned; returns
-/// it (the solve's PlanResult::attempts).
-std::vector<Attempt> recordTrail(SolveContext& context, std::vector<Attempt> trail,
-                                 std::size_t kept) {
-  if (kept < trail.size()) trail[kept].kept = true;
-  for (const Attempt& a : trail) context.record(a);
-  return trail;
+/// The solve's answer: the attempt at `kept` marked as the one returned, the solve's trail (from
+/// `first`) from the context.
+void keepAttempt(SolveContext& context, std::size_t first, std::size_t kept, PlanResult* result) {
+  context.markKept(kept);
+  result->attempts = context.attemptsFrom(first);
 }
 
 }  // namespace
@@ -402,10 +405,11 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                                   SolveContext& context,
                                   const InteriorPointParameters& parameters) {
   const Solve solve{parameters, context};
-  std::vector<Attempt> trail;
+  const std::size_t first = context.attempts().size();
+  std::size_t at = first;
   const SolveContext::IterationTally tally(context);  // every attempt's
   PlanResult result =
-      attempt(problem, options, solve, AttemptStage::Constrained, startOf(options), &trail).result;
+      attempt(problem, options, solve, AttemptStage::Constrained, startOf(options), &at).result;
   // Pointing cones together with torque or rate limits, from a start inside a cone: the
   // iterate can leave the cone with torques far beyond their bounds and never recover. Retry
   // once in two stages: the cones alone (a path around them), then every constraint from that
@@ -418,7 +422,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                       std::any_of(problem.constraints.begin(), problem.constraints.end(),
                                   [](const PlanningConstraint& c) { return !c.isCone(); });
   if (!stuck || !cones || !others) {
-    result.attempts = recordTrail(context, trail, 0);
+    keepAttempt(context, first, at, &result);
     return result;
   }
   PlanningProblem cones_only = problem;
@@ -426,17 +430,19 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   cones_only.constraints.clear();
   for (const PlanningConstraint& c : problem.constraints)
     if (c.isCone()) cones_only.constraints.push_back(c);
-  const PlanResult around =
-      attempt(cones_only, options, solve, AttemptStage::ConstrainedRetry, startOf(options), &trail)
-          .result;
+  std::size_t around_at = at;
+  const PlanResult around = attempt(cones_only, options, solve, AttemptStage::ConstrainedRetry,
+                                    startOf(options), &around_at)
+                                .result;
   if (!around.converged()) {
-    result.attempts = recordTrail(context, trail, 0);
+    keepAttempt(context, first, at, &result);
     return result;
   }
   SolverOptions staged = options;
   staged.warm_start = &around.maneuver;
+  std::size_t second_at = at;
   PlanResult second = attempt(problem, staged, solve, AttemptStage::ConstrainedRetry,
-                              AttemptStart::PreviousAttempt, &trail)
+                              AttemptStart::PreviousAttempt, &second_at)
                           .result;
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
@@ -446,7 +452,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   appendLevels(&solved_levels, second);
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
   if (take_second) result = second;
-  result.attempts = recordTrail(context, trail, take_second ? 2 : 0);
+  keepAttempt(context, first, take_second ? second_at : at, &result);
   result.iterations = tally.iterations();
   result.levels = solved_levels;
   addNote(&result, notes::RetriedInTwoStages{first_message});
@@ -487,9 +493,9 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   from.constrained_from_warm_start = false;
   GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
   PlanResult result = std::move(outcome.result);
-  result.attempts = recordTrail(
-      context, {attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart)},
-      0);
+  const std::size_t at = context.attempts().size();
+  context.record(attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart));
+  keepAttempt(context, at, at, &result);
   addNote(&result, notes::FromInitialGuess{});
   return result;
 }

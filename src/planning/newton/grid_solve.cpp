@@ -19,6 +19,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -366,10 +367,7 @@ class GridSolver {
 PlanResult finished(PlanResult result, int steps, int iterations, Termination termination,
                     const std::string& reason, double relative_gradient, double decrement) {
   result.termination = termination;
-  std::ostringstream msg;
-  msg << reason << " after " << iterations << " iterations (relative gradient " << relative_gradient
-      << ", relative Newton decrement " << decrement << ")";
-  result.message = msg.str();
+  recordVerdict(&result, verdicts::NewtonEnded{reason, iterations, relative_gradient, decrement});
   result.levels.push_back(
       {steps, iterations, termination, relative_gradient, decrement, result.message});
   return result;
@@ -384,7 +382,8 @@ std::optional<ReducedProblem> startedProblem(const PlanningProblem& problem, con
   } catch (const StepTooLarge& e) {
     *result = finished(*result, problem.steps, 0, Termination::StepTooLarge,
                        std::string("boundary velocity: ") + e.what(), 0.0, 0.0);
-    result->message = result->levels.back().reason = std::string("boundary velocity: ") + e.what();
+    recordVerdict(result, verdicts::NoBoundaryStep{e.what()});
+    result->levels.back().reason = result->message;
     return std::nullopt;
   }
   result->extremal_summary = extremalOf(startOnHermiteCurve(problem, &*reduced));

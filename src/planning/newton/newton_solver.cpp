@@ -611,8 +611,12 @@ void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, 
                               Globalization::TrustRegion};
   const SolveContext::Scope scope(context, AttemptStage::Solve, homotopyClassOf(problem));
   PlanResult r = solveThroughGrids(problem, context, settings, options.warm_start, p);
-  const AttemptStart start =
-      options.warm_start ? AttemptStart::WarmStart : startOf(Method::ThroughGrids, problem, p);
+  // A warm start that is the request's unconstrained optimum solved before (a class solve's
+  // polish) is an earlier attempt's plan.
+  const AttemptStart start = !options.warm_start ? startOf(Method::ThroughGrids, problem, p)
+                             : options.warm_start == options.unconstrained_optimum
+                                 ? AttemptStart::PreviousAttempt
+                                 : AttemptStart::WarmStart;
   const int iterations = r.iterations;
   walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations);
 }

@@ -298,6 +298,28 @@ std::string judged(const verdicts::NloptEnded& v, const std::string&) {
   return message.str();
 }
 
+std::string judged(const verdicts::NewtonEnded& v, const std::string&) {
+  std::ostringstream message;
+  message << v.how << " after " << v.iterations << " iterations (relative gradient "
+          << v.relative_gradient << ", relative Newton decrement " << v.relative_decrement << ")";
+  return message.str();
+}
+std::string judged(const verdicts::InteriorPointEnded& v, const std::string&) {
+  std::ostringstream message;
+  message << v.how << " after " << v.iterations
+          << " interior-point iterations (relative Newton decrement " << v.relative_decrement
+          << ", barrier " << v.barrier << " x cost, max elastic violation "
+          << v.max_elastic_violation << ")";
+  return message.str();
+}
+std::string judged(const verdicts::NoBoundaryStep& v, const std::string&) {
+  return "boundary velocity: " + v.what;
+}
+std::string judged(const verdicts::ConeAtFixedNode& v, const std::string&) {
+  return "infeasible: " + v.violation +
+         ", an attitude the boundary velocities fix (increase steps or move the boundary)";
+}
+
 }  // namespace
 
 std::string renderNote(const Note& note) {

@@ -79,4 +79,20 @@ void SolveContext::markKept(std::size_t index) {
   for (std::size_t i = 0; i < attempts_.size(); ++i) attempts_[i].kept = i == index;
 }
 
+std::optional<std::size_t> SolveContext::keptAttempt() const {
+  for (std::size_t i = 0; i < attempts_.size(); ++i) {
+    if (attempts_[i].kept) return i;
+  }
+  return std::nullopt;
+}
+
+void SolveContext::restoreKept(std::optional<std::size_t> index) {
+  markKept(index.value_or(attempts_.size()));
+}
+
+std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
+  if (first >= attempts_.size()) return {};
+  return {attempts_.begin() + static_cast<std::ptrdiff_t>(first), attempts_.end()};
+}
+
 }  // namespace attitude_planner

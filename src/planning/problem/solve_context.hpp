@@ -151,7 +151,34 @@ class SolveContext : public Interruption {
   /// Marks the attempt at `index` as the one whose plan is returned, clearing the others' mark
   /// (a later solve of the same request, e.g. the interior point after Newton, marks its own).
   void markKept(std::size_t index);
+  /// The kept attempt's index (nothing if none is marked).
+  std::optional<std::size_t> keptAttempt() const;
+  /// Marks `index` kept (as markKept), or with nothing clears every mark: a plan no single
+  /// attempt produced (a combination of two) or an earlier answer kept after later attempts.
+  void restoreKept(std::optional<std::size_t> index);
   const std::vector<Attempt>& attempts() const { return attempts_; }
+  /// The trail of a driver whose attempts began at `first` (attempts().size() when it started).
+  std::vector<Attempt> attemptsFrom(std::size_t first) const;
+
+  /// While alive, the attempts recorded are parts of an enclosing attempt (a level's
+  /// unconstrained start, a start's helper solve, a search's probes, which the search records as
+  /// one attempt per start): when it ends they leave the trail and the kept mark is as before.
+  class Aside {
+   public:
+    explicit Aside(SolveContext& context)
+        : context_(context), first_(context.attempts_.size()), kept_(context.keptAttempt()) {}
+    ~Aside() {
+      context_.attempts_.resize(first_);
+      context_.restoreKept(kept_);
+    }
+    Aside(const Aside&) = delete;
+    Aside& operator=(const Aside&) = delete;
+
+   private:
+    SolveContext& context_;
+    std::size_t first_;
+    std::optional<std::size_t> kept_;
+  };
 
  private:
   SolverOptions request_;

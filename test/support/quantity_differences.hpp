@@ -1,12 +1,14 @@
 // A stage quantity's terms (value, node Jacobian, contracted curvature, and with h free the h
 // column, mixed and hh entries) against central differences of its values along one direction
-// of the node unknowns and in h: the check every quantity's typed suite runs
+// of the node unknowns and in h, and the curvature times a direction against mixed differences
+// along two directions: the check every quantity's typed suite runs
 // (test_stage_constraints, test_reaction_wheels).
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -39,15 +41,16 @@ struct QuantityDifferences {
     out.setCurrent(out.retract(direction, alpha));
     return out;
   }
-  /// δ restricted to the local nodes of instance k (fixed nodes 0).
-  Eigen::Matrix<double, 9, 1> localPart(int k) const {
+  /// δ (`of`: the direction) restricted to the local nodes of instance k (fixed nodes 0).
+  Eigen::Matrix<double, 9, 1> localPart(int k, const Eigen::VectorXd& of) const {
     Eigen::Matrix<double, 9, 1> out = Eigen::Matrix<double, 9, 1>::Zero();
     for (int n = 0; n < support.width; ++n) {
       const int v = np.variableIndex(k + support.node_offset + n);
-      if (v >= 0) out.segment<3>(3 * n) = direction.segment<3>(v);
+      if (v >= 0) out.segment<3>(3 * n) = of.segment<3>(v);
     }
     return out;
   }
+  Eigen::Matrix<double, 9, 1> localPart(int k) const { return localPart(k, direction); }
 
   /// forEachTerms at the current h; returns the instances visited.
   int checkAtFixedTimeStep() const {
@@ -72,6 +75,52 @@ struct QuantityDifferences {
           EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2))) << where;
         });
     return visited;
+  }
+
+  /// The curvature times the direction against mixed central differences: for `count` seeded
+  /// random directions e of the node unknowns, eᵀ(Σ λ_i ∇²q_i)d = ∂²(λᵀq)/∂α∂β of
+  /// q(R exp((α d + β e)^)) at 0 (exponential coordinates at the iterate, as the terms are), which
+  /// holds the Hessian–vector product along every e (dᵀH d alone, checkAtFixedTimeStep's, sees only
+  /// the symmetric part of H along d). Returns the products checked.
+  int checkCurvatureTimesDirection(int count, unsigned seed) const {
+    const double h = np.timeStep(), e = 1e-4;
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> normal;
+    int checked = 0;
+    for (int j = 0; j < count; ++j) {
+      Eigen::VectorXd other(direction.size());
+      for (int i = 0; i < other.size(); ++i) other(i) = normal(rng);
+      const auto at = [&](double a, double b) {
+        ReducedProblem out = np;
+        out.setTimeStep(h);
+        out.setCurrent(out.retract(a * direction + b * other, 1.0));
+        return values(out);
+      };
+      // The mixed difference at steps e and e/2, extrapolated (Richardson): its O(e²) truncation
+      // error, visible on the wheels' quartic ½|q|², goes.
+      const auto mixed = [&](double step) {
+        const std::vector<Vector3> pp = at(step, step), pm = at(step, -step), mp = at(-step, step),
+                                   mm = at(-step, -step);
+        std::vector<double> out;
+        for (std::size_t i = 0; i < pp.size(); ++i)
+          out.push_back(contracted.dot(pp[i] - pm[i] - mp[i] + mm[i]) / (4 * step * step));
+        return out;
+      };
+      const std::vector<double> coarse = mixed(e), fine = mixed(e / 2);
+      quantity.forEachTerms(
+          np, support, [&](int, const Vector3&) { return lambda; },
+          [&](const QuantityTerms& t) {
+            const int i = t.k - support.first_k;
+            // The lower triangle, as the band reads it (BandedSymmetric::addSymmetricBlock).
+            const Eigen::Matrix<double, 9, 1> product =
+                t.curvature.template selfadjointView<Eigen::Lower>() * localPart(t.k, direction);
+            const double fd = (4 * fine[i] - coarse[i]) / 3;
+            EXPECT_NEAR(localPart(t.k, other).dot(product), fd, 1e-5 * (1 + std::abs(fd)))
+                << "k = " << t.k << ", direction " << j;
+            ++checked;
+          });
+    }
+    return checked;
   }
 
   /// forEachTermsWithTimeStep with η = h/scale; returns the instances visited.

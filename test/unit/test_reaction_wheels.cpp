@@ -255,6 +255,12 @@ TEST_P(WheelQuantityDerivatives, TermsMatchCentralDifferencesAtAFixedTimeStep) {
   EXPECT_GE(visited, problem_.steps - 3);
 }
 
+/// The curvature as a Hessian–vector product: three seeded directions against the step direction.
+TEST_P(WheelQuantityDerivatives, CurvatureTimesADirectionMatchesMixedCentralDifferences) {
+  EXPECT_EQ(check().checkCurvatureTimesDirection(3, 29),
+            3 * (support_.last_k - support_.first_k + 1));
+}
+
 /// In η = h/2.5: the h column times the scale, the hh corner times its square.
 TEST_P(WheelQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH) {
   EXPECT_EQ(check().checkWithTimeStep(2.5), support_.last_k - support_.first_k + 1);

@@ -1,6 +1,7 @@
 // The stage constraints (planning/transcription/stage_constraints.hpp): the list one problem
 // builds, each constraint's value and derivatives composed with its quantity's (the chain rule the
-// assemblers apply) against central differences in the node unknowns δ and in the time step h;
+// assemblers apply, and the interior points' chain rule on their rows) against central differences
+// in the node unknowns δ and in the time step h;
 // and minimum time with a keep-out cone or a rate limit (free_time_solver.cpp): a KKT point within
 // the constraints, no slower than the search on T it replaced, and the same in a rotated world.
 #include <gtest/gtest.h>
@@ -19,6 +20,7 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
+#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -386,6 +388,157 @@ TEST(StageConstraints, ChainRuleThroughTheTranscriptionMatchesCentralDifferences
 
 namespace {
 
+/// The rows of every stage constraint of `list` with seeded random multipliers, in one block per
+/// quantity object (the torque's included), as the interior points hold them.
+template <int Entries>
+struct RowsByQuantity {
+  std::vector<ap::ConstraintRows<Entries>> groups;
+  std::vector<std::vector<int>> blocks;
+
+  RowsByQuantity(const ap::StageConstraints& list, const ap::ReducedProblem& np, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> multiplier(0.1, 2.0);
+    std::vector<const ap::StageQuantityModel*> quantities;
+    for (const auto& c : list) {
+      groups.emplace_back(*c, np.firstFreeNode(), np.lastFreeNode());
+      for (ap::ConstraintRow<Entries>& row : groups.back().at) row.z = multiplier(rng);
+      const int i = static_cast<int>(groups.size()) - 1;
+      const auto known = std::find(quantities.begin(), quantities.end(), &c->quantityModel());
+      if (known == quantities.end()) {
+        quantities.push_back(&c->quantityModel());
+        blocks.push_back({i});
+      } else {
+        blocks[known - quantities.begin()].push_back(i);
+      }
+    }
+  }
+  /// contractQuantityRows with the multipliers as they are (no barrier form).
+  ap::QuantityContraction contraction(const std::vector<int>& block) {
+    return [this, &block](int k, const ap::Vector3& q) {
+      return ap::contractQuantityRows(groups, block, k, q,
+                                      [](const auto&, ap::ConstraintRow<Entries>&) {});
+    };
+  }
+};
+
+/// Row `g`'s value at instance k of `at`'s iterate.
+template <int Entries>
+double rowValue(const ap::ConstraintRows<Entries>& g, const ap::ReducedProblem& at, int k) {
+  return g.constraint->value(g.quantity->value(ap::QuantityInputs(at, at.current()), k));
+}
+
+}  // namespace
+
+/// The chain rule both interior points call (interior_point/constraint_assembly.hpp), on the rows
+/// of every quantity object's constraints with seeded random multipliers: each row's gradient
+/// along a direction, and the Lagrangian's curvature −Σ z∇²c along it (the torque's norm bound
+/// carries the c'' term), against central differences of the rows' values.
+TEST(StageConstraints, TheInteriorPointsChainRuleMatchesCentralDifferencesOfTheRows) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    const ap::PlanningProblem p = everyKind(scheme);
+    const ap::StageConstraints list = ap::buildStageConstraints(p);
+    const ap::ReducedProblem np = perturbed(p, 9);
+    RowsByQuantity<9> rows(list, np, 21);
+    std::mt19937 rng(23);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(np.unknowns());
+    for (int i = 0; i < d.size(); ++i) d(i) = normal(rng);
+    const double e = 1e-6, e2 = 1e-4;
+    const auto moved = [&](double alpha) {
+      ap::ReducedProblem out = np;
+      out.setCurrent(np.retract(d, alpha));
+      return out;
+    };
+    const ap::ReducedProblem up = moved(e), down = moved(-e), up2 = moved(e2), down2 = moved(-e2);
+    int instances = 0, expected = 0;
+    for (const std::vector<int>& block : rows.blocks) {
+      const ap::FixedStepRows& first = rows.groups[block.front()];
+      expected += first.support.last_k - first.support.first_k + 1;
+      first.quantity->forEachTerms(
+          np, first.support, rows.contraction(block), [&](const ap::QuantityTerms& t) {
+            Eigen::Matrix<double, 9, 9> curvature;
+            ap::chainQuantityRows(rows.groups, block, t, &curvature);
+            Eigen::Matrix<double, 9, 1> local = Eigen::Matrix<double, 9, 1>::Zero();
+            for (int n = 0; n < first.support.width; ++n) {
+              const int v = np.variableIndex(t.k + first.support.node_offset + n);
+              if (v >= 0) local.segment<3>(3 * n) = d.segment<3>(v);
+            }
+            double fd2 = 0.0;  // −Σ z c along d, second difference
+            for (const int i : block) {
+              const ap::FixedStepRows& g = rows.groups[i];
+              const std::string where = g.constraint->describe() + " k = " + std::to_string(t.k);
+              const double c0 = rowValue(g, np, t.k);
+              EXPECT_NEAR(g.instance(t.k).c, c0, 1e-12 * (1 + std::abs(c0))) << where;
+              const double fd = (rowValue(g, up, t.k) - rowValue(g, down, t.k)) / (2 * e);
+              EXPECT_NEAR(g.instance(t.k).g.dot(local), fd, 1e-6 * (1 + std::abs(fd))) << where;
+              fd2 -= g.instance(t.k).z *
+                     (rowValue(g, up2, t.k) - 2 * c0 + rowValue(g, down2, t.k)) / (e2 * e2);
+            }
+            const double second = local.dot(curvature.selfadjointView<Eigen::Lower>() * local);
+            EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2)))
+                << ap::schemeName(scheme) << " k = " << t.k;
+            ++instances;
+          });
+    }
+    EXPECT_EQ(rows.blocks.size(), 4u) << "torque, rate and two cones";
+    EXPECT_EQ(instances, expected) << "every quantity's instances were visited";
+  }
+}
+
+/// The same chain rule with h free (free time's rows, entry 9 the time step): each row's ∂c/∂h and
+/// the Lagrangian's ∂²/∂h² against central differences in h, rest to rest and with spinning ends
+/// (the boundary paths move R_1, R_{N−1} with h).
+TEST(StageConstraints, TheInteriorPointsChainRuleMatchesCentralDifferencesInTheTimeStep) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    for (const bool spinning : {false, true}) {
+      ap::PlanningProblem p = everyKind(scheme);
+      if (spinning) {
+        p.initial_velocity = ap::Vector3(0.05, -0.03, 0.08);
+        p.final_velocity = ap::Vector3(-0.04, 0.06, 0.02);
+      }
+      const ap::StageConstraints list = ap::buildStageConstraints(p);
+      const ap::ReducedProblem np = perturbed(p, 10);
+      RowsByQuantity<10> rows(list, np, 31);
+      const double h = np.timeStep(), dh = 1e-5 * h;
+      const auto at = [&](double step) {
+        ap::ReducedProblem out = np;
+        out.setTimeStep(step);
+        return out;
+      };
+      const ap::ReducedProblem later = at(h + dh), earlier = at(h - dh);
+      int instances = 0, expected = 0;
+      for (const std::vector<int>& block : rows.blocks) {
+        const ap::FreeTimeRows& first = rows.groups[block.front()];
+        expected += first.support.last_k - first.support.first_k + 1;
+        first.quantity->forEachTermsWithTimeStep(
+            np, first.support, 1.0, rows.contraction(block),
+            [&](const ap::QuantityTermsWithTimeStep& t) {
+              Eigen::Matrix<double, 10, 10> curvature;
+              ap::chainQuantityRows(rows.groups, block, t, &curvature);
+              double fd_hh = 0.0;  // −Σ z c in h, second difference
+              for (const int i : block) {
+                const ap::FreeTimeRows& g = rows.groups[i];
+                const std::string where = g.constraint->describe() + " k = " + std::to_string(t.k);
+                const double c0 = rowValue(g, np, t.k);
+                const double fd = (rowValue(g, later, t.k) - rowValue(g, earlier, t.k)) / (2 * dh);
+                EXPECT_NEAR(g.instance(t.k).g(9), fd, 1e-6 * (1 + std::abs(fd))) << where;
+                fd_hh -= g.instance(t.k).z *
+                         (rowValue(g, later, t.k) - 2 * c0 + rowValue(g, earlier, t.k)) / (dh * dh);
+              }
+              EXPECT_NEAR(curvature(9, 9), fd_hh, 1e-4 * (1 + std::abs(fd_hh)))
+                  << ap::schemeName(scheme) << " k = " << t.k;
+              ++instances;
+            });
+      }
+      EXPECT_EQ(instances, expected);
+    }
+  }
+}
+
+namespace {
+
 /// sun_keep_out's body and cone as a minimum-time problem under |τ_i| ≤ 0.2 N m.
 ap::PlanningProblem minimumTimeWithCone(ap::SchemeKind scheme, int steps) {
   ap::PlanningProblem p = scene("sun_keep_out", steps);
@@ -571,6 +724,19 @@ TEST_P(StageQuantityDerivatives, TermsMatchCentralDifferencesAtAFixedTimeStep) {
   const ap::test_support::QuantityDifferences check{*quantity_, *np_,         support_, direction_,
                                                     lambda_,    contracted(), 1e-13};
   EXPECT_EQ(check.checkAtFixedTimeStep(), support_.last_k - support_.first_k + 1);
+}
+
+/// The curvature as a Hessian–vector product (three seeded directions against the step
+/// direction) at three seeded random iterates.
+TEST_P(StageQuantityDerivatives, CurvatureTimesADirectionMatchesMixedCentralDifferences) {
+  for (const int seed : {5, 6, 7}) {
+    const ap::ReducedProblem np = perturbed(problem_, seed);
+    const ap::test_support::QuantityDifferences check{
+        *quantity_, np, support_, direction_, lambda_, contracted(), 1e-13};
+    EXPECT_EQ(check.checkCurvatureTimesDirection(3, 100 + seed),
+              3 * (support_.last_k - support_.first_k + 1))
+        << "iterate seed " << seed;
+  }
 }
 
 TEST_P(StageQuantityDerivatives, TermsWithTheTimeStepMatchCentralDifferencesInH) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/multiplier_estimate.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/transcription/node_constraints.hpp"
@@ -243,37 +244,24 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
-/// The groups of one quantity (a rate, a cone) through the quantity's terms: c(q) and the
-/// multipliers in the contraction, λ = −Σ z c'(q); then ∇c = Jᵀc'(q), and −Σ z∇²c = λ·∇²q (the
-/// quantity's curvature) − Σ z c'' JᵀJ (the constraints' isotropic curvature), with each
-/// constraint's barrier term g gᵀ/D.
+/// The groups of one quantity (a rate, a cone, a wheel quantity) through the quantity's terms and
+/// the chain rule (constraint_assembly.hpp), with each constraint's barrier term g gᵀ/D.
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, BandedSymmetric<Scalar>* H) {
   const FixedStepRows& first = groups_[block.front()];
   const StageSupport support = first.support;
+  const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
+    if (H) form_->prepare(in, mu, rho, primal);
+  };
   const auto contract = [&](int k, const Vector3& q) {
     pollEvery(k);
-    Vector3 lambda = Vector3::Zero();
-    for (const int i : block) {
-      FixedStepRow& in = groups_[i].instance(k);
-      in.c = groups_[i].constraint->value(q);
-      if (H) form_->prepare(in, mu, rho, primal);
-      lambda -= in.z * groups_[i].constraint->gradient(q);
-    }
-    return lambda;
+    return contractQuantityRows(groups_, block, k, q, prepare);
   };
   const auto visit = [&](const QuantityTerms& t) {
     const int node = t.k + support.node_offset;
-    Eigen::Matrix<double, 9, 9> curvature = t.curvature;
-    for (const int i : block) {
-      const StageConstraint& c = *groups_[i].constraint;
-      FixedStepRow& in = groups_[i].instance(t.k);
-      in.g = t.jacobian.transpose() * c.gradient(t.value);
-      if (H && c.curvature() != 0.0) {
-        curvature -= (in.z * c.curvature()) * t.jacobian.transpose() * t.jacobian;
-      }
-    }
+    Eigen::Matrix<double, 9, 9> curvature;
+    chainQuantityRows(groups_, block, t, H ? &curvature : nullptr);
     if (!H) return;
     addLocal(np_, H, twistSink(), node, support.width, curvature);
     for (const int i : block) {

@@ -50,6 +50,7 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_update.hpp"
+#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
@@ -448,29 +449,23 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   lagrangian_gradient_(n_) += dT;
 }
 
-/// The groups of one quantity (a cone, a rate) through the quantity's terms in (local nodes, h):
-/// c(q) and λ = −Σ z c'(q) in the contraction; ∇c = c'∇q, −Σ z∇²c = λ·∇²q (the constraints on
-/// these quantities are affine in q), and each constraint's barrier term (z/c) g gᵀ, in η = h/h₀.
+/// The groups of one quantity (a cone, a rate, a wheel quantity) through the quantity's terms in
+/// (local nodes, η = h/h₀) and the chain rule (constraint_assembly.hpp), with each constraint's
+/// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
   const FreeTimeRows& first = groups_[block.front()];
+  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) { prepareRow(g, in, mu); };
   const auto contract = [&](int k, const Vector3& q) {
-    Vector3 lambda = Vector3::Zero();
-    for (const int i : block) {
-      FreeTimeRow& in = groups_[i].instance(k);
-      in.c = groups_[i].constraint->value(q);
-      prepareRow(groups_[i], in, mu);
-      lambda -= in.z * groups_[i].constraint->gradient(q);
-    }
-    return lambda;
+    return contractQuantityRows(groups_, block, k, q, prepare);
   };
   first.quantity->forEachTermsWithTimeStep(
       np_, first.support, h0_, contract, [&](const QuantityTermsWithTimeStep& t) {
-        Eigen::Matrix<double, 10, 10> H = t.curvature;
+        Eigen::Matrix<double, 10, 10> H;
+        chainQuantityRows(groups_, block, t, &H);
         Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
         const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
         for (const int i : block) {
           FreeTimeRow& in = groups_[i].instance(t.k);
-          in.g = t.jacobian.transpose() * groups_[i].constraint->gradient(t.value);
           // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
           const RowTerms row = rowTerms(groups_[i], in, mu);
           const double w = row.weight;

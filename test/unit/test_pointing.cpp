@@ -227,19 +227,6 @@ TEST(PointingPlan, RequestsItCannotServeAreRefusedByName) {
     }
     return std::string("not refused");
   };
-  // Minimum time serves torque bounds (test_free_time_twist.cpp); a margin and cones not yet.
-  PlanningProblem timed = p;
-  timed.objective = Objective::MinimumTime;
-  timed.max_torque = Vector3::Constant(1.0);
-  timed.time_margin = 0.05;
-  EXPECT_NE(refusal(timed).find("final.pointing: not supported with objective minimum_time and "
-                                "time_margin 0.05"),
-            std::string::npos)
-      << refusal(timed);
-  timed.time_margin = 0.0;
-  timed.constraints.push_back(PlanningConstraint::keepOut(Vector3::UnitX(), Vector3::UnitY(), 0.2));
-  EXPECT_NE(refusal(timed).find("minimum_time and a keep_out or keep_in cone"), std::string::npos)
-      << refusal(timed);
   PlanningProblem effected = p;
   auto effects = std::make_shared<EffectModel>();
   effects->add(std::make_unique<DisturbanceTorque>(Vector3(0.0, 0.0, 1e-3), TorqueFrame::Body));

@@ -229,9 +229,11 @@ TEST(PointingMinimumTime, BacksABoundedPointingVerdictWithTheTwistFree) {
   const PlanResult below = planManeuver(p);
   EXPECT_EQ(below.termination, Termination::Infeasible) << below.message;
   EXPECT_NEAR(below.duration_verdict.least_duration_found, T_star, 1e-6 * T_star);
+  EXPECT_EQ(below.pointing.infeasible_basis, PointingInfeasibleBasis::MinimumTimeOverTwist);
   p.duration = 1.05 * T_star;
   const PlanResult above = planManeuver(p);
   EXPECT_NE(above.termination, Termination::Infeasible) << above.message;
+  EXPECT_EQ(above.pointing.infeasible_basis, PointingInfeasibleBasis::None);
 }
 
 }  // namespace

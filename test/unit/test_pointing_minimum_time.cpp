@@ -58,6 +58,19 @@ TEST(PointingMinimumTime, ServesAConeThatExcludesSomeEndTwists) {
       << "swept best at twist " << sweep.best_twist << "; " << r.message;
 }
 
+TEST(PointingMinimumTime, FromTheIdentityTheBodyIsThereOnlyWhereItsBoresightIsOnTheTarget) {
+  // R_0 = I (the final attitude a pointing request leaves unset): moved only where R_0 b ≠ d.
+  PlanningProblem p = test_support::randomBettsPointingRequest(4306, 16, SchemeKind::Paper);
+  p.initial_attitude = Matrix3::Identity();
+  const PlanResult r = planManeuver(p);
+  expectPointingAnswer(p, r);
+  EXPECT_GT(r.minimum_duration, 0.0) << r.message;
+  p.end_condition.world_direction = p.end_condition.body_axis;
+  const PlanResult there = planManeuver(p);
+  ASSERT_TRUE(there.converged()) << there.message;
+  EXPECT_EQ(there.minimum_duration, 0.0) << there.message;
+}
+
 TEST(PointingMinimumTime, TimeMarginPlansMinimumEffortWithTheTwistFreeAtMostTheSweepsBest) {
   PlanningProblem p = test_support::randomBettsPointingRequest(4303, 32, SchemeKind::SecondOrder);
   const PlanResult fastest = planManeuver(p);

@@ -7,6 +7,7 @@
 #include "attitude_planner/analysis/accuracy.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
@@ -37,6 +38,9 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
   PlanResult result = planRequest(problem, options);
   // What the transcription's cost sums (NLopt's dense transcription minimizes the same τ_k).
   result.minimized_effort = ReducedProblem::kMinimizedEffort;
+  if (problem.end_condition.pointing()) {
+    result.pointing.infeasible_basis = pointingInfeasibleBasis(result);
+  }
   return result;
 }
 

@@ -128,7 +128,8 @@ std::string pointingJson(const PlanningProblem& problem, const PlanResult& r) {
       << ", \"error\": " << jsonNumber(r.pointing.error)
       << ", \"twist_gradient\": " << jsonNumber(r.pointing.twist_gradient)
       << ", \"twist_stationarity\": " << jsonNumber(r.pointing.twist_stationarity)
-      << ", \"starts\": " << r.pointing.starts << "}";
+      << ", \"starts\": " << r.pointing.starts << ", \"infeasible_basis\": "
+      << jsonString(pointingInfeasibleBasisName(r.pointing.infeasible_basis)) << "}";
   return out.str();
 }
 

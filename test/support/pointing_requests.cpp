@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/planning/constraints.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 
 namespace attitude_planner::test_support {
@@ -86,11 +87,33 @@ PlanningProblem randomBettsPointingRequest(unsigned seed, int steps, SchemeKind 
   return p;
 }
 
+PlanningProblem randomBettsConstrainedPointingRequest(unsigned seed, int steps, SchemeKind scheme) {
+  for (unsigned attempt = 0;; ++attempt) {
+    PlanningProblem p = randomBettsPointingRequest(seed + 1000 * attempt, steps, scheme);
+    const Vector3 b = p.end_condition.body_axis, d = p.end_condition.world_direction;
+    const Vector3 start = p.initial_attitude * b;
+    const double angle = std::atan2(start.cross(d).norm(), start.dot(d));
+    if (angle < 0.8 || angle > 2.6) continue;
+    const PlanResult free = planManeuver(p);
+    if (!free.converged()) throw std::runtime_error("pointing minimum time: " + free.message);
+    double fastest = 0.0;
+    for (const Vector3& w : free.maneuver.angular_velocity) fastest = std::max(fastest, w.norm());
+    p.constraints.push_back(PlanningConstraint::keepOut(b, (start + d).normalized(), 0.35 * angle));
+    p.constraints.push_back(PlanningConstraint::maxAngularRate(0.7 * fastest));
+    return p;
+  }
+}
+
 TwistSweep sweepTwist(const PlanningProblem& pointing) {
   PlanningProblem fixed = pointing;
   fixed.end_condition = EndCondition();
   const auto cost = [&](double twist) {
     fixed.final_attitude = pointingAttitude(pointing.end_condition, twist);
+    for (const PlanningConstraint& c : fixed.constraints) {
+      if (c.isCone() && coneMargin(c, fixed.final_attitude) < 0.0) {
+        return std::numeric_limits<double>::infinity();  // no plan ends there
+      }
+    }
     const PlanResult r = planManeuver(fixed);
     if (!r.converged()) return std::numeric_limits<double>::infinity();
     return pointing.objective == Objective::MinimumTime ? r.minimum_duration : r.cost;

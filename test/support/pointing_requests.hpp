@@ -32,10 +32,15 @@ PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool 
 /// diag(5621, 4547, 2364) kg m², |τ_i| ≤ 50 N m), rest to rest: random b, d and R_0.
 PlanningProblem randomBettsPointingRequest(unsigned seed, int steps, SchemeKind scheme);
 
+/// randomBettsPointingRequest (seed, seed + 1000, … until R_0 b is 0.8 … 2.6 rad from d) with a
+/// keep-out cone on the boresight about the bisector of R_0 b and d (half angle 0.35 of their
+/// angle) and a rate limit of 0.7 × the largest rate of that request's answer without them.
+PlanningProblem randomBettsConstrainedPointingRequest(unsigned seed, int steps, SchemeKind scheme);
+
 /// The fixed-attitude optimum (planManeuver, classes enumerated) over the twist ψ of `pointing`'s
 /// end condition: every 5° (`sweep` receives the 72 costs, NaN where a solve did not converge),
 /// the best bracket refined by golden section to |Δψ| < 1e-7 rad. The cost; with objective
-/// minimum time, T*.
+/// minimum time, T*. A twist whose R_N a cone excludes has no plan (+∞, NaN in `costs`).
 struct TwistSweep {
   std::vector<double> twists, costs;
   double best = 0.0, best_twist = 0.0;  ///< the refined minimum

@@ -67,6 +67,37 @@ TEST(PointingConventions, TwistOfInvertsPointingAttitude) {
 // The summary every driver fills: ψ and the residual of the plan's own R_N, an R_N off the end
 // condition by a tilt about an axis perpendicular to b reported as that tilt, and the solver's
 // fields left alone.
+TEST(PointingConventions, AnInfeasibleAnswerSaysWhatItRestsOn) {
+  PlanResult r;
+  r.termination = Termination::Converged;
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::None);
+  r.termination = Termination::Infeasible;  // a solver's own local verdict at its starts
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::LocalToStarts);
+  r.verdict = verdicts::NoPointingStartConverged{8};
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::LocalToStarts);
+  r.verdict = verdicts::LocallyInfeasible{10.0, 12.0, "minimum time", 0.0, "", false};
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::MinimumTimeOverTwist);
+  r.verdict = verdicts::MinimumTimeFoundNone{Termination::NotConverged};
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::MinimumTimeOverTwist);
+  r.duration_verdict.proven_infeasible = true;
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::Proven);
+  r.termination = Termination::NotConverged;
+  EXPECT_EQ(pointingInfeasibleBasis(r), PointingInfeasibleBasis::None);
+}
+
+TEST(PointingPlan, ARateLimitBelowTheAngleToTurnIsProvenInfeasibleOverEveryTwist) {
+  // Rest to rest, |Omega| <= w: every R_N(psi) turns R_0 b onto d, so T >= angle / w (proven);
+  // planned through planManeuver, the field says so.
+  PlanningProblem p = randomPointingRequest(47, 32, false, SchemeKind::Paper);
+  const Vector3 from = p.initial_attitude * p.end_condition.body_axis;
+  const double angle = std::atan2(from.cross(p.end_condition.world_direction).norm(),
+                                  from.dot(p.end_condition.world_direction));
+  p.constraints.push_back(PlanningConstraint::maxAngularRate(0.5 * angle / p.duration));
+  const PlanResult r = planManeuver(p);
+  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message;
+  EXPECT_EQ(r.pointing.infeasible_basis, PointingInfeasibleBasis::Proven) << r.message;
+}
+
 TEST(PointingConventions, SummaryOfAnEndReportsItsTwistAndResidual) {
   std::mt19937 rng(6);
   std::uniform_real_distribution<double> u(-M_PI + 1e-9, M_PI), tilt(1e-6, 0.5);
@@ -227,19 +258,6 @@ TEST(PointingPlan, RequestsItCannotServeAreRefusedByName) {
     }
     return std::string("not refused");
   };
-  // Minimum time serves torque bounds (test_free_time_twist.cpp); a margin and cones not yet.
-  PlanningProblem timed = p;
-  timed.objective = Objective::MinimumTime;
-  timed.max_torque = Vector3::Constant(1.0);
-  timed.time_margin = 0.05;
-  EXPECT_NE(refusal(timed).find("final.pointing: not supported with objective minimum_time and "
-                                "time_margin 0.05"),
-            std::string::npos)
-      << refusal(timed);
-  timed.time_margin = 0.0;
-  timed.constraints.push_back(PlanningConstraint::keepOut(Vector3::UnitX(), Vector3::UnitY(), 0.2));
-  EXPECT_NE(refusal(timed).find("minimum_time and a keep_out or keep_in cone"), std::string::npos)
-      << refusal(timed);
   PlanningProblem effected = p;
   auto effects = std::make_shared<EffectModel>();
   effects->add(std::make_unique<DisturbanceTorque>(Vector3(0.0, 0.0, 1e-3), TorqueFrame::Body));

@@ -35,6 +35,12 @@ double nearestTwist(const Matrix3& from, const EndCondition& end);
 void summarizePointingEnd(const Matrix3& planned_end, const EndCondition& end,
                           PointingSummary* summary);
 
+/// What a pointing request's answer `r` rests on if it is "infeasible": its verdict proven
+/// (below a proven bound, no duration admits a plan), the minimum time over the twist (a
+/// LocallyInfeasible T* or MinimumTimeFoundNone: the bounded drivers check it where a torque
+/// bound is present), else the starts' local verdicts; None where it is not infeasible.
+PointingInfeasibleBasis pointingInfeasibleBasis(const PlanResult& r);
+
 /// `problem` with R_N = `final_attitude` where its end condition is a pointing one (the twist a
 /// plan or a start chose: a solve from that plan starts there, and the plan is judged there),
 /// else `problem` unchanged.

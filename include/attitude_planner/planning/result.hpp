@@ -213,6 +213,29 @@ struct DurationVerdict {
   double longest_duration_found = 0.0;
 };
 
+/// What a pointing request's "infeasible" rests on (PointingSummary::infeasible_basis, JSON
+/// `pointing.infeasible_basis`; pointingInfeasibleBasis is the rule).
+enum class PointingInfeasibleBasis {
+  None,  ///< the answer is not "infeasible"
+  /// The interior point's verdicts at the start twists and ways round tried, and no check over
+  /// the twist (cones and rate limits without a torque bound): local, another twist may admit a
+  /// plan.
+  LocalToStarts,
+  /// Minimum time with the twist free under the same bounds (a torque bound present) found its
+  /// least T above the request's (a local T*: DurationVerdict::least_duration_found) or none.
+  MinimumTimeOverTwist,
+  /// Proven: T below a proven lower bound, or no duration admits a plan.
+  Proven,
+};
+inline constexpr NamedValue<PointingInfeasibleBasis> kPointingInfeasibleBasisNames[] = {
+    {PointingInfeasibleBasis::None, "none"},
+    {PointingInfeasibleBasis::LocalToStarts, "local_to_starts"},
+    {PointingInfeasibleBasis::MinimumTimeOverTwist, "minimum_time_over_twist"},
+    {PointingInfeasibleBasis::Proven, "proven"},
+};
+/// "none", "local_to_starts", ... (JSON).
+std::string pointingInfeasibleBasisName(PointingInfeasibleBasis basis);
+
 /// A pointing end condition's answer (PlanningProblem::end_condition); `active` false otherwise.
 struct PointingSummary {
   bool active = false;
@@ -228,6 +251,8 @@ struct PointingSummary {
   /// minimum time as the free-time residuals are (already relative to T₀): the stationarity in ψ.
   double twist_stationarity = 0.0;
   int starts = 0;  ///< twist × class starts surveyed
+  /// What an "infeasible" answer rests on (set for every pointing request, `active` or not).
+  PointingInfeasibleBasis infeasible_basis = PointingInfeasibleBasis::None;
 };
 
 /// Which torques the effort a plan minimizes is made of (JSON `reaction_wheels.effort_minimized`,

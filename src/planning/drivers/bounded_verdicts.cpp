@@ -8,6 +8,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/constraints.hpp"
+#include "attitude_planner/planning/pointing.hpp"
 #include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
@@ -29,8 +30,12 @@ Maneuver restingPlan(const PlanningProblem& problem, double T) {
 }
 
 bool identicalRestStates(const PlanningProblem& problem) {
-  return problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) &&
-         so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0 &&
+  // A pointing end is reached where R_0 b = d (its final_attitude is no datum of the request).
+  const bool there =
+      problem.end_condition.pointing()
+          ? pointingError(problem.initial_attitude, problem.end_condition) == 0.0
+          : so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0;
+  return problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) && there &&
          problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
          (!problem.effects || problem.effects->empty());
 }

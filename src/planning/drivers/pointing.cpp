@@ -454,15 +454,19 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
             << " starts; each verdict is local to its start twist)";
     }
     brief << "; attempt " << kept->second - first_recorded + 1 << " of " << result.attempts.size()
-          << " kept (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
-          << " ways round";
-    if (problem.hasNodeConstraints()) {
-      brief << " unconstrained, each distinct optimum below the cheapest constrained answer "
-               "starting the interior point with the twist free; where none converged, each "
-               "the other way round and the fixed-twist unconstrained optima; then each twist's "
-               "fixed-twist constrained optimum)";
+          << " kept";
+    if (survey.empty()) {
+      brief << " (the interior point with the twist free from the plan given, strictly inside "
+               "every bound)";
+    } else if (problem.hasNodeConstraints()) {
+      brief << " (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
+            << " ways round unconstrained, each distinct optimum below the cheapest constrained "
+               "answer starting the interior point with the twist free; where none converged, "
+               "each the other way round and the fixed-twist unconstrained optima; then each "
+               "twist's fixed-twist constrained optimum)";
     } else {
-      brief << ")";
+      brief << " (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
+            << " ways round)";
     }
     result.message = brief.str();
   }
@@ -647,6 +651,45 @@ std::vector<TwistRun> constrainedFromTwistOptima(
   return survey;
 }
 
+/// Whether `options` hold a plan on the request's grid strictly inside every bound (a plan at T*
+/// time-scaled to a longer T: SolverOptions::warm_start_strictly_inside), which the interior point
+/// with ψ free starts from (fromPlanInside).
+bool startsInsideOnItsGrid(const PlanningProblem& problem, const SolverOptions& options) {
+  return options.warm_start && options.constrained_from_warm_start &&
+         options.warm_start_strictly_inside && problem.hasNodeConstraints() &&
+         options.warm_start->steps() == problem.steps;
+}
+
+/// The interior point with ψ free from `plan` (startsInsideOnItsGrid) at its own twist, its
+/// multipliers re-derived from stationarity (as fromFixedTwistPlan), appended to `finals`.
+void fromPlanInside(const PlanningProblem& problem, const Maneuver& plan, SolveContext& context,
+                    std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  const double twist = twistOf(plan.attitude.back(), problem.end_condition);
+  const PlanningProblem at = posedAt(problem, problem.steps, twist);
+  TwistRun run;
+  run.homotopy = kPointingClasses[0];
+  run.start_twist = run.solve.twist = twist;
+  run.steps = problem.steps;
+  run.start = AttemptStart::PreviousAttempt;
+  const int counted_before = context.iterations();
+  try {
+    ReducedProblem np(at);
+    np.setInteriorFromAttitudes(plan.attitude);
+    const InteriorPointParameters parameters;
+    const LevelDuals duals =
+        ConstrainedSystem(at, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
+    const ReducedProblem::StepVectors steps = np.current();
+    takeInteriorPoint(solveInteriorPointOnGrid(at, context.options(), context, &steps, &duals),
+                      &run);
+  } catch (const StepTooLarge& e) {
+    run.solve.termination = Termination::StepTooLarge;
+    run.solve.reason = std::string("boundary velocity: ") + e.what();
+  }
+  run.solve.iterations = context.iterations() - counted_before;
+  const std::size_t index = record(run, AttemptStage::Solve, run.start, 0, context);
+  finals->emplace_back(std::move(run), index);
+}
+
 }  // namespace
 
 PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& options,
@@ -656,17 +699,26 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
                        " does not serve final.pointing (the twist is an unknown of the newton "
                        "solver only)");
   }
-  if (options.warm_start) {
+  if (options.warm_start && !startsInsideOnItsGrid(problem, options)) {
     throw InvalidInput("final.pointing: not supported with a warm start (initial_guess) yet");
   }
-  const SolveContext::Call call(context, options);
+  SolverOptions cold = options;  // the starts' own solves take no warm start
+  cold.warm_start = nullptr;
+  cold.constrained_from_warm_start = cold.warm_start_strictly_inside = false;
+  const SolveContext::Call call(context, cold);
   const NewtonParameters& p = newtonDefaults();
   const std::size_t first_recorded = context.attempts().size();
   const int counted_at_start = context.iterations();
   std::vector<std::pair<TwistRun, std::size_t>> finals;  // on the requested grid, trail index
-  std::vector<TwistRun> survey = problem.hasNodeConstraints()
-                                     ? constrainedFromTwistOptima(problem, context, p, &finals)
-                                     : unconstrainedStarts(problem, context, p, &finals);
+  if (options.warm_start) {
+    const SolveContext::Call inside(context, options);
+    fromPlanInside(problem, *options.warm_start, context, &finals);
+  }
+  std::vector<TwistRun> survey;
+  if (!anyConverged(finals) && !context.stopReason()) {
+    survey = problem.hasNodeConstraints() ? constrainedFromTwistOptima(problem, context, p, &finals)
+                                          : unconstrainedStarts(problem, context, p, &finals);
+  }
   if (problem.hasNodeConstraints() && !anyConverged(finals) && !context.stopReason()) {
     // No interior point from an unconstrained optimum converged: each twist from its fixed-twist
     // constrained optimum, every way round solved under the constraints there (on the requested

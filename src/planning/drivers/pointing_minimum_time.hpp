@@ -17,10 +17,14 @@ using MinimumTimeRecipe = std::function<PlanResult(const PlanningProblem& posed)
 
 /// Plans `problem` (end_condition.pointing(), objective minimum time) with `recipe` from
 /// kPointingStartTwists start twists, ψ₀ + 2πi/kPointingStartTwists (ψ₀ the twist of least
-/// rotation from R_0: nearestTwist); the ways round are the recipe's own starts. The kept answer is
-/// the converged one with the least T* (else the last start's), with every start's trail (each
-/// attempt's start_detail.twist its start twist) and the pointing summary (final_twist, the end
-/// condition's residual, ∂L/∂ψ at the KKT point). Stops at a cancel or the deadline.
+/// rotation from R_0: nearestTwist), on a survey grid of N/4 steps (at least 16; none where that
+/// is not below N), then with `recipe` on N at the twist of the survey's least T* alone; where
+/// that does not converge (or without a survey), every start twist on N. A start twist whose R_N
+/// a cone excludes is not posed. The ways round are the recipe's own starts. The kept answer is
+/// the converged one on N with the least T* (else the last start's on N), with every start's
+/// trail (each attempt's start_detail.twist its start twist) and the pointing summary
+/// (final_twist, the end condition's residual, ∂L/∂ψ at the KKT point). Stops at a cancel or the
+/// deadline.
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                const MinimumTimeRecipe& recipe);
 

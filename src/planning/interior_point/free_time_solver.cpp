@@ -108,7 +108,14 @@ class FreeTimeSolver final : public PrimalDualProblem {
         barrier_(parameters, freeTimeMonotone(parameters)),
         inertia_(parameters) {
     for (const auto& c : constraints) {
-      groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
+      FreeTimeRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
+      // A free twist moves R_N (and R_{N−1} of paper and variational): rows on them too, their
+      // ψ entries from the block's own (scatterTwist).
+      if (np_.hasTwist()) {
+        g.support =
+            g.quantity->supportWithTwist(np_.firstFreeNode(), np_.lastFreeNode(), np_.steps());
+        g.at.resize(g.support.last_k - g.support.first_k + 1);
+      }
     }
     QuantityBlocks blocks = quantityBlocks(constraints);
     stencil_groups_ = std::move(blocks.on_cost_stencil);
@@ -131,7 +138,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
     for (int i = 0; i < parameters_.free_time_max_start_growths; ++i) {
       if (smallestValue(np_.current(), true) >= parameters_.free_time_start_margin) {
         h0_ = np_.timeStep();
-        return "";
+        return conesAfterRaise();
       }
       const double raised = np_.timeStep() * parameters_.free_time_start_growth;
       if (allow_elastic_ && raised > kLargestRaise * h_start) {
@@ -147,6 +154,19 @@ class FreeTimeSolver final : public PrimalDualProblem {
            std::to_string(std::pow(parameters_.free_time_start_growth,
                                    parameters_.free_time_max_start_growths)) +
            " times the start's duration";
+  }
+
+  /// Empty where every cone still holds strictly at the raised h, else why not: with spinning
+  /// ends h moves R_{N−1} of paper and variational (ReducedProblem::nodePath), a cone's row where
+  /// a pointing end's twist makes it one.
+  std::string conesAfterRaise() const {
+    const double cone_value = smallestValue(np_.current(), false);
+    if (cone_value > 0) return "";
+    std::ostringstream why;
+    why << "raising T for the start moved an attitude the boundary rate fixes into a cone "
+           "(smallest value "
+        << cone_value << ")";
+    return why.str();
   }
 
   /// The elastic start at the start's own T: every constraint that moves with h ℓ1-elastic.
@@ -956,8 +976,11 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     ReducedProblem np(at);
     np.setInteriorFromAttitudes(attitudes);
     // R_0, R_N and, where the boundary data fix them, R_1, R_{N−1}: no iterate moves them.
+    // A free twist moves R_{N−1} and R_N: their cones are rows then (a start outside them is
+    // refused by startInside).
     const std::string fixed =
-        fixedNodeConeViolation(problem, np, {0, 1, np.steps() - 1, np.steps()});
+        np.hasTwist() ? fixedNodeConeViolation(problem, np, {0, 1})
+                      : fixedNodeConeViolation(problem, np, {0, 1, np.steps() - 1, np.steps()});
     if (!fixed.empty()) {
       failed.message = fixed + ", an attitude the boundary data fix";
       return failed;

@@ -1,6 +1,7 @@
 #include "attitude_planner/planning/pointing.hpp"
 
 #include <cmath>
+#include <variant>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
@@ -58,6 +59,19 @@ void summarizePointingEnd(const Matrix3& planned_end, const EndCondition& end,
   summary->active = true;
   summary->final_twist = twistOf(planned_end, end);
   summary->error = pointingError(planned_end, end);
+}
+
+PointingInfeasibleBasis pointingInfeasibleBasis(const PlanResult& r) {
+  if (r.termination != Termination::Infeasible) return PointingInfeasibleBasis::None;
+  const bool proven = r.duration_verdict.proven_infeasible ||
+                      std::holds_alternative<verdicts::BelowProvenBound>(r.verdict) ||
+                      std::holds_alternative<verdicts::InfeasibleAtEveryDuration>(r.verdict);
+  if (proven) return PointingInfeasibleBasis::Proven;
+  if (std::holds_alternative<verdicts::LocallyInfeasible>(r.verdict) ||
+      std::holds_alternative<verdicts::MinimumTimeFoundNone>(r.verdict)) {
+    return PointingInfeasibleBasis::MinimumTimeOverTwist;
+  }
+  return PointingInfeasibleBasis::LocalToStarts;
 }
 
 PlanningProblem endingAt(const PlanningProblem& problem, const Matrix3& final_attitude) {

@@ -174,30 +174,8 @@ void requireFloatingPointRange(const PlanningProblem& p, const Vector3& moments)
   requireMagnitude(moments(2) / (T * T), field, "the torque scale J/T^2 [N m]");
 }
 
-/// Minimum time to a pointing end condition: the twist is a global unknown of the free-time
-/// interior point with torque bounds; its cones and rate limits (rows on the nodes the twist
-/// moves) and the plan at (1 + time_margin) T* (a minimum-effort pointing solve from the plan at
-/// T*) are refused by name.
-void requirePointingMinimumTimeServed(const PlanningProblem& p) {
-  for (const PlanningConstraint& c : p.constraints) {
-    if (c.kind == ConstraintKind::MaxTorqueNorm) continue;
-    throw InvalidInput(
-        "final.pointing",
-        "not supported with objective minimum_time and a " +
-            std::string(c.isCone() ? "keep_out or keep_in cone" : "max_angular_rate constraint") +
-            " yet (the free-time twist serves torque bounds only); give a final "
-            "attitude instead");
-  }
-  if (p.time_margin > 0.0) {
-    throw InvalidInput("final.pointing",
-                       "not supported with objective minimum_time and time_margin " +
-                           exactNumber(p.time_margin) +
-                           " yet (the plan at T* is returned: give time_margin 0)");
-  }
-}
-
 /// A pointing end condition: its vectors, and the requests the pointing solver serves (minimum
-/// effort with every stage constraint, minimum time with torque bounds, no effects, a direct
+/// effort and minimum time with every stage constraint, no effects, a direct
 /// scheme, the class left to the planner). The others are refused by name.
 void requirePointingServed(const PlanningProblem& p) {
   requirePointingVector(p.end_condition.body_axis, "final.pointing.body_axis");
@@ -206,7 +184,6 @@ void requirePointingServed(const PlanningProblem& p) {
     throw InvalidInput("final.pointing",
                        "not supported with " + what + " yet; give a final attitude instead");
   };
-  if (p.objective == Objective::MinimumTime) requirePointingMinimumTimeServed(p);
   if (p.scheme == SchemeKind::FourthOrder) refuse("scheme fourth_order");
   if (p.effects && !p.effects->empty()) refuse("effects");
   if (p.accuracy.active()) refuse("an accuracy target");

@@ -9,6 +9,10 @@ std::string minimizedEffortName(MinimizedEffort effort) {
   return nameIn(kMinimizedEffortNames, effort);
 }
 
+std::string pointingInfeasibleBasisName(PointingInfeasibleBasis basis) {
+  return nameIn(kPointingInfeasibleBasisNames, basis);
+}
+
 std::string attemptStageName(AttemptStage stage) {
   return nameIn(kAttemptStageNames, stage);
 }

@@ -304,12 +304,31 @@ class PointingQuantity final : public StageQuantityModel {
                     const QuantityContraction& contract, const TermsVisitor& visit) const override {
     forEachInstance<QuantityTerms>(np, support, contract, visit);
   }
-  /// h does not move R_k: the h row and column stay zero.
+  /// h moves R_k only where a boundary rate fixes it (R_{N−1} of paper and variational, an
+  /// instance where a pointing end's free twist makes it one; ReducedProblem::nodePath), as a node
+  /// perturbation d(h) = e Δh + ½ e₂ Δh²: ∂q/∂h = ∇qᵀe, ∂∇q/∂h = ∇²q e, ∂²q/∂h² = eᵀ∇²q e +
+  /// ∇qᵀe₂ (in η = h/time_scale: e, e₂ times time_scale, time_scale²). Elsewhere they are zero.
   void forEachTermsWithTimeStep(const ReducedProblem& np, const StageSupport& support,
-                                double /*time_scale: h does not move R_k*/,
-                                const QuantityContraction& contract,
+                                double time_scale, const QuantityContraction& contract,
                                 const TimeStepTermsVisitor& visit) const override {
-    forEachInstance<QuantityTermsWithTimeStep>(np, support, contract, visit);
+    const std::vector<Matrix3> R = np.attitudes(np.current());
+    for (int k = support.first_k; k <= support.last_k; ++k) {
+      const PointingTerms p = pointingTerms(R[k], body_axis_, world_direction_);
+      QuantityTermsWithTimeStep t;
+      t.k = k;
+      t.value(0) = p.cosine;
+      const double lambda = contract(k, t.value)(0);
+      const ReducedProblem::BoundaryPath path = np.nodePath(k);
+      const Vector3 e = path.first * time_scale, e2 = path.second * (time_scale * time_scale);
+      const Vector3 He = p.hessian * e;
+      t.jacobian.block<1, 3>(0, 0) = p.gradient.transpose();
+      t.jacobian(0, 9) = p.gradient.dot(e);
+      t.curvature.topLeftCorner<3, 3>() = lambda * p.hessian;
+      t.curvature.block<3, 1>(0, 9) = lambda * He;
+      t.curvature.block<1, 3>(9, 0) = lambda * He.transpose();
+      t.curvature(9, 9) = lambda * (e.dot(He) + p.gradient.dot(e2));
+      visit(t);
+    }
   }
 
  private:

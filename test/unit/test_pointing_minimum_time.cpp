@@ -1,0 +1,94 @@
+// Minimum time to a pointing target under every stage constraint (a keep-out cone, a rate limit,
+// torque bounds) and with a time margin, against sweeps of fixed twists on seeded random requests
+// on Betts's body (the torque bounds alone: test_free_time_twist.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/pointing.hpp"
+#include "support/pointing_requests.hpp"
+
+using namespace attitude_planner;
+
+namespace {
+
+/// The properties every pointing answer here holds: converged, the end condition to round-off,
+/// and every constraint met on the returned maneuver.
+void expectPointingAnswer(const PlanningProblem& p, const PlanResult& r) {
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.pointing.active);
+  EXPECT_LT(r.pointing.error, 1e-9);
+  EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-9);
+  EXPECT_LE(r.max_constraint_violation, 1e-9) << r.message;
+}
+
+TEST(PointingMinimumTime, UnderAConeAndARateLimitAtMostTheSweepsBestTwist) {
+  // The cone binds on the boresight's way to d, the rate limit at the middle of the slew. (One
+  // request: the sweep's fixed-twist solves with a cone take ~1 s each.)
+  const std::pair<unsigned, SchemeKind> requests[] = {{4301u, SchemeKind::Paper}};
+  for (const auto& [seed, scheme] : requests) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", " + schemeName(scheme));
+    const PlanningProblem p = test_support::randomBettsConstrainedPointingRequest(seed, 16, scheme);
+    const PlanResult r = planManeuver(p);
+    expectPointingAnswer(p, r);
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_GT(r.active_constraints, 0);
+    EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+    EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
+        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+  }
+}
+
+TEST(PointingMinimumTime, ServesAConeThatExcludesSomeEndTwists) {
+  // A keep-out cone on an axis across the boresight: some R_N about d violate it (those start
+  // twists are not posed), the answer's R_N clears it and is at most the sweep's best.
+  PlanningProblem p = test_support::randomBettsPointingRequest(4305, 16, SchemeKind::Paper);
+  const Vector3 across = p.end_condition.body_axis.unitOrthogonal();
+  const Matrix3 R_ref = pointingAttitude(p.end_condition, 0.0);
+  p.constraints.push_back(PlanningConstraint::keepOut(across, R_ref * across, 0.6));
+  const PlanResult r = planManeuver(p);
+  expectPointingAnswer(p, r);
+  EXPECT_GE(coneMargin(p.constraints.back(), r.maneuver.attitude.back()), -1e-12);
+  const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+  EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
+      << "swept best at twist " << sweep.best_twist << "; " << r.message;
+}
+
+TEST(PointingMinimumTime, FromTheIdentityTheBodyIsThereOnlyWhereItsBoresightIsOnTheTarget) {
+  // R_0 = I (the final attitude a pointing request leaves unset): moved only where R_0 b ≠ d.
+  PlanningProblem p = test_support::randomBettsPointingRequest(4306, 16, SchemeKind::Paper);
+  p.initial_attitude = Matrix3::Identity();
+  const PlanResult r = planManeuver(p);
+  expectPointingAnswer(p, r);
+  EXPECT_GT(r.minimum_duration, 0.0) << r.message;
+  p.end_condition.world_direction = p.end_condition.body_axis;
+  const PlanResult there = planManeuver(p);
+  ASSERT_TRUE(there.converged()) << there.message;
+  EXPECT_EQ(there.minimum_duration, 0.0) << there.message;
+}
+
+TEST(PointingMinimumTime, TimeMarginPlansMinimumEffortWithTheTwistFreeAtMostTheSweepsBest) {
+  PlanningProblem p = test_support::randomBettsPointingRequest(4303, 32, SchemeKind::SecondOrder);
+  const PlanResult fastest = planManeuver(p);
+  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  p.time_margin = 0.05;
+  const PlanResult r = planManeuver(p);
+  expectPointingAnswer(p, r);
+  EXPECT_DOUBLE_EQ(r.minimum_duration, fastest.minimum_duration);
+  EXPECT_NEAR(r.duration, 1.05 * fastest.minimum_duration, 1e-9 * r.duration);
+  EXPECT_LT(r.pointing.twist_stationarity, 1e-6) << r.message;
+  // Against minimum effort at that T over fixed twists (infeasible ones have no cost).
+  PlanningProblem effort = p;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = r.duration;
+  const test_support::TwistSweep sweep = test_support::sweepTwist(effort);
+  EXPECT_LE(r.cost, sweep.best * (1.0 + 1e-6))
+      << "swept best at twist " << sweep.best_twist << "; " << r.message;
+}
+
+}  // namespace

@@ -53,6 +53,29 @@ struct Counters {
 };
 Counters* counters = nullptr;
 
+/// A ~mode replan run (namespace `replan`) against the feedback run it is measured by
+/// (`reference`): re-planned at least once, no re-plan failed, the terminal attitude error within
+/// twice the reference's, and every wheel command within its torque limit.
+void expectReplansLandWithinTwice(const std::string& reference, const std::string& replan,
+                                  const std::string& label) {
+  ros::NodeHandle reference_nh(reference), nh(replan);
+  ros_testing::DoneListener reference_done(reference_nh), listener(nh);
+  const ReplayResult::ConstPtr feedback = reference_done.wait(120.0);
+  const ReplayResult::ConstPtr done = listener.wait(60.0);
+  ASSERT_TRUE(feedback && done) << "no done from /" << reference << " and /" << replan;
+  ASSERT_TRUE(done->success) << done->message;
+  EXPECT_EQ(done->mode, "replan");
+  std::printf("%s: %d re-plans, %d failed, terminal attitude error %.3g rad (feedback %.3g rad)\n",
+              label.c_str(), done->replans, done->replan_failures, done->terminal_attitude_error,
+              feedback->terminal_attitude_error);
+  EXPECT_GE(done->replans, 1);
+  EXPECT_EQ(done->replan_failures, 0) << done->replan_error;
+  EXPECT_LE(done->terminal_attitude_error, 2.0 * feedback->terminal_attitude_error);
+  ASSERT_EQ(done->reaction_wheels.wheels.size(), 4u);
+  for (const WheelPeak& w : done->reaction_wheels.wheels)
+    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
+}
+
 }  // namespace
 
 TEST(TrackerExternalWheels, MeasuredWheelLoopLandsWithinTwiceTheInternalError) {
@@ -100,25 +123,8 @@ TEST(TrackerExternalWheels, ReplanModeReplansFromTheMeasuredBodyAndWheelMomenta)
   // ~mode replan with wheels on the plant: re-plans from the measured body and wheel momenta
   // (the planner's initial_momentum) every 5 s, adopted, none failed, and the law on the plan in
   // force, distributed over the wheels, lands within twice the internal feedback mode's error.
-  ros::NodeHandle internal_nh("internal_wheels"), nh("external_wheels_replan");
-  ros_testing::DoneListener internal_done(internal_nh), listener(nh);
-  const ReplayResult::ConstPtr internal = internal_done.wait(120.0);
-  const ReplayResult::ConstPtr done = listener.wait(60.0);
-  ASSERT_TRUE(internal && done) << "no done from /internal_wheels and /external_wheels_replan";
-  ASSERT_TRUE(done->success) << done->message;
-  EXPECT_EQ(done->mode, "replan");
-  std::printf(
-      "wheels, external replan: %d re-plans, %d failed, terminal attitude error %.3g rad "
-      "(internal feedback %.3g rad)\n",
-      done->replans, done->replan_failures, done->terminal_attitude_error,
-      internal->terminal_attitude_error);
-  EXPECT_GE(done->replans, 1);
-  EXPECT_EQ(done->replan_failures, 0) << done->replan_error;
-  EXPECT_LE(done->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
-  ASSERT_EQ(done->reaction_wheels.wheels.size(), 4u);
-  for (const WheelPeak& w : done->reaction_wheels.wheels) {
-    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
-  }
+  expectReplansLandWithinTwice("internal_wheels", "external_wheels_replan",
+                               "wheels, external replan");
 }
 
 TEST(TrackerExternalWheels, ReplayModeCommandsThePlansWheelTorquesOpenLoop) {
@@ -208,24 +214,8 @@ TEST(TrackerWheelsLoop, InternalReplanModeReplansFromTheSimulatedBodyAndWheelMom
   // ~mode replan with wheels on the tracker's own body + wheels: re-planned every 5 s from the
   // simulated body and wheel momenta (with the disturbance in the re-planned problem), adopted,
   // none failed, landing within twice the feedback mode's error under the same disturbance.
-  ros::NodeHandle feedback_nh("internal_wheels_disturbed"), nh("internal_wheels_replan");
-  ros_testing::DoneListener feedback_done(feedback_nh), listener(nh);
-  const ReplayResult::ConstPtr feedback = feedback_done.wait(120.0);
-  const ReplayResult::ConstPtr done = listener.wait(60.0);
-  ASSERT_TRUE(feedback && done) << "no done from the feedback and replan runs";
-  ASSERT_TRUE(done->success) << done->message;
-  EXPECT_EQ(done->mode, "replan");
-  std::printf(
-      "wheels, internal replan under the disturbance: %d re-plans, %d failed, terminal attitude "
-      "error %.3g rad (feedback %.3g rad)\n",
-      done->replans, done->replan_failures, done->terminal_attitude_error,
-      feedback->terminal_attitude_error);
-  EXPECT_GE(done->replans, 1);
-  EXPECT_EQ(done->replan_failures, 0) << done->replan_error;
-  EXPECT_LE(done->terminal_attitude_error, 2.0 * feedback->terminal_attitude_error);
-  ASSERT_EQ(done->reaction_wheels.wheels.size(), 4u);
-  for (const WheelPeak& w : done->reaction_wheels.wheels)
-    EXPECT_GE(w.torque_margin, -1e-12 * w.max_torque) << w.name << ": commands cut to U";
+  expectReplansLandWithinTwice("internal_wheels_disturbed", "internal_wheels_replan",
+                               "wheels, internal replan under the disturbance");
 }
 
 int main(int argc, char** argv) {

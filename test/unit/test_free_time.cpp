@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "attitude_planner/dynamics/effects.hpp"
+#include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
@@ -370,6 +371,34 @@ TEST(FreeTime, AnElasticPhaseBegunFromItsViolationsEndsAtAKktPointAndAFeasibleSt
   EXPECT_FALSE(a.elastic_start);
   EXPECT_EQ(b.duration, a.duration);
   EXPECT_EQ(b.iterations, a.iterations);
+}
+
+TEST(FreeTime, AnIterateStrictlyInsideItsBoundsIsAPlanAtItsOwnT) {
+  // What the probes below T* hand on where a free-time solve stops short of a KKT point: its last
+  // iterate, strictly inside every bound, is a plan at its own T. Its torques replayed from the
+  // initial state by the scheme's own integrator land on the final attitude and rate, and meet
+  // the bounds.
+  ap::PlanningProblem p = spinningRequest(64);
+  p.duration = 3.5;
+  const ap::ReducedProblem geodesic(p);
+  int checked = 0;
+  for (const int limit : {5, 10, 20, 40}) {
+    const ap::FreeTimeOutcome o =
+        ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, limit);
+    if (o.termination != ap::Termination::NotConverged || !(o.smallest_value > 0)) continue;
+    ++checked;
+    for (const ap::Vector3& t : o.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0);
+    ap::SimulationInput replay;
+    replay.initial_attitude = p.initial_attitude;
+    replay.initial_velocity = p.initial_velocity;
+    replay.torque = o.maneuver.torque;
+    const ap::Maneuver m =
+        ap::simulate(ap::DiscreteScheme(p.scheme, p.inertia, o.time_step), replay);
+    EXPECT_LE(ap::so3::angleBetween(m.attitude.back(), p.final_attitude), 1e-8) << limit;
+    EXPECT_LE((m.angular_velocity.back() - p.final_velocity).norm(), 1e-8) << limit;
+    EXPECT_NEAR(o.duration, o.time_step * p.steps, 1e-12 * o.duration);
+  }
+  EXPECT_GT(checked, 0) << "no iteration limit left a strictly feasible iterate";
 }
 
 namespace {

@@ -128,13 +128,20 @@ class FreeTimeMinimumTime {
 
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
   /// duration, e.g. the search's): its KKT point if it converged at or below that T.
-  std::optional<PlanResult> runFrom(const Maneuver& plan, double duration,
-                                    const std::string& name) {
+  std::optional<PlanResult> runFrom(const Maneuver& plan, double duration, const std::string& name,
+                                    std::optional<Maneuver>* below) {
     StartDetail detail;
     detail.duration = duration;
     const FreeTimeOutcome o =
         solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt, detail);
     recordStart(plan.attitude, duration, name, o, -1);
+    // Every iterate strictly inside its bounds is a plan (the reduced problem meets the dynamics
+    // and the boundary data by construction): one that ended short of a KKT point below T is
+    // still a plan at its own T.
+    if (below && o.termination == Termination::NotConverged && o.smallest_value > 0 &&
+        o.duration < duration && !o.maneuver.attitude.empty()) {
+      *below = o.maneuver;
+    }
     // The plan's T is known to the search's tolerance: a KKT point a rounding above it is the
     // same answer, sharpened (measured: 2.4e-11 relative above).
     if (o.termination != Termination::Converged ||
@@ -660,8 +667,9 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context) {
-  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, "search's plan");
+                                           double duration, SolveContext& context,
+                                           std::optional<Maneuver>* below) {
+  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, "search's plan", below);
 }
 
 }  // namespace attitude_planner

@@ -51,9 +51,11 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
 /// `duration` (the search's answer where the structured starts did not converge): its
 /// KKT point if it converged at or below `duration`, else empty (its solve is in the context's
-/// trail either way).
+/// trail either way). Where it ended short of a KKT point at an iterate strictly inside every
+/// bound below `duration`, that iterate's plan goes to `*below` (a plan at its own T).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context);
+                                           double duration, SolveContext& context,
+                                           std::optional<Maneuver>* below = nullptr);
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
 /// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a

@@ -277,16 +277,20 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
       discreteDurationLowerBound(durationLowerBound(problem), problem.steps);  // 0: no bound
   ProbeSteps steps;
   std::optional<Maneuver> lower_plan;  // a free-time iterate's plan below the answer's T
+  int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
     PlanningProblem effort = problem;
     effort.objective = Objective::MinimumEffort;
     effort.time_margin = 0.0;
     effort.duration = std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor);
     SolverOptions options = context.options();
-    if (lower_plan) {  // the probe at the iterate's T, from it
+    const bool from_iterate = lower_plan && handed_on < kMaxProbes;
+    if (from_iterate) {  // the probe at the iterate's T, from it
       effort.duration = lower_plan->time_step * lower_plan->steps();
       options.warm_start = &*lower_plan;
       options.constrained_from_warm_start = true;
+      ++handed_on;
+      --probe;
     }
     if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
     const std::optional<std::size_t> answer_kept = context.keptAttempt();
@@ -297,12 +301,12 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     if (!provesFeasible(effort, below)) {
       context.restoreKept(answer_kept);
       answer.attempts = context.attemptsFrom(first);
-      if (!steps.nothingFound()) break;
+      if (!from_iterate && !steps.nothingFound()) break;
       continue;
     }
     answer = lowerAnswer(problem, effort, answer, below, keptSince(context, probe_first), first,
                          context, &lower_plan);
-    steps.found(answer.minimum_duration < effort.duration);
+    if (!from_iterate) steps.found(answer.minimum_duration < effort.duration);
   }
   return answer;
 }

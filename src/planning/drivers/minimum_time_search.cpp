@@ -30,6 +30,14 @@ constexpr double kExcursionAngles[] = {0.3, 0.8};
 constexpr double kExcursionStartFactors[] = {1.04, 0.96};
 /// A search doubles its first T at most this many times looking for a feasible one.
 constexpr int kMaxDoublings = 12;
+/// Where doubling reaches the durations the grid cannot hold before any T is found feasible, the
+/// search goes below its first T by this factor, at most kMaxShortenings times and never below
+/// the proven least duration. Why: with spinning ends the first T sits at the grid's largest
+/// boundary step (eigenaxisDurationGuess), where a cold minimum-effort solve fails locally while
+/// plans exist well below it (measured on the seed-45 spinning suite: five requests answered "no
+/// plan found below" their first T, with minimum-effort plans converged at 0.3-0.5 of it).
+constexpr double kShorteningFactor = 0.7;
+constexpr int kMaxShortenings = 6;
 /// Grids above this N search from the T* plan of the grid with half the steps.
 constexpr int kCoarsestSearchGrid = 64;
 /// That search's first T, relative to the coarse grid's T*.
@@ -141,6 +149,7 @@ class MinimumTimeSearch {
     for (int doublings = 0; !feasible(T) && !stopped() && T < unrepresentable_from_; T *= 2.0) {
       if (++doublings > kMaxDoublings) return;
     }
+    if (!out.feasible && T >= unrepresentable_from_) T = shortened(T_first, feasible);
     if (!out.feasible) return;
     // Down from the first feasible T in small steps, each warm-started from the last feasible
     // plan: a large step leaves the interior point far outside the bounds (torques grow like
@@ -151,6 +160,19 @@ class MinimumTimeSearch {
       out.T_hi = out.T_lo;
       out.T_lo *= kContinuationFactor;
     }
+  }
+
+  /// Below T_first (kShorteningFactor), cold, until `feasible` holds: the T where it did, or 0.
+  template <typename Feasible>
+  double shortened(double T_first, const Feasible& feasible) {
+    const double floor = discreteDurationLowerBound(durationLowerBound(problem_), problem_.steps);
+    double T = T_first;
+    for (int k = 0; k < kMaxShortenings && !stopped(); ++k) {
+      T *= kShorteningFactor;
+      if (T < floor) return 0.0;
+      if (feasible(T)) return T;
+    }
+    return 0.0;
   }
 
   /// Bisection of a search's bracket [T_lo infeasible, T_hi feasible], from its plans.

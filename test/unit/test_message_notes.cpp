@@ -258,6 +258,11 @@ TEST(DriverVerdicts, EachKindSaysTheWordsOfItsFormerExpression) {
   EXPECT_EQ(
       ap::renderVerdict(v::SearchStopped{ap::Termination::Cancelled}, ""),
       ap::terminationName(ap::Termination::Cancelled) + " before any duration was found feasible");
+  EXPECT_EQ(ap::renderVerdict(v::SearchUnrepresentable{T, 48, false, 0.25 * T}, ""),
+            "not converged: no plan was found below T = " + ap::exactNumber(T) +
+                " s (tried down to T = " + ap::exactNumber(0.25 * T) +
+                " s), and from there on one step of " + ap::exactNumber(T / 48) +
+                " s at the boundary rates has no solution (N = 48)");
   for (const bool coarse : {false, true}) {
     EXPECT_EQ(ap::renderVerdict(v::SearchUnrepresentable{T, 48, coarse}, ""),
               std::string(coarse ? "step too large, increase steps" : "not converged") +

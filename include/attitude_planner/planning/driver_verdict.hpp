@@ -94,16 +94,20 @@ struct SearchStopped {
   Termination stop = Termination::TimedOut;
   std::vector<VerdictFigure> figures() const { return {}; }
 };
-/// The minimum-time search found no plan below T = `from`, and from there on one step at the
-/// boundary rates has no solution on N steps; `coarse`: even at the proven least duration a
-/// boundary step turns more than 1 rad (StepTooLarge), else NotConverged.
+/// The minimum-time search found no plan below T = `from` (it tried durations down to
+/// `least_tried`), and from there on one step at the boundary rates has no solution on N steps;
+/// `coarse`: even at the proven least duration a boundary step turns more than 1 rad
+/// (StepTooLarge), else NotConverged.
 struct SearchUnrepresentable {
   static constexpr const char* kKind = "search_unrepresentable";
   double from = 0.0;  ///< [s]
   int steps = 0;      ///< N
   bool coarse = false;
+  double least_tried = 0.0;  ///< [s] the least duration a solve was tried at (0: none)
   std::vector<VerdictFigure> figures() const {
-    return {{"unrepresentable_from", from}, {"steps", double(steps)}};
+    return {{"unrepresentable_from", from},
+            {"steps", double(steps)},
+            {"least_duration_tried", least_tried}};
   }
 };
 /// The minimum-time search doubled its first guess `doublings` times and found no duration that

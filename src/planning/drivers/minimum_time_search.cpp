@@ -117,6 +117,7 @@ class MinimumTimeSearch {
       return false;
     }
     ++out->solves;
+    least_tried_ = std::min(least_tried_, T);
     if (r.termination == Termination::TimedOut || r.termination == Termination::Cancelled) {
       stopped_ = r.termination;
     }
@@ -283,8 +284,9 @@ class MinimumTimeSearch {
       // is too coarse at the proven least duration is the step count the cause.
       const bool coarse = representableDuration(problem_) < durationLowerBound(problem_).seconds;
       none.termination = coarse ? Termination::StepTooLarge : Termination::NotConverged;
-      recordVerdict(&none,
-                    verdicts::SearchUnrepresentable{unrepresentable_from_, problem_.steps, coarse});
+      recordVerdict(
+          &none, verdicts::SearchUnrepresentable{unrepresentable_from_, problem_.steps, coarse,
+                                                 std::isfinite(least_tried_) ? least_tried_ : 0.0});
     } else {
       none.termination = Termination::Infeasible;
       recordVerdict(&none, verdicts::SearchInfeasible{kMaxDoublings, guess});
@@ -362,6 +364,8 @@ class MinimumTimeSearch {
   std::optional<Termination> stopped_;
   /// The least T at which this grid had no boundary step (tryDuration); infinity: none.
   double unrepresentable_from_ = std::numeric_limits<double>::infinity();
+  /// The least T a minimum-effort solve was tried at (tryDuration); infinity: none.
+  double least_tried_ = std::numeric_limits<double>::infinity();
   double coarse_minimum_duration_ = 0.0;
   int solves_ = 0;
 };

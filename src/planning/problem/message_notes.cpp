@@ -266,7 +266,9 @@ std::string judged(const verdicts::SearchUnrepresentable& v, const std::string&)
   // Longer plans are not shown infeasible: this grid cannot hold them.
   return std::string(v.coarse ? "step too large, increase steps" : "not converged") +
          ": no plan was found below T = " + exactNumber(v.from) +
-         " s, and from there on one step of " + exactNumber(v.from / v.steps) +
+         (v.least_tried > 0 ? " s (tried down to T = " + exactNumber(v.least_tried) + " s)"
+                            : " s") +
+         ", and from there on one step of " + exactNumber(v.from / v.steps) +
          " s at the boundary rates has no solution (N = " + std::to_string(v.steps) + ")" +
          (v.coarse ? "; even at the proven least duration a boundary step turns more than 1 rad"
                    : "");

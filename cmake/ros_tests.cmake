@@ -98,6 +98,9 @@ add_rostest_gtest(test_tracker_external test/ros/tracker_external.test
 target_link_libraries(test_tracker_external ${PROJECT_NAME}_ros ${catkin_LIBRARIES})
 add_dependencies(test_tracker_external attitude_tracker_node attitude_plant_node)
 list(APPEND AP_EXPECTED_TESTS test_tracker_external)
+# The same binary (TrackerPlantLoop.*): tracker.launch's plant:=node (attitude_plant_node started
+# by the launch, the loop over topics) against its plant:=internal (the in-process body).
+add_rostest(test/ros/tracker_plant_loop.test DEPENDENCIES test_tracker_external)
 
 # A new maneuver mid-run: with a planner that never answers (hung_planner_node) the
 # stream keeps its rate and both runs get `done`; the body is flown on from its state (no jump).

@@ -142,6 +142,7 @@ DiagnosticStatus trackerStatus(const std::string& name, const TrackerHealth& hea
   add(&status, "attitude error [rad]", health.attitude_error);
   add(&status, "angular velocity error [rad/s]", health.rate_error);
   add(&status, "measurement age [s]", health.measurement_age);
+  add(&status, "wheel measurement age [s]", health.wheel_measurement_age);
   add(&status, "re-plans adopted", health.replans);
   add(&status, "re-plans failed", health.replan_failures);
   add(&status, "runs finished", health.runs_finished);

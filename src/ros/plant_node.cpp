@@ -8,6 +8,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/ros/conversions.hpp"
 #include "attitude_planner/ros/parameters.hpp"
+#include "attitude_planner/ros/tracker_node.hpp"  // defaultBodyFrame: the tracker's rule
 
 namespace attitude_planner {
 
@@ -23,19 +24,18 @@ PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                            " is required: the scene whose body, initial state and effects "
                            "the plant simulates");
   }
+  const std::string replay_scene = readFileParam(pnh, "replay_scene");
   const double rate = readParam<double>(pnh, "rate", 100.0, positive, "> 0 Hz");
   rate_factor_ = readParam<double>(pnh, "rate_factor", 1.0, positive, "> 0");
   double max_step = readParam<double>(pnh, "max_step", 0.0, non_negative, ">= 0 s, 0 = h / 4");
   world_frame_ = readParam<std::string>(pnh, "world_frame", "world", non_empty, "non-empty");
-  body_frame_ = readParam<std::string>(pnh, "body_frame", "body", non_empty, "non-empty");
+  body_frame_ = readParam<std::string>(pnh, "body_frame", "body");
+  // Empty: the frame a tracker in this namespace flies by default, so the two pair up.
+  if (body_frame_.empty()) body_frame_ = defaultBodyFrame(nh.getNamespace());
   warnUnknownParameters(pnh);
-  Scene scene;
-  try {
-    scene = loadScene(scene_path);
-  } catch (const std::exception& e) {
-    throw InvalidParameter("parameter " + pnh.resolveName("scene") + " = " + scene_path + ": " +
-                           e.what());
-  }
+  Scene scene = loadSceneParam(pnh, "scene", scene_path);
+  if (!replay_scene.empty())
+    scene.effects = loadSceneParam(pnh, "replay_scene", replay_scene).effects;
   const PlanningProblem& p = scene.problem;
   if (max_step == 0.0) max_step = 0.25 * p.duration / p.steps;
   odometry_pub_ = nh.advertise<nav_msgs::Odometry>("odometry", 10);
@@ -65,10 +65,20 @@ PlantNode::PlantNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   timer_ = nh.createTimer(ros::Duration(1.0 / rate), &PlantNode::onTimer, this);
   ROS_INFO(
-      "attitude_plant_node: %s, %zu effects, odometry at %g Hz (rate factor %g), waiting for "
-      "%s",
-      scene_path.c_str(), scene.effects.size(), rate, rate_factor_,
+      "attitude_plant_node: %s, %zu effects%s%s, odometry at %g Hz (rate factor %g), frames %s -> "
+      "%s, waiting for %s",
+      scene_path.c_str(), scene.effects.size(), replay_scene.empty() ? "" : " of ",
+      replay_scene.c_str(), rate, rate_factor_, world_frame_.c_str(), body_frame_.c_str(),
       command_sub_.getTopic().c_str());
+}
+
+Scene PlantNode::loadSceneParam(const ros::NodeHandle& pnh, const std::string& name,
+                                const std::string& path) {
+  try {
+    return loadScene(path);
+  } catch (const std::exception& e) {
+    throw InvalidParameter("parameter " + pnh.resolveName(name) + " = " + path + ": " + e.what());
+  }
 }
 
 double PlantNode::maneuverTime(const ros::Time& stamp) const {

@@ -1200,12 +1200,10 @@ void TrackerNode::runReplay(Replay replay) {
   ROS_INFO("%s done: terminal attitude error %.3g rad, rate error %.3g rad/s vs the plan's end",
            result.mode.c_str(), result.terminal_attitude_error, result.terminal_velocity_error);
   publishDone(result);
-  // The simulated body stays where it ended; an external body goes on moving (its measurements,
-  // not a held pose, say where).
-  if (plant_ == PlantKind::Internal) {
-    held_ = HeldPose{pb.world_frame, pb.body_frame,
-                     rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
-  }
+  // The simulated body stays where it ended; an external body goes on moving (holdFinalAttitude
+  // follows its measurements).
+  held_ = HeldPose{pb.world_frame, pb.body_frame,
+                   rc::attitudeFromMsg(result.final_attitude, "final_attitude")};
 }
 
 void TrackerNode::holdFinalAttitude() {
@@ -1221,6 +1219,10 @@ void TrackerNode::holdFinalAttitude() {
     const ros::Time now = ros::Time::now();
     if (!now.isZero() && now > tf.header.stamp) {  // sim time may pause: never a repeated stamp
       tf.header.stamp = now;
+      if (plant_ == PlantKind::External) {  // the body where it is measured now, not where it was
+        if (const std::optional<Matrix3> R = measuredAttitude(*held_))
+          tf.transform.rotation = rc::attitudeToMsg(*R);
+      }
       tf_broadcaster_.sendTransform(tf);
     }
     ros::WallDuration(kHoldPeriod).sleep();
@@ -1400,6 +1402,26 @@ void TrackerNode::onWheelMeasurement(const sensor_msgs::JointState::ConstPtr& ms
   wheel_received_ = ros::Time::now();
 }
 
+std::optional<Matrix3> TrackerNode::measuredAttitude(const HeldPose& frames) {
+  nav_msgs::Odometry::ConstPtr msg;
+  {
+    std::lock_guard<std::mutex> lock(odometry_mutex_);
+    msg = odometry_;
+  }
+  if (!msg) return std::nullopt;
+  const std::string& frame = msg->header.frame_id;
+  const std::string& child = msg->child_frame_id;
+  if ((!frame.empty() && frame != frames.world_frame) ||
+      (!child.empty() && child != frames.body_frame)) {
+    return std::nullopt;
+  }
+  try {
+    return rc::measuredStateFromMsg(*msg).attitude;
+  } catch (const std::exception&) {
+    return std::nullopt;  // a bad quaternion: the last good attitude stays
+  }
+}
+
 MeasurementAtSample TrackerNode::measurementAt(const Playback& pb, const ros::Time& start,
                                                const ros::Time& stamp, const Vector3& held_command,
                                                bool predict) {
@@ -1561,6 +1583,10 @@ MeasurementAtSample TrackerNode::wheelMeasurementAt(const Playback& pb, const ro
   if (!wheels) return unusable("no measurement on " + wheel_measurement_sub_.getTopic() + " yet");
   const ros::Time taken = wheels->header.stamp.isZero() ? received : wheels->header.stamp;
   const double age = (stamp - taken).toSec();
+  {
+    std::lock_guard<std::mutex> lock(health_mutex_);
+    health_.wheel_measurement_age = age;
+  }
   if (age > measurement_timeout_) {
     return unusable("newest wheel_measurement is " + exactNumber(age) +
                     " s old (~measurement_timeout " + exactNumber(measurement_timeout_) + " s)");

@@ -104,8 +104,20 @@ TEST(NodeParameters, PlantNodeNeedsASceneAndRunsWithOne) {
   expectStopped(kPlant + " __name:=sceneless_plant", {"/sceneless_plant/scene is required"});
   expectStopped(kPlant + " __name:=bad_plant_rate _rate:=0" + scene,
                 {"/bad_plant_rate/rate = 0 is invalid"});
+  // ~replay_scene (tracker.launch's plant:=node passes it on): a scene whose effects act instead.
+  expectStopped(kPlant + " __name:=bad_replay_plant _replay_scene:=/no/such/scene.yaml" + scene,
+                {"/bad_replay_plant/replay_scene = /no/such/scene.yaml", "no readable file"});
+  expectStopped(
+      kPlant + " __name:=wrong_replay_plant _replay_scene:=" AP_SOURCE_DIR "/launch/plant.launch" +
+          scene,
+      {"/wrong_replay_plant/replay_scene = "});
   const NodeRun good = runNode(kPlant + " __name:=good_plant" + scene, 5);
   EXPECT_EQ(good.status, kTimeoutExit) << "the plant should still run:\n" << good.output;
+  const NodeRun replayed =
+      runNode(kPlant + " __name:=replay_plant" + scene +
+                  " _replay_scene:=" AP_SOURCE_DIR "/scenes/disturbed_replay.yaml",
+              5);
+  EXPECT_EQ(replayed.status, kTimeoutExit) << "the plant should still run:\n" << replayed.output;
 }
 
 TEST(NodeParameters, PlantNodeWithWheelsNeedsSpinInertiasAndNoActuatorEffects) {

@@ -1264,6 +1264,12 @@ TEST(Diagnostics, TrackerStatusWarnsOnAStaleMeasurementOrAFailedReplanAndErrsOnA
   health.attitude_error = 0.25;
   EXPECT_EQ(trackerStatus("/t", health).level, diagnostic_msgs::DiagnosticStatus::OK);
   EXPECT_EQ(valueOf(trackerStatus("/t", health), "attitude error [rad]"), "0.25");
+  // Each measurement's age under its own key: the body's odometry and the wheels' spin rates.
+  EXPECT_EQ(valueOf(trackerStatus("/t", health), "wheel measurement age [s]"), "-1");
+  health.measurement_age = 0.01;
+  health.wheel_measurement_age = 1.5;
+  EXPECT_EQ(valueOf(trackerStatus("/t", health), "measurement age [s]"), "0.01");
+  EXPECT_EQ(valueOf(trackerStatus("/t", health), "wheel measurement age [s]"), "1.5");
   health.measurement_problem = "newest odometry is 0.9 s old (~measurement_timeout 0.5 s)";
   diagnostic_msgs::DiagnosticStatus status = trackerStatus("/t", health);
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);

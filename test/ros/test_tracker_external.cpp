@@ -1,8 +1,8 @@
-// rostest (tracker_external.test): the tracker's external plant mode. The same plan of
-// scenes/leo_slew.yaml under scenes/disturbed_replay.yaml's torque noise (a disturbance the plan
-// never saw) flown by the internal feedback mode (/internal) and by the same law on the measured
-// state of attitude_plant_node over ROS topics (/external): the external loop lands within 2x
-// the internal one's terminal attitude error. A tracker with no measurement (/unmeasured) sends
+// rostest (tracker_external.test, TrackerExternal.*): the tracker's external plant mode. The same
+// plan of scenes/leo_slew.yaml under scenes/disturbed_replay.yaml's torque noise (a disturbance the
+// plan never saw) flown by the internal feedback mode (/internal) and by the same law on the
+// measured state of attitude_plant_node over ROS topics (/external): the external loop lands within
+// 2x the internal one's terminal attitude error. A tracker with no measurement (/unmeasured) sends
 // zero commands at its rate, warns, and ends with a failed `done`: nothing blocks.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -13,13 +13,20 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <std_msgs/Float64.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <atomic>
+#include <cmath>
+#include <deque>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "attitude_planner/ReplayResult.h"
+#include "attitude_planner/lie/so3.hpp"
+#include "attitude_planner/ros/conversions.hpp"
 #include "ros_test_helpers.hpp"
 
 using namespace attitude_planner;
@@ -95,6 +102,46 @@ struct StaleSource {
 };
 StaleSource* stale_source = nullptr;
 CommandCounter* stale_commands = nullptr;
+
+/// What rviz/maneuver.rviz shows of one tracker (namespace `ns`, body frame `ns/body`): the
+/// per-sample topics' message counts, the latched ones', and the body's transforms on /tf (how
+/// many, and the newest: its rotation and when it arrived).
+struct ShownTopics {
+  explicit ShownTopics(const std::string& ns) : nh(ns), body_frame(ns + "/body") {
+    for (const char* topic : {"body_marker", "ghost_markers", "constraint_markers", "legend"})
+      count<visualization_msgs::MarkerArray>(topic);
+    for (const char* topic : {"attitude_trail", "status_text", "attitude_path"})
+      count<visualization_msgs::Marker>(topic);
+    count<geometry_msgs::WrenchStamped>("torque");
+    tf = nh.subscribe<tf2_msgs::TFMessage>(
+        "/tf", 1000, [this](const tf2_msgs::TFMessage::ConstPtr& m) {
+          for (const geometry_msgs::TransformStamped& t : m->transforms) {
+            if (t.child_frame_id != body_frame) continue;
+            std::lock_guard<std::mutex> lock(mutex);
+            ++transforms;
+            last_rotation = t.transform.rotation;
+            last_arrival = ros::WallTime::now();
+          }
+        });
+  }
+  template <class Message>
+  void count(const std::string& topic) {
+    subs.push_back(
+        nh.subscribe<Message>(topic, 1000, [this, topic](const typename Message::ConstPtr&) {
+          std::lock_guard<std::mutex> lock(mutex);
+          ++counts[topic];
+        }));
+  }
+  ros::NodeHandle nh;
+  std::string body_frame;
+  std::mutex mutex;
+  std::map<std::string, int> counts;
+  int transforms = 0;
+  geometry_msgs::Quaternion last_rotation;
+  ros::WallTime last_arrival;
+  std::vector<ros::Subscriber> subs;
+  ros::Subscriber tf;
+};
 
 }  // namespace
 
@@ -230,6 +277,80 @@ TEST(TrackerExternal, AStaleMeasurementGivesZeroCommandsAWarningAndAFailedDone) 
     EXPECT_GT(stale_source->ages[i], 0.5) << "status " << i;
     EXPECT_LT(stale_source->ages[i], 2.0 * StaleSource::kAge) << "status " << i;
   }
+}
+
+// tracker_plant_loop.test (this binary filtered to TrackerPlantLoop.*): tracker.launch's
+// plant:=node against its plant:=internal on one scene.
+TEST(TrackerPlantLoop, LaunchedPlantNodeLandsAsTheInProcessBodyAndShowsTheSameTopics) {
+  // plant:=internal simulates the body in the tracker; plant:=node starts attitude_plant_node in
+  // the namespace (scene's body, replay_scene's effects, the tracker's clock and frames) and the
+  // tracker flies it over odometry / torque_command. The same law under the same unplanned noise
+  // lands within a factor 2 either way (tracker_external.test measured 1.01-1.04x), and rviz gets
+  // the same topics, the same number of samples, and the body's transform held after the run.
+  ShownTopics in_process("in_process"), over_topics("over_topics");
+  CommandCounter commands(over_topics.nh);
+  std::atomic<int> odometry{0};
+  std::mutex measured_mutex;
+  std::deque<Matrix3> measured;  // the plant's newest attitudes
+  ros::Subscriber odometry_sub = over_topics.nh.subscribe<nav_msgs::Odometry>(
+      "odometry", 1000, [&](const nav_msgs::Odometry::ConstPtr& m) {
+        if (m->child_frame_id != "over_topics/body") return;
+        ++odometry;
+        std::lock_guard<std::mutex> lock(measured_mutex);
+        measured.push_back(ros_conversions::attitudeFromMsg(m->pose.pose.orientation, "odometry"));
+        if (measured.size() > 200) measured.pop_front();  // a second at the plant's 200 Hz
+      });
+  ros_testing::DoneListener in_done(in_process.nh), over_done(over_topics.nh);
+  const ReplayResult::ConstPtr internal = in_done.wait(150.0);
+  const ReplayResult::ConstPtr node = over_done.wait(30.0);
+  ASSERT_TRUE(internal && node) << "no done from both trackers";
+  ASSERT_TRUE(internal->success) << internal->message;
+  ASSERT_TRUE(node->success) << node->message;
+  EXPECT_EQ(node->mode, "feedback");
+  EXPECT_EQ(node->replay_effects, internal->replay_effects);
+  std::printf("plant:=node %.3g rad, plant:=internal %.3g rad (ratio %.3g); effort %.5g and %.5g\n",
+              node->terminal_attitude_error, internal->terminal_attitude_error,
+              node->terminal_attitude_error / internal->terminal_attitude_error, node->effort,
+              internal->effort);
+  EXPECT_GT(internal->terminal_attitude_error, 1e-7) << "the unplanned noise moves the body";
+  EXPECT_LE(node->terminal_attitude_error, 2.0 * internal->terminal_attitude_error);
+  EXPECT_GE(node->terminal_attitude_error, 0.5 * internal->terminal_attitude_error);
+  EXPECT_NEAR(node->effort, internal->effort, 0.05 * internal->effort);
+  // The loop went through the launched plant: its odometry in the namespace's default body
+  // frame (the plant's empty ~body_frame paired with the tracker's), a command per sample.
+  EXPECT_GT(odometry, 100);
+  ros::WallDuration(1.0).sleep();  // the final zero command; a few held transforms
+  {
+    std::lock_guard<std::mutex> lock(commands.mutex);
+    EXPECT_EQ(commands.count, 302) << "one command per sample and the final zero";
+    EXPECT_EQ(commands.frame, "over_topics/body");
+  }
+  const ros::WallTime after_done = ros::WallTime::now() - ros::WallDuration(0.5);
+  for (ShownTopics* shown : {&in_process, &over_topics}) {
+    std::lock_guard<std::mutex> lock(shown->mutex);
+    for (const char* topic : {"body_marker", "status_text", "torque"})
+      EXPECT_EQ(shown->counts[topic], 301) << shown->body_frame << " " << topic << ": per sample";
+    EXPECT_GE(shown->counts["attitude_trail"], 300) << shown->body_frame << ": from the 2nd sample";
+    for (const char* topic : {"attitude_path", "ghost_markers", "constraint_markers", "legend"})
+      EXPECT_GE(shown->counts[topic], 1) << shown->body_frame << " " << topic << ": latched";
+    EXPECT_GT(shown->transforms, 301) << shown->body_frame << ": the samples and the hold";
+    EXPECT_GT(shown->last_arrival, after_done) << shown->body_frame << ": held after the run";
+  }
+  // Held where the body is: the simulated one exactly where the run ended; the plant's body,
+  // uncontrolled under the scene's effects (60 maneuver seconds per ROS second), where it is
+  // measured: one of the plant's newest attitudes.
+  const auto held = [](ShownTopics& shown) {
+    std::lock_guard<std::mutex> lock(shown.mutex);
+    return ros_conversions::attitudeFromMsg(shown.last_rotation, "tf");
+  };
+  EXPECT_LT(so3::angleBetween(held(in_process),
+                              ros_conversions::attitudeFromMsg(internal->final_attitude, "done")),
+            1e-9);
+  const Matrix3 shown = held(over_topics);
+  std::lock_guard<std::mutex> lock(measured_mutex);
+  double nearest = M_PI;
+  for (const Matrix3& R : measured) nearest = std::min(nearest, so3::angleBetween(shown, R));
+  EXPECT_LT(nearest, 1e-9) << "the held transform is a measured attitude";
 }
 
 int main(int argc, char** argv) {

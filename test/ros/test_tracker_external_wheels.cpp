@@ -4,17 +4,22 @@
 // ROS topics (/external_wheels: odometry and the wheels' spin rates in, wheel torques out): the
 // external loop lands within 2x the internal one's terminal attitude error, every command within
 // the wheels' torque limits, named wheel_1..4; without spin inertias (/nospin) the external mode
-// is refused by name; without a plant (/unmeasured_wheels) every wheel command is zero and `done`
-// fails: nothing blocks.
+// is refused by name; without a plant (/unmeasured_wheels), or with a stale wheel_measurement
+// (/stale_wheels), every wheel command is zero and `done` fails: nothing blocks.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <nav_msgs/Odometry.h>
 #include <sensor_msgs/JointState.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <mutex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "attitude_planner/ReplayResult.h"
@@ -44,12 +49,75 @@ struct JointCounter {
   ros::Subscriber sub;
 };
 
-/// The topics every test reads, subscribed in main before any run starts (the runs go on while
-/// the tests before one wait).
+/// /stale_wheels' measurements: odometry of the right frames stamped now and wheel_measurement
+/// (every wheel at rest relative to the body) stamped `kAge` seconds old, both at 50 Hz; and the
+/// tracker's /diagnostics statuses while it flies (level, the two measurement ages).
+struct StaleWheelSource {
+  static constexpr double kAge = 1.5;  // [s], three times the tracker's ~measurement_timeout
+  StaleWheelSource()
+      : nh("stale_wheels"),
+        odometry(nh.advertise<nav_msgs::Odometry>("odometry", 10)),
+        wheels(nh.advertise<sensor_msgs::JointState>("wheel_measurement", 10)),
+        diagnostics(
+            ros::NodeHandle().subscribe("/diagnostics", 100, &StaleWheelSource::onStatus, this)),
+        thread([this] { publish(); }) {}
+  ~StaleWheelSource() {
+    stop = true;
+    thread.join();
+  }
+  void publish() {
+    nav_msgs::Odometry body;
+    body.header.frame_id = "world";
+    body.child_frame_id = "stale_wheels_body";
+    body.pose.pose.orientation.w = 1.0;
+    sensor_msgs::JointState spin;
+    spin.header.frame_id = "stale_wheels_body";
+    spin.name = {"wheel_1", "wheel_2", "wheel_3", "wheel_4"};
+    spin.velocity.assign(4, 0.0);
+    while (!stop && ros::ok()) {
+      body.header.stamp = ros::Time::now();
+      spin.header.stamp = body.header.stamp - ros::Duration(kAge);
+      odometry.publish(body);
+      wheels.publish(spin);
+      ros::WallDuration(0.02).sleep();
+    }
+  }
+  void onStatus(const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+    for (const diagnostic_msgs::DiagnosticStatus& s : array->status) {
+      if (s.name.find("/stale_wheels/") != 0) continue;
+      bool running = false;
+      double body_age = -1.0, wheel_age = -1.0;
+      for (const diagnostic_msgs::KeyValue& kv : s.values) {
+        if (kv.key == "running") running = kv.value == "true";
+        if (kv.key == "measurement age [s]") body_age = std::stod(kv.value);
+        if (kv.key == "wheel measurement age [s]") wheel_age = std::stod(kv.value);
+      }
+      if (!running) continue;
+      std::lock_guard<std::mutex> lock(mutex);
+      levels.push_back(s.level);
+      body_ages.push_back(body_age);
+      wheel_ages.push_back(wheel_age);
+    }
+  }
+  ros::NodeHandle nh;
+  ros::Publisher odometry, wheels;
+  ros::Subscriber diagnostics;
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::vector<int> levels;                    ///< the tracker's status levels while it flew
+  std::vector<double> body_ages, wheel_ages;  ///< the odometry's and the wheels' ages [s]
+  std::thread thread;
+};
+
+/// The topics every test reads, subscribed (and /stale_wheels' measurements published) in main
+/// before any run starts (the runs go on while the tests before one wait).
 struct Counters {
-  ros::NodeHandle external{"external_wheels"}, unmeasured{"unmeasured_wheels"};
+  ros::NodeHandle external{"external_wheels"}, unmeasured{"unmeasured_wheels"},
+      stale{"stale_wheels"};
   JointCounter commands{external, "wheel_command"}, measured{external, "wheel_measurement"};
   JointCounter unmeasured_commands{unmeasured, "wheel_command"};
+  JointCounter stale_commands{stale, "wheel_command"};
+  StaleWheelSource stale_source;
 };
 Counters* counters = nullptr;
 
@@ -173,6 +241,40 @@ TEST(TrackerExternalWheels, WithoutMeasurementsEveryWheelCommandIsZeroAndDoneFai
   EXPECT_GT(commands.count, 200) << "the stream keeps its rate without measurements";
   EXPECT_EQ(commands.largest_effort, 0.0);
   EXPECT_EQ(commands.names, (std::set<std::string>{"wheel_1", "wheel_2", "wheel_3", "wheel_4"}));
+}
+
+TEST(TrackerExternalWheels, AStaleWheelMeasurementGivesZeroCommandsAWarningAndAFailedDone) {
+  // Fresh odometry, but every wheel_measurement stamped 1.5 s old (~measurement_timeout 0.5 s):
+  // the wheels' momenta are unknown, so the same as a stale odometry. Every sample commands zero,
+  // the tracker's status warns with the wheels' age past the timeout (the body's is fresh),
+  // `done` fails; the stream keeps its rate.
+  ros::NodeHandle nh("stale_wheels");
+  JointCounter& commands = counters->stale_commands;
+  StaleWheelSource& source = counters->stale_source;
+  ros_testing::DoneListener listener(nh);
+  const ReplayResult::ConstPtr done = listener.wait(120.0);
+  ASSERT_TRUE(done) << "no done from /stale_wheels";
+  EXPECT_FALSE(done->success);
+  EXPECT_NE(done->message.find("had no fresh measurement and got a zero command"),
+            std::string::npos)
+      << done->message;
+  ros::WallDuration(0.5).sleep();  // the final zero command
+  {
+    std::lock_guard<std::mutex> lock(commands.mutex);
+    EXPECT_GT(commands.count, 200) << "one command per sample (20 s at 12.5 samples per s)";
+    EXPECT_EQ(commands.largest_effort, 0.0);
+    EXPECT_EQ(commands.names, (std::set<std::string>{"wheel_1", "wheel_2", "wheel_3", "wheel_4"}));
+  }
+  std::lock_guard<std::mutex> lock(source.mutex);
+  // About 10 statuses over the 10 s run (1 Hz); the first may precede the first sample.
+  ASSERT_GE(source.levels.size(), 4u) << "too few /diagnostics statuses from /stale_wheels";
+  for (std::size_t i = 1; i < source.levels.size(); ++i) {
+    EXPECT_EQ(source.levels[i], diagnostic_msgs::DiagnosticStatus::WARN) << "status " << i;
+    EXPECT_GT(source.wheel_ages[i], 0.5) << "status " << i << ": the wheels' stamps, stale";
+    EXPECT_LT(source.wheel_ages[i], 2.0 * StaleWheelSource::kAge) << "status " << i;
+    // Measured (not the -1 of none) and fresh: stamped about when the sample was taken.
+    EXPECT_LT(std::abs(source.body_ages[i]), 0.5) << "status " << i << ": odometry fresh";
+  }
 }
 
 // tracker_wheels_loop.test (this binary filtered to TrackerWheelsLoop.*): the spin scene's plan

@@ -65,6 +65,8 @@ struct TrackerHealth {
   double attitude_error = 0.0;    ///< |log(R_dᵀR)| at the newest sample [rad]
   double rate_error = 0.0;        ///< |e_Ω| at the newest sample [rad/s]
   double measurement_age = -1.0;  ///< external plant: age of the newest odometry [s] (< 0: none)
+  /// External plant with wheels: age of the newest wheel_measurement [s] (< 0: none)
+  double wheel_measurement_age = -1.0;
   /// External plant: why the newest sample had no usable measurement (stale, missing, wrong
   /// frames), as the tracker's own check said; empty when it had one.
   std::string measurement_problem;

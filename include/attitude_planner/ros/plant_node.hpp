@@ -36,12 +36,16 @@
 //
 // Private parameters (a bad value stops the node with exit status 78, naming it):
 //   ~scene        string  (required)  scene YAML: inertia, initial state, effects
+//   ~replay_scene string  ""          scene YAML whose effects act instead of ~scene's (its body
+//                                     and states are not used: as the tracker's ~replay_scene)
 //   ~rate         double  100.0       odometry messages per ROS second [Hz] (> 0)
 //   ~rate_factor  double  1.0         maneuver seconds per ROS second (> 0; the tracker's)
 //   ~max_step     double  0.0         largest integration step [s, maneuver time] (>= 0;
 //                                     0 = a quarter of the scene's time step T / N)
 //   ~world_frame  string  "world"     odometry header.frame_id
-//   ~body_frame   string  "body"      odometry child_frame_id, and the command's frame
+//   ~body_frame   string  "body"      odometry child_frame_id, and the command's frame; "" =
+//                                     the tracker's default in this namespace (defaultBodyFrame:
+//                                     "body" in the root namespace, "NS/body" in /NS)
 #pragma once
 
 #include <memory>
@@ -54,6 +58,7 @@
 
 #include "attitude_planner/analysis/tracking.hpp"
 #include "attitude_planner/analysis/wheel_plant.hpp"
+#include "attitude_planner/io/scene.hpp"
 
 namespace attitude_planner {
 
@@ -65,6 +70,9 @@ class PlantNode {
   PlantNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
 
  private:
+  /// The scene of parameter `name` (at `path`); InvalidParameter naming it if it does not load.
+  static Scene loadSceneParam(const ros::NodeHandle& pnh, const std::string& name,
+                              const std::string& path);
   /// `torque_command`: integrates up to the command's time, then holds the new command.
   void onCommand(const geometry_msgs::WrenchStamped::ConstPtr& msg);
   /// `wheel_command` (a scene with wheels): integrates up to its time, then holds the torques.

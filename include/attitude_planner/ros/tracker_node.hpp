@@ -121,7 +121,9 @@
 //   ~plant            string  "internal" internal: the tracker simulates the body itself (above);
 //                                      external: the body is the user's — the tracker subscribes
 //                                      to its measured state (`odometry`) and publishes the
-//                                      command (`torque_command`) at ~rate (docs/ros_tracker.md)
+//                                      command (`torque_command`) at ~rate (docs/ros_tracker.md);
+//                                      tracker.launch's plant:=node is external on an
+//                                      attitude_plant_node the launch starts in the namespace
 //   ~measurement_timeout double 0.5    [s, ROS time] an `odometry` older than this at a sample
 //                                      is stale: zero command, a warning, `done` fails (external)
 //
@@ -134,7 +136,8 @@
 // `torque_command` (geometry_msgs/WrenchStamped, body frame) the law's command on it
 // (TrackingLaw, feedback; the law on the plan in force, replan, re-planned from the measured
 // state) or the plan's torque τ(t) (replay). tf, markers and errors show the
-// measured body. After the last sample a zero command is sent.
+// measured body. After the last sample a zero command is sent, and tf follows the newest
+// measured attitude until the next maneuver.
 #pragma once
 
 #include <atomic>
@@ -407,6 +410,10 @@ class TrackerNode {
   /// Sets the frame pair the current run publishes; returns the conflict seen since the last
   /// call ("" if none) and clears it.
   std::string claimFrames(const std::string& world_frame, const std::string& body_frame);
+  struct HeldPose;
+  /// The newest `odometry`'s attitude when its frames are `frames`' (empty ones taken as those)
+  /// and its quaternion is usable; none otherwise.
+  std::optional<Matrix3> measuredAttitude(const HeldPose& frames);
   /// `odometry` callback: keeps the newest measurement.
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   /// The newest measurement at the sample stamped `stamp` of the run started at `start`, moved
@@ -500,8 +507,9 @@ class TrackerNode {
                    const std::string& body_frame, const PrincipalBox& box,
                    const Vector3& trace_axis, std::deque<Vector3>* trail,
                    const visualization_msgs::MarkerArray& world_axes = {});
-  /// After a rigid-body run: publishes world → body at the run's final attitude every 0.1 s (wall)
-  /// until the next maneuver or shutdown (the replay thread's last job).
+  /// After a rigid-body run: publishes world → body at the run's final attitude (external plant:
+  /// the newest measured one) every 0.1 s (wall) until the next maneuver or shutdown (the replay
+  /// thread's last job).
   void holdFinalAttitude();
   /// Publishes `done` (latched); with ~exit_when_done, then shuts the node down.
   void publishDone(ReplayResult result);

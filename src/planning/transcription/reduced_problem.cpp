@@ -235,35 +235,71 @@ std::vector<Matrix3> ReducedProblem::attitudes(const StepVectors& steps) const {
   return R;
 }
 
-std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
-  std::vector<Vector3> tau(N_ + 1, Vector3::Zero());
-  const double h = scheme_.timeStep();
-  Matrix3 E_prev = so3::expMinusIdentity(steps[0]);  // F_{k−1} − I
-  Vector3 mu_prev = scheme_.momentumOfStep(steps[0], E_prev);
-  Matrix3 R = initial_attitude_;  // R_k, only needed with effects
-  for (int k = 1; k < N_; ++k) {
-    const Matrix3 E = so3::expMinusIdentity(steps[k]);
-    const Vector3 mu = scheme_.momentumOfStep(steps[k], E);
+namespace {
+
+/// τ_k, k = 0..N, of `steps` (ReducedProblem::torques), and with `attitudes` the rows
+/// R_{k+1} = R_k F_k from the same pass. Each step's exp(ω^) and exp(ω^) − I come from one
+/// Rodrigues evaluation (so3::expWithMinusIdentity: the values of exp and expMinusIdentity, so
+/// the rows are attitudes()' and the torques are the same with or without them).
+std::vector<Vector3> stepTorques(const DiscreteScheme& scheme,
+                                 const ReducedProblem::StepVectors& steps, int N,
+                                 const Matrix3& initial_attitude, const Vector3& initial_momentum,
+                                 const Vector3& final_momentum, const EffectModel* effects,
+                                 std::vector<Matrix3>* attitudes) {
+  std::vector<Vector3> tau(N + 1, Vector3::Zero());
+  const double h = scheme.timeStep();
+  const bool track_attitude = attitudes || effects;
+  // F = exp(ω^) only where the attitudes are followed; E = F − I always.
+  const auto step = [&](const Vector3& omega, Matrix3* F, Matrix3* E) {
+    if (track_attitude) {
+      so3::expWithMinusIdentity<double>(omega, F, E);
+    } else {
+      *E = so3::expMinusIdentity(omega);
+    }
+  };
+  Matrix3 F_prev, E_prev;  // F_{k−1}, F_{k−1} − I
+  step(steps[0], &F_prev, &E_prev);
+  const Vector3 mu_first = scheme.momentumOfStep(steps[0], E_prev);
+  Vector3 mu_prev = mu_first;
+  Matrix3 R = initial_attitude;  // R_k, only needed with effects or attitudes
+  if (attitudes) {
+    attitudes->resize(N + 1);
+    (*attitudes)[0] = R;
+  }
+  for (int k = 1; k < N; ++k) {
+    Matrix3 F, E;
+    step(steps[k], &F, &E);
+    const Vector3 mu = scheme.momentumOfStep(steps[k], E);
     // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
     // cancel in a difference of accurately formed momenta.
     tau[k] = ((mu - mu_prev) - E_prev.transpose() * mu_prev) / h;
-    if (effects_) {
-      R = R * so3::exp(steps[k - 1]);
-      tau[k] -= effects_->torque(R, k * h);  // the control supplies what the effects do not
-    }
+    if (track_attitude) R = R * F_prev;
+    if (attitudes) (*attitudes)[k] = R;
+    if (effects) tau[k] -= effects->torque(R, k * h);  // the control supplies the rest
     mu_prev = mu;
     E_prev = E;
+    if (track_attitude) F_prev = F;
   }
-  if (scheme_.hasEndTorques()) {
+  if (track_attitude) R = R * F_prev;  // R_N
+  if (attitudes) (*attitudes)[N] = R;
+  if (scheme.hasEndTorques()) {
     // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N
-    tau[0] = 2.0 * (scheme_.momentumOfStep(steps[0]) - initial_momentum_) / h;
-    tau[N_] = 2.0 * (final_momentum_ - so3::exp(steps[N_ - 1]).transpose() * mu_prev) / h;
-    if (effects_) {
-      tau[0] -= effects_->torque(initial_attitude_, 0.0);
-      tau[N_] -= effects_->torque(Matrix3(R * so3::exp(steps[N_ - 1])), N_ * h);
+    tau[0] = 2.0 * (mu_first - initial_momentum) / h;
+    const Matrix3 F_last = track_attitude ? F_prev : so3::exp(steps[N - 1]);
+    tau[N] = 2.0 * (final_momentum - F_last.transpose() * mu_prev) / h;
+    if (effects) {
+      tau[0] -= effects->torque(initial_attitude, 0.0);
+      tau[N] -= effects->torque(R, N * h);
     }
   }
   return tau;
+}
+
+}  // namespace
+
+std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
+  return stepTorques(scheme_, steps, N_, initial_attitude_, initial_momentum_, final_momentum_,
+                     effects_.get(), nullptr);
 }
 
 bool ReducedProblem::onPrincipalBranch(const StepVectors& steps) const {
@@ -274,8 +310,9 @@ bool ReducedProblem::onPrincipalBranch(const StepVectors& steps) const {
 Maneuver ReducedProblem::maneuver(const StepVectors& steps) const {
   Maneuver m;
   m.time_step = scheme_.timeStep();
-  m.attitude = attitudes(steps);
-  m.torque = torques(steps);
+  // The rows R_k from the torques' pass over the steps (one exponential per step, not two).
+  m.torque = stepTorques(scheme_, steps, N_, initial_attitude_, initial_momentum_, final_momentum_,
+                         effects_.get(), &m.attitude);
   m.time.resize(N_ + 1);
   m.angular_velocity.resize(N_ + 1);
   for (int k = 0; k <= N_; ++k) m.time[k] = k * m.time_step;

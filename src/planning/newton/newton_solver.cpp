@@ -715,7 +715,9 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
       }
     }
   }
-  return walk.finish();
+  PlanResult result = walk.finish();
+  context.recordLevels(result.levels);  // the plan's: its kept attempt's
+  return result;
 }
 
 }  // namespace attitude_planner

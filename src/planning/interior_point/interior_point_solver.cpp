@@ -302,9 +302,7 @@ void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
     }
     if (feasible_level > 0) {
       result->termination = Termination::NotConverged;
-      result->message = "not converged: the N = " + std::to_string(feasible_level) +
-                        " level met every constraint, but a finer level stopped (" +
-                        result->message + ")";
+      frameMessage(result, frames::FinerLevelStopped{feasible_level});
     }
   }
   addNote(result, notes::GridContinuation{record.levels.front().steps});

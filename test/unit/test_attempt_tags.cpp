@@ -281,6 +281,87 @@ TEST(AttemptTags, APointingRequestsTrailIsTheContextsTrail) {
   expectTheContextsTrail(r, context, r.converged());
 }
 
+TEST(AttemptTags, APointingMinimumTimeRequestsTrailIsTheContextsTrailTaggedWithItsTwists) {
+  // Minimum time to a pointing target: each start twist's fixed-twist solves (on the survey grid,
+  // then the best on N), with and without a time margin; the trail is what the context recorded,
+  // and every attempt names the start twist it was posed at.
+  ap::PlanningProblem p =
+      ap::test_support::randomBettsPointingRequest(4303, 32, ap::SchemeKind::SecondOrder);
+  for (const double margin : {0.0, 0.05}) {
+    SCOPED_TRACE(margin);
+    p.time_margin = margin;
+    const ap::SolverOptions options;
+    ap::SolveContext context(options);
+    const ap::PlanResult r = ap::planMinimumTime(p, context);
+    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_FALSE(r.attempts.empty());
+    expectTheContextsTrail(r, context);
+    std::set<double> twists;
+    for (const ap::Attempt& a : r.attempts) {
+      EXPECT_TRUE(std::isfinite(a.start_detail.twist)) << ap::attemptStageName(a.stage);
+      twists.insert(a.start_detail.twist);
+    }
+    EXPECT_GT(twists.size(), 1u) << "the start twists are told apart";
+  }
+}
+
+TEST(AttemptTags, ABoundedPointingRequestsTrailIsTheContextsTrail) {
+  // Minimum effort to a pointing target below T* (the twist free): the interior point ends
+  // infeasible and the minimum-time phase over the start twists backs the verdict; the trail
+  // holds both, as the context recorded them.
+  ap::PlanningProblem p =
+      ap::test_support::randomBettsPointingRequest(4303, 32, ap::SchemeKind::SecondOrder);
+  const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
+  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  p.objective = ap::Objective::MinimumEffort;
+  p.duration = 0.9 * fastest.minimum_duration;
+  const ap::SolverOptions options;
+  ap::SolveContext context(options);
+  const ap::PlanResult r = ap::planBoundedMinimumEffort(p, context);
+  EXPECT_FALSE(r.converged()) << r.message;
+  EXPECT_TRUE(std::any_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+    return a.stage == ap::AttemptStage::MinimumTimeSolve && std::isfinite(a.start_detail.twist);
+  })) << r.message;
+  expectTheContextsTrail(r, context, false);
+}
+
+/// The result's levels are what the request's context recorded, level for level.
+void expectTheContextsLevels(const ap::PlanResult& r, const ap::SolveContext& context) {
+  const std::vector<ap::LevelSummary>& levels = context.levels();
+  ASSERT_EQ(levels.size(), r.levels.size()) << r.message;
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(r.levels[i].steps, levels[i].steps);
+    EXPECT_EQ(r.levels[i].iterations, levels[i].iterations);
+    EXPECT_EQ(r.levels[i].termination, levels[i].termination);
+    EXPECT_EQ(r.levels[i].relative_gradient, levels[i].relative_gradient);
+    EXPECT_EQ(r.levels[i].newton_decrement, levels[i].newton_decrement);
+    EXPECT_EQ(r.levels[i].reason, levels[i].reason);
+  }
+}
+
+TEST(AttemptTags, AConstrainedRequestsLevelsAreTheContextsLevels) {
+  // Newton's kept attempt's levels, then every grid solve of the interior point (at N = 512 its
+  // continuation's levels, each from its own unconstrained optimum or the coarser level): the
+  // result's levels are the context's, one of them on the requested grid.
+  for (const int steps : {64, 512}) {
+    for (const char* scene : {"torque_limited", "rate_limited", "sun_keep_out"}) {
+      SCOPED_TRACE(scene);
+      SCOPED_TRACE(steps);
+      ap::PlanningProblem p = ap::test_support::sceneProblem(scene, steps);
+      ap::SolverOptions options;
+      options.enumerate_classes = false;  // one class: the request's levels alone
+      ap::SolveContext context(options);
+      const ap::PlanResult r = ap::planAtResolution(p, options, context);
+      ASSERT_FALSE(r.levels.empty()) << r.message;
+      expectTheContextsLevels(r, context);
+      EXPECT_TRUE(std::any_of(r.levels.begin(), r.levels.end(), [&](const ap::LevelSummary& l) {
+        return l.steps == steps;
+      })) << r.message;
+    }
+  }
+}
+
 TEST(AttemptTags, TheKeptAttemptOfAConstrainedRequestIsAmongTheTagsReported) {
   // Under a torque bound the interior point follows Newton's optimum: its iterations are tagged
   // `constrained`, and the kept attempt's stage and class were reported.

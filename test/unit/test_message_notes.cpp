@@ -127,6 +127,9 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
       ap::frames::OutsideRequestedClass{"it turns 0.3 rad"},
       ap::frames::ReplayFailed{"step 7 too large"},
       ap::frames::PointingStarts{{{0.5, ap::Termination::Converged, 21.8363}}, 0},
+      ap::frames::StagedUnfinished{"rate continuation", 0.375, 4},
+      ap::frames::NoAttemptPlanned{3},
+      ap::frames::FinerLevelStopped{64},
   };
   for (const ap::Frame& frame : all) {
     const std::string words = ap::renderFrame(frame, reason);
@@ -321,7 +324,10 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
                                         v::NewtonEnded{},
                                         v::InteriorPointEnded{},
                                         v::NoBoundaryStep{},
-                                        v::ConeAtFixedNode{}};
+                                        v::ConeAtFixedNode{},
+                                        v::FreeTimeEnded{},
+                                        v::FreeTimeConeAtFixedNode{},
+                                        v::NoStrictlyFeasibleStart{}};
   std::vector<std::string> kinds;
   for (const ap::Verdict& verdict : all) {
     const std::string kind = ap::verdictKindName(verdict);
@@ -365,6 +371,65 @@ TEST(DriverVerdicts, TheSolversFirstReasonsSayTheWordsOfTheirFormerExpressions) 
   EXPECT_EQ(figures[0].value, 41.0);
   EXPECT_EQ(figures[2].name, "barrier_over_cost");
   EXPECT_EQ(figures[2].value, mu);
+}
+
+TEST(DriverVerdicts, TheFreeTimeSolversReasonsSayTheWordsOfTheirFormerExpressions) {
+  // The free-time solve's endings as data: the words free_time_solver wrote itself before (its
+  // expressions, repeated here), and the figures by name.
+  namespace v = ap::verdicts;
+  const double T = 12.0 + 1.0 / 3.0, g = 2.0 / 7.0 * 1e-9, h = 1.0 / 9.0 * 1e-10,
+               gap = 3.0 / 11.0 * 1e-12, c = 1.0 / 13.0;
+  std::ostringstream ended;
+  ended << "converged"
+        << " after " << 23 << " iterations: T = " << T << " s, stationarity " << g << " (h row "
+        << h << "), complementarity " << gap << ", min c " << c;
+  const v::FreeTimeEnded free_time{"converged", 23, T, g, h, gap, c};
+  EXPECT_EQ(ap::renderVerdict(free_time, "ignored"), ended.str());
+  EXPECT_EQ(ap::renderVerdict(v::FreeTimeConeAtFixedNode{"keep_out at R_1 by 0.1 rad"}, ""),
+            std::string("keep_out at R_1 by 0.1 rad") + ", an attitude the boundary data fix");
+  EXPECT_EQ(ap::renderVerdict(v::NoStrictlyFeasibleStart{"no strictly feasible start: x"}, ""),
+            "no strictly feasible start: x");
+  EXPECT_EQ(ap::renderVerdict(v::NoBoundaryStep{"9 rad/s", true}, ""),
+            std::string("the boundary rates admit no step: ") + "9 rad/s");
+  const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(free_time);
+  ASSERT_EQ(figures.size(), 6u);
+  EXPECT_EQ(figures[1].name, "duration");
+  EXPECT_EQ(figures[1].value, T);
+  EXPECT_EQ(figures[5].name, "min_constraint_value");
+  EXPECT_EQ(figures[5].value, c);
+}
+
+TEST(MessageFrames, TheSolversWrappersSayTheWordsOfTheirFormerExpressions) {
+  // Newton's staged continuation that stopped, its walk with no plan on the requested grid, and
+  // the interior point's finer level that stopped: the former hand-built expressions.
+  const std::string reason = "line search failed after 3 iterations";
+  std::ostringstream staged;
+  staged << "inertia homotopy"
+         << " reached s = " << std::max(-0.5, 0.0) << " of 1 (" << 2 << " stages): " << reason;
+  EXPECT_EQ(ap::renderFrame(ap::frames::StagedUnfinished{"inertia homotopy", -0.5, 2}, reason),
+            staged.str());
+  EXPECT_EQ(ap::renderFrame(ap::frames::StagedUnfinished{"x", 0.625, 5}, reason),
+            "x reached s = 0.625 of 1 (5 stages): " + reason);
+  EXPECT_EQ(ap::renderFrame(ap::frames::NoAttemptPlanned{4}, reason),
+            "no attempt produced a plan on the requested grid (" + std::to_string(4) +
+                " tried); the last: " + reason);
+  EXPECT_EQ(ap::renderFrame(ap::frames::FinerLevelStopped{128}, reason),
+            "not converged: the N = " + std::to_string(128) +
+                " level met every constraint, but a finer level stopped (" + reason + ")");
+}
+
+TEST(DriverVerdicts, AReasonCarriedTakesItsVerdictAlong) {
+  // A result given another's reason (a wrapper's, a driver's from its solver's outcome) carries
+  // the verdict with the words, so a frame around it keeps the kind.
+  ap::PlanResult solved;
+  ap::recordVerdict(&solved, ap::verdicts::NewtonEnded{"iteration limit reached", 50, 1e-3, 0.5});
+  ap::PlanResult wrapper;
+  ap::carryReason(&wrapper, solved);
+  ap::frameMessage(&wrapper, ap::frames::StagedUnfinished{"rate continuation", 0.5, 3});
+  EXPECT_EQ(ap::verdictKindName(wrapper.verdict), "newton_ended");
+  EXPECT_EQ(
+      wrapper.message,
+      ap::renderFrame(ap::frames::StagedUnfinished{"rate continuation", 0.5, 3}, solved.message));
 }
 
 TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -9,7 +10,9 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "tool_runner.hpp"
 
@@ -218,6 +221,32 @@ TEST(Report, PlanManeuverPrintsTheWholeSummaryAtLargeN) {
         "terminal attitude error", "solve time", "grid levels"}) {
     EXPECT_TRUE(contains(r.output, label)) << label << "\n" << r.output;
   }
+}
+
+TEST(Verdicts, AFreeTimeSolvesEndingIsItsOutcomesVerdictKind) {
+  // Minimum time's solver: the free-time solve's own ending is a verdict kind on its outcome,
+  // with its KKT figures, and its message is the kind's words (the driver carries both to the
+  // level's result; the answer's message is the driver's account of T*).
+  PlanningProblem p =
+      loadScene(std::string(AP_SOURCE_DIR) + "/scenes/min_time_bilimoria_wie.yaml").problem;
+  p.steps = 32;
+  const Vector3 turn = so3::log(p.initial_attitude.transpose() * p.final_attitude);
+  std::vector<Matrix3> geodesic;
+  for (int k = 0; k <= p.steps; ++k) {
+    geodesic.push_back(p.initial_attitude * so3::exp(turn * (double(k) / p.steps)));
+  }
+  const FreeTimeOutcome o = solveFreeTime(p, geodesic, 3.4, 1e-9, 500);
+  ASSERT_EQ(o.termination, Termination::Converged) << o.message;
+  EXPECT_EQ(verdictKindName(o.verdict), "free_time_ended");
+  EXPECT_EQ(o.message, renderVerdict(o.verdict, ""));
+  std::map<std::string, double> figure;
+  for (const VerdictFigure& f : verdictFigures(o.verdict)) figure[f.name] = f.value;
+  EXPECT_EQ(figure.at("duration"), o.duration);
+  EXPECT_EQ(figure.at("stationarity"), o.stationarity);
+  EXPECT_EQ(figure.at("time_row"), o.time_row);
+  EXPECT_EQ(figure.at("min_constraint_value"), o.smallest_value);
+  EXPECT_GT(figure.at("iterations"), 0.0);
+  EXPECT_LE(figure.at("iterations"), o.iterations);  // the run that ended, of the solve's
 }
 
 TEST(Verdicts, ASolversFirstReasonIsItsVerdictKind) {

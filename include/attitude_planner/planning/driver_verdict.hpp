@@ -183,10 +183,12 @@ struct InteriorPointEnded {
   }
 };
 /// A boundary velocity has no step at this h (no reduced problem on this grid): StepTooLarge,
-/// before any iteration (Newton or the interior point).
+/// before any iteration (Newton or the interior point), or the free-time solve's end before any
+/// iteration (`free_time`).
 struct NoBoundaryStep {
   static constexpr const char* kKind = "no_boundary_step";
   std::string what;  ///< which velocity and why
+  bool free_time = false;
   std::vector<VerdictFigure> figures() const { return {}; }
 };
 /// A keep-out or keep-in cone is violated at a node the boundary velocities fix (R_1, R_{N−1}):
@@ -197,19 +199,52 @@ struct ConeAtFixedNode {
   std::vector<VerdictFigure> figures() const { return {}; }
 };
 
+/// A free-time solve (interior_point/free_time_solver) ended: how, after how many iterations,
+/// and the KKT figures of the discrete minimum-time problem there.
+struct FreeTimeEnded {
+  static constexpr const char* kKind = "free_time_ended";
+  std::string how;  ///< "converged", "iteration limit", a watch's or a stop's reason, ...
+  int iterations = 0;
+  double duration = 0.0;         ///< T = N h [s] at the end
+  double stationarity = 0.0;     ///< max |∇L| of the minimum-time Lagrangian
+  double time_row = 0.0;         ///< |∂L/∂h|, its h row
+  double complementarity = 0.0;  ///< Σ z c
+  double smallest_value = 0.0;   ///< min c over the constraint rows
+  std::vector<VerdictFigure> figures() const {
+    return {{"iterations", double(iterations)},   {"duration", duration},
+            {"stationarity", stationarity},       {"time_row", time_row},
+            {"complementarity", complementarity}, {"min_constraint_value", smallest_value}};
+  }
+};
+/// A free-time solve's start violates a cone at a node the boundary data fix (R_0, R_N and, where
+/// they fix them, R_1, R_{N−1}): no iterate moves it, so no solve (NotConverged).
+struct FreeTimeConeAtFixedNode {
+  static constexpr const char* kKind = "free_time_cone_at_fixed_node";
+  std::string violation;  ///< the cone, the node and by how much
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+/// A free-time solve found no strictly feasible start (raising h, or the elastic phase where it
+/// is not allowed): `why`, no solve (NotConverged).
+struct NoStrictlyFeasibleStart {
+  static constexpr const char* kKind = "no_strictly_feasible_start";
+  std::string why;
+  std::vector<VerdictFigure> figures() const { return {}; }
+};
+
 }  // namespace verdicts
 
 /// What a driver answered, as data (PlanResult::verdict): the kind and its figures. A solver's
 /// first reason is a kind too (NloptEnded, NewtonEnded, InteriorPointEnded, NoBoundaryStep,
-/// ConeAtFixedNode); SolverReason where a solver's reason is still words only.
-using Verdict =
-    std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
-                 verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
-                 verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
-                 verdicts::SearchStopped, verdicts::SearchUnrepresentable,
-                 verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
-                 verdicts::NoPointingStartConverged, verdicts::NloptEnded, verdicts::NewtonEnded,
-                 verdicts::InteriorPointEnded, verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode>;
+/// ConeAtFixedNode, FreeTimeEnded, FreeTimeConeAtFixedNode, NoStrictlyFeasibleStart);
+/// SolverReason where a solver's reason is still words only.
+using Verdict = std::variant<
+    verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
+    verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration, verdicts::LocallyInfeasible,
+    verdicts::MinimumTimeFoundNone, verdicts::SearchStopped, verdicts::SearchUnrepresentable,
+    verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime, verdicts::NoPointingStartConverged,
+    verdicts::NloptEnded, verdicts::NewtonEnded, verdicts::InteriorPointEnded,
+    verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode, verdicts::FreeTimeEnded,
+    verdicts::FreeTimeConeAtFixedNode, verdicts::NoStrictlyFeasibleStart>;
 
 /// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
 inline std::string verdictKindName(const Verdict& verdict) {

@@ -439,11 +439,6 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
     return result;
   }
   if (problem.time_margin > 0.0) {
-    // A pointing request's minimum-time trail carries each start's twist (pointingMinimumTime),
-    // which the context's does not.
-    const std::vector<Attempt> minimum_time_trail =
-        problem.end_condition.pointing() ? result.attempts : std::vector<Attempt>{};
-    const std::size_t margin_first = context.attempts().size();
     const Maneuver at_minimum_time = result.maneuver;
     context.restoreKept(std::nullopt);  // the plan returned is the one at the margin
     result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
@@ -453,14 +448,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
                                  pair, context);
     });
     recordLowerBound(bound, &result);
-    if (problem.end_condition.pointing()) {
-      result.attempts = minimum_time_trail;
-      for (Attempt& a : result.attempts) a.kept = false;
-      const std::vector<Attempt> margin = context.attemptsFrom(margin_first);
-      result.attempts.insert(result.attempts.end(), margin.begin(), margin.end());
-    } else {
-      result.attempts = context.attemptsFrom(first);
-    }
+    result.attempts = context.attemptsFrom(first);
     addNote(&result, notes::PlannedAtMargin{problem.time_margin, result.duration, T_star});
   }
   result.minimum_duration = T_star;
@@ -661,10 +649,9 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   context.restoreKept(first_kept);  // the first answer's, until a plan from T* replaces it
   // Every answer below has the whole trail: the first solve's, the minimum-time phase's, the
   // plans from T*'s (the context's from `first`), the first solve's attempt kept unless a later
-  // plan is returned. A pointing request's minimum-time attempts carry twists the context's do
-  // not: it keeps the first solve's trail.
+  // plan is returned.
   const auto finish = [&](PlanResult r) {
-    if (!problem.end_condition.pointing()) r.attempts = context.attemptsFrom(first);
+    r.attempts = context.attemptsFrom(first);
     recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     r.solve_time_s =

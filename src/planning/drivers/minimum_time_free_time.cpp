@@ -13,6 +13,7 @@
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/problem/duration_bound.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -79,7 +80,7 @@ struct FreeTimeCarry {
 PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
   PlanResult r;
   r.termination = o.termination;
-  r.message = o.message;
+  carryReason(&r, o);
   r.iterations = o.iterations;
   LevelSummary level;
   level.steps = steps;

@@ -139,6 +139,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
   std::vector<ClassPlan> survey_plans;
   const std::size_t first_recorded = context.attempts().size();
+  const std::size_t first_level = context.levels().size();
   const SolveContext::IterationTally tally(context);  // Newton, then the interior point
   PlanResult result = solveWithNewton(problem, newton_options, context, &survey_plans);
   const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
@@ -155,12 +156,11 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
   const bool started_from_optimum = result.converged();
   const Maneuver unconstrained_plan = result.maneuver;
   constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
-  const std::vector<LevelSummary> newton_levels = result.levels;
   // The interior point keeps the class it starts in: the unconstrained optimum's.
   ExtremalSummary survey = result.extremal_summary;
   result = solveWithInteriorPoint(problem, constrained, context);
   result.iterations = tally.iterations();
-  result.levels.insert(result.levels.begin(), newton_levels.begin(), newton_levels.end());
+  result.levels = context.levelsFrom(first_level);  // Newton's, then the interior point's
   if (started_from_optimum) addNote(&result, started);
   if (survey.known && constrained.warm_start == &unconstrained_plan) {
     result.extremal_summary = survey;
@@ -214,13 +214,14 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     // on by O(h) and starts the unconstrained optimum instead, as below (measured: torque_limited
     // 64 → 256, 29 interior-point iterations from the guess, 25 cold).
     const SolveContext::IterationTally tally(context);  // from the guess, then the retry
+    const std::size_t first_level = context.levels().size();
     result = solveWithInteriorPointFromGuess(problem, options, context);
     if (result.termination == Termination::NotConverged ||
         result.termination == Termination::Infeasible) {
       const PlanResult first = result;
       result = solveWithInteriorPoint(problem, options, context);
       result.iterations = tally.iterations();
-      result.levels.insert(result.levels.begin(), first.levels.begin(), first.levels.end());
+      result.levels = context.levelsFrom(first_level);
       addNote(&result, notes::AfterGuessStopped{first.message});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "attitude_planner/planning/constraints.hpp"
@@ -14,10 +15,12 @@ namespace attitude_planner {
 
 namespace {
 
-/// One start twist's answer.
+/// One start twist's answer and its kept attempt in the context's trail (none: no solve, or no
+/// attempt of its own kept).
 struct TwistStart {
   double twist = 0.0;
   PlanResult result;
+  std::optional<std::size_t> kept_attempt;
 };
 
 /// The index of the converged start with the least T* (on `steps` steps where given; −1: none).
@@ -73,17 +76,21 @@ std::string coneAtEnd(const PlanningProblem& problem, double twist) {
   return "";
 }
 
-/// One start twist's answer: the recipe at R_N there, or, where a cone excludes that R_N,
-/// infeasible without a solve.
-TwistStart startAt(const PlanningProblem& problem, double twist, const MinimumTimeRecipe& recipe) {
-  TwistStart s{twist, {}};
+/// One start twist's answer: the recipe at R_N there (its attempts in the context tagged with
+/// the twist), or, where a cone excludes that R_N, infeasible without a solve.
+TwistStart startAt(const PlanningProblem& problem, double twist, SolveContext& context,
+                   const MinimumTimeRecipe& recipe) {
+  TwistStart s{twist, {}, std::nullopt};
   const std::string excluded = coneAtEnd(problem, twist);
   if (!excluded.empty()) {
     s.result.termination = Termination::Infeasible;  // no solve: the trail shows none
     return s;
   }
+  const std::size_t first = context.attempts().size();
   s.result = recipe(endingAt(problem, pointingAttitude(problem.end_condition, twist)));
-  for (Attempt& a : s.result.attempts) a.start_detail.twist = twist;
+  context.posedAtTwist(first, twist);
+  const std::optional<std::size_t> kept = context.keptAttempt();
+  if (kept && *kept >= first) s.kept_attempt = kept;
   return s;
 }
 
@@ -113,9 +120,12 @@ std::vector<TwistStart> overStartTwists(const PlanningProblem& problem, SolveCon
 
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                const MinimumTimeRecipe& recipe) {
-  const auto posedAt = [&recipe](const PlanningProblem& on) {
-    return [at = &on, &recipe](double twist) { return startAt(*at, twist, recipe); };
+  const auto posedAt = [&context, &recipe](const PlanningProblem& on) {
+    return [at = &on, &context, &recipe](double twist) {
+      return startAt(*at, twist, context, recipe);
+    };
   };
+  const std::size_t first = context.attempts().size();
   std::vector<TwistStart> starts;
   if (const int survey = surveySteps(problem)) {
     // The start twists on a coarse grid, then the recipe on N at the least T*'s twist only: the
@@ -127,7 +137,7 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
     const int best = leastDuration(starts);
     if (best >= 0 && !context.stopReason()) {
       const Matrix3& R_N = starts[best].result.maneuver.attitude.back();
-      starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), recipe));
+      starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), context, recipe));
     }
   }
   if (leastDuration(starts, problem.steps) < 0 && !context.stopReason()) {
@@ -143,15 +153,10 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
   }
   const int kept = leastDuration(starts, problem.steps);
   PlanResult result = starts[kept >= 0 ? kept : lastWithPlan(starts, problem.steps)].result;
-  result.attempts.clear();
   result.minimum_time.solves = 0;  // every start's free-time solves
-  for (std::size_t i = 0; i < starts.size(); ++i) {
-    result.minimum_time.solves += starts[i].result.minimum_time.solves;
-    for (Attempt a : starts[i].result.attempts) {
-      a.kept = a.kept && static_cast<int>(i) == kept;
-      result.attempts.push_back(a);
-    }
-  }
+  for (const TwistStart& s : starts) result.minimum_time.solves += s.result.minimum_time.solves;
+  context.restoreKept(kept >= 0 ? starts[kept].kept_attempt : std::nullopt);
+  result.attempts = context.attemptsFrom(first);
   summarizePointing(problem, static_cast<int>(starts.size()), &result);
   frameMessage(&result, startsFrame(starts, kept));
   return result;

@@ -59,6 +59,7 @@
 #include "planning/interior_point/primal_dual_loop.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 
@@ -923,11 +924,9 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
     }
   }
   out.maneuver = np_.maneuver(out.steps);
-  std::ostringstream message;
-  message << why << " after " << iterations << " iterations: T = " << out.duration
-          << " s, stationarity " << out.stationarity << " (h row " << out.time_row
-          << "), complementarity " << out.complementarity << ", min c " << out.smallest_value;
-  out.message = message.str();
+  recordVerdict(
+      &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,
+                                    out.complementarity, out.smallest_value});
   return out;
 }
 
@@ -982,7 +981,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
         np.hasTwist() ? fixedNodeConeViolation(problem, np, {0, 1})
                       : fixedNodeConeViolation(problem, np, {0, 1, np.steps() - 1, np.steps()});
     if (!fixed.empty()) {
-      failed.message = fixed + ", an attitude the boundary data fix";
+      recordVerdict(&failed, verdicts::FreeTimeConeAtFixedNode{fixed});
       return failed;
     }
     const StageConstraints constraints = buildStageConstraints(problem);
@@ -991,8 +990,10 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     const Matrix3 start_end = np.finalAttitude();
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     solver.setElasticBarrier(elastic_barrier);
-    failed.message = solver.startInside();
-    if (!failed.message.empty()) return failed;
+    if (const std::string outside = solver.startInside(); !outside.empty()) {
+      recordVerdict(&failed, verdicts::NoStrictlyFeasibleStart{outside});
+      return failed;
+    }
     FreeTimeOutcome out = solver.run(tolerance, max_iterations, context, watch);
     if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
     // The elastic start did not reach a KKT point: the start raised inside instead.
@@ -1001,11 +1002,10 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     np.setCurrent(start_steps);
     FreeTimeSolver raised(problem, &np, constraints, parameters);
     raised.disallowElastic();
-    failed.message = raised.startInside();
-    if (!failed.message.empty()) return out;
+    if (!raised.startInside().empty()) return out;
     return raised.run(tolerance, max_iterations, context, watch);
   } catch (const StepTooLarge& e) {
-    failed.message = std::string("the boundary rates admit no step: ") + e.what();
+    recordVerdict(&failed, verdicts::NoBoundaryStep{e.what(), true});
     return failed;
   }
 }

@@ -19,7 +19,8 @@ namespace attitude_planner {
 /// discrete minimum-time problem at the end.
 struct FreeTimeOutcome {
   Termination termination = Termination::NotConverged;
-  std::string message;
+  Verdict verdict;                    ///< how it ended, as data (driver_verdict.hpp)
+  std::string message;                ///< its words (recordVerdict)
   ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
   double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)

@@ -104,11 +104,6 @@ constexpr FormulationRecipe kProbeRecipe = {
     {Formulation::FreeSlacks, BarrierRule::Monotone, "free slacks"},
 };
 
-/// Appends the levels `solved` reports to `levels` (every solve of a plan is listed, in order).
-void appendLevels(std::vector<LevelSummary>* levels, const PlanResult& solved) {
-  levels->insert(levels->end(), solved.levels.begin(), solved.levels.end());
-}
-
 bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
@@ -121,8 +116,8 @@ struct Solve {
 
 /// One grid in the recipe's first formulation, retried once in the other from the same start
 /// when it ends infeasible or unconverged. The answer: a converged solve, else an
-/// infeasibility certificate, else the first solve's reason; every solve's levels and
-/// iterations are kept.
+/// infeasibility certificate, else the first solve's reason; every solve's iterations are kept
+/// and its levels recorded in the context as it ends.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true) {
@@ -134,6 +129,7 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
       problem, options, solve.parameters, solve.context,
       {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals, final_grid});
   first.formulation = recipe.first.formulation;
+  solve.context.recordLevels(first.result.levels);
   const Termination t = first.result.termination;
   if (t != Termination::Infeasible && t != Termination::NotConverged) return first;
   if (solve.context.stopReason()) return first;  // cancelled or out of time: no retry
@@ -141,14 +137,12 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
       problem, options, solve.parameters, solve.context,
       {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr, final_grid});
   second.formulation = recipe.retry.formulation;
+  solve.context.recordLevels(second.result.levels);
   const bool take_second =
       second.result.converged() ||
       (t != Termination::Infeasible && second.result.termination == Termination::Infeasible);
   GridOutcome answer = take_second ? std::move(second) : std::move(first);
   const PlanResult& other = take_second ? first.result : second.result;
-  std::vector<LevelSummary> levels = take_second ? other.levels : answer.result.levels;
-  appendLevels(&levels, take_second ? answer.result : other);
-  answer.result.levels = levels;
   answer.result.iterations = tally.iterations();
   addNote(&answer.result, notes::FormulationRetry{recipe.retry.name, recipe.first.name, take_second,
                                                   other.message});
@@ -196,21 +190,19 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
 }
 
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
-/// once more through the level in between. Replaces *direct if that converges; adds every solve's
-/// levels to *total (the level's tally counts their iterations).
+/// once more through the level in between. Replaces *direct if that converges (the level's tally
+/// counts every solve's iterations, the context records their levels).
 void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options,
                          const Solve& solve, const ReducedProblem::StepVectors& coarse,
-                         GridOutcome* direct, PlanResult* total) {
+                         GridOutcome* direct) {
   PlanningProblem half = at;
   half.steps = at.steps / 2;
   SolverOptions from_coarse = options;
   from_coarse.warm_start = nullptr;  // both start from the coarse steps
   const GridOutcome middle =
       solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr, /*final_grid=*/false);
-  appendLevels(&total->levels, middle.result);
   if (!middle.result.converged()) return;
   GridOutcome fine = solveGridWithRetry(at, from_coarse, solve, &middle.steps, nullptr);
-  appendLevels(&total->levels, fine.result);
   if (!fine.result.converged()) return;
   addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, direct->result.message});
   direct->result = fine.result;
@@ -226,11 +218,16 @@ std::string onLevel(const ContinuationStop& stop) {
 
 /// A level after a stop. Cancelled or out of time: the finer levels are skipped and the last
 /// accepted iterate goes to the requested N at once. Infeasible: each finer level evaluates
-/// the carried iterate without iterating and reports the coarse level's certificate.
+/// the carried iterate without iterating and reports the coarse level's certificate. Its last
+/// level recorded ends as the stop did.
 GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& options,
                         const Solve& solve, const LevelRequest<LevelIterate>& r) {
   const ContinuationStop& stop = *r.stop;
   const SolveContext::IterationTally tally(solve.context);  // the start's and the level's
+  const std::size_t first_level = solve.context.levels().size();
+  const auto endsAsTheStop = [&] {
+    if (solve.context.levels().size() > first_level) solve.context.endLastLevelAs(stop.termination);
+  };
   if (ranOut(stop.termination)) {
     GridOutcome carried;
     if (r.coarse) carried.steps = r.coarse->steps;
@@ -238,6 +235,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
     if (!r.finest) return carried;  // handed on as it is
     GridOutcome outcome = carryToGrid(r.problem, carried.steps, stop.termination, onLevel(stop));
     outcome.formulation = carried.formulation;
+    solve.context.recordLevels(outcome.result.levels);
+    endsAsTheStop();
     return outcome;
   }
   SolverOptions level_options = options;
@@ -253,23 +252,20 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
-  std::vector<LevelSummary> levels = start.levels;
-  appendLevels(&levels, outcome.result);
-  outcome.result.levels = levels;
   outcome.result.message = onLevel(stop);
+  endsAsTheStop();
   return outcome;
 }
 
 /// One level of the continuation: from the coarser level's iterate and duals, else from its own
 /// unconstrained optimum; a 4× refinement that stops is tried once more through the level in
-/// between. The result carries every solve's iterations and levels.
+/// between. The result carries every solve's iterations (the context records their levels).
 GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& options,
                        const Solve& solve, const LevelRequest<LevelIterate>& r) {
   if (r.replay_only) return replayLevel(problem, options, solve, r);
   SolverOptions level_options = options;
   level_options.warm_start = nullptr;
   level_options.tolerance = r.tolerance;
-  PlanResult total;  // the levels of every solve on this level
   const SolveContext::IterationTally tally(solve.context);  // the iterations of every solve on it
   Maneuver resampled;
   PlanResult unconstrained;
@@ -277,21 +273,18 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& opti
     unconstrained =
         unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
-    appendLevels(&total.levels, unconstrained);
   }
   const LevelDuals no_duals;
   GridOutcome outcome =
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
                          r.coarse ? &r.coarse->duals : &no_duals, r.finest);
-  appendLevels(&total.levels, outcome.result);
   const LevelDuals direct_duals = outcome.duals;
   if (!outcome.result.converged() && !ranOut(outcome.result.termination) && r.coarse &&
       r.problem.steps % 2 == 0) {
-    refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome, &total);
+    refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome);
   }
   outcome.duals = direct_duals;  // the direct solve's: a refinement's are not carried
   outcome.result.iterations = tally.iterations();
-  outcome.result.levels = std::move(total.levels);
   return outcome;
 }
 
@@ -309,9 +302,7 @@ void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
     }
     if (feasible_level > 0) {
       result->termination = Termination::NotConverged;
-      result->message = "not converged: the N = " + std::to_string(feasible_level) +
-                        " level met every constraint, but a finer level stopped (" +
-                        result->message + ")";
+      frameMessage(result, frames::FinerLevelStopped{feasible_level});
     }
   }
   addNote(result, notes::GridContinuation{record.levels.front().steps});
@@ -392,11 +383,19 @@ GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options
   return outcome;
 }
 
-/// The solve's answer: the attempt at `kept` marked as the one returned, the solve's trail (from
-/// `first`) from the context.
-void keepAttempt(SolveContext& context, std::size_t first, std::size_t kept, PlanResult* result) {
+/// Where a solve began in the context's trail and levels.
+struct Begun {
+  std::size_t attempts, levels;
+  explicit Begun(const SolveContext& context)
+      : attempts(context.attempts().size()), levels(context.levels().size()) {}
+};
+
+/// The solve's answer: the attempt at `kept` marked as the one returned, the solve's trail and
+/// levels (since `begun`) from the context.
+void keepAttempt(SolveContext& context, const Begun& begun, std::size_t kept, PlanResult* result) {
   context.markKept(kept);
-  result->attempts = context.attemptsFrom(first);
+  result->attempts = context.attemptsFrom(begun.attempts);
+  result->levels = context.levelsFrom(begun.levels);
 }
 
 }  // namespace
@@ -405,8 +404,8 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                                   SolveContext& context,
                                   const InteriorPointParameters& parameters) {
   const Solve solve{parameters, context};
-  const std::size_t first = context.attempts().size();
-  std::size_t at = first;
+  const Begun begun(context);
+  std::size_t at = begun.attempts;
   const SolveContext::IterationTally tally(context);  // every attempt's
   PlanResult result =
       attempt(problem, options, solve, AttemptStage::Constrained, startOf(options), &at).result;
@@ -422,7 +421,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                       std::any_of(problem.constraints.begin(), problem.constraints.end(),
                                   [](const PlanningConstraint& c) { return !c.isCone(); });
   if (!stuck || !cones || !others) {
-    keepAttempt(context, first, at, &result);
+    keepAttempt(context, begun, at, &result);
     return result;
   }
   PlanningProblem cones_only = problem;
@@ -435,7 +434,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
                                     startOf(options), &around_at)
                                 .result;
   if (!around.converged()) {
-    keepAttempt(context, first, at, &result);
+    keepAttempt(context, begun, at, &result);
     return result;
   }
   SolverOptions staged = options;
@@ -447,14 +446,10 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   const std::string first_message = result.message;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
-  std::vector<LevelSummary> solved_levels = result.levels;
-  appendLevels(&solved_levels, around);
-  appendLevels(&solved_levels, second);
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
   if (take_second) result = second;
-  keepAttempt(context, first, take_second ? second_at : at, &result);
+  keepAttempt(context, begun, take_second ? second_at : at, &result);
   result.iterations = tally.iterations();
-  result.levels = solved_levels;
   addNote(&result, notes::RetriedInTwoStages{first_message});
   return result;
 }
@@ -467,7 +462,11 @@ GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const Solve
   SolverOptions from = options;
   from.warm_start = nullptr;  // the start is start_steps
   from.constrained_from_warm_start = false;
-  return solveGridWithRetry(problem, from, {parameters, context}, start_steps, start_duals);
+  const std::size_t first_level = context.levels().size();
+  GridOutcome outcome =
+      solveGridWithRetry(problem, from, {parameters, context}, start_steps, start_duals);
+  outcome.result.levels = context.levelsFrom(first_level);
+  return outcome;
 }
 
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
@@ -491,11 +490,11 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   SolverOptions from = options;
   from.warm_start = nullptr;  // the guess's steps start the grid
   from.constrained_from_warm_start = false;
+  const Begun begun(context);
   GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
   PlanResult result = std::move(outcome.result);
-  const std::size_t at = context.attempts().size();
   context.record(attemptOf(problem, outcome, AttemptStage::Constrained, AttemptStart::WarmStart));
-  keepAttempt(context, at, at, &result);
+  keepAttempt(context, begun, begun.attempts, &result);
   addNote(&result, notes::FromInitialGuess{});
   return result;
 }

@@ -477,15 +477,14 @@ constexpr RecipeEntry kNewtonRecipe[] = {
      keptClassNotCoasted},
 };
 
-/// A staged continuation that did not reach the request: no plan for it.
+/// A staged continuation that did not reach the request: no plan for it; the reason it is given
+/// is its last stage's.
 PlanResult unfinished(const StagedOutcome& staged, const std::string& what) {
   PlanResult r;
   r.termination = staged.stopped.value_or(Termination::NotConverged);
   r.iterations = staged.iterations;
-  std::ostringstream msg;
-  msg << what << " reached s = " << std::max(staged.reached, 0.0) << " of 1 (" << staged.stages
-      << " stages): " << staged.plan.message;
-  r.message = msg.str();
+  carryReason(&r, staged.plan);
+  frameMessage(&r, frames::StagedUnfinished{what, staged.reached, staged.stages});
   r.cost = std::numeric_limits<double>::quiet_NaN();
   return r;
 }
@@ -648,8 +647,7 @@ PlanResult Walk::finish() {
   if (!kept_) {  // no attempt planned on the requested grid: nothing is kept
     PlanResult none = std::move(unplanned_);
     if (none.termination == Termination::Converged) none.termination = Termination::NotConverged;
-    none.message = "no attempt produced a plan on the requested grid (" +
-                   std::to_string(trail_.size()) + " tried); the last: " + none.message;
+    frameMessage(&none, frames::NoAttemptPlanned{trail_.size()});
     none.attempts = trail_;
     return none;
   }
@@ -715,7 +713,9 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
       }
     }
   }
-  return walk.finish();
+  PlanResult result = walk.finish();
+  context.recordLevels(result.levels);  // the plan's: its kept attempt's
+  return result;
 }
 
 }  // namespace attitude_planner

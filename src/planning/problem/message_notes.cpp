@@ -1,6 +1,7 @@
 // The wording of every clause of message_notes.hpp, in one place.
 #include "planning/problem/message_notes.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
@@ -215,6 +216,20 @@ std::string framed(const frames::PointingStarts& f, const std::string& reason) {
   if (f.kept >= 0) note << ", the start from " << f.starts[f.kept].twist << " rad kept";
   return note.str() + "; " + reason;
 }
+std::string framed(const frames::StagedUnfinished& f, const std::string& reason) {
+  std::ostringstream note;
+  note << f.what << " reached s = " << std::max(f.reached, 0.0) << " of 1 (" << f.stages
+       << " stages): " << reason;
+  return note.str();
+}
+std::string framed(const frames::NoAttemptPlanned& f, const std::string& reason) {
+  return "no attempt produced a plan on the requested grid (" + std::to_string(f.tried) +
+         " tried); the last: " + reason;
+}
+std::string framed(const frames::FinerLevelStopped& f, const std::string& reason) {
+  return "not converged: the N = " + std::to_string(f.feasible_steps) +
+         " level met every constraint, but a finer level stopped (" + reason + ")";
+}
 
 // The words of the drivers' verdicts (driver_verdict.hpp).
 std::string judged(const verdicts::SolverReason&, const std::string& reason) {
@@ -315,11 +330,24 @@ std::string judged(const verdicts::InteriorPointEnded& v, const std::string&) {
   return message.str();
 }
 std::string judged(const verdicts::NoBoundaryStep& v, const std::string&) {
-  return "boundary velocity: " + v.what;
+  return (v.free_time ? "the boundary rates admit no step: " : "boundary velocity: ") + v.what;
 }
 std::string judged(const verdicts::ConeAtFixedNode& v, const std::string&) {
   return "infeasible: " + v.violation +
          ", an attitude the boundary velocities fix (increase steps or move the boundary)";
+}
+std::string judged(const verdicts::FreeTimeEnded& v, const std::string&) {
+  std::ostringstream message;
+  message << v.how << " after " << v.iterations << " iterations: T = " << v.duration
+          << " s, stationarity " << v.stationarity << " (h row " << v.time_row
+          << "), complementarity " << v.complementarity << ", min c " << v.smallest_value;
+  return message.str();
+}
+std::string judged(const verdicts::FreeTimeConeAtFixedNode& v, const std::string&) {
+  return v.violation + ", an attitude the boundary data fix";
+}
+std::string judged(const verdicts::NoStrictlyFeasibleStart& v, const std::string&) {
+  return v.why;
 }
 
 }  // namespace

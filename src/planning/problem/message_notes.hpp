@@ -232,13 +232,34 @@ struct PointingStarts {
   int kept = -1;
 };
 
+/// A staged continuation (a rate continuation, an inertia homotopy: `what`) stopped at s =
+/// `reached` of 1 after `stages` stages: no plan for the request; the reason it is given is its
+/// last stage's message.
+struct StagedUnfinished {
+  std::string what;
+  double reached = 0.0;
+  int stages = 0;
+};
+/// Newton's walk: none of its `tried` attempts produced a plan on the requested grid; the reason
+/// it is given is the last one's message.
+struct NoAttemptPlanned {
+  std::size_t tried = 0;
+};
+/// The interior point's continuation: a finer level ended "infeasible" after the level at N =
+/// `feasible_steps` met every constraint, so not converged (its solver stopped at a local minimum
+/// of the violation, no certificate); the reason it is given is the finer level's message.
+struct FinerLevelStopped {
+  int feasible_steps = 0;
+};
+
 }  // namespace frames
 
 using Frame =
     std::variant<frames::PairSolveStopped, frames::PairCombined, frames::MinimumTimePairStopped,
                  frames::MinimumTimePairCombined, frames::UpperBoundFromProbe,
                  frames::StuckAtMinimumTimePlan, frames::OutsideRequestedClass,
-                 frames::ReplayFailed, frames::PointingStarts>;
+                 frames::ReplayFailed, frames::PointingStarts, frames::StagedUnfinished,
+                 frames::NoAttemptPlanned, frames::FinerLevelStopped>;
 
 /// The message `frame` makes of `reason` (the message it is given).
 std::string renderFrame(const Frame& frame, const std::string& reason);
@@ -253,5 +274,18 @@ std::string renderVerdict(const Verdict& verdict, const std::string& reason);
 /// Records `verdict` on the result and renders result->message from it (the reason it is given
 /// is the message the result carried).
 void recordVerdict(PlanResult* result, const Verdict& verdict);
+/// The same for a solver's own outcome that carries a verdict and its message (FreeTimeOutcome).
+template <class Outcome>
+void recordVerdict(Outcome* outcome, const Verdict& verdict) {
+  outcome->verdict = verdict;
+  outcome->message = renderVerdict(verdict, outcome->message);
+}
+/// `to` is given `from`'s reason: its verdict and the message rendered so far (a wrapper then
+/// frames it; a driver's result takes its solver's outcome's).
+template <class To, class From>
+void carryReason(To* to, const From& from) {
+  to->verdict = from.verdict;
+  to->message = from.message;
+}
 
 }  // namespace attitude_planner

@@ -90,6 +90,23 @@ void SolveContext::restoreKept(std::optional<std::size_t> index) {
   markKept(index.value_or(attempts_.size()));
 }
 
+void SolveContext::recordLevels(const std::vector<LevelSummary>& levels) {
+  levels_.insert(levels_.end(), levels.begin(), levels.end());
+}
+
+void SolveContext::endLastLevelAs(Termination termination) {
+  if (!levels_.empty()) levels_.back().termination = termination;
+}
+
+std::vector<LevelSummary> SolveContext::levelsFrom(std::size_t first) const {
+  if (first >= levels_.size()) return {};
+  return {levels_.begin() + static_cast<std::ptrdiff_t>(first), levels_.end()};
+}
+
+void SolveContext::posedAtTwist(std::size_t first, double twist) {
+  for (std::size_t i = first; i < attempts_.size(); ++i) attempts_[i].start_detail.twist = twist;
+}
+
 std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
   if (first >= attempts_.size()) return {};
   return {attempts_.begin() + static_cast<std::ptrdiff_t>(first), attempts_.end()};

@@ -160,6 +160,20 @@ class SolveContext : public Interruption {
   /// The trail of a driver whose attempts began at `first` (attempts().size() when it started).
   std::vector<Attempt> attemptsFrom(std::size_t first) const;
 
+  /// Appends the levels (LevelSummary) a solve on one grid ended with, in the order solves end:
+  /// each of the interior point's grid solves, and a Newton solve's when it returns (the kept
+  /// attempt's levels: those of the plan it returns, not of the attempts it left). A solve's
+  /// `levels` are levelsFrom(levels().size() when it began).
+  void recordLevels(const std::vector<LevelSummary>& levels);
+  /// The last level recorded ends as `termination` (a level evaluated after its continuation
+  /// stopped reports the stop).
+  void endLastLevelAs(Termination termination);
+  const std::vector<LevelSummary>& levels() const { return levels_; }
+  std::vector<LevelSummary> levelsFrom(std::size_t first) const;
+  /// The attempts recorded from `first` on were posed at a pointing request's start twist ψ
+  /// [rad] (Attempt::start_detail.twist): the solves of a start R_N fixed there.
+  void posedAtTwist(std::size_t first, double twist);
+
   /// While alive, the attempts recorded are parts of an enclosing attempt (a level's
   /// unconstrained start, a start's helper solve, a search's probes, which the search records as
   /// one attempt per start): when it ends they leave the trail and the kept mark is as before.
@@ -190,6 +204,7 @@ class SolveContext : public Interruption {
   AttemptTag attempt_;
   bool scope_names_nested_ = false;  ///< an open scope is Nested::ScopeStage
   std::vector<Attempt> attempts_;
+  std::vector<LevelSummary> levels_;
 };
 
 }  // namespace attitude_planner

@@ -2,13 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "attitude_planner/planning/constraints.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/termination.hpp"
+#include "planning/drivers/minimum_time_free_time.hpp"
+#include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/pointing.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/strategies/starts.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
 
@@ -87,12 +92,100 @@ TwistStart startAt(const PlanningProblem& problem, double twist, const MinimumTi
   return s;
 }
 
+/// A start twist's free-time solve with ψ free from the eigenaxis bang–bang slew to R_N there,
+/// started kEigenaxisStartFactor above that slew's least T: beside the fixed-twist recipe's plan,
+/// the survey's other way into the ψ-free basins (measured on seeded requests: each way alone
+/// missed the least basin on one request, by 3.7e-3 and 3.6e-3 relative on N). Not converged
+/// (no solve) unless rest to rest with that slew and R_N clear of the cones; and where the solve
+/// does not converge at or below its start's T.
+TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, SolveContext& context) {
+  TwistStart s{twist, {}};
+  const PlanningProblem posed = endingAt(problem, pointingAttitude(problem.end_condition, twist));
+  PlanningProblem at = posed;
+  at.end_condition = EndCondition();
+  at.duration = kEigenaxisStartFactor * eigenaxisBangBangDuration(at);
+  const Maneuver slew = excursionSlew(at, Vector3::UnitX(), 0.0);
+  if (hasSpinningEnds(problem) || !coneAtEnd(problem, twist).empty() ||
+      coneClearance(posed, slew.attitude) < kConeStartClearance) {
+    return s;
+  }
+  const std::size_t first = context.attempts().size();
+  std::optional<PlanResult> freed = freeTimeFromPlan(posed, slew, at.duration, context);
+  if (freed) s.result = std::move(*freed);
+  s.result.minimum_time.solves = 1;
+  s.result.attempts = context.attemptsFrom(first);
+  for (Attempt& a : s.result.attempts) a.start_detail.twist = twist;
+  return s;
+}
+
 /// The survey grid of a minimum-time pointing request: N / kSurveyCoarsening, at least
 /// kSurveyLeastSteps; 0 where that is not below N (no survey: the start twists on N).
 constexpr int kSurveyCoarsening = 4, kSurveyLeastSteps = 16;
 int surveySteps(const PlanningProblem& problem) {
   const int steps = std::max(kSurveyLeastSteps, problem.steps / kSurveyCoarsening);
   return steps < problem.steps ? steps : 0;
+}
+
+/// A grid level's free-time solve starts from the coarser level's T* raised by this: a finer
+/// grid's T* lies above the coarser one's (measured on the seeded requests of
+/// docs/results/pointing_minimum_time.md: 0.2–0.4 % from N/4 to N), and the solve from a plan at T
+/// is accepted at or below that T (freeTimeFromPlan).
+constexpr double kLevelStartSlack = 0.02;
+
+/// The free-time plan `coarse` (ψ free, converged on its grid) carried to `level`'s grid: one
+/// free-time solve with ψ free from its plan prolonged (prolonged: its rates interpolated in time)
+/// at kLevelStartSlack above its T*. Empty where that solve does not converge at or below its
+/// start's T, or the coarse plan admits no prolongation.
+std::optional<PlanResult> onFinerLevel(const PlanningProblem& level, const PlanResult& coarse,
+                                       SolveContext& context) {
+  const Matrix3 R_N = coarse.maneuver.attitude.back();
+  PlanningProblem on_coarse = endingAt(level, R_N);
+  on_coarse.steps = coarse.maneuver.steps();
+  on_coarse.duration = coarse.minimum_duration;
+  FreeTimeOutcome carried;
+  try {
+    ReducedProblem np(on_coarse);
+    np.setInteriorFromAttitudes(coarse.maneuver.attitude);
+    carried.steps = np.current();
+  } catch (const StepTooLarge&) {  // the boundary rates admit no step at the coarse h
+    return std::nullopt;
+  }
+  carried.maneuver = coarse.maneuver;
+  carried.duration = coarse.minimum_duration;
+  const PlanningProblem posed = endingAt(level, R_N);
+  Maneuver start;
+  start.attitude = prolonged(posed, carried);
+  return freeTimeFromPlan(posed, start, (1.0 + kLevelStartSlack) * coarse.minimum_duration,
+                          context);
+}
+
+/// The survey's answer `survey` (a converged ψ-free plan on the survey grid) carried to the
+/// requested grid through factor-2 levels, ψ free on each (onFinerLevel): a start for N that costs
+/// one free-time solve per level instead of the fixed-twist recipe on N. (By 4 at once the solve
+/// slid into another basin on one seeded request, 4.4e-5 above; by 2 it reached the recipe's T* on
+/// all 16 measured.) Not converged where a level's solve did not.
+TwistStart carriedToGrid(const PlanningProblem& problem, const TwistStart& survey,
+                         SolveContext& context) {
+  TwistStart s{survey.twist, survey.result};
+  const std::size_t first = context.attempts().size();
+  int solves = 0;
+  while (s.result.converged() && s.result.maneuver.steps() < problem.steps &&
+         !context.stopReason()) {
+    PlanningProblem level = problem;
+    level.steps = std::min(problem.steps, 2 * s.result.maneuver.steps());
+    std::optional<PlanResult> next = onFinerLevel(level, s.result, context);
+    ++solves;
+    if (!next) {
+      s.result = PlanResult();
+      s.result.termination = context.stopReason().value_or(Termination::NotConverged);
+      break;
+    }
+    s.result = std::move(*next);
+  }
+  s.result.attempts = context.attemptsFrom(first);
+  for (Attempt& a : s.result.attempts) a.start_detail.twist = survey.twist;
+  s.result.minimum_time.solves = solves;
+  return s;
 }
 
 /// Every start twist (ψ₀ + 2πi/kPointingStartTwists) solved by `solve`; stops at a cancel or the
@@ -109,6 +202,30 @@ std::vector<TwistStart> overStartTwists(const PlanningProblem& problem, SolveCon
   return starts;
 }
 
+/// The survey on `survey` steps (each start twist by `posed` and from its eigenaxis slew), its
+/// least T* carried to N (carriedToGrid), and only where that does not converge `recipe` on N at
+/// its twist: the coarse answers rank the basins at a quarter of the cost (measured on the seeded
+/// requests of docs/results/pointing_minimum_time.md).
+template <typename Posed>
+std::vector<TwistStart> surveyThenCarried(const PlanningProblem& problem, int survey,
+                                          SolveContext& context, const Posed& posed,
+                                          const MinimumTimeRecipe& recipe) {
+  PlanningProblem coarse = problem;
+  coarse.steps = survey;
+  std::vector<TwistStart> starts = overStartTwists(coarse, context, posed(coarse));
+  const std::vector<TwistStart> slews = overStartTwists(
+      coarse, context, [&](double twist) { return fromEigenaxisSlew(coarse, twist, context); });
+  starts.insert(starts.end(), slews.begin(), slews.end());
+  const int best = leastDuration(starts);
+  if (best < 0 || context.stopReason()) return starts;
+  starts.push_back(carriedToGrid(problem, starts[best], context));
+  if (!starts.back().result.converged() && !context.stopReason()) {
+    const Matrix3& R_N = starts[best].result.maneuver.attitude.back();
+    starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), recipe));
+  }
+  return starts;
+}
+
 }  // namespace
 
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
@@ -118,17 +235,7 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
   };
   std::vector<TwistStart> starts;
   if (const int survey = surveySteps(problem)) {
-    // The start twists on a coarse grid, then the recipe on N at the least T*'s twist only: the
-    // coarse answers rank the basins at a quarter of the cost (measured on the seeded requests
-    // of docs/results/pointing_minimum_time.md).
-    PlanningProblem coarse = problem;
-    coarse.steps = survey;
-    starts = overStartTwists(coarse, context, posedAt(coarse));
-    const int best = leastDuration(starts);
-    if (best >= 0 && !context.stopReason()) {
-      const Matrix3& R_N = starts[best].result.maneuver.attitude.back();
-      starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), recipe));
-    }
+    starts = surveyThenCarried(problem, survey, context, posedAt, recipe);
   }
   if (leastDuration(starts, problem.steps) < 0 && !context.stopReason()) {
     // No survey, or its answer did not carry to N: every start twist on N.

@@ -67,6 +67,12 @@ for i, c in enumerate(cases):
 
 
 
+def p90(values):
+    """The 90th percentile (nearest rank: the smallest value at least 90% of them are at or below)."""
+    ordered = sorted(values)
+    return ordered[max(0, math.ceil(0.9 * len(ordered)) - 1)]
+
+
 def summary(group, what):
     """The summary lines of one group of requests."""
     if not group:
@@ -86,11 +92,11 @@ def summary(group, what):
 - Cost: %d of %d at most the sweep's best + %g relative (largest excess %+.2e).%s
   The worst fixed twist costs %.3g-%.3gx the best (median %.3g).
 - End condition: largest angle(R_N b, d) %.1e rad; largest relative stationarity in psi %.1e.
-- Time: pointing / fixed at the chosen twist median %.2fx, largest %.2fx; %d of %d within %gx.
+- Time: pointing / fixed at the chosen twist median %.2fx, p90 %.2fx, largest %.2fx; %d of %d within %gx.
 """ % (what, len(group), sum(e <= COST_TARGET for e in excesses), len(referenced), COST_TARGET,
        max(excesses), note, min(worst_over_best), max(worst_over_best), statistics.median(worst_over_best),
        max(c["error"] for c in group if c["converged"]), max(c["stationarity"] for c in group if c["converged"]),
-       statistics.median(ratios), max(ratios), sum(r <= TIME_TARGET for r in ratios), len(group),
+       statistics.median(ratios), p90(ratios), max(ratios), sum(r <= TIME_TARGET for r in ratios), len(group),
        TIME_TARGET)
 
 

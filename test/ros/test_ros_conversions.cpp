@@ -1302,6 +1302,24 @@ TEST(RosConversions, PointingRequestIsPlannedAndReportsItsTwist) {
       rc::attitudeFromMsg(res.maneuver.attitude.back(), "attitude") * Vector3::UnitZ();
   EXPECT_LT((aimed - Vector3(1, 1, 0).normalized()).norm(), 1e-9);
   EXPECT_TRUE(std::isfinite(res.attempts.front().start_detail.twist));
+  EXPECT_EQ(res.pointing_infeasible_basis, "none");
+  // A rate limit below the angle from R_0 b to d over T: no twist admits a plan (proven), and the
+  // response carries what the verdict rests on as the JSON summary does.
+  PlanAttitudeManeuver::Request slow = r;
+  slow.constraints.push_back(
+      rc::constraintToMsg(PlanningConstraint::maxAngularRate(0.5 * (M_PI / 2) / r.duration)));
+  const PlanOutcome none = planRequest(slow, rc::PlannerDefaults(), nullptr);
+  ASSERT_EQ(none.error_code, PlanErrorCode::INFEASIBLE) << none.message;
+  PlanAttitudeManeuver::Response slow_res;
+  fillResponse(none, "world", "body", &slow_res);
+  EXPECT_EQ(slow_res.pointing_infeasible_basis,
+            pointingInfeasibleBasisName(none.result.pointing.infeasible_basis));
+  EXPECT_EQ(slow_res.pointing_infeasible_basis, "proven");
+  // An attitude end condition has no pointing verdict.
+  const PlanOutcome attitude_end = planRequest(seedRequest(), rc::PlannerDefaults(), nullptr);
+  PlanAttitudeManeuver::Response attitude_res;
+  fillResponse(attitude_end, "world", "body", &attitude_res);
+  EXPECT_EQ(attitude_res.pointing_infeasible_basis, "");
   // A name it does not know, a zero vector and an unserved combination are named.
   r.end_condition = "aim";
   EXPECT_NE(invalidMessage(r).find("end_condition"), std::string::npos);

@@ -3,6 +3,7 @@
 // on Betts's body (the torque bounds alone: test_free_time_twist.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -37,6 +38,27 @@ TEST(PointingMinimumTime, UnderAConeAndARateLimitAtMostTheSweepsBestTwist) {
     EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
     EXPECT_GT(r.active_constraints, 0);
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    const test_support::TwistSweep sweep = test_support::sweepTwist(p);
+    EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
+        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+  }
+}
+
+TEST(PointingMinimumTime, CarriedFromTheSurveyGridAtMostTheSweepsBestTwist) {
+  // N = 64: the start twists on the survey grid, its least T* carried to N through the finer
+  // levels with the twist free; the answer a KKT point in (plan, T, twist) on N.
+  const std::pair<unsigned, SchemeKind> requests[] = {{4310u, SchemeKind::SecondOrder},
+                                                      {4311u, SchemeKind::Paper}};
+  for (const auto& [seed, scheme] : requests) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", " + schemeName(scheme));
+    const PlanningProblem p = test_support::randomBettsPointingRequest(seed, 64, scheme);
+    const PlanResult r = planManeuver(p);
+    expectPointingAnswer(p, r);
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
+    const bool kept_on_n = std::any_of(r.attempts.begin(), r.attempts.end(),
+                                       [](const Attempt& a) { return a.kept && a.steps == 64; });
+    EXPECT_TRUE(kept_on_n) << r.message;
     const test_support::TwistSweep sweep = test_support::sweepTwist(p);
     EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
         << "swept best at twist " << sweep.best_twist << "; " << r.message;

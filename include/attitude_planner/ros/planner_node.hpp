@@ -450,6 +450,9 @@ void fillResponse(const PlanOutcome& outcome, const std::string& world_frame,
   res->duration_verdict = ros_conversions::durationVerdictToMsg(r.duration_verdict);
   res->verdict_kind = verdictKindName(r.verdict);
   res->verdict_figures = ros_conversions::verdictFiguresToMsg(r.verdict);
+  res->pointing_infeasible_basis = outcome.problem.end_condition.pointing()
+                                       ? pointingInfeasibleBasisName(r.pointing.infeasible_basis)
+                                       : std::string();
 }
 
 }  // namespace attitude_planner

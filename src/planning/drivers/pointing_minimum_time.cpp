@@ -8,8 +8,12 @@
 #include "attitude_planner/planning/constraints.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/termination.hpp"
+#include "planning/drivers/minimum_time_free_time.hpp"
+#include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/pointing.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/strategies/starts.hpp"
+#include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
 
@@ -76,6 +80,14 @@ std::string coneAtEnd(const PlanningProblem& problem, double twist) {
   return "";
 }
 
+/// The attempts a start at `s.twist` recorded from `first` on, tagged with its twist in the
+/// context, and its kept attempt among them (the answer's, if the start wins).
+void tagStartsAttempts(SolveContext& context, std::size_t first, TwistStart* s) {
+  context.posedAtTwist(first, s->twist);
+  const std::optional<std::size_t> kept = context.keptAttempt();
+  if (kept && *kept >= first) s->kept_attempt = kept;
+}
+
 /// One start twist's answer: the recipe at R_N there (its attempts in the context tagged with
 /// the twist), or, where a cone excludes that R_N, infeasible without a solve.
 TwistStart startAt(const PlanningProblem& problem, double twist, SolveContext& context,
@@ -88,9 +100,33 @@ TwistStart startAt(const PlanningProblem& problem, double twist, SolveContext& c
   }
   const std::size_t first = context.attempts().size();
   s.result = recipe(endingAt(problem, pointingAttitude(problem.end_condition, twist)));
-  context.posedAtTwist(first, twist);
-  const std::optional<std::size_t> kept = context.keptAttempt();
-  if (kept && *kept >= first) s.kept_attempt = kept;
+  tagStartsAttempts(context, first, &s);
+  return s;
+}
+
+/// A start twist's free-time solve with ψ free from the eigenaxis bang–bang slew to R_N there,
+/// started kEigenaxisStartFactor above that slew's least T: beside the fixed-twist recipe's plan,
+/// the survey's other way into the ψ-free basins (measured on seeded requests: each way alone
+/// missed the least basin on one request, by 3.7e-3 and 3.6e-3 relative on N). Not converged
+/// (no solve) unless rest to rest with that slew and R_N clear of the cones; and where the solve
+/// does not converge at or below its start's T.
+TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, SolveContext& context) {
+  TwistStart s{twist, {}};
+  const PlanningProblem posed = endingAt(problem, pointingAttitude(problem.end_condition, twist));
+  PlanningProblem at = posed;
+  at.end_condition = EndCondition();
+  at.duration = kEigenaxisStartFactor * eigenaxisBangBangDuration(at);
+  const Maneuver slew = excursionSlew(at, Vector3::UnitX(), 0.0);
+  if (hasSpinningEnds(problem) || !coneAtEnd(problem, twist).empty() ||
+      coneClearance(posed, slew.attitude) < kConeStartClearance) {
+    return s;
+  }
+  const std::size_t first = context.attempts().size();
+  std::optional<PlanResult> freed = freeTimeFromPlan(posed, slew, at.duration, context);
+  if (freed) s.result = std::move(*freed);
+  s.result.minimum_time.solves = 1;
+  tagStartsAttempts(context, first, &s);
+  s.result.attempts = context.attemptsFrom(first);
   return s;
 }
 
@@ -100,6 +136,68 @@ constexpr int kSurveyCoarsening = 4, kSurveyLeastSteps = 16;
 int surveySteps(const PlanningProblem& problem) {
   const int steps = std::max(kSurveyLeastSteps, problem.steps / kSurveyCoarsening);
   return steps < problem.steps ? steps : 0;
+}
+
+/// A grid level's free-time solve starts from the coarser level's T* raised by this: a finer
+/// grid's T* lies above the coarser one's (measured on the seeded requests of
+/// docs/results/pointing_minimum_time.md: 0.2–0.4 % from N/4 to N), and the solve from a plan at T
+/// is accepted at or below that T (freeTimeFromPlan).
+constexpr double kLevelStartSlack = 0.02;
+
+/// The free-time plan `coarse` (ψ free, converged on its grid) carried to `level`'s grid: one
+/// free-time solve with ψ free from its plan prolonged (prolonged: its rates interpolated in time)
+/// at kLevelStartSlack above its T*. Empty where that solve does not converge at or below its
+/// start's T, or the coarse plan admits no prolongation.
+std::optional<PlanResult> onFinerLevel(const PlanningProblem& level, const PlanResult& coarse,
+                                       SolveContext& context) {
+  const Matrix3 R_N = coarse.maneuver.attitude.back();
+  PlanningProblem on_coarse = endingAt(level, R_N);
+  on_coarse.steps = coarse.maneuver.steps();
+  on_coarse.duration = coarse.minimum_duration;
+  FreeTimeOutcome carried;
+  try {
+    ReducedProblem np(on_coarse);
+    np.setInteriorFromAttitudes(coarse.maneuver.attitude);
+    carried.steps = np.current();
+  } catch (const StepTooLarge&) {  // the boundary rates admit no step at the coarse h
+    return std::nullopt;
+  }
+  carried.maneuver = coarse.maneuver;
+  carried.duration = coarse.minimum_duration;
+  const PlanningProblem posed = endingAt(level, R_N);
+  Maneuver start;
+  start.attitude = prolonged(posed, carried);
+  return freeTimeFromPlan(posed, start, (1.0 + kLevelStartSlack) * coarse.minimum_duration,
+                          context);
+}
+
+/// The survey's answer `survey` (a converged ψ-free plan on the survey grid) carried to the
+/// requested grid through factor-2 levels, ψ free on each (onFinerLevel): a start for N that costs
+/// one free-time solve per level instead of the fixed-twist recipe on N. (By 4 at once the solve
+/// slid into another basin on one seeded request, 4.4e-5 above; by 2 it reached the recipe's T* on
+/// all 16 measured.) Not converged where a level's solve did not.
+TwistStart carriedToGrid(const PlanningProblem& problem, const TwistStart& survey,
+                         SolveContext& context) {
+  TwistStart s{survey.twist, survey.result};
+  const std::size_t first = context.attempts().size();
+  int solves = 0;
+  while (s.result.converged() && s.result.maneuver.steps() < problem.steps &&
+         !context.stopReason()) {
+    PlanningProblem level = problem;
+    level.steps = std::min(problem.steps, 2 * s.result.maneuver.steps());
+    std::optional<PlanResult> next = onFinerLevel(level, s.result, context);
+    ++solves;
+    if (!next) {
+      s.result = PlanResult();
+      s.result.termination = context.stopReason().value_or(Termination::NotConverged);
+      break;
+    }
+    s.result = std::move(*next);
+  }
+  tagStartsAttempts(context, first, &s);
+  s.result.attempts = context.attemptsFrom(first);
+  s.result.minimum_time.solves = solves;
+  return s;
 }
 
 /// Every start twist (ψ₀ + 2πi/kPointingStartTwists) solved by `solve`; stops at a cancel or the
@@ -116,6 +214,30 @@ std::vector<TwistStart> overStartTwists(const PlanningProblem& problem, SolveCon
   return starts;
 }
 
+/// The survey on `survey` steps (each start twist by `posed` and from its eigenaxis slew), its
+/// least T* carried to N (carriedToGrid), and only where that does not converge `recipe` on N at
+/// its twist: the coarse answers rank the basins at a quarter of the cost (measured on the seeded
+/// requests of docs/results/pointing_minimum_time.md).
+template <typename Posed>
+std::vector<TwistStart> surveyThenCarried(const PlanningProblem& problem, int survey,
+                                          SolveContext& context, const Posed& posed,
+                                          const MinimumTimeRecipe& recipe) {
+  PlanningProblem coarse = problem;
+  coarse.steps = survey;
+  std::vector<TwistStart> starts = overStartTwists(coarse, context, posed(coarse));
+  const std::vector<TwistStart> slews = overStartTwists(
+      coarse, context, [&](double twist) { return fromEigenaxisSlew(coarse, twist, context); });
+  starts.insert(starts.end(), slews.begin(), slews.end());
+  const int best = leastDuration(starts);
+  if (best < 0 || context.stopReason()) return starts;
+  starts.push_back(carriedToGrid(problem, starts[best], context));
+  if (!starts.back().result.converged() && !context.stopReason()) {
+    const Matrix3& R_N = starts[best].result.maneuver.attitude.back();
+    starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), context, recipe));
+  }
+  return starts;
+}
+
 }  // namespace
 
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
@@ -128,17 +250,7 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
   const std::size_t first = context.attempts().size();
   std::vector<TwistStart> starts;
   if (const int survey = surveySteps(problem)) {
-    // The start twists on a coarse grid, then the recipe on N at the least T*'s twist only: the
-    // coarse answers rank the basins at a quarter of the cost (measured on the seeded requests
-    // of docs/results/pointing_minimum_time.md).
-    PlanningProblem coarse = problem;
-    coarse.steps = survey;
-    starts = overStartTwists(coarse, context, posedAt(coarse));
-    const int best = leastDuration(starts);
-    if (best >= 0 && !context.stopReason()) {
-      const Matrix3& R_N = starts[best].result.maneuver.attitude.back();
-      starts.push_back(startAt(problem, twistOf(R_N, problem.end_condition), context, recipe));
-    }
+    starts = surveyThenCarried(problem, survey, context, posedAt, recipe);
   }
   if (leastDuration(starts, problem.steps) < 0 && !context.stopReason()) {
     // No survey, or its answer did not carry to N: every start twist on N.

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <stdexcept>
@@ -104,9 +105,10 @@ TEST(InertiaCorrection, RowRelativeShiftGrowsUntilAnIndefiniteBandFactors) {
   const ap::KktBlocks<double> k = randomBlocks(0, -40.0, 4);
   ap::RowRelativeShift correction(p);
   ap::BandKkt<double> kkt;
+  ap::KktFactorization<double> system(kkt, k, nullptr);
   Eigen::VectorXd d;
   double shift = 0.0;
-  ASSERT_TRUE(correction.factorAndSolve(kkt, k, ones(kN), &d, &shift, nullptr));
+  ASSERT_TRUE(correction.factorAndSolve(system, ones(kN), &d, &shift));
   // The schedule: 0, first_shift, then ×shift_growth.
   EXPECT_GT(shift, p.first_shift);
   const double steps = std::log(shift / p.first_shift) / std::log(p.shift_growth);
@@ -122,15 +124,16 @@ TEST(InertiaCorrection, RowRelativeShiftFloorRisesPastItsCapOnceAndRelaxes) {
   ap::RowRelativeShift correction(p);
   const ap::KktBlocks<double> definite = randomBlocks(0, 0.0, 5);
   ap::BandKkt<double> kkt;
+  ap::KktFactorization<double> system(kkt, definite, nullptr);
   Eigen::VectorXd d;
   // A positive definite band factors at the floor itself: the shift used is the floor.
   const auto floor = [&] {
     double shift = -1.0;
-    EXPECT_TRUE(correction.factorAndSolve(kkt, definite, ones(kN), &d, &shift, nullptr));
+    EXPECT_TRUE(correction.factorAndSolve(system, ones(kN), &d, &shift));
     return shift;
   };
   std::vector<double> floors;
-  while (correction.raiseFloor()) floors.push_back(floor());
+  while (correction.afterRejection()) floors.push_back(floor());
   // line_search_shift, then ×shift_growth while below max_shift_floor. With the defaults
   // 1e-8 × 100³ rounds to just below 1e-2, so one more raise takes the floor to about 1: the cap
   // says when the raises stop, not how large the floor gets.
@@ -142,7 +145,7 @@ TEST(InertiaCorrection, RowRelativeShiftFloorRisesPastItsCapOnceAndRelaxes) {
   }
   EXPECT_GE(floors.back(), p.max_shift_floor);
   // ÷shift_growth per accepted step, and 0 once at or below line_search_shift.
-  for (std::size_t i = 0; i <= floors.size(); ++i) correction.relax();
+  for (std::size_t i = 0; i <= floors.size(); ++i) correction.afterStep(1.0, false);
   EXPECT_EQ(floor(), 0.0);
 }
 
@@ -155,14 +158,20 @@ TEST(InertiaCorrection, PerturbationHandlerRestoresTheInertiaAndADescentStep) {
   ap::BorderedBandKkt<double> kkt;
   const Eigen::VectorXd rhs = ones(kN + 1);
   Eigen::VectorXd d;
-  ASSERT_TRUE(handler.factorAndSolve(kkt, k, rhs, &d));
+  double shift = 0.0;
+  ap::KktFactorization<double> system(kkt, k, nullptr);
+  ASSERT_TRUE(handler.factorAndSolve(system, rhs, &d, &shift));
+  EXPECT_GT(shift, 0.0);
   EXPECT_EQ(kkt.inertia().positive, 1);
   EXPECT_EQ(kkt.inertia().negative, 0);
   EXPECT_GT(d.dot(rhs), 0.0);
   // Positive definite to begin with: the first system takes no shift, d = K⁻¹ rhs.
   const ap::KktBlocks<double> definite = randomBlocks(1, 0.0, 7);
   ap::PerturbationHandler fresh(p);
-  ASSERT_TRUE(fresh.factorAndSolve(kkt, definite, rhs, &d));
+  ap::KktFactorization<double> definite_system(kkt, definite, nullptr);
+  ASSERT_TRUE(fresh.factorAndSolve(definite_system, rhs, &d, &shift));
+  EXPECT_EQ(shift, 0.0);
+  EXPECT_DOUBLE_EQ(definite_system.meanAbsDiagonal(), dense(definite).diagonal().cwiseAbs().mean());
   EXPECT_LT((dense(definite) * d - rhs).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
@@ -221,8 +230,22 @@ TEST(MonotoneBarrier, FreeTimeProfileFallsToTheSmallerOfKappaMuAndThetaMuUnsnapp
   EXPECT_FALSE(rule.solved(1.0001 * 10.0 * 1e-3, 1e-3, scales));
   // The decrement test is the other profile's: a step leaves μ as it is.
   double mu = 1e-3;
-  rule.afterStep(SlackResidualState(0.0), scales, {0.0, 1.0, 1.0, 0.0}, &mu);
+  SlackResidualState rows(0.0);
+  rule.afterStep({&mu, scales, &rows, 0.0, 1.0}, {0.0, 1.0});
   EXPECT_EQ(mu, 1e-3);
+  // As the loop asks it: solved above μ_final where the residual is within κ_ε μ, or where the
+  // problem found the barrier problem solved to round-off; then μ falls.
+  ap::BarrierState state;
+  state.barrier_residual = 10.0 * 1e-3;
+  EXPECT_TRUE(rule.subproblemSolved(state, {&mu, scales, nullptr, 0.0, 0.0}));
+  state.barrier_residual = 1.0;
+  EXPECT_FALSE(rule.subproblemSolved(state, {&mu, scales, nullptr, 0.0, 0.0}));
+  state.solved_to_round_off = true;
+  EXPECT_TRUE(rule.subproblemSolved(state, {&mu, scales, nullptr, 0.0, 0.0}));
+  state.at_final_barrier = true;
+  EXPECT_FALSE(rule.subproblemSolved(state, {&mu, scales, nullptr, 0.0, 0.0}));
+  rule.decrease({&mu, scales, nullptr, 0.0, 0.0});
+  EXPECT_DOUBLE_EQ(mu, std::pow(1e-3, 1.3));
 }
 
 TEST(MonotoneBarrier, FixedStepProfileScalesMuSnapsAndTestsTheDecrement) {
@@ -238,12 +261,17 @@ TEST(MonotoneBarrier, FixedStepProfileScalesMuSnapsAndTestsTheDecrement) {
   // After a step: μ falls only where the decrement and the slack residual are ≤ κ_ε μ (scaled).
   const double bound = p.monotone_kappa_epsilon * s;
   double at = mu;
-  rule.afterStep(SlackResidualState(2.0 * bound), scaled, {0.5 * bound, 1.0, 0.5, 0.0}, &at);
+  SlackResidualState large(2.0 * bound), small(0.5 * bound);
+  rule.afterStep({&at, scaled, &large, 0.0, 1.0}, {0.5 * bound, 0.5});
   EXPECT_EQ(at, mu);  // the slack residual too large
-  rule.afterStep(SlackResidualState(0.5 * bound), scaled, {2.0 * bound, 1.0, 0.5, 0.0}, &at);
+  rule.afterStep({&at, scaled, &small, 0.0, 1.0}, {2.0 * bound, 0.5});
   EXPECT_EQ(at, mu);  // the decrement too large, the step cut (not a stall)
-  rule.afterStep(SlackResidualState(0.5 * bound), scaled, {0.5 * bound, 1.0, 0.5, 0.0}, &at);
+  rule.afterStep({&at, scaled, &small, 0.0, 1.0}, {0.5 * bound, 0.5});
   EXPECT_DOUBLE_EQ(at, std::pow(s, 1.5) * 4.0 / 8);
+  // The KKT residual test is the other profile's: never solved at the top of a pass.
+  ap::BarrierState state;
+  state.solved_to_round_off = true;
+  EXPECT_FALSE(rule.subproblemSolved(state, {&at, scaled, nullptr, 0.0, 0.0}));
 }
 
 TEST(StoppingTests, KktResidualToleranceGrowsLikeNSquaredAbove256) {
@@ -427,11 +455,13 @@ TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeP
 
 namespace {
 
-/// A problem on φ(x) = (x − 1)² from x = 0 whose hooks log their calls (b: before the direction,
-/// d: the direction, a: a step accepted (A: one the stopping test marked final), r: rejected,
-/// E: ended by the stopping test, L: the iteration limit, S/I: stopped between passes / inside
-/// one), one pass a '|'. Its direction is Newton's (1 − x), or the ascent
-/// direction −1000 (1 − x) where `ascent`; `before` scripts beforeDirection's answer per pass.
+/// A problem on φ(x) = (x − 1)² from x = 0 whose hooks log their calls (b: a pass begins, m: μ
+/// fell at a solved barrier problem, d/p: the direction assembled (p: with primal multipliers),
+/// a: a step accepted (A: one the stopping test marked final), R: a retry the inertia correction
+/// granted, r: rejected, E: ended by the stopping test, L: the iteration limit, S/I: stopped
+/// between passes / inside one), one pass a '|'. Its direction is Newton's (1 − x), or the ascent
+/// direction −1000 (1 − x) where `ascent`; `before` scripts per pass whether the barrier problem
+/// is solved there (Step: not; Continue: solved, μ falls; Stop: solved, and the observer stops).
 class ScriptedProblem final : public ap::PrimalDualProblem {
  public:
   double merit() override { return phi(accepted_); }
@@ -442,22 +472,31 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
   }
   void moveTo(const Eigen::VectorXd& d, double alpha) override { x_ = accepted_ + alpha * d(0); }
   void restore() override { x_ = accepted_; }
-  ap::Pass beforeDirection() override {
-    log += 'b';
-    const int pass = static_cast<int>(std::count(log.begin(), log.end(), 'b')) - 1;
-    return pass < static_cast<int>(before.size()) ? before[pass] : ap::Pass::Step;
-  }
+  void prepare() override { log += 'b'; }
   ap::BarrierState state() const override {
     ap::BarrierState s;
     s.iteration = static_cast<int>(std::count(log.begin(), log.end(), '|'));
+    // Solved only where scripted (the residual never passes the μ rule's κ_ε test).
+    s.barrier_residual = std::numeric_limits<double>::infinity();
+    s.solved_to_round_off = scripted() != ap::Pass::Step;
     return s;
   }
-  ap::Pass direction(ap::LineSearchRequest* request, Eigen::VectorXd** d,
-                     ap::DirectionMeasures*) override {
-    log += 'd';
+  ap::BarrierAccess barrier() override { return {&mu, {1.0, 1, 1, 0.0}, nullptr, 0.0, 0.0}; }
+  ap::Pass atSolvedBarrier() override {
+    return scripted() == ap::Pass::Stop ? ap::Pass::Stop : ap::Pass::Step;
+  }
+  void barrierDecreased() override { log += 'm'; }
+  ap::Pass assemble(bool primal) override {
+    log += primal ? 'p' : 'd';
     if (throw_in_direction) throw ap::SolveInterrupted{ap::Termination::TimedOut};
     // The ascent is steep enough that even the last halving rises above φ's round-off.
-    d_ = Eigen::VectorXd::Constant(1, (ascent ? -1000.0 : 1.0) * (1.0 - accepted_));
+    rhs_ = Eigen::VectorXd::Constant(1, (ascent ? -1000.0 : 1.0) * (1.0 - accepted_));
+    return ap::Pass::Step;
+  }
+  ap::NewtonSystem newtonSystem() override { return {&system_, &rhs_, &d_}; }
+  ap::Pass direction(bool primal, double, ap::LineSearchRequest* request, Eigen::VectorXd** d,
+                     ap::DirectionMeasures*) override {
+    if (no_descent_once && !primal) return ap::Pass::Retry;
     *request = {-2.0 * (1.0 - accepted_) * std::abs(d_(0)), 1.0, false, false, false};
     *d = &d_;
     return ap::Pass::Step;
@@ -465,6 +504,10 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
   ap::Pass accept(const ap::LineSearchResult&, const ap::StopVerdict& verdict) override {
     log += verdict.final_step ? "A|" : "a|";
     accepted_ = x_;
+    return ap::Pass::Continue;
+  }
+  ap::Pass retry(const ap::StopVerdict&) override {
+    log += "R|";
     return ap::Pass::Continue;
   }
   ap::Pass rejected(const ap::LineSearchResult&, const ap::StopVerdict&) override {
@@ -485,12 +528,52 @@ class ScriptedProblem final : public ap::PrimalDualProblem {
 
   std::string log;
   std::vector<ap::Pass> before;
-  bool ascent = false, throw_in_direction = false;
+  bool ascent = false, throw_in_direction = false, no_descent_once = false;
   ap::Termination ending = ap::Termination::Converged;
+  double mu = 1.0;
+  int retries = 0;        ///< the inertia correction's retries after a rejection
+  int inertia_steps = 0;  ///< the steps the inertia correction was told of
 
  private:
+  /// K = 1: the step is the right-hand side.
+  class IdentitySystem final : public ap::ShiftedSystem {
+   public:
+    bool factor(const ap::Shift&) override { return true; }
+    const ap::KktInertia& inertia() const override { return inertia_; }
+    void solve(Eigen::VectorXd*) const override {}
+    int globals() const override { return 0; }
+    double maxAbsDiagonal() const override { return 1.0; }
+    double meanAbsDiagonal() const override { return 1.0; }
+
+   private:
+    ap::KktInertia inertia_;
+  };
+  ap::Pass scripted() const {
+    const int pass = static_cast<int>(std::count(log.begin(), log.end(), 'b')) - 1;
+    return pass >= 0 && pass < static_cast<int>(before.size()) ? before[pass] : ap::Pass::Step;
+  }
   double x_ = 0.0, accepted_ = 0.0;
-  Eigen::VectorXd d_;
+  Eigen::VectorXd rhs_, d_;
+  IdentitySystem system_;
+};
+
+/// The inertia correction of a ScriptedProblem: no shift, `retries` after rejections, the steps
+/// it is told of counted.
+class ScriptedInertia final : public ap::InertiaCorrection {
+ public:
+  explicit ScriptedInertia(ScriptedProblem* problem) : problem_(*problem) {}
+  bool factorAndSolve(ap::ShiftedSystem& system, const Eigen::VectorXd& rhs, Eigen::VectorXd* d,
+                      double* shift) override {
+    *d = rhs;
+    system.solve(d);
+    *shift = 0.0;
+    return true;
+  }
+  bool afterRejection() override { return problem_.retries-- > 0; }
+  void afterStep(double, bool) override { ++problem_.inertia_steps; }
+
+ private:
+  ScriptedProblem& problem_;
 };
 
 /// A stopping test scripted by pass (the state's iteration): converged before the direction at
@@ -526,8 +609,11 @@ int runLoop(ScriptedProblem* problem, bool limits_first, int max_iterations,
   const ap::InteriorPointParameters p;
   int iteration = 0;
   ScriptedCheck never;
-  ap::PrimalDualLoop(*problem, check ? *check : never, {ap::fixedStepLineSearch(p), limits_first},
-                     context)
+  ap::PrimalDualLoop(
+      *problem,
+      {check ? *check : never, std::make_unique<ap::MonotoneBarrier>(p, ap::freeTimeMonotone(p)),
+       std::make_unique<ScriptedInertia>(problem)},
+      {ap::fixedStepLineSearch(p), limits_first, true}, context)
       .run(max_iterations, &iteration);
   return iteration;
 }
@@ -545,12 +631,30 @@ TEST(PrimalDualLoop, FixedStepTestsTheLimitBeforeAPassAndFreeTimeAfterWhatComesB
 TEST(PrimalDualLoop, APassEndedBeforeItsDirectionCountsAndARejectedStepEndsWhereTheProblemSays) {
   ScriptedProblem problem;
   problem.before = {ap::Pass::Continue, ap::Pass::Step, ap::Pass::Stop};
-  EXPECT_EQ(runLoop(&problem, true, 5), 2);  // the Continue and the step count, the Stop not
-  EXPECT_EQ(problem.log, "bbda|b");
+  // The μ fall and the step count, the observer's Stop not; μ fell once, by the loop's rule.
+  EXPECT_EQ(runLoop(&problem, true, 5), 2);
+  EXPECT_EQ(problem.log, "bmbda|b");
+  const ap::InteriorPointParameters p;
+  EXPECT_DOUBLE_EQ(problem.mu, p.monotone_kappa_mu);
+  EXPECT_EQ(problem.inertia_steps, 1);  // the inertia correction told of the one step
   ScriptedProblem ascent;
   ascent.ascent = true;  // every halving of an ascent direction is rejected
   EXPECT_EQ(runLoop(&ascent, true, 5), 0);
   EXPECT_EQ(ascent.log, "bdr");
+  // The inertia correction's retry after a rejection is a counted pass, before the failure.
+  ScriptedProblem retried;
+  retried.ascent = true;
+  retried.retries = 1;
+  EXPECT_EQ(runLoop(&retried, true, 5), 1);
+  EXPECT_EQ(retried.log, "bdR|bdr");
+  EXPECT_EQ(retried.inertia_steps, 0);
+}
+
+TEST(PrimalDualLoop, ADirectionThatIsNoDescentIsAssembledAgainWithPrimalMultipliers) {
+  ScriptedProblem problem;
+  problem.no_descent_once = true;
+  EXPECT_EQ(runLoop(&problem, true, 1), 1);
+  EXPECT_EQ(problem.log, "bdpa|L");
 }
 
 TEST(PrimalDualLoop, AStopReasonEndsTheSolveInTheProfilesPlaceAndAnInterruptionInsideAPass) {
@@ -573,7 +677,7 @@ TEST(PrimalDualLoop, TheLoopCallsTheStoppingTestBeforeTheDirectionOnItAndOnAReje
   check.converge_at = 2;
   check.final_at = 1;
   EXPECT_EQ(runLoop(&problem, true, 5, nullptr, &check), 2);
-  EXPECT_EQ(problem.log, "bda|bdA|E");  // the verdict reaches the step; converged before pass 3
+  EXPECT_EQ(problem.log, "bda|bdA|bE");  // the verdict reaches the step; converged at pass 3
   EXPECT_EQ(problem.ending, ap::Termination::Converged);
   ASSERT_EQ(check.accepted_steps.size(), 2u);  // told of both steps whose pass goes on
   EXPECT_EQ(check.accepted_steps[0], 1.0);     // Newton's full step on the parabola

@@ -22,9 +22,11 @@ class MehrotraPredictorCorrector : public BarrierUpdate {
       : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Mehrotra; }
 
-  void beforeStep(BarrierRows& state, const FactorSolve& solve, const Eigen::VectorXd& rhs,
-                  const BarrierScales& scales, double previous_decrement, double* mu,
+  void beforeStep(const BarrierAccess& b, const FactorSolve& solve, const Eigen::VectorXd& rhs,
                   Eigen::VectorXd* delta) override {
+    BarrierRows& state = *b.rows;
+    const BarrierScales& scales = b.scales;
+    double* mu = b.mu;
     Eigen::VectorXd barrier_part = Eigen::VectorXd::Zero(rhs.size());  // Σ g/s
     state.addSlackWeightedGradients(nullptr, &barrier_part);
     const Eigen::VectorXd affine_rhs = rhs - *mu * barrier_part;
@@ -36,7 +38,7 @@ class MehrotraPredictorCorrector : public BarrierUpdate {
         std::pow(std::min(1.0, mu_affine / average), parameters_.mehrotra_exponent);
     *mu = std::max(
         scales.mu_final,
-        std::min(*mu, std::max(sigma * average, progressFloor(scales, previous_decrement, *mu))));
+        std::min(*mu, std::max(sigma * average, progressFloor(scales, b.previous_decrement, *mu))));
     *mu = snapToFinalBarrier(*mu, scales.mu_final, parameters_);
     state.setComplementarityTarget(*mu, &products_);
     *delta = affine_rhs + *mu * barrier_part;
@@ -72,11 +74,12 @@ class LoqoBarrier : public BarrierUpdate {
   explicit LoqoBarrier(const InteriorPointParameters& parameters) : parameters_(parameters) {}
   BarrierRule rule() const override { return BarrierRule::Loqo; }
 
-  void afterStep(const BarrierRows& state, const BarrierScales& scales, const AcceptedStep& step,
-                 double* mu) override {
+  void afterStep(const BarrierAccess& b, const AcceptedStep&) override {
     const InteriorPointParameters& p = parameters_;
+    double* mu = b.mu;
+    const BarrierScales& scales = b.scales;
     double average = 0.0, smallest = 0.0;
-    state.complementarity(*mu, step.rho, &average, &smallest);
+    b.rows->complementarity(*mu, b.rho, &average, &smallest);
     const double xi = smallest / average;
     const double sigma =
         p.loqo_scale * std::pow(std::min(p.loqo_centrality * (1 - xi) / xi, p.loqo_cap), 3);
@@ -98,17 +101,23 @@ MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters) {
   return {parameters.free_time_theta_mu, BarrierProblemTest::KktResidual, false};
 }
 
-void MonotoneBarrier::afterStep(const BarrierRows& state, const BarrierScales& scales,
-                                const AcceptedStep& step, double* mu) {
+bool MonotoneBarrier::subproblemSolved(const BarrierState& state, const BarrierAccess& b) const {
+  return profile_.test == BarrierProblemTest::KktResidual && !state.at_final_barrier &&
+         (state.solved_to_round_off || solved(state.barrier_residual, *b.mu, b.scales));
+}
+
+void MonotoneBarrier::afterStep(const BarrierAccess& b, const AcceptedStep& step) {
   if (profile_.test != BarrierProblemTest::Decrement) return;
   const InteriorPointParameters& p = parameters_;
+  double* mu = b.mu;
+  const BarrierScales& scales = b.scales;
   const double scaled_mu = *mu * scales.constraints / scales.f_scale;
   const bool stalled =
-      step.alpha == 1.0 && step.relative_decrement > p.stall_ratio * step.previous_decrement;
+      step.alpha == 1.0 && step.relative_decrement > p.stall_ratio * b.previous_decrement;
   stalled_steps_ = stalled ? stalled_steps_ + 1 : 0;
   const bool solved = step.relative_decrement <= p.monotone_kappa_epsilon * scaled_mu ||
                       stalled_steps_ >= p.monotone_stalled_steps;
-  if (state.maxSlackResidual() <= p.monotone_kappa_epsilon * scaled_mu && solved) {
+  if (b.rows->maxSlackResidual() <= p.monotone_kappa_epsilon * scaled_mu && solved) {
     *mu = decreased(*mu, scales);
     stalled_steps_ = 0;
   }

@@ -1,8 +1,8 @@
 // The interior point's barrier update μ as a strategy: Mehrotra's predictor–corrector (μ chosen
 // for each step from its affine-scaling predictor), the monotone Fiacco–McCormick rule (IPOPT's:
 // μ falls once the barrier problem is solved to κ_ε μ) and LOQO's adaptive rule (μ from the
-// complementarity's mean and spread after every step). The solver calls both hooks; each rule
-// uses the one it needs.
+// complementarity's mean and spread after every step). The primal–dual loop calls the hooks;
+// each rule uses the ones it needs.
 #pragma once
 
 #include <functional>
@@ -13,6 +13,7 @@
 
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/interior_point/stopping_tests.hpp"
 
 namespace attitude_planner {
 
@@ -30,31 +31,45 @@ struct BarrierScales {
   double mu_final = 0.0;  ///< the final barrier
 };
 
+/// What a rule reads and moves of the problem's barrier (PrimalDualProblem::barrier): μ, its
+/// scales, the rows (fixed h's slack rows; null where the problem has none a rule reads), the
+/// elastic penalty and the last step's relative decrement (+∞ before the first).
+struct BarrierAccess {
+  double* mu = nullptr;
+  BarrierScales scales;
+  BarrierRows* rows = nullptr;
+  double rho = 0.0;
+  double previous_decrement = 0.0;
+};
+
 /// What the step just accepted looked like (for the rules updating after a step).
 struct AcceptedStep {
   double relative_decrement = 0.0;
-  double previous_decrement = 0.0;  ///< of the step before (+∞ at the first)
-  double alpha = 1.0;               ///< its length
-  double rho = 0.0;                 ///< the elastic penalty
+  double alpha = 1.0;  ///< its length
 };
 
 /// Solves H x = b in place with the current factor.
 using FactorSolve = std::function<void(Eigen::VectorXd*)>;
 
+/// The μ rule as the primal–dual loop (primal_dual_loop.hpp) calls it, each rule using the hooks
+/// it needs: whether the barrier problem is solved at the top of a pass (then `decrease`, a pass
+/// without a step), the predictor before a step, the update after one.
 class BarrierUpdate {
  public:
   virtual ~BarrierUpdate() = default;
   virtual BarrierRule rule() const = 0;
-  /// Before a primal–dual step, the system factored and `delta` solved for `rhs` at μ: may set μ
-  /// for this step and replace `delta` (the predictor–corrector). `previous_decrement` is the
-  /// last step's relative decrement (+∞ at the first).
-  virtual void beforeStep(BarrierRows& /*state*/, const FactorSolve& /*solve*/,
-                          const Eigen::VectorXd& /*rhs*/, const BarrierScales& /*scales*/,
-                          double /*previous_decrement*/, double* /*mu*/,
-                          Eigen::VectorXd* /*delta*/) {}
-  /// After an accepted step above μ_final: the next μ.
-  virtual void afterStep(const BarrierRows& /*state*/, const BarrierScales& /*scales*/,
-                         const AcceptedStep& /*step*/, double* /*mu*/) {}
+  /// At the top of a pass, at the assembled iterate: the barrier problem is solved.
+  virtual bool subproblemSolved(const BarrierState& /*state*/, const BarrierAccess& /*b*/) const {
+    return false;
+  }
+  /// After a solved barrier problem: the next μ.
+  virtual void decrease(const BarrierAccess& /*b*/) {}
+  /// Before a primal–dual step above μ_final, the system factored and `delta` solved for `rhs`
+  /// at μ: may set μ for this step and replace `delta` (the predictor–corrector).
+  virtual void beforeStep(const BarrierAccess& /*b*/, const FactorSolve& /*solve*/,
+                          const Eigen::VectorXd& /*rhs*/, Eigen::VectorXd* /*delta*/) {}
+  /// After an accepted step above μ_final (not a barrier problem's last): the next μ.
+  virtual void afterStep(const BarrierAccess& /*b*/, const AcceptedStep& /*step*/) {}
 };
 
 /// How the monotone rule tells that a barrier problem is solved (IPOPT's κ_ε μ test, on one of two
@@ -90,9 +105,12 @@ class MonotoneBarrier final : public BarrierUpdate {
   MonotoneBarrier(const InteriorPointParameters& parameters, const MonotoneProfile& profile)
       : parameters_(parameters), profile_(profile) {}
   BarrierRule rule() const override { return BarrierRule::Monotone; }
+  /// The KKT residual test (BarrierProblemTest::KktResidual) above μ_final, or a barrier problem
+  /// the problem found solved to round-off.
+  bool subproblemSolved(const BarrierState& state, const BarrierAccess& b) const override;
+  void decrease(const BarrierAccess& b) override { *b.mu = decreased(*b.mu, b.scales); }
   /// The decrement test (BarrierProblemTest::Decrement): μ falls after a step that solves it.
-  void afterStep(const BarrierRows& state, const BarrierScales& scales, const AcceptedStep& step,
-                 double* mu) override;
+  void afterStep(const BarrierAccess& b, const AcceptedStep& step) override;
   /// The KKT residual test (BarrierProblemTest::KktResidual) at μ.
   bool solved(double kkt_residual, double mu, const BarrierScales& scales) const;
   /// The next barrier: max(μ_final, min(κ_μ μ, μ^θ_μ)), snapped where the profile says.

@@ -106,8 +106,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
         N_(np->steps()),
         n_(np->unknowns()),
         form_(parameters),
-        barrier_(parameters, freeTimeMonotone(parameters)),
-        inertia_(parameters) {
+        factorization_(step_factor_, kkt_, nullptr) {
     for (const auto& c : constraints) {
       FreeTimeRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
       // A free twist moves R_N (and R_{N−1} of paper and variational): rows on them too, their
@@ -316,10 +315,21 @@ class FreeTimeSolver final : public PrimalDualProblem {
     s.elastic = elastic_;
     s.stationarity = stationarity_;
     s.gap = gap_;
+    s.barrier_residual = barrier_residual_;
+    s.solved_to_round_off = solved_to_round_off_;
+    s.end_game = late_;
     return s;
   }
-  Pass beforeDirection() override;
-  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d,
+  BarrierAccess barrier() override { return {&mu_, scales_, nullptr, rho_, 0.0}; }
+  Pass atSolvedBarrier() override;
+  void barrierDecreased() override { report(0.0, stationarity_); }
+  /// Assembled in prepare(); the end game is known before the factorization.
+  Pass assemble(bool) override {
+    late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
+    return Pass::Step;
+  }
+  NewtonSystem newtonSystem() override { return {&factorization_, &rhs_, &d_}; }
+  Pass direction(bool primal, double shift, LineSearchRequest* request, Eigen::VectorXd** d,
                  DirectionMeasures* measures) override;
   Pass accept(const LineSearchResult& result, const StopVerdict& verdict) override;
   Pass solvedToRoundOff(const LineSearchResult& result) override;
@@ -362,8 +372,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   int N_, n_;
   double h0_ = 0.0;
   std::vector<FreeTimeRows> groups_;
-  Feasible form_;            ///< −μ ln c: the rows' multipliers, merit terms and dual step
-  MonotoneBarrier barrier_;  ///< the monotone μ rule in its free-time profile
+  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
   /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
   std::vector<int> stencil_groups_;
   /// The other groups by quantity (indices into groups_): one pass per quantity.
@@ -371,8 +380,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
-  PerturbationHandler inertia_;          ///< the shift schedule and the damping after cut steps
-  BorderedBandKkt<double> step_factor_;  ///< the last step's factor (the correction reuses it)
+  BorderedBandKkt<double> step_factor_;     ///< the last step's factor (the correction reuses it)
+  KktFactorization<double> factorization_;  ///< step_factor_ over kkt_, as the loop factors it
   // The run (run()): its barrier problems and the stopping test.
   double mu0_ = 0.0, mu_final_ = 0.0, epsilon0_ = 0.0;
   double mu_ = 0.0, epsilon_ = 0.0;  ///< the barrier problem of this pass: μ, ε(μ)
@@ -381,7 +390,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   const BarrierWatch* watch_ = nullptr;
   int iterations_ = 0;  ///< counted passes (the loop advances it)
   /// What this pass measured at the assembled iterate, and its step.
-  double gap_ = 0.0, stationarity_ = 0.0;
+  double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
   Eigen::VectorXd d_;
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
@@ -780,7 +789,11 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   scales_ = {1.0, 1, N_, mu_final_};
   mu_ = firstBarrier();
   initializeDuals(mu_);
-  PrimalDualLoop(*this, test_, {freeTimeLineSearch(parameters_), false}, context)
+  PrimalDualLoop(
+      *this,
+      {test_, std::make_unique<MonotoneBarrier>(parameters_, freeTimeMonotone(parameters_)),
+       std::make_unique<PerturbationHandler>(parameters_)},
+      {freeTimeLineSearch(parameters_), false, false}, context)
       .run(max_iterations, &iterations_);
   return out_;
 }
@@ -800,34 +813,27 @@ void FreeTimeSolver::prepare() {
   assemble(mu_, epsilon_);
   gap_ = dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
+  barrier_residual_ = mu_ > mu_final_ ? barrierResidual(mu_) : 0.0;  // the μ rule's test
 }
 
-/// Above μ_final, whether the barrier problem is solved: then the watch, the elastic penalty, the
-/// next μ, a pass counted without a step at the same iterate.
-Pass FreeTimeSolver::beforeDirection() {
-  if (mu_ > mu_final_ &&
-      (solved_to_round_off_ || barrier_.solved(barrierResidual(mu_), mu_, scales_))) {
-    solved_to_round_off_ = false;
-    const std::string stop = watched(*watch_, mu_, gap_, epsilon_, iterations_);
-    if (!stop.empty()) {
-      end(Termination::NotConverged, stop);
-      out_.stopped_by_watch = true;
-      return Pass::Stop;
-    }
-    if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved still outside: the penalty was too low
-    mu_ = barrier_.decreased(mu_, scales_);
-    report(0.0, stationarity_);
-    return Pass::Continue;  // the same iterate for the next barrier problem
+/// A solved barrier problem (the μ rule's test, or solved to round-off): the watch, then the
+/// elastic penalty; the loop lowers μ.
+Pass FreeTimeSolver::atSolvedBarrier() {
+  solved_to_round_off_ = false;
+  const std::string stop = watched(*watch_, mu_, gap_, epsilon_, iterations_);
+  if (!stop.empty()) {
+    end(Termination::NotConverged, stop);
+    out_.stopped_by_watch = true;
+    return Pass::Stop;
   }
+  if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved still outside: the penalty was too low
   return Pass::Step;
 }
 
-/// The shifted Newton step (PerturbationHandler) and the search from the accepted iterate: in the
+/// The step found by the inertia correction, and the search from the accepted iterate: in the
 /// end game a rejected full step is first retried with its second-order correction.
-Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d,
+Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::VectorXd** d,
                                DirectionMeasures*) {
-  late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
-  if (!inertia_.factorAndSolve(step_factor_, kkt_, rhs_, &d_)) return Pass::Reject;
   accepted_ = {np_.timeStep(), mu_, epsilon_, np_.current()};
   accepted_end_ = np_.finalAttitude();
   clearCorrection();
@@ -836,10 +842,9 @@ Pass FreeTimeSolver::direction(LineSearchRequest* request, Eigen::VectorXd** d,
   return Pass::Step;
 }
 
-/// The order is the method's: dual step, damping, leaving the elastic phase, κ_Σ.
+/// The order is the method's: dual step, leaving the elastic phase, κ_Σ (the loop then damps).
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
   dualStep(d_, mu_);
-  inertia_.afterStep(result.alpha, late_);
   leaveElasticIfInside();
   safeguardDuals(mu_);
   report(result.alpha, stationarity_);

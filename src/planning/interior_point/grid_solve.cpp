@@ -36,15 +36,6 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
   return s.str();
 }
 
-/// The Newton direction of one iteration and what the line search and stopping test need of it.
-struct Direction {
-  bool factored = false;
-  double cost = 0.0;   ///< f at the iterate
-  double slope = 0.0;  ///< ∇φ·dδ (free slacks: with the slacks' and the penalty's part)
-  double shift = 0.0;  ///< the inertia correction used
-  double decrement_slope = 0.0;  ///< free slacks: the slope the decrement is measured on
-};
-
 bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
@@ -62,11 +53,10 @@ class GridSolve final : public PrimalDualProblem {
         request_(request),
         np_(*np),
         system_(problem, np, request.formulation, parameters),
-        barrier_(makeBarrierUpdate(request.barrier, parameters)),
         free_slacks_(system_.freeSlacks()),
-        inertia_(parameters),
         kkt_blocks_(np->unknowns()),
         kkt_(makeKkt<Scalar>(system_.globals())),
+        factorization_(*kkt_, kkt_blocks_, &context),
         test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
               free_slacks_) {
     system_.setInterruption(&context);
@@ -74,7 +64,10 @@ class GridSolve final : public PrimalDualProblem {
 
   GridOutcome run() {
     initialize();
-    PrimalDualLoop(*this, test_, {fixedStepLineSearch(p_), true}, context_)
+    PrimalDualLoop(
+        *this,
+        {test_, makeBarrierUpdate(request_.barrier, p_), std::make_unique<RowRelativeShift>(p_)},
+        {fixedStepLineSearch(p_), true, true}, context_)
         .run(options_.max_iterations, &iteration_);
     system_.setInterruption(nullptr);
     return finish();
@@ -130,26 +123,43 @@ class GridSolve final : public PrimalDualProblem {
     return s;
   }
 
-  Pass direction(LineSearchRequest* request, Eigen::VectorXd** d,
-                 DirectionMeasures* measures) override {
-    const Direction direction = computeDirection();
-    if (!std::isfinite(direction.cost)) {
+  BarrierAccess barrier() override {
+    return {&mu_, scales_, &system_, rho_, test_.previousDecrement()};
+  }
+  /// The condensed system (primal: with the multipliers μ/s); a non-finite cost ends the solve.
+  Pass assemble(bool primal) override {
+    cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_.band, &rhs_, &merit_gradient_).cost;
+    if (!std::isfinite(cost_)) {
       return end(Termination::StepTooLarge,
                  "non-finite cost (step too large for this h? increase steps)");
     }
-    if (!direction.factored) {
-      return end(Termination::NotConverged, "Newton system could not be made positive definite");
+    if (system_.globals() == 1) {  // the twist ψ's border (a pointing end condition)
+      kkt_blocks_.border = system_.twistBorder().column;
+      kkt_blocks_.corner = Eigen::MatrixXd::Constant(1, 1, system_.twistBorder().corner);
     }
-    *measures = {free_slacks_ ? direction.decrement_slope : direction.slope, direction.shift};
-    cost_ = direction.cost;
-    request->slope = direction.slope;
+    return Pass::Step;
+  }
+  NewtonSystem newtonSystem() override { return {&factorization_, &rhs_, &delta_}; }
+  /// The slope of φ_μ along the step (free slacks: with the slack terms); without the primal
+  /// multipliers a step that is no descent direction is taken again with them (it is one with
+  /// them, H being positive definite).
+  Pass direction(bool primal, double shift, LineSearchRequest* request, Eigen::VectorXd** d,
+                 DirectionMeasures* measures) override {
+    double slope = merit_gradient_.dot(delta_);
+    double decrement_slope = 0.0;
+    if (free_slacks_) addSlackTerms(&slope, &decrement_slope);
+    if (slope >= 0.0 && !primal) return Pass::Retry;
+    *measures = {free_slacks_ ? decrement_slope : slope, shift};
+    request->slope = slope;
     request->alpha0 = free_slacks_ ? alpha_slack_ : 1.0;
     *d = &delta_;
     return Pass::Step;
   }
+  Pass noDirection() override {
+    return end(Termination::NotConverged, "Newton system could not be made positive definite");
+  }
 
-  /// Takes the step, reports it; the barrier problem's last step ends it, else the barrier rule
-  /// updates μ.
+  /// Takes the step, reports it; the barrier problem's last step ends it.
   Pass accept(const LineSearchResult& result, const StopVerdict& verdict) override {
     const double alpha = result.alpha;
     takeStep(trial_, alpha);
@@ -157,13 +167,7 @@ class GridSolve final : public PrimalDualProblem {
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
-    if (verdict.final_step) return endBarrierProblem();
-    if (!verdict.at_final_barrier) {
-      barrier_->afterStep(system_, scales_,
-                          {verdict.relative_decrement, test_.previousDecrement(), alpha, rho_},
-                          &mu_);
-    }
-    return Pass::Continue;
+    return verdict.final_step ? endBarrierProblem() : Pass::Continue;
   }
 
   void iterationLimit() override {}  // ending_ and reason_ say so from the start
@@ -171,52 +175,23 @@ class GridSolve final : public PrimalDualProblem {
     end(termination, termination == Termination::Cancelled ? "cancelled" : "time budget exceeded");
   }
 
-  /// Assembles and factors the condensed system, lets the barrier rule choose μ (Mehrotra),
-  /// and falls back to the primal multipliers μ/s when the primal–dual step is no descent
-  /// direction of φ_μ (it is one with them, H being positive definite).
-  Direction computeDirection() {
-    Direction d;
-    bool primal = false;
-    for (int attempt = 0; attempt < 2 && !d.factored; ++attempt) {
-      d.cost = system_.assemble(mu_, rho_, primal, &kkt_blocks_.band, &rhs_, &merit_gradient_).cost;
-      if (!std::isfinite(d.cost)) break;
-      if (system_.globals() == 1) {  // the twist ψ's border (a pointing end condition)
-        kkt_blocks_.border = system_.twistBorder().column;
-        kkt_blocks_.corner = Eigen::MatrixXd::Constant(1, 1, system_.twistBorder().corner);
-      }
-      d.factored = inertia_.factorAndSolve(*kkt_, kkt_blocks_, rhs_, &delta_, &d.shift, &context_);
-      if (d.factored && !primal && mu_ > scales_.mu_final) {
-        barrier_->beforeStep(
-            system_, [this](Eigen::VectorXd* b) { kkt_->solve(b); }, rhs_, scales_,
-            test_.previousDecrement(), &mu_, &delta_);
-      }
-      d.slope = merit_gradient_.dot(delta_);
-      if (d.factored && free_slacks_) addSlackTerms(&d);
-      if (d.factored && d.slope >= 0.0 && !primal) {
-        d.factored = false;
-        primal = true;
-      }
-    }
-    return d;
-  }
-
   /// Free slacks: the slack and dual steps, the ℓ1 merit's ν (at least the multipliers after the
   /// step, and large enough that the step decreases the merit by a fraction of its predicted
   /// infeasibility reduction), and the slopes with the slacks' and the penalty's part.
-  void addSlackTerms(Direction* d) {
+  void addSlackTerms(double* slope, double* decrement_slope) {
     const ConstrainedSystem::SlackStep slack = system_.slackStep(delta_, mu_);
     alpha_slack_ = slack.alpha;
     alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
     nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.largestMultiplier(dz_, 0.0));
-    const double without_penalty = d->slope + slack.barrier_slope;
+    const double without_penalty = *slope + slack.barrier_slope;
     const double fraction = p_.merit_infeasibility_fraction;
     if (slack.residual > 0.0 && without_penalty > -fraction * nu_ * slack.residual) {
       nu_ = std::max(nu_, 2.0 * without_penalty / ((1.0 - fraction) * slack.residual));
     }
-    d->slope = without_penalty - nu_ * slack.residual;
+    *slope = without_penalty - nu_ * slack.residual;
     // (Its magnitude: a step that mostly repairs round-off residuals may raise f and the barrier
     // a little; that is not convergence.)
-    d->decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
+    *decrement_slope = -std::abs(without_penalty) - nu_ * slack.significant_residual;
   }
 
   // The line search (ArmijoBacktracking in the fixed-h profile) is Armijo on φ_μ along the
@@ -242,21 +217,22 @@ class GridSolve final : public PrimalDualProblem {
   double penalty() const { return free_slacks_ ? nu_ : rho_; }
 
   /// A direction the line search rejects (not at the round-off floor: the decrement test ends
-  /// the solve there): regularize more (Levenberg–Marquardt) and retry, a few times. A retry is
-  /// an iteration (counted): it is reported too, at the same iterate (step 0).
+  /// the solve there), regularized more by the inertia correction (Levenberg–Marquardt): a retry
+  /// is an iteration (counted), reported too, at the same iterate (step 0).
+  Pass retry(const StopVerdict& verdict) override {
+    if (report(cost_, verdict.relative_decrement, 0.0)) return Pass::Continue;
+    ++iteration_;
+    return end(Termination::Cancelled, "cancelled");
+  }
+  /// No retry left.
   Pass rejected(const LineSearchResult&, const StopVerdict& verdict) override {
-    if (inertia_.raiseFloor()) {
-      if (report(cost_, verdict.relative_decrement, 0.0)) return Pass::Continue;
-      ++iteration_;
-      return end(Termination::Cancelled, "cancelled");
-    }
     relative_decrement_ = verdict.relative_decrement;
     return end(Termination::NotConverged, "line search failed");
   }
   Pass ended(const LoopEnd& e) override { return end(e.termination, e.reason, e.decrement); }
 
   /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
-  /// dual step), the iterate; relaxes the shift floor.
+  /// dual step), the iterate.
   void takeStep(const ReducedProblem::StepVectors& trial, double alpha) {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
@@ -269,7 +245,6 @@ class GridSolve final : public PrimalDualProblem {
     } else {
       np_.setCurrent(trial);
     }
-    inertia_.relax();
   }
 
   /// Records the iteration and reports it; false if the caller asked to stop.
@@ -394,13 +369,11 @@ class GridSolve final : public PrimalDualProblem {
   const GridRequest request_;
   ReducedProblem& np_;
   ConstrainedSystem system_;
-  std::unique_ptr<BarrierUpdate> barrier_;
   const bool free_slacks_;
-  RowRelativeShift
-      inertia_;  ///< its floor: raised after a failed line search, relaxed after a success
   /// The condensed system: a band, bordered by the twist ψ with a pointing end condition.
   KktBlocks<Scalar> kkt_blocks_;
   std::unique_ptr<KktSystem<Scalar>> kkt_;
+  KktFactorization<Scalar> factorization_;  ///< kkt_ over kkt_blocks_, as the loop factors it
   DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
   Eigen::VectorXd rhs_, merit_gradient_, delta_;
   BarrierScales scales_;

@@ -7,7 +7,6 @@
 
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
-#include "planning/linalg/interruption.hpp"
 
 namespace attitude_planner {
 
@@ -17,6 +16,23 @@ namespace attitude_planner {
 constexpr double kIpoptShiftGrowth = 8.0;         ///< κ_w⁺
 constexpr double kIpoptShiftResumeDivisor = 3.0;  ///< 1/κ_w⁻
 
+/// The inertia correction as the primal–dual loop (primal_dual_loop.hpp) calls it: the shifted
+/// factorization of each pass's system, and its schedule's updates after a step and after a line
+/// search that took none.
+class InertiaCorrection {
+ public:
+  virtual ~InertiaCorrection() = default;
+  /// Factors K + shift with the schedule's shifts and solves *d = K⁻¹ rhs; *shift is the shift
+  /// used. False if no shift the schedule allows gives a step.
+  virtual bool factorAndSolve(ShiftedSystem& system, const Eigen::VectorXd& rhs, Eigen::VectorXd* d,
+                              double* shift) = 0;
+  /// After a line search that took no step: true where a stronger regularization is worth a retry
+  /// from the same iterate.
+  virtual bool afterRejection() { return false; }
+  /// After an accepted step of length `alpha`; `end_game`: μ ≤ the damped barrier (free time).
+  virtual void afterStep(double /*alpha*/, bool /*end_game*/) {}
+};
+
 /// Fixed h: a shift relative to each row's scale (Shift::Rule::RowRelative, the row floor
 /// `shift_row_floor` × the largest diagonal), from the current floor, first `first_shift`, then
 /// ×`shift_growth`, at most `max_inertia_corrections` factorizations, until the band factors
@@ -24,20 +40,16 @@ constexpr double kIpoptShiftResumeDivisor = 3.0;  ///< 1/κ_w⁻
 /// others, and a uniform shift sized by them damps the free directions into linear
 /// convergence). After a rejected line search the floor rises (Levenberg–Marquardt), and it is
 /// relaxed after every accepted step.
-class RowRelativeShift {
+class RowRelativeShift final : public InertiaCorrection {
  public:
   explicit RowRelativeShift(const InteriorPointParameters& parameters) : p_(parameters) {}
-  /// Factors K + shift and solves *d = K⁻¹ rhs; *shift is the shift used. False if no shift
-  /// within the tries factors with a finite solution.
-  template <typename Scalar>
-  bool factorAndSolve(KktSystem<Scalar>& kkt, const KktBlocks<Scalar>& k,
-                      const Eigen::VectorXd& rhs, Eigen::VectorXd* d, double* shift,
-                      const Interruption* interruption);
-  /// After a rejected line search: the floor rises to max(line_search_shift, growth × floor);
-  /// false when it is at max_shift_floor already (the direction cannot be regularized further).
-  bool raiseFloor();
-  /// After an accepted step: the floor falls by the growth factor, to 0 below line_search_shift.
-  void relax();
+  bool factorAndSolve(ShiftedSystem& system, const Eigen::VectorXd& rhs, Eigen::VectorXd* d,
+                      double* shift) override;
+  /// The floor rises to max(line_search_shift, growth × floor); false when it is at
+  /// max_shift_floor already (the direction cannot be regularized further).
+  bool afterRejection() override;
+  /// The floor falls by the growth factor, to 0 below line_search_shift.
+  void afterStep(double alpha, bool end_game) override;
 
  private:
   const InteriorPointParameters& p_;
@@ -51,12 +63,11 @@ class RowRelativeShift {
 /// κ_w⁺ (else by shift_growth), at most free_time_max_shift; accepted where K's inertia is
 /// (n + m, 0, 0) and the step is a descent direction (dᵀrhs > 0). Plus the damping after steps
 /// cut short (afterStep).
-class PerturbationHandler {
+class PerturbationHandler final : public InertiaCorrection {
  public:
   explicit PerturbationHandler(const InteriorPointParameters& parameters) : p_(parameters) {}
-  template <typename Scalar>
-  bool factorAndSolve(KktSystem<Scalar>& kkt, const KktBlocks<Scalar>& k,
-                      const Eigen::VectorXd& rhs, Eigen::VectorXd* d);
+  bool factorAndSolve(ShiftedSystem& system, const Eigen::VectorXd& rhs, Eigen::VectorXd* d,
+                      double* shift) override;
   /// A Levenberg–Marquardt damping of the Newton step (the shift of factorAndSolve, from the
   /// first shift, ×growth per further cut step, ÷growth per full step, 0 below the smallest
   /// damping): where minimum time is flat (a torque strictly inside its bounds along an arc:
@@ -64,8 +75,8 @@ class PerturbationHandler {
   /// constraints' curvature along it cuts it at the boundary again and again (measured: 0.96 N m
   /// about body x against |u_x| ≤ 1, N = 64: 500 iterations at steps of 1/512 … 1/8 with the
   /// stationarity stuck at 3e-5). The residuals that decide convergence are the undamped ones:
-  /// the KKT point is the same, only the path to it is shorter. `late`: μ ≤ the damped barrier.
-  void afterStep(double alpha, bool late);
+  /// the KKT point is the same, only the path to it is shorter.
+  void afterStep(double alpha, bool end_game) override;
 
  private:
   const InteriorPointParameters& p_;

@@ -10,6 +10,7 @@
 // (Mehrotra's corrector and the second-order correction reuse it).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <optional>
 
@@ -87,6 +88,47 @@ class BorderedBandKkt final : public KktSystem<Scalar> {
 
  private:
   BorderedBandedFactor<Scalar> factor_;
+};
+
+/// One assembled K and its KktSystem as the inertia correction sees them, whatever the precision:
+/// the primal–dual loop factors through this (PrimalDualProblem::newtonSystem).
+class ShiftedSystem {
+ public:
+  virtual ~ShiftedSystem() = default;
+  /// Factors K + shift (polling the problem's interruption where it has one).
+  virtual bool factor(const Shift& shift) = 0;
+  virtual const KktInertia& inertia() const = 0;
+  virtual void solve(Eigen::VectorXd* rhs) const = 0;
+  virtual int globals() const = 0;
+  /// max |A(i, i)|, the row-relative shift's floor scale.
+  virtual double maxAbsDiagonal() const = 0;
+  /// The mean |diagonal| of K (A and D): the uniform shift's scale.
+  virtual double meanAbsDiagonal() const = 0;
+};
+
+/// A KktSystem<Scalar> over the blocks one assembly fills.
+template <typename Scalar>
+class KktFactorization final : public ShiftedSystem {
+ public:
+  KktFactorization(KktSystem<Scalar>& kkt, const KktBlocks<Scalar>& k,
+                   const Interruption* interruption)
+      : kkt_(kkt), k_(k), interruption_(interruption) {}
+  bool factor(const Shift& shift) override { return kkt_.factor(k_, shift, interruption_); }
+  const KktInertia& inertia() const override { return kkt_.inertia(); }
+  void solve(Eigen::VectorXd* rhs) const override { kkt_.solve(rhs); }
+  int globals() const override { return k_.globals(); }
+  double maxAbsDiagonal() const override { return k_.band.maxAbsDiagonal(); }
+  double meanAbsDiagonal() const override {
+    const int n = k_.band.size();
+    double scale = k_.corner.diagonal().cwiseAbs().sum();
+    for (int i = 0; i < n; ++i) scale += std::abs(k_.band(i, i));
+    return scale / (n + k_.globals());
+  }
+
+ private:
+  KktSystem<Scalar>& kkt_;
+  const KktBlocks<Scalar>& k_;
+  const Interruption* interruption_;
 };
 
 /// The implementation for m global unknowns (the loop never asks which).

@@ -11,8 +11,8 @@
 
 namespace attitude_planner {
 
-/// What the stopping tests read of the iterate; both problems expose it (PrimalDualProblem::state),
-/// each filling what its test reads.
+/// What the stopping tests and the μ rule read of the iterate; both problems expose it
+/// (PrimalDualProblem::state), each filling what its strategies read.
 struct BarrierState {
   int iteration = 0;              ///< the passes counted so far
   bool at_final_barrier = false;  ///< μ ≤ μ_final
@@ -21,6 +21,11 @@ struct BarrierState {
   double stationarity = 0.0;      ///< free time: ‖∇L‖∞ at the assembled iterate
   double gap = 0.0;               ///< free time: the duality gap Σ zc there
   double f_scale = 1.0;           ///< fixed h: the start's cost (floored), the decrement's scale
+  /// Free time: the barrier problem's KKT residual at the assembled iterate (its μ rule's test).
+  double barrier_residual = 0.0;
+  /// Free time: the last search found the barrier problem solved as far as round-off allows.
+  bool solved_to_round_off = false;
+  bool end_game = false;  ///< free time: μ ≤ the damped barrier (the damping after cut steps)
 };
 
 /// What the decrement test reads of a direction.

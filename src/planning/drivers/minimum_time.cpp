@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -205,31 +206,45 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
 
 /// Spinning ends: the probes below T* (probedBelow). A probe asks (1 − δ 2^j) T for the least
 /// duration T found so far, δ = kProbeBelow: j grows while probes succeed (a descent by doubling
-/// steps), falls back by one after a failure (bisection), and the descent stops where the probes
-/// at both δ and 2δ below T found nothing: a cold minimum-effort solve's failure is local, and the
-/// seeded bounded suite had requests where 0.99 T failed and 0.98 T converged. kMaxProbes bounds
-/// the time (each probe is one constrained minimum-effort solve and one free-time solve).
+/// steps), falls back by one after a failure (bisection), and where the probes at both δ and 2δ
+/// below T found nothing, the far probes follow (kFarProbes below T, each once) before the
+/// descent stops. A cold minimum-effort solve's failure is local and feasibility in T is not
+/// monotone with spinning ends: the seeded bounded suite had requests where 0.99 T failed and
+/// 0.98 T converged, and the seed-45 spinning suite's #77 (N = 215) a KKT point at 6.8175 s with
+/// minimum-effort plans failing at 0.99 and 0.98 of it and converging at 6.3 s and 5.3 s (the
+/// issue's own evidence: plans at 0.90 T*). kMaxProbes bounds the time (each probe is one
+/// constrained minimum-effort solve and, where it finds a plan, one free-time solve).
 constexpr double kProbeBelow = 0.01;
 constexpr int kLargestProbeExponent = 5;  ///< at most 32 δ = 32 % below T per probe
+constexpr double kFarProbes[] = {0.1, 0.2};
 constexpr int kMaxProbes = 12;
 
-/// What the probes below the current T have shown: which steps δ 2^j found nothing.
+/// What the probes below the current T have shown: which steps δ 2^j found nothing, and which
+/// far probe is next once the near ones found nothing.
 struct ProbeSteps {
   int exponent = 0;
   bool failed_at_one = false, failed_at_two = false;  ///< j = 0, j = 1 found nothing
+  int far = -1;  ///< the far probe being asked (kFarProbes index); −1: the near ones
 
-  double fraction() const { return kProbeBelow * std::ldexp(1.0, exponent); }
+  double fraction() const {
+    return far >= 0 ? kFarProbes[far] : kProbeBelow * std::ldexp(1.0, exponent);
+  }
   /// After a probe that found a plan (a lower T): `descended` if a free-time KKT point came of it
   /// (a new basin: start again at δ), else larger steps.
   void found(bool descended) {
-    exponent = descended ? 0 : std::min(exponent + 1, kLargestProbeExponent);
+    exponent = descended || far >= 0 ? 0 : std::min(exponent + 1, kLargestProbeExponent);
     failed_at_one = failed_at_two = false;
+    far = -1;
   }
   /// After a probe that found nothing: false when the descent stops.
   bool nothingFound() {
+    if (far >= 0) return ++far < static_cast<int>(std::size(kFarProbes));
     if (exponent == 0) failed_at_one = true;
     if (exponent == 1) failed_at_two = true;
-    if (failed_at_one && failed_at_two) return false;
+    if (failed_at_one && failed_at_two) {
+      far = 0;
+      return true;
+    }
     exponent = exponent > 1 ? exponent - 1 : (failed_at_one ? 1 : 0);
     return true;
   }

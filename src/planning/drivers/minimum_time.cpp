@@ -258,8 +258,8 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
                        const PlanResult& answer, const PlanResult& below,
                        std::optional<std::size_t> below_kept, std::size_t first,
                        SolveContext& context, std::optional<Maneuver>* lower_plan) {
-  std::optional<PlanResult> lower =
-      freeTimeFromPlan(problem, below.maneuver, effort.duration, context, lower_plan);
+  std::optional<PlanResult> lower = freeTimeFromPlan(problem, below.maneuver, effort.duration,
+                                                     "probe's plan", context, lower_plan);
   if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
     lower->attempts = context.attemptsFrom(first);
     addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
@@ -357,8 +357,8 @@ PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
   const PlanResult at_twist = minimumTimePlan(fixed, context);
   if (at_twist.converged() &&
       at_twist.maneuver.attitude.size() == static_cast<std::size_t>(posed.steps) + 1) {
-    std::optional<PlanResult> freed =
-        freeTimeFromPlan(posed, at_twist.maneuver, at_twist.minimum_duration, context);
+    std::optional<PlanResult> freed = freeTimeFromPlan(
+        posed, at_twist.maneuver, at_twist.minimum_duration, "fixed-twist plan", context);
     if (freed && freed->converged()) {
       freed->attempts = context.attemptsFrom(first);
       freed->minimum_time.solves += at_twist.minimum_time.solves;
@@ -406,7 +406,7 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
   // free-time solve can reach a KKT point at or below it where the structured starts did not.
   const std::optional<std::size_t> search_kept = context.keptAttempt();
   std::optional<PlanResult> sharpened =
-      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration, context);
+      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration, "search's plan", context);
   if (!sharpened || !sharpened->converged()) {
     // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
     context.restoreKept(search_kept);

@@ -668,9 +668,9 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 }
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context,
-                                           std::optional<Maneuver>* below) {
-  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, "search's plan", below);
+                                           double duration, const std::string& start,
+                                           SolveContext& context, std::optional<Maneuver>* below) {
+  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, start, below);
 }
 
 }  // namespace attitude_planner

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
@@ -49,12 +50,14 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
                                               SolveContext& context);
 
 /// One free-time solve on the requested grid from `plan`, a plan meeting every bound at T =
-/// `duration` (the search's answer where the structured starts did not converge): its
+/// `duration` (the search's answer where the structured starts did not converge, a probe's, ...;
+/// `start` names it in the answer's message): its
 /// KKT point if it converged at or below `duration`, else empty (its solve is in the context's
 /// trail either way). Where it ended short of a KKT point at an iterate strictly inside every
 /// bound below `duration`, that iterate's plan goes to `*below` (a plan at its own T).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
-                                           double duration, SolveContext& context,
+                                           double duration, const std::string& start,
+                                           SolveContext& context,
                                            std::optional<Maneuver>* below = nullptr);
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its

@@ -122,7 +122,8 @@ TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, Solve
     return s;
   }
   const std::size_t first = context.attempts().size();
-  std::optional<PlanResult> freed = freeTimeFromPlan(posed, slew, at.duration, context);
+  std::optional<PlanResult> freed =
+      freeTimeFromPlan(posed, slew, at.duration, "eigenaxis slew", context);
   if (freed) s.result = std::move(*freed);
   s.result.minimum_time.solves = 1;
   tagStartsAttempts(context, first, &s);
@@ -168,7 +169,7 @@ std::optional<PlanResult> onFinerLevel(const PlanningProblem& level, const PlanR
   Maneuver start;
   start.attitude = prolonged(posed, carried);
   return freeTimeFromPlan(posed, start, (1.0 + kLevelStartSlack) * coarse.minimum_duration,
-                          context);
+                          "coarser grid's plan", context);
 }
 
 /// The survey's answer `survey` (a converged ψ-free plan on the survey grid) carried to the

@@ -249,18 +249,23 @@ TEST(AttemptTags, AMinimumTimeRequestsTrailIsTheContextsTrail) {
   }
 }
 
+/// Minimum effort for `p` (a minimum-time request) at 0.9 of its T*, planned in `context`.
+ap::PlanResult boundedBelowItsMinimumTime(ap::PlanningProblem p, ap::SolveContext& context) {
+  const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
+  EXPECT_TRUE(fastest.converged()) << fastest.message;
+  p.objective = ap::Objective::MinimumEffort;
+  p.duration = 0.9 * fastest.minimum_duration;
+  return ap::planBoundedMinimumEffort(p, context);
+}
+
 TEST(AttemptTags, ABoundedRequestsTrailIsTheContextsTrail) {
   // Minimum effort at 0.9 T*: the interior point ends infeasible, the minimum-time phase backs
   // the verdict; the trail holds both, as the context recorded them.
   ap::PlanningProblem p = ap::test_support::sceneProblem("min_time_bilimoria_wie", 32);
   p.objective = ap::Objective::MinimumTime;
-  const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
-  ASSERT_TRUE(fastest.converged()) << fastest.message;
-  p.objective = ap::Objective::MinimumEffort;
-  p.duration = 0.9 * fastest.minimum_duration;
   const ap::SolverOptions options;
   ap::SolveContext context(options);
-  const ap::PlanResult r = ap::planBoundedMinimumEffort(p, context);
+  const ap::PlanResult r = boundedBelowItsMinimumTime(p, context);
   EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
   const bool minimum_time_phase = std::any_of(
       r.attempts.begin(), r.attempts.end(),
@@ -309,15 +314,11 @@ TEST(AttemptTags, ABoundedPointingRequestsTrailIsTheContextsTrail) {
   // Minimum effort to a pointing target below T* (the twist free): the interior point ends
   // infeasible and the minimum-time phase over the start twists backs the verdict; the trail
   // holds both, as the context recorded them.
-  ap::PlanningProblem p =
+  const ap::PlanningProblem p =
       ap::test_support::randomBettsPointingRequest(4303, 32, ap::SchemeKind::SecondOrder);
-  const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
-  ASSERT_TRUE(fastest.converged()) << fastest.message;
-  p.objective = ap::Objective::MinimumEffort;
-  p.duration = 0.9 * fastest.minimum_duration;
   const ap::SolverOptions options;
   ap::SolveContext context(options);
-  const ap::PlanResult r = ap::planBoundedMinimumEffort(p, context);
+  const ap::PlanResult r = boundedBelowItsMinimumTime(p, context);
   EXPECT_FALSE(r.converged()) << r.message;
   EXPECT_TRUE(std::any_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return a.stage == ap::AttemptStage::MinimumTimeSolve && std::isfinite(a.start_detail.twist);

@@ -118,7 +118,7 @@ TEST(DurationBound, NoSchemesMinimumTimePlanIsShorter) {
     const PlanResult r = planManeuver(p);
     if (!r.converged()) continue;
     ++checked;
-    const double bound = discreteDurationLowerBound(durationLowerBound(p), p.steps);
+    const double bound = discreteDurationLowerBound(p);
     EXPECT_GE(r.minimum_duration, bound);
     EXPECT_DOUBLE_EQ(r.duration_verdict.lower_bound, durationLowerBound(p).seconds);
     EXPECT_DOUBLE_EQ(r.duration_verdict.torque_limit, durationLowerBound(p).torque_limit);
@@ -304,6 +304,17 @@ TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
     } else {
       EXPECT_EQ(r.termination, Termination::NotConverged) << r.message;
       EXPECT_EQ(r.message.find("(feasible:"), std::string::npos) << r.message;
+      // Where a rung converged, the durations at which plans were found are the answer's data.
+      const bool rung_converged =
+          std::any_of(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
+            return a.stage == AttemptStage::DurationLadder &&
+                   a.termination == Termination::Converged;
+          });
+      if (rung_converged) {
+        EXPECT_GT(v.least_duration_found, 0.0);
+        EXPECT_GE(v.longest_duration_found, v.least_duration_found);
+        EXPECT_LT(v.longest_duration_found, request->problem.duration);
+      }
     }
   }
 }

@@ -12,9 +12,11 @@
 #include <optional>
 #include <thread>
 #include <tuple>
+#include <vector>
 
 #include "attitude_planner/planner.hpp"
 #include "planning/strategies/grid_continuation.hpp"
+#include "planning/strategies/staged_continuation.hpp"
 #include "support/robustness_cases.hpp"
 #include "support/scene_problem.hpp"
 
@@ -434,4 +436,112 @@ TEST(SolveContext, OneRequestNumbersItsIterationsOnce) {
       EXPECT_EQ(static_cast<int>(numbers.size()), r.iterations) << name << ": " << r.message;
     }
   }
+}
+
+namespace {
+
+/// An adaptive continuation over s in [0, 1] whose stages converge only where s moved by at most
+/// `largest` from the last converged stage and s <= `wall` (beyond it, as past a fold, no stage
+/// converges): whether each stage solved, and from which converged s to which s each stage was
+/// posed (in order).
+struct AdaptiveRun {
+  StagedOutcome out;
+  std::vector<bool> solved;
+  std::vector<std::pair<double, double>> posed;
+};
+
+AdaptiveRun adaptiveStages(double largest, int hold_after_failure, double first_increment = 0.05,
+                           double max_increment = 0.4, double wall = 1.0) {
+  SolveContext context{SolverOptions{}};
+  AdaptiveSchedule schedule;
+  schedule.first_increment = first_increment;
+  schedule.max_increment = max_increment;
+  schedule.min_increment = 0.01;
+  schedule.max_stages = 80;
+  schedule.hold_after_failure = hold_after_failure;
+  double last = 0.0;
+  AdaptiveRun run;
+  run.out = solveByAdaptiveStages(
+      context,
+      [](double s) {
+        PlanningProblem p;
+        p.duration = 1.0 + s;
+        return p;
+      },
+      schedule,
+      [&](const PlanningProblem& stage, const Maneuver* from) {
+        const double s = stage.duration - 1.0;
+        PlanResult r;
+        const bool ok = from == nullptr || (s - last <= largest * (1.0 + 1e-12) && s <= wall);
+        r.termination = ok ? Termination::Converged : Termination::Infeasible;
+        if (from) {
+          run.solved.push_back(ok);
+          run.posed.emplace_back(last, s);
+        }
+        if (ok) last = s;
+        return r;
+      });
+  return run;
+}
+
+/// The fewest converged stages between two failed ones (a large number where fewer than two
+/// failed).
+int fewestConvergedBetweenFailures(const std::vector<bool>& solved) {
+  int fewest = 1 << 20;
+  int since = -1;  // converged stages since the last failed one (−1: none failed yet)
+  for (const bool ok : solved) {
+    if (ok) {
+      if (since >= 0) ++since;
+    } else {
+      if (since >= 0) fewest = std::min(fewest, since);
+      since = 0;
+    }
+  }
+  return fewest;
+}
+
+}  // namespace
+
+// Doubling the increment straight back after a failed stage alternates failed and converged
+// stages; held for one converged stage, the continuation reaches s = 1 with fewer failed stages,
+// and never two failures with fewer than two converged stages between them.
+TEST(StagedContinuation, AHeldIncrementAfterAFailureFailsLessOften) {
+  for (const double largest : {0.07, 0.1, 0.13, 0.21}) {
+    SCOPED_TRACE(largest);
+    const AdaptiveRun doubling = adaptiveStages(largest, 0);
+    const AdaptiveRun holding = adaptiveStages(largest, 1);
+    const auto failures = [](const std::vector<bool>& v) {
+      return std::count(v.begin(), v.end(), false);
+    };
+    EXPECT_TRUE(doubling.out.complete());
+    EXPECT_TRUE(holding.out.complete());
+    EXPECT_LT(failures(holding.solved), failures(doubling.solved));
+    EXPECT_EQ(fewestConvergedBetweenFailures(doubling.solved), 1);
+    EXPECT_GE(fewestConvergedBetweenFailures(holding.solved), 2);
+  }
+}
+
+// A stage is never posed twice from the same plan (a deterministic solver would fail it again),
+// in particular where s + ds was cut at s = 1 and failed there (halving ds, not the increment
+// tried, posed s = 1 again from the same plan); the continuation still gets close to the wall.
+TEST(StagedContinuation, NoFailedStageIsPosedAgainFromTheSamePlan) {
+  int runs = 0;
+  for (const double largest : {0.3, 0.6, 1.0}) {
+    for (const double first : {0.05, 0.25, 0.5}) {
+      for (const double wall : {0.6, 0.95, 0.99}) {
+        for (const int hold : {0, 1}) {
+          SCOPED_TRACE(std::to_string(largest) + " " + std::to_string(first) + " " +
+                       std::to_string(wall) + " " + std::to_string(hold));
+          const AdaptiveRun run = adaptiveStages(largest, hold, first, 1.0, wall);
+          std::vector<std::pair<double, double>> posed = run.posed;
+          std::sort(posed.begin(), posed.end());
+          EXPECT_EQ(std::adjacent_find(posed.begin(), posed.end()), posed.end());
+          EXPECT_LE(run.out.reached, wall);
+          EXPECT_GE(run.out.reached, wall - 0.1);
+          ++runs;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(runs, 54);
 }

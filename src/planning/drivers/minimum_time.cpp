@@ -288,8 +288,7 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
 /// `answer`'s began).
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
                        SolveContext& context) {
-  const double floor =
-      discreteDurationLowerBound(durationLowerBound(problem), problem.steps);  // 0: no bound
+  const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
   std::optional<Maneuver> lower_plan;  // a free-time iterate's plan below the answer's T
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
@@ -488,11 +487,12 @@ std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResu
 }
 
 /// The duration ladder's rungs: a first step of 15 % in T, up to 30 % after converged rungs,
-/// a failed rung's step halved down to 0.4 %, at most 24 rungs.
+/// a failed rung's step halved down to 0.4 % and held for one converged rung, at most 24 rungs.
 constexpr double kLadderFirstRatio = 1.15;
 constexpr double kLadderLargestRatio = 1.3;
 constexpr double kLadderLeastRatio = 1.004;
 constexpr int kLadderRungs = 24;
+constexpr int kLadderHoldAfterFailure = 1;
 
 /// Where the duration ladder got: the plan at the requested T if it converged there, else the
 /// last solve's; `reached` the longest duration at which a rung converged within the bounds;
@@ -537,10 +537,12 @@ LadderClimb climbDurationLadder(const PlanningProblem& problem, const PlanResult
   const double log_ratio = std::log(problem.duration / T_star);
   const auto share = [&](double ratio) { return std::min(1.0, std::log(ratio) / log_ratio); };
   AdaptiveSchedule schedule;
-  schedule.first_increment = share(kLadderFirstRatio);
+  // The ladder climbs where the start at T itself failed: its first rung is below T.
+  schedule.first_increment = std::min(share(kLadderFirstRatio), 0.5);
   schedule.max_increment = share(kLadderLargestRatio);
   schedule.min_increment = share(kLadderLeastRatio);
   schedule.max_stages = kLadderRungs;
+  schedule.hold_after_failure = kLadderHoldAfterFailure;
   const auto duration = [&](double s) {
     return s >= 1.0 ? problem.duration : T_star * std::exp(s * log_ratio);
   };
@@ -619,6 +621,11 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
     // Nothing better than the first answer: it stays, with what was tried.
     context.restoreKept(first_kept);
     PlanResult kept = first;
+    if (climb.reached > 0.0) {
+      // The first answer stands, but where plans were found is data, not only words.
+      kept.duration_verdict.least_duration_found = T_star;
+      kept.duration_verdict.longest_duration_found = climb.reached;
+    }
     addNote(&kept, restart);
     addNote(&kept, notes::RestartEnded{again.termination, again.message});
     return kept;

@@ -166,7 +166,7 @@ class MinimumTimeSearch {
   /// Below T_first (kShorteningFactor), cold, until `feasible` holds: the T where it did, or 0.
   template <typename Feasible>
   double shortened(double T_first, const Feasible& feasible) {
-    const double floor = discreteDurationLowerBound(durationLowerBound(problem_), problem_.steps);
+    const double floor = discreteDurationLowerBound(problem_);
     double T = T_first;
     for (int k = 0; k < kMaxShortenings && !stopped(); ++k) {
       T *= kShorteningFactor;

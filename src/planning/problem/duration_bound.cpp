@@ -136,4 +136,8 @@ double discreteDurationLowerBound(const DurationLowerBound& bound, int steps) {
   return bound.seconds / (1.0 + kDiscreteMargin / std::max(steps, 1));
 }
 
+double discreteDurationLowerBound(const PlanningProblem& problem) {
+  return discreteDurationLowerBound(durationLowerBound(problem), problem.steps);
+}
+
 }  // namespace attitude_planner

@@ -51,6 +51,8 @@ DurationLowerBound durationLowerBound(const PlanningProblem& problem);
 /// schemes with end torques and of the variational map, see above). Tested against every
 /// scheme's minimum time on random problems (test_duration_bound).
 double discreteDurationLowerBound(const DurationLowerBound& bound, int steps);
+/// The same for `problem`'s own bound on its own grid (0: no bound applies).
+double discreteDurationLowerBound(const PlanningProblem& problem);
 constexpr double kDiscreteMargin = 4.0;
 
 }  // namespace attitude_planner

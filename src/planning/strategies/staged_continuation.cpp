@@ -27,6 +27,7 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
   if (!out.plan.converged()) return out;
   out.reached = 0.0;
   double ds = schedule.first_increment;
+  int held = 0;  // converged stages still to go at ds before it may double
   while (out.reached < 1.0 && out.stages < schedule.max_stages && !context.stopReason()) {
     const double next = std::min(1.0, out.reached + ds);
     const Maneuver from = out.plan.maneuver;
@@ -41,9 +42,16 @@ StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProb
     if (r.converged()) {
       out.plan = std::move(r);
       out.reached = next;
-      ds = std::min(2.0 * ds, schedule.max_increment);
+      if (held > 0) {
+        --held;
+      } else {
+        ds = std::min(2.0 * ds, schedule.max_increment);
+      }
     } else {
-      ds *= 0.5;
+      // Half the increment tried, not ds: where s + ds was cut at 1, halving ds could pose the
+      // failed stage again from the same plan.
+      ds = 0.5 * (next - out.reached);
+      held = schedule.hold_after_failure;
       if (ds < schedule.min_increment) break;
     }
   }

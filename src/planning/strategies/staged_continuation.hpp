@@ -30,13 +30,18 @@ struct StagedOutcome {
   bool complete() const { return !stopped && reached == 1.0 && plan.converged(); }
 };
 
-/// The adaptive schedule: s = 0, then s + ds with ds doubling (to max_increment) after a
-/// converged stage and halving after a failed one (giving up below min_increment).
+/// The adaptive schedule: s = 0, then s + ds (at most 1) with ds doubling (to max_increment)
+/// after a converged stage and half the increment tried after a failed one (giving up below
+/// min_increment). After a
+/// failed stage ds is held for `hold_after_failure` converged stages before it doubles again: an
+/// increment that just failed is likely to fail again from the next stage (doubling straight back
+/// to it alternates failed and converged stages, and failed stages count against max_stages).
 struct AdaptiveSchedule {
   double first_increment = 0.25;
   double max_increment = 0.5;
   double min_increment = 1.0 / 64;
   int max_stages = 24;
+  int hold_after_failure = 0;
 };
 
 StagedOutcome solveByAdaptiveStages(const SolveContext& context, const StageProblem& at,

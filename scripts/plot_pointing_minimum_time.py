@@ -60,10 +60,10 @@ summary = """- T*: %d of %d at most the sweep's best + %g relative (largest exce
   The worst swept twist's T* is %.3g-%.3gx the best (median %.3g).
 - End condition: largest angle(R_N b, d) %s rad; largest stationarity in psi |dL/dpsi| %s.
 - Time: pointing / fixed at the chosen twist median %.2fx, p90 %.2fx, largest %.2fx, %d of %d within 3x (a
-  pointing request runs, from each of 4 start twists on a survey grid of N/4 steps, the
-  fixed-attitude minimum-time recipe and one psi-free solve from its plan, and one psi-free
-  solve from the eigenaxis slew, then one psi-free solve per factor-2 level from the survey's
-  best plan prolonged up to N).
+  pointing request runs, at each of 4 start twists on a survey grid of N/4 steps, the
+  fixed-twist free-time solve from the eigenaxis slew and one psi-free solve from its plan, and
+  one psi-free solve from the slew itself, then one psi-free solve per factor-2 level from the
+  survey's best plan prolonged up to N).
 """ % (sum(e <= TARGET for e in excesses), len(cases), TARGET, max(excesses), len(converged), len(cases),
        min(spread), max(spread), statistics.median(spread),
        "%.1e" % max(c["error"] for c in converged) if converged else "-",
@@ -79,11 +79,12 @@ body (J = diag(5621, 4547, 2364) kg m^2, |tau_i| <= 50 N m, scenes/min_time_bett
 rest, random boresight b, target d and R_0, second_order, N = %d. Load while measuring: %s.
 
 Each request is planned once as a pointing request (`final.pointing`, objective minimum_time: the
-twist psi a global unknown of the free-time interior point: from each of 4 start twists the
-fixed-twist minimum time, then one free-time solve with psi free from its plan, and one free-time
-solve with psi free from the eigenaxis slew, on a survey grid of N/4 steps; the survey's least T* carried to N through factor-2 levels, one free-time solve
-with psi free per level from the coarser plan prolonged; the recipe on N at its twist only where
-that does not converge), and judged
+twist psi a global unknown of the free-time interior point: at each of 4 start twists on a survey
+grid of N/4 steps the fixed-twist free-time solve from the eigenaxis slew, then one free-time
+solve with psi free from its plan (the fixed-twist plan kept where that ends above it), and one
+free-time solve with psi free from the slew itself; the survey's least T* carried to N through
+factor-2 levels, one free-time solve with psi free per level from the coarser plan prolonged; the
+fixed-twist minimum-time recipe on N at its twist only where that does not converge), and judged
 against the least T* over fixed twists: planManeuver's minimum time at R_N = R_ref exp(psi b^)
 every 5 degrees, the best bracket refined by golden section to 1e-7 rad. Times: the median thread
 CPU time of %d runs each, the pointing request beside one fixed-attitude minimum-time request at

@@ -8,14 +8,16 @@
 // With `--constrained C`, C more requests with one binding constraint each (in turn a keep-out cone
 // between R_0 b and d, a torque box, a torque norm bound: randomConstrainedPointingRequest). With
 // `--minimum-time M`, M minimum-time requests on Betts's body (randomBettsPointingRequest; rest
-// to rest, second_order), their "cost" T* and the sweep's fixed-twist T*.
+// to rest, second_order), their "cost" T* and the sweep's fixed-twist T*. With `--sweep 0`, no
+// sweep (its fields null): the times of a larger suite alone, judged against a sweep run before.
 //
 //   pointing_study [--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N]
-//   [--repeats R] --out RAW.json
+//   [--repeats R] [--sweep 0|1] --out RAW.json
 #include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -33,6 +35,7 @@ namespace {
 
 struct Options {
   int count = 32, constrained = 12, minimum_time = 0, steps = 64, repeats = 5;
+  int sweep = 1;  ///< 0: no sweep (the times and answers alone; the sweep's fields null)
   unsigned seed = 41;
   std::string out;
 };
@@ -46,11 +49,12 @@ Options parse(int argc, char** argv) {
       .add("--seed", &o.seed)
       .add("--steps", &o.steps)
       .add("--repeats", &o.repeats)
+      .add("--sweep", &o.sweep)
       .add("--out", &o.out)
       .require("--out");
   st::readFlagsOrExit(flags, argc, argv, "pointing_study",
                       "[--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N] "
-                      "[--repeats R] --out RAW.json");
+                      "[--repeats R] [--sweep 0|1] --out RAW.json");
   return o;
 }
 
@@ -88,15 +92,19 @@ std::string list(const std::vector<double>& v) {
 
 /// One request's JSON object: the pointing answer, its sweep and the two times.
 std::string caseJson(unsigned seed, bool spinning, const std::string& binding,
-                     const ap::PlanningProblem& p, int repeats) {
+                     const ap::PlanningProblem& p, int repeats, bool swept) {
   double pointing_time = 0.0, fixed_time = 0.0;
   const ap::PlanResult r = timed(p, repeats, &pointing_time);
   ap::PlanningProblem fixed = p;
   fixed.end_condition = ap::EndCondition();
   fixed.final_attitude = ap::pointingAttitude(p.end_condition, r.pointing.final_twist);
   const ap::PlanResult f = timed(fixed, repeats, &fixed_time);
-  const attitude_planner::test_support::TwistSweep sweep =
-      attitude_planner::test_support::sweepTwist(p);
+  attitude_planner::test_support::TwistSweep sweep;
+  if (swept) {
+    sweep = attitude_planner::test_support::sweepTwist(p);
+  } else {
+    sweep.best = sweep.best_twist = sweep.worst = std::numeric_limits<double>::quiet_NaN();
+  }
   // What the sweep compares: the effort, or T* for a minimum-time request.
   const bool timed_request = p.objective == ap::Objective::MinimumTime;
   const double value = timed_request ? r.minimum_duration : r.cost;
@@ -138,7 +146,7 @@ int main(int argc, char** argv) {
       const ap::SchemeKind scheme = i % 4 < 2 ? ap::SchemeKind::Paper : ap::SchemeKind::SecondOrder;
       const ap::PlanningProblem p =
           attitude_planner::test_support::randomPointingRequest(seed, o.steps, spinning, scheme);
-      out << (i ? ",\n" : "") << caseJson(seed, spinning, "none", p, o.repeats);
+      out << (i ? ",\n" : "") << caseJson(seed, spinning, "none", p, o.repeats, o.sweep != 0);
       out.flush();
       std::cerr << "request " << i + 1 << " of " << o.count << " done\n";
     }
@@ -155,7 +163,8 @@ int main(int argc, char** argv) {
       const ap::PlanningProblem p =
           attitude_planner::test_support::randomConstrainedPointingRequest(seed, o.steps, spinning,
                                                                            scheme, binding);
-      out << (o.count + i ? ",\n" : "") << caseJson(seed, spinning, name, p, o.repeats);
+      out << (o.count + i ? ",\n" : "")
+          << caseJson(seed, spinning, name, p, o.repeats, o.sweep != 0);
       out.flush();
       std::cerr << "constrained request " << i + 1 << " of " << o.constrained << " done\n";
     }
@@ -164,7 +173,8 @@ int main(int argc, char** argv) {
       const ap::PlanningProblem p = attitude_planner::test_support::randomBettsPointingRequest(
           seed, o.steps, ap::SchemeKind::SecondOrder);
       const bool first = o.count + o.constrained + i == 0;
-      out << (first ? "" : ",\n") << caseJson(seed, false, "torque_box", p, o.repeats);
+      out << (first ? "" : ",\n")
+          << caseJson(seed, false, "torque_box", p, o.repeats, o.sweep != 0);
       out.flush();
       std::cerr << "minimum-time request " << i + 1 << " of " << o.minimum_time << " done\n";
     }

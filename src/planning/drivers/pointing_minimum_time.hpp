@@ -15,18 +15,20 @@ namespace attitude_planner {
 /// still a pointing one: the twist stays free in its solves).
 using MinimumTimeRecipe = std::function<PlanResult(const PlanningProblem& posed)>;
 
-/// Plans `problem` (end_condition.pointing(), objective minimum time) with `recipe` from
-/// kPointingStartTwists start twists, ψ₀ + 2πi/kPointingStartTwists (ψ₀ the twist of least
-/// rotation from R_0: nearestTwist), on a survey grid of N/4 steps (at least 16; none where that
-/// is not below N), and on that grid from each start twist one ψ-free free-time solve from the
-/// eigenaxis slew (rest to rest, clear of the cones); the survey's least T* carried to N through
-/// factor-2 levels (one free-time solve with ψ free per level from the coarser plan prolonged),
-/// else `recipe` on N at its twist; where that does not converge either (or without a survey),
-/// every start twist on N. A start twist whose R_N a cone excludes is not posed. The ways round are
-/// the recipe's own starts. The kept answer is the converged one on N with the least T* (else the
-/// last start's on N), with every start's trail (each attempt's start_detail.twist its start twist)
-/// and the pointing summary (final_twist, the end condition's residual, ∂L/∂ψ at the KKT point).
-/// Stops at a cancel or the deadline.
+/// Plans `problem` (end_condition.pointing(), objective minimum time) from kPointingStartTwists
+/// start twists, ψ₀ + 2πi/kPointingStartTwists (ψ₀ the twist of least rotation from R_0:
+/// nearestTwist), on a survey grid of N/4 steps (at least 16; none where that is not below N): at
+/// each start twist, where the eigenaxis slew is a start (rest to rest, it and R_N clear of the
+/// cones), the fixed-twist free-time solve from that slew, one free-time solve with ψ free from its
+/// plan (the fixed-twist plan kept where that ends above it) and one from the slew itself, else
+/// `recipe` there; the survey's least T* carried to N through factor-2 levels (one free-time solve
+/// with ψ free per level from the coarser plan prolonged), else `recipe` on N at its twist; where
+/// that does not converge either (or without a survey), `recipe` at every start twist on N. A
+/// start twist whose R_N a cone excludes is not posed. The ways round are the recipe's own starts.
+/// The kept answer is the converged one on N with the least T* (else the last start's on N), with
+/// every start's trail (each attempt's start_detail.twist its start twist) and the pointing summary
+/// (final_twist, the end condition's residual, ∂L/∂ψ at the KKT point). Stops at a cancel or the
+/// deadline.
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
                                const MinimumTimeRecipe& recipe);
 

@@ -1,4 +1,6 @@
-// The chain rule of the interior point's rows on one stage quantity, written once for both
+// What both interior points share about their rows: the row set each holds (ConstraintRowSet),
+// where a local block lands among the unknowns (localSlots, addBandBlock, addNodeVector,
+// addNodeDot), and the chain rule of the rows on one stage quantity, written once for both
 // assemblers (constrained_system.cpp at a fixed h, free_time_solver.cpp with h free): the
 // constraints on one quantity object (a block of quantityBlocks, stage_constraints.hpp) are
 // contracted together, c_i = c_i(q) and λ = −Σ z_i c_i'(q), so that the quantity forms λ·∇²q in

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "planning/interior_point/constraint_assembly.hpp"
+#include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/multiplier_estimate.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/transcription/node_constraints.hpp"
@@ -14,45 +14,19 @@ namespace attitude_planner {
 
 namespace {
 
-/// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the unknowns:
-/// its offset and its free entries first..last−1 (fixed nodes skipped).
-struct LocalSlots {
-  int offset = 0, first = 0, last = 0;
-  bool empty() const { return first >= last; }
-};
-
-LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
-  const int first_free = std::max(0, np.firstFreeNode() - first_node);
-  const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
-  return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
-}
-
-/// The twist ψ's motion of the local nodes first_node..first_node+width−1 (ReducedProblem::
-/// twistMotion; zero without a pointing end condition): a local 9-vector g has ψ-component gᵀe.
-Eigen::Matrix<double, 9, 1> localTwist(const ReducedProblem& np, int first_node, int width) {
-  Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero();
-  if (!np.hasTwist()) return e;
-  for (int n = 0; n < width; ++n) e.segment<3>(3 * n) = np.twistMotion(first_node + n);
-  return e;
-}
-
 /// Adds M (local 9×9, lower triangle used) to the banded Hessian and, with a twist, (M e)_free to
 /// its border column and eᵀM e to its corner (ψ moves R_N and R_{N−1} linearly in their
 /// perturbation coordinates: reduced_problem_twist.cpp).
 template <typename Scalar>
 void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, TwistBorder* border,
               int first_node, int width, const Eigen::Matrix<double, 9, 9>& M) {
-  const LocalSlots l = localSlots(np, first_node, width);
-  if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
+  addBandBlock(np, H, first_node, width, M);
   if (!border) return;
-  const Eigen::Matrix<double, 9, 1> e = localTwist(np, first_node, width);
+  const Eigen::Matrix<double, 9, 1> e = localTwistMotion(np, first_node, width);
   if (e.isZero()) return;
   const Eigen::Matrix<double, 9, 1> Me = M.selfadjointView<Eigen::Lower>() * e;
   border->corner += e.dot(Me);
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) border->column.segment<3>(v) += Me.segment<3>(3 * n);
-  }
+  addNodeVector(np, Me, 1.0, first_node, width, border->column);
 }
 
 /// Adds weight·g gᵀ (local) to the banded Hessian, each product formed in its own precision (see
@@ -65,35 +39,26 @@ void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, Twist
   const LocalSlots l = localSlots(np, first_node, width);
   if (!l.empty()) H->template addRankOne<9>(l.offset, g, weight, l.first, l.last);
   if (!border) return;
-  const double ge = g.dot(localTwist(np, first_node, width));
+  const double ge = g.dot(localTwistMotion(np, first_node, width));
   if (ge == 0.0) return;
   border->corner += weight * ge * ge;
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) border->column.segment<3>(v) += (weight * ge) * g.segment<3>(3 * n);
-  }
+  addNodeVector(np, g, weight * ge, first_node, width, border->column);
 }
 
 /// gᵀ dδ over the local nodes (fixed nodes contribute nothing), plus gᵀe dψ with a twist (the
 /// last entry of d).
 double localDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, int first_node,
                 int width, const Eigen::VectorXd& d) {
-  double sum = 0.0;
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
-  }
-  if (np.hasTwist()) sum += g.dot(localTwist(np, first_node, width)) * d(np.unknowns());
+  double sum = addNodeDot(np, g, first_node, width, d, 0.0);
+  if (np.hasTwist()) sum += g.dot(localTwistMotion(np, first_node, width)) * d(np.unknowns());
   return sum;
 }
 
 void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, double weight,
                     int first_node, int width, Eigen::VectorXd* out) {
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) out->segment<3>(v) += weight * g.segment<3>(3 * n);
-  }
-  if (np.hasTwist()) (*out)(np.unknowns()) += weight * g.dot(localTwist(np, first_node, width));
+  addNodeVector(np, g, weight, first_node, width, *out);
+  if (np.hasTwist())
+    (*out)(np.unknowns()) += weight * g.dot(localTwistMotion(np, first_node, width));
 }
 
 }  // namespace
@@ -106,34 +71,13 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
       parameters_(parameters),
       free_slacks_(formulation == Formulation::FreeSlacks),
       form_(makeSlackForm(formulation, parameters)),
-      constraints_(buildStageConstraints(problem)) {
-  // One group per stage constraint, on its quantity's support (stage_quantities.hpp); the
-  // groups on one quantity object form one block, assembled in one pass.
-  groups_.reserve(constraints_.size());
-  for (const auto& c : constraints_) {
-    // In place: `at` is ~150 bytes per node.
-    FixedStepRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
-    // A free twist moves R_N (and R_{N−1} of paper and variational): rows on them too.
-    if (np_.hasTwist()) {
-      g.support =
-          g.quantity->supportWithTwist(np_.firstFreeNode(), np_.lastFreeNode(), np_.steps());
-      g.at.resize(g.support.last_k - g.support.first_k + 1);
-    }
-    constraint_count_ += static_cast<int>(g.at.size());
-  }
-  QuantityBlocks blocks = quantityBlocks(constraints_);
-  stencil_groups_ = std::move(blocks.on_cost_stencil);
-  quantity_blocks_ = std::move(blocks.blocks);
-}
+      constraints_(buildStageConstraints(problem)),
+      rows_(constraints_, *np) {}
 
 void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const QuantityInputs at(np_, steps);
-  for (FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      g.instance(k).c = g.constraint->value(g.quantity->value(at, k));
-    }
-  }
+  rows_.forEachValue(at, [](FixedStepRows&, int, FixedStepRow& in, double c) { in.c = c; });
   if (torques_out) *torques_out = at.torques();
 }
 
@@ -148,9 +92,7 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
 
 double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
   double phi = 0.0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) phi += form_->rowMerit(in, mu, rho, alpha);
-  }
+  rows_.forEach([&](auto&, int, auto& in) { phi += form_->rowMerit(in, mu, rho, alpha); });
   return phi;
 }
 
@@ -168,8 +110,7 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedS
   merit_gradient->setZero(n + globals());
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
-  for (const std::vector<int>& block : quantity_blocks_)
-    assembleQuantity(block, mu, rho, primal, H);
+  for (const std::vector<int>& block : rows_.blocks) assembleQuantity(block, mu, rho, primal, H);
   addConstraintGradients(mu, rhs, merit_gradient);
   return out;
 }
@@ -184,8 +125,7 @@ template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  std::vector<FixedStepRows*> torque_groups;
-  for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
+  const std::vector<FixedStepRows*> torque_groups = rows_.stencilGroups();
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
   const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
@@ -249,23 +189,24 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, BandedSymmetric<Scalar>* H) {
-  const FixedStepRows& first = groups_[block.front()];
+  std::vector<FixedStepRows>& groups = rows_.groups;
+  const FixedStepRows& first = groups[block.front()];
   const StageSupport support = first.support;
   const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
     if (H) form_->prepare(in, mu, rho, primal);
   };
   const auto contract = [&](int k, const Vector3& q) {
     pollEvery(k);
-    return contractQuantityRows(groups_, block, k, q, prepare);
+    return contractQuantityRows(groups, block, k, q, prepare);
   };
   const auto visit = [&](const QuantityTerms& t) {
     const int node = t.k + support.node_offset;
     Eigen::Matrix<double, 9, 9> curvature;
-    chainQuantityRows(groups_, block, t, H ? &curvature : nullptr);
+    chainQuantityRows(groups, block, t, H ? &curvature : nullptr);
     if (!H) return;
     addLocal(np_, H, twistSink(), node, support.width, curvature);
     for (const int i : block) {
-      const FixedStepRow& in = groups_[i].instance(t.k);
+      const FixedStepRow& in = groups[i].instance(t.k);
       addLocalRankOne(np_, H, twistSink(), node, support.width, in.g, 1.0 / in.D);
     }
   };
@@ -276,16 +217,13 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
 /// slope); rhs = −∇f + Σ g (z + q/D).
 void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) const {
-  for (const FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FixedStepRow& in = g.instance(k);
-      const int first = k + g.support.node_offset;
-      if (form_->barrierInMeritGradient()) {
-        addLocalVector(np_, in.g, -mu / in.s, first, g.support.width, merit_gradient);
-      }
-      addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.support.width, rhs);
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    const int first = k + g.support.node_offset;
+    if (form_->barrierInMeritGradient()) {
+      addLocalVector(np_, in.g, -mu / in.s, first, g.support.width, merit_gradient);
     }
-  }
+    addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.support.width, rhs);
+  });
 }
 
 /// FreeSlacks, Mehrotra's predictor: from the affine-scaling step dδ_aff (solved with μ = 0,
@@ -297,26 +235,21 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   products->clear();
   double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
   std::vector<double> ds, dz;
-  for (const FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FixedStepRow& in = g.at[k - g.support.first_k];
-      const double lin = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
-      ds.push_back(lin + in.c - in.s);
-      dz.push_back((-in.c - lin) / in.D);
-      if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
-      if (dz.back() < 0) alpha_d = std::min(alpha_d, -in.z / dz.back());
-      sum += in.s * in.z;
-    }
-  }
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    const double lin = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
+    ds.push_back(lin + in.c - in.s);
+    dz.push_back((-in.c - lin) / in.D);
+    if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
+    if (dz.back() < 0) alpha_d = std::min(alpha_d, -in.z / dz.back());
+    sum += in.s * in.z;
+  });
   double affine = 0.0;
   std::size_t i = 0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) {
-      affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
-      products->push_back(ds[i] * dz[i]);
-      ++i;
-    }
-  }
+  rows_.forEach([&](const FixedStepRows&, int, const FixedStepRow& in) {
+    affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
+    products->push_back(ds[i] * dz[i]);
+    ++i;
+  });
   const double m = std::max<double>(1.0, static_cast<double>(i));
   *average = sum / m;
   return affine / m;
@@ -327,25 +260,19 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
 void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* products,
                                                   Eigen::VectorXd* out) const {
   std::size_t i = 0;
-  for (const FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k, ++i) {
-      const FixedStepRow& in = g.at[k - g.support.first_k];
-      const double weight = products ? -(*products)[i] / in.s : 1.0 / in.s;
-      addLocalVector(np_, in.g, weight, k + g.support.node_offset, g.support.width, out);
-    }
-  }
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    const double weight = products ? -(*products)[i++] / in.s : 1.0 / in.s;
+    addLocalVector(np_, in.g, weight, k + g.support.node_offset, g.support.width, out);
+  });
 }
 
 /// The condensation's q for the complementarity target s z = μ − ds_aff dz_aff (FreeSlacks;
 /// `products` may be null: the plain barrier μ).
 void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<double>* products) {
   std::size_t i = 0;
-  for (FixedStepRows& g : groups_) {
-    for (FixedStepRow& in : g.at) {
-      in.q = (mu - (products ? (*products)[i] : 0.0)) / in.z - in.c;
-      ++i;
-    }
-  }
+  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) {
+    in.q = (mu - (products ? (*products)[i++] : 0.0)) / in.z - in.c;
+  });
 }
 
 /// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
@@ -353,66 +280,52 @@ void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<do
 double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
   dz->clear();
   double alpha = 1.0;
-  for (FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FixedStepRow& in = g.instance(k);
-      const double step =
-          (in.q - localDot(np_, in.g, k + g.support.node_offset, g.support.width, d)) / in.D;
-      dz->push_back(step);
-      alpha = form_->dualStepLimit(in, step, rho, alpha);
-    }
-  }
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    const double step =
+        (in.q - localDot(np_, in.g, k + g.support.node_offset, g.support.width, d)) / in.D;
+    dz->push_back(step);
+    alpha = form_->dualStepLimit(in, step, rho, alpha);
+  });
   return alpha;
 }
 
 void ConstrainedSystem::applyDualStep(const std::vector<double>& dz, double alpha) {
   std::size_t i = 0;
-  for (FixedStepRows& g : groups_) {
-    for (FixedStepRow& in : g.at) in.z += alpha * dz[i++];
-  }
+  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.z += alpha * dz[i++]; });
 }
 
 ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
   SlackStep step;
-  for (FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      FixedStepRow& in = g.instance(k);
-      in.ds = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d) + in.c - in.s;
-      if (in.ds < 0) {
-        step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
-      }
-      step.barrier_slope -= mu * in.ds / in.s;
-      step.residual += std::abs(in.c - in.s);
-      if (std::abs(in.c - in.s) > parameters_.round_off_slack_residual) {
-        step.significant_residual += std::abs(in.c - in.s);
-      }
+  rows_.forEach([&](const FixedStepRows& g, int k, FixedStepRow& in) {
+    in.ds = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d) + in.c - in.s;
+    if (in.ds < 0) {
+      step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
     }
-  }
+    step.barrier_slope -= mu * in.ds / in.s;
+    step.residual += std::abs(in.c - in.s);
+    if (std::abs(in.c - in.s) > parameters_.round_off_slack_residual) {
+      step.significant_residual += std::abs(in.c - in.s);
+    }
+  });
   return step;
 }
 
 void ConstrainedSystem::applySlackStep(double alpha) {
-  for (FixedStepRows& g : groups_) {
-    for (FixedStepRow& in : g.at) in.s += alpha * in.ds;
-  }
+  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.s += alpha * in.ds; });
 }
 
 /// FreeSlacks: the largest multiplier after the dual step dz (for the merit's ν).
 double ConstrainedSystem::largestMultiplier(const std::vector<double>& dz, double alpha) const {
   double largest = 0.0;
   std::size_t i = 0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) largest = std::max(largest, in.z + alpha * dz[i++]);
-  }
+  rows_.forEach([&](auto&, int, auto& in) { largest = std::max(largest, in.z + alpha * dz[i++]); });
   return largest;
 }
 
 /// FreeSlacks: max |c − s| at the last evaluated c.
 double ConstrainedSystem::maxSlackResidual() const {
   double worst = 0.0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) worst = std::max(worst, std::abs(in.c - in.s));
-  }
+  rows_.forEach([&](auto&, int, auto& in) { worst = std::max(worst, std::abs(in.c - in.s)); });
   return worst;
 }
 
@@ -422,9 +335,8 @@ void ConstrainedSystem::complementarity(double mu, double rho, double* average,
                                         double* smallest) const {
   double sum = 0.0, low = std::numeric_limits<double>::infinity();
   int count = 0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) form_->addComplementarity(in, mu, rho, &sum, &low, &count);
-  }
+  rows_.forEach(
+      [&](auto&, int, auto& in) { form_->addComplementarity(in, mu, rho, &sum, &low, &count); });
   *average = sum / std::max(count, 1);
   *smallest = low;
 }
@@ -432,9 +344,7 @@ void ConstrainedSystem::complementarity(double mu, double rho, double* average,
 /// Largest elastic violation max v_i (constraint units) at the last assembly or merit.
 double ConstrainedSystem::maxViolation() const {
   double worst = 0.0;
-  for (const FixedStepRows& g : groups_) {
-    for (const FixedStepRow& in : g.at) worst = std::max(worst, -in.c);
-  }
+  rows_.forEach([&](auto&, int, auto& in) { worst = std::max(worst, -in.c); });
   return worst;
 }
 
@@ -443,16 +353,14 @@ double ConstrainedSystem::maxViolation() const {
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
   std::vector<Vector3> sigma;
-  for (const FixedStepRows& g : groups_) {
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
     const int a = g.constraint->axis();
-    if (a < 0) continue;  // only a box side is affine in one torque axis
+    if (a < 0) return;  // only a box side is affine in one torque axis
     if (sigma.empty()) sigma = torque;
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
-      const double weight = np_.scheme().torqueWeight(k, np_.steps());
-      sigma[k](a) -= g.at[k - g.support.first_k].z * g.constraint->gradient(torque[k])(a) / weight;
-    }
-  }
+    // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
+    const double weight = np_.scheme().torqueWeight(k, np_.steps());
+    sigma[k](a) -= in.z * g.constraint->gradient(torque[k])(a) / weight;
+  });
   return sigma;
 }
 
@@ -471,12 +379,9 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
   } else {
     np_.evaluate(&residual, nullptr, &unused);  // ∇f
   }
-  for (const FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FixedStepRow& in = g.at[k - g.support.first_k];
-      addLocalVector(np_, in.g, -in.z, k + g.support.node_offset, g.support.width, &residual);
-    }
-  }
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    addLocalVector(np_, in.g, -in.z, k + g.support.node_offset, g.support.width, &residual);
+  });
   twist_gradient_ = np_.hasTwist() ? residual(np_.unknowns()) : 0.0;
   twist_stationarity_ = scale > 0 ? std::abs(twist_gradient_) / scale : 0.0;
   return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
@@ -486,7 +391,7 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
 LevelDuals ConstrainedSystem::duals() const {
   LevelDuals d;
   d.steps = np_.steps();
-  for (const FixedStepRows& g : groups_) {
+  for (const FixedStepRows& g : rows_.groups) {
     d.first_k.push_back(g.support.first_k);
     d.z.emplace_back();
     d.s.emplace_back();
@@ -506,8 +411,8 @@ LevelDuals ConstrainedSystem::duals() const {
 double ConstrainedSystem::warmStartDuals(const LevelDuals& coarse) {
   double sum = 0.0;
   int count = 0;
-  for (std::size_t gi = 0; gi < groups_.size() && gi < coarse.z.size(); ++gi) {
-    FixedStepRows& g = groups_[gi];
+  for (std::size_t gi = 0; gi < rows_.groups.size() && gi < coarse.z.size(); ++gi) {
+    FixedStepRows& g = rows_.groups[gi];
     const std::vector<double>& zc = coarse.z[gi];
     if (zc.empty()) continue;
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
@@ -536,22 +441,20 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   double gradient_scale = 0.0;
   const double cost = np_.evaluate(&cost_gradient, nullptr, &gradient_scale);
   std::vector<StationarityColumn> columns;
-  for (const FixedStepRows& g : groups_) {
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      StationarityColumn column{g.instance(k).c, g.instance(k).g};
-      for (int n = 0; n < g.support.width; ++n)
-        column.index[n] = np_.variableIndex(k + g.support.node_offset + n);
-      columns.push_back(column);
-    }
-  }
+  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    StationarityColumn column{in.c, in.g};
+    for (int n = 0; n < g.support.width; ++n)
+      column.index[n] = np_.variableIndex(k + g.support.node_offset + n);
+    columns.push_back(column);
+  });
   // Without an active constraint the multipliers take μ/c with μ a share of the cost per
   // constraint: the scale the cold start's barrier has too.
   const MultiplierEstimate e =
-      estimateMultipliers(cost_gradient, columns, cost / std::max(constraint_count_, 1));
+      estimateMultipliers(cost_gradient, columns, cost / std::max(rows_.count, 1));
   LevelDuals d;
   d.steps = np_.steps();
   std::size_t i = 0;
-  for (const FixedStepRows& g : groups_) {
+  for (const FixedStepRows& g : rows_.groups) {
     d.first_k.push_back(g.support.first_k);
     d.z.emplace_back(e.z.begin() + i, e.z.begin() + i + g.at.size());
     d.s.emplace_back(e.s.begin() + i, e.s.begin() + i + g.at.size());
@@ -563,9 +466,7 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
 /// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
 /// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
 void ConstrainedSystem::initializeMultipliers(double mu, double rho, double cap) {
-  for (FixedStepRows& g : groups_) {
-    for (FixedStepRow& in : g.at) form_->initialize(in, mu, rho, cap);
-  }
+  rows_.forEach([&](auto&, int, auto& in) { form_->initialize(in, mu, rho, cap); });
 }
 
 template Assembly ConstrainedSystem::assemble<double>(double, double, bool,

@@ -13,6 +13,7 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"
@@ -51,7 +52,7 @@ class ConstrainedSystem final : public BarrierRows {
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
                     const InteriorPointParameters& parameters);
 
-  int constraintCount() const { return constraint_count_; }
+  int constraintCount() const { return rows_.count; }
   /// Global unknowns beside the node unknowns: 1 (ψ) with a pointing end condition, else 0.
   int globals() const { return np_.hasTwist() ? 1 : 0; }
   /// The last assembly's ψ border (globals() == 1 only).
@@ -146,12 +147,7 @@ class ConstrainedSystem final : public BarrierRows {
   bool free_slacks_;
   std::unique_ptr<SlackForm> form_;  ///< FreeSlacks or L1Elastic: how a row enters φ_μ
   StageConstraints constraints_;     ///< buildStageConstraints(problem): one group each
-  std::vector<FixedStepRows> groups_;
-  /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
-  std::vector<int> stencil_groups_;
-  /// The other groups by quantity (indices into groups_): one pass over the band per quantity.
-  std::vector<std::vector<int>> quantity_blocks_;
-  int constraint_count_ = 0;
+  ConstraintRowSet<9> rows_;
   const Interruption* interruption_ = nullptr;
   TwistBorder twist_border_;
   double twist_gradient_ = 0.0, twist_stationarity_ = 0.0;

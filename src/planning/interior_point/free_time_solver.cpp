@@ -105,22 +105,9 @@ class FreeTimeSolver final : public PrimalDualProblem {
         parameters_(parameters),
         N_(np->steps()),
         n_(np->unknowns()),
+        rows_(constraints, *np),
         form_(parameters),
-        factorization_(step_factor_, kkt_, nullptr) {
-    for (const auto& c : constraints) {
-      FreeTimeRows& g = groups_.emplace_back(*c, np_.firstFreeNode(), np_.lastFreeNode());
-      // A free twist moves R_N (and R_{N−1} of paper and variational): rows on them too, their
-      // ψ entries from the block's own (scatterTwist).
-      if (np_.hasTwist()) {
-        g.support =
-            g.quantity->supportWithTwist(np_.firstFreeNode(), np_.lastFreeNode(), np_.steps());
-        g.at.resize(g.support.last_k - g.support.first_k + 1);
-      }
-    }
-    QuantityBlocks blocks = quantityBlocks(constraints);
-    stencil_groups_ = std::move(blocks.on_cost_stencil);
-    quantity_blocks_ = std::move(blocks.blocks);
-  }
+        factorization_(step_factor_, kkt_, nullptr) {}
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
   /// the cones, must already hold strictly: raising h does not move an attitude). Empty if the
@@ -197,30 +184,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void disallowElastic() { allow_elastic_ = false; }
 
  private:
-  int constraintCount() const {
-    int m = 0;
-    for (const FreeTimeRows& g : groups_) m += static_cast<int>(g.at.size());
-    return m;
-  }
   double torqueScale(int k) const { return std::sqrt(torqueWeight(k)); }
   double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
   /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
   bool hasTorqueBox() const {
     // Only a box side is affine in one torque axis.
-    return std::any_of(groups_.begin(), groups_.end(),
+    return std::any_of(rows_.groups.begin(), rows_.groups.end(),
                        [](const FreeTimeRows& g) { return g.constraint->axis() >= 0; });
-  }
-
-  /// Calls f(group, k, c) for every instance's value c at `steps` (the quantities' shared
-  /// products, torques and attitudes, formed once).
-  template <typename F>
-  void forEachValue(const ReducedProblem::StepVectors& steps, F&& f) const {
-    const QuantityInputs at(np_, steps);
-    for (const FreeTimeRows& g : groups_) {
-      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-        f(g, k, g.constraint->value(g.quantity->value(at, k)));
-      }
-    }
   }
 
   /// Whether the group's rows are ℓ1-elastic now: the constraints that move with h, while the
@@ -258,10 +228,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
     double smallest = std::numeric_limits<double>::infinity();
-    forEachValue(steps, [&](const FreeTimeRows& g, int, double c) {
-      if (g.quantity->dependsOnTimeStep() == time_dependent) {
-        smallest = std::min(smallest, c);
-      }
+    rows_.forEachValue(QuantityInputs(np_, steps), [&](auto& g, int, auto&, double c) {
+      if (g.quantity->dependsOnTimeStep() == time_dependent) smallest = std::min(smallest, c);
     });
     return smallest;
   }
@@ -271,11 +239,11 @@ class FreeTimeSolver final : public PrimalDualProblem {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
     bool inside = true;
-    forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
+    rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
       if (elasticRows(g)) {
         phi += elasticSlacks(c, mu, rho_).psi;
       } else {
-        form_.addRowMerit(c, g.instance(k).c, mu, check_boundary, &inside, &phi);
+        form_.addRowMerit(c, in.c, mu, check_boundary, &inside, &phi);
       }
     });
     return inside ? phi : std::numeric_limits<double>::infinity();
@@ -371,12 +339,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
   const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  std::vector<FreeTimeRows> groups_;
+  ConstraintRowSet<10> rows_;
   Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
-  /// The groups on the cost's stencil residuals (the torques: formed in the cost's pass).
-  std::vector<int> stencil_groups_;
-  /// The other groups by quantity (indices into groups_): one pass per quantity.
-  std::vector<std::vector<int>> quantity_blocks_;
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
@@ -420,8 +384,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
-  std::vector<FreeTimeRows*> torque_groups;
-  for (const int i : stencil_groups_) torque_groups.push_back(&groups_[i]);
+  const std::vector<FreeTimeRows*> torque_groups = rows_.stencilGroups();
   const auto weights = [&](int k, const Vector3& r) {
     // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
     const double s = torqueScale(k);
@@ -469,8 +432,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
       weights);
   // The quantities that do not move with h first (the order the band's sums were formed in).
   for (const bool moves_with_h : {false, true}) {
-    for (const std::vector<int>& block : quantity_blocks_) {
-      if (groups_[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
+    for (const std::vector<int>& block : rows_.blocks) {
+      if (rows_.groups[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
         assembleQuantity(block, mu);
       }
     }
@@ -483,21 +446,22 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// (local nodes, η = h/h₀) and the chain rule (constraint_assembly.hpp), with each constraint's
 /// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
-  const FreeTimeRows& first = groups_[block.front()];
+  std::vector<FreeTimeRows>& groups = rows_.groups;
+  const FreeTimeRows& first = groups[block.front()];
   const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) { prepareRow(g, in, mu); };
   const auto contract = [&](int k, const Vector3& q) {
-    return contractQuantityRows(groups_, block, k, q, prepare);
+    return contractQuantityRows(groups, block, k, q, prepare);
   };
   first.quantity->forEachTermsWithTimeStep(
       np_, first.support, h0_, contract, [&](const QuantityTermsWithTimeStep& t) {
         Eigen::Matrix<double, 10, 10> H;
-        chainQuantityRows(groups_, block, t, &H);
+        chainQuantityRows(groups, block, t, &H);
         Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
         const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
         for (const int i : block) {
-          FreeTimeRow& in = groups_[i].instance(t.k);
+          FreeTimeRow& in = groups[i].instance(t.k);
           // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-          const RowTerms row = rowTerms(groups_[i], in, mu);
+          const RowTerms row = rowTerms(groups[i], in, mu);
           const double w = row.weight;
           H.topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
           H.block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
@@ -523,23 +487,13 @@ void FreeTimeSolver::leaveElasticIfInside() {
 void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                              const Eigen::Matrix<double, 10, 1>& rhs,
                              const Eigen::Matrix<double, 10, 1>& lagrangian) {
-  for (int node = 0; node < width; ++node) {
-    const int v = np_.variableIndex(first_node + node);
-    if (v < 0) continue;
-    rhs_.segment<3>(v) += rhs.segment<3>(3 * node);
-    lagrangian_gradient_.segment<3>(v) += lagrangian.segment<3>(3 * node);
-    kkt_.border.col(0).segment<3>(v) += H.block<3, 1>(3 * node, 9);
-  }
+  addNodeVector(np_, rhs.head<9>(), 1.0, first_node, width, rhs_);
+  addNodeVector(np_, lagrangian.head<9>(), 1.0, first_node, width, lagrangian_gradient_);
+  addNodeVector(np_, H.block<9, 1>(0, 9), 1.0, first_node, width, kkt_.border.col(0));
   rhs_(n_) += rhs(9);
   lagrangian_gradient_(n_) += lagrangian(9);
   kkt_.corner(0, 0) += H(9, 9);
-  const int first_slot = std::max(0, np_.firstFreeNode() - first_node);
-  const int last_slot = std::min(width - 1, np_.lastFreeNode() - first_node);
-  if (first_slot <= last_slot) {
-    kkt_.band.addSymmetricBlock<9>(3 * (first_node - np_.firstFreeNode()),
-                                   Eigen::Matrix<double, 9, 9>(H.topLeftCorner<9, 9>()),
-                                   3 * first_slot, 3 * (last_slot + 1));
-  }
+  addBandBlock(np_, &kkt_.band, first_node, width, H.topLeftCorner<9, 9>());
   scatterTwist(first_node, width, H, rhs, lagrangian);
 }
 
@@ -615,18 +569,14 @@ void FreeTimeSolver::restore() {
 bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
-  forEachValue(np_.current(), [&](const FreeTimeRows& group, int k, double c_at_step) {
-    FreeTimeRow& in = const_cast<FreeTimeRows&>(group).instance(k);
-    in.r = c_at_step - in.c - localDot(group, k, in.g, d);
-    const double w = -rowTerms(group, in, 0.0).weight * in.r;
+  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int k, auto& in, double c) {
+    in.r = c - in.c - localDot(g, k, in.g, d);
+    const double w = -rowTerms(g, in, 0.0).weight * in.r;
     if (w == 0.0) return;
     curved = true;
     v(n_) += w * in.g(9);
-    if (np_.hasTwist()) v(n_ + twistColumn()) += w * twistComponent(group, k, in.g);
-    for (int node = 0; node < group.support.width; ++node) {
-      const int index = np_.variableIndex(k + group.support.node_offset + node);
-      if (index >= 0) v.segment<3>(index) += w * in.g.segment<3>(3 * node);
-    }
+    if (np_.hasTwist()) v(n_ + twistColumn()) += w * twistComponent(g, k, in.g);
+    addNodeVector(np_, in.g.template head<9>(), w, k + g.support.node_offset, g.support.width, v);
   });
   if (!curved) return false;
   step_factor_.solve(&v);
@@ -636,9 +586,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
 }
 
 void FreeTimeSolver::clearCorrection() {
-  for (FreeTimeRows& g : groups_) {
-    for (FreeTimeRow& in : g.at) in.r = 0.0;
-  }
+  rows_.forEach([](FreeTimeRows&, int, FreeTimeRow& in) { in.r = 0.0; });
 }
 
 double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
@@ -646,11 +594,7 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
                                 const Eigen::VectorXd& d) const {
   double sum = gradient(9) * d(n_);
   if (np_.hasTwist()) sum += twistComponent(g, k, gradient) * d(n_ + twistColumn());
-  for (int node = 0; node < g.support.width; ++node) {
-    const int v = np_.variableIndex(k + g.support.node_offset + node);
-    if (v >= 0) sum += gradient.segment<3>(3 * node).dot(d.segment<3>(v));
-  }
-  return sum;
+  return addNodeDot(np_, gradient.head<9>(), k + g.support.node_offset, g.support.width, d, sum);
 }
 
 /// dz = μ/c − z − (z/c) (gᵀd + r) at the assembled point (r: the second-order correction's
@@ -658,22 +602,16 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
 /// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   double alpha = 1.0;
-  for (FreeTimeRows& g : groups_) {
-    const bool elastic = elasticRows(g);
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      FreeTimeRow& in = g.instance(k);
-      const double slope = localDot(g, k, in.g, d) + in.r;
-      if (elastic) {
-        in.dz = (in.q - slope) / in.D;
-        alpha = elasticDualStepLimit(in.z, in.dz, rho_, alpha, parameters_);
-      } else {
-        in.dz = form_.dualDirection(in.z, in.c, mu, slope, &alpha);
-      }
+  rows_.forEach([&](FreeTimeRows& g, int k, FreeTimeRow& in) {
+    const double slope = localDot(g, k, in.g, d) + in.r;
+    if (elasticRows(g)) {
+      in.dz = (in.q - slope) / in.D;
+      alpha = elasticDualStepLimit(in.z, in.dz, rho_, alpha, parameters_);
+    } else {
+      in.dz = form_.dualDirection(in.z, in.c, mu, slope, &alpha);
     }
-  }
-  for (FreeTimeRows& g : groups_) {
-    for (FreeTimeRow& in : g.at) in.z += alpha * in.dz;
-  }
+  });
+  rows_.forEach([&](FreeTimeRows&, int, FreeTimeRow& in) { in.z += alpha * in.dz; });
 }
 
 /// ∇φ_μ·d at the assembled point. The right-hand side is −∇φ_μ where every row's coefficient β
@@ -682,29 +620,23 @@ void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
 double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   double slope = -d.dot(rhs_);
   if (!elastic_) return slope;
-  for (const FreeTimeRows& g : groups_) {
-    if (!elasticRows(g)) continue;
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeRow& in = g.instance(k);
-      slope += (rowTerms(g, in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
-    }
-  }
+  rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
+    if (elasticRows(g)) slope += (rowTerms(g, in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
+  });
   return slope;
 }
 
 /// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c (an elastic row's multiplier is
 /// safeguarded where it is prepared for the next assembly).
 void FreeTimeSolver::safeguardDuals(double mu) {
-  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
-    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
+  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
     if (!elasticRows(g)) in.z = form_.safeguarded(in.z, c, mu);
   });
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
-  forEachValue(np_.current(), [&](const FreeTimeRows& g, int k, double c) {
-    FreeTimeRow& in = const_cast<FreeTimeRows&>(g).instance(k);
+  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
     if (elasticRows(g)) {
       prepareElasticRow(in, mu, rho_, true, parameters_);
@@ -718,23 +650,21 @@ void FreeTimeSolver::initializeDuals(double mu) {
 /// elastic row: |zs − μ| and |(ρ − z)v − μ|).
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  if (!elastic_) return form_.residual(groups_, stationarity, mu);
+  if (!elastic_) return form_.residual(rows_.groups, stationarity, mu);
   double worst = stationarity;
-  for (const FreeTimeRows& g : groups_) {
-    for (const FreeTimeRow& in : g.at) {
-      if (!elasticRows(g)) {
-        worst = std::max(worst, std::abs(in.z * in.c - mu));
-      } else {
-        worst = std::max({worst, std::abs(in.z * in.s - mu), std::abs((rho_ - in.z) * in.v - mu)});
-      }
+  rows_.forEach([&](const FreeTimeRows& g, int, const FreeTimeRow& in) {
+    if (!elasticRows(g)) {
+      worst = std::max(worst, std::abs(in.z * in.c - mu));
+    } else {
+      worst = std::max({worst, std::abs(in.z * in.s - mu), std::abs((rho_ - in.z) * in.v - mu)});
     }
-  }
+  });
   return worst;
 }
 
 /// Σ zᵢcᵢ at the assembled point.
 double FreeTimeSolver::dualityGap() const {
-  return form_.dualityGap(groups_);
+  return form_.dualityGap(rows_.groups);
 }
 
 /// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
@@ -779,7 +709,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
                                     const BarrierWatch& watch) {
   context_ = &context;
   watch_ = &watch;
-  const int m = constraintCount();
+  const int m = rows_.count;
   mu0_ = kInitialBarrier / m;
   mu_final_ = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
   const double C0 = np_.cost(np_.current());
@@ -912,22 +842,16 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
   const std::vector<Vector3> tau = np_.torques(out.steps);
   if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  for (const FreeTimeRows& g : groups_) {
+  rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
+    out.complementarity += in.z * in.c;
+    out.smallest_value = std::min(out.smallest_value, in.c);
     const int a = g.constraint->axis();
-    for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-      const FreeTimeRow& in = g.instance(k);
-      out.complementarity += in.z * in.c;
-      out.smallest_value = std::min(out.smallest_value, in.c);
-      // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
-      if (a >= 0) {  // only a box side is affine in one torque axis
-        const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
-        out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
-        if (!out.switching_function.empty()) {
-          out.switching_function[k](a) -= in.z * slope / torqueWeight(k);
-        }
-      }
-    }
-  }
+    if (a < 0) return;  // only a box side is affine in one torque axis (and hasTorqueBox())
+    // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
+    const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
+    out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
+    out.switching_function[k](a) -= in.z * slope / torqueWeight(k);
+  });
   out.maneuver = np_.maneuver(out.steps);
   recordVerdict(
       &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,

@@ -537,8 +537,9 @@ LadderClimb climbDurationLadder(const PlanningProblem& problem, const PlanResult
   const double log_ratio = std::log(problem.duration / T_star);
   const auto share = [&](double ratio) { return std::min(1.0, std::log(ratio) / log_ratio); };
   AdaptiveSchedule schedule;
-  // The ladder climbs where the start at T itself failed: its first rung is below T.
-  schedule.first_increment = std::min(share(kLadderFirstRatio), 0.5);
+  // The ladder climbs where the start at T itself failed, so its first rung is below T: where
+  // 15 % above T* would reach T, halfway (in log T).
+  schedule.first_increment = share(kLadderFirstRatio) < 1.0 ? share(kLadderFirstRatio) : 0.5;
   schedule.max_increment = share(kLadderLargestRatio);
   schedule.min_increment = share(kLadderLeastRatio);
   schedule.max_stages = kLadderRungs;

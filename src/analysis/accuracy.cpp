@@ -9,6 +9,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -150,8 +151,8 @@ Rung solveRung(PlanningProblem problem, int N, SolveContext& context, double ord
     const PlanResult half = planAtResolution(problem, context.options(), context);
     if (!half.converged()) {
       rung.plan.termination = half.termination;
-      rung.plan.message =
-          "N/2 = " + std::to_string(N / 2) + " for the Richardson estimate: " + half.message;
+      recordReason(&rung.plan, "N/2 = " + std::to_string(N / 2) +
+                                   " for the Richardson estimate: " + half.message);
       return rung;
     }
     const double T = problem.duration;
@@ -207,8 +208,8 @@ SchemeChoice chooseScheme(const PlanningProblem& problem, SolveContext& context,
     estimate->errors_tried.push_back(coarse.error);
     estimate->schemes_tried.push_back(schemeName(scheme));
     if (!coarse.plan.converged()) {
-      coarse.plan.message = "coarse resolution N = 64 (" + schemeName(scheme) +
-                            ") did not converge: " + coarse.plan.message;
+      recordReason(&coarse.plan, "coarse resolution N = 64 (" + schemeName(scheme) +
+                                     ") did not converge: " + coarse.plan.message);
       SchemeChoice failed;
       failed.coarse = coarse;
       failed.failed = true;
@@ -242,6 +243,7 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
                         : "Richardson: |hC(N) - h'C(N/2)| / (2^p - 1)";
   const auto finish = [&](PlanResult result) {
     result.accuracy = estimate;
+    renderMessageOnce(&result);
     result.solve_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
@@ -267,9 +269,10 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
       estimate.estimated_error = last.error;
       PlanResult failed = last.plan;
       failed.termination = Termination::NotConverged;
-      failed.message = "accuracy_target " + formatted("%.3g", target.value) + " (" +
-                       accuracyMeasureName(target.measure) + ") needs N = " + std::to_string(N) +
-                       " > max_steps = " + std::to_string(target.max_steps);
+      recordReason(&failed, "accuracy_target " + formatted("%.3g", target.value) + " (" +
+                                accuracyMeasureName(target.measure) +
+                                ") needs N = " + std::to_string(N) +
+                                " > max_steps = " + std::to_string(target.max_steps));
       return finish(failed);
     }
     Rung rung = solveRung(chosen, N, context, estimate.order);
@@ -280,19 +283,20 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
     estimate.estimated_error = rung.error;
     last = rung;
     if (rung.error <= target.value) {
-      rung.plan.message += "; " + accuracyMeasureName(target.measure) + " " +
-                           formatted("%.3g <= target %.3g", rung.error, target.value) +
-                           " at N = " + std::to_string(N) + " (" + schemeName(best_scheme) + ")";
+      recordReason(&rung.plan,
+                   rung.plan.message + "; " + accuracyMeasureName(target.measure) + " " +
+                       formatted("%.3g <= target %.3g", rung.error, target.value) +
+                       " at N = " + std::to_string(N) + " (" + schemeName(best_scheme) + ")");
       return finish(rung.plan);
     }
     const int next = predictSteps(N, rung.error, target.value, estimate.order);
     estimate.predicted_error = rung.error * std::pow(double(N) / next, estimate.order);
     if (round == 3) {
       rung.plan.termination = Termination::NotConverged;
-      rung.plan.message = "accuracy_target not reached: " + accuracyMeasureName(target.measure) +
-                          " " + formatted("%.3g > target %.3g", rung.error, target.value) +
-                          " at N = " + std::to_string(N) +
-                          " after 4 refinements (round-off floor?)";
+      recordReason(&rung.plan,
+                   "accuracy_target not reached: " + accuracyMeasureName(target.measure) + " " +
+                       formatted("%.3g > target %.3g", rung.error, target.value) +
+                       " at N = " + std::to_string(N) + " after 4 refinements (round-off floor?)");
       return finish(rung.plan);
     }
     N = std::max(next, N + 2);

@@ -107,7 +107,7 @@ class ClassSearch {
       const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
       r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
     } catch (const StepTooLarge& e) {
-      r.message = e.what();
+      recordReason(&r, e.what());
     }
     iterations_ += r.iterations;
     // The attempt whose plan r is: its kept one, else its last.

@@ -556,7 +556,7 @@ class FreeTimeMinimumTime {
     }
     note << " " << solves_ << " free-time solves)";
     // A replay that failed (freeTimePlan) says so after the answer's account.
-    result.message = note.str() + (result.message.empty() ? "" : "; " + result.message);
+    recordReason(&result, note.str() + (result.message.empty() ? "" : "; " + result.message));
     result.minimum_duration = answer.duration;
     result.minimum_time.kkt_point = true;
     result.minimum_time.stationarity = answer.stationarity;
@@ -593,7 +593,7 @@ class FreeTimeMinimumTime {
       replayFigures(effort, &r);
     } catch (const StepTooLarge& e) {
       r.termination = Termination::StepTooLarge;
-      r.message = std::string("replay of the planned torques failed: ") + e.what();
+      recordReason(&r, std::string("replay of the planned torques failed: ") + e.what());
     }
     const ConstraintCheck check = checkConstraints(effort, r.maneuver);
     r.constraints = check.names;

@@ -98,7 +98,8 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
-  result.message = renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message);
+  recordReason(&result,
+               renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message));
   return result;
 }
 
@@ -178,7 +179,9 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  return planAtResolution(problem, options, context);
+  PlanResult result = planAtResolution(problem, options, context);
+  renderMessageOnce(&result);
+  return result;
 }
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,

@@ -306,7 +306,7 @@ PlanResult constrainedResultOf(const TwistRun& run) {
   msg << result.message << "; pointing: twist " << result.pointing.final_twist
       << " rad, d L/d twist " << result.pointing.twist_gradient << " (relative "
       << result.pointing.twist_stationarity << ")";
-  result.message = msg.str();
+  recordReason(&result, msg.str());
   return result;
 }
 
@@ -345,7 +345,7 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
       << run.solve.relative_gradient << ", relative Newton decrement "
       << run.solve.relative_decrement << "); pointing: twist " << result.pointing.final_twist
       << " rad, d cost/d twist " << run.solve.twist_gradient;
-  result.message = msg.str();
+  recordReason(&result, msg.str());
   return result;
 }
 
@@ -468,7 +468,7 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
       brief << " (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
             << " ways round)";
     }
-    result.message = brief.str();
+    recordReason(&result, brief.str());
   }
   return result;
 }

@@ -212,7 +212,7 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
 
 /// Where a stopped continuation's answer comes from, for its message.
 std::string onLevel(const ContinuationStop& stop) {
-  return stop.level.message + " (on the N = " + std::to_string(stop.level.steps) +
+  return renderClauses(stop.level.clauses) + " (on the N = " + std::to_string(stop.level.steps) +
          " level of the grid continuation)";
 }
 
@@ -233,7 +233,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
     if (r.coarse) carried.steps = r.coarse->steps;
     if (r.coarse) carried.formulation = r.coarse->formulation;
     if (!r.finest) return carried;  // handed on as it is
-    GridOutcome outcome = carryToGrid(r.problem, carried.steps, stop.termination, onLevel(stop));
+    GridOutcome outcome =
+        carryToGrid(r.problem, carried.steps, stop.termination, {clauses::Reason{onLevel(stop)}});
     outcome.formulation = carried.formulation;
     solve.context.recordLevels(outcome.result.levels);
     endsAsTheStop();
@@ -252,7 +253,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
-  outcome.result.message = onLevel(stop);
+  recordReason(&outcome.result, onLevel(stop));
   endsAsTheStop();
   return outcome;
 }

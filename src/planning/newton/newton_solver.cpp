@@ -193,11 +193,12 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
   const std::string survey_grid = "N = " + std::to_string(plan.levels[plan.survey].steps);
   const ContinuationFinish finish = [&](const ContinuationRecord& record, PlanResult* r) {
     if (record.stop) {
-      r->message =
+      recordReason(
+          r,
           std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
                                                                          : "time budget exceeded") +
-          "; the plan is the " + survey_grid +
-          " class survey's iterate carried over to N = " + std::to_string(plan.levels.back().steps);
+              "; the plan is the " + survey_grid + " class survey's iterate carried over to N = " +
+              std::to_string(plan.levels.back().steps));
       return;
     }
     if (record.reached < record.levels.size()) {
@@ -660,7 +661,7 @@ PlanResult Walk::finish() {
     if (i != kept_at_) kept.extremal_summary.others.push_back(trail_[i]);
   }
   kept.extremal = describeExtremal(kept.extremal_summary);
-  kept.message = briefOf(kept, trail_, kept_at_, stop);
+  recordReason(&kept, briefOf(kept, trail_, kept_at_, stop));
   if (stop && !kept.converged()) kept.termination = *stop;
   kept.attempts = trail_;
   return kept;

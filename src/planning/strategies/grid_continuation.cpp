@@ -28,11 +28,11 @@ void describeContinuation(const ContinuationRecord& record, PlanResult* finest) 
   const std::string requested = std::to_string(record.levels.back().steps);
   const LevelEnd& below = record.levels[count - 2];
   if (record.stop) {
-    finest->message =
-        std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
-                                                                       : "time budget exceeded") +
-        " on the N = " + std::to_string(record.stop->level.steps) +
-        " level; the plan is its iterate carried over to N = " + requested;
+    recordReason(finest, std::string(record.stop->termination == Termination::Cancelled
+                                         ? "cancelled"
+                                         : "time budget exceeded") +
+                             " on the N = " + std::to_string(record.stop->level.steps) +
+                             " level; the plan is its iterate carried over to N = " + requested);
   } else {
     addNote(finest, notes::CoarserLevel{below.steps, below.termination});
   }

@@ -568,3 +568,58 @@ TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
   EXPECT_EQ(combined.clauses.size(), 1u);
   EXPECT_EQ(ap::renderMessage(combined), "other words");
 }
+
+TEST(MessageFrames, TheBriefsAndTheStopsSayTheWordsOfTheirFormerExpressions) {
+  // The walks' briefs, the continuations' stops, the pointing and the accuracy clauses, once
+  // built by hand around a message, are frames and notes: the words of those expressions.
+  namespace f = ap::frames;
+  const std::string reason = "converged after 3 iterations";
+  EXPECT_EQ(ap::renderFrame(f::OnContinuationLevel{16}, reason),
+            reason + " (on the N = 16 level of the grid continuation)");
+  EXPECT_EQ(
+      ap::renderFrame(f::CarriedOverAfterStop{ap::Termination::Cancelled, 16, 64, false}, reason),
+      "cancelled on the N = 16 level; the plan is its iterate carried over to N = 64");
+  EXPECT_EQ(
+      ap::renderFrame(f::CarriedOverAfterStop{ap::Termination::TimedOut, 16, 64, true}, reason),
+      "time budget exceeded; the plan is the N = 16 class survey's iterate carried over to N = 64");
+  EXPECT_EQ(ap::renderFrame(f::WalkKept{true, ap::Termination::TimedOut, "constrained_retry", 0, 3,
+                                        "solve", "hermite"},
+                            reason),
+            "time budget exceeded during the constrained_retry attempt; the plan returned: " +
+                reason + "; attempt 1 of 3 kept (solve from hermite)");
+  EXPECT_EQ(ap::renderFrame(
+                f::WalkKept{false, ap::Termination::Cancelled, "solve", 0, 1, "solve", "hermite"},
+                reason),
+            reason);
+  f::PointingWalk walk{true, 8, 2, 9, true, false, 4, 2};
+  EXPECT_EQ(ap::renderFrame(walk, reason),
+            reason +
+                "; no twist start converged (8 starts; each verdict is local to its start "
+                "twist); attempt 3 of 9 kept (4 start twists x 2 ways round)");
+  walk.none_converged = false;
+  walk.survey = false;
+  EXPECT_EQ(ap::renderFrame(walk, reason),
+            reason +
+                "; attempt 3 of 9 kept (the interior point with the twist free from the plan "
+                "given, strictly inside every bound)");
+  walk.survey = true;
+  walk.constrained = true;
+  EXPECT_TRUE(contains(ap::renderFrame(walk, reason),
+                       "; attempt 3 of 9 kept (4 start twists x 2 ways round unconstrained, each "
+                       "distinct optimum below the cheapest constrained answer"));
+  EXPECT_EQ(ap::renderNote(notes::PointingTwist{0.25, -1.5, true, 2e-9}),
+            "; pointing: twist 0.25 rad, d L/d twist -1.5 (relative 2e-09)");
+  EXPECT_EQ(ap::renderNote(notes::PointingTwist{0.25, -1.5}),
+            "; pointing: twist 0.25 rad, d cost/d twist -1.5");
+  EXPECT_EQ(ap::renderNote(notes::AccuracyReached{"cost_error", 1.23456e-5, 1e-4, 128, "paper"}),
+            "; cost_error 1.23e-05 <= target 0.0001 at N = 128 (paper)");
+  EXPECT_EQ(ap::renderFrame(f::RichardsonHalfStopped{32}, reason),
+            "N/2 = 32 for the Richardson estimate: " + reason);
+  EXPECT_EQ(ap::renderFrame(f::CoarseResolutionStopped{"second_order"}, reason),
+            "coarse resolution N = 64 (second_order) did not converge: " + reason);
+  EXPECT_EQ(ap::renderFrame(f::AccuracyNeedsSteps{1e-6, "terminal_miss", 70000, 65536}, reason),
+            "accuracy_target 1e-06 (terminal_miss) needs N = 70000 > max_steps = 65536");
+  EXPECT_EQ(ap::renderFrame(f::AccuracyNotReached{"cost_error", 2.5e-3, 1e-3, 512}, reason),
+            "accuracy_target not reached: cost_error 0.0025 > target 0.001 at N = 512 after 4 "
+            "refinements (round-off floor?)");
+}

@@ -112,9 +112,8 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   at.duration = T;
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
-  recordReason(&result,
-               renderFrame(frames::PairCombined{each_from_its_plan, replaced, fine.message},
-                           coarse.message));
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, fine.message});
   if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
   result.attempts = context.attemptsFrom(first);
   return result;
@@ -199,10 +198,9 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
     context.restoreKept(replaced ? coarse_kept : std::nullopt);
   }
   result.attempts = context.attemptsFrom(first);
-  recordReason(&result,
-               renderFrame(frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds,
-                                                           replaced, fine.message},
-                           coarse.message));
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced,
+                                                        fine.message});
   return result;
 }
 
@@ -273,9 +271,7 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
   upper.minimum_time.solves = answer.minimum_time.solves;
-  recordReason(&upper,
-               renderFrame(frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration},
-                           below.message));
+  frameMessage(&upper, frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration});
   return upper;
 }
 

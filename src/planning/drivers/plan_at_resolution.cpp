@@ -98,8 +98,8 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
-  recordReason(&result,
-               renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message));
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::PairCombined{pair, false, fine.message});
   return result;
 }
 

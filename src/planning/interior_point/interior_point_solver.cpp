@@ -210,10 +210,12 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   direct->formulation = fine.formulation;
 }
 
-/// Where a stopped continuation's answer comes from, for its message.
-std::string onLevel(const ContinuationStop& stop) {
-  return renderClauses(stop.level.clauses) + " (on the N = " + std::to_string(stop.level.steps) +
-         " level of the grid continuation)";
+/// Where a stopped continuation's answer comes from: the stopping level's reason, said on it.
+std::vector<MessageClause> onLevel(const ContinuationStop& stop) {
+  PlanResult said;
+  takeReason(&said, stop.level.clauses);
+  frameMessage(&said, frames::OnContinuationLevel{stop.level.steps});
+  return said.clauses;
 }
 
 /// A level after a stop. Cancelled or out of time: the finer levels are skipped and the last
@@ -233,8 +235,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
     if (r.coarse) carried.steps = r.coarse->steps;
     if (r.coarse) carried.formulation = r.coarse->formulation;
     if (!r.finest) return carried;  // handed on as it is
-    GridOutcome outcome =
-        carryToGrid(r.problem, carried.steps, stop.termination, {clauses::Reason{onLevel(stop)}});
+    GridOutcome outcome = carryToGrid(r.problem, carried.steps, stop.termination, onLevel(stop));
     outcome.formulation = carried.formulation;
     solve.context.recordLevels(outcome.result.levels);
     endsAsTheStop();
@@ -253,7 +254,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
-  recordReason(&outcome.result, onLevel(stop));
+  takeReason(&outcome.result, onLevel(stop));
   endsAsTheStop();
   return outcome;
 }

@@ -113,7 +113,7 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
   takeReason(&result, coarse);
-  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, fine.message});
+  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, renderMessage(fine)});
   if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
   result.attempts = context.attemptsFrom(first);
   return result;
@@ -200,7 +200,7 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   result.attempts = context.attemptsFrom(first);
   takeReason(&result, coarse);
   frameMessage(&result, frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced,
-                                                        fine.message});
+                                                        renderMessage(fine)});
   return result;
 }
 
@@ -621,7 +621,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
     context.restoreKept(first_kept);
     PlanResult kept = first;
     addNote(&kept, restart);
-    addNote(&kept, notes::RestartEnded{again.termination, again.message});
+    addNote(&kept, notes::RestartEnded{again.termination, renderMessage(again)});
     return kept;
   }
   if (again.termination == Termination::Infeasible)

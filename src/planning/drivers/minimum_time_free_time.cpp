@@ -87,7 +87,7 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
   level.iterations = o.iterations;
   level.termination = o.termination;
   level.relative_gradient = o.stationarity;
-  level.reason = o.message;
+  level.reason = renderClauses(o.clauses);
   r.levels.push_back(level);
   return r;
 }

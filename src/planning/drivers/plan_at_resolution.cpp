@@ -99,7 +99,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
   takeReason(&result, coarse);
-  frameMessage(&result, frames::PairCombined{pair, false, fine.message});
+  frameMessage(&result, frames::PairCombined{pair, false, renderMessage(fine)});
   return result;
 }
 
@@ -225,7 +225,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       result = solveWithInteriorPoint(problem, options, context);
       result.iterations = tally.iterations();
       result.levels = context.levelsFrom(first_level);
-      addNote(&result, notes::AfterGuessStopped{first.message});
+      addNote(&result, notes::AfterGuessStopped{renderMessage(first)});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {

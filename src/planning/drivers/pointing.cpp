@@ -79,7 +79,7 @@ int surveySteps(const PlanningProblem& problem, const NewtonParameters& p) {
 void takeInteriorPoint(GridOutcome outcome, TwistRun* run) {
   const PlanResult& r = outcome.result;
   run->solve.termination = r.termination;
-  run->solve.reason = r.message;
+  run->solve.reason = renderMessage(r);
   run->solve.iterations = r.iterations;
   run->solve.twist = r.pointing.active ? r.pointing.final_twist : run->solve.twist;
   run->solve.cost = r.cost;

@@ -358,7 +358,7 @@ class GridSolve final : public PrimalDualProblem {
                              relative_decrement_,
                              std::string(free_slacks_ ? "interior point (free slacks): "
                                                       : "interior point (elastic): ") +
-                                 result.message});
+                                 renderMessage(result)});
     return out;
   }
 
@@ -456,7 +456,7 @@ GridOutcome carryToGrid(const PlanningProblem& problem,
   evaluatePlan(problem, planned.torque, &result, &planned);
   result.levels.push_back(
       {np.steps(), 0, termination, result.max_residual, 0.0,
-       "interior point: carried from a coarser level (" + result.message + ")"});
+       "interior point: carried from a coarser level (" + renderMessage(result) + ")"});
   return out;
 }
 

@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -150,8 +150,8 @@ Rung solveRung(PlanningProblem problem, int N, SolveContext& context, double ord
     const PlanResult half = planAtResolution(problem, context.options(), context);
     if (!half.converged()) {
       rung.plan.termination = half.termination;
-      rung.plan.message =
-          "N/2 = " + std::to_string(N / 2) + " for the Richardson estimate: " + half.message;
+      takeReason(&rung.plan, half);
+      frameMessage(&rung.plan, frames::RichardsonHalfStopped{N / 2});
       return rung;
     }
     const double T = problem.duration;
@@ -167,12 +167,6 @@ int predictSteps(int N0, double error0, double target, double order) {
   const double N = 1.15 * N0 * std::pow(std::max(error0, 1e-300) / target, 1.0 / order);
   const double even = 2.0 * std::ceil(std::min(N, 1e9) / 2.0);
   return static_cast<int>(std::max(16.0, even));
-}
-
-std::string formatted(const char* format, double a, double b = 0.0) {
-  char buffer[96];
-  std::snprintf(buffer, sizeof buffer, format, a, b);
-  return buffer;
 }
 
 // Coarse resolution of each candidate scheme (N = kCoarse; its estimate uses N/2 too).
@@ -207,8 +201,7 @@ SchemeChoice chooseScheme(const PlanningProblem& problem, SolveContext& context,
     estimate->errors_tried.push_back(coarse.error);
     estimate->schemes_tried.push_back(schemeName(scheme));
     if (!coarse.plan.converged()) {
-      coarse.plan.message = "coarse resolution N = 64 (" + schemeName(scheme) +
-                            ") did not converge: " + coarse.plan.message;
+      frameMessage(&coarse.plan, frames::CoarseResolutionStopped{schemeName(scheme)});
       SchemeChoice failed;
       failed.coarse = coarse;
       failed.failed = true;
@@ -242,6 +235,7 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
                         : "Richardson: |hC(N) - h'C(N/2)| / (2^p - 1)";
   const auto finish = [&](PlanResult result) {
     result.accuracy = estimate;
+    renderMessageOnce(&result);
     result.solve_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
@@ -267,9 +261,9 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
       estimate.estimated_error = last.error;
       PlanResult failed = last.plan;
       failed.termination = Termination::NotConverged;
-      failed.message = "accuracy_target " + formatted("%.3g", target.value) + " (" +
-                       accuracyMeasureName(target.measure) + ") needs N = " + std::to_string(N) +
-                       " > max_steps = " + std::to_string(target.max_steps);
+      frameMessage(&failed,
+                   frames::AccuracyNeedsSteps{target.value, accuracyMeasureName(target.measure), N,
+                                              target.max_steps});
       return finish(failed);
     }
     Rung rung = solveRung(chosen, N, context, estimate.order);
@@ -280,19 +274,16 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
     estimate.estimated_error = rung.error;
     last = rung;
     if (rung.error <= target.value) {
-      rung.plan.message += "; " + accuracyMeasureName(target.measure) + " " +
-                           formatted("%.3g <= target %.3g", rung.error, target.value) +
-                           " at N = " + std::to_string(N) + " (" + schemeName(best_scheme) + ")";
+      addNote(&rung.plan, notes::AccuracyReached{accuracyMeasureName(target.measure), rung.error,
+                                                 target.value, N, schemeName(best_scheme)});
       return finish(rung.plan);
     }
     const int next = predictSteps(N, rung.error, target.value, estimate.order);
     estimate.predicted_error = rung.error * std::pow(double(N) / next, estimate.order);
     if (round == 3) {
       rung.plan.termination = Termination::NotConverged;
-      rung.plan.message = "accuracy_target not reached: " + accuracyMeasureName(target.measure) +
-                          " " + formatted("%.3g > target %.3g", rung.error, target.value) +
-                          " at N = " + std::to_string(N) +
-                          " after 4 refinements (round-off floor?)";
+      frameMessage(&rung.plan, frames::AccuracyNotReached{accuracyMeasureName(target.measure),
+                                                          rung.error, target.value, N});
       return finish(rung.plan);
     }
     N = std::max(next, N + 2);

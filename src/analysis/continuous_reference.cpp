@@ -10,6 +10,7 @@
 #include "analysis/extrapolation_integrator.hpp"
 #include "attitude_planner/errors.hpp"
 #include "lie/dual.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 namespace {
@@ -338,7 +339,7 @@ const Maneuver* referenceGuess(const PlanningProblem& problem, const ReferenceOp
   coarse.scheme = SchemeKind::Paper;
   const PlanResult plan = planAtResolution(coarse);
   if (!plan.converged()) {
-    *failure = "initial guess: the discrete plan did not converge: " + plan.message;
+    *failure = "initial guess: the discrete plan did not converge: " + renderMessage(plan);
     return nullptr;
   }
   *storage = plan.maneuver;

@@ -11,7 +11,13 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/problem/solve_context.hpp"
+#include "support/bounded_requests.hpp"
+#include "support/pointing_requests.hpp"
+#include "support/random_problems.hpp"
+#include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
 namespace notes = attitude_planner::notes;
@@ -327,7 +333,8 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
                                         v::ConeAtFixedNode{},
                                         v::FreeTimeEnded{},
                                         v::FreeTimeConeAtFixedNode{},
-                                        v::NoStrictlyFeasibleStart{}};
+                                        v::NoStrictlyFeasibleStart{},
+                                        v::MinimumTimeAnswer{}};
   std::vector<std::string> kinds;
   for (const ap::Verdict& verdict : all) {
     const std::string kind = ap::verdictKindName(verdict);
@@ -453,4 +460,166 @@ TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
   EXPECT_EQ(figures[0].value, 0.125);
   EXPECT_EQ(figures[1].name, "relative_stationarity");
   EXPECT_EQ(figures[1].value, 0.0625);
+}
+
+namespace {
+
+/// A request planned as planManeuver plans it, without the rendering at its end: the drivers'
+/// own answer (their context overloads), whose message each clause extended as it was recorded.
+ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
+                                   const ap::SolverOptions& options = {}) {
+  ap::SolveContext context(options);
+  return problem.objective == ap::Objective::MinimumTime
+             ? ap::planMinimumTime(problem, context)
+             : ap::planBoundedMinimumEffort(problem, context);
+}
+
+/// The message as the drivers left it is the fold of the clauses recorded: no clause of it was
+/// written around them.
+void expectItsClausesFolded(const ap::PlanResult& r, const std::string& label, int* checked) {
+  SCOPED_TRACE(label + ": " + r.message);
+  EXPECT_FALSE(r.clauses.empty());
+  EXPECT_FALSE(r.message.empty());
+  EXPECT_EQ(r.message, ap::renderMessage(r));
+  ++*checked;
+}
+
+}  // namespace
+
+TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
+  namespace rb = ap::robustness;
+  namespace ts = ap::test_support;
+  int checked = 0;
+  // Minimum effort, unconstrained: seeded random bodies, ends, horizons and N; those up to N = 256
+  // as fourth_order too (a Richardson pair at N and 2N, framed around its N solve's reason).
+  for (int i = 0; i < 4; ++i) {
+    rb::RandomCase c = rb::randomCase(4601, i);
+    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label, &checked);
+    if (c.problem.steps > 256) continue;
+    c.problem.scheme = ap::SchemeKind::FourthOrder;
+    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked);
+  }
+  // Bounded: a torque norm, per-axis torques, a norm with a rate limit and a replan, each a
+  // minimum-effort request (the minimum-time phase where it ends infeasible), and two asked as
+  // minimum time.
+  for (int i : {0, 1, 2, 3, 4, 5, 12, 13}) {
+    const std::optional<rb::BoundedRequest> request = rb::boundedRequest(4602, i);
+    if (!request) continue;
+    expectItsClausesFolded(plannedByTheDrivers(request->problem), request->label, &checked);
+  }
+  // Constrained scenes (a keep-out cone, a rate limit, torque bounds; classes enumerated) and the
+  // minimum-time scenes at two grids each.
+  for (const char* scene : {"sun_keep_out", "rate_limited", "torque_limited", "min_time_keep_out",
+                            "min_time_bilimoria_wie"}) {
+    for (int steps : {32, 64}) {
+      expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
+                             std::string(scene) + " N = " + std::to_string(steps), &checked);
+    }
+  }
+  // Pointing: unconstrained, under a cone and under torque bounds, and minimum time on Betts's
+  // body (its start twists framed around the kept answer).
+  for (unsigned seed : {4603u, 4604u}) {
+    const std::string at = " seed " + std::to_string(seed);
+    expectItsClausesFolded(plannedByTheDrivers(ts::randomPointingRequest(
+                               seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
+                           "pointing" + at, &checked);
+    for (ts::PointingBinding binding :
+         {ts::PointingBinding::KeepOut, ts::PointingBinding::TorqueBox}) {
+      expectItsClausesFolded(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
+                                 seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
+                             "constrained pointing" + at, &checked);
+    }
+    expectItsClausesFolded(
+        plannedByTheDrivers(ts::randomBettsPointingRequest(seed, 32, ap::SchemeKind::SecondOrder)),
+        "pointing minimum time" + at, &checked);
+  }
+  // The NLopt cross-check, and a request stopped by its iteration limit.
+  ap::SolverOptions nlopt;
+  nlopt.solver = ap::SolverKind::Nlopt;
+  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
+                         &checked);
+  ap::SolverOptions capped;
+  capped.max_iterations = 3;
+  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
+                         "sun_keep_out capped", &checked);
+  EXPECT_GE(checked, 30) << "the requests were planned";
+}
+
+TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
+  // A reason, a verdict that judges it, a note and a frame, in that order: the fold is the
+  // message recorded clause by clause, and a taken reason carries the clauses, not the verdict.
+  ap::PlanResult r;
+  ap::recordReason(&r, "replay failed");
+  ap::recordVerdict(&r, ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible});
+  ap::addNote(&r, notes::GridContinuation{8});
+  ap::frameMessage(&r, ap::frames::OnContinuationLevel{16});
+  ASSERT_EQ(r.clauses.size(), 4u);
+  EXPECT_EQ(ap::renderMessage(r), r.message);
+  EXPECT_EQ(r.message,
+            ap::renderVerdict(ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible},
+                              "replay failed") +
+                "; grid continuation from N = 8 (on the N = 16 level of the grid "
+                "continuation)");
+  ap::PlanResult combined;
+  ap::takeReason(&combined, r);
+  EXPECT_EQ(combined.message, r.message);
+  EXPECT_EQ(ap::verdictKindName(combined.verdict), "solver_reason");
+  ap::recordReason(&combined, "other words");
+  EXPECT_EQ(combined.clauses.size(), 1u);
+  EXPECT_EQ(ap::renderMessage(combined), "other words");
+}
+
+TEST(MessageFrames, TheBriefsAndTheStopsSayTheWordsOfTheirFormerExpressions) {
+  // The walks' briefs, the continuations' stops, the pointing and the accuracy clauses, once
+  // built by hand around a message, are frames and notes: the words of those expressions.
+  namespace f = ap::frames;
+  const std::string reason = "converged after 3 iterations";
+  EXPECT_EQ(ap::renderFrame(f::OnContinuationLevel{16}, reason),
+            reason + " (on the N = 16 level of the grid continuation)");
+  EXPECT_EQ(
+      ap::renderFrame(f::CarriedOverAfterStop{ap::Termination::Cancelled, 16, 64, false}, reason),
+      "cancelled on the N = 16 level; the plan is its iterate carried over to N = 64");
+  EXPECT_EQ(
+      ap::renderFrame(f::CarriedOverAfterStop{ap::Termination::TimedOut, 16, 64, true}, reason),
+      "time budget exceeded; the plan is the N = 16 class survey's iterate carried over to N = 64");
+  EXPECT_EQ(ap::renderFrame(f::WalkKept{true, ap::Termination::TimedOut, "constrained_retry", 0, 3,
+                                        "solve", "hermite"},
+                            reason),
+            "time budget exceeded during the constrained_retry attempt; the plan returned: " +
+                reason + "; attempt 1 of 3 kept (solve from hermite)");
+  EXPECT_EQ(ap::renderFrame(
+                f::WalkKept{false, ap::Termination::Cancelled, "solve", 0, 1, "solve", "hermite"},
+                reason),
+            reason);
+  f::PointingWalk walk{true, 8, 2, 9, true, false, 4, 2};
+  EXPECT_EQ(ap::renderFrame(walk, reason),
+            reason +
+                "; no twist start converged (8 starts; each verdict is local to its start "
+                "twist); attempt 3 of 9 kept (4 start twists x 2 ways round)");
+  walk.none_converged = false;
+  walk.survey = false;
+  EXPECT_EQ(ap::renderFrame(walk, reason),
+            reason +
+                "; attempt 3 of 9 kept (the interior point with the twist free from the plan "
+                "given, strictly inside every bound)");
+  walk.survey = true;
+  walk.constrained = true;
+  EXPECT_TRUE(contains(ap::renderFrame(walk, reason),
+                       "; attempt 3 of 9 kept (4 start twists x 2 ways round unconstrained, each "
+                       "distinct optimum below the cheapest constrained answer"));
+  EXPECT_EQ(ap::renderNote(notes::PointingTwist{0.25, -1.5, true, 2e-9}),
+            "; pointing: twist 0.25 rad, d L/d twist -1.5 (relative 2e-09)");
+  EXPECT_EQ(ap::renderNote(notes::PointingTwist{0.25, -1.5}),
+            "; pointing: twist 0.25 rad, d cost/d twist -1.5");
+  EXPECT_EQ(ap::renderNote(notes::AccuracyReached{"cost_error", 1.23456e-5, 1e-4, 128, "paper"}),
+            "; cost_error 1.23e-05 <= target 0.0001 at N = 128 (paper)");
+  EXPECT_EQ(ap::renderFrame(f::RichardsonHalfStopped{32}, reason),
+            "N/2 = 32 for the Richardson estimate: " + reason);
+  EXPECT_EQ(ap::renderFrame(f::CoarseResolutionStopped{"second_order"}, reason),
+            "coarse resolution N = 64 (second_order) did not converge: " + reason);
+  EXPECT_EQ(ap::renderFrame(f::AccuracyNeedsSteps{1e-6, "terminal_miss", 70000, 65536}, reason),
+            "accuracy_target 1e-06 (terminal_miss) needs N = 70000 > max_steps = 65536");
+  EXPECT_EQ(ap::renderFrame(f::AccuracyNotReached{"cost_error", 2.5e-3, 1e-3, 512}, reason),
+            "accuracy_target not reached: cost_error 0.0025 > target 0.001 at N = 512 after 4 "
+            "refinements (round-off floor?)");
 }

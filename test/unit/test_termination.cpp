@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
@@ -247,6 +248,48 @@ TEST(Verdicts, AFreeTimeSolvesEndingIsItsOutcomesVerdictKind) {
   EXPECT_EQ(figure.at("min_constraint_value"), o.smallest_value);
   EXPECT_GT(figure.at("iterations"), 0.0);
   EXPECT_LE(figure.at("iterations"), o.iterations);  // the run that ended, of the solve's
+}
+
+TEST(Verdicts, AMinimumTimeAnswerIsItsOwnKindWithTheFiguresOfItsCertificate) {
+  // The answer's account of T* is a verdict kind: T*, whether it is shown a strict local minimum,
+  // the start it came from and every start solved, its figures those of the certificate.
+  for (const char* scene :
+       {"min_time_bilimoria_wie", "min_time_keep_out", "min_time_sphere", "min_time_betts"}) {
+    for (int steps : {64}) {
+      SCOPED_TRACE(std::string(scene) + " N = " + std::to_string(steps));
+      PlanningProblem p =
+          loadScene(std::string(AP_SOURCE_DIR) + "/scenes/" + scene + ".yaml").problem;
+      p.steps = steps;
+      const PlanResult r = planManeuver(p, SolverOptions());
+      ASSERT_TRUE(r.converged()) << r.message;
+      ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+      ASSERT_TRUE(std::holds_alternative<verdicts::MinimumTimeAnswer>(r.verdict)) << r.message;
+      const auto& answer = std::get<verdicts::MinimumTimeAnswer>(r.verdict);
+      EXPECT_EQ(answer.minimum_duration, r.minimum_duration);
+      EXPECT_EQ(answer.second_order_sufficient, r.minimum_time.second_order_sufficient);
+      EXPECT_EQ(answer.stationarity, r.minimum_time.stationarity);
+      EXPECT_EQ(answer.time_row, r.minimum_time.time_stationarity);
+      EXPECT_EQ(answer.complementarity, r.minimum_time.complementarity);
+      EXPECT_EQ(answer.solves, r.minimum_time.solves);
+      EXPECT_FALSE(answer.start.empty());
+      ASSERT_FALSE(answer.starts.empty());
+      // The start it came from is among the starts solved, converged at T*.
+      bool found = false;
+      for (const verdicts::MinimumTimeAnswer::Start& s : answer.starts) {
+        found = found ||
+                (s.name == answer.start && s.termination == Termination::Converged &&
+                 std::abs(s.duration - answer.minimum_duration) <= 1e-9 * answer.minimum_duration);
+      }
+      EXPECT_TRUE(found) << r.message;
+      std::map<std::string, double> figure;
+      for (const VerdictFigure& f : verdictFigures(r.verdict)) figure[f.name] = f.value;
+      EXPECT_EQ(figure.at("minimum_duration"), r.minimum_duration);
+      EXPECT_EQ(figure.at("solves"), r.minimum_time.solves);
+      EXPECT_EQ(figure.at("second_order_sufficient"),
+                r.minimum_time.second_order_sufficient ? 1.0 : 0.0);
+      EXPECT_EQ(r.message.rfind(renderVerdict(r.verdict, ""), 0), 0u) << r.message;
+    }
+  }
 }
 
 TEST(Verdicts, ASolversFirstReasonIsItsVerdictKind) {

@@ -231,20 +231,58 @@ struct NoStrictlyFeasibleStart {
   std::vector<VerdictFigure> figures() const { return {}; }
 };
 
+/// The minimum-time answer: T* from one free-time solve that ended at a KKT point of the discrete
+/// minimum-time problem, second-order sufficient there (a strict local minimum) or not, from
+/// `start`; its residuals, and every start solved (each with its T* or how it ended). A failed
+/// replay of the plan is the reason it is given, said after it.
+struct MinimumTimeAnswer {
+  static constexpr const char* kKind = "minimum_time_answer";
+  /// One start solved: its name, the earlier start it repeats (empty: none), how it ended and,
+  /// converged, its T* and whether that is second-order sufficient (else a saddle).
+  struct Start {
+    std::string name;
+    std::string same_as;
+    Termination termination = Termination::NotConverged;
+    double duration = 0.0;
+    bool second_order_sufficient = false;
+  };
+  double minimum_duration = 0.0;  ///< T* [s]
+  bool second_order_sufficient = false;
+  std::string start;  ///< the start the answering solve came from
+  int iterations = 0;
+  double stationarity = 0.0;
+  double time_row = 0.0;
+  double complementarity = 0.0;
+  std::vector<Start> starts;
+  int solves = 0;  ///< free-time solves run
+  std::vector<VerdictFigure> figures() const {
+    return {{"minimum_duration", minimum_duration},
+            {"second_order_sufficient", second_order_sufficient ? 1.0 : 0.0},
+            {"iterations", double(iterations)},
+            {"stationarity", stationarity},
+            {"time_row", time_row},
+            {"complementarity", complementarity},
+            {"solves", double(solves)}};
+  }
+};
+
 }  // namespace verdicts
 
 /// What a driver answered, as data (PlanResult::verdict): the kind and its figures. A solver's
 /// first reason is a kind too (NloptEnded, NewtonEnded, InteriorPointEnded, NoBoundaryStep,
-/// ConeAtFixedNode, FreeTimeEnded, FreeTimeConeAtFixedNode, NoStrictlyFeasibleStart);
+/// ConeAtFixedNode, FreeTimeEnded, FreeTimeConeAtFixedNode, NoStrictlyFeasibleStart), and so is
+/// the minimum-time answer's account of T* (MinimumTimeAnswer);
 /// SolverReason where a solver's reason is still words only.
-using Verdict = std::variant<
-    verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
-    verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration, verdicts::LocallyInfeasible,
-    verdicts::MinimumTimeFoundNone, verdicts::SearchStopped, verdicts::SearchUnrepresentable,
-    verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime, verdicts::NoPointingStartConverged,
-    verdicts::NloptEnded, verdicts::NewtonEnded, verdicts::InteriorPointEnded,
-    verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode, verdicts::FreeTimeEnded,
-    verdicts::FreeTimeConeAtFixedNode, verdicts::NoStrictlyFeasibleStart>;
+using Verdict =
+    std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
+                 verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
+                 verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
+                 verdicts::SearchStopped, verdicts::SearchUnrepresentable,
+                 verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
+                 verdicts::NoPointingStartConverged, verdicts::NloptEnded, verdicts::NewtonEnded,
+                 verdicts::InteriorPointEnded, verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode,
+                 verdicts::FreeTimeEnded, verdicts::FreeTimeConeAtFixedNode,
+                 verdicts::NoStrictlyFeasibleStart, verdicts::MinimumTimeAnswer>;
 
 /// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
 inline std::string verdictKindName(const Verdict& verdict) {

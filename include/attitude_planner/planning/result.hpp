@@ -7,6 +7,7 @@
 
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/driver_verdict.hpp"
+#include "attitude_planner/planning/message_clauses.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/termination.hpp"
 
@@ -274,10 +275,17 @@ std::string minimizedEffortName(MinimizedEffort effort);
 struct PlanResult {
   Termination termination = Termination::NotConverged;
   bool converged() const { return termination == Termination::Converged; }
-  std::string message;  ///< human-readable explanation of `termination`
+  /// Human-readable explanation of `termination`: the fold of `clauses` (renderMessage), kept
+  /// as each clause is recorded and rendered from them once more at the end of each public entry
+  /// point.
+  std::string message;
+  /// The message as data, in the order its clauses were recorded: the solver's words or verdict,
+  /// the notes after it, the frames around it (message_clauses.hpp).
+  std::vector<MessageClause> clauses;
   /// A driver's verdict as data (kind and figures; JSON `verdict`): where a driver answered
   /// (before any solve, a local "infeasible", the search's end, ...), its first clause of
   /// `message` is rendered from it (recordVerdict); SolverReason where a solver's reason stands.
+  /// The clauses may hold the verdicts of the solves its reason came from too.
   Verdict verdict;
   /// Every solve run for this request, in order (the trail); the kept one has `kept`.
   std::vector<Attempt> attempts;

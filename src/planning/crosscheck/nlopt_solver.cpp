@@ -459,8 +459,8 @@ PlanResult solveWithNlopt(const PlanningProblem& problem, const SolverOptions& o
     evaluatePlan(problem, torque, &result);
   } catch (const StepTooLarge& e) {
     result.termination = Termination::StepTooLarge;
-    result.message =
-        "nlopt: " + resultName(outcome.code) + "; final torques cannot be replayed: " + e.what();
+    recordReason(&result, "nlopt: " + resultName(outcome.code) +
+                              "; final torques cannot be replayed: " + e.what());
     return result;
   }
   const TerminalConstraints c = evaluateTerminalConstraints(problem, xv, true);

@@ -107,7 +107,7 @@ class ClassSearch {
       const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
       r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
     } catch (const StepTooLarge& e) {
-      r.message = e.what();
+      recordReason(&r, e.what());
     }
     iterations_ += r.iterations;
     // The attempt whose plan r is: its kept one, else its last.
@@ -174,7 +174,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const HomotopyClass first_class = survey.known ? survey.homotopy : homotopyClassOf(problem);
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
   if (surveyed.classes.size() < 2) return first;
-  const std::string first_message = first.message;
+  const std::vector<MessageClause> first_said = first.clauses;
   ClassSearch search(problem, options, context, survey_plans, std::move(first), first_recorded);
   const bool on_requested_grid = surveyed.steps >= problem.steps;
   std::optional<HomotopyClass> cheapest;  // on the survey grid
@@ -196,7 +196,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);
   if (!first_kept) {
-    addNote(&result, notes::CheapestClass{first_message});
+    addNote(&result, notes::CheapestClass{renderClauses(first_said)});
   }
   return result;
 }

@@ -112,8 +112,8 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   at.duration = T;
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
-  result.message =
-      renderFrame(frames::PairCombined{each_from_its_plan, replaced, fine.message}, coarse.message);
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, renderMessage(fine)});
   if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
   result.attempts = context.attemptsFrom(first);
   return result;
@@ -198,9 +198,9 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
     context.restoreKept(replaced ? coarse_kept : std::nullopt);
   }
   result.attempts = context.attemptsFrom(first);
-  result.message = renderFrame(
-      frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced, fine.message},
-      coarse.message);
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced,
+                                                        renderMessage(fine)});
   return result;
 }
 
@@ -271,8 +271,7 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
   upper.minimum_time.solves = answer.minimum_time.solves;
-  upper.message = renderFrame(frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration},
-                              below.message);
+  frameMessage(&upper, frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration});
   return upper;
 }
 
@@ -421,7 +420,9 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  return planMinimumTime(problem, context);
+  PlanResult result = planMinimumTime(problem, context);
+  renderMessageOnce(&result);
+  return result;
 }
 
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
@@ -628,7 +629,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
       kept.duration_verdict.longest_duration_found = climb.reached;
     }
     addNote(&kept, restart);
-    addNote(&kept, notes::RestartEnded{again.termination, again.message});
+    addNote(&kept, notes::RestartEnded{again.termination, renderMessage(again)});
     return kept;
   }
   if (again.termination == Termination::Infeasible)
@@ -642,7 +643,9 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  return planBoundedMinimumEffort(problem, context);
+  PlanResult result = planBoundedMinimumEffort(problem, context);
+  renderMessageOnce(&result);
+  return result;
 }
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context) {

@@ -87,7 +87,7 @@ PlanResult levelResult(int steps, const FreeTimeOutcome& o) {
   level.iterations = o.iterations;
   level.termination = o.termination;
   level.relative_gradient = o.stationarity;
-  level.reason = o.message;
+  level.reason = renderClauses(o.clauses);
   r.levels.push_back(level);
   return r;
 }
@@ -535,28 +535,22 @@ class FreeTimeMinimumTime {
     PlanResult result = freeTimePlan(at, answer);
     if (!trail_.empty()) trail_[best_attempt_].kept = true;
     if (!trail_.empty()) context_.markKept(first_recorded_ + best_attempt_);
-    std::ostringstream note;
-    note << "minimum time T* = " << answer.duration
-         << " s: a KKT point of the discrete minimum-time problem, "
-         << (answer.second_order_sufficient ? "second-order sufficient (a strict local minimum)"
-                                            : "not second-order sufficient (not shown a local "
-                                              "minimum)")
-         << " (one free-time interior-point solve from the " << from << " start, "
-         << answer.iterations << " iterations; stationarity " << answer.stationarity << ", h row "
-         << answer.time_row << ", complementarity " << answer.complementarity << "; starts:";
+    verdicts::MinimumTimeAnswer told{answer.duration,
+                                     answer.second_order_sufficient,
+                                     from,
+                                     answer.iterations,
+                                     answer.stationarity,
+                                     answer.time_row,
+                                     answer.complementarity,
+                                     {},
+                                     solves_};
     for (const StartRecord& st : starts_) {
-      note << " " << st.name << " ";
-      if (st.same_as >= 0) note << "(as " << starts_[st.same_as].name << ") ";
-      if (st.outcome.termination == Termination::Converged) {
-        note << st.outcome.duration << " s"
-             << (st.outcome.second_order_sufficient ? "" : " (saddle)") << ";";
-      } else {
-        note << terminationName(st.outcome.termination) << ";";
-      }
+      told.starts.push_back({st.name, st.same_as >= 0 ? starts_[st.same_as].name : std::string(),
+                             st.outcome.termination, st.outcome.duration,
+                             st.outcome.second_order_sufficient});
     }
-    note << " " << solves_ << " free-time solves)";
-    // A replay that failed (freeTimePlan) says so after the answer's account.
-    result.message = note.str() + (result.message.empty() ? "" : "; " + result.message);
+    // A replay that failed (freeTimePlan) is the reason it is given, said after its account.
+    recordVerdict(&result, told);
     result.minimum_duration = answer.duration;
     result.minimum_time.kkt_point = true;
     result.minimum_time.stationarity = answer.stationarity;
@@ -593,7 +587,7 @@ class FreeTimeMinimumTime {
       replayFigures(effort, &r);
     } catch (const StepTooLarge& e) {
       r.termination = Termination::StepTooLarge;
-      r.message = std::string("replay of the planned torques failed: ") + e.what();
+      recordReason(&r, std::string("replay of the planned torques failed: ") + e.what());
     }
     const ConstraintCheck check = checkConstraints(effort, r.maneuver);
     r.constraints = check.names;

@@ -98,7 +98,8 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   if (!fine.converged()) return failed(fine, 2 * N);
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
-  result.message = renderFrame(frames::PairCombined{pair, false, fine.message}, coarse.message);
+  takeReason(&result, coarse);
+  frameMessage(&result, frames::PairCombined{pair, false, renderMessage(fine)});
   return result;
 }
 
@@ -178,7 +179,9 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  return planAtResolution(problem, options, context);
+  PlanResult result = planAtResolution(problem, options, context);
+  renderMessageOnce(&result);
+  return result;
 }
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,
@@ -222,7 +225,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       result = solveWithInteriorPoint(problem, options, context);
       result.iterations = tally.iterations();
       result.levels = context.levelsFrom(first_level);
-      addNote(&result, notes::AfterGuessStopped{first.message});
+      addNote(&result, notes::AfterGuessStopped{renderMessage(first)});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {

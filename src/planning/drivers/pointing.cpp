@@ -79,7 +79,7 @@ int surveySteps(const PlanningProblem& problem, const NewtonParameters& p) {
 void takeInteriorPoint(GridOutcome outcome, TwistRun* run) {
   const PlanResult& r = outcome.result;
   run->solve.termination = r.termination;
-  run->solve.reason = r.message;
+  run->solve.reason = renderMessage(r);
   run->solve.iterations = r.iterations;
   run->solve.twist = r.pointing.active ? r.pointing.final_twist : run->solve.twist;
   run->solve.cost = r.cost;
@@ -302,11 +302,8 @@ PlanResult constrainedResultOf(const TwistRun& run) {
   result.iterations = run.solve.iterations;
   result.history = run.history;
   result.extremal_summary = extremalOf(run.lift);
-  std::ostringstream msg;
-  msg << result.message << "; pointing: twist " << result.pointing.final_twist
-      << " rad, d L/d twist " << result.pointing.twist_gradient << " (relative "
-      << result.pointing.twist_stationarity << ")";
-  result.message = msg.str();
+  addNote(&result, notes::PointingTwist{result.pointing.final_twist, result.pointing.twist_gradient,
+                                        true, result.pointing.twist_stationarity});
   return result;
 }
 
@@ -340,12 +337,10 @@ PlanResult resultOf(const PlanningProblem& problem, const TwistRun& run) {
   Eigen::VectorXd gradient;
   np.evaluateWithTwist(&gradient, nullptr, nullptr, nullptr, &scale);
   result.pointing.twist_stationarity = std::abs(gradient(np.unknowns())) / scale;
-  std::ostringstream msg;
-  msg << reason << " after " << run.solve.iterations << " iterations (relative gradient "
-      << run.solve.relative_gradient << ", relative Newton decrement "
-      << run.solve.relative_decrement << "); pointing: twist " << result.pointing.final_twist
-      << " rad, d cost/d twist " << run.solve.twist_gradient;
-  result.message = msg.str();
+  recordVerdict(&result,
+                verdicts::NewtonEnded{reason, run.solve.iterations, run.solve.relative_gradient,
+                                      run.solve.relative_decrement});
+  addNote(&result, notes::PointingTwist{result.pointing.final_twist, run.solve.twist_gradient});
   return result;
 }
 
@@ -445,30 +440,16 @@ PlanResult finishPointing(const PlanningProblem& problem, const std::vector<Twis
   result.attempts.assign(context.attempts().begin() + first_recorded, context.attempts().end());
   result.pointing.starts = static_cast<int>(survey.size());
   if (kept && !fallback) {
-    std::ostringstream brief;
-    brief << result.message;
-    // Each start's verdict is local (its ψ and way round): no start converged, which is not a
-    // proof that no twist admits a plan.
-    if (!kept->first.converged()) {
-      brief << "; no twist start converged (" << survey.size()
-            << " starts; each verdict is local to its start twist)";
-    }
-    brief << "; attempt " << kept->second - first_recorded + 1 << " of " << result.attempts.size()
-          << " kept";
-    if (survey.empty()) {
-      brief << " (the interior point with the twist free from the plan given, strictly inside "
-               "every bound)";
-    } else if (problem.hasNodeConstraints()) {
-      brief << " (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
-            << " ways round unconstrained, each distinct optimum below the cheapest constrained "
-               "answer starting the interior point with the twist free; where none converged, "
-               "each the other way round and the fixed-twist unconstrained optima; then each "
-               "twist's fixed-twist constrained optimum)";
-    } else {
-      brief << " (" << kPointingStartTwists << " start twists x " << std::size(kPointingClasses)
-            << " ways round)";
-    }
-    result.message = brief.str();
+    frames::PointingWalk walk;
+    walk.none_converged = !kept->first.converged();
+    walk.starts = survey.size();
+    walk.kept_at = kept->second - first_recorded;
+    walk.attempts = result.attempts.size();
+    walk.survey = !survey.empty();
+    walk.constrained = problem.hasNodeConstraints();
+    walk.start_twists = kPointingStartTwists;
+    walk.ways_round = std::size(kPointingClasses);
+    frameMessage(&result, walk);
   }
   return result;
 }

@@ -19,8 +19,9 @@ namespace attitude_planner {
 /// discrete minimum-time problem at the end.
 struct FreeTimeOutcome {
   Termination termination = Termination::NotConverged;
-  Verdict verdict;                    ///< how it ended, as data (driver_verdict.hpp)
-  std::string message;                ///< its words (recordVerdict)
+  Verdict verdict;                     ///< how it ended, as data (driver_verdict.hpp)
+  std::vector<MessageClause> clauses;  ///< its words as data (recordVerdict)
+  std::string message;                 ///< their fold
   ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
   double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)

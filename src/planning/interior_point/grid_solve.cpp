@@ -358,7 +358,7 @@ class GridSolve final : public PrimalDualProblem {
                              relative_decrement_,
                              std::string(free_slacks_ ? "interior point (free slacks): "
                                                       : "interior point (elastic): ") +
-                                 result.message});
+                                 renderMessage(result)});
     return out;
   }
 
@@ -434,12 +434,12 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
 
 GridOutcome carryToGrid(const PlanningProblem& problem,
                         const ReducedProblem::StepVectors& coarse_steps, Termination termination,
-                        const std::string& message) {
+                        const std::vector<MessageClause>& said) {
   GridOutcome out;
   PlanResult& result = out.result;
   result.solver = "interior_point";
   result.termination = termination;
-  result.message = message;
+  takeReason(&result, said);
   std::optional<ReducedProblem> reduced;
   try {
     reduced.emplace(problem);
@@ -454,8 +454,9 @@ GridOutcome carryToGrid(const PlanningProblem& problem,
   const Maneuver planned = np.maneuver(np.current());
   result.max_residual = std::numeric_limits<double>::quiet_NaN();  // not measured
   evaluatePlan(problem, planned.torque, &result, &planned);
-  result.levels.push_back({np.steps(), 0, termination, result.max_residual, 0.0,
-                           "interior point: carried from a coarser level (" + message + ")"});
+  result.levels.push_back(
+      {np.steps(), 0, termination, result.max_residual, 0.0,
+       "interior point: carried from a coarser level (" + renderMessage(result) + ")"});
   return out;
 }
 

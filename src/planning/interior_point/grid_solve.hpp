@@ -49,10 +49,10 @@ GridOutcome solveOnGrid(const PlanningProblem& problem, const SolverOptions& opt
                         const GridRequest& request);
 
 /// A coarser level's iterate carried to the requested grid without iterating (a solve stopped
-/// on a coarse level: cancelled or out of time), evaluated as a plan, with `termination` and
-/// `message` (StepTooLarge if the boundary data admit no step at this N).
+/// on a coarse level: cancelled or out of time), evaluated as a plan, with `termination` and the
+/// reason `said` (StepTooLarge if the boundary data admit no step at this N).
 GridOutcome carryToGrid(const PlanningProblem& problem,
                         const ReducedProblem::StepVectors& coarse_steps, Termination termination,
-                        const std::string& message);
+                        const std::vector<MessageClause>& said);
 
 }  // namespace attitude_planner

@@ -145,7 +145,7 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
   const PlanResult& other = take_second ? first.result : second.result;
   answer.result.iterations = tally.iterations();
   addNote(&answer.result, notes::FormulationRetry{recipe.retry.name, recipe.first.name, take_second,
-                                                  other.message});
+                                                  renderMessage(other)});
   answer.duals = LevelDuals{};  // the retry's are not carried
   return answer;
 }
@@ -204,16 +204,18 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   if (!middle.result.converged()) return;
   GridOutcome fine = solveGridWithRetry(at, from_coarse, solve, &middle.steps, nullptr);
   if (!fine.result.converged()) return;
-  addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, direct->result.message});
+  addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, renderMessage(direct->result)});
   direct->result = fine.result;
   direct->steps = fine.steps;
   direct->formulation = fine.formulation;
 }
 
-/// Where a stopped continuation's answer comes from, for its message.
-std::string onLevel(const ContinuationStop& stop) {
-  return stop.level.message + " (on the N = " + std::to_string(stop.level.steps) +
-         " level of the grid continuation)";
+/// Where a stopped continuation's answer comes from: the stopping level's reason, said on it.
+std::vector<MessageClause> onLevel(const ContinuationStop& stop) {
+  PlanResult said;
+  takeReason(&said, stop.level.clauses);
+  frameMessage(&said, frames::OnContinuationLevel{stop.level.steps});
+  return said.clauses;
 }
 
 /// A level after a stop. Cancelled or out of time: the finer levels are skipped and the last
@@ -252,7 +254,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
-  outcome.result.message = onLevel(stop);
+  takeReason(&outcome.result, onLevel(stop));
   endsAsTheStop();
   return outcome;
 }
@@ -443,14 +445,14 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   PlanResult second = attempt(problem, staged, solve, AttemptStage::ConstrainedRetry,
                               AttemptStart::PreviousAttempt, &second_at)
                           .result;
-  const std::string first_message = result.message;
+  const std::vector<MessageClause> first_said = result.clauses;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
   if (take_second) result = second;
   keepAttempt(context, begun, take_second ? second_at : at, &result);
   result.iterations = tally.iterations();
-  addNote(&result, notes::RetriedInTwoStages{first_message});
+  addNote(&result, notes::RetriedInTwoStages{renderClauses(first_said)});
   return result;
 }
 

@@ -369,7 +369,7 @@ PlanResult finished(PlanResult result, int steps, int iterations, Termination te
   result.termination = termination;
   recordVerdict(&result, verdicts::NewtonEnded{reason, iterations, relative_gradient, decrement});
   result.levels.push_back(
-      {steps, iterations, termination, relative_gradient, decrement, result.message});
+      {steps, iterations, termination, relative_gradient, decrement, renderMessage(result)});
   return result;
 }
 
@@ -383,7 +383,7 @@ std::optional<ReducedProblem> startedProblem(const PlanningProblem& problem, con
     *result = finished(*result, problem.steps, 0, Termination::StepTooLarge,
                        std::string("boundary velocity: ") + e.what(), 0.0, 0.0);
     recordVerdict(result, verdicts::NoBoundaryStep{e.what()});
-    result->levels.back().reason = result->message;
+    result->levels.back().reason = renderMessage(*result);
     return std::nullopt;
   }
   result->extremal_summary = extremalOf(startOnHermiteCurve(problem, &*reduced));

@@ -190,14 +190,11 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
     return solveOnGrid(r.problem, context, at_level, {nullptr, r.coarse, r.coarser}, final_steps,
                        p);
   };
-  const std::string survey_grid = "N = " + std::to_string(plan.levels[plan.survey].steps);
   const ContinuationFinish finish = [&](const ContinuationRecord& record, PlanResult* r) {
     if (record.stop) {
-      r->message =
-          std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
-                                                                         : "time budget exceeded") +
-          "; the plan is the " + survey_grid +
-          " class survey's iterate carried over to N = " + std::to_string(plan.levels.back().steps);
+      frameMessage(
+          r, frames::CarriedOverAfterStop{record.stop->termination, plan.levels[plan.survey].steps,
+                                          plan.levels.back().steps, true});
       return;
     }
     if (record.reached < record.levels.size()) {
@@ -620,22 +617,18 @@ void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, 
   walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations);
 }
 
-/// The one-line brief: how the kept attempt ended, what stopped the walk, which attempt it was.
-std::string briefOf(const PlanResult& kept, const std::vector<Attempt>& trail, std::size_t kept_at,
-                    std::optional<Termination> stop) {
-  std::ostringstream brief;
-  if (stop && trail[kept_at].termination != *stop) {
-    brief << (*stop == Termination::Cancelled ? "cancelled" : "time budget exceeded")
-          << " during the " << attemptStageName(trail.back().stage)
-          << " attempt; the plan returned: ";
-  }
-  brief << kept.message;
-  if (trail.size() > 1) {
-    brief << "; attempt " << kept_at + 1 << " of " << trail.size() << " kept ("
-          << attemptStageName(trail[kept_at].stage) << " from "
-          << attemptStartName(trail[kept_at].start) << ")";
-  }
-  return brief.str();
+/// The walk's brief around the kept attempt's reason: what stopped the walk, which attempt it was.
+frames::WalkKept briefOf(const std::vector<Attempt>& trail, std::size_t kept_at,
+                         std::optional<Termination> stop) {
+  frames::WalkKept brief;
+  brief.stopped = stop && trail[kept_at].termination != *stop;
+  if (stop) brief.stop = *stop;
+  brief.during = attemptStageName(trail.back().stage);
+  brief.kept_at = kept_at;
+  brief.tried = trail.size();
+  brief.kept_stage = attemptStageName(trail[kept_at].stage);
+  brief.kept_start = attemptStartName(trail[kept_at].start);
+  return brief;
 }
 
 PlanResult Walk::finish() {
@@ -660,7 +653,7 @@ PlanResult Walk::finish() {
     if (i != kept_at_) kept.extremal_summary.others.push_back(trail_[i]);
   }
   kept.extremal = describeExtremal(kept.extremal_summary);
-  kept.message = briefOf(kept, trail_, kept_at_, stop);
+  frameMessage(&kept, briefOf(trail_, kept_at_, stop));
   if (stop && !kept.converged()) kept.termination = *stop;
   kept.attempts = trail_;
   return kept;

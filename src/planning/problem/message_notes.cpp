@@ -129,6 +129,28 @@ std::string words(const MinimumTimeUnsolved& n) {
          terminationName(n.termination) + ")";
 }
 
+std::string words(const PointingTwist& n) {
+  std::ostringstream s;
+  s << "; pointing: twist " << n.twist << " rad, ";
+  if (n.lagrangian) {
+    s << "d L/d twist " << n.gradient << " (relative " << n.relative << ")";
+  } else {
+    s << "d cost/d twist " << n.gradient;
+  }
+  return s.str();
+}
+
+/// printf's %.3g (the accuracy clauses' figures).
+std::string threeDigits(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+std::string words(const AccuracyReached& n) {
+  return "; " + n.measure + " " + threeDigits(n.error) + " <= target " + threeDigits(n.target) +
+         " at " + grid(n.steps) + " (" + n.scheme + ")";
+}
+
 std::string words(const frames::RichardsonPair& p) {
   return "fourth_order (Richardson extrapolation of second_order at " + grid(p.steps) +
          " and 2N = " + std::to_string(2 * p.steps) +
@@ -229,6 +251,72 @@ std::string framed(const frames::NoAttemptPlanned& f, const std::string& reason)
 std::string framed(const frames::FinerLevelStopped& f, const std::string& reason) {
   return "not converged: the N = " + std::to_string(f.feasible_steps) +
          " level met every constraint, but a finer level stopped (" + reason + ")";
+}
+
+std::string framed(const frames::OnContinuationLevel& f, const std::string& reason) {
+  return reason + " (on the " + grid(f.steps) + " level of the grid continuation)";
+}
+std::string stopped(Termination stop) {
+  return stop == Termination::Cancelled ? "cancelled" : "time budget exceeded";
+}
+std::string framed(const frames::CarriedOverAfterStop& f, const std::string&) {
+  if (f.class_survey) {
+    return stopped(f.stop) + "; the plan is the " + grid(f.steps) +
+           " class survey's iterate carried over to " + grid(f.requested);
+  }
+  return stopped(f.stop) + " on the " + grid(f.steps) +
+         " level; the plan is its iterate carried over to " + grid(f.requested);
+}
+std::string framed(const frames::WalkKept& f, const std::string& reason) {
+  std::ostringstream brief;
+  if (f.stopped) {
+    brief << stopped(f.stop) << " during the " << f.during << " attempt; the plan returned: ";
+  }
+  brief << reason;
+  if (f.tried > 1) {
+    brief << "; attempt " << f.kept_at + 1 << " of " << f.tried << " kept (" << f.kept_stage
+          << " from " << f.kept_start << ")";
+  }
+  return brief.str();
+}
+std::string framed(const frames::PointingWalk& f, const std::string& reason) {
+  std::ostringstream brief;
+  brief << reason;
+  // Each start's verdict is local (its ψ and way round): no start converged, which is not a
+  // proof that no twist admits a plan.
+  if (f.none_converged) {
+    brief << "; no twist start converged (" << f.starts
+          << " starts; each verdict is local to its start twist)";
+  }
+  brief << "; attempt " << f.kept_at + 1 << " of " << f.attempts << " kept";
+  if (!f.survey) {
+    brief << " (the interior point with the twist free from the plan given, strictly inside "
+             "every bound)";
+  } else if (f.constrained) {
+    brief << " (" << f.start_twists << " start twists x " << f.ways_round
+          << " ways round unconstrained, each distinct optimum below the cheapest constrained "
+             "answer starting the interior point with the twist free; where none converged, "
+             "each the other way round and the fixed-twist unconstrained optima; then each "
+             "twist's fixed-twist constrained optimum)";
+  } else {
+    brief << " (" << f.start_twists << " start twists x " << f.ways_round << " ways round)";
+  }
+  return brief.str();
+}
+
+std::string framed(const frames::RichardsonHalfStopped& f, const std::string& reason) {
+  return "N/2 = " + std::to_string(f.half_steps) + " for the Richardson estimate: " + reason;
+}
+std::string framed(const frames::CoarseResolutionStopped& f, const std::string& reason) {
+  return "coarse resolution N = 64 (" + f.scheme + ") did not converge: " + reason;
+}
+std::string framed(const frames::AccuracyNeedsSteps& f, const std::string&) {
+  return "accuracy_target " + threeDigits(f.target) + " (" + f.measure + ") needs " +
+         grid(f.steps) + " > max_steps = " + std::to_string(f.max_steps);
+}
+std::string framed(const frames::AccuracyNotReached& f, const std::string&) {
+  return "accuracy_target not reached: " + f.measure + " " + threeDigits(f.error) + " > target " +
+         threeDigits(f.target) + " at " + grid(f.steps) + " after 4 refinements (round-off floor?)";
 }
 
 // The words of the drivers' verdicts (driver_verdict.hpp).
@@ -350,6 +438,39 @@ std::string judged(const verdicts::NoStrictlyFeasibleStart& v, const std::string
   return v.why;
 }
 
+std::string judged(const verdicts::MinimumTimeAnswer& v, const std::string& reason) {
+  std::ostringstream note;
+  note << "minimum time T* = " << v.minimum_duration
+       << " s: a KKT point of the discrete minimum-time problem, "
+       << (v.second_order_sufficient ? "second-order sufficient (a strict local minimum)"
+                                     : "not second-order sufficient (not shown a local "
+                                       "minimum)")
+       << " (one free-time interior-point solve from the " << v.start << " start, " << v.iterations
+       << " iterations; stationarity " << v.stationarity << ", h row " << v.time_row
+       << ", complementarity " << v.complementarity << "; starts:";
+  for (const verdicts::MinimumTimeAnswer::Start& st : v.starts) {
+    note << " " << st.name << " ";
+    if (!st.same_as.empty()) note << "(as " << st.same_as << ") ";
+    if (st.termination == Termination::Converged) {
+      note << st.duration << " s" << (st.second_order_sufficient ? "" : " (saddle)") << ";";
+    } else {
+      note << terminationName(st.termination) << ";";
+    }
+  }
+  note << " " << v.solves << " free-time solves)";
+  // A replay that failed says so after the answer's account.
+  return note.str() + (reason.empty() ? "" : "; " + reason);
+}
+
+/// The fold of a message's clauses (MessageClause): each clause takes the message so far.
+struct Fold {
+  std::string* message;
+  void operator()(const clauses::Reason& r) const { *message = r.words; }
+  void operator()(const Verdict& v) const { *message = renderVerdict(v, *message); }
+  void operator()(const Note& n) const { message->append(renderNote(n)); }
+  void operator()(const Frame& f) const { *message = renderFrame(f, *message); }
+};
+
 }  // namespace
 
 std::string renderNote(const Note& note) {
@@ -357,6 +478,7 @@ std::string renderNote(const Note& note) {
 }
 
 void addNote(PlanResult* result, const Note& note) {
+  result->clauses.push_back(note);
   result->message.append(renderNote(note));
 }
 
@@ -365,6 +487,7 @@ std::string renderFrame(const Frame& frame, const std::string& reason) {
 }
 
 void frameMessage(PlanResult* result, const Frame& frame) {
+  result->clauses.push_back(frame);
   result->message = renderFrame(frame, result->message);
 }
 
@@ -374,7 +497,36 @@ std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
 
 void recordVerdict(PlanResult* result, const Verdict& verdict) {
   result->verdict = verdict;
+  result->clauses.push_back(verdict);
   result->message = renderVerdict(verdict, result->message);
+}
+
+void recordReason(PlanResult* result, const std::string& words) {
+  result->clauses.assign(1, clauses::Reason{words});
+  result->message = words;
+}
+
+void takeReason(PlanResult* to, const PlanResult& from) {
+  takeReason(to, from.clauses);
+}
+
+void takeReason(PlanResult* to, const std::vector<MessageClause>& clauses) {
+  to->clauses = clauses;
+  to->message = renderClauses(clauses);
+}
+
+std::string renderClauses(const std::vector<MessageClause>& clauses) {
+  std::string message;
+  for (const MessageClause& clause : clauses) std::visit(Fold{&message}, clause);
+  return message;
+}
+
+std::string renderMessage(const PlanResult& result) {
+  return renderClauses(result.clauses);
+}
+
+void renderMessageOnce(PlanResult* result) {
+  result->message = renderMessage(*result);
 }
 
 }  // namespace attitude_planner

@@ -1,291 +1,68 @@
-// The clauses a solver or a driver adds to an answer's message after its first reason, as data:
-// what happened, on which grid, how the solve it names ended, its figures, and the message of the
-// solve it refers to. addNote is the one place they are worded (renderNote), so a clause reads
-// the same wherever it is recorded; the figures a caller needs are fields of the answer
-// (PlanResult, its trail `attempts`, its `levels`), never parsed from these words.
+// The wording of an answer's message and the recording of its clauses (message_clauses.hpp):
+// what happened, on which grid, how the solve it names ended, its figures, and the reason of the
+// solve it refers to. Each clause is worded in one place (renderNote, renderFrame,
+// renderVerdict) and the message is their fold (renderMessage), so a clause reads the same
+// wherever it is recorded; the figures a caller needs are fields of the answer (PlanResult, its
+// trail `attempts`, its `levels`, its `clauses`), never parsed from these words.
 #pragma once
 
 #include <string>
-#include <variant>
 #include <vector>
 
+#include "attitude_planner/planning/message_clauses.hpp"
 #include "attitude_planner/planning/result.hpp"
 
 namespace attitude_planner {
-namespace notes {
-
-/// The interior point's other formulation tried from the same start after the first stopped
-/// (interior_point_solver.cpp: the formulation recipe). `solved`: its answer is returned, else
-/// the first's is, and `reason` is the other solve's message.
-struct FormulationRetry {
-  std::string retry;  ///< the retry's formulation ("elastic", ...)
-  std::string first;  ///< the first one's
-  bool solved = false;
-  std::string reason;
-};
-/// A 4x refinement that stopped, reached once more through the level in between (N = `steps`).
-struct ReachedThroughMiddle {
-  int steps = 0;
-  std::string reason;  ///< the direct refinement's message
-};
-/// The interior point's levels: the coarsest one's N.
-struct GridContinuation {
-  int steps = 0;
-};
-/// Cones with other limits, from a start inside a cone: the cones alone, then every constraint.
-struct RetriedInTwoStages {
-  std::string reason;  ///< the first solve's message
-};
-/// The interior point from the caller's plan of this N, its multipliers re-derived.
-struct FromInitialGuess {};
-/// Newton's grid continuation: the level below the requested grid (N = `steps`) and how it ended:
-/// converged, its plan started the requested grid, else the geodesic did.
-struct CoarserLevel {
-  int steps = 0;
-  Termination termination = Termination::Converged;
-};
-/// Newton's class survey on a coarser grid (N = `steps`), its chosen class refined.
-struct RefinedFromSurvey {
-  int steps = 0;
-};
-/// The unconstrained optimum met every node constraint: it is the answer.
-struct ConstraintsInactive {};
-/// The unconstrained optimum (cost `cost`) violates `worst` at `where` (empty `worst`: only a
-/// cone's margin) and started the interior point after `newton_iterations`.
-struct UnconstrainedStart {
-  double cost = 0.0;
-  std::string worst;
-  std::string where;
-  int newton_iterations = 0;
-};
-/// The interior point from the caller's guess stopped; the answer is the usual start's.
-struct AfterGuessStopped {
-  std::string reason;  ///< the solve from the guess's message
-};
-/// An answer that is no plan (infeasible, stopped) whose torques also fail the replay.
-struct LastIterateDoesNotReplay {
-  std::string reason;  ///< the replay's failure
-};
-/// A request with its class left free: another class under the constraints is cheaper.
-struct CheapestClass {
-  std::string reason;  ///< the first class's (the unconstrained optimum's) message
-};
-/// A pointing request where no start converged: the last start's reason.
-struct LastPointingStart {
-  std::string reason;
-};
-/// A constrained pointing request whose free-twist solves did not converge, answered with the
-/// cheapest converged fixed-attitude plan at one twist (the twist not optimized).
-struct FixedTwistFallback {
-  double twist = 0.0;  ///< ψ [rad] of the plan returned
-  std::string reason;  ///< the free-twist solve's message there
-};
-/// A bounded pointing request not converged at T where minimum time with the twist free found
-/// T* <= T: plans exist, the restart from the minimum-time plan is not served for pointing yet.
-struct PointingRestartNotServed {
-  double minimum_duration = 0.0;  ///< T* [s]
-};
-/// The minimum-time search's summary (drivers/minimum_time_search.cpp renders its bracket, the
-/// starts' least durations and the solves from its outcomes).
-struct SearchSummary {
-  std::string summary;
-};
-/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration`, and the free-time
-/// solve from it descended to a lower KKT point.
-struct DescendedFromProbe {
-  double duration = 0.0;
-  double previous = 0.0;
-};
-/// Minimum time searched on T instead of solved free-time, and `why`.
-struct SearchedOnT {
-  std::string why;
-};
-/// The search's plan (T = `duration`) started the free-time solve that answers.
-struct SharpenedFromSearch {
-  std::string why;  ///< why the structured starts did not answer
-  double duration = 0.0;
-};
-/// The plan at (1 + `margin`) T* (T = `duration`) from the T* plan.
-struct PlannedAtMargin {
-  double margin = 0.0;
-  double duration = 0.0;
-  double minimum_duration = 0.0;  ///< T*
-};
-/// A bounded minimum-effort request restarted from the minimum-time plan at T* after its first
-/// solve `why`: directly, else through a ladder of durations from T*.
-struct MinimumTimeRestart {
-  double minimum_duration = 0.0;  ///< T*
-  std::string why;
-  bool ladder_reached = false;                     ///< the ladder reached T (its plan answers)
-  Termination direct = Termination::NotConverged;  ///< the direct start's end
-  bool ladder_tried = false;
-  double ladder_longest = 0.0;  ///< the longest T it found a plan at (0: none)
-};
-/// How a restart that did not beat the first answer ended (after MinimumTimeRestart).
-struct RestartEnded {
-  Termination termination = Termination::NotConverged;
-  std::string reason;
-};
-/// The first solve `why` and the minimum-time problem under the same bounds ended `termination`.
-struct MinimumTimeUnsolved {
-  std::string why;
-  Termination termination = Termination::NotConverged;
-};
-
-}  // namespace notes
-
-using Note =
-    std::variant<notes::FormulationRetry, notes::ReachedThroughMiddle, notes::GridContinuation,
-                 notes::RetriedInTwoStages, notes::FromInitialGuess, notes::CoarserLevel,
-                 notes::RefinedFromSurvey, notes::ConstraintsInactive, notes::UnconstrainedStart,
-                 notes::AfterGuessStopped, notes::LastIterateDoesNotReplay, notes::CheapestClass,
-                 notes::LastPointingStart, notes::FixedTwistFallback,
-                 notes::PointingRestartNotServed, notes::SearchSummary, notes::SearchedOnT,
-                 notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
-                 notes::RestartEnded, notes::MinimumTimeUnsolved, notes::DescendedFromProbe>;
 
 /// The clause's words ("; grid continuation from N = 8", ...), each starting with its separator.
 std::string renderNote(const Note& note);
-/// Adds the clause to result->message (after what it says already).
+/// Adds the clause to the result's clauses (its message: after what it says already).
 void addNote(PlanResult* result, const Note& note);
-
-// The clauses that frame a message instead of following it: said before the reason they are
-// given (and around it), worded here as the notes are (renderFrame).
-namespace frames {
-
-/// fourth_order's pair of second_order solves at N = `steps` and 2N; `from_plans_at_minimum_time`:
-/// each solve started from its own plan at T* (minimum_time.cpp), else from the usual starts.
-struct RichardsonPair {
-  int steps = 0;
-  bool from_plans_at_minimum_time = false;
-};
-/// A solve of the pair did not converge (the one at N = `stopped_steps`): its plan is returned,
-/// the reason it is given is that solve's message.
-struct PairSolveStopped {
-  RichardsonPair pair;
-  int stopped_steps = 0;
-};
-/// Both solves converged and were combined; the reason it is given is the N solve's message.
-/// `replaced`: the plan is the N solve's (the combination left a bound both meet).
-struct PairCombined {
-  RichardsonPair pair;
-  bool replaced = false;
-  std::string fine_reason;  ///< the 2N solve's message
-};
-/// fourth_order minimum time: a solve of its pair of second_order problems (N = `steps` and 2N)
-/// did not converge, the one at 2N (`at_fine`) or at N: its minimum-time problem, or
-/// (`effort_at_minimum_time`) the other one's minimum-effort plan at the binding T*; its plan is
-/// returned, the reason it is given is that solve's message.
-struct MinimumTimePairStopped {
-  int steps = 0;
-  bool at_fine = false;
-  bool effort_at_minimum_time = false;
-};
-/// fourth_order minimum time from its pair: T* = max(T* at N, T* at 2N), the one at 2N binds
-/// (`fine_binds`) or the one at N; `replaced`: the plan is the N plan at T* (see PairCombined).
-/// The reason it is given is the N solve's message, said last.
-struct MinimumTimePairCombined {
-  int steps = 0;
-  double minimum_duration = 0.0;  ///< T*
-  double at_coarse = 0.0;         ///< T* at N
-  double at_fine = 0.0;           ///< T* at 2N
-  bool fine_binds = false;
-  bool replaced = false;
-  std::string fine_reason;  ///< the 2N solve's message
-};
-/// Spinning ends: a probe below T* = `previous` found a plan at T = `duration` from which the
-/// free-time solve did not descend: T* ≤ `duration`, an upper bound; the reason it is given is the
-/// probe's message.
-struct UpperBoundFromProbe {
-  double duration = 0.0;
-  double previous = 0.0;
-};
-/// A bounded minimum-effort request at T (`requested`) ≥ T* = `minimum_duration` whose solves
-/// from the minimum-time plan ended at infeasible points: rest to rest, feasible but not
-/// converged; else, where the ladder of durations found plans up to `ladder_reached` (> 0), a
-/// local "infeasible from here"; else not converged. The reason it is given is the last solve's.
-struct StuckAtMinimumTimePlan {
-  bool rest_to_rest = false;
-  double minimum_duration = 0.0;
-  double requested = 0.0;
-  double ladder_reached = 0.0;
-};
-/// A converged plan outside the class the request named: `why` (classInconsistency), around the
-/// plan's own message.
-struct OutsideRequestedClass {
-  std::string why;
-};
-/// The replay of a converged plan's torques failed (`what`), around the plan's own message.
-struct ReplayFailed {
-  std::string what;
-};
-/// Minimum time to a pointing end: the start twists solved (none: no start was solved), each
-/// with its T* or its termination, and the one kept (-1: none); the reason it is given is the
-/// kept answer's message, said last.
-struct PointingStarts {
-  struct Start {
-    double twist = 0.0;  ///< ψ [rad]
-    Termination termination = Termination::NotConverged;
-    double minimum_duration = 0.0;  ///< T* [s] where converged
-  };
-  std::vector<Start> starts;
-  int kept = -1;
-};
-
-/// A staged continuation (a rate continuation, an inertia homotopy: `what`) stopped at s =
-/// `reached` of 1 after `stages` stages: no plan for the request; the reason it is given is its
-/// last stage's message.
-struct StagedUnfinished {
-  std::string what;
-  double reached = 0.0;
-  int stages = 0;
-};
-/// Newton's walk: none of its `tried` attempts produced a plan on the requested grid; the reason
-/// it is given is the last one's message.
-struct NoAttemptPlanned {
-  std::size_t tried = 0;
-};
-/// The interior point's continuation: a finer level ended "infeasible" after the level at N =
-/// `feasible_steps` met every constraint, so not converged (its solver stopped at a local minimum
-/// of the violation, no certificate); the reason it is given is the finer level's message.
-struct FinerLevelStopped {
-  int feasible_steps = 0;
-};
-
-}  // namespace frames
-
-using Frame =
-    std::variant<frames::PairSolveStopped, frames::PairCombined, frames::MinimumTimePairStopped,
-                 frames::MinimumTimePairCombined, frames::UpperBoundFromProbe,
-                 frames::StuckAtMinimumTimePlan, frames::OutsideRequestedClass,
-                 frames::ReplayFailed, frames::PointingStarts, frames::StagedUnfinished,
-                 frames::NoAttemptPlanned, frames::FinerLevelStopped>;
 
 /// The message `frame` makes of `reason` (the message it is given).
 std::string renderFrame(const Frame& frame, const std::string& reason);
-/// result->message framed by `frame`.
+/// Adds the frame to the result's clauses (its message: framed by `frame`).
 void frameMessage(PlanResult* result, const Frame& frame);
 
 /// The message a driver's `verdict` makes (include/attitude_planner/planning/driver_verdict.hpp):
 /// its words, then, for the kinds that judge a solve (LocallyInfeasible, MinimumTimeFoundNone,
-/// FeasibleAtMinimumTime, SolverReason), `reason`, the message of that solve; the kinds that
+/// FeasibleAtMinimumTime, SolverReason; MinimumTimeAnswer: a failed replay), `reason`, the
+/// message of that solve; the kinds that
 /// answer without one (before any solve, the search's end, no pointing start) do not read it.
 std::string renderVerdict(const Verdict& verdict, const std::string& reason);
-/// Records `verdict` on the result and renders result->message from it (the reason it is given
-/// is the message the result carried).
+/// Records `verdict` on the result and adds it to its clauses (the reason it is given is the
+/// message the result carried).
 void recordVerdict(PlanResult* result, const Verdict& verdict);
-/// The same for a solver's own outcome that carries a verdict and its message (FreeTimeOutcome).
+/// The same for a solver's own outcome that carries a verdict, its clauses and its message
+/// (FreeTimeOutcome).
 template <class Outcome>
 void recordVerdict(Outcome* outcome, const Verdict& verdict) {
   outcome->verdict = verdict;
+  outcome->clauses.push_back(verdict);
   outcome->message = renderVerdict(verdict, outcome->message);
 }
-/// `to` is given `from`'s reason: its verdict and the message rendered so far (a wrapper then
-/// frames it; a driver's result takes its solver's outcome's).
+/// Words no kind, note or frame holds yet (a caught error's text): the result's clauses start
+/// again from them.
+void recordReason(PlanResult* result, const std::string& words);
+/// `to` is given `from`'s reason: its verdict and its clauses (a wrapper then frames it; a
+/// driver's result takes its solver's outcome's).
 template <class To, class From>
 void carryReason(To* to, const From& from) {
   to->verdict = from.verdict;
+  to->clauses = from.clauses;
   to->message = from.message;
 }
+/// `to` says `from`'s reason (its clauses) and keeps its own verdict: a plan made of other
+/// solves' (a Richardson combination, a probe's plan) framed around one solve's reason.
+void takeReason(PlanResult* to, const PlanResult& from);
+/// The same from a reason kept as clauses (a level's end, a frame's own).
+void takeReason(PlanResult* to, const std::vector<MessageClause>& clauses);
+
+/// The message `clauses` make, folded in order (MessageClause).
+std::string renderClauses(const std::vector<MessageClause>& clauses);
+/// The message of `result`: renderClauses of its clauses.
+std::string renderMessage(const PlanResult& result);
+/// Renders result->message from its clauses: once, at the end of each public entry point.
+void renderMessageOnce(PlanResult* result);
 
 }  // namespace attitude_planner

@@ -25,14 +25,11 @@ std::vector<PlanningProblem> gridLevels(const PlanningProblem& problem, const Gr
 void describeContinuation(const ContinuationRecord& record, PlanResult* finest) {
   const std::size_t count = record.levels.size();
   if (count < 2) return;
-  const std::string requested = std::to_string(record.levels.back().steps);
   const LevelEnd& below = record.levels[count - 2];
   if (record.stop) {
-    finest->message =
-        std::string(record.stop->termination == Termination::Cancelled ? "cancelled"
-                                                                       : "time budget exceeded") +
-        " on the N = " + std::to_string(record.stop->level.steps) +
-        " level; the plan is its iterate carried over to N = " + requested;
+    frameMessage(finest,
+                 frames::CarriedOverAfterStop{record.stop->termination, record.stop->level.steps,
+                                              record.levels.back().steps, false});
   } else {
     addNote(finest, notes::CoarserLevel{below.steps, below.termination});
   }

@@ -55,7 +55,7 @@ std::vector<PlanningProblem> gridLevels(const PlanningProblem& problem, const Gr
 struct LevelEnd {
   int steps = 0;  ///< its N
   Termination termination = Termination::NotConverged;
-  std::string message;
+  std::vector<MessageClause> clauses;  ///< its result's reason, as data
 };
 
 /// What stopped a continuation (cancel, deadline, or a level's end under the rule) and where.
@@ -157,7 +157,7 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
     }
     result = solve(request, finest ? nullptr : &carry[i]);
     record.levels[i].termination = result.termination;
-    record.levels[i].message = result.message;
+    record.levels[i].clauses = result.clauses;
     record.reached = i + 1;
     if (record.stop) {
       result.termination = record.stop->termination;
@@ -182,7 +182,7 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
 inline ContinuationRecord recordOf(const std::vector<PlanningProblem>& levels) {
   ContinuationRecord record;
   for (const PlanningProblem& level : levels) {
-    record.levels.push_back({level.steps, Termination::NotConverged, std::string()});
+    record.levels.push_back({level.steps, Termination::NotConverged, {}});
   }
   return record;
 }

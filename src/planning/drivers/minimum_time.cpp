@@ -225,8 +225,7 @@ constexpr int kMaxProbes = 12;
 struct ProbeSteps {
   int exponent = 0;
   bool failed_at_one = false, failed_at_two = false;  ///< j = 0, j = 1 found nothing
-  int far = -1;            ///< the far probe being asked (kFarProbes index); −1: the near ones
-  bool far_found = false;  ///< a far probe has found a plan in this request (farProbesBelow)
+  int far = -1;  ///< the far probe being asked (kFarProbes index); −1: the near ones
 
   double fraction() const {
     return far >= 0 ? kFarProbes[far] : kProbeBelow * std::ldexp(1.0, exponent);
@@ -235,7 +234,6 @@ struct ProbeSteps {
   /// (a new basin: start again at δ), else larger steps.
   void found(bool descended) {
     exponent = descended || far >= 0 ? 0 : std::min(exponent + 1, kLargestProbeExponent);
-    far_found = far_found || far >= 0;
     failed_at_one = failed_at_two = false;
     far = -1;
   }
@@ -255,19 +253,15 @@ struct ProbeSteps {
   }
 };
 
-/// Whether the far probes look below `answer` once the near ones found nothing: where it is not
-/// shown a local minimum (a KKT point that is not second-order sufficient, or a probe's plan, an
-/// upper bound), or where a far probe has already found a plan in this request (`far_found`:
-/// feasibility in T is shown not monotone there). Below the first second-order sufficient KKT
-/// point of a request the near probes have looked just below a strict local minimum, and the
-/// descent stops. A cost rule, not a proof: a strict local minimum can still have another basin
-/// far below it. Measured on the seed-45 spinning page: the far probes below such answers gave no
-/// lower answer; its two gains came from answers not shown a local minimum (#77's KKT point at
-/// 6.8175 s, #221's at 91.69 s), and on #77 the far probes then went on below a second-order
-/// sufficient KKT point at 5.738 s to 5.182 s (with "not shown a local minimum" alone it stopped
-/// at 5.738 s).
-bool farProbesBelow(const PlanResult& answer, const ProbeSteps& steps) {
-  return !answer.minimum_time.second_order_sufficient || steps.far_found;
+/// Whether the far probes look below `answer` once the near ones found nothing: only where it is
+/// not shown a local minimum (a KKT point that is not second-order sufficient, or a probe's plan,
+/// an upper bound). Below a second-order sufficient KKT point the near probes have already looked
+/// just below a strict local minimum, and the far probes' cold solves below such answers gave no
+/// lower answer on the seed-45 spinning page; its two gains came from answers not shown a local
+/// minimum (#77's KKT point at 6.8175 s, #221's answer at 91.69 s). A cost rule, not a proof: a
+/// strict local minimum can still have another basin far below it.
+bool farProbesBelow(const PlanResult& answer) {
+  return !answer.minimum_time.second_order_sufficient;
 }
 
 /// The answer from a probe at `effort.duration` that found a plan (`below`, its attempt kept
@@ -336,7 +330,7 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     if (!provesFeasible(effort, below)) {
       context.restoreKept(answer_kept);
       answer.attempts = context.attemptsFrom(first);
-      if (!from_iterate && !steps.nothingFound(farProbesBelow(answer, steps))) break;
+      if (!from_iterate && !steps.nothingFound(farProbesBelow(answer))) break;
       continue;
     }
     answer = lowerAnswer(problem, effort, answer, below, keptSince(context, probe_first), first,

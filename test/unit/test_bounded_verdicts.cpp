@@ -344,6 +344,26 @@ TEST(BoundedVerdicts, SpinningMinimumTimeIsNotLeftWithoutAPlanWhereOneExists) {
   EXPECT_GE(requests, 3);
 }
 
+TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBelowAFirstTNearItsFloor) {
+  // A request of the seeded suite (at its drawn N) where no free-time start converges and the
+  // search's first T (the eigenaxis guess, 12.58 s) lies within 2x of the proven floor: cold
+  // minimum-effort plans converge at 11 and 12 s, none at 8.8, 9 and 10 s, so a shortening by a
+  // fixed 0.7 (8.8 s, then below the floor) found no plan and the answer was "not converged".
+  // Its answer is a plan, checked as planAndCheck does (replayed within its bounds, none found
+  // at 0.99 T*), at or above the proven bound on its grid (T_c / (1 + 4/N)).
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 108);
+  ASSERT_TRUE(request.has_value());
+  ASSERT_TRUE(hasSpinningEnds(request->problem));
+  SCOPED_TRACE(request->label);
+  const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+  EXPECT_EQ(check.input_error, "");
+  ASSERT_TRUE(check.result.converged()) << check.result.message;
+  EXPECT_EQ(check.wrong, "") << check.result.message;
+  const double N = request->problem.steps;
+  EXPECT_GE(check.result.minimum_duration,
+            check.result.duration_verdict.lower_bound / (1.0 + 4.0 / N));
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at

@@ -350,7 +350,7 @@ TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBelowAFirstTNearItsFloor) {
   // minimum-effort plans converge at 11 and 12 s, none at 8.8, 9 and 10 s, so a shortening by a
   // fixed 0.7 (8.8 s, then below the floor) found no plan and the answer was "not converged".
   // Its answer is a plan, checked as planAndCheck does (replayed within its bounds, none found
-  // at 0.99 T*), at or above the proven bound on its grid (T_c / (1 + 4/N)).
+  // at 0.99 T*), at or above the proven bound on its grid (discreteDurationLowerBound).
   const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 108);
   ASSERT_TRUE(request.has_value());
   ASSERT_TRUE(hasSpinningEnds(request->problem));
@@ -359,9 +359,7 @@ TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBelowAFirstTNearItsFloor) {
   EXPECT_EQ(check.input_error, "");
   ASSERT_TRUE(check.result.converged()) << check.result.message;
   EXPECT_EQ(check.wrong, "") << check.result.message;
-  const double N = request->problem.steps;
-  EXPECT_GE(check.result.minimum_duration,
-            check.result.duration_verdict.lower_bound / (1.0 + 4.0 / N));
+  EXPECT_GE(check.result.minimum_duration, discreteDurationLowerBound(request->problem));
 }
 
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {

@@ -219,7 +219,9 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"least_duration_found\": " << jsonNumber(r.duration_verdict.least_duration_found)
       << ", \"longest_duration_found\": " << jsonNumber(r.duration_verdict.longest_duration_found)
       << ", \"rate_limit\": " << jsonNumber(r.duration_verdict.rate_limit)
-      << ", \"torque_limit\": " << jsonNumber(r.duration_verdict.torque_limit) << "},\n"
+      << ", \"torque_limit\": " << jsonNumber(r.duration_verdict.torque_limit)
+      << ", \"plan_within_bounds\": " << (r.duration_verdict.plan_within_bounds ? "true" : "false")
+      << "},\n"
       << "  \"verdict\": " << verdictJson(r.verdict) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"

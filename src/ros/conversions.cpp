@@ -146,6 +146,7 @@ DurationVerdictSummary durationVerdictToMsg(const DurationVerdict& v) {
   msg.longest_duration_found = v.longest_duration_found;
   msg.rate_limit = v.rate_limit;
   msg.torque_limit = v.torque_limit;
+  msg.plan_within_bounds = v.plan_within_bounds;
   return msg;
 }
 

@@ -113,10 +113,24 @@ double minimumTimeOf(const PlanningProblem& problem, const SolverOptions& option
   }
 }
 
+/// Whether the plan starts and ends at the request's states (within 1e-8, rates relative to the
+/// larger boundary rate) and meets every bound: a plan of the request at its T.
+bool planMeetsRequest(const PlanningProblem& p, const Maneuver& m) {
+  if (m.attitude.empty()) return false;
+  const double rate_scale = std::max({1.0, p.initial_velocity.norm(), p.final_velocity.norm()});
+  const bool ends = so3::angleBetween(m.attitude.front(), p.initial_attitude) <= 1e-8 &&
+                    so3::angleBetween(m.attitude.back(), p.final_attitude) <= 1e-8 &&
+                    (m.angular_velocity.front() - p.initial_velocity).norm() <= 1e-8 * rate_scale &&
+                    (m.angular_velocity.back() - p.final_velocity).norm() <= 1e-8 * rate_scale;
+  return ends && checkConstraints(p, m).max_relative_violation <= kPlanOutsideBounds;
+}
+
 void checkVerdict(const PlanningProblem& p, const SolverOptions& options, VerdictCheck* check) {
   const PlanResult& r = check->result;
   const DurationVerdict& v = r.duration_verdict;
-  if (r.converged() && p.objective == Objective::MinimumEffort) {
+  if (!r.converged() && v.plan_within_bounds && !planMeetsRequest(p, r.maneuver)) {
+    check->wrong = "within bounds";
+  } else if (r.converged() && p.objective == Objective::MinimumEffort) {
     const double outside = checkConstraints(p, r.maneuver).max_relative_violation;
     if (outside > kPlanOutsideBounds) check->wrong = "converged";
   } else if (r.converged() && r.minimum_duration > 0.0) {

@@ -48,6 +48,9 @@ struct VerdictCheck {
   ///   proven         a minimum-time plan exists below the proven bound on the grid
   ///   local          least_duration_found X, yet a minimum-effort plan converges at 0.98 X
   ///   minimum time   a minimum-effort plan converges at 0.99 T*
+  ///   within bounds  an answer not converged says its plan is within the bounds
+  ///                  (plan_within_bounds), yet it leaves a bound by more than 1e-6 or misses
+  ///                  its boundary states by more than 1e-8
   std::string wrong;
   double check_duration = 0.0;  ///< the T the check solved at (0: none)
 };

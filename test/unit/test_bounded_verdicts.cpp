@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <iostream>
 #include <string>
 #include <variant>
 
@@ -39,6 +41,9 @@ PlanningProblem minimumTime(PlanningProblem p) {
   p.duration = 0.0;
   return p;
 }
+
+/// An iteration limit at which the seeded suite's solves stop short of optimality.
+constexpr int kCutIterations = 12;
 
 }  // namespace
 
@@ -273,6 +278,37 @@ TEST(BoundedVerdicts, SeededBoundedRequestsHaveHonestVerdicts) {
     EXPECT_EQ(check.wrong, "") << check.result.message;
   }
   EXPECT_GE(requests, 12);
+}
+
+TEST(BoundedVerdicts, AnAnswerStoppedShortSaysWhetherItHoldsAPlanAtT) {
+  // The seeded suites' minimum-effort requests under box bounds (where the interior point's two
+  // formulations stop at different iterates) with the iteration limit cut, so that solves stop
+  // short of optimality: every answer says as data whether its plan meets the request at T
+  // (plan_within_bounds), and where a stopped answer says so, its plan is checked independently
+  // (boundary states, every bound: planAndCheck); a converged answer always holds one.
+  SolverOptions options;
+  options.max_iterations = kCutIterations;
+  int stopped_within = 0;
+  int requests = 0;
+  for (const std::uint64_t seed : {4545u, 4646u}) {
+    for (int i = 0; i < 24; ++i) {
+      const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(seed, i);
+      if (!request || request->kind != "box" ||
+          request->problem.objective != Objective::MinimumEffort) {
+        continue;
+      }
+      ++requests;
+      SCOPED_TRACE(request->label);
+      const robustness::VerdictCheck check = robustness::planAndCheck(*request, options);
+      const PlanResult& r = check.result;
+      EXPECT_EQ(check.input_error, "");
+      EXPECT_EQ(check.wrong, "") << r.message;
+      if (r.converged()) EXPECT_TRUE(r.duration_verdict.plan_within_bounds) << r.message;
+      if (!r.converged() && r.duration_verdict.plan_within_bounds) ++stopped_within;
+    }
+  }
+  EXPECT_GE(requests, 8);
+  EXPECT_GE(stopped_within, 1);
 }
 
 TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {

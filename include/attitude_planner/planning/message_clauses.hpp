@@ -19,12 +19,14 @@ namespace notes {
 
 /// The interior point's other formulation tried from the same start after the first stopped
 /// (interior_point_solver.cpp: the formulation recipe). `solved`: its answer is returned, else
-/// the first's is, and `reason` is the other solve's message.
+/// the first's is, and `reason` is the other solve's message. `within_bounds`: the retry is
+/// returned though it stopped too, its plan within the bounds where the first's was not.
 struct FormulationRetry {
   std::string retry;  ///< the retry's formulation ("elastic", ...)
   std::string first;  ///< the first one's
   bool solved = false;
   std::string reason;
+  bool within_bounds = false;
 };
 /// A 4x refinement that stopped, reached once more through the level in between (N = `steps`).
 struct ReachedThroughMiddle {
@@ -134,6 +136,11 @@ struct MinimumTimeUnsolved {
   std::string why;
   Termination termination = Termination::NotConverged;
 };
+/// A bounded answer that stopped short of optimality whose plan still meets the dynamics, the ends
+/// and every bound at T = `duration` (DurationVerdict::plan_within_bounds).
+struct PlanWithinBounds {
+  double duration = 0.0;
+};
 
 /// A pointing answer's twist ψ [rad] and the stationarity in ψ: with constraints or bounds
 /// (`lagrangian`) ∂L/∂ψ and its relative size, else ∂C/∂ψ.
@@ -165,7 +172,7 @@ using Note =
                  notes::PointingRestartNotServed, notes::SearchSummary, notes::SearchedOnT,
                  notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
                  notes::RestartEnded, notes::MinimumTimeUnsolved, notes::DescendedFromProbe,
-                 notes::PointingTwist, notes::AccuracyReached>;
+                 notes::PlanWithinBounds, notes::PointingTwist, notes::AccuracyReached>;
 
 // The clauses that frame a message instead of following it: said before the reason they are
 // given (and around it), worded here as the notes are (renderFrame).

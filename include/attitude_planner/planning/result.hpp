@@ -212,6 +212,10 @@ struct DurationVerdict {
   /// minimum-time plan: the longest T [s] at which one was (where the ladder of durations from
   /// T* stopped: not a limit); 0: none was sought.
   double longest_duration_found = 0.0;
+  /// Bounded minimum effort: the returned plan meets the dynamics, the ends and every bound at
+  /// the requested T, checked step by step (true for every converged answer; an answer that
+  /// stopped short of optimality may still hold a plan at T, not shown optimal).
+  bool plan_within_bounds = false;
 };
 
 /// What a pointing request's "infeasible" rests on (PointingSummary::infeasible_basis, JSON

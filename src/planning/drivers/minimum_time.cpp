@@ -266,8 +266,10 @@ bool farProbesBelow(const PlanResult& answer) {
 
 /// The answer from a probe at `effort.duration` that found a plan (`below`, its attempt kept
 /// `below_kept`): the free-time KKT point from its plan where one lies lower, else the probe's
-/// plan as an upper bound on T*. Its trail: the context's from `first`. Where that free-time solve
-/// ended short of a KKT point at a plan below the probe's T, the plan goes to `*lower_plan`.
+/// plan as an upper bound on T* (answerFeasibleAt: converged also where the probe's solve
+/// stopped short of optimality inside the bounds, as the search's T* is). Its trail: the context's
+/// from `first`. Where that free-time solve ended short of a KKT point at a plan below the probe's
+/// T, the plan goes to `*lower_plan`.
 PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
                        const PlanResult& answer, const PlanResult& below,
                        std::optional<std::size_t> below_kept, std::size_t first,
@@ -282,8 +284,8 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   PlanResult upper = below;
   context.restoreKept(below_kept);
   upper.attempts = context.attemptsFrom(first);
-  upper.minimum_duration = effort.duration;
   upper.minimum_time = MinimumTimeCertificate{};
+  answerFeasibleAt(effort.duration, &upper);
   upper.minimum_time.solves = answer.minimum_time.solves;
   frameMessage(&upper, frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration});
   return upper;
@@ -501,6 +503,16 @@ std::string needsMinimumTimeStart(const PlanningProblem& problem, const PlanResu
   return "left a bound by " + exactNumber(check.max_relative_violation) + " (relative)";
 }
 
+/// One rule for a bounded minimum-effort answer's plan: whether it proves the requested T feasible
+/// (provesFeasible: the dynamics, the ends and every bound, step by step), as data, and said where
+/// the answer stopped short of optimality (a plan at T, not shown optimal).
+void recordPlanWithinBounds(const PlanningProblem& problem, PlanResult* result) {
+  result->duration_verdict.plan_within_bounds = provesFeasible(problem, *result);
+  if (result->duration_verdict.plan_within_bounds && !result->converged()) {
+    addNote(result, notes::PlanWithinBounds{problem.duration});
+  }
+}
+
 /// The duration ladder's rungs: a first step of 15 % in T, up to 30 % after converged rungs,
 /// a failed rung's step halved down to 0.4 % and held for one converged rung, at most 24 rungs.
 constexpr double kLadderFirstRatio = 1.15;
@@ -554,7 +566,8 @@ LadderClimb climbDurationLadder(const PlanningProblem& problem, const PlanResult
   AdaptiveSchedule schedule;
   // The ladder climbs where the start at T itself failed, so its first rung is below T: where
   // 15 % above T* would reach T, halfway (in log T).
-  schedule.first_increment = share(kLadderFirstRatio) < 1.0 ? share(kLadderFirstRatio) : 0.5;
+  const double first_share = share(kLadderFirstRatio);
+  schedule.first_increment = first_share < 1.0 ? first_share : 0.5;
   schedule.max_increment = share(kLadderLargestRatio);
   schedule.min_increment = share(kLadderLeastRatio);
   schedule.max_stages = kLadderRungs;
@@ -674,6 +687,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   const std::string why = needsMinimumTimeStart(problem, result);
   if (why.empty() || !std::isfinite(torqueAuthority(problem).smallest_about_any_axis) ||
       problem.accuracy.active()) {
+    recordPlanWithinBounds(problem, &result);
     return result;
   }
   // The interior point's "infeasible" is local (its elastic form stopped at a minimum of the
@@ -694,6 +708,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
     r.attempts = context.attemptsFrom(first);
     recordLowerBound(bound, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
+    recordPlanWithinBounds(problem, &r);
     r.solve_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return r;

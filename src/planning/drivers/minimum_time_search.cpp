@@ -332,13 +332,9 @@ class MinimumTimeSearch {
 
   PlanResult atMinimumTime(const SearchOutcome& found, std::size_t first) const {
     PlanResult result = found.best;
-    if (!result.converged()) {
-      // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
-      // short of optimality while its plan meets every constraint, which is what T* rests on.
-      result.termination = Termination::Converged;
-      recordVerdict(&result, verdicts::FeasibleAtMinimumTime{found.T_hi});
-    }
-    result.minimum_duration = found.T_hi;
+    // At T* the feasible set shrinks to the bang–bang plan: its minimum-effort solve may stop
+    // short of optimality while its plan meets every constraint.
+    answerFeasibleAt(found.T_hi, &result);
     result.attempts = context_.attemptsFrom(first);
     addNote(&result, notes::SearchSummary{searchNote(found)});
     return result;
@@ -398,6 +394,14 @@ bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
     return false;
   }
   return planInconsistency(problem, r, true).empty();
+}
+
+void answerFeasibleAt(double T, PlanResult* plan) {
+  if (!plan->converged()) {
+    plan->termination = Termination::Converged;
+    recordVerdict(plan, verdicts::FeasibleAtMinimumTime{T});
+  }
+  plan->minimum_duration = T;
 }
 
 PlanResult searchMinimumTime(const PlanningProblem& problem, SolveContext& context) {

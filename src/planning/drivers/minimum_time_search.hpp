@@ -18,6 +18,13 @@ namespace attitude_planner {
 /// the T* found stopped at the iteration limit with feasible iterates).
 bool provesFeasible(const PlanningProblem& problem, const PlanResult& r);
 
+/// A minimum-time answer at `T` from a plan that proves T feasible (provesFeasible): T is the
+/// least duration found feasible, which is what a minimum-time answer rests on, whether or not
+/// the plan's minimum-effort solve stopped short of optimality (then said as
+/// FeasibleAtMinimumTime, and the answer is converged). One rule for the search's T* and for a
+/// probe's plan below a free-time T*.
+void answerFeasibleAt(double T, PlanResult* plan);
+
 /// The plan at the least feasible T the search finds (minimum_duration = T*, minimum_time.kkt_point
 /// false), or why there is none (Infeasible: no duration up to 2^12 times the first guess; the
 /// stop's termination when cancelled or out of time). Its solves run in `context` with its

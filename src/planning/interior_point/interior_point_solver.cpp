@@ -62,6 +62,7 @@
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/problem/verdict.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 
 namespace attitude_planner {
@@ -114,10 +115,20 @@ struct Solve {
   SolveContext& context;
 };
 
+/// Whether a solve that stopped short still holds a plan of its grid's problem (planInconsistency:
+/// the dynamics step by step and every node constraint): its iterate is a plan at T, not shown
+/// optimal.
+bool stoppedWithinBounds(const PlanningProblem& problem, const PlanResult& r) {
+  return r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
+         planInconsistency(problem, r, true).empty();
+}
+
 /// One grid in the recipe's first formulation, retried once in the other from the same start
 /// when it ends infeasible or unconverged. The answer: a converged solve, else an
-/// infeasibility certificate, else the first solve's reason; every solve's iterations are kept
-/// and its levels recorded in the context as it ends.
+/// infeasibility certificate, else a stopped solve whose plan is within the bounds where the
+/// first's is not (an "infeasible" or an iterate outside a bound is no answer beside a plan),
+/// else the first solve's reason; every solve's iterations are kept and its levels recorded in
+/// the context as it ends.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true) {
@@ -138,14 +149,17 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
       {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr, final_grid});
   second.formulation = recipe.retry.formulation;
   solve.context.recordLevels(second.result.levels);
+  const bool second_within =
+      stoppedWithinBounds(problem, second.result) && !stoppedWithinBounds(problem, first.result);
   const bool take_second =
       second.result.converged() ||
-      (t != Termination::Infeasible && second.result.termination == Termination::Infeasible);
+      (t != Termination::Infeasible && second.result.termination == Termination::Infeasible) ||
+      second_within;
   GridOutcome answer = take_second ? std::move(second) : std::move(first);
   const PlanResult& other = take_second ? first.result : second.result;
   answer.result.iterations = tally.iterations();
   addNote(&answer.result, notes::FormulationRetry{recipe.retry.name, recipe.first.name, take_second,
-                                                  renderMessage(other)});
+                                                  renderMessage(other), second_within});
   answer.duals = LevelDuals{};  // the retry's are not carried
   return answer;
 }

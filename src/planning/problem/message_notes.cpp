@@ -17,6 +17,10 @@ std::string grid(int steps) {
 }
 
 std::string words(const FormulationRetry& n) {
+  if (n.within_bounds) {
+    return "; answered with " + n.retry + "'s plan, within the bounds, after " + n.first +
+           " ended outside them: " + n.reason;
+  }
   return (n.solved ? "; solved with " + n.retry + " after " + n.first + " stopped: "
                    : "; retried with " + n.retry + ": ") +
          n.reason;
@@ -127,6 +131,11 @@ std::string words(const MinimumTimeUnsolved& n) {
   return "; the first solve " + n.why +
          " and the minimum-time problem under the same bounds did not converge (" +
          terminationName(n.termination) + ")";
+}
+
+std::string words(const PlanWithinBounds& n) {
+  return "; its plan meets the dynamics, the ends and every bound at T = " +
+         exactNumber(n.duration) + " s: a plan at T, not shown optimal";
 }
 
 std::string words(const PointingTwist& n) {

@@ -618,26 +618,27 @@ std::vector<TwistRun> fixedTwistOptima(const PlanningProblem& problem,
   return starts;
 }
 
-/// Whether every run in `finals` (the interior point with ψ free from an unconstrained optimum)
-/// ended with the interior point's certificate of local infeasibility (its elastic form's
-/// violation stopped decreasing: Termination::Infeasible), from at least kPointingStartTwists
-/// distinct starts (twist and way round). Then each start twist's fixed-twist constrained optimum
-/// (a whole fixed-attitude request per twist) is not tried: on the seeded requests of seeds 41, 43
-/// and 47 (72 with one binding constraint) it never gave the answer, and on the infeasible ones it
-/// took 3/4 of the request's iterations. The verdict stays local to the starts tried.
+/// Whether the interior point's runs in `finals` (each with ψ free from an unconstrained optimum)
+/// hold its certificate of local infeasibility (its elastic form's violation stopped decreasing:
+/// Termination::Infeasible) from at least kPointingStartTwists distinct starts (twist and way
+/// round); runs that stopped otherwise certify nothing either way. Called where none converged:
+/// each start twist's fixed-twist constrained optimum (a whole fixed-attitude request per twist)
+/// is then not tried. On the seeded requests of seeds 41, 43 and 47 (72 with one binding
+/// constraint) those never gave the answer, and on the infeasible ones they took 3/4 of the
+/// request's iterations. The verdict stays local to the starts tried.
 bool locallyInfeasibleFromEnoughStarts(
     const std::vector<std::pair<TwistRun, std::size_t>>& finals) {
-  std::vector<const TwistRun*> distinct;
+  std::vector<const TwistRun*> certified;
   for (const auto& [run, index] : finals) {
-    if (run.solve.termination != Termination::Infeasible) return false;
+    if (run.solve.termination != Termination::Infeasible) continue;
     const auto same = [&run = run](const TwistRun* o) {
       return o->homotopy.long_way == run.homotopy.long_way &&
              std::abs(std::remainder(o->start_twist - run.start_twist, 2.0 * M_PI)) <
                  kSameSurveyTwist;
     };
-    if (std::none_of(distinct.begin(), distinct.end(), same)) distinct.push_back(&run);
+    if (std::none_of(certified.begin(), certified.end(), same)) certified.push_back(&run);
   }
-  return distinct.size() >= static_cast<std::size_t>(kPointingStartTwists);
+  return certified.size() >= static_cast<std::size_t>(kPointingStartTwists);
 }
 
 /// Whether `optimum` (an unconstrained twist optimum on the requested grid) meets every node
@@ -663,7 +664,7 @@ void solveFromOptima(const PlanningProblem& problem, const std::vector<TwistRun>
                      std::vector<std::pair<TwistRun, std::size_t>>* finals, bool twist_optimal) {
   for (const TwistRun& start : starts) {
     if (!start.converged() || start.solve.cost >= *cheapest || context.stopReason()) return;
-    if (!finals->empty() && locallyInfeasibleFromEnoughStarts(*finals)) return;
+    if (!anyConverged(*finals) && locallyInfeasibleFromEnoughStarts(*finals)) return;
     TwistRun run = start;  // its way round, start twist and grid
     const int counted_before = context.iterations();
     if (twist_optimal && meetsEveryNodeConstraint(problem, start)) {

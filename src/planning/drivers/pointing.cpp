@@ -624,7 +624,7 @@ std::vector<TwistRun> fixedTwistOptima(const PlanningProblem& problem,
 /// round); runs that stopped otherwise certify nothing either way. Called where none converged:
 /// each start twist's fixed-twist constrained optimum (a whole fixed-attitude request per twist)
 /// is then not tried. On the seeded requests of seeds 41, 43 and 47 (72 with one binding
-/// constraint) those never gave the answer, and on the infeasible ones they took 3/4 of the
+/// constraint) those never gave the answer, and on the infeasible ones they took a third of the
 /// request's iterations. The verdict stays local to the starts tried.
 bool locallyInfeasibleFromEnoughStarts(
     const std::vector<std::pair<TwistRun, std::size_t>>& finals) {

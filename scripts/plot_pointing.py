@@ -147,11 +147,15 @@ request is one problem: the twist Newton's starts (4 twists x 2 ways round, the 
 seen) give the unconstrained twist optima, and the interior point with psi free starts from each
 distinct one, cheapest first, while its unconstrained cost is below the cheapest constrained
 answer found (constraints only add cost within a start's basin, and the interior point keeps the
-way round it starts in). Where none of those converges (a cone across the optimum's path): the
-same from each optimum the other way round at its psi and from the fixed-twist unconstrained
-optima at the 4 start twists (a path that passes the cone on one side); only where none of those
-converges either, each start twist from its fixed-twist constrained optimum (every way round
-solved under the constraints there) frees psi from that plan. The fixed solve it is timed
+way round it starts in); an optimum that meets every constraint is that basin's answer as it is.
+Where none of those converges (a cone across the optimum's path): the same from each optimum
+the other way round at its psi and from the fixed-twist unconstrained optima at the 4 start
+twists (a path that passes the cone on one side); only where none of those converges either, and
+the interior point has not certified local infeasibility from 4 distinct starts (then the loop
+stops: a local verdict), each start twist from its fixed-twist constrained optimum (every way
+round solved under the constraints there) frees psi from that plan. In both kinds a survey start
+whose Newton model's minimum lies on an answer the survey already holds (cost within 1e-3, psi
+within 1e-2 rad, relative decrement at most 0.1) is stopped there. The fixed solve it is timed
 against is one request's whole driver: the class survey, the interior point from the
 unconstrained optimum and, where that has no plan, the other classes under the constraints.
 

@@ -11,6 +11,9 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/newton/newton_parameters.hpp"
+#include "planning/newton/twist_newton.hpp"
+#include "planning/strategies/starts.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/perturbed_problem.hpp"
 #include "support/pointing_requests.hpp"
@@ -197,6 +200,47 @@ TEST(TwistUnknown, FixedEndProblemHasNoTwist) {
   const ReducedProblem rp(p);
   EXPECT_FALSE(rp.hasTwist());
   EXPECT_EQ(rp.twistMotion(p.steps), Vector3::Zero());
+}
+
+/// The twist Newton on `p` from the Hermite curve at ψ = 0 (R_N posed there), watched by `watch`.
+TwistSolve twistNewtonFromHermite(const PlanningProblem& p, const TwistWatch* watch) {
+  PlanningProblem at = p;
+  at.final_attitude = pointingAttitude(p.end_condition, 0.0);
+  ReducedProblem np(at);
+  startOnHermiteCurve(at, &np);
+  SolveContext context{SolverOptions()};
+  return solveTwistNewton(np, 0.0, context, 1e-10, 200, newtonDefaults(), nullptr, watch);
+}
+
+TEST(TwistUnknown, AWatchSeesTheModelsMinimumAndEndsTheSolveWhereItSaysSo) {
+  for (unsigned seed : {111u, 112u, 113u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const PlanningProblem p = randomPointingRequest(seed, 16, seed % 2 == 0, SchemeKind::Paper);
+    const TwistSolve plain = twistNewtonFromHermite(p, nullptr);
+    ASSERT_EQ(plain.termination, Termination::Converged) << plain.reason;
+    // A watch that never stops changes nothing; the model's minimum it is shown converges to the
+    // answer (cost and ψ) as the decrement falls.
+    double last_gap = INFINITY;
+    const TwistWatch silent = [&](double cost, double twist, double decrement) {
+      if (decrement < 1e-3) {
+        last_gap = std::max(std::abs(cost - plain.cost) / plain.cost,
+                            std::abs(std::remainder(twist - plain.twist, 2.0 * M_PI)));
+      }
+      return std::string();
+    };
+    const TwistSolve watched = twistNewtonFromHermite(p, &silent);
+    EXPECT_EQ(watched.termination, Termination::Converged);
+    EXPECT_EQ(watched.iterations, plain.iterations);
+    EXPECT_EQ(watched.cost, plain.cost);
+    EXPECT_LT(last_gap, 1e-5);
+    // A watch that stops when first asked (at the first unshifted step) ends the solve there, not
+    // converged, with its reason.
+    const TwistWatch stop = [](double, double, double) { return std::string("stopped"); };
+    const TwistSolve stopped = twistNewtonFromHermite(p, &stop);
+    EXPECT_EQ(stopped.termination, Termination::NotConverged);
+    EXPECT_EQ(stopped.reason, "stopped");
+    EXPECT_LT(stopped.iterations, plain.iterations);
+  }
 }
 
 TEST(PointingPlan, AtMostTheSweepsBestTwistOnSeededRandomRequests) {

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
@@ -131,8 +133,8 @@ PlanResult expectAtMostTheSweep(const PlanningProblem& p) {
 
 /// expectAtMostTheSweep, and the request solved as one problem: its trail holds the twist
 /// Newton's starts (every start twist each way round), unconstrained solves (their refinements,
-/// fixed-twist optima) and interior-point runs with ψ free from those optima, no fixed-twist
-/// interior point; the answer is the cheapest run.
+/// fixed-twist optima) and interior-point runs with ψ free from those optima (or an optimum that
+/// meets every constraint itself), no fixed-twist interior point; the answer is the cheapest run.
 void expectOneProblemAtMostTheSweep(const PlanningProblem& p) {
   const PlanResult r = expectAtMostTheSweep(p);
   EXPECT_EQ(r.pointing.starts, 2 * kPointingStartTwists);
@@ -146,7 +148,9 @@ void expectOneProblemAtMostTheSweep(const PlanningProblem& p) {
       continue;
     }
     EXPECT_EQ(a.start, AttemptStart::UnconstrainedOptimum);
-    EXPECT_NE(a.formulation, Formulation::Unconstrained);
+    // An interior-point run, or an unconstrained ψ optimum meeting every node constraint taken as
+    // it is (the constrained optimum of its basin: no iterations of its own).
+    if (a.formulation == Formulation::Unconstrained) EXPECT_EQ(a.iterations, 0);
     if (a.termination == Termination::Converged) cheapest = std::min(cheapest, a.cost);
     ++interior;
   }
@@ -182,4 +186,31 @@ TEST(ConstrainedPointingPlan, SpinningStartUnderAConeAtMostTheSweepsBest) {
 TEST(ConstrainedPointingPlan, SpinningStartUnderATorqueBoxAtMostTheSweepsBest) {
   expectOneProblemAtMostTheSweep(test_support::randomConstrainedPointingRequest(
       223, 32, true, SchemeKind::SecondOrder, PointingBinding::TorqueBox));
+}
+
+TEST(ConstrainedPointingPlan, LocalInfeasibilityCertifiedFromEnoughStartsEndsTheStartLoop) {
+  // A spinning start under a torque box with 0.8 of the generator's T: every interior point with
+  // ψ free ends with its certificate of local infeasibility. Once 4 distinct starts (twist, way
+  // round) hold one, the start twists' fixed-twist constrained optima (interior-point attempts of
+  // stage solve) are not run; the verdict is not converged or infeasible, never converged.
+  for (unsigned seed : {231u, 232u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    PlanningProblem p = test_support::randomConstrainedPointingRequest(
+        seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
+    p.duration *= 0.8;
+    const PlanResult r = planManeuver(p);
+    EXPECT_FALSE(r.converged()) << r.message;
+    std::set<std::pair<long, bool>> certified;
+    int fixed_twist_interior_points = 0;
+    for (const Attempt& a : r.attempts) {
+      if (a.stage == AttemptStage::Constrained && a.termination == Termination::Infeasible &&
+          std::isfinite(a.start_detail.twist)) {
+        certified.insert({std::lround(a.start_detail.twist * 1e4), a.homotopy.long_way});
+      }
+      const bool interior_point = a.formulation != Formulation::Unconstrained;
+      fixed_twist_interior_points += a.stage == AttemptStage::Solve && interior_point;
+    }
+    EXPECT_GE(certified.size(), std::size_t(kPointingStartTwists));
+    EXPECT_EQ(fixed_twist_interior_points, 0);
+  }
 }

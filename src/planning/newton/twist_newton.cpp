@@ -89,7 +89,7 @@ bool evaluateModel(const ReducedProblem& np, TwistModel* m, TwistSolve* out) {
 
 TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
                             double tolerance, int max_iterations, const NewtonParameters& p,
-                            std::vector<IterationInfo>* history) {
+                            std::vector<IterationInfo>* history, const TwistWatch* watch) {
   TwistSolve out;
   TwistModel m(np);
   Eigen::VectorXd step;
@@ -97,6 +97,7 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
   double shift = 0.0, best_decrement = INFINITY;
   double previous_full_step = 0.0;  ///< the last iteration's decrement if it was a full Newton step
   int stalled = 0;
+  std::string watched;  ///< why `watch` ended the solve (empty: it did not)
   while (evaluateModel(np, &m, &out) && out.iterations < max_iterations) {
     if (const auto stop = context.stopReason()) {
       out.termination = *stop;
@@ -115,6 +116,10 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
       // As grid_solve.cpp's StoppingTest: the last full step took d₋ to d, so this one leaves
       // about d³/d₋² (quadratic convergence): well inside the tolerance, this step is the last.
       const double d = out.relative_decrement;
+      if (watch && shift == 0.0) {
+        watched = (*watch)(m.cost + 0.5 * slope, twist + step(np.unknowns()), d);
+      }
+      if (!watched.empty()) break;
       const bool predicted = previous_full_step > 0.0 && d < previous_full_step &&
                              d * d * d / (previous_full_step * previous_full_step) <=
                                  p.final_step_prediction_margin * tolerance;
@@ -124,8 +129,8 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
       alpha = acceptStep(np, m, step, unjudged, p, &twist);
       if (alpha == 0.0) shift = shift == 0.0 ? p.first_rejection_shift : 10.0 * shift;
     }
-    if (alpha == 0.0) {
-      out.reason = "no step decreased the cost";
+    if (!watched.empty() || alpha == 0.0) {
+      out.reason = watched.empty() ? "no step decreased the cost" : watched;
       break;
     }
     ++out.iterations;

@@ -5,6 +5,9 @@
 // backtracking on the cost; stops on the relative Newton decrement as grid_solve.cpp does.
 #pragma once
 
+#include <functional>
+#include <string>
+
 #include "attitude_planner/planning/result.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
@@ -24,11 +27,17 @@ struct TwistSolve {
   double relative_decrement = 0.0;  ///< √(−gᵀΔ)/|τ|₂ of the last step
 };
 
+/// Asked before each unshifted Newton step with where the quadratic model puts the full step (its
+/// cost C + ½∇Cᵀ Δ and ψ + Δψ) and the step's relative decrement: a non-empty reason ends the solve
+/// there, not converged, with that reason.
+using TwistWatch =
+    std::function<std::string(double model_cost, double model_twist, double relative_decrement)>;
+
 /// Newton on (δ, ψ) from `np`'s iterate and `twist` (np built for R_N = pointingAttitude(twist));
 /// `np` ends at the last accepted iterate. Iterations are reported through `context`; a cancel or
-/// the deadline ends the solve with that termination.
+/// the deadline ends the solve with that termination, and so does `watch` (where given).
 TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
                             double tolerance, int max_iterations, const NewtonParameters& p,
-                            std::vector<IterationInfo>* history);
+                            std::vector<IterationInfo>* history, const TwistWatch* watch = nullptr);
 
 }  // namespace attitude_planner

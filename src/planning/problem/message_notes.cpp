@@ -305,8 +305,9 @@ std::string framed(const frames::PointingWalk& f, const std::string& reason) {
     brief << " (" << f.start_twists << " start twists x " << f.ways_round
           << " ways round unconstrained, each distinct optimum below the cheapest constrained "
              "answer starting the interior point with the twist free; where none converged, "
-             "each the other way round and the fixed-twist unconstrained optima; then each "
-             "twist's fixed-twist constrained optimum)";
+             "each the other way round and the fixed-twist unconstrained optima; then, unless "
+             "those were each certified locally infeasible from at least as many starts as "
+             "start twists, each twist's fixed-twist constrained optimum)";
   } else {
     brief << " (" << f.start_twists << " start twists x " << f.ways_round << " ways round)";
   }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -43,6 +44,7 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
       notes::UnconstrainedStart{1.5, "w", "at k = 3", 7},
       notes::AfterGuessStopped{"r"},
       notes::LastIterateDoesNotReplay{"r"},
+      notes::OpenLoopReplayParted{"r", 1e-12},
       notes::CheapestClass{"r"},
       notes::LastPointingStart{"r"},
       notes::FixedTwistFallback{0.5, "r"},
@@ -185,8 +187,11 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
             "not converged in the requested class: w (" + reason + ")");
   ap::PlanResult r;
   r.message = reason;
-  ap::frameMessage(&r, ap::frames::ReplayFailed{"e"});
-  EXPECT_EQ(r.message, "replay of the planned torques failed: e (" + reason + ")");
+  ap::frameMessage(&r, ap::frames::ReplayFailed{"e", 3, HUGE_VAL});
+  EXPECT_EQ(r.message,
+            "not converged: the plan's step k = 3 is not the step the replay solves from the "
+            "plan's own state there (no root found), and its torques replayed open-loop fail: e (" +
+                reason + ")");
 }
 
 TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {

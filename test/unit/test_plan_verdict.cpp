@@ -5,9 +5,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <random>
 
+#include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "planning/problem/verdict.hpp"
 #include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
@@ -41,7 +45,93 @@ PlanningProblem spinningShape(double time_scale, double inertia_scale, SchemeKin
   return p;
 }
 
+/// Seeded: a spin near the intermediate axis of a random anisotropic body, spun up over 40-60 s
+/// (unstable: its open-loop replay parts from the plan exponentially).
+PlanningProblem unstableSpin(std::mt19937_64* rng, SchemeKind scheme) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  PlanningProblem p;
+  p.inertia = Vector3(0.2 + 0.3 * u(*rng), 2.0 + u(*rng), 3.0 + 2.0 * u(*rng)).asDiagonal();
+  p.allow_nonphysical_inertia = true;
+  p.scheme = scheme;
+  p.duration = 40.0 + 20.0 * u(*rng);
+  p.steps = 400;
+  const double w = 1.0 + u(*rng);
+  p.initial_velocity = Vector3(0.0, w, 0.0);
+  p.final_velocity = Vector3(0.0, 3.0 * w, 0.1);
+  p.final_attitude = so3::exp(Vector3(0.3 * u(*rng), 1.0, 0.2));
+  return p;
+}
+
+/// The plan with its step k moved onto another root of the step's momentum map (the same
+/// momentum, far from the plan's step; found from the step's angle reflected about pi/2), the
+/// attitudes after it carried along. Empty where Newton finds no such root from there.
+std::optional<Maneuver> withStepOnAnotherRoot(const PlanningProblem& p, const Maneuver& plan,
+                                              int k) {
+  const DiscreteScheme scheme(p.scheme, p.inertia, plan.time_step);
+  const Matrix3 F = plan.attitude[k].transpose() * plan.attitude[k + 1];
+  const Vector3 phi = so3::log(F);
+  StepSolveReport report;
+  const Matrix3 other =
+      scheme.solveStep(scheme.momentum<double>(F),
+                       so3::exp(Vector3((M_PI - phi.norm()) * phi.normalized())), &report);
+  if (!report.converged || so3::angleBetween(other, F) < 0.1) return std::nullopt;
+  Maneuver moved = plan;
+  const Matrix3 turn = plan.attitude[k] * other * F.transpose() * plan.attitude[k].transpose();
+  for (int j = k + 1; j <= plan.steps(); ++j) moved.attitude[j] = turn * plan.attitude[j];
+  return moved;
+}
+
 }  // namespace
+
+TEST(PlanVerdict, AConvergedPlanWhoseOpenLoopReplayFailsIsJudgedByItsStepsReplayed) {
+  // Seeded unstable spins: the open-loop replay of a converged plan parts from it (round-off
+  // grows like e^{λt}) and may reach a step with no root: a sensitivity (replay_miss +inf, the
+  // verdict kept) where every step replayed from the plan's own state lands on the plan's step.
+  std::mt19937_64 rng(4547);
+  int parted = 0;
+  for (int i = 0; i < 3; ++i) {
+    const PlanningProblem p = unstableSpin(&rng, SchemeKind::Paper);
+    const PlanResult r = planManeuver(p);
+    SCOPED_TRACE("spin " + std::to_string(i) + ": " + r.message);
+    if (!r.converged()) continue;
+    const StepwiseReplay stepwise = replayStepByStep(p, r.maneuver);
+    EXPECT_TRUE(stepwise.reproduces())
+        << stepwise.worst_angle << " rad at k = " << stepwise.worst_step;
+    if (r.replay_miss > 1.0) ++parted;  // the open-loop replay ends a radian off
+    PlanResult judged = r;
+    judgeFailedReplay(p, "no implicit step", &judged);
+    EXPECT_EQ(judged.termination, Termination::Converged);
+    EXPECT_TRUE(std::isinf(judged.replay_miss));
+    EXPECT_TRUE(judged.maneuver.attitude == r.maneuver.attitude);
+  }
+  EXPECT_GE(parted, 2);  // the draw exercises the case (else the assertions say little)
+}
+
+TEST(PlanVerdict, AStepOnAnotherRootOfItsMomentumMapIsNotReplayedSoNotConverged) {
+  // The variational momentum map folds (sin θ): a step moved onto the other root of its own
+  // momentum still meets the step's kinematics, but the replay's solve from the plan's state
+  // does not land on it, so a converged plan with such a step whose open-loop replay fails is
+  // not converged (never step_too_large: the request's N was not the cause).
+  const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(replayStepByStep(p, r.maneuver).reproduces());
+  int moved_steps = 0;
+  for (int k : {1, p.steps / 2, p.steps - 2}) {
+    const std::optional<Maneuver> moved = withStepOnAnotherRoot(p, r.maneuver, k);
+    if (!moved) continue;
+    ++moved_steps;
+    const StepwiseReplay off = replayStepByStep(p, *moved);
+    EXPECT_FALSE(off.reproduces());
+    EXPECT_EQ(off.worst_step, k);
+    PlanResult judged = r;
+    judged.maneuver = *moved;
+    judgeFailedReplay(p, "no implicit step", &judged);
+    EXPECT_EQ(judged.termination, Termination::NotConverged);
+    EXPECT_TRUE(std::isinf(judged.replay_miss));
+  }
+  EXPECT_GE(moved_steps, 1);
+}
 
 TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {
   // Rates of ~3e9 rad/s: the absolute 1e-9 replay threshold refused this optimum before.

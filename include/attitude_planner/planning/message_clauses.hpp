@@ -71,6 +71,13 @@ struct AfterGuessStopped {
 struct LastIterateDoesNotReplay {
   std::string reason;  ///< the replay's failure
 };
+/// A converged plan that replays step by step from its own states (within `step_angle` rad)
+/// whose torques replayed open-loop parted from it until a step had no root (`what`): an
+/// unstable motion's sensitivity, replay_miss +inf.
+struct OpenLoopReplayParted {
+  std::string what;
+  double step_angle = 0.0;
+};
 /// A request with its class left free: another class under the constraints is cheaper.
 struct CheapestClass {
   std::string reason;  ///< the first class's (the unconstrained optimum's) message
@@ -167,12 +174,13 @@ using Note =
     std::variant<notes::FormulationRetry, notes::ReachedThroughMiddle, notes::GridContinuation,
                  notes::RetriedInTwoStages, notes::FromInitialGuess, notes::CoarserLevel,
                  notes::RefinedFromSurvey, notes::ConstraintsInactive, notes::UnconstrainedStart,
-                 notes::AfterGuessStopped, notes::LastIterateDoesNotReplay, notes::CheapestClass,
-                 notes::LastPointingStart, notes::FixedTwistFallback,
-                 notes::PointingRestartNotServed, notes::SearchSummary, notes::SearchedOnT,
-                 notes::SharpenedFromSearch, notes::PlannedAtMargin, notes::MinimumTimeRestart,
-                 notes::RestartEnded, notes::MinimumTimeUnsolved, notes::DescendedFromProbe,
-                 notes::PlanWithinBounds, notes::PointingTwist, notes::AccuracyReached>;
+                 notes::AfterGuessStopped, notes::LastIterateDoesNotReplay,
+                 notes::OpenLoopReplayParted, notes::CheapestClass, notes::LastPointingStart,
+                 notes::FixedTwistFallback, notes::PointingRestartNotServed, notes::SearchSummary,
+                 notes::SearchedOnT, notes::SharpenedFromSearch, notes::PlannedAtMargin,
+                 notes::MinimumTimeRestart, notes::RestartEnded, notes::MinimumTimeUnsolved,
+                 notes::DescendedFromProbe, notes::PlanWithinBounds, notes::PointingTwist,
+                 notes::AccuracyReached>;
 
 // The clauses that frame a message instead of following it: said before the reason they are
 // given (and around it), worded here as the notes are (renderFrame).
@@ -240,9 +248,13 @@ struct StuckAtMinimumTimePlan {
 struct OutsideRequestedClass {
   std::string why;
 };
-/// The replay of a converged plan's torques failed (`what`), around the plan's own message.
+/// The replay of a converged plan's torques failed (`what`), and its step `step` replayed from
+/// the plan's own state lands `angle` rad from the plan's (+inf: no root), around the plan's own
+/// message.
 struct ReplayFailed {
   std::string what;
+  int step = -1;
+  double angle = 0.0;
 };
 /// Minimum time to a pointing end: the start twists solved (none: no start was solved), each
 /// with its T* or its termination, and the one kept (-1: none); the reason it is given is the

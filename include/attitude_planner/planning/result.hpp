@@ -336,7 +336,8 @@ struct PlanResult {
   /// max(terminal_attitude_error, T·terminal_velocity_error) [rad]: how far the planned torques,
   /// replayed open-loop from R_0, Ω_0 through the same integrator, end from the target. A
   /// sensitivity of the maneuver (round-off grows like e^{λT} on unstable motions), reported,
-  /// never a reason to refuse an optimum.
+  /// never a reason to refuse an optimum; +inf where the replay parted so far that a step had no
+  /// root while every step replayed from the plan's own state lands on it (judgeFailedReplay).
   double replay_miss = 0.0;
   /// false: the open-loop replay was not run, so dynamics_residual, terminal_attitude_error,
   /// terminal_velocity_error and replay_miss are NaN (not measured). A plan stopped by its time

@@ -253,14 +253,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
     try {
       replayFigures(judged, &result);
     } catch (const StepTooLarge& e) {
-      // Only a converged plan's failed replay is the verdict; an iterate that is no answer
-      // (infeasible, stopped) keeps its own, with the replay's failure said after it.
-      if (result.converged()) {
-        result.termination = Termination::StepTooLarge;
-        frameMessage(&result, frames::ReplayFailed{e.what()});
-      } else {
-        addNote(&result, notes::LastIterateDoesNotReplay{e.what()});
-      }
+      judgeFailedReplay(judged, e.what(), &result);
     }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);

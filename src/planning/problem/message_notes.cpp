@@ -68,6 +68,14 @@ std::string words(const AfterGuessStopped& n) {
 std::string words(const LastIterateDoesNotReplay& n) {
   return "; its last iterate's torques do not replay: " + n.reason;
 }
+std::string words(const OpenLoopReplayParted& n) {
+  std::ostringstream s;
+  s << "; its torques replayed open-loop from R_0, Omega_0 part from it until a step has no root ("
+    << n.what << "): round-off grows along this unstable motion, so replay_miss is infinite (a "
+    << "sensitivity: a tracker needs feedback), while every step replayed from the plan's own "
+    << "state lands on its step (within " << n.step_angle << " rad)";
+  return s.str();
+}
 std::string words(const CheapestClass& n) {
   return "; the cheapest homotopy class under the constraints (after the unconstrained "
          "optimum's class: " +
@@ -229,7 +237,16 @@ std::string framed(const frames::OutsideRequestedClass& f, const std::string& re
   return "not converged in the requested class: " + f.why + " (" + reason + ")";
 }
 std::string framed(const frames::ReplayFailed& f, const std::string& reason) {
-  return "replay of the planned torques failed: " + f.what + " (" + reason + ")";
+  std::ostringstream s;
+  s << "not converged: the plan's step k = " << f.step
+    << " is not the step the replay solves from the plan's own state there (";
+  if (std::isfinite(f.angle)) {
+    s << f.angle << " rad apart: another root of the step's momentum map";
+  } else {
+    s << "no root found";
+  }
+  s << "), and its torques replayed open-loop fail: " << f.what << " (" << reason << ")";
+  return s.str();
 }
 std::string framed(const frames::PointingStarts& f, const std::string& reason) {
   if (f.starts.empty()) return "pointing: no start twist was solved";

@@ -12,6 +12,7 @@
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/verdict.hpp"
+#include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
 
@@ -20,6 +21,26 @@ double stepResidualTolerance(int steps, double step_angle) {
   const double floor = step_angle > 0 ? 16.0 * eps * (1.0 / step_angle + steps) : 0.0;
   return kStepResidualTolerance + floor;
 }
+
+namespace {
+
+/// What the body receives at node k of plan m: its control torque and the effects at (R_k, t_k).
+Vector3 appliedAt(const PlanningProblem& problem, const Maneuver& m, int k) {
+  Vector3 a = m.torque[k];
+  if (problem.effects) a += problem.effects->torque(m.attitude[k], k * m.time_step);
+  return a;
+}
+
+/// c_k: the momentum step k of plan m carries, from its reported velocity (full precision):
+/// paper exp(hΩ_k^) J Ω_k, variational J Ω_k; second_order Π_k + (h/2) a_k with Π_k = J Ω_k
+/// (a_0 enters only second_order's c_0).
+Vector3 carriedMomentum(const PlanningProblem& problem, const DiscreteScheme& scheme,
+                        const Maneuver& m, int k) {
+  if (!scheme.hasEndTorques()) return scheme.momentumOfVelocity(m.angular_velocity[k]);
+  return problem.inertia * m.angular_velocity[k] + 0.5 * m.time_step * appliedAt(problem, m, k);
+}
+
+}  // namespace
 
 StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver& m) {
   const int N = m.steps();
@@ -55,29 +76,19 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
   worst = std::max(worst, relative((m.angular_velocity[0] - problem.initial_velocity).norm(), W));
   worst = std::max(
       worst, relative((m.angular_velocity[last_velocity] - problem.final_velocity).norm(), W));
-  // a_k: what the body receives at node k (control and effects).
-  const auto applied = [&](int k) {
-    Vector3 a = m.torque[k];
-    if (problem.effects) a += problem.effects->torque(m.attitude[k], k * h);
-    return a;
-  };
+  const auto applied = [&](int k) { return appliedAt(problem, m, k); };
   // One pass over the steps (each F_k = R_kᵀR_{k+1} and c_k formed once, nothing of size N
   // allocated: at N = 1e5 this check is a fifth of a stopped solve's hand-over).
-  // c_k: the momentum step k carries, from the reported velocities (full precision): paper
-  // exp(hΩ_k^) J Ω_k, variational J Ω_k; second_order Π_k + (h/2) a_k with Π_k = J Ω_k. It must
-  // be F_k's own momentum, and c_k = F_{k−1}ᵀ c_{k−1} + h a_k (seed 000, eq. 18; second_order:
-  // both half impulses).
+  // c_k (carriedMomentum) must be F_k's own momentum, and c_k = F_{k−1}ᵀ c_{k−1} + h a_k (seed
+  // 000, eq. 18; second_order: both half impulses).
   Vector3 carried_prev = Vector3::Zero();
   Matrix3 F_prev = Matrix3::Identity();
   for (int k = 0; k < N; ++k) {
-    const bool impulse = nodes || k >= 1;  // a_0 only enters second_order's c_0
-    const Vector3 a = impulse ? applied(k) : Vector3::Zero();
-    const Vector3 carried = nodes ? Vector3(problem.inertia * m.angular_velocity[k] + 0.5 * h * a)
-                                  : scheme.momentumOfVelocity(m.angular_velocity[k]);
+    const Vector3 carried = carriedMomentum(problem, scheme, m, k);
     const Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
     worst = std::max(worst, relative((scheme.momentumOfStep(so3::log(F)) - carried).norm(), P));
     if (k >= 1) {
-      const Vector3 r = carried - F_prev.transpose() * carried_prev - h * a;
+      const Vector3 r = carried - F_prev.transpose() * carried_prev - h * applied(k);
       worst = std::max(worst, relative(r.norm(), P));
     }
     carried_prev = carried;
@@ -112,6 +123,46 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
     }
   }
   return "";
+}
+
+StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan) {
+  const int N = plan.steps();
+  const DiscreteScheme scheme(problem.scheme, problem.inertia, plan.time_step);
+  StepwiseReplay out;
+  // The open-loop replay's warm start for step k is its step k − 1 (F_0: exp(hΩ_0)).
+  Matrix3 guess = so3::exp(Vector3(plan.time_step * problem.initial_velocity));
+  for (int k = 0; k < N; ++k) {
+    const Matrix3 planned = plan.attitude[k].transpose() * plan.attitude[k + 1];
+    StepSolveReport report;
+    const Matrix3 F = scheme.solveStep(carriedMomentum(problem, scheme, plan, k), guess, &report);
+    const double apart =
+        report.converged ? so3::angleBetween(F, planned) : std::numeric_limits<double>::infinity();
+    if (!(apart <= out.worst_angle)) {
+      out.worst_angle = apart;
+      out.worst_step = k;
+    }
+    guess = planned;
+  }
+  return out;
+}
+
+void judgeFailedReplay(const PlanningProblem& problem, const std::string& what,
+                       PlanResult* result) {
+  if (!result->converged()) {
+    addNote(result, notes::LastIterateDoesNotReplay{what});
+    return;
+  }
+  const StepwiseReplay stepwise = replayStepByStep(problem, result->maneuver);
+  const double not_measured = std::numeric_limits<double>::quiet_NaN();
+  result->dynamics_residual = result->terminal_attitude_error = not_measured;
+  result->terminal_velocity_error = not_measured;
+  result->replay_miss = std::numeric_limits<double>::infinity();
+  if (stepwise.reproduces()) {
+    addNote(result, notes::OpenLoopReplayParted{what, stepwise.worst_angle});
+  } else {
+    result->termination = Termination::NotConverged;
+    frameMessage(result, frames::ReplayFailed{what, stepwise.worst_step, stepwise.worst_angle});
+  }
 }
 
 void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result) {

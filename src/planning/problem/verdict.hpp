@@ -2,6 +2,8 @@
 // one convergence rule beside each solver's own first-order test.
 #pragma once
 
+#include <string>
+
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 
@@ -39,6 +41,30 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
 /// turn shorter is in another class (e.g. the nearest one, after a solve labelled with extra
 /// turns slid back); within half a turn it counts as its class (see the definition).
 std::string classInconsistency(const PlanResult& result);
+
+/// A plan replayed step by step: each step k solved by the open-loop replay's own implicit-step
+/// solve (DiscreteScheme::solveStep) from the plan's state, the momentum c_k it carries and, as
+/// the replay warm-starts, the plan's step k − 1. A consistent plan (measureStepResidual) has
+/// each F_k a root of its momentum map; this says whether it is the root the replay finds: a
+/// step on another root (past a fold) lands O(1) rad away, a consistent one within round-off
+/// of its step residual. Unlike the open-loop replay, round-off does not grow along the plan.
+struct StepwiseReplay {
+  double worst_angle = 0.0;  ///< max_k ∠(F_k solved, F_k planned) [rad]; +inf: no root found
+  int worst_step = -1;       ///< its k (−1: no step)
+  /// Every step lands on the plan's own (1e-6 rad: far above a consistent plan's round-off,
+  /// far below another root's distance).
+  bool reproduces() const { return worst_angle <= 1e-6; }
+};
+StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan);
+
+/// The open-loop replay of the plan's torques found no implicit step (`what`). An iterate that
+/// is no answer (infeasible, stopped) keeps its verdict, the failure said after it. A converged
+/// plan whose every step the replay's solve reproduces from the plan's own state
+/// (replayStepByStep) is a plan: the open-loop replay has parted from it (round-off grows along
+/// an unstable motion until a step has no root), a sensitivity, so replay_miss is +inf and the
+/// verdict stands. One with a step the replay does not reproduce is not converged (never the
+/// user's step count: the request's own N holds a consistent plan).
+void judgeFailedReplay(const PlanningProblem& problem, const std::string& what, PlanResult* result);
 
 /// Sets the terminal errors of an open-loop replay and replay_miss, the larger of the attitude
 /// miss and T × the velocity miss (one rule for every scheme's replay).

@@ -125,49 +125,37 @@ template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  const std::vector<FixedStepRows*> torque_groups = rows_.stencilGroups();
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
   const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
   const auto weights = [&](int k, const Vector3& residual) {
     const double r = root(k);
-    const Vector3 tau = residual / r;
-    Vector3 w = residual;
-    double beta = 1.0;
-    for (FixedStepRows* g : torque_groups) {
-      FixedStepRow& in = g->instance(k);
-      in.c = g->constraint->value(tau);
-      if (H) form_->prepare(in, mu, rho, primal);
-      w -= (in.z / r) * g->constraint->gradient(tau);
-      beta -= in.z * g->constraint->curvature() / (r * r);
-    }
-    beta_k = beta;
-    return w;
+    beta_k = 1.0;
+    return contractTorqueRows(rows_.groups, rows_.stencil, k, residual, r, residual,
+                              [&](const FixedStepRows& g, FixedStepRow& in) {
+                                form_->prepare(in, mu, rho, primal);  // called with H only
+                                beta_k -= in.z * g.constraint->curvature() / (r * r);
+                              });
   };
   const auto visit = [&](const ReducedProblem::Stencil& st) {
     pollEvery(st.k);
     jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
     torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
     const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
-    const double r = root(st.k);
-    const Vector3 tau = st.tau / r;
-    for (FixedStepRows* g : torque_groups) {
-      g->instance(st.k).g = st.jacobian.transpose() * (g->constraint->gradient(tau) / r);
-    }
-    if (H) {
-      // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
-      // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
-      Vector3 weight = Vector3::Constant(beta_k);
-      for (FixedStepRows* g : torque_groups) {
-        const FixedStepRow& in = g->instance(st.k);
-        const int a = g->constraint->axis();
-        if (a < 0) {
-          addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
-        } else {
-          const double slope = g->constraint->gradient(tau)(a) / r;
-          weight(a) += slope * slope / in.D;
-        }
+    // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
+    // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
+    Vector3 weight = Vector3::Constant(beta_k);
+    const auto fold = [&](const FixedStepRows& g, const FixedStepRow& in, const Vector3& a) {
+      if (!H) return;
+      const int axis = g.constraint->axis();
+      if (axis < 0) {
+        addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
+      } else {
+        weight(axis) += a(axis) * a(axis) / in.D;
       }
+    };
+    chainTorqueRows(rows_.groups, rows_.stencil, st.k, st.tau, root(st.k), st.jacobian, fold);
+    if (H) {
       for (int a = 0; a < 3; ++a) {
         addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, st.jacobian.row(a).transpose(),
                         weight(a));
@@ -179,7 +167,7 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
   };
   out->cost =
       np_.forEachStencil(H != nullptr, visit,
-                         torque_groups.empty() ? ReducedProblem::SecondOrderWeights()
+                         rows_.stencil.empty() ? ReducedProblem::SecondOrderWeights()
                                                : ReducedProblem::SecondOrderWeights(weights));
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }

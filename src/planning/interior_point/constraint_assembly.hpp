@@ -9,7 +9,9 @@
 //     −Σ z_i ∇²c_i = λ·∇²q − Σ z_i c_i'' ∇qᵀ∇q        (c_i'' the constraint's isotropic curvature).
 // What each assembler does with a row afterwards (its barrier form's g gᵀ weight, the band's
 // precision, the border) stays its own. The torque constraints ride in the cost's stencil pass
-// instead (formedByCostStencil), where their weights fold into the cost's Gauss–Newton terms.
+// instead (formedByCostStencil): the same chain rule in the residual's space ρ = √w τ
+// (contractTorqueRows, chainTorqueRows), their part of λ added to the cost's second-order weights;
+// how each assembler folds their curvature and barrier terms stays its own.
 #pragma once
 
 #include <vector>
@@ -61,12 +63,6 @@ struct ConstraintRowSet {
   void forEachValue(const QuantityInputs& at, F&& f) const {
     visit(*this, [&](const Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
   }
-  std::vector<Rows*> stencilGroups() {
-    std::vector<Rows*> out;
-    for (const int i : stencil) out.push_back(&groups[i]);
-    return out;
-  }
-
   std::vector<Rows> groups;
   std::vector<int> stencil;              ///< the groups on the cost's stencil (the torques)
   std::vector<std::vector<int>> blocks;  ///< the other groups by quantity (indices into groups)
@@ -153,6 +149,41 @@ void chainQuantityRows(std::vector<ConstraintRows<Entries>>& groups, const std::
     if (curvature && c.curvature() != 0.0) {
       *curvature -= (in.z * c.curvature()) * t.jacobian.transpose() * t.jacobian;
     }
+  }
+}
+
+/// The torque rows of `block` (indices into groups) at stencil k, whose residual is ρ = √w τ
+/// (`root` = √w, w the cost's weight of τ_k): each row's value c(τ), then row(group, row) (the
+/// assembler's: its barrier form's preparation, fixed h's c''); returns `weights` − Σ (z/√w) c'(τ),
+/// the stencil's second-order weights (`weights` on entry the cost's own: ρ, or ε ρ).
+template <int Entries, typename Row>
+Vector3 contractTorqueRows(std::vector<ConstraintRows<Entries>>& groups,
+                           const std::vector<int>& block, int k, const Vector3& residual,
+                           double root, Vector3 weights, const Row& row) {
+  const Vector3 tau = residual / root;
+  for (const int i : block) {
+    ConstraintRow<Entries>& in = groups[i].instance(k);
+    in.c = groups[i].constraint->value(tau);
+    row(groups[i], in);
+    weights -= (in.z / root) * groups[i].constraint->gradient(tau);
+  }
+  return weights;
+}
+
+/// The torque rows' gradients at stencil k: with a = c'(τ)/√w = ∂c/∂ρ, g = Gᵀa (G = ∂ρ/∂x over
+/// the stencil's entries: 9, or 10 with η), then fold(group, row, a): how the assembler adds the
+/// row's curvature and barrier term (fixed h folds a box side's into its axis's Gauss–Newton
+/// weight, free time every row's into one 3×3 weight of Gᵀ W G).
+template <int Entries, typename Fold>
+void chainTorqueRows(std::vector<ConstraintRows<Entries>>& groups, const std::vector<int>& block,
+                     int k, const Vector3& residual, double root,
+                     const Eigen::Matrix<double, 3, Entries>& G, const Fold& fold) {
+  const Vector3 tau = residual / root;
+  for (const int i : block) {
+    ConstraintRow<Entries>& in = groups[i].instance(k);
+    const Vector3 a = groups[i].constraint->gradient(tau) / root;
+    in.g = G.transpose() * a;
+    fold(groups[i], in, a);
   }
 }
 

@@ -384,22 +384,17 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
-  const std::vector<FreeTimeRows*> torque_groups = rows_.stencilGroups();
   const auto weights = [&](int k, const Vector3& r) {
-    // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
-    const double s = torqueScale(k);
-    Vector3 w = epsilon * r;
-    for (FreeTimeRows* g : torque_groups) {
-      w -= (g->instance(k).z / s) * g->constraint->gradient(r / s);
-    }
-    return w;
+    // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
+    // rows are prepared in the visit, after z entered w).
+    return contractTorqueRows(rows_.groups, rows_.stencil, k, r, torqueScale(k),
+                              Vector3(epsilon * r), [](const FreeTimeRows&, FreeTimeRow&) {});
   };
   const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
   np_.forEachStencilWithTimeStep(
       [&](const ReducedProblem::TimeStepStencil& st) {
         if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
         const double s = torqueScale(st.k);
-        const Vector3 tau = st.tau / s;
         Eigen::Matrix<double, 3, 10> G;  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
         G.leftCols<9>() = st.jacobian;
         G.col(9) = st.tau_h * h0_;
@@ -410,22 +405,19 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
         H(9, 9) = st.second_hh * h0_ * h0_;
         // The torque's 3×3 weight W, so that the stencil's block is H + Gᵀ W G: Gauss–Newton's
         // ε of the effort and −z c''/w_k of the constraints' isotropic curvature, and the
-        // barrier's (z/c) a aᵀ of each bound, a = ∂c/∂r (one product instead of one per bound).
+        // barrier's ω a aᵀ of each bound, a = ∂c/∂r (one product instead of one per bound).
         Matrix3 W = epsilon * Matrix3::Identity();
         Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
         Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-        for (FreeTimeRows* g : torque_groups) {
-          FreeTimeRow& in = g->instance(st.k);
-          in.c = g->constraint->value(tau);
-          prepareRow(*g, in, mu);
-          const RowTerms row = rowTerms(*g, in, mu);
-          const Vector3 a = g->constraint->gradient(tau) / s;
-          in.g = G.transpose() * a;
-          W.diagonal().array() -= in.z * g->constraint->curvature() / (s * s);
+        const auto fold = [&](const FreeTimeRows& g, FreeTimeRow& in, const Vector3& a) {
+          prepareRow(g, in, mu);
+          const RowTerms row = rowTerms(g, in, mu);
+          W.diagonal().array() -= in.z * g.constraint->curvature() / (s * s);
           W.noalias() += row.weight * a * a.transpose();
           rhs += row.rhs * in.g;
           lagrangian -= in.z * in.g;
-        }
+        };
+        chainTorqueRows(rows_.groups, rows_.stencil, st.k, st.tau, s, G, fold);
         H.noalias() += G.transpose() * W * G;
         scatter(st.k - 1, 3, H, rhs, lagrangian);
       },

@@ -20,11 +20,11 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
-#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 #include "support/quantity_differences.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
@@ -429,7 +429,7 @@ double rowValue(const ap::ConstraintRows<Entries>& g, const ap::ReducedProblem& 
 
 }  // namespace
 
-/// The chain rule both interior points call (interior_point/constraint_assembly.hpp), on the rows
+/// The chain rule both interior points call (transcription/stage_transcription.hpp), on the rows
 /// of every quantity object's constraints with seeded random multipliers: each row's gradient
 /// along a direction, and the Lagrangian's curvature −Σ z∇²c along it (the torque's norm bound
 /// carries the c'' term), against central differences of the rows' values.
@@ -521,8 +521,8 @@ TEST(StageConstraints, TheTorqueRowsChainRuleMatchesCentralDifferencesOfTheRows)
       isotropic = 0.0;
       return ap::contractTorqueRows(
           rows.groups, torque, k, residual, root(k), ap::Vector3::Zero().eval(),
-          [&](const ap::FixedStepRows& g, ap::FixedStepRow& in) {
-            isotropic += in.z * g.constraint->curvature() / (root(k) * root(k));
+          [&](const ap::FixedStepRows& g, ap::FixedStepRow& in, double r) {
+            isotropic += in.z * g.constraint->curvature() / (r * r);
           });
     };
     int stencils = 0;

@@ -127,17 +127,15 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
-  const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
-  const auto weights = [&](int k, const Vector3& residual) {
-    const double r = root(k);
+  const auto cost = [&](int, const Vector3& residual) {
     beta_k = 1.0;
-    return contractTorqueRows(rows_.groups, rows_.stencil, k, residual, r, residual,
-                              [&](const FixedStepRows& g, FixedStepRow& in) {
-                                form_->prepare(in, mu, rho, primal);  // called with H only
-                                beta_k -= in.z * g.constraint->curvature() / (r * r);
-                              });
+    return residual;
   };
-  const auto visit = [&](const ReducedProblem::Stencil& st) {
+  const auto row = [&](const FixedStepRows& g, FixedStepRow& in, double r) {
+    form_->prepare(in, mu, rho, primal);  // the weights are formed with H only
+    beta_k -= in.z * g.constraint->curvature() / (r * r);
+  };
+  const auto visit = [&](const ReducedProblem::Stencil& st, double r) {
     pollEvery(st.k);
     jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
     torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
@@ -154,7 +152,7 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
         weight(axis) += a(axis) * a(axis) / in.D;
       }
     };
-    chainTorqueRows(rows_.groups, rows_.stencil, st.k, st.tau, root(st.k), st.jacobian, fold);
+    rows_.chainTorques(st, r, st.jacobian, fold);
     if (H) {
       for (int a = 0; a < 3; ++a) {
         addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, st.jacobian.row(a).transpose(),
@@ -165,40 +163,30 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
     addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
   };
-  out->cost =
-      np_.forEachStencil(H != nullptr, visit,
-                         rows_.stencil.empty() ? ReducedProblem::SecondOrderWeights()
-                                               : ReducedProblem::SecondOrderWeights(weights));
+  out->cost = rows_.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
 /// The groups of one quantity (a rate, a cone, a wheel quantity) through the quantity's terms and
-/// the chain rule (constraint_assembly.hpp), with each constraint's barrier term g gᵀ/D.
+/// the chain rule (StageTranscription), with each constraint's barrier term g gᵀ/D.
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, BandedSymmetric<Scalar>* H) {
-  std::vector<FixedStepRows>& groups = rows_.groups;
-  const FixedStepRows& first = groups[block.front()];
-  const StageSupport support = first.support;
+  const StageSupport support = rows_.groups[block.front()].support;
   const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
     if (H) form_->prepare(in, mu, rho, primal);
   };
-  const auto contract = [&](int k, const Vector3& q) {
-    pollEvery(k);
-    return contractQuantityRows(groups, block, k, q, prepare);
-  };
-  const auto visit = [&](const QuantityTerms& t) {
-    const int node = t.k + support.node_offset;
-    Eigen::Matrix<double, 9, 9> curvature;
-    chainQuantityRows(groups, block, t, H ? &curvature : nullptr);
+  const auto visit = [&](const QuantityTerms& t, const Eigen::Matrix<double, 9, 9>* curvature) {
     if (!H) return;
-    addLocal(np_, H, twistSink(), node, support.width, curvature);
+    const int node = t.k + support.node_offset;
+    addLocal(np_, H, twistSink(), node, support.width, *curvature);
     for (const int i : block) {
-      const FixedStepRow& in = groups[i].instance(t.k);
+      const FixedStepRow& in = rows_.groups[i].instance(t.k);
       addLocalRankOne(np_, H, twistSink(), node, support.width, in.g, 1.0 / in.D);
     }
   };
-  first.quantity->forEachTerms(np_, support, contract, visit);
+  rows_.forEachQuantityInstance(
+      np_, FixedTimeStep{}, block, H != nullptr, [&](int k) { pollEvery(k); }, prepare, visit);
 }
 
 /// ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is the slack step's

@@ -20,11 +20,11 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
-#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 #include "support/quantity_differences.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
@@ -429,7 +429,7 @@ double rowValue(const ap::ConstraintRows<Entries>& g, const ap::ReducedProblem& 
 
 }  // namespace
 
-/// The chain rule both interior points call (interior_point/constraint_assembly.hpp), on the rows
+/// The chain rule both interior points call (transcription/stage_transcription.hpp), on the rows
 /// of every quantity object's constraints with seeded random multipliers: each row's gradient
 /// along a direction, and the Lagrangian's curvature −Σ z∇²c along it (the torque's norm bound
 /// carries the c'' term), against central differences of the rows' values.
@@ -483,6 +483,79 @@ TEST(StageConstraints, TheInteriorPointsChainRuleMatchesCentralDifferencesOfTheR
     }
     EXPECT_EQ(rows.blocks.size(), 4u) << "torque, rate and two cones";
     EXPECT_EQ(instances, expected) << "every quantity's instances were visited";
+  }
+}
+
+/// The torque rows' chain rule both interior points call in the cost's stencil pass
+/// (contractTorqueRows for the stencil's weights, chainTorqueRows for the gradients), with seeded
+/// random multipliers and no cost: each row's gradient along a direction, and −Σ z∇²c along it —
+/// the stencil's `second` at those weights plus the rows' c'' term −Σ z c''/w |J d|² (the norm
+/// bound carries one) — against central differences of the rows' values, on every scheme (second
+/// order's end nodes have w ≠ 1).
+TEST(StageConstraints, TheTorqueRowsChainRuleMatchesCentralDifferencesOfTheRows) {
+  for (const ap::SchemeKind scheme :
+       {ap::SchemeKind::Paper, ap::SchemeKind::Variational, ap::SchemeKind::SecondOrder}) {
+    const ap::PlanningProblem p = everyKind(scheme);
+    const ap::StageConstraints list = ap::buildStageConstraints(p);
+    const ap::ReducedProblem np = perturbed(p, 11);
+    RowsByQuantity<9> rows(list, np, 41);
+    std::vector<int> torque;
+    for (int i = 0; i < static_cast<int>(rows.groups.size()); ++i) {
+      if (rows.groups[i].quantity->formedByCostStencil()) torque.push_back(i);
+    }
+    ASSERT_EQ(torque.size(), 7u) << "the box's six sides and the norm bound";
+    std::mt19937 rng(43);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(np.unknowns());
+    for (int i = 0; i < d.size(); ++i) d(i) = normal(rng);
+    const double e = 1e-6, e2 = 1e-4;
+    const auto moved = [&](double alpha) {
+      ap::ReducedProblem out = np;
+      out.setCurrent(np.retract(d, alpha));
+      return out;
+    };
+    const ap::ReducedProblem up = moved(e), down = moved(-e), up2 = moved(e2), down2 = moved(-e2);
+    const auto root = [&](int k) { return std::sqrt(np.scheme().torqueWeight(k, p.steps)); };
+    double isotropic = 0.0;  // Σ z c''/w of the stencil the weights were formed for
+    const auto weights = [&](int k, const ap::Vector3& residual) {
+      isotropic = 0.0;
+      return ap::contractTorqueRows(
+          rows.groups, torque, k, residual, root(k), ap::Vector3::Zero().eval(),
+          [&](const ap::FixedStepRows& g, ap::FixedStepRow& in, double r) {
+            isotropic += in.z * g.constraint->curvature() / (r * r);
+          });
+    };
+    int stencils = 0;
+    np.forEachStencil(
+        true,
+        [&](const ap::ReducedProblem::Stencil& st) {
+          ap::chainTorqueRows(rows.groups, torque, st.k, st.tau, root(st.k), st.jacobian,
+                              [](const auto&, const auto&, const ap::Vector3&) {});
+          Eigen::Matrix<double, 9, 1> local = Eigen::Matrix<double, 9, 1>::Zero();
+          for (int n = 0; n < 3; ++n) {
+            const int v = np.variableIndex(st.k - 1 + n);
+            if (v >= 0) local.segment<3>(3 * n) = d.segment<3>(v);
+          }
+          double fd2 = 0.0;  // −Σ z c along d, second difference
+          for (const int i : torque) {
+            const ap::FixedStepRows& g = rows.groups[i];
+            const std::string where = g.constraint->describe() + " k = " + std::to_string(st.k);
+            const ap::FixedStepRow& in = g.instance(st.k);
+            const double c0 = rowValue(g, np, st.k);
+            EXPECT_NEAR(in.c, c0, 1e-12 * (1 + std::abs(c0))) << where;
+            const double fd = (rowValue(g, up, st.k) - rowValue(g, down, st.k)) / (2 * e);
+            EXPECT_NEAR(in.g.dot(local), fd, 1e-6 * (1 + std::abs(fd))) << where;
+            fd2 -= in.z * (rowValue(g, up2, st.k) - 2 * c0 + rowValue(g, down2, st.k)) / (e2 * e2);
+          }
+          const double second = local.dot(st.second.selfadjointView<Eigen::Lower>() * local) -
+                                isotropic * (st.jacobian * local).squaredNorm();
+          EXPECT_NEAR(second, fd2, 1e-5 * (1 + std::abs(fd2)))
+              << ap::schemeName(scheme) << " k = " << st.k;
+          ++stencils;
+        },
+        weights);
+    const ap::StageSupport& support = rows.groups[torque.front()].support;
+    EXPECT_EQ(stencils, support.last_k - support.first_k + 1) << "every torque instance visited";
   }
 }
 

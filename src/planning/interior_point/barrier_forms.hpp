@@ -18,44 +18,9 @@
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "planning/transcription/stage_quantities.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 
 namespace attitude_planner {
-
-/// One row c ≥ 0 of the interior point (one instance of a stage constraint): value c, gradient g
-/// over its local nodes (at most three: 9 entries) and, with a global unknown, η (Entries = 10,
-/// entry 9), multiplier z, and what its barrier form keeps.
-template <int Entries>
-struct ConstraintRow {
-  double c = 0.0;  ///< value (dimensionless)
-  Eigen::Matrix<double, Entries, 1> g = Eigen::Matrix<double, Entries, 1>::Zero();  ///< ∂c/∂x
-  double z = 0.0;                                                                   ///< multiplier
-  // FreeSlacks, L1Elastic:
-  double s = 0.0, v = 0.0;  ///< slacks (L1Elastic: elasticSlacks of c; FreeSlacks: s free)
-  double D = 1.0, q = 0.0;  ///< condensation terms
-  double ds = 0.0;          ///< FreeSlacks: the slack's Newton step
-  // Feasible:
-  double dz = 0.0;  ///< the multiplier's step
-  /// The second-order correction's curvature term c(x + d) − c − gᵀd at the rejected full step
-  /// (0 when the step taken is not a corrected one).
-  double r = 0.0;
-};
-
-/// The rows of one stage constraint on its quantity's support (stage_quantities.hpp).
-template <int Entries>
-struct ConstraintRows {
-  ConstraintRows(const StageConstraint& c, int first_free_node, int last_free_node)
-      : constraint(&c),
-        quantity(&c.quantityModel()),
-        support(quantity->support(first_free_node, last_free_node)),
-        at(support.last_k - support.first_k + 1) {}
-  ConstraintRow<Entries>& instance(int k) { return at[k - support.first_k]; }
-  const ConstraintRow<Entries>& instance(int k) const { return at[k - support.first_k]; }
-
-  const StageConstraint* constraint;
-  const StageQuantityModel* quantity;  ///< &constraint->quantityModel()
-  StageSupport support;
-  std::vector<ConstraintRow<Entries>> at;  ///< at[k − support.first_k]
-};
 
 /// What a barrier rule (barrier_update.hpp) reads of the barrier problem's rows, and Mehrotra's
 /// corrector sets: a view the problem implements (ConstrainedSystem at fixed h), so that the rules
@@ -77,10 +42,6 @@ class BarrierRows {
   /// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z).
   virtual void complementarity(double mu, double rho, double* average, double* smallest) const = 0;
 };
-
-/// The fixed-h interior point's rows (the node unknowns only).
-using FixedStepRow = ConstraintRow<9>;
-using FixedStepRows = ConstraintRows<9>;
 
 /// The ℓ1-elastic row c + v − s = 0 at its value c: the slacks s, v (elasticSlacks), the
 /// multiplier z (the primal μ/s, or κ_Σ-safeguarded and kept below ρ so that u = ρ − z > 0) and
@@ -153,10 +114,6 @@ class L1Elastic final : public SlackForm {
 
 std::unique_ptr<SlackForm> makeSlackForm(Formulation formulation,
                                          const InteriorPointParameters& parameters);
-
-/// The free-time interior point's rows (the node unknowns and η).
-using FreeTimeRow = ConstraintRow<10>;
-using FreeTimeRows = ConstraintRows<10>;
 
 /// −μ Σ ln c with every iterate strictly inside (free time). A scalar barrier unknown (the elastic
 /// start's θ ≥ 0) is one more such row with c = θ: the same functions on (z, c).

@@ -125,49 +125,35 @@ template <typename Scalar>
 void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
                                         BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
                                         Eigen::VectorXd* merit_gradient, Assembly* out) {
-  const std::vector<FixedStepRows*> torque_groups = rows_.stencilGroups();
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
-  const auto root = [&](int k) { return std::sqrt(np_.scheme().torqueWeight(k, np_.steps())); };
-  const auto weights = [&](int k, const Vector3& residual) {
-    const double r = root(k);
-    const Vector3 tau = residual / r;
-    Vector3 w = residual;
-    double beta = 1.0;
-    for (FixedStepRows* g : torque_groups) {
-      FixedStepRow& in = g->instance(k);
-      in.c = g->constraint->value(tau);
-      if (H) form_->prepare(in, mu, rho, primal);
-      w -= (in.z / r) * g->constraint->gradient(tau);
-      beta -= in.z * g->constraint->curvature() / (r * r);
-    }
-    beta_k = beta;
-    return w;
+  const auto cost = [&](int, const Vector3& residual) {
+    beta_k = 1.0;
+    return residual;
   };
-  const auto visit = [&](const ReducedProblem::Stencil& st) {
+  const auto row = [&](const FixedStepRows& g, FixedStepRow& in, double r) {
+    form_->prepare(in, mu, rho, primal);  // the weights are formed with H only
+    beta_k -= in.z * g.constraint->curvature() / (r * r);
+  };
+  const auto visit = [&](const ReducedProblem::Stencil& st, double r) {
     pollEvery(st.k);
     jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
     torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
     const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
-    const double r = root(st.k);
-    const Vector3 tau = st.tau / r;
-    for (FixedStepRows* g : torque_groups) {
-      g->instance(st.k).g = st.jacobian.transpose() * (g->constraint->gradient(tau) / r);
-    }
-    if (H) {
-      // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
-      // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
-      Vector3 weight = Vector3::Constant(beta_k);
-      for (FixedStepRows* g : torque_groups) {
-        const FixedStepRow& in = g->instance(st.k);
-        const int a = g->constraint->axis();
-        if (a < 0) {
-          addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
-        } else {
-          const double slope = g->constraint->gradient(tau)(a) / r;
-          weight(a) += slope * slope / in.D;
-        }
+    // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
+    // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
+    Vector3 weight = Vector3::Constant(beta_k);
+    const auto fold = [&](const FixedStepRows& g, const FixedStepRow& in, const Vector3& a) {
+      if (!H) return;
+      const int axis = g.constraint->axis();
+      if (axis < 0) {
+        addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
+      } else {
+        weight(axis) += a(axis) * a(axis) / in.D;
       }
+    };
+    rows_.chainTorques(st, r, st.jacobian, fold);
+    if (H) {
       for (int a = 0; a < 3; ++a) {
         addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, st.jacobian.row(a).transpose(),
                         weight(a));
@@ -177,40 +163,30 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
     addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
     addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
   };
-  out->cost =
-      np_.forEachStencil(H != nullptr, visit,
-                         torque_groups.empty() ? ReducedProblem::SecondOrderWeights()
-                                               : ReducedProblem::SecondOrderWeights(weights));
+  out->cost = rows_.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
 /// The groups of one quantity (a rate, a cone, a wheel quantity) through the quantity's terms and
-/// the chain rule (constraint_assembly.hpp), with each constraint's barrier term g gᵀ/D.
+/// the chain rule (StageTranscription), with each constraint's barrier term g gᵀ/D.
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, BandedSymmetric<Scalar>* H) {
-  std::vector<FixedStepRows>& groups = rows_.groups;
-  const FixedStepRows& first = groups[block.front()];
-  const StageSupport support = first.support;
+  const StageSupport support = rows_.groups[block.front()].support;
   const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
     if (H) form_->prepare(in, mu, rho, primal);
   };
-  const auto contract = [&](int k, const Vector3& q) {
-    pollEvery(k);
-    return contractQuantityRows(groups, block, k, q, prepare);
-  };
-  const auto visit = [&](const QuantityTerms& t) {
-    const int node = t.k + support.node_offset;
-    Eigen::Matrix<double, 9, 9> curvature;
-    chainQuantityRows(groups, block, t, H ? &curvature : nullptr);
+  const auto visit = [&](const QuantityTerms& t, const Eigen::Matrix<double, 9, 9>* curvature) {
     if (!H) return;
-    addLocal(np_, H, twistSink(), node, support.width, curvature);
+    const int node = t.k + support.node_offset;
+    addLocal(np_, H, twistSink(), node, support.width, *curvature);
     for (const int i : block) {
-      const FixedStepRow& in = groups[i].instance(t.k);
+      const FixedStepRow& in = rows_.groups[i].instance(t.k);
       addLocalRankOne(np_, H, twistSink(), node, support.width, in.g, 1.0 / in.D);
     }
   };
-  first.quantity->forEachTerms(np_, support, contract, visit);
+  rows_.forEachQuantityInstance(
+      np_, FixedTimeStep{}, block, H != nullptr, [&](int k) { pollEvery(k); }, prepare, visit);
 }
 
 /// ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is the slack step's

@@ -13,7 +13,6 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
-#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"
@@ -145,9 +144,9 @@ class ConstrainedSystem final : public BarrierRows {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  std::unique_ptr<SlackForm> form_;  ///< FreeSlacks or L1Elastic: how a row enters φ_μ
-  StageConstraints constraints_;     ///< buildStageConstraints(problem): one group each
-  ConstraintRowSet<9> rows_;
+  std::unique_ptr<SlackForm> form_;         ///< FreeSlacks or L1Elastic: how a row enters φ_μ
+  StageConstraints constraints_;            ///< buildStageConstraints(problem): one group each
+  StageTranscription<FixedTimeStep> rows_;  ///< the rows and their passes over the grid
   const Interruption* interruption_ = nullptr;
   TwistBorder twist_border_;
   double twist_gradient_ = 0.0, twist_stationarity_ = 0.0;

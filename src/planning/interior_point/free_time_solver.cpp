@@ -50,7 +50,6 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_update.hpp"
-#include "planning/interior_point/constraint_assembly.hpp"
 #include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
@@ -184,7 +183,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void disallowElastic() { allow_elastic_ = false; }
 
  private:
-  double torqueScale(int k) const { return std::sqrt(torqueWeight(k)); }
   double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
   /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
   bool hasTorqueBox() const {
@@ -339,7 +337,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  ConstraintRowSet<10> rows_;
+  StageTranscription<FreeTimeStep> rows_;  ///< the rows and their passes over the grid (η)
   Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
@@ -384,52 +382,35 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   kkt_.corner.setZero(b, b);
   rhs_.setZero(n_ + b);
   lagrangian_gradient_.setZero(n_ + b);
-  const std::vector<FreeTimeRows*> torque_groups = rows_.stencilGroups();
-  const auto weights = [&](int k, const Vector3& r) {
-    // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ.
-    const double s = torqueScale(k);
-    Vector3 w = epsilon * r;
-    for (FreeTimeRows* g : torque_groups) {
-      w -= (g->instance(k).z / s) * g->constraint->gradient(r / s);
-    }
-    return w;
-  };
+  const FreeTimeStep step{h0_};
+  // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
+  // rows are prepared in the visit, after z entered w).
+  const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
+  const auto row = [](const FreeTimeRows&, FreeTimeRow&, double) {};
   const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
-  np_.forEachStencilWithTimeStep(
-      [&](const ReducedProblem::TimeStepStencil& st) {
-        if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
-        const double s = torqueScale(st.k);
-        const Vector3 tau = st.tau / s;
-        Eigen::Matrix<double, 3, 10> G;  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
-        G.leftCols<9>() = st.jacobian;
-        G.col(9) = st.tau_h * h0_;
-        Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Zero();
-        H.topLeftCorner<9, 9>() = st.second;
-        H.block<9, 1>(0, 9) = st.second_h * h0_;
-        H.block<1, 9>(9, 0) = (st.second_h * h0_).transpose();
-        H(9, 9) = st.second_hh * h0_ * h0_;
-        // The torque's 3×3 weight W, so that the stencil's block is H + Gᵀ W G: Gauss–Newton's
-        // ε of the effort and −z c''/w_k of the constraints' isotropic curvature, and the
-        // barrier's (z/c) a aᵀ of each bound, a = ∂c/∂r (one product instead of one per bound).
-        Matrix3 W = epsilon * Matrix3::Identity();
-        Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
-        Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-        for (FreeTimeRows* g : torque_groups) {
-          FreeTimeRow& in = g->instance(st.k);
-          in.c = g->constraint->value(tau);
-          prepareRow(*g, in, mu);
-          const RowTerms row = rowTerms(*g, in, mu);
-          const Vector3 a = g->constraint->gradient(tau) / s;
-          in.g = G.transpose() * a;
-          W.diagonal().array() -= in.z * g->constraint->curvature() / (s * s);
-          W.noalias() += row.weight * a * a.transpose();
-          rhs += row.rhs * in.g;
-          lagrangian -= in.z * in.g;
-        }
-        H.noalias() += G.transpose() * W * G;
-        scatter(st.k - 1, 3, H, rhs, lagrangian);
-      },
-      weights);
+  const auto visit = [&](const ReducedProblem::TimeStepStencil& st, double s) {
+    if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
+    const Eigen::Matrix<double, 3, 10> G = step.jacobian(st);  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
+    Eigen::Matrix<double, 10, 10> H = step.second(st);
+    // The torque's 3×3 weight W, so that the stencil's block is H + Gᵀ W G: Gauss–Newton's ε of
+    // the effort and −z c''/w_k of the constraints' isotropic curvature, and the barrier's ω a aᵀ
+    // of each bound, a = ∂c/∂r (one product instead of one per bound).
+    Matrix3 W = epsilon * Matrix3::Identity();
+    Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
+    Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
+    const auto fold = [&](const FreeTimeRows& g, FreeTimeRow& in, const Vector3& a) {
+      prepareRow(g, in, mu);
+      const RowTerms terms = rowTerms(g, in, mu);
+      W.diagonal().array() -= in.z * g.constraint->curvature() / (s * s);
+      W.noalias() += terms.weight * a * a.transpose();
+      rhs += terms.rhs * in.g;
+      lagrangian -= in.z * in.g;
+    };
+    rows_.chainTorques(st, s, G, fold);
+    H.noalias() += G.transpose() * W * G;
+    scatter(st.k - 1, 3, H, rhs, lagrangian);
+  };
+  rows_.forEachTorqueStencil(np_, step, true, cost, row, visit);
   // The quantities that do not move with h first (the order the band's sums were formed in).
   for (const bool moves_with_h : {false, true}) {
     for (const std::vector<int>& block : rows_.blocks) {
@@ -443,35 +424,30 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 }
 
 /// The groups of one quantity (a cone, a rate, a wheel quantity) through the quantity's terms in
-/// (local nodes, η = h/h₀) and the chain rule (constraint_assembly.hpp), with each constraint's
+/// (local nodes, η = h/h₀) and the chain rule (StageTranscription), with each constraint's
 /// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
-  std::vector<FreeTimeRows>& groups = rows_.groups;
-  const FreeTimeRows& first = groups[block.front()];
+  const StageSupport support = rows_.groups[block.front()].support;
   const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) { prepareRow(g, in, mu); };
-  const auto contract = [&](int k, const Vector3& q) {
-    return contractQuantityRows(groups, block, k, q, prepare);
+  const auto visit = [&](const QuantityTermsWithTimeStep& t, Eigen::Matrix<double, 10, 10>* H) {
+    Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
+    const int m = 3 * support.width;  // g is 0 past the local nodes but for η
+    for (const int i : block) {
+      FreeTimeRow& in = rows_.groups[i].instance(t.k);
+      // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
+      const RowTerms terms = rowTerms(rows_.groups[i], in, mu);
+      const double w = terms.weight;
+      H->topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
+      H->block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
+      H->block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
+      (*H)(9, 9) += (w * in.g(9)) * in.g(9);
+      rhs += terms.rhs * in.g;
+      lagrangian -= in.z * in.g;
+    }
+    scatter(t.k + support.node_offset, support.width, *H, rhs, lagrangian);
   };
-  first.quantity->forEachTermsWithTimeStep(
-      np_, first.support, h0_, contract, [&](const QuantityTermsWithTimeStep& t) {
-        Eigen::Matrix<double, 10, 10> H;
-        chainQuantityRows(groups, block, t, &H);
-        Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
-        const int m = 3 * first.support.width;  // g is 0 past the local nodes but for η
-        for (const int i : block) {
-          FreeTimeRow& in = groups[i].instance(t.k);
-          // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-          const RowTerms row = rowTerms(groups[i], in, mu);
-          const double w = row.weight;
-          H.topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
-          H.block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
-          H.block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
-          H(9, 9) += (w * in.g(9)) * in.g(9);
-          rhs += row.rhs * in.g;
-          lagrangian -= in.z * in.g;
-        }
-        scatter(t.k + first.support.node_offset, first.support.width, H, rhs, lagrangian);
-      });
+  rows_.forEachQuantityInstance(
+      np_, FreeTimeStep{h0_}, block, true, [](int) {}, prepare, visit);
 }
 
 /// Leaves the elastic phase once every constraint holds strictly: from then on the iterate is a

@@ -5,6 +5,7 @@
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "planning/transcription/node_constraints.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 #include "planning/transcription/wheel_quantities.hpp"
 
 namespace attitude_planner {
@@ -133,12 +134,9 @@ class TorqueQuantity final : public StageQuantityModel {
           QuantityTermsWithTimeStep t;
           t.k = st.k;
           t.value = st.tau / root;
-          t.jacobian.leftCols<9>() = st.jacobian / root;
-          t.jacobian.col(9) = st.tau_h * time_scale / root;
-          t.curvature.topLeftCorner<9, 9>() = st.second;
-          t.curvature.block<9, 1>(0, 9) = st.second_h * time_scale;
-          t.curvature.block<1, 9>(9, 0) = (st.second_h * time_scale).transpose();
-          t.curvature(9, 9) = st.second_hh * time_scale * time_scale;
+          const FreeTimeStep step{time_scale};
+          t.jacobian = step.jacobian(st) / root;
+          t.curvature = step.second(st);
           visit(t);
         },
         weights);

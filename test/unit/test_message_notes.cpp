@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -70,10 +71,10 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
 
 TEST(MessageNotes, AddNoteExtendsTheMessageWithTheNotesFiguresAndReason) {
   ap::PlanResult r;
-  r.message = "converged after 12 interior-point iterations";
+  ap::recordReason(&r, "converged after 12 interior-point iterations");
   ap::addNote(&r, notes::GridContinuation{8});
   ap::addNote(&r, notes::FormulationRetry{"elastic", "free slacks", false, "infeasible at N = 8"});
-  EXPECT_EQ(r.message,
+  EXPECT_EQ(r.message(),
             "converged after 12 interior-point iterations; grid continuation from N = 8; retried "
             "with elastic: infeasible at N = 8");
 }
@@ -184,9 +185,9 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   EXPECT_EQ(ap::renderFrame(ap::frames::OutsideRequestedClass{"w"}, reason),
             "not converged in the requested class: w (" + reason + ")");
   ap::PlanResult r;
-  r.message = reason;
+  ap::recordReason(&r, reason);
   ap::frameMessage(&r, ap::frames::ReplayFailed{"e"});
-  EXPECT_EQ(r.message, "replay of the planned torques failed: e (" + reason + ")");
+  EXPECT_EQ(r.message(), "replay of the planned torques failed: e (" + reason + ")");
 }
 
 TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {
@@ -298,13 +299,13 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
   ap::PlanResult r;
   EXPECT_EQ(ap::verdictKindName(r.verdict), "solver_reason");  // a solver's reason stands
   EXPECT_TRUE(ap::verdictFigures(r.verdict).empty());
-  r.message = "infeasible at N = 32";
+  ap::recordReason(&r, "infeasible at N = 32");
   ap::recordVerdict(&r, v::LocallyInfeasible{3.0, 3.25, "what", 2.75, "b", true});
   EXPECT_EQ(ap::verdictKindName(r.verdict), "locally_infeasible");
   ASSERT_TRUE(std::holds_alternative<v::LocallyInfeasible>(r.verdict));
   EXPECT_EQ(std::get<v::LocallyInfeasible>(r.verdict).least_found, 3.25);
-  EXPECT_EQ(r.message.rfind("infeasible from here", 0), 0u);
-  EXPECT_NE(r.message.find("(infeasible at T: infeasible at N = 32)"), std::string::npos);
+  EXPECT_EQ(r.message().rfind("infeasible from here", 0), 0u);
+  EXPECT_NE(r.message().find("(infeasible at T: infeasible at N = 32)"), std::string::npos);
   // The figures by name carry the fields' values, each name once.
   const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(r.verdict);
   ASSERT_EQ(figures.size(), 3u);
@@ -435,8 +436,8 @@ TEST(DriverVerdicts, AReasonCarriedTakesItsVerdictAlong) {
   ap::frameMessage(&wrapper, ap::frames::StagedUnfinished{"rate continuation", 0.5, 3});
   EXPECT_EQ(ap::verdictKindName(wrapper.verdict), "newton_ended");
   EXPECT_EQ(
-      wrapper.message,
-      ap::renderFrame(ap::frames::StagedUnfinished{"rate continuation", 0.5, 3}, solved.message));
+      wrapper.message(),
+      ap::renderFrame(ap::frames::StagedUnfinished{"rate continuation", 0.5, 3}, solved.message()));
 }
 
 TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
@@ -464,8 +465,7 @@ TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
 
 namespace {
 
-/// A request planned as planManeuver plans it, without the rendering at its end: the drivers'
-/// own answer (their context overloads), whose message each clause extended as it was recorded.
+/// A request planned as planManeuver plans it: the drivers' own answer (their context overloads).
 ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
                                    const ap::SolverOptions& options = {}) {
   ap::SolveContext context(options);
@@ -474,19 +474,19 @@ ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
              : ap::planBoundedMinimumEffort(problem, context);
 }
 
-/// The message as the drivers left it is the fold of the clauses recorded: no clause of it was
-/// written around them.
-void expectItsClausesFolded(const ap::PlanResult& r, const std::string& label, int* checked) {
-  SCOPED_TRACE(label + ": " + r.message);
+/// Every path records what it says: the answer's clauses are not empty, and they say a message
+/// of one line.
+void expectItsClausesSaid(const ap::PlanResult& r, const std::string& label, int* checked) {
+  SCOPED_TRACE(label + ": " + r.message());
   EXPECT_FALSE(r.clauses.empty());
-  EXPECT_FALSE(r.message.empty());
-  EXPECT_EQ(r.message, ap::renderMessage(r));
+  EXPECT_FALSE(r.message().empty());
+  EXPECT_EQ(r.message().find('\n'), std::string::npos);
   ++*checked;
 }
 
 }  // namespace
 
-TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
+TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
   namespace rb = ap::robustness;
   namespace ts = ap::test_support;
   int checked = 0;
@@ -494,10 +494,10 @@ TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
   // as fourth_order too (a Richardson pair at N and 2N, framed around its N solve's reason).
   for (int i = 0; i < 4; ++i) {
     rb::RandomCase c = rb::randomCase(4601, i);
-    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label, &checked);
     if (c.problem.steps > 256) continue;
     c.problem.scheme = ap::SchemeKind::FourthOrder;
-    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked);
   }
   // Bounded: a torque norm, per-axis torques, a norm with a rate limit and a replan, each a
   // minimum-effort request (the minimum-time phase where it ends infeasible), and two asked as
@@ -505,43 +505,43 @@ TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
   for (int i : {0, 1, 2, 3, 4, 5, 12, 13}) {
     const std::optional<rb::BoundedRequest> request = rb::boundedRequest(4602, i);
     if (!request) continue;
-    expectItsClausesFolded(plannedByTheDrivers(request->problem), request->label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(request->problem), request->label, &checked);
   }
   // Constrained scenes (a keep-out cone, a rate limit, torque bounds; classes enumerated) and the
   // minimum-time scenes at two grids each.
   for (const char* scene : {"sun_keep_out", "rate_limited", "torque_limited", "min_time_keep_out",
                             "min_time_bilimoria_wie"}) {
     for (int steps : {32, 64}) {
-      expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
-                             std::string(scene) + " N = " + std::to_string(steps), &checked);
+      expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
+                           std::string(scene) + " N = " + std::to_string(steps), &checked);
     }
   }
   // Pointing: unconstrained, under a cone and under torque bounds, and minimum time on Betts's
   // body (its start twists framed around the kept answer).
   for (unsigned seed : {4603u, 4604u}) {
     const std::string at = " seed " + std::to_string(seed);
-    expectItsClausesFolded(plannedByTheDrivers(ts::randomPointingRequest(
-                               seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
-                           "pointing" + at, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(ts::randomPointingRequest(
+                             seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
+                         "pointing" + at, &checked);
     for (ts::PointingBinding binding :
          {ts::PointingBinding::KeepOut, ts::PointingBinding::TorqueBox}) {
-      expectItsClausesFolded(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
-                                 seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
-                             "constrained pointing" + at, &checked);
+      expectItsClausesSaid(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
+                               seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
+                           "constrained pointing" + at, &checked);
     }
-    expectItsClausesFolded(
+    expectItsClausesSaid(
         plannedByTheDrivers(ts::randomBettsPointingRequest(seed, 32, ap::SchemeKind::SecondOrder)),
         "pointing minimum time" + at, &checked);
   }
   // The NLopt cross-check, and a request stopped by its iteration limit.
   ap::SolverOptions nlopt;
   nlopt.solver = ap::SolverKind::Nlopt;
-  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
-                         &checked);
+  expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
+                       &checked);
   ap::SolverOptions capped;
   capped.max_iterations = 3;
-  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
-                         "sun_keep_out capped", &checked);
+  expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
+                       "sun_keep_out capped", &checked);
   EXPECT_GE(checked, 30) << "the requests were planned";
 }
 
@@ -554,19 +554,41 @@ TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
   ap::addNote(&r, notes::GridContinuation{8});
   ap::frameMessage(&r, ap::frames::OnContinuationLevel{16});
   ASSERT_EQ(r.clauses.size(), 4u);
-  EXPECT_EQ(ap::renderMessage(r), r.message);
-  EXPECT_EQ(r.message,
+  EXPECT_EQ(ap::renderMessage(r), r.message());
+  EXPECT_EQ(r.message(),
             ap::renderVerdict(ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible},
                               "replay failed") +
                 "; grid continuation from N = 8 (on the N = 16 level of the grid "
                 "continuation)");
   ap::PlanResult combined;
   ap::takeReason(&combined, r);
-  EXPECT_EQ(combined.message, r.message);
+  EXPECT_EQ(combined.message(), r.message());
   EXPECT_EQ(ap::verdictKindName(combined.verdict), "solver_reason");
   ap::recordReason(&combined, "other words");
   EXPECT_EQ(combined.clauses.size(), 1u);
   EXPECT_EQ(ap::renderMessage(combined), "other words");
+}
+
+TEST(MessageClauses, TheMessageIsOnlyTheRenderingOfItsClauses) {
+  // No copy of the words to write: the message is a function of the clauses alone.
+  static_assert(std::is_member_function_pointer_v<decltype(&ap::PlanResult::message)>,
+                "PlanResult::message renders the clauses; it stores nothing");
+  // Another solve's reason, said in a note, is rendered where the outer message is.
+  ap::PlanResult first;
+  ap::recordReason(&first, "replay failed");
+  ap::recordVerdict(&first, ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible});
+  ap::PlanResult r;
+  ap::recordReason(&r, "converged after 3 iterations");
+  ap::addNote(&r, notes::CheapestClass{first.message()});
+  EXPECT_EQ(r.message(),
+            "converged after 3 iterations; the cheapest homotopy class under the constraints "
+            "(after the unconstrained optimum's class: " +
+                first.message() + ")");
+  ap::PlanResult same;
+  same.clauses = r.clauses;
+  EXPECT_EQ(same.message(), r.message());
+  r.clauses.clear();
+  EXPECT_EQ(r.message(), "");
 }
 
 TEST(MessageFrames, TheBriefsAndTheStopsSayTheWordsOfTheirFormerExpressions) {

@@ -115,7 +115,7 @@ namespace {
 /// the constraints held and ψ stationary.
 PlanResult expectAtMostTheSweep(const PlanningProblem& p) {
   const PlanResult r = planManeuver(p);
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_TRUE(r.pointing.active);
   if (!r.converged() || !r.pointing.active) return r;
   const test_support::TwistSweep sweep = test_support::sweepTwist(p);

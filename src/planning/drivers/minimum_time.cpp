@@ -434,9 +434,7 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planMinimumTime(problem, context);
-  renderMessageOnce(&result);
-  return result;
+  return planMinimumTime(problem, context);
 }
 
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
@@ -657,9 +655,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planBoundedMinimumEffort(problem, context);
-  renderMessageOnce(&result);
-  return result;
+  return planBoundedMinimumEffort(problem, context);
 }
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context) {

@@ -179,9 +179,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planAtResolution(problem, options, context);
-  renderMessageOnce(&result);
-  return result;
+  return planAtResolution(problem, options, context);
 }
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,

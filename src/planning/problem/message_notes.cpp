@@ -479,7 +479,6 @@ std::string renderNote(const Note& note) {
 
 void addNote(PlanResult* result, const Note& note) {
   result->clauses.push_back(note);
-  result->message.append(renderNote(note));
 }
 
 std::string renderFrame(const Frame& frame, const std::string& reason) {
@@ -488,7 +487,6 @@ std::string renderFrame(const Frame& frame, const std::string& reason) {
 
 void frameMessage(PlanResult* result, const Frame& frame) {
   result->clauses.push_back(frame);
-  result->message = renderFrame(frame, result->message);
 }
 
 std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
@@ -498,12 +496,10 @@ std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
 void recordVerdict(PlanResult* result, const Verdict& verdict) {
   result->verdict = verdict;
   result->clauses.push_back(verdict);
-  result->message = renderVerdict(verdict, result->message);
 }
 
 void recordReason(PlanResult* result, const std::string& words) {
   result->clauses.assign(1, clauses::Reason{words});
-  result->message = words;
 }
 
 void takeReason(PlanResult* to, const PlanResult& from) {
@@ -512,7 +508,6 @@ void takeReason(PlanResult* to, const PlanResult& from) {
 
 void takeReason(PlanResult* to, const std::vector<MessageClause>& clauses) {
   to->clauses = clauses;
-  to->message = renderClauses(clauses);
 }
 
 std::string renderClauses(const std::vector<MessageClause>& clauses) {
@@ -525,8 +520,8 @@ std::string renderMessage(const PlanResult& result) {
   return renderClauses(result.clauses);
 }
 
-void renderMessageOnce(PlanResult* result) {
-  result->message = renderMessage(*result);
+std::string PlanResult::message() const {
+  return renderClauses(clauses);
 }
 
 }  // namespace attitude_planner

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <typeinfo>
 #include <variant>
 #include <vector>
 
@@ -29,22 +30,27 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+/// Another solve's reason as the clauses a note or a frame holds: its bare words.
+ap::MessageClauses said(const std::string& words) {
+  return {ap::clauses::Reason{words}};
+}
+
 }  // namespace
 
 TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
   const std::vector<ap::Note> all = {
-      notes::FormulationRetry{"elastic", "free slacks", true, "r"},
-      notes::ReachedThroughMiddle{64, "r"},
+      notes::FormulationRetry{"elastic", "free slacks", true, said("r")},
+      notes::ReachedThroughMiddle{64, said("r")},
       notes::GridContinuation{8},
-      notes::RetriedInTwoStages{"r"},
+      notes::RetriedInTwoStages{said("r")},
       notes::FromInitialGuess{},
       notes::CoarserLevel{32, ap::Termination::Converged},
       notes::RefinedFromSurvey{16},
       notes::ConstraintsInactive{},
       notes::UnconstrainedStart{1.5, "w", "at k = 3", 7},
-      notes::AfterGuessStopped{"r"},
+      notes::AfterGuessStopped{said("r")},
       notes::LastIterateDoesNotReplay{"r"},
-      notes::CheapestClass{"r"},
+      notes::CheapestClass{said("r")},
       notes::LastPointingStart{"r"},
       notes::FixedTwistFallback{0.5, "r"},
       notes::PointingRestartNotServed{3.5},
@@ -62,8 +68,9 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
     EXPECT_GT(words.size(), 4u);
     EXPECT_EQ(words.find('\n'), std::string::npos);
   }
-  EXPECT_EQ(ap::renderNote(notes::RestartEnded{ap::Termination::Infeasible, "r"}).rfind(": ", 0),
-            0u);
+  EXPECT_EQ(
+      ap::renderNote(notes::RestartEnded{ap::Termination::Infeasible, said("r")}).rfind(": ", 0),
+      0u);
   // The search's summary is its own rendering (minimum_time_search.cpp), kept as given.
   EXPECT_EQ(ap::renderNote(notes::SearchSummary{"; minimum time T* = 1 s"}),
             "; minimum time T* = 1 s");
@@ -73,7 +80,8 @@ TEST(MessageNotes, AddNoteExtendsTheMessageWithTheNotesFiguresAndReason) {
   ap::PlanResult r;
   ap::recordReason(&r, "converged after 12 interior-point iterations");
   ap::addNote(&r, notes::GridContinuation{8});
-  ap::addNote(&r, notes::FormulationRetry{"elastic", "free slacks", false, "infeasible at N = 8"});
+  ap::addNote(
+      &r, notes::FormulationRetry{"elastic", "free slacks", false, said("infeasible at N = 8")});
   EXPECT_EQ(r.message(),
             "converged after 12 interior-point iterations; grid continuation from N = 8; retried "
             "with elastic: infeasible at N = 8");
@@ -89,9 +97,9 @@ TEST(MessageNotes, TheFieldsChooseTheBranchOfTheWording) {
                        "N = 32 level ended " + ap::terminationName(ap::Termination::NotConverged)));
   EXPECT_TRUE(contains(stopped, "geodesic"));
   // A retry that answers names both formulations; one that did not, the retry's.
-  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", true, ""}),
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", true, {}}),
                        "solved with elastic after free slacks stopped"));
-  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", false, ""}),
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", false, {}}),
                        "retried with elastic: "));
   // Only the cone's margin is violated when no stated limit is.
   EXPECT_TRUE(contains(ap::renderNote(notes::UnconstrainedStart{2.0, "", "", 5}),
@@ -122,11 +130,11 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   const ap::frames::RichardsonPair from_t_star{32, true};
   const std::vector<ap::Frame> all = {
       ap::frames::PairSolveStopped{pair, 64},
-      ap::frames::PairCombined{pair, false, "2N's"},
-      ap::frames::PairCombined{from_t_star, true, "2N's"},
+      ap::frames::PairCombined{pair, false, said("2N's")},
+      ap::frames::PairCombined{from_t_star, true, said("2N's")},
       ap::frames::MinimumTimePairStopped{32, true, false},
       ap::frames::MinimumTimePairStopped{32, false, true},
-      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, "2N's"},
+      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, said("2N's")},
       ap::frames::UpperBoundFromProbe{2.5, 3.0},
       ap::frames::StuckAtMinimumTimePlan{true, 2.0, 3.0, 0.0},
       ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 2.5},
@@ -162,12 +170,12 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   EXPECT_TRUE(contains(stopped, "second_order at N = 32 and 2N = 64)"));
   EXPECT_TRUE(contains(stopped, "the second_order solve at N = 64 did not converge"));
   const std::string combined =
-      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, "2N's"}, reason);
+      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, said("2N's")}, reason);
   EXPECT_TRUE(contains(combined, "2N = 64, each from its plan at T*)"));
   EXPECT_TRUE(contains(combined, "the plan is the second_order plan at N"));
   EXPECT_TRUE(contains(combined, ": N: " + reason + " | 2N: 2N's"));
-  EXPECT_FALSE(
-      contains(ap::renderFrame(ap::frames::PairCombined{pair, false, "x"}, reason), "the plan is"));
+  EXPECT_FALSE(contains(ap::renderFrame(ap::frames::PairCombined{pair, false, said("x")}, reason),
+                        "the plan is"));
   // fourth_order minimum time: which solve stopped, and T* with the two it is the larger of.
   EXPECT_TRUE(contains(
       ap::renderFrame(ap::frames::MinimumTimePairStopped{32, false, true}, reason),
@@ -176,7 +184,8 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
                        "): the one at 2N did not converge (its plan is returned): " + reason));
   const double T_star = 2.0 + 1.0 / 3.0;
   const std::string pair_t_star = ap::renderFrame(
-      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, "2N's"}, reason);
+      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, said("2N's")},
+      reason);
   EXPECT_TRUE(contains(pair_t_star, "T* = " + ap::exactNumber(T_star) + " s, the one at 2N binds"));
   EXPECT_TRUE(contains(pair_t_star, "(T* at N = " + ap::exactNumber(2.0) + " s"));
   EXPECT_TRUE(contains(pair_t_star, "the plan is the second_order plan at N at T*"));
@@ -474,13 +483,47 @@ ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
              : ap::planBoundedMinimumEffort(problem, context);
 }
 
-/// Every path records what it says: the answer's clauses are not empty, and they say a message
-/// of one line.
-void expectItsClausesSaid(const ap::PlanResult& r, const std::string& label, int* checked) {
+/// The clauses a note or a frame holds (another solve's reason: `reason` or `fine_reason`).
+template <class T, class = void>
+struct HoldsReason : std::false_type {};
+template <class T>
+struct HoldsReason<T, std::void_t<decltype(T::reason)>>
+    : std::is_same<decltype(T::reason), ap::MessageClauses> {};
+template <class T, class = void>
+struct HoldsFineReason : std::false_type {};
+template <class T>
+struct HoldsFineReason<T, std::void_t<decltype(T::fine_reason)>>
+    : std::is_same<decltype(T::fine_reason), ap::MessageClauses> {};
+
+/// Every reason held inside `clauses`, however deep: each is the clauses of a solve that said
+/// something (none empty). Returns how many there were.
+int expectNestedReasonsSaid(const ap::MessageClauses& clauses) {
+  int nested = 0;
+  const auto inner = [&](const auto& held) {
+    using T = std::decay_t<decltype(held)>;
+    const ap::MessageClauses* reason = nullptr;
+    if constexpr (HoldsReason<T>::value) reason = &held.reason;
+    if constexpr (HoldsFineReason<T>::value) reason = &held.fine_reason;
+    if (!reason) return;
+    EXPECT_FALSE(reason->empty()) << typeid(T).name() << " holds no reason";
+    nested += 1 + expectNestedReasonsSaid(*reason);
+  };
+  for (const ap::MessageClause& clause : clauses) {
+    if (const auto* note = std::get_if<ap::Note>(&clause)) std::visit(inner, *note);
+    if (const auto* frame = std::get_if<ap::Frame>(&clause)) std::visit(inner, *frame);
+  }
+  return nested;
+}
+
+/// Every path records what it says: the answer's clauses, and every solve's reason they hold,
+/// are not empty, and they say a message of one line.
+void expectItsClausesSaid(const ap::PlanResult& r, const std::string& label, int* checked,
+                          int* nested) {
   SCOPED_TRACE(label + ": " + r.message());
   EXPECT_FALSE(r.clauses.empty());
   EXPECT_FALSE(r.message().empty());
   EXPECT_EQ(r.message().find('\n'), std::string::npos);
+  *nested += expectNestedReasonsSaid(r.clauses);
   ++*checked;
 }
 
@@ -490,14 +533,16 @@ TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
   namespace rb = ap::robustness;
   namespace ts = ap::test_support;
   int checked = 0;
+  int nested = 0;
   // Minimum effort, unconstrained: seeded random bodies, ends, horizons and N; those up to N = 256
   // as fourth_order too (a Richardson pair at N and 2N, framed around its N solve's reason).
   for (int i = 0; i < 4; ++i) {
     rb::RandomCase c = rb::randomCase(4601, i);
-    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label, &checked, &nested);
     if (c.problem.steps > 256) continue;
     c.problem.scheme = ap::SchemeKind::FourthOrder;
-    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked,
+                         &nested);
   }
   // Bounded: a torque norm, per-axis torques, a norm with a rate limit and a replan, each a
   // minimum-effort request (the minimum-time phase where it ends infeasible), and two asked as
@@ -505,7 +550,7 @@ TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
   for (int i : {0, 1, 2, 3, 4, 5, 12, 13}) {
     const std::optional<rb::BoundedRequest> request = rb::boundedRequest(4602, i);
     if (!request) continue;
-    expectItsClausesSaid(plannedByTheDrivers(request->problem), request->label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(request->problem), request->label, &checked, &nested);
   }
   // Constrained scenes (a keep-out cone, a rate limit, torque bounds; classes enumerated) and the
   // minimum-time scenes at two grids each.
@@ -513,7 +558,7 @@ TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
                             "min_time_bilimoria_wie"}) {
     for (int steps : {32, 64}) {
       expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
-                           std::string(scene) + " N = " + std::to_string(steps), &checked);
+                           std::string(scene) + " N = " + std::to_string(steps), &checked, &nested);
     }
   }
   // Pointing: unconstrained, under a cone and under torque bounds, and minimum time on Betts's
@@ -522,27 +567,28 @@ TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
     const std::string at = " seed " + std::to_string(seed);
     expectItsClausesSaid(plannedByTheDrivers(ts::randomPointingRequest(
                              seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
-                         "pointing" + at, &checked);
+                         "pointing" + at, &checked, &nested);
     for (ts::PointingBinding binding :
          {ts::PointingBinding::KeepOut, ts::PointingBinding::TorqueBox}) {
       expectItsClausesSaid(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
                                seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
-                           "constrained pointing" + at, &checked);
+                           "constrained pointing" + at, &checked, &nested);
     }
     expectItsClausesSaid(
         plannedByTheDrivers(ts::randomBettsPointingRequest(seed, 32, ap::SchemeKind::SecondOrder)),
-        "pointing minimum time" + at, &checked);
+        "pointing minimum time" + at, &checked, &nested);
   }
   // The NLopt cross-check, and a request stopped by its iteration limit.
   ap::SolverOptions nlopt;
   nlopt.solver = ap::SolverKind::Nlopt;
   expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
-                       &checked);
+                       &checked, &nested);
   ap::SolverOptions capped;
   capped.max_iterations = 3;
   expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
-                       "sun_keep_out capped", &checked);
+                       "sun_keep_out capped", &checked, &nested);
   EXPECT_GE(checked, 30) << "the requests were planned";
+  EXPECT_GT(nested, 0) << "some answer says another solve's reason";
 }
 
 TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
@@ -573,13 +619,13 @@ TEST(MessageClauses, TheMessageIsOnlyTheRenderingOfItsClauses) {
   // No copy of the words to write: the message is a function of the clauses alone.
   static_assert(std::is_member_function_pointer_v<decltype(&ap::PlanResult::message)>,
                 "PlanResult::message renders the clauses; it stores nothing");
-  // Another solve's reason, said in a note, is rendered where the outer message is.
+  // Another solve's reason is held as its clauses and rendered where the outer message is.
   ap::PlanResult first;
   ap::recordReason(&first, "replay failed");
   ap::recordVerdict(&first, ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible});
   ap::PlanResult r;
   ap::recordReason(&r, "converged after 3 iterations");
-  ap::addNote(&r, notes::CheapestClass{first.message()});
+  ap::addNote(&r, notes::CheapestClass{first.clauses});
   EXPECT_EQ(r.message(),
             "converged after 3 iterations; the cheapest homotopy class under the constraints "
             "(after the unconstrained optimum's class: " +

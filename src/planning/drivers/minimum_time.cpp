@@ -113,7 +113,7 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
   takeReason(&result, coarse);
-  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, renderMessage(fine)});
+  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, fine.clauses});
   if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
   result.attempts = context.attemptsFrom(first);
   return result;
@@ -200,7 +200,7 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   result.attempts = context.attemptsFrom(first);
   takeReason(&result, coarse);
   frameMessage(&result, frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced,
-                                                        renderMessage(fine)});
+                                                        fine.clauses});
   return result;
 }
 
@@ -641,7 +641,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
       kept.duration_verdict.longest_duration_found = climb.reached;
     }
     addNote(&kept, restart);
-    addNote(&kept, notes::RestartEnded{again.termination, renderMessage(again)});
+    addNote(&kept, notes::RestartEnded{again.termination, again.clauses});
     return kept;
   }
   if (again.termination == Termination::Infeasible)

@@ -19,10 +19,11 @@ std::string grid(int steps) {
 std::string words(const FormulationRetry& n) {
   return (n.solved ? "; solved with " + n.retry + " after " + n.first + " stopped: "
                    : "; retried with " + n.retry + ": ") +
-         n.reason;
+         renderClauses(n.reason);
 }
 std::string words(const ReachedThroughMiddle& n) {
-  return "; reached through " + grid(n.steps) + " after the direct refinement stopped: " + n.reason;
+  return "; reached through " + grid(n.steps) +
+         " after the direct refinement stopped: " + renderClauses(n.reason);
 }
 std::string words(const GridContinuation& n) {
   return "; grid continuation from " + grid(n.steps);
@@ -30,7 +31,7 @@ std::string words(const GridContinuation& n) {
 std::string words(const RetriedInTwoStages& n) {
   return "; retried in two stages (the cones alone, then every constraint from that path) "
          "after: " +
-         n.reason;
+         renderClauses(n.reason);
 }
 std::string words(const FromInitialGuess&) {
   return "; from the initial guess, its multipliers re-derived";
@@ -59,7 +60,7 @@ std::string words(const UnconstrainedStart& n) {
   return s.str();
 }
 std::string words(const AfterGuessStopped& n) {
-  return "; after the start from the initial guess stopped: " + n.reason;
+  return "; after the start from the initial guess stopped: " + renderClauses(n.reason);
 }
 std::string words(const LastIterateDoesNotReplay& n) {
   return "; its last iterate's torques do not replay: " + n.reason;
@@ -67,7 +68,7 @@ std::string words(const LastIterateDoesNotReplay& n) {
 std::string words(const CheapestClass& n) {
   return "; the cheapest homotopy class under the constraints (after the unconstrained "
          "optimum's class: " +
-         n.reason + ")";
+         renderClauses(n.reason) + ")";
 }
 std::string words(const LastPointingStart& n) {
   return "; the last: " + n.reason;
@@ -121,7 +122,7 @@ std::string words(const MinimumTimeRestart& n) {
   return s;
 }
 std::string words(const RestartEnded& n) {
-  return ": " + terminationName(n.termination) + " (" + n.reason + ")";
+  return ": " + terminationName(n.termination) + " (" + renderClauses(n.reason) + ")";
 }
 std::string words(const MinimumTimeUnsolved& n) {
   return "; the first solve " + n.why +
@@ -165,7 +166,7 @@ std::string framed(const frames::PairCombined& f, const std::string& reason) {
          (f.replaced ? ": the plan is the second_order plan at N (the Richardson combination left "
                        "a bound both meet)"
                      : "") +
-         ": N: " + reason + " | 2N: " + f.fine_reason;
+         ": N: " + reason + " | 2N: " + renderClauses(f.fine_reason);
 }
 std::string minimumTimePair(int steps) {
   return "fourth_order minimum time (the second_order minimum-time problems at " + grid(steps) +
@@ -187,7 +188,7 @@ std::string framed(const frames::MinimumTimePairCombined& f, const std::string& 
                      "with the 2N plan left a bound both meet"
                    : "the plan combines the binding plan and the other's minimum-effort plan "
                      "at T*")
-    << " | 2N: " << f.fine_reason << " | N: " << reason;
+    << " | 2N: " << renderClauses(f.fine_reason) << " | N: " << reason;
   return s.str();
 }
 std::string framed(const frames::UpperBoundFromProbe& f, const std::string& reason) {

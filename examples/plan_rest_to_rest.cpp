@@ -29,7 +29,7 @@ int main() {
               terminationName(plan.termination).c_str(), plan.iterations, plan.cost,
               plan.replay_miss);
   if (!plan.converged()) {
-    std::fprintf(stderr, "%s\n", plan.message.c_str());  // why, in words
+    std::fprintf(stderr, "%s\n", plan.message().c_str());  // why, in words
     return 1;
   }
   const Vector3& tau = plan.maneuver.torque[1];  // τ_k [N m], body, k = 0..N

@@ -9,7 +9,6 @@
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/requests.hpp"
-#include "planning/problem/message_notes.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
@@ -42,7 +41,6 @@ PlanResult planManeuver(const PlanningProblem& problem, const SolverOptions& opt
   if (problem.end_condition.pointing()) {
     result.pointing.infeasible_basis = pointingInfeasibleBasis(result);
   }
-  renderMessageOnce(&result);
   return result;
 }
 

@@ -1707,7 +1707,7 @@ std::vector<Vector3> ourSteps(const ap::PlanningProblem& problem, PeerStart star
     solved.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   }
   const ap::PlanResult r = ap::planManeuver(solved, ap::SolverOptions());
-  if (!r.converged()) throw ap::InvalidInput("--start: our plan did not converge: " + r.message);
+  if (!r.converged()) throw ap::InvalidInput("--start: our plan did not converge: " + r.message());
   std::vector<Vector3> w;
   for (int k = 0; k < r.maneuver.steps(); ++k) {
     w.push_back(
@@ -1757,7 +1757,7 @@ Measurement run(const std::string& solver, const ap::PlanningProblem& problem, d
   if (is_ours) {
     m.iterations = ours.iterations;
     m.converged = ours.converged();
-    m.message = ours.message;
+    m.message = ours.message();
   } else {
     // The peer's torques replayed exactly as ours are (outside the timed region).
     ap::PlanResult replay;

@@ -116,7 +116,7 @@ void runSuite(const Options& o, const std::function<void(const std::string&)>& w
     tally.add(i, *request, c);
     std::cerr << i << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
               << " s\n";
-    if (o.only >= 0) std::cerr << c.result.message << "\n" << rb::attemptLines(c.result);
+    if (o.only >= 0) std::cerr << c.result.message() << "\n" << rb::attemptLines(c.result);
     written(tally.render(o));
   }
   written(tally.render(o));
@@ -128,7 +128,7 @@ std::string specialRow(const std::string& what, const ap::PlanningProblem& p) {
   std::string outcome;
   try {
     const ap::PlanResult r = ap::planManeuver(p);
-    outcome = "**" + ap::terminationName(r.termination) + "**: " + r.message.substr(0, 220);
+    outcome = "**" + ap::terminationName(r.termination) + "**: " + r.message().substr(0, 220);
   } catch (const ap::FieldError& e) {
     outcome = std::string("refused: ") + e.what();
   }

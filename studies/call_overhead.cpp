@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!result.converged()) {
-        std::cerr << "call_overhead: not converged: " << result.message << "\n";
+        std::cerr << "call_overhead: not converged: " << result.message() << "\n";
         return 1;
       }
       std::printf("%.9f\n", seconds);

@@ -148,7 +148,9 @@ int main(int argc, char** argv) {
     std::cerr << index << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
               << " s\n";
     if (o.only >= 0) {
-      std::cerr << request->label << "\n" << c.result.message << "\n" << rb::attemptLines(c.result);
+      std::cerr << request->label << "\n"
+                << c.result.message() << "\n"
+                << rb::attemptLines(c.result);
       break;
     }
     if (!o.out.empty()) std::ofstream(o.out) << tally.render(o);

@@ -133,7 +133,7 @@ void study(const std::string& path, int seeds, double extra_noise, double cycles
   }
   const PlanResult plan = planManeuver(scene.problem);
   if (!plan.converged()) {
-    std::fprintf(stderr, "%s: not planned: %s\n", path.c_str(), plan.message.c_str());
+    std::fprintf(stderr, "%s: not planned: %s\n", path.c_str(), plan.message().c_str());
     std::exit(1);
   }
   const Matrix3& J = scene.problem.inertia;

@@ -136,7 +136,7 @@ void constrained(const std::string& scenes, int repeats, std::ostream& out) {
       p.steps = N;
       const ap::PlanResult plan = timedPlan(p, nullptr).result;
       if (!plan.converged()) {
-        out << "| " << scene << " | " << N << " | plan not converged: " << plan.message
+        out << "| " << scene << " | " << N << " | plan not converged: " << plan.message()
             << " | | | | | | |\n";
         continue;
       }

@@ -235,7 +235,6 @@ PlanResult planToAccuracy(const PlanningProblem& problem, const SolverOptions& o
                         : "Richardson: |hC(N) - h'C(N/2)| / (2^p - 1)";
   const auto finish = [&](PlanResult result) {
     result.accuracy = estimate;
-    renderMessageOnce(&result);
     result.solve_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

@@ -200,7 +200,7 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
   out << "{\n"
       << "  \"converged\": " << (r.converged() ? "true" : "false") << ",\n"
       << "  \"termination\": " << jsonString(terminationName(r.termination)) << ",\n"
-      << "  \"message\": " << jsonString(r.message) << ",\n"
+      << "  \"message\": " << jsonString(r.message()) << ",\n"
       << "  \"solver\": " << jsonString(r.solver) << ",\n"
       << "  \"scheme\": " << jsonString(schemeName(planScheme(problem, r))) << ",\n"
       << "  \"steps\": " << planSteps(problem, r) << ",\n"
@@ -284,7 +284,7 @@ std::string planResultText(const PlanningProblem& problem, const PlanResult& r) 
   const int N = planSteps(problem, r);
   std::string text;
   text += line("converged", r.converged() ? "yes" : "NO (" + terminationName(r.termination) + ")");
-  text += line("message", r.message);
+  text += line("message", r.message());
   text += line("solver / scheme", r.solver + " / " + schemeName(planScheme(problem, r)));
   const double T = r.duration > 0 ? r.duration : problem.duration;
   text += line("steps N, duration T",

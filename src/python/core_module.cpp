@@ -207,7 +207,7 @@ py::dict plan(const ap::Scene& parsed,
     out["minimum_duration"] = result.minimum_duration;
     out["solve_time_s"] = result.solve_time_s;
     out["termination"] = ap::terminationName(result.termination);
-    out["message"] = result.message;
+    out["message"] = result.message();
     // The JSON summary is written when Python first asks for it (Result.summary): it costs as
     // much as the rest of the call's overhead together, and a batch row needs three numbers.
     out["summary"] = std::make_shared<HeldSummary>(HeldSummary{scene.problem, std::move(result)});

@@ -39,7 +39,7 @@ std::string infeasibleSummary(const PlanningProblem& problem, const PlanResult& 
   s << "infeasible: ";
   if (result.duration_verdict.proven_infeasible) {
     // The core's message opens with the bound and the bounds in force, then how it is proven.
-    const std::string& m = result.message;
+    const std::string& m = result.message();
     return m.substr(0, m.find(" (proven")) +
            " (proven; duration_verdict); details has the solver's account";
   }

@@ -288,7 +288,7 @@ ReplanAnswer planRemainder(const PlanningProblem& rest, const std::vector<Effect
     const PlanResult result = planManeuver(rest, options);  // rest's effects: already shifted
     answer.solve_time = result.solve_time_s;
     if (!result.converged()) {
-      answer.error = "planner: " + result.message;
+      answer.error = "planner: " + result.message();
       return answer;
     }
     answer.plan = result.maneuver;
@@ -337,7 +337,7 @@ bool planScene(const PlanningProblem& problem, const std::vector<EffectSpec>& ef
   }
   const PlanResult result = planManeuver(problem);
   if (!result.converged()) {
-    *error = "planner: " + result.message;
+    *error = "planner: " + result.message();
     return false;
   }
   const bool wheels = problem.reaction_wheels.present();

@@ -296,7 +296,7 @@ int main(int argc, char** argv) {
       if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
     }
     if (!result.converged()) {
-      std::cerr << "plan_maneuver: not converged: " << result.message << " (termination "
+      std::cerr << "plan_maneuver: not converged: " << result.message() << " (termination "
                 << ap::terminationName(result.termination) << ")\n";
       return 1;
     }

@@ -99,7 +99,7 @@ TEST(TrackerConstraintHealth, ProjectsAStartInsideAConeAndReportsTheWorstViolati
   ASSERT_TRUE(ros::param::get("~scene", scene_path));
   Scene scene = loadScene(scene_path);
   const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message();
   constexpr double kWidening = 3e-3;  // [rad]
   PlanningConstraint& cone = scene.problem.constraints.at(0);
   cone.half_angle += kWidening;

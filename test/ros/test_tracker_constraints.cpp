@@ -137,7 +137,7 @@ TEST(TrackerConstraints, TheServicePlanIsTheConstrainedOne) {
   ASSERT_TRUE(done->success) << done->message;
   const Scene scene = testScene();
   const PlanResult in_process = planManeuver(scene.problem);
-  ASSERT_TRUE(in_process.converged()) << in_process.message;
+  ASSERT_TRUE(in_process.converged()) << in_process.message();
   EXPECT_EQ(in_process.solver, "interior_point");  // the cone binds
   EXPECT_NEAR(done->plan_cost, in_process.cost, 1e-9 * in_process.cost);
   EXPECT_LT(done->terminal_attitude_error, 1e-9);

@@ -122,7 +122,7 @@ AttitudeManeuver slew(const Matrix3& start, const Vector3& rate, const std::stri
   p.duration = 12.8;
   p.steps = 32;
   const PlanResult plan = planManeuver(p);
-  EXPECT_TRUE(plan.converged()) << plan.message;
+  EXPECT_TRUE(plan.converged()) << plan.message();
   return rc::maneuverToMsg(plan.maneuver, p, "world", body_frame, ros::Time());
 }
 

@@ -46,7 +46,7 @@ PlanningProblem randomConstrainedPointingRequest(unsigned seed, int steps, bool 
   if (binding != PointingBinding::KeepOut) {
     PlanningProblem p = randomPointingRequest(seed, steps, spinning, scheme);
     const PlanResult free = planManeuver(p);
-    if (!free.converged()) throw std::runtime_error("unconstrained pointing: " + free.message);
+    if (!free.converged()) throw std::runtime_error("unconstrained pointing: " + free.message());
     Vector3 largest = Vector3::Zero();
     for (const Vector3& tau : free.maneuver.torque) largest = largest.cwiseMax(tau.cwiseAbs());
     double largest_norm = 0.0;
@@ -95,7 +95,7 @@ PlanningProblem randomBettsConstrainedPointingRequest(unsigned seed, int steps, 
     const double angle = std::atan2(start.cross(d).norm(), start.dot(d));
     if (angle < 0.8 || angle > 2.6) continue;
     const PlanResult free = planManeuver(p);
-    if (!free.converged()) throw std::runtime_error("pointing minimum time: " + free.message);
+    if (!free.converged()) throw std::runtime_error("pointing minimum time: " + free.message());
     double fastest = 0.0;
     for (const Vector3& w : free.maneuver.angular_velocity) fastest = std::max(fastest, w.norm());
     p.constraints.push_back(PlanningConstraint::keepOut(b, (start + d).normalized(), 0.35 * angle));

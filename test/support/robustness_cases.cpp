@@ -344,7 +344,7 @@ void intermediateAxisSpin(Recorder& r) {
     r.record(label, p, res);
     iterations.push_back(res.iterations);
     r.holds("T = 60: converged (judged by the plan, not by its open-loop replay)", res.converged(),
-            res.message.substr(0, 160));
+            res.message().substr(0, 160));
     r.atMost("T = 60: relative first-order residual at the end (stationary point found)",
              res.max_residual, 1e-9);
     r.atMost("T = 60: relative step residual of the plan", res.step_residual,
@@ -387,9 +387,9 @@ std::string convergesOrClearError(Recorder& r, const std::string& label, const P
     }
     r.holds(label + ": not converged, and the result says step too large / increase steps",
             res.termination == Termination::StepTooLarge &&
-                res.message.find("increase steps") != std::string::npos,
-            res.message);
-    return res.message;
+                res.message().find("increase steps") != std::string::npos,
+            res.message());
+    return res.message();
   } catch (const StepTooLarge& e) {
     r.holds(label + ": StepTooLarge naming the fix (increase steps)",
             std::string(e.what()).find("increase steps") != std::string::npos, e.what());
@@ -515,7 +515,7 @@ void Recorder::record(const std::string& label, const PlanningProblem& problem,
   f.dynamics_residual = res.dynamics_residual;
   f.solve_time_s = res.solve_time_s;
   f.extremal = res.extremal;
-  f.message = res.message;
+  f.message = res.message();
   outcome_.runs.push_back(f);
 }
 
@@ -523,7 +523,7 @@ PlanResult Recorder::plan(const std::string& label, const PlanningProblem& probl
                           const SolverOptions& options, double terminal_bound) {
   PlanResult res = planManeuver(problem, options);
   record(label, problem, res);
-  holds(label + ": converged", res.converged(), res.message);
+  holds(label + ": converged", res.converged(), res.message());
   holds(label + ": no NaN/Inf in R_k, Ω_k, τ_k, cost",
         allFinite(res.maneuver) && std::isfinite(res.cost));
   atMost(label + ": terminal attitude error [rad]", res.terminal_attitude_error, terminal_bound);

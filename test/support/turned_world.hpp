@@ -23,8 +23,8 @@ inline PlanningProblem inATurnedWorld(PlanningProblem p, const Matrix3& Q) {
 inline PlanResult expectSameTStarWhenTurned(const PlanningProblem& turned, const PlanResult& answer,
                                             double relative, const std::string& label) {
   const PlanResult in_turned = planManeuver(turned);
-  EXPECT_TRUE(in_turned.converged()) << label << ": " << in_turned.message;
-  EXPECT_TRUE(in_turned.minimum_time.kkt_point) << label << ": " << in_turned.message;
+  EXPECT_TRUE(in_turned.converged()) << label << ": " << in_turned.message();
+  EXPECT_TRUE(in_turned.minimum_time.kkt_point) << label << ": " << in_turned.message();
   EXPECT_NEAR(in_turned.minimum_duration, answer.minimum_duration,
               relative * answer.minimum_duration)
       << label;

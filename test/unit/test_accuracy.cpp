@@ -124,8 +124,8 @@ TEST(ZeroOrderHold, TorqueFreeAnisotropicBodyConservesEnergyAndMomentum) {
   EXPECT_GT((W - W0).norm(), 0.1);  // the body did tumble
 }
 
-// The orders the planner relies on (measuredOrder, docs/results/accuracy.md) hold on a small sweep of
-// both seed examples and all schemes (property test: ±0.2). Trajectory and torque errors are
+// The orders the planner relies on (measuredOrder, docs/results/accuracy.md) hold on a small sweep
+// of both seed examples and all schemes (property test: ±0.2). Trajectory and torque errors are
 // documented as order 1 for paper and variational, 2 for second_order (which also has order 2
 // in the velocity miss, ≥ 1.9 being the target).
 TEST(MeasuredOrders, SmallSweepAgreesWithDocumentedOrders) {
@@ -178,7 +178,7 @@ TEST(PlanToAccuracy, TerminalMissTargetIsMetAndReported) {
     p.accuracy.measure = AccuracyMeasure::TerminalMiss;
     p.accuracy.value = target;
     const PlanResult plan = planManeuver(p);
-    ASSERT_TRUE(plan.converged()) << plan.message;
+    ASSERT_TRUE(plan.converged()) << plan.message();
     ASSERT_TRUE(plan.accuracy.requested);
     EXPECT_EQ(plan.scheme, scheme);
     EXPECT_LE(plan.accuracy.estimated_error, target);
@@ -200,7 +200,7 @@ TEST(PlanToAccuracy, UnreachableTargetFailsFastNamingTheSteps) {
   p.accuracy.value = 1e-8;
   const PlanResult plan = planManeuver(p);
   EXPECT_FALSE(plan.converged());
-  EXPECT_NE(plan.message.find("> max_steps"), std::string::npos) << plan.message;
+  EXPECT_NE(plan.message().find("> max_steps"), std::string::npos) << plan.message();
   EXPECT_EQ(plan.accuracy.steps_tried.size(), 1u);  // only the coarse resolution was solved
 }
 
@@ -210,7 +210,7 @@ TEST(PlanToAccuracy, CostErrorEstimateIsHonest) {
   p.accuracy.value = 1e-2;
   p.accuracy.choose_scheme = true;
   const PlanResult plan = planManeuver(p);
-  ASSERT_TRUE(plan.converged()) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message();
   EXPECT_LE(plan.accuracy.estimated_error, 1e-2);
   EXPECT_EQ(plan.accuracy.schemes_tried.size(), plan.accuracy.steps_tried.size());
   PlanningProblem at_N = seedProblem(true);
@@ -232,7 +232,7 @@ TEST(PlanToAccuracy, WithTorqueLimitsTheTargetsHoldAndTheCostEstimateIsAnUpperBo
   p.accuracy.measure = AccuracyMeasure::TerminalMiss;
   p.accuracy.value = 1e-5;
   const PlanResult miss = planManeuver(p);
-  ASSERT_TRUE(miss.converged()) << miss.message;
+  ASSERT_TRUE(miss.converged()) << miss.message();
   EXPECT_LE(miss.accuracy.estimated_error, 1e-5);
   EXPECT_LE(miss.max_constraint_violation, 1e-8);
   EXPECT_GT(miss.active_constraints, 0);  // the limits bind
@@ -244,14 +244,14 @@ TEST(PlanToAccuracy, WithTorqueLimitsTheTargetsHoldAndTheCostEstimateIsAnUpperBo
   p.accuracy.measure = AccuracyMeasure::CostError;
   p.accuracy.value = 1e-3;
   const PlanResult cost = planManeuver(p);
-  ASSERT_TRUE(cost.converged()) << cost.message;
+  ASSERT_TRUE(cost.converged()) << cost.message();
   EXPECT_EQ(cost.accuracy.order, 1.0);
   EXPECT_LE(cost.accuracy.estimated_error, 1e-3);
   PlanningProblem fine = p;
   fine.accuracy = AccuracyTarget{};
   fine.steps = 8192;
   const PlanResult reference = planManeuver(fine);
-  ASSERT_TRUE(reference.converged()) << reference.message;
+  ASSERT_TRUE(reference.converged()) << reference.message();
   const double actual = std::abs(cost.effort - reference.effort);
   std::printf("torque limits, cost error target 1e-3: N = %d, estimate %.3g, actual %.3g\n",
               cost.maneuver.steps(), cost.accuracy.estimated_error, actual);

@@ -32,7 +32,7 @@ PlanningProblem sceneProblem(const std::string& name, int N) {
 /// tolerance; a stopped interior point's too).
 void expectAnytimePlan(const PlanningProblem& p, const PlanResult& r, double tolerance) {
   const int N = p.steps;
-  ASSERT_EQ(r.maneuver.steps(), N) << r.message;
+  ASSERT_EQ(r.maneuver.steps(), N) << r.message();
   ASSERT_EQ(static_cast<int>(r.maneuver.attitude.size()), N + 1);
   for (int k = 0; k <= N; ++k) {
     ASSERT_LT(so3::orthogonalityError(r.maneuver.attitude[k]), 1e-12) << "R_" << k;
@@ -42,15 +42,15 @@ void expectAnytimePlan(const PlanningProblem& p, const PlanResult& r, double tol
   EXPECT_LT(so3::angleBetween(r.maneuver.attitude[N], p.final_attitude), 1e-12);
   EXPECT_LT((r.maneuver.angular_velocity[0] - p.initial_velocity).norm(), 1e-12);
   EXPECT_LT((r.maneuver.angular_velocity[N - 1] - p.final_velocity).norm(), 1e-12);
-  EXPECT_LT(test_support::paperEquationMiss(p.inertia, r.maneuver), 1e-11) << r.message;
+  EXPECT_LT(test_support::paperEquationMiss(p.inertia, r.maneuver), 1e-11) << r.message();
   // The package's own step residual, reported with the plan, agrees with the equations above.
   const StepResidual own = measureStepResidual(p, r.maneuver);
   EXPECT_LE(own.relative, own.tolerance);
   EXPECT_NEAR(r.step_residual, own.relative, 1e-15);
   // Not an answer, and its figures say so.
   EXPECT_FALSE(r.converged());
-  EXPECT_TRUE(std::isfinite(r.max_residual)) << r.message;
-  EXPECT_GT(r.max_residual, tolerance) << r.message;
+  EXPECT_TRUE(std::isfinite(r.max_residual)) << r.message();
+  EXPECT_GT(r.max_residual, tolerance) << r.message();
   EXPECT_TRUE(std::isfinite(r.cost));
   EXPECT_GT(r.cost, 0.0);
   // Handed over without its open-loop replay (N implicit steps), and said so as data.
@@ -84,7 +84,7 @@ TEST(AnytimePlan, TimedOutBeforeTheFirstIterationReturnsTheStartWithItsResiduals
   SolverOptions options;
   options.time_budget_s = 1e-9;
   const PlanResult r = planManeuver(p, options);
-  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message;
+  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message();
   expectAnytimePlan(p, r, options.tolerance);
 }
 
@@ -93,7 +93,7 @@ TEST(AnytimePlan, TimedOutAfterSomeIterationsReturnsTheIterateOnTheGroup) {
     const PlanningProblem p = sceneProblem("rest_to_rest.yaml", N);
     const SolverOptions options = stoppedAt(3, 0.2);
     const PlanResult r = planManeuver(p, options);
-    EXPECT_EQ(r.termination, Termination::TimedOut) << N << ": " << r.message;
+    EXPECT_EQ(r.termination, Termination::TimedOut) << N << ": " << r.message();
     expectAnytimePlan(p, r, 1e-10);
   }
 }
@@ -102,7 +102,7 @@ TEST(AnytimePlan, CancelledReturnsTheIterateOnTheGroup) {
   for (int N : {32, 512}) {
     const PlanningProblem p = sceneProblem("rest_to_rest.yaml", N);
     const PlanResult r = planManeuver(p, stoppedAt(2, 0.0));
-    EXPECT_EQ(r.termination, Termination::Cancelled) << N << ": " << r.message;
+    EXPECT_EQ(r.termination, Termination::Cancelled) << N << ": " << r.message();
     expectAnytimePlan(p, r, 1e-10);
   }
 }
@@ -122,7 +122,7 @@ TEST(AnytimePlan, StoppedUnderConstraintsReturnsTheIterateWithItsViolations) {
   ASSERT_GT(newton_iterations, 2);
   for (int stop_at : {2, newton_iterations + 3}) {
     const PlanResult r = planManeuver(p, stoppedAt(stop_at, 0.0));
-    EXPECT_EQ(r.termination, Termination::Cancelled) << stop_at << ": " << r.message;
+    EXPECT_EQ(r.termination, Termination::Cancelled) << stop_at << ": " << r.message();
     expectAnytimePlan(p, r, 1e-10);
     ASSERT_EQ(r.constraints.size(), 1u) << stop_at;
     EXPECT_TRUE(std::isfinite(r.max_constraint_violation));
@@ -136,7 +136,7 @@ TEST(AnytimePlan, OnlyAStoppedPlanIsHandedOverWithoutItsReplay) {
   // replay figures, measured: only TimedOut and Cancelled skip the replay.
   const PlanningProblem p = sceneProblem("rest_to_rest.yaml", 64);
   const PlanResult converged = planManeuver(p, SolverOptions());
-  ASSERT_TRUE(converged.converged()) << converged.message;
+  ASSERT_TRUE(converged.converged()) << converged.message();
   EXPECT_TRUE(converged.replay_measured);
   EXPECT_TRUE(std::isfinite(converged.replay_miss));
   EXPECT_LT(converged.replay_miss, 1e-8);
@@ -144,7 +144,7 @@ TEST(AnytimePlan, OnlyAStoppedPlanIsHandedOverWithoutItsReplay) {
   limited.tolerance = 1e-300;
   limited.max_iterations = 2;
   const PlanResult not_converged = planManeuver(p, limited);
-  ASSERT_EQ(not_converged.termination, Termination::NotConverged) << not_converged.message;
+  ASSERT_EQ(not_converged.termination, Termination::NotConverged) << not_converged.message();
   EXPECT_TRUE(not_converged.replay_measured);
   EXPECT_TRUE(std::isfinite(not_converged.replay_miss));
 }
@@ -172,16 +172,16 @@ TEST(AnytimePlan, ARefinementStoppedOnACoarseLevelHandsOverItsOwnIterate) {
     options.time_budget_s = budget;
     const PlanResult r = planManeuver(p, options);
     EXPECT_EQ(r.termination, budget > 0.0 ? Termination::TimedOut : Termination::Cancelled)
-        << r.message;
+        << r.message();
     expectAnytimePlan(p, r, 1e-10);
     ASSERT_FALSE(r.attempts.empty());
     const Attempt& last = r.attempts.back();
-    EXPECT_EQ(last.stage, AttemptStage::ClassRefine) << r.message;
-    EXPECT_TRUE(last.kept) << r.message;
+    EXPECT_EQ(last.stage, AttemptStage::ClassRefine) << r.message();
+    EXPECT_TRUE(last.kept) << r.message();
     EXPECT_EQ(last.termination, r.termination);
     for (const Attempt& a : r.attempts) {
       EXPECT_NE(a.stage, AttemptStage::Solve)
-          << "a second attempt ran after the stop: " << r.message;
+          << "a second attempt ran after the stop: " << r.message();
     }
   }
 }

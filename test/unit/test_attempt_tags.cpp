@@ -99,7 +99,7 @@ TEST(AttemptTags, AClassSurveysIterationsAreTaggedWithTheTrailsStagesAndClasses)
   ap::PlanningProblem p = ap::test_support::sceneProblem("rest_to_rest", 64);
   ap::PlanResult r;
   const std::vector<ap::IterationInfo> infos = reported(p, &r);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_FALSE(infos.empty());
   EXPECT_TRUE(std::all_of(infos.begin(), infos.end(),
                           [](const ap::IterationInfo& i) { return i.attempt.number > 0; }));
@@ -108,7 +108,7 @@ TEST(AttemptTags, AClassSurveysIterationsAreTaggedWithTheTrailsStagesAndClasses)
   const auto surveys = std::count_if(infos.begin(), infos.end(), [](const ap::IterationInfo& i) {
     return i.attempt.stage == ap::AttemptStage::ClassSurvey;
   });
-  EXPECT_GT(surveys, 0) << r.message;
+  EXPECT_GT(surveys, 0) << r.message();
 }
 
 TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
@@ -121,12 +121,12 @@ TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
     const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, 64);
     ap::PlanResult r;
     const std::vector<ap::IterationInfo> infos = reported(p, &r);
-    ASSERT_FALSE(infos.empty()) << r.message;
+    ASSERT_FALSE(infos.empty()) << r.message();
     EXPECT_TRUE(std::any_of(
         r.attempts.begin(), r.attempts.end(),
         [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
-        << "the interior point ran: " << r.message;
-    EXPECT_EQ(byTag(infos), byTrail(r.attempts)) << r.message;
+        << "the interior point ran: " << r.message();
+    EXPECT_EQ(byTag(infos), byTrail(r.attempts)) << r.message();
     EXPECT_EQ(static_cast<int>(infos.size()), r.iterations);
   }
 }
@@ -136,7 +136,7 @@ TEST(AttemptTags, AConstrainedRequestsAttemptsCountTheIterationsTheyReported) {
 void expectTheContextsTrail(const ap::PlanResult& r, const ap::SolveContext& context,
                             bool one_kept = true) {
   const std::vector<ap::Attempt>& trail = context.attempts();
-  ASSERT_EQ(trail.size(), r.attempts.size()) << r.message;
+  ASSERT_EQ(trail.size(), r.attempts.size()) << r.message();
   for (std::size_t i = 0; i < trail.size(); ++i) {
     SCOPED_TRACE(i);
     const ap::Attempt &a = r.attempts[i], &b = trail[i];
@@ -160,7 +160,7 @@ void expectTheContextsTrail(const ap::PlanResult& r, const ap::SolveContext& con
   const auto kept = [](const std::vector<ap::Attempt>& t) {
     return std::count_if(t.begin(), t.end(), [](const ap::Attempt& a) { return a.kept; });
   };
-  if (one_kept) EXPECT_EQ(kept(r.attempts), 1) << r.message;
+  if (one_kept) EXPECT_EQ(kept(r.attempts), 1) << r.message();
   EXPECT_EQ(kept(trail), kept(r.attempts));
 }
 
@@ -180,7 +180,7 @@ TEST(AttemptTags, AConstrainedRequestsTrailIsTheContextsTrail) {
       ASSERT_TRUE(std::any_of(
           r.attempts.begin(), r.attempts.end(),
           [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
-          << "the interior point ran: " << r.message;
+          << "the interior point ran: " << r.message();
       expectTheContextsTrail(r, context);
       // The interior point's continuation is one attempt: the Newton solve that starts its
       // coarsest level (which its scope would name `constrained`) is no attempt of the trail.
@@ -188,7 +188,7 @@ TEST(AttemptTags, AConstrainedRequestsTrailIsTheContextsTrail) {
         return a.formulation == ap::Formulation::Unconstrained &&
                (a.stage == ap::AttemptStage::Constrained ||
                 a.stage == ap::AttemptStage::ConstrainedRetry);
-      })) << r.message;
+      })) << r.message();
     }
   }
 }
@@ -204,7 +204,7 @@ TEST(AttemptTags, AFourthOrderRequestsTrailIsTheContextsTrail) {
     const ap::SolverOptions options;
     ap::SolveContext context(options);
     const ap::PlanResult r = ap::planAtResolution(p, options, context);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     expectTheContextsTrail(r, context);
     const auto named = [&](ap::AttemptStage stage) {
       return std::any_of(r.attempts.begin(), r.attempts.end(),
@@ -243,7 +243,7 @@ TEST(AttemptTags, AMinimumTimeRequestsTrailIsTheContextsTrail) {
     const ap::SolverOptions options;
     ap::SolveContext context(options);
     const ap::PlanResult r = ap::planMinimumTime(p, context);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     ASSERT_FALSE(r.attempts.empty());
     expectTheContextsTrail(r, context);
   }
@@ -252,7 +252,7 @@ TEST(AttemptTags, AMinimumTimeRequestsTrailIsTheContextsTrail) {
 /// Minimum effort for `p` (a minimum-time request) at 0.9 of its T*, planned in `context`.
 ap::PlanResult boundedBelowItsMinimumTime(ap::PlanningProblem p, ap::SolveContext& context) {
   const ap::PlanResult fastest = ap::planManeuver(p, ap::SolverOptions());
-  EXPECT_TRUE(fastest.converged()) << fastest.message;
+  EXPECT_TRUE(fastest.converged()) << fastest.message();
   p.objective = ap::Objective::MinimumEffort;
   p.duration = 0.9 * fastest.minimum_duration;
   return ap::planBoundedMinimumEffort(p, context);
@@ -266,11 +266,11 @@ TEST(AttemptTags, ABoundedRequestsTrailIsTheContextsTrail) {
   const ap::SolverOptions options;
   ap::SolveContext context(options);
   const ap::PlanResult r = boundedBelowItsMinimumTime(p, context);
-  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message();
   const bool minimum_time_phase = std::any_of(
       r.attempts.begin(), r.attempts.end(),
       [](const ap::Attempt& a) { return a.stage == ap::AttemptStage::MinimumTimeSolve; });
-  EXPECT_TRUE(minimum_time_phase) << r.message;
+  EXPECT_TRUE(minimum_time_phase) << r.message();
   expectTheContextsTrail(r, context, false);
 }
 
@@ -282,7 +282,7 @@ TEST(AttemptTags, APointingRequestsTrailIsTheContextsTrail) {
   const ap::SolverOptions options;
   ap::SolveContext context(options);
   const ap::PlanResult r = ap::planAtResolution(p, options, context);
-  ASSERT_FALSE(r.attempts.empty()) << r.message;
+  ASSERT_FALSE(r.attempts.empty()) << r.message();
   expectTheContextsTrail(r, context, r.converged());
 }
 
@@ -298,7 +298,7 @@ TEST(AttemptTags, APointingMinimumTimeRequestsTrailIsTheContextsTrailTaggedWithI
     const ap::SolverOptions options;
     ap::SolveContext context(options);
     const ap::PlanResult r = ap::planMinimumTime(p, context);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     ASSERT_FALSE(r.attempts.empty());
     expectTheContextsTrail(r, context);
     std::set<double> twists;
@@ -319,17 +319,17 @@ TEST(AttemptTags, ABoundedPointingRequestsTrailIsTheContextsTrail) {
   const ap::SolverOptions options;
   ap::SolveContext context(options);
   const ap::PlanResult r = boundedBelowItsMinimumTime(p, context);
-  EXPECT_FALSE(r.converged()) << r.message;
+  EXPECT_FALSE(r.converged()) << r.message();
   EXPECT_TRUE(std::any_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return a.stage == ap::AttemptStage::MinimumTimeSolve && std::isfinite(a.start_detail.twist);
-  })) << r.message;
+  })) << r.message();
   expectTheContextsTrail(r, context, false);
 }
 
 /// The result's levels are what the request's context recorded, level for level.
 void expectTheContextsLevels(const ap::PlanResult& r, const ap::SolveContext& context) {
   const std::vector<ap::LevelSummary>& levels = context.levels();
-  ASSERT_EQ(levels.size(), r.levels.size()) << r.message;
+  ASSERT_EQ(levels.size(), r.levels.size()) << r.message();
   for (std::size_t i = 0; i < levels.size(); ++i) {
     SCOPED_TRACE(i);
     EXPECT_EQ(r.levels[i].steps, levels[i].steps);
@@ -354,11 +354,11 @@ TEST(AttemptTags, AConstrainedRequestsLevelsAreTheContextsLevels) {
       options.enumerate_classes = false;  // one class: the request's levels alone
       ap::SolveContext context(options);
       const ap::PlanResult r = ap::planAtResolution(p, options, context);
-      ASSERT_FALSE(r.levels.empty()) << r.message;
+      ASSERT_FALSE(r.levels.empty()) << r.message();
       expectTheContextsLevels(r, context);
       EXPECT_TRUE(std::any_of(r.levels.begin(), r.levels.end(), [&](const ap::LevelSummary& l) {
         return l.steps == steps;
-      })) << r.message;
+      })) << r.message();
     }
   }
 }
@@ -369,12 +369,12 @@ TEST(AttemptTags, TheKeptAttemptOfAConstrainedRequestIsAmongTheTagsReported) {
   const ap::PlanningProblem p = ap::test_support::sceneProblem("torque_limited", 64);
   ap::PlanResult r;
   const std::vector<ap::IterationInfo> infos = reported(p, &r);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(),
                                  [](const ap::Attempt& a) { return a.kept; });
   ASSERT_NE(kept, r.attempts.end());
   const std::map<StageAndClass, int> tags = byTag(infos);
-  EXPECT_EQ(tags.count(keyOf(kept->stage, kept->homotopy)), 1u) << r.message;
+  EXPECT_EQ(tags.count(keyOf(kept->stage, kept->homotopy)), 1u) << r.message();
   EXPECT_TRUE(std::any_of(infos.begin(), infos.end(), [](const ap::IterationInfo& i) {
     return i.attempt.stage == ap::AttemptStage::Constrained;
   }));
@@ -390,7 +390,7 @@ TEST(AttemptTags, ASpinningMinimumTimeRequestsClassOptimaRunInTheRequestsContext
   p.initial_velocity = ap::Vector3(0.2, 0.0, 0.0);
   ap::PlanResult r;
   const std::vector<ap::IterationInfo> infos = reported(p, &r);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   std::set<std::pair<bool, int>> classes;
   for (const ap::IterationInfo& i : infos) {
     if (i.attempt.stage == ap::AttemptStage::MinimumTimeSolve) {
@@ -413,7 +413,7 @@ TEST(AttemptTags, ASpinningMinimumTimeRequestsClassOptimaRunInTheRequestsContext
     return false;  // cancel at once
   };
   const ap::PlanResult cancelled = ap::planManeuver(p, options);
-  EXPECT_EQ(cancelled.termination, ap::Termination::Cancelled) << cancelled.message;
+  EXPECT_EQ(cancelled.termination, ap::Termination::Cancelled) << cancelled.message();
   ASSERT_FALSE(until_cancel.empty());
   EXPECT_EQ(until_cancel.front().attempt.stage, ap::AttemptStage::MinimumTimeSolve);
   EXPECT_EQ(until_cancel.size(), 1u);

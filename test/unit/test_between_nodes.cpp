@@ -132,7 +132,7 @@ TEST(BetweenNodes, PlannedSunKeepOutDipsBetweenNodesWithinTheBound) {
   // max_violation_between_nodes is what the sampling finds.
   const ap::PlanningProblem p = coarseSunKeepOut();
   const ap::PlanResult r = ap::planManeuver(p, ap::SolverOptions());
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const ap::PlanningConstraint& cone = p.constraints[0];
   EXPECT_LE(r.max_constraint_violation, 1e-9);
   double worst = std::numeric_limits<double>::infinity();
@@ -159,14 +159,14 @@ TEST(BetweenNodes, PlannedSunKeepOutDipsBetweenNodesWithinTheBound) {
 TEST(BetweenNodes, MarginKeepsTheContinuousMotionOutOfTheCone) {
   ap::PlanningProblem p = coarseSunKeepOut();
   const ap::PlanResult plain = ap::planManeuver(p, ap::SolverOptions());
-  ASSERT_TRUE(plain.converged()) << plain.message;
+  ASSERT_TRUE(plain.converged()) << plain.message();
   const Sampled before = sampleCone(p.constraints[0], plain.maneuver);
   ASSERT_LT(before.worst_margin, -1e-4);
   // The margin for steps 25 % longer than the plain plan's longest (the detour lengthens them).
   const double margin = ap::requiredConeMargin(p.constraints[0], 1.25 * before.largest_step);
   p.constraints[0].margin = margin;
   const ap::PlanResult r = ap::planManeuver(p, ap::SolverOptions());
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const Sampled after = sampleCone(p.constraints[0], r.maneuver);
   // The guarantee needs the margin to cover the margined plan's own steps: checked, not assumed.
   ASSERT_LE(ap::requiredConeMargin(p.constraints[0], after.largest_step), margin);

@@ -139,14 +139,14 @@ TEST(BoundedVerdicts, AHopelessRequestAtTwoMillionStepsIsProvenInfeasibleBeforeA
   p.duration = 20.0;
   p.steps = 2000000;
   const PlanResult r = planManeuver(p);
-  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message;
+  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
   EXPECT_TRUE(r.duration_verdict.proven_infeasible);
   EXPECT_GT(r.duration_verdict.lower_bound, p.duration);
   EXPECT_EQ(r.iterations, 0);
   EXPECT_TRUE(r.attempts.empty());
   // The verdict as data: the bound, the request's T below the bound on its grid, which the
   // grid holds within O(h) of the continuous one.
-  ASSERT_TRUE(std::holds_alternative<verdicts::BelowProvenBound>(r.verdict)) << r.message;
+  ASSERT_TRUE(std::holds_alternative<verdicts::BelowProvenBound>(r.verdict)) << r.message();
   const auto& below = std::get<verdicts::BelowProvenBound>(r.verdict);
   EXPECT_EQ(below.lower_bound, r.duration_verdict.lower_bound);
   EXPECT_EQ(below.basis, r.duration_verdict.lower_bound_basis);
@@ -158,7 +158,7 @@ TEST(BoundedVerdicts, AHopelessRequestAtTwoMillionStepsIsProvenInfeasibleBeforeA
   // The same as minimum time with that duration as its upper bound.
   p.objective = Objective::MinimumTime;
   const PlanResult fastest = planManeuver(p);
-  EXPECT_EQ(fastest.termination, Termination::Infeasible) << fastest.message;
+  EXPECT_EQ(fastest.termination, Termination::Infeasible) << fastest.message();
   EXPECT_TRUE(fastest.duration_verdict.proven_infeasible);
   ASSERT_TRUE(std::holds_alternative<verdicts::BelowProvenBound>(fastest.verdict));
   EXPECT_TRUE(std::get<verdicts::BelowProvenBound>(fastest.verdict).upper_limit);
@@ -170,7 +170,7 @@ TEST(BoundedVerdicts, JustAboveTheBoundIsNotDeclaredInfeasibleByIt) {
   p.constraints = {PlanningConstraint::maxTorqueNorm(0.2)};
   p.duration = 1.05 * durationLowerBound(p).seconds;
   const PlanResult r = planManeuver(p);
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_FALSE(r.duration_verdict.proven_infeasible);
 }
 
@@ -179,10 +179,10 @@ TEST(BoundedVerdicts, MinimumTimeBetweenIdenticalRestStatesIsAnsweredAtOnce) {
   p.initial_attitude = p.final_attitude = so3::fromAxisAngle(Vector3(1, 2, 2).normalized(), 1.0);
   p.max_torque = Vector3::Constant(0.1);
   const PlanResult r = planManeuver(p);
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.minimum_duration, 0.0);
   EXPECT_EQ(r.iterations, 0);
-  EXPECT_TRUE(std::holds_alternative<verdicts::AlreadyAtRest>(r.verdict)) << r.message;
+  EXPECT_TRUE(std::holds_alternative<verdicts::AlreadyAtRest>(r.verdict)) << r.message();
   ASSERT_EQ(r.maneuver.steps(), p.steps);
   for (const Matrix3& R : r.maneuver.attitude) EXPECT_EQ(R, p.initial_attitude);
   for (const Vector3& tau : r.maneuver.torque) EXPECT_TRUE(tau.isZero(0.0));
@@ -223,7 +223,7 @@ TEST(BoundedVerdicts, MagnitudesOutsideTheFloatingPointRangeAreRefusedByField) {
     SCOPED_TRACE(c.what);
     try {
       const PlanResult r = planManeuver(c.problem);
-      ADD_FAILURE() << "answered " << terminationName(r.termination) << ": " << r.message;
+      ADD_FAILURE() << "answered " << terminationName(r.termination) << ": " << r.message();
     } catch (const InvalidInput& e) {
       EXPECT_EQ(e.field(), c.field) << e.what();
     }
@@ -258,7 +258,7 @@ TEST(HomotopyClasses, APlanIsNeverAnsweredAsAClassItIsNotIn) {
     for (int k = 1; k + 1 < r.maneuver.steps(); ++k) {
       turned += so3::angleBetween(r.maneuver.attitude[k], r.maneuver.attitude[k + 1]);
     }
-    EXPECT_GE(turned, 2 * M_PI * turns) << r.message;
+    EXPECT_GE(turned, 2 * M_PI * turns) << r.message();
     ASSERT_TRUE(r.extremal_summary.known);
     EXPECT_EQ(r.extremal_summary.homotopy.extra_revolutions, turns);
   }
@@ -275,7 +275,7 @@ TEST(BoundedVerdicts, SeededBoundedRequestsHaveHonestVerdicts) {
     SCOPED_TRACE(request->label);
     const robustness::VerdictCheck check = robustness::planAndCheck(*request);
     EXPECT_EQ(check.input_error, "");
-    EXPECT_EQ(check.wrong, "") << check.result.message;
+    EXPECT_EQ(check.wrong, "") << check.result.message();
   }
   EXPECT_GE(requests, 12);
 }
@@ -302,8 +302,8 @@ TEST(BoundedVerdicts, AnAnswerStoppedShortSaysWhetherItHoldsAPlanAtT) {
       const robustness::VerdictCheck check = robustness::planAndCheck(*request, options);
       const PlanResult& r = check.result;
       EXPECT_EQ(check.input_error, "");
-      EXPECT_EQ(check.wrong, "") << r.message;
-      if (r.converged()) EXPECT_TRUE(r.duration_verdict.plan_within_bounds) << r.message;
+      EXPECT_EQ(check.wrong, "") << r.message();
+      if (r.converged()) EXPECT_TRUE(r.duration_verdict.plan_within_bounds) << r.message();
       if (!r.converged() && r.duration_verdict.plan_within_bounds) ++stopped_within;
     }
   }
@@ -323,11 +323,11 @@ TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
     SCOPED_TRACE(request->label);
     const robustness::VerdictCheck check = robustness::planAndCheck(*request);
     const PlanResult& r = check.result;
-    EXPECT_EQ(check.wrong, "") << r.message;
+    EXPECT_EQ(check.wrong, "") << r.message();
     const bool climbed = std::any_of(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
       return a.stage == AttemptStage::DurationLadder;
     });
-    EXPECT_TRUE(climbed) << r.message;
+    EXPECT_TRUE(climbed) << r.message();
     const DurationVerdict& v = r.duration_verdict;
     if (r.converged()) {
       EXPECT_LE(checkConstraints(request->problem, r.maneuver).max_relative_violation, 1e-6);
@@ -338,8 +338,8 @@ TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
       EXPECT_GE(v.longest_duration_found, v.least_duration_found);
       EXPECT_LT(v.longest_duration_found, request->problem.duration);
     } else {
-      EXPECT_EQ(r.termination, Termination::NotConverged) << r.message;
-      EXPECT_EQ(r.message.find("(feasible:"), std::string::npos) << r.message;
+      EXPECT_EQ(r.termination, Termination::NotConverged) << r.message();
+      EXPECT_EQ(r.message().find("(feasible:"), std::string::npos) << r.message();
       // Where a rung converged, the durations at which plans were found are the answer's data.
       const bool rung_converged =
           std::any_of(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
@@ -373,8 +373,8 @@ TEST(BoundedVerdicts, SpinningMinimumTimeIsNotLeftWithoutAPlanWhereOneExists) {
     SCOPED_TRACE(request->label);
     const robustness::VerdictCheck check = robustness::planAndCheck(*request);
     EXPECT_EQ(check.input_error, "");
-    EXPECT_EQ(check.wrong, "") << check.result.message;
-    EXPECT_NE(check.result.termination, Termination::NotConverged) << check.result.message;
+    EXPECT_EQ(check.wrong, "") << check.result.message();
+    EXPECT_NE(check.result.termination, Termination::NotConverged) << check.result.message();
     if (check.result.converged()) EXPECT_GT(check.result.minimum_duration, 0.0);
   }
   EXPECT_GE(requests, 3);
@@ -393,8 +393,8 @@ TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBelowAFirstTNearItsFloor) {
   SCOPED_TRACE(request->label);
   const robustness::VerdictCheck check = robustness::planAndCheck(*request);
   EXPECT_EQ(check.input_error, "");
-  ASSERT_TRUE(check.result.converged()) << check.result.message;
-  EXPECT_EQ(check.wrong, "") << check.result.message;
+  ASSERT_TRUE(check.result.converged()) << check.result.message();
+  EXPECT_EQ(check.wrong, "") << check.result.message();
   EXPECT_GE(check.result.minimum_duration, discreteDurationLowerBound(request->problem));
 }
 
@@ -410,12 +410,12 @@ TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   ASSERT_TRUE(hasSpinningEnds(request->problem));
   SCOPED_TRACE(request->label);
   const robustness::VerdictCheck check = robustness::planAndCheck(*request);
-  ASSERT_TRUE(check.result.converged()) << check.result.message;
-  EXPECT_EQ(check.wrong, "") << check.result.message;
+  ASSERT_TRUE(check.result.converged()) << check.result.message();
+  EXPECT_EQ(check.wrong, "") << check.result.message();
   PlanningProblem below = request->problem;
   below.objective = Objective::MinimumEffort;
   below.duration = 0.8 * check.result.minimum_duration;
   const PlanResult r = planManeuver(below);
   EXPECT_FALSE(r.converged() && checkConstraints(below, r.maneuver).max_relative_violation <= 1e-6)
-      << "a plan at 0.8 T* = " << below.duration << " s: " << r.message;
+      << "a plan at 0.8 T* = " << below.duration << " s: " << r.message();
 }

@@ -127,7 +127,7 @@ TEST(ProjectOntoConstraints, LetsThePlannerReplanABodyJustInsideAKeepOutCone) {
   // node where the cone is active is refused as a start, and planned from once projected.
   const Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/sun_keep_out.yaml");
   const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message();
   const PlanningConstraint& cone = scene.problem.constraints.at(0);
   int k = 1;  // the node nearest the cone
   for (int i = 1; i < plan.maneuver.steps() / 2; ++i) {
@@ -168,6 +168,6 @@ TEST(ProjectOntoConstraints, LetsThePlannerReplanABodyJustInsideAKeepOutCone) {
   SolverOptions options;
   options.warm_start = &guess;
   const PlanResult replanned = planManeuver(rest, options);
-  EXPECT_TRUE(replanned.converged()) << replanned.message;
+  EXPECT_TRUE(replanned.converged()) << replanned.message();
   EXPECT_LE(replanned.max_constraint_violation, 1e-6);
 }

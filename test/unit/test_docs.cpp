@@ -151,8 +151,8 @@ TEST(CodeShape, HandMergedMessagesAndIterationCountsOnlyFall) {
   const std::string planning = kSourceDir + "/src/planning";
   const std::vector<std::string> owners = {"/problem/solve_context.", "/problem/message_notes."};
   int files = 0;
-  const auto messages =
-      linesContaining(planning, {"message +=", "message.append("}, owners, &files);
+  const std::vector<std::string> appends = {"message +=", "message.append(", "message->append("};
+  const auto messages = linesContaining(planning, appends, owners, &files);
   const auto iterations = linesContaining(planning, {"iterations +="}, owners, &files);
   EXPECT_GT(files, 40) << "the scan read no sources";
   std::string listed;
@@ -160,10 +160,9 @@ TEST(CodeShape, HandMergedMessagesAndIterationCountsOnlyFall) {
   for (const std::string& line : iterations) listed += line + "\n";
   EXPECT_LE(messages.size(), kMessageAppendsLeft) << listed;
   EXPECT_LE(iterations.size(), kIterationSumsLeft) << listed;
-  // The scan finds what it looks for: the one place that appends a clause.
+  // The scan finds what it looks for: the one place that appends a clause (the fold).
   int owner_files = 0;
-  EXPECT_FALSE(
-      linesContaining(planning + "/problem", {"message.append("}, {}, &owner_files).empty());
+  EXPECT_FALSE(linesContaining(planning + "/problem", appends, {}, &owner_files).empty());
   RecordProperty("message_appends", static_cast<int>(messages.size()));
   RecordProperty("iteration_sums", static_cast<int>(iterations.size()));
 }
@@ -171,7 +170,8 @@ TEST(CodeShape, HandMergedMessagesAndIterationCountsOnlyFall) {
 // The message is the fold of the answer's clauses (PlanResult::clauses, rendered in
 // problem/message_notes): the lines that assign a message outside it (a copy, a frame built by
 // hand, `message =` at a line's end included) only fall, and so do the words recorded as a bare
-// Reason (recordReason) instead of a kind, a note or a frame.
+// Reason (recordReason) instead of a kind, a note or a frame. An answer's message stores nothing:
+// PlanResult and the free-time outcome declare it as the rendering of their clauses.
 TEST(CodeShape, MessageAssignmentsOnlyFall) {
   // main 5e2b279: 49; 52ad54e: 41; e0578f8: 30; 9bd3e73: 24; a32e35a: 15 (19 with the lines
   // ending in `message =`)
@@ -202,6 +202,18 @@ TEST(CodeShape, MessageAssignmentsOnlyFall) {
     owned += std::regex_search(line, assignment) ? 1 : 0;
   }
   EXPECT_GT(owned, 0u) << "the scan finds what it looks for";
+  int declaring_files = 0;
+  std::vector<std::string> declared;
+  for (const std::string& dir : {"/include/attitude_planner/planning", "/src/planning"}) {
+    for (const std::string& line :
+         linesContaining(kSourceDir + dir, {"std::string message"}, owners, &declaring_files)) {
+      declared.push_back(line);
+    }
+  }
+  ASSERT_EQ(declared.size(), 2u) << "PlanResult's and FreeTimeOutcome's message";
+  for (const std::string& line : declared) {
+    EXPECT_NE(line.find("std::string message() const"), std::string::npos) << line;
+  }
   RecordProperty("message_assignments", static_cast<int>(assigned.size()));
   RecordProperty("bare_reasons", static_cast<int>(reasons.size()));
 }

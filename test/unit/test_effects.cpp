@@ -219,7 +219,7 @@ PlanningProblem leoSlew(bool with_effects) {
 
 TEST(Effects, PlanningWithEffectsLandsWhenReplayedUnderTheSameEffects) {
   const PlanResult r = planManeuver(leoSlew(true));
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_LE(r.terminal_attitude_error, 1e-9);  // evaluatePlan replays with the same effects
   EXPECT_LE(r.terminal_velocity_error, 1e-9);
   ASSERT_EQ(r.effects.size(), 2u);
@@ -264,7 +264,7 @@ TEST(Effects, TorqueLimitedPlansRespectTheBoundsAndCostAtLeastTheUnlimitedOne) {
   // active bounds at 70 % of the unbounded peak
   p.max_torque = Vector3::Constant(0.7 * largest);
   const PlanResult tight = planManeuver(p);
-  ASSERT_TRUE(tight.converged()) << tight.message;
+  ASSERT_TRUE(tight.converged()) << tight.message();
   EXPECT_EQ(tight.solver, "interior_point");
   EXPECT_LE(tight.terminal_attitude_error, 1e-10);
   int at_bound = 0;

@@ -66,7 +66,7 @@ TEST(ExtremalClasses, ARequestThatNamesItsClassGetsExactlyThatClass) {
   const PlanningProblem base = spinningProblem(draw);
   for (const HomotopyClass& c : {kClasses[1], kClasses[2], kClasses[3]}) {
     const PlanResult r = planManeuver(pinnedToClass(base, c));
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     EXPECT_TRUE(sameHomotopyClass(r.extremal_summary.homotopy, c)) << r.extremal;
     for (const Attempt& a : r.attempts) {
       EXPECT_TRUE(sameHomotopyClass(a.homotopy, c)) << attemptStageName(a.stage);
@@ -80,11 +80,11 @@ TEST(ExtremalClasses, AWarmStartedRequestIsNotEnumerated) {
   Draw draw(31);
   const PlanningProblem p = spinningProblem(draw);
   const PlanResult first = planManeuver(pinnedToClass(p, kClasses[1]));
-  ASSERT_TRUE(first.converged()) << first.message;
+  ASSERT_TRUE(first.converged()) << first.message();
   SolverOptions warm;
   warm.warm_start = &first.maneuver;
   const PlanResult r = planManeuver(p, warm);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   for (const Attempt& a : r.attempts) EXPECT_NE(a.stage, AttemptStage::ClassSurvey);
   EXPECT_NEAR(r.cost, first.cost, 1e-8 * first.cost);  // the guess's extremal, not another
 }
@@ -106,7 +106,7 @@ TEST(ExtremalClasses, ASpinHandedOverBetweenAxesTakesTheCheapestClass) {
   std::vector<PlanResult> own;
   for (const HomotopyClass& c : kClasses) {
     own.push_back(planManeuver(pinnedToClass(p, c), nearest_only));
-    ASSERT_TRUE(own.back().converged()) << own.back().message;
+    ASSERT_TRUE(own.back().converged()) << own.back().message();
     ASSERT_EQ(own.back().attempts.size(), 1u);  // each class alone, no survey
   }
   const auto cheapest =
@@ -115,7 +115,7 @@ TEST(ExtremalClasses, ASpinHandedOverBetweenAxesTakesTheCheapestClass) {
   ASSERT_GT(own[0].cost, 1.2 * cheapest->cost);
 
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_LE(r.cost, cheapest->cost * (1 + 1e-9)) << r.extremal;
   EXPECT_TRUE(sameHomotopyClass(r.extremal_summary.homotopy, cheapest->extremal_summary.homotopy))
       << r.extremal;
@@ -150,7 +150,7 @@ TEST(ExtremalClasses, TheDefaultIsNoCostlierThanAnyClassOnSeededSpinningProblems
   for (int i = 0; i < kCases; ++i) {
     const PlanningProblem p = spinningProblem(draw);
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << i << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << i << ": " << r.message();
     double least = std::numeric_limits<double>::infinity();
     for (const HomotopyClass& c : kClasses) {
       const PlanResult own = planManeuver(pinnedToClass(p, c), nearest_only);
@@ -213,7 +213,7 @@ bool triedConstrainedClasses(const PlanResult& r) {
 TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasibleClass) {
   const PlanningProblem p = coneAcrossTheShortWay();
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_TRUE(triedConstrainedClasses(r));
   EXPECT_LE(r.max_constraint_violation, 0.0);
   EXPECT_LE(r.max_violation_between_nodes, 1e-3);
@@ -230,14 +230,14 @@ TEST(ExtremalClasses, UnderAConeAcrossTheShortWayTheDefaultIsTheCheapestFeasible
       continue;
     }
     ++from_survey;
-    EXPECT_EQ(a.start, AttemptStart::PreviousAttempt) << a.steps << ": " << r.message;
+    EXPECT_EQ(a.start, AttemptStart::PreviousAttempt) << a.steps << ": " << r.message();
   }
-  EXPECT_GE(from_survey, 4) << r.message;
+  EXPECT_GE(from_survey, 4) << r.message();
   ASSERT_TRUE(r.extremal_summary.known);
   SolverOptions nearest_only;
   nearest_only.enumerate_classes = false;
   const PlanResult own = planManeuver(pinnedToClass(p, r.extremal_summary.homotopy), nearest_only);
-  ASSERT_TRUE(own.converged()) << own.message;
+  ASSERT_TRUE(own.converged()) << own.message();
   EXPECT_NEAR(r.cost, own.cost, 1e-8 * own.cost) << r.extremal;
 }
 
@@ -266,7 +266,7 @@ TEST(ExtremalClasses, UnderATorqueNormBoundTheDefaultIsNoCostlierThanAnyClass) {
     PlanningProblem p = spinningProblem(draw);
     p.steps = 64;
     const PlanResult free = planManeuver(p);
-    ASSERT_TRUE(free.converged()) << i << ": " << free.message;
+    ASSERT_TRUE(free.converged()) << i << ": " << free.message();
     double peak = 0.0;
     for (const Vector3& tau : free.maneuver.torque) peak = std::max(peak, tau.norm());
     p.constraints.push_back(PlanningConstraint::maxTorqueNorm(0.85 * peak));
@@ -274,7 +274,7 @@ TEST(ExtremalClasses, UnderATorqueNormBoundTheDefaultIsNoCostlierThanAnyClass) {
     if (!std::isfinite(least)) continue;
     ++compared;
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << i << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << i << ": " << r.message();
     EXPECT_LE(r.cost, least * (1 + 1e-6)) << i << ": " << r.extremal;
   }
   std::printf("%d of %d cases compared\n", compared, kCases);

@@ -46,7 +46,7 @@ TEST(FourthOrder, SmallSweepMeasuresOrderFourInEveryMeasure) {
     for (int N = 32; N <= 256; N *= 2) {
       p.steps = N;
       const PlanResult plan = planManeuver(p);
-      ASSERT_TRUE(plan.converged()) << plan.message;
+      ASSERT_TRUE(plan.converged()) << plan.message();
       EXPECT_EQ(plan.scheme, SchemeKind::FourthOrder);
       EXPECT_EQ(plan.maneuver.steps(), N);
       const AccuracyMeasures m = measureAccuracy(p, plan.maneuver, ref);
@@ -85,7 +85,7 @@ TEST(FourthOrder, SeedRestToRestTorqueWithinOnePpmAtSixtyFourSteps) {
   ASSERT_TRUE(ref.converged) << ref.message;
   p.steps = 64;
   const PlanResult plan = planManeuver(p);
-  ASSERT_TRUE(plan.converged()) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message();
   const AccuracyMeasures m = measureAccuracy(p, plan.maneuver, ref);
   EXPECT_LE(m.torque_error / maxTorque(plan.maneuver), 1e-6);
   // and the effort converges to the continuous optimum's
@@ -107,7 +107,7 @@ TEST(FourthOrder, IsotropicRestToRestClosedForm) {
     p.final_attitude = so3::fromAxisAngle(a, theta);
     p.scheme = SchemeKind::FourthOrder;
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     const double h = T / N;
     double te = 0, re = 0;
     for (int k = 0; k <= N; ++k) {
@@ -139,7 +139,7 @@ TEST(FourthOrder, EquivarianceUnderWorldRotation) {
   p.initial_attitude = Q * p.initial_attitude;
   p.final_attitude = Q * p.final_attitude;
   const PlanResult b = planManeuver(p);
-  ASSERT_TRUE(a.converged() && b.converged()) << a.message << " / " << b.message;
+  ASSERT_TRUE(a.converged() && b.converged()) << a.message() << " / " << b.message();
   double torque = 0, attitude = 0, velocity = 0;
   for (int k = 0; k <= 64; ++k) {
     torque = std::max(torque, (a.maneuver.torque[k] - b.maneuver.torque[k]).norm());
@@ -181,7 +181,7 @@ TEST(FourthOrder, IsTheRichardsonCombinationOfSecondOrderAtNAndTwoN) {
       coarse_converged_before = true;
     }
   }
-  EXPECT_EQ(kept, 1) << four.message;
+  EXPECT_EQ(kept, 1) << four.message();
   for (int k = 0; k <= 32; ++k) {
     const Vector3 tau = fine.maneuver.torque[2 * k] +
                         (fine.maneuver.torque[2 * k] - coarse.maneuver.torque[k]) / 3.0;
@@ -240,7 +240,7 @@ TEST(FourthOrder, ReplayWithCubicHoldAndRkmk4IsOrderFour) {
     for (int N = 32; N <= 256; N *= 2) {
       p.steps = N;
       const PlanResult plan = planManeuver(p);
-      ASSERT_TRUE(plan.converged()) << plan.message;
+      ASSERT_TRUE(plan.converged()) << plan.message();
       SimulationInput input;
       input.initial_attitude = p.initial_attitude;
       input.initial_velocity = p.initial_velocity;
@@ -292,10 +292,10 @@ TEST(FourthOrder, UnconvergedSubSolveIsReported) {
   options.max_iterations = 1;
   const PlanResult r = planManeuver(p, options);
   EXPECT_FALSE(r.converged());
-  EXPECT_NE(r.message.find("fourth_order (Richardson extrapolation of second_order at N = 256"),
+  EXPECT_NE(r.message().find("fourth_order (Richardson extrapolation of second_order at N = 256"),
             std::string::npos)
-      << r.message;
-  EXPECT_NE(r.message.find("did not converge"), std::string::npos) << r.message;
+      << r.message();
+  EXPECT_NE(r.message().find("did not converge"), std::string::npos) << r.message();
 }
 
 TEST(FourthOrder, SceneKeyAndAutoChoice) {
@@ -314,7 +314,7 @@ TEST(FourthOrder, SceneKeyAndAutoChoice) {
   p.accuracy.value = 1e-8;
   p.accuracy.choose_scheme = true;
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_GE(r.accuracy.schemes_tried.size(), 4u);
   EXPECT_EQ(r.accuracy.schemes_tried[3], "fourth_order");
   EXPECT_EQ(r.scheme, SchemeKind::FourthOrder);
@@ -346,7 +346,7 @@ TEST(FourthOrder, ConstrainedScenesPlanThroughTheInteriorPoint) {
     p.steps = 64;
     p.scheme = SchemeKind::FourthOrder;
     const PlanResult four = planManeuver(p);
-    ASSERT_TRUE(four.converged()) << c.scene << ": " << four.message;
+    ASSERT_TRUE(four.converged()) << c.scene << ": " << four.message();
     EXPECT_EQ(four.scheme, SchemeKind::FourthOrder);
     EXPECT_FALSE(four.constraints.empty()) << c.scene;
     EXPECT_LE(four.max_constraint_violation, 1e-8) << c.scene;
@@ -355,7 +355,7 @@ TEST(FourthOrder, ConstrainedScenesPlanThroughTheInteriorPoint) {
     }
     p.scheme = SchemeKind::SecondOrder;
     const PlanResult second = planManeuver(p);
-    ASSERT_TRUE(second.converged()) << c.scene << ": " << second.message;
+    ASSERT_TRUE(second.converged()) << c.scene << ": " << second.message();
     EXPECT_LT(std::abs(four.effort - c.converged_effort),
               0.3 * std::abs(second.effort - c.converged_effort))
         << c.scene << ": fourth_order " << four.effort << ", second_order " << second.effort;
@@ -370,10 +370,10 @@ TEST(FourthOrder, MinimumTimeOnTheSphere) {
   p.steps = 32;
   p.scheme = SchemeKind::FourthOrder;
   const PlanResult four = planManeuver(p);
-  ASSERT_TRUE(four.converged()) << four.message;
+  ASSERT_TRUE(four.converged()) << four.message();
   p.scheme = SchemeKind::SecondOrder;
   const PlanResult second = planManeuver(p);
-  ASSERT_TRUE(second.converged()) << second.message;
+  ASSERT_TRUE(second.converged()) << second.message();
   const double exact = 2 * std::sqrt(10.0);
   EXPECT_NEAR(four.minimum_duration, exact, 1e-3 * exact);
   EXPECT_LT(std::abs(four.minimum_duration - exact), std::abs(second.minimum_duration - exact));

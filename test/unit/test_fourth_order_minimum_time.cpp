@@ -43,9 +43,9 @@ TEST(FourthOrderMinimumTime, IsTheLargerSecondOrderTStarAKktPointNoSlowerThanThe
       const ap::PlanningProblem p = fourthOrder(name, N);
       EXPECT_EQ(ap::freeTimeUnsupported(p), "");
       const ap::PlanResult r = ap::planManeuver(p);
-      ASSERT_TRUE(r.converged()) << name << " N = " << N << ": " << r.message;
+      ASSERT_TRUE(r.converged()) << name << " N = " << N << ": " << r.message();
       EXPECT_EQ(r.scheme, ap::SchemeKind::FourthOrder);
-      ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+      ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
       EXPECT_LE(r.minimum_time.stationarity, 1e-8) << name << " N = " << N;
       EXPECT_LE(r.minimum_time.complementarity, 1e-8) << name << " N = " << N;
       EXPECT_NEAR(r.duration, r.minimum_duration, 1e-12 * r.duration);
@@ -65,7 +65,7 @@ TEST(FourthOrderMinimumTime, IsTheLargerSecondOrderTStarAKktPointNoSlowerThanThe
       // T* is the larger of second_order's T* at N and at 2N, each solved on its own.
       const ap::PlanResult at_N = secondOrder(p, N);
       const ap::PlanResult at_2N = secondOrder(p, 2 * N);
-      ASSERT_TRUE(at_N.converged() && at_2N.converged()) << at_N.message << at_2N.message;
+      ASSERT_TRUE(at_N.converged() && at_2N.converged()) << at_N.message() << at_2N.message();
       const double larger = std::max(at_N.minimum_duration, at_2N.minimum_duration);
       EXPECT_NEAR(r.minimum_duration, larger, 1e-9 * larger) << name << " N = " << N;
       // The other one is feasible there: its minimum-effort plan at T* meets the bounds.
@@ -75,12 +75,12 @@ TEST(FourthOrderMinimumTime, IsTheLargerSecondOrderTStarAKktPointNoSlowerThanThe
       other.objective = ap::Objective::MinimumEffort;
       other.duration = r.minimum_duration;
       const ap::PlanResult other_at_T = ap::planManeuver(other);
-      ASSERT_TRUE(other_at_T.converged()) << other_at_T.message;
+      ASSERT_TRUE(other_at_T.converged()) << other_at_T.message();
       EXPECT_LE(other_at_T.max_constraint_violation, 1e-8);
 
       // The search's T is an upper bound on T* (bracketed to 1e-9 relative).
       const ap::PlanResult search = ap::test_support::searchedMinimumTime(p);
-      ASSERT_TRUE(search.converged()) << search.message;
+      ASSERT_TRUE(search.converged()) << search.message();
       EXPECT_FALSE(search.minimum_time.kkt_point);
       EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8)) << name << " N = " << N;
       std::printf(
@@ -104,12 +104,12 @@ TEST(FourthOrderMinimumTime, MarginAndABoundedRequestBelowTStarUseThePair) {
   // is the N one there.
   const ap::PlanningProblem p = fourthOrder("min_time_betts", 64);
   const ap::PlanResult tight = ap::planManeuver(p);
-  ASSERT_TRUE(tight.converged()) << tight.message;
+  ASSERT_TRUE(tight.converged()) << tight.message();
   for (const double margin : {0.005, 0.02, 0.1}) {
     ap::PlanningProblem relaxed = p;
     relaxed.time_margin = margin;
     const ap::PlanResult r = ap::planManeuver(relaxed);
-    ASSERT_TRUE(r.converged()) << "margin " << margin << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "margin " << margin << ": " << r.message();
     EXPECT_EQ(r.scheme, ap::SchemeKind::FourthOrder);
     EXPECT_NEAR(r.minimum_duration, tight.minimum_duration, 1e-12 * tight.minimum_duration);
     EXPECT_NEAR(r.duration, (1 + margin) * tight.minimum_duration, 1e-12 * r.duration);
@@ -121,6 +121,6 @@ TEST(FourthOrderMinimumTime, MarginAndABoundedRequestBelowTStarUseThePair) {
   below.objective = ap::Objective::MinimumEffort;
   below.duration = 0.999 * tight.minimum_duration;
   const ap::PlanResult refused = ap::planManeuver(below);
-  EXPECT_EQ(refused.termination, ap::Termination::Infeasible) << refused.message;
+  EXPECT_EQ(refused.termination, ap::Termination::Infeasible) << refused.message();
   EXPECT_NEAR(refused.minimum_duration, tight.minimum_duration, 1e-12 * tight.minimum_duration);
 }

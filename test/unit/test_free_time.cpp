@@ -82,7 +82,7 @@ TEST(FreeTime, AnswerIsAKktPointOfTheDiscreteMinimumTimeProblem) {
   const double r = std::sqrt(0.5);
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   EXPECT_LT(o.duration, 0.97 * 2 * std::sqrt(M_PI)) << "below the eigenaxis slew";
   EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible";
   const std::vector<ap::Vector3> tau = o.maneuver.torque;
@@ -121,8 +121,8 @@ TEST(FreeTime, NoFeasiblePlanSlightlyFasterFromTheAnswer) {
   // plan finds no plan meeting the bounds, while at (1 + 1e-3) T* it converges.
   ap::PlanningProblem p = scene("min_time_betts", 64);
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
   EXPECT_LE(r.minimum_time.stationarity, 1e-8);
   EXPECT_LE(r.minimum_time.complementarity, 1e-8);
   p.objective = ap::Objective::MinimumEffort;
@@ -131,10 +131,10 @@ TEST(FreeTime, NoFeasiblePlanSlightlyFasterFromTheAnswer) {
   from.constrained_from_warm_start = true;
   p.duration = (1 - 1e-3) * r.minimum_duration;
   const ap::PlanResult faster = ap::planAtResolution(p, from);
-  EXPECT_FALSE(faster.converged() && faster.max_constraint_violation <= 1e-8) << faster.message;
+  EXPECT_FALSE(faster.converged() && faster.max_constraint_violation <= 1e-8) << faster.message();
   p.duration = (1 + 1e-3) * r.minimum_duration;
   const ap::PlanResult slower = ap::planAtResolution(p, from);
-  EXPECT_TRUE(slower.converged()) << slower.message;
+  EXPECT_TRUE(slower.converged()) << slower.message();
   EXPECT_LE(slower.max_constraint_violation, 1e-8);
 }
 
@@ -155,7 +155,7 @@ TEST(FreeTime, TStarIsInvariantUnderWorldRotationsAndAxisRelabelling) {
         p.final_attitude = Q * p.final_attitude;
       }
       const ap::PlanResult r = ap::planManeuver(p);
-      ASSERT_TRUE(r.converged()) << r.message;
+      ASSERT_TRUE(r.converged()) << r.message();
       EXPECT_TRUE(r.minimum_time.kkt_point);
       std::printf("axis %d frame %d: T* = %.9f\n", axis, frame, r.minimum_duration);
       found.push_back(r.minimum_duration);
@@ -175,8 +175,8 @@ TEST(FreeTime, TStarIsMonotoneInNAndMeetsThePublishedValues) {
     double previous = 0.0;
     for (const int N : {64, 96, 128, 192, 256, 512, 1024, 2048}) {
       const ap::PlanResult r = ap::planManeuver(scene(name, N));
-      ASSERT_TRUE(r.converged()) << name << " N = " << N << ": " << r.message;
-      EXPECT_TRUE(r.minimum_time.kkt_point) << name << " N = " << N << ": " << r.message;
+      ASSERT_TRUE(r.converged()) << name << " N = " << N << ": " << r.message();
+      EXPECT_TRUE(r.minimum_time.kkt_point) << name << " N = " << N << ": " << r.message();
       std::printf("%s N = %d: T* = %.9f\n", name, N, r.minimum_duration);
       EXPECT_NEAR(r.minimum_duration, published, 0.005 * published) << name << " N = " << N;
       EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << name << " N = " << N;
@@ -190,15 +190,15 @@ TEST(FreeTime, TStarScalesWithTheBoundsAndFallsWithAStrongerOne) {
   // (discrete too); a stronger bound on one axis only cannot slow the slew.
   ap::PlanningProblem p = scene("min_time_betts", 64);
   const ap::PlanResult base = ap::planManeuver(p);
-  ASSERT_TRUE(base.converged()) << base.message;
+  ASSERT_TRUE(base.converged()) << base.message();
   p.max_torque *= 4.0;
   const ap::PlanResult fast = ap::planManeuver(p);
-  ASSERT_TRUE(fast.converged()) << fast.message;
+  ASSERT_TRUE(fast.converged()) << fast.message();
   EXPECT_NEAR(fast.minimum_duration, 0.5 * base.minimum_duration, 1e-7 * base.minimum_duration);
   p.max_torque /= 4.0;
   p.max_torque(1) *= 1.5;
   const ap::PlanResult stronger = ap::planManeuver(p);
-  ASSERT_TRUE(stronger.converged()) << stronger.message;
+  ASSERT_TRUE(stronger.converged()) << stronger.message();
   EXPECT_LT(stronger.minimum_duration, base.minimum_duration);
 }
 
@@ -208,8 +208,8 @@ TEST(FreeTime, EverySchemeStaysWithinPublishedPlusOneStep) {
     ap::PlanningProblem p = scene("min_time_bilimoria_wie", 64);
     p.scheme = scheme;
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
-    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message();
     const double h = r.minimum_duration / p.steps;
     std::printf("%s N = 64: T* = %.9f (h = %.4f)\n", ap::schemeName(scheme).c_str(),
                 r.minimum_duration, h);
@@ -271,8 +271,8 @@ TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerT
   for (const int N : {64, 128, 256, 512}) {
     const ap::PlanningProblem p = spinningRequest(N);
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
-    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message();
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message();
     EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
     EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
     for (const ap::Vector3& t : r.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-9);
@@ -286,8 +286,8 @@ TEST(FreeTime, SpinningEndsGiveAKktPointInvariantUnderAWorldRotationAndNoSlowerT
 
     if (N != 64 && N != 256) continue;  // the search: on the start grid and the first refined one
     const ap::PlanResult search = searched(N);
-    ASSERT_TRUE(search.converged()) << search.message;
-    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    ASSERT_TRUE(search.converged()) << search.message();
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message();
     std::printf("the search on the same request: T = %.9f\n", search.minimum_duration);
     // The search's T is the least duration whose minimum-effort plan met the bounds (to their
     // tolerance), bracketed to 1e-9 relative: T* may sit that far above it, no more.
@@ -306,7 +306,7 @@ TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
   const ap::ReducedProblem geodesic(p);
   ap::FreeTimeOutcome o =
       ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, 500);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   for (const int N : {128, 256}) {
     ap::PlanningProblem fine = spinningRequest(N);
     fine.duration = o.duration;
@@ -321,7 +321,7 @@ TEST(FreeTime, ElasticStartCarriesASpinningAnswerToAFinerGrid) {
     }
     const double coarse_T = o.duration;
     o = ap::solveFreeTime(fine, start, coarse_T, 1e-9, 500);
-    ASSERT_EQ(o.termination, ap::Termination::Converged) << "N = " << N << ": " << o.message;
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << "N = " << N << ": " << o.message();
     EXPECT_TRUE(o.elastic_start) << "N = " << N;
     EXPECT_NEAR(o.start_time_step * N, coarse_T, 1e-12 * coarse_T) << "no raise: T0 = coarse T";
     EXPECT_GE(o.duration, coarse_T) << "T*(N) rises with N";
@@ -344,7 +344,7 @@ TEST(FreeTime, AnElasticPhaseBegunFromItsViolationsEndsAtAKktPointAndAFeasibleSt
   const ap::ReducedProblem geodesic(p);
   const ap::FreeTimeOutcome coarse =
       ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, 500);
-  ASSERT_EQ(coarse.termination, ap::Termination::Converged) << coarse.message;
+  ASSERT_EQ(coarse.termination, ap::Termination::Converged) << coarse.message();
   ap::PlanningProblem fine = spinningRequest(128);
   fine.duration = coarse.duration;
   ap::ReducedProblem np(fine);
@@ -353,7 +353,7 @@ TEST(FreeTime, AnElasticPhaseBegunFromItsViolationsEndsAtAKktPointAndAFeasibleSt
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(fine, np.attitudes(np.current()), coarse.duration, 1e-9, 500, context, {},
                         ap::ElasticBarrier::FromViolations);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   EXPECT_TRUE(o.elastic_start);
   EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible at the end";
   for (const ap::Vector3& t : o.maneuver.torque) EXPECT_LE(t.cwiseAbs().maxCoeff(), 1.0 + 1e-12);
@@ -367,7 +367,7 @@ TEST(FreeTime, AnElasticPhaseBegunFromItsViolationsEndsAtAKktPointAndAFeasibleSt
   const ap::FreeTimeOutcome a = ap::solveFreeTime(rest, start, 3.4, 1e-9, 500, at_mu0);
   const ap::FreeTimeOutcome b = ap::solveFreeTime(rest, start, 3.4, 1e-9, 500, from_violations, {},
                                                   ap::ElasticBarrier::FromViolations);
-  ASSERT_EQ(a.termination, ap::Termination::Converged) << a.message;
+  ASSERT_EQ(a.termination, ap::Termination::Converged) << a.message();
   EXPECT_FALSE(a.elastic_start);
   EXPECT_EQ(b.duration, a.duration);
   EXPECT_EQ(b.iterations, a.iterations);
@@ -510,8 +510,8 @@ TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
     p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(1.0));
     EXPECT_EQ(ap::freeTimeUnsupported(p), "");
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
-    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
+    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
     EXPECT_LE(r.minimum_time.stationarity, 1e-8);
     EXPECT_LE(r.minimum_time.complementarity, 1e-8);
     EXPECT_LE(r.max_constraint_violation, 1e-8);
@@ -523,8 +523,8 @@ TEST(FreeTime, RateLimitedSpinningEndsGiveAKktPointNoSlowerThanTheSearch) {
     ap::test_support::expectSameTStarWhenTurned(ap::test_support::inATurnedWorld(p, Q), r, 1e-8,
                                                 "turned");
     const ap::PlanResult search = ap::test_support::searchedMinimumTime(p);
-    ASSERT_TRUE(search.converged()) << search.message;
-    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message;
+    ASSERT_TRUE(search.converged()) << search.message();
+    EXPECT_FALSE(search.minimum_time.kkt_point) << search.message();
     std::printf("%s, |w| <= 1: T* = %.9f, the search %.9f\n", ap::schemeName(scheme).c_str(),
                 r.minimum_duration, search.minimum_duration);
     EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8));
@@ -542,8 +542,8 @@ TEST(FreeTime, ConeAndRateLimitRefinedToN128IsAKktPoint) {
     ap::PlanningProblem p = scene("min_time_keep_out", N);
     p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.05));
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
-    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message();
+    ASSERT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message();
     EXPECT_LE(r.minimum_time.stationarity, 1e-8) << "N = " << N;
     EXPECT_LE(r.minimum_time.complementarity, 1e-8) << "N = " << N;
     EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
@@ -622,13 +622,13 @@ void expectBoxKktPoint(const ap::PlanningProblem& p, const ap::FreeTimeOutcome& 
 ap::PlanResult expectKktAnswerNoSlowerThanTheSearch(const ap::PlanningProblem& p,
                                                     const std::string& label) {
   const ap::PlanResult r = ap::planManeuver(p);
-  EXPECT_TRUE(r.converged()) << label << ": " << r.message;
-  EXPECT_TRUE(r.minimum_time.kkt_point) << label << ": " << r.message;
+  EXPECT_TRUE(r.converged()) << label << ": " << r.message();
+  EXPECT_TRUE(r.minimum_time.kkt_point) << label << ": " << r.message();
   EXPECT_LE(r.minimum_time.stationarity, 1e-8) << label;
   EXPECT_LE(r.minimum_time.complementarity, 1e-8) << label;
   EXPECT_LE(r.max_constraint_violation, 1e-8) << label;
   const ap::PlanResult search = ap::test_support::searchedMinimumTime(p);
-  EXPECT_TRUE(search.converged()) << label << ": " << search.message;
+  EXPECT_TRUE(search.converged()) << label << ": " << search.message();
   std::printf("%s: T* = %.9f, the search %.9f\n", label.c_str(), r.minimum_duration,
               search.minimum_duration);
   EXPECT_LE(r.minimum_duration, search.minimum_duration * (1 + 1e-8)) << label;
@@ -762,7 +762,7 @@ TEST(FreeTime, EffectsGiveAKktPointCheckedOnThePlan) {
     const ap::PlanningProblem p = bettsWithGravityGradient(32);
     const ap::FreeTimeOutcome o =
         ap::solveFreeTime(p, excursion(p, ap::Vector3(0, r, r), 0.3), 29.0, 1e-9, 500);
-    ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
     EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible";
     EXPECT_LE(o.stationarity, 1e-8);
     EXPECT_LE(o.complementarity, 1e-8);
@@ -773,7 +773,7 @@ TEST(FreeTime, EffectsGiveAKktPointCheckedOnThePlan) {
     const std::string label = "Bilimoria–Wie + disturbance, " + ap::torqueFrameName(frame);
     const ap::FreeTimeOutcome o =
         ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500);
-    ASSERT_EQ(o.termination, ap::Termination::Converged) << label << ": " << o.message;
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << label << ": " << o.message();
     EXPECT_GT(o.smallest_value, 0.0) << label;
     expectBoxKktPoint(p, o, ap::Vector3(1, 1, 1), label);
   }
@@ -795,7 +795,7 @@ TEST(FreeTime, MinimumTimeWithEffectsIsAKktPointNoSlowerThanTheSearch) {
     turned.initial_attitude = Q * p.initial_attitude;
     turned.final_attitude = Q * p.final_attitude;
     const ap::PlanResult in_turned = ap::planManeuver(turned);
-    ASSERT_TRUE(in_turned.minimum_time.kkt_point) << label << ": " << in_turned.message;
+    ASSERT_TRUE(in_turned.minimum_time.kkt_point) << label << ": " << in_turned.message();
     EXPECT_NEAR(in_turned.minimum_duration, r.minimum_duration, 1e-8 * r.minimum_duration) << label;
   }
 }
@@ -813,7 +813,7 @@ TEST(FreeTime, ADisturbanceNearItsBoundGivesAKktPointBelowTheSearch) {
   const double r = std::sqrt(0.5);
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(p, excursion(p, ap::Vector3(0, r, r), 0.3), 2 * std::sqrt(M_PI), 1e-9, 500);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   EXPECT_TRUE(o.elastic_start);
   EXPECT_GT(o.smallest_value, 0.0) << "strictly feasible at the end";
   EXPECT_LE(o.stationarity, 1e-8);
@@ -822,7 +822,7 @@ TEST(FreeTime, ADisturbanceNearItsBoundGivesAKktPointBelowTheSearch) {
   std::printf("disturbance 0.96 about x, N = 32: T* = %.9f after %d iterations\n", o.duration,
               o.iterations);
   const ap::PlanResult search = ap::test_support::searchedMinimumTime(p);
-  ASSERT_TRUE(search.converged()) << search.message;
+  ASSERT_TRUE(search.converged()) << search.message();
   std::printf("the search: T = %.9f\n", search.minimum_duration);
   EXPECT_LE(o.duration, search.minimum_duration * (1 + 1e-8));
 
@@ -858,9 +858,9 @@ TEST(FreeTime, ADisturbanceBeyondItsBoundOnASymmetricBodyIsInfeasibleAtEveryDura
   const ap::PlanningProblem p =
       bilimoriaWieDisturbed(64, ap::Vector3(1.2, 0, 0), ap::TorqueFrame::Body);
   const ap::PlanResult r = ap::planManeuver(p);
-  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
-  EXPECT_NE(r.message.find("disturbance_torque"), std::string::npos) << r.message;
-  EXPECT_NE(r.message.find("max_torque"), std::string::npos) << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message();
+  EXPECT_NE(r.message().find("disturbance_torque"), std::string::npos) << r.message();
+  EXPECT_NE(r.message().find("max_torque"), std::string::npos) << r.message();
   EXPECT_EQ(r.iterations, 0) << "no solve ran";
   // Shown wherever the argument holds, and only there.
   EXPECT_FALSE(ap::infeasibleAtEveryDuration(
@@ -960,13 +960,13 @@ TEST(FreeTime, AroundAConeTStarIsALocalMinimumMonotoneInNInvariantAndNoSlowerTha
     ap::PlanningProblem p = ap::parseScene(cone).problem;
     p.steps = N;
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
-    EXPECT_TRUE(r.minimum_time.second_order_sufficient) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << "N = " << N << ": " << r.message();
+    EXPECT_TRUE(r.minimum_time.second_order_sufficient) << "N = " << N << ": " << r.message();
     EXPECT_GE(r.minimum_duration, previous * (1 - 1e-9)) << "N = " << N;
     previous = r.minimum_duration;
     if (N == 128) continue;  // the search there takes seconds; 32 and 64 were the rows above it
     const ap::PlanResult s = ap::test_support::searchedMinimumTime(p);
-    ASSERT_TRUE(s.converged()) << s.message;
+    ASSERT_TRUE(s.converged()) << s.message();
     EXPECT_FALSE(s.minimum_time.kkt_point) << "the search answered";
     EXPECT_LE(r.minimum_duration, s.minimum_duration * (1 + 1e-8)) << "N = " << N;
     if (N != 64) continue;
@@ -982,9 +982,9 @@ TEST(FreeTime, AroundAConeTStarIsALocalMinimumMonotoneInNInvariantAndNoSlowerTha
     p.steps = N;
     p.scheme = ap::SchemeKind::Paper;
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << "N = " << N << ": " << r.message();
     const ap::PlanResult s = ap::test_support::searchedMinimumTime(p);
-    ASSERT_TRUE(s.converged()) << s.message;
+    ASSERT_TRUE(s.converged()) << s.message();
     EXPECT_LE(r.minimum_duration, s.minimum_duration * (1 + 1e-8)) << "paper, N = " << N;
   }
 }
@@ -1036,7 +1036,7 @@ TEST(FreeTime, EachSolvedBarrierProblemBoundsTheTTheSolveReaches) {
     ap::SolveContext context{ap::SolverOptions{}};
     const ap::FreeTimeOutcome o =
         ap::solveFreeTime(c.problem, c.start, c.duration, 1e-9, 500, context, record);
-    ASSERT_EQ(o.termination, ap::Termination::Converged) << c.label << ": " << o.message;
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << c.label << ": " << o.message();
     ASSERT_GE(points.size(), 3u) << c.label;
     for (const ap::BarrierPoint& point : points) {
       if (point.locally_convex) {
@@ -1071,7 +1071,7 @@ TEST(FreeTime, AWatchThatStopsASolveEndsItThereWithItsPlan) {
   EXPECT_EQ(calls, 2);
   EXPECT_EQ(o.termination, ap::Termination::NotConverged);
   EXPECT_TRUE(o.stopped_by_watch);
-  EXPECT_NE(o.message.find("the watch's reason"), std::string::npos) << o.message;
+  EXPECT_NE(o.message().find("the watch's reason"), std::string::npos) << o.message();
   EXPECT_EQ(o.iterations, stopped_at.iterations);
   EXPECT_DOUBLE_EQ(o.duration, stopped_at.duration);
   ASSERT_EQ(o.maneuver.attitude.size(), stopped_at.attitudes.size());
@@ -1087,7 +1087,7 @@ TEST(FreeTime, TheMinimumTimeAnswerIsTheKeptFreeTimeSolvesPlan) {
   // switching functions are that solve's (σ = (z⁺ − z⁻)/(a w): τ = ±a where σ ≷ 0).
   for (const char* name : {"min_time_betts", "min_time_keep_out"}) {
     const ap::PlanResult r = ap::planManeuver(scene(name, 64));
-    ASSERT_TRUE(r.converged()) << name << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message();
     EXPECT_TRUE(r.minimum_time.kkt_point) << name;
     EXPECT_DOUBLE_EQ(r.duration, r.minimum_duration) << name;
     EXPECT_NEAR(r.maneuver.time.back(), r.minimum_duration, 1e-12 * r.minimum_duration) << name;
@@ -1127,7 +1127,7 @@ TEST(FreeTime, EveryIterationIsReportedToTheContextNumberedOnce) {
   ap::SolveContext context(options);
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500, context);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   ASSERT_GT(o.iterations, 0);
   ASSERT_EQ(reports.size(), static_cast<std::size_t>(o.iterations));
   EXPECT_EQ(context.iterations(), o.iterations);
@@ -1162,7 +1162,7 @@ TEST(FreeTime, ACallbackThatRefusesEndsTheSolveCancelledAtOnce) {
   ap::SolveContext context(options);
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(p, excursion(p, ap::Vector3(r, r, 0), 0.3), 3.4, 1e-9, 500, context);
-  EXPECT_EQ(o.termination, ap::Termination::Cancelled) << o.message;
+  EXPECT_EQ(o.termination, ap::Termination::Cancelled) << o.message();
   EXPECT_EQ(calls, 3);
   EXPECT_EQ(o.iterations, 3);
   EXPECT_GT(o.smallest_value, 0.0);
@@ -1180,7 +1180,7 @@ TEST(FreeTime, AMinimumTimeRequestReportsEveryFreeTimeIteration) {
       return true;
     };
     const ap::PlanResult r = ap::planManeuver(scene(name, 64), options);
-    ASSERT_TRUE(r.converged()) << name << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message();
     int free_time_iterations = 0;
     for (const ap::Attempt& a : r.attempts) {
       if (a.stage == ap::AttemptStage::MinimumTimeSolve) free_time_iterations += a.iterations;

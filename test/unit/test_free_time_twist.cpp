@@ -201,12 +201,12 @@ TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
     SCOPED_TRACE("seed " + std::to_string(seed) + ", " + schemeName(scheme));
     const PlanningProblem p = test_support::randomBettsPointingRequest(seed, 32, scheme);
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     ASSERT_TRUE(r.pointing.active);
-    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message();
     const test_support::TwistSweep sweep = test_support::sweepTwist(p);
     EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
-        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+        << "swept best at twist " << sweep.best_twist << "; " << r.message();
     EXPECT_LT(r.pointing.error, 1e-9);
     EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-9);
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
@@ -222,17 +222,17 @@ TEST(PointingMinimumTime, BacksABoundedPointingVerdictWithTheTwistFree) {
   // verdict is infeasible with T* as the least duration found; above, never infeasible.
   PlanningProblem p = test_support::randomBettsPointingRequest(4203, 32, SchemeKind::SecondOrder);
   const PlanResult fastest = planManeuver(p);
-  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  ASSERT_TRUE(fastest.converged()) << fastest.message();
   const double T_star = fastest.minimum_duration;
   p.objective = Objective::MinimumEffort;
   p.duration = 0.97 * T_star;
   const PlanResult below = planManeuver(p);
-  EXPECT_EQ(below.termination, Termination::Infeasible) << below.message;
+  EXPECT_EQ(below.termination, Termination::Infeasible) << below.message();
   EXPECT_NEAR(below.duration_verdict.least_duration_found, T_star, 1e-6 * T_star);
   EXPECT_EQ(below.pointing.infeasible_basis, PointingInfeasibleBasis::MinimumTimeOverTwist);
   p.duration = 1.05 * T_star;
   const PlanResult above = planManeuver(p);
-  EXPECT_NE(above.termination, Termination::Infeasible) << above.message;
+  EXPECT_NE(above.termination, Termination::Infeasible) << above.message();
   EXPECT_EQ(above.pointing.infeasible_basis, PointingInfeasibleBasis::None);
 }
 

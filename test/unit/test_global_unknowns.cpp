@@ -314,7 +314,7 @@ namespace {
 double profileAt(PlanningProblem problem, double kappa, double T) {
   problem.duration = T;
   const PlanResult result = planManeuver(problem);
-  EXPECT_TRUE(result.converged()) << result.message;
+  EXPECT_TRUE(result.converged()) << result.message();
   return result.cost + kappa * T * T;
 }
 
@@ -418,7 +418,7 @@ TEST(GlobalUnknowns, FreeTimeStepNewtonAgreesWithAScanOverTheDuration) {
     const double kappa = 2.0 * planManeuver(problem).cost / 36.0;
     problem.duration = 5.0;
     const PlanResult start = planManeuver(problem);
-    ASSERT_TRUE(start.converged()) << start.message;
+    ASSERT_TRUE(start.converged()) << start.message();
     ReducedProblem rp(problem);
     rp.setInteriorFromAttitudes(start.maneuver.attitude);
     const FreeTimeStepSolve free = solveWithFreeTimeStep(rp, EffortPlusTimeSquared(kappa));

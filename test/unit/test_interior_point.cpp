@@ -60,10 +60,10 @@ void expectAgreesWithNlopt(const ap::PlanningProblem& p, double tolerance = 1e-8
   for (ap::Vector3& t : start.torque) t *= 0.9;
   if (perturbed_start) o.warm_start = &start;
   const ap::PlanResult slsqp = ap::planManeuver(p, o);
-  ASSERT_TRUE(ip.converged()) << ip.message;
-  ASSERT_TRUE(slsqp.converged()) << slsqp.message;
-  EXPECT_EQ(ip.solver, "interior_point") << ip.message;
-  EXPECT_NEAR(ip.cost, slsqp.cost, tolerance * slsqp.cost) << ip.message;
+  ASSERT_TRUE(ip.converged()) << ip.message();
+  ASSERT_TRUE(slsqp.converged()) << slsqp.message();
+  EXPECT_EQ(ip.solver, "interior_point") << ip.message();
+  EXPECT_NEAR(ip.cost, slsqp.cost, tolerance * slsqp.cost) << ip.message();
   EXPECT_LE(ip.max_constraint_violation, 1e-9);
   EXPECT_GT(ip.active_constraints, 0);
 }
@@ -324,7 +324,7 @@ TEST(InteriorPoint, KeepInAgreesWithNlopt) {
       ap::PlanningConstraint::keepIn(out.body_axis, -out.world_direction, M_PI - out.half_angle)};
   const ap::PlanResult keep_in = plan(p, "newton");
   const ap::PlanResult keep_out = plan(sceneProblem("sun_keep_out.yaml", 24), "newton");
-  ASSERT_TRUE(keep_in.converged()) << keep_in.message;
+  ASSERT_TRUE(keep_in.converged()) << keep_in.message();
   EXPECT_NEAR(keep_in.cost, keep_out.cost, 1e-8 * keep_out.cost);
   expectAgreesWithNlopt(p, 1e-8, true);
 }
@@ -363,7 +363,7 @@ TEST(InteriorPoint, KktConditionsHoldInTorqueSpace) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 32);
   p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5)};
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const Eigen::VectorXd x = ap::unknownsFromTorqueSequence(r.maneuver.torque);
   const ap::TerminalConstraints c = ap::evaluateTerminalConstraints(p, x, true);
   EXPECT_LT(c.value.cwiseAbs().maxCoeff(), 1e-10);  // feasibility: terminal state
@@ -406,7 +406,7 @@ TEST(InteriorPoint, SecondOrderKktConditionsHoldInAttitudes) {
   p.scheme = ap::SchemeKind::SecondOrder;
   p.constraints = {ap::PlanningConstraint::maxTorqueNorm(0.5)};
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.solver, "interior_point");
   EXPECT_LE(r.max_constraint_violation, 1e-9);
   const int N = p.steps;
@@ -481,7 +481,7 @@ TEST(InteriorPoint, SecondOrderConstrainedEffortConvergesAtOrderTwo) {
       ap::PlanningProblem p = sceneProblem(scene, N);
       p.scheme = ap::SchemeKind::SecondOrder;
       const ap::PlanResult r = plan(p, "newton");
-      ASSERT_TRUE(r.converged()) << scene << " N " << N << ": " << r.message;
+      ASSERT_TRUE(r.converged()) << scene << " N " << N << ": " << r.message();
       EXPECT_GT(r.active_constraints, 0) << scene;
       EXPECT_LE(r.max_constraint_violation, 1e-9) << scene;
       effort.push_back(r.effort);
@@ -515,7 +515,7 @@ TEST(InteriorPoint, InactiveConstraintsKeepTheNewtonPath) {
 TEST(InteriorPoint, WorksWithGravityGradientAndLimits) {
   ap::PlanningProblem p = sceneProblem("leo_slew_limited.yaml", 60);
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.solver, "interior_point");
   EXPECT_GT(r.active_constraints, 0);
   EXPECT_LE(r.max_constraint_violation, 1e-9);
@@ -528,8 +528,8 @@ TEST(InteriorPoint, ShippedConstrainedScenesBindAndHold) {
     const ap::PlanningProblem p =
         ap::loadScene(AP_SOURCE_DIR "/scenes/" + std::string(scene)).problem;
     const ap::PlanResult r = plan(p, "newton");
-    ASSERT_TRUE(r.converged()) << r.message;
-    EXPECT_EQ(r.solver, "interior_point") << "the constraint must bind: " << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
+    EXPECT_EQ(r.solver, "interior_point") << "the constraint must bind: " << r.message();
     EXPECT_GT(r.active_constraints, 0);
     EXPECT_LE(r.max_constraint_violation, 1e-9);
     // Its first-order (KKT stationarity) residual is measured and reported, as Newton's is: the
@@ -551,27 +551,27 @@ TEST(InteriorPoint, InfeasibleTorqueLimitSaysWhatBacksTheVerdict) {
   ap::PlanningProblem p = sceneProblem("rest_to_rest.yaml", 32);
   p.max_torque = ap::Vector3::Constant(0.01);
   const ap::PlanResult r = plan(p, "newton");
-  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message();
   EXPECT_TRUE(r.duration_verdict.proven_infeasible);
   EXPECT_GT(r.duration_verdict.lower_bound, p.duration);
-  EXPECT_EQ(r.message.find('\n'), std::string::npos) << "one line";
+  EXPECT_EQ(r.message().find('\n'), std::string::npos) << "one line";
   ap::PlanningProblem fastest = p;
   fastest.objective = ap::Objective::MinimumTime;
   fastest.duration = 0.0;
   const ap::PlanResult t_star = ap::planManeuver(fastest);
-  ASSERT_TRUE(t_star.converged()) << t_star.message;
+  ASSERT_TRUE(t_star.converged()) << t_star.message();
   EXPECT_GE(t_star.minimum_duration, r.duration_verdict.lower_bound);
   p.duration = 0.95 * t_star.minimum_duration;
   const ap::PlanResult local = plan(p, "newton");
-  EXPECT_EQ(local.termination, ap::Termination::Infeasible) << local.message;
+  EXPECT_EQ(local.termination, ap::Termination::Infeasible) << local.message();
   EXPECT_FALSE(local.duration_verdict.proven_infeasible);
   EXPECT_NEAR(local.duration_verdict.least_duration_found, t_star.minimum_duration,
               1e-6 * t_star.minimum_duration);
   EXPECT_EQ(local.minimum_duration, local.duration_verdict.least_duration_found);
-  EXPECT_EQ(local.message.find('\n'), std::string::npos) << "one line";
+  EXPECT_EQ(local.message().find('\n'), std::string::npos) << "one line";
   p.duration = 1.02 * t_star.minimum_duration;
   const ap::PlanResult slower = plan(p, "newton");
-  EXPECT_TRUE(slower.converged()) << slower.message;
+  EXPECT_TRUE(slower.converged()) << slower.message();
   EXPECT_LE(slower.max_constraint_violation, 1e-9);
 }
 
@@ -584,7 +584,7 @@ TEST(InteriorPoint, TightTorqueNormAroundAKeepOutConeIsNotCalledInfeasible) {
   ap::PlanningProblem p = sceneProblem("sun_keep_out.yaml", 32);
   p.constraints.push_back(ap::PlanningConstraint::maxTorqueNorm(0.07));
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_NEAR(r.cost, 0.0604084963144, 1e-9 * 0.0604) << "IPOPT's optimum";
   expectAgreesWithNlopt(p, 1e-8, true);
 }
@@ -597,7 +597,7 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtLargeNAreNotCalledInfeasible) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 8192);
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.11)};
   const ap::PlanResult r = plan(p, "newton");
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_LE(r.max_constraint_violation, 1e-9);
   // 1e-3 relative: other starts of the coarse levels reach 787.54698 or a point 1e-4 above it
   // (at the round-off floor, or a neighbouring local optimum).
@@ -613,7 +613,7 @@ TEST(InteriorPoint, TorqueAndRateLimitsAtN1e5Converge) {
   ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 100000);
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.12)};
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_LE(r.max_constraint_violation, 1e-9);
   EXPECT_LE(r.dynamics_residual, 1e-12);
   // First-order optimality with the solve's own multipliers (∇f − Σ z∇c, relative): 6.8e-6; it
@@ -634,12 +634,12 @@ TEST(InteriorPoint, InfeasibleRateLimitIsNamed) {
   p.constraints = {ap::PlanningConstraint::maxAngularRate(0.05)};
   const ap::PlanResult r = plan(p, "newton");
   EXPECT_FALSE(r.converged());
-  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::Infeasible) << r.message();
   EXPECT_TRUE(r.duration_verdict.proven_infeasible);
   EXPECT_NEAR(r.duration_verdict.lower_bound, M_PI / 3 / 0.05, 1e-9);
   // The proof's figures: the rate limit binds, no torque bound is in force.
-  EXPECT_EQ(r.duration_verdict.rate_limit, 0.05) << r.message;
-  EXPECT_EQ(r.duration_verdict.torque_limit, 0.0) << r.message;
+  EXPECT_EQ(r.duration_verdict.rate_limit, 0.05) << r.message();
+  EXPECT_EQ(r.duration_verdict.torque_limit, 0.0) << r.message();
   EXPECT_EQ(r.iterations, 0);
 }
 
@@ -737,7 +737,7 @@ TEST(InteriorPoint, LevelsAccountForEveryIteration) {
   // the per-level counts add up to the reported total and the last entry is the requested grid's
   // interior point.
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_FALSE(r.levels.empty());
   int sum = 0;
   for (const ap::LevelSummary& l : r.levels) sum += l.iterations;
@@ -754,8 +754,8 @@ TEST(InteriorPoint, PredictorCorrectorReachesIpoptsOptimumAtN2048) {
   // solved first stops 2.6e-9 above). IPOPT's optimum of the same discrete problem (exact
   // Hessian, tol 1e-12; docs/results/constraints.md): 133.097692032.
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
-  EXPECT_NEAR(r.cost, 133.097692032, 1e-9 * 133.1) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_NEAR(r.cost, 133.097692032, 1e-9 * 133.1) << r.message();
   EXPECT_EQ(r.levels.back().reason.rfind("interior point (free slacks)", 0), 0u)
       << r.levels.back().reason;
 }
@@ -766,7 +766,7 @@ TEST(InteriorPoint, PredictorCorrectorNeedsFewIterations) {
   // steps for 8 iterations), 13 with the predictor–corrector. The optimum agrees with SLSQP's.
   const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 128);
   const ap::PlanResult r = plan(p, "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_FALSE(r.levels.empty());
   EXPECT_LE(r.levels.back().iterations, 18) << r.levels.back().reason;
   EXPECT_NEAR(r.cost, 8.63484875423, 1e-10 * 8.63)
@@ -779,7 +779,7 @@ TEST(InteriorPoint, FinerLevelsStartFromTheCoarserMultipliers) {
   // N = 2048 took 12 interior-point iterations on its finest level from the coarse steps alone,
   // 8 with the multipliers.
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 2048), "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_FALSE(r.levels.empty());
   EXPECT_EQ(r.levels.back().steps, 2048);
   EXPECT_LE(r.levels.back().iterations, 10) << r.levels.back().reason;
@@ -794,7 +794,7 @@ TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
   ap::PlanningProblem free = p;
   free.max_torque = ap::Vector3::Constant(std::numeric_limits<double>::infinity());
   const ap::PlanResult unconstrained = ap::planManeuver(free, ap::SolverOptions{});
-  ASSERT_TRUE(unconstrained.converged()) << unconstrained.message;
+  ASSERT_TRUE(unconstrained.converged()) << unconstrained.message();
   ap::SolverOptions o;
   o.warm_start = &unconstrained.maneuver;
   const ap::InteriorPointParameters parameters;
@@ -810,8 +810,8 @@ TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
     request.barrier = rule;
     const ap::GridOutcome out = ap::solveOnGrid(p, o, parameters, context, request);
     SCOPED_TRACE(static_cast<int>(rule));
-    ASSERT_TRUE(out.result.converged()) << out.result.message;
-    EXPECT_NEAR(out.result.cost, 8.63484875423, 1e-9 * 8.63) << out.result.message;
+    ASSERT_TRUE(out.result.converged()) << out.result.message();
+    EXPECT_NEAR(out.result.cost, 8.63484875423, 1e-9 * 8.63) << out.result.message();
     EXPECT_EQ(context.iterations(), out.result.iterations);
     EXPECT_EQ(out.duals.empty(), formulation == ap::Formulation::Elastic);
   }
@@ -822,7 +822,7 @@ TEST(InteriorPointStrategies, EveryBarrierRuleReachesTheSameOptimum) {
 // optimum, kept, with the result's cost.
 TEST(InteriorPointStrategies, AttemptsRecordFormulationStartAndCost) {
   const ap::PlanResult r = plan(sceneProblem("torque_limited.yaml", 128), "newton");
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_EQ(r.attempts.size(), 2u);
   EXPECT_EQ(r.attempts.front().formulation, ap::Formulation::Unconstrained);
   EXPECT_FALSE(r.attempts.front().kept);
@@ -858,13 +858,13 @@ TEST(InteriorPointStrategies, PrecisionAutoFollowsTheStepThresholds) {
 TEST(InteriorPointStrategies, EveryPrecisionReachesTheSameOptimum) {
   const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 512);
   const ap::PlanResult reference = plan(p, "newton");
-  ASSERT_TRUE(reference.converged()) << reference.message;
+  ASSERT_TRUE(reference.converged()) << reference.message();
   for (ap::Precision precision :
        {ap::Precision::Double, ap::Precision::Extended, ap::Precision::DoubleDouble}) {
     ap::SolverOptions o;
     o.precision = precision;
     const ap::PlanResult r = ap::planManeuver(p, o);
-    ASSERT_TRUE(r.converged()) << ap::precisionName(precision) << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << ap::precisionName(precision) << ": " << r.message();
     EXPECT_NEAR(r.cost, reference.cost, 1e-10 * reference.cost) << ap::precisionName(precision);
   }
 }
@@ -902,8 +902,8 @@ TEST(InteriorPointStrategies, CancelFromAnotherThreadEndsCancelledAtN1e5) {
   }
   done.notify_all();
   canceller.join();
-  ASSERT_TRUE(cancel.load()) << "the solve ended before the cancel: " << r.message;
-  EXPECT_EQ(r.termination, ap::Termination::Cancelled) << r.message;
+  ASSERT_TRUE(cancel.load()) << "the solve ended before the cancel: " << r.message();
+  EXPECT_EQ(r.termination, ap::Termination::Cancelled) << r.message();
   EXPECT_EQ(r.maneuver.steps(), 100000);
   ASSERT_FALSE(context.attempts().empty());
   EXPECT_EQ(context.attempts().back().termination, ap::Termination::Cancelled);

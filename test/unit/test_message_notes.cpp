@@ -8,6 +8,8 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <typeinfo>
 #include <variant>
 #include <vector>
 
@@ -29,23 +31,28 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+/// Another solve's reason as the clauses a note or a frame holds: its bare words.
+ap::MessageClauses said(const std::string& words) {
+  return {ap::clauses::Reason{words}};
+}
+
 }  // namespace
 
 TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
   const std::vector<ap::Note> all = {
-      notes::FormulationRetry{"elastic", "free slacks", true, "r"},
-      notes::ReachedThroughMiddle{64, "r"},
+      notes::FormulationRetry{"elastic", "free slacks", true, said("r")},
+      notes::ReachedThroughMiddle{64, said("r")},
       notes::GridContinuation{8},
-      notes::RetriedInTwoStages{"r"},
+      notes::RetriedInTwoStages{said("r")},
       notes::FromInitialGuess{},
       notes::CoarserLevel{32, ap::Termination::Converged},
       notes::RefinedFromSurvey{16},
       notes::ConstraintsInactive{},
       notes::UnconstrainedStart{1.5, "w", "at k = 3", 7},
-      notes::AfterGuessStopped{"r"},
+      notes::AfterGuessStopped{said("r")},
       notes::LastIterateDoesNotReplay{"r"},
       notes::OpenLoopReplayParted{"r", 1e-12},
-      notes::CheapestClass{"r"},
+      notes::CheapestClass{said("r")},
       notes::LastPointingStart{"r"},
       notes::FixedTwistFallback{0.5, "r"},
       notes::PointingRestartNotServed{3.5},
@@ -63,8 +70,9 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
     EXPECT_GT(words.size(), 4u);
     EXPECT_EQ(words.find('\n'), std::string::npos);
   }
-  EXPECT_EQ(ap::renderNote(notes::RestartEnded{ap::Termination::Infeasible, "r"}).rfind(": ", 0),
-            0u);
+  EXPECT_EQ(
+      ap::renderNote(notes::RestartEnded{ap::Termination::Infeasible, said("r")}).rfind(": ", 0),
+      0u);
   // The search's summary is its own rendering (minimum_time_search.cpp), kept as given.
   EXPECT_EQ(ap::renderNote(notes::SearchSummary{"; minimum time T* = 1 s"}),
             "; minimum time T* = 1 s");
@@ -72,10 +80,11 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
 
 TEST(MessageNotes, AddNoteExtendsTheMessageWithTheNotesFiguresAndReason) {
   ap::PlanResult r;
-  r.message = "converged after 12 interior-point iterations";
+  ap::recordReason(&r, "converged after 12 interior-point iterations");
   ap::addNote(&r, notes::GridContinuation{8});
-  ap::addNote(&r, notes::FormulationRetry{"elastic", "free slacks", false, "infeasible at N = 8"});
-  EXPECT_EQ(r.message,
+  ap::addNote(
+      &r, notes::FormulationRetry{"elastic", "free slacks", false, said("infeasible at N = 8")});
+  EXPECT_EQ(r.message(),
             "converged after 12 interior-point iterations; grid continuation from N = 8; retried "
             "with elastic: infeasible at N = 8");
 }
@@ -90,9 +99,9 @@ TEST(MessageNotes, TheFieldsChooseTheBranchOfTheWording) {
                        "N = 32 level ended " + ap::terminationName(ap::Termination::NotConverged)));
   EXPECT_TRUE(contains(stopped, "geodesic"));
   // A retry that answers names both formulations; one that did not, the retry's.
-  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", true, ""}),
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", true, {}}),
                        "solved with elastic after free slacks stopped"));
-  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", false, ""}),
+  EXPECT_TRUE(contains(ap::renderNote(notes::FormulationRetry{"elastic", "free slacks", false, {}}),
                        "retried with elastic: "));
   // Only the cone's margin is violated when no stated limit is.
   EXPECT_TRUE(contains(ap::renderNote(notes::UnconstrainedStart{2.0, "", "", 5}),
@@ -123,11 +132,11 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   const ap::frames::RichardsonPair from_t_star{32, true};
   const std::vector<ap::Frame> all = {
       ap::frames::PairSolveStopped{pair, 64},
-      ap::frames::PairCombined{pair, false, "2N's"},
-      ap::frames::PairCombined{from_t_star, true, "2N's"},
+      ap::frames::PairCombined{pair, false, said("2N's")},
+      ap::frames::PairCombined{from_t_star, true, said("2N's")},
       ap::frames::MinimumTimePairStopped{32, true, false},
       ap::frames::MinimumTimePairStopped{32, false, true},
-      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, "2N's"},
+      ap::frames::MinimumTimePairCombined{32, 2.5, 2.25, 2.5, true, false, said("2N's")},
       ap::frames::UpperBoundFromProbe{2.5, 3.0},
       ap::frames::StuckAtMinimumTimePlan{true, 2.0, 3.0, 0.0},
       ap::frames::StuckAtMinimumTimePlan{false, 2.0, 3.0, 2.5},
@@ -163,12 +172,12 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   EXPECT_TRUE(contains(stopped, "second_order at N = 32 and 2N = 64)"));
   EXPECT_TRUE(contains(stopped, "the second_order solve at N = 64 did not converge"));
   const std::string combined =
-      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, "2N's"}, reason);
+      ap::renderFrame(ap::frames::PairCombined{from_t_star, true, said("2N's")}, reason);
   EXPECT_TRUE(contains(combined, "2N = 64, each from its plan at T*)"));
   EXPECT_TRUE(contains(combined, "the plan is the second_order plan at N"));
   EXPECT_TRUE(contains(combined, ": N: " + reason + " | 2N: 2N's"));
-  EXPECT_FALSE(
-      contains(ap::renderFrame(ap::frames::PairCombined{pair, false, "x"}, reason), "the plan is"));
+  EXPECT_FALSE(contains(ap::renderFrame(ap::frames::PairCombined{pair, false, said("x")}, reason),
+                        "the plan is"));
   // fourth_order minimum time: which solve stopped, and T* with the two it is the larger of.
   EXPECT_TRUE(contains(
       ap::renderFrame(ap::frames::MinimumTimePairStopped{32, false, true}, reason),
@@ -177,7 +186,8 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
                        "): the one at 2N did not converge (its plan is returned): " + reason));
   const double T_star = 2.0 + 1.0 / 3.0;
   const std::string pair_t_star = ap::renderFrame(
-      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, "2N's"}, reason);
+      ap::frames::MinimumTimePairCombined{32, T_star, 2.0, T_star, true, true, said("2N's")},
+      reason);
   EXPECT_TRUE(contains(pair_t_star, "T* = " + ap::exactNumber(T_star) + " s, the one at 2N binds"));
   EXPECT_TRUE(contains(pair_t_star, "(T* at N = " + ap::exactNumber(2.0) + " s"));
   EXPECT_TRUE(contains(pair_t_star, "the plan is the second_order plan at N at T*"));
@@ -186,9 +196,9 @@ TEST(MessageFrames, EachFrameSaysItsFiguresBeforeTheReasonItIsGiven) {
   EXPECT_EQ(ap::renderFrame(ap::frames::OutsideRequestedClass{"w"}, reason),
             "not converged in the requested class: w (" + reason + ")");
   ap::PlanResult r;
-  r.message = reason;
+  ap::recordReason(&r, reason);
   ap::frameMessage(&r, ap::frames::ReplayFailed{"e", 3, HUGE_VAL});
-  EXPECT_EQ(r.message,
+  EXPECT_EQ(r.message(),
             "not converged: the plan's step k = 3 is not the step the replay solves from the "
             "plan's own state there (no root found), and its torques replayed open-loop fail: e (" +
                 reason + ")");
@@ -303,13 +313,13 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
   ap::PlanResult r;
   EXPECT_EQ(ap::verdictKindName(r.verdict), "solver_reason");  // a solver's reason stands
   EXPECT_TRUE(ap::verdictFigures(r.verdict).empty());
-  r.message = "infeasible at N = 32";
+  ap::recordReason(&r, "infeasible at N = 32");
   ap::recordVerdict(&r, v::LocallyInfeasible{3.0, 3.25, "what", 2.75, "b", true});
   EXPECT_EQ(ap::verdictKindName(r.verdict), "locally_infeasible");
   ASSERT_TRUE(std::holds_alternative<v::LocallyInfeasible>(r.verdict));
   EXPECT_EQ(std::get<v::LocallyInfeasible>(r.verdict).least_found, 3.25);
-  EXPECT_EQ(r.message.rfind("infeasible from here", 0), 0u);
-  EXPECT_NE(r.message.find("(infeasible at T: infeasible at N = 32)"), std::string::npos);
+  EXPECT_EQ(r.message().rfind("infeasible from here", 0), 0u);
+  EXPECT_NE(r.message().find("(infeasible at T: infeasible at N = 32)"), std::string::npos);
   // The figures by name carry the fields' values, each name once.
   const std::vector<ap::VerdictFigure> figures = ap::verdictFigures(r.verdict);
   ASSERT_EQ(figures.size(), 3u);
@@ -440,8 +450,8 @@ TEST(DriverVerdicts, AReasonCarriedTakesItsVerdictAlong) {
   ap::frameMessage(&wrapper, ap::frames::StagedUnfinished{"rate continuation", 0.5, 3});
   EXPECT_EQ(ap::verdictKindName(wrapper.verdict), "newton_ended");
   EXPECT_EQ(
-      wrapper.message,
-      ap::renderFrame(ap::frames::StagedUnfinished{"rate continuation", 0.5, 3}, solved.message));
+      wrapper.message(),
+      ap::renderFrame(ap::frames::StagedUnfinished{"rate continuation", 0.5, 3}, solved.message()));
 }
 
 TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
@@ -469,8 +479,7 @@ TEST(DriverVerdicts, NloptsEndingSaysItsResultAndFiguresAsBefore) {
 
 namespace {
 
-/// A request planned as planManeuver plans it, without the rendering at its end: the drivers'
-/// own answer (their context overloads), whose message each clause extended as it was recorded.
+/// A request planned as planManeuver plans it: the drivers' own answer (their context overloads).
 ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
                                    const ap::SolverOptions& options = {}) {
   ap::SolveContext context(options);
@@ -479,30 +488,66 @@ ap::PlanResult plannedByTheDrivers(const ap::PlanningProblem& problem,
              : ap::planBoundedMinimumEffort(problem, context);
 }
 
-/// The message as the drivers left it is the fold of the clauses recorded: no clause of it was
-/// written around them.
-void expectItsClausesFolded(const ap::PlanResult& r, const std::string& label, int* checked) {
-  SCOPED_TRACE(label + ": " + r.message);
+/// The clauses a note or a frame holds (another solve's reason: `reason` or `fine_reason`).
+template <class T, class = void>
+struct HoldsReason : std::false_type {};
+template <class T>
+struct HoldsReason<T, std::void_t<decltype(T::reason)>>
+    : std::is_same<decltype(T::reason), ap::MessageClauses> {};
+template <class T, class = void>
+struct HoldsFineReason : std::false_type {};
+template <class T>
+struct HoldsFineReason<T, std::void_t<decltype(T::fine_reason)>>
+    : std::is_same<decltype(T::fine_reason), ap::MessageClauses> {};
+
+/// Every reason held inside `clauses`, however deep: each is the clauses of a solve that said
+/// something (none empty). Returns how many there were.
+int expectNestedReasonsSaid(const ap::MessageClauses& clauses) {
+  int nested = 0;
+  const auto inner = [&](const auto& held) {
+    using T = std::decay_t<decltype(held)>;
+    const ap::MessageClauses* reason = nullptr;
+    if constexpr (HoldsReason<T>::value) reason = &held.reason;
+    if constexpr (HoldsFineReason<T>::value) reason = &held.fine_reason;
+    if (!reason) return;
+    EXPECT_FALSE(reason->empty()) << typeid(T).name() << " holds no reason";
+    nested += 1 + expectNestedReasonsSaid(*reason);
+  };
+  for (const ap::MessageClause& clause : clauses) {
+    if (const auto* note = std::get_if<ap::Note>(&clause)) std::visit(inner, *note);
+    if (const auto* frame = std::get_if<ap::Frame>(&clause)) std::visit(inner, *frame);
+  }
+  return nested;
+}
+
+/// Every path records what it says: the answer's clauses, and every solve's reason they hold,
+/// are not empty, and they say a message of one line.
+void expectItsClausesSaid(const ap::PlanResult& r, const std::string& label, int* checked,
+                          int* nested) {
+  SCOPED_TRACE(label + ": " + r.message());
   EXPECT_FALSE(r.clauses.empty());
-  EXPECT_FALSE(r.message.empty());
-  EXPECT_EQ(r.message, ap::renderMessage(r));
+  EXPECT_FALSE(r.message().empty());
+  EXPECT_EQ(r.message().find('\n'), std::string::npos);
+  *nested += expectNestedReasonsSaid(r.clauses);
   ++*checked;
 }
 
 }  // namespace
 
-TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
+TEST(MessageClauses, EveryKindOfRequestRecordsClausesThatSayItsMessage) {
   namespace rb = ap::robustness;
   namespace ts = ap::test_support;
   int checked = 0;
+  int nested = 0;
   // Minimum effort, unconstrained: seeded random bodies, ends, horizons and N; those up to N = 256
   // as fourth_order too (a Richardson pair at N and 2N, framed around its N solve's reason).
   for (int i = 0; i < 4; ++i) {
     rb::RandomCase c = rb::randomCase(4601, i);
-    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label, &checked, &nested);
     if (c.problem.steps > 256) continue;
     c.problem.scheme = ap::SchemeKind::FourthOrder;
-    expectItsClausesFolded(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked);
+    expectItsClausesSaid(plannedByTheDrivers(c.problem), c.label + " fourth_order", &checked,
+                         &nested);
   }
   // Bounded: a torque norm, per-axis torques, a norm with a rate limit and a replan, each a
   // minimum-effort request (the minimum-time phase where it ends infeasible), and two asked as
@@ -510,44 +555,45 @@ TEST(MessageClauses, EveryKindOfRequestsMessageIsItsClausesFolded) {
   for (int i : {0, 1, 2, 3, 4, 5, 12, 13}) {
     const std::optional<rb::BoundedRequest> request = rb::boundedRequest(4602, i);
     if (!request) continue;
-    expectItsClausesFolded(plannedByTheDrivers(request->problem), request->label, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(request->problem), request->label, &checked, &nested);
   }
   // Constrained scenes (a keep-out cone, a rate limit, torque bounds; classes enumerated) and the
   // minimum-time scenes at two grids each.
   for (const char* scene : {"sun_keep_out", "rate_limited", "torque_limited", "min_time_keep_out",
                             "min_time_bilimoria_wie"}) {
     for (int steps : {32, 64}) {
-      expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
-                             std::string(scene) + " N = " + std::to_string(steps), &checked);
+      expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem(scene, steps)),
+                           std::string(scene) + " N = " + std::to_string(steps), &checked, &nested);
     }
   }
   // Pointing: unconstrained, under a cone and under torque bounds, and minimum time on Betts's
   // body (its start twists framed around the kept answer).
   for (unsigned seed : {4603u, 4604u}) {
     const std::string at = " seed " + std::to_string(seed);
-    expectItsClausesFolded(plannedByTheDrivers(ts::randomPointingRequest(
-                               seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
-                           "pointing" + at, &checked);
+    expectItsClausesSaid(plannedByTheDrivers(ts::randomPointingRequest(
+                             seed, 32, seed % 2 == 1, ap::SchemeKind::SecondOrder)),
+                         "pointing" + at, &checked, &nested);
     for (ts::PointingBinding binding :
          {ts::PointingBinding::KeepOut, ts::PointingBinding::TorqueBox}) {
-      expectItsClausesFolded(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
-                                 seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
-                             "constrained pointing" + at, &checked);
+      expectItsClausesSaid(plannedByTheDrivers(ts::randomConstrainedPointingRequest(
+                               seed, 32, false, ap::SchemeKind::SecondOrder, binding)),
+                           "constrained pointing" + at, &checked, &nested);
     }
-    expectItsClausesFolded(
+    expectItsClausesSaid(
         plannedByTheDrivers(ts::randomBettsPointingRequest(seed, 32, ap::SchemeKind::SecondOrder)),
-        "pointing minimum time" + at, &checked);
+        "pointing minimum time" + at, &checked, &nested);
   }
   // The NLopt cross-check, and a request stopped by its iteration limit.
   ap::SolverOptions nlopt;
   nlopt.solver = ap::SolverKind::Nlopt;
-  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
-                         &checked);
+  expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("rest_to_rest", 32), nlopt), "nlopt",
+                       &checked, &nested);
   ap::SolverOptions capped;
   capped.max_iterations = 3;
-  expectItsClausesFolded(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
-                         "sun_keep_out capped", &checked);
+  expectItsClausesSaid(plannedByTheDrivers(ts::sceneProblem("sun_keep_out", 64), capped),
+                       "sun_keep_out capped", &checked, &nested);
   EXPECT_GE(checked, 30) << "the requests were planned";
+  EXPECT_GT(nested, 0) << "some answer says another solve's reason";
 }
 
 TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
@@ -559,19 +605,41 @@ TEST(MessageClauses, AFoldSaysWhatTheRecordingSaid) {
   ap::addNote(&r, notes::GridContinuation{8});
   ap::frameMessage(&r, ap::frames::OnContinuationLevel{16});
   ASSERT_EQ(r.clauses.size(), 4u);
-  EXPECT_EQ(ap::renderMessage(r), r.message);
-  EXPECT_EQ(r.message,
+  EXPECT_EQ(ap::renderMessage(r), r.message());
+  EXPECT_EQ(r.message(),
             ap::renderVerdict(ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible},
                               "replay failed") +
                 "; grid continuation from N = 8 (on the N = 16 level of the grid "
                 "continuation)");
   ap::PlanResult combined;
   ap::takeReason(&combined, r);
-  EXPECT_EQ(combined.message, r.message);
+  EXPECT_EQ(combined.message(), r.message());
   EXPECT_EQ(ap::verdictKindName(combined.verdict), "solver_reason");
   ap::recordReason(&combined, "other words");
   EXPECT_EQ(combined.clauses.size(), 1u);
   EXPECT_EQ(ap::renderMessage(combined), "other words");
+}
+
+TEST(MessageClauses, TheMessageIsOnlyTheRenderingOfItsClauses) {
+  // No copy of the words to write: the message is a function of the clauses alone.
+  static_assert(std::is_member_function_pointer_v<decltype(&ap::PlanResult::message)>,
+                "PlanResult::message renders the clauses; it stores nothing");
+  // Another solve's reason is held as its clauses and rendered where the outer message is.
+  ap::PlanResult first;
+  ap::recordReason(&first, "replay failed");
+  ap::recordVerdict(&first, ap::verdicts::MinimumTimeFoundNone{ap::Termination::Infeasible});
+  ap::PlanResult r;
+  ap::recordReason(&r, "converged after 3 iterations");
+  ap::addNote(&r, notes::CheapestClass{first.clauses});
+  EXPECT_EQ(r.message(),
+            "converged after 3 iterations; the cheapest homotopy class under the constraints "
+            "(after the unconstrained optimum's class: " +
+                first.message() + ")");
+  ap::PlanResult same;
+  same.clauses = r.clauses;
+  EXPECT_EQ(same.message(), r.message());
+  r.clauses.clear();
+  EXPECT_EQ(r.message(), "");
 }
 
 TEST(MessageFrames, TheBriefsAndTheStopsSayTheWordsOfTheirFormerExpressions) {

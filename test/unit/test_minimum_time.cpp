@@ -47,7 +47,7 @@ TEST(MinimumTime, SphereUnderANormBoundConvergesToTheClosedForm) {
   double previous = 0.0;
   for (int N : {32, 64, 128}) {
     const ap::PlanResult r = ap::planManeuver(sphere(N, ap::Vector3(1, 2, -1)));
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     const double error = std::abs(r.minimum_duration - closedForm());
     std::printf("N = %d: T* = %.8f s (closed form %.8f), %.3f s\n", N, r.minimum_duration,
                 closedForm(), r.solve_time_s);
@@ -64,7 +64,7 @@ TEST(MinimumTime, SphereUnderANormBoundConvergesToTheClosedForm) {
 
 TEST(MinimumTime, PlanAtTStarIsBangBang) {
   const ap::PlanResult r = ap::planManeuver(sphere(64));
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   // At every node but those next to the switch (t = T/2) |τ| is at its bound.
   int at_bound = 0;
   for (const ap::Vector3& t : r.maneuver.torque) at_bound += t.norm() >= kNormBound * (1 - 1e-3);
@@ -79,7 +79,7 @@ TEST(MinimumTime, MarginGivesAFeasibleCheaperPlan) {
   const ap::PlanResult tight = ap::planManeuver(p);
   p.time_margin = 0.2;
   const ap::PlanResult relaxed = ap::planManeuver(p);
-  ASSERT_TRUE(tight.converged() && relaxed.converged()) << relaxed.message;
+  ASSERT_TRUE(tight.converged() && relaxed.converged()) << relaxed.message();
   EXPECT_NEAR(relaxed.minimum_duration, tight.minimum_duration, 1e-4 * tight.minimum_duration);
   EXPECT_NEAR(relaxed.duration, 1.2 * relaxed.minimum_duration, 1e-12 * relaxed.duration);
   EXPECT_NEAR(relaxed.maneuver.time.back(), relaxed.duration, 1e-9 * relaxed.duration);
@@ -97,7 +97,7 @@ TEST(MinimumTime, TStarFallsWithAStrongerBoundAndRisesWithARateLimit) {
   ap::PlanningProblem limited = sphere(64);
   limited.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.25));
   const ap::PlanResult slower = ap::planManeuver(limited);
-  ASSERT_TRUE(slower.converged()) << slower.message;
+  ASSERT_TRUE(slower.converged()) << slower.message();
   EXPECT_GT(slower.minimum_duration, base.minimum_duration * 1.01);
   // At T* the plan sits on the limits: within the planner's node tolerance (relative).
   EXPECT_LE(slower.max_constraint_violation, ap::kNodeConstraintTolerance * 0.25);
@@ -109,16 +109,16 @@ TEST(MinimumTime, StructuredStartsReachBettsPublishedTStar) {
   // at 35–37 s, and only a start off the eigenaxis reaches the multi-axis optimum.
   const ap::PlanningProblem p = ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_betts.yaml").problem;
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   std::printf("Betts, N = %d: T* = %.6f s (published 28.6304), %.2f s\n", p.steps,
               r.minimum_duration, r.solve_time_s);
-  EXPECT_NEAR(r.minimum_duration, 28.6304, 0.005 * 28.6304) << r.message;
+  EXPECT_NEAR(r.minimum_duration, 28.6304, 0.005 * 28.6304) << r.message();
   // The kept free-time solve started off the eigenaxis.
   const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return a.kept && a.stage == ap::AttemptStage::MinimumTimeSolve;
   });
-  ASSERT_NE(kept, r.attempts.end()) << r.message;
-  EXPECT_EQ(kept->start, ap::AttemptStart::Excursion) << r.message;
+  ASSERT_NE(kept, r.attempts.end()) << r.message();
+  EXPECT_EQ(kept->start, ap::AttemptStart::Excursion) << r.message();
   // Its parameters as data (start_detail): the eigenaxis is the rotation's (body x), the
   // excursion turns about a unit body axis perpendicular to it, by 0.3 rad.
   const ap::StartDetail& detail = kept->start_detail;
@@ -168,11 +168,11 @@ TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {
   ap::PlanningProblem p = ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_betts.yaml").problem;
   p.steps = 128;
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return a.kept && a.stage == ap::AttemptStage::MinimumTimeSolve;
   });
-  ASSERT_NE(kept, r.attempts.end()) << r.message;
+  ASSERT_NE(kept, r.attempts.end()) << r.message();
   EXPECT_EQ(kept->start, ap::AttemptStart::CoarseLevel);
   EXPECT_EQ(kept->steps, 128);
   const ap::StartDetail& detail = kept->start_detail;
@@ -186,7 +186,7 @@ TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {
     return a.stage == ap::AttemptStage::MinimumTimeSolve && a.steps == 64 &&
            a.start == ap::AttemptStart::Excursion && a.cost == detail.duration;
   });
-  ASSERT_NE(coarse, r.attempts.end()) << r.message;
+  ASSERT_NE(coarse, r.attempts.end()) << r.message();
   EXPECT_EQ(coarse->start_detail.excursion_axis, detail.excursion_axis);
 }
 
@@ -198,7 +198,7 @@ TEST(MinimumTime, AroundAConeTheExcursionStartsCarryTheirSkewedPeak) {
   const ap::PlanningProblem p =
       ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_keep_out.yaml").problem;
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   int excursions = 0;
   for (const ap::Attempt& a : r.attempts) {
     if (a.stage != ap::AttemptStage::MinimumTimeSolve) continue;
@@ -212,7 +212,7 @@ TEST(MinimumTime, AroundAConeTheExcursionStartsCarryTheirSkewedPeak) {
       EXPECT_DOUBLE_EQ(a.start_detail.excursion_peak, 0.5);
     }
   }
-  EXPECT_GE(excursions, 4) << r.message;  // body x and y off the eigenaxis (z), both signs
+  EXPECT_GE(excursions, 4) << r.message();  // body x and y off the eigenaxis (z), both signs
 }
 
 TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {
@@ -224,8 +224,8 @@ TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {
       ap::loadScene(AP_SOURCE_DIR "/scenes/min_time_bilimoria_wie.yaml").problem;
   p.steps = 32;
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  EXPECT_LT(r.minimum_duration, 0.97 * 2.0 * std::sqrt(M_PI)) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_LT(r.minimum_duration, 0.97 * 2.0 * std::sqrt(M_PI)) << r.message();
   double off_axis = 0.0;  // the largest torque about x or y: zero on the eigenaxis slew
   for (const ap::Vector3& t : r.maneuver.torque) {
     off_axis = std::max(off_axis, t.head<2>().cwiseAbs().maxCoeff());
@@ -233,10 +233,10 @@ TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {
   EXPECT_GT(off_axis, 0.5);
   p.steps = 128;
   const ap::PlanResult fine = ap::planManeuver(p);
-  ASSERT_TRUE(fine.converged()) << fine.message;
+  ASSERT_TRUE(fine.converged()) << fine.message();
   std::printf("Bilimoria-Wie, N = 128: T* = %.6f (published 3.2430), %.2f s\n",
               fine.minimum_duration, fine.solve_time_s);
-  EXPECT_NEAR(fine.minimum_duration, 3.2430, 0.005 * 3.2430) << fine.message;
+  EXPECT_NEAR(fine.minimum_duration, 3.2430, 0.005 * 3.2430) << fine.message();
 }
 
 TEST(MinimumTime, RequestsWithoutABoundOrWithABadMarginAreNamed) {
@@ -318,14 +318,14 @@ TEST(MinimumTime, NoDurationAboveTStarIsAnsweredInfeasible) {
   // (answered "infeasible" in ~15 ms before the feasibility phase backed such verdicts).
   for (const ap::PlanningProblem& p : minimumTimeCases()) {
     const ap::PlanResult fastest = ap::planManeuver(p);
-    ASSERT_TRUE(fastest.converged()) << fastest.message;
+    ASSERT_TRUE(fastest.converged()) << fastest.message();
     const double T_star = fastest.minimum_duration;
     for (const double m : {0.005, 0.02, 0.1}) {
       ap::PlanningProblem effort = p;
       effort.objective = ap::Objective::MinimumEffort;
       effort.duration = (1.0 + m) * T_star;
       const ap::PlanResult r = ap::planManeuver(effort);
-      EXPECT_TRUE(r.converged()) << "T* = " << T_star << ", m = " << m << ": " << r.message;
+      EXPECT_TRUE(r.converged()) << "T* = " << T_star << ", m = " << m << ": " << r.message();
       EXPECT_LE(r.max_constraint_violation, 1e-8) << "m = " << m;
     }
   }
@@ -347,7 +347,7 @@ TEST(MinimumTime, BilimoriaWieNearTStarConvergesBothWays) {
     p.scheme = scheme;
     p.time_margin = m;
     const ap::PlanResult margin = ap::planManeuver(p);  // (a) minimum time with a margin
-    ASSERT_TRUE(margin.converged()) << steps << ": " << margin.message;
+    ASSERT_TRUE(margin.converged()) << steps << ": " << margin.message();
     const double T_star = margin.minimum_duration;
     EXPECT_NEAR(margin.duration, (1.0 + m) * T_star, 1e-9 * T_star);
     EXPECT_LE(margin.max_constraint_violation, 1e-8);
@@ -357,7 +357,7 @@ TEST(MinimumTime, BilimoriaWieNearTStarConvergesBothWays) {
     effort.time_margin = 0.0;
     effort.duration = (1.0 + m) * T_star;
     const ap::PlanResult r = ap::planManeuver(effort);
-    ASSERT_TRUE(r.converged()) << steps << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << steps << ": " << r.message();
     EXPECT_NEAR(r.duration, effort.duration, 1e-12 * effort.duration);
     EXPECT_LE(r.max_constraint_violation, 1e-8);
     // Both ways answer the same minimum-effort problem from the same start: the same plan.
@@ -374,12 +374,12 @@ TEST(MinimumTime, AFourthOrderPlanOutsideItsBoundsStartsAgainFromTheMinimumTimeP
   p.steps = 64;
   p.scheme = ap::SchemeKind::FourthOrder;
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_LE(ap::checkConstraints(p, r.maneuver).max_relative_violation,
             ap::kNodeConstraintTolerance)
-      << r.message;
-  EXPECT_NE(r.message.find("after the first solve left a bound by"), std::string::npos)
-      << r.message;
+      << r.message();
+  EXPECT_NE(r.message().find("after the first solve left a bound by"), std::string::npos)
+      << r.message();
   EXPECT_GT(r.minimum_duration, 0.0);
   EXPECT_LE(r.minimum_duration, p.duration);
   EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::ConstrainedRetry);
@@ -390,10 +390,10 @@ TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndReportsTStarAsTheLeastFound) 
   // minimum-effort request at that duration.
   ap::PlanningProblem p = minimumTimeCases()[1];  // Bilimoria–Wie
   const ap::PlanResult free = ap::planManeuver(p);
-  ASSERT_TRUE(free.converged()) << free.message;
+  ASSERT_TRUE(free.converged()) << free.message();
   p.duration = 0.95 * free.minimum_duration;
   const ap::PlanResult bounded = ap::planManeuver(p);
-  EXPECT_EQ(bounded.termination, ap::Termination::Infeasible) << bounded.message;
+  EXPECT_EQ(bounded.termination, ap::Termination::Infeasible) << bounded.message();
   EXPECT_NEAR(bounded.minimum_duration, free.minimum_duration, 1e-9 * free.minimum_duration);
   // T* is a local minimum: named as the least duration found, not as a proven requirement,
   // beside the proven bound, which lies below it.
@@ -405,7 +405,7 @@ TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndReportsTStarAsTheLeastFound) 
   // it is given is the minimum-time solve's (not a solve at T).
   namespace verdicts = ap::verdicts;
   ASSERT_TRUE(std::holds_alternative<verdicts::LocallyInfeasible>(bounded.verdict))
-      << bounded.message;
+      << bounded.message();
   const auto& local = std::get<verdicts::LocallyInfeasible>(bounded.verdict);
   EXPECT_EQ(local.requested, p.duration);
   EXPECT_EQ(local.least_found, bounded.minimum_duration);
@@ -413,12 +413,12 @@ TEST(MinimumTime, DurationBelowTStarIsInfeasibleAndReportsTStarAsTheLeastFound) 
   EXPECT_FALSE(local.solved_at_requested);
   p.objective = ap::Objective::MinimumEffort;
   const ap::PlanResult effort = ap::planManeuver(p);
-  EXPECT_EQ(effort.termination, ap::Termination::Infeasible) << effort.message;
-  EXPECT_GT(effort.minimum_duration, p.duration) << effort.message;
+  EXPECT_EQ(effort.termination, ap::Termination::Infeasible) << effort.message();
+  EXPECT_GT(effort.minimum_duration, p.duration) << effort.message();
   EXPECT_EQ(effort.duration_verdict.least_duration_found, effort.minimum_duration);
   // A minimum-effort request: the verdict judges its solve at T.
   ASSERT_TRUE(std::holds_alternative<verdicts::LocallyInfeasible>(effort.verdict))
-      << effort.message;
+      << effort.message();
   EXPECT_EQ(std::get<verdicts::LocallyInfeasible>(effort.verdict).least_found,
             effort.minimum_duration);
   EXPECT_TRUE(std::get<verdicts::LocallyInfeasible>(effort.verdict).solved_at_requested);
@@ -431,7 +431,7 @@ TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {
   for (const double m : {0.01, 0.2}) {
     p.time_margin = m;
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << "m = " << m << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "m = " << m << ": " << r.message();
     EXPECT_NEAR(r.duration, (1.0 + m) * r.minimum_duration, 1e-9 * r.duration);
     EXPECT_LE(r.max_constraint_violation, 1e-8);
     EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);

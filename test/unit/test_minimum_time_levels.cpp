@@ -60,8 +60,8 @@ TEST(MinimumTimeLevels, FreeTimeLevelsHalveDownToTheCoarsestAtOrAbove64) {
 
 TEST(MinimumTimeLevels, RefinedAnswerReportsItsLevelsAndKeepsTheRefinedSolve) {
   const ap::PlanResult r = ap::planManeuver(scene("min_time_bilimoria_wie", 256));
-  ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
   // The free-time levels come first: the kept start's on N = 64, then each refined level.
   ASSERT_GE(r.levels.size(), 3u);
   const int expected[] = {64, 128, 256};
@@ -103,10 +103,10 @@ TEST(MinimumTimeLevels, ProlongedConeAnswerClearsTheConesItsCoarseNodesTouch) {
   // strictly, and the N = 128 solve from it converges.
   const ap::PlanningProblem coarse = scene("min_time_keep_out", 64);
   const ap::PlanResult answer = ap::planManeuver(coarse);
-  ASSERT_TRUE(answer.converged() && answer.minimum_time.kkt_point) << answer.message;
+  ASSERT_TRUE(answer.converged() && answer.minimum_time.kkt_point) << answer.message();
   const ap::FreeTimeOutcome o =
       ap::solveFreeTime(coarse, answer.maneuver.attitude, answer.minimum_duration, 1e-9, 500);
-  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
   ap::PlanningProblem fine = scene("min_time_keep_out", 128);
   fine.constraints[0].half_angle += ap::coneClearance(coarse, o.maneuver.attitude) - 1e-4;
   ASSERT_LT(ap::coneClearance(fine, o.maneuver.attitude), 0.5 * ap::kConeStartClearance);
@@ -116,7 +116,7 @@ TEST(MinimumTimeLevels, ProlongedConeAnswerClearsTheConesItsCoarseNodesTouch) {
   EXPECT_LE((start.front() - fine.initial_attitude).norm(), 1e-12);
   EXPECT_LE((start.back() - fine.final_attitude).norm(), 1e-12);
   const ap::FreeTimeOutcome refined = ap::solveFreeTime(fine, start, o.duration, 1e-9, 500);
-  EXPECT_EQ(refined.termination, ap::Termination::Converged) << refined.message;
+  EXPECT_EQ(refined.termination, ap::Termination::Converged) << refined.message();
   EXPECT_GE(ap::coneClearance(fine, refined.maneuver.attitude), -1e-9);
 }
 
@@ -151,7 +151,7 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   // 18 free-time solves on N = 64: 29.00779406049 s).
   const ap::PlanningProblem p = scene("min_time_keep_out", 64);
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message();
   ap::SolveContext starts_context{ap::SolverOptions{}};
   const std::size_t starts = ap::freeTimeStarts(p, true, starts_context).size();
   const auto solves = std::count_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
@@ -170,7 +170,7 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   // (and no saddle is left: that is for cones, so no solve from the previous attempt).
   const ap::PlanningProblem box = scene("min_time_bilimoria_wie", 64);
   const ap::PlanResult b = ap::planManeuver(box);
-  ASSERT_TRUE(b.converged()) << b.message;
+  ASSERT_TRUE(b.converged()) << b.message();
   const auto box_escapes =
       std::count_if(b.attempts.begin(), b.attempts.end(), [](const ap::Attempt& a) {
         return a.stage == ap::AttemptStage::MinimumTimeSolve &&
@@ -179,7 +179,7 @@ TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   EXPECT_EQ(box_escapes, 0);
   EXPECT_EQ(static_cast<std::size_t>(b.minimum_time.solves - box_escapes),
             ap::freeTimeStarts(box, true, starts_context).size());
-  EXPECT_TRUE(b.minimum_time.second_order_sufficient) << b.message;
+  EXPECT_TRUE(b.minimum_time.second_order_sufficient) << b.message();
 }
 
 namespace {
@@ -218,13 +218,13 @@ TEST(MinimumTimeLevels, WhereTheSearchAnswersItsPlanStartsAFreeTimeSolveToAKktPo
   // test/support/searched_minimum_time.hpp).
   const ap::PlanningProblem p = searchAnswersCase();
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_TRUE(r.minimum_time.kkt_point) << r.message();
   EXPECT_LE(r.minimum_time.stationarity, 1e-8);
   EXPECT_LE(r.minimum_time.complementarity, 1e-8);
   EXPECT_LE(r.max_constraint_violation, 1e-8);
   const ap::PlanResult searched = ap::test_support::searchedMinimumTime(p);
-  ASSERT_TRUE(searched.converged()) << searched.message;
+  ASSERT_TRUE(searched.converged()) << searched.message();
   EXPECT_FALSE(searched.minimum_time.kkt_point);
   EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-9));
   const auto kept = std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
@@ -239,10 +239,10 @@ TEST(MinimumTimeLevels, ASearchAnswersTrailListsTheFreeTimeSolvesThatFailedBefor
   // the free-time solve from the search's plan (started at the search's T), then the probes
   // below T*.
   const ap::PlanResult r = ap::planManeuver(searchAnswersCase());
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const std::vector<ap::Attempt>& trail = r.attempts;
   const auto first_probe = std::find_if(trail.begin(), trail.end(), isProbe);
-  ASSERT_NE(first_probe, trail.end()) << r.message;
+  ASSERT_NE(first_probe, trail.end()) << r.message();
   ASSERT_NE(first_probe, trail.begin()) << "no free-time solve before the search";
   EXPECT_TRUE(std::all_of(trail.begin(), first_probe, isFreeTimeSolve));
   EXPECT_TRUE(
@@ -300,12 +300,12 @@ TEST(MinimumTimeLevels, TheSearchGetsWhatIsLeftOfTheTimeBudget) {
   ap::SolverOptions budgeted;
   budgeted.time_budget_s = 1e-3;
   const ap::PlanResult r = ap::planManeuver(scene("min_time_betts", 64), budgeted);
-  EXPECT_EQ(r.termination, ap::Termination::TimedOut) << r.message;
+  EXPECT_EQ(r.termination, ap::Termination::TimedOut) << r.message();
   EXPECT_TRUE(std::none_of(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
     return isFreeTimeSolve(a) && a.termination == ap::Termination::Converged;
-  })) << r.message;
-  EXPECT_EQ(std::count_if(r.attempts.begin(), r.attempts.end(), isProbe), 1) << r.message;
+  })) << r.message();
+  EXPECT_EQ(std::count_if(r.attempts.begin(), r.attempts.end(), isProbe), 1) << r.message();
   ASSERT_FALSE(r.attempts.empty());
-  EXPECT_TRUE(isProbe(r.attempts.back())) << r.message;
-  EXPECT_EQ(r.attempts.back().iterations, 0) << r.message;
+  EXPECT_TRUE(isProbe(r.attempts.back())) << r.message();
+  EXPECT_EQ(r.attempts.back().iterations, 0) << r.message();
 }

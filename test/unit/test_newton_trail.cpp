@@ -45,7 +45,7 @@ TEST(NewtonTrail, OneAttemptForARequestThatNamesItsClass) {
   PlanningProblem p = restToRest(M_PI / 3, 128);
   p.direction = RotationDirection::LongWay;
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_EQ(r.attempts.size(), 1u);
   const Attempt& a = r.attempts[0];
   EXPECT_EQ(a.stage, AttemptStage::Solve);
@@ -74,7 +74,7 @@ TEST(NewtonTrail, OneAttemptForARequestThatNamesItsClass) {
 // the requested grid; one kept, the others with their costs in the structured extremal.
 TEST(NewtonTrail, AFreeClassIsSurveyedThenTheCheapestRefined) {
   const PlanResult r = planManeuver(restToRest(M_PI / 3, 128));
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_GE(r.attempts.size(), 5u) << r.extremal;
   for (int i = 0; i < 4; ++i) {
     const Attempt& a = r.attempts[i];
@@ -127,7 +127,7 @@ TEST(NewtonTrail, AFreeClassIsSurveyedThenTheCheapestRefined) {
 
 TEST(NewtonTrail, NearPiTheSurveySolvesBothWaysWithTheirCostsAndOneIsKept) {
   const PlanResult r = planManeuver(restToRest(M_PI - 0.05, 64));
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   // Surveyed on N = 16; both ways are within the margin of each other: both refined to N = 64.
   ASSERT_GE(r.attempts.size(), 6u) << r.extremal;
   for (int i = 0; i < 4; ++i) {
@@ -173,7 +173,7 @@ TEST(NewtonTrail, AStalledSpinningRequestRecordsItsRateContinuationAndNumbersIte
     return true;
   };
   const PlanResult r = planManeuver(p, options);
-  ASSERT_GE(r.attempts.size(), 7u) << r.message;
+  ASSERT_GE(r.attempts.size(), 7u) << r.message();
   for (int i = 0; i < 4; ++i) {
     EXPECT_EQ(r.attempts[i].stage, AttemptStage::ClassSurvey) << i;
     EXPECT_EQ(r.attempts[i].termination, Termination::NotConverged) << i;
@@ -218,7 +218,7 @@ TEST(NewtonTrail, ACancelFromAnotherThreadEndsALargeSolveCancelled) {
   };
   const PlanResult r = planManeuver(restToRest(M_PI / 3, N), options);
   canceller.join();
-  EXPECT_EQ(r.termination, Termination::Cancelled) << r.message;
+  EXPECT_EQ(r.termination, Termination::Cancelled) << r.message();
   EXPECT_EQ(r.maneuver.steps(), N);  // the last iterate, carried over to the requested grid
   ASSERT_FALSE(r.attempts.empty());
   EXPECT_EQ(r.attempts.back().termination, Termination::Cancelled);
@@ -279,7 +279,7 @@ struct StandIn {
       result.termination = end == ends.end() ? Termination::Converged : end->second;
       result.iterations = r.replay_only ? 0 : 3;
       for (int i = 0; i < result.iterations; ++i) context.reportIteration(IterationInfo{});
-      result.message = "N = " + std::to_string(r.problem.steps);
+      result.clauses = {clauses::Reason{"N = " + std::to_string(r.problem.steps)}};
       result.levels.push_back({r.problem.steps, result.iterations, result.termination, 0, 0, ""});
       return result;
     };
@@ -433,7 +433,7 @@ TEST(SolveContext, OneRequestNumbersItsIterationsOnce) {
       ASSERT_EQ(numbers[i], static_cast<int>(i) + 1) << name << ": report " << i;
     }
     if (p.objective == Objective::MinimumEffort) {
-      EXPECT_EQ(static_cast<int>(numbers.size()), r.iterations) << name << ": " << r.message;
+      EXPECT_EQ(static_cast<int>(numbers.size()), r.iterations) << name << ": " << r.message();
     }
   }
 }

@@ -129,10 +129,10 @@ TEST_P(SeedExamples, NloptReachesAFeasibleKktPoint) {
   options.solver = ap::SolverKind::Nlopt;
   options.max_iterations = 2000;
   const ap::PlanResult r = ap::planManeuver(p, options);
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.solver, "nlopt");
-  EXPECT_LE(r.terminal_attitude_error, 1e-10) << r.message;
-  EXPECT_LE(r.terminal_velocity_error, 1e-10) << r.message;
+  EXPECT_LE(r.terminal_attitude_error, 1e-10) << r.message();
+  EXPECT_LE(r.terminal_velocity_error, 1e-10) << r.message();
   EXPECT_GT(r.cost, 0.0);
 
   // KKT: ∇f = τ lies in the row space of the constraint Jacobian (checked here with a QR
@@ -142,7 +142,7 @@ TEST_P(SeedExamples, NloptReachesAFeasibleKktPoint) {
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(C.transpose());
   const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(x.size(), 6);
   const Eigen::VectorXd outside = x - Q * (Q.transpose() * x);
-  EXPECT_LT(outside.norm(), 1e-6 * x.norm()) << r.message;
+  EXPECT_LT(outside.norm(), 1e-6 * x.norm()) << r.message();
 
   // And a small feasible-direction check: moving along the constraints' null space (then
   // re-projecting to feasibility by Gauss–Newton) never lowers the cost.
@@ -182,7 +182,7 @@ TEST(NloptSolver, CancellationStopsAndIsReported) {
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());
   EXPECT_EQ(calls, 3);
-  EXPECT_NE(r.message.find("cancelled"), std::string::npos) << r.message;
+  EXPECT_NE(r.message().find("cancelled"), std::string::npos) << r.message();
 }
 
 TEST(NloptSolver, IterationLimitIsHonoredAndNotConverged) {
@@ -193,7 +193,7 @@ TEST(NloptSolver, IterationLimitIsHonoredAndNotConverged) {
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());
   EXPECT_LE(r.iterations, 3);
-  EXPECT_NE(r.message.find("NLOPT_MAXEVAL_REACHED"), std::string::npos) << r.message;
+  EXPECT_NE(r.message().find("NLOPT_MAXEVAL_REACHED"), std::string::npos) << r.message();
 }
 
 namespace {
@@ -214,8 +214,8 @@ TEST_P(CrossCheck, NewtonAndNloptAgreeOnCostAndTorques) {
   nlopt_options.solver = ap::SolverKind::Nlopt;
   nlopt_options.max_iterations = 2000;
   const ap::PlanResult nlopt = ap::planManeuver(p, nlopt_options);
-  ASSERT_TRUE(newton.converged()) << newton.message;
-  ASSERT_TRUE(nlopt.converged()) << nlopt.message;
+  ASSERT_TRUE(newton.converged()) << newton.message();
+  ASSERT_TRUE(nlopt.converged()) << nlopt.message();
   EXPECT_NEAR(nlopt.cost, newton.cost, 1e-8 * newton.cost);
   double torque_scale = 0.0, torque_difference = 0.0;
   for (int k = 0; k <= p.steps; ++k) {
@@ -279,5 +279,5 @@ TEST(NloptSolver, ExhaustedTimeBudgetIsNotConvergence) {
   options.time_budget_s = 1e-9;
   const ap::PlanResult r = ap::planManeuver(p, options);
   EXPECT_FALSE(r.converged());
-  EXPECT_NE(r.message.find("NLOPT_MAXTIME_REACHED"), std::string::npos) << r.message;
+  EXPECT_NE(r.message().find("NLOPT_MAXTIME_REACHED"), std::string::npos) << r.message();
 }

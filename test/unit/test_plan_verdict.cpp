@@ -92,7 +92,7 @@ TEST(PlanVerdict, AConvergedPlanWhoseOpenLoopReplayFailsIsJudgedByItsStepsReplay
   for (int i = 0; i < 3; ++i) {
     const PlanningProblem p = unstableSpin(&rng, SchemeKind::Paper);
     const PlanResult r = planManeuver(p);
-    SCOPED_TRACE("spin " + std::to_string(i) + ": " + r.message);
+    SCOPED_TRACE("spin " + std::to_string(i) + ": " + r.message());
     if (!r.converged()) continue;
     const StepwiseReplay stepwise = replayStepByStep(p, r.maneuver);
     EXPECT_TRUE(stepwise.reproduces())
@@ -114,7 +114,7 @@ TEST(PlanVerdict, AStepOnAnotherRootOfItsMomentumMapIsNotReplayedSoNotConverged)
   // not converged (never step_too_large: the request's N was not the cause).
   const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_TRUE(replayStepByStep(p, r.maneuver).reproduces());
   int moved_steps = 0;
   for (int k : {1, p.steps / 2, p.steps - 2}) {
@@ -137,13 +137,13 @@ TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {
   // Rates of ~3e9 rad/s: the absolute 1e-9 replay threshold refused this optimum before.
   const PlanningProblem p = piAboutX(1e-9, 64);
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_LE(r.step_residual, measureStepResidual(p, r.maneuver).tolerance);
   EXPECT_LE(r.max_residual, 1e-9);
   EXPECT_TRUE(std::isfinite(r.replay_miss));
   // The same shape at T = 12.8 s costs (12.8/1e-9)⁴ less: τ ∝ 1/T².
   const PlanResult slow = planManeuver(piAboutX(12.8, 64));
-  ASSERT_TRUE(slow.converged()) << slow.message;
+  ASSERT_TRUE(slow.converged()) << slow.message();
   EXPECT_NEAR(r.cost * std::pow(1e-9 / 12.8, 4), slow.cost, 1e-9 * slow.cost);
   std::printf("T = 1e-9 s: %d iterations, step residual %.2e, replay miss %.2e rad\n", r.iterations,
               r.step_residual, r.replay_miss);
@@ -156,7 +156,7 @@ TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
   one_class.enumerate_classes = false;
   for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     const PlanResult base = planManeuver(spinningShape(1.0, 1.0, scheme), one_class);
-    ASSERT_TRUE(base.converged()) << base.message;
+    ASSERT_TRUE(base.converged()) << base.message();
     struct Scaling {
       double time, inertia;
     };
@@ -166,7 +166,7 @@ TEST(PlanVerdict, VerdictsAreInvariantUnderTimeAndInertiaScaling) {
       const PlanResult r = planManeuver(p, one_class);
       SCOPED_TRACE(schemeName(scheme) + ", T x " + std::to_string(s.time) + ", J x " +
                    std::to_string(s.inertia));
-      EXPECT_EQ(r.termination, base.termination) << r.message;
+      EXPECT_EQ(r.termination, base.termination) << r.message();
       EXPECT_EQ(r.iterations, base.iterations);
       // τ ∝ J/T², so the cost ∝ J²/T⁴: equal to round-off once scaled back.
       const double cost_scale = s.inertia * s.inertia / std::pow(s.time, 4);
@@ -193,7 +193,7 @@ TEST(PlanVerdict, UnstableOptimumConvergesAndReportsItsReplayMiss) {
   p.final_velocity = Vector3(0, 1, 0);
   p.final_attitude = so3::exp(Vector3(0, 60.0, 0)) * so3::exp(Vector3(0.2, 0, 0));
   const PlanResult r = planManeuver(p);
-  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message();
   EXPECT_LE(r.max_residual, 1e-9);
   EXPECT_LE(r.step_residual, measureStepResidual(p, r.maneuver).tolerance);
   // The returned plan itself ends on the target; the replay does not.
@@ -211,7 +211,7 @@ TEST(PlanVerdict, StepResidualDetectsAnInconsistentPlan) {
   for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
     const PlanningProblem p = spinningShape(1.0, 1.0, scheme);
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     const StepResidual clean = measureStepResidual(p, r.maneuver);
     EXPECT_LE(clean.relative, clean.tolerance);
     double max_torque = 0.0;
@@ -232,7 +232,7 @@ TEST(PlanVerdict, ZeroManeuverHasZeroResidual) {
   PlanningProblem p = piAboutX(12.8, 32);
   p.final_attitude = Matrix3::Identity();
   const PlanResult r = planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.step_residual, 0.0);
   EXPECT_EQ(r.replay_miss, 0.0);
 }

@@ -97,8 +97,8 @@ TEST(PointingPlan, ARateLimitBelowTheAngleToTurnIsProvenInfeasibleOverEveryTwist
                                   from.dot(p.end_condition.world_direction));
   p.constraints.push_back(PlanningConstraint::maxAngularRate(0.5 * angle / p.duration));
   const PlanResult r = planManeuver(p);
-  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message;
-  EXPECT_EQ(r.pointing.infeasible_basis, PointingInfeasibleBasis::Proven) << r.message;
+  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
+  EXPECT_EQ(r.pointing.infeasible_basis, PointingInfeasibleBasis::Proven) << r.message();
 }
 
 TEST(PointingConventions, SummaryOfAnEndReportsItsTwistAndResidual) {
@@ -249,7 +249,7 @@ TEST(PointingPlan, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
     const PlanningProblem p = randomPointingRequest(seed, 32, spinning, SchemeKind::Paper);
     SCOPED_TRACE("seed " + std::to_string(seed));
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     ASSERT_TRUE(r.pointing.active);
     const test_support::TwistSweep sweep = test_support::sweepTwist(p);
     EXPECT_LE(r.cost, sweep.best * (1.0 + 1e-6)) << "swept best at twist " << sweep.best_twist;
@@ -268,7 +268,7 @@ TEST(PointingPlan, EverySchemeMeetsTheEndCondition) {
     SCOPED_TRACE(schemeName(scheme));
     const PlanningProblem p = randomPointingRequest(31, 48, true, scheme);
     const PlanResult r = planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     EXPECT_LT(r.pointing.error, 1e-12);
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
     const std::string json = planResultJson(p, r);
@@ -354,7 +354,7 @@ TEST(PointingScene, ParsesFormatsAndRefusesBadKeys) {
 TEST(PointingScene, ExampleSceneAimsTheBoresight) {
   const Scene scene = loadScene(AP_SOURCE_DIR "/scenes/point_boresight.yaml");
   const PlanResult r = planManeuver(scene.problem);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const Vector3 aimed = r.maneuver.attitude.back() * Vector3::UnitZ();
   EXPECT_LT((aimed - Vector3(1, 1, 0).normalized()).norm(), 1e-12);
   EXPECT_NEAR(r.pointing.final_twist,

@@ -117,7 +117,7 @@ namespace {
 /// the constraints held and ψ stationary.
 PlanResult expectAtMostTheSweep(const PlanningProblem& p) {
   const PlanResult r = planManeuver(p);
-  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_TRUE(r.converged()) << r.message();
   EXPECT_TRUE(r.pointing.active);
   if (!r.converged() || !r.pointing.active) return r;
   const test_support::TwistSweep sweep = test_support::sweepTwist(p);
@@ -199,7 +199,7 @@ TEST(ConstrainedPointingPlan, LocalInfeasibilityCertifiedFromEnoughStartsEndsThe
         seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
     p.duration *= 0.8;
     const PlanResult r = planManeuver(p);
-    EXPECT_FALSE(r.converged()) << r.message;
+    EXPECT_FALSE(r.converged()) << r.message();
     std::set<std::pair<long, bool>> certified;
     int fixed_twist_interior_points = 0;
     for (const Attempt& a : r.attempts) {

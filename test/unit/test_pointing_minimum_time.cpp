@@ -19,11 +19,11 @@ namespace {
 /// The properties every pointing answer here holds: converged, the end condition to round-off,
 /// and every constraint met on the returned maneuver.
 void expectPointingAnswer(const PlanningProblem& p, const PlanResult& r) {
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_TRUE(r.pointing.active);
   EXPECT_LT(r.pointing.error, 1e-9);
   EXPECT_LT(pointingError(r.maneuver.attitude.back(), p.end_condition), 1e-9);
-  EXPECT_LE(r.max_constraint_violation, 1e-9) << r.message;
+  EXPECT_LE(r.max_constraint_violation, 1e-9) << r.message();
 }
 
 TEST(PointingMinimumTime, UnderAConeAndARateLimitAtMostTheSweepsBestTwist) {
@@ -35,12 +35,12 @@ TEST(PointingMinimumTime, UnderAConeAndARateLimitAtMostTheSweepsBestTwist) {
     const PlanningProblem p = test_support::randomBettsConstrainedPointingRequest(seed, 16, scheme);
     const PlanResult r = planManeuver(p);
     expectPointingAnswer(p, r);
-    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message();
     EXPECT_GT(r.active_constraints, 0);
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
     const test_support::TwistSweep sweep = test_support::sweepTwist(p);
     EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
-        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+        << "swept best at twist " << sweep.best_twist << "; " << r.message();
   }
 }
 
@@ -54,14 +54,14 @@ TEST(PointingMinimumTime, CarriedFromTheSurveyGridAtMostTheSweepsBestTwist) {
     const PlanningProblem p = test_support::randomBettsPointingRequest(seed, 64, scheme);
     const PlanResult r = planManeuver(p);
     expectPointingAnswer(p, r);
-    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message;
+    EXPECT_TRUE(r.minimum_time.kkt_point) << r.message();
     EXPECT_LT(r.pointing.twist_stationarity, 1e-8);
     const bool kept_on_n = std::any_of(r.attempts.begin(), r.attempts.end(),
                                        [](const Attempt& a) { return a.kept && a.steps == 64; });
-    EXPECT_TRUE(kept_on_n) << r.message;
+    EXPECT_TRUE(kept_on_n) << r.message();
     const test_support::TwistSweep sweep = test_support::sweepTwist(p);
     EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
-        << "swept best at twist " << sweep.best_twist << "; " << r.message;
+        << "swept best at twist " << sweep.best_twist << "; " << r.message();
   }
 }
 
@@ -77,7 +77,7 @@ TEST(PointingMinimumTime, ServesAConeThatExcludesSomeEndTwists) {
   EXPECT_GE(coneMargin(p.constraints.back(), r.maneuver.attitude.back()), -1e-12);
   const test_support::TwistSweep sweep = test_support::sweepTwist(p);
   EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
-      << "swept best at twist " << sweep.best_twist << "; " << r.message;
+      << "swept best at twist " << sweep.best_twist << "; " << r.message();
 }
 
 TEST(PointingMinimumTime, FromTheIdentityTheBodyIsThereOnlyWhereItsBoresightIsOnTheTarget) {
@@ -86,23 +86,23 @@ TEST(PointingMinimumTime, FromTheIdentityTheBodyIsThereOnlyWhereItsBoresightIsOn
   p.initial_attitude = Matrix3::Identity();
   const PlanResult r = planManeuver(p);
   expectPointingAnswer(p, r);
-  EXPECT_GT(r.minimum_duration, 0.0) << r.message;
+  EXPECT_GT(r.minimum_duration, 0.0) << r.message();
   p.end_condition.world_direction = p.end_condition.body_axis;
   const PlanResult there = planManeuver(p);
-  ASSERT_TRUE(there.converged()) << there.message;
-  EXPECT_EQ(there.minimum_duration, 0.0) << there.message;
+  ASSERT_TRUE(there.converged()) << there.message();
+  EXPECT_EQ(there.minimum_duration, 0.0) << there.message();
 }
 
 TEST(PointingMinimumTime, TimeMarginPlansMinimumEffortWithTheTwistFreeAtMostTheSweepsBest) {
   PlanningProblem p = test_support::randomBettsPointingRequest(4303, 32, SchemeKind::SecondOrder);
   const PlanResult fastest = planManeuver(p);
-  ASSERT_TRUE(fastest.converged()) << fastest.message;
+  ASSERT_TRUE(fastest.converged()) << fastest.message();
   p.time_margin = 0.05;
   const PlanResult r = planManeuver(p);
   expectPointingAnswer(p, r);
   EXPECT_DOUBLE_EQ(r.minimum_duration, fastest.minimum_duration);
   EXPECT_NEAR(r.duration, 1.05 * fastest.minimum_duration, 1e-9 * r.duration);
-  EXPECT_LT(r.pointing.twist_stationarity, 1e-6) << r.message;
+  EXPECT_LT(r.pointing.twist_stationarity, 1e-6) << r.message();
   // Against minimum effort at that T over fixed twists (infeasible ones have no cost).
   PlanningProblem effort = p;
   effort.objective = Objective::MinimumEffort;
@@ -110,7 +110,7 @@ TEST(PointingMinimumTime, TimeMarginPlansMinimumEffortWithTheTwistFreeAtMostTheS
   effort.duration = r.duration;
   const test_support::TwistSweep sweep = test_support::sweepTwist(effort);
   EXPECT_LE(r.cost, sweep.best * (1.0 + 1e-6))
-      << "swept best at twist " << sweep.best_twist << "; " << r.message;
+      << "swept best at twist " << sweep.best_twist << "; " << r.message();
 }
 
 }  // namespace

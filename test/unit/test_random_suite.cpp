@@ -78,9 +78,9 @@ TEST(RandomSuite, EveryCaseConverges) {
     if (kKnownStalls.count(c.index)) {
       EXPECT_NE(r.termination, Termination::Converged)
           << c.label << " converges now: remove it from kKnownStalls";
-      EXPECT_EQ(r.termination, Termination::NotConverged) << c.label << ": " << r.message;
+      EXPECT_EQ(r.termination, Termination::NotConverged) << c.label << ": " << r.message();
     } else {
-      EXPECT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
+      EXPECT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message();
     }
     if (r.converged()) {
       ++converged;
@@ -111,7 +111,7 @@ TEST(RandomSuite, EveryCaseConverges) {
 TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 150);
   const PlanResult r = planManeuver(c.problem);
-  ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
+  ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message();
   // The trail: every class's solve (the class survey, on the requested grid) and the
   // continuation in the boundary rates stalled, the coasting start converged.
   const auto stage = [&r](AttemptStage s) {
@@ -129,9 +129,9 @@ TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
   EXPECT_NE(continuation->termination, Termination::Converged);
   EXPECT_EQ(coasting, continuation + 1);
   EXPECT_EQ(coasting->start, AttemptStart::Coasting);
-  EXPECT_EQ(coasting->termination, Termination::Converged) << r.message;
+  EXPECT_EQ(coasting->termination, Termination::Converged) << r.message();
   EXPECT_LE(r.step_residual, measureStepResidual(c.problem, r.maneuver).tolerance);
-  EXPECT_LE(r.max_residual, 1e-8) << r.message;  // relative first-order residual at the optimum
+  EXPECT_LE(r.max_residual, 1e-8) << r.message();  // relative first-order residual at the optimum
   EXPECT_LT(r.cost, 547.642) << c.label;
   std::printf("%s: %d iterations, %.2f s, cost %.10g\n", c.label.c_str(), r.iterations,
               r.solve_time_s, r.cost);
@@ -145,7 +145,7 @@ TEST(RandomSuite, StalledSpinningCaseConvergesFromTheCoastingStart) {
 TEST(RandomSuite, SlowSpinningSolveKeepsTheCheapestOfMoreStarts) {
   const RandomCase c = robustness::randomCase(kSuiteSeed, 192);
   const PlanResult r = planManeuver(c.problem);
-  ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message;
+  ASSERT_EQ(r.termination, Termination::Converged) << c.label << ": " << r.message();
   const auto more = std::count_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
     return a.stage == AttemptStage::MoreStarts;
   });
@@ -175,7 +175,7 @@ TEST(RandomSuite, MoreStartsReachExtremalsAsCheapAsIpopts) {
   for (const auto& expected : cases) {
     const RandomCase c = robustness::randomCase(kSuiteSeed, expected.index);
     const PlanResult r = planManeuver(c.problem);
-    ASSERT_TRUE(r.converged()) << c.label << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << c.label << ": " << r.message();
     const auto kept =
         std::find_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; });
     ASSERT_NE(kept, r.attempts.end());
@@ -187,7 +187,7 @@ TEST(RandomSuite, MoreStartsReachExtremalsAsCheapAsIpopts) {
         << c.label << ": " << r.extremal;
     EXPECT_LE(r.cost, expected.ipopt_cost * (1 + 1e-8)) << c.label << ": " << r.extremal;
     EXPECT_LE(r.step_residual, measureStepResidual(c.problem, r.maneuver).tolerance);
-    EXPECT_LE(r.max_residual, 1e-8) << c.label << ": " << r.message;
+    EXPECT_LE(r.max_residual, 1e-8) << c.label << ": " << r.message();
     std::printf("%s: cost %.10g, %d iterations, kept %s from %s\n", c.label.c_str(), r.cost,
                 r.iterations, attemptStageName(kept->stage).c_str(),
                 attemptStartName(kept->start).c_str());

@@ -336,7 +336,7 @@ TEST(ReactionWheelPhysics, WheelTorquesAreTheMomentaRateToSecondOrder) {
       const ap::ReactionWheels wheels = p.reaction_wheels;
       p.reaction_wheels = {};  // the plan without limits; the wheels only read it
       const ap::PlanResult r = ap::planManeuver(p);
-      ASSERT_TRUE(r.converged()) << r.message;
+      ASSERT_TRUE(r.converged()) << r.message();
       const ap::WheelStates w = ap::wheelStates(scheme, p.inertia, wheels, r.maneuver);
       double worst = 0.0;
       for (int k = 2; k < N - 1; ++k) {
@@ -384,10 +384,10 @@ TEST(ReactionWheelMinimumTime, MomentumLimitedSlewMeetsTheBangCoastBangClosedFor
   std::vector<double> errors;
   for (const int N : {32, 64, 128}) {
     const ap::PlanResult r = ap::planManeuver(closedFormSlew(N));
-    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message();
     // Free time's KKT point, not the fallback search on T (a curvature term the free-time
     // assembly omits for non-stencil quantities once made the envelope stall it).
-    EXPECT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message;
+    EXPECT_TRUE(r.minimum_time.kkt_point) << "N = " << N << ": " << r.message();
     // On the bound to the interior point's tolerance (N m and N m s, limits 1 and 2).
     EXPECT_LE(r.max_constraint_violation, 1e-8) << "N = " << N;
     errors.push_back(std::abs(r.minimum_duration - kClosedForm) / kClosedForm);
@@ -416,7 +416,7 @@ TEST(ReactionWheelMinimumTime, WheelTorqueLimitsAloneBoundMinimumTime) {
     p.reaction_wheels.max_momentum = {0.6};
     p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << ap::schemeName(scheme) << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << ap::schemeName(scheme) << ": " << r.message();
     EXPECT_GT(r.minimum_duration, 0.0);
     const double h = r.maneuver.time_step;
     const ap::WheelStates w = ap::wheelStates(scheme, p.inertia, p.reaction_wheels, r.maneuver);
@@ -450,7 +450,7 @@ WheelPeaks unconstrainedPeaks(ap::PlanningProblem p) {
   const ap::ReactionWheels wheels = p.reaction_wheels;
   p.reaction_wheels = {};
   const ap::PlanResult free = ap::planManeuver(p);
-  EXPECT_TRUE(free.converged()) << free.message;
+  EXPECT_TRUE(free.converged()) << free.message();
   const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, wheels, free.maneuver);
   WheelPeaks out;
   for (int k = 0; k <= p.steps; ++k) {
@@ -545,7 +545,7 @@ TEST(ReactionWheelMinimumEffort, SeededSuiteAcrossSchemesMeetsEveryWheelLimit) {
     ++planned;
     const ap::PlanResult r = ap::planManeuver(p);
     if (!r.converged()) {
-      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message.c_str());
+      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message().c_str());
       continue;
     }
     ++converged;
@@ -591,7 +591,7 @@ TEST(ReactionWheelReplay, WheelTorquesFlyThePlanWithinTheLimitsToSecondOrder) {
     p.reaction_wheels.max_momentum = {0.85 * peak};
     p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message();
     const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
     const ap::WheelArray array = ap::wheelArray(p.reaction_wheels);
     Eigen::VectorXd h0(4);
@@ -629,7 +629,7 @@ TEST(ReactionWheelReplay, WorldDisturbanceIsFlownByTheWheelTorquesToSecondOrder)
   disturb(&base, ap::Vector3(0.004, -0.006, 0.003));
   const ap::Vector3 tau_d = base.worldDisturbance();
   const ap::PlanResult free = ap::planManeuver(base);
-  ASSERT_TRUE(free.converged()) << free.message;
+  ASSERT_TRUE(free.converged()) << free.message();
   double peak = 0.0;
   for (const Eigen::VectorXd& h :
        ap::wheelStates(base.scheme, base.inertia, base.reaction_wheels, free.maneuver, tau_d)
@@ -642,7 +642,7 @@ TEST(ReactionWheelReplay, WorldDisturbanceIsFlownByTheWheelTorquesToSecondOrder)
     p.steps = N;
     p.reaction_wheels.max_momentum = {limit};
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << "N = " << N << ": " << r.message();
     EXPECT_GT(r.active_constraints, 0);
     const ap::WheelStates w =
         ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver, tau_d);
@@ -700,7 +700,7 @@ TEST(ReactionWheelReplay, DiscreteReplayFromTheWheelTorquesReproducesThePlanToRo
     if (!refusalOf(p).empty()) continue;  // an end state beyond a limit: nothing to replay
     const ap::PlanResult r = ap::planManeuver(p);
     if (!r.converged()) {
-      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message.c_str());
+      std::printf("case %d (%s): %s\n", c, ap::schemeName(p.scheme).c_str(), r.message().c_str());
       continue;
     }
     ++replayed;
@@ -800,7 +800,7 @@ TEST(ReactionWheelMinimumEffort, TheReportedEffortIsTheOneThePlanMinimizes) {
   p.reaction_wheels.max_momentum = {30.0};
   p.reaction_wheels.max_momentum_norm = std::numeric_limits<double>::infinity();
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   ASSERT_EQ(r.active_constraints, 0);
   const auto costs = [&](const ap::Maneuver& m) {
     const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, m);
@@ -847,7 +847,7 @@ TEST(ReactionWheelMinimumEffort, TheReportedEffortIsTheOneThePlanMinimizes) {
 TEST(ReactionWheelOutputs, CsvColumnsAndJsonMarginsPerWheel) {
   const ap::PlanningProblem p = closedFormSlew(32);
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const ap::WheelStates w = ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
   const std::string csv = std::string(AP_BINARY_DIR) + "/test_reaction_wheels.csv";
   ap::writeManeuverCsv(r.maneuver, w, csv);

@@ -398,7 +398,7 @@ CarriedOver carriedTorqueError(SchemeKind scheme, int coarse_steps, int fine_ste
   const PlanningProblem coarse_problem = randomProblem(scheme, coarse_steps);
   const PlanningProblem fine_problem = randomProblem(scheme, fine_steps);
   const PlanResult coarse = planManeuver(coarse_problem), fine = planManeuver(fine_problem);
-  EXPECT_TRUE(coarse.converged() && fine.converged()) << coarse.message << fine.message;
+  EXPECT_TRUE(coarse.converged() && fine.converged()) << coarse.message() << fine.message();
   ReducedProblem c(coarse_problem);
   c.setInteriorFromAttitudes(coarse.maneuver.attitude);
   ReducedProblem f(fine_problem);

@@ -68,7 +68,7 @@ TEST(RemainderProblem, KeepsTheGridTargetAndConstraintsFromTheState) {
 // run is the single closed-loop run (to round-off), which is what makes re-plans comparable.
 TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
   const Maneuver& nodes = plan.maneuver;
@@ -103,7 +103,7 @@ TEST(RecedingHorizonRun, AdoptingThePlansOwnRestContinuesTheSameClosedLoop) {
 // body lands far better than open loop, as the law alone does.
 TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
   const Maneuver& nodes = plan.maneuver;
@@ -128,7 +128,7 @@ TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
     SolverOptions options;
     options.warm_start = &guess;
     const PlanResult replan = planManeuver(rest, options);
-    ASSERT_TRUE(replan.converged()) << "from node " << k << ": " << replan.message;
+    ASSERT_TRUE(replan.converged()) << "from node " << k << ": " << replan.message();
     // The body is near the plan: the rest re-planned from it starts where the body is.
     EXPECT_TRUE(replan.maneuver.attitude.front().isApprox(body.attitude, 1e-12));
     run.adopt(replan.maneuver, k, k + 1);
@@ -144,7 +144,7 @@ TEST(RecedingHorizonRun, ReplannedUnderNoiseLandsAsTheLawDoes) {
 // state, not at the plan's R_0: exactly simulateTracking's run from that state.
 TEST(RecedingHorizonRun, StartsFromTheGivenStateAsSimulateTrackingDoes) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const auto& [scene, plan, J, effects] = disturbed;
   const SchemeKind scheme = scene.problem.scheme;
   const Maneuver& nodes = plan.maneuver;
@@ -181,7 +181,7 @@ TEST(ReplanPeriodSteps, RoundsAPeriodAndDerivesTheDefaultFromThePlan) {
 // the same command again (the same reference, the effects' clock shifted by t_k).
 TEST(RecedingHorizonRun, CommandAtIsTheLawOnThePlanInForce) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const Maneuver& nodes = disturbed.plan.maneuver;
   const SchemeKind scheme = disturbed.scene.problem.scheme;
   const ManeuverInterpolation reference(nodes, scheme, disturbed.J, disturbed.effects.get());

@@ -34,7 +34,7 @@ double worst(const std::vector<double>& v) {
 TEST(SeedConditions, CorrectedConditionsVanishAtTheOptimum) {
   for (int N : {32, 128}) {
     const PlanResult r = solveSlewUp(N);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     EXPECT_LE(worst(seedConditionRelativeResiduals(r.maneuver, kSeedInertia,
                                                    SeedConditionForm::Corrected)),
               1e-9)
@@ -54,8 +54,8 @@ TEST(SeedConditions, PrintedConditionsDoNotVanish) {
 }
 
 TEST(SeedConditions, DroppingDexpLeavesASmallDefectOfOrderThree) {
-  // Measured (docs/results/necessary_conditions.md): without the dexp factors the relative residual is
-  // nonzero and falls like h³ (1.4e-4 at N = 128, 1.8e-5 at N = 256 on the slew-up).
+  // Measured (docs/results/necessary_conditions.md): without the dexp factors the relative residual
+  // is nonzero and falls like h³ (1.4e-4 at N = 128, 1.8e-5 at N = 256 on the slew-up).
   const double a = worst(seedConditionRelativeResiduals(solveSlewUp(128).maneuver, kSeedInertia,
                                                         SeedConditionForm::PrintedWithTyposFixed));
   const double b = worst(seedConditionRelativeResiduals(solveSlewUp(256).maneuver, kSeedInertia,

@@ -218,7 +218,7 @@ ap::Vector3 quantityOnPlan(const ap::StageConstraint& c, const ap::Maneuver& pla
 TEST(StageConstraints, EveryKindIsOneClassThatTheCheckerAndTheDenseRowsRead) {
   ap::PlanningProblem base = scene("rest_to_rest", 16);
   const ap::PlanResult free_plan = ap::planManeuver(base);
-  ASSERT_TRUE(free_plan.converged()) << free_plan.message;
+  ASSERT_TRUE(free_plan.converged()) << free_plan.message();
   const ap::Maneuver& plan = free_plan.maneuver;
   std::mt19937 rng(29);
   std::normal_distribution<double> normal(0.0, 0.4);
@@ -278,7 +278,7 @@ TEST(StageConstraints, EveryKindIsOneClassThatTheCheckerAndTheDenseRowsRead) {
     o.solver = ap::SolverKind::Nlopt;
     o.max_iterations = 5000;
     const ap::PlanResult slsqp = ap::solveWithNlopt(p, o);
-    EXPECT_TRUE(slsqp.converged()) << name << ": " << slsqp.message;
+    EXPECT_TRUE(slsqp.converged()) << name << ": " << slsqp.message();
     EXPECT_LE(ap::checkConstraints(p, slsqp.maneuver).max_relative_violation,
               ap::kNodeConstraintTolerance)
         << name;
@@ -630,8 +630,8 @@ TEST(FreeTimeCones, KeepOutMinimumTimeIsAKktPointOutsideTheConeNearTheSearch) {
     const ap::PlanningProblem p = minimumTimeWithCone(scheme, 32);
     EXPECT_EQ(ap::freeTimeUnsupported(p), "");
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
-    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
+    ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
     EXPECT_LE(r.minimum_time.stationarity, 1e-8);
     EXPECT_LE(r.minimum_time.time_stationarity, 1e-8);
     EXPECT_LE(r.minimum_time.complementarity, 1e-8);
@@ -640,8 +640,8 @@ TEST(FreeTimeCones, KeepOutMinimumTimeIsAKktPointOutsideTheConeNearTheSearch) {
     }
     EXPECT_LE(r.max_constraint_violation, 1e-8);
     const ap::PlanResult searched = searchedMinimumTime(p);
-    ASSERT_TRUE(searched.converged()) << searched.message;
-    EXPECT_FALSE(searched.minimum_time.kkt_point) << searched.message;
+    ASSERT_TRUE(searched.converged()) << searched.message();
+    EXPECT_FALSE(searched.minimum_time.kkt_point) << searched.message();
     // The structured starts do not reach every basin around a cone: the answer is a KKT point,
     // but the search (a continuation over many minimum-effort solves) can end in a lower basin
     // (second_order N = 32: 28.9937 against 28.9825, +0.04 %; docs/results/minimum_time.md).
@@ -656,7 +656,7 @@ TEST(FreeTimeCones, KeepOutMinimumTimeIsAKktPointOutsideTheConeNearTheSearch) {
 TEST(FreeTimeCones, TStarIsInvariantUnderAWorldRotationOfAttitudesAndCone) {
   const ap::PlanningProblem p = minimumTimeWithCone(ap::SchemeKind::SecondOrder, 32);
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message();
   std::mt19937 rng(31);
   std::normal_distribution<double> normal;
   for (int trial = 0; trial < 2; ++trial) {
@@ -676,7 +676,7 @@ TEST(FreeTimeCones, AStartInsideTheConeIsRefusedByName) {
   }
   const ap::FreeTimeOutcome o = ap::solveFreeTime(p, through, 40.0, 1e-9, 100);
   EXPECT_EQ(o.termination, ap::Termination::NotConverged);
-  EXPECT_NE(o.message.find("violate a cone"), std::string::npos) << o.message;
+  EXPECT_NE(o.message().find("violate a cone"), std::string::npos) << o.message();
 }
 
 TEST(FreeTimeRates, RateLimitedMinimumTimeIsAKktPointWithinTheLimit) {
@@ -686,13 +686,13 @@ TEST(FreeTimeRates, RateLimitedMinimumTimeIsAKktPointWithinTheLimit) {
   p.constraints.push_back(ap::PlanningConstraint::maxAngularRate(0.1));
   EXPECT_EQ(ap::freeTimeUnsupported(p), "");
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
-  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
   EXPECT_LE(r.minimum_time.stationarity, 1e-8);
   EXPECT_LE(r.minimum_time.complementarity, 1e-8);
   for (const ap::Vector3& w : r.maneuver.angular_velocity) EXPECT_LE(w.norm(), 0.1 * (1 + 1e-9));
   const ap::PlanResult searched = searchedMinimumTime(p);
-  ASSERT_TRUE(searched.converged()) << searched.message;
+  ASSERT_TRUE(searched.converged()) << searched.message();
   EXPECT_LE(r.minimum_duration, searched.minimum_duration * (1 + 1e-8));
   // With spinning ends too (test_free_time: RateLimited… and RateLimitDerivativesInH…).
   p.initial_velocity = ap::Vector3(0.01, 0, 0);

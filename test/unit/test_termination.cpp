@@ -49,7 +49,7 @@ TEST(Termination, ConvergedSolveListsItsGridLevelsCoarsestFirst) {
   SolverOptions one_class;  // one solve's levels (the class survey: test_extremal_classes)
   one_class.enumerate_classes = false;
   const PlanResult r = planManeuver(seedRestToRest(128), one_class);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   EXPECT_EQ(r.termination, Termination::Converged);
   ASSERT_GE(r.levels.size(), 2u);  // continuation: 16 -> 32 -> 128
   EXPECT_EQ(r.levels.back().steps, 128);
@@ -62,7 +62,7 @@ TEST(Termination, ConvergedSolveListsItsGridLevelsCoarsestFirst) {
   }
   EXPECT_EQ(iterations, r.iterations);
   // The message explains the outcome in one level: no coarse-level message nested in it.
-  EXPECT_LT(r.message.size(), 400u) << r.message;
+  EXPECT_LT(r.message().size(), 400u) << r.message();
 }
 
 TEST(Termination, CancelledByTheCallback) {
@@ -70,7 +70,7 @@ TEST(Termination, CancelledByTheCallback) {
   options.on_iteration = [](const IterationInfo&) { return false; };
   for (int N : {12, 128}) {  // one grid; several levels (cancelled on the coarsest)
     const PlanResult r = planManeuver(seedRestToRest(N), options);
-    EXPECT_EQ(r.termination, Termination::Cancelled) << N << ": " << r.message;
+    EXPECT_EQ(r.termination, Termination::Cancelled) << N << ": " << r.message();
     EXPECT_FALSE(r.converged());
     EXPECT_EQ(r.maneuver.steps(), N);  // the plan so far, on the requested grid
   }
@@ -80,8 +80,8 @@ TEST(Termination, TimedOutWhenTheBudgetRunsOut) {
   SolverOptions options;
   options.time_budget_s = 1e-9;
   const PlanResult r = planManeuver(seedRestToRest(1024), options);
-  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message;
-  EXPECT_TRUE(contains(r.message, "time budget")) << r.message;
+  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message();
+  EXPECT_TRUE(contains(r.message(), "time budget")) << r.message();
   EXPECT_EQ(r.maneuver.steps(), 1024);
 }
 
@@ -92,15 +92,15 @@ TEST(Termination, TimedOutAlsoWhenPlanningToAnAccuracy) {
   SolverOptions options;
   options.time_budget_s = 1e-9;
   const PlanResult r = planManeuver(p, options);
-  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message;
+  EXPECT_EQ(r.termination, Termination::TimedOut) << r.message();
 }
 
 TEST(Termination, IterationLimitIsNotConverged) {
   SolverOptions options;
   options.max_iterations = 1;
   const PlanResult r = planManeuver(seedRestToRest(64), options);
-  EXPECT_EQ(r.termination, Termination::NotConverged) << r.message;
-  EXPECT_TRUE(contains(r.message, "iteration limit")) << r.message;
+  EXPECT_EQ(r.termination, Termination::NotConverged) << r.message();
+  EXPECT_TRUE(contains(r.message(), "iteration limit")) << r.message();
 }
 
 TEST(Termination, StepTooLargeIsItsOwnStatusOrException) {
@@ -115,7 +115,7 @@ TEST(Report, TextSummaryKeepsEveryFieldWhateverTheMessageLength) {
   // A message longer than any fixed buffer (5000 bytes) must not cut the fields after it.
   const PlanningProblem p = seedRestToRest(128);
   PlanResult r;
-  r.message = std::string(5000, 'x');
+  r.clauses.push_back(clauses::Reason{std::string(5000, 'x')});
   r.extremal = "short way";
   r.solver = "newton";
   r.iterations = 7;
@@ -237,9 +237,9 @@ TEST(Verdicts, AFreeTimeSolvesEndingIsItsOutcomesVerdictKind) {
     geodesic.push_back(p.initial_attitude * so3::exp(turn * (double(k) / p.steps)));
   }
   const FreeTimeOutcome o = solveFreeTime(p, geodesic, 3.4, 1e-9, 500);
-  ASSERT_EQ(o.termination, Termination::Converged) << o.message;
+  ASSERT_EQ(o.termination, Termination::Converged) << o.message();
   EXPECT_EQ(verdictKindName(o.verdict), "free_time_ended");
-  EXPECT_EQ(o.message, renderVerdict(o.verdict, ""));
+  EXPECT_EQ(o.message(), renderVerdict(o.verdict, ""));
   std::map<std::string, double> figure;
   for (const VerdictFigure& f : verdictFigures(o.verdict)) figure[f.name] = f.value;
   EXPECT_EQ(figure.at("duration"), o.duration);
@@ -261,9 +261,9 @@ TEST(Verdicts, AMinimumTimeAnswerIsItsOwnKindWithTheFiguresOfItsCertificate) {
           loadScene(std::string(AP_SOURCE_DIR) + "/scenes/" + scene + ".yaml").problem;
       p.steps = steps;
       const PlanResult r = planManeuver(p, SolverOptions());
-      ASSERT_TRUE(r.converged()) << r.message;
-      ASSERT_TRUE(r.minimum_time.kkt_point) << r.message;
-      ASSERT_TRUE(std::holds_alternative<verdicts::MinimumTimeAnswer>(r.verdict)) << r.message;
+      ASSERT_TRUE(r.converged()) << r.message();
+      ASSERT_TRUE(r.minimum_time.kkt_point) << r.message();
+      ASSERT_TRUE(std::holds_alternative<verdicts::MinimumTimeAnswer>(r.verdict)) << r.message();
       const auto& answer = std::get<verdicts::MinimumTimeAnswer>(r.verdict);
       EXPECT_EQ(answer.minimum_duration, r.minimum_duration);
       EXPECT_EQ(answer.second_order_sufficient, r.minimum_time.second_order_sufficient);
@@ -280,14 +280,14 @@ TEST(Verdicts, AMinimumTimeAnswerIsItsOwnKindWithTheFiguresOfItsCertificate) {
                 (s.name == answer.start && s.termination == Termination::Converged &&
                  std::abs(s.duration - answer.minimum_duration) <= 1e-9 * answer.minimum_duration);
       }
-      EXPECT_TRUE(found) << r.message;
+      EXPECT_TRUE(found) << r.message();
       std::map<std::string, double> figure;
       for (const VerdictFigure& f : verdictFigures(r.verdict)) figure[f.name] = f.value;
       EXPECT_EQ(figure.at("minimum_duration"), r.minimum_duration);
       EXPECT_EQ(figure.at("solves"), r.minimum_time.solves);
       EXPECT_EQ(figure.at("second_order_sufficient"),
                 r.minimum_time.second_order_sufficient ? 1.0 : 0.0);
-      EXPECT_EQ(r.message.rfind(renderVerdict(r.verdict, ""), 0), 0u) << r.message;
+      EXPECT_EQ(r.message().rfind(renderVerdict(r.verdict, ""), 0), 0u) << r.message();
     }
   }
 }
@@ -307,10 +307,10 @@ TEST(Verdicts, ASolversFirstReasonIsItsVerdictKind) {
         loadScene(std::string(AP_SOURCE_DIR) + "/scenes/" + c.scene + ".yaml").problem;
     p.steps = 32;
     const PlanResult r = planManeuver(p, SolverOptions());
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     EXPECT_EQ(verdictKindName(r.verdict), c.kind);
     const std::string words = renderVerdict(r.verdict, "");
-    EXPECT_EQ(r.message.rfind(words, 0), 0u) << r.message << "\n" << words;
+    EXPECT_EQ(r.message().rfind(words, 0), 0u) << r.message() << "\n" << words;
     const std::vector<VerdictFigure> figures = verdictFigures(r.verdict);
     ASSERT_FALSE(figures.empty());
     EXPECT_EQ(figures[0].name, "iterations");

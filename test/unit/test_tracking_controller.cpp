@@ -240,7 +240,7 @@ TEST(ManeuverInterpolation, MeanTorqueIsTheHoldsMeanOverTheInterval) {
 TEST(RigidBodyPlant, OpenLoopCommandsOfTheHoldsMeanDoNotLagThePlan) {
   Scene scene = loadScene(std::string(AP_SOURCE_DIR) + "/scenes/leo_slew.yaml");
   const PlanResult plan = planManeuver(scene.problem);
-  ASSERT_TRUE(plan.converged()) << plan.message;
+  ASSERT_TRUE(plan.converged()) << plan.message();
   const Matrix3 J = scene.problem.inertia;
   const std::shared_ptr<const EffectModel> effects = plannableEffects(scene.effects, J);
   const Maneuver& nodes = plan.maneuver;
@@ -304,7 +304,7 @@ TEST(SimulateTracking, TracksAPlanFromAPerturbedStart) {
 // actuator noise. Open loop misses by the noise's random walk; closed loop by far less.
 TEST(SimulateTracking, FeedbackBeatsOpenLoopReplayUnderNoiseByAnOrderOfMagnitude) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const auto& [scene, plan, J, effects] = disturbed;
   const Maneuver& nodes = plan.maneuver;
 
@@ -391,7 +391,7 @@ TEST(RigidBodyPlant, PredictStateIsTheBodysMotion) {
 // ~plant external with attitude_plant_node reproduces over ROS topics.
 TEST(RigidBodyPlant, DrivenByTheLawAtTheControlSamplesReproducesSimulateTracking) {
   const DisturbedPlan disturbed;
-  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message;
+  ASSERT_TRUE(disturbed.plan.converged()) << disturbed.plan.message();
   const auto& [scene, plan, J, effects] = disturbed;
   const Maneuver& nodes = plan.maneuver;
   const ManeuverInterpolation reference(nodes, scene.problem.scheme, J, effects.get());

@@ -72,7 +72,7 @@ TEST(WarmStart, RemainderOfThePlanIsRecoveredInAtMostTwoIterations) {
   ASSERT_EQ(spinning, 3);
   for (const ap::PlanningProblem& p : problems) {
     const ap::PlanResult full = plan(p);
-    ASSERT_TRUE(full.converged()) << full.message;
+    ASSERT_TRUE(full.converged()) << full.message();
     const int N = p.steps;
     for (const int k : {1, N / 4, N / 2}) {
       SCOPED_TRACE("N = " + std::to_string(N) + ", k = " + std::to_string(k) + ", scheme " +
@@ -81,7 +81,7 @@ TEST(WarmStart, RemainderOfThePlanIsRecoveredInAtMostTwoIterations) {
       ASSERT_FALSE(rest.initial_velocity.isZero());
       const ap::Maneuver guess = ap::remainderOfPlan(full.maneuver, k);
       const ap::PlanResult warm = plan(rest, &guess);
-      ASSERT_TRUE(warm.converged()) << warm.message;
+      ASSERT_TRUE(warm.converged()) << warm.message();
       const double expected = remainderCost(full.maneuver, k);
       EXPECT_NEAR(warm.cost, expected, 1e-8 * expected);
       EXPECT_LE(warm.iterations, 2);
@@ -104,7 +104,7 @@ TEST(WarmStart, ReplanStaysInTheGuesssHomotopyClass) {
   ASSERT_FALSE(cheaper.extremal_summary.others.empty()) << cheaper.extremal;
   ASSERT_GT(other.cost, 1.001 * cheaper.cost);  // two classes, the cold answer the cheaper
   const ap::PlanResult warm = plan(p, &other.maneuver);
-  ASSERT_TRUE(warm.converged()) << warm.message;
+  ASSERT_TRUE(warm.converged()) << warm.message();
   EXPECT_NEAR(warm.cost, other.cost, 1e-9 * other.cost);
   EXPECT_LE(warm.iterations, 1);
 }
@@ -115,7 +115,7 @@ TEST(WarmStart, GuessOfAnotherResolutionIsResampled) {
   for (const char* name : {"rest_to_rest.yaml", "torque_limited.yaml"}) {
     SCOPED_TRACE(name);
     const ap::PlanResult coarse = plan(scene(name, 64));
-    ASSERT_TRUE(coarse.converged()) << coarse.message;
+    ASSERT_TRUE(coarse.converged()) << coarse.message();
     const ap::PlanningProblem fine = scene(name, 256);
     const ap::Maneuver on_grid = ap::initialGuessOnGrid(coarse.maneuver, fine);
     ASSERT_EQ(on_grid.steps(), 256);
@@ -124,7 +124,7 @@ TEST(WarmStart, GuessOfAnotherResolutionIsResampled) {
     }
     const ap::PlanResult cold = plan(fine);
     const ap::PlanResult warm = plan(fine, &coarse.maneuver);
-    ASSERT_TRUE(cold.converged() && warm.converged()) << cold.message << " | " << warm.message;
+    ASSERT_TRUE(cold.converged() && warm.converged()) << cold.message() << " | " << warm.message();
     EXPECT_NEAR(warm.cost, cold.cost, 1e-8 * cold.cost);
     EXPECT_LE(warm.iterations, cold.iterations);
   }
@@ -141,7 +141,7 @@ TEST(WarmStart, GuessThatDoesNotMatchTheBoundaryDataIsOnlyAStart) {
   ASSERT_TRUE(unrelated.converged());
   const ap::PlanResult cold = plan(p);
   const ap::PlanResult warm = plan(p, &unrelated.maneuver);
-  ASSERT_TRUE(warm.converged()) << warm.message;
+  ASSERT_TRUE(warm.converged()) << warm.message();
   EXPECT_NEAR(warm.cost, cold.cost, 1e-9 * cold.cost);
 }
 
@@ -188,13 +188,13 @@ TEST(WarmStart, ConstrainedReplanStartsFromTheGuess) {
     SCOPED_TRACE(name);
     const ap::PlanningProblem p = scene(name, 128);
     const ap::PlanResult full = plan(p);
-    ASSERT_TRUE(full.converged()) << full.message;
+    ASSERT_TRUE(full.converged()) << full.message();
     ASSERT_GT(full.active_constraints, 0);
     const ap::PlanningProblem rest = ap::remainderProblem(p, full.maneuver, 32);
     const ap::Maneuver guess = ap::remainderOfPlan(full.maneuver, 32);
     const ap::PlanResult cold = plan(rest);
     const ap::PlanResult warm = plan(rest, &guess);
-    ASSERT_TRUE(cold.converged() && warm.converged()) << cold.message << " | " << warm.message;
+    ASSERT_TRUE(cold.converged() && warm.converged()) << cold.message() << " | " << warm.message();
     ASSERT_FALSE(warm.attempts.empty());
     EXPECT_EQ(warm.attempts.front().start, ap::AttemptStart::WarmStart);
     EXPECT_EQ(warm.attempts.front().stage, ap::AttemptStage::Constrained);

@@ -106,7 +106,7 @@ TEST(WheelFlight, ReplayOnThePlansSchemeReproducesThePlanToRoundOff) {
     p.reaction_wheels.max_momentum = {0.9};  // binding on some wheel (checked below)
     const std::string name = ap::schemeName(scheme);
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << name << ": " << r.message;
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message();
     ASSERT_GT(r.active_constraints, 0) << name;
     const ap::WheelStates planned =
         ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
@@ -154,7 +154,7 @@ TEST(WheelFlight, ContinuousFlightFollowsThePlanToSecondOrder) {
   for (const int N : {32, 64, 128}) {
     const ap::PlanningProblem p = pyramidSlew(N);
     const ap::PlanResult r = ap::planManeuver(p);
-    ASSERT_TRUE(r.converged()) << r.message;
+    ASSERT_TRUE(r.converged()) << r.message();
     const ap::WheelStates planned =
         ap::wheelStates(p.scheme, p.inertia, p.reaction_wheels, r.maneuver);
     const ap::WheelFlight flight =
@@ -185,7 +185,7 @@ TEST(WheelFlight, ContinuousFlightFollowsThePlanToSecondOrder) {
 /// Plans `p` (which must converge) and flies the plan's own wheel torques from its start.
 void planAndFly(const ap::PlanningProblem& p, ap::PlanResult* r, ap::WheelFlight* flight) {
   *r = ap::planManeuver(p);
-  ASSERT_TRUE(r->converged()) << r->message;
+  ASSERT_TRUE(r->converged()) << r->message();
   *flight = ap::flyWithWheels(p.inertia, p.scheme, p.reaction_wheels, r->maneuver, {},
                               ap::RigidBodyState{p.initial_attitude, p.initial_velocity});
 }
@@ -292,7 +292,7 @@ TEST(WheelTracking, WheelsDeliverTheLawsTorqueAndAreCutAtTheirLimits) {
   ap::PlanningProblem p = pyramidSlew(64);
   p.reaction_wheels.max_momentum = {3.0};  // room for the correction
   const ap::PlanResult r = ap::planManeuver(p);
-  ASSERT_TRUE(r.converged()) << r.message;
+  ASSERT_TRUE(r.converged()) << r.message();
   const ap::ManeuverInterpolation reference(r.maneuver, p.scheme, p.inertia, nullptr);
   const ap::RigidBodyState start{ap::so3::exp(ap::Vector3(0.02, -0.01, 0.015)),
                                  ap::Vector3(0.002, 0.0, -0.001)};

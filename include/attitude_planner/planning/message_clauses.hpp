@@ -15,6 +15,12 @@
 
 namespace attitude_planner {
 
+/// One clause of a message (defined below); a note or a frame that says another solve's reason
+/// holds that solve's clauses, rendered where the message it is part of is rendered.
+struct MessageClause;
+/// A message as data: its clauses in the order they were recorded.
+using MessageClauses = std::vector<MessageClause>;
+
 namespace notes {
 
 /// The interior point's other formulation tried from the same start after the first stopped
@@ -25,13 +31,13 @@ struct FormulationRetry {
   std::string retry;  ///< the retry's formulation ("elastic", ...)
   std::string first;  ///< the first one's
   bool solved = false;
-  std::string reason;
+  MessageClauses reason;  ///< the other solve's clauses
   bool within_bounds = false;
 };
 /// A 4x refinement that stopped, reached once more through the level in between (N = `steps`).
 struct ReachedThroughMiddle {
   int steps = 0;
-  std::string reason;  ///< the direct refinement's message
+  MessageClauses reason;  ///< the direct refinement's clauses
 };
 /// The interior point's levels: the coarsest one's N.
 struct GridContinuation {
@@ -39,7 +45,7 @@ struct GridContinuation {
 };
 /// Cones with other limits, from a start inside a cone: the cones alone, then every constraint.
 struct RetriedInTwoStages {
-  std::string reason;  ///< the first solve's message
+  MessageClauses reason;  ///< the first solve's clauses
 };
 /// The interior point from the caller's plan of this N, its multipliers re-derived.
 struct FromInitialGuess {};
@@ -65,7 +71,7 @@ struct UnconstrainedStart {
 };
 /// The interior point from the caller's guess stopped; the answer is the usual start's.
 struct AfterGuessStopped {
-  std::string reason;  ///< the solve from the guess's message
+  MessageClauses reason;  ///< the solve from the guess's clauses
 };
 /// An answer that is no plan (infeasible, stopped) whose torques also fail the replay.
 struct LastIterateDoesNotReplay {
@@ -80,7 +86,7 @@ struct OpenLoopReplayParted {
 };
 /// A request with its class left free: another class under the constraints is cheaper.
 struct CheapestClass {
-  std::string reason;  ///< the first class's (the unconstrained optimum's) message
+  MessageClauses reason;  ///< the first class's (the unconstrained optimum's) clauses
 };
 /// A pointing request where no start converged: the last start's reason.
 struct LastPointingStart {
@@ -136,7 +142,7 @@ struct MinimumTimeRestart {
 /// How a restart that did not beat the first answer ended (after MinimumTimeRestart).
 struct RestartEnded {
   Termination termination = Termination::NotConverged;
-  std::string reason;
+  MessageClauses reason;  ///< the restart's clauses
 };
 /// The first solve `why` and the minimum-time problem under the same bounds ended `termination`.
 struct MinimumTimeUnsolved {
@@ -203,7 +209,7 @@ struct PairSolveStopped {
 struct PairCombined {
   RichardsonPair pair;
   bool replaced = false;
-  std::string fine_reason;  ///< the 2N solve's message
+  MessageClauses fine_reason;  ///< the 2N solve's clauses
 };
 /// fourth_order minimum time: a solve of its pair of second_order problems (N = `steps` and 2N)
 /// did not converge, the one at 2N (`at_fine`) or at N: its minimum-time problem, or
@@ -224,7 +230,7 @@ struct MinimumTimePairCombined {
   double at_fine = 0.0;           ///< T* at 2N
   bool fine_binds = false;
   bool replaced = false;
-  std::string fine_reason;  ///< the 2N solve's message
+  MessageClauses fine_reason;  ///< the 2N solve's clauses
 };
 /// Spinning ends: a probe below T* = `previous` found a plan at T = `duration` from which the
 /// free-time solve did not descend: T* ≤ `duration`, an upper bound; the reason it is given is the
@@ -381,7 +387,10 @@ struct Reason {
 }  // namespace clauses
 
 /// One clause of a message: folded in order, a Reason sets the message, a Verdict words it with
-/// the message so far as its reason, a Note is appended, a Frame words its clause around it.
-using MessageClause = std::variant<clauses::Reason, Verdict, Note, Frame>;
+/// the message so far as its reason, a Note is appended, a Frame words its clause around it. A
+/// class (not an alias) so that notes and frames can hold clauses (MessageClauses).
+struct MessageClause : std::variant<clauses::Reason, Verdict, Note, Frame> {
+  using variant::variant;
+};
 
 }  // namespace attitude_planner

@@ -279,10 +279,10 @@ std::string minimizedEffortName(MinimizedEffort effort);
 struct PlanResult {
   Termination termination = Termination::NotConverged;
   bool converged() const { return termination == Termination::Converged; }
-  /// Human-readable explanation of `termination`: the fold of `clauses` (renderMessage), kept
-  /// as each clause is recorded and rendered from them once more at the end of each public entry
-  /// point.
-  std::string message;
+  /// Human-readable explanation of `termination`: the fold of `clauses`, rendered on each call
+  /// (renderClauses, src/planning/problem/message_notes). There is no other copy of the words: a
+  /// solver or driver records clauses, never a message.
+  std::string message() const;
   /// The message as data, in the order its clauses were recorded: the solver's words or verdict,
   /// the notes after it, the frames around it (message_clauses.hpp).
   std::vector<MessageClause> clauses;

@@ -373,8 +373,8 @@ PlanOutcome planRequest(const Request& req, const ros_conversions::PlannerDefaul
     out.error_code = errorCodeOf(out.result.termination);
     out.message = out.result.termination == Termination::Infeasible
                       ? infeasibleSummary(out.problem, out.result)
-                      : out.result.message;
-    out.details = out.result.message;
+                      : out.result.message();
+    out.details = out.result.message();
     enforceDeadline(&out);
   } catch (...) {
     describeCurrentException(&out.error_code, &out.message);

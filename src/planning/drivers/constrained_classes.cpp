@@ -196,7 +196,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);
   if (!first_kept) {
-    addNote(&result, notes::CheapestClass{renderClauses(first_said)});
+    addNote(&result, notes::CheapestClass{first_said});
   }
   return result;
 }

@@ -113,7 +113,7 @@ PlanResult fourthOrderFromPair(const PlanningProblem& problem, double T, const R
   bool replaced = false;
   PlanResult result = richardsonCombinationWithinTheBounds(at, coarse, fine, &replaced);
   takeReason(&result, coarse);
-  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, renderMessage(fine)});
+  frameMessage(&result, frames::PairCombined{each_from_its_plan, replaced, fine.clauses});
   if (replaced) context.restoreKept(coarse_kept);  // the N solve's plan is the one returned
   result.attempts = context.attemptsFrom(first);
   return result;
@@ -200,7 +200,7 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   result.attempts = context.attemptsFrom(first);
   takeReason(&result, coarse);
   frameMessage(&result, frames::MinimumTimePairCombined{N, T_star, T_N, T_2N, fine_binds, replaced,
-                                                        renderMessage(fine)});
+                                                        fine.clauses});
   return result;
 }
 
@@ -436,9 +436,7 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
 
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planMinimumTime(problem, context);
-  renderMessageOnce(&result);
-  return result;
+  return planMinimumTime(problem, context);
 }
 
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
@@ -656,7 +654,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
       kept.duration_verdict.longest_duration_found = climb.reached;
     }
     addNote(&kept, restart);
-    addNote(&kept, notes::RestartEnded{again.termination, renderMessage(again)});
+    addNote(&kept, notes::RestartEnded{again.termination, again.clauses});
     return kept;
   }
   if (again.termination == Termination::Infeasible)
@@ -670,9 +668,7 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planBoundedMinimumEffort(problem, context);
-  renderMessageOnce(&result);
-  return result;
+  return planBoundedMinimumEffort(problem, context);
 }
 
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context) {

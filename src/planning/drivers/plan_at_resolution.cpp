@@ -99,7 +99,7 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
 
   PlanResult result = richardsonCombination(problem, coarse, fine);
   takeReason(&result, coarse);
-  frameMessage(&result, frames::PairCombined{pair, false, renderMessage(fine)});
+  frameMessage(&result, frames::PairCombined{pair, false, fine.clauses});
   return result;
 }
 
@@ -179,9 +179,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  PlanResult result = planAtResolution(problem, options, context);
-  renderMessageOnce(&result);
-  return result;
+  return planAtResolution(problem, options, context);
 }
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,
@@ -225,7 +223,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       result = solveWithInteriorPoint(problem, options, context);
       result.iterations = tally.iterations();
       result.levels = context.levelsFrom(first_level);
-      addNote(&result, notes::AfterGuessStopped{renderMessage(first)});
+      addNote(&result, notes::AfterGuessStopped{first.clauses});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
              options.constrained_from_warm_start && options.warm_start) {

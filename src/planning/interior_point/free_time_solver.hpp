@@ -10,6 +10,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/problem/message_notes.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
@@ -21,7 +22,7 @@ struct FreeTimeOutcome {
   Termination termination = Termination::NotConverged;
   Verdict verdict;                     ///< how it ended, as data (driver_verdict.hpp)
   std::vector<MessageClause> clauses;  ///< its words as data (recordVerdict)
-  std::string message;                 ///< their fold
+  std::string message() const { return renderClauses(clauses); }  ///< their fold
   ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
   double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)

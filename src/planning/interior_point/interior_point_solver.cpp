@@ -159,7 +159,7 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
   const PlanResult& other = take_second ? first.result : second.result;
   answer.result.iterations = tally.iterations();
   addNote(&answer.result, notes::FormulationRetry{recipe.retry.name, recipe.first.name, take_second,
-                                                  renderMessage(other), second_within});
+                                                  other.clauses, second_within});
   answer.duals = LevelDuals{};  // the retry's are not carried
   return answer;
 }
@@ -218,7 +218,7 @@ void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options
   if (!middle.result.converged()) return;
   GridOutcome fine = solveGridWithRetry(at, from_coarse, solve, &middle.steps, nullptr);
   if (!fine.result.converged()) return;
-  addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, renderMessage(direct->result)});
+  addNote(&fine.result, notes::ReachedThroughMiddle{half.steps, direct->result.clauses});
   direct->result = fine.result;
   direct->steps = fine.steps;
   direct->formulation = fine.formulation;
@@ -466,7 +466,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   if (take_second) result = second;
   keepAttempt(context, begun, take_second ? second_at : at, &result);
   result.iterations = tally.iterations();
-  addNote(&result, notes::RetriedInTwoStages{renderClauses(first_said)});
+  addNote(&result, notes::RetriedInTwoStages{first_said});
   return result;
 }
 

@@ -19,14 +19,15 @@ std::string grid(int steps) {
 std::string words(const FormulationRetry& n) {
   if (n.within_bounds) {
     return "; answered with " + n.retry + "'s plan, within the bounds, after " + n.first +
-           " ended outside them: " + n.reason;
+           " ended outside them: " + renderClauses(n.reason);
   }
   return (n.solved ? "; solved with " + n.retry + " after " + n.first + " stopped: "
                    : "; retried with " + n.retry + ": ") +
-         n.reason;
+         renderClauses(n.reason);
 }
 std::string words(const ReachedThroughMiddle& n) {
-  return "; reached through " + grid(n.steps) + " after the direct refinement stopped: " + n.reason;
+  return "; reached through " + grid(n.steps) +
+         " after the direct refinement stopped: " + renderClauses(n.reason);
 }
 std::string words(const GridContinuation& n) {
   return "; grid continuation from " + grid(n.steps);
@@ -34,7 +35,7 @@ std::string words(const GridContinuation& n) {
 std::string words(const RetriedInTwoStages& n) {
   return "; retried in two stages (the cones alone, then every constraint from that path) "
          "after: " +
-         n.reason;
+         renderClauses(n.reason);
 }
 std::string words(const FromInitialGuess&) {
   return "; from the initial guess, its multipliers re-derived";
@@ -63,7 +64,7 @@ std::string words(const UnconstrainedStart& n) {
   return s.str();
 }
 std::string words(const AfterGuessStopped& n) {
-  return "; after the start from the initial guess stopped: " + n.reason;
+  return "; after the start from the initial guess stopped: " + renderClauses(n.reason);
 }
 std::string words(const LastIterateDoesNotReplay& n) {
   return "; its last iterate's torques do not replay: " + n.reason;
@@ -79,7 +80,7 @@ std::string words(const OpenLoopReplayParted& n) {
 std::string words(const CheapestClass& n) {
   return "; the cheapest homotopy class under the constraints (after the unconstrained "
          "optimum's class: " +
-         n.reason + ")";
+         renderClauses(n.reason) + ")";
 }
 std::string words(const LastPointingStart& n) {
   return "; the last: " + n.reason;
@@ -133,7 +134,7 @@ std::string words(const MinimumTimeRestart& n) {
   return s;
 }
 std::string words(const RestartEnded& n) {
-  return ": " + terminationName(n.termination) + " (" + n.reason + ")";
+  return ": " + terminationName(n.termination) + " (" + renderClauses(n.reason) + ")";
 }
 std::string words(const MinimumTimeUnsolved& n) {
   return "; the first solve " + n.why +
@@ -182,7 +183,7 @@ std::string framed(const frames::PairCombined& f, const std::string& reason) {
          (f.replaced ? ": the plan is the second_order plan at N (the Richardson combination left "
                        "a bound both meet)"
                      : "") +
-         ": N: " + reason + " | 2N: " + f.fine_reason;
+         ": N: " + reason + " | 2N: " + renderClauses(f.fine_reason);
 }
 std::string minimumTimePair(int steps) {
   return "fourth_order minimum time (the second_order minimum-time problems at " + grid(steps) +
@@ -204,7 +205,7 @@ std::string framed(const frames::MinimumTimePairCombined& f, const std::string& 
                      "with the 2N plan left a bound both meet"
                    : "the plan combines the binding plan and the other's minimum-effort plan "
                      "at T*")
-    << " | 2N: " << f.fine_reason << " | N: " << reason;
+    << " | 2N: " << renderClauses(f.fine_reason) << " | N: " << reason;
   return s.str();
 }
 std::string framed(const frames::UpperBoundFromProbe& f, const std::string& reason) {
@@ -506,7 +507,6 @@ std::string renderNote(const Note& note) {
 
 void addNote(PlanResult* result, const Note& note) {
   result->clauses.push_back(note);
-  result->message.append(renderNote(note));
 }
 
 std::string renderFrame(const Frame& frame, const std::string& reason) {
@@ -515,7 +515,6 @@ std::string renderFrame(const Frame& frame, const std::string& reason) {
 
 void frameMessage(PlanResult* result, const Frame& frame) {
   result->clauses.push_back(frame);
-  result->message = renderFrame(frame, result->message);
 }
 
 std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
@@ -525,12 +524,10 @@ std::string renderVerdict(const Verdict& verdict, const std::string& reason) {
 void recordVerdict(PlanResult* result, const Verdict& verdict) {
   result->verdict = verdict;
   result->clauses.push_back(verdict);
-  result->message = renderVerdict(verdict, result->message);
 }
 
 void recordReason(PlanResult* result, const std::string& words) {
   result->clauses.assign(1, clauses::Reason{words});
-  result->message = words;
 }
 
 void takeReason(PlanResult* to, const PlanResult& from) {
@@ -539,7 +536,6 @@ void takeReason(PlanResult* to, const PlanResult& from) {
 
 void takeReason(PlanResult* to, const std::vector<MessageClause>& clauses) {
   to->clauses = clauses;
-  to->message = renderClauses(clauses);
 }
 
 std::string renderClauses(const std::vector<MessageClause>& clauses) {
@@ -552,8 +548,8 @@ std::string renderMessage(const PlanResult& result) {
   return renderClauses(result.clauses);
 }
 
-void renderMessageOnce(PlanResult* result) {
-  result->message = renderMessage(*result);
+std::string PlanResult::message() const {
+  return renderClauses(clauses);
 }
 
 }  // namespace attitude_planner

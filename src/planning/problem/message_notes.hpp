@@ -16,12 +16,12 @@ namespace attitude_planner {
 
 /// The clause's words ("; grid continuation from N = 8", ...), each starting with its separator.
 std::string renderNote(const Note& note);
-/// Adds the clause to the result's clauses (its message: after what it says already).
+/// Adds the clause to the result's clauses (its message says it after what it says already).
 void addNote(PlanResult* result, const Note& note);
 
 /// The message `frame` makes of `reason` (the message it is given).
 std::string renderFrame(const Frame& frame, const std::string& reason);
-/// Adds the frame to the result's clauses (its message: framed by `frame`).
+/// Adds the frame to the result's clauses (its message is framed by `frame`).
 void frameMessage(PlanResult* result, const Frame& frame);
 
 /// The message a driver's `verdict` makes (include/attitude_planner/planning/driver_verdict.hpp):
@@ -33,13 +33,11 @@ std::string renderVerdict(const Verdict& verdict, const std::string& reason);
 /// Records `verdict` on the result and adds it to its clauses (the reason it is given is the
 /// message the result carried).
 void recordVerdict(PlanResult* result, const Verdict& verdict);
-/// The same for a solver's own outcome that carries a verdict, its clauses and its message
-/// (FreeTimeOutcome).
+/// The same for a solver's own outcome that carries a verdict and its clauses (FreeTimeOutcome).
 template <class Outcome>
 void recordVerdict(Outcome* outcome, const Verdict& verdict) {
   outcome->verdict = verdict;
   outcome->clauses.push_back(verdict);
-  outcome->message = renderVerdict(verdict, outcome->message);
 }
 /// Words no kind, note or frame holds yet (a caught error's text): the result's clauses start
 /// again from them.
@@ -50,7 +48,6 @@ template <class To, class From>
 void carryReason(To* to, const From& from) {
   to->verdict = from.verdict;
   to->clauses = from.clauses;
-  to->message = from.message;
 }
 /// `to` says `from`'s reason (its clauses) and keeps its own verdict: a plan made of other
 /// solves' (a Richardson combination, a probe's plan) framed around one solve's reason.
@@ -60,9 +57,7 @@ void takeReason(PlanResult* to, const std::vector<MessageClause>& clauses);
 
 /// The message `clauses` make, folded in order (MessageClause).
 std::string renderClauses(const std::vector<MessageClause>& clauses);
-/// The message of `result`: renderClauses of its clauses.
+/// The message of `result`: renderClauses of its clauses (PlanResult::message).
 std::string renderMessage(const PlanResult& result);
-/// Renders result->message from its clauses: once, at the end of each public entry point.
-void renderMessageOnce(PlanResult* result);
 
 }  // namespace attitude_planner

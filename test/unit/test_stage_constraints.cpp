@@ -427,6 +427,32 @@ double rowValue(const ap::ConstraintRows<Entries>& g, const ap::ReducedProblem& 
   return g.constraint->value(g.quantity->value(ap::QuantityInputs(at, at.current()), k));
 }
 
+/// A seeded random direction d in the unknowns and the problem moved along it by ±e and ±e2: the
+/// points of the central first and second differences.
+struct MovedAlong {
+  MovedAlong(const ap::ReducedProblem& np, unsigned seed)
+      : d(randomDirection(np.unknowns(), seed)),
+        up(moved(np, e)),
+        down(moved(np, -e)),
+        up2(moved(np, e2)),
+        down2(moved(np, -e2)) {}
+  static Eigen::VectorXd randomDirection(int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd d(n);
+    for (int i = 0; i < n; ++i) d(i) = normal(rng);
+    return d;
+  }
+  ap::ReducedProblem moved(const ap::ReducedProblem& np, double alpha) const {
+    ap::ReducedProblem out = np;
+    out.setCurrent(np.retract(d, alpha));
+    return out;
+  }
+  Eigen::VectorXd d;
+  double e = 1e-6, e2 = 1e-4;
+  ap::ReducedProblem up, down, up2, down2;
+};
+
 }  // namespace
 
 /// The chain rule both interior points call (transcription/stage_transcription.hpp), on the rows
@@ -440,17 +466,11 @@ TEST(StageConstraints, TheInteriorPointsChainRuleMatchesCentralDifferencesOfTheR
     const ap::StageConstraints list = ap::buildStageConstraints(p);
     const ap::ReducedProblem np = perturbed(p, 9);
     RowsByQuantity<9> rows(list, np, 21);
-    std::mt19937 rng(23);
-    std::normal_distribution<double> normal;
-    Eigen::VectorXd d(np.unknowns());
-    for (int i = 0; i < d.size(); ++i) d(i) = normal(rng);
-    const double e = 1e-6, e2 = 1e-4;
-    const auto moved = [&](double alpha) {
-      ap::ReducedProblem out = np;
-      out.setCurrent(np.retract(d, alpha));
-      return out;
-    };
-    const ap::ReducedProblem up = moved(e), down = moved(-e), up2 = moved(e2), down2 = moved(-e2);
+    const MovedAlong along(np, 23);
+    const Eigen::VectorXd& d = along.d;
+    const double e = along.e, e2 = along.e2;
+    const ap::ReducedProblem &up = along.up, &down = along.down, &up2 = along.up2,
+                             &down2 = along.down2;
     int instances = 0, expected = 0;
     for (const std::vector<int>& block : rows.blocks) {
       const ap::FixedStepRows& first = rows.groups[block.front()];
@@ -504,17 +524,11 @@ TEST(StageConstraints, TheTorqueRowsChainRuleMatchesCentralDifferencesOfTheRows)
       if (rows.groups[i].quantity->formedByCostStencil()) torque.push_back(i);
     }
     ASSERT_EQ(torque.size(), 7u) << "the box's six sides and the norm bound";
-    std::mt19937 rng(43);
-    std::normal_distribution<double> normal;
-    Eigen::VectorXd d(np.unknowns());
-    for (int i = 0; i < d.size(); ++i) d(i) = normal(rng);
-    const double e = 1e-6, e2 = 1e-4;
-    const auto moved = [&](double alpha) {
-      ap::ReducedProblem out = np;
-      out.setCurrent(np.retract(d, alpha));
-      return out;
-    };
-    const ap::ReducedProblem up = moved(e), down = moved(-e), up2 = moved(e2), down2 = moved(-e2);
+    const MovedAlong along(np, 43);
+    const Eigen::VectorXd& d = along.d;
+    const double e = along.e, e2 = along.e2;
+    const ap::ReducedProblem &up = along.up, &down = along.down, &up2 = along.up2,
+                             &down2 = along.down2;
     const auto root = [&](int k) { return std::sqrt(np.scheme().torqueWeight(k, p.steps)); };
     double isotropic = 0.0;  // Σ z c''/w of the stencil the weights were formed for
     const auto weights = [&](int k, const ap::Vector3& residual) {

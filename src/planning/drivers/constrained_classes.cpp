@@ -9,8 +9,11 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
+#include "attitude_planner/planning/warm_start.hpp"
 #include "planning/drivers/requests.hpp"
+#include "planning/newton/newton_parameters.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/strategies/starts.hpp"
 
 namespace attitude_planner {
 
@@ -23,23 +26,34 @@ PlanningProblem pinnedTo(const PlanningProblem& problem, const HomotopyClass& ho
   return out;
 }
 
-/// The classes the survey solved to convergence, `first_class` first, and its grid (the fewest
-/// steps among its class_survey attempts; the requested N if none).
+/// The classes the survey solved to convergence, `first_class` first, their costs there, and its
+/// grid (the fewest steps among its class_survey attempts; the requested N if none).
 struct SurveyedClasses {
   std::vector<HomotopyClass> classes;
+  std::vector<double> costs;  ///< each class's survey cost (NaN: not surveyed on that grid)
   int steps = 0;
 };
 
 SurveyedClasses surveyedClasses(const ExtremalSummary& survey, const HomotopyClass& first_class,
                                 int requested_steps) {
-  SurveyedClasses out{{first_class}, requested_steps};
+  SurveyedClasses out{{first_class}, {std::numeric_limits<double>::quiet_NaN()}, requested_steps};
   for (const Attempt& a : survey.others) {
     if (a.stage == AttemptStage::ClassSurvey) out.steps = std::min(out.steps, a.steps);
+  }
+  for (const Attempt& a : survey.others) {
     if (a.termination != Termination::Converged) continue;
-    const bool listed =
-        std::any_of(out.classes.begin(), out.classes.end(),
-                    [&](const HomotopyClass& c) { return sameHomotopyClass(c, a.homotopy); });
-    if (!listed) out.classes.push_back(a.homotopy);
+    const auto it =
+        std::find_if(out.classes.begin(), out.classes.end(),
+                     [&](const HomotopyClass& c) { return sameHomotopyClass(c, a.homotopy); });
+    const double cost = a.stage == AttemptStage::ClassSurvey && a.steps == out.steps
+                            ? a.cost
+                            : std::numeric_limits<double>::quiet_NaN();
+    if (it == out.classes.end()) {
+      out.classes.push_back(a.homotopy);
+      out.costs.push_back(cost);
+    } else if (std::isnan(out.costs[it - out.classes.begin()])) {
+      out.costs[it - out.classes.begin()] = cost;
+    }
   }
   return out;
 }
@@ -59,10 +73,11 @@ bool better(const PlanResult& r, const PlanResult& best) {
 }
 
 /// One class's constrained solve, as the extremal's entry.
-Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int steps) {
+Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int steps,
+                     AttemptStart start) {
   Attempt a;
   a.stage = AttemptStage::ConstrainedClass;
-  a.start = AttemptStart::UnconstrainedOptimum;
+  a.start = start;
   a.formulation = Formulation::FreeSlacks;
   a.homotopy = homotopy;
   a.steps = steps;
@@ -72,36 +87,47 @@ Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int ste
   return a;
 }
 
+/// Where a class's constrained solve starts: by default from its unconstrained optimum (the
+/// survey's plan of it on that grid if there is one); `unconstrained_optimum` hands that optimum
+/// in; `constrained_plan` (a plan of the class under the constraints on another grid) starts the
+/// interior point itself, so the solve keeps the side of each cone that plan passes.
+struct ClassStart {
+  const Maneuver* unconstrained_optimum = nullptr;
+  const Maneuver* constrained_plan = nullptr;
+};
+
 /// The classes' solves and the trail they leave in the context (after `first`'s, which begins
 /// at `first_recorded`).
 class ClassSearch {
  public:
   ClassSearch(const PlanningProblem& problem, const SolverOptions& options, SolveContext& context,
-              const std::vector<ClassPlan>& survey_plans, PlanResult first,
-              std::size_t first_recorded)
+              const std::vector<ClassPlan>& survey_plans, const HomotopyClass& first_class,
+              PlanResult first, std::size_t first_recorded)
       : problem_(problem),
         options_(options),
         context_(context),
         survey_plans_(survey_plans),
         first_recorded_(first_recorded),
         first_iterations_(first.iterations),
+        first_attempt_(
+            classAttempt(first_class, first, problem.steps, AttemptStart::UnconstrainedOptimum)),
         best_(std::move(first)),
         kept_(context.keptAttempt()) {
     options_.enumerate_classes = false;  // each solve in its own class
   }
 
-  /// One solve of `homotopy` on `steps` steps, from the survey's plan of it on that grid if there
-  /// is one (its attempts named constrained_class where they were the solver's own solve). A grid
-  /// with no boundary step at its h gives no plan.
-  PlanResult solve(const HomotopyClass& homotopy, int steps) {
+  /// One solve of `homotopy` on `steps` steps from `start` (its attempts named constrained_class
+  /// where they were the solver's own solve). A grid with no boundary step at its h gives no plan.
+  PlanResult solve(const HomotopyClass& homotopy, int steps, const ClassStart& start = {}) {
     PlanResult r;
     r.termination = Termination::NotConverged;
     SolverOptions options = options_;
-    const auto surveyed =
-        std::find_if(survey_plans_.begin(), survey_plans_.end(), [&](const ClassPlan& c) {
-          return sameHomotopyClass(c.homotopy, homotopy) && c.plan.steps() == steps;
-        });
-    options.unconstrained_optimum = surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
+    options.unconstrained_optimum = start.unconstrained_optimum;
+    if (!start.unconstrained_optimum && !start.constrained_plan) {
+      options.unconstrained_optimum = surveyPlan(homotopy, steps);
+    }
+    options.warm_start = start.constrained_plan;
+    options.constrained_from_warm_start = start.constrained_plan != nullptr;
     const std::size_t before = context_.attempts().size();
     try {
       const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
@@ -110,12 +136,60 @@ class ClassSearch {
       recordReason(&r, e.what());
     }
     iterations_ += r.iterations;
+    // A solve from a constrained plan runs the interior point alone, which names no extremal.
+    if (r.converged() && !r.extremal_summary.known)
+      r.extremal_summary = extremalIn(homotopy, steps);
     // The attempt whose plan r is: its kept one, else its last.
     const std::optional<std::size_t> kept = context_.keptAttempt();
     const std::size_t end = context_.attempts().size();
     if (end > before) last_kept_ = kept && *kept >= before ? *kept : end - 1;
-    tried_.push_back(classAttempt(homotopy, r, steps));
+    const AttemptStart from =
+        start.constrained_plan ? AttemptStart::PreviousAttempt : AttemptStart::UnconstrainedOptimum;
+    tried_.push_back(classAttempt(homotopy, r, steps, from));
     return r;
+  }
+
+  /// The unconstrained optimum of `homotopy` on `steps` steps, by Newton from the survey's finest
+  /// plan of it (the constraints ignored, as the unconstrained solve ignores them).
+  PlanResult unconstrainedOptimum(const HomotopyClass& homotopy, int steps) {
+    const PlanningProblem pinned = pinnedTo(problem_, homotopy, steps);
+    SolverOptions options = options_;
+    Maneuver guess;
+    if (const Maneuver* surveyed = finestSurveyPlan(homotopy)) {
+      guess = initialGuessOnGrid(*surveyed, pinned);
+      options.warm_start = &guess;
+    }
+    PlanResult r;
+    r.termination = Termination::NotConverged;
+    try {
+      const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
+      r = solveWithNewton(pinned, options, context_);
+    } catch (const StepTooLarge& e) {
+      recordReason(&r, e.what());
+    }
+    iterations_ += r.iterations;
+    return r;
+  }
+
+  /// The cheapest converged plan of `homotopy` under the constraints on `steps` steps, from its
+  /// unconstrained optimum there and from a start on each side of the cone that optimum violates
+  /// most deeply (coneSideStarts); not converged if none is.
+  PlanResult cheapestOnGrid(const HomotopyClass& homotopy, int steps) {
+    PlanResult best = solve(homotopy, steps);
+    const Maneuver* optimum = surveyPlan(homotopy, steps);
+    Maneuver resampled;
+    if (!optimum) {
+      const Maneuver* finest = finestSurveyPlan(homotopy);
+      if (!finest) return best;
+      resampled = initialGuessOnGrid(*finest, pinnedTo(problem_, homotopy, steps));
+      optimum = &resampled;
+    }
+    for (const Maneuver& side : coneSideStarts(problem_, *optimum)) {
+      if (stopped()) break;
+      PlanResult r = solve(homotopy, steps, ClassStart{nullptr, &side});
+      if (r.converged() && (!best.converged() || r.cost < best.cost)) best = std::move(r);
+    }
+    return best;
   }
 
   /// Keeps r (a plan on the requested grid) if it is better than the best so far.
@@ -126,9 +200,20 @@ class ClassSearch {
     kept_ = last_kept_;
   }
 
+  /// Whether the best plan converged and holds the constraints between the nodes too.
+  bool holdsAPlanWithinTheConstraints() const {
+    return best_.converged() && best_.max_violation_between_nodes <= kBetweenNodesSlack;
+  }
+
+  /// Whether a plan of this cost could replace the best one (there is no best plan yet, or it
+  /// costs more).
+  bool couldBeat(double cost) const { return !best_.converged() || cost < best_.cost; }
+  bool holdsAPlan() const { return best_.converged(); }
+
   bool stopped() const { return context_.stopReason().has_value(); }
 
-  /// The best plan with the whole trail, the classes tried in its extremal.
+  /// The best plan with the whole trail, the classes tried in its extremal (the first class's
+  /// solve among them where another plan is kept).
   PlanResult finish(const ExtremalSummary& survey, const HomotopyClass& first_class) {
     context_.restoreKept(kept_);
     best_.attempts = context_.attemptsFrom(first_recorded_);
@@ -136,6 +221,7 @@ class ClassSearch {
     ExtremalSummary& extremal = best_.extremal_summary;
     if (firstKept()) extremal.homotopy = first_class;
     extremal.others = survey.others;
+    if (!firstKept()) extremal.others.push_back(first_attempt_);
     for (std::size_t i = 0; i < tried_.size(); ++i) {
       if (!best_tried_ || i != *best_tried_) extremal.others.push_back(tried_[i]);
     }
@@ -146,6 +232,30 @@ class ClassSearch {
   bool firstKept() const { return !best_tried_; }
 
  private:
+  /// The extremal of a plan of `homotopy` on `steps` steps: its class's lift.
+  ExtremalSummary extremalIn(const HomotopyClass& homotopy, int steps) const {
+    const PlanningProblem pinned = pinnedTo(problem_, homotopy, steps);
+    const std::vector<Lift> lifts = nearestLifts(pinned, ReducedProblem(pinned));
+    return extremalOf(lifts[homotopy.long_way ? 1 : 0]);
+  }
+
+  const Maneuver* surveyPlan(const HomotopyClass& homotopy, int steps) const {
+    const auto surveyed =
+        std::find_if(survey_plans_.begin(), survey_plans_.end(), [&](const ClassPlan& c) {
+          return sameHomotopyClass(c.homotopy, homotopy) && c.plan.steps() == steps;
+        });
+    return surveyed != survey_plans_.end() ? &surveyed->plan : nullptr;
+  }
+
+  const Maneuver* finestSurveyPlan(const HomotopyClass& homotopy) const {
+    const Maneuver* finest = nullptr;
+    for (const ClassPlan& c : survey_plans_) {
+      if (!sameHomotopyClass(c.homotopy, homotopy)) continue;
+      if (!finest || c.plan.steps() > finest->steps()) finest = &c.plan;
+    }
+    return finest;
+  }
+
   const PlanningProblem& problem_;
   SolverOptions options_;
   SolveContext& context_;
@@ -153,6 +263,7 @@ class ClassSearch {
   std::size_t first_recorded_;
   std::vector<Attempt> tried_;
   int first_iterations_ = 0;
+  Attempt first_attempt_;
   PlanResult best_;
   std::optional<std::size_t> kept_;        ///< the best plan's attempt in the context's trail
   std::optional<std::size_t> last_kept_;   ///< the last solve's
@@ -160,39 +271,129 @@ class ClassSearch {
   int iterations_ = 0;
 };
 
+bool listed(const std::vector<HomotopyClass>& classes, const HomotopyClass& c) {
+  return std::any_of(classes.begin(), classes.end(),
+                     [&](const HomotopyClass& d) { return sameHomotopyClass(c, d); });
+}
+
+/// Where the first class ended without a plan on the requested grid: every surveyed class under
+/// the constraints on the survey grid, then the converged ones carried to the requested grid in
+/// order of their cost there, each from its own survey-grid plan (a class's plan on a coarse grid
+/// says which side of each cone it passes, which its unconstrained optimum does not: the first
+/// class's solve from that optimum is the one that failed), until one converges within the
+/// constraints between the nodes too. On the requested grid already (no coarser survey), each
+/// class's solve is its answer. Returns the classes solved on the requested grid.
+std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const SurveyedClasses& surveyed,
+                                               const HomotopyClass& first_class, int steps) {
+  std::vector<HomotopyClass> solved;
+  if (surveyed.steps >= steps) {
+    for (const HomotopyClass& c : surveyed.classes) {
+      if (search.stopped()) break;
+      if (sameHomotopyClass(c, first_class)) continue;  // `first` is that solve
+      search.offer(search.solve(c, steps));
+      solved.push_back(c);
+    }
+    return solved;
+  }
+  std::vector<std::pair<HomotopyClass, PlanResult>> coarse;
+  for (const HomotopyClass& c : surveyed.classes) {
+    if (search.stopped()) break;
+    PlanResult r = search.cheapestOnGrid(c, surveyed.steps);
+    if (r.converged()) coarse.emplace_back(c, std::move(r));
+  }
+  std::stable_sort(coarse.begin(), coarse.end(),
+                   [](const auto& a, const auto& b) { return a.second.cost < b.second.cost; });
+  for (const auto& [c, plan] : coarse) {
+    if (search.stopped() || search.holdsAPlanWithinTheConstraints()) break;
+    search.offer(search.solve(c, steps, ClassStart{nullptr, &plan.maneuver}));
+    solved.push_back(c);
+  }
+  return solved;
+}
+
+/// Whether a cost ratio is within the class survey's refine margin (NewtonParameters::
+/// class_refine_margin: coarse costs reorder on refinement within it). NaN: not within.
+bool withinSurveyMargin(double ratio) {
+  return ratio <= 1 + newtonDefaults().class_refine_margin;
+}
+
+/// Where the first class converged at a cost the constraints raised beyond the survey's margin
+/// (measured on docs/results/keep_out_grids.md's suite: 1.00–1.75 times the unconstrained optimum
+/// where the first plan was the class's best, 27–733 where it was not): the class's cheapest plan
+/// under the constraints on the survey grid (on twice as many steps while a coarser grid's solves
+/// end without a plan, below the requested grid) and, if its effort h·cost is below the first
+/// plan's, the class solved once more on the requested grid from it. A finer grid's optimum in one
+/// basin costs no more than a coarse one's (the coarse grid holds the cones at fewer nodes, and its
+/// discretization costs more: measured, h·cost falls with N on every request of that page whose
+/// answer keeps its basin), so a first plan above it sits in a costlier basin, one its start from
+/// the unconstrained optimum, which crosses a cone, led it into.
+void retryFromItsCoarsePlan(ClassSearch& search, const HomotopyClass& first_class,
+                            double first_cost, int coarse_steps, int steps) {
+  for (int coarse = coarse_steps; coarse < steps && !search.stopped(); coarse *= 2) {
+    const PlanResult plan = search.cheapestOnGrid(first_class, coarse);
+    if (!plan.converged()) continue;
+    if (plan.cost / coarse >= first_cost / steps || search.stopped()) return;
+    search.offer(search.solve(first_class, steps, ClassStart{nullptr, &plan.maneuver}));
+    return;
+  }
+}
+
+/// Whether class i of the survey could beat a plan that cost `rise` times its class's
+/// unconstrained optimum: its survey cost is within the survey's own refine margin (coarse costs
+/// reorder on refinement within it, NewtonParameters::class_refine_margin) of the first class's
+/// survey cost raised by the constraints as much. Unknown costs: it could.
+bool couldBeatOnTheSurvey(const SurveyedClasses& surveyed, std::size_t i, double rise) {
+  const double own = surveyed.costs[i];
+  const double first = surveyed.costs.front();
+  if (std::isnan(own) || std::isnan(first) || !std::isfinite(rise)) return true;
+  return withinSurveyMargin(own / (first * rise));
+}
+
+/// Once a plan is in hand, every other surveyed class whose unconstrained optimum on the
+/// requested grid costs less than it is solved under the constraints too (from that optimum):
+/// the constraints only add to a class's cost from its own optimum, so a class whose
+/// unconstrained optimum costs more cannot beat the plan, and is not solved under them. A class
+/// whose survey cost is beyond the survey's margin of the first class's, raised by `rise` (the
+/// best plan's cost over its class's unconstrained optimum), is not solved at all.
+void solveClassesThatCouldBeatIt(ClassSearch& search, const SurveyedClasses& surveyed,
+                                 const std::vector<HomotopyClass>& solved, double rise, int steps) {
+  for (std::size_t i = 0; i < surveyed.classes.size(); ++i) {
+    const HomotopyClass& c = surveyed.classes[i];
+    if (search.stopped() || !search.holdsAPlan()) break;
+    if (listed(solved, c) || !couldBeatOnTheSurvey(surveyed, i, rise)) continue;
+    const PlanResult optimum = search.unconstrainedOptimum(c, steps);
+    if (!optimum.converged() || !search.couldBeat(optimum.cost)) continue;
+    search.offer(search.solve(c, steps, ClassStart{&optimum.maneuver, nullptr}));
+  }
+}
+
 }  // namespace
 
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
                                     SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first,
-                                    std::size_t first_recorded) {
-  // A class that converged answers: solving the others costs more than the whole request on
-  // a constrained scene (measured, min_time_keep_out.yaml at N = 128 and 1.05 T*: 9 → 69 ms, the
-  // other classes infeasible on the survey grid after hundreds of iterations) for a cheaper plan
-  // seen in none of 8 seeded cases (docs/results/extremal_classes.md).
-  if (first.converged()) return first;
+                                    double unconstrained_cost, std::size_t first_recorded) {
   const HomotopyClass first_class = survey.known ? survey.homotopy : homotopyClassOf(problem);
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
-  if (surveyed.classes.size() < 2) return first;
+  if (surveyed.classes.size() < 2 && surveyed.steps >= problem.steps) return first;
   const std::vector<MessageClause> first_said = first.clauses;
-  ClassSearch search(problem, options, context, survey_plans, std::move(first), first_recorded);
-  const bool on_requested_grid = surveyed.steps >= problem.steps;
-  std::optional<HomotopyClass> cheapest;  // on the survey grid
-  PlanResult cheapest_plan;
-  for (const HomotopyClass& c : surveyed.classes) {
-    if (search.stopped()) break;
-    if (on_requested_grid && sameHomotopyClass(c, first_class)) continue;  // `first` is that solve
-    PlanResult r = search.solve(c, on_requested_grid ? problem.steps : surveyed.steps);
-    if (on_requested_grid) {
-      search.offer(std::move(r));
-    } else if (!cheapest || better(r, cheapest_plan)) {
-      cheapest = c;
-      cheapest_plan = std::move(r);
-    }
+  const bool first_converged = first.converged();
+  const double first_cost = first.cost;
+  ClassSearch search(problem, options, context, survey_plans, first_class, std::move(first),
+                     first_recorded);
+  std::vector<HomotopyClass> solved{first_class};
+  // How much the constraints raised the first class's cost from its unconstrained optimum.
+  const double first_rise = first_cost / unconstrained_cost;
+  if (first_converged && surveyed.steps < problem.steps && !withinSurveyMargin(first_rise)) {
+    retryFromItsCoarsePlan(search, first_class, first_cost, surveyed.steps, problem.steps);
+  } else if (!first_converged) {
+    const std::vector<HomotopyClass> carried =
+        carryFromSurveyGrid(search, surveyed, first_class, problem.steps);
+    solved.insert(solved.end(), carried.begin(), carried.end());
   }
-  const bool refine = !on_requested_grid && cheapest && cheapest_plan.converged() &&
-                      !sameHomotopyClass(*cheapest, first_class) && !search.stopped();
-  if (refine) search.offer(search.solve(*cheapest, problem.steps));
+  const double rise =
+      search.firstKept() && first_converged ? first_rise : std::numeric_limits<double>::infinity();
+  solveClassesThatCouldBeatIt(search, surveyed, solved, rise, problem.steps);
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);
   if (!first_kept) {

@@ -1,11 +1,18 @@
 // The cheapest homotopy class under constraints: a constrained request that leaves its class free
 // (classLeftFree) is first solved from the unconstrained optimum's class (the class survey's
-// cheapest). Where that ends without a plan (infeasible or unconverged: a verdict about one class
-// only), the classes the survey solved are solved under the constraints on the survey grid, and
-// the cheapest there, if it is not the first, is solved on the requested grid too; the better
-// plan is kept. (A class's unconstrained cost is no bound on what its constrained solve
-// reaches: a class is a lift of the rotation, and lifts two turns apart are one homotopy class on
-// SO(3), whose loops are Z₂, so the interior point can slide from one to the other.)
+// cheapest). Which side of a cone the interior point passes depends on that start, which violates
+// the cone, so the first plan is checked against the class's plan on the survey grid: where that
+// coarse plan's h·cost is lower, the class is solved again from it. Where the first solve ends
+// without a plan (infeasible or unconverged: a verdict about one class and one start only), the
+// classes the survey solved are solved under the constraints on the survey grid and carried to
+// the requested grid in order of their cost there, each from its own coarse plan, until one holds
+// the constraints between the nodes too. Once a plan is in hand, every other class whose
+// unconstrained optimum on the requested grid costs less than it is solved under the constraints
+// too, the cheaper plan kept: the constraints only add to a class's cost from its own optimum.
+// (That bound holds in the class's basin, not globally: a class is a lift of the rotation, and
+// lifts two turns apart are one homotopy class on SO(3), whose loops are Z₂, so the interior point
+// can slide from one to the other.) A class whose survey cost is beyond the survey's refine margin
+// of the first class's, raised as much as the constraints raised the first's, is not solved.
 #pragma once
 
 #include <vector>
@@ -20,19 +27,18 @@ namespace attitude_planner {
 /// differs by more than this are told apart by it before their cost.
 constexpr double kBetweenNodesSlack = 1e-3;
 
-/// `first` (the constrained solve from the unconstrained optimum's class, on the requested grid)
-/// if it converged; else the better of it and the cheapest other class under the constraints: every
-/// class `survey` (the unconstrained solve's structured extremal) solved is solved under the
-/// constraints on its survey grid (the requested grid if that is no finer), and the cheapest there
-/// carried to the requested grid by a solve in its class. The result's extremal lists each class
-/// tried (stage constrained_class) after the survey's attempts; its attempts are the context's
-/// from `first_recorded` (where `first`'s began), the best plan's attempt kept. `first` is returned
-/// as it is when the survey solved no other class. A class with a plan in `survey_plans`
-/// (solveWithNewton's) on the grid of its solve starts from it: its unconstrained Newton solve is
-/// not run again (SolverOptions::unconstrained_optimum).
+/// The cheapest plan over the classes `survey` (the unconstrained solve's structured extremal)
+/// solved, under the constraints, as the comment above describes; `first` is the constrained solve
+/// from the unconstrained optimum's class on the requested grid, `unconstrained_cost` that
+/// optimum's cost (NaN: unknown). The result's extremal lists each
+/// class tried (stage constrained_class) after the survey's attempts; its attempts are the
+/// context's from `first_recorded` (where `first`'s began), the best plan's attempt kept. `first`
+/// is returned as it is when the survey solved no other class. A class with a plan in
+/// `survey_plans` (solveWithNewton's) on the grid of its solve starts from it: its unconstrained
+/// Newton solve is not run again (SolverOptions::unconstrained_optimum).
 PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
                                     SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first,
-                                    std::size_t first_recorded);
+                                    double unconstrained_cost, std::size_t first_recorded);
 
 }  // namespace attitude_planner

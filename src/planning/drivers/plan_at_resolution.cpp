@@ -169,8 +169,10 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
     result.extremal = describeExtremal(result.extremal_summary);
   }
   if (classLeftFree(problem, options)) {
-    result = cheapestConstrainedClass(problem, options, context, survey, survey_plans,
-                                      std::move(result), first_recorded);
+    result = cheapestConstrainedClass(
+        problem, options, context, survey, survey_plans, std::move(result),
+        started_from_optimum ? started.cost : std::numeric_limits<double>::quiet_NaN(),
+        first_recorded);
   }
   return result;
 }

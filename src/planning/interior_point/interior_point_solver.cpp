@@ -190,13 +190,24 @@ GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
 
 /// The coarsest level starts from its own unconstrained optimum; Newton reaches it from the warm
 /// start (the requested grid's unconstrained optimum) resampled, instead of repeating the grid
-/// continuation that found the warm start. Sets level_options->warm_start to it (or null).
+/// continuation that found the warm start. A warm start that is to start the interior point itself
+/// (SolverOptions::constrained_from_warm_start) starts the level resampled. Sets
+/// level_options->warm_start to null.
 PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProblem& at,
                               const SolverOptions& options, SolveContext& context,
                               SolverOptions* level_options, Maneuver* resampled) {
   if (options.warm_start && options.warm_start->steps() == problem.steps) {
     resampled->attitude = resampleAttitudes(*options.warm_start, at.steps);
     level_options->warm_start = resampled;
+    if (options.constrained_from_warm_start) {
+      // A plan under the constraints starts the level itself: its unconstrained optimum would
+      // drop which side of each cone the plan passes.
+      PlanResult start;
+      start.termination = Termination::Converged;
+      start.maneuver = *resampled;
+      level_options->warm_start = nullptr;
+      return start;
+    }
   }
   PlanResult unconstrained = solveWithNewton(at, *level_options, context);
   level_options->warm_start = nullptr;

@@ -96,4 +96,92 @@ std::optional<Maneuver> coastingStart(const PlanningProblem& problem) {
   }
 }
 
+namespace {
+
+double angleBetween(const Vector3& a, const Vector3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+/// The free node (2 … N − 2) where `cone` is violated most deeply, and the first and last
+/// violated free nodes; nothing if none is.
+struct ConeViolation {
+  int deepest = -1, first = -1, last = -1;
+};
+
+ConeViolation deepestViolation(const PlanningConstraint& cone, const std::vector<Matrix3>& R) {
+  ConeViolation v;
+  double worst = 0.0;
+  const int N = static_cast<int>(R.size()) - 1;
+  for (int k = 2; k <= N - 2; ++k) {
+    const double depth =
+        cone.half_angle + cone.margin - angleBetween(R[k] * cone.body_axis, cone.world_direction);
+    if (depth <= 0.0) continue;
+    if (v.first < 0) v.first = k;
+    v.last = k;
+    if (depth > worst) {
+      worst = depth;
+      v.deepest = k;
+    }
+  }
+  return v;
+}
+
+/// 1 on [first, last], falling smoothly to 0 over as many nodes again on each side, 0 at the
+/// boundary nodes (0, 1, N − 1, N).
+double sideWeight(int k, const ConeViolation& v, int N) {
+  if (k < 2 || k > N - 2) return 0.0;
+  const double width = v.last - v.first + 1;
+  double x = 1.0;
+  if (k < v.first) x = 1.0 - (v.first - k) / width;
+  if (k > v.last) x = 1.0 - (k - v.last) / width;
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+}  // namespace
+
+std::vector<Maneuver> coneSideStarts(const PlanningProblem& problem, const Maneuver& plan) {
+  const std::vector<Matrix3>& R = plan.attitude;
+  const int N = plan.steps();
+  const PlanningConstraint* cone = nullptr;
+  ConeViolation violation;
+  double worst = 0.0;
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (c.kind != ConstraintKind::KeepOut) continue;
+    const ConeViolation v = deepestViolation(c, R);
+    if (v.deepest < 0) continue;
+    const double depth =
+        c.half_angle + c.margin - angleBetween(R[v.deepest] * c.body_axis, c.world_direction);
+    if (depth > worst) {
+      worst = depth;
+      cone = &c;
+      violation = v;
+    }
+  }
+  if (!cone) return {};
+  const int k = violation.deepest;
+  const Vector3& d = cone->world_direction;
+  const Vector3 boresight = R[k] * cone->body_axis;
+  const Vector3 along = R[k + 1] * cone->body_axis - R[k - 1] * cone->body_axis;
+  Vector3 across = d.cross(along);
+  if (across.norm() < 1e-12) across = d.unitOrthogonal();
+  across.normalize();
+  const double offset = kConeSideOffset * (cone->half_angle + cone->margin);
+  std::vector<Maneuver> starts;
+  for (const double side : {1.0, -1.0}) {
+    const Vector3 target = std::cos(offset) * d + std::sin(offset) * side * across;
+    const Vector3 turn_axis = boresight.cross(target);
+    const double angle = angleBetween(boresight, target);
+    const Vector3 turn =
+        turn_axis.norm() > 1e-12 ? Vector3(angle * turn_axis.normalized()) : Vector3::Zero();
+    Maneuver start;
+    start.attitude = R;
+    for (int j = 0; j <= N; ++j) {
+      start.attitude[j] = so3::exp(Vector3(sideWeight(j, violation, N) * turn)) * R[j];
+    }
+    starts.push_back(std::move(start));
+  }
+  return starts;
+}
+
 }  // namespace attitude_planner

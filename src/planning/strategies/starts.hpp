@@ -41,4 +41,16 @@ bool hasSpinningEnds(const PlanningProblem& problem);
 /// no solution at this h.
 std::optional<Maneuver> coastingStart(const PlanningProblem& problem);
 
+/// Starts on either side of the keep-out cone a plan violates most deeply: the plan's attitudes
+/// (N + 1) turned in the world, over the nodes inside the cone and as many again on each side
+/// (tapering to none at the boundary nodes), by the rotation that takes the deepest node's
+/// boresight to kConeSideOffset × the node bound (half angle + margin) from the cone's axis, on one
+/// side of the path and then on the other (the side is across the path's direction there). Empty if
+/// the plan violates no keep-out cone at a free node. Which side a solve from the violating plan
+/// passes is decided by its first steps; these name it.
+std::vector<Maneuver> coneSideStarts(const PlanningProblem& problem, const Maneuver& plan);
+
+/// How far off a cone's axis a side start puts the deepest node's boresight, in half angles.
+constexpr double kConeSideOffset = 1.25;
+
 }  // namespace attitude_planner

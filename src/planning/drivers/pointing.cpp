@@ -406,7 +406,7 @@ std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, doubl
 }
 
 /// A constrained request none of whose free-twist runs converged: the cheapest converged
-/// fixed-attitude plan among the starts' fixed-twist optima and one bounded fixed-attitude request
+/// fixed-attitude plan among the starts' fixed-twist optima and one fixed-attitude request
 /// at the twist of `unconverged` (the run that would be answered, not converged), labelled (the
 /// twist not optimized: its stationarity not measured, NaN). Empty where none converged.
 std::optional<PlanResult> fixedTwistFallback(
@@ -422,11 +422,14 @@ std::optional<PlanResult> fixedTwistFallback(
     if (f.first.fixed_plan) consider(*f.first.fixed_plan, f.first.solve.reason);
   }
   if (unconverged && std::isfinite(unconverged->solve.twist) && !context.stopReason()) {
-    // The request's own bounded driver at that twist (its minimum-time restart included: measured,
-    // seed 41501 of docs/results/pointing.md converges there, not from the constrained starts).
+    // The fixed-attitude request at that twist, without a minimum-time phase of its own: minimum
+    // time over the twist follows this request where a torque bound is present (the bounded
+    // driver), backs its verdict and restarts from its plan where T* <= T. Measured on the six
+    // infeasible torque-box requests of seeds 41, 43, 47 and 53: the fixed-twist T* exceeded T in
+    // each, and that phase took a quarter to a third of the request.
     PlanningProblem at = posedAt(problem, problem.steps, unconverged->solve.twist);
     at.end_condition = EndCondition();
-    const PlanResult plan = planBoundedMinimumEffort(at, context);
+    const PlanResult plan = planAtResolution(at, context.options(), context);
     if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
   }
   if (!best) return std::nullopt;

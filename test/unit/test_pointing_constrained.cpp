@@ -275,3 +275,29 @@ TEST(ConstrainedPointingPlan, AConesRidgeIsStartedFromBothSidesAndAtMostTheSweep
   EXPECT_GE(ridges, 1);
   EXPECT_GE(others, 1);
 }
+
+TEST(ConstrainedPointingPlan, AnInfeasibleAnswerSolvesMinimumTimeOverTheTwistOnly) {
+  // The requests of the test above (every start certified locally infeasible): no plan at the
+  // unconverged run's twist either, and minimum time is solved over the twist only (every
+  // minimum-time attempt has its start twist), not again at that one fixed twist: an infeasible
+  // verdict names the least T over the twist, above T.
+  for (unsigned seed : {231u, 232u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    PlanningProblem p = test_support::randomConstrainedPointingRequest(
+        seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
+    p.duration *= 0.8;
+    const PlanResult r = planManeuver(p);
+    EXPECT_FALSE(r.converged()) << r.message();
+    int over_the_twist = 0;
+    for (const Attempt& a : r.attempts) {
+      if (a.stage != AttemptStage::MinimumTimeSolve) continue;
+      EXPECT_TRUE(std::isfinite(a.start_detail.twist));
+      ++over_the_twist;
+    }
+    EXPECT_GE(over_the_twist, 1);
+    if (r.termination == Termination::Infeasible) {
+      EXPECT_EQ(r.pointing.infeasible_basis, PointingInfeasibleBasis::MinimumTimeOverTwist);
+      EXPECT_GT(r.duration_verdict.least_duration_found, p.duration);
+    }
+  }
+}

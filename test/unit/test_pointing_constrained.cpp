@@ -4,7 +4,7 @@
 // scheme, and the planned answer against a 5° sweep of fixed-attitude constrained solves refined by
 // golden section on seeded random requests (a keep-out cone, torque bounds, spinning starts), each
 // solved as one problem (the interior point with ψ free from unconstrained optima, no fixed-twist
-// interior point).
+// interior point; an optimum on a cone's ridge started from both its sides).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -212,5 +212,92 @@ TEST(ConstrainedPointingPlan, LocalInfeasibilityCertifiedFromEnoughStartsEndsThe
     }
     EXPECT_GE(certified.size(), std::size_t(kPointingStartTwists));
     EXPECT_EQ(fixed_twist_interior_points, 0);
+  }
+}
+
+namespace {
+
+/// The least margin [rad] of `p`'s cones over the nodes of `plan` (node bounds).
+double leastConeMargin(const PlanningProblem& p, const Maneuver& plan) {
+  double least = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : p.constraints) {
+    if (!c.isCone()) continue;
+    for (const Matrix3& R : plan.attitude) least = std::min(least, coneMargin(c, R) - c.margin);
+  }
+  return least;
+}
+
+/// Whether the constrained attempts of `r` include one started at `twist` (modulo 2π).
+bool startedAt(const PlanResult& r, double twist) {
+  for (const Attempt& a : r.attempts) {
+    if (a.stage == AttemptStage::Constrained &&
+        std::abs(std::remainder(a.start_detail.twist - twist, 2.0 * M_PI)) < 1e-6) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST(ConstrainedPointingPlan, AConesRidgeIsStartedFromBothSidesAndAtMostTheSweepsBest) {
+  // Where the unconstrained twist optimum ψ* (the request without its cone) crosses the cone
+  // deeper than the fixed-twist unconstrained optima at ψ* ± kPointingRidgeOffset, each measured
+  // here on planManeuver's own plans, the constrained cost over ψ has a ridge at ψ*: the interior
+  // point with ψ free starts from both those optima, else from ψ*'s. Either way the answer is at
+  // most the sweep's best. Seeded so that both kinds occur.
+  int ridges = 0, others = 0;
+  for (unsigned seed : {201u, 202u, 203u, 204u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const PlanningProblem p = test_support::randomConstrainedPointingRequest(
+        seed, 32, false, SchemeKind::Paper, PointingBinding::KeepOut);
+    PlanningProblem free_of_cones = p;
+    free_of_cones.constraints.clear();
+    const PlanResult optimum = planManeuver(free_of_cones);
+    ASSERT_TRUE(optimum.converged()) << optimum.message();
+    const double twist = optimum.pointing.final_twist;
+    const double deepest = leastConeMargin(p, optimum.maneuver);
+    bool ridge = deepest < 0.0;
+    for (const double offset : {-kPointingRidgeOffset, kPointingRidgeOffset}) {
+      PlanningProblem fixed = free_of_cones;
+      fixed.end_condition = EndCondition();
+      fixed.final_attitude = pointingAttitude(p.end_condition, twist + offset);
+      const PlanResult side = planManeuver(fixed);
+      ASSERT_TRUE(side.converged()) << side.message();
+      ridge = ridge && leastConeMargin(p, side.maneuver) > deepest;
+    }
+    const PlanResult r = expectAtMostTheSweep(p);
+    const bool both_sides =
+        startedAt(r, twist - kPointingRidgeOffset) && startedAt(r, twist + kPointingRidgeOffset);
+    EXPECT_EQ(both_sides, ridge) << "twist optimum " << twist << ", least margin " << deepest;
+    (ridge ? ridges : others) += 1;
+  }
+  EXPECT_GE(ridges, 1);
+  EXPECT_GE(others, 1);
+}
+
+TEST(ConstrainedPointingPlan, AnInfeasibleAnswerSolvesMinimumTimeOverTheTwistOnly) {
+  // The requests of the test above (every start certified locally infeasible): no plan at the
+  // unconverged run's twist either, and minimum time is solved over the twist only (every
+  // minimum-time attempt has its start twist), not again at that one fixed twist: an infeasible
+  // verdict names the least T over the twist, above T.
+  for (unsigned seed : {231u, 232u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    PlanningProblem p = test_support::randomConstrainedPointingRequest(
+        seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
+    p.duration *= 0.8;
+    const PlanResult r = planManeuver(p);
+    EXPECT_FALSE(r.converged()) << r.message();
+    int over_the_twist = 0;
+    for (const Attempt& a : r.attempts) {
+      if (a.stage != AttemptStage::MinimumTimeSolve) continue;
+      EXPECT_TRUE(std::isfinite(a.start_detail.twist));
+      ++over_the_twist;
+    }
+    EXPECT_GE(over_the_twist, 1);
+    if (r.termination == Termination::Infeasible) {
+      EXPECT_EQ(r.pointing.infeasible_basis, PointingInfeasibleBasis::MinimumTimeOverTwist);
+      EXPECT_GT(r.duration_verdict.least_duration_found, p.duration);
+    }
   }
 }

@@ -725,18 +725,15 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
                                               bound, true));
     return finish(result);
   }
-  if (problem.end_condition.pointing()) {
-    // T* (the twist free) <= T: a plan exists at some twist, so no "infeasible"; the restart from
-    // the minimum-time plan would be a warm-started pointing solve, which planPointing does not
-    // serve yet.
-    if (result.termination == Termination::Infeasible)
-      result.termination = Termination::NotConverged;
-    addNote(&result, notes::PointingRestartNotServed{T_star});
-    return finish(result);
-  }
-  return finish(runInternalPhase("the restart from the minimum-time plan", [&] {
+  PlanResult again = runInternalPhase("the restart from the minimum-time plan", [&] {
     return fromMinimumTimePlan(problem, result, why, minimum_time, pair, first_kept, context);
-  }));
+  });
+  // To a pointing target the restart is the interior point with the twist free from the T* plan
+  // (planPointing from a plan inside every bound). T* over the twist <= T: a plan exists at some
+  // twist, so the answer is never "infeasible".
+  if (problem.end_condition.pointing() && again.termination == Termination::Infeasible)
+    again.termination = Termination::NotConverged;
+  return finish(again);
 }
 
 }  // namespace attitude_planner

@@ -406,7 +406,7 @@ std::vector<TwistRun> runStarts(const PlanningProblem& problem, int steps, doubl
 }
 
 /// A constrained request none of whose free-twist runs converged: the cheapest converged
-/// fixed-attitude plan among the starts' fixed-twist optima and one bounded fixed-attitude request
+/// fixed-attitude plan among the starts' fixed-twist optima and one fixed-attitude request
 /// at the twist of `unconverged` (the run that would be answered, not converged), labelled (the
 /// twist not optimized: its stationarity not measured, NaN). Empty where none converged.
 std::optional<PlanResult> fixedTwistFallback(
@@ -422,11 +422,14 @@ std::optional<PlanResult> fixedTwistFallback(
     if (f.first.fixed_plan) consider(*f.first.fixed_plan, f.first.solve.reason);
   }
   if (unconverged && std::isfinite(unconverged->solve.twist) && !context.stopReason()) {
-    // The request's own bounded driver at that twist (its minimum-time restart included: measured,
-    // seed 41501 of docs/results/pointing.md converges there, not from the constrained starts).
+    // The fixed-attitude request at that twist, without a minimum-time phase of its own: minimum
+    // time over the twist follows this request where a torque bound is present (the bounded
+    // driver), backs its verdict and restarts from its plan where T* <= T. Measured on the six
+    // infeasible torque-box requests of seeds 41, 43, 47 and 53: the fixed-twist T* exceeded T in
+    // each, and that phase took a quarter to a third of the request.
     PlanningProblem at = posedAt(problem, problem.steps, unconverged->solve.twist);
     at.end_condition = EndCondition();
-    const PlanResult plan = planBoundedMinimumEffort(at, context);
+    const PlanResult plan = planAtResolution(at, context.options(), context);
     if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
   }
   if (!best) return std::nullopt;
@@ -651,32 +654,89 @@ bool meetsEveryNodeConstraint(const PlanningProblem& problem, const TwistRun& op
   return checkConstraints(at, np.maneuver(optimum.iterate)).max_node_bound_violation <= 0.0;
 }
 
+/// The least cone margin [rad] over the nodes of `run`'s plan (on the requested grid, posed at its
+/// twist) against the node bounds the planner imposes (coneMargin less each cone's margin); +∞
+/// without cones.
+double leastConeMargin(const PlanningProblem& problem, const TwistRun& run) {
+  const PlanningProblem at = posedAt(problem, problem.steps, run.solve.twist);
+  ReducedProblem np(at);
+  np.setCurrent(run.iterate);
+  const Maneuver plan = np.maneuver(run.iterate);
+  double least = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints) {
+    if (!c.isCone()) continue;
+    for (const Matrix3& R : plan.attitude) least = std::min(least, coneMargin(c, R) - c.margin);
+  }
+  return least;
+}
+
+/// Where `optimum` (an unconstrained twist optimum that crosses a cone) sits on a ridge of the
+/// constrained cost over ψ: its path crosses the cone deeper than the fixed-twist unconstrained
+/// optima kPointingRidgeOffset either side of its twist (fixedTwistOptimum, its way round) do. The
+/// plan around the cone then passes it on one side or the other, each side's optimum at another
+/// twist, and the interior point with ψ free started on the ridge stalls between them (measured:
+/// held-out requests 53506 and 53518, 225 and 124 iterations against 49 for the fixed request at
+/// the answer's twist). The two sides cheapest first; empty where `optimum` is no ridge.
+std::vector<TwistRun> ridgeSides(const PlanningProblem& problem, const TwistRun& optimum,
+                                 SolveContext& context) {
+  const double deepest = leastConeMargin(problem, optimum);
+  if (!(deepest < 0.0)) return {};
+  std::vector<TwistRun> sides;
+  for (const double offset : {-kPointingRidgeOffset, kPointingRidgeOffset}) {
+    if (context.stopReason()) return {};
+    const double twist = std::remainder(optimum.solve.twist + offset, 2.0 * M_PI);
+    TwistRun side = fixedTwistOptimum(problem, twist, optimum.homotopy, context);
+    if (!side.converged() || leastConeMargin(problem, side) <= deepest) return {};
+    sides.push_back(std::move(side));
+  }
+  sortByCost(&sides);
+  return sides;
+}
+
+/// The interior point with ψ free from `start` (fromUnconstrainedRun), or `start` itself where
+/// `as_it_is` (an optimum meeting every node constraint), recorded and appended to `finals`;
+/// `*cheapest` updated.
+void solveFrom(const PlanningProblem& problem, const TwistRun& start, bool as_it_is,
+               SolveContext& context, double* cheapest,
+               std::vector<std::pair<TwistRun, std::size_t>>* finals) {
+  TwistRun run = start;  // its way round, start twist and grid
+  const int counted_before = context.iterations();
+  if (as_it_is) {
+    run.start = AttemptStart::UnconstrainedOptimum;
+  } else {
+    fromUnconstrainedRun(posedAt(problem, problem.steps, start.solve.twist), start,
+                         context.options(), context, &run);
+  }
+  run.solve.iterations = context.iterations() - counted_before;
+  const std::size_t at = record(run, AttemptStage::Constrained, run.start, 0, context);
+  if (run.converged()) *cheapest = std::min(*cheapest, run.solve.cost);
+  finals->emplace_back(std::move(run), at);
+}
+
 /// The interior point with ψ free (fromUnconstrainedRun) from each of `starts` (cheapest first) in
 /// turn, each run appended to `finals` (where `twist_optimal`, the starts optimal in ψ too, a start
-/// meeting every node constraint itself: meetsEveryNodeConstraint), until `finals` hold
-/// certificates of local infeasibility from enough starts (locallyInfeasibleFromEnoughStarts) or a
-/// start's unconstrained cost is at least
-/// `*cheapest` (the least converged constrained cost so far, updated): constraints only add cost to
-/// the plans of a start's basin, and the interior point keeps the way round it starts in (a bound
-/// as long as the solve stays in that basin; a class's cost is no bound across classes).
+/// meeting every node constraint itself: meetsEveryNodeConstraint; one on a cone's ridge from
+/// both its sides instead: ridgeSides), until `finals` hold certificates of local infeasibility
+/// from enough starts (locallyInfeasibleFromEnoughStarts) or a start's unconstrained cost is at
+/// least `*cheapest` (the least converged constrained cost so far, updated): constraints only add
+/// cost to the plans of a start's basin, and the interior point keeps the way round it starts in
+/// (a bound as long as the solve stays in that basin; a class's cost is no bound across classes).
 void solveFromOptima(const PlanningProblem& problem, const std::vector<TwistRun>& starts,
                      SolveContext& context, double* cheapest,
                      std::vector<std::pair<TwistRun, std::size_t>>* finals, bool twist_optimal) {
   for (const TwistRun& start : starts) {
     if (!start.converged() || start.solve.cost >= *cheapest || context.stopReason()) return;
     if (!anyConverged(*finals) && locallyInfeasibleFromEnoughStarts(*finals)) return;
-    TwistRun run = start;  // its way round, start twist and grid
-    const int counted_before = context.iterations();
     if (twist_optimal && meetsEveryNodeConstraint(problem, start)) {
-      run.start = AttemptStart::UnconstrainedOptimum;
-    } else {
-      fromUnconstrainedRun(posedAt(problem, problem.steps, start.solve.twist), start,
-                           context.options(), context, &run);
+      solveFrom(problem, start, true, context, cheapest, finals);
+      continue;
     }
-    run.solve.iterations = context.iterations() - counted_before;
-    const std::size_t at = record(run, AttemptStage::Constrained, run.start, 0, context);
-    if (run.converged()) *cheapest = std::min(*cheapest, run.solve.cost);
-    finals->emplace_back(std::move(run), at);
+    const std::vector<TwistRun> sides =
+        twist_optimal ? ridgeSides(problem, start, context) : std::vector<TwistRun>();
+    if (sides.empty()) solveFrom(problem, start, false, context, cheapest, finals);
+    for (const TwistRun& side : sides) {
+      if (!context.stopReason()) solveFrom(problem, side, false, context, cheapest, finals);
+    }
   }
 }
 

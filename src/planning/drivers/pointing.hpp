@@ -3,6 +3,8 @@
 // ψ and the ways round, the cheapest kept.
 #pragma once
 
+#include <cmath>
+
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/problem/solve_context.hpp"
@@ -12,6 +14,12 @@ namespace attitude_planner {
 /// Start twists per way round: ψ₀ + 2πi/kPointingStartTwists, ψ₀ the twist of least rotation from
 /// R_0 (nearestTwist). With both ways round that is 2·kPointingStartTwists survey solves.
 constexpr int kPointingStartTwists = 4;
+
+/// A constrained request whose unconstrained twist optimum ψ* crosses a cone deeper than the
+/// fixed-twist unconstrained optima at ψ* ± kPointingRidgeOffset [rad] do (a ridge of the
+/// constrained cost over ψ: the plan passes the cone on one side or the other) starts the interior
+/// point with ψ free from those two optima instead of from ψ*'s.
+constexpr double kPointingRidgeOffset = M_PI / 4.0;
 
 /// Plans `problem` (end_condition.pointing(), validated) in `context` with `options` for this
 /// solve: the starts solved on a coarse survey grid (the coarsest of 16·4^k steps whose boundary

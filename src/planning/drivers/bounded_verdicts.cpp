@@ -184,8 +184,9 @@ double rateLimit(const PlanningProblem& problem) {
 /// leastRateBeforeTheEnd a proof may take (each a few 3x3 solves).
 constexpr int kRoomSamples = 1024;
 constexpr int kRoomEvaluations = 20000;
-/// The least rate must clear the limit by this much (relative) at a sample: round-off.
-constexpr double kRoomRoundOff = 1e-9;
+/// The least rate must clear the limit by this much (relative): by the plan check's own
+/// tolerance, so that no plan it would accept as within the bounds lies where none is proven.
+constexpr double kRoomRoundOff = kNodeConstraintTolerance;
 
 /// Proves leastRateBeforeTheEnd > w on [h1, h2] from its values at the ends (Lipschitz constant
 /// `K`), splitting the interval where they do not suffice; false where a split finds room or

@@ -496,6 +496,7 @@ TEST(BoundedVerdicts, APaperPlansLastFreeStepIsTheStepTheLeastRateBeforeTheEndBo
   const Maneuver& m = r.maneuver;
   const int N = p.steps;
   const double h = m.time_step;
+  EXPECT_LT((m.angular_velocity[N - 1] - p.final_velocity).norm(), 1e-9);  // the boundary datum
   const Vector3 momentum =
       so3::exp(h * m.angular_velocity[N - 1]) * (p.inertia * m.angular_velocity[N - 1]) -
       h * m.torque[N - 1];

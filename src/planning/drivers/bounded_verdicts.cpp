@@ -252,8 +252,9 @@ NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem) {
   const double a = torqueAuthority(problem).largest_magnitude;
   const double boundary_rate =
       std::max(problem.initial_velocity.norm(), problem.final_velocity.norm());
+  // With N < 3 the step before the last is the first, whose rate is data (no rate row).
   if (!std::isfinite(w) || !std::isfinite(leastRateBeforeTheEnd(problem, 1.0)) ||
-      !(boundary_rate > 0)) {
+      !(boundary_rate > 0) || problem.steps < 3) {
     return {};
   }
   const int N = problem.steps;

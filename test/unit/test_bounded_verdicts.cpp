@@ -9,11 +9,13 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <random>
 #include <string>
 #include <variant>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
 #include "support/bounded_requests.hpp"
@@ -418,4 +420,138 @@ TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   const PlanResult r = planManeuver(below);
   EXPECT_FALSE(r.converged() && checkConstraints(below, r.maneuver).max_relative_violation <= 1e-6)
       << "a plan at 0.8 T* = " << below.duration << " s: " << r.message();
+}
+
+namespace {
+
+/// A paper-scheme request that ends spinning at `final_rate` under a norm bound `a` and the rate
+/// limit `w`, from rest, on J = Rᵀ diag(moments) R.
+PlanningProblem spinningEnd(const Vector3& moments, const Matrix3& R, const Vector3& final_rate,
+                            double a, double w) {
+  PlanningProblem p = slew(moments, 1.0, Vector3(1, 2, 2));
+  p.inertia = R.transpose() * moments.asDiagonal() * R;
+  p.scheme = SchemeKind::Paper;
+  p.final_velocity = final_rate;
+  p.constraints = {PlanningConstraint::maxTorqueNorm(a), PlanningConstraint::maxAngularRate(w)};
+  return p;
+}
+
+/// The least |J⁻¹(c − hτ)| over |τ| ≤ a by projected gradient from the best of many samples of
+/// the ball: an independent solver of the problem leastRateBeforeTheEnd bounds by duality.
+double leastRateByProjectedGradient(const PlanningProblem& p, double h, double a,
+                                    std::mt19937_64& rng) {
+  const Matrix3 M = p.inertia.inverse();
+  const Vector3 c = so3::exp(h * p.final_velocity) * (p.inertia * p.final_velocity);
+  const auto value = [&](const Vector3& t) { return (M * (c - h * t)).norm(); };
+  const auto project = [&](Vector3 t) { return t.norm() > a ? Vector3(t * (a / t.norm())) : t; };
+  std::normal_distribution<double> normal;
+  Vector3 best = Vector3::Zero();
+  for (int i = 0; i < 2000; ++i) {
+    const Vector3 t = project(a * Vector3(normal(rng), normal(rng), normal(rng)));
+    if (value(t) < value(best)) best = t;
+  }
+  const double step = 1.0 / (h * h * (M * M).norm());  // 1 / the gradient's Lipschitz constant
+  for (int i = 0; i < 20000; ++i) {
+    const Vector3 gradient = -h * M * M * (c - h * best);
+    best = project(best - step * gradient);
+  }
+  return value(best);
+}
+
+}  // namespace
+
+TEST(BoundedVerdicts, TheLeastRateBeforeTheEndIsTheLeastOverTheTorqueBall) {
+  // Random bodies, final rates, bounds and steps: the bound by weak duality is at most the least
+  // rate an independent projected-gradient solve finds over the ball, and within 1e-6 of it.
+  std::mt19937_64 rng(4548);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < 12; ++i) {
+    const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
+    const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
+    const Vector3 rate =
+        (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+    const double a = 0.05 + 2 * unit(rng);
+    PlanningProblem p = spinningEnd(moments, R, rate, a, rate.norm());
+    const double h = 0.005 + 0.4 * unit(rng) / rate.norm();
+    SCOPED_TRACE("case " + std::to_string(i));
+    const double bound = leastRateBeforeTheEnd(p, h * p.steps);
+    const double found = leastRateByProjectedGradient(p, h, a, rng);
+    EXPECT_LE(bound, found * (1 + 1e-12));
+    EXPECT_NEAR(bound, found, 1e-6 * found);
+  }
+}
+
+TEST(BoundedVerdicts, APaperPlansLastFreeStepIsTheStepTheLeastRateBeforeTheEndBounds) {
+  // A converged paper plan ending spinning under a norm bound: its Ω_{N−2} follows from its τ_{N−1}
+  // by J Ω_{N−2} = exp(hΩ̂_{N−1}) J Ω_{N−1} − h τ_{N−1}, and its rate there is at least the least
+  // rate any plan at its T can have.
+  PlanningProblem p = spinningEnd(Vector3(1, 2, 3), so3::exp(Vector3(0.3, -0.2, 0.5)),
+                                  Vector3(0.3, -0.2, 0.4), 1.0, 10.0);
+  p.constraints = {PlanningConstraint::maxTorqueNorm(1.0)};
+  p.duration = 6.0;
+  p.steps = 32;
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  const Maneuver& m = r.maneuver;
+  const int N = p.steps;
+  const double h = m.time_step;
+  EXPECT_LT((m.angular_velocity[N - 1] - p.final_velocity).norm(), 1e-9);  // the boundary datum
+  const Vector3 momentum =
+      so3::exp(h * m.angular_velocity[N - 1]) * (p.inertia * m.angular_velocity[N - 1]) -
+      h * m.torque[N - 1];
+  EXPECT_LT((p.inertia * m.angular_velocity[N - 2] - momentum).norm(), 1e-9 * momentum.norm());
+  EXPECT_GE(m.angular_velocity[N - 2].norm(), leastRateBeforeTheEnd(p, p.duration) * (1 - 1e-12));
+}
+
+TEST(BoundedVerdicts, AFinalRateOnTheRateLimitHasNoRoomOverTheDurationsProven) {
+  // Random bodies whose final rate lies on the rate limit: wherever durations are proven to have
+  // no room before the end, the least rate there exceeds the limit at random durations in them.
+  std::mt19937_64 rng(4549);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  int proven = 0;
+  for (int i = 0; i < 12; ++i) {
+    const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
+    const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
+    const Vector3 rate =
+        (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+    PlanningProblem p = spinningEnd(moments, R, rate, 0.05 + 2 * unit(rng), rate.norm());
+    p.steps = 64;
+    const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
+    if (!(none.to > none.from)) continue;
+    ++proven;
+    SCOPED_TRACE("case " + std::to_string(i));
+    for (int j = 0; j < 50; ++j) {
+      const double T = none.from + unit(rng) * (none.to - none.from);
+      EXPECT_GT(leastRateBeforeTheEnd(p, T), rate.norm()) << "T = " << T;
+    }
+  }
+  EXPECT_GE(proven, 6);
+}
+
+TEST(BoundedVerdicts, AFinalRateTheTorqueCannotApproachFromInsideIsInfeasibleAtEveryDuration) {
+  // J = diag(1, 2, 4) ending at Ω_N = 2 (1, 1, 1)/√3 on the rate limit w = 2 under |τ| ≤ 0.3:
+  // d|Ω|²/2dt = Ω·J⁻¹(JΩ × Ω + τ) ≤ −0.1443 w³ + 0.661 a w < 0 there for every allowed torque, so
+  // no continuous plan reaches Ω_N from inside the rate ball, and on the paper grid the last free
+  // step has no room at any step h (proven over intervals of h): answered before any solve.
+  PlanningProblem p = spinningEnd(Vector3(1, 2, 4), Matrix3::Identity(),
+                                  2.0 * Vector3(1, 1, 1).normalized(), 0.3, 2.0);
+  p = minimumTime(p);
+  p.steps = 64;
+  const Vector3& W = p.final_velocity;
+  const Matrix3 Ji = p.inertia.inverse();
+  EXPECT_LT(W.dot(Ji * (p.inertia * W).cross(W)) + 0.3 * (Ji * W).norm(), 0.0);
+  const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
+  EXPECT_TRUE(none.everywhere);
+  const PlanResult r = planManeuver(p);
+  EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
+  EXPECT_TRUE(std::holds_alternative<verdicts::InfeasibleAtEveryDuration>(r.verdict))
+      << r.message();
+  EXPECT_TRUE(r.attempts.empty());
+  // With 10x the torque the end can be approached from inside (d|Ω|²/2dt > 0 is allowed there):
+  // not refused so.
+  p.constraints[0] = PlanningConstraint::maxTorqueNorm(3.0);
+  EXPECT_GT(W.dot(Ji * (p.inertia * W).cross(W)) + 3.0 * (Ji * W).norm(), 0.0);
+  EXPECT_EQ(infeasibleAtEveryDuration(p), "");
 }

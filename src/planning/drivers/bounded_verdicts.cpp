@@ -1,14 +1,19 @@
 #include "planning/drivers/bounded_verdicts.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
+
+#include <Eigen/Eigenvalues>
 
 #include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/constraints.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/problem/duration_bound.hpp"
 #include "planning/problem/message_notes.hpp"
 
 namespace attitude_planner {
@@ -141,9 +146,7 @@ bool gyroscopicFreeAxis(const Matrix3& J, int i) {
          std::abs(J(j, k)) <= tolerance && std::abs(J(j, j) - J(k, k)) <= tolerance;
 }
 
-}  // namespace
-
-std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
+std::string disturbanceBeyondItsAxisBound(const PlanningProblem& problem) {
   if (!problem.effects || !problem.hasTorqueBounds()) return "";
   const std::optional<Vector3> d = problem.effects->constantBodyTorque();
   if (!d) return "";
@@ -167,6 +170,134 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
     return why.str();
   }
   return "";
+}
+
+/// The rate limit in force (the least of them), +∞ without.
+double rateLimit(const PlanningProblem& problem) {
+  double w = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.kind == ConstraintKind::MaxAngularRate) w = std::min(w, c.limit);
+  return w;
+}
+
+/// Samples of h before the intervals between them are proven, and the most evaluations of
+/// leastRateBeforeTheEnd a proof may take (each a few 3x3 solves).
+constexpr int kRoomSamples = 1024;
+constexpr int kRoomEvaluations = 20000;
+/// The least rate must clear the limit by this much (relative): by the plan check's own
+/// tolerance, so that no plan it would accept as within the bounds lies where none is proven.
+constexpr double kRoomRoundOff = kNodeConstraintTolerance;
+
+/// Proves leastRateBeforeTheEnd > w on [h1, h2] from its values at the ends (Lipschitz constant
+/// `K`), splitting the interval where they do not suffice; false where a split finds room or
+/// the evaluations run out.
+class RoomProof {
+ public:
+  RoomProof(const PlanningProblem& problem, double w, double K) : problem_(problem), w_(w), K_(K) {}
+
+  double rate(double h) {
+    ++evaluations_;
+    return leastRateBeforeTheEnd(problem_, h * problem_.steps);
+  }
+  bool above(double r) const { return r > w_ * (1.0 + kRoomRoundOff); }
+
+  bool noRoom(double h1, double r1, double h2, double r2) {
+    if (!above(r1) || !above(r2) || evaluations_ > kRoomEvaluations) return false;
+    if (std::min(r1, r2) - w_ * (1.0 + kRoomRoundOff) > 0.5 * K_ * (h2 - h1)) return true;
+    const double mid = 0.5 * (h1 + h2);
+    const double r_mid = rate(mid);
+    return noRoom(h1, r1, mid, r_mid) && noRoom(mid, r_mid, h2, r2);
+  }
+
+ private:
+  const PlanningProblem& problem_;
+  double w_, K_;
+  int evaluations_ = 0;
+};
+
+}  // namespace
+
+double leastRateBeforeTheEnd(const PlanningProblem& problem, double duration) {
+  const double a = torqueAuthority(problem).largest_magnitude;
+  if (problem.scheme != SchemeKind::Paper || !std::isfinite(a) ||
+      (problem.effects && !problem.effects->empty())) {
+    return std::numeric_limits<double>::infinity();
+  }
+  const double h = duration / problem.steps;
+  const Matrix3 M = problem.inertia.inverse();
+  const Matrix3 M2 = M * M;  // J symmetric
+  const Vector3& omega = problem.final_velocity;
+  const Vector3 c = so3::exp(h * omega) * (problem.inertia * omega);
+  // min over |τ| ≤ a of f(τ) = ½|M(c − hτ)|². The Lagrangian's minimizer at λ ≥ 0 is
+  // τ(λ) = (h²M² + λI)⁻¹ h M² c; its value f(τ(λ)) + λ(|τ(λ)|² − a²)/2 bounds the least f from
+  // below at every λ (weak duality), and equals it where |τ(λ)| = a (or λ = 0 inside the ball).
+  const auto tau = [&](double lambda) {
+    return Vector3((h * h * M2 + lambda * Matrix3::Identity()).ldlt().solve(h * M2 * c));
+  };
+  const auto dual = [&](double lambda) {
+    const Vector3 t = tau(lambda);
+    return 0.5 * (M * (c - h * t)).squaredNorm() + 0.5 * lambda * (t.squaredNorm() - a * a);
+  };
+  if (tau(0.0).norm() <= a) return std::sqrt(2.0 * std::max(dual(0.0), 0.0));
+  double lo = 0.0, hi = h * (M2 * c).norm() / a;  // |τ(hi)| ≤ h|M²c|/hi = a
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (tau(mid).norm() > a ? lo : hi) = mid;
+  }
+  return std::sqrt(2.0 * std::max(std::max(dual(lo), dual(hi)), 0.0));
+}
+
+NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem) {
+  const double w = rateLimit(problem);
+  const double a = torqueAuthority(problem).largest_magnitude;
+  const double boundary_rate =
+      std::max(problem.initial_velocity.norm(), problem.final_velocity.norm());
+  // With N < 3 the step before the last is the first, whose rate is data (no rate row).
+  if (!std::isfinite(w) || !std::isfinite(leastRateBeforeTheEnd(problem, 1.0)) ||
+      !(boundary_rate > 0) || problem.steps < 3) {
+    return {};
+  }
+  const int N = problem.steps;
+  const Vector3& omega = problem.final_velocity;
+  const double K =
+      1.0 / Eigen::SelfAdjointEigenSolver<Matrix3>(problem.inertia).eigenvalues().minCoeff() *
+      (omega.norm() * (problem.inertia * omega).norm() + a);
+  // The planner's steps at the boundary rates turn less than π (validateProblem's step check).
+  const double h_top = M_PI / boundary_rate * (1.0 - 1e-12);
+  const double h_floor = std::max(discreteDurationLowerBound(problem) / N, 1e-9 * h_top);
+  if (!(h_floor < h_top)) return {};
+  RoomProof proof(problem, w, K);
+  // The samples from the top down while the step has no room; the intervals between them proven.
+  const double step = (h_top - h_floor) / kRoomSamples;
+  double h2 = h_top, r2 = proof.rate(h_top);
+  double proven_from = h_top;
+  for (int i = kRoomSamples - 1; i >= 0; --i) {
+    const double h1 = h_floor + i * step;
+    const double r1 = proof.rate(h1);
+    if (!proof.noRoom(h1, r1, h2, r2)) break;
+    proven_from = h1;
+    h2 = h1;
+    r2 = r1;
+  }
+  if (!(proven_from < h_top)) return {};
+  return {proven_from * N, h_top * N, proven_from == h_floor};
+}
+
+std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
+  const std::string disturbance = disturbanceBeyondItsAxisBound(problem);
+  if (!disturbance.empty()) return disturbance;
+  const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(problem);
+  if (!none.everywhere) return "";
+  std::ostringstream why;
+  why << "the final rate " << problem.final_velocity.norm() << " rad/s against max_angular_rate "
+      << rateLimit(problem) << " rad/s: the paper scheme's last free step Omega_{N-2} (J "
+      << "Omega_{N-2} = exp(h Omega_{N-1}^) J Omega_{N-1} - h tau_{N-1}, |tau| <= "
+      << torqueAuthority(problem).largest_magnitude
+      << " N m) exceeds the rate limit at every step h from the proven least duration on the "
+      << "grid, T = " << none.from
+      << " s, up to the largest step the planner takes, T = " << none.to
+      << " s (N = " << problem.steps << "; proven over intervals of h)";
+  return why.str();
 }
 
 }  // namespace attitude_planner

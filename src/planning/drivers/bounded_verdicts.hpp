@@ -46,6 +46,35 @@ verdicts::LocallyInfeasible localInfeasibility(double requested, double least_fo
 /// which boundary rates with no such change (rest to rest) forbid at every T. A start from the
 /// free-time solver's raise never gets inside there, and the search ends "infeasible" only after
 /// every start has failed (about 16 000 iterations at N = 64).
+///
+/// Also shown for the paper scheme's last free step into a final rate on the rate limit
+/// (noRoomBeforeTheEnd below): where that step has no room at any step h the planner takes.
 std::string infeasibleAtEveryDuration(const PlanningProblem& problem);
+
+/// The paper scheme's last free step Ω_{N−2} into the final rate Ω_{N−1} (boundary data) at
+/// h = T/N: J Ω_{N−2} = exp(hΩ̂_{N−1}) J Ω_{N−1} − h τ_{N−1} (the scheme's equation at k = N − 1),
+/// τ_{N−1} within the torque bounds. A lower bound on the least |Ω_{N−2}| any plan at T has: the
+/// least over the ball |τ| ≤ a, a the largest torque magnitude the bounds allow (the norm bound,
+/// or a box's corner: a ball that holds every allowed torque), by weak duality (exact to the
+/// bisection's round-off for a norm bound). A plan at T needs it at most the rate limit, and at a
+/// final rate on the limit the torque-free step leaves the ball by O(h²) while the torque brings
+/// it back by O(h): above some T the step has no room (docs/design/planner_behaviour.md,
+/// "Spinning ends: a final rate on the rate limit"). +∞ where it does not apply (another scheme,
+/// no torque bound, effects).
+double leastRateBeforeTheEnd(const PlanningProblem& problem, double duration);
+
+/// Where the last free step has no room (leastRateBeforeTheEnd above every rate limit in force),
+/// proven over a range of durations: [from, to] [s] with no plan on the request's grid (0, 0:
+/// none proven). Proven over intervals of h: leastRateBeforeTheEnd is Lipschitz in h with
+/// constant λ_max(J⁻¹)(|Ω_{N−1}| |J Ω_{N−1}| + a), so its values at the ends of an interval bound
+/// it inside; intervals are split until that holds or a duration with room is found. The range
+/// searched: from the proven least duration on the grid (discreteDurationLowerBound) up to the
+/// largest step the planner takes at the boundary rates (h |Ω| < π), from its top down.
+struct NoRoomBeforeTheEnd {
+  double from = 0.0;
+  double to = 0.0;
+  bool everywhere = false;  ///< the whole range searched: no plan at any duration on this grid
+};
+NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem);
 
 }  // namespace attitude_planner

@@ -12,6 +12,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
+#include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/duration_bound.hpp"
@@ -65,7 +66,7 @@ struct SearchOutcome {
 class MinimumTimeSearch {
  public:
   MinimumTimeSearch(const PlanningProblem& problem, SolveContext& context)
-      : problem_(problem), context_(context) {
+      : problem_(problem), context_(context), no_room_(noRoomBeforeTheEnd(problem)) {
     effort_ = problem;
     effort_.objective = Objective::MinimumEffort;
     effort_.time_margin = 0.0;
@@ -101,6 +102,9 @@ class MinimumTimeSearch {
   /// One minimum-effort solve at T from `warm`: true, with the plan kept in `out`, if it proves
   /// T feasible (provesFeasible).
   bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out) {
+    // No plan exists there on this grid (the last step into the final rate has no room under the
+    // rate limit, proven): no solve.
+    if (T >= no_room_.from && T <= no_room_.to) return false;
     effort_.duration = T;
     const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeProbe,
                                     homotopyClassOf(effort_));
@@ -377,6 +381,7 @@ class MinimumTimeSearch {
   std::optional<Termination> stopped_;
   /// The least T at which this grid had no boundary step (tryDuration); infinity: none.
   double unrepresentable_from_ = std::numeric_limits<double>::infinity();
+  NoRoomBeforeTheEnd no_room_;  ///< the durations proven to hold no plan on this grid
   /// The least T a minimum-effort solve was tried at (tryDuration); infinity: none.
   double least_tried_ = std::numeric_limits<double>::infinity();
   double coarse_minimum_duration_ = 0.0;

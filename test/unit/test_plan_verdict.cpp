@@ -3,6 +3,7 @@
 // replay of its torques is a reported sensitivity (replay_miss), not a verdict.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -131,6 +132,56 @@ TEST(PlanVerdict, AStepOnAnotherRootOfItsMomentumMapIsNotReplayedSoNotConverged)
     EXPECT_TRUE(std::isinf(judged.replay_miss));
   }
   EXPECT_GE(moved_steps, 1);
+}
+
+TEST(PlanVerdict, AStoppedPlanProvesItsDurationOnlyWithinItsBoundsAndOnItsEnds) {
+  // The one rule for "a plan at T exists" (provesFeasible): a stopped solve's iterate counts when
+  // it meets the discrete equations, its ends and every bound within the tolerances
+  // planInconsistency names; just inside a bound it counts, just outside or off an end it does
+  // not, in every scheme with discrete equations.
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    SCOPED_TRACE(schemeName(scheme));
+    const PlanningProblem p = spinningShape(1.0, 1.0, scheme);
+    const PlanResult converged = planManeuver(p);
+    ASSERT_TRUE(converged.converged()) << converged.message();
+    EXPECT_TRUE(provesFeasible(p, converged));
+    PlanResult stopped = converged;
+    stopped.termination = Termination::NotConverged;
+    EXPECT_TRUE(provesFeasible(p, stopped));
+    double peak = 0.0;
+    for (const Vector3& t : stopped.maneuver.torque) peak = std::max(peak, t.norm());
+    const auto bounded = [&](double relative_violation) {
+      PlanningProblem b = p;
+      b.constraints = {PlanningConstraint::maxTorqueNorm(peak / (1 + relative_violation))};
+      return b;
+    };
+    EXPECT_TRUE(provesFeasible(bounded(0.0), stopped));  // the bound active at the peak
+    EXPECT_TRUE(provesFeasible(bounded(0.1 * kNodeConstraintTolerance), stopped));
+    EXPECT_FALSE(provesFeasible(bounded(10 * kNodeConstraintTolerance), stopped));
+    const double tolerance = measureStepResidual(p, stopped.maneuver).tolerance;
+    const auto moved_end = [&](double angle) {
+      PlanningProblem m = p;
+      m.final_attitude = p.final_attitude * so3::exp(Vector3(angle, 0.0, 0.0));
+      return m;
+    };
+    EXPECT_TRUE(provesFeasible(moved_end(0.1 * tolerance), stopped));
+    EXPECT_FALSE(provesFeasible(moved_end(10 * tolerance), stopped));
+    PlanningProblem faster_start = p;
+    faster_start.initial_velocity *= 1 + 1e3 * tolerance;
+    EXPECT_FALSE(provesFeasible(faster_start, stopped));
+    // No plan at T: another end, another grid, or a scheme with no discrete equations of its own.
+    for (Termination t : {Termination::Infeasible, Termination::TimedOut, Termination::Cancelled}) {
+      PlanResult other = stopped;
+      other.termination = t;
+      EXPECT_FALSE(provesFeasible(p, other)) << terminationName(t);
+    }
+    PlanningProblem finer = p;
+    finer.steps = 2 * p.steps;
+    EXPECT_FALSE(provesFeasible(finer, stopped));
+    PlanningProblem fourth = p;
+    fourth.scheme = SchemeKind::FourthOrder;
+    EXPECT_FALSE(provesFeasible(fourth, stopped));
+  }
 }
 
 TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {

@@ -125,6 +125,15 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
   return "";
 }
 
+bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
+  if (r.converged()) return true;
+  if (r.termination != Termination::NotConverged || r.maneuver.steps() != problem.steps ||
+      !schemeIsDiscretization(problem.scheme)) {
+    return false;
+  }
+  return planInconsistency(problem, r, true).empty();
+}
+
 StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan) {
   const int N = plan.steps();
   const DiscreteScheme scheme(problem.scheme, problem.inertia, plan.time_step);

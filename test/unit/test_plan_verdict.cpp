@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <optional>
 #include <random>
+#include <utility>
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/planner.hpp"
@@ -80,6 +81,35 @@ std::optional<Maneuver> withStepOnAnotherRoot(const PlanningProblem& p, const Ma
   const Matrix3 turn = plan.attitude[k] * other * F.transpose() * plan.attitude[k].transpose();
   for (int j = k + 1; j <= plan.steps(); ++j) moved.attitude[j] = turn * plan.attitude[j];
   return moved;
+}
+
+/// A variational plan that meets its discrete equations step by step with step k on another
+/// root of its momentum map: the plan up to k, step k moved (withStepOnAnotherRoot), then the
+/// scheme's recursion c_{j+1} = F_jᵀ c_j + h τ_{j+1} under the plan's torques with each step
+/// solved from the last, and the problem ending where that plan ends. Empty where no other root
+/// is found.
+std::optional<std::pair<PlanningProblem, Maneuver>> consistentPlanOnAnotherRoot(
+    const PlanningProblem& p, const Maneuver& plan, int k) {
+  std::optional<Maneuver> moved = withStepOnAnotherRoot(p, plan, k);
+  if (!moved) return std::nullopt;
+  Maneuver& m = *moved;
+  const int N = m.steps();
+  const double h = m.time_step;
+  const DiscreteScheme scheme(p.scheme, p.inertia, h);
+  Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
+  Vector3 c = p.inertia * m.angular_velocity[k];  // variational: c_k = J Ω_k
+  for (int j = k + 1; j < N; ++j) {
+    c = F.transpose() * c + h * m.torque[j];
+    m.angular_velocity[j] = p.inertia.ldlt().solve(c);
+    StepSolveReport report;
+    F = scheme.solveStep(c, F, &report);
+    if (!report.converged) return std::nullopt;
+    m.attitude[j + 1] = m.attitude[j] * F;
+  }
+  PlanningProblem q = p;
+  q.final_attitude = m.attitude[N];
+  q.final_velocity = m.angular_velocity[N - 1];
+  return std::make_pair(q, m);
 }
 
 }  // namespace
@@ -182,6 +212,73 @@ TEST(PlanVerdict, AStoppedPlanProvesItsDurationOnlyWithinItsBoundsAndOnItsEnds) 
     fourth.scheme = SchemeKind::FourthOrder;
     EXPECT_FALSE(provesFeasible(fourth, stopped));
   }
+}
+
+TEST(PlanVerdict, TheHardCasesJudgeAPartedReplayByThePlansOwnEndsAndSteps) {
+  // The hard cases' rule "converged => terminal error <= 1e-9" reads the open-loop replay's
+  // ends. Where that replay parted (judgeFailedReplay: replay_miss +inf, its ends not measured)
+  // the plan's own ends and steps are checked instead: a consistent plan passes, the same plan
+  // off its end or with a step on another root fails.
+  const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  robustness::Recorder measured;
+  measured.checkConverged("replayed", p, r, 1e-9);
+  EXPECT_EQ(measured.outcome().passed(),
+            std::max(r.terminal_attitude_error, r.terminal_velocity_error) <= 1e-9)
+      << measured.outcome().failures();
+  PlanResult parted = r;
+  judgeFailedReplay(p, "no implicit step", &parted);
+  ASSERT_EQ(parted.termination, Termination::Converged);
+  ASSERT_TRUE(std::isinf(parted.replay_miss));
+  ASSERT_TRUE(std::isnan(parted.terminal_attitude_error));
+  robustness::Recorder accepted;
+  accepted.checkConverged("parted", p, parted, 1e-9);
+  EXPECT_TRUE(accepted.outcome().passed()) << accepted.outcome().failures();
+  PlanningProblem moved_end = p;
+  moved_end.final_attitude = p.final_attitude * so3::exp(Vector3(1e-6, 0.0, 0.0));
+  robustness::Recorder off_end;
+  off_end.checkConverged("parted", moved_end, parted, 1e-9);
+  EXPECT_FALSE(off_end.outcome().passed());
+  std::optional<Maneuver> other_root;
+  for (int k : {1, p.steps / 2, p.steps - 2}) {
+    if (!other_root) other_root = withStepOnAnotherRoot(p, r.maneuver, k);
+  }
+  ASSERT_TRUE(other_root.has_value());
+  PlanResult off_root = parted;
+  off_root.maneuver = *other_root;
+  robustness::Recorder rejected;
+  rejected.checkConverged("parted", p, off_root, 1e-9);
+  EXPECT_FALSE(rejected.outcome().passed());
+}
+
+TEST(PlanVerdict, APlanWithAStepOnAnotherRootIsNotAccepted) {
+  // Newton can converge to a plan that meets the discrete equations with a step on another root
+  // of the step's momentum map (past its fold): not the motion the scheme integrates. The
+  // acceptance (planInconsistency) replays each step from the plan's own state and refuses it,
+  // so it is neither converged nor a plan proving its duration.
+  const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_EQ(planInconsistency(p, r, true), "");
+  int built = 0;
+  for (int k : {1, p.steps / 2, p.steps - 2}) {
+    const auto other = consistentPlanOnAnotherRoot(p, r.maneuver, k);
+    if (!other) continue;
+    ++built;
+    const PlanningProblem& q = other->first;
+    PlanResult off = r;
+    off.maneuver = other->second;
+    const StepResidual residual = measureStepResidual(q, off.maneuver);
+    EXPECT_LE(residual.relative, residual.tolerance) << "k = " << k;  // its equations hold
+    const StepwiseReplay stepwise = replayStepByStep(q, off.maneuver);
+    EXPECT_FALSE(stepwise.reproduces());
+    EXPECT_EQ(stepwise.worst_step, k);
+    EXPECT_NE(planInconsistency(q, off, false), "") << "k = " << k;
+    off.termination = Termination::NotConverged;
+    EXPECT_FALSE(provesFeasible(q, off)) << "k = " << k;
+  }
+  EXPECT_GE(built, 1);
 }
 
 TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {

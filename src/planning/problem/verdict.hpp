@@ -28,7 +28,9 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step
-/// (measureStepResidual within its tolerance) and, with `constraints`, its node constraints
+/// (measureStepResidual within its tolerance), each of its steps is the one the scheme's own
+/// step solve finds from the plan's state (replayStepByStep: not a step on another root of its
+/// momentum map) and, with `constraints`, its node constraints
 /// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
 /// it does. The open-loop replay (replay_miss) is not part of it.
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,

@@ -57,9 +57,18 @@ struct CaseOutcome {
 class Recorder {
  public:
   /// Plans `problem`, records its figures and checks the defaults every run must meet: converged,
-  /// finite, terminal attitude and velocity error ≤ `terminal_bound`, residuals finite.
+  /// and checkConverged.
   PlanResult plan(const std::string& label, const PlanningProblem& problem,
                   const SolverOptions& options = {}, double terminal_bound = 1e-9);
+  /// The checks every converged run must meet: finite, residuals finite, and its ends. Where the
+  /// open-loop replay ran to the end, its terminal attitude and velocity error ≤
+  /// `terminal_bound`. Where it parted (replay_miss +inf, the terminal errors and the dynamics
+  /// residual not measured: judgeFailedReplay kept the plan because every step replayed from
+  /// the plan's own state lands on it), the plan's own end attitude ≤ `terminal_bound`, its
+  /// ends and steps (planInconsistency) and every step replayed (replayStepByStep) instead; each
+  /// check's label says which rule it is.
+  void checkConverged(const std::string& label, const PlanningProblem& problem,
+                      const PlanResult& result, double terminal_bound);
   /// Records the figures of a result without the default checks (a run whose expected outcome
   /// is not "converged"; the case checks what it expects).
   void record(const std::string& label, const PlanningProblem& problem, const PlanResult& result);

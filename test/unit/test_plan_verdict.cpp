@@ -3,10 +3,12 @@
 // replay of its torques is a reported sensitivity (replay_miss), not a verdict.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <random>
+#include <utility>
 
 #include "attitude_planner/dynamics/discrete_scheme.hpp"
 #include "attitude_planner/planner.hpp"
@@ -81,6 +83,35 @@ std::optional<Maneuver> withStepOnAnotherRoot(const PlanningProblem& p, const Ma
   return moved;
 }
 
+/// A variational plan that meets its discrete equations step by step with step k on another
+/// root of its momentum map: the plan up to k, step k moved (withStepOnAnotherRoot), then the
+/// scheme's recursion c_{j+1} = F_jᵀ c_j + h τ_{j+1} under the plan's torques with each step
+/// solved from the last, and the problem ending where that plan ends. Empty where no other root
+/// is found.
+std::optional<std::pair<PlanningProblem, Maneuver>> consistentPlanOnAnotherRoot(
+    const PlanningProblem& p, const Maneuver& plan, int k) {
+  std::optional<Maneuver> moved = withStepOnAnotherRoot(p, plan, k);
+  if (!moved) return std::nullopt;
+  Maneuver& m = *moved;
+  const int N = m.steps();
+  const double h = m.time_step;
+  const DiscreteScheme scheme(p.scheme, p.inertia, h);
+  Matrix3 F = m.attitude[k].transpose() * m.attitude[k + 1];
+  Vector3 c = p.inertia * m.angular_velocity[k];  // variational: c_k = J Ω_k
+  for (int j = k + 1; j < N; ++j) {
+    c = F.transpose() * c + h * m.torque[j];
+    m.angular_velocity[j] = p.inertia.ldlt().solve(c);
+    StepSolveReport report;
+    F = scheme.solveStep(c, F, &report);
+    if (!report.converged) return std::nullopt;
+    m.attitude[j + 1] = m.attitude[j] * F;
+  }
+  PlanningProblem q = p;
+  q.final_attitude = m.attitude[N];
+  q.final_velocity = m.angular_velocity[N - 1];
+  return std::make_pair(q, m);
+}
+
 }  // namespace
 
 TEST(PlanVerdict, AConvergedPlanWhoseOpenLoopReplayFailsIsJudgedByItsStepsReplayed) {
@@ -131,6 +162,123 @@ TEST(PlanVerdict, AStepOnAnotherRootOfItsMomentumMapIsNotReplayedSoNotConverged)
     EXPECT_TRUE(std::isinf(judged.replay_miss));
   }
   EXPECT_GE(moved_steps, 1);
+}
+
+TEST(PlanVerdict, AStoppedPlanProvesItsDurationOnlyWithinItsBoundsAndOnItsEnds) {
+  // The one rule for "a plan at T exists" (provesFeasible): a stopped solve's iterate counts when
+  // it meets the discrete equations, its ends and every bound within the tolerances
+  // planInconsistency names; just inside a bound it counts, just outside or off an end it does
+  // not, in every scheme with discrete equations.
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    SCOPED_TRACE(schemeName(scheme));
+    const PlanningProblem p = spinningShape(1.0, 1.0, scheme);
+    const PlanResult converged = planManeuver(p);
+    ASSERT_TRUE(converged.converged()) << converged.message();
+    EXPECT_TRUE(provesFeasible(p, converged));
+    PlanResult stopped = converged;
+    stopped.termination = Termination::NotConverged;
+    EXPECT_TRUE(provesFeasible(p, stopped));
+    double peak = 0.0;
+    for (const Vector3& t : stopped.maneuver.torque) peak = std::max(peak, t.norm());
+    const auto bounded = [&](double relative_violation) {
+      PlanningProblem b = p;
+      b.constraints = {PlanningConstraint::maxTorqueNorm(peak / (1 + relative_violation))};
+      return b;
+    };
+    EXPECT_TRUE(provesFeasible(bounded(0.0), stopped));  // the bound active at the peak
+    EXPECT_TRUE(provesFeasible(bounded(0.1 * kNodeConstraintTolerance), stopped));
+    EXPECT_FALSE(provesFeasible(bounded(10 * kNodeConstraintTolerance), stopped));
+    const double tolerance = measureStepResidual(p, stopped.maneuver).tolerance;
+    const auto moved_end = [&](double angle) {
+      PlanningProblem m = p;
+      m.final_attitude = p.final_attitude * so3::exp(Vector3(angle, 0.0, 0.0));
+      return m;
+    };
+    EXPECT_TRUE(provesFeasible(moved_end(0.1 * tolerance), stopped));
+    EXPECT_FALSE(provesFeasible(moved_end(10 * tolerance), stopped));
+    PlanningProblem faster_start = p;
+    faster_start.initial_velocity *= 1 + 1e3 * tolerance;
+    EXPECT_FALSE(provesFeasible(faster_start, stopped));
+    // No plan at T: another end, another grid, or a scheme with no discrete equations of its own.
+    for (Termination t : {Termination::Infeasible, Termination::TimedOut, Termination::Cancelled}) {
+      PlanResult other = stopped;
+      other.termination = t;
+      EXPECT_FALSE(provesFeasible(p, other)) << terminationName(t);
+    }
+    PlanningProblem finer = p;
+    finer.steps = 2 * p.steps;
+    EXPECT_FALSE(provesFeasible(finer, stopped));
+    PlanningProblem fourth = p;
+    fourth.scheme = SchemeKind::FourthOrder;
+    EXPECT_FALSE(provesFeasible(fourth, stopped));
+  }
+}
+
+TEST(PlanVerdict, TheHardCasesJudgeAPartedReplayByThePlansOwnEndsAndSteps) {
+  // The hard cases' rule "converged => terminal error <= 1e-9" reads the open-loop replay's
+  // ends. Where that replay parted (judgeFailedReplay: replay_miss +inf, its ends not measured)
+  // the plan's own ends and steps are checked instead: a consistent plan passes, the same plan
+  // off its end or with a step on another root fails.
+  const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  robustness::Recorder measured;
+  measured.checkConverged("replayed", p, r, 1e-9);
+  EXPECT_EQ(measured.outcome().passed(),
+            std::max(r.terminal_attitude_error, r.terminal_velocity_error) <= 1e-9)
+      << measured.outcome().failures();
+  PlanResult parted = r;
+  judgeFailedReplay(p, "no implicit step", &parted);
+  ASSERT_EQ(parted.termination, Termination::Converged);
+  ASSERT_TRUE(std::isinf(parted.replay_miss));
+  ASSERT_TRUE(std::isnan(parted.terminal_attitude_error));
+  robustness::Recorder accepted;
+  accepted.checkConverged("parted", p, parted, 1e-9);
+  EXPECT_TRUE(accepted.outcome().passed()) << accepted.outcome().failures();
+  PlanningProblem moved_end = p;
+  moved_end.final_attitude = p.final_attitude * so3::exp(Vector3(1e-6, 0.0, 0.0));
+  robustness::Recorder off_end;
+  off_end.checkConverged("parted", moved_end, parted, 1e-9);
+  EXPECT_FALSE(off_end.outcome().passed());
+  std::optional<Maneuver> other_root;
+  for (int k : {1, p.steps / 2, p.steps - 2}) {
+    if (!other_root) other_root = withStepOnAnotherRoot(p, r.maneuver, k);
+  }
+  ASSERT_TRUE(other_root.has_value());
+  PlanResult off_root = parted;
+  off_root.maneuver = *other_root;
+  robustness::Recorder rejected;
+  rejected.checkConverged("parted", p, off_root, 1e-9);
+  EXPECT_FALSE(rejected.outcome().passed());
+}
+
+TEST(PlanVerdict, APlanWithAStepOnAnotherRootIsNotAccepted) {
+  // Newton can converge to a plan that meets the discrete equations with a step on another root
+  // of the step's momentum map (past its fold): not the motion the scheme integrates. The
+  // acceptance (planInconsistency) replays each step from the plan's own state and refuses it,
+  // so it is neither converged nor a plan proving its duration.
+  const PlanningProblem p = spinningShape(1.0, 1.0, SchemeKind::Variational);
+  const PlanResult r = planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_EQ(planInconsistency(p, r, true), "");
+  int built = 0;
+  for (int k : {1, p.steps / 2, p.steps - 2}) {
+    const auto other = consistentPlanOnAnotherRoot(p, r.maneuver, k);
+    if (!other) continue;
+    ++built;
+    const PlanningProblem& q = other->first;
+    PlanResult off = r;
+    off.maneuver = other->second;
+    const StepResidual residual = measureStepResidual(q, off.maneuver);
+    EXPECT_LE(residual.relative, residual.tolerance) << "k = " << k;  // its equations hold
+    const StepwiseReplay stepwise = replayStepByStep(q, off.maneuver);
+    EXPECT_FALSE(stepwise.reproduces());
+    EXPECT_EQ(stepwise.worst_step, k);
+    EXPECT_NE(planInconsistency(q, off, false), "") << "k = " << k;
+    off.termination = Termination::NotConverged;
+    EXPECT_FALSE(provesFeasible(q, off)) << "k = " << k;
+  }
+  EXPECT_GE(built, 1);
 }
 
 TEST(PlanVerdict, NanosecondHorizonPiAboutXConverges) {

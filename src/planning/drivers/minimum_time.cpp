@@ -20,6 +20,7 @@
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/problem/verdict.hpp"
 #include "planning/strategies/staged_continuation.hpp"
 #include "planning/strategies/starts.hpp"
 

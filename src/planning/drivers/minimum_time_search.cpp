@@ -390,17 +390,6 @@ class MinimumTimeSearch {
 
 }  // namespace
 
-bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
-  if (r.converged()) return true;
-  // fourth_order solves no discrete equations of its own: an unconverged one returns the
-  // second_order sub-plan that stopped, no fourth_order plan to check.
-  if (r.termination != Termination::NotConverged || r.maneuver.steps() != problem.steps ||
-      !schemeIsDiscretization(problem.scheme)) {
-    return false;
-  }
-  return planInconsistency(problem, r, true).empty();
-}
-
 void answerFeasibleAt(double T, PlanResult* plan) {
   if (!plan->converged()) {
     plan->termination = Termination::Converged;

@@ -10,15 +10,11 @@
 
 namespace attitude_planner {
 
-/// A plan at T proves T feasible when it meets every node constraint and the discrete equations
-/// step by step (planInconsistency): the reduced problem's iterates satisfy the dynamics and the
-/// boundary data by construction, so a minimum-effort solve that stops short of optimality (the
-/// iteration limit, a stalled line search) still proves T feasible. Whether it also minimizes the
-/// effort does not matter to the search (measured: on Bilimoria–Wie's case the solves just below
-/// the T* found stopped at the iteration limit with feasible iterates).
-bool provesFeasible(const PlanningProblem& problem, const PlanResult& r);
-
-/// A minimum-time answer at `T` from a plan that proves T feasible (provesFeasible): T is the
+/// A minimum-time answer at `T` from a plan that proves T feasible (provesFeasible in
+/// planning/problem/verdict.hpp; a minimum-effort solve that stopped short of optimality proves
+/// it too, and whether it also minimizes the effort does not matter to the search — measured: on
+/// Bilimoria–Wie's case the solves just below the T* found stopped at the iteration limit with
+/// feasible iterates): T is the
 /// least duration found feasible, which is what a minimum-time answer rests on, whether or not
 /// the plan's minimum-effort solve stopped short of optimality (then said as
 /// FeasibleAtMinimumTime, and the answer is converged). One rule for the search's T* and for a

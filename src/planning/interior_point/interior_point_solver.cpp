@@ -115,14 +115,6 @@ struct Solve {
   SolveContext& context;
 };
 
-/// Whether a solve that stopped short still holds a plan of its grid's problem (planInconsistency:
-/// the dynamics step by step and every node constraint): its iterate is a plan at T, not shown
-/// optimal.
-bool stoppedWithinBounds(const PlanningProblem& problem, const PlanResult& r) {
-  return r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
-         planInconsistency(problem, r, true).empty();
-}
-
 /// One grid in the recipe's first formulation, retried once in the other from the same start
 /// when it ends infeasible or unconverged. The answer: a converged solve, else an
 /// infeasibility certificate, else a stopped solve whose plan is within the bounds where the
@@ -149,8 +141,8 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptio
       {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr, final_grid});
   second.formulation = recipe.retry.formulation;
   solve.context.recordLevels(second.result.levels);
-  const bool second_within =
-      stoppedWithinBounds(problem, second.result) && !stoppedWithinBounds(problem, first.result);
+  const bool second_within = !second.result.converged() && provesFeasible(problem, second.result) &&
+                             !provesFeasible(problem, first.result);
   const bool take_second =
       second.result.converged() ||
       (t != Termination::Infeasible && second.result.termination == Termination::Infeasible) ||

@@ -113,6 +113,19 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
         << residual.relative << " relative (tolerance " << residual.tolerance << ")";
     return why.str();
   }
+  // A plan can meet its equations with a step on another root of the step's momentum map (past
+  // a fold): not the motion the scheme's own step integrates from the plan's state.
+  const StepwiseReplay stepwise = replayStepByStep(problem, result.maneuver);
+  if (!stepwise.reproduces()) {
+    why << "stationary point found, but its step k = " << stepwise.worst_step
+        << " is not the step the replay solves from the plan's own state (";
+    if (std::isfinite(stepwise.worst_angle)) {
+      why << stepwise.worst_angle << " rad apart: another root of the step's momentum map)";
+    } else {
+      why << "no root found)";
+    }
+    return why.str();
+  }
   if (constraints && problem.hasNodeConstraints()) {
     const ConstraintCheck check = checkConstraints(problem, result.maneuver);
     if (!check.withinBounds()) {
@@ -123,6 +136,15 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
     }
   }
   return "";
+}
+
+bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
+  if (r.converged()) return true;
+  if (r.termination != Termination::NotConverged || r.maneuver.steps() != problem.steps ||
+      !schemeIsDiscretization(problem.scheme)) {
+    return false;
+  }
+  return planInconsistency(problem, r, true).empty();
 }
 
 StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan) {

@@ -28,11 +28,25 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step
-/// (measureStepResidual within its tolerance) and, with `constraints`, its node constraints
+/// (measureStepResidual within its tolerance), each of its steps is the one the scheme's own
+/// step solve finds from the plan's state (replayStepByStep: not a step on another root of its
+/// momentum map) and, with `constraints`, its node constraints
 /// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
 /// it does. The open-loop replay (replay_miss) is not part of it.
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
                               bool constraints);
+
+/// Whether `r` holds a plan at the problem's T within every bound: the one judgement of "a plan
+/// at T exists" (a stopped solve that answers the interior point's formulation retry, the
+/// minimum-time search's and probes' feasible durations, a bounded answer's plan_within_bounds).
+/// A converged answer holds one by its verdict. A solve that stopped short of optimality
+/// (NotConverged: the iteration limit, a stalled line search) holds one when its iterate is a plan
+/// on the problem's own grid that meets the discrete equations step by step, its ends and every
+/// node constraint (planInconsistency with constraints, within kStepResidualTolerance and
+/// kNodeConstraintTolerance): a plan at T, not shown optimal. Nothing else does: an infeasible
+/// end, a stop by the clock or a cancel, or a scheme without discrete equations of its own
+/// (fourth_order's unconverged answer is the second_order sub-plan that stopped).
+bool provesFeasible(const PlanningProblem& problem, const PlanResult& r);
 
 /// Why a plan is not in the homotopy class its extremal names (empty: nothing says it is not).
 /// The class is the lift φ of R_1ᵀR_{N−1} its solve started on (ExtremalSummary::angle = |φ|);

@@ -911,3 +911,26 @@ TEST(InteriorPointStrategies, CancelFromAnotherThreadEndsCancelledAtN1e5) {
   std::printf("cancel latency at N = 1e5: %.1f ms (flag set -> solve returned)\n", latency_ms);
   RecordProperty("cancel_latency_ms", std::to_string(latency_ms));
 }
+
+// A stop (time budget, cancel) that comes before any level of the interior point's grid
+// continuation holds an iterate leaves nothing to carry to the requested grid: the outcome is the
+// stop's, with no plan, never an input error about a coarse grid of 0 steps.
+TEST(InteriorPointStrategies, AStopBeforeAnyLevelHeldAnIterateCarriesNoPlan) {
+  const ap::PlanningProblem p = sceneProblem("torque_limited.yaml", 1024);
+  const ap::GridOutcome out = ap::carryToGrid(p, {}, ap::Termination::TimedOut, {});
+  EXPECT_EQ(out.result.termination, ap::Termination::TimedOut);
+  EXPECT_TRUE(out.result.maneuver.attitude.empty());
+  EXPECT_TRUE(out.steps.empty());
+  ASSERT_EQ(out.result.levels.size(), 1u);
+  EXPECT_EQ(out.result.levels.front().steps, 1024);
+  // Through the public entry point, on budgets that end inside the continuation or before it:
+  // every answer is a verdict, never a thrown error.
+  for (const double budget : {1e-4, 1e-3, 3e-3, 1e-2, 3e-2}) {
+    ap::SolverOptions options;
+    options.time_budget_s = budget;
+    ap::PlanResult r;
+    EXPECT_NO_THROW(r = ap::planManeuver(p, options)) << budget;
+    EXPECT_TRUE(r.converged() || r.termination == ap::Termination::TimedOut)
+        << budget << ": " << r.message();
+  }
+}

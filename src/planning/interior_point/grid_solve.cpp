@@ -448,6 +448,14 @@ GridOutcome carryToGrid(const PlanningProblem& problem,
     recordVerdict(&result, verdicts::NoBoundaryStep{e.what()});
     return out;
   }
+  if (coarse_steps.empty()) {
+    // Stopped before any level held an iterate: there is no plan to carry, and no input error.
+    result.levels.push_back({problem.steps, 0, termination,
+                             std::numeric_limits<double>::quiet_NaN(), 0.0,
+                             "interior point: stopped before any level held an iterate (" +
+                                 renderMessage(result) + ")"});
+    return out;
+  }
   ReducedProblem& np = *reduced;
   np.initializeFromCoarser(coarse_steps);
   out.steps = np.current();

@@ -50,7 +50,8 @@ GridOutcome solveOnGrid(const PlanningProblem& problem, const SolverOptions& opt
 
 /// A coarser level's iterate carried to the requested grid without iterating (a solve stopped
 /// on a coarse level: cancelled or out of time), evaluated as a plan, with `termination` and the
-/// reason `said` (StepTooLarge if the boundary data admit no step at this N).
+/// reason `said` (StepTooLarge if the boundary data admit no step at this N); no plan if the stop
+/// came before any level held an iterate (`coarse_steps` empty).
 GridOutcome carryToGrid(const PlanningProblem& problem,
                         const ReducedProblem::StepVectors& coarse_steps, Termination termination,
                         const std::vector<MessageClause>& said);

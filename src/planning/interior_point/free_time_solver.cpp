@@ -105,7 +105,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
         N_(np->steps()),
         n_(np->unknowns()),
         rows_(constraints, *np),
-        form_(parameters),
+        feasible_(parameters),
+        elastic_form_(parameters),
         factorization_(step_factor_, kkt_, nullptr) {}
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
@@ -196,19 +197,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   bool elasticRows(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep();
   }
-  /// An elastic row prepared at its value in.c: z safeguarded (as the fixed-h slack forms do where
-  /// a row is prepared for an assembly), D and q (prepareElasticRow).
-  void prepareRow(const FreeTimeRows& g, FreeTimeRow& in, double mu) const {
-    if (elasticRows(g)) prepareElasticRow(in, mu, rho_, false, parameters_);
+  /// The form a group's rows are in now: ℓ1-elastic while elasticRows, else Feasible.
+  const BarrierForm<10>& form(const FreeTimeRows& g) const {
+    if (elasticRows(g)) return elastic_form_;
+    return feasible_;
   }
-  /// How a prepared row enters the condensed Newton system [W + Σ ω g gᵀ] dx = −∇f + Σ β g:
-  /// feasible ω = z/c, β = μ/c; elastic ω = 1/D, β = z + q/D.
-  struct RowTerms {
-    double weight, rhs;
-  };
-  RowTerms rowTerms(const FreeTimeRows& g, const FreeTimeRow& in, double mu) const {
-    if (!elasticRows(g)) return {in.z / in.c, mu / in.c};
-    return {1.0 / in.D, in.z + in.q / in.D};
+  auto formOf() const {
+    return [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); };
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return 1 + (np_.hasTwist() ? 1 : 0); }
@@ -236,15 +231,11 @@ class FreeTimeSolver final : public PrimalDualProblem {
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
-    bool inside = true;
+    MeritSum sum{phi};
     rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
-      if (elasticRows(g)) {
-        phi += elasticSlacks(c, mu, rho_).psi;
-      } else {
-        form_.addRowMerit(c, in.c, mu, check_boundary, &inside, &phi);
-      }
+      sum.add(form(g).rowMerit(in, c, mu, rho_, 0.0, check_boundary));
     });
-    return inside ? phi : std::numeric_limits<double>::infinity();
+    return sum.value();
   }
 
   double T0() const { return N_ * h0_; }
@@ -338,7 +329,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
   int N_, n_;
   double h0_ = 0.0;
   StageTranscription<FreeTimeStep> rows_;  ///< the rows and their passes over the grid (η)
-  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  Feasible feasible_;                      ///< −μ ln c: how a row enters the barrier problem
+  L1Elastic<10> elastic_form_;             ///< an elastic start's rows (elasticRows)
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
@@ -399,8 +391,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
     Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
     Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
     const auto fold = [&](const FreeTimeRows& g, FreeTimeRow& in, const Vector3& a) {
-      prepareRow(g, in, mu);
-      const RowTerms terms = rowTerms(g, in, mu);
+      form(g).prepare(in, mu, rho_, false);
+      const RowTerms terms = form(g).terms(in, mu);
       W.diagonal().array() -= in.z * g.constraint->curvature() / (s * s);
       W.noalias() += terms.weight * a * a.transpose();
       rhs += terms.rhs * in.g;
@@ -428,14 +420,16 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
   const StageSupport support = rows_.groups[block.front()].support;
-  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) { prepareRow(g, in, mu); };
+  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) {
+    form(g).prepare(in, mu, rho_, false);
+  };
   const auto visit = [&](const QuantityTermsWithTimeStep& t, Eigen::Matrix<double, 10, 10>* H) {
     Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
     const int m = 3 * support.width;  // g is 0 past the local nodes but for η
     for (const int i : block) {
       FreeTimeRow& in = rows_.groups[i].instance(t.k);
       // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-      const RowTerms terms = rowTerms(rows_.groups[i], in, mu);
+      const RowTerms terms = form(rows_.groups[i]).terms(in, mu);
       const double w = terms.weight;
       H->topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
       H->block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
@@ -547,7 +541,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
   bool curved = false;
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int k, auto& in, double c) {
     in.r = c - in.c - localDot(g, k, in.g, d);
-    const double w = -rowTerms(g, in, 0.0).weight * in.r;
+    const double w = -form(g).terms(in, 0.0).weight * in.r;
     if (w == 0.0) return;
     curved = true;
     v(n_) += w * in.g(9);
@@ -577,17 +571,10 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
 /// curvature term, 0 for an uncorrected step; an elastic row: dz = (q − gᵀd)/D), and the largest
 /// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
-  double alpha = 1.0;
-  rows_.forEach([&](FreeTimeRows& g, int k, FreeTimeRow& in) {
-    const double slope = localDot(g, k, in.g, d) + in.r;
-    if (elasticRows(g)) {
-      in.dz = (in.q - slope) / in.D;
-      alpha = elasticDualStepLimit(in.z, in.dz, rho_, alpha, parameters_);
-    } else {
-      in.dz = form_.dualDirection(in.z, in.c, mu, slope, &alpha);
-    }
-  });
-  rows_.forEach([&](FreeTimeRows&, int, FreeTimeRow& in) { in.z += alpha * in.dz; });
+  const auto slope = [&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
+    return localDot(g, k, in.g, d) + in.r;
+  };
+  applyDualSteps(rows_, dualSteps(rows_, formOf(), slope, mu, rho_));
 }
 
 /// ∇φ_μ·d at the assembled point. The right-hand side is −∇φ_μ where every row's coefficient β
@@ -597,7 +584,8 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   double slope = -d.dot(rhs_);
   if (!elastic_) return slope;
   rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    if (elasticRows(g)) slope += (rowTerms(g, in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
+    if (elasticRows(g))
+      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
   });
   return slope;
 }
@@ -607,18 +595,14 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
 void FreeTimeSolver::safeguardDuals(double mu) {
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
-    if (!elasticRows(g)) in.z = form_.safeguarded(in.z, c, mu);
+    form(g).afterAccept(in, mu);
   });
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
-    if (elasticRows(g)) {
-      prepareElasticRow(in, mu, rho_, true, parameters_);
-    } else {
-      in.z = form_.initialMultiplier(c, mu);
-    }
+    form(g).prepare(in, mu, rho_, true);
   });
 }
 
@@ -626,21 +610,14 @@ void FreeTimeSolver::initializeDuals(double mu) {
 /// elastic row: |zs − μ| and |(ρ − z)v − μ|).
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  if (!elastic_) return form_.residual(rows_.groups, stationarity, mu);
-  double worst = stationarity;
-  rows_.forEach([&](const FreeTimeRows& g, int, const FreeTimeRow& in) {
-    if (!elasticRows(g)) {
-      worst = std::max(worst, std::abs(in.z * in.c - mu));
-    } else {
-      worst = std::max({worst, std::abs(in.z * in.s - mu), std::abs((rho_ - in.z) * in.v - mu)});
-    }
-  });
-  return worst;
+  return std::max(stationarity, complementarityOf(rows_, formOf(), mu, rho_).worst);
 }
 
 /// Σ zᵢcᵢ at the assembled point.
 double FreeTimeSolver::dualityGap() const {
-  return form_.dualityGap(rows_.groups);
+  double gap = 0.0;
+  rows_.forEach([&](auto&, int, auto& in) { gap += in.z * in.c; });
+  return gap;
 }
 
 /// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the

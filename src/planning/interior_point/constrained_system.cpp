@@ -315,15 +315,9 @@ double ConstrainedSystem::maxViolation() const {
 /// multipliers; empty without per-axis bounds.
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
-  std::vector<Vector3> sigma;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const int a = g.constraint->axis();
-    if (a < 0) return;  // only a box side is affine in one torque axis
-    if (sigma.empty()) sigma = torque;
-    // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
-    const double weight = np_.scheme().torqueWeight(k, np_.steps());
-    sigma[k](a) -= in.z * g.constraint->gradient(torque[k])(a) / weight;
-  });
+  if (!rows_.hasTorqueBox()) return {};
+  std::vector<Vector3> sigma = torque;
+  rows_.addBoxMultipliers(np_, torque, &sigma, nullptr);
   return sigma;
 }
 

@@ -59,6 +59,7 @@
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/transcription/minimum_time_objective.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 
@@ -68,12 +69,6 @@ namespace {
 
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
-/// ε₀ C₀ = this × T₀ at the start (C₀ its effort): a light regularization, gone as μ → 0.
-constexpr double kInitialEffortShare = 1e-2;
-/// ε never falls below this × ε₀: where the plan is strictly inside its bounds (the switches)
-/// minimum time alone has no curvature, and a shifted Newton step stalls there (measured on
-/// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
-constexpr double kFinalEffortFraction = 1e-8;
 /// The start's h is raised at most this factor before the elastic start takes over: with spinning
 /// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
 /// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
@@ -184,14 +179,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void disallowElastic() { allow_elastic_ = false; }
 
  private:
-  double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
-  /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
-  bool hasTorqueBox() const {
-    // Only a box side is affine in one torque axis.
-    return std::any_of(rows_.groups.begin(), rows_.groups.end(),
-                       [](const FreeTimeRows& g) { return g.constraint->axis() >= 0; });
-  }
-
   /// Whether the group's rows are ℓ1-elastic now: the constraints that move with h, while the
   /// start is elastic (the others, the cones, hold strictly at every iterate).
   bool elasticRows(const FreeTimeRows& g) const {
@@ -230,15 +217,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
-    double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
-    MeritSum sum{phi};
+    MeritSum sum{objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon)};
     rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
       sum.add(form(g).rowMerit(in, c, mu, rho_, 0.0, check_boundary));
     });
     return sum.value();
   }
 
-  double T0() const { return N_ * h0_; }
   double firstBarrier() const;
   void assemble(double mu, double epsilon);
   void assembleQuantity(const std::vector<int>& block, double mu);
@@ -308,7 +293,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
   double dualityGap() const;
-  double localLowerBound(double gap, double epsilon) const;
   /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
   bool barrierHessianDefinite() const;
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
@@ -337,7 +321,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
   BorderedBandKkt<double> step_factor_;     ///< the last step's factor (the correction reuses it)
   KktFactorization<double> factorization_;  ///< step_factor_ over kkt_, as the loop factors it
   // The run (run()): its barrier problems and the stopping test.
-  double mu0_ = 0.0, mu_final_ = 0.0, epsilon0_ = 0.0;
+  double mu0_ = 0.0, mu_final_ = 0.0;
+  MinimumTimeObjective objective_{1, 1.0, 0.0, 1.0};  ///< T/T₀ + ε(μ) C (set by run())
   double mu_ = 0.0, epsilon_ = 0.0;  ///< the barrier problem of this pass: μ, ε(μ)
   BarrierScales scales_;
   KktResidualTest test_{0.0, 1};
@@ -379,7 +364,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   // rows are prepared in the visit, after z entered w).
   const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
   const auto row = [](const FreeTimeRows&, FreeTimeRow&, double) {};
-  const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
+  const double dT = objective_.timeGradient();  // ∂(T/T₀)/∂η = 1
   const auto visit = [&](const ReducedProblem::TimeStepStencil& st, double s) {
     if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
     const Eigen::Matrix<double, 3, 10> G = step.jacobian(st);  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
@@ -620,21 +605,13 @@ double FreeTimeSolver::dualityGap() const {
   return gap;
 }
 
-/// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
-/// duality gap Σ zc below the iterate's value (weak duality of the barrier problem's Lagrangian,
-/// local), and εC, which vanishes with μ, at most its own size: T − T₀ (Σ zc + εC) [s].
-double FreeTimeSolver::localLowerBound(double gap, double epsilon) const {
-  const double T0 = N_ * h0_;
-  return N_ * np_.timeStep() - T0 * (gap + epsilon * np_.cost(np_.current()));
-}
-
 std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double gap,
                                     double epsilon, int iterations) const {
   if (!watch || elastic_) return "";
   BarrierPoint point;
   point.mu = mu;
   point.duration = N_ * np_.timeStep();
-  point.lower_bound = localLowerBound(gap, epsilon);
+  point.lower_bound = objective_.lowerBound(np_.timeStep(), gap, np_.cost(np_.current()), epsilon);
   point.attitudes = np_.attitudes(np_.current());
   point.iterations = iterations;
   point.locally_convex = barrierHessianDefinite();
@@ -665,8 +642,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   const int m = rows_.count;
   mu0_ = kInitialBarrier / m;
   mu_final_ = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
-  const double C0 = np_.cost(np_.current());
-  epsilon0_ = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
+  objective_ = MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
   test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
   scales_ = {1.0, 1, N_, mu_final_};
@@ -692,7 +668,7 @@ double FreeTimeSolver::firstBarrier() const {
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
 /// test reads what it measures).
 void FreeTimeSolver::prepare() {
-  epsilon_ = epsilon0_ * std::clamp(mu_ / mu0_, kFinalEffortFraction, 1.0);
+  epsilon_ = objective_.setBarrier(mu_);
   assemble(mu_, epsilon_);
   gap_ = dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
@@ -791,20 +767,14 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
     out.twist_gradient = lagrangian_gradient_(n_ + twistColumn());
   }
+  out.complementarity = dualityGap();
   out.smallest_value = std::numeric_limits<double>::infinity();
+  rows_.forEach(
+      [&](auto&, int, auto& in) { out.smallest_value = std::min(out.smallest_value, in.c); });
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
-  const std::vector<Vector3> tau = np_.torques(out.steps);
-  if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    out.complementarity += in.z * in.c;
-    out.smallest_value = std::min(out.smallest_value, in.c);
-    const int a = g.constraint->axis();
-    if (a < 0) return;  // only a box side is affine in one torque axis (and hasTorqueBox())
-    // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
-    const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
-    out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
-    out.switching_function[k](a) -= in.z * slope / torqueWeight(k);
-  });
+  if (rows_.hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
+  rows_.addBoxMultipliers(np_, np_.torques(out.steps), &out.switching_function,
+                          &out.torque_multipliers);
   out.maneuver = np_.maneuver(out.steps);
   recordVerdict(
       &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,

@@ -10,6 +10,7 @@
 
 #include "attitude_planner/planner.hpp"
 #include "planning/linalg/bordered_band.hpp"
+#include "planning/transcription/minimum_time_objective.hpp"
 #include "planning/transcription/objective.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/perturbed_problem.hpp"
@@ -145,8 +146,11 @@ TEST(GlobalUnknowns, TimeStepDerivativesMatchFiniteDifferences) {
   const EffortObjective effort;
   const TimePlusEffortObjective time_plus_effort(0.01);
   const EffortPlusTimeSquared effort_plus_time_squared(0.7);
+  // Free time's objective T/T₀ + ε(μ)C at a barrier between μ₀ and its floor.
+  MinimumTimeObjective minimum_time(9, 0.3, 2.0, 0.1);
+  minimum_time.setBarrier(0.01);
   const TranscriptionObjective* objectives[] = {&effort, &time_plus_effort,
-                                                &effort_plus_time_squared};
+                                                &effort_plus_time_squared, &minimum_time};
   for (SchemeKind scheme : kDiscretizations) {
     for (unsigned seed : {1u, 2u, 3u}) {
       for (const bool effects : {false, true}) {
@@ -264,6 +268,35 @@ TEST(GlobalUnknowns, TimeObjectiveIsTheDuration) {
 // setTimeStep keeps the free attitudes and honours the boundary velocities at the new h: its
 // torques are those of a problem built at that duration through the same attitudes (with
 // effects too: read at t_k = k h_new).
+// Free time's objective: 1 + ε₀C₀ = 1 + kInitialEffortShare at the start, ε(μ) linear in μ
+// between μ₀ and its floor kFinalEffortFraction ε₀, and its value through evaluateWithTimeStep
+// (the stencils) the one the solver's merit forms from the torques.
+TEST(GlobalUnknowns, MinimumTimeObjectiveStartsAtOneAndItsEffortWeightFollowsTheBarrier) {
+  for (unsigned seed : {4u, 5u, 6u}) {
+    const ReducedProblem rp =
+        perturbedReducedProblem(randomProblem(SchemeKind::SecondOrder, 12, seed), seed);
+    const double h0 = rp.timeStep(), C0 = rp.cost(rp.current()), mu0 = 0.1 / (seed + 1);
+    MinimumTimeObjective objective(rp.steps(), h0, C0, mu0);
+    const double epsilon0 = objective.setBarrier(mu0);
+    EXPECT_NEAR(objective.value(h0, C0, epsilon0), 1.0 + MinimumTimeObjective::kInitialEffortShare,
+                1e-15);
+    EXPECT_EQ(objective.setBarrier(10 * mu0), epsilon0);
+    EXPECT_NEAR(objective.setBarrier(0.25 * mu0), 0.25 * epsilon0, 1e-16 * epsilon0);
+    EXPECT_NEAR(objective.setBarrier(1e-20 * mu0),
+                MinimumTimeObjective::kFinalEffortFraction * epsilon0, 1e-16 * epsilon0);
+    const double epsilon = objective.setBarrier(0.5 * mu0);
+    Eigen::VectorXd g;
+    const double value = rp.evaluateWithTimeStep(objective, &g, nullptr, nullptr, nullptr);
+    EXPECT_NEAR(value, objective.value(h0, C0, epsilon), 1e-14);
+    // Without effort (C₀ = 0: ε = 0) ∂Φ/∂η = h₀ ∂Φ/∂h is the time row the solver adds, 1.
+    const MinimumTimeObjective time_only(rp.steps(), h0, 0.0, mu0);
+    rp.evaluateWithTimeStep(time_only, &g, nullptr, nullptr, nullptr);
+    EXPECT_NEAR(g(rp.unknowns()) * h0, time_only.timeGradient(), 1e-15);
+    EXPECT_NEAR(time_only.timeGradient(), 1.0, 1e-15);
+    EXPECT_NEAR(objective.lowerBound(h0, 0.0, C0, 0.0), rp.steps() * h0, 1e-15 * rp.steps() * h0);
+  }
+}
+
 TEST(GlobalUnknowns, SetTimeStepIsTheProblemAtTheNewDuration) {
   for (SchemeKind scheme : kDiscretizations) {
     for (const bool effects : {false, true}) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -288,6 +289,78 @@ TEST(ElasticSlacks, AnElasticRowsNewtonTermsAtItsPrimalMultiplierAreItsMeritsDer
         EXPECT_LT(row.z, rho) << at;
       }
     }
+  }
+}
+
+// The barrier forms through their one interface (BarrierForm): each form's Newton terms at its
+// primal multiplier are its merit term's derivatives in c (β = −ψ'(c), ω = ψ''(c), by central
+// differences of rowMerit), and every dual step keeps z (and an elastic row's ρ − z) at least
+// (1 − τ) of itself; Feasible's step is the Newton step of z c = μ. Seeded random rows.
+template <int Entries>
+void expectFormTermsAreMeritDerivatives(const ap::BarrierForm<Entries>& form, double c, double mu,
+                                        double rho, const std::string& at) {
+  ap::ConstraintRow<Entries> row;
+  row.c = c;
+  form.prepare(row, mu, rho, true);
+  const double step = 1e-4 * std::max(std::abs(c), mu / rho);
+  const auto psi = [&](double x) { return form.rowMerit(row, x, mu, rho, 0.0, false); };
+  const double first = (psi(c + step) - psi(c - step)) / (2 * step);
+  const double second = (psi(c + step) - 2 * psi(c) + psi(c - step)) / (step * step);
+  const ap::RowTerms terms = form.terms(row, mu);
+  EXPECT_NEAR(terms.rhs, -first, 1e-6 * std::abs(first)) << at;
+  // The second difference loses ε|ψ|/step² to round-off (ψ ≈ ρ|c| far outside an elastic row).
+  const double round_off =
+      8 * std::numeric_limits<double>::epsilon() * std::abs(psi(c)) / (step * step);
+  EXPECT_NEAR(terms.weight, second, 1e-3 * std::abs(second) + round_off) << at;
+}
+
+TEST(BarrierForms, NewtonTermsAtThePrimalMultiplierAreTheMeritsDerivatives) {
+  const ap::InteriorPointParameters parameters;
+  const ap::Feasible feasible(parameters);
+  const ap::L1Elastic<10> elastic(parameters);
+  std::mt19937 rng(48);
+  std::uniform_real_distribution<double> exponent(-3.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    const double mu = std::pow(10.0, exponent(rng) - 2.0), rho = 1e2;
+    const double c = std::pow(10.0, exponent(rng));
+    const std::string at = "c = " + std::to_string(c) + ", mu = " + std::to_string(mu);
+    expectFormTermsAreMeritDerivatives<10>(feasible, c, mu, rho, "feasible " + at);
+    expectFormTermsAreMeritDerivatives<10>(elastic, c, mu, rho, "elastic " + at);
+    expectFormTermsAreMeritDerivatives<10>(elastic, -c, mu, rho, "elastic " + at + " outside");
+  }
+}
+
+TEST(BarrierForms, DualStepsKeepTheMultipliersInsideAndFeasibleIsNewtonsOnZcEqualsMu) {
+  const ap::InteriorPointParameters parameters;
+  const double tau = parameters.fraction_to_boundary, rho = 1e2;
+  const ap::Feasible feasible(parameters);
+  const ap::L1Elastic<10> elastic(parameters);
+  const ap::FreeSlacks free_slacks(parameters);
+  std::mt19937 rng(4848);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double mu = std::pow(10.0, 2 * unit(rng) - 3), c = std::pow(10.0, 2 * unit(rng));
+    const double slope = 10 * unit(rng);
+    ap::ConstraintRow<10> f;
+    f.c = c;
+    f.z = mu / c * std::pow(10.0, unit(rng));
+    const double alpha_f = feasible.dualStep(f, slope, mu, rho, 1.0);
+    EXPECT_NEAR(f.z * f.c + f.c * f.dz + f.z * slope, mu,
+                1e-12 * (mu + f.z * f.c + f.z * std::abs(slope)));
+    EXPECT_GE(f.z + alpha_f * f.dz, (1 - tau) * f.z * (1 - 1e-12));
+    ap::ConstraintRow<10> e;
+    e.c = c * (unit(rng) > 0 ? 1 : -1);
+    e.z = 0.5 * rho;
+    elastic.prepare(e, mu, rho, false);
+    const double alpha_e = elastic.dualStep(e, slope, mu, rho, 1.0);
+    EXPECT_GE(e.z + alpha_e * e.dz, (1 - tau) * e.z * (1 - 1e-12));
+    EXPECT_GE(rho - e.z - alpha_e * e.dz, (1 - tau) * (rho - e.z) * (1 - 1e-9));
+    ap::ConstraintRow<9> s;
+    s.c = e.c;
+    free_slacks.initialize(s, mu, rho, 1e3);
+    free_slacks.prepare(s, mu, rho, false);
+    const double alpha_s = free_slacks.dualStep(s, slope, mu, rho, 1.0);
+    EXPECT_GE(s.z + alpha_s * s.dz, (1 - tau) * s.z * (1 - 1e-12));
   }
 }
 

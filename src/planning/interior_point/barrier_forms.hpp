@@ -1,14 +1,20 @@
-// The constraint rows of the interior point and the barrier forms that say how a row c(x) ≥ 0
-// enters the barrier problem: its multiplier's safeguard, its merit term, its dual step.
+// The barrier forms that say how a row c(x) ≥ 0 of a stage transcription (ConstraintRow, 9
+// entries at a fixed h, 10 with h free) enters the barrier problem: its multiplier's safeguard,
+// its Newton terms, its merit term, its dual step, its complementarity; one interface
+// (BarrierForm), so that the loops over the rows are written once (dualSteps, applyDualSteps,
+// complementarityOf, MeritSum) and both interior points call them.
 //   FreeSlacks (fixed h): c − s = 0, s > 0 a variable, −μ ln s + ν|c − s| in the merit.
-//   L1Elastic  (fixed h): c + v − s = 0, s, v ≥ 0 eliminated for c (elasticSlacks), the merit
-//                         ψ_μ(c) = ρ v − μ ln s − μ ln v; its multiplier z < ρ (u = ρ − z > 0).
+//   L1Elastic  (fixed h; free time's elastic start): c + v − s = 0, s, v ≥ 0 eliminated for c
+//              (elasticSlacks), the merit ψ_μ(c) = ρ v − μ ln s − μ ln v; z < ρ (u = ρ − z > 0).
 //   Feasible   (free time): −μ ln c, every iterate strictly inside; the feasible dual step
-//                         dz = μ/c − z − (z/c) gᵀd.
+//              dz = μ/c − z − (z/c) gᵀd.
 // κ_Σ (dual_safeguard) keeps each form's moment: the slack forms clamp z where a row is prepared
 // for an assembly (with the new μ), Feasible after a step is accepted (with the step's μ).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -16,6 +22,7 @@
 
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "planning/transcription/stage_quantities.hpp"
 #include "planning/transcription/stage_transcription.hpp"
@@ -43,6 +50,21 @@ class BarrierRows {
   virtual void complementarity(double mu, double rho, double* average, double* smallest) const = 0;
 };
 
+/// How a prepared row enters the condensed Newton system [W + Σ ω g gᵀ] dx = −∇f + Σ β g.
+struct RowTerms {
+  double weight;  ///< ω
+  double rhs;     ///< β
+};
+
+/// The rows' complementarity products (s z; an elastic row also v u; Feasible z c).
+struct Complementarity {
+  double sum = 0.0;  ///< Σ of the products (an elastic row's pair added as one term)
+  double low = std::numeric_limits<double>::infinity();  ///< the least product
+  double worst = 0.0;  ///< max |product − μ|: the barrier problem's complementarity residual
+  int count = 0;
+  double average() const { return sum / std::max(count, 1); }
+};
+
 /// The ℓ1-elastic row c + v − s = 0 at its value c: the slacks s, v (elasticSlacks), the
 /// multiplier z (the primal μ/s, or κ_Σ-safeguarded and kept below ρ so that u = ρ − z > 0) and
 /// the condensation terms D = s/z + v/u, q = μ/z − s − μ/u + v: the row adds g gᵀ/D to the
@@ -55,89 +77,165 @@ void prepareElasticRow(ConstraintRow<Entries>& row, double mu, double rho, bool 
 double elasticDualStepLimit(double z, double dz, double rho, double alpha,
                             const InteriorPointParameters& p);
 
-/// How a row enters the fixed-h barrier problem (Formulation::FreeSlacks or Elastic).
-class SlackForm {
+/// How a row c(x) ≥ 0 enters a barrier problem: one interface on the rows of either time step
+/// (Entries 9 at a fixed h, 10 with h free), so that the loops over the rows (the dual step, the
+/// merit, the complementarity) are written once, in the problems that own the rows.
+template <int Entries>
+class BarrierForm {
  public:
-  explicit SlackForm(const InteriorPointParameters& parameters) : p_(parameters) {}
-  virtual ~SlackForm() = default;
-  /// Slacks, the (κ_Σ-safeguarded, or primal μ/s) multiplier and the condensation terms D, q for
-  /// the row's value c.
-  virtual void prepare(FixedStepRow& row, double mu, double rho, bool primal) const = 0;
-  /// The row's term of the merit (ρ: the elastic penalty; FreeSlacks: the merit's ν, at the slack
-  /// s + α ds).
-  virtual double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const = 0;
+  using Row = ConstraintRow<Entries>;
+  explicit BarrierForm(const InteriorPointParameters& parameters) : p_(parameters) {}
+  virtual ~BarrierForm() = default;
+  /// The multiplier (κ_Σ-safeguarded, or the primal one) and the condensation terms for the
+  /// row's value c, where the row is prepared for an assembly (Feasible: only the primal one).
+  virtual void prepare(Row& row, double mu, double rho, bool primal) const = 0;
+  /// ω and β of the prepared row.
+  virtual RowTerms terms(const Row& row, double mu) const = 0;
+  /// The row's term of the merit at value c (row.c the accepted one; ρ: the elastic penalty,
+  /// FreeSlacks the merit's ν at the slack s + α ds); +∞ where c is outside the form's domain
+  /// (Feasible, checking the boundary: c ≤ 0 or c < (1 − τ) row.c).
+  virtual double rowMerit(const Row& row, double c, double mu, double rho, double alpha,
+                          bool check_boundary) const = 0;
+  /// The multiplier's step dz (into row.dz) for the row's slope gᵀd (+ r), and `alpha` limited
+  /// by the fraction to the boundary after it.
+  virtual double dualStep(Row& row, double slope, double mu, double rho, double alpha) const = 0;
+  /// Adds the row's complementarity products at its value c.
+  virtual void addComplementarity(const Row& row, double mu, double rho,
+                                  Complementarity* out) const = 0;
+  /// κ_Σ after an accepted step, at the row's new value c (Feasible's moment; the slack forms
+  /// clamp in prepare).
+  virtual void afterAccept(Row&, double) const {}
   /// Whether ∇_δ φ_μ carries the row's barrier term −(μ/s) g (L1Elastic: the slacks are
   /// functions of c; FreeSlacks: the slack step's slope carries it).
-  virtual bool barrierInMeritGradient() const = 0;
-  /// `alpha` limited by the fraction to the boundary after the row's dual step dz.
-  virtual double dualStepLimit(const FixedStepRow& row, double dz, double rho,
-                               double alpha) const = 0;
+  virtual bool barrierInMeritGradient() const { return true; }
   /// The first multiplier (and FreeSlacks' slack) at the row's value c: the primal one μ/s,
   /// capped at `cap`.
-  virtual void initialize(FixedStepRow& row, double mu, double rho, double cap) const = 0;
-  /// Adds the row's complementarity products (s z; L1Elastic also v u) to *sum and *count and
-  /// their least to *low.
-  virtual void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum,
-                                  double* low, int* count) const = 0;
+  virtual void initialize(Row& row, double mu, double rho, double cap) const = 0;
 
  protected:
   /// z ≥ 0 kept at least (1 − τ) of itself.
-  double multiplierLimit(const FixedStepRow& row, double dz, double alpha) const;
+  double multiplierLimit(double z, double dz, double alpha) const {
+    if (dz < 0) alpha = std::min(alpha, -p_.fraction_to_boundary * z / dz);
+    return alpha;
+  }
   const InteriorPointParameters& p_;
 };
 
-/// c − s = 0 with s > 0 free: the multiplier stays near μ/s, the condensation that of c − s = 0.
-class FreeSlacks final : public SlackForm {
+/// c − s = 0 with s > 0 free (fixed h): the multiplier stays near μ/s, the condensation that of
+/// c − s = 0.
+class FreeSlacks final : public BarrierForm<9> {
  public:
-  using SlackForm::SlackForm;
-  void prepare(FixedStepRow& row, double mu, double rho, bool primal) const override;
-  double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const override;
+  using BarrierForm::BarrierForm;
+  void prepare(Row& row, double mu, double rho, bool primal) const override;
+  RowTerms terms(const Row& row, double) const override {
+    return {1.0 / row.D, row.z + row.q / row.D};
+  }
+  double rowMerit(const Row& row, double c, double mu, double rho, double alpha,
+                  bool) const override;
+  double dualStep(Row& row, double slope, double, double, double alpha) const override {
+    row.dz = (row.q - slope) / row.D;
+    return multiplierLimit(row.z, row.dz, alpha);  // z has no upper bound
+  }
+  void addComplementarity(const Row& row, double mu, double rho,
+                          Complementarity* out) const override;
   bool barrierInMeritGradient() const override { return false; }
-  double dualStepLimit(const FixedStepRow& row, double dz, double rho, double alpha) const override;
-  void initialize(FixedStepRow& row, double mu, double rho, double cap) const override;
-  void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum, double* low,
-                          int* count) const override;
+  void initialize(Row& row, double mu, double rho, double cap) const override;
 };
 
-/// c + v − s = 0, ℓ1-penalized v (the certificate of local infeasibility at fixed h).
-class L1Elastic final : public SlackForm {
+/// c + v − s = 0, ℓ1-penalized v: the certificate of local infeasibility at fixed h, and the
+/// free-time solver's elastic start (Entries 10).
+template <int Entries>
+class L1Elastic final : public BarrierForm<Entries> {
  public:
-  using SlackForm::SlackForm;
-  void prepare(FixedStepRow& row, double mu, double rho, bool primal) const override;
-  double rowMerit(const FixedStepRow& row, double mu, double rho, double alpha) const override;
-  bool barrierInMeritGradient() const override { return true; }
-  double dualStepLimit(const FixedStepRow& row, double dz, double rho, double alpha) const override;
-  void initialize(FixedStepRow& row, double mu, double rho, double cap) const override;
-  void addComplementarity(const FixedStepRow& row, double mu, double rho, double* sum, double* low,
-                          int* count) const override;
+  using Row = ConstraintRow<Entries>;
+  using BarrierForm<Entries>::BarrierForm;
+  void prepare(Row& row, double mu, double rho, bool primal) const override {
+    prepareElasticRow(row, mu, rho, primal, this->p_);
+  }
+  RowTerms terms(const Row& row, double) const override {
+    return {1.0 / row.D, row.z + row.q / row.D};
+  }
+  double rowMerit(const Row&, double c, double mu, double rho, double, bool) const override {
+    return elasticSlacks(c, mu, rho).psi;
+  }
+  double dualStep(Row& row, double slope, double, double rho, double alpha) const override {
+    row.dz = (row.q - slope) / row.D;
+    return elasticDualStepLimit(row.z, row.dz, rho, alpha, this->p_);
+  }
+  void addComplementarity(const Row& row, double mu, double rho,
+                          Complementarity* out) const override {
+    const ElasticSlacks sl = elasticSlacks(row.c, mu, rho);
+    const double a = sl.s * row.z, b = sl.v * (rho - row.z);
+    out->sum += a + b;
+    out->low = std::min(out->low, std::min(a, b));
+    out->worst = std::max({out->worst, std::abs(a - mu), std::abs(b - mu)});
+    out->count += 2;
+  }
+  void initialize(Row& row, double mu, double rho, double cap) const override {
+    const ElasticSlacks sl = elasticSlacks(row.c, mu, rho);
+    row.z = std::min(mu / sl.s, std::min(cap, 0.5 * rho));
+  }
 };
 
-std::unique_ptr<SlackForm> makeSlackForm(Formulation formulation,
-                                         const InteriorPointParameters& parameters);
+/// The fixed-h form of a formulation (Formulation::FreeSlacks or Elastic).
+std::unique_ptr<BarrierForm<9>> makeSlackForm(Formulation formulation,
+                                              const InteriorPointParameters& parameters);
 
-/// −μ Σ ln c with every iterate strictly inside (free time). A scalar barrier unknown (the elastic
-/// start's θ ≥ 0) is one more such row with c = θ: the same functions on (z, c).
-class Feasible {
+/// −μ ln c with every iterate strictly inside (free time): the multiplier's feasible step
+/// dz = μ/c − z − (z/c)(gᵀd + r), κ_Σ after each accepted step. A scalar barrier unknown (the
+/// elastic start's θ ≥ 0) is one more such row with c = θ.
+class Feasible final : public BarrierForm<10> {
  public:
-  explicit Feasible(const InteriorPointParameters& parameters) : p_(parameters) {}
-  /// The primal multiplier μ/c.
-  double initialMultiplier(double c, double mu) const { return mu / c; }
+  using BarrierForm::BarrierForm;
+  void prepare(Row& row, double mu, double, bool primal) const override {
+    if (primal) row.z = mu / row.c;
+  }
+  RowTerms terms(const Row& row, double mu) const override { return {row.z / row.c, mu / row.c}; }
+  double rowMerit(const Row& row, double c, double mu, double, double,
+                  bool check_boundary) const override;
+  double dualStep(Row& row, double slope, double mu, double, double alpha) const override {
+    row.dz = mu / row.c - row.z - row.z / row.c * slope;
+    return multiplierLimit(row.z, row.dz, alpha);
+  }
+  void addComplementarity(const Row& row, double mu, double, Complementarity* out) const override;
   /// z within [μ/(κ_Σ c), κ_Σ μ/c].
-  double safeguarded(double z, double c, double mu) const;
-  /// −μ ln c added to *phi while *inside: false (and *inside false) where c ≤ 0 or, checking the
-  /// boundary, c < (1 − τ) c_old.
-  void addRowMerit(double c, double c_old, double mu, bool check_boundary, bool* inside,
-                   double* phi) const;
-  /// dz = μ/c − z − (z/c) slope (slope = gᵀd + r at the assembled point), and `alpha` limited
-  /// by the fraction to the boundary on z.
-  double dualDirection(double z, double c, double mu, double slope, double* alpha) const;
-  /// max(‖∇L‖∞, max |zc − μ|) over the rows (the barrier problem's KKT residual without θ).
-  double residual(const std::vector<FreeTimeRows>& rows, double stationarity, double mu) const;
-  /// Σ zᵢcᵢ at the assembled point.
-  double dualityGap(const std::vector<FreeTimeRows>& rows) const;
+  void afterAccept(Row& row, double mu) const override;
+  void initialize(Row& row, double mu, double, double cap) const override {
+    row.z = std::min(mu / row.c, cap);
+  }
+};
 
- private:
-  const InteriorPointParameters& p_;
+/// The rows' dual steps (row.dz; slope(group, k, row) each row's gᵀd) and the largest step in
+/// (0, 1] by the fraction to the boundary; form(group) the form a group's rows are in now.
+template <typename Rows, typename FormOf, typename Slope>
+double dualSteps(Rows& rows, const FormOf& form, const Slope& slope, double mu, double rho) {
+  double alpha = 1.0;
+  rows.forEach([&](auto& g, int k, auto& in) {
+    alpha = form(g).dualStep(in, slope(g, k, in), mu, rho, alpha);
+  });
+  return alpha;
+}
+/// z += α dz on every row.
+template <typename Rows>
+void applyDualSteps(Rows& rows, double alpha) {
+  rows.forEach([&](auto&, int, auto& in) { in.z += alpha * in.dz; });
+}
+/// The rows' complementarity products at their values c.
+template <typename Rows, typename FormOf>
+Complementarity complementarityOf(const Rows& rows, const FormOf& form, double mu, double rho) {
+  Complementarity out;
+  rows.forEach([&](auto& g, int, auto& in) { form(g).addComplementarity(in, mu, rho, &out); });
+  return out;
+}
+/// A merit's sum over the rows: +∞ once a row is outside its form's domain.
+struct MeritSum {
+  double phi = 0.0;
+  bool inside = true;
+  void add(double term) {
+    if (term == std::numeric_limits<double>::infinity()) inside = false;
+    if (inside) phi += term;
+  }
+  double value() const { return inside ? phi : std::numeric_limits<double>::infinity(); }
 };
 
 }  // namespace attitude_planner

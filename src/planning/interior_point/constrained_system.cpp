@@ -91,9 +91,10 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
 }
 
 double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
-  double phi = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { phi += form_->rowMerit(in, mu, rho, alpha); });
-  return phi;
+  MeritSum phi;
+  rows_.forEach(
+      [&](auto&, int, auto& in) { phi.add(form_->rowMerit(in, in.c, mu, rho, alpha, false)); });
+  return phi.value();
 }
 
 void ConstrainedSystem::pollEvery(int k) const {
@@ -198,7 +199,7 @@ void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
     if (form_->barrierInMeritGradient()) {
       addLocalVector(np_, in.g, -mu / in.s, first, g.support.width, merit_gradient);
     }
-    addLocalVector(np_, in.g, in.z + in.q / in.D, first, g.support.width, rhs);
+    addLocalVector(np_, in.g, form_->terms(in, mu).rhs, first, g.support.width, rhs);
   });
 }
 
@@ -253,21 +254,11 @@ void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<do
 
 /// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
 /// and the steps dz themselves (stored in `dz`, instance order).
-double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz) {
-  dz->clear();
-  double alpha = 1.0;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const double step =
-        (in.q - localDot(np_, in.g, k + g.support.node_offset, g.support.width, d)) / in.D;
-    dz->push_back(step);
-    alpha = form_->dualStepLimit(in, step, rho, alpha);
-  });
-  return alpha;
-}
-
-void ConstrainedSystem::applyDualStep(const std::vector<double>& dz, double alpha) {
-  std::size_t i = 0;
-  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.z += alpha * dz[i++]; });
+double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double mu, double rho) {
+  const auto slope = [&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    return localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
+  };
+  return dualSteps(rows_, formOf(), slope, mu, rho);
 }
 
 ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
@@ -291,10 +282,9 @@ void ConstrainedSystem::applySlackStep(double alpha) {
 }
 
 /// FreeSlacks: the largest multiplier after the dual step dz (for the merit's ν).
-double ConstrainedSystem::largestMultiplier(const std::vector<double>& dz, double alpha) const {
+double ConstrainedSystem::largestMultiplier(double alpha) const {
   double largest = 0.0;
-  std::size_t i = 0;
-  rows_.forEach([&](auto&, int, auto& in) { largest = std::max(largest, in.z + alpha * dz[i++]); });
+  rows_.forEach([&](auto&, int, auto& in) { largest = std::max(largest, in.z + alpha * in.dz); });
   return largest;
 }
 
@@ -309,12 +299,9 @@ double ConstrainedSystem::maxSlackResidual() const {
 /// evaluated c.
 void ConstrainedSystem::complementarity(double mu, double rho, double* average,
                                         double* smallest) const {
-  double sum = 0.0, low = std::numeric_limits<double>::infinity();
-  int count = 0;
-  rows_.forEach(
-      [&](auto&, int, auto& in) { form_->addComplementarity(in, mu, rho, &sum, &low, &count); });
-  *average = sum / std::max(count, 1);
-  *smallest = low;
+  const Complementarity products = complementarityOf(rows_, formOf(), mu, rho);
+  *average = products.average();
+  *smallest = products.low;
 }
 
 /// Largest elastic violation max v_i (constraint units) at the last assembly or merit.
@@ -328,15 +315,9 @@ double ConstrainedSystem::maxViolation() const {
 /// multipliers; empty without per-axis bounds.
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
-  std::vector<Vector3> sigma;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const int a = g.constraint->axis();
-    if (a < 0) return;  // only a box side is affine in one torque axis
-    if (sigma.empty()) sigma = torque;
-    // −z ∂c/∂τ_a / w_k: ±z/(a w_k) for the box's upper and lower sides.
-    const double weight = np_.scheme().torqueWeight(k, np_.steps());
-    sigma[k](a) -= in.z * g.constraint->gradient(torque[k])(a) / weight;
-  });
+  if (!rows_.hasTorqueBox()) return {};
+  std::vector<Vector3> sigma = torque;
+  rows_.addBoxMultipliers(np_, torque, &sigma, nullptr);
   return sigma;
 }
 

@@ -90,9 +90,10 @@ class ConstrainedSystem final : public BarrierRows {
   void addSlackWeightedGradients(const std::vector<double>* products,
                                  Eigen::VectorXd* out) const override;
   void setComplementarityTarget(double mu, const std::vector<double>* products) override;
-  /// The largest dual step in (0, 1] by the fraction to the boundary, and the steps dz.
-  double dualStep(const Eigen::VectorXd& d, double rho, std::vector<double>* dz);
-  void applyDualStep(const std::vector<double>& dz, double alpha);
+  /// The largest dual step in (0, 1] by the fraction to the boundary, and the steps dz (kept in
+  /// the rows until applyDualStep).
+  double dualStep(const Eigen::VectorXd& d, double mu, double rho);
+  void applyDualStep(double alpha) { applyDualSteps(rows_, alpha); }
 
   /// What slackStep measures about the slack step.
   struct SlackStep {
@@ -105,7 +106,7 @@ class ConstrainedSystem final : public BarrierRows {
   SlackStep slackStep(const Eigen::VectorXd& d, double mu);
   void applySlackStep(double alpha);
   /// FreeSlacks: the largest multiplier after the dual step dz.
-  double largestMultiplier(const std::vector<double>& dz, double alpha) const;
+  double largestMultiplier(double alpha) const;
   // BarrierRows (FreeSlacks' max |c − s|; the complementarity products).
   double maxSlackResidual() const override;
   void complementarity(double mu, double rho, double* average, double* smallest) const override;
@@ -137,6 +138,10 @@ class ConstrainedSystem final : public BarrierRows {
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
+  /// The form every row is in (one per formulation).
+  auto formOf() const {
+    return [this](const FixedStepRows&) -> const BarrierForm<9>& { return *form_; };
+  }
   /// Where the assembly's ψ border goes (null without a twist).
   TwistBorder* twistSink() { return np_.hasTwist() ? &twist_border_ : nullptr; }
 
@@ -144,7 +149,7 @@ class ConstrainedSystem final : public BarrierRows {
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  std::unique_ptr<SlackForm> form_;         ///< FreeSlacks or L1Elastic: how a row enters φ_μ
+  std::unique_ptr<BarrierForm<9>> form_;    ///< FreeSlacks or L1Elastic: how a row enters φ_μ
   StageConstraints constraints_;            ///< buildStageConstraints(problem): one group each
   StageTranscription<FixedTimeStep> rows_;  ///< the rows and their passes over the grid
   const Interruption* interruption_ = nullptr;

@@ -59,6 +59,7 @@
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/problem/message_notes.hpp"
+#include "planning/transcription/minimum_time_objective.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 
@@ -68,12 +69,6 @@ namespace {
 
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
-/// ε₀ C₀ = this × T₀ at the start (C₀ its effort): a light regularization, gone as μ → 0.
-constexpr double kInitialEffortShare = 1e-2;
-/// ε never falls below this × ε₀: where the plan is strictly inside its bounds (the switches)
-/// minimum time alone has no curvature, and a shifted Newton step stalls there (measured on
-/// Bilimoria–Wie: stationarity stuck at 1e-6); T moves by O(ε) ~ 1e-10 T₀.
-constexpr double kFinalEffortFraction = 1e-8;
 /// The start's h is raised at most this factor before the elastic start takes over: with spinning
 /// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
 /// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
@@ -105,7 +100,8 @@ class FreeTimeSolver final : public PrimalDualProblem {
         N_(np->steps()),
         n_(np->unknowns()),
         rows_(constraints, *np),
-        form_(parameters),
+        feasible_(parameters),
+        elastic_form_(parameters),
         factorization_(step_factor_, kkt_, nullptr) {}
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
@@ -183,32 +179,18 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void disallowElastic() { allow_elastic_ = false; }
 
  private:
-  double torqueWeight(int k) const { return np_.scheme().torqueWeight(k, N_); }
-  /// Whether a per-axis torque bound is among the constraints (the switching functions' axes).
-  bool hasTorqueBox() const {
-    // Only a box side is affine in one torque axis.
-    return std::any_of(rows_.groups.begin(), rows_.groups.end(),
-                       [](const FreeTimeRows& g) { return g.constraint->axis() >= 0; });
-  }
-
   /// Whether the group's rows are ℓ1-elastic now: the constraints that move with h, while the
   /// start is elastic (the others, the cones, hold strictly at every iterate).
   bool elasticRows(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep();
   }
-  /// An elastic row prepared at its value in.c: z safeguarded (as the fixed-h slack forms do where
-  /// a row is prepared for an assembly), D and q (prepareElasticRow).
-  void prepareRow(const FreeTimeRows& g, FreeTimeRow& in, double mu) const {
-    if (elasticRows(g)) prepareElasticRow(in, mu, rho_, false, parameters_);
+  /// The form a group's rows are in now: ℓ1-elastic while elasticRows, else Feasible.
+  const BarrierForm<10>& form(const FreeTimeRows& g) const {
+    if (elasticRows(g)) return elastic_form_;
+    return feasible_;
   }
-  /// How a prepared row enters the condensed Newton system [W + Σ ω g gᵀ] dx = −∇f + Σ β g:
-  /// feasible ω = z/c, β = μ/c; elastic ω = 1/D, β = z + q/D.
-  struct RowTerms {
-    double weight, rhs;
-  };
-  RowTerms rowTerms(const FreeTimeRows& g, const FreeTimeRow& in, double mu) const {
-    if (!elasticRows(g)) return {in.z / in.c, mu / in.c};
-    return {1.0 / in.D, in.z + in.q / in.D};
+  auto formOf() const {
+    return [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); };
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return 1 + (np_.hasTwist() ? 1 : 0); }
@@ -235,19 +217,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
-    double phi = N_ * np_.timeStep() / T0() + epsilon * np_.scheme().cost(tau);
-    bool inside = true;
+    MeritSum sum{objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon)};
     rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
-      if (elasticRows(g)) {
-        phi += elasticSlacks(c, mu, rho_).psi;
-      } else {
-        form_.addRowMerit(c, in.c, mu, check_boundary, &inside, &phi);
-      }
+      sum.add(form(g).rowMerit(in, c, mu, rho_, 0.0, check_boundary));
     });
-    return inside ? phi : std::numeric_limits<double>::infinity();
+    return sum.value();
   }
 
-  double T0() const { return N_ * h0_; }
   double firstBarrier() const;
   void assemble(double mu, double epsilon);
   void assembleQuantity(const std::vector<int>& block, double mu);
@@ -317,7 +293,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
   double dualityGap() const;
-  double localLowerBound(double gap, double epsilon) const;
   /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
   bool barrierHessianDefinite() const;
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
@@ -338,14 +313,16 @@ class FreeTimeSolver final : public PrimalDualProblem {
   int N_, n_;
   double h0_ = 0.0;
   StageTranscription<FreeTimeStep> rows_;  ///< the rows and their passes over the grid (η)
-  Feasible form_;  ///< −μ ln c: the rows' multipliers, merit terms and dual step
+  Feasible feasible_;                      ///< −μ ln c: how a row enters the barrier problem
+  L1Elastic<10> elastic_form_;             ///< an elastic start's rows (elasticRows)
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
   BorderedBandKkt<double> step_factor_;     ///< the last step's factor (the correction reuses it)
   KktFactorization<double> factorization_;  ///< step_factor_ over kkt_, as the loop factors it
   // The run (run()): its barrier problems and the stopping test.
-  double mu0_ = 0.0, mu_final_ = 0.0, epsilon0_ = 0.0;
+  double mu0_ = 0.0, mu_final_ = 0.0;
+  MinimumTimeObjective objective_{1, 1.0, 0.0, 1.0};  ///< T/T₀ + ε(μ) C (set by run())
   double mu_ = 0.0, epsilon_ = 0.0;  ///< the barrier problem of this pass: μ, ε(μ)
   BarrierScales scales_;
   KktResidualTest test_{0.0, 1};
@@ -387,7 +364,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   // rows are prepared in the visit, after z entered w).
   const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
   const auto row = [](const FreeTimeRows&, FreeTimeRow&, double) {};
-  const double dT = N_ * h0_ / T0();  // ∂(T/T₀)/∂η = 1
+  const double dT = objective_.timeGradient();  // ∂(T/T₀)/∂η = 1
   const auto visit = [&](const ReducedProblem::TimeStepStencil& st, double s) {
     if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
     const Eigen::Matrix<double, 3, 10> G = step.jacobian(st);  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
@@ -399,8 +376,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
     Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
     Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
     const auto fold = [&](const FreeTimeRows& g, FreeTimeRow& in, const Vector3& a) {
-      prepareRow(g, in, mu);
-      const RowTerms terms = rowTerms(g, in, mu);
+      form(g).prepare(in, mu, rho_, false);
+      const RowTerms terms = form(g).terms(in, mu);
       W.diagonal().array() -= in.z * g.constraint->curvature() / (s * s);
       W.noalias() += terms.weight * a * a.transpose();
       rhs += terms.rhs * in.g;
@@ -428,14 +405,16 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
   const StageSupport support = rows_.groups[block.front()].support;
-  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) { prepareRow(g, in, mu); };
+  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) {
+    form(g).prepare(in, mu, rho_, false);
+  };
   const auto visit = [&](const QuantityTermsWithTimeStep& t, Eigen::Matrix<double, 10, 10>* H) {
     Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
     const int m = 3 * support.width;  // g is 0 past the local nodes but for η
     for (const int i : block) {
       FreeTimeRow& in = rows_.groups[i].instance(t.k);
       // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-      const RowTerms terms = rowTerms(rows_.groups[i], in, mu);
+      const RowTerms terms = form(rows_.groups[i]).terms(in, mu);
       const double w = terms.weight;
       H->topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
       H->block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
@@ -547,7 +526,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
   bool curved = false;
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int k, auto& in, double c) {
     in.r = c - in.c - localDot(g, k, in.g, d);
-    const double w = -rowTerms(g, in, 0.0).weight * in.r;
+    const double w = -form(g).terms(in, 0.0).weight * in.r;
     if (w == 0.0) return;
     curved = true;
     v(n_) += w * in.g(9);
@@ -577,17 +556,10 @@ double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
 /// curvature term, 0 for an uncorrected step; an elastic row: dz = (q − gᵀd)/D), and the largest
 /// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
-  double alpha = 1.0;
-  rows_.forEach([&](FreeTimeRows& g, int k, FreeTimeRow& in) {
-    const double slope = localDot(g, k, in.g, d) + in.r;
-    if (elasticRows(g)) {
-      in.dz = (in.q - slope) / in.D;
-      alpha = elasticDualStepLimit(in.z, in.dz, rho_, alpha, parameters_);
-    } else {
-      in.dz = form_.dualDirection(in.z, in.c, mu, slope, &alpha);
-    }
-  });
-  rows_.forEach([&](FreeTimeRows&, int, FreeTimeRow& in) { in.z += alpha * in.dz; });
+  const auto slope = [&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
+    return localDot(g, k, in.g, d) + in.r;
+  };
+  applyDualSteps(rows_, dualSteps(rows_, formOf(), slope, mu, rho_));
 }
 
 /// ∇φ_μ·d at the assembled point. The right-hand side is −∇φ_μ where every row's coefficient β
@@ -597,7 +569,8 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   double slope = -d.dot(rhs_);
   if (!elastic_) return slope;
   rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    if (elasticRows(g)) slope += (rowTerms(g, in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
+    if (elasticRows(g))
+      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
   });
   return slope;
 }
@@ -607,18 +580,14 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
 void FreeTimeSolver::safeguardDuals(double mu) {
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
-    if (!elasticRows(g)) in.z = form_.safeguarded(in.z, c, mu);
+    form(g).afterAccept(in, mu);
   });
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
     in.c = c;
-    if (elasticRows(g)) {
-      prepareElasticRow(in, mu, rho_, true, parameters_);
-    } else {
-      in.z = form_.initialMultiplier(c, mu);
-    }
+    form(g).prepare(in, mu, rho_, true);
   });
 }
 
@@ -626,29 +595,14 @@ void FreeTimeSolver::initializeDuals(double mu) {
 /// elastic row: |zs − μ| and |(ρ − z)v − μ|).
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  if (!elastic_) return form_.residual(rows_.groups, stationarity, mu);
-  double worst = stationarity;
-  rows_.forEach([&](const FreeTimeRows& g, int, const FreeTimeRow& in) {
-    if (!elasticRows(g)) {
-      worst = std::max(worst, std::abs(in.z * in.c - mu));
-    } else {
-      worst = std::max({worst, std::abs(in.z * in.s - mu), std::abs((rho_ - in.z) * in.v - mu)});
-    }
-  });
-  return worst;
+  return std::max(stationarity, complementarityOf(rows_, formOf(), mu, rho_).worst);
 }
 
 /// Σ zᵢcᵢ at the assembled point.
 double FreeTimeSolver::dualityGap() const {
-  return form_.dualityGap(rows_.groups);
-}
-
-/// BarrierPoint::lower_bound: on its central path the local minimum of T/T₀ + εC lies at most the
-/// duality gap Σ zc below the iterate's value (weak duality of the barrier problem's Lagrangian,
-/// local), and εC, which vanishes with μ, at most its own size: T − T₀ (Σ zc + εC) [s].
-double FreeTimeSolver::localLowerBound(double gap, double epsilon) const {
-  const double T0 = N_ * h0_;
-  return N_ * np_.timeStep() - T0 * (gap + epsilon * np_.cost(np_.current()));
+  double gap = 0.0;
+  rows_.forEach([&](auto&, int, auto& in) { gap += in.z * in.c; });
+  return gap;
 }
 
 std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double gap,
@@ -657,7 +611,7 @@ std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double
   BarrierPoint point;
   point.mu = mu;
   point.duration = N_ * np_.timeStep();
-  point.lower_bound = localLowerBound(gap, epsilon);
+  point.lower_bound = objective_.lowerBound(np_.timeStep(), gap, np_.cost(np_.current()), epsilon);
   point.attitudes = np_.attitudes(np_.current());
   point.iterations = iterations;
   point.locally_convex = barrierHessianDefinite();
@@ -688,8 +642,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   const int m = rows_.count;
   mu0_ = kInitialBarrier / m;
   mu_final_ = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
-  const double C0 = np_.cost(np_.current());
-  epsilon0_ = C0 > 0 ? kInitialEffortShare / C0 : 0.0;
+  objective_ = MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
   test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
   scales_ = {1.0, 1, N_, mu_final_};
@@ -715,7 +668,7 @@ double FreeTimeSolver::firstBarrier() const {
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
 /// test reads what it measures).
 void FreeTimeSolver::prepare() {
-  epsilon_ = epsilon0_ * std::clamp(mu_ / mu0_, kFinalEffortFraction, 1.0);
+  epsilon_ = objective_.setBarrier(mu_);
   assemble(mu_, epsilon_);
   gap_ = dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
@@ -814,20 +767,14 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
     out.twist_gradient = lagrangian_gradient_(n_ + twistColumn());
   }
+  out.complementarity = dualityGap();
   out.smallest_value = std::numeric_limits<double>::infinity();
+  rows_.forEach(
+      [&](auto&, int, auto& in) { out.smallest_value = std::min(out.smallest_value, in.c); });
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
-  const std::vector<Vector3> tau = np_.torques(out.steps);
-  if (hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    out.complementarity += in.z * in.c;
-    out.smallest_value = std::min(out.smallest_value, in.c);
-    const int a = g.constraint->axis();
-    if (a < 0) return;  // only a box side is affine in one torque axis (and hasTorqueBox())
-    // z⁺ − z⁻ per box axis: the side is the sign of ∂c/∂τ_a (− upper, + lower).
-    const double slope = g.constraint->gradient(tau[k])(a);  // ∂c/∂τ_a: ∓1/a
-    out.torque_multipliers[k](a) -= std::copysign(in.z, slope);
-    out.switching_function[k](a) -= in.z * slope / torqueWeight(k);
-  });
+  if (rows_.hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
+  rows_.addBoxMultipliers(np_, np_.torques(out.steps), &out.switching_function,
+                          &out.torque_multipliers);
   out.maneuver = np_.maneuver(out.steps);
   recordVerdict(
       &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,

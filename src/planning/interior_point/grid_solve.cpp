@@ -181,8 +181,8 @@ class GridSolve final : public PrimalDualProblem {
   void addSlackTerms(double* slope, double* decrement_slope) {
     const ConstrainedSystem::SlackStep slack = system_.slackStep(delta_, mu_);
     alpha_slack_ = slack.alpha;
-    alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
-    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.largestMultiplier(dz_, 0.0));
+    alpha_dual_ = system_.dualStep(delta_, mu_, rho_);
+    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.largestMultiplier(0.0));
     const double without_penalty = *slope + slack.barrier_slope;
     const double fraction = p_.merit_infeasibility_fraction;
     if (slack.residual > 0.0 && without_penalty > -fraction * nu_ * slack.residual) {
@@ -237,9 +237,9 @@ class GridSolve final : public PrimalDualProblem {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
     } else {
-      alpha_dual_ = system_.dualStep(delta_, rho_, &dz_);
+      alpha_dual_ = system_.dualStep(delta_, mu_, rho_);
     }
-    system_.applyDualStep(dz_, std::min(alpha_dual_, 1.0));
+    system_.applyDualStep(std::min(alpha_dual_, 1.0));
     if (np_.hasTwist()) {
       np_.setCurrentWithTwist(trial, alpha * delta_(np_.unknowns()));
     } else {
@@ -382,7 +382,6 @@ class GridSolve final : public PrimalDualProblem {
   double nu_ = 0.0;    ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
   double cost_ = 0.0;  ///< f at the iterate (the line search's φ_μ)
   ReducedProblem::StepVectors trial_;  ///< the line search's trial point
-  std::vector<double> dz_;
   double alpha_dual_ = 1.0, alpha_slack_ = 1.0;
   // The stopping test's memory.
   int iteration_ = 0;

@@ -276,6 +276,25 @@ struct StageTranscription {
   void forEachValue(const QuantityInputs& at, F&& f) const {
     visit(*this, [&](const Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
   }
+  /// Whether a per-axis torque bound is among the rows (a box side: the one constraint affine in
+  /// one torque axis).
+  bool hasTorqueBox() const {
+    return std::any_of(groups.begin(), groups.end(),
+                       [](const Rows& g) { return g.constraint->axis() >= 0; });
+  }
+  /// The box sides' multipliers at the torques τ: σ_k(a) −= z ∂c/∂τ_a / w_k (±z/(a w_k), the
+  /// multipliers' part of the switching function, PlanResult::switching_function) and, with
+  /// `multipliers`, (z⁺ − z⁻)_k(a) −= sign(∂c/∂τ_a) z (the side is that sign: − upper, + lower).
+  void addBoxMultipliers(const ReducedProblem& np, const std::vector<Vector3>& torque,
+                         std::vector<Vector3>* sigma, std::vector<Vector3>* multipliers) const {
+    forEach([&](const Rows& g, int k, const Row& in) {
+      const int a = g.constraint->axis();
+      if (a < 0) return;
+      const double slope = g.constraint->gradient(torque[k])(a);  // ∂c/∂τ_a: ∓1/a
+      if (multipliers) (*multipliers)[k](a) -= std::copysign(in.z, slope);
+      (*sigma)[k](a) -= in.z * slope / np.scheme().torqueWeight(k, np.steps());
+    });
+  }
   /// The cost's stencils at the iterate of `np` with the torque rows: the stencil's second-order
   /// weights are cost(k, ρ) (the cost's own) with the rows contracted into them
   /// (contractTorqueRows, row(group, row, √w) after each value); then visit(stencil, √w), which

@@ -12,7 +12,9 @@
 // (That bound holds in the class's basin, not globally: a class is a lift of the rotation, and
 // lifts two turns apart are one homotopy class on SO(3), whose loops are Z₂, so the interior point
 // can slide from one to the other.) A class whose survey cost is beyond the survey's refine margin
-// of the first class's, raised as much as the constraints raised the first's, is not solved.
+// of the first class's, raised as much as the constraints raised the first's, is not solved. The
+// first-plan check and the other classes' solves are for requests whose constraints are all cones;
+// under torque or rate bounds a converged first class answers.
 #pragma once
 
 #include <vector>

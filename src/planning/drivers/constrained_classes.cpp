@@ -284,14 +284,18 @@ bool listed(const std::vector<HomotopyClass>& classes, const HomotopyClass& c) {
 }
 
 /// Where the first class ended without a plan on the requested grid: every surveyed class under
-/// the constraints on the survey grid, then the converged ones carried to the requested grid in
-/// order of their cost there, each from its own survey-grid plan (a class's plan on a coarse grid
-/// says which side of each cone it passes, which its unconstrained optimum does not: the first
-/// class's solve from that optimum is the one that failed), until one converges within the
-/// constraints between the nodes too. On the requested grid already (no coarser survey), each
-/// class's solve is its answer. Returns the classes solved on the requested grid.
+/// the constraints on the survey grid, then carried to the requested grid. With cones only, each
+/// class's cheapest plan there (cheapestOnGrid) and the converged ones carried in order of their
+/// cost, each from its own coarse plan (a class's plan on a coarse grid says which side of each
+/// cone it passes, which its unconstrained optimum does not: the first class's solve from that
+/// optimum is the one that failed), until one converges within the constraints between the nodes
+/// too. Under torque or rate bounds, the best coarse plan's class alone, if it is another class,
+/// solved from its unconstrained optimum (each further solve there runs to its limit near the
+/// least duration). On the requested grid already (no coarser survey), each class's solve is its
+/// answer. Returns the classes solved on the requested grid.
 std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const SurveyedClasses& surveyed,
-                                               const HomotopyClass& first_class, int steps) {
+                                               const HomotopyClass& first_class, int steps,
+                                               bool cones_only) {
   std::vector<HomotopyClass> solved;
   if (surveyed.steps >= steps) {
     for (const HomotopyClass& c : surveyed.classes) {
@@ -305,13 +309,20 @@ std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const Survey
   std::vector<std::pair<HomotopyClass, PlanResult>> coarse;
   for (const HomotopyClass& c : surveyed.classes) {
     if (search.stopped()) break;
-    PlanResult r = search.cheapestOnGrid(c, surveyed.steps);
+    PlanResult r =
+        cones_only ? search.cheapestOnGrid(c, surveyed.steps) : search.solve(c, surveyed.steps);
     if (r.converged()) coarse.emplace_back(c, std::move(r));
   }
-  std::stable_sort(coarse.begin(), coarse.end(),
-                   [](const auto& a, const auto& b) { return a.second.cost < b.second.cost; });
+  std::stable_sort(coarse.begin(), coarse.end(), [&](const auto& a, const auto& b) {
+    return cones_only ? a.second.cost < b.second.cost : better(a.second, b.second);
+  });
   for (const auto& [c, plan] : coarse) {
     if (search.stopped() || search.holdsAPlanWithinTheConstraints()) break;
+    if (!cones_only) {
+      if (!sameHomotopyClass(c, first_class)) search.offer(search.solve(c, steps));
+      solved.push_back(c);
+      break;
+    }
     search.offer(search.solve(c, steps, ClassStart{nullptr, &plan.maneuver}));
     solved.push_back(c);
   }
@@ -387,7 +398,8 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   if (first.converged() && !conesOnly(problem)) return first;
   const HomotopyClass first_class = survey.known ? survey.homotopy : homotopyClassOf(problem);
   const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
-  if (surveyed.classes.size() < 2 && surveyed.steps >= problem.steps) return first;
+  const bool alone = surveyed.classes.size() < 2;
+  if (alone && (surveyed.steps >= problem.steps || !conesOnly(problem))) return first;
   const std::vector<MessageClause> first_said = first.clauses;
   const bool first_converged = first.converged();
   const double first_cost = first.cost;
@@ -400,13 +412,14 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
     retryFromItsCoarsePlan(search, first_class, first_cost, surveyed.steps, problem.steps);
   } else if (!first_converged) {
     const std::vector<HomotopyClass> carried =
-        carryFromSurveyGrid(search, surveyed, first_class, problem.steps);
+        carryFromSurveyGrid(search, surveyed, first_class, problem.steps, conesOnly(problem));
     solved.insert(solved.end(), carried.begin(), carried.end());
   }
   const double rise =
       search.firstKept() && first_converged ? first_rise : std::numeric_limits<double>::infinity();
-  if (conesOnly(problem))
+  if (conesOnly(problem)) {
     solveClassesThatCouldBeatIt(search, surveyed, solved, rise, problem.steps);
+  }
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);
   if (!first_kept) {

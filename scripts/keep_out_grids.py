@@ -17,6 +17,7 @@ one (its h·cost spread and the solve-time ratio per request are reported beside
 """
 import argparse
 import datetime
+import importlib.util
 import json
 import math
 import os
@@ -26,24 +27,22 @@ import time
 
 import numpy as np
 
+# The uniform rotations and the scene's number format of the homotopy-class suite.
+_spec = importlib.util.spec_from_file_location(
+    "extremal_classes", os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                     "extremal_classes.py"))
+extremal_classes = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(extremal_classes)
+random_rotation = extremal_classes.random_rotation
+quat_to_matrix = extremal_classes.quat_to_matrix
+vec = extremal_classes.vec
+
 CLASSES = [("shortest", 0), ("long_way", 0), ("shortest", 1), ("long_way", 1)]
 RELATIVE = 1e-6  # "the default is the cheapest class": within this relative tolerance
 SPREAD_TARGET = 0.10  # issue 40: h*cost settles in N, spread under 10 %
 END_MARGIN = 0.1  # rad: both ends' boresights at least this far outside the cone
 MIN_ANGLE, MAX_ANGLE = 0.5, math.pi - 0.02  # rad, the slew's rotation angle
 MIN_HALF_ANGLE, MAX_HALF_ANGLE = 0.15, 0.6  # rad, the cone's half angle
-
-
-def random_rotation(rng):
-    q = rng.normal(size=4)
-    return q / np.linalg.norm(q)  # Hamilton (w, x, y, z), uniform on SO(3)
-
-
-def quat_to_matrix(q):
-    w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def axis_angle_quat(axis, angle):
@@ -92,10 +91,6 @@ def draw_case(rng, index):
     return {"index": index, "inertia": J, "q0": q0, "qN": qN, "theta": theta,
             "body_axis": body_axis, "direction": direction, "half_angle": half,
             "T": math.exp(rng.uniform(math.log(10.0), math.log(100.0)))}
-
-
-def vec(v):
-    return "[" + ", ".join("%.17g" % x for x in v) + "]"
 
 
 def scene_text(c):
@@ -176,9 +171,10 @@ def fmt(x):
 
 
 def render(args, cases, results, steps, wall, load):
+    second = steps[1] if len(steps) > 1 else steps[0]  # the spread from the second grid on
     lines = []
     head = ["#", "θ [rad]", "half angle [rad]", "T [s]"] + ["h·cost N = %d" % n for n in steps] + [
-        "spread", "spread N ≥ %d" % steps[1], "largest violation between nodes [rad]",
+        "spread", "spread N ≥ %d" % second, "largest violation between nodes [rad]",
         "default not cheapest at N", "no answer where a class has one"]
     if args.baseline:
         head += ["baseline spread", "solve-time ratio (median over N)"]
@@ -197,7 +193,7 @@ def render(args, cases, results, steps, wall, load):
         for r in rows:
             d = r["default"]
             cells.append(fmt(d["effort"]) if d["converged"] else d["termination"])
-        fine = spread_of(rows, "default", steps[1])
+        fine = spread_of(rows, "default", second)
         fine_spreads.append(fine)
         jumps = [r["default"].get("between_nodes", math.nan) for r in rows]
         jump = max((j for j in jumps if not math.isnan(j)), default=math.nan)
@@ -221,7 +217,7 @@ def render(args, cases, results, steps, wall, load):
                                          100 * statistics.median(spreads) if spreads else math.nan,
                                          100 * max(spreads) if spreads else math.nan),
         "- The same over N ≥ %d: **%d of %d**." % (
-            steps[1], sum(1 for s in fine_spreads if s <= SPREAD_TARGET), len(fine_spreads)),
+            second, sum(1 for s in fine_spreads if s <= SPREAD_TARGET), len(fine_spreads)),
     ]
     if not args.no_classes:
         summary += [

@@ -120,7 +120,6 @@ class ClassSearch {
   /// where they were the solver's own solve). A grid with no boundary step at its h gives no plan.
   PlanResult solve(const HomotopyClass& homotopy, int steps, const ClassStart& start = {}) {
     PlanResult r;
-    r.termination = Termination::NotConverged;
     SolverOptions options = options_;
     options.unconstrained_optimum = start.unconstrained_optimum;
     if (!start.unconstrained_optimum && !start.constrained_plan) {
@@ -129,16 +128,13 @@ class ClassSearch {
     options.warm_start = start.constrained_plan;
     options.constrained_from_warm_start = start.constrained_plan != nullptr;
     const std::size_t before = context_.attempts().size();
-    try {
-      const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
-      r = planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
-    } catch (const StepTooLarge& e) {
-      recordReason(&r, e.what());
-    }
-    iterations_ += r.iterations;
+    r = inClass(homotopy, [&] {
+      return planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
+    });
     // A solve from a constrained plan runs the interior point alone, which names no extremal.
-    if (r.converged() && !r.extremal_summary.known)
+    if (r.converged() && !r.extremal_summary.known) {
       r.extremal_summary = extremalIn(homotopy, steps);
+    }
     // The attempt whose plan r is: its kept one, else its last.
     const std::optional<std::size_t> kept = context_.keptAttempt();
     const std::size_t end = context_.attempts().size();
@@ -159,16 +155,7 @@ class ClassSearch {
       guess = initialGuessOnGrid(*surveyed, pinned);
       options.warm_start = &guess;
     }
-    PlanResult r;
-    r.termination = Termination::NotConverged;
-    try {
-      const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
-      r = solveWithNewton(pinned, options, context_);
-    } catch (const StepTooLarge& e) {
-      recordReason(&r, e.what());
-    }
-    iterations_ += r.iterations;
-    return r;
+    return inClass(homotopy, [&] { return solveWithNewton(pinned, options, context_); });
   }
 
   /// The cheapest converged plan of `homotopy` under the constraints on `steps` steps, from its
@@ -232,6 +219,22 @@ class ClassSearch {
   bool firstKept() const { return !best_tried_; }
 
  private:
+  /// `solve()` in the context's scope of `homotopy`, its iterations counted; a grid with no
+  /// boundary step at its h gives no plan.
+  template <class Solve>
+  PlanResult inClass(const HomotopyClass& homotopy, Solve&& solve) {
+    PlanResult r;
+    r.termination = Termination::NotConverged;
+    try {
+      const SolveContext::Scope scope(context_, AttemptStage::ConstrainedClass, homotopy);
+      r = solve();
+    } catch (const StepTooLarge& e) {
+      recordReason(&r, e.what());
+    }
+    iterations_ += r.iterations;
+    return r;
+  }
+
   /// The extremal of a plan of `homotopy` on `steps` steps: its class's lift.
   ExtremalSummary extremalIn(const HomotopyClass& homotopy, int steps) const {
     const PlanningProblem pinned = pinnedTo(problem_, homotopy, steps);

@@ -39,7 +39,7 @@ vec = extremal_classes.vec
 
 CLASSES = [("shortest", 0), ("long_way", 0), ("shortest", 1), ("long_way", 1)]
 RELATIVE = 1e-6  # "the default is the cheapest class": within this relative tolerance
-SPREAD_TARGET = 0.10  # issue 40: h*cost settles in N, spread under 10 %
+SPREAD_TARGET = 0.10  # the target: h*cost settles in N, spread under 10 %
 END_MARGIN = 0.1  # rad: both ends' boresights at least this far outside the cone
 MIN_ANGLE, MAX_ANGLE = 0.5, math.pi - 0.02  # rad, the slew's rotation angle
 MIN_HALF_ANGLE, MAX_HALF_ANGLE = 0.15, 0.6  # rad, the cone's half angle

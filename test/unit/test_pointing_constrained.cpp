@@ -159,6 +159,15 @@ void expectOneProblemAtMostTheSweep(const PlanningProblem& p) {
   EXPECT_DOUBLE_EQ(cheapest, r.cost);
 }
 
+/// The generator's spinning request `seed` under a torque box (paper, N = 32) at 0.8 of its T:
+/// every start ends certified locally infeasible.
+PlanningProblem spinningUnderATorqueBoxAtFourFifthsOfT(unsigned seed) {
+  PlanningProblem p = test_support::randomConstrainedPointingRequest(
+      seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
+  p.duration *= 0.8;
+  return p;
+}
+
 }  // namespace
 
 TEST(ConstrainedPointingPlan, KeepOutConeAtMostTheSweepsBest) {
@@ -195,10 +204,7 @@ TEST(ConstrainedPointingPlan, LocalInfeasibilityCertifiedFromEnoughStartsEndsThe
   // stage solve) are not run; the verdict is not converged or infeasible, never converged.
   for (unsigned seed : {231u, 232u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    PlanningProblem p = test_support::randomConstrainedPointingRequest(
-        seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
-    p.duration *= 0.8;
-    const PlanResult r = planManeuver(p);
+    const PlanResult r = planManeuver(spinningUnderATorqueBoxAtFourFifthsOfT(seed));
     EXPECT_FALSE(r.converged()) << r.message();
     std::set<std::pair<long, bool>> certified;
     int fixed_twist_interior_points = 0;
@@ -283,9 +289,7 @@ TEST(ConstrainedPointingPlan, AnInfeasibleAnswerSolvesMinimumTimeOverTheTwistOnl
   // verdict names the least T over the twist, above T.
   for (unsigned seed : {231u, 232u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    PlanningProblem p = test_support::randomConstrainedPointingRequest(
-        seed, 32, true, SchemeKind::Paper, PointingBinding::TorqueBox);
-    p.duration *= 0.8;
+    const PlanningProblem p = spinningUnderATorqueBoxAtFourFifthsOfT(seed);
     const PlanResult r = planManeuver(p);
     EXPECT_FALSE(r.converged()) << r.message();
     int over_the_twist = 0;

@@ -304,6 +304,37 @@ TEST(ExtremalClasses, UnderAKeepOutConeTheDefaultIsNoCostlierThanAnyClassOnEvery
   EXPECT_GE(compared, kCases);
 }
 
+// Seeded keep-out slews on a coarse grid: the answer keeps the basin the finer grid's answer is
+// in (h·cost within the paper scheme's own discretization between N = 32 and 64, about 5 %, and
+// the 10 % the issue allows). Before, where the plan round the cone cut it between two nodes by
+// more than 1e-3 rad, a costlier class that holds it answered (seed 7002's first request: h·cost
+// 0.60 at N = 32 against 0.18 at N = 64); now that plan is solved again from itself with the
+// cone's node bound tightened by the margin its longest step needs, and says so.
+TEST(ExtremalClasses, OnACoarseGridTheAnswerKeepsItsBasinWhereThePlanRoundTheConeCutsIt) {
+  constexpr int kCases = 12;
+  Draw draw(7002);
+  int tightened = 0;
+  for (int i = 0; i < kCases; ++i) {
+    PlanningProblem p = keepOutSlew(draw);
+    double effort[2];
+    for (int j = 0; j < 2; ++j) {
+      p.steps = j == 0 ? 32 : 64;
+      const PlanResult r = planManeuver(p);
+      ASSERT_TRUE(r.converged()) << i << ", N = " << p.steps << ": " << r.message();
+      effort[j] = r.cost * p.duration / p.steps;
+      const bool held = std::any_of(r.clauses.begin(), r.clauses.end(), [](const auto& c) {
+        const Note* note = std::get_if<Note>(&c);
+        return note && std::holds_alternative<notes::ConesTightenedBetweenNodes>(*note);
+      });
+      if (!held) continue;
+      ++tightened;
+      EXPECT_LE(r.max_violation_between_nodes, 1e-3) << i << ", N = " << p.steps;
+    }
+    EXPECT_LE(effort[0], 1.10 * effort[1]) << i;
+  }
+  std::printf("%d answers from tightened node bounds\n", tightened);
+}
+
 // The starts on either side of a cone: each puts the deepest violating node's boresight
 // kConeSideOffset half angles off the cone's axis, the two on opposite sides of the great circle
 // through the axis along the path there; the boundary nodes keep their attitudes and every

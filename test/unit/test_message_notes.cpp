@@ -53,6 +53,7 @@ TEST(MessageNotes, EveryKindIsOneClauseThatBeginsWithItsSeparator) {
       notes::LastIterateDoesNotReplay{"r"},
       notes::OpenLoopReplayParted{"r", 1e-12},
       notes::CheapestClass{said("r")},
+      notes::ConesTightenedBetweenNodes{0.004, 0.006},
       notes::LastPointingStart{"r"},
       notes::FixedTwistFallback{0.5, "r"},
       notes::PointingRestartNotServed{3.5},

@@ -88,6 +88,14 @@ struct OpenLoopReplayParted {
 struct CheapestClass {
   MessageClauses reason;  ///< the first class's (the unconstrained optimum's) clauses
 };
+/// A class's plan that cut a cone between nodes (by `cut` rad past its half angle), solved again
+/// from itself with every cone's node bound tightened by up to `margin` rad: the margin its
+/// longest step needs (PlanningConstraint::margin, requiredConeMargin), so the motion between
+/// the nodes keeps the cones too.
+struct ConesTightenedBetweenNodes {
+  double cut = 0.0;
+  double margin = 0.0;
+};
 /// A pointing request where no start converged: the last start's reason.
 struct LastPointingStart {
   std::string reason;
@@ -181,7 +189,8 @@ using Note =
                  notes::RetriedInTwoStages, notes::FromInitialGuess, notes::CoarserLevel,
                  notes::RefinedFromSurvey, notes::ConstraintsInactive, notes::UnconstrainedStart,
                  notes::AfterGuessStopped, notes::LastIterateDoesNotReplay,
-                 notes::OpenLoopReplayParted, notes::CheapestClass, notes::LastPointingStart,
+                 notes::OpenLoopReplayParted, notes::CheapestClass,
+                 notes::ConesTightenedBetweenNodes, notes::LastPointingStart,
                  notes::FixedTwistFallback, notes::PointingRestartNotServed, notes::SearchSummary,
                  notes::SearchedOnT, notes::SharpenedFromSearch, notes::PlannedAtMargin,
                  notes::MinimumTimeRestart, notes::RestartEnded, notes::MinimumTimeUnsolved,

@@ -72,6 +72,49 @@ bool better(const PlanResult& r, const PlanResult& best) {
   return r.cost < best.cost;
 }
 
+/// Whether every constraint of the request is a cone (no torque bound, norm or rate limit).
+bool conesOnly(const PlanningProblem& problem) {
+  return !problem.hasTorqueBounds() &&
+         std::all_of(problem.constraints.begin(), problem.constraints.end(),
+                     [](const PlanningConstraint& c) { return c.isCone(); });
+}
+
+/// Whether a converged plan cuts a cone between two nodes by more than the slack.
+bool cutsBetweenNodes(const PlanResult& r) {
+  return r.converged() && r.max_violation_between_nodes > kBetweenNodesSlack;
+}
+
+/// The longest step |log(R_kᵀ R_{k+1})| of a plan [rad].
+double longestStepAngle(const Maneuver& plan) {
+  double longest = 0.0;
+  for (int k = 0; k < plan.steps(); ++k) {
+    const Matrix3 step = plan.attitude[k].transpose() * plan.attitude[k + 1];
+    longest = std::max(longest, so3::log(step).norm());
+  }
+  return longest;
+}
+
+/// How much longer than a plan's longest step the steps of its re-solve at tightened node bounds
+/// may be (the detour round the wider cone), docs/notes/constraints_notes.md "Between nodes".
+constexpr double kTightenedDetour = 1.25;
+
+/// `problem` with each cone's node bound tightened by the margin that keeps the cone between
+/// nodes over steps up to `step_angle` (requiredConeMargin; a cone's own margin where larger),
+/// and that margin (the largest); nothing where a cone's node bound would leave (0, π).
+std::optional<std::pair<PlanningProblem, double>> tightenedForSteps(const PlanningProblem& problem,
+                                                                    double step_angle) {
+  PlanningProblem out = problem;
+  double largest = 0.0;
+  for (PlanningConstraint& c : out.constraints) {
+    if (!c.isCone()) continue;
+    c.margin = std::max(c.margin, requiredConeMargin(c, step_angle));
+    const double node = c.nodeHalfAngle();
+    if (!std::isfinite(c.margin) || !(node > 0.0 && node < M_PI)) return std::nullopt;
+    largest = std::max(largest, c.margin);
+  }
+  return std::make_pair(std::move(out), largest);
+}
+
 /// One class's constrained solve, as the extremal's entry.
 Attempt classAttempt(const HomotopyClass& homotopy, const PlanResult& r, int steps,
                      AttemptStart start) {
@@ -114,11 +157,18 @@ class ClassSearch {
         best_(std::move(first)),
         kept_(context.keptAttempt()) {
     options_.enumerate_classes = false;  // each solve in its own class
+    if (cutsBetweenNodes(best_)) cheapest_cut_ = CutPlan{first_class, best_};
   }
 
   /// One solve of `homotopy` on `steps` steps from `start` (its attempts named constrained_class
   /// where they were the solver's own solve). A grid with no boundary step at its h gives no plan.
   PlanResult solve(const HomotopyClass& homotopy, int steps, const ClassStart& start = {}) {
+    return solveProblem(problem_, homotopy, steps, start);
+  }
+
+  /// `solve` of `problem` (the request, or the request with tightened cones).
+  PlanResult solveProblem(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps,
+                          const ClassStart& start) {
     PlanResult r;
     SolverOptions options = options_;
     options.unconstrained_optimum = start.unconstrained_optimum;
@@ -129,7 +179,7 @@ class ClassSearch {
     options.constrained_from_warm_start = start.constrained_plan != nullptr;
     const std::size_t before = context_.attempts().size();
     r = inClass(homotopy, [&] {
-      return planAtResolution(pinnedTo(problem_, homotopy, steps), options, context_);
+      return planAtResolution(pinnedTo(problem, homotopy, steps), options, context_);
     });
     // A solve from a constrained plan runs the interior point alone, which names no extremal.
     if (r.converged() && !r.extremal_summary.known) {
@@ -179,8 +229,28 @@ class ClassSearch {
     return best;
   }
 
-  /// Keeps r (a plan on the requested grid) if it is better than the best so far.
-  void offer(PlanResult r) {
+  /// Keeps r (a plan of `homotopy` on the requested grid) if it is better than the best so far,
+  /// and the cheapest plan that cut a cone between nodes (for holdTheCheapestBetweenNodes).
+  void offer(const HomotopyClass& homotopy, PlanResult r) {
+    if (cutsBetweenNodes(r) && (!cheapest_cut_ || r.cost < cheapest_cut_->plan.cost)) {
+      cheapest_cut_ = CutPlan{homotopy, r};
+    }
+    offerAsIs(std::move(r));
+  }
+
+  /// Where the best plan holds the cones between nodes and a cheaper plan cut one (`better`
+  /// passed it over for that): the cheaper plan's class re-solved from it at node bounds
+  /// tightened so its motion keeps the cones between the nodes too (offerHeldBetweenNodes), so a
+  /// coarse grid's cut does not hand the answer to a costlier class.
+  void holdTheCheapestBetweenNodes() {
+    if (!cheapest_cut_ || !holdsAPlanWithinTheConstraints()) return;
+    if (cheapest_cut_->plan.cost >= best_.cost) return;
+    const CutPlan cut = *cheapest_cut_;
+    offerHeldBetweenNodes(cut.homotopy, cut.plan.maneuver, cut.plan.max_violation_between_nodes);
+  }
+
+  /// Keeps r if it is better than the best so far.
+  void offerAsIs(PlanResult r) {
     if (!better(r, best_)) return;
     best_ = std::move(r);
     best_tried_ = tried_.size() - 1;
@@ -219,6 +289,21 @@ class ClassSearch {
   bool firstKept() const { return !best_tried_; }
 
  private:
+  /// A plan that cut a cone between nodes (by `cut`) re-solved from itself, its class pinned, at
+  /// node bounds tightened for steps up to kTightenedDetour times its longest (the class keeps
+  /// its side of each cone; the plan's own steps fix the margin, which no grid alone does), and
+  /// offered with the note of the margin.
+  void offerHeldBetweenNodes(const HomotopyClass& homotopy, const Maneuver& plan, double cut) {
+    if (stopped()) return;
+    const auto tightened = tightenedForSteps(problem_, kTightenedDetour * longestStepAngle(plan));
+    if (!tightened) return;
+    PlanResult held =
+        solveProblem(tightened->first, homotopy, problem_.steps, ClassStart{nullptr, &plan});
+    if (!held.converged()) return;
+    addNote(&held, notes::ConesTightenedBetweenNodes{cut, tightened->second});
+    offerAsIs(std::move(held));
+  }
+
   /// `solve()` in the context's scope of `homotopy`, its iterations counted; a grid with no
   /// boundary step at its h gives no plan.
   template <class Solve>
@@ -271,15 +356,13 @@ class ClassSearch {
   std::optional<std::size_t> kept_;        ///< the best plan's attempt in the context's trail
   std::optional<std::size_t> last_kept_;   ///< the last solve's
   std::optional<std::size_t> best_tried_;  ///< empty: `first` is kept
+  struct CutPlan {
+    HomotopyClass homotopy;
+    PlanResult plan;
+  };
+  std::optional<CutPlan> cheapest_cut_;  ///< the cheapest converged plan that cut a cone
   int iterations_ = 0;
 };
-
-/// Whether every constraint of the request is a cone (no torque bound, norm or rate limit).
-bool conesOnly(const PlanningProblem& problem) {
-  return !problem.hasTorqueBounds() &&
-         std::all_of(problem.constraints.begin(), problem.constraints.end(),
-                     [](const PlanningConstraint& c) { return c.isCone(); });
-}
 
 bool listed(const std::vector<HomotopyClass>& classes, const HomotopyClass& c) {
   return std::any_of(classes.begin(), classes.end(),
@@ -304,7 +387,7 @@ std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const Survey
     for (const HomotopyClass& c : surveyed.classes) {
       if (search.stopped()) break;
       if (sameHomotopyClass(c, first_class)) continue;  // `first` is that solve
-      search.offer(search.solve(c, steps));
+      search.offer(c, search.solve(c, steps));
       solved.push_back(c);
     }
     return solved;
@@ -322,11 +405,11 @@ std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const Survey
   for (const auto& [c, plan] : coarse) {
     if (search.stopped() || search.holdsAPlanWithinTheConstraints()) break;
     if (!cones_only) {
-      if (!sameHomotopyClass(c, first_class)) search.offer(search.solve(c, steps));
+      if (!sameHomotopyClass(c, first_class)) search.offer(c, search.solve(c, steps));
       solved.push_back(c);
       break;
     }
-    search.offer(search.solve(c, steps, ClassStart{nullptr, &plan.maneuver}));
+    search.offer(c, search.solve(c, steps, ClassStart{nullptr, &plan.maneuver}));
     solved.push_back(c);
   }
   return solved;
@@ -354,7 +437,8 @@ void retryFromItsCoarsePlan(ClassSearch& search, const HomotopyClass& first_clas
     const PlanResult plan = search.cheapestOnGrid(first_class, coarse);
     if (!plan.converged()) continue;
     if (plan.cost / coarse >= first_cost / steps || search.stopped()) return;
-    search.offer(search.solve(first_class, steps, ClassStart{nullptr, &plan.maneuver}));
+    search.offer(first_class,
+                 search.solve(first_class, steps, ClassStart{nullptr, &plan.maneuver}));
     return;
   }
 }
@@ -384,7 +468,7 @@ void solveClassesThatCouldBeatIt(ClassSearch& search, const SurveyedClasses& sur
     if (listed(solved, c) || !couldBeatOnTheSurvey(surveyed, i, rise)) continue;
     const PlanResult optimum = search.unconstrainedOptimum(c, steps);
     if (!optimum.converged() || !search.couldBeat(optimum.cost)) continue;
-    search.offer(search.solve(c, steps, ClassStart{&optimum.maneuver, nullptr}));
+    search.offer(c, search.solve(c, steps, ClassStart{&optimum.maneuver, nullptr}));
   }
 }
 
@@ -422,6 +506,7 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
       search.firstKept() && first_converged ? first_rise : std::numeric_limits<double>::infinity();
   if (conesOnly(problem)) {
     solveClassesThatCouldBeatIt(search, surveyed, solved, rise, problem.steps);
+    search.holdTheCheapestBetweenNodes();
   }
   const bool first_kept = search.firstKept();
   PlanResult result = search.finish(survey, first_class);

@@ -82,6 +82,11 @@ std::string words(const CheapestClass& n) {
          "optimum's class: " +
          renderClauses(n.reason) + ")";
 }
+std::string words(const ConesTightenedBetweenNodes& n) {
+  return "; the cones' node bounds tightened by up to " + exactNumber(n.margin) +
+         " rad (the class's plan at the nodes' bounds cut a cone by " + exactNumber(n.cut) +
+         " rad between two nodes; this margin keeps the motion between the nodes outside it)";
+}
 std::string words(const LastPointingStart& n) {
   return "; the last: " + n.reason;
 }

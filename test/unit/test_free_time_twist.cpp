@@ -240,7 +240,7 @@ void checkRowsAlongDirections(const PlanningProblem& p, const ReducedProblem& rp
   double largest = 0.0;
   rows.forEach([&](const auto& g, int k, const auto& in) {
     const double slope = rows.dot(rp, g, k, in.g, d), fd = (plus[i] - minus[i]) / (2 * e);
-    EXPECT_NEAR(slope, fd, 1e-6 * (std::abs(fd) + 1.0)) << "row " << i;
+    EXPECT_NEAR(slope, fd, 1e-8 * (std::abs(fd) + 1.0)) << "row " << i;
     Eigen::VectorXd scattered = Eigen::VectorXd::Zero(m);
     rows.addRow(rp, g, k, in.g, 1.0, &scattered);
     EXPECT_NEAR(scattered.dot(d), slope, 1e-13 * (std::abs(slope) + 1.0)) << "row " << i;

@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/free_time_twist.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 #include "support/perturbed_problem.hpp"
 #include "support/pointing_requests.hpp"
 
@@ -180,6 +182,91 @@ TEST(FreeTimeTwist, ConeAndRateRowsOnTheNodesTheTwistMovesMatchCentralDifference
                                (2 * e);
     EXPECT_LT((fd - got.nodes).cwiseAbs().maxCoeff(),
               1e-5 * (got.nodes.cwiseAbs().maxCoeff() + 1.0));
+  }
+}
+
+/// Every row's gradient over the transcription's unknowns, formed through its passes (the torque
+/// rows in the cost's stencil pass, the others by quantity) with no barrier form.
+template <typename TimeStep>
+void formGradients(StageTranscription<TimeStep>* rows, const ReducedProblem& rp,
+                   const TimeStep& step) {
+  using Rows = typename StageTranscription<TimeStep>::Rows;
+  using Row = typename StageTranscription<TimeStep>::Row;
+  const auto cost = [](int, const Vector3& r) { return r; };
+  const auto row = [](const Rows&, Row&, double) {};
+  rows->forEachTorqueStencil(rp, step, false, cost, row,
+                             [&](const typename TimeStep::Stencil& st, double root) {
+                               rows->chainTorques(st, root, step.jacobian(st),
+                                                  [](const Rows&, const Row&, const Vector3&) {});
+                             });
+  for (const std::vector<int>& block : rows->blocks) {
+    rows->forEachQuantityInstance(
+        rp, step, block, false, [](int) {}, [](const Rows&, Row&) {},
+        [](const auto&, const auto*) {});
+  }
+}
+
+/// The rows' values after the transcription's move by t·d over (δ, η, ψ): h first (free time's
+/// order), then the nodes and the twist (retract, accept).
+template <typename TimeStep>
+std::vector<double> valuesMovedBy(const StageTranscription<TimeStep>& rows,
+                                  const ReducedProblem& rp, const Eigen::VectorXd& d, double t,
+                                  double h0) {
+  ReducedProblem q = rp;
+  if constexpr (TimeStep::kEntries == 10) q.setTimeStep(rp.timeStep() + t * h0 * d(rp.unknowns()));
+  StageTranscription<TimeStep>::accept(q, StageTranscription<TimeStep>::retract(q, d, t), d, t);
+  std::vector<double> c;
+  rows.forEachValue(QuantityInputs(q, q.current()),
+                    [&](const auto&, int, const auto&, double value) { c.push_back(value); });
+  return c;
+}
+
+/// One time step's rows: gᵀd (dot) against central differences of the values along d over every
+/// unknown, and addRow its adjoint.
+template <typename TimeStep>
+void checkRowsAlongDirections(const PlanningProblem& p, const ReducedProblem& rp,
+                              const TimeStep& step, std::mt19937* rng) {
+  const StageConstraints constraints = buildStageConstraints(p);
+  StageTranscription<TimeStep> rows(constraints, rp);
+  formGradients(&rows, rp, step);
+  const int m = rp.unknowns() + TimeStep::globals(rp);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::VectorXd d(m);
+  for (int i = 0; i < m; ++i) d(i) = 1e-2 * normal(*rng);
+  const double e = 1e-5;
+  const std::vector<double> plus = valuesMovedBy(rows, rp, d, e, rp.timeStep());
+  const std::vector<double> minus = valuesMovedBy(rows, rp, d, -e, rp.timeStep());
+  std::size_t i = 0;
+  double largest = 0.0;
+  rows.forEach([&](const auto& g, int k, const auto& in) {
+    const double slope = rows.dot(rp, g, k, in.g, d), fd = (plus[i] - minus[i]) / (2 * e);
+    EXPECT_NEAR(slope, fd, 1e-8 * (std::abs(fd) + 1.0)) << "row " << i;
+    Eigen::VectorXd scattered = Eigen::VectorXd::Zero(m);
+    rows.addRow(rp, g, k, in.g, 1.0, &scattered);
+    EXPECT_NEAR(scattered.dot(d), slope, 1e-13 * (std::abs(slope) + 1.0)) << "row " << i;
+    largest = std::max(largest, std::abs(slope));
+    ++i;
+  });
+  EXPECT_EQ(i, plus.size());
+  EXPECT_GT(largest, 0.0);  // the direction moves the rows
+}
+
+TEST(TranscriptionRows, TheirSlopeOverNodesTimeStepAndTwistMatchesCentralDifferences) {
+  std::mt19937 rng(49);
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    // Spinning ends, a pointing end (ψ free), a cone off the boresight, a rate limit and a torque
+    // bound: every quantity's rows, on the nodes ψ and h move.
+    PlanningProblem p = test_support::randomPointingRequest(31, 24, true, scheme);
+    p.final_attitude = pointingAttitude(p.end_condition, 0.4);
+    const Vector3 other = p.end_condition.body_axis.unitOrthogonal();
+    p.constraints.push_back(PlanningConstraint::keepOut(other, Vector3(0.3, -0.5, 0.8), 0.2));
+    p.constraints.push_back(PlanningConstraint::maxAngularRate(10.0));
+    p.constraints.push_back(PlanningConstraint::maxTorqueNorm(50.0));
+    const ReducedProblem rp = test_support::perturbedReducedProblem(p, 11);
+    ASSERT_TRUE(rp.hasTwist());
+    checkRowsAlongDirections(p, rp, FixedTimeStep{}, &rng);
+    checkRowsAlongDirections(p, rp, FreeTimeStep{rp.timeStep()}, &rng);
   }
 }
 

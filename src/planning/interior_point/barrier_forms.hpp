@@ -237,5 +237,20 @@ struct MeritSum {
   }
   double value() const { return inside ? phi : std::numeric_limits<double>::infinity(); }
 };
+/// Adds the rows' merit terms (BarrierForm::rowMerit) to `sum`: at the rows' own values c, or,
+/// with `at`, at their values there (the rows untouched: a trial point's, each checked against
+/// the row's accepted c).
+template <typename Rows, typename FormOf>
+void addRowMerits(const Rows& rows, const FormOf& form, const QuantityInputs* at, double mu,
+                  double rho, double alpha, bool check_boundary, MeritSum* sum) {
+  const auto add = [&](auto& g, int, auto& in, double c) {
+    sum->add(form(g).rowMerit(in, c, mu, rho, alpha, check_boundary));
+  };
+  if (at) {
+    rows.forEachValue(*at, add);
+  } else {
+    rows.forEach([&](auto& g, int k, auto& in) { add(g, k, in, in.c); });
+  }
+}
 
 }  // namespace attitude_planner

@@ -45,20 +45,11 @@ void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, Twist
   addNodeVector(np, g, weight * ge, first_node, width, border->column);
 }
 
-/// gᵀ dδ over the local nodes (fixed nodes contribute nothing), plus gᵀe dψ with a twist (the
-/// last entry of d).
-double localDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, int first_node,
-                int width, const Eigen::VectorXd& d) {
-  double sum = addNodeDot(np, g, first_node, width, d, 0.0);
-  if (np.hasTwist()) sum += g.dot(localTwistMotion(np, first_node, width)) * d(np.unknowns());
-  return sum;
-}
-
+/// weight·g over the local nodes and, with a twist, ψ (a stencil's gradient).
 void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, double weight,
                     int first_node, int width, Eigen::VectorXd* out) {
   addNodeVector(np, g, weight, first_node, width, *out);
-  if (np.hasTwist())
-    (*out)(np.unknowns()) += weight * g.dot(localTwistMotion(np, first_node, width));
+  FixedTimeStep::addGlobals(np, g, weight, first_node, width, out);
 }
 
 }  // namespace
@@ -77,7 +68,7 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
 void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const QuantityInputs at(np_, steps);
-  rows_.forEachValue(at, [](FixedStepRows&, int, FixedStepRow& in, double c) { in.c = c; });
+  rows_.evaluate(at);
   if (torques_out) *torques_out = at.torques();
 }
 
@@ -92,8 +83,7 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
 
 double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
   MeritSum phi;
-  rows_.forEach(
-      [&](auto&, int, auto& in) { phi.add(form_->rowMerit(in, in.c, mu, rho, alpha, false)); });
+  addRowMerits(rows_, formOf(), nullptr, mu, rho, alpha, false, &phi);
   return phi.value();
 }
 
@@ -195,11 +185,8 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
 void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) const {
   rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const int first = k + g.support.node_offset;
-    if (form_->barrierInMeritGradient()) {
-      addLocalVector(np_, in.g, -mu / in.s, first, g.support.width, merit_gradient);
-    }
-    addLocalVector(np_, in.g, form_->terms(in, mu).rhs, first, g.support.width, rhs);
+    if (form_->barrierInMeritGradient()) rows_.addRow(np_, g, k, in.g, -mu / in.s, merit_gradient);
+    rows_.addRow(np_, g, k, in.g, form_->terms(in, mu).rhs, rhs);
   });
 }
 
@@ -213,7 +200,7 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
   std::vector<double> ds, dz;
   rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const double lin = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
+    const double lin = rows_.dot(np_, g, k, in.g, d);
     ds.push_back(lin + in.c - in.s);
     dz.push_back((-in.c - lin) / in.D);
     if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
@@ -238,8 +225,7 @@ void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* pro
                                                   Eigen::VectorXd* out) const {
   std::size_t i = 0;
   rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const double weight = products ? -(*products)[i++] / in.s : 1.0 / in.s;
-    addLocalVector(np_, in.g, weight, k + g.support.node_offset, g.support.width, out);
+    rows_.addRow(np_, g, k, in.g, products ? -(*products)[i++] / in.s : 1.0 / in.s, out);
   });
 }
 
@@ -256,7 +242,7 @@ void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<do
 /// and the steps dz themselves (stored in `dz`, instance order).
 double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double mu, double rho) {
   const auto slope = [&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    return localDot(np_, in.g, k + g.support.node_offset, g.support.width, d);
+    return rows_.dot(np_, g, k, in.g, d);
   };
   return dualSteps(rows_, formOf(), slope, mu, rho);
 }
@@ -264,7 +250,7 @@ double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double mu, double r
 ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
   SlackStep step;
   rows_.forEach([&](const FixedStepRows& g, int k, FixedStepRow& in) {
-    in.ds = localDot(np_, in.g, k + g.support.node_offset, g.support.width, d) + in.c - in.s;
+    in.ds = rows_.dot(np_, g, k, in.g, d) + in.c - in.s;
     if (in.ds < 0) {
       step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
     }
@@ -337,7 +323,7 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
     np_.evaluate(&residual, nullptr, &unused);  // ∇f
   }
   rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    addLocalVector(np_, in.g, -in.z, k + g.support.node_offset, g.support.width, &residual);
+    rows_.addRow(np_, g, k, in.g, -in.z, &residual);
   });
   twist_gradient_ = np_.hasTwist() ? residual(np_.unknowns()) : 0.0;
   twist_stationarity_ = scale > 0 ? std::abs(twist_gradient_) / scale : 0.0;

@@ -53,7 +53,7 @@ class ConstrainedSystem final : public BarrierRows {
 
   int constraintCount() const { return rows_.count; }
   /// Global unknowns beside the node unknowns: 1 (ψ) with a pointing end condition, else 0.
-  int globals() const { return np_.hasTwist() ? 1 : 0; }
+  int globals() const { return FixedTimeStep::globals(np_); }
   /// The last assembly's ψ border (globals() == 1 only).
   const TwistBorder& twistBorder() const { return twist_border_; }
   /// ∂L/∂ψ = ∂f/∂ψ − Σ zᵢ∂cᵢ/∂ψ [N²·m²/rad] and its size relative as relativeStationarity's

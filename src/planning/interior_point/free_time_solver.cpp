@@ -193,34 +193,23 @@ class FreeTimeSolver final : public PrimalDualProblem {
     return [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); };
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
-  int borderSize() const { return 1 + (np_.hasTwist() ? 1 : 0); }
+  int borderSize() const { return FreeTimeStep::globals(np_); }
   /// ψ's column of the border (the last; its unknown is n_ + twistColumn()).
   int twistColumn() const { return borderSize() - 1; }
-  /// The ψ-component gᵀe of a row's local gradient (0 without a pointing end condition).
-  double twistComponent(const FreeTimeRows& g, int k,
-                        const Eigen::Matrix<double, 10, 1>& gradient) const {
-    if (!np_.hasTwist()) return 0.0;
-    return gradient.head<9>().dot(
-        localTwistMotion(np_, k + g.support.node_offset, g.support.width));
-  }
-
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
-    double smallest = std::numeric_limits<double>::infinity();
-    rows_.forEachValue(QuantityInputs(np_, steps), [&](auto& g, int, auto&, double c) {
-      if (g.quantity->dependsOnTimeStep() == time_dependent) smallest = std::min(smallest, c);
+    return rows_.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
+      return g.quantity->dependsOnTimeStep() == time_dependent;
     });
-    return smallest;
   }
 
   /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
     MeritSum sum{objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon)};
-    rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
-      sum.add(form(g).rowMerit(in, c, mu, rho_, 0.0, check_boundary));
-    });
+    const QuantityInputs at(np_, np_.current());
+    addRowMerits(rows_, formOf(), &at, mu, rho_, 0.0, check_boundary, &sum);
     return sum.value();
   }
 
@@ -235,8 +224,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void scatterTwist(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                     const Eigen::Matrix<double, 10, 1>& rhs,
                     const Eigen::Matrix<double, 10, 1>& lagrangian);
-  /// The iterate's nodes moved by α d (and R_N by α dψ with a pointing end).
-  void moveNodes(const Eigen::VectorXd& d, double alpha);
   /// Back to the accepted R_N with the accepted steps (a trial's twist moved it).
   void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
@@ -286,13 +273,10 @@ class FreeTimeSolver final : public PrimalDualProblem {
   Pass end(Termination t, const std::string& why);
   /// Ends the solve converged, with the second-order check.
   Pass converged(const std::string& why);
-  double localDot(const FreeTimeRows& g, int k, const Eigen::Matrix<double, 10, 1>& gradient,
-                  const Eigen::VectorXd& d) const;
   void dualStep(const Eigen::VectorXd& d, double mu);
   double meritSlope(const Eigen::VectorXd& d) const;
   void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
-  double dualityGap() const;
   /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
   bool barrierHessianDefinite() const;
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
@@ -470,16 +454,6 @@ void FreeTimeSolver::scatterTwist(int first_node, int width, const Eigen::Matrix
   kkt_.corner(p, p) += t.twist;
 }
 
-void FreeTimeSolver::moveNodes(const Eigen::VectorXd& d, double alpha) {
-  if (!np_.hasTwist()) {
-    np_.setCurrent(np_.retract(d.head(n_), alpha));
-    return;
-  }
-  const double twist_step = alpha * d(n_ + twistColumn());
-  np_.setCurrentWithTwist(np_.retractWithTwist(d.head(n_), d(n_ + twistColumn()), alpha),
-                          twist_step);
-}
-
 void FreeTimeSolver::restoreAcceptedEnd() {
   if (np_.hasTwist()) np_.setCurrentWithFinalAttitude(accepted_.steps, accepted_end_);
 }
@@ -490,7 +464,8 @@ void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
   np_.setCurrent(accepted_.steps);
   restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h + alpha * h0_ * d(n_));
-  moveNodes(d, alpha);
+  // The iterate's nodes moved by α d (and R_N by α dψ with a pointing end).
+  rows_.accept(np_, rows_.retract(np_, d, alpha), d, alpha);
 }
 
 double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
@@ -525,13 +500,11 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
   rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int k, auto& in, double c) {
-    in.r = c - in.c - localDot(g, k, in.g, d);
+    in.r = c - in.c - rows_.dot(np_, g, k, in.g, d);
     const double w = -form(g).terms(in, 0.0).weight * in.r;
     if (w == 0.0) return;
     curved = true;
-    v(n_) += w * in.g(9);
-    if (np_.hasTwist()) v(n_ + twistColumn()) += w * twistComponent(g, k, in.g);
-    addNodeVector(np_, in.g.template head<9>(), w, k + g.support.node_offset, g.support.width, v);
+    rows_.addRow(np_, g, k, in.g, w, &v);
   });
   if (!curved) return false;
   step_factor_.solve(&v);
@@ -544,20 +517,12 @@ void FreeTimeSolver::clearCorrection() {
   rows_.forEach([](FreeTimeRows&, int, FreeTimeRow& in) { in.r = 0.0; });
 }
 
-double FreeTimeSolver::localDot(const FreeTimeRows& g, int k,
-                                const Eigen::Matrix<double, 10, 1>& gradient,
-                                const Eigen::VectorXd& d) const {
-  double sum = gradient(9) * d(n_);
-  if (np_.hasTwist()) sum += twistComponent(g, k, gradient) * d(n_ + twistColumn());
-  return addNodeDot(np_, gradient.head<9>(), k + g.support.node_offset, g.support.width, d, sum);
-}
-
 /// dz = μ/c − z − (z/c) (gᵀd + r) at the assembled point (r: the second-order correction's
 /// curvature term, 0 for an uncorrected step; an elastic row: dz = (q − gᵀd)/D), and the largest
 /// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
 void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
   const auto slope = [&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    return localDot(g, k, in.g, d) + in.r;
+    return rows_.dot(np_, g, k, in.g, d) + in.r;
   };
   applyDualSteps(rows_, dualSteps(rows_, formOf(), slope, mu, rho_));
 }
@@ -570,7 +535,7 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   if (!elastic_) return slope;
   rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
     if (elasticRows(g))
-      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * localDot(g, k, in.g, d);
+      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * rows_.dot(np_, g, k, in.g, d);
   });
   return slope;
 }
@@ -578,17 +543,13 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
 /// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c (an elastic row's multiplier is
 /// safeguarded where it is prepared for the next assembly).
 void FreeTimeSolver::safeguardDuals(double mu) {
-  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
-    in.c = c;
-    form(g).afterAccept(in, mu);
-  });
+  rows_.evaluate(QuantityInputs(np_, np_.current()));
+  rows_.forEach([&](auto& g, int, auto& in) { form(g).afterAccept(in, mu); });
 }
 
 void FreeTimeSolver::initializeDuals(double mu) {
-  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int, auto& in, double c) {
-    in.c = c;
-    form(g).prepare(in, mu, rho_, true);
-  });
+  rows_.evaluate(QuantityInputs(np_, np_.current()));
+  rows_.forEach([&](auto& g, int, auto& in) { form(g).prepare(in, mu, rho_, true); });
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point (an
@@ -596,13 +557,6 @@ void FreeTimeSolver::initializeDuals(double mu) {
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   return std::max(stationarity, complementarityOf(rows_, formOf(), mu, rho_).worst);
-}
-
-/// Σ zᵢcᵢ at the assembled point.
-double FreeTimeSolver::dualityGap() const {
-  double gap = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { gap += in.z * in.c; });
-  return gap;
 }
 
 std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double gap,
@@ -670,7 +624,7 @@ double FreeTimeSolver::firstBarrier() const {
 void FreeTimeSolver::prepare() {
   epsilon_ = objective_.setBarrier(mu_);
   assemble(mu_, epsilon_);
-  gap_ = dualityGap();
+  gap_ = rows_.dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   barrier_residual_ = mu_ > mu_final_ ? barrierResidual(mu_) : 0.0;  // the μ rule's test
 }
@@ -767,7 +721,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
     out.twist_gradient = lagrangian_gradient_(n_ + twistColumn());
   }
-  out.complementarity = dualityGap();
+  out.complementarity = rows_.dualityGap();
   out.smallest_value = std::numeric_limits<double>::infinity();
   rows_.forEach(
       [&](auto&, int, auto& in) { out.smallest_value = std::min(out.smallest_value, in.c); });

@@ -3,13 +3,6 @@
 
 namespace attitude_planner {
 
-Eigen::Matrix<double, 9, 1> localTwistMotion(const ReducedProblem& np, int first_node, int width) {
-  Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero();
-  if (!np.hasTwist()) return e;
-  for (int n = 0; n < width; ++n) e.segment<3>(3 * n) = np.twistMotion(first_node + n);
-  return e;
-}
-
 TwistEntries twistEntries(const ReducedProblem& np, int first_node, int width, double h0,
                           const Eigen::Matrix<double, 10, 10>& H,
                           const Eigen::Matrix<double, 10, 1>& rhs,

@@ -16,12 +16,9 @@
 #include <Eigen/Core>
 
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_transcription.hpp"  // localTwistMotion
 
 namespace attitude_planner {
-
-/// e over the local nodes first_node .. first_node + width − 1 (zero past width and where the
-/// twist moves nothing).
-Eigen::Matrix<double, 9, 1> localTwistMotion(const ReducedProblem& np, int first_node, int width);
 
 /// ψ's entries of one local block of the free-time system over (local nodes, η = h/h₀), from that
 /// block's Hessian H (barrier terms included), right-hand side and Lagrangian gradient (fixed

@@ -201,17 +201,14 @@ class GridSolve final : public PrimalDualProblem {
   // iterate's slacks moved with the step.
   double merit() override { return system_.assembledMerit(cost_, mu_, penalty()); }
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
-    trial_ = retracted(d, alpha);
+    trial_ = FixedStepTranscription::retract(np_, d, alpha);
     if (moved) *moved = true;
     // The domain, as the barrier's c > 0: a step past the scheme's fold aliases a slow motion.
     if (!np_.onPrincipalBranch(trial_)) return std::numeric_limits<double>::infinity();
     return system_.merit(trial_, mu_, penalty(), nullptr, alpha);
   }
-  void moveTo(const Eigen::VectorXd& d, double alpha) override { trial_ = retracted(d, alpha); }
-  /// The iterate moved by α d; with a twist, ψ by α d(n) too (R_N and the steps next to it).
-  ReducedProblem::StepVectors retracted(const Eigen::VectorXd& d, double alpha) const {
-    if (!np_.hasTwist()) return np_.retract(d, alpha);
-    return np_.retractWithTwist(d, d(np_.unknowns()), alpha);
+  void moveTo(const Eigen::VectorXd& d, double alpha) override {
+    trial_ = FixedStepTranscription::retract(np_, d, alpha);
   }
   void restore() override {}  // the trials never moved the accepted iterate
   double penalty() const { return free_slacks_ ? nu_ : rho_; }
@@ -240,11 +237,7 @@ class GridSolve final : public PrimalDualProblem {
       alpha_dual_ = system_.dualStep(delta_, mu_, rho_);
     }
     system_.applyDualStep(std::min(alpha_dual_, 1.0));
-    if (np_.hasTwist()) {
-      np_.setCurrentWithTwist(trial, alpha * delta_(np_.unknowns()));
-    } else {
-      np_.setCurrent(trial);
-    }
+    FixedStepTranscription::accept(np_, trial, delta_, alpha);
   }
 
   /// Records the iteration and reports it; false if the caller asked to stop.

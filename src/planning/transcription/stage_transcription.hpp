@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -66,6 +67,54 @@ struct ConstraintRows {
   std::vector<ConstraintRow<Entries>> at;  ///< at[k − support.first_k]
 };
 
+/// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the node unknowns:
+/// its offset and its free entries first..last−1 (fixed nodes skipped).
+struct LocalSlots {
+  int offset = 0, first = 0, last = 0;
+  bool empty() const { return first >= last; }
+};
+inline LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
+  const int first_free = std::max(0, np.firstFreeNode() - first_node);
+  const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
+  return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
+}
+/// Adds a local 9×9 block (lower triangle used) to the band, fixed nodes skipped.
+template <typename Scalar>
+void addBandBlock(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node, int width,
+                  const Eigen::Matrix<double, 9, 9>& M) {
+  const LocalSlots l = localSlots(np, first_node, width);
+  if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
+}
+/// Adds weight·g over the local nodes' free entries to `out` (node unknowns first).
+inline void addNodeVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g,
+                          double weight, int first_node, int width,
+                          Eigen::Ref<Eigen::VectorXd> out) {
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) out.segment<3>(v) += weight * g.segment<3>(3 * n);
+  }
+}
+/// `sum` plus gᵀd over the local nodes' free entries, node by node.
+inline double addNodeDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g,
+                         int first_node, int width, const Eigen::VectorXd& d, double sum) {
+  for (int n = 0; n < width; ++n) {
+    const int v = np.variableIndex(first_node + n);
+    if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
+  }
+  return sum;
+}
+
+/// A pointing end's twist ψ moves R_N by exp(Δψ b^) and, for paper and variational, R_{N−1} by
+/// exp(Δψ e^) (ReducedProblem::twistMotion): e over the local nodes first_node .. first_node +
+/// width − 1, the ψ-column of a local block (zero past width and where the twist moves nothing).
+inline Eigen::Matrix<double, 9, 1> localTwistMotion(const ReducedProblem& np, int first_node,
+                                                    int width) {
+  Eigen::Matrix<double, 9, 1> e = Eigen::Matrix<double, 9, 1>::Zero();
+  if (!np.hasTwist()) return e;
+  for (int n = 0; n < width; ++n) e.segment<3>(3 * n) = np.twistMotion(first_node + n);
+  return e;
+}
+
 /// The time step of a transcription at a fixed h: an instance's entries are its local nodes'.
 struct FixedTimeStep {
   static constexpr int kEntries = 9;
@@ -83,6 +132,23 @@ struct FixedTimeStep {
   }
   /// ∂ρ/∂x over the stencil's entries (ρ = √w τ_k the stencil's residual).
   const Eigen::Matrix<double, 3, 9>& jacobian(const Stencil& st) const { return st.jacobian; }
+  /// The global unknowns after the node unknowns: a pointing end's ψ (index np.unknowns()).
+  static int globals(const ReducedProblem& np) { return np.hasTwist() ? 1 : 0; }
+  static int twistIndex(const ReducedProblem& np) { return np.unknowns(); }
+  /// gᵀd over a local gradient's unknowns: its nodes', then ψ's (this order: bit for bit).
+  static double dot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, int first_node,
+                    int width, const Eigen::VectorXd& d) {
+    double sum = addNodeDot(np, g, first_node, width, d, 0.0);
+    if (np.hasTwist()) sum += g.dot(localTwistMotion(np, first_node, width)) * d(np.unknowns());
+    return sum;
+  }
+  /// out(ψ) += weight·gᵀe (the globals' part of weight·g; the nodes' is addNodeVector's).
+  static void addGlobals(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g,
+                         double weight, int first_node, int width, Eigen::VectorXd* out) {
+    if (np.hasTwist()) {
+      (*out)(np.unknowns()) += weight * g.dot(localTwistMotion(np, first_node, width));
+    }
+  }
 };
 
 /// The fixed-h interior point's rows (the node unknowns only).
@@ -122,48 +188,32 @@ struct FreeTimeStep {
     H(9, 9) = st.second_hh * scale * scale;
     return H;
   }
+  /// The global unknowns after the node unknowns: η (index np.unknowns()), then a pointing end's
+  /// ψ.
+  static int globals(const ReducedProblem& np) { return np.hasTwist() ? 2 : 1; }
+  static int twistIndex(const ReducedProblem& np) { return np.unknowns() + 1; }
+  /// gᵀd over a local gradient's unknowns: η's, ψ's, then its nodes' (this order: bit for bit).
+  static double dot(const ReducedProblem& np, const Eigen::Matrix<double, 10, 1>& g, int first_node,
+                    int width, const Eigen::VectorXd& d) {
+    double sum = g(9) * d(np.unknowns());
+    if (np.hasTwist()) {
+      sum += g.head<9>().dot(localTwistMotion(np, first_node, width)) * d(twistIndex(np));
+    }
+    return addNodeDot(np, g.head<9>(), first_node, width, d, sum);
+  }
+  /// out(η) += weight·g(9), out(ψ) += weight·gᵀe (the nodes' part is addNodeVector's).
+  static void addGlobals(const ReducedProblem& np, const Eigen::Matrix<double, 10, 1>& g,
+                         double weight, int first_node, int width, Eigen::VectorXd* out) {
+    (*out)(np.unknowns()) += weight * g(9);
+    if (np.hasTwist()) {
+      (*out)(twistIndex(np)) += weight * g.head<9>().dot(localTwistMotion(np, first_node, width));
+    }
+  }
 };
 
 /// The free-time interior point's rows (the node unknowns and η).
 using FreeTimeRow = ConstraintRow<FreeTimeStep::kEntries>;
 using FreeTimeRows = ConstraintRows<FreeTimeStep::kEntries>;
-
-/// Where a local 9-vector over nodes first_node..first_node+width−1 sits among the node unknowns:
-/// its offset and its free entries first..last−1 (fixed nodes skipped).
-struct LocalSlots {
-  int offset = 0, first = 0, last = 0;
-  bool empty() const { return first >= last; }
-};
-inline LocalSlots localSlots(const ReducedProblem& np, int first_node, int width) {
-  const int first_free = std::max(0, np.firstFreeNode() - first_node);
-  const int last_free = std::min(width - 1, np.lastFreeNode() - first_node);
-  return {3 * (first_node - np.firstFreeNode()), 3 * first_free, 3 * (last_free + 1)};
-}
-/// Adds a local 9×9 block (lower triangle used) to the band, fixed nodes skipped.
-template <typename Scalar>
-void addBandBlock(const ReducedProblem& np, BandedSymmetric<Scalar>* H, int first_node, int width,
-                  const Eigen::Matrix<double, 9, 9>& M) {
-  const LocalSlots l = localSlots(np, first_node, width);
-  if (!l.empty()) H->template addSymmetricBlock<9>(l.offset, M, l.first, l.last);
-}
-/// Adds weight·g over the local nodes' free entries to `out` (node unknowns first).
-inline void addNodeVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g,
-                          double weight, int first_node, int width,
-                          Eigen::Ref<Eigen::VectorXd> out) {
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) out.segment<3>(v) += weight * g.segment<3>(3 * n);
-  }
-}
-/// `sum` plus gᵀd over the local nodes' free entries, node by node.
-inline double addNodeDot(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g,
-                         int first_node, int width, const Eigen::VectorXd& d, double sum) {
-  for (int n = 0; n < width; ++n) {
-    const int v = np.variableIndex(first_node + n);
-    if (v >= 0) sum += g.segment<3>(3 * n).dot(d.segment<3>(v));
-  }
-  return sum;
-}
 
 /// The rows of `block` at instance k with quantity value q: each row's value c(q), then
 /// prepare(rows, row) (its barrier form's multiplier and condensation terms at that value);
@@ -276,6 +326,55 @@ struct StageTranscription {
   void forEachValue(const QuantityInputs& at, F&& f) const {
     visit(*this, [&](const Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
   }
+  /// Each row's value c at `at`, into the row.
+  void evaluate(const QuantityInputs& at) {
+    forEachValue(at, [](Rows&, int, Row& in, double c) { in.c = c; });
+  }
+  /// The least value at `at` of the groups `which(group)` selects (+∞ without; rows untouched).
+  template <typename Which>
+  double smallestValue(const QuantityInputs& at, const Which& which) const {
+    double smallest = std::numeric_limits<double>::infinity();
+    forEachValue(at, [&](const Rows& g, int, const Row&, double c) {
+      if (which(g)) smallest = std::min(smallest, c);
+    });
+    return smallest;
+  }
+  /// Σ z c at the rows' values: the duality gap.
+  double dualityGap() const {
+    double gap = 0.0;
+    forEach([&](const Rows&, int, const Row& in) { gap += in.z * in.c; });
+    return gap;
+  }
+  /// gᵀd for a gradient of row k of group g over the unknowns (δ, then the globals in force:
+  /// η with h free, a pointing end's ψ), summed in the time step's order.
+  double dot(const ReducedProblem& np, const Rows& g, int k,
+             const Eigen::Matrix<double, kEntries, 1>& gradient, const Eigen::VectorXd& d) const {
+    return TimeStep::dot(np, gradient, k + g.support.node_offset, g.support.width, d);
+  }
+  /// out += weight·gradient (row k of group g) over the unknowns: dot's adjoint.
+  void addRow(const ReducedProblem& np, const Rows& g, int k,
+              const Eigen::Matrix<double, kEntries, 1>& gradient, double weight,
+              Eigen::VectorXd* out) const {
+    const int first = k + g.support.node_offset;
+    addNodeVector(np, gradient.template head<9>(), weight, first, g.support.width, *out);
+    TimeStep::addGlobals(np, gradient, weight, first, g.support.width, out);
+  }
+  /// The iterate's steps moved by α d over the unknowns (a pointing end's ψ: R_N moves with it,
+  /// and the steps next to it); np's iterate untouched.
+  static ReducedProblem::StepVectors retract(const ReducedProblem& np, const Eigen::VectorXd& d,
+                                             double alpha) {
+    if (!np.hasTwist()) return np.retract(d, alpha);
+    return np.retractWithTwist(d, d(TimeStep::twistIndex(np)), alpha);
+  }
+  /// Takes steps that retract(np, d, α) formed as the iterate (R_N moved by α dψ with a twist).
+  static void accept(ReducedProblem& np, const ReducedProblem::StepVectors& steps,
+                     const Eigen::VectorXd& d, double alpha) {
+    if (np.hasTwist()) {
+      np.setCurrentWithTwist(steps, alpha * d(TimeStep::twistIndex(np)));
+    } else {
+      np.setCurrent(steps);
+    }
+  }
   /// Whether a per-axis torque bound is among the rows (a box side: the one constraint affine in
   /// one torque axis).
   bool hasTorqueBox() const {
@@ -355,5 +454,9 @@ struct StageTranscription {
     return g.constraint->value(g.quantity->value(at, k));
   }
 };
+
+/// The stage transcription at a fixed h (the interior point's) and with h free (free time's).
+using FixedStepTranscription = StageTranscription<FixedTimeStep>;
+using FreeTimeTranscription = StageTranscription<FreeTimeStep>;
 
 }  // namespace attitude_planner

@@ -221,7 +221,8 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"rate_limit\": " << jsonNumber(r.duration_verdict.rate_limit)
       << ", \"torque_limit\": " << jsonNumber(r.duration_verdict.torque_limit)
       << ", \"plan_within_bounds\": " << (r.duration_verdict.plan_within_bounds ? "true" : "false")
-      << "},\n"
+      << ", \"no_plan_from\": " << jsonNumber(r.duration_verdict.no_plan_from)
+      << ", \"no_plan_to\": " << jsonNumber(r.duration_verdict.no_plan_to) << "},\n"
       << "  \"verdict\": " << verdictJson(r.verdict) << ",\n"
       << "  \"iterations\": " << r.iterations << ",\n"
       << "  \"cost\": " << jsonNumber(r.cost) << ",\n"

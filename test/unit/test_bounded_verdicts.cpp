@@ -16,6 +16,9 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
+#include "planning/drivers/minimum_time_free_time.hpp"
+#include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
 #include "support/bounded_requests.hpp"
@@ -549,9 +552,72 @@ TEST(BoundedVerdicts, AFinalRateTheTorqueCannotApproachFromInsideIsInfeasibleAtE
   EXPECT_TRUE(std::holds_alternative<verdicts::InfeasibleAtEveryDuration>(r.verdict))
       << r.message();
   EXPECT_TRUE(r.attempts.empty());
+  // The range proven without a plan is data of the answer.
+  EXPECT_EQ(r.duration_verdict.no_plan_from, none.from);
+  EXPECT_EQ(r.duration_verdict.no_plan_to, none.to);
   // With 10x the torque the end can be approached from inside (d|Ω|²/2dt > 0 is allowed there):
   // not refused so.
   p.constraints[0] = PlanningConstraint::maxTorqueNorm(3.0);
   EXPECT_GT(W.dot(Ji * (p.inertia * W).cross(W)) + 3.0 * (Ji * W).norm(), 0.0);
   EXPECT_EQ(infeasibleAtEveryDuration(p), "");
+}
+
+TEST(BoundedVerdicts, AMinimumEffortRequestInARangeWithoutRoomIsProvenInfeasibleWithTheRange) {
+  // Random bodies whose final rate lies on the rate limit: a minimum-effort request at a T inside
+  // a range proven without room before the end is answered infeasible before any solve, proven,
+  // the range as data; just below the range's start (room there) it is not answered so.
+  std::mt19937_64 rng(4950);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  int ranges = 0;
+  for (int i = 0; i < 16; ++i) {
+    const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
+    const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
+    const Vector3 rate =
+        (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+    PlanningProblem p = spinningEnd(moments, R, rate, 0.05 + 2 * unit(rng), rate.norm());
+    p.steps = 64;
+    const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
+    if (!(none.to > none.from) || none.everywhere) continue;
+    ++ranges;
+    SCOPED_TRACE("case " + std::to_string(i));
+    p.duration = none.from + unit(rng) * (none.to - none.from);
+    const PlanResult r = planManeuver(p);
+    EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
+    EXPECT_TRUE(r.duration_verdict.proven_infeasible);
+    EXPECT_TRUE(std::holds_alternative<verdicts::NoRoomAtDuration>(r.verdict)) << r.message();
+    EXPECT_EQ(r.duration_verdict.no_plan_from, none.from);
+    EXPECT_EQ(r.duration_verdict.no_plan_to, none.to);
+    EXPECT_TRUE(r.attempts.empty());
+    // The least rate before the end exceeds the limit at the requested T: no plan exists there.
+    EXPECT_GT(leastRateBeforeTheEnd(p, p.duration), rate.norm());
+    p.duration = none.from * (1 - 1e-3);
+    if (p.duration > discreteDurationLowerBound(p)) {
+      EXPECT_FALSE(answerBeforeSolving(p, durationLowerBound(p)).has_value());
+    }
+  }
+  EXPECT_GE(ranges, 4);
+}
+
+TEST(BoundedVerdicts, ElasticFreeTimeStartsNeverEndBelowTheProvenLeastDuration) {
+  // An elastic free-time iterate is no plan: its phase traded violation for a T below every
+  // plan's on the seed-46 spinning request #46 (paper, N = 256, norm bound and rate limit), whose
+  // coarse class starts begun from their violations ended at 8.28-8.33 s under the proven 8.595 s.
+  // Every coarse start at both elastic barriers ends at or above the floor on its grid.
+  const auto request = robustness::boundedRequest(46, 46);
+  ASSERT_TRUE(request.has_value());
+  PlanningProblem p = request->problem;
+  p = minimumTime(p);
+  const PlanningProblem coarsest = freeTimeLevels(p).front();
+  const double floor = discreteDurationLowerBound(coarsest);
+  ASSERT_GT(floor, 0.0);
+  SolveContext context{SolverOptions{}};
+  for (const FreeTimeStart& start : freeTimeStarts(coarsest, false, context)) {
+    for (const ElasticBarrier barrier : {ElasticBarrier::Initial, ElasticBarrier::FromViolations}) {
+      const FreeTimeOutcome o =
+          solveFreeTime(coarsest, start.attitudes, start.duration, 1e-9, 500, context, {}, barrier);
+      if (o.maneuver.attitude.empty()) continue;
+      EXPECT_GE(o.duration, floor) << start.name << ": " << o.message();
+    }
+  }
 }

@@ -335,6 +335,7 @@ TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
                                         v::BelowProvenBound{},
                                         v::InternalPhaseFailed{},
                                         v::InfeasibleAtEveryDuration{},
+                                        v::NoRoomAtDuration{},
                                         v::LocallyInfeasible{},
                                         v::MinimumTimeFoundNone{},
                                         v::SearchStopped{},

@@ -62,6 +62,23 @@ struct InfeasibleAtEveryDuration {
   std::string why;
   std::vector<VerdictFigure> figures() const { return {}; }
 };
+/// Bounded minimum effort: the requested T lies in a range of durations proven to hold no plan on
+/// its grid (DurationVerdict::no_plan_from, no_plan_to; `why`: what has no room there), answered
+/// before any solve.
+struct NoRoomAtDuration {
+  static constexpr const char* kKind = "no_room_at_duration";
+  double requested = 0.0;  ///< T [s]
+  double from = 0.0;       ///< the range proven without a plan [s]
+  double to = 0.0;
+  int steps = 0;  ///< N
+  std::string why;
+  std::vector<VerdictFigure> figures() const {
+    return {{"requested_duration", requested},
+            {"no_plan_from", from},
+            {"no_plan_to", to},
+            {"steps", double(steps)}};
+  }
+};
 /// A local "infeasible" at the requested T: no plan was found at T; the least duration at which
 /// one was found (a local minimum-time plan, not a requirement) and the proven bound where one
 /// applies. The reason it is given follows: the minimum-time solve's (minimum time with T as
@@ -273,16 +290,15 @@ struct MinimumTimeAnswer {
 /// ConeAtFixedNode, FreeTimeEnded, FreeTimeConeAtFixedNode, NoStrictlyFeasibleStart), and so is
 /// the minimum-time answer's account of T* (MinimumTimeAnswer);
 /// SolverReason where a solver's reason is still words only.
-using Verdict =
-    std::variant<verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
-                 verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration,
-                 verdicts::LocallyInfeasible, verdicts::MinimumTimeFoundNone,
-                 verdicts::SearchStopped, verdicts::SearchUnrepresentable,
-                 verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime,
-                 verdicts::NoPointingStartConverged, verdicts::NloptEnded, verdicts::NewtonEnded,
-                 verdicts::InteriorPointEnded, verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode,
-                 verdicts::FreeTimeEnded, verdicts::FreeTimeConeAtFixedNode,
-                 verdicts::NoStrictlyFeasibleStart, verdicts::MinimumTimeAnswer>;
+using Verdict = std::variant<
+    verdicts::SolverReason, verdicts::AlreadyAtRest, verdicts::BelowProvenBound,
+    verdicts::InternalPhaseFailed, verdicts::InfeasibleAtEveryDuration, verdicts::LocallyInfeasible,
+    verdicts::MinimumTimeFoundNone, verdicts::SearchStopped, verdicts::SearchUnrepresentable,
+    verdicts::SearchInfeasible, verdicts::FeasibleAtMinimumTime, verdicts::NoPointingStartConverged,
+    verdicts::NloptEnded, verdicts::NewtonEnded, verdicts::InteriorPointEnded,
+    verdicts::NoBoundaryStep, verdicts::ConeAtFixedNode, verdicts::FreeTimeEnded,
+    verdicts::FreeTimeConeAtFixedNode, verdicts::NoStrictlyFeasibleStart,
+    verdicts::MinimumTimeAnswer, verdicts::NoRoomAtDuration>;
 
 /// "solver_reason", "below_proven_bound", ... (JSON `verdict.kind`).
 inline std::string verdictKindName(const Verdict& verdict) {

@@ -216,6 +216,13 @@ struct DurationVerdict {
   /// the requested T, checked step by step (true for every converged answer; an answer that
   /// stopped short of optimality may still hold a plan at T, not shown optimal).
   bool plan_within_bounds = false;
+  /// Durations proven to hold no plan on the request's grid [s], no_plan_from to no_plan_to: the
+  /// paper scheme's last free step into a final rate on the rate limit has no room there (its
+  /// least rate over the allowed torques exceeds the limit at every step h in the range); 0, 0:
+  /// none proven. Minimum time answers `infeasible` where the range covers every duration the
+  /// grid holds, and a bounded minimum-effort request whose T lies in it before any solve.
+  double no_plan_from = 0.0;
+  double no_plan_to = 0.0;
 };
 
 /// What a pointing request's "infeasible" rests on (PointingSummary::infeasible_basis, JSON

@@ -90,6 +90,23 @@ PlanResult provenInfeasible(const PlanningProblem& problem, const DurationLowerB
   return r;
 }
 
+std::string lastFreeStepWithoutRoom(const PlanningProblem& problem);
+
+/// A bounded minimum-effort request whose T lies where noRoomBeforeTheEnd proves no plan.
+PlanResult noRoomAt(const PlanningProblem& problem, const DurationLowerBound& bound,
+                    const NoRoomBeforeTheEnd& none) {
+  PlanResult r;
+  r.termination = Termination::Infeasible;
+  r.scheme = problem.scheme;
+  r.solver = solverName(SolverKind::Structured);
+  recordLowerBound(bound, &r);
+  recordNoRoom(none, &r);
+  r.duration_verdict.proven_infeasible = true;
+  recordVerdict(&r, verdicts::NoRoomAtDuration{problem.duration, none.from, none.to, problem.steps,
+                                               lastFreeStepWithoutRoom(problem)});
+  return r;
+}
+
 }  // namespace
 
 std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
@@ -101,8 +118,13 @@ std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
     return std::nullopt;
   }
   const double grid_bound = discreteDurationLowerBound(bound, problem.steps);
-  if (problem.duration >= grid_bound) return std::nullopt;
-  return provenInfeasible(problem, bound, grid_bound);
+  if (problem.duration < grid_bound) return provenInfeasible(problem, bound, grid_bound);
+  if (problem.objective == Objective::MinimumTime) return std::nullopt;
+  const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(problem);
+  if (!(problem.duration >= none.from && problem.duration <= none.to && none.to > none.from)) {
+    return std::nullopt;
+  }
+  return noRoomAt(problem, bound, none);
 }
 
 PlanResult runInternalPhase(const std::string& phase, const std::function<PlanResult()>& solve) {
@@ -215,6 +237,16 @@ class RoomProof {
   int evaluations_ = 0;
 };
 
+/// What has no room where noRoomBeforeTheEnd proves durations without a plan (verdict words).
+std::string lastFreeStepWithoutRoom(const PlanningProblem& problem) {
+  std::ostringstream why;
+  why << "the final rate " << problem.final_velocity.norm() << " rad/s against max_angular_rate "
+      << rateLimit(problem) << " rad/s: the paper scheme's last free step Omega_{N-2} (J "
+      << "Omega_{N-2} = exp(h Omega_{N-1}^) J Omega_{N-1} - h tau_{N-1}, |tau| <= "
+      << torqueAuthority(problem).largest_magnitude << " N m) exceeds the rate limit";
+  return why.str();
+}
+
 }  // namespace
 
 double leastRateBeforeTheEnd(const PlanningProblem& problem, double duration) {
@@ -252,9 +284,10 @@ NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem) {
   const double a = torqueAuthority(problem).largest_magnitude;
   const double boundary_rate =
       std::max(problem.initial_velocity.norm(), problem.final_velocity.norm());
-  // With N < 3 the step before the last is the first, whose rate is data (no rate row).
+  // With N < 3 the step before the last is the first, whose rate is data (no rate row); with an
+  // accuracy target the planner chooses N.
   if (!std::isfinite(w) || !std::isfinite(leastRateBeforeTheEnd(problem, 1.0)) ||
-      !(boundary_rate > 0) || problem.steps < 3) {
+      !(boundary_rate > 0) || problem.steps < 3 || problem.accuracy.active()) {
     return {};
   }
   const int N = problem.steps;
@@ -289,15 +322,17 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
   const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(problem);
   if (!none.everywhere) return "";
   std::ostringstream why;
-  why << "the final rate " << problem.final_velocity.norm() << " rad/s against max_angular_rate "
-      << rateLimit(problem) << " rad/s: the paper scheme's last free step Omega_{N-2} (J "
-      << "Omega_{N-2} = exp(h Omega_{N-1}^) J Omega_{N-1} - h tau_{N-1}, |tau| <= "
-      << torqueAuthority(problem).largest_magnitude
-      << " N m) exceeds the rate limit at every step h from the proven least duration on the "
-      << "grid, T = " << none.from
+  why << lastFreeStepWithoutRoom(problem) << " at every step h from the proven least duration on "
+      << "the grid, T = " << none.from
       << " s, up to the largest step the planner takes, T = " << none.to
       << " s (N = " << problem.steps << "; proven over intervals of h)";
   return why.str();
+}
+
+void recordNoRoom(const NoRoomBeforeTheEnd& none, PlanResult* result) {
+  if (!(none.to > none.from)) return;
+  result->duration_verdict.no_plan_from = none.from;
+  result->duration_verdict.no_plan_to = none.to;
 }
 
 }  // namespace attitude_planner

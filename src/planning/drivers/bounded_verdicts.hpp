@@ -15,8 +15,10 @@
 namespace attitude_planner {
 
 /// The answer to `problem` that needs no solve, if any: minimum time between identical rest
-/// states without effects (T* = 0: the body is there), or a bounded request whose duration lies
-/// below the proven lower bound on its grid (Infeasible, DurationVerdict::proven_infeasible).
+/// states without effects (T* = 0: the body is there), a bounded request whose duration lies
+/// below the proven lower bound on its grid (Infeasible, DurationVerdict::proven_infeasible), or a
+/// bounded minimum-effort request whose duration lies in a range noRoomBeforeTheEnd proves without
+/// a plan (Infeasible, proven, the range in DurationVerdict::no_plan_from/to).
 std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
                                               const DurationLowerBound& bound);
 
@@ -76,5 +78,9 @@ struct NoRoomBeforeTheEnd {
   bool everywhere = false;  ///< the whole range searched: no plan at any duration on this grid
 };
 NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem);
+
+/// Sets `result->duration_verdict`'s range without a plan (no_plan_from, no_plan_to) from `none`
+/// where it proves one.
+void recordNoRoom(const NoRoomBeforeTheEnd& none, PlanResult* result);
 
 }  // namespace attitude_planner

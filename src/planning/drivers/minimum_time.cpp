@@ -445,11 +445,14 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   validateMinimumTime(problem);
   const DurationLowerBound bound = durationLowerBound(problem);
   if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
+  const NoRoomBeforeTheEnd no_room = noRoomBeforeTheEnd(problem);
   const std::string impossible = infeasibleAtEveryDuration(problem);
   if (!impossible.empty()) {
     PlanResult none;
     none.termination = Termination::Infeasible;
     recordVerdict(&none, verdicts::InfeasibleAtEveryDuration{impossible});
+    recordLowerBound(bound, &none);
+    recordNoRoom(no_room, &none);
     return none;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -458,6 +461,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   PlanResult result = runInternalPhase(
       "minimum time", [&] { return minimumTimeOverTwists(problem, context, &pair); });
   recordLowerBound(bound, &result);
+  recordNoRoom(no_room, &result);
   if (!result.converged()) return result;
   const double T_star = result.minimum_duration;
   if (problem.duration > 0 && T_star > problem.duration * (1.0 + kMinimumTimeTolerance)) {
@@ -478,6 +482,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
                                  pair, context);
     });
     recordLowerBound(bound, &result);
+    recordNoRoom(no_room, &result);
     result.attempts = context.attemptsFrom(first);
     addNote(&result, notes::PlannedAtMargin{problem.time_margin, result.duration, T_star});
   }
@@ -680,7 +685,9 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   const std::size_t first = context.attempts().size();
   PlanResult result = planAtResolution(problem, context.options(), context);
   const std::optional<std::size_t> first_kept = keptSince(context, first);
+  const NoRoomBeforeTheEnd no_room = noRoomBeforeTheEnd(problem);
   recordLowerBound(bound, &result);
+  recordNoRoom(no_room, &result);
   const std::string why = needsMinimumTimeStart(problem, result);
   if (why.empty() || !std::isfinite(torqueAuthority(problem).smallest_about_any_axis) ||
       problem.accuracy.active()) {
@@ -704,6 +711,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   const auto finish = [&](PlanResult r) {
     r.attempts = context.attemptsFrom(first);
     recordLowerBound(bound, &r);
+    recordNoRoom(no_room, &r);
     r.minimum_duration = minimum_time.converged() ? minimum_time.minimum_duration : 0.0;
     recordPlanWithinBounds(problem, &r);
     r.solve_time_s =

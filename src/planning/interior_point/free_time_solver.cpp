@@ -58,6 +58,7 @@
 #include "planning/interior_point/primal_dual_loop.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 #include "planning/linalg/bordered_band.hpp"
+#include "planning/problem/duration_bound.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/transcription/minimum_time_objective.hpp"
 #include "planning/transcription/node_constraints.hpp"
@@ -470,7 +471,18 @@ void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
 
 double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
   if (moved) *moved = false;
-  if (accepted_.h + alpha * h0_ * d(n_) <= 0) return std::numeric_limits<double>::infinity();
+  const double h = accepted_.h + alpha * h0_ * d(n_);
+  if (h <= 0) return std::numeric_limits<double>::infinity();
+  // An elastic iterate is no plan: its phase can trade violation for a T below every plan's
+  // (measured: starts ending under the proven least duration on the grid, still violating). So
+  // while elastic, h keeps the fraction to the boundary of that floor; a strictly feasible iterate
+  // is a plan and lies above it anyway.
+  if (elastic_ && h < accepted_.h) {
+    const double floor = discreteDurationLowerBound(problem_) / N_;  // 0: no bound applies
+    if (floor > 0 && h - floor < (1.0 - parameters_.fraction_to_boundary) * (accepted_.h - floor)) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
   try {
     moveTo(d, alpha);
     if (moved) *moved = true;

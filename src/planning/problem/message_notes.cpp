@@ -375,6 +375,13 @@ std::string judged(const verdicts::InternalPhaseFailed& v, const std::string&) {
 std::string judged(const verdicts::InfeasibleAtEveryDuration& v, const std::string&) {
   return "infeasible: " + v.why;
 }
+std::string judged(const verdicts::NoRoomAtDuration& v, const std::string&) {
+  std::ostringstream why;
+  why << "infeasible: no plan exists at T = " << exactNumber(v.requested) << " s on " << v.steps
+      << " steps (proven: " << v.why << ", at every duration from " << exactNumber(v.from)
+      << " s to " << exactNumber(v.to) << " s); answered before any solve";
+  return why.str();
+}
 std::string judged(const verdicts::LocallyInfeasible& v, const std::string& reason) {
   std::ostringstream why;
   why << "infeasible from here (a local verdict): no plan within the bounds was found at T = "

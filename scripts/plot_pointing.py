@@ -148,8 +148,8 @@ seen) give the unconstrained twist optima, and the interior point with psi free 
 distinct one, cheapest first, while its unconstrained cost is below the cheapest constrained
 answer found (constraints only add cost within a start's basin, and the interior point keeps the
 way round it starts in); an optimum that meets every constraint is that basin's answer as it is.
-An optimum whose path crosses a cone deeper than the fixed-twist unconstrained optima 45 degrees
-either side of its psi do (a ridge of the constrained cost over psi: the plan passes the cone on
+An optimum whose path comes within 15 %% of a cone's half angle of its axis and crosses it deeper
+than the fixed-twist unconstrained optima 45 degrees either side of its psi do (a ridge of the constrained cost over psi: the plan passes the cone on
 one side or the other, each side's optimum at another twist) starts it from those two optima
 instead, both run. Where none of those converges (a cone across the optimum's path): the same from each optimum
 the other way round at its psi and from the fixed-twist unconstrained optima at the 4 start

@@ -223,12 +223,15 @@ TEST(ConstrainedPointingPlan, LocalInfeasibilityCertifiedFromEnoughStartsEndsThe
 
 namespace {
 
-/// The least margin [rad] of `p`'s cones over the nodes of `plan` (node bounds).
+/// The least margin of `p`'s cones over the nodes of `plan` (node bounds) relative to each cone's
+/// node half angle (−1 on its axis).
 double leastConeMargin(const PlanningProblem& p, const Maneuver& plan) {
   double least = std::numeric_limits<double>::infinity();
   for (const PlanningConstraint& c : p.constraints) {
     if (!c.isCone()) continue;
-    for (const Matrix3& R : plan.attitude) least = std::min(least, coneMargin(c, R) - c.margin);
+    for (const Matrix3& R : plan.attitude) {
+      least = std::min(least, (coneMargin(c, R) - c.margin) / c.nodeHalfAngle());
+    }
   }
   return least;
 }
@@ -248,7 +251,8 @@ bool startedAt(const PlanResult& r, double twist) {
 
 TEST(ConstrainedPointingPlan, AConesRidgeIsStartedFromBothSidesAndAtMostTheSweepsBest) {
   // Where the unconstrained twist optimum ψ* (the request without its cone) crosses the cone
-  // deeper than the fixed-twist unconstrained optima at ψ* ± kPointingRidgeOffset, each measured
+  // near its axis (deeper than kPointingRidgeDepth of its half angle) and deeper than the
+  // fixed-twist unconstrained optima at ψ* ± kPointingRidgeOffset, each measured
   // here on planManeuver's own plans, the constrained cost over ψ has a ridge at ψ*: the interior
   // point with ψ free starts from both those optima, else from ψ*'s. Either way the answer is at
   // most the sweep's best. Seeded so that both kinds occur.
@@ -263,7 +267,7 @@ TEST(ConstrainedPointingPlan, AConesRidgeIsStartedFromBothSidesAndAtMostTheSweep
     ASSERT_TRUE(optimum.converged()) << optimum.message();
     const double twist = optimum.pointing.final_twist;
     const double deepest = leastConeMargin(p, optimum.maneuver);
-    bool ridge = deepest < 0.0;
+    bool ridge = deepest < -kPointingRidgeDepth;
     for (const double offset : {-kPointingRidgeOffset, kPointingRidgeOffset}) {
       PlanningProblem fixed = free_of_cones;
       fixed.end_condition = EndCondition();

@@ -130,11 +130,11 @@ class FreeTimeMinimumTime {
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
   /// duration, e.g. the search's): its KKT point if it converged at or below that T.
   std::optional<PlanResult> runFrom(const Maneuver& plan, double duration, const std::string& name,
-                                    std::optional<Maneuver>* below) {
+                                    std::optional<Maneuver>* below, StartBarrier barrier) {
     StartDetail detail;
     detail.duration = duration;
-    const FreeTimeOutcome o =
-        solve(problem_, plan.attitude, duration, AttemptStart::PreviousAttempt, detail);
+    const FreeTimeOutcome o = solve(problem_, plan.attitude, duration,
+                                    AttemptStart::PreviousAttempt, detail, {}, barrier);
     recordStart(plan.attitude, duration, name, o, -1);
     // Every iterate strictly inside its bounds is a plan (the reduced problem meets the dynamics
     // and the boundary data by construction): one that ended short of a KKT point below T is
@@ -159,12 +159,14 @@ class FreeTimeMinimumTime {
   /// recorded in the trail with its start's parameters.
   FreeTimeOutcome solve(const PlanningProblem& p, const std::vector<Matrix3>& start,
                         double duration, AttemptStart kind, const StartDetail& detail,
-                        const BarrierWatch& watch = {}) {
+                        const BarrierWatch& watch = {},
+                        StartBarrier start_barrier = StartBarrier::Initial) {
     const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
     const ElasticBarrier barrier =
         detail.elastic_from_violations ? ElasticBarrier::FromViolations : ElasticBarrier::Initial;
-    FreeTimeOutcome o = solveFreeTime(p, start, duration, kFreeTimeTolerance,
-                                      kFreeTimeMaxIterations, context_, watch, barrier);
+    FreeTimeOutcome o =
+        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, context_,
+                      watch, barrier, start_barrier);
     o.iterations = scope.iterations();  // an elastic start's run and the raised one's
     Attempt a;
     a.stage = AttemptStage::MinimumTimeSolve;
@@ -663,8 +665,9 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
                                            double duration, const std::string& start,
-                                           SolveContext& context, std::optional<Maneuver>* below) {
-  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, start, below);
+                                           SolveContext& context, std::optional<Maneuver>* below,
+                                           StartBarrier barrier) {
+  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, start, below, barrier);
 }
 
 }  // namespace attitude_planner

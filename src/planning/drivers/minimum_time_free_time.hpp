@@ -54,11 +54,14 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 /// `start` names it in the answer's message): its
 /// KKT point if it converged at or below `duration`, else empty (its solve is in the context's
 /// trail either way). Where it ended short of a KKT point at an iterate strictly inside every
-/// bound below `duration`, that iterate's plan goes to `*below` (a plan at its own T).
+/// bound below `duration`, that iterate's plan goes to `*below` (a plan at its own T). `barrier`:
+/// where its barrier begins (StartBarrier::NearKktPoint for a plan that is a neighbouring
+/// problem's KKT point).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
                                            double duration, const std::string& start,
                                            SolveContext& context,
-                                           std::optional<Maneuver>* below = nullptr);
+                                           std::optional<Maneuver>* below = nullptr,
+                                           StartBarrier barrier = StartBarrier::Initial);
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
 /// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a

@@ -654,9 +654,9 @@ bool meetsEveryNodeConstraint(const PlanningProblem& problem, const TwistRun& op
   return checkConstraints(at, np.maneuver(optimum.iterate)).max_node_bound_violation <= 0.0;
 }
 
-/// The least cone margin [rad] over the nodes of `run`'s plan (on the requested grid, posed at its
-/// twist) against the node bounds the planner imposes (coneMargin less each cone's margin); +∞
-/// without cones.
+/// The least relative cone margin over the nodes of `run`'s plan (on the requested grid, posed at
+/// its twist) against the node bounds the planner imposes: (coneMargin less the cone's margin)
+/// over its node half angle, −1 on the cone's axis; +∞ without cones.
 double leastConeMargin(const PlanningProblem& problem, const TwistRun& run) {
   const PlanningProblem at = posedAt(problem, problem.steps, run.solve.twist);
   ReducedProblem np(at);
@@ -665,7 +665,9 @@ double leastConeMargin(const PlanningProblem& problem, const TwistRun& run) {
   double least = std::numeric_limits<double>::infinity();
   for (const PlanningConstraint& c : problem.constraints) {
     if (!c.isCone()) continue;
-    for (const Matrix3& R : plan.attitude) least = std::min(least, coneMargin(c, R) - c.margin);
+    for (const Matrix3& R : plan.attitude) {
+      least = std::min(least, (coneMargin(c, R) - c.margin) / c.nodeHalfAngle());
+    }
   }
   return least;
 }
@@ -676,11 +678,12 @@ double leastConeMargin(const PlanningProblem& problem, const TwistRun& run) {
 /// plan around the cone then passes it on one side or the other, each side's optimum at another
 /// twist, and the interior point with ψ free started on the ridge stalls between them (measured:
 /// held-out requests 53506 and 53518, 225 and 124 iterations against 49 for the fixed request at
-/// the answer's twist). The two sides cheapest first; empty where `optimum` is no ridge.
+/// the answer's twist). Checked only where the path comes near the cone's axis
+/// (kPointingRidgeDepth). The two sides cheapest first; empty where `optimum` is no ridge.
 std::vector<TwistRun> ridgeSides(const PlanningProblem& problem, const TwistRun& optimum,
                                  SolveContext& context) {
   const double deepest = leastConeMargin(problem, optimum);
-  if (!(deepest < 0.0)) return {};
+  if (!(deepest < -kPointingRidgeDepth)) return {};
   std::vector<TwistRun> sides;
   for (const double offset : {-kPointingRidgeOffset, kPointingRidgeOffset}) {
     if (context.stopReason()) return {};

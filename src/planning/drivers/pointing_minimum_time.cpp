@@ -285,6 +285,69 @@ std::vector<TwistStart> surveyThenCarried(const PlanningProblem& problem, int su
   return starts;
 }
 
+/// The fixed-twist probes' offset from a ψ-free answer's twist [rad] (onLowerBranch): on the
+/// held-out request behind onLowerBranch the lower branch is reached from 0.01–0.03 rad off the
+/// answer's twist, not from 5° off.
+constexpr double kBranchProbeOffset = 0.01;
+/// At most this many rounds of onLowerBranch, each from the last one's answer: the branches can
+/// form a staircase (seeded request 4367: the first round's answer 22.0875 s at ψ = 0.728, a third
+/// branch 22.0811 s at 0.711).
+constexpr int kBranchProbeRounds = 4;
+
+/// The fixed-twist free-time solve on N from the eigenaxis slew at `twist` (its attempts tagged
+/// with the twist); empty where the slew is no start there or the solve did not converge.
+std::optional<PlanResult> fixedTwistProbe(const PlanningProblem& problem, double twist,
+                                          SolveContext& context) {
+  const std::optional<SlewStart> start = eigenaxisStartAt(problem, twist);
+  if (!start) return std::nullopt;
+  PlanningProblem fixed = start->posed;
+  fixed.end_condition = EndCondition();
+  const std::size_t first = context.attempts().size();
+  std::optional<PlanResult> r =
+      freeTimeFromPlan(fixed, start->slew, start->duration, "eigenaxis slew", context);
+  context.posedAtTwist(first, twist);
+  return r;
+}
+
+/// The ψ-free answer `answer` on N against another branch of the fixed-twist T*(ψ) beside it: T*
+/// at a fixed twist can have two branches (two switching structures) whose minima over ψ are
+/// both KKT points of the ψ-free problem, and the survey's carried answer can end on the upper
+/// one. At ψ* ± kBranchProbeOffset the fixed-twist free-time solve from the eigenaxis slew on N;
+/// where the lower of the two ends below the answer's T*, one free-time solve with ψ free from
+/// its plan, its barrier begun near that KKT point (StartBarrier::NearKktPoint: begun at μ₀ it
+/// re-centres onto the answer's branch). That solve's answer where it converged at or below the
+/// probe's T (freeTimeFromPlan); else empty. A probe's fixed-twist plan is never the answer: its
+/// ψ-stationarity is not a KKT point's.
+std::optional<TwistStart> onLowerBranch(const PlanningProblem& problem, const TwistStart& answer,
+                                        SolveContext& context) {
+  const double twist = twistOf(answer.result.maneuver.attitude.back(), problem.end_condition);
+  const std::size_t first = context.attempts().size();
+  std::optional<PlanResult> probe;
+  double probe_twist = twist;
+  for (const double side : {-1.0, 1.0}) {
+    const double at = std::remainder(twist + side * kBranchProbeOffset, 2.0 * M_PI);
+    std::optional<PlanResult> r = fixedTwistProbe(problem, at, context);
+    const double least = probe ? probe->minimum_duration : answer.result.minimum_duration;
+    if (r && r->minimum_duration < least) {
+      probe = std::move(r);
+      probe_twist = at;
+    }
+  }
+  if (!probe || context.stopReason()) return std::nullopt;
+  TwistStart s{probe_twist, {}, std::nullopt};
+  const PlanningProblem posed =
+      endingAt(problem, pointingAttitude(problem.end_condition, probe_twist));
+  std::optional<PlanResult> freed =
+      freeTimeFromPlan(posed, probe->maneuver, probe->minimum_duration, "fixed-twist probe",
+                       context, nullptr, StartBarrier::NearKktPoint);
+  if (!freed) return std::nullopt;
+  s.result = std::move(*freed);
+  s.result.minimum_time.solves = 3;
+  tagStartsAttempts(context, first, &s);
+  s.result.attempts = context.attemptsFrom(first);
+  return s;
+}
+
 }  // namespace
 
 PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& context,
@@ -303,6 +366,13 @@ PlanResult pointingMinimumTime(const PlanningProblem& problem, SolveContext& con
     // No survey, or its answer did not carry to N: every start twist on N.
     std::vector<TwistStart> on_grid = overStartTwists(problem, context, posedAt(problem));
     starts.insert(starts.end(), on_grid.begin(), on_grid.end());
+  }
+  for (int round = 0; round < kBranchProbeRounds && !context.stopReason(); ++round) {
+    const int answer = leastDuration(starts, problem.steps);
+    if (answer < 0) break;
+    std::optional<TwistStart> lower = onLowerBranch(problem, starts[answer], context);
+    if (!lower) break;
+    starts.push_back(std::move(*lower));
   }
   if (starts.empty()) {
     PlanResult none;

@@ -23,7 +23,10 @@ using MinimumTimeRecipe = std::function<PlanResult(const PlanningProblem& posed)
 /// plan (the fixed-twist plan kept where that ends above it) and one from the slew itself, else
 /// `recipe` there; the survey's least T* carried to N through factor-2 levels (one free-time solve
 /// with ψ free per level from the coarser plan prolonged), else `recipe` on N at its twist; where
-/// that does not converge either (or without a survey), `recipe` at every start twist on N. A
+/// that does not converge either (or without a survey), `recipe` at every start twist on N; then
+/// the least T* on N against another branch of the fixed-twist T*(ψ) beside its twist (fixed-twist
+/// free-time solves from the eigenaxis slew at ψ* ± 0.01 rad, and where one ends below it one
+/// ψ-free solve from its plan begun near that KKT point; up to 4 rounds). A
 /// start twist whose R_N a cone excludes is not posed. The ways round are the recipe's own starts.
 /// The kept answer is the converged one on N with the least T* (else the last start's on N), with
 /// every start's trail (each attempt's start_detail.twist its start twist) and the pointing summary

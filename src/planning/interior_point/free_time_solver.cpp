@@ -70,6 +70,9 @@ namespace {
 
 /// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
 constexpr double kInitialBarrier = 0.1;
+/// A start that is a neighbouring problem's KKT plan begins its barrier at this × μ₀
+/// (firstBarrier).
+constexpr double kNearKktBarrier = 1e-2;
 /// The start's h is raised at most this factor before the elastic start takes over: with spinning
 /// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
 /// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
@@ -175,6 +178,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
                       const BarrierWatch& watch);
   void setElasticBarrier(ElasticBarrier b) { elastic_barrier_ = b; }
+  void setStartBarrier(StartBarrier b) { start_barrier_ = b; }
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
   void disallowElastic() { allow_elastic_ = false; }
@@ -332,6 +336,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
   double rho_ = kElasticPenalty;
   ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
+  StartBarrier start_barrier_ = StartBarrier::Initial;
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -625,8 +630,13 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
 
 /// μ₀, or in an elastic phase begun FromViolations the μ that widens its rows' kinks to
 /// kElasticKinkWidth of the largest violation (never below μ₀; the effort weight ε stays at ε₀
-/// while μ is above μ₀: prepare).
+/// while μ is above μ₀: prepare), or from a start that is a neighbouring problem's KKT plan
+/// (StartBarrier::NearKktPoint) kNearKktBarrier μ₀: measured on a held-out pointing request whose
+/// fixed-twist T*(ψ) has two branches, the ψ-free solve from the lower branch's KKT plan ended on
+/// the upper branch begun at μ₀ and at μ₀/10, and stayed on its own begun at μ₀/100 (26
+/// iterations) and μ₀/1000 (48).
 double FreeTimeSolver::firstBarrier() const {
+  if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint) return kNearKktBarrier * mu0_;
   if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
   return std::max(mu0_, kElasticKinkWidth * rho_ * -smallestValue(np_.current(), true));
 }
@@ -783,7 +793,7 @@ std::string freeTimeUnsupported(const PlanningProblem&) {
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch,
-                              ElasticBarrier elastic_barrier) {
+                              ElasticBarrier elastic_barrier, StartBarrier start_barrier) {
   PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -808,6 +818,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     const Matrix3 start_end = np.finalAttitude();
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     solver.setElasticBarrier(elastic_barrier);
+    solver.setStartBarrier(start_barrier);
     if (const std::string outside = solver.startInside(); !outside.empty()) {
       recordVerdict(&failed, verdicts::NoStrictlyFeasibleStart{outside});
       return failed;
@@ -820,6 +831,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     np.setCurrent(start_steps);
     FreeTimeSolver raised(problem, &np, constraints, parameters);
     raised.disallowElastic();
+    raised.setStartBarrier(start_barrier);
     if (!raised.startInside().empty()) return out;
     return raised.run(tolerance, max_iterations, context, watch);
   } catch (const StepTooLarge& e) {

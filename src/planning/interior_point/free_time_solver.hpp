@@ -72,6 +72,12 @@ struct FreeTimeOutcome {
 /// free_time_solver.cpp kElasticKinkWidth). The two reach different KKT points from one start.
 enum class ElasticBarrier { Initial, FromViolations };
 
+/// Where a start strictly inside (or raised inside) begins its barrier: at μ₀, or (NearKktPoint)
+/// at kNearKktBarrier μ₀ for a start that is already a KKT plan of a neighbouring problem (a
+/// fixed-twist minimum-time plan started with the twist free): begun at μ₀ the barrier re-centres
+/// such a start and may carry it to another local minimum (free_time_solver.cpp).
+enum class StartBarrier { Initial, NearKktPoint };
+
 /// A solved barrier problem of a free-time solve: its point on the central path at μ.
 struct BarrierPoint {
   double mu = 0.0;
@@ -122,7 +128,8 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch = {},
-                              ElasticBarrier elastic_barrier = ElasticBarrier::Initial);
+                              ElasticBarrier elastic_barrier = ElasticBarrier::Initial,
+                              StartBarrier start_barrier = StartBarrier::Initial);
 /// The same in a context of its own with default options (no budget, no callback): for tests and
 /// studies that run one free-time solve outside a request. Its iterations: every run's.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,

@@ -117,7 +117,9 @@ struct Tally {
         << (o.steps > 0 ? " --steps " + std::to_string(o.steps) : "") << "`), load average "
         << st::loadAverage()
         << ". The requests: the minimum-time requests with a nonzero end rate of the seeded "
-           "bounded suite (test/support/bounded_requests.hpp), re-posed as the command says. "
+           "bounded suite (test/support/bounded_requests.hpp; their bounds fractions of the stored "
+           "references in test/data/bounded_references.csv, the same requests on every library), "
+           "re-posed as the command says. "
            "Check: a minimum-effort plan at 0.99 T* refutes T* (planAndCheck).\n\n"
         << "| outcome | requests |\n|---|---|\n";
     for (const auto& [name, n] : outcomes) out << "| " << name << " | " << n << " |\n";

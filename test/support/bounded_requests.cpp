@@ -9,6 +9,7 @@
 #include "attitude_planner/analysis/replanning.hpp"
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
+#include "support/bounded_references.hpp"
 #include "support/random_problems.hpp"
 
 namespace attitude_planner {
@@ -25,50 +26,30 @@ double fractionOf(std::uint64_t seed, double lo, double hi) {
   return lo + (hi - lo) * u;
 }
 
-double peakNorm(const std::vector<Vector3>& v) {
-  double peak = 0.0;
-  for (const Vector3& x : v) peak = std::max(peak, x.norm());
-  return peak;
-}
-
-Vector3 peakPerAxis(const std::vector<Vector3>& v) {
-  Vector3 peak = Vector3::Zero();
-  for (const Vector3& x : v) peak = peak.cwiseMax(x.cwiseAbs());
-  return peak;
-}
-
 }  // namespace
 
 std::optional<BoundedRequest> boundedRequest(std::uint64_t suite_seed, int index) {
   const RandomCase base = randomCase(suite_seed, index);
-  PlanResult unbounded;
-  try {
-    unbounded = planManeuver(base.problem);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (!unbounded.converged()) return std::nullopt;
+  const BoundedReference ref = storedReference(suite_seed, index);
+  if (!ref.converged) return std::nullopt;
   BoundedRequest r;
   r.index = index;
   r.problem = base.problem;
   r.fraction = fractionOf(base.seed, 0.6, 0.9);
-  const Maneuver& plan = unbounded.maneuver;
   static const char* kKinds[] = {"norm", "box", "norm+rate", "replan"};
   r.kind = kKinds[index % 4];
   if (r.kind == "replan") {
-    const int k = plan.steps() / 3;
-    r.problem = remainderProblem(base.problem, k, plan.attitude[k], plan.angular_velocity[k]);
-    const std::vector<Vector3> rest(plan.torque.begin() + k, plan.torque.end());
-    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * peakNorm(rest))};
+    r.problem = remainderProblem(base.problem, ref.rest_node, ref.rest_attitude, ref.rest_rate);
+    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * ref.rest_peak_torque)};
   } else if (r.kind == "box") {
-    r.problem.max_torque = r.fraction * peakPerAxis(plan.torque);
+    r.problem.max_torque = r.fraction * ref.peak_axis_torque;
   } else {
-    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * peakNorm(plan.torque))};
+    r.problem.constraints = {PlanningConstraint::maxTorqueNorm(r.fraction * ref.peak_torque)};
   }
   if (r.kind == "norm+rate") {
     const double boundary =
         std::max(base.problem.initial_velocity.norm(), base.problem.final_velocity.norm());
-    const double rate = fractionOf(base.seed >> 7, 0.8, 1.0) * peakNorm(plan.angular_velocity);
+    const double rate = fractionOf(base.seed >> 7, 0.8, 1.0) * ref.peak_rate;
     r.problem.constraints.push_back(PlanningConstraint::maxAngularRate(std::max(rate, boundary)));
   }
   if ((index / 4) % 4 == 3) {

@@ -4,15 +4,20 @@
 // docs/results/bounded_verdicts.md).
 //
 // Request `index` starts from robustness::randomCase(suite_seed, index) (random body, attitudes,
-// spinning or resting ends, horizon, N) and its unbounded minimum-effort plan, then bounds it by
-// kind (index mod 4):
-//   norm       |τ| ≤ f·(the plan's peak |τ_k|)
-//   box        |τ_i| ≤ f·(the plan's peak |τ_i|), each axis
-//   norm+rate  the norm bound and |Ω| ≤ max(boundary rates, f'·(the plan's peak |Ω_k|))
-//   replan     the rest of the plan from node N/3 (analysis/replanning's remainderProblem, a
-//              spinning start), under the norm bound of the rest's peak
+// spinning or resting ends, horizon, N) and bounds it by kind (index mod 4), against the case's
+// stored reference (test/support/bounded_references.hpp: the peaks of its unbounded
+// minimum-effort plan as one library planned it once, kept in test/data/bounded_references.csv,
+// so a request is a function of (suite_seed, index) alone and no planner change moves it):
+//   norm       |τ| ≤ f·(the reference's peak |τ_k|)
+//   box        |τ_i| ≤ f·(the reference's peak |τ_i|), each axis
+//   norm+rate  the norm bound and |Ω| ≤ max(boundary rates, f'·(the reference's peak |Ω_k|))
+//   replan     the rest of the reference plan from node N/3 (analysis/replanning's
+//              remainderProblem from the reference's state there, a spinning start), under the
+//              norm bound of the rest's peak
 // with f drawn in [0.6, 0.9] (f' in [0.8, 1.0]). Every fourth request of a kind is asked as
-// minimum time instead (the bound in force, no duration).
+// minimum time instead (the bound in force, no duration). A case whose reference plan did not
+// converge has no request; a seed without references, or a stale reference, is refused
+// (std::runtime_error naming the seed and index).
 #pragma once
 
 #include <cstdint>
@@ -33,8 +38,9 @@ struct BoundedRequest {
   std::string label;    ///< the random case's label, the kind and f
 };
 
-/// Request `index` of the suite, or nothing where its unbounded plan does not converge (no peak
-/// to bound by).
+/// Request `index` of the suite, or nothing where its reference plan did not converge (no peak
+/// to bound by). Throws std::runtime_error where the reference file has no entry for it or a
+/// stale one.
 std::optional<BoundedRequest> boundedRequest(std::uint64_t suite_seed, int index);
 
 /// One request planned and its verdict checked independently of the planner's own words.

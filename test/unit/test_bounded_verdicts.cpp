@@ -8,10 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <random>
 #include <string>
 #include <variant>
+
+#include <unistd.h>
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
@@ -21,6 +26,7 @@
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
+#include "support/bounded_references.hpp"
 #include "support/bounded_requests.hpp"
 #include "support/random_problems.hpp"
 #include "support/scene_problem.hpp"
@@ -283,6 +289,56 @@ TEST(BoundedVerdicts, SeededBoundedRequestsHaveHonestVerdicts) {
     EXPECT_EQ(check.wrong, "") << check.result.message();
   }
   EXPECT_GE(requests, 12);
+}
+
+TEST(BoundedVerdicts, TheSuitesRequestsComeFromStoredReferencesAndAMissingOrStaleOneIsRefused) {
+  // A request is a function of (seed, index) alone: its bounds are fractions of a stored
+  // reference (the unbounded plan's peaks as planned once), never of this library's own plan. A
+  // file without the entry, or with an entry whose random case now draws another duration, is
+  // refused naming the seed and the request.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::string good = (dir / ("bounded_references_" + std::to_string(::getpid()) + ".csv"));
+  const std::string stale = good + ".stale.csv";
+  robustness::writeReferences(4545, 2, good);
+  const robustness::BoundedReference first = robustness::storedReference(4545, 0, good);
+  ASSERT_TRUE(first.converged);
+  EXPECT_GT(first.peak_torque, 0.0);
+  EXPECT_EQ(first.rest_node, first.steps / 3);
+  std::ifstream in(good);
+  std::ofstream out(stale);
+  for (std::string line; std::getline(in, line);) {
+    // The duration of request 1 (third field) moved by a part in 1e12.
+    if (line.rfind("4545,1,", 0) == 0) {
+      const std::size_t end = line.find(',', 7);
+      char moved[40];
+      std::snprintf(moved, sizeof moved, "%.17g", std::stod(line.substr(7, end - 7)) * (1 + 1e-12));
+      line = "4545,1," + std::string(moved) + line.substr(end);
+    }
+    out << line << "\n";
+  }
+  out.close();
+  const auto refusal = [](std::uint64_t seed, int index, const std::string& path) {
+    try {
+      robustness::storedReference(seed, index, path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal(4545, 2, good).find("seed 4545 request 2: no reference"), std::string::npos);
+  EXPECT_NE(refusal(4546, 0, good).find("seed 4546 request 0: no reference"), std::string::npos);
+  EXPECT_NE(refusal(4545, 1, stale).find("seed 4545 request 1: the reference"), std::string::npos);
+  EXPECT_NE(refusal(4545, 1, stale).find("is stale"), std::string::npos);
+  EXPECT_EQ(refusal(4545, 0, stale), "");
+  // The repository's references give the suite's requests their bounds: f times the peak.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(4545, 0);
+  ASSERT_TRUE(request.has_value());
+  ASSERT_EQ(request->kind, "norm");
+  const robustness::BoundedReference stored = robustness::storedReference(4545, 0);
+  ASSERT_EQ(request->problem.constraints.size(), 1u);
+  EXPECT_EQ(request->problem.constraints[0].limit, request->fraction * stored.peak_torque);
+  std::filesystem::remove(good);
+  std::filesystem::remove(stale);
 }
 
 TEST(BoundedVerdicts, AnAnswerStoppedShortSaysWhetherItHoldsAPlanAtT) {

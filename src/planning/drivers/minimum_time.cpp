@@ -535,8 +535,8 @@ struct LadderClimb {
 };
 
 /// One rung: minimum effort at the stage's T from the last rung's plan, continued once from its
-/// own iterate where the iteration limit stopped it inside the bounds (the reduced problem's
-/// iterates meet the dynamics and the boundary data, so such an iterate is a start).
+/// own iterate where the iteration limit stopped it at a plan of the rung (provesFeasible: the
+/// dynamics step by step, the ends and every bound), so such an iterate is a start.
 PlanResult ladderRung(const PlanningProblem& rung, const Maneuver& from, SolveContext& context,
                       int* solves) {
   const auto solve = [&](const Maneuver& start) {
@@ -549,8 +549,7 @@ PlanResult ladderRung(const PlanningProblem& rung, const Maneuver& from, SolveCo
     });
   };
   PlanResult r = solve(from);
-  if (r.termination == Termination::NotConverged && !r.maneuver.attitude.empty() &&
-      checkConstraints(rung, r.maneuver).withinBounds()) {
+  if (r.termination == Termination::NotConverged && provesFeasible(rung, r)) {
     const Maneuver inside = r.maneuver;
     r = solve(inside);
   }

@@ -563,6 +563,24 @@ TEST(BoundedVerdicts, APaperPlansLastFreeStepIsTheStepTheLeastRateBeforeTheEndBo
   EXPECT_GE(m.angular_velocity[N - 2].norm(), leastRateBeforeTheEnd(p, p.duration) * (1 - 1e-12));
 }
 
+namespace {
+
+/// A random body (moments in [0.5, 4.5], random axes) on N = 64 ending at a random rate on the
+/// rate limit under a random norm bound (spinningEnd).
+PlanningProblem finalRateOnTheLimit(std::mt19937_64& rng,
+                                    std::uniform_real_distribution<double>& unit,
+                                    std::normal_distribution<double>& normal) {
+  const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
+  const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
+  const Vector3 rate =
+      (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+  PlanningProblem p = spinningEnd(moments, R, rate, 0.05 + 2 * unit(rng), rate.norm());
+  p.steps = 64;
+  return p;
+}
+
+}  // namespace
+
 TEST(BoundedVerdicts, AFinalRateOnTheRateLimitHasNoRoomOverTheDurationsProven) {
   // Random bodies whose final rate lies on the rate limit: wherever durations are proven to have
   // no room before the end, the least rate there exceeds the limit at random durations in them.
@@ -571,12 +589,8 @@ TEST(BoundedVerdicts, AFinalRateOnTheRateLimitHasNoRoomOverTheDurationsProven) {
   std::normal_distribution<double> normal;
   int proven = 0;
   for (int i = 0; i < 12; ++i) {
-    const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
-    const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
-    const Vector3 rate =
-        (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
-    PlanningProblem p = spinningEnd(moments, R, rate, 0.05 + 2 * unit(rng), rate.norm());
-    p.steps = 64;
+    PlanningProblem p = finalRateOnTheLimit(rng, unit, normal);
+    const Vector3 rate = p.final_velocity;
     const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
     if (!(none.to > none.from)) continue;
     ++proven;
@@ -627,12 +641,8 @@ TEST(BoundedVerdicts, AMinimumEffortRequestInARangeWithoutRoomIsProvenInfeasible
   std::normal_distribution<double> normal;
   int ranges = 0;
   for (int i = 0; i < 16; ++i) {
-    const Vector3 moments(0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng), 0.5 + 4 * unit(rng));
-    const Matrix3 R = so3::exp(Vector3(normal(rng), normal(rng), normal(rng)));
-    const Vector3 rate =
-        (0.5 + 4 * unit(rng)) * Vector3(normal(rng), normal(rng), normal(rng)).normalized();
-    PlanningProblem p = spinningEnd(moments, R, rate, 0.05 + 2 * unit(rng), rate.norm());
-    p.steps = 64;
+    PlanningProblem p = finalRateOnTheLimit(rng, unit, normal);
+    const Vector3 rate = p.final_velocity;
     const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
     if (!(none.to > none.from) || none.everywhere) continue;
     ++ranges;

@@ -31,7 +31,7 @@ keep_out_grids = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(keep_out_grids)
 vec = keep_out_grids.vec
 
-TARGET = 10.0  # issue 40: minimum time at most 10x one minimum-effort solve at 1.05 T*
+TARGET = 10.0  # the target: minimum time at most 10x one minimum-effort solve at 1.05 T*
 EFFORT_AT = 1.05  # the minimum-effort solve's duration over T*
 MIN_BOUND, MAX_BOUND = 0.005, 0.05  # the torque bound per axis over the largest moment [1/s^2]
 

@@ -306,10 +306,11 @@ TEST(ExtremalClasses, UnderAKeepOutConeTheDefaultIsNoCostlierThanAnyClassOnEvery
 
 // Seeded keep-out slews on a coarse grid: the answer keeps the basin the finer grid's answer is
 // in (h·cost within the paper scheme's own discretization between N = 32 and 64, about 5 %, and
-// the 10 % the issue allows). Before, where the plan round the cone cut it between two nodes by
-// more than 1e-3 rad, a costlier class that holds it answered (seed 7002's first request: h·cost
-// 0.60 at N = 32 against 0.18 at N = 64); now that plan is solved again from itself with the
-// cone's node bound tightened by the margin its longest step needs, and says so.
+// the 10 % the issue allows). Where the plan round the cone cuts it between two nodes by more than
+// 1e-3 rad, the between-nodes rule alone would answer with a costlier class that holds it (seed
+// 7002's first request: h·cost 0.60 at N = 32 against 0.18 at N = 64); that plan is solved again
+// from itself with the cone's node bound tightened by the margin its longest step needs, and says
+// so.
 TEST(ExtremalClasses, OnACoarseGridTheAnswerKeepsItsBasinWhereThePlanRoundTheConeCutsIt) {
   constexpr int kCases = 12;
   Draw draw(7002);

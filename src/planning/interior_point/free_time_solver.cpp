@@ -127,7 +127,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
         return conesAfterRaise();
       }
       const double raised = np_.timeStep() * parameters_.free_time_start_growth;
-      if (allow_elastic_ && raised > kLargestRaise * h_start) {
+      if (allow_elastic_ && !raisesUntilInside() && raised > kLargestRaise * h_start) {
         return startElastic(h_start, steps_start);
       }
       if (!raisedTo(raised)) {
@@ -140,6 +140,16 @@ class FreeTimeSolver final : public PrimalDualProblem {
            std::to_string(std::pow(parameters_.free_time_start_growth,
                                    parameters_.free_time_max_start_growths)) +
            " times the start's duration";
+  }
+
+  /// StartRaise::UntilInside where it applies: rest to rest, without wheels, a raise of h at fixed
+  /// attitudes scales every row that moves with h down (torques like 1/h², rates like 1/h), so it
+  /// reaches a strictly feasible start however far outside the start's own T is. (A wheel's
+  /// momentum keeps its initial value; with spinning ends an end torque carries the boundary
+  /// momentum: kLargestRaise.)
+  bool raisesUntilInside() const {
+    return start_raise_ == StartRaise::UntilInside && problem_.initial_velocity.isZero(0.0) &&
+           problem_.final_velocity.isZero(0.0) && !problem_.reaction_wheels.present();
   }
 
   /// Empty where every cone still holds strictly at the raised h, else why not: with spinning
@@ -179,6 +189,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
                       const BarrierWatch& watch);
   void setElasticBarrier(ElasticBarrier b) { elastic_barrier_ = b; }
   void setStartBarrier(StartBarrier b) { start_barrier_ = b; }
+  void setStartRaise(StartRaise r) { start_raise_ = r; }
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
   void disallowElastic() { allow_elastic_ = false; }
@@ -337,6 +348,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   double rho_ = kElasticPenalty;
   ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
   StartBarrier start_barrier_ = StartBarrier::Initial;
+  StartRaise start_raise_ = StartRaise::Bounded;
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -793,7 +805,8 @@ std::string freeTimeUnsupported(const PlanningProblem&) {
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch,
-                              ElasticBarrier elastic_barrier, StartBarrier start_barrier) {
+                              ElasticBarrier elastic_barrier, StartBarrier start_barrier,
+                              StartRaise start_raise) {
   PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -819,6 +832,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     FreeTimeSolver solver(problem, &np, constraints, parameters);
     solver.setElasticBarrier(elastic_barrier);
     solver.setStartBarrier(start_barrier);
+    solver.setStartRaise(start_raise);
     if (const std::string outside = solver.startInside(); !outside.empty()) {
       recordVerdict(&failed, verdicts::NoStrictlyFeasibleStart{outside});
       return failed;

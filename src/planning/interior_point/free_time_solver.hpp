@@ -78,6 +78,14 @@ enum class ElasticBarrier { Initial, FromViolations };
 /// such a start and may carry it to another local minimum (free_time_solver.cpp).
 enum class StartBarrier { Initial, NearKktPoint };
 
+/// How far a start outside the bounds that move with h is raised before its elastic phase takes
+/// over. Bounded: at most kLargestRaise (free_time_solver.cpp), for a start whose T is near its
+/// answer's (a coarser grid's T*, a plan's own T), whose local violations a raise would trade
+/// for a start far from T*. UntilInside: as far as needed where a raise scales every such row
+/// down (rest to rest, no wheel momentum; elsewhere Bounded), for a start whose T is a guess (the
+/// structured starts: the eigenaxis slew's profile).
+enum class StartRaise { Bounded, UntilInside };
+
 /// A solved barrier problem of a free-time solve: its point on the central path at μ.
 struct BarrierPoint {
   double mu = 0.0;
@@ -129,7 +137,8 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch = {},
                               ElasticBarrier elastic_barrier = ElasticBarrier::Initial,
-                              StartBarrier start_barrier = StartBarrier::Initial);
+                              StartBarrier start_barrier = StartBarrier::Initial,
+                              StartRaise start_raise = StartRaise::Bounded);
 /// The same in a context of its own with default options (no budget, no callback): for tests and
 /// studies that run one free-time solve outside a request. Its iterations: every run's.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,

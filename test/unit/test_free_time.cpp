@@ -1196,3 +1196,85 @@ TEST(FreeTime, AMinimumTimeRequestReportsEveryFreeTimeIteration) {
     EXPECT_EQ(quiet.attempts.size(), r.attempts.size()) << name;
   }
 }
+
+namespace {
+
+/// A rest-to-rest slew of `angle` about a random axis, a random physical body (principal moments
+/// 2–6 kg m², random axes), per-axis torque bounds of 0.5–1.5 N m, second_order, N steps.
+ap::PlanningProblem smallRestToRestSlew(std::mt19937& rng, double angle, int steps) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), moment(1.0, 3.0), bound(0.5, 1.5);
+  const auto randomAxis = [&] {
+    ap::Vector3 v;
+    do v = ap::Vector3(unit(rng), unit(rng), unit(rng));
+    while (v.norm() < 0.1 || v.norm() > 1.0);
+    return ap::Vector3(v.normalized());
+  };
+  ap::PlanningProblem p;
+  const ap::Matrix3 axes = ap::so3::exp(M_PI * unit(rng) * randomAxis());
+  // J_i = s_j + s_k with s > 0: the triangle inequality of a physical body.
+  const ap::Vector3 s(moment(rng), moment(rng), moment(rng));
+  const ap::Vector3 principal(s(1) + s(2), s(0) + s(2), s(0) + s(1));
+  p.inertia = axes * principal.asDiagonal() * axes.transpose();
+  p.initial_attitude = ap::so3::exp(M_PI * unit(rng) * randomAxis());
+  p.final_attitude = p.initial_attitude * ap::so3::exp(angle * randomAxis());
+  p.steps = steps;
+  p.scheme = ap::SchemeKind::SecondOrder;
+  p.objective = ap::Objective::MinimumTime;
+  p.max_torque = ap::Vector3(bound(rng), bound(rng), bound(rng));
+  p.duration = 1.0;
+  return p;
+}
+
+}  // namespace
+
+TEST(FreeTime, AStructuredStartFarOutsideItsBoundsIsRaisedInsideRestToRestAndReachesTheSameTStar) {
+  // A 0.3 rad excursion of a small slew at 0.96 T of the eigenaxis slew needs more than the
+  // largest raise a start's T is trusted with: StartRaise::UntilInside raises it inside (rest to
+  // rest every bound falls with h) where StartRaise::Bounded starts it elastic at its own T; both
+  // are starts of one problem and end at one KKT point.
+  std::mt19937 rng(5050);
+  int raised_inside = 0;
+  for (int i = 0; i < 6; ++i) {
+    const ap::PlanningProblem p = smallRestToRestSlew(rng, 0.3 + 0.1 * i, 32);
+    const ap::Vector3 e =
+        ap::so3::log(p.initial_attitude.transpose() * p.final_attitude).normalized();
+    const ap::Vector3 off = e.unitOrthogonal();
+    const std::vector<ap::Matrix3> start = excursion(p, off, 0.3);
+    const double T = 0.96 * ap::eigenaxisBangBangDuration(p);
+    ap::SolveContext bounded_context{ap::SolverOptions{}}, raised_context{ap::SolverOptions{}};
+    const ap::FreeTimeOutcome bounded =
+        ap::solveFreeTime(p, start, T, 1e-9, 500, bounded_context, {}, ap::ElasticBarrier::Initial,
+                          ap::StartBarrier::Initial, ap::StartRaise::Bounded);
+    const ap::FreeTimeOutcome raised =
+        ap::solveFreeTime(p, start, T, 1e-9, 500, raised_context, {}, ap::ElasticBarrier::Initial,
+                          ap::StartBarrier::Initial, ap::StartRaise::UntilInside);
+    SCOPED_TRACE("slew " + std::to_string(i));
+    ASSERT_EQ(raised.termination, ap::Termination::Converged);
+    EXPECT_FALSE(raised.elastic_start);
+    EXPECT_GT(raised.start_time_step * p.steps, T);  // raised, never lowered
+    if (bounded.elastic_start) ++raised_inside;
+    if (bounded.termination == ap::Termination::Converged) {
+      EXPECT_NEAR(raised.duration, bounded.duration, 1e-8 * bounded.duration);
+    }
+  }
+  EXPECT_GT(raised_inside, 0);  // the suite holds starts beyond the largest raise
+}
+
+TEST(FreeTime, WithSpinningEndsAStructuredStartKeepsTheLargestRaise) {
+  // An end torque carries the boundary momentum: a raise does not scale it down, so UntilInside
+  // applies rest to rest only and a spinning start far outside still starts elastic.
+  const ap::PlanningProblem p = spinningRequest(32);
+  const std::vector<ap::Matrix3> start = excursion(p, ap::Vector3::UnitX(), 0.3);
+  const double T = 0.5 * ap::eigenaxisBangBangDuration(p);
+  ap::SolveContext bounded_context{ap::SolverOptions{}}, raised_context{ap::SolverOptions{}};
+  const ap::FreeTimeOutcome bounded =
+      ap::solveFreeTime(p, start, T, 1e-9, 500, bounded_context, {}, ap::ElasticBarrier::Initial,
+                        ap::StartBarrier::Initial, ap::StartRaise::Bounded);
+  const ap::FreeTimeOutcome raised =
+      ap::solveFreeTime(p, start, T, 1e-9, 500, raised_context, {}, ap::ElasticBarrier::Initial,
+                        ap::StartBarrier::Initial, ap::StartRaise::UntilInside);
+  ASSERT_TRUE(bounded.elastic_start);  // beyond the largest raise
+  EXPECT_TRUE(raised.elastic_start);
+  EXPECT_EQ(raised.termination, bounded.termination);
+  EXPECT_EQ(raised.duration, bounded.duration);
+}

@@ -437,3 +437,41 @@ TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {
     EXPECT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);
   }
 }
+
+TEST(MinimumTime, ARefinedLevelThatEndsShortInsideItsBoundsIsResumedNotSearched) {
+  // A seeded rest-to-rest slew (scripts/minimum_time_cost.py's suite, seed 5151 #19) whose
+  // refined N = 128 level ends at T* to 5e-12 with the line search at the round-off floor's edge
+  // (stationarity 1.6e-7 against a floor of 1e-7): resumed once from its plan near its KKT point
+  // it converges; the search (8,000 iterations to the same T*) is not called.
+  const ap::PlanningProblem p =
+      ap::parseScene(
+          "inertia: [[37.942331065999042, -9.940262472178965, -0.54713097154135104], "
+          "[-9.940262472178965, 87.639038417557217, -6.7793602938197282], "
+          "[-0.54713097154135104, -6.7793602938197282, 68.316047644971533]]\n"
+          "steps: 128\nscheme: second_order\nobjective: minimum_time\n"
+          "initial: {attitude: {quaternion: [0.30420894468912485, 0.35090835614762134, "
+          "0.8667078296694426, -0.18203785745439782]}, angular_velocity: [0, 0, 0]}\n"
+          "final: {attitude: {quaternion: [0.10920734642478444, 0.36399012897649846, "
+          "0.82113032291792754, 0.42582852684998618]}, angular_velocity: [0, 0, 0]}\n"
+          "effects: [{actuator_limits: {max_torque: [3.0151134918152644, 4.0674412081972342, "
+          "2.0525554664996215]}}]\n")
+          .problem;
+  const ap::PlanResult r = ap::planManeuver(p);
+  ASSERT_TRUE(r.converged()) << r.message();
+  EXPECT_TRUE(r.minimum_time.kkt_point);
+  const auto ended_short =
+      std::find_if(r.attempts.begin(), r.attempts.end(), [](const ap::Attempt& a) {
+        return a.stage == ap::AttemptStage::MinimumTimeSolve &&
+               a.start == ap::AttemptStart::CoarseLevel && a.steps == 128 &&
+               a.termination == ap::Termination::NotConverged;
+      });
+  ASSERT_NE(ended_short, r.attempts.end())
+      << "the refined level converged at once: " << r.message();
+  const auto resumed = std::next(ended_short);
+  ASSERT_NE(resumed, r.attempts.end());
+  EXPECT_EQ(resumed->start, ap::AttemptStart::PreviousAttempt);
+  EXPECT_EQ(resumed->steps, 128);
+  EXPECT_TRUE(resumed->kept);
+  EXPECT_EQ(resumed->start_detail.duration, ended_short->cost);  // from its plan, at its T
+  for (const ap::Attempt& a : r.attempts) EXPECT_NE(a.stage, ap::AttemptStage::MinimumTimeProbe);
+}

@@ -8,7 +8,7 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
-#include "planning/interior_point/free_time_twist.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "planning/transcription/stage_transcription.hpp"
@@ -30,10 +30,35 @@ struct SummedEntries {
   double path_term = 0.0;  ///< the part of `time` from the path's curvature at R_{N−1}
 };
 
+/// The ψ entries a KktSink over (δ, η, ψ) and addLocalVector left: ∂L/∂ψ, ∂²L/∂ψ∂η, ∂²L/∂ψ²,
+/// ∂²L/∂δ∂ψ, and ∂L/∂η, ∂²L/∂η², ∂L/∂δ.
+struct Scattered {
+  KktBlocks<double> kkt;
+  Eigen::VectorXd gradient;
+  Scattered(const ReducedProblem& rp, double h0)
+      : kkt(rp.unknowns()), sink(rp, FreeTimeStep{h0}, &kkt), rp_(rp) {
+    gradient = Eigen::VectorXd::Zero(rp.unknowns() + 2);
+  }
+  /// One local block with its Lagrangian gradient, as the solver scatters it.
+  void add(int first, int width, const Eigen::Matrix<double, 10, 10>& H,
+           const Eigen::Matrix<double, 10, 1>& lagrangian) {
+    sink.addBlock(first, width, H, &lagrangian);
+    addLocalVector<FreeTimeStep>(rp_, lagrangian, 1.0, first, width, &gradient);
+  }
+  double twistGradient() const { return gradient(rp_.unknowns() + 1); }
+  double time() const { return kkt.corner(0, 1); }
+  double twist() const { return kkt.corner(1, 1); }
+  Eigen::VectorXd nodes() const { return kkt.border.col(1); }
+  KktSink<double, FreeTimeStep> sink;
+
+ private:
+  const ReducedProblem& rp_;
+};
+
 SummedEntries summedEntries(const ReducedProblem& rp) {
   const double h0 = rp.timeStep();
   SummedEntries sum;
-  sum.nodes = Eigen::VectorXd::Zero(rp.unknowns());
+  Scattered scattered(rp, h0);
   rp.forEachStencilWithTimeStep([&](const ReducedProblem::TimeStepStencil& st) {
     Eigen::Matrix<double, 3, 10> G;
     G.leftCols<9>() = st.jacobian;
@@ -44,20 +69,17 @@ SummedEntries summedEntries(const ReducedProblem& rp) {
     H.block<1, 9>(9, 0) += (st.second_h * h0).transpose();
     H(9, 9) += st.second_hh * h0 * h0;
     const Eigen::Matrix<double, 10, 1> lagrangian = G.transpose() * st.tau;
-    const TwistEntries t = twistEntries(rp, st.k - 1, 3, h0, H, -lagrangian, lagrangian);
-    sum.gradient += t.lagrangian;
-    sum.time += t.time;
-    sum.twist += t.twist;
+    scattered.add(st.k - 1, 3, H, lagrangian);
     const int slot = rp.steps() - 1 - (st.k - 1);
     if (slot >= 0 && slot < 3) {
       const Vector3 e = rp.twistMotion(rp.steps() - 1), d = rp.nodePath(rp.steps() - 1).first * h0;
       sum.path_term += lagrangian.segment<3>(3 * slot).dot(0.5 * e.cross(d));
     }
-    for (int s = 0; s < 3; ++s) {
-      const int v = rp.variableIndex(st.k - 1 + s);
-      if (v >= 0) sum.nodes.segment<3>(v) += t.nodes.segment<3>(3 * s);
-    }
   });
+  sum.gradient = scattered.twistGradient();
+  sum.time = scattered.time();
+  sum.twist = scattered.twist();
+  sum.nodes = scattered.nodes();
   return sum;
 }
 
@@ -121,7 +143,7 @@ struct RowSums {
 
 RowSums rowSums(const PlanningProblem& p, const ReducedProblem& rp, double h0) {
   RowSums sum;
-  sum.nodes = sum.node_gradient = Eigen::VectorXd::Zero(rp.unknowns());
+  Scattered scattered(rp, h0);
   const StageConstraints constraints = buildStageConstraints(p);
   const QuantityInputs at(rp, rp.current());
   const auto unit = [](int, const Vector3&) { return Vector3(1.0, 0.0, 0.0); };
@@ -133,21 +155,17 @@ RowSums rowSums(const PlanningProblem& p, const ReducedProblem& rp, double h0) {
     for (int k = support.first_k; k <= support.last_k; ++k) sum.value += q.value(at, k)(0);
     q.forEachTermsWithTimeStep(rp, support, h0, unit, [&](const QuantityTermsWithTimeStep& t) {
       const Eigen::Matrix<double, 10, 1> g = t.jacobian.row(0).transpose();
-      const int first = t.k + support.node_offset;
-      const TwistEntries e = twistEntries(rp, first, support.width, h0, t.curvature, -g, g);
-      sum.gradient += e.lagrangian;
-      sum.time += e.time;
-      sum.twist += e.twist;
-      sum.time_gradient += g(9);
-      sum.time_curvature += t.curvature(9, 9);
-      for (int s = 0; s < support.width; ++s) {
-        const int v = rp.variableIndex(first + s);
-        if (v < 0) continue;
-        sum.nodes.segment<3>(v) += e.nodes.segment<3>(3 * s);
-        sum.node_gradient.segment<3>(v) += g.segment<3>(3 * s);
-      }
+      scattered.add(t.k + support.node_offset, support.width, t.curvature, g);
     });
   }
+  const int n = rp.unknowns();
+  sum.gradient = scattered.twistGradient();
+  sum.time = scattered.time();
+  sum.twist = scattered.twist();
+  sum.time_gradient = scattered.gradient(n);
+  sum.time_curvature = scattered.kkt.corner(0, 0);
+  sum.nodes = scattered.nodes();
+  sum.node_gradient = scattered.gradient.head(n);
   return sum;
 }
 
@@ -274,9 +292,13 @@ TEST(FreeTimeTwist, WithoutPointingNoEntries) {
   PlanningProblem p = test_support::randomPointingRequest(19, 16, true, SchemeKind::Paper);
   p.end_condition = EndCondition();
   const ReducedProblem rp(p);
-  const Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Identity();
+  KktBlocks<double> kkt(rp.unknowns());
+  KktSink<double, FreeTimeStep> sink(rp, FreeTimeStep{rp.timeStep()}, &kkt);
   const Eigen::Matrix<double, 10, 1> g = Eigen::Matrix<double, 10, 1>::Ones();
-  EXPECT_FALSE(twistEntries(rp, p.steps - 2, 3, rp.timeStep(), H, g, g).any);
+  sink.addBlock(p.steps - 2, 3, Eigen::Matrix<double, 10, 10>::Identity(), &g);
+  EXPECT_EQ(kkt.globals(), 1);  // η alone
+  EXPECT_EQ(kkt.border.cols(), 1);
+  EXPECT_GT(kkt.corner(0, 0), 0.0);
 }
 
 TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {

@@ -61,8 +61,8 @@ MeritAt meritAt(const PlanningProblem& p, const ReducedProblem& rp, double dpsi,
   MeritAt out;
   out.merit = system.merit(q.current(), mu, rho, nullptr);
   Eigen::VectorXd rhs;
-  BandedSymmetricMatrix band(q.unknowns(), ReducedProblem::kHalfBandwidth);
-  system.assemble<double>(mu, rho, true, &band, &rhs, &out.gradient);  // slacks formed
+  KktBlocks<double> kkt(q.unknowns());
+  system.assemble<double>(mu, rho, true, &kkt, &rhs, &out.gradient);  // slacks formed
   return out;
 }
 
@@ -83,12 +83,13 @@ TEST(ConstrainedTwist, BorderAndGradientMatchCentralDifferencesForEveryScheme) {
     ConstrainedSystem system(p, &rp, Formulation::Elastic, parameters);
     ASSERT_EQ(system.globals(), 1);
     const double merit = system.merit(rp.current(), mu, rho, nullptr);
-    BandedSymmetricMatrix band(n, ReducedProblem::kHalfBandwidth);
+    KktBlocks<double> kkt(n);
     Eigen::VectorXd rhs, gradient;
-    system.assemble<double>(mu, rho, true, &band, &rhs, &gradient);
+    system.assemble<double>(mu, rho, true, &kkt, &rhs, &gradient);
     ASSERT_EQ(gradient.size(), n + 1);
-    const Eigen::VectorXd border = system.twistBorder().column;
-    const double corner = system.twistBorder().corner;
+    ASSERT_EQ(kkt.globals(), 1);
+    const Eigen::VectorXd border = kkt.border.col(0);
+    const double corner = kkt.corner(0, 0);
     EXPECT_GT(std::abs(gradient(n)), 1e-6);  // ψ matters here: the test can fail
     const double e = 1e-5;
     const MeritAt plus = meritAt(p, rp, e, mu, rho), minus = meritAt(p, rp, -e, mu, rho);

@@ -1,6 +1,6 @@
 // Minimum time to a pointing end condition (R_N b = d, the twist ψ about b free): the request's
 // minimum-time recipe (drivers/minimum_time.cpp) run from several start twists, ψ a global
-// unknown of every free-time solve (interior_point/free_time_twist.hpp), the least T* kept.
+// unknown of every free-time solve (interior_point/kkt_system.hpp: KktSink), the least T* kept.
 #pragma once
 
 #include <functional>

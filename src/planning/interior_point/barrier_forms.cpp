@@ -30,11 +30,7 @@ void FreeSlacks::initialize(Row& row, double mu, double, double cap) const {
 }
 
 void FreeSlacks::addComplementarity(const Row& row, double mu, double, Complementarity* out) const {
-  const double product = row.s * row.z;
-  out->sum += product;
-  out->low = std::min(out->low, product);
-  out->worst = std::max(out->worst, std::abs(product - mu));
-  ++out->count;
+  out->add(row.s * row.z, mu);
 }
 
 template <int Entries>
@@ -86,11 +82,7 @@ double Feasible::rowMerit(const Row& row, double c, double mu, double, double,
 }
 
 void Feasible::addComplementarity(const Row& row, double mu, double, Complementarity* out) const {
-  const double product = row.z * row.c;
-  out->sum += product;
-  out->low = std::min(out->low, product);
-  out->worst = std::max(out->worst, std::abs(product - mu));
-  ++out->count;
+  out->add(row.z * row.c, mu);
 }
 
 void Feasible::afterAccept(Row& row, double mu) const {

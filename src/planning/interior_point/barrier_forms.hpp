@@ -63,6 +63,13 @@ struct Complementarity {
   double worst = 0.0;  ///< max |product − μ|: the barrier problem's complementarity residual
   int count = 0;
   double average() const { return sum / std::max(count, 1); }
+  /// One row's product (a slack or value times its multiplier) at the barrier μ.
+  void add(double product, double mu) {
+    sum += product;
+    low = std::min(low, product);
+    worst = std::max(worst, std::abs(product - mu));
+    ++count;
+  }
 };
 
 /// The ℓ1-elastic row c + v − s = 0 at its value c: the slacks s, v (elasticSlacks), the

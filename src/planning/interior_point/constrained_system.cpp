@@ -4,55 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
-#include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/multiplier_estimate.hpp"
 #include "planning/linalg/double_double.hpp"
 #include "planning/transcription/node_constraints.hpp"
 
 namespace attitude_planner {
-
-namespace {
-
-/// Adds M (local 9×9, lower triangle used) to the banded Hessian and, with a twist, (M e)_free to
-/// its border column and eᵀM e to its corner (ψ moves R_N and R_{N−1} linearly in their
-/// perturbation coordinates: reduced_problem_twist.cpp).
-template <typename Scalar>
-void addLocal(const ReducedProblem& np, BandedSymmetric<Scalar>* H, TwistBorder* border,
-              int first_node, int width, const Eigen::Matrix<double, 9, 9>& M) {
-  addBandBlock(np, H, first_node, width, M);
-  if (!border) return;
-  const Eigen::Matrix<double, 9, 1> e = localTwistMotion(np, first_node, width);
-  if (e.isZero()) return;
-  const Eigen::Matrix<double, 9, 1> Me = M.selfadjointView<Eigen::Lower>() * e;
-  border->corner += e.dot(Me);
-  addNodeVector(np, Me, 1.0, first_node, width, border->column);
-}
-
-/// Adds weight·g gᵀ (local) to the banded Hessian, each product formed in its own precision (see
-/// interior_point_solver.cpp: the precision rule). Rounding the weight only scales the term. With
-/// a twist, weight·(gᵀe)·g_free to the border and weight·(gᵀe)² to the corner.
-template <typename Scalar>
-void addLocalRankOne(const ReducedProblem& np, BandedSymmetric<Scalar>* H, TwistBorder* border,
-                     int first_node, int width, const Eigen::Matrix<double, 9, 1>& g,
-                     double weight) {
-  const LocalSlots l = localSlots(np, first_node, width);
-  if (!l.empty()) H->template addRankOne<9>(l.offset, g, weight, l.first, l.last);
-  if (!border) return;
-  const double ge = g.dot(localTwistMotion(np, first_node, width));
-  if (ge == 0.0) return;
-  border->corner += weight * ge * ge;
-  addNodeVector(np, g, weight * ge, first_node, width, border->column);
-}
-
-/// weight·g over the local nodes and, with a twist, ψ (a stencil's gradient).
-void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, 9, 1>& g, double weight,
-                    int first_node, int width, Eigen::VectorXd* out) {
-  addNodeVector(np, g, weight, first_node, width, *out);
-  FixedTimeStep::addGlobals(np, g, weight, first_node, width, out);
-}
-
-}  // namespace
 
 ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np,
                                      Formulation formulation,
@@ -92,13 +50,13 @@ void ConstrainedSystem::pollEvery(int k) const {
 }
 
 template <typename Scalar>
-Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
+Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt,
                                      Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient) {
-  const int n = np_.unknowns();
-  if (H) H->setZero();
-  if (H && np_.hasTwist()) twist_border_ = {Eigen::VectorXd::Zero(n), 0.0};
-  rhs->setZero(n + globals());
-  merit_gradient->setZero(n + globals());
+  std::optional<Sink<Scalar>> sink;
+  if (kkt) sink.emplace(np_, FixedTimeStep{}, kkt);
+  Sink<Scalar>* H = sink ? &*sink : nullptr;
+  rhs->setZero(np_.unknowns() + globals());
+  merit_gradient->setZero(np_.unknowns() + globals());
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
   for (const std::vector<int>& block : rows_.blocks) assembleQuantity(block, mu, rho, primal, H);
@@ -113,9 +71,9 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, BandedS
 /// c' = ∂c/∂τ, ∇c = Jᵀc'/√w_k and −z∇²c = Σ_i (−z c'_i/√w_k) ∇²r_i − (z c''/w_k) JᵀJ (c'' the
 /// constraint's isotropic curvature).
 template <typename Scalar>
-void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
-                                        BandedSymmetric<Scalar>* H, Eigen::VectorXd* rhs,
-                                        Eigen::VectorXd* merit_gradient, Assembly* out) {
+void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal, Sink<Scalar>* H,
+                                        Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient,
+                                        Assembly* out) {
   double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
   double jacobian_scale = 0.0, torque_scale = 0.0;
   const auto cost = [&](int, const Vector3& residual) {
@@ -138,21 +96,19 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
       if (!H) return;
       const int axis = g.constraint->axis();
       if (axis < 0) {
-        addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, in.g, 1.0 / in.D);
+        H->addRankOne(st.k - 1, 3, in.g, 1.0 / in.D);
       } else {
         weight(axis) += a(axis) * a(axis) / in.D;
       }
     };
     rows_.chainTorques(st, r, st.jacobian, fold);
     if (H) {
-      for (int a = 0; a < 3; ++a) {
-        addLocalRankOne(np_, H, twistSink(), st.k - 1, 3, st.jacobian.row(a).transpose(),
-                        weight(a));
-      }
-      addLocal(np_, H, twistSink(), st.k - 1, 3, st.second);
+      for (int a = 0; a < 3; ++a)
+        H->addRankOne(st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
+      H->addBlock(st.k - 1, 3, st.second);
     }
-    addLocalVector(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
-    addLocalVector(np_, grad_f, -1.0, st.k - 1, 3, rhs);
+    addLocalVector<FixedTimeStep>(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
+    addLocalVector<FixedTimeStep>(np_, grad_f, -1.0, st.k - 1, 3, rhs);
   };
   out->cost = rows_.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
@@ -162,7 +118,7 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal,
 /// the chain rule (StageTranscription), with each constraint's barrier term g gᵀ/D.
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
-                                         bool primal, BandedSymmetric<Scalar>* H) {
+                                         bool primal, Sink<Scalar>* H) {
   const StageSupport support = rows_.groups[block.front()].support;
   const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
     if (H) form_->prepare(in, mu, rho, primal);
@@ -170,10 +126,10 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
   const auto visit = [&](const QuantityTerms& t, const Eigen::Matrix<double, 9, 9>* curvature) {
     if (!H) return;
     const int node = t.k + support.node_offset;
-    addLocal(np_, H, twistSink(), node, support.width, *curvature);
+    H->addBlock(node, support.width, *curvature);
     for (const int i : block) {
       const FixedStepRow& in = rows_.groups[i].instance(t.k);
-      addLocalRankOne(np_, H, twistSink(), node, support.width, in.g, 1.0 / in.D);
+      H->addRankOne(node, support.width, in.g, 1.0 / in.D);
     }
   };
   rows_.forEachQuantityInstance(
@@ -412,14 +368,13 @@ void ConstrainedSystem::initializeMultipliers(double mu, double rho, double cap)
   rows_.forEach([&](auto&, int, auto& in) { form_->initialize(in, mu, rho, cap); });
 }
 
-template Assembly ConstrainedSystem::assemble<double>(double, double, bool,
-                                                      BandedSymmetric<double>*, Eigen::VectorXd*,
-                                                      Eigen::VectorXd*);
+template Assembly ConstrainedSystem::assemble<double>(double, double, bool, KktBlocks<double>*,
+                                                      Eigen::VectorXd*, Eigen::VectorXd*);
 template Assembly ConstrainedSystem::assemble<long double>(double, double, bool,
-                                                           BandedSymmetric<long double>*,
+                                                           KktBlocks<long double>*,
                                                            Eigen::VectorXd*, Eigen::VectorXd*);
 template Assembly ConstrainedSystem::assemble<DoubleDouble>(double, double, bool,
-                                                            BandedSymmetric<DoubleDouble>*,
+                                                            KktBlocks<DoubleDouble>*,
                                                             Eigen::VectorXd*, Eigen::VectorXd*);
 
 }  // namespace attitude_planner

@@ -14,6 +14,7 @@
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -36,16 +37,9 @@ struct Assembly {
   double gradient_scale = 0.0;  ///< max|∂τ/∂δ| · max|τ|
 };
 
-/// The twist ψ's border of the condensed system (a pointing end condition, ψ a global unknown):
-/// the column ∂²φ/∂δ∂ψ over the node unknowns and the corner ∂²φ/∂ψ².
-struct TwistBorder {
-  Eigen::VectorXd column;
-  double corner = 0.0;
-};
-
 /// The node constraints of one problem in one formulation, and the condensed Newton system.
 /// With a pointing end condition (ReducedProblem::hasTwist) the unknowns are (δ, ψ): every vector
-/// has unknowns() + 1 entries, ψ last, and an assembly with H fills twistBorder() too.
+/// has unknowns() + 1 entries, ψ last, and an assembly fills K's border and corner on ψ too.
 class ConstrainedSystem final : public BarrierRows {
  public:
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
@@ -54,8 +48,6 @@ class ConstrainedSystem final : public BarrierRows {
   int constraintCount() const { return rows_.count; }
   /// Global unknowns beside the node unknowns: 1 (ψ) with a pointing end condition, else 0.
   int globals() const { return FixedTimeStep::globals(np_); }
-  /// The last assembly's ψ border (globals() == 1 only).
-  const TwistBorder& twistBorder() const { return twist_border_; }
   /// ∂L/∂ψ = ∂f/∂ψ − Σ zᵢ∂cᵢ/∂ψ [N²·m²/rad] and its size relative as relativeStationarity's
   /// (set by it; 0 without a twist).
   double twistGradient() const { return twist_gradient_; }
@@ -77,11 +69,12 @@ class ConstrainedSystem final : public BarrierRows {
     return cost + constraintMerit(mu, rho, 0.0);
   }
 
-  /// Assembles the condensed Newton system at the current iterate: H, rhs, ∇φ_μ. `primal`: the
-  /// multipliers are replaced by their primal values μ/s (then the step is Newton's on φ_μ).
-  /// H = null: the constraint values and gradients only (multipliers and slacks untouched).
+  /// Assembles the condensed Newton system at the current iterate: K (the band and, with a twist,
+  /// its border and corner), rhs, ∇φ_μ. `primal`: the multipliers are replaced by their primal
+  /// values μ/s (then the step is Newton's on φ_μ). kkt = null: the constraint values and
+  /// gradients only (multipliers and slacks untouched).
   template <typename Scalar>
-  Assembly assemble(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
+  Assembly assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt,
                     Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient);
 
   // BarrierRows (the predictor–corrector's part; q for the complementarity target).
@@ -130,11 +123,13 @@ class ConstrainedSystem final : public BarrierRows {
 
  private:
   template <typename Scalar>
-  void assembleTorques(double mu, double rho, bool primal, BandedSymmetric<Scalar>* H,
-                       Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient, Assembly* out);
+  using Sink = KktSink<Scalar, FixedTimeStep>;
+  template <typename Scalar>
+  void assembleTorques(double mu, double rho, bool primal, Sink<Scalar>* H, Eigen::VectorXd* rhs,
+                       Eigen::VectorXd* merit_gradient, Assembly* out);
   template <typename Scalar>
   void assembleQuantity(const std::vector<int>& block, double mu, double rho, bool primal,
-                        BandedSymmetric<Scalar>* H);
+                        Sink<Scalar>* H);
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
@@ -142,8 +137,6 @@ class ConstrainedSystem final : public BarrierRows {
   auto formOf() const {
     return [this](const FixedStepRows&) -> const BarrierForm<9>& { return *form_; };
   }
-  /// Where the assembly's ψ border goes (null without a twist).
-  TwistBorder* twistSink() { return np_.hasTwist() ? &twist_border_ : nullptr; }
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
@@ -153,7 +146,6 @@ class ConstrainedSystem final : public BarrierRows {
   StageConstraints constraints_;            ///< buildStageConstraints(problem): one group each
   StageTranscription<FixedTimeStep> rows_;  ///< the rows and their passes over the grid
   const Interruption* interruption_ = nullptr;
-  TwistBorder twist_border_;
   double twist_gradient_ = 0.0, twist_stationarity_ = 0.0;
 };
 

@@ -50,7 +50,6 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_update.hpp"
-#include "planning/interior_point/free_time_twist.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
@@ -210,8 +209,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
-  /// ψ's column of the border (the last; its unknown is n_ + twistColumn()).
-  int twistColumn() const { return borderSize() - 1; }
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
@@ -230,16 +227,15 @@ class FreeTimeSolver final : public PrimalDualProblem {
   }
 
   double firstBarrier() const;
+  using Sink = KktSink<double, FreeTimeStep>;
   void assemble(double mu, double epsilon);
-  void assembleQuantity(const std::vector<int>& block, double mu);
+  void assembleQuantity(Sink& sink, const std::vector<int>& block, double mu);
   void leaveElasticIfInside();
-  void scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
+  /// One local block (nodes and η): its Hessian into K, its right-hand side and Lagrangian
+  /// gradient into theirs.
+  void scatter(Sink& sink, int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
                const Eigen::Matrix<double, 10, 1>& rhs,
                const Eigen::Matrix<double, 10, 1>& lagrangian);
-  /// A pointing end's ψ entries of one local block (free_time_twist.hpp).
-  void scatterTwist(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
-                    const Eigen::Matrix<double, 10, 1>& rhs,
-                    const Eigen::Matrix<double, 10, 1>& lagrangian);
   /// Back to the accepted R_N with the accepted steps (a trial's twist moved it).
   void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
@@ -355,13 +351,10 @@ class FreeTimeSolver final : public PrimalDualProblem {
 };
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
-  kkt_.band = BandedSymmetric<double>(n_, ReducedProblem::kHalfBandwidth);
-  const int b = borderSize();
-  kkt_.border.setZero(n_, b);
-  kkt_.corner.setZero(b, b);
-  rhs_.setZero(n_ + b);
-  lagrangian_gradient_.setZero(n_ + b);
   const FreeTimeStep step{h0_};
+  Sink sink(np_, step, &kkt_);
+  rhs_.setZero(n_ + borderSize());
+  lagrangian_gradient_.setZero(n_ + borderSize());
   // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
   // rows are prepared in the visit, after z entered w).
   const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
@@ -387,14 +380,14 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
     };
     rows_.chainTorques(st, s, G, fold);
     H.noalias() += G.transpose() * W * G;
-    scatter(st.k - 1, 3, H, rhs, lagrangian);
+    scatter(sink, st.k - 1, 3, H, rhs, lagrangian);
   };
   rows_.forEachTorqueStencil(np_, step, true, cost, row, visit);
   // The quantities that do not move with h first (the order the band's sums were formed in).
   for (const bool moves_with_h : {false, true}) {
     for (const std::vector<int>& block : rows_.blocks) {
       if (rows_.groups[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
-        assembleQuantity(block, mu);
+        assembleQuantity(sink, block, mu);
       }
     }
   }
@@ -405,7 +398,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// The groups of one quantity (a cone, a rate, a wheel quantity) through the quantity's terms in
 /// (local nodes, η = h/h₀) and the chain rule (StageTranscription), with each constraint's
 /// barrier term ω g gᵀ.
-void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) {
+void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block, double mu) {
   const StageSupport support = rows_.groups[block.front()].support;
   const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) {
     form(g).prepare(in, mu, rho_, false);
@@ -425,7 +418,7 @@ void FreeTimeSolver::assembleQuantity(const std::vector<int>& block, double mu) 
       rhs += terms.rhs * in.g;
       lagrangian -= in.z * in.g;
     }
-    scatter(t.k + support.node_offset, support.width, *H, rhs, lagrangian);
+    scatter(sink, t.k + support.node_offset, support.width, *H, rhs, lagrangian);
   };
   rows_.forEachQuantityInstance(
       np_, FreeTimeStep{h0_}, block, true, [](int) {}, prepare, visit);
@@ -439,37 +432,13 @@ void FreeTimeSolver::leaveElasticIfInside() {
   elastic_ = false;
 }
 
-/// Adds one instance's Hessian block (local nodes and η), right-hand side and Lagrangian gradient
-/// to the bordered system (fixed nodes skipped).
-void FreeTimeSolver::scatter(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
+void FreeTimeSolver::scatter(Sink& sink, int first_node, int width,
+                             const Eigen::Matrix<double, 10, 10>& H,
                              const Eigen::Matrix<double, 10, 1>& rhs,
                              const Eigen::Matrix<double, 10, 1>& lagrangian) {
-  addNodeVector(np_, rhs.head<9>(), 1.0, first_node, width, rhs_);
-  addNodeVector(np_, lagrangian.head<9>(), 1.0, first_node, width, lagrangian_gradient_);
-  addNodeVector(np_, H.block<9, 1>(0, 9), 1.0, first_node, width, kkt_.border.col(0));
-  rhs_(n_) += rhs(9);
-  lagrangian_gradient_(n_) += lagrangian(9);
-  kkt_.corner(0, 0) += H(9, 9);
-  addBandBlock(np_, &kkt_.band, first_node, width, H.topLeftCorner<9, 9>());
-  scatterTwist(first_node, width, H, rhs, lagrangian);
-}
-
-void FreeTimeSolver::scatterTwist(int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
-                                  const Eigen::Matrix<double, 10, 1>& rhs,
-                                  const Eigen::Matrix<double, 10, 1>& lagrangian) {
-  if (!np_.hasTwist()) return;
-  const TwistEntries t = twistEntries(np_, first_node, width, h0_, H, rhs, lagrangian);
-  if (!t.any) return;
-  const int p = twistColumn();
-  for (int node = 0; node < width; ++node) {
-    const int v = np_.variableIndex(first_node + node);
-    if (v >= 0) kkt_.border.col(p).segment<3>(v) += t.nodes.segment<3>(3 * node);
-  }
-  rhs_(n_ + p) += t.rhs;
-  lagrangian_gradient_(n_ + p) += t.lagrangian;
-  kkt_.corner(0, p) += t.time;
-  kkt_.corner(p, 0) += t.time;
-  kkt_.corner(p, p) += t.twist;
+  sink.addBlock(first_node, width, H, &lagrangian);
+  addLocalVector<FreeTimeStep>(np_, rhs, 1.0, first_node, width, &rhs_);
+  addLocalVector<FreeTimeStep>(np_, lagrangian, 1.0, first_node, width, &lagrangian_gradient_);
 }
 
 void FreeTimeSolver::restoreAcceptedEnd() {
@@ -753,7 +722,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   out.stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   out.time_row = std::abs(lagrangian_gradient_(n_));
   if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
-    out.twist_gradient = lagrangian_gradient_(n_ + twistColumn());
+    out.twist_gradient = lagrangian_gradient_(FreeTimeStep::twistIndex(np_));
   }
   out.complementarity = rows_.dualityGap();
   out.smallest_value = std::numeric_limits<double>::infinity();

@@ -128,14 +128,10 @@ class GridSolve final : public PrimalDualProblem {
   }
   /// The condensed system (primal: with the multipliers μ/s); a non-finite cost ends the solve.
   Pass assemble(bool primal) override {
-    cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_.band, &rhs_, &merit_gradient_).cost;
+    cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_, &rhs_, &merit_gradient_).cost;
     if (!std::isfinite(cost_)) {
       return end(Termination::StepTooLarge,
                  "non-finite cost (step too large for this h? increase steps)");
-    }
-    if (system_.globals() == 1) {  // the twist ψ's border (a pointing end condition)
-      kkt_blocks_.border = system_.twistBorder().column;
-      kkt_blocks_.corner = Eigen::MatrixXd::Constant(1, 1, system_.twistBorder().corner);
     }
     return Pass::Step;
   }

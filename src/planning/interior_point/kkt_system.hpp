@@ -5,9 +5,10 @@
 //     K = [ A   B ]     A  n×n banded, half bandwidth ReducedProblem::kHalfBandwidth,
 //         [ Bᵀ  D ],    B  n×m dense, D m×m (m = 0 at fixed h).
 //
-// One assembly fills KktBlocks; a KktSystem factors K plus a diagonal shift (the inertia
-// correction's, inertia_correction.hpp), reads its inertia, and solves with the last factor
-// (Mehrotra's corrector and the second-order correction reuse it).
+// One assembly fills KktBlocks through a KktSink (where each local block lands); a KktSystem
+// factors K plus a diagonal shift (the inertia correction's, inertia_correction.hpp), reads its
+// inertia, and solves with the last factor (Mehrotra's corrector and the second-order correction
+// reuse it).
 #pragma once
 
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/linalg/interruption.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_transcription.hpp"
 
 namespace attitude_planner {
 
@@ -29,9 +31,90 @@ template <typename Scalar>
 struct KktBlocks {
   explicit KktBlocks(int n) : band(n, ReducedProblem::kHalfBandwidth) {}
   int globals() const { return static_cast<int>(corner.rows()); }
+  /// Zero, sized for n node unknowns and m global ones.
+  void clear(int n, int m) {
+    if (band.size() == n) {
+      band.setZero();
+    } else {
+      band = BandedSymmetric<Scalar>(n, ReducedProblem::kHalfBandwidth);
+    }
+    border.setZero(n, m);
+    corner.setZero(m, m);
+  }
   BandedSymmetric<Scalar> band;
   Eigen::MatrixXd border;  ///< B: n × m
   Eigen::MatrixXd corner;  ///< D: m × m
+};
+
+/// Where an assembly's local pieces land in K: a block over the unknowns of at most three
+/// consecutive nodes (9 entries, a fixed node's included and skipped here) and, with h free
+/// (FreeTimeStep), η (entry 9: the border's first column). A pointing end's twist ψ, the last
+/// global unknown, moves R_N and, for paper and variational, R_{N−1} linearly in their
+/// perturbation coordinates, by e = localTwistMotion (ReducedProblem::twistMotion): a block H has
+/// the ψ-column H e and corner eᵀHe (a gradient g the ψ entry gᵀe: addLocalVector). With h free
+/// the motions compose: h moves R_{N−1} along its boundary path d(h) (ReducedProblem::nodePath),
+///     R_N exp(Δψ b^) F(h)ᵀ = R_{N−1} exp(Δψ e^) exp(d^),   x = Δψ e + d + ½ Δψ e × d + O(3)
+/// (Baker–Campbell–Hausdorff), so ∂²L/∂ψ∂η = e·H(:, η) + ∇_{x_{N−1}}L · ½ (e × d′) h₀: the path's
+/// curvature term, from the block's Lagrangian gradient. How the blocks are summed stays each
+/// problem's: fixed h adds the rows' g gᵀ/D one by one as rank-one terms in the band's precision
+/// (the precision rule, interior_point_solver.cpp), free time sums a stencil's block in double
+/// and adds it once.
+template <typename Scalar, typename TimeStep>
+class KktSink {
+ public:
+  static constexpr int kEntries = TimeStep::kEntries;
+  using Local = Eigen::Matrix<double, kEntries, 1>;
+  using Block = Eigen::Matrix<double, kEntries, kEntries>;
+  /// Clears `kkt` to the node unknowns and the time step's global unknowns in force.
+  KktSink(const ReducedProblem& np, const TimeStep& step, KktBlocks<Scalar>* kkt)
+      : np_(np), step_(step), kkt_(*kkt), twist_(TimeStep::twistIndex(np) - np.unknowns()) {
+    kkt->clear(np.unknowns(), TimeStep::globals(np));
+  }
+
+  /// H at the block's nodes (and η), the lower triangle of its node part used; with h free,
+  /// `lagrangian` is the block's ∇L (fixed nodes' entries included) for the path's term.
+  void addBlock(int first_node, int width, const Block& H, const Local* lagrangian = nullptr) {
+    const Eigen::Matrix<double, 9, 9> nodes = H.template topLeftCorner<9, 9>();
+    addBandBlock(np_, &kkt_.band, first_node, width, nodes);
+    if constexpr (kEntries == 10) {
+      addNodeVector(np_, H.template block<9, 1>(0, 9), 1.0, first_node, width, kkt_.border.col(0));
+      kkt_.corner(0, 0) += H(9, 9);
+    }
+    if (!np_.hasTwist()) return;
+    const Eigen::Matrix<double, 9, 1> e = localTwistMotion(np_, first_node, width);
+    if (e.isZero(0.0)) return;
+    const Eigen::Matrix<double, 9, 1> He = nodes.selfadjointView<Eigen::Lower>() * e;
+    kkt_.corner(twist_, twist_) += e.dot(He);
+    addNodeVector(np_, He, 1.0, first_node, width, kkt_.border.col(twist_));
+    if constexpr (kEntries == 10) {
+      double time = e.dot(H.template block<9, 1>(0, 9));
+      const int slot = np_.steps() - 1 - first_node;  // R_{N−1}: h and ψ both move it
+      if (lagrangian && slot >= 0 && slot < width) {
+        const Vector3 path = np_.nodePath(np_.steps() - 1).first * step_.scale;
+        time += lagrangian->template segment<3>(3 * slot).dot(
+            0.5 * Vector3(e.segment<3>(3 * slot)).cross(path));
+      }
+      kkt_.corner(0, twist_) += time;
+      kkt_.corner(twist_, 0) += time;
+    }
+  }
+
+  /// weight·g gᵀ over the block's nodes, the band's part formed in its precision.
+  void addRankOne(int first_node, int width, const Eigen::Matrix<double, 9, 1>& g, double weight) {
+    const LocalSlots l = localSlots(np_, first_node, width);
+    if (!l.empty()) kkt_.band.template addRankOne<9>(l.offset, g, weight, l.first, l.last);
+    if (!np_.hasTwist()) return;
+    const double ge = g.dot(localTwistMotion(np_, first_node, width));
+    if (ge == 0.0) return;
+    kkt_.corner(twist_, twist_) += weight * ge * ge;
+    addNodeVector(np_, g, weight * ge, first_node, width, kkt_.border.col(twist_));
+  }
+
+ private:
+  const ReducedProblem& np_;
+  TimeStep step_;
+  KktBlocks<Scalar>& kkt_;
+  int twist_;  ///< ψ's column of the border (meaningful with a twist only)
 };
 
 /// The diagonal shift added before a factorization. RowRelative (fixed h; a twist's corner alike):

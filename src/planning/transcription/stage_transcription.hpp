@@ -215,6 +215,15 @@ struct FreeTimeStep {
 using FreeTimeRow = ConstraintRow<FreeTimeStep::kEntries>;
 using FreeTimeRows = ConstraintRows<FreeTimeStep::kEntries>;
 
+/// out += weight·g over a local gradient's unknowns (its free nodes', then the time step's
+/// globals): TimeStep::dot's adjoint.
+template <typename TimeStep>
+void addLocalVector(const ReducedProblem& np, const Eigen::Matrix<double, TimeStep::kEntries, 1>& g,
+                    double weight, int first_node, int width, Eigen::VectorXd* out) {
+  addNodeVector(np, g.template head<9>(), weight, first_node, width, *out);
+  TimeStep::addGlobals(np, g, weight, first_node, width, out);
+}
+
 /// The rows of `block` at instance k with quantity value q: each row's value c(q), then
 /// prepare(rows, row) (its barrier form's multiplier and condensation terms at that value);
 /// returns λ = −Σ z c'(q), what the quantity contracts its curvature with.
@@ -355,9 +364,7 @@ struct StageTranscription {
   void addRow(const ReducedProblem& np, const Rows& g, int k,
               const Eigen::Matrix<double, kEntries, 1>& gradient, double weight,
               Eigen::VectorXd* out) const {
-    const int first = k + g.support.node_offset;
-    addNodeVector(np, gradient.template head<9>(), weight, first, g.support.width, *out);
-    TimeStep::addGlobals(np, gradient, weight, first, g.support.width, out);
+    addLocalVector<TimeStep>(np, gradient, weight, k + g.support.node_offset, g.support.width, out);
   }
   /// The iterate's steps moved by α d over the unknowns (a pointing end's ψ: R_N moves with it,
   /// and the steps next to it); np's iterate untouched.

@@ -64,7 +64,8 @@ summary = """- T*: %d of %d at most the sweep's best + %g relative (largest exce
   fixed-twist free-time solve from the eigenaxis slew and one psi-free solve from its plan, and
   one psi-free solve from the slew itself, then one psi-free solve per factor-2 level from the
   survey's best plan prolonged up to N, then two fixed-twist free-time solves on N 0.01 rad either
-  side of its twist, the branch probes).
+  side of its twist, the branch probes; a psi-free survey solve and a probe stop where they can no
+  longer end below the least T* so far).
 """ % (sum(e <= TARGET for e in excesses), len(cases), TARGET, max(excesses), len(converged), len(cases),
        min(spread), max(spread), statistics.median(spread),
        "%.1e" % max(c["error"] for c in converged) if converged else "-",
@@ -83,12 +84,15 @@ Each request is planned once as a pointing request (`final.pointing`, objective 
 twist psi a global unknown of the free-time interior point: at each of 4 start twists on a survey
 grid of N/4 steps the fixed-twist free-time solve from the eigenaxis slew, then one free-time
 solve with psi free from its plan (the fixed-twist plan kept where that ends above it), and one
-free-time solve with psi free from the slew itself; the survey's least T* carried to N through
+free-time solve with psi free from the slew itself, each psi-free survey solve stopped where it can
+no longer end below the survey's least T* so far (its T less the duality gap above it at a locally
+convex barrier point); the survey's least T* carried to N through
 factor-2 levels, one free-time solve with psi free per level from the coarser plan prolonged; the
 fixed-twist minimum-time recipe on N at its twist only where that does not converge; then the
-branch probes: the fixed-twist free-time solves from the eigenaxis slew on N at psi* +- 0.01 rad,
-and where one ends below the answer one free-time solve with psi free from its plan, its barrier
-begun at mu0/100 so that it keeps that branch of the fixed-twist T*(psi), up to 4 rounds), and judged
+branch probes: the fixed-twist free-time solves from the eigenaxis slew on N at psi* +- 0.01 rad
+(stopped by the same bound against the answer's T*), and where one ends below the answer one
+free-time solve with psi free from its plan, its barrier begun at mu0/100 so that it keeps that
+branch of the fixed-twist T*(psi), up to 4 rounds), and judged
 against the least T* over fixed twists: planManeuver's minimum time at R_N = R_ref exp(psi b^)
 every 5 degrees, the best bracket refined by golden section to 1e-7 rad. Times: the median thread
 CPU time of %d runs each, the pointing request beside one fixed-attitude minimum-time request at

@@ -36,6 +36,7 @@ namespace {
 struct Options {
   int count = 32, constrained = 12, minimum_time = 0, steps = 64, repeats = 5;
   int sweep = 1;  ///< 0: no sweep (the times and answers alone; the sweep's fields null)
+  int trail = 0;  ///< 1: each request's attempts (both plans') written to stderr
   unsigned seed = 41;
   std::string out;
 };
@@ -50,11 +51,12 @@ Options parse(int argc, char** argv) {
       .add("--steps", &o.steps)
       .add("--repeats", &o.repeats)
       .add("--sweep", &o.sweep)
+      .add("--trail", &o.trail)
       .add("--out", &o.out)
       .require("--out");
   st::readFlagsOrExit(flags, argc, argv, "pointing_study",
                       "[--count K] [--constrained C] [--minimum-time M] [--seed S] [--steps N] "
-                      "[--repeats R] [--sweep 0|1] --out RAW.json");
+                      "[--repeats R] [--sweep 0|1] [--trail 0|1] --out RAW.json");
   return o;
 }
 
@@ -80,6 +82,18 @@ ap::PlanResult timed(const ap::PlanningProblem& problem, int repeats, double* se
   return r;
 }
 
+/// `r`'s attempts, one a line: stage, start, N, iterations, termination, cost, twist.
+void writeTrail(const std::string& label, const ap::PlanResult& r) {
+  std::cerr << label << ": " << r.iterations << " iterations, " << r.attempts.size()
+            << " attempts\n";
+  for (const ap::Attempt& a : r.attempts) {
+    std::cerr << "  " << ap::attemptStageName(a.stage) << " " << ap::attemptStartName(a.start)
+              << " N=" << a.steps << " it=" << a.iterations << " "
+              << ap::terminationName(a.termination) << " cost=" << a.cost
+              << " twist=" << a.start_detail.twist << (a.kept ? " kept" : "") << "\n";
+  }
+}
+
 std::string number(double v) {
   return std::isfinite(v) ? st::formatted(v, "%.17g") : "null";
 }
@@ -92,13 +106,17 @@ std::string list(const std::vector<double>& v) {
 
 /// One request's JSON object: the pointing answer, its sweep and the two times.
 std::string caseJson(unsigned seed, bool spinning, const std::string& binding,
-                     const ap::PlanningProblem& p, int repeats, bool swept) {
+                     const ap::PlanningProblem& p, int repeats, bool swept, bool trail) {
   double pointing_time = 0.0, fixed_time = 0.0;
   const ap::PlanResult r = timed(p, repeats, &pointing_time);
   ap::PlanningProblem fixed = p;
   fixed.end_condition = ap::EndCondition();
   fixed.final_attitude = ap::pointingAttitude(p.end_condition, r.pointing.final_twist);
   const ap::PlanResult f = timed(fixed, repeats, &fixed_time);
+  if (trail) {
+    writeTrail("request " + std::to_string(seed) + " pointing", r);
+    writeTrail("request " + std::to_string(seed) + " fixed", f);
+  }
   attitude_planner::test_support::TwistSweep sweep;
   if (swept) {
     sweep = attitude_planner::test_support::sweepTwist(p);
@@ -146,7 +164,8 @@ int main(int argc, char** argv) {
       const ap::SchemeKind scheme = i % 4 < 2 ? ap::SchemeKind::Paper : ap::SchemeKind::SecondOrder;
       const ap::PlanningProblem p =
           attitude_planner::test_support::randomPointingRequest(seed, o.steps, spinning, scheme);
-      out << (i ? ",\n" : "") << caseJson(seed, spinning, "none", p, o.repeats, o.sweep != 0);
+      out << (i ? ",\n" : "")
+          << caseJson(seed, spinning, "none", p, o.repeats, o.sweep != 0, o.trail != 0);
       out.flush();
       std::cerr << "request " << i + 1 << " of " << o.count << " done\n";
     }
@@ -164,7 +183,7 @@ int main(int argc, char** argv) {
           attitude_planner::test_support::randomConstrainedPointingRequest(seed, o.steps, spinning,
                                                                            scheme, binding);
       out << (o.count + i ? ",\n" : "")
-          << caseJson(seed, spinning, name, p, o.repeats, o.sweep != 0);
+          << caseJson(seed, spinning, name, p, o.repeats, o.sweep != 0, o.trail != 0);
       out.flush();
       std::cerr << "constrained request " << i + 1 << " of " << o.constrained << " done\n";
     }
@@ -174,7 +193,7 @@ int main(int argc, char** argv) {
           seed, o.steps, ap::SchemeKind::SecondOrder);
       const bool first = o.count + o.constrained + i == 0;
       out << (first ? "" : ",\n")
-          << caseJson(seed, false, "torque_box", p, o.repeats, o.sweep != 0);
+          << caseJson(seed, false, "torque_box", p, o.repeats, o.sweep != 0, o.trail != 0);
       out.flush();
       std::cerr << "minimum-time request " << i + 1 << " of " << o.minimum_time << " done\n";
     }

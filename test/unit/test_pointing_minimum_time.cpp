@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -63,6 +64,36 @@ TEST(PointingMinimumTime, CarriedFromTheSurveyGridAtMostTheSweepsBestTwist) {
     EXPECT_LE(r.minimum_duration, sweep.best * (1.0 + 1e-6))
         << "swept best at twist " << sweep.best_twist << "; " << r.message();
   }
+}
+
+/// The attempts of `r` on `steps` steps that ended, not converged, at a T above the least T* its
+/// converged attempts there reached.
+long endedAboveTheLeast(const PlanResult& r, int steps) {
+  double least = std::numeric_limits<double>::infinity();
+  for (const Attempt& a : r.attempts) {
+    if (a.steps == steps && a.termination == Termination::Converged)
+      least = std::min(least, a.cost);
+  }
+  return std::count_if(r.attempts.begin(), r.attempts.end(), [&](const Attempt& a) {
+    return a.steps == steps && a.termination == Termination::NotConverged && a.cost > least;
+  });
+}
+
+TEST(PointingMinimumTime, SurveySolvesThatCanNoLongerEndBelowTheLeastSoFarAreStopped) {
+  // A psi-free survey solve (N/4 = 16 steps) matters only if it ends below the survey's least T*
+  // so far: it is stopped where its T less the duality gap passes that least (a bound that holds
+  // at a locally convex barrier point), so it ends not converged above the least. Seeded so that
+  // such solves occur; the answers against a sweep: CarriedFromTheSurveyGridAtMostTheSweepsBest.
+  long stopped = 0;
+  for (const unsigned seed : {4320u, 4321u, 4322u, 4323u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const PlanningProblem p =
+        test_support::randomBettsPointingRequest(seed, 64, SchemeKind::SecondOrder);
+    const PlanResult r = planManeuver(p);
+    expectPointingAnswer(p, r);
+    stopped += endedAboveTheLeast(r, 16);
+  }
+  EXPECT_GE(stopped, 1);
 }
 
 TEST(PointingMinimumTime, ServesAConeThatExcludesSomeEndTwists) {

@@ -137,11 +137,12 @@ class FreeTimeMinimumTime {
   /// One free-time solve on the requested grid from `plan` (a plan meeting every bound at T =
   /// duration, e.g. the search's): its KKT point if it converged at or below that T.
   std::optional<PlanResult> runFrom(const Maneuver& plan, double duration, const std::string& name,
-                                    std::optional<Maneuver>* below, StartBarrier barrier) {
+                                    std::optional<Maneuver>* below, StartBarrier barrier,
+                                    const BarrierWatch& watch) {
     StartDetail detail;
     detail.duration = duration;
     const FreeTimeOutcome o = solve(problem_, plan.attitude, duration,
-                                    AttemptStart::PreviousAttempt, detail, {}, barrier);
+                                    AttemptStart::PreviousAttempt, detail, watch, barrier);
     recordStart(plan.attitude, duration, name, o, -1);
     // Every iterate strictly inside its bounds is a plan (the reduced problem meets the dynamics
     // and the boundary data by construction): one that ended short of a KKT point below T is
@@ -695,8 +696,9 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
                                            double duration, const std::string& start,
                                            SolveContext& context, std::optional<Maneuver>* below,
-                                           StartBarrier barrier) {
-  return FreeTimeMinimumTime(problem, context).runFrom(plan, duration, start, below, barrier);
+                                           StartBarrier barrier, const BarrierWatch& watch) {
+  return FreeTimeMinimumTime(problem, context)
+      .runFrom(plan, duration, start, below, barrier, watch);
 }
 
 }  // namespace attitude_planner

@@ -56,12 +56,13 @@ std::optional<PlanResult> freeTimeMinimumTime(const PlanningProblem& problem,
 /// trail either way). Where it ended short of a KKT point at an iterate strictly inside every
 /// bound below `duration`, that iterate's plan goes to `*below` (a plan at its own T). `barrier`:
 /// where its barrier begins (StartBarrier::NearKktPoint for a plan that is a neighbouring
-/// problem's KKT point).
+/// problem's KKT point). `watch`: the caller's stop at a solved barrier problem (empty if none).
 std::optional<PlanResult> freeTimeFromPlan(const PlanningProblem& problem, const Maneuver& plan,
                                            double duration, const std::string& start,
                                            SolveContext& context,
                                            std::optional<Maneuver>* below = nullptr,
-                                           StartBarrier barrier = StartBarrier::Initial);
+                                           StartBarrier barrier = StartBarrier::Initial,
+                                           const BarrierWatch& watch = {});
 
 /// The attitudes of a converged outcome's plan moved by `size` [rad, signed] along its
 /// negative-curvature direction (R_j exp(size δ_j^)), the boundary attitudes kept: a start off a

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include "attitude_planner/planning/constraints.hpp"
@@ -124,18 +126,38 @@ std::optional<SlewStart> eigenaxisStartAt(const PlanningProblem& problem, double
   return s;
 }
 
+/// The watch of a free-time solve that matters only if it ends below `least` [s] (`what` names
+/// that T): it stops the solve where it no longer can, its T less the duality gap above `least`
+/// at a locally convex barrier point, where that bound holds (the rule the fixed-twist recipe
+/// stops its own starts by). No stop while `least` is +∞.
+constexpr const char* kSurveysLeast = "the survey's least T* so far";
+BarrierWatch cannotEndBelow(double least, const std::string& what) {
+  return [least, what](const BarrierPoint& point) -> std::string {
+    if (!point.locally_convex || !(point.lower_bound > least)) return "";
+    std::ostringstream why;
+    why << "stopped at T = " << point.duration << " s: it can no longer end below " << least
+        << " s, " << what << " (its T less the duality gap at mu = " << point.mu << ": "
+        << point.lower_bound << " s)";
+    return why.str();
+  };
+}
+
 /// A start twist's free-time solve with ψ free from the eigenaxis slew (eigenaxisStartAt): beside
 /// the fixed-twist plan's (fromFixedTwistSlew), the survey's other way into the ψ-free basins
 /// (measured on seeded requests: each way alone missed the least basin on one request, by 3.7e-3
-/// and 3.6e-3 relative on N). Not converged (no solve) where the slew is no start, and where the
-/// solve does not converge at or below its start's T.
-TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, SolveContext& context) {
+/// and 3.6e-3 relative on N). Not converged (no solve) where the slew is no start, where the
+/// solve does not converge at or below its start's T, and where it is stopped because it can no
+/// longer end below `least`, the survey's least T* so far (cannotEndBelow: the survey carries its
+/// least answer alone).
+TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, double least,
+                             SolveContext& context) {
   TwistStart s{twist, {}, std::nullopt};
   const std::optional<SlewStart> start = eigenaxisStartAt(problem, twist);
   if (!start) return s;
   const std::size_t first = context.attempts().size();
   std::optional<PlanResult> freed =
-      freeTimeFromPlan(start->posed, start->slew, start->duration, "eigenaxis slew", context);
+      freeTimeFromPlan(start->posed, start->slew, start->duration, "eigenaxis slew", context,
+                       nullptr, StartBarrier::Initial, cannotEndBelow(least, kSurveysLeast));
   if (freed) s.result = std::move(*freed);
   s.result.minimum_time.solves = 1;
   tagStartsAttempts(context, first, &s);
@@ -150,7 +172,7 @@ TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, Solve
 /// own fixed-twist plan). The recipe's other starts at a survey twist (its excursions) cost 60 %
 /// of the survey's iterations (measured on seed 41802: 670 of 1130) and are left out.
 std::optional<TwistStart> fromFixedTwistSlew(const PlanningProblem& problem, double twist,
-                                             SolveContext& context) {
+                                             double least, SolveContext& context) {
   const std::optional<SlewStart> start = eigenaxisStartAt(problem, twist);
   if (!start) return std::nullopt;
   TwistStart s{twist, {}, std::nullopt};
@@ -163,7 +185,8 @@ std::optional<TwistStart> fromFixedTwistSlew(const PlanningProblem& problem, dou
   if (at_twist) {
     const std::optional<std::size_t> fixed_kept = context.keptAttempt();
     std::optional<PlanResult> freed = freeTimeFromPlan(
-        start->posed, at_twist->maneuver, at_twist->minimum_duration, "fixed-twist plan", context);
+        start->posed, at_twist->maneuver, at_twist->minimum_duration, "fixed-twist plan", context,
+        nullptr, StartBarrier::Initial, cannotEndBelow(least, kSurveysLeast));
     if (!freed) context.restoreKept(fixed_kept);
     s.result = freed ? std::move(*freed) : std::move(*at_twist);
     s.result.minimum_time.solves = 2;
@@ -268,12 +291,18 @@ std::vector<TwistStart> surveyThenCarried(const PlanningProblem& problem, int su
   PlanningProblem coarse = problem;
   coarse.steps = survey;
   const auto survey_posed = posed(coarse);
+  double least = std::numeric_limits<double>::infinity();  // the survey's least T* so far
+  const auto lowered = [&least](TwistStart s) {
+    if (s.result.converged()) least = std::min(least, s.result.minimum_duration);
+    return s;
+  };
   std::vector<TwistStart> starts = overStartTwists(coarse, context, [&](double twist) {
-    std::optional<TwistStart> s = fromFixedTwistSlew(coarse, twist, context);
-    return s ? std::move(*s) : survey_posed(twist);
+    std::optional<TwistStart> s = fromFixedTwistSlew(coarse, twist, least, context);
+    return lowered(s ? std::move(*s) : survey_posed(twist));
   });
-  const std::vector<TwistStart> slews = overStartTwists(
-      coarse, context, [&](double twist) { return fromEigenaxisSlew(coarse, twist, context); });
+  const std::vector<TwistStart> slews = overStartTwists(coarse, context, [&](double twist) {
+    return lowered(fromEigenaxisSlew(coarse, twist, least, context));
+  });
   starts.insert(starts.end(), slews.begin(), slews.end());
   const int best = leastDuration(starts);
   if (best < 0 || context.stopReason()) return starts;
@@ -295,16 +324,20 @@ constexpr double kBranchProbeOffset = 0.01;
 constexpr int kBranchProbeRounds = 4;
 
 /// The fixed-twist free-time solve on N from the eigenaxis slew at `twist` (its attempts tagged
-/// with the twist); empty where the slew is no start there or the solve did not converge.
+/// with the twist); empty where the slew is no start there or the solve did not converge. A probe
+/// matters only if it ends below `least` [s]: it is stopped where it no longer can
+/// (cannotEndBelow). Measured on the minimum-time page's seeded requests: a probe that ends above
+/// the answer spent its last ~30 % of iterations there.
 std::optional<PlanResult> fixedTwistProbe(const PlanningProblem& problem, double twist,
-                                          SolveContext& context) {
+                                          double least, SolveContext& context) {
   const std::optional<SlewStart> start = eigenaxisStartAt(problem, twist);
   if (!start) return std::nullopt;
   PlanningProblem fixed = start->posed;
   fixed.end_condition = EndCondition();
   const std::size_t first = context.attempts().size();
   std::optional<PlanResult> r =
-      freeTimeFromPlan(fixed, start->slew, start->duration, "eigenaxis slew", context);
+      freeTimeFromPlan(fixed, start->slew, start->duration, "eigenaxis slew", context, nullptr,
+                       StartBarrier::Initial, cannotEndBelow(least, "the answer's T*"));
   context.posedAtTwist(first, twist);
   return r;
 }
@@ -326,8 +359,8 @@ std::optional<TwistStart> onLowerBranch(const PlanningProblem& problem, const Tw
   double probe_twist = twist;
   for (const double side : {-1.0, 1.0}) {
     const double at = std::remainder(twist + side * kBranchProbeOffset, 2.0 * M_PI);
-    std::optional<PlanResult> r = fixedTwistProbe(problem, at, context);
     const double least = probe ? probe->minimum_duration : answer.result.minimum_duration;
+    std::optional<PlanResult> r = fixedTwistProbe(problem, at, least, context);
     if (r && r->minimum_duration < least) {
       probe = std::move(r);
       probe_twist = at;

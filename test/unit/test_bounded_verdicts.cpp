@@ -23,6 +23,7 @@
 #include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/strategies/starts.hpp"
@@ -700,4 +701,34 @@ TEST(BoundedVerdicts, ElasticFreeTimeStartsNeverEndBelowTheProvenLeastDuration) 
       EXPECT_GE(o.duration, floor) << start.name << ": " << o.message();
     }
   }
+}
+
+TEST(BoundedVerdicts,
+     UnderTorqueBoundsAloneAConstrainedWarmStartBeginsTheCoarsestLevelAtItsOptimum) {
+  // A plan under a torque box warm-starting minimum effort at a shorter T above the interior
+  // point's coarsest grid (the minimum-time search's probes, the restart from T*): only a cone has
+  // a side the coarsest level's unconstrained optimum could drop, so without cones that level
+  // begins at its unconstrained optimum (a Newton level on the coarsest grid, from the plan
+  // resampled) and the answer is a plan at the shorter T.
+  PlanningProblem p = sceneProblem("torque_limited", 512);
+  const PlanResult plan = planAtResolution(p, {});
+  ASSERT_TRUE(plan.converged()) << plan.message();
+  p.duration *= 0.97;
+  SolverOptions from_plan;
+  from_plan.warm_start = &plan.maneuver;
+  from_plan.constrained_from_warm_start = true;
+  SolveContext context(from_plan);
+  const PlanResult shorter = planAtResolution(p, from_plan, context);
+  EXPECT_TRUE(shorter.converged()) << shorter.message();
+  const int coarsest = std::min_element(context.levels().begin(), context.levels().end(),
+                                        [](const LevelSummary& a, const LevelSummary& b) {
+                                          return a.steps < b.steps;
+                                        })
+                           ->steps;
+  const bool newton_on_coarsest =
+      std::any_of(context.levels().begin(), context.levels().end(), [&](const LevelSummary& l) {
+        return l.steps == coarsest && l.reason.rfind("interior point", 0) != 0;
+      });
+  EXPECT_LT(coarsest, p.steps);
+  EXPECT_TRUE(newton_on_coarsest);
 }

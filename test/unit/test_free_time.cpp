@@ -1225,6 +1225,14 @@ ap::PlanningProblem smallRestToRestSlew(std::mt19937& rng, double angle, int ste
   return p;
 }
 
+/// One free-time solve from `start` at T with the given start raise, in a context of its own.
+ap::FreeTimeOutcome solvedWith(ap::StartRaise raise, const ap::PlanningProblem& p,
+                               const std::vector<ap::Matrix3>& start, double T) {
+  ap::SolveContext context{ap::SolverOptions{}};
+  return ap::solveFreeTime(p, start, T, 1e-9, 500, context, {}, ap::ElasticBarrier::Initial,
+                           ap::StartBarrier::Initial, raise);
+}
+
 }  // namespace
 
 TEST(FreeTime, AStructuredStartFarOutsideItsBoundsIsRaisedInsideRestToRestAndReachesTheSameTStar) {
@@ -1241,13 +1249,8 @@ TEST(FreeTime, AStructuredStartFarOutsideItsBoundsIsRaisedInsideRestToRestAndRea
     const ap::Vector3 off = e.unitOrthogonal();
     const std::vector<ap::Matrix3> start = excursion(p, off, 0.3);
     const double T = 0.96 * ap::eigenaxisBangBangDuration(p);
-    ap::SolveContext bounded_context{ap::SolverOptions{}}, raised_context{ap::SolverOptions{}};
-    const ap::FreeTimeOutcome bounded =
-        ap::solveFreeTime(p, start, T, 1e-9, 500, bounded_context, {}, ap::ElasticBarrier::Initial,
-                          ap::StartBarrier::Initial, ap::StartRaise::Bounded);
-    const ap::FreeTimeOutcome raised =
-        ap::solveFreeTime(p, start, T, 1e-9, 500, raised_context, {}, ap::ElasticBarrier::Initial,
-                          ap::StartBarrier::Initial, ap::StartRaise::UntilInside);
+    const ap::FreeTimeOutcome bounded = solvedWith(ap::StartRaise::Bounded, p, start, T);
+    const ap::FreeTimeOutcome raised = solvedWith(ap::StartRaise::UntilInside, p, start, T);
     SCOPED_TRACE("slew " + std::to_string(i));
     ASSERT_EQ(raised.termination, ap::Termination::Converged);
     EXPECT_FALSE(raised.elastic_start);
@@ -1266,13 +1269,8 @@ TEST(FreeTime, WithSpinningEndsAStructuredStartKeepsTheLargestRaise) {
   const ap::PlanningProblem p = spinningRequest(32);
   const std::vector<ap::Matrix3> start = excursion(p, ap::Vector3::UnitX(), 0.3);
   const double T = 0.5 * ap::eigenaxisBangBangDuration(p);
-  ap::SolveContext bounded_context{ap::SolverOptions{}}, raised_context{ap::SolverOptions{}};
-  const ap::FreeTimeOutcome bounded =
-      ap::solveFreeTime(p, start, T, 1e-9, 500, bounded_context, {}, ap::ElasticBarrier::Initial,
-                        ap::StartBarrier::Initial, ap::StartRaise::Bounded);
-  const ap::FreeTimeOutcome raised =
-      ap::solveFreeTime(p, start, T, 1e-9, 500, raised_context, {}, ap::ElasticBarrier::Initial,
-                        ap::StartBarrier::Initial, ap::StartRaise::UntilInside);
+  const ap::FreeTimeOutcome bounded = solvedWith(ap::StartRaise::Bounded, p, start, T);
+  const ap::FreeTimeOutcome raised = solvedWith(ap::StartRaise::UntilInside, p, start, T);
   ASSERT_TRUE(bounded.elastic_start);  // beyond the largest raise
   EXPECT_TRUE(raised.elastic_start);
   EXPECT_EQ(raised.termination, bounded.termination);

@@ -582,25 +582,42 @@ PlanningProblem finalRateOnTheLimit(std::mt19937_64& rng,
 
 }  // namespace
 
+namespace {
+
+/// `check(p, none, draw)` on each of `cases` seeded random bodies whose final rate lies on the
+/// rate limit (finalRateOnTheLimit) and that have a range of durations proven without room before
+/// the end (with `partial_only`, not every duration); `draw()` is the suite's uniform [0, 1).
+/// Returns how many were checked.
+template <typename Check>
+int forEachProvenRange(std::uint64_t seed, int cases, bool partial_only, Check check) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  const auto draw = [&] { return unit(rng); };
+  int checked = 0;
+  for (int i = 0; i < cases; ++i) {
+    PlanningProblem p = finalRateOnTheLimit(rng, unit, normal);
+    const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
+    if (!(none.to > none.from) || (partial_only && none.everywhere)) continue;
+    ++checked;
+    SCOPED_TRACE("case " + std::to_string(i));
+    check(p, none, draw);
+  }
+  return checked;
+}
+
+}  // namespace
+
 TEST(BoundedVerdicts, AFinalRateOnTheRateLimitHasNoRoomOverTheDurationsProven) {
   // Random bodies whose final rate lies on the rate limit: wherever durations are proven to have
   // no room before the end, the least rate there exceeds the limit at random durations in them.
-  std::mt19937_64 rng(4549);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> normal;
-  int proven = 0;
-  for (int i = 0; i < 12; ++i) {
-    PlanningProblem p = finalRateOnTheLimit(rng, unit, normal);
-    const Vector3 rate = p.final_velocity;
-    const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
-    if (!(none.to > none.from)) continue;
-    ++proven;
-    SCOPED_TRACE("case " + std::to_string(i));
-    for (int j = 0; j < 50; ++j) {
-      const double T = none.from + unit(rng) * (none.to - none.from);
-      EXPECT_GT(leastRateBeforeTheEnd(p, T), rate.norm()) << "T = " << T;
-    }
-  }
+  const int proven = forEachProvenRange(
+      4549, 12, false, [](const PlanningProblem& p, const NoRoomBeforeTheEnd& none, auto draw) {
+        for (int j = 0; j < 50; ++j) {
+          const double T = none.from + draw() * (none.to - none.from);
+          EXPECT_GT(leastRateBeforeTheEnd(p, T), p.final_velocity.norm()) << "T = " << T;
+        }
+      });
   EXPECT_GE(proven, 6);
 }
 
@@ -637,32 +654,24 @@ TEST(BoundedVerdicts, AMinimumEffortRequestInARangeWithoutRoomIsProvenInfeasible
   // Random bodies whose final rate lies on the rate limit: a minimum-effort request at a T inside
   // a range proven without room before the end is answered infeasible before any solve, proven,
   // the range as data; just below the range's start (room there) it is not answered so.
-  std::mt19937_64 rng(4950);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> normal;
-  int ranges = 0;
-  for (int i = 0; i < 16; ++i) {
-    PlanningProblem p = finalRateOnTheLimit(rng, unit, normal);
-    const Vector3 rate = p.final_velocity;
-    const NoRoomBeforeTheEnd none = noRoomBeforeTheEnd(p);
-    if (!(none.to > none.from) || none.everywhere) continue;
-    ++ranges;
-    SCOPED_TRACE("case " + std::to_string(i));
-    p.duration = none.from + unit(rng) * (none.to - none.from);
-    const PlanResult r = planManeuver(p);
-    EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
-    EXPECT_TRUE(r.duration_verdict.proven_infeasible);
-    EXPECT_TRUE(std::holds_alternative<verdicts::NoRoomAtDuration>(r.verdict)) << r.message();
-    EXPECT_EQ(r.duration_verdict.no_plan_from, none.from);
-    EXPECT_EQ(r.duration_verdict.no_plan_to, none.to);
-    EXPECT_TRUE(r.attempts.empty());
-    // The least rate before the end exceeds the limit at the requested T: no plan exists there.
-    EXPECT_GT(leastRateBeforeTheEnd(p, p.duration), rate.norm());
-    p.duration = none.from * (1 - 1e-3);
-    if (p.duration > discreteDurationLowerBound(p)) {
-      EXPECT_FALSE(answerBeforeSolving(p, durationLowerBound(p)).has_value());
-    }
-  }
+  const int ranges = forEachProvenRange(
+      4950, 16, true, [](PlanningProblem p, const NoRoomBeforeTheEnd& none, auto draw) {
+        const Vector3 rate = p.final_velocity;
+        p.duration = none.from + draw() * (none.to - none.from);
+        const PlanResult r = planManeuver(p);
+        EXPECT_EQ(r.termination, Termination::Infeasible) << r.message();
+        EXPECT_TRUE(r.duration_verdict.proven_infeasible);
+        EXPECT_TRUE(std::holds_alternative<verdicts::NoRoomAtDuration>(r.verdict)) << r.message();
+        EXPECT_EQ(r.duration_verdict.no_plan_from, none.from);
+        EXPECT_EQ(r.duration_verdict.no_plan_to, none.to);
+        EXPECT_TRUE(r.attempts.empty());
+        // The least rate before the end exceeds the limit at the requested T: no plan exists there.
+        EXPECT_GT(leastRateBeforeTheEnd(p, p.duration), rate.norm());
+        p.duration = none.from * (1 - 1e-3);
+        if (p.duration > discreteDurationLowerBound(p)) {
+          EXPECT_FALSE(answerBeforeSolving(p, durationLowerBound(p)).has_value());
+        }
+      });
   EXPECT_GE(ranges, 4);
 }
 

@@ -663,10 +663,7 @@ std::vector<Matrix3> prolonged(const PlanningProblem& p, const FreeTimeOutcome& 
   } catch (const StepTooLarge&) {  // the boundary rates admit no step at this h
     attitudes = resampleAttitudes(coarse.maneuver, p.steps);
   }
-  if (coneClearance(p, attitudes) < 0.5 * kConeStartClearance) {
-    attitudes = pushedOutOfCones(p, attitudes, kConeStartClearance);
-  }
-  return attitudes;
+  return pushedOutOfCones(p, attitudes, kNeighbourConeClearance);
 }
 
 GridLevelRule freeTimeGridRule() {

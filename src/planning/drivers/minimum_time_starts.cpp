@@ -336,18 +336,41 @@ double coneClearance(const PlanningProblem& problem, const std::vector<Matrix3>&
   return smallest;
 }
 
+namespace {
+
+/// Each node's turn out of cone `c` (pushedOutOfCones): the turn node j needs to clear the bound
+/// by `clearance`, spread to the nodes within W = max(2, N/kConePushTaper) of it by the weight
+/// cos²(π|k − j| / (2(W + 1))), the largest of these at each node.
+std::vector<double> taperedConeTurns(const PlanningConstraint& c, const std::vector<Matrix3>& R,
+                                     double clearance) {
+  const int n = static_cast<int>(R.size());
+  const int W = std::max(2, (n - 1) / kConePushTaper);
+  std::vector<double> turns(n, 0.0);
+  for (int j = 1; j + 1 < n; ++j) {
+    const double needed = clearance - (coneMargin(c, R[j]) - c.margin);
+    if (needed <= 0) continue;
+    for (int k = std::max(1, j - W); k <= std::min(n - 2, j + W); ++k) {
+      const double weight = std::cos(M_PI * std::abs(k - j) / (2.0 * (W + 1)));
+      turns[k] = std::max(turns[k], needed * weight * weight);
+    }
+  }
+  return turns;
+}
+
+}  // namespace
+
 std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vector<Matrix3> R,
                                       double clearance) {
   for (const PlanningConstraint& c : problem.constraints) {
     if (!c.isCone()) continue;
     const bool keep_out = c.kind == ConstraintKind::KeepOut;
+    const std::vector<double> turns = taperedConeTurns(c, R, clearance);
     for (std::size_t k = 1; k + 1 < R.size(); ++k) {
-      const double turn = clearance - (coneMargin(c, R[k]) - c.margin);
-      if (turn <= 0) continue;
+      if (turns[k] <= 0) continue;
       const Vector3 v = R[k] * c.body_axis;
       Vector3 axis = c.world_direction.cross(v);  // turning about it by + moves v away from s
       axis = axis.norm() > 1e-12 ? axis.normalized() : c.world_direction.unitOrthogonal();
-      R[k] = so3::exp((keep_out ? turn : -turn) * axis) * R[k];
+      R[k] = so3::exp((keep_out ? turns[k] : -turns[k]) * axis) * R[k];
     }
   }
   return R;

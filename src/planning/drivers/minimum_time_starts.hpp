@@ -63,9 +63,22 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
 /// (+∞ without cones).
 double coneClearance(const PlanningProblem& problem, const std::vector<Matrix3>& R);
 
-/// R_k turned (in the world frame, about s × R_k b) just far enough to clear each cone's node
-/// bound by `clearance`: for a resampled coarse T* plan, whose new nodes between the coarse ones
-/// dip past an active bound by O(h²).
+/// A start that is a neighbouring KKT point's plan (a coarser level's answer prolonged, a saddle
+/// left) clears its cones by this much [rad]: strict room for the barrier, no more. Measured on
+/// seeded keep-out slews (scripts/minimum_time_cost.py, N = 64 -> 128): a 1e-2 rad push cost the
+/// refined level 100-330 iterations, 1e-4 rad 29-37 (the same T*).
+constexpr double kNeighbourConeClearance = 1e-4;
+
+/// A node's turn out of a cone is spread over its neighbours within N/this nodes
+/// (pushedOutOfCones).
+constexpr int kConePushTaper = 16;
+
+/// R_k turned (in the world frame, about s × R_k b) far enough to clear each cone's node bound by
+/// `clearance`: for a resampled coarse T* plan, whose new nodes between the coarse ones dip past
+/// an active bound by O(h²). The turn is tapered over the neighbouring nodes
+/// (kConePushTaper): a turn δ of single nodes is a kink, a torque of about J δ/h² (measured at N
+/// = 128: 3.4-11x the torque bound for pushes of 1e-4 to 1e-2 rad, the start then began elastic;
+/// tapered, the prolongation's own 1.2-1.4x).
 std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vector<Matrix3> R,
                                       double clearance);
 

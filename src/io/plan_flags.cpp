@@ -17,6 +17,7 @@ const char* const kPlanFlagNames[] = {"--steps",
                                       "--tolerance",
                                       "--max-iterations",
                                       "--time-budget",
+                                      "--threads",
                                       "--target-miss",
                                       "--target-cost-error",
                                       "--objective",
@@ -120,6 +121,9 @@ void applyPlanFlag(const std::string& flag, const std::string& value, PlanFlags*
     }
   } else if (flag == "--time-budget") {
     f.time_budget = parsePositive(flag, value, " s");
+  } else if (flag == "--threads") {
+    f.threads = parseInteger(flag, value);
+    if (f.threads < 1) throw InvalidInput(flag, "must be >= 1, got " + value);
   } else if (flag == "--target-miss" || flag == "--target-cost-error") {
     f.target_value = parsePositive(flag, value);
     f.target_flag = flag;
@@ -178,6 +182,7 @@ void applyPlanFlags(const PlanFlags& flags, PlanningProblem* problem, SolverOpti
   if (flags.tolerance > 0.0) options->tolerance = flags.tolerance;
   if (flags.max_iterations > 0) options->max_iterations = flags.max_iterations;
   options->time_budget_s = flags.time_budget;
+  if (flags.threads > 0) options->threads = flags.threads;
 }
 
 }  // namespace attitude_planner

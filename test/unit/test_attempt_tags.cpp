@@ -93,6 +93,57 @@ TEST(AttemptTags, ScopesNumberAttemptsAndNameNestedSolvesByTheirDriversStage) {
   EXPECT_EQ(context.iterations(), 1);
 }
 
+TEST(AttemptTags, BranchesRunAtOnceReportInOneSequenceAndJoinTheTrailInTheirOrder) {
+  // Four branches, two at a time on two threads: every report reaches the caller once, numbered
+  // 1, 2, ... in the order the caller sees them; attempts are numbered once across branches; the
+  // trail holds each branch's attempt in the branches' order, and the iterations all of them.
+  std::vector<int> numbers;
+  std::set<int> attempt_numbers;
+  ap::SolverOptions options;
+  options.threads = 2;
+  options.on_iteration = [&](const ap::IterationInfo& info) {
+    numbers.push_back(info.iteration);
+    attempt_numbers.insert(info.attempt.number);
+    return true;
+  };
+  ap::SolveContext context(options);
+  constexpr int kBranches = 4, kIterations = 50;
+  ap::runBranches(context, kBranches, [&](int i, ap::SolveContext& branch) {
+    const ap::SolveContext::Scope scope(branch, ap::AttemptStage::MinimumTimeSolve, {false, 0});
+    for (int k = 0; k < kIterations; ++k) branch.reportIteration({});
+    ap::Attempt a;
+    a.iterations = scope.iterations();
+    a.cost = i;  // which branch
+    branch.record(a);
+  });
+  ASSERT_EQ(numbers.size(), static_cast<std::size_t>(kBranches * kIterations));
+  for (std::size_t k = 0; k < numbers.size(); ++k) EXPECT_EQ(numbers[k], static_cast<int>(k) + 1);
+  EXPECT_EQ(attempt_numbers.size(), static_cast<std::size_t>(kBranches));
+  EXPECT_EQ(context.iterations(), kBranches * kIterations);
+  ASSERT_EQ(context.attempts().size(), static_cast<std::size_t>(kBranches));
+  for (int i = 0; i < kBranches; ++i) {
+    EXPECT_EQ(context.attempts()[i].cost, i);
+    EXPECT_EQ(context.attempts()[i].iterations, kIterations);
+  }
+}
+
+TEST(AttemptTags, ACallerRefusingAReportStopsEveryBranch) {
+  // The refusal is the request's: a branch that has not reported yet stops too.
+  ap::SolverOptions options;
+  options.threads = 2;
+  std::atomic<int> calls{0};
+  options.on_iteration = [&](const ap::IterationInfo&) { return ++calls < 10; };
+  ap::SolveContext context(options);
+  std::atomic<int> stopped{0};
+  ap::runBranches(context, 2, [&](int, ap::SolveContext& branch) {
+    for (int k = 0; k < 1000000 && !branch.stopReason(); ++k) branch.reportIteration({});
+    if (branch.stopReason() == ap::Termination::Cancelled) ++stopped;
+  });
+  EXPECT_EQ(stopped, 2);
+  EXPECT_EQ(context.stopReason(), ap::Termination::Cancelled);
+  EXPECT_LT(context.iterations(), 1000);
+}
+
 TEST(AttemptTags, AClassSurveysIterationsAreTaggedWithTheTrailsStagesAndClasses) {
   // Near a half turn the survey solves several classes and refines the cheapest: each report
   // names its attempt, and the reports of each stage and class add up to the trail's count.

@@ -1263,6 +1263,55 @@ TEST(FreeTime, AStructuredStartFarOutsideItsBoundsIsRaisedInsideRestToRestAndRea
   EXPECT_GT(raised_inside, 0);  // the suite holds starts beyond the largest raise
 }
 
+/// `p` with a keep-out cone across its eigenaxis slew: a random body axis b, the cone about the
+/// boresight R b at the slew's middle turned a little off it, its half angle 0.8 of the ends'
+/// nearest angle to the cone's axis (at most 0.4 rad).
+ap::PlanningProblem withKeepOutAcrossThePath(ap::PlanningProblem p, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const ap::Vector3 turn = ap::so3::log(p.initial_attitude.transpose() * p.final_attitude);
+  const ap::Matrix3 middle = p.initial_attitude * ap::so3::exp(0.5 * turn);
+  const ap::Vector3 b = ap::Vector3(unit(rng), unit(rng), unit(rng)).normalized();
+  const ap::Vector3 boresight = middle * b;
+  const ap::Vector3 off = boresight.unitOrthogonal();
+  const ap::Vector3 s = ap::so3::exp(0.05 * off) * boresight;
+  const auto angleTo = [&](const ap::Matrix3& R) { return std::acos((R * b).dot(s)); };
+  const double half_angle =
+      std::min(0.4, 0.8 * std::min(angleTo(p.initial_attitude), angleTo(p.final_attitude)));
+  p.constraints.push_back(ap::PlanningConstraint::keepOut(b, s, half_angle));
+  return p;
+}
+
+TEST(FreeTime, TheStartsRunAtOnceReachTheSameTStarAsOneAfterTheOther) {
+  // Minimum time's starts on two threads (SolverOptions::threads) against one after the other:
+  // the same T* (a start the watch stops there could not have ended below the least T; one that
+  // joins a path would have ended at its end), with and without a keep-out cone; the reports
+  // reach the caller numbered 1, 2, ..., n, n the request's iterations.
+  std::mt19937 rng(5151);
+  for (int i = 0; i < 4; ++i) {
+    ap::PlanningProblem p = smallRestToRestSlew(rng, 0.8 + 0.5 * i, 64);
+    if (i % 2 == 1) p = withKeepOutAcrossThePath(p, rng);
+    p.duration = 100.0;  // minimum time's upper bound and first guess
+    SCOPED_TRACE("request " + std::to_string(i));
+    ap::SolverOptions serial;
+    serial.threads = 1;
+    const ap::PlanResult one = ap::planManeuver(p, serial);
+    ap::SolverOptions at_once;
+    at_once.threads = 2;
+    std::vector<int> numbers;
+    at_once.on_iteration = [&](const ap::IterationInfo& info) {
+      numbers.push_back(info.iteration);
+      return true;
+    };
+    const ap::PlanResult two = ap::planManeuver(p, at_once);
+    ASSERT_TRUE(one.converged()) << one.message();
+    ASSERT_TRUE(two.converged()) << two.message();
+    EXPECT_NEAR(two.minimum_duration, one.minimum_duration, 1e-9 * one.minimum_duration);
+    ASSERT_FALSE(numbers.empty());
+    for (std::size_t k = 0; k < numbers.size(); ++k) EXPECT_EQ(numbers[k], static_cast<int>(k) + 1);
+    EXPECT_EQ(numbers.back(), two.iterations);
+  }
+}
+
 TEST(FreeTime, WithSpinningEndsAStructuredStartKeepsTheLargestRaise) {
   // An end torque carries the boundary momentum: a raise does not scale it down, so UntilInside
   // applies rest to rest only and a spinning start far outside still starts elastic.

@@ -20,6 +20,7 @@ struct PlanFlags {
   double tolerance = -1.0;     ///< < 0: the default
   int max_iterations = -1;     ///< < 0: the default
   double time_budget = 0.0;    ///< 0: none
+  int threads = 0;             ///< 0: not given (the machine's cores)
   std::string target_flag;     ///< "--target-miss" / "--target-cost-error", "" if absent
   double target_value = 0.0;   ///< its value (> 0)
   std::string objective;       ///< "" : the scene's

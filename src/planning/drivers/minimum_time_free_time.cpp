@@ -169,14 +169,28 @@ class FreeTimeMinimumTime {
                         double duration, AttemptStart kind, const StartDetail& detail,
                         const BarrierWatch& watch = {},
                         StartBarrier start_barrier = StartBarrier::Initial) {
-    const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
+    Attempt a;
+    FreeTimeOutcome o =
+        solveIn(context_, p, start, duration, kind, detail, watch, start_barrier, &a);
+    recordSolve(a);
+    return o;
+  }
+
+  /// solve's work in `context` (the request's, or a branch of it: runBranches), its attempt
+  /// recorded there and returned in `*attempt`; nothing of this object is written.
+  static FreeTimeOutcome solveIn(SolveContext& context, const PlanningProblem& p,
+                                 const std::vector<Matrix3>& start, double duration,
+                                 AttemptStart kind, const StartDetail& detail,
+                                 const BarrierWatch& watch, StartBarrier start_barrier,
+                                 Attempt* attempt) {
+    const SolveContext::Scope scope(context, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
     const ElasticBarrier barrier =
         detail.elastic_from_violations ? ElasticBarrier::FromViolations : ElasticBarrier::Initial;
     FreeTimeOutcome o =
-        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, context_,
+        solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, context,
                       watch, barrier, start_barrier, startRaiseOf(kind));
     o.iterations = scope.iterations();  // an elastic start's run and the raised one's
-    Attempt a;
+    Attempt& a = *attempt;
     a.stage = AttemptStage::MinimumTimeSolve;
     a.start = kind;
     a.formulation = Formulation::FreeSlacks;
@@ -186,17 +200,22 @@ class FreeTimeMinimumTime {
     // The free-time objective: T [s]; NaN where the solve left no plan (no start inside).
     if (!o.maneuver.attitude.empty()) a.cost = o.duration;
     a.start_detail = detail;
-    trail_.push_back(a);
-    context_.record(a);
-    ++solves_;
+    context.record(a);
     return o;
   }
 
+  /// A solve's attempt in this object's trail (the context holds it already).
+  void recordSolve(const Attempt& a) {
+    trail_.push_back(a);
+    ++solves_;
+  }
+
   /// A structured start made to clear the cones: a start too close to a cone is replaced by the
-  /// minimum-effort plan under the cones alone from it (coneClearStart).
-  std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st) {
+  /// minimum-effort plan under the cones alone from it (coneClearStart), solved in `context`.
+  static std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st,
+                                           SolveContext& context) {
     if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
-    return coneClearStart(p, st.attitudes, st.duration, context_).value_or(st.attitudes);
+    return coneClearStart(p, st.attitudes, st.duration, context).value_or(st.attitudes);
   }
 
   /// The earlier start whose solve this one would repeat (the same T and attitudes within
@@ -223,23 +242,81 @@ class FreeTimeMinimumTime {
   }
 
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
-  /// the index of the converged one with the least T (−1: none converged).
+  /// the index of the converged one with the least T (−1: none converged). The starts are cleared
+  /// of the cones, then solved in batches of up to the request's threads at once (runBranches),
+  /// each watched against the starts recorded before its batch, and recorded in their order.
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
+    std::vector<std::vector<Matrix3>> cleared(starts.size());
+    runBranches(context_, static_cast<int>(starts.size()), [&](int i, SolveContext& branch) {
+      cleared[i] =
+          branch.stopReason() ? starts[i].attitudes : clearOfCones(grid, starts[i], branch);
+    });
     int best = -1;
-    for (const FreeTimeStart& st : starts) {
-      if (context_.stopReason()) break;
-      std::vector<Matrix3> start = clearOfCones(grid, st);
-      const int same = sameStartAs(start, st.duration);
-      StartDetail detail = st.detail;
-      detail.cleared_of_cones = start != st.attitudes;
-      if (same >= 0) {
-        recordStart(start, st.duration, st.name, starts_[same].outcome, same);
-        continue;
+    std::vector<int> recorded_as(starts.size(), -1);  // each start's index in starts_
+    for (std::size_t next = 0; next < starts.size() && !context_.stopReason();) {
+      const std::vector<BatchEntry> batch = nextBatch(starts, cleared, next);
+      std::vector<std::size_t> solved;
+      for (const BatchEntry& e : batch) {
+        if (e.repeats < 0 && e.repeats_in_batch < 0) solved.push_back(e.start);
       }
-      solveWatched(grid, start, st.duration, st.kind, detail, st.name, best);
-      keepIfLeast(&best);
+      std::vector<WatchedRun> runs(solved.size());
+      runBranches(context_, static_cast<int>(runs.size()), [&](int j, SolveContext& branch) {
+        const std::size_t i = solved[j];
+        runs[j] = solveWatchedIn(branch, grid, cleared[i], starts[i].duration, starts[i].kind,
+                                 clearedDetail(starts[i], cleared[i]), best);
+      });
+      std::size_t j = 0;
+      for (const BatchEntry& e : batch) {
+        const FreeTimeStart& st = starts[e.start];
+        const int same = e.repeats_in_batch >= 0 ? recorded_as[e.repeats_in_batch] : e.repeats;
+        if (same >= 0) {
+          recordStart(cleared[e.start], st.duration, st.name, starts_[same].outcome, same);
+        } else {
+          recordWatched(std::move(runs[j++]), cleared[e.start], st.duration, st.name);
+          keepIfLeast(&best);
+        }
+        recorded_as[e.start] = static_cast<int>(starts_.size()) - 1;
+      }
+      next = batch.back().start + 1;
     }
     return best;
+  }
+
+  /// A start of a batch (nextBatch): solved in it, or a repeat of a start recorded before it
+  /// (`repeats`, its index in starts_) or of one solved in it (`repeats_in_batch`, its index in
+  /// the starts).
+  struct BatchEntry {
+    std::size_t start = 0;
+    int repeats = -1;
+    int repeats_in_batch = -1;
+  };
+
+  /// The starts from `next` on that one batch covers: up to the request's threads of them
+  /// solved at once, and the repeats among and after them.
+  std::vector<BatchEntry> nextBatch(const std::vector<FreeTimeStart>& starts,
+                                    const std::vector<std::vector<Matrix3>>& cleared,
+                                    std::size_t next) const {
+    std::vector<BatchEntry> batch;
+    std::vector<std::size_t> solved;
+    const std::size_t at_once = static_cast<std::size_t>(context_.threads());
+    for (std::size_t i = next; i < starts.size() && solved.size() < at_once; ++i) {
+      BatchEntry e{i, sameStartAs(cleared[i], starts[i].duration), -1};
+      for (const std::size_t k : solved) {
+        if (e.repeats < 0 && starts[k].duration == starts[i].duration &&
+            largestDifference(cleared[k], cleared[i]) <= kSameStart) {
+          e.repeats_in_batch = static_cast<int>(k);
+        }
+      }
+      if (e.repeats < 0 && e.repeats_in_batch < 0) solved.push_back(i);
+      batch.push_back(e);
+    }
+    return batch;
+  }
+
+  static StartDetail clearedDetail(const FreeTimeStart& st, const std::vector<Matrix3>& cleared) {
+    StartDetail detail = st.detail;
+    detail.cleared_of_cones = cleared != st.attitudes;
+    return detail;
   }
 
   /// Spinning ends: every start (those recorded from `first` on, one per entry of `starts`) solved
@@ -251,18 +328,35 @@ class FreeTimeMinimumTime {
   /// start's central path. Returns the least converged start.
   int solveFromViolations(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts,
                           std::size_t first, int best) {
+    std::vector<std::size_t> solved;  // the starts solved the first time (not repeats)
     for (std::size_t i = 0; i < starts.size() && first + i < starts_.size(); ++i) {
-      if (context_.stopReason()) break;
-      if (starts_[first + i].same_as >= 0) continue;
-      const std::vector<Matrix3> attitudes = starts_[first + i].attitudes;  // starts_ grows
-      StartDetail detail = starts[i].detail;
-      detail.cleared_of_cones = attitudes != starts[i].attitudes;
-      detail.elastic_from_violations = true;
-      solveWatched(grid, attitudes, starts[i].duration, starts[i].kind, detail,
-                   starts[i].name + ", its elastic phase from its violations", best);
-      keepIfLeast(&best);
+      if (starts_[first + i].same_as < 0) solved.push_back(i);
+    }
+    const std::size_t at_once = static_cast<std::size_t>(context_.threads());
+    for (std::size_t next = 0; next < solved.size() && !context_.stopReason(); next += at_once) {
+      const std::size_t count = std::min(at_once, solved.size() - next);
+      std::vector<WatchedRun> runs(count);
+      runBranches(context_, static_cast<int>(count), [&](int j, SolveContext& branch) {
+        const std::size_t i = solved[next + j];
+        runs[j] = solveWatchedIn(branch, grid, starts_[first + i].attitudes, starts[i].duration,
+                                 starts[i].kind,
+                                 fromViolationsDetail(starts[i], starts_[first + i]), best);
+      });
+      for (std::size_t j = 0; j < count; ++j) {
+        const std::size_t i = solved[next + j];
+        const std::vector<Matrix3> attitudes = starts_[first + i].attitudes;  // starts_ grows
+        recordWatched(std::move(runs[j]), attitudes, starts[i].duration,
+                      starts[i].name + ", its elastic phase from its violations");
+        keepIfLeast(&best);
+      }
     }
     return best;
+  }
+
+  static StartDetail fromViolationsDetail(const FreeTimeStart& st, const StartRecord& solved) {
+    StartDetail detail = clearedDetail(st, solved.attitudes);
+    detail.elastic_from_violations = true;
+    return detail;
   }
 
   /// The last recorded start kept (best, best_attempt_) if it converged below the best's T.
@@ -283,10 +377,24 @@ class FreeTimeMinimumTime {
   void solveWatched(const PlanningProblem& grid, const std::vector<Matrix3>& start, double duration,
                     AttemptStart kind, const StartDetail& detail, const std::string& name,
                     int best) {
+    recordWatched(solveWatchedIn(context_, grid, start, duration, kind, detail, best), start,
+                  duration, name);
+  }
+
+  /// solveWatched's solve in `context` (the request's or a branch), watched against the starts
+  /// recorded so far (read only).
+  struct WatchedRun {
+    FreeTimeOutcome outcome;
+    Attempt attempt;
+    std::vector<BarrierPoint> path;
+    int joined = -1;  ///< the earlier start whose central path it joined (−1: none)
+  };
+  WatchedRun solveWatchedIn(SolveContext& context, const PlanningProblem& grid,
+                            const std::vector<Matrix3>& start, double duration, AttemptStart kind,
+                            const StartDetail& detail, int best) const {
     const double least =
         best < 0 ? std::numeric_limits<double>::infinity() : starts_[best].outcome.duration;
-    std::vector<BarrierPoint> path;
-    int joined = -1;
+    WatchedRun run;
     const BarrierWatch watch = [&](const BarrierPoint& point) -> std::string {
       std::ostringstream why;
       if (point.locally_convex && point.lower_bound > least) {
@@ -295,23 +403,32 @@ class FreeTimeMinimumTime {
             << point.lower_bound << " s)";
         return why.str();
       }
-      joined = sameCentralPath(point);
-      if (joined >= 0) {
+      run.joined = sameCentralPath(point);
+      if (run.joined >= 0) {
         why << "stopped at T = " << point.duration << " s: on the central path of the start "
-            << starts_[joined].name << " (the same barrier problem's point, mu = " << point.mu
+            << starts_[run.joined].name << " (the same barrier problem's point, mu = " << point.mu
             << ")";
         return why.str();
       }
-      path.push_back(point);
+      run.path.push_back(point);
       return "";
     };
-    FreeTimeOutcome o = solve(grid, start, duration, kind, detail, watch);
-    if (joined >= 0) {
-      recordStart(start, duration, name, starts_[joined].outcome, joined);
+    run.outcome = solveIn(context, grid, start, duration, kind, detail, watch,
+                          StartBarrier::Initial, &run.attempt);
+    return run;
+  }
+
+  /// A watched solve's attempt and start recorded (a joined one takes the earlier start's
+  /// outcome).
+  void recordWatched(WatchedRun run, const std::vector<Matrix3>& start, double duration,
+                     const std::string& name) {
+    recordSolve(run.attempt);
+    if (run.joined >= 0) {
+      recordStart(start, duration, name, starts_[run.joined].outcome, run.joined);
     } else {
-      recordStart(start, duration, name, std::move(o), -1);
+      recordStart(start, duration, name, std::move(run.outcome), -1);
     }
-    starts_.back().path = std::move(path);
+    starts_.back().path = std::move(run.path);
   }
 
   /// The earlier start whose solve passed through `point` (the same μ, every attitude within

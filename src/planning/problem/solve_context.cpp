@@ -1,12 +1,44 @@
 #include "planning/problem/solve_context.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <limits>
+#include <thread>
 
 namespace attitude_planner {
 
 SolveContext::SolveContext(const SolverOptions& request)
-    : request_(request), call_(&request_), start_(Clock::now()) {}
+    : request_(request),
+      call_(&request_),
+      start_(Clock::now()),
+      shared_(std::make_shared<Shared>()) {}
+
+SolveContext::SolveContext(SolveContext& parent, Branch)
+    : request_(parent.request_),
+      call_(parent.call_),
+      start_(parent.start_),
+      shared_(parent.shared_),
+      attempt_(parent.attempt_),
+      scope_names_nested_(parent.scope_names_nested_) {}
+
+void SolveContext::join(SolveContext& branch) {
+  iterations_ += branch.iterations_;
+  for (Attempt& a : branch.attempts_) {
+    if (a.kept) {
+      for (Attempt& b : attempts_) b.kept = false;
+    }
+    attempts_.push_back(std::move(a));
+  }
+  levels_.insert(levels_.end(), branch.levels_.begin(), branch.levels_.end());
+  branch.attempts_.clear();
+  branch.levels_.clear();
+  branch.iterations_ = 0;
+}
+
+int SolveContext::threads() const {
+  if (request_.threads > 0) return request_.threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 double SolveContext::elapsedSeconds() const {
   return std::chrono::duration<double>(Clock::now() - start_).count();
@@ -27,7 +59,7 @@ SolverOptions SolveContext::remainingOptions() const {
 }
 
 std::optional<Termination> SolveContext::stopReason() const {
-  if (refused_by_callback_) return Termination::Cancelled;
+  if (shared_->refused_by_callback) return Termination::Cancelled;
   if (request_.cancel_requested && request_.cancel_requested->load(std::memory_order_relaxed)) {
     return Termination::Cancelled;
   }
@@ -43,12 +75,14 @@ void SolveContext::poll() const {
 
 bool SolveContext::reportIteration(const IterationInfo& info) {
   ++iterations_;
+  const std::lock_guard<std::mutex> one_at_a_time(shared_->report);
+  const int number = ++shared_->reported;
   if (!request_.on_iteration) return true;
   IterationInfo numbered = info;
-  numbered.iteration = iterations_;
+  numbered.iteration = number;
   numbered.attempt = attempt_;
-  if (!request_.on_iteration(numbered)) refused_by_callback_ = true;
-  return !refused_by_callback_;
+  if (!request_.on_iteration(numbered)) shared_->refused_by_callback = true;
+  return !shared_->refused_by_callback;
 }
 
 SolveContext::Scope::Scope(SolveContext& context, AttemptStage stage, const HomotopyClass& homotopy,
@@ -59,7 +93,12 @@ SolveContext::Scope::Scope(SolveContext& context, AttemptStage stage, const Homo
       tally_(context) {
   const bool inside = previous_.number > 0;
   const bool renamed = inside && (previous_names_nested_ || stage == AttemptStage::Solve);
-  context_.attempt_ = {++context_.attempts_begun_, renamed ? previous_.stage : stage, homotopy};
+  int number = 0;
+  {
+    const std::lock_guard<std::mutex> one_at_a_time(context_.shared_->report);
+    number = ++context_.shared_->attempts_begun;
+  }
+  context_.attempt_ = {number, renamed ? previous_.stage : stage, homotopy};
   context_.scope_names_nested_ = previous_names_nested_ || nested == Nested::ScopeStage;
 }
 
@@ -110,6 +149,34 @@ void SolveContext::posedAtTwist(std::size_t first, double twist) {
 std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
   if (first >= attempts_.size()) return {};
   return {attempts_.begin() + static_cast<std::ptrdiff_t>(first), attempts_.end()};
+}
+
+void runBranches(SolveContext& context, int count,
+                 const std::function<void(int, SolveContext&)>& work) {
+  const int at_once = std::max(1, std::min(context.threads(), count));
+  std::vector<std::unique_ptr<SolveContext>> branches;
+  for (int i = 0; i < count; ++i) {
+    branches.push_back(std::make_unique<SolveContext>(context, SolveContext::Branch{}));
+  }
+  std::vector<std::exception_ptr> failures(count);
+  const auto run = [&](int i) {
+    try {
+      work(i, *branches[i]);
+    } catch (...) {
+      failures[i] = std::current_exception();
+    }
+  };
+  for (int first = 0; first < count; first += at_once) {
+    const int last = std::min(first + at_once, count);
+    std::vector<std::thread> others;
+    for (int i = first + 1; i < last; ++i) others.emplace_back(run, i);
+    run(first);
+    for (std::thread& t : others) t.join();
+  }
+  for (int i = 0; i < count; ++i) {
+    context.join(*branches[i]);
+    if (failures[i]) std::rethrow_exception(failures[i]);
+  }
 }
 
 }  // namespace attitude_planner

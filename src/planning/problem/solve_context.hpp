@@ -5,7 +5,11 @@
 // (remainingSeconds, stopReason) instead of being re-derived per sub-solve.
 #pragma once
 
+#include <atomic>
 #include <chrono>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -30,6 +34,18 @@ class SolveContext : public Interruption {
   explicit SolveContext(const SolverOptions& request);
   SolveContext(const SolveContext&) = delete;
   SolveContext& operator=(const SolveContext&) = delete;
+
+  /// A branch of `parent` for one of several solves run at once on other threads (runBranches):
+  /// the parent's request, deadline, cancel flag, solve in progress (options()) and enclosing
+  /// attempt; its reports reach the caller one at a time, numbered in the request's one
+  /// sequence; its attempts and levels are its own until `join` appends them to the parent's.
+  struct Branch {};
+  SolveContext(SolveContext& parent, Branch);
+  /// Appends a branch's attempts, levels and iteration count to this context's, after the
+  /// branch's thread ended (in the order the caller joins branches: the trail's order).
+  void join(SolveContext& branch);
+  /// Solves the request may run at once (SolverOptions::threads; 0: the machine's cores).
+  int threads() const;
 
   /// The options of the solve in progress (what a driver hands its solver: the warm start, the
   /// tolerance, the class policy; the request's own outside any Call). Their time budget, cancel
@@ -195,16 +211,31 @@ class SolveContext : public Interruption {
   };
 
  private:
+  /// What a request's contexts (its root and the branches) share: the numbering of reports and
+  /// attempts, the caller's refusal, and the lock that lets one report reach the caller at a time.
+  struct Shared {
+    std::mutex report;
+    int reported = 0;
+    int attempts_begun = 0;
+    std::atomic<bool> refused_by_callback{false};
+  };
+
   SolverOptions request_;
   const SolverOptions* call_;
   Clock::time_point start_;
-  int iterations_ = 0;
-  bool refused_by_callback_ = false;
-  int attempts_begun_ = 0;
+  std::shared_ptr<Shared> shared_;
+  int iterations_ = 0;  ///< reported from this context (a branch's own, for its tallies)
   AttemptTag attempt_;
   bool scope_names_nested_ = false;  ///< an open scope is Nested::ScopeStage
   std::vector<Attempt> attempts_;
   std::vector<LevelSummary> levels_;
 };
+
+/// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each on its own
+/// thread in its own branch of `context` (SolveContext::Branch), and joins the branches into
+/// `context` in the order of i; an exception thrown by any work is rethrown after every branch
+/// joined (the first in that order). The work must not touch what another one writes.
+void runBranches(SolveContext& context, int count,
+                 const std::function<void(int, SolveContext&)>& work);
 
 }  // namespace attitude_planner

@@ -11,6 +11,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/newton/least_raise.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/strategies/starts.hpp"
@@ -240,6 +241,24 @@ TEST(TwistUnknown, AWatchSeesTheModelsMinimumAndEndsTheSolveWhereItSaysSo) {
     EXPECT_EQ(stopped.termination, Termination::NotConverged);
     EXPECT_EQ(stopped.reason, "stopped");
     EXPECT_LT(stopped.iterations, plain.iterations);
+  }
+}
+
+TEST(TwistUnknown, TheLeastDefiniteShiftIsTheOneByOneScansWithFewerFactorizations) {
+  // Success from a least raise on (definiteness above the least definite shift): the search ends
+  // where a scan 0, 1, 2, … does, or reports none within `most`, in O(log) tests.
+  for (int most = 0; most <= 80; ++most) {
+    for (int least = 0; least <= most + 1; ++least) {
+      SCOPED_TRACE("most " + std::to_string(most) + ", least " + std::to_string(least));
+      int tests = 0;
+      const int found = leastSucceedingRaise(most, [&](int r) {
+        ++tests;
+        return r >= least;
+      });
+      EXPECT_EQ(found, least <= most ? least : -1);
+      EXPECT_LE(tests, 2 * static_cast<int>(std::floor(std::log2(least + 1.0))) + 3);
+      if (least >= 8 && least <= most) EXPECT_LT(tests, least + 1);  // the scan's count
+    }
   }
 }
 

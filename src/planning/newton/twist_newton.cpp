@@ -57,19 +57,22 @@ struct DefiniteShift {
 };
 
 /// The shift a one-by-one scan (shiftedStep at `from`, raised until it succeeds) stops at, found
-/// by leastSucceedingRaise: in exact arithmetic both end at the same raise, so the same iterates
-/// follow (measured: 132 seeded requests' iterations, costs and twists bit for bit the same), with
-/// fewer factorizations where a start's Hessian is indefinite.
-DefiniteShift leastDefiniteShift(const TwistModel& m, double from, int most_raises,
+/// by leastSucceedingRaise from `guess`: in exact arithmetic both end at the same raise, so the
+/// same iterates follow (measured: 132 seeded requests' iterations, costs and twists bit for bit
+/// the same), with fewer factorizations where a start's Hessian is indefinite.
+DefiniteShift leastDefiniteShift(const TwistModel& m, double from, int most_raises, int guess,
                                  const NewtonParameters& p, Eigen::VectorXd* step) {
   Eigen::VectorXd trial;
   int last_success = -1;  // the raise whose step `step` holds
-  const int raises = leastSucceedingRaise(most_raises, [&](int r) {
-    if (!shiftedStep(m, raisedShift(from, r, p), &trial)) return false;
-    *step = trial;
-    last_success = r;
-    return true;
-  });
+  const int raises = leastSucceedingRaise(
+      most_raises,
+      [&](int r) {
+        if (!shiftedStep(m, raisedShift(from, r, p), &trial)) return false;
+        *step = trial;
+        last_success = r;
+        return true;
+      },
+      guess);
   if (raises < 0) return {};
   if (last_success != raises) shiftedStep(m, raisedShift(from, raises, p), step);
   return {true, raisedShift(from, raises, p), raises};
@@ -126,7 +129,8 @@ bool evaluateModel(const ReducedProblem& np, TwistModel* m, TwistSolve* out) {
 
 TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
                             double tolerance, int max_iterations, const NewtonParameters& p,
-                            std::vector<IterationInfo>* history, const TwistWatch* watch) {
+                            std::vector<IterationInfo>* history, const TwistWatch* watch,
+                            int raise_guess) {
   TwistSolve out;
   TwistModel m(np);
   Eigen::VectorXd step;
@@ -144,9 +148,13 @@ TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& cont
     double alpha = 0.0;
     bool final_step = false;
     for (int attempt = 0; attempt < p.max_step_attempts && alpha == 0.0; ++attempt) {
-      const DefiniteShift definite =
-          leastDefiniteShift(m, shift, p.max_step_attempts - 1 - attempt, p, &step);
+      // From λ = 0 the least definite shift is searched from the last one found from 0 (the
+      // Hessian's scale changes little between iterations and starts); from a carried λ, at it.
+      const bool fresh = shift == 0.0;
+      const DefiniteShift definite = leastDefiniteShift(m, shift, p.max_step_attempts - 1 - attempt,
+                                                        fresh ? raise_guess : 1, p, &step);
       if (!definite.found) break;
+      if (fresh && definite.raises > 0) raise_guess = out.fresh_raises = definite.raises;
       shift = definite.shift;
       attempt += definite.raises;  // as many attempts as the raises one at a time would take
       const double slope = m.gradient.dot(step);

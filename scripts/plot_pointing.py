@@ -147,7 +147,10 @@ request is one problem: the twist Newton's starts (4 twists x 2 ways round, the 
 seen) give the unconstrained twist optima, and the interior point with psi free starts from each
 distinct one, cheapest first, while its unconstrained cost is below the cheapest constrained
 answer found (constraints only add cost within a start's basin, and the interior point keeps the
-way round it starts in); an optimum that meets every constraint is that basin's answer as it is.
+way round it starts in); an optimum that meets every constraint is that basin's answer as it is,
+and an interior point whose lower bound (at a feasible, locally convex iterate with a small step:
+C - sum z c + g'd/2) passes the cheapest such answer or the cheapest constrained answer found is
+stopped there.
 An optimum whose path comes within 15 %% of a cone's half angle of its axis and crosses it deeper
 than the fixed-twist unconstrained optima 45 degrees either side of its psi do (a ridge of the constrained cost over psi: the plan passes the cone on
 one side or the other, each side's optimum at another twist) starts it from those two optima
@@ -157,8 +160,9 @@ twists (a path that passes the cone on one side); only where none of those conve
 the interior point has not certified local infeasibility from 4 distinct starts (then the loop
 stops: a local verdict), each start twist from its fixed-twist constrained optimum (every way
 round solved under the constraints there) frees psi from that plan. In both kinds a survey start
-whose Newton model's minimum lies on an answer the survey already holds (cost within 1e-3, psi
-within 1e-2 rad, relative decrement at most 0.1) is stopped there. The fixed solve it is timed
+whose Newton model's minimum lies on an answer the survey already holds (relative decrement d at
+most 0.3, cost within max(1e-3, 2 d^3), psi within max(1e-2, d^2) rad, its cost not below that
+answer's) is stopped there. The fixed solve it is timed
 against is one request's whole driver: the class survey, the interior point from the
 unconstrained optimum and, where that has no plan, the other classes under the constraints.
 

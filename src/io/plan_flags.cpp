@@ -10,22 +10,14 @@ namespace attitude_planner {
 
 namespace {
 
-const char* const kPlanFlagNames[] = {"--steps",
-                                      "--scheme",
-                                      "--solver",
-                                      "--precision",
-                                      "--tolerance",
-                                      "--max-iterations",
-                                      "--time-budget",
-                                      "--threads",
-                                      "--target-miss",
-                                      "--target-cost-error",
-                                      "--objective",
-                                      "--time-margin",
-                                      "--direction",
-                                      "--extra-revolutions",
-                                      "--point-body-axis",
-                                      "--point-world-direction"};
+const char* const kPlanFlagNames[] = {"--steps",           "--scheme",
+                                      "--solver",          "--precision",
+                                      "--tolerance",       "--max-iterations",
+                                      "--time-budget",     "--threads",
+                                      "--target-miss",     "--target-cost-error",
+                                      "--objective",       "--time-margin",
+                                      "--direction",       "--extra-revolutions",
+                                      "--point-body-axis", "--point-world-direction"};
 
 int parseInteger(const std::string& flag, const std::string& text) {
   char* end = nullptr;

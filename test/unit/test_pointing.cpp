@@ -11,6 +11,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/newton/least_raise.hpp"
 #include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/strategies/starts.hpp"
@@ -240,6 +241,34 @@ TEST(TwistUnknown, AWatchSeesTheModelsMinimumAndEndsTheSolveWhereItSaysSo) {
     EXPECT_EQ(stopped.termination, Termination::NotConverged);
     EXPECT_EQ(stopped.reason, "stopped");
     EXPECT_LT(stopped.iterations, plain.iterations);
+  }
+}
+
+TEST(TwistUnknown, TheLeastDefiniteShiftIsTheOneByOneScansWithFewerFactorizations) {
+  // Success from a least raise on (definiteness above the least definite shift): the search ends
+  // where a scan 0, 1, 2, … does, or reports none within `most`, from any guess, in tests
+  // logarithmic in the guess's distance (3 where the guess is the least raise: 0 is tried first).
+  const auto log2Of = [](int n) { return static_cast<int>(std::floor(std::log2(n + 1.0))); };
+  for (int most = 0; most <= 48; ++most) {
+    for (int least = 0; least <= most + 1; ++least) {
+      for (int guess = 0; guess <= most; ++guess) {
+        SCOPED_TRACE("most " + std::to_string(most) + ", least " + std::to_string(least) +
+                     ", guess " + std::to_string(guess));
+        int tests = 0;
+        const int found = leastSucceedingRaise(
+            most,
+            [&](int r) {
+              ++tests;
+              return r >= least;
+            },
+            guess);
+        ASSERT_EQ(found, least <= most ? least : -1);
+        ASSERT_LE(tests, 2 * log2Of(std::abs(least - std::max(guess, 1))) + 4);
+        if (guess <= 1 && least >= 8 && least <= most) ASSERT_LT(tests, least + 1);  // the scan's
+        if (guess == least && least > 1) ASSERT_EQ(tests, 3);  // 0, the guess, one below it
+        if (least == 0) ASSERT_EQ(tests, 1);
+      }
+    }
   }
 }
 

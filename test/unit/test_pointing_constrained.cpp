@@ -7,6 +7,7 @@
 // interior point; an optimum on a cone's ridge started from both its sides).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -17,6 +18,7 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/pointing.hpp"
 #include "planning/interior_point/constrained_system.hpp"
+#include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/perturbed_problem.hpp"
 #include "support/pointing_requests.hpp"
@@ -170,6 +172,52 @@ PlanningProblem spinningUnderATorqueBoxAtFourFifthsOfT(unsigned seed) {
 }
 
 }  // namespace
+
+TEST(ConstrainedTwist, AFeasibleIteratesLowerBoundIsBelowTheEndAndItsWatchStopsTheSolve) {
+  // The interior point with ψ free from the geodesic at ψ = 0.3 on seeded requests (a cone, a
+  // torque box, a spinning start): every bound it reports lies below the cost it converges to,
+  // and a watch that stops once the bound passes just below that cost ends it sooner.
+  int bounds = 0;
+  const std::pair<unsigned, PointingBinding> requests[] = {{201u, PointingBinding::KeepOut},
+                                                           {202u, PointingBinding::KeepOut},
+                                                           {211u, PointingBinding::TorqueBox},
+                                                           {221u, PointingBinding::KeepOut}};
+  for (const auto& [seed, binding] : requests) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    PlanningProblem p = test_support::randomConstrainedPointingRequest(seed, 32, seed == 221u,
+                                                                       SchemeKind::Paper, binding);
+    p.final_attitude = pointingAttitude(p.end_condition, 0.3);
+    std::vector<FeasibleIterate> seen;
+    const FeasibleIterateWatch silent = [&seen](const FeasibleIterate& at) {
+      seen.push_back(at);
+      return std::string();
+    };
+    SolveContext context{SolverOptions{}};
+    const GridOutcome plain =
+        solveInteriorPointOnGrid(p, SolverOptions{}, context, nullptr, nullptr, &silent);
+    if (!plain.result.converged()) continue;
+    const double end = plain.result.cost;
+    for (const FeasibleIterate& at : seen) {
+      EXPECT_LE(at.lower_bound, end * (1.0 + 1e-9)) << "iteration " << at.iteration;
+      EXPECT_GE(at.cost, at.lower_bound);
+    }
+    bounds += static_cast<int>(seen.size());
+    const auto first_above = std::find_if(seen.begin(), seen.end(), [&](const FeasibleIterate& at) {
+      return at.lower_bound > end * (1.0 - 1e-3);
+    });
+    if (first_above == seen.end()) continue;
+    const FeasibleIterateWatch stop = [&](const FeasibleIterate& at) {
+      return at.lower_bound > end * (1.0 - 1e-3) ? std::string("bound passed") : std::string();
+    };
+    SolveContext again{SolverOptions{}};
+    const GridOutcome stopped =
+        solveInteriorPointOnGrid(p, SolverOptions{}, again, nullptr, nullptr, &stop);
+    EXPECT_TRUE(stopped.stopped_by_watch);
+    EXPECT_EQ(stopped.result.termination, Termination::NotConverged);
+    EXPECT_LT(stopped.result.iterations, plain.result.iterations);
+  }
+  EXPECT_GE(bounds, 4);  // the bound was put to the test
+}
 
 TEST(ConstrainedPointingPlan, KeepOutConeAtMostTheSweepsBest) {
   for (unsigned seed : {201u, 202u}) {

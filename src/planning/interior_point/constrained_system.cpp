@@ -253,6 +253,12 @@ double ConstrainedSystem::maxViolation() const {
   return worst;
 }
 
+double ConstrainedSystem::multipliedValues() const {
+  double sum = 0.0;
+  rows_.forEach([&](auto&, int, auto& in) { sum += in.z * in.c; });
+  return sum;
+}
+
 /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function) at the current
 /// multipliers; empty without per-axis bounds.
 std::vector<Vector3> ConstrainedSystem::switchingFunction(

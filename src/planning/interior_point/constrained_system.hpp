@@ -105,6 +105,8 @@ class ConstrainedSystem final : public BarrierRows {
   void complementarity(double mu, double rho, double* average, double* smallest) const override;
   /// Largest elastic violation max(−c_i) at the last assembly or merit.
   double maxViolation() const;
+  /// Σ z_i c_i at the last assembly or merit: the constraints' part of the Lagrangian C − Σ z c.
+  double multipliedValues() const;
   /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function).
   std::vector<Vector3> switchingFunction(const std::vector<Vector3>& torque) const;
   /// max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ| at the current iterate.

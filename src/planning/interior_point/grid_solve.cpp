@@ -145,11 +145,28 @@ class GridSolve final : public PrimalDualProblem {
     double decrement_slope = 0.0;
     if (free_slacks_) addSlackTerms(&slope, &decrement_slope);
     if (slope >= 0.0 && !primal) return Pass::Retry;
+    if (watched(shift, free_slacks_ ? decrement_slope : slope)) return Pass::Stop;
     *measures = {free_slacks_ ? decrement_slope : slope, shift};
     request->slope = slope;
     request->alpha0 = free_slacks_ ? alpha_slack_ : 1.0;
     *d = &delta_;
     return Pass::Step;
+  }
+  /// Whether the request's watch stops the solve at this iterate (a FeasibleIterate: free
+  /// slacks, every constraint met, no shift, a small step; `slope` the merit's along the step,
+  /// a lower one than φ's own with free slacks), ending it with the watch's reason.
+  bool watched(double shift, double slope) {
+    if (!request_.watch || !free_slacks_ || shift != 0.0 || slope >= 0.0) return false;
+    if (system_.maxViolation() > 0.0) return false;
+    const FeasibleIterate at{
+        cost_, cost_ - system_.multipliedValues() + 0.5 * slope,
+        std::sqrt(-slope / std::max(2.0 * cost_, std::numeric_limits<double>::min())), iteration_};
+    if (!(at.relative_decrement <= kLocalBoundDecrement)) return false;
+    const std::string stop = (*request_.watch)(at);
+    if (stop.empty()) return false;
+    stopped_by_watch_ = true;
+    end(Termination::NotConverged, stop);
+    return true;
   }
   Pass noDirection() override {
     return end(Termination::NotConverged, "Newton system could not be made positive definite");
@@ -302,6 +319,7 @@ class GridSolve final : public PrimalDualProblem {
   /// The result: the plan at the last accepted iterate, its figures and the message.
   GridOutcome finish() {
     GridOutcome out;
+    out.stopped_by_watch = stopped_by_watch_;
     PlanResult& result = out.result;
     result.solver = "interior_point";
     result.iterations = iteration_;
@@ -376,6 +394,7 @@ class GridSolve final : public PrimalDualProblem {
   int iteration_ = 0;
   double relative_decrement_ = 0.0;
   int penalty_raises_ = 0;
+  bool stopped_by_watch_ = false;
   std::vector<IterationInfo> history_;
   Termination ending_ = Termination::NotConverged;
   std::string reason_ = "iteration limit reached";

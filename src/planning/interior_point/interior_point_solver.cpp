@@ -123,18 +123,20 @@ struct Solve {
 /// the context as it ends.
 GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
                                const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
-                               const LevelDuals* coarse_duals, bool final_grid = true) {
+                               const LevelDuals* coarse_duals, bool final_grid = true,
+                               const FeasibleIterateWatch* watch = nullptr) {
   const FormulationRecipe& recipe =
       options.constrained_from_warm_start && !options.warm_start_strictly_inside ? kProbeRecipe
                                                                                  : kRequestRecipe;
   const SolveContext::IterationTally tally(solve.context);  // both solves'
-  GridOutcome first = solveOnGrid(
-      problem, options, solve.parameters, solve.context,
-      {recipe.first.formulation, recipe.first.barrier, coarse_steps, coarse_duals, final_grid});
+  GridOutcome first = solveOnGrid(problem, options, solve.parameters, solve.context,
+                                  {recipe.first.formulation, recipe.first.barrier, coarse_steps,
+                                   coarse_duals, final_grid, watch});
   first.formulation = recipe.first.formulation;
   solve.context.recordLevels(first.result.levels);
   const Termination t = first.result.termination;
   if (t != Termination::Infeasible && t != Termination::NotConverged) return first;
+  if (first.stopped_by_watch) return first;      // the caller's bound: no other formulation wanted
   if (solve.context.stopReason()) return first;  // cancelled or out of time: no retry
   GridOutcome second = solveOnGrid(
       problem, options, solve.parameters, solve.context,
@@ -487,14 +489,15 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
 GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const SolverOptions& options,
                                      SolveContext& context,
                                      const ReducedProblem::StepVectors* start_steps,
-                                     const LevelDuals* start_duals) {
+                                     const LevelDuals* start_duals,
+                                     const FeasibleIterateWatch* watch) {
   const InteriorPointParameters parameters;
   SolverOptions from = options;
   from.warm_start = nullptr;  // the start is start_steps
   from.constrained_from_warm_start = false;
   const std::size_t first_level = context.levels().size();
-  GridOutcome outcome =
-      solveGridWithRetry(problem, from, {parameters, context}, start_steps, start_duals);
+  GridOutcome outcome = solveGridWithRetry(problem, from, {parameters, context}, start_steps,
+                                           start_duals, true, watch);
   outcome.result.levels = context.levelsFrom(first_level);
   return outcome;
 }

@@ -23,12 +23,13 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
 /// The interior point on `problem`'s own grid alone (no grid continuation, no staged retry), for a
 /// driver that runs its own levels (pointing): from `start_steps` (steps of this N, or of a coarser
 /// grid's solution) with `start_duals` (free slacks; may be null), else from the geodesic, in the
-/// request's formulation with its retry. Reports its iterations through `context`; records no
-/// attempt.
+/// request's formulation with its retry (not after `watch`, where given, stopped the first: see
+/// GridRequest::watch). Reports its iterations through `context`; records no attempt.
 GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const SolverOptions& options,
                                      SolveContext& context,
                                      const ReducedProblem::StepVectors* start_steps,
-                                     const LevelDuals* start_duals);
+                                     const LevelDuals* start_duals,
+                                     const FeasibleIterateWatch* watch = nullptr);
 
 /// The interior point from options.warm_start (a plan given as the initial guess, with the
 /// problem's N: initialGuessOnGrid) rather than from the unconstrained optimum.

@@ -25,6 +25,9 @@ struct TwistSolve {
   double twist_gradient = 0.0;      ///< ∂C/∂ψ at the end [N²·m²/rad]
   double relative_gradient = 0.0;   ///< max|∇C| (δ and ψ) / (|∂τ/∂δ|·max|τ|) at the end
   double relative_decrement = 0.0;  ///< √(−gᵀΔ)/|τ|₂ of the last step
+  /// The raises of λ from 0 its last indefinite iteration without a carried shift needed (0:
+  /// none): a guess for the next start's (solveTwistNewton's `raise_guess`).
+  int fresh_raises = 0;
 };
 
 /// Asked before each unshifted Newton step with where the quadratic model puts the full step (its
@@ -36,8 +39,11 @@ using TwistWatch =
 /// Newton on (δ, ψ) from `np`'s iterate and `twist` (np built for R_N = pointingAttitude(twist));
 /// `np` ends at the last accepted iterate. Iterations are reported through `context`; a cancel or
 /// the deadline ends the solve with that termination, and so does `watch` (where given).
+/// `raise_guess`: where the least definite shift from λ = 0 is searched first (an earlier
+/// start's TwistSolve::fresh_raises); it changes the factorizations tried, not the iterates.
 TwistSolve solveTwistNewton(ReducedProblem& np, double twist, SolveContext& context,
                             double tolerance, int max_iterations, const NewtonParameters& p,
-                            std::vector<IterationInfo>* history, const TwistWatch* watch = nullptr);
+                            std::vector<IterationInfo>* history, const TwistWatch* watch = nullptr,
+                            int raise_guess = 1);
 
 }  // namespace attitude_planner

@@ -219,7 +219,7 @@ def plan(problem, warm_start=None, **options):
     """Plans `problem` (a Problem, or a dict / path Problem() accepts) and returns a Result.
 
     `options` are plan_maneuver's planning flags as keywords, with the same meaning and checks:
-    steps, scheme, solver, precision, tolerance, max_iterations, time_budget, target_miss,
+    steps, scheme, solver, precision, tolerance, max_iterations, time_budget, threads, target_miss,
     target_cost_error, objective, time_margin, direction, extra_revolutions. `warm_start` is a
     previous Result (the CLI's --warm-start). The GIL is released during the solve, so threads
     plan in parallel. Raises InputError (a ValueError) naming the field and the value for bad

@@ -113,6 +113,9 @@ def jobs_of(requests, base_dir="."):
     options = requests.get("options") or {}
     if not isinstance(options, dict):
         raise _field_error("options", "expected a mapping of plan() keywords, got %r" % (options,))
+    # A batch runs one solve per core already: each solve on one thread (plan_maneuver --threads).
+    options = dict(options)
+    options.setdefault("threads", 1)
     if kinds[0] == "slew_table":
         return _slew_table_jobs(requests["slew_table"], options)
     return _scene_list_jobs(requests["scenes"], options, base_dir)

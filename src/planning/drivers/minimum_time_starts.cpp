@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -117,7 +118,8 @@ constexpr HomotopyClass kSpinningStartClasses[] = {{false, 0}, {true, 0}, {false
 /// from both ends, blended), all at the eigenaxis guess. Minimum time with spinning ends has
 /// local minima in several classes, which one geodesic start misses
 /// (docs/results/bounded_verdicts.md). The class optima come first: they start inside the bounds
-/// most often, and the watch then stops the later starts that cannot beat the least T found.
+/// most often, and the watch then stops the later starts that cannot beat the least T found. The
+/// class optima are solved at once (runBranches), each in a branch of `context`.
 std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem, SolveContext& context) {
   std::vector<FreeTimeStart> starts;
   PlanningProblem at = problem;
@@ -126,11 +128,17 @@ std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem, SolveC
     starts.push_back({name, kind, std::move(attitudes), at.duration});
     starts.back().detail.duration = at.duration;
   };
-  for (const HomotopyClass& c : kSpinningStartClasses) {
-    if (std::optional<std::vector<Matrix3>> attitudes = classOptimum(at, c, context)) {
+  constexpr int kClasses = std::size(kSpinningStartClasses);
+  std::optional<std::vector<Matrix3>> optima[kClasses];
+  runBranches(context, kClasses, [&](int i, SolveContext& branch) {
+    optima[i] = classOptimum(at, kSpinningStartClasses[i], branch);
+  });
+  for (int i = 0; i < kClasses; ++i) {
+    const HomotopyClass& c = kSpinningStartClasses[i];
+    if (optima[i]) {
       add(std::string("unconstrained optimum in the ") + (c.long_way ? "other-way" : "nearest") +
               " lift + " + std::to_string(c.extra_revolutions) + " turn(s)",
-          AttemptStart::UnconstrainedOptimum, std::move(*attitudes));
+          AttemptStart::UnconstrainedOptimum, std::move(*optima[i]));
     }
   }
   starts.push_back(geodesicStart(problem));

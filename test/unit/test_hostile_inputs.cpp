@@ -137,7 +137,7 @@ TEST(HostileOptions, BadSolverOptionsNameTheOptionAndTheValue) {
     ap::SolverOptions options;
     std::string expected;
   };
-  std::vector<Case> cases(6);
+  std::vector<Case> cases(7);
   cases[0].options.tolerance = -1e-12;
   cases[0].expected = "tolerance: must be a finite number > 0, got -9.9999999999999998e-13";
   cases[1].options.tolerance = nan;
@@ -150,6 +150,8 @@ TEST(HostileOptions, BadSolverOptionsNameTheOptionAndTheValue) {
   cases[4].expected = "time_budget: must be a finite number >= 0 s (0 = none), got -1";
   cases[5].options.time_budget_s = std::numeric_limits<double>::infinity();
   cases[5].expected = "time_budget: must be a finite number >= 0 s (0 = none), got inf";
+  cases[6].options.threads = -2;
+  cases[6].expected = "threads: must be >= 0 (0 = the machine's cores), got -2";
   for (const Case& c : cases) {
     EXPECT_EQ(errorOf([&] { ap::planManeuver(p, c.options); }), c.expected);
   }
@@ -171,6 +173,10 @@ TEST(HostileOptions, FlagValuesAreUsageErrorsNamingTheValue) {
   EXPECT_EQ(budget.status, 1) << budget.output;
   EXPECT_NE(budget.output.find("--time-budget: must be > 0 s, got -5"), std::string::npos)
       << budget.output;
+  const ToolRun threads = run(scene + " --threads 0");
+  EXPECT_EQ(threads.status, 1) << threads.output;
+  EXPECT_NE(threads.output.find("--threads: must be >= 1, got 0"), std::string::npos)
+      << threads.output;
   const ToolRun turns = run(scene + " --extra-revolutions -1");
   EXPECT_EQ(turns.status, 1) << turns.output;
   EXPECT_NE(turns.output.find("--extra-revolutions: must be >= 0, got -1"), std::string::npos)

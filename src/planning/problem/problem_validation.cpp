@@ -335,6 +335,10 @@ void validateOptions(const SolverOptions& o) {
     throw InvalidInput("time_budget: must be a finite number >= 0 s (0 = none), got " +
                        exactNumber(o.time_budget_s));
   }
+  if (o.threads < 0) {
+    throw InvalidInput("threads: must be >= 0 (0 = the machine's cores), got " +
+                       std::to_string(o.threads));
+  }
   if (o.warm_start) validateInitialGuess(*o.warm_start, "warm_start");
 }
 

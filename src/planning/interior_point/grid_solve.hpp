@@ -1,11 +1,11 @@
 // The interior point on one grid: one formulation, one barrier rule, one start (grid_solve.cpp).
 #pragma once
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/constrained_system.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 

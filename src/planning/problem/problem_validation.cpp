@@ -336,6 +336,7 @@ void validateOptions(const SolverOptions& o) {
                        exactNumber(o.time_budget_s));
   }
   if (o.warm_start) validateInitialGuess(*o.warm_start, "warm_start");
+  validateAdvancedParameters(o.advanced);
 }
 
 void requirePhysicalInertia(const Matrix3& inertia) {

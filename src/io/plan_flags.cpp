@@ -17,7 +17,8 @@ const char* const kPlanFlagNames[] = {"--steps",           "--scheme",
                                       "--target-miss",     "--target-cost-error",
                                       "--objective",       "--time-margin",
                                       "--direction",       "--extra-revolutions",
-                                      "--point-body-axis", "--point-world-direction"};
+                                      "--point-body-axis", "--point-world-direction",
+                                      "--advanced"};
 
 int parseInteger(const std::string& flag, const std::string& text) {
   char* end = nullptr;
@@ -45,6 +46,22 @@ double parsePositive(const std::string& flag, const std::string& text, const cha
   const double v = parseFinite(flag, text);
   if (!(v > 0.0)) throw InvalidInput(flag, std::string("must be > 0") + unit + ", got " + text);
   return v;
+}
+
+/// "NAME=VALUE" (--advanced): one field of the advanced parameters, checked against its range.
+void applyAdvancedFlag(const std::string& flag, const std::string& text,
+                       AdvancedParameters* advanced) {
+  const std::size_t equals = text.find('=');
+  if (equals == std::string::npos) {
+    throw InvalidInput(flag,
+                       "expected NAME=VALUE (e.g. interior_point.armijo=1e-4), got '" + text + "'");
+  }
+  const double value = parseFinite(flag, text.substr(equals + 1));
+  try {
+    setAdvancedParameter(advanced, text.substr(0, equals), value);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(flag, e.what());
+  }
 }
 
 /// "X,Y,Z": a finite nonzero vector (a pointing flag's value).
@@ -131,6 +148,8 @@ void applyPlanFlag(const std::string& flag, const std::string& value, PlanFlags*
     f.point_body_axis = parseDirectionVector(flag, value);
   } else if (flag == "--point-world-direction") {
     f.point_world_direction = parseDirectionVector(flag, value);
+  } else if (flag == "--advanced") {
+    applyAdvancedFlag(flag, value, &f.advanced);
   } else {
     throw InvalidInput(flag, "not a planning flag (value '" + value + "')");
   }
@@ -175,6 +194,7 @@ void applyPlanFlags(const PlanFlags& flags, PlanningProblem* problem, SolverOpti
   if (flags.max_iterations > 0) options->max_iterations = flags.max_iterations;
   options->time_budget_s = flags.time_budget;
   if (flags.threads > 0) options->threads = flags.threads;
+  options->advanced = flags.advanced;
 }
 
 }  // namespace attitude_planner

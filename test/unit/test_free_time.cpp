@@ -536,7 +536,8 @@ TEST(FreeTime, ConeAndRateLimitRefinedToN128IsAKktPoint) {
   // the best refined to 128. A sensitive case for the barrier's fall: at μ → μ^1.5 the
   // refinement reaches μ's floor (~1e-13) within ~40 iterations, a node rate bound sits at
   // c ~ 1e-14 and the step's curvature (~1e-8 in c) cuts every step to α ~ 1e-3 until the
-  // iteration limit (then the search answers); at μ^1.3 (free_time_theta_mu) it converges.
+  // iteration limit (then the search answers); at μ^1.3 (the free-time profile's theta_mu) it
+  // converges.
   double previous = 0.0;
   for (const int N : {64, 128}) {
     ap::PlanningProblem p = scene("min_time_keep_out", N);

@@ -110,8 +110,8 @@ TEST(InertiaCorrection, RowRelativeShiftGrowsUntilAnIndefiniteBandFactors) {
   double shift = 0.0;
   ASSERT_TRUE(correction.factorAndSolve(system, ones(kN), &d, &shift));
   // The schedule: 0, first_shift, then ×shift_growth.
-  EXPECT_GT(shift, p.first_shift);
-  const double steps = std::log(shift / p.first_shift) / std::log(p.shift_growth);
+  EXPECT_GT(shift, p.fixed_step.first_shift);
+  const double steps = std::log(shift / p.fixed_step.first_shift) / std::log(p.shift_growth);
   EXPECT_NEAR(steps, std::round(steps), 1e-9);
   Eigen::MatrixXd K = dense(k);
   const double row_floor = p.shift_row_floor * k.band.maxAbsDiagonal();
@@ -374,7 +374,7 @@ TEST(LineSearch, ArmijoBacktrackingTakesTheFirstHalvingThatDecreasesEnough) {
     LineProblem problem(phi, wall);
     Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 4.0);
     const ap::LineSearchResult r = search.search(problem, {-4.0, 1.0, false, false, false}, &d);
-    const double expected = firstArmijoStep(phi, 4.0, -4.0, 1.0, p.max_halvings, wall);
+    const double expected = firstArmijoStep(phi, 4.0, -4.0, 1.0, p.fixed_step.max_halvings, wall);
     ASSERT_TRUE(r.accepted) << wall;
     EXPECT_EQ(r.alpha, expected) << wall;
     EXPECT_LT(r.alpha, 1.0);
@@ -392,7 +392,7 @@ TEST(LineSearch, AnAscentDirectionIsRejectedAfterEveryHalvingAndTheIterateRestor
     const ap::LineSearchResult r = ap::ArmijoBacktracking(ap::fixedStepLineSearch(p))
                                        .search(problem, {-1.0, 1.0, false, at_floor, false}, &d);
     EXPECT_FALSE(r.accepted);
-    EXPECT_EQ(problem.trials, at_floor ? p.floor_halvings : p.max_halvings);
+    EXPECT_EQ(problem.trials, at_floor ? p.fixed_step.floor_halvings : p.fixed_step.max_halvings);
     EXPECT_EQ(problem.restores, 1);
     EXPECT_EQ(problem.x, 0.0);
   }
@@ -418,7 +418,7 @@ TEST(LineSearch, ARoundOffDecreaseIsTakenAtFixedStepAndOnlyFlaggedInFreeTime) {
           .search(free_time, {slope, 1.0, false, false, false}, &d);
   EXPECT_TRUE(flagged.at_round_off);
   EXPECT_FALSE(flagged.accepted);
-  EXPECT_EQ(free_time.trials, p.free_time_max_halvings);
+  EXPECT_EQ(free_time.trials, p.free_time.max_halvings);
 }
 
 TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeProfile) {
@@ -443,12 +443,12 @@ TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeP
   r = search.search(plain, {slope, 1.0, false, false, true}, &d);
   EXPECT_EQ(plain.clears, 1);
   EXPECT_EQ(plain.trials, 2);  // the full step, then α = 1/2 (accepted: φ(2.25) is small)
-  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 0.5, p.free_time_max_halvings, 100.0));
+  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 0.5, p.free_time.max_halvings, 100.0));
   EXPECT_EQ(d(0), 4.5);
   LineProblem fixed(phi, 100.0, 2.0);
   r = ap::ArmijoBacktracking(ap::fixedStepLineSearch(p))
           .search(fixed, {slope, 1.0, false, false, true}, &d);
-  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 1.0, p.max_halvings, 100.0));
+  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 1.0, p.fixed_step.max_halvings, 100.0));
   EXPECT_EQ(d(0), 4.5);
   EXPECT_EQ(fixed.clears, 0);
 }

@@ -475,6 +475,35 @@ TEST_F(CliTest, UsageErrorsNameTheFlag) {
   EXPECT_CONTAINS(sim.output, "expected SCENE.yaml and MANEUVER.csv");
 }
 
+TEST_F(CliTest, AdvancedParametersReachTheSolverAndABadOneIsNamed) {
+  // A set value moves the minimum-time iterations, not T* (the flag reaches the free-time solver).
+  const std::string scene = kScenes + "min_time_bilimoria_wie.yaml --steps 32 --summary ";
+  const ToolRun base = run("plan_maneuver", scene + dir_ + "/base.json");
+  const ToolRun set = run("plan_maneuver", scene + dir_ + "/set.json" +
+                                               " --advanced interior_point.free_time.theta_mu=1.2");
+  ASSERT_EQ(base.status, 0) << base.output;
+  ASSERT_EQ(set.status, 0) << set.output;
+  const std::string b = readFile(dir_ + "/base.json"), a = readFile(dir_ + "/set.json");
+  EXPECT_NE(jsonNumber(a, "iterations"), jsonNumber(b, "iterations"));
+  EXPECT_NEAR(jsonNumber(a, "minimum_duration"), jsonNumber(b, "minimum_duration"), 1e-8);
+
+  const ToolRun range = run("plan_maneuver", kScenes +
+                                                 "torque_limited.yaml --advanced "
+                                                 "interior_point.armijo=0.5");
+  EXPECT_EQ(range.status, 1) << range.output;
+  EXPECT_CONTAINS(range.output,
+                  "--advanced: advanced.interior_point.armijo: must be a finite number in (0, "
+                  "0.5), got 0.5");
+  const ToolRun unknown = run("plan_maneuver", kScenes +
+                                                   "torque_limited.yaml --advanced "
+                                                   "interior_point.armijo_typo=0.1");
+  EXPECT_EQ(unknown.status, 1) << unknown.output;
+  EXPECT_CONTAINS(unknown.output, "advanced.interior_point.armijo_typo: not an advanced parameter");
+  const ToolRun shape = run("plan_maneuver", kScenes + "torque_limited.yaml --advanced armijo");
+  EXPECT_EQ(shape.status, 1) << shape.output;
+  EXPECT_CONTAINS(shape.output, "--advanced: expected NAME=VALUE");
+}
+
 TEST_F(CliTest, SimulateTorquesRejectsABadCsvNamingTheLine) {
   const std::string csv = dir_ + "/bad.csv";
   std::ofstream(csv) << "k,t,qw,qx,qy,qz,wx,wy,wz,tx,ty,tz\n0,0,1,0,0,0,0,0,0,0,0,0\n"

@@ -30,6 +30,9 @@ struct PlanFlags {
   /// --point-body-axis / --point-world-direction "X,Y,Z": a pointing end condition replacing the
   /// scene's final attitude (both or neither).
   std::optional<Vector3> point_body_axis, point_world_direction;
+  /// --advanced NAME=VALUE (repeatable): the solvers' tuning, each field checked as it is set
+  /// (interior_point_parameters.hpp, advancedFields names them).
+  AdvancedParameters advanced;
 };
 
 /// Whether `flag` ("--steps") is one of the planning flags.

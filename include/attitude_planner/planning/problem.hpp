@@ -22,6 +22,7 @@
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
 #include "attitude_planner/planning/constraints.hpp"
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/reaction_wheels.hpp"
 
 namespace attitude_planner {
@@ -331,6 +332,9 @@ struct SolverOptions {
   /// not depend on it beyond the order the starts' watch sees them
   /// (drivers/minimum_time_free_time).
   int threads = 0;
+  /// The solvers' tuning (interior_point_parameters.hpp): the planner's defaults unless set;
+  /// validateOptions checks every field's range.
+  AdvancedParameters advanced;
 };
 
 /// The request asks for the default homotopy class (shortest way, no extra turns) from no guess
@@ -387,18 +391,14 @@ void requireRepresentableTurns(int extra_revolutions, int steps);
 void applySchemeName(const std::string& text, const std::string& field, PlanningProblem* problem);
 
 /// Checks the solver settings (tolerance finite and > 0, max_iterations ≥ 0, time budget finite
-/// and ≥ 0): throws InvalidInput naming the option and the value.
+/// and ≥ 0, every advanced parameter in its range): throws InvalidInput naming the option and the
+/// value.
 void validateOptions(const SolverOptions& options);
 
 /// A node constraint is counted active when its slack to the node bound (a cone's half angle
 /// tightened by its margin) is within this fraction of its limit (torque, rate) or this many
 /// radians (cones).
 constexpr double kActiveConstraintTolerance = 1e-6;
-
-/// A plan meets its node constraints when no violation exceeds this fraction of the constraint's
-/// scale (ConstraintCheck::max_relative_violation); the interior-point solver stops on the same
-/// figure for its elastic violations.
-constexpr double kNodeConstraintTolerance = 1e-8;
 
 /// The node constraints of `problem` (per-axis bounds and PlanningProblem::constraints) checked
 /// on a maneuver's own rows, independently of any solver (transcription/stage_constraints.cpp).

@@ -442,6 +442,7 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
 
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   validateProblem(problem);
+  validateOptions(context.options());
   validateMinimumTime(problem);
   const DurationLowerBound bound = durationLowerBound(problem);
   if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;

@@ -94,6 +94,7 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at, cons
   in_class.direction = c.long_way ? RotationDirection::LongWay : RotationDirection::Shortest;
   in_class.extra_revolutions = c.extra_revolutions;
   SolverOptions options;
+  options.advanced = context.options().advanced;
   options.enumerate_classes = false;
   options.tolerance = kClassOptimumTolerance;
   try {

@@ -20,8 +20,8 @@
 
 #include <Eigen/Core>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/result.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "planning/transcription/stage_quantities.hpp"

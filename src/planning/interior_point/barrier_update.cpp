@@ -94,11 +94,11 @@ class LoqoBarrier : public BarrierUpdate {
 }  // namespace
 
 MonotoneProfile fixedStepMonotone(const InteriorPointParameters& parameters) {
-  return {parameters.monotone_theta_mu, BarrierProblemTest::Decrement, true};
+  return {parameters.fixed_step.theta_mu, BarrierProblemTest::Decrement, true};
 }
 
 MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters) {
-  return {parameters.free_time_theta_mu, BarrierProblemTest::KktResidual, false};
+  return {parameters.free_time.theta_mu, BarrierProblemTest::KktResidual, false};
 }
 
 bool MonotoneBarrier::subproblemSolved(const BarrierState& state, const BarrierAccess& b) const {

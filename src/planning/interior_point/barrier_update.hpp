@@ -11,8 +11,8 @@
 
 #include <Eigen/Dense>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/stopping_tests.hpp"
 
 namespace attitude_planner {
@@ -90,9 +90,9 @@ struct MonotoneProfile {
   BarrierProblemTest test = BarrierProblemTest::Decrement;
   bool snap_to_final = true;
 };
-/// Fixed h: IPOPT's θ_μ (monotone_theta_mu), the decrement test, snapped.
+/// Fixed h: the fixed-step profile's θ_μ (IPOPT's 1.5), the decrement test, snapped.
 MonotoneProfile fixedStepMonotone(const InteriorPointParameters& parameters);
-/// Free time: free_time_theta_mu, the KKT residual test, not snapped.
+/// Free time: the free-time profile's θ_μ, the KKT residual test, not snapped.
 MonotoneProfile freeTimeMonotone(const InteriorPointParameters& parameters);
 
 /// Monotone (Fiacco–McCormick, as IPOPT's): μ falls only once the barrier problem is solved to

@@ -10,10 +10,10 @@
 
 #include <Eigen/Dense>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/linalg/banded_matrix.hpp"
 #include "planning/linalg/interruption.hpp"

@@ -29,7 +29,7 @@
 // Start: h is raised until every constraint that moves with h holds with a margin (rest to rest
 // each of them falls with h). With spinning ends a raise at fixed attitudes makes an end torque
 // worse (it carries the boundary momentum, ∓2√w JΩ/h, which a slower interior no longer meets),
-// so past a raise of kLargestRaise the start stays at its own T and is made feasible by an
+// so past a raise of largest_start_raise the start stays at its own T and is made feasible by an
 // elastic phase (as IPOPT's restoration, in one problem): each of those constraints becomes
 // c + v − s = 0 with its own s, v ≥ 0 and the exact ℓ1 penalty ρ Σ v in the objective, s and v
 // eliminated for c (the fixed-h solver's L1Elastic rows: prepareElasticRow, barrier_forms.hpp);
@@ -47,11 +47,11 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
 #include "planning/interior_point/primal_dual_loop.hpp"
@@ -66,32 +66,6 @@
 namespace attitude_planner {
 
 namespace {
-
-/// μ₀ = this / m (m constraints): the barrier terms start at a tenth of the objective T/T₀ = 1.
-constexpr double kInitialBarrier = 0.1;
-/// A start that is a neighbouring problem's KKT plan begins its barrier at this × μ₀
-/// (firstBarrier).
-constexpr double kNearKktBarrier = 1e-2;
-/// The start's h is raised at most this factor before the elastic start takes over: with spinning
-/// ends a raise at fixed attitudes does not scale every torque down (an end torque carries the
-/// boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start a little
-/// outside its bounds at T was raised to 52 T before every bound held (a prolonged N = 128
-/// answer on N = 256, docs/results/minimum_time.md "Spinning ends") and the solve, started that
-/// far from T*, stopped at the iteration limit. Rest to rest every such constraint falls with h
-/// and a raise of a few percent suffices.
-constexpr double kLargestRaise = 2.0;
-/// ρ of the elastic start's penalty ρ Σ v (objective T/T₀ = 1 at the start): above every
-/// multiplier the relaxed problem's minimum has v = 0 (an exact penalty); raised ×10 whenever a
-/// barrier problem is solved with the iterate still outside.
-constexpr double kElasticPenalty = 100.0;
-/// ElasticBarrier::FromViolations: the elastic phase's first μ puts the width μ/ρ of an elastic
-/// row's kink (where its merit turns from ρ|c| to −μ ln c) at this fraction of the largest
-/// violation. At μ₀ (about 0.1/m) the kink is far narrower than the violations of a spinning
-/// start (c down to −50), the merit is ℓ1 in all but name and its Newton model sees no curvature
-/// there (measured: 500 iterations of steps α ≈ 1e-4–1e-2); at the wider kink the starts reach
-/// KKT points more often, in other basins (docs/design/planner_behaviour.md).
-constexpr double kElasticKinkWidth = 0.1;
-constexpr double kElasticPenaltyGrowth = 10.0;
 
 class FreeTimeSolver final : public PrimalDualProblem {
  public:
@@ -120,13 +94,14 @@ class FreeTimeSolver final : public PrimalDualProblem {
     }
     const double h_start = np_.timeStep();
     const ReducedProblem::StepVectors steps_start = np_.current();
-    for (int i = 0; i < parameters_.free_time_max_start_growths; ++i) {
-      if (smallestValue(np_.current(), true) >= parameters_.free_time_start_margin) {
+    for (int i = 0; i < parameters_.max_start_growths; ++i) {
+      if (smallestValue(np_.current(), true) >= parameters_.start_margin) {
         h0_ = np_.timeStep();
         return conesAfterRaise();
       }
-      const double raised = np_.timeStep() * parameters_.free_time_start_growth;
-      if (allow_elastic_ && !raisesUntilInside() && raised > kLargestRaise * h_start) {
+      const double raised = np_.timeStep() * parameters_.start_growth;
+      if (allow_elastic_ && !raisesUntilInside() &&
+          raised > parameters_.largest_start_raise * h_start) {
         return startElastic(h_start, steps_start);
       }
       if (!raisedTo(raised)) {
@@ -136,8 +111,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
       }
     }
     return "no strictly feasible start: the constraints still fail at " +
-           std::to_string(std::pow(parameters_.free_time_start_growth,
-                                   parameters_.free_time_max_start_growths)) +
+           std::to_string(std::pow(parameters_.start_growth, parameters_.max_start_growths)) +
            " times the start's duration";
   }
 
@@ -145,7 +119,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// attitudes scales every row that moves with h down (torques like 1/h², rates like 1/h), so it
   /// reaches a strictly feasible start however far outside the start's own T is. (A wheel's
   /// momentum keeps its initial value; with spinning ends an end torque carries the boundary
-  /// momentum: kLargestRaise.)
+  /// momentum: largest_start_raise.)
   bool raisesUntilInside() const {
     return start_raise_ == StartRaise::UntilInside && problem_.initial_velocity.isZero(0.0) &&
            problem_.final_velocity.isZero(0.0) && !problem_.reaction_wheels.present();
@@ -170,7 +144,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
     np_.setCurrent(steps_start);
     h0_ = h_start;
     elastic_ = started_elastic_ = true;
-    rho_ = kElasticPenalty;
+    rho_ = parameters_.free_time.initial_penalty;
     return "";
   }
 
@@ -266,7 +240,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void barrierDecreased() override { report(0.0, stationarity_); }
   /// Assembled in prepare(); the end game is known before the factorization.
   Pass assemble(bool) override {
-    late_ = mu_ <= parameters_.free_time_damped_barrier * mu0_;
+    late_ = mu_ <= parameters_.damped_barrier * mu0_;
     return Pass::Step;
   }
   NewtonSystem newtonSystem() override { return {&factorization_, &rhs_, &d_}; }
@@ -341,7 +315,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   // The elastic start (startInside): until the iterate is strictly inside every constraint that
   // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
-  double rho_ = kElasticPenalty;
+  double rho_ = parameters_.free_time.initial_penalty;
   ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
   StartBarrier start_barrier_ = StartBarrier::Initial;
   StartRaise start_raise_ = StartRaise::Bounded;
@@ -592,8 +566,8 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   context_ = &context;
   watch_ = &watch;
   const int m = rows_.count;
-  mu0_ = kInitialBarrier / m;
-  mu_final_ = 0.1 * tolerance / m;  // the duality gap Σ zc ≈ m μ below tolerance
+  mu0_ = parameters_.free_time.initial_barrier / m;
+  mu_final_ = parameters_.final_barrier_fraction * tolerance / m;
   objective_ = MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
   test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
@@ -610,16 +584,18 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
 }
 
 /// μ₀, or in an elastic phase begun FromViolations the μ that widens its rows' kinks to
-/// kElasticKinkWidth of the largest violation (never below μ₀; the effort weight ε stays at ε₀
+/// elastic_kink_width of the largest violation (never below μ₀; the effort weight ε stays at ε₀
 /// while μ is above μ₀: prepare), or from a start that is a neighbouring problem's KKT plan
-/// (StartBarrier::NearKktPoint) kNearKktBarrier μ₀: measured on a held-out pointing request whose
-/// fixed-twist T*(ψ) has two branches, the ψ-free solve from the lower branch's KKT plan ended on
-/// the upper branch begun at μ₀ and at μ₀/10, and stayed on its own begun at μ₀/100 (26
+/// (StartBarrier::NearKktPoint) near_kkt_barrier × μ₀: measured on a held-out pointing request
+/// whose fixed-twist T*(ψ) has two branches, the ψ-free solve from the lower branch's KKT plan
+/// ended on the upper branch begun at μ₀ and at μ₀/10, and stayed on its own begun at μ₀/100 (26
 /// iterations) and μ₀/1000 (48).
 double FreeTimeSolver::firstBarrier() const {
-  if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint) return kNearKktBarrier * mu0_;
+  if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint)
+    return parameters_.near_kkt_barrier * mu0_;
   if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
-  return std::max(mu0_, kElasticKinkWidth * rho_ * -smallestValue(np_.current(), true));
+  return std::max(mu0_,
+                  parameters_.elastic_kink_width * rho_ * -smallestValue(np_.current(), true));
 }
 
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
@@ -642,7 +618,8 @@ Pass FreeTimeSolver::atSolvedBarrier() {
     out_.stopped_by_watch = true;
     return Pass::Stop;
   }
-  if (elastic_) rho_ *= kElasticPenaltyGrowth;  // solved still outside: the penalty was too low
+  if (elastic_)
+    rho_ *= parameters_.free_time.penalty_growth;  // solved still outside: the penalty was too low
   return Pass::Step;
 }
 
@@ -780,7 +757,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
   at.duration = start_duration;
   FreeTimeOutcome failed;
   failed.termination = Termination::NotConverged;
-  const InteriorPointParameters parameters;
+  const InteriorPointParameters& parameters = context.options().advanced.interior_point;
   try {
     ReducedProblem np(at);
     np.setInteriorFromAttitudes(attitudes);

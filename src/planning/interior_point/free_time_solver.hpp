@@ -69,18 +69,18 @@ struct FreeTimeOutcome {
 
 /// Where an elastic start (FreeTimeOutcome::elastic_start) begins its barrier: at μ₀, as every
 /// free-time solve does, or at a μ on the scale of the start's violations (FromViolations:
-/// free_time_solver.cpp kElasticKinkWidth). The two reach different KKT points from one start.
+/// InteriorPointParameters::elastic_kink_width). The two reach different KKT points from one start.
 enum class ElasticBarrier { Initial, FromViolations };
 
 /// Where a start strictly inside (or raised inside) begins its barrier: at μ₀, or (NearKktPoint)
-/// at kNearKktBarrier μ₀ for a start that is already a KKT plan of a neighbouring problem (a
+/// at near_kkt_barrier × μ₀ for a start that is already a KKT plan of a neighbouring problem (a
 /// fixed-twist minimum-time plan started with the twist free): begun at μ₀ the barrier re-centres
 /// such a start and may carry it to another local minimum (free_time_solver.cpp).
 enum class StartBarrier { Initial, NearKktPoint };
 
 /// How far a start outside the bounds that move with h is raised before its elastic phase takes
-/// over. Bounded: at most kLargestRaise (free_time_solver.cpp), for a start whose T is near its
-/// answer's (a coarser grid's T*, a plan's own T), whose local violations a raise would trade
+/// over. Bounded: at most InteriorPointParameters::largest_start_raise, for a start whose T is near
+/// its answer's (a coarser grid's T*, a plan's own T), whose local violations a raise would trade
 /// for a start far from T*. UntilInside: as far as needed where a raise scales every such row
 /// down (rest to rest, no wheel momentum; elsewhere Bounded), for a start whose T is a guess (the
 /// structured starts: the eigenaxis slew's profile).

@@ -91,10 +91,10 @@ class GridSolve final : public PrimalDualProblem {
     scales_.steps = N;
     const double f = scales_.f_scale;
     const int m = scales_.constraints;
-    rho_ = p_.initial_penalty * scales_.f_scale;
+    rho_ = p_.fixed_step.initial_penalty * scales_.f_scale;
     // From a coarse solution the active set is nearly right: a barrier that starts small keeps
     // the iterate near it.
-    mu_start_ = (request_.coarse_steps ? p_.warm_barrier : p_.initial_barrier) * f / m;
+    mu_start_ = (request_.coarse_steps ? p_.warm_barrier : p_.fixed_step.initial_barrier) * f / m;
     mu_ = mu_start_;
     // The final barrier grows with N above final_barrier_round_off_steps: a torque constraint's
     // value 1 ∓ τ_a/a carries round-off ~ε|Π|/(h a), which grows like N, and final slacks below
@@ -273,7 +273,7 @@ class GridSolve final : public PrimalDualProblem {
     if (violation <= p_.feasibility_tolerance) return end(Termination::Converged, "converged");
     if (!free_slacks_ && penalty_raises_ == 0 && violation <= p_.penalty_raise_violation) {
       ++penalty_raises_;
-      rho_ *= p_.penalty_growth;
+      rho_ *= p_.fixed_step.penalty_growth;
       mu_ = mu_start_;
       test_.restart(iteration_);
       system_.initializeMultipliers(

@@ -4,11 +4,11 @@
 #include <functional>
 #include <string>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/constrained_system.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 

@@ -17,7 +17,7 @@ bool RowRelativeShift::factorAndSolve(ShiftedSystem& system, const Eigen::Vector
       system.solve(d);
       if (d->allFinite()) return true;
     }
-    *shift = *shift == 0.0 ? p_.first_shift : p_.shift_growth * *shift;
+    *shift = *shift == 0.0 ? p_.fixed_step.first_shift : p_.shift_growth * *shift;
   }
   return false;
 }
@@ -36,12 +36,13 @@ bool PerturbationHandler::factorAndSolve(ShiftedSystem& system, const Eigen::Vec
                                          Eigen::VectorXd* d, double* used) {
   const int m = system.globals();
   const double scale = system.meanAbsDiagonal();
-  const double resumed = last_shift_ > 0 ? std::max(p_.free_time_smallest_shift,
-                                                    last_shift_ / kIpoptShiftResumeDivisor)
-                                         : p_.free_time_first_shift;
-  for (double shift = damping_; shift <= p_.free_time_max_shift;
-       shift = shift == 0.0 ? resumed
-                            : shift * (last_shift_ > 0 ? kIpoptShiftGrowth : p_.shift_growth)) {
+  const double resumed =
+      last_shift_ > 0 ? std::max(p_.smallest_resumed_shift, last_shift_ / p_.resumed_shift_divisor)
+                      : p_.free_time.first_shift;
+  for (double shift = damping_; shift <= p_.max_uniform_shift;
+       shift = shift == 0.0
+                   ? resumed
+                   : shift * (last_shift_ > 0 ? p_.resumed_shift_growth : p_.shift_growth)) {
     if (!system.factor({shift * scale, Shift::Rule::Uniform, 0.0})) continue;
     if (system.inertia().positive != m) continue;
     *d = rhs;
@@ -56,12 +57,12 @@ bool PerturbationHandler::factorAndSolve(ShiftedSystem& system, const Eigen::Vec
 }
 
 void PerturbationHandler::afterStep(double alpha, bool end_game) {
-  cut_steps_ = end_game && alpha < p_.free_time_cut_step ? cut_steps_ + 1 : 0;
-  const double growth = p_.free_time_damping_growth;
-  if (cut_steps_ >= p_.free_time_cut_steps_before_damping) {
-    damping_ = std::max(growth * damping_, p_.free_time_first_shift);
+  cut_steps_ = end_game && alpha < p_.damping_cut_step ? cut_steps_ + 1 : 0;
+  const double growth = p_.damping_growth;
+  if (cut_steps_ >= p_.damping_cut_steps) {
+    damping_ = std::max(growth * damping_, p_.free_time.first_shift);
   } else if (alpha == 1.0) {
-    damping_ = damping_ / growth >= p_.free_time_smallest_damping ? damping_ / growth : 0.0;
+    damping_ = damping_ / growth >= p_.smallest_damping ? damping_ / growth : 0.0;
   }
 }
 

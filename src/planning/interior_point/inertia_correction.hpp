@@ -5,16 +5,10 @@
 
 #include <Eigen/Core>
 
-#include "planning/interior_point/interior_point_parameters.hpp"
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 
 namespace attitude_planner {
-
-/// IPOPT's perturbation handler (Wächter & Biegler 2006, §3.1): after a system that needed a
-/// shift δ_w, the next one resumes at κ_w⁻ δ_w and grows by κ_w⁺ (κ_w⁻ = 1/3, κ_w⁺ = 8). κ_w⁻
-/// is applied as a division by 3: multiplying by the rounded 1/3 would move the iterates.
-constexpr double kIpoptShiftGrowth = 8.0;         ///< κ_w⁺
-constexpr double kIpoptShiftResumeDivisor = 3.0;  ///< 1/κ_w⁻
 
 /// The inertia correction as the primal–dual loop (primal_dual_loop.hpp) calls it: the shifted
 /// factorization of each pass's system, and its schedule's updates after a step and after a line
@@ -34,12 +28,12 @@ class InertiaCorrection {
 };
 
 /// Fixed h: a shift relative to each row's scale (Shift::Rule::RowRelative, the row floor
-/// `shift_row_floor` × the largest diagonal), from the current floor, first `first_shift`, then
-/// ×`shift_growth`, at most `max_inertia_corrections` factorizations, until the band factors
-/// positive definite (at the final barrier the active constraints' rows are ~1/μ larger than the
-/// others, and a uniform shift sized by them damps the free directions into linear
-/// convergence). After a rejected line search the floor rises (Levenberg–Marquardt), and it is
-/// relaxed after every accepted step.
+/// `shift_row_floor` × the largest diagonal), from the current floor, first the fixed-step
+/// profile's `first_shift`, then ×`shift_growth`, at most `max_inertia_corrections` factorizations,
+/// until the band factors positive definite (at the final barrier the active constraints' rows are
+/// ~1/μ larger than the others, and a uniform shift sized by them damps the free directions into
+/// linear convergence). After a rejected line search the floor rises (Levenberg–Marquardt), and it
+/// is relaxed after every accepted step.
 class RowRelativeShift final : public InertiaCorrection {
  public:
   explicit RowRelativeShift(const InteriorPointParameters& parameters) : p_(parameters) {}
@@ -59,8 +53,10 @@ class RowRelativeShift final : public InertiaCorrection {
 /// Free time: a shift times the mean |diagonal| of K (Shift::Rule::Uniform, the globals' corner
 /// included: a row-relative shift would scale with the barrier terms of active bounds and stall
 /// the step), from the damping (afterStep) or 0, then the first shift or, after a system that
-/// needed one, that shift resumed (IPOPT's κ_w⁻, floor free_time_smallest_shift) and grown by
-/// κ_w⁺ (else by shift_growth), at most free_time_max_shift; accepted where K's inertia is
+/// needed one, that shift resumed (IPOPT's perturbation handler, Wächter & Biegler 2006, §3.1:
+/// ÷ resumed_shift_divisor, i.e. κ_w⁻ = 1/3 applied as a division, as multiplying by the rounded
+/// 1/3 would move the iterates; floor smallest_resumed_shift) and grown by resumed_shift_growth
+/// (κ_w⁺; else by shift_growth), at most max_uniform_shift; accepted where K's inertia is
 /// (n + m, 0, 0) and the step is a descent direction (dᵀrhs > 0). Plus the damping after steps
 /// cut short (afterStep).
 class PerturbationHandler final : public InertiaCorrection {
@@ -82,7 +78,7 @@ class PerturbationHandler final : public InertiaCorrection {
   const InteriorPointParameters& p_;
   double last_shift_ = 0.0;  ///< the last system's shift (0: none)
   double damping_ = 0.0;     ///< the damping (0: none)
-  int cut_steps_ = 0;        ///< steps in a row cut below free_time_cut_step
+  int cut_steps_ = 0;        ///< steps in a row cut below damping_cut_step
 };
 
 }  // namespace attitude_planner

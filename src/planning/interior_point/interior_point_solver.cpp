@@ -433,9 +433,8 @@ void keepAttempt(SolveContext& context, const Begun& begun, std::size_t kept, Pl
 }  // namespace
 
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
-                                  SolveContext& context,
-                                  const InteriorPointParameters& parameters) {
-  const Solve solve{parameters, context};
+                                  SolveContext& context) {
+  const Solve solve{options.advanced.interior_point, context};
   const Begun begun(context);
   std::size_t at = begun.attempts;
   const SolveContext::IterationTally tally(context);  // every attempt's
@@ -491,13 +490,13 @@ GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const Solve
                                      const ReducedProblem::StepVectors* start_steps,
                                      const LevelDuals* start_duals,
                                      const FeasibleIterateWatch* watch) {
-  const InteriorPointParameters parameters;
   SolverOptions from = options;
   from.warm_start = nullptr;  // the start is start_steps
   from.constrained_from_warm_start = false;
   const std::size_t first_level = context.levels().size();
-  GridOutcome outcome = solveGridWithRetry(problem, from, {parameters, context}, start_steps,
-                                           start_duals, true, watch);
+  GridOutcome outcome =
+      solveGridWithRetry(problem, from, {options.advanced.interior_point, context}, start_steps,
+                         start_duals, true, watch);
   outcome.result.levels = context.levelsFrom(first_level);
   return outcome;
 }
@@ -512,14 +511,13 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
   try {
     ReducedProblem np(problem);
     np.setInteriorFromAttitudes(options.warm_start->attitude);
-    const InteriorPointParameters parameters;
+    const InteriorPointParameters& parameters = options.advanced.interior_point;
     duals = ConstrainedSystem(problem, &np, Formulation::FreeSlacks, parameters).estimatedDuals();
     steps = np.current();
   } catch (const StepTooLarge&) {
     return solveWithInteriorPoint(problem, options, context);  // reports it
   }
-  const InteriorPointParameters parameters;
-  const Solve solve{parameters, context};
+  const Solve solve{options.advanced.interior_point, context};
   SolverOptions from = options;
   from.warm_start = nullptr;  // the guess's steps start the grid
   from.constrained_from_warm_start = false;

@@ -5,7 +5,6 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/grid_solve.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
 
 namespace attitude_planner {
@@ -15,10 +14,10 @@ namespace attitude_planner {
 /// from options.warm_start if given. Ends Infeasible when the constraints cannot be met. Polls
 /// `context` (cancel flag, deadline) inside its long loops, reports its iterations and records
 /// its attempts there (the kept one marked; they are its PlanResult::attempts too). Fills
-/// everything but solve_time_s and the constraint figures.
+/// everything but solve_time_s and the constraint figures. Its constants:
+/// options.advanced.interior_point.
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
-                                  SolveContext& context,
-                                  const InteriorPointParameters& parameters = {});
+                                  SolveContext& context);
 
 /// The interior point on `problem`'s own grid alone (no grid continuation, no staged retry), for a
 /// driver that runs its own levels (pointing): from `start_steps` (steps of this N, or of a coarser

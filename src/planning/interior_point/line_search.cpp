@@ -8,16 +8,16 @@ namespace attitude_planner {
 LineSearchProfile fixedStepLineSearch(const InteriorPointParameters& parameters) {
   LineSearchProfile profile;
   profile.armijo = parameters.armijo;
-  profile.max_halvings = parameters.max_halvings;
-  profile.floor_halvings = parameters.floor_halvings;
+  profile.max_halvings = parameters.fixed_step.max_halvings;
+  profile.floor_halvings = parameters.fixed_step.floor_halvings;
   profile.merit_round_off = parameters.merit_round_off;
   return profile;
 }
 
 LineSearchProfile freeTimeLineSearch(const InteriorPointParameters& parameters) {
   LineSearchProfile profile = fixedStepLineSearch(parameters);
-  profile.max_halvings = parameters.free_time_max_halvings;
-  profile.floor_halvings = parameters.free_time_max_halvings;
+  profile.max_halvings = parameters.free_time.max_halvings;
+  profile.floor_halvings = parameters.free_time.floor_halvings;
   profile.take_round_off_step = false;
   profile.second_order_correction = true;
   return profile;

@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "planning/interior_point/barrier_problem.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 
 namespace attitude_planner {
 
@@ -22,9 +22,9 @@ struct LineSearchProfile {
   /// second-order correction before halving (BarrierProblem::correctedStep).
   bool second_order_correction = false;
 };
-/// Fixed h: armijo, max_halvings, floor_halvings; round-off steps taken; no correction.
+/// Fixed h: armijo, the fixed-step profile's halvings; round-off steps taken; no correction.
 LineSearchProfile fixedStepLineSearch(const InteriorPointParameters& parameters);
-/// Free time: armijo, free_time_max_halvings; round-off steps flagged; the correction.
+/// Free time: armijo, the free-time profile's halvings; round-off steps flagged; the correction.
 LineSearchProfile freeTimeLineSearch(const InteriorPointParameters& parameters);
 
 /// One search's inputs from the loop.

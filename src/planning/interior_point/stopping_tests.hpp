@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/termination.hpp"
-#include "planning/interior_point/interior_point_parameters.hpp"
 
 namespace attitude_planner {
 

@@ -340,6 +340,7 @@ void validateOptions(const SolverOptions& o) {
                        std::to_string(o.threads));
   }
   if (o.warm_start) validateInitialGuess(*o.warm_start, "warm_start");
+  validateAdvancedParameters(o.advanced);
 }
 
 void requirePhysicalInertia(const Matrix3& inertia) {

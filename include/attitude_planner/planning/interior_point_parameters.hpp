@@ -1,25 +1,70 @@
 // The interior point's tuning constants, each with its symbol in the paper it follows (IPOPT:
 // Wächter & Biegler, Math. Program. 106 (2006); LOQO: Vanderbei & Shanno, Comput. Optim. Appl. 13
 // (1999); Mehrotra, SIAM J. Optim. 2 (1992)), its default and why. How the defaults were chosen
-// (the measurements behind them) is in docs/notes/interior_point_tuning.md.
+// (the measurements behind them) is in docs/notes/interior_point_tuning.md. One struct: the
+// constants once, and where the two problems the interior point solves (fixed h, free time) take
+// different values of one idea, two named profiles of InteriorPointProfile. A user sets them as
+// SolverOptions::advanced (problem.hpp); validateAdvancedParameters bounds every field.
 #pragma once
 
-#include "attitude_planner/planning/constraints.hpp"
-#include "attitude_planner/planning/problem.hpp"  // kNodeConstraintTolerance
+#include <string>
+#include <vector>
 
 namespace attitude_planner {
 
-/// Every constant of the interior point (interior_point_solver.cpp). Scales: μ and ρ relative to
-/// f_scale/m (the start's cost over the number of constraints), decrements relative to √(2
-/// f_scale).
+/// A plan meets its node constraints when no violation exceeds this fraction of the constraint's
+/// scale (ConstraintCheck::max_relative_violation); the interior-point solver stops on the same
+/// figure for its elastic violations.
+constexpr double kNodeConstraintTolerance = 1e-8;
+
+/// The values of one idea that differ between the interior point's two problems: fixed h (the
+/// constrained minimum effort: objective C, scale f_scale = the start's cost) and free time
+/// (minimum time: objective T/T₀ + εC, scale 1). Each field's unit is its problem's scale.
+struct InteriorPointProfile {
+  /// μ₀ × f_scale/m (m constraints): fixed h starts the barrier terms as large as the cost, free
+  /// time at a tenth of the objective T/T₀ = 1.
+  double initial_barrier;
+  /// Monotone μ rule (IPOPT θ_μ): superlinear decrease μ ← μ^θ_μ (scaled). Free time below
+  /// IPOPT's 1.5: a steeper fall sent the next steps halving their way into the active bounds for
+  /// ~6 iterations per barrier level (one solve, Bilimoria–Wie N = 256: 50 → 38 iterations; Betts
+  /// N = 64: 85 → 53).
+  double theta_mu;
+  /// Most halvings of the line search (free time fewer: a step of 1e-12 in η is no progress in
+  /// T) ...
+  int max_halvings;
+  /// ... and at the round-off floor (fixed h: where a 32× shortened step is no progress; free
+  /// time's KKT residual test names no floor, so its value there, max_halvings', is not read).
+  int floor_halvings;
+  /// First shift of the inertia correction (IPOPT δ_w⁰): fixed h relative to each row's diagonal,
+  /// a round-off nudge; free time relative to the mean |diagonal|, which the border's corner and
+  /// the barrier terms dominate.
+  double first_shift;
+  /// Elastic ρ₀ × f_scale: far above the multipliers met in practice (fixed h: a binding z is ~
+  /// f/N; free time: the relaxed problem's minimum has v = 0 above every multiplier).
+  double initial_penalty;
+  /// ρ ← this × ρ: fixed h once before a request is called infeasible, free time whenever a
+  /// barrier problem is solved with the iterate still outside.
+  double penalty_growth;
+};
+
+/// Fixed h (interior_point_solver.cpp, grid_solve.cpp).
+constexpr InteriorPointProfile kFixedStepProfile{1.0, 1.5, 60, 5, 1e-14, 1e4, 1e4};
+/// Free time (free_time_solver.cpp).
+constexpr InteriorPointProfile kFreeTimeProfile{0.1, 1.3, 40, 40, 1e-10, 100.0, 10.0};
+
+/// Every constant of the interior point (interior_point_solver.cpp, free_time_solver.cpp). Scales:
+/// μ and ρ relative to f_scale/m (the start's cost over the number of constraints), decrements
+/// relative to √(2 f_scale).
 struct InteriorPointParameters {
+  InteriorPointProfile fixed_step = kFixedStepProfile;  ///< the constrained minimum effort
+  InteriorPointProfile free_time = kFreeTimeProfile;    ///< minimum time
+
   // --- barrier μ -------------------------------------------------------------------------------
-  /// μ₀ × f_scale/m: the barrier terms start as large as the cost.
-  double initial_barrier = 1.0;
   /// μ₀ × f_scale/m on a grid started from a coarser grid's solution: its active set is nearly
   /// right and a small barrier keeps the iterate near it.
   double warm_barrier = 1e-3;
-  /// μ_final = this × tolerance × f_scale/m: the barrier's cost gap stays below the tolerance.
+  /// μ_final = this × tolerance × f_scale/m: the barrier's cost gap (the duality gap Σ zc ≈ m μ)
+  /// stays below the tolerance.
   double final_barrier_fraction = 0.1;
   /// Above this N μ_final grows like N: a torque constraint's value carries round-off ~ N.
   int final_barrier_round_off_steps = 2048;
@@ -37,8 +82,7 @@ struct InteriorPointParameters {
   double monotone_kappa_epsilon = 10.0;
   /// Monotone (IPOPT κ_μ): linear decrease μ ← κ_μ μ.
   double monotone_kappa_mu = 0.2;
-  /// Monotone (IPOPT θ_μ): superlinear decrease μ ← μ^θ_μ (scaled); the smaller of the two.
-  double monotone_theta_mu = 1.5;
+  /// (Monotone θ_μ is a profile's: the smaller of the two decreases.)
   /// Monotone: full steps in a row that no longer halve the decrement after which a barrier
   /// problem counts as solved as far as round-off allows.
   int monotone_stalled_steps = 2;
@@ -63,11 +107,7 @@ struct InteriorPointParameters {
   /// multiplier ≈ ρ would swamp the Hessian).
   double initial_multiplier_cap = 10.0;
 
-  // --- penalty (elastic ρ, free-slack merit ν) -------------------------------------------------
-  /// ρ₀ × f_scale: far above the multipliers met in practice (a binding z is ~ f/N).
-  double initial_penalty = 1e4;
-  /// ρ ← this × ρ once before a request is called infeasible.
-  double penalty_growth = 1e4;
+  // --- penalty (elastic ρ: a profile's; free-slack merit ν) ------------------------------------
   /// A violation above this is not a penalty below a multiplier: no raise, infeasible.
   double penalty_raise_violation = 1e-3;
   /// ν ≥ this × the largest multiplier after the step (the ℓ1 merit is exact above it).
@@ -79,9 +119,7 @@ struct InteriorPointParameters {
   // --- inertia correction ----------------------------------------------------------------------
   /// Factorizations tried with growing shifts before the system counts as not positive definite.
   int max_inertia_corrections = 40;
-  /// First relative shift δ_w (IPOPT δ_w⁰, relative here): a round-off nudge.
-  double first_shift = 1e-14;
-  /// δ_w ← this × δ_w after a failed factorization (IPOPT κ_w⁺).
+  /// δ_w ← this × δ_w after a failed factorization (IPOPT's κ̄_w⁺, the first growth).
   double shift_growth = 100.0;
   /// The shift's floor per row: this × the largest diagonal (rows of zero scale still move).
   double shift_row_floor = 1e-8;
@@ -99,10 +137,6 @@ struct InteriorPointParameters {
   double armijo = 1e-4;
   /// A predicted merit decrease below this × |φ| is round-off: the step is taken.
   double merit_round_off = 1e-14;
-  /// Most halvings of the line search ...
-  int max_halvings = 60;
-  /// ... and at the round-off floor (where a 32× shortened step is no progress).
-  int floor_halvings = 5;
 
   // --- stopping test ---------------------------------------------------------------------------
   /// Relative decrement below which a stall at μ_final counts as converged (at N ≤ 1024) ...
@@ -138,37 +172,54 @@ struct InteriorPointParameters {
   /// ... with θ at least this [rad].
   double angle_floor = 1e-3;
 
-  // --- minimum time (free_time_solver.cpp: the feasible barrier method with h free) -----------
+  // --- minimum time's own strategies (free_time_solver.cpp, inertia_correction.cpp) -----------
   /// The start's h grows by this factor until every constraint that moves with h holds with the
   /// start margin (torques scale like 1/h²: a few percent per growth keeps T₀ near the least
   /// feasible T of the start's path).
-  double free_time_start_growth = 1.05;
+  double start_growth = 1.05;
   /// ... with c ≥ this: a start on its bounds would begin with infinite barrier terms.
-  double free_time_start_margin = 0.05;
+  double start_margin = 0.05;
   /// ... at most this many growths (1.05⁴⁰⁰ ≈ 3e8: a start no slower plan makes feasible).
-  int free_time_max_start_growths = 400;
-  /// Most halvings of its line search (fewer than the fixed-h solver's: a step of 1e-12 in η is
-  /// no progress in T).
-  int free_time_max_halvings = 40;
-  /// First relative shift of its inertia correction (relative to the mean diagonal, which the
-  /// border's corner and the barrier terms dominate, not to the largest one) ...
-  double free_time_first_shift = 1e-10;
-  /// A shift that worked is resumed at a third of itself down to this (IPOPT's δ_w^min): a floor
-  /// at the first shift swamped the soft directions' curvature once the barrier terms of active
-  /// bounds make the mean diagonal ~1e11 (N ≥ 1024) and stalled the refinement.
-  double free_time_smallest_shift = 1e-20;
-  /// ... and the largest before the step counts as failed.
-  double free_time_max_shift = 1e10;
+  int max_start_growths = 400;
+  /// A bounded raise (StartRaise::Bounded) stops at this factor and the elastic start takes over:
+  /// with spinning ends a raise at fixed attitudes does not scale every torque down (an end torque
+  /// carries the boundary momentum, 2√w JΩ/h, which a slower interior no longer meets), so a start
+  /// a little outside its bounds at T was raised to 52 T before every bound held (a prolonged
+  /// N = 128 answer on N = 256, docs/results/minimum_time.md "Spinning ends") and the solve,
+  /// started that far from T*, stopped at the iteration limit. Rest to rest every such
+  /// constraint falls with h and a raise of a few percent suffices.
+  double largest_start_raise = 2.0;
+  /// A start that is a neighbouring problem's KKT plan (StartBarrier::NearKktPoint) begins its
+  /// barrier at this × μ₀.
+  double near_kkt_barrier = 1e-2;
+  /// ElasticBarrier::FromViolations: the elastic phase's first μ puts the width μ/ρ of an elastic
+  /// row's kink (where its merit turns from ρ|c| to −μ ln c) at this fraction of the largest
+  /// violation. At μ₀ (about 0.1/m) the kink is far narrower than the violations of a spinning
+  /// start (c down to −50), the merit is ℓ1 in all but name and its Newton model sees no curvature
+  /// there (measured: 500 iterations of steps α ≈ 1e-4–1e-2); at the wider kink the starts reach
+  /// KKT points more often, in other basins (docs/design/planner_behaviour.md).
+  double elastic_kink_width = 0.1;
+  /// After a system that needed a shift the next one resumes at that shift ÷ this (1/IPOPT κ_w⁻)
+  /// ...
+  double resumed_shift_divisor = 3.0;
+  /// ... and grows by this (IPOPT κ_w⁺) instead of shift_growth ...
+  double resumed_shift_growth = 8.0;
+  /// ... down to this (IPOPT's δ_w^min): a floor at the first shift swamped the soft directions'
+  /// curvature once the barrier terms of active bounds make the mean diagonal ~1e11 (N ≥ 1024)
+  /// and stalled the refinement.
+  double smallest_resumed_shift = 1e-20;
+  /// The largest shift (relative to the mean |diagonal|) before the step counts as failed.
+  double max_uniform_shift = 1e10;
   /// Steps the line search cut below this length ...
-  double free_time_cut_step = 1.0 / 16;
+  double damping_cut_step = 1.0 / 16;
   /// ... this many times in a row damp the next Newton steps (a shift from the first shift up,
-  /// free_time_solver.cpp dampAfterCutSteps): where minimum time is flat along an arc the
-  /// undamped step runs into the constraints' curvature (0.96 N m about body x against
-  /// |u_x| ≤ 1, N = 64: 500 iterations without converging; damped, a KKT point in 380). Two: one
-  /// damped after a single cut step, common on the way. Measured (N = 64, plan_maneuver): T* the
-  /// same to the last digit on Bilimoria–Wie, Betts, the cone and the cone + rate rows,
-  /// iterations 397 → 292, 188 → 188, 1123 → 1129, 1117 → 1127.
-  int free_time_cut_steps_before_damping = 2;
+  /// PerturbationHandler::afterStep): where minimum time is flat along an arc the undamped step
+  /// runs into the constraints' curvature (0.96 N m about body x against |u_x| ≤ 1, N = 64: 500
+  /// iterations without converging; damped, a KKT point in 380). Two: one damped after a single
+  /// cut step, common on the way. Measured (N = 64, plan_maneuver): T* the same to the last digit
+  /// on Bilimoria–Wie, Betts, the cone and the cone + rate rows, iterations 397 → 292, 188 → 188,
+  /// 1123 → 1129, 1117 → 1127.
+  int damping_cut_steps = 2;
   /// ... once the barrier μ is at most this × its start μ₀ (the end game: where the basin is
   /// chosen, at the first barrier levels, damped steps took paper on min_time_keep_out.yaml
   /// N = 32 to a higher KKT point, 29.7404 s instead of 29.7113 s). In the end game too a
@@ -179,15 +230,11 @@ struct InteriorPointParameters {
   /// limit, the search's answer); 0.99 N m, N = 64: a KKT point in 673 (before: the search). At
   /// every μ the correction changed the basin: paper around the keep-out cone took 310 → 529
   /// iterations at N = 64 (the eigenaxis start left its saddle), the same T*.
-  double free_time_damped_barrier = 1e-2;
+  double damped_barrier = 1e-2;
   /// The damping grows by this factor per further cut step and falls by it per full step ...
-  double free_time_damping_growth = 10.0;
+  double damping_growth = 10.0;
   /// ... down to this, then none.
-  double free_time_smallest_damping = 1e-14;
-  /// θ_μ of its monotone barrier update (μ → min(κ_μ μ, μ^θ_μ)), below IPOPT's 1.5: a steeper
-  /// fall sent the next steps halving their way into the active bounds for ~6 iterations per
-  /// barrier level (one solve, Bilimoria–Wie N = 256: 50 → 38 iterations; Betts N = 64: 85 → 53).
-  double free_time_theta_mu = 1.3;
+  double smallest_damping = 1e-14;
 
   // --- grids -----------------------------------------------------------------------------------
   /// Above this N the constrained problem is first solved on coarser grids (down to 16 steps).
@@ -195,5 +242,35 @@ struct InteriorPointParameters {
   /// N of a level ÷ N of the next coarser one.
   int coarsening_factor = 4;
 };
+
+/// The tuning a user may set beside the solver options (SolverOptions::advanced): every field
+/// has a default that is the planner's own, and bounds validateAdvancedParameters checks.
+struct AdvancedParameters {
+  InteriorPointParameters interior_point;  ///< "interior_point.<field>" in the table below
+};
+
+/// One settable field of AdvancedParameters: its name ("interior_point.armijo",
+/// "interior_point.free_time.theta_mu") and the range it must lie in (a finite number; an
+/// integer where `integer`; an infinite bound is no bound).
+struct AdvancedField {
+  std::string name;
+  double lower = 0.0;
+  double upper = 0.0;
+  bool lower_open = false;  ///< the value must exceed `lower` (else be at least it)
+  bool upper_open = false;  ///< the value must stay below `upper` (else at most it)
+  bool integer = false;
+  double value = 0.0;  ///< its value in the AdvancedParameters listed
+};
+
+/// Every field of `parameters`, in the struct's order, with its range and value.
+std::vector<AdvancedField> advancedFields(const AdvancedParameters& parameters);
+
+/// Throws InvalidInput naming the field and the value ("advanced.interior_point.armijo: must be
+/// in (0, 0.5), got 0.7") unless every field of `parameters` lies in its range.
+void validateAdvancedParameters(const AdvancedParameters& parameters);
+
+/// Sets the field `name` (as advancedFields names it) to `value`, checked against its range:
+/// throws InvalidInput naming an unknown field (with the known ones) or a value out of range.
+void setAdvancedParameter(AdvancedParameters* parameters, const std::string& name, double value);
 
 }  // namespace attitude_planner

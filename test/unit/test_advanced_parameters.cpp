@@ -1,0 +1,218 @@
+// The advanced parameters (interior_point_parameters.hpp): every field in the table, every field
+// bounded and named when out of range, a set value reaching the solver it tunes, the defaults the
+// planner's own.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "attitude_planner/errors.hpp"
+#include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/interior_point_parameters.hpp"
+#include "support/scene_problem.hpp"
+
+namespace ap = attitude_planner;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The numeric members of `struct_name` as the header declares them ("double name = ..." or
+/// "double name;"): read from the source, so a field added without a table row is found.
+std::set<std::string> declaredFields(const std::string& struct_name) {
+  std::ifstream in(AP_SOURCE_DIR
+                   "/include/attitude_planner/planning/interior_point_parameters.hpp");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string source = text.str();
+  const std::size_t begin = source.find("struct " + struct_name + " {");
+  const std::size_t end = source.find("\n};", begin);
+  const std::string body = source.substr(begin, end - begin);
+  const std::regex member(R"(\n  (?:double|int) (\w+)(?: = [^;]+)?;)");
+  std::set<std::string> names;
+  for (std::sregex_iterator it(body.begin(), body.end(), member), last; it != last; ++it) {
+    names.insert((*it)[1]);
+  }
+  return names;
+}
+
+/// The message of the InvalidInput `set` throws ("" if none).
+template <typename Call>
+std::string refusal(Call set, std::string* field = nullptr) {
+  try {
+    set();
+  } catch (const ap::InvalidInput& e) {
+    if (field) *field = e.field();
+    return e.what();
+  }
+  return "";
+}
+
+/// The values of every field of `a`, in the table's order.
+std::vector<double> valuesOf(const ap::AdvancedParameters& a) {
+  std::vector<double> values;
+  for (const ap::AdvancedField& f : ap::advancedFields(a)) values.push_back(f.value);
+  return values;
+}
+
+/// Values just outside `f`'s range (and non-finite ones, and a fraction for an integer field).
+std::vector<double> outside(const ap::AdvancedField& f) {
+  std::vector<double> values = {std::nan(""), kInf, -kInf};
+  values.push_back(f.lower_open ? f.lower : std::nextafter(f.lower, -kInf));
+  if (std::isfinite(f.upper))
+    values.push_back(f.upper_open ? f.upper : std::nextafter(f.upper, kInf));
+  if (f.integer) values.push_back(f.lower + 1.5);
+  return values;
+}
+
+}  // namespace
+
+TEST(AdvancedParameters, EveryFieldOfTheStructsHasOneRowInTheTable) {
+  std::set<std::string> expected;
+  for (const std::string& profile : {"fixed_step.", "free_time."}) {
+    for (const std::string& name : declaredFields("InteriorPointProfile")) {
+      expected.insert("interior_point." + profile + name);
+    }
+  }
+  for (const std::string& name : declaredFields("InteriorPointParameters")) {
+    expected.insert("interior_point." + name);
+  }
+  std::set<std::string> listed;
+  for (const ap::AdvancedField& f : ap::advancedFields({})) {
+    EXPECT_TRUE(listed.insert(f.name).second) << f.name << " listed twice";
+  }
+  EXPECT_EQ(listed, expected);
+  EXPECT_GE(expected.size(), 70u);  // the parser found the structs
+}
+
+TEST(AdvancedParameters, EachRowNamesItsOwnField) {
+  // Setting one field moves that row's value alone: no two rows read the same member.
+  const std::vector<ap::AdvancedField> defaults = ap::advancedFields({});
+  for (const ap::AdvancedField& f : defaults) {
+    ap::AdvancedParameters moved;
+    const double other = f.integer ? f.value + 1 : std::nextafter(f.value, kInf);
+    ap::setAdvancedParameter(&moved, f.name, other);
+    const std::vector<ap::AdvancedField> after = ap::advancedFields(moved);
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      EXPECT_EQ(after[i].value, after[i].name == f.name ? other : defaults[i].value)
+          << "setting " << f.name << " moved " << after[i].name;
+    }
+  }
+}
+
+TEST(AdvancedParameters, DefaultsAreTheSolversConstantsAndValid) {
+  const ap::InteriorPointParameters p;
+  // The values the solvers held as literals and copies before they were profiles.
+  const ap::InteriorPointProfile fixed = p.fixed_step, free = p.free_time;
+  EXPECT_EQ(fixed.initial_barrier, 1.0);
+  EXPECT_EQ(fixed.theta_mu, 1.5);
+  EXPECT_EQ(fixed.max_halvings, 60);
+  EXPECT_EQ(fixed.floor_halvings, 5);
+  EXPECT_EQ(fixed.first_shift, 1e-14);
+  EXPECT_EQ(fixed.initial_penalty, 1e4);
+  EXPECT_EQ(fixed.penalty_growth, 1e4);
+  EXPECT_EQ(free.initial_barrier, 0.1);
+  EXPECT_EQ(free.theta_mu, 1.3);
+  EXPECT_EQ(free.max_halvings, 40);
+  EXPECT_EQ(free.floor_halvings, 40);
+  EXPECT_EQ(free.first_shift, 1e-10);
+  EXPECT_EQ(free.initial_penalty, 100.0);
+  EXPECT_EQ(free.penalty_growth, 10.0);
+  EXPECT_EQ(p.final_barrier_fraction, 0.1);
+  EXPECT_EQ(p.resumed_shift_divisor, 3.0);  // IPOPT κ_w⁻ = 1/3
+  EXPECT_EQ(p.resumed_shift_growth, 8.0);   // IPOPT κ_w⁺
+  EXPECT_NO_THROW(ap::validateAdvancedParameters({}));
+  EXPECT_NO_THROW(ap::validateOptions({}));
+}
+
+TEST(AdvancedParameters, EachFieldRefusesAValueOutsideItsRangeNamingTheFieldAndTheValue) {
+  for (const ap::AdvancedField& f : ap::advancedFields({})) {
+    for (const double bad : outside(f)) {
+      ap::AdvancedParameters a;
+      std::string field;
+      const std::string message =
+          refusal([&] { ap::setAdvancedParameter(&a, f.name, bad); }, &field);
+      EXPECT_EQ(field, "advanced." + f.name) << message;
+      EXPECT_NE(message.find("got " + ap::exactNumber(bad)), std::string::npos) << message;
+      EXPECT_EQ(valuesOf(a), valuesOf({})) << "a refused value was set";
+    }
+    ap::AdvancedParameters a;  // a closed bound is inside
+    if (!f.lower_open) EXPECT_NO_THROW(ap::setAdvancedParameter(&a, f.name, f.lower)) << f.name;
+  }
+}
+
+TEST(AdvancedParameters, TheRangesTheMethodNeeds) {
+  // Rows written out: the table's words and bounds for the fields whose range is the method's.
+  struct Row {
+    const char* name;
+    double value;
+    const char* message;
+  };
+  const Row rows[] = {
+      {"interior_point.armijo", 0.5,
+       "advanced.interior_point.armijo: must be a finite number in (0, 0.5), got 0.5"},
+      {"interior_point.free_time.theta_mu", 1.0,
+       "advanced.interior_point.free_time.theta_mu: must be a finite number in (1, 2), got 1"},
+      {"interior_point.fixed_step.max_halvings", 0,
+       "advanced.interior_point.fixed_step.max_halvings: must be an integer in [1, 1074], got 0"},
+      {"interior_point.fraction_to_boundary", 1.0,
+       "advanced.interior_point.fraction_to_boundary: must be a finite number in (0, 1), got 1"},
+      {"interior_point.resumed_shift_growth", 1.0,
+       "advanced.interior_point.resumed_shift_growth: must be a finite number > 1, got 1"},
+      {"interior_point.coarsening_factor", 1,
+       "advanced.interior_point.coarsening_factor: must be an integer in [2, 64], got 1"},
+      {"interior_point.warm_barrier", -1e-3,
+       "advanced.interior_point.warm_barrier: must be a finite number > 0, got -0.001"},
+      {"interior_point.armijo_typo", 0.1, "advanced.interior_point.armijo_typo: not an advanced"},
+  };
+  for (const Row& row : rows) {
+    ap::AdvancedParameters a;
+    const std::string message = refusal([&] { ap::setAdvancedParameter(&a, row.name, row.value); });
+    EXPECT_EQ(message.substr(0, std::string(row.message).size()), row.message);
+  }
+}
+
+TEST(AdvancedParameters, AValueWrittenIntoTheOptionsIsRefusedByThePlanner) {
+  ap::SolverOptions o;
+  o.advanced.interior_point.free_time.theta_mu = 2.5;
+  EXPECT_EQ(
+      refusal([&] { ap::validateOptions(o); }),
+      "advanced.interior_point.free_time.theta_mu: must be a finite number in (1, 2), got 2.5");
+  // Both drivers check them: minimum effort under bounds and minimum time.
+  EXPECT_NE(
+      refusal([&] { ap::planManeuver(ap::test_support::sceneProblem("torque_limited", 16), o); }),
+      "");
+  EXPECT_NE(refusal([&] {
+              ap::planManeuver(ap::test_support::sceneProblem("min_time_bilimoria_wie", 16), o);
+            }),
+            "");
+}
+
+TEST(AdvancedParameters, AFixedStepProfileValueReachesTheInteriorPoint) {
+  const ap::PlanningProblem p = ap::test_support::sceneProblem("torque_limited", 32);
+  const ap::PlanResult base = ap::planManeuver(p);
+  ap::SolverOptions o;
+  o.advanced.interior_point.fixed_step.initial_barrier = 1e-2;  // μ₀ 100× smaller
+  const ap::PlanResult moved = ap::planManeuver(p, o);
+  ASSERT_TRUE(base.converged()) << base.message();
+  ASSERT_TRUE(moved.converged()) << moved.message();
+  EXPECT_NE(moved.iterations, base.iterations);
+  EXPECT_NEAR(moved.cost, base.cost, 1e-8 * base.cost);  // another path to the same optimum
+}
+
+TEST(AdvancedParameters, AFreeTimeProfileValueReachesTheMinimumTimeSolver) {
+  const ap::PlanningProblem p = ap::test_support::sceneProblem("min_time_bilimoria_wie", 32);
+  const ap::PlanResult base = ap::planManeuver(p);
+  ap::SolverOptions o;
+  o.advanced.interior_point.free_time.theta_mu = 1.2;
+  const ap::PlanResult moved = ap::planManeuver(p, o);
+  ASSERT_TRUE(base.converged()) << base.message();
+  ASSERT_TRUE(moved.converged()) << moved.message();
+  EXPECT_NE(moved.iterations, base.iterations);
+  EXPECT_NEAR(moved.minimum_duration, base.minimum_duration, 1e-8);  // the same T*
+}

@@ -5,9 +5,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
+#include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -125,6 +129,66 @@ TEST(AttemptTags, BranchesRunAtOnceReportInOneSequenceAndJoinTheTrailInTheirOrde
     EXPECT_EQ(context.attempts()[i].cost, i);
     EXPECT_EQ(context.attempts()[i].iterations, kIterations);
   }
+}
+
+TEST(AttemptTags, ASlidingWindowBeginsEachWorkAfterTheSameEndsHoweverLongTheWorksTake) {
+  // Works of random lengths, some empty (no place taken), on 1, 2 and 3 threads: the ends run in
+  // order, at most `threads` works run at once, and what each begin has seen (the ends before
+  // it) is the same on every run: with every work non-empty, begin(i) follows ends 0..i − threads.
+  std::mt19937 random(52);
+  for (const int threads : {1, 2, 3}) {
+    std::vector<int> seen_first;
+    for (int run = 0; run < 4; ++run) {
+      ap::SolverOptions options;
+      options.threads = threads;
+      ap::SolveContext context(options);
+      constexpr int kWorks = 9;
+      std::vector<int> ends, seen(kWorks, -1);
+      std::atomic<int> running{0}, most{0};
+      std::vector<int> pause_us(kWorks);
+      for (int& p : pause_us) p = std::uniform_int_distribution<int>(0, 3000)(random);
+      const auto begin = [&](int i) -> ap::BranchWork {
+        seen[i] = static_cast<int>(ends.size());
+        if (i % 4 == 3) return {};  // a repeat: nothing to run
+        return [&, i](ap::SolveContext& branch) {
+          most = std::max(most.load(), ++running);
+          std::this_thread::sleep_for(std::chrono::microseconds(pause_us[i]));
+          ap::Attempt a;
+          a.cost = i;
+          branch.record(a);
+          --running;
+        };
+      };
+      ap::runSlidingWindow(context, kWorks, begin, [&](int i) { ends.push_back(i); });
+      ASSERT_EQ(ends.size(), static_cast<std::size_t>(kWorks));
+      for (int i = 0; i < kWorks; ++i) EXPECT_EQ(ends[i], i);
+      EXPECT_LE(most.load(), threads);
+      ASSERT_EQ(context.attempts().size(), 7u);  // the non-empty works, in their order
+      for (std::size_t k = 1; k < context.attempts().size(); ++k) {
+        EXPECT_LT(context.attempts()[k - 1].cost, context.attempts()[k].cost);
+      }
+      if (run == 0) seen_first = seen;
+      EXPECT_EQ(seen, seen_first) << threads << " threads, run " << run;
+      for (int i = 0; i < 3; ++i) EXPECT_EQ(seen[i], std::max(0, i - threads + 1));
+    }
+  }
+}
+
+TEST(AttemptTags, ASlidingWindowRethrowsAWorksExceptionAtItsEndAndBeginsNothingAfter) {
+  ap::SolverOptions options;
+  options.threads = 2;
+  ap::SolveContext context(options);
+  std::vector<int> begun, ended;
+  const auto begin = [&](int i) -> ap::BranchWork {
+    begun.push_back(i);
+    return [i](ap::SolveContext&) {
+      if (i == 2) throw std::runtime_error("work 2 failed");
+    };
+  };
+  EXPECT_THROW(ap::runSlidingWindow(context, 8, begin, [&](int i) { ended.push_back(i); }),
+               std::runtime_error);
+  EXPECT_EQ(ended, (std::vector<int>{0, 1}));
+  EXPECT_LE(begun.size(), 4u);  // work 2 and at most one after it had begun when it ended
 }
 
 TEST(AttemptTags, ACallerRefusingAReportStopsEveryBranch) {

@@ -202,6 +202,12 @@ struct PlanningProblem {
   /// Reaction wheels (scene `actuators: {reaction_wheels: …}`, reaction_wheels.hpp): their
   /// torque and momentum limits are node constraints of the plan. Empty: none.
   ReactionWheels reaction_wheels;
+  /// Any keep-out or keep-in cone among the constraints (a cone has sides: its solves depend on
+  /// the start in ways a bound's do not).
+  bool hasCones() const {
+    return std::any_of(constraints.begin(), constraints.end(),
+                       [](const PlanningConstraint& c) { return c.isCone(); });
+  }
   /// Any per-axis bound, node constraint or reaction-wheel limit.
   bool hasNodeConstraints() const {
     return hasTorqueBounds() || !constraints.empty() || reaction_wheels.present();

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -69,6 +71,23 @@ struct StartRecord {
   std::size_t attempt = 0;         ///< its solve in the trail (a repeat: the earlier start's)
 };
 
+/// The starts recorded so far (a record stays where it is while later ones are recorded) and the
+/// least T among the converged ones (+∞: none): what a watched solve is watched against, read
+/// only, on any thread.
+struct Recorded {
+  std::vector<const StartRecord*> starts;
+  double least_duration = std::numeric_limits<double>::infinity();
+};
+
+/// A watched solve's outcome, its attempt, the barrier points it passed (sameCentralPath) and the
+/// earlier start whose central path it joined (−1: none).
+struct WatchedRun {
+  FreeTimeOutcome outcome;
+  Attempt attempt;
+  std::vector<BarrierPoint> path;
+  int joined = -1;
+};
+
 /// What one free-time grid level hands the next: its outcome (plan, T, steps).
 struct FreeTimeCarry {
   FreeTimeOutcome outcome;
@@ -122,8 +141,8 @@ class FreeTimeMinimumTime {
     // Saddles are left where cones are present: without them the excursion axes reach the least
     // basin (Bilimoria–Wie, Betts: no descent went lower), and the descent from a far saddle
     // (Betts's eigenaxis slew, 20 % above T*) ran to the iteration limit (0.08 → 0.77 s at N = 64).
-    if (best >= 0 && hasCones(coarsest)) best = leaveSaddles(coarsest, best, 0);
-    if (coarsest.steps < kFreeTimeStartGrid && hasCones(coarsest)) {
+    if (best >= 0 && coarsest.hasCones()) best = leaveSaddles(coarsest, best, 0);
+    if (coarsest.steps < kFreeTimeStartGrid && coarsest.hasCones()) {
       best = fromStartGrid(coarsest, rest_to_rest, best);
     }
     if (best < 0) return std::nullopt;
@@ -243,8 +262,8 @@ class FreeTimeMinimumTime {
 
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
   /// the index of the converged one with the least T (−1: none converged). The starts are cleared
-  /// of the cones, then solved in batches of up to the request's threads at once (runBranches),
-  /// each watched against the starts recorded before its batch, and recorded in their order.
+  /// of the cones, then solved in a sliding window (solveInWindow): a start repeats one recorded
+  /// before it or one still being solved when it is posed.
   int solveStarts(const PlanningProblem& grid, const std::vector<FreeTimeStart>& starts) {
     std::vector<std::vector<Matrix3>> cleared(starts.size());
     runBranches(context_, static_cast<int>(starts.size()), [&](int i, SolveContext& branch) {
@@ -252,65 +271,73 @@ class FreeTimeMinimumTime {
           branch.stopReason() ? starts[i].attitudes : clearOfCones(grid, starts[i], branch);
     });
     int best = -1;
-    std::vector<int> recorded_as(starts.size(), -1);  // each start's index in starts_
-    for (std::size_t next = 0; next < starts.size() && !context_.stopReason();) {
-      const std::vector<BatchEntry> batch = nextBatch(starts, cleared, next);
-      std::vector<std::size_t> solved;
-      for (const BatchEntry& e : batch) {
-        if (e.repeats < 0 && e.repeats_in_batch < 0) solved.push_back(e.start);
-      }
-      std::vector<WatchedRun> runs(solved.size());
-      runBranches(context_, static_cast<int>(runs.size()), [&](int j, SolveContext& branch) {
-        const std::size_t i = solved[j];
-        runs[j] = solveWatchedIn(branch, grid, cleared[i], starts[i].duration, starts[i].kind,
-                                 clearedDetail(starts[i], cleared[i]), best);
-      });
-      std::size_t j = 0;
-      for (const BatchEntry& e : batch) {
-        const FreeTimeStart& st = starts[e.start];
-        const int same = e.repeats_in_batch >= 0 ? recorded_as[e.repeats_in_batch] : e.repeats;
-        if (same >= 0) {
-          recordStart(cleared[e.start], st.duration, st.name, starts_[same].outcome, same);
-        } else {
-          recordWatched(std::move(runs[j++]), cleared[e.start], st.duration, st.name);
-          keepIfLeast(&best);
+    std::vector<int> repeats(starts.size(), -1);       // the start it repeats, by index in starts_
+    std::vector<int> repeats_open(starts.size(), -1);  // ... or by index in `starts`
+    std::vector<int> recorded_as(starts.size(), -1);   // each start's index in starts_
+    std::vector<std::size_t> open;                     // the starts being solved, not yet recorded
+    const auto pose = [&](int i) -> std::optional<WindowStart> {
+      const FreeTimeStart& st = starts[i];
+      repeats[i] = sameStartAs(cleared[i], st.duration);
+      for (const std::size_t k : open) {
+        if (repeats[i] < 0 && repeats_open[i] < 0 && starts[k].duration == st.duration &&
+            largestDifference(cleared[k], cleared[i]) <= kSameStart) {
+          repeats_open[i] = static_cast<int>(k);
         }
-        recorded_as[e.start] = static_cast<int>(starts_.size()) - 1;
       }
-      next = batch.back().start + 1;
-    }
+      if (repeats[i] >= 0 || repeats_open[i] >= 0) return std::nullopt;
+      open.push_back(i);
+      return WindowStart{&cleared[i], st.duration, st.kind, clearedDetail(st, cleared[i])};
+    };
+    const auto record = [&](int i, std::optional<WatchedRun> run) {
+      const FreeTimeStart& st = starts[i];
+      if (run) {
+        open.erase(std::find(open.begin(), open.end(), static_cast<std::size_t>(i)));
+        recordWatched(std::move(*run), cleared[i], st.duration, st.name);
+        keepIfLeast(&best);
+      } else {
+        const int same = repeats_open[i] >= 0 ? recorded_as[repeats_open[i]] : repeats[i];
+        recordStart(cleared[i], st.duration, st.name, starts_[same].outcome, same);
+      }
+      recorded_as[i] = static_cast<int>(starts_.size()) - 1;
+    };
+    solveInWindow(grid, static_cast<int>(starts.size()), &best, pose, record);
     return best;
   }
 
-  /// A start of a batch (nextBatch): solved in it, or a repeat of a start recorded before it
-  /// (`repeats`, its index in starts_) or of one solved in it (`repeats_in_batch`, its index in
-  /// the starts).
-  struct BatchEntry {
-    std::size_t start = 0;
-    int repeats = -1;
-    int repeats_in_batch = -1;
+  /// A start solveInWindow solves: its attitudes (alive until it is recorded), T and parameters.
+  struct WindowStart {
+    const std::vector<Matrix3>* attitudes = nullptr;
+    double duration = 0.0;
+    AttemptStart kind = AttemptStart::EigenaxisSlew;
+    StartDetail detail;
   };
 
-  /// The starts from `next` on that one batch covers: up to the request's threads of them
-  /// solved at once, and the repeats among and after them.
-  std::vector<BatchEntry> nextBatch(const std::vector<FreeTimeStart>& starts,
-                                    const std::vector<std::vector<Matrix3>>& cleared,
-                                    std::size_t next) const {
-    std::vector<BatchEntry> batch;
-    std::vector<std::size_t> solved;
-    const std::size_t at_once = static_cast<std::size_t>(context_.threads());
-    for (std::size_t i = next; i < starts.size() && solved.size() < at_once; ++i) {
-      BatchEntry e{i, sameStartAs(cleared[i], starts[i].duration), -1};
-      for (const std::size_t k : solved) {
-        if (e.repeats < 0 && starts[k].duration == starts[i].duration &&
-            largestDifference(cleared[k], cleared[i]) <= kSameStart) {
-          e.repeats_in_batch = static_cast<int>(k);
-        }
-      }
-      if (e.repeats < 0 && e.repeats_in_batch < 0) solved.push_back(i);
-      batch.push_back(e);
-    }
-    return batch;
+  /// Solves `count` starts in a sliding window of the request's threads (runSlidingWindow): start
+  /// i is posed (pose(i), on this thread: the start to solve, or nothing where it repeats an
+  /// earlier one) once the starts before it leave a place free, solved in a branch watched
+  /// against the starts recorded by then and the least T among them (`*best`), and recorded
+  /// (record(i, its run or nothing), on this thread) in the order of i. On one thread each start
+  /// sees every start before it; on more, start i sees those up to i − threads at least, the
+  /// same ones on every run. Nothing is posed once the request must stop.
+  void solveInWindow(const PlanningProblem& grid, int count, const int* best,
+                     const std::function<std::optional<WindowStart>(int)>& pose,
+                     const std::function<void(int, std::optional<WatchedRun>)>& record) {
+    std::vector<std::optional<WatchedRun>> runs(count);
+    std::vector<char> posed(count, 0);
+    const auto begin = [&](int i) -> BranchWork {
+      if (context_.stopReason()) return {};
+      posed[i] = 1;
+      const std::optional<WindowStart> start = pose(i);
+      if (!start) return {};
+      return [this, &grid, &runs, i, start = *start,
+              seen = recordedSoFar(*best)](SolveContext& branch) {
+        runs[i] = solveWatchedIn(branch, grid, *start.attitudes, start.duration, start.kind,
+                                 start.detail, seen);
+      };
+    };
+    runSlidingWindow(context_, count, begin, [&](int i) {
+      if (posed[i]) record(i, std::move(runs[i]));
+    });
   }
 
   static StartDetail clearedDetail(const FreeTimeStart& st, const std::vector<Matrix3>& cleared) {
@@ -332,24 +359,19 @@ class FreeTimeMinimumTime {
     for (std::size_t i = 0; i < starts.size() && first + i < starts_.size(); ++i) {
       if (starts_[first + i].same_as < 0) solved.push_back(i);
     }
-    const std::size_t at_once = static_cast<std::size_t>(context_.threads());
-    for (std::size_t next = 0; next < solved.size() && !context_.stopReason(); next += at_once) {
-      const std::size_t count = std::min(at_once, solved.size() - next);
-      std::vector<WatchedRun> runs(count);
-      runBranches(context_, static_cast<int>(count), [&](int j, SolveContext& branch) {
-        const std::size_t i = solved[next + j];
-        runs[j] = solveWatchedIn(branch, grid, starts_[first + i].attitudes, starts[i].duration,
-                                 starts[i].kind,
-                                 fromViolationsDetail(starts[i], starts_[first + i]), best);
-      });
-      for (std::size_t j = 0; j < count; ++j) {
-        const std::size_t i = solved[next + j];
-        const std::vector<Matrix3> attitudes = starts_[first + i].attitudes;  // starts_ grows
-        recordWatched(std::move(runs[j]), attitudes, starts[i].duration,
-                      starts[i].name + ", its elastic phase from its violations");
-        keepIfLeast(&best);
-      }
-    }
+    const auto pose = [&](int j) -> std::optional<WindowStart> {
+      const std::size_t i = solved[j];
+      const StartRecord& once = starts_[first + i];
+      return WindowStart{&once.attitudes, starts[i].duration, starts[i].kind,
+                         fromViolationsDetail(starts[i], once)};
+    };
+    const auto record = [&](int j, std::optional<WatchedRun> run) {
+      const std::size_t i = solved[j];
+      recordWatched(std::move(*run), starts_[first + i].attitudes, starts[i].duration,
+                    starts[i].name + ", its elastic phase from its violations");
+      keepIfLeast(&best);
+    };
+    solveInWindow(grid, static_cast<int>(solved.size()), &best, pose, record);
     return best;
   }
 
@@ -377,23 +399,24 @@ class FreeTimeMinimumTime {
   void solveWatched(const PlanningProblem& grid, const std::vector<Matrix3>& start, double duration,
                     AttemptStart kind, const StartDetail& detail, const std::string& name,
                     int best) {
-    recordWatched(solveWatchedIn(context_, grid, start, duration, kind, detail, best), start,
-                  duration, name);
+    recordWatched(
+        solveWatchedIn(context_, grid, start, duration, kind, detail, recordedSoFar(best)), start,
+        duration, name);
   }
 
-  /// solveWatched's solve in `context` (the request's or a branch), watched against the starts
-  /// recorded so far (read only).
-  struct WatchedRun {
-    FreeTimeOutcome outcome;
-    Attempt attempt;
-    std::vector<BarrierPoint> path;
-    int joined = -1;  ///< the earlier start whose central path it joined (−1: none)
-  };
+  /// The starts recorded so far and the least T among the converged ones (`best`'s).
+  Recorded recordedSoFar(int best) const {
+    Recorded seen;
+    for (const StartRecord& st : starts_) seen.starts.push_back(&st);
+    if (best >= 0) seen.least_duration = starts_[best].outcome.duration;
+    return seen;
+  }
+
+  /// solveWatched's solve in `context` (the request's or a branch), watched against `seen`.
   WatchedRun solveWatchedIn(SolveContext& context, const PlanningProblem& grid,
                             const std::vector<Matrix3>& start, double duration, AttemptStart kind,
-                            const StartDetail& detail, int best) const {
-    const double least =
-        best < 0 ? std::numeric_limits<double>::infinity() : starts_[best].outcome.duration;
+                            const StartDetail& detail, const Recorded& seen) const {
+    const double least = seen.least_duration;
     WatchedRun run;
     const BarrierWatch watch = [&](const BarrierPoint& point) -> std::string {
       std::ostringstream why;
@@ -403,11 +426,11 @@ class FreeTimeMinimumTime {
             << point.lower_bound << " s)";
         return why.str();
       }
-      run.joined = sameCentralPath(point);
+      run.joined = sameCentralPath(point, seen.starts);
       if (run.joined >= 0) {
         why << "stopped at T = " << point.duration << " s: on the central path of the start "
-            << starts_[run.joined].name << " (the same barrier problem's point, mu = " << point.mu
-            << ")";
+            << seen.starts[run.joined]->name
+            << " (the same barrier problem's point, mu = " << point.mu << ")";
         return why.str();
       }
       run.path.push_back(point);
@@ -434,13 +457,14 @@ class FreeTimeMinimumTime {
   /// The earlier start whose solve passed through `point` (the same μ, every attitude within
   /// kSamePath), or −1: one barrier problem's local solution is one point of one central path,
   /// so the two solves go on to the same end.
-  int sameCentralPath(const BarrierPoint& point) const {
+  static int sameCentralPath(const BarrierPoint& point,
+                             const std::vector<const StartRecord*>& seen) {
     int closest = -1;
     double nearest = std::numeric_limits<double>::infinity();
-    for (std::size_t j = 0; j < starts_.size(); ++j) {
+    for (std::size_t j = 0; j < seen.size(); ++j) {
       // A path that ended without a KKT point is not followed to its end by joining it.
-      if (starts_[j].outcome.termination != Termination::Converged) continue;
-      for (const BarrierPoint& q : starts_[j].path) {
+      if (seen[j]->outcome.termination != Termination::Converged) continue;
+      for (const BarrierPoint& q : seen[j]->path) {
         if (q.mu != point.mu || q.attitudes.size() != point.attitudes.size()) continue;
         const double difference = largestDifference(q.attitudes, point.attitudes);
         if (difference < nearest) {
@@ -450,11 +474,6 @@ class FreeTimeMinimumTime {
       }
     }
     return nearest <= kSamePath ? closest : -1;
-  }
-
-  static bool hasCones(const PlanningProblem& p) {
-    return std::any_of(p.constraints.begin(), p.constraints.end(),
-                       [](const PlanningConstraint& c) { return c.isCone(); });
   }
 
   /// A request below the start grid, with cones: the structured starts and their saddles solved
@@ -748,8 +767,10 @@ class FreeTimeMinimumTime {
 
   const PlanningProblem& problem_;
   SolveContext& context_;
-  std::size_t first_recorded_;        ///< where its solves begin in the context's trail
-  std::vector<StartRecord> starts_;   ///< every start solved (or repeated), in order
+  std::size_t first_recorded_;  ///< where its solves begin in the context's trail
+  /// Every start solved (or repeated), in order; a deque, so that a record stays where it is
+  /// while later ones are recorded (solves on other threads read the earlier ones: Recorded).
+  std::deque<StartRecord> starts_;
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;

@@ -298,8 +298,7 @@ std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool r
   // With cones both signs of each excursion: a cone is passed on one side or the other, and
   // the sides are different local minima of T.
   std::vector<Vector3> axes = excursionAxes(e);
-  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
-                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  const bool cones = problem.hasCones();
   if (cones) {
     for (std::size_t i = 0, n = axes.size(); i < n; ++i) axes.push_back(-axes[i]);
   }

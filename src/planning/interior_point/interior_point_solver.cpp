@@ -182,29 +182,23 @@ GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
   return rule;
 }
 
-/// Whether a constrained warm start must start the coarsest level itself: only a cone has sides
-/// that the level's unconstrained optimum could drop. Under torque and rate bounds alone the warm
-/// start resampled starts Newton on the level, as an unconstrained warm start does (measured on the
-/// bounded suite's seed-45 #33, N = 540 under a torque box: with every constrained warm start
-/// starting its coarsest level, the minimum-time search's probes ended elsewhere and T* rose from
-/// 59.62 s to 64.62 s, above the requested 61.38 s).
-bool keepsConeSides(const PlanningProblem& problem) {
-  return std::any_of(problem.constraints.begin(), problem.constraints.end(),
-                     [](const PlanningConstraint& c) { return c.isCone(); });
-}
-
 /// The coarsest level starts from its own unconstrained optimum; Newton reaches it from the warm
 /// start (the requested grid's unconstrained optimum) resampled, instead of repeating the grid
 /// continuation that found the warm start. A warm start that is to start the interior point itself
 /// (SolverOptions::constrained_from_warm_start) starts the level resampled where the problem has
-/// cones (keepsConeSides). Sets level_options->warm_start to null.
+/// cones: only a cone has sides that the level's unconstrained optimum could drop. Under torque and
+/// rate bounds alone the warm start resampled starts Newton on the level, as an unconstrained warm
+/// start does (measured on the bounded suite's seed-45 #33, N = 540 under a torque box: with every
+/// constrained warm start starting its coarsest level, the minimum-time search's probes ended
+/// elsewhere and T* rose from 59.62 s to 64.62 s, above the requested 61.38 s). Sets
+/// level_options->warm_start to null.
 PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProblem& at,
                               const SolverOptions& options, SolveContext& context,
                               SolverOptions* level_options, Maneuver* resampled) {
   if (options.warm_start && options.warm_start->steps() == problem.steps) {
     resampled->attitude = resampleAttitudes(*options.warm_start, at.steps);
     level_options->warm_start = resampled;
-    if (options.constrained_from_warm_start && keepsConeSides(problem)) {
+    if (options.constrained_from_warm_start && problem.hasCones()) {
       // A plan under the constraints starts the level itself: its unconstrained optimum would
       // drop which side of each cone the plan passes.
       PlanResult start;
@@ -446,8 +440,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   // path.
   const bool stuck = result.termination == Termination::Infeasible ||
                      result.termination == Termination::NotConverged;
-  const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),
-                                 [](const PlanningConstraint& c) { return c.isCone(); });
+  const bool cones = problem.hasCones();
   const bool others = problem.hasTorqueBounds() ||
                       std::any_of(problem.constraints.begin(), problem.constraints.end(),
                                   [](const PlanningConstraint& c) { return !c.isCone(); });

@@ -1,6 +1,7 @@
 #include "planning/problem/solve_context.hpp"
 
 #include <algorithm>
+#include <deque>
 #include <exception>
 #include <limits>
 #include <thread>
@@ -177,6 +178,68 @@ void runBranches(SolveContext& context, int count,
     context.join(*branches[i]);
     if (failures[i]) std::rethrow_exception(failures[i]);
   }
+}
+
+namespace {
+
+/// One work of runSlidingWindow between its begin and its end.
+struct OpenWork {
+  int index = 0;
+  std::unique_ptr<SolveContext> branch;  ///< none: begin(index) returned no work
+  std::thread thread;                    ///< not joinable: run on the calling thread
+  std::exception_ptr failure;
+};
+
+}  // namespace
+
+void runSlidingWindow(SolveContext& context, int count, const std::function<BranchWork(int)>& begin,
+                      const std::function<void(int)>& end) {
+  const int at_once = std::max(1, context.threads());
+  std::deque<OpenWork> open;  // in the order of index; references stay valid as it grows
+  int running = 0;
+  std::exception_ptr failure;
+  const auto endFirst = [&] {
+    OpenWork& w = open.front();
+    if (w.thread.joinable()) w.thread.join();
+    if (w.branch) {
+      context.join(*w.branch);
+      --running;
+    }
+    if (!failure && w.failure) failure = w.failure;
+    if (!failure) end(w.index);
+    open.pop_front();
+  };
+  try {
+    for (int i = 0; i < count && !failure; ++i) {
+      while (running >= at_once) endFirst();
+      if (failure) break;
+      BranchWork work = begin(i);
+      OpenWork& w = open.emplace_back();
+      w.index = i;
+      if (!work) continue;
+      w.branch = std::make_unique<SolveContext>(context, SolveContext::Branch{});
+      ++running;
+      const auto run = [&w, work = std::move(work)] {
+        try {
+          work(*w.branch);
+        } catch (...) {
+          w.failure = std::current_exception();
+        }
+      };
+      if (at_once == 1) {
+        run();
+      } else {
+        w.thread = std::thread(run);
+      }
+    }
+    while (!open.empty()) endFirst();
+  } catch (...) {  // from begin or end, on this thread: the works still running end first
+    for (OpenWork& w : open) {
+      if (w.thread.joinable()) w.thread.join();
+    }
+    throw;
+  }
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace attitude_planner

@@ -238,4 +238,17 @@ class SolveContext : public Interruption {
 void runBranches(SolveContext& context, int count,
                  const std::function<void(int, SolveContext&)>& work);
 
+/// What runSlidingWindow's begin(i) hands over to run for i in a branch (empty: nothing to run).
+using BranchWork = std::function<void(SolveContext&)>;
+/// Runs `count` works in the order of i, up to context.threads() at once, as a sliding window:
+/// begin(i) runs on the calling thread and returns the work for i, run on a thread of its own in
+/// a branch of `context`; end(i) runs on the calling thread in the order of i, after work i ended
+/// and its branch joined `context`. Before begin(i) the earliest works still open are ended until
+/// a place is free, never a later one first, so what begin(i) sees (the ends before it) does not
+/// depend on which work finishes first: the same answer on every run. Work i may read what the
+/// ends before its begin wrote, never what a later end writes. An exception thrown by a work is
+/// rethrown at its end, once every work begun has ended; no work begins after it.
+void runSlidingWindow(SolveContext& context, int count, const std::function<BranchWork(int)>& begin,
+                      const std::function<void(int)>& end);
+
 }  // namespace attitude_planner

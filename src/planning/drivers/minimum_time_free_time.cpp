@@ -419,15 +419,11 @@ class FreeTimeMinimumTime {
     const double least = seen.least_duration;
     WatchedRun run;
     const BarrierWatch watch = [&](const BarrierPoint& point) -> std::string {
-      std::ostringstream why;
-      if (point.locally_convex && point.lower_bound > least) {
-        why << "stopped at T = " << point.duration << " s: it can no longer end below " << least
-            << " s, the least T so far (its T less the duality gap at mu = " << point.mu << ": "
-            << point.lower_bound << " s)";
-        return why.str();
-      }
+      const std::string above = cannotEndBelow(point.bound(), least, "the least T [s] so far");
+      if (!above.empty()) return above;
       run.joined = sameCentralPath(point, seen.starts);
       if (run.joined >= 0) {
+        std::ostringstream why;
         why << "stopped at T = " << point.duration << " s: on the central path of the start "
             << seen.starts[run.joined]->name
             << " (the same barrier problem's point, mu = " << point.mu << ")";

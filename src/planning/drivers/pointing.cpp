@@ -710,15 +710,12 @@ std::vector<TwistRun> ridgeSides(const PlanningProblem& problem, const TwistRun&
   return sides;
 }
 
-/// The watch of an interior point with ψ free (FeasibleIterateWatch): a reason where the solve's
-/// lower bound is above `least` (a constrained answer already held, or one that will be: an
-/// optimum meeting every node constraint), whose cost it can then no longer beat; else empty.
-FeasibleIterateWatch cannotEndBelow(double least) {
+/// The watch of an interior point with ψ free (FeasibleIterateWatch): a reason where the solve
+/// can no longer end below `least` (cannotEndBelow: a constrained answer already held, or one
+/// that will be, an optimum meeting every node constraint); else empty.
+FeasibleIterateWatch endingBelow(double least) {
   return [least](const FeasibleIterate& at) {
-    if (!(at.lower_bound > least)) return std::string();
-    std::ostringstream why;
-    why << "cannot end below " << least << " (its lower bound " << at.lower_bound << ")";
-    return why.str();
+    return cannotEndBelow(at.bound(), least, "the least constrained cost held");
   };
 }
 
@@ -733,7 +730,7 @@ void solveFrom(const PlanningProblem& problem, const TwistRun& start, bool as_it
   if (as_it_is) {
     run.start = AttemptStart::UnconstrainedOptimum;
   } else {
-    const FeasibleIterateWatch watch = cannotEndBelow(least);
+    const FeasibleIterateWatch watch = endingBelow(least);
     fromUnconstrainedRun(posedAt(problem, problem.steps, start.solve.twist), start,
                          context.options(), context, &run, std::isfinite(least) ? &watch : nullptr);
   }

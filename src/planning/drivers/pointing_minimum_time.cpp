@@ -127,18 +127,12 @@ std::optional<SlewStart> eigenaxisStartAt(const PlanningProblem& problem, double
 }
 
 /// The watch of a free-time solve that matters only if it ends below `least` [s] (`what` names
-/// that T): it stops the solve where it no longer can, its T less the duality gap above `least`
-/// at a locally convex barrier point, where that bound holds (the rule the fixed-twist recipe
-/// stops its own starts by). No stop while `least` is +∞.
-constexpr const char* kSurveysLeast = "the survey's least T* so far";
-BarrierWatch cannotEndBelow(double least, const std::string& what) {
-  return [least, what](const BarrierPoint& point) -> std::string {
-    if (!point.locally_convex || !(point.lower_bound > least)) return "";
-    std::ostringstream why;
-    why << "stopped at T = " << point.duration << " s: it can no longer end below " << least
-        << " s, " << what << " (its T less the duality gap at mu = " << point.mu << ": "
-        << point.lower_bound << " s)";
-    return why.str();
+/// that T): it stops the solve where it no longer can (cannotEndBelow, the rule the fixed-twist
+/// recipe stops its own starts by). No stop while `least` is +∞.
+constexpr const char* kSurveysLeast = "the survey's least T* [s] so far";
+BarrierWatch endingBelow(double least, const std::string& what) {
+  return [least, what](const BarrierPoint& point) {
+    return cannotEndBelow(point.bound(), least, what);
   };
 }
 
@@ -157,7 +151,7 @@ TwistStart fromEigenaxisSlew(const PlanningProblem& problem, double twist, doubl
   const std::size_t first = context.attempts().size();
   std::optional<PlanResult> freed =
       freeTimeFromPlan(start->posed, start->slew, start->duration, "eigenaxis slew", context,
-                       nullptr, StartBarrier::Initial, cannotEndBelow(least, kSurveysLeast));
+                       nullptr, StartBarrier::Initial, endingBelow(least, kSurveysLeast));
   if (freed) s.result = std::move(*freed);
   s.result.minimum_time.solves = 1;
   tagStartsAttempts(context, first, &s);
@@ -186,7 +180,7 @@ std::optional<TwistStart> fromFixedTwistSlew(const PlanningProblem& problem, dou
     const std::optional<std::size_t> fixed_kept = context.keptAttempt();
     std::optional<PlanResult> freed = freeTimeFromPlan(
         start->posed, at_twist->maneuver, at_twist->minimum_duration, "fixed-twist plan", context,
-        nullptr, StartBarrier::Initial, cannotEndBelow(least, kSurveysLeast));
+        nullptr, StartBarrier::Initial, endingBelow(least, kSurveysLeast));
     if (!freed) context.restoreKept(fixed_kept);
     s.result = freed ? std::move(*freed) : std::move(*at_twist);
     s.result.minimum_time.solves = 2;
@@ -337,7 +331,7 @@ std::optional<PlanResult> fixedTwistProbe(const PlanningProblem& problem, double
   const std::size_t first = context.attempts().size();
   std::optional<PlanResult> r =
       freeTimeFromPlan(fixed, start->slew, start->duration, "eigenaxis slew", context, nullptr,
-                       StartBarrier::Initial, cannotEndBelow(least, "the answer's T*"));
+                       StartBarrier::Initial, endingBelow(least, "the answer's T* [s]"));
   context.posedAtTwist(first, twist);
   return r;
 }

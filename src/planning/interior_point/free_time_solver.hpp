@@ -10,6 +10,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/local_lower_bound.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -100,6 +101,8 @@ struct BarrierPoint {
   /// the solve may still slide to a lower point: measured on Bilimoria–Wie N = 32, a bound of
   /// 3.27871 s at μ = 2.7e-6, then 68 iterations at that μ, the end 3.27774 s.)
   bool locally_convex = false;
+  /// Its T [s] and lower bound, which holds where it is locally convex.
+  LocalLowerBound bound() const { return {duration, lower_bound, locally_convex}; }
 };
 
 /// Called at every solved barrier problem of a feasible free-time solve (not while elastic);

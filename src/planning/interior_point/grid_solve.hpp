@@ -9,6 +9,7 @@
 #include "attitude_planner/planning/result.hpp"
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/constrained_system.hpp"
+#include "planning/interior_point/local_lower_bound.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
@@ -33,6 +34,8 @@ struct FeasibleIterate {
   /// √(−gᵀΔ / 2C): the step's relative size (the Newton decrement over |τ|₂).
   double relative_decrement = 0.0;
   int iteration = 0;
+  /// Its cost and lower bound, which holds here (definite without a shift).
+  LocalLowerBound bound() const { return {cost, lower_bound, true}; }
 };
 
 /// Asked at each FeasibleIterate of a solve; a non-empty reason stops it there, NotConverged

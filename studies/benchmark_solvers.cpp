@@ -1849,11 +1849,12 @@ SuiteRow runSuiteCase(const ap::robustness::RandomCase& c, double time_budget) {
 #endif
   std::fprintf(stderr,
                "{\"case\": %d, \"label\": \"%s\", \"termination\": \"%s\", \"iterations\": %d, "
-               "\"time_s\": %.4g, \"cost\": %.17g, \"ipopt\": %s, \"ipopt_cost\": %.17g}\n",
+               "\"time_s\": %.4g, \"cost\": %.17g, \"ipopt\": %s, \"ipopt_cost\": %.17g, "
+               "\"ipopt_iterations\": %d, \"ipopt_time_s\": %.4g}\n",
                c.index, escaped(c.label).c_str(), ap::terminationName(row.ours.termination).c_str(),
                row.ours.iterations, row.ours.solve_time_s, row.ours.cost,
                row.ipopt_ran ? (row.ipopt.optimal ? "\"optimal\"" : "\"failed\"") : "null",
-               row.ipopt_cost);
+               row.ipopt_cost, row.ipopt.iterations, row.ipopt_time_s);
   return row;
 }
 

@@ -1,6 +1,7 @@
 #include "planning/problem/solve_context.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <limits>
 #include <thread>
@@ -152,7 +153,7 @@ std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
 }
 
 void runBranches(SolveContext& context, int count,
-                 const std::function<void(int, SolveContext&)>& work) {
+                 const std::function<void(int, SolveContext&)>& work, BranchSchedule schedule) {
   const int at_once = std::max(1, std::min(context.threads(), count));
   std::vector<std::unique_ptr<SolveContext>> branches;
   for (int i = 0; i < count; ++i) {
@@ -166,7 +167,17 @@ void runBranches(SolveContext& context, int count,
       failures[i] = std::current_exception();
     }
   };
-  for (int first = 0; first < count; first += at_once) {
+  if (schedule == BranchSchedule::Queue) {
+    std::atomic<int> next{0};
+    const auto take = [&] {
+      for (int i = next++; i < count; i = next++) run(i);
+    };
+    std::vector<std::thread> others;
+    for (int t = 1; t < at_once; ++t) others.emplace_back(take);
+    take();
+    for (std::thread& t : others) t.join();
+  }
+  for (int first = 0; schedule == BranchSchedule::Batches && first < count; first += at_once) {
     const int last = std::min(first + at_once, count);
     std::vector<std::thread> others;
     for (int i = first + 1; i < last; ++i) others.emplace_back(run, i);

@@ -231,11 +231,20 @@ class SolveContext : public Interruption {
   std::vector<LevelSummary> levels_;
 };
 
+/// How runBranches hands its works to the threads.
+enum class BranchSchedule {
+  Batches,  ///< `threads` works at once, the next batch once the whole batch ended (a work may
+            ///< read what the batches before its own wrote)
+  Queue,    ///< each thread takes the next work as soon as its last one ended (independent works
+            ///< of unequal length: no thread waits for a batch's longest)
+};
+
 /// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each on its own
 /// thread in its own branch of `context` (SolveContext::Branch), and joins the branches into
 /// `context` in the order of i; an exception thrown by any work is rethrown after every branch
 /// joined (the first in that order). The work must not touch what another one writes.
 void runBranches(SolveContext& context, int count,
-                 const std::function<void(int, SolveContext&)>& work);
+                 const std::function<void(int, SolveContext&)>& work,
+                 BranchSchedule schedule = BranchSchedule::Batches);
 
 }  // namespace attitude_planner

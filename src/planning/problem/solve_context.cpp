@@ -4,6 +4,7 @@
 #include <atomic>
 #include <exception>
 #include <limits>
+#include <locale>
 #include <thread>
 
 namespace attitude_planner {
@@ -155,6 +156,10 @@ std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
 void runBranches(SolveContext& context, int count,
                  const std::function<void(int, SolveContext&)>& work, BranchSchedule schedule) {
   const int at_once = std::max(1, std::min(context.threads(), count));
+  // libstdc++ fills the locale's ctype widen table on its first use (number formatting in a
+  // message); a first use from two threads at once is a data race (benign, but Helgrind and TSan
+  // report it), so it is filled here before any thread starts.
+  std::use_facet<std::ctype<char>>(std::locale()).widen('0');
   std::vector<std::unique_ptr<SolveContext>> branches;
   for (int i = 0; i < count; ++i) {
     branches.push_back(std::make_unique<SolveContext>(context, SolveContext::Branch{}));

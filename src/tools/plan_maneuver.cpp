@@ -60,7 +60,7 @@ const char* const kUsage =
     "                            nlopt: function evaluations)\n"
     "  --time-budget S           wall-time limit [s] (default: none)\n"
     "  --threads K               independent solves run at once, K >= 1 (minimum time's\n"
-    "                            starts; default: the machine's cores)\n"
+    "                            starts, the homotopy classes; default: the machine's cores)\n"
     "  --direction shortest|long_way  which way round (rigid_body; overrides the scene);\n"
     "                            shortest with no extra turns (the default): the cheapest of\n"
     "                            the homotopy classes (both ways, 0 or 1 extra turn)\n"

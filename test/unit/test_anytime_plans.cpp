@@ -6,6 +6,7 @@
 // package's own residual (measureStepResidual), which is compared with them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -175,10 +176,15 @@ TEST(AnytimePlan, ARefinementStoppedOnACoarseLevelHandsOverItsOwnIterate) {
         << r.message();
     expectAnytimePlan(p, r, 1e-10);
     ASSERT_FALSE(r.attempts.empty());
-    const Attempt& last = r.attempts.back();
-    EXPECT_EQ(last.stage, AttemptStage::ClassRefine) << r.message();
-    EXPECT_TRUE(last.kept) << r.message();
-    EXPECT_EQ(last.termination, r.termination);
+    // The kept attempt is a refinement the stop ended; the refinements run at once on the
+    // machine's cores, so others the stop ended too may follow it in the trail, and nothing else.
+    const auto kept =
+        std::find_if(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) { return a.kept; });
+    ASSERT_NE(kept, r.attempts.end()) << r.message();
+    for (auto a = kept; a != r.attempts.end(); ++a) {
+      EXPECT_EQ(a->stage, AttemptStage::ClassRefine) << r.message();
+      EXPECT_EQ(a->termination, r.termination) << r.message();
+    }
     for (const Attempt& a : r.attempts) {
       EXPECT_NE(a.stage, AttemptStage::Solve)
           << "a second attempt ran after the stop: " << r.message();

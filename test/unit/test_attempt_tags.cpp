@@ -191,6 +191,40 @@ TEST(AttemptTags, ASlidingWindowRethrowsAWorksExceptionAtItsEndAndBeginsNothingA
   EXPECT_LE(begun.size(), 4u);  // work 2 and at most one after it had begun when it ended
 }
 
+TEST(AttemptTags, QueuedBranchesRunEachWorkOnceWithoutWaitingForABatchAndJoinInTheirOrder) {
+  // Five works of unequal length on two threads, queued: each runs once, and a long first work
+  // does not hold the others back (the other thread takes works 1..4 while work 0 runs, which a
+  // batch of two would not allow); the trail is still in the works' order.
+  ap::SolverOptions options;
+  options.threads = 2;
+  ap::SolveContext context(options);
+  constexpr int kWorks = 5;
+  std::vector<int> runs(kWorks, 0);
+  std::atomic<bool> first_done{false};
+  std::atomic<int> done_during_first{0};
+  ap::runBranches(context, kWorks, [&](int i, ap::SolveContext& branch) {
+    ++runs[i];
+    if (i == 0) {
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+      while (done_during_first < kWorks - 1 && std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+      first_done = true;
+    } else if (!first_done) {
+      ++done_during_first;
+    }
+    branch.reportIteration({});
+    ap::Attempt a;
+    a.cost = i;
+    branch.record(a);
+  });
+  for (int i = 0; i < kWorks; ++i) EXPECT_EQ(runs[i], 1) << i;
+  EXPECT_EQ(done_during_first, kWorks - 1);
+  EXPECT_EQ(context.iterations(), kWorks);
+  ASSERT_EQ(context.attempts().size(), static_cast<std::size_t>(kWorks));
+  for (int i = 0; i < kWorks; ++i) EXPECT_EQ(context.attempts()[i].cost, i);
+}
+
 TEST(AttemptTags, ACallerRefusingAReportStopsEveryBranch) {
   // The refusal is the request's: a branch that has not reported yet stops too.
   ap::SolverOptions options;

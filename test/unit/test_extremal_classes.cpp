@@ -204,6 +204,51 @@ TEST(ExtremalClasses, TheDefaultIsNoCostlierThanAnyClassOnSeededSpinningProblems
   EXPECT_GE(cheapest, 0.99 * compared);
 }
 
+// The classes are surveyed and refined in branches on the machine's cores: on two threads each
+// seeded request (spinning, and rest to rest with one of each kind's N) gets the answer it gets
+// on one, bit for bit, with the same trail in the same order; and the kept class is the cheapest
+// of the classes carried to the requested grid.
+TEST(ExtremalClasses, TheClassesSolvedAtOnceGiveTheAnswerOfOneThreadAndKeepTheCheapest) {
+  Draw draw(5252);
+  int refined_at_once = 0;  // requests whose refinements ran in two branches
+  for (int i = 0; i < 12; ++i) {
+    PlanningProblem p = spinningProblem(draw);
+    if (i % 2) {  // at rest at both ends, on a grid the survey reaches through two levels
+      p.initial_velocity.setZero();
+      p.final_velocity.setZero();
+      p.steps = 256;
+    }
+    SolverOptions one, two;
+    one.threads = 1;
+    two.threads = 2;
+    const PlanResult a = planManeuver(p, one);
+    const PlanResult b = planManeuver(p, two);
+    ASSERT_TRUE(a.converged()) << i << ": " << a.message();
+    EXPECT_EQ(a.cost, b.cost) << i;
+    EXPECT_EQ(a.iterations, b.iterations) << i;
+    EXPECT_EQ(a.extremal, b.extremal) << i;
+    ASSERT_EQ(a.attempts.size(), b.attempts.size()) << i;
+    double least_refined = std::numeric_limits<double>::infinity();
+    refined_at_once += std::count_if(a.attempts.begin(), a.attempts.end(), [](const Attempt& x) {
+                         return x.stage == AttemptStage::ClassRefine;
+                       }) > 1;
+    for (std::size_t k = 0; k < a.attempts.size(); ++k) {
+      const Attempt& x = a.attempts[k];
+      const Attempt& y = b.attempts[k];
+      EXPECT_EQ(x.stage, y.stage) << i << ", attempt " << k;
+      EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
+      EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
+      EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
+      const bool on_grid = x.steps == p.steps && x.termination == Termination::Converged;
+      if (x.stage == AttemptStage::ClassRefine && on_grid) {
+        least_refined = std::min(least_refined, x.cost);
+      }
+    }
+    EXPECT_LE(a.cost, least_refined * (1 + 1e-12)) << i << ": " << a.extremal;
+  }
+  EXPECT_GE(refined_at_once, 3);
+}
+
 namespace {
 
 /// Rest to rest, 3 rad about z; a keep-out cone of half angle 0.9 rad round the direction body x

@@ -333,10 +333,10 @@ struct SolverOptions {
   /// warm start) is solved in every class of the class survey and the cheapest plan kept
   /// (newton_solver.cpp); false: in the nearest lift's class only, as a named class is.
   bool enumerate_classes = true;
-  /// Independent solves a driver runs at once (minimum time's starts on the start grid), each on
-  /// its own thread; 0: as many as the machine has cores, 1: one after the other. The answer does
-  /// not depend on it beyond the order the starts' watch sees them
-  /// (drivers/minimum_time_free_time).
+  /// Independent solves a driver runs at once (minimum time's starts on the start grid, the class
+  /// survey and refinements), each on its own thread; 0: as many as the machine has cores, 1: one
+  /// after the other. The answer does not depend on it beyond the order minimum time's watch sees
+  /// its starts (drivers/minimum_time_free_time).
   int threads = 0;
   /// The solvers' tuning (interior_point_parameters.hpp): the planner's defaults unless set;
   /// validateOptions checks every field's range.

@@ -83,6 +83,13 @@ struct NewtonParameters {
   /// Classes whose survey cost is within this relative margin of the cheapest are all refined to
   /// the requested grid: coarse costs reorder on refinement (docs/notes/newton_tuning.md).
   double class_refine_margin = 0.5;
+  /// Where no caller reads the refined classes' plans (a request without node constraints: a
+  /// constrained one starts each class's solve from its refined plan and keeps
+  /// class_refine_margin), a class other than the request's own is refined only within this
+  /// margin of the cheapest survey cost. Measured over 660 seeded requests (rest to rest and
+  /// spinning, N = 64–256, docs/notes/newton_tuning.md): the class cheapest on the requested grid
+  /// was the request's own or within 1.253× the cheapest survey cost; 0.35 keeps 0.1 above that.
+  double unconstrained_refine_margin = 0.35;
   /// Two surveyed classes whose costs agree to this relative difference reached the same extremal
   /// from different starts (a survey is solved to a 1e-6 relative decrement, its cost to ~1e-12):
   /// only the first is refined.

@@ -2,12 +2,12 @@
 // (direction shortest, no extra revolutions, no warm start) is solved in every class of
 // kEnumeratedClasses on a coarse grid of its grid continuation (the class survey), the classes
 // within a margin of the cheapest survey cost are refined to the requested grid, and the cheapest
-// converged plan is kept. A request that names its class, or is warm-started, is solved in that
-// class only. Then, as data (kNewtonRecipe), each behind a named gate: the continuation in the
-// boundary rates and the coasting start for a spinning request that stalled, and more starts in
-// the kept class for a slow spinning solve. Every attempt runs in the request's SolveContext (one
-// clock and deadline, one cancel flag, iterations numbered across attempts) and is recorded in
-// its trail.
+// converged plan is kept; the surveys, then the refinements, run at once on the request's threads.
+// A request that names its class, or is warm-started, is solved in that class only. Then, as data
+// (kNewtonRecipe), each behind a named gate: the continuation in the boundary rates and the
+// coasting start for a spinning request that stalled, and more starts in the kept class for a slow
+// spinning solve. Every attempt runs in the request's SolveContext (one clock and deadline, one
+// cancel flag, iterations numbered across attempts) and is recorded in its trail.
 #include "planning/newton/newton_solver.hpp"
 
 #include <algorithm>
@@ -316,10 +316,98 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
   return a;
 }
 
+/// Each of `classes` surveyed in its own branch of `context` (runBranches, a queue on the
+/// request's threads), the results in the classes' order. The request's own class, which is
+/// refined whatever its survey cost (classesToRefine), is refined in its survey's branch as soon
+/// as its survey converged (`*own_refined`), while the other classes are surveyed beside it. Each
+/// survey and refinement is an independent solve, so each result is the same on any number of
+/// threads.
+std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
+                                    const PlanningProblem& problem, const SurveyPlan& plan,
+                                    SolveContext& context, const GridSettings& settings,
+                                    const NewtonParameters& p,
+                                    std::optional<PlanResult>* own_refined) {
+  std::vector<Surveyed> surveyed(classes.size());
+  const bool refined_later = plan.survey + 1 < plan.levels.size();
+  const auto work = [&](int i, SolveContext& branch) {
+    {
+      const SolveContext::Scope scope(branch, AttemptStage::ClassSurvey, classes[i]);
+      surveyed[i] = surveyClass(classes[i], plan, branch, settings, p);
+    }
+    const bool own = sameHomotopyClass(classes[i], homotopyClassOf(problem));
+    if (!own || !refined_later || !surveyed[i].result.converged() || branch.stopReason()) return;
+    const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
+    *own_refined = refineClass(surveyed[i], plan, branch, settings, p);
+  };
+  runBranches(context, static_cast<int>(classes.size()), work);
+  return surveyed;
+}
+
+/// The surveyed classes carried to the requested grid: the request's own (the answer is never
+/// costlier than its solve alone) and those whose survey cost is within `margin` of the cheapest
+/// (coarse costs reorder on refinement); a class whose survey met one already chosen (the same
+/// extremal from another start) would repeat it. Read from the survey alone, so the refinements
+/// are independent of one another.
+std::vector<const Surveyed*> classesToRefine(const std::vector<Surveyed>& surveyed,
+                                             const PlanningProblem& problem, double margin,
+                                             const NewtonParameters& p) {
+  double cheapest = std::numeric_limits<double>::infinity();
+  for (const Surveyed& s : surveyed) {
+    if (s.result.converged()) cheapest = std::min(cheapest, s.result.cost);
+  }
+  std::vector<const Surveyed*> out;
+  for (const Surveyed& s : surveyed) {
+    if (!s.result.converged()) continue;
+    const bool wanted = sameHomotopyClass(s.homotopy, homotopyClassOf(problem)) ||
+                        s.result.cost <= cheapest * (1 + margin);
+    const bool repeated = std::any_of(out.begin(), out.end(), [&](const Surveyed* r) {
+      return std::abs(s.result.cost - r->result.cost) <= p.same_extremal_cost * r->result.cost;
+    });
+    if (wanted && !repeated) out.push_back(&s);
+  }
+  return out;
+}
+
+/// The chosen classes' refinements (classesToRefine's order), each in its own branch of
+/// `context` (a queue on the request's threads) but the request's own when `own_refined` holds it
+/// already; a refinement the stop kept from beginning is left out, with those after it.
+std::vector<PlanResult> refineClasses(const std::vector<const Surveyed*>& refine,
+                                      const PlanningProblem& problem, const SurveyPlan& plan,
+                                      SolveContext& context, const GridSettings& settings,
+                                      const NewtonParameters& p,
+                                      std::optional<PlanResult> own_refined) {
+  std::vector<std::optional<PlanResult>> refined(refine.size());
+  std::vector<std::size_t> pending;
+  for (std::size_t i = 0; i < refine.size(); ++i) {
+    if (own_refined && sameHomotopyClass(refine[i]->homotopy, homotopyClassOf(problem))) {
+      refined[i] = std::move(*own_refined);
+      own_refined.reset();
+    } else {
+      pending.push_back(i);
+    }
+  }
+  const auto work = [&](int j, SolveContext& branch) {
+    if (branch.stopReason()) return;
+    const Surveyed& s = *refine[pending[j]];
+    const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, s.homotopy);
+    refined[pending[j]] = refineClass(s, plan, branch, settings, p);
+  };
+  runBranches(context, static_cast<int>(pending.size()), work);
+  std::vector<PlanResult> out;
+  for (std::optional<PlanResult>& r : refined) {
+    if (!r) break;
+    out.push_back(std::move(*r));
+  }
+  return out;
+}
+
 /// Surveys every distinct class, then refines the request's own and those whose survey cost is
-/// within class_refine_margin of the cheapest. A stop (cancel, deadline) carries the class being
-/// surveyed to the requested grid and ends the enumeration. `plans` (optional) receives each
-/// converged survey's and refinement's plan.
+/// near the cheapest (classesToRefine: within class_refine_margin where `plans` hands the refined
+/// plans on, else unconstrained_refine_margin); the surveys and the refinements run in branches
+/// (surveyClasses, refineClasses) and are recorded in the classes' order. A stop (cancel,
+/// deadline) carries the first class whose survey it ended to the requested grid (the request's
+/// own class: its refinement, if it began) and ends the enumeration. `plans` (optional) receives
+/// each converged survey's and refinement's plan.
 void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
                       const NewtonParameters& p, std::vector<ClassPlan>* plans) {
   const SolverOptions& options = context.options();
@@ -330,59 +418,48 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   const AttemptStart survey_start = usesCoarserLevel(survey_grid, newtonGridRule(p))
                                         ? AttemptStart::CoarseLevel
                                         : AttemptStart::Hermite;
-  std::vector<Surveyed> surveyed;
+  std::optional<PlanResult> own_refined;
   // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
-  for (const HomotopyClass& c : distinctClasses(plan.levels.front())) {
-    if (!walk->empty() && context.stopReason()) break;
-    Surveyed s = [&] {
-      const SolveContext::Scope scope(context, AttemptStage::ClassSurvey, c);
-      return surveyClass(c, plan, context, settings, p);
-    }();
-    walk->add(attemptIn(AttemptStage::ClassSurvey, survey_start, pinnedToClass(survey_grid, c)),
-              s.result, s.result.iterations);
-    if (plans && s.result.converged()) plans->push_back({c, surveyedPlan(s, survey_grid)});
-    surveyed.push_back(std::move(s));
-    // A class at zero cost (the zero maneuver) cannot be beaten: costs are sums of squares.
-    const bool unbeatable = surveyed.back().result.converged() && surveyed.back().result.cost == 0;
-    if (unbeatable && !context.stopReason()) break;
-    if (context.stopReason()) {
-      if (!surveyed.back().on_requested_grid && !surveyed.back().steps.empty()) {
-        const SolveContext::Scope scope(context, AttemptStage::ClassRefine, c);
-        const PlanResult carried = refineClass(surveyed.back(), plan, context, settings, p);
-        walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
-                            pinnedToClass(problem, c)),
-                  carried, carried.iterations);
-      }
-      return;
-    }
-  }
-  if (plan.survey + 1 == plan.levels.size()) return;  // the survey was on the requested grid
-  double cheapest = std::numeric_limits<double>::infinity();
-  for (const Surveyed& s : surveyed) {
-    if (s.result.converged()) cheapest = std::min(cheapest, s.result.cost);
-  }
-  std::vector<double> refined_costs;  // the survey costs of the classes refined so far
-  for (const Surveyed& s : surveyed) {
-    if (!s.result.converged()) continue;
-    // The request's own class always (the answer is never costlier than its solve alone), the
-    // others near the cheapest; a class whose survey met one already refined (the same extremal
-    // from another start) would repeat it.
-    const bool wanted = sameHomotopyClass(s.homotopy, homotopyClassOf(problem)) ||
-                        s.result.cost <= cheapest * (1 + p.class_refine_margin);
-    const bool repeated = std::any_of(refined_costs.begin(), refined_costs.end(), [&](double c) {
-      return std::abs(s.result.cost - c) <= p.same_extremal_cost * c;
-    });
-    if (!wanted || repeated) continue;
-    if (context.stopReason()) return;
-    refined_costs.push_back(s.result.cost);
-    const SolveContext::Scope scope(context, AttemptStage::ClassRefine, s.homotopy);
-    const PlanResult refined = refineClass(s, plan, context, settings, p);
+  std::vector<Surveyed> surveyed = surveyClasses(distinctClasses(plan.levels.front()), problem,
+                                                 plan, context, settings, p, &own_refined);
+  const auto addRefined = [&](const Surveyed& s, const PlanResult& refined, int own_iterations) {
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),
-              refined, s.result.iterations + refined.iterations);
+              refined, own_iterations);
     if (plans && refined.converged() && refined.maneuver.steps() == problem.steps) {
       plans->push_back({s.homotopy, refined.maneuver});
     }
+  };
+  for (std::size_t i = 0; i < surveyed.size(); ++i) {
+    const Surveyed& s = surveyed[i];
+    walk->add(
+        attemptIn(AttemptStage::ClassSurvey, survey_start, pinnedToClass(survey_grid, s.homotopy)),
+        s.result, s.result.iterations);
+    if (plans && s.result.converged()) plans->push_back({s.homotopy, surveyedPlan(s, survey_grid)});
+    // A class at zero cost (the zero maneuver) cannot be beaten: costs are sums of squares.
+    const bool unbeatable = s.result.converged() && s.result.cost == 0;
+    if (context.stopReason()) {
+      if (own_refined && sameHomotopyClass(s.homotopy, homotopyClassOf(problem))) {
+        addRefined(s, *own_refined, s.result.iterations + own_refined->iterations);
+      } else if (!s.on_requested_grid && !s.steps.empty()) {
+        const SolveContext::Scope scope(context, AttemptStage::ClassRefine, s.homotopy);
+        const PlanResult carried = refineClass(s, plan, context, settings, p);
+        addRefined(s, carried, carried.iterations);
+      }
+      return;
+    }
+    if (unbeatable) {
+      surveyed.resize(i + 1);
+      break;
+    }
+  }
+  if (plan.survey + 1 == plan.levels.size()) return;  // the survey was on the requested grid
+  const double margin = plans ? p.class_refine_margin : p.unconstrained_refine_margin;
+  const std::vector<const Surveyed*> refine = classesToRefine(surveyed, problem, margin, p);
+  const std::vector<PlanResult> refined =
+      refineClasses(refine, problem, plan, context, settings, p, std::move(own_refined));
+  for (std::size_t i = 0; i < refined.size(); ++i) {
+    addRefined(*refine[i], refined[i], refine[i]->result.iterations + refined[i].iterations);
   }
 }
 

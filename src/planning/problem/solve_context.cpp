@@ -1,9 +1,11 @@
 #include "planning/problem/solve_context.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <deque>
 #include <exception>
 #include <limits>
+#include <locale>
 #include <thread>
 
 namespace attitude_planner {
@@ -152,28 +154,40 @@ std::vector<Attempt> SolveContext::attemptsFrom(std::size_t first) const {
   return {attempts_.begin() + static_cast<std::ptrdiff_t>(first), attempts_.end()};
 }
 
+namespace {
+
+/// libstdc++ fills the locale's ctype widen table on its first use (number formatting in a
+/// message); a first use from two threads at once is a data race (benign, but Helgrind and TSan
+/// report it), so it is filled before any branch's thread starts.
+void fillLocaleTablesBeforeThreads() {
+  std::use_facet<std::ctype<char>>(std::locale()).widen('0');
+}
+
+}  // namespace
+
 void runBranches(SolveContext& context, int count,
                  const std::function<void(int, SolveContext&)>& work) {
   const int at_once = std::max(1, std::min(context.threads(), count));
+  fillLocaleTablesBeforeThreads();
   std::vector<std::unique_ptr<SolveContext>> branches;
   for (int i = 0; i < count; ++i) {
     branches.push_back(std::make_unique<SolveContext>(context, SolveContext::Branch{}));
   }
   std::vector<std::exception_ptr> failures(count);
-  const auto run = [&](int i) {
-    try {
-      work(i, *branches[i]);
-    } catch (...) {
-      failures[i] = std::current_exception();
+  std::atomic<int> next{0};
+  const auto take = [&] {  // each thread takes the next work as soon as its last one ended
+    for (int i = next++; i < count; i = next++) {
+      try {
+        work(i, *branches[i]);
+      } catch (...) {
+        failures[i] = std::current_exception();
+      }
     }
   };
-  for (int first = 0; first < count; first += at_once) {
-    const int last = std::min(first + at_once, count);
-    std::vector<std::thread> others;
-    for (int i = first + 1; i < last; ++i) others.emplace_back(run, i);
-    run(first);
-    for (std::thread& t : others) t.join();
-  }
+  std::vector<std::thread> others;
+  for (int t = 1; t < at_once; ++t) others.emplace_back(take);
+  take();
+  for (std::thread& t : others) t.join();
   for (int i = 0; i < count; ++i) {
     context.join(*branches[i]);
     if (failures[i]) std::rethrow_exception(failures[i]);
@@ -195,6 +209,7 @@ struct OpenWork {
 void runSlidingWindow(SolveContext& context, int count, const std::function<BranchWork(int)>& begin,
                       const std::function<void(int)>& end) {
   const int at_once = std::max(1, context.threads());
+  if (at_once > 1) fillLocaleTablesBeforeThreads();
   std::deque<OpenWork> open;  // in the order of index; references stay valid as it grows
   int running = 0;
   std::exception_ptr failure;

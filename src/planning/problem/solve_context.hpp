@@ -231,8 +231,9 @@ class SolveContext : public Interruption {
   std::vector<LevelSummary> levels_;
 };
 
-/// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each on its own
-/// thread in its own branch of `context` (SolveContext::Branch), and joins the branches into
+/// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each in its own
+/// branch of `context` (SolveContext::Branch); a thread takes the next work as soon as its last one
+/// ended (works of unequal length: no thread waits for another's), and the branches join into
 /// `context` in the order of i; an exception thrown by any work is rethrown after every branch
 /// joined (the first in that order). The work must not touch what another one writes.
 void runBranches(SolveContext& context, int count,

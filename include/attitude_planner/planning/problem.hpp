@@ -21,8 +21,8 @@
 #include "attitude_planner/input_rules.hpp"
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
+#include "attitude_planner/planning/advanced_parameters.hpp"
 #include "attitude_planner/planning/constraints.hpp"
-#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/reaction_wheels.hpp"
 
 namespace attitude_planner {
@@ -332,7 +332,7 @@ struct SolverOptions {
   /// not depend on it beyond the order the starts' watch sees them
   /// (drivers/minimum_time_free_time).
   int threads = 0;
-  /// The solvers' tuning (interior_point_parameters.hpp): the planner's defaults unless set;
+  /// The solvers' tuning (advanced_parameters.hpp): the planner's defaults unless set;
   /// validateOptions checks every field's range.
   AdvancedParameters advanced;
 };

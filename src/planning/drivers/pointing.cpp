@@ -7,11 +7,11 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/constrained_system.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/problem/message_notes.hpp"
@@ -860,7 +860,7 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   cold.warm_start = nullptr;
   cold.constrained_from_warm_start = cold.warm_start_strictly_inside = false;
   const SolveContext::Call call(context, cold);
-  const NewtonParameters& p = newtonDefaults();
+  const NewtonParameters& p = options.advanced.newton;
   const std::size_t first_recorded = context.attempts().size();
   const int counted_at_start = context.iterations();
   std::vector<std::pair<TwistRun, std::size_t>> finals;  // on the requested grid, trail index

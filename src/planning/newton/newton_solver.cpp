@@ -17,8 +17,8 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/grid_solve.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/strategies/staged_continuation.hpp"
@@ -670,8 +670,8 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& call_options,
                            SolveContext& context, std::vector<ClassPlan>* survey_plans) {
   const SolveContext::Call call(context, call_options);
-  const NewtonParameters& p = newtonDefaults();
   const SolverOptions& options = context.options();
+  const NewtonParameters& p = options.advanced.newton;
   Walk walk(problem, context, p);
   if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
   // The request's own class when it names one or is warm-started; after the class survey, when

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <regex>
@@ -14,6 +15,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/advanced_parameters.hpp"
+#include "planning/problem/solve_request.hpp"
 #include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
@@ -260,4 +262,51 @@ TEST(AdvancedParameters, ANewtonValueReachesTheNewtonSolver) {
   EXPECT_GT(base.levels.size(), moved.levels.size());  // the coarse levels are gone
   EXPECT_NE(moved.iterations, base.iterations);
   EXPECT_NEAR(moved.cost, base.cost, 1e-8 * base.cost);
+}
+
+TEST(SolveRequest, TheDeprecatedStartFieldsBecomeTheStartAndAreCleared) {
+  const ap::Maneuver optimum;
+  ap::SolverOptions user;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  user.constrained_from_warm_start = true;
+  user.warm_start_strictly_inside = true;
+  user.unconstrained_optimum = &optimum;
+  const ap::SolveRequest request(user);
+  EXPECT_FALSE(request.constrained_from_warm_start);
+  EXPECT_FALSE(request.warm_start_strictly_inside);
+  EXPECT_EQ(request.unconstrained_optimum, nullptr);
+#pragma GCC diagnostic pop
+  EXPECT_TRUE(request.start.from_constrained_plan);
+  EXPECT_TRUE(request.start.strictly_inside);
+  EXPECT_EQ(request.start.unconstrained_optimum, &optimum);
+  const ap::SolveRequest plain{ap::SolverOptions{}};
+  EXPECT_FALSE(plain.start.from_constrained_plan || plain.start.strictly_inside);
+  EXPECT_EQ(plain.start.unconstrained_optimum, nullptr);
+}
+
+TEST(SolveRequest, TheDeprecatedStartFieldsAreReadOnlyWhereTheyAreTranslated) {
+  // The planner hands its start in SolveRequest::start: the public fields stay for API users.
+  namespace fs = std::filesystem;
+  const std::string fields[] = {"constrained_from_warm_start", "warm_start_strictly_inside",
+                                ".unconstrained_optimum"};
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(AP_SOURCE_DIR) / "src")) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".cpp" && ext != ".hpp") continue;
+    if (entry.path().filename() == "solve_request.hpp") continue;  // the translation
+    ++files;
+    std::ifstream in(entry.path());
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+      for (const std::string& field : fields) {
+        for (std::size_t at = line.find(field); at != std::string::npos;
+             at = line.find(field, at + 1)) {
+          const bool the_start = at >= 5 && line.compare(at - 5, 5, "start") == 0;
+          EXPECT_TRUE(the_start) << entry.path() << ":" << number << ": " << line;
+        }
+      }
+    }
+  }
+  EXPECT_GT(files, 100);
 }

@@ -147,7 +147,7 @@ struct ClassStart {
 /// at `first_recorded`).
 class ClassSearch {
  public:
-  ClassSearch(const PlanningProblem& problem, const SolverOptions& options, SolveContext& context,
+  ClassSearch(const PlanningProblem& problem, const SolveRequest& options, SolveContext& context,
               const std::vector<ClassPlan>& survey_plans, const HomotopyClass& first_class,
               PlanResult first, std::size_t first_recorded)
       : problem_(problem),
@@ -174,13 +174,13 @@ class ClassSearch {
   PlanResult solveProblem(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps,
                           const ClassStart& start) {
     PlanResult r;
-    SolverOptions options = options_;
-    options.unconstrained_optimum = start.unconstrained_optimum;
+    SolveRequest options = options_;
+    options.start.unconstrained_optimum = start.unconstrained_optimum;
     if (!start.unconstrained_optimum && !start.constrained_plan) {
-      options.unconstrained_optimum = surveyPlan(homotopy, steps);
+      options.start.unconstrained_optimum = surveyPlan(homotopy, steps);
     }
     options.warm_start = start.constrained_plan;
-    options.constrained_from_warm_start = start.constrained_plan != nullptr;
+    options.start.from_constrained_plan = start.constrained_plan != nullptr;
     const std::size_t before = context_.attempts().size();
     r = inClass(homotopy, [&] {
       return planAtResolution(pinnedTo(problem, homotopy, steps), options, context_);
@@ -203,7 +203,7 @@ class ClassSearch {
   /// plan of it (the constraints ignored, as the unconstrained solve ignores them).
   PlanResult unconstrainedOptimum(const HomotopyClass& homotopy, int steps) {
     const PlanningProblem pinned = pinnedTo(problem_, homotopy, steps);
-    SolverOptions options = options_;
+    SolveRequest options = options_;
     Maneuver guess;
     if (const Maneuver* surveyed = finestSurveyPlan(homotopy)) {
       guess = initialGuessOnGrid(*surveyed, pinned);
@@ -349,7 +349,7 @@ class ClassSearch {
   }
 
   const PlanningProblem& problem_;
-  SolverOptions options_;
+  SolveRequest options_;
   SolveContext& context_;
   const std::vector<ClassPlan>& survey_plans_;
   std::size_t first_recorded_;
@@ -477,7 +477,7 @@ void solveClassesThatCouldBeatIt(ClassSearch& search, const SurveyedClasses& sur
 
 }  // namespace
 
-PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolveRequest& options,
                                     SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first,
                                     double unconstrained_cost, std::size_t first_recorded) {

@@ -141,13 +141,13 @@ Rung solveRung(PlanningProblem problem, int N, SolveContext& context, double ord
   problem.accuracy = AccuracyTarget{};
   problem.steps = N;
   Rung rung;
-  rung.plan = planAtResolution(problem, context.options(), context);
+  rung.plan = planAtResolution(problem, SolveRequest(context.options()), context);
   if (!rung.plan.converged()) return rung;
   if (measure == AccuracyMeasure::TerminalMiss) {
     rung.error = replayZeroOrderHold(problem, rung.plan.maneuver).attitude_miss;
   } else {
     problem.steps = N / 2;
-    const PlanResult half = planAtResolution(problem, context.options(), context);
+    const PlanResult half = planAtResolution(problem, SolveRequest(context.options()), context);
     if (!half.converged()) {
       rung.plan.termination = half.termination;
       takeReason(&rung.plan, half);

@@ -215,20 +215,47 @@ def _flag_value(keyword, value):
     return value
 
 
+def _advanced_flags(value, prefix=""):
+    """The solvers' tuning as plan_maneuver's --advanced flags, one NAME=VALUE per field: from a
+    dict of field names ("newton.armijo") or of nested dicts ({"newton": {"armijo": ...}}), or
+    from one "NAME=VALUE" text."""
+    if isinstance(value, str) and not prefix:
+        return [("--advanced", value)]
+    if not isinstance(value, dict):
+        raise _input_error("advanced" + ("." + prefix[:-1] if prefix else ""),
+                           "expected a dict of field names and values, got %r" % (value,))
+    flags = []
+    for name, field_value in value.items():
+        if not isinstance(name, str):
+            raise _input_error("advanced", "a field name must be a str, got %r" % (name,))
+        if isinstance(field_value, dict):
+            flags += _advanced_flags(field_value, prefix + name + ".")
+        else:
+            text = _flag_value("advanced." + prefix + name, field_value)
+            flags.append(("--advanced", prefix + name + "=" + text))
+    return flags
+
+
 def plan(problem, warm_start=None, **options):
     """Plans `problem` (a Problem, or a dict / path Problem() accepts) and returns a Result.
 
     `options` are plan_maneuver's planning flags as keywords, with the same meaning and checks:
     steps, scheme, solver, precision, tolerance, max_iterations, time_budget, threads, target_miss,
-    target_cost_error, objective, time_margin, direction, extra_revolutions. `warm_start` is a
-    previous Result (the CLI's --warm-start). The GIL is released during the solve, so threads
-    plan in parallel. Raises InputError (a ValueError) naming the field and the value for bad
-    input; a solve that does not converge is not an error (Result.termination says how it ended).
+    target_cost_error, objective, time_margin, direction, extra_revolutions, and `advanced`, the
+    solvers' tuning as a dict ({"newton.armijo": 1e-3} or {"newton": {"armijo": 1e-3}}), one
+    --advanced NAME=VALUE per field. `warm_start` is a previous Result (the CLI's --warm-start).
+    The GIL is released during the solve, so threads plan in parallel. Raises InputError (a
+    ValueError) naming the field and the value for bad input; a solve that does not converge is
+    not an error (Result.termination says how it ended).
     """
     if not isinstance(problem, Problem):
         problem = Problem(problem)
-    flags = [("--" + key.replace("_", "-"), _flag_value(key, value))
-             for key, value in options.items()]
+    flags = []
+    for key, value in options.items():
+        if key == "advanced":
+            flags += _advanced_flags(value)
+        else:
+            flags.append(("--" + key.replace("_", "-"), _flag_value(key, value)))
     warm = None
     if warm_start is not None:
         if not isinstance(warm_start, _Trajectory):

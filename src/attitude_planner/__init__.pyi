@@ -56,7 +56,8 @@ def plan(problem: SceneLike, warm_start: Optional[Result] = ..., *,
          steps: int = ..., scheme: str = ..., solver: str = ..., precision: str = ...,
          tolerance: float = ..., max_iterations: int = ..., time_budget: float = ...,
          target_miss: float = ..., target_cost_error: float = ..., objective: str = ...,
-         time_margin: float = ..., direction: str = ..., extra_revolutions: int = ...) -> Result: ...
+         time_margin: float = ..., direction: str = ..., extra_revolutions: int = ...,
+         advanced: Union[str, Dict[str, Any]] = ...) -> Result: ...
 
 def simulate(problem: SceneLike, torques: Union[_Trajectory, npt.ArrayLike],
              time_step: Optional[float] = ..., scheme: Optional[str] = ...) -> Simulation: ...

@@ -99,6 +99,18 @@ class SameAsTheCommandLine(unittest.TestCase):
         self.assertGreater(result.minimum_duration, 0.0)
         self.assertAlmostEqual(result.duration, 1.1 * result.minimum_duration, places=9)
 
+    def test_advanced_as_a_dict_is_one_flag_per_field(self):
+        # Nested and dotted names alike; each field reaches the solver as the CLI's flag does.
+        flags = ["--steps", "32", "--advanced", "newton.coarsest_steps=32",
+                 "--advanced", "newton.armijo=0.001"]
+        advanced = {"newton": {"coarsest_steps": 32}, "newton.armijo": 1e-3}
+        result = self.check_same(REST_TO_REST, flags, {"steps": 32, "advanced": advanced})
+        self.assertTrue(result.converged, result.message)
+        default = ap.plan(ap.Problem(REST_TO_REST), steps=32)
+        self.assertNotEqual(result.summary["iterations"], default.summary["iterations"])
+        self.assertAlmostEqual(result.summary["cost"], default.summary["cost"],
+                               delta=1e-8 * default.summary["cost"])
+
 
 class Problems(unittest.TestCase):
 
@@ -155,6 +167,18 @@ class BadInput(unittest.TestCase):
         with self.assertRaises(ap.InputError) as caught:
             ap.plan(ap.Problem(REST_TO_REST), steps=True)
         self.assert_names(caught.exception, "steps", "True")
+
+    def test_a_bad_advanced_field_is_named(self):
+        with self.assertRaises(ap.InputError) as caught:
+            ap.plan(ap.Problem(REST_TO_REST), advanced={"newton.armijo": 0.75})
+        self.assert_names(caught.exception, "advanced", "0.75")
+        self.assertIn("advanced.newton.armijo", str(caught.exception))
+        with self.assertRaises(ap.InputError) as caught:
+            ap.plan(ap.Problem(REST_TO_REST), advanced={"newton": {"armijo_typo": 0.1}})
+        self.assertIn("newton.armijo_typo", str(caught.exception))
+        with self.assertRaises(ap.InputError) as caught:
+            ap.plan(ap.Problem(REST_TO_REST), advanced=[0.1])
+        self.assertEqual(caught.exception.field, "advanced")
 
     def test_step_too_large_is_an_input_error(self):
         spinning = {"initial": {"attitude": {"axis": [1, 0, 0], "angle": 0.0},

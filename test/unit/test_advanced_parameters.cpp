@@ -1,9 +1,10 @@
-// The advanced parameters (interior_point_parameters.hpp): every field in the table, every field
-// bounded and named when out of range, a set value reaching the solver it tunes, the defaults the
-// planner's own.
+// The advanced parameters (advanced_parameters.hpp: the Newton solver's and the interior point's):
+// every field in the table, every field bounded and named when out of range, a set value reaching
+// the solver it tunes, the defaults the planner's own.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <regex>
@@ -13,7 +14,8 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
-#include "attitude_planner/planning/interior_point_parameters.hpp"
+#include "attitude_planner/planning/advanced_parameters.hpp"
+#include "planning/problem/solve_request.hpp"
 #include "support/scene_problem.hpp"
 
 namespace ap = attitude_planner;
@@ -22,11 +24,11 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// The numeric members of `struct_name` as the header declares them ("double name = ..." or
-/// "double name;"): read from the source, so a field added without a table row is found.
-std::set<std::string> declaredFields(const std::string& struct_name) {
-  std::ifstream in(AP_SOURCE_DIR
-                   "/include/attitude_planner/planning/interior_point_parameters.hpp");
+/// The numeric members of `struct_name` as `header` (in include/attitude_planner/planning/)
+/// declares them ("double name = ..." or "double name;"): read from the source, so a field added
+/// without a table row is found.
+std::set<std::string> declaredFields(const std::string& header, const std::string& struct_name) {
+  std::ifstream in(AP_SOURCE_DIR "/include/attitude_planner/planning/" + header);
   std::stringstream text;
   text << in.rdbuf();
   const std::string source = text.str();
@@ -74,20 +76,24 @@ std::vector<double> outside(const ap::AdvancedField& f) {
 
 TEST(AdvancedParameters, EveryFieldOfTheStructsHasOneRowInTheTable) {
   std::set<std::string> expected;
+  const std::string ip_header = "interior_point_parameters.hpp";
   for (const std::string& profile : {"fixed_step.", "free_time."}) {
-    for (const std::string& name : declaredFields("InteriorPointProfile")) {
+    for (const std::string& name : declaredFields(ip_header, "InteriorPointProfile")) {
       expected.insert("interior_point." + profile + name);
     }
   }
-  for (const std::string& name : declaredFields("InteriorPointParameters")) {
+  for (const std::string& name : declaredFields(ip_header, "InteriorPointParameters")) {
     expected.insert("interior_point." + name);
   }
+  const std::set<std::string> newton = declaredFields("newton_parameters.hpp", "NewtonParameters");
+  for (const std::string& name : newton) expected.insert("newton." + name);
   std::set<std::string> listed;
   for (const ap::AdvancedField& f : ap::advancedFields({})) {
     EXPECT_TRUE(listed.insert(f.name).second) << f.name << " listed twice";
   }
   EXPECT_EQ(listed, expected);
-  EXPECT_GE(expected.size(), 70u);  // the parser found the structs
+  EXPECT_GE(expected.size(), 70u + 30u);  // the parser found the structs
+  EXPECT_GE(newton.size(), 30u);
 }
 
 TEST(AdvancedParameters, EachRowNamesItsOwnField) {
@@ -126,6 +132,16 @@ TEST(AdvancedParameters, DefaultsAreTheSolversConstantsAndValid) {
   EXPECT_EQ(p.final_barrier_fraction, 0.1);
   EXPECT_EQ(p.resumed_shift_divisor, 3.0);  // IPOPT κ_w⁻ = 1/3
   EXPECT_EQ(p.resumed_shift_growth, 8.0);   // IPOPT κ_w⁺
+  // The Newton solver's: a few of its step control's and stopping test's.
+  const ap::NewtonParameters n = ap::AdvancedParameters{}.newton;
+  EXPECT_EQ(n.normal_equations_max_steps, 256);
+  EXPECT_EQ(n.armijo, 1e-4);
+  EXPECT_EQ(n.max_halvings, 40);
+  EXPECT_EQ(n.smallest_shift, 1e-14);
+  EXPECT_EQ(n.accept_ratio, 1e-4);
+  EXPECT_EQ(n.coarsest_steps, 16);
+  EXPECT_EQ(n.class_refine_margin, 0.5);
+  EXPECT_EQ(n.rate_continuation_min_increment, 1.0 / 64);
   EXPECT_NO_THROW(ap::validateAdvancedParameters({}));
   EXPECT_NO_THROW(ap::validateOptions({}));
 }
@@ -168,6 +184,14 @@ TEST(AdvancedParameters, TheRangesTheMethodNeeds) {
        "advanced.interior_point.coarsening_factor: must be an integer in [2, 64], got 1"},
       {"interior_point.warm_barrier", -1e-3,
        "advanced.interior_point.warm_barrier: must be a finite number > 0, got -0.001"},
+      {"newton.armijo", 0.0, "advanced.newton.armijo: must be a finite number in (0, 0.5), got 0"},
+      {"newton.coarsest_steps", 3,
+       "advanced.newton.coarsest_steps: must be an integer in [4, 1000000000], got 3"},
+      {"newton.indefinite_shift_growth", 0.5,
+       "advanced.newton.indefinite_shift_growth: must be a finite number > 1, got 0.5"},
+      {"newton.more_starts_above_iterations", -1,
+       "advanced.newton.more_starts_above_iterations: must be an integer in [0, 1000000000], got "
+       "-1"},
       {"interior_point.armijo_typo", 0.1, "advanced.interior_point.armijo_typo: not an advanced"},
   };
   for (const Row& row : rows) {
@@ -178,6 +202,14 @@ TEST(AdvancedParameters, TheRangesTheMethodNeeds) {
 }
 
 TEST(AdvancedParameters, AValueWrittenIntoTheOptionsIsRefusedByThePlanner) {
+  ap::SolverOptions newton;
+  newton.advanced.newton.backtrack_factor = 1.0;
+  EXPECT_EQ(refusal([&] { ap::validateOptions(newton); }),
+            "advanced.newton.backtrack_factor: must be a finite number in (0, 1), got 1");
+  EXPECT_NE(refusal([&] {
+              ap::planManeuver(ap::test_support::sceneProblem("rest_to_rest", 16), newton);
+            }),
+            "");
   ap::SolverOptions o;
   o.advanced.interior_point.free_time.theta_mu = 2.5;
   EXPECT_EQ(
@@ -215,4 +247,66 @@ TEST(AdvancedParameters, AFreeTimeProfileValueReachesTheMinimumTimeSolver) {
   ASSERT_TRUE(moved.converged()) << moved.message();
   EXPECT_NE(moved.iterations, base.iterations);
   EXPECT_NEAR(moved.minimum_duration, base.minimum_duration, 1e-8);  // the same T*
+}
+
+TEST(AdvancedParameters, ANewtonValueReachesTheNewtonSolver) {
+  // Every Newton start begins at the grid continuation's coarsest level: one level fewer (the
+  // coarsest grid at the requested N) changes the iterations the walk takes, not its optimum.
+  const ap::PlanningProblem p = ap::test_support::sceneProblem("rest_to_rest", 256);
+  const ap::PlanResult base = ap::planManeuver(p);
+  ap::SolverOptions o;
+  o.advanced.newton.coarsest_steps = 256;
+  const ap::PlanResult moved = ap::planManeuver(p, o);
+  ASSERT_TRUE(base.converged()) << base.message();
+  ASSERT_TRUE(moved.converged()) << moved.message();
+  EXPECT_GT(base.levels.size(), moved.levels.size());  // the coarse levels are gone
+  EXPECT_NE(moved.iterations, base.iterations);
+  EXPECT_NEAR(moved.cost, base.cost, 1e-8 * base.cost);
+}
+
+TEST(SolveRequest, TheDeprecatedStartFieldsBecomeTheStartAndAreCleared) {
+  const ap::Maneuver optimum;
+  ap::SolverOptions user;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  user.constrained_from_warm_start = true;
+  user.warm_start_strictly_inside = true;
+  user.unconstrained_optimum = &optimum;
+  const ap::SolveRequest request(user);
+  EXPECT_FALSE(request.constrained_from_warm_start);
+  EXPECT_FALSE(request.warm_start_strictly_inside);
+  EXPECT_EQ(request.unconstrained_optimum, nullptr);
+#pragma GCC diagnostic pop
+  EXPECT_TRUE(request.start.from_constrained_plan);
+  EXPECT_TRUE(request.start.strictly_inside);
+  EXPECT_EQ(request.start.unconstrained_optimum, &optimum);
+  const ap::SolveRequest plain{ap::SolverOptions{}};
+  EXPECT_FALSE(plain.start.from_constrained_plan || plain.start.strictly_inside);
+  EXPECT_EQ(plain.start.unconstrained_optimum, nullptr);
+}
+
+TEST(SolveRequest, TheDeprecatedStartFieldsAreReadOnlyWhereTheyAreTranslated) {
+  // The planner hands its start in SolveRequest::start: the public fields stay for API users.
+  namespace fs = std::filesystem;
+  const std::string fields[] = {"constrained_from_warm_start", "warm_start_strictly_inside",
+                                ".unconstrained_optimum"};
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(AP_SOURCE_DIR) / "src")) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".cpp" && ext != ".hpp") continue;
+    if (entry.path().filename() == "solve_request.hpp") continue;  // the translation
+    ++files;
+    std::ifstream in(entry.path());
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+      for (const std::string& field : fields) {
+        for (std::size_t at = line.find(field); at != std::string::npos;
+             at = line.find(field, at + 1)) {
+          const bool the_start = at >= 5 && line.compare(at - 5, 5, "start") == 0;
+          EXPECT_TRUE(the_start) << entry.path() << ":" << number << ": " << line;
+        }
+      }
+    }
+  }
+  EXPECT_GT(files, 100);
 }

@@ -325,7 +325,7 @@ TEST(AttemptTags, AConstrainedRequestsTrailIsTheContextsTrail) {
       const ap::PlanningProblem p = ap::test_support::sceneProblem(scene, steps);
       const ap::SolverOptions options;
       ap::SolveContext context(options);
-      const ap::PlanResult r = ap::planAtResolution(p, options, context);
+      const ap::PlanResult r = ap::planAtResolution(p, ap::SolveRequest(options), context);
       ASSERT_TRUE(std::any_of(
           r.attempts.begin(), r.attempts.end(),
           [](const ap::Attempt& a) { return a.formulation != ap::Formulation::Unconstrained; }))
@@ -352,7 +352,7 @@ TEST(AttemptTags, AFourthOrderRequestsTrailIsTheContextsTrail) {
     p.scheme = ap::SchemeKind::FourthOrder;
     const ap::SolverOptions options;
     ap::SolveContext context(options);
-    const ap::PlanResult r = ap::planAtResolution(p, options, context);
+    const ap::PlanResult r = ap::planAtResolution(p, ap::SolveRequest(options), context);
     ASSERT_TRUE(r.converged()) << r.message();
     expectTheContextsTrail(r, context);
     const auto named = [&](ap::AttemptStage stage) {
@@ -430,7 +430,7 @@ TEST(AttemptTags, APointingRequestsTrailIsTheContextsTrail) {
       7, 32, false, ap::SchemeKind::SecondOrder, ap::test_support::PointingBinding::KeepOut);
   const ap::SolverOptions options;
   ap::SolveContext context(options);
-  const ap::PlanResult r = ap::planAtResolution(p, options, context);
+  const ap::PlanResult r = ap::planAtResolution(p, ap::SolveRequest(options), context);
   ASSERT_FALSE(r.attempts.empty()) << r.message();
   expectTheContextsTrail(r, context, r.converged());
 }
@@ -502,7 +502,7 @@ TEST(AttemptTags, AConstrainedRequestsLevelsAreTheContextsLevels) {
       ap::SolverOptions options;
       options.enumerate_classes = false;  // one class: the request's levels alone
       ap::SolveContext context(options);
-      const ap::PlanResult r = ap::planAtResolution(p, options, context);
+      const ap::PlanResult r = ap::planAtResolution(p, ap::SolveRequest(options), context);
       ASSERT_FALSE(r.levels.empty()) << r.message();
       expectTheContextsLevels(r, context);
       EXPECT_TRUE(std::any_of(r.levels.begin(), r.levels.end(), [&](const ap::LevelSummary& l) {

@@ -723,9 +723,9 @@ TEST(BoundedVerdicts,
   const PlanResult plan = planAtResolution(p, {});
   ASSERT_TRUE(plan.converged()) << plan.message();
   p.duration *= 0.97;
-  SolverOptions from_plan;
+  SolveRequest from_plan(SolverOptions{});
   from_plan.warm_start = &plan.maneuver;
-  from_plan.constrained_from_warm_start = true;
+  from_plan.start.from_constrained_plan = true;
   SolveContext context(from_plan);
   const PlanResult shorter = planAtResolution(p, from_plan, context);
   EXPECT_TRUE(shorter.converged()) << shorter.message();

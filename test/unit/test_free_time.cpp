@@ -128,7 +128,11 @@ TEST(FreeTime, NoFeasiblePlanSlightlyFasterFromTheAnswer) {
   p.objective = ap::Objective::MinimumEffort;
   ap::SolverOptions from;
   from.warm_start = &r.maneuver;
+  // The deprecated field, as an API user sets it: still honoured (SolveRequest translates it).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
   from.constrained_from_warm_start = true;
+#pragma GCC diagnostic pop
   p.duration = (1 - 1e-3) * r.minimum_duration;
   const ap::PlanResult faster = ap::planAtResolution(p, from);
   EXPECT_FALSE(faster.converged() && faster.max_constraint_violation <= 1e-8) << faster.message();

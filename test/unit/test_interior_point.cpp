@@ -967,7 +967,7 @@ TEST(InteriorPointStrategies, CancelFromAnotherThreadEndsCancelledAtN1e5) {
     cancel = true;
   });
   ap::SolveContext context(o);
-  const ap::PlanResult r = ap::solveWithInteriorPoint(p, o, context);
+  const ap::PlanResult r = ap::solveWithInteriorPoint(p, ap::SolveRequest(o), context);
   const Clock::time_point returned = Clock::now();
   {
     std::lock_guard<std::mutex> lock(m);

@@ -10,9 +10,9 @@
 #include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/newton/least_raise.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/strategies/starts.hpp"
 #include "planning/transcription/reduced_problem.hpp"
@@ -210,7 +210,7 @@ TwistSolve twistNewtonFromHermite(const PlanningProblem& p, const TwistWatch* wa
   ReducedProblem np(at);
   startOnHermiteCurve(at, &np);
   SolveContext context{SolverOptions()};
-  return solveTwistNewton(np, 0.0, context, 1e-10, 200, newtonDefaults(), nullptr, watch);
+  return solveTwistNewton(np, 0.0, context, 1e-10, 200, NewtonParameters{}, nullptr, watch);
 }
 
 TEST(TwistUnknown, AWatchSeesTheModelsMinimumAndEndsTheSolveWhereItSaysSo) {

@@ -31,7 +31,7 @@ struct PlanFlags {
   /// scene's final attitude (both or neither).
   std::optional<Vector3> point_body_axis, point_world_direction;
   /// --advanced NAME=VALUE (repeatable): the solvers' tuning, each field checked as it is set
-  /// (interior_point_parameters.hpp, advancedFields names them).
+  /// (advanced_parameters.hpp, advancedFields names them).
   AdvancedParameters advanced;
 };
 

@@ -4,11 +4,8 @@
 // (the measurements behind them) is in docs/notes/interior_point_tuning.md. One struct: the
 // constants once, and where the two problems the interior point solves (fixed h, free time) take
 // different values of one idea, two named profiles of InteriorPointProfile. A user sets them as
-// SolverOptions::advanced (problem.hpp); validateAdvancedParameters bounds every field.
+// SolverOptions::advanced.interior_point (advanced_parameters.hpp), which bounds every field.
 #pragma once
-
-#include <string>
-#include <vector>
 
 namespace attitude_planner {
 
@@ -242,35 +239,5 @@ struct InteriorPointParameters {
   /// N of a level ÷ N of the next coarser one.
   int coarsening_factor = 4;
 };
-
-/// The tuning a user may set beside the solver options (SolverOptions::advanced): every field
-/// has a default that is the planner's own, and bounds validateAdvancedParameters checks.
-struct AdvancedParameters {
-  InteriorPointParameters interior_point;  ///< "interior_point.<field>" in the table below
-};
-
-/// One settable field of AdvancedParameters: its name ("interior_point.armijo",
-/// "interior_point.free_time.theta_mu") and the range it must lie in (a finite number; an
-/// integer where `integer`; an infinite bound is no bound).
-struct AdvancedField {
-  std::string name;
-  double lower = 0.0;
-  double upper = 0.0;
-  bool lower_open = false;  ///< the value must exceed `lower` (else be at least it)
-  bool upper_open = false;  ///< the value must stay below `upper` (else at most it)
-  bool integer = false;
-  double value = 0.0;  ///< its value in the AdvancedParameters listed
-};
-
-/// Every field of `parameters`, in the struct's order, with its range and value.
-std::vector<AdvancedField> advancedFields(const AdvancedParameters& parameters);
-
-/// Throws InvalidInput naming the field and the value ("advanced.interior_point.armijo: must be
-/// in (0, 0.5), got 0.7") unless every field of `parameters` lies in its range.
-void validateAdvancedParameters(const AdvancedParameters& parameters);
-
-/// Sets the field `name` (as advancedFields names it) to `value`, checked against its range:
-/// throws InvalidInput naming an unknown field (with the known ones) or a value out of range.
-void setAdvancedParameter(AdvancedParameters* parameters, const std::string& name, double value);
 
 }  // namespace attitude_planner

@@ -21,8 +21,8 @@
 #include "attitude_planner/input_rules.hpp"
 #include "attitude_planner/name_table.hpp"
 #include "attitude_planner/planning/accuracy_target.hpp"
+#include "attitude_planner/planning/advanced_parameters.hpp"
 #include "attitude_planner/planning/constraints.hpp"
-#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/reaction_wheels.hpp"
 
 namespace attitude_planner {
@@ -296,7 +296,11 @@ struct IterationInfo {
   AttemptTag attempt;   ///< which attempt iterated (filled by SolveContext::reportIteration)
 };
 
-/// Solver settings. Defaults solve to round-off on the seed's examples.
+/// Solver settings. Defaults solve to round-off on the seed's examples. (The pragmas keep the
+/// compiler from reporting the deprecated fields where the options are built or copied by the
+/// implicit constructors; a user's own read or write of one is still reported.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 struct SolverOptions {
   SolverKind solver = SolverKind::Structured;
   double tolerance = 1e-10;  ///< relative torque accuracy (Newton decrement / |τ|₂)
@@ -315,20 +319,18 @@ struct SolverOptions {
   const Maneuver* warm_start = nullptr;
   /// The arithmetic of the interior point's Newton system; `auto` chooses by N.
   Precision precision = Precision::Auto;
-  /// With node constraints and a warm start: start the interior point from the warm start itself
-  /// instead of from the unconstrained optimum (the minimum-time search, whose last feasible plan
-  /// is far closer to the next one than the unconstrained optimum is).
-  bool constrained_from_warm_start = false;
-  /// With constrained_from_warm_start: the warm start meets every constraint with room (a plan at
-  /// T* time-scaled to a longer T), so the interior point takes a request's own recipe (free
-  /// slacks, Mehrotra) rather than the probes' (elastic form first, LOQO's barrier), which is
-  /// for starts that may be infeasible (interior_point_solver.cpp).
-  bool warm_start_strictly_inside = false;
-  /// With node constraints and no warm start: the request's unconstrained optimum, already
-  /// solved on its grid in its class (the class survey's plan, drivers/constrained_classes.cpp).
-  /// Newton polishes it (an iteration or two) instead of solving the class again through the
-  /// grids, and it starts the interior point as that solve would. Null, or another N: none.
-  const Maneuver* unconstrained_optimum = nullptr;
+  /// Deprecated (the planner's drivers hand it to their solvers as part of the start, not through
+  /// the user's options; still honoured for one release): with node constraints and a warm start,
+  /// start the interior point from the warm start itself instead of from its unconstrained
+  /// optimum.
+  [[deprecated("a driver's start, not a user's option")]] bool constrained_from_warm_start = false;
+  /// Deprecated with constrained_from_warm_start: the warm start meets every constraint with room
+  /// (a plan at T* time-scaled to a longer T), so the interior point takes a request's own recipe.
+  [[deprecated("a driver's start, not a user's option")]] bool warm_start_strictly_inside = false;
+  /// Deprecated with constrained_from_warm_start: with node constraints and no warm start, the
+  /// request's unconstrained optimum already solved on its grid in its class.
+  [[deprecated("a driver's start, not a user's option")]] const Maneuver* unconstrained_optimum =
+      nullptr;
   /// A request that leaves its homotopy class free (direction shortest, no extra revolutions, no
   /// warm start) is solved in every class of the class survey and the cheapest plan kept
   /// (newton_solver.cpp); false: in the nearest lift's class only, as a named class is.
@@ -338,10 +340,11 @@ struct SolverOptions {
   /// after the other. The answer does not depend on it beyond the order minimum time's watch sees
   /// its starts (drivers/minimum_time_free_time).
   int threads = 0;
-  /// The solvers' tuning (interior_point_parameters.hpp): the planner's defaults unless set;
+  /// The solvers' tuning (advanced_parameters.hpp): the planner's defaults unless set;
   /// validateOptions checks every field's range.
   AdvancedParameters advanced;
 };
+#pragma GCC diagnostic pop
 
 /// The request asks for the default homotopy class (shortest way, no extra turns) from no guess
 /// of its own: only then are the classes enumerated (unless the caller pins the nearest), by

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
 #include "planning/drivers/requests.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -32,11 +32,15 @@ struct SurveyedClasses {
   std::vector<HomotopyClass> classes;
   std::vector<double> costs;  ///< each class's survey cost (NaN: not surveyed on that grid)
   int steps = 0;
+  /// The survey's refine margin (NewtonParameters::class_refine_margin: coarse costs reorder on
+  /// refinement within it).
+  double refine_margin = 0.0;
 };
 
 SurveyedClasses surveyedClasses(const ExtremalSummary& survey, const HomotopyClass& first_class,
-                                int requested_steps) {
-  SurveyedClasses out{{first_class}, {std::numeric_limits<double>::quiet_NaN()}, requested_steps};
+                                int requested_steps, double refine_margin) {
+  SurveyedClasses out{
+      {first_class}, {std::numeric_limits<double>::quiet_NaN()}, requested_steps, refine_margin};
   for (const Attempt& a : survey.others) {
     if (a.stage == AttemptStage::ClassSurvey) out.steps = std::min(out.steps, a.steps);
   }
@@ -143,7 +147,7 @@ struct ClassStart {
 /// at `first_recorded`).
 class ClassSearch {
  public:
-  ClassSearch(const PlanningProblem& problem, const SolverOptions& options, SolveContext& context,
+  ClassSearch(const PlanningProblem& problem, const SolveRequest& options, SolveContext& context,
               const std::vector<ClassPlan>& survey_plans, const HomotopyClass& first_class,
               PlanResult first, std::size_t first_recorded)
       : problem_(problem),
@@ -170,13 +174,13 @@ class ClassSearch {
   PlanResult solveProblem(const PlanningProblem& problem, const HomotopyClass& homotopy, int steps,
                           const ClassStart& start) {
     PlanResult r;
-    SolverOptions options = options_;
-    options.unconstrained_optimum = start.unconstrained_optimum;
+    SolveRequest options = options_;
+    options.start.unconstrained_optimum = start.unconstrained_optimum;
     if (!start.unconstrained_optimum && !start.constrained_plan) {
-      options.unconstrained_optimum = surveyPlan(homotopy, steps);
+      options.start.unconstrained_optimum = surveyPlan(homotopy, steps);
     }
     options.warm_start = start.constrained_plan;
-    options.constrained_from_warm_start = start.constrained_plan != nullptr;
+    options.start.from_constrained_plan = start.constrained_plan != nullptr;
     const std::size_t before = context_.attempts().size();
     r = inClass(homotopy, [&] {
       return planAtResolution(pinnedTo(problem, homotopy, steps), options, context_);
@@ -199,7 +203,7 @@ class ClassSearch {
   /// plan of it (the constraints ignored, as the unconstrained solve ignores them).
   PlanResult unconstrainedOptimum(const HomotopyClass& homotopy, int steps) {
     const PlanningProblem pinned = pinnedTo(problem_, homotopy, steps);
-    SolverOptions options = options_;
+    SolveRequest options = options_;
     Maneuver guess;
     if (const Maneuver* surveyed = finestSurveyPlan(homotopy)) {
       guess = initialGuessOnGrid(*surveyed, pinned);
@@ -345,7 +349,7 @@ class ClassSearch {
   }
 
   const PlanningProblem& problem_;
-  SolverOptions options_;
+  SolveRequest options_;
   SolveContext& context_;
   const std::vector<ClassPlan>& survey_plans_;
   std::size_t first_recorded_;
@@ -415,10 +419,9 @@ std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const Survey
   return solved;
 }
 
-/// Whether a cost ratio is within the class survey's refine margin (NewtonParameters::
-/// class_refine_margin: coarse costs reorder on refinement within it). NaN: not within.
-bool withinSurveyMargin(double ratio) {
-  return ratio <= 1 + newtonDefaults().class_refine_margin;
+/// Whether a cost ratio is within the class survey's refine margin. NaN: not within.
+bool withinSurveyMargin(const SurveyedClasses& surveyed, double ratio) {
+  return ratio <= 1 + surveyed.refine_margin;
 }
 
 /// Where the first class converged at a cost the constraints raised beyond the survey's margin
@@ -451,7 +454,7 @@ bool couldBeatOnTheSurvey(const SurveyedClasses& surveyed, std::size_t i, double
   const double own = surveyed.costs[i];
   const double first = surveyed.costs.front();
   if (std::isnan(own) || std::isnan(first) || !std::isfinite(rise)) return true;
-  return withinSurveyMargin(own / (first * rise));
+  return withinSurveyMargin(surveyed, own / (first * rise));
 }
 
 /// Once a plan is in hand, every other surveyed class whose unconstrained optimum on the
@@ -474,7 +477,7 @@ void solveClassesThatCouldBeatIt(ClassSearch& search, const SurveyedClasses& sur
 
 }  // namespace
 
-PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolveRequest& options,
                                     SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first,
                                     double unconstrained_cost, std::size_t first_recorded) {
@@ -484,7 +487,8 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   // bounded minimum effort at 1.02 T*: 110 -> 3,087 iterations for the same plan).
   if (first.converged() && !conesOnly(problem)) return first;
   const HomotopyClass first_class = survey.known ? survey.homotopy : homotopyClassOf(problem);
-  const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps);
+  const SurveyedClasses surveyed = surveyedClasses(survey, first_class, problem.steps,
+                                                   options.advanced.newton.class_refine_margin);
   const bool alone = surveyed.classes.size() < 2;
   if (alone && (surveyed.steps >= problem.steps || !conesOnly(problem))) return first;
   const std::vector<MessageClause> first_said = first.clauses;
@@ -495,7 +499,8 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const Solver
   std::vector<HomotopyClass> solved{first_class};
   // How much the constraints raised the first class's cost from its unconstrained optimum.
   const double first_rise = first_cost / unconstrained_cost;
-  if (first_converged && surveyed.steps < problem.steps && !withinSurveyMargin(first_rise)) {
+  if (first_converged && surveyed.steps < problem.steps &&
+      !withinSurveyMargin(surveyed, first_rise)) {
     retryFromItsCoarsePlan(search, first_class, first_cost, surveyed.steps, problem.steps);
   } else if (!first_converged) {
     const std::vector<HomotopyClass> carried =

@@ -37,8 +37,8 @@ constexpr double kBetweenNodesSlack = 1e-3;
 /// context's from `first_recorded` (where `first`'s began), the best plan's attempt kept. `first`
 /// is returned as it is when the survey solved no other class. A class with a plan in
 /// `survey_plans` (solveWithNewton's) on the grid of its solve starts from it: its unconstrained
-/// Newton solve is not run again (SolverOptions::unconstrained_optimum).
-PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolverOptions& options,
+/// Newton solve is not run again (StartSpec::unconstrained_optimum).
+PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolveRequest& options,
                                     SolveContext& context, const ExtremalSummary& survey,
                                     const std::vector<ClassPlan>& survey_plans, PlanResult first,
                                     double unconstrained_cost, std::size_t first_recorded);

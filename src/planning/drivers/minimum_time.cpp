@@ -69,17 +69,17 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
 /// T*): slower than the bang–bang plan, every node constraint is met with room (torques scale
 /// like (T*/T)², rates like T*/T for rest-to-rest motions), so the interior point starts
 /// strictly inside instead of from the unconstrained optimum, with a request's own recipe
-/// (SolverOptions::warm_start_strictly_inside).
+/// (StartSpec::strictly_inside).
 PlanResult planFromMinimumTimePlan(const PlanningProblem& problem, double T,
                                    const Maneuver& at_minimum_time, SolveContext& context) {
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
   effort.duration = T;
-  SolverOptions o = context.options();
+  SolveRequest o(context.options());
   o.warm_start = &at_minimum_time;
-  o.constrained_from_warm_start = true;
-  o.warm_start_strictly_inside = true;
+  o.start.from_constrained_plan = true;
+  o.start.strictly_inside = true;
   return planAtResolution(effort, o, context);
 }
 
@@ -313,12 +313,12 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     effort.objective = Objective::MinimumEffort;
     effort.time_margin = 0.0;
     effort.duration = std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor);
-    SolverOptions options = context.options();
+    SolveRequest options(context.options());
     const bool from_iterate = lower_plan && handed_on < kMaxProbes;
     if (from_iterate) {  // the probe at the iterate's T, from it
       effort.duration = lower_plan->time_step * lower_plan->steps();
       options.warm_start = &*lower_plan;
-      options.constrained_from_warm_start = true;
+      options.start.from_constrained_plan = true;
       ++handed_on;
       --probe;
     }
@@ -683,7 +683,7 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   if (std::optional<PlanResult> answer = answerBeforeSolving(problem, bound)) return *answer;
   const auto start = std::chrono::steady_clock::now();
   const std::size_t first = context.attempts().size();
-  PlanResult result = planAtResolution(problem, context.options(), context);
+  PlanResult result = planAtResolution(problem, SolveRequest(context.options()), context);
   const std::optional<std::size_t> first_kept = keptSince(context, first);
   const NoRoomBeforeTheEnd no_room = noRoomBeforeTheEnd(problem);
   recordLowerBound(bound, &result);

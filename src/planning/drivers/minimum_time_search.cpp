@@ -108,10 +108,10 @@ class MinimumTimeSearch {
     effort_.duration = T;
     const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeProbe,
                                     homotopyClassOf(effort_));
-    SolverOptions o = context_.options();
+    SolveRequest o(context_.options());
     if (warm) {
       o.warm_start = warm;
-      o.constrained_from_warm_start = true;
+      o.start.from_constrained_plan = true;
     }
     PlanResult r;
     try {

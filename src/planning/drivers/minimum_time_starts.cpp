@@ -103,7 +103,7 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at, cons
     // cancel flag stop it (then it gives no start). Its attempts stay out of the answer's trail.
     const SolveContext::Aside start_only(context);
     const SolveContext::Scope scope(context, AttemptStage::MinimumTimeSolve, c);
-    const PlanResult r = solveWithNewton(in_class, options, context);
+    const PlanResult r = solveWithNewton(in_class, SolveRequest(options), context);
     if (r.converged()) return r.maneuver.attitude;
   } catch (const StepTooLarge& e) {  // no boundary step at the guess's h
   }
@@ -406,18 +406,18 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   // A start, not an attempt: its solves stay out of the answer's trail.
   const SolveContext::Aside start_only(context);
   try {
-    SolverOptions o = context.options();
+    SolveRequest o(context.options());
     o.tolerance = std::max(o.tolerance, kConeClearTolerance);
     o.enumerate_classes = false;  // a start keeps its class (the free-time solves compare them)
     ReducedProblem np(effort);
     np.setInteriorFromAttitudes(attitudes);
     const Maneuver guess = np.maneuver(np.current());
     o.warm_start = &guess;
-    o.constrained_from_warm_start = true;
+    o.start.from_constrained_plan = true;
     PlanResult r = planAtResolution(effort, o, context);
     if (!r.converged()) {
       o.warm_start = nullptr;
-      o.constrained_from_warm_start = false;
+      o.start.from_constrained_plan = false;
       r = planAtResolution(effort, o, context);
     }
     if (r.converged()) return r.maneuver.attitude;

@@ -64,7 +64,7 @@ void requireSchemeSupported(const PlanningProblem& problem, const SolverOptions&
 /// result converges only if both do; its trail is the N solve's attempts (stage
 /// fourth_order_coarse where they were the solver's own solve), then the 2N solve's
 /// (fourth_order_fine), the 2N solve's kept one kept (the N solve's if it stopped).
-PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult planFourthOrder(const PlanningProblem& problem, const SolveRequest& options,
                            SolveContext& context) {
   const int N = problem.steps;
   PlanningProblem sub = problem;
@@ -80,9 +80,9 @@ PlanResult planFourthOrder(const PlanningProblem& problem, const SolverOptions& 
   };
   if (!coarse.converged()) return failed(coarse, N);
   sub.steps = 2 * N;
-  SolverOptions fine_options = options;
+  SolveRequest fine_options = options;
   fine_options.warm_start = nullptr;
-  fine_options.constrained_from_warm_start = false;
+  fine_options.start.from_constrained_plan = false;
   if (coarse.extremal_summary.known) {
     // Richardson combines two solutions of one extremal: the 2N solve in the class the N solve
     // chose (a class left free is enumerated once, at N).
@@ -130,14 +130,14 @@ void refuseAnotherClass(const PlanningProblem& problem, PlanResult* result) {
 /// it meets every node constraint it is the constrained optimum too; otherwise it starts the
 /// interior point, in its class, and a request that left its class free has the other classes
 /// solved under the constraints too (constrained_classes.hpp), each from its class survey's plan.
-PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult planUnderConstraints(const PlanningProblem& problem, const SolveRequest& options,
                                 SolveContext& context) {
-  // The unconstrained optimum, already solved (SolverOptions::unconstrained_optimum): polished
-  // from it, the Newton attempt named as started from that earlier attempt's plan.
-  SolverOptions newton_options = options;
-  const bool solved_before =
-      options.unconstrained_optimum && options.unconstrained_optimum->steps() == problem.steps;
-  if (solved_before) newton_options.warm_start = options.unconstrained_optimum;
+  // The unconstrained optimum, already solved (StartSpec::unconstrained_optimum): polished from
+  // it, the Newton attempt named as started from that earlier attempt's plan.
+  SolveRequest newton_options = options;
+  const Maneuver* solved = options.start.unconstrained_optimum;
+  const bool solved_before = solved && solved->steps() == problem.steps;
+  if (solved_before) newton_options.warm_start = solved;
   std::vector<ClassPlan> survey_plans;
   const std::size_t first_recorded = context.attempts().size();
   const std::size_t first_level = context.levels().size();
@@ -150,7 +150,7 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
     addNote(&result, notes::ConstraintsInactive{});
     return result;
   }
-  SolverOptions constrained = options;
+  SolveRequest constrained = options;
   const int newton_iterations = result.iterations;
   const notes::UnconstrainedStart started{result.cost, unconstrained.worst,
                                           unconstrained.worst_where, newton_iterations};
@@ -181,17 +181,17 @@ PlanResult planUnderConstraints(const PlanningProblem& problem, const SolverOpti
 
 PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options) {
   SolveContext context(options);
-  return planAtResolution(problem, options, context);
+  return planAtResolution(problem, SolveRequest(options), context);
 }
 
-PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& requested,
+PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& requested,
                             SolveContext& context) {
   validateProblem(problem);
   validateOptions(requested);
   requireSchemeSupported(problem, requested);
   if (schemeIsDiscretization(problem.scheme)) requireBoundarySteps(problem);
   // A guess of another N is resampled to this grid (warm_start.hpp).
-  SolverOptions options = requested;
+  SolveRequest options = requested;
   Maneuver on_grid;
   const bool guess_resampled =
       requested.warm_start && requested.warm_start->steps() != problem.steps;
@@ -210,7 +210,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
   } else if (problem.scheme == SchemeKind::FourthOrder) {
     result = planFourthOrder(problem, options, context);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
-             options.warm_start && !options.constrained_from_warm_start && !guess_resampled) {
+             options.warm_start && !options.start.from_constrained_plan && !guess_resampled) {
     // A plan of this N given as the initial guess (e.g. the remainder of the plan being flown):
     // the interior point from it directly, its multipliers re-derived; if that stops, from it
     // through the usual continuation. A resampled guess (another N) is off the bounds it rode
@@ -228,7 +228,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions&
       addNote(&result, notes::AfterGuessStopped{first.clauses});
     }
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints() &&
-             options.constrained_from_warm_start && options.warm_start) {
+             options.start.from_constrained_plan && options.warm_start) {
     result = solveWithInteriorPoint(problem, options, context);
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
     result = planUnderConstraints(problem, options, context);

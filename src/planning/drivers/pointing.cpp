@@ -7,11 +7,11 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/constrained_system.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/newton/newton_solver.hpp"
 #include "planning/newton/twist_newton.hpp"
 #include "planning/problem/message_notes.hpp"
@@ -99,7 +99,7 @@ std::optional<PlanResult> fixedTwistPlan(const PlanningProblem& at, const Solver
                                          SolveContext& context) {
   PlanningProblem fixed = at;
   fixed.end_condition = EndCondition();
-  PlanResult plan = planAtResolution(fixed, options, context);
+  PlanResult plan = planAtResolution(fixed, SolveRequest(options), context);
   if (!plan.converged() || plan.maneuver.steps() != at.steps) return std::nullopt;
   return plan;
 }
@@ -443,7 +443,7 @@ std::optional<PlanResult> fixedTwistFallback(
     // each, and that phase took a quarter to a third of the request.
     PlanningProblem at = posedAt(problem, problem.steps, unconverged->solve.twist);
     at.end_condition = EndCondition();
-    const PlanResult plan = planAtResolution(at, context.options(), context);
+    const PlanResult plan = planAtResolution(at, SolveRequest(context.options()), context);
     if (plan.maneuver.steps() == problem.steps) consider(plan, unconverged->solve.reason);
   }
   if (!best) return std::nullopt;
@@ -549,7 +549,7 @@ TwistRun fixedTwistOptimum(const PlanningProblem& problem, double twist, const H
   options.enumerate_classes = false;
   PlanningProblem fixed = posedAt(problem, problem.steps, twist, way);
   fixed.end_condition = EndCondition();
-  const PlanResult plan = solveWithNewton(fixed, options, context);
+  const PlanResult plan = solveWithNewton(fixed, SolveRequest(options), context);
   TwistRun run;
   run.homotopy = way;
   run.start_twist = twist;
@@ -802,12 +802,12 @@ std::vector<TwistRun> constrainedFromTwistOptima(
   return survey;
 }
 
-/// Whether `options` hold a plan on the request's grid strictly inside every bound (a plan at T*
-/// time-scaled to a longer T: SolverOptions::warm_start_strictly_inside), which the interior point
-/// with ψ free starts from (fromPlanInside).
-bool startsInsideOnItsGrid(const PlanningProblem& problem, const SolverOptions& options) {
-  return options.warm_start && options.constrained_from_warm_start &&
-         options.warm_start_strictly_inside && problem.hasNodeConstraints() &&
+/// Whether `request` holds a plan on the request's grid strictly inside every bound (a plan at T*
+/// time-scaled to a longer T: StartSpec::strictly_inside), which the interior point with ψ free
+/// starts from (fromPlanInside).
+bool startsInsideOnItsGrid(const PlanningProblem& problem, const SolveRequest& options) {
+  return options.warm_start && options.start.from_constrained_plan &&
+         options.start.strictly_inside && problem.hasNodeConstraints() &&
          options.warm_start->steps() == problem.steps;
 }
 
@@ -843,7 +843,7 @@ void fromPlanInside(const PlanningProblem& problem, const Maneuver& plan, SolveC
 
 }  // namespace
 
-PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult planPointing(const PlanningProblem& problem, const SolveRequest& options,
                         SolveContext& context) {
   if (options.solver != SolverKind::Structured) {
     throw InvalidInput("solver: " + solverName(options.solver) +
@@ -853,11 +853,10 @@ PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& opt
   if (options.warm_start && !startsInsideOnItsGrid(problem, options)) {
     throw InvalidInput("final.pointing: not supported with a warm start (initial_guess) yet");
   }
-  SolverOptions cold = options;  // the starts' own solves take no warm start
+  SolverOptions cold = options;  // the starts' own solves take no warm start (nor its start)
   cold.warm_start = nullptr;
-  cold.constrained_from_warm_start = cold.warm_start_strictly_inside = false;
   const SolveContext::Call call(context, cold);
-  const NewtonParameters& p = newtonDefaults();
+  const NewtonParameters& p = options.advanced.newton;
   const std::size_t first_recorded = context.attempts().size();
   const int counted_at_start = context.iterations();
   std::vector<std::pair<TwistRun, std::size_t>> finals;  // on the requested grid, trail index

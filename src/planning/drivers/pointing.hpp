@@ -8,6 +8,7 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "planning/problem/solve_request.hpp"
 
 namespace attitude_planner {
 
@@ -34,7 +35,7 @@ constexpr double kPointingRidgeDepth = 0.85;
 /// survey's margin of the cheapest carried to the requested grid through factor-4 levels, the
 /// cheapest converged plan kept. Every start and refinement is an attempt in the trail (its start
 /// twist in start_detail.twist). Throws InvalidInput for a solver or warm start it cannot serve.
-PlanResult planPointing(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult planPointing(const PlanningProblem& problem, const SolveRequest& options,
                         SolveContext& context);
 
 }  // namespace attitude_planner

@@ -7,11 +7,13 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "planning/problem/solve_request.hpp"
 
 namespace attitude_planner {
 
-/// planAtResolution (plan_at_resolution.hpp) with `options` for this solve, in `context`.
-PlanResult planAtResolution(const PlanningProblem& problem, const SolverOptions& options,
+/// planAtResolution (plan_at_resolution.hpp) with `request` for this solve (the user's options
+/// and where it starts), in `context`.
+PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& request,
                             SolveContext& context);
 
 /// planMinimumTime (minimum_time.hpp) with the request's options, context.options().

@@ -91,9 +91,9 @@ constexpr FormulationRecipe kRequestRecipe = {
     {Formulation::Elastic, BarrierRule::Loqo, "the elastic form"},
 };
 /// The minimum-time search's feasibility probes (started from its last feasible plan,
-/// SolverOptions::constrained_from_warm_start): the elastic form first (an infeasible probe then
+/// StartSpec::from_constrained_plan): the elastic form first (an infeasible probe then
 /// pays one form), the free slacks with a monotone barrier as the retry. Not for a start strictly
-/// inside every bound (SolverOptions::warm_start_strictly_inside: the plan at T* time-scaled to
+/// inside every bound (StartSpec::strictly_inside: the plan at T* time-scaled to
 /// (1 + m) T*), which takes kRequestRecipe: from such a well-centred start LOQO's σ = 0.1 (0.05
 /// (1 − ξ)/ξ)³ is ~1e-8 (ξ ≈ 0.9), μ fell from 0.43 to 6e-9 (× f/m) in one step with the
 /// decrement still 0.1, and the elastic solve crawled with steps cut to 1/64 … 1/128 to the
@@ -121,13 +121,13 @@ struct Solve {
 /// first's is not (an "infeasible" or an iterate outside a bound is no answer beside a plan),
 /// else the first solve's reason; every solve's iterations are kept and its levels recorded in
 /// the context as it ends.
-GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolverOptions& options,
+GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolveRequest& options,
                                const Solve& solve, const ReducedProblem::StepVectors* coarse_steps,
                                const LevelDuals* coarse_duals, bool final_grid = true,
                                const FeasibleIterateWatch* watch = nullptr) {
   const FormulationRecipe& recipe =
-      options.constrained_from_warm_start && !options.warm_start_strictly_inside ? kProbeRecipe
-                                                                                 : kRequestRecipe;
+      options.start.from_constrained_plan && !options.start.strictly_inside ? kProbeRecipe
+                                                                            : kRequestRecipe;
   const SolveContext::IterationTally tally(solve.context);  // both solves'
   GridOutcome first = solveOnGrid(problem, options, solve.parameters, solve.context,
                                   {recipe.first.formulation, recipe.first.barrier, coarse_steps,
@@ -185,7 +185,7 @@ GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
 /// The coarsest level starts from its own unconstrained optimum; Newton reaches it from the warm
 /// start (the requested grid's unconstrained optimum) resampled, instead of repeating the grid
 /// continuation that found the warm start. A warm start that is to start the interior point itself
-/// (SolverOptions::constrained_from_warm_start) starts the level resampled where the problem has
+/// (StartSpec::from_constrained_plan) starts the level resampled where the problem has
 /// cones: only a cone has sides that the level's unconstrained optimum could drop. Under torque and
 /// rate bounds alone the warm start resampled starts Newton on the level, as an unconstrained warm
 /// start does (measured on the bounded suite's seed-45 #33, N = 540 under a torque box: with every
@@ -193,12 +193,12 @@ GridLevelRule interiorPointGridRule(const InteriorPointParameters& parameters) {
 /// elsewhere and T* rose from 59.62 s to 64.62 s, above the requested 61.38 s). Sets
 /// level_options->warm_start to null.
 PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProblem& at,
-                              const SolverOptions& options, SolveContext& context,
-                              SolverOptions* level_options, Maneuver* resampled) {
+                              const SolveRequest& options, SolveContext& context,
+                              SolveRequest* level_options, Maneuver* resampled) {
   if (options.warm_start && options.warm_start->steps() == problem.steps) {
     resampled->attitude = resampleAttitudes(*options.warm_start, at.steps);
     level_options->warm_start = resampled;
-    if (options.constrained_from_warm_start && problem.hasCones()) {
+    if (options.start.from_constrained_plan && problem.hasCones()) {
       // A plan under the constraints starts the level itself: its unconstrained optimum would
       // drop which side of each cone the plan passes.
       PlanResult start;
@@ -216,12 +216,11 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
 /// once more through the level in between. Replaces *direct if that converges (the level's tally
 /// counts every solve's iterations, the context records their levels).
-void refineThroughMiddle(const PlanningProblem& at, const SolverOptions& options,
-                         const Solve& solve, const ReducedProblem::StepVectors& coarse,
-                         GridOutcome* direct) {
+void refineThroughMiddle(const PlanningProblem& at, const SolveRequest& options, const Solve& solve,
+                         const ReducedProblem::StepVectors& coarse, GridOutcome* direct) {
   PlanningProblem half = at;
   half.steps = at.steps / 2;
-  SolverOptions from_coarse = options;
+  SolveRequest from_coarse = options;
   from_coarse.warm_start = nullptr;  // both start from the coarse steps
   const GridOutcome middle =
       solveGridWithRetry(half, from_coarse, solve, &coarse, nullptr, /*final_grid=*/false);
@@ -246,7 +245,7 @@ std::vector<MessageClause> onLevel(const ContinuationStop& stop) {
 /// accepted iterate goes to the requested N at once. Infeasible: each finer level evaluates
 /// the carried iterate without iterating and reports the coarse level's certificate. Its last
 /// level recorded ends as the stop did.
-GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& options,
+GridOutcome replayLevel(const PlanningProblem& problem, const SolveRequest& options,
                         const Solve& solve, const LevelRequest<LevelIterate>& r) {
   const ContinuationStop& stop = *r.stop;
   const SolveContext::IterationTally tally(solve.context);  // the start's and the level's
@@ -265,7 +264,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
     endsAsTheStop();
     return outcome;
   }
-  SolverOptions level_options = options;
+  SolveRequest level_options = options;
   level_options.warm_start = nullptr;
   level_options.max_iterations = 0;
   PlanResult start;
@@ -286,10 +285,10 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
 /// One level of the continuation: from the coarser level's iterate and duals, else from its own
 /// unconstrained optimum; a 4× refinement that stops is tried once more through the level in
 /// between. The result carries every solve's iterations (the context records their levels).
-GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& options,
+GridOutcome solveLevel(const PlanningProblem& problem, const SolveRequest& options,
                        const Solve& solve, const LevelRequest<LevelIterate>& r) {
   if (r.replay_only) return replayLevel(problem, options, solve, r);
-  SolverOptions level_options = options;
+  SolveRequest level_options = options;
   level_options.warm_start = nullptr;
   level_options.tolerance = r.tolerance;
   const SolveContext::IterationTally tally(solve.context);  // the iterations of every solve on it
@@ -336,8 +335,8 @@ void finishContinuation(const ContinuationRecord& record, PlanResult* result) {
 
 /// A warm start on the requested grid strictly inside every bound (the time-scaled T* plan):
 /// the requested grid's own start, which a coarser level's (its unconstrained optimum) is not.
-bool startsInsideOnThisGrid(const PlanningProblem& problem, const SolverOptions& options) {
-  return options.constrained_from_warm_start && options.warm_start_strictly_inside &&
+bool startsInsideOnThisGrid(const PlanningProblem& problem, const SolveRequest& options) {
+  return options.start.from_constrained_plan && options.start.strictly_inside &&
          options.warm_start && options.warm_start->steps() == problem.steps;
 }
 
@@ -346,7 +345,7 @@ bool startsInsideOnThisGrid(const PlanningProblem& problem, const SolverOptions&
 /// inside on this grid: the continuation's coarsest level starts from its unconstrained optimum,
 /// not from that plan (Bilimoria–Wie at 1.02 T*, N = 512 and 1024: "infeasible" on the N = 128
 /// level, 0.43 beyond |τ_z| ≤ 1; from the plan, converged).
-GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& options,
+GridOutcome solveContinued(const PlanningProblem& problem, const SolveRequest& options,
                            const Solve& solve) {
   const GridLevelRule rule = interiorPointGridRule(solve.parameters);
   if (!usesCoarserLevel(problem, rule) || startsInsideOnThisGrid(problem, options)) {
@@ -373,9 +372,9 @@ GridOutcome solveContinued(const PlanningProblem& problem, const SolverOptions& 
 }
 
 /// Where the interior point's iterate starts (for the trail).
-AttemptStart startOf(const SolverOptions& options) {
+AttemptStart startOf(const SolveRequest& options) {
   if (!options.warm_start) return AttemptStart::Hermite;
-  return options.constrained_from_warm_start ? AttemptStart::PreviousAttempt
+  return options.start.from_constrained_plan ? AttemptStart::PreviousAttempt
                                              : AttemptStart::UnconstrainedOptimum;
 }
 
@@ -396,9 +395,8 @@ Attempt attemptOf(const PlanningProblem& problem, const GridOutcome& outcome, At
 
 /// Runs one continuation and records it in the context as one attempt (not kept); the levels'
 /// unconstrained starts are parts of it. Returns its index in the context's trail.
-GridOutcome attempt(const PlanningProblem& problem, const SolverOptions& options,
-                    const Solve& solve, AttemptStage stage, AttemptStart start,
-                    std::size_t* recorded_at) {
+GridOutcome attempt(const PlanningProblem& problem, const SolveRequest& options, const Solve& solve,
+                    AttemptStage stage, AttemptStart start, std::size_t* recorded_at) {
   GridOutcome outcome = [&] {
     const SolveContext::Aside parts(solve.context);
     const SolveContext::Scope scope(solve.context, stage, homotopyClassOf(problem));
@@ -426,7 +424,7 @@ void keepAttempt(SolveContext& context, const Begun& begun, std::size_t kept, Pl
 
 }  // namespace
 
-PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
+PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolveRequest& options,
                                   SolveContext& context) {
   const Solve solve{options.advanced.interior_point, context};
   const Begun begun(context);
@@ -461,7 +459,7 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
     keepAttempt(context, begun, at, &result);
     return result;
   }
-  SolverOptions staged = options;
+  SolveRequest staged = options;
   staged.warm_start = &around.maneuver;
   std::size_t second_at = at;
   PlanResult second = attempt(problem, staged, solve, AttemptStage::ConstrainedRetry,
@@ -483,9 +481,9 @@ GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const Solve
                                      const ReducedProblem::StepVectors* start_steps,
                                      const LevelDuals* start_duals,
                                      const FeasibleIterateWatch* watch) {
-  SolverOptions from = options;
+  SolveRequest from(options);
   from.warm_start = nullptr;  // the start is start_steps
-  from.constrained_from_warm_start = false;
+  from.start.from_constrained_plan = false;
   const std::size_t first_level = context.levels().size();
   GridOutcome outcome =
       solveGridWithRetry(problem, from, {options.advanced.interior_point, context}, start_steps,
@@ -495,7 +493,7 @@ GridOutcome solveInteriorPointOnGrid(const PlanningProblem& problem, const Solve
 }
 
 PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
-                                           const SolverOptions& options, SolveContext& context) {
+                                           const SolveRequest& options, SolveContext& context) {
   // The guess (a plan of this N, e.g. the remainder of the plan being flown) starts the
   // requested grid directly, as a converged coarser level starts a finer one: its steps, its
   // multipliers re-derived from stationarity (the guess carries none) and a small barrier.
@@ -511,9 +509,9 @@ PlanResult solveWithInteriorPointFromGuess(const PlanningProblem& problem,
     return solveWithInteriorPoint(problem, options, context);  // reports it
   }
   const Solve solve{options.advanced.interior_point, context};
-  SolverOptions from = options;
+  SolveRequest from = options;
   from.warm_start = nullptr;  // the guess's steps start the grid
-  from.constrained_from_warm_start = false;
+  from.start.from_constrained_plan = false;
   const Begun begun(context);
   GridOutcome outcome = solveGridWithRetry(problem, from, solve, &steps, &duals);
   PlanResult result = std::move(outcome.result);

@@ -37,6 +37,9 @@ double augmentedShiftScale(const ReducedProblem& np) {
 /// The augmented system's block positions: the torques k = first − 1 .. last + 1, each followed
 /// by δ_k if R_k is free.
 struct AugmentedLayout {
+  /// Half bandwidth in scalar rows: a stencil's S couples δ_{k−1} with δ_{k+1}, four blocks
+  /// apart in the order y, δ alternating; with 3 × 3 blocks that is 3·4 + 2 = 14 rows.
+  static constexpr int kHalfBandwidth = 14;
   int first, last;
   int y(int k) const { return k < first ? 0 : 2 * (k - first) + 1; }
   int d(int j) const { return 2 * (j - first) + 2; }
@@ -285,7 +288,8 @@ class GridSolver {
   bool newtonStep(double shift, double shift_scale) {
     delta_ = -gradient_;
     if (augmented_) {
-      return solveAugmented(np_, shift, p_.augmented_bandwidth, context_, &delta_, &workspace_) &&
+      return solveAugmented(np_, shift, AugmentedLayout::kHalfBandwidth, context_, &delta_,
+                            &workspace_) &&
              gradient_.dot(delta_) < 0;
     }
     BandedSymmetricMatrix shifted = hessian_;

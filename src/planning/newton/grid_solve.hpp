@@ -6,7 +6,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
-#include "planning/newton/newton_parameters.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/step_control.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"

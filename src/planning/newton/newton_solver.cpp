@@ -17,8 +17,8 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/grid_solve.hpp"
-#include "planning/newton/newton_parameters.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/strategies/staged_continuation.hpp"
@@ -678,7 +678,7 @@ AttemptStart startOf(Method method, const PlanningProblem& problem, const Newton
 
 /// The request's own class through the grids (from its warm start if given).
 void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, Walk* walk,
-                         const NewtonParameters& p) {
+                         const NewtonParameters& p, const Maneuver* solved_before) {
   const SolverOptions& options = context.options();
   const GridSettings settings{options.tolerance, options.max_iterations,
                               Globalization::TrustRegion};
@@ -687,9 +687,8 @@ void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, 
   // A warm start that is the request's unconstrained optimum solved before (a class solve's
   // polish) is an earlier attempt's plan.
   const AttemptStart start = !options.warm_start ? startOf(Method::ThroughGrids, problem, p)
-                             : options.warm_start == options.unconstrained_optimum
-                                 ? AttemptStart::PreviousAttempt
-                                 : AttemptStart::WarmStart;
+                             : options.warm_start == solved_before ? AttemptStart::PreviousAttempt
+                                                                   : AttemptStart::WarmStart;
   const int iterations = r.iterations;
   walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations);
 }
@@ -744,11 +743,11 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
   return np.current();
 }
 
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& call_options,
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
                            SolveContext& context, std::vector<ClassPlan>* survey_plans) {
-  const SolveContext::Call call(context, call_options);
-  const NewtonParameters& p = newtonDefaults();
+  const SolveContext::Call call(context, request);
   const SolverOptions& options = context.options();
+  const NewtonParameters& p = options.advanced.newton;
   Walk walk(problem, context, p);
   if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
   // The request's own class when it names one or is warm-started; after the class survey, when
@@ -756,7 +755,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& 
   const bool converged = walk.kept() && walk.kept()->converged();
   const bool request_solved = walk.solvedOnRequestedGrid(homotopyClassOf(problem));
   if (!walk.kept() || (!converged && !request_solved && !context.stopReason())) {
-    solveRequestedClass(problem, context, &walk, p);
+    solveRequestedClass(problem, context, &walk, p, request.start.unconstrained_optimum);
   }
   const auto run = [&](const RecipeEntry& entry, const PlanningProblem& in) {
     const SolveContext::Scope scope(context, entry.stage, homotopyClassOf(in));

@@ -8,6 +8,7 @@
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "planning/problem/solve_request.hpp"
 
 namespace attitude_planner {
 
@@ -19,13 +20,14 @@ struct ClassPlan {
 
 /// Newton's method on the first-order optimality conditions, O(N) per iteration, every attempt
 /// of the recipe in `context` (its deadline, cancel flag, iteration numbering; each attempt is
-/// recorded in its trail, the kept one marked), with the solve's own `options` (warm start,
-/// tolerance, class policy: SolveContext::Call). Fills everything but solve_time_s; `attempts`
-/// is this solve's part of the context's trail. `survey_plans` (optional) receives the class
-/// survey's converged plans (a request that leaves its class free): each class on the survey grid,
-/// and those refined on the requested grid there too; they start the constrained class search
-/// (drivers/constrained_classes.hpp) instead of solving each class again.
-PlanResult solveWithNewton(const PlanningProblem& problem, const SolverOptions& options,
+/// recorded in its trail, the kept one marked), with the solve's own `request` (warm start,
+/// tolerance, class policy: SolveContext::Call; a warm start that is the request's
+/// start.unconstrained_optimum is named an earlier attempt's plan). Fills everything but
+/// solve_time_s; `attempts` is this solve's part of the context's trail. `survey_plans` (optional)
+/// receives the class survey's converged plans (a request that leaves its class free): each class
+/// on the survey grid, and those refined on the requested grid there too; they start the
+/// constrained class search (drivers/constrained_classes.hpp) instead of solving each class again.
+PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
                            SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr);
 
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the

@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "attitude_planner/planning/result.hpp"
-#include "planning/newton/newton_parameters.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {

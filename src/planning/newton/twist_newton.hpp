@@ -9,7 +9,7 @@
 #include <string>
 
 #include "attitude_planner/planning/result.hpp"
-#include "planning/newton/newton_parameters.hpp"
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 

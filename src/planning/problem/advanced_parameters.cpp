@@ -1,11 +1,12 @@
-// The advanced parameters' table (interior_point_parameters.hpp): every field once, with the
-// range it must lie in, read by the validation and by the setter of a named field.
+// The advanced parameters' table (advanced_parameters.hpp): every field once, with the range it
+// must lie in, read by the validation and by the setter of a named field.
 #include <cmath>
 #include <limits>
 #include <type_traits>
 
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/planning/interior_point_parameters.hpp"
+#include "attitude_planner/planning/advanced_parameters.hpp"
+#include "attitude_planner/planning/problem.hpp"
 
 namespace attitude_planner {
 
@@ -22,14 +23,18 @@ struct Range {
   bool upper_open;
 };
 
-constexpr Range kPositive{0, kInf, true, false};         // (0, ∞)
-constexpr Range kNonNegative{0, kInf, false, false};     // [0, ∞)
-constexpr Range kOpenUnit{0, 1, true, true};             // (0, 1): a fraction
-constexpr Range kUpToOne{0, 1, true, false};             // (0, 1]
-constexpr Range kBelowOne{0, 1, false, true};            // [0, 1)
-constexpr Range kAboveOne{1, kInf, true, false};         // (1, ∞): a growth factor
-constexpr Range kAtLeastOne{1, kInf, false, false};      // [1, ∞)
-constexpr Range kCount{1, kLargestCount, false, false};  // an integer ≥ 1
+constexpr Range kPositive{0, kInf, true, false};                 // (0, ∞)
+constexpr Range kNonNegative{0, kInf, false, false};             // [0, ∞)
+constexpr Range kOpenUnit{0, 1, true, true};                     // (0, 1): a fraction
+constexpr Range kUpToOne{0, 1, true, false};                     // (0, 1]
+constexpr Range kBelowOne{0, 1, false, true};                    // [0, 1)
+constexpr Range kAboveOne{1, kInf, true, false};                 // (1, ∞): a growth factor
+constexpr Range kAtLeastOne{1, kInf, false, false};              // [1, ∞)
+constexpr Range kCount{1, kLargestCount, false, false};          // an integer ≥ 1
+constexpr Range kCountOrNone{0, kLargestCount, false, false};    // an integer ≥ 0
+constexpr Range kSteps{kMinSteps, kLargestCount, false, false};  // a grid's N
+constexpr Range kArmijo{0, 0.5, true, true};  // (0, ½): a full Newton step passes near the solution
+constexpr Range kCoarsening{2, 64, false, false};  // each coarser level has fewer steps
 
 /// Visits each profile field of `profile` as (name, value, range).
 template <typename Profile, typename Visit>
@@ -43,12 +48,56 @@ void forEachProfileField(const std::string& prefix, Profile& profile, Visit& vis
   visit(prefix + "penalty_growth", profile.penalty_growth, kAboveOne);
 }
 
+/// Visits every Newton field of `p` (NewtonParameters, const or not) in the struct's order.
+template <typename Newton, typename Visit>
+void forEachNewtonField(Newton& p, Visit& visit) {
+  const std::string n = "newton.";
+  visit(n + "normal_equations_max_steps", p.normal_equations_max_steps, kCountOrNone);
+  visit(n + "round_off_acceptance_min", p.round_off_acceptance_min, kOpenUnit);
+  visit(n + "round_off_floor_factor", p.round_off_floor_factor, kPositive);
+  visit(n + "final_step_prediction_margin", p.final_step_prediction_margin, kUpToOne);
+  visit(n + "negligible_decrease", p.negligible_decrease, kBelowOne);
+  visit(n + "stall_decrement_ratio", p.stall_decrement_ratio, kOpenUnit);
+  visit(n + "stall_iterations", p.stall_iterations, kCount);
+  visit(n + "cost_floor", p.cost_floor, kPositive);
+  visit(n + "round_off_report", p.round_off_report, kNonNegative);
+  visit(n + "max_step_attempts", p.max_step_attempts, kCount);
+  visit(n + "smallest_shift", p.smallest_shift, kPositive);
+  visit(n + "negligible_shift", p.negligible_shift, kNonNegative);
+  visit(n + "indefinite_shift_growth", p.indefinite_shift_growth, kAboveOne);
+  visit(n + "first_rejection_shift", p.first_rejection_shift, kPositive);
+  visit(n + "accept_ratio", p.accept_ratio, kOpenUnit);
+  visit(n + "shift_min_factor", p.shift_min_factor, kOpenUnit);
+  visit(n + "initial_shift_growth", p.initial_shift_growth, kAboveOne);
+  visit(n + "shift_growth_growth", p.shift_growth_growth, kAtLeastOne);
+  visit(n + "armijo", p.armijo, kArmijo);
+  visit(n + "max_halvings", p.max_halvings, Range{1, 1074, false, false});
+  visit(n + "backtrack_factor", p.backtrack_factor, kOpenUnit);
+  visit(n + "line_search_shift_carry", p.line_search_shift_carry, kNonNegative);
+  visit(n + "coarsest_steps", p.coarsest_steps, kSteps);
+  visit(n + "coarsening_factor", p.coarsening_factor, kCoarsening);
+  visit(n + "coarse_max_step_angle", p.coarse_max_step_angle, kPositive);
+  visit(n + "coarse_tolerance_floor", p.coarse_tolerance_floor, kOpenUnit);
+  visit(n + "class_survey_min_steps", p.class_survey_min_steps, kSteps);
+  visit(n + "class_refine_margin", p.class_refine_margin, kNonNegative);
+  visit(n + "same_extremal_cost", p.same_extremal_cost, kBelowOne);
+  visit(n + "cheaper_tie", p.cheaper_tie, kBelowOne);
+  visit(n + "rate_continuation_max_stages", p.rate_continuation_max_stages, kCount);
+  visit(n + "rate_continuation_first_increment", p.rate_continuation_first_increment, kUpToOne);
+  visit(n + "rate_continuation_max_increment", p.rate_continuation_max_increment, kUpToOne);
+  visit(n + "rate_continuation_min_increment", p.rate_continuation_min_increment, kUpToOne);
+  visit(n + "coasting_iteration_factor", p.coasting_iteration_factor, kCount);
+  visit(n + "inertia_homotopy_stages", p.inertia_homotopy_stages, kCount);
+  visit(n + "more_starts_above_iterations", p.more_starts_above_iterations, kCountOrNone);
+}
+
 /// Visits every field of `a` (AdvancedParameters, const or not) in the struct's order. Ranges:
 /// where the method needs them (a fraction to the boundary in (0, 1), a growth above 1, a count
 /// at least 1, Armijo's constant in (0, ½) so that a Newton step's full length passes near the
-/// solution), else positive.
+/// solution, a grid of at least kMinSteps), else positive.
 template <typename Advanced, typename Visit>
 void forEachField(Advanced& a, Visit&& visit) {
+  forEachNewtonField(a.newton, visit);
   auto& p = a.interior_point;
   const std::string ip = "interior_point.";
   forEachProfileField(ip + "fixed_step.", p.fixed_step, visit);
@@ -81,7 +130,7 @@ void forEachField(Advanced& a, Visit&& visit) {
   visit(ip + "line_search_shift", p.line_search_shift, kPositive);
   visit(ip + "max_shift_floor", p.max_shift_floor, kPositive);
   visit(ip + "negligible_shift", p.negligible_shift, kNonNegative);
-  visit(ip + "armijo", p.armijo, Range{0, 0.5, true, true});
+  visit(ip + "armijo", p.armijo, kArmijo);
   visit(ip + "merit_round_off", p.merit_round_off, kBelowOne);
   visit(ip + "stall_acceptance", p.stall_acceptance, kOpenUnit);
   visit(ip + "stall_acceptance_steps", p.stall_acceptance_steps, kCount);
@@ -100,7 +149,7 @@ void forEachField(Advanced& a, Visit&& visit) {
   visit(ip + "angle_floor", p.angle_floor, kPositive);
   visit(ip + "start_growth", p.start_growth, kAboveOne);
   visit(ip + "start_margin", p.start_margin, kOpenUnit);
-  visit(ip + "max_start_growths", p.max_start_growths, Range{0, kLargestCount, false, false});
+  visit(ip + "max_start_growths", p.max_start_growths, kCountOrNone);
   visit(ip + "largest_start_raise", p.largest_start_raise, kAtLeastOne);
   visit(ip + "near_kkt_barrier", p.near_kkt_barrier, kUpToOne);
   visit(ip + "elastic_kink_width", p.elastic_kink_width, kPositive);
@@ -114,7 +163,7 @@ void forEachField(Advanced& a, Visit&& visit) {
   visit(ip + "damping_growth", p.damping_growth, kAboveOne);
   visit(ip + "smallest_damping", p.smallest_damping, kOpenUnit);
   visit(ip + "coarsest_grid", p.coarsest_grid, Range{16, kLargestCount, false, false});
-  visit(ip + "coarsening_factor", p.coarsening_factor, Range{2, 64, false, false});
+  visit(ip + "coarsening_factor", p.coarsening_factor, kCoarsening);
 }
 
 /// "a finite number > 0", "an integer in [1, 1074]", "a finite number in (0, 0.5)".

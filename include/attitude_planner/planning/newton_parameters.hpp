@@ -1,6 +1,7 @@
 // Every tuning constant of the Newton solver and its strategies, one field per idea, with its
 // symbol where the literature has one, its default and why. How the values were chosen (the
-// random-suite measurements) is in docs/notes/newton_tuning.md.
+// random-suite measurements) is in docs/notes/newton_tuning.md. A user sets them as
+// SolverOptions::advanced.newton (advanced_parameters.hpp), which bounds every field.
 #pragma once
 
 #include <algorithm>
@@ -13,8 +14,6 @@ struct NewtonParameters {
   /// Above this N the normal equations (condition ~N⁴, λ_max/λ_min = 7e10 at N = 256) risk losing
   /// the Cholesky factorization to round-off; the augmented system has condition ~N².
   int normal_equations_max_steps = 256;
-  /// Half bandwidth of the augmented system ordered by node (y_k before δ_k).
-  int augmented_bandwidth = 14;
 
   // --- Stopping test -----------------------------------------------------------------------------
   /// Least relative torque accuracy (decrement / |τ|₂) a round-off stall counts as converged at.
@@ -121,11 +120,5 @@ struct NewtonParameters {
     return round_off_floor_factor * std::numeric_limits<double>::epsilon() * double(steps) * steps;
   }
 };
-
-/// The defaults (every solve today uses them).
-inline const NewtonParameters& newtonDefaults() {
-  static const NewtonParameters defaults;
-  return defaults;
-}
 
 }  // namespace attitude_planner

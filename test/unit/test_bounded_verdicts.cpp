@@ -19,7 +19,6 @@
 #include <unistd.h>
 
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/io/csv.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
@@ -27,7 +26,6 @@
 #include "planning/drivers/requests.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/problem/duration_bound.hpp"
-#include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 #include "support/bounded_references.hpp"
 #include "support/bounded_requests.hpp"
@@ -742,28 +740,4 @@ TEST(BoundedVerdicts,
       });
   EXPECT_LT(coarsest, p.steps);
   EXPECT_TRUE(newton_on_coarsest);
-}
-
-TEST(BoundedVerdicts, AProbeWithoutAPlanFromTheCoarsestLevelsOptimumFindsOneFromThePlanResampled) {
-  // Seed-45 #89 (N = 305 under a torque box, spinning start): one step of the minimum-time
-  // search's descent in T, 5 % below the search's plan (stored as the search held it:
-  // test/data/seed45_89_descent_plan.csv). Started at the interior point's coarsest level's own
-  // unconstrained optimum the probe ends without a plan, and the descent would stop there; with
-  // the plan resampled starting that level it ends with a plan within the bounds.
-  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 89);
-  ASSERT_TRUE(request);
-  const Maneuver plan = readManeuverCsv(AP_SOURCE_DIR "/test/data/seed45_89_descent_plan.csv");
-  PlanningProblem effort = request->problem;
-  effort.objective = Objective::MinimumEffort;
-  effort.time_margin = 0.0;
-  ASSERT_EQ(plan.steps(), effort.steps);
-  effort.duration = plan.time_step * plan.steps() * 0.95;
-  SolverOptions from_plan;
-  from_plan.warm_start = &plan;
-  from_plan.constrained_from_warm_start = true;
-  const PlanResult first = planAtResolution(effort, from_plan);
-  EXPECT_FALSE(provesFeasible(effort, first)) << first.message();
-  from_plan.warm_start_second_coarsest_start = true;
-  const PlanResult second = planAtResolution(effort, from_plan);
-  EXPECT_TRUE(provesFeasible(effort, second)) << second.message();
 }

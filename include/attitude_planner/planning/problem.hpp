@@ -318,13 +318,6 @@ struct SolverOptions {
   /// slacks, Mehrotra) rather than the probes' (elastic form first, LOQO's barrier), which is
   /// for starts that may be infeasible (interior_point_solver.cpp).
   bool warm_start_strictly_inside = false;
-  /// With constrained_from_warm_start, without cones, on a grid the interior point reaches through
-  /// coarser levels: where the solve whose coarsest level starts at that level's unconstrained
-  /// optimum ends without a plan, solve once more with the warm start resampled starting that
-  /// level. Set by the minimum-time search for its descent in T and the first probes of its
-  /// bisection, whose probes without a plan decide which plan the search keeps
-  /// (interior_point_solver.cpp, minimum_time_search.cpp).
-  bool warm_start_second_coarsest_start = false;
   /// With node constraints and no warm start: the request's unconstrained optimum, already
   /// solved on its grid in its class (the class survey's plan, drivers/constrained_classes.cpp).
   /// Newton polishes it (an iteration or two) instead of solving the class again through the

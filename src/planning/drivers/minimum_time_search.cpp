@@ -40,14 +40,6 @@ constexpr int kMaxDoublings = 12;
 /// minimum-effort plans converged at 0.3-0.5 of it).
 constexpr double kShorteningFactor = 0.7;
 constexpr int kMaxShortenings = 6;
-/// A probe of the descent in T, or of the bisection while its bracket is wider than this
-/// (relative to its feasible end), that ends without a plan tries the interior point's second
-/// start of its coarsest level (SolverOptions::warm_start_second_coarsest_start). Why: which
-/// probes find a plan decides which plan the search keeps, and so which local T* free time reaches
-/// from it; but the second start costs as much again on every probe without a plan, and the
-/// bisection's late probes (about 20 of its 25, to 1e-9) move T by less than this. Measured on the
-/// bounded suite's seed-45 #189: T* 31.75 -> 30.77 s with 16 second starts (56 on every probe).
-constexpr double kSecondStartBracket = 1e-3;
 /// Grids above this N search from the T* plan of the grid with half the steps.
 constexpr int kCoarsestSearchGrid = 64;
 /// That search's first T, relative to the coarse grid's T*.
@@ -109,7 +101,7 @@ class MinimumTimeSearch {
  private:
   /// One minimum-effort solve at T from `warm`: true, with the plan kept in `out`, if it proves
   /// T feasible (provesFeasible).
-  bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out, bool second_start) {
+  bool tryDuration(double T, const Maneuver* warm, SearchOutcome* out) {
     // No plan exists there on this grid (the last step into the final rate has no room under the
     // rate limit, proven): no solve.
     if (T >= no_room_.from && T <= no_room_.to) return false;
@@ -120,7 +112,6 @@ class MinimumTimeSearch {
     if (warm) {
       o.warm_start = warm;
       o.constrained_from_warm_start = true;
-      o.warm_start_second_coarsest_start = second_start;
     }
     PlanResult r;
     try {
@@ -157,8 +148,8 @@ class MinimumTimeSearch {
   /// The search of `search`: doubling T from T_first until feasible, then down from there.
   void descend(const Maneuver* from, double T_first, SearchOutcome* found) {
     SearchOutcome& out = *found;
-    const auto feasible = [&](double T) {  // every probe of the descent may take the second start
-      return tryDuration(T, out.feasible ? &out.best.maneuver : from, &out, true);
+    const auto feasible = [&](double T) {
+      return tryDuration(T, out.feasible ? &out.best.maneuver : from, &out);
     };
     double T = T_first;
     for (int doublings = 0; !feasible(T) && !stopped() && T < unrepresentable_from_; T *= 2.0) {
@@ -212,8 +203,7 @@ class MinimumTimeSearch {
     while (!stopped() && out->T_hi - out->T_lo > kMinimumTimeTolerance * out->T_hi) {
       const double mid = 0.5 * (out->T_lo + out->T_hi);
       const Maneuver from = out->best.maneuver;
-      const bool wide = out->T_hi - out->T_lo > kSecondStartBracket * out->T_hi;
-      (tryDuration(mid, &from, out, wide) ? out->T_hi : out->T_lo) = mid;
+      (tryDuration(mid, &from, out) ? out->T_hi : out->T_lo) = mid;
     }
     out->tally.pause();
   }

@@ -109,16 +109,10 @@ bool ranOut(Termination t) {
   return t == Termination::Cancelled || t == Termination::TimedOut;
 }
 
-/// Where the grid continuation's coarsest level starts a constrained warm start on the requested
-/// grid: from that level's own unconstrained optimum (Newton from the warm plan resampled), or from
-/// the warm plan resampled itself.
-enum class CoarsestStart { LevelOptimum, WarmPlan };
-
 /// What a solve of the interior point needs besides the problem.
 struct Solve {
   const InteriorPointParameters& parameters;
   SolveContext& context;
-  CoarsestStart coarsest = CoarsestStart::LevelOptimum;  ///< with cones always WarmPlan
 };
 
 /// One grid in the recipe's first formulation, retried once in the other from the same start
@@ -205,13 +199,12 @@ bool keepsConeSides(const PlanningProblem& problem) {
 /// (SolverOptions::constrained_from_warm_start) starts the level resampled where the problem has
 /// cones (keepsConeSides). Sets level_options->warm_start to null.
 PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProblem& at,
-                              const SolverOptions& options, const Solve& solve,
+                              const SolverOptions& options, SolveContext& context,
                               SolverOptions* level_options, Maneuver* resampled) {
   if (options.warm_start && options.warm_start->steps() == problem.steps) {
     resampled->attitude = resampleAttitudes(*options.warm_start, at.steps);
     level_options->warm_start = resampled;
-    if (options.constrained_from_warm_start &&
-        (keepsConeSides(problem) || solve.coarsest == CoarsestStart::WarmPlan)) {
+    if (options.constrained_from_warm_start && keepsConeSides(problem)) {
       // A plan under the constraints starts the level itself: its unconstrained optimum would
       // drop which side of each cone the plan passes.
       PlanResult start;
@@ -221,7 +214,7 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
       return start;
     }
   }
-  PlanResult unconstrained = solveWithNewton(at, *level_options, solve.context);
+  PlanResult unconstrained = solveWithNewton(at, *level_options, context);
   level_options->warm_start = nullptr;
   return unconstrained;
 }
@@ -284,7 +277,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolverOptions& opt
   PlanResult start;
   Maneuver resampled;
   if (!r.coarse) {
-    start = unconstrainedStart(problem, r.problem, options, solve, &level_options, &resampled);
+    start =
+        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = start.converged() ? &start.maneuver : nullptr;
   }
   GridOutcome outcome = solveGridWithRetry(
@@ -309,7 +303,7 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolverOptions& opti
   PlanResult unconstrained;
   if (!r.coarse) {
     unconstrained =
-        unconstrainedStart(problem, r.problem, options, solve, &level_options, &resampled);
+        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
     level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
   }
   const LevelDuals no_duals;
@@ -436,44 +430,6 @@ void keepAttempt(SolveContext& context, const Begun& begun, std::size_t kept, Pl
   result->levels = context.levelsFrom(begun.levels);
 }
 
-/// Whether a constrained warm start that ended without a plan is solved once more with its
-/// coarsest level started from the warm plan resampled: under torque and rate bounds alone (with
-/// cones the level starts there already), on a grid the continuation reaches through coarser
-/// levels, from a warm start of this grid. Which start of the coarsest level the interior point
-/// reaches a plan from differs between requests (measured on the bounded suite: the level's
-/// unconstrained optimum for seed-45 #33, the plan resampled for the minimum-time search's
-/// probes of #89 and #189).
-bool triesTheWarmPlanToo(const PlanningProblem& problem, const SolverOptions& options,
-                         const Solve& solve, const PlanResult& first) {
-  if (!options.warm_start_second_coarsest_start) return false;
-  if (!options.constrained_from_warm_start || !options.warm_start) return false;
-  if (options.warm_start->steps() != problem.steps || keepsConeSides(problem)) return false;
-  if (startsInsideOnThisGrid(problem, options)) return false;
-  if (!usesCoarserLevel(problem, interiorPointGridRule(solve.parameters))) return false;
-  if (solve.context.stopReason()) return false;  // cancelled or out of time
-  return !provesFeasible(problem, first);
-}
-
-/// The constrained warm start solved again from the other start of its coarsest level
-/// (triesTheWarmPlanToo): its answer where it reaches a plan, else the first's, which stays the
-/// answer's reason. Every solve's iterations are counted; the kept attempt is marked.
-PlanResult withTheWarmPlanStart(const PlanningProblem& problem, const SolverOptions& options,
-                                const Solve& solve, const Begun& begun, std::size_t first_at,
-                                PlanResult first) {
-  const SolveContext::IterationTally tally(solve.context);
-  const Solve from_plan{solve.parameters, solve.context, CoarsestStart::WarmPlan};
-  std::size_t second_at = first_at;
-  PlanResult second = attempt(problem, options, from_plan, AttemptStage::ConstrainedRetry,
-                              AttemptStart::PreviousAttempt, &second_at)
-                          .result;
-  const bool take_second = provesFeasible(problem, second);
-  const int first_iterations = first.iterations;
-  PlanResult result = take_second ? std::move(second) : std::move(first);
-  keepAttempt(solve.context, begun, take_second ? second_at : first_at, &result);
-  result.iterations = first_iterations + tally.iterations();
-  return result;
-}
-
 }  // namespace
 
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOptions& options,
@@ -488,9 +444,6 @@ PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolverOp
   // iterate can leave the cone with torques far beyond their bounds and never recover. Retry
   // once in two stages: the cones alone (a path around them), then every constraint from that
   // path.
-  if (triesTheWarmPlanToo(problem, options, solve, result)) {
-    return withTheWarmPlanStart(problem, options, solve, begun, at, std::move(result));
-  }
   const bool stuck = result.termination == Termination::Infeasible ||
                      result.termination == Termination::NotConverged;
   const bool cones = std::any_of(problem.constraints.begin(), problem.constraints.end(),

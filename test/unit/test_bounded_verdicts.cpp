@@ -460,6 +460,23 @@ TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBelowAFirstTNearItsFloor) {
   EXPECT_GE(check.result.minimum_duration, discreteDurationLowerBound(request->problem));
 }
 
+TEST(BoundedVerdicts, SpinningMinimumTimeSearchesBetweenItsDoublings) {
+  // A request of the seeded suite (at its drawn N = 256) where no free-time start converges and
+  // the search's doublings of its first T (25.28, 50.57, 101.1, 202.3 s) and its shortenings
+  // below it find no plan, while cold minimum-effort plans converge in between (28.95 and 33.30
+  // s, none at 25.18 or 38.29 s): the answer was "not converged, no plan found". Its answer is a
+  // plan, checked as planAndCheck does, at or above the proven bound on its grid.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 206);
+  ASSERT_TRUE(request.has_value());
+  ASSERT_TRUE(hasSpinningEnds(request->problem));
+  SCOPED_TRACE(request->label);
+  const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+  EXPECT_EQ(check.input_error, "");
+  ASSERT_TRUE(check.result.converged()) << check.result.message();
+  EXPECT_EQ(check.wrong, "") << check.result.message();
+  EXPECT_GE(check.result.minimum_duration, discreteDurationLowerBound(request->problem));
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at

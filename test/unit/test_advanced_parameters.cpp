@@ -141,6 +141,7 @@ TEST(AdvancedParameters, DefaultsAreTheSolversConstantsAndValid) {
   EXPECT_EQ(n.accept_ratio, 1e-4);
   EXPECT_EQ(n.coarsest_steps, 16);
   EXPECT_EQ(n.class_refine_margin, 0.5);
+  EXPECT_EQ(n.unconstrained_refine_margin, 0.35);
   EXPECT_EQ(n.rate_continuation_min_increment, 1.0 / 64);
   EXPECT_NO_THROW(ap::validateAdvancedParameters({}));
   EXPECT_NO_THROW(ap::validateOptions({}));

@@ -80,6 +80,7 @@ void forEachNewtonField(Newton& p, Visit& visit) {
   visit(n + "coarse_tolerance_floor", p.coarse_tolerance_floor, kOpenUnit);
   visit(n + "class_survey_min_steps", p.class_survey_min_steps, kSteps);
   visit(n + "class_refine_margin", p.class_refine_margin, kNonNegative);
+  visit(n + "unconstrained_refine_margin", p.unconstrained_refine_margin, kNonNegative);
   visit(n + "same_extremal_cost", p.same_extremal_cost, kBelowOne);
   visit(n + "cheaper_tie", p.cheaper_tie, kBelowOne);
   visit(n + "rate_continuation_max_stages", p.rate_continuation_max_stages, kCount);

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/grid_solve.hpp"
 #include "planning/problem/message_notes.hpp"
@@ -329,6 +330,12 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
                                     std::optional<PlanResult>* own_refined) {
   std::vector<Surveyed> surveyed(classes.size());
   const bool refined_later = plan.survey + 1 < plan.levels.size();
+  // At rest at both ends with R_N = R_0 the request's own class may be the zero maneuver, whose
+  // cost 0 no class beats (costs are sums of squares): it is surveyed first, alone, and the
+  // others only where it is not.
+  const bool may_cost_nothing =
+      problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) &&
+      so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0;
   const auto work = [&](int i, SolveContext& branch) {
     {
       const SolveContext::Scope scope(branch, AttemptStage::ClassSurvey, classes[i]);
@@ -339,7 +346,23 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
     *own_refined = refineClass(surveyed[i], plan, branch, settings, p);
   };
-  runBranches(context, static_cast<int>(classes.size()), work);
+  std::size_t first = 0;
+  if (may_cost_nothing) {
+    for (; first < classes.size(); ++first) {
+      if (!sameHomotopyClass(classes[first], homotopyClassOf(problem))) continue;
+      runBranches(context, 1, [&](int, SolveContext& branch) { work(first, branch); });
+      if (surveyed[first].result.converged() && surveyed[first].result.cost == 0) {
+        return {surveyed[first]};
+      }
+      break;
+    }
+  }
+  std::vector<int> others;
+  for (std::size_t i = 0; i < classes.size(); ++i) {
+    if (!(may_cost_nothing && i == first)) others.push_back(static_cast<int>(i));
+  }
+  runBranches(context, static_cast<int>(others.size()),
+              [&](int j, SolveContext& branch) { work(others[j], branch); });
   return surveyed;
 }
 

@@ -208,6 +208,10 @@ struct PlanningProblem {
     return std::any_of(constraints.begin(), constraints.end(),
                        [](const PlanningConstraint& c) { return c.isCone(); });
   }
+  /// At rest at both ends with R_0 already meeting the end condition, in the shortest class with
+  /// no extra revolutions and no effect pushing the body: the zero maneuver (no torque, no
+  /// motion) is a plan at any duration, of cost 0, which no plan beats (planning_problem.cpp).
+  bool zeroManeuverReachesTheEnd() const;
   /// Any per-axis bound, node constraint or reaction-wheel limit.
   bool hasNodeConstraints() const {
     return hasTorqueBounds() || !constraints.empty() || reaction_wheels.present();

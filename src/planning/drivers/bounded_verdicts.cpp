@@ -34,17 +34,6 @@ Maneuver restingPlan(const PlanningProblem& problem, double T) {
   return plan;
 }
 
-bool identicalRestStates(const PlanningProblem& problem) {
-  // A pointing end is reached where R_0 b = d (its final_attitude is no datum of the request).
-  const bool there =
-      problem.end_condition.pointing()
-          ? pointingError(problem.initial_attitude, problem.end_condition) == 0.0
-          : so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0;
-  return problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) && there &&
-         problem.direction == RotationDirection::Shortest && problem.extra_revolutions == 0 &&
-         (!problem.effects || problem.effects->empty());
-}
-
 /// Minimum time between identical rest states: T* = 0, the body is already there; the plan at
 /// (1 + margin) T* = 0 s is the body at rest (every node at t = 0, zero torques).
 PlanResult alreadyThere(const PlanningProblem& problem) {
@@ -111,7 +100,7 @@ PlanResult noRoomAt(const PlanningProblem& problem, const DurationLowerBound& bo
 
 std::optional<PlanResult> answerBeforeSolving(const PlanningProblem& problem,
                                               const DurationLowerBound& bound) {
-  if (problem.objective == Objective::MinimumTime && identicalRestStates(problem)) {
+  if (problem.objective == Objective::MinimumTime && problem.zeroManeuverReachesTheEnd()) {
     return alreadyThere(problem);
   }
   if (!(bound.seconds > 0.0) || !(problem.duration > 0.0) || problem.accuracy.active()) {

@@ -330,12 +330,10 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
                                     std::optional<PlanResult>* own_refined) {
   std::vector<Surveyed> surveyed(classes.size());
   const bool refined_later = plan.survey + 1 < plan.levels.size();
-  // At rest at both ends with R_N = R_0 the request's own class may be the zero maneuver, whose
-  // cost 0 no class beats (costs are sums of squares): it is surveyed first, alone, and the
-  // others only where it is not.
-  const bool may_cost_nothing =
-      problem.initial_velocity.isZero(0.0) && problem.final_velocity.isZero(0.0) &&
-      so3::angleBetween(problem.initial_attitude, problem.final_attitude) == 0.0;
+  // Where the zero maneuver reaches the end, the request's own class is surveyed first, alone:
+  // its cost 0 no class beats (costs are sums of squares), and the others are surveyed only where
+  // it is not.
+  const bool may_cost_nothing = problem.zeroManeuverReachesTheEnd();
   const auto work = [&](int i, SolveContext& branch) {
     {
       const SolveContext::Scope scope(branch, AttemptStage::ClassSurvey, classes[i]);

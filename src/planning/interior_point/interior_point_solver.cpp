@@ -105,10 +105,6 @@ constexpr FormulationRecipe kProbeRecipe = {
     {Formulation::FreeSlacks, BarrierRule::Monotone, "free slacks"},
 };
 
-bool ranOut(Termination t) {
-  return t == Termination::Cancelled || t == Termination::TimedOut;
-}
-
 /// What a solve of the interior point needs besides the problem.
 struct Solve {
   const InteriorPointParameters& parameters;
@@ -253,7 +249,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolveRequest& opti
   const auto endsAsTheStop = [&] {
     if (solve.context.levels().size() > first_level) solve.context.endLastLevelAs(stop.termination);
   };
-  if (ranOut(stop.termination)) {
+  if (stoppedByRequest(stop.termination)) {
     GridOutcome carried;
     if (r.coarse) carried.steps = r.coarse->steps;
     if (r.coarse) carried.formulation = r.coarse->formulation;
@@ -304,7 +300,7 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolveRequest& optio
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
                          r.coarse ? &r.coarse->duals : &no_duals, r.finest);
   const LevelDuals direct_duals = outcome.duals;
-  if (!outcome.result.converged() && !ranOut(outcome.result.termination) && r.coarse &&
+  if (!outcome.result.converged() && !stoppedByRequest(outcome.result.termination) && r.coarse &&
       r.problem.steps % 2 == 0) {
     refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome);
   }

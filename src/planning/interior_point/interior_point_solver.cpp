@@ -209,6 +209,22 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
   return unconstrained;
 }
 
+/// Without a coarser iterate a level starts from its unconstrained optimum (unconstrainedStart):
+/// *level_options warm-start from that plan where it converged (the plan and the resampled warm
+/// start they may point at are kept in *start).
+struct OwnStart {
+  PlanResult plan;
+  Maneuver resampled;
+};
+void startFromOwnOptimum(const PlanningProblem& problem, const SolveRequest& options,
+                         const Solve& solve, const LevelRequest<LevelIterate>& r,
+                         SolveRequest* level_options, OwnStart* start) {
+  if (r.coarse) return;
+  start->plan = unconstrainedStart(problem, r.problem, options, solve.context, level_options,
+                                   &start->resampled);
+  level_options->warm_start = start->plan.converged() ? &start->plan.maneuver : nullptr;
+}
+
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
 /// once more through the level in between. Replaces *direct if that converges (the level's tally
 /// counts every solve's iterations, the context records their levels).
@@ -263,13 +279,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolveRequest& opti
   SolveRequest level_options = options;
   level_options.warm_start = nullptr;
   level_options.max_iterations = 0;
-  PlanResult start;
-  Maneuver resampled;
-  if (!r.coarse) {
-    start =
-        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
-    level_options.warm_start = start.converged() ? &start.maneuver : nullptr;
-  }
+  OwnStart start;
+  startFromOwnOptimum(problem, options, solve, r, &level_options, &start);
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
@@ -288,13 +299,8 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolveRequest& optio
   level_options.warm_start = nullptr;
   level_options.tolerance = r.tolerance;
   const SolveContext::IterationTally tally(solve.context);  // the iterations of every solve on it
-  Maneuver resampled;
-  PlanResult unconstrained;
-  if (!r.coarse) {
-    unconstrained =
-        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
-    level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
-  }
+  OwnStart start;
+  startFromOwnOptimum(problem, options, solve, r, &level_options, &start);
   const LevelDuals no_duals;
   GridOutcome outcome =
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,

@@ -364,6 +364,72 @@ TEST(BarrierForms, DualStepsKeepTheMultipliersInsideAndFeasibleIsNewtonsOnZcEqua
   }
 }
 
+// The constraint block both interior points hold (BarrierRowBlock), on a free-time problem whose
+// rows are in two forms at once as an elastic start has them (the rows that move with h
+// ℓ1-elastic, the cone Feasible): the merit at a point is the merit of the values evaluated
+// there; one dual step keeps every multiplier, and an elastic row's ρ − z, at least (1 − τ) of
+// itself; a Feasible row's dz is Newton's on z c = μ along the slope gᵀd + r (r the second-order
+// correction's term); an elastic row's complementarity is a pair. Seeded gradients and step.
+TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
+  ap::PlanningProblem p = sceneProblem("min_time_keep_out.yaml", 16);
+  p.duration = 20.0;
+  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), ap::Vector3::UnitZ(), 0.5),
+                   ap::PlanningConstraint::maxAngularRate(0.2)};
+  const ap::ReducedProblem np(p);
+  const ap::StageConstraints constraints = ap::buildStageConstraints(p);
+  const ap::InteriorPointParameters parameters;
+  const ap::Feasible feasible(parameters);
+  const ap::L1Elastic<10> elastic(parameters);
+  const auto form = [&](const ap::FreeTimeRows& g) -> const ap::BarrierForm<10>& {
+    if (g.quantity->dependsOnTimeStep()) return elastic;
+    return feasible;
+  };
+  ap::BarrierRowBlock<ap::FreeTimeStep> block(constraints, np, form);
+  const double mu = 1e-2, rho = 1e2, tau = parameters.fraction_to_boundary;
+  block.evaluate(np.current());
+  block.prepare(mu, rho, true);
+  const ap::QuantityInputs at(np, np.current());
+  const double merit = block.merit(1.5, nullptr, mu, rho, 0.0, false);
+  ASSERT_TRUE(std::isfinite(merit));
+  EXPECT_EQ(merit, block.merit(1.5, &at, mu, rho, 0.0, false));
+
+  std::mt19937 rng(53);
+  std::normal_distribution<double> normal;
+  int rows = 0, elastic_rows = 0;
+  std::vector<double> z0;
+  block.rows.forEach([&](ap::FreeTimeRows& g, int, ap::FreeTimeRow& in) {
+    for (int i = 0; i < 10; ++i) in.g(i) = normal(rng);
+    in.r = 0.1 * normal(rng);
+    z0.push_back(in.z);
+    ++rows;
+    if (g.quantity->dependsOnTimeStep()) ++elastic_rows;
+  });
+  ASSERT_GT(elastic_rows, 0);
+  ASSERT_LT(elastic_rows, rows);
+  Eigen::VectorXd d(np.unknowns() + ap::FreeTimeStep::globals(np));
+  for (Eigen::Index i = 0; i < d.size(); ++i) d(i) = normal(rng);
+  const double alpha = block.dualStep(d, mu, rho);
+  ASSERT_GT(alpha, 0.0);
+  ASSERT_LE(alpha, 1.0);
+  block.rows.forEach([&](const ap::FreeTimeRows& g, int k, const ap::FreeTimeRow& in) {
+    EXPECT_GE(in.z + alpha * in.dz, (1 - tau) * in.z * (1 - 1e-12));
+    if (g.quantity->dependsOnTimeStep()) {
+      EXPECT_GE(rho - in.z - alpha * in.dz, (1 - tau) * (rho - in.z) * (1 - 1e-9));
+    } else {
+      const double slope = block.rows.dot(np, g, k, in.g, d) + in.r;
+      EXPECT_NEAR(in.z * in.c + in.c * in.dz + in.z * slope, mu,
+                  1e-12 * (mu + in.z * in.c + in.z * std::abs(slope)));
+    }
+  });
+  block.applyDualStep(alpha);
+  std::size_t i = 0;
+  block.rows.forEach([&](const ap::FreeTimeRows&, int, const ap::FreeTimeRow& in) {
+    EXPECT_EQ(in.z, z0[i] + alpha * in.dz);
+    ++i;
+  });
+  EXPECT_EQ(block.complementarity(mu, rho).count, rows + elastic_rows);
+}
+
 // ---- constrained optima
 // --------------------------------------------------------------------------
 

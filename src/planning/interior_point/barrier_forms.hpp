@@ -1,8 +1,8 @@
 // The barrier forms that say how a row c(x) ≥ 0 of a stage transcription (ConstraintRow, 9
 // entries at a fixed h, 10 with h free) enters the barrier problem: its multiplier's safeguard,
 // its Newton terms, its merit term, its dual step, its complementarity; one interface
-// (BarrierForm), so that the loops over the rows are written once (dualSteps, applyDualSteps,
-// complementarityOf, MeritSum) and both interior points call them.
+// (BarrierForm), so that the loops over the rows are written once (BarrierRowBlock, the
+// constraint block both interior points hold).
 //   FreeSlacks (fixed h): c − s = 0, s > 0 a variable, −μ ln s + ν|c − s| in the merit.
 //   L1Elastic  (fixed h; free time's elastic start): c + v − s = 0, s, v ≥ 0 eliminated for c
 //              (elasticSlacks), the merit ψ_μ(c) = ρ v − μ ln s − μ ln v; z < ρ (u = ρ − z > 0).
@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -212,28 +213,6 @@ class Feasible final : public BarrierForm<10> {
   }
 };
 
-/// The rows' dual steps (row.dz; slope(group, k, row) each row's gᵀd) and the largest step in
-/// (0, 1] by the fraction to the boundary; form(group) the form a group's rows are in now.
-template <typename Rows, typename FormOf, typename Slope>
-double dualSteps(Rows& rows, const FormOf& form, const Slope& slope, double mu, double rho) {
-  double alpha = 1.0;
-  rows.forEach([&](auto& g, int k, auto& in) {
-    alpha = form(g).dualStep(in, slope(g, k, in), mu, rho, alpha);
-  });
-  return alpha;
-}
-/// z += α dz on every row.
-template <typename Rows>
-void applyDualSteps(Rows& rows, double alpha) {
-  rows.forEach([&](auto&, int, auto& in) { in.z += alpha * in.dz; });
-}
-/// The rows' complementarity products at their values c.
-template <typename Rows, typename FormOf>
-Complementarity complementarityOf(const Rows& rows, const FormOf& form, double mu, double rho) {
-  Complementarity out;
-  rows.forEach([&](auto& g, int, auto& in) { form(g).addComplementarity(in, mu, rho, &out); });
-  return out;
-}
 /// A merit's sum over the rows: +∞ once a row is outside its form's domain.
 struct MeritSum {
   double phi = 0.0;
@@ -244,20 +223,107 @@ struct MeritSum {
   }
   double value() const { return inside ? phi : std::numeric_limits<double>::infinity(); }
 };
-/// Adds the rows' merit terms (BarrierForm::rowMerit) to `sum`: at the rows' own values c, or,
-/// with `at`, at their values there (the rows untouched: a trial point's, each checked against
-/// the row's accepted c).
-template <typename Rows, typename FormOf>
-void addRowMerits(const Rows& rows, const FormOf& form, const QuantityInputs* at, double mu,
-                  double rho, double alpha, bool check_boundary, MeritSum* sum) {
-  const auto add = [&](auto& g, int, auto& in, double c) {
-    sum->add(form(g).rowMerit(in, c, mu, rho, alpha, check_boundary));
-  };
-  if (at) {
-    rows.forEachValue(*at, add);
-  } else {
-    rows.forEach([&](auto& g, int k, auto& in) { add(g, k, in, in.c); });
+
+/// The constraint block of a barrier problem over a stage transcription: its rows and what a
+/// primal–dual method does with them row by row (values, merit terms, dual step, κ_Σ,
+/// complementarity), written once for either time step; the interior point at a fixed h
+/// (ConstrainedSystem) and the free-time solver each hold one. `form(group)` is the barrier form
+/// a group's rows are in now (fixed h: its formulation's; free time: ℓ1-elastic while its start
+/// is, else Feasible). Sums run group by group, k rising (StageTranscription::forEach).
+template <typename TimeStep>
+class BarrierRowBlock {
+ public:
+  static constexpr int kEntries = TimeStep::kEntries;
+  using Rows = ConstraintRows<kEntries>;
+  using Row = ConstraintRow<kEntries>;
+  using Form = BarrierForm<kEntries>;
+  using FormOf = std::function<const Form&(const Rows&)>;
+
+  BarrierRowBlock(const StageConstraints& constraints, const ReducedProblem& np, FormOf form)
+      : rows(constraints, np), np_(np), form_(std::move(form)) {}
+
+  const Form& form(const Rows& g) const { return form_(g); }
+  /// Each row's value c at `steps`.
+  void evaluate(const ReducedProblem::StepVectors& steps) {
+    rows.evaluate(QuantityInputs(np_, steps));
   }
-}
+  /// `start` plus the rows' merit terms (BarrierForm::rowMerit): at their own values c, or, with
+  /// `at`, at their values there (rows untouched; each checked against its accepted c).
+  double merit(double start, const QuantityInputs* at, double mu, double rho, double alpha,
+               bool check_boundary) const {
+    MeritSum sum{start};
+    const auto add = [&](const Rows& g, int, const Row& in, double c) {
+      sum.add(form(g).rowMerit(in, c, mu, rho, alpha, check_boundary));
+    };
+    if (at) {
+      rows.forEachValue(*at, add);
+    } else {
+      rows.forEach([&](const Rows& g, int k, const Row& in) { add(g, k, in, in.c); });
+    }
+    return sum.value();
+  }
+  /// The rows' dual steps dz (into the rows) for the step d, each row's slope gᵀd + r (r the
+  /// second-order correction's term, 0 but for a corrected step), and the largest step in (0, 1]
+  /// by the fraction to the boundary.
+  double dualStep(const Eigen::VectorXd& d, double mu, double rho) {
+    double alpha = 1.0;
+    rows.forEach([&](const Rows& g, int k, Row& in) {
+      alpha = form(g).dualStep(in, rows.dot(np_, g, k, in.g, d) + in.r, mu, rho, alpha);
+    });
+    return alpha;
+  }
+  /// z += α dz on every row.
+  void applyDualStep(double alpha) {
+    rows.forEach([&](Rows&, int, Row& in) { in.z += alpha * in.dz; });
+  }
+  /// Every row prepared at its value c (BarrierForm::prepare).
+  void prepare(double mu, double rho, bool primal) {
+    rows.forEach([&](const Rows& g, int, Row& in) { form(g).prepare(in, mu, rho, primal); });
+  }
+  /// The first multipliers at the rows' values: the primal ones, capped at `cap`.
+  void initialize(double mu, double rho, double cap) {
+    rows.forEach([&](const Rows& g, int, Row& in) { form(g).initialize(in, mu, rho, cap); });
+  }
+  /// κ_Σ after an accepted step, at the rows' new values.
+  void afterAccept(double mu) {
+    rows.forEach([&](const Rows& g, int, Row& in) { form(g).afterAccept(in, mu); });
+  }
+  /// The rows' complementarity products at their values c.
+  Complementarity complementarity(double mu, double rho) const {
+    Complementarity out;
+    rows.forEach(
+        [&](const Rows& g, int, const Row& in) { form(g).addComplementarity(in, mu, rho, &out); });
+    return out;
+  }
+  /// The largest multiplier after the dual step α dz.
+  double largestMultiplier(double alpha) const {
+    double largest = 0.0;
+    rows.forEach([&](const Rows&, int, const Row& in) {
+      largest = std::max(largest, in.z + alpha * in.dz);
+    });
+    return largest;
+  }
+  /// min c over the rows at their values (+∞ without rows).
+  double smallestValue() const {
+    double smallest = std::numeric_limits<double>::infinity();
+    rows.forEach([&](const Rows&, int, const Row& in) { smallest = std::min(smallest, in.c); });
+    return smallest;
+  }
+  /// max(0, −min c): the largest violation at the rows' values.
+  double maxViolation() const { return std::max(0.0, -smallestValue()); }
+  /// max |c − s| at the rows' values (FreeSlacks' primal residual).
+  double maxSlackResidual() const {
+    double worst = 0.0;
+    rows.forEach(
+        [&](const Rows&, int, const Row& in) { worst = std::max(worst, std::abs(in.c - in.s)); });
+    return worst;
+  }
+
+  StageTranscription<TimeStep> rows;
+
+ private:
+  const ReducedProblem& np_;
+  FormOf form_;
+};
 
 }  // namespace attitude_planner

@@ -21,12 +21,14 @@ ConstrainedSystem::ConstrainedSystem(const PlanningProblem& problem, ReducedProb
       free_slacks_(formulation == Formulation::FreeSlacks),
       form_(makeSlackForm(formulation, parameters)),
       constraints_(buildStageConstraints(problem)),
-      rows_(constraints_, *np) {}
+      block_(
+          constraints_, *np,
+          [form = form_.get()](const FixedStepRows&) -> const BarrierForm<9>& { return *form; }) {}
 
 void ConstrainedSystem::evaluateValues(const ReducedProblem::StepVectors& steps,
                                        std::vector<Vector3>* torques_out) {
   const QuantityInputs at(np_, steps);
-  rows_.evaluate(at);
+  block_.rows.evaluate(at);
   if (torques_out) *torques_out = at.torques();
 }
 
@@ -36,13 +38,7 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
   evaluateValues(steps, &tau);
   const double f = np_.scheme().cost(tau);
   if (cost) *cost = f;
-  return f + constraintMerit(mu, rho, slack_alpha);
-}
-
-double ConstrainedSystem::constraintMerit(double mu, double rho, double alpha) const {
-  MeritSum phi;
-  addRowMerits(rows_, formOf(), nullptr, mu, rho, alpha, false, &phi);
-  return phi.value();
+  return f + block_.merit(0.0, nullptr, mu, rho, slack_alpha, false);
 }
 
 void ConstrainedSystem::pollEvery(int k) const {
@@ -59,7 +55,8 @@ Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, KktBloc
   merit_gradient->setZero(np_.unknowns() + globals());
   Assembly out;
   assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
-  for (const std::vector<int>& block : rows_.blocks) assembleQuantity(block, mu, rho, primal, H);
+  for (const std::vector<int>& block : block_.rows.blocks)
+    assembleQuantity(block, mu, rho, primal, H);
   addConstraintGradients(mu, rhs, merit_gradient);
   return out;
 }
@@ -101,7 +98,7 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal, Sink
         weight(axis) += a(axis) * a(axis) / in.D;
       }
     };
-    rows_.chainTorques(st, r, st.jacobian, fold);
+    block_.rows.chainTorques(st, r, st.jacobian, fold);
     if (H) {
       for (int a = 0; a < 3; ++a)
         H->addRankOne(st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
@@ -110,7 +107,8 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal, Sink
     addLocalVector<FixedTimeStep>(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
     addLocalVector<FixedTimeStep>(np_, grad_f, -1.0, st.k - 1, 3, rhs);
   };
-  out->cost = rows_.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
+  out->cost =
+      block_.rows.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
   out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
 }
 
@@ -119,7 +117,7 @@ void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal, Sink
 template <typename Scalar>
 void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
                                          bool primal, Sink<Scalar>* H) {
-  const StageSupport support = rows_.groups[block.front()].support;
+  const StageSupport support = block_.rows.groups[block.front()].support;
   const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
     if (H) form_->prepare(in, mu, rho, primal);
   };
@@ -128,11 +126,11 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
     const int node = t.k + support.node_offset;
     H->addBlock(node, support.width, *curvature);
     for (const int i : block) {
-      const FixedStepRow& in = rows_.groups[i].instance(t.k);
+      const FixedStepRow& in = block_.rows.groups[i].instance(t.k);
       H->addRankOne(node, support.width, in.g, 1.0 / in.D);
     }
   };
-  rows_.forEachQuantityInstance(
+  block_.rows.forEachQuantityInstance(
       np_, FixedTimeStep{}, block, H != nullptr, [&](int k) { pollEvery(k); }, prepare, visit);
 }
 
@@ -140,9 +138,10 @@ void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double m
 /// slope); rhs = −∇f + Σ g (z + q/D).
 void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) const {
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    if (form_->barrierInMeritGradient()) rows_.addRow(np_, g, k, in.g, -mu / in.s, merit_gradient);
-    rows_.addRow(np_, g, k, in.g, form_->terms(in, mu).rhs, rhs);
+  block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    if (form_->barrierInMeritGradient())
+      block_.rows.addRow(np_, g, k, in.g, -mu / in.s, merit_gradient);
+    block_.rows.addRow(np_, g, k, in.g, form_->terms(in, mu).rhs, rhs);
   });
 }
 
@@ -155,8 +154,8 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   products->clear();
   double alpha_p = 1.0, alpha_d = 1.0, sum = 0.0;
   std::vector<double> ds, dz;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    const double lin = rows_.dot(np_, g, k, in.g, d);
+  block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    const double lin = block_.rows.dot(np_, g, k, in.g, d);
     ds.push_back(lin + in.c - in.s);
     dz.push_back((-in.c - lin) / in.D);
     if (ds.back() < 0) alpha_p = std::min(alpha_p, -in.s / ds.back());
@@ -165,7 +164,7 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   });
   double affine = 0.0;
   std::size_t i = 0;
-  rows_.forEach([&](const FixedStepRows&, int, const FixedStepRow& in) {
+  block_.rows.forEach([&](const FixedStepRows&, int, const FixedStepRow& in) {
     affine += (in.s + alpha_p * ds[i]) * (in.z + alpha_d * dz[i]);
     products->push_back(ds[i] * dz[i]);
     ++i;
@@ -180,8 +179,8 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
 void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* products,
                                                   Eigen::VectorXd* out) const {
   std::size_t i = 0;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    rows_.addRow(np_, g, k, in.g, products ? -(*products)[i++] / in.s : 1.0 / in.s, out);
+  block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    block_.rows.addRow(np_, g, k, in.g, products ? -(*products)[i++] / in.s : 1.0 / in.s, out);
   });
 }
 
@@ -189,24 +188,15 @@ void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* pro
 /// `products` may be null: the plain barrier μ).
 void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<double>* products) {
   std::size_t i = 0;
-  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) {
+  block_.rows.forEach([&](FixedStepRows&, int, FixedStepRow& in) {
     in.q = (mu - (products ? (*products)[i++] : 0.0)) / in.z - in.c;
   });
 }
 
-/// The largest dual step in (0, 1] keeping z and u = ρ − z at least (1 − τ) of their values,
-/// and the steps dz themselves (stored in `dz`, instance order).
-double ConstrainedSystem::dualStep(const Eigen::VectorXd& d, double mu, double rho) {
-  const auto slope = [&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    return rows_.dot(np_, g, k, in.g, d);
-  };
-  return dualSteps(rows_, formOf(), slope, mu, rho);
-}
-
 ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd& d, double mu) {
   SlackStep step;
-  rows_.forEach([&](const FixedStepRows& g, int k, FixedStepRow& in) {
-    in.ds = rows_.dot(np_, g, k, in.g, d) + in.c - in.s;
+  block_.rows.forEach([&](const FixedStepRows& g, int k, FixedStepRow& in) {
+    in.ds = block_.rows.dot(np_, g, k, in.g, d) + in.c - in.s;
     if (in.ds < 0) {
       step.alpha = std::min(step.alpha, -parameters_.fraction_to_boundary * in.s / in.ds);
     }
@@ -220,52 +210,25 @@ ConstrainedSystem::SlackStep ConstrainedSystem::slackStep(const Eigen::VectorXd&
 }
 
 void ConstrainedSystem::applySlackStep(double alpha) {
-  rows_.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.s += alpha * in.ds; });
-}
-
-/// FreeSlacks: the largest multiplier after the dual step dz (for the merit's ν).
-double ConstrainedSystem::largestMultiplier(double alpha) const {
-  double largest = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { largest = std::max(largest, in.z + alpha * in.dz); });
-  return largest;
-}
-
-/// FreeSlacks: max |c − s| at the last evaluated c.
-double ConstrainedSystem::maxSlackResidual() const {
-  double worst = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { worst = std::max(worst, std::abs(in.c - in.s)); });
-  return worst;
+  block_.rows.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.s += alpha * in.ds; });
 }
 
 /// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z) at the last
 /// evaluated c.
 void ConstrainedSystem::complementarity(double mu, double rho, double* average,
                                         double* smallest) const {
-  const Complementarity products = complementarityOf(rows_, formOf(), mu, rho);
+  const Complementarity products = block_.complementarity(mu, rho);
   *average = products.average();
   *smallest = products.low;
-}
-
-/// Largest elastic violation max v_i (constraint units) at the last assembly or merit.
-double ConstrainedSystem::maxViolation() const {
-  double worst = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { worst = std::max(worst, -in.c); });
-  return worst;
-}
-
-double ConstrainedSystem::multipliedValues() const {
-  double sum = 0.0;
-  rows_.forEach([&](auto&, int, auto& in) { sum += in.z * in.c; });
-  return sum;
 }
 
 /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function) at the current
 /// multipliers; empty without per-axis bounds.
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
-  if (!rows_.hasTorqueBox()) return {};
+  if (!block_.rows.hasTorqueBox()) return {};
   std::vector<Vector3> sigma = torque;
-  rows_.addBoxMultipliers(np_, torque, &sigma, nullptr);
+  block_.rows.addBoxMultipliers(np_, torque, &sigma, nullptr);
   return sigma;
 }
 
@@ -284,8 +247,8 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
   } else {
     np_.evaluate(&residual, nullptr, &unused);  // ∇f
   }
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
-    rows_.addRow(np_, g, k, in.g, -in.z, &residual);
+  block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+    block_.rows.addRow(np_, g, k, in.g, -in.z, &residual);
   });
   twist_gradient_ = np_.hasTwist() ? residual(np_.unknowns()) : 0.0;
   twist_stationarity_ = scale > 0 ? std::abs(twist_gradient_) / scale : 0.0;
@@ -296,7 +259,7 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
 LevelDuals ConstrainedSystem::duals() const {
   LevelDuals d;
   d.steps = np_.steps();
-  for (const FixedStepRows& g : rows_.groups) {
+  for (const FixedStepRows& g : block_.rows.groups) {
     d.first_k.push_back(g.support.first_k);
     d.z.emplace_back();
     d.s.emplace_back();
@@ -312,12 +275,12 @@ LevelDuals ConstrainedSystem::duals() const {
 /// instance nearest in time (a node constraint's multiplier does not scale with h: the cost
 /// Σ ½|τ_k|² weighs every node alike), and its slack c pushed inside by at most
 /// parameters_.warm_slack_push where the coarse constraint was binding (its coarse slack below the
-/// push), else as initializeMultipliers pushes it. Returns mean(s z).
+/// push), else as the form's initialize pushes it. Returns mean(s z).
 double ConstrainedSystem::warmStartDuals(const LevelDuals& coarse) {
   double sum = 0.0;
   int count = 0;
-  for (std::size_t gi = 0; gi < rows_.groups.size() && gi < coarse.z.size(); ++gi) {
-    FixedStepRows& g = rows_.groups[gi];
+  for (std::size_t gi = 0; gi < block_.rows.groups.size() && gi < coarse.z.size(); ++gi) {
+    FixedStepRows& g = block_.rows.groups[gi];
     const std::vector<double>& zc = coarse.z[gi];
     if (zc.empty()) continue;
     for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
@@ -346,7 +309,7 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   double gradient_scale = 0.0;
   const double cost = np_.evaluate(&cost_gradient, nullptr, &gradient_scale);
   std::vector<StationarityColumn> columns;
-  rows_.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
+  block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
     StationarityColumn column{in.c, in.g};
     for (int n = 0; n < g.support.width; ++n)
       column.index[n] = np_.variableIndex(k + g.support.node_offset + n);
@@ -355,23 +318,17 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   // Without an active constraint the multipliers take μ/c with μ a share of the cost per
   // constraint: the scale the cold start's barrier has too.
   const MultiplierEstimate e =
-      estimateMultipliers(cost_gradient, columns, cost / std::max(rows_.count, 1));
+      estimateMultipliers(cost_gradient, columns, cost / std::max(block_.rows.count, 1));
   LevelDuals d;
   d.steps = np_.steps();
   std::size_t i = 0;
-  for (const FixedStepRows& g : rows_.groups) {
+  for (const FixedStepRows& g : block_.rows.groups) {
     d.first_k.push_back(g.support.first_k);
     d.z.emplace_back(e.z.begin() + i, e.z.begin() + i + g.at.size());
     d.s.emplace_back(e.s.begin() + i, e.s.begin() + i + g.at.size());
     i += g.at.size();
   }
   return d;
-}
-
-/// Initial multipliers: the primal ones μ/s, capped at `cap` (violated constraints' primal
-/// multipliers are ≈ ρ: as duals they would swamp the Lagrangian's Hessian).
-void ConstrainedSystem::initializeMultipliers(double mu, double rho, double cap) {
-  rows_.forEach([&](auto&, int, auto& in) { form_->initialize(in, mu, rho, cap); });
 }
 
 template Assembly ConstrainedSystem::assemble<double>(double, double, bool, KktBlocks<double>*,

@@ -45,7 +45,10 @@ class ConstrainedSystem final : public BarrierRows {
   ConstrainedSystem(const PlanningProblem& problem, ReducedProblem* np, Formulation formulation,
                     const InteriorPointParameters& parameters);
 
-  int constraintCount() const { return rows_.count; }
+  int constraintCount() const { return block_.rows.count; }
+  /// The constraint block (its rows, their forms, the row-by-row steps).
+  BarrierRowBlock<FixedTimeStep>& block() { return block_; }
+  const BarrierRowBlock<FixedTimeStep>& block() const { return block_; }
   /// Global unknowns beside the node unknowns: 1 (ψ) with a pointing end condition, else 0.
   int globals() const { return FixedTimeStep::globals(np_); }
   /// ∂L/∂ψ = ∂f/∂ψ − Σ zᵢ∂cᵢ/∂ψ [N²·m²/rad] and its size relative as relativeStationarity's
@@ -61,12 +64,10 @@ class ConstrainedSystem final : public BarrierRows {
   /// φ_μ = f + Σ ψ_μ(c_i) at `steps` (and f in *cost); FreeSlacks at s + slack_alpha ds.
   double merit(const ReducedProblem::StepVectors& steps, double mu, double rho, double* cost,
                double slack_alpha = 0.0);
-  /// The constraints' part of the merit at the current values c: Elastic Σ ψ_μ(c_i) (ρ the
-  /// penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν) at s = s + α ds.
-  double constraintMerit(double mu, double rho, double alpha) const;
-  /// φ_μ from the constraint values of the last assembly (f = its cost).
+  /// φ_μ from the constraint values of the last assembly (f = its cost): Elastic Σ ψ_μ(c_i) (ρ
+  /// the penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν).
   double assembledMerit(double cost, double mu, double rho) const {
-    return cost + constraintMerit(mu, rho, 0.0);
+    return cost + block_.merit(0.0, nullptr, mu, rho, 0.0, false);
   }
 
   /// Assembles the condensed Newton system at the current iterate: K (the band and, with a twist,
@@ -83,10 +84,6 @@ class ConstrainedSystem final : public BarrierRows {
   void addSlackWeightedGradients(const std::vector<double>* products,
                                  Eigen::VectorXd* out) const override;
   void setComplementarityTarget(double mu, const std::vector<double>* products) override;
-  /// The largest dual step in (0, 1] by the fraction to the boundary, and the steps dz (kept in
-  /// the rows until applyDualStep).
-  double dualStep(const Eigen::VectorXd& d, double mu, double rho);
-  void applyDualStep(double alpha) { applyDualSteps(rows_, alpha); }
 
   /// What slackStep measures about the slack step.
   struct SlackStep {
@@ -98,15 +95,9 @@ class ConstrainedSystem final : public BarrierRows {
   /// FreeSlacks: the slack steps ds = gᵀdδ + c − s (stored in the instances).
   SlackStep slackStep(const Eigen::VectorXd& d, double mu);
   void applySlackStep(double alpha);
-  /// FreeSlacks: the largest multiplier after the dual step dz.
-  double largestMultiplier(double alpha) const;
   // BarrierRows (FreeSlacks' max |c − s|; the complementarity products).
-  double maxSlackResidual() const override;
+  double maxSlackResidual() const override { return block_.maxSlackResidual(); }
   void complementarity(double mu, double rho, double* average, double* smallest) const override;
-  /// Largest elastic violation max(−c_i) at the last assembly or merit.
-  double maxViolation() const;
-  /// Σ z_i c_i at the last assembly or merit: the constraints' part of the Lagrangian C − Σ z c.
-  double multipliedValues() const;
   /// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function).
   std::vector<Vector3> switchingFunction(const std::vector<Vector3>& torque) const;
   /// max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ| at the current iterate.
@@ -120,8 +111,6 @@ class ConstrainedSystem final : public BarrierRows {
   /// warmStartDuals takes them: re-derived from stationarity at the current iterate
   /// (multiplier_estimate.hpp). Evaluates the constraints' values and gradients.
   LevelDuals estimatedDuals();
-  /// Initial multipliers: the primal ones μ/s, capped at `cap`.
-  void initializeMultipliers(double mu, double rho, double cap);
 
  private:
   template <typename Scalar>
@@ -135,18 +124,14 @@ class ConstrainedSystem final : public BarrierRows {
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;
-  /// The form every row is in (one per formulation).
-  auto formOf() const {
-    return [this](const FixedStepRows&) -> const BarrierForm<9>& { return *form_; };
-  }
 
   const PlanningProblem& problem_;
   ReducedProblem& np_;
   const InteriorPointParameters& parameters_;
   bool free_slacks_;
-  std::unique_ptr<BarrierForm<9>> form_;    ///< FreeSlacks or L1Elastic: how a row enters φ_μ
-  StageConstraints constraints_;            ///< buildStageConstraints(problem): one group each
-  StageTranscription<FixedTimeStep> rows_;  ///< the rows and their passes over the grid
+  std::unique_ptr<BarrierForm<9>> form_;  ///< FreeSlacks or L1Elastic: how a row enters φ_μ
+  StageConstraints constraints_;          ///< buildStageConstraints(problem): one group each
+  BarrierRowBlock<FixedTimeStep> block_;  ///< the rows (all in form_) and their passes
   const Interruption* interruption_ = nullptr;
   double twist_gradient_ = 0.0, twist_stationarity_ = 0.0;
 };

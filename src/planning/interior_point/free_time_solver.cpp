@@ -76,9 +76,10 @@ class FreeTimeSolver final : public PrimalDualProblem {
         parameters_(parameters),
         N_(np->steps()),
         n_(np->unknowns()),
-        rows_(constraints, *np),
         feasible_(parameters),
         elastic_form_(parameters),
+        block_(constraints, *np,
+               [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); }),
         factorization_(step_factor_, kkt_, nullptr) {}
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
@@ -178,15 +179,12 @@ class FreeTimeSolver final : public PrimalDualProblem {
     if (elasticRows(g)) return elastic_form_;
     return feasible_;
   }
-  auto formOf() const {
-    return [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); };
-  }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
   /// The smallest value of the constraints that move with h (time_dependent) or of the others,
   /// not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
-    return rows_.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
+    return block_.rows.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
       return g.quantity->dependsOnTimeStep() == time_dependent;
     });
   }
@@ -194,10 +192,9 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
   double merit(double mu, double epsilon, bool check_boundary) const {
     const std::vector<Vector3> tau = np_.torques(np_.current());
-    MeritSum sum{objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon)};
     const QuantityInputs at(np_, np_.current());
-    addRowMerits(rows_, formOf(), &at, mu, rho_, 0.0, check_boundary, &sum);
-    return sum.value();
+    return block_.merit(objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon), &at, mu,
+                        rho_, 0.0, check_boundary);
   }
 
   double firstBarrier() const;
@@ -259,16 +256,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
   Pass end(Termination t, const std::string& why);
   /// Ends the solve converged, with the second-order check.
   Pass converged(const std::string& why);
-  void dualStep(const Eigen::VectorXd& d, double mu);
   double meritSlope(const Eigen::VectorXd& d) const;
-  void safeguardDuals(double mu);
   double barrierResidual(double mu) const;
   /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
   bool barrierHessianDefinite() const;
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
   std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
                       int iterations) const;
-  void initializeDuals(double mu);
   /// Reports one pass of the loop (one counted iteration) to the context: an accepted step of
   /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
   /// iterate the pass started from.
@@ -282,9 +276,9 @@ class FreeTimeSolver final : public PrimalDualProblem {
   const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  StageTranscription<FreeTimeStep> rows_;  ///< the rows and their passes over the grid (η)
-  Feasible feasible_;                      ///< −μ ln c: how a row enters the barrier problem
-  L1Elastic<10> elastic_form_;             ///< an elastic start's rows (elasticRows)
+  Feasible feasible_;                    ///< −μ ln c: how a row enters the barrier problem
+  L1Elastic<10> elastic_form_;           ///< an elastic start's rows (elasticRows)
+  BarrierRowBlock<FreeTimeStep> block_;  ///< the constraint block, its rows in form(group)
   /// The assembled system at the current iterate: the band, its border (η) and corner.
   KktBlocks<double> kkt_{1};
   Eigen::VectorXd rhs_, lagrangian_gradient_;
@@ -352,15 +346,15 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
       rhs += terms.rhs * in.g;
       lagrangian -= in.z * in.g;
     };
-    rows_.chainTorques(st, s, G, fold);
+    block_.rows.chainTorques(st, s, G, fold);
     H.noalias() += G.transpose() * W * G;
     scatter(sink, st.k - 1, 3, H, rhs, lagrangian);
   };
-  rows_.forEachTorqueStencil(np_, step, true, cost, row, visit);
+  block_.rows.forEachTorqueStencil(np_, step, true, cost, row, visit);
   // The quantities that do not move with h first (the order the band's sums were formed in).
   for (const bool moves_with_h : {false, true}) {
-    for (const std::vector<int>& block : rows_.blocks) {
-      if (rows_.groups[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
+    for (const std::vector<int>& block : block_.rows.blocks) {
+      if (block_.rows.groups[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
         assembleQuantity(sink, block, mu);
       }
     }
@@ -373,7 +367,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// (local nodes, η = h/h₀) and the chain rule (StageTranscription), with each constraint's
 /// barrier term ω g gᵀ.
 void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block, double mu) {
-  const StageSupport support = rows_.groups[block.front()].support;
+  const StageSupport support = block_.rows.groups[block.front()].support;
   const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) {
     form(g).prepare(in, mu, rho_, false);
   };
@@ -381,9 +375,9 @@ void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block,
     Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
     const int m = 3 * support.width;  // g is 0 past the local nodes but for η
     for (const int i : block) {
-      FreeTimeRow& in = rows_.groups[i].instance(t.k);
+      FreeTimeRow& in = block_.rows.groups[i].instance(t.k);
       // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-      const RowTerms terms = form(rows_.groups[i]).terms(in, mu);
+      const RowTerms terms = form(block_.rows.groups[i]).terms(in, mu);
       const double w = terms.weight;
       H->topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
       H->block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
@@ -394,7 +388,7 @@ void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block,
     }
     scatter(sink, t.k + support.node_offset, support.width, *H, rhs, lagrangian);
   };
-  rows_.forEachQuantityInstance(
+  block_.rows.forEachQuantityInstance(
       np_, FreeTimeStep{h0_}, block, true, [](int) {}, prepare, visit);
 }
 
@@ -426,7 +420,7 @@ void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
   restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h + alpha * h0_ * d(n_));
   // The iterate's nodes moved by α d (and R_N by α dψ with a pointing end).
-  rows_.accept(np_, rows_.retract(np_, d, alpha), d, alpha);
+  block_.rows.accept(np_, block_.rows.retract(np_, d, alpha), d, alpha);
 }
 
 double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) {
@@ -466,18 +460,19 @@ void FreeTimeSolver::restore() {
 /// next to it, curved in the attitudes, cut it to 1/8 … 1/512 again and again (measured: 0.96 N m
 /// about body x against |u_x| ≤ 1). The corrected step solves the same Newton system with the
 /// barrier's linearization c + gᵀd + r: d' = d − K⁻¹ Σ (z/c) r g, one more solve with the step's
-/// factorization; its dual step uses the same model (dualStep). False where no r is nonzero or
-/// the corrected step is not finite.
+/// factorization; its dual step uses the same model (BarrierRowBlock::dualStep). False where no r
+/// is nonzero or the corrected step is not finite.
 bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
-  rows_.forEachValue(QuantityInputs(np_, np_.current()), [&](auto& g, int k, auto& in, double c) {
-    in.r = c - in.c - rows_.dot(np_, g, k, in.g, d);
-    const double w = -form(g).terms(in, 0.0).weight * in.r;
-    if (w == 0.0) return;
-    curved = true;
-    rows_.addRow(np_, g, k, in.g, w, &v);
-  });
+  block_.rows.forEachValue(QuantityInputs(np_, np_.current()),
+                           [&](auto& g, int k, auto& in, double c) {
+                             in.r = c - in.c - block_.rows.dot(np_, g, k, in.g, d);
+                             const double w = -form(g).terms(in, 0.0).weight * in.r;
+                             if (w == 0.0) return;
+                             curved = true;
+                             block_.rows.addRow(np_, g, k, in.g, w, &v);
+                           });
   if (!curved) return false;
   step_factor_.solve(&v);
   if (!v.allFinite()) return false;
@@ -486,17 +481,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
 }
 
 void FreeTimeSolver::clearCorrection() {
-  rows_.forEach([](FreeTimeRows&, int, FreeTimeRow& in) { in.r = 0.0; });
-}
-
-/// dz = μ/c − z − (z/c) (gᵀd + r) at the assembled point (r: the second-order correction's
-/// curvature term, 0 for an uncorrected step; an elastic row: dz = (q − gᵀd)/D), and the largest
-/// dual step by the fraction to the boundary (an elastic row's on z and on ρ − z); applied to z.
-void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
-  const auto slope = [&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
-    return rows_.dot(np_, g, k, in.g, d) + in.r;
-  };
-  applyDualSteps(rows_, dualSteps(rows_, formOf(), slope, mu, rho_));
+  block_.rows.forEach([](FreeTimeRows&, int, FreeTimeRow& in) { in.r = 0.0; });
 }
 
 /// ∇φ_μ·d at the assembled point. The right-hand side is −∇φ_μ where every row's coefficient β
@@ -505,30 +490,18 @@ void FreeTimeSolver::dualStep(const Eigen::VectorXd& d, double mu) {
 double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   double slope = -d.dot(rhs_);
   if (!elastic_) return slope;
-  rows_.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
+  block_.rows.forEach([&](const FreeTimeRows& g, int k, const FreeTimeRow& in) {
     if (elasticRows(g))
-      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * rows_.dot(np_, g, k, in.g, d);
+      slope += (form(g).terms(in, mu_).rhs - mu_ / in.s) * block_.rows.dot(np_, g, k, in.g, d);
   });
   return slope;
-}
-
-/// z within [μ/(κ_Σ c), κ_Σ μ/c] at the current values c (an elastic row's multiplier is
-/// safeguarded where it is prepared for the next assembly).
-void FreeTimeSolver::safeguardDuals(double mu) {
-  rows_.evaluate(QuantityInputs(np_, np_.current()));
-  rows_.forEach([&](auto& g, int, auto& in) { form(g).afterAccept(in, mu); });
-}
-
-void FreeTimeSolver::initializeDuals(double mu) {
-  rows_.evaluate(QuantityInputs(np_, np_.current()));
-  rows_.forEach([&](auto& g, int, auto& in) { form(g).prepare(in, mu, rho_, true); });
 }
 
 /// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point (an
 /// elastic row: |zs − μ| and |(ρ − z)v − μ|).
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  return std::max(stationarity, complementarityOf(rows_, formOf(), mu, rho_).worst);
+  return std::max(stationarity, block_.complementarity(mu, rho_).worst);
 }
 
 std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double gap,
@@ -565,7 +538,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
                                     const BarrierWatch& watch) {
   context_ = &context;
   watch_ = &watch;
-  const int m = rows_.count;
+  const int m = block_.rows.count;
   mu0_ = parameters_.free_time.initial_barrier / m;
   mu_final_ = parameters_.final_barrier_fraction * tolerance / m;
   objective_ = MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
@@ -573,7 +546,9 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
   scales_ = {1.0, 1, N_, mu_final_};
   mu_ = firstBarrier();
-  initializeDuals(mu_);
+  // The first multipliers: the primal ones at the start's values (an elastic row safeguarded).
+  block_.evaluate(np_.current());
+  block_.prepare(mu_, rho_, true);
   PrimalDualLoop(
       *this,
       {test_, std::make_unique<MonotoneBarrier>(parameters_, freeTimeMonotone(parameters_)),
@@ -603,7 +578,7 @@ double FreeTimeSolver::firstBarrier() const {
 void FreeTimeSolver::prepare() {
   epsilon_ = objective_.setBarrier(mu_);
   assemble(mu_, epsilon_);
-  gap_ = rows_.dualityGap();
+  gap_ = block_.rows.dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   barrier_residual_ = mu_ > mu_final_ ? barrierResidual(mu_) : 0.0;  // the μ rule's test
 }
@@ -637,9 +612,14 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 
 /// The order is the method's: dual step, leaving the elastic phase, κ_Σ (the loop then damps).
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
-  dualStep(d_, mu_);
+  // dz = μ/c − z − (z/c)(gᵀd + r) (r: the second-order correction's term; an elastic row's
+  // dz = (q − gᵀd)/D) and the largest dual step by the fraction to the boundary, applied.
+  block_.applyDualStep(block_.dualStep(d_, mu_, rho_));
   leaveElasticIfInside();
-  safeguardDuals(mu_);
+  // κ_Σ: z within [μ/(κ_Σ c), κ_Σ μ/c] at the new values c (an elastic row's multiplier is
+  // safeguarded where it is prepared for the next assembly).
+  block_.evaluate(np_.current());
+  block_.afterAccept(mu_);
   report(result.alpha, stationarity_);
   return Pass::Continue;
 }
@@ -701,14 +681,12 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   if (np_.hasTwist() && lagrangian_gradient_.size() == n_ + borderSize()) {
     out.twist_gradient = lagrangian_gradient_(FreeTimeStep::twistIndex(np_));
   }
-  out.complementarity = rows_.dualityGap();
-  out.smallest_value = std::numeric_limits<double>::infinity();
-  rows_.forEach(
-      [&](auto&, int, auto& in) { out.smallest_value = std::min(out.smallest_value, in.c); });
+  out.complementarity = block_.rows.dualityGap();
+  out.smallest_value = block_.smallestValue();
   out.torque_multipliers.assign(N_ + 1, Vector3::Zero());
-  if (rows_.hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
-  rows_.addBoxMultipliers(np_, np_.torques(out.steps), &out.switching_function,
-                          &out.torque_multipliers);
+  if (block_.rows.hasTorqueBox()) out.switching_function.assign(N_ + 1, Vector3::Zero());
+  block_.rows.addBoxMultipliers(np_, np_.torques(out.steps), &out.switching_function,
+                                &out.torque_multipliers);
   out.maneuver = np_.maneuver(out.steps);
   recordVerdict(
       &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,

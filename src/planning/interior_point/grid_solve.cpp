@@ -36,10 +36,6 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
   return s.str();
 }
 
-bool ranOut(Termination t) {
-  return t == Termination::Cancelled || t == Termination::TimedOut;
-}
-
 template <typename Scalar>
 class GridSolve final : public PrimalDualProblem {
  public:
@@ -103,7 +99,7 @@ class GridSolve final : public PrimalDualProblem {
         std::min(mu_, p_.final_barrier_fraction * options_.tolerance * f / m *
                           std::max(1.0, static_cast<double>(N) / p_.final_barrier_round_off_steps));
     system_.evaluateValues(np_.current(), nullptr);
-    system_.initializeMultipliers(mu_, rho_, p_.initial_multiplier_cap * f / m);
+    system_.block().initialize(mu_, rho_, p_.initial_multiplier_cap * f / m);
     if (request_.barrier == BarrierRule::Mehrotra && request_.coarse_duals &&
         !request_.coarse_duals->empty() && request_.coarse_steps) {
       // The barrier of the warm start: its own complementarity (the predictor lowers it).
@@ -118,7 +114,7 @@ class GridSolve final : public PrimalDualProblem {
     BarrierState s;
     s.iteration = iteration_;
     s.at_final_barrier = mu_ <= scales_.mu_final;
-    s.max_violation = system_.maxViolation();
+    s.max_violation = system_.block().maxViolation();
     s.f_scale = scales_.f_scale;
     return s;
   }
@@ -157,9 +153,9 @@ class GridSolve final : public PrimalDualProblem {
   /// a lower one than φ's own with free slacks), ending it with the watch's reason.
   bool watched(double shift, double slope) {
     if (!request_.watch || !free_slacks_ || shift != 0.0 || slope >= 0.0) return false;
-    if (system_.maxViolation() > 0.0) return false;
+    if (system_.block().maxViolation() > 0.0) return false;
     const FeasibleIterate at{
-        cost_, cost_ - system_.multipliedValues() + 0.5 * slope,
+        cost_, cost_ - system_.block().rows.dualityGap() + 0.5 * slope,
         std::sqrt(-slope / std::max(2.0 * cost_, std::numeric_limits<double>::min())), iteration_};
     if (!(at.relative_decrement <= kLocalBoundDecrement)) return false;
     const std::string stop = (*request_.watch)(at);
@@ -194,8 +190,8 @@ class GridSolve final : public PrimalDualProblem {
   void addSlackTerms(double* slope, double* decrement_slope) {
     const ConstrainedSystem::SlackStep slack = system_.slackStep(delta_, mu_);
     alpha_slack_ = slack.alpha;
-    alpha_dual_ = system_.dualStep(delta_, mu_, rho_);
-    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.largestMultiplier(0.0));
+    alpha_dual_ = system_.block().dualStep(delta_, mu_, rho_);
+    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.block().largestMultiplier(0.0));
     const double without_penalty = *slope + slack.barrier_slope;
     const double fraction = p_.merit_infeasibility_fraction;
     if (slack.residual > 0.0 && without_penalty > -fraction * nu_ * slack.residual) {
@@ -247,9 +243,9 @@ class GridSolve final : public PrimalDualProblem {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
     } else {
-      alpha_dual_ = system_.dualStep(delta_, mu_, rho_);
+      alpha_dual_ = system_.block().dualStep(delta_, mu_, rho_);
     }
-    system_.applyDualStep(std::min(alpha_dual_, 1.0));
+    system_.block().applyDualStep(std::min(alpha_dual_, 1.0));
     FixedStepTranscription::accept(np_, trial, delta_, alpha);
   }
 
@@ -269,15 +265,15 @@ class GridSolve final : public PrimalDualProblem {
   Pass endBarrierProblem() {
     ++iteration_;
     system_.evaluateValues(np_.current(), nullptr);
-    const double violation = system_.maxViolation();
+    const double violation = system_.block().maxViolation();
     if (violation <= p_.feasibility_tolerance) return end(Termination::Converged, "converged");
     if (!free_slacks_ && penalty_raises_ == 0 && violation <= p_.penalty_raise_violation) {
       ++penalty_raises_;
       rho_ *= p_.fixed_step.penalty_growth;
       mu_ = mu_start_;
       test_.restart(iteration_);
-      system_.initializeMultipliers(
-          mu_, rho_, p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
+      system_.block().initialize(mu_, rho_,
+                                 p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
       // The raise is counted as an iteration (the step before it ended a pass too): reported,
       // at the same iterate, so that the context's count is the solve's.
       if (report(cost_, relative_decrement_, 0.0)) return Pass::Continue;
@@ -333,7 +329,7 @@ class GridSolve final : public PrimalDualProblem {
     // tell a stopped iterate from an answer).
     result.max_residual = std::numeric_limits<double>::quiet_NaN();
     const PlanningProblem posed = posedAtIterate();
-    if (!ranOut(ending_) || request_.evaluate_when_stopped) {
+    if (!stoppedByRequest(ending_) || request_.evaluate_when_stopped) {
       const Maneuver planned = np_.maneuver(np_.current());
       result.switching_function = system_.switchingFunction(planned.torque);
       result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
@@ -358,9 +354,9 @@ class GridSolve final : public PrimalDualProblem {
       msg << reason_;
     }
     result.termination = ending_;
-    recordVerdict(&result,
-                  verdicts::InteriorPointEnded{msg.str(), iteration_, relative_decrement_,
-                                               mu_ / scales_.f_scale, system_.maxViolation()});
+    recordVerdict(&result, verdicts::InteriorPointEnded{msg.str(), iteration_, relative_decrement_,
+                                                        mu_ / scales_.f_scale,
+                                                        system_.block().maxViolation()});
     result.levels.push_back({np_.steps(), iteration_, ending_, result.max_residual,
                              relative_decrement_,
                              std::string(free_slacks_ ? "interior point (free slacks): "

@@ -105,10 +105,6 @@ constexpr FormulationRecipe kProbeRecipe = {
     {Formulation::FreeSlacks, BarrierRule::Monotone, "free slacks"},
 };
 
-bool ranOut(Termination t) {
-  return t == Termination::Cancelled || t == Termination::TimedOut;
-}
-
 /// What a solve of the interior point needs besides the problem.
 struct Solve {
   const InteriorPointParameters& parameters;
@@ -213,6 +209,22 @@ PlanResult unconstrainedStart(const PlanningProblem& problem, const PlanningProb
   return unconstrained;
 }
 
+/// Without a coarser iterate a level starts from its unconstrained optimum (unconstrainedStart):
+/// *level_options warm-start from that plan where it converged (the plan and the resampled warm
+/// start they may point at are kept in *start).
+struct OwnStart {
+  PlanResult plan;
+  Maneuver resampled;
+};
+void startFromOwnOptimum(const PlanningProblem& problem, const SolveRequest& options,
+                         const Solve& solve, const LevelRequest<LevelIterate>& r,
+                         SolveRequest* level_options, OwnStart* start) {
+  if (r.coarse) return;
+  start->plan = unconstrainedStart(problem, r.problem, options, solve.context, level_options,
+                                   &start->resampled);
+  level_options->warm_start = start->plan.converged() ? &start->plan.maneuver : nullptr;
+}
+
 /// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
 /// once more through the level in between. Replaces *direct if that converges (the level's tally
 /// counts every solve's iterations, the context records their levels).
@@ -253,7 +265,7 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolveRequest& opti
   const auto endsAsTheStop = [&] {
     if (solve.context.levels().size() > first_level) solve.context.endLastLevelAs(stop.termination);
   };
-  if (ranOut(stop.termination)) {
+  if (stoppedByRequest(stop.termination)) {
     GridOutcome carried;
     if (r.coarse) carried.steps = r.coarse->steps;
     if (r.coarse) carried.formulation = r.coarse->formulation;
@@ -267,13 +279,8 @@ GridOutcome replayLevel(const PlanningProblem& problem, const SolveRequest& opti
   SolveRequest level_options = options;
   level_options.warm_start = nullptr;
   level_options.max_iterations = 0;
-  PlanResult start;
-  Maneuver resampled;
-  if (!r.coarse) {
-    start =
-        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
-    level_options.warm_start = start.converged() ? &start.maneuver : nullptr;
-  }
+  OwnStart start;
+  startFromOwnOptimum(problem, options, solve, r, &level_options, &start);
   GridOutcome outcome = solveGridWithRetry(
       r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr, nullptr, r.finest);
   outcome.result.iterations = tally.iterations();
@@ -292,19 +299,14 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolveRequest& optio
   level_options.warm_start = nullptr;
   level_options.tolerance = r.tolerance;
   const SolveContext::IterationTally tally(solve.context);  // the iterations of every solve on it
-  Maneuver resampled;
-  PlanResult unconstrained;
-  if (!r.coarse) {
-    unconstrained =
-        unconstrainedStart(problem, r.problem, options, solve.context, &level_options, &resampled);
-    level_options.warm_start = unconstrained.converged() ? &unconstrained.maneuver : nullptr;
-  }
+  OwnStart start;
+  startFromOwnOptimum(problem, options, solve, r, &level_options, &start);
   const LevelDuals no_duals;
   GridOutcome outcome =
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
                          r.coarse ? &r.coarse->duals : &no_duals, r.finest);
   const LevelDuals direct_duals = outcome.duals;
-  if (!outcome.result.converged() && !ranOut(outcome.result.termination) && r.coarse &&
+  if (!outcome.result.converged() && !stoppedByRequest(outcome.result.termination) && r.coarse &&
       r.problem.steps % 2 == 0) {
     refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome);
   }

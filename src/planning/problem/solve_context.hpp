@@ -25,6 +25,12 @@ struct SolveInterrupted {
   Termination termination = Termination::Cancelled;  ///< Cancelled or TimedOut
 };
 
+/// Whether a solve ended because the request stopped it (Cancelled or TimedOut): no retry, no
+/// further level, the last iterate as it is.
+inline bool stoppedByRequest(Termination t) {
+  return t == Termination::Cancelled || t == Termination::TimedOut;
+}
+
 class SolveContext : public Interruption {
  public:
   using Clock = std::chrono::steady_clock;

@@ -121,27 +121,30 @@ Matrix3 DiscreteScheme::stepFromVelocity(const Vector3& omega) const {
 Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
                                   StepSolveReport* report) const {
   constexpr int kMaxIterations = 60;
+  const bool paper = kind_ == SchemeKind::Paper;
   // Warm starts chain F from step to step: restore orthogonality so round-off in F cannot
   // accumulate over millions of steps (μ of a non-orthogonal F breaks momentum conservation).
   Matrix3 F = 0.5 * guess * (3.0 * Matrix3::Identity() - guess.transpose() * guess);
-  Vector3 r = momentum<double>(F) - p;
+  // log(F), formed once per iterate: the paper μ, its Jacobian and the tolerance all read it.
+  Vector3 w = so3::log(F);
+  Vector3 r = momentumWithLog<double>(F, w) - p;
   double r_norm = r.norm();
-  auto tolerance = [&](const Matrix3& G) {
+  auto tolerance = [&](const Vector3& log_of_F) {
     // relative part, plus the absolute round-off floor of evaluating μ (≈ eps·‖J‖/h at any F)
-    return 1e-14 * (p.norm() + J_.norm() * so3::log(G).norm() / h_) + 1e-15 * J_.norm() / h_;
+    return 1e-14 * (p.norm() + J_.norm() * log_of_F.norm() / h_) + 1e-15 * J_.norm() / h_;
   };
   report->converged = false;
   int polish_steps = 0;
   int it = 0;
   for (; it < kMaxIterations; ++it) {
-    if (r_norm <= tolerance(F)) {
+    if (r_norm <= tolerance(w)) {
       report->converged = true;
       // Newton converges quadratically: up to two more steps take the residual from the
       // tolerance to round-off, so conserved quantities do not drift by tolerance × steps.
       if (r_norm == 0.0 || polish_steps >= 2) break;
       ++polish_steps;
     }
-    const Matrix3 D = momentumJacobian<double>(F);
+    const Matrix3 D = paper ? paperMomentumJacobian<double>(F, w) : momentumJacobian<double>(F);
     // 3×3 cofactor inverse (a Newton step corrects its own round-off); singular relative to
     // D's scale means no step can be found from here.
     const double scale = D.cwiseAbs().maxCoeff();
@@ -153,9 +156,11 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
     bool improved = false;
     for (int back = 0; back < 30; ++back) {
       const Matrix3 trial = F * so3::exp(Vector3(step * delta));
-      const Vector3 r_trial = momentum<double>(trial) - p;
+      const Vector3 w_trial = paper ? so3::log(trial) : Vector3::Zero();
+      const Vector3 r_trial = momentumWithLog<double>(trial, w_trial) - p;
       if (r_trial.allFinite() && r_trial.norm() < r_norm) {
         F = trial;
+        w = paper ? w_trial : so3::log(F);
         r = r_trial;
         r_norm = r_trial.norm();
         improved = true;
@@ -166,13 +171,13 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
     }
     if (!improved) {
       // Round-off floor reached: accept if within 100× the tolerance.
-      if (r_norm <= 100.0 * tolerance(F)) report->converged = true;
+      if (r_norm <= 100.0 * tolerance(w)) report->converged = true;
       break;
     }
   }
   report->iterations = it;
-  report->residual = (momentum<double>(F) - p).norm();
-  if (!report->converged && report->residual <= tolerance(F)) report->converged = true;
+  report->residual = (momentumWithLog<double>(F, w) - p).norm();
+  if (!report->converged && report->residual <= tolerance(w)) report->converged = true;
   // |p| beyond ~1e154 overflows the norms: the tolerance becomes +inf and every test above
   // passes (found by fuzz_request: Ω_0 = −5e153 rad/s was "solved"). No such step exists.
   if (!std::isfinite(report->residual) || !F.allFinite()) report->converged = false;

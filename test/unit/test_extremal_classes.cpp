@@ -14,6 +14,7 @@
 #include <random>
 #include <vector>
 
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/strategies/starts.hpp"
 
@@ -239,6 +240,7 @@ TEST(ExtremalClasses, TheClassesSolvedAtOnceGiveTheAnswerOfOneThreadAndKeepTheCh
       EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
       EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
       EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
+      EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
       const bool on_grid = x.steps == p.steps && x.termination == Termination::Converged;
       if (x.stage == AttemptStage::ClassRefine && on_grid) {
         least_refined = std::min(least_refined, x.cost);
@@ -247,6 +249,62 @@ TEST(ExtremalClasses, TheClassesSolvedAtOnceGiveTheAnswerOfOneThreadAndKeepTheCh
     EXPECT_LE(a.cost, least_refined * (1 + 1e-12)) << i << ": " << a.extremal;
   }
   EXPECT_GE(refined_at_once, 3);
+}
+
+// Slow spinning solves (scripts/extremal_classes.py's generator, N = 64) whose more starts run
+// in branches: 3 in the kept class, and 6 in two classes (the kept one and the request's own).
+// Each start is an independent solve, so one and two threads give the same trail and answer.
+TEST(ExtremalClasses, TheMoreStartsRunAtOnceGiveTheAnswerOfOneThread) {
+  const char* scenes[] = {
+      "inertia: [[40.9053900518525, 3.6054074968064342, -0.28164841523941142], "
+      "[3.6054074968064342, 68.978893603131922, -9.804713140251863], [-0.28164841523941142, "
+      "-9.804713140251863, 41.87368780680174]]\n"
+      "duration: 14.544711502630824\nsteps: 64\nscheme: paper\n"
+      "initial: {attitude: {quaternion: [-0.31947350194083779, -0.61958428260905574, "
+      "-0.15897861754650094, -0.69912645312881894]}, angular_velocity: [-0.36868571465208672, "
+      "-0.0015790015139541987, 4.1043659914646042]}\n"
+      "final: {attitude: {quaternion: [-0.14040452528866926, -0.46608876476477235, "
+      "0.8219292559260355, -0.29577040232481971]}, angular_velocity: [1.0859671799735451, "
+      "3.7173718750229181, -1.2587261631436981]}\n",
+      "inertia: [[1.087579760275547, 0.1114897336681428, 0.16150268979342522], "
+      "[0.1114897336681428, 0.9886668414034997, 0.16503593828882052], [0.16150268979342522, "
+      "0.16503593828882052, 1.5324755258280274]]\n"
+      "duration: 19.582854065187238\nsteps: 64\nscheme: paper\n"
+      "initial: {attitude: {quaternion: [0.81267929769133418, 0.072567714934403726, "
+      "0.2125399903416649, 0.53769232685494417]}, angular_velocity: [-2.3816623399376473, "
+      "3.3917483011872682, 2.5181753832412799]}\n"
+      "final: {attitude: {quaternion: [0.85233312448114629, 0.27573117313918388, "
+      "-0.4269410676538869, -0.12337702307178358]}, angular_velocity: [0.26543858974793527, "
+      "0.29630140626943263, 0.16988949986585566]}\n"};
+  const long more_starts[] = {3, 6};
+  for (int i = 0; i < 2; ++i) {
+    const PlanningProblem p = parseScene(scenes[i]).problem;
+    SolverOptions one, two;
+    one.threads = 1;
+    two.threads = 2;
+    const PlanResult a = planManeuver(p, one);
+    const PlanResult b = planManeuver(p, two);
+    ASSERT_TRUE(a.converged()) << i << ": " << a.message();
+    EXPECT_EQ(std::count_if(a.attempts.begin(), a.attempts.end(),
+                            [](const Attempt& x) { return x.stage == AttemptStage::MoreStarts; }),
+              more_starts[i])
+        << i;
+    EXPECT_EQ(a.cost, b.cost) << i;
+    EXPECT_EQ(a.iterations, b.iterations) << i;
+    EXPECT_EQ(a.extremal, b.extremal) << i;
+    ASSERT_EQ(a.attempts.size(), b.attempts.size()) << i;
+    for (std::size_t k = 0; k < a.attempts.size(); ++k) {
+      const Attempt& x = a.attempts[k];
+      const Attempt& y = b.attempts[k];
+      EXPECT_EQ(x.stage, y.stage) << i << ", attempt " << k;
+      EXPECT_EQ(x.start, y.start) << i << ", attempt " << k;
+      EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
+      EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
+      EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
+      EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
+      if (x.termination == Termination::Converged) EXPECT_EQ(x.cost, y.cost) << i << ", " << k;
+    }
+  }
 }
 
 namespace {

@@ -184,6 +184,10 @@ class DiscreteScheme {
   /// The paper scheme's dμ/dε at F = exp(w^).
   template <typename S>
   so3::Mat3<S> paperMomentumJacobian(const so3::Mat3<S>& F, const so3::Vec3<S>& w) const;
+  /// μ(F) given w = log(F) (the paper scheme reads it; the variational one does not): the one
+  /// formula of momentum(), for a caller that holds the log already.
+  template <typename S>
+  so3::Vec3<S> momentumWithLog(const so3::Mat3<S>& F, const so3::Vec3<S>& w) const;
 
   SchemeKind kind_;
   Matrix3 J_;
@@ -196,9 +200,15 @@ class DiscreteScheme {
 
 template <typename S>
 so3::Vec3<S> DiscreteScheme::momentum(const so3::Mat3<S>& F) const {
-  const so3::Mat3<S> J = J_.template cast<S>();
+  if (kind_ == SchemeKind::Paper) return momentumWithLog<S>(F, so3::log<S>(F));
+  return momentumWithLog<S>(F, so3::Vec3<S>::Zero());
+}
+
+template <typename S>
+so3::Vec3<S> DiscreteScheme::momentumWithLog(const so3::Mat3<S>& F, const so3::Vec3<S>& w) const {
   if (kind_ == SchemeKind::Paper) {  // variational and second_order share μ
-    const so3::Vec3<S> Omega = so3::log<S>(F) / S(h_);
+    const so3::Mat3<S> J = J_.template cast<S>();
+    const so3::Vec3<S> Omega = w / S(h_);
     return F * (J * Omega);
   }
   const so3::Mat3<S> Jd = Jd_.template cast<S>();

@@ -447,10 +447,11 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
     // a stopped solve's hand-over).
     result.maneuver = np.maneuver(np.current());
     result.max_residual = solver.relativeGradient();
-    evaluatePlan(problem, result.maneuver.torque, &result, &result.maneuver);
+    StepResidual residual;
+    evaluatePlan(problem, result.maneuver.torque, &result, &result.maneuver, &residual);
     // Judged by what the plan is: the open-loop replay's miss is a sensitivity, not a verdict.
     if (termination == Termination::Converged) {
-      const std::string inconsistent = planInconsistency(problem, result, false);
+      const std::string inconsistent = planInconsistency(problem, result, false, &residual);
       if (!inconsistent.empty()) {
         termination = Termination::NotConverged;
         reason = inconsistent;

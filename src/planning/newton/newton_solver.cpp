@@ -6,8 +6,9 @@
 // A request that names its class, or is warm-started, is solved in that class only. Then, as data
 // (kNewtonRecipe), each behind a named gate: the continuation in the boundary rates and the
 // coasting start for a spinning request that stalled, and more starts in the kept class for a slow
-// spinning solve. Every attempt runs in the request's SolveContext (one clock and deadline, one
-// cancel flag, iterations numbered across attempts) and is recorded in its trail.
+// spinning solve (independent solves: at once, on the request's threads). Every attempt runs in the
+// request's SolveContext (one clock and deadline, one cancel flag, iterations numbered across
+// attempts) and is recorded in its trail.
 #include "planning/newton/newton_solver.hpp"
 
 #include <algorithm>
@@ -697,6 +698,59 @@ AttemptStart startOf(Method method, const PlanningProblem& problem, const Newton
                                                       : AttemptStart::Hermite;
 }
 
+/// One more start: a recipe entry and the class it runs in.
+struct MoreStart {
+  const RecipeEntry* entry;
+  PlanningProblem in_class;
+};
+
+/// The more starts whose gates hold, in the recipe's order for each searched class (the kept
+/// one, then the request's own). The gates read only what the walk held before them (a converged
+/// kept plan stays converged, and each class's coasting attempts are its own), so they are read
+/// at once, before any of them runs.
+std::vector<MoreStart> moreStarts(const PlanningProblem& problem, RecipeState* state) {
+  std::vector<MoreStart> out;
+  const HomotopyClass kept = state->walk.keptClass();
+  for (const ClassSolve& searched : state->walk.searchedClasses(homotopyClassOf(problem))) {
+    state->class_iterations = searched.iterations;
+    state->kept_class = sameHomotopyClass(searched.homotopy, kept);
+    state->searched = searched.homotopy;
+    for (const RecipeEntry& entry : kNewtonRecipe) {
+      if (entry.stage == AttemptStage::MoreStarts && entry.when(*state)) {
+        out.push_back({&entry, pinnedToClass(problem, searched.homotopy)});
+      }
+    }
+  }
+  return out;
+}
+
+/// The more starts, each an independent solve in its own branch of `context` (a queue on the
+/// request's threads), recorded in their order; as run one after another, the walk ends with the
+/// first that a stop (cancel, deadline) ended, and a start the stop kept from beginning is left
+/// out, with those after it.
+void runMoreStarts(const std::vector<MoreStart>& starts, SolveContext& context, Walk* walk,
+                   const NewtonParameters& p) {
+  std::vector<std::optional<PlanResult>> results(starts.size());
+  std::vector<char> began(starts.size(), 0);  // not vector<bool>: each thread writes its own
+  runBranches(context, static_cast<int>(starts.size()), [&](int i, SolveContext& branch) {
+    if (branch.stopReason()) return;
+    began[i] = 1;
+    const SolveContext::Scope scope(branch, starts[i].entry->stage,
+                                    homotopyClassOf(starts[i].in_class));
+    results[i] = runEntry(*starts[i].entry, starts[i].in_class, branch, p);
+  });
+  for (std::size_t i = 0; i < starts.size() && began[i]; ++i) {
+    if (!results[i]) continue;  // no start (no coasting motion at this h)
+    const RecipeEntry& entry = *starts[i].entry;
+    const Termination termination = results[i]->termination;
+    const int own = results[i]->iterations;
+    walk->add(attemptIn(entry.stage, startOf(entry.method, starts[i].in_class, p),
+                        starts[i].in_class, entry.globalization),
+              std::move(*results[i]), own);
+    if (termination == Termination::Cancelled || termination == Termination::TimedOut) break;
+  }
+}
+
 /// The request's own class through the grids (from its warm start if given).
 void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, Walk* walk,
                          const NewtonParameters& p, const Maneuver* solved_before) {
@@ -791,18 +845,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& r
     if (context.stopReason()) break;
     if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);
   }
-  const HomotopyClass kept = walk.keptClass();
-  for (const ClassSolve& searched : walk.searchedClasses(homotopyClassOf(problem))) {
-    state.class_iterations = searched.iterations;
-    state.kept_class = sameHomotopyClass(searched.homotopy, kept);
-    state.searched = searched.homotopy;
-    for (const RecipeEntry& entry : kNewtonRecipe) {
-      if (context.stopReason()) break;
-      if (entry.stage == AttemptStage::MoreStarts && entry.when(state)) {
-        run(entry, pinnedToClass(problem, searched.homotopy));
-      }
-    }
-  }
+  if (!context.stopReason()) runMoreStarts(moreStarts(problem, &state), context, &walk, p);
   PlanResult result = walk.finish();
   context.recordLevels(result.levels);  // the plan's: its kept attempt's
   return result;

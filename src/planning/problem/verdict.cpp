@@ -104,9 +104,10 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
 }
 
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
-                              bool constraints) {
+                              bool constraints, const StepResidual* measured) {
   std::ostringstream why;
-  const StepResidual residual = measureStepResidual(problem, result.maneuver);
+  const StepResidual residual =
+      measured ? *measured : measureStepResidual(problem, result.maneuver);
   if (!(residual.relative <= residual.tolerance)) {
     why << "stationary point found, but its attitudes, velocities and torques miss the discrete "
            "equations of motion by "
@@ -210,7 +211,7 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 }
 
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
-                  PlanResult* result, const Maneuver* planned) {
+                  PlanResult* result, const Maneuver* planned, StepResidual* residual) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);
   result->scheme = problem.scheme;
   result->effects = problem.effects ? problem.effects->names() : std::vector<std::string>{};
@@ -228,7 +229,9 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
     replayFigures(problem, result, &replay);
     result->maneuver = replay;
   }
-  result->step_residual = measureStepResidual(problem, result->maneuver).relative;
+  const StepResidual measured = measureStepResidual(problem, result->maneuver);
+  result->step_residual = measured.relative;
+  if (residual) *residual = measured;
 }
 
 std::string classInconsistency(const PlanResult& result) {

@@ -6,6 +6,7 @@
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "attitude_planner/planning/verdict.hpp"
 
 namespace attitude_planner {
 
@@ -16,9 +17,10 @@ namespace attitude_planner {
 /// The replay of a planned trajectory is left to replayFigures, which planAtResolution calls once
 /// for the plan it returns (not for every grid level and start: at N = 512 with torque limits
 /// those replays were a fifth of the solve). Throws StepTooLarge if a replay's implicit step
-/// fails.
+/// fails. `residual` (optional) receives the step residual measured, for planInconsistency.
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
-                  PlanResult* result, const Maneuver* planned = nullptr);
+                  PlanResult* result, const Maneuver* planned = nullptr,
+                  StepResidual* residual = nullptr);
 
 /// Replays the plan's torques τ_k (k = 0..N, τ_0 = τ_N = 0 but with end torques) through the
 /// problem's scheme from R_0, Ω_0 and sets dynamics_residual, the terminal errors and replay_miss
@@ -32,9 +34,10 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 /// step solve finds from the plan's state (replayStepByStep: not a step on another root of its
 /// momentum map) and, with `constraints`, its node constraints
 /// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
-/// it does. The open-loop replay (replay_miss) is not part of it.
+/// it does. The open-loop replay (replay_miss) is not part of it. `measured`: the plan's step
+/// residual if evaluatePlan measured it already (measureStepResidual of the same plan).
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
-                              bool constraints);
+                              bool constraints, const StepResidual* measured = nullptr);
 
 /// Whether `r` holds a plan at the problem's T within every bound: the one judgement of "a plan
 /// at T exists" (a stopped solve that answers the interior point's formulation retry, the

@@ -205,6 +205,36 @@ TEST(ExtremalClasses, TheDefaultIsNoCostlierThanAnyClassOnSeededSpinningProblems
   EXPECT_GE(cheapest, 0.99 * compared);
 }
 
+namespace {
+
+/// Plans `p` on one thread and on two, expects the same answer attempt by attempt (the solves
+/// run at once are recorded in the recipe's order), and returns the one-thread result.
+PlanResult expectTheSameAnswerOnOneAndTwoThreads(const PlanningProblem& p, int i) {
+  SolverOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const PlanResult a = planManeuver(p, one);
+  const PlanResult b = planManeuver(p, two);
+  EXPECT_EQ(a.cost, b.cost) << i;
+  EXPECT_EQ(a.iterations, b.iterations) << i;
+  EXPECT_EQ(a.extremal, b.extremal) << i;
+  EXPECT_EQ(a.attempts.size(), b.attempts.size()) << i;
+  for (std::size_t k = 0; k < std::min(a.attempts.size(), b.attempts.size()); ++k) {
+    const Attempt& x = a.attempts[k];
+    const Attempt& y = b.attempts[k];
+    EXPECT_EQ(x.stage, y.stage) << i << ", attempt " << k;
+    EXPECT_EQ(x.start, y.start) << i << ", attempt " << k;
+    EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
+    EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
+    EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
+    EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
+    if (x.termination == Termination::Converged) EXPECT_EQ(x.cost, y.cost) << i << ", " << k;
+  }
+  return a;
+}
+
+}  // namespace
+
 // The classes are surveyed and refined in branches on the machine's cores: on two threads each
 // seeded request (spinning, and rest to rest with one of each kind's N) gets the answer it gets
 // on one, bit for bit, with the same trail in the same order; and the kept class is the cheapest
@@ -219,28 +249,13 @@ TEST(ExtremalClasses, TheClassesSolvedAtOnceGiveTheAnswerOfOneThreadAndKeepTheCh
       p.final_velocity.setZero();
       p.steps = 256;
     }
-    SolverOptions one, two;
-    one.threads = 1;
-    two.threads = 2;
-    const PlanResult a = planManeuver(p, one);
-    const PlanResult b = planManeuver(p, two);
+    const PlanResult a = expectTheSameAnswerOnOneAndTwoThreads(p, i);
     ASSERT_TRUE(a.converged()) << i << ": " << a.message();
-    EXPECT_EQ(a.cost, b.cost) << i;
-    EXPECT_EQ(a.iterations, b.iterations) << i;
-    EXPECT_EQ(a.extremal, b.extremal) << i;
-    ASSERT_EQ(a.attempts.size(), b.attempts.size()) << i;
     double least_refined = std::numeric_limits<double>::infinity();
     refined_at_once += std::count_if(a.attempts.begin(), a.attempts.end(), [](const Attempt& x) {
                          return x.stage == AttemptStage::ClassRefine;
                        }) > 1;
-    for (std::size_t k = 0; k < a.attempts.size(); ++k) {
-      const Attempt& x = a.attempts[k];
-      const Attempt& y = b.attempts[k];
-      EXPECT_EQ(x.stage, y.stage) << i << ", attempt " << k;
-      EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
-      EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
-      EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
-      EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
+    for (const Attempt& x : a.attempts) {
       const bool on_grid = x.steps == p.steps && x.termination == Termination::Converged;
       if (x.stage == AttemptStage::ClassRefine && on_grid) {
         least_refined = std::min(least_refined, x.cost);
@@ -279,31 +294,12 @@ TEST(ExtremalClasses, TheMoreStartsRunAtOnceGiveTheAnswerOfOneThread) {
   const long more_starts[] = {3, 6};
   for (int i = 0; i < 2; ++i) {
     const PlanningProblem p = parseScene(scenes[i]).problem;
-    SolverOptions one, two;
-    one.threads = 1;
-    two.threads = 2;
-    const PlanResult a = planManeuver(p, one);
-    const PlanResult b = planManeuver(p, two);
+    const PlanResult a = expectTheSameAnswerOnOneAndTwoThreads(p, i);
     ASSERT_TRUE(a.converged()) << i << ": " << a.message();
     EXPECT_EQ(std::count_if(a.attempts.begin(), a.attempts.end(),
                             [](const Attempt& x) { return x.stage == AttemptStage::MoreStarts; }),
               more_starts[i])
         << i;
-    EXPECT_EQ(a.cost, b.cost) << i;
-    EXPECT_EQ(a.iterations, b.iterations) << i;
-    EXPECT_EQ(a.extremal, b.extremal) << i;
-    ASSERT_EQ(a.attempts.size(), b.attempts.size()) << i;
-    for (std::size_t k = 0; k < a.attempts.size(); ++k) {
-      const Attempt& x = a.attempts[k];
-      const Attempt& y = b.attempts[k];
-      EXPECT_EQ(x.stage, y.stage) << i << ", attempt " << k;
-      EXPECT_EQ(x.start, y.start) << i << ", attempt " << k;
-      EXPECT_TRUE(sameHomotopyClass(x.homotopy, y.homotopy)) << i << ", attempt " << k;
-      EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
-      EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
-      EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
-      if (x.termination == Termination::Converged) EXPECT_EQ(x.cost, y.cost) << i << ", " << k;
-    }
   }
 }
 

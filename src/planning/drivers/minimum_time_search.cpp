@@ -123,7 +123,7 @@ class MinimumTimeSearch {
     }
     ++out->solves;
     least_tried_ = std::min(least_tried_, T);
-    if (r.termination == Termination::TimedOut || r.termination == Termination::Cancelled) {
+    if (stoppedByRequest(r.termination)) {
       stopped_ = r.termination;
     }
     if (!provesFeasible(effort_, r)) return false;

@@ -238,8 +238,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
     const SolveContext::Call call(context, options);
     result = solveWithNlopt(problem, context.remainingOptions());
   }
-  const bool stopped =
-      result.termination == Termination::TimedOut || result.termination == Termination::Cancelled;
+  const bool stopped = stoppedByRequest(result.termination);
   const bool replayable = options.solver == SolverKind::Structured &&
                           schemeIsDiscretization(problem.scheme) &&
                           result.maneuver.steps() == problem.steps;

@@ -747,7 +747,7 @@ void runMoreStarts(const std::vector<MoreStart>& starts, SolveContext& context, 
     walk->add(attemptIn(entry.stage, startOf(entry.method, starts[i].in_class, p),
                         starts[i].in_class, entry.globalization),
               std::move(*results[i]), own);
-    if (termination == Termination::Cancelled || termination == Termination::TimedOut) break;
+    if (stoppedByRequest(termination)) break;
   }
 }
 
@@ -787,7 +787,7 @@ PlanResult Walk::finish() {
   // further attempts, otherwise the request ends with its termination.
   std::optional<Termination> stop;
   const Termination last = trail_.back().termination;
-  if (last == Termination::Cancelled || last == Termination::TimedOut) stop = last;
+  if (stoppedByRequest(last)) stop = last;
   if (!kept_) {  // no attempt planned on the requested grid: nothing is kept
     PlanResult none = std::move(unplanned_);
     if (none.termination == Termination::Converged) none.termination = Termination::NotConverged;

@@ -167,8 +167,7 @@ PlanResult runLevels(const std::vector<PlanningProblem>& levels, std::size_t fir
     // A level stopped inside its solve (cancel, deadline) is not an unconverged end: its
     // iterate is carried on to the requested grid as after a stop between levels, so that a
     // stopped refinement still hands over its plan (and no other attempt is run to get one).
-    const bool stopped_inside =
-        result.termination == Termination::Cancelled || result.termination == Termination::TimedOut;
+    const bool stopped_inside = stoppedByRequest(result.termination);
     if (!finest && !record.stop && rule.unconverged_ends && !result.converged() && !stopped_inside)
       break;
   }

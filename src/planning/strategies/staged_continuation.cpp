@@ -7,7 +7,7 @@ namespace attitude_planner {
 namespace {
 
 bool stoppedEarly(const PlanResult& r) {
-  return r.termination == Termination::Cancelled || r.termination == Termination::TimedOut;
+  return stoppedByRequest(r.termination);
 }
 
 }  // namespace

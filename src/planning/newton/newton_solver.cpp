@@ -18,7 +18,6 @@
 #include <sstream>
 
 #include "attitude_planner/errors.hpp"
-#include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/grid_solve.hpp"
 #include "planning/problem/message_notes.hpp"
@@ -345,20 +344,21 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
     *own_refined = refineClass(surveyed[i], plan, branch, settings, p);
   };
-  std::size_t first = 0;
-  if (may_cost_nothing) {
-    for (; first < classes.size(); ++first) {
-      if (!sameHomotopyClass(classes[first], homotopyClassOf(problem))) continue;
-      runBranches(context, 1, [&](int, SolveContext& branch) { work(first, branch); });
-      if (surveyed[first].result.converged() && surveyed[first].result.cost == 0) {
-        return {surveyed[first]};
-      }
-      break;
+  const auto own = std::find_if(classes.begin(), classes.end(), [&](const HomotopyClass& c) {
+    return sameHomotopyClass(c, homotopyClassOf(problem));
+  });
+  const int first = may_cost_nothing && own != classes.end()
+                        ? static_cast<int>(own - classes.begin())
+                        : -1;  // none surveyed alone
+  if (first >= 0) {
+    runBranches(context, 1, [&](int, SolveContext& branch) { work(first, branch); });
+    if (surveyed[first].result.converged() && surveyed[first].result.cost == 0) {
+      return {surveyed[first]};
     }
   }
   std::vector<int> others;
-  for (std::size_t i = 0; i < classes.size(); ++i) {
-    if (!(may_cost_nothing && i == first)) others.push_back(static_cast<int>(i));
+  for (int i = 0; i < static_cast<int>(classes.size()); ++i) {
+    if (i != first) others.push_back(i);
   }
   runBranches(context, static_cast<int>(others.size()),
               [&](int j, SolveContext& branch) { work(others[j], branch); });

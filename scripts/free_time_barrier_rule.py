@@ -20,6 +20,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import minimum_time_cost as mtc  # noqa: E402  (the suite's generator and plan())
+from study_page import load_average, write_page  # noqa: E402
 
 SAME_T = 1e-9
 
@@ -92,16 +93,12 @@ def main():
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     thetas = args.thetas.split(",")
-    load = " ".join(open("/proc/loadavg").read().split()[:3])
+    load = load_average()
     rows = []
     for seed in [int(s) for s in args.seeds.split(",")]:
         rows += run_suite(args, seed, thetas)
     page = render(args, thetas, rows, load)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(page)
-    else:
-        print(page)
+    write_page(page, args.out)
 
 
 if __name__ == "__main__":

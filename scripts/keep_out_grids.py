@@ -23,9 +23,13 @@ import math
 import os
 import statistics
 import subprocess
+import sys
 import time
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_page import load_average, write_page  # noqa: E402
 
 # The uniform rotations and the scene's number format of the homotopy-class suite.
 _spec = importlib.util.spec_from_file_location(
@@ -275,15 +279,11 @@ def main():
     cases = [draw_case(rng, i) for i in range(args.count)]
     if args.only is not None:
         cases = [cases[args.only]]
-    load = " ".join(open("/proc/loadavg").read().split()[:3])
+    load = load_average()
     start = time.time()
     results = [run_case(args, c, steps) for c in cases]
     page = render(args, cases, results, steps, time.time() - start, load)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(page)
-    else:
-        print(page)
+    write_page(page, args.out)
 
 
 if __name__ == "__main__":

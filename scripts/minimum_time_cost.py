@@ -20,9 +20,13 @@ import math
 import os
 import statistics
 import subprocess
+import sys
 import time
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_page import load_average, write_page  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location(
     "keep_out_grids", os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -197,7 +201,7 @@ def main():
     rng = np.random.default_rng(args.seed)
     cases = [draw_request(rng, i) for i in range(args.count)]
     chosen = [cases[args.only]] if args.only is not None else cases
-    load = " ".join(open("/proc/loadavg").read().split()[:3])
+    load = load_average()
     start = time.time()
     rows = []
     for c in chosen:
@@ -209,11 +213,7 @@ def main():
                   (c["index"], cone, row["termination"], row["T"], row.get("ratio", "-")),
                   flush=True)
     page = render(args, cases, rows, time.time() - start, load)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(page)
-    else:
-        print(page)
+    write_page(page, args.out)
 
 
 if __name__ == "__main__":

@@ -1058,6 +1058,74 @@ TEST(FreeTime, EachSolvedBarrierProblemBoundsTheTTheSolveReaches) {
   EXPECT_GE(convex, 15) << "too few locally convex points to check the bound on";
 }
 
+TEST(FreeTime, StartsOnOneSharedScaleThatReachOneKktPointMeetOnOneCentralPath) {
+  // Starts at different T solved on one scale (FreeTimeScale: the first start's T and effort)
+  // solve one family of barrier problems, so two that end at one KKT point pass through one point
+  // of one central path at each μ near it (what the driver's watch recognizes, and stops the
+  // later start on), and each locally convex point's lower bound still holds in that scale's T₀.
+  const double r = std::sqrt(0.5);
+  const ap::PlanningProblem p = scene("min_time_bilimoria_wie", 32);
+  struct Start {
+    std::vector<ap::Matrix3> attitudes;
+    double duration;
+  };
+  std::vector<Start> starts;
+  for (const ap::Vector3& off : {ap::Vector3(r, r, 0), ap::Vector3(r, -r, 0), ap::Vector3(-r, r, 0),
+                                 ap::Vector3(-r, -r, 0)}) {
+    for (const double duration : {3.4, 3.3}) starts.push_back({excursion(p, off, 0.3), duration});
+  }
+  const ap::FreeTimeScale scale =
+      ap::freeTimeScaleOf(p, starts.front().attitudes, starts.front().duration);
+  ASSERT_TRUE(scale.set());
+  const auto largestDifference = [](const std::vector<ap::Matrix3>& x,
+                                    const std::vector<ap::Matrix3>& y) {
+    double largest = 0.0;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      largest = std::max(largest, (x[k] - y[k]).cwiseAbs().maxCoeff());
+    }
+    return largest;
+  };
+  std::vector<std::vector<ap::BarrierPoint>> paths;
+  std::vector<std::vector<ap::Matrix3>> ends;  // the KKT points' plans
+  for (const Start& st : starts) {
+    std::vector<ap::BarrierPoint> points;
+    const ap::BarrierWatch record = [&](const ap::BarrierPoint& point) {
+      points.push_back(point);
+      return std::string();
+    };
+    ap::SolveContext context{ap::SolverOptions{}};
+    const ap::FreeTimeOutcome o = ap::solveFreeTime(
+        p, st.attitudes, st.duration, 1e-9, 500, context, record, ap::ElasticBarrier::Initial,
+        ap::StartBarrier::Initial, ap::StartRaise::Bounded, scale);
+    ASSERT_EQ(o.termination, ap::Termination::Converged) << o.message();
+    for (const ap::BarrierPoint& point : points) {
+      if (point.locally_convex) EXPECT_LE(point.lower_bound, o.duration * (1 + 1e-9));
+    }
+    paths.push_back(points);
+    ends.push_back(o.maneuver.attitude);
+  }
+  // On one family two solves at one μ meet at one central-path point: near it (μ ≤ 1e-7) they
+  // agree far better than that point agrees with the KKT point (the central path's distance to
+  // it is O(μ)). Measured here: 1e-9 and below on one scale; 2.7e-7 at μ = 5.7e-8 on the
+  // starts' own scales, two central paths.
+  int pairs = 0;
+  for (std::size_t a = 0; a < paths.size(); ++a) {
+    for (std::size_t b = a + 1; b < paths.size(); ++b) {
+      // The symmetric body has KKT points of one T that are turned copies of each other.
+      if (largestDifference(ends[a], ends[b]) > 1e-6) continue;  // two KKT points
+      for (const ap::BarrierPoint& q : paths[a]) {
+        const auto same_mu = std::find_if(paths[b].begin(), paths[b].end(),
+                                          [&](const ap::BarrierPoint& o) { return o.mu == q.mu; });
+        if (q.mu > 1e-7 || same_mu == paths[b].end()) continue;
+        ++pairs;
+        EXPECT_LE(largestDifference(q.attitudes, same_mu->attitudes), 1e-8)
+            << "starts " << a << " and " << b << " at mu = " << q.mu;
+      }
+    }
+  }
+  EXPECT_GE(pairs, 2) << "too few starts ended at one KKT point to compare their paths";
+}
+
 TEST(FreeTime, AWatchThatStopsASolveEndsItThereWithItsPlan) {
   // A watch answering why at the second solved barrier problem: the solve ends there,
   // NotConverged, stopped_by_watch, the message the watch's, the plan the point's.

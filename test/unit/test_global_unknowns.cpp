@@ -149,8 +149,11 @@ TEST(GlobalUnknowns, TimeStepDerivativesMatchFiniteDifferences) {
   // Free time's objective T/T₀ + ε(μ)C at a barrier between μ₀ and its floor.
   MinimumTimeObjective minimum_time(9, 0.3, 2.0, 0.1);
   minimum_time.setBarrier(0.01);
-  const TranscriptionObjective* objectives[] = {&effort, &time_plus_effort,
-                                                &effort_plus_time_squared, &minimum_time};
+  // ... and on a scale shared with other starts (T₀ = 3.7 s, not N h₀ = 2.7 s).
+  MinimumTimeObjective shared_scale(9, 0.3, 2.0, 0.1, 3.7);
+  shared_scale.setBarrier(0.01);
+  const TranscriptionObjective* objectives[] = {
+      &effort, &time_plus_effort, &effort_plus_time_squared, &minimum_time, &shared_scale};
   for (SchemeKind scheme : kDiscretizations) {
     for (unsigned seed : {1u, 2u, 3u}) {
       for (const bool effects : {false, true}) {
@@ -294,6 +297,32 @@ TEST(GlobalUnknowns, MinimumTimeObjectiveStartsAtOneAndItsEffortWeightFollowsThe
     EXPECT_NEAR(g(rp.unknowns()) * h0, time_only.timeGradient(), 1e-15);
     EXPECT_NEAR(time_only.timeGradient(), 1.0, 1e-15);
     EXPECT_NEAR(objective.lowerBound(h0, 0.0, C0, 0.0), rp.steps() * h0, 1e-15 * rp.steps() * h0);
+  }
+}
+
+// On a scale shared by the starts of one grid (FreeTimeScale: T₀ and C₀ a reference's, not the
+// start's): Φ = T/T₀ + εC with ε₀ C₀ = kInitialEffortShare, the time row N h₀/T₀ (the unknown
+// is still η = h/h₀), and the lower bound T − T₀ (gap + εC) in that T₀.
+TEST(GlobalUnknowns, MinimumTimeObjectiveOnASharedScaleMeasuresTimeInTheReferenceDuration) {
+  for (unsigned seed : {7u, 8u}) {
+    const ReducedProblem rp =
+        perturbedReducedProblem(randomProblem(SchemeKind::SecondOrder, 12, seed), seed);
+    const double h0 = rp.timeStep(), C0 = rp.cost(rp.current()), mu0 = 0.1;
+    const double T_ref = 1.3 * rp.steps() * h0, C_ref = 0.6 * C0;
+    MinimumTimeObjective objective(rp.steps(), h0, C_ref, mu0, T_ref);
+    const double epsilon0 = objective.setBarrier(mu0);
+    EXPECT_NEAR(epsilon0 * C_ref, MinimumTimeObjective::kInitialEffortShare, 1e-16);
+    EXPECT_NEAR(objective.value(h0, C0, epsilon0), rp.steps() * h0 / T_ref + epsilon0 * C0, 1e-15);
+    Eigen::VectorXd g;
+    const double value = rp.evaluateWithTimeStep(objective, &g, nullptr, nullptr, nullptr);
+    EXPECT_NEAR(value, objective.value(h0, C0, epsilon0), 1e-14);
+    const MinimumTimeObjective time_only(rp.steps(), h0, 0.0, mu0, T_ref);
+    rp.evaluateWithTimeStep(time_only, &g, nullptr, nullptr, nullptr);
+    EXPECT_NEAR(g(rp.unknowns()) * h0, time_only.timeGradient(), 1e-15);
+    EXPECT_NEAR(time_only.timeGradient(), rp.steps() * h0 / T_ref, 1e-15);
+    const double h = 0.9 * h0, gap = 1e-3, epsilon = 0.5 * epsilon0;
+    EXPECT_NEAR(objective.lowerBound(h, gap, C0, epsilon),
+                rp.steps() * h - T_ref * (gap + epsilon * C0), 1e-14 * T_ref);
   }
 }
 

@@ -439,22 +439,25 @@ TEST(MinimumTime, MarginPlansFromTheTStarPlanOnBetts) {
 }
 
 TEST(MinimumTime, ARefinedLevelThatEndsShortInsideItsBoundsIsResumedNotSearched) {
-  // A seeded rest-to-rest slew (scripts/minimum_time_cost.py's suite, seed 5151 #19) whose
-  // refined N = 128 level ends at T* to 5e-12 with the line search at the round-off floor's edge
-  // (stationarity 1.6e-7 against a floor of 1e-7): resumed once from its plan near its KKT point
-  // it converges; the search (8,000 iterations to the same T*) is not called.
+  // A seeded rest-to-rest slew (scripts/minimum_time_cost.py's suite, seed 1818 #12) whose
+  // refined N = 128 level ends short of its KKT point inside its bounds (the line search at the
+  // round-off floor's edge, T* reached to 1e-11): resumed once from its plan near its KKT point
+  // it converges; the search (thousands of iterations to the same T*) is not called. Which
+  // requests end short moves with the last bits of the iterates (about 1 in 200 of that suite):
+  // where this one stops ending short, re-choose one among the suite's seeds whose attempts show
+  // a coarse_level solve on N = 128 ended not_converged.
   const ap::PlanningProblem p =
       ap::parseScene(
-          "inertia: [[37.942331065999042, -9.940262472178965, -0.54713097154135104], "
-          "[-9.940262472178965, 87.639038417557217, -6.7793602938197282], "
-          "[-0.54713097154135104, -6.7793602938197282, 68.316047644971533]]\n"
+          "inertia: [[2.1957485310728146, -0.53668322520455836, -0.10177337983641539], "
+          "[-0.53668322520455836, 2.335558743277327, -0.28574702824583664], "
+          "[-0.10177337983641539, -0.28574702824583664, 2.9737075094011809]]\n"
           "steps: 128\nscheme: second_order\nobjective: minimum_time\n"
-          "initial: {attitude: {quaternion: [0.30420894468912485, 0.35090835614762134, "
-          "0.8667078296694426, -0.18203785745439782]}, angular_velocity: [0, 0, 0]}\n"
-          "final: {attitude: {quaternion: [0.10920734642478444, 0.36399012897649846, "
-          "0.82113032291792754, 0.42582852684998618]}, angular_velocity: [0, 0, 0]}\n"
-          "effects: [{actuator_limits: {max_torque: [3.0151134918152644, 4.0674412081972342, "
-          "2.0525554664996215]}}]\n")
+          "initial: {attitude: {quaternion: [0.29275483868574703, -0.54170991486264009, "
+          "-0.74750730196158666, 0.24915418134099787]}, angular_velocity: [0, 0, 0]}\n"
+          "final: {attitude: {quaternion: [0.49187343925139776, -0.72680521888433025, "
+          "-0.46629008631671393, -0.1113025110419974]}, angular_velocity: [0, 0, 0]}\n"
+          "effects: [{actuator_limits: {max_torque: [0.041534149200971759, 0.098066790320898253, "
+          "0.045325217167925085]}}]\n")
           .problem;
   const ap::PlanResult r = ap::planManeuver(p);
   ASSERT_TRUE(r.converged()) << r.message();

@@ -201,13 +201,13 @@ class FreeTimeMinimumTime {
                                  const std::vector<Matrix3>& start, double duration,
                                  AttemptStart kind, const StartDetail& detail,
                                  const BarrierWatch& watch, StartBarrier start_barrier,
-                                 Attempt* attempt) {
+                                 Attempt* attempt, const FreeTimeScale& scale = {}) {
     const SolveContext::Scope scope(context, AttemptStage::MinimumTimeSolve, homotopyClassOf(p));
     const ElasticBarrier barrier =
         detail.elastic_from_violations ? ElasticBarrier::FromViolations : ElasticBarrier::Initial;
     FreeTimeOutcome o =
         solveFreeTime(p, start, duration, kFreeTimeTolerance, kFreeTimeMaxIterations, context,
-                      watch, barrier, start_barrier, startRaiseOf(kind));
+                      watch, barrier, start_barrier, startRaiseOf(kind), scale);
     o.iterations = scope.iterations();  // an elastic start's run and the raised one's
     Attempt& a = *attempt;
     a.stage = AttemptStage::MinimumTimeSolve;
@@ -270,6 +270,7 @@ class FreeTimeMinimumTime {
       cleared[i] =
           branch.stopReason() ? starts[i].attitudes : clearOfCones(grid, starts[i], branch);
     });
+    if (!starts.empty()) shareScale(grid, cleared.front(), starts.front().duration);
     int best = -1;
     std::vector<int> repeats(starts.size(), -1);       // the start it repeats, by index in starts_
     std::vector<int> repeats_open(starts.size(), -1);  // ... or by index in `starts`
@@ -302,6 +303,21 @@ class FreeTimeMinimumTime {
     };
     solveInWindow(grid, static_cast<int>(starts.size()), &best, pose, record);
     return best;
+  }
+
+  /// The scale every watched solve on `grid` shares from now on: the first start's (T and effort
+  /// before any raise; FreeTimeScale). Measured on the seeded minimum-time suite without cones: on
+  /// their own scales the excursions that fall into the eigenaxis start's basin ran to its KKT
+  /// point (seed 4949 #6: 233 and 242 iterations each); on one scale the watch sees them join
+  /// its central path within 5-14 (docs/results/minimum_time_shared_scale.md).
+  void shareScale(const PlanningProblem& grid, const std::vector<Matrix3>& start, double duration) {
+    shared_scale_ = freeTimeScaleOf(grid, start, duration);
+    shared_scale_steps_ = grid.steps;
+  }
+
+  /// The scale of the watched solves on `grid` (unset on a grid no starts were solved on).
+  FreeTimeScale scaleOn(const PlanningProblem& grid) const {
+    return grid.steps == shared_scale_steps_ ? shared_scale_ : FreeTimeScale{};
   }
 
   /// A start solveInWindow solves: its attitudes (alive until it is recorded), T and parameters.
@@ -433,7 +449,7 @@ class FreeTimeMinimumTime {
       return "";
     };
     run.outcome = solveIn(context, grid, start, duration, kind, detail, watch,
-                          StartBarrier::Initial, &run.attempt);
+                          StartBarrier::Initial, &run.attempt, scaleOn(grid));
     return run;
   }
 
@@ -771,6 +787,8 @@ class FreeTimeMinimumTime {
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;
   int solves_ = 0;
+  FreeTimeScale shared_scale_;   ///< the watched solves' scale on the starts' grid (shareScale)
+  int shared_scale_steps_ = -1;  ///< that grid's N
 };
 
 }  // namespace

@@ -164,6 +164,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void setElasticBarrier(ElasticBarrier b) { elastic_barrier_ = b; }
   void setStartBarrier(StartBarrier b) { start_barrier_ = b; }
   void setStartRaise(StartRaise r) { start_raise_ = r; }
+  void setScale(const FreeTimeScale& scale) { scale_ = scale; }
   /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
   bool startedElastic() const { return started_elastic_; }
   void disallowElastic() { allow_elastic_ = false; }
@@ -313,6 +314,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
   ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
   StartBarrier start_barrier_ = StartBarrier::Initial;
   StartRaise start_raise_ = StartRaise::Bounded;
+  FreeTimeScale scale_;  ///< the objective's T₀ and C₀ (unset: the start's own)
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -327,7 +329,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   // rows are prepared in the visit, after z entered w).
   const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
   const auto row = [](const FreeTimeRows&, FreeTimeRow&, double) {};
-  const double dT = objective_.timeGradient();  // ∂(T/T₀)/∂η = 1
+  const double dT = objective_.timeGradient();  // ∂(T/T₀)/∂η = N h₀/T₀
   const auto visit = [&](const ReducedProblem::TimeStepStencil& st, double s) {
     if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
     const Eigen::Matrix<double, 3, 10> G = step.jacobian(st);  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
@@ -541,9 +543,10 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   const int m = block_.rows.count;
   mu0_ = parameters_.free_time.initial_barrier / m;
   mu_final_ = parameters_.final_barrier_fraction * tolerance / m;
-  objective_ = MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
+  objective_ = scale_.set() ? MinimumTimeObjective(N_, h0_, scale_.cost, mu0_, scale_.duration)
+                            : MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
   test_ = KktResidualTest(tolerance, N_);
-  // μ is already on the objective's scale (T/T₀ = 1 at the start): the rule's scaled μ is μ.
+  // μ is already on the objective's scale (T/T₀ about 1 at the start): the rule's scaled μ is μ.
   scales_ = {1.0, 1, N_, mu_final_};
   mu_ = firstBarrier();
   // The first multipliers: the primal ones at the start's values (an elastic row safeguarded).
@@ -730,7 +733,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch,
                               ElasticBarrier elastic_barrier, StartBarrier start_barrier,
-                              StartRaise start_raise) {
+                              StartRaise start_raise, const FreeTimeScale& scale) {
   PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
   at.duration = start_duration;
   FreeTimeOutcome failed;
@@ -757,6 +760,7 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     solver.setElasticBarrier(elastic_barrier);
     solver.setStartBarrier(start_barrier);
     solver.setStartRaise(start_raise);
+    solver.setScale(scale);
     if (const std::string outside = solver.startInside(); !outside.empty()) {
       recordVerdict(&failed, verdicts::NoStrictlyFeasibleStart{outside});
       return failed;
@@ -770,12 +774,27 @@ FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<
     FreeTimeSolver raised(problem, &np, constraints, parameters);
     raised.disallowElastic();
     raised.setStartBarrier(start_barrier);
+    raised.setScale(scale);
     if (!raised.startInside().empty()) return out;
     return raised.run(tolerance, max_iterations, context, watch);
   } catch (const StepTooLarge& e) {
     recordVerdict(&failed, verdicts::NoBoundaryStep{e.what(), true});
     return failed;
   }
+}
+
+FreeTimeScale freeTimeScaleOf(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
+                              double duration) {
+  PlanningProblem at = endingAt(problem, attitudes.back());
+  at.duration = duration;
+  try {
+    ReducedProblem np(at);
+    np.setInteriorFromAttitudes(attitudes);
+    const double cost = np.cost(np.current());
+    if (std::isfinite(cost)) return {duration, cost};
+  } catch (const StepTooLarge&) {  // no step at this T: no scale to share
+  }
+  return {};
 }
 
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,

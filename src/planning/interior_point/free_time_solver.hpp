@@ -87,6 +87,23 @@ enum class StartBarrier { Initial, NearKktPoint };
 /// structured starts: the eigenaxis slew's profile).
 enum class StartRaise { Bounded, UntilInside };
 
+/// The scale of a free-time solve's objective T/T₀ + εC (ε = ε₀ μ/μ₀, ε₀ C₀ a fixed share): T₀
+/// and C₀. Unset (0), a solve takes its own start's (the raised start's T and effort). Starts on
+/// one grid that share one scale solve one family of barrier problems: two of them at the same μ
+/// near one local solution are at one point of one central path, which the watch recognizes
+/// (sameCentralPath); on their own scales they follow different central paths to the same KKT
+/// point, and a start that joins another's basin runs to its end.
+struct FreeTimeScale {
+  double duration = 0.0;  ///< T₀ [s]
+  double cost = 0.0;      ///< C₀ [N² m²], the effort at T₀
+  bool set() const { return duration > 0.0 && cost > 0.0; }
+};
+
+/// The scale of the start through `attitudes` at T = duration (its T and effort before any raise),
+/// for other starts on the same grid to share; unset where the start admits no step.
+FreeTimeScale freeTimeScaleOf(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
+                              double duration);
+
 /// A solved barrier problem of a free-time solve: its point on the central path at μ.
 struct BarrierPoint {
   double mu = 0.0;
@@ -135,13 +152,15 @@ std::string freeTimeUnsupported(const PlanningProblem& problem);
 /// reported to `context` (SolveContext::reportIteration: the request's iteration callback, and so
 /// an action's feedback); a refusal ends the solve Cancelled. FreeTimeOutcome::iterations counts
 /// the last run's (the raised one's after an elastic start failed); the solve's are the context's
-/// (SolveContext::IterationTally).
+/// (SolveContext::IterationTally). `scale`: the objective's (FreeTimeScale), the start's own
+/// where unset.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
                               double start_duration, double tolerance, int max_iterations,
                               SolveContext& context, const BarrierWatch& watch = {},
                               ElasticBarrier elastic_barrier = ElasticBarrier::Initial,
                               StartBarrier start_barrier = StartBarrier::Initial,
-                              StartRaise start_raise = StartRaise::Bounded);
+                              StartRaise start_raise = StartRaise::Bounded,
+                              const FreeTimeScale& scale = {});
 /// The same in a context of its own with default options (no budget, no callback): for tests and
 /// studies that run one free-time solve outside a request. Its iterations: every run's.
 FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,

@@ -202,7 +202,6 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
   const auto start = std::chrono::steady_clock::now();
   const std::size_t first_attempt = context.attempts().size();
   PlanResult result;
-  bool replayed_by_solver = false;
   // A pointing request is judged (replay, terminal errors) against the end attitude it chose.
   PlanningProblem judged = problem;
   if (problem.end_condition.pointing()) {
@@ -234,8 +233,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
     result = planUnderConstraints(problem, options, context);
   } else if (options.solver == SolverKind::Structured) {
-    // The walk measures its kept plan's replay beside that plan's check, on another thread.
-    result = solveWithNewton(problem, options, context, nullptr, &replayed_by_solver);
+    result = solveWithNewton(problem, options, context);
   } else {
     const SolveContext::Call call(context, options);
     result = solveWithNlopt(problem, context.remainingOptions());
@@ -248,10 +246,14 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
     // A stopped plan is handed over at once, without its open-loop replay (N implicit steps:
     // 0.10-0.14 s at N = 1e5, where a cancel waits 30 ms): its figures say "not measured".
     markReplayNotMeasured(&result);
-  } else if (replayable && !replayed_by_solver) {
+  } else if (replayable) {
     // The Newton and interior-point plans are their own trajectories; their open-loop replay
     // (replay_miss, the terminal errors) is measured once, here, for the plan returned.
-    applyOpenLoopReplay(judged, replayOpenLoop(judged, result), &result);
+    try {
+      replayFigures(judged, &result);
+    } catch (const StepTooLarge& e) {
+      judgeFailedReplay(judged, e.what(), &result);
+    }
   }
   if (result.solver.empty()) result.solver = solverName(options.solver);
   // The trail: every attempt the request's solves recorded in the context, in order.

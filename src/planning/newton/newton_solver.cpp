@@ -9,8 +9,7 @@
 // spinning solve (independent solves: at once, on the request's threads). Every attempt runs in the
 // request's SolveContext (one clock and deadline, one cancel flag, iterations numbered across
 // attempts) and is recorded in its trail. A plan's check (planInconsistency) is deferred and run
-// only where the walk's choice reads it (kept_plan.hpp): the kept plan's always, with its
-// open-loop replay beside it on another thread when the caller asks for the replay.
+// only where the walk's choice reads it (kept_plan.hpp): the kept plan's always.
 #include "planning/newton/newton_solver.hpp"
 
 #include <algorithm>
@@ -240,8 +239,6 @@ struct WalkPlan {
   /// Its solver converged and its check was deferred (GridSettings::deferred_check): the step
   /// residual measured for its figures.
   std::optional<StepResidual> unchecked;
-  /// Its open-loop replay, measured beside its check (Walk::finish with a replay).
-  std::optional<OpenLoopReplay> replay;
 };
 
 class Walk {
@@ -280,7 +277,7 @@ class Walk {
                         : unchecked    ? PlanStanding::Unchecked
                                        : PlanStanding::Checked);
     costs_.push_back(r.cost);
-    plans_.push_back({trail_.size() - 1, std::move(r), own_iterations, unchecked, std::nullopt});
+    plans_.push_back({trail_.size() - 1, std::move(r), own_iterations, unchecked});
   }
 
   bool hasPlan() const { return !plans_.empty(); }
@@ -320,10 +317,8 @@ class Walk {
     });
   }
 
-  /// The kept plan with the request's totals, the structured extremal and the brief. With
-  /// `replayed`: its open-loop replay measured too (beside its check, in two branches), and
-  /// whether it was (not for a stopped plan).
-  PlanResult finish(bool* replayed);
+  /// The kept plan with the request's totals, the structured extremal and the brief.
+  PlanResult finish();
 
  private:
   /// The kept plan's index among plans_, every check it depends on run (once each).
@@ -338,8 +333,8 @@ class Walk {
     }
     return standing_[i] != PlanStanding::NotConverged;
   }
-  /// Runs plan i's deferred check (beside its open-loop replay while finish asks for one); a
-  /// plan that fails it becomes what its solve returns for such a plan, and so does its attempt.
+  /// Runs plan i's deferred check; a plan that fails it becomes what its solve returns for such a
+  /// plan, and so does its attempt.
   bool check(std::size_t i);
 
   const PlanningProblem& problem_;
@@ -351,7 +346,6 @@ class Walk {
   std::vector<WalkPlan> plans_;  ///< the plans on the requested grid, in attempt order
   std::vector<PlanStanding> standing_;
   std::vector<double> costs_;
-  bool replay_beside_checks_ = false;  ///< while finish chooses the plan it returns
   /// The last attempt that produced no plan on the requested grid (e.g. a boundary rate with no
   /// step on a coarser one), while none did: the answer if none ever does.
   PlanResult unplanned_;
@@ -853,21 +847,8 @@ frames::WalkKept briefOf(const std::vector<Attempt>& trail, std::size_t kept_at,
 
 bool Walk::check(std::size_t i) {
   WalkPlan& plan = plans_[i];
-  bool passed = false;
-  const PlanningProblem solved = pinnedToClass(problem_, trail_[plan.at].homotopy);
-  const auto checkIt = [&] { passed = checkDeferredPlan(solved, *plan.unchecked, &plan.result); };
-  if (replay_beside_checks_ && !plan.replay) {
-    // Both only read the plan's trajectory (a failed check rewrites its verdict, not its rows).
-    runBranches(context_, 2, [&](int work, SolveContext&) {
-      if (work == 0) {
-        checkIt();
-      } else {
-        plan.replay = replayOpenLoop(problem_, plan.result);
-      }
-    });
-  } else {
-    checkIt();
-  }
+  const bool passed = checkDeferredPlan(pinnedToClass(problem_, trail_[plan.at].homotopy),
+                                        *plan.unchecked, &plan.result);
   plan.unchecked.reset();
   Attempt& attempt = trail_[plan.at];
   attempt.plan_checked = true;
@@ -876,8 +857,7 @@ bool Walk::check(std::size_t i) {
   return passed;
 }
 
-PlanResult Walk::finish(bool* replayed) {
-  if (replayed) *replayed = false;
+PlanResult Walk::finish() {
   // An attempt cancelled or out of time ends the walk; after a converged plan it only spared
   // further attempts, otherwise the request ends with its termination.
   std::optional<Termination> stop;
@@ -890,9 +870,7 @@ PlanResult Walk::finish(bool* replayed) {
     none.attempts = trail_;
     return none;
   }
-  replay_beside_checks_ = replayed != nullptr;
   WalkPlan& chosen = plans_[keptPlan()];
-  replay_beside_checks_ = false;
   const std::size_t kept_at = chosen.at;
   PlanResult kept = std::move(chosen.result);
   if (kept.converged()) stop.reset();
@@ -906,12 +884,6 @@ PlanResult Walk::finish(bool* replayed) {
   frameMessage(&kept, briefOf(trail_, kept_at, stop));
   if (stop && !kept.converged()) kept.termination = *stop;
   kept.attempts = trail_;
-  // A stopped plan is handed over without its replay (the caller marks it not measured).
-  if (replayed && !stoppedByRequest(kept.termination)) {
-    applyOpenLoopReplay(problem_, chosen.replay ? *chosen.replay : replayOpenLoop(problem_, kept),
-                        &kept);
-    *replayed = true;
-  }
   return kept;
 }
 
@@ -924,8 +896,7 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 }
 
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
-                           SolveContext& context, std::vector<ClassPlan>* survey_plans,
-                           bool* kept_plan_replayed) {
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans) {
   const SolveContext::Call call(context, request);
   const SolverOptions& options = context.options();
   const NewtonParameters& p = options.advanced.newton;
@@ -951,7 +922,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& r
     if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);
   }
   if (!context.stopReason()) runMoreStarts(moreStarts(problem, &state), context, &walk, p);
-  PlanResult result = walk.finish(kept_plan_replayed);
+  PlanResult result = walk.finish();
   context.recordLevels(result.levels);  // the plan's: its kept attempt's
   return result;
 }

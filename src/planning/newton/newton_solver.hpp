@@ -29,13 +29,9 @@ struct ClassPlan {
 /// constrained class search (drivers/constrained_classes.hpp) instead of solving each class again.
 /// A plan's check (planInconsistency) runs only where the walk's choice depends on it: the plan
 /// kept is always checked, a plan that fails its check is never kept (unless none converged), and
-/// the others' attempts say `plan_checked` false. With `kept_plan_replayed`, the kept plan's
-/// open-loop replay (replayFigures, judged against `problem`) is measured beside its check on
-/// another of the request's threads, and `*kept_plan_replayed` says whether it was (not for a
-/// plan stopped by a cancel or the deadline: the caller marks that one not measured).
+/// the others' attempts say `plan_checked` false.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
-                           SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr,
-                           bool* kept_plan_replayed = nullptr);
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr);
 
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
 /// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before

@@ -210,35 +210,6 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
   if (replay) *replay = replayed;
 }
 
-OpenLoopReplay replayOpenLoop(const PlanningProblem& problem, const PlanResult& plan) {
-  OpenLoopReplay out;
-  PlanResult figures;  // replayFigures reads only the torques
-  figures.maneuver.torque = plan.maneuver.torque;
-  try {
-    replayFigures(problem, &figures);
-  } catch (const StepTooLarge& e) {
-    out.failed = e.what();
-    return out;
-  }
-  out.dynamics_residual = figures.dynamics_residual;
-  out.terminal_attitude_error = figures.terminal_attitude_error;
-  out.terminal_velocity_error = figures.terminal_velocity_error;
-  out.replay_miss = figures.replay_miss;
-  return out;
-}
-
-void applyOpenLoopReplay(const PlanningProblem& problem, const OpenLoopReplay& replay,
-                         PlanResult* result) {
-  if (replay.failed) {
-    judgeFailedReplay(problem, *replay.failed, result);
-    return;
-  }
-  result->dynamics_residual = replay.dynamics_residual;
-  result->terminal_attitude_error = replay.terminal_attitude_error;
-  result->terminal_velocity_error = replay.terminal_velocity_error;
-  result->replay_miss = replay.replay_miss;
-}
-
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
                   PlanResult* result, const Maneuver* planned, StepResidual* residual) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);

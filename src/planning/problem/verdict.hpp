@@ -2,7 +2,6 @@
 // one convergence rule beside each solver's own first-order test.
 #pragma once
 
-#include <optional>
 #include <string>
 
 #include "attitude_planner/planning/problem.hpp"
@@ -87,22 +86,5 @@ void judgeFailedReplay(const PlanningProblem& problem, const std::string& what, 
 /// Sets the terminal errors of an open-loop replay and replay_miss, the larger of the attitude
 /// miss and T × the velocity miss (one rule for every scheme's replay).
 void setReplayMiss(const PlanningProblem& problem, const Maneuver& replayed, PlanResult* result);
-
-/// A plan's open-loop replay measured apart from the plan it is of (on another thread than the
-/// plan's check), applied to it later (applyOpenLoopReplay): replayFigures' figures, or why a
-/// step had no root.
-struct OpenLoopReplay {
-  double dynamics_residual = 0.0;
-  double terminal_attitude_error = 0.0;
-  double terminal_velocity_error = 0.0;
-  double replay_miss = 0.0;
-  std::optional<std::string> failed;  ///< the StepTooLarge's words
-};
-/// replayFigures of `plan`'s torques (reads only `plan`).
-OpenLoopReplay replayOpenLoop(const PlanningProblem& problem, const PlanResult& plan);
-/// Sets the figures on `result`, or judges the failed replay (judgeFailedReplay): as replayFigures
-/// and its caller's judgement of a StepTooLarge would have.
-void applyOpenLoopReplay(const PlanningProblem& problem, const OpenLoopReplay& replay,
-                         PlanResult* result);
 
 }  // namespace attitude_planner

@@ -368,11 +368,11 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
 /// refined whatever its survey cost (classesToRefine), is refined in its survey's branch as soon
 /// as its survey converged (`*own_refined`), while the other classes are surveyed beside it. Each
 /// survey and refinement is an independent solve, so each result is the same on any number of
-/// threads. `defer_check`: the refinement's check is left to the walk.
+/// threads.
 std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
                                     const PlanningProblem& problem, const SurveyPlan& plan,
                                     SolveContext& context, const GridSettings& settings,
-                                    const NewtonParameters& p, bool defer_check,
+                                    const NewtonParameters& p,
                                     std::optional<Refined>* own_refined) {
   std::vector<Surveyed> surveyed(classes.size());
   const bool refined_later = plan.survey + 1 < plan.levels.size();
@@ -388,7 +388,9 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
     const bool own = sameHomotopyClass(classes[i], homotopyClassOf(problem));
     if (!own || !refined_later || !surveyed[i].result.converged() || branch.stopReason()) return;
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
-    *own_refined = refineClass(surveyed[i], plan, branch, settings, p, defer_check);
+    // Checked here: it is the plan kept in most requests, and its branch often ends before the
+    // others' surveys do, so its check is off the request's critical path.
+    *own_refined = refineClass(surveyed[i], plan, branch, settings, p, false);
   };
   const auto own = std::find_if(classes.begin(), classes.end(), [&](const HomotopyClass& c) {
     return sameHomotopyClass(c, homotopyClassOf(problem));
@@ -490,9 +492,8 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   const bool defer_checks = !plans;
   std::optional<Refined> own_refined;
   // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
-  std::vector<Surveyed> surveyed =
-      surveyClasses(distinctClasses(plan.levels.front()), problem, plan, context, settings, p,
-                    defer_checks, &own_refined);
+  std::vector<Surveyed> surveyed = surveyClasses(distinctClasses(plan.levels.front()), problem,
+                                                 plan, context, settings, p, &own_refined);
   const auto addRefined = [&](const Surveyed& s, const Refined& refined, int own_iterations) {
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),

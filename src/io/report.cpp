@@ -145,6 +145,7 @@ std::string attemptJson(const Attempt& a) {
       << ", \"termination\": " << jsonString(terminationName(a.termination))
       << ", \"iterations\": " << a.iterations << ", \"cost\": " << jsonNumber(a.cost)
       << ", \"kept\": " << (a.kept ? "true" : "false")
+      << ", \"plan_checked\": " << (a.plan_checked ? "true" : "false")
       << ", \"start_detail\": " << startDetailJson(a) << "}";
   return out.str();
 }

@@ -11,11 +11,15 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/newton/grid_solve.hpp"
+#include "planning/newton/kept_plan.hpp"
+#include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
 
 using namespace attitude_planner;
@@ -228,6 +232,7 @@ PlanResult expectTheSameAnswerOnOneAndTwoThreads(const PlanningProblem& p, int i
     EXPECT_EQ(x.iterations, y.iterations) << i << ", attempt " << k;
     EXPECT_EQ(x.termination, y.termination) << i << ", attempt " << k;
     EXPECT_EQ(x.kept, y.kept) << i << ", attempt " << k;
+    EXPECT_EQ(x.plan_checked, y.plan_checked) << i << ", attempt " << k;
     if (x.termination == Termination::Converged) EXPECT_EQ(x.cost, y.cost) << i << ", " << k;
   }
   return a;
@@ -264,6 +269,135 @@ TEST(ExtremalClasses, TheClassesSolvedAtOnceGiveTheAnswerOfOneThreadAndKeepTheCh
     EXPECT_LE(a.cost, least_refined * (1 + 1e-12)) << i << ": " << a.extremal;
   }
   EXPECT_GE(refined_at_once, 3);
+}
+
+// The walk keeps a plan by its rule over every plan's check (the cheapest converged, ties to the
+// earlier); checking on demand gives the rule's answer over what every check would say, runs
+// each check at most once, checks the plan it keeps (unless none converged: then the first plan,
+// as the rule keeps it) and so never keeps one that fails. Random walks of 1-6 plans whose costs
+// fall in clusters within the tie (one extremal reached by several attempts), solvers that
+// converged or not, checks that pass or fail.
+TEST(ExtremalClasses, TheKeptPlanIsCheckedAndAPlanThatFailsItsCheckIsNeverKept) {
+  std::mt19937_64 engine(5454);
+  const auto below = [&](int n) { return static_cast<int>(engine() % n); };
+  const double tie = 1e-12;
+  int walks_with_checks_spared = 0, tie_clusters = 0;
+  for (int walk = 0; walk < 20000; ++walk) {
+    const int n = 1 + below(6);
+    std::vector<double> cost(n);
+    std::vector<PlanStanding> standing(n), every_check(n);
+    std::vector<bool> passes(n);
+    int solver_converged = 0;
+    for (int i = 0; i < n; ++i) {
+      cost[i] = (1.0 + 0.1 * below(3)) * (1.0 + 0.6e-12 * (below(5) - 2));
+      const bool converged = below(5) > 0;
+      passes[i] = below(5) > 0;
+      solver_converged += converged;
+      standing[i] = converged ? PlanStanding::Unchecked : PlanStanding::NotConverged;
+      every_check[i] = converged && passes[i] ? PlanStanding::Checked : PlanStanding::NotConverged;
+    }
+    std::vector<int> checks(n, 0);
+    const std::size_t kept = keptWithChecksOnDemand(cost, &standing, tie, [&](std::size_t i) {
+      ++checks[i];
+      return static_cast<bool>(passes[i]);
+    });
+    ASSERT_EQ(kept, keptByTheWalksRule(cost, every_check, tie)) << walk;
+    int run = 0;
+    for (int i = 0; i < n; ++i) {
+      ASSERT_LE(checks[i], 1) << walk;
+      run += checks[i];
+      if (checks[i]) {
+        EXPECT_EQ(standing[i], passes[i] ? PlanStanding::Checked : PlanStanding::NotConverged);
+      }
+    }
+    const bool any_converged =
+        std::count(every_check.begin(), every_check.end(), PlanStanding::Checked) > 0;
+    if (any_converged) {
+      EXPECT_EQ(standing[kept], PlanStanding::Checked) << walk;
+      EXPECT_TRUE(passes[kept]) << walk;
+    } else {
+      EXPECT_EQ(kept, 0u) << walk;
+    }
+    walks_with_checks_spared += run < solver_converged;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < i; ++j) {
+        tie_clusters += cost[i] != cost[j] && std::abs(cost[i] - cost[j]) <= 2 * tie * cost[j];
+      }
+    }
+  }
+  EXPECT_GT(walks_with_checks_spared, 10000);  // the point of deferring: most walks spare some
+  EXPECT_GT(tie_clusters, 1000);               // and the ties the rule reads are exercised
+}
+
+// A Newton solve whose check is deferred returns its converged plan and the step residual it
+// measured; the check run later leaves a plan that passes as it was, and makes one that fails what
+// the solve returns for such a plan: not converged, the check's words as how its Newton solve and
+// its level ended (here a residual put beyond its tolerance).
+TEST(ExtremalClasses, APlanThatFailsItsDeferredCheckEndsAsItsSolveEndsSuchAPlan) {
+  PlanningProblem p;
+  p.inertia = Vector3(1.0, 1.2, 1.4).asDiagonal();
+  p.final_attitude = so3::exp(Vector3(0.3, -0.5, 1.1));
+  p.duration = 10.0;
+  p.steps = 32;
+  const SolverOptions options;
+  SolveContext context(options);
+  std::optional<StepResidual> unchecked;
+  GridSettings settings;
+  settings.deferred_check = &unchecked;
+  const PlanResult r = solveOnGrid(p, context, settings, {}, nullptr, options.advanced.newton);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(unchecked.has_value());
+  PlanResult passing = r;
+  EXPECT_TRUE(checkDeferredPlan(p, *unchecked, &passing));
+  EXPECT_TRUE(passing.converged());
+  EXPECT_EQ(passing.message(), r.message());
+  StepResidual beyond = *unchecked;
+  beyond.relative = 10 * beyond.tolerance;
+  const std::string words = planInconsistency(p, r, false, &beyond);
+  ASSERT_FALSE(words.empty());
+  PlanResult failing = r;
+  EXPECT_FALSE(checkDeferredPlan(p, beyond, &failing));
+  EXPECT_EQ(failing.termination, Termination::NotConverged);
+  EXPECT_EQ(std::get<verdicts::NewtonEnded>(failing.verdict).how, words);
+  EXPECT_EQ(failing.message().rfind(words, 0), 0u) << failing.message();
+  EXPECT_EQ(failing.levels.back().termination, Termination::NotConverged);
+  EXPECT_EQ(failing.levels.back().reason, failing.message());
+  EXPECT_EQ(failing.cost, r.cost);
+}
+
+// Requests planned through the walk: the kept attempt's plan is checked; an attempt whose plan
+// was not checked converged and was not kept; the replay figures the walk measured beside the
+// check are those of the plan returned; one thread and two give the same answer and trail.
+TEST(ExtremalClasses, OnlyTheKeptPlanNeedsItsCheckAndItsReplayIsTheReturnedPlans) {
+  Draw draw(5454);
+  int unchecked = 0;
+  for (int i = 0; i < 8; ++i) {
+    PlanningProblem p = spinningProblem(draw);
+    if (i % 2) {  // at rest at both ends: the walk ends after the classes
+      p.initial_velocity.setZero();
+      p.final_velocity.setZero();
+    }
+    const PlanResult a = expectTheSameAnswerOnOneAndTwoThreads(p, i);
+    ASSERT_TRUE(a.converged()) << i << ": " << a.message();
+    for (const Attempt& x : a.attempts) {
+      if (x.kept) {
+        EXPECT_TRUE(x.plan_checked) << i;
+      }
+      if (!x.plan_checked) {
+        EXPECT_FALSE(x.kept) << i;
+        EXPECT_EQ(x.termination, Termination::Converged) << i;
+        ++unchecked;
+      }
+    }
+    EXPECT_TRUE(planInconsistency(p, a, false).empty()) << i;
+    PlanResult replayed = a;
+    replayFigures(p, &replayed);
+    EXPECT_EQ(replayed.replay_miss, a.replay_miss) << i;
+    EXPECT_EQ(replayed.terminal_attitude_error, a.terminal_attitude_error) << i;
+    EXPECT_EQ(replayed.terminal_velocity_error, a.terminal_velocity_error) << i;
+    EXPECT_EQ(replayed.dynamics_residual, a.dynamics_residual) << i;
+  }
+  EXPECT_GT(unchecked, 0);  // some plans were spared their check
 }
 
 // Slow spinning solves (scripts/extremal_classes.py's generator, N = 64) whose more starts run

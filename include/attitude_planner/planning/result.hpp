@@ -145,6 +145,9 @@ struct Attempt {
   double cost = std::numeric_limits<double>::quiet_NaN();
   bool kept = false;         ///< its plan is the one returned
   StartDetail start_detail;  ///< its start's parameters (where the start has any)
+  /// false: its solver converged, but its plan was not kept and the check every plan kept passes
+  /// (planInconsistency: the equations of motion step by step) was not run on it.
+  bool plan_checked = true;
 };
 
 /// The extremal a solve returned, structured: its homotopy class, the rotation its start turned

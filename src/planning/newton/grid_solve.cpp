@@ -450,7 +450,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
     StepResidual residual;
     evaluatePlan(problem, result.maneuver.torque, &result, &result.maneuver, &residual);
     // Judged by what the plan is: the open-loop replay's miss is a sensitivity, not a verdict.
-    if (termination == Termination::Converged) {
+    if (termination == Termination::Converged && settings.deferred_check) {
+      *settings.deferred_check = residual;
+    } else if (termination == Termination::Converged) {
       const std::string inconsistent = planInconsistency(problem, result, false, &residual);
       if (!inconsistent.empty()) {
         termination = Termination::NotConverged;
@@ -460,6 +462,22 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
   }
   return finished(std::move(result), np.steps(), iterations, termination, reason,
                   solver.relativeGradient(), solver.relativeDecrement());
+}
+
+bool checkDeferredPlan(const PlanningProblem& problem, const StepResidual& residual,
+                       PlanResult* plan) {
+  const std::string inconsistent = planInconsistency(problem, *plan, false, &residual);
+  if (inconsistent.empty()) return true;
+  // solveOnGrid's result begins with its Newton end (finished: the verdict, then the level's
+  // summary in those words); the continuation's notes come after it.
+  auto& ended = std::get<verdicts::NewtonEnded>(std::get<Verdict>(plan->clauses.front()));
+  ended.how = inconsistent;
+  plan->verdict = ended;
+  plan->termination = Termination::NotConverged;
+  LevelSummary& level = plan->levels.back();
+  level.termination = Termination::NotConverged;
+  level.reason = renderClauses({plan->clauses.front()});
+  return false;
 }
 
 }  // namespace attitude_planner

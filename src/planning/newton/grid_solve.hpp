@@ -4,11 +4,14 @@
 // cost is the merit function. O(N) time and memory per iteration.
 #pragma once
 
+#include <optional>
+
+#include "attitude_planner/planning/newton_parameters.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
-#include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/step_control.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "planning/problem/verdict.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
@@ -18,6 +21,10 @@ struct GridSettings {
   double tolerance = 1e-10;  ///< on the relative Newton decrement
   int max_iterations = 200;
   Globalization globalization = Globalization::TrustRegion;
+  /// Where set, a plan its solver converged to is not checked (planInconsistency): the step
+  /// residual measured for its figures is left here, and the caller checks the plan if it keeps
+  /// it (checkDeferredPlan; the Newton walk checks only the plan it keeps).
+  std::optional<StepResidual>* deferred_check = nullptr;
 };
 
 /// Where one grid solve starts: the Hermite curve to the request's lift, replaced by the warm
@@ -36,5 +43,12 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
                        const GridSettings& settings, const GridStart& start,
                        ReducedProblem::StepVectors* final_steps,
                        const NewtonParameters& parameters);
+
+/// The check solveOnGrid deferred (GridSettings::deferred_check) of its converged `plan` (a grid
+/// continuation's finest level, its notes added after): true if it passes; else the plan becomes
+/// what solveOnGrid returns for a plan that fails its check (not converged, the check's words as
+/// how its Newton solve and its level ended).
+bool checkDeferredPlan(const PlanningProblem& problem, const StepResidual& residual,
+                       PlanResult* plan);
 
 }  // namespace attitude_planner

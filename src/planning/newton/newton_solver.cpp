@@ -8,7 +8,8 @@
 // coasting start for a spinning request that stalled, and more starts in the kept class for a slow
 // spinning solve (independent solves: at once, on the request's threads). Every attempt runs in the
 // request's SolveContext (one clock and deadline, one cancel flag, iterations numbered across
-// attempts) and is recorded in its trail.
+// attempts) and is recorded in its trail. A plan's check (planInconsistency) is deferred and run
+// only where the walk's choice reads it (kept_plan.hpp): the kept plan's always.
 #include "planning/newton/newton_solver.hpp"
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/newton_parameters.hpp"
 #include "planning/newton/grid_solve.hpp"
+#include "planning/newton/kept_plan.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 #include "planning/strategies/staged_continuation.hpp"
@@ -171,12 +173,21 @@ Maneuver surveyedPlan(const Surveyed& s, const PlanningProblem& survey_grid) {
   return ReducedProblem(pinnedToClass(survey_grid, s.homotopy)).maneuver(s.steps);
 }
 
+/// A class carried to the requested grid, and its plan's deferred check.
+struct Refined {
+  PlanResult result;
+  /// Its solver converged and its check was deferred: the step residual it measured.
+  std::optional<StepResidual> unchecked;
+};
+
 /// A surveyed class carried from the survey grid through the finer levels to the requested one:
 /// the grid continuation resumed from the survey grid's iterate. A finer level that does not
 /// converge ends it with no plan (a fresh start there would be another attempt); stopped
-/// (cancel, deadline), the iterate is carried over without iterating.
-PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& context,
-                       const GridSettings& settings, const NewtonParameters& p) {
+/// (cancel, deadline), the iterate is carried over without iterating. `defer_check`: the plan's
+/// check is left to the walk (Refined::unchecked).
+Refined refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& context,
+                    const GridSettings& settings, const NewtonParameters& p, bool defer_check) {
+  Refined out;
   std::vector<PlanningProblem> levels;
   for (const PlanningProblem& level : plan.levels) {
     levels.push_back(pinnedToClass(level, s.homotopy));
@@ -188,6 +199,7 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
     GridSettings at_level = settings;
     at_level.tolerance = r.tolerance;
     if (r.replay_only) at_level.max_iterations = 0;
+    if (r.finest && defer_check) at_level.deferred_check = &out.unchecked;
     return solveOnGrid(r.problem, context, at_level, {nullptr, r.coarse, r.coarser}, final_steps,
                        p);
   };
@@ -205,7 +217,9 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
   };
   const SolvedLevel<StepVectors> survey{plan.survey, s.result.termination, s.steps, s.below,
                                         s.below_converged};
-  return resumeGridContinuation(levels, survey, context, rule, settings.tolerance, level, finish);
+  out.result =
+      resumeGridContinuation(levels, survey, context, rule, settings.tolerance, level, finish);
+  return out;
 }
 
 // --- The walk: every attempt recorded, the cheapest converged plan kept --------------------------
@@ -213,8 +227,18 @@ PlanResult refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& 
 /// A class's own solve on the requested grid (surveyed there, refined, or the request's solve).
 struct ClassSolve {
   HomotopyClass homotopy;
-  int iterations = 0;  ///< its own: survey and refinement, or the whole solve
-  bool converged = false;
+  int iterations = 0;    ///< its own: survey and refinement, or the whole solve
+  std::size_t plan = 0;  ///< its plan among the walk's
+};
+
+/// An attempt's plan on the requested grid, and its check where deferred.
+struct WalkPlan {
+  std::size_t at = 0;  ///< its attempt in the walk's trail
+  PlanResult result;
+  int own_iterations = 0;
+  /// Its solver converged and its check was deferred (GridSettings::deferred_check): the step
+  /// residual measured for its figures.
+  std::optional<StepResidual> unchecked;
 };
 
 class Walk {
@@ -228,35 +252,41 @@ class Walk {
 
   /// Records an attempt; its plan competes if it is on the requested grid. `own_iterations`:
   /// what the slow-solve gate reads if it is kept (the class's survey and refinement).
-  void add(Attempt a, PlanResult r, int own_iterations) {
+  /// `unchecked`: its solver converged and its plan's check was deferred (the step residual its
+  /// solve measured): the check runs only if the walk's choice depends on it.
+  void add(Attempt a, PlanResult r, int own_iterations,
+           std::optional<StepResidual> unchecked = std::nullopt) {
     a.termination = r.termination;
     a.iterations = r.iterations;
     const bool plan = r.maneuver.steps() == problem_.steps;
     a.cost = plan || a.stage == AttemptStage::ClassSurvey
                  ? r.cost
                  : std::numeric_limits<double>::quiet_NaN();
+    if (!r.converged()) unchecked.reset();
+    a.plan_checked = !unchecked;
     trail_.push_back(a);
     context_.record(a);
     if (!plan) {
-      if (!kept_) unplanned_ = std::move(r);  // how the walk ends if no attempt plans
+      if (plans_.empty()) unplanned_ = std::move(r);  // how the walk ends if no attempt plans
       return;
     }
     if (a.stage != AttemptStage::MoreStarts) {
-      solved_.push_back({a.homotopy, own_iterations, r.converged()});
+      solved_.push_back({a.homotopy, own_iterations, plans_.size()});
     }
-    // The cheaper converged plan; ties go to the earlier attempt (deterministic at exactly π).
-    const bool cheaper = r.converged() && (!kept_ || !kept_->converged() ||
-                                           r.cost < kept_->cost * (1 - p_.cheaper_tie));
-    if (!kept_ || cheaper) {
-      kept_ = std::move(r);
-      kept_at_ = trail_.size() - 1;
-      kept_iterations_ = own_iterations;
-    }
+    standing_.push_back(!r.converged() ? PlanStanding::NotConverged
+                        : unchecked    ? PlanStanding::Unchecked
+                                       : PlanStanding::Checked);
+    costs_.push_back(r.cost);
+    plans_.push_back({trail_.size() - 1, std::move(r), own_iterations, unchecked});
   }
 
-  const std::optional<PlanResult>& kept() const { return kept_; }
-  HomotopyClass keptClass() const { return trail_[kept_at_].homotopy; }
-  int keptIterations() const { return kept_iterations_; }
+  bool hasPlan() const { return !plans_.empty(); }
+  /// The plan kept so far (with a plan: hasPlan), checked: the cheapest converged plan, ties to
+  /// the earlier attempt (deterministic at exactly π); the first plan if none converged.
+  const PlanResult& kept() { return plans_[keptPlan()].result; }
+  /// Whether a plan is kept and converged (its check run).
+  bool keptConverged() { return hasPlan() && kept().converged(); }
+  HomotopyClass keptClass() { return trail_[plans_[keptPlan()].at].homotopy; }
   bool empty() const { return trail_.empty(); }
   /// Whether `homotopy` was solved on the requested grid (not counting the more starts).
   bool solvedOnRequestedGrid(const HomotopyClass& homotopy) const {
@@ -266,11 +296,11 @@ class Walk {
   }
   /// The classes the more starts may search: the kept one, and the request's own when it was
   /// solved on the requested grid too and converged (its basins are not the kept class's).
-  std::vector<ClassSolve> searchedClasses(const HomotopyClass& request) const {
+  std::vector<ClassSolve> searchedClasses(const HomotopyClass& request) {
     std::vector<ClassSolve> out;
     for (const HomotopyClass& c : {keptClass(), request}) {
       const auto found = std::find_if(solved_.begin(), solved_.end(), [&](const ClassSolve& s) {
-        return sameHomotopyClass(s.homotopy, c) && s.converged;
+        return sameHomotopyClass(s.homotopy, c) && converged(s.plan);
       });
       const bool listed = std::any_of(out.begin(), out.end(), [&](const ClassSolve& s) {
         return sameHomotopyClass(s.homotopy, c);
@@ -291,18 +321,34 @@ class Walk {
   PlanResult finish();
 
  private:
+  /// The kept plan's index among plans_, every check it depends on run (once each).
+  std::size_t keptPlan() {
+    return keptWithChecksOnDemand(costs_, &standing_, p_.cheaper_tie,
+                                  [this](std::size_t i) { return check(i); });
+  }
+  /// Whether plan i converged, its check run if it was deferred.
+  bool converged(std::size_t i) {
+    if (standing_[i] == PlanStanding::Unchecked) {
+      standing_[i] = check(i) ? PlanStanding::Checked : PlanStanding::NotConverged;
+    }
+    return standing_[i] != PlanStanding::NotConverged;
+  }
+  /// Runs plan i's deferred check; a plan that fails it becomes what its solve returns for such a
+  /// plan, and so does its attempt.
+  bool check(std::size_t i);
+
   const PlanningProblem& problem_;
   SolveContext& context_;
   const NewtonParameters& p_;
   std::size_t first_recorded_;
   SolveContext::IterationTally tally_;  ///< the walk's iterations, every attempt's
   std::vector<Attempt> trail_;
-  std::optional<PlanResult> kept_;
+  std::vector<WalkPlan> plans_;  ///< the plans on the requested grid, in attempt order
+  std::vector<PlanStanding> standing_;
+  std::vector<double> costs_;
   /// The last attempt that produced no plan on the requested grid (e.g. a boundary rate with no
   /// step on a coarser one), while none did: the answer if none ever does.
   PlanResult unplanned_;
-  std::size_t kept_at_ = 0;
-  int kept_iterations_ = 0;
   std::vector<ClassSolve> solved_;  ///< the classes solved on the requested grid, in order
 };
 
@@ -327,7 +373,7 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
                                     const PlanningProblem& problem, const SurveyPlan& plan,
                                     SolveContext& context, const GridSettings& settings,
                                     const NewtonParameters& p,
-                                    std::optional<PlanResult>* own_refined) {
+                                    std::optional<Refined>* own_refined) {
   std::vector<Surveyed> surveyed(classes.size());
   const bool refined_later = plan.survey + 1 < plan.levels.size();
   // Where the zero maneuver reaches the end, the request's own class is surveyed first, alone:
@@ -342,7 +388,9 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
     const bool own = sameHomotopyClass(classes[i], homotopyClassOf(problem));
     if (!own || !refined_later || !surveyed[i].result.converged() || branch.stopReason()) return;
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
-    *own_refined = refineClass(surveyed[i], plan, branch, settings, p);
+    // Checked here: it is the plan kept in most requests, and its branch often ends before the
+    // others' surveys do, so its check is off the request's critical path.
+    *own_refined = refineClass(surveyed[i], plan, branch, settings, p, false);
   };
   const auto own = std::find_if(classes.begin(), classes.end(), [&](const HomotopyClass& c) {
     return sameHomotopyClass(c, homotopyClassOf(problem));
@@ -393,12 +441,12 @@ std::vector<const Surveyed*> classesToRefine(const std::vector<Surveyed>& survey
 /// The chosen classes' refinements (classesToRefine's order), each in its own branch of
 /// `context` (a queue on the request's threads) but the request's own when `own_refined` holds it
 /// already; a refinement the stop kept from beginning is left out, with those after it.
-std::vector<PlanResult> refineClasses(const std::vector<const Surveyed*>& refine,
-                                      const PlanningProblem& problem, const SurveyPlan& plan,
-                                      SolveContext& context, const GridSettings& settings,
-                                      const NewtonParameters& p,
-                                      std::optional<PlanResult> own_refined) {
-  std::vector<std::optional<PlanResult>> refined(refine.size());
+std::vector<Refined> refineClasses(const std::vector<const Surveyed*>& refine,
+                                   const PlanningProblem& problem, const SurveyPlan& plan,
+                                   SolveContext& context, const GridSettings& settings,
+                                   const NewtonParameters& p, bool defer_check,
+                                   std::optional<Refined> own_refined) {
+  std::vector<std::optional<Refined>> refined(refine.size());
   std::vector<std::size_t> pending;
   for (std::size_t i = 0; i < refine.size(); ++i) {
     if (own_refined && sameHomotopyClass(refine[i]->homotopy, homotopyClassOf(problem))) {
@@ -412,11 +460,11 @@ std::vector<PlanResult> refineClasses(const std::vector<const Surveyed*>& refine
     if (branch.stopReason()) return;
     const Surveyed& s = *refine[pending[j]];
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, s.homotopy);
-    refined[pending[j]] = refineClass(s, plan, branch, settings, p);
+    refined[pending[j]] = refineClass(s, plan, branch, settings, p, defer_check);
   };
   runBranches(context, static_cast<int>(pending.size()), work);
-  std::vector<PlanResult> out;
-  for (std::optional<PlanResult>& r : refined) {
+  std::vector<Refined> out;
+  for (std::optional<Refined>& r : refined) {
     if (!r) break;
     out.push_back(std::move(*r));
   }
@@ -429,7 +477,8 @@ std::vector<PlanResult> refineClasses(const std::vector<const Surveyed*>& refine
 /// (surveyClasses, refineClasses) and are recorded in the classes' order. A stop (cancel,
 /// deadline) carries the first class whose survey it ended to the requested grid (the request's
 /// own class: its refinement, if it began) and ends the enumeration. `plans` (optional) receives
-/// each converged survey's and refinement's plan.
+/// each converged survey's and refinement's plan (checked: the constrained search reads them);
+/// without it, the refinements' checks are left to the walk, which runs those its choice reads.
 void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
                       const NewtonParameters& p, std::vector<ClassPlan>* plans) {
   const SolverOptions& options = context.options();
@@ -440,16 +489,17 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   const AttemptStart survey_start = usesCoarserLevel(survey_grid, newtonGridRule(p))
                                         ? AttemptStart::CoarseLevel
                                         : AttemptStart::Hermite;
-  std::optional<PlanResult> own_refined;
+  const bool defer_checks = !plans;
+  std::optional<Refined> own_refined;
   // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
   std::vector<Surveyed> surveyed = surveyClasses(distinctClasses(plan.levels.front()), problem,
                                                  plan, context, settings, p, &own_refined);
-  const auto addRefined = [&](const Surveyed& s, const PlanResult& refined, int own_iterations) {
+  const auto addRefined = [&](const Surveyed& s, const Refined& refined, int own_iterations) {
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),
-              refined, own_iterations);
-    if (plans && refined.converged() && refined.maneuver.steps() == problem.steps) {
-      plans->push_back({s.homotopy, refined.maneuver});
+              refined.result, own_iterations, refined.unchecked);
+    if (plans && refined.result.converged() && refined.result.maneuver.steps() == problem.steps) {
+      plans->push_back({s.homotopy, refined.result.maneuver});
     }
   };
   for (std::size_t i = 0; i < surveyed.size(); ++i) {
@@ -462,11 +512,11 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
     const bool unbeatable = s.result.converged() && s.result.cost == 0;
     if (context.stopReason()) {
       if (own_refined && sameHomotopyClass(s.homotopy, homotopyClassOf(problem))) {
-        addRefined(s, *own_refined, s.result.iterations + own_refined->iterations);
+        addRefined(s, *own_refined, s.result.iterations + own_refined->result.iterations);
       } else if (!s.on_requested_grid && !s.steps.empty()) {
         const SolveContext::Scope scope(context, AttemptStage::ClassRefine, s.homotopy);
-        const PlanResult carried = refineClass(s, plan, context, settings, p);
-        addRefined(s, carried, carried.iterations);
+        const Refined carried = refineClass(s, plan, context, settings, p, defer_checks);
+        addRefined(s, carried, carried.result.iterations);
       }
       return;
     }
@@ -478,10 +528,10 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   if (plan.survey + 1 == plan.levels.size()) return;  // the survey was on the requested grid
   const double margin = plans ? p.class_refine_margin : p.unconstrained_refine_margin;
   const std::vector<const Surveyed*> refine = classesToRefine(surveyed, problem, margin, p);
-  const std::vector<PlanResult> refined =
-      refineClasses(refine, problem, plan, context, settings, p, std::move(own_refined));
+  const std::vector<Refined> refined = refineClasses(refine, problem, plan, context, settings, p,
+                                                     defer_checks, std::move(own_refined));
   for (std::size_t i = 0; i < refined.size(); ++i) {
-    addRefined(*refine[i], refined[i], refine[i]->result.iterations + refined[i].iterations);
+    addRefined(*refine[i], refined[i], refine[i]->result.iterations + refined[i].result.iterations);
   }
 }
 
@@ -502,7 +552,8 @@ struct RecipeState {
   const PlanningProblem& problem;
   const SolverOptions& options;
   const NewtonParameters& p;
-  const Walk& walk;
+  /// The attempts so far: reading whether its kept plan converged runs that plan's check.
+  Walk& walk;
   /// The own iterations of the class the more starts would search (its survey and refinement,
   /// or the request's solve): the gate judges that first answer, not the further starts.
   int class_iterations = 0;
@@ -515,15 +566,20 @@ using Gate = bool (*)(const RecipeState&);
 /// A spinning request that stalled from the Hermite start: fast rates over long horizons end at
 /// the iteration limit; easier problems (rest to rest, or the coasting motion) lead to it.
 bool stalledWithSpinningEnds(const RecipeState& s) {
-  return !s.walk.kept()->converged() && hasSpinningEnds(s.problem) && !s.options.warm_start;
+  return hasSpinningEnds(s.problem) && !s.options.warm_start && !s.walk.keptConverged();
+}
+
+/// The more starts search a spinning request that left its class free; their gates hold for no
+/// other request, and are not read for one (reading them runs the checks of the plans they read).
+bool mayTryMoreStarts(const RecipeState& s) {
+  return hasSpinningEnds(s.problem) && classLeftFree(s.problem, s.options);
 }
 
 /// A converged spinning solve of a class that took many iterations (survey and refinement, or
 /// its whole solve) wandered far from its start: within that class another start may reach a
 /// cheaper extremal (the class survey compares classes, not the basins inside one).
 bool slowSpinningSolve(const RecipeState& s) {
-  return s.walk.kept()->converged() && hasSpinningEnds(s.problem) &&
-         classLeftFree(s.problem, s.options) &&
+  return mayTryMoreStarts(s) && s.walk.keptConverged() &&
          s.class_iterations > s.p.more_starts_above_iterations;
 }
 
@@ -537,8 +593,7 @@ bool slowAndNotCoasted(const RecipeState& s) {
 /// start competes even when the solve was fast (through the grids, which keeps it cheap): it
 /// often ends in a cheaper basin than the Hermite curve's (docs/notes/newton_tuning.md).
 bool keptClassNotCoasted(const RecipeState& s) {
-  return s.walk.kept()->converged() && hasSpinningEnds(s.problem) &&
-         classLeftFree(s.problem, s.options) && s.kept_class && !slowSpinningSolve(s) &&
+  return mayTryMoreStarts(s) && s.walk.keptConverged() && s.kept_class && !slowSpinningSolve(s) &&
          !s.walk.triedFrom(AttemptStart::Coasting, s.searched);
 }
 
@@ -654,11 +709,17 @@ std::optional<PlanResult> coastingThroughGrids(const PlanningProblem& problem,
 }
 
 /// Runs one entry of the recipe on `problem` (the class it runs in); nothing if it has no start
-/// (no coasting motion at this h).
+/// (no coasting motion at this h). `deferred` (optional): the plan's check is left to the walk
+/// (GridSettings::deferred_check), except a staged continuation's, whose stages are each checked
+/// as they end (each starts the next).
 std::optional<PlanResult> runEntry(const RecipeEntry& entry, const PlanningProblem& problem,
-                                   SolveContext& context, const NewtonParameters& p) {
+                                   SolveContext& context, const NewtonParameters& p,
+                                   std::optional<StepResidual>* deferred = nullptr) {
   const SolverOptions& options = context.options();
   GridSettings settings{options.tolerance, options.max_iterations, entry.globalization};
+  const bool staged =
+      entry.method == Method::RateContinuation || entry.method == Method::InertiaHomotopy;
+  if (!staged) settings.deferred_check = deferred;
   switch (entry.method) {
     case Method::ThroughGrids:
       return solveThroughGrids(problem, context, settings, nullptr, p);
@@ -710,6 +771,7 @@ struct MoreStart {
 /// at once, before any of them runs.
 std::vector<MoreStart> moreStarts(const PlanningProblem& problem, RecipeState* state) {
   std::vector<MoreStart> out;
+  if (!mayTryMoreStarts(*state) || !state->walk.hasPlan()) return out;
   const HomotopyClass kept = state->walk.keptClass();
   for (const ClassSolve& searched : state->walk.searchedClasses(homotopyClassOf(problem))) {
     state->class_iterations = searched.iterations;
@@ -731,13 +793,14 @@ std::vector<MoreStart> moreStarts(const PlanningProblem& problem, RecipeState* s
 void runMoreStarts(const std::vector<MoreStart>& starts, SolveContext& context, Walk* walk,
                    const NewtonParameters& p) {
   std::vector<std::optional<PlanResult>> results(starts.size());
+  std::vector<std::optional<StepResidual>> unchecked(starts.size());
   std::vector<char> began(starts.size(), 0);  // not vector<bool>: each thread writes its own
   runBranches(context, static_cast<int>(starts.size()), [&](int i, SolveContext& branch) {
     if (branch.stopReason()) return;
     began[i] = 1;
     const SolveContext::Scope scope(branch, starts[i].entry->stage,
                                     homotopyClassOf(starts[i].in_class));
-    results[i] = runEntry(*starts[i].entry, starts[i].in_class, branch, p);
+    results[i] = runEntry(*starts[i].entry, starts[i].in_class, branch, p, &unchecked[i]);
   });
   for (std::size_t i = 0; i < starts.size() && began[i]; ++i) {
     if (!results[i]) continue;  // no start (no coasting motion at this h)
@@ -746,7 +809,7 @@ void runMoreStarts(const std::vector<MoreStart>& starts, SolveContext& context, 
     const int own = results[i]->iterations;
     walk->add(attemptIn(entry.stage, startOf(entry.method, starts[i].in_class, p),
                         starts[i].in_class, entry.globalization),
-              std::move(*results[i]), own);
+              std::move(*results[i]), own, unchecked[i]);
     if (stoppedByRequest(termination)) break;
   }
 }
@@ -755,8 +818,9 @@ void runMoreStarts(const std::vector<MoreStart>& starts, SolveContext& context, 
 void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, Walk* walk,
                          const NewtonParameters& p, const Maneuver* solved_before) {
   const SolverOptions& options = context.options();
-  const GridSettings settings{options.tolerance, options.max_iterations,
-                              Globalization::TrustRegion};
+  std::optional<StepResidual> unchecked;  // its check is left to the walk
+  GridSettings settings{options.tolerance, options.max_iterations, Globalization::TrustRegion};
+  settings.deferred_check = &unchecked;
   const SolveContext::Scope scope(context, AttemptStage::Solve, homotopyClassOf(problem));
   PlanResult r = solveThroughGrids(problem, context, settings, options.warm_start, p);
   // A warm start that is the request's unconstrained optimum solved before (a class solve's
@@ -765,7 +829,7 @@ void solveRequestedClass(const PlanningProblem& problem, SolveContext& context, 
                              : options.warm_start == solved_before ? AttemptStart::PreviousAttempt
                                                                    : AttemptStart::WarmStart;
   const int iterations = r.iterations;
-  walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations);
+  walk->add(attemptIn(AttemptStage::Solve, start, problem), std::move(r), iterations, unchecked);
 }
 
 /// The walk's brief around the kept attempt's reason: what stopped the walk, which attempt it was.
@@ -782,29 +846,43 @@ frames::WalkKept briefOf(const std::vector<Attempt>& trail, std::size_t kept_at,
   return brief;
 }
 
+bool Walk::check(std::size_t i) {
+  WalkPlan& plan = plans_[i];
+  const bool passed = checkDeferredPlan(pinnedToClass(problem_, trail_[plan.at].homotopy),
+                                        *plan.unchecked, &plan.result);
+  plan.unchecked.reset();
+  Attempt& attempt = trail_[plan.at];
+  attempt.plan_checked = true;
+  attempt.termination = plan.result.termination;
+  context_.planChecked(first_recorded_ + plan.at, attempt.termination);
+  return passed;
+}
+
 PlanResult Walk::finish() {
   // An attempt cancelled or out of time ends the walk; after a converged plan it only spared
   // further attempts, otherwise the request ends with its termination.
   std::optional<Termination> stop;
   const Termination last = trail_.back().termination;
   if (stoppedByRequest(last)) stop = last;
-  if (!kept_) {  // no attempt planned on the requested grid: nothing is kept
+  if (plans_.empty()) {  // no attempt planned on the requested grid: nothing is kept
     PlanResult none = std::move(unplanned_);
     if (none.termination == Termination::Converged) none.termination = Termination::NotConverged;
     frameMessage(&none, frames::NoAttemptPlanned{trail_.size()});
     none.attempts = trail_;
     return none;
   }
-  PlanResult kept = std::move(*kept_);
+  WalkPlan& chosen = plans_[keptPlan()];
+  const std::size_t kept_at = chosen.at;
+  PlanResult kept = std::move(chosen.result);
   if (kept.converged()) stop.reset();
-  trail_[kept_at_].kept = true;
-  context_.markKept(first_recorded_ + kept_at_);
+  trail_[kept_at].kept = true;
+  context_.markKept(first_recorded_ + kept_at);
   kept.iterations = tally_.iterations();
   for (std::size_t i = 0; i < trail_.size(); ++i) {
-    if (i != kept_at_) kept.extremal_summary.others.push_back(trail_[i]);
+    if (i != kept_at) kept.extremal_summary.others.push_back(trail_[i]);
   }
   kept.extremal = describeExtremal(kept.extremal_summary);
-  frameMessage(&kept, briefOf(trail_, kept_at_, stop));
+  frameMessage(&kept, briefOf(trail_, kept_at, stop));
   if (stop && !kept.converged()) kept.termination = *stop;
   kept.attempts = trail_;
   return kept;
@@ -827,9 +905,8 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& r
   if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
   // The request's own class when it names one or is warm-started; after the class survey, when
   // no class converged on the requested grid and the request's class was not solved whole there.
-  const bool converged = walk.kept() && walk.kept()->converged();
   const bool request_solved = walk.solvedOnRequestedGrid(homotopyClassOf(problem));
-  if (!walk.kept() || (!converged && !request_solved && !context.stopReason())) {
+  if (!walk.hasPlan() || (!request_solved && !context.stopReason() && !walk.kept().converged())) {
     solveRequestedClass(problem, context, &walk, p, request.start.unconstrained_optimum);
   }
   const auto run = [&](const RecipeEntry& entry, const PlanningProblem& in) {
@@ -840,7 +917,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& r
     walk.add(attemptIn(entry.stage, startOf(entry.method, in, p), in, entry.globalization),
              std::move(*r), own);
   };
-  RecipeState state{problem, options, p, walk, walk.keptIterations()};
+  RecipeState state{problem, options, p, walk};
   for (const RecipeEntry& entry : kNewtonRecipe) {  // stalled: in the request's class
     if (context.stopReason()) break;
     if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);

@@ -27,6 +27,9 @@ struct ClassPlan {
 /// receives the class survey's converged plans (a request that leaves its class free): each class
 /// on the survey grid, and those refined on the requested grid there too; they start the
 /// constrained class search (drivers/constrained_classes.hpp) instead of solving each class again.
+/// A plan's check (planInconsistency) runs only where the walk's choice depends on it: the plan
+/// kept is always checked, a plan that fails its check is never kept (unless none converged), and
+/// the others' attempts say `plan_checked` false.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
                            SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr);
 

@@ -121,6 +121,11 @@ void SolveContext::markKept(std::size_t index) {
   for (std::size_t i = 0; i < attempts_.size(); ++i) attempts_[i].kept = i == index;
 }
 
+void SolveContext::planChecked(std::size_t index, Termination termination) {
+  attempts_[index].plan_checked = true;
+  attempts_[index].termination = termination;
+}
+
 std::optional<std::size_t> SolveContext::keptAttempt() const {
   for (std::size_t i = 0; i < attempts_.size(); ++i) {
     if (attempts_[i].kept) return i;

@@ -173,6 +173,9 @@ class SolveContext : public Interruption {
   /// Marks the attempt at `index` as the one whose plan is returned, clearing the others' mark
   /// (a later solve of the same request, e.g. the interior point after Newton, marks its own).
   void markKept(std::size_t index);
+  /// The attempt at `index` had its plan's check deferred (the Newton walk's); it has run now and
+  /// says `termination` (not converged where the check failed).
+  void planChecked(std::size_t index, Termination termination);
   /// The kept attempt's index (nothing if none is marked).
   std::optional<std::size_t> keptAttempt() const;
   /// Marks `index` kept (as markKept), or with nothing clears every mark: a plan no single

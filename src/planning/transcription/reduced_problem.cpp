@@ -17,11 +17,11 @@ namespace {
 struct StepTerms {
   Vector3 omega;  ///< ω = log F, as stored: no log map to recover it
   Matrix3 F;
+  Matrix3 E;  ///< F − I (stepTorques' difference of momenta reads it)
   Vector3 mu, G;
   Matrix3 D, dG, DFt, dGFt;
 
   StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
-    Matrix3 E;  // F − I
     so3::expWithMinusIdentity<double>(omega, &F, &E);
     mu = scheme.momentumOfStep(omega, E);
     G = F.transpose() * mu;
@@ -410,19 +410,35 @@ double ReducedProblem::forEachStencil(bool with_second_order,
                                       const std::function<void(const Stencil&)>& visit,
                                       const SecondOrderWeights& weights) const {
   const double h = scheme_.timeStep();
-  const std::vector<Vector3> tau = torques(steps_);
   double cost = 0.0;
   Stencil st;
   st.second.setZero();
   // τ_k = f (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h, where at an end node (end torques only) the missing
   // step's momentum is the boundary one (J Ω(0), J Ω(T)), a constant, and f = 2. The stencil
   // holds the residual r_k = √w_k τ_k of the cost Σ ½ w_k |τ_k|² = Σ ½ |r_k|².
+  // τ_k as stepTorques forms it (the same expressions of the same exp, F − I and μ values), from
+  // the stencil's step terms: the steps are not passed over twice. R_k with effects only.
+  const auto torqueOfStencil = [&](int k, const StepTerms* prev, const StepTerms* next,
+                                   const Matrix3& R_k) {
+    Vector3 tau;
+    if (prev && next) {
+      tau = ((next->mu - prev->mu) - prev->E.transpose() * prev->mu) / h;
+      if (effects_) tau -= effects_->torque(R_k, k * h);
+    } else if (next) {  // k = 0
+      tau = 2.0 * (next->mu - initial_momentum_) / h;
+      if (effects_) tau -= effects_->torque(initial_attitude_, 0.0);
+    } else {  // k = N, at R_N = R_{N−1} F_{N−1}
+      tau = 2.0 * (final_momentum_ - prev->F.transpose() * prev->mu) / h;
+      if (effects_) tau -= effects_->torque(Matrix3(R_k * prev->F), N_ * h);
+    }
+    return tau;
+  };
   const auto visit_torque = [&](int k, const StepTerms* prev, const StepTerms* next,
                                 const Matrix3& R_k) {
     const double root = std::sqrt(scheme_.torqueWeight(k, N_));
     const double factor = (prev && next ? 1.0 : 2.0) * root / h;
     st.k = k;
-    st.tau = root * tau[k];
+    st.tau = root * torqueOfStencil(k, prev, next, R_k);
     const Vector3 w = with_second_order && weights ? weights(k, st.tau) : st.tau;
     momentumCombination(scheme_, prev, next, factor, -factor, with_second_order ? &w : nullptr,
                         &st.jacobian, &st.second);

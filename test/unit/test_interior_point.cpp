@@ -21,6 +21,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/direct_method.hpp"
@@ -428,6 +429,53 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
     ++i;
   });
   EXPECT_EQ(block.complementarity(mu, rho).count, rows + elastic_rows);
+}
+
+// Both interior points are profiles of one barrier-problem solve (barrier_problem_solve.hpp):
+// each ends at its iteration limit with that many passes counted, reported to the context and
+// its iterate kept (free time: still strictly inside), and stops at once when the context is out
+// of time, each saying so in its own words (user-facing, kept per profile).
+TEST(BarrierProblemSolve, BothProfilesEndAtTheLimitAndOnAStopInTheirOwnWords) {
+  const auto says = [](const std::string& message, const char* word) {
+    return message.find(word) != std::string::npos;
+  };
+  const ap::PlanningProblem fixed = sceneProblem("torque_limited.yaml", 64);
+  // Bilimoria–Wie from the geodesic at T = 20 s: strictly inside its bounds, no raise.
+  ap::PlanningProblem free = sceneProblem("min_time_bilimoria_wie.yaml", 32);
+  free.duration = 20.0;
+  const ap::ReducedProblem geodesic(free);
+  const std::vector<ap::Matrix3> start = geodesic.attitudes(geodesic.current());
+  for (const double budget : {0.0, 1e-12}) {
+    SCOPED_TRACE(budget);
+    ap::SolverOptions o;
+    o.max_iterations = 3;
+    o.time_budget_s = budget;
+    ap::SolveContext grid_context(o);
+    const ap::GridOutcome grid =
+        ap::solveOnGrid(fixed, o, ap::InteriorPointParameters{}, grid_context, ap::GridRequest{});
+    ap::SolveContext free_context(o);
+    const ap::FreeTimeOutcome minimum_time =
+        ap::solveFreeTime(free, start, free.duration, 1e-9, o.max_iterations, free_context);
+    EXPECT_EQ(grid_context.iterations(), grid.result.iterations);
+    EXPECT_EQ(free_context.iterations(), minimum_time.iterations);
+    EXPECT_GT(minimum_time.smallest_value, 0.0) << minimum_time.message();
+    EXPECT_FALSE(grid.steps.empty());
+    if (budget == 0.0) {
+      EXPECT_EQ(grid.result.termination, ap::Termination::NotConverged);
+      EXPECT_EQ(grid.result.iterations, 3);
+      EXPECT_TRUE(says(grid.result.message(), "iteration limit reached")) << grid.result.message();
+      EXPECT_EQ(minimum_time.termination, ap::Termination::NotConverged);
+      EXPECT_EQ(minimum_time.iterations, 3);
+      EXPECT_TRUE(says(minimum_time.message(), "iteration limit after")) << minimum_time.message();
+    } else {
+      EXPECT_EQ(grid.result.termination, ap::Termination::TimedOut);
+      EXPECT_EQ(grid.result.iterations, 0);
+      EXPECT_TRUE(says(grid.result.message(), "time budget exceeded")) << grid.result.message();
+      EXPECT_EQ(minimum_time.termination, ap::Termination::TimedOut);
+      EXPECT_EQ(minimum_time.iterations, 0);
+      EXPECT_TRUE(says(minimum_time.message(), "out of time")) << minimum_time.message();
+    }
+  }
 }
 
 // ---- constrained optima

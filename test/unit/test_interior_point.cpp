@@ -445,36 +445,37 @@ TEST(BarrierProblemSolve, BothProfilesEndAtTheLimitAndOnAStopInTheirOwnWords) {
   free.duration = 20.0;
   const ap::ReducedProblem geodesic(free);
   const std::vector<ap::Matrix3> start = geodesic.attitudes(geodesic.current());
-  for (const double budget : {0.0, 1e-12}) {
-    SCOPED_TRACE(budget);
+  struct Ending {
+    double budget;  ///< the context's time budget [s] (0: none)
+    ap::Termination termination;
+    int iterations;
+    const char* fixed_h_says;
+    const char* free_time_says;
+  };
+  for (const Ending& e :
+       {Ending{0.0, ap::Termination::NotConverged, 3, "iteration limit reached",
+               "iteration limit after"},
+        Ending{1e-12, ap::Termination::TimedOut, 0, "time budget exceeded", "out of time"}}) {
+    SCOPED_TRACE(e.budget);
     ap::SolverOptions o;
     o.max_iterations = 3;
-    o.time_budget_s = budget;
+    o.time_budget_s = e.budget;
     ap::SolveContext grid_context(o);
     const ap::GridOutcome grid =
         ap::solveOnGrid(fixed, o, ap::InteriorPointParameters{}, grid_context, ap::GridRequest{});
     ap::SolveContext free_context(o);
     const ap::FreeTimeOutcome minimum_time =
         ap::solveFreeTime(free, start, free.duration, 1e-9, o.max_iterations, free_context);
-    EXPECT_EQ(grid_context.iterations(), grid.result.iterations);
-    EXPECT_EQ(free_context.iterations(), minimum_time.iterations);
-    EXPECT_GT(minimum_time.smallest_value, 0.0) << minimum_time.message();
+    EXPECT_EQ(grid.result.termination, e.termination);
+    EXPECT_EQ(grid.result.iterations, e.iterations);
+    EXPECT_EQ(grid_context.iterations(), e.iterations);
     EXPECT_FALSE(grid.steps.empty());
-    if (budget == 0.0) {
-      EXPECT_EQ(grid.result.termination, ap::Termination::NotConverged);
-      EXPECT_EQ(grid.result.iterations, 3);
-      EXPECT_TRUE(says(grid.result.message(), "iteration limit reached")) << grid.result.message();
-      EXPECT_EQ(minimum_time.termination, ap::Termination::NotConverged);
-      EXPECT_EQ(minimum_time.iterations, 3);
-      EXPECT_TRUE(says(minimum_time.message(), "iteration limit after")) << minimum_time.message();
-    } else {
-      EXPECT_EQ(grid.result.termination, ap::Termination::TimedOut);
-      EXPECT_EQ(grid.result.iterations, 0);
-      EXPECT_TRUE(says(grid.result.message(), "time budget exceeded")) << grid.result.message();
-      EXPECT_EQ(minimum_time.termination, ap::Termination::TimedOut);
-      EXPECT_EQ(minimum_time.iterations, 0);
-      EXPECT_TRUE(says(minimum_time.message(), "out of time")) << minimum_time.message();
-    }
+    EXPECT_TRUE(says(grid.result.message(), e.fixed_h_says)) << grid.result.message();
+    EXPECT_EQ(minimum_time.termination, e.termination);
+    EXPECT_EQ(minimum_time.iterations, e.iterations);
+    EXPECT_EQ(free_context.iterations(), e.iterations);
+    EXPECT_GT(minimum_time.smallest_value, 0.0) << minimum_time.message();
+    EXPECT_TRUE(says(minimum_time.message(), e.free_time_says)) << minimum_time.message();
   }
 }
 

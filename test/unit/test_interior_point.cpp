@@ -21,6 +21,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/free_time_solver.hpp"
 #include "planning/interior_point/grid_solve.hpp"
 #include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/direct_method.hpp"
@@ -428,6 +429,54 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
     ++i;
   });
   EXPECT_EQ(block.complementarity(mu, rho).count, rows + elastic_rows);
+}
+
+// Both interior points are profiles of one barrier-problem solve (barrier_problem_solve.hpp):
+// each ends at its iteration limit with that many passes counted, reported to the context and
+// its iterate kept (free time: still strictly inside), and stops at once when the context is out
+// of time, each saying so in its own words (user-facing, kept per profile).
+TEST(BarrierProblemSolve, BothProfilesEndAtTheLimitAndOnAStopInTheirOwnWords) {
+  const auto says = [](const std::string& message, const char* word) {
+    return message.find(word) != std::string::npos;
+  };
+  const ap::PlanningProblem fixed = sceneProblem("torque_limited.yaml", 64);
+  // Bilimoria–Wie from the geodesic at T = 20 s: strictly inside its bounds, no raise.
+  ap::PlanningProblem free = sceneProblem("min_time_bilimoria_wie.yaml", 32);
+  free.duration = 20.0;
+  const ap::ReducedProblem geodesic(free);
+  const std::vector<ap::Matrix3> start = geodesic.attitudes(geodesic.current());
+  struct Ending {
+    double budget;  ///< the context's time budget [s] (0: none)
+    ap::Termination termination;
+    int iterations;
+    const char* fixed_h_says;
+    const char* free_time_says;
+  };
+  for (const Ending& e :
+       {Ending{0.0, ap::Termination::NotConverged, 3, "iteration limit reached",
+               "iteration limit after"},
+        Ending{1e-12, ap::Termination::TimedOut, 0, "time budget exceeded", "out of time"}}) {
+    SCOPED_TRACE(e.budget);
+    ap::SolverOptions o;
+    o.max_iterations = 3;
+    o.time_budget_s = e.budget;
+    ap::SolveContext grid_context(o);
+    const ap::GridOutcome grid =
+        ap::solveOnGrid(fixed, o, ap::InteriorPointParameters{}, grid_context, ap::GridRequest{});
+    ap::SolveContext free_context(o);
+    const ap::FreeTimeOutcome minimum_time =
+        ap::solveFreeTime(free, start, free.duration, 1e-9, o.max_iterations, free_context);
+    EXPECT_EQ(grid.result.termination, e.termination);
+    EXPECT_EQ(grid.result.iterations, e.iterations);
+    EXPECT_EQ(grid_context.iterations(), e.iterations);
+    EXPECT_FALSE(grid.steps.empty());
+    EXPECT_TRUE(says(grid.result.message(), e.fixed_h_says)) << grid.result.message();
+    EXPECT_EQ(minimum_time.termination, e.termination);
+    EXPECT_EQ(minimum_time.iterations, e.iterations);
+    EXPECT_EQ(free_context.iterations(), e.iterations);
+    EXPECT_GT(minimum_time.smallest_value, 0.0) << minimum_time.message();
+    EXPECT_TRUE(says(minimum_time.message(), e.free_time_says)) << minimum_time.message();
+  }
 }
 
 // ---- constrained optima

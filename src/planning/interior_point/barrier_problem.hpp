@@ -1,7 +1,8 @@
 // What the interior point's strategies ask of a problem: the barrier problem φ_μ at the accepted
-// iterate and at trial points along a direction. Two implementations: the fixed-h band
-// (grid_solve.cpp: ConstrainedSystem over the ReducedProblem) and free time
-// (free_time_solver.cpp: the node unknowns bordered by η = h/h₀ and, while elastic, θ).
+// iterate and at trial points along a direction. Two implementations, the profiles of one
+// BarrierProblemSolve (barrier_problem_solve.hpp): the fixed-h band (grid_solve.cpp:
+// ConstrainedSystem over the ReducedProblem) and free time (free_time_solver.cpp: the node
+// unknowns bordered by η = h/h₀ and a pointing end's twist ψ).
 #pragma once
 
 #include <Eigen/Core>

@@ -50,6 +50,7 @@
 #include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
+#include "planning/interior_point/barrier_problem_solve.hpp"
 #include "planning/interior_point/barrier_update.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
@@ -67,20 +68,25 @@ namespace attitude_planner {
 
 namespace {
 
-class FreeTimeSolver final : public PrimalDualProblem {
+/// The free-time profile of the barrier problem: objective T/T₀ + ε(μ) C, every row Feasible but
+/// an elastic start's, a stencil's block summed in double, the trial point h and then the nodes,
+/// the second-order correction, the KKT residual test.
+class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
                  const StageConstraints& constraints, const InteriorPointParameters& parameters)
-      : problem_(problem),
-        np_(*np),
-        parameters_(parameters),
+      : BarrierProblemSolve(*np, parameters, constraint_block_, nullptr,
+                            {"iteration limit", "out of time"}),
+        problem_(problem),
         N_(np->steps()),
         n_(np->unknowns()),
         feasible_(parameters),
         elastic_form_(parameters),
-        block_(constraints, *np,
-               [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); }),
-        factorization_(step_factor_, kkt_, nullptr) {}
+        constraint_block_(
+            constraints, *np,
+            [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); }) {
+    rho_ = p_.free_time.initial_penalty;
+  }
 
   /// Raises h until every constraint that moves with h holds with the start margin (the others,
   /// the cones, must already hold strictly: raising h does not move an attitude). Empty if the
@@ -95,14 +101,13 @@ class FreeTimeSolver final : public PrimalDualProblem {
     }
     const double h_start = np_.timeStep();
     const ReducedProblem::StepVectors steps_start = np_.current();
-    for (int i = 0; i < parameters_.max_start_growths; ++i) {
-      if (smallestValue(np_.current(), true) >= parameters_.start_margin) {
+    for (int i = 0; i < p_.max_start_growths; ++i) {
+      if (smallestValue(np_.current(), true) >= p_.start_margin) {
         h0_ = np_.timeStep();
         return conesAfterRaise();
       }
-      const double raised = np_.timeStep() * parameters_.start_growth;
-      if (allow_elastic_ && !raisesUntilInside() &&
-          raised > parameters_.largest_start_raise * h_start) {
+      const double raised = np_.timeStep() * p_.start_growth;
+      if (allow_elastic_ && !raisesUntilInside() && raised > p_.largest_start_raise * h_start) {
         return startElastic(h_start, steps_start);
       }
       if (!raisedTo(raised)) {
@@ -112,7 +117,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
       }
     }
     return "no strictly feasible start: the constraints still fail at " +
-           std::to_string(std::pow(parameters_.start_growth, parameters_.max_start_growths)) +
+           std::to_string(std::pow(p_.start_growth, p_.max_start_growths)) +
            " times the start's duration";
   }
 
@@ -145,7 +150,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
     np_.setCurrent(steps_start);
     h0_ = h_start;
     elastic_ = started_elastic_ = true;
-    rho_ = parameters_.free_time.initial_penalty;
+    rho_ = p_.free_time.initial_penalty;
     return "";
   }
 
@@ -221,42 +226,33 @@ class FreeTimeSolver final : public PrimalDualProblem {
   void clearCorrection() override;
   // PrimalDualProblem: the free-time profile's pass (free_time_solver.cpp).
   void prepare() override;
-  BarrierState state() const override {
-    BarrierState s;
-    s.iteration = iterations_;
-    s.at_final_barrier = mu_ <= mu_final_;
-    s.elastic = elastic_;
-    s.stationarity = stationarity_;
-    s.gap = gap_;
-    s.barrier_residual = barrier_residual_;
-    s.solved_to_round_off = solved_to_round_off_;
-    s.end_game = late_;
-    return s;
+  void describe(BarrierState* s) const override {
+    s->elastic = elastic_;
+    s->stationarity = stationarity_;
+    s->gap = gap_;
+    s->barrier_residual = barrier_residual_;
+    s->solved_to_round_off = solved_to_round_off_;
+    s->end_game = late_;
   }
-  BarrierAccess barrier() override { return {&mu_, scales_, nullptr, rho_, 0.0}; }
   Pass atSolvedBarrier() override;
   void barrierDecreased() override { report(0.0, stationarity_); }
   /// Assembled in prepare(); the end game is known before the factorization.
   Pass assemble(bool) override {
-    late_ = mu_ <= parameters_.damped_barrier * mu0_;
+    late_ = mu_ <= p_.damped_barrier * mu0_;
     return Pass::Step;
   }
-  NewtonSystem newtonSystem() override { return {&factorization_, &rhs_, &d_}; }
   Pass direction(bool primal, double shift, LineSearchRequest* request, Eigen::VectorXd** d,
                  DirectionMeasures* measures) override;
   Pass accept(const LineSearchResult& result, const StopVerdict& verdict) override;
   Pass solvedToRoundOff(const LineSearchResult& result) override;
   Pass rejected(const LineSearchResult& result, const StopVerdict& verdict) override;
-  Pass ended(const LoopEnd& e) override {
-    return e.termination == Termination::Converged ? converged(e.reason)
-                                                   : end(e.termination, e.reason);
+  Pass ended(const LoopEnd& e) override { return end(e.termination, e.reason); }
+  /// Stopped inside an assembly: the iterate's system is assembled once more without polling, so
+  /// the residuals reported are the iterate's.
+  void interruptedInsidePass() override {
+    context_ = nullptr;
+    assemble(mu_, epsilon_);
   }
-  void iterationLimit() override { end(Termination::NotConverged, "iteration limit"); }
-  void stopped(Termination t, bool inside_pass) override;
-  /// Ends the solve: the outcome at the iterate, with `why`.
-  Pass end(Termination t, const std::string& why);
-  /// Ends the solve converged, with the second-order check.
-  Pass converged(const std::string& why);
   double meritSlope(const Eigen::VectorXd& d) const;
   double barrierResidual(double mu) const;
   /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
@@ -268,39 +264,30 @@ class FreeTimeSolver final : public PrimalDualProblem {
   /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
   /// iterate the pass started from.
   void report(double alpha, double stationarity) const;
-  FreeTimeOutcome outcome(Termination t, const std::string& why, int iterations,
-                          double epsilon) const;
+  /// The outcome at the iterate the solve ended at (termination_, reason_).
+  FreeTimeOutcome outcome() const;
   void checkSecondOrder(FreeTimeOutcome* out) const;
 
   const PlanningProblem& problem_;
-  ReducedProblem& np_;
-  const InteriorPointParameters& parameters_;
   int N_, n_;
   double h0_ = 0.0;
-  Feasible feasible_;                    ///< −μ ln c: how a row enters the barrier problem
-  L1Elastic<10> elastic_form_;           ///< an elastic start's rows (elasticRows)
-  BarrierRowBlock<FreeTimeStep> block_;  ///< the constraint block, its rows in form(group)
-  /// The assembled system at the current iterate: the band, its border (η) and corner.
-  KktBlocks<double> kkt_{1};
-  Eigen::VectorXd rhs_, lagrangian_gradient_;
-  BorderedBandKkt<double> step_factor_;     ///< the last step's factor (the correction reuses it)
-  KktFactorization<double> factorization_;  ///< step_factor_ over kkt_, as the loop factors it
+  Feasible feasible_;           ///< −μ ln c: how a row enters the barrier problem
+  L1Elastic<10> elastic_form_;  ///< an elastic start's rows (elasticRows)
+  BarrierRowBlock<FreeTimeStep> constraint_block_;  ///< block_: its rows in form(group)
+  Eigen::VectorXd lagrangian_gradient_;  ///< ∇L at the assembled iterate (rhs_ is −∇φ_μ)
   // The run (run()): its barrier problems and the stopping test.
-  double mu0_ = 0.0, mu_final_ = 0.0;
+  double mu0_ = 0.0;
   MinimumTimeObjective objective_{1, 1.0, 0.0, 1.0};  ///< T/T₀ + ε(μ) C (set by run())
-  double mu_ = 0.0, epsilon_ = 0.0;  ///< the barrier problem of this pass: μ, ε(μ)
-  BarrierScales scales_;
+  double epsilon_ = 0.0;                              ///< ε(μ) of this pass's barrier problem
   KktResidualTest test_{0.0, 1};
   const BarrierWatch* watch_ = nullptr;
-  int iterations_ = 0;  ///< counted passes (the loop advances it)
+  bool stopped_by_watch_ = false;
   /// What this pass measured at the assembled iterate, and its step.
   double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
-  Eigen::VectorXd d_;
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
   /// changes φ_μ): the next pass lowers μ.
   bool solved_to_round_off_ = false;
-  FreeTimeOutcome out_;  ///< the outcome, once the solve has ended
   /// The accepted iterate a line search starts from, and its barrier problem.
   struct SearchStart {
     double h = 0.0, mu = 0.0, epsilon = 0.0;
@@ -310,7 +297,6 @@ class FreeTimeSolver final : public PrimalDualProblem {
   // The elastic start (startInside): until the iterate is strictly inside every constraint that
   // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
-  double rho_ = parameters_.free_time.initial_penalty;
   ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
   StartBarrier start_barrier_ = StartBarrier::Initial;
   StartRaise start_raise_ = StartRaise::Bounded;
@@ -322,7 +308,7 @@ class FreeTimeSolver final : public PrimalDualProblem {
 
 void FreeTimeSolver::assemble(double mu, double epsilon) {
   const FreeTimeStep step{h0_};
-  Sink sink(np_, step, &kkt_);
+  Sink sink(np_, step, &kkt_blocks_);
   rhs_.setZero(n_ + borderSize());
   lagrangian_gradient_.setZero(n_ + borderSize());
   // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
@@ -435,7 +421,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
   // is a plan and lies above it anyway.
   if (elastic_ && h < accepted_.h) {
     const double floor = discreteDurationLowerBound(problem_) / N_;  // 0: no bound applies
-    if (floor > 0 && h - floor < (1.0 - parameters_.fraction_to_boundary) * (accepted_.h - floor)) {
+    if (floor > 0 && h - floor < (1.0 - p_.fraction_to_boundary) * (accepted_.h - floor)) {
       return std::numeric_limits<double>::infinity();
     }
   }
@@ -476,7 +462,7 @@ bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* co
                              block_.rows.addRow(np_, g, k, in.g, w, &v);
                            });
   if (!curved) return false;
-  step_factor_.solve(&v);
+  kkt_->solve(&v);
   if (!v.allFinite()) return false;
   *corrected = d + v;
   return true;
@@ -519,11 +505,6 @@ std::string FreeTimeSolver::watched(const BarrierWatch& watch, double mu, double
   return watch(point);
 }
 
-/// The word a stopped solve's message starts with.
-const char* stopWord(Termination t) {
-  return t == Termination::Cancelled ? "cancelled" : "out of time";
-}
-
 void FreeTimeSolver::report(double alpha, double stationarity) const {
   IterationInfo info;
   info.gradient_norm = stationarity;
@@ -541,24 +522,23 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   context_ = &context;
   watch_ = &watch;
   const int m = block_.rows.count;
-  mu0_ = parameters_.free_time.initial_barrier / m;
-  mu_final_ = parameters_.final_barrier_fraction * tolerance / m;
+  mu0_ = p_.free_time.initial_barrier / m;
   objective_ = scale_.set() ? MinimumTimeObjective(N_, h0_, scale_.cost, mu0_, scale_.duration)
                             : MinimumTimeObjective(N_, h0_, np_.cost(np_.current()), mu0_);
   test_ = KktResidualTest(tolerance, N_);
   // μ is already on the objective's scale (T/T₀ about 1 at the start): the rule's scaled μ is μ.
-  scales_ = {1.0, 1, N_, mu_final_};
+  scales_ = {1.0, 1, N_, p_.final_barrier_fraction * tolerance / m};
   mu_ = firstBarrier();
   // The first multipliers: the primal ones at the start's values (an elastic row safeguarded).
   block_.evaluate(np_.current());
   block_.prepare(mu_, rho_, true);
-  PrimalDualLoop(
-      *this,
-      {test_, std::make_unique<MonotoneBarrier>(parameters_, freeTimeMonotone(parameters_)),
-       std::make_unique<PerturbationHandler>(parameters_)},
-      {freeTimeLineSearch(parameters_), false, false}, context)
-      .run(max_iterations, &iterations_);
-  return out_;
+  solve({test_, std::make_unique<MonotoneBarrier>(p_, freeTimeMonotone(p_)),
+         std::make_unique<PerturbationHandler>(p_)},
+        {freeTimeLineSearch(p_), false, false}, context, max_iterations);
+  FreeTimeOutcome out = outcome();
+  out.stopped_by_watch = stopped_by_watch_;
+  if (termination_ == Termination::Converged) checkSecondOrder(&out);
+  return out;
 }
 
 /// μ₀, or in an elastic phase begun FromViolations the μ that widens its rows' kinks to
@@ -569,11 +549,9 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
 /// ended on the upper branch begun at μ₀ and at μ₀/10, and stayed on its own begun at μ₀/100 (26
 /// iterations) and μ₀/1000 (48).
 double FreeTimeSolver::firstBarrier() const {
-  if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint)
-    return parameters_.near_kkt_barrier * mu0_;
+  if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint) return p_.near_kkt_barrier * mu0_;
   if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
-  return std::max(mu0_,
-                  parameters_.elastic_kink_width * rho_ * -smallestValue(np_.current(), true));
+  return std::max(mu0_, p_.elastic_kink_width * rho_ * -smallestValue(np_.current(), true));
 }
 
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
@@ -583,21 +561,20 @@ void FreeTimeSolver::prepare() {
   assemble(mu_, epsilon_);
   gap_ = block_.rows.dualityGap();
   stationarity_ = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
-  barrier_residual_ = mu_ > mu_final_ ? barrierResidual(mu_) : 0.0;  // the μ rule's test
+  barrier_residual_ = mu_ > scales_.mu_final ? barrierResidual(mu_) : 0.0;  // the μ rule's test
 }
 
 /// A solved barrier problem (the μ rule's test, or solved to round-off): the watch, then the
 /// elastic penalty; the loop lowers μ.
 Pass FreeTimeSolver::atSolvedBarrier() {
   solved_to_round_off_ = false;
-  const std::string stop = watched(*watch_, mu_, gap_, epsilon_, iterations_);
+  const std::string stop = watched(*watch_, mu_, gap_, epsilon_, iteration_);
   if (!stop.empty()) {
-    end(Termination::NotConverged, stop);
-    out_.stopped_by_watch = true;
-    return Pass::Stop;
+    stopped_by_watch_ = true;
+    return end(Termination::NotConverged, stop);
   }
   if (elastic_)
-    rho_ *= parameters_.free_time.penalty_growth;  // solved still outside: the penalty was too low
+    rho_ *= p_.free_time.penalty_growth;  // solved still outside: the penalty was too low
   return Pass::Step;
 }
 
@@ -617,7 +594,7 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
   // dz = μ/c − z − (z/c)(gᵀd + r) (r: the second-order correction's term; an elastic row's
   // dz = (q − gᵀd)/D) and the largest dual step by the fraction to the boundary, applied.
-  block_.applyDualStep(block_.dualStep(d_, mu_, rho_));
+  block_.applyDualStep(dualStep());
   leaveElasticIfInside();
   // κ_Σ: z within [μ/(κ_Σ c), κ_Σ μ/c] at the new values c (an elastic row's multiplier is
   // safeguarded where it is prepared for the next assembly).
@@ -633,7 +610,7 @@ Pass FreeTimeSolver::solvedToRoundOff(const LineSearchResult& result) {
   // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
   // Bilimoria–Wie disturbance start stopped at μ = 2e-7 μ₀ on the round-off floor, 1.3e-8
   // above its T*.
-  if (!elastic_ && mu_ > mu_final_ && result.at_round_off) {
+  if (!elastic_ && mu_ > scales_.mu_final && result.at_round_off) {
     solved_to_round_off_ = true;
     report(0.0, stationarity_);
     return Pass::Continue;
@@ -646,38 +623,16 @@ Pass FreeTimeSolver::rejected(const LineSearchResult&, const StopVerdict&) {
   return end(Termination::NotConverged, "no descent step (line search failed)");
 }
 
-/// Stopped inside an assembly: the iterate's system is assembled once more without polling, so
-/// the residuals reported are the iterate's.
-void FreeTimeSolver::stopped(Termination t, bool inside_pass) {
-  if (inside_pass) {
-    context_ = nullptr;
-    assemble(mu_, epsilon_);
-  }
-  end(t, stopWord(t));
-}
-
-Pass FreeTimeSolver::end(Termination t, const std::string& why) {
-  out_ = outcome(t, why, iterations_, epsilon_);
-  return Pass::Stop;
-}
-
-Pass FreeTimeSolver::converged(const std::string& why) {
-  end(Termination::Converged, why);
-  checkSecondOrder(&out_);
-  return Pass::Stop;
-}
-
-FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, int iterations,
-                                        double epsilon) const {
+FreeTimeOutcome FreeTimeSolver::outcome() const {
   FreeTimeOutcome out;
-  out.termination = t;
+  out.termination = termination_;
   out.steps = np_.current();
   out.time_step = np_.timeStep();
   out.start_time_step = h0_;
   out.elastic_start = started_elastic_;
   out.duration = N_ * out.time_step;
-  out.iterations = iterations;
-  out.effort_weight = epsilon;
+  out.iterations = iteration_;
+  out.effort_weight = epsilon_;
   // Residuals of the Lagrangian T/T₀ + εC − Σ z c (ε → 0 with μ: minimum time at the end).
   out.stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   out.time_row = std::abs(lagrangian_gradient_(n_));
@@ -691,9 +646,9 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
   block_.rows.addBoxMultipliers(np_, np_.torques(out.steps), &out.switching_function,
                                 &out.torque_multipliers);
   out.maneuver = np_.maneuver(out.steps);
-  recordVerdict(
-      &out, verdicts::FreeTimeEnded{why, iterations, out.duration, out.stationarity, out.time_row,
-                                    out.complementarity, out.smallest_value});
+  recordVerdict(&out,
+                verdicts::FreeTimeEnded{reason_, iteration_, out.duration, out.stationarity,
+                                        out.time_row, out.complementarity, out.smallest_value});
   return out;
 }
 
@@ -703,7 +658,7 @@ FreeTimeOutcome FreeTimeSolver::outcome(Termination t, const std::string& why, i
 /// runs once per converged solve, and only there).
 bool FreeTimeSolver::barrierHessianDefinite() const {
   BorderedBandKkt<double> factor;
-  return factor.factor(kkt_, Shift{}) && factor.inertia().positive == borderSize() &&
+  return factor.factor(kkt_blocks_, Shift{}) && factor.inertia().positive == borderSize() &&
          factor.inertia().negative == 0;
 }
 
@@ -711,7 +666,7 @@ void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
   const bool definite = barrierHessianDefinite();
   out->second_order_sufficient = definite;
   if (definite) return;
-  const std::optional<LeastEigenpair> least = leastEigenpair(kkt_);
+  const std::optional<LeastEigenpair> least = leastEigenpair(kkt_blocks_);
   if (!least) return;
   out->least_curvature = least->value / least->scale;
   const Eigen::VectorXd v = least->vector.head(n_);

@@ -13,6 +13,7 @@
 
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/interior_point/barrier_problem_solve.hpp"
 #include "planning/interior_point/inertia_correction.hpp"
 #include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/line_search.hpp"
@@ -36,23 +37,28 @@ std::string describeManeuverSpan(const PlanningProblem& problem) {
   return s.str();
 }
 
+/// The fixed-h profile of the barrier problem: objective C, every row in the formulation's form
+/// (free slacks or ℓ1-elastic), the rows' g gᵀ/D as rank-one terms in the band's precision, the
+/// trial point the node unknowns' retraction, the merit's penalty ν or ρ, the decrement test.
 template <typename Scalar>
-class GridSolve final : public PrimalDualProblem {
+class GridSolve final : public BarrierProblemSolve<FixedTimeStep, Scalar> {
+  using Base = BarrierProblemSolve<FixedTimeStep, Scalar>;
+  using Base::np_, Base::p_, Base::block_, Base::kkt_blocks_, Base::rhs_, Base::d_, Base::scales_,
+      Base::mu_, Base::rho_, Base::iteration_, Base::termination_, Base::reason_, Base::end,
+      Base::dualStep;
+
  public:
   GridSolve(const PlanningProblem& problem, const SolverOptions& options,
             const InteriorPointParameters& parameters, SolveContext& context,
-            const GridRequest& request, ReducedProblem* np)
-      : problem_(problem),
+            const GridRequest& request, ReducedProblem* np, ConstrainedSystem* system)
+      : Base(*np, parameters, system->block(), &context,
+             {"iteration limit reached", "time budget exceeded"}),
+        problem_(problem),
         options_(options),
-        p_(parameters),
         context_(context),
         request_(request),
-        np_(*np),
-        system_(problem, np, request.formulation, parameters),
-        free_slacks_(system_.freeSlacks()),
-        kkt_blocks_(np->unknowns()),
-        kkt_(makeKkt<Scalar>(system_.globals())),
-        factorization_(*kkt_, kkt_blocks_, &context),
+        system_(*system),
+        free_slacks_(system->freeSlacks()),
         test_(parameters, options.tolerance, np->steps(), request.barrier == BarrierRule::Mehrotra,
               free_slacks_) {
     system_.setInterruption(&context);
@@ -60,11 +66,9 @@ class GridSolve final : public PrimalDualProblem {
 
   GridOutcome run() {
     initialize();
-    PrimalDualLoop(
-        *this,
+    this->solve(
         {test_, makeBarrierUpdate(request_.barrier, p_), std::make_unique<RowRelativeShift>(p_)},
-        {fixedStepLineSearch(p_), true, true}, context_)
-        .run(options_.max_iterations, &iteration_);
+        {fixedStepLineSearch(p_), true, true}, context_, options_.max_iterations);
     system_.setInterruption(nullptr);
     return finish();
   }
@@ -99,7 +103,7 @@ class GridSolve final : public PrimalDualProblem {
         std::min(mu_, p_.final_barrier_fraction * options_.tolerance * f / m *
                           std::max(1.0, static_cast<double>(N) / p_.final_barrier_round_off_steps));
     system_.evaluateValues(np_.current(), nullptr);
-    system_.block().initialize(mu_, rho_, p_.initial_multiplier_cap * f / m);
+    block_.initialize(mu_, rho_, p_.initial_multiplier_cap * f / m);
     if (request_.barrier == BarrierRule::Mehrotra && request_.coarse_duals &&
         !request_.coarse_duals->empty() && request_.coarse_steps) {
       // The barrier of the warm start: its own complementarity (the predictor lowers it).
@@ -110,18 +114,12 @@ class GridSolve final : public PrimalDualProblem {
 
   // PrimalDualProblem: what the decrement test reads, the direction, the step, a rejection, the
   // ends.
-  BarrierState state() const override {
-    BarrierState s;
-    s.iteration = iteration_;
-    s.at_final_barrier = mu_ <= scales_.mu_final;
-    s.max_violation = system_.block().maxViolation();
-    s.f_scale = scales_.f_scale;
-    return s;
+  void describe(BarrierState* s) const override {
+    s->max_violation = block_.maxViolation();
+    s->f_scale = scales_.f_scale;
   }
-
-  BarrierAccess barrier() override {
-    return {&mu_, scales_, &system_, rho_, test_.previousDecrement()};
-  }
+  BarrierRows* barrierRows() override { return &system_; }
+  double previousDecrement() const override { return test_.previousDecrement(); }
   /// The condensed system (primal: with the multipliers μ/s); a non-finite cost ends the solve.
   Pass assemble(bool primal) override {
     cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_, &rhs_, &merit_gradient_).cost;
@@ -131,13 +129,12 @@ class GridSolve final : public PrimalDualProblem {
     }
     return Pass::Step;
   }
-  NewtonSystem newtonSystem() override { return {&factorization_, &rhs_, &delta_}; }
   /// The slope of φ_μ along the step (free slacks: with the slack terms); without the primal
   /// multipliers a step that is no descent direction is taken again with them (it is one with
   /// them, H being positive definite).
   Pass direction(bool primal, double shift, LineSearchRequest* request, Eigen::VectorXd** d,
                  DirectionMeasures* measures) override {
-    double slope = merit_gradient_.dot(delta_);
+    double slope = merit_gradient_.dot(d_);
     double decrement_slope = 0.0;
     if (free_slacks_) addSlackTerms(&slope, &decrement_slope);
     if (slope >= 0.0 && !primal) return Pass::Retry;
@@ -145,7 +142,7 @@ class GridSolve final : public PrimalDualProblem {
     *measures = {free_slacks_ ? decrement_slope : slope, shift};
     request->slope = slope;
     request->alpha0 = free_slacks_ ? alpha_slack_ : 1.0;
-    *d = &delta_;
+    *d = &d_;
     return Pass::Step;
   }
   /// Whether the request's watch stops the solve at this iterate (a FeasibleIterate: free
@@ -153,9 +150,9 @@ class GridSolve final : public PrimalDualProblem {
   /// a lower one than φ's own with free slacks), ending it with the watch's reason.
   bool watched(double shift, double slope) {
     if (!request_.watch || !free_slacks_ || shift != 0.0 || slope >= 0.0) return false;
-    if (system_.block().maxViolation() > 0.0) return false;
+    if (block_.maxViolation() > 0.0) return false;
     const FeasibleIterate at{
-        cost_, cost_ - system_.block().rows.dualityGap() + 0.5 * slope,
+        cost_, cost_ - block_.rows.dualityGap() + 0.5 * slope,
         std::sqrt(-slope / std::max(2.0 * cost_, std::numeric_limits<double>::min())), iteration_};
     if (!(at.relative_decrement <= kLocalBoundDecrement)) return false;
     const std::string stop = (*request_.watch)(at);
@@ -179,19 +176,14 @@ class GridSolve final : public PrimalDualProblem {
     return verdict.final_step ? endBarrierProblem() : Pass::Continue;
   }
 
-  void iterationLimit() override {}  // ending_ and reason_ say so from the start
-  void stopped(Termination termination, bool) override {
-    end(termination, termination == Termination::Cancelled ? "cancelled" : "time budget exceeded");
-  }
-
   /// Free slacks: the slack and dual steps, the ℓ1 merit's ν (at least the multipliers after the
   /// step, and large enough that the step decreases the merit by a fraction of its predicted
   /// infeasibility reduction), and the slopes with the slacks' and the penalty's part.
   void addSlackTerms(double* slope, double* decrement_slope) {
-    const ConstrainedSystem::SlackStep slack = system_.slackStep(delta_, mu_);
+    const ConstrainedSystem::SlackStep slack = system_.slackStep(d_, mu_);
     alpha_slack_ = slack.alpha;
-    alpha_dual_ = system_.block().dualStep(delta_, mu_, rho_);
-    nu_ = std::max(nu_, p_.merit_multiplier_margin * system_.block().largestMultiplier(0.0));
+    alpha_dual_ = dualStep();
+    nu_ = std::max(nu_, p_.merit_multiplier_margin * block_.largestMultiplier(0.0));
     const double without_penalty = *slope + slack.barrier_slope;
     const double fraction = p_.merit_infeasibility_fraction;
     if (slack.residual > 0.0 && without_penalty > -fraction * nu_ * slack.residual) {
@@ -235,7 +227,10 @@ class GridSolve final : public PrimalDualProblem {
     relative_decrement_ = verdict.relative_decrement;
     return end(Termination::NotConverged, "line search failed");
   }
-  Pass ended(const LoopEnd& e) override { return end(e.termination, e.reason, e.decrement); }
+  Pass ended(const LoopEnd& e) override {
+    if (e.decrement) relative_decrement_ = *e.decrement;
+    return end(e.termination, e.reason);
+  }
 
   /// Takes the step: slacks, multipliers (the values the step was computed with, moved by the
   /// dual step), the iterate.
@@ -243,10 +238,10 @@ class GridSolve final : public PrimalDualProblem {
     if (free_slacks_) {
       system_.applySlackStep(alpha);
     } else {
-      alpha_dual_ = system_.block().dualStep(delta_, mu_, rho_);
+      alpha_dual_ = dualStep();
     }
-    system_.block().applyDualStep(std::min(alpha_dual_, 1.0));
-    FixedStepTranscription::accept(np_, trial, delta_, alpha);
+    block_.applyDualStep(std::min(alpha_dual_, 1.0));
+    FixedStepTranscription::accept(np_, trial, d_, alpha);
   }
 
   /// Records the iteration and reports it; false if the caller asked to stop.
@@ -265,15 +260,15 @@ class GridSolve final : public PrimalDualProblem {
   Pass endBarrierProblem() {
     ++iteration_;
     system_.evaluateValues(np_.current(), nullptr);
-    const double violation = system_.block().maxViolation();
+    const double violation = block_.maxViolation();
     if (violation <= p_.feasibility_tolerance) return end(Termination::Converged, "converged");
     if (!free_slacks_ && penalty_raises_ == 0 && violation <= p_.penalty_raise_violation) {
       ++penalty_raises_;
       rho_ *= p_.fixed_step.penalty_growth;
       mu_ = mu_start_;
       test_.restart(iteration_);
-      system_.block().initialize(mu_, rho_,
-                                 p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
+      block_.initialize(mu_, rho_,
+                        p_.initial_multiplier_cap * scales_.f_scale / scales_.constraints);
       // The raise is counted as an iteration (the step before it ended a pass too): reported,
       // at the same iterate, so that the context's count is the solve's.
       if (report(cost_, relative_decrement_, 0.0)) return Pass::Continue;
@@ -281,14 +276,6 @@ class GridSolve final : public PrimalDualProblem {
       return end(Termination::Cancelled, "cancelled");
     }
     return end(Termination::Infeasible, "infeasible");
-  }
-
-  Pass end(Termination termination, std::string reason,
-           std::optional<double> decrement = std::nullopt) {
-    ending_ = termination;
-    reason_ = std::move(reason);
-    if (decrement) relative_decrement_ = *decrement;
-    return Pass::Stop;
   }
 
   /// The problem as the iterate poses it: with a pointing end condition, R_N at the iterate's
@@ -329,7 +316,7 @@ class GridSolve final : public PrimalDualProblem {
     // tell a stopped iterate from an answer).
     result.max_residual = std::numeric_limits<double>::quiet_NaN();
     const PlanningProblem posed = posedAtIterate();
-    if (!stoppedByRequest(ending_) || request_.evaluate_when_stopped) {
+    if (!stoppedByRequest(termination_) || request_.evaluate_when_stopped) {
       const Maneuver planned = np_.maneuver(np_.current());
       result.switching_function = system_.switchingFunction(planned.torque);
       result.max_residual = system_.relativeStationarity(mu_, rho_, &rhs_, &merit_gradient_);
@@ -337,27 +324,27 @@ class GridSolve final : public PrimalDualProblem {
       if (np_.hasTwist()) reportTwist(planned, &result);
     }
     std::ostringstream msg;
-    if (ending_ == Termination::Infeasible) {
+    if (termination_ == Termination::Infeasible) {
       const ConstraintCheck check = checkConstraints(posed, result.maneuver);
       msg << "infeasible: " << (check.worst.empty() ? std::string("the constraints") : check.worst)
           << " " << describeManeuverSpan(problem_)
           << " (the violation stopped decreasing; the last iterate exceeds it " << check.worst_where
           << ")";
     } else {
-      if (ending_ == Termination::Converged) {
+      if (termination_ == Termination::Converged) {
         const std::string inconsistent = planInconsistency(posed, result, true);
         if (!inconsistent.empty()) {
-          ending_ = Termination::NotConverged;
+          termination_ = Termination::NotConverged;
           reason_ = inconsistent;
         }
       }
       msg << reason_;
     }
-    result.termination = ending_;
-    recordVerdict(&result, verdicts::InteriorPointEnded{msg.str(), iteration_, relative_decrement_,
-                                                        mu_ / scales_.f_scale,
-                                                        system_.block().maxViolation()});
-    result.levels.push_back({np_.steps(), iteration_, ending_, result.max_residual,
+    result.termination = termination_;
+    recordVerdict(&result,
+                  verdicts::InteriorPointEnded{msg.str(), iteration_, relative_decrement_,
+                                               mu_ / scales_.f_scale, block_.maxViolation()});
+    result.levels.push_back({np_.steps(), iteration_, termination_, result.max_residual,
                              relative_decrement_,
                              std::string(free_slacks_ ? "interior point (free slacks): "
                                                       : "interior point (elastic): ") +
@@ -367,33 +354,21 @@ class GridSolve final : public PrimalDualProblem {
 
   const PlanningProblem& problem_;
   const SolverOptions& options_;
-  const InteriorPointParameters& p_;
   SolveContext& context_;
   const GridRequest request_;
-  ReducedProblem& np_;
-  ConstrainedSystem system_;
+  ConstrainedSystem& system_;
   const bool free_slacks_;
-  /// The condensed system: a band, bordered by the twist ψ with a pointing end condition.
-  KktBlocks<Scalar> kkt_blocks_;
-  std::unique_ptr<KktSystem<Scalar>> kkt_;
-  KktFactorization<Scalar> factorization_;  ///< kkt_ over kkt_blocks_, as the loop factors it
   DecrementTest test_;  ///< the stopping test and its memory (stalls, the last step)
-  Eigen::VectorXd rhs_, merit_gradient_, delta_;
-  BarrierScales scales_;
-  double mu_ = 0.0, mu_start_ = 0.0;
-  double rho_ = 0.0;   ///< elastic penalty ρ
+  Eigen::VectorXd merit_gradient_;
+  double mu_start_ = 0.0;
   double nu_ = 0.0;    ///< free slacks: the merit's ν ≥ the multipliers (raised as needed)
   double cost_ = 0.0;  ///< f at the iterate (the line search's φ_μ)
   ReducedProblem::StepVectors trial_;  ///< the line search's trial point
   double alpha_dual_ = 1.0, alpha_slack_ = 1.0;
-  // The stopping test's memory.
-  int iteration_ = 0;
   double relative_decrement_ = 0.0;
   int penalty_raises_ = 0;
   bool stopped_by_watch_ = false;
   std::vector<IterationInfo> history_;
-  Termination ending_ = Termination::NotConverged;
-  std::string reason_ = "iteration limit reached";
 };
 
 template <typename Scalar>
@@ -430,7 +405,8 @@ GridOutcome solveIn(const PlanningProblem& problem, const SolverOptions& options
     recordVerdict(&out.result, verdicts::ConeAtFixedNode{fixed});
     return out;
   }
-  return GridSolve<Scalar>(problem, options, parameters, context, request, &np).run();
+  ConstrainedSystem system(problem, &np, request.formulation, parameters);
+  return GridSolve<Scalar>(problem, options, parameters, context, request, &np, &system).run();
 }
 
 }  // namespace

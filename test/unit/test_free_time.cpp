@@ -31,6 +31,7 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
+#include "planning/problem/verdict.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"
@@ -381,7 +382,9 @@ TEST(FreeTime, AnIterateStrictlyInsideItsBoundsIsAPlanAtItsOwnT) {
   // What the probes below T* hand on where a free-time solve stops short of a KKT point: its last
   // iterate, strictly inside every bound, is a plan at its own T. Its torques replayed from the
   // initial state by the scheme's own integrator land on the final attitude and rate, and meet
-  // the bounds.
+  // the bounds; and the one rule for plans (provesFeasible: the dynamics step by step, the ends,
+  // every bound) accepts it as a plan at that T, as the probes take it where no minimum-effort
+  // solve from it finds one.
   ap::PlanningProblem p = spinningRequest(64);
   p.duration = 3.5;
   const ap::ReducedProblem geodesic(p);
@@ -401,6 +404,14 @@ TEST(FreeTime, AnIterateStrictlyInsideItsBoundsIsAPlanAtItsOwnT) {
     EXPECT_LE(ap::so3::angleBetween(m.attitude.back(), p.final_attitude), 1e-8) << limit;
     EXPECT_LE((m.angular_velocity.back() - p.final_velocity).norm(), 1e-8) << limit;
     EXPECT_NEAR(o.duration, o.time_step * p.steps, 1e-12 * o.duration);
+    ap::PlanningProblem at = p;
+    at.objective = ap::Objective::MinimumEffort;
+    at.duration = o.duration;
+    ap::PlanResult plan;
+    plan.termination = ap::Termination::NotConverged;
+    ap::evaluatePlan(at, o.maneuver.torque, &plan, &o.maneuver);
+    EXPECT_TRUE(ap::provesFeasible(at, plan))
+        << limit << ": " << ap::planInconsistency(at, plan, true);
   }
   EXPECT_GT(checked, 0) << "no iteration limit left a strictly feasible iterate";
 }

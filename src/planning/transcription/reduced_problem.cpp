@@ -237,6 +237,22 @@ std::vector<Matrix3> ReducedProblem::attitudes(const StepVectors& steps) const {
 
 namespace {
 
+/// h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1} at an interior node,
+/// before the effects: the large parts cancel in a difference of accurately formed momenta.
+Vector3 interiorTorque(const Vector3& mu, const Vector3& mu_prev, const Matrix3& E_prev, double h) {
+  return ((mu - mu_prev) - E_prev.transpose() * mu_prev) / h;
+}
+
+/// The end torques, before the effects: Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and
+/// Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N.
+Vector3 firstTorque(const Vector3& mu_first, const Vector3& initial_momentum, double h) {
+  return 2.0 * (mu_first - initial_momentum) / h;
+}
+Vector3 lastTorque(const Vector3& final_momentum, const Matrix3& F_last, const Vector3& mu_last,
+                   double h) {
+  return 2.0 * (final_momentum - F_last.transpose() * mu_last) / h;
+}
+
 /// τ_k, k = 0..N, of `steps` (ReducedProblem::torques), and with `attitudes` the rows
 /// R_{k+1} = R_k F_k from the same pass. Each step's exp(ω^) and exp(ω^) − I come from one
 /// Rodrigues evaluation (so3::expWithMinusIdentity: the values of exp and expMinusIdentity, so
@@ -270,9 +286,7 @@ std::vector<Vector3> stepTorques(const DiscreteScheme& scheme,
     Matrix3 F, E;
     step(steps[k], &F, &E);
     const Vector3 mu = scheme.momentumOfStep(steps[k], E);
-    // h τ_k = μ_k − F_{k−1}ᵀ μ_{k−1} = (μ_k − μ_{k−1}) − (F_{k−1} − I)ᵀ μ_{k−1}: the large parts
-    // cancel in a difference of accurately formed momenta.
-    tau[k] = ((mu - mu_prev) - E_prev.transpose() * mu_prev) / h;
+    tau[k] = interiorTorque(mu, mu_prev, E_prev, h);
     if (track_attitude) R = R * F_prev;
     if (attitudes) (*attitudes)[k] = R;
     if (effects) tau[k] -= effects->torque(R, k * h);  // the control supplies the rest
@@ -283,10 +297,9 @@ std::vector<Vector3> stepTorques(const DiscreteScheme& scheme,
   if (track_attitude) R = R * F_prev;  // R_N
   if (attitudes) (*attitudes)[N] = R;
   if (scheme.hasEndTorques()) {
-    // Π_0 = J Ω(0) = μ(F_0) − (h/2) τ_0 and Π_N = J Ω(T) = F_{N−1}ᵀ μ(F_{N−1}) + (h/2) τ_N
-    tau[0] = 2.0 * (mu_first - initial_momentum) / h;
+    tau[0] = firstTorque(mu_first, initial_momentum, h);
     const Matrix3 F_last = track_attitude ? F_prev : so3::exp(steps[N - 1]);
-    tau[N] = 2.0 * (final_momentum - F_last.transpose() * mu_prev) / h;
+    tau[N] = lastTorque(final_momentum, F_last, mu_prev, h);
     if (effects) {
       tau[0] -= effects->torque(initial_attitude, 0.0);
       tau[N] -= effects->torque(R, N * h);
@@ -416,19 +429,19 @@ double ReducedProblem::forEachStencil(bool with_second_order,
   // τ_k = f (μ(F_k) − F_{k−1}ᵀ μ(F_{k−1}))/h, where at an end node (end torques only) the missing
   // step's momentum is the boundary one (J Ω(0), J Ω(T)), a constant, and f = 2. The stencil
   // holds the residual r_k = √w_k τ_k of the cost Σ ½ w_k |τ_k|² = Σ ½ |r_k|².
-  // τ_k as stepTorques forms it (the same expressions of the same exp, F − I and μ values), from
+  // τ_k as stepTorques forms it (its torque functions over the same exp, F − I and μ values), from
   // the stencil's step terms: the steps are not passed over twice. R_k with effects only.
   const auto torqueOfStencil = [&](int k, const StepTerms* prev, const StepTerms* next,
                                    const Matrix3& R_k) {
     Vector3 tau;
     if (prev && next) {
-      tau = ((next->mu - prev->mu) - prev->E.transpose() * prev->mu) / h;
+      tau = interiorTorque(next->mu, prev->mu, prev->E, h);
       if (effects_) tau -= effects_->torque(R_k, k * h);
     } else if (next) {  // k = 0
-      tau = 2.0 * (next->mu - initial_momentum_) / h;
+      tau = firstTorque(next->mu, initial_momentum_, h);
       if (effects_) tau -= effects_->torque(initial_attitude_, 0.0);
     } else {  // k = N, at R_N = R_{N−1} F_{N−1}
-      tau = 2.0 * (final_momentum_ - prev->F.transpose() * prev->mu) / h;
+      tau = lastTorque(final_momentum_, prev->F, prev->mu, h);
       if (effects_) tau -= effects_->torque(Matrix3(R_k * prev->F), N_ * h);
     }
     return tau;

@@ -240,6 +240,22 @@ TEST(AttemptTags, ACallerRefusingAReportStopsEveryBranch) {
   EXPECT_EQ(stopped, 2);
   EXPECT_EQ(context.stopReason(), ap::Termination::Cancelled);
   EXPECT_LT(context.iterations(), 1000);
+  EXPECT_EQ(calls.load(),
+            10);  // the other branch's reports after the refusal never reach the caller
+}
+
+TEST(AttemptTags, ACallerThatRefusedHearsNoFurtherReport) {
+  // A branch on another thread reports until it next polls; the caller who said stop must not
+  // be called again (its last report stays the one it refused).
+  ap::SolverOptions options;
+  options.threads = 2;
+  int calls = 0;
+  options.on_iteration = [&](const ap::IterationInfo&) { return ++calls < 3; };
+  ap::SolveContext context(options);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(context.reportIteration({}), k < 2);
+  for (int k = 0; k < 5; ++k) EXPECT_FALSE(context.reportIteration({}));
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(context.stopReason(), ap::Termination::Cancelled);
 }
 
 TEST(AttemptTags, AClassSurveysIterationsAreTaggedWithTheTrailsStagesAndClasses) {

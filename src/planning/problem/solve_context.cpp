@@ -79,6 +79,9 @@ void SolveContext::poll() const {
 bool SolveContext::reportIteration(const IterationInfo& info) {
   ++iterations_;
   const std::lock_guard<std::mutex> one_at_a_time(shared_->report);
+  // A caller that refused hears nothing more: branches on other threads may still report until
+  // they next poll.
+  if (shared_->refused_by_callback) return false;
   const int number = ++shared_->reported;
   if (!request_.on_iteration) return true;
   IterationInfo numbered = info;

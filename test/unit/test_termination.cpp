@@ -287,6 +287,8 @@ TEST(Verdicts, AMinimumTimeAnswerIsItsOwnKindWithTheFiguresOfItsCertificate) {
       EXPECT_EQ(figure.at("solves"), r.minimum_time.solves);
       EXPECT_EQ(figure.at("second_order_sufficient"),
                 r.minimum_time.second_order_sufficient ? 1.0 : 0.0);
+      EXPECT_EQ(figure.at("kkt_point"), 1.0);
+      EXPECT_TRUE(answer.kkt_point);
       EXPECT_EQ(r.message().rfind(renderVerdict(r.verdict, ""), 0), 0u) << r.message();
     }
   }

@@ -250,8 +250,10 @@ struct NoStrictlyFeasibleStart {
 
 /// The minimum-time answer: T* from one free-time solve that ended at a KKT point of the discrete
 /// minimum-time problem, second-order sufficient there (a strict local minimum) or not, from
-/// `start`; its residuals, and every start solved (each with its T* or how it ended). A failed
-/// replay of the plan is the reason it is given, said after it.
+/// `start`; its residuals, and every start solved (each with its T* or how it ended). Not a KKT
+/// point (`kkt_point` false): the solve on the requested grid ended short of one at a plan inside
+/// every bound, so T* is that plan's T, an upper bound. A failed replay of the plan is the reason
+/// it is given, said after it.
 struct MinimumTimeAnswer {
   static constexpr const char* kKind = "minimum_time_answer";
   /// One start solved: its name, the earlier start it repeats (empty: none), how it ended and,
@@ -264,8 +266,9 @@ struct MinimumTimeAnswer {
     bool second_order_sufficient = false;
   };
   double minimum_duration = 0.0;  ///< T* [s]
-  bool second_order_sufficient = false;
-  std::string start;  ///< the start the answering solve came from
+  bool kkt_point = true;
+  bool second_order_sufficient = false;  ///< only at a KKT point
+  std::string start;                     ///< the start the answering solve came from
   int iterations = 0;
   double stationarity = 0.0;
   double time_row = 0.0;
@@ -274,6 +277,7 @@ struct MinimumTimeAnswer {
   int solves = 0;  ///< free-time solves run
   std::vector<VerdictFigure> figures() const {
     return {{"minimum_duration", minimum_duration},
+            {"kkt_point", kkt_point ? 1.0 : 0.0},
             {"second_order_sufficient", second_order_sufficient ? 1.0 : 0.0},
             {"iterations", double(iterations)},
             {"stationarity", stationarity},

@@ -626,7 +626,7 @@ class FreeTimeMinimumTime {
       if (!refined || (least && refined->duration >= least->duration)) continue;
       least = std::move(refined);
       name = starts_[c].name;
-      attempt = trail_.size() - 1;  // the refined solve is the one returned
+      attempt = refined_attempt_;
       least_levels = levels_;
     }
     if (!least) return std::nullopt;
@@ -638,7 +638,9 @@ class FreeTimeMinimumTime {
 
   /// The coarsest level's best answer carried through the finer `levels` (the grid continuation
   /// resumed from it): each level one free-time solve from the coarser answer prolonged, at its
-  /// T. Empty if a level does not converge or the solve is stopped (cancel, deadline).
+  /// T. Its attempt is refined_attempt_. Empty if the solve is stopped (cancel, deadline) or a
+  /// level does not converge, but for the requested grid's ending short inside its bounds
+  /// (endedShortInside, after its resume): that plan is returned, not a KKT point.
   std::optional<FreeTimeOutcome> refine(const std::vector<PlanningProblem>& levels,
                                         const FreeTimeOutcome& coarsest) {
     std::optional<FreeTimeOutcome> finest;
@@ -662,6 +664,7 @@ class FreeTimeMinimumTime {
       detail.elastic_from_violations = false;
       FreeTimeOutcome o = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
                                 AttemptStart::CoarseLevel, detail);
+      refined_attempt_ = trail_.size() - 1;
       if (endedShortInside(o)) o = resumed(r.problem, o, detail);
       PlanResult result = levelResult(r.problem.steps, o);
       if (handed_on) {
@@ -676,7 +679,12 @@ class FreeTimeMinimumTime {
     const SolvedLevel<FreeTimeCarry> from{0, Termination::Converged, {coarsest}, {}, false};
     const PlanResult result = resumeGridContinuation(levels, from, context_, freeTimeGridRule(),
                                                      kFreeTimeTolerance, level, finish);
-    if (!result.converged() || !finest) return std::nullopt;
+    if (!finest) return std::nullopt;
+    // The requested grid's level ended short of its KKT point inside every bound, resumed too: its
+    // iterate is still a plan at its own T, an upper bound on T* (answerAt says so). Discarded,
+    // the search from scratch answered a worse bound (measured: a seeded slew around a cone,
+    // 13.5065 s after 24,000 iterations against the plan's 13.4896 s, T* reached to 1e-13).
+    if (!result.converged() && !endedShortInside(*finest)) return std::nullopt;
     levels_.insert(levels_.end(), result.levels.begin(), result.levels.end());
     return finest;
   }
@@ -699,14 +707,17 @@ class FreeTimeMinimumTime {
     FreeTimeOutcome o =
         solve(p, ended.maneuver.attitude, ended.duration, AttemptStart::PreviousAttempt, detail, {},
               StartBarrier::NearKktPoint);
-    return o.termination == Termination::Converged ? o : ended;
+    if (o.termination != Termination::Converged) return ended;
+    refined_attempt_ = trail_.size() - 1;
+    return o;
   }
 
   /// The answer: the free-time plan at T* itself, measured as every plan is (freeTimePlan), its
-  /// switching functions from the solve's own bound multipliers. No minimum-effort solve at T*
-  /// follows: at T* the feasible set is that one plan to the tolerance, so such a solve is
-  /// degenerate and ends where it starts (measured: 40–150 interior-point iterations at N = 128
-  /// for the same plan, more than every start together around a cone).
+  /// switching functions from the solve's own bound multipliers. A KKT point where the solve
+  /// converged; else (refine: ended short inside every bound) a plan at its T, an upper bound. No
+  /// minimum-effort solve at T* follows: at T* the feasible set is that one plan to the tolerance,
+  /// so such a solve is degenerate and ends where it starts (measured: 40–150 interior-point
+  /// iterations at N = 128 for the same plan, more than every start together around a cone).
   PlanResult answerAt(const FreeTimeOutcome& answer, const std::string& from) {
     PlanningProblem at = endingAt(problem_, answer.maneuver.attitude.back());
     at.objective = Objective::MinimumEffort;
@@ -715,15 +726,11 @@ class FreeTimeMinimumTime {
     PlanResult result = freeTimePlan(at, answer);
     if (!trail_.empty()) trail_[best_attempt_].kept = true;
     if (!trail_.empty()) context_.markKept(first_recorded_ + best_attempt_);
-    verdicts::MinimumTimeAnswer told{answer.duration,
-                                     answer.second_order_sufficient,
-                                     from,
-                                     answer.iterations,
-                                     answer.stationarity,
-                                     answer.time_row,
-                                     answer.complementarity,
-                                     {},
-                                     solves_};
+    const bool kkt_point = answer.termination == Termination::Converged;
+    const bool second_order_sufficient = kkt_point && answer.second_order_sufficient;
+    verdicts::MinimumTimeAnswer told{
+        answer.duration,     kkt_point,       second_order_sufficient, from, answer.iterations,
+        answer.stationarity, answer.time_row, answer.complementarity,  {},   solves_};
     for (const StartRecord& st : starts_) {
       told.starts.push_back({st.name, st.same_as >= 0 ? starts_[st.same_as].name : std::string(),
                              st.outcome.termination, st.outcome.duration,
@@ -732,12 +739,12 @@ class FreeTimeMinimumTime {
     // A replay that failed (freeTimePlan) is the reason it is given, said after its account.
     recordVerdict(&result, told);
     result.minimum_duration = answer.duration;
-    result.minimum_time.kkt_point = true;
+    result.minimum_time.kkt_point = kkt_point;
     result.minimum_time.stationarity = answer.stationarity;
     result.minimum_time.time_stationarity = answer.time_row;
     result.minimum_time.complementarity = answer.complementarity;
     result.minimum_time.solves = solves_;
-    result.minimum_time.second_order_sufficient = answer.second_order_sufficient;
+    result.minimum_time.second_order_sufficient = second_order_sufficient;
     recordTwist(at, answer, &result);
     result.attempts = context_.attemptsFrom(first_recorded_);
     result.levels = levels_;
@@ -786,6 +793,7 @@ class FreeTimeMinimumTime {
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;
+  std::size_t refined_attempt_ = 0;  ///< the attempt of refine's answer on the requested grid
   int solves_ = 0;
   FreeTimeScale shared_scale_;   ///< the watched solves' scale on the starts' grid (shareScale)
   int shared_scale_steps_ = -1;  ///< that grid's N

@@ -480,12 +480,17 @@ std::string judged(const verdicts::NoStrictlyFeasibleStart& v, const std::string
 
 std::string judged(const verdicts::MinimumTimeAnswer& v, const std::string& reason) {
   std::ostringstream note;
-  note << "minimum time T* = " << v.minimum_duration
-       << " s: a KKT point of the discrete minimum-time problem, "
-       << (v.second_order_sufficient ? "second-order sufficient (a strict local minimum)"
-                                     : "not second-order sufficient (not shown a local "
-                                       "minimum)")
-       << " (one free-time interior-point solve from the " << v.start << " start, " << v.iterations
+  note << "minimum time T* = " << v.minimum_duration << " s: ";
+  if (v.kkt_point) {
+    note << "a KKT point of the discrete minimum-time problem, "
+         << (v.second_order_sufficient ? "second-order sufficient (a strict local minimum)"
+                                       : "not second-order sufficient (not shown a local "
+                                         "minimum)");
+  } else {
+    note << "an upper bound, not a KKT point: the free-time solve on the requested grid ended "
+            "short of its KKT point at a plan inside every bound";
+  }
+  note << " (one free-time interior-point solve from the " << v.start << " start, " << v.iterations
        << " iterations; stationarity " << v.stationarity << ", h row " << v.time_row
        << ", complementarity " << v.complementarity << "; starts:";
   for (const verdicts::MinimumTimeAnswer::Start& st : v.starts) {

@@ -31,6 +31,12 @@ constexpr double kFreeTimeStartFactor = 0.96;
 /// scenes/min_time_keep_out.yaml at N = 128: 1e-4 instead of the request's 1e-10 took the six
 /// clearing solves from 149 to 99 interior-point iterations, every T* of the cone table the same.
 constexpr double kConeClearTolerance = 1e-4;
+/// The iterations the warm clearing solve gets before the cold one (coneClearStart). A warm solve
+/// that has not cleared its start by then is crossing the cone the long way: measured on the
+/// seeded cone suite (scripts/minimum_time_cost.py, seed 4949), the warm solves that converged
+/// took 4-65 iterations but for a tail of 93-244, while a cold solve takes 4-8; the clearings
+/// were 37 % of minimum time's iterations around a cone.
+constexpr int kConeClearWarmIterations = 60;
 /// The rotation [rad] of a boundary step at the boundary rate that a start's duration keeps to
 /// (representableDuration): beyond about pi no step exists, and the implicit variational step
 /// loses its solution earlier on thin bodies (h |Omega| = 2.25 rad measured).
@@ -414,10 +420,13 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
     const Maneuver guess = np.maneuver(np.current());
     o.warm_start = &guess;
     o.start.from_constrained_plan = true;
+    const int max_iterations = o.max_iterations;
+    o.max_iterations = std::min(max_iterations, kConeClearWarmIterations);
     PlanResult r = planAtResolution(effort, o, context);
     if (!r.converged()) {
       o.warm_start = nullptr;
       o.start.from_constrained_plan = false;
+      o.max_iterations = max_iterations;
       r = planAtResolution(effort, o, context);
     }
     if (r.converged()) return r.maneuver.attitude;

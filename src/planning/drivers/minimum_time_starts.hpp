@@ -85,7 +85,8 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 /// A start that clears the cones: the minimum-effort plan at `duration` under the cones alone,
 /// their node bounds tightened by kConeStartClearance (the torque bounds left out: the free-time
 /// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
-/// side of a cone; cold if that does not converge. Empty if none converges. Its solves run in
+/// side of a cone; cold if that does not converge in a few iterations (a warm solve that long is
+/// crossing the cone the long way). Empty if none converges. Its solves run in
 /// `context` with its options().
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,

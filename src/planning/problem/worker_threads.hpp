@@ -1,8 +1,8 @@
 // Threads kept between requests for the solves that run at once (runBranches, runSlidingWindow).
-// A thread started per call costs its start and, on a loaded machine, waits for a core before it
-// runs (a new thread queues behind the running ones; a waiting thread woken by a hand-over is
-// placed as a sleeper); a kept thread only wakes. A work handed over that no thread has taken
-// yet can be taken back and run by the caller, so a caller never waits for a thread to start.
+// A thread started per call costs its start, and its caller's join waits until it has run, which
+// on a loaded machine can be a scheduler tick away; a kept thread only wakes. A work handed over
+// that no thread has taken yet can be taken back and run by the caller, so a caller never waits
+// for a thread to start.
 #pragma once
 
 #include <condition_variable>

@@ -51,7 +51,36 @@ bool DiscreteScheme::onPrincipalBranch(const Vector3& omega) const {
 
 Matrix3 DiscreteScheme::momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
                                                     const Vector3& tau) const {
+  return momentumJacobianContraction(stepJacobianTerms(F, omega), tau);
+}
+
+DiscreteScheme::StepJacobianTerms DiscreteScheme::stepJacobianTerms(const Matrix3& F,
+                                                                    const Vector3& omega) const {
+  StepJacobianTerms step;
+  step.F = F;
+  step.omega = omega;
+  if (kind_ != SchemeKind::Paper) return step;
+  const double theta2 = omega.squaredNorm();
+  step.c = so3::rightJacobianInverseCoefficient<double>(theta2);
+  step.dc = so3::rightJacobianInverseCoefficientDerivative(theta2);
+  step.W = so3::hat<double>(omega);
+  // so3::rightJacobianInverse's formula, with the coefficient formed once
+  step.Jr_inverse = Matrix3::Identity() + 0.5 * step.W + step.c * (step.W * step.W);
+  step.JJr_inverse = J_ * step.Jr_inverse;
+  step.Jw = J_ * omega;
+  return step;
+}
+
+Matrix3 DiscreteScheme::momentumJacobianOfStep(const StepJacobianTerms& step) const {
+  if (kind_ != SchemeKind::Paper) return momentumJacobian<double>(step.F);
+  // paperMomentumJacobian's formula over the step's terms
+  return step.F * (step.JJr_inverse - so3::hat<double>(step.Jw)) / h_;
+}
+
+Matrix3 DiscreteScheme::momentumJacobianContraction(const StepJacobianTerms& step,
+                                                    const Vector3& tau) const {
   using so3::hat;
+  const Matrix3& F = step.F;
   if (kind_ != SchemeKind::Paper) {  // the variational μ
     // The bilinear part of h μ(F e^ε e^η) is (A − Aᵀ)^∨, A = F ε^ η^ J_d, and
     // τ·(A − Aᵀ)^∨ = −tr(P ε^ η^) = εᵀ(tr(P) I − P)η with P = J_d τ^ F.
@@ -64,20 +93,18 @@ Matrix3 DiscreteScheme::momentumJacobianContraction(const Matrix3& F, const Vect
   //   aᵀ ε^ η^ Jω + aᵀ ε^ J Jr⁻¹ η + aᵀ η^ J Jr⁻¹ ε + (Ja)ᵀ dJr⁻¹(ω)[Jr⁻¹ε] η,
   // and with Jr⁻¹(ω) = I + ½ω^ + c(|ω|²) ω^², for q = Ja and u = Jr⁻¹ε:
   //   qᵀ dJr⁻¹[u] η = uᵀ(−½ q^ + 2c' ω (ω^² q)ᵀ − c q^ ω^ − c (q × ω)^) η.
-  const Vector3& w = omega;
-  const double theta2 = w.squaredNorm();
-  const double c = so3::rightJacobianInverseCoefficient<double>(theta2);
-  const double dc = so3::rightJacobianInverseCoefficientDerivative(theta2);
-  const Matrix3 W = hat<double>(w);
-  const Matrix3 Jr_inverse = Matrix3::Identity() + 0.5 * W + c * (W * W);
+  const Vector3& w = step.omega;
+  const double c = step.c, dc = step.dc;
+  const Matrix3& W = step.W;
+  const Matrix3& Jr_inverse = step.Jr_inverse;
   const Vector3 a = F.transpose() * tau;
   const Vector3 q = J_ * a;
   const Matrix3 A = hat<double>(a);
-  const Matrix3 M = J_ * Jr_inverse;
+  const Matrix3& M = step.JJr_inverse;
   const Matrix3 B = -0.5 * hat<double>(q) + 2 * dc * w * (W * (W * q)).transpose() -
                     c * hat<double>(q) * W - c * hat<double>(Vector3(q.cross(w)));
   const Matrix3 K =
-      A * hat<double>(Vector3(J_ * w)) - A * M + M.transpose() * A + Jr_inverse.transpose() * B;
+      A * hat<double>(step.Jw) - A * M + M.transpose() * A + Jr_inverse.transpose() * B;
   return K.transpose() / h_;
 }
 

@@ -96,6 +96,36 @@ TEST(DiscreteScheme, MomentumJacobianContractionMatchesDualNumbers) {
   }
 }
 
+// The step's terms, formed once per step for the Hessian's two contractions of it, give the same
+// values (bit for bit) as the Jacobian and contraction formed from the step alone: both schemes,
+// the series branch (below kSmallAngle), both sides of the derivative's switch and near π.
+TEST(DiscreteScheme, StepJacobianTermsGiveTheStepsOwnJacobianAndContraction) {
+  Matrix3 J;
+  J << 13.25, -7.80, -11.40, -7.80, 16.25, 4.71, -11.40, 4.71, 18.37;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (SchemeKind kind : {SchemeKind::Paper, SchemeKind::Variational}) {
+    const DiscreteScheme scheme(kind, J, 0.05);
+    for (double angle : {0.0, 1e-6, 1e-3, 0.3, 0.49, 0.51, 1.0, 2.5, 3.1}) {
+      const Vector3 omega = angle * Vector3(n(rng), n(rng), n(rng)).normalized();
+      const Matrix3 F = so3::exp(omega);
+      const DiscreteScheme::StepJacobianTerms step = scheme.stepJacobianTerms(F, omega);
+      EXPECT_EQ(scheme.momentumJacobianOfStep(step), scheme.momentumJacobianOfStep(F, omega))
+          << schemeName(kind) << " angle " << angle;
+      if (kind == SchemeKind::Paper) {
+        EXPECT_EQ(step.Jr_inverse, so3::rightJacobianInverse<double>(omega));
+      }
+      for (int trial = 0; trial < 3; ++trial) {
+        const Vector3 tau(n(rng), n(rng), n(rng));
+        const Matrix3 expected =
+            DiscreteScheme(kind, J, 0.05).momentumJacobianContraction(so3::exp(omega), omega, tau);
+        EXPECT_EQ(scheme.momentumJacobianContraction(step, tau), expected)
+            << schemeName(kind) << " angle " << angle;
+      }
+    }
+  }
+}
+
 // dc/dθ² of Jr⁻¹'s coefficient (series below θ = 0.5, closed form above) against a 40-digit
 // reference, on both sides of the switch and up to near 2π. The reference values come from
 //   python3 -c "import mpmath as mp; mp.mp.dps = 40;
@@ -196,6 +226,60 @@ TEST(ReducedProblem, BandedCholeskyMatchesDenseSolve) {
   indefinite.add(2, 2, 1.0);
   Eigen::VectorXd b = Eigen::VectorXd::Ones(3);
   EXPECT_FALSE(indefinite.solvePositiveDefinite(&b));
+}
+
+// The factor's order of work (column by column) is free, its arithmetic is not: every entry is
+// L(i, j) = (A(i, j) − Σ_k L(i, k) L(j, k)) / L(j, j), the sum over k = max(0, i − p) .. j − 1 in
+// ascending order, as a row-by-row textbook factorization forms it; then the same substitutions.
+// Bit for bit on a Newton Hessian and on random banded SPD matrices of several bandwidths.
+TEST(ReducedProblem, BandedCholeskyFormsEachEntryAsTheTextbookSumInAscendingOrder) {
+  const auto textbook = [](const Eigen::MatrixXd& A, int p, Eigen::VectorXd b) {
+    const int n = static_cast<int>(A.rows());
+    Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+      for (int j = std::max(0, i - p); j <= i; ++j) {
+        double s = A(i, j);
+        for (int k = std::max(0, i - p); k < j; ++k) s -= L(i, k) * L(j, k);
+        L(i, j) = j < i ? s / L(j, j) : std::sqrt(s);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      double s = b(i);
+      for (int k = std::max(0, i - p); k < i; ++k) s -= L(i, k) * b(k);
+      b(i) = s / L(i, i);
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      double s = b(i);
+      for (int k = i + 1; k <= std::min(n - 1, i + p); ++k) s -= L(k, i) * b(k);
+      b(i) = s / L(i, i);
+    }
+    return b;
+  };
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<BandedSymmetricMatrix> matrices;
+  Eigen::VectorXd g;
+  matrices.push_back(definiteHessian(perturbedProblem(SchemeKind::Paper, 40, 3), &g));
+  for (const int p : {1, 3, 8}) {
+    const int n = 30;
+    BandedSymmetricMatrix A(n, p);
+    for (int i = 0; i < n; ++i) {
+      for (int j = std::max(0, i - p); j < i; ++j) A.add(i, j, normal(rng));
+      A.add(i, i, 4.0 * p + std::abs(normal(rng)));  // diagonally dominant: definite
+    }
+    matrices.push_back(A);
+  }
+  for (const BandedSymmetricMatrix& A : matrices) {
+    Eigen::VectorXd b(A.size());
+    for (int i = 0; i < b.size(); ++i) b(i) = normal(rng);
+    BandedCholesky cholesky;
+    ASSERT_TRUE(cholesky.factor(A));
+    Eigen::VectorXd x = b;
+    cholesky.solve(&x);
+    const Eigen::VectorXd expected = textbook(A.toDense(), A.bandwidth(), b);
+    for (int i = 0; i < b.size(); ++i)
+      EXPECT_EQ(x(i), expected(i)) << "bandwidth " << A.bandwidth();
+  }
 }
 
 TEST(ReducedProblem, BandedCholeskyFactorSolvesSeveralRightHandSides) {

@@ -155,6 +155,26 @@ class DiscreteScheme {
   Matrix3 momentumJacobianContraction(const Matrix3& F, const Vector3& omega,
                                       const Vector3& tau) const;
 
+  /// What momentumJacobianOfStep and momentumJacobianContraction read of the step F = exp(ω^)
+  /// alone, not of τ: formed once where one step's Jacobian is contracted with several τ (a
+  /// Newton Hessian reaches each step from the two torques beside it). The paper scheme's terms
+  /// (its log map's Jacobian); the variational μ reads F alone.
+  struct StepJacobianTerms {
+    Matrix3 F;
+    Vector3 omega;        ///< ω = log F
+    double c = 0.0;       ///< so3::rightJacobianInverseCoefficient(|ω|²) (paper)
+    double dc = 0.0;      ///< its derivative in |ω|² (paper)
+    Matrix3 W;            ///< ω^ (paper)
+    Matrix3 Jr_inverse;   ///< Jr⁻¹(ω) (paper)
+    Matrix3 JJr_inverse;  ///< J Jr⁻¹(ω) (paper)
+    Vector3 Jw;           ///< J ω (paper)
+  };
+  StepJacobianTerms stepJacobianTerms(const Matrix3& F, const Vector3& omega) const;
+  /// momentumJacobianOfStep(F, ω), the same values, from the step's terms.
+  Matrix3 momentumJacobianOfStep(const StepJacobianTerms& step) const;
+  /// momentumJacobianContraction(F, ω, τ), the same values, from the step's terms.
+  Matrix3 momentumJacobianContraction(const StepJacobianTerms& step, const Vector3& tau) const;
+
   /// Body angular velocity [rad/s] reported for a step: paper log(F)/h (constant over the step),
   /// variational and second_order J⁻¹ μ(F) (nodal velocity at the step's start; second_order
   /// reports J⁻¹ Π_k at the nodes instead, simulation.hpp).

@@ -202,6 +202,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
   const auto start = std::chrono::steady_clock::now();
   const std::size_t first_attempt = context.attempts().size();
   PlanResult result;
+  bool replayed_by_solver = false;
   // A pointing request is judged (replay, terminal errors) against the end attitude it chose.
   PlanningProblem judged = problem;
   if (problem.end_condition.pointing()) {
@@ -233,7 +234,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
   } else if (options.solver == SolverKind::Structured && problem.hasNodeConstraints()) {
     result = planUnderConstraints(problem, options, context);
   } else if (options.solver == SolverKind::Structured) {
-    result = solveWithNewton(problem, options, context);
+    result = solveWithNewton(problem, options, context, nullptr, &replayed_by_solver);
   } else {
     const SolveContext::Call call(context, options);
     result = solveWithNlopt(problem, context.remainingOptions());
@@ -246,9 +247,10 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
     // A stopped plan is handed over at once, without its open-loop replay (N implicit steps:
     // 0.10-0.14 s at N = 1e5, where a cancel waits 30 ms): its figures say "not measured".
     markReplayNotMeasured(&result);
-  } else if (replayable) {
+  } else if (replayable && !replayed_by_solver) {
     // The Newton and interior-point plans are their own trajectories; their open-loop replay
-    // (replay_miss, the terminal errors) is measured once, here, for the plan returned.
+    // (replay_miss, the terminal errors) is measured once, here, for the plan returned (the
+    // Newton walk measures its own class's beside that plan's check).
     try {
       replayFigures(judged, &result);
     } catch (const StepTooLarge& e) {

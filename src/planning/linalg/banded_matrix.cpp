@@ -89,8 +89,12 @@ bool BandedSymmetric<Scalar>::solvePositiveDefinite(Eigen::VectorXd* b,
 template <typename Scalar>
 bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A,
                                           const Interruption* interruption) {
-  // Row-oriented Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds
-  // L(i, i − p..i) at w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory.
+  // Cholesky A = L Lᵀ in a copy with the same layout: row i of L holds L(i, i − p..i) at
+  // w·i .. w·i + p, so L(i, k) for consecutive k is consecutive memory. Column by column: the
+  // p entries below a diagonal are independent of one another (the processor overlaps their
+  // inner products), where along a row each entry waits for the one before it. Each entry is
+  //   L(i, j) = (A(i, j) − Σ_{k = max(0, i − p)}^{j − 1} L(i, k) L(j, k)) / L(j, j),
+  // its sum in the same order whatever the order of the entries.
   n_ = A.n_;
   p_ = A.p_;
   const int w = p_ + 1;
@@ -99,22 +103,20 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A,
     return L_.data() + static_cast<size_t>(i) * w + p_ - i;
   };  // row(i)[j] = L(i, j)
   if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_.resize(n_);
-  for (int i = 0; i < n_; ++i) {
-    if (interruption && i % kColumnsBetweenPolls == 0) interruption->poll();
-    Scalar* li = row(i);
-    const int first = std::max(0, i - p_);
-    for (int j = first; j <= i; ++j) {
-      const Scalar* lj = row(j);
+  for (int j = 0; j < n_; ++j) {
+    if (interruption && j % kColumnsBetweenPolls == 0) interruption->poll();
+    Scalar* lj = row(j);
+    const auto lj_at = [lj](int k) { return lj[k]; };
+    const Scalar d = minusDot(lj[j], std::max(0, j - p_), j, lj_at, lj_at);
+    if (!(d > 0) || !scalarIsFinite(d)) return false;
+    lj[j] = scalarSqrt(d);
+    if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_[j] = Scalar(1.0) / lj[j];
+    const int last = std::min(n_ - 1, j + p_);
+    for (int i = j + 1; i <= last; ++i) {
+      Scalar* li = row(i);
       const Scalar s = minusDot(
-          li[j], std::max(first, j - p_), j, [li](int k) { return li[k]; },
-          [lj](int k) { return lj[k]; });
-      if (j < i) {
-        li[j] = divideByDiagonal(s, j);
-      } else {
-        if (!(s > 0) || !scalarIsFinite(s)) return false;
-        li[i] = scalarSqrt(s);
-        if constexpr (kMultipliesByReciprocal) reciprocal_diagonal_[i] = Scalar(1.0) / li[i];
-      }
+          li[j], std::max(0, i - p_), j, [li](int k) { return li[k]; }, lj_at);
+      li[j] = divideByDiagonal(s, j);
     }
   }
   return true;

@@ -178,6 +178,8 @@ struct Refined {
   PlanResult result;
   /// Its solver converged and its check was deferred: the step residual it measured.
   std::optional<StepResidual> unchecked;
+  /// Its open-loop replay's figures are measured (replayFigures, beside its check).
+  bool replayed = false;
 };
 
 /// A surveyed class carried from the survey grid through the finer levels to the requested one:
@@ -222,6 +224,37 @@ Refined refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& con
   return out;
 }
 
+/// The refined plan's deferred check beside its open-loop replay (replayFigures, what
+/// planAtResolution measures for the plan it returns), in two branches of `context`: most
+/// requests keep this plan, and the replay then costs no time after the walk. The replay's
+/// figures are the plan's only where its check passed; a replay that fails is left to the caller.
+void checkBesideReplay(const PlanningProblem& problem, const HomotopyClass& homotopy,
+                       SolveContext& context, Refined* refined) {
+  PlanResult& plan = refined->result;
+  const StepResidual residual = *refined->unchecked;
+  refined->unchecked.reset();
+  PlanResult replay;  // the replay's figures, apart from the plan its check may change
+  replay.maneuver.torque = plan.maneuver.torque;
+  bool replayed = false;
+  runBranches(context, 2, [&](int i, SolveContext&) {
+    if (i == 0) {
+      checkDeferredPlan(pinnedToClass(problem, homotopy), residual, &plan);
+      return;
+    }
+    try {
+      replayFigures(problem, &replay);
+      replayed = true;
+    } catch (const StepTooLarge&) {  // judged by the caller's own replay
+    }
+  });
+  if (!replayed || !plan.converged()) return;
+  plan.dynamics_residual = replay.dynamics_residual;
+  plan.terminal_attitude_error = replay.terminal_attitude_error;
+  plan.terminal_velocity_error = replay.terminal_velocity_error;
+  plan.replay_miss = replay.replay_miss;
+  refined->replayed = true;
+}
+
 // --- The walk: every attempt recorded, the cheapest converged plan kept --------------------------
 
 /// A class's own solve on the requested grid (surveyed there, refined, or the request's solve).
@@ -239,6 +272,8 @@ struct WalkPlan {
   /// Its solver converged and its check was deferred (GridSettings::deferred_check): the step
   /// residual measured for its figures.
   std::optional<StepResidual> unchecked;
+  /// Its open-loop replay's figures are measured (checkBesideReplay).
+  bool replayed = false;
 };
 
 class Walk {
@@ -253,9 +288,10 @@ class Walk {
   /// Records an attempt; its plan competes if it is on the requested grid. `own_iterations`:
   /// what the slow-solve gate reads if it is kept (the class's survey and refinement).
   /// `unchecked`: its solver converged and its plan's check was deferred (the step residual its
-  /// solve measured): the check runs only if the walk's choice depends on it.
+  /// solve measured): the check runs only if the walk's choice depends on it. `replayed`: its
+  /// open-loop replay's figures are measured.
   void add(Attempt a, PlanResult r, int own_iterations,
-           std::optional<StepResidual> unchecked = std::nullopt) {
+           std::optional<StepResidual> unchecked = std::nullopt, bool replayed = false) {
     a.termination = r.termination;
     a.iterations = r.iterations;
     const bool plan = r.maneuver.steps() == problem_.steps;
@@ -277,7 +313,7 @@ class Walk {
                         : unchecked    ? PlanStanding::Unchecked
                                        : PlanStanding::Checked);
     costs_.push_back(r.cost);
-    plans_.push_back({trail_.size() - 1, std::move(r), own_iterations, unchecked});
+    plans_.push_back({trail_.size() - 1, std::move(r), own_iterations, unchecked, replayed});
   }
 
   bool hasPlan() const { return !plans_.empty(); }
@@ -318,7 +354,8 @@ class Walk {
   }
 
   /// The kept plan with the request's totals, the structured extremal and the brief.
-  PlanResult finish();
+  /// `replayed` (optional): whether the kept plan's open-loop replay figures are measured.
+  PlanResult finish(bool* replayed = nullptr);
 
  private:
   /// The kept plan's index among plans_, every check it depends on run (once each).
@@ -368,12 +405,13 @@ Attempt attemptIn(AttemptStage stage, AttemptStart start, const PlanningProblem&
 /// refined whatever its survey cost (classesToRefine), is refined in its survey's branch as soon
 /// as its survey converged (`*own_refined`), while the other classes are surveyed beside it. Each
 /// survey and refinement is an independent solve, so each result is the same on any number of
-/// threads.
+/// threads. `replay_own`: the own class's refined plan is checked beside its open-loop replay
+/// (checkBesideReplay).
 std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
                                     const PlanningProblem& problem, const SurveyPlan& plan,
                                     SolveContext& context, const GridSettings& settings,
-                                    const NewtonParameters& p,
-                                    std::optional<Refined>* own_refined) {
+                                    const NewtonParameters& p, std::optional<Refined>* own_refined,
+                                    bool replay_own) {
   std::vector<Surveyed> surveyed(classes.size());
   const bool refined_later = plan.survey + 1 < plan.levels.size();
   // Where the zero maneuver reaches the end, the request's own class is surveyed first, alone:
@@ -390,7 +428,8 @@ std::vector<Surveyed> surveyClasses(const std::vector<HomotopyClass>& classes,
     const SolveContext::Scope scope(branch, AttemptStage::ClassRefine, classes[i]);
     // Checked here: it is the plan kept in most requests, and its branch often ends before the
     // others' surveys do, so its check is off the request's critical path.
-    *own_refined = refineClass(surveyed[i], plan, branch, settings, p, false);
+    *own_refined = refineClass(surveyed[i], plan, branch, settings, p, replay_own);
+    if ((*own_refined)->unchecked) checkBesideReplay(problem, classes[i], branch, &**own_refined);
   };
   const auto own = std::find_if(classes.begin(), classes.end(), [&](const HomotopyClass& c) {
     return sameHomotopyClass(c, homotopyClassOf(problem));
@@ -480,7 +519,7 @@ std::vector<Refined> refineClasses(const std::vector<const Surveyed*>& refine,
 /// each converged survey's and refinement's plan (checked: the constrained search reads them);
 /// without it, the refinements' checks are left to the walk, which runs those its choice reads.
 void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Walk* walk,
-                      const NewtonParameters& p, std::vector<ClassPlan>* plans) {
+                      const NewtonParameters& p, std::vector<ClassPlan>* plans, bool replay_own) {
   const SolverOptions& options = context.options();
   const GridSettings settings{options.tolerance, options.max_iterations,
                               Globalization::TrustRegion};
@@ -492,12 +531,13 @@ void enumerateClasses(const PlanningProblem& problem, SolveContext& context, Wal
   const bool defer_checks = !plans;
   std::optional<Refined> own_refined;
   // The classes' lifts are those of the coarsest level, where their Hermite curves are built.
-  std::vector<Surveyed> surveyed = surveyClasses(distinctClasses(plan.levels.front()), problem,
-                                                 plan, context, settings, p, &own_refined);
+  std::vector<Surveyed> surveyed =
+      surveyClasses(distinctClasses(plan.levels.front()), problem, plan, context, settings, p,
+                    &own_refined, replay_own && !plans);
   const auto addRefined = [&](const Surveyed& s, const Refined& refined, int own_iterations) {
     walk->add(attemptIn(AttemptStage::ClassRefine, AttemptStart::CoarseLevel,
                         pinnedToClass(problem, s.homotopy)),
-              refined.result, own_iterations, refined.unchecked);
+              refined.result, own_iterations, refined.unchecked, refined.replayed);
     if (plans && refined.result.converged() && refined.result.maneuver.steps() == problem.steps) {
       plans->push_back({s.homotopy, refined.result.maneuver});
     }
@@ -858,7 +898,7 @@ bool Walk::check(std::size_t i) {
   return passed;
 }
 
-PlanResult Walk::finish() {
+PlanResult Walk::finish(bool* replayed) {
   // An attempt cancelled or out of time ends the walk; after a converged plan it only spared
   // further attempts, otherwise the request ends with its termination.
   std::optional<Termination> stop;
@@ -872,6 +912,7 @@ PlanResult Walk::finish() {
     return none;
   }
   WalkPlan& chosen = plans_[keptPlan()];
+  if (replayed) *replayed = chosen.replayed;
   const std::size_t kept_at = chosen.at;
   PlanResult kept = std::move(chosen.result);
   if (kept.converged()) stop.reset();
@@ -897,12 +938,18 @@ std::vector<Vector3> newtonInitialSteps(const PlanningProblem& problem) {
 }
 
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
-                           SolveContext& context, std::vector<ClassPlan>* survey_plans) {
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans,
+                           bool* replayed) {
   const SolveContext::Call call(context, request);
   const SolverOptions& options = context.options();
   const NewtonParameters& p = options.advanced.newton;
   Walk walk(problem, context, p);
-  if (classLeftFree(problem, options)) enumerateClasses(problem, context, &walk, p, survey_plans);
+  if (replayed) *replayed = false;
+  // The own class's replay beside its check pays where another thread is there to run it.
+  const bool replay_own = replayed && context.threads() > 1;
+  if (classLeftFree(problem, options)) {
+    enumerateClasses(problem, context, &walk, p, survey_plans, replay_own);
+  }
   // The request's own class when it names one or is warm-started; after the class survey, when
   // no class converged on the requested grid and the request's class was not solved whole there.
   const bool request_solved = walk.solvedOnRequestedGrid(homotopyClassOf(problem));
@@ -923,7 +970,7 @@ PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& r
     if (entry.stage != AttemptStage::MoreStarts && entry.when(state)) run(entry, problem);
   }
   if (!context.stopReason()) runMoreStarts(moreStarts(problem, &state), context, &walk, p);
-  PlanResult result = walk.finish();
+  PlanResult result = walk.finish(replayed);
   context.recordLevels(result.levels);  // the plan's: its kept attempt's
   return result;
 }

@@ -30,8 +30,13 @@ struct ClassPlan {
 /// A plan's check (planInconsistency) runs only where the walk's choice depends on it: the plan
 /// kept is always checked, a plan that fails its check is never kept (unless none converged), and
 /// the others' attempts say `plan_checked` false.
+/// `replayed` (optional): the caller measures the returned plan's open-loop replay
+/// (replayFigures of `problem`) unless this says the walk measured it already: with more than one
+/// thread the request's own class's plan is checked beside its replay, and is kept in most
+/// requests.
 PlanResult solveWithNewton(const PlanningProblem& problem, const SolveRequest& request,
-                           SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr);
+                           SolveContext& context, std::vector<ClassPlan>* survey_plans = nullptr,
+                           bool* replayed = nullptr);
 
 /// The steps ω_k, k = 0..N−1, of the Newton solver's first guess on the requested grid (the
 /// rate-honouring Hermite curve to the nearest lift, or the other way round for LongWay), before

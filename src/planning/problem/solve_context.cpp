@@ -8,6 +8,8 @@
 #include <locale>
 #include <thread>
 
+#include "planning/problem/worker_threads.hpp"
+
 namespace attitude_planner {
 
 SolveContext::SolveContext(const SolverOptions& request)
@@ -192,10 +194,15 @@ void runBranches(SolveContext& context, int count,
       }
     }
   };
-  std::vector<std::thread> others;
-  for (int t = 1; t < at_once; ++t) others.emplace_back(take);
+  // The calling thread takes works too; a helper no thread has begun when the caller finds no
+  // work left is taken back (it would find none either), so the caller never waits for a start.
+  std::vector<std::unique_ptr<HandedWork>> helpers;
+  for (int t = 1; t < at_once; ++t) {
+    helpers.push_back(std::make_unique<HandedWork>(take));
+    WorkerThreads::shared().handOver(*helpers.back());
+  }
   take();
-  for (std::thread& t : others) t.join();
+  for (const auto& helper : helpers) WorkerThreads::shared().takeBackOrWait(*helper);
   for (int i = 0; i < count; ++i) {
     context.join(*branches[i]);
     if (failures[i]) std::rethrow_exception(failures[i]);
@@ -208,7 +215,7 @@ namespace {
 struct OpenWork {
   int index = 0;
   std::unique_ptr<SolveContext> branch;  ///< none: begin(index) returned no work
-  std::thread thread;                    ///< not joinable: run on the calling thread
+  std::unique_ptr<HandedWork> run;       ///< none: run on the calling thread at its begin
   std::exception_ptr failure;
 };
 
@@ -221,9 +228,14 @@ void runSlidingWindow(SolveContext& context, int count, const std::function<Bran
   std::deque<OpenWork> open;  // in the order of index; references stay valid as it grows
   int running = 0;
   std::exception_ptr failure;
+  // A work no worker thread has begun by its end is taken back and run on the calling thread.
+  const auto finish = [](OpenWork& w) {
+    if (w.run && !WorkerThreads::shared().takeBackOrWait(*w.run)) w.run->runHere();
+    w.run.reset();
+  };
   const auto endFirst = [&] {
     OpenWork& w = open.front();
-    if (w.thread.joinable()) w.thread.join();
+    finish(w);
     if (w.branch) {
       context.join(*w.branch);
       --running;
@@ -252,13 +264,14 @@ void runSlidingWindow(SolveContext& context, int count, const std::function<Bran
       if (at_once == 1) {
         run();
       } else {
-        w.thread = std::thread(run);
+        w.run = std::make_unique<HandedWork>(run);
+        WorkerThreads::shared().handOver(*w.run);
       }
     }
     while (!open.empty()) endFirst();
-  } catch (...) {  // from begin or end, on this thread: the works still running end first
+  } catch (...) {  // from begin or end, on this thread: the works handed over end first
     for (OpenWork& w : open) {
-      if (w.thread.joinable()) w.thread.join();
+      if (w.run) WorkerThreads::shared().takeBackOrWait(*w.run);
     }
     throw;
   }

@@ -18,14 +18,16 @@ struct StepTerms {
   Vector3 omega;  ///< ω = log F, as stored: no log map to recover it
   Matrix3 F;
   Matrix3 E;  ///< F − I (stepTorques' difference of momenta reads it)
+  DiscreteScheme::StepJacobianTerms step;  ///< what D and its contractions read of F alone
   Vector3 mu, G;
   Matrix3 D, dG, DFt, dGFt;
 
   StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
     so3::expWithMinusIdentity<double>(omega, &F, &E);
+    step = scheme.stepJacobianTerms(F, omega);
     mu = scheme.momentumOfStep(omega, E);
     G = F.transpose() * mu;
-    D = scheme.momentumJacobianOfStep(F, omega);
+    D = scheme.momentumJacobianOfStep(step);
     dG = so3::hat<double>(G) + F.transpose() * D;
     DFt = D * F.transpose();
     dGFt = dG * F.transpose();
@@ -35,14 +37,14 @@ struct StepTerms {
   /// X = D, D Fᵀ, dG, dG Fᵀ, all from the scheme's C_D by the product rule with
   /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^.
   Matrix3 contractD(const DiscreteScheme& scheme, const Vector3& tau) const {
-    return scheme.momentumJacobianContraction(F, omega, tau);
+    return scheme.momentumJacobianContraction(step, tau);
   }
   Matrix3 contractDFt(const Matrix3& C_D, const Vector3& tau) const {
     return F * (C_D - so3::hat<double>(Vector3(D.transpose() * tau)));
   }
   Matrix3 contractdG(const DiscreteScheme& scheme, const Vector3& tau) const {
     const Matrix3 tau_hat = so3::hat<double>(tau);
-    return tau_hat * dG + scheme.momentumJacobianContraction(F, omega, Vector3(F * tau)) -
+    return tau_hat * dG + scheme.momentumJacobianContraction(step, Vector3(F * tau)) -
            D.transpose() * F * tau_hat;
   }
   Matrix3 contractdGFt(const Matrix3& C_dG, const Vector3& tau) const {

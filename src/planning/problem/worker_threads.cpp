@@ -1,0 +1,62 @@
+#include "planning/problem/worker_threads.hpp"
+
+#include <system_error>
+#include <thread>
+
+namespace attitude_planner {
+
+WorkerThreads& WorkerThreads::shared() {
+  // Never destroyed: its threads wait for works until the process ends, and a destructor run at
+  // exit would have to join them (behind any solve still running on one).
+  static WorkerThreads* const threads = new WorkerThreads;
+  return *threads;
+}
+
+void WorkerThreads::handOver(HandedWork& work) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  work.state_ = HandedWork::State::Queued;
+  work.queued_at_ = queue_.insert(queue_.end(), &work);
+  if (static_cast<int>(queue_.size()) <= waiting_) {
+    queued_.notify_one();
+    return;
+  }
+  try {  // every queued work has a thread of its own to start at once
+    std::thread([this] { serve(); }).detach();
+  } catch (const std::system_error&) {
+    // No thread to be had: the work waits for a thread that ends its work, or for its caller
+    // (takeBackOrWait), which runs it itself.
+  }
+}
+
+bool WorkerThreads::takeBackOrWait(HandedWork& work) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (work.state_ == HandedWork::State::Queued) {
+    queue_.erase(work.queued_at_);
+    work.state_ = HandedWork::State::Done;
+    return false;
+  }
+  ended_.wait(lock, [&] { return work.state_ == HandedWork::State::Done; });
+  return true;
+}
+
+void WorkerThreads::serve() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    while (queue_.empty()) {
+      ++waiting_;
+      queued_.wait(lock);
+      --waiting_;
+    }
+    HandedWork& work = *queue_.front();
+    queue_.pop_front();
+    work.state_ = HandedWork::State::Running;
+    lock.unlock();
+    work.run_();
+    lock.lock();
+    // The caller may destroy `work` as soon as it reads Done: it is not touched after this.
+    work.state_ = HandedWork::State::Done;
+    ended_.notify_all();
+  }
+}
+
+}  // namespace attitude_planner

@@ -20,10 +20,10 @@
 
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
+#include "planning/drivers/constrained_recipe.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
 #include "planning/interior_point/grid_solve.hpp"
-#include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/direct_method.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"

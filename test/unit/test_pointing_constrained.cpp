@@ -16,9 +16,9 @@
 
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/pointing.hpp"
+#include "planning/drivers/constrained_recipe.hpp"
 #include "planning/drivers/pointing.hpp"
 #include "planning/interior_point/constrained_system.hpp"
-#include "planning/interior_point/interior_point_solver.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/perturbed_problem.hpp"
 #include "support/pointing_requests.hpp"
@@ -71,7 +71,7 @@ MeritAt meritAt(const PlanningProblem& p, const ReducedProblem& rp, double dpsi,
 }  // namespace
 
 // With the elastic form's primal multipliers (μ/s) the condensed matrix is the exact Hessian of
-// φ_μ (interior_point_solver.cpp): its ψ border and corner are the central differences of the
+// φ_μ (constrained_system.hpp): its ψ border and corner are the central differences of the
 // assembled gradient, whose ψ entry is the central difference of φ_μ itself (a fresh system on the
 // twisted problem each time: the rows on R_{N−1}, R_N are re-evaluated from the moved attitudes).
 TEST(ConstrainedTwist, BorderAndGradientMatchCentralDifferencesForEveryScheme) {

@@ -44,12 +44,12 @@ struct InteriorPointProfile {
   double penalty_growth;
 };
 
-/// Fixed h (interior_point_solver.cpp, grid_solve.cpp).
+/// Fixed h (grid_solve.cpp, drivers/constrained_recipe.cpp).
 constexpr InteriorPointProfile kFixedStepProfile{1.0, 1.5, 60, 5, 1e-14, 1e4, 1e4};
 /// Free time (free_time_solver.cpp).
 constexpr InteriorPointProfile kFreeTimeProfile{0.1, 1.3, 40, 40, 1e-10, 100.0, 10.0};
 
-/// Every constant of the interior point (interior_point_solver.cpp, free_time_solver.cpp). Scales:
+/// Every constant of the interior point (grid_solve.cpp, free_time_solver.cpp). Scales:
 /// μ and ρ relative to f_scale/m (the start's cost over the number of constraints), decrements
 /// relative to √(2 f_scale).
 struct InteriorPointParameters {

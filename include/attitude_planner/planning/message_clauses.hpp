@@ -24,7 +24,7 @@ using MessageClauses = std::vector<MessageClause>;
 namespace notes {
 
 /// The interior point's other formulation tried from the same start after the first stopped
-/// (interior_point_solver.cpp: the formulation recipe). `solved`: its answer is returned, else
+/// (drivers/constrained_recipe.cpp: the formulation recipe). `solved`: its answer is returned, else
 /// the first's is, and `reason` is the other solve's message. `within_bounds`: the retry is
 /// returned though it stopped too, its plan within the bounds where the first's was not.
 struct FormulationRetry {

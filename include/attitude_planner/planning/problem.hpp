@@ -78,7 +78,7 @@ inline SolverKind parseSolver(const std::string& text, const std::string& field)
 
 /// The arithmetic of the interior point's condensed Newton system (SolverOptions::precision). At
 /// a bound the system's condition grows like N⁴/μ; the smooth modes need more than double above
-/// about N = 1024 (interior_point_solver.cpp).
+/// about N = 1024 (interior_point/grid_solve.hpp).
 enum class Precision {
   Auto,      ///< double to kAutoDoubleMaxSteps, extended to kAutoExtendedMaxSteps, then
              ///< double-double (extended only where long double is the x87 format)
@@ -194,7 +194,7 @@ struct PlanningProblem {
   }
   /// Per-axis bound |τ_i| ≤ max_torque_i [N m] on the control (actuator_limits); +∞: unbounded.
   /// A problem whose unconstrained optimum violates a bound or a constraint is solved by the
-  /// interior-point solver (interior_point_solver.cpp), O(N) per iteration.
+  /// interior-point solver (drivers/constrained_recipe.cpp), O(N) per iteration.
   Vector3 max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
   bool hasTorqueBounds() const { return max_torque.allFinite(); }
   /// Constraints at every node (scene key `constraints:`, constraints.hpp); empty: none.

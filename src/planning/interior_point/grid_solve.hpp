@@ -71,7 +71,13 @@ struct GridOutcome {
 enum class SystemPrecision { Double, LongDouble, DoubleDouble };
 
 /// `precision` resolved for N steps: `auto` is double up to N = 1024, long double up to 8192
-/// where it is the x87 format, double-double above (interior_point_solver.cpp derives why).
+/// where it is the x87 format, double-double above.
+/// Why: at a bound a constraint's condensed term g gᵀ/D (D → 0) exceeds the curvature
+/// ∇²f − Σ z∇²c by up to ~1e12, and the smooth modes' curvature falls like N⁻⁴ against the
+/// largest (torques are second differences of attitudes); the step along the active constraints'
+/// null space depends on that curvature alone. Above 1024 where long double is not x87 (aarch64's
+/// is a software quad, slower than double-double) double-double too. The measurements behind the
+/// thresholds: docs/notes/interior_point_tuning.md.
 SystemPrecision resolvePrecision(Precision precision, int steps);
 
 /// The interior point on one grid in the resolved precision (`options`: this solve's tolerance,

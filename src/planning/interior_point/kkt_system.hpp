@@ -57,7 +57,7 @@ struct KktBlocks {
 /// (Baker–Campbell–Hausdorff), so ∂²L/∂ψ∂η = e·H(:, η) + ∇_{x_{N−1}}L · ½ (e × d′) h₀: the path's
 /// curvature term, from the block's Lagrangian gradient. How the blocks are summed stays each
 /// problem's: fixed h adds the rows' g gᵀ/D one by one as rank-one terms in the band's precision
-/// (the precision rule, interior_point_solver.cpp), free time sums a stencil's block in double
+/// (the precision rule, grid_solve.hpp), free time sums a stencil's block in double
 /// and adds it once.
 template <typename Scalar, typename TimeStep>
 class KktSink {

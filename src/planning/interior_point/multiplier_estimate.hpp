@@ -1,6 +1,6 @@
 // Multipliers for a constrained solve started from a plan that carries none (a warm start from a
 // CSV or a message): re-derived from the first-order condition at the plan itself
-// (multiplier_estimate.cpp; used by the interior point, interior_point_solver.cpp).
+// (multiplier_estimate.cpp; used by the interior point, drivers/constrained_recipe.cpp).
 #pragma once
 
 #include <array>
@@ -10,7 +10,7 @@
 
 namespace attitude_planner {
 
-/// One node constraint c_i(δ) ≥ 0 (dimensionless, interior_point_solver.cpp) at the plan: its
+/// One node constraint c_i(δ) ≥ 0 (dimensionless, constrained_system.hpp) at the plan: its
 /// value and its gradient over up to three consecutive nodes.
 struct StationarityColumn {
   double value = 0.0;                    ///< c_i

@@ -16,7 +16,7 @@ namespace attitude_planner {
 /// (the Cholesky inner products then run over consecutive memory). Scalar: double, or long double
 /// or DoubleDouble (ExtendedBandedMatrix, ~106 significant bits) where a system's entries span more
 /// orders than double can add and factor without losing the small ones (the interior point's
-/// barrier terms and its N⁴ condition; see interior_point_solver: kExtendedPrecisionAboveSteps).
+/// barrier terms and its N⁴ condition; see grid_solve.hpp: resolvePrecision).
 template <typename Scalar>
 class BandedSymmetric {
  public:

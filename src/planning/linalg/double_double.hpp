@@ -2,7 +2,7 @@
 // |lo| ≤ ulp(hi)/2, about 106 significant bits (ε ≈ 1.2e-32), from IEEE double operations and a
 // correctly rounded fma alone (Dekker 1971; Knuth's two-sum; Hida, Li and Bailey's QD library
 // for the formulas). It is the interior point's scalar above N = 8192 (above 1024 where long
-// double is not the x87 format; interior_point_solver.cpp: kExtendedPrecisionAboveSteps), where
+// double is not the x87 format; interior_point/grid_solve.hpp: resolvePrecision), where
 // the Newton system's condition (~N⁴ from torques that are second differences of attitudes,
 // times the barrier's 1/D) exceeds long double's 64-bit significand. Measured per
 // multiply–add in a dependent chain (x86-64): double 0.44 ns, long double (x87) 1.8 ns,

@@ -17,7 +17,7 @@ struct StartSpec {
   /// With from_constrained_plan: that plan meets every constraint with room (a plan at T*
   /// time-scaled to a longer T), so the interior point takes a request's own recipe (free
   /// slacks, Mehrotra) rather than the probes' (elastic form first, LOQO's barrier), which is for
-  /// starts that may be infeasible (interior_point_solver.cpp).
+  /// starts that may be infeasible (drivers/constrained_recipe.cpp).
   bool strictly_inside = false;
   /// With node constraints and no warm start: the request's unconstrained optimum, already solved
   /// on its grid in its class (the class survey's plan, drivers/constrained_classes.cpp). Newton

@@ -1,4 +1,4 @@
-// Internal to the interior-point solver (interior_point_solver.cpp) and its tests: the node
+// Internal to the interior-point solver (constrained_system.hpp) and its tests: the node
 // constraints that are not functions of a torque, with exact first and second derivatives under
 // the reduced problem's retraction R_j → R_j exp(δ_j^) (reduced_problem.hpp).
 #pragma once

@@ -116,7 +116,7 @@ class ReducedProblem {
   /// Calls visit(stencil) for k = 1..N−1 at the current iterate; `second` is formed only if
   /// with_second_order. Returns the cost. With `weights`, `second` is sym(Σ_i w_i ∂jacobian_i/∂δ),
   /// w = weights(k, τ_k): the Hessian of a Lagrangian whose constraints are functions of τ_k
-  /// (the formulas are linear in the weights; interior_point_solver.cpp).
+  /// (the formulas are linear in the weights; constrained_system.hpp).
   double forEachStencil(bool with_second_order, const std::function<void(const Stencil&)>& visit,
                         const SecondOrderWeights& weights = nullptr) const;
 

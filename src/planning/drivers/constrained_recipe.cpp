@@ -1,58 +1,16 @@
-// Primal–dual interior-point Newton method for the discrete problem with node constraints
-// (per-axis torque bounds, torque norm, angular rate, keep-out / keep-in cones), O(N) per
-// iteration on the reduced problem's band (reduced_problem.hpp), for every scheme. With end
-// torques (second_order) the torque constraints hold at k = 0..N too, the stencils carry the
-// residuals √w_k τ_k (constraints act on τ_k), and rates are node rates J⁻¹Π_k through the node
-// momentum's stencil (ReducedProblem::forEachNodeMomentum).
-//
-// Every constraint is stage-local in the reduced unknowns δ_j (R_j → R_j exp(δ_j^)): a torque
-// constraint depends on R_{k−1}, R_k, R_{k+1} (τ_k's stencil), a rate constraint on F_k =
-// R_kᵀR_{k+1}, a cone on R_k. Each is written dimensionless as c_i(δ) ≥ 0:
-//   torque box   1 ∓ τ_{k,a}/a_a          torque norm   1 − |τ_k|²/t²
-//   rate         1 − |Ω_k|²/w²            keep_out      cos α − sᵀR_k b
-//   keep_in      sᵀR_k b − cos α
-//
-// Elastic (ℓ1) formulation, so that every iterate has a finite merit and an infeasible request
-// ends at a certificate instead of an endless restoration (as IPOPT's restoration phase and
-// Curtis's penalty–interior-point method do):
-//   min f(δ) + ρ Σ v_i   s.t.  c_i(δ) + v_i − s_i = 0,  s, v ≥ 0,     f = Σ ½|τ_k|²,
-// barrier μ; with multipliers z (of s) and u = ρ − z (of v), the Newton step condenses
-// (per constraint, D_i = s_i/z_i + v_i/u_i) to
-//   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i),   q_i = μ/z_i − s_i − μ/u_i + v_i,
-//   W = ∇²f − Σ_i z_i ∇²c_i,  g_i = ∇c_i,  dz_i = (q_i − g_iᵀdδ)/D_i.
-// Each g_i g_iᵀ lies inside one stencil's 9×9 block, so the system keeps the unconstrained
-// Hessian's band (half bandwidth 8) and is factored by the same banded Cholesky, in the precision
-// SolverOptions::precision chooses (below). The slacks are eliminated exactly for the current c
-// (node_constraints.hpp: elasticSlacks), so the merit φ_μ(δ) = f + Σ ψ_μ(c_i) depends on δ
-// alone; the line search is Armijo on φ_μ along the retraction, and the dual step keeps z and u
-// positive (fraction to the boundary).
-//
-// The free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free
-// variables, the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
-// f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z. Its Hessian carries Newton's own
-// multipliers instead of z → ρ for violated constraints, which is where the elastic form stalls.
-//
-// The pieces: constrained_system (the constraints and the condensed system), barrier_update
-// (Mehrotra, monotone, LOQO), grid_solve (one grid: step, inertia correction, stopping test, line
-// search), and here the order of attempts: the formulations of a grid (kFormulationRecipes), the
-// grid continuation, and the cones-first retry.
-//
-// Precision (SolverOptions::precision, `auto`): at a bound a constraint's condensed term g gᵀ/D
-// (D → 0) exceeds the curvature ∇²f − Σ z∇²c by up to ~1e12, and the smooth modes' curvature
-// falls like N⁻⁴ against the largest (torques are second differences of attitudes); the step along
-// the active constraints' null space depends on that curvature alone. So the system is formed and
-// factored in double up to N = 1024, in long double (x87, 64-bit significand) up to 8192, and in
-// double-double arithmetic above (and above 1024 where long double is not x87: aarch64's is a
-// software quad, slower than double-double). The measurements behind the thresholds:
-// docs/notes/interior_point_tuning.md.
-//
-// Between nodes: the constraints hold at the nodes only. Within step k the continuous motion
-// R_k exp(s ω_k^), s ∈ [0, 1], turns at the constant rate ω_k/h (paper scheme), so a rate limit
-// holds between nodes too, and torques are held over a step, so their bounds hold throughout; a
-// cone's angle can dip past its bound within a step by up to a − acos(cos a + |ω_k|²/8): the
-// cones are imposed at their node half angle, tightened by the user's margin
-// (constraints.hpp: requiredConeMargin).
-#include "planning/interior_point/interior_point_solver.hpp"
+// The constrained recipe: the order of the fixed-h interior point's attempts on a request with
+// node constraints, each a stage behind a named gate (the method itself is interior_point/:
+// constrained_system.hpp derives it, grid_solve.cpp runs it on one grid). Three layers:
+// - per grid, a formulation recipe (kRequestRecipe, kProbeRecipe): the first form, and the other
+//   form from the same start where mayRetryInOtherForm holds;
+// - per request, the levels of the shared grid continuation (strategies/grid_continuation.hpp):
+//   a level starts from the coarser level's iterate and duals, else from its own unconstrained
+//   optimum; a 4× refinement that stops goes once more through the level in between where
+//   mayRefineThroughMiddle holds;
+// - the attempts (kConstrainedRecipe): every constraint from the request's start; the cones
+//   alone where stuckBetweenConesAndBounds holds; every constraint from the cones' path where
+//   pathAroundCones holds.
+#include "planning/drivers/constrained_recipe.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -111,6 +69,15 @@ struct Solve {
   SolveContext& context;
 };
 
+/// The gate of a formulation recipe's retry: the first form ended infeasible or unconverged, and
+/// neither the caller's watch (its bound: no other formulation wanted) nor the context (cancelled
+/// or out of time) stopped it.
+bool mayRetryInOtherForm(const GridOutcome& first, const SolveContext& context) {
+  const Termination t = first.result.termination;
+  return (t == Termination::Infeasible || t == Termination::NotConverged) &&
+         !first.stopped_by_watch && !context.stopReason();
+}
+
 /// One grid in the recipe's first formulation, retried once in the other from the same start
 /// when it ends infeasible or unconverged. The answer: a converged solve, else an
 /// infeasibility certificate, else a stopped solve whose plan is within the bounds where the
@@ -130,10 +97,8 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolveReques
                                    coarse_duals, final_grid, watch});
   first.formulation = recipe.first.formulation;
   solve.context.recordLevels(first.result.levels);
+  if (!mayRetryInOtherForm(first, solve.context)) return first;
   const Termination t = first.result.termination;
-  if (t != Termination::Infeasible && t != Termination::NotConverged) return first;
-  if (first.stopped_by_watch) return first;      // the caller's bound: no other formulation wanted
-  if (solve.context.stopReason()) return first;  // cancelled or out of time: no retry
   GridOutcome second = solveOnGrid(
       problem, options, solve.parameters, solve.context,
       {recipe.retry.formulation, recipe.retry.barrier, coarse_steps, nullptr, final_grid});
@@ -153,10 +118,6 @@ GridOutcome solveGridWithRetry(const PlanningProblem& problem, const SolveReques
   answer.duals = LevelDuals{};  // the retry's are not carried
   return answer;
 }
-
-}  // namespace
-
-namespace {
 
 /// What a level of the interior point's continuation hands the next: its iterate, the
 /// formulation that reached it and, when it converged, its multipliers and slacks (free slacks).
@@ -225,8 +186,14 @@ void startFromOwnOptimum(const PlanningProblem& problem, const SolveRequest& opt
   level_options->warm_start = start->plan.converged() ? &start->plan.maneuver : nullptr;
 }
 
-/// A 4× refinement can start too far from the fine optimum where bounds bind near the ends:
-/// once more through the level in between. Replaces *direct if that converges (the level's tally
+/// The gate of a level's second way: a 4× refinement (from a coarser level, to an even N) that
+/// stopped by itself can start too far from the fine optimum where bounds bind near the ends.
+bool mayRefineThroughMiddle(const GridOutcome& direct, const LevelRequest<LevelIterate>& r) {
+  return !direct.result.converged() && !stoppedByRequest(direct.result.termination) && r.coarse &&
+         r.problem.steps % 2 == 0;
+}
+
+/// Once more through the level in between. Replaces *direct if that converges (the level's tally
 /// counts every solve's iterations, the context records their levels).
 void refineThroughMiddle(const PlanningProblem& at, const SolveRequest& options, const Solve& solve,
                          const ReducedProblem::StepVectors& coarse, GridOutcome* direct) {
@@ -306,8 +273,7 @@ GridOutcome solveLevel(const PlanningProblem& problem, const SolveRequest& optio
       solveGridWithRetry(r.problem, level_options, solve, r.coarse ? &r.coarse->steps : nullptr,
                          r.coarse ? &r.coarse->duals : &no_duals, r.finest);
   const LevelDuals direct_duals = outcome.duals;
-  if (!outcome.result.converged() && !stoppedByRequest(outcome.result.termination) && r.coarse &&
-      r.problem.steps % 2 == 0) {
+  if (mayRefineThroughMiddle(outcome, r)) {
     refineThroughMiddle(r.problem, level_options, solve, r.coarse->steps, &outcome);
   }
   outcome.duals = direct_duals;  // the direct solve's: a refinement's are not carried
@@ -424,55 +390,113 @@ void keepAttempt(SolveContext& context, const Begun& begun, std::size_t kept, Pl
   result->levels = context.levelsFrom(begun.levels);
 }
 
+/// How an attempt of the constrained recipe poses the request and where it starts.
+enum class Posed {
+  AsRequested,    ///< every constraint, from the request's start
+  ConesAlone,     ///< the cones alone (torque and rate bounds dropped), from the request's start
+  FromConesPath,  ///< every constraint, from the cones-alone plan
+};
+
+/// What the attempts' gates read: the request and the answers so far.
+struct RecipeState {
+  const PlanningProblem& problem;
+  const PlanResult* first = nullptr;   ///< the attempt as requested
+  const PlanResult* around = nullptr;  ///< the cones alone
+};
+
+using Gate = bool (*)(const RecipeState&);
+
+bool always(const RecipeState&) {
+  return true;
+}
+
+/// Pointing cones together with torque or rate limits, from a start inside a cone: the iterate
+/// can leave the cone with torques far beyond their bounds and never recover. A path around the
+/// cones alone may lead to the request.
+bool stuckBetweenConesAndBounds(const RecipeState& s) {
+  const Termination t = s.first->termination;
+  const bool stuck = t == Termination::Infeasible || t == Termination::NotConverged;
+  const bool others = s.problem.hasTorqueBounds() ||
+                      std::any_of(s.problem.constraints.begin(), s.problem.constraints.end(),
+                                  [](const PlanningConstraint& c) { return !c.isCone(); });
+  return stuck && s.problem.hasCones() && others;
+}
+
+/// The cones alone were met: their plan starts every constraint.
+bool pathAroundCones(const RecipeState& s) {
+  return s.around && s.around->converged();
+}
+
+struct RecipeEntry {
+  AttemptStage stage;
+  Posed posed;
+  Gate when;
+};
+
+/// The attempts in order, each when its gate holds; a closed gate ends the recipe.
+constexpr RecipeEntry kConstrainedRecipe[] = {
+    {AttemptStage::Constrained, Posed::AsRequested, always},
+    {AttemptStage::ConstrainedRetry, Posed::ConesAlone, stuckBetweenConesAndBounds},
+    {AttemptStage::ConstrainedRetry, Posed::FromConesPath, pathAroundCones},
+};
+
+/// The request with its cones alone.
+PlanningProblem conesOnly(const PlanningProblem& problem) {
+  PlanningProblem cones_only = problem;
+  cones_only.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
+  cones_only.constraints.clear();
+  for (const PlanningConstraint& c : problem.constraints)
+    if (c.isCone()) cones_only.constraints.push_back(c);
+  return cones_only;
+}
+
+/// One entry's attempt, recorded in the context (its index in *recorded_at).
+PlanResult runEntry(const RecipeEntry& entry, const RecipeState& s, const SolveRequest& options,
+                    const Solve& solve, std::size_t* recorded_at) {
+  if (entry.posed == Posed::ConesAlone) {
+    return attempt(conesOnly(s.problem), options, solve, entry.stage, startOf(options), recorded_at)
+        .result;
+  }
+  if (entry.posed == Posed::FromConesPath) {
+    SolveRequest staged = options;
+    staged.warm_start = &s.around->maneuver;
+    return attempt(s.problem, staged, solve, entry.stage, AttemptStart::PreviousAttempt,
+                   recorded_at)
+        .result;
+  }
+  return attempt(s.problem, options, solve, entry.stage, startOf(options), recorded_at).result;
+}
+
 }  // namespace
 
 PlanResult solveWithInteriorPoint(const PlanningProblem& problem, const SolveRequest& options,
                                   SolveContext& context) {
   const Solve solve{options.advanced.interior_point, context};
   const Begun begun(context);
-  std::size_t at = begun.attempts;
   const SolveContext::IterationTally tally(context);  // every attempt's
-  PlanResult result =
-      attempt(problem, options, solve, AttemptStage::Constrained, startOf(options), &at).result;
-  // Pointing cones together with torque or rate limits, from a start inside a cone: the
-  // iterate can leave the cone with torques far beyond their bounds and never recover. Retry
-  // once in two stages: the cones alone (a path around them), then every constraint from that
-  // path.
-  const bool stuck = result.termination == Termination::Infeasible ||
-                     result.termination == Termination::NotConverged;
-  const bool cones = problem.hasCones();
-  const bool others = problem.hasTorqueBounds() ||
-                      std::any_of(problem.constraints.begin(), problem.constraints.end(),
-                                  [](const PlanningConstraint& c) { return !c.isCone(); });
-  if (!stuck || !cones || !others) {
-    keepAttempt(context, begun, at, &result);
-    return result;
+  PlanResult answers[std::size(kConstrainedRecipe)];
+  std::size_t recorded_at[std::size(kConstrainedRecipe)] = {};
+  RecipeState state{problem};
+  std::size_t ran = 0;
+  for (const RecipeEntry& entry : kConstrainedRecipe) {
+    if (!entry.when(state)) break;
+    answers[ran] = runEntry(entry, state, options, solve, &recorded_at[ran]);
+    if (entry.posed == Posed::AsRequested) state.first = &answers[ran];
+    if (entry.posed == Posed::ConesAlone) state.around = &answers[ran];
+    ++ran;
   }
-  PlanningProblem cones_only = problem;
-  cones_only.max_torque = Vector3::Constant(std::numeric_limits<double>::infinity());
-  cones_only.constraints.clear();
-  for (const PlanningConstraint& c : problem.constraints)
-    if (c.isCone()) cones_only.constraints.push_back(c);
-  std::size_t around_at = at;
-  const PlanResult around = attempt(cones_only, options, solve, AttemptStage::ConstrainedRetry,
-                                    startOf(options), &around_at)
-                                .result;
-  if (!around.converged()) {
-    keepAttempt(context, begun, at, &result);
-    return result;
+  PlanResult& first = answers[0];
+  if (ran < std::size(kConstrainedRecipe)) {  // the request's own attempt answers
+    keepAttempt(context, begun, recorded_at[0], &first);
+    return first;
   }
-  SolveRequest staged = options;
-  staged.warm_start = &around.maneuver;
-  std::size_t second_at = at;
-  PlanResult second = attempt(problem, staged, solve, AttemptStage::ConstrainedRetry,
-                              AttemptStart::PreviousAttempt, &second_at)
-                          .result;
-  const std::vector<MessageClause> first_said = result.clauses;
   // The staged answer replaces the first unless it did no better (then the first is kept: its
   // reason is the one measured from the requested start).
+  const PlanResult& second = answers[ran - 1];
   const bool take_second = second.converged() || second.termination == Termination::Infeasible;
-  if (take_second) result = second;
-  keepAttempt(context, begun, take_second ? second_at : at, &result);
+  const std::vector<MessageClause> first_said = first.clauses;
+  PlanResult result = take_second ? second : first;
+  keepAttempt(context, begun, recorded_at[take_second ? ran - 1 : 0], &result);
   result.iterations = tally.iterations();
   addNote(&result, notes::RetriedInTwoStages{first_said});
   return result;

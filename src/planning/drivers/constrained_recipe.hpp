@@ -1,5 +1,6 @@
-// The constrained solver: a primal–dual interior point on the reduced problem with the node
-// constraints. Call planManeuver() rather than this directly.
+// The constrained recipe: minimum effort under node constraints by the fixed-h interior point
+// (interior_point/grid_solve.hpp), its attempts in order (constrained_recipe.cpp). Call
+// planManeuver() rather than this directly.
 #pragma once
 
 #include "attitude_planner/planning/problem.hpp"
@@ -11,7 +12,7 @@
 namespace attitude_planner {
 
 /// Primal–dual interior point on the reduced problem with the node constraints (per-axis torque
-/// bounds, PlanningProblem::constraints), O(N) per iteration (interior_point_solver.cpp). Starts
+/// bounds, PlanningProblem::constraints), O(N) per iteration (constrained_recipe.cpp). Starts
 /// from request.warm_start if given (request.start says what that plan is). Ends Infeasible when
 /// the constraints cannot be met. Polls `context` (cancel flag, deadline) inside its long loops,
 /// reports its iterations and records its attempts there (the kept one marked; they are its

@@ -28,6 +28,7 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/plan_at_resolution.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
+#include "planning/drivers/lowest_iterate.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/interior_point/free_time_solver.hpp"
@@ -414,6 +415,49 @@ TEST(FreeTime, AnIterateStrictlyInsideItsBoundsIsAPlanAtItsOwnT) {
         << limit << ": " << ap::planInconsistency(at, plan, true);
   }
   EXPECT_GT(checked, 0) << "no iteration limit left a strictly feasible iterate";
+}
+
+TEST(FreeTime, TheLowestIterateThatIsAPlanIsKeptAndNoOtherIterate) {
+  // What the minimum-time driver answers at most with spinning ends: the lowest iterate offered
+  // that is a plan at its own T. Iterates of one solve stopped at growing iteration limits (each
+  // strictly inside every bound) are offered in turn: the one kept is the least T among them, and
+  // stays kept when they are offered again; an iterate whose torque leaves its bound, offered
+  // below it, is refused (not a plan); and nothing is kept below a T the kept one does not lie
+  // strictly under.
+  ap::PlanningProblem p = spinningRequest(64);
+  p.duration = 3.5;
+  const ap::ReducedProblem geodesic(p);
+  ap::LowestIterate lowest;
+  double least = std::numeric_limits<double>::infinity();
+  std::size_t least_limit = 0;
+  std::vector<ap::Maneuver> offered;
+  for (const int limit : {5, 10, 20, 40}) {
+    const ap::FreeTimeOutcome o =
+        ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, limit);
+    if (o.termination != ap::Termination::NotConverged || !(o.smallest_value > 0)) continue;
+    lowest.offer(p, ap::IterateBelow{o.maneuver, static_cast<std::size_t>(limit)});
+    if (o.duration < least) least_limit = static_cast<std::size_t>(limit);
+    least = std::min(least, o.duration);
+    offered.push_back(o.maneuver);
+  }
+  ASSERT_TRUE(std::isfinite(least)) << "no iteration limit left a strictly feasible iterate";
+  const ap::LowestIterate::Plan* kept = lowest.below(std::numeric_limits<double>::infinity());
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(kept->effort.duration, least);
+  EXPECT_EQ(kept->effort.objective, ap::Objective::MinimumEffort);
+  EXPECT_TRUE(ap::provesFeasible(kept->effort, kept->plan));
+  EXPECT_EQ(kept->attempt, least_limit);
+  EXPECT_EQ(lowest.below(least), nullptr);
+
+  for (const ap::Maneuver& m : offered) lowest.offer(p, ap::IterateBelow{m, 1});  // none lower
+  ap::Maneuver outside = offered.back();
+  outside.time_step *= 0.9;  // a lower T: the same torques no longer reach the final state
+  outside.torque.front() *= 3.0;
+  lowest.offer(p, ap::IterateBelow{outside, 1});
+  kept = lowest.below(std::numeric_limits<double>::infinity());
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(kept->effort.duration, least);
+  EXPECT_EQ(kept->attempt, least_limit);
 }
 
 namespace {

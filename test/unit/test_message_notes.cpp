@@ -215,7 +215,7 @@ TEST(MessageFrames, ProbesAndTheLadderSayTheirDurationsExactly) {
   EXPECT_EQ(ap::renderFrame(ap::frames::UpperBoundFromProbe{below, previous}, "r"),
             "minimum time T* <= " + ap::exactNumber(below) +
                 " s, the least duration found feasible (an upper bound)" + found +
-                " (its minimum-effort plan is returned): r");
+                " (the plan found there is returned): r");
   // Stuck at the minimum-time plan: the branch its fields choose, the durations exact.
   const std::string rest =
       ap::renderFrame(ap::frames::StuckAtMinimumTimePlan{true, below, 3, 2.9}, "r");

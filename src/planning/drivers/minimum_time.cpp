@@ -12,6 +12,7 @@
 #include "attitude_planner/errors.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/fourth_order.hpp"
+#include "planning/drivers/lowest_iterate.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
@@ -265,23 +266,72 @@ bool farProbesBelow(const PlanResult& answer) {
   return !answer.minimum_time.second_order_sufficient;
 }
 
-/// The answer from a probe at `effort.duration` that found a plan (`below`, its attempt kept
-/// `below_kept`): the free-time KKT point from its plan where one lies lower, else the probe's
-/// plan as an upper bound on T* (answerFeasibleAt: converged also where the probe's solve
-/// stopped short of optimality inside the bounds, as the search's T* is). Its trail: the context's
-/// from `first`. Where that free-time solve ended short of a KKT point at a plan below the probe's
-/// T, the plan goes to `*lower_plan`.
-PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
-                       const PlanResult& answer, const PlanResult& below,
-                       std::optional<std::size_t> below_kept, std::size_t first,
-                       SolveContext& context, std::optional<Maneuver>* lower_plan) {
-  std::optional<PlanResult> lower = freeTimeFromPlan(problem, below.maneuver, effort.duration,
-                                                     "probe's plan", context, lower_plan);
-  if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
-    lower->attempts = context.attemptsFrom(first);
-    addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
-    return *lower;
+/// freeTimeFromPlan, its iterate below the plan's T (if any) handed to `*below` with its solve's
+/// place in the trail (the solve recorded last).
+std::optional<PlanResult> freeTimeFrom(const PlanningProblem& problem, const Maneuver& plan,
+                                       double duration, const std::string& start,
+                                       SolveContext& context, std::optional<IterateBelow>* below) {
+  std::optional<Maneuver> iterate;
+  std::optional<PlanResult> solved =
+      freeTimeFromPlan(problem, plan, duration, start, context, &iterate);
+  below->reset();
+  if (iterate) *below = IterateBelow{std::move(*iterate), context.attempts().size() - 1};
+  return solved;
+}
+
+}  // namespace
+
+PlanningProblem effortAt(const PlanningProblem& problem, double duration) {
+  PlanningProblem effort = problem;
+  effort.objective = Objective::MinimumEffort;
+  effort.time_margin = 0.0;
+  effort.duration = duration;
+  return effort;
+}
+
+/// A free-time iterate strictly inside every bound is such a plan by construction, and T* is at
+/// most its T whether or not a minimum-effort solve at that T converges: measured on the seed-45
+/// spinning suite's #221 (N = 405), the probes from such iterates ended "infeasible" at 57.93,
+/// 56.71 and 55.73 s, and the answer fell back to a probe's plan at 72.62 s, which the page's
+/// check refuted.
+std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Maneuver& iterate) {
+  PlanResult r;
+  r.solver = "interior_point";
+  r.termination = Termination::NotConverged;
+  try {
+    evaluatePlan(effort, iterate.torque, &r, &iterate);
+    replayFigures(effort, &r);
+  } catch (const StepTooLarge&) {  // the replay found no step: not shown a plan
+    return std::nullopt;
   }
+  if (!provesFeasible(effort, r)) return std::nullopt;
+  const ConstraintCheck check = checkConstraints(effort, r.maneuver);
+  r.constraints = check.names;
+  r.max_constraint_violation = check.max_violation;
+  r.max_violation_between_nodes = check.max_violation_between_nodes;
+  r.active_constraints = check.active;
+  recordReason(&r,
+               "the free-time solve ended short of its KKT point at this iterate, strictly inside "
+               "every bound: a plan at its T, not a minimum-effort optimum");
+  return r;
+}
+
+void LowestIterate::offer(const PlanningProblem& problem,
+                          const std::optional<IterateBelow>& iterate) {
+  if (!iterate || (lowest_ && !(iterate->duration() < lowest_->effort.duration))) return;
+  const PlanningProblem effort = effortAt(problem, iterate->duration());
+  std::optional<PlanResult> plan = iterateAsPlan(effort, iterate->plan);
+  if (plan) lowest_ = Plan{effort, std::move(*plan), iterate->attempt};
+}
+
+namespace {
+
+/// `below`, a plan at effort.duration below `answer`'s T (its attempt `below_kept`), as the
+/// answer: an upper bound on T* (answerFeasibleAt: converged also where the plan is not a
+/// minimum-effort optimum, as the search's T* is). Its trail: the context's from `first`.
+PlanResult upperBoundAt(const PlanningProblem& effort, const PlanResult& answer,
+                        const PlanResult& below, std::optional<std::size_t> below_kept,
+                        std::size_t first, SolveContext& context) {
   PlanResult upper = below;
   context.restoreKept(below_kept);
   upper.attempts = context.attemptsFrom(first);
@@ -292,6 +342,36 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
   return upper;
 }
 
+/// The answer from a plan at `effort.duration` below `answer`'s T (`below`: a probe's, or an
+/// iterate; its attempt kept `below_kept`): the free-time KKT point from it where one lies lower,
+/// else that plan as an upper bound on T* (upperBoundAt). Its trail: the context's from `first`.
+/// Where that free-time solve ended short of a KKT point at a plan below `below`'s T, the plan
+/// goes to `*lower_plan` and is offered to `iterates`.
+PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
+                       const PlanResult& answer, const PlanResult& below,
+                       std::optional<std::size_t> below_kept, std::size_t first,
+                       SolveContext& context, std::optional<IterateBelow>* lower_plan,
+                       LowestIterate& iterates) {
+  std::optional<PlanResult> lower =
+      freeTimeFrom(problem, below.maneuver, effort.duration, "probe's plan", context, lower_plan);
+  iterates.offer(problem, *lower_plan);
+  if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
+    lower->attempts = context.attemptsFrom(first);
+    addNote(&*lower, notes::DescendedFromProbe{effort.duration, answer.minimum_duration});
+    return *lower;
+  }
+  return upperBoundAt(effort, answer, below, below_kept, first, context);
+}
+
+/// The lowest iterate that is a plan as the answer where it lies below `answer`'s T (an upper
+/// bound on T*); else `answer`.
+PlanResult atMostLowestIterate(PlanResult answer, const LowestIterate& iterates, std::size_t first,
+                               SolveContext& context) {
+  const LowestIterate::Plan* lowest = iterates.below(answer.minimum_duration);
+  if (!lowest || !answer.converged()) return answer;
+  return upperBoundAt(lowest->effort, answer, lowest->plan, lowest->attempt, first, context);
+}
+
 /// Minimum time with spinning ends has local minima that the structured starts miss, with
 /// minimum-effort plans below their T* (docs/results/bounded_verdicts.md). So a free-time answer
 /// with spinning ends is probed: cold minimum-effort solves below T* (ProbeSteps); where one
@@ -299,25 +379,25 @@ PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& ef
 /// its plan is the answer, an upper bound; where that free-time solve ended at its iteration limit
 /// at a plan below the probe's T (every iterate strictly inside is a plan), the next probe is at
 /// that plan's T, warm-started from it (measured on #173 of the seed-45 spinning suite: an iterate
-/// at 6.27 s below the probe's 9.94 s, from which the descent reaches 6.095 s). No probe goes below
-/// the proven bound T_c on the grid. The trail keeps every probe (the context's from `first`, where
-/// `answer`'s began).
+/// at 6.27 s below the probe's 9.94 s, from which the descent reaches 6.095 s). With
+/// `iterates_are_plans`, where that probe finds no plan the iterate is the plan at its T
+/// (iterateAsPlan) and the free-time solve goes on from it. Every such iterate is offered to
+/// `iterates`. No probe goes below the proven bound T_c on the grid. The trail keeps every probe
+/// (the context's from `first`, where `answer`'s began).
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
-                       SolveContext& context) {
+                       SolveContext& context, LowestIterate& iterates,
+                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
-  std::optional<Maneuver> lower_plan;  // a free-time iterate's plan below the answer's T
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
-    PlanningProblem effort = problem;
-    effort.objective = Objective::MinimumEffort;
-    effort.time_margin = 0.0;
-    effort.duration = std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor);
+    PlanningProblem effort =
+        effortAt(problem, std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor));
     SolveRequest options(context.options());
     const bool from_iterate = lower_plan && handed_on < kMaxProbes;
     if (from_iterate) {  // the probe at the iterate's T, from it
-      effort.duration = lower_plan->time_step * lower_plan->steps();
-      options.warm_start = &*lower_plan;
+      effort.duration = lower_plan->duration();
+      options.warm_start = &lower_plan->plan;
       options.start.from_constrained_plan = true;
       ++handed_on;
       --probe;
@@ -325,8 +405,16 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
     const std::optional<std::size_t> answer_kept = context.keptAttempt();
     const std::size_t probe_first = context.attempts().size();
-    const PlanResult below = runInternalPhase(
-        "the probe below T*", [&] { return planAtResolution(effort, options, context); });
+    PlanResult below = runInternalPhase("the probe below T*",
+                                        [&] { return planAtResolution(effort, options, context); });
+    std::optional<std::size_t> below_kept = keptSince(context, probe_first);
+    if (from_iterate && iterates_are_plans && !provesFeasible(effort, below)) {
+      // No minimum-effort plan came of the iterate: the iterate itself is one at its T.
+      if (std::optional<PlanResult> iterate = iterateAsPlan(effort, lower_plan->plan)) {
+        below = std::move(*iterate);
+        below_kept = lower_plan->attempt;
+      }
+    }
     lower_plan.reset();
     if (!provesFeasible(effort, below)) {
       context.restoreKept(answer_kept);
@@ -334,19 +422,45 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
       if (!from_iterate && !steps.nothingFound(farProbesBelow(answer))) break;
       continue;
     }
-    answer = lowerAnswer(problem, effort, answer, below, keptSince(context, probe_first), first,
-                         context, &lower_plan);
+    answer = lowerAnswer(problem, effort, answer, below, below_kept, first, context, &lower_plan,
+                         iterates);
     if (!from_iterate) steps.found(answer.minimum_duration < effort.duration);
   }
   return answer;
+}
+
+/// The probes below T* again from the lowest iterate that is a plan, where it lies below
+/// `answer`'s T (else `answer`): that iterate is the answer, the free-time solve goes on from it,
+/// and the probes (probedBelow, iterates as plans) follow; the answer is then at most the lowest
+/// iterate any solve ended at. So T* is at most the T of every iterate that is a plan, and never
+/// above `answer`'s (the probes before it are untouched). Measured on the seed-45 spinning suite:
+/// iterates as plans during the first probes (hand-ons from the search's plan) moved #77 from its
+/// 5.18 s basin to a second-order sufficient KKT point at 6.54 s, below which the far probes are
+/// not asked; run after them, as here, #77 keeps 5.18 s, #221 (N = 405) goes from a probe's plan at
+/// 72.62 s to 51.66 s, and #47 of the held-out seed-47 suite from 25.19 s to 21.48 s.
+PlanResult probedBelowLowestIterate(const PlanningProblem& problem, PlanResult answer,
+                                    std::size_t first, SolveContext& context,
+                                    LowestIterate& iterates) {
+  const LowestIterate::Plan* found = iterates.below(answer.minimum_duration);
+  if (!found || !answer.converged() || context.stopReason()) return answer;
+  const LowestIterate::Plan lowest = *found;  // the solve from it offers lower ones
+  std::optional<IterateBelow> lower_plan;
+  answer = lowerAnswer(problem, lowest.effort, answer, lowest.plan, lowest.attempt, first, context,
+                       &lower_plan, iterates);
+  answer = probedBelow(problem, std::move(answer), first, context, iterates, std::move(lower_plan),
+                       true);
+  return atMostLowestIterate(std::move(answer), iterates, first, context);
 }
 
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,
 /// or if none of its solves converged, the search (searchMinimumTime, an upper bound) with what is
 /// left of the time budget; where the free-time problem applies, the search's plan starts one more
 /// free-time solve (a KKT point). The trail keeps every stage in order: the free-time solves that
-/// did not give the answer, the search's starts, the solve from the search's plan.
-PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context);
+/// did not give the answer, the search's starts, the solve from the search's plan. Where that
+/// solve ended short of its KKT point at a plan below the search's T, the plan is offered to
+/// `iterates`.
+PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context,
+                                 LowestIterate& iterates);
 
 PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context,
                            RichardsonPair* pair) {
@@ -354,9 +468,11 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
     return fourthOrderMinimumTime(problem, context, pair);
   }
   const std::size_t first = context.attempts().size();
-  PlanResult answer = structuredMinimumTime(problem, context);
+  LowestIterate iterates;
+  PlanResult answer = structuredMinimumTime(problem, context, iterates);
   if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
-  return probedBelow(problem, std::move(answer), first, context);
+  answer = probedBelow(problem, std::move(answer), first, context, iterates, std::nullopt, false);
+  return probedBelowLowestIterate(problem, std::move(answer), first, context, iterates);
 }
 
 /// One start twist of a pointing request (`posed`: R_N at the start twist): the fixed-attitude
@@ -398,7 +514,8 @@ PlanResult minimumTimeOverTwists(const PlanningProblem& problem, SolveContext& c
 }
 
 /// minimumTimePlan of a discretization before the probe below T* (probedBelow).
-PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context) {
+PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& context,
+                                 LowestIterate& iterates) {
   const std::string unsupported = freeTimeUnsupported(problem);
   std::string why;
   const std::size_t first = context.attempts().size();
@@ -420,8 +537,10 @@ PlanResult structuredMinimumTime(const PlanningProblem& problem, SolveContext& c
   // The search's plan meets every bound at its T (an upper bound on T*): started from it, one
   // free-time solve can reach a KKT point at or below it where the structured starts did not.
   const std::optional<std::size_t> search_kept = context.keptAttempt();
-  std::optional<PlanResult> sharpened =
-      freeTimeFromPlan(problem, result.maneuver, result.minimum_duration, "search's plan", context);
+  std::optional<IterateBelow> below;
+  std::optional<PlanResult> sharpened = freeTimeFrom(
+      problem, result.maneuver, result.minimum_duration, "search's plan", context, &below);
+  iterates.offer(problem, below);
   if (!sharpened || !sharpened->converged()) {
     // The search's answer stands; its kept probe stays kept, the solve from its plan follows.
     context.restoreKept(search_kept);

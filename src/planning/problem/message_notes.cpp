@@ -216,7 +216,7 @@ std::string framed(const frames::MinimumTimePairCombined& f, const std::string& 
 std::string framed(const frames::UpperBoundFromProbe& f, const std::string& reason) {
   return "minimum time T* <= " + exactNumber(f.duration) +
          " s, the least duration found feasible (an upper bound)" +
-         foundBelow(f.duration, f.previous) + " (its minimum-effort plan is returned): " + reason;
+         foundBelow(f.duration, f.previous) + " (the plan found there is returned): " + reason;
 }
 std::string framed(const frames::StuckAtMinimumTimePlan& f, const std::string& reason) {
   std::ostringstream why;

@@ -20,6 +20,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "attitude_planner/dynamics/effects.hpp"
@@ -445,7 +446,12 @@ TEST(FreeTime, TheLowestIterateThatIsAPlanIsKeptAndNoOtherIterate) {
   ASSERT_NE(kept, nullptr);
   EXPECT_EQ(kept->effort.duration, least);
   EXPECT_EQ(kept->effort.objective, ap::Objective::MinimumEffort);
-  EXPECT_TRUE(ap::provesFeasible(kept->effort, kept->plan));
+  // A plan at its T, said to be an iterate; checked step by step, not by its verdict.
+  ASSERT_TRUE(std::holds_alternative<ap::verdicts::FeasibleAtMinimumTime>(kept->plan.verdict));
+  EXPECT_TRUE(std::get<ap::verdicts::FeasibleAtMinimumTime>(kept->plan.verdict).free_time_iterate);
+  ap::PlanResult unjudged = kept->plan;
+  unjudged.termination = ap::Termination::NotConverged;
+  EXPECT_TRUE(ap::provesFeasible(kept->effort, unjudged));
   EXPECT_EQ(kept->attempt, least_limit);
   EXPECT_EQ(lowest.below(least), nullptr);
 

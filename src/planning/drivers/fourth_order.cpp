@@ -25,13 +25,7 @@ void measureFourthOrderPlan(const PlanningProblem& problem, PlanResult* result) 
                 replayPlan(SchemeKind::FourthOrder, problem.inertia, problem.duration / N, input),
                 result);
   // The combination is not re-solved under the constraints: its node figures are measured.
-  if (problem.hasNodeConstraints()) {
-    const ConstraintCheck check = checkConstraints(problem, m);
-    result->constraints = check.names;
-    result->max_constraint_violation = check.max_violation;
-    result->max_violation_between_nodes = check.max_violation_between_nodes;
-    result->active_constraints = check.active;
-  }
+  if (problem.hasNodeConstraints()) recordConstraintFigures(problem, result);
 }
 
 }  // namespace

@@ -305,11 +305,7 @@ std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Man
     return std::nullopt;
   }
   if (!provesFeasible(effort, r)) return std::nullopt;
-  const ConstraintCheck check = checkConstraints(effort, r.maneuver);
-  r.constraints = check.names;
-  r.max_constraint_violation = check.max_violation;
-  r.max_violation_between_nodes = check.max_violation_between_nodes;
-  r.active_constraints = check.active;
+  recordConstraintFigures(effort, &r);
   // Feasible at its T, as answerFeasibleAt says of a plan, and said to be an iterate.
   r.termination = Termination::Converged;
   recordVerdict(&r, verdicts::FeasibleAtMinimumTime{effort.duration, true});

@@ -88,6 +88,12 @@ struct WatchedRun {
   int joined = -1;
 };
 
+/// A refined level's outcome and its solve in the trail (a resume's, where the resume answered).
+struct RefinedOutcome {
+  FreeTimeOutcome outcome;
+  std::size_t attempt = 0;
+};
+
 /// What one free-time grid level hands the next: its outcome (plan, T, steps).
 struct FreeTimeCarry {
   FreeTimeOutcome outcome;
@@ -614,36 +620,34 @@ class FreeTimeMinimumTime {
   /// answer. Empty if none refined.
   std::optional<PlanResult> refineLeast(const std::vector<PlanningProblem>& levels,
                                         const std::vector<int>& candidates) {
-    std::optional<FreeTimeOutcome> least;
+    std::optional<RefinedOutcome> least;
     std::string name;
-    std::size_t attempt = 0;
     std::vector<LevelSummary> least_levels;
     for (const int c : candidates) {
       if (least && context_.stopReason()) break;
       best_attempt_ = starts_[c].attempt;
       levels_ = levelResult(levels.front().steps, starts_[c].outcome).levels;
-      std::optional<FreeTimeOutcome> refined = refine(levels, starts_[c].outcome);
-      if (!refined || (least && refined->duration >= least->duration)) continue;
+      std::optional<RefinedOutcome> refined = refine(levels, starts_[c].outcome);
+      if (!refined || (least && refined->outcome.duration >= least->outcome.duration)) continue;
       least = std::move(refined);
       name = starts_[c].name;
-      attempt = refined_attempt_;
       least_levels = levels_;
     }
     if (!least) return std::nullopt;
-    best_attempt_ = attempt;
+    best_attempt_ = least->attempt;
     levels_ = least_levels;
-    return answerAt(*least, "coarse grid (N = " + std::to_string(levels.front().steps) + ", " +
-                                name + "), refined by 2 at a time");
+    return answerAt(least->outcome, "coarse grid (N = " + std::to_string(levels.front().steps) +
+                                        ", " + name + "), refined by 2 at a time");
   }
 
   /// The coarsest level's best answer carried through the finer `levels` (the grid continuation
   /// resumed from it): each level one free-time solve from the coarser answer prolonged, at its
-  /// T. Its attempt is refined_attempt_. Empty if the solve is stopped (cancel, deadline) or a
+  /// T, with its attempt in the trail. Empty if the solve is stopped (cancel, deadline) or a
   /// level does not converge, but for the requested grid's ending short inside its bounds
   /// (endedShortInside, after its resume): that plan is returned, not a KKT point.
-  std::optional<FreeTimeOutcome> refine(const std::vector<PlanningProblem>& levels,
-                                        const FreeTimeOutcome& coarsest) {
-    std::optional<FreeTimeOutcome> finest;
+  std::optional<RefinedOutcome> refine(const std::vector<PlanningProblem>& levels,
+                                       const FreeTimeOutcome& coarsest) {
+    std::optional<RefinedOutcome> finest;
     const Attempt origin = trail_[best_attempt_];  // the coarsest level's kept solve
     const LevelSolver<FreeTimeCarry> level = [&](const LevelRequest<FreeTimeCarry>& r,
                                                  FreeTimeCarry* handed_on) {
@@ -662,13 +666,14 @@ class FreeTimeMinimumTime {
       // of the seed-45 spinning suite refined from its violations to a saddle at 0.6661 s, at μ₀
       // to a local minimum at 0.6530 s from the same coarse answer).
       detail.elastic_from_violations = false;
-      FreeTimeOutcome o = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
-                                AttemptStart::CoarseLevel, detail);
-      refined_attempt_ = trail_.size() - 1;
-      if (endedShortInside(o)) o = resumed(r.problem, o, detail);
-      PlanResult result = levelResult(r.problem.steps, o);
+      RefinedOutcome o;
+      o.outcome = solve(r.problem, prolonged(r.problem, coarse), coarse.duration,
+                        AttemptStart::CoarseLevel, detail);
+      o.attempt = trail_.size() - 1;
+      if (endedShortInside(o.outcome)) o = resumed(r.problem, std::move(o), detail);
+      PlanResult result = levelResult(r.problem.steps, o.outcome);
       if (handed_on) {
-        handed_on->outcome = std::move(o);
+        handed_on->outcome = std::move(o.outcome);
       } else {
         finest = std::move(o);
       }
@@ -684,7 +689,7 @@ class FreeTimeMinimumTime {
     // iterate is still a plan at its own T, an upper bound on T* (answerAt says so). Discarded,
     // the search from scratch answered a worse bound (measured: a seeded slew around a cone,
     // 13.5065 s after 24,000 iterations against the plan's 13.4896 s, T* reached to 1e-13).
-    if (!result.converged() && !endedShortInside(*finest)) return std::nullopt;
+    if (!result.converged() && !endedShortInside(finest->outcome)) return std::nullopt;
     levels_.insert(levels_.end(), result.levels.begin(), result.levels.end());
     return finest;
   }
@@ -702,14 +707,13 @@ class FreeTimeMinimumTime {
   /// it does not converge. Measured on a seeded rest-to-rest slew (N = 128): the refined level
   /// stopped at T* to 5e-12 with stationarity 1.6e-7 (the floor 1e-7), the search then took 8,000
   /// iterations to the same T*; resumed, it converges in 40.
-  FreeTimeOutcome resumed(const PlanningProblem& p, FreeTimeOutcome ended, StartDetail detail) {
-    detail.duration = ended.duration;
+  RefinedOutcome resumed(const PlanningProblem& p, RefinedOutcome ended, StartDetail detail) {
+    detail.duration = ended.outcome.duration;
     FreeTimeOutcome o =
-        solve(p, ended.maneuver.attitude, ended.duration, AttemptStart::PreviousAttempt, detail, {},
-              StartBarrier::NearKktPoint);
+        solve(p, ended.outcome.maneuver.attitude, ended.outcome.duration,
+              AttemptStart::PreviousAttempt, detail, {}, StartBarrier::NearKktPoint);
     if (o.termination != Termination::Converged) return ended;
-    refined_attempt_ = trail_.size() - 1;
-    return o;
+    return {std::move(o), trail_.size() - 1};
   }
 
   /// The answer: the free-time plan at T* itself, measured as every plan is (freeTimePlan), its
@@ -776,11 +780,7 @@ class FreeTimeMinimumTime {
       r.termination = Termination::StepTooLarge;
       recordReason(&r, std::string("replay of the planned torques failed: ") + e.what());
     }
-    const ConstraintCheck check = checkConstraints(effort, r.maneuver);
-    r.constraints = check.names;
-    r.max_constraint_violation = check.max_violation;
-    r.max_violation_between_nodes = check.max_violation_between_nodes;
-    r.active_constraints = check.active;
+    recordConstraintFigures(effort, &r);
     return r;
   }
 
@@ -793,7 +793,6 @@ class FreeTimeMinimumTime {
   std::vector<LevelSummary> levels_;  ///< the kept start's level and each refined level
   std::vector<Attempt> trail_;
   std::size_t best_attempt_ = 0;
-  std::size_t refined_attempt_ = 0;  ///< the attempt of refine's answer on the requested grid
   int solves_ = 0;
   FreeTimeScale shared_scale_;   ///< the watched solves' scale on the starts' grid (shareScale)
   int shared_scale_steps_ = -1;  ///< that grid's N

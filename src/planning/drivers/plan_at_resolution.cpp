@@ -262,11 +262,7 @@ PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& 
   result.attempts = context.attemptsFrom(first_attempt);
   refuseAnotherClass(problem, &result);
   if (problem.hasNodeConstraints() && result.maneuver.steps() == problem.steps) {
-    const ConstraintCheck check = checkConstraints(problem, result.maneuver);
-    result.constraints = check.names;
-    result.max_constraint_violation = check.max_violation;
-    result.max_violation_between_nodes = check.max_violation_between_nodes;
-    result.active_constraints = check.active;
+    recordConstraintFigures(problem, &result);
   }
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -210,6 +210,14 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
   if (replay) *replay = replayed;
 }
 
+void recordConstraintFigures(const PlanningProblem& problem, PlanResult* result) {
+  const ConstraintCheck check = checkConstraints(problem, result->maneuver);
+  result->constraints = check.names;
+  result->max_constraint_violation = check.max_violation;
+  result->max_violation_between_nodes = check.max_violation_between_nodes;
+  result->active_constraints = check.active;
+}
+
 void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& torque,
                   PlanResult* result, const Maneuver* planned, StepResidual* residual) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, problem.duration / problem.steps);

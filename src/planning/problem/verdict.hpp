@@ -28,6 +28,11 @@ void evaluatePlan(const PlanningProblem& problem, const std::vector<Vector3>& to
 /// implicit step fails.
 void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver* replay = nullptr);
 
+/// Measures the result's plan against the problem's node constraints and sets the four figures a
+/// user reads of them (constraints, max_constraint_violation, max_violation_between_nodes,
+/// active_constraints): one place for every plan that is answered.
+void recordConstraintFigures(const PlanningProblem& problem, PlanResult* result);
+
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step
 /// (measureStepResidual within its tolerance), each of its steps is the one the scheme's own

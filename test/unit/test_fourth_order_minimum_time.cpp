@@ -12,7 +12,7 @@
 #include <string>
 
 #include "attitude_planner/planner.hpp"
-#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/drivers/free_time_recipe.hpp"
 #include "support/scene_problem.hpp"
 #include "support/searched_minimum_time.hpp"
 #include "support/turned_world.hpp"

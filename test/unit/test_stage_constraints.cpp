@@ -20,7 +20,7 @@
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/minimum_time.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
-#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/drivers/free_time_recipe.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "planning/transcription/stage_constraints.hpp"

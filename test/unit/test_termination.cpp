@@ -13,7 +13,7 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
-#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/drivers/free_time_recipe.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "tool_runner.hpp"
 

@@ -169,7 +169,8 @@ struct InteriorPointParameters {
   /// ... with θ at least this [rad].
   double angle_floor = 1e-3;
 
-  // --- minimum time's own strategies (free_time_solver.cpp, inertia_correction.cpp) -----------
+  // --- minimum time's own strategies (free_time_solver.cpp, inertia_correction.cpp; the start --
+  // raise: drivers/free_time_recipe.cpp) -------------------------------------------------------
   /// The start's h grows by this factor until every constraint that moves with h holds with the
   /// start margin (torques scale like 1/h²: a few percent per growth keeps T₀ near the least
   /// feasible T of the start's path).

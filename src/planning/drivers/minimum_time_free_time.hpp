@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
-#include "planning/interior_point/free_time_solver.hpp"
+#include "planning/drivers/free_time_recipe.hpp"
 #include "planning/strategies/grid_continuation.hpp"
 
 namespace attitude_planner {

@@ -44,11 +44,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <sstream>
 
-#include "attitude_planner/errors.hpp"
 #include "attitude_planner/planning/interior_point_parameters.hpp"
-#include "attitude_planner/planning/pointing.hpp"
 #include "planning/interior_point/barrier_forms.hpp"
 #include "planning/interior_point/barrier_problem_solve.hpp"
 #include "planning/interior_point/barrier_update.hpp"
@@ -71,10 +68,13 @@ namespace {
 /// The free-time profile of the barrier problem: objective T/T₀ + ε(μ) C, every row Feasible but
 /// an elastic start's, a stencil's block summed in double, the trial point h and then the nodes,
 /// the second-order correction, the KKT residual test.
-class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
+class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
+                             public FreeTimeProblem {
  public:
   FreeTimeSolver(const PlanningProblem& problem, ReducedProblem* np,
-                 const StageConstraints& constraints, const InteriorPointParameters& parameters)
+                 const StageConstraints& constraints, const InteriorPointParameters& parameters,
+                 ElasticBarrier elastic_barrier, StartBarrier start_barrier,
+                 const FreeTimeScale& scale)
       : BarrierProblemSolve(*np, parameters, constraint_block_, nullptr,
                             {"iteration limit", "out of time"}),
         problem_(problem),
@@ -84,95 +84,28 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
         elastic_form_(parameters),
         constraint_block_(
             constraints, *np,
-            [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); }) {
+            [this](const FreeTimeRows& g) -> const BarrierForm<10>& { return form(g); }),
+        elastic_barrier_(elastic_barrier),
+        start_barrier_(start_barrier),
+        scale_(scale) {
     rho_ = p_.free_time.initial_penalty;
   }
 
-  /// Raises h until every constraint that moves with h holds with the start margin (the others,
-  /// the cones, must already hold strictly: raising h does not move an attitude). Empty if the
-  /// start is strictly feasible, else why not.
-  std::string startInside() {
-    const double cone_value = smallestValue(np_.current(), false);
-    if (!(cone_value > 0)) {
-      std::ostringstream why;
-      why << "the start's attitudes violate a cone (smallest value " << cone_value
-          << "; raising T does not move them)";
-      return why.str();
-    }
-    const double h_start = np_.timeStep();
-    const ReducedProblem::StepVectors steps_start = np_.current();
-    for (int i = 0; i < p_.max_start_growths; ++i) {
-      if (smallestValue(np_.current(), true) >= p_.start_margin) {
-        h0_ = np_.timeStep();
-        return conesAfterRaise();
-      }
-      const double raised = np_.timeStep() * p_.start_growth;
-      if (allow_elastic_ && !raisesUntilInside() && raised > p_.largest_start_raise * h_start) {
-        return startElastic(h_start, steps_start);
-      }
-      if (!raisedTo(raised)) {
-        if (allow_elastic_) return startElastic(h_start, steps_start);
-        return "no strictly feasible start: at T = " + std::to_string(raised * N_) +
-               " s the boundary rates admit no step before the constraints hold";
-      }
-    }
-    return "no strictly feasible start: the constraints still fail at " +
-           std::to_string(std::pow(p_.start_growth, p_.max_start_growths)) +
-           " times the start's duration";
+  double smallestValue(bool moves_with_h) const override {
+    return smallestValue(np_.current(), moves_with_h);
   }
-
-  /// StartRaise::UntilInside where it applies: rest to rest, without wheels, a raise of h at fixed
-  /// attitudes scales every row that moves with h down (torques like 1/h², rates like 1/h), so it
-  /// reaches a strictly feasible start however far outside the start's own T is. (A wheel's
-  /// momentum keeps its initial value; with spinning ends an end torque carries the boundary
-  /// momentum: largest_start_raise.)
-  bool raisesUntilInside() const {
-    return start_raise_ == StartRaise::UntilInside && problem_.initial_velocity.isZero(0.0) &&
-           problem_.final_velocity.isZero(0.0) && !problem_.reaction_wheels.present();
-  }
-
-  /// Empty where every cone still holds strictly at the raised h, else why not: with spinning
-  /// ends h moves R_{N−1} of paper and variational (ReducedProblem::nodePath), a cone's row where
-  /// a pointing end's twist makes it one.
-  std::string conesAfterRaise() const {
-    const double cone_value = smallestValue(np_.current(), false);
-    if (cone_value > 0) return "";
-    std::ostringstream why;
-    why << "raising T for the start moved an attitude the boundary rate fixes into a cone "
-           "(smallest value "
-        << cone_value << ")";
-    return why.str();
-  }
-
-  /// The elastic start at the start's own T: every constraint that moves with h ℓ1-elastic.
-  std::string startElastic(double h_start, const ReducedProblem::StepVectors& steps_start) {
-    np_.setTimeStep(h_start);
-    np_.setCurrent(steps_start);
-    h0_ = h_start;
+  void beginAt(bool elastic) override {
+    h0_ = np_.timeStep();
+    if (!elastic) return;
     elastic_ = started_elastic_ = true;
     rho_ = p_.free_time.initial_penalty;
-    return "";
   }
-
-  /// h raised for the start; false (h unchanged) where the boundary rates admit no step at it.
-  bool raisedTo(double h) {
-    try {
-      np_.setTimeStep(h);
-      return true;
-    } catch (const StepTooLarge&) {
-      return false;
-    }
-  }
-
   FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
-                      const BarrierWatch& watch);
-  void setElasticBarrier(ElasticBarrier b) { elastic_barrier_ = b; }
-  void setStartBarrier(StartBarrier b) { start_barrier_ = b; }
-  void setStartRaise(StartRaise r) { start_raise_ = r; }
-  void setScale(const FreeTimeScale& scale) { scale_ = scale; }
-  /// Whether this solve started elastic (a failed elastic solve is retried raising h alone).
-  bool startedElastic() const { return started_elastic_; }
-  void disallowElastic() { allow_elastic_ = false; }
+                      const BarrierWatch& watch) override;
+  bool barrierHessianDefinite() const override;
+  std::optional<LeastEigenpair> barrierHessianLeastEigenpair() const override {
+    return leastEigenpair(kkt_blocks_);
+  }
 
  private:
   /// Whether the group's rows are ℓ1-elastic now: the constraints that move with h, while the
@@ -255,8 +188,6 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
   }
   double meritSlope(const Eigen::VectorXd& d) const;
   double barrierResidual(double mu) const;
-  /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
-  bool barrierHessianDefinite() const;
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
   std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
                       int iterations) const;
@@ -266,7 +197,6 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
   void report(double alpha, double stationarity) const;
   /// The outcome at the iterate the solve ended at (termination_, reason_).
   FreeTimeOutcome outcome() const;
-  void checkSecondOrder(FreeTimeOutcome* out) const;
 
   const PlanningProblem& problem_;
   int N_, n_;
@@ -294,13 +224,12 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double> {
     ReducedProblem::StepVectors steps;
   } accepted_;
   Matrix3 accepted_end_ = Matrix3::Identity();  ///< R_N at the accepted iterate
-  // The elastic start (startInside): until the iterate is strictly inside every constraint that
-  // moves with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
-  bool allow_elastic_ = true, elastic_ = false, started_elastic_ = false;
-  ElasticBarrier elastic_barrier_ = ElasticBarrier::Initial;
-  StartBarrier start_barrier_ = StartBarrier::Initial;
-  StartRaise start_raise_ = StartRaise::Bounded;
-  FreeTimeScale scale_;  ///< the objective's T₀ and C₀ (unset: the start's own)
+  // An elastic start (beginAt): until the iterate is strictly inside every constraint that moves
+  // with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
+  bool elastic_ = false, started_elastic_ = false;
+  const ElasticBarrier elastic_barrier_;
+  const StartBarrier start_barrier_;
+  const FreeTimeScale scale_;  ///< the objective's T₀ and C₀ (unset: the start's own)
   /// The request's context while run() is in progress: polled inside the assembly (null: no
   /// polls), reported to after every accepted step.
   SolveContext* context_ = nullptr;
@@ -537,7 +466,6 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
         {freeTimeLineSearch(p_), false, false}, context, max_iterations);
   FreeTimeOutcome out = outcome();
   out.stopped_by_watch = stopped_by_watch_;
-  if (termination_ == Termination::Converged) checkSecondOrder(&out);
   return out;
 }
 
@@ -652,113 +580,22 @@ FreeTimeOutcome FreeTimeSolver::outcome() const {
   return out;
 }
 
-/// The second-order check at the assembled (converged) point: the condensed barrier Hessian
-/// factored without a shift (FreeTimeOutcome::second_order_sufficient). Where it is not positive
-/// definite, its least eigenpair from the dense matrix (n ≤ a few hundred at the start grid; this
-/// runs once per converged solve, and only there).
+/// The condensed barrier Hessian factored without a shift: FreeTimeOutcome::second_order_sufficient
+/// at a converged point, BarrierPoint::locally_convex at a solved barrier problem.
 bool FreeTimeSolver::barrierHessianDefinite() const {
   BorderedBandKkt<double> factor;
   return factor.factor(kkt_blocks_, Shift{}) && factor.inertia().positive == borderSize() &&
          factor.inertia().negative == 0;
 }
 
-void FreeTimeSolver::checkSecondOrder(FreeTimeOutcome* out) const {
-  const bool definite = barrierHessianDefinite();
-  out->second_order_sufficient = definite;
-  if (definite) return;
-  const std::optional<LeastEigenpair> least = leastEigenpair(kkt_blocks_);
-  if (!least) return;
-  out->least_curvature = least->value / least->scale;
-  const Eigen::VectorXd v = least->vector.head(n_);
-  const Eigen::Index at = [&] {
-    Eigen::Index i = 0;
-    v.cwiseAbs().maxCoeff(&i);
-    return i;
-  }();
-  if (v(at) != 0) out->negative_curvature = v / v(at);  // max |δ_j| = 1, that entry positive
-}
-
 }  // namespace
 
-std::string freeTimeUnsupported(const PlanningProblem&) {
-  return "";
-}
-
-FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations,
-                              SolveContext& context, const BarrierWatch& watch,
-                              ElasticBarrier elastic_barrier, StartBarrier start_barrier,
-                              StartRaise start_raise, const FreeTimeScale& scale) {
-  PlanningProblem at = endingAt(problem, attitudes.back());  // a pointing start's own twist
-  at.duration = start_duration;
-  FreeTimeOutcome failed;
-  failed.termination = Termination::NotConverged;
-  const InteriorPointParameters& parameters = context.options().advanced.interior_point;
-  try {
-    ReducedProblem np(at);
-    np.setInteriorFromAttitudes(attitudes);
-    // R_0, R_N and, where the boundary data fix them, R_1, R_{N−1}: no iterate moves them.
-    // A free twist moves R_{N−1} and R_N: their cones are rows then (a start outside them is
-    // refused by startInside).
-    const std::string fixed =
-        np.hasTwist() ? fixedNodeConeViolation(problem, np, {0, 1})
-                      : fixedNodeConeViolation(problem, np, {0, 1, np.steps() - 1, np.steps()});
-    if (!fixed.empty()) {
-      recordVerdict(&failed, verdicts::FreeTimeConeAtFixedNode{fixed});
-      return failed;
-    }
-    const StageConstraints constraints = buildStageConstraints(problem);
-    const std::vector<Vector3> start_steps = np.current();
-    const double start_h = np.timeStep();
-    const Matrix3 start_end = np.finalAttitude();
-    FreeTimeSolver solver(problem, &np, constraints, parameters);
-    solver.setElasticBarrier(elastic_barrier);
-    solver.setStartBarrier(start_barrier);
-    solver.setStartRaise(start_raise);
-    solver.setScale(scale);
-    if (const std::string outside = solver.startInside(); !outside.empty()) {
-      recordVerdict(&failed, verdicts::NoStrictlyFeasibleStart{outside});
-      return failed;
-    }
-    FreeTimeOutcome out = solver.run(tolerance, max_iterations, context, watch);
-    if (out.termination != Termination::NotConverged || !solver.startedElastic()) return out;
-    // The elastic start did not reach a KKT point: the start raised inside instead.
-    np.setCurrentWithFinalAttitude(start_steps, start_end);  // R_N where the twist started
-    np.setTimeStep(start_h);
-    np.setCurrent(start_steps);
-    FreeTimeSolver raised(problem, &np, constraints, parameters);
-    raised.disallowElastic();
-    raised.setStartBarrier(start_barrier);
-    raised.setScale(scale);
-    if (!raised.startInside().empty()) return out;
-    return raised.run(tolerance, max_iterations, context, watch);
-  } catch (const StepTooLarge& e) {
-    recordVerdict(&failed, verdicts::NoBoundaryStep{e.what(), true});
-    return failed;
-  }
-}
-
-FreeTimeScale freeTimeScaleOf(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double duration) {
-  PlanningProblem at = endingAt(problem, attitudes.back());
-  at.duration = duration;
-  try {
-    ReducedProblem np(at);
-    np.setInteriorFromAttitudes(attitudes);
-    const double cost = np.cost(np.current());
-    if (std::isfinite(cost)) return {duration, cost};
-  } catch (const StepTooLarge&) {  // no step at this T: no scale to share
-  }
-  return {};
-}
-
-FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations) {
-  SolveContext context{SolverOptions{}};
-  FreeTimeOutcome outcome =
-      solveFreeTime(problem, attitudes, start_duration, tolerance, max_iterations, context);
-  outcome.iterations = context.iterations();  // both runs' where the start was raised inside
-  return outcome;
+std::unique_ptr<FreeTimeProblem> makeFreeTimeProblem(
+    const PlanningProblem& problem, ReducedProblem* np, const StageConstraints& constraints,
+    const InteriorPointParameters& parameters, ElasticBarrier elastic_barrier,
+    StartBarrier start_barrier, const FreeTimeScale& scale) {
+  return std::make_unique<FreeTimeSolver>(problem, np, constraints, parameters, elastic_barrier,
+                                          start_barrier, scale);
 }
 
 }  // namespace attitude_planner

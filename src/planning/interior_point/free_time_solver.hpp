@@ -1,19 +1,25 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
 // node unknowns δ of the reduced problem, objective T, the torque constraints, pointing cones and
 // rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
-// free_time_solver.cpp derives the method).
+// free_time_solver.cpp derives the method). Where a solve begins, its retry and the second-order
+// check of its end are its recipe's (drivers/free_time_recipe.hpp: solveFreeTime).
 #pragma once
 
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/interior_point/local_lower_bound.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
+#include "planning/transcription/stage_constraints.hpp"
 
 namespace attitude_planner {
 
@@ -79,14 +85,6 @@ enum class ElasticBarrier { Initial, FromViolations };
 /// such a start and may carry it to another local minimum (free_time_solver.cpp).
 enum class StartBarrier { Initial, NearKktPoint };
 
-/// How far a start outside the bounds that move with h is raised before its elastic phase takes
-/// over. Bounded: at most InteriorPointParameters::largest_start_raise, for a start whose T is near
-/// its answer's (a coarser grid's T*, a plan's own T), whose local violations a raise would trade
-/// for a start far from T*. UntilInside: as far as needed where a raise scales every such row
-/// down (rest to rest, no wheel momentum; elsewhere Bounded), for a start whose T is a guess (the
-/// structured starts: the eigenaxis slew's profile).
-enum class StartRaise { Bounded, UntilInside };
-
 /// The scale of a free-time solve's objective T/T₀ + εC (ε = ε₀ μ/μ₀, ε₀ C₀ a fixed share): T₀
 /// and C₀. Unset (0), a solve takes its own start's (the raised start's T and effort). Starts on
 /// one grid that share one scale solve one family of barrier problems: two of them at the same μ
@@ -98,11 +96,6 @@ struct FreeTimeScale {
   double cost = 0.0;      ///< C₀ [N² m²], the effort at T₀
   bool set() const { return duration > 0.0 && cost > 0.0; }
 };
-
-/// The scale of the start through `attitudes` at T = duration (its T and effort before any raise),
-/// for other starts on the same grid to share; unset where the start admits no step.
-FreeTimeScale freeTimeScaleOf(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double duration);
 
 /// A solved barrier problem of a free-time solve: its point on the central path at μ.
 struct BarrierPoint {
@@ -127,43 +120,32 @@ struct BarrierPoint {
 /// FreeTimeOutcome::stopped_by_watch.
 using BarrierWatch = std::function<std::string(const BarrierPoint&)>;
 
-/// Why `problem` cannot be solved free-time here (empty: it can; minimum_time.cpp falls back to
-/// the search otherwise). Every request can today: effects are written in h (their time
-/// t_k = k h moves with h: ReducedProblem::forEachStencilWithTimeStep), and fourth_order, which
-/// has no single transcription, is the pair of its second_order problems at N and 2N
-/// (minimum_time.cpp, fourthOrderMinimumTime). Kept as the one place a future case names itself.
-std::string freeTimeUnsupported(const PlanningProblem& problem);
+/// The free-time barrier problem as its recipe sees it (drivers/free_time_recipe.cpp): the rows'
+/// values at the iterate, where the solve begins, the solve, and the Newton matrix it ends at.
+class FreeTimeProblem {
+ public:
+  virtual ~FreeTimeProblem() = default;
+  /// The least value at the iterate of the constraints that move with h (`moves_with_h`) or of
+  /// the others (the cones), never relaxed.
+  virtual double smallestValue(bool moves_with_h) const = 0;
+  /// Begins at the iterate's h (h₀ = h, T₀ = N h₀): strictly inside every constraint, or
+  /// (`elastic`) with the constraints that move with h ℓ1-elastic until the iterate is inside them.
+  virtual void beginAt(bool elastic) = 0;
+  /// The solve from there (solveFreeTime's contract, without the second-order check's fields).
+  virtual FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
+                              const BarrierWatch& watch) = 0;
+  /// Whether the condensed barrier Hessian assembled at the iterate factors without a shift.
+  virtual bool barrierHessianDefinite() const = 0;
+  /// That matrix's least eigenpair (leastEigenpair, kkt_system.hpp).
+  virtual std::optional<LeastEigenpair> barrierHessianLeastEigenpair() const = 0;
+};
 
-/// One free-time interior-point solve from the plan through `attitudes` (N + 1 of them, R_0 and
-/// R_N the problem's) at T = start_duration, raised until every torque constraint holds strictly
-/// (a cone must hold strictly at the start's attitudes already, and at the attitudes the boundary
-/// data fix: raising T does not move them). If a raise by 2× does not suffice (spinning ends: an
-/// end torque carries the boundary momentum, which a slower interior no longer meets), the start
-/// stays at its T and is brought inside by an elastic phase instead: the constraints that move
-/// with h relaxed to c + θ ≥ 0, θ ≥ 0 one more unknown penalized in the objective, dropped at the
-/// first iterate strictly inside every constraint; from then on every iterate is strictly
-/// feasible (if that solve fails, it is retried raising h alone). Boundary rates are held at
-/// every h. Ends Converged at a KKT point of the discrete minimum-time problem
-/// (complementarity within `tolerance`, stationarity within it × max(1, (N/256)²): round-off),
-/// NotConverged at the iteration limit or a failed line search (its last iterate still feasible),
-/// Cancelled or TimedOut when `context` asks (SolveContext::stopReason every iteration, polled
-/// inside the assembly too), and NotConverged (stopped_by_watch) where `watch` stops it. Every
-/// iteration (an accepted step, or a barrier update at the same iterate: step length 0) is
-/// reported to `context` (SolveContext::reportIteration: the request's iteration callback, and so
-/// an action's feedback); a refusal ends the solve Cancelled. FreeTimeOutcome::iterations counts
-/// the last run's (the raised one's after an elastic start failed); the solve's are the context's
-/// (SolveContext::IterationTally). `scale`: the objective's (FreeTimeScale), the start's own
-/// where unset.
-FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations,
-                              SolveContext& context, const BarrierWatch& watch = {},
-                              ElasticBarrier elastic_barrier = ElasticBarrier::Initial,
-                              StartBarrier start_barrier = StartBarrier::Initial,
-                              StartRaise start_raise = StartRaise::Bounded,
-                              const FreeTimeScale& scale = {});
-/// The same in a context of its own with default options (no budget, no callback): for tests and
-/// studies that run one free-time solve outside a request. Its iterations: every run's.
-FreeTimeOutcome solveFreeTime(const PlanningProblem& problem, const std::vector<Matrix3>& attitudes,
-                              double start_duration, double tolerance, int max_iterations);
+/// The free-time profile of the barrier problem over `np` (which its iterates move), the
+/// constraints `constraints` of `problem` in force: where its barrier begins (ElasticBarrier,
+/// StartBarrier) and the objective's scale (FreeTimeScale: the start's own where unset).
+std::unique_ptr<FreeTimeProblem> makeFreeTimeProblem(
+    const PlanningProblem& problem, ReducedProblem* np, const StageConstraints& constraints,
+    const InteriorPointParameters& parameters, ElasticBarrier elastic_barrier,
+    StartBarrier start_barrier, const FreeTimeScale& scale);
 
 }  // namespace attitude_planner

@@ -100,16 +100,12 @@ Matrix3 DiscreteScheme::momentumJacobianContraction(const StepJacobianTerms& ste
   const Vector3 a = F.transpose() * tau;
   const Vector3 q = J_ * a;
   const Matrix3& M = step.JJr_inverse;
-  // Products with a hat matrix in closed form: x^ y^ = y xᵀ − (x·y) I, and x^ M column by
-  // column as cross products; Mᵀ a^ = −(a^ M)ᵀ, a^ being antisymmetric.
-  const auto hat_hat = [](const Vector3& x, const Vector3& y) {
-    return Matrix3(y * x.transpose() - x.dot(y) * Matrix3::Identity());
-  };
-  Matrix3 AM;  // a^ M
-  for (int j = 0; j < 3; ++j) AM.col(j) = a.cross(M.col(j));
+  // Mᵀ a^ = −(a^ M)ᵀ (a^ is antisymmetric): one product, not two, and the same sums.
+  const Matrix3 A = hat<double>(a);
+  const Matrix3 AM = A * M;
   const Matrix3 B = -0.5 * hat<double>(q) + 2 * dc * w * (W * (W * q)).transpose() -
-                    c * hat_hat(q, w) - c * hat<double>(Vector3(q.cross(w)));
-  const Matrix3 K = hat_hat(a, step.Jw) - AM - AM.transpose() + Jr_inverse.transpose() * B;
+                    c * hat<double>(q) * W - c * hat<double>(Vector3(q.cross(w)));
+  const Matrix3 K = A * hat<double>(step.Jw) - AM - AM.transpose() + Jr_inverse.transpose() * B;
   return K.transpose() / h_;
 }
 

@@ -227,11 +227,11 @@ TEST(AttemptTags, QueuedBranchesRunEachWorkOnceWithoutWaitingForABatchAndJoinInT
   for (int i = 0; i < kWorks; ++i) EXPECT_EQ(context.attempts()[i].cost, i);
 }
 
-TEST(WorkerThreads, EachWorkRunsOnceWhetherTheThreadsPollOrSleep) {
-  // Bursts of works handed over at once, the bursts closer together than an idle thread polls
-  // (it takes the next unwoken) and farther apart (it has gone to sleep and must be woken): at
-  // any speed each work runs exactly once, on a thread or, taken back before any thread began
-  // it, on its caller, and what it wrote is visible to its caller after takeBackOrWait.
+TEST(WorkerThreads, EachWorkRunsOnceWhetherHandedOverInBurstsOrApart) {
+  // Bursts of works handed over at once, the bursts from 0 to 3 ms apart (a thread that ended
+  // its work may or may not be waiting again): at any speed each work runs exactly once, on a
+  // thread or, taken back before any thread began it, on its caller, and what it wrote is
+  // visible to its caller after takeBackOrWait.
   ap::WorkerThreads& threads = ap::WorkerThreads::shared();
   constexpr int kBurst = 3, kRounds = 15;
   for (const int pause_us : {0, 100, 300, 800, 3000}) {

@@ -5,8 +5,6 @@
 // for a thread to start.
 #pragma once
 
-#include <atomic>
-#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <list>
@@ -51,22 +49,12 @@ class WorkerThreads {
   WorkerThreads() = default;
   /// A worker thread's life: runs queued works, waits while none is queued.
   void serve();
-  /// Returns, `lock` held, once a work is queued: polling for kPollBeforeSleep first, then
-  /// asleep. A request hands works over in bursts a fraction of a millisecond apart; a thread
-  /// that polls takes the next at once, where a sleeping one waits for the scheduler to wake it.
-  void waitForWork(std::unique_lock<std::mutex>& lock);
-  /// How long an idle thread polls before it sleeps (a request's hand-overs come ~0.3 ms apart).
-  static constexpr std::chrono::microseconds kPollBeforeSleep{500};
 
   std::mutex mutex_;                ///< guards everything below and every work's state
   std::condition_variable queued_;  ///< a work was queued
   std::condition_variable ended_;   ///< a work ended
   std::list<HandedWork*> queue_;    ///< works handed over, not yet begun, oldest first
-  int waiting_ = 0;                 ///< threads waiting for a work, polling or asleep
-  int polling_ = 0;                 ///< of those, the ones polling (they need no wake-up)
-  /// queue_.size(), written under mutex_: a polling thread reads it without the lock, as a hint
-  /// to take the lock and look (every decision is made under the lock).
-  std::atomic<size_t> queued_hint_{0};
+  int waiting_ = 0;                 ///< threads waiting for a work
 };
 
 }  // namespace attitude_planner

@@ -99,12 +99,13 @@ Matrix3 DiscreteScheme::momentumJacobianContraction(const StepJacobianTerms& ste
   const Matrix3& Jr_inverse = step.Jr_inverse;
   const Vector3 a = F.transpose() * tau;
   const Vector3 q = J_ * a;
-  const Matrix3 A = hat<double>(a);
   const Matrix3& M = step.JJr_inverse;
+  // Mᵀ a^ = −(a^ M)ᵀ (a^ is antisymmetric): one product, not two, and the same sums.
+  const Matrix3 A = hat<double>(a);
+  const Matrix3 AM = A * M;
   const Matrix3 B = -0.5 * hat<double>(q) + 2 * dc * w * (W * (W * q)).transpose() -
                     c * hat<double>(q) * W - c * hat<double>(Vector3(q.cross(w)));
-  const Matrix3 K =
-      A * hat<double>(step.Jw) - A * M + M.transpose() * A + Jr_inverse.transpose() * B;
+  const Matrix3 K = A * hat<double>(step.Jw) - AM - AM.transpose() + Jr_inverse.transpose() * B;
   return K.transpose() / h_;
 }
 

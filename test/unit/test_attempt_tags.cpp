@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -18,6 +19,7 @@
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/solve_context.hpp"
+#include "planning/problem/worker_threads.hpp"
 #include "support/pointing_requests.hpp"
 #include "support/scene_problem.hpp"
 
@@ -223,6 +225,33 @@ TEST(AttemptTags, QueuedBranchesRunEachWorkOnceWithoutWaitingForABatchAndJoinInT
   EXPECT_EQ(context.iterations(), kWorks);
   ASSERT_EQ(context.attempts().size(), static_cast<std::size_t>(kWorks));
   for (int i = 0; i < kWorks; ++i) EXPECT_EQ(context.attempts()[i].cost, i);
+}
+
+TEST(WorkerThreads, EachWorkRunsOnceWhetherHandedOverInBurstsOrApart) {
+  // Bursts of works handed over at once, the bursts from 0 to 3 ms apart (a thread that ended
+  // its work may or may not be waiting again): at any speed each work runs exactly once, on a
+  // thread or, taken back before any thread began it, on its caller, and what it wrote is
+  // visible to its caller after takeBackOrWait.
+  ap::WorkerThreads& threads = ap::WorkerThreads::shared();
+  constexpr int kBurst = 3, kRounds = 15;
+  for (const int pause_us : {0, 100, 300, 800, 3000}) {
+    for (int round = 0; round < kRounds; ++round) {
+      std::vector<int> runs(kBurst, 0);  // each written by its own work only
+      std::vector<std::unique_ptr<ap::HandedWork>> works;
+      for (int i = 0; i < kBurst; ++i) {
+        works.push_back(std::make_unique<ap::HandedWork>([&runs, i] { ++runs[i]; }));
+      }
+      for (auto& work : works) threads.handOver(*work);
+      for (int i = 0; i < kBurst; ++i) {
+        if (!threads.takeBackOrWait(*works[i])) {
+          EXPECT_EQ(runs[i], 0) << "a work taken back had begun";
+          works[i]->runHere();
+        }
+        EXPECT_EQ(runs[i], 1) << "pause " << pause_us << " us, round " << round << ", work " << i;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(pause_us));
+    }
+  }
 }
 
 TEST(AttemptTags, ACallerRefusingAReportStopsEveryBranch) {

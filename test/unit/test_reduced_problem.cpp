@@ -195,6 +195,36 @@ TEST(ReducedProblem, HessianMatchesSecondDifferencesOfTheCost) {
   }
 }
 
+// evaluate() forms only the band's lower triangle, from the stencils' unsymmetrized curvature;
+// the same Hessian, to round-off, as the full symmetric blocks JᵀJ + second that forEachStencil
+// hands every other reader, summed densely here: all schemes, with and without effects (whose
+// curvature enters the middle block), on grids whose end stencils cut fixed nodes off.
+TEST(ReducedProblem, HessianIsTheSumOfTheStencilsSymmetricBlocks) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    for (bool effects : {false, true}) {
+      const ReducedProblem rp = perturbedProblem(scheme, 11, 4, effects);
+      const int n = rp.unknowns();
+      Eigen::VectorXd g;
+      double scale;
+      BandedSymmetricMatrix H(n, ReducedProblem::kHalfBandwidth);
+      rp.evaluate(&g, &H, &scale);
+      Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(n, n);
+      rp.forEachStencil(true, [&](const ReducedProblem::Stencil& st) {
+        const Eigen::Matrix<double, 9, 9> block = st.jacobian.transpose() * st.jacobian + st.second;
+        for (int s = 0; s < 3; ++s) {
+          for (int t = 0; t < 3; ++t) {
+            const int vs = rp.variableIndex(st.k - 1 + s), vt = rp.variableIndex(st.k - 1 + t);
+            if (vs >= 0 && vt >= 0) expected.block<3, 3>(vs, vt) += block.block<3, 3>(3 * s, 3 * t);
+          }
+        }
+      });
+      const double tolerance = 1e-13 * expected.cwiseAbs().maxCoeff();
+      EXPECT_LE((H.toDense() - expected).cwiseAbs().maxCoeff(), tolerance)
+          << schemeName(scheme) << " effects " << effects;
+    }
+  }
+}
+
 namespace {
 
 /// The Hessian of `rp` at its iterate and its gradient, shifted by the most negative eigenvalue

@@ -292,8 +292,9 @@ class GridSolver {
                             &workspace_) &&
              gradient_.dot(delta_) < 0;
     }
+    if (shift == 0.0) return hessian_.solvePositiveDefinite(&delta_, &context_);  // no copy
     BandedSymmetricMatrix shifted = hessian_;
-    if (shift > 0) shifted.addToDiagonal(shift * shift_scale);
+    shifted.addToDiagonal(shift * shift_scale);
     return shifted.solvePositiveDefinite(&delta_, &context_);
   }
 

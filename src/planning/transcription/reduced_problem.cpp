@@ -366,12 +366,19 @@ ReducedProblem::StepVectors ReducedProblem::retract(const Eigen::VectorXd& delta
 ReducedProblem::StepVectors ReducedProblem::movedSteps(
     const std::function<Vector3(int j)>& perturbation) const {
   StepVectors out = steps_;
+  // exp(δ_{j+1}^) of step j is exp(−δ_{j+1}^)'s conjugate in step j + 1: formed once (the
+  // quaternion of −v is that of v with its vector part negated, exactly).
+  Eigen::Vector4d moved_start =
+      so3::quaternionOfRotationVector<double>(perturbation(first_free_ - 1));
   for (int j = first_free_ - 1; j <= last_free_; ++j) {  // the steps next to a free attitude
+    const Eigen::Vector4d moved_end = so3::quaternionOfRotationVector<double>(perturbation(j + 1));
+    moved_start.tail<3>() = -moved_start.tail<3>();  // exp(−δ_j^)
     const Eigen::Vector4d q = so3::quaternionProduct<double>(
-        so3::quaternionProduct<double>(so3::quaternionOfRotationVector<double>(-perturbation(j)),
+        so3::quaternionProduct<double>(moved_start,
                                        so3::quaternionOfRotationVector<double>(steps_[j])),
-        so3::quaternionOfRotationVector<double>(perturbation(j + 1)));
+        moved_end);
     out[j] = so3::logOfQuaternion<double>(q);
+    moved_start = moved_end;
   }
   return out;
 }
@@ -381,8 +388,10 @@ namespace {
 /// Jacobian (3×9 over δ_{k−1}, δ_k, δ_{k+1}) of a μ_k + b G_{k−1} (either step may be absent), and
 /// with `w` the symmetric part of Σ_i w_i ∂(jacobian_i)/∂δ, by the chain rule through ε_{k−1},
 /// ε_k (StepTerms). Torques are a = f/h, b = −f/h; the node momentum Π_k is a = b = ½.
+/// Unless `symmetrize`, `second` is left as the sum S itself, whose symmetric part (S + Sᵀ)/2 is
+/// meant: for a reader of one triangle, which forms only that triangle's entries.
 void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, const StepTerms* next,
-                         double a, double b, const Vector3* w,
+                         double a, double b, const Vector3* w, bool symmetrize,
                          Eigen::Matrix<double, 3, 9>* jacobian,
                          Eigen::Matrix<double, 9, 9>* second) {
   jacobian->setZero();
@@ -395,7 +404,8 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
     jacobian->block<3, 3>(0, 6) = a * next->D;
   }
   if (!w) return;
-  Eigen::Matrix<double, 9, 9> raw = Eigen::Matrix<double, 9, 9>::Zero();
+  Eigen::Matrix<double, 9, 9>& raw = *second;
+  raw.setZero();
   if (prev) {
     const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
     const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}
@@ -416,7 +426,26 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
   }
   // The antisymmetric part is cancelled exactly by the retraction's derivative
   // (dJr(δ)/dδ = −½(·)^ contracted with the gradient): the symmetric part is exact.
-  *second = 0.5 * (raw + raw.transpose());
+  if (!symmetrize) return;
+  for (int c = 0; c < 9; ++c) {
+    for (int r = c + 1; r < 9; ++r) raw(r, c) = raw(c, r) = 0.5 * (raw(r, c) + raw(c, r));
+  }
+}
+
+/// The stencil's block JᵀJ + (S + Sᵀ)/2 of the Hessian (S = `second` as visitStencils leaves it
+/// unsymmetrized), its lower triangle only: the band stores one triangle, so the other's 36
+/// entries are not formed. All 9 × 9 (fixed bounds, unrolled); the caller cuts off fixed nodes.
+Eigen::Matrix<double, 9, 9> lowerHessianBlock(const ReducedProblem::Stencil& st) {
+  const Eigen::Matrix<double, 3, 9>& J = st.jacobian;
+  const Eigen::Matrix<double, 9, 9>& S = st.second;
+  Eigen::Matrix<double, 9, 9> block;  // the strict upper triangle is left unset
+  for (int c = 0; c < 9; ++c) {
+    for (int r = c; r < 9; ++r) {
+      block(r, c) =
+          J(0, r) * J(0, c) + J(1, r) * J(1, c) + J(2, r) * J(2, c) + 0.5 * (S(r, c) + S(c, r));
+    }
+  }
+  return block;
 }
 
 }  // namespace
@@ -424,6 +453,12 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
 double ReducedProblem::forEachStencil(bool with_second_order,
                                       const std::function<void(const Stencil&)>& visit,
                                       const SecondOrderWeights& weights) const {
+  return visitStencils(with_second_order, true, visit, weights);
+}
+
+double ReducedProblem::visitStencils(bool with_second_order, bool symmetric_second,
+                                     const std::function<void(const Stencil&)>& visit,
+                                     const SecondOrderWeights& weights) const {
   const double h = scheme_.timeStep();
   double cost = 0.0;
   Stencil st;
@@ -456,7 +491,7 @@ double ReducedProblem::forEachStencil(bool with_second_order,
     st.tau = root * torqueOfStencil(k, prev, next, R_k);
     const Vector3 w = with_second_order && weights ? weights(k, st.tau) : st.tau;
     momentumCombination(scheme_, prev, next, factor, -factor, with_second_order ? &w : nullptr,
-                        &st.jacobian, &st.second);
+                        symmetric_second, &st.jacobian, &st.second);
     // τ_k −= τ_e(R_k, t_k): only R_k's block depends on the effects (fixed at the end nodes).
     const bool interior = prev && next;
     if (effects_ && interior)
@@ -491,8 +526,8 @@ void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMome
     node.k = k;
     node.momentum = 0.5 * (next.mu + prev.G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
     const Vector3 w = weights ? weights(k, node.momentum) : Vector3::Zero().eval();
-    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, &node.jacobian,
-                        &node.second);
+    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, true,
+                        &node.jacobian, &node.second);
     visit(node);
     prev = next;
   }
@@ -503,7 +538,9 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
   gradient->setZero(unknowns());
   if (hessian) hessian->setZero();
   double jacobian_scale = 0.0, torque_scale = 0.0;
-  const double cost = forEachStencil(hessian != nullptr, [&](const Stencil& st) {
+  // lowerHessianBlock symmetrizes `second` in the lower triangle it forms
+  const bool symmetric_second = false;
+  const auto add_stencil = [&](const Stencil& st) {
     jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
     torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
     const Eigen::Matrix<double, 9, 1> g = st.jacobian.transpose() * st.tau;
@@ -512,15 +549,13 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
       if (v >= 0) gradient->segment<3>(v) += g.segment<3>(3 * s);
     }
     if (!hessian) return;
-    const Eigen::Matrix<double, 9, 9> block =
-        st.jacobian.transpose().lazyProduct(st.jacobian) + st.second;
     // The stencil's unknowns R_{k−1}, R_k, R_{k+1} are consecutive (R_{k−1}'s would be at
     // 3(k − 1 − first free node)); the fixed ones among them are cut off the block.
-    const int first_slot = std::max(0, first_free_ - (st.k - 1));
-    const int last_slot = std::min(2, last_free_ - (st.k - 1));
-    hessian->addSymmetricBlock<9>(3 * (st.k - 1 - first_free_), block, 3 * first_slot,
-                                  3 * (last_slot + 1));
-  });
+    const int first = 3 * std::max(0, first_free_ - (st.k - 1));
+    const int last = 3 * (std::min(2, last_free_ - (st.k - 1)) + 1);
+    hessian->addSymmetricBlock<9>(3 * (st.k - 1 - first_free_), lowerHessianBlock(st), first, last);
+  };
+  const double cost = visitStencils(hessian != nullptr, symmetric_second, add_stencil, nullptr);
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;
 }

@@ -218,6 +218,11 @@ class ReducedProblem {
   }
 
  private:
+  /// forEachStencil's loop; unless `symmetric_second`, `second` is left as the sum S whose
+  /// symmetric part (S + Sᵀ)/2 forEachStencil gives, for a reader that forms one triangle.
+  double visitStencils(bool with_second_order, bool symmetric_second,
+                       const std::function<void(const Stencil&)>& visit,
+                       const SecondOrderWeights& weights) const;
   /// The free steps' composition R_firstᵀR_{last+1} (what they must compose to), in quaternions.
   Eigen::Vector4d freeStepsComposition() const;
   /// Closes the gap between the free steps' composition and `target` smoothly (see

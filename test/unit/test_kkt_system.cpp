@@ -320,24 +320,31 @@ namespace {
 class LineProblem final : public ap::BarrierProblem {
  public:
   LineProblem(std::function<double(double)> phi, double wall, double corrected = 0.0)
-      : phi_(std::move(phi)), wall_(wall), corrected_(corrected) {}
+      : phi_(std::move(phi)), wall_(wall), corrected_([corrected](double) { return corrected; }) {}
+  /// A wall a trial point lies past as a feasible method's iterate does (moved there, φ = +∞),
+  /// with the correction `corrected(trial step)` offered there (none where it is 0).
+  LineProblem(std::function<double(double)> phi, double wall,
+              std::function<double(double)> corrected)
+      : phi_(std::move(phi)), wall_(wall), corrected_(std::move(corrected)), moves_past_(true) {}
   double merit() override { return phi_(accepted_); }
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override {
     ++trials;
     if (moved) *moved = false;
-    if (accepted_ + alpha * d(0) >= wall_) return std::numeric_limits<double>::infinity();
+    const bool past = accepted_ + alpha * d(0) >= wall_;
+    if (past && !moves_past_) return std::numeric_limits<double>::infinity();
     moveTo(d, alpha);
     if (moved) *moved = true;
-    return phi_(x);
+    return past ? std::numeric_limits<double>::infinity() : phi_(x);
   }
   void moveTo(const Eigen::VectorXd& d, double alpha) override { x = accepted_ + alpha * d(0); }
   void restore() override {
     ++restores;
     x = accepted_;
   }
-  bool correctedStep(const Eigen::VectorXd&, Eigen::VectorXd* corrected) override {
-    if (corrected_ == 0.0) return false;
-    *corrected = Eigen::VectorXd::Constant(1, corrected_);
+  bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override {
+    const double step = corrected_(d(0));
+    if (step == 0.0) return false;
+    *corrected = Eigen::VectorXd::Constant(1, step);
     return true;
   }
   void clearCorrection() override { ++clears; }
@@ -346,7 +353,9 @@ class LineProblem final : public ap::BarrierProblem {
 
  private:
   std::function<double(double)> phi_;
-  double wall_, corrected_;
+  double wall_;
+  std::function<double(double)> corrected_;
+  bool moves_past_ = false;
   double accepted_ = 0.0;
 };
 
@@ -451,6 +460,37 @@ TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeP
   EXPECT_EQ(r.alpha, firstArmijoStep(phi, 4.5, slope, 1.0, p.fixed_step.max_halvings, 100.0));
   EXPECT_EQ(d(0), 4.5);
   EXPECT_EQ(fixed.clears, 0);
+}
+
+TEST(LineSearch, InTheEndGameEveryTrialLengthTheBoundaryRejectsIsRetriedWithItsCorrection) {
+  const ap::InteriorPointParameters p;
+  const ap::ArmijoBacktracking search(ap::freeTimeLineSearch(p));
+  // φ = −x falls along d = 16 up to a wall at 1 that a trial passes as a feasible method's does
+  // (moved there, φ = +∞). The correction pulls a trial back to 0.9 of the wall where the trial
+  // step is at most 4 (a curvature the linear model misses only that far out), else none.
+  const auto phi = [](double x) { return -x; };
+  const auto pulled_back = [](double step) { return step <= 4.0 ? 0.9 : 0.0; };
+  const double slope = -16.0;
+  LineProblem late(phi, 1.0, pulled_back);
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 16.0);
+  ap::LineSearchResult r = search.search(late, {slope, 1.0, false, false, true}, &d);
+  ASSERT_TRUE(r.accepted);
+  EXPECT_EQ(r.alpha, 1.0);  // the corrected step, taken whole
+  EXPECT_EQ(d(0), 0.9);
+  EXPECT_EQ(late.x, 0.9);
+  EXPECT_EQ(late.trials, 4);  // α = 1 and 1/2 (no correction there), 1/4 and its correction
+  EXPECT_EQ(late.clears, 2);
+  // Not in the end game: plain halvings to the first length inside the wall, 1/32 (x = 0.5).
+  LineProblem early(phi, 1.0, pulled_back);
+  d(0) = 16.0;
+  r = search.search(early, {slope, 1.0, false, false, false}, &d);
+  ASSERT_TRUE(r.accepted);
+  EXPECT_EQ(r.alpha, firstArmijoStep(phi, 16.0, slope, 1.0, p.free_time.max_halvings, 1.0));
+  EXPECT_EQ(r.alpha, 1.0 / 32);
+  EXPECT_EQ(d(0), 16.0);
+  EXPECT_EQ(early.trials, 6);
+  EXPECT_EQ(early.clears, 0);
+  EXPECT_LT(phi(late.x), phi(early.x));  // the corrected search went further in fewer trials
 }
 
 namespace {

@@ -220,10 +220,12 @@ struct InteriorPointParameters {
   int damping_cut_steps = 2;
   /// ... once the barrier μ is at most this × its start μ₀ (the end game: where the basin is
   /// chosen, at the first barrier levels, damped steps took paper on min_time_keep_out.yaml
-  /// N = 32 to a higher KKT point, 29.7404 s instead of 29.7113 s). In the end game too a
-  /// rejected full step is retried with its second-order correction (free_time_solver.cpp
-  /// correctedStep): there the torque bounds' curvature, not the basin, cuts the steps.
-  /// Measured (plan_maneuver, free-time iterations of all starts): 0.96 N m about body x
+  /// N = 32 to a higher KKT point, 29.7404 s instead of 29.7113 s). In the end game too each
+  /// rejected trial step, the full one and every halving, is retried with its second-order
+  /// correction (line_search.cpp correctedTrial, free_time_solver.cpp correctedStep): there the
+  /// torque bounds' curvature, not the basin, cuts the steps (every halving too, not the full
+  /// step alone: docs/results/minimum_time_step.md). Measured with the full step alone:
+  /// plan_maneuver, free-time iterations of all starts: 0.96 N m about body x
   /// against |u_x| ≤ 1, N = 64: 1188 → 520, N = 128: a KKT point in 867 (before: the iteration
   /// limit, the search's answer); 0.99 N m, N = 64: a KKT point in 673 (before: the search). At
   /// every μ the correction changed the basin: paper around the keep-out cone took 310 → 529

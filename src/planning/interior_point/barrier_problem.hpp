@@ -39,7 +39,8 @@ class BarrierProblem {
   virtual void moveTo(const Eigen::VectorXd& d, double alpha) = 0;
   /// Back to the accepted iterate after a search that accepted no step.
   virtual void restore() = 0;
-  /// The second-order correction of the full step d, the iterate at x + d: the same Newton system
+  /// The second-order correction of a trial step d (the full step or a shorter one, α d), the
+  /// iterate at x + d: the same Newton system
   /// solved with the constraints' curvature along d (r = c(x + d) − c − gᵀd) in their linear
   /// model, with the step's factor. False where the problem has none or no r is nonzero.
   virtual bool correctedStep(const Eigen::VectorXd& /*d*/, Eigen::VectorXd* /*corrected*/) {

@@ -21,8 +21,8 @@
 // over x = (δ, η): a band (the node unknowns) bordered by one column (η), solved by the Schur
 // complement (linalg/bordered_band.hpp). Inertia: the band must be positive definite and the
 // Schur complement positive (else a growing shift, as IPOPT's δ_w); line search Armijo on
-// φ_μ = f − μ Σ ln cᵢ with the fraction to the boundary on c and z (in the end game a rejected
-// full step is first retried with IPOPT's second-order correction); barrier μ decreased
+// φ_μ = f − μ Σ ln cᵢ with the fraction to the boundary on c and z (in the end game each rejected
+// trial step is first retried with IPOPT's second-order correction); barrier μ decreased
 // monotonically (IPOPT's κ_μ, θ_μ) once the barrier problem's residual is ≤ κ_ε μ. Those
 // constants are InteriorPointParameters' (one value per idea with the fixed-h interior point).
 //
@@ -370,7 +370,7 @@ void FreeTimeSolver::restore() {
   np_.setCurrent(accepted_.steps);
 }
 
-/// The second-order correction of a rejected full step d (IPOPT's, Wächter & Biegler 2006 §2.4,
+/// The second-order correction of a rejected trial step d (IPOPT's, Wächter & Biegler 2006 §2.4,
 /// for this feasible barrier method): at x + d (the iterate on entry) each constraint misses its
 /// linear model by r = c(x + d) − c − gᵀd, its curvature along d. Where minimum time is flat
 /// along an arc the Newton step is long in the arc's directions, and the torque bounds active
@@ -507,7 +507,7 @@ Pass FreeTimeSolver::atSolvedBarrier() {
 }
 
 /// The step found by the inertia correction, and the search from the accepted iterate: in the
-/// end game a rejected full step is first retried with its second-order correction.
+/// end game each rejected trial step is first retried with its second-order correction.
 Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::VectorXd** d,
                                DirectionMeasures*) {
   accepted_ = {np_.timeStep(), mu_, epsilon_, np_.current()};

@@ -35,16 +35,15 @@ LineSearchResult ArmijoBacktracking::search(BarrierProblem& problem,
     result.accepted = true;
     return result;
   }
-  if (profile_.second_order_correction && request.late) {
-    if (correctedFullStep(problem, phi, request.slope, d)) {
-      result.alpha = 1.0;
-      result.accepted = true;
-      return result;
+  const bool correct = profile_.second_order_correction && request.late;
+  // The corrected full step is one trial more than the halvings.
+  const int trials = (request.at_floor ? profile_.floor_halvings : profile_.max_halvings) + correct;
+  for (int i = 0; i < trials; ++i, result.alpha *= 0.5) {
+    if (correct) {
+      result.accepted = correctedTrial(problem, phi, request.slope, &result.alpha, d);
+      if (result.accepted) return result;
+      continue;
     }
-    result.alpha = 0.5;  // the full step was just tried
-  }
-  const int halvings = request.at_floor ? profile_.floor_halvings : profile_.max_halvings;
-  for (int i = 0; i < halvings; ++i, result.alpha *= 0.5) {
     const double trial = problem.trialMerit(*d, result.alpha, nullptr);
     if (std::isfinite(trial) && trial <= phi + profile_.armijo * result.alpha * request.slope) {
       result.accepted = true;
@@ -55,17 +54,19 @@ LineSearchResult ArmijoBacktracking::search(BarrierProblem& problem,
   return result;
 }
 
-/// The full step, then (the iterate at x + d) its second-order correction, which replaces *d when
-/// it is accepted. Where neither is, the correction's terms are cleared.
-bool ArmijoBacktracking::correctedFullStep(BarrierProblem& problem, double phi, double slope,
-                                           Eigen::VectorXd* d) const {
-  const double threshold = phi + profile_.armijo * slope;
+/// The trial x + α d, then (the iterate there) its second-order correction α d + v, which
+/// replaces *d, taken whole (*alpha = 1), when it is accepted: both are held to the Armijo
+/// condition at α. Where neither is, the correction's terms are cleared.
+bool ArmijoBacktracking::correctedTrial(BarrierProblem& problem, double phi, double slope,
+                                        double* alpha, Eigen::VectorXd* d) const {
+  const double threshold = phi + profile_.armijo * *alpha * slope;
   bool moved = false;
-  if (problem.trialMerit(*d, 1.0, &moved) <= threshold) return true;
+  if (problem.trialMerit(*d, *alpha, &moved) <= threshold) return true;
   Eigen::VectorXd corrected;
-  if (moved && problem.correctedStep(*d, &corrected) &&
+  if (moved && problem.correctedStep(*alpha * *d, &corrected) &&
       problem.trialMerit(corrected, 1.0, nullptr) <= threshold) {
     *d = corrected;
+    *alpha = 1.0;
     return true;
   }
   problem.clearCorrection();

@@ -18,8 +18,11 @@ struct LineSearchProfile {
   /// A step whose predicted decrease is round-off is taken outright (fixed h: no step length can
   /// be told from another there); else it is searched and only flagged (free time).
   bool take_round_off_step = true;
-  /// In the end game (LineSearchRequest::late) a rejected full step is retried once with its
-  /// second-order correction before halving (BarrierProblem::correctedStep).
+  /// In the end game (LineSearchRequest::late) every rejected trial step α d, the full one and
+  /// each halving, is retried once with its second-order correction before the next halving
+  /// (BarrierProblem::correctedStep). The boundary, not the merit, cuts the steps of a feasible
+  /// method there: a constraint's curvature along d carries the trial outside while its linear
+  /// model still grows, at whatever α the halving has reached.
   bool second_order_correction = false;
 };
 /// Fixed h: armijo, the fixed-step profile's halvings; round-off steps taken; no correction.
@@ -52,8 +55,9 @@ class ArmijoBacktracking {
                           Eigen::VectorXd* d) const;
 
  private:
-  bool correctedFullStep(BarrierProblem& problem, double phi, double slope,
-                         Eigen::VectorXd* d) const;
+  /// Whether the trial α d, else its second-order correction, meets the Armijo condition at α.
+  bool correctedTrial(BarrierProblem& problem, double phi, double slope, double* alpha,
+                      Eigen::VectorXd* d) const;
   LineSearchProfile profile_;
 };
 

@@ -418,13 +418,13 @@ TEST(FreeTime, AnIterateStrictlyInsideItsBoundsIsAPlanAtItsOwnT) {
   EXPECT_GT(checked, 0) << "no iteration limit left a strictly feasible iterate";
 }
 
-TEST(FreeTime, TheIteratesThatArePlansAreKeptLowestFirstAndNoOtherIterate) {
+TEST(FreeTime, TheLowestIterateThatIsAPlanIsKeptAndNoOtherIterate) {
   // What the minimum-time driver answers at most with spinning ends: the lowest iterate offered
-  // that is a plan at its own T; the probes run again from each such iterate. Iterates of one
-  // solve stopped at growing iteration limits (each strictly inside every bound) are offered in
-  // turn: the lowest is the least T among them, and stays so when they are offered again; each T
-  // is kept once, lowest first; an iterate whose torque leaves its bound, offered below it, is
-  // refused (not a plan); and nothing is kept below a T the kept one does not lie strictly under.
+  // that is a plan at its own T. Iterates of one solve stopped at growing iteration limits (each
+  // strictly inside every bound) are offered in turn: the one kept is the least T among them, and
+  // stays kept when they are offered again; an iterate whose torque leaves its bound, offered
+  // below it, is refused (not a plan); and nothing is kept below a T the kept one does not lie
+  // strictly under.
   ap::PlanningProblem p = spinningRequest(64);
   p.duration = 3.5;
   const ap::ReducedProblem geodesic(p);
@@ -432,7 +432,6 @@ TEST(FreeTime, TheIteratesThatArePlansAreKeptLowestFirstAndNoOtherIterate) {
   double least = std::numeric_limits<double>::infinity();
   std::size_t least_limit = 0;
   std::vector<ap::Maneuver> offered;
-  std::vector<double> offered_T;
   for (const int limit : {5, 10, 20, 40}) {
     const ap::FreeTimeOutcome o =
         ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), 3.5, 1e-9, limit);
@@ -441,7 +440,6 @@ TEST(FreeTime, TheIteratesThatArePlansAreKeptLowestFirstAndNoOtherIterate) {
     if (o.duration < least) least_limit = static_cast<std::size_t>(limit);
     least = std::min(least, o.duration);
     offered.push_back(o.maneuver);
-    offered_T.push_back(o.duration);
   }
   ASSERT_TRUE(std::isfinite(least)) << "no iteration limit left a strictly feasible iterate";
   const ap::LowestIterate::Plan* kept = lowest.below(std::numeric_limits<double>::infinity());
@@ -466,19 +464,6 @@ TEST(FreeTime, TheIteratesThatArePlansAreKeptLowestFirstAndNoOtherIterate) {
   ASSERT_NE(kept, nullptr);
   EXPECT_EQ(kept->effort.duration, least);
   EXPECT_EQ(kept->attempt, least_limit);
-  // Every offered T once (each of these iterates is a plan: provesFeasible above), lowest first.
-  std::sort(offered_T.begin(), offered_T.end());
-  offered_T.erase(std::unique(offered_T.begin(), offered_T.end()), offered_T.end());
-  const std::vector<ap::LowestIterate::Plan> all =
-      lowest.allBelow(std::numeric_limits<double>::infinity());
-  ASSERT_GE(offered_T.size(), 2u);  // more than the lowest to keep
-  ASSERT_EQ(all.size(), offered_T.size());
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    EXPECT_EQ(all[i].effort.duration, offered_T[i]) << i;
-    EXPECT_TRUE(
-        std::get<ap::verdicts::FeasibleAtMinimumTime>(all[i].plan.verdict).free_time_iterate);
-  }
-  EXPECT_TRUE(lowest.allBelow(least).empty());
 }
 
 namespace {

@@ -1,12 +1,11 @@
 // The free-time iterates the probes below a spinning minimum-time T* meet
 // (drivers/minimum_time.cpp): where a free-time solve stops short of its KKT point strictly inside
-// every bound, its last iterate is a plan at its own T. The driver keeps every such plan: T* is
-// never answered above the lowest, and the probes may run again from each.
+// every bound, its last iterate is a plan at its own T. The driver keeps the lowest such plan, so
+// T* is never answered above it.
 #pragma once
 
 #include <cstddef>
 #include <optional>
-#include <vector>
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
@@ -31,9 +30,8 @@ PlanningProblem effortAt(const PlanningProblem& problem, double duration);
 /// step by step, the ends and every bound); else empty.
 std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Maneuver& iterate);
 
-/// The iterates offered that are plans at their own T (iterateAsPlan), each T once: the lowest
-/// is an upper bound on T* whether or not a probe took it, and each is a start the probes below
-/// T* may run from again.
+/// The lowest of the iterates offered that is a plan at its own T (iterateAsPlan): an upper
+/// bound on T* whether or not a probe took it.
 class LowestIterate {
  public:
   struct Plan {
@@ -42,18 +40,16 @@ class LowestIterate {
     std::size_t attempt = 0;  ///< its free-time solve in the trail
   };
 
-  /// Keeps `iterate` (problem: the minimum-time request) if it is a plan at its T, unless one at
-  /// the same T is kept; an iterate not shown a plan is dropped.
+  /// Keeps `iterate` (problem: the minimum-time request) if it lies below the lowest kept and is
+  /// a plan at its T; an iterate not shown a plan is dropped.
   void offer(const PlanningProblem& problem, const std::optional<IterateBelow>& iterate);
   /// The lowest plan kept if it lies strictly below `duration`, else null.
   const Plan* below(double duration) const {
-    return !plans_.empty() && plans_.front().effort.duration < duration ? &plans_.front() : nullptr;
+    return lowest_ && lowest_->effort.duration < duration ? &*lowest_ : nullptr;
   }
-  /// Every plan kept strictly below `duration`, lowest first.
-  std::vector<Plan> allBelow(double duration) const;
 
  private:
-  std::vector<Plan> plans_;  ///< ascending in T
+  std::optional<Plan> lowest_;
 };
 
 }  // namespace attitude_planner

@@ -318,24 +318,10 @@ std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Man
 
 void LowestIterate::offer(const PlanningProblem& problem,
                           const std::optional<IterateBelow>& iterate) {
-  if (!iterate) return;
-  const double T = iterate->duration();
-  const auto at = std::lower_bound(plans_.begin(), plans_.end(), T, [](const Plan& kept, double d) {
-    return kept.effort.duration < d;
-  });
-  if (at != plans_.end() && at->effort.duration == T) return;  // this T is kept
-  const PlanningProblem effort = effortAt(problem, T);
+  if (!iterate || (lowest_ && !(iterate->duration() < lowest_->effort.duration))) return;
+  const PlanningProblem effort = effortAt(problem, iterate->duration());
   std::optional<PlanResult> plan = iterateAsPlan(effort, iterate->plan);
-  if (plan) plans_.insert(at, Plan{effort, std::move(*plan), iterate->attempt});
-}
-
-std::vector<LowestIterate::Plan> LowestIterate::allBelow(double duration) const {
-  std::vector<Plan> below;
-  for (const Plan& kept : plans_) {
-    if (!(kept.effort.duration < duration)) break;
-    below.push_back(kept);
-  }
-  return below;
+  if (plan) lowest_ = Plan{effort, std::move(*plan), iterate->attempt};
 }
 
 namespace {
@@ -400,13 +386,11 @@ PlanResult atMostLowestIterate(PlanResult answer, const LowestIterate& iterates,
 /// (the context's from `first`, where `answer`'s began).
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
                        SolveContext& context, LowestIterate& iterates,
-                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans,
-                       int* solves_left = nullptr) {
+                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
-    if (solves_left && (*solves_left)-- <= 0) break;
     PlanningProblem effort =
         effortAt(problem, std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor));
     SolveRequest options(context.options());
@@ -445,68 +429,27 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
   return answer;
 }
 
-/// The probes below T* again from `from`, an iterate that is a plan below `answer`'s T: that
-/// iterate is the answer, the free-time solve goes on from it, and the probes (probedBelow,
-/// iterates as plans) follow, within `*solves_left` solves where that is given.
-PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& answer,
-                             const LowestIterate::Plan& from, std::size_t first,
-                             SolveContext& context, LowestIterate& iterates, int* solves_left) {
-  std::optional<IterateBelow> lower_plan;
-  PlanResult run = lowerAnswer(problem, from.effort, answer, from.plan, from.attempt, first,
-                               context, &lower_plan, iterates);
-  return probedBelow(problem, std::move(run), first, context, iterates, std::move(lower_plan), true,
-                     solves_left);
-}
-
-/// The probes below T* once more from each other iterate that was a plan below `answer`'s T when
-/// the first probes ended, lowest first (probedFromIterate), within kMaxProbes solves in all
-/// (each probe and each probe from an iterate one); `best` (its kept attempt `best_kept`) is the
-/// least answer so far and stays the answer unless a run ends lower. Measured on the seed-45
-/// spinning suite's #221: the reverted rule of a9af3a3 reached 40.65 s by the probes from the
-/// iterate of the solve from the search's plan (71.13 s), which lies above the lowest iterate.
-PlanResult probedFromOtherIterates(const PlanningProblem& problem, const PlanResult& answer,
-                                   const std::vector<LowestIterate::Plan>& others, PlanResult best,
-                                   std::size_t first, SolveContext& context,
-                                   LowestIterate& iterates) {
-  std::optional<std::size_t> best_kept = context.keptAttempt();
-  int solves_left = kMaxProbes;
-  for (const LowestIterate::Plan& from : others) {
-    if (solves_left <= 0 || context.stopReason()) break;
-    --solves_left;  // the free-time solve from it
-    PlanResult run =
-        probedFromIterate(problem, answer, from, first, context, iterates, &solves_left);
-    if (run.converged() && run.minimum_duration < best.minimum_duration) {
-      best = std::move(run);
-      best_kept = context.keptAttempt();
-    }
-  }
-  context.restoreKept(best_kept);
-  best.attempts = context.attemptsFrom(first);
-  return best;
-}
-
-/// The probes below T* again from the iterates that are plans below `answer`'s T (else `answer`):
-/// from the lowest (probedFromIterate), then from the others (probedFromOtherIterates); the answer
-/// is then at most the lowest iterate any solve ended at. So T* is at most the T of every iterate
-/// that is a plan, never above `answer`'s (the probes before it are untouched) and never above
-/// the run from the lowest alone. Measured on the seed-45 spinning suite: iterates as plans during
-/// the first probes (hand-ons from the search's plan) moved #77 from its 5.18 s basin to a
-/// second-order sufficient KKT point at 6.54 s, below which the far probes are not asked; run
-/// after them, as here, #77 keeps 5.18 s, #221 (N = 405) goes from a probe's plan at 72.62 s to
-/// 51.66 s from the lowest, and #47 of the held-out seed-47 suite from 25.19 s to 21.48 s.
+/// The probes below T* again from the lowest iterate that is a plan, where it lies below
+/// `answer`'s T (else `answer`): that iterate is the answer, the free-time solve goes on from it,
+/// and the probes (probedBelow, iterates as plans) follow; the answer is then at most the lowest
+/// iterate any solve ended at. So T* is at most the T of every iterate that is a plan, and never
+/// above `answer`'s (the probes before it are untouched). Measured on the seed-45 spinning suite:
+/// iterates as plans during the first probes (hand-ons from the search's plan) moved #77 from its
+/// 5.18 s basin to a second-order sufficient KKT point at 6.54 s, below which the far probes are
+/// not asked; run after them, as here, #77 keeps 5.18 s, #221 (N = 405) goes from a probe's plan at
+/// 72.62 s to 51.66 s, and #47 of the held-out seed-47 suite from 25.19 s to 21.48 s.
 PlanResult probedBelowLowestIterate(const PlanningProblem& problem, PlanResult answer,
                                     std::size_t first, SolveContext& context,
                                     LowestIterate& iterates) {
-  if (!answer.converged() || context.stopReason()) return answer;
-  const std::vector<LowestIterate::Plan> below = iterates.allBelow(answer.minimum_duration);
-  if (below.empty()) return answer;
-  PlanResult best =
-      probedFromIterate(problem, answer, below.front(), first, context, iterates, nullptr);
-  best = atMostLowestIterate(std::move(best), iterates, first, context);
-  const std::vector<LowestIterate::Plan> others(below.begin() + 1, below.end());
-  best =
-      probedFromOtherIterates(problem, answer, others, std::move(best), first, context, iterates);
-  return atMostLowestIterate(std::move(best), iterates, first, context);
+  const LowestIterate::Plan* found = iterates.below(answer.minimum_duration);
+  if (!found || !answer.converged() || context.stopReason()) return answer;
+  const LowestIterate::Plan lowest = *found;  // the solve from it offers lower ones
+  std::optional<IterateBelow> lower_plan;
+  answer = lowerAnswer(problem, lowest.effort, answer, lowest.plan, lowest.attempt, first, context,
+                       &lower_plan, iterates);
+  answer = probedBelow(problem, std::move(answer), first, context, iterates, std::move(lower_plan),
+                       true);
+  return atMostLowestIterate(std::move(answer), iterates, first, context);
 }
 
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,

@@ -507,6 +507,37 @@ TEST(BoundedVerdicts, SpinningMinimumTimeWithoutAConvergedStartSearchesDurations
   expectACheckedPlanAtOrAboveTheFloor(45, 206);
 }
 
+TEST(BoundedVerdicts, AStartThatJoinedAnotherStartsPathIsSolvedAgainFromItsViolations) {
+  // Spinning ends: every start on the starts' grid is solved a second time with its elastic
+  // phase from its own violations, a different solve. A start whose first solve was stopped on an
+  // earlier start's central path (a join) is a start of its own there too. A request of the seeded
+  // suite where a start joins (its coasting start, on the shared objective scale), and its second
+  // solve is the one that reaches the lower basin: every first solve on that grid has its second,
+  // and the answer lies in that basin (0.653 s; the joined start skipped: 0.6661 s).
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 45);
+  ASSERT_TRUE(request.has_value());
+  ASSERT_TRUE(hasSpinningEnds(request->problem));
+  SCOPED_TRACE(request->label);
+  const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+  ASSERT_TRUE(check.result.converged()) << check.result.message();
+  EXPECT_EQ(check.wrong, "") << check.result.message();
+  const std::vector<Attempt>& trail = check.result.attempts;
+  ASSERT_FALSE(trail.empty());
+  const int starts_grid = trail.front().steps;
+  int first_solves = 0, second_solves = 0;
+  for (const Attempt& a : trail) {
+    if (a.stage != AttemptStage::MinimumTimeSolve || a.steps != starts_grid) continue;
+    if (a.start_detail.elastic_from_violations) {
+      ++second_solves;
+    } else if (second_solves == 0) {  // the first round, before any second solve
+      ++first_solves;
+    }
+  }
+  EXPECT_GE(first_solves, 5);
+  EXPECT_EQ(second_solves, first_solves);
+  EXPECT_LT(check.result.minimum_duration, 0.66);
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at

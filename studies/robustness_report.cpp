@@ -233,7 +233,8 @@ void writeHostileScenes(std::ostream& out, const std::string& dir_path) {
          "`test_hostile_inputs`, which also checks that the message contains the file's "
          "`# expect:` text). Command-line flags with bad values (`--tolerance -1e-3`, "
          "`--time-budget -5`, `--extra-revolutions -1`, `--direction sideways`, `--tolerance "
-         "nan`) keep the documented usage-error status 2 and name the value.\n\n"
+         "nan`) exit with status 1 as invalid input naming the flag and the value; 2 is kept for "
+         "a malformed command line (an unknown option, a missing value).\n\n"
       << "| file | what is wrong | message |\n|---|---|---|\n";
   for (const fs::path& f : files) {
     std::string message = "(accepted!)";

@@ -19,10 +19,14 @@
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
+#include "command_line.hpp"
 
 namespace ap = attitude_planner;
 
 namespace {
+
+using ap::tools::InvalidFlagValue;
+using ap::tools::UsageError;
 
 const char* const kUsage =
     "usage: plan_maneuver SCENE.yaml [options]\n"
@@ -90,17 +94,6 @@ const char* const kUsage =
     "\n"
     "exit status: 0 converged, 1 not converged or invalid input (a bad scene or a bad flag\n"
     "value), 2 usage error (unknown option, missing value or scene file)\n";
-
-/// A malformed command line (unknown option, missing value or scene): the usage text, exit 2.
-struct UsageError {
-  std::string message;
-};
-
-/// A flag whose value is invalid (not a number, NaN, out of range, unknown name): bad input like
-/// a bad scene value, exit status 1, the message names the flag and the value.
-struct InvalidFlagValue {
-  std::string message;
-};
 
 /// "p1,p2,p3" → the three finite numbers.
 ap::Vector3 parseCostate(const std::string& text) {
@@ -242,80 +235,58 @@ int runDriftTwoInput(const Arguments& args, const ap::Scene& scene) {
   return 0;
 }
 
+/// Plans the scene of `args` and writes what they ask for; the exit status.
+int run(const Arguments& args) {
+  ap::Scene scene = ap::loadScene(args.scene);
+  if (scene.system == ap::SystemKind::DriftTwoInput) return runDriftTwoInput(args, scene);
+  if (!args.initial_costate.empty()) {
+    std::cerr << "plan_maneuver: --initial-costate applies to system: drift_two_input only\n\n"
+              << kUsage;
+    return 2;
+  }
+  ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
+  ap::PlanningProblem& problem = scene.problem;
+  ap::SolverOptions options;
+  ap::applyPlanFlags(args.flags, &problem, &options);
+  ap::Maneuver guess;
+  if (!args.warm_start.empty()) {
+    try {
+      guess = ap::readManeuverCsv(args.warm_start);
+    } catch (const ap::InvalidInput& e) {
+      throw ap::InvalidInput(std::string("--warm-start: ") + e.what());
+    }
+    ap::validateInitialGuess(guess, "--warm-start");
+    options.warm_start = &guess;
+  }
+
+  const ap::PlanResult result = ap::planManeuver(problem, options);
+  std::cout << "scene                    " << args.scene << "\n"
+            << ap::planResultText(problem, result);
+  if (!args.csv.empty() && !result.maneuver.attitude.empty()) {
+    if (problem.reaction_wheels.present()) {
+      ap::writeManeuverCsv(result.maneuver,
+                           ap::wheelStates(problem.scheme, problem.inertia, problem.reaction_wheels,
+                                           result.maneuver, problem.worldDisturbance()),
+                           args.csv);
+    } else {
+      ap::writeManeuverCsv(result.maneuver, args.csv);
+    }
+  }
+  if (!args.summary.empty()) {
+    std::ofstream out(args.summary);
+    out << ap::planResultJson(problem, result);
+    if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
+  }
+  if (!result.converged()) {
+    std::cerr << "plan_maneuver: not converged: " << result.message() << " (termination "
+              << ap::terminationName(result.termination) << ")\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  Arguments args;
-  try {
-    args = parseArguments(argc, argv);
-  } catch (const UsageError& e) {
-    std::cerr << "plan_maneuver: " << e.message << "\n\n" << kUsage;
-    return 2;
-  } catch (const InvalidFlagValue& e) {
-    std::cerr << "plan_maneuver: " << e.message << "\n";
-    return 1;
-  }
-  if (args.help) {
-    std::cout << kUsage;
-    return 0;
-  }
-
-  try {
-    ap::Scene scene = ap::loadScene(args.scene);
-    if (scene.system == ap::SystemKind::DriftTwoInput) return runDriftTwoInput(args, scene);
-    if (!args.initial_costate.empty()) {
-      std::cerr << "plan_maneuver: --initial-costate applies to system: drift_two_input only\n\n"
-                << kUsage;
-      return 2;
-    }
-    ap::requirePlannable(scene);  // effects / other systems: refuse, never ignore
-    ap::PlanningProblem& problem = scene.problem;
-    ap::SolverOptions options;
-    ap::applyPlanFlags(args.flags, &problem, &options);
-    ap::Maneuver guess;
-    if (!args.warm_start.empty()) {
-      try {
-        guess = ap::readManeuverCsv(args.warm_start);
-      } catch (const ap::InvalidInput& e) {
-        throw ap::InvalidInput(std::string("--warm-start: ") + e.what());
-      }
-      ap::validateInitialGuess(guess, "--warm-start");
-      options.warm_start = &guess;
-    }
-
-    const ap::PlanResult result = ap::planManeuver(problem, options);
-    std::cout << "scene                    " << args.scene << "\n"
-              << ap::planResultText(problem, result);
-    if (!args.csv.empty() && !result.maneuver.attitude.empty()) {
-      if (problem.reaction_wheels.present()) {
-        ap::writeManeuverCsv(
-            result.maneuver,
-            ap::wheelStates(problem.scheme, problem.inertia, problem.reaction_wheels,
-                            result.maneuver, problem.worldDisturbance()),
-            args.csv);
-      } else {
-        ap::writeManeuverCsv(result.maneuver, args.csv);
-      }
-    }
-    if (!args.summary.empty()) {
-      std::ofstream out(args.summary);
-      out << ap::planResultJson(problem, result);
-      if (!out) throw ap::InvalidInput("--summary: cannot write '" + args.summary + "'");
-    }
-    if (!result.converged()) {
-      std::cerr << "plan_maneuver: not converged: " << result.message() << " (termination "
-                << ap::terminationName(result.termination) << ")\n";
-      return 1;
-    }
-    return 0;
-  } catch (const ap::InvalidInput& e) {
-    std::cerr << "plan_maneuver: invalid input: " << e.what() << "\n";
-    return 1;
-  } catch (const ap::StepTooLarge& e) {
-    std::cerr << "plan_maneuver: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "plan_maneuver: error: " << e.what() << "\n";
-    return 1;
-  }
+  return ap::tools::runTool("plan_maneuver", kUsage, argc, argv, parseArguments, run);
 }

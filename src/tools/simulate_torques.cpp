@@ -17,6 +17,7 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/io/csv.hpp"
 #include "attitude_planner/io/scene.hpp"
+#include "command_line.hpp"
 
 namespace ap = attitude_planner;
 
@@ -41,9 +42,7 @@ const char* const kUsage =
     "  --max-miss TOL            exit 1 unless both terminal errors are <= TOL\n"
     "  --help                    show this help\n";
 
-struct UsageError {
-  std::string message;
-};
+using ap::tools::UsageError;
 
 struct Arguments {
   std::string scene_path, csv_path, scheme, out_csv;
@@ -248,24 +247,5 @@ int run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Arguments args;
-  try {
-    args = parseArguments(argc, argv);
-  } catch (const UsageError& e) {
-    std::cerr << "simulate_torques: " << e.message << "\n\n" << kUsage;
-    return 2;
-  }
-  if (args.help) {
-    std::cout << kUsage;
-    return 0;
-  }
-  try {
-    return run(args);
-  } catch (const ap::InvalidInput& e) {
-    std::cerr << "simulate_torques: invalid input: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "simulate_torques: " << e.what() << "\n";
-    return 1;
-  }
+  return ap::tools::runTool("simulate_torques", kUsage, argc, argv, parseArguments, run);
 }

@@ -157,7 +157,7 @@ TEST(HostileOptions, BadSolverOptionsNameTheOptionAndTheValue) {
   }
 }
 
-TEST(HostileOptions, FlagValuesAreUsageErrorsNamingTheValue) {
+TEST(HostileOptions, FlagValuesAreInvalidInputNamingTheValue) {
   // A bad flag value is invalid input like a bad scene value: exit status 1, naming flag and value
   // (2 stays for a malformed command line: unknown option, missing value).
   const std::string scene = "'" AP_SOURCE_DIR "/scenes/rest_to_rest.yaml'";

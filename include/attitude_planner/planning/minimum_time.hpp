@@ -14,13 +14,14 @@
 // (the switching functions from its bound multipliers). With cones each start is first made to
 // clear them (a minimum-effort plan under the cones tightened by 0.01 rad). T* is a KKT point of
 // the discrete minimum-time problem, its residuals in PlanResult::minimum_time; with effects too
-// (their time t_k = k h moves with h). fourth_order is not written in h yet: for it (or if no
-// free-time solve converges) the former search answers — several starts, each a continuation down
-// in T over minimum-effort solves warm-started from the last feasible plan and a bisection to
-// kMinimumTimeTolerance; its T* is the least duration found feasible, an upper bound
-// (minimum_time.kkt_point false). Where the free-time problem applies, the search's plan (feasible
-// at its T) then starts one more free-time solve, and a KKT point at or below the search's T is the
-// answer if it converges. docs/results/minimum_time.md has the figures.
+// (their time t_k = k h moves with h). With spinning ends the answer is also probed below T* by
+// minimum-effort solves, and a plan found there lowers it. fourth_order's T* is the larger of the
+// two second_order minimum times at N and 2N (both plans must exist at T), a KKT point of the
+// pair. Where no free-time solve converges, a search answers (a continuation down in T over
+// minimum-effort solves and a bisection to kMinimumTimeTolerance): its T* is the least duration
+// found feasible, an upper bound (minimum_time.kkt_point false); its plan then starts one more
+// free-time solve, whose KKT point at or below the search's T is the answer if it converges.
+// docs/results/minimum_time.md has the figures.
 #pragma once
 
 #include "attitude_planner/planning/plan_at_resolution.hpp"
@@ -37,11 +38,15 @@ constexpr double kMinimumTimeTolerance = 1e-9;
 /// problem.duration > 0 is an upper bound: T* above it ends Infeasible, naming T*.
 PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& options);
 
-/// A minimum-effort plan at problem.duration whose "infeasible" is backed: when the solve ends
-/// Infeasible under a torque bound, the minimum-time problem under the same bounds either shows
-/// the duration feasible (T* ≤ T: the plan is solved again from the T* plan, which meets every
-/// bound with room) or names the least duration found feasible ("needs T >= T* s"); the
-/// result's minimum_duration is that T* (0 when it was not needed or not found).
+/// A minimum-effort plan at problem.duration whose "infeasible" is backed (defined in
+/// src/planning/drivers/minimum_effort.cpp): when the solve ends Infeasible, stops, or leaves a
+/// bound under a torque bound, the minimum-time problem under the same bounds either shows the
+/// duration feasible (T* ≤ T: the plan is solved again from the T* plan, which meets every bound
+/// with room, through a ladder of durations where that start is stuck) or the answer is
+/// "infeasible from here": T* is the least duration at which a plan was found, a local figure,
+/// not a requirement, beside the proven lower bound on T where one is known
+/// (duration_verdict). The result's minimum_duration is that T* (0 when it was not needed or
+/// not found).
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, const SolverOptions& options);
 
 /// A duration at which an eigenaxis bang–bang slew would need the smallest authority of the

@@ -12,7 +12,6 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "attitude_planner/planning/warm_start.hpp"
 #include "planning/crosscheck/nlopt_solver.hpp"
-#include "planning/drivers/constrained_classes.hpp"
 #include "planning/drivers/constrained_recipe.hpp"
 #include "planning/drivers/fourth_order.hpp"
 #include "planning/drivers/pointing.hpp"
@@ -124,57 +123,6 @@ void refuseAnotherClass(const PlanningProblem& problem, PlanResult* result) {
   if (why.empty()) return;
   result->termination = Termination::NotConverged;
   frameMessage(result, frames::OutsideRequestedClass{why});
-}
-
-/// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
-/// it meets every node constraint it is the constrained optimum too; otherwise it starts the
-/// interior point, in its class, and a request that left its class free has the other classes
-/// solved under the constraints too (constrained_classes.hpp), each from its class survey's plan.
-PlanResult planUnderConstraints(const PlanningProblem& problem, const SolveRequest& options,
-                                SolveContext& context) {
-  // The unconstrained optimum, already solved (StartSpec::unconstrained_optimum): polished from
-  // it, the Newton attempt named as started from that earlier attempt's plan.
-  SolveRequest newton_options = options;
-  const Maneuver* solved = options.start.unconstrained_optimum;
-  const bool solved_before = solved && solved->steps() == problem.steps;
-  if (solved_before) newton_options.warm_start = solved;
-  std::vector<ClassPlan> survey_plans;
-  const std::size_t first_recorded = context.attempts().size();
-  const std::size_t first_level = context.levels().size();
-  const SolveContext::IterationTally tally(context);  // Newton, then the interior point
-  PlanResult result = solveWithNewton(problem, newton_options, context, &survey_plans);
-  const ConstraintCheck unconstrained = result.maneuver.steps() == problem.steps
-                                            ? checkConstraints(problem, result.maneuver)
-                                            : ConstraintCheck{};
-  if (result.converged() && unconstrained.max_node_bound_violation <= 0.0) {
-    addNote(&result, notes::ConstraintsInactive{});
-    return result;
-  }
-  SolveRequest constrained = options;
-  const int newton_iterations = result.iterations;
-  const notes::UnconstrainedStart started{result.cost, unconstrained.worst,
-                                          unconstrained.worst_where, newton_iterations};
-  const bool started_from_optimum = result.converged();
-  const Maneuver unconstrained_plan = result.maneuver;
-  constrained.warm_start = result.converged() ? &unconstrained_plan : options.warm_start;
-  // The interior point keeps the class it starts in: the unconstrained optimum's.
-  ExtremalSummary survey = result.extremal_summary;
-  result = solveWithInteriorPoint(problem, constrained, context);
-  result.iterations = tally.iterations();
-  result.levels = context.levelsFrom(first_level);  // Newton's, then the interior point's
-  if (started_from_optimum) addNote(&result, started);
-  if (survey.known && constrained.warm_start == &unconstrained_plan) {
-    result.extremal_summary = survey;
-    result.extremal_summary.others.clear();
-    result.extremal = describeExtremal(result.extremal_summary);
-  }
-  if (classLeftFree(problem, options)) {
-    result = cheapestConstrainedClass(
-        problem, options, context, survey, survey_plans, std::move(result),
-        started_from_optimum ? started.cost : std::numeric_limits<double>::quiet_NaN(),
-        first_recorded);
-  }
-  return result;
 }
 
 }  // namespace

@@ -16,10 +16,19 @@ namespace attitude_planner {
 PlanResult planAtResolution(const PlanningProblem& problem, const SolveRequest& request,
                             SolveContext& context);
 
+/// Node constraints from no guess of their own: the unconstrained optimum first (fast path): if
+/// it meets every node constraint it is the constrained optimum too; otherwise it starts the
+/// interior point, in its class, and a request that left its class free has the other classes
+/// solved under the constraints too (constrained_classes.hpp), each from its class survey's plan
+/// (minimum_effort.cpp).
+PlanResult planUnderConstraints(const PlanningProblem& problem, const SolveRequest& request,
+                                SolveContext& context);
+
 /// planMinimumTime (minimum_time.hpp) with the request's options, context.options().
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context);
 
-/// planBoundedMinimumEffort (minimum_time.hpp) with the request's options, context.options().
+/// planBoundedMinimumEffort (minimum_time.hpp, defined in minimum_effort.cpp) with the request's
+/// options, context.options().
 PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext& context);
 
 }  // namespace attitude_planner

@@ -138,6 +138,12 @@ std::optional<std::size_t> SolveContext::keptAttempt() const {
   return std::nullopt;
 }
 
+std::optional<std::size_t> SolveContext::keptSince(std::size_t first) const {
+  const std::optional<std::size_t> kept = keptAttempt();
+  if (kept && *kept >= first) return kept;
+  return std::nullopt;
+}
+
 void SolveContext::restoreKept(std::optional<std::size_t> index) {
   markKept(index.value_or(attempts_.size()));
 }

@@ -178,6 +178,9 @@ class SolveContext : public Interruption {
   void planChecked(std::size_t index, Termination termination);
   /// The kept attempt's index (nothing if none is marked).
   std::optional<std::size_t> keptAttempt() const;
+  /// The kept attempt if it is one recorded from `first` on (a sub-solve's kept attempt, read
+  /// after it returned).
+  std::optional<std::size_t> keptSince(std::size_t first) const;
   /// Marks `index` kept (as markKept), or with nothing clears every mark: a plan no single
   /// attempt produced (a combination of two) or an earlier answer kept after later attempts.
   void restoreKept(std::optional<std::size_t> index);

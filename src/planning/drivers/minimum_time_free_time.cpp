@@ -59,18 +59,25 @@ double largestDifference(const std::vector<Matrix3>& a, const std::vector<Matrix
   return largest;
 }
 
+/// Where a start's outcome comes from.
+enum class OutcomeFrom {
+  ItsSolve,  ///< solved as posed
+  Repeat,    ///< the same attitudes and T as an earlier start: not solved, that start's outcome
+  Joined,    ///< solved until it joined an earlier start's central path: that start's outcome
+};
+
 /// One start of the free-time solves: its attitudes as solved (cleared of the cones), T, name,
-/// the outcome, and the earlier start it repeats (its outcome taken; −1: none), either as a start
-/// (the same attitudes and T) or as a solve that joined that start's central path (`joined`).
+/// the outcome, and where the outcome comes from (an earlier start's: `earlier`).
 struct StartRecord {
   std::vector<Matrix3> attitudes;
   double duration = 0.0;
   std::string name;
   FreeTimeOutcome outcome;
-  int same_as = -1;
+  OutcomeFrom from = OutcomeFrom::ItsSolve;
+  int earlier = -1;                ///< the start whose outcome it took (−1: its own)
   std::vector<BarrierPoint> path;  ///< its solve's solved barrier problems (sameCentralPath)
-  std::size_t attempt = 0;         ///< its solve in the trail (a repeat: the earlier start's)
-  bool joined = false;  ///< solved until it joined same_as's central path: a start of its own
+  std::size_t attempt = 0;         ///< its solve in the trail (a taken outcome: the earlier's)
+  bool tookEarlierOutcome() const { return from != OutcomeFrom::ItsSolve; }
 };
 
 /// The starts recorded so far (a record stays where it is while later ones are recorded) and the
@@ -170,7 +177,7 @@ class FreeTimeMinimumTime {
     detail.duration = duration;
     const FreeTimeOutcome o = solve(problem_, plan.attitude, duration,
                                     AttemptStart::PreviousAttempt, detail, watch, barrier);
-    recordStart(plan.attitude, duration, name, o, -1);
+    recordStart(plan.attitude, duration, name, o);
     // Every iterate strictly inside its bounds is a plan (the reduced problem meets the dynamics
     // and the boundary data by construction): one that ended short of a KKT point below T is
     // still a plan at its own T.
@@ -251,7 +258,7 @@ class FreeTimeMinimumTime {
   int sameStartAs(const std::vector<Matrix3>& start, double duration) const {
     for (std::size_t j = 0; j < starts_.size(); ++j) {
       const StartRecord& earlier = starts_[j];
-      if (earlier.same_as >= 0 || earlier.duration != duration ||
+      if (earlier.tookEarlierOutcome() || earlier.duration != duration ||
           earlier.attitudes.size() != start.size()) {
         continue;
       }
@@ -260,12 +267,26 @@ class FreeTimeMinimumTime {
     return -1;
   }
 
-  /// Records a start (its attitudes as solved, T, name) with its outcome and the earlier start it
-  /// repeats (−1: none), for sameStartAs and the message.
+  /// Records a start (its attitudes as solved, T, name) with the outcome of its own solve, for
+  /// sameStartAs and the message.
   void recordStart(const std::vector<Matrix3>& start, double duration, const std::string& name,
-                   FreeTimeOutcome outcome, int same) {
-    const std::size_t attempt = same >= 0 ? starts_[same].attempt : trail_.size() - 1;
-    starts_.push_back({start, duration, name, std::move(outcome), same, {}, attempt});
+                   FreeTimeOutcome outcome) {
+    starts_.push_back({start,
+                       duration,
+                       name,
+                       std::move(outcome),
+                       OutcomeFrom::ItsSolve,
+                       -1,
+                       {},
+                       trail_.size() - 1});
+  }
+
+  /// Records a start whose outcome is the earlier start's (a repeat, or a solve that joined its
+  /// central path).
+  void recordTaken(const std::vector<Matrix3>& start, double duration, const std::string& name,
+                   int earlier, OutcomeFrom from) {
+    const StartRecord& taken = starts_[earlier];
+    starts_.push_back({start, duration, name, taken.outcome, from, earlier, {}, taken.attempt});
   }
 
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
@@ -305,7 +326,7 @@ class FreeTimeMinimumTime {
         keepIfLeast(&best);
       } else {
         const int same = repeats_open[i] >= 0 ? recorded_as[repeats_open[i]] : repeats[i];
-        recordStart(cleared[i], st.duration, st.name, starts_[same].outcome, same);
+        recordTaken(cleared[i], st.duration, st.name, same, OutcomeFrom::Repeat);
       }
       recorded_as[i] = static_cast<int>(starts_.size()) - 1;
     };
@@ -388,7 +409,7 @@ class FreeTimeMinimumTime {
     std::vector<std::size_t> solved;  // the starts solved the first time (not repeats of a start)
     for (std::size_t i = 0; i < starts.size() && first + i < starts_.size(); ++i) {
       const StartRecord& once = starts_[first + i];
-      if (once.same_as < 0 || once.joined) solved.push_back(i);
+      if (once.from != OutcomeFrom::Repeat) solved.push_back(i);
     }
     const auto pose = [&](int j) -> std::optional<WindowStart> {
       const std::size_t i = solved[j];
@@ -474,10 +495,9 @@ class FreeTimeMinimumTime {
                      const std::string& name) {
     recordSolve(run.attempt);
     if (run.joined >= 0) {
-      recordStart(start, duration, name, starts_[run.joined].outcome, run.joined);
-      starts_.back().joined = true;
+      recordTaken(start, duration, name, run.joined, OutcomeFrom::Joined);
     } else {
-      recordStart(start, duration, name, std::move(run.outcome), -1);
+      recordStart(start, duration, name, std::move(run.outcome));
     }
     starts_.back().path = std::move(run.path);
   }
@@ -534,7 +554,7 @@ class FreeTimeMinimumTime {
     StartDetail detail;
     detail.duration = T;
     FreeTimeOutcome o = solve(grid, start, T, AttemptStart::PreviousAttempt, detail);
-    recordStart(start, T, "restricted (" + answer.name + ")", std::move(o), -1);
+    recordStart(start, T, "restricted (" + answer.name + ")", std::move(o));
     keepIfLeast(&best);
     return best;
   }
@@ -552,7 +572,7 @@ class FreeTimeMinimumTime {
     const std::size_t structured = starts_.size();
     for (std::size_t i = first; i < structured; ++i) {
       const FreeTimeOutcome& o = starts_[i].outcome;
-      if (starts_[i].same_as >= 0 || o.termination != Termination::Converged ||
+      if (starts_[i].tookEarlierOutcome() || o.termination != Termination::Converged ||
           o.second_order_sufficient) {
         continue;
       }
@@ -746,9 +766,9 @@ class FreeTimeMinimumTime {
         answer.duration,     kkt_point,       second_order_sufficient, from, answer.iterations,
         answer.stationarity, answer.time_row, answer.complementarity,  {},   solves_};
     for (const StartRecord& st : starts_) {
-      told.starts.push_back({st.name, st.same_as >= 0 ? starts_[st.same_as].name : std::string(),
-                             st.outcome.termination, st.outcome.duration,
-                             st.outcome.second_order_sufficient});
+      told.starts.push_back(
+          {st.name, st.tookEarlierOutcome() ? starts_[st.earlier].name : std::string(),
+           st.outcome.termination, st.outcome.duration, st.outcome.second_order_sufficient});
     }
     // A replay that failed (freeTimePlan) is the reason it is given, said after its account.
     recordVerdict(&result, told);

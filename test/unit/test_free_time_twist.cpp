@@ -301,6 +301,41 @@ TEST(FreeTimeTwist, WithoutPointingNoEntries) {
   EXPECT_GT(kkt.corner(0, 0), 0.0);
 }
 
+TEST(FreeTimeTwist, ARankOneTermLandsWhereItsOuterProductBlockDoes) {
+  // KktSink::addRankOne(w, g) over (δ, η) with ψ free: the band, the η and ψ columns and the corner
+  // of addBlock(w g gᵀ) (no Lagrangian gradient: no path term), on the last stencils (which ψ
+  // moves) and an inner one (which it does not), every scheme.
+  for (const SchemeKind scheme : kDiscretizations) {
+    SCOPED_TRACE(schemeName(scheme));
+    const PlanningProblem p = test_support::randomPointingRequest(19, 16, true, scheme);
+    const ReducedProblem rp(p);
+    ASSERT_TRUE(rp.hasTwist());
+    std::mt19937 rng(23);
+    std::normal_distribution<double> normal;
+    Eigen::Matrix<double, 10, 1> g;
+    for (int i = 0; i < 10; ++i) g(i) = normal(rng);
+    const double w = 0.37;
+    for (const int first : {p.steps - 2, p.steps - 3, 4}) {
+      SCOPED_TRACE("first node " + std::to_string(first));
+      KktBlocks<double> rank_one(rp.unknowns()), block(rp.unknowns());
+      KktSink<double, FreeTimeStep>(rp, FreeTimeStep{rp.timeStep()}, &rank_one)
+          .addRankOne(first, 3, g, w);
+      KktSink<double, FreeTimeStep>(rp, FreeTimeStep{rp.timeStep()}, &block)
+          .addBlock(first, 3, w * g * g.transpose());
+      EXPECT_LT((rank_one.corner - block.corner).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_LT((rank_one.border - block.border).cwiseAbs().maxCoeff(), 1e-12);
+      double band = 0.0;
+      for (int i = 0; i < rp.unknowns(); ++i) {
+        for (int j = std::max(0, i - ReducedProblem::kHalfBandwidth); j <= i; ++j)
+          band = std::max(band, std::abs(rank_one.band(i, j) - block.band(i, j)));
+      }
+      EXPECT_LT(band, 1e-12);
+      EXPECT_GT(block.corner.cwiseAbs().maxCoeff(), 1e-3);  // η's entries at least
+      if (first == p.steps - 2) EXPECT_GT(std::abs(block.corner(1, 1)), 1e-6);  // ψ's
+    }
+  }
+}
+
 TEST(PointingMinimumTime, AtMostTheSweepsBestTwistOnSeededRandomRequests) {
   // Every discretization: h and ψ both move R_{N−1} of paper and variational.
   const std::pair<unsigned, SchemeKind> requests[] = {{4201u, SchemeKind::SecondOrder},

@@ -23,6 +23,7 @@
 
 #include "attitude_planner/planning/interior_point_parameters.hpp"
 #include "attitude_planner/planning/result.hpp"
+#include "planning/interior_point/kkt_system.hpp"
 #include "planning/transcription/node_constraints.hpp"
 #include "planning/transcription/stage_constraints.hpp"
 #include "planning/transcription/stage_quantities.hpp"
@@ -213,6 +214,27 @@ class Feasible final : public BarrierForm<10> {
   }
 };
 
+/// Where the two profiles' assemblies differ (BarrierRowBlock::assemble), as values.
+struct AssemblyChoices {
+  /// The cost's weight on its residual's Gauss–Newton term and gradient: 1 (fixed h: C), or ε
+  /// (free time: ε C).
+  double cost_weight = 1.0;
+  /// A torque row is prepared where its value is formed, before z enters the stencil's
+  /// second-order weights (fixed h), or after the weights used z (free time: the elastic
+  /// safeguard may change z in between). Its c'' joins W where it is prepared.
+  bool prepare_at_value = false;
+  /// A local block's rank-one terms folded into it in double and the block added once (free
+  /// time), or added one by one in the band's precision (fixed h: the precision rule,
+  /// grid_solve.hpp), a box side's into its axis's Gauss–Newton weight.
+  bool sum_in_double = false;
+  /// Each row's β g and −z g go to the right-hand side and the gradient in the pass (free time:
+  /// −∇φ_μ and ∇L); else the gradient is the cost's alone (fixed h adds the rows after it).
+  bool row_gradients = false;
+  bool primal = false;  ///< the rows prepared with their primal multipliers
+  /// The quantities that do not move with h first (free time: the order its sums were formed in).
+  bool fixed_quantities_first = false;
+};
+
 /// A merit's sum over the rows: +∞ once a row is outside its form's domain.
 struct MeritSum {
   double phi = 0.0;
@@ -319,6 +341,136 @@ class BarrierRowBlock {
     return worst;
   }
 
+  /// The Newton system at np's iterate: the cost's stencils with the torque rows, then one pass
+  /// per other quantity, into `sink` (null: the rows' gradients only, rows not prepared), the
+  /// right-hand side `rhs` and `gradient` (AssemblyChoices::row_gradients). `poll(k)` at each
+  /// stencil and instance (it may throw). Returns the cost.
+  template <typename Scalar, typename Poll>
+  double assemble(KktSink<Scalar, TimeStep>* sink, const TimeStep& step, double mu, double rho,
+                  const AssemblyChoices& choices, Eigen::VectorXd* rhs, Eigen::VectorXd* gradient,
+                  const Poll& poll) {
+    const double cost = assembleTorques(sink, step, mu, rho, choices, rhs, gradient, poll);
+    for (const bool moving_pass : {false, true}) {
+      for (const std::vector<int>& block : rows.blocks) {
+        const bool moves = rows.groups[block.front()].quantity->dependsOnTimeStep();
+        if (choices.fixed_quantities_first ? moves == moving_pass : !moving_pass)
+          assembleQuantity(sink, step, block, mu, rho, choices, rhs, gradient, poll);
+      }
+    }
+    return cost;
+  }
+
+ private:
+  using Local = Eigen::Matrix<double, kEntries, 1>;
+  using Block = Eigen::Matrix<double, kEntries, kEntries>;
+
+  /// The cost's stencils (residual ρ = √w τ, weighted by cost_weight) with the torque rows: the
+  /// Lagrangian's block ∂²(wᵀρ) + Gᵀ W G (G = ∂ρ/∂x), W = cost_weight·I − Σ z c''/w (the rows'
+  /// isotropic curvature) + Σ ω a aᵀ (a = ∂c/∂ρ), folded as the choices say. The weights callback
+  /// forms the rows' values, so the stencil's second-order weights carry −Σ z c'(τ)/√w with z as
+  /// prepared there or not yet.
+  template <typename Scalar, typename Poll>
+  double assembleTorques(KktSink<Scalar, TimeStep>* sink, const TimeStep& step, double mu,
+                         double rho, const AssemblyChoices& choices, Eigen::VectorXd* rhs,
+                         Eigen::VectorXd* gradient, const Poll& poll) {
+    double weight = choices.cost_weight;  // less Σ z c''/w of the rows prepared at their value
+    const auto cost = [&](int, const Vector3& residual) {
+      weight = choices.cost_weight;
+      return Vector3(choices.cost_weight * residual);
+    };
+    const auto row = [&](const Rows& g, Row& in, double root) {
+      if (!choices.prepare_at_value) return;
+      form(g).prepare(in, mu, rho, choices.primal);
+      weight -= in.z * g.constraint->curvature() / (root * root);
+    };
+    const auto visit = [&](const typename TimeStep::Stencil& st, double root) {
+      poll(st.k);
+      const Eigen::Matrix<double, 3, kEntries> G = step.jacobian(st);
+      Matrix3 W = weight * Matrix3::Identity();
+      const Local grad_f = choices.cost_weight * G.transpose() * st.tau;
+      Local local_rhs = -grad_f, local_gradient = grad_f;
+      const auto fold = [&](const Rows& g, Row& in, const Vector3& a) {
+        if (!sink) return;
+        if (!choices.prepare_at_value) {
+          form(g).prepare(in, mu, rho, choices.primal);
+          W.diagonal().array() -= in.z * g.constraint->curvature() / (root * root);
+        }
+        const RowTerms terms = form(g).terms(in, mu);
+        const int axis = g.constraint->axis();
+        if (choices.sum_in_double) {
+          W.noalias() += terms.weight * a * a.transpose();
+        } else if (axis >= 0) {  // a box side: affine in one axis (the slack forms' ω = 1/D)
+          W(axis, axis) += a(axis) * a(axis) / in.D;
+        } else {
+          sink->addRankOne(st.k - 1, 3, in.g, terms.weight);
+        }
+        addRowGradient(choices, terms, in, &local_rhs, &local_gradient);
+      };
+      rows.chainTorques(st, root, G, fold);
+      if (sink && choices.sum_in_double) {
+        Block H = step.second(st);
+        H.noalias() += G.transpose() * W * G;
+        sink->addBlock(st.k - 1, 3, H, &local_gradient);
+      } else if (sink) {
+        for (int a = 0; a < 3; ++a) sink->addRankOne(st.k - 1, 3, G.row(a).transpose(), W(a, a));
+        sink->addBlock(st.k - 1, 3, step.second(st), &local_gradient);
+      }
+      addLocalVector<TimeStep>(np_, local_gradient, 1.0, st.k - 1, 3, gradient);
+      addLocalVector<TimeStep>(np_, local_rhs, 1.0, st.k - 1, 3, rhs);
+    };
+    return rows.forEachTorqueStencil(np_, step, sink != nullptr, cost, row, visit);
+  }
+
+  /// The groups of one quantity (a rate, a cone, a wheel quantity) through the quantity's terms
+  /// and the chain rule (StageTranscription), with each row's barrier term ω g gᵀ.
+  template <typename Scalar, typename Poll>
+  void assembleQuantity(KktSink<Scalar, TimeStep>* sink, const TimeStep& step,
+                        const std::vector<int>& block, double mu, double rho,
+                        const AssemblyChoices& choices, Eigen::VectorXd* rhs,
+                        Eigen::VectorXd* gradient, const Poll& poll) {
+    const StageSupport support = rows.groups[block.front()].support;
+    const auto prepare = [&](const Rows& g, Row& in) {
+      if (sink) form(g).prepare(in, mu, rho, choices.primal);
+    };
+    const auto visit = [&](const typename TimeStep::Terms& t, Block* H) {
+      if (!sink) return;
+      const int node = t.k + support.node_offset;
+      Local local_rhs = Local::Zero(), local_gradient = Local::Zero();
+      if (!choices.sum_in_double) sink->addBlock(node, support.width, *H);
+      for (const int i : block) {
+        Row& in = rows.groups[i].instance(t.k);
+        const RowTerms terms = form(rows.groups[i]).terms(in, mu);
+        if (choices.sum_in_double) {
+          addOuterProduct(H, terms.weight, in.g, 3 * support.width);
+        } else {
+          sink->addRankOne(node, support.width, in.g, terms.weight);
+        }
+        addRowGradient(choices, terms, in, &local_rhs, &local_gradient);
+      }
+      if (choices.sum_in_double) sink->addBlock(node, support.width, *H, &local_gradient);
+      if (!choices.row_gradients) return;
+      addLocalVector<TimeStep>(np_, local_rhs, 1.0, node, support.width, rhs);
+      addLocalVector<TimeStep>(np_, local_gradient, 1.0, node, support.width, gradient);
+    };
+    rows.forEachQuantityInstance(np_, step, block, sink != nullptr, poll, prepare, visit);
+  }
+  static void addRowGradient(const AssemblyChoices& choices, const RowTerms& terms, const Row& in,
+                             Local* rhs, Local* gradient) {
+    if (!choices.row_gradients) return;
+    *rhs += terms.rhs * in.g;
+    *gradient -= in.z * in.g;
+  }
+  /// H += ω g gᵀ on the entries g can reach: its first m (the instance's nodes) and η.
+  static void addOuterProduct(Block* H, double w, const Local& g, int m) {
+    H->topLeftCorner(m, m).noalias() += (w * g.head(m)) * g.head(m).transpose();
+    if constexpr (kEntries == 10) {
+      H->block(0, 9, m, 1) += (w * g.head(m)) * g(9);
+      H->block(9, 0, 1, m) += ((w * g(9)) * g.head(m)).transpose();
+      (*H)(9, 9) += (w * g(9)) * g(9);
+    }
+  }
+
+ public:
   StageTranscription<TimeStep> rows;
 
  private:

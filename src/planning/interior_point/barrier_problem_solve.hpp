@@ -4,9 +4,9 @@
 // KktSink (KktBlocks, factored by the KktSystem of the time step's global unknowns), the barrier μ
 // with the μ rule's scales, the elastic penalty ρ, the step d, the count of passes and how the
 // solve ended. A profile derives from it for what differs: the objective (C, or T/T₀ + ε C), the
-// assembly's summation (rank-one terms in the band's precision, or a local block in double), the
-// trial point (the node unknowns, or h and then the nodes), the merit's penalty (ν, ρ), the start
-// and the outcome.
+// assembly's choices (AssemblyChoices: one assembly, BarrierRowBlock::assemble), the trial point
+// (the node unknowns, or h and then the nodes), the merit's penalty (ν, ρ), the start and the
+// outcome.
 #pragma once
 
 #include <memory>

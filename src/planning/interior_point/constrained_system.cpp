@@ -45,93 +45,26 @@ void ConstrainedSystem::pollEvery(int k) const {
   if (interruption_ && k % kColumnsBetweenPolls == 0) interruption_->poll();
 }
 
+/// The stencils hold the residuals r_k = √w_k τ_k (w_k the cost weight, 1 but at the end nodes of
+/// schemes with end torques): constraints are on τ_k = r_k/√w_k, so with c' = ∂c/∂τ,
+/// ∇c = Jᵀc'/√w_k and −z∇²c = Σ_i (−z c'_i/√w_k) ∇²r_i − (z c''/w_k) JᵀJ (c'' the constraint's
+/// isotropic curvature). The rows are prepared where their values are formed, in the stencil's
+/// weights callback: their multipliers enter the second-order weights; the rows' right-hand
+/// side terms are added after the pass (addConstraintGradients).
 template <typename Scalar>
-Assembly ConstrainedSystem::assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt,
-                                     Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient) {
-  std::optional<Sink<Scalar>> sink;
+double ConstrainedSystem::assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt,
+                                   Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient) {
+  std::optional<KktSink<Scalar, FixedTimeStep>> sink;
   if (kkt) sink.emplace(np_, FixedTimeStep{}, kkt);
-  Sink<Scalar>* H = sink ? &*sink : nullptr;
   rhs->setZero(np_.unknowns() + globals());
   merit_gradient->setZero(np_.unknowns() + globals());
-  Assembly out;
-  assembleTorques(mu, rho, primal, H, rhs, merit_gradient, &out);
-  for (const std::vector<int>& block : block_.rows.blocks)
-    assembleQuantity(block, mu, rho, primal, H);
+  AssemblyChoices choices;
+  choices.prepare_at_value = true;
+  choices.primal = primal;
+  const double cost = block_.assemble(sink ? &*sink : nullptr, FixedTimeStep{}, mu, rho, choices,
+                                      rhs, merit_gradient, [&](int k) { pollEvery(k); });
   addConstraintGradients(mu, rhs, merit_gradient);
-  return out;
-}
-
-/// The cost's stencils and the constraints on the torques: values and multipliers are needed for
-/// the stencil's second-order weights (∇²f − Σ z ∇²c, all through ∂²τ_k), so they are formed in
-/// the weights callback. The stencils hold the residuals r_k = √w_k τ_k (w_k the cost weight, 1
-/// but at the end nodes of schemes with end torques): constraints are on τ_k = r_k/√w_k, so with
-/// c' = ∂c/∂τ, ∇c = Jᵀc'/√w_k and −z∇²c = Σ_i (−z c'_i/√w_k) ∇²r_i − (z c''/w_k) JᵀJ (c'' the
-/// constraint's isotropic curvature).
-template <typename Scalar>
-void ConstrainedSystem::assembleTorques(double mu, double rho, bool primal, Sink<Scalar>* H,
-                                        Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient,
-                                        Assembly* out) {
-  double beta_k = 1.0;  // β_k = 1 − Σ z c''/w_k, of the stencil the weights were formed for
-  double jacobian_scale = 0.0, torque_scale = 0.0;
-  const auto cost = [&](int, const Vector3& residual) {
-    beta_k = 1.0;
-    return residual;
-  };
-  const auto row = [&](const FixedStepRows& g, FixedStepRow& in, double r) {
-    form_->prepare(in, mu, rho, primal);  // the weights are formed with H only
-    beta_k -= in.z * g.constraint->curvature() / (r * r);
-  };
-  const auto visit = [&](const ReducedProblem::Stencil& st, double r) {
-    pollEvery(st.k);
-    jacobian_scale = std::max(jacobian_scale, st.jacobian.cwiseAbs().maxCoeff());
-    torque_scale = std::max(torque_scale, st.tau.cwiseAbs().maxCoeff());
-    const Eigen::Matrix<double, 9, 1> grad_f = st.jacobian.transpose() * st.tau;
-    // Jᵀ diag(weight) J: the Gauss–Newton term β JᵀJ and, per torque axis, the g gᵀ/D of the
-    // constraints affine in that axis alone (the box: g = c'_a J_a/r); the others' g gᵀ/D apart.
-    Vector3 weight = Vector3::Constant(beta_k);
-    const auto fold = [&](const FixedStepRows& g, const FixedStepRow& in, const Vector3& a) {
-      if (!H) return;
-      const int axis = g.constraint->axis();
-      if (axis < 0) {
-        H->addRankOne(st.k - 1, 3, in.g, 1.0 / in.D);
-      } else {
-        weight(axis) += a(axis) * a(axis) / in.D;
-      }
-    };
-    block_.rows.chainTorques(st, r, st.jacobian, fold);
-    if (H) {
-      for (int a = 0; a < 3; ++a)
-        H->addRankOne(st.k - 1, 3, st.jacobian.row(a).transpose(), weight(a));
-      H->addBlock(st.k - 1, 3, st.second);
-    }
-    addLocalVector<FixedTimeStep>(np_, grad_f, 1.0, st.k - 1, 3, merit_gradient);
-    addLocalVector<FixedTimeStep>(np_, grad_f, -1.0, st.k - 1, 3, rhs);
-  };
-  out->cost =
-      block_.rows.forEachTorqueStencil(np_, FixedTimeStep{}, H != nullptr, cost, row, visit);
-  out->gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
-}
-
-/// The groups of one quantity (a rate, a cone, a wheel quantity) through the quantity's terms and
-/// the chain rule (StageTranscription), with each constraint's barrier term g gᵀ/D.
-template <typename Scalar>
-void ConstrainedSystem::assembleQuantity(const std::vector<int>& block, double mu, double rho,
-                                         bool primal, Sink<Scalar>* H) {
-  const StageSupport support = block_.rows.groups[block.front()].support;
-  const auto prepare = [&](const FixedStepRows&, FixedStepRow& in) {
-    if (H) form_->prepare(in, mu, rho, primal);
-  };
-  const auto visit = [&](const QuantityTerms& t, const Eigen::Matrix<double, 9, 9>* curvature) {
-    if (!H) return;
-    const int node = t.k + support.node_offset;
-    H->addBlock(node, support.width, *curvature);
-    for (const int i : block) {
-      const FixedStepRow& in = block_.rows.groups[i].instance(t.k);
-      H->addRankOne(node, support.width, in.g, 1.0 / in.D);
-    }
-  };
-  block_.rows.forEachQuantityInstance(
-      np_, FixedTimeStep{}, block, H != nullptr, [&](int k) { pollEvery(k); }, prepare, visit);
+  return cost;
 }
 
 /// ∇φ_μ = ∇f − Σ (μ/s) g (Elastic; FreeSlacks: ∇_δ φ = ∇f, the slacks' part is the slack step's
@@ -238,14 +171,13 @@ std::vector<Vector3> ConstrainedSystem::switchingFunction(
 /// iterate's), first order only, leaving the multipliers as they are.
 double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) {
-  double unused = 0.0;
-  const double scale =
-      assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient).gradient_scale;
+  assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient);
+  double scale = 0.0;  // max|∂τ/∂δ| · max|τ|
   Eigen::VectorXd residual;
   if (np_.hasTwist()) {
-    np_.evaluateWithTwist(&residual, nullptr, nullptr, nullptr, &unused);  // ∇f, ∂f/∂ψ last
+    np_.evaluateWithTwist(&residual, nullptr, nullptr, nullptr, &scale);  // ∇f, ∂f/∂ψ last
   } else {
-    np_.evaluate(&residual, nullptr, &unused);  // ∇f
+    np_.evaluate(&residual, nullptr, &scale);  // ∇f
   }
   block_.rows.forEach([&](const FixedStepRows& g, int k, const FixedStepRow& in) {
     block_.rows.addRow(np_, g, k, in.g, -in.z, &residual);
@@ -331,13 +263,13 @@ LevelDuals ConstrainedSystem::estimatedDuals() {
   return d;
 }
 
-template Assembly ConstrainedSystem::assemble<double>(double, double, bool, KktBlocks<double>*,
-                                                      Eigen::VectorXd*, Eigen::VectorXd*);
-template Assembly ConstrainedSystem::assemble<long double>(double, double, bool,
-                                                           KktBlocks<long double>*,
-                                                           Eigen::VectorXd*, Eigen::VectorXd*);
-template Assembly ConstrainedSystem::assemble<DoubleDouble>(double, double, bool,
-                                                            KktBlocks<DoubleDouble>*,
-                                                            Eigen::VectorXd*, Eigen::VectorXd*);
+template double ConstrainedSystem::assemble<double>(double, double, bool, KktBlocks<double>*,
+                                                    Eigen::VectorXd*, Eigen::VectorXd*);
+template double ConstrainedSystem::assemble<long double>(double, double, bool,
+                                                         KktBlocks<long double>*, Eigen::VectorXd*,
+                                                         Eigen::VectorXd*);
+template double ConstrainedSystem::assemble<DoubleDouble>(double, double, bool,
+                                                          KktBlocks<DoubleDouble>*,
+                                                          Eigen::VectorXd*, Eigen::VectorXd*);
 
 }  // namespace attitude_planner

@@ -67,12 +67,6 @@ struct LevelDuals {
   bool empty() const { return steps == 0; }
 };
 
-/// What an assembly returns besides the system.
-struct Assembly {
-  double cost = 0.0;            ///< f at the iterate
-  double gradient_scale = 0.0;  ///< max|∂τ/∂δ| · max|τ|
-};
-
 /// The node constraints of one problem in one formulation, and the condensed Newton system.
 /// With a pointing end condition (ReducedProblem::hasTwist) the unknowns are (δ, ψ): every vector
 /// has unknowns() + 1 entries, ψ last, and an assembly fills K's border and corner on ψ too.
@@ -109,10 +103,10 @@ class ConstrainedSystem final : public BarrierRows {
   /// Assembles the condensed Newton system at the current iterate: K (the band and, with a twist,
   /// its border and corner), rhs, ∇φ_μ. `primal`: the multipliers are replaced by their primal
   /// values μ/s (then the step is Newton's on φ_μ). kkt = null: the constraint values and
-  /// gradients only (multipliers and slacks untouched).
+  /// gradients only (multipliers and slacks untouched). Returns f at the iterate.
   template <typename Scalar>
-  Assembly assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt,
-                    Eigen::VectorXd* rhs, Eigen::VectorXd* merit_gradient);
+  double assemble(double mu, double rho, bool primal, KktBlocks<Scalar>* kkt, Eigen::VectorXd* rhs,
+                  Eigen::VectorXd* merit_gradient);
 
   // BarrierRows (the predictor–corrector's part; q for the complementarity target).
   double affineComplementarity(const Eigen::VectorXd& d, double* average,
@@ -149,14 +143,6 @@ class ConstrainedSystem final : public BarrierRows {
   LevelDuals estimatedDuals();
 
  private:
-  template <typename Scalar>
-  using Sink = KktSink<Scalar, FixedTimeStep>;
-  template <typename Scalar>
-  void assembleTorques(double mu, double rho, bool primal, Sink<Scalar>* H, Eigen::VectorXd* rhs,
-                       Eigen::VectorXd* merit_gradient, Assembly* out);
-  template <typename Scalar>
-  void assembleQuantity(const std::vector<int>& block, double mu, double rho, bool primal,
-                        Sink<Scalar>* H);
   void addConstraintGradients(double mu, Eigen::VectorXd* rhs,
                               Eigen::VectorXd* merit_gradient) const;
   void pollEvery(int k) const;

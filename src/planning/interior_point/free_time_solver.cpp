@@ -137,15 +137,8 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   }
 
   double firstBarrier() const;
-  using Sink = KktSink<double, FreeTimeStep>;
   void assemble(double mu, double epsilon);
-  void assembleQuantity(Sink& sink, const std::vector<int>& block, double mu);
   void leaveElasticIfInside();
-  /// One local block (nodes and η): its Hessian into K, its right-hand side and Lagrangian
-  /// gradient into theirs.
-  void scatter(Sink& sink, int first_node, int width, const Eigen::Matrix<double, 10, 10>& H,
-               const Eigen::Matrix<double, 10, 1>& rhs,
-               const Eigen::Matrix<double, 10, 1>& lagrangian);
   /// Back to the accepted R_N with the accepted steps (a trial's twist moved it).
   void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
@@ -235,78 +228,24 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   SolveContext* context_ = nullptr;
 };
 
+/// w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
+/// rows are prepared in the visit, after z entered w); a stencil's block, with every row's ω a aᵀ
+/// in one 3×3 W, summed in double (BarrierRowBlock::assemble); the cones before the rows that
+/// move with h (the order the band's sums were formed in).
 void FreeTimeSolver::assemble(double mu, double epsilon) {
   const FreeTimeStep step{h0_};
-  Sink sink(np_, step, &kkt_blocks_);
+  KktSink<double, FreeTimeStep> sink(np_, step, &kkt_blocks_);
   rhs_.setZero(n_ + borderSize());
   lagrangian_gradient_.setZero(n_ + borderSize());
-  // w = ε r − Σ zᵢ ∂cᵢ/∂r: the Lagrangian's second-order weights of the residual r = √w τ (the
-  // rows are prepared in the visit, after z entered w).
-  const auto cost = [&](int, const Vector3& r) { return Vector3(epsilon * r); };
-  const auto row = [](const FreeTimeRows&, FreeTimeRow&, double) {};
+  AssemblyChoices choices;
+  choices.cost_weight = epsilon;
+  choices.sum_in_double = choices.row_gradients = choices.fixed_quantities_first = true;
+  block_.assemble(&sink, step, mu, rho_, choices, &rhs_, &lagrangian_gradient_, [&](int k) {
+    if (context_ && k % kColumnsBetweenPolls == 0) context_->poll();
+  });
   const double dT = objective_.timeGradient();  // ∂(T/T₀)/∂η = N h₀/T₀
-  const auto visit = [&](const ReducedProblem::TimeStepStencil& st, double s) {
-    if (context_ && st.k % kColumnsBetweenPolls == 0) context_->poll();
-    const Eigen::Matrix<double, 3, 10> G = step.jacobian(st);  // ∂r/∂(δ_{k−1}, δ_k, δ_{k+1}, η)
-    Eigen::Matrix<double, 10, 10> H = step.second(st);
-    // The torque's 3×3 weight W, so that the stencil's block is H + Gᵀ W G: Gauss–Newton's ε of
-    // the effort and −z c''/w_k of the constraints' isotropic curvature, and the barrier's ω a aᵀ
-    // of each bound, a = ∂c/∂r (one product instead of one per bound).
-    Matrix3 W = epsilon * Matrix3::Identity();
-    Eigen::Matrix<double, 10, 1> grad_f = epsilon * G.transpose() * st.tau;
-    Eigen::Matrix<double, 10, 1> rhs = -grad_f, lagrangian = grad_f;
-    const auto fold = [&](const FreeTimeRows& g, FreeTimeRow& in, const Vector3& a) {
-      form(g).prepare(in, mu, rho_, false);
-      const RowTerms terms = form(g).terms(in, mu);
-      W.diagonal().array() -= in.z * g.constraint->curvature() / (s * s);
-      W.noalias() += terms.weight * a * a.transpose();
-      rhs += terms.rhs * in.g;
-      lagrangian -= in.z * in.g;
-    };
-    block_.rows.chainTorques(st, s, G, fold);
-    H.noalias() += G.transpose() * W * G;
-    scatter(sink, st.k - 1, 3, H, rhs, lagrangian);
-  };
-  block_.rows.forEachTorqueStencil(np_, step, true, cost, row, visit);
-  // The quantities that do not move with h first (the order the band's sums were formed in).
-  for (const bool moves_with_h : {false, true}) {
-    for (const std::vector<int>& block : block_.rows.blocks) {
-      if (block_.rows.groups[block.front()].quantity->dependsOnTimeStep() == moves_with_h) {
-        assembleQuantity(sink, block, mu);
-      }
-    }
-  }
   rhs_(n_) -= dT;
   lagrangian_gradient_(n_) += dT;
-}
-
-/// The groups of one quantity (a cone, a rate, a wheel quantity) through the quantity's terms in
-/// (local nodes, η = h/h₀) and the chain rule (StageTranscription), with each constraint's
-/// barrier term ω g gᵀ.
-void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block, double mu) {
-  const StageSupport support = block_.rows.groups[block.front()].support;
-  const auto prepare = [&](const FreeTimeRows& g, FreeTimeRow& in) {
-    form(g).prepare(in, mu, rho_, false);
-  };
-  const auto visit = [&](const QuantityTermsWithTimeStep& t, Eigen::Matrix<double, 10, 10>* H) {
-    Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero(), lagrangian = rhs;
-    const int m = 3 * support.width;  // g is 0 past the local nodes but for η
-    for (const int i : block) {
-      FreeTimeRow& in = block_.rows.groups[i].instance(t.k);
-      // ω g gᵀ on the entries g can reach (a cone: 3 + 1 of 10).
-      const RowTerms terms = form(block_.rows.groups[i]).terms(in, mu);
-      const double w = terms.weight;
-      H->topLeftCorner(m, m).noalias() += (w * in.g.head(m)) * in.g.head(m).transpose();
-      H->block(0, 9, m, 1) += (w * in.g.head(m)) * in.g(9);
-      H->block(9, 0, 1, m) += ((w * in.g(9)) * in.g.head(m)).transpose();
-      (*H)(9, 9) += (w * in.g(9)) * in.g(9);
-      rhs += terms.rhs * in.g;
-      lagrangian -= in.z * in.g;
-    }
-    scatter(sink, t.k + support.node_offset, support.width, *H, rhs, lagrangian);
-  };
-  block_.rows.forEachQuantityInstance(
-      np_, FreeTimeStep{h0_}, block, true, [](int) {}, prepare, visit);
 }
 
 /// Leaves the elastic phase once every constraint holds strictly: from then on the iterate is a
@@ -315,15 +254,6 @@ void FreeTimeSolver::assembleQuantity(Sink& sink, const std::vector<int>& block,
 void FreeTimeSolver::leaveElasticIfInside() {
   if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
   elastic_ = false;
-}
-
-void FreeTimeSolver::scatter(Sink& sink, int first_node, int width,
-                             const Eigen::Matrix<double, 10, 10>& H,
-                             const Eigen::Matrix<double, 10, 1>& rhs,
-                             const Eigen::Matrix<double, 10, 1>& lagrangian) {
-  sink.addBlock(first_node, width, H, &lagrangian);
-  addLocalVector<FreeTimeStep>(np_, rhs, 1.0, first_node, width, &rhs_);
-  addLocalVector<FreeTimeStep>(np_, lagrangian, 1.0, first_node, width, &lagrangian_gradient_);
 }
 
 void FreeTimeSolver::restoreAcceptedEnd() {

@@ -122,7 +122,7 @@ class GridSolve final : public BarrierProblemSolve<FixedTimeStep, Scalar> {
   double previousDecrement() const override { return test_.previousDecrement(); }
   /// The condensed system (primal: with the multipliers μ/s); a non-finite cost ends the solve.
   Pass assemble(bool primal) override {
-    cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_, &rhs_, &merit_gradient_).cost;
+    cost_ = system_.assemble(mu_, rho_, primal, &kkt_blocks_, &rhs_, &merit_gradient_);
     if (!std::isfinite(cost_)) {
       return end(Termination::StepTooLarge,
                  "non-finite cost (step too large for this h? increase steps)");

@@ -55,10 +55,10 @@ struct KktBlocks {
 /// the motions compose: h moves R_{N−1} along its boundary path d(h) (ReducedProblem::nodePath),
 ///     R_N exp(Δψ b^) F(h)ᵀ = R_{N−1} exp(Δψ e^) exp(d^),   x = Δψ e + d + ½ Δψ e × d + O(3)
 /// (Baker–Campbell–Hausdorff), so ∂²L/∂ψ∂η = e·H(:, η) + ∇_{x_{N−1}}L · ½ (e × d′) h₀: the path's
-/// curvature term, from the block's Lagrangian gradient. How the blocks are summed stays each
-/// problem's: fixed h adds the rows' g gᵀ/D one by one as rank-one terms in the band's precision
-/// (the precision rule, grid_solve.hpp), free time sums a stencil's block in double
-/// and adds it once.
+/// curvature term, from the block's Lagrangian gradient. How the blocks are summed is the
+/// profile's (AssemblyChoices::sum_in_double): the rows' g gᵀ/D one by one as rank-one terms in
+/// the band's precision (fixed h, the precision rule, grid_solve.hpp), or a block summed in double
+/// and added once (free time).
 template <typename Scalar, typename TimeStep>
 class KktSink {
  public:
@@ -99,15 +99,24 @@ class KktSink {
     }
   }
 
-  /// weight·g gᵀ over the block's nodes, the band's part formed in its precision.
-  void addRankOne(int first_node, int width, const Eigen::Matrix<double, 9, 1>& g, double weight) {
+  /// weight·g gᵀ over the block's nodes (and η), the band's part formed in its precision.
+  void addRankOne(int first_node, int width, const Local& g, double weight) {
     const LocalSlots l = localSlots(np_, first_node, width);
-    if (!l.empty()) kkt_.band.template addRankOne<9>(l.offset, g, weight, l.first, l.last);
+    const Eigen::Matrix<double, 9, 1> nodes = g.template head<9>();
+    if (!l.empty()) kkt_.band.template addRankOne<9>(l.offset, nodes, weight, l.first, l.last);
+    if constexpr (kEntries == 10) {
+      addNodeVector(np_, nodes, weight * g(9), first_node, width, kkt_.border.col(0));
+      kkt_.corner(0, 0) += weight * g(9) * g(9);
+    }
     if (!np_.hasTwist()) return;
-    const double ge = g.dot(localTwistMotion(np_, first_node, width));
+    const double ge = nodes.dot(localTwistMotion(np_, first_node, width));
     if (ge == 0.0) return;
     kkt_.corner(twist_, twist_) += weight * ge * ge;
-    addNodeVector(np_, g, weight * ge, first_node, width, kkt_.border.col(twist_));
+    addNodeVector(np_, nodes, weight * ge, first_node, width, kkt_.border.col(twist_));
+    if constexpr (kEntries == 10) {
+      kkt_.corner(0, twist_) += weight * ge * g(9);
+      kkt_.corner(twist_, 0) += weight * ge * g(9);
+    }
   }
 
  private:

@@ -132,6 +132,8 @@ struct FixedTimeStep {
   }
   /// ∂ρ/∂x over the stencil's entries (ρ = √w τ_k the stencil's residual).
   const Eigen::Matrix<double, 3, 9>& jacobian(const Stencil& st) const { return st.jacobian; }
+  /// ∂²(wᵀρ) over the same entries (w the stencil's second-order weights).
+  const Eigen::Matrix<double, 9, 9>& second(const Stencil& st) const { return st.second; }
   /// The global unknowns after the node unknowns: a pointing end's ψ (index np.unknowns()).
   static int globals(const ReducedProblem& np) { return np.hasTwist() ? 1 : 0; }
   static int twistIndex(const ReducedProblem& np) { return np.unknowns(); }

@@ -466,6 +466,70 @@ TEST(FreeTime, TheLowestIterateThatIsAPlanIsKeptAndNoOtherIterate) {
   EXPECT_EQ(kept->attempt, least_limit);
 }
 
+TEST(FreeTime, EachChainKeepsItsLowestIterateAndTheOtherChainsComeHighestFirst) {
+  // The probes below a spinning T* run again from each chain's lowest iterate that is a plan (a
+  // chain: the iterates that descend from one solve's, each offered with its chain's root). Two
+  // chains of iterates, each from solves of one start stopped at growing iteration limits (from
+  // the geodesic at 3.5 s and at 4.5 s), offered interleaved: each chain keeps its own lowest,
+  // the lowest of all is the least T offered, and the chains but the lowest's come highest first,
+  // only those strictly below the T asked; a chain's iterate offered again above its lowest
+  // changes nothing.
+  ap::PlanningProblem p = spinningRequest(64);
+  struct Chain {
+    double from;
+    std::size_t root;
+    double least = std::numeric_limits<double>::infinity();
+    std::vector<ap::Maneuver> iterates;
+  };
+  Chain chains[] = {{3.5, 100}, {4.5, 200}};
+  ap::LowestIterate kept;
+  for (const int limit : {5, 10, 20, 40}) {
+    for (Chain& c : chains) {
+      p.duration = c.from;
+      const ap::ReducedProblem geodesic(p);
+      const ap::FreeTimeOutcome o =
+          ap::solveFreeTime(p, geodesic.attitudes(geodesic.current()), c.from, 1e-9, limit);
+      if (o.termination != ap::Termination::NotConverged || !(o.smallest_value > 0)) continue;
+      // The chain's first solve is its root; the later ones continue it.
+      ap::IterateBelow iterate{o.maneuver, c.root};
+      if (!c.iterates.empty()) {
+        iterate.attempt = c.root + static_cast<std::size_t>(limit);
+        iterate.chain_root = c.root;
+      }
+      kept.offer(p, iterate);
+      c.least = std::min(c.least, o.duration);
+      c.iterates.push_back(o.maneuver);
+    }
+  }
+  for (const Chain& c : chains) ASSERT_GE(c.iterates.size(), 2u) << c.from;
+  const std::size_t roots[] = {chains[0].root, chains[1].root};
+  const double least = std::min(chains[0].least, chains[1].least);
+  const int low = chains[0].least <= chains[1].least ? 0 : 1;
+  const double inf = std::numeric_limits<double>::infinity();
+  ASSERT_NE(kept.below(inf), nullptr);
+  EXPECT_EQ(kept.below(inf)->effort.duration, least);
+  EXPECT_EQ(kept.below(inf)->root, roots[low]);
+  // The other chain, its lowest; both chains highest first where none is excepted.
+  std::vector<ap::LowestIterate::Plan> others = kept.chainsBelow(inf, roots[low]);
+  ASSERT_EQ(others.size(), 1u);
+  EXPECT_EQ(others[0].root, roots[1 - low]);
+  EXPECT_EQ(others[0].effort.duration, chains[1 - low].least);
+  const std::vector<ap::LowestIterate::Plan> both = kept.chainsBelow(inf, 0);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_GT(both[0].effort.duration, both[1].effort.duration);
+  EXPECT_EQ(both[1].effort.duration, least);
+  EXPECT_TRUE(kept.chainsBelow(chains[1 - low].least, roots[low]).empty());
+  // The lowest chain's first iterate again (above its lowest): nothing moves.
+  ap::IterateBelow again{chains[low].iterates.front(), 999};
+  again.chain_root = roots[low];
+  kept.offer(p, again);
+  others = kept.chainsBelow(inf, roots[low]);
+  ASSERT_EQ(others.size(), 1u);
+  EXPECT_EQ(others[0].effort.duration, chains[1 - low].least);
+  EXPECT_EQ(kept.below(inf)->effort.duration, least);
+  EXPECT_EQ(kept.chainsBelow(inf, 0).size(), 2u);
+}
+
 namespace {
 
 /// q = ½|Ω|² of rate-limit instance k (a step's rate for paper and variational, a node's J⁻¹Π_k

@@ -300,10 +300,40 @@ std::optional<PlanResult> iterateAsPlan(const PlanningProblem& effort, const Man
 
 void LowestIterate::offer(const PlanningProblem& problem,
                           const std::optional<IterateBelow>& iterate) {
-  if (!iterate || (lowest_ && !(iterate->duration() < lowest_->effort.duration))) return;
+  if (!iterate) return;
+  const std::size_t root = iterate->root();
+  const auto chain = std::find_if(chains_.begin(), chains_.end(),
+                                  [&](const Plan& kept) { return kept.root == root; });
+  if (chain != chains_.end() && !(iterate->duration() < chain->effort.duration)) return;
   const PlanningProblem effort = effortAt(problem, iterate->duration());
   std::optional<PlanResult> plan = iterateAsPlan(effort, iterate->plan);
-  if (plan) lowest_ = Plan{effort, std::move(*plan), iterate->attempt};
+  if (!plan) return;
+  Plan kept{effort, std::move(*plan), iterate->attempt, root};
+  if (chain != chains_.end()) {
+    *chain = std::move(kept);
+  } else {
+    chains_.push_back(std::move(kept));
+  }
+}
+
+const LowestIterate::Plan* LowestIterate::below(double duration) const {
+  const Plan* lowest = nullptr;
+  for (const Plan& kept : chains_) {
+    if (kept.effort.duration < (lowest ? lowest->effort.duration : duration)) lowest = &kept;
+  }
+  return lowest;
+}
+
+std::vector<LowestIterate::Plan> LowestIterate::chainsBelow(double duration,
+                                                            std::size_t except_root) const {
+  std::vector<Plan> below;
+  for (const Plan& kept : chains_) {
+    if (kept.root != except_root && kept.effort.duration < duration) below.push_back(kept);
+  }
+  std::stable_sort(below.begin(), below.end(), [](const Plan& a, const Plan& b) {
+    return a.effort.duration > b.effort.duration;
+  });
+  return below;
 }
 
 namespace {
@@ -328,14 +358,16 @@ PlanResult upperBoundAt(const PlanningProblem& effort, const PlanResult& answer,
 /// iterate; its attempt kept `below_kept`): the free-time KKT point from it where one lies lower,
 /// else that plan as an upper bound on T* (upperBoundAt). Its trail: the context's from `first`.
 /// Where that free-time solve ended short of a KKT point at a plan below `below`'s T, the plan
-/// goes to `*lower_plan` and is offered to `iterates`.
+/// goes to `*lower_plan` and is offered to `iterates`, in the chain `chain_root` where `below`
+/// came of an iterate of that chain (else a chain of its own).
 PlanResult lowerAnswer(const PlanningProblem& problem, const PlanningProblem& effort,
                        const PlanResult& answer, const PlanResult& below,
                        std::optional<std::size_t> below_kept, std::size_t first,
                        SolveContext& context, std::optional<IterateBelow>* lower_plan,
-                       LowestIterate& iterates) {
+                       LowestIterate& iterates, std::optional<std::size_t> chain_root) {
   std::optional<PlanResult> lower =
       freeTimeFrom(problem, below.maneuver, effort.duration, "probe's plan", context, lower_plan);
+  if (*lower_plan) (*lower_plan)->chain_root = chain_root;
   iterates.offer(problem, *lower_plan);
   if (lower && lower->converged() && lower->minimum_duration < effort.duration) {
     lower->attempts = context.attemptsFrom(first);
@@ -365,14 +397,17 @@ PlanResult atMostLowestIterate(PlanResult answer, const LowestIterate& iterates,
 /// `iterates_are_plans`, where that probe finds no plan the iterate is the plan at its T
 /// (iterateAsPlan) and the free-time solve goes on from it. Every such iterate is offered to
 /// `iterates`. No probe goes below the proven bound T_c on the grid. The trail keeps every probe
-/// (the context's from `first`, where `answer`'s began).
+/// (the context's from `first`, where `answer`'s began). Where `solves_left` is given, each probe
+/// takes one of its solves and none is asked once it is spent.
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
                        SolveContext& context, LowestIterate& iterates,
-                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans) {
+                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans,
+                       int* solves_left = nullptr) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
+    if (solves_left && (*solves_left)-- <= 0) break;
     PlanningProblem effort =
         effortAt(problem, std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor));
     SolveRequest options(context.options());
@@ -397,6 +432,8 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
         below_kept = lower_plan->attempt;
       }
     }
+    const std::optional<std::size_t> chain_root =
+        from_iterate ? std::optional<std::size_t>(lower_plan->root()) : std::nullopt;
     lower_plan.reset();
     if (!provesFeasible(effort, below)) {
       context.restoreKept(answer_kept);
@@ -405,33 +442,83 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
       continue;
     }
     answer = lowerAnswer(problem, effort, answer, below, below_kept, first, context, &lower_plan,
-                         iterates);
+                         iterates, chain_root);
     if (!from_iterate) steps.found(answer.minimum_duration < effort.duration);
   }
   return answer;
 }
 
+/// The solves the probes from the other chains' iterates may take in all (probedFromOtherChains):
+/// one run of probedBelow's worth, kMaxProbes probes and kMaxProbes hand-ons. Why that many:
+/// measured on the seed-45 spinning suite's #221 (N = 405), the crawl from the iterate of the
+/// solve from the search's plan (71.13 s) took 12 hand-ons to 62.61 s before a cold probe found
+/// the basin of 40.65 s.
+constexpr int kOtherChainsSolves = 2 * kMaxProbes;
+
+/// The probes below T* again from `from`, an iterate that is a plan below `answer`'s T: that
+/// iterate is the answer, the free-time solve goes on from it, and the probes (probedBelow,
+/// iterates as plans) follow, within `*solves_left` solves where that is given (the free-time
+/// solve from `from` one of them). Every iterate of the run is in `from`'s chain.
+PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& answer,
+                             const LowestIterate::Plan& from, std::size_t first,
+                             SolveContext& context, LowestIterate& iterates, int* solves_left) {
+  if (solves_left) --*solves_left;
+  std::optional<IterateBelow> lower_plan;
+  PlanResult run = lowerAnswer(problem, from.effort, answer, from.plan, from.attempt, first,
+                               context, &lower_plan, iterates, from.root);
+  return probedBelow(problem, std::move(run), first, context, iterates, std::move(lower_plan), true,
+                     solves_left);
+}
+
+/// The probes below T* from each other chain's lowest iterate below `answer`'s T (`others`,
+/// highest first: probedFromIterate), within kOtherChainsSolves solves in all. `best` (the run
+/// from the lowest iterate) stays the answer unless a run ends lower, so the answer is never
+/// above it. Highest first: a chain's iterates are successive points of one crawl, so the lowest
+/// ones lie on the chain the first run already followed; the chains that begin highest (the
+/// solve from the search's plan) are the ones farthest from it.
+PlanResult probedFromOtherChains(const PlanningProblem& problem, const PlanResult& answer,
+                                 const std::vector<LowestIterate::Plan>& others, PlanResult best,
+                                 std::size_t first, SolveContext& context,
+                                 LowestIterate& iterates) {
+  std::optional<std::size_t> best_kept = context.keptAttempt();
+  int solves_left = kOtherChainsSolves;
+  for (const LowestIterate::Plan& from : others) {
+    if (solves_left <= 0 || context.stopReason()) break;
+    PlanResult run =
+        probedFromIterate(problem, answer, from, first, context, iterates, &solves_left);
+    if (run.converged() && run.minimum_duration < best.minimum_duration) {
+      best = std::move(run);
+      best_kept = context.keptAttempt();
+    }
+  }
+  context.restoreKept(best_kept);
+  best.attempts = context.attemptsFrom(first);
+  return best;
+}
+
 /// The probes below T* again from the lowest iterate that is a plan, where it lies below
 /// `answer`'s T (else `answer`): that iterate is the answer, the free-time solve goes on from it,
-/// and the probes (probedBelow, iterates as plans) follow; the answer is then at most the lowest
-/// iterate any solve ended at. So T* is at most the T of every iterate that is a plan, and never
-/// above `answer`'s (the probes before it are untouched). Measured on the seed-45 spinning suite:
-/// iterates as plans during the first probes (hand-ons from the search's plan) moved #77 from its
-/// 5.18 s basin to a second-order sufficient KKT point at 6.54 s, below which the far probes are
-/// not asked; run after them, as here, #77 keeps 5.18 s, #221 (N = 405) goes from a probe's plan at
-/// 72.62 s to 51.66 s, and #47 of the held-out seed-47 suite from 25.19 s to 21.48 s.
+/// and the probes (probedBelow, iterates as plans) follow; then from each other chain's lowest
+/// iterate below `answer`'s T (probedFromOtherChains). The answer is then at most the lowest
+/// iterate any solve ended at. So T* is at most the T of every iterate that is a plan, never above
+/// `answer`'s (the probes before it are untouched) and never above the run from the lowest alone.
+/// Measured on the seed-45 spinning suite: iterates as plans during the first probes (hand-ons from
+/// the search's plan) moved #77 from its 5.18 s basin to a second-order sufficient KKT point at
+/// 6.54 s, below which the far probes are not asked; run after them, as here, #77 keeps 5.18 s,
+/// #221 (N = 405) goes from a probe's plan at 72.62 s to 51.66 s from the lowest, and #47 of the
+/// held-out seed-47 suite from 25.19 s to 21.48 s.
 PlanResult probedBelowLowestIterate(const PlanningProblem& problem, PlanResult answer,
                                     std::size_t first, SolveContext& context,
                                     LowestIterate& iterates) {
   const LowestIterate::Plan* found = iterates.below(answer.minimum_duration);
   if (!found || !answer.converged() || context.stopReason()) return answer;
   const LowestIterate::Plan lowest = *found;  // the solve from it offers lower ones
-  std::optional<IterateBelow> lower_plan;
-  answer = lowerAnswer(problem, lowest.effort, answer, lowest.plan, lowest.attempt, first, context,
-                       &lower_plan, iterates);
-  answer = probedBelow(problem, std::move(answer), first, context, iterates, std::move(lower_plan),
-                       true);
-  return atMostLowestIterate(std::move(answer), iterates, first, context);
+  const std::vector<LowestIterate::Plan> others =
+      iterates.chainsBelow(answer.minimum_duration, lowest.root);
+  PlanResult best = probedFromIterate(problem, answer, lowest, first, context, iterates, nullptr);
+  best = atMostLowestIterate(std::move(best), iterates, first, context);
+  best = probedFromOtherChains(problem, answer, others, std::move(best), first, context, iterates);
+  return atMostLowestIterate(std::move(best), iterates, first, context);
 }
 
 /// T* and its plan: the free-time interior point where it applies (freeTimeUnsupported), else,

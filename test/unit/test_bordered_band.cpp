@@ -213,3 +213,28 @@ TYPED_TEST(BorderedBandTest, WithoutABorderIsTheBandedSolve) {
   ASSERT_TRUE(bandOf<TypeParam>(c).solvePositiveDefinite(&b));
   EXPECT_EQ((x - b).cwiseAbs().maxCoeff(), 0.0);
 }
+
+// The Newton systems' half bandwidth (8) is factored and substituted by loops of fixed length away
+// from the band's ends (banded_matrix.cpp): the same products in the same order as the general
+// loops, so the same bits. The general loops run on the same band stored with one more diagonal,
+// zero (each extra product is 0 and leaves its sum unchanged).
+TEST(BandedCholesky, NewtonBandwidthGivesTheGeneralLoopsBits) {
+  const int n = 60, p = 8;
+  for (BandKind kind : {BandKind::DiagonallyDominant, BandKind::Biharmonic}) {
+    std::mt19937 rng(kind == BandKind::Biharmonic ? 23 : 21);
+    const Eigen::MatrixXd A = randomBand(n, p, kind, &rng);
+    BandedSymmetricMatrix fixed(n, p), general(n, p + 1);
+    for (int i = 0; i < n; ++i) {
+      for (int j = std::max(0, i - p); j <= i; ++j) {
+        fixed.add(i, j, A(i, j));
+        general.add(i, j, A(i, j));
+      }
+    }
+    const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+    Eigen::VectorXd x_fixed = rhs, x_general = rhs;
+    ASSERT_TRUE(fixed.solvePositiveDefinite(&x_fixed));
+    ASSERT_TRUE(general.solvePositiveDefinite(&x_general));
+    for (int i = 0; i < n; ++i) EXPECT_EQ(x_fixed(i), x_general(i)) << "row " << i;
+    EXPECT_LT((A * x_fixed - rhs).norm(), 1e-12 * A.norm() * x_fixed.norm());  // it solves it
+  }
+}

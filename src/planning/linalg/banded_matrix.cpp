@@ -36,6 +36,54 @@ Scalar minusDot(Scalar s, int first, int last, A a, B b) {
     return s;
   }
 }
+
+/// The Newton systems' half bandwidth (ReducedProblem::kHalfBandwidth, which this layer may not
+/// include): their rows away from the ends are factored and substituted with the sums' lengths
+/// known at compile time, so the compiler unrolls them.
+constexpr int kFixedBandwidth = 8;
+
+/// Whether row (column) i of an n-row band of half bandwidth P has all P entries on both sides:
+/// then the general loops' sums run over exactly the ranges the fixed ones below spell out.
+template <int P>
+bool hasFullBand(int i, int n) {
+  return i >= P && i + P <= n - 1;
+}
+
+/// Column j of the Cholesky factor (BandedCholeskyFactor::factor's loop body) where
+/// hasFullBand<P>(j): the same products subtracted in the same order, in double. `lj` is
+/// row(j) (row(j)[k] = L(j, k)); row(j + t) = row(j) + t P in that layout. False if the
+/// pivot is not positive.
+template <int P>
+bool factorFullColumn(double* lj, int j) {
+  const int base = j - P;  // L(·, base + m), m = 0..P − 1: the columns the sums run over
+  double d = lj[j];
+  for (int m = 0; m < P; ++m) d -= lj[base + m] * lj[base + m];
+  if (!(d > 0) || !std::isfinite(d)) return false;
+  lj[j] = std::sqrt(d);
+  for (int t = 1; t <= P; ++t) {
+    double* li = lj + t * P;  // row(j + t): its sum starts at column j + t − P = base + t
+    double s = li[j];
+    for (int m = t; m < P; ++m) s -= li[base + m] * lj[base + m];
+    li[j] = s / lj[j];
+  }
+  return true;
+}
+
+/// Forward substitution's row i (L y = b) where hasFullBand<P>(i); `li` is row(i).
+template <int P>
+void forwardFullRow(const double* li, double* y, int i) {
+  double s = y[i];
+  for (int m = 0; m < P; ++m) s -= li[i - P + m] * y[i - P + m];
+  y[i] = s / li[i];
+}
+
+/// Back substitution's row i (Lᵀ x = y) where hasFullBand<P>(i): L(i + t, i) = row(i)[i + t P].
+template <int P>
+void backwardFullRow(const double* li, double* y, int i) {
+  double s = y[i];
+  for (int t = 1; t <= P; ++t) s -= li[i + t * P] * y[i + t];
+  y[i] = s / li[i];
+}
 }  // namespace
 
 template <typename Scalar>
@@ -106,6 +154,12 @@ bool BandedCholeskyFactor<Scalar>::factor(const BandedSymmetric<Scalar>& A,
   for (int j = 0; j < n_; ++j) {
     if (interruption && j % kColumnsBetweenPolls == 0) interruption->poll();
     Scalar* lj = row(j);
+    if constexpr (std::is_same_v<Scalar, double>) {
+      if (p_ == kFixedBandwidth && hasFullBand<kFixedBandwidth>(j, n_)) {
+        if (!factorFullColumn<kFixedBandwidth>(lj, j)) return false;
+        continue;
+      }
+    }
     const auto lj_at = [lj](int k) { return lj[k]; };
     const Scalar d = minusDot(lj[j], std::max(0, j - p_), j, lj_at, lj_at);
     if (!(d > 0) || !scalarIsFinite(d)) return false;
@@ -137,13 +191,26 @@ template <typename Scalar>
 void BandedCholeskyFactor<Scalar>::substitute(Scalar* y) const {
   const int w = p_ + 1;
   const auto row = [&](int i) { return L_.data() + static_cast<size_t>(i) * w + p_ - i; };
+  [[maybe_unused]] const bool fixed = p_ == kFixedBandwidth;
   for (int i = 0; i < n_; ++i) {  // L y = b
     const Scalar* li = row(i);
+    if constexpr (std::is_same_v<Scalar, double>) {
+      if (fixed && hasFullBand<kFixedBandwidth>(i, n_)) {
+        forwardFullRow<kFixedBandwidth>(li, y, i);
+        continue;
+      }
+    }
     const Scalar s = minusDot(
         y[i], std::max(0, i - p_), i, [li](int k) { return li[k]; }, [y](int k) { return y[k]; });
     y[i] = divideByDiagonal(s, i);
   }
   for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = y
+    if constexpr (std::is_same_v<Scalar, double>) {
+      if (fixed && hasFullBand<kFixedBandwidth>(i, n_)) {
+        backwardFullRow<kFixedBandwidth>(row(i), y, i);
+        continue;
+      }
+    }
     const Scalar s = minusDot(
         y[i], i + 1, std::min(n_ - 1, i + p_) + 1, [&row, i](int k) { return row(k)[i]; },
         [y](int k) { return y[k]; });

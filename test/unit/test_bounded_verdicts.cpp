@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 #include <variant>
@@ -828,6 +829,68 @@ TEST(BoundedVerdicts, AMinimumEffortRequestInARangeWithoutRoomIsProvenInfeasible
         }
       });
   EXPECT_GE(ranges, 4);
+}
+
+namespace {
+
+/// The durations a verdict of the search that found no plan says are proven (nothing: another
+/// kind).
+std::optional<verdicts::ProvenDurations> provenDurationsOf(const Verdict& verdict) {
+  if (const auto* v = std::get_if<verdicts::SearchUnrepresentable>(&verdict)) return v->proven;
+  if (const auto* v = std::get_if<verdicts::SearchInfeasible>(&verdict)) return v->proven;
+  if (const auto* v = std::get_if<verdicts::SearchStopped>(&verdict)) return v->proven;
+  return std::nullopt;
+}
+
+/// The figure `name` of `verdict` (NaN: none).
+double figureOf(const Verdict& verdict, const std::string& name) {
+  for (const VerdictFigure& f : verdictFigures(verdict))
+    if (f.name == name) return f.value;
+  return std::nan("");
+}
+
+}  // namespace
+
+TEST(BoundedVerdicts, MinimumTimeWithoutAPlanSaysTheDurationsProvenWithoutOneAsItsDataHasThem) {
+  // The seeded suite's #158 (paper, N = 256, its final rate on the rate limit): minimum time
+  // finds no plan, and the bounds prove none below the grid's lower bound and none from where
+  // the last free step has no room on (up to the largest step at the boundary rates). The
+  // verdict holds those durations as data, the same as the answer's duration_verdict; its words
+  // say each figure, and the one window left where a plan may lie.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 158);
+  ASSERT_TRUE(request.has_value());
+  SCOPED_TRACE(request->label);
+  const PlanningProblem& p = request->problem;
+  const PlanResult r = planManeuver(p);
+  ASSERT_FALSE(r.converged()) << r.message();
+  const std::optional<verdicts::ProvenDurations> proven = provenDurationsOf(r.verdict);
+  ASSERT_TRUE(proven.has_value()) << r.message();
+  EXPECT_EQ(proven->steps, p.steps);
+  EXPECT_EQ(proven->least, discreteDurationLowerBound(p));
+  ASSERT_TRUE(proven->rangeProven());
+  EXPECT_EQ(proven->no_plan_from, r.duration_verdict.no_plan_from);
+  EXPECT_EQ(proven->no_plan_to, r.duration_verdict.no_plan_to);
+  EXPECT_LT(proven->least, proven->no_plan_from);
+  EXPECT_EQ(figureOf(r.verdict, "grid_lower_bound"), proven->least);
+  EXPECT_EQ(figureOf(r.verdict, "no_plan_from"), proven->no_plan_from);
+  EXPECT_EQ(figureOf(r.verdict, "no_plan_to"), proven->no_plan_to);
+  const std::string message = r.message();
+  for (const std::string& said :
+       {"no plan below " + exactNumber(proven->least) + " s (" + proven->least_basis + ")",
+        "none from " + exactNumber(proven->no_plan_from) + " s on (to " +
+            exactNumber(proven->no_plan_to) + " s",
+        "a plan can lie only in [" + exactNumber(proven->least) + ", " +
+            exactNumber(proven->no_plan_from) + ") s"}) {
+    EXPECT_NE(message.find(said), std::string::npos) << said << "\n" << message;
+  }
+  // What the words call proven holds: the last free step has no room inside the range.
+  double rate_limit = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : p.constraints)
+    if (c.kind == ConstraintKind::MaxAngularRate) rate_limit = std::min(rate_limit, c.limit);
+  for (const double f : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const double T = proven->no_plan_from + f * (proven->no_plan_to - proven->no_plan_from);
+    EXPECT_GT(leastRateBeforeTheEnd(p, T), rate_limit) << "T = " << T;
+  }
 }
 
 TEST(BoundedVerdicts, ElasticFreeTimeStartsNeverEndBelowTheProvenLeastDuration) {

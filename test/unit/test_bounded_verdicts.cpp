@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 #include <variant>
@@ -538,6 +539,83 @@ TEST(BoundedVerdicts, AStartThatJoinedAnotherStartsPathIsSolvedAgainFromItsViola
   EXPECT_LT(check.result.minimum_duration, 0.66);
 }
 
+TEST(BoundedVerdicts, SpinningExcursionStartsLeaveTheNodesTheEndRatesFixAsTheGeodesicHasThem) {
+  // Spinning ends get excursion starts as rest to rest has: the geodesic start turned at its
+  // free nodes by the 0.3 rad bump about the axes perpendicular to its turn. On the spinning
+  // minimum-time requests of a seeded slice, at the grid the starts are solved on: the nodes the
+  // boundary rates fix (R_0, R_1, R_{N-1}, R_N) are the geodesic's exactly, the largest turn off
+  // it is the bump's size to its sampling at the nodes, and each axis is perpendicular to the turn.
+  int requests = 0;
+  for (int i = 0; i < 40; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    if (!request || request->problem.objective != Objective::MinimumTime ||
+        !hasSpinningEnds(request->problem)) {
+      continue;
+    }
+    SCOPED_TRACE(request->label);
+    const PlanningProblem coarsest = freeTimeLevels(request->problem).front();
+    SolveContext context{SolverOptions{}};
+    const std::vector<FreeTimeStart> starts = freeTimeStarts(coarsest, false, context);
+    const auto geodesic = std::find_if(starts.begin(), starts.end(),
+                                       [](const FreeTimeStart& s) { return s.name == "geodesic"; });
+    ASSERT_NE(geodesic, starts.end());
+    const std::vector<Matrix3>& G = geodesic->attitudes;
+    const int N = coarsest.steps;
+    int excursions = 0;
+    for (const FreeTimeStart& s : starts) {
+      if (s.kind != AttemptStart::Excursion) continue;
+      ++excursions;
+      SCOPED_TRACE(s.name);
+      ASSERT_EQ(s.attitudes.size(), G.size());
+      for (const int k : {0, 1, N - 1, N}) EXPECT_EQ(s.attitudes[k], G[k]) << "k = " << k;
+      double largest = 0.0;
+      for (int k = 0; k <= N; ++k)
+        largest = std::max(largest, so3::angleBetween(G[k], s.attitudes[k]));
+      EXPECT_LE(largest, s.detail.excursion * (1 + 1e-12));
+      EXPECT_GE(largest, s.detail.excursion * std::pow(std::cos(M_PI / (N - 2)), 2) * (1 - 1e-9));
+      EXPECT_NEAR(s.detail.excursion_axis.dot(s.detail.eigenaxis), 0.0, 1e-12);
+      EXPECT_EQ(s.duration, geodesic->duration);
+    }
+    EXPECT_GE(excursions, 3);
+    ++requests;
+  }
+  EXPECT_GE(requests, 4);
+}
+
+TEST(BoundedVerdicts, ASpinningRequestWhoseOtherStartsEndInAWorseBasinIsAnsweredFromAnExcursion) {
+  // The spinning minimum-time requests of the seeded suite's first slice (seed 45, #0-#15), each
+  // checked as planAndCheck does: in at least one, the least T of the starts is an excursion's,
+  // below every other start's (the class optima, the geodesic, the coasting start and their
+  // elastic phases: the answer without excursions), and that excursion answers.
+  int requests = 0, from_excursion = 0;
+  for (int i = 0; i < 16; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    if (!request || request->problem.objective != Objective::MinimumTime ||
+        !hasSpinningEnds(request->problem)) {
+      continue;
+    }
+    ++requests;
+    SCOPED_TRACE(request->label);
+    const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+    EXPECT_EQ(check.wrong, "") << check.result.message();
+    const auto* answer = std::get_if<verdicts::MinimumTimeAnswer>(&check.result.verdict);
+    if (!answer) continue;
+    double excursion = std::numeric_limits<double>::infinity();
+    double others = std::numeric_limits<double>::infinity();
+    for (const verdicts::MinimumTimeAnswer::Start& s : answer->starts) {
+      if (s.termination != Termination::Converged) continue;
+      double& least = s.name.rfind("excursion", 0) == 0 ? excursion : others;
+      least = std::min(least, s.duration);
+    }
+    if (excursion < others * (1 - 1e-3) && answer->start.rfind("excursion", 0) == 0) {
+      ++from_excursion;
+      EXPECT_LE(check.result.minimum_duration, excursion * (1 + 1e-9));
+    }
+  }
+  EXPECT_GE(requests, 3);
+  EXPECT_GE(from_excursion, 1);
+}
+
 TEST(BoundedVerdicts, SpinningMinimumTimeHasNoPlanFarBelowIt) {
   // Feasibility in T is not monotone with spinning ends: a KKT point can have no plan found 1 %
   // and 2 % below it and minimum-effort plans further below (the evidence: plans at
@@ -751,6 +829,68 @@ TEST(BoundedVerdicts, AMinimumEffortRequestInARangeWithoutRoomIsProvenInfeasible
         }
       });
   EXPECT_GE(ranges, 4);
+}
+
+namespace {
+
+/// The durations a verdict of the search that found no plan says are proven (nothing: another
+/// kind).
+std::optional<verdicts::ProvenDurations> provenDurationsOf(const Verdict& verdict) {
+  if (const auto* v = std::get_if<verdicts::SearchUnrepresentable>(&verdict)) return v->proven;
+  if (const auto* v = std::get_if<verdicts::SearchInfeasible>(&verdict)) return v->proven;
+  if (const auto* v = std::get_if<verdicts::SearchStopped>(&verdict)) return v->proven;
+  return std::nullopt;
+}
+
+/// The figure `name` of `verdict` (NaN: none).
+double figureOf(const Verdict& verdict, const std::string& name) {
+  for (const VerdictFigure& f : verdictFigures(verdict))
+    if (f.name == name) return f.value;
+  return std::nan("");
+}
+
+}  // namespace
+
+TEST(BoundedVerdicts, MinimumTimeWithoutAPlanSaysTheDurationsProvenWithoutOneAsItsDataHasThem) {
+  // The seeded suite's #158 (paper, N = 256, its final rate on the rate limit): minimum time
+  // finds no plan, and the bounds prove none below the grid's lower bound and none from where
+  // the last free step has no room on (up to the largest step at the boundary rates). The
+  // verdict holds those durations as data, the same as the answer's duration_verdict; its words
+  // say each figure, and the one window left where a plan may lie.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 158);
+  ASSERT_TRUE(request.has_value());
+  SCOPED_TRACE(request->label);
+  const PlanningProblem& p = request->problem;
+  const PlanResult r = planManeuver(p);
+  ASSERT_FALSE(r.converged()) << r.message();
+  const std::optional<verdicts::ProvenDurations> proven = provenDurationsOf(r.verdict);
+  ASSERT_TRUE(proven.has_value()) << r.message();
+  EXPECT_EQ(proven->steps, p.steps);
+  EXPECT_EQ(proven->least, discreteDurationLowerBound(p));
+  ASSERT_TRUE(proven->rangeProven());
+  EXPECT_EQ(proven->no_plan_from, r.duration_verdict.no_plan_from);
+  EXPECT_EQ(proven->no_plan_to, r.duration_verdict.no_plan_to);
+  EXPECT_LT(proven->least, proven->no_plan_from);
+  EXPECT_EQ(figureOf(r.verdict, "grid_lower_bound"), proven->least);
+  EXPECT_EQ(figureOf(r.verdict, "no_plan_from"), proven->no_plan_from);
+  EXPECT_EQ(figureOf(r.verdict, "no_plan_to"), proven->no_plan_to);
+  const std::string message = r.message();
+  for (const std::string& said :
+       {"no plan below " + exactNumber(proven->least) + " s (" + proven->least_basis + ")",
+        "none from " + exactNumber(proven->no_plan_from) + " s on (to " +
+            exactNumber(proven->no_plan_to) + " s",
+        "a plan can lie only in [" + exactNumber(proven->least) + ", " +
+            exactNumber(proven->no_plan_from) + ") s"}) {
+    EXPECT_NE(message.find(said), std::string::npos) << said << "\n" << message;
+  }
+  // What the words call proven holds: the last free step has no room inside the range.
+  double rate_limit = std::numeric_limits<double>::infinity();
+  for (const PlanningConstraint& c : p.constraints)
+    if (c.kind == ConstraintKind::MaxAngularRate) rate_limit = std::min(rate_limit, c.limit);
+  for (const double f : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const double T = proven->no_plan_from + f * (proven->no_plan_to - proven->no_plan_from);
+    EXPECT_GT(leastRateBeforeTheEnd(p, T), rate_limit) << "T = " << T;
+  }
 }
 
 TEST(BoundedVerdicts, ElasticFreeTimeStartsNeverEndBelowTheProvenLeastDuration) {

@@ -309,6 +309,45 @@ TEST(DriverVerdicts, EachKindSaysTheWordsOfItsFormerExpression) {
             "no start converged (16 twist and way-round starts tried)");
 }
 
+TEST(DriverVerdicts, TheSearchsVerdictsSayTheProvenDurationsFromTheirFigures) {
+  // A search that found no plan says what the bounds prove about the durations, from the
+  // verdict's data: none below the grid's lower bound, none from the range without room on, and
+  // the window left between them; each part only where its figures prove it.
+  namespace v = ap::verdicts;
+  const double least = 10.084716, from = 13.8437, to = 164.0412, T = 186.08;
+  const v::ProvenDurations both{256, least, "momentum", from, to};
+  const std::string below = "no plan below " + ap::exactNumber(least) + " s (momentum)";
+  const std::string range =
+      "from " + ap::exactNumber(from) + " s on (to " + ap::exactNumber(to) +
+      " s the paper scheme's last free step into the final rate on the rate limit has no room; "
+      "above it a step at the boundary rates would turn pi or more, no step of the scheme)";
+  const std::string window =
+      ": a plan can lie only in [" + ap::exactNumber(least) + ", " + ap::exactNumber(from) + ") s";
+  const std::string unrepresentable = ap::renderVerdict(v::SearchUnrepresentable{T, 256}, "");
+  EXPECT_EQ(ap::renderVerdict(v::SearchUnrepresentable{T, 256, false, 0.0, both}, ""),
+            unrepresentable + "; proven on 256 steps: " + below + ", none " + range + window);
+  const v::ProvenDurations floor_only{256, least, "momentum"};
+  EXPECT_EQ(ap::renderVerdict(v::SearchInfeasible{12, T, floor_only}, ""),
+            ap::renderVerdict(v::SearchInfeasible{12, T}, "") + "; proven on 256 steps: " + below);
+  const v::ProvenDurations range_only{256, 0.0, "", from, to};
+  EXPECT_EQ(ap::renderVerdict(v::SearchStopped{ap::Termination::TimedOut, range_only}, ""),
+            ap::renderVerdict(v::SearchStopped{ap::Termination::TimedOut}, "") +
+                "; proven on 256 steps: no plan " + range);
+  // Nothing proven, nothing said; the figures carry the same values the words say.
+  EXPECT_EQ(ap::renderVerdict(v::SearchStopped{ap::Termination::TimedOut, {256}}, ""),
+            ap::renderVerdict(v::SearchStopped{ap::Termination::TimedOut}, ""));
+  const std::vector<ap::VerdictFigure> figures =
+      ap::verdictFigures(v::SearchUnrepresentable{T, 256, false, 0.0, both});
+  const auto figure = [&](const std::string& name) {
+    for (const ap::VerdictFigure& f : figures)
+      if (f.name == name) return f.value;
+    return -1.0;
+  };
+  EXPECT_EQ(figure("grid_lower_bound"), least);
+  EXPECT_EQ(figure("no_plan_from"), from);
+  EXPECT_EQ(figure("no_plan_to"), to);
+}
+
 TEST(DriverVerdicts, RecordingKeepsTheVerdictAndItsFiguresAsData) {
   namespace v = ap::verdicts;
   ap::PlanResult r;

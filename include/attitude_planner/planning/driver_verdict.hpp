@@ -20,6 +20,34 @@ struct VerdictFigure {
 
 namespace verdicts {
 
+/// What the bounds alone prove about the durations of a request's plans on its grid (N =
+/// `steps`), said with a verdict that found no plan (the search's): no plan below `least` (the
+/// proven lower bound on the grid, `least_basis` its proof; 0: none applies), and none from
+/// `no_plan_from` on (the paper scheme's last free step into a final rate on the rate limit has
+/// no room up to `no_plan_to`, NoRoomBeforeTheEnd; above `no_plan_to` a step at the boundary
+/// rates turns π or more, which no step of the scheme does; 0, 0: none proven). Where both are
+/// proven a plan can lie only in [least, no_plan_from) (DurationVerdict holds the same figures:
+/// lower_bound's grid value, no_plan_from, no_plan_to).
+struct ProvenDurations {
+  int steps = 0;
+  double least = 0.0;  ///< [s]
+  std::string least_basis;
+  double no_plan_from = 0.0;  ///< [s]
+  double no_plan_to = 0.0;    ///< [s]
+  bool rangeProven() const { return no_plan_to > no_plan_from; }
+  std::vector<VerdictFigure> figures() const {
+    return {
+        {"grid_lower_bound", least}, {"no_plan_from", no_plan_from}, {"no_plan_to", no_plan_to}};
+  }
+};
+
+/// `figures` followed by `proven`'s.
+inline std::vector<VerdictFigure> withProven(std::vector<VerdictFigure> figures,
+                                             const ProvenDurations& proven) {
+  for (const VerdictFigure& f : proven.figures()) figures.push_back(f);
+  return figures;
+}
+
 /// No driver's verdict: the message is the solver's own reason (and the notes after it).
 struct SolverReason {
   static constexpr const char* kKind = "solver_reason";
@@ -105,36 +133,41 @@ struct MinimumTimeFoundNone {
   std::vector<VerdictFigure> figures() const { return {}; }
 };
 /// The minimum-time search was stopped (`stop`: timed out, cancelled) before any duration was
-/// found feasible.
+/// found feasible; what the bounds prove about the durations (`proven`).
 struct SearchStopped {
   static constexpr const char* kKind = "search_stopped";
   Termination stop = Termination::TimedOut;
-  std::vector<VerdictFigure> figures() const { return {}; }
+  ProvenDurations proven;
+  std::vector<VerdictFigure> figures() const { return proven.figures(); }
 };
 /// The minimum-time search found no plan below T = `from` (it tried durations down to
 /// `least_tried`), and from there on one step at the boundary rates has no solution on N steps;
 /// `coarse`: even at the proven least duration a boundary step turns more than 1 rad
-/// (StepTooLarge), else NotConverged.
+/// (StepTooLarge), else NotConverged; what the bounds prove about the durations (`proven`).
 struct SearchUnrepresentable {
   static constexpr const char* kKind = "search_unrepresentable";
   double from = 0.0;  ///< [s]
   int steps = 0;      ///< N
   bool coarse = false;
   double least_tried = 0.0;  ///< [s] the least duration a solve was tried at (0: none)
+  ProvenDurations proven;
   std::vector<VerdictFigure> figures() const {
-    return {{"unrepresentable_from", from},
-            {"steps", double(steps)},
-            {"least_duration_tried", least_tried}};
+    return withProven({{"unrepresentable_from", from},
+                       {"steps", double(steps)},
+                       {"least_duration_tried", least_tried}},
+                      proven);
   }
 };
 /// The minimum-time search doubled its first guess `doublings` times and found no duration that
-/// admits a plan (a local search: every start's solves ended infeasible or unconverged).
+/// admits a plan (a local search: every start's solves ended infeasible or unconverged); what the
+/// bounds prove about the durations (`proven`).
 struct SearchInfeasible {
   static constexpr const char* kKind = "search_infeasible";
   int doublings = 0;
   double first_guess = 0.0;  ///< [s]
+  ProvenDurations proven;
   std::vector<VerdictFigure> figures() const {
-    return {{"doublings", double(doublings)}, {"first_guess", first_guess}};
+    return withProven({{"doublings", double(doublings)}, {"first_guess", first_guess}}, proven);
   }
 };
 /// The search's plan at T* meets every bound while its minimum-effort solve stopped short of

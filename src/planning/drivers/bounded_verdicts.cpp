@@ -318,6 +318,19 @@ std::string infeasibleAtEveryDuration(const PlanningProblem& problem) {
   return why.str();
 }
 
+verdicts::ProvenDurations provenDurations(const PlanningProblem& problem,
+                                          const NoRoomBeforeTheEnd& none) {
+  verdicts::ProvenDurations proven;
+  proven.steps = problem.steps;
+  proven.least = discreteDurationLowerBound(problem);
+  if (proven.least > 0.0) proven.least_basis = durationLowerBound(problem).basis;
+  if (none.to > none.from) {
+    proven.no_plan_from = none.from;
+    proven.no_plan_to = none.to;
+  }
+  return proven;
+}
+
 void recordNoRoom(const NoRoomBeforeTheEnd& none, PlanResult* result) {
   if (!(none.to > none.from)) return;
   result->duration_verdict.no_plan_from = none.from;

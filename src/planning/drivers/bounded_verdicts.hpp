@@ -79,6 +79,12 @@ struct NoRoomBeforeTheEnd {
 };
 NoRoomBeforeTheEnd noRoomBeforeTheEnd(const PlanningProblem& problem);
 
+/// What the bounds prove about `problem`'s durations on its grid, for a verdict that found no
+/// plan: no plan below its proven lower bound on the grid (discreteDurationLowerBound) and none in
+/// `none`'s range or above it.
+verdicts::ProvenDurations provenDurations(const PlanningProblem& problem,
+                                          const NoRoomBeforeTheEnd& none);
+
 /// Sets `result->duration_verdict`'s range without a plan (no_plan_from, no_plan_to) from `none`
 /// where it proves one.
 void recordNoRoom(const NoRoomBeforeTheEnd& none, PlanResult* result);

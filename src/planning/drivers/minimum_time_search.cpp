@@ -316,20 +316,21 @@ class MinimumTimeSearch {
 
   PlanResult noneFeasible(double guess, std::size_t first) const {
     PlanResult none;
+    const verdicts::ProvenDurations proven = provenDurations(problem_, no_room_);
     if (stopped_) {
       none.termination = *stopped_;
-      recordVerdict(&none, verdicts::SearchStopped{*stopped_});
+      recordVerdict(&none, verdicts::SearchStopped{*stopped_, proven});
     } else if (std::isfinite(unrepresentable_from_)) {
       // Longer plans are not shown infeasible: this grid cannot hold them. Only where the grid
       // is too coarse at the proven least duration is the step count the cause.
       const bool coarse = representableDuration(problem_) < durationLowerBound(problem_).seconds;
       none.termination = coarse ? Termination::StepTooLarge : Termination::NotConverged;
-      recordVerdict(
-          &none, verdicts::SearchUnrepresentable{unrepresentable_from_, problem_.steps, coarse,
-                                                 std::isfinite(least_tried_) ? least_tried_ : 0.0});
+      recordVerdict(&none, verdicts::SearchUnrepresentable{
+                               unrepresentable_from_, problem_.steps, coarse,
+                               std::isfinite(least_tried_) ? least_tried_ : 0.0, proven});
     } else {
       none.termination = Termination::Infeasible;
-      recordVerdict(&none, verdicts::SearchInfeasible{kMaxDoublings, guess});
+      recordVerdict(&none, verdicts::SearchInfeasible{kMaxDoublings, guess, proven});
     }
     none.attempts = context_.attemptsFrom(first);
     return none;

@@ -402,8 +402,31 @@ std::string judged(const verdicts::MinimumTimeFoundNone& v, const std::string& r
          "feasible duration either, " +
          terminationName(v.minimum_time) + "): " + reason;
 }
+/// What the bounds prove about the durations (verdicts::ProvenDurations), said after a verdict
+/// that found no plan: "; proven on N = 256 steps: no plan below ... s (...), none from ... s on
+/// (...): a plan can lie only in [..., ...) s"; empty where nothing is proven.
+std::string provenWords(const verdicts::ProvenDurations& p) {
+  const bool least = p.least > 0.0;
+  if (!least && !p.rangeProven()) return "";
+  std::ostringstream words;
+  words << "; proven on " << p.steps << " steps: no plan ";
+  if (least) words << "below " << exactNumber(p.least) << " s (" << p.least_basis << ")";
+  if (p.rangeProven()) {
+    words << (least ? ", none " : "") << "from " << exactNumber(p.no_plan_from) << " s on (to "
+          << exactNumber(p.no_plan_to)
+          << " s the paper scheme's last free step into the final rate on the rate limit has no "
+             "room; above it a step at the boundary rates would turn pi or more, no step of the "
+             "scheme)";
+  }
+  if (least && p.rangeProven()) {
+    words << ": a plan can lie only in [" << exactNumber(p.least) << ", "
+          << exactNumber(p.no_plan_from) << ") s";
+  }
+  return words.str();
+}
 std::string judged(const verdicts::SearchStopped& v, const std::string&) {
-  return terminationName(v.stop) + " before any duration was found feasible";
+  return terminationName(v.stop) + " before any duration was found feasible" +
+         provenWords(v.proven);
 }
 std::string judged(const verdicts::SearchUnrepresentable& v, const std::string&) {
   // Longer plans are not shown infeasible: this grid cannot hold them.
@@ -414,13 +437,15 @@ std::string judged(const verdicts::SearchUnrepresentable& v, const std::string&)
          ", and from there on one step of " + exactNumber(v.from / v.steps) +
          " s at the boundary rates has no solution (N = " + std::to_string(v.steps) + ")" +
          (v.coarse ? "; even at the proven least duration a boundary step turns more than 1 rad"
-                   : "");
+                   : "") +
+         provenWords(v.proven);
 }
 std::string judged(const verdicts::SearchInfeasible& v, const std::string&) {
   return "infeasible: no duration up to 2^" + std::to_string(v.doublings) +
          " times the first guess " + exactNumber(v.first_guess) +
          " s admits a plan under the bounds and constraints in force (a local search: every "
-         "start's solves ended infeasible or unconverged)";
+         "start's solves ended infeasible or unconverged)" +
+         provenWords(v.proven);
 }
 std::string judged(const verdicts::FeasibleAtMinimumTime& v, const std::string& reason) {
   if (v.free_time_iterate) {

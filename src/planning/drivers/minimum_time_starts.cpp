@@ -69,77 +69,23 @@ std::string axisName(const Vector3& v) {
   return out.str();
 }
 
-/// An excursion start's parameters as data (Attempt::start_detail).
-void describeExcursion(const Vector3& eigenaxis, const Vector3& axis, double size,
-                       FreeTimeStart* start) {
-  StartDetail& detail = start->detail;
-  detail.duration = start->duration;
-  detail.eigenaxis = eigenaxis;
-  detail.excursion_axis = axis;
-  detail.excursion = size;
-}
-
-/// Spinning ends: the reduced problem's own start (the geodesic between the fixed inner
-/// attitudes) at `at`'s T, or nothing where a boundary rate has no step at its h.
-std::optional<std::vector<Matrix3>> geodesicAttitudes(const PlanningProblem& at) {
-  try {
-    const ReducedProblem np(at);
-    return np.attitudes(np.current());
-  } catch (const StepTooLarge&) {
-    return std::nullopt;
-  }
-}
-
-/// Spinning ends: the geodesic start at the eigenaxis guess. Without a boundary step there, every
-/// node at R_0 (an empty list of attitudes once reached setInteriorFromAttitudes: every spinning
-/// minimum-time request ended "invalid input"), and the solve reports the step.
+/// Spinning ends: the reduced problem's own start (the geodesic between the
+/// fixed inner attitudes) at the eigenaxis guess. (An empty list of attitudes
+/// here once reached setInteriorFromAttitudes: every spinning minimum-time
+/// request ended "invalid input".)
 FreeTimeStart geodesicStart(const PlanningProblem& problem) {
   PlanningProblem at = problem;
   at.duration = eigenaxisDurationGuess(problem);
-  std::vector<Matrix3> attitudes = geodesicAttitudes(at).value_or(
-      std::vector<Matrix3>(problem.steps + 1, problem.initial_attitude));
+  std::vector<Matrix3> attitudes;
+  try {
+    const ReducedProblem np(at);
+    attitudes = np.attitudes(np.current());
+  } catch (const StepTooLarge&) {  // no boundary step at that h: the solve reports it
+    attitudes.assign(problem.steps + 1, problem.initial_attitude);
+  }
   FreeTimeStart start{"geodesic", AttemptStart::Hermite, attitudes, at.duration};
   start.detail.duration = at.duration;
   return start;
-}
-
-/// Spinning ends: `R` (a start's R_0..R_N) turned at its free nodes by excursionSlew's bump about
-/// the body axis p̂, R_k exp(b_k p̂), b_k = ε sin²(π s_k), s_k = (k − 1)/(N − 2): b and its slope
-/// vanish at R_1 and R_{N−1}, so the nodes the boundary rates fix (R_0, R_1, R_{N−1}, R_N) stay
-/// the start's and the end rates with them. The excursion of a spinning maneuver: the same
-/// sideways departure as rest to rest, off a path that already spins at its ends.
-std::vector<Matrix3> withSpinningExcursion(std::vector<Matrix3> R, const Vector3& axis,
-                                           double excursion) {
-  const int N = static_cast<int>(R.size()) - 1;
-  for (int k = 2; k <= N - 2; ++k) {
-    const double bump = std::sin(M_PI * (k - 1) / (N - 2));
-    R[k] = R[k] * so3::exp(excursion * bump * bump * axis);
-  }
-  return R;
-}
-
-/// Spinning ends: excursions of kFreeTimeExcursion off the geodesic start at `at`'s T (rest to
-/// rest has them off the eigenaxis slew), about excursionAxes of the rotation R_1ᵀR_{N−1} between
-/// the fixed inner nodes: the same table of axes. Minimum time with spinning ends has local
-/// minima a start's first steps choose between (docs/results/spinning_minimum_time.md, #189: the
-/// basin a plan falls into decides T*, 3 % apart); nothing where the boundary rates have no step
-/// at that h.
-std::vector<FreeTimeStart> spinningExcursions(const PlanningProblem& at) {
-  const std::optional<std::vector<Matrix3>> geodesic = geodesicAttitudes(at);
-  if (!geodesic || geodesic->size() < 5) return {};
-  const int N = at.steps;
-  const Vector3 turn = so3::log((*geodesic)[1].transpose() * (*geodesic)[N - 1]);
-  const Vector3 e = turn.norm() > 0 ? Vector3(turn.normalized()) : Vector3::Zero();
-  std::vector<FreeTimeStart> starts;
-  for (const Vector3& axis : excursionAxes(e)) {
-    std::ostringstream name;
-    name << "excursion " << kFreeTimeExcursion << " rad about " << axisName(axis)
-         << " off the geodesic";
-    starts.push_back({name.str(), AttemptStart::Excursion,
-                      withSpinningExcursion(*geodesic, axis, kFreeTimeExcursion), at.duration});
-    describeExcursion(e, axis, kFreeTimeExcursion, &starts.back());
-  }
-  return starts;
 }
 
 /// The unconstrained minimum-effort plan (Newton) in class `c` at the start's T, or nothing where
@@ -178,9 +124,8 @@ std::optional<std::vector<Matrix3>> classOptimum(const PlanningProblem& at, cons
 constexpr HomotopyClass kSpinningStartClasses[] = {{false, 0}, {true, 0}, {false, 1}, {true, 1}};
 
 /// Spinning ends: the unconstrained optima in the classes of kSpinningStartClasses
-/// (classOptimum), the geodesic (geodesicStart), the coasting start (the torque-free motions
-/// from both ends, blended) and excursions off the geodesic (spinningExcursions), all at the
-/// eigenaxis guess. Minimum time with spinning ends has
+/// (classOptimum), the geodesic (geodesicStart) and the coasting start (the torque-free motions
+/// from both ends, blended), all at the eigenaxis guess. Minimum time with spinning ends has
 /// local minima in several classes, which one geodesic start misses
 /// (docs/results/bounded_verdicts.md). The class optima come first: they start inside the bounds
 /// most often, and the watch then stops the later starts that cannot beat the least T found. The
@@ -213,9 +158,17 @@ std::vector<FreeTimeStart> spinningStarts(const PlanningProblem& problem, SolveC
     }
   } catch (const StepTooLarge&) {  // no boundary step at the guess's h
   }
-  // Last, so the starts before them solve as they did without them.
-  for (FreeTimeStart& excursion : spinningExcursions(at)) starts.push_back(std::move(excursion));
   return starts;
+}
+
+/// An excursion start's parameters as data (Attempt::start_detail).
+void describeExcursion(const Vector3& eigenaxis, const Vector3& axis, double size,
+                       FreeTimeStart* start) {
+  StartDetail& detail = start->detail;
+  detail.duration = start->duration;
+  detail.eigenaxis = eigenaxis;
+  detail.excursion_axis = axis;
+  detail.excursion = size;
 }
 
 }  // namespace

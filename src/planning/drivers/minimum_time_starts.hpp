@@ -54,10 +54,8 @@ std::vector<Vector3> excursionAxes(const Vector3& e);
 
 /// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
 /// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
-/// guess, the unconstrained optima of its classes, solved in `context` (the request's: its
-/// budget, cancel flag and iteration numbering), the coasting start, and excursions off the
-/// geodesic about the same table of axes (its free nodes turned, the nodes the end rates fix
-/// left as they are).
+/// guess, and the unconstrained optima of its classes, solved in `context` (the request's: its
+/// budget, cancel flag and iteration numbering).
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,
                                           SolveContext& context);
 

@@ -204,13 +204,24 @@ const std::pair<int, const char*> kClearingRequests[] = {
      "-0.59386883577638416], world_direction: [0.83213928906033396, "
      "0.47176552832657487, 0.29151584842836514], half_angle: 0.55649821837555946}\n"}};
 
+/// The driver's repeat test's distance (kSameStart, minimum_time_free_time.cpp).
+constexpr double kSameStart = 1e-3;
+
+/// The largest entry of R_k − R'_k over two plans of one length.
+double largestDifference(const std::vector<ap::Matrix3>& a, const std::vector<ap::Matrix3>& b) {
+  double largest = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    largest = std::max(largest, (a[k] - b[k]).cwiseAbs().maxCoeff());
+  }
+  return largest;
+}
+
 TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
   // The clearing solve's tolerance is loose (a start, not an answer), but tight enough that the
   // driver's repeat test sees it: two structured starts that clear to one minimum-effort plan
   // agree within the driver's kSameStart (max entry of R_k − R'_k, 1e-3), so the second start is
   // a repeat and not solved again; two that clear to different plans differ by far more. No
   // pair lies in between, where one plan would count as two starts (kClearingRequests).
-  constexpr double kSameStart = 1e-3;  // minimum_time_free_time.cpp
   const ap::SolverOptions options;
   for (const auto& [index, text] : kClearingRequests) {
     const ap::PlanningProblem p = ap::parseScene(text).problem;
@@ -226,10 +237,7 @@ TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
     int repeats = 0;
     for (std::size_t i = 0; i < cleared.size(); ++i) {
       for (std::size_t j = 0; j < i; ++j) {
-        double largest = 0.0;
-        for (std::size_t k = 0; k < cleared[i].size(); ++k) {
-          largest = std::max(largest, (cleared[i][k] - cleared[j][k]).cwiseAbs().maxCoeff());
-        }
+        const double largest = largestDifference(cleared[i], cleared[j]);
         EXPECT_TRUE(largest <= kSameStart || largest > 10 * kSameStart)
             << "#" << index << ": starts " << j << " and " << i << " differ by " << largest;
         repeats += largest <= kSameStart ? 1 : 0;
@@ -239,22 +247,12 @@ TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
   }
 }
 
-/// The largest entry of R_k − R'_k over two plans of one length.
-double largestDifference(const std::vector<ap::Matrix3>& a, const std::vector<ap::Matrix3>& b) {
-  double largest = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    largest = std::max(largest, (a[k] - b[k]).cwiseAbs().maxCoeff());
-  }
-  return largest;
-}
-
 TEST(MinimumTimeLevels, AClearingStoppedAtAnEarlierClearingsPlanWouldHaveRepeatedIt) {
   // The driver stops a cone clearing where its iterate comes within kSameStart of a plan an
   // earlier clearing at the same T reached, and takes that plan as the start (clearOfCones). The
   // property that rule relies on: such a clearing, run to its end, ends within kSameStart of that
   // plan too (a repeat, whose free-time solve the driver skips either way); the stopped one takes
   // fewer iterations, and a clearing the watch does not stop runs as before.
-  constexpr double kSameStart = 1e-3;  // minimum_time_free_time.cpp
   const ap::SolverOptions options;
   for (const auto& [index, text] : kClearingRequests) {
     const ap::PlanningProblem p = ap::parseScene(text).problem;

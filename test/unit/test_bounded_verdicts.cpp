@@ -23,6 +23,8 @@
 #include "attitude_planner/errors.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
+#include "planning/drivers/constrained_classes.hpp"
+#include "planning/drivers/constrained_recipe.hpp"
 #include "planning/drivers/free_time_recipe.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
@@ -881,4 +883,85 @@ TEST(BoundedVerdicts,
       });
   EXPECT_LT(coarsest, p.steps);
   EXPECT_TRUE(newton_on_coarsest);
+}
+
+TEST(BoundedVerdicts, AFirstClassWithoutAPlanIsContinuedFromItsPlanUnderTheBoundsOnTheSurveyGrid) {
+  // Under torque bounds, where the first class's solve on the requested grid ends without a plan
+  // (here stopped at an iteration limit of 2, as a cold start near the least duration ends
+  // "infeasible"), the best class under the bounds on the survey's coarse grid is carried to the
+  // requested grid from its unconstrained optimum and, where that gives no plan, from its coarse
+  // plan (carryUnderBounds). Stated on the seeded suite's minimum-effort requests at N = 64: where
+  // a coarse plan under the bounds converged, a solve on the requested grid from it follows unless
+  // a plan was already found; every answer that converged holds the bounds; and the rule gives
+  // plans on some of them.
+  constexpr int kSteps = 64;
+  int exercised = 0, continued = 0, planned = 0;
+  for (int i = 0; i < 60 && exercised < 6; ++i) {
+    const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
+    if (!request || request->problem.objective != Objective::MinimumEffort ||
+        request->kind == "replan" || request->kind == "norm+rate") {
+      continue;
+    }
+    PlanningProblem p = request->problem;
+    p.steps = kSteps;
+    SCOPED_TRACE(request->label);
+    const SolverOptions options;
+    SolveContext context(options);
+    const SolveRequest asked(options);
+    std::vector<ClassPlan> plans;
+    PlanResult unconstrained;
+    try {
+      unconstrained = solveWithNewton(p, asked, context, &plans);
+    } catch (const StepTooLarge&) {
+      continue;  // N = 64 cannot hold the request's steps
+    }
+    if (!unconstrained.converged() || !unconstrained.extremal_summary.known) continue;
+    const std::size_t first_recorded = context.attempts().size();
+    SolverOptions cut = options;
+    cut.max_iterations = 2;
+    SolveRequest first_request(cut);
+    first_request.warm_start = &unconstrained.maneuver;
+    PlanResult first;
+    {
+      const SolveContext::Call call(context, cut);
+      first = solveWithInteriorPoint(p, first_request, context);
+    }
+    if (first.converged()) continue;
+    const std::size_t after_first = context.attempts().size();
+    const PlanResult r = cheapestConstrainedClass(p, asked, context, unconstrained.extremal_summary,
+                                                  plans, first, unconstrained.cost, first_recorded);
+    const std::vector<Attempt>& trail = context.attempts();
+    std::optional<std::size_t> coarse_plan;  // the first coarse plan under the bounds
+    for (std::size_t a = after_first; a < trail.size() && !coarse_plan; ++a) {
+      if (trail[a].stage == AttemptStage::Constrained && trail[a].steps < kSteps &&
+          trail[a].termination == Termination::Converged) {
+        coarse_plan = a;
+      }
+    }
+    if (!coarse_plan) continue;
+    ++exercised;
+    const bool from_it =
+        std::any_of(trail.begin() + *coarse_plan + 1, trail.end(), [](const Attempt& a) {
+          return a.stage == AttemptStage::Constrained && a.steps == kSteps &&
+                 a.start == AttemptStart::PreviousAttempt;
+        });
+    const bool found_before =
+        std::any_of(trail.begin() + *coarse_plan + 1, trail.end(), [](const Attempt& a) {
+          return a.stage == AttemptStage::Constrained && a.steps == kSteps &&
+                 a.start != AttemptStart::PreviousAttempt &&
+                 a.termination == Termination::Converged;
+        });
+    EXPECT_TRUE(from_it || found_before) << r.message();
+    continued += from_it;
+    if (r.converged()) {
+      ++planned;
+      EXPECT_LE(checkConstraints(p, r.maneuver).max_relative_violation, 1e-6) << r.message();
+    }
+  }
+  EXPECT_GE(exercised, 3);
+  EXPECT_GE(continued, 1);
+  EXPECT_GE(planned, 1);
+  RecordProperty("exercised", exercised);
+  RecordProperty("continued", continued);
+  RecordProperty("planned", planned);
 }

@@ -57,10 +57,19 @@ def run_suite(args, seed, thetas):
                 mt = s.get("minimum_time", {})
                 row["runs"].append((s.get("termination"), s.get("minimum_duration"),
                                     s.get("iterations", 0), fine, mt.get("cone_clearings"),
-                                    mt.get("cone_clearing_iterations")))
+                                    mt.get("cone_clearing_iterations"), adds_up(s)))
             rows.append(row)
             print(seed, c["index"], cone, row["runs"], flush=True)
     return rows
+
+
+def adds_up(s):
+    """Whether the attempts' iterations and the cone clearings' make the request's (None where
+    the build does not report the clearings)."""
+    clearing = s.get("minimum_time", {}).get("cone_clearing_iterations")
+    if clearing is None:
+        return None
+    return sum(a["iterations"] for a in s.get("attempts", [])) + clearing == s.get("iterations", 0)
 
 
 def same_t(a, b):
@@ -99,7 +108,7 @@ def render(args, thetas, rows, load):
                   when, load, suite, args.parameter, counted % (symbol, SAME_T))]
     out += ["", "Cone clearings: the minimum-effort solves that clear the starts of the cone "
             "(JSON minimum_time.cone_clearings and cone_clearing_iterations; \"-\" where the "
-            "build does not report them), within the iterations.",
+            "build does not report them), within the iterations. %s" % counts_add_up(rows, thetas),
             "", "| seed | cone | requests | %s | iterations | on N = 128 | largest on N = 128 | "
             "same T* | lower | higher | cone clearings | their iterations |" % symbol,
             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -120,6 +129,18 @@ def render(args, thetas, rows, load):
                               same, len(mine), lower, higher, reported(mine, j, 4),
                               reported(mine, j, 5)))
     return "\n".join(out) + "\n"
+
+
+def counts_add_up(rows, thetas):
+    """Per run that reports the clearings: on how many requests the attempts' iterations and the
+    clearings' make the request's."""
+    said = []
+    for j, theta in enumerate(thetas):
+        checked = [r["runs"][j][6] for r in rows if r["runs"][j][6] is not None]
+        if checked:
+            said.append("%s: the attempts' iterations and the clearings' make the request's on %d "
+                        "of %d requests." % (theta, sum(checked), len(checked)))
+    return " ".join(said)
 
 
 def reported(rows, j, field):

@@ -103,20 +103,14 @@ struct RefinedOutcome {
   std::size_t attempt = 0;
 };
 
-/// The cone clearings' work (coneClearStart; minimum_time.cone_clearings ...): how many ran, their
-/// interior-point iterations, and how many ended at a plan an earlier clearing reached.
+/// The cone clearings run (coneClearStart; minimum_time.cone_clearings) and how many of them
+/// ended at a plan an earlier clearing reached. Their iterations are the context's tally
+/// (SolveContext::coneClearingIterations), not summed here.
 struct ClearingWork {
   int clearings = 0;
-  int iterations = 0;
   int joined = 0;
-  void add(int its, bool joined_earlier) {
-    ++clearings;
-    iterations += its;
-    joined += joined_earlier ? 1 : 0;
-  }
   void add(const ClearingWork& other) {
     clearings += other.clearings;
-    iterations += other.iterations;
     joined += other.joined;
   }
 };
@@ -268,12 +262,11 @@ class FreeTimeMinimumTime {
   /// the earlier clearings at its T reached) ends there with that plan: its free-time solve would
   /// be a repeat of that plan's (sameStartAs), the rest of the clearing only the way there
   /// (measured, seed 4949's 20 cone requests: 70 of 137 clearings ended at such a plan, 1,919
-  /// iterations). Its work is added to `*work`.
+  /// iterations). It is counted in `*work`.
   static std::vector<Matrix3> clearOfCones(const PlanningProblem& p, const FreeTimeStart& st,
                                            const std::vector<const std::vector<Matrix3>*>& earlier,
                                            SolveContext& context, ClearingWork* work) {
     if (coneClearance(p, st.attitudes) >= 0.5 * kConeStartClearance) return st.attitudes;
-    const SolveContext::IterationTally tally(context);
     int joined = -1;
     const auto joins = [&](const std::vector<Matrix3>& attitudes) -> std::string {
       joined = sameAttitudesIn(attitudes, earlier);
@@ -281,7 +274,8 @@ class FreeTimeMinimumTime {
     };
     const std::optional<std::vector<Matrix3>> cleared =
         coneClearStart(p, st.attitudes, st.duration, context, joins);
-    work->add(tally.iterations(), joined >= 0);
+    ++work->clearings;
+    if (joined >= 0) ++work->joined;
     if (joined >= 0) return *earlier[joined];
     return cleared.value_or(st.attitudes);
   }
@@ -378,8 +372,8 @@ class FreeTimeMinimumTime {
 
   /// Every start cleared of the cones (clearOfCones), in a sliding window of the request's
   /// threads (runSlidingWindow): a clearing may join the plans of the clearings ended before it
-  /// began (on one thread every earlier one), the same ones on every run. Their work is counted
-  /// in clearing_work_.
+  /// began (on one thread every earlier one), the same ones on every run. They are counted
+  /// in clearing_work_, their iterations in the context's tally (SolveContext::ClearingCones).
   std::vector<std::vector<Matrix3>> clearedOfCones(const PlanningProblem& grid,
                                                    const std::vector<FreeTimeStart>& starts) {
     const int count = static_cast<int>(starts.size());
@@ -400,6 +394,7 @@ class FreeTimeMinimumTime {
         cleared[i] = clearOfCones(grid, starts[i], earlier, branch, &work[i]);
       };
     };
+    const SolveContext::ClearingCones counted(context_);  // the branches join their iterations
     runSlidingWindow(context_, count, begin, [&](int i) {
       ended.push_back(i);
       clearing_work_.add(work[i]);
@@ -853,7 +848,7 @@ class FreeTimeMinimumTime {
     result.minimum_time.solves = solves_;
     result.minimum_time.second_order_sufficient = second_order_sufficient;
     result.minimum_time.cone_clearings = clearing_work_.clearings;
-    result.minimum_time.cone_clearing_iterations = clearing_work_.iterations;
+    result.minimum_time.cone_clearing_iterations = context_.coneClearingIterations();
     result.minimum_time.cone_clearings_joined = clearing_work_.joined;
     recordTwist(at, answer, &result);
     result.attempts = context_.attemptsFrom(first_recorded_);

@@ -99,8 +99,10 @@ class SolveContext : public Interruption {
       at_open_ = context_->iterations_;
       counting_ = true;
     }
+    bool counting() const { return counting_; }
 
    private:
+    friend class SolveContext;  // join: a branch's paused tally into its parent's
     const SolveContext* context_;
     int at_open_;
     int counted_ = 0;
@@ -243,6 +245,32 @@ class SolveContext : public Interruption {
     return iterate_watch_ ? iterate_watch_->stopAt(attitudes) : std::string();
   }
 
+  /// The iterations of the request's cone clearings (minimum time's starts cleared of the cones
+  /// by minimum-effort solves that stand aside: in no attempt of the trail), read from the one
+  /// numbering by one tally that counts only while a ClearingCones is alive (a branch's clearings
+  /// join with the branch). Every minimum-time answer of the request reads it here, so an answer
+  /// made of two minimum-time solves (a Richardson pair, a fixed twist then the free one) counts
+  /// both without adding them.
+  int coneClearingIterations() const { return cone_clearings_.iterations(); }
+  /// While alive, the iterations reported in this context (and the branches joined into it) are
+  /// the request's cone clearings' (coneClearingIterations).
+  class ClearingCones {
+   public:
+    explicit ClearingCones(SolveContext& context)
+        : tally_(context.cone_clearings_), was_counting_(tally_.counting()) {
+      tally_.resume();
+    }
+    ~ClearingCones() {
+      if (!was_counting_) tally_.pause();
+    }
+    ClearingCones(const ClearingCones&) = delete;
+    ClearingCones& operator=(const ClearingCones&) = delete;
+
+   private:
+    IterationTally& tally_;
+    bool was_counting_;
+  };
+
   /// While alive, the attempts recorded are parts of an enclosing attempt (a level's
   /// unconstrained start, a start's helper solve, a search's probes, which the search records as
   /// one attempt per start): when it ends they leave the trail and the kept mark is as before.
@@ -283,6 +311,7 @@ class SolveContext : public Interruption {
   std::vector<Attempt> attempts_;
   std::vector<LevelSummary> levels_;
   WatchIterates* iterate_watch_ = nullptr;  ///< this context's own (a branch starts without)
+  IterationTally cone_clearings_{*this};    ///< paused outside ClearingCones
 };
 
 /// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each in its own

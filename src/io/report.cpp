@@ -213,7 +213,10 @@ std::string planResultJson(const PlanningProblem& problem, const PlanResult& r) 
       << ", \"time_stationarity\": " << jsonNumber(r.minimum_time.time_stationarity)
       << ", \"complementarity\": " << jsonNumber(r.minimum_time.complementarity)
       << ", \"solves\": " << r.minimum_time.solves << ", \"second_order_sufficient\": "
-      << (r.minimum_time.second_order_sufficient ? "true" : "false") << "},\n"
+      << (r.minimum_time.second_order_sufficient ? "true" : "false")
+      << ", \"cone_clearings\": " << r.minimum_time.cone_clearings
+      << ", \"cone_clearing_iterations\": " << r.minimum_time.cone_clearing_iterations
+      << ", \"cone_clearings_joined\": " << r.minimum_time.cone_clearings_joined << "},\n"
       << "  \"duration_verdict\": {\"lower_bound\": " << jsonNumber(r.duration_verdict.lower_bound)
       << ", \"lower_bound_basis\": " << jsonString(r.duration_verdict.lower_bound_basis)
       << ", \"proven_infeasible\": " << (r.duration_verdict.proven_infeasible ? "true" : "false")

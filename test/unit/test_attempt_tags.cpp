@@ -133,6 +133,46 @@ TEST(AttemptTags, BranchesRunAtOnceReportInOneSequenceAndJoinTheTrailInTheirOrde
   }
 }
 
+TEST(AttemptTags, TheConeClearingsTallyCountsOnlyWhileClearingWithTheBranchesJoinedThen) {
+  // The request's cone clearings are read from the one numbering (coneClearingIterations): what
+  // is reported while a ClearingCones is alive, the branches joined then included; a branch's
+  // own clearings join with it; a nested ClearingCones ends without pausing the outer one.
+  ap::SolverOptions options;
+  options.threads = 2;
+  ap::SolveContext context(options);
+  const auto report = [](ap::SolveContext& c, int n) {
+    for (int k = 0; k < n; ++k) c.reportIteration({});
+  };
+  report(context, 5);
+  EXPECT_EQ(context.coneClearingIterations(), 0);
+  {
+    const ap::SolveContext::ClearingCones clearing(context);
+    report(context, 7);
+    ap::runBranches(context, 2, [&](int, ap::SolveContext& branch) { report(branch, 10); });
+  }
+  EXPECT_EQ(context.coneClearingIterations(), 27);
+  report(context, 3);
+  ap::runBranches(context, 2, [&](int, ap::SolveContext& branch) {
+    {
+      const ap::SolveContext::ClearingCones clearing(branch);
+      report(branch, 4);
+    }
+    report(branch, 6);
+  });
+  EXPECT_EQ(context.coneClearingIterations(), 35);
+  {
+    const ap::SolveContext::ClearingCones outer(context);
+    {
+      const ap::SolveContext::ClearingCones inner(context);
+      report(context, 1);
+    }
+    report(context, 1);
+  }
+  report(context, 2);
+  EXPECT_EQ(context.coneClearingIterations(), 37);
+  EXPECT_EQ(context.iterations(), 5 + 27 + 3 + 20 + 2 + 2);
+}
+
 TEST(AttemptTags, ASlidingWindowBeginsEachWorkAfterTheSameEndsHoweverLongTheWorksTake) {
   // Works of random lengths, some empty (no place taken), on 1, 2 and 3 threads: the ends run in
   // order, at most `threads` works run at once, and what each begin has seen (the ends before

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/report.hpp"
 #include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/lie/so3.hpp"
 #include "attitude_planner/planner.hpp"
@@ -165,52 +166,64 @@ TEST(MinimumTimeLevels, EveryClearedStartClearsTheConesWhetherWarmOrCold) {
   }
 }
 
+/// Seed 4949 of the seeded cone suite (scripts/minimum_time_cost.py), requests #12 and #19, on
+/// their starts' grid N = 64: most of their starts clear to one of a few plans.
+const std::pair<int, const char*> kClearingRequests[] = {
+    {12,
+     "inertia: [[12.594975342201728, -2.7742071096502388, -1.065584862092311], "
+     "[-2.7742071096502388, 20.283687658589528, 1.2690718170671369], "
+     "[-1.065584862092311, 1.2690718170671369, 11.718290427206997]]\n"
+     "steps: 64\n"
+     "scheme: second_order\n"
+     "objective: minimum_time\n"
+     "initial: {attitude: {quaternion: [0.61452313277618076, -0.39289550319798067, "
+     "0.25808750615339265, -0.63354974707380041]}, angular_velocity: [0, 0, 0]}\n"
+     "final: {attitude: {quaternion: [0.20839175156990886, -0.6570719886817612, "
+     "-0.7012362404014405, -0.18192584949664037]}, angular_velocity: [0, 0, 0]}\n"
+     "effects: [{actuator_limits: {max_torque: [0.3819803095340541, "
+     "0.51594203295811736, 0.63047754875894413]}}]\n"
+     "constraints:\n"
+     "  - keep_out: {body_axis: [0.89144698284256385, -0.24300112711900654, "
+     "-0.38245617918891295], world_direction: [0.16206821844160968, "
+     "-0.43349853068979582, 0.88646089392648941], half_angle: 0.57880005478359897}\n"},
+    {19,
+     "inertia: [[4.4126194375484209, 0.37519610903713452, -0.97197427677281711], "
+     "[0.37519610903713452, 5.4040431841554382, -0.82088234880708177], "
+     "[-0.97197427677281711, -0.82088234880708177, 3.7959339277047786]]\n"
+     "steps: 64\n"
+     "scheme: second_order\n"
+     "objective: minimum_time\n"
+     "initial: {attitude: {quaternion: [0.65225068834669753, -0.01230188959251691, "
+     "0.23757501046321694, -0.71970536851347378]}, angular_velocity: [0, 0, 0]}\n"
+     "final: {attitude: {quaternion: [-0.59077246617034784, -0.073409911320168553, "
+     "0.6929897844871673, -0.40664977158655768]}, angular_velocity: [0, 0, 0]}\n"
+     "effects: [{actuator_limits: {max_torque: [0.21095298210584135, "
+     "0.15505100148399206, 0.094331111553482436]}}]\n"
+     "constraints:\n"
+     "  - keep_out: {body_axis: [-0.74023490669455416, -0.31523338783274019, "
+     "-0.59386883577638416], world_direction: [0.83213928906033396, "
+     "0.47176552832657487, 0.29151584842836514], half_angle: 0.55649821837555946}\n"}};
+
+/// The driver's repeat test's distance (kSameStart, minimum_time_free_time.cpp).
+constexpr double kSameStart = 1e-3;
+
+/// The largest entry of R_k − R'_k over two plans of one length.
+double largestDifference(const std::vector<ap::Matrix3>& a, const std::vector<ap::Matrix3>& b) {
+  double largest = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    largest = std::max(largest, (a[k] - b[k]).cwiseAbs().maxCoeff());
+  }
+  return largest;
+}
+
 TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
   // The clearing solve's tolerance is loose (a start, not an answer), but tight enough that the
   // driver's repeat test sees it: two structured starts that clear to one minimum-effort plan
   // agree within the driver's kSameStart (max entry of R_k − R'_k, 1e-3), so the second start is
   // a repeat and not solved again; two that clear to different plans differ by far more. No
-  // pair lies in between, where one plan would count as two starts. Seed 4949 of the seeded cone
-  // suite (scripts/minimum_time_cost.py), requests #12 and #19, on their starts' grid N = 64:
-  // most of their starts clear to one of a few plans.
-  constexpr double kSameStart = 1e-3;  // minimum_time_free_time.cpp
-  const std::pair<int, const char*> requests[] = {
-      {12,
-       "inertia: [[12.594975342201728, -2.7742071096502388, -1.065584862092311], "
-       "[-2.7742071096502388, 20.283687658589528, 1.2690718170671369], "
-       "[-1.065584862092311, 1.2690718170671369, 11.718290427206997]]\n"
-       "steps: 64\n"
-       "scheme: second_order\n"
-       "objective: minimum_time\n"
-       "initial: {attitude: {quaternion: [0.61452313277618076, -0.39289550319798067, "
-       "0.25808750615339265, -0.63354974707380041]}, angular_velocity: [0, 0, 0]}\n"
-       "final: {attitude: {quaternion: [0.20839175156990886, -0.6570719886817612, "
-       "-0.7012362404014405, -0.18192584949664037]}, angular_velocity: [0, 0, 0]}\n"
-       "effects: [{actuator_limits: {max_torque: [0.3819803095340541, "
-       "0.51594203295811736, 0.63047754875894413]}}]\n"
-       "constraints:\n"
-       "  - keep_out: {body_axis: [0.89144698284256385, -0.24300112711900654, "
-       "-0.38245617918891295], world_direction: [0.16206821844160968, "
-       "-0.43349853068979582, 0.88646089392648941], half_angle: 0.57880005478359897}\n"},
-      {19,
-       "inertia: [[4.4126194375484209, 0.37519610903713452, -0.97197427677281711], "
-       "[0.37519610903713452, 5.4040431841554382, -0.82088234880708177], "
-       "[-0.97197427677281711, -0.82088234880708177, 3.7959339277047786]]\n"
-       "steps: 64\n"
-       "scheme: second_order\n"
-       "objective: minimum_time\n"
-       "initial: {attitude: {quaternion: [0.65225068834669753, -0.01230188959251691, "
-       "0.23757501046321694, -0.71970536851347378]}, angular_velocity: [0, 0, 0]}\n"
-       "final: {attitude: {quaternion: [-0.59077246617034784, -0.073409911320168553, "
-       "0.6929897844871673, -0.40664977158655768]}, angular_velocity: [0, 0, 0]}\n"
-       "effects: [{actuator_limits: {max_torque: [0.21095298210584135, "
-       "0.15505100148399206, 0.094331111553482436]}}]\n"
-       "constraints:\n"
-       "  - keep_out: {body_axis: [-0.74023490669455416, -0.31523338783274019, "
-       "-0.59386883577638416], world_direction: [0.83213928906033396, "
-       "0.47176552832657487, 0.29151584842836514], half_angle: 0.55649821837555946}\n"}};
+  // pair lies in between, where one plan would count as two starts (kClearingRequests).
   const ap::SolverOptions options;
-  for (const auto& [index, text] : requests) {
+  for (const auto& [index, text] : kClearingRequests) {
     const ap::PlanningProblem p = ap::parseScene(text).problem;
     ap::SolveContext context{options};
     std::vector<std::vector<ap::Matrix3>> cleared;
@@ -224,10 +237,7 @@ TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
     int repeats = 0;
     for (std::size_t i = 0; i < cleared.size(); ++i) {
       for (std::size_t j = 0; j < i; ++j) {
-        double largest = 0.0;
-        for (std::size_t k = 0; k < cleared[i].size(); ++k) {
-          largest = std::max(largest, (cleared[i][k] - cleared[j][k]).cwiseAbs().maxCoeff());
-        }
+        const double largest = largestDifference(cleared[i], cleared[j]);
         EXPECT_TRUE(largest <= kSameStart || largest > 10 * kSameStart)
             << "#" << index << ": starts " << j << " and " << i << " differ by " << largest;
         repeats += largest <= kSameStart ? 1 : 0;
@@ -235,6 +245,123 @@ TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
     }
     EXPECT_GE(repeats, 3) << "#" << index;
   }
+}
+
+TEST(MinimumTimeLevels, AClearingStoppedAtAnEarlierClearingsPlanWouldHaveRepeatedIt) {
+  // The driver stops a cone clearing where its iterate comes within kSameStart of a plan an
+  // earlier clearing at the same T reached, and takes that plan as the start (clearOfCones). The
+  // property that rule relies on: such a clearing, run to its end, ends within kSameStart of that
+  // plan too (a repeat, whose free-time solve the driver skips either way); the stopped one takes
+  // fewer iterations, and a clearing the watch does not stop runs as before.
+  const ap::SolverOptions options;
+  for (const auto& [index, text] : kClearingRequests) {
+    const ap::PlanningProblem p = ap::parseScene(text).problem;
+    ap::SolveContext context{options};
+    std::vector<std::vector<ap::Matrix3>> plans;  // the earlier clearings' ends
+    int stopped = 0, missed = 0;
+    for (const ap::FreeTimeStart& st : ap::freeTimeStarts(p, true, context)) {
+      if (ap::coneClearance(p, st.attitudes) >= 0.5 * ap::kConeStartClearance) continue;
+      if (st.kind != ap::AttemptStart::Excursion) continue;  // one T: the excursions'
+      ap::SolveContext full_run{options};
+      const auto full = ap::coneClearStart(p, st.attitudes, st.duration, full_run);
+      ASSERT_TRUE(full.has_value()) << st.name;
+      int joined = -1;
+      const auto joins = [&](const std::vector<ap::Matrix3>& attitudes) -> std::string {
+        for (std::size_t j = 0; j < plans.size() && joined < 0; ++j) {
+          if (largestDifference(attitudes, plans[j]) <= kSameStart) joined = static_cast<int>(j);
+        }
+        return joined >= 0 ? "joined" : "";
+      };
+      ap::SolveContext watched_run{options};
+      const auto watched = ap::coneClearStart(p, st.attitudes, st.duration, watched_run, joins);
+      int repeats = -1;
+      for (std::size_t j = 0; j < plans.size() && repeats < 0; ++j) {
+        if (largestDifference(*full, plans[j]) <= kSameStart) repeats = static_cast<int>(j);
+      }
+      // Stopped, it takes the plan the whole clearing repeats. (Not every repeat is stopped on
+      // its way: #19 has one whose last solve ran where the watch does not look, on another
+      // path than the warm fixed-h interior point's steps; it is then solved as a repeat.)
+      missed += joined < 0 && repeats >= 0 ? 1 : 0;
+      if (joined >= 0) {
+        EXPECT_EQ(joined, repeats) << "#" << index << " " << st.name;
+        EXPECT_FALSE(watched.has_value());
+        EXPECT_LT(watched_run.iterations(), full_run.iterations()) << st.name;
+        ++stopped;
+      } else {
+        ASSERT_TRUE(watched.has_value()) << st.name;
+        EXPECT_EQ(watched_run.iterations(), full_run.iterations()) << st.name;
+        plans.push_back(*full);
+      }
+    }
+    EXPECT_GE(stopped, 2) << "#" << index;
+    EXPECT_LE(missed, 1) << "#" << index;
+  }
+}
+
+TEST(MinimumTimeLevels, TheAnswerCountsItsConeClearings) {
+  // The cone clearings are starts, in no attempt of the trail: minimum_time.cone_clearings and
+  // cone_clearing_iterations account for the request's iterations the attempts do not show
+  // (rest to rest, no other solve stands aside), and the JSON summary carries them.
+  ap::SolverOptions options;
+  options.threads = 1;
+  const ap::PlanningProblem p = scene("min_time_keep_out", 64);
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message();
+  const ap::MinimumTimeCertificate& m = r.minimum_time;
+  EXPECT_GE(m.cone_clearings, 1);
+  EXPECT_GE(m.cone_clearing_iterations, m.cone_clearings);
+  EXPECT_LE(m.cone_clearings_joined, m.cone_clearings);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + m.cone_clearing_iterations, r.iterations);
+  const std::string json = ap::planResultJson(p, r);
+  EXPECT_NE(
+      json.find("\"cone_clearings\": " + std::to_string(m.cone_clearings) +
+                ", \"cone_clearing_iterations\": " + std::to_string(m.cone_clearing_iterations) +
+                ", \"cone_clearings_joined\": " + std::to_string(m.cone_clearings_joined)),
+      std::string::npos)
+      << json;
+  // Without the cone no start is cleared.
+  ap::PlanningProblem free = p;
+  free.constraints.clear();
+  const ap::PlanResult unconstrained = ap::planManeuver(free, options);
+  ASSERT_TRUE(unconstrained.converged()) << unconstrained.message();
+  EXPECT_EQ(unconstrained.minimum_time.cone_clearings, 0);
+  EXPECT_EQ(unconstrained.minimum_time.cone_clearing_iterations, 0);
+}
+
+TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {
+  // fourth_order minimum time is two second_order ones (N and 2N): the answer's clearings are
+  // both solves' (their iterations read from the request's one tally, not added), the same as
+  // each solved on its own, and they still make up the request's iterations with the attempts.
+  ap::SolverOptions options;
+  options.threads = 1;
+  ap::PlanningProblem p = scene("min_time_keep_out", 32);
+  p.time_margin = 0.0;
+  ap::PlanningProblem second_order = p;
+  p.scheme = ap::SchemeKind::FourthOrder;
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  int clearings = 0, iterations = 0, joined = 0, solves = 0;
+  for (const int N : {32, 64}) {
+    second_order.steps = N;
+    const ap::PlanResult alone = ap::planManeuver(second_order, options);
+    ASSERT_TRUE(alone.converged()) << "N = " << N << ": " << alone.message();
+    EXPECT_GE(alone.minimum_time.cone_clearings, 1) << "N = " << N;
+    clearings += alone.minimum_time.cone_clearings;
+    iterations += alone.minimum_time.cone_clearing_iterations;
+    joined += alone.minimum_time.cone_clearings_joined;
+    solves += alone.minimum_time.solves;
+  }
+  // Both solves' work, the other's taken before its plan at T* (a minimum-effort answer)
+  // replaced it.
+  EXPECT_EQ(r.minimum_time.solves, solves);
+  EXPECT_EQ(r.minimum_time.cone_clearings, clearings);
+  EXPECT_EQ(r.minimum_time.cone_clearing_iterations, iterations);
+  EXPECT_EQ(r.minimum_time.cone_clearings_joined, joined);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
 }
 
 TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {

@@ -187,6 +187,12 @@ struct MinimumTimeCertificate {
   double time_stationarity = 0.0;  ///< its η row alone
   double complementarity = 0.0;    ///< Σ zᵢcᵢ (the duality gap, relative to T₀)
   int solves = 0;                  ///< free-time solves run (one per start)
+  /// Starts cleared of the cones by a minimum-effort solve under the cones alone (a start, not
+  /// an attempt: in no attempt of the trail), their interior-point iterations (within the
+  /// request's), and how many of them ended at a plan an earlier clearing reached (joined).
+  int cone_clearings = 0;
+  int cone_clearing_iterations = 0;
+  int cone_clearings_joined = 0;
   /// With kkt_point: the reduced Hessian on the tangent of the active constraints is positive
   /// definite there (a strict local minimum of the discrete problem); false: a saddle or a
   /// degenerate KKT point (FreeTimeOutcome::second_order_sufficient).

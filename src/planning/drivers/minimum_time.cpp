@@ -44,6 +44,24 @@ void validateMinimumTime(const PlanningProblem& problem) {
 PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context,
                            RichardsonPair* pair = nullptr);
 
+/// `from`'s work (its free-time solves and cone clearings) added to `*to`'s: an answer made of
+/// two minimum-time solves (a Richardson pair, a fixed twist then the free one) counts both. The
+/// clearings' iterations are the request's, read from the context's one tally.
+void addSolveWork(const MinimumTimeCertificate& from, const SolveContext& context,
+                  MinimumTimeCertificate* to) {
+  to->solves += from.solves;
+  to->cone_clearings += from.cone_clearings;
+  to->cone_clearings_joined += from.cone_clearings_joined;
+  to->cone_clearing_iterations = context.coneClearingIterations();
+}
+
+/// `*to` with `from`'s work (its solves and cone clearings) in place of its own.
+void setSolveWork(const MinimumTimeCertificate& from, const SolveContext& context,
+                  MinimumTimeCertificate* to) {
+  to->solves = to->cone_clearings = to->cone_clearings_joined = 0;
+  addSolveWork(from, context, to);
+}
+
 }  // namespace
 
 std::string tStarKind(const PlanResult& r) {
@@ -149,8 +167,11 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   const bool fine_binds = fine.minimum_duration >= coarse.minimum_duration;
   const double T_star = std::max(fine.minimum_duration, coarse.minimum_duration);
   const double T_N = coarse.minimum_duration, T_2N = fine.minimum_duration;
-  const MinimumTimeCertificate certificate = (fine_binds ? fine : coarse).minimum_time;
-  const int solves = fine.minimum_time.solves + coarse.minimum_time.solves;
+  // The binding one's certificate with both solves' work, taken before the other's plan at T*
+  // (a minimum-effort answer) replaces it below.
+  MinimumTimeCertificate certificate = (fine_binds ? fine : coarse).minimum_time;
+  setSolveWork(fine.minimum_time, context, &certificate);
+  addSolveWork(coarse.minimum_time, context, &certificate);
   // The other one's minimum-effort plan at T* (at its own T*: its plan already).
   std::optional<std::size_t> other_kept;
   PlanResult& other = fine_binds ? coarse : fine;
@@ -177,7 +198,6 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   if (pair) *pair = RichardsonPair{coarse.maneuver, fine.maneuver};
   result.minimum_duration = T_star;
   result.minimum_time = certificate;
-  result.minimum_time.solves = solves;
   // Kept: the plan returned, the binding one's (the combination) or the N plan's (replaced):
   // the 2N minimum time's, the N minimum time's, or the N plan's polish at T*.
   if (fine_binds) {
@@ -349,7 +369,7 @@ PlanResult upperBoundAt(const PlanningProblem& effort, const PlanResult& answer,
   upper.attempts = context.attemptsFrom(first);
   upper.minimum_time = MinimumTimeCertificate{};
   answerFeasibleAt(effort.duration, &upper);
-  upper.minimum_time.solves = answer.minimum_time.solves;
+  setSolveWork(answer.minimum_time, context, &upper.minimum_time);
   frameMessage(&upper, frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration});
   return upper;
 }
@@ -561,14 +581,14 @@ PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
         posed, at_twist.maneuver, at_twist.minimum_duration, "fixed-twist plan", context);
     if (freed && freed->converged()) {
       freed->attempts = context.attemptsFrom(first);
-      freed->minimum_time.solves += at_twist.minimum_time.solves;
+      addSolveWork(at_twist.minimum_time, context, &freed->minimum_time);
       return *freed;
     }
   }
   context.restoreKept(std::nullopt);  // the plan returned is the one from the free twist
   PlanResult free_start = minimumTimePlan(posed, context);
   free_start.attempts = context.attemptsFrom(first);
-  free_start.minimum_time.solves += at_twist.minimum_time.solves;
+  addSolveWork(at_twist.minimum_time, context, &free_start.minimum_time);
   return free_start;
 }
 

@@ -395,7 +395,8 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
-                                                   double duration, SolveContext& context) {
+                                                   double duration, SolveContext& context,
+                                                   const SolveContext::IterateWatch& joins) {
   PlanningProblem effort = problem;
   effort.objective = Objective::MinimumEffort;
   effort.time_margin = 0.0;
@@ -414,6 +415,8 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
   }
   // A start, not an attempt: its solves stay out of the answer's trail.
   const SolveContext::Aside start_only(context);
+  std::optional<SolveContext::WatchIterates> watching;
+  if (joins) watching.emplace(context, joins);
   try {
     SolveRequest o(context.options());
     o.tolerance = std::max(o.tolerance, kConeClearTolerance);
@@ -426,13 +429,14 @@ std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& proble
     const int max_iterations = o.max_iterations;
     o.max_iterations = std::min(max_iterations, kConeClearWarmIterations);
     PlanResult r = planAtResolution(effort, o, context);
+    if (watching && watching->stoppedASolve()) return std::nullopt;  // the caller's plan
     if (!r.converged()) {
       o.warm_start = nullptr;
       o.start.from_constrained_plan = false;
       o.max_iterations = max_iterations;
       r = planAtResolution(effort, o, context);
     }
-    if (r.converged()) return r.maneuver.attitude;
+    if (r.converged() && !(watching && watching->stoppedASolve())) return r.maneuver.attitude;
   } catch (const StepTooLarge&) {  // a boundary rate with no step at this T: no cleared start
   }
   return std::nullopt;

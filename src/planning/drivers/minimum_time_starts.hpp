@@ -87,10 +87,13 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 /// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
 /// side of a cone; cold if that does not converge in a few iterations (a warm solve that long is
 /// crossing the cone the long way). Empty if none converges. Its solves run in
-/// `context` with its options().
+/// `context` with its options(). `joins` (where given) watches their iterates
+/// (SolveContext::IterateWatch): where it stops one the clearing ends there, empty (the caller
+/// knows the plan its watch recognized).
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,
-                                                   double duration, SolveContext& context);
+                                                   double duration, SolveContext& context,
+                                                   const SolveContext::IterateWatch& joins = {});
 /// The same as a request of its own (tests).
 std::optional<std::vector<Matrix3>> coneClearStart(const PlanningProblem& problem,
                                                    const std::vector<Matrix3>& attitudes,

@@ -173,7 +173,18 @@ class GridSolve final : public BarrierProblemSolve<FixedTimeStep, Scalar> {
       ++iteration_;
       return end(Termination::Cancelled, "cancelled");
     }
+    if (const std::string stop = iterateStop(); !stop.empty()) {
+      ++iteration_;
+      stopped_by_watch_ = true;
+      return end(Termination::NotConverged, stop);
+    }
     return verdict.final_step ? endBarrierProblem() : Pass::Continue;
+  }
+
+  /// The context's IterateWatch on the accepted iterate (empty: go on, or no watch).
+  std::string iterateStop() {
+    if (!context_.watchesIterates()) return {};
+    return context_.iterateStop(np_.attitudes(np_.current()));
   }
 
   /// Free slacks: the slack and dual steps, the ℓ1 merit's ν (at least the multipliers after the

@@ -16,7 +16,9 @@ SolveContext::SolveContext(const SolverOptions& request)
     : request_(request),
       call_(&request_),
       start_(Clock::now()),
-      shared_(std::make_shared<Shared>()) {}
+      shared_(std::make_shared<Shared>()) {
+  cone_clearings_.pause();
+}
 
 SolveContext::SolveContext(SolveContext& parent, Branch)
     : request_(parent.request_),
@@ -24,9 +26,14 @@ SolveContext::SolveContext(SolveContext& parent, Branch)
       start_(parent.start_),
       shared_(parent.shared_),
       attempt_(parent.attempt_),
-      scope_names_nested_(parent.scope_names_nested_) {}
+      scope_names_nested_(parent.scope_names_nested_) {
+  cone_clearings_.pause();
+}
 
 void SolveContext::join(SolveContext& branch) {
+  // The branch's clearings join the request's tally; while it counts, the branch's whole count
+  // below is in it already.
+  if (!cone_clearings_.counting()) cone_clearings_.counted_ += branch.coneClearingIterations();
   iterations_ += branch.iterations_;
   for (Attempt& a : branch.attempts_) {
     if (a.kept) {
@@ -38,6 +45,8 @@ void SolveContext::join(SolveContext& branch) {
   branch.attempts_.clear();
   branch.levels_.clear();
   branch.iterations_ = 0;
+  branch.cone_clearings_ = IterationTally(branch);
+  branch.cone_clearings_.pause();
 }
 
 int SolveContext::threads() const {

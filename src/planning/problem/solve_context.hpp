@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "attitude_planner/planning/problem.hpp"
@@ -98,8 +99,10 @@ class SolveContext : public Interruption {
       at_open_ = context_->iterations_;
       counting_ = true;
     }
+    bool counting() const { return counting_; }
 
    private:
+    friend class SolveContext;  // join: a branch's paused tally into its parent's
     const SolveContext* context_;
     int at_open_;
     int counted_ = 0;
@@ -202,6 +205,72 @@ class SolveContext : public Interruption {
   /// [rad] (Attempt::start_detail.twist): the solves of a start R_N fixed there.
   void posedAtTwist(std::size_t first, double twist);
 
+  /// A stop a driver puts on the fixed-h interior point's iterates: asked with the attitudes
+  /// R_0..R_N after each accepted step; a non-empty reason stops that solve there (NotConverged,
+  /// GridOutcome::stopped_by_watch, so no retry in the other form). Once it stopped a solve it
+  /// stops every later one at its first step with the same reason: the driver has what it wanted
+  /// (a cone clearing that reached a plan an earlier clearing made), and the fallbacks after a
+  /// stopped solve (the other attempts of the constrained recipe) would only repeat the work.
+  using IterateWatch = std::function<std::string(const std::vector<Matrix3>&)>;
+  /// While alive, `watch` watches the iterates of this context's fixed-h interior points (not a
+  /// branch's: a branch runs its own solves, and a watch that records what it saw is not shared
+  /// across threads).
+  class WatchIterates {
+   public:
+    WatchIterates(SolveContext& context, IterateWatch watch)
+        : context_(context), previous_(context.iterate_watch_), watch_(std::move(watch)) {
+      context_.iterate_watch_ = this;
+    }
+    ~WatchIterates() { context_.iterate_watch_ = previous_; }
+    WatchIterates(const WatchIterates&) = delete;
+    WatchIterates& operator=(const WatchIterates&) = delete;
+    /// The watch's say on an iterate (sticky once it stopped one).
+    std::string stopAt(const std::vector<Matrix3>& attitudes) {
+      if (stopped_.empty()) stopped_ = watch_(attitudes);
+      return stopped_;
+    }
+    /// Whether it stopped a solve.
+    bool stoppedASolve() const { return !stopped_.empty(); }
+
+   private:
+    SolveContext& context_;
+    WatchIterates* previous_;
+    IterateWatch watch_;
+    std::string stopped_;
+  };
+  /// Whether an IterateWatch is in force (the attitudes are formed only then).
+  bool watchesIterates() const { return iterate_watch_ != nullptr; }
+  /// The reason the IterateWatch in force stops a solve at `attitudes` (empty: go on, or none).
+  std::string iterateStop(const std::vector<Matrix3>& attitudes) {
+    return iterate_watch_ ? iterate_watch_->stopAt(attitudes) : std::string();
+  }
+
+  /// The iterations of the request's cone clearings (minimum time's starts cleared of the cones
+  /// by minimum-effort solves that stand aside: in no attempt of the trail), read from the one
+  /// numbering by one tally that counts only while a ClearingCones is alive (a branch's clearings
+  /// join with the branch). Every minimum-time answer of the request reads it here, so an answer
+  /// made of two minimum-time solves (a Richardson pair, a fixed twist then the free one) counts
+  /// both without adding them.
+  int coneClearingIterations() const { return cone_clearings_.iterations(); }
+  /// While alive, the iterations reported in this context (and the branches joined into it) are
+  /// the request's cone clearings' (coneClearingIterations).
+  class ClearingCones {
+   public:
+    explicit ClearingCones(SolveContext& context)
+        : tally_(context.cone_clearings_), was_counting_(tally_.counting()) {
+      tally_.resume();
+    }
+    ~ClearingCones() {
+      if (!was_counting_) tally_.pause();
+    }
+    ClearingCones(const ClearingCones&) = delete;
+    ClearingCones& operator=(const ClearingCones&) = delete;
+
+   private:
+    IterationTally& tally_;
+    bool was_counting_;
+  };
+
   /// While alive, the attempts recorded are parts of an enclosing attempt (a level's
   /// unconstrained start, a start's helper solve, a search's probes, which the search records as
   /// one attempt per start): when it ends they leave the trail and the kept mark is as before.
@@ -241,6 +310,8 @@ class SolveContext : public Interruption {
   bool scope_names_nested_ = false;  ///< an open scope is Nested::ScopeStage
   std::vector<Attempt> attempts_;
   std::vector<LevelSummary> levels_;
+  WatchIterates* iterate_watch_ = nullptr;  ///< this context's own (a branch starts without)
+  IterationTally cone_clearings_{*this};    ///< paused outside ClearingCones
 };
 
 /// Runs work(i, branch) for i in [0, count), up to context.threads() at once, each in its own

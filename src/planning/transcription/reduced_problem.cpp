@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "attitude_planner/errors.hpp"
+#include "lie/skew_products.hpp"
 
 namespace attitude_planner {
 
@@ -21,6 +22,7 @@ struct StepTerms {
   DiscreteScheme::StepJacobianTerms step;  ///< what D and its contractions read of F alone
   Vector3 mu, G;
   Matrix3 D, dG, DFt, dGFt;
+  Matrix3 DtF;  ///< Dᵀ F (contractdG's, the same for both torques beside the step)
 
   StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
     so3::expWithMinusIdentity<double>(omega, &F, &E);
@@ -31,11 +33,13 @@ struct StepTerms {
     dG = so3::hat<double>(G) + F.transpose() * D;
     DFt = D * F.transpose();
     dGFt = dG * F.transpose();
+    DtF = D.transpose() * F;
   }
 
   /// τ-weighted derivatives C_X(m, e) = Σ_i τ_i ∂X(i, m)/∂ε_e of this step's Jacobian blocks
   /// X = D, D Fᵀ, dG, dG Fᵀ, all from the scheme's C_D by the product rule with
-  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^.
+  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^ (the
+  /// products with τ^ skip its zeros: skew_products.hpp).
   Matrix3 contractD(const DiscreteScheme& scheme, const Vector3& tau) const {
     return scheme.momentumJacobianContraction(step, tau);
   }
@@ -43,9 +47,8 @@ struct StepTerms {
     return F * (C_D - so3::hat<double>(Vector3(D.transpose() * tau)));
   }
   Matrix3 contractdG(const DiscreteScheme& scheme, const Vector3& tau) const {
-    const Matrix3 tau_hat = so3::hat<double>(tau);
-    return tau_hat * dG + scheme.momentumJacobianContraction(step, Vector3(F * tau)) -
-           D.transpose() * F * tau_hat;
+    return so3::hatTimes(tau, dG) + scheme.momentumJacobianContraction(step, Vector3(F * tau)) -
+           so3::timesHat(DtF, tau);
   }
   Matrix3 contractdGFt(const Matrix3& C_dG, const Vector3& tau) const {
     return F * (C_dG - so3::hat<double>(Vector3(dG.transpose() * tau)));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "attitude_planner/errors.hpp"
 #include "lie/skew_products.hpp"
@@ -24,7 +25,10 @@ struct StepTerms {
   Matrix3 D, dG, DFt, dGFt;
   Matrix3 DtF;  ///< Dᵀ F (contractdG's, the same for both torques beside the step)
 
-  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
+  /// The terms of the step ω_in, formed in place (the rolling windows below keep two StepTerms
+  /// and swap pointers: no copy of their ~130 numbers a step).
+  void assign(const DiscreteScheme& scheme, const Vector3& omega_in) {
+    omega = omega_in;
     so3::expWithMinusIdentity<double>(omega, &F, &E);
     step = scheme.stepJacobianTerms(F, omega);
     mu = scheme.momentumOfStep(omega, E);
@@ -514,16 +518,18 @@ double ReducedProblem::visitStencils(bool with_second_order, bool symmetric_seco
     visit(st);
   };
   // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  StepTerms prev(scheme_, steps_[0]);
-  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, &prev, initial_attitude_);
+  StepTerms window[2];
+  StepTerms *prev = &window[0], *next = &window[1];
+  prev->assign(scheme_, steps_[0]);
+  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, prev, initial_attitude_);
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
-    StepTerms next(scheme_, steps_[k]);
-    if (effects_) R = R * prev.F;
-    visit_torque(k, &prev, &next, R);
-    prev = next;
+    next->assign(scheme_, steps_[k]);
+    if (effects_) R = R * prev->F;
+    visit_torque(k, prev, next, R);
+    std::swap(prev, next);
   }
-  if (scheme_.hasEndTorques()) visit_torque(N_, &prev, nullptr, R);
+  if (scheme_.hasEndTorques()) visit_torque(N_, prev, nullptr, R);
   return cost;
 }
 
@@ -531,16 +537,18 @@ void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMome
                                          const SecondOrderWeights& weights) const {
   NodeMomentum node;
   node.second.setZero();
-  StepTerms prev(scheme_, steps_[0]);
+  StepTerms window[2];
+  StepTerms *prev = &window[0], *next = &window[1];
+  prev->assign(scheme_, steps_[0]);
   for (int k = 1; k < N_; ++k) {
-    StepTerms next(scheme_, steps_[k]);
+    next->assign(scheme_, steps_[k]);
     node.k = k;
-    node.momentum = 0.5 * (next.mu + prev.G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
+    node.momentum = 0.5 * (next->mu + prev->G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
     const Vector3 w = weights ? weights(k, node.momentum) : Vector3::Zero().eval();
-    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, true,
-                        &node.jacobian, &node.second);
+    momentumCombination(scheme_, prev, next, 0.5, 0.5, weights ? &w : nullptr, true, &node.jacobian,
+                        &node.second);
     visit(node);
-    prev = next;
+    std::swap(prev, next);
   }
 }
 

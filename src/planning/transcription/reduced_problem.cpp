@@ -421,22 +421,23 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
   } else {
     raw.setZero();
   }
+  // The products go straight into their blocks (noalias: no 3 × 3 temporary; the same sums).
   if (prev) {
     const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
     const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}
     const Matrix3 T_dG_prev = b * C_dG_prev;                             // block b, via ε_{k−1}
-    raw.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
+    raw.block<3, 3>(0, 0).noalias() = -T_dGFt_prev * prev->F.transpose();
     raw.block<3, 3>(0, 3) = T_dGFt_prev;
-    raw.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
+    raw.block<3, 3>(3, 0).noalias() = -T_dG_prev * prev->F.transpose();
     raw.block<3, 3>(3, 3) = T_dG_prev;
   }
   if (next) {
     const Matrix3 C_D = next->contractD(scheme, *w);
     const Matrix3 T_DFt = -a * next->contractDFt(C_D, *w);  // block b, via ε_k
     const Matrix3 T_D = a * C_D;                            // block c, via ε_k
-    raw.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
+    raw.block<3, 3>(3, 3).noalias() -= T_DFt * next->F.transpose();
     raw.block<3, 3>(3, 6) = T_DFt;
-    raw.block<3, 3>(6, 3) = -T_D * next->F.transpose();
+    raw.block<3, 3>(6, 3).noalias() = -T_D * next->F.transpose();
     raw.block<3, 3>(6, 6) = T_D;
   }
   // The antisymmetric part is cancelled exactly by the retraction's derivative

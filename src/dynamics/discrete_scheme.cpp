@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "lie/skew_products.hpp"
+
 namespace attitude_planner {
 
 DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step)
@@ -64,8 +66,10 @@ DiscreteScheme::StepJacobianTerms DiscreteScheme::stepJacobianTerms(const Matrix
   step.c = so3::rightJacobianInverseCoefficient<double>(theta2);
   step.dc = so3::rightJacobianInverseCoefficientDerivative(theta2);
   step.W = so3::hat<double>(omega);
-  // so3::rightJacobianInverse's formula, with the coefficient formed once
-  step.Jr_inverse = Matrix3::Identity() + 0.5 * step.W + step.c * (step.W * step.W);
+  // so3::rightJacobianInverse's formula, with the coefficient formed once. Eigen forms
+  // c (W W) as (W c) W, and W c = (c ω)^.
+  step.Jr_inverse =
+      Matrix3::Identity() + 0.5 * step.W + so3::hatTimesHat(Vector3(step.c * omega), omega);
   step.JJr_inverse = J_ * step.Jr_inverse;
   step.Jw = J_ * omega;
   return step;
@@ -79,12 +83,11 @@ Matrix3 DiscreteScheme::momentumJacobianOfStep(const StepJacobianTerms& step) co
 
 Matrix3 DiscreteScheme::momentumJacobianContraction(const StepJacobianTerms& step,
                                                     const Vector3& tau) const {
-  using so3::hat;
   const Matrix3& F = step.F;
   if (kind_ != SchemeKind::Paper) {  // the variational μ
     // The bilinear part of h μ(F e^ε e^η) is (A − Aᵀ)^∨, A = F ε^ η^ J_d, and
     // τ·(A − Aᵀ)^∨ = −tr(P ε^ η^) = εᵀ(tr(P) I − P)η with P = J_d τ^ F.
-    const Matrix3 P = Jd_ * hat<double>(tau) * F / h_;
+    const Matrix3 P = so3::timesHat(Jd_, tau) * F / h_;
     const Matrix3 K = P.trace() * Matrix3::Identity() - P;
     return K.transpose();
   }
@@ -95,17 +98,19 @@ Matrix3 DiscreteScheme::momentumJacobianContraction(const StepJacobianTerms& ste
   //   qᵀ dJr⁻¹[u] η = uᵀ(−½ q^ + 2c' ω (ω^² q)ᵀ − c q^ ω^ − c (q × ω)^) η.
   const Vector3& w = step.omega;
   const double c = step.c, dc = step.dc;
-  const Matrix3& W = step.W;
   const Matrix3& Jr_inverse = step.Jr_inverse;
   const Vector3 a = F.transpose() * tau;
   const Vector3 q = J_ * a;
   const Matrix3& M = step.JJr_inverse;
-  // Mᵀ a^ = −(a^ M)ᵀ (a^ is antisymmetric): one product, not two, and the same sums.
-  const Matrix3 A = hat<double>(a);
-  const Matrix3 AM = A * M;
-  const Matrix3 B = -0.5 * hat<double>(q) + 2 * dc * w * (W * (W * q)).transpose() -
-                    c * hat<double>(q) * W - c * hat<double>(Vector3(q.cross(w)));
-  const Matrix3 K = A * hat<double>(step.Jw) - AM - AM.transpose() + Jr_inverse.transpose() * B;
+  // Mᵀ a^ = −(a^ M)ᵀ (a^ is antisymmetric): one product, not two, and the same sums. The products
+  // with a skew factor skip its zeros (skew_products.hpp: the dense products' values).
+  const Matrix3 AM = so3::hatTimes(a, M);
+  // B = −½ q^ + 2c' ω (ω^ ω^ q)ᵀ − c q^ ω^ − c (q × ω)^, with s v^ formed as (s v)^ (the same
+  // entries, up to the sign of the zeros on the diagonal).
+  const Matrix3 B = so3::hat<double>(Vector3(-0.5 * q)) +
+                    Vector3(2 * dc * w) * so3::hatTimes(w, so3::hatTimes(w, q)).transpose() -
+                    so3::hatTimesHat(Vector3(c * q), w) - so3::hat<double>(Vector3(c * q.cross(w)));
+  const Matrix3 K = so3::hatTimesHat(a, step.Jw) - AM - AM.transpose() + Jr_inverse.transpose() * B;
   return K.transpose() / h_;
 }
 

@@ -2,10 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "attitude_planner/lie/so3.hpp"
 #include "lie/dual.hpp"
+#include "lie/skew_products.hpp"
 
 using namespace attitude_planner;
 
@@ -224,4 +226,38 @@ TEST(So3, QuaternionCompositionOfSmallStepsKeepsRelativePrecision) {
       so3::quaternionOfRotationVector<double>(a), so3::quaternionOfRotationVector<double>(b)));
   const Vector3 bch = a + b + 0.5 * a.cross(b);  // exact to O(|a|³) = 1e-24
   EXPECT_LE((via_quaternions - bch).norm(), 1e-15 * bch.norm());
+}
+
+namespace {
+template <typename A, typename B>
+bool sameBits(const A& a, const B& b) {
+  static_assert(sizeof(typename A::Scalar) == sizeof(double));
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
+}
+}  // namespace
+
+TEST(SkewProducts, GiveTheDenseProductsBits) {
+  // The Newton Hessian's stencils use these in place of the dense products with so3::hat and
+  // must keep the plans' bits: every entry the same double, on random operands of mixed scales.
+  std::mt19937 rng(59);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto vector = [&] {
+    return Vector3(u(rng), u(rng), u(rng)).cwiseProduct(Vector3(1.0, 1e-3, 1e3)).eval();
+  };
+  int checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vector3 v = vector(), x = vector();
+    Matrix3 M;
+    for (int i = 0; i < 9; ++i) M.data()[i] = u(rng) * std::pow(10.0, 3 * u(rng));
+    const Matrix3 V = so3::hat<double>(v), X = so3::hat<double>(x);
+    ASSERT_TRUE(sameBits(so3::hatTimes(v, x), Vector3(V * x))) << trial;
+    ASSERT_TRUE(sameBits(so3::hatTimes(v, M), Matrix3(V * M))) << trial;
+    ASSERT_TRUE(sameBits(so3::timesHat(M, v), Matrix3(M * V))) << trial;
+    ASSERT_TRUE(sameBits(so3::hatTimesHat(v, x), Matrix3(V * X))) << trial;
+    // Eigen forms s (V X) as (V s) X: its replacement scales v, not the product.
+    const double s = u(rng);
+    ASSERT_TRUE(sameBits(so3::hatTimesHat(Vector3(s * v), x), Matrix3(s * (V * X)))) << trial;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2000);
 }

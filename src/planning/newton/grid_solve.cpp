@@ -292,10 +292,18 @@ class GridSolver {
                             &workspace_) &&
              gradient_.dot(delta_) < 0;
     }
-    if (shift == 0.0) return hessian_.solvePositiveDefinite(&delta_, &context_);  // no copy
+    if (shift == 0.0) return solveWith(hessian_);  // no copy
     BandedSymmetricMatrix shifted = hessian_;
     shifted.addToDiagonal(shift * shift_scale);
-    return shifted.solvePositiveDefinite(&delta_, &context_);
+    return solveWith(shifted);
+  }
+
+  /// delta_ ← A⁻¹ delta_ by the solver's one Cholesky factor (its storage reused from iteration
+  /// to iteration, not allocated per solve); false if A is not positive definite.
+  bool solveWith(const BandedSymmetricMatrix& A) {
+    if (!cholesky_.factor(A, &context_)) return false;
+    cholesky_.solve(&delta_);
+    return true;
   }
 
   /// Trial steps until one is accepted (the iterate moves); false if none is.
@@ -355,6 +363,7 @@ class GridSolver {
   const NewtonParameters& p_;
   const bool augmented_;
   BandedSymmetricMatrix hessian_;
+  BandedCholesky cholesky_;
   std::unique_ptr<BandedLinearSystem> workspace_;
   Eigen::VectorXd gradient_, delta_;
   StoppingTest stopping_;

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "attitude_planner/errors.hpp"
+#include "lie/skew_products.hpp"
 
 namespace attitude_planner {
 
@@ -21,8 +23,12 @@ struct StepTerms {
   DiscreteScheme::StepJacobianTerms step;  ///< what D and its contractions read of F alone
   Vector3 mu, G;
   Matrix3 D, dG, DFt, dGFt;
+  Matrix3 DtF;  ///< Dᵀ F (contractdG's, the same for both torques beside the step)
 
-  StepTerms(const DiscreteScheme& scheme, const Vector3& omega_in) : omega(omega_in) {
+  /// The terms of the step ω_in, formed in place (the rolling windows below keep two StepTerms
+  /// and swap pointers: no copy of their ~130 numbers a step).
+  void assign(const DiscreteScheme& scheme, const Vector3& omega_in) {
+    omega = omega_in;
     so3::expWithMinusIdentity<double>(omega, &F, &E);
     step = scheme.stepJacobianTerms(F, omega);
     mu = scheme.momentumOfStep(omega, E);
@@ -31,11 +37,13 @@ struct StepTerms {
     dG = so3::hat<double>(G) + F.transpose() * D;
     DFt = D * F.transpose();
     dGFt = dG * F.transpose();
+    DtF = D.transpose() * F;
   }
 
   /// τ-weighted derivatives C_X(m, e) = Σ_i τ_i ∂X(i, m)/∂ε_e of this step's Jacobian blocks
   /// X = D, D Fᵀ, dG, dG Fᵀ, all from the scheme's C_D by the product rule with
-  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^.
+  /// ∂F/∂ε_e = F ê_e^:  C_{X Fᵀ} = F (C_X − (Xᵀτ)^),  C_dG = τ^ dG + C_D(Fτ) − DᵀF τ^ (the
+  /// products with τ^ skip its zeros: skew_products.hpp).
   Matrix3 contractD(const DiscreteScheme& scheme, const Vector3& tau) const {
     return scheme.momentumJacobianContraction(step, tau);
   }
@@ -43,9 +51,8 @@ struct StepTerms {
     return F * (C_D - so3::hat<double>(Vector3(D.transpose() * tau)));
   }
   Matrix3 contractdG(const DiscreteScheme& scheme, const Vector3& tau) const {
-    const Matrix3 tau_hat = so3::hat<double>(tau);
-    return tau_hat * dG + scheme.momentumJacobianContraction(step, Vector3(F * tau)) -
-           D.transpose() * F * tau_hat;
+    return so3::hatTimes(tau, dG) + scheme.momentumJacobianContraction(step, Vector3(F * tau)) -
+           so3::timesHat(DtF, tau);
   }
   Matrix3 contractdGFt(const Matrix3& C_dG, const Vector3& tau) const {
     return F * (C_dG - so3::hat<double>(Vector3(dG.transpose() * tau)));
@@ -414,22 +421,23 @@ void momentumCombination(const DiscreteScheme& scheme, const StepTerms* prev, co
   } else {
     raw.setZero();
   }
+  // The products go straight into their blocks (noalias: no 3 × 3 temporary; the same sums).
   if (prev) {
     const Matrix3 C_dG_prev = prev->contractdG(scheme, *w);
     const Matrix3 T_dGFt_prev = -b * prev->contractdGFt(C_dG_prev, *w);  // block a, via ε_{k−1}
     const Matrix3 T_dG_prev = b * C_dG_prev;                             // block b, via ε_{k−1}
-    raw.block<3, 3>(0, 0) = -T_dGFt_prev * prev->F.transpose();
+    raw.block<3, 3>(0, 0).noalias() = -T_dGFt_prev * prev->F.transpose();
     raw.block<3, 3>(0, 3) = T_dGFt_prev;
-    raw.block<3, 3>(3, 0) = -T_dG_prev * prev->F.transpose();
+    raw.block<3, 3>(3, 0).noalias() = -T_dG_prev * prev->F.transpose();
     raw.block<3, 3>(3, 3) = T_dG_prev;
   }
   if (next) {
     const Matrix3 C_D = next->contractD(scheme, *w);
     const Matrix3 T_DFt = -a * next->contractDFt(C_D, *w);  // block b, via ε_k
     const Matrix3 T_D = a * C_D;                            // block c, via ε_k
-    raw.block<3, 3>(3, 3) -= T_DFt * next->F.transpose();
+    raw.block<3, 3>(3, 3).noalias() -= T_DFt * next->F.transpose();
     raw.block<3, 3>(3, 6) = T_DFt;
-    raw.block<3, 3>(6, 3) = -T_D * next->F.transpose();
+    raw.block<3, 3>(6, 3).noalias() = -T_D * next->F.transpose();
     raw.block<3, 3>(6, 6) = T_D;
   }
   // The antisymmetric part is cancelled exactly by the retraction's derivative
@@ -511,16 +519,18 @@ double ReducedProblem::visitStencils(bool with_second_order, bool symmetric_seco
     visit(st);
   };
   // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
-  StepTerms prev(scheme_, steps_[0]);
-  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, &prev, initial_attitude_);
+  StepTerms window[2];
+  StepTerms *prev = &window[0], *next = &window[1];
+  prev->assign(scheme_, steps_[0]);
+  if (scheme_.hasEndTorques()) visit_torque(0, nullptr, prev, initial_attitude_);
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
-    StepTerms next(scheme_, steps_[k]);
-    if (effects_) R = R * prev.F;
-    visit_torque(k, &prev, &next, R);
-    prev = next;
+    next->assign(scheme_, steps_[k]);
+    if (effects_) R = R * prev->F;
+    visit_torque(k, prev, next, R);
+    std::swap(prev, next);
   }
-  if (scheme_.hasEndTorques()) visit_torque(N_, &prev, nullptr, R);
+  if (scheme_.hasEndTorques()) visit_torque(N_, prev, nullptr, R);
   return cost;
 }
 
@@ -528,16 +538,18 @@ void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMome
                                          const SecondOrderWeights& weights) const {
   NodeMomentum node;
   node.second.setZero();
-  StepTerms prev(scheme_, steps_[0]);
+  StepTerms window[2];
+  StepTerms *prev = &window[0], *next = &window[1];
+  prev->assign(scheme_, steps_[0]);
   for (int k = 1; k < N_; ++k) {
-    StepTerms next(scheme_, steps_[k]);
+    next->assign(scheme_, steps_[k]);
     node.k = k;
-    node.momentum = 0.5 * (next.mu + prev.G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
+    node.momentum = 0.5 * (next->mu + prev->G);  // Π_k = μ(F_k) − (h/2)τ_k = G_{k−1} + (h/2)τ_k
     const Vector3 w = weights ? weights(k, node.momentum) : Vector3::Zero().eval();
-    momentumCombination(scheme_, &prev, &next, 0.5, 0.5, weights ? &w : nullptr, true,
-                        &node.jacobian, &node.second);
+    momentumCombination(scheme_, prev, next, 0.5, 0.5, weights ? &w : nullptr, true, &node.jacobian,
+                        &node.second);
     visit(node);
-    prev = next;
+    std::swap(prev, next);
   }
 }
 

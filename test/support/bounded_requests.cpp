@@ -106,11 +106,22 @@ bool planMeetsRequest(const PlanningProblem& p, const Maneuver& m) {
   return ends && checkConstraints(p, m).max_relative_violation <= kPlanOutsideBounds;
 }
 
+/// Whether `m` is a plan of the request at its own T (N steps ending at T) that meets it
+/// (planMeetsRequest). An "infeasible" answer may carry a local minimum-time plan at another T.
+bool planAtTMeetsRequest(const PlanningProblem& p, const Maneuver& m) {
+  const bool at_T = m.steps() == p.steps && !m.time.empty() &&
+                    std::abs(m.time.back() - p.duration) <= 1e-9 * p.duration;
+  return at_T && planMeetsRequest(p, m);
+}
+
 void checkVerdict(const PlanningProblem& p, const SolverOptions& options, VerdictCheck* check) {
   const PlanResult& r = check->result;
   const DurationVerdict& v = r.duration_verdict;
   if (!r.converged() && v.plan_within_bounds && !planMeetsRequest(p, r.maneuver)) {
     check->wrong = "within bounds";
+  } else if (r.termination == Termination::Infeasible && p.duration > 0.0 &&
+             planAtTMeetsRequest(p, r.maneuver)) {
+    check->wrong = "infeasible with a plan";
   } else if (r.converged() && p.objective == Objective::MinimumEffort) {
     const double outside = checkConstraints(p, r.maneuver).max_relative_violation;
     if (outside > kPlanOutsideBounds) check->wrong = "converged";
@@ -131,6 +142,30 @@ void checkVerdict(const PlanningProblem& p, const SolverOptions& options, Verdic
 }
 
 }  // namespace
+
+ProbeAt probeAt(const PlanningProblem& problem, double T, const SolverOptions& options) {
+  PlanningProblem at = problem;
+  at.objective = Objective::MinimumEffort;
+  at.time_margin = 0.0;
+  at.duration = T;
+  ProbeAt probe;
+  probe.duration = T;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const PlanResult r = planManeuver(at, options);
+    probe.converged = r.converged() &&
+                      checkConstraints(at, r.maneuver).max_relative_violation <= kPlanOutsideBounds;
+    probe.plan = probe.converged || (!r.converged() && planAtTMeetsRequest(at, r.maneuver));
+    probe.outcome = outcomeName(r);
+    probe.message = r.message();
+    probe.iterations = r.iterations;
+  } catch (const FieldError& e) {
+    probe.outcome = "input error";
+    probe.message = e.what();
+  }
+  probe.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return probe;
+}
 
 VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& options) {
   VerdictCheck check;

@@ -57,12 +57,28 @@ struct VerdictCheck {
   ///   within bounds  an answer not converged says its plan is within the bounds
   ///                  (plan_within_bounds), yet it leaves a bound by more than 1e-6 or misses
   ///                  its boundary states by more than 1e-8
+  ///   infeasible with a plan  an "infeasible" answer whose own plan is a plan of the request
+  ///                  at T (its N steps end at T; the boundary states and every bound met)
   std::string wrong;
   double check_duration = 0.0;  ///< the T the check solved at (0: none)
 };
 
 /// Plans `request` (planManeuver with `options`) and checks its verdict as above.
 VerdictCheck planAndCheck(const BoundedRequest& request, const SolverOptions& options = {});
+
+/// A cold minimum-effort solve at T under the request's bounds (what the check solves at 0.99 T*):
+/// whether it found a plan (converged within the bounds, or an answer not converged whose plan
+/// meets the request: boundary states and bounds), its outcome and iterations.
+struct ProbeAt {
+  double duration = 0.0;
+  bool converged = false;  ///< a minimum-effort optimum within the bounds
+  bool plan = false;       ///< converged, or a plan within the bounds that did not converge
+  std::string outcome;     ///< outcomeName, or "input error"
+  std::string message;     ///< the answer's message (or the input error's)
+  int iterations = 0;
+  double seconds = 0.0;
+};
+ProbeAt probeAt(const PlanningProblem& problem, double T, const SolverOptions& options = {});
 
 /// The attempts of a plan, one line each (a study's --only output).
 std::string attemptLines(const PlanResult& result);

@@ -409,6 +409,28 @@ TEST(BoundedVerdicts, AnAnswerStoppedShortSaysWhetherItHoldsAPlanAtT) {
   EXPECT_GE(stopped_within, 1);
 }
 
+TEST(BoundedVerdicts, AMinimumEffortAnswerHoldingAPlanAtTIsNeverInfeasible) {
+  // Found by the spinning study's probe scan (docs/results/spinning_minimum_time.md, session 60):
+  // the study suite's request #109 (spinning ends, box bounds) asked for minimum effort at
+  // 37.577 s. Its interior point stops at the iteration limit at a plan within the bounds, and
+  // the minimum-time phase's local T* (38.74 s) lies above T: the answer must hold that plan (not
+  // converged, plan_within_bounds, T* as data), never "infeasible" (the check's "infeasible with
+  // a plan").
+  std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 109);
+  ASSERT_TRUE(request);
+  request->problem.objective = Objective::MinimumEffort;
+  request->problem.time_margin = 0.0;
+  request->problem.duration = 37.577;
+  const robustness::VerdictCheck check = robustness::planAndCheck(*request);
+  const PlanResult& r = check.result;
+  EXPECT_EQ(check.input_error, "");
+  EXPECT_EQ(check.wrong, "") << r.message();
+  EXPECT_NE(r.termination, Termination::Infeasible) << r.message();
+  if (!r.converged()) {
+    EXPECT_TRUE(r.duration_verdict.plan_within_bounds) << r.message();
+  }
+}
+
 TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
   // Requests of the seeded suite (seed 45) whose T lies several times above T* with spinning
   // ends, where the minimum-time plan time-scaled to T is no start. The answer either converges

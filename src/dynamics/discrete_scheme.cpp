@@ -8,6 +8,27 @@
 
 namespace attitude_planner {
 
+namespace {
+
+/// so3::rightJacobianInverse(ω)'s values with its coefficient c(|ω|²) given (formed once where
+/// a caller reads it twice). Eigen forms c (W W) as (W c) W, and W c = (c ω)^: the product of two
+/// skew matrices skips their zeros (skew_products.hpp), the same entries.
+Matrix3 rightJacobianInverseWith(const Vector3& omega, double c) {
+  return Matrix3::Identity() + 0.5 * so3::hat<double>(omega) +
+         so3::hatTimesHat(Vector3(c * omega), omega);
+}
+
+/// paperMomentumJacobian(F, ω)'s values (the formula momentumJacobianOfStep reads from the
+/// step's terms), for solveStep's iterates: its Jr⁻¹(ω) by the skew products.
+Matrix3 paperMomentumJacobianOfIterate(const Matrix3& J, double h, const Matrix3& F,
+                                       const Vector3& omega) {
+  const double c = so3::rightJacobianInverseCoefficient<double>(omega.squaredNorm());
+  const Matrix3 JJr_inverse = J * rightJacobianInverseWith(omega, c);
+  return F * (JJr_inverse - so3::hat<double>(Vector3(J * omega))) / h;
+}
+
+}  // namespace
+
 DiscreteScheme::DiscreteScheme(SchemeKind kind, const Matrix3& inertia, double time_step)
     : kind_(kind), J_(inertia), J_inverse_(inertia.inverse()), h_(time_step) {
   if (!schemeIsDiscretization(kind)) {
@@ -66,10 +87,7 @@ DiscreteScheme::StepJacobianTerms DiscreteScheme::stepJacobianTerms(const Matrix
   step.c = so3::rightJacobianInverseCoefficient<double>(theta2);
   step.dc = so3::rightJacobianInverseCoefficientDerivative(theta2);
   step.W = so3::hat<double>(omega);
-  // so3::rightJacobianInverse's formula, with the coefficient formed once. Eigen forms
-  // c (W W) as (W c) W, and W c = (c ω)^.
-  step.Jr_inverse =
-      Matrix3::Identity() + 0.5 * step.W + so3::hatTimesHat(Vector3(step.c * omega), omega);
+  step.Jr_inverse = rightJacobianInverseWith(omega, step.c);
   step.JJr_inverse = J_ * step.Jr_inverse;
   step.Jw = J_ * omega;
   return step;
@@ -162,9 +180,11 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
   Vector3 w = so3::log(F);
   Vector3 r = momentumWithLog<double>(F, w) - p;
   double r_norm = r.norm();
+  // |p| and ‖J‖ formed once, not at every test (the same values)
+  const double p_norm = p.norm(), J_norm = J_.norm();
   auto tolerance = [&](const Vector3& log_of_F) {
     // relative part, plus the absolute round-off floor of evaluating μ (≈ eps·‖J‖/h at any F)
-    return 1e-14 * (p.norm() + J_.norm() * log_of_F.norm() / h_) + 1e-15 * J_.norm() / h_;
+    return 1e-14 * (p_norm + J_norm * log_of_F.norm() / h_) + 1e-15 * J_norm / h_;
   };
   report->converged = false;
   int polish_steps = 0;
@@ -177,7 +197,8 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
       if (r_norm == 0.0 || polish_steps >= 2) break;
       ++polish_steps;
     }
-    const Matrix3 D = paper ? paperMomentumJacobian<double>(F, w) : momentumJacobian<double>(F);
+    const Matrix3 D =
+        paper ? paperMomentumJacobianOfIterate(J_, h_, F, w) : momentumJacobian<double>(F);
     // 3×3 cofactor inverse (a Newton step corrects its own round-off); singular relative to
     // D's scale means no step can be found from here.
     const double scale = D.cwiseAbs().maxCoeff();
@@ -209,7 +230,9 @@ Matrix3 DiscreteScheme::solveStep(const Vector3& p, const Matrix3& guess,
     }
   }
   report->iterations = it;
-  report->residual = (momentumWithLog<double>(F, w) - p).norm();
+  // r is μ(F) − p of the F and w kept (the variational μ does not read w), formed as the same
+  // expression: its norm is the residual, not evaluated again.
+  report->residual = r_norm;
   if (!report->converged && report->residual <= tolerance(w)) report->converged = true;
   // |p| beyond ~1e154 overflows the norms: the tolerance becomes +inf and every test above
   // passes (found by fuzz_request: Ω_0 = −5e153 rad/s was "solved"). No such step exists.

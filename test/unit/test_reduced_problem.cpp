@@ -7,6 +7,7 @@
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 
@@ -221,6 +222,56 @@ TEST(ReducedProblem, HessianIsTheSumOfTheStencilsSymmetricBlocks) {
       const double tolerance = 1e-13 * expected.cwiseAbs().maxCoeff();
       EXPECT_LE((H.toDense() - expected).cwiseAbs().maxCoeff(), tolerance)
           << schemeName(scheme) << " effects " << effects;
+    }
+  }
+}
+
+namespace {
+
+bool sameBits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+// The accepted trial's evaluation from the step forms its cost kept (StepForms) gives the bits
+// of the evaluation that forms them itself; forms of other steps, or of another h, are not read.
+TEST(ReducedProblem, EvaluationFromTheTrialsKeptStepFormsGivesTheSameBits) {
+  for (SchemeKind scheme : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+    for (bool effects : {false, true}) {
+      ReducedProblem rp = perturbedProblem(scheme, 12, 5, effects);
+      const int n = rp.unknowns();
+      Eigen::VectorXd g0, g1;
+      double scale0, scale1;
+      BandedSymmetricMatrix H0(n, ReducedProblem::kHalfBandwidth),
+          H1(n, ReducedProblem::kHalfBandwidth);
+      rp.evaluate(&g0, &H0, &scale0);
+      const ReducedProblem::StepVectors trial = rp.retract(-0.1 * g0 / g0.norm(), 1.0);
+      ReducedProblem::StepForms forms;
+      const double trial_cost = rp.cost(trial, &forms);
+      EXPECT_EQ(trial_cost, rp.cost(trial));
+      rp.setCurrent(trial);
+      const double c0 = rp.evaluate(&g0, &H0, &scale0);
+      const double c1 = rp.evaluate(&g1, &H1, &scale1, &forms);
+      const std::string what = schemeName(scheme) + (effects ? " with effects" : "");
+      EXPECT_EQ(c0, c1) << what;
+      EXPECT_EQ(c0, trial_cost) << what;
+      EXPECT_EQ(scale0, scale1) << what;
+      EXPECT_TRUE(sameBits(g0, g1)) << what;
+      EXPECT_TRUE(sameBits(H0.toDense(), H1.toDense())) << what;
+      // Forms of steps that are not the iterate's (one step moved in its last bit) are not read.
+      ReducedProblem::StepVectors other = trial;
+      other[rp.firstFreeNode()].x() = std::nextafter(other[rp.firstFreeNode()].x(), 1.0);
+      rp.cost(other, &forms);
+      rp.evaluate(&g1, &H1, &scale1, &forms);
+      EXPECT_TRUE(sameBits(g0, g1)) << what;
+      EXPECT_TRUE(sameBits(H0.toDense(), H1.toDense())) << what;
+      // Nor those kept at another h (μ reads h).
+      ReducedProblem at_other_h = rp;
+      at_other_h.setTimeStep(1.25 * rp.timeStep());
+      at_other_h.cost(trial, &forms);  // the same steps, μ at 1.25 h
+      rp.evaluate(&g1, &H1, &scale1, &forms);
+      EXPECT_TRUE(sameBits(g0, g1)) << what;
     }
   }
 }

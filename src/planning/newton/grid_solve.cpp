@@ -236,7 +236,7 @@ class GridSolver {
   /// The first-order residual at the final iterate (not at the one before the last step).
   void evaluateAtFinalIterate() {
     double scale = 0.0;
-    np_.evaluate(&gradient_, nullptr, &scale);
+    np_.evaluate(&gradient_, nullptr, &scale, &trial_forms_);
     relative_gradient_ = gradient_.size() ? gradient_.cwiseAbs().maxCoeff() / scale : 0.0;
   }
 
@@ -268,7 +268,7 @@ class GridSolver {
   /// The cost, gradient and (normal equations) Hessian at the iterate; false if the solve ends.
   bool evaluate() {
     double scale = 0.0;
-    cost_ = np_.evaluate(&gradient_, augmented_ ? nullptr : &hessian_, &scale);
+    cost_ = np_.evaluate(&gradient_, augmented_ ? nullptr : &hessian_, &scale, &trial_forms_);
     relative_gradient_ = gradient_.size() ? gradient_.cwiseAbs().maxCoeff() / scale : 0.0;
     if (!std::isfinite(cost_) || !std::isfinite(relative_gradient_)) {
       termination_ = Termination::StepTooLarge;
@@ -326,7 +326,8 @@ class GridSolver {
       if (accepted) {
         control_->acceptUnjudged();
       } else {
-        accepted = control_->judge({np_, cost_, slope, delta_, shift_scale, &trial, &step_length_});
+        accepted = control_->judge(
+            {np_, cost_, slope, delta_, shift_scale, &trial, &step_length_, &trial_forms_});
       }
       if (accepted) {
         np_.setCurrent(trial);
@@ -366,6 +367,9 @@ class GridSolver {
   BandedCholesky cholesky_;
   std::unique_ptr<BandedLinearSystem> workspace_;
   Eigen::VectorXd gradient_, delta_;
+  /// The judged trials' step forms: the accepted trial is the next iterate, whose evaluation
+  /// reads them instead of forming them again.
+  ReducedProblem::StepForms trial_forms_;
   StoppingTest stopping_;
   std::unique_ptr<StepControl> control_;
   StepAssessment assessment_;

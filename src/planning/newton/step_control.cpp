@@ -6,7 +6,7 @@
 namespace attitude_planner {
 
 bool TrustRegionControl::judge(const StepTrial& t) {
-  const double trial_cost = t.problem.cost(*t.trial);
+  const double trial_cost = t.problem.cost(*t.trial, t.forms);
   // Model m(δ) = C + gᵀδ + ½δᵀHδ with (H + λI)δ = −g: C − m(δ) = ½(−gᵀδ + λ|δ|²).
   const double predicted = 0.5 * (-t.slope + shift() * t.shift_scale * t.delta.squaredNorm());
   const double ratio = (t.cost - trial_cost) / predicted;
@@ -23,7 +23,7 @@ bool LineSearchControl::judge(const StepTrial& t) {
   bool accepted = false;
   for (int halving = 0; halving < p_.max_halvings && !accepted; ++halving) {
     if (halving > 0) *t.trial = t.problem.retract(t.delta, *t.step_length *= p_.backtrack_factor);
-    const double trial_cost = t.problem.cost(*t.trial);
+    const double trial_cost = t.problem.cost(*t.trial, t.forms);
     accepted =
         std::isfinite(trial_cost) && trial_cost <= t.cost + p_.armijo * *t.step_length * t.slope;
   }

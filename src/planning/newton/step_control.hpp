@@ -12,8 +12,8 @@
 
 #include <Eigen/Core>
 
-#include "attitude_planner/planning/result.hpp"
 #include "attitude_planner/planning/newton_parameters.hpp"
+#include "attitude_planner/planning/result.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 
 namespace attitude_planner {
@@ -27,6 +27,8 @@ struct StepTrial {
   double shift_scale = 0.0;            ///< what the relative shift multiplies
   ReducedProblem::StepVectors* trial;  ///< the full step on entry; the iterate to accept on return
   double* step_length;                 ///< 1 on entry; the step length taken on return
+  /// Where the trials' step forms are kept (the accepted one's evaluation reads them); may be null.
+  ReducedProblem::StepForms* forms = nullptr;
 };
 
 class StepControl {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 #include "attitude_planner/errors.hpp"
@@ -26,12 +27,20 @@ struct StepTerms {
   Matrix3 DtF;  ///< Dᵀ F (contractdG's, the same for both torques beside the step)
 
   /// The terms of the step ω_in, formed in place (the rolling windows below keep two StepTerms
-  /// and swap pointers: no copy of their ~130 numbers a step).
-  void assign(const DiscreteScheme& scheme, const Vector3& omega_in) {
+  /// and swap pointers: no copy of their ~130 numbers a step). With `known` (forms of the steps
+  /// this one is step j of) F, E and μ are read, not formed again: the same values.
+  void assign(const DiscreteScheme& scheme, const Vector3& omega_in,
+              const ReducedProblem::StepForms* known = nullptr, int j = 0) {
     omega = omega_in;
-    so3::expWithMinusIdentity<double>(omega, &F, &E);
+    if (known) {
+      F = known->F[j];
+      E = known->E[j];
+      mu = known->mu[j];
+    } else {
+      so3::expWithMinusIdentity<double>(omega, &F, &E);
+      mu = scheme.momentumOfStep(omega, E);
+    }
     step = scheme.stepJacobianTerms(F, omega);
-    mu = scheme.momentumOfStep(omega, E);
     G = F.transpose() * mu;
     D = scheme.momentumJacobianOfStep(step);
     dG = so3::hat<double>(G) + F.transpose() * D;
@@ -265,26 +274,42 @@ Vector3 lastTorque(const Vector3& final_momentum, const Matrix3& F_last, const V
 /// τ_k, k = 0..N, of `steps` (ReducedProblem::torques), and with `attitudes` the rows
 /// R_{k+1} = R_k F_k from the same pass. Each step's exp(ω^) and exp(ω^) − I come from one
 /// Rodrigues evaluation (so3::expWithMinusIdentity: the values of exp and expMinusIdentity, so
-/// the rows are attitudes()' and the torques are the same with or without them).
+/// the rows are attitudes()' and the torques are the same with or without them). With `keep`
+/// each step's F, E and μ are kept there (ReducedProblem::StepForms).
 std::vector<Vector3> stepTorques(const DiscreteScheme& scheme,
                                  const ReducedProblem::StepVectors& steps, int N,
                                  const Matrix3& initial_attitude, const Vector3& initial_momentum,
                                  const Vector3& final_momentum, const EffectModel* effects,
-                                 std::vector<Matrix3>* attitudes) {
+                                 std::vector<Matrix3>* attitudes,
+                                 ReducedProblem::StepForms* keep = nullptr) {
   std::vector<Vector3> tau(N + 1, Vector3::Zero());
   const double h = scheme.timeStep();
   const bool track_attitude = attitudes || effects;
-  // F = exp(ω^) only where the attitudes are followed; E = F − I always.
-  const auto step = [&](const Vector3& omega, Matrix3* F, Matrix3* E) {
-    if (track_attitude) {
-      so3::expWithMinusIdentity<double>(omega, F, E);
+  const bool form_F = track_attitude || keep;
+  if (keep) {
+    keep->steps = steps;
+    keep->time_step = h;
+    keep->F.resize(N);
+    keep->E.resize(N);
+    keep->mu.resize(N);
+  }
+  // F = exp(ω^) only where the attitudes are followed or kept; E = F − I always. Returns μ.
+  const auto step = [&](int k, Matrix3* F, Matrix3* E) {
+    if (form_F) {
+      so3::expWithMinusIdentity<double>(steps[k], F, E);
     } else {
-      *E = so3::expMinusIdentity(omega);
+      *E = so3::expMinusIdentity(steps[k]);
     }
+    const Vector3 mu = scheme.momentumOfStep(steps[k], *E);
+    if (keep) {
+      keep->F[k] = *F;
+      keep->E[k] = *E;
+      keep->mu[k] = mu;
+    }
+    return mu;
   };
   Matrix3 F_prev, E_prev;  // F_{k−1}, F_{k−1} − I
-  step(steps[0], &F_prev, &E_prev);
-  const Vector3 mu_first = scheme.momentumOfStep(steps[0], E_prev);
+  const Vector3 mu_first = step(0, &F_prev, &E_prev);
   Vector3 mu_prev = mu_first;
   Matrix3 R = initial_attitude;  // R_k, only needed with effects or attitudes
   if (attitudes) {
@@ -293,8 +318,7 @@ std::vector<Vector3> stepTorques(const DiscreteScheme& scheme,
   }
   for (int k = 1; k < N; ++k) {
     Matrix3 F, E;
-    step(steps[k], &F, &E);
-    const Vector3 mu = scheme.momentumOfStep(steps[k], E);
+    const Vector3 mu = step(k, &F, &E);
     tau[k] = interiorTorque(mu, mu_prev, E_prev, h);
     if (track_attitude) R = R * F_prev;
     if (attitudes) (*attitudes)[k] = R;
@@ -360,6 +384,11 @@ Maneuver ReducedProblem::maneuver(const StepVectors& steps) const {
 
 double ReducedProblem::cost(const StepVectors& steps) const {
   return scheme_.cost(torques(steps));
+}
+
+double ReducedProblem::cost(const StepVectors& steps, StepForms* keep) const {
+  return scheme_.cost(stepTorques(scheme_, steps, N_, initial_attitude_, initial_momentum_,
+                                  final_momentum_, effects_.get(), nullptr, keep));
 }
 
 ReducedProblem::StepVectors ReducedProblem::retract(const Eigen::VectorXd& delta,
@@ -474,7 +503,8 @@ double ReducedProblem::forEachStencil(bool with_second_order,
 
 double ReducedProblem::visitStencils(bool with_second_order, bool symmetric_second,
                                      const std::function<void(const Stencil&)>& visit,
-                                     const SecondOrderWeights& weights) const {
+                                     const SecondOrderWeights& weights,
+                                     const StepForms* known) const {
   const double h = scheme_.timeStep();
   double cost = 0.0;
   Stencil st;
@@ -521,11 +551,11 @@ double ReducedProblem::visitStencils(bool with_second_order, bool symmetric_seco
   // Rolling window over steps: `prev` holds F_{k−1}'s terms, `next` F_k's (each F once).
   StepTerms window[2];
   StepTerms *prev = &window[0], *next = &window[1];
-  prev->assign(scheme_, steps_[0]);
+  prev->assign(scheme_, steps_[0], known, 0);
   if (scheme_.hasEndTorques()) visit_torque(0, nullptr, prev, initial_attitude_);
   Matrix3 R = initial_attitude_;  // R_k, only needed with effects
   for (int k = 1; k < N_; ++k) {
-    next->assign(scheme_, steps_[k]);
+    next->assign(scheme_, steps_[k], known, k);
     if (effects_) R = R * prev->F;
     visit_torque(k, prev, next, R);
     std::swap(prev, next);
@@ -553,8 +583,26 @@ void ReducedProblem::forEachNodeMomentum(const std::function<void(const NodeMome
   }
 }
 
+namespace {
+
+/// Whether `forms` belong to `steps` at time step h, bit for bit (a −0 and a +0 step may form
+/// different zeros).
+bool formsOf(const ReducedProblem::StepForms& forms, const ReducedProblem::StepVectors& steps,
+             double h) {
+  return forms.time_step == h && forms.steps.size() == steps.size() &&
+         std::memcmp(forms.steps.data(), steps.data(), steps.size() * sizeof(Vector3)) == 0;
+}
+
+}  // namespace
+
 double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
                                 double* gradient_scale) const {
+  return evaluate(gradient, hessian, gradient_scale, nullptr);
+}
+
+double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
+                                double* gradient_scale, const StepForms* known) const {
+  if (known && !formsOf(*known, steps_, scheme_.timeStep())) known = nullptr;
   gradient->setZero(unknowns());
   if (hessian) hessian->setZero();
   double jacobian_scale = 0.0, torque_scale = 0.0;
@@ -575,7 +623,8 @@ double ReducedProblem::evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix
     const int last = 3 * (std::min(2, last_free_ - (st.k - 1)) + 1);
     hessian->addSymmetricBlock<9>(3 * (st.k - 1 - first_free_), lowerHessianBlock(st), first, last);
   };
-  const double cost = visitStencils(hessian != nullptr, symmetric_second, add_stencil, nullptr);
+  const double cost =
+      visitStencils(hessian != nullptr, symmetric_second, add_stencil, nullptr, known);
   *gradient_scale = jacobian_scale * std::max(torque_scale, 1e-300);
   return cost;
 }

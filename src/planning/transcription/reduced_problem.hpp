@@ -98,6 +98,19 @@ class ReducedProblem {
   Maneuver maneuver(const StepVectors& steps) const;
   /// C = Σ ½ w_k |τ_k|² (DiscreteScheme::torqueWeight).
   double cost(const StepVectors& steps) const;
+
+  /// What a pass over steps forms of each step alone, exp(ω^), exp(ω^) − I and μ (the values
+  /// evaluate's own pass would form): kept by cost(steps, keep), read by evaluate(…, known) when
+  /// its iterate is those steps (the trial a step control judged and accepted). Held by the
+  /// caller: the problem's const methods keep no state.
+  struct StepForms {
+    StepVectors steps;          ///< the ω the forms below belong to
+    double time_step = 0.0;     ///< and the h (μ reads it)
+    std::vector<Matrix3> F, E;  ///< exp(ω^), exp(ω^) − I
+    StepVectors mu;             ///< μ(F)
+  };
+  /// cost(steps), keeping the steps' forms in `keep`.
+  double cost(const StepVectors& steps, StepForms* keep) const;
   /// Whether every step lies on the scheme's principal branch (DiscreteScheme::onPrincipalBranch):
   /// the interior points' domain, as h > 0 is (a trial iterate outside it has merit +∞).
   bool onPrincipalBranch(const StepVectors& steps) const;
@@ -137,6 +150,10 @@ class ReducedProblem {
   /// `gradient_scale` = max|∂τ/∂δ| · max|τ| (for a relative gradient); hessian may be null.
   double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian,
                   double* gradient_scale) const;
+  /// evaluate(), reading the steps' forms from `known` where it holds the current iterate's
+  /// (bit for bit the values it would form; otherwise it forms them).
+  double evaluate(Eigen::VectorXd* gradient, BandedSymmetricMatrix* hessian, double* gradient_scale,
+                  const StepForms* known) const;
 
   // ---- the time step as a global unknown (objective.hpp, planning/linalg/bordered_band.hpp) ----
   // The unknowns are (δ, h): the free attitudes R_j exp(δ_j^) and h, with the boundary data held
@@ -220,9 +237,10 @@ class ReducedProblem {
  private:
   /// forEachStencil's loop; unless `symmetric_second`, `second` is left as the sum S whose
   /// symmetric part (S + Sᵀ)/2 forEachStencil gives, for a reader that forms one triangle.
+  /// `known`: the steps' forms where they are the current iterate's (else null).
   double visitStencils(bool with_second_order, bool symmetric_second,
                        const std::function<void(const Stencil&)>& visit,
-                       const SecondOrderWeights& weights) const;
+                       const SecondOrderWeights& weights, const StepForms* known = nullptr) const;
   /// The free steps' composition R_firstᵀR_{last+1} (what they must compose to), in quaternions.
   Eigen::Vector4d freeStepsComposition() const;
   /// Closes the gap between the free steps' composition and `target` smoothly (see

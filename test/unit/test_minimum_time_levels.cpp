@@ -330,6 +330,49 @@ TEST(MinimumTimeLevels, TheAnswerCountsItsConeClearings) {
   EXPECT_EQ(unconstrained.minimum_time.cone_clearing_iterations, 0);
 }
 
+TEST(MinimumTimeLevels, TheSearchsAnswerCountsTheClearingsThatRanBeforeIt) {
+  // A free-time solve that may halve its line search only once fails from every start (each
+  // cleared of the cone first), so the search answers (an upper bound, not a KKT point) and its
+  // plan's free-time solve fails too: the answer is the search's, built without the clearings'
+  // figure. planMinimumTime stamps the request's on it: the attempts' and the clearings'
+  // iterations make the request's. (On main d02a42c it said 0: 149 iterations unaccounted.)
+  ap::SolverOptions options;
+  options.threads = 1;
+  options.advanced.interior_point.free_time.max_halvings = 1;
+  const ap::PlanningProblem p = scene("min_time_keep_out", 16);
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_FALSE(r.minimum_time.kkt_point) << "not the search's answer: " << r.message();
+  EXPECT_NE(r.message().find("searched on T"), std::string::npos) << r.message();
+  EXPECT_GE(r.minimum_time.cone_clearing_iterations, 1);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+}
+
+TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations) {
+  // The plan at (1 + time_margin) T* is a minimum-effort answer, built after the free-time
+  // starts' clearings ran: the request's answer carries the clearings' iterations all the same
+  // (planMinimumTime stamps the context's figure on whatever answer leaves), so the attempts' and
+  // the clearings' iterations make the request's. (On main d02a42c the margin's answer said 0.)
+  ap::SolverOptions options;
+  options.threads = 1;
+  ap::PlanningProblem p = scene("min_time_keep_out", 64);
+  const ap::PlanResult at_T_star = ap::planManeuver(p, options);
+  ASSERT_TRUE(at_T_star.converged()) << at_T_star.message();
+  ASSERT_GE(at_T_star.minimum_time.cone_clearing_iterations, 1);
+  p.time_margin = 0.1;
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);
+  // The same minimum-time solves ran before the margin's plan: the same clearings.
+  EXPECT_EQ(r.minimum_time.cone_clearing_iterations,
+            at_T_star.minimum_time.cone_clearing_iterations);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+}
+
 TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {
   // fourth_order minimum time is two second_order ones (N and 2N): the answer's clearings are
   // both solves' (their iterations read from the request's one tally, not added), the same as

@@ -23,6 +23,7 @@
 #include "planning/drivers/minimum_time_free_time.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/strategies/grid_continuation.hpp"
+#include "planning/strategies/starts.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 #include "support/random_problems.hpp"
 #include "support/scene_problem.hpp"
@@ -216,6 +217,41 @@ double largestDifference(const std::vector<ap::Matrix3>& a, const std::vector<ap
   return largest;
 }
 
+TEST(MinimumTimeLevels, AStartThatCrossesTheConeIsClearedOnTheSideNearerIt) {
+  // A start whose nodes cross the keep-out cone is cleared from itself turned round the cone on
+  // the side nearer it (coneSideStarts' two, the one that moves it least), not from its nodes
+  // inside the cone, where the warm solve's first steps chose the side, often the far one (a
+  // long way round, or no plan in its iterations and then the cold solve's side): each cleared
+  // start lies nearer the near side's start than the far side's. (On main d02a42c #19's
+  // excursion about [0.441, 0.825, 0.354] was cleared on the far side.)
+  const ap::SolverOptions options;
+  int crossing = 0, far = 0;
+  for (const auto& [index, text] : kClearingRequests) {
+    const ap::PlanningProblem p = ap::parseScene(text).problem;
+    ap::SolveContext context{options};
+    for (const ap::FreeTimeStart& st : ap::freeTimeStarts(p, true, context)) {
+      if (ap::coneClearance(p, st.attitudes) >= 0.5 * ap::kConeStartClearance) continue;
+      ap::Maneuver start;
+      start.attitude = st.attitudes;
+      const std::vector<ap::Maneuver> sides = ap::coneSideStarts(p, start);
+      if (sides.size() != 2) continue;
+      ++crossing;
+      const bool first_near = largestDifference(sides[0].attitude, st.attitudes) <=
+                              largestDifference(sides[1].attitude, st.attitudes);
+      const ap::Maneuver& near = sides[first_near ? 0 : 1];
+      const ap::Maneuver& other = sides[first_near ? 1 : 0];
+      const auto cleared = ap::coneClearStart(p, st.attitudes, st.duration, options);
+      ASSERT_TRUE(cleared.has_value()) << "#" << index << " " << st.name;
+      const bool on_the_far_side =
+          largestDifference(*cleared, other.attitude) < largestDifference(*cleared, near.attitude);
+      EXPECT_FALSE(on_the_far_side) << "#" << index << " " << st.name;
+      far += on_the_far_side ? 1 : 0;
+    }
+  }
+  EXPECT_GE(crossing, 10);
+  EXPECT_EQ(far, 0);
+}
+
 TEST(MinimumTimeLevels, StartsClearedToOneMinimumEffortPlanAreOneStart) {
   // The clearing solve's tolerance is loose (a start, not an answer), but tight enough that the
   // driver's repeat test sees it: two structured starts that clear to one minimum-effort plan
@@ -328,6 +364,49 @@ TEST(MinimumTimeLevels, TheAnswerCountsItsConeClearings) {
   ASSERT_TRUE(unconstrained.converged()) << unconstrained.message();
   EXPECT_EQ(unconstrained.minimum_time.cone_clearings, 0);
   EXPECT_EQ(unconstrained.minimum_time.cone_clearing_iterations, 0);
+}
+
+TEST(MinimumTimeLevels, TheSearchsAnswerCountsTheClearingsThatRanBeforeIt) {
+  // A free-time solve that may halve its line search only once fails from every start (each
+  // cleared of the cone first), so the search answers (an upper bound, not a KKT point) and its
+  // plan's free-time solve fails too: the answer is the search's, built without the clearings'
+  // figure. planMinimumTime stamps the request's on it: the attempts' and the clearings'
+  // iterations make the request's. (On main d02a42c it said 0: 149 iterations unaccounted.)
+  ap::SolverOptions options;
+  options.threads = 1;
+  options.advanced.interior_point.free_time.max_halvings = 1;
+  const ap::PlanningProblem p = scene("min_time_keep_out", 16);
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_FALSE(r.minimum_time.kkt_point) << "not the search's answer: " << r.message();
+  EXPECT_NE(r.message().find("searched on T"), std::string::npos) << r.message();
+  EXPECT_GE(r.minimum_time.cone_clearing_iterations, 1);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+}
+
+TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations) {
+  // The plan at (1 + time_margin) T* is a minimum-effort answer, built after the free-time
+  // starts' clearings ran: the request's answer carries the clearings' iterations all the same
+  // (planMinimumTime stamps the context's figure on whatever answer leaves), so the attempts' and
+  // the clearings' iterations make the request's. (On main d02a42c the margin's answer said 0.)
+  ap::SolverOptions options;
+  options.threads = 1;
+  ap::PlanningProblem p = scene("min_time_keep_out", 64);
+  const ap::PlanResult at_T_star = ap::planManeuver(p, options);
+  ASSERT_TRUE(at_T_star.converged()) << at_T_star.message();
+  ASSERT_GE(at_T_star.minimum_time.cone_clearing_iterations, 1);
+  p.time_margin = 0.1;
+  const ap::PlanResult r = ap::planManeuver(p, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin);
+  // The same minimum-time solves ran before the margin's plan: the same clearings.
+  EXPECT_EQ(r.minimum_time.cone_clearing_iterations,
+            at_T_star.minimum_time.cone_clearing_iterations);
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
 }
 
 TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {

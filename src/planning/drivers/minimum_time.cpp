@@ -650,7 +650,10 @@ PlanResult planMinimumTime(const PlanningProblem& problem, const SolverOptions& 
   return planMinimumTime(problem, context);
 }
 
-PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
+namespace {
+
+/// planMinimumTime's answer before its clearing figure is stamped (planMinimumTime).
+PlanResult minimumTimeRequest(const PlanningProblem& problem, SolveContext& context) {
   validateProblem(problem);
   validateOptions(context.options());
   validateMinimumTime(problem);
@@ -700,6 +703,17 @@ PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context
   result.minimum_duration = T_star;
   result.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace
+
+PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
+  PlanResult result = minimumTimeRequest(problem, context);
+  // The request's cone clearings' iterations, whichever answer leaves: the search's, a plan at
+  // the margin and the checks before solving were built without the figure, though clearings
+  // may have run before them (the free-time starts the search followed).
+  result.minimum_time.cone_clearing_iterations = context.coneClearingIterations();
   return result;
 }
 

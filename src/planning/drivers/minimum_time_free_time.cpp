@@ -50,14 +50,6 @@ constexpr int kMaxSaddleEscapes = 3;
 /// whose least curvature is at round-off, left either way, ends at the same T to 1e-9; followed
 /// on, it cost 8 solves for nothing.
 constexpr double kSameSaddle = 1e-6;
-/// The largest entry of R_k − R'_k over two lists of attitudes of one length.
-double largestDifference(const std::vector<Matrix3>& a, const std::vector<Matrix3>& b) {
-  double largest = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    largest = std::max(largest, (a[k] - b[k]).cwiseAbs().maxCoeff());
-  }
-  return largest;
-}
 
 /// Where a start's outcome comes from.
 enum class OutcomeFrom {

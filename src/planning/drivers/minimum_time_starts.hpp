@@ -59,6 +59,9 @@ std::vector<Vector3> excursionAxes(const Vector3& e);
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,
                                           SolveContext& context);
 
+/// The largest entry of R_k − R'_k over two lists of attitudes of one length.
+double largestDifference(const std::vector<Matrix3>& a, const std::vector<Matrix3>& b);
+
 /// The smallest clearance of the free attitudes R_1..R_{N−1} to their cones' node bounds [rad]
 /// (+∞ without cones).
 double coneClearance(const PlanningProblem& problem, const std::vector<Matrix3>& R);
@@ -85,8 +88,9 @@ std::vector<Matrix3> pushedOutOfCones(const PlanningProblem& problem, std::vecto
 /// A start that clears the cones: the minimum-effort plan at `duration` under the cones alone,
 /// their node bounds tightened by kConeStartClearance (the torque bounds left out: the free-time
 /// solve meets them by raising T), warm-started from `attitudes` so that each start keeps its own
-/// side of a cone; cold if that does not converge in a few iterations (a warm solve that long is
-/// crossing the cone the long way). Empty if none converges. Its solves run in
+/// side of a cone: where they cross a keep-out cone, from them turned round it on the side nearer
+/// them (coneSideStarts); cold if that does not converge in a few iterations (a warm solve that
+/// long is crossing the cone the long way). Empty if none converges. Its solves run in
 /// `context` with its options(). `joins` (where given) watches their iterates
 /// (SolveContext::IterateWatch): where it stops one the clearing ends there, empty (the caller
 /// knows the plan its watch recognized).

@@ -46,6 +46,14 @@ std::vector<int> halvedLevels(int N) {
   return levels;
 }
 
+/// The attempts' and the cone clearings' iterations make the request's: every iteration is in
+/// one of them, none twice.
+void expectIterationsAccountedFor(const ap::PlanResult& r) {
+  int in_attempts = 0;
+  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
+  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+}
+
 }  // namespace
 
 TEST(MinimumTimeLevels, FreeTimeLevelsHalveDownToTheCoarsestAtOrAbove64) {
@@ -347,9 +355,7 @@ TEST(MinimumTimeLevels, TheAnswerCountsItsConeClearings) {
   EXPECT_GE(m.cone_clearings, 1);
   EXPECT_GE(m.cone_clearing_iterations, m.cone_clearings);
   EXPECT_LE(m.cone_clearings_joined, m.cone_clearings);
-  int in_attempts = 0;
-  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
-  EXPECT_EQ(in_attempts + m.cone_clearing_iterations, r.iterations);
+  expectIterationsAccountedFor(r);
   const std::string json = ap::planResultJson(p, r);
   EXPECT_NE(
       json.find("\"cone_clearings\": " + std::to_string(m.cone_clearings) +
@@ -381,9 +387,7 @@ TEST(MinimumTimeLevels, TheSearchsAnswerCountsTheClearingsThatRanBeforeIt) {
   ASSERT_FALSE(r.minimum_time.kkt_point) << "not the search's answer: " << r.message();
   EXPECT_NE(r.message().find("searched on T"), std::string::npos) << r.message();
   EXPECT_GE(r.minimum_time.cone_clearing_iterations, 1);
-  int in_attempts = 0;
-  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
-  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+  expectIterationsAccountedFor(r);
 }
 
 TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations) {
@@ -404,9 +408,7 @@ TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations
   // The same minimum-time solves ran before the margin's plan: the same clearings.
   EXPECT_EQ(r.minimum_time.cone_clearing_iterations,
             at_T_star.minimum_time.cone_clearing_iterations);
-  int in_attempts = 0;
-  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
-  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+  expectIterationsAccountedFor(r);
 }
 
 TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {
@@ -438,9 +440,7 @@ TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {
   EXPECT_EQ(r.minimum_time.cone_clearings, clearings);
   EXPECT_EQ(r.minimum_time.cone_clearing_iterations, iterations);
   EXPECT_EQ(r.minimum_time.cone_clearings_joined, joined);
-  int in_attempts = 0;
-  for (const ap::Attempt& a : r.attempts) in_attempts += a.iterations;
-  EXPECT_EQ(in_attempts + r.minimum_time.cone_clearing_iterations, r.iterations);
+  expectIterationsAccountedFor(r);
 }
 
 TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {

@@ -65,21 +65,6 @@ std::optional<BoundedRequest> boundedRequest(std::uint64_t suite_seed, int index
 
 namespace {
 
-/// Minimum effort at T, cold: converged within the bounds.
-bool planFoundAt(const PlanningProblem& problem, double T, const SolverOptions& options) {
-  PlanningProblem at = problem;
-  at.objective = Objective::MinimumEffort;
-  at.time_margin = 0.0;
-  at.duration = T;
-  try {
-    const PlanResult r = planManeuver(at, options);
-    return r.converged() &&
-           checkConstraints(at, r.maneuver).max_relative_violation <= kPlanOutsideBounds;
-  } catch (const FieldError&) {
-    return false;
-  }
-}
-
 /// The least T of the minimum-time problem under the same bounds (0: none converged).
 double minimumTimeOf(const PlanningProblem& problem, const SolverOptions& options) {
   PlanningProblem fastest = problem;
@@ -127,7 +112,7 @@ void checkVerdict(const PlanningProblem& p, const SolverOptions& options, Verdic
     if (outside > kPlanOutsideBounds) check->wrong = "converged";
   } else if (r.converged() && r.minimum_duration > 0.0) {
     check->check_duration = 0.99 * r.minimum_duration;
-    if (planFoundAt(p, check->check_duration, options)) check->wrong = "minimum time";
+    if (probeAt(p, check->check_duration, options).converged) check->wrong = "minimum time";
   } else if (r.termination == Termination::Infeasible && v.proven_infeasible) {
     const double T_star = minimumTimeOf(p, options);
     check->check_duration = T_star;
@@ -135,7 +120,7 @@ void checkVerdict(const PlanningProblem& p, const SolverOptions& options, Verdic
   } else if (r.termination == Termination::Infeasible && v.least_duration_found > 0.0) {
     check->check_duration = 0.98 * v.least_duration_found;
     if (p.objective == Objective::MinimumEffort && check->check_duration > p.duration &&
-        planFoundAt(p, check->check_duration, options)) {
+        probeAt(p, check->check_duration, options).converged) {
       check->wrong = "local";
     }
   }

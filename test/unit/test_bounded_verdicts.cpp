@@ -410,12 +410,11 @@ TEST(BoundedVerdicts, AnAnswerStoppedShortSaysWhetherItHoldsAPlanAtT) {
 }
 
 TEST(BoundedVerdicts, AMinimumEffortAnswerHoldingAPlanAtTIsNeverInfeasible) {
-  // Found by the spinning study's probe scan (docs/results/spinning_minimum_time.md, session 60):
-  // the study suite's request #109 (spinning ends, box bounds) asked for minimum effort at
-  // 37.577 s. Its interior point stops at the iteration limit at a plan within the bounds, and
-  // the minimum-time phase's local T* (38.74 s) lies above T: the answer must hold that plan (not
-  // converged, plan_within_bounds, T* as data), never "infeasible" (the check's "infeasible with
-  // a plan").
+  // The spinning study suite's request #109 (spinning ends, box bounds) asked for minimum effort
+  // at 37.577 s (docs/results/spinning_minimum_time.md, the probe scan): its interior point stops
+  // at the iteration limit at a plan within the bounds, and the minimum-time phase's local T*
+  // (38.74 s) lies above T: the answer must hold that plan (not converged, plan_within_bounds, T*
+  // as data), never "infeasible" (the check's "infeasible with a plan").
   std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 109);
   ASSERT_TRUE(request);
   request->problem.objective = Objective::MinimumEffort;

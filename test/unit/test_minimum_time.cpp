@@ -485,9 +485,8 @@ TEST(MinimumTime, ARefinedLevelThatEndsShortAgainIsAnsweredAsAnUpperBoundNotSear
   // resume ends short too (T reached to 1e-15, the line search at the round-off floor's edge).
   // Its plan is still a plan at its own T: the answer is that plan, said to be an upper bound and
   // not a KKT point, and the search is not run. Which requests end short moves with the last bits
-  // of the iterates (seed 4949 #5 did until the cone clearing's tolerance became 1e-3, seed 6161
-  // #39 until the clearings started from the cone's near side in session 60): where this one
-  // stops ending short, re-choose one among the suite's seeds whose attempts show a coarse_level
+  // of the iterates (a change of the cone clearings moves them): where this one stops ending
+  // short, re-choose one among the suite's seeds whose attempts show a coarse_level
   // solve on N = 128 and its resume both ended not_converged.
   const ap::PlanningProblem p =
       ap::parseScene(

@@ -230,8 +230,7 @@ TEST(MinimumTimeLevels, AStartThatCrossesTheConeIsClearedOnTheSideNearerIt) {
   // the side nearer it (coneSideStarts' two, the one that moves it least), not from its nodes
   // inside the cone, where the warm solve's first steps chose the side, often the far one (a
   // long way round, or no plan in its iterations and then the cold solve's side): each cleared
-  // start lies nearer the near side's start than the far side's. (On main d02a42c #19's
-  // excursion about [0.441, 0.825, 0.354] was cleared on the far side.)
+  // start lies nearer the near side's start than the far side's.
   const ap::SolverOptions options;
   int crossing = 0, far = 0;
   for (const auto& [index, text] : kClearingRequests) {
@@ -377,7 +376,7 @@ TEST(MinimumTimeLevels, TheSearchsAnswerCountsTheClearingsThatRanBeforeIt) {
   // cleared of the cone first), so the search answers (an upper bound, not a KKT point) and its
   // plan's free-time solve fails too: the answer is the search's, built without the clearings'
   // figure. planMinimumTime stamps the request's on it: the attempts' and the clearings'
-  // iterations make the request's. (On main d02a42c it said 0: 149 iterations unaccounted.)
+  // iterations make the request's.
   ap::SolverOptions options;
   options.threads = 1;
   options.advanced.interior_point.free_time.max_halvings = 1;
@@ -394,7 +393,7 @@ TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations
   // The plan at (1 + time_margin) T* is a minimum-effort answer, built after the free-time
   // starts' clearings ran: the request's answer carries the clearings' iterations all the same
   // (planMinimumTime stamps the context's figure on whatever answer leaves), so the attempts' and
-  // the clearings' iterations make the request's. (On main d02a42c the margin's answer said 0.)
+  // the clearings' iterations make the request's.
   ap::SolverOptions options;
   options.threads = 1;
   ap::PlanningProblem p = scene("min_time_keep_out", 64);

@@ -307,9 +307,8 @@ PlanResult planBoundedMinimumEffort(const PlanningProblem& problem, SolveContext
   }
   const double T_star = minimum_time.minimum_duration;
   // A first solve stopped at a plan within every bound at T answers with it (not converged, a
-  // plan at T): T is feasible, and a T* above it is a local minimum, not a requirement. Measured
-  // on the spinning study's #109 at 0.97 T*: the interior point stopped at its iteration limit
-  // at such a plan, and the answer was "infeasible".
+  // plan at T): T is feasible, and a T* above it is a local minimum, not a requirement (the
+  // spinning study's #109 at 0.97 T*: its interior point stops at its iteration limit there).
   if (T_star > problem.duration && provesFeasible(problem, result)) return finish(result);
   if (T_star > problem.duration) {
     result.termination = Termination::Infeasible;

@@ -32,12 +32,12 @@ constexpr double kFreeTimeStartFactor = 0.96;
 /// clearing solves from 149 to 99 interior-point iterations, every T* of the cone table the same.
 /// 1e-3 instead of 1e-4, on the seeded cone suite (scripts/minimum_time_cost.py, seed 4949, 20
 /// requests): 11,057 -> 10,105 iterations, every T* the same to 1e-9; 1e-2 gave 9,888 but one
-/// request 27 % more (docs/results/minimum_time_clearing_tolerance.md). Back to 1e-4 since the
-/// clearings start from the cone's near side (onTheNearSide): at 1e-3 clearings of one plan,
-/// reached from starts on different sides of it, ended 1.2e-3 to 5e-3 apart (seed 4949 #12), one
+/// request 27 % more (docs/results/minimum_time_clearing_tolerance.md). With the clearings
+/// started from the cone's near side (onTheNearSide), 1e-3 is too loose: clearings of one plan,
+/// reached from starts on different sides of it, end 1.2e-3 to 5e-3 apart (seed 4949 #12), one
 /// plan counted as several starts (StartsClearedToOneMinimumEffortPlanAreOneStart); at 1e-4 they
-/// agree within kSameStart again, for 48,098 instead of 47,251 iterations on the 120 seeded cone
-/// requests (every T* the same; 63,562 from the start's own attitudes at 1e-3).
+/// agree within kSameStart, for 48,098 instead of 47,251 iterations on the 120 seeded cone
+/// requests, every T* the same (docs/results/minimum_time_cone_sides.md).
 constexpr double kConeClearTolerance = 1e-4;
 /// The iterations the warm clearing solve gets before the cold one (coneClearStart). A warm solve
 /// that has not cleared its start by then is crossing the cone the long way: measured on the

@@ -410,6 +410,37 @@ TEST(MinimumTimeLevels, AnAnswerBuiltAfterTheClearingsStillCountsTheirIterations
   expectIterationsAccountedFor(r);
 }
 
+TEST(MinimumTimeLevels, ThePlanAtTheMarginCarriesWhatBacksTStar) {
+  // With a time margin the plan is a minimum-effort one at (1 + margin) T*, and the answer still
+  // reports T*: the certificate of T* (a KKT point, its residuals, its second-order test, the
+  // free-time solves) goes with it, the same as the answer at T* itself.
+  ap::SolverOptions options;
+  options.threads = 1;
+  for (const char* name : {"min_time_sphere", "min_time_keep_out"}) {
+    ap::PlanningProblem p = scene(name, 64);
+    p.time_margin = 0.0;
+    const ap::PlanResult at_T_star = ap::planManeuver(p, options);
+    ASSERT_TRUE(at_T_star.converged()) << name << ": " << at_T_star.message();
+    ASSERT_TRUE(at_T_star.minimum_time.kkt_point) << name;
+    p.time_margin = 0.1;
+    const ap::PlanResult r = ap::planManeuver(p, options);
+    ASSERT_TRUE(r.converged()) << name << ": " << r.message();
+    ASSERT_EQ(r.attempts.back().stage, ap::AttemptStage::MinimumTimeMargin) << name;
+    EXPECT_EQ(r.minimum_duration, at_T_star.minimum_duration) << name;
+    EXPECT_NEAR(r.duration, 1.1 * at_T_star.minimum_duration, 1e-12 * r.duration) << name;
+    const ap::MinimumTimeCertificate& c = r.minimum_time;
+    const ap::MinimumTimeCertificate& expected = at_T_star.minimum_time;
+    EXPECT_TRUE(c.kkt_point) << name;
+    EXPECT_EQ(c.second_order_sufficient, expected.second_order_sufficient) << name;
+    EXPECT_EQ(c.stationarity, expected.stationarity) << name;
+    EXPECT_EQ(c.time_stationarity, expected.time_stationarity) << name;
+    EXPECT_EQ(c.complementarity, expected.complementarity) << name;
+    EXPECT_EQ(c.solves, expected.solves) << name;
+    EXPECT_EQ(c.cone_clearings, expected.cone_clearings) << name;
+    EXPECT_EQ(c.cone_clearing_iterations, expected.cone_clearing_iterations) << name;
+  }
+}
+
 TEST(MinimumTimeLevels, ARichardsonPairCountsTheClearingsOfBothItsSolves) {
   // fourth_order minimum time is two second_order ones (N and 2N): the answer's clearings are
   // both solves' (their iterations read from the request's one tally, not added), the same as

@@ -688,6 +688,9 @@ PlanResult minimumTimeRequest(const PlanningProblem& problem, SolveContext& cont
   }
   if (problem.time_margin > 0.0) {
     const Maneuver at_minimum_time = result.maneuver;
+    // What backs T* stays with the answer that reports T* (minimum_duration), though its plan is
+    // the minimum-effort one at the margin.
+    const MinimumTimeCertificate certificate = result.minimum_time;
     context.restoreKept(std::nullopt);  // the plan returned is the one at the margin
     result = runInternalPhase("the plan at (1 + time_margin) T*", [&] {
       const SolveContext::Scope scope(context, AttemptStage::MinimumTimeMargin,
@@ -699,6 +702,7 @@ PlanResult minimumTimeRequest(const PlanningProblem& problem, SolveContext& cont
     recordNoRoom(no_room, &result);
     result.attempts = context.attemptsFrom(first);
     addNote(&result, notes::PlannedAtMargin{problem.time_margin, result.duration, T_star});
+    result.minimum_time = certificate;
   }
   result.minimum_duration = T_star;
   result.solve_time_s =

@@ -33,7 +33,7 @@ SolveContext::SolveContext(SolveContext& parent, Branch)
 void SolveContext::join(SolveContext& branch) {
   // The branch's clearings join the request's tally; while it counts, the branch's whole count
   // below is in it already.
-  if (!cone_clearings_.counting()) cone_clearings_.counted_ += branch.coneClearingIterations();
+  if (!cone_clearings_.counting()) cone_clearings_.addCountedApart(branch.coneClearingIterations());
   iterations_ += branch.iterations_;
   for (Attempt& a : branch.attempts_) {
     if (a.kept) {

@@ -100,9 +100,11 @@ class SolveContext : public Interruption {
       counting_ = true;
     }
     bool counting() const { return counting_; }
+    /// Adds what another tally counted apart from this one (a joined branch's, counted in the
+    /// branch while this one was paused).
+    void addCountedApart(int iterations) { counted_ += iterations; }
 
    private:
-    friend class SolveContext;  // join: a branch's paused tally into its parent's
     const SolveContext* context_;
     int at_open_;
     int counted_ = 0;

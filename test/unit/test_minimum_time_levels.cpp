@@ -498,6 +498,95 @@ TEST(MinimumTimeLevels, ConeClearStartRefusesQuietlyOnlyWhereItHasNoStart) {
   EXPECT_THROW(ap::coneClearStart(invalid, attitudes, 30.0, options), ap::InvalidInput);
 }
 
+/// Seed 4949 of the seeded cone suite (scripts/minimum_time_cost.py), request #18 on its starts'
+/// grid N = 64: of its 16 excursions most clear to one of a few plans, and many of their solves
+/// meet the central paths of earlier ones at the first barrier problem.
+const char* const kWatchedStartsRequest =
+    "inertia: [[2.0330653982376607, -0.50715223184692082, -0.4645521998210998], "
+    "[-0.50715223184692082, 2.9661586747286548, 0.032897770739216403], "
+    "[-0.4645521998210998, 0.032897770739216403, 2.6185952146744977]]\n"
+    "steps: 64\n"
+    "scheme: second_order\n"
+    "objective: minimum_time\n"
+    "initial: {attitude: {quaternion: [0.65038163269573579, 0.49766715416583635, "
+    "-0.13181629598246222, 0.55852985562991231]}, angular_velocity: [0, 0, 0]}\n"
+    "final: {attitude: {quaternion: [0.35704246449636096, 0.21204403975621533, "
+    "0.85771338084152116, 0.30312664032651004]}, angular_velocity: [0, 0, 0]}\n"
+    "effects: [{actuator_limits: {max_torque: [0.14877277202162634, 0.029958884811316772, "
+    "0.14805661706359638]}}]\n"
+    "constraints:\n"
+    "  - keep_out: {body_axis: [0.88531469508915284, 0.45648597689783399, "
+    "-0.088534984920259602], world_direction: [-0.055172207816901436, 0.93017306692419521, "
+    "0.36295191562167778], half_angle: 0.45251891271961175}\n";
+
+/// kWatchedStartsRequest planned on one thread (the starts each see every earlier one).
+ap::PlanResult plannedOnOneThread(const char* text) {
+  ap::SolverOptions options;
+  options.threads = 1;
+  return ap::planMinimumTime(ap::parseScene(text).problem, options);
+}
+
+TEST(MinimumTimeLevels, NoStartIsSolvedTwiceFromOnePlan) {
+  // A start cleared to the plan of a start whose solve joined an earlier start's central path is
+  // that solve again (the same attitudes, T and shared scale): it takes that start's outcome
+  // instead of a second solve. Two solves on the starts' grid that ended, unconverged, at the
+  // same T to the last bit after the same iterations are one solve run twice (main 19e6708:
+  // four such solves of 14 iterations on this request).
+  const ap::PlanResult r = plannedOnOneThread(kWatchedStartsRequest);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message();
+  std::vector<const ap::Attempt*> ended_short;
+  for (const ap::Attempt& a : r.attempts) {
+    if (a.stage != ap::AttemptStage::MinimumTimeSolve ||
+        a.termination == ap::Termination::Converged)
+      continue;
+    for (const ap::Attempt* earlier : ended_short) {
+      EXPECT_FALSE(earlier->start_detail.duration == a.start_detail.duration &&
+                   earlier->iterations == a.iterations && earlier->cost == a.cost)
+          << "two solves ended at T = " << a.cost << " s after " << a.iterations << " iterations";
+    }
+    ended_short.push_back(&a);
+  }
+  EXPECT_GE(ended_short.size(), 4u);
+  // The same T* as main 19e6708's (each of its starts solved).
+  EXPECT_NEAR(r.minimum_duration, 14.521936320567265, 1e-9 * 14.52);
+}
+
+TEST(MinimumTimeLevels, AStartOnAPathTheLeastTBoundStoppedTakesThatOutcome) {
+  // A solve whose solved barrier problem lies on the central path of a start its watch stopped
+  // because that start could not end below the least T (its local lower bound, which held there,
+  // above the least T) goes on to the same point and the same bound: it is stopped at the join
+  // and takes that start's outcome, not converged. So a start can take an unconverged outcome by
+  // a solve of its own, not only as a repeat (no solve). On main 19e6708 a join took only a
+  // converged outcome (13 free-time solves on this request; here 9), and T* is the same.
+  const ap::PlanningProblem p = ap::parseScene(kWatchedStartsRequest).problem;
+  const ap::PlanResult r = plannedOnOneThread(kWatchedStartsRequest);
+  ASSERT_TRUE(r.converged() && r.minimum_time.kkt_point) << r.message();
+  const auto* told = std::get_if<ap::verdicts::MinimumTimeAnswer>(&r.verdict);
+  ASSERT_NE(told, nullptr) << r.message();
+  // Which structured starts were solved: their attempts carry their parameters.
+  ap::SolveContext starts_context{ap::SolverOptions{}};
+  const std::vector<ap::FreeTimeStart> starts = ap::freeTimeStarts(p, true, starts_context);
+  const auto solved = [&](const std::string& name) {
+    const auto st = std::find_if(starts.begin(), starts.end(),
+                                 [&](const ap::FreeTimeStart& s) { return s.name == name; });
+    if (st == starts.end()) return false;
+    return std::any_of(r.attempts.begin(), r.attempts.end(), [&](const ap::Attempt& a) {
+      return a.stage == ap::AttemptStage::MinimumTimeSolve && a.start == st->kind &&
+             a.start_detail.excursion_axis == st->detail.excursion_axis &&
+             a.start_detail.excursion_peak == st->detail.excursion_peak;
+    });
+  };
+  int joined_unconverged = 0;
+  for (const auto& st : told->starts) {
+    const bool took_unconverged =
+        !st.same_as.empty() && st.termination != ap::Termination::Converged;
+    if (took_unconverged && solved(st.name)) ++joined_unconverged;
+  }
+  EXPECT_GE(joined_unconverged, 1) << r.message();
+  EXPECT_LT(r.minimum_time.solves, 13);
+  EXPECT_NEAR(r.minimum_duration, 14.521936320567265, 1e-9 * 14.52);
+}
+
 TEST(MinimumTimeLevels, AStartClearedToAnEarlierOnesPlanIsNotSolvedAgain) {
   // Around the keep-out cone most structured starts clear it to the same minimum-effort plan:
   // each distinct start is solved once, and T* is the one every start solved gave (main 6b00274,

@@ -14,6 +14,7 @@
 #include "attitude_planner/planning/pointing.hpp"
 #include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
+#include "planning/interior_point/local_lower_bound.hpp"
 #include "planning/problem/duration_bound.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/problem/solve_context.hpp"
@@ -69,6 +70,10 @@ struct StartRecord {
   int earlier = -1;                ///< the start whose outcome it took (−1: its own)
   std::vector<BarrierPoint> path;  ///< its solve's solved barrier problems (sameCentralPath)
   std::size_t attempt = 0;         ///< its solve in the trail (a taken outcome: the earlier's)
+  /// Where its watch stopped its solve because it could not end below the least T so far: that
+  /// lower bound [s], which held (cannotEndBelow); a start that joined such a start's central
+  /// path carries the same (−∞: neither).
+  double cannot_end_below = -std::numeric_limits<double>::infinity();
   bool tookEarlierOutcome() const { return from != OutcomeFrom::ItsSolve; }
 };
 
@@ -87,6 +92,9 @@ struct WatchedRun {
   Attempt attempt;
   std::vector<BarrierPoint> path;
   int joined = -1;
+  /// The lower bound [s] at which the watch stopped it as unable to end below the least T (−∞:
+  /// not stopped so).
+  double cannot_end_below = -std::numeric_limits<double>::infinity();
 };
 
 /// A refined level's outcome and its solve in the trail (a resume's, where the resume answered).
@@ -286,11 +294,16 @@ class FreeTimeMinimumTime {
 
   /// The earlier start whose solve this one would repeat (the same T and attitudes within
   /// kSameStart), or −1. Around a cone most starts clear it to the same minimum-effort plan
-  /// (measured, scenes/min_time_keep_out.yaml N = 64: 18 starts, 8 distinct once cleared).
+  /// (measured, scenes/min_time_keep_out.yaml N = 64: 18 starts, 8 distinct once cleared). A
+  /// start that joined an earlier start's central path is one to repeat too: the solve from the
+  /// same start at the same T on the grid's shared scale is its solve again, up to where it joined
+  /// that path (measured, seed 4949's 20 cone requests: 29 such solves, 272 iterations, each
+  /// joined where the start it repeated had). A repeat is never one: within kSameStart of a
+  /// repeat is within 2 kSameStart of the start it repeats.
   int sameStartAs(const std::vector<Matrix3>& start, double duration) const {
     for (std::size_t j = 0; j < starts_.size(); ++j) {
       const StartRecord& earlier = starts_[j];
-      if (earlier.tookEarlierOutcome() || earlier.duration != duration ||
+      if (earlier.from == OutcomeFrom::Repeat || earlier.duration != duration ||
           earlier.attitudes.size() != start.size()) {
         continue;
       }
@@ -318,7 +331,15 @@ class FreeTimeMinimumTime {
   void recordTaken(const std::vector<Matrix3>& start, double duration, const std::string& name,
                    int earlier, OutcomeFrom from) {
     const StartRecord& taken = starts_[earlier];
-    starts_.push_back({start, duration, name, taken.outcome, from, earlier, {}, taken.attempt});
+    starts_.push_back({start,
+                       duration,
+                       name,
+                       taken.outcome,
+                       from,
+                       earlier,
+                       {},
+                       taken.attempt,
+                       taken.cannot_end_below});
   }
 
   /// Runs every start on `grid` (a start that repeats an earlier one takes its outcome); returns
@@ -532,13 +553,20 @@ class FreeTimeMinimumTime {
     WatchedRun run;
     const BarrierWatch watch = [&](const BarrierPoint& point) -> std::string {
       const std::string above = cannotEndBelow(point.bound(), least, "the least T [s] so far");
-      if (!above.empty()) return above;
-      run.joined = sameCentralPath(point, seen.starts);
+      if (!above.empty()) {
+        run.cannot_end_below = point.lower_bound;
+        return above;
+      }
+      run.joined = sameCentralPath(point, seen.starts, least);
       if (run.joined >= 0) {
+        const StartRecord& joined = *seen.starts[run.joined];
         std::ostringstream why;
         why << "stopped at T = " << point.duration << " s: on the central path of the start "
-            << seen.starts[run.joined]->name
-            << " (the same barrier problem's point, mu = " << point.mu << ")";
+            << joined.name << " (the same barrier problem's point, mu = " << point.mu << ")";
+        if (joined.outcome.termination != Termination::Converged) {
+          why << ", which cannot end below the least T so far, " << least
+              << " s (its local lower bound " << joined.cannot_end_below << ")";
+        }
         return why.str();
       }
       run.path.push_back(point);
@@ -558,20 +586,21 @@ class FreeTimeMinimumTime {
       recordTaken(start, duration, name, run.joined, OutcomeFrom::Joined);
     } else {
       recordStart(start, duration, name, std::move(run.outcome));
+      starts_.back().cannot_end_below = run.cannot_end_below;
     }
     starts_.back().path = std::move(run.path);
   }
 
   /// The earlier start whose solve passed through `point` (the same μ, every attitude within
-  /// kSamePath), or −1: one barrier problem's local solution is one point of one central path,
-  /// so the two solves go on to the same end.
-  static int sameCentralPath(const BarrierPoint& point,
-                             const std::vector<const StartRecord*>& seen) {
+  /// kSamePath) and whose end is known (pathEndKnown against `least`), or −1: one barrier
+  /// problem's local solution is one point of one central path, so the two solves go on to the
+  /// same end.
+  static int sameCentralPath(const BarrierPoint& point, const std::vector<const StartRecord*>& seen,
+                             double least) {
     int closest = -1;
     double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t j = 0; j < seen.size(); ++j) {
-      // A path that ended without a KKT point is not followed to its end by joining it.
-      if (seen[j]->outcome.termination != Termination::Converged) continue;
+      if (!pathEndKnown(*seen[j], least)) continue;
       for (const BarrierPoint& q : seen[j]->path) {
         if (q.mu != point.mu || q.attitudes.size() != point.attitudes.size()) continue;
         const double difference = largestDifference(q.attitudes, point.attitudes);
@@ -582,6 +611,21 @@ class FreeTimeMinimumTime {
       }
     }
     return nearest <= kSamePath ? closest : -1;
+  }
+
+  /// Whether a solve that joins start `st`'s central path knows its end: the KKT point where `st`
+  /// converged, or that it cannot end below `least`, where `st`'s watch stopped it at a locally
+  /// convex barrier point whose lower bound, which holds there, lies above `least` (cannotEndBelow,
+  /// the one rule, tested against today's least). Safe by issue 45's rule: the joining solve
+  /// follows `st`'s central path from the join on, so its basin is `st`'s, and it would pass that
+  /// same point and be stopped by that same bound; it is stopped at the join instead (measured,
+  /// seed 4949's 20 cone requests: 32 solves reached such a path at their first barrier problem
+  /// and ran 211 iterations more to the bound). A path that ended otherwise (the iteration limit,
+  /// no descent step) is not followed to its end by joining it: its end is not known.
+  static bool pathEndKnown(const StartRecord& st, double least) {
+    if (st.outcome.termination == Termination::Converged) return true;
+    const LocalLowerBound stopped{st.outcome.duration, st.cannot_end_below, true};
+    return !cannotEndBelow(stopped, least, "").empty();
   }
 
   /// A request below the start grid, with cones: the structured starts and their saddles solved

@@ -290,7 +290,8 @@ constexpr double kLadderShare = 0.5;
 /// just below a strict local minimum, and the far probes' cold solves below such answers gave no
 /// lower answer on the seed-45 spinning page; its two gains came from answers not shown a local
 /// minimum (#77's KKT point at 6.8175 s, #221's answer at 91.69 s). A cost rule, not a proof: a
-/// strict local minimum can still have another basin far below it.
+/// strict local minimum can still have another basin far below it: below one, the ladder looks
+/// (kLadder, within its budget).
 bool farProbesBelow(const PlanResult& answer) {
   return !answer.minimum_time.second_order_sufficient;
 }

@@ -430,6 +430,27 @@ TEST(BoundedVerdicts, AMinimumEffortAnswerHoldingAPlanAtTIsNeverInfeasible) {
   }
 }
 
+TEST(BoundedVerdicts, BelowAStrictLocalMinimumTheProbesGoOnPastTwoFailuresWithinABudget) {
+  // The spinning study suite's request #12 (rest to spin, N = 124): its T* (2.424 s) is a
+  // second-order sufficient KKT point and the cold probes 1 % and 2 % below it find nothing. A cold
+  // probe's outcome alternates with T there, so two failures do not end the probes: the ladder
+  // below T* asks more (probedBelow, kLadder), within a budget of half the request's iterations
+  // before the probes (about 1,950 here, each probe about 720), so it stops before its last rung.
+  // Each cold probe's interior point from its unconstrained optimum is one `constrained` attempt
+  // on the request's grid started there. (Where two failures ended the probes: 2 of them.)
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 12);
+  ASSERT_TRUE(request);
+  const PlanResult r = planManeuver(request->problem);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(r.minimum_time.second_order_sufficient) << r.message();
+  const auto probes = std::count_if(r.attempts.begin(), r.attempts.end(), [&](const Attempt& a) {
+    return a.stage == AttemptStage::Constrained && a.steps == request->problem.steps &&
+           a.start == AttemptStart::UnconstrainedOptimum;
+  });
+  EXPECT_GT(probes, 2) << r.message();
+  EXPECT_LT(probes, 2 + 4) << r.message();  // the near probes and fewer than the four rungs
+}
+
 TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
   // Requests of the seeded suite (seed 45) whose T lies several times above T* with spinning
   // ends, where the minimum-time plan time-scaled to T is no start. The answer either converges

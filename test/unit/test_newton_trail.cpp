@@ -195,6 +195,28 @@ TEST(NewtonTrail, AStalledSpinningRequestRecordsItsRateContinuationAndNumbersIte
   for (std::size_t i = 0; i < numbers.size(); ++i) EXPECT_EQ(numbers[i], static_cast<int>(i) + 1);
 }
 
+TEST(NewtonTrail, AStalledSpinningRequestAllowedNoRateStagesGoesToTheCoastingStartAtOnce) {
+  // The stalled request above with rate_continuation_max_stages = 0 (as the probes below a
+  // minimum-time T* ask, drivers/minimum_time.cpp): the continuation in the boundary rates is not
+  // tried, no attempt of it is recorded and none of its iterations are counted; the coasting
+  // start follows the request's class solve. (A library that rejects 0 throws here.)
+  PlanningProblem p = restToRest(M_PI / 6, 64);
+  p.final_velocity = Vector3(0.3, 0.2, 0.3);
+  SolverOptions options;
+  options.max_iterations = 2;
+  options.advanced.newton.rate_continuation_max_stages = 0;
+  const PlanResult r = planManeuver(p, options);
+  ASSERT_GE(r.attempts.size(), 6u) << r.message();
+  EXPECT_EQ(r.attempts[4].stage, AttemptStage::Solve);
+  EXPECT_EQ(r.attempts[5].stage, AttemptStage::CoastingRetry);
+  EXPECT_TRUE(std::none_of(r.attempts.begin(), r.attempts.end(), [](const Attempt& a) {
+    return a.stage == AttemptStage::RateContinuation;
+  }));
+  int total = 0;
+  for (const Attempt& a : r.attempts) total += a.iterations;
+  EXPECT_EQ(total, r.iterations);
+}
+
 TEST(NewtonTrail, ACancelFromAnotherThreadEndsALargeSolveCancelled) {
   const int N = 100000;
   std::atomic<bool> cancel{false};

@@ -95,8 +95,9 @@ struct NewtonParameters {
   double same_extremal_cost = 1e-9;
   /// Two converged costs within this relative difference tie (the first start keeps it).
   double cheaper_tie = 1e-12;
-  /// Continuation in the boundary rates: most stages, the first increment of the rate scale s,
-  /// its largest, and the smallest before giving up.
+  /// Continuation in the boundary rates: most stages (0: not tried; the probes below a
+  /// minimum-time T* ask that), the first increment of the rate scale s, its largest, and the
+  /// smallest before giving up.
   int rate_continuation_max_stages = 24;
   double rate_continuation_first_increment = 0.25;
   double rate_continuation_max_increment = 0.5;

@@ -216,7 +216,8 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
 /// duration T found so far, δ = kProbeBelow: j grows while probes succeed (a descent by doubling
 /// steps), falls back by one after a failure (bisection), and where the probes at both δ and 2δ
 /// below T found nothing, the far probes follow (kFarProbes below T, each once; only below an
-/// answer not shown a local minimum: farProbesBelow) before the descent stops. A cold
+/// answer not shown a local minimum: farProbesBelow; below one that is, the ladder kLadder within
+/// its budget) before the descent stops. A cold
 /// minimum-effort solve's failure is local and feasibility in T is not monotone with spinning ends:
 /// the seeded bounded suite had requests where 0.99 T failed and 0.98 T converged, and the seed-45
 /// spinning suite's #77 (N = 215) a KKT point at 6.8175 s with minimum-effort plans failing at 0.99
@@ -227,17 +228,27 @@ constexpr double kProbeBelow = 0.01;
 constexpr int kLargestProbeExponent = 5;  ///< at most 32 δ = 32 % below T per probe
 constexpr double kFarProbes[] = {0.1, 0.2};
 constexpr int kMaxProbes = 12;
+/// Below an answer shown a strict local minimum (second-order sufficient), where the near probes
+/// found nothing: the ladder, probes at these fractions below T, each once, while its budget
+/// lasts (kLadderShare). Why: a cold probe's outcome alternates with T there (the seed-45
+/// spinning suite's #109: plans 2.5-9 % below a second-order sufficient 38.74 s, "infeasible" at
+/// durations between them), so two failures are samples, not a verdict; the rungs are spaced by
+/// about 1.5 from the near probes' 2 % up to the far probes' first 10 %.
+constexpr double kLadder[] = {0.03, 0.05, 0.07, 0.1};
 
 /// What the probes below the current T have shown: which steps δ 2^j found nothing, and which
-/// far probe is next once the near ones found nothing.
+/// far probe (or rung of the ladder) is next once the near ones found nothing.
 struct ProbeSteps {
   int exponent = 0;
   bool failed_at_one = false, failed_at_two = false;  ///< j = 0, j = 1 found nothing
-  int far = -1;  ///< the far probe being asked (kFarProbes index); −1: the near ones
+  int far = -1;         ///< the far probe or rung being asked (index); −1: the near ones
+  bool ladder = false;  ///< far indexes kLadder (below a strict local minimum), else kFarProbes
 
   double fraction() const {
-    return far >= 0 ? kFarProbes[far] : kProbeBelow * std::ldexp(1.0, exponent);
+    if (far < 0) return kProbeBelow * std::ldexp(1.0, exponent);
+    return ladder ? kLadder[far] : kFarProbes[far];
   }
+  bool onLadder() const { return far >= 0 && ladder; }
   /// After a probe that found a plan (a lower T): `descended` if a free-time KKT point came of it
   /// (a new basin: start again at δ), else larger steps.
   void found(bool descended) {
@@ -246,13 +257,18 @@ struct ProbeSteps {
     far = -1;
   }
   /// After a probe that found nothing: false when the descent stops. `look_far`: the far probes
-  /// follow once the near ones found nothing (farProbesBelow).
-  bool nothingFound(bool look_far) {
-    if (far >= 0) return ++far < static_cast<int>(std::size(kFarProbes));
+  /// follow once the near ones found nothing (farProbesBelow); else the ladder, where
+  /// `ladder_affordable` (its budget holds another probe).
+  bool nothingFound(bool look_far, bool ladder_affordable) {
+    if (far >= 0) {
+      const int rungs = ladder ? std::size(kLadder) : std::size(kFarProbes);
+      return ++far < rungs && (!ladder || ladder_affordable);
+    }
     if (exponent == 0) failed_at_one = true;
     if (exponent == 1) failed_at_two = true;
     if (failed_at_one && failed_at_two) {
-      if (!look_far) return false;
+      if (!look_far && !ladder_affordable) return false;
+      ladder = !look_far;
       far = 0;
       return true;
     }
@@ -261,13 +277,21 @@ struct ProbeSteps {
   }
 };
 
+/// The iterations the ladder may take in one run of the probes: kLadderShare of the request's
+/// iterations before them, so that a cheap request stays cheap (on the seed-45 spinning suite's
+/// 48 cheapest rows no probe 0.5-15 % below T* found a plan) and a request that cost much may
+/// spend in proportion on looking below its T*. A rung is asked only where the ladder's
+/// iterations so far and the last probe's (the likely cost of the next) fit in it.
+constexpr double kLadderShare = 0.5;
+
 /// Whether the far probes look below `answer` once the near ones found nothing: only where it is
 /// not shown a local minimum (a KKT point that is not second-order sufficient, or a probe's plan,
 /// an upper bound). Below a second-order sufficient KKT point the near probes have already looked
 /// just below a strict local minimum, and the far probes' cold solves below such answers gave no
 /// lower answer on the seed-45 spinning page; its two gains came from answers not shown a local
 /// minimum (#77's KKT point at 6.8175 s, #221's answer at 91.69 s). A cost rule, not a proof: a
-/// strict local minimum can still have another basin far below it.
+/// strict local minimum can still have another basin far below it: below one, the ladder looks
+/// (kLadder, within its budget).
 bool farProbesBelow(const PlanResult& answer) {
   return !answer.minimum_time.second_order_sufficient;
 }
@@ -425,12 +449,20 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
                        int* solves_left = nullptr) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
+  const double ladder_budget = kLadderShare * context.iterations();
+  int ladder_spent = 0, last_probe = 0;
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
     if (solves_left && (*solves_left)-- <= 0) break;
     PlanningProblem effort =
         effortAt(problem, std::max((1.0 - steps.fraction()) * answer.minimum_duration, floor));
     SolveRequest options(context.options());
+    // A cold probe whose unconstrained solve stalls goes to the interior point without the
+    // continuation in the boundary rates: measured on the seed-45 spinning suite's #109, it
+    // failed in every probe and took two thirds of each probe's iterations (3,094 of 4,609 and
+    // 3,917 of 5,628), and where it fails the interior point starts as it would without it
+    // (from the coasting start's optimum, or cold). No probe of the 48 cheap rows stalled.
+    options.advanced.newton.rate_continuation_max_stages = 0;
     const bool from_iterate = lower_plan && handed_on < kMaxProbes;
     if (from_iterate) {  // the probe at the iterate's T, from it
       effort.duration = lower_plan->duration();
@@ -442,8 +474,13 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
     const std::optional<std::size_t> answer_kept = context.keptAttempt();
     const std::size_t probe_first = context.attempts().size();
+    const int probe_start = context.iterations();
     PlanResult below = runInternalPhase("the probe below T*",
                                         [&] { return planAtResolution(effort, options, context); });
+    if (!from_iterate) {
+      last_probe = context.iterations() - probe_start;
+      if (steps.onLadder()) ladder_spent += last_probe;
+    }
     std::optional<std::size_t> below_kept = context.keptSince(probe_first);
     if (from_iterate && iterates_are_plans && !provesFeasible(effort, below)) {
       // No minimum-effort plan came of the iterate: the iterate itself is one at its T.
@@ -458,7 +495,10 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
     if (!provesFeasible(effort, below)) {
       context.restoreKept(answer_kept);
       answer.attempts = context.attemptsFrom(first);
-      if (!from_iterate && !steps.nothingFound(farProbesBelow(answer))) break;
+      if (!from_iterate &&
+          !steps.nothingFound(farProbesBelow(answer), ladder_spent + last_probe <= ladder_budget)) {
+        break;
+      }
       continue;
     }
     answer = lowerAnswer(problem, effort, answer, below, below_kept, first, context, &lower_plan,

@@ -609,6 +609,12 @@ bool stalledWithSpinningEnds(const RecipeState& s) {
   return hasSpinningEnds(s.problem) && !s.options.warm_start && !s.walk.keptConverged();
 }
 
+/// The stalled spinning request's continuation in the boundary rates, where it may take a stage
+/// (a continuation allowed none is not tried: the probes below T*, drivers/minimum_time.cpp).
+bool stalledAndRatesContinued(const RecipeState& s) {
+  return stalledWithSpinningEnds(s) && s.p.rate_continuation_max_stages > 0;
+}
+
 /// The more starts search a spinning request that left its class free; their gates hold for no
 /// other request, and are not read for one (reading them runs the checks of the plans they read).
 bool mayTryMoreStarts(const RecipeState& s) {
@@ -655,7 +661,7 @@ struct RecipeEntry {
 /// more starts in the kept class and in the request's own (Walk::searchedClasses).
 constexpr RecipeEntry kNewtonRecipe[] = {
     {AttemptStage::RateContinuation, Method::RateContinuation, Globalization::TrustRegion,
-     stalledWithSpinningEnds},
+     stalledAndRatesContinued},
     {AttemptStage::CoastingRetry, Method::Coasting, Globalization::TrustRegion,
      stalledWithSpinningEnds},
     {AttemptStage::MoreStarts, Method::RequestedGridOnly, Globalization::TrustRegion,

@@ -83,7 +83,9 @@ void forEachNewtonField(Newton& p, Visit& visit) {
   visit(n + "unconstrained_refine_margin", p.unconstrained_refine_margin, kNonNegative);
   visit(n + "same_extremal_cost", p.same_extremal_cost, kBelowOne);
   visit(n + "cheaper_tie", p.cheaper_tie, kBelowOne);
-  visit(n + "rate_continuation_max_stages", p.rate_continuation_max_stages, kCount);
+  // 0: the stalled spinning solve's continuation in the boundary rates is not tried (the probes
+  // below T* ask for that, drivers/minimum_time.cpp).
+  visit(n + "rate_continuation_max_stages", p.rate_continuation_max_stages, kCountOrNone);
   visit(n + "rate_continuation_first_increment", p.rate_continuation_first_increment, kUpToOne);
   visit(n + "rate_continuation_max_increment", p.rate_continuation_max_increment, kUpToOne);
   visit(n + "rate_continuation_min_increment", p.rate_continuation_min_increment, kUpToOne);

@@ -26,6 +26,23 @@ TEST(LocalLowerBound, AStartIsStoppedOnlyWhereItsBoundHoldsAndLiesAboveTheLeastA
   EXPECT_TRUE(ap::cannotEndBelow({12.0, std::nan(""), true}, 10.0, "the least T").empty());
 }
 
+TEST(LocalLowerBound, TheRuleAndItsReasonAgreeEverywhere) {
+  // cannotEndBelowLeast is the rule and cannotEndBelow its words: a reason exactly where the rule
+  // stops, over bounds that hold or not and least answers below, at, above, +∞ and NaN.
+  const double leasts[] = {-kInfinity, -1.0, 10.0, 11.0, 11.5, 12.0, kInfinity, std::nan("")};
+  for (const bool holds : {true, false}) {
+    for (const double bound : {-kInfinity, 0.0, 11.0, kInfinity}) {
+      for (const double least : leasts) {
+        const ap::LocalLowerBound at{12.0, bound, holds};
+        EXPECT_EQ(ap::cannotEndBelowLeast(at, least), !ap::cannotEndBelow(at, least, "x").empty())
+            << holds << " " << bound << " " << least;
+      }
+    }
+  }
+  EXPECT_TRUE(ap::cannotEndBelowLeast({12.0, 11.0, true}, 10.0));
+  EXPECT_FALSE(ap::cannotEndBelowLeast({12.0, 11.0, true}, 11.0));
+}
+
 TEST(LocalLowerBound, FreeTimesBarrierPointsHoldWhereLocallyConvexAndFixedStepIteratesAlways) {
   ap::BarrierPoint point;
   point.duration = 5.0;

@@ -615,17 +615,17 @@ class FreeTimeMinimumTime {
 
   /// Whether a solve that joins start `st`'s central path knows its end: the KKT point where `st`
   /// converged, or that it cannot end below `least`, where `st`'s watch stopped it at a locally
-  /// convex barrier point whose lower bound, which holds there, lies above `least` (cannotEndBelow,
-  /// the one rule, tested against today's least). Safe by issue 45's rule: the joining solve
-  /// follows `st`'s central path from the join on, so its basin is `st`'s, and it would pass that
-  /// same point and be stopped by that same bound; it is stopped at the join instead (measured,
+  /// convex barrier point whose lower bound, which holds there, lies above `least`
+  /// (cannotEndBelowLeast, the one rule, tested against the least T held now). Safe because a
+  /// watch stops only a start whose bound holds: the joining solve follows `st`'s central path
+  /// from the join on, so its basin is `st`'s, and it would pass that same point and be stopped by
+  /// that same bound; it is stopped at the join instead (measured,
   /// seed 4949's 20 cone requests: 32 solves reached such a path at their first barrier problem
   /// and ran 211 iterations more to the bound). A path that ended otherwise (the iteration limit,
   /// no descent step) is not followed to its end by joining it: its end is not known.
   static bool pathEndKnown(const StartRecord& st, double least) {
     if (st.outcome.termination == Termination::Converged) return true;
-    const LocalLowerBound stopped{st.outcome.duration, st.cannot_end_below, true};
-    return !cannotEndBelow(stopped, least, "").empty();
+    return cannotEndBelowLeast({st.outcome.duration, st.cannot_end_below, true}, least);
   }
 
   /// A request below the start grid, with cones: the structured starts and their saddles solved

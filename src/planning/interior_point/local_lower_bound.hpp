@@ -19,6 +19,10 @@ struct LocalLowerBound {
   bool holds = false;
 };
 
+/// Whether a solve at `at` cannot end below `least`, the least answer held: the bound holds there
+/// and lies above `least` (never while `least` is +∞ or NaN). The one rule every watch stops by.
+bool cannotEndBelowLeast(const LocalLowerBound& at, double least);
+
 /// Why a solve at `at` cannot end below `least`, the least answer held (`what` names it), or empty
 /// where it still can: the bound does not hold, or lies at or below `least` (always while `least`
 /// is +∞ or NaN).

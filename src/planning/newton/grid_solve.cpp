@@ -19,6 +19,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "attitude_planner/errors.hpp"
+#include "planning/newton/least_raise.hpp"
 #include "planning/problem/message_notes.hpp"
 #include "planning/problem/verdict.hpp"
 #include "planning/strategies/starts.hpp"
@@ -306,6 +307,31 @@ class GridSolver {
     return true;
   }
 
+  /// The least of the step control's raised shifts (raisedShift) at which H + λI is definite,
+  /// within `most_raises` raises of the current one, by leastSucceedingRaise: the λ a one-by-one
+  /// scan stops at (definiteness is monotone in λ), with about 2 log₂ of the raises in
+  /// factorizations (a Hermite start's first iterate on the class survey grid needs 18 to 22
+  /// raises from 0; from 0 the search starts at the raises the last search from 0 needed). The
+  /// control's shift is raised to it and delta_ holds its step; returns the raises, −1 if none.
+  int raisesToDefinite(double shift_scale, int most_raises) {
+    const double from = control_->shift();
+    const bool fresh = from == 0.0;
+    int held = -1;  // the raise whose step delta_ holds
+    const int raises = leastSucceedingRaise(
+        most_raises,
+        [&](int r) {
+          const bool definite = newtonStep(raisedShift(from, r, p_), shift_scale);
+          held = definite ? r : -1;
+          return definite;
+        },
+        fresh ? fresh_raises_ : 1);
+    if (raises < 0) return -1;
+    if (held != raises) newtonStep(raisedShift(from, raises, p_), shift_scale);
+    if (fresh && raises > 0) fresh_raises_ = raises;
+    control_->raiseForIndefinite(raises);
+    return raises;
+  }
+
   /// Trial steps until one is accepted (the iterate moves); false if none is.
   bool takeStep() {
     control_->beginIteration();
@@ -314,11 +340,10 @@ class GridSolver {
     bool factored = false;
     ReducedProblem::StepVectors trial;
     for (int attempt = 0; attempt < p_.max_step_attempts; ++attempt) {
-      factored = newtonStep(control_->shift(), shift_scale);
-      if (!factored) {
-        control_->raiseForIndefinite();
-        continue;
-      }
+      const int raises = raisesToDefinite(shift_scale, p_.max_step_attempts - 1 - attempt);
+      factored = raises >= 0;
+      if (!factored) break;
+      attempt += raises;  // each raise counts as the trial it replaces
       const double slope = gradient_.dot(delta_);
       assessment_ = stopping_.assess(slope, cost_, control_->shift());
       trial = np_.retract(delta_, 1.0);  // steps are taken in full; λ does the damping
@@ -377,6 +402,7 @@ class GridSolver {
   double relative_gradient_ = 0.0;
   double step_length_ = 1.0;
   int iteration_ = 0;
+  int fresh_raises_ = 1;  ///< the raises the last definite-shift search from λ = 0 needed
   Termination termination_ = Termination::NotConverged;
   std::string reason_ = "iteration limit reached";
 };

@@ -5,6 +5,14 @@
 
 namespace attitude_planner {
 
+double raisedShift(double from, int raises, const NewtonParameters& p) {
+  double shift = from;
+  for (int i = 0; i < raises; ++i) {
+    shift = shift == 0.0 ? p.smallest_shift : p.indefinite_shift_growth * shift;
+  }
+  return shift;
+}
+
 bool TrustRegionControl::judge(const StepTrial& t) {
   const double trial_cost = t.problem.cost(*t.trial, t.forms);
   // Model m(δ) = C + gᵀδ + ½δᵀHδ with (H + λI)δ = −g: C − m(δ) = ½(−gᵀδ + λ|δ|²).

@@ -31,6 +31,11 @@ struct StepTrial {
   ReducedProblem::StepForms* forms = nullptr;
 };
 
+/// The shift after `raises` raises of `from` while H + λI is indefinite (0 → λ_min, then
+/// ×growth each: steps fine enough to stay near the least definite λ), by the same products the
+/// raises make one at a time.
+double raisedShift(double from, int raises, const NewtonParameters& p);
+
 class StepControl {
  public:
   explicit StepControl(const NewtonParameters& parameters) : p_(parameters) {}
@@ -43,10 +48,8 @@ class StepControl {
   }
   /// λ of the next trial (relative).
   double shift() const { return shift_; }
-  /// H + λI was not definite: grow λ in steps fine enough to stay near the least definite one.
-  void raiseForIndefinite() {
-    shift_ = shift_ == 0.0 ? p_.smallest_shift : p_.indefinite_shift_growth * shift_;
-  }
+  /// H + λI was not definite: λ raised `raises` times (raisedShift).
+  void raiseForIndefinite(int raises = 1) { shift_ = raisedShift(shift_, raises, p_); }
   /// The step is taken without judging it (a final step, or a decrease below round-off): the
   /// next iteration is pure Newton.
   void acceptUnjudged() { carried_ = 0.0; }

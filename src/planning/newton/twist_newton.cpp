@@ -4,6 +4,7 @@
 
 #include "planning/linalg/bordered_band.hpp"
 #include "planning/newton/least_raise.hpp"
+#include "planning/newton/step_control.hpp"
 
 namespace attitude_planner {
 
@@ -37,16 +38,6 @@ bool shiftedStep(const TwistModel& m, double shift, Eigen::VectorXd* step) {
   *step = -m.gradient;
   factor.solve(step);
   return step->allFinite() && m.gradient.dot(*step) < 0.0;
-}
-
-/// The shift after `raises` raises of `from` while the bordered matrix is indefinite (0 → λ_min,
-/// then ×growth each), by the same products the raises make one at a time.
-double raisedShift(double from, int raises, const NewtonParameters& p) {
-  double shift = from;
-  for (int i = 0; i < raises; ++i) {
-    shift = shift == 0.0 ? p.smallest_shift : p.indefinite_shift_growth * shift;
-  }
-  return shift;
 }
 
 /// The least definite shift among `from` raised 0, 1, …, `most_raises` times, its step in `step`.

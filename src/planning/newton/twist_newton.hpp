@@ -8,8 +8,8 @@
 #include <functional>
 #include <string>
 
-#include "attitude_planner/planning/result.hpp"
 #include "attitude_planner/planning/newton_parameters.hpp"
+#include "attitude_planner/planning/result.hpp"
 #include "planning/problem/solve_context.hpp"
 #include "planning/transcription/reduced_problem.hpp"
 

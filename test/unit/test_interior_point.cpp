@@ -431,6 +431,60 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
   EXPECT_EQ(block.complementarity(mu, rho).count, rows + elastic_rows);
 }
 
+// A trial point's rows (BarrierRowBlock::rowMeritsInside, free time's line search): where every
+// row's value lies inside its form's domain, every row's term, and the merit from those terms is
+// the merit evaluated there, the same sum to the bit; where one lies outside (Feasible: c ≤ 0 or
+// c < (1 − τ) of its accepted value), the terms stop at the first such row, every one before it
+// finite, and the merit there is +∞: a rejected trial evaluates no row after it, and the row it
+// was rejected at is the first tested the next time.
+TEST(BarrierRowBlock, ATrialsTermsStopAtTheFirstRowOutsideAndInsideGiveTheSameMerit) {
+  ap::PlanningProblem p = sceneProblem("min_time_keep_out.yaml", 16);
+  p.duration = 120.0;  // the geodesic start strictly inside its torque bounds
+  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), ap::Vector3::UnitZ(), 0.5),
+                   ap::PlanningConstraint::maxAngularRate(0.2)};
+  const ap::ReducedProblem np(p);
+  const ap::StageConstraints constraints = ap::buildStageConstraints(p);
+  const ap::InteriorPointParameters parameters;
+  const ap::Feasible feasible(parameters);
+  const auto form = [&](const ap::FreeTimeRows&) -> const ap::BarrierForm<10>& { return feasible; };
+  ap::BarrierRowBlock<ap::FreeTimeStep> block(constraints, np, form);
+  block.evaluate(np.current());
+  ASSERT_GT(block.smallestValue(), 0.0);  // the start strictly inside every row
+  const double mu = 1e-3, rho = 1e2;
+  std::vector<double> terms;
+  for (const double slower : {1.0, 1.1}) {  // the start itself, and a trial inside it
+    ap::ReducedProblem trial = np;
+    trial.setTimeStep(slower * np.timeStep());
+    const ap::QuantityInputs at(trial, trial.current());
+    ASSERT_TRUE(block.rowMeritsInside(at, mu, rho, &terms)) << slower;
+    EXPECT_EQ(static_cast<int>(terms.size()), block.rows.count);
+    const double merit = block.merit(1.5, &at, mu, rho, 0.0, true);
+    ASSERT_TRUE(std::isfinite(merit));
+    EXPECT_EQ(block.merit(1.5, terms), merit) << slower;
+  }
+  // A trial at a third of the time step: the torques grow ninefold, past their bounds.
+  ap::ReducedProblem trial = np;
+  trial.setTimeStep(np.timeStep() / 3);
+  const ap::QuantityInputs at(trial, trial.current());
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms));
+  ASSERT_FALSE(terms.empty());
+  EXPECT_LT(static_cast<int>(terms.size()), block.rows.count);
+  EXPECT_TRUE(std::isinf(block.merit(1.5, &at, mu, rho, 0.0, true)));
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    EXPECT_EQ(std::isinf(terms[i]), i + 1 == terms.size()) << "row " << i;
+  }
+  // The row found outside, named (`outside`), is tested first the next time: the same trial is
+  // rejected at it alone; a trial inside still gives every term.
+  int outside = -1;
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms, &outside));
+  EXPECT_EQ(outside, static_cast<int>(terms.size()) - 1);
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms, &outside));
+  EXPECT_TRUE(terms.empty());
+  EXPECT_TRUE(
+      block.rowMeritsInside(ap::QuantityInputs(np, np.current()), mu, rho, &terms, &outside));
+  EXPECT_EQ(static_cast<int>(terms.size()), block.rows.count);
+}
+
 // Both interior points are profiles of one barrier-problem solve (barrier_problem_solve.hpp):
 // each ends at its iteration limit with that many passes counted, reported to the context and
 // its iterate kept (free time: still strictly inside), and stops at once when the context is out

@@ -284,6 +284,36 @@ class BarrierRowBlock {
     }
     return sum.value();
   }
+  /// Each row's merit term at `at` (rowMerit at its value there, checking the boundary) into
+  /// `terms`, forEach's order, while it is finite; false at the first +∞ term (a value outside
+  /// its row's domain: the merit there is +∞), the rows after it not evaluated. `outside`
+  /// (optional): the index of a row found outside before, tested first (the trials of one line
+  /// search mostly fail at one row: a rejection in one value), and where a row is found outside
+  /// now, its index.
+  bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, std::vector<double>* terms,
+                       int* outside = nullptr) const {
+    terms->clear();
+    if (outside && *outside >= 0) {
+      double term = 0.0;
+      rows.atRow(*outside, at, [&](const Rows& g, int, const Row& in, double c) {
+        term = form(g).rowMerit(in, c, mu, rho, 0.0, true);
+      });
+      if (term == std::numeric_limits<double>::infinity()) return false;
+    }
+    return rows.everyValue(at, [&](const Rows& g, int, const Row& in, double c) {
+      terms->push_back(form(g).rowMerit(in, c, mu, rho, 0.0, true));
+      if (terms->back() != std::numeric_limits<double>::infinity()) return true;
+      if (outside) *outside = static_cast<int>(terms->size()) - 1;
+      return false;
+    });
+  }
+  /// `start` plus the rows' merit terms as rowMeritsInside gave them: merit(start, at, μ, ρ, 0,
+  /// true) there, the same terms summed in the same order.
+  static double merit(double start, const std::vector<double>& terms) {
+    MeritSum sum{start};
+    for (const double term : terms) sum.add(term);
+    return sum.value();
+  }
   /// The rows' dual steps dz (into the rows) for the step d, each row's slope gᵀd + r (r the
   /// second-order correction's term, 0 but for a corrected step), and the largest step in (0, 1]
   /// by the fraction to the boundary.

@@ -337,6 +337,31 @@ struct StageTranscription {
   void forEachValue(const QuantityInputs& at, F&& f) const {
     visit(*this, [&](const Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
   }
+  /// f(group, k, row, c) with each row's value c at `at`, in forEach's order, until f returns
+  /// false: false then (the rows after it not evaluated), else true.
+  template <typename F>
+  bool everyValue(const QuantityInputs& at, F&& f) const {
+    for (const Rows& g : groups) {
+      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
+        if (!f(g, k, g.instance(k), valueAt(g, at, k))) return false;
+      }
+    }
+    return true;
+  }
+  /// f(group, k, row, c) for the row at `index` in forEach's order (none where index is out of
+  /// range), its value c at `at`.
+  template <typename F>
+  void atRow(int index, const QuantityInputs& at, F&& f) const {
+    for (const Rows& g : groups) {
+      const int rows_in_group = g.support.last_k - g.support.first_k + 1;
+      if (index < rows_in_group) {
+        const int k = g.support.first_k + index;
+        f(g, k, g.instance(k), valueAt(g, at, k));
+        return;
+      }
+      index -= rows_in_group;
+    }
+  }
   /// Each row's value c at `at`, into the row.
   void evaluate(const QuantityInputs& at) {
     forEachValue(at, [](Rows&, int, Row& in, double c) { in.c = c; });

@@ -4,6 +4,7 @@
 // refused and a plan never answered as a class it is not in; and a seeded suite of bounded
 // requests whose every verdict is checked independently (test/support/bounded_requests.hpp).
 #include <gtest/gtest.h>
+#include <map>
 
 #include <algorithm>
 #include <cmath>
@@ -449,6 +450,39 @@ TEST(BoundedVerdicts, BelowAStrictLocalMinimumTheProbesGoOnPastTwoFailuresWithin
   });
   EXPECT_GT(probes, 2) << r.message();
   EXPECT_LT(probes, 2 + 4) << r.message();  // the near probes and fewer than the four rungs
+}
+
+TEST(BoundedVerdicts, TheLaddersRungsAreSolvedOnTheRequestsGridAlone) {
+  // The spinning study suite's request #188 (seed 45; paper, N = 315, above the interior point's
+  // coarsest_grid): its T* is a second-order sufficient KKT point and the near probes below it
+  // find nothing, so rungs of the ladder follow (probedBelow). A near probe's interior point runs
+  // through its grid continuation (iterations on coarser grids first); a rung samples another
+  // start, the request's own grid alone.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 188);
+  ASSERT_TRUE(request);
+  const int N = request->problem.steps;
+  ASSERT_GT(N, InteriorPointParameters{}.coarsest_grid);
+  // Each probe's interior point is one or more `constrained` attempts (formulations side by
+  // side): the least N each iterated on, by attempt number (the order they began).
+  std::map<int, int> coarsest_of_attempt;
+  SolverOptions options;
+  options.on_iteration = [&](const IterationInfo& i) {
+    if (i.attempt.stage == AttemptStage::Constrained && i.steps > 0) {
+      const auto [at, fresh] = coarsest_of_attempt.emplace(i.attempt.number, i.steps);
+      if (!fresh) at->second = std::min(at->second, i.steps);
+    }
+    return true;
+  };
+  const PlanResult r = planManeuver(request->problem, options);
+  ASSERT_TRUE(r.converged()) << r.message();
+  ASSERT_TRUE(r.minimum_time.second_order_sufficient) << r.message();
+  // The near probes' attempts through the continuation first, then the rungs' on N alone.
+  std::vector<bool> on_grid_alone;
+  for (const auto& [number, steps] : coarsest_of_attempt) on_grid_alone.push_back(steps == N);
+  const auto first_rung = std::find(on_grid_alone.begin(), on_grid_alone.end(), true);
+  ASSERT_NE(first_rung, on_grid_alone.end()) << r.message();
+  EXPECT_NE(first_rung, on_grid_alone.begin()) << r.message();
+  EXPECT_TRUE(std::all_of(first_rung, on_grid_alone.end(), [](bool b) { return b; }));
 }
 
 TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {

@@ -365,6 +365,15 @@ TEST(BarrierForms, DualStepsKeepTheMultipliersInsideAndFeasibleIsNewtonsOnZcEqua
   }
 }
 
+/// The keep-out scene's body at N = 16 and duration T, under a keep-out cone and a rate limit.
+ap::PlanningProblem coneAndRateProblem(double T) {
+  ap::PlanningProblem p = sceneProblem("min_time_keep_out.yaml", 16);
+  p.duration = T;
+  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), ap::Vector3::UnitZ(), 0.5),
+                   ap::PlanningConstraint::maxAngularRate(0.2)};
+  return p;
+}
+
 // The constraint block both interior points hold (BarrierRowBlock), on a free-time problem whose
 // rows are in two forms at once as an elastic start has them (the rows that move with h
 // ℓ1-elastic, the cone Feasible): the merit at a point is the merit of the values evaluated
@@ -372,10 +381,7 @@ TEST(BarrierForms, DualStepsKeepTheMultipliersInsideAndFeasibleIsNewtonsOnZcEqua
 // itself; a Feasible row's dz is Newton's on z c = μ along the slope gᵀd + r (r the second-order
 // correction's term); an elastic row's complementarity is a pair. Seeded gradients and step.
 TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
-  ap::PlanningProblem p = sceneProblem("min_time_keep_out.yaml", 16);
-  p.duration = 20.0;
-  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), ap::Vector3::UnitZ(), 0.5),
-                   ap::PlanningConstraint::maxAngularRate(0.2)};
+  const ap::PlanningProblem p = coneAndRateProblem(20.0);
   const ap::ReducedProblem np(p);
   const ap::StageConstraints constraints = ap::buildStageConstraints(p);
   const ap::InteriorPointParameters parameters;
@@ -438,10 +444,8 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
 // finite, and the merit there is +∞: a rejected trial evaluates no row after it, and the row it
 // was rejected at is the first tested the next time.
 TEST(BarrierRowBlock, ATrialsTermsStopAtTheFirstRowOutsideAndInsideGiveTheSameMerit) {
-  ap::PlanningProblem p = sceneProblem("min_time_keep_out.yaml", 16);
-  p.duration = 120.0;  // the geodesic start strictly inside its torque bounds
-  p.constraints = {ap::PlanningConstraint::keepOut(ap::Vector3::UnitX(), ap::Vector3::UnitZ(), 0.5),
-                   ap::PlanningConstraint::maxAngularRate(0.2)};
+  // at T = 120 s the geodesic start lies strictly inside its torque bounds
+  const ap::PlanningProblem p = coneAndRateProblem(120.0);
   const ap::ReducedProblem np(p);
   const ap::StageConstraints constraints = ap::buildStageConstraints(p);
   const ap::InteriorPointParameters parameters;

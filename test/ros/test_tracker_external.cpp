@@ -347,6 +347,10 @@ TEST(TrackerPlantLoop, LaunchedPlantNodeLandsAsTheInProcessBodyAndShowsTheSameTo
                               ros_conversions::attitudeFromMsg(internal->final_attitude, "done")),
             1e-9);
   const Matrix3 shown = held(over_topics);
+  // The transform and the odometry it was taken from reach this process over two connections:
+  // the odometry may still be on its way when the transform is read. The deque holds a second of
+  // the plant's attitudes; a third of one later it holds the transform's too.
+  ros::WallDuration(0.3).sleep();
   std::lock_guard<std::mutex> lock(measured_mutex);
   double nearest = M_PI;
   for (const Matrix3& R : measured) nearest = std::min(nearest, so3::angleBetween(shown, R));

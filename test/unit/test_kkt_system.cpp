@@ -430,6 +430,29 @@ TEST(LineSearch, ARoundOffDecreaseIsTakenAtFixedStepAndOnlyFlaggedInFreeTime) {
   EXPECT_EQ(free_time.trials, p.free_time.max_halvings);
 }
 
+TEST(LineSearch, AtTheRoundOffFloorAFreeTimeRoundOffStepIsNotTried) {
+  const ap::InteriorPointParameters p;
+  const ap::ArmijoBacktracking search(ap::freeTimeLineSearch(p));
+  // φ falls along d, so any trial would pass Armijo's test; the predicted decrease is round-off
+  // of φ(0) = 1. At the floor no trial is made and the iterate stays; off the floor, or with a
+  // decrease above round-off at the floor, the step is searched (and taken whole here).
+  const auto phi = [](double x) { return 1.0 - x; };
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(1, 1e-3);
+  const double round_off = -0.5 * p.merit_round_off, real = -1e-3;
+  for (const bool at_floor : {false, true}) {
+    for (const double slope : {round_off, real}) {
+      LineProblem problem(phi, 100.0);
+      const ap::LineSearchResult r =
+          search.search(problem, {slope, 1.0, false, at_floor, false}, &d);
+      const bool untried = at_floor && slope == round_off;
+      EXPECT_EQ(r.at_round_off, slope == round_off);
+      EXPECT_EQ(r.accepted, !untried) << at_floor << " " << slope;
+      EXPECT_EQ(problem.trials, untried ? 0 : 1);
+      EXPECT_EQ(problem.x, untried ? 0.0 : 1e-3);
+    }
+  }
+}
+
 TEST(LineSearch, TheSecondOrderCorrectionReplacesARejectedFullStepInTheFreeTimeProfile) {
   const ap::InteriorPointParameters p;
   // φ = (x − 2)²: the full step d = 4.5 overshoots the minimum at 2 (φ(4.5) > φ(0)), the
@@ -749,6 +772,21 @@ TEST(StoppingTests, EachTestEndsTheSolveWhereItsProfileSays) {
   EXPECT_TRUE(test.onRejected(s, {}));
   s.stationarity = 101e-9;
   EXPECT_FALSE(test.onRejected(s, {}));
+  // The floor a direction is at (its round-off step is then not tried: the line search): at
+  // μ_final, outside the elastic start, both residuals within 100 × their tolerances.
+  s.stationarity = 99e-9;
+  s.gap = 99e-9;
+  EXPECT_TRUE(test.afterDirection(s, {}).at_floor);
+  s.gap = 101e-9;
+  EXPECT_FALSE(test.afterDirection(s, {}).at_floor);
+  s.gap = 1e-10;
+  s.elastic = true;
+  EXPECT_FALSE(test.afterDirection(s, {}).at_floor);
+  s.elastic = false;
+  s.at_final_barrier = false;
+  EXPECT_FALSE(test.afterDirection(s, {}).at_floor);
+  s.at_final_barrier = true;
+  EXPECT_FALSE(test.afterDirection(s, {}).final_step);  // the KKT residual test ends before it
   // The decrement test: converged at the floor it found on the direction, with its decrement.
   const ap::InteriorPointParameters p;
   ap::DecrementTest decrement(p, 1e-8, 64, false, false);

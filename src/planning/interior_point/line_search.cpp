@@ -35,6 +35,9 @@ LineSearchResult ArmijoBacktracking::search(BarrierProblem& problem,
     result.accepted = true;
     return result;
   }
+  // At the floor a trial of a round-off step would be accepted or not by the merit's round-off
+  // alone: none is taken (the stopping test then ends the solve where it is).
+  if (request.at_floor && result.at_round_off) return result;
   const bool correct = profile_.second_order_correction && request.late;
   // The corrected full step is one trial more than the halvings.
   const int trials = (request.at_floor ? profile_.floor_halvings : profile_.max_halvings) + correct;

@@ -16,7 +16,8 @@ struct LineSearchProfile {
   int floor_halvings = 5;  ///< the same at the round-off floor (LineSearchRequest::at_floor)
   double merit_round_off = 1e-14;  ///< a predicted decrease ≤ this × |φ| is round-off
   /// A step whose predicted decrease is round-off is taken outright (fixed h: no step length can
-  /// be told from another there); else it is searched and only flagged (free time).
+  /// be told from another there); else it is searched and only flagged (free time), but for one
+  /// at the round-off floor (LineSearchRequest::at_floor), which is not taken.
   bool take_round_off_step = true;
   /// In the end game (LineSearchRequest::late) every rejected trial step α d, the full one and
   /// each halving, is retried once with its second-order correction before the next halving

@@ -111,6 +111,12 @@ std::optional<LoopEnd> KktResidualTest::beforeDirection(const BarrierState& s) {
   return LoopEnd{Termination::Converged, "converged", std::nullopt};
 }
 
+StopVerdict KktResidualTest::afterDirection(const BarrierState& s, const DirectionMeasures&) {
+  StopVerdict v;
+  v.at_floor = !s.elastic && s.at_final_barrier && atRoundOffFloor(s.stationarity, s.gap);
+  return v;
+}
+
 std::optional<LoopEnd> KktResidualTest::onRejected(const BarrierState& s, const StopVerdict&) {
   if (s.elastic || !atRoundOffFloor(s.stationarity, s.gap)) return std::nullopt;
   return LoopEnd{Termination::Converged, "converged to the round-off floor", std::nullopt};

@@ -131,6 +131,9 @@ class KktResidualTest final : public ConvergenceCheck {
   KktResidualTest(double tolerance, int steps);
   /// Converged at μ_final outside the elastic start.
   std::optional<LoopEnd> beforeDirection(const BarrierState& state) override;
+  /// At the round-off floor (StopVerdict::at_floor): at μ_final outside the elastic start, both
+  /// residuals within kRoundOffFloor of their tolerances.
+  StopVerdict afterDirection(const BarrierState& state, const DirectionMeasures&) override;
   /// No descent step left outside the elastic start, both residuals at the round-off floor.
   std::optional<LoopEnd> onRejected(const BarrierState& state, const StopVerdict& v) override;
   bool converged(double stationarity, double gap) const {

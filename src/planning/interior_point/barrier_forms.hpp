@@ -269,46 +269,45 @@ class BarrierRowBlock {
   void evaluate(const ReducedProblem::StepVectors& steps) {
     rows.evaluate(QuantityInputs(np_, steps));
   }
-  /// `start` plus the rows' merit terms (BarrierForm::rowMerit): at their own values c, or, with
-  /// `at`, at their values there (rows untouched; each checked against its accepted c).
-  double merit(double start, const QuantityInputs* at, double mu, double rho, double alpha,
-               bool check_boundary) const {
-    MeritSum sum{start};
-    const auto add = [&](const Rows& g, int, const Row& in, double c) {
-      sum.add(form(g).rowMerit(in, c, mu, rho, alpha, check_boundary));
-    };
-    if (at) {
-      rows.forEachValue(*at, add);
-    } else {
-      rows.forEach([&](const Rows& g, int k, const Row& in) { add(g, k, in, in.c); });
-    }
+  /// The rows' merit terms (BarrierForm::rowMerit) at their own values c, summed in forEach's
+  /// order.
+  double merit(double mu, double rho, double alpha) const {
+    MeritSum sum;
+    rows.forEach([&](const Rows& g, int, const Row& in) {
+      sum.add(form(g).rowMerit(in, in.c, mu, rho, alpha, false));
+    });
     return sum.value();
   }
-  /// Each row's merit term at `at` (rowMerit at its value there, checking the boundary) into
-  /// `terms`, forEach's order, while it is finite; false at the first +∞ term (a value outside
-  /// its row's domain: the merit there is +∞), the rows after it not evaluated. `outside`
-  /// (optional): the index of a row found outside before, tested first (the trials of one line
-  /// search mostly fail at one row: a rejection in one value), and where a row is found outside
-  /// now, its index.
-  bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, std::vector<double>* terms,
-                       int* outside = nullptr) const {
+  /// Each row's merit term at its value at `at` (rows untouched; `check_boundary` as rowMerit's)
+  /// into `terms`, forEach's order, while it is finite; false at the first +∞ term (a value
+  /// outside its row's domain: the merit there is +∞), the rows after it not evaluated.
+  /// `outside` (optional): the index of a row found outside before, tested first (the trials of
+  /// one line search mostly fail at one row), and where a row is found outside now, its index.
+  bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, bool check_boundary,
+                       std::vector<double>* terms, int* outside = nullptr) const {
+    const auto term = [&](const Rows& g, int k, const Row& in) {
+      return form(g).rowMerit(in, rows.valueAt(g, at, k), mu, rho, 0.0, check_boundary);
+    };
+    constexpr double kOutside = std::numeric_limits<double>::infinity();
+    const int hint = outside ? *outside : -1;
+    double hinted = 0.0;
     terms->clear();
-    if (outside && *outside >= 0) {
-      double term = 0.0;
-      rows.atRow(*outside, at, [&](const Rows& g, int, const Row& in, double c) {
-        term = form(g).rowMerit(in, c, mu, rho, 0.0, true);
+    if (hint >= 0) {
+      rows.forEachFrom(hint, [&](const Rows& g, int k, const Row& in) {
+        hinted = term(g, k, in);
+        return false;
       });
-      if (term == std::numeric_limits<double>::infinity()) return false;
+      if (hinted == kOutside) return false;
     }
-    return rows.everyValue(at, [&](const Rows& g, int, const Row& in, double c) {
-      terms->push_back(form(g).rowMerit(in, c, mu, rho, 0.0, true));
-      if (terms->back() != std::numeric_limits<double>::infinity()) return true;
-      if (outside) *outside = static_cast<int>(terms->size()) - 1;
+    return rows.forEachFrom(0, [&](const Rows& g, int k, const Row& in) {
+      const int index = static_cast<int>(terms->size());
+      terms->push_back(index == hint ? hinted : term(g, k, in));
+      if (terms->back() != kOutside) return true;
+      if (outside) *outside = index;
       return false;
     });
   }
-  /// `start` plus the rows' merit terms as rowMeritsInside gave them: merit(start, at, μ, ρ, 0,
-  /// true) there, the same terms summed in the same order.
+  /// `start` plus the rows' merit terms as rowMeritsInside gave them, summed in their order.
   static double merit(double start, const std::vector<double>& terms) {
     MeritSum sum{start};
     for (const double term : terms) sum.add(term);

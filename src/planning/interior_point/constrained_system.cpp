@@ -38,7 +38,7 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
   evaluateValues(steps, &tau);
   const double f = np_.scheme().cost(tau);
   if (cost) *cost = f;
-  return f + block_.merit(0.0, nullptr, mu, rho, slack_alpha, false);
+  return f + block_.merit(mu, rho, slack_alpha);
 }
 
 void ConstrainedSystem::pollEvery(int k) const {

@@ -97,7 +97,7 @@ class ConstrainedSystem final : public BarrierRows {
   /// φ_μ from the constraint values of the last assembly (f = its cost): Elastic Σ ψ_μ(c_i) (ρ
   /// the penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν).
   double assembledMerit(double cost, double mu, double rho) const {
-    return cost + block_.merit(0.0, nullptr, mu, rho, 0.0, false);
+    return cost + block_.merit(mu, rho, 0.0);
   }
 
   /// Assembles the condensed Newton system at the current iterate: K (the band and, with a twist,

@@ -128,12 +128,21 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
     });
   }
 
-  /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
-  double merit(double mu, double epsilon, bool check_boundary) const {
-    const std::vector<Vector3> tau = np_.torques(np_.current());
+  /// φ_μ = T/T₀ + εC plus the rows' merit terms at the iterate: +∞ at the first row outside its
+  /// form's domain, at a trial (`trial`) also below (1 − τ) of its accepted value or where a step
+  /// has left the scheme's principal branch. A trial is mostly rejected at a row (the first
+  /// barrier problems' halvings), before the rows after it, the branch test and the cost.
+  double merit(double mu, double epsilon, bool trial) {
     const QuantityInputs at(np_, np_.current());
-    return block_.merit(objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon), &at, mu,
-                        rho_, 0.0, check_boundary);
+    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    if (trial && !np_.onPrincipalBranch(np_.current())) {
+      return std::numeric_limits<double>::infinity();
+    }
+    const double cost = np_.scheme().cost(np_.torques(np_.current()));
+    return BarrierRowBlock<FreeTimeStep>::merit(objective_.value(np_.timeStep(), cost, epsilon),
+                                                row_terms_);
   }
 
   double firstBarrier() const;
@@ -208,8 +217,8 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// What this pass measured at the assembled iterate, and its step.
   double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
-  std::vector<double> trial_terms_;  ///< the rows' merit terms at a trial point (trialMerit)
-  int row_outside_ = -1;  ///< the row a trial last found outside its domain (rowMeritsInside)
+  std::vector<double> row_terms_;  ///< the rows' merit terms at the iterate (merit)
+  int row_outside_ = -1;  ///< the row a merit last found outside its domain (rowMeritsInside)
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
   /// changes φ_μ): the next pass lowers μ.
   bool solved_to_round_off_ = false;
@@ -289,20 +298,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
   try {
     moveTo(d, alpha);
     if (moved) *moved = true;
-    // φ_μ is +∞ at a trial where some row's term is (its value outside the row's domain), known
-    // at that row: the rows after it, the branch test, the torques and the cost are left for
-    // the trials inside, and the row a trial failed at is tested first at the next. Measured on
-    // seed 4949's 20 cone requests: most trials are rejected so (the first barrier problems'
-    // halvings), and each had cost as much as an accepted one. Where every row is inside, φ_μ is
-    // the same sum of the same terms.
-    if (!block_.rowMeritsInside(QuantityInputs(np_, np_.current()), accepted_.mu, rho_,
-                                &trial_terms_, &row_outside_)) {
-      return std::numeric_limits<double>::infinity();
-    }
-    if (!np_.onPrincipalBranch(np_.current())) return std::numeric_limits<double>::infinity();
-    const std::vector<Vector3> tau = np_.torques(np_.current());
-    return block_.merit(objective_.value(np_.timeStep(), np_.scheme().cost(tau), accepted_.epsilon),
-                        trial_terms_);
+    return merit(accepted_.mu, accepted_.epsilon, true);
   } catch (const std::exception&) {  // no boundary step at that h (StepTooLarge)
     return std::numeric_limits<double>::infinity();
   }

@@ -107,9 +107,8 @@ struct BarrierPoint {
   std::vector<Matrix3> attitudes;  ///< R_0 … R_N of the iterate
   int iterations = 0;
   /// The condensed barrier Hessian over (δ, η) factors without a shift at the iterate: a strict
-  /// local minimum of this barrier problem, where lower_bound holds locally. (Where it does not,
-  /// the solve may still slide to a lower point: measured on Bilimoria–Wie N = 32, a bound of
-  /// 3.27871 s at μ = 2.7e-6, then 68 iterations at that μ, the end 3.27774 s.)
+  /// local minimum of this barrier problem, where lower_bound holds locally (elsewhere the solve
+  /// may still slide below it).
   bool locally_convex = false;
   /// Its T [s] and lower bound, which holds where it is locally convex.
   LocalLowerBound bound() const { return {duration, lower_bound, locally_convex}; }

@@ -79,25 +79,22 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   bool elasticRows(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep();
   }
-  /// The form a group's rows are in now: ℓ1-elastic while elasticRows, else Feasible.
   const BarrierForm<10>& form(const FreeTimeRows& g) const {
     if (elasticRows(g)) return elastic_form_;
     return feasible_;
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
-  /// The smallest value of the constraints that move with h (time_dependent) or of the others,
-  /// not relaxed.
+  /// The least value of the rows that move with h (time_dependent) or of the others, not relaxed.
   double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
     return block_.rows.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
       return g.quantity->dependsOnTimeStep() == time_dependent;
     });
   }
 
-  /// φ_μ = T/T₀ + εC plus the rows' merit terms at the iterate: +∞ at the first row outside its
-  /// form's domain, at a trial (`trial`) also below (1 − τ) of its accepted value or where a step
-  /// has left the scheme's principal branch. A trial is mostly rejected at a row (the first
-  /// barrier problems' halvings), before the rows after it, the branch test and the cost.
+  /// φ_μ = T/T₀ + εC plus the rows' terms at the iterate: +∞ at the first row outside its form's
+  /// domain (at a trial also below (1 − τ) of its accepted value) or, at a trial, off the principal
+  /// branch. Most trials are rejected at a row: the cost and the rows after it are left.
   double merit(double mu, double epsilon, bool trial) {
     const QuantityInputs at(np_, np_.current());
     if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_)) {
@@ -118,14 +115,12 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
   double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
-  /// φ_μ at the iterate moved by α d, +∞ where h ≤ 0 or no boundary step exists there (`moved`
-  /// false then: the iterate is not there) or a step has left the scheme's principal branch.
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override;
   void moveTo(const Eigen::VectorXd& d, double alpha) override;
   void restore() override;
   bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override;
   void clearCorrection() override;
-  // PrimalDualProblem: the free-time profile's pass (free_time_solver.cpp).
+  // PrimalDualProblem: the free-time profile's pass.
   void prepare() override;
   void describe(BarrierState* s) const override {
     s->elastic = elastic_;
@@ -159,9 +154,7 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
   std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
                       int iterations) const;
-  /// Reports one pass of the loop (one counted iteration) to the context: an accepted step of
-  /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
-  /// iterate the pass started from.
+  /// Reports one counted pass to the context: a step of length `alpha`, or (0) a barrier update.
   void report(double alpha, double stationarity) const;
   /// The outcome at the iterate the solve ended at (termination_, reason_).
   FreeTimeOutcome outcome() const;
@@ -225,9 +218,8 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   lagrangian_gradient_(n_) += dT;
 }
 
-/// Leaves the elastic phase once every constraint holds strictly: from then on the iterate is a
-/// plan meeting its bounds, as a start raised inside would be (the rows' multipliers carry over,
-/// safeguarded for the feasible form).
+/// Leaves the elastic phase once every constraint holds strictly: the iterate is a plan (the
+/// rows' multipliers carry over, safeguarded for the feasible form).
 void FreeTimeSolver::leaveElasticIfInside() {
   if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
   elastic_ = false;
@@ -314,8 +306,7 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   return slope;
 }
 
-/// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point (an
-/// elastic row: |zs − μ| and |(ρ − z)v − μ|).
+/// The barrier problem's KKT residual max(‖∇L‖∞, max |zc − μ|) at the assembled point.
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   return std::max(stationarity, block_.complementarity(mu, rho_).worst);
@@ -417,12 +408,8 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 
 /// The order is the method's: dual step, leaving the elastic phase, κ_Σ (the loop then damps).
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
-  // dz = μ/c − z − (z/c)(gᵀd + r) (r: the second-order correction's term; an elastic row's
-  // dz = (q − gᵀd)/D) and the largest dual step by the fraction to the boundary, applied.
   block_.applyDualStep(dualStep());
   leaveElasticIfInside();
-  // κ_Σ: z within [μ/(κ_Σ c), κ_Σ μ/c] at the new values c (an elastic row's multiplier is
-  // safeguarded where it is prepared for the next assembly).
   block_.evaluate(np_.current());
   block_.afterAccept(mu_);
   report(result.alpha, stationarity_);

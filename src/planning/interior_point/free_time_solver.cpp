@@ -58,7 +58,9 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   }
 
   double smallestValue(bool moves_with_h) const override {
-    return smallestValue(np_.current(), moves_with_h);
+    return block_.rows.smallestValue(
+        QuantityInputs(np_, np_.current()),
+        [&](const FreeTimeRows& g) { return g.quantity->dependsOnTimeStep() == moves_with_h; });
   }
   void beginAt(bool elastic) override {
     h0_ = np_.timeStep();
@@ -85,12 +87,6 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
-  /// The least value of the rows that move with h (time_dependent) or of the others, not relaxed.
-  double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
-    return block_.rows.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
-      return g.quantity->dependsOnTimeStep() == time_dependent;
-    });
-  }
 
   /// φ_μ = T/T₀ + εC plus the rows' terms at the iterate: +∞ at the first row outside its form's
   /// domain (at a trial also below (1 − τ) of its accepted value) or, at a trial, off the principal
@@ -221,7 +217,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// Leaves the elastic phase once every constraint holds strictly: the iterate is a plan (the
 /// rows' multipliers carry over, safeguarded for the feasible form).
 void FreeTimeSolver::leaveElasticIfInside() {
-  if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
+  if (!elastic_ || !(smallestValue(true) > 0)) return;
   elastic_ = false;
 }
 
@@ -367,7 +363,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
 double FreeTimeSolver::firstBarrier() const {
   if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint) return p_.near_kkt_barrier * mu0_;
   if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
-  return std::max(mu0_, p_.elastic_kink_width * rho_ * -smallestValue(np_.current(), true));
+  return std::max(mu0_, p_.elastic_kink_width * rho_ * -smallestValue(true));
 }
 
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual

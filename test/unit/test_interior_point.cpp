@@ -395,10 +395,11 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
   const double mu = 1e-2, rho = 1e2, tau = parameters.fraction_to_boundary;
   block.evaluate(np.current());
   block.prepare(mu, rho, true);
-  const ap::QuantityInputs at(np, np.current());
-  const double merit = block.merit(1.5, nullptr, mu, rho, 0.0, false);
+  std::vector<double> terms;
+  ASSERT_TRUE(block.rowMeritsInside(ap::QuantityInputs(np, np.current()), mu, rho, false, &terms));
+  const double merit = block.merit(mu, rho, 0.0);
   ASSERT_TRUE(std::isfinite(merit));
-  EXPECT_EQ(merit, block.merit(1.5, &at, mu, rho, 0.0, false));
+  EXPECT_EQ(merit, block.merit(0.0, terms));
 
   std::mt19937 rng(53);
   std::normal_distribution<double> normal;
@@ -437,12 +438,11 @@ TEST(BarrierRowBlock, RowsInTwoFormsStepAsTheirFormsSay) {
   EXPECT_EQ(block.complementarity(mu, rho).count, rows + elastic_rows);
 }
 
-// A trial point's rows (BarrierRowBlock::rowMeritsInside, free time's line search): where every
-// row's value lies inside its form's domain, every row's term, and the merit from those terms is
-// the merit evaluated there, the same sum to the bit; where one lies outside (Feasible: c ≤ 0 or
-// c < (1 − τ) of its accepted value), the terms stop at the first such row, every one before it
-// finite, and the merit there is +∞: a rejected trial evaluates no row after it, and the row it
-// was rejected at is the first tested the next time.
+// A trial point's rows (BarrierRowBlock::rowMeritsInside, free time's merit): where every row's
+// value lies inside its form's domain, every row's term at its value there, in the rows' order;
+// where one lies outside (Feasible: c ≤ 0 or c < (1 − τ) of its accepted value), the terms stop
+// at the first such row, every one before it finite, and the merit there is +∞: a rejected trial
+// evaluates no row after it, and the row it was rejected at is the first tested the next time.
 TEST(BarrierRowBlock, ATrialsTermsStopAtTheFirstRowOutsideAndInsideGiveTheSameMerit) {
   // at T = 120 s the geodesic start lies strictly inside its torque bounds
   const ap::PlanningProblem p = coneAndRateProblem(120.0);
@@ -460,33 +460,66 @@ TEST(BarrierRowBlock, ATrialsTermsStopAtTheFirstRowOutsideAndInsideGiveTheSameMe
     ap::ReducedProblem trial = np;
     trial.setTimeStep(slower * np.timeStep());
     const ap::QuantityInputs at(trial, trial.current());
-    ASSERT_TRUE(block.rowMeritsInside(at, mu, rho, &terms)) << slower;
-    EXPECT_EQ(static_cast<int>(terms.size()), block.rows.count);
-    const double merit = block.merit(1.5, &at, mu, rho, 0.0, true);
-    ASSERT_TRUE(std::isfinite(merit));
-    EXPECT_EQ(block.merit(1.5, terms), merit) << slower;
+    ASSERT_TRUE(block.rowMeritsInside(at, mu, rho, true, &terms)) << slower;
+    ASSERT_EQ(static_cast<int>(terms.size()), block.rows.count);
+    std::size_t i = 0;
+    block.rows.forEachValue(
+        at, [&](const ap::FreeTimeRows&, int, const ap::FreeTimeRow& in, double c) {
+          EXPECT_EQ(terms[i++], feasible.rowMerit(in, c, mu, rho, 0.0, true)) << slower;
+        });
+    EXPECT_TRUE(std::isfinite(block.merit(1.5, terms))) << slower;
   }
   // A trial at a third of the time step: the torques grow ninefold, past their bounds.
   ap::ReducedProblem trial = np;
   trial.setTimeStep(np.timeStep() / 3);
   const ap::QuantityInputs at(trial, trial.current());
-  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms));
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, true, &terms));
   ASSERT_FALSE(terms.empty());
   EXPECT_LT(static_cast<int>(terms.size()), block.rows.count);
-  EXPECT_TRUE(std::isinf(block.merit(1.5, &at, mu, rho, 0.0, true)));
+  EXPECT_TRUE(std::isinf(block.merit(1.5, terms)));
   for (std::size_t i = 0; i < terms.size(); ++i) {
     EXPECT_EQ(std::isinf(terms[i]), i + 1 == terms.size()) << "row " << i;
   }
   // The row found outside, named (`outside`), is tested first the next time: the same trial is
   // rejected at it alone; a trial inside still gives every term.
   int outside = -1;
-  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms, &outside));
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, true, &terms, &outside));
   EXPECT_EQ(outside, static_cast<int>(terms.size()) - 1);
-  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, &terms, &outside));
+  EXPECT_FALSE(block.rowMeritsInside(at, mu, rho, true, &terms, &outside));
   EXPECT_TRUE(terms.empty());
-  EXPECT_TRUE(
-      block.rowMeritsInside(ap::QuantityInputs(np, np.current()), mu, rho, &terms, &outside));
+  const ap::QuantityInputs start(np, np.current());
+  EXPECT_TRUE(block.rowMeritsInside(start, mu, rho, true, &terms, &outside));
   EXPECT_EQ(static_cast<int>(terms.size()), block.rows.count);
+  // the hinted row's term, taken from the test before the pass, is the one the pass would form
+  std::vector<double> without_hint;
+  ASSERT_TRUE(block.rowMeritsInside(start, mu, rho, true, &without_hint));
+  EXPECT_EQ(terms, without_hint);
+}
+
+// The stage rows' one traversal (StageTranscription::forEachFrom): from a row's index in
+// forEach's order it visits the rows forEach visits from there on, and stops where asked.
+TEST(StageTranscription, ARowsIndexIsItsPlaceInForEachsOrder) {
+  const ap::PlanningProblem p = coneAndRateProblem(20.0);
+  const ap::ReducedProblem np(p);
+  const ap::FreeTimeTranscription rows(ap::buildStageConstraints(p), np);
+  std::vector<const ap::FreeTimeRow*> all;
+  rows.forEach(
+      [&](const ap::FreeTimeRows&, int, const ap::FreeTimeRow& in) { all.push_back(&in); });
+  ASSERT_EQ(static_cast<int>(all.size()), rows.count);
+  ASSERT_GT(rows.groups.size(), 1u);
+  for (const int index : {0, 1, rows.count / 2, rows.count - 1, rows.count}) {
+    std::vector<const ap::FreeTimeRow*> from;
+    EXPECT_TRUE(
+        rows.forEachFrom(index, [&](const ap::FreeTimeRows&, int, const ap::FreeTimeRow& in) {
+          from.push_back(&in);
+          return true;
+        }));
+    EXPECT_EQ(from, std::vector<const ap::FreeTimeRow*>(all.begin() + index, all.end())) << index;
+  }
+  int visited = 0;
+  EXPECT_FALSE(rows.forEachFrom(
+      3, [&](const ap::FreeTimeRows&, int, const ap::FreeTimeRow&) { return ++visited < 2; }));
+  EXPECT_EQ(visited, 2);
 }
 
 // Both interior points are profiles of one barrier-problem solve (barrier_problem_solve.hpp):

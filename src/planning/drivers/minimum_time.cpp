@@ -46,20 +46,17 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
 
 /// `from`'s work (its free-time solves and cone clearings) added to `*to`'s: an answer made of
 /// two minimum-time solves (a Richardson pair, a fixed twist then the free one) counts both. The
-/// clearings' iterations are the request's, read from the context's one tally.
-void addSolveWork(const MinimumTimeCertificate& from, const SolveContext& context,
-                  MinimumTimeCertificate* to) {
+/// clearings' iterations are the request's (planMinimumTime).
+void addSolveWork(const MinimumTimeCertificate& from, MinimumTimeCertificate* to) {
   to->solves += from.solves;
   to->cone_clearings += from.cone_clearings;
   to->cone_clearings_joined += from.cone_clearings_joined;
-  to->cone_clearing_iterations = context.coneClearingIterations();
 }
 
 /// `*to` with `from`'s work (its solves and cone clearings) in place of its own.
-void setSolveWork(const MinimumTimeCertificate& from, const SolveContext& context,
-                  MinimumTimeCertificate* to) {
+void setSolveWork(const MinimumTimeCertificate& from, MinimumTimeCertificate* to) {
   to->solves = to->cone_clearings = to->cone_clearings_joined = 0;
-  addSolveWork(from, context, to);
+  addSolveWork(from, to);
 }
 
 }  // namespace
@@ -170,8 +167,8 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
   // The binding one's certificate with both solves' work, taken before the other's plan at T*
   // (a minimum-effort answer) replaces it below.
   MinimumTimeCertificate certificate = (fine_binds ? fine : coarse).minimum_time;
-  setSolveWork(fine.minimum_time, context, &certificate);
-  addSolveWork(coarse.minimum_time, context, &certificate);
+  setSolveWork(fine.minimum_time, &certificate);
+  addSolveWork(coarse.minimum_time, &certificate);
   // The other one's minimum-effort plan at T* (at its own T*: its plan already).
   std::optional<std::size_t> other_kept;
   PlanResult& other = fine_binds ? coarse : fine;
@@ -393,7 +390,7 @@ PlanResult upperBoundAt(const PlanningProblem& effort, const PlanResult& answer,
   upper.attempts = context.attemptsFrom(first);
   upper.minimum_time = MinimumTimeCertificate{};
   answerFeasibleAt(effort.duration, &upper);
-  setSolveWork(answer.minimum_time, context, &upper.minimum_time);
+  setSolveWork(answer.minimum_time, &upper.minimum_time);
   frameMessage(&upper, frames::UpperBoundFromProbe{effort.duration, answer.minimum_duration});
   return upper;
 }
@@ -632,14 +629,14 @@ PlanResult fromFixedTwist(const PlanningProblem& posed, SolveContext& context) {
         posed, at_twist.maneuver, at_twist.minimum_duration, "fixed-twist plan", context);
     if (freed && freed->converged()) {
       freed->attempts = context.attemptsFrom(first);
-      addSolveWork(at_twist.minimum_time, context, &freed->minimum_time);
+      addSolveWork(at_twist.minimum_time, &freed->minimum_time);
       return *freed;
     }
   }
   context.restoreKept(std::nullopt);  // the plan returned is the one from the free twist
   PlanResult free_start = minimumTimePlan(posed, context);
   free_start.attempts = context.attemptsFrom(first);
-  addSolveWork(at_twist.minimum_time, context, &free_start.minimum_time);
+  addSolveWork(at_twist.minimum_time, &free_start.minimum_time);
   return free_start;
 }
 
@@ -765,9 +762,9 @@ PlanResult minimumTimeRequest(const PlanningProblem& problem, SolveContext& cont
 
 PlanResult planMinimumTime(const PlanningProblem& problem, SolveContext& context) {
   PlanResult result = minimumTimeRequest(problem, context);
-  // The request's cone clearings' iterations, whichever answer leaves: the search's, a plan at
-  // the margin and the checks before solving were built without the figure, though clearings
-  // may have run before them (the free-time starts the search followed).
+  // The request's cone clearings' iterations, stamped here only: whichever answer leaves (the
+  // search's, a Richardson pair's, a plan at the margin, a check before solving) counts every
+  // clearing the request ran.
   result.minimum_time.cone_clearing_iterations = context.coneClearingIterations();
   return result;
 }

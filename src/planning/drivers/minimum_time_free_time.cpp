@@ -105,7 +105,7 @@ struct RefinedOutcome {
 
 /// The cone clearings run (coneClearStart; minimum_time.cone_clearings) and how many of them
 /// ended at a plan an earlier clearing reached. Their iterations are the context's tally
-/// (SolveContext::coneClearingIterations), not summed here.
+/// (SolveContext::coneClearingIterations), stamped on the request's answer by planMinimumTime.
 struct ClearingWork {
   int clearings = 0;
   int joined = 0;
@@ -884,7 +884,6 @@ class FreeTimeMinimumTime {
     result.minimum_time.solves = solves_;
     result.minimum_time.second_order_sufficient = second_order_sufficient;
     result.minimum_time.cone_clearings = clearing_work_.clearings;
-    result.minimum_time.cone_clearing_iterations = context_.coneClearingIterations();
     result.minimum_time.cone_clearings_joined = clearing_work_.joined;
     recordTwist(at, answer, &result);
     result.attempts = context_.attemptsFrom(first_recorded_);

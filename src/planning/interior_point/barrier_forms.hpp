@@ -1,15 +1,6 @@
-// The barrier forms that say how a row c(x) ≥ 0 of a stage transcription (ConstraintRow, 9
-// entries at a fixed h, 10 with h free) enters the barrier problem: its multiplier's safeguard,
-// its Newton terms, its merit term, its dual step, its complementarity; one interface
-// (BarrierForm), so that the loops over the rows are written once (BarrierRowBlock, the
-// constraint block both interior points hold).
-//   FreeSlacks (fixed h): c − s = 0, s > 0 a variable, −μ ln s + ν|c − s| in the merit.
-//   L1Elastic  (fixed h; free time's elastic start): c + v − s = 0, s, v ≥ 0 eliminated for c
-//              (elasticSlacks), the merit ψ_μ(c) = ρ v − μ ln s − μ ln v; z < ρ (u = ρ − z > 0).
-//   Feasible   (free time): −μ ln c, every iterate strictly inside; the feasible dual step
-//              dz = μ/c − z − (z/c) gᵀd.
-// κ_Σ (dual_safeguard) keeps each form's moment: the slack forms clamp z where a row is prepared
-// for an assembly (with the new μ), Feasible after a step is accepted (with the step's μ).
+// How a row c(x) ≥ 0 of a stage transcription enters a barrier problem (BarrierForm: FreeSlacks,
+// L1Elastic, Feasible), and the loops over the rows written once for both interior points
+// (BarrierRowBlock).
 #pragma once
 
 #include <algorithm>
@@ -86,9 +77,9 @@ void prepareElasticRow(ConstraintRow<Entries>& row, double mu, double rho, bool 
 double elasticDualStepLimit(double z, double dz, double rho, double alpha,
                             const InteriorPointParameters& p);
 
-/// How a row c(x) ≥ 0 enters a barrier problem: one interface on the rows of either time step
-/// (Entries 9 at a fixed h, 10 with h free), so that the loops over the rows (the dual step, the
-/// merit, the complementarity) are written once, in the problems that own the rows.
+/// How a row c(x) ≥ 0 enters a barrier problem, on the rows of either time step (Entries 9 at a
+/// fixed h, 10 with h free). κ_Σ keeps each form's moment: the slack forms clamp z in prepare
+/// (with the new μ), Feasible in afterAccept (with the step's μ).
 template <int Entries>
 class BarrierForm {
  public:
@@ -98,7 +89,6 @@ class BarrierForm {
   /// The multiplier (κ_Σ-safeguarded, or the primal one) and the condensation terms for the
   /// row's value c, where the row is prepared for an assembly (Feasible: only the primal one).
   virtual void prepare(Row& row, double mu, double rho, bool primal) const = 0;
-  /// ω and β of the prepared row.
   virtual RowTerms terms(const Row& row, double mu) const = 0;
   /// The row's term of the merit at value c (row.c the accepted one; ρ: the elastic penalty,
   /// FreeSlacks the merit's ν at the slack s + α ds); +∞ where c is outside the form's domain
@@ -108,7 +98,6 @@ class BarrierForm {
   /// The multiplier's step dz (into row.dz) for the row's slope gᵀd (+ r), and `alpha` limited
   /// by the fraction to the boundary after it.
   virtual double dualStep(Row& row, double slope, double mu, double rho, double alpha) const = 0;
-  /// Adds the row's complementarity products at its value c.
   virtual void addComplementarity(const Row& row, double mu, double rho,
                                   Complementarity* out) const = 0;
   /// κ_Σ after an accepted step, at the row's new value c (Feasible's moment; the slack forms
@@ -122,7 +111,6 @@ class BarrierForm {
   virtual void initialize(Row& row, double mu, double rho, double cap) const = 0;
 
  protected:
-  /// z ≥ 0 kept at least (1 − τ) of itself.
   double multiplierLimit(double z, double dz, double alpha) const {
     if (dz < 0) alpha = std::min(alpha, -p_.fraction_to_boundary * z / dz);
     return alpha;
@@ -130,8 +118,7 @@ class BarrierForm {
   const InteriorPointParameters& p_;
 };
 
-/// c − s = 0 with s > 0 free (fixed h): the multiplier stays near μ/s, the condensation that of
-/// c − s = 0.
+/// c − s = 0 with s > 0 a variable (fixed h), −μ ln s + ν|c − s| in the merit.
 class FreeSlacks final : public BarrierForm<9> {
  public:
   using BarrierForm::BarrierForm;
@@ -151,8 +138,8 @@ class FreeSlacks final : public BarrierForm<9> {
   void initialize(Row& row, double mu, double rho, double cap) const override;
 };
 
-/// c + v − s = 0, ℓ1-penalized v: the certificate of local infeasibility at fixed h, and the
-/// free-time solver's elastic start (Entries 10).
+/// c + v − s = 0, ℓ1-penalized v, s and v eliminated for c (elasticSlacks): the certificate of
+/// local infeasibility at fixed h, and the free-time solver's elastic start (Entries 10).
 template <int Entries>
 class L1Elastic final : public BarrierForm<Entries> {
  public:
@@ -191,8 +178,7 @@ std::unique_ptr<BarrierForm<9>> makeSlackForm(Formulation formulation,
                                               const InteriorPointParameters& parameters);
 
 /// −μ ln c with every iterate strictly inside (free time): the multiplier's feasible step
-/// dz = μ/c − z − (z/c)(gᵀd + r), κ_Σ after each accepted step. A scalar barrier unknown (the
-/// elastic start's θ ≥ 0) is one more such row with c = θ.
+/// dz = μ/c − z − (z/c)(gᵀd + r), κ_Σ after each accepted step.
 class Feasible final : public BarrierForm<10> {
  public:
   using BarrierForm::BarrierForm;
@@ -207,7 +193,6 @@ class Feasible final : public BarrierForm<10> {
     return multiplierLimit(row.z, row.dz, alpha);
   }
   void addComplementarity(const Row& row, double mu, double, Complementarity* out) const override;
-  /// z within [μ/(κ_Σ c), κ_Σ μ/c].
   void afterAccept(Row& row, double mu) const override;
   void initialize(Row& row, double mu, double, double cap) const override {
     row.z = std::min(mu / row.c, cap);
@@ -247,11 +232,8 @@ struct MeritSum {
 };
 
 /// The constraint block of a barrier problem over a stage transcription: its rows and what a
-/// primal–dual method does with them row by row (values, merit terms, dual step, κ_Σ,
-/// complementarity), written once for either time step; the interior point at a fixed h
-/// (ConstrainedSystem) and the free-time solver each hold one. `form(group)` is the barrier form
-/// a group's rows are in now (fixed h: its formulation's; free time: ℓ1-elastic while its start
-/// is, else Feasible). Sums run group by group, k rising (StageTranscription::forEach).
+/// primal–dual method does with them row by row, for either time step. `form(group)` is the form
+/// a group's rows are in now. Sums run in StageTranscription::forEach's order.
 template <typename TimeStep>
 class BarrierRowBlock {
  public:
@@ -265,58 +247,54 @@ class BarrierRowBlock {
       : rows(constraints, np), np_(np), form_(std::move(form)) {}
 
   const Form& form(const Rows& g) const { return form_(g); }
-  /// Each row's value c at `steps`.
   void evaluate(const ReducedProblem::StepVectors& steps) {
     rows.evaluate(QuantityInputs(np_, steps));
   }
-  /// `start` plus the rows' merit terms (BarrierForm::rowMerit): at their own values c, or, with
-  /// `at`, at their values there (rows untouched; each checked against its accepted c).
-  double merit(double start, const QuantityInputs* at, double mu, double rho, double alpha,
-               bool check_boundary) const {
-    MeritSum sum{start};
-    const auto add = [&](const Rows& g, int, const Row& in, double c) {
-      sum.add(form(g).rowMerit(in, c, mu, rho, alpha, check_boundary));
-    };
-    if (at) {
-      rows.forEachValue(*at, add);
-    } else {
-      rows.forEach([&](const Rows& g, int k, const Row& in) { add(g, k, in, in.c); });
-    }
+  /// The rows' merit terms (BarrierForm::rowMerit) at their own values c.
+  double merit(double mu, double rho, double alpha) const {
+    MeritSum sum;
+    rows.forEach([&](const Rows& g, int, const Row& in) {
+      sum.add(form(g).rowMerit(in, in.c, mu, rho, alpha, false));
+    });
     return sum.value();
   }
-  /// Each row's merit term at `at` (rowMerit at its value there, checking the boundary) into
-  /// `terms`, forEach's order, while it is finite; false at the first +∞ term (a value outside
-  /// its row's domain: the merit there is +∞), the rows after it not evaluated. `outside`
-  /// (optional): the index of a row found outside before, tested first (the trials of one line
-  /// search mostly fail at one row: a rejection in one value), and where a row is found outside
-  /// now, its index.
-  bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, std::vector<double>* terms,
-                       int* outside = nullptr) const {
+  /// Each row's merit term at its value at `at` (rows untouched; `check_boundary` as rowMerit's)
+  /// into `terms`, forEach's order, while it is finite; false at the first +∞ term (a value
+  /// outside its row's domain: the merit there is +∞), the rows after it not evaluated.
+  /// `outside` (optional): the index of a row found outside before, tested first (the trials of
+  /// one line search mostly fail at one row), and where a row is found outside now, its index.
+  bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, bool check_boundary,
+                       std::vector<double>* terms, int* outside = nullptr) const {
+    const auto term = [&](const Rows& g, int k, const Row& in) {
+      return form(g).rowMerit(in, rows.valueAt(g, at, k), mu, rho, 0.0, check_boundary);
+    };
+    constexpr double kOutside = std::numeric_limits<double>::infinity();
+    const int hint = outside ? *outside : -1;
+    double hinted = 0.0;
     terms->clear();
-    if (outside && *outside >= 0) {
-      double term = 0.0;
-      rows.atRow(*outside, at, [&](const Rows& g, int, const Row& in, double c) {
-        term = form(g).rowMerit(in, c, mu, rho, 0.0, true);
+    if (hint >= 0) {
+      rows.forEachFrom(hint, [&](const Rows& g, int k, const Row& in) {
+        hinted = term(g, k, in);
+        return false;
       });
-      if (term == std::numeric_limits<double>::infinity()) return false;
+      if (hinted == kOutside) return false;
     }
-    return rows.everyValue(at, [&](const Rows& g, int, const Row& in, double c) {
-      terms->push_back(form(g).rowMerit(in, c, mu, rho, 0.0, true));
-      if (terms->back() != std::numeric_limits<double>::infinity()) return true;
-      if (outside) *outside = static_cast<int>(terms->size()) - 1;
+    return rows.forEachFrom(0, [&](const Rows& g, int k, const Row& in) {
+      const int index = static_cast<int>(terms->size());
+      terms->push_back(index == hint ? hinted : term(g, k, in));
+      if (terms->back() != kOutside) return true;
+      if (outside) *outside = index;
       return false;
     });
   }
-  /// `start` plus the rows' merit terms as rowMeritsInside gave them: merit(start, at, μ, ρ, 0,
-  /// true) there, the same terms summed in the same order.
+  /// `start` plus the rows' merit terms as rowMeritsInside gave them, summed in their order.
   static double merit(double start, const std::vector<double>& terms) {
     MeritSum sum{start};
     for (const double term : terms) sum.add(term);
     return sum.value();
   }
-  /// The rows' dual steps dz (into the rows) for the step d, each row's slope gᵀd + r (r the
-  /// second-order correction's term, 0 but for a corrected step), and the largest step in (0, 1]
-  /// by the fraction to the boundary.
+  /// The rows' dual steps dz for the step d (slope gᵀd + r, r a second-order correction's term),
+  /// and the largest step in (0, 1] by the fraction to the boundary.
   double dualStep(const Eigen::VectorXd& d, double mu, double rho) {
     double alpha = 1.0;
     rows.forEach([&](const Rows& g, int k, Row& in) {
@@ -324,30 +302,24 @@ class BarrierRowBlock {
     });
     return alpha;
   }
-  /// z += α dz on every row.
   void applyDualStep(double alpha) {
     rows.forEach([&](Rows&, int, Row& in) { in.z += alpha * in.dz; });
   }
-  /// Every row prepared at its value c (BarrierForm::prepare).
   void prepare(double mu, double rho, bool primal) {
     rows.forEach([&](const Rows& g, int, Row& in) { form(g).prepare(in, mu, rho, primal); });
   }
-  /// The first multipliers at the rows' values: the primal ones, capped at `cap`.
   void initialize(double mu, double rho, double cap) {
     rows.forEach([&](const Rows& g, int, Row& in) { form(g).initialize(in, mu, rho, cap); });
   }
-  /// κ_Σ after an accepted step, at the rows' new values.
   void afterAccept(double mu) {
     rows.forEach([&](const Rows& g, int, Row& in) { form(g).afterAccept(in, mu); });
   }
-  /// The rows' complementarity products at their values c.
   Complementarity complementarity(double mu, double rho) const {
     Complementarity out;
     rows.forEach(
         [&](const Rows& g, int, const Row& in) { form(g).addComplementarity(in, mu, rho, &out); });
     return out;
   }
-  /// The largest multiplier after the dual step α dz.
   double largestMultiplier(double alpha) const {
     double largest = 0.0;
     rows.forEach([&](const Rows&, int, const Row& in) {
@@ -361,9 +333,7 @@ class BarrierRowBlock {
     rows.forEach([&](const Rows&, int, const Row& in) { smallest = std::min(smallest, in.c); });
     return smallest;
   }
-  /// max(0, −min c): the largest violation at the rows' values.
   double maxViolation() const { return std::max(0.0, -smallestValue()); }
-  /// max |c − s| at the rows' values (FreeSlacks' primal residual).
   double maxSlackResidual() const {
     double worst = 0.0;
     rows.forEach(

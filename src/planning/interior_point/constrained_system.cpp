@@ -38,7 +38,7 @@ double ConstrainedSystem::merit(const ReducedProblem::StepVectors& steps, double
   evaluateValues(steps, &tau);
   const double f = np_.scheme().cost(tau);
   if (cost) *cost = f;
-  return f + block_.merit(0.0, nullptr, mu, rho, slack_alpha, false);
+  return f + block_.merit(mu, rho, slack_alpha);
 }
 
 void ConstrainedSystem::pollEvery(int k) const {
@@ -78,10 +78,7 @@ void ConstrainedSystem::addConstraintGradients(double mu, Eigen::VectorXd* rhs,
   });
 }
 
-/// FreeSlacks, Mehrotra's predictor: from the affine-scaling step dδ_aff (solved with μ = 0,
-/// i.e. q = −c), the complementarity the step to the boundary would leave,
-/// μ_aff = mean((s + α_p ds)(z + α_d dz)), and the mean complementarity now (*average). Keeps
-/// each instance's ds_aff·dz_aff (in `products`) for the corrector.
+/// FreeSlacks (the affine-scaling step solved with μ = 0, i.e. q = −c).
 double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double* average,
                                                 std::vector<double>* products) const {
   products->clear();
@@ -107,8 +104,6 @@ double ConstrainedSystem::affineComplementarity(const Eigen::VectorXd& d, double
   return affine / m;
 }
 
-/// Adds Σ_i g_i/s_i (the barrier's part of the right-hand side is μ times it) or, with
-/// `products`, the corrector's Σ_i −g_i·products_i/s_i, to `out`.
 void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* products,
                                                   Eigen::VectorXd* out) const {
   std::size_t i = 0;
@@ -117,8 +112,7 @@ void ConstrainedSystem::addSlackWeightedGradients(const std::vector<double>* pro
   });
 }
 
-/// The condensation's q for the complementarity target s z = μ − ds_aff dz_aff (FreeSlacks;
-/// `products` may be null: the plain barrier μ).
+/// The condensation's q for that target (FreeSlacks).
 void ConstrainedSystem::setComplementarityTarget(double mu, const std::vector<double>* products) {
   std::size_t i = 0;
   block_.rows.forEach([&](FixedStepRows&, int, FixedStepRow& in) {
@@ -146,8 +140,6 @@ void ConstrainedSystem::applySlackStep(double alpha) {
   block_.rows.forEach([&](FixedStepRows&, int, FixedStepRow& in) { in.s += alpha * in.ds; });
 }
 
-/// Mean and smallest complementarity product (s z and v u; FreeSlacks: s z) at the last
-/// evaluated c.
 void ConstrainedSystem::complementarity(double mu, double rho, double* average,
                                         double* smallest) const {
   const Complementarity products = block_.complementarity(mu, rho);
@@ -155,8 +147,7 @@ void ConstrainedSystem::complementarity(double mu, double rho, double* average,
   *smallest = products.low;
 }
 
-/// σ_k = τ_k + (z⁺ − z⁻)/(a w_k) per axis (PlanResult::switching_function) at the current
-/// multipliers; empty without per-axis bounds.
+/// Empty without per-axis bounds.
 std::vector<Vector3> ConstrainedSystem::switchingFunction(
     const std::vector<Vector3>& torque) const {
   if (!block_.rows.hasTorqueBox()) return {};
@@ -165,10 +156,8 @@ std::vector<Vector3> ConstrainedSystem::switchingFunction(
   return sigma;
 }
 
-/// The first-order (KKT stationarity) residual at the current iterate with this solve's
-/// multipliers: max-norm of ∇f − Σ zᵢ∇cᵢ relative to |∂τ/∂R|·max|τ|, as the Newton solver's
-/// max_residual. Re-forms the gradients at the iterate (the last assembly's are the previous
-/// iterate's), first order only, leaving the multipliers as they are.
+/// As the Newton solver's max_residual; the gradients re-formed at the iterate (the last
+/// assembly's are the previous iterate's), the multipliers left as they are.
 double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::VectorXd* rhs,
                                                Eigen::VectorXd* merit_gradient) {
   assemble<double>(mu, rho, false, nullptr, rhs, merit_gradient);
@@ -187,7 +176,6 @@ double ConstrainedSystem::relativeStationarity(double mu, double rho, Eigen::Vec
   return residual.size() && scale > 0 ? residual.cwiseAbs().maxCoeff() / scale : 0.0;
 }
 
-/// The multipliers and slacks of this iterate (FreeSlacks), to start a finer level from.
 LevelDuals ConstrainedSystem::duals() const {
   LevelDuals d;
   d.steps = np_.steps();

@@ -1,45 +1,10 @@
-// The fixed-h interior point's node constraints on the reduced problem's band: their primal–dual
-// state (values c_i, gradients g_i, multipliers z_i, slacks s_i, v_i) and the condensed Newton
-// system, assembled at the current iterate in O(N) (grid_solve.cpp runs the method on one grid,
-// drivers/constrained_recipe.cpp orders its attempts). The constraints: per-axis torque bounds,
-// torque norm, angular rate, keep-out / keep-in cones, for every scheme. With end torques
-// (second_order) the torque constraints hold at k = 0..N too, the stencils carry the residuals
-// √w_k τ_k (constraints act on τ_k), and rates are node rates J⁻¹Π_k through the node momentum's
-// stencil (ReducedProblem::forEachNodeMomentum).
-//
-// Every constraint is stage-local in the reduced unknowns δ_j (R_j → R_j exp(δ_j^)): a torque
-// constraint depends on R_{k−1}, R_k, R_{k+1} (τ_k's stencil), a rate constraint on F_k =
-// R_kᵀR_{k+1}, a cone on R_k. Each is written dimensionless as c_i(δ) ≥ 0:
-//   torque box   1 ∓ τ_{k,a}/a_a          torque norm   1 − |τ_k|²/t²
-//   rate         1 − |Ω_k|²/w²            keep_out      cos α − sᵀR_k b
-//   keep_in      sᵀR_k b − cos α
-//
-// Elastic (ℓ1) formulation, so that every iterate has a finite merit and an infeasible request
-// ends at a certificate instead of an endless restoration (as IPOPT's restoration phase and
-// Curtis's penalty–interior-point method do):
-//   min f(δ) + ρ Σ v_i   s.t.  c_i(δ) + v_i − s_i = 0,  s, v ≥ 0,     f = Σ ½|τ_k|²,
-// barrier μ; with multipliers z (of s) and u = ρ − z (of v), the Newton step condenses
-// (per constraint, D_i = s_i/z_i + v_i/u_i) to
-//   (W + Σ_i g_i g_iᵀ / D_i) dδ = −∇f + Σ_i g_i (z_i + q_i/D_i),   q_i = μ/z_i − s_i − μ/u_i + v_i,
-//   W = ∇²f − Σ_i z_i ∇²c_i,  g_i = ∇c_i,  dz_i = (q_i − g_iᵀdδ)/D_i.
-// Each g_i g_iᵀ lies inside one stencil's 9×9 block, so the system keeps the unconstrained
-// Hessian's band (ReducedProblem::kHalfBandwidth) and is factored by the same banded Cholesky, in
-// the precision SolverOptions::precision chooses (grid_solve.hpp: resolvePrecision). The slacks
-// are eliminated exactly for the current c (node_constraints.hpp: elasticSlacks), so the merit
-// φ_μ(δ) = f + Σ ψ_μ(c_i) depends on δ alone; the line search is Armijo on φ_μ along the
-// retraction, and the dual step keeps z and u positive (fraction to the boundary).
-//
-// The free-slack form (Formulation::FreeSlacks, as IPOPT): c(δ) − s = 0 with s > 0 free
-// variables, the same condensation with D = s/z, q = μ/z − c (so ds = gᵀdδ + c − s), merit
-// f − μ Σ ln s + ν‖c − s‖₁, fraction to the boundary on s and z. Its Hessian carries Newton's own
-// multipliers instead of z → ρ for violated constraints, which is where the elastic form stalls.
-//
-// Between nodes: the constraints hold at the nodes only. Within step k the continuous motion
-// R_k exp(s ω_k^), s ∈ [0, 1], turns at the constant rate ω_k/h (paper scheme), so a rate limit
-// holds between nodes too, and torques are held over a step, so their bounds hold throughout; a
-// cone's angle can dip past its bound within a step by up to a − acos(cos a + |ω_k|²/8): the
-// cones are imposed at their node half angle, tightened by the user's margin
-// (constraints.hpp: requiredConeMargin).
+// The fixed-h interior point's stage constraints c_i(δ) ≥ 0 on the reduced problem's band (torque
+// box and norm, rate, keep-out / keep-in cones, for every scheme) and the condensed Newton system
+// [W + Σ g_i g_iᵀ/D_i] dδ = −∇f + Σ g_i (z_i + q_i/D_i), assembled in O(N) in the band of the
+// unconstrained Hessian; ℓ1-elastic (a certificate of local infeasibility instead of an endless
+// restoration) or free slacks (as IPOPT). The cones are imposed at their node half angle tightened
+// by the user's margin (between nodes a cone's angle may dip: constraints.hpp:
+// requiredConeMargin). The derivation: docs/notes/interior_point_formulation.md.
 #pragma once
 
 #include <vector>
@@ -97,7 +62,7 @@ class ConstrainedSystem final : public BarrierRows {
   /// φ_μ from the constraint values of the last assembly (f = its cost): Elastic Σ ψ_μ(c_i) (ρ
   /// the penalty); FreeSlacks Σ −μ ln s_i + ρ|c_i − s_i| (ρ the merit's ν).
   double assembledMerit(double cost, double mu, double rho) const {
-    return cost + block_.merit(0.0, nullptr, mu, rho, 0.0, false);
+    return cost + block_.merit(mu, rho, 0.0);
   }
 
   /// Assembles the condensed Newton system at the current iterate: K (the band and, with a twist,

@@ -1,42 +1,8 @@
-// Minimum time as one interior-point problem (free_time_solver.hpp).
-//
-// Unknowns: the free attitudes R_j exp(δ_j^) of the reduced problem and η = h/h₀ (h₀ the start's
-// time step, T₀ = N h₀), the boundary data R_0, R_N, Ω(0), Ω(T) held at every h
-// (ReducedProblem::setTimeStep). Problem, with the torque constraints c_i ≥ 0 written as the
-// fixed-h interior point writes them (constrained_system.cpp):
-//     min f = T/T₀ + ε C(δ, h)   s.t.  c_i(δ, h) ≥ 0,   torque box 1 ∓ τ_{k,a}/a_a, norm 1 −
-//     |τ_k|²/t²,
-// C the scheme's effort Σ ½ w_k |τ_k|² and ε = ε₀ μ/μ₀ a regularization that vanishes with the
-// barrier μ (minimum time alone is bang–bang: where a torque is strictly inside its bounds, ε
-// makes the Newton system definite; at μ → 0 the answer is a KKT point of minimum time itself).
-// A pointing cone is a function of R_k alone (not of h). Every other constraint is a function of
-// one torque τ_k, so of R_{k−1}, R_k, R_{k+1} and h:
-// ∂τ_k/∂h comes from ReducedProblem::forEachStencilWithTimeStep (tau_h, with the fixed inner
-// attitudes of paper and variational moving with h), and the Hessian of the Lagrangian
-// L = f − Σ zᵢcᵢ is that stencil's `second` with the weights w_k = ε r_k − Σ zᵢ ∂cᵢ/∂r_k plus the
-// Gauss–Newton terms of C and the norm bound. A feasible primal–dual barrier method: the iterates
-// stay strictly inside (every iterate is a plan meeting every constraint and the discrete
-// dynamics), the Newton step of the barrier problem condenses to
-//     [W + Σ (zᵢ/cᵢ) gᵢgᵢᵀ] dx = −∇f + Σ (μ/cᵢ) gᵢ,   dzᵢ = μ/cᵢ − zᵢ − (zᵢ/cᵢ) gᵢᵀdx,
-// over x = (δ, η): a band (the node unknowns) bordered by one column (η), solved by the Schur
-// complement (linalg/bordered_band.hpp). Inertia: the band must be positive definite and the
-// Schur complement positive (else a growing shift, as IPOPT's δ_w); line search Armijo on
-// φ_μ = f − μ Σ ln cᵢ with the fraction to the boundary on c and z (in the end game each rejected
-// trial step is first retried with IPOPT's second-order correction); barrier μ decreased
-// monotonically (IPOPT's κ_μ, θ_μ) once the barrier problem's residual is ≤ κ_ε μ. Those
-// constants are InteriorPointParameters' (one value per idea with the fixed-h interior point).
-//
-// Start: h is raised until every constraint that moves with h holds with a margin (rest to rest
-// each of them falls with h). With spinning ends a raise at fixed attitudes makes an end torque
-// worse (it carries the boundary momentum, ∓2√w JΩ/h, which a slower interior no longer meets),
-// so past a raise of largest_start_raise the start stays at its own T and is made feasible by an
-// elastic phase (as IPOPT's restoration, in one problem): each of those constraints becomes
-// c + v − s = 0 with its own s, v ≥ 0 and the exact ℓ1 penalty ρ Σ v in the objective, s and v
-// eliminated for c (the fixed-h solver's L1Elastic rows: prepareElasticRow, barrier_forms.hpp);
-// the first iterate with every c > 0 leaves the phase and the method continues as above from a
-// strictly feasible plan. One relaxation per row, not one shared by all: with a single shared
-// θ (c + θ ≥ 0) every active row's gradient carried the same θ column, the Newton systems were
-// degenerate, and spinning starts stayed elastic for 500 iterations.
+// Minimum time as one feasible primal–dual barrier problem over x = (δ, η = h/h₀): min T/T₀ + εC
+// s.t. c_i(δ, h) ≥ 0, ε = ε₀ μ/μ₀ vanishing with μ (it makes the Newton system definite where a
+// torque is strictly inside its bounds; at μ → 0 the end is a KKT point of minimum time itself).
+// A start h cannot bring inside (spinning ends) is made feasible by an ℓ1-elastic phase, one
+// relaxation per row. The derivation: docs/notes/interior_point_formulation.md.
 #include "planning/interior_point/free_time_solver.hpp"
 
 #include <algorithm>
@@ -92,7 +58,9 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   }
 
   double smallestValue(bool moves_with_h) const override {
-    return smallestValue(np_.current(), moves_with_h);
+    return block_.rows.smallestValue(
+        QuantityInputs(np_, np_.current()),
+        [&](const FreeTimeRows& g) { return g.quantity->dependsOnTimeStep() == moves_with_h; });
   }
   void beginAt(bool elastic) override {
     h0_ = np_.timeStep();
@@ -113,27 +81,27 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   bool elasticRows(const FreeTimeRows& g) const {
     return elastic_ && g.quantity->dependsOnTimeStep();
   }
-  /// The form a group's rows are in now: ℓ1-elastic while elasticRows, else Feasible.
   const BarrierForm<10>& form(const FreeTimeRows& g) const {
     if (elasticRows(g)) return elastic_form_;
     return feasible_;
   }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
-  /// The smallest value of the constraints that move with h (time_dependent) or of the others,
-  /// not relaxed.
-  double smallestValue(const ReducedProblem::StepVectors& steps, bool time_dependent) const {
-    return block_.rows.smallestValue(QuantityInputs(np_, steps), [&](const FreeTimeRows& g) {
-      return g.quantity->dependsOnTimeStep() == time_dependent;
-    });
-  }
 
-  /// φ_μ at the current iterate (+∞ unless every constraint is ≥ fraction · its old value).
-  double merit(double mu, double epsilon, bool check_boundary) const {
-    const std::vector<Vector3> tau = np_.torques(np_.current());
+  /// φ_μ = T/T₀ + εC plus the rows' terms at the iterate: +∞ at the first row outside its form's
+  /// domain (at a trial also below (1 − τ) of its accepted value) or, at a trial, off the principal
+  /// branch. Most trials are rejected at a row: the cost and the rows after it are left.
+  double merit(double mu, double epsilon, bool trial) {
     const QuantityInputs at(np_, np_.current());
-    return block_.merit(objective_.value(np_.timeStep(), np_.scheme().cost(tau), epsilon), &at, mu,
-                        rho_, 0.0, check_boundary);
+    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    if (trial && !np_.onPrincipalBranch(np_.current())) {
+      return std::numeric_limits<double>::infinity();
+    }
+    const double cost = np_.scheme().cost(np_.torques(np_.current()));
+    return BarrierRowBlock<FreeTimeStep>::merit(objective_.value(np_.timeStep(), cost, epsilon),
+                                                row_terms_);
   }
 
   double firstBarrier() const;
@@ -143,14 +111,12 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   void restoreAcceptedEnd();
   // BarrierProblem, from the point the line search started at (accepted_).
   double merit() override { return merit(accepted_.mu, accepted_.epsilon, false); }
-  /// φ_μ at the iterate moved by α d, +∞ where h ≤ 0 or no boundary step exists there (`moved`
-  /// false then: the iterate is not there) or a step has left the scheme's principal branch.
   double trialMerit(const Eigen::VectorXd& d, double alpha, bool* moved) override;
   void moveTo(const Eigen::VectorXd& d, double alpha) override;
   void restore() override;
   bool correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) override;
   void clearCorrection() override;
-  // PrimalDualProblem: the free-time profile's pass (free_time_solver.cpp).
+  // PrimalDualProblem: the free-time profile's pass.
   void prepare() override;
   void describe(BarrierState* s) const override {
     s->elastic = elastic_;
@@ -184,9 +150,7 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// Why `watch` stops the solve at this solved barrier problem (empty: it goes on).
   std::string watched(const BarrierWatch& watch, double mu, double gap, double epsilon,
                       int iterations) const;
-  /// Reports one pass of the loop (one counted iteration) to the context: an accepted step of
-  /// length `alpha`, or a barrier update at the same iterate (alpha 0); `stationarity` at the
-  /// iterate the pass started from.
+  /// Reports one counted pass to the context: a step of length `alpha`, or (0) a barrier update.
   void report(double alpha, double stationarity) const;
   /// The outcome at the iterate the solve ended at (termination_, reason_).
   FreeTimeOutcome outcome() const;
@@ -208,8 +172,8 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// What this pass measured at the assembled iterate, and its step.
   double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
-  std::vector<double> trial_terms_;  ///< the rows' merit terms at a trial point (trialMerit)
-  int row_outside_ = -1;  ///< the row a trial last found outside its domain (rowMeritsInside)
+  std::vector<double> row_terms_;  ///< the rows' merit terms at the iterate (merit)
+  int row_outside_ = -1;  ///< the row a merit last found outside its domain (rowMeritsInside)
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
   /// changes φ_μ): the next pass lowers μ.
   bool solved_to_round_off_ = false;
@@ -250,11 +214,10 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
   lagrangian_gradient_(n_) += dT;
 }
 
-/// Leaves the elastic phase once every constraint holds strictly: from then on the iterate is a
-/// plan meeting its bounds, as a start raised inside would be (the rows' multipliers carry over,
-/// safeguarded for the feasible form).
+/// Leaves the elastic phase once every constraint holds strictly: the iterate is a plan (the
+/// rows' multipliers carry over, safeguarded for the feasible form).
 void FreeTimeSolver::leaveElasticIfInside() {
-  if (!elastic_ || !(smallestValue(np_.current(), true) > 0)) return;
+  if (!elastic_ || !(smallestValue(true) > 0)) return;
   elastic_ = false;
 }
 
@@ -276,10 +239,8 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
   if (moved) *moved = false;
   const double h = accepted_.h + alpha * h0_ * d(n_);
   if (h <= 0) return std::numeric_limits<double>::infinity();
-  // An elastic iterate is no plan: its phase can trade violation for a T below every plan's
-  // (measured: starts ending under the proven least duration on the grid, still violating). So
-  // while elastic, h keeps the fraction to the boundary of that floor; a strictly feasible iterate
-  // is a plan and lies above it anyway.
+  // An elastic iterate is no plan and can trade violation for a T below every plan's: while
+  // elastic, h keeps the fraction to the boundary of the proven least duration.
   if (elastic_ && h < accepted_.h) {
     const double floor = discreteDurationLowerBound(problem_) / N_;  // 0: no bound applies
     if (floor > 0 && h - floor < (1.0 - p_.fraction_to_boundary) * (accepted_.h - floor)) {
@@ -289,20 +250,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
   try {
     moveTo(d, alpha);
     if (moved) *moved = true;
-    // φ_μ is +∞ at a trial where some row's term is (its value outside the row's domain), known
-    // at that row: the rows after it, the branch test, the torques and the cost are left for
-    // the trials inside, and the row a trial failed at is tested first at the next. Measured on
-    // seed 4949's 20 cone requests: most trials are rejected so (the first barrier problems'
-    // halvings), and each had cost as much as an accepted one. Where every row is inside, φ_μ is
-    // the same sum of the same terms.
-    if (!block_.rowMeritsInside(QuantityInputs(np_, np_.current()), accepted_.mu, rho_,
-                                &trial_terms_, &row_outside_)) {
-      return std::numeric_limits<double>::infinity();
-    }
-    if (!np_.onPrincipalBranch(np_.current())) return std::numeric_limits<double>::infinity();
-    const std::vector<Vector3> tau = np_.torques(np_.current());
-    return block_.merit(objective_.value(np_.timeStep(), np_.scheme().cost(tau), accepted_.epsilon),
-                        trial_terms_);
+    return merit(accepted_.mu, accepted_.epsilon, true);
   } catch (const std::exception&) {  // no boundary step at that h (StepTooLarge)
     return std::numeric_limits<double>::infinity();
   }
@@ -314,15 +262,11 @@ void FreeTimeSolver::restore() {
   np_.setCurrent(accepted_.steps);
 }
 
-/// The second-order correction of a rejected trial step d (IPOPT's, Wächter & Biegler 2006 §2.4,
-/// for this feasible barrier method): at x + d (the iterate on entry) each constraint misses its
-/// linear model by r = c(x + d) − c − gᵀd, its curvature along d. Where minimum time is flat
-/// along an arc the Newton step is long in the arc's directions, and the torque bounds active
-/// next to it, curved in the attitudes, cut it to 1/8 … 1/512 again and again (measured: 0.96 N m
-/// about body x against |u_x| ≤ 1). The corrected step solves the same Newton system with the
-/// barrier's linearization c + gᵀd + r: d' = d − K⁻¹ Σ (z/c) r g, one more solve with the step's
-/// factorization; its dual step uses the same model (BarrierRowBlock::dualStep). False where no r
-/// is nonzero or the corrected step is not finite.
+/// The second-order correction of a rejected trial step d (IPOPT's, Wächter & Biegler 2006 §2.4):
+/// at x + d (the iterate on entry) each row misses its linear model by r = c(x + d) − c − gᵀd;
+/// d' = d − K⁻¹ Σ (z/c) r g with the step's factorization (where minimum time is flat along an arc,
+/// the bounds' curvature cuts the Newton step again and again). False where no r is nonzero or d'
+/// is not finite.
 bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
@@ -358,8 +302,7 @@ double FreeTimeSolver::meritSlope(const Eigen::VectorXd& d) const {
   return slope;
 }
 
-/// The barrier problem's KKT residual: max(‖∇L‖∞, max |zc − μ|) at the assembled point (an
-/// elastic row: |zs − μ| and |(ρ − z)v − μ|).
+/// The barrier problem's KKT residual max(‖∇L‖∞, max |zc − μ|) at the assembled point.
 double FreeTimeSolver::barrierResidual(double mu) const {
   const double stationarity = lagrangian_gradient_.lpNorm<Eigen::Infinity>();
   return std::max(stationarity, block_.complementarity(mu, rho_).worst);
@@ -414,16 +357,13 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
 }
 
 /// μ₀, or in an elastic phase begun FromViolations the μ that widens its rows' kinks to
-/// elastic_kink_width of the largest violation (never below μ₀; the effort weight ε stays at ε₀
-/// while μ is above μ₀: prepare), or from a start that is a neighbouring problem's KKT plan
-/// (StartBarrier::NearKktPoint) near_kkt_barrier × μ₀: measured on a held-out pointing request
-/// whose fixed-twist T*(ψ) has two branches, the ψ-free solve from the lower branch's KKT plan
-/// ended on the upper branch begun at μ₀ and at μ₀/10, and stayed on its own begun at μ₀/100 (26
-/// iterations) and μ₀/1000 (48).
+/// elastic_kink_width of the largest violation (never below μ₀), or from a start that is a
+/// neighbouring problem's KKT plan (StartBarrier::NearKktPoint) near_kkt_barrier × μ₀, low enough
+/// not to carry it to another branch (docs/notes/interior_point_tuning.md).
 double FreeTimeSolver::firstBarrier() const {
   if (!elastic_ && start_barrier_ == StartBarrier::NearKktPoint) return p_.near_kkt_barrier * mu0_;
   if (!elastic_ || elastic_barrier_ != ElasticBarrier::FromViolations) return mu0_;
-  return std::max(mu0_, p_.elastic_kink_width * rho_ * -smallestValue(np_.current(), true));
+  return std::max(mu0_, p_.elastic_kink_width * rho_ * -smallestValue(true));
 }
 
 /// Assembles at the iterate (every pass: the limits are tested after it, and the KKT residual
@@ -464,12 +404,8 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 
 /// The order is the method's: dual step, leaving the elastic phase, κ_Σ (the loop then damps).
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
-  // dz = μ/c − z − (z/c)(gᵀd + r) (r: the second-order correction's term; an elastic row's
-  // dz = (q − gᵀd)/D) and the largest dual step by the fraction to the boundary, applied.
   block_.applyDualStep(dualStep());
   leaveElasticIfInside();
-  // κ_Σ: z within [μ/(κ_Σ c), κ_Σ μ/c] at the new values c (an elastic row's multiplier is
-  // safeguarded where it is prepared for the next assembly).
   block_.evaluate(np_.current());
   block_.afterAccept(mu_);
   report(result.alpha, stationarity_);
@@ -478,10 +414,8 @@ Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) 
 
 Pass FreeTimeSolver::solvedToRoundOff(const LineSearchResult& result) {
   // A barrier problem above μ_final whose Newton step no longer changes φ_μ beyond round-off
-  // is solved as far as it can be (its residual test κ_ε μ may lie below the round-off of
-  // the stationarity): the next μ, as the fixed-h solver's stalled steps do. Measured: a
-  // Bilimoria–Wie disturbance start stopped at μ = 2e-7 μ₀ on the round-off floor, 1.3e-8
-  // above its T*.
+  // is solved as far as it can be (its test κ_ε μ may lie below the stationarity's round-off):
+  // the next μ, as the fixed-h solver's stalled steps do.
   if (!elastic_ && mu_ > scales_.mu_final && result.at_round_off) {
     solved_to_round_off_ = true;
     report(0.0, stationarity_);

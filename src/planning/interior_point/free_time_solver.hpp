@@ -1,7 +1,6 @@
 // Minimum time as one interior-point problem: the time step h (T = N h) an unknown next to the
-// node unknowns δ of the reduced problem, objective T, the torque constraints, pointing cones and
-// rate limits in force (the stage constraints, transcription/stage_constraints.hpp;
-// free_time_solver.cpp derives the method). Where a solve begins, its retry and the second-order
+// node unknowns δ, objective T, the stage constraints in force (the method:
+// docs/notes/interior_point_formulation.md). Where a solve begins, its retry and the second-order
 // check of its end are its recipe's (drivers/free_time_recipe.hpp: solveFreeTime).
 #pragma once
 
@@ -33,8 +32,8 @@ struct FreeTimeOutcome {
   ReducedProblem::StepVectors steps;  ///< the iterate's steps (every iterate meets the constraints)
   double time_step = 0.0;             ///< h at the end
   double start_time_step = 0.0;  ///< h₀: the start's h once strictly feasible (T₀ = N h₀)
-  /// The start was brought inside by the elastic phase (c + θ ≥ 0, θ driven to 0) at its own T,
-  /// not by raising h (h₀ is then the start's h).
+  /// The start was brought inside by the elastic phase (the rows that move with h ℓ1-elastic) at
+  /// its own T, not by raising h (h₀ is then the start's h).
   bool elastic_start = false;
   double duration = 0.0;  ///< T = N h
   int iterations = 0;
@@ -82,7 +81,7 @@ enum class ElasticBarrier { Initial, FromViolations };
 /// Where a start strictly inside (or raised inside) begins its barrier: at μ₀, or (NearKktPoint)
 /// at near_kkt_barrier × μ₀ for a start that is already a KKT plan of a neighbouring problem (a
 /// fixed-twist minimum-time plan started with the twist free): begun at μ₀ the barrier re-centres
-/// such a start and may carry it to another local minimum (free_time_solver.cpp).
+/// such a start and may carry it to another local minimum.
 enum class StartBarrier { Initial, NearKktPoint };
 
 /// The scale of a free-time solve's objective T/T₀ + εC (ε = ε₀ μ/μ₀, ε₀ C₀ a fixed share): T₀
@@ -107,9 +106,8 @@ struct BarrierPoint {
   std::vector<Matrix3> attitudes;  ///< R_0 … R_N of the iterate
   int iterations = 0;
   /// The condensed barrier Hessian over (δ, η) factors without a shift at the iterate: a strict
-  /// local minimum of this barrier problem, where lower_bound holds locally. (Where it does not,
-  /// the solve may still slide to a lower point: measured on Bilimoria–Wie N = 32, a bound of
-  /// 3.27871 s at μ = 2.7e-6, then 68 iterations at that μ, the end 3.27774 s.)
+  /// local minimum of this barrier problem, where lower_bound holds locally (elsewhere the solve
+  /// may still slide below it).
   bool locally_convex = false;
   /// Its T [s] and lower bound, which holds where it is locally convex.
   LocalLowerBound bound() const { return {duration, lower_bound, locally_convex}; }

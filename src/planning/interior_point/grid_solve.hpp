@@ -16,9 +16,8 @@
 namespace attitude_planner {
 
 /// The largest relative Newton decrement at which a FeasibleIterate is reported: its bound is
-/// local, and farther from a minimum the solve may still end elsewhere (measured: from the
-/// geodesic, a bound 46 % above the converged cost at a decrement of 0.21; every bound at or
-/// below 0.08 held on those requests: test_pointing_constrained).
+/// local, and farther from a minimum the solve may still end elsewhere
+/// (docs/notes/interior_point_tuning.md).
 inline constexpr double kLocalBoundDecrement = 0.1;
 
 /// An iterate of a minimum-effort interior point (free slacks) that meets every constraint

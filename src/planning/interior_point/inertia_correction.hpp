@@ -66,12 +66,9 @@ class PerturbationHandler final : public InertiaCorrection {
                       double* shift) override;
   /// A Levenberg–Marquardt damping of the Newton step (the shift of factorAndSolve, from the
   /// first shift, ×growth per further cut step, ÷growth per full step, 0 below the smallest
-  /// damping): where minimum time is flat (a torque strictly inside its bounds along an arc:
-  /// only the vanishing ε C curves it) the Newton step is long in those directions, and the
-  /// constraints' curvature along it cuts it at the boundary again and again (measured: 0.96 N m
-  /// about body x against |u_x| ≤ 1, N = 64: 500 iterations at steps of 1/512 … 1/8 with the
-  /// stationarity stuck at 3e-5). The residuals that decide convergence are the undamped ones:
-  /// the KKT point is the same, only the path to it is shorter.
+  /// damping): where minimum time is flat along an arc (only the vanishing ε C curves it) the
+  /// Newton step is long there and the constraints' curvature cuts it again and again
+  /// (docs/notes/interior_point_tuning.md). The KKT point is the same, the path to it shorter.
   void afterStep(double alpha, bool end_game) override;
 
  private:

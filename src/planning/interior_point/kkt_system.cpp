@@ -76,12 +76,8 @@ template std::unique_ptr<KktSystem<double>> makeKkt<double>(int);
 template std::unique_ptr<KktSystem<long double>> makeKkt<long double>(int);
 template std::unique_ptr<KktSystem<DoubleDouble>> makeKkt<DoubleDouble>(int);
 
-// The least eigenpair of K = [band border; borderᵀ corner] from its banded factorizations
-// alone (O(n b²) each, where a dense eigensolver costs O(n³): 13 ms at n = 190): λ_min =
-// sup {σ : K − σI positive definite}, found by bisection on whether the shifted matrix factors
-// positive definite (BorderedBandedFactor reports it), between a Gershgorin bound below and 0;
-// then inverse iteration with the shift just below λ_min, where (K − σI)⁻¹ is dominated by the
-// least eigenvector (ratio (λ₁ − σ)/(λ₂ − σ) per step).
+// Banded factorizations alone: O(n b²) each, where a dense eigensolver costs O(n³). Inverse
+// iteration just below λ_min converges at the ratio (λ₁ − σ)/(λ₂ − σ) per step.
 std::optional<LeastEigenpair> leastEigenpair(const KktBlocks<double>& kkt) {
   const int n = kkt.band.size(), b = kkt.globals();
   const int size = n + b;

@@ -1,6 +1,6 @@
 // The interior point's Newton (KKT) system behind one interface: the band of the node unknowns
-// alone (fixed h), or that band bordered by a few global unknowns (free time: η = h/h₀ and, while
-// the start is elastic, θ),
+// alone (fixed h), or that band bordered by a few global unknowns (free time's η = h/h₀, a
+// pointing end's twist ψ),
 //
 //     K = [ A   B ]     A  n×n banded, half bandwidth ReducedProblem::kHalfBandwidth,
 //         [ Bᵀ  D ],    B  n×m dense, D m×m (m = 0 at fixed h).
@@ -31,7 +31,6 @@ template <typename Scalar>
 struct KktBlocks {
   explicit KktBlocks(int n) : band(n, ReducedProblem::kHalfBandwidth) {}
   int globals() const { return static_cast<int>(corner.rows()); }
-  /// Zero, sized for n node unknowns and m global ones.
   void clear(int n, int m) {
     if (band.size() == n) {
       band.setZero();
@@ -56,9 +55,7 @@ struct KktBlocks {
 ///     R_N exp(Δψ b^) F(h)ᵀ = R_{N−1} exp(Δψ e^) exp(d^),   x = Δψ e + d + ½ Δψ e × d + O(3)
 /// (Baker–Campbell–Hausdorff), so ∂²L/∂ψ∂η = e·H(:, η) + ∇_{x_{N−1}}L · ½ (e × d′) h₀: the path's
 /// curvature term, from the block's Lagrangian gradient. How the blocks are summed is the
-/// profile's (AssemblyChoices::sum_in_double): the rows' g gᵀ/D one by one as rank-one terms in
-/// the band's precision (fixed h, the precision rule, grid_solve.hpp), or a block summed in double
-/// and added once (free time).
+/// profile's (AssemblyChoices::sum_in_double).
 template <typename Scalar, typename TimeStep>
 class KktSink {
  public:
@@ -127,9 +124,8 @@ class KktSink {
 };
 
 /// The diagonal shift added before a factorization. RowRelative (fixed h; a twist's corner alike):
-/// A(i, i) += value ·
-/// (|A(i, i)| + row_floor) on the band's rows (BandedSymmetric::addRelativeToDiagonal); Uniform
-/// (free time): value on every diagonal entry of A and D. A zero value leaves the band as it is.
+/// A(i, i) += value · (|A(i, i)| + row_floor) (BandedSymmetric::addRelativeToDiagonal); Uniform
+/// (free time): value on every diagonal entry of A and D.
 struct Shift {
   enum class Rule { RowRelative, Uniform };
   double value = 0.0;

@@ -16,7 +16,7 @@ namespace {
 /// one component never bind together, but a torque bound and a torque-norm bound can).
 constexpr double kRelativeRidge = 1e-10;
 /// Active-set passes: each drops the columns whose least-squares multiplier came out negative
-/// (a bound touched but not pushed against); measured, one or two suffice on the scenes.
+/// (a bound touched but not pushed against); one or two suffice on the scenes.
 constexpr int kMaxActiveSetPasses = 5;
 /// Refinement steps of the normal equations' solution (see leastSquares).
 constexpr int kRefinementSteps = 2;
@@ -44,8 +44,7 @@ Eigen::VectorXd leastSquares(const Eigen::VectorXd& cost_gradient,
   const double ridge = kRelativeRidge * (largest > 0.0 ? largest : 1.0);
   for (int j = 0; j < m; ++j) normal.coeffRef(j, j) += ridge;
   // The set is in node order, so the normal matrix is banded (a column overlaps those within
-  // two nodes): factored in that order it does not fill beyond the band (O(m)); a fill-reducing
-  // ordering (AMD) made it superlinear (measured 0.1 ms at N = 48, 9.5 ms at N = 768).
+  // two nodes): factored in that order it does not fill beyond the band (O(m)); AMD fills it.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
       solver(normal);
   const Eigen::VectorXd rhs = G.transpose() * cost_gradient;
@@ -54,8 +53,7 @@ Eigen::VectorXd leastSquares(const Eigen::VectorXd& cost_gradient,
   // The normal equations square the condition of G (consecutive torque columns are second
   // differences: a long arc's smooth multiplier profile is poorly determined by them alone);
   // refinement on the residual of the least-squares problem itself recovers it (corrected
-  // semi-normal equations; measured on torque_limited at N = 256: residual 6.5e-3 → ~1e-6 of
-  // |∇f| = 67, as a dense QR).
+  // semi-normal equations: as accurate as a dense QR).
   for (int step = 0; step < kRefinementSteps; ++step) {
     const Eigen::VectorXd residual = cost_gradient - G * z;
     z += solver.solve(G.transpose() * residual);
@@ -71,9 +69,7 @@ Eigen::VectorXd leastSquares(const Eigen::VectorXd& cost_gradient,
 /// (the central slack: no binding column is pushed further off its bound, as the finer grid
 /// levels push one by InteriorPointParameters::warm_slack_push; a weakly active one, z ≈ 0, starts
 /// off the degenerate corner s = z = 0, from which Newton's steps on s z = μ only halve the gap),
-/// and an inactive one takes the central slack. Measured on sun_keep_out at N = 1024 (its one cone
-/// touched at one node, its neighbours near-active with small multipliers): 6 warm iterations where
-/// a cap of 1e-3 on the slack took 8, the first step's relative decrement 0.0016 instead of 0.4.
+/// and an inactive one takes the central slack.
 void centerPair(double value, bool active, double mu, double* s, double* z) {
   constexpr double kCentralSlack = kEstimateComplementarity;
   *s = active ? std::min(mu / std::max(*z, mu / kCentralSlack), kCentralSlack) : kCentralSlack;

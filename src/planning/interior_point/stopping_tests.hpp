@@ -123,9 +123,8 @@ class DecrementTest final : public ConvergenceCheck {
 };
 
 /// Free time: converged at μ_final where the Lagrangian's stationarity is within the tolerance
-/// (× max(1, (N/256)²): torques are second differences of the attitudes, so their round-off and
-/// the stationarity's floor grow like N²; measured 2e-10 at N = 512, above 1e-9 at 1024) and the
-/// duality gap Σ zc within the tolerance.
+/// × max(1, (N/256)²) (torques are second differences of the attitudes: their round-off grows
+/// like N²) and the duality gap Σ zc within the tolerance.
 class KktResidualTest final : public ConvergenceCheck {
  public:
   KktResidualTest(double tolerance, int steps);

@@ -322,45 +322,36 @@ struct StageTranscription {
   /// f(group, k, row) for every row: group by group, k rising (the order every sum is formed in).
   template <typename F>
   void forEach(F&& f) {
-    visit(*this, f);
+    visit(*this, 0, [&](Rows& g, int k, Row& row) {
+      f(g, k, row);
+      return true;
+    });
   }
   template <typename F>
   void forEach(F&& f) const {
-    visit(*this, f);
+    visit(*this, 0, [&](const Rows& g, int k, const Row& row) {
+      f(g, k, row);
+      return true;
+    });
   }
   /// f(group, k, row, c) with each row's value c at `at` (the row's c untouched).
   template <typename F>
   void forEachValue(const QuantityInputs& at, F&& f) {
-    visit(*this, [&](Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
+    forEach([&](Rows& g, int k, Row& row) { f(g, k, row, valueAt(g, at, k)); });
   }
   template <typename F>
   void forEachValue(const QuantityInputs& at, F&& f) const {
-    visit(*this, [&](const Rows& g, int k, auto& row) { f(g, k, row, valueAt(g, at, k)); });
+    forEach([&](const Rows& g, int k, const Row& row) { f(g, k, row, valueAt(g, at, k)); });
   }
-  /// f(group, k, row, c) with each row's value c at `at`, in forEach's order, until f returns
-  /// false: false then (the rows after it not evaluated), else true.
+  /// f(group, k, row) for the rows from the one at `index` in forEach's order on, until f returns
+  /// false: false then, else true.
   template <typename F>
-  bool everyValue(const QuantityInputs& at, F&& f) const {
-    for (const Rows& g : groups) {
-      for (int k = g.support.first_k; k <= g.support.last_k; ++k) {
-        if (!f(g, k, g.instance(k), valueAt(g, at, k))) return false;
-      }
-    }
-    return true;
+  bool forEachFrom(int index, F&& f) const {
+    return visit(*this, index, f);
   }
-  /// f(group, k, row, c) for the row at `index` in forEach's order (none where index is out of
-  /// range), its value c at `at`.
-  template <typename F>
-  void atRow(int index, const QuantityInputs& at, F&& f) const {
-    for (const Rows& g : groups) {
-      const int rows_in_group = g.support.last_k - g.support.first_k + 1;
-      if (index < rows_in_group) {
-        const int k = g.support.first_k + index;
-        f(g, k, g.instance(k), valueAt(g, at, k));
-        return;
-      }
-      index -= rows_in_group;
-    }
+  /// Row k's value c of group g at `at`.
+  static double valueAt(const Rows& g, const QuantityInputs& at, int k) {
+    return g.constraint->value(g.quantity->value(at, k));
   }
   /// Each row's value c at `at`, into the row.
   void evaluate(const QuantityInputs& at) {
@@ -478,14 +469,21 @@ struct StageTranscription {
   int count = 0;                         ///< rows in all
 
  private:
+  /// The one traversal: from the row at `index` in forEach's order, until f returns false.
   template <typename Self, typename F>
-  static void visit(Self& self, F&& f) {
+  static bool visit(Self& self, int index, F&& f) {
     for (auto& g : self.groups) {
-      for (int k = g.support.first_k; k <= g.support.last_k; ++k) f(g, k, g.instance(k));
+      const int rows_in_group = g.support.last_k - g.support.first_k + 1;
+      if (index >= rows_in_group) {
+        index -= rows_in_group;
+        continue;
+      }
+      for (int k = g.support.first_k + index; k <= g.support.last_k; ++k) {
+        if (!f(g, k, g.instance(k))) return false;
+      }
+      index = 0;
     }
-  }
-  static double valueAt(const Rows& g, const QuantityInputs& at, int k) {
-    return g.constraint->value(g.quantity->value(at, k));
+    return true;
   }
 };
 

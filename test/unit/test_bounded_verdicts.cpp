@@ -31,6 +31,7 @@
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/duration_bound.hpp"
+#include "planning/problem/solve_context.hpp"
 #include "planning/strategies/starts.hpp"
 #include "support/bounded_references.hpp"
 #include "support/bounded_requests.hpp"
@@ -483,6 +484,34 @@ TEST(BoundedVerdicts, TheLaddersRungsAreSolvedOnTheRequestsGridAlone) {
   ASSERT_NE(first_rung, on_grid_alone.end()) << r.message();
   EXPECT_NE(first_rung, on_grid_alone.begin()) << r.message();
   EXPECT_TRUE(std::all_of(first_rung, on_grid_alone.end(), [](bool b) { return b; }));
+}
+
+TEST(BoundedVerdicts, AMinimumTimeSolveGetsTheSameLadderWhoeverAsks) {
+  // The spinning study suite's request #188 (seed 45): below its second-order sufficient T* the
+  // near probes find nothing and the ladder's budget holds one rung only (probedBelow,
+  // ladderBudget). The same minimum-time problem is also asked after other solves of a request
+  // (a minimum-effort request's minimum-time phase, after its first solve failed: the check at
+  // 0.99 T*). Asked twice in one context, the second solve follows the first's iterations and
+  // must still take the same trail: the same attempts, iterations and T*, so the same ladder.
+  // (Where the budget was a share of the request's iterations, the second got a larger ladder.)
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 188);
+  ASSERT_TRUE(request);
+  SolveContext context{SolverOptions{}};
+  const PlanResult alone = planMinimumTime(request->problem, context);
+  ASSERT_TRUE(alone.converged()) << alone.message();
+  const std::size_t first_again = context.attempts().size();
+  const PlanResult again = planMinimumTime(request->problem, context);
+  EXPECT_EQ(again.minimum_duration, alone.minimum_duration) << again.message();
+  const std::vector<Attempt> trail_alone = context.attemptsFrom(0);
+  const std::vector<Attempt> trail_again = context.attemptsFrom(first_again);
+  ASSERT_EQ(trail_again.size(), first_again) << again.message();
+  for (std::size_t i = 0; i < first_again; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(trail_again[i].stage, trail_alone[i].stage);
+    EXPECT_EQ(trail_again[i].steps, trail_alone[i].steps);
+    EXPECT_EQ(trail_again[i].iterations, trail_alone[i].iterations);
+    EXPECT_EQ(trail_again[i].termination, trail_alone[i].termination);
+  }
 }
 
 TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {

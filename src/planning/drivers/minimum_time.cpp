@@ -274,12 +274,23 @@ struct ProbeSteps {
   }
 };
 
-/// The iterations the ladder may take in one run of the probes: kLadderShare of the request's
-/// iterations before them, so that a cheap request stays cheap (on the seed-45 spinning suite's
-/// 48 cheapest rows no probe 0.5-15 % below T* found a plan) and a request that cost much may
-/// spend in proportion on looking below its T*. A rung is asked only where the ladder's
+/// The iterations the ladder may take in one run of the probes: kLadderShare of the minimum-time
+/// solve's iterations before them, so that a cheap request stays cheap (on the seed-45 spinning
+/// suite's 48 cheapest rows no probe 0.5-15 % below T* found a plan) and a request that cost much
+/// may spend in proportion on looking below its T*. A rung is asked only where the ladder's
 /// iterations so far and the last probe's (the likely cost of the next) fit in it.
 constexpr double kLadderShare = 0.5;
+
+/// The ladder's budget for a run of the probes beginning now: kLadderShare of what `solve` (this
+/// minimum-time solve's tally, opened where minimumTimePlan began) has counted. Its own
+/// iterations, not the request's: what the budget bounds is the cost of this solve's verdict, and
+/// a caller's earlier solves are no part of it. Counted from the request, the same minimum-time
+/// problem got a larger ladder as a minimum-effort request's minimum-time phase (after the
+/// minimum-effort solve that failed) than asked alone: seed-45 spinning #188, 760 iterations
+/// against 556, so the check at 0.99 T* ran a rung the request never ran and refuted its T*.
+double ladderBudget(const SolveContext::IterationTally& solve) {
+  return kLadderShare * solve.iterations();
+}
 
 /// Whether the far probes look below `answer` once the near ones found nothing: only where it is
 /// not shown a local minimum (a KKT point that is not second-order sufficient, or a probe's plan,
@@ -439,14 +450,15 @@ PlanResult atMostLowestIterate(PlanResult answer, const LowestIterate& iterates,
 /// (iterateAsPlan) and the free-time solve goes on from it. Every such iterate is offered to
 /// `iterates`. No probe goes below the proven bound T_c on the grid. The trail keeps every probe
 /// (the context's from `first`, where `answer`'s began). Where `solves_left` is given, each probe
-/// takes one of its solves and none is asked once it is spent.
+/// takes one of its solves and none is asked once it is spent. `solve`: the minimum-time solve's
+/// iterations (ladderBudget).
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
-                       SolveContext& context, LowestIterate& iterates,
-                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans,
-                       int* solves_left = nullptr) {
+                       SolveContext& context, const SolveContext::IterationTally& solve,
+                       LowestIterate& iterates, std::optional<IterateBelow> lower_plan,
+                       bool iterates_are_plans, int* solves_left = nullptr) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
-  const double ladder_budget = kLadderShare * context.iterations();
+  const double ladder_budget = ladderBudget(solve);
   int ladder_spent = 0, last_probe = 0;
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
@@ -529,13 +541,14 @@ constexpr int kOtherChainsSolves = 2 * kMaxProbes;
 /// solve from `from` one of them). Every iterate of the run is in `from`'s chain.
 PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& answer,
                              const LowestIterate::Plan& from, std::size_t first,
-                             SolveContext& context, LowestIterate& iterates, int* solves_left) {
+                             SolveContext& context, const SolveContext::IterationTally& solve,
+                             LowestIterate& iterates, int* solves_left) {
   if (solves_left) --*solves_left;
   std::optional<IterateBelow> lower_plan;
   PlanResult run = lowerAnswer(problem, from.effort, answer, from.plan, from.attempt, first,
                                context, &lower_plan, iterates, from.root);
-  return probedBelow(problem, std::move(run), first, context, iterates, std::move(lower_plan), true,
-                     solves_left);
+  return probedBelow(problem, std::move(run), first, context, solve, iterates,
+                     std::move(lower_plan), true, solves_left);
 }
 
 /// The probes below T* from each other chain's lowest iterate below `answer`'s T (`others`,
@@ -547,13 +560,14 @@ PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& a
 PlanResult probedFromOtherChains(const PlanningProblem& problem, const PlanResult& answer,
                                  const std::vector<LowestIterate::Plan>& others, PlanResult best,
                                  std::size_t first, SolveContext& context,
+                                 const SolveContext::IterationTally& solve,
                                  LowestIterate& iterates) {
   std::optional<std::size_t> best_kept = context.keptAttempt();
   int solves_left = kOtherChainsSolves;
   for (const LowestIterate::Plan& from : others) {
     if (solves_left <= 0 || context.stopReason()) break;
     PlanResult run =
-        probedFromIterate(problem, answer, from, first, context, iterates, &solves_left);
+        probedFromIterate(problem, answer, from, first, context, solve, iterates, &solves_left);
     if (run.converged() && run.minimum_duration < best.minimum_duration) {
       best = std::move(run);
       best_kept = context.keptAttempt();
@@ -577,15 +591,18 @@ PlanResult probedFromOtherChains(const PlanningProblem& problem, const PlanResul
 /// held-out seed-47 suite from 25.19 s to 21.48 s.
 PlanResult probedBelowLowestIterate(const PlanningProblem& problem, PlanResult answer,
                                     std::size_t first, SolveContext& context,
+                                    const SolveContext::IterationTally& solve,
                                     LowestIterate& iterates) {
   const LowestIterate::Plan* found = iterates.below(answer.minimum_duration);
   if (!found || !answer.converged() || context.stopReason()) return answer;
   const LowestIterate::Plan lowest = *found;  // the solve from it offers lower ones
   const std::vector<LowestIterate::Plan> others =
       iterates.chainsBelow(answer.minimum_duration, lowest.root);
-  PlanResult best = probedFromIterate(problem, answer, lowest, first, context, iterates, nullptr);
+  PlanResult best =
+      probedFromIterate(problem, answer, lowest, first, context, solve, iterates, nullptr);
   best = atMostLowestIterate(std::move(best), iterates, first, context);
-  best = probedFromOtherChains(problem, answer, others, std::move(best), first, context, iterates);
+  best = probedFromOtherChains(problem, answer, others, std::move(best), first, context, solve,
+                               iterates);
   return atMostLowestIterate(std::move(best), iterates, first, context);
 }
 
@@ -605,11 +622,13 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
     return fourthOrderMinimumTime(problem, context, pair);
   }
   const std::size_t first = context.attempts().size();
+  const SolveContext::IterationTally solve(context);  // the ladder's budget (ladderBudget)
   LowestIterate iterates;
   PlanResult answer = structuredMinimumTime(problem, context, iterates);
   if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
-  answer = probedBelow(problem, std::move(answer), first, context, iterates, std::nullopt, false);
-  return probedBelowLowestIterate(problem, std::move(answer), first, context, iterates);
+  answer =
+      probedBelow(problem, std::move(answer), first, context, solve, iterates, std::nullopt, false);
+  return probedBelowLowestIterate(problem, std::move(answer), first, context, solve, iterates);
 }
 
 /// One start twist of a pointing request (`posed`: R_N at the start twist): the fixed-attitude

@@ -30,7 +30,7 @@ struct InteriorPointProfile {
   /// T) ...
   int max_halvings;
   /// ... and at the round-off floor (fixed h: where a 32× shortened step is no progress; free
-  /// time's KKT residual test names no floor, so its value there, max_halvings', is not read).
+  /// time: max_halvings' value, its floor's round-off steps are not tried at all).
   int floor_halvings;
   /// First shift of the inertia correction (IPOPT δ_w⁰): fixed h relative to each row's diagonal,
   /// a round-off nudge; free time relative to the mean |diagonal|, which the border's corner and
@@ -132,7 +132,8 @@ struct InteriorPointParameters {
   // --- line search -----------------------------------------------------------------------------
   /// Armijo's sufficient-decrease constant (IPOPT η_φ).
   double armijo = 1e-4;
-  /// A predicted merit decrease below this × |φ| is round-off: the step is taken.
+  /// A predicted merit decrease below this × |φ| is round-off: the step is taken (fixed h), or
+  /// searched, and not tried at the round-off floor (free time).
   double merit_round_off = 1e-14;
 
   // --- stopping test ---------------------------------------------------------------------------

@@ -113,12 +113,12 @@ std::optional<LoopEnd> KktResidualTest::beforeDirection(const BarrierState& s) {
 
 StopVerdict KktResidualTest::afterDirection(const BarrierState& s, const DirectionMeasures&) {
   StopVerdict v;
-  v.at_floor = !s.elastic && s.at_final_barrier && atRoundOffFloor(s.stationarity, s.gap);
+  v.at_floor = s.at_final_barrier && atRoundOffFloor(s);
   return v;
 }
 
 std::optional<LoopEnd> KktResidualTest::onRejected(const BarrierState& s, const StopVerdict&) {
-  if (s.elastic || !atRoundOffFloor(s.stationarity, s.gap)) return std::nullopt;
+  if (!atRoundOffFloor(s)) return std::nullopt;
   return LoopEnd{Termination::Converged, "converged to the round-off floor", std::nullopt};
 }
 

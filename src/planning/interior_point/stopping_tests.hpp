@@ -143,6 +143,10 @@ class KktResidualTest final : public ConvergenceCheck {
     return stationarity <= kRoundOffFloor * stationarity_tolerance_ &&
            gap <= kRoundOffFloor * tolerance_;
   }
+  /// The iterate at the round-off floor: outside the elastic start, both residuals there.
+  bool atRoundOffFloor(const BarrierState& s) const {
+    return !s.elastic && atRoundOffFloor(s.stationarity, s.gap);
+  }
 
  private:
   static constexpr double kRoundOffFloor = 100.0;

@@ -374,18 +374,21 @@ bool listed(const std::vector<HomotopyClass>& classes, const HomotopyClass& c) {
 }
 
 /// Under torque or rate bounds, the best coarse plan's class `c` on the requested grid: from its
-/// unconstrained optimum where it is another class (the first class's solve from its optimum is
-/// the one that failed), then, where that gives no plan, from its coarse plan under the bounds,
-/// resampled: a continuation of a plan that holds them, which the unconstrained optimum, outside
-/// them, is not. A cold start's "infeasible" near the least duration is local: measured on the
-/// held-out seed-47 spinning suite's #45, the probe 1 % below T* = 1.781 s ended "infeasible" on
-/// N = 64 with the class's plan under the bounds on N = 16 in hand (whether it did flipped with an
-/// ulp of the probe's T); from that plan it converges, and T* falls to 1.4998 s.
+/// coarse plan under the bounds, resampled (a continuation of a plan that holds them, which the
+/// unconstrained optimum, outside them, is not), then, where that gives no plan and `c` is another
+/// class than the first, from its unconstrained optimum (the first class's solve from its optimum
+/// is the one that failed). A cold start's "infeasible" near the least duration is local: measured
+/// on the held-out seed-47 spinning suite's #45, the probe 1 % below T* = 1.781 s ended
+/// "infeasible" on N = 64 with the class's plan under the bounds on N = 16 in hand (whether it did
+/// flipped with an ulp of the probe's T); from that plan it converges, and T* falls to 1.4998 s.
+/// The coarse plan comes first because the cold start near the least duration runs to its limits
+/// before it (docs/results/near_minimum_time_cones.md's 240 requests at 1.05 T*: 8 answers sooner,
+/// 16,542 -> 14,520 iterations, every cost the same).
 void carryUnderBounds(ClassSearch& search, const HomotopyClass& c, const Maneuver& coarse_plan,
                       const HomotopyClass& first_class, int steps) {
-  if (!sameHomotopyClass(c, first_class)) search.offer(c, search.solve(c, steps));
-  if (search.holdsAPlan() || search.stopped()) return;
   search.offer(c, search.solve(c, steps, ClassStart{nullptr, &coarse_plan}));
+  if (search.holdsAPlan() || search.stopped() || sameHomotopyClass(c, first_class)) return;
+  search.offer(c, search.solve(c, steps));
 }
 
 /// Where the first class ended without a plan on the requested grid: every surveyed class under
@@ -394,9 +397,9 @@ void carryUnderBounds(ClassSearch& search, const HomotopyClass& c, const Maneuve
 /// cost, each from its own coarse plan (a class's plan on a coarse grid says which side of each
 /// cone it passes, which its unconstrained optimum does not: the first class's solve from that
 /// optimum is the one that failed), until one converges within the constraints between the nodes
-/// too. Under torque or rate bounds, the best coarse plan's class alone, if it is another class,
-/// solved from its unconstrained optimum (each further solve there runs to its limit near the
-/// least duration), and where that gives no plan, from its coarse plan (carryUnderBounds). On the
+/// too. Under torque or rate bounds, the best coarse plan's class alone (each further solve there
+/// runs to its limit near the least duration): from its coarse plan, and where that gives no plan
+/// and it is another class, from its unconstrained optimum (carryUnderBounds). On the
 /// requested grid already (no coarser survey), each class's solve is its answer. Returns the
 /// classes solved on the requested grid.
 std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const SurveyedClasses& surveyed,

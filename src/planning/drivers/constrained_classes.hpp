@@ -7,16 +7,16 @@
 // classes the survey solved are solved under the constraints on the survey grid and carried to
 // the requested grid: with cones only, in order of their cost there, each from its own coarse
 // plan, until one holds the constraints between the nodes too; under torque or rate bounds, the
-// best coarse plan's class alone, from its unconstrained optimum where it is another class, then
-// from its coarse plan under the bounds (carryUnderBounds). Once a plan is in hand, every other
-// class whose unconstrained optimum on the requested grid costs less than it is solved under the
-// constraints too, the cheaper plan kept: the constraints only add to a class's cost from its own
-// optimum. (That bound holds in the class's basin, not globally: a class is a lift of the rotation,
-// and lifts two turns apart are one homotopy class on SO(3), whose loops are Z₂, so the interior
-// point can slide from one to the other.) A class whose survey cost is beyond the survey's refine
-// margin of the first class's, raised as much as the constraints raised the first's, is not solved.
-// The first-plan check and the other classes' solves are for requests whose constraints are all
-// cones; under torque or rate bounds a converged first class answers.
+// best coarse plan's class alone, from its coarse plan under the bounds, then from its
+// unconstrained optimum where it is another class (carryUnderBounds). Once a plan is in hand, every
+// other class whose unconstrained optimum on the requested grid costs less than it is solved under
+// the constraints too, the cheaper plan kept: the constraints only add to a class's cost from its
+// own optimum. (That bound holds in the class's basin, not globally: a class is a lift of the
+// rotation, and lifts two turns apart are one homotopy class on SO(3), whose loops are Z₂, so the
+// interior point can slide from one to the other.) A class whose survey cost is beyond the survey's
+// refine margin of the first class's, raised as much as the constraints raised the first's, is not
+// solved. The first-plan check and the other classes' solves are for requests whose constraints are
+// all cones; under torque or rate bounds a converged first class answers.
 #pragma once
 
 #include <vector>

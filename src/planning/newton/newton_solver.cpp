@@ -229,7 +229,7 @@ Refined refineClass(const Surveyed& s, const SurveyPlan& plan, SolveContext& con
 /// the other thread, which wakes later (40-90 us on the loaded 2-core machine), takes the pieces
 /// in turn, the calling thread those left when its replay ends. The two cost the same (seed
 /// request: 0.85 M instructions each), so the request waits about half a wake less.
-constexpr int kStepwisePieces = 4;
+constexpr int kStepwisePieces = 8;
 
 /// The refined plan's deferred check beside its open-loop replay (replayFigures, what
 /// planAtResolution measures for the plan it returns), in branches of `context`: most requests

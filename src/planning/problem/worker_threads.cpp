@@ -15,6 +15,7 @@ WorkerThreads& WorkerThreads::shared() {
 void WorkerThreads::handOver(HandedWork& work) {
   std::unique_lock<std::mutex> lock(mutex_);
   work.state_ = HandedWork::State::Queued;
+  work.finished_ = false;
   work.queued_at_ = queue_.insert(queue_.end(), &work);
   if (static_cast<int>(queue_.size()) <= waiting_) {
     // Woken after the lock is released: a thread woken under it would find it held and wait
@@ -38,6 +39,12 @@ bool WorkerThreads::takeBackOrWait(HandedWork& work) {
     work.state_ = HandedWork::State::Done;
     return false;
   }
+  if (work.state_ != HandedWork::State::Done) {
+    lock.unlock();
+    const auto until = std::chrono::steady_clock::now() + kCallerStaysAwake;
+    while (!work.finished_ && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+    lock.lock();
+  }
   ended_.wait(lock, [&] { return work.state_ == HandedWork::State::Done; });
   return true;
 }
@@ -58,6 +65,7 @@ void WorkerThreads::serve() {
     lock.lock();
     // The caller may destroy `work` as soon as it reads Done: it is not touched after this.
     work.state_ = HandedWork::State::Done;
+    work.finished_ = true;
     // The waiting caller is woken with the lock released, as in handOver.
     lock.unlock();
     ended_.notify_all();

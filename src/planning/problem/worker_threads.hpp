@@ -2,9 +2,13 @@
 // A thread started per call costs its start, and its caller's join waits until it has run, which
 // on a loaded machine can be a scheduler tick away; a kept thread only wakes. A work handed over
 // that no thread has taken yet can be taken back and run by the caller, so a caller never waits
-// for a thread to start.
+// for a thread to start. A caller waiting for a work that runs stays awake a while first
+// (kCallerStaysAwake): the caller is on the request's critical path, and a thread asleep that a
+// work's end wakes resumed 75-110 us later on the 2-core machine (session 64).
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <list>
@@ -27,6 +31,7 @@ class HandedWork {
   enum class State { Queued, Running, Done };
   std::function<void()> run_;  ///< must not throw
   State state_ = State::Queued;
+  std::atomic<bool> finished_{false};  ///< state_ is Done: read without the lock by a caller awake
   std::list<HandedWork*>::iterator queued_at_;  ///< while Queued
 };
 
@@ -46,6 +51,9 @@ class WorkerThreads {
   bool takeBackOrWait(HandedWork& work);
 
  private:
+  /// How long a caller waiting for a work that runs stays awake (yielding) before it sleeps.
+  static constexpr std::chrono::microseconds kCallerStaysAwake{150};
+
   WorkerThreads() = default;
   /// A worker thread's life: runs queued works, waits while none is queued.
   void serve();

@@ -505,8 +505,8 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
 }
 
 bool checkDeferredPlan(const PlanningProblem& problem, const StepResidual& residual,
-                       PlanResult* plan) {
-  const std::string inconsistent = planInconsistency(problem, *plan, false, &residual);
+                       PlanResult* plan, const StepwiseReplay* stepwise) {
+  const std::string inconsistent = planInconsistency(problem, *plan, false, &residual, stepwise);
   if (inconsistent.empty()) return true;
   // solveOnGrid's result begins with its Newton end (finished: the verdict, then the level's
   // summary in those words); the continuation's notes come after it.

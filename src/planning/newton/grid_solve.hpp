@@ -47,8 +47,9 @@ PlanResult solveOnGrid(const PlanningProblem& problem, SolveContext& context,
 /// The check solveOnGrid deferred (GridSettings::deferred_check) of its converged `plan` (a grid
 /// continuation's finest level, its notes added after): true if it passes; else the plan becomes
 /// what solveOnGrid returns for a plan that fails its check (not converged, the check's words as
-/// how its Newton solve and its level ended).
+/// how its Newton solve and its level ended). `stepwise`: the plan's stepwise replay if measured
+/// already (planInconsistency).
 bool checkDeferredPlan(const PlanningProblem& problem, const StepResidual& residual,
-                       PlanResult* plan);
+                       PlanResult* plan, const StepwiseReplay* stepwise = nullptr);
 
 }  // namespace attitude_planner

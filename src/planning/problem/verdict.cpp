@@ -104,7 +104,8 @@ StepResidual measureStepResidual(const PlanningProblem& problem, const Maneuver&
 }
 
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
-                              bool constraints, const StepResidual* measured) {
+                              bool constraints, const StepResidual* measured,
+                              const StepwiseReplay* replayed) {
   std::ostringstream why;
   const StepResidual residual =
       measured ? *measured : measureStepResidual(problem, result.maneuver);
@@ -116,7 +117,7 @@ std::string planInconsistency(const PlanningProblem& problem, const PlanResult& 
   }
   // A plan can meet its equations with a step on another root of the step's momentum map (past
   // a fold): not the motion the scheme's own step integrates from the plan's state.
-  const StepwiseReplay stepwise = replayStepByStep(problem, result.maneuver);
+  const StepwiseReplay stepwise = replayed ? *replayed : replayStepByStep(problem, result.maneuver);
   if (!stepwise.reproduces()) {
     why << "stationary point found, but its step k = " << stepwise.worst_step
         << " is not the step the replay solves from the plan's own state (";
@@ -149,22 +150,37 @@ bool provesFeasible(const PlanningProblem& problem, const PlanResult& r) {
 }
 
 StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan) {
-  const int N = plan.steps();
+  std::vector<double> apart(plan.steps());
+  stepReplayAngles(problem, plan, 0, plan.steps(), &apart);
+  return worstStepReplay(apart);
+}
+
+void stepReplayAngles(const PlanningProblem& problem, const Maneuver& plan, int first, int last,
+                      std::vector<double>* apart) {
   const DiscreteScheme scheme(problem.scheme, problem.inertia, plan.time_step);
-  StepwiseReplay out;
   // The open-loop replay's warm start for step k is its step k − 1 (F_0: exp(hΩ_0)).
-  Matrix3 guess = so3::exp(Vector3(plan.time_step * problem.initial_velocity));
-  for (int k = 0; k < N; ++k) {
-    const Matrix3 planned = plan.attitude[k].transpose() * plan.attitude[k + 1];
+  const auto plannedStep = [&](int k) {
+    return Matrix3(plan.attitude[k].transpose() * plan.attitude[k + 1]);
+  };
+  Matrix3 guess = first == 0 ? so3::exp(Vector3(plan.time_step * problem.initial_velocity))
+                             : plannedStep(first - 1);
+  for (int k = first; k < last; ++k) {
+    const Matrix3 planned = plannedStep(k);
     StepSolveReport report;
     const Matrix3 F = scheme.solveStep(carriedMomentum(problem, scheme, plan, k), guess, &report);
-    const double apart =
+    (*apart)[k] =
         report.converged ? so3::angleBetween(F, planned) : std::numeric_limits<double>::infinity();
-    if (!(apart <= out.worst_angle)) {
-      out.worst_angle = apart;
+    guess = planned;
+  }
+}
+
+StepwiseReplay worstStepReplay(const std::vector<double>& apart) {
+  StepwiseReplay out;
+  for (int k = 0; k < static_cast<int>(apart.size()); ++k) {
+    if (!(apart[k] <= out.worst_angle)) {
+      out.worst_angle = apart[k];
       out.worst_step = k;
     }
-    guess = planned;
   }
   return out;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "attitude_planner/planning/problem.hpp"
 #include "attitude_planner/planning/result.hpp"
@@ -33,6 +34,8 @@ void replayFigures(const PlanningProblem& problem, PlanResult* result, Maneuver*
 /// active_constraints): one place for every plan that is answered.
 void recordConstraintFigures(const PlanningProblem& problem, PlanResult* result);
 
+struct StepwiseReplay;
+
 /// The one convergence rule beside first-order optimality (which each solver tests on its own
 /// iterate): the plan satisfies the discrete equations of motion step by step
 /// (measureStepResidual within its tolerance), each of its steps is the one the scheme's own
@@ -41,8 +44,11 @@ void recordConstraintFigures(const PlanningProblem& problem, PlanResult* result)
 /// (ConstraintCheck::max_relative_violation ≤ kNodeConstraintTolerance). Returns why not, or "" if
 /// it does. The open-loop replay (replay_miss) is not part of it. `measured`: the plan's step
 /// residual if evaluatePlan measured it already (measureStepResidual of the same plan).
+/// `stepwise`: the plan's stepwise replay if measured already (replayStepByStep of the same plan,
+/// e.g. joined from pieces measured at once: stepReplayAngles, worstStepReplay).
 std::string planInconsistency(const PlanningProblem& problem, const PlanResult& result,
-                              bool constraints, const StepResidual* measured = nullptr);
+                              bool constraints, const StepResidual* measured = nullptr,
+                              const StepwiseReplay* stepwise = nullptr);
 
 /// Whether `r` holds a plan at the problem's T within every bound: the one judgement of "a plan
 /// at T exists" (a stopped solve that answers the interior point's formulation retry, the
@@ -78,6 +84,13 @@ struct StepwiseReplay {
   bool reproduces() const { return worst_angle <= 1e-6; }
 };
 StepwiseReplay replayStepByStep(const PlanningProblem& problem, const Maneuver& plan);
+/// replayStepByStep's angle at each step k in [first, last) into (*apart)[k] (sized N): each
+/// step's solve starts from the plan alone, so pieces of the plan may be measured apart (at
+/// once, on other threads) and folded by worstStepReplay to replayStepByStep's result.
+void stepReplayAngles(const PlanningProblem& problem, const Maneuver& plan, int first, int last,
+                      std::vector<double>* apart);
+/// The worst of the steps' angles, the first of equals, as replayStepByStep folds them.
+StepwiseReplay worstStepReplay(const std::vector<double>& apart);
 
 /// The open-loop replay of the plan's torques found no implicit step (`what`). An iterate that
 /// is no answer (infeasible, stopped) keeps its verdict, the failure said after it. A converged

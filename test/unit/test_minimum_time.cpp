@@ -191,8 +191,8 @@ TEST(MinimumTime, ARefinedAnswerNamesTheCoarseStartItDescendsFrom) {
 }
 
 TEST(MinimumTime, AroundAConeTheExcursionStartsCarryTheirSkewedPeak) {
-  // scenes/min_time_keep_out.yaml (N = 64): with a cone the excursions (0.8 rad, both signs of
-  // each axis) have their bumps skewed in time, peaking at s = 0.4 (minimum_time_starts.cpp).
+  // scenes/min_time_keep_out.yaml (N = 64): with a cone the excursions (0.8 rad, about four
+  // directions round the eigenaxis) have their bumps skewed in time, peaking at s = 0.4 (minimum_time_starts.cpp).
   // Each of those free-time solves carries it in start_detail.excursion_peak (the data, not the
   // start's name); the eigenaxis start, which has no bump, keeps ½.
   const ap::PlanningProblem p =
@@ -212,7 +212,9 @@ TEST(MinimumTime, AroundAConeTheExcursionStartsCarryTheirSkewedPeak) {
       EXPECT_DOUBLE_EQ(a.start_detail.excursion_peak, 0.5);
     }
   }
-  EXPECT_GE(excursions, 4) << r.message();  // body x and y off the eigenaxis (z), both signs
+  // Four directions round the eigenaxis (z): body x, y and their negatives, one of which clears to
+  // an earlier one's plan and takes its outcome (no solve of its own).
+  EXPECT_GE(excursions, 3) << r.message();
 }
 
 TEST(MinimumTime, BilimoriaWieSlewNutatesBelowTheEigenaxisTime) {

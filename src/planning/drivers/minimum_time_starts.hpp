@@ -53,7 +53,8 @@ struct FreeTimeStart {
 std::vector<Vector3> excursionAxes(const Vector3& e);
 
 /// The structured starts: rest to rest, the eigenaxis bang–bang slew at its closed-form T and
-/// excursions off it (excursionAxes); otherwise the reduced problem's own start at the eigenaxis
+/// excursions off it (excursionAxes; with cones larger ones about directions evenly spaced round
+/// the eigenaxis, coneExcursionAxes, and the slew turned round the cone on each side); otherwise the reduced problem's own start at the eigenaxis
 /// guess, and the unconstrained optima of its classes, solved in `context` (the request's: its
 /// budget, cancel flag and iteration numbering).
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,

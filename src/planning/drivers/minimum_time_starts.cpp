@@ -305,6 +305,8 @@ std::vector<Vector3> excursionAxes(const Vector3& e) {
   return distinct;
 }
 
+namespace {
+
 /// kConeExcursionDirections directions evenly spaced in the plane perpendicular to the eigenaxis
 /// `e`, from the body axis whose part perpendicular to it is longest: body-fixed, so the same in
 /// every world frame, and the same set whatever the body axes' labels or signs.
@@ -323,6 +325,8 @@ std::vector<Vector3> coneExcursionAxes(const Vector3& e) {
   }
   return axes;
 }
+
+}  // namespace
 
 std::vector<FreeTimeStart> freeTimeStarts(const PlanningProblem& problem, bool rest_to_rest,
                                           SolveContext& context) {

@@ -61,11 +61,12 @@ constexpr double kSmallestProjection = 0.3;
 constexpr double kSameAxis = 0.99;
 /// With cones the excursions' directions: this many evenly spaced about the eigenaxis
 /// (coneExcursionAxes), with the eigenaxis slew turned round the cone on each side
-/// (coneSideStarts). Measured (docs/results/minimum_time_cone_sides.md, "Session 64"): on 380
-/// seeded cone requests 4 to 12 evenly spaced directions kept every T* of the up to 18 directions
-/// of excursionAxes and their negatives but one (8181 #4, +1.09 %: a basin narrower than 30
-/// degrees in direction, between two of the directions); with the two sides too every T* was
-/// kept, on those and on 160 requests of seeds never looked at before, at 0.62x the iterations.
+/// (coneSideStarts). Measured (docs/results/minimum_time_cone_sides.md, fewer excursion
+/// directions): on 380 seeded cone requests 4 to 12 evenly spaced directions kept every T* of the
+/// up to 18 directions of excursionAxes and their negatives but one (8181 #4, +1.09 %: a basin
+/// narrower than 30 degrees in direction, between two of the directions); with the two sides too
+/// every T* was kept, on those and on 160 requests of seeds never looked at before, at 0.62x the
+/// iterations.
 constexpr int kConeExcursionDirections = 4;
 /// With cones the excursions' bumps peak at these s = t/T (skewedExcursionSlew): skewed in time.
 /// A symmetric start meets the time-symmetric KKT points (saddles on second_order, poorer local

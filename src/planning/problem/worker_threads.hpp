@@ -2,7 +2,7 @@
 // A thread started per call costs its start, and its caller's join waits until it has run, which
 // on a loaded machine can be a scheduler tick away; a kept thread only wakes. A work handed over
 // that no thread has taken yet can be taken back and run by the caller, so a caller never waits
-// for a thread to start. Waking a thread asleep is slow on the 2-core machine (session 64: the
+// for a thread to start. Waking a thread asleep is slow on the 2-core machine (measured: the
 // waker's notify 30-45 us, the woken thread running 75-110 us later), so a caller waiting for a
 // work that runs stays awake a while first (kCallerStaysAwake: it is on the request's critical
 // path), and so does a thread that ended a work (kThreadStaysAwake: a request's works come in

@@ -85,11 +85,6 @@ def route_summary(rows, cone, slow_only):
         1e3 * statistics.median(secs), 1e3 * statistics.median(m_secs), against_default(r))
 
 
-def quantile(values, q):
-    values = sorted(values)
-    return values[min(len(values) - 1, max(0, int(np.ceil(q * len(values))) - 1))]
-
-
 def summary(rows, cone):
     r = [x for x in rows if x["cone"] == cone and "iterations" in x]
     its = [x["iterations"] for x in r]
@@ -98,7 +93,7 @@ def summary(rows, cone):
     slower = sum(1 for x in r if x["effort_s"] > x["time_s"])
     return ("| %s | %d | %d | %d / %d / %d | %.1f / %.0f | %d | %d | %d |" % (
         "yes" if cone else "no", len(r), sum(1 for x in r if x["converged"]),
-        statistics.median(its), quantile(its, 0.9), max(its), 1e3 * statistics.median(secs),
+        statistics.median(its), mtc.quantile(its, 0.9), max(its), 1e3 * statistics.median(secs),
         1e3 * max(secs), sum(1 for i in its if i > SLOW), via_time, slower))
 
 

@@ -263,18 +263,24 @@ class BarrierRowBlock {
   /// outside its row's domain: the merit there is +∞), the rows after it not evaluated.
   /// `outside` (optional): the index of a row found outside before, tested first (the trials of
   /// one line search mostly fail at one row), and where a row is found outside now, its index.
+  /// `values` (optional): each row's value at `at`, as `terms`.
   bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, bool check_boundary,
-                       std::vector<double>* terms, int* outside = nullptr) const {
+                       std::vector<double>* terms, int* outside = nullptr,
+                       std::vector<double>* values = nullptr) const {
+    double value = 0.0;  // the last row's value at `at`
     const auto term = [&](const Rows& g, int k, const Row& in) {
-      return form(g).rowMerit(in, rows.valueAt(g, at, k), mu, rho, 0.0, check_boundary);
+      value = rows.valueAt(g, at, k);
+      return form(g).rowMerit(in, value, mu, rho, 0.0, check_boundary);
     };
     constexpr double kOutside = std::numeric_limits<double>::infinity();
     const int hint = outside ? *outside : -1;
-    double hinted = 0.0;
+    double hinted = 0.0, hinted_value = 0.0;
     terms->clear();
+    if (values) values->clear();
     if (hint >= 0) {
       rows.forEachFrom(hint, [&](const Rows& g, int k, const Row& in) {
         hinted = term(g, k, in);
+        hinted_value = value;
         return false;
       });
       if (hinted == kOutside) return false;
@@ -282,6 +288,7 @@ class BarrierRowBlock {
     return rows.forEachFrom(0, [&](const Rows& g, int k, const Row& in) {
       const int index = static_cast<int>(terms->size());
       terms->push_back(index == hint ? hinted : term(g, k, in));
+      if (values) values->push_back(index == hint ? hinted_value : value);
       if (terms->back() != kOutside) return true;
       if (outside) *outside = index;
       return false;
@@ -409,7 +416,7 @@ class BarrierRowBlock {
       rows.chainTorques(st, root, G, fold);
       if (sink && choices.sum_in_double) {
         Block H = step.second(st);
-        H.noalias() += G.transpose() * W * G;
+        H.noalias() += (G.transpose() * W).lazyProduct(G);
         sink->addBlock(st.k - 1, 3, H, &local_gradient);
       } else if (sink) {
         for (int a = 0; a < 3; ++a) sink->addRankOne(st.k - 1, 3, G.row(a).transpose(), W(a, a));

@@ -93,13 +93,15 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// branch. Most trials are rejected at a row: the cost and the rows after it are left.
   double merit(double mu, double epsilon, bool trial) {
     const QuantityInputs at(np_, np_.current());
-    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_)) {
+    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_,
+                                trial ? &trial_values_ : nullptr)) {
       return std::numeric_limits<double>::infinity();
     }
     if (trial && !np_.onPrincipalBranch(np_.current())) {
       return std::numeric_limits<double>::infinity();
     }
-    const double cost = np_.scheme().cost(np_.torques(np_.current()));
+    trial_values_at_iterate_ = trial;
+    const double cost = np_.scheme().cost(at.torques());
     return BarrierRowBlock<FreeTimeStep>::merit(objective_.value(np_.timeStep(), cost, epsilon),
                                                 row_terms_);
   }
@@ -173,6 +175,11 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
   std::vector<double> row_terms_;  ///< the rows' merit terms at the iterate (merit)
+  /// The rows' values at the last trial whose merit was formed; they are the iterate's while
+  /// trial_values_at_iterate_ (the iterate has not moved since), so an accepted trial's rows are
+  /// not evaluated again.
+  std::vector<double> trial_values_;
+  bool trial_values_at_iterate_ = false;
   int row_outside_ = -1;  ///< the row a merit last found outside its domain (rowMeritsInside)
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
   /// changes φ_μ): the next pass lowers μ.
@@ -226,6 +233,7 @@ void FreeTimeSolver::restoreAcceptedEnd() {
 }
 
 void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
+  trial_values_at_iterate_ = false;
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
   np_.setCurrent(accepted_.steps);
@@ -257,6 +265,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
 }
 
 void FreeTimeSolver::restore() {
+  trial_values_at_iterate_ = false;
   restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h);
   np_.setCurrent(accepted_.steps);
@@ -406,7 +415,11 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
   block_.applyDualStep(dualStep());
   leaveElasticIfInside();
-  block_.evaluate(np_.current());
+  if (trial_values_at_iterate_) {
+    block_.rows.assignValues(trial_values_);
+  } else {
+    block_.evaluate(np_.current());
+  }
   block_.afterAccept(mu_);
   report(result.alpha, stationarity_);
   return Pass::Continue;

@@ -5,8 +5,11 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/SVD>
+
 #include "attitude_planner/dynamics/simulation.hpp"
 #include "attitude_planner/errors.hpp"
+#include "dynamics/principal_branch.hpp"
 #include "support/robustness_cases.hpp"
 
 using namespace attitude_planner;
@@ -113,6 +116,41 @@ TEST(Integrators, MomentumJacobianMatchesFiniteDifferences) {
       }
     }
   }
+}
+
+TEST(Integrators, StepsShorterThanThePrincipalBranchRadiusAreOnTheBranchWithMargin) {
+  // principalBranchRadius's bound, against the momentum Jacobian itself: random inertias
+  // (random principal axes, condition numbers up to the limit, bodies that violate the triangle
+  // inequality too) and random steps shorter than the radius have σ_min(h ∂μ/∂ε) ≥ λ_min(J)/2.
+  std::mt19937 rng(6565);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double h = 0.3;
+  for (int body = 0; body < 60; ++body) {
+    const double spread = std::pow(kPrincipalBranchConditionLimit, u(rng));
+    const Vector3 moments(1.0, 1.0 + (spread - 1.0) * u(rng), spread);
+    const Matrix3 axes = so3::exp(Vector3(n(rng), n(rng), n(rng)));
+    const Matrix3 J = axes * moments.asDiagonal() * axes.transpose();
+    for (SchemeKind kind : {SchemeKind::Paper, SchemeKind::Variational, SchemeKind::SecondOrder}) {
+      const DiscreteScheme scheme(kind, J, h);
+      const double radius = principalBranchRadius(scheme);
+      ASSERT_GT(radius, 0.0) << schemeName(kind);
+      for (int step = 0; step < 40; ++step) {
+        const Vector3 omega = u(rng) * radius * Vector3(n(rng), n(rng), n(rng)).normalized();
+        const Matrix3 D = h * scheme.momentumJacobianOfStep(so3::exp(omega), omega);
+        const double least = Eigen::JacobiSVD<Matrix3>(D).singularValues()(2);
+        EXPECT_GE(least, 0.5 * moments.minCoeff() * (1 - 1e-12)) << schemeName(kind);
+        EXPECT_TRUE(scheme.onPrincipalBranch(omega)) << schemeName(kind);
+      }
+    }
+  }
+  // Isotropic: the radius lies inside the branch (the fold at π/2), and a body past the
+  // condition limit gets none.
+  const DiscreteScheme isotropic(SchemeKind::SecondOrder, 2.0 * Matrix3::Identity(), h);
+  EXPECT_GT(principalBranchRadius(isotropic), 0.2);
+  EXPECT_LT(principalBranchRadius(isotropic), M_PI / 2);
+  const Matrix3 slender = Vector3(1.0, 2e3, 2e3).asDiagonal();
+  EXPECT_EQ(principalBranchRadius(DiscreteScheme(SchemeKind::Paper, slender, h)), 0.0);
 }
 
 TEST(Integrators, PrincipalBranchEndsAtTheFoldOfTheMomentum) {

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "attitude_planner/errors.hpp"
+#include "dynamics/principal_branch.hpp"
 #include "lie/skew_products.hpp"
 
 namespace attitude_planner {
@@ -349,8 +350,10 @@ std::vector<Vector3> ReducedProblem::torques(const StepVectors& steps) const {
 }
 
 bool ReducedProblem::onPrincipalBranch(const StepVectors& steps) const {
-  return std::all_of(steps.begin(), steps.end(),
-                     [&](const Vector3& omega) { return scheme_.onPrincipalBranch(omega); });
+  const double proven = principalBranchRadius(scheme_);  // steps shorter need no test
+  return std::all_of(steps.begin(), steps.end(), [&](const Vector3& omega) {
+    return omega.norm() < proven || scheme_.onPrincipalBranch(omega);
+  });
 }
 
 Maneuver ReducedProblem::maneuver(const StepVectors& steps) const {

@@ -67,6 +67,7 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
     if (!elastic) return;
     elastic_ = started_elastic_ = true;
     rho_ = p_.free_time.initial_penalty;
+    least_time_step_ = discreteDurationLowerBound(problem_) / N_;  // 0: no bound applies
   }
   FreeTimeOutcome run(double tolerance, int max_iterations, SolveContext& context,
                       const BarrierWatch& watch) override;
@@ -193,6 +194,7 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   // An elastic start (beginAt): until the iterate is strictly inside every constraint that moves
   // with h, those constraints' rows are ℓ1-elastic with the penalty ρ.
   bool elastic_ = false, started_elastic_ = false;
+  double least_time_step_ = 0.0;  ///< the proven least duration over N (0: no bound applies)
   const ElasticBarrier elastic_barrier_;
   const StartBarrier start_barrier_;
   const FreeTimeScale scale_;  ///< the objective's T₀ and C₀ (unset: the start's own)
@@ -250,7 +252,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
   // An elastic iterate is no plan and can trade violation for a T below every plan's: while
   // elastic, h keeps the fraction to the boundary of the proven least duration.
   if (elastic_ && h < accepted_.h) {
-    const double floor = discreteDurationLowerBound(problem_) / N_;  // 0: no bound applies
+    const double floor = least_time_step_;
     if (floor > 0 && h - floor < (1.0 - p_.fraction_to_boundary) * (accepted_.h - floor)) {
       return std::numeric_limits<double>::infinity();
     }

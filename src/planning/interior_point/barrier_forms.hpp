@@ -263,24 +263,18 @@ class BarrierRowBlock {
   /// outside its row's domain: the merit there is +∞), the rows after it not evaluated.
   /// `outside` (optional): the index of a row found outside before, tested first (the trials of
   /// one line search mostly fail at one row), and where a row is found outside now, its index.
-  /// `values` (optional): each row's value at `at`, as `terms`.
   bool rowMeritsInside(const QuantityInputs& at, double mu, double rho, bool check_boundary,
-                       std::vector<double>* terms, int* outside = nullptr,
-                       std::vector<double>* values = nullptr) const {
-    double value = 0.0;  // the last row's value at `at`
+                       std::vector<double>* terms, int* outside = nullptr) const {
     const auto term = [&](const Rows& g, int k, const Row& in) {
-      value = rows.valueAt(g, at, k);
-      return form(g).rowMerit(in, value, mu, rho, 0.0, check_boundary);
+      return form(g).rowMerit(in, rows.valueAt(g, at, k), mu, rho, 0.0, check_boundary);
     };
     constexpr double kOutside = std::numeric_limits<double>::infinity();
     const int hint = outside ? *outside : -1;
-    double hinted = 0.0, hinted_value = 0.0;
+    double hinted = 0.0;
     terms->clear();
-    if (values) values->clear();
     if (hint >= 0) {
       rows.forEachFrom(hint, [&](const Rows& g, int k, const Row& in) {
         hinted = term(g, k, in);
-        hinted_value = value;
         return false;
       });
       if (hinted == kOutside) return false;
@@ -288,7 +282,6 @@ class BarrierRowBlock {
     return rows.forEachFrom(0, [&](const Rows& g, int k, const Row& in) {
       const int index = static_cast<int>(terms->size());
       terms->push_back(index == hint ? hinted : term(g, k, in));
-      if (values) values->push_back(index == hint ? hinted_value : value);
       if (terms->back() != kOutside) return true;
       if (outside) *outside = index;
       return false;

@@ -58,9 +58,7 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   }
 
   double smallestValue(bool moves_with_h) const override {
-    return block_.rows.smallestValue(
-        QuantityInputs(np_, np_.current()),
-        [&](const FreeTimeRows& g) { return g.quantity->dependsOnTimeStep() == moves_with_h; });
+    return smallestValue(QuantityInputs(np_, np_.current()), moves_with_h);
   }
   void beginAt(bool elastic) override {
     h0_ = np_.timeStep();
@@ -86,6 +84,15 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
     if (elasticRows(g)) return elastic_form_;
     return feasible_;
   }
+  double smallestValue(const QuantityInputs& at, bool moves_with_h) const {
+    return block_.rows.smallestValue(
+        at, [&](const FreeTimeRows& g) { return g.quantity->dependsOnTimeStep() == moves_with_h; });
+  }
+  /// The quantities' inputs at the iterate (inputs_), while run() is in progress.
+  const QuantityInputs& inputs() {
+    if (!inputs_) inputs_.emplace(np_, np_.current());
+    return *inputs_;
+  }
   /// The global unknowns bordering the band: η, and a pointing end's twist ψ.
   int borderSize() const { return FreeTimeStep::globals(np_); }
 
@@ -93,15 +100,13 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   /// domain (at a trial also below (1 − τ) of its accepted value) or, at a trial, off the principal
   /// branch. Most trials are rejected at a row: the cost and the rows after it are left.
   double merit(double mu, double epsilon, bool trial) {
-    const QuantityInputs at(np_, np_.current());
-    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_,
-                                trial ? &trial_values_ : nullptr)) {
+    const QuantityInputs& at = inputs();
+    if (!block_.rowMeritsInside(at, mu, rho_, trial, &row_terms_, &row_outside_)) {
       return std::numeric_limits<double>::infinity();
     }
     if (trial && !np_.onPrincipalBranch(np_.current())) {
       return std::numeric_limits<double>::infinity();
     }
-    trial_values_at_iterate_ = trial;
     const double cost = np_.scheme().cost(at.torques());
     return BarrierRowBlock<FreeTimeStep>::merit(objective_.value(np_.timeStep(), cost, epsilon),
                                                 row_terms_);
@@ -176,11 +181,10 @@ class FreeTimeSolver final : public BarrierProblemSolve<FreeTimeStep, double>,
   double gap_ = 0.0, stationarity_ = 0.0, barrier_residual_ = 0.0;
   bool late_ = false;  ///< μ ≤ the damped barrier: the end game (damping, the correction)
   std::vector<double> row_terms_;  ///< the rows' merit terms at the iterate (merit)
-  /// The rows' values at the last trial whose merit was formed; they are the iterate's while
-  /// trial_values_at_iterate_ (the iterate has not moved since), so an accepted trial's rows are
-  /// not evaluated again.
-  std::vector<double> trial_values_;
-  bool trial_values_at_iterate_ = false;
+  /// The quantities' inputs at the iterate (its torques and attitudes), formed once while it does
+  /// not move: a trial's merit, its second-order correction, the accepted step's rows and the next
+  /// search's first merit read one set (inputs(); every move resets it).
+  std::optional<QuantityInputs> inputs_;
   int row_outside_ = -1;  ///< the row a merit last found outside its domain (rowMeritsInside)
   /// The barrier problem is solved as far as round-off allows (its Newton step no longer
   /// changes φ_μ): the next pass lowers μ.
@@ -226,7 +230,7 @@ void FreeTimeSolver::assemble(double mu, double epsilon) {
 /// Leaves the elastic phase once every constraint holds strictly: the iterate is a plan (the
 /// rows' multipliers carry over, safeguarded for the feasible form).
 void FreeTimeSolver::leaveElasticIfInside() {
-  if (!elastic_ || !(smallestValue(true) > 0)) return;
+  if (!elastic_ || !(smallestValue(inputs(), true) > 0)) return;
   elastic_ = false;
 }
 
@@ -235,7 +239,7 @@ void FreeTimeSolver::restoreAcceptedEnd() {
 }
 
 void FreeTimeSolver::moveTo(const Eigen::VectorXd& d, double alpha) {
-  trial_values_at_iterate_ = false;
+  inputs_.reset();
   // Back to the accepted iterate (its boundary steps at its h), then h, then the attitudes:
   // setTimeStep keeps the free attitudes, which the δ-step then moves.
   np_.setCurrent(accepted_.steps);
@@ -267,7 +271,7 @@ double FreeTimeSolver::trialMerit(const Eigen::VectorXd& d, double alpha, bool* 
 }
 
 void FreeTimeSolver::restore() {
-  trial_values_at_iterate_ = false;
+  inputs_.reset();
   restoreAcceptedEnd();
   np_.setTimeStep(accepted_.h);
   np_.setCurrent(accepted_.steps);
@@ -281,14 +285,13 @@ void FreeTimeSolver::restore() {
 bool FreeTimeSolver::correctedStep(const Eigen::VectorXd& d, Eigen::VectorXd* corrected) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(n_ + borderSize());
   bool curved = false;
-  block_.rows.forEachValue(QuantityInputs(np_, np_.current()),
-                           [&](auto& g, int k, auto& in, double c) {
-                             in.r = c - in.c - block_.rows.dot(np_, g, k, in.g, d);
-                             const double w = -form(g).terms(in, 0.0).weight * in.r;
-                             if (w == 0.0) return;
-                             curved = true;
-                             block_.rows.addRow(np_, g, k, in.g, w, &v);
-                           });
+  block_.rows.forEachValue(inputs(), [&](auto& g, int k, auto& in, double c) {
+    in.r = c - in.c - block_.rows.dot(np_, g, k, in.g, d);
+    const double w = -form(g).terms(in, 0.0).weight * in.r;
+    if (w == 0.0) return;
+    curved = true;
+    block_.rows.addRow(np_, g, k, in.g, w, &v);
+  });
   if (!curved) return false;
   kkt_->solve(&v);
   if (!v.allFinite()) return false;
@@ -348,6 +351,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
                                     const BarrierWatch& watch) {
   context_ = &context;
   watch_ = &watch;
+  inputs_.reset();  // the recipe may have moved the iterate since
   const int m = block_.rows.count;
   mu0_ = p_.free_time.initial_barrier / m;
   objective_ = scale_.set() ? MinimumTimeObjective(N_, h0_, scale_.cost, mu0_, scale_.duration)
@@ -357,7 +361,7 @@ FreeTimeOutcome FreeTimeSolver::run(double tolerance, int max_iterations, SolveC
   scales_ = {1.0, 1, N_, p_.final_barrier_fraction * tolerance / m};
   mu_ = firstBarrier();
   // The first multipliers: the primal ones at the start's values (an elastic row safeguarded).
-  block_.evaluate(np_.current());
+  block_.rows.evaluate(inputs());
   block_.prepare(mu_, rho_, true);
   solve({test_, std::make_unique<MonotoneBarrier>(p_, freeTimeMonotone(p_)),
          std::make_unique<PerturbationHandler>(p_)},
@@ -417,11 +421,7 @@ Pass FreeTimeSolver::direction(bool, double, LineSearchRequest* request, Eigen::
 Pass FreeTimeSolver::accept(const LineSearchResult& result, const StopVerdict&) {
   block_.applyDualStep(dualStep());
   leaveElasticIfInside();
-  if (trial_values_at_iterate_) {
-    block_.rows.assignValues(trial_values_);
-  } else {
-    block_.evaluate(np_.current());
-  }
+  block_.rows.evaluate(inputs());
   block_.afterAccept(mu_);
   report(result.alpha, stationarity_);
   return Pass::Continue;

@@ -357,11 +357,6 @@ struct StageTranscription {
   void evaluate(const QuantityInputs& at) {
     forEachValue(at, [](Rows&, int, Row& in, double c) { in.c = c; });
   }
-  /// Each row's value c from `values`, in forEach's order (values formed at the iterate before).
-  void assignValues(const std::vector<double>& values) {
-    std::size_t i = 0;
-    forEach([&](Rows&, int, Row& in) { in.c = values[i++]; });
-  }
   /// The least value at `at` of the groups `which(group)` selects (+∞ without; rows untouched).
   template <typename Which>
   double smallestValue(const QuantityInputs& at, const Which& which) const {

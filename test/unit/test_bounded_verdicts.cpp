@@ -22,6 +22,7 @@
 
 #include "attitude_planner/dynamics/effects.hpp"
 #include "attitude_planner/errors.hpp"
+#include "attitude_planner/io/scene.hpp"
 #include "attitude_planner/planner.hpp"
 #include "planning/drivers/bounded_verdicts.hpp"
 #include "planning/drivers/constrained_classes.hpp"
@@ -1064,4 +1065,97 @@ TEST(BoundedVerdicts, AFirstClassWithoutAPlanIsContinuedFromItsPlanUnderTheBound
   RecordProperty("exercised", exercised);
   RecordProperty("continued", continued);
   RecordProperty("planned", planned);
+}
+
+/// Minimum effort at 1.05 T* under per-axis torque bounds and a keep-out cone, where the first
+/// class ends without a plan on the requested grid (scripts/near_minimum_time_cones.py, seed
+/// 9191 #30 and seed 7474 #14; the duration is 1.05 times main's T*).
+const char* const kNearTheLeastDurationUnderACone[] = {
+    "inertia: [[2.2121386778804291, -0.0064727781838871123, -0.054160142310838232], "
+    "[-0.0064727781838871123, 2.1320935127401528, -0.0062827507104379066], [-0.054160142310838232, "
+    "-0.0062827507104379066, 2.2409388690820271]]\n"
+    "steps: 128\n"
+    "scheme: second_order\n"
+    "objective: minimum_effort\n"
+    "initial: {attitude: {quaternion: [0.21895206630893171, 0.83713011956334171, "
+    "0.099241687143981003, -0.49134941041150171]}, angular_velocity: [0, 0, 0]}\n"
+    "final: {attitude: {quaternion: [-0.18705466826518327, 0.80597511256400511, "
+    "-0.54473209459024163, -0.13668070138453825]}, angular_velocity: [0, 0, 0]}\n"
+    "effects: [{actuator_limits: {max_torque: [0.085895741230969477, 0.023826742140102105, "
+    "0.017387843053482885]}}]\n"
+    "constraints:\n"
+    "  - keep_out: {body_axis: [-0.35677833800157588, 0.93175638222124102, -0.067374043390742613], "
+    "world_direction: [-0.58456093352922556, -0.66503172326299054, 0.4647809398472541], "
+    "half_angle: 0.42032900218845193}\n"
+    "duration: 20.680709723033971\n",
+    "inertia: [[1.1451055146576339, 0.26168301581586872, 0.02505750365208842], "
+    "[0.26168301581586872, 0.75531797387366906, 0.16719331517004593], [0.02505750365208842, "
+    "0.16719331517004593, 1.1727665241943992]]\n"
+    "steps: 128\n"
+    "scheme: second_order\n"
+    "objective: minimum_effort\n"
+    "initial: {attitude: {quaternion: [0.78484928208051175, 0.50639170033517233, "
+    "0.27565971061274469, -0.22713602575165456]}, angular_velocity: [0, 0, 0]}\n"
+    "final: {attitude: {quaternion: [0.52410475288991276, 0.32304332246807982, "
+    "0.76157064054440426, 0.20240400012789675]}, angular_velocity: [0, 0, 0]}\n"
+    "effects: [{actuator_limits: {max_torque: [0.017520112968561857, 0.05148324470221436, "
+    "0.014489500847364719]}}]\n"
+    "constraints:\n"
+    "  - keep_out: {body_axis: [-0.77716726565809724, -0.46034036433974812, -0.42906618387967188], "
+    "world_direction: [-0.82020892460116057, -0.48053631685782083, 0.31039034808661081], "
+    "half_angle: 0.5053208697987126}\n"
+    "duration: 18.981120292613692\n",
+};
+
+TEST(BoundedVerdicts, UnderBoundsTheSurveyGridSolvesOnlyClassesThatCouldBeatThePlanInHand) {
+  // Under torque bounds a first class without a plan has the surveyed classes solved under the
+  // constraints on the survey grid, in order of their survey cost, until the next class's
+  // unconstrained optimum there costs at least a plan in hand (the constraints only add to a
+  // class's cost). Stated from the answer's extremal: no class solved there after a cheaper plan
+  // was in hand, at least one surveyed class left unsolved, and each class left unsolved, solved
+  // on its own under the constraints there, gives no plan cheaper than the one in hand.
+  for (const char* text : kNearTheLeastDurationUnderACone) {
+    const PlanningProblem p = parseScene(text).problem;
+    const PlanResult r = planAtResolution(p, SolverOptions{});
+    ASSERT_TRUE(r.converged()) << r.message();
+    const std::vector<Attempt>& others = r.extremal_summary.others;
+    int survey_steps = p.steps;
+    for (const Attempt& a : others) {
+      if (a.stage == AttemptStage::ClassSurvey) survey_steps = std::min(survey_steps, a.steps);
+    }
+    std::vector<Attempt> surveyed;  // each class's survey entry on the survey grid
+    for (const Attempt& a : others) {
+      if (a.stage == AttemptStage::ClassSurvey && a.steps == survey_steps) surveyed.push_back(a);
+    }
+    const auto surveyCost = [&](const HomotopyClass& c) {
+      for (const Attempt& s : surveyed) {
+        if (sameHomotopyClass(s.homotopy, c)) return s.cost;
+      }
+      return std::numeric_limits<double>::quiet_NaN();
+    };
+    double in_hand = std::numeric_limits<double>::infinity();
+    std::vector<HomotopyClass> solved;
+    for (const Attempt& a : others) {
+      if (a.stage != AttemptStage::ConstrainedClass || a.steps != survey_steps) continue;
+      EXPECT_LT(surveyCost(a.homotopy), in_hand);
+      solved.push_back(a.homotopy);
+      if (a.termination == Termination::Converged) in_hand = std::min(in_hand, a.cost);
+    }
+    ASSERT_TRUE(std::isfinite(in_hand)) << "no plan under the constraints on the survey grid";
+    int skipped = 0;
+    for (const Attempt& s : surveyed) {
+      const bool was_solved =
+          std::any_of(solved.begin(), solved.end(),
+                      [&](const HomotopyClass& c) { return sameHomotopyClass(c, s.homotopy); });
+      if (was_solved) continue;
+      ++skipped;
+      PlanningProblem alone = pinnedToClass(p, s.homotopy);
+      alone.steps = survey_steps;
+      SolverOptions pinned;
+      pinned.enumerate_classes = false;
+      const PlanResult own = planAtResolution(alone, pinned);
+      if (own.converged()) EXPECT_GE(own.cost, in_hand);
+    }
+    EXPECT_GE(skipped, 1);
+  }
 }

@@ -391,6 +391,66 @@ void carryUnderBounds(ClassSearch& search, const HomotopyClass& c, const Maneuve
   search.offer(c, search.solve(c, steps));
 }
 
+/// The surveyed classes' plans under the constraints on the survey grid (converged ones, in the
+/// survey's order).
+using CoarsePlans = std::vector<std::pair<HomotopyClass, PlanResult>>;
+
+/// With cones only, each surveyed class's cheapest plan on the survey grid (cheapestOnGrid).
+CoarsePlans cheapestPlansOnSurveyGrid(ClassSearch& search, const SurveyedClasses& surveyed) {
+  CoarsePlans coarse;
+  for (const HomotopyClass& c : surveyed.classes) {
+    if (search.stopped()) break;
+    PlanResult r = search.cheapestOnGrid(c, surveyed.steps);
+    if (r.converged()) coarse.emplace_back(c, std::move(r));
+  }
+  return coarse;
+}
+
+/// The surveyed classes in order of their survey cost, those without one (NaN) first.
+std::vector<std::size_t> bySurveyCost(const SurveyedClasses& surveyed) {
+  std::vector<std::size_t> order(surveyed.classes.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto key = [&](std::size_t i) {
+    const double cost = surveyed.costs[i];
+    return std::isnan(cost) ? -std::numeric_limits<double>::infinity() : cost;
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  return order;
+}
+
+/// Whether a class of this survey cost (its unconstrained optimum on the survey grid) cannot beat
+/// `best`, a plan under the constraints there: the constraints only add to a class's cost from its
+/// own optimum, so where `best` holds the cones between nodes (`better` then compares costs
+/// alone) a class whose optimum costs as much or more loses to it (the rule of
+/// solveClassesThatCouldBeatIt, on one grid: no refine margin).
+bool cannotBeatOnTheSurveyGrid(double survey_cost, const PlanResult* best) {
+  return best && !std::isnan(survey_cost) && survey_cost >= best->cost;
+}
+
+/// Under torque or rate bounds, the surveyed classes under the constraints on the survey grid, in
+/// order of their survey cost until a plan in hand is cheaper than the next class's unconstrained
+/// optimum (cannotBeatOnTheSurveyGrid): near the least duration most classes end without a plan
+/// after some hundreds of iterations each (docs/results/near_minimum_time_cones.md, "Session
+/// 65"), and the ones skipped could not have been carried. Returned in the survey's order, as
+/// every class's plan was.
+CoarsePlans plansUnderBoundsOnSurveyGrid(ClassSearch& search, const SurveyedClasses& surveyed) {
+  std::vector<std::optional<PlanResult>> plans(surveyed.classes.size());
+  const PlanResult* best = nullptr;
+  for (std::size_t i : bySurveyCost(surveyed)) {
+    if (search.stopped() || cannotBeatOnTheSurveyGrid(surveyed.costs[i], best)) break;
+    PlanResult r = search.solve(surveyed.classes[i], surveyed.steps);
+    if (!r.converged()) continue;
+    plans[i] = std::move(r);
+    if (!best || better(*plans[i], *best)) best = &*plans[i];
+  }
+  CoarsePlans coarse;
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    if (plans[i]) coarse.emplace_back(surveyed.classes[i], std::move(*plans[i]));
+  }
+  return coarse;
+}
+
 /// Where the first class ended without a plan on the requested grid: every surveyed class under
 /// the constraints on the survey grid, then carried to the requested grid. With cones only, each
 /// class's cheapest plan there (cheapestOnGrid) and the converged ones carried in order of their
@@ -415,13 +475,8 @@ std::vector<HomotopyClass> carryFromSurveyGrid(ClassSearch& search, const Survey
     }
     return solved;
   }
-  std::vector<std::pair<HomotopyClass, PlanResult>> coarse;
-  for (const HomotopyClass& c : surveyed.classes) {
-    if (search.stopped()) break;
-    PlanResult r =
-        cones_only ? search.cheapestOnGrid(c, surveyed.steps) : search.solve(c, surveyed.steps);
-    if (r.converged()) coarse.emplace_back(c, std::move(r));
-  }
+  CoarsePlans coarse = cones_only ? cheapestPlansOnSurveyGrid(search, surveyed)
+                                  : plansUnderBoundsOnSurveyGrid(search, surveyed);
   std::stable_sort(coarse.begin(), coarse.end(), [&](const auto& a, const auto& b) {
     return cones_only ? a.second.cost < b.second.cost : better(a.second, b.second);
   });

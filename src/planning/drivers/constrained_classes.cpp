@@ -419,11 +419,11 @@ std::vector<std::size_t> bySurveyCost(const SurveyedClasses& surveyed) {
   return order;
 }
 
-/// Whether a class of this survey cost (its unconstrained optimum on the survey grid) cannot beat
-/// `best`, a plan under the constraints there: the constraints only add to a class's cost from its
-/// own optimum, so where `best` holds the cones between nodes (`better` then compares costs
-/// alone) a class whose optimum costs as much or more loses to it (the rule of
-/// solveClassesThatCouldBeatIt, on one grid: no refine margin).
+/// Whether a class of this survey cost (its unconstrained optimum on the survey grid) is not
+/// expected to beat `best`, a plan under the constraints there: the constraints only add to a
+/// class's cost from its own optimum (the rule of solveClassesThatCouldBeatIt, on one grid: no
+/// refine margin). A gate, not a bound: a solve pinned to a class can slide to another lift, and
+/// `better` prefers a plan that holds the cones between nodes to a cheaper one that does not.
 bool cannotBeatOnTheSurveyGrid(double survey_cost, const PlanResult* best) {
   return best && !std::isnan(survey_cost) && survey_cost >= best->cost;
 }

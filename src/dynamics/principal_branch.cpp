@@ -24,12 +24,20 @@ double principalBranchRadius(const DiscreteScheme& scheme) {
   const double least = moments(0), largest = moments(2);
   if (!(least > 0.0) || largest > kPrincipalBranchConditionLimit * least) return 0.0;
   const double margin = 0.5 * least;  // ‖E‖₂ allowed
-  if (scheme.kind() == SchemeKind::Paper) return std::min(1.0, margin / (1.6 * largest));
-  // J_d = ½ tr(J) I − J: its eigenvalues from J's
-  const Vector3 nonstandard = Vector3::Constant(0.5 * moments.sum()) - moments;
-  const double nuclear = nonstandard.cwiseAbs().sum();
-  const double spectral = nonstandard.cwiseAbs().maxCoeff();
-  return margin / (nuclear + spectral);
+  switch (scheme.kind()) {
+    case SchemeKind::Paper:
+      return std::min(1.0, margin / (1.6 * largest));
+    case SchemeKind::Variational:
+    case SchemeKind::SecondOrder:
+    case SchemeKind::FourthOrder: {
+      // J_d = ½ tr(J) I − J: its eigenvalues from J's
+      const Vector3 nonstandard = Vector3::Constant(0.5 * moments.sum()) - moments;
+      const double nuclear = nonstandard.cwiseAbs().sum();
+      const double spectral = nonstandard.cwiseAbs().maxCoeff();
+      return margin / (nuclear + spectral);
+    }
+  }
+  return 0.0;  // a scheme without a bound here: every step takes the determinant test
 }
 
 }  // namespace attitude_planner

@@ -10,14 +10,20 @@
 // (test/support/bounded_references.hpp) and writes them into FILE (scripts/bounded_references).
 //
 //   bounded_verdicts_study [--count K] [--seed S] [--out FILE] [--only I]
-//                          [--write-references FILE]
+//                          [--write-references FILE] [--probe-at T1,T2,...]
+//
+// With --only I and --probe-at, request I is not planned as asked: a cold minimum-effort solve at
+// each listed T under its bounds (probeAt, the check's own solve) is reported on stderr instead,
+// to trace a verdict (where plans lie in T).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -44,18 +50,44 @@ struct Options {
   std::uint64_t seed = 45;
   std::string out;
   std::string write_references;  ///< non-empty: the references written there, nothing planned
+  std::vector<double> probe_durations;  ///< --probe-at [s], with --only
 };
+
+/// "1.5,2" as durations > 0 [s]; exits naming the flag on anything else.
+std::vector<double> durationsOrExit(const std::string& list) {
+  std::vector<double> out;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double T = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || *end != '\0' || !(T > 0.0)) {
+      std::cerr << "bounded_verdicts_study: --probe-at: '" << item << "' is not a duration > 0\n";
+      std::exit(2);
+    }
+    out.push_back(T);
+  }
+  return out;
+}
 
 Options parse(int argc, char** argv) {
   Options o;
+  std::string durations;
   st::FlagReader flags;
   flags.add("--count", &o.count)
       .add("--seed", &o.seed)
       .add("--out", &o.out)
       .add("--only", &o.only)
-      .add("--write-references", &o.write_references);
+      .add("--write-references", &o.write_references)
+      .add("--probe-at", &durations);
   st::readFlagsOrExit(flags, argc, argv, "bounded_verdicts_study",
-                      "[--count K] [--seed S] [--out FILE] [--only I] [--write-references FILE]");
+                      "[--count K] [--seed S] [--out FILE] [--only I] [--write-references FILE] "
+                      "[--probe-at T1,T2,...]");
+  if (!durations.empty()) o.probe_durations = durationsOrExit(durations);
+  if (!o.probe_durations.empty() && o.only < 0) {
+    std::cerr << "bounded_verdicts_study: --probe-at needs --only I\n";
+    std::exit(2);
+  }
   return o;
 }
 
@@ -132,6 +164,23 @@ void runSuite(const Options& o, const std::function<void(const std::string&)>& w
   written(tally.render(o));
 }
 
+/// Request `o.only` probed at each of `o.probe_durations` (a cold minimum-effort solve under its
+/// bounds), one line each on stderr.
+void probeRequest(const Options& o) {
+  const std::optional<rb::BoundedRequest> request = rb::boundedRequest(o.seed, o.only);
+  if (!request) {
+    std::cerr << o.only << ": no request (its unbounded plan did not converge)\n";
+    return;
+  }
+  std::cerr << request->label << "\n";
+  for (const double T : o.probe_durations) {
+    const rb::ProbeAt p = rb::probeAt(request->problem, T);
+    std::cerr << "  probe T = " << g(T, "%.6g") << " s: " << p.outcome
+              << (p.plan ? " (a plan)" : "") << ", " << p.iterations << " iterations, "
+              << g(p.seconds, "%.2f") << " s\n    " << p.message.substr(0, 400) << "\n";
+  }
+}
+
 /// One special request: its outcome and wall time (an exception is an outcome too).
 std::string specialRow(const std::string& what, const ap::PlanningProblem& p) {
   const auto start = std::chrono::steady_clock::now();
@@ -187,6 +236,10 @@ int main(int argc, char** argv) {
   const Options o = parse(argc, argv);
   if (!o.write_references.empty()) {
     rb::writeReferences(o.seed, o.count, o.write_references);
+    return 0;
+  }
+  if (!o.probe_durations.empty()) {
+    probeRequest(o);
     return 0;
   }
   std::ostringstream head;

@@ -521,7 +521,9 @@ TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
   // within its bounds at T (the ladder of durations from T*, in the trail), or is a local verdict
   // that names T* and the longest duration it reached, below T, or says it did not converge;
   // never "feasible" claimed from T* <= T alone (spinning ends: longer need not be feasible).
-  for (int i : {161, 168}) {
+  // #89 (T 4 % above T*): the first solve ends infeasible, the ladder converges one rung and the
+  // answer is not converged; the durations of its plans were words only before session 65.
+  for (int i : {161, 168, 89}) {
     const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
     ASSERT_TRUE(request.has_value());
     SCOPED_TRACE(request->label);

@@ -197,14 +197,18 @@ bool restToRest(const PlanningProblem& problem) {
 void labelStuckAnswer(const PlanningProblem& problem, double T_star, const LadderClimb& climb,
                       PlanResult* again) {
   const bool rest_to_rest = restToRest(problem);
-  if (rest_to_rest || !(climb.reached > 0.0)) {
-    again->termination = Termination::NotConverged;
-  } else {
-    again->duration_verdict.least_duration_found = T_star;
-    again->duration_verdict.longest_duration_found = climb.reached;
-  }
+  if (rest_to_rest || !(climb.reached > 0.0)) again->termination = Termination::NotConverged;
   frameMessage(
       again, frames::StuckAtMinimumTimePlan{rest_to_rest, T_star, problem.duration, climb.reached});
+}
+
+/// Where plans were found is data, not only words: an answer without a plan at T after a
+/// ladder that found plans from T* up to some duration carries T* and that duration, whichever
+/// way it ended (infeasible, not converged, or the first answer kept).
+void recordLadderReach(double T_star, const LadderClimb& climb, PlanResult* answer) {
+  if (answer->converged() || !(climb.reached > 0.0)) return;
+  answer->duration_verdict.least_duration_found = T_star;
+  answer->duration_verdict.longest_duration_found = climb.reached;
 }
 
 /// A bounded minimum-effort answer from the minimum-time plan at T* ≤ T (`first` the solve
@@ -233,17 +237,14 @@ PlanResult fromMinimumTimePlan(const PlanningProblem& problem, const PlanResult&
     // Nothing better than the first answer: it stays, with what was tried.
     context.restoreKept(first_kept);
     PlanResult kept = first;
-    if (climb.reached > 0.0) {
-      // The first answer stands, but where plans were found is data, not only words.
-      kept.duration_verdict.least_duration_found = T_star;
-      kept.duration_verdict.longest_duration_found = climb.reached;
-    }
+    recordLadderReach(T_star, climb, &kept);  // the first answer stands
     addNote(&kept, restart);
     addNote(&kept, notes::RestartEnded{again.termination, again.clauses});
     return kept;
   }
   if (again.termination == Termination::Infeasible)
     labelStuckAnswer(problem, T_star, climb, &again);
+  recordLadderReach(T_star, climb, &again);
   addNote(&again, restart);
   if (!from_ladder) context.restoreKept(direct_kept);  // else the last rung's is kept
   return again;

@@ -53,37 +53,19 @@ struct Options {
   std::vector<double> probe_durations;  ///< --probe-at [s], with --only
 };
 
-/// "1.5,2" as durations > 0 [s]; exits naming the flag on anything else.
-std::vector<double> durationsOrExit(const std::string& list) {
-  std::vector<double> out;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double T = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || !(T > 0.0)) {
-      std::cerr << "bounded_verdicts_study: --probe-at: '" << item << "' is not a duration > 0\n";
-      std::exit(2);
-    }
-    out.push_back(T);
-  }
-  return out;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
-  std::string durations;
   st::FlagReader flags;
   flags.add("--count", &o.count)
       .add("--seed", &o.seed)
       .add("--out", &o.out)
       .add("--only", &o.only)
       .add("--write-references", &o.write_references)
-      .add("--probe-at", &durations);
+      .add(
+          "--probe-at", &o.probe_durations, [](double T) { return T > 0.0; }, "a duration > 0 [s]");
   st::readFlagsOrExit(flags, argc, argv, "bounded_verdicts_study",
                       "[--count K] [--seed S] [--out FILE] [--only I] [--write-references FILE] "
                       "[--probe-at T1,T2,...]");
-  if (!durations.empty()) o.probe_durations = durationsOrExit(durations);
   if (!o.probe_durations.empty() && o.only < 0) {
     std::cerr << "bounded_verdicts_study: --probe-at needs --only I\n";
     std::exit(2);

@@ -48,27 +48,8 @@ struct Options {
   std::vector<double> probe_fractions;  ///< --probe-scan
 };
 
-/// "0.01,0.02" as numbers in (0, 1); exits naming the flag on anything else.
-std::vector<double> fractionsOrExit(const std::string& list) {
-  std::vector<double> out;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double f = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || !(f > 0.0 && f < 1.0)) {
-      std::cerr << "spinning_minimum_time_study: --probe-scan: '" << item
-                << "' is not a fraction in (0, 1)\n";
-      std::exit(2);
-    }
-    out.push_back(f);
-  }
-  return out;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
-  std::string fractions;
   st::FlagReader flags;
   flags.add("--count", &o.count)
       .add("--seed", &o.seed)
@@ -76,11 +57,12 @@ Options parse(int argc, char** argv) {
       .add("--steps", &o.steps)
       .add("--out", &o.out)
       .add("--only", &o.only)
-      .add("--probe-scan", &fractions);
+      .add(
+          "--probe-scan", &o.probe_fractions, [](double f) { return f > 0.0 && f < 1.0; },
+          "a fraction in (0, 1)");
   st::readFlagsOrExit(flags, argc, argv, "spinning_minimum_time_study",
                       "[--count K] [--seed S] [--scheme NAME] [--steps N] [--out FILE] [--only I] "
                       "[--probe-scan F1,F2,...]");
-  if (!fractions.empty()) o.probe_fractions = fractionsOrExit(fractions);
   return o;
 }
 

@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,6 +71,25 @@ Integer integerFlag(const std::string& flag, const std::string& value) {
   return parsed;
 }
 
+/// `value` of `flag` as comma-separated numbers ("1.5,2"), each one `accepts`; `what` says what
+/// they must be in the usage error that names the item refused.
+inline std::vector<double> numberListFlag(const std::string& flag, const std::string& value,
+                                          const std::function<bool(double)>& accepts,
+                                          const std::string& what) {
+  std::vector<double> out;
+  std::stringstream in(value);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || *end != '\0' || !accepts(x)) {
+      throw UsageError(flag + ": '" + item + "' is not " + what);
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
 /// The `--flag value` pairs of a study's command line, each bound to the option it sets (which
 /// keeps its default when the flag is absent). Unknown flags and a flag without a value are
 /// usage errors, never ignored: a mistyped flag would otherwise run the default study silently.
@@ -84,6 +104,14 @@ class FlagReader {
   }
   FlagReader& add(const std::string& flag, std::string* target) {
     setters_[flag] = [target](const std::string& v) { *target = v; };
+    return *this;
+  }
+  /// A list of numbers (numberListFlag).
+  FlagReader& add(const std::string& flag, std::vector<double>* target,
+                  std::function<bool(double)> accepts, std::string what) {
+    setters_[flag] = [flag, target, accepts, what](const std::string& v) {
+      *target = numberListFlag(flag, v, accepts, what);
+    };
     return *this;
   }
   /// `flag` must be given (it has no default).

@@ -72,3 +72,19 @@ TEST(StudyFlags, UsageErrorsNameTheFlagAndTheValue) {
   EXPECT_NE(usageError({"--small-seed", "-1"}), "");
   EXPECT_NE(usageError({"--small-seed", "4294967296"}), "");
 }
+
+TEST(StudyFlags, NumberListsKeepTheirOrderAndNameTheItemRefused) {
+  const auto positive = [](double x) { return x > 0.0; };
+  EXPECT_EQ(st::numberListFlag("--probe-at", "1.5,2,0.25", positive, "a duration > 0"),
+            (std::vector<double>{1.5, 2.0, 0.25}));
+  for (const std::string bad : {"1,x", "1,,2", "1,-2", "2.5s", "0"}) {
+    try {
+      st::numberListFlag("--probe-at", bad, positive, "a duration > 0");
+      ADD_FAILURE() << bad << " was read";
+    } catch (const st::UsageError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("--probe-at: '", 0), 0u) << message;
+      EXPECT_NE(message.find("is not a duration > 0"), std::string::npos) << message;
+    }
+  }
+}

@@ -664,3 +664,55 @@ TEST(ExtremalClasses, UnderATorqueNormBoundTheDefaultIsNoCostlierThanAnyClass) {
   std::printf("%d of %d cases compared\n", compared, kCases);
   EXPECT_GE(compared, 2);
 }
+
+// A keep-out slew whose first class's plan came from the interior point's ℓ1-elastic fallback
+// (the free-slacks formulation ended at its limit) passes the cone on the side the fallback's
+// path chose: held out (scripts/keep_out_grids --seed 6565, request 24, paper), at N = 256 alone
+// the side costing 16 % more while N = 255 and 257 pass on the cheaper one. The class is then
+// solved again from its cheapest coarse plan (both sides of the cone) and the cheaper plan kept,
+// so h·cost settles in N.
+TEST(ExtremalClasses, APlanFromTheElasticFallbackIsSolvedAgainFromTheClassesCheapestCoarsePlan) {
+  const PlanningProblem base = parseScene(R"(
+inertia: [[2.0385117765811231, 0.045526310767005362, 0.048908559769587197],
+          [0.045526310767005362, 2.1139151255983588, -0.011345479405849096],
+          [0.048908559769587197, -0.011345479405849096, 2.3382760787780659]]
+duration: 39.200711279408587
+steps: 64
+scheme: paper
+initial: {attitude: {quaternion: [0.2126039490965155, 0.36603876813254388, -0.83910463111518896,
+                                  0.34164103836280957]}, angular_velocity: [0, 0, 0]}
+final: {attitude: {quaternion: [-0.55475646629963715, 0.48284763182407187, -0.48204717941569891,
+                                0.47616587903586111]}, angular_velocity: [0, 0, 0]}
+constraints:
+  - keep_out: {body_axis: [0.08849657812687993, 0.80757831150457893, 0.58308286413446087],
+               world_direction: [0.014908224201728798, -0.19251580973831206, -0.9811806193825644],
+               half_angle: 0.22886599318329565}
+)")
+                                   .problem;
+  double effort[3];
+  bool fallback_seen = false;
+  for (int j = 0; j < 3; ++j) {
+    PlanningProblem p = base;
+    p.steps = 255 + j;
+    const PlanResult r = planManeuver(p);
+    ASSERT_TRUE(r.converged()) << p.steps << ": " << r.message();
+    EXPECT_LE(r.max_constraint_violation, 0.0);
+    effort[j] = r.cost * p.duration / p.steps;
+    // The first class's elastic plan on N, not kept, and a later plan of the class on N that is.
+    bool elastic_first = false, kept_after = false;
+    for (const Attempt& a : r.attempts) {
+      if (a.steps != p.steps || a.formulation == Formulation::Unconstrained) continue;
+      if (!elastic_first && a.formulation == Formulation::Elastic && !a.kept) {
+        elastic_first = true;
+      } else if (elastic_first && a.kept) {
+        kept_after = true;
+      }
+    }
+    if (elastic_first) {
+      fallback_seen = true;
+      EXPECT_TRUE(kept_after) << p.steps << ": " << r.message();
+    }
+  }
+  EXPECT_TRUE(fallback_seen) << "no grid exercised the fallback";
+  for (const double e : effort) EXPECT_NEAR(e, effort[0], 0.01 * effort[0]);
+}

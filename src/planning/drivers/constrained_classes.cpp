@@ -508,16 +508,35 @@ bool withinSurveyMargin(const SurveyedClasses& surveyed, double ratio) {
 /// discretization costs more: measured, h·cost falls with N on every request of that page whose
 /// answer keeps its basin), so a first plan above it sits in a costlier basin, one its start from
 /// the unconstrained optimum, which crosses a cone, led it into.
+/// `whatever_it_costs`: the class is solved from the coarse plan however the two compare (a first
+/// plan whose basin the fallback formulation chose, fromTheElasticFallback: on the survey grid
+/// the paper scheme's discretization alone can outweigh a basin's difference).
 void retryFromItsCoarsePlan(ClassSearch& search, const HomotopyClass& first_class,
-                            double first_cost, int coarse_steps, int steps) {
+                            double first_cost, int coarse_steps, int steps,
+                            bool whatever_it_costs) {
   for (int coarse = coarse_steps; coarse < steps && !search.stopped(); coarse *= 2) {
     const PlanResult plan = search.cheapestOnGrid(first_class, coarse);
     if (!plan.converged()) continue;
-    if (plan.cost / coarse >= first_cost / steps || search.stopped()) return;
+    if (search.stopped()) return;
+    if (!whatever_it_costs && plan.cost / coarse >= first_cost / steps) return;
     search.offer(first_class,
                  search.solve(first_class, steps, ClassStart{nullptr, &plan.maneuver}));
     return;
   }
+}
+
+/// Whether the first class's plan on `steps` came from the ℓ1-elastic formulation, the interior
+/// point's fallback where the free-slacks one ended without a plan: then the fallback's path, not
+/// the start, chose the plan's basin, e.g. the side of a cone it passes (a keep-out slew at
+/// N = 256 alone passing on the side that costs 16 % more: docs/results/keep_out_grids_6565.md).
+bool fromTheElasticFallback(const SolveContext& context, std::size_t first_recorded, int steps) {
+  const std::vector<Attempt>& trail = context.attempts();
+  for (std::size_t i = trail.size(); i-- > first_recorded;) {
+    const Attempt& a = trail[i];
+    if (a.steps != steps || a.formulation == Formulation::Unconstrained) continue;
+    return a.termination == Termination::Converged && a.formulation == Formulation::Elastic;
+  }
+  return false;
 }
 
 /// Whether class i of the survey could beat a plan that cost `rise` times its class's
@@ -567,6 +586,8 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolveR
   if (alone && (surveyed.steps >= problem.steps || !conesOnly(problem))) return first;
   const std::vector<MessageClause> first_said = first.clauses;
   const bool first_converged = first.converged();
+  const bool from_fallback =
+      first_converged && fromTheElasticFallback(context, first_recorded, problem.steps);
   const double first_cost = first.cost;
   ClassSearch search(problem, options, context, survey_plans, first_class, std::move(first),
                      first_recorded);
@@ -574,8 +595,9 @@ PlanResult cheapestConstrainedClass(const PlanningProblem& problem, const SolveR
   // How much the constraints raised the first class's cost from its unconstrained optimum.
   const double first_rise = first_cost / unconstrained_cost;
   if (first_converged && surveyed.steps < problem.steps &&
-      !withinSurveyMargin(surveyed, first_rise)) {
-    retryFromItsCoarsePlan(search, first_class, first_cost, surveyed.steps, problem.steps);
+      (from_fallback || !withinSurveyMargin(surveyed, first_rise))) {
+    retryFromItsCoarsePlan(search, first_class, first_cost, surveyed.steps, problem.steps,
+                           from_fallback);
   } else if (!first_converged) {
     const std::vector<HomotopyClass> carried =
         carryFromSurveyGrid(search, surveyed, first_class, problem.steps, conesOnly(problem));

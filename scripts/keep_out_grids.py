@@ -17,7 +17,6 @@ one (its h·cost spread and the solve-time ratio per request are reported beside
 """
 import argparse
 import datetime
-import importlib.util
 import json
 import math
 import os
@@ -32,11 +31,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_page import load_average, write_page  # noqa: E402
 
 # The uniform rotations and the scene's number format of the homotopy-class suite.
-_spec = importlib.util.spec_from_file_location(
-    "extremal_classes", os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                     "extremal_classes.py"))
-extremal_classes = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(extremal_classes)
+import extremal_classes  # noqa: E402
 random_rotation = extremal_classes.random_rotation
 quat_to_matrix = extremal_classes.quat_to_matrix
 vec = extremal_classes.vec

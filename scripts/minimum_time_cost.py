@@ -14,7 +14,6 @@ Called by scripts/minimum_time_cost; usable alone:
 """
 import argparse
 import datetime
-import importlib.util
 import json
 import math
 import os
@@ -28,11 +27,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_page import load_average, write_page  # noqa: E402
 
-_spec = importlib.util.spec_from_file_location(
-    "keep_out_grids", os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                   "keep_out_grids.py"))
-keep_out_grids = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(keep_out_grids)
+import keep_out_grids  # noqa: E402
 vec = keep_out_grids.vec
 
 TARGET = 10.0  # the target: minimum time at most 10x one minimum-effort solve at 1.05 T*

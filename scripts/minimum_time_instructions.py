@@ -14,7 +14,6 @@ runs of a second build, and each count's ratio after/before.
 """
 import argparse
 import datetime
-import importlib.util
 import json
 import os
 import re
@@ -28,11 +27,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_page import load_average, write_page  # noqa: E402
 
-_spec = importlib.util.spec_from_file_location(
-    "minimum_time_cost", os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                      "minimum_time_cost.py"))
-minimum_time_cost = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(minimum_time_cost)
+import minimum_time_cost  # noqa: E402
 
 
 def counted(binary, library, text, work):

@@ -21,7 +21,6 @@ minimum-effort cost (1e-9 relative), the termination, the iterations.
 """
 import argparse
 import datetime
-import importlib.util
 import os
 import statistics
 import sys
@@ -32,11 +31,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_page import load_average, write_page  # noqa: E402
 
-_spec = importlib.util.spec_from_file_location(
-    "minimum_time_cost", os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                                      "minimum_time_cost.py"))
-mtc = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(mtc)
+import minimum_time_cost as mtc  # noqa: E402
 
 SLOW = 300  # iterations: "many" for one minimum-effort request at N = 128 (the median is 49-77)
 

@@ -64,13 +64,19 @@ def as_effort(text, duration):
         "duration: %.17g\n" % duration
 
 
-def plan(binary, text, work, flags=()):
+def request_files(text, work):
+    """The request written to WORK/request.yaml, and its summary's path (cleared)."""
     scene = os.path.join(work, "request.yaml")
     summary = os.path.join(work, "summary.json")
     with open(scene, "w") as f:
         f.write(text)
     if os.path.exists(summary):
         os.remove(summary)
+    return scene, summary
+
+
+def plan(binary, text, work, flags=()):
+    scene, summary = request_files(text, work)
     subprocess.run([binary, scene, "--summary", summary] + list(flags), stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL, timeout=900)
     try:

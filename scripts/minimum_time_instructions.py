@@ -32,12 +32,7 @@ import minimum_time_cost  # noqa: E402
 
 def counted(binary, library, text, work):
     """The summary and the instructions callgrind counted for one plan_maneuver run."""
-    scene = os.path.join(work, "request.yaml")
-    summary = os.path.join(work, "summary.json")
-    with open(scene, "w") as f:
-        f.write(text)
-    if os.path.exists(summary):
-        os.remove(summary)
+    scene, summary = minimum_time_cost.request_files(text, work)
     env = dict(os.environ, LD_LIBRARY_PATH=library) if library else None
     run = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", binary,
                           scene, "--summary", summary, "--threads", "1"],

@@ -522,7 +522,7 @@ TEST(BoundedVerdicts, SpinningRequestsAboveTStarClimbFromIt) {
   // that names T* and the longest duration it reached, below T, or says it did not converge;
   // never "feasible" claimed from T* <= T alone (spinning ends: longer need not be feasible).
   // #89 (T 4 % above T*): the first solve ends infeasible, the ladder converges one rung and the
-  // answer is not converged; the durations of its plans were words only before session 65.
+  // answer is not converged; the durations of its plans are data, not only words.
   for (int i : {161, 168, 89}) {
     const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, i);
     ASSERT_TRUE(request.has_value());

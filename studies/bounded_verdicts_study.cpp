@@ -10,11 +10,13 @@
 // (test/support/bounded_references.hpp) and writes them into FILE (scripts/bounded_references).
 //
 //   bounded_verdicts_study [--count K] [--seed S] [--out FILE] [--only I]
-//                          [--write-references FILE] [--probe-at T1,T2,...]
+//                          [--write-references FILE] [--probe-at T1,T2,...] [--progress K]
 //
 // With --only I and --probe-at, request I is not planned as asked: a cold minimum-effort solve at
 // each listed T under its bounds (probeAt, the check's own solve) is reported on stderr instead,
-// to trace a verdict (where plans lie in T).
+// to trace a verdict (where plans lie in T). With --only I and --progress K, every K-th iteration
+// of the request is reported on stderr (its attempt, stage, grid and the seconds so far), to see
+// where a long request spends its time.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -51,6 +53,7 @@ struct Options {
   std::string out;
   std::string write_references;  ///< non-empty: the references written there, nothing planned
   std::vector<double> probe_durations;  ///< --probe-at [s], with --only
+  int progress = 0;                     ///< --progress K, with --only: every K-th iteration
 };
 
 Options parse(int argc, char** argv) {
@@ -62,12 +65,17 @@ Options parse(int argc, char** argv) {
       .add("--only", &o.only)
       .add("--write-references", &o.write_references)
       .add(
-          "--probe-at", &o.probe_durations, [](double T) { return T > 0.0; }, "a duration > 0 [s]");
+          "--probe-at", &o.probe_durations, [](double T) { return T > 0.0; }, "a duration > 0 [s]")
+      .add("--progress", &o.progress);
   st::readFlagsOrExit(flags, argc, argv, "bounded_verdicts_study",
                       "[--count K] [--seed S] [--out FILE] [--only I] [--write-references FILE] "
-                      "[--probe-at T1,T2,...]");
-  if (!o.probe_durations.empty() && o.only < 0) {
-    std::cerr << "bounded_verdicts_study: --probe-at needs --only I\n";
+                      "[--probe-at T1,T2,...] [--progress K]");
+  if (o.progress < 0) {
+    std::cerr << "bounded_verdicts_study: --progress " << o.progress << ": needs K > 0\n";
+    std::exit(2);
+  }
+  if ((!o.probe_durations.empty() || o.progress > 0) && o.only < 0) {
+    std::cerr << "bounded_verdicts_study: --probe-at and --progress need --only I\n";
     std::exit(2);
   }
   return o;
@@ -124,6 +132,23 @@ struct SuiteTally {
   }
 };
 
+/// Options whose callback reports every `every`-th iteration on stderr (none for 0).
+ap::SolverOptions progressReports(int every) {
+  ap::SolverOptions options;
+  if (every <= 0) return options;
+  const auto start = std::chrono::steady_clock::now();
+  options.on_iteration = [every, start](const ap::IterationInfo& info) {
+    if (info.iteration % every != 0) return true;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cerr << "iteration " << info.iteration << ": attempt " << info.attempt.number << " ("
+              << ap::attemptStageName(info.attempt.stage) << "), N = " << info.steps << ", "
+              << g(seconds, "%.1f") << " s\n";
+    return true;
+  };
+  return options;
+}
+
 /// The suite, request by request; `written` gets the section after each request.
 void runSuite(const Options& o, const std::function<void(const std::string&)>& written) {
   SuiteTally tally;
@@ -136,7 +161,7 @@ void runSuite(const Options& o, const std::function<void(const std::string&)>& w
       ++tally.skipped;
       continue;
     }
-    const rb::VerdictCheck c = rb::planAndCheck(*request);
+    const rb::VerdictCheck c = rb::planAndCheck(*request, progressReports(o.progress));
     tally.add(i, *request, c);
     std::cerr << i << " " << rb::outcomeName(c) << " " << c.wrong << " " << g(c.seconds, "%.2f")
               << " s\n";

@@ -87,6 +87,9 @@ TEST(AdvancedParameters, EveryFieldOfTheStructsHasOneRowInTheTable) {
   }
   const std::set<std::string> newton = declaredFields("newton_parameters.hpp", "NewtonParameters");
   for (const std::string& name : newton) expected.insert("newton." + name);
+  const std::set<std::string> drivers =
+      declaredFields("advanced_parameters.hpp", "AdvancedParameters");
+  expected.insert(drivers.begin(), drivers.end());
   std::set<std::string> listed;
   for (const ap::AdvancedField& f : ap::advancedFields({})) {
     EXPECT_TRUE(listed.insert(f.name).second) << f.name << " listed twice";
@@ -94,6 +97,7 @@ TEST(AdvancedParameters, EveryFieldOfTheStructsHasOneRowInTheTable) {
   EXPECT_EQ(listed, expected);
   EXPECT_GE(expected.size(), 70u + 30u);  // the parser found the structs
   EXPECT_GE(newton.size(), 30u);
+  EXPECT_EQ(drivers.count("search_work_allowance"), 1u);
 }
 
 TEST(AdvancedParameters, EachRowNamesItsOwnField) {
@@ -193,6 +197,8 @@ TEST(AdvancedParameters, TheRangesTheMethodNeeds) {
       {"newton.more_starts_above_iterations", -1,
        "advanced.newton.more_starts_above_iterations: must be an integer in [0, 1000000000], got "
        "-1"},
+      {"search_work_allowance", 0.0,
+       "advanced.search_work_allowance: must be a finite number > 0, got 0"},
       {"interior_point.armijo_typo", 0.1, "advanced.interior_point.armijo_typo: not an advanced"},
   };
   for (const Row& row : rows) {

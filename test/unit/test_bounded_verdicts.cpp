@@ -29,6 +29,7 @@
 #include "planning/drivers/constrained_recipe.hpp"
 #include "planning/drivers/free_time_recipe.hpp"
 #include "planning/drivers/minimum_time_free_time.hpp"
+#include "planning/drivers/minimum_time_search.hpp"
 #include "planning/drivers/minimum_time_starts.hpp"
 #include "planning/drivers/requests.hpp"
 #include "planning/problem/duration_bound.hpp"
@@ -1160,4 +1161,85 @@ TEST(BoundedVerdicts, UnderBoundsTheSurveyGridSolvesOnlyClassesThatCouldBeatTheP
     }
     EXPECT_GE(skipped, 1);
   }
+}
+
+namespace {
+
+/// Whether `r`'s message holds the note that its probes below T* stopped at their allowance.
+bool probesStopped(const PlanResult& r) {
+  return std::any_of(r.clauses.begin(), r.clauses.end(), [](const MessageClause& c) {
+    const Note* note = std::get_if<Note>(&c);
+    return note && std::holds_alternative<notes::ProbesStopped>(*note);
+  });
+}
+
+/// The cold probes below T* of a minimum-time answer (each a `constrained` attempt on the
+/// request's grid from its unconstrained optimum: probedBelow).
+long coldProbes(const PlanResult& r, int steps) {
+  return std::count_if(r.attempts.begin(), r.attempts.end(), [&](const Attempt& a) {
+    return a.stage == AttemptStage::Constrained && a.steps == steps &&
+           a.start == AttemptStart::UnconstrainedOptimum;
+  });
+}
+
+}  // namespace
+
+TEST(SolveContext, WorkCountsEachIterationAtItsGridsStepsAndBranchesJoinIt) {
+  SolveContext context{SolverOptions{}};
+  IterationInfo info;
+  info.steps = 128;
+  context.reportIteration(info);
+  info.steps = 0;  // a report without a grid counts one
+  context.reportIteration(info);
+  EXPECT_EQ(context.work(), 129.0);
+  const SolveContext::WorkAllowance allowance(context, 300.0);
+  SolveContext branch(context, SolveContext::Branch{});
+  info.steps = 200;
+  branch.reportIteration(info);
+  EXPECT_EQ(branch.work(), 329.0);      // the parent's when it began, and its own
+  EXPECT_FALSE(allowance.exhausted());  // the parent's own count has not seen it yet
+  context.join(branch);
+  EXPECT_EQ(context.work(), 329.0);
+  EXPECT_FALSE(allowance.exhausted());  // 200 of 300 since it opened
+  info.steps = 100;
+  context.reportIteration(info);
+  EXPECT_TRUE(allowance.exhausted());
+  EXPECT_TRUE(allowance.stopped());
+}
+
+TEST(BoundedVerdicts, TheProbesBelowTStarStopAtTheirWorkAllowanceAndSaySo) {
+  // The spinning study suite's request #12 (N = 124): with the default allowance its probes below
+  // T* run to their own end (more than two cold probes, BelowAStrictLocalMinimum... above); with
+  // an allowance of one node-iteration the first probe spends it, so it is the only one, and the
+  // answer is the minimum-time solve's own, saying that the probes stopped.
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 12);
+  ASSERT_TRUE(request);
+  const int N = request->problem.steps;
+  const PlanResult free = planManeuver(request->problem);
+  ASSERT_TRUE(free.converged()) << free.message();
+  EXPECT_GT(coldProbes(free, N), 1) << free.message();
+  EXPECT_FALSE(probesStopped(free)) << free.message();
+  SolverOptions options;
+  options.advanced.search_work_allowance = 1.0;
+  const PlanResult held = planManeuver(request->problem, options);
+  ASSERT_TRUE(held.converged()) << held.message();
+  EXPECT_EQ(coldProbes(held, N), 1) << held.message();
+  EXPECT_TRUE(probesStopped(held)) << held.message();
+  EXPECT_GE(held.minimum_duration, free.minimum_duration * (1.0 - 1e-9));
+}
+
+TEST(BoundedVerdicts, TheSearchOnDurationsStopsAtItsWorkAllowanceWithAVerdictSayingSo) {
+  // The spinning study suite's request #108 (N = 128): the search's first duration holds no plan
+  // (SpinningMinimumTimeWithoutAConvergedStartSearchesDurationsUntilAPlan). With an allowance of
+  // one node-iteration the search, its coarse grid's included, stops after that first solve:
+  // not converged, the verdict search_stopped with the allowance as a figure, not "infeasible".
+  const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 108);
+  ASSERT_TRUE(request);
+  SolverOptions options;
+  options.advanced.search_work_allowance = 1.0;
+  SolveContext context(options);
+  const PlanResult r = searchMinimumTime(request->problem, context);
+  EXPECT_EQ(r.termination, Termination::NotConverged) << r.message();
+  EXPECT_TRUE(std::holds_alternative<verdicts::SearchStopped>(r.verdict)) << r.message();
+  EXPECT_EQ(figureOf(r.verdict, "work_allowance"), 1.0) << r.message();
 }

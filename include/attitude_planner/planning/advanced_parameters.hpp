@@ -17,6 +17,17 @@ namespace attitude_planner {
 struct AdvancedParameters {
   NewtonParameters newton;                 ///< "newton.<field>": the unconstrained solver
   InteriorPointParameters interior_point;  ///< "interior_point.<field>": under constraints
+  /// "search_work_allowance": the work (node-iterations: Σ over the iterations of the grid's N)
+  /// that each search for a better answer than the one in hand may spend: the minimum-time search
+  /// on durations (its coarse grids included) and the probes below a minimum time with spinning
+  /// ends. Checked between their solves, so such a search ends after at most this and the solve in
+  /// progress, on any grid, without a time budget, at the same point on every run (seconds would
+  /// not); where it stops one, the answer says so. Why 2e7: 1-2 minutes on a 2-core machine
+  /// (4-8 us a node-iteration, measured at N = 410 and 787 on held-out requests whose probes and
+  /// search had run 100,000 iterations, 250 s to over 800 s, before an answer), and above the whole
+  /// work of the seed-45 spinning suite's longest requests (36,000-49,000 iterations at
+  /// N = 128-303: at most 1.3e7), whose probes found their lower T*.
+  double search_work_allowance = 2e7;
 };
 
 /// One settable field of AdvancedParameters: its name ("newton.armijo", "interior_point.armijo",

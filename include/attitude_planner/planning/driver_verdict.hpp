@@ -132,13 +132,20 @@ struct MinimumTimeFoundNone {
   Termination minimum_time = Termination::NotConverged;
   std::vector<VerdictFigure> figures() const { return {}; }
 };
-/// The minimum-time search was stopped (`stop`: timed out, cancelled) before any duration was
-/// found feasible; what the bounds prove about the durations (`proven`).
+/// The minimum-time search was stopped (`stop`: timed out, cancelled; not converged where it
+/// spent its own work allowance, `work_allowance` node-iterations, figure "work_allowance")
+/// before any duration was found feasible; what the bounds prove about the durations (`proven`).
+/// Local: durations the search did not try are not judged.
 struct SearchStopped {
   static constexpr const char* kKind = "search_stopped";
   Termination stop = Termination::TimedOut;
   ProvenDurations proven;
-  std::vector<VerdictFigure> figures() const { return proven.figures(); }
+  double work_allowance = 0.0;  ///< > 0: the search's own allowance stopped it, not the caller
+  std::vector<VerdictFigure> figures() const {
+    std::vector<VerdictFigure> f = proven.figures();
+    if (work_allowance > 0.0) f.push_back({"work_allowance", work_allowance});
+    return f;
+  }
 };
 /// The minimum-time search found no plan below T = `from` (it tried durations down to
 /// `least_tried`), and from there on one step at the boundary rates has no solution on N steps;

@@ -122,6 +122,12 @@ struct DescendedFromProbe {
   double duration = 0.0;
   double previous = 0.0;
 };
+/// Spinning ends: the probes below T* stopped at their work allowance (`work_allowance`
+/// node-iterations, AdvancedParameters::search_work_allowance) before they ran out of durations to
+/// try: a lower T* may exist.
+struct ProbesStopped {
+  double work_allowance = 0.0;
+};
 /// Minimum time searched on T instead of solved free-time, and `why`.
 struct SearchedOnT {
   std::string why;
@@ -194,8 +200,8 @@ using Note =
                  notes::FixedTwistFallback, notes::PointingRestartNotServed, notes::SearchSummary,
                  notes::SearchedOnT, notes::SharpenedFromSearch, notes::PlannedAtMargin,
                  notes::MinimumTimeRestart, notes::RestartEnded, notes::MinimumTimeUnsolved,
-                 notes::DescendedFromProbe, notes::PlanWithinBounds, notes::PointingTwist,
-                 notes::AccuracyReached>;
+                 notes::DescendedFromProbe, notes::ProbesStopped, notes::PlanWithinBounds,
+                 notes::PointingTwist, notes::AccuracyReached>;
 
 // The clauses that frame a message instead of following it: said before the reason they are
 // given (and around it), worded here as the notes are (renderFrame).

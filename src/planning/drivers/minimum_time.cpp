@@ -219,8 +219,9 @@ PlanResult fourthOrderMinimumTime(const PlanningProblem& problem, SolveContext& 
 /// the seeded bounded suite had requests where 0.99 T failed and 0.98 T converged, and the seed-45
 /// spinning suite's #77 (N = 215) a KKT point at 6.8175 s with minimum-effort plans failing at 0.99
 /// and 0.98 of it and converging at 6.3 s and 5.3 s (the issue's own evidence: plans at 0.90 T*).
-/// kMaxProbes bounds the time (each probe is one constrained minimum-effort solve and, where it
-/// finds a plan, one free-time solve).
+/// kMaxProbes bounds their number (each probe is one constrained minimum-effort solve and, where
+/// it finds a plan, one free-time solve), and the work allowance their time (ProbeBudget: a
+/// probe's solve at N = 400-800 can take thousands of iterations).
 constexpr double kProbeBelow = 0.01;
 constexpr int kLargestProbeExponent = 5;  ///< at most 32 δ = 32 % below T per probe
 constexpr double kFarProbes[] = {0.1, 0.2};
@@ -291,6 +292,18 @@ constexpr double kLadderShare = 0.5;
 double ladderBudget(const SolveContext::IterationTally& solve) {
   return kLadderShare * solve.iterations();
 }
+
+/// What the probes below T* may spend: the ladder's share of the minimum-time solve's
+/// iterations (`solve`, ladderBudget) and, for the whole phase (every probe, hand-on and chain),
+/// the request's search_work_allowance (AdvancedParameters) of work (`work`, opened where the
+/// probes begin).
+struct ProbeBudget {
+  ProbeBudget(const SolveContext& context, const SolveContext::IterationTally& minimum_time_solve)
+      : solve(minimum_time_solve),
+        work(context, context.request().advanced.search_work_allowance) {}
+  const SolveContext::IterationTally& solve;
+  SolveContext::WorkAllowance work;
+};
 
 /// Whether the far probes look below `answer` once the near ones found nothing: only where it is
 /// not shown a local minimum (a KKT point that is not second-order sufficient, or a probe's plan,
@@ -450,15 +463,16 @@ PlanResult atMostLowestIterate(PlanResult answer, const LowestIterate& iterates,
 /// (iterateAsPlan) and the free-time solve goes on from it. Every such iterate is offered to
 /// `iterates`. No probe goes below the proven bound T_c on the grid. The trail keeps every probe
 /// (the context's from `first`, where `answer`'s began). Where `solves_left` is given, each probe
-/// takes one of its solves and none is asked once it is spent. `solve`: the minimum-time solve's
-/// iterations (ladderBudget).
+/// takes one of its solves and none is asked once it is spent. `budget`: the ladder's share of the
+/// minimum-time solve's iterations (ladderBudget) and the probes' work allowance (none is asked
+/// once it is spent).
 PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::size_t first,
-                       SolveContext& context, const SolveContext::IterationTally& solve,
-                       LowestIterate& iterates, std::optional<IterateBelow> lower_plan,
-                       bool iterates_are_plans, int* solves_left = nullptr) {
+                       SolveContext& context, const ProbeBudget& budget, LowestIterate& iterates,
+                       std::optional<IterateBelow> lower_plan, bool iterates_are_plans,
+                       int* solves_left = nullptr) {
   const double floor = discreteDurationLowerBound(problem);  // 0: no bound
   ProbeSteps steps;
-  const double ladder_budget = ladderBudget(solve);
+  const double ladder_budget = ladderBudget(budget.solve);
   int ladder_spent = 0, last_probe = 0;
   int handed_on = 0;  // probes from such a plan: beside the descent's own, which they do not steer
   for (int probe = 0; probe < kMaxProbes && answer.converged(); ++probe) {
@@ -491,7 +505,10 @@ PlanResult probedBelow(const PlanningProblem& problem, PlanResult answer, std::s
       ++handed_on;
       --probe;
     }
-    if (effort.duration >= answer.minimum_duration || context.stopReason()) break;
+    if (effort.duration >= answer.minimum_duration || context.stopReason() ||
+        budget.work.exhausted()) {
+      break;
+    }
     const std::optional<std::size_t> answer_kept = context.keptAttempt();
     const std::size_t probe_first = context.attempts().size();
     const int probe_start = context.iterations();
@@ -541,13 +558,13 @@ constexpr int kOtherChainsSolves = 2 * kMaxProbes;
 /// solve from `from` one of them). Every iterate of the run is in `from`'s chain.
 PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& answer,
                              const LowestIterate::Plan& from, std::size_t first,
-                             SolveContext& context, const SolveContext::IterationTally& solve,
+                             SolveContext& context, const ProbeBudget& budget,
                              LowestIterate& iterates, int* solves_left) {
   if (solves_left) --*solves_left;
   std::optional<IterateBelow> lower_plan;
   PlanResult run = lowerAnswer(problem, from.effort, answer, from.plan, from.attempt, first,
                                context, &lower_plan, iterates, from.root);
-  return probedBelow(problem, std::move(run), first, context, solve, iterates,
+  return probedBelow(problem, std::move(run), first, context, budget, iterates,
                      std::move(lower_plan), true, solves_left);
 }
 
@@ -560,14 +577,13 @@ PlanResult probedFromIterate(const PlanningProblem& problem, const PlanResult& a
 PlanResult probedFromOtherChains(const PlanningProblem& problem, const PlanResult& answer,
                                  const std::vector<LowestIterate::Plan>& others, PlanResult best,
                                  std::size_t first, SolveContext& context,
-                                 const SolveContext::IterationTally& solve,
-                                 LowestIterate& iterates) {
+                                 const ProbeBudget& budget, LowestIterate& iterates) {
   std::optional<std::size_t> best_kept = context.keptAttempt();
   int solves_left = kOtherChainsSolves;
   for (const LowestIterate::Plan& from : others) {
-    if (solves_left <= 0 || context.stopReason()) break;
+    if (solves_left <= 0 || context.stopReason() || budget.work.exhausted()) break;
     PlanResult run =
-        probedFromIterate(problem, answer, from, first, context, solve, iterates, &solves_left);
+        probedFromIterate(problem, answer, from, first, context, budget, iterates, &solves_left);
     if (run.converged() && run.minimum_duration < best.minimum_duration) {
       best = std::move(run);
       best_kept = context.keptAttempt();
@@ -591,17 +607,18 @@ PlanResult probedFromOtherChains(const PlanningProblem& problem, const PlanResul
 /// held-out seed-47 suite from 25.19 s to 21.48 s.
 PlanResult probedBelowLowestIterate(const PlanningProblem& problem, PlanResult answer,
                                     std::size_t first, SolveContext& context,
-                                    const SolveContext::IterationTally& solve,
-                                    LowestIterate& iterates) {
+                                    const ProbeBudget& budget, LowestIterate& iterates) {
   const LowestIterate::Plan* found = iterates.below(answer.minimum_duration);
-  if (!found || !answer.converged() || context.stopReason()) return answer;
+  if (!found || !answer.converged() || context.stopReason() || budget.work.exhausted()) {
+    return answer;
+  }
   const LowestIterate::Plan lowest = *found;  // the solve from it offers lower ones
   const std::vector<LowestIterate::Plan> others =
       iterates.chainsBelow(answer.minimum_duration, lowest.root);
   PlanResult best =
-      probedFromIterate(problem, answer, lowest, first, context, solve, iterates, nullptr);
+      probedFromIterate(problem, answer, lowest, first, context, budget, iterates, nullptr);
   best = atMostLowestIterate(std::move(best), iterates, first, context);
-  best = probedFromOtherChains(problem, answer, others, std::move(best), first, context, solve,
+  best = probedFromOtherChains(problem, answer, others, std::move(best), first, context, budget,
                                iterates);
   return atMostLowestIterate(std::move(best), iterates, first, context);
 }
@@ -626,9 +643,12 @@ PlanResult minimumTimePlan(const PlanningProblem& problem, SolveContext& context
   LowestIterate iterates;
   PlanResult answer = structuredMinimumTime(problem, context, iterates);
   if (!answer.converged() || !hasSpinningEnds(problem)) return answer;
-  answer =
-      probedBelow(problem, std::move(answer), first, context, solve, iterates, std::nullopt, false);
-  return probedBelowLowestIterate(problem, std::move(answer), first, context, solve, iterates);
+  const ProbeBudget budget(context, solve);
+  answer = probedBelow(problem, std::move(answer), first, context, budget, iterates, std::nullopt,
+                       false);
+  answer = probedBelowLowestIterate(problem, std::move(answer), first, context, budget, iterates);
+  if (budget.work.stopped()) addNote(&answer, notes::ProbesStopped{budget.work.allowance()});
+  return answer;
 }
 
 /// One start twist of a pointing request (`posed`: R_N at the start twist): the fixed-attitude

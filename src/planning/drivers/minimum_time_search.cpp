@@ -65,8 +65,14 @@ struct SearchOutcome {
 /// solves warm-started from the last feasible plan, and a bisection of the best bracket.
 class MinimumTimeSearch {
  public:
-  MinimumTimeSearch(const PlanningProblem& problem, SolveContext& context)
-      : problem_(problem), context_(context), no_room_(noRoomBeforeTheEnd(problem)) {
+  /// `allowance`: the work the search may spend, shared with the search on a coarser grid that
+  /// starts it (searchFromCoarseGrid).
+  MinimumTimeSearch(const PlanningProblem& problem, SolveContext& context,
+                    const SolveContext::WorkAllowance& allowance)
+      : problem_(problem),
+        context_(context),
+        allowance_(allowance),
+        no_room_(noRoomBeforeTheEnd(problem)) {
     effort_ = problem;
     effort_.objective = Objective::MinimumEffort;
     effort_.time_margin = 0.0;
@@ -105,6 +111,7 @@ class MinimumTimeSearch {
     // No plan exists there on this grid (the last step into the final rate has no room under the
     // rate limit, proven): no solve.
     if (T >= no_room_.from && T <= no_room_.to) return false;
+    if (allowance_.exhausted()) return false;
     effort_.duration = T;
     const SolveContext::Scope scope(context_, AttemptStage::MinimumTimeProbe,
                                     homotopyClassOf(effort_));
@@ -132,7 +139,7 @@ class MinimumTimeSearch {
     return true;
   }
 
-  bool stopped() const { return stopped_.has_value(); }
+  bool stopped() const { return stopped_.has_value() || allowance_.exhausted(); }
 
   /// One search from one start: `from` (attitudes, any T) starts the first solve at T_first;
   /// null: the minimum-effort problem's own start (its unconstrained optimum). Each later solve
@@ -237,7 +244,7 @@ class MinimumTimeSearch {
     PlanningProblem coarse_problem = problem_;
     coarse_problem.steps = problem_.steps / 2;
     coarse_problem.time_margin = 0.0;
-    const PlanResult coarse = MinimumTimeSearch(coarse_problem, context_).run();
+    const PlanResult coarse = MinimumTimeSearch(coarse_problem, context_, allowance_).run();
     if (!coarse.converged()) return;
     Maneuver resampled = coarse.maneuver;
     resampled.attitude = resampleAttitudes(coarse.maneuver, problem_.steps);
@@ -320,6 +327,10 @@ class MinimumTimeSearch {
     if (stopped_) {
       none.termination = *stopped_;
       recordVerdict(&none, verdicts::SearchStopped{*stopped_, proven});
+    } else if (allowance_.stopped()) {
+      none.termination = Termination::NotConverged;
+      recordVerdict(&none, verdicts::SearchStopped{Termination::NotConverged, proven,
+                                                   allowance_.allowance()});
     } else if (std::isfinite(unrepresentable_from_)) {
       // Longer plans are not shown infeasible: this grid cannot hold them. Only where the grid
       // is too coarse at the proven least duration is the step count the cause.
@@ -381,7 +392,8 @@ class MinimumTimeSearch {
       }
     }
     note << " " << solves_ << " minimum-effort solves"
-         << (stopped_ ? ", stopped by " + terminationName(*stopped_) : std::string()) << ")";
+         << (stopped_ ? ", stopped by " + terminationName(*stopped_) : std::string())
+         << (allowance_.stopped() ? ", stopped at its work allowance" : "") << ")";
     if (coarse_minimum_duration_ > 0) {
       note << "; on the coarse grid T* = " << coarse_minimum_duration_ << " s";
     }
@@ -396,6 +408,7 @@ class MinimumTimeSearch {
 
   const PlanningProblem& problem_;
   SolveContext& context_;
+  const SolveContext::WorkAllowance& allowance_;
   PlanningProblem effort_;
   std::vector<SearchOutcome> outcomes_;
   std::optional<Termination> stopped_;
@@ -419,7 +432,9 @@ void answerFeasibleAt(double T, PlanResult* plan) {
 }
 
 PlanResult searchMinimumTime(const PlanningProblem& problem, SolveContext& context) {
-  return MinimumTimeSearch(problem, context).run();
+  const SolveContext::WorkAllowance allowance(context,
+                                              context.request().advanced.search_work_allowance);
+  return MinimumTimeSearch(problem, context, allowance).run();
 }
 
 PlanResult searchMinimumTime(const PlanningProblem& problem, const SolverOptions& options) {

@@ -23,8 +23,9 @@ void answerFeasibleAt(double T, PlanResult* plan);
 
 /// The plan at the least feasible T the search finds (minimum_duration = T*, minimum_time.kkt_point
 /// false), or why there is none (Infeasible: no duration up to 2^12 times the first guess; the
-/// stop's termination when cancelled or out of time). Its solves run in `context` with its
-/// options().
+/// stop's termination when cancelled or out of time; not converged where it stopped at its work
+/// allowance, AdvancedParameters::search_work_allowance, before a duration was found feasible). Its
+/// solves run in `context` with its options().
 PlanResult searchMinimumTime(const PlanningProblem& problem, SolveContext& context);
 /// The same as a request of its own (tests, studies).
 PlanResult searchMinimumTime(const PlanningProblem& problem, const SolverOptions& options);

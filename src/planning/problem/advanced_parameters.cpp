@@ -128,6 +128,8 @@ void forEachNewtonField(Newton& p, Visit& visit) {
 template <typename Advanced, typename Visit>
 void forEachField(Advanced& a, Visit&& visit) {
   forEachNewtonField(a.newton, visit);
+  const NamePrefix drivers{""};
+  visit(drivers + "search_work_allowance", a.search_work_allowance, kPositive);
   auto& p = a.interior_point;
   const NamePrefix ip{"interior_point."};
   forEachProfileField(ip.text + "fixed_step.", p.fixed_step, visit);

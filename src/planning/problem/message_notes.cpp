@@ -111,6 +111,10 @@ std::string foundBelow(double duration, double previous) {
 std::string words(const DescendedFromProbe& n) {
   return foundBelow(n.duration, n.previous) + ", and the free-time solve from it descended";
 }
+std::string words(const ProbesStopped& n) {
+  return "; the probes below T* stopped at their work allowance (" + exactNumber(n.work_allowance) +
+         " node-iterations): a lower T* may exist";
+}
 std::string words(const SearchedOnT& n) {
   return "; searched on T (" + n.why + ")";
 }
@@ -425,6 +429,13 @@ std::string provenWords(const verdicts::ProvenDurations& p) {
   return words.str();
 }
 std::string judged(const verdicts::SearchStopped& v, const std::string&) {
+  if (v.work_allowance > 0.0) {
+    return terminationName(v.stop) + ": the minimum-time search stopped at its work allowance (" +
+           exactNumber(v.work_allowance) +
+           " node-iterations) before any duration was found feasible; durations it did not try "
+           "are not judged" +
+           provenWords(v.proven);
+  }
   return terminationName(v.stop) + " before any duration was found feasible" +
          provenWords(v.proven);
 }

@@ -25,6 +25,7 @@ SolveContext::SolveContext(SolveContext& parent, Branch)
       call_(parent.call_),
       start_(parent.start_),
       shared_(parent.shared_),
+      work_before_(parent.work()),
       attempt_(parent.attempt_),
       scope_names_nested_(parent.scope_names_nested_) {
   cone_clearings_.pause();
@@ -35,6 +36,7 @@ void SolveContext::join(SolveContext& branch) {
   // below is in it already.
   if (!cone_clearings_.counting()) cone_clearings_.addCountedApart(branch.coneClearingIterations());
   iterations_ += branch.iterations_;
+  work_ += branch.work_;
   for (Attempt& a : branch.attempts_) {
     if (a.kept) {
       for (Attempt& b : attempts_) b.kept = false;
@@ -101,6 +103,7 @@ void SolveContext::poll() const {
 
 bool SolveContext::reportIteration(const IterationInfo& info) {
   ++iterations_;
+  work_ += std::max(info.steps, 1);
   const std::lock_guard<std::mutex> one_at_a_time(shared_->report);
   // A caller that refused hears nothing more: branches on other threads may still report until
   // they next poll.

@@ -111,6 +111,31 @@ class SolveContext : public Interruption {
     bool counting_ = true;
   };
 
+  /// The work an optional phase may spend (work(), counted from its construction): a phase that
+  /// searches for a better answer than the one in hand (the probes below a minimum time, the
+  /// search on durations) asks exhausted() between its solves and stops once it says so. So such
+  /// a phase ends after at most its allowance and the solve in progress, on any grid and
+  /// without a time budget, and at the same point on every run.
+  class WorkAllowance {
+   public:
+    WorkAllowance(const SolveContext& context, double node_iterations)
+        : context_(&context), at_open_(context.work()), allowance_(node_iterations) {}
+    /// Whether the work since it opened reached the allowance; once it said so, stopped() holds.
+    bool exhausted() const {
+      if (context_->work() - at_open_ >= allowance_) stopped_ = true;
+      return stopped_;
+    }
+    /// Whether exhausted() ever said so (a phase that stopped for it).
+    bool stopped() const { return stopped_; }
+    double allowance() const { return allowance_; }
+
+   private:
+    const SolveContext* context_;
+    double at_open_;
+    double allowance_;
+    mutable bool stopped_ = false;
+  };
+
   /// How a scope names the attempts begun inside it (the trail relabels them the same way).
   enum class Nested {
     /// Theirs, but an attempt of stage Solve (a solver's own solve) takes the scope's stage (a
@@ -169,6 +194,12 @@ class SolveContext : public Interruption {
   bool hasIterationCallback() const { return static_cast<bool>(request_.on_iteration); }
   /// Iterations reported so far.
   int iterations() const { return iterations_; }
+  /// Work reported so far: Σ over the iterations reported of the grid's N (IterationInfo::steps,
+  /// 1 where a report names none), in node-iterations. An iteration's cost grows with N (the
+  /// banded KKT system), so a bound on the work bounds the time on any grid; it is the same on
+  /// every run of a request (unlike seconds), so an answer bounded by it is reproducible. In a
+  /// branch: the parent's work when the branch began, and the branch's own.
+  double work() const { return work_before_ + work_; }
 
   /// Appends an attempt to the trail (in the order attempts end), named as the open scopes name
   /// an attempt begun inside them (Nested: a solver's `solve` takes the scope's stage, and any
@@ -307,7 +338,9 @@ class SolveContext : public Interruption {
   const SolverOptions* call_;
   Clock::time_point start_;
   std::shared_ptr<Shared> shared_;
-  int iterations_ = 0;  ///< reported from this context (a branch's own, for its tallies)
+  int iterations_ = 0;        ///< reported from this context (a branch's own, for its tallies)
+  double work_ = 0.0;         ///< node-iterations reported from this context (work())
+  double work_before_ = 0.0;  ///< a branch's parent's work() when the branch began
   AttemptTag attempt_;
   bool scope_names_nested_ = false;  ///< an open scope is Nested::ScopeStage
   std::vector<Attempt> attempts_;

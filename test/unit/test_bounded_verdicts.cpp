@@ -1209,9 +1209,10 @@ TEST(SolveContext, WorkCountsEachIterationAtItsGridsStepsAndBranchesJoinIt) {
 
 TEST(BoundedVerdicts, TheProbesBelowTStarStopAtTheirWorkAllowanceAndSaySo) {
   // The spinning study suite's request #12 (N = 124): with the default allowance its probes below
-  // T* run to their own end (more than two cold probes, BelowAStrictLocalMinimum... above); with
-  // an allowance of one node-iteration the first probe spends it, so it is the only one, and the
-  // answer is the minimum-time solve's own, saying that the probes stopped.
+  // T* run to their own end (more than one cold probe: the near probes and rungs of the ladder,
+  // BelowAStrictLocalMinimumTheProbesGoOnPastTwoFailuresWithinABudget); with an allowance of one
+  // node-iteration the first probe spends it, so it is the only one, and the answer says that the
+  // probes stopped.
   const std::optional<robustness::BoundedRequest> request = robustness::boundedRequest(45, 12);
   ASSERT_TRUE(request);
   const int N = request->problem.steps;
